@@ -1,0 +1,405 @@
+//! The sensorless estimator of Fig. 5: flux integration with disturbance feedback or limiter,
+//! the frequency-adaptive disturbance observer, the rotor-flux angle and the two T2S trackers.
+//!
+//! ```text
+//!  v*_ab ─┐     ┌────────────┐ λ1  ┌──────────┐ D̂   λ2 = λ1 − D̂   λ̂r = λ2 − L̂q·i   θm = ∠λ̂r
+//!  i_ab ──┴──▶ │ ∫(v − R̂s·i │────▶│   DOB    │───▶ ──────────────▶ ────────────────▶ ──┬──▶ T2S-1 ──▶ θ̂, ω̂1 ─┐
+//!              │    − fb)   │     │ (Fig. 2) │                                            └──▶ T2S-2 ──▶ ω̂ (control)
+//!              └─────▲──────┘     └────▲─────┘                                                              │
+//!                    │ fb = k_df·D̂ (|f̂| > 1.5 Hz, Fig. 3)  │ ω̂1 ◀──────────────────────────────────────────┘
+//!                    │   or k_af·(λ̂r − Π(λ̂r)) (below, Fig. 6)
+//! ```
+//!
+//! Order of operations at sample n (SPEC §1): integrate with the feedback from sample n−1,
+//! run the observer with ω̂ of T2S-1, form λ2, λ̂r and θm, update both trackers, then choose
+//! the mode from |ω̂| of T2S-2 and compute the feedback for sample n+1.
+
+use crate::error::{ConfigError, check};
+use crate::flux::{
+    DisturbanceFeedback, DisturbanceFeedbackConfig, FluxIntegrator, FluxIntegratorConfig,
+    FluxLimiter, FluxLimiterConfig,
+};
+use crate::mode::{Mode, ModeSelector, ModeSelectorConfig};
+use crate::observer::{DisturbanceObserver, DisturbanceObserverConfig};
+use crate::rotor_flux::{rotor_angle, rotor_flux, stator_flux};
+use crate::tracker::{BandwidthDefinition, TrackerConfig, TypeTwoTracker};
+use crate::{Ab, Real};
+
+/// Everything the estimator needs, flat so that it maps one-to-one onto TOML and Python
+/// keyword arguments. Defaults are the paper's (section V) or SPEC.md's, as each field says.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EstimatorConfig<T> {
+    /// Sampling period Ts in s. Default 100 µs (paper, V: 10 kHz).
+    pub ts: T,
+    /// Stator resistance estimate R̂s in Ω. Default 0.327 Ω (paper, V).
+    pub rs_hat: T,
+    /// q-axis inductance estimate L̂q in H. Default 2.63 mH (paper, V).
+    pub lq_hat: T,
+    /// Magnet flux linkage estimate λ̂f in Wb (peak, per phase). Sets the limiter radius, the
+    /// tracker hold level and the start-up flux only; the angle does not depend on it (eq. (6)).
+    /// Default 0.088 Wb (SPEC §6 [A]).
+    pub flux_linkage_hat: T,
+    /// Disturbance feedback gain k_df in s⁻¹ (Fig. 3). Default 0.5 (paper, V).
+    pub k_df: T,
+    /// Ramp time of k_df on activation in s, 0 = abrupt as in the paper. Default 0 (SPEC §1 [A]).
+    pub k_df_ramp_time: T,
+    /// Limiter gain k_af in s⁻¹ (Fig. 6). Default 2π·100 (paper, V).
+    pub k_af: T,
+    /// Limiter radius as a multiple of λ̂f. Default 1.15 (paper, V).
+    pub limiter_radius_ratio: T,
+    /// Speed threshold between limiter and k_df in Hz electrical. Default 1.5 Hz (paper, V).
+    pub mode_threshold_hz: T,
+    /// Hysteresis half-band of the threshold in Hz. Default 0.2 Hz (SPEC §1 [A]).
+    pub mode_hysteresis_hz: T,
+    /// Bandwidth of T2S-1 (angle, observer speed) in Hz. Default 60 Hz (paper, V).
+    pub t2s1_bandwidth_hz: T,
+    /// Bandwidth of T2S-2 (speed for control) in Hz. Default 35 Hz (paper, V).
+    pub t2s2_bandwidth_hz: T,
+    /// Damping ratio of both trackers. Default 1/√2 (SPEC §3 [A]).
+    pub tracker_damping: T,
+    /// Meaning of the tracker bandwidths. Default −3 dB (SPEC §3).
+    pub bandwidth_definition: BandwidthDefinition,
+    /// Trackers coast (no update) while |λ̂r| is below this fraction of λ̂f. Default 0.2
+    /// (SPEC §3 [A]).
+    pub tracker_hold_ratio: T,
+    /// Average the current over the interval for the resistive drop. Default true (SPEC §1 [A]).
+    pub average_current: bool,
+    /// Rotor angle assumed at reset (rad), e.g. from an alignment. Default 0 (SPEC §1 [A]).
+    pub initial_angle: T,
+}
+
+impl<T: Real> Default for EstimatorConfig<T> {
+    fn default() -> Self {
+        Self {
+            ts: T::lit(100e-6),
+            rs_hat: T::lit(0.327),
+            lq_hat: T::lit(2.63e-3),
+            flux_linkage_hat: T::lit(0.088),
+            k_df: T::lit(0.5),
+            k_df_ramp_time: T::zero(),
+            k_af: T::lit(2.0 * core::f64::consts::PI * 100.0),
+            limiter_radius_ratio: T::lit(1.15),
+            mode_threshold_hz: T::lit(1.5),
+            mode_hysteresis_hz: T::lit(0.2),
+            t2s1_bandwidth_hz: T::lit(60.0),
+            t2s2_bandwidth_hz: T::lit(35.0),
+            tracker_damping: T::lit(core::f64::consts::FRAC_1_SQRT_2),
+            bandwidth_definition: BandwidthDefinition::Minus3Db,
+            tracker_hold_ratio: T::lit(0.2),
+            average_current: true,
+            initial_angle: T::zero(),
+        }
+    }
+}
+
+impl<T: Real> EstimatorConfig<T> {
+    /// Checks every field; the error names the first bad one.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        SensorlessEstimator::new(*self).map(|_| ())
+    }
+
+    fn tracker(&self, bandwidth_hz: T) -> TrackerConfig<T> {
+        TrackerConfig {
+            ts: self.ts,
+            bandwidth_hz,
+            damping: self.tracker_damping,
+            definition: self.bandwidth_definition,
+        }
+    }
+}
+
+/// Internal signals of one sample, named as in the paper's figures.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Diagnostics<T> {
+    /// λ1: the integrated stator flux (eq. (7), (21)).
+    pub lambda1: Ab<T>,
+    /// D̂: the estimated disturbance (eq. (10)).
+    pub disturbance: Ab<T>,
+    /// λ2 = λ1 − D̂ (eq. (20)).
+    pub lambda2: Ab<T>,
+    /// λ̂r = λ2 − L̂q·i (eq. (5)).
+    pub lambda_r: Ab<T>,
+    /// θm = ∠λ̂r, the directly calculated angle of eq. (6) (before the T2S).
+    pub theta_direct: T,
+    /// Which flux feedback is active.
+    pub mode: Mode,
+    /// FLAG_limit of Fig. 10: the limiter mode is active.
+    pub flag_limit: bool,
+    /// The limiter is pulling λ̂r back to its circle this sample.
+    pub limiter_clamping: bool,
+    /// The trackers coasted because |λ̂r| was too small.
+    pub tracker_hold: bool,
+    /// This sample's inputs were non-finite and were rejected; the state is unchanged and the
+    /// other fields repeat the last good sample.
+    pub input_fault: bool,
+}
+
+/// The estimator's outputs for one sample.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Estimate<T> {
+    /// θ̂: estimated rotor angle (rad, electrical, in [−π, π]) from T2S-1.
+    pub theta: T,
+    /// ω̂ of T2S-1 (rad/s, electrical): the speed fed back to the observer.
+    pub omega: T,
+    /// ω̂ of T2S-2 (rad/s, electrical): the smoother speed for speed and current control.
+    pub omega_control: T,
+    /// Internal signals.
+    pub diagnostics: Diagnostics<T>,
+}
+
+/// The sensorless estimator of Fig. 5, generic over `f32` and `f64`, allocation-free.
+///
+/// ```
+/// use fado_core::{Ab, EstimatorConfig, SensorlessEstimator};
+/// let mut est = SensorlessEstimator::<f32>::new(EstimatorConfig::default()).unwrap();
+/// // In the 10 kHz ISR: the voltage applied over the last interval and the sampled currents.
+/// let out = est.step(Ab::new(1.2, -0.3), Ab::new(4.0, 0.1));
+/// assert!(!out.diagnostics.input_fault);
+/// let _angle = out.theta;
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SensorlessEstimator<T> {
+    config: EstimatorConfig<T>,
+    integrator: FluxIntegrator<T>,
+    observer: DisturbanceObserver<T>,
+    disturbance_feedback: DisturbanceFeedback<T>,
+    limiter: FluxLimiter<T>,
+    selector: ModeSelector<T>,
+    t2s1: TypeTwoTracker<T>,
+    t2s2: TypeTwoTracker<T>,
+    /// Feedback term computed at the end of the previous sample.
+    feedback: Ab<T>,
+    hold_level_sq: T,
+    k_df_enabled: bool,
+    last: Estimate<T>,
+    rejected_samples: u32,
+}
+
+impl<T: Real> SensorlessEstimator<T> {
+    /// Builds the estimator; every field of `config` is checked and a bad one is named.
+    pub fn new(config: EstimatorConfig<T>) -> Result<Self, ConfigError> {
+        let ts = check::positive("ts", config.ts)?;
+        check::non_negative("lq_hat", config.lq_hat)?;
+        let lf = check::positive("flux_linkage_hat", config.flux_linkage_hat)?;
+        let ratio = check::positive("limiter_radius_ratio", config.limiter_radius_ratio)?;
+        let hold = check::non_negative("tracker_hold_ratio", config.tracker_hold_ratio)?;
+        check::below("tracker_hold_ratio", hold, T::one(), "below 1")?;
+        check::finite("initial_angle", config.initial_angle)?;
+        let rename = |field: &'static str| {
+            move |e: ConfigError| match e {
+                ConfigError::OutOfRange { expected, .. } => {
+                    ConfigError::OutOfRange { field, expected }
+                }
+                ConfigError::NotFinite { .. } => ConfigError::NotFinite { field },
+                ConfigError::NotPositive { .. } => ConfigError::NotPositive { field },
+                ConfigError::Negative { .. } => ConfigError::Negative { field },
+            }
+        };
+        let integrator = FluxIntegrator::new(FluxIntegratorConfig {
+            ts,
+            rs_hat: config.rs_hat,
+            average_current: config.average_current,
+        })?;
+        let observer = DisturbanceObserver::new(DisturbanceObserverConfig { ts })?;
+        let disturbance_feedback = DisturbanceFeedback::new(DisturbanceFeedbackConfig {
+            ts,
+            k_df: config.k_df,
+            ramp_time: config.k_df_ramp_time,
+        })
+        .map_err(|e| match e.field() {
+            "ramp_time" => rename("k_df_ramp_time")(e),
+            _ => e,
+        })?;
+        let limiter = FluxLimiter::new(FluxLimiterConfig {
+            k_af: config.k_af,
+            radius: ratio * lf,
+        })?;
+        let selector = ModeSelector::new(ModeSelectorConfig {
+            threshold_hz: config.mode_threshold_hz,
+            hysteresis_hz: config.mode_hysteresis_hz,
+        })
+        .map_err(|e| match e.field() {
+            "threshold_hz" => rename("mode_threshold_hz")(e),
+            _ => rename("mode_hysteresis_hz")(e),
+        })?;
+        check::positive("tracker_damping", config.tracker_damping)?;
+        let t2s1 = TypeTwoTracker::new(config.tracker(config.t2s1_bandwidth_hz))
+            .map_err(rename("t2s1_bandwidth_hz"))?;
+        let t2s2 = TypeTwoTracker::new(config.tracker(config.t2s2_bandwidth_hz))
+            .map_err(rename("t2s2_bandwidth_hz"))?;
+        let hold_level = hold * lf;
+        let mut est = Self {
+            config,
+            integrator,
+            observer,
+            disturbance_feedback,
+            limiter,
+            selector,
+            t2s1,
+            t2s2,
+            feedback: Ab::zero(),
+            hold_level_sq: hold_level * hold_level,
+            k_df_enabled: true,
+            last: Estimate::default(),
+            rejected_samples: 0,
+        };
+        est.reset();
+        Ok(est)
+    }
+
+    /// Back to the start-up state at `config.initial_angle` with zero current.
+    pub fn reset(&mut self) {
+        self.align(self.config.initial_angle, Ab::zero());
+    }
+
+    /// Start-up at a known rotor angle θ0 with the present current (SPEC §1 step 6):
+    /// λ1 = λ̂f·e^{jθ0} + L̂q·i, D̂ = 0, θ̂ = θ0, ω̂ = 0, limiter mode.
+    pub fn align(&mut self, theta0: T, i_ab: Ab<T>) {
+        let theta0 = if theta0.is_finite() {
+            theta0
+        } else {
+            T::zero()
+        };
+        let i_ab = if i_ab.is_finite() { i_ab } else { Ab::zero() };
+        let lambda_r = Ab::from_polar(self.config.flux_linkage_hat, theta0);
+        let lambda1 = lambda_r + i_ab * self.config.lq_hat;
+        self.integrator.reset_to(lambda1);
+        self.observer.reset_to(lambda1);
+        self.disturbance_feedback.reset();
+        self.selector.reset();
+        self.t2s1.reset_to(theta0, T::zero());
+        self.t2s2.reset_to(theta0, T::zero());
+        self.feedback = Ab::zero();
+        self.rejected_samples = 0;
+        self.last = Estimate {
+            theta: self.t2s1.angle(),
+            omega: T::zero(),
+            omega_control: T::zero(),
+            diagnostics: Diagnostics {
+                lambda1,
+                disturbance: Ab::zero(),
+                lambda2: lambda1,
+                lambda_r,
+                theta_direct: self.t2s1.angle(),
+                mode: Mode::Limiter,
+                flag_limit: true,
+                limiter_clamping: false,
+                tracker_hold: false,
+                input_fault: false,
+            },
+        };
+    }
+
+    /// One 10 kHz sample (Fig. 5).
+    ///
+    /// `v_ab` is the voltage reference that was applied over the last sampling interval (with
+    /// a one-sample computational delay, the one computed two samples ago, before dead-time
+    /// compensation); `i_ab` the currents sampled now. A non-finite input is rejected: the state
+    /// is untouched and the previous estimate is returned with `input_fault` set.
+    #[inline]
+    pub fn step(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> Estimate<T> {
+        if !(v_ab.is_finite() && i_ab.is_finite()) {
+            return self.reject();
+        }
+        let backup = *self;
+        match self.step_unchecked(v_ab, i_ab) {
+            Some(out) => {
+                self.last = out;
+                out
+            }
+            None => {
+                // Finite but absurd inputs overflowed a state: roll back, never poison.
+                *self = backup;
+                self.reject()
+            }
+        }
+    }
+
+    fn reject(&mut self) -> Estimate<T> {
+        self.rejected_samples = self.rejected_samples.saturating_add(1);
+        let mut out = self.last;
+        out.diagnostics.input_fault = true;
+        out
+    }
+
+    #[inline]
+    fn step_unchecked(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> Option<Estimate<T>> {
+        // 1. Integrate with the feedback of the previous sample (eq. (21) / (24)).
+        let lambda1 = self.integrator.step(v_ab, i_ab, self.feedback).ok()?;
+        // 2. Disturbance observer at ω̂ of T2S-1 (eq. (10), (16)).
+        let disturbance = self.observer.step(lambda1, self.t2s1.speed()).ok()?;
+        // 3. Rotor flux and direct angle (eq. (20), (5), (6)).
+        let lambda2 = stator_flux(lambda1, disturbance);
+        let lambda_r = rotor_flux(lambda2, i_ab, self.config.lq_hat);
+        let tracker_hold = lambda_r.norm_squared() < self.hold_level_sq;
+        let theta_direct = rotor_angle(lambda_r);
+        // 4. Trackers (Fig. 1, Fig. 5).
+        let (theta, omega, omega_control) = if tracker_hold {
+            let (th, w) = self.t2s1.coast();
+            (th, w, self.t2s2.coast().1)
+        } else {
+            let (th, w) = self.t2s1.step(theta_direct).ok()?;
+            (th, w, self.t2s2.step(theta_direct).ok()?.1)
+        };
+        // 5. Mode from the control speed, and the feedback for the next sample.
+        let mode = self.selector.step(omega_control);
+        let kdf_active = mode == Mode::DisturbanceFeedback && self.k_df_enabled;
+        let kdf_fb = self.disturbance_feedback.step(kdf_active, disturbance);
+        let (feedback, clamping) = match mode {
+            Mode::DisturbanceFeedback => (kdf_fb, false),
+            Mode::Limiter => {
+                let l = self.limiter.step(lambda_r);
+                (l.feedback, l.clamping)
+            }
+        };
+        if !(feedback.is_finite() && disturbance.is_finite() && lambda1.is_finite()) {
+            return None;
+        }
+        self.feedback = feedback;
+        Some(Estimate {
+            theta,
+            omega,
+            omega_control,
+            diagnostics: Diagnostics {
+                lambda1,
+                disturbance,
+                lambda2,
+                lambda_r,
+                theta_direct,
+                mode,
+                flag_limit: mode == Mode::Limiter,
+                limiter_clamping: clamping,
+                tracker_hold,
+                input_fault: false,
+            },
+        })
+    }
+
+    /// The last good estimate.
+    pub fn last(&self) -> &Estimate<T> {
+        &self.last
+    }
+
+    /// Number of samples rejected since the last reset.
+    pub fn rejected_samples(&self) -> u32 {
+        self.rejected_samples
+    }
+
+    /// Enables or disables the k_df feedback at run time regardless of speed (the experiment
+    /// of Fig. 9 switches it off on purpose). Enabled after `new`.
+    pub fn set_disturbance_feedback_enabled(&mut self, enabled: bool) {
+        self.k_df_enabled = enabled;
+    }
+
+    /// Replaces R̂s at run time (for online resistance adaptation). Refuses bad values.
+    pub fn set_rs_hat(&mut self, rs_hat: T) -> Result<(), ConfigError> {
+        self.integrator.set_rs_hat(rs_hat)?;
+        self.config.rs_hat = rs_hat;
+        Ok(())
+    }
+
+    /// The configuration in use.
+    pub fn config(&self) -> &EstimatorConfig<T> {
+        &self.config
+    }
+}

@@ -1,0 +1,345 @@
+//! Stator-flux integration with its two feedbacks: the disturbance feedback k_df (Fig. 3,
+//! eq. (21)-(22)) above the speed threshold and the flux limiter k_af (Fig. 6, eq. (24)-(25))
+//! below it.
+//!
+//! Both feedbacks act on the *same* integrator state λ1 (SPEC §1 step 5): a hand-over only
+//! changes the integrand, so λ̂r changes slope but never jumps, and neither does the angle.
+
+use crate::error::{ConfigError, NonFiniteInput, check};
+use crate::{Ab, Real};
+
+/// Configuration of a [`FluxIntegrator`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FluxIntegratorConfig<T> {
+    /// Sampling period Ts in s. Default 100 µs (paper, section V).
+    pub ts: T,
+    /// Stator resistance estimate R̂s in Ω. Default 0.327 Ω (paper, section V).
+    pub rs_hat: T,
+    /// Use (i[n] + i[n−1])/2 for the resistive drop, which matches the interval the applied
+    /// voltage acted over (SPEC §1, [A]). Default `true`.
+    pub average_current: bool,
+}
+
+impl<T: Real> Default for FluxIntegratorConfig<T> {
+    fn default() -> Self {
+        Self {
+            ts: T::lit(100e-6),
+            rs_hat: T::lit(0.327),
+            average_current: true,
+        }
+    }
+}
+
+/// The voltage-model integrator λ1 ← λ1 + Ts·(v* − R̂s·i − fb) (eq. (3), (21), (24)),
+/// forward rectangle: v* is the voltage that acted over the *last* interval.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FluxIntegrator<T> {
+    config: FluxIntegratorConfig<T>,
+    lambda1: Ab<T>,
+    i_prev: Ab<T>,
+    has_prev: bool,
+}
+
+impl<T: Real> FluxIntegrator<T> {
+    /// A new integrator at λ1 = 0.
+    pub fn new(config: FluxIntegratorConfig<T>) -> Result<Self, ConfigError> {
+        check::positive("ts", config.ts)?;
+        check::non_negative("rs_hat", config.rs_hat)?;
+        Ok(Self {
+            config,
+            lambda1: Ab::zero(),
+            i_prev: Ab::zero(),
+            has_prev: false,
+        })
+    }
+
+    /// λ1 = 0, no remembered current.
+    pub fn reset(&mut self) {
+        self.reset_to(Ab::zero());
+    }
+
+    /// Starts from a known flux λ1 (SPEC §1 step 6: λf·e^{jθ0} + L̂q·i).
+    pub fn reset_to(&mut self, lambda1: Ab<T>) {
+        self.lambda1 = lambda1;
+        self.i_prev = Ab::zero();
+        self.has_prev = false;
+    }
+
+    /// One sample: `v_ab` applied over the last interval, `i_ab` sampled now, `feedback` the
+    /// k_df·D̂ or k_af·(λ̂r − λ̂r_lim) term (V). Returns λ1[n].
+    #[inline]
+    pub fn step(
+        &mut self,
+        v_ab: Ab<T>,
+        i_ab: Ab<T>,
+        feedback: Ab<T>,
+    ) -> Result<Ab<T>, NonFiniteInput> {
+        if !(v_ab.is_finite() && i_ab.is_finite() && feedback.is_finite()) {
+            return Err(NonFiniteInput);
+        }
+        let i_drop = if self.config.average_current && self.has_prev {
+            (i_ab + self.i_prev) * T::lit(0.5)
+        } else {
+            i_ab
+        };
+        self.i_prev = i_ab;
+        self.has_prev = true;
+        self.lambda1 += (v_ab - i_drop * self.config.rs_hat - feedback) * self.config.ts;
+        Ok(self.lambda1)
+    }
+
+    /// λ1, the integrated stator flux.
+    #[inline]
+    pub fn flux(&self) -> Ab<T> {
+        self.lambda1
+    }
+
+    /// The configuration in use.
+    pub fn config(&self) -> &FluxIntegratorConfig<T> {
+        &self.config
+    }
+
+    /// Replaces R̂s (for online resistance adaptation). Refuses non-finite or negative values.
+    pub fn set_rs_hat(&mut self, rs_hat: T) -> Result<(), ConfigError> {
+        self.config.rs_hat = check::non_negative("rs_hat", rs_hat)?;
+        Ok(())
+    }
+}
+
+/// Configuration of a [`DisturbanceFeedback`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DisturbanceFeedbackConfig<T> {
+    /// Sampling period Ts in s. Default 100 µs (paper, section V).
+    pub ts: T,
+    /// Disturbance feedback gain k_df in s⁻¹ (Fig. 3, eq. (21)). Default 0.5 (paper, V).
+    pub k_df: T,
+    /// Time to ramp k_df from 0 to its value on activation, s; 0 switches it abruptly as the
+    /// paper does. A ramp softens the re-activation distortion of Fig. 9 (SPEC §1 [A]).
+    /// Default 0.
+    pub ramp_time: T,
+}
+
+impl<T: Real> Default for DisturbanceFeedbackConfig<T> {
+    fn default() -> Self {
+        Self {
+            ts: T::lit(100e-6),
+            k_df: T::lit(0.5),
+            ramp_time: T::zero(),
+        }
+    }
+}
+
+/// The k_df·D̂ feedback of Fig. 3 with an optional activation ramp.
+///
+/// With it the flux loop is λ1 = u / (s + k_df·G(s)), G = D̂/λ1 (eq. (22)): stable for all
+/// ±ω, a DC gain 1/k_df instead of an integrator's infinite one (bounded drift), and an
+/// exact integrator at ω (SPEC §2).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DisturbanceFeedback<T> {
+    k_df: T,
+    ramp_increment: T,
+    gain: T,
+}
+
+impl<T: Real> DisturbanceFeedback<T> {
+    /// A new feedback, inactive.
+    pub fn new(config: DisturbanceFeedbackConfig<T>) -> Result<Self, ConfigError> {
+        let ts = check::positive("ts", config.ts)?;
+        let k_df = check::non_negative("k_df", config.k_df)?;
+        let ramp = check::non_negative("ramp_time", config.ramp_time)?;
+        let ramp_increment = if ramp > T::zero() {
+            k_df * ts / ramp
+        } else {
+            k_df
+        };
+        Ok(Self {
+            k_df,
+            ramp_increment,
+            gain: T::zero(),
+        })
+    }
+
+    /// Back to inactive (gain 0).
+    pub fn reset(&mut self) {
+        self.gain = T::zero();
+    }
+
+    /// One sample: returns k_df·D̂ when `active`, 0 otherwise (the gain ramps on activation).
+    #[inline]
+    pub fn step(&mut self, active: bool, disturbance: Ab<T>) -> Ab<T> {
+        self.gain = if active {
+            (self.gain + self.ramp_increment).min(self.k_df)
+        } else {
+            T::zero()
+        };
+        disturbance * self.gain
+    }
+
+    /// The gain in effect after the last step.
+    pub fn gain(&self) -> T {
+        self.gain
+    }
+}
+
+/// Configuration of a [`FluxLimiter`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FluxLimiterConfig<T> {
+    /// Convergence gain k_af in s⁻¹ (Fig. 6, eq. (24)-(25)). Default 2π·100 (paper, V).
+    pub k_af: T,
+    /// Radius ρ of the limiting circle in Wb. Default 1.15·0.088 = 0.1012 Wb (paper, V:
+    /// 1.15 times the flux linkage; λf = 0.088 Wb is SPEC §6 [A]).
+    pub radius: T,
+}
+
+impl<T: Real> Default for FluxLimiterConfig<T> {
+    fn default() -> Self {
+        Self {
+            k_af: T::lit(2.0 * core::f64::consts::PI * 100.0),
+            radius: T::lit(1.15 * 0.088),
+        }
+    }
+}
+
+/// Output of the flux limiter for one sample.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LimiterOutput<T> {
+    /// The feedback k_af·(λ̂r − Π(λ̂r)) to subtract from the integrand (V).
+    pub feedback: Ab<T>,
+    /// True when |λ̂r| exceeded the radius, i.e. the limiter pulled the flux back.
+    pub clamping: bool,
+}
+
+/// The flux limiter of Fig. 6 (eq. (24)-(25)).
+///
+/// Π(x) = x·min(1, ρ/|x|) is the radial projection onto the disc of radius ρ (SPEC §1 [A]):
+/// inside the circle the integrator is pure, outside the excess is pulled back radially with
+/// time constant 1/k_af (1.6 ms by default), and the angle is never constrained.
+/// Stateless apart from its configuration; `step` and `reset` exist for uniformity.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FluxLimiter<T> {
+    config: FluxLimiterConfig<T>,
+}
+
+impl<T: Real> FluxLimiter<T> {
+    /// A new limiter.
+    pub fn new(config: FluxLimiterConfig<T>) -> Result<Self, ConfigError> {
+        check::non_negative("k_af", config.k_af)?;
+        check::positive("radius", config.radius)?;
+        Ok(Self { config })
+    }
+
+    /// No state to clear.
+    pub fn reset(&mut self) {}
+
+    /// Π(λ̂r), the limited rotor flux λ̂r_lim of Fig. 6.
+    #[inline]
+    pub fn project(&self, lambda_r: Ab<T>) -> Ab<T> {
+        let n2 = lambda_r.norm_squared();
+        let rho = self.config.radius;
+        if n2 > rho * rho {
+            lambda_r * (rho / n2.sqrt())
+        } else {
+            lambda_r
+        }
+    }
+
+    /// The feedback for the next integration step.
+    #[inline]
+    pub fn step(&self, lambda_r: Ab<T>) -> LimiterOutput<T> {
+        let n2 = lambda_r.norm_squared();
+        let rho = self.config.radius;
+        if n2 > rho * rho {
+            let n = n2.sqrt();
+            LimiterOutput {
+                feedback: lambda_r * (self.config.k_af * (n - rho) / n),
+                clamping: true,
+            }
+        } else {
+            LimiterOutput {
+                feedback: Ab::zero(),
+                clamping: false,
+            }
+        }
+    }
+
+    /// The configuration in use.
+    pub fn config(&self) -> &FluxLimiterConfig<T> {
+        &self.config
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn integrator_integrates_and_averages_current() {
+        let mut int = FluxIntegrator::new(FluxIntegratorConfig {
+            ts: 1e-4_f64,
+            rs_hat: 1.0,
+            average_current: true,
+        })
+        .unwrap();
+        int.step(Ab::new(1.0, 0.0), Ab::new(0.0, 0.0), Ab::zero())
+            .unwrap();
+        let l = int
+            .step(Ab::new(1.0, 0.0), Ab::new(0.5, 0.0), Ab::zero())
+            .unwrap();
+        // 1e-4·1 + 1e-4·(1 − 0.25)
+        assert!((l.alpha - 1.75e-4).abs() < 1e-15);
+    }
+
+    #[test]
+    fn feedback_ramps_and_switches_off() {
+        let mut fb = DisturbanceFeedback::new(DisturbanceFeedbackConfig {
+            ts: 1e-4_f64,
+            k_df: 0.5,
+            ramp_time: 0.1,
+        })
+        .unwrap();
+        for _ in 0..500 {
+            fb.step(true, Ab::new(1.0, 0.0));
+        }
+        assert!((fb.gain() - 0.25).abs() < 1e-9);
+        for _ in 0..1000 {
+            fb.step(true, Ab::new(1.0, 0.0));
+        }
+        assert_eq!(fb.gain(), 0.5);
+        assert_eq!(fb.step(false, Ab::new(1.0, 0.0)), Ab::zero());
+    }
+
+    #[test]
+    fn limiter_projects_radially() {
+        let lim = FluxLimiter::new(FluxLimiterConfig {
+            k_af: 100.0_f64,
+            radius: 0.1,
+        })
+        .unwrap();
+        let x = Ab::new(0.3, 0.4);
+        let p = lim.project(x);
+        assert!((p.norm() - 0.1).abs() < 1e-15);
+        assert!((p.angle() - x.angle()).abs() < 1e-15);
+        let out = lim.step(x);
+        assert!(out.clamping);
+        assert!((out.feedback.norm() - 100.0 * 0.4).abs() < 1e-12);
+        assert_eq!(lim.project(Ab::new(0.05, 0.0)), Ab::new(0.05, 0.0));
+        assert!(!lim.step(Ab::new(0.05, 0.0)).clamping);
+    }
+
+    #[test]
+    fn bad_config_names_field() {
+        let e = FluxLimiter::new(FluxLimiterConfig {
+            k_af: 1.0,
+            radius: 0.0,
+        })
+        .unwrap_err();
+        assert_eq!(e.field(), "radius");
+        let e = FluxIntegrator::new(FluxIntegratorConfig {
+            ts: 1e-4_f64,
+            rs_hat: f64::NAN,
+            average_current: true,
+        })
+        .unwrap_err();
+        assert_eq!(e.field(), "rs_hat");
+    }
+}

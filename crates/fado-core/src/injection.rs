@@ -1,0 +1,72 @@
+//! d-axis current injection at light load, paper eq. (23).
+//!
+//! A positive i_d keeps the stator current above I_min so that the flux variation stays
+//! observable, and steers the integrand errors at standstill towards the positive d-axis where
+//! the rotor flux lies (paper, section V, Fig. 10 discussion).
+
+use crate::Real;
+use crate::error::{ConfigError, check};
+
+/// Configuration of [`CurrentInjection`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CurrentInjectionConfig<T> {
+    /// Minimum current magnitude I_min in A. Default 4 A (paper, section V).
+    pub i_min: T,
+}
+
+impl<T: Real> Default for CurrentInjectionConfig<T> {
+    fn default() -> Self {
+        Self { i_min: T::lit(4.0) }
+    }
+}
+
+/// The rule of eq. (23): i_d* = √(I_min² − i_q*²) when |i_q*| < I_min, else 0, so that the
+/// d-q reference vector has magnitude at least I_min (SPEC §4).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CurrentInjection<T> {
+    i_min: T,
+}
+
+impl<T: Real> CurrentInjection<T> {
+    /// A new rule.
+    pub fn new(config: CurrentInjectionConfig<T>) -> Result<Self, ConfigError> {
+        Ok(Self {
+            i_min: check::non_negative("i_min", config.i_min)?,
+        })
+    }
+
+    /// Stateless; exists for uniformity.
+    pub fn reset(&mut self) {}
+
+    /// i_d* for a q-axis reference `iq_ref` (A). A non-finite `iq_ref` gives 0.
+    #[inline]
+    pub fn step(&self, iq_ref: T) -> T {
+        let rest = self.i_min * self.i_min - iq_ref * iq_ref;
+        if rest > T::zero() {
+            rest.sqrt()
+        } else {
+            T::zero()
+        }
+    }
+
+    /// I_min in use.
+    pub fn i_min(&self) -> T {
+        self.i_min
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn eq_23() {
+        let inj = CurrentInjection::new(CurrentInjectionConfig { i_min: 4.0_f64 }).unwrap();
+        assert_eq!(inj.step(0.0), 4.0);
+        assert!((inj.step(-2.4) - 3.2).abs() < 1e-12);
+        assert_eq!(inj.step(4.0), 0.0);
+        assert_eq!(inj.step(-7.5), 0.0);
+        assert_eq!(inj.step(f64::NAN), 0.0);
+        assert!(CurrentInjection::new(CurrentInjectionConfig { i_min: -1.0 }).is_err());
+    }
+}

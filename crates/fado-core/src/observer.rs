@@ -1,0 +1,333 @@
+//! The frequency-adaptive disturbance observer: paper eq. (7)-(10) with the gains (16), Fig. 2.
+//!
+//! # Model and gains
+//! The initially estimated stator flux is a vector rotating at ω_f plus a slowly varying
+//! disturbance, λ1 = λm·e^{jθf} + D (eq. (7)). In complex form (SPEC §2, with z = λ̂1,
+//! d = D̂, y = λ1, e = y − z) the observer (10) with the gains (16)
+//! (p1 = p4 = 2|ω|, p2 = −p3 = −ω, q1 = q4 = 0, q2 = −q3 = −ω) reads
+//!
+//! ```text
+//! dz/dt = jω(z − d) + (2|ω| + jω)·e,    dd/dt = jω·e
+//! ```
+//!
+//! whose characteristic polynomial is (s + |ω|)⁴ for either sign of ω, with
+//! d/y = ω(ω + js)/(s + |ω|)²: unity at DC, a notch at s = jω (eq. (17)-(19)).
+//!
+//! # Discretisation (why this one)
+//! Forward Euler leaks 1.6 % of the rotating flux through the notch at 100 Hz and goes
+//! unstable for |ω|·Ts > 2; Tustin and ZOH move the notch off ω. We instead discretise the
+//! *internal model* exactly — between samples z − d rotates by a = e^{jωTs} — and place the
+//! observer's double complex pole at r = e^{−|ω|Ts}, the exact image of −|ω|:
+//!
+//! ```text
+//! z⁺ = a·z + (1 − a)·d + ℓ1·e,   ℓ1 = 1 + a − 2r
+//! d⁺ = d + ℓ2·e,                 ℓ2 = (1 − r)² / (1 − a)
+//! ```
+//!
+//! so the four real poles sit at r for every ω (tested up to |ω|·Ts = 3), the map is
+//! symmetric in the sign of ω, the notch is exactly at e^{jωTs}, and all gains vanish at
+//! ω = 0 so the observer freezes at standstill (paper, Fig. 2 discussion). The gains are
+//! evaluated through the half angle, 1 − a = −2j·sin(x/2)·e^{jx/2} with x = ωTs, which stays
+//! accurate in `f32` at the smallest speeds (ℓ2 → jωTs as ωTs → 0).
+
+use crate::error::{ConfigError, NonFiniteInput, check};
+use crate::{Ab, Real};
+
+/// Configuration of a [`DisturbanceObserver`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DisturbanceObserverConfig<T> {
+    /// Sampling period Ts in s. Default 100 µs (paper, section V: 10 kHz sampling).
+    pub ts: T,
+}
+
+impl<T: Real> Default for DisturbanceObserverConfig<T> {
+    fn default() -> Self {
+        Self { ts: T::lit(100e-6) }
+    }
+}
+
+/// The discrete observer gains for one value of ω·Ts (see the module docs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DiscreteGains<T> {
+    /// a = e^{jωTs}: rotation of the internal model over one sample.
+    pub a: Ab<T>,
+    /// 1 − a, computed through the half angle.
+    pub one_minus_a: Ab<T>,
+    /// ℓ1 = 1 + a − 2r.
+    pub l1: Ab<T>,
+    /// ℓ2 = (1 − r)² / (1 − a).
+    pub l2: Ab<T>,
+    /// r = e^{−|ω|Ts}: the (quadruple) observer pole.
+    pub r: T,
+}
+
+impl<T: Real> DiscreteGains<T> {
+    /// Gains for the flux speed `omega` (rad/s, signed) and sampling period `ts`.
+    #[inline]
+    pub fn new(omega: T, ts: T) -> Self {
+        let x = omega * ts;
+        let half = T::lit(0.5);
+        let two = T::lit(2.0);
+        let (sh, ch) = (x * half).sin_cos();
+        let one_minus_r = -(-x.abs()).exp_m1();
+        let a = Ab::new(ch * ch - sh * sh, two * sh * ch);
+        let one_minus_a = Ab::new(two * sh * sh, -two * sh * ch);
+        let l1 = Ab::new(two * one_minus_r - one_minus_a.alpha, -one_minus_a.beta);
+        // (1 − r)²/(1 − a) = (1 − r)²·(sh + j·ch)/(2·sh); exactly zero at ω = 0.
+        let m = one_minus_r * one_minus_r * half;
+        let l2 = if sh == T::zero() {
+            Ab::zero()
+        } else {
+            Ab::new(m, m * ch / sh)
+        };
+        Self {
+            a,
+            one_minus_a,
+            l1,
+            l2,
+            r: T::one() - one_minus_r,
+        }
+    }
+}
+
+/// Continuous-time gains of eq. (16) for a flux speed ω (rad/s, signed):
+/// `[p1, p2, p3, p4, q1, q2, q3, q4]`. Used to document and test the paper's design; the
+/// running observer uses [`DiscreteGains`].
+pub fn continuous_gains<T: Real>(omega: T) -> [T; 8] {
+    let two_abs = T::lit(2.0) * omega.abs();
+    [
+        two_abs,
+        -omega,
+        omega,
+        two_abs,
+        T::zero(),
+        -omega,
+        omega,
+        T::zero(),
+    ]
+}
+
+/// Frequency-adaptive disturbance observer (paper eq. (9)-(10), gains (16), Fig. 2),
+/// discretised as described in the module docs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DisturbanceObserver<T> {
+    ts: T,
+    /// λ̂1: the observer's copy of the stator flux.
+    z: Ab<T>,
+    /// D̂: the estimated disturbance.
+    d: Ab<T>,
+}
+
+impl<T: Real> DisturbanceObserver<T> {
+    /// A new observer with zero state.
+    pub fn new(config: DisturbanceObserverConfig<T>) -> Result<Self, ConfigError> {
+        let ts = check::positive("ts", config.ts)?;
+        Ok(Self {
+            ts,
+            z: Ab::zero(),
+            d: Ab::zero(),
+        })
+    }
+
+    /// Clears the state (λ̂1 = D̂ = 0).
+    pub fn reset(&mut self) {
+        self.z = Ab::zero();
+        self.d = Ab::zero();
+    }
+
+    /// Starts from a known flux with no disturbance: λ̂1 = `lambda1`, D̂ = 0, so that the
+    /// first samples see no innovation step.
+    pub fn reset_to(&mut self, lambda1: Ab<T>) {
+        self.z = lambda1;
+        self.d = Ab::zero();
+    }
+
+    /// One sample: `lambda1` is λ1[n] (the integrator output), `omega` the signed flux speed
+    /// estimate (rad/s) used for the adaptive gains. Returns D̂ after the update.
+    ///
+    /// A non-finite input is refused and leaves the state untouched.
+    #[inline]
+    pub fn step(&mut self, lambda1: Ab<T>, omega: T) -> Result<Ab<T>, NonFiniteInput> {
+        if !(lambda1.is_finite() && omega.is_finite()) {
+            return Err(NonFiniteInput);
+        }
+        let g = DiscreteGains::new(omega, self.ts);
+        let e = lambda1 - self.z;
+        self.z = g.a.complex_mul(self.z) + g.one_minus_a.complex_mul(self.d) + g.l1.complex_mul(e);
+        self.d += g.l2.complex_mul(e);
+        Ok(self.d)
+    }
+
+    /// D̂, the current disturbance estimate.
+    #[inline]
+    pub fn disturbance(&self) -> Ab<T> {
+        self.d
+    }
+
+    /// λ̂1, the observer's estimate of the stator flux including the disturbance.
+    #[inline]
+    pub fn flux(&self) -> Ab<T> {
+        self.z
+    }
+
+    /// The sampling period.
+    pub fn ts(&self) -> T {
+        self.ts
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use core::f64::consts::PI;
+    use nalgebra::{Matrix2, Matrix4};
+
+    /// Real 4×4 error-dynamics matrix of the discrete observer, state (zα, zβ, dα, dβ).
+    fn error_matrix(omega: f64, ts: f64) -> Matrix4<f64> {
+        let g = DiscreteGains::new(omega, ts);
+        let c = |v: Ab<f64>| Matrix2::new(v.alpha, -v.beta, v.beta, v.alpha);
+        let a_l1 = c(g.a - g.l1);
+        let oma = c(g.one_minus_a);
+        let l2 = c(g.l2);
+        let mut m = Matrix4::zeros();
+        m.fixed_view_mut::<2, 2>(0, 0).copy_from(&a_l1);
+        m.fixed_view_mut::<2, 2>(0, 2).copy_from(&oma);
+        m.fixed_view_mut::<2, 2>(2, 0).copy_from(&(-l2));
+        m.fixed_view_mut::<2, 2>(2, 2)
+            .copy_from(&Matrix2::identity());
+        m
+    }
+
+    #[test]
+    fn discrete_poles_are_image_of_minus_abs_omega_both_signs() {
+        let ts = 100e-6;
+        for k in 0..=60 {
+            let f = -300.0 + 10.0 * k as f64;
+            let w = 2.0 * PI * f;
+            let r = (-w.abs() * ts).exp();
+            let m = error_matrix(w, ts);
+            // All four eigenvalues at r (two 2×2 Jordan blocks): (M − rI)² = 0.
+            let n = m - Matrix4::identity() * r;
+            let n2 = n * n;
+            assert!(
+                n2.abs().max() < 1e-12,
+                "f = {f} Hz: |(M-rI)^2| = {}",
+                n2.abs().max()
+            );
+            // And the map for −ω is the mirror (complex conjugate) of the one for +ω.
+            let mm = error_matrix(-w, ts);
+            let flip = Matrix4::from_diagonal(&nalgebra::Vector4::new(1.0, -1.0, 1.0, -1.0));
+            assert!((flip * m * flip - mm).abs().max() < 1e-15);
+        }
+        // Far beyond the 300 Hz the issue asks for: ωTs = 3.
+        let n = error_matrix(3.0 / ts, ts) - Matrix4::identity() * (-3.0f64).exp();
+        assert!((n * n).abs().max() < 1e-12);
+    }
+
+    #[test]
+    fn continuous_gains_place_poles_at_minus_abs_omega() {
+        for w in [-2.0 * PI * 300.0, -5.0, 0.3, 2.0 * PI * 50.0] {
+            let [p1, p2, p3, p4, q1, q2, q3, q4] = continuous_gains(w);
+            // A_m − L_m C_m of eq. (9)-(10).
+            let a = Matrix4::new(
+                -p1,
+                -w - p2,
+                0.0,
+                w, //
+                w - p3,
+                -p4,
+                -w,
+                0.0, //
+                -q1,
+                -q2,
+                0.0,
+                0.0, //
+                -q3,
+                -q4,
+                0.0,
+                0.0,
+            );
+            let n = a + Matrix4::identity() * w.abs();
+            let scale = w.abs().powi(2);
+            assert!((n * n).abs().max() < 1e-9 * scale, "ω = {w}");
+        }
+    }
+
+    #[test]
+    fn separates_rotating_flux_from_dc_offset() {
+        let ts = 100e-6;
+        for f in [-50.0, -6.0, 1.0, 20.0, 300.0] {
+            let w = 2.0 * PI * f;
+            let offset = Ab::new(0.013, -0.021);
+            let mut obs = DisturbanceObserver::new(DisturbanceObserverConfig { ts }).unwrap();
+            let mut d = Ab::zero();
+            let settle = (25.0 / (w.abs() * ts)) as usize + 10;
+            for n in 0..settle {
+                let y = Ab::from_polar(0.088, w * ts * n as f64) + offset;
+                d = obs.step(y, w).unwrap();
+            }
+            assert!((d - offset).norm() < 1e-4 * 0.088, "f = {f}: D̂ = {d:?}");
+        }
+    }
+
+    #[test]
+    fn notch_is_exactly_at_omega() {
+        // Steady-state response of D̂ to a pure rotating input at the model frequency is zero.
+        let ts = 100e-6;
+        let w = 2.0 * PI * 100.0;
+        let g = DiscreteGains::new(w, ts);
+        // Closed loop: state x = (z, d); input y = a^n; steady state x = X·a^n.
+        // z: a·Z = a·Z + (1−a)·D + ℓ1(1 − Z)  and  d: a·D = D + ℓ2(1 − Z).
+        // Solve the 2×2 complex system numerically through nalgebra.
+        use nalgebra::Complex;
+        let cx = |v: Ab<f64>| Complex::new(v.alpha, v.beta);
+        let (a, l1, l2, oma) = (cx(g.a), cx(g.l1), cx(g.l2), cx(g.one_minus_a));
+        let m = nalgebra::Matrix2::new(l1, -oma, l2, a - Complex::new(1.0, 0.0));
+        let rhs = nalgebra::Vector2::new(l1, l2);
+        let x = m.lu().solve(&rhs).unwrap();
+        assert!(
+            x[1].norm_sqr().sqrt() < 1e-12,
+            "notch leak {}",
+            x[1].norm_sqr().sqrt()
+        );
+        // Negative sequence passes with unity-order gain (the continuous |d/y| = 1).
+        let a_neg = a.conj();
+        let m = nalgebra::Matrix2::new(a_neg - a + l1, -oma, l2, a_neg - Complex::new(1.0, 0.0));
+        let x = m.lu().solve(&rhs).unwrap();
+        assert!(
+            (x[1].norm_sqr().sqrt() - 1.0).abs() < 0.01,
+            "negative sequence gain {}",
+            x[1].norm_sqr().sqrt()
+        );
+    }
+
+    #[test]
+    fn freezes_at_zero_speed() {
+        let mut obs = DisturbanceObserver::new(DisturbanceObserverConfig { ts: 1e-4 }).unwrap();
+        obs.reset_to(Ab::new(0.1, 0.0));
+        for _ in 0..1000 {
+            obs.step(Ab::new(0.5, 0.5), 0.0).unwrap();
+        }
+        assert_eq!(obs.disturbance(), Ab::zero());
+        assert_eq!(obs.flux(), Ab::new(0.1, 0.0));
+    }
+
+    #[test]
+    fn small_speed_gains_are_accurate_in_f32() {
+        let w = 1e-3_f32;
+        let g = DiscreteGains::<f32>::new(w, 1e-4);
+        // ℓ2 → jωTs.
+        assert!((g.l2.beta / (w * 1e-4) - 1.0).abs() < 1e-3);
+    }
+
+    #[test]
+    fn rejects_non_finite_and_keeps_state() {
+        let mut obs = DisturbanceObserver::new(DisturbanceObserverConfig { ts: 1e-4 }).unwrap();
+        obs.step(Ab::new(0.1, 0.2), 100.0).unwrap();
+        let before = obs;
+        assert!(obs.step(Ab::new(f64::NAN, 0.0), 100.0).is_err());
+        assert!(obs.step(Ab::new(0.0, 0.0), f64::INFINITY).is_err());
+        assert_eq!(obs, before);
+        assert!(DisturbanceObserver::new(DisturbanceObserverConfig { ts: -1.0 }).is_err());
+    }
+}
