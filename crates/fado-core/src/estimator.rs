@@ -403,3 +403,34 @@ impl<T: Real> SensorlessEstimator<T> {
         &self.config
     }
 }
+
+/// What a drive needs from a rotor-angle estimator. Implemented by [`SensorlessEstimator`]
+/// and by the reference observers fado is compared against, so that one drive and one set of
+/// scenarios can run any of them.
+pub trait RotorAngleEstimator<T: Real> {
+    /// One sample: `v_ab` applied over the last interval, `i_ab` sampled now. Fields of
+    /// [`Diagnostics`] an estimator does not have are left at their defaults.
+    fn step(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> Estimate<T>;
+    /// Start-up at a known rotor angle with the present current.
+    fn align(&mut self, theta0: T, i_ab: Ab<T>);
+    /// Back to the configured start-up state.
+    fn reset(&mut self);
+    /// A short name for tables and plots.
+    fn name(&self) -> &'static str;
+}
+
+impl<T: Real> RotorAngleEstimator<T> for SensorlessEstimator<T> {
+    #[inline]
+    fn step(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> Estimate<T> {
+        SensorlessEstimator::step(self, v_ab, i_ab)
+    }
+    fn align(&mut self, theta0: T, i_ab: Ab<T>) {
+        SensorlessEstimator::align(self, theta0, i_ab)
+    }
+    fn reset(&mut self) {
+        SensorlessEstimator::reset(self)
+    }
+    fn name(&self) -> &'static str {
+        "fado"
+    }
+}

@@ -32,7 +32,9 @@ pub mod rotor_flux;
 pub mod tracker;
 
 pub use error::{ConfigError, NonFiniteInput};
-pub use estimator::{Diagnostics, Estimate, EstimatorConfig, SensorlessEstimator};
+pub use estimator::{
+    Diagnostics, Estimate, EstimatorConfig, RotorAngleEstimator, SensorlessEstimator,
+};
 pub use frames::{Ab, Abc, Dq, Rotation};
 pub use mode::Mode;
 pub use real::{Real, wrap_angle};
