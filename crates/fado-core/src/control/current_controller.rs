@@ -80,12 +80,12 @@ impl<T: Real> CurrentController<T> {
         let lq = check::positive("lq_hat", config.lq_hat)?;
         check::non_negative("flux_linkage_hat", config.flux_linkage_hat)?;
         let wc = T::two_pi() * check::positive("bandwidth_hz", config.bandwidth_hz)?;
-        check::below(
-            "bandwidth_hz",
-            wc * ts,
-            T::lit(0.5 + 1e-12),
-            "2π·bandwidth_hz·ts at most 0.5",
-        )?;
+        if wc * ts > T::lit(0.5) {
+            return Err(ConfigError::OutOfRange {
+                field: "bandwidth_hz",
+                expected: "2π·bandwidth_hz·ts at most 0.5",
+            });
+        }
         let ratio = check::non_negative("anti_windup_ratio", config.anti_windup_ratio)?;
         let bound = check::positive("voltage_bound", config.voltage_bound)?;
         let axis = |l: T| {

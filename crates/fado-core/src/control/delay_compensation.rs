@@ -42,7 +42,12 @@ impl<T: Real> DelayCompensation<T> {
     pub fn new(config: DelayCompensationConfig<T>) -> Result<Self, ConfigError> {
         let ts = check::positive("ts", config.ts)?;
         let k = check::non_negative("factor", config.factor)?;
-        check::below("factor", k, T::lit(10.0 + 1e-12), "at most 10 samples")?;
+        if k > T::lit(10.0) {
+            return Err(ConfigError::OutOfRange {
+                field: "factor",
+                expected: "at most 10 samples",
+            });
+        }
         Ok(Self {
             config,
             advance_per_omega: k * ts,

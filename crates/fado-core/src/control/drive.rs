@@ -200,7 +200,12 @@ impl<T: Real> Blocks<T> {
         let ts = check::positive("ts", c.ts)?;
         let i_max = check::positive("i_max", c.i_max)?;
         let i_min = check::non_negative("i_min", c.i_min)?;
-        check::below("i_min", i_min, i_max + T::lit(1e-30), "at most i_max")?;
+        if i_min > i_max {
+            return Err(ConfigError::OutOfRange {
+                field: "i_min",
+                expected: "at most i_max",
+            });
+        }
         let trip = check::positive("trip_current", c.trip_current)?;
         if trip <= i_max {
             return Err(ConfigError::OutOfRange {

@@ -70,7 +70,12 @@ impl<T: Real> SpaceVectorModulator<T> {
     /// A new modulator; `max_modulation` must be in (0, 1].
     pub fn new(config: ModulatorConfig<T>) -> Result<Self, ConfigError> {
         let m = check::positive("max_modulation", config.max_modulation)?;
-        check::below("max_modulation", m, T::lit(1.0 + 1e-12), "at most 1")?;
+        if m > T::one() {
+            return Err(ConfigError::OutOfRange {
+                field: "max_modulation",
+                expected: "at most 1",
+            });
+        }
         Ok(Self { config })
     }
 
