@@ -5,7 +5,10 @@
 use core::f64::consts::TAU;
 use std::vec::Vec;
 
-use fado_core::control::{DeadTimeMethod, DriveConfig, DriveOutput, SensorlessDrive};
+use fado_core::control::{
+    DeadTimeCompensation, DeadTimeCompensationConfig, DeadTimeMethod, DriveConfig, DriveOutput,
+    SensorlessDrive,
+};
 use fado_core::{
     Ab, Abc, Diagnostics, Estimate, EstimatorConfig, Rotation, RotorAngleEstimator,
     SensorlessEstimator,
@@ -113,6 +116,35 @@ fn estimator_gets_the_voltage_computed_two_samples_earlier() {
         let v_dq = o.v_ref_ab.to_dq(Rotation::from_angle(adv));
         assert!((v_dq - o.v_dq_ref).norm() < 1e-9);
     }
+}
+
+#[test]
+fn duties_realise_the_reference_plus_the_dead_time_compensation() {
+    // duty·Vdc (Clarke) = realised reference + Clarke of the per-phase compensation, which is
+    // the trapezoid of the reference current at θ̂ + 1.5·ω̂·Ts; at a low Vdc the sum is
+    // limited to the hexagon and the reported reference is what remains after compensation.
+    let mut drive = spy_drive();
+    let dtc = DeadTimeCompensation::new(DeadTimeCompensationConfig::default()).unwrap();
+    let mut saturated = 0;
+    for n in 0..200 {
+        let vdc = if n % 3 == 0 { 20.0 } else { 300.0 };
+        let i = currents(n);
+        let o = drive.step(i, vdc, 80.0);
+        let adv = Rotation::from_angle(o.estimate.theta + 1.5 * o.estimate.omega * 100e-6);
+        let comp = dtc.step(adv, o.i_dq_ref, i, vdc);
+        let applied = (o.duty * vdc).to_ab();
+        assert!((applied - (o.v_ref_ab + comp)).norm() < 1e-9, "sample {n}");
+        let span = |v: Ab<f64>| {
+            let p = v.to_abc();
+            p.a.max(p.b).max(p.c) - p.a.min(p.b).min(p.c)
+        };
+        assert!(span(applied) <= vdc * (1.0 + 1e-12));
+        if o.voltage_saturated {
+            saturated += 1;
+            assert!((span(applied) - vdc).abs() < 1e-9);
+        }
+    }
+    assert!(saturated > 30, "the 20 V samples saturate: {saturated}");
 }
 
 #[test]

@@ -467,16 +467,18 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         // 7. Dead-time compensation, hexagon limit, SVPWM.
         let v_comp = b.dead_time.step(rot, i_dq_ref, i_abc, vdc);
         let m = b.modulator.step(v_ab + v_comp, vdc);
-        let v_realised = if vdc > T::zero() {
-            m.v_ab - v_comp
+        let (v_realised, v_dq_realised) = if !m.saturated {
+            (v_ab, v_dq) // exactly what was asked for: nothing to back-calculate
+        } else if vdc > T::zero() {
+            let v = m.v_ab - v_comp;
+            (v, v.to_dq(rot))
         } else {
-            Ab::zero()
+            (Ab::zero(), Dq::zero())
         };
-        if !(v_realised.is_finite() && m.duty.is_finite()) {
+        if !(v_realised.is_finite() && v_dq_realised.is_finite() && m.duty.is_finite()) {
             return self.reject_after_estimate(backup, estimate, i_dq);
         }
         // 8. Anti-windup with the realised voltage in the same frame; speed loop too.
-        let v_dq_realised = v_realised.to_dq(rot);
         b.current.realised(v_dq_realised);
         b.speed.realised(i_dq_ref.q);
         self.history = [v_realised, self.history[0]];
