@@ -23,6 +23,8 @@ struct Spy {
     theta: f64,
     omega: f64,
     aligned: Option<(f64, Ab<f64>)>,
+    /// Answer NaN at this sample, like a broken estimator.
+    nan_at: Option<usize>,
 }
 
 impl RotorAngleEstimator<f64> for Spy {
@@ -30,8 +32,9 @@ impl RotorAngleEstimator<f64> for Spy {
         self.v.push(v_ab);
         self.i.push(i_ab);
         self.theta = fado_core::wrap_angle(self.theta + self.omega * 100e-6);
+        let broken = self.nan_at == Some(self.v.len() - 1);
         Estimate {
-            theta: self.theta,
+            theta: if broken { f64::NAN } else { self.theta },
             omega: self.omega,
             omega_control: 0.9 * self.omega,
             diagnostics: Diagnostics::default(),
@@ -116,6 +119,20 @@ fn estimator_gets_the_voltage_computed_two_samples_earlier() {
         let v_dq = o.v_ref_ab.to_dq(Rotation::from_angle(adv));
         assert!((v_dq - o.v_dq_ref).norm() < 1e-9);
     }
+}
+
+#[test]
+fn a_non_finite_estimate_holds_the_duty_and_steps_the_estimator_once() {
+    let mut drive = spy_drive();
+    drive.estimator_mut().nan_at = Some(7);
+    let outs: Vec<_> = (0..12)
+        .map(|n| drive.step(currents(n), 300.0, 20.0))
+        .collect();
+    assert_eq!(drive.estimator().v.len(), 12);
+    assert!(outs[7].input_fault && !outs[8].input_fault);
+    assert_eq!(outs[7].duty, outs[6].duty);
+    assert!(outs[7].estimate.theta.is_finite());
+    assert_eq!(drive.rejected_samples(), 1);
 }
 
 #[test]

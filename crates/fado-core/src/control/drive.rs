@@ -439,8 +439,10 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         // 2. Estimator: voltage of [n−1, n] = realised reference computed at n−2.
         let estimate = self.estimator.step(self.history[1], i_ab);
         if !estimate_is_finite(&estimate) {
-            // An estimator that went non-finite cannot steer the drive: hold like a bad input.
-            return self.reject(i_abc);
+            // An estimator that went non-finite cannot steer the drive: hold like a bad input
+            // (it has had its sample).
+            let out = self.last;
+            return self.finish_reject(out);
         }
         self.last_i_ab = i_ab;
         // 3. Measured current in the estimated rotor frame.
