@@ -17,21 +17,21 @@ pub struct SpeedControllerConfig<T> {
     pub ts: T,
     /// Pole pairs p. Default 4 (paper, V: 8 poles).
     pub pole_pairs: T,
-    /// Inertia estimate Ĵ in kg·m². Default 0.012 (SPEC §6 [A]).
+    /// Inertia estimate Ĵ in kg·m². Default 0.012 (SPEC §6 \[A\]).
     pub inertia_hat: T,
-    /// Magnet flux linkage estimate λ̂f in Wb, for K̂t = 1.5·p·λ̂f. Default 0.088 (SPEC §6 [A]).
+    /// Magnet flux linkage estimate λ̂f in Wb, for K̂t = 1.5·p·λ̂f. Default 0.088 (SPEC §6 \[A\]).
     pub flux_linkage_hat: T,
     /// Speed-loop bandwidth in Hz. Default 5 Hz (paper, V).
     pub bandwidth_hz: T,
     /// Ratio ωsc/(Ki/Kp): the PI zero sits this many times below the crossover. Default 5
     /// (SPEC §6: Ki = Kp·2π·5/5).
     pub zero_ratio: T,
-    /// Current limit I_max in A (q-axis output limit). Default 40 A (SPEC §6 [A]).
+    /// Current limit I_max in A (q-axis output limit). Default 40 A (SPEC §6 \[A\]).
     pub i_max: T,
     /// Back-calculation gain as a multiple of Ki/Kp (see [`PiConfig`]). Default 5, i.e. a
     /// tracking time constant of 1/ωsc: with the realisable setting (1) the integral relaxes
     /// only with 5/ωsc = 160 ms and a long saturated acceleration leaves it near I_max,
-    /// which costs a large speed overshoot [A].
+    /// which costs a large speed overshoot \[A\].
     pub anti_windup_ratio: T,
 }
 
