@@ -164,7 +164,7 @@ impl<T: Real> EmfObserverEstimator<T> {
             flux_linkage_hat: lf,
         })?;
         let (kp, ki) = trackers.t2s1_gains();
-        if !(p * kp > ki) {
+        if p * kp <= ki {
             return Err(ConfigError::OutOfRange {
                 field: "emf_bandwidth_hz",
                 expected: "2π·emf_bandwidth_hz above Ki/Kp of T2S-1 (module docs)",
