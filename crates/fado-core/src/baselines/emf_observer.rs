@@ -325,3 +325,126 @@ impl<T: Real> RotorAngleEstimator<T> for EmfObserverEstimator<T> {
         "emf-observer"
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn config_errors_name_the_field() {
+        type C = EmfObserverConfig<f64>;
+        let cases: [(C, &str); 12] = [
+            (
+                C {
+                    ts: f64::NAN,
+                    ..C::default()
+                },
+                "ts",
+            ),
+            (
+                C {
+                    rs_hat: -0.1,
+                    ..C::default()
+                },
+                "rs_hat",
+            ),
+            (
+                C {
+                    lq_hat: f64::INFINITY,
+                    ..C::default()
+                },
+                "lq_hat",
+            ),
+            (
+                C {
+                    flux_linkage_hat: -0.088,
+                    ..C::default()
+                },
+                "flux_linkage_hat",
+            ),
+            (
+                C {
+                    emf_bandwidth_hz: 0.0,
+                    ..C::default()
+                },
+                "emf_bandwidth_hz",
+            ),
+            (
+                C {
+                    emf_bandwidth_hz: 2_000.0,
+                    ..C::default()
+                },
+                "emf_bandwidth_hz",
+            ),
+            // 2π·10 Hz = 63 rad/s < Ki/Kp = 130 rad/s of the 60 Hz T2S-1.
+            (
+                C {
+                    emf_bandwidth_hz: 10.0,
+                    ..C::default()
+                },
+                "emf_bandwidth_hz",
+            ),
+            (
+                C {
+                    speed_floor_hz: 0.0,
+                    ..C::default()
+                },
+                "speed_floor_hz",
+            ),
+            (
+                C {
+                    t2s1_bandwidth_hz: -60.0,
+                    ..C::default()
+                },
+                "t2s1_bandwidth_hz",
+            ),
+            (
+                C {
+                    t2s2_bandwidth_hz: 0.0,
+                    ..C::default()
+                },
+                "t2s2_bandwidth_hz",
+            ),
+            (
+                C {
+                    tracker_damping: -1.0,
+                    ..C::default()
+                },
+                "tracker_damping",
+            ),
+            (
+                C {
+                    initial_angle: f64::NEG_INFINITY,
+                    ..C::default()
+                },
+                "initial_angle",
+            ),
+        ];
+        for (config, field) in cases {
+            assert_eq!(config.validate().unwrap_err().field(), field);
+        }
+        assert!(C::default().validate().is_ok());
+        // Just above the speed-feedback bound is accepted.
+        assert!(
+            C {
+                emf_bandwidth_hz: 21.0,
+                ..C::default()
+            }
+            .validate()
+            .is_ok()
+        );
+    }
+
+    #[test]
+    fn no_emf_at_standstill_makes_the_trackers_coast() {
+        let mut est = EmfObserverEstimator::new(EmfObserverConfig::<f64>::default()).unwrap();
+        est.align(0.5, Ab::new(4.0, 0.0));
+        for _ in 0..1_000 {
+            // A standing current: v = R·i, no EMF.
+            let out = est.step(Ab::new(0.327 * 4.0, 0.0), Ab::new(4.0, 0.0));
+            assert!(out.diagnostics.tracker_hold);
+            assert!((out.theta - 0.5).abs() < 1e-12);
+        }
+        assert!(est.emf().norm() < 1e-9);
+    }
+}

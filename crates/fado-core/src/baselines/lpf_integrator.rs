@@ -316,3 +316,183 @@ impl<T: Real> RotorAngleEstimator<T> for LpfIntegratorEstimator<T> {
         "lpf-integrator"
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn config_errors_name_the_field() {
+        type C = LpfIntegratorConfig<f64>;
+        let cases: [(C, &str); 13] = [
+            (
+                C {
+                    ts: 0.0,
+                    ..C::default()
+                },
+                "ts",
+            ),
+            (
+                C {
+                    rs_hat: -1.0,
+                    ..C::default()
+                },
+                "rs_hat",
+            ),
+            (
+                C {
+                    lq_hat: f64::NAN,
+                    ..C::default()
+                },
+                "lq_hat",
+            ),
+            (
+                C {
+                    flux_linkage_hat: 0.0,
+                    ..C::default()
+                },
+                "flux_linkage_hat",
+            ),
+            (
+                C {
+                    cutoff_hz: -1.0,
+                    ..C::default()
+                },
+                "cutoff_hz",
+            ),
+            (
+                C {
+                    cutoff_hz: 2_000.0,
+                    ..C::default()
+                },
+                "cutoff_hz",
+            ),
+            (
+                C {
+                    compensation_floor_hz: 0.0,
+                    ..C::default()
+                },
+                "compensation_floor_hz",
+            ),
+            (
+                C {
+                    t2s1_bandwidth_hz: 5_000.0,
+                    ..C::default()
+                },
+                "t2s1_bandwidth_hz",
+            ),
+            (
+                C {
+                    t2s2_bandwidth_hz: f64::NAN,
+                    ..C::default()
+                },
+                "t2s2_bandwidth_hz",
+            ),
+            (
+                C {
+                    tracker_damping: 0.0,
+                    ..C::default()
+                },
+                "tracker_damping",
+            ),
+            (
+                C {
+                    tracker_hold_ratio: 1.0,
+                    ..C::default()
+                },
+                "tracker_hold_ratio",
+            ),
+            (
+                C {
+                    tracker_hold_ratio: -0.1,
+                    ..C::default()
+                },
+                "tracker_hold_ratio",
+            ),
+            (
+                C {
+                    initial_angle: f64::INFINITY,
+                    ..C::default()
+                },
+                "initial_angle",
+            ),
+        ];
+        for (config, field) in cases {
+            assert_eq!(config.validate().unwrap_err().field(), field);
+        }
+        assert!(C::default().validate().is_ok());
+        // ωc = 0 is the open integrator of eq. (3).
+        assert!(
+            C {
+                cutoff_hz: 0.0,
+                ..C::default()
+            }
+            .validate()
+            .is_ok()
+        );
+    }
+
+    /// z for a rotation by x, as (re, im).
+    fn div(a: (f64, f64), b: (f64, f64)) -> (f64, f64) {
+        let n = b.0 * b.0 + b.1 * b.1;
+        ((a.0 * b.0 + a.1 * b.1) / n, (a.1 * b.0 - a.0 * b.1) / n)
+    }
+
+    #[test]
+    fn compensation_is_the_exact_inverse_of_the_discrete_low_pass() {
+        // LPF ψ/u = Ts/(1 − (1 − ωcTs)z⁻¹), integrator λ/u = Ts/(1 − z⁻¹): the compensation
+        // must equal their ratio (1 − (1 − ωcTs)z⁻¹)/(1 − z⁻¹) at z = e^{jωTs} (floor → 0).
+        let est = LpfIntegratorEstimator::new(LpfIntegratorConfig {
+            cutoff_hz: 3.0,
+            compensation_floor_hz: 1e-9,
+            ..Default::default()
+        })
+        .unwrap();
+        let (ts, wc) = (1e-4, core::f64::consts::TAU * 3.0);
+        for w in [-2_000.0, -300.0, -20.0, 5.0, 125.0, 3_000.0] {
+            let (s, c) = (-w * ts as f64).sin_cos(); // z⁻¹
+            let ratio = div(
+                (1.0 - (1.0 - wc * ts) * c, -(1.0 - wc * ts) * s),
+                (1.0 - c, -s),
+            );
+            let got = est.compensation(w);
+            assert!(
+                (got.alpha - ratio.0).abs() < 1e-9 && (got.beta - ratio.1).abs() < 1e-9,
+                "{w}: {got:?} vs {ratio:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn regularised_compensation_is_one_at_standstill_and_symmetric() {
+        let est = LpfIntegratorEstimator::new(LpfIntegratorConfig::<f64>::default()).unwrap();
+        assert_eq!(est.compensation(0.0), Ab::new(1.0, 0.0));
+        for w in [0.5, 6.0, 40.0, 400.0] {
+            let (p, n) = (est.compensation(w), est.compensation(-w));
+            assert!((p.alpha - n.alpha).abs() < 1e-15 && (p.beta + n.beta).abs() < 1e-15);
+            // Never more than atan(ωc/2ω_f) = atan(½) with the default floor = cutoff.
+            assert!(p.beta.abs() / p.alpha <= 0.5 + 1e-9);
+        }
+    }
+
+    #[test]
+    fn dc_integrand_settles_at_eps_over_wc() {
+        // The bounded drift that replaces the open integrator's ramp: ψ → ε/ωc.
+        let mut est = LpfIntegratorEstimator::new(LpfIntegratorConfig::<f64> {
+            flux_linkage_hat: 1e-3,
+            ..Default::default()
+        })
+        .unwrap();
+        est.align(0.0, Ab::zero());
+        let eps = Ab::new(0.05, -0.02);
+        for _ in 0..20_000 {
+            est.step(eps, Ab::zero());
+        }
+        let wc = core::f64::consts::TAU;
+        let psi = est.filtered_flux();
+        assert!(
+            (psi - eps * (1.0 / wc)).norm() < 1e-3 * eps.norm() / wc,
+            "{psi:?}"
+        );
+    }
+}

@@ -205,3 +205,106 @@ impl<T: Real> AngleTrackers<T> {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::RotorAngleEstimator;
+
+    /// Warms `est` up on a rotating machine-like input, then checks that a non-finite and an
+    /// overflowing sample are both refused with the state left exactly as it was.
+    fn rejects_bad_samples<E: RotorAngleEstimator<f32> + Clone>(mut est: E) {
+        let (w, ts) = (125.0_f32, 1e-4_f32);
+        let mut last = None;
+        for n in 0..200 {
+            let th = w * ts * n as f32;
+            let v = Ab::from_polar(11.0, th + 1.6);
+            let i = Ab::from_polar(5.0, th + 1.5);
+            last = Some(est.step(v, i));
+        }
+        let mut last = last.unwrap();
+        for (v, i) in [
+            (Ab::new(f32::NAN, 0.0), Ab::new(1.0, 0.0)),
+            (Ab::new(1.0, 0.0), Ab::new(0.0, f32::INFINITY)),
+            // Finite but absurd: v − R̂s·i overflows f32.
+            (Ab::new(3e38, 0.0), Ab::new(-3e38, 0.0)),
+        ] {
+            let mut twin = est.clone();
+            let out = est.step(v, i);
+            assert!(out.diagnostics.input_fault, "{}", est.name());
+            assert_eq!(out.theta, last.theta);
+            assert_eq!(out.diagnostics.lambda_r, last.diagnostics.lambda_r);
+            let good = (Ab::new(2.0, 3.0), Ab::new(1.0, -1.0));
+            let next = est.step(good.0, good.1);
+            assert_eq!(next, twin.step(good.0, good.1));
+            assert!(!next.diagnostics.input_fault);
+            last = next;
+        }
+    }
+
+    #[test]
+    fn every_baseline_rejects_non_finite_and_overflowing_samples() {
+        rejects_bad_samples(LpfIntegratorEstimator::new(LpfIntegratorConfig::default()).unwrap());
+        rejects_bad_samples(OrtegaEstimator::new(OrtegaConfig::default()).unwrap());
+        rejects_bad_samples(EmfObserverEstimator::new(EmfObserverConfig::default()).unwrap());
+    }
+
+    #[test]
+    fn names_are_distinct() {
+        let names = [
+            LpfIntegratorEstimator::<f64>::new(LpfIntegratorConfig::default())
+                .unwrap()
+                .name(),
+            OrtegaEstimator::<f64>::new(OrtegaConfig::default())
+                .unwrap()
+                .name(),
+            EmfObserverEstimator::<f64>::new(EmfObserverConfig::default())
+                .unwrap()
+                .name(),
+        ];
+        assert_eq!(names, ["lpf-integrator", "ortega", "emf-observer"]);
+    }
+
+    #[test]
+    fn align_sets_angle_and_reset_returns_to_the_configured_start() {
+        fn check<E: RotorAngleEstimator<f64>>(mut est: E, initial: f64) {
+            est.align(1.0, Ab::new(3.0, -2.0));
+            for _ in 0..50 {
+                est.step(Ab::new(5.0, 1.0), Ab::new(3.0, -2.0));
+            }
+            est.reset();
+            // At reset ω̂ = 0 and no voltage: the first estimate sits at the configured angle.
+            let out = est.step(Ab::zero(), Ab::zero());
+            assert!(
+                (out.theta - initial).abs() < 1e-9,
+                "{}: {}",
+                est.name(),
+                out.theta
+            );
+        }
+        check(
+            LpfIntegratorEstimator::new(LpfIntegratorConfig {
+                initial_angle: 0.3,
+                ..Default::default()
+            })
+            .unwrap(),
+            0.3,
+        );
+        check(
+            OrtegaEstimator::new(OrtegaConfig {
+                initial_angle: 0.3,
+                ..Default::default()
+            })
+            .unwrap(),
+            0.3,
+        );
+        check(
+            EmfObserverEstimator::new(EmfObserverConfig {
+                initial_angle: 0.3,
+                ..Default::default()
+            })
+            .unwrap(),
+            0.3,
+        );
+    }
+}

@@ -341,3 +341,187 @@ impl<T: Real> RotorAngleEstimator<T> for OrtegaEstimator<T> {
         "ortega"
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn config_errors_name_the_field() {
+        type C = OrtegaConfig<f64>;
+        let cases: [(C, &str); 12] = [
+            (
+                C {
+                    ts: -1e-4,
+                    ..C::default()
+                },
+                "ts",
+            ),
+            (
+                C {
+                    rs_hat: f64::NAN,
+                    ..C::default()
+                },
+                "rs_hat",
+            ),
+            (
+                C {
+                    lq_hat: -1e-3,
+                    ..C::default()
+                },
+                "lq_hat",
+            ),
+            (
+                C {
+                    flux_linkage_hat: 0.0,
+                    ..C::default()
+                },
+                "flux_linkage_hat",
+            ),
+            (
+                C {
+                    observer_bandwidth: 0.0,
+                    ..C::default()
+                },
+                "observer_bandwidth",
+            ),
+            (
+                C {
+                    observer_bandwidth: 10_000.0,
+                    ..C::default()
+                },
+                "observer_bandwidth",
+            ),
+            (
+                C {
+                    flux_adaptation_ratio: -0.2,
+                    ..C::default()
+                },
+                "flux_adaptation_ratio",
+            ),
+            (
+                C {
+                    t2s1_bandwidth_hz: 0.0,
+                    ..C::default()
+                },
+                "t2s1_bandwidth_hz",
+            ),
+            (
+                C {
+                    t2s2_bandwidth_hz: 1e9,
+                    ..C::default()
+                },
+                "t2s2_bandwidth_hz",
+            ),
+            (
+                C {
+                    tracker_damping: f64::NAN,
+                    ..C::default()
+                },
+                "tracker_damping",
+            ),
+            (
+                C {
+                    tracker_hold_ratio: 2.0,
+                    ..C::default()
+                },
+                "tracker_hold_ratio",
+            ),
+            (
+                C {
+                    initial_angle: f64::NAN,
+                    ..C::default()
+                },
+                "initial_angle",
+            ),
+        ];
+        for (config, field) in cases {
+            assert_eq!(config.validate().unwrap_err().field(), field);
+        }
+        assert!(C::default().validate().is_ok());
+    }
+
+    #[test]
+    fn default_gain_is_critically_damped_at_300_rpm() {
+        // s² + ω_obs·s + ω² has a double root at ω = 2π·20 Hz (4 pole pairs, 300 r/min).
+        let c = OrtegaConfig::<f64>::default();
+        let w = core::f64::consts::TAU * 300.0 / 60.0 * 4.0;
+        assert!((c.observer_bandwidth * c.observer_bandwidth - 4.0 * w * w).abs() < 1e-6);
+        assert!((c.gamma() * 0.088 * 0.088 - c.observer_bandwidth).abs() < 1e-9);
+    }
+
+    #[test]
+    fn radial_error_decays_at_the_observer_bandwidth_without_turning_the_angle() {
+        // At standstill with no current the map is r⁺ = r + Ts·(γ/2)·r·(λ² − r²), linearised
+        // 1 − ω_obs·Ts at r = λ; the direction of η̂ must not move.
+        let c = OrtegaConfig::<f64>::default();
+        let mut est = OrtegaEstimator::new(c).unwrap();
+        est.align(0.7, Ab::zero());
+        est.x = Ab::from_polar(0.088 * 1.0001, 0.7);
+        let n = 60;
+        let mut eta = Ab::zero();
+        for _ in 0..n {
+            eta = est.step(Ab::zero(), Ab::zero()).diagnostics.lambda_r;
+            assert!((eta.angle() - 0.7).abs() < 1e-12);
+        }
+        let measured = (eta.norm() - 0.088) / (0.088 * 1e-4);
+        let predicted = (1.0 - c.observer_bandwidth * c.ts).powi(n);
+        assert!(
+            (measured / predicted - 1.0).abs() < 1e-3,
+            "{measured} {predicted}"
+        );
+    }
+
+    #[test]
+    fn a_far_out_flux_is_pulled_in_monotonically_without_flipping() {
+        let mut est = OrtegaEstimator::new(OrtegaConfig::<f64>::default()).unwrap();
+        est.align(-2.0, Ab::zero());
+        est.x = Ab::from_polar(0.088 * 50.0, -2.0);
+        let mut r = est.x.norm();
+        for _ in 0..5_000 {
+            let eta = est.step(Ab::zero(), Ab::zero()).diagnostics.lambda_r;
+            assert!((eta.angle() + 2.0).abs() < 1e-9);
+            assert!(eta.norm() <= r && eta.norm() >= 0.088 * (1.0 - 1e-12));
+            r = eta.norm();
+        }
+        assert!((r / 0.088 - 1.0).abs() < 1e-9, "{r}");
+    }
+
+    #[test]
+    fn tangential_error_decays_at_the_slow_pole_at_low_speed() {
+        // Rotor-frame error dynamics s² + ω_obs·s + ω² (module docs): at 3 Hz electrical the
+        // slow pole is ≈ −ω²/ω_obs = −1.4 s⁻¹. Start with the flux estimate 5 mrad off (small:
+        // the second-order term of |η̂|² is amplified by ω_obs/ω like a λ̂f error).
+        let c = OrtegaConfig::<f64>::default();
+        let (ts, lf) = (c.ts, c.flux_linkage_hat);
+        for w in [
+            2.0 * core::f64::consts::PI * 3.0,
+            -2.0 * core::f64::consts::PI * 3.0,
+        ] {
+            let slow =
+                (-c.observer_bandwidth + (c.observer_bandwidth.powi(2) - 4.0 * w * w).sqrt()) / 2.0;
+            let mut est = OrtegaEstimator::new(c).unwrap();
+            est.align(0.005, Ab::zero());
+            let err_at = |t_end: f64, est: &mut OrtegaEstimator<f64>, n0: usize| {
+                let n1 = (t_end / ts) as usize;
+                let mut err = 0.0;
+                for n in n0..n1 {
+                    // No current; v = d(λf·e^{jθ})/dt over the interval, exactly.
+                    let th = |k: usize| w * ts * k as f64;
+                    let v =
+                        (Ab::from_polar(lf, th(n + 1)) - Ab::from_polar(lf, th(n))) * (1.0 / ts);
+                    let out = est.step(v, Ab::zero());
+                    err = crate::wrap_angle(out.diagnostics.theta_direct - th(n + 1));
+                }
+                (err, n1)
+            };
+            let (e1, n1) = err_at(0.5, &mut est, 0);
+            let (e2, _) = err_at(1.5, &mut est, n1);
+            let measured = (e2 / e1).ln();
+            assert!(
+                (measured / slow - 1.0).abs() < 0.02,
+                "ω = {w}: decay {measured} vs {slow}"
+            );
+        }
+    }
+}
