@@ -448,9 +448,9 @@ mod tests {
             ..Default::default()
         })
         .unwrap();
-        let (ts, wc) = (1e-4, core::f64::consts::TAU * 3.0);
+        let (ts, wc): (f64, f64) = (1e-4, core::f64::consts::TAU * 3.0);
         for w in [-2_000.0, -300.0, -20.0, 5.0, 125.0, 3_000.0] {
-            let (s, c) = (-w * ts as f64).sin_cos(); // z⁻¹
+            let (s, c) = (-w * ts).sin_cos(); // z⁻¹
             let ratio = div(
                 (1.0 - (1.0 - wc * ts) * c, -(1.0 - wc * ts) * s),
                 (1.0 - c, -s),

@@ -490,8 +490,9 @@ mod tests {
     #[test]
     fn tangential_error_decays_at_the_slow_pole_at_low_speed() {
         // Rotor-frame error dynamics s² + ω_obs·s + ω² (module docs): at 3 Hz electrical the
-        // slow pole is ≈ −ω²/ω_obs = −1.4 s⁻¹. Start with the flux estimate 5 mrad off (small:
-        // the second-order term of |η̂|² is amplified by ω_obs/ω like a λ̂f error).
+        // slow pole is ≈ −ω²/ω_obs = −1.4 s⁻¹. Start with the flux estimate 2 mrad off (small:
+        // the second-order term of |η̂|² is amplified by ω_obs/ω like a λ̂f error). The forward
+        // step's radial rate −ln(1 − ω_obs·Ts)/Ts is 1.3 % above ω_obs, hence the tolerance.
         let c = OrtegaConfig::<f64>::default();
         let (ts, lf) = (c.ts, c.flux_linkage_hat);
         for w in [
@@ -501,7 +502,7 @@ mod tests {
             let slow =
                 (-c.observer_bandwidth + (c.observer_bandwidth.powi(2) - 4.0 * w * w).sqrt()) / 2.0;
             let mut est = OrtegaEstimator::new(c).unwrap();
-            est.align(0.005, Ab::zero());
+            est.align(0.002, Ab::zero());
             let err_at = |t_end: f64, est: &mut OrtegaEstimator<f64>, n0: usize| {
                 let n1 = (t_end / ts) as usize;
                 let mut err = 0.0;
@@ -519,7 +520,7 @@ mod tests {
             let (e2, _) = err_at(1.5, &mut est, n1);
             let measured = (e2 / e1).ln();
             assert!(
-                (measured / slow - 1.0).abs() < 0.02,
+                (measured / slow - 1.0).abs() < 0.03,
                 "ω = {w}: decay {measured} vs {slow}"
             );
         }
