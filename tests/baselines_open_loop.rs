@@ -164,10 +164,10 @@ fn ortega_turns_a_dc_voltage_error_into_the_predicted_ripple() {
     // Rotor-frame error dynamics ε̇d = ud + ω·εq − ω_obs·εd, ε̇q = uq − ω·εd driven by ε
     // rotating at −ω: |εq| = |ε|·√(4ω² + ω_obs²)/(|ω|·ω_obs) (module docs, linearised).
     let cfg = OrtegaConfig::<f64>::default();
-    let w_obs = cfg.observer_bandwidth;
     let eps = Ab::new(0.12, -0.16); // 0.2 V
     for rpm in [300.0, -300.0] {
         let w = electrical_speed(rpm);
+        let w_obs = cfg.scheduled_bandwidth(w);
         let mut est = OrtegaEstimator::new(cfg).unwrap();
         let err = settled_error(&mut est, rpm, Dq::new(0.0, 10.0), 1.5, 0.5, eps);
         let eq = eps.norm() * (4.0 * w * w + w_obs * w_obs).sqrt() / (w.abs() * w_obs);
@@ -176,23 +176,38 @@ fn ortega_turns_a_dc_voltage_error_into_the_predicted_ripple() {
     }
 }
 
-/// The steady angle error of the Ortega observer pulled to a wrong radius λ̂: e = c·η with
-/// 1 + c = 1/(1 − jb) and −ω·b = (γ/2)·(λ̂² − λf²/(1 + b²)); the error is atan(b).
-fn ortega_radius_error(w: f64, w_obs: f64, lambda_hat: f64) -> f64 {
-    let half_gamma = 0.5 * w_obs / (lambda_hat * lambda_hat);
-    let f = |b: f64| w * b + half_gamma * (lambda_hat * lambda_hat - LF * LF / (1.0 + b * b));
-    // f is monotone in b for this sign of ω on the bracket; bisect.
-    let (mut lo, mut hi) = (-10.0_f64, 10.0_f64);
-    let rising = f(hi) > f(lo);
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if (f(mid) > 0.0) == rising {
-            hi = mid;
-        } else {
-            lo = mid;
+/// The steady angle error φ of the Ortega observer (module docs, lock condition): the root
+/// nearest 0 of tan φ + (ω_obs/2ω)·(1 − (a/λ̂)²·cos²φ) = 0, where a = λf + uq/ω is the radius of
+/// the integrated flux circle and λ̂ the radius the observer pulls to.
+fn ortega_steady_angle(w: f64, w_obs: f64, a: f64, lambda_hat: f64) -> f64 {
+    let r = w_obs / (2.0 * w);
+    let k = (a / lambda_hat).powi(2);
+    let g = |phi: f64| phi.tan() + r * (1.0 - k * phi.cos().powi(2));
+    let half = core::f64::consts::FRAC_PI_2 - 1e-6;
+    let steps = 200_000;
+    let mut best = f64::NAN;
+    for j in 0..steps {
+        let (p0, p1) = (
+            -half + 2.0 * half * j as f64 / steps as f64,
+            -half + 2.0 * half * (j + 1) as f64 / steps as f64,
+        );
+        if g(p0).signum() != g(p1).signum() {
+            let (mut lo, mut hi) = (p0, p1);
+            for _ in 0..60 {
+                let mid = 0.5 * (lo + hi);
+                if g(mid).signum() == g(lo).signum() {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            let root = 0.5 * (lo + hi);
+            if best.is_nan() || root.abs() < best.abs() {
+                best = root;
+            }
         }
     }
-    (0.5 * (lo + hi)).atan().abs()
+    best.abs()
 }
 
 #[test]
@@ -206,7 +221,7 @@ fn ortega_flux_linkage_error_gives_the_predicted_angle_error_and_adaptation_remo
             };
             let mut est = OrtegaEstimator::new(cfg).unwrap();
             let err = settled_error(&mut est, rpm, Dq::new(0.0, 10.0), 1.5, 0.3, Ab::zero());
-            let predicted = ortega_radius_error(w, cfg.observer_bandwidth, ratio * LF);
+            let predicted = ortega_steady_angle(w, cfg.scheduled_bandwidth(w), LF, ratio * LF);
             assert_close("ortega λ̂f error", err, predicted, 0.05);
             // With the VESC-style adaptation (κ = 0.2) λ̂ converges to λf and the error goes.
             let mut est = OrtegaEstimator::new(OrtegaConfig {
@@ -220,5 +235,76 @@ fn ortega_flux_linkage_error_gives_the_predicted_angle_error_and_adaptation_remo
             assert!((lambda / LF - 1.0).abs() < 1e-3, "λ̂ = {lambda}");
             assert!(err < 0.2 * predicted && err < 5e-3, "{err}");
         }
+    }
+}
+
+#[test]
+fn ortega_fixed_gain_loses_lock_where_predicted_and_the_schedule_keeps_it() {
+    // An R̂s error x under motoring load iq is the q-axis integrand error uq = −x·Rs·iq: the
+    // integrated circle shrinks to a = λf + uq/ω. With a fixed ω_obs the small-error root
+    // exists while δ = 1 − (a/λf)² ≤ ω²/ω_obs² (first order): at 90 r/min and 251 rad/s that
+    // is x ≈ 0.8 %. Half of it settles where predicted; three times it leaves no equilibrium
+    // and the estimate slips poles periodically; the default schedule (ω_obs = 2|ω|) keeps lock
+    // at three times it, with the predicted error.
+    let fixed = OrtegaConfig::<f64> {
+        observer_speed_ratio: 0.0,
+        observer_bandwidth: 2.0 * core::f64::consts::TAU * 20.0,
+        ..OrtegaConfig::default()
+    };
+    for (rpm, iq) in [(90.0, 14.2), (-90.0, -14.2)] {
+        let w = electrical_speed(rpm);
+        let uq_per_x = -RS * iq;
+        let delta_for = |x: f64| 1.0 - ((LF + x * uq_per_x / w) / LF).powi(2);
+        // Bisect the first-order limit δ(x) = ω²/ω_obs².
+        let limit = (w / fixed.observer_bandwidth).powi(2);
+        let (mut lo, mut hi) = (0.0, 0.1);
+        for _ in 0..60 {
+            let mid = 0.5 * (lo + hi);
+            if delta_for(mid) < limit {
+                lo = mid
+            } else {
+                hi = mid
+            }
+        }
+        let x_limit = lo;
+        assert!((x_limit - 0.008).abs() < 0.001, "{x_limit}");
+        let i_dq = Dq::new(0.0, iq);
+        let run = |cfg: OrtegaConfig<f64>, x: f64, seconds: f64| {
+            let mut est = OrtegaEstimator::new(OrtegaConfig {
+                rs_hat: RS * (1.0 + x),
+                ..cfg
+            })
+            .unwrap();
+            settled_error(&mut est, rpm, i_dq, seconds, 0.5, Ab::zero())
+        };
+        let a = |x: f64| LF + x * uq_per_x / w;
+        // Half the limit: the predicted equilibrium.
+        let x = 0.5 * x_limit;
+        let predicted = ortega_steady_angle(w, fixed.observer_bandwidth, a(x), LF);
+        assert_close(
+            "ortega fixed gain, ½ limit",
+            run(fixed, x, 4.0),
+            predicted,
+            0.05,
+        );
+        // Three times the limit: a pole slip (the error passes through ±π) within 6 s.
+        let mut est = OrtegaEstimator::new(OrtegaConfig {
+            rs_hat: RS * (1.0 + 3.0 * x_limit),
+            ..fixed
+        })
+        .unwrap();
+        let err = settled_error(&mut est, rpm, i_dq, 6.0, 5.8, Ab::zero());
+        println!("ortega fixed gain, 3 × limit: max {err:.3} rad");
+        assert!(err > 2.5, "{err}");
+        // The schedule at three times the limit holds, where predicted.
+        let sched = OrtegaConfig::<f64>::default();
+        let x = 3.0 * x_limit;
+        let predicted = ortega_steady_angle(w, sched.scheduled_bandwidth(w), a(x), LF);
+        assert_close(
+            "ortega schedule, 3 × limit",
+            run(sched, x, 2.0),
+            predicted,
+            0.05,
+        );
     }
 }

@@ -24,8 +24,9 @@
 //! - the compensated LPF cannot integrate below ~ωc and turns a DC integrand error ε (current
 //!   offsets, R̂s error on a DC current, dead time) into a standing flux error ε/ωc;
 //! - the Ortega observer corrects only the flux *magnitude*: its tangential error decays at
-//!   only ≈ ω²/ω_obs at low speed, a q-axis voltage error or a wrong λ̂f is amplified by ω_obs/ω
-//!   into the angle, and at standstill it is an open integrator;
+//!   ω²/ω_obs, a q-axis voltage error or a wrong λ̂f enters the angle amplified by ω_obs/ω, and
+//!   beyond ω²/ω_obs² of λf the estimate slips poles (so the default gain is scheduled,
+//!   ω_obs = 2|ω̂|, as VESC does in spirit); at standstill it is an open integrator;
 //! - the EMF observer has nothing to measure at zero speed (e = jω·λf) and needs the sign of
 //!   ω̂, so a reversal through zero flips its angle reference.
 

@@ -12,7 +12,7 @@
 //! dx̂/dt = v* − R̂s·i + (γ/2)·η̂·(λ̂f² − |η̂|²),   η̂ = x̂ − L̂·i,   θm = ∠η̂  →  T2S-1 / T2S-2
 //! ```
 //!
-//! # Gain γ (the reasoning behind the default)
+//! # Gain γ (the reasoning behind the defaults)
 //! With exact parameters the error e = x̂ − x obeys ė = (γ/2)(η + e)(λf² − |η + e|²);
 //! linearised, ė = −γ·η·Re(η*·e): only the *radial* error is corrected, at the rate
 //! ω_obs = γ·λf² (ODrive's normalised `observer_gain`, whose default is 1000 rad/s). In the
@@ -23,16 +23,31 @@
 //! ```
 //!
 //! so the tangential (angle) error is corrected only through rotation: critically damped at
-//! ω_obs = 2|ω|, and for |ω| ≪ ω_obs the slow pole is −ω²/ω_obs. The steady state for a
-//! constant rotor-frame voltage error u is εd = uq/ω, εq = (ω_obs·uq/ω − ud)/ω: beyond what
-//! the open integrator suffers (−ud/ω), a q-axis error (R̂s error × iq, dead time) and,
-//! equivalently, a flux-linkage error Δλ (angle error ≈ (ω_obs/ω)·Δλ/λf) are amplified by
-//! ω_obs/ω. A large ω_obs is therefore *not* better at low speed. The default
-//! ω_obs = 2·(2π·20 Hz) ≈ 251 rad/s makes the observer critically damped at 20 Hz electrical
-//! (300 r/min with 4 pole pairs: the medium speed of these checks and of the fig9 scenario);
-//! at the 6 Hz of the ±90 r/min reversal the slow pole is then −5.6 s⁻¹ and the amplification
-//! 6.7, where ODrive's 1000 rad/s would give −1.4 s⁻¹ and 26.5. In the paper's normalisation
-//! γ = ω_obs/λ̂f² = 3.2e4 Wb⁻²s⁻¹ at λ̂f = 0.088 Wb.
+//! ω_obs = 2|ω|, and for |ω| ≪ ω_obs the slow pole is −ω²/ω_obs.
+//!
+//! **Lock condition.** A rotor-frame integrand error u (R̂s error × i, dead time) moves the
+//! integrated flux circle to the radius a = λf + uq/ω; a wrong λ̂f moves the target. In
+//! steady rotation with η̂ = ρ·e^{j(θ + φ)} the observer gives ρ = a·cos φ and
+//!
+//! ```text
+//! tan φ = −(ω_obs/2ω)·(1 − (a/λ̂f)²·cos²φ)        (plus −ud/ω, as for an open integrator)
+//! ```
+//!
+//! whose small root φ ≈ −(ω_obs/2ω)·δ, δ = 1 − (a/λ̂f)², exists only while δ ≤ ω²/ω_obs²
+//! (first order); beyond it only a root near ∓90° is left and the angle is lost. The harmful
+//! side is a < λ̂f: λ̂f too large, or uq opposing the EMF (R̂s too high while motoring). So a
+//! fixed gain amplifies these errors by ω_obs/ω and its margin shrinks like ω²/ω_obs²: with
+//! ω_obs = 251 rad/s (critical at 300 r/min) the limit under 14.2 A at 90 r/min is a +0.8 %
+//! R̂s error (tested: half of it settles as predicted, three times it slips poles), and with
+//! ODrive's 1000 rad/s the limit at 300 r/min is +1.9 %.
+//!
+//! **Default: a speed-scheduled gain** ω_obs = clamp(k·|ω̂|, ω_min, ω_max) with k = 2 (ω̂ of
+//! T2S-1): critically damped at every speed, amplification 1 and margin δ ≤ ¼ (a 12 % flux or
+//! EMF error). VESC schedules its γ the same way, linearly in the duty cycle above the floor
+//! `foc_observer_gain_slow`. ω_min = 2·2π·1.5 Hz keeps it critical down to fado's 1.5 Hz mode
+//! threshold; ω_max = 2·2π·100 Hz is critical at the rated 1500 r/min (ω_max·Ts = 0.126).
+//! k = 0 gives the paper's and ODrive's fixed gain ω_obs = `observer_bandwidth`. In the
+//! paper's normalisation γ = ω_obs/λ̂f² (3.2e4 Wb⁻²s⁻¹ at 300 r/min).
 //!
 //! # Discretisation
 //! As in ODrive: predict x̂⁻ = x̂ + Ts·(v* − R̂s·i) (the forward rectangle and averaged current
@@ -40,8 +55,8 @@
 //! correct x̂ = x̂⁻ + k·η̂⁻ with k = Ts·(γ/2)·(λ̂f² − |η̂⁻|²). The linearised radial map is
 //! 1 − ω_obs·Ts, so `new` requires ω_obs·Ts < 1 (monotone convergence). For |η̂| far outside
 //! the circle k would overshoot through the origin and flip the angle; k is floored at −½,
-//! which only acts for |η̂|² > λ̂f²·(1 + 1/(ω_obs·Ts)) (|η̂| > 6.4·λ̂f at the defaults), i.e.
-//! never in operation.
+//! which only acts for |η̂|² > λ̂f²·(1 + 1/(ω_obs·Ts)) (|η̂| > 3·λ̂f at ω_max), i.e. never in
+//! operation.
 //!
 //! # Flux-linkage adaptation (option, off by default)
 //! With `flux_adaptation_ratio` κ > 0 the target radius adapts, as in VESC's
@@ -52,14 +67,16 @@
 //! Off by default because fado and the comparison assume known parameters.
 //!
 //! # Where it fails
-//! - **Low speed.** The tangential error decays at ≈ ω²/ω_obs; at standstill the observer is
-//!   an open integrator along the angle direction and drifts with any integrand error, and it
-//!   has no mechanism like fado's limiter and positive-i_d steering (Fig. 6, eq. (23)).
-//! - **Offsets.** A DC integrand error ε is rejected at speed (average decay ω_obs/2 in every
-//!   direction when |ω| ≫ ω_obs), leaving an angle ripple ≈ 2|ε|/(ω_obs·λf) at the
-//!   fundamental, but is integrated along the angle at standstill.
-//! - **Parameters.** λ̂f, R̂s (under load) and q-axis voltage errors are amplified by
-//!   ω_obs/ω (above); L̂ errors act under load as in fado; the model assumes Ld = Lq.
+//! - **Low speed.** The tangential error decays at ω²/ω_obs (|ω|/2 with the schedule, down to
+//!   ω_min); at standstill the observer is an open integrator along the angle direction and
+//!   drifts with any integrand error, and it has no mechanism like fado's limiter and
+//!   positive-i_d steering (Fig. 6, eq. (23)).
+//! - **Offsets.** A DC integrand error ε rotates at −ω in the rotor frame and leaves an angle
+//!   ripple |ε|·√(4ω² + ω_obs²)/(|ω|·ω_obs·λf) at the fundamental (√2·|ε|/(|ω|·λf) with the
+//!   schedule): bounded at speed, unbounded as ω → 0.
+//! - **Parameters.** uq errors and λ̂f enter the angle (lock condition above), where fado and
+//!   the EMF observer only see a magnitude error; L̂ errors act under load as in fado; the
+//!   model assumes Ld = Lq.
 
 use super::{AngleTrackers, Integrand, TrackerSettings};
 use crate::error::{ConfigError, check};
@@ -84,10 +101,18 @@ pub struct OrtegaConfig<T> {
     /// Magnet flux linkage estimate λ̂f in Wb: the radius η̂ is pulled to. Unlike fado, the
     /// angle depends on it (module docs). Default 0.088 Wb (SPEC §6 [A]).
     pub flux_linkage_hat: T,
-    /// Radial (flux-magnitude) correction rate ω_obs = γ·λ̂f² in rad/s; ω_obs·ts must be
-    /// below 1. Default 2·2π·20 ≈ 251 rad/s [A]: critically damped at 20 Hz electrical
-    /// (300 r/min), see the module docs for the trade-off.
+    /// Radial (flux-magnitude) correction rate ω_obs = γ·λ̂f² in rad/s: the fixed value when
+    /// `observer_speed_ratio` is 0, else the upper bound ω_max of the schedule; times `ts` it
+    /// must be below 1. Default 2·2π·100 ≈ 1257 rad/s [A]: critically damped at the rated
+    /// 1500 r/min (module docs).
     pub observer_bandwidth: T,
+    /// Speed ratio k of the schedule ω_obs = clamp(k·|ω̂|, ω_min, ω_max); 0 fixes
+    /// ω_obs = `observer_bandwidth`. Default 2 [A]: critically damped at every speed (module
+    /// docs).
+    pub observer_speed_ratio: T,
+    /// Lower bound ω_min of the schedule in rad/s, at most `observer_bandwidth`. Default
+    /// 2·2π·1.5 ≈ 18.8 rad/s [A]: critical down to fado's 1.5 Hz mode threshold (paper, V).
+    pub observer_bandwidth_min: T,
     /// Flux-linkage adaptation ratio κ (module docs); 0 disables it. Default 0 [A].
     pub flux_adaptation_ratio: T,
     /// Bandwidth of T2S-1 in Hz. Default 60 Hz (paper, V), as fado.
@@ -114,7 +139,9 @@ impl<T: Real> Default for OrtegaConfig<T> {
             rs_hat: T::lit(0.327),
             lq_hat: T::lit(2.63e-3),
             flux_linkage_hat: T::lit(0.088),
-            observer_bandwidth: T::lit(2.0 * core::f64::consts::TAU * 20.0),
+            observer_bandwidth: T::lit(2.0 * core::f64::consts::TAU * 100.0),
+            observer_speed_ratio: T::lit(2.0),
+            observer_bandwidth_min: T::lit(2.0 * core::f64::consts::TAU * 1.5),
             flux_adaptation_ratio: T::zero(),
             t2s1_bandwidth_hz: T::lit(60.0),
             t2s2_bandwidth_hz: T::lit(35.0),
@@ -133,9 +160,21 @@ impl<T: Real> OrtegaConfig<T> {
         OrtegaEstimator::new(*self).map(|_| ())
     }
 
-    /// γ of the paper's eq. (8), ω_obs/λ̂f², in Wb⁻²·s⁻¹.
-    pub fn gamma(&self) -> T {
-        self.observer_bandwidth / (self.flux_linkage_hat * self.flux_linkage_hat)
+    /// γ of the paper's eq. (8), ω_obs/λ̂f², in Wb⁻²·s⁻¹, for the speed ω̂ (rad/s).
+    pub fn gamma(&self, omega: T) -> T {
+        self.scheduled_bandwidth(omega) / (self.flux_linkage_hat * self.flux_linkage_hat)
+    }
+
+    /// ω_obs at the speed ω̂ (rad/s): clamp(k·|ω̂|, ω_min, ω_max), or the fixed value.
+    #[inline]
+    pub fn scheduled_bandwidth(&self, omega: T) -> T {
+        if self.observer_speed_ratio > T::zero() {
+            (self.observer_speed_ratio * omega.abs())
+                .max(self.observer_bandwidth_min)
+                .min(self.observer_bandwidth)
+        } else {
+            self.observer_bandwidth
+        }
     }
 }
 
@@ -157,8 +196,8 @@ pub struct OrtegaEstimator<T> {
     x: Ab<T>,
     /// λ̂: the radius η̂ is pulled to (λ̂f unless adapted).
     lambda: T,
-    /// Ts·γ/2.
-    k_ts: T,
+    /// Ts/(2·λ̂f²): Ts·γ/2 per rad/s of ω_obs.
+    ts_half_over_lf2: T,
     last: Estimate<T>,
     rejected_samples: u32,
 }
@@ -177,6 +216,14 @@ impl<T: Real> OrtegaEstimator<T> {
             T::one(),
             "observer_bandwidth·ts below 1",
         )?;
+        check::non_negative("observer_speed_ratio", config.observer_speed_ratio)?;
+        let w_min = check::positive("observer_bandwidth_min", config.observer_bandwidth_min)?;
+        check::below(
+            "observer_bandwidth_min",
+            w_min,
+            w_obs * (T::one() + T::default_epsilon()),
+            "at most observer_bandwidth",
+        )?;
         check::non_negative("flux_adaptation_ratio", config.flux_adaptation_ratio)?;
         check::finite("initial_angle", config.initial_angle)?;
         let trackers = AngleTrackers::new(TrackerSettings {
@@ -194,7 +241,7 @@ impl<T: Real> OrtegaEstimator<T> {
             trackers,
             x: Ab::zero(),
             lambda: lf,
-            k_ts: ts * config.gamma() * T::lit(0.5),
+            ts_half_over_lf2: ts / (T::lit(2.0) * lf * lf),
             last: Estimate::default(),
             rejected_samples: 0,
         };
@@ -271,14 +318,15 @@ impl<T: Real> OrtegaEstimator<T> {
         let x_pred = self.x + self.integrand.step(v_ab, i_ab) * self.config.ts;
         let eta_pred = x_pred - li;
         let radius_error = self.lambda * self.lambda - eta_pred.norm_squared();
-        let k = (self.k_ts * radius_error).max(T::lit(-0.5));
+        let k_ts = self.ts_half_over_lf2 * self.config.scheduled_bandwidth(self.trackers.speed());
+        let k = (k_ts * radius_error).max(T::lit(-0.5));
         let x = x_pred + eta_pred * k;
         let eta = x - li;
         let kappa = self.config.flux_adaptation_ratio;
         let lambda = if kappa > T::zero() {
             let lf = self.config.flux_linkage_hat;
             let (lo, hi) = ADAPTATION_BOUNDS;
-            (self.lambda - kappa * self.k_ts * self.lambda * radius_error)
+            (self.lambda - kappa * k_ts * self.lambda * radius_error)
                 .max(T::lit(lo) * lf)
                 .min(T::lit(hi) * lf)
         } else {
@@ -349,7 +397,7 @@ mod tests {
     #[test]
     fn config_errors_name_the_field() {
         type C = OrtegaConfig<f64>;
-        let cases: [(C, &str); 12] = [
+        let cases: [(C, &str); 15] = [
             (
                 C {
                     ts: -1e-4,
@@ -391,6 +439,27 @@ mod tests {
                     ..C::default()
                 },
                 "observer_bandwidth",
+            ),
+            (
+                C {
+                    observer_speed_ratio: -1.0,
+                    ..C::default()
+                },
+                "observer_speed_ratio",
+            ),
+            (
+                C {
+                    observer_bandwidth_min: 0.0,
+                    ..C::default()
+                },
+                "observer_bandwidth_min",
+            ),
+            (
+                C {
+                    observer_bandwidth_min: 2_000.0,
+                    ..C::default()
+                },
+                "observer_bandwidth_min",
             ),
             (
                 C {
@@ -442,39 +511,61 @@ mod tests {
     }
 
     #[test]
-    fn default_gain_is_critically_damped_at_300_rpm() {
-        // s² + ω_obs·s + ω² has a double root at ω = 2π·20 Hz (4 pole pairs, 300 r/min).
+    fn default_schedule_is_critically_damped_between_its_bounds() {
+        // s² + ω_obs·s + ω² has a double root when ω_obs = 2|ω|.
         let c = OrtegaConfig::<f64>::default();
-        let w = core::f64::consts::TAU * 300.0 / 60.0 * 4.0;
-        assert!((c.observer_bandwidth * c.observer_bandwidth - 4.0 * w * w).abs() < 1e-6);
-        assert!((c.gamma() * 0.088 * 0.088 - c.observer_bandwidth).abs() < 1e-9);
+        let tau = core::f64::consts::TAU;
+        for f in [-100.0, -20.0, -1.6, 1.6, 6.0, 20.0, 100.0] {
+            let w = tau * f;
+            let w_obs = c.scheduled_bandwidth(w);
+            assert!((w_obs * w_obs - 4.0 * w * w).abs() < 1e-9 * w * w, "{f} Hz");
+            assert!((c.gamma(w) * 0.088 * 0.088 - w_obs).abs() < 1e-9);
+        }
+        assert_eq!(c.scheduled_bandwidth(0.0), c.observer_bandwidth_min);
+        assert_eq!(c.scheduled_bandwidth(-tau * 500.0), c.observer_bandwidth);
+        let fixed = OrtegaConfig {
+            observer_speed_ratio: 0.0,
+            ..c
+        };
+        assert_eq!(fixed.scheduled_bandwidth(tau * 3.0), c.observer_bandwidth);
     }
 
     #[test]
     fn radial_error_decays_at_the_observer_bandwidth_without_turning_the_angle() {
         // At standstill with no current the map is r⁺ = r + Ts·(γ/2)·r·(λ² − r²), linearised
-        // 1 − ω_obs·Ts at r = λ; the direction of η̂ must not move.
-        let c = OrtegaConfig::<f64>::default();
-        let mut est = OrtegaEstimator::new(c).unwrap();
-        est.align(0.7, Ab::zero());
-        est.x = Ab::from_polar(0.088 * 1.0001, 0.7);
-        let n = 60;
-        let mut eta = Ab::zero();
-        for _ in 0..n {
-            eta = est.step(Ab::zero(), Ab::zero()).diagnostics.lambda_r;
-            assert!((eta.angle() - 0.7).abs() < 1e-12);
+        // 1 − ω_obs·Ts at r = λ; the direction of η̂ must not move. ω̂ = 0: the fixed gain, or
+        // the schedule's floor.
+        for speed_ratio in [0.0, 2.0] {
+            let c = OrtegaConfig::<f64> {
+                observer_speed_ratio: speed_ratio,
+                ..OrtegaConfig::default()
+            };
+            let mut est = OrtegaEstimator::new(c).unwrap();
+            est.align(0.7, Ab::zero());
+            est.x = Ab::from_polar(0.088 * 1.0001, 0.7);
+            let n = 60;
+            let mut eta = Ab::zero();
+            for _ in 0..n {
+                eta = est.step(Ab::zero(), Ab::zero()).diagnostics.lambda_r;
+                assert!((eta.angle() - 0.7).abs() < 1e-12);
+            }
+            let measured = (eta.norm() - 0.088) / (0.088 * 1e-4);
+            let predicted = (1.0 - c.scheduled_bandwidth(0.0) * c.ts).powi(n);
+            assert!(
+                (measured / predicted - 1.0).abs() < 1e-3,
+                "{measured} {predicted}"
+            );
         }
-        let measured = (eta.norm() - 0.088) / (0.088 * 1e-4);
-        let predicted = (1.0 - c.observer_bandwidth * c.ts).powi(n);
-        assert!(
-            (measured / predicted - 1.0).abs() < 1e-3,
-            "{measured} {predicted}"
-        );
     }
 
     #[test]
     fn a_far_out_flux_is_pulled_in_monotonically_without_flipping() {
-        let mut est = OrtegaEstimator::new(OrtegaConfig::<f64>::default()).unwrap();
+        // The fixed ω_max gain, where the floor k ≥ −½ acts for |η̂| > 3·λ̂f.
+        let mut est = OrtegaEstimator::new(OrtegaConfig::<f64> {
+            observer_speed_ratio: 0.0,
+            ..OrtegaConfig::default()
+        })
+        .unwrap();
         est.align(-2.0, Ab::zero());
         est.x = Ab::from_polar(0.088 * 50.0, -2.0);
         let mut r = est.x.norm();
@@ -493,7 +584,12 @@ mod tests {
         // slow pole is ≈ −ω²/ω_obs = −1.4 s⁻¹. Start with the flux estimate 2 mrad off (small:
         // the second-order term of |η̂|² is amplified by ω_obs/ω like a λ̂f error). The forward
         // step's radial rate −ln(1 − ω_obs·Ts)/Ts is 1.3 % above ω_obs, hence the tolerance.
-        let c = OrtegaConfig::<f64>::default();
+        // The fixed gain of the analysis, critical at 300 r/min.
+        let c = OrtegaConfig::<f64> {
+            observer_speed_ratio: 0.0,
+            observer_bandwidth: 2.0 * core::f64::consts::TAU * 20.0,
+            ..OrtegaConfig::default()
+        };
         let (ts, lf) = (c.ts, c.flux_linkage_hat);
         for w in [
             2.0 * core::f64::consts::PI * 3.0,
