@@ -29,8 +29,8 @@
 //! Off its tuning the filter has the phase ≈ (ω̂ − ω)/p, so ω̂ feeds back into θm. With T2S-1
 //! (Kp, Ki) the loop becomes s² + (Kp − Ki/p)·s + Ki: stable only for p > Ki/Kp (130 rad/s
 //! for 60 Hz), which `new` enforces. The default p = 2π·100 Hz keeps 80 % of the tracker's
-//! damping term, is 2.5 × the 40 Hz electrical of 600 r/min, and lets through only
-//! p·L̂·σ_i ≈ 17 mV of EMF noise for σ_i = 10 mA (SPEC §6).
+//! damping term, costs 10 mrad of phase per 1 Hz of speed error (ω̂ lagging an acceleration),
+//! and lets through only p·L̂·σ_i ≈ 17 mV of EMF noise for σ_i = 10 mA (SPEC §6).
 //!
 //! # Where it fails
 //! - **Low speed.** The EMF vanishes with ω (0.55 V per Hz for this motor): below a few Hz it
@@ -40,8 +40,9 @@
 //! - **Reversal.** The flux direction is ∠ê − sgn(ω̂)·90°: if ω̂ has the wrong sign the angle is
 //!   off by π, and crossing zero speed under load is a guess.
 //! - **Offsets.** A DC voltage error ε passes the rotating filter with gain p/√(p² + ω²),
-//!   giving an angle ripple ≈ |ε|·p/(√(p² + ω²)·|ω|·λf) at the fundamental: bounded at speed,
-//!   unbounded as ω → 0.
+//!   giving an angle ripple ≈ |ε|·p/(√(p² + ω²)·|ω|·λf) in θm at the fundamental: bounded at
+//!   speed, unbounded as ω → 0. It reaches θ̂ through the less damped loop above,
+//!   |(Kp·s + Ki)/(s² + (Kp − Ki/p)·s + Ki)| (1.49 instead of 1.26 at 20 Hz; tested).
 //! - **Parameters.** L̂ errors act through L̂·di/dt (transients) and, as in fado, under load.
 
 use super::{AngleTrackers, Integrand, TrackerSettings};

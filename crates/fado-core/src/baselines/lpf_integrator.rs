@@ -5,7 +5,7 @@
 //! The pure integrator of eq. (3) drifts with any DC integrand error; the classic remedy
 //! replaces 1/s by the low-pass filter 1/(s + ωc), whose DC gain is finite (J. Hu and B. Wu,
 //! "New integration algorithms for estimating motor flux over a wide speed range", IEEE
-//! Trans. Power Electron. 13(5), 1998, analyse this LPF and its gain and phase error). For a
+//! Trans. Power Electron. 13(5), 1998, discuss this LPF and its gain and phase error). For a
 //! flux rotating at ω the LPF output differs from the integral by the factor
 //! jω/(jω + ωc), so the stator flux is recovered by multiplying with its inverse at the
 //! estimated speed ω̂:
@@ -38,12 +38,14 @@
 //!
 //! # Where it fails
 //! - **Low speed.** Below a few ωc the compensation depends on ω̂ ever more steeply
-//!   (∂∠/∂ω̂ = ωc/(ω̂² + ωc²)), and below ω_f it is switched off, so λ̂s is a low-passed
-//!   EMF rotated towards +90° and the angle is lost; at standstill ψ → (v* − R̂s·i)/ωc.
+//!   (∂∠/∂ω̂ = ωc/(ω̂² + ωc²)), and below ω_f it fades out, so λ̂s becomes the low-passed
+//!   EMF, sgn(ω)·90° ahead of the flux, and the angle is lost; at standstill
+//!   ψ → (v* − R̂s·i)/ωc.
 //!   A speed reversal therefore passes through a region with no valid angle.
 //! - **Offsets.** A DC integrand error ε (current-sensor offset × R̂s, R̂s error on a DC
 //!   current, uncompensated dead time) leaves the standing flux error ε/ωc·(1 − jωc/ω̂): an
-//!   angle ripple at the fundamental of about |ε|/(ωc·λf) (50 mV → 0.09 rad at the default).
+//!   angle ripple at the fundamental of about |ε|/(ωc·λf) in θm (50 mV → 0.09 rad at the
+//!   default), times the tracker's |T(jω)| in θ̂ (tested).
 //!   Raising ωc shrinks it but widens the low-speed region; the transient after a start or
 //!   a step decays with 1/ωc (160 ms at the default).
 //! - **Parameters.** Like fado, R̂s errors act at low speed and L̂q errors under load.

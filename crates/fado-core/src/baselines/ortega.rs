@@ -34,7 +34,8 @@
 //! ```
 //!
 //! whose small root φ ≈ −(ω_obs/2ω)·δ, δ = 1 − (a/λ̂f)², exists only while δ ≤ ω²/ω_obs²
-//! (first order); beyond it only a root near ∓90° is left and the angle is lost. The harmful
+//! (first order); beyond it only a root near ∓90° is left, which is not held: the estimate
+//! slips poles periodically. The harmful
 //! side is a < λ̂f: λ̂f too large, or uq opposing the EMF (R̂s too high while motoring). So a
 //! fixed gain amplifies these errors by ω_obs/ω and its margin shrinks like ω²/ω_obs²: with
 //! ω_obs = 251 rad/s (critical at 300 r/min) the limit under 14.2 A at 90 r/min is a +0.8 %
@@ -42,8 +43,8 @@
 //! ODrive's 1000 rad/s the limit at 300 r/min is +1.9 %.
 //!
 //! **Default: a speed-scheduled gain** ω_obs = clamp(k·|ω̂|, ω_min, ω_max) with k = 2 (ω̂ of
-//! T2S-1): critically damped at every speed, amplification 1 and margin δ ≤ ¼ (a 12 % flux or
-//! EMF error). VESC schedules its γ the same way, linearly in the duty cycle above the floor
+//! T2S-1): critically damped at every speed, amplification 1 and margin δ ≤ ¼ (a ≥ 0.87·λ̂f:
+//! a 13 % flux or EMF error). VESC schedules its γ the same way, linearly in the duty cycle above the floor
 //! `foc_observer_gain_slow`. ω_min = 2·2π·1.5 Hz keeps it critical down to fado's 1.5 Hz mode
 //! threshold; ω_max = 2·2π·100 Hz is critical at the rated 1500 r/min (ω_max·Ts = 0.126).
 //! k = 0 gives the paper's and ODrive's fixed gain ω_obs = `observer_bandwidth`. In the
@@ -63,12 +64,13 @@
 //! `ORTEGA_LAMBDA_COMP` observer (after P. Bernard and L. Praly, IFAC 2017):
 //! dλ̂/dt = κ·(γ/2)·λ̂·(|η̂|² − λ̂²), clamped to [0.3, 2.5]·λ̂f (VESC's bounds; VESC uses
 //! κ = 0.2). While the rotor turns the only equilibrium without a standing radial push is
-//! λ̂ = λf, which removes the Δλ angle error above; at standstill λ̂ is unobservable.
+//! λ̂ = a (λf, or the radius a uq error leaves), which removes the angle error of the lock
+//! condition; at standstill λ̂ is unobservable.
 //! Off by default because fado and the comparison assume known parameters.
 //!
 //! # Where it fails
-//! - **Low speed.** The tangential error decays at ω²/ω_obs (|ω|/2 with the schedule, down to
-//!   ω_min); at standstill the observer is an open integrator along the angle direction and
+//! - **Low speed.** The tangential error decays at ω²/ω_obs (with the schedule as t·e^{−|ω|t},
+//!   down to ω_min); at standstill the observer is an open integrator along the angle direction and
 //!   drifts with any integrand error, and it has no mechanism like fado's limiter and
 //!   positive-i_d steering (Fig. 6, eq. (23)).
 //! - **Offsets.** A DC integrand error ε rotates at −ω in the rotor frame and leaves an angle
