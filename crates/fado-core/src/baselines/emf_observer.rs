@@ -3,7 +3,7 @@
 //! # Algorithm
 //! The extended EMF of Z. Chen, M. Tomita, S. Doki and S. Okuma, "An extended electromotive
 //! force model for sensorless control of interior permanent-magnet synchronous motors", IEEE
-//! Trans. Ind. Electron. 50(2), 2003 (in the rotor frame: Morimoto et al. 2002, ref. [4] of the
+//! Trans. Ind. Electron. 50(2), 2003 (in the rotor frame: Morimoto et al. 2002, ref. \[4\] of the
 //! paper) is the part of the voltage equation that carries the rotor position,
 //! v = R·i + Ld·di/dt + ω(Ld − Lq)·J·i + e_ex. For the surface-mount machine of SPEC §6
 //! (Ld = Lq = L) it is the back-EMF e = d(λf·e^{jθ})/dt = jω·λf·e^{jθ}, a vector rotating at ω
@@ -62,29 +62,29 @@ pub struct EmfObserverConfig<T> {
     /// Inductance estimate L̂ = L̂d = L̂q in H. Default 2.63 mH (paper, V).
     pub lq_hat: T,
     /// Magnet flux linkage estimate λ̂f in Wb: sets the tracker hold level only. Default
-    /// 0.088 Wb (SPEC §6 [A]).
+    /// 0.088 Wb (SPEC §6 \[A\]).
     pub flux_linkage_hat: T,
     /// Bandwidth p/2π of the rotating EMF filter in Hz; 2π·p must exceed Ki/Kp of T2S-1.
-    /// Default 100 Hz [A] (module docs).
+    /// Default 100 Hz \[A\] (module docs).
     pub emf_bandwidth_hz: T,
     /// Speed floor f_f in Hz below which the EMF is divided by 2π·f_f instead of ω̂.
-    /// Default 2 Hz [A]: there the EMF (1.1 V) is already of the order of the dead-time voltage
+    /// Default 2 Hz \[A\]: there the EMF (1.1 V) is already of the order of the dead-time voltage
     /// error of SPEC §5.
     pub speed_floor_hz: T,
     /// Bandwidth of T2S-1 in Hz. Default 60 Hz (paper, V), as fado.
     pub t2s1_bandwidth_hz: T,
     /// Bandwidth of T2S-2 in Hz. Default 35 Hz (paper, V), as fado.
     pub t2s2_bandwidth_hz: T,
-    /// Damping ratio of both trackers. Default 1/√2 (SPEC §3 [A]).
+    /// Damping ratio of both trackers. Default 1/√2 (SPEC §3 \[A\]).
     pub tracker_damping: T,
     /// Meaning of the tracker bandwidths. Default −3 dB (SPEC §3).
     pub bandwidth_definition: BandwidthDefinition,
-    /// Trackers coast while |λ̂r| is below this fraction of λ̂f. Default 0.2 (SPEC §3 [A]).
+    /// Trackers coast while |λ̂r| is below this fraction of λ̂f. Default 0.2 (SPEC §3 \[A\]).
     pub tracker_hold_ratio: T,
     /// Average the current over the interval for the resistive drop. Default true (SPEC §1
-    /// [A]).
+    /// \[A\]).
     pub average_current: bool,
-    /// Rotor angle assumed at reset (rad). Default 0 (SPEC §1 [A]).
+    /// Rotor angle assumed at reset (rad). Default 0 (SPEC §1 \[A\]).
     pub initial_angle: T,
 }
 

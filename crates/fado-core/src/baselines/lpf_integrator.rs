@@ -17,7 +17,7 @@
 //! ```
 //!
 //! ω̂ is the T2S-1 speed of the previous sample. Since 1/ω̂ has no limit at standstill, the
-//! compensation is regularised [A]: 1/ω̂ becomes ω̂/(ω̂² + ω_f²) with the floor
+//! compensation is regularised \[A\]: 1/ω̂ becomes ω̂/(ω̂² + ω_f²) with the floor
 //! ω_f = 2π·`compensation_floor_hz`. It is exact to a relative ω_f²/ω̂² well above the
 //! floor, tends to 1 (no compensation) at ω̂ = 0 and passes through a reversal without a
 //! jump, where a clamped 1/ω̂ would rotate λ̂s by 90° when ω̂ changes sign.
@@ -67,31 +67,31 @@ pub struct LpfIntegratorConfig<T> {
     /// q-axis inductance estimate L̂q in H (eq. (5)). Default 2.63 mH (paper, V).
     pub lq_hat: T,
     /// Magnet flux linkage estimate λ̂f in Wb; sets the start-up flux and the tracker hold
-    /// level only. Default 0.088 Wb (SPEC §6 [A]).
+    /// level only. Default 0.088 Wb (SPEC §6 \[A\]).
     pub flux_linkage_hat: T,
     /// Cutoff fc of the low-pass integrator 1/(s + 2π·fc) in Hz; 0 gives the open integrator
-    /// of eq. (3). Default 1 Hz [A]: one sixth of the 6 Hz electrical speed of the paper's
+    /// of eq. (3). Default 1 Hz \[A\]: one sixth of the 6 Hz electrical speed of the paper's
     /// ±90 r/min tests (compensation 9.5° there), while a DC integrand error ε leaves a bounded
     /// flux error ε/ωc (50 mV → 8 mWb, 9 % of λf).
     pub cutoff_hz: T,
     /// Speed floor f_f of the regularised compensation ωc·ω̂/(ω̂² + ω_f²) in Hz (module docs).
-    /// Default 1 Hz [A]: equal to the cutoff, so the regularised compensation never exceeds
+    /// Default 1 Hz \[A\]: equal to the cutoff, so the regularised compensation never exceeds
     /// atan(½) = 27° and at 6 Hz it differs from the exact one by 4.4 mrad.
     pub compensation_floor_hz: T,
     /// Bandwidth of T2S-1 in Hz. Default 60 Hz (paper, V), as fado.
     pub t2s1_bandwidth_hz: T,
     /// Bandwidth of T2S-2 in Hz. Default 35 Hz (paper, V), as fado.
     pub t2s2_bandwidth_hz: T,
-    /// Damping ratio of both trackers. Default 1/√2 (SPEC §3 [A]).
+    /// Damping ratio of both trackers. Default 1/√2 (SPEC §3 \[A\]).
     pub tracker_damping: T,
     /// Meaning of the tracker bandwidths. Default −3 dB (SPEC §3).
     pub bandwidth_definition: BandwidthDefinition,
-    /// Trackers coast while |λ̂r| is below this fraction of λ̂f. Default 0.2 (SPEC §3 [A]).
+    /// Trackers coast while |λ̂r| is below this fraction of λ̂f. Default 0.2 (SPEC §3 \[A\]).
     pub tracker_hold_ratio: T,
     /// Average the current over the interval for the resistive drop. Default true (SPEC §1
-    /// [A]).
+    /// \[A\]).
     pub average_current: bool,
-    /// Rotor angle assumed at reset (rad). Default 0 (SPEC §1 [A]).
+    /// Rotor angle assumed at reset (rad). Default 0 (SPEC §1 \[A\]).
     pub initial_angle: T,
 }
 

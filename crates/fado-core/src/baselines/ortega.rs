@@ -101,36 +101,36 @@ pub struct OrtegaConfig<T> {
     /// Default 2.63 mH (paper, V).
     pub lq_hat: T,
     /// Magnet flux linkage estimate λ̂f in Wb: the radius η̂ is pulled to. Unlike fado, the
-    /// angle depends on it (module docs). Default 0.088 Wb (SPEC §6 [A]).
+    /// angle depends on it (module docs). Default 0.088 Wb (SPEC §6 \[A\]).
     pub flux_linkage_hat: T,
     /// Radial (flux-magnitude) correction rate ω_obs = γ·λ̂f² in rad/s: the fixed value when
     /// `observer_speed_ratio` is 0, else the upper bound ω_max of the schedule; times `ts` it
-    /// must be below 1. Default 2·2π·100 ≈ 1257 rad/s [A]: critically damped at the rated
+    /// must be below 1. Default 2·2π·100 ≈ 1257 rad/s \[A\]: critically damped at the rated
     /// 1500 r/min (module docs).
     pub observer_bandwidth: T,
     /// Speed ratio k of the schedule ω_obs = clamp(k·|ω̂|, ω_min, ω_max); 0 fixes
-    /// ω_obs = `observer_bandwidth`. Default 2 [A]: critically damped at every speed (module
+    /// ω_obs = `observer_bandwidth`. Default 2 \[A\]: critically damped at every speed (module
     /// docs).
     pub observer_speed_ratio: T,
     /// Lower bound ω_min of the schedule in rad/s, at most `observer_bandwidth`. Default
-    /// 2·2π·1.5 ≈ 18.8 rad/s [A]: critical down to fado's 1.5 Hz mode threshold (paper, V).
+    /// 2·2π·1.5 ≈ 18.8 rad/s \[A\]: critical down to fado's 1.5 Hz mode threshold (paper, V).
     pub observer_bandwidth_min: T,
-    /// Flux-linkage adaptation ratio κ (module docs); 0 disables it. Default 0 [A].
+    /// Flux-linkage adaptation ratio κ (module docs); 0 disables it. Default 0 \[A\].
     pub flux_adaptation_ratio: T,
     /// Bandwidth of T2S-1 in Hz. Default 60 Hz (paper, V), as fado.
     pub t2s1_bandwidth_hz: T,
     /// Bandwidth of T2S-2 in Hz. Default 35 Hz (paper, V), as fado.
     pub t2s2_bandwidth_hz: T,
-    /// Damping ratio of both trackers. Default 1/√2 (SPEC §3 [A]).
+    /// Damping ratio of both trackers. Default 1/√2 (SPEC §3 \[A\]).
     pub tracker_damping: T,
     /// Meaning of the tracker bandwidths. Default −3 dB (SPEC §3).
     pub bandwidth_definition: BandwidthDefinition,
-    /// Trackers coast while |η̂| is below this fraction of λ̂f. Default 0.2 (SPEC §3 [A]).
+    /// Trackers coast while |η̂| is below this fraction of λ̂f. Default 0.2 (SPEC §3 \[A\]).
     pub tracker_hold_ratio: T,
     /// Average the current over the interval for the resistive drop. Default true (SPEC §1
-    /// [A]).
+    /// \[A\]).
     pub average_current: bool,
-    /// Rotor angle assumed at reset (rad). Default 0 (SPEC §1 [A]).
+    /// Rotor angle assumed at reset (rad). Default 0 (SPEC §1 \[A\]).
     pub initial_angle: T,
 }
 
