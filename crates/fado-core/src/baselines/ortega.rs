@@ -52,7 +52,7 @@
 //!
 //! # Discretisation
 //! As in ODrive: predict x̂⁻ = x̂ + Ts·(v* − R̂s·i) (the forward rectangle and averaged current
-//! of [`crate::flux::FluxIntegrator`]), form η̂⁻ = x̂⁻ − L̂·i[n] with the fresh current, then
+//! of [`crate::flux::FluxIntegrator`]), form η̂⁻ = x̂⁻ − L̂·i\[n\] with the fresh current, then
 //! correct x̂ = x̂⁻ + k·η̂⁻ with k = Ts·(γ/2)·(λ̂f² − |η̂⁻|²). The linearised radial map is
 //! 1 − ω_obs·Ts, so `new` requires ω_obs·Ts < 1 (monotone convergence). For |η̂| far outside
 //! the circle k would overshoot through the origin and flip the angle; k is floored at −½,
