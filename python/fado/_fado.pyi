@@ -9,6 +9,22 @@ from typing import Any, ClassVar, Final, Literal, final
 import numpy as np
 import numpy.typing as npt
 
+__all__ = [
+    "EstimatorConfig",
+    "Estimator",
+    "estimate",
+    "EstimateResult",
+    "StepResult",
+    "MODE_LIMITER",
+    "MODE_DISTURBANCE_FEEDBACK",
+    "FadoError",
+    "ConfigError",
+    "InputError",
+    "SimulationError",
+    "__version__",
+    "OUTPUT_NAMES",
+]
+
 __version__: Final[str]
 OUTPUT_NAMES: Final[list[str]]
 MODE_LIMITER: Final[int]
@@ -82,8 +98,8 @@ class EstimatorConfig:
     ) -> EstimatorConfig: ...
     def to_dict(self) -> dict[str, float | str | bool]: ...
     def __getnewargs_ex__(self) -> tuple[tuple[()], dict[str, float | str | bool]]: ...
-    def __eq__(self, other: object) -> bool: ...
-    def __ne__(self, other: object) -> bool: ...
+    def __eq__(self, value: object, /) -> bool: ...
+    def __ne__(self, value: object, /) -> bool: ...
     @property
     def ts(self) -> float:
         """Sampling period Ts in s."""
@@ -141,8 +157,8 @@ class StepResult:
     """One sample of the estimator's outputs and diagnostics (Fig. 5)."""
 
     def to_dict(self) -> dict[str, float | int | bool]: ...
-    def __eq__(self, other: object) -> bool: ...
-    def __ne__(self, other: object) -> bool: ...
+    def __eq__(self, value: object, /) -> bool: ...
+    def __ne__(self, value: object, /) -> bool: ...
     @property
     def theta(self) -> float: ...
     @property

@@ -64,8 +64,8 @@ macro_rules! config_class {
                 let changed = Self {
                     $($field: $field.unwrap_or_else(|| self.$field.clone()),)*
                 };
-                changed.to_core(py)?;
-                Ok(changed)
+                // Validated, and with the bandwidth definition in its canonical spelling.
+                Ok(Self::from_core(&changed.to_core(py)?))
             }
 
             fn items<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
