@@ -43,7 +43,7 @@ impl ColumnSlice<'_> {
 }
 
 impl Column<'_> {
-    /// The samples. Checked contiguous and aligned when the column was made.
+    /// The samples ([`column`] made sure that they form one slice).
     pub fn slice(&self) -> ColumnSlice<'_> {
         match self {
             Column::F64(a) => ColumnSlice::F64(a.as_slice().unwrap_or(&[])),
@@ -132,6 +132,19 @@ pub fn column<'py>(argument: &str, obj: &Bound<'py, PyAny>) -> PyResult<Column<'
             py,
             argument,
             "the array's data are not aligned; pass numpy.require(x, requirements='CA')".to_owned(),
+        ));
+    }
+    // The checks above are exactly what `as_slice` needs; refuse rather than assume.
+    let readable = match &column {
+        Column::F64(a) => a.as_slice().is_ok(),
+        Column::F32(a) => a.as_slice().is_ok(),
+    };
+    if !readable {
+        return Err(input_error(
+            py,
+            argument,
+            "the array's memory cannot be read as one slice; pass numpy.ascontiguousarray(x)"
+                .to_owned(),
         ));
     }
     Ok(column)
