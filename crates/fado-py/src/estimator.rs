@@ -93,16 +93,10 @@ impl Engine {
     /// Replays the signals with the GIL released.
     fn run(&mut self, py: Python<'_>, signals: &Signals<'_>, ts: f64) -> EstimateResult {
         let slices = signals.slices();
-        match self {
-            Engine::F64(e) => {
-                let columns = py.detach(|| run_slices(e, slices));
-                EstimateResult::from_columns(py, columns, ts)
-            }
-            Engine::F32(e) => {
-                let columns = py.detach(|| run_slices(e, slices));
-                EstimateResult::from_columns(py, columns, ts)
-            }
-        }
+        with_engine!(self, e => {
+            let columns = py.detach(|| run_slices(e, slices));
+            EstimateResult::from_columns(py, columns, ts)
+        })
     }
 }
 
@@ -175,6 +169,8 @@ impl PyEstimator {
 
     /// Steps through whole arrays (1-D, contiguous, float64 or float32, equal lengths) with the
     /// GIL released, continuing from the present state; returns every output as arrays.
+    /// Other threads keep running meanwhile: they must not write to the input arrays, and
+    /// using this estimator from another thread raises until the call returns.
     fn run(
         &mut self,
         py: Python<'_>,
@@ -256,7 +252,8 @@ impl PyEstimator {
 /// `ts` overrides `config.ts`; `theta0` aligns the estimator at that angle with the first
 /// current sample before the first step (otherwise it starts at `config.initial_angle`);
 /// `dtype='float32'` runs the single-precision estimator. Bad arrays raise `InputError`,
-/// bad settings `ConfigError` (both are `ValueError`s).
+/// bad settings `ConfigError` (both are `ValueError`s). The inputs are read in place, not
+/// copied: other threads must not write to them during the call.
 #[pyfunction]
 #[pyo3(
     signature = (v_alpha, v_beta, i_alpha, i_beta, *, ts = None, config = None, theta0 = None, dtype = Dtype::Float64),
