@@ -77,15 +77,28 @@ impl<T: Real> FluxIntegrator<T> {
         if !(v_ab.is_finite() && i_ab.is_finite() && feedback.is_finite()) {
             return Err(NonFiniteInput);
         }
+        let lambda1 = self.next_flux(v_ab, i_ab, feedback);
+        self.commit(lambda1, i_ab);
+        Ok(lambda1)
+    }
+
+    /// λ1 after one more sample, computed without changing the state.
+    #[inline]
+    pub(crate) fn next_flux(&self, v_ab: Ab<T>, i_ab: Ab<T>, feedback: Ab<T>) -> Ab<T> {
         let i_drop = if self.config.average_current && self.has_prev {
             (i_ab + self.i_prev) * T::lit(0.5)
         } else {
             i_ab
         };
+        self.lambda1 + (v_ab - i_drop * self.config.rs_hat - feedback) * self.config.ts
+    }
+
+    /// Takes λ1 computed by [`Self::next_flux`] for the sample with current `i_ab`.
+    #[inline]
+    pub(crate) fn commit(&mut self, lambda1: Ab<T>, i_ab: Ab<T>) {
+        self.lambda1 = lambda1;
         self.i_prev = i_ab;
         self.has_prev = true;
-        self.lambda1 += (v_ab - i_drop * self.config.rs_hat - feedback) * self.config.ts;
-        Ok(self.lambda1)
     }
 
     /// λ1, the integrated stator flux.
@@ -167,12 +180,24 @@ impl<T: Real> DisturbanceFeedback<T> {
     /// One sample: returns k_df·D̂ when `active`, 0 otherwise (the gain ramps on activation).
     #[inline]
     pub fn step(&mut self, active: bool, disturbance: Ab<T>) -> Ab<T> {
-        self.gain = if active {
+        self.gain = self.next_gain(active);
+        disturbance * self.gain
+    }
+
+    /// The gain the next sample would use, without changing the state.
+    #[inline]
+    pub(crate) fn next_gain(&self, active: bool) -> T {
+        if active {
             (self.gain + self.ramp_increment).min(self.k_df)
         } else {
             T::zero()
-        };
-        disturbance * self.gain
+        }
+    }
+
+    /// Takes a gain computed by [`Self::next_gain`].
+    #[inline]
+    pub(crate) fn commit(&mut self, gain: T) {
+        self.gain = gain;
     }
 
     /// The gain in effect after the last step.

@@ -67,13 +67,25 @@ impl<T: Real> ModeSelector<T> {
     /// One sample with the speed estimate ω̂ (rad/s, electrical, signed).
     #[inline]
     pub fn step(&mut self, omega: T) -> Mode {
+        self.mode = self.next_mode(omega);
+        self.mode
+    }
+
+    /// The mode the next sample would select, without changing the state.
+    #[inline]
+    pub(crate) fn next_mode(&self, omega: T) -> Mode {
         let w = omega.abs();
-        self.mode = match self.mode {
+        match self.mode {
             Mode::Limiter if w > self.enter => Mode::DisturbanceFeedback,
             Mode::DisturbanceFeedback if w < self.leave => Mode::Limiter,
             m => m,
-        };
-        self.mode
+        }
+    }
+
+    /// Takes a mode computed by [`Self::next_mode`].
+    #[inline]
+    pub(crate) fn commit(&mut self, mode: Mode) {
+        self.mode = mode;
     }
 
     /// The current mode.
