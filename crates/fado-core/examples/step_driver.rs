@@ -8,7 +8,7 @@
 
 use std::hint::black_box;
 
-use fado_core::{Ab, EstimatorConfig, Real, SensorlessEstimator};
+use fado_core::{Ab, Estimate, EstimatorConfig, Real, SensorlessEstimator};
 
 /// Samples in the signal table: a power of two holding exactly 8 electrical periods.
 const TABLE: usize = 4096;
@@ -42,6 +42,13 @@ fn signal<T: Real>() -> Vec<(Ab<T>, Ab<T>)> {
         .collect()
 }
 
+/// One estimator step behind a call, as a firmware ISR makes it; not inlined, so that callgrind
+/// can count exactly the instructions inside (`--toggle-collect=*isr_step*`).
+#[inline(never)]
+fn isr_step<T: Real>(est: &mut SensorlessEstimator<T>, v: Ab<T>, i: Ab<T>) -> Estimate<T> {
+    est.step(v, i)
+}
+
 fn run<T: Real>(steps: usize) -> f64 {
     let table = signal::<T>();
     let mut est = SensorlessEstimator::<T>::new(EstimatorConfig::default()).expect("valid");
@@ -52,7 +59,7 @@ fn run<T: Real>(steps: usize) -> f64 {
     let mut acc = T::zero();
     for k in 0..steps {
         let (v, i) = table[k & (TABLE - 1)];
-        let out = est.step(black_box(v), black_box(i));
+        let out = isr_step(&mut est, black_box(v), black_box(i));
         acc += black_box(out).theta;
     }
     acc.to_f64()
