@@ -141,15 +141,32 @@ const ONE_MINUS_EXP_OVER_Y: [f64; 13] = [
 fn half_angle_terms<T: Real>(x: T) -> (T, T, T) {
     let y = x.abs();
     if y <= T::lit(SERIES_LIMIT) {
-        // f32 needs fewer terms; the test folds to a constant per type.
-        let single = T::one() + T::lit(1e-12) == T::one();
-        let (n_sin, n_cos, n_exp) = if single { (4, 4, 8) } else { (6, 7, 13) };
         let h = x * T::lit(0.5);
         let h2 = h * h;
-        let sh = h * horner(h2, &SIN_OVER_H[..n_sin]);
-        let ch = horner(h2, &COS[..n_cos]);
-        let one_minus_r = y * horner(y, &ONE_MINUS_EXP_OVER_Y[..n_exp]);
-        (sh, ch, one_minus_r)
+        let h4 = h2 * h2;
+        let y2 = y * y;
+        let y4 = y2 * y2;
+        // f32 needs fewer terms (the test folds to a constant per type); the sums are grouped
+        // by Estrin's scheme (see `cubic`).
+        let (sin_over_h, cos, one_minus_exp_over_y) = if T::one() + T::lit(1e-12) == T::one() {
+            let (s, c, e) = (&SIN_OVER_H, &COS, &ONE_MINUS_EXP_OVER_Y);
+            (
+                cubic(h2, h4, s),
+                cubic(h2, h4, c),
+                cubic(y, y2, e) + y4 * cubic(y, y2, &e[4..]),
+            )
+        } else {
+            let (s, c, e) = (&SIN_OVER_H, &COS, &ONE_MINUS_EXP_OVER_Y);
+            let lit = T::lit;
+            let y8 = y4 * y4;
+            (
+                cubic(h2, h4, s) + h4 * h4 * (lit(s[4]) + lit(s[5]) * h2),
+                cubic(h2, h4, c) + h4 * h4 * ((lit(c[4]) + lit(c[5]) * h2) + h4 * lit(c[6])),
+                (cubic(y, y2, e) + y4 * cubic(y, y2, &e[4..]))
+                    + y8 * (cubic(y, y2, &e[8..]) + y4 * lit(e[12])),
+            )
+        };
+        (h * sin_over_h, cos, y * one_minus_exp_over_y)
     } else {
         // Large speeds (and NaN, which propagates).
         let (sh, ch) = (x * T::lit(0.5)).sin_cos();
@@ -157,13 +174,12 @@ fn half_angle_terms<T: Real>(x: T) -> (T, T, T) {
     }
 }
 
-/// Σ c_k·t^k by Horner's rule.
+/// c0 + c1·t + c2·t² + c3·t³ as (c0 + c1·t) + t²·(c2 + c3·t) (Estrin's scheme): two
+/// multiply-adds deep instead of Horner's three. The gains sit on the estimator's
+/// sample-to-sample critical path (ω̂ → gains → D̂ → θm → ω̂), so depth is time.
 #[inline(always)]
-fn horner<T: Real>(t: T, coefficients: &[f64]) -> T {
-    coefficients
-        .iter()
-        .rev()
-        .fold(T::zero(), |acc, &c| acc * t + T::lit(c))
+fn cubic<T: Real>(t: T, t2: T, c: &[f64]) -> T {
+    (T::lit(c[0]) + T::lit(c[1]) * t) + t2 * (T::lit(c[2]) + T::lit(c[3]) * t)
 }
 
 /// Continuous-time gains of eq. (16) for a flux speed ω (rad/s, signed):
