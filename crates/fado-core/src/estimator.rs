@@ -37,11 +37,11 @@ pub struct EstimatorConfig<T> {
     pub lq_hat: T,
     /// Magnet flux linkage estimate λ̂f in Wb (peak, per phase). Sets the limiter radius, the
     /// tracker hold level and the start-up flux only; the angle does not depend on it (eq. (6)).
-    /// Default 0.088 Wb (SPEC §6 [A]).
+    /// Default 0.088 Wb (SPEC §6 \[A\]).
     pub flux_linkage_hat: T,
     /// Disturbance feedback gain k_df in s⁻¹ (Fig. 3). Default 0.5 (paper, V).
     pub k_df: T,
-    /// Ramp time of k_df on activation in s, 0 = abrupt as in the paper. Default 0 (SPEC §1 [A]).
+    /// Ramp time of k_df on activation in s, 0 = abrupt as in the paper. Default 0 (SPEC §1 \[A\]).
     pub k_df_ramp_time: T,
     /// Limiter gain k_af in s⁻¹ (Fig. 6). Default 2π·100 (paper, V).
     pub k_af: T,
@@ -49,22 +49,22 @@ pub struct EstimatorConfig<T> {
     pub limiter_radius_ratio: T,
     /// Speed threshold between limiter and k_df in Hz electrical. Default 1.5 Hz (paper, V).
     pub mode_threshold_hz: T,
-    /// Hysteresis half-band of the threshold in Hz. Default 0.2 Hz (SPEC §1 [A]).
+    /// Hysteresis half-band of the threshold in Hz. Default 0.2 Hz (SPEC §1 \[A\]).
     pub mode_hysteresis_hz: T,
     /// Bandwidth of T2S-1 (angle, observer speed) in Hz. Default 60 Hz (paper, V).
     pub t2s1_bandwidth_hz: T,
     /// Bandwidth of T2S-2 (speed for control) in Hz. Default 35 Hz (paper, V).
     pub t2s2_bandwidth_hz: T,
-    /// Damping ratio of both trackers. Default 1/√2 (SPEC §3 [A]).
+    /// Damping ratio of both trackers. Default 1/√2 (SPEC §3 \[A\]).
     pub tracker_damping: T,
     /// Meaning of the tracker bandwidths. Default −3 dB (SPEC §3).
     pub bandwidth_definition: BandwidthDefinition,
     /// Trackers coast (no update) while |λ̂r| is below this fraction of λ̂f. Default 0.2
-    /// (SPEC §3 [A]).
+    /// (SPEC §3 \[A\]).
     pub tracker_hold_ratio: T,
-    /// Average the current over the interval for the resistive drop. Default true (SPEC §1 [A]).
+    /// Average the current over the interval for the resistive drop. Default true (SPEC §1 \[A\]).
     pub average_current: bool,
-    /// Rotor angle assumed at reset (rad), e.g. from an alignment. Default 0 (SPEC §1 [A]).
+    /// Rotor angle assumed at reset (rad), e.g. from an alignment. Default 0 (SPEC §1 \[A\]).
     pub initial_angle: T,
 }
 

@@ -15,8 +15,8 @@ pub struct FluxIntegratorConfig<T> {
     pub ts: T,
     /// Stator resistance estimate R̂s in Ω. Default 0.327 Ω (paper, section V).
     pub rs_hat: T,
-    /// Use (i[n] + i[n−1])/2 for the resistive drop, which matches the interval the applied
-    /// voltage acted over (SPEC §1, [A]). Default `true`.
+    /// Use (i\[n\] + i[n−1])/2 for the resistive drop, which matches the interval the applied
+    /// voltage acted over (SPEC §1, \[A\]). Default `true`.
     pub average_current: bool,
 }
 
@@ -66,7 +66,7 @@ impl<T: Real> FluxIntegrator<T> {
     }
 
     /// One sample: `v_ab` applied over the last interval, `i_ab` sampled now, `feedback` the
-    /// k_df·D̂ or k_af·(λ̂r − λ̂r_lim) term (V). Returns λ1[n].
+    /// k_df·D̂ or k_af·(λ̂r − λ̂r_lim) term (V). Returns λ1\[n\].
     #[inline]
     pub fn step(
         &mut self,
@@ -127,7 +127,7 @@ pub struct DisturbanceFeedbackConfig<T> {
     /// Disturbance feedback gain k_df in s⁻¹ (Fig. 3, eq. (21)). Default 0.5 (paper, V).
     pub k_df: T,
     /// Time to ramp k_df from 0 to its value on activation, s; 0 switches it abruptly as the
-    /// paper does. A ramp softens the re-activation distortion of Fig. 9 (SPEC §1 [A]).
+    /// paper does. A ramp softens the re-activation distortion of Fig. 9 (SPEC §1 \[A\]).
     /// Default 0.
     pub ramp_time: T,
 }
@@ -212,7 +212,7 @@ pub struct FluxLimiterConfig<T> {
     /// Convergence gain k_af in s⁻¹ (Fig. 6, eq. (24)-(25)). Default 2π·100 (paper, V).
     pub k_af: T,
     /// Radius ρ of the limiting circle in Wb. Default 1.15·0.088 = 0.1012 Wb (paper, V:
-    /// 1.15 times the flux linkage; λf = 0.088 Wb is SPEC §6 [A]).
+    /// 1.15 times the flux linkage; λf = 0.088 Wb is SPEC §6 \[A\]).
     pub radius: T,
 }
 
@@ -236,7 +236,7 @@ pub struct LimiterOutput<T> {
 
 /// The flux limiter of Fig. 6 (eq. (24)-(25)).
 ///
-/// Π(x) = x·min(1, ρ/|x|) is the radial projection onto the disc of radius ρ (SPEC §1 [A]):
+/// Π(x) = x·min(1, ρ/|x|) is the radial projection onto the disc of radius ρ (SPEC §1 \[A\]):
 /// inside the circle the integrator is pure, outside the excess is pulled back radially with
 /// time constant 1/k_af (1.6 ms by default), and the angle is never constrained.
 /// Stateless apart from its configuration; `step` and `reset` exist for uniformity.

@@ -20,7 +20,7 @@ pub struct ModeSelectorConfig<T> {
     /// Threshold on |ω̂|/2π in Hz, electrical. Default 1.5 Hz (paper, section V).
     pub threshold_hz: T,
     /// Half-width of the hysteresis band in Hz: enter above threshold + h, leave below
-    /// threshold − h. Default 0.2 Hz (SPEC §1 [A]).
+    /// threshold − h. Default 0.2 Hz (SPEC §1 \[A\]).
     pub hysteresis_hz: T,
 }
 

@@ -234,7 +234,7 @@ impl<T: Real> DisturbanceObserver<T> {
         self.d = Ab::zero();
     }
 
-    /// One sample: `lambda1` is λ1[n] (the integrator output), `omega` the signed flux speed
+    /// One sample: `lambda1` is λ1\[n\] (the integrator output), `omega` the signed flux speed
     /// estimate (rad/s) used for the adaptive gains. Returns D̂ after the update.
     ///
     /// A non-finite input is refused and leaves the state untouched.
@@ -273,7 +273,9 @@ impl<T: Real> DisturbanceObserver<T> {
         self.d
     }
 
-    /// λ̂1, the observer's estimate of the stator flux including the disturbance.
+    /// λ̂1, the observer's estimate of the stator flux including the disturbance. After a
+    /// `step` with λ1\[n\] it is the internal model's prediction of λ1[n+1] (the flux rotated on
+    /// by one sample), which is what the next innovation is measured against.
     #[inline]
     pub fn flux(&self) -> Ab<T> {
         self.z

@@ -3,7 +3,7 @@
 //!
 //! Two integrators in the open loop make it type 2: zero steady-state angle error for a
 //! constant speed and a constant error α/Ki for a constant acceleration α. The closed loop is
-//! T(s) = (Kp·s + Ki)/(s² + Kp·s + Ki), Kp = 2ζωn, Ki = ωn² (SPEC §3 [A]: the paper's
+//! T(s) = (Kp·s + Ki)/(s² + Kp·s + Ki), Kp = 2ζωn, Ki = ωn² (SPEC §3 \[A\]: the paper's
 //! references 9 and 11 that define it are not recoverable).
 //!
 //! Discretisation (SPEC §3): e = wrap(θm − θ̂⁻); xI ← xI + Ki·Ts·e;
@@ -40,7 +40,7 @@ pub struct TrackerConfig<T> {
     pub ts: T,
     /// Bandwidth in Hz. Default 60 Hz (paper, V: T2S-1); T2S-2 uses 35 Hz.
     pub bandwidth_hz: T,
-    /// Damping ratio ζ. Default 1/√2 (SPEC §3 [A]).
+    /// Damping ratio ζ. Default 1/√2 (SPEC §3 \[A\]).
     pub damping: T,
     /// How `bandwidth_hz` is defined. Default −3 dB (SPEC §3).
     pub definition: BandwidthDefinition,
@@ -139,7 +139,7 @@ impl<T: Real> TypeTwoTracker<T> {
     }
 
     /// One sample without a measurement: θ̂ coasts at ω̂ and the integrator holds (used when
-    /// |λ̂r| is too small for eq. (6) to mean anything, SPEC §3 [A]).
+    /// |λ̂r| is too small for eq. (6) to mean anything, SPEC §3 \[A\]).
     #[inline]
     pub fn coast(&mut self) -> (T, T) {
         let next = self.coasted_state();
