@@ -27,7 +27,7 @@ if [[ ! -d "$venv" ]]; then
         "$python" -m virtualenv --quiet "$venv"
     fi
 fi
-"$venv/bin/python" -m pip install --quiet --upgrade pip
+"$venv/bin/python" -m pip install --quiet --upgrade pip || echo "pip upgrade failed (offline?): keeping the venv's pip"
 # Builds the extension through its maturin build backend (pip fetches maturin as needed).
 "$venv/bin/python" -m pip install --quiet '.[plot,pandas]' pytest
 
