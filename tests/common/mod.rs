@@ -45,3 +45,55 @@ pub fn constant_speed(
         (v, i, theta)
     })
 }
+
+/// One sample of a [`profile`]: what the estimator is given and the truth behind it.
+#[derive(Clone, Copy, Debug)]
+pub struct Sample {
+    /// Voltage applied over the interval ending at this sample (plus any voltage error).
+    pub v: Ab<f64>,
+    /// Current as measured now (true current plus any sensor offset).
+    pub i: Ab<f64>,
+    /// True electrical rotor angle.
+    pub theta: f64,
+    /// True electrical speed (rad/s).
+    pub omega: f64,
+}
+
+/// Samples of the ideal machine following the electrical speed `speed(t)` (rad/s) with rotor
+/// currents `i_dq(t)`, starting at `theta0` (t = 0 is sample 0, which is not emitted). The angle
+/// integrates the speed by the trapezoidal rule. `v_error` is added to the voltage (an
+/// integrand error), `i_offset` to the measured current (a sensor offset); the voltage itself
+/// is computed from the true current.
+pub fn profile(
+    theta0: f64,
+    samples: usize,
+    speed: impl Fn(f64) -> f64,
+    i_dq: impl Fn(f64) -> Dq<f64>,
+    v_error: Ab<f64>,
+    i_offset: Ab<f64>,
+) -> impl Iterator<Item = Sample> {
+    let mut theta = theta0;
+    let mut omega = speed(0.0);
+    let (mut lambda_prev, mut i_prev) = flux_and_current(theta0, i_dq(0.0));
+    (1..=samples).map(move |n| {
+        let t = TS * n as f64;
+        let omega_now = speed(t);
+        theta += 0.5 * TS * (omega + omega_now);
+        omega = omega_now;
+        let (lambda, i) = flux_and_current(theta, i_dq(t));
+        let v = (lambda - lambda_prev) * (1.0 / TS) + (i + i_prev) * (0.5 * RS) + v_error;
+        lambda_prev = lambda;
+        i_prev = i;
+        Sample {
+            v,
+            i: i + i_offset,
+            theta,
+            omega,
+        }
+    })
+}
+
+/// Electrical rad/s from mechanical r/min (the user-facing unit of the paper's figures).
+pub fn rpm_to_electrical(rpm: f64) -> f64 {
+    rpm * PP * core::f64::consts::TAU / 60.0
+}

@@ -37,11 +37,11 @@ pub struct EstimatorConfig<T> {
     pub lq_hat: T,
     /// Magnet flux linkage estimate λ̂f in Wb (peak, per phase). Sets the limiter radius, the
     /// tracker hold level and the start-up flux only; the angle does not depend on it (eq. (6)).
-    /// Default 0.088 Wb (SPEC §6 [A]).
+    /// Default 0.088 Wb (SPEC §6 \[A\]).
     pub flux_linkage_hat: T,
     /// Disturbance feedback gain k_df in s⁻¹ (Fig. 3). Default 0.5 (paper, V).
     pub k_df: T,
-    /// Ramp time of k_df on activation in s, 0 = abrupt as in the paper. Default 0 (SPEC §1 [A]).
+    /// Ramp time of k_df on activation in s, 0 = abrupt as in the paper. Default 0 (SPEC §1 \[A\]).
     pub k_df_ramp_time: T,
     /// Limiter gain k_af in s⁻¹ (Fig. 6). Default 2π·100 (paper, V).
     pub k_af: T,
@@ -49,22 +49,22 @@ pub struct EstimatorConfig<T> {
     pub limiter_radius_ratio: T,
     /// Speed threshold between limiter and k_df in Hz electrical. Default 1.5 Hz (paper, V).
     pub mode_threshold_hz: T,
-    /// Hysteresis half-band of the threshold in Hz. Default 0.2 Hz (SPEC §1 [A]).
+    /// Hysteresis half-band of the threshold in Hz. Default 0.2 Hz (SPEC §1 \[A\]).
     pub mode_hysteresis_hz: T,
     /// Bandwidth of T2S-1 (angle, observer speed) in Hz. Default 60 Hz (paper, V).
     pub t2s1_bandwidth_hz: T,
     /// Bandwidth of T2S-2 (speed for control) in Hz. Default 35 Hz (paper, V).
     pub t2s2_bandwidth_hz: T,
-    /// Damping ratio of both trackers. Default 1/√2 (SPEC §3 [A]).
+    /// Damping ratio of both trackers. Default 1/√2 (SPEC §3 \[A\]).
     pub tracker_damping: T,
     /// Meaning of the tracker bandwidths. Default −3 dB (SPEC §3).
     pub bandwidth_definition: BandwidthDefinition,
     /// Trackers coast (no update) while |λ̂r| is below this fraction of λ̂f. Default 0.2
-    /// (SPEC §3 [A]).
+    /// (SPEC §3 \[A\]).
     pub tracker_hold_ratio: T,
-    /// Average the current over the interval for the resistive drop. Default true (SPEC §1 [A]).
+    /// Average the current over the interval for the resistive drop. Default true (SPEC §1 \[A\]).
     pub average_current: bool,
-    /// Rotor angle assumed at reset (rad), e.g. from an alignment. Default 0 (SPEC §1 [A]).
+    /// Rotor angle assumed at reset (rad), e.g. from an alignment. Default 0 (SPEC §1 \[A\]).
     pub initial_angle: T,
 }
 
@@ -301,65 +301,59 @@ impl<T: Real> SensorlessEstimator<T> {
         if !(v_ab.is_finite() && i_ab.is_finite()) {
             return self.reject();
         }
-        let backup = *self;
-        match self.step_unchecked(v_ab, i_ab) {
-            Some(out) => {
-                self.last = out;
-                out
-            }
-            None => {
-                // Finite but absurd inputs overflowed a state: roll back, never poison.
-                *self = backup;
-                self.reject()
-            }
-        }
-    }
-
-    fn reject(&mut self) -> Estimate<T> {
-        self.rejected_samples = self.rejected_samples.saturating_add(1);
-        let mut out = self.last;
-        out.diagnostics.input_fault = true;
-        out
-    }
-
-    #[inline]
-    fn step_unchecked(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> Option<Estimate<T>> {
+        // The whole new state is computed first and committed only if it is finite: finite but
+        // absurd inputs can still overflow a state, and a rejected sample must leave none of it
+        // changed. (Cheaper than copying the estimator as a backup every sample.)
         // 1. Integrate with the feedback of the previous sample (eq. (21) / (24)).
-        let lambda1 = self.integrator.step(v_ab, i_ab, self.feedback).ok()?;
+        let lambda1 = self.integrator.next_flux(v_ab, i_ab, self.feedback);
         // 2. Disturbance observer at ω̂ of T2S-1 (eq. (10), (16)).
-        let disturbance = self.observer.step(lambda1, self.t2s1.speed()).ok()?;
+        let (observer_flux, disturbance) = self.observer.next_state(lambda1, self.t2s1.speed());
         // 3. Rotor flux and direct angle (eq. (20), (5), (6)).
         let lambda2 = stator_flux(lambda1, disturbance);
         let lambda_r = rotor_flux(lambda2, i_ab, self.config.lq_hat);
         let tracker_hold = lambda_r.norm_squared() < self.hold_level_sq;
         let theta_direct = rotor_angle(lambda_r);
         // 4. Trackers (Fig. 1, Fig. 5).
-        let (theta, omega, omega_control) = if tracker_hold {
-            let (th, w) = self.t2s1.coast();
-            (th, w, self.t2s2.coast().1)
+        let (t2s1, t2s2) = if tracker_hold {
+            (self.t2s1.coasted_state(), self.t2s2.coasted_state())
         } else {
-            let (th, w) = self.t2s1.step(theta_direct).ok()?;
-            (th, w, self.t2s2.step(theta_direct).ok()?.1)
+            (
+                self.t2s1.next_state(theta_direct),
+                self.t2s2.next_state(theta_direct),
+            )
         };
         // 5. Mode from the control speed, and the feedback for the next sample.
-        let mode = self.selector.step(omega_control);
+        let mode = self.selector.next_mode(t2s2.omega);
         let kdf_active = mode == Mode::DisturbanceFeedback && self.k_df_enabled;
-        let kdf_fb = self.disturbance_feedback.step(kdf_active, disturbance);
+        let kdf_gain = self.disturbance_feedback.next_gain(kdf_active);
         let (feedback, clamping) = match mode {
-            Mode::DisturbanceFeedback => (kdf_fb, false),
+            Mode::DisturbanceFeedback => (disturbance * kdf_gain, false),
             Mode::Limiter => {
                 let l = self.limiter.step(lambda_r);
                 (l.feedback, l.clamping)
             }
         };
-        if !(feedback.is_finite() && disturbance.is_finite() && lambda1.is_finite()) {
-            return None;
+        let finite = lambda1.is_finite()
+            & observer_flux.is_finite()
+            & disturbance.is_finite()
+            & lambda_r.is_finite()
+            & feedback.is_finite()
+            & t2s1.is_finite()
+            & t2s2.is_finite();
+        if !finite {
+            return self.reject();
         }
+        self.integrator.commit(lambda1, i_ab);
+        self.observer.commit(observer_flux, disturbance);
+        self.t2s1.commit(t2s1);
+        self.t2s2.commit(t2s2);
+        self.selector.commit(mode);
+        self.disturbance_feedback.commit(kdf_gain);
         self.feedback = feedback;
-        Some(Estimate {
-            theta,
-            omega,
-            omega_control,
+        let out = Estimate {
+            theta: t2s1.theta,
+            omega: t2s1.omega,
+            omega_control: t2s2.omega,
             diagnostics: Diagnostics {
                 lambda1,
                 disturbance,
@@ -372,7 +366,16 @@ impl<T: Real> SensorlessEstimator<T> {
                 tracker_hold,
                 input_fault: false,
             },
-        })
+        };
+        self.last = out;
+        out
+    }
+
+    fn reject(&mut self) -> Estimate<T> {
+        self.rejected_samples = self.rejected_samples.saturating_add(1);
+        let mut out = self.last;
+        out.diagnostics.input_fault = true;
+        out
     }
 
     /// The last good estimate.

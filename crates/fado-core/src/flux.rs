@@ -15,8 +15,8 @@ pub struct FluxIntegratorConfig<T> {
     pub ts: T,
     /// Stator resistance estimate R̂s in Ω. Default 0.327 Ω (paper, section V).
     pub rs_hat: T,
-    /// Use (i[n] + i[n−1])/2 for the resistive drop, which matches the interval the applied
-    /// voltage acted over (SPEC §1, [A]). Default `true`.
+    /// Use (i\[n\] + i[n−1])/2 for the resistive drop, which matches the interval the applied
+    /// voltage acted over (SPEC §1, \[A\]). Default `true`.
     pub average_current: bool,
 }
 
@@ -66,7 +66,7 @@ impl<T: Real> FluxIntegrator<T> {
     }
 
     /// One sample: `v_ab` applied over the last interval, `i_ab` sampled now, `feedback` the
-    /// k_df·D̂ or k_af·(λ̂r − λ̂r_lim) term (V). Returns λ1[n].
+    /// k_df·D̂ or k_af·(λ̂r − λ̂r_lim) term (V). Returns λ1\[n\].
     #[inline]
     pub fn step(
         &mut self,
@@ -77,15 +77,28 @@ impl<T: Real> FluxIntegrator<T> {
         if !(v_ab.is_finite() && i_ab.is_finite() && feedback.is_finite()) {
             return Err(NonFiniteInput);
         }
+        let lambda1 = self.next_flux(v_ab, i_ab, feedback);
+        self.commit(lambda1, i_ab);
+        Ok(lambda1)
+    }
+
+    /// λ1 after one more sample, computed without changing the state.
+    #[inline]
+    pub(crate) fn next_flux(&self, v_ab: Ab<T>, i_ab: Ab<T>, feedback: Ab<T>) -> Ab<T> {
         let i_drop = if self.config.average_current && self.has_prev {
             (i_ab + self.i_prev) * T::lit(0.5)
         } else {
             i_ab
         };
+        self.lambda1 + (v_ab - i_drop * self.config.rs_hat - feedback) * self.config.ts
+    }
+
+    /// Takes λ1 computed by [`Self::next_flux`] for the sample with current `i_ab`.
+    #[inline]
+    pub(crate) fn commit(&mut self, lambda1: Ab<T>, i_ab: Ab<T>) {
+        self.lambda1 = lambda1;
         self.i_prev = i_ab;
         self.has_prev = true;
-        self.lambda1 += (v_ab - i_drop * self.config.rs_hat - feedback) * self.config.ts;
-        Ok(self.lambda1)
     }
 
     /// λ1, the integrated stator flux.
@@ -114,7 +127,7 @@ pub struct DisturbanceFeedbackConfig<T> {
     /// Disturbance feedback gain k_df in s⁻¹ (Fig. 3, eq. (21)). Default 0.5 (paper, V).
     pub k_df: T,
     /// Time to ramp k_df from 0 to its value on activation, s; 0 switches it abruptly as the
-    /// paper does. A ramp softens the re-activation distortion of Fig. 9 (SPEC §1 [A]).
+    /// paper does. A ramp softens the re-activation distortion of Fig. 9 (SPEC §1 \[A\]).
     /// Default 0.
     pub ramp_time: T,
 }
@@ -167,12 +180,24 @@ impl<T: Real> DisturbanceFeedback<T> {
     /// One sample: returns k_df·D̂ when `active`, 0 otherwise (the gain ramps on activation).
     #[inline]
     pub fn step(&mut self, active: bool, disturbance: Ab<T>) -> Ab<T> {
-        self.gain = if active {
+        self.gain = self.next_gain(active);
+        disturbance * self.gain
+    }
+
+    /// The gain the next sample would use, without changing the state.
+    #[inline]
+    pub(crate) fn next_gain(&self, active: bool) -> T {
+        if active {
             (self.gain + self.ramp_increment).min(self.k_df)
         } else {
             T::zero()
-        };
-        disturbance * self.gain
+        }
+    }
+
+    /// Takes a gain computed by [`Self::next_gain`].
+    #[inline]
+    pub(crate) fn commit(&mut self, gain: T) {
+        self.gain = gain;
     }
 
     /// The gain in effect after the last step.
@@ -187,7 +212,7 @@ pub struct FluxLimiterConfig<T> {
     /// Convergence gain k_af in s⁻¹ (Fig. 6, eq. (24)-(25)). Default 2π·100 (paper, V).
     pub k_af: T,
     /// Radius ρ of the limiting circle in Wb. Default 1.15·0.088 = 0.1012 Wb (paper, V:
-    /// 1.15 times the flux linkage; λf = 0.088 Wb is SPEC §6 [A]).
+    /// 1.15 times the flux linkage; λf = 0.088 Wb is SPEC §6 \[A\]).
     pub radius: T,
 }
 
@@ -211,7 +236,7 @@ pub struct LimiterOutput<T> {
 
 /// The flux limiter of Fig. 6 (eq. (24)-(25)).
 ///
-/// Π(x) = x·min(1, ρ/|x|) is the radial projection onto the disc of radius ρ (SPEC §1 [A]):
+/// Π(x) = x·min(1, ρ/|x|) is the radial projection onto the disc of radius ρ (SPEC §1 \[A\]):
 /// inside the circle the integrator is pure, outside the excess is pulled back radially with
 /// time constant 1/k_af (1.6 ms by default), and the angle is never constrained.
 /// Stateless apart from its configuration; `step` and `reset` exist for uniformity.

@@ -20,7 +20,7 @@ pub struct ModeSelectorConfig<T> {
     /// Threshold on |ω̂|/2π in Hz, electrical. Default 1.5 Hz (paper, section V).
     pub threshold_hz: T,
     /// Half-width of the hysteresis band in Hz: enter above threshold + h, leave below
-    /// threshold − h. Default 0.2 Hz (SPEC §1 [A]).
+    /// threshold − h. Default 0.2 Hz (SPEC §1 \[A\]).
     pub hysteresis_hz: T,
 }
 
@@ -67,13 +67,25 @@ impl<T: Real> ModeSelector<T> {
     /// One sample with the speed estimate ω̂ (rad/s, electrical, signed).
     #[inline]
     pub fn step(&mut self, omega: T) -> Mode {
+        self.mode = self.next_mode(omega);
+        self.mode
+    }
+
+    /// The mode the next sample would select, without changing the state.
+    #[inline]
+    pub(crate) fn next_mode(&self, omega: T) -> Mode {
         let w = omega.abs();
-        self.mode = match self.mode {
+        match self.mode {
             Mode::Limiter if w > self.enter => Mode::DisturbanceFeedback,
             Mode::DisturbanceFeedback if w < self.leave => Mode::Limiter,
             m => m,
-        };
-        self.mode
+        }
+    }
+
+    /// Takes a mode computed by [`Self::next_mode`].
+    #[inline]
+    pub(crate) fn commit(&mut self, mode: Mode) {
+        self.mode = mode;
     }
 
     /// The current mode.

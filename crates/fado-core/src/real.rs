@@ -36,8 +36,57 @@ impl Real for f64 {
 }
 
 /// Wraps an angle into [−π, π]: `x − 2π·round(x / 2π)` (SPEC notation).
+///
+/// Every caller in the estimator wraps a sum of angles already in [−π, π] plus a small step,
+/// so the argument lies within ±3π; there one exact subtraction (Sterbenz: |x| ≥ π = 2π/2)
+/// gives the same result as the rounding formula without a call to `round`. Anything larger
+/// takes the general formula; NaN stays NaN and ±∞ becomes NaN as with the formula.
 #[inline]
 pub fn wrap_angle<T: Real>(x: T) -> T {
+    let pi = T::pi();
     let two_pi = T::two_pi();
+    let three_pi = T::lit(3.0 * core::f64::consts::PI);
+    if x > pi {
+        if x <= three_pi {
+            return x - two_pi;
+        }
+    } else if x < -pi {
+        if x >= -three_pi {
+            return x + two_pi;
+        }
+    } else {
+        return x;
+    }
     x - two_pi * (x / two_pi).round()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use core::f64::consts::PI;
+
+    #[test]
+    fn wrap_agrees_with_the_rounding_formula() {
+        let reference = |x: f64| x - 2.0 * PI * (x / (2.0 * PI)).round();
+        for k in -4000..=4000 {
+            let x = k as f64 * 0.00731 * PI;
+            let w = wrap_angle(x);
+            assert!((-PI..=PI).contains(&w), "{x} -> {w}");
+            // Equal, or the two representations ±π of the same angle at a tie.
+            let r = reference(x);
+            assert!(w == r || (w.abs() - PI).abs() < 1e-12 && (r.abs() - PI).abs() < 1e-12);
+            let wf = wrap_angle(x as f32);
+            let rf = (x as f32)
+                - 2.0
+                    * core::f32::consts::PI
+                    * ((x as f32) / (2.0 * core::f32::consts::PI)).round();
+            assert!(
+                (wf - rf).abs() < 1e-5 || (wf.abs() - core::f32::consts::PI).abs() < 1e-5,
+                "{x}"
+            );
+        }
+        assert!(wrap_angle(f64::NAN).is_nan());
+        assert!(wrap_angle(f64::INFINITY).is_nan());
+        assert!(wrap_angle(f32::NEG_INFINITY).is_nan());
+    }
 }

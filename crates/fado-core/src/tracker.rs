@@ -3,7 +3,7 @@
 //!
 //! Two integrators in the open loop make it type 2: zero steady-state angle error for a
 //! constant speed and a constant error α/Ki for a constant acceleration α. The closed loop is
-//! T(s) = (Kp·s + Ki)/(s² + Kp·s + Ki), Kp = 2ζωn, Ki = ωn² (SPEC §3 [A]: the paper's
+//! T(s) = (Kp·s + Ki)/(s² + Kp·s + Ki), Kp = 2ζωn, Ki = ωn² (SPEC §3 \[A\]: the paper's
 //! references 9 and 11 that define it are not recoverable).
 //!
 //! Discretisation (SPEC §3): e = wrap(θm − θ̂⁻); xI ← xI + Ki·Ts·e;
@@ -40,7 +40,7 @@ pub struct TrackerConfig<T> {
     pub ts: T,
     /// Bandwidth in Hz. Default 60 Hz (paper, V: T2S-1); T2S-2 uses 35 Hz.
     pub bandwidth_hz: T,
-    /// Damping ratio ζ. Default 1/√2 (SPEC §3 [A]).
+    /// Damping ratio ζ. Default 1/√2 (SPEC §3 \[A\]).
     pub damping: T,
     /// How `bandwidth_hz` is defined. Default −3 dB (SPEC §3).
     pub definition: BandwidthDefinition,
@@ -133,20 +133,50 @@ impl<T: Real> TypeTwoTracker<T> {
         if !theta_measured.is_finite() {
             return Err(NonFiniteInput);
         }
-        let e = wrap_angle(theta_measured - self.predicted);
-        self.omega += self.ki_ts * e;
-        self.theta = wrap_angle(self.predicted + self.ts * self.kp * e);
-        self.predicted = wrap_angle(self.theta + self.ts * self.omega);
-        Ok((self.theta, self.omega))
+        let next = self.next_state(theta_measured);
+        self.commit(next);
+        Ok((next.theta, next.omega))
     }
 
     /// One sample without a measurement: θ̂ coasts at ω̂ and the integrator holds (used when
-    /// |λ̂r| is too small for eq. (6) to mean anything, SPEC §3 [A]).
+    /// |λ̂r| is too small for eq. (6) to mean anything, SPEC §3 \[A\]).
     #[inline]
     pub fn coast(&mut self) -> (T, T) {
-        self.theta = self.predicted;
-        self.predicted = wrap_angle(self.theta + self.ts * self.omega);
-        (self.theta, self.omega)
+        let next = self.coasted_state();
+        self.commit(next);
+        (next.theta, next.omega)
+    }
+
+    /// The state after one sample with the measurement θm, without changing `self`.
+    #[inline]
+    pub(crate) fn next_state(&self, theta_measured: T) -> TrackerState<T> {
+        let e = wrap_angle(theta_measured - self.predicted);
+        let omega = self.omega + self.ki_ts * e;
+        let theta = wrap_angle(self.predicted + self.ts * self.kp * e);
+        TrackerState {
+            predicted: wrap_angle(theta + self.ts * omega),
+            theta,
+            omega,
+        }
+    }
+
+    /// The state after one coasting sample, without changing `self`.
+    #[inline]
+    pub(crate) fn coasted_state(&self) -> TrackerState<T> {
+        let theta = self.predicted;
+        TrackerState {
+            predicted: wrap_angle(theta + self.ts * self.omega),
+            theta,
+            omega: self.omega,
+        }
+    }
+
+    /// Takes a state computed by [`Self::next_state`] or [`Self::coasted_state`].
+    #[inline]
+    pub(crate) fn commit(&mut self, next: TrackerState<T>) {
+        self.predicted = next.predicted;
+        self.theta = next.theta;
+        self.omega = next.omega;
     }
 
     /// θ̂ for the last sample, in [−π, π].
@@ -170,6 +200,25 @@ impl<T: Real> TypeTwoTracker<T> {
     /// (Kp, Ki) in use.
     pub fn gains(&self) -> (T, T) {
         (self.kp, self.ki_ts / self.ts)
+    }
+}
+
+/// The tracker's state after a sample, computed before it is committed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct TrackerState<T> {
+    /// θ̂⁻ for the next sample.
+    pub predicted: T,
+    /// θ̂.
+    pub theta: T,
+    /// ω̂.
+    pub omega: T,
+}
+
+impl<T: Real> TrackerState<T> {
+    /// True when every component is finite.
+    #[inline]
+    pub fn is_finite(&self) -> bool {
+        self.predicted.is_finite() & self.theta.is_finite() & self.omega.is_finite()
     }
 }
 

@@ -1,0 +1,84 @@
+//! Runs `SensorlessEstimator::step` a given number of times over a precomputed rotating signal:
+//! the workload `scripts/callgrind.sh` counts instructions of (two runs, differenced, so that
+//! set-up and warm-up cancel).
+//!
+//! ```text
+//! cargo run --release -p fado-core --example step_driver -- f32 100000
+//! ```
+
+use std::hint::black_box;
+
+use fado_core::{Ab, Estimate, EstimatorConfig, Real, SensorlessEstimator};
+
+/// Samples in the signal table: a power of two holding exactly 8 electrical periods.
+const TABLE: usize = 4096;
+/// Sampling period (s).
+const TS: f64 = 100e-6;
+
+/// An ideal surface-mounted PMSM (SPEC §6) at 19.5 Hz electrical with 10 A on q: the voltage is
+/// the exact interval average that moves the flux from one sample to the next.
+fn signal<T: Real>() -> Vec<(Ab<T>, Ab<T>)> {
+    let (rs, l, lf, iq) = (0.327, 2.63e-3, 0.088, 10.0);
+    let w = core::f64::consts::TAU * 8.0 / (TABLE as f64 * TS);
+    let at = |n: usize| {
+        let th = w * TS * n as f64;
+        let (s, c) = th.sin_cos();
+        // λ = e^{jθ}(λf + j·L·iq), i = e^{jθ}(j·iq)
+        let lambda = (lf * c - l * iq * s, lf * s + l * iq * c);
+        let i = (-iq * s, iq * c);
+        (lambda, i)
+    };
+    (1..=TABLE)
+        .map(|n| {
+            let ((l0a, l0b), (i0a, i0b)) = at(n - 1);
+            let ((l1a, l1b), (i1a, i1b)) = at(n);
+            let va = (l1a - l0a) / TS + 0.5 * rs * (i1a + i0a);
+            let vb = (l1b - l0b) / TS + 0.5 * rs * (i1b + i0b);
+            (
+                Ab::new(T::lit(va), T::lit(vb)),
+                Ab::new(T::lit(i1a), T::lit(i1b)),
+            )
+        })
+        .collect()
+}
+
+/// One estimator step behind a call, as a firmware ISR makes it; not inlined, so that callgrind
+/// can count exactly the instructions inside (`--toggle-collect=*isr_step*`).
+#[inline(never)]
+fn isr_step<T: Real>(est: &mut SensorlessEstimator<T>, v: Ab<T>, i: Ab<T>) -> Estimate<T> {
+    est.step(v, i)
+}
+
+fn run<T: Real>(steps: usize) -> f64 {
+    let table = signal::<T>();
+    let mut est = SensorlessEstimator::<T>::new(EstimatorConfig::default()).expect("valid");
+    // Warm-up: one second, so that the counted steps run in the settled k_df mode.
+    for &(v, i) in table.iter().cycle().take(10_000) {
+        est.step(v, i);
+    }
+    let mut acc = T::zero();
+    for k in 0..steps {
+        let (v, i) = table[k & (TABLE - 1)];
+        let out = isr_step(&mut est, black_box(v), black_box(i));
+        acc += black_box(out).theta;
+    }
+    acc.to_f64()
+}
+
+fn main() {
+    let mut args = std::env::args().skip(1);
+    let precision = args.next().unwrap_or_else(|| "f32".into());
+    let steps: usize = args
+        .next()
+        .map(|s| s.parse().expect("N must be an integer"))
+        .unwrap_or(100_000);
+    let acc = match precision.as_str() {
+        "f32" => run::<f32>(steps),
+        "f64" => run::<f64>(steps),
+        other => {
+            eprintln!("usage: step_driver <f32|f64> <N>  (got {other:?})");
+            std::process::exit(2);
+        }
+    };
+    println!("{precision}: {steps} steps, checksum {acc:.6}");
+}
