@@ -1,1 +1,19 @@
-//! fado-sim
+//! # fado-sim
+//!
+//! Closed-loop simulator of the paper's experimental set-up (Fig. 7): an 8-pole SMPMSM
+//! ([`motor`]) fed by a two-level PWM inverter ([`inverter`], switching-resolved or averaged),
+//! measured by non-ideal sensors ([`sensors`]), loaded by a torque profile or a
+//! speed-controlled dynamometer ([`load`]), and driven by a controller — the sensorless drive
+//! of `fado-core` or any [`controller::Controller`].
+
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+pub mod error;
+pub mod inverter;
+pub mod load;
+pub mod motor;
+pub mod profile;
+pub mod sensors;
+
+pub use error::SimConfigError;
