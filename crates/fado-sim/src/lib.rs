@@ -9,11 +9,13 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+pub mod controller;
 pub mod error;
 pub mod inverter;
 pub mod load;
 pub mod motor;
 pub mod profile;
 pub mod sensors;
+pub mod sim;
 
 pub use error::SimConfigError;
