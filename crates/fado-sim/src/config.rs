@@ -427,7 +427,10 @@ fn key_error(e: toml::de::Error) -> SimConfigError {
         (None, _) => path,
     };
     let first_line = msg.lines().next().unwrap_or("").to_owned();
-    SimConfigError::new(if key.is_empty() { "<file>".into() } else { key }, first_line)
+    SimConfigError::new(
+        if key.is_empty() { "<file>".into() } else { key },
+        first_line,
+    )
 }
 
 #[cfg(test)]

@@ -11,11 +11,13 @@
 
 pub mod config;
 pub mod controller;
+pub mod drive;
 pub mod error;
 pub mod inverter;
 pub mod load;
 pub mod motor;
 pub mod profile;
+pub mod scenario;
 pub mod sensors;
 pub mod sim;
 

@@ -78,8 +78,7 @@ impl Plant {
             current_sensor: CurrentSensor::new(params.current_sensor.clone())
                 .map_err(|e| s(e, "current_sensor"))?,
             dc_link_sensor: params.dc_link_sensor.clone(),
-            load: Load::new(params.load.clone(), params.motor.inertia)
-                .map_err(|e| s(e, "load"))?,
+            load: Load::new(params.load.clone(), params.motor.inertia).map_err(|e| s(e, "load"))?,
             encoder: Encoder::default(),
             load_torque: 0.0,
             last: SampleOutcome::default(),

@@ -74,12 +74,13 @@ impl Controller for SensoredFoc {
         );
         let v_ab = v.to_ab(Rotation::from_angle(theta + 1.5 * w * self.ts));
         // Sign-based dead-time compensation of the reference current's phases.
-        let i_ref_abc = i_ref.to_ab(Rotation::from_angle(theta + 1.5 * w * self.ts)).to_abc();
+        let i_ref_abc = i_ref
+            .to_ab(Rotation::from_angle(theta + 1.5 * w * self.ts))
+            .to_abc();
         let sgn = |x: f64| (x / 0.3).clamp(-1.0, 1.0);
         let comp = Abc::new(sgn(i_ref_abc.a), sgn(i_ref_abc.b), sgn(i_ref_abc.c)) * self.comp_v;
         let v_abc = (v_ab.to_abc() + comp) * (1.0 / m.vdc);
-        let mid = 0.5
-            * (v_abc.a.max(v_abc.b).max(v_abc.c) + v_abc.a.min(v_abc.b).min(v_abc.c));
+        let mid = 0.5 * (v_abc.a.max(v_abc.b).max(v_abc.c) + v_abc.a.min(v_abc.b).min(v_abc.c));
         let duty = Abc::new(
             (0.5 + v_abc.a - mid).clamp(0.0, 1.0),
             (0.5 + v_abc.b - mid).clamp(0.0, 1.0),
@@ -134,7 +135,11 @@ fn run(model: InverterModel, comp_v: f64) -> (Metrics, f64, f64) {
     };
     sim.run(1.5, &mut [&mut metrics, &mut cur], None);
     let st = sim.plant().motor().state();
-    (metrics, st.omega_mech * 60.0 / std::f64::consts::TAU, cur.worst_late)
+    (
+        metrics,
+        st.omega_mech * 60.0 / std::f64::consts::TAU,
+        cur.worst_late,
+    )
 }
 
 #[test]
@@ -143,7 +148,11 @@ fn sensored_foc_tracks_speed_under_load_in_both_inverter_models() {
         let (m, rpm, cur_err) = run(model, 3.9);
         assert!(!m.tripped);
         assert!((rpm - 300.0).abs() < 2.0, "{model:?}: {rpm} r/min");
-        assert!(m.max_speed_error_rpm < 5.0, "{model:?}: {}", m.max_speed_error_rpm);
+        assert!(
+            m.max_speed_error_rpm < 5.0,
+            "{model:?}: {}",
+            m.max_speed_error_rpm
+        );
         // q current settles on 7.5 N·m / Kt ≈ 14.2 A with the PI (ripple of the resolved
         // model filtered by synchronous sampling).
         assert!(cur_err < 1.0, "{model:?}: |iq* − iq| = {cur_err}");
