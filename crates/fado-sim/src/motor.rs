@@ -191,7 +191,7 @@ impl ElectricalPropagator {
         let xp0 = [(w0 * self.k[0]).re, (w0 * self.k[1]).re];
         let xp1 = [(w1 * self.k[0]).re, (w1 * self.k[1]).re];
         let y = [i.d - xp0[0] - self.x_c[0], i.q - xp0[1] - self.x_c[1]];
-        let e = (self.mu * h).exp();
+        let e = crate::fastmath::exp(self.mu * h);
         let (c, sn) = if self.surface {
             // ν = |ω|, sin(νh)/ν·N = sin(ωh)·[[0, 1], [−1, 0]]; N's entries are ±ω.
             let sin_over = if self.omega != 0.0 {
@@ -240,6 +240,10 @@ fn expm_traceless(s: f64, h: f64) -> (f64, f64) {
 pub struct Motor {
     params: MotorParams,
     state: MotorState,
+    /// e^{jθ}, computed once per sample.
+    rot: Complex64,
+    /// (ts, e^{−B·ts/J}) of the last mechanical step: the sample period never changes.
+    decay: (f64, f64),
 }
 
 impl Motor {
@@ -249,6 +253,8 @@ impl Motor {
         let mut m = Self {
             params,
             state: MotorState::default(),
+            rot: Complex64::new(1.0, 0.0),
+            decay: (0.0, 1.0),
         };
         m.set_state(Dq::zero(), theta0, 0.0);
         Ok(m)
@@ -262,6 +268,18 @@ impl Motor {
             omega_mech,
             theta_mech: theta / self.params.pole_pairs as f64,
         };
+        self.update_rotation();
+    }
+
+    fn update_rotation(&mut self) {
+        let (s, c) = self.state.theta.sin_cos();
+        self.rot = Complex64::new(c, s);
+    }
+
+    /// e^{jθ} of the present rotor angle.
+    #[inline]
+    pub fn rotation(&self) -> Complex64 {
+        self.rot
     }
 
     /// Parameters.
@@ -283,14 +301,14 @@ impl Motor {
     /// Stator current in the stationary frame.
     #[inline]
     pub fn i_ab(&self) -> Ab<f64> {
-        let (s, c) = self.state.theta.sin_cos();
+        let (c, s) = (self.rot.re, self.rot.im);
         let i = self.state.i_dq;
         Ab::new(i.d * c - i.q * s, i.d * s + i.q * c)
     }
 
     /// Stator flux linkage in the stationary frame (what the estimator's λ2 should equal).
     pub fn flux_ab(&self) -> Ab<f64> {
-        let (s, c) = self.state.theta.sin_cos();
+        let (c, s) = (self.rot.re, self.rot.im);
         let f = self.params.flux_dq(self.state.i_dq);
         Ab::new(f.d * c - f.q * s, f.d * s + f.q * c)
     }
@@ -309,10 +327,14 @@ impl Motor {
         let w = self.state.omega_mech;
         self.state.theta = wrap_angle(self.state.theta + p * w * ts);
         self.state.theta_mech += w * ts;
+        self.update_rotation();
         let (j, b) = (self.params.inertia, self.params.viscous_friction);
         let drive = te_avg - load_torque;
+        if self.decay.0 != ts {
+            self.decay = (ts, (-b * ts / j).exp());
+        }
         self.state.omega_mech = if b > 0.0 {
-            let decay = (-b * ts / j).exp();
+            let decay = self.decay.1;
             w * decay + drive / b * (1.0 - decay)
         } else {
             w + ts * drive / j
