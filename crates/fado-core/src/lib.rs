@@ -20,6 +20,7 @@
 #[cfg(test)]
 extern crate std;
 
+pub mod control;
 pub mod error;
 pub mod estimator;
 pub mod flux;
@@ -31,6 +32,7 @@ pub mod real;
 pub mod rotor_flux;
 pub mod tracker;
 
+pub use control::{DriveConfig, DriveOutput, SensorlessDrive};
 pub use error::{ConfigError, NonFiniteInput};
 pub use estimator::{
     Diagnostics, Estimate, EstimatorConfig, RotorAngleEstimator, SensorlessEstimator,

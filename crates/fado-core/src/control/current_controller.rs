@@ -1,0 +1,212 @@
+//! Synchronous-frame current control of Fig. 5: one PI per axis with decoupling and back-EMF
+//! feed-forward, anti-windup against the voltage the inverter could actually realise.
+//!
+//! Gains (SPEC §6): Kp,d = L̂d·ωc, Kp,q = L̂q·ωc, Ki = R̂s·ωc with ωc = 2π·250 Hz (paper, V).
+//! The PI zero then cancels the stator pole R̂s/L̂ and the loop gain is ωc/s: a first-order
+//! closed loop ωc/(s + ωc), rise time 2.2/ωc, apart from the 1.5-sample delay of computation
+//! and PWM hold (which [`DelayCompensation`](super::delay_compensation) keeps out of the
+//! rotating frame, but not out of the loop).
+//!
+//! Feed-forward (SPEC §6 [A]), from the machine model v_d = R·i_d + L_d·di_d/dt − ω·L_q·i_q,
+//! v_q = R·i_q + L_q·di_q/dt + ω·(L_d·i_d + λ_f), with the measured currents:
+//! v_d,ff = −ω·L̂q·i_q, v_q,ff = ω·(L̂d·i_d + λ̂f). It turns the cross-coupled plant into two
+//! independent R-L branches.
+//!
+//! Anti-windup: back-calculation (see [`pi`](super::pi)): `step` returns the unlimited
+//! voltage, the caller limits it (to the hexagon, after rotation and compensation) and hands
+//! the realisable d-q voltage back through [`CurrentController::realised`].
+
+use crate::control::pi::{Pi, PiConfig};
+use crate::error::{ConfigError, NonFiniteInput, check};
+use crate::{Dq, Real};
+
+/// Configuration of a [`CurrentController`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CurrentControllerConfig<T> {
+    /// Sampling period Ts in s. Default 100 µs (paper, V).
+    pub ts: T,
+    /// Stator resistance estimate R̂s in Ω. Default 0.327 Ω (paper, V).
+    pub rs_hat: T,
+    /// d-axis inductance estimate L̂d in H. Default 2.63 mH (paper, V).
+    pub ld_hat: T,
+    /// q-axis inductance estimate L̂q in H. Default 2.63 mH (paper, V).
+    pub lq_hat: T,
+    /// Magnet flux linkage estimate λ̂f in Wb (back-EMF feed-forward). Default 0.088 Wb
+    /// (SPEC §6 [A]).
+    pub flux_linkage_hat: T,
+    /// Closed-loop bandwidth in Hz. Default 250 Hz (paper, V). Limited to ωc·Ts ≤ 0.5 so the
+    /// 1.5-sample loop delay leaves at least 47° of phase margin.
+    pub bandwidth_hz: T,
+    /// Add the decoupling and back-EMF feed-forward. Default true (SPEC §6 [A]).
+    pub decoupling: bool,
+    /// Back-calculation gain as a multiple of Ki/Kp = R̂s/L̂ (see [`PiConfig`]). Default 1, the
+    /// realisable reference [A].
+    pub anti_windup_ratio: T,
+    /// Hard bound on each axis' voltage and integral in V, a last guard against absurd
+    /// estimates; the real limit is the inverter's (modulation). Default 1000 V [A].
+    pub voltage_bound: T,
+}
+
+impl<T: Real> Default for CurrentControllerConfig<T> {
+    fn default() -> Self {
+        Self {
+            ts: T::lit(100e-6),
+            rs_hat: T::lit(0.327),
+            ld_hat: T::lit(2.63e-3),
+            lq_hat: T::lit(2.63e-3),
+            flux_linkage_hat: T::lit(0.088),
+            bandwidth_hz: T::lit(250.0),
+            decoupling: true,
+            anti_windup_ratio: T::one(),
+            voltage_bound: T::lit(1000.0),
+        }
+    }
+}
+
+/// Synchronous-frame PI current controller with decoupling (module docs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CurrentController<T> {
+    config: CurrentControllerConfig<T>,
+    d: Pi<T>,
+    q: Pi<T>,
+}
+
+impl<T: Real> CurrentController<T> {
+    /// A new controller; every field is checked and a bad one named.
+    pub fn new(config: CurrentControllerConfig<T>) -> Result<Self, ConfigError> {
+        let ts = check::positive("ts", config.ts)?;
+        let rs = check::non_negative("rs_hat", config.rs_hat)?;
+        let ld = check::positive("ld_hat", config.ld_hat)?;
+        let lq = check::positive("lq_hat", config.lq_hat)?;
+        check::non_negative("flux_linkage_hat", config.flux_linkage_hat)?;
+        let wc = T::two_pi() * check::positive("bandwidth_hz", config.bandwidth_hz)?;
+        if wc * ts > T::lit(0.5) {
+            return Err(ConfigError::OutOfRange {
+                field: "bandwidth_hz",
+                expected: "2π·bandwidth_hz·ts at most 0.5",
+            });
+        }
+        let ratio = check::non_negative("anti_windup_ratio", config.anti_windup_ratio)?;
+        let bound = check::positive("voltage_bound", config.voltage_bound)?;
+        let axis = |l: T| {
+            Pi::new(PiConfig {
+                ts,
+                kp: l * wc,
+                ki: rs * wc,
+                output_min: -bound,
+                output_max: bound,
+                anti_windup_ratio: ratio,
+            })
+            .map_err(|e| match e.field() {
+                "anti_windup_ratio" => e,
+                _ => ConfigError::OutOfRange {
+                    field: "bandwidth_hz",
+                    expected: "finite PI gains",
+                },
+            })
+        };
+        let d = axis(ld)?;
+        let q = axis(lq)?;
+        Ok(Self { config, d, q })
+    }
+
+    /// Integrators back to zero.
+    pub fn reset(&mut self) {
+        self.d.reset();
+        self.q.reset();
+    }
+
+    /// The decoupling and back-EMF feed-forward at electrical speed `omega` for the measured
+    /// currents `i_dq` (zero when `decoupling` is off).
+    #[inline]
+    pub fn feedforward(&self, i_dq: Dq<T>, omega: T) -> Dq<T> {
+        if self.config.decoupling {
+            let c = &self.config;
+            Dq::new(
+                -omega * c.lq_hat * i_dq.q,
+                omega * (c.ld_hat * i_dq.d + c.flux_linkage_hat),
+            )
+        } else {
+            Dq::zero()
+        }
+    }
+
+    /// One sample: reference and measured d-q currents (A) in the estimated rotor frame and the
+    /// electrical speed `omega` (rad/s, T2S-2 in the drive). Returns the *unlimited* d-q
+    /// voltage reference v*_dq; limit it and call [`realised`](Self::realised). A non-finite
+    /// input is rejected with the state untouched.
+    #[inline]
+    pub fn step(
+        &mut self,
+        reference: Dq<T>,
+        measured: Dq<T>,
+        omega: T,
+    ) -> Result<Dq<T>, NonFiniteInput> {
+        if !(reference.is_finite() && measured.is_finite() && omega.is_finite()) {
+            return Err(NonFiniteInput);
+        }
+        let ff = self.feedforward(measured, omega);
+        let e = reference - measured;
+        let (d0, q0) = (self.d, self.q);
+        let vd = self.d.step(e.d, ff.d)?;
+        let vq = match self.q.step(e.q, ff.q) {
+            Ok(v) => v,
+            Err(err) => {
+                (self.d, self.q) = (d0, q0);
+                return Err(err);
+            }
+        };
+        Ok(Dq::new(vd, vq))
+    }
+
+    /// Anti-windup: the d-q voltage that was actually realisable after limiting the output of
+    /// the last `step` (back-calculation, see [`Pi::realised`]). Ignored if not finite.
+    #[inline]
+    pub fn realised(&mut self, v_dq: Dq<T>) {
+        if v_dq.is_finite() {
+            self.d.realised(v_dq.d);
+            self.q.realised(v_dq.q);
+        }
+    }
+
+    /// Convenience for a circular limit (e.g. the hexagon's inscribed circle Vdc/√3): steps,
+    /// scales the vector into |v| ≤ `v_max` keeping its angle, feeds that back and returns it.
+    #[inline]
+    pub fn step_limited(
+        &mut self,
+        reference: Dq<T>,
+        measured: Dq<T>,
+        omega: T,
+        v_max: T,
+    ) -> Result<Dq<T>, NonFiniteInput> {
+        if !v_max.is_finite() {
+            return Err(NonFiniteInput);
+        }
+        let v = self.step(reference, measured, omega)?;
+        let v_max = v_max.max(T::zero());
+        let n = v.norm();
+        let limited = if n > v_max { v * (v_max / n) } else { v };
+        self.realised(limited);
+        Ok(limited)
+    }
+
+    /// Proportional gains (Kp,d, Kp,q) in V/A.
+    pub fn kp(&self) -> Dq<T> {
+        Dq::new(self.d.config().kp, self.q.config().kp)
+    }
+
+    /// Integral gain Ki in V/(A·s), the same on both axes.
+    pub fn ki(&self) -> T {
+        self.d.config().ki
+    }
+
+    /// The integral states (V).
+    pub fn integral(&self) -> Dq<T> {
+        Dq::new(self.d.integral(), self.q.integral())
+    }
+
+    /// The configuration in use.
+    pub fn config(&self) -> &CurrentControllerConfig<T> {
+        &self.config
+    }
+}

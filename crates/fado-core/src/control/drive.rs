@@ -1,0 +1,576 @@
+//! The whole sensorless drive of Fig. 5: estimator, speed and current control, d-axis
+//! injection, delay and dead-time compensation, SVPWM — one `step` per 10 kHz sample.
+//!
+//! Order of operations at sample n (SPEC §1, §5):
+//!
+//! 1. Reject non-finite inputs; trip (gates off, latched) when a phase current exceeds
+//!    `trip_current`.
+//! 2. Estimator with the α-β currents sampled now and the voltage that acted over
+//!    [n−1, n]: the realised reference computed at n−2 (computation delay: a duty computed at
+//!    n is loaded at n+1 and acts over [n+1, n+2]), before dead-time compensation.
+//! 3. Park of the measured current at θ̂[n] (T2S-1).
+//! 4. Speed PI on ω̂ of T2S-2 → i_q*; injection (23) → i_d*; |i_dq*| ≤ I_max (d first).
+//! 5. Current PI with decoupling at ω̂ of T2S-2 → v*_dq.
+//! 6. Delay compensation: v*_ab = e^{j(θ̂ + 1.5·ω̂·Ts)}·v*_dq, with ω̂ of T2S-1 (the derivative
+//!    of the θ̂ being extrapolated).
+//! 7. Dead-time compensation v_comp (Clarke of the per-phase trapezoid) added; the sum is
+//!    limited to the hexagon and modulated. The realised reference is limited − v_comp: what
+//!    the inverter produces once its non-linearity has eaten v_comp.
+//! 8. Anti-windup: the realised reference, back in the same advanced d-q frame, feeds the
+//!    current PIs; it enters the two-deep history for the estimator.
+
+use crate::control::current_controller::{CurrentController, CurrentControllerConfig};
+use crate::control::dead_time_compensation::{
+    DeadTimeCompensation, DeadTimeCompensationConfig, DeadTimeMethod,
+};
+use crate::control::delay_compensation::{DelayCompensation, DelayCompensationConfig};
+use crate::control::modulation::{ModulatorConfig, SpaceVectorModulator, VoltageLimit};
+use crate::control::speed_controller::{
+    SpeedController, SpeedControllerConfig, limit_current_d_priority,
+};
+use crate::error::{ConfigError, check};
+use crate::estimator::{Estimate, EstimatorConfig, RotorAngleEstimator, SensorlessEstimator};
+use crate::injection::{CurrentInjection, CurrentInjectionConfig};
+use crate::{Ab, Abc, Dq, Real, Rotation};
+
+/// Everything the drive around the estimator needs, flat so that it maps one-to-one onto
+/// TOML and Python keyword arguments. Defaults are the paper's (section V) or SPEC's.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DriveConfig<T> {
+    /// Sampling period Ts in s. Default 100 µs (paper, V: 10 kHz); must equal the
+    /// estimator's.
+    pub ts: T,
+    /// Pole pairs p. Default 4 (paper, V: 8 poles).
+    pub pole_pairs: T,
+    /// Stator resistance estimate R̂s in Ω (current PI). Default 0.327 Ω (paper, V).
+    pub rs_hat: T,
+    /// d-axis inductance estimate L̂d in H. Default 2.63 mH (paper, V).
+    pub ld_hat: T,
+    /// q-axis inductance estimate L̂q in H. Default 2.63 mH (paper, V).
+    pub lq_hat: T,
+    /// Magnet flux linkage estimate λ̂f in Wb (back-EMF feed-forward, K̂t). Default 0.088 Wb
+    /// (SPEC §6 [A]).
+    pub flux_linkage_hat: T,
+    /// Inertia estimate Ĵ in kg·m² (speed PI). Default 0.012 (SPEC §6 [A]).
+    pub inertia_hat: T,
+    /// Current-loop bandwidth in Hz. Default 250 Hz (paper, V).
+    pub current_bandwidth_hz: T,
+    /// Speed-loop bandwidth in Hz. Default 5 Hz (paper, V).
+    pub speed_bandwidth_hz: T,
+    /// Speed PI zero as a fraction of its bandwidth, Ki = Kp·ωsc/ratio. Default 5 (SPEC §6).
+    pub speed_zero_ratio: T,
+    /// Current limit I_max in A (|i_dq*|). Default 40 A (SPEC §6 [A]).
+    pub i_max: T,
+    /// Minimum current I_min of the injection (23) in A; 0 disables it. Default 4 A (paper, V).
+    pub i_min: T,
+    /// Dead time Td in s. Default 2.5 µs (paper, V).
+    pub dead_time: T,
+    /// Switching frequency in Hz. Default 5 kHz (paper, V).
+    pub switching_frequency: T,
+    /// Device threshold voltage of the dead-time compensation in V. Default 1 V (SPEC §5 [A]).
+    pub dead_time_threshold_voltage: T,
+    /// Current band Ic of the trapezoidal compensation in A. Default 0.3 A (SPEC §5 [A]).
+    pub dead_time_current_band: T,
+    /// Compensate the dead time at all. Default true (paper IV-B).
+    pub dead_time_compensation: bool,
+    /// Trapezoidal (SPEC §5) or sign(i) compensation. Default trapezoidal [A].
+    pub dead_time_method: DeadTimeMethod,
+    /// Angle advance of the voltage in samples. Default 1.5 (SPEC §5 [A], ref. [13]).
+    pub delay_compensation_factor: T,
+    /// Over-current trip level on any phase current in A (latched until `reset`).
+    /// Default 60 A (1.5·I_max) [A].
+    pub trip_current: T,
+    /// Decoupling and back-EMF feed-forward in the current PI. Default true (SPEC §6 [A]).
+    pub decoupling: bool,
+    /// Realisable voltage set. Default the hexagon (SVPWM [16]).
+    pub voltage_limit: VoltageLimit,
+    /// Usable fraction of the voltage limit (0, 1]. Default 1 [A].
+    pub max_modulation: T,
+    /// Current PI back-calculation gain in units of Ki/Kp. Default 1 (realisable
+    /// reference) [A].
+    pub current_anti_windup_ratio: T,
+    /// Speed PI back-calculation gain in units of Ki/Kp. Default 5 (tracking at ωsc) [A].
+    pub speed_anti_windup_ratio: T,
+}
+
+impl<T: Real> Default for DriveConfig<T> {
+    fn default() -> Self {
+        Self {
+            ts: T::lit(100e-6),
+            pole_pairs: T::lit(4.0),
+            rs_hat: T::lit(0.327),
+            ld_hat: T::lit(2.63e-3),
+            lq_hat: T::lit(2.63e-3),
+            flux_linkage_hat: T::lit(0.088),
+            inertia_hat: T::lit(0.012),
+            current_bandwidth_hz: T::lit(250.0),
+            speed_bandwidth_hz: T::lit(5.0),
+            speed_zero_ratio: T::lit(5.0),
+            i_max: T::lit(40.0),
+            i_min: T::lit(4.0),
+            dead_time: T::lit(2.5e-6),
+            switching_frequency: T::lit(5e3),
+            dead_time_threshold_voltage: T::one(),
+            dead_time_current_band: T::lit(0.3),
+            dead_time_compensation: true,
+            dead_time_method: DeadTimeMethod::Trapezoidal,
+            delay_compensation_factor: T::lit(1.5),
+            trip_current: T::lit(60.0),
+            decoupling: true,
+            voltage_limit: VoltageLimit::Hexagon,
+            max_modulation: T::one(),
+            current_anti_windup_ratio: T::one(),
+            speed_anti_windup_ratio: T::lit(5.0),
+        }
+    }
+}
+
+impl<T: Real> DriveConfig<T> {
+    /// Checks every field (without an estimator); the error names the first bad one.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        Blocks::new(self).map(|_| ())
+    }
+}
+
+/// The drive's outputs for one sample.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DriveOutput<T> {
+    /// Duty cycles of the upper switches in [0, 1], to be loaded at the next sample.
+    pub duty: Abc<T>,
+    /// False after a trip: the gates must be switched off.
+    pub gates_enabled: bool,
+    /// The realised α-β voltage reference before dead-time compensation (V): what the
+    /// estimator will be told acted over [n+1, n+2].
+    pub v_ref_ab: Ab<T>,
+    /// The measured current in the estimated rotor frame (A).
+    pub i_dq: Dq<T>,
+    /// The current reference (A).
+    pub i_dq_ref: Dq<T>,
+    /// The estimator's output for this sample.
+    pub estimate: Estimate<T>,
+    /// The drive has tripped (latched until `reset`).
+    pub tripped: bool,
+    /// This sample's inputs were non-finite: the last duty is held and the controllers are
+    /// untouched.
+    pub input_fault: bool,
+    /// The realised voltage reference in the delay-compensated d-q frame (V).
+    pub v_dq_ref: Dq<T>,
+    /// The voltage reference (with dead-time compensation) had to be limited.
+    pub voltage_saturated: bool,
+}
+
+impl<T: Real> DriveOutput<T> {
+    fn idle(estimate: Estimate<T>) -> Self {
+        let half = T::lit(0.5);
+        Self {
+            duty: Abc::new(half, half, half),
+            gates_enabled: true,
+            v_ref_ab: Ab::zero(),
+            i_dq: Dq::zero(),
+            i_dq_ref: Dq::zero(),
+            estimate,
+            tripped: false,
+            input_fault: false,
+            v_dq_ref: Dq::zero(),
+            voltage_saturated: false,
+        }
+    }
+}
+
+impl<T: Real> Default for DriveOutput<T> {
+    /// Duties ½ (zero voltage), gates enabled, everything else zero.
+    fn default() -> Self {
+        Self::idle(Estimate::default())
+    }
+}
+
+/// The control blocks built from a [`DriveConfig`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Blocks<T> {
+    speed: SpeedController<T>,
+    injection: CurrentInjection<T>,
+    current: CurrentController<T>,
+    delay: DelayCompensation<T>,
+    dead_time: DeadTimeCompensation<T>,
+    modulator: SpaceVectorModulator<T>,
+}
+
+impl<T: Real> Blocks<T> {
+    fn new(c: &DriveConfig<T>) -> Result<Self, ConfigError> {
+        let ts = check::positive("ts", c.ts)?;
+        let i_max = check::positive("i_max", c.i_max)?;
+        let i_min = check::non_negative("i_min", c.i_min)?;
+        if i_min > i_max {
+            return Err(ConfigError::OutOfRange {
+                field: "i_min",
+                expected: "at most i_max",
+            });
+        }
+        let trip = check::positive("trip_current", c.trip_current)?;
+        if trip <= i_max {
+            return Err(ConfigError::OutOfRange {
+                field: "trip_current",
+                expected: "above i_max",
+            });
+        }
+        let rename = |map: &'static [(&'static str, &'static str)]| {
+            move |e: ConfigError| {
+                let field = map
+                    .iter()
+                    .find(|(from, _)| *from == e.field())
+                    .map_or(e.field(), |(_, to)| *to);
+                match e {
+                    ConfigError::NotFinite { .. } => ConfigError::NotFinite { field },
+                    ConfigError::NotPositive { .. } => ConfigError::NotPositive { field },
+                    ConfigError::Negative { .. } => ConfigError::Negative { field },
+                    ConfigError::OutOfRange { expected, .. } => {
+                        ConfigError::OutOfRange { field, expected }
+                    }
+                }
+            }
+        };
+        let speed = SpeedController::new(SpeedControllerConfig {
+            ts,
+            pole_pairs: c.pole_pairs,
+            inertia_hat: c.inertia_hat,
+            flux_linkage_hat: c.flux_linkage_hat,
+            bandwidth_hz: c.speed_bandwidth_hz,
+            zero_ratio: c.speed_zero_ratio,
+            i_max,
+            anti_windup_ratio: c.speed_anti_windup_ratio,
+        })
+        .map_err(rename(&[
+            ("bandwidth_hz", "speed_bandwidth_hz"),
+            ("zero_ratio", "speed_zero_ratio"),
+            ("anti_windup_ratio", "speed_anti_windup_ratio"),
+        ]))?;
+        let injection = CurrentInjection::new(CurrentInjectionConfig { i_min })?;
+        let current = CurrentController::new(CurrentControllerConfig {
+            ts,
+            rs_hat: c.rs_hat,
+            ld_hat: c.ld_hat,
+            lq_hat: c.lq_hat,
+            flux_linkage_hat: c.flux_linkage_hat,
+            bandwidth_hz: c.current_bandwidth_hz,
+            decoupling: c.decoupling,
+            anti_windup_ratio: c.current_anti_windup_ratio,
+            ..CurrentControllerConfig::default()
+        })
+        .map_err(rename(&[
+            ("bandwidth_hz", "current_bandwidth_hz"),
+            ("anti_windup_ratio", "current_anti_windup_ratio"),
+        ]))?;
+        let delay = DelayCompensation::new(DelayCompensationConfig {
+            ts,
+            factor: c.delay_compensation_factor,
+        })
+        .map_err(rename(&[("factor", "delay_compensation_factor")]))?;
+        let dead_time = DeadTimeCompensation::new(DeadTimeCompensationConfig {
+            enabled: c.dead_time_compensation,
+            method: c.dead_time_method,
+            dead_time: c.dead_time,
+            switching_frequency: c.switching_frequency,
+            threshold_voltage: c.dead_time_threshold_voltage,
+            current_band: c.dead_time_current_band,
+        })
+        .map_err(rename(&[
+            ("threshold_voltage", "dead_time_threshold_voltage"),
+            ("current_band", "dead_time_current_band"),
+        ]))?;
+        let modulator = SpaceVectorModulator::new(ModulatorConfig {
+            limit: c.voltage_limit,
+            max_modulation: c.max_modulation,
+        })?;
+        Ok(Self {
+            speed,
+            injection,
+            current,
+            delay,
+            dead_time,
+            modulator,
+        })
+    }
+
+    fn reset(&mut self) {
+        self.speed.reset();
+        self.injection.reset();
+        self.current.reset();
+        self.delay.reset();
+        self.dead_time.reset();
+        self.modulator.reset();
+    }
+}
+
+/// The sensorless drive of Fig. 5 around any [`RotorAngleEstimator`] (by default the
+/// paper's [`SensorlessEstimator`]). Allocation-free, never panics; see the module docs for
+/// the order of operations and the timing contract.
+///
+/// ```
+/// use fado_core::control::{DriveConfig, SensorlessDrive};
+/// use fado_core::{Abc, EstimatorConfig};
+/// let mut drive =
+///     SensorlessDrive::<f32>::new(DriveConfig::default(), EstimatorConfig::default()).unwrap();
+/// drive.align(0.0);
+/// // In the 10 kHz ISR: phase currents sampled now, dc-link voltage, speed reference.
+/// let out = drive.step(Abc::new(0.1, -0.05, -0.05), 300.0, 10.0);
+/// assert!(out.gates_enabled && (0.0..=1.0).contains(&out.duty.a));
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SensorlessDrive<T, E = SensorlessEstimator<T>> {
+    config: DriveConfig<T>,
+    estimator: E,
+    blocks: Blocks<T>,
+    /// Realised references (before dead-time compensation) computed at n−1 and n−2.
+    history: [Ab<T>; 2],
+    /// The last finite α-β current, fed to the estimator while inputs are rejected.
+    last_i_ab: Ab<T>,
+    last: DriveOutput<T>,
+    tripped: bool,
+    rejected_samples: u32,
+}
+
+impl<T: Real> SensorlessDrive<T, SensorlessEstimator<T>> {
+    /// The drive with the paper's estimator. `estimator.ts` must equal `config.ts`.
+    pub fn new(config: DriveConfig<T>, estimator: EstimatorConfig<T>) -> Result<Self, ConfigError> {
+        if estimator.ts != config.ts {
+            return Err(ConfigError::OutOfRange {
+                field: "ts",
+                expected: "equal to the estimator's ts",
+            });
+        }
+        Self::with_estimator(config, SensorlessEstimator::new(estimator)?)
+    }
+}
+
+impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
+    /// The drive around an estimator built by the caller (which must run at `config.ts`).
+    /// The estimator is reset.
+    pub fn with_estimator(config: DriveConfig<T>, estimator: E) -> Result<Self, ConfigError> {
+        let blocks = Blocks::new(&config)?;
+        let mut drive = Self {
+            config,
+            estimator,
+            blocks,
+            history: [Ab::zero(); 2],
+            last_i_ab: Ab::zero(),
+            last: DriveOutput::idle(Estimate::default()),
+            tripped: false,
+            rejected_samples: 0,
+        };
+        drive.reset();
+        Ok(drive)
+    }
+
+    /// Everything back to the start-up state: controllers, history, estimator, and the trip.
+    pub fn reset(&mut self) {
+        self.estimator.reset();
+        self.clear_control(T::zero());
+        self.last_i_ab = Ab::zero();
+        self.tripped = false;
+        self.rejected_samples = 0;
+    }
+
+    /// Start-up at a known (e.g. aligned) rotor angle θ0 (SPEC §1 step 6): the estimator
+    /// starts from it with the last measured current; controllers and voltage history are
+    /// cleared (the next duty is the first). A trip stays latched.
+    pub fn align(&mut self, theta0: T) {
+        self.estimator.align(theta0, self.last_i_ab);
+        let theta0 = if theta0.is_finite() {
+            crate::wrap_angle(theta0)
+        } else {
+            T::zero()
+        };
+        self.clear_control(theta0);
+        if self.tripped {
+            self.trip_output();
+        }
+    }
+
+    fn clear_control(&mut self, theta: T) {
+        self.blocks.reset();
+        self.history = [Ab::zero(); 2];
+        self.last = DriveOutput::idle(Estimate {
+            theta,
+            ..Estimate::default()
+        });
+    }
+
+    fn trip_output(&mut self) {
+        let half = T::lit(0.5);
+        self.last.duty = Abc::new(half, half, half);
+        self.last.gates_enabled = false;
+        self.last.tripped = true;
+        self.last.v_ref_ab = Ab::zero();
+        self.last.v_dq_ref = Dq::zero();
+        self.history = [Ab::zero(); 2];
+    }
+
+    /// One 10 kHz sample: phase currents `i_abc` sampled now (A), dc-link voltage `vdc` (V),
+    /// speed reference `speed_ref_mech` (mechanical rad/s). The duty returned is to be loaded
+    /// at the next sample.
+    ///
+    /// A non-finite input rejects the sample: the last duty is held (so the history repeats
+    /// the held voltage), the controllers are untouched, and the estimator still integrates
+    /// the interval with the last good current so that it keeps time. A phase current above
+    /// `trip_current` trips the drive: gates off, duties ½, latched until [`reset`](Self::reset);
+    /// while tripped nothing is stepped.
+    pub fn step(&mut self, i_abc: Abc<T>, vdc: T, speed_ref_mech: T) -> DriveOutput<T> {
+        let finite = i_abc.is_finite() && vdc.is_finite() && speed_ref_mech.is_finite();
+        if self.tripped {
+            let mut out = self.last;
+            out.input_fault = !finite;
+            return out;
+        }
+        if !finite {
+            return self.reject(i_abc);
+        }
+        let trip = self.config.trip_current;
+        if i_abc.a.abs() > trip || i_abc.b.abs() > trip || i_abc.c.abs() > trip {
+            self.tripped = true;
+            self.trip_output();
+            self.last.input_fault = false;
+            return self.last;
+        }
+        let i_ab = i_abc.to_ab();
+        if !i_ab.is_finite() {
+            return self.reject(i_abc);
+        }
+
+        // 2. Estimator: voltage of [n−1, n] = realised reference computed at n−2.
+        let estimate = self.estimator.step(self.history[1], i_ab);
+        if !estimate_is_finite(&estimate) {
+            // An estimator that went non-finite cannot steer the drive: hold like a bad input.
+            return self.reject(i_abc);
+        }
+        self.last_i_ab = i_ab;
+        // 3. Measured current in the estimated rotor frame.
+        let i_dq = i_ab.to_dq(Rotation::from_angle(estimate.theta));
+        let omega_ctrl = estimate.omega_control;
+
+        // 4. Speed loop, injection (23) and current-vector limit.
+        let backup = self.blocks;
+        let b = &mut self.blocks;
+        let Ok(iq_ref) = b
+            .speed
+            .step(speed_ref_mech * self.config.pole_pairs, omega_ctrl)
+        else {
+            return self.reject_after_estimate(backup, estimate, i_dq);
+        };
+        let i_dq_ref =
+            limit_current_d_priority(Dq::new(b.injection.step(iq_ref), iq_ref), self.config.i_max);
+        // 5. Current loop (unlimited).
+        let Ok(v_dq) = b.current.step(i_dq_ref, i_dq, omega_ctrl) else {
+            return self.reject_after_estimate(backup, estimate, i_dq);
+        };
+        // 6. Delay compensation with the advanced angle.
+        let (v_ab, rot) = b.delay.step(v_dq, estimate.theta, estimate.omega);
+        // 7. Dead-time compensation, hexagon limit, SVPWM.
+        let v_comp = b.dead_time.step(rot, i_dq_ref, i_abc, vdc);
+        let m = b.modulator.step(v_ab + v_comp, vdc);
+        let v_realised = if vdc > T::zero() {
+            m.v_ab - v_comp
+        } else {
+            Ab::zero()
+        };
+        if !(v_realised.is_finite() && m.duty.is_finite()) {
+            return self.reject_after_estimate(backup, estimate, i_dq);
+        }
+        // 8. Anti-windup with the realised voltage in the same frame; speed loop too.
+        let v_dq_realised = v_realised.to_dq(rot);
+        b.current.realised(v_dq_realised);
+        b.speed.realised(i_dq_ref.q);
+        self.history = [v_realised, self.history[0]];
+        self.last = DriveOutput {
+            duty: m.duty,
+            gates_enabled: true,
+            v_ref_ab: v_realised,
+            i_dq,
+            i_dq_ref,
+            estimate,
+            tripped: false,
+            input_fault: false,
+            v_dq_ref: v_dq_realised,
+            voltage_saturated: m.saturated,
+        };
+        self.last
+    }
+
+    /// Rejected sample: hold the duty, keep the estimator's clock with the last good current.
+    fn reject(&mut self, i_abc: Abc<T>) -> DriveOutput<T> {
+        let i_ab = i_abc.to_ab();
+        let i_ab = if i_ab.is_finite() {
+            i_ab
+        } else {
+            self.last_i_ab
+        };
+        let estimate = self.estimator.step(self.history[1], i_ab);
+        let mut out = self.last;
+        if estimate_is_finite(&estimate) {
+            out.estimate = estimate;
+        }
+        self.finish_reject(out)
+    }
+
+    /// Rejected after the estimator ran (a controller refused its input): controllers restored.
+    fn reject_after_estimate(
+        &mut self,
+        blocks: Blocks<T>,
+        estimate: Estimate<T>,
+        i_dq: Dq<T>,
+    ) -> DriveOutput<T> {
+        self.blocks = blocks;
+        let mut out = self.last;
+        out.estimate = estimate;
+        out.i_dq = i_dq;
+        self.finish_reject(out)
+    }
+
+    fn finish_reject(&mut self, mut out: DriveOutput<T>) -> DriveOutput<T> {
+        self.rejected_samples = self.rejected_samples.saturating_add(1);
+        // The held duty applies the same voltage once more.
+        self.history = [self.history[0], self.history[0]];
+        out.input_fault = true;
+        self.last = out;
+        out
+    }
+
+    /// The estimator.
+    pub fn estimator(&self) -> &E {
+        &self.estimator
+    }
+
+    /// The estimator, mutable (e.g. to switch k_df off as in Fig. 9).
+    pub fn estimator_mut(&mut self) -> &mut E {
+        &mut self.estimator
+    }
+
+    /// The configuration in use.
+    pub fn config(&self) -> &DriveConfig<T> {
+        &self.config
+    }
+
+    /// The last output.
+    pub fn last(&self) -> &DriveOutput<T> {
+        &self.last
+    }
+
+    /// True after an over-current trip, until `reset`.
+    pub fn is_tripped(&self) -> bool {
+        self.tripped
+    }
+
+    /// Samples rejected since the last reset.
+    pub fn rejected_samples(&self) -> u32 {
+        self.rejected_samples
+    }
+
+    /// The realised references computed at n−1 and n−2 (the latter is what the estimator
+    /// gets at the next sample).
+    pub fn voltage_history(&self) -> [Ab<T>; 2] {
+        self.history
+    }
+}
+
+fn estimate_is_finite<T: Real>(e: &Estimate<T>) -> bool {
+    e.theta.is_finite() && e.omega.is_finite() && e.omega_control.is_finite()
+}

@@ -1,0 +1,24 @@
+//! The drive around the estimator (the rest of Fig. 5): speed and current PI control with
+//! anti-windup, the d-axis injection of eq. (23), delay and dead-time compensation (paper
+//! IV-B, SPEC §5), hexagon limiting and SVPWM, composed into [`SensorlessDrive`].
+//!
+//! Every block follows the crate's pattern (`new(config) -> Result<_, ConfigError>`, `step`,
+//! `reset`), is allocation-free, generic over [`Real`](crate::Real) and never panics.
+
+pub mod current_controller;
+pub mod dead_time_compensation;
+pub mod delay_compensation;
+pub mod drive;
+pub mod modulation;
+pub mod pi;
+pub mod speed_controller;
+
+pub use current_controller::{CurrentController, CurrentControllerConfig};
+pub use dead_time_compensation::{
+    DeadTimeCompensation, DeadTimeCompensationConfig, DeadTimeMethod,
+};
+pub use delay_compensation::{DelayCompensation, DelayCompensationConfig};
+pub use drive::{DriveConfig, DriveOutput, SensorlessDrive};
+pub use modulation::{Modulation, ModulatorConfig, SpaceVectorModulator, VoltageLimit, svpwm_duty};
+pub use pi::{Pi, PiConfig};
+pub use speed_controller::{SpeedController, SpeedControllerConfig, limit_current_d_priority};

@@ -1,0 +1,265 @@
+//! Voltage limiting to the inverter hexagon and space-vector PWM (paper, V: "synthesized by
+//! the space vector PWM (SVPWM) [16]").
+//!
+//! **Limit: keep the angle, scale the magnitude.** A two-level inverter with dc link Vdc can
+//! realise (on average over a period) exactly the α-β vectors whose phase voltages span at
+//! most Vdc: max(v_a, v_b, v_c) − min(v_a, v_b, v_c) ≤ Vdc — the hexagon with vertices
+//! 2/3·Vdc. A vector outside is scaled by Vdc/span onto the boundary along its own direction.
+//! The minimum-distance projection would give a little more voltage in overmodulation, but
+//! it turns the vector towards a vertex, i.e. changes the d/q ratio the current controller
+//! asked for; scaling keeps the direction the controller wants and is what the anti-windup and
+//! the estimator are told was applied. The inscribed circle Vdc/√3 is offered as an option.
+//!
+//! **SVPWM as min-max zero-sequence injection** [16]: v_x + v_0 with
+//! v_0 = −(max + min)/2 centres the three references in the carrier, which is equivalent to
+//! the symmetric placement of the two zero vectors in classical SVPWM. Duty d_x = ½ + (v_x +
+//! v_0)/Vdc ∈ [0, 1] for every realisable vector.
+
+use crate::control::pi::clamp;
+use crate::error::{ConfigError, check};
+use crate::{Ab, Abc, Real};
+
+/// Which set of α-β vectors counts as realisable.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum VoltageLimit {
+    /// The inverter hexagon (linear SVPWM range plus the six sectors' corners), radius Vdc/√3
+    /// to 2·Vdc/3 depending on angle. Default.
+    #[default]
+    Hexagon,
+    /// The hexagon's inscribed circle, |v| ≤ Vdc/√3: a direction-independent limit.
+    InscribedCircle,
+}
+
+/// Configuration of a [`SpaceVectorModulator`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ModulatorConfig<T> {
+    /// Realisable set. Default [`VoltageLimit::Hexagon`] (SVPWM [16], paper V).
+    pub limit: VoltageLimit,
+    /// Fraction (0, 1] of the limit that may be used, a margin e.g. for minimum pulses.
+    /// Default 1 [A].
+    pub max_modulation: T,
+}
+
+impl<T: Real> Default for ModulatorConfig<T> {
+    fn default() -> Self {
+        Self {
+            limit: VoltageLimit::Hexagon,
+            max_modulation: T::one(),
+        }
+    }
+}
+
+/// Result of one modulation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Modulation<T> {
+    /// Duty cycles of the upper switches, each in [0, 1].
+    pub duty: Abc<T>,
+    /// The α-β voltage these duties realise (the limited reference) in V.
+    pub v_ab: Ab<T>,
+    /// True when the reference had to be scaled (or Vdc was not usable).
+    pub saturated: bool,
+}
+
+/// Hexagon limiter and min-max SVPWM (module docs). Stateless.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpaceVectorModulator<T> {
+    config: ModulatorConfig<T>,
+}
+
+impl<T: Real> SpaceVectorModulator<T> {
+    /// A new modulator; `max_modulation` must be in (0, 1].
+    pub fn new(config: ModulatorConfig<T>) -> Result<Self, ConfigError> {
+        let m = check::positive("max_modulation", config.max_modulation)?;
+        if m > T::one() {
+            return Err(ConfigError::OutOfRange {
+                field: "max_modulation",
+                expected: "at most 1",
+            });
+        }
+        Ok(Self { config })
+    }
+
+    /// No state.
+    pub fn reset(&mut self) {}
+
+    /// The reference limited to the realisable set for dc-link voltage `vdc`, keeping its
+    /// angle; and whether it was scaled. Non-finite inputs or vdc ≤ 0 give the zero vector
+    /// (flagged as saturated).
+    #[inline]
+    pub fn limit(&self, v_ab: Ab<T>, vdc: T) -> (Ab<T>, bool) {
+        if !(v_ab.is_finite() && vdc.is_finite() && vdc > T::zero()) {
+            return (Ab::zero(), true);
+        }
+        let m = self.config.max_modulation;
+        let scale = match self.config.limit {
+            VoltageLimit::Hexagon => {
+                let span = phase_span(v_ab.to_abc());
+                let avail = m * vdc;
+                if span > avail { avail / span } else { T::one() }
+            }
+            VoltageLimit::InscribedCircle => {
+                let n = v_ab.norm();
+                let avail = m * vdc * T::lit(0.577_350_269_189_625_8);
+                if n > avail { avail / n } else { T::one() }
+            }
+        };
+        if scale < T::one() {
+            (v_ab * scale, true)
+        } else {
+            (v_ab, false)
+        }
+    }
+
+    /// Limits `v_ab` and modulates it: duties in [0, 1] and the realised α-β vector.
+    #[inline]
+    pub fn step(&self, v_ab: Ab<T>, vdc: T) -> Modulation<T> {
+        let (v, saturated) = self.limit(v_ab, vdc);
+        let duty = if vdc.is_finite() && vdc > T::zero() {
+            svpwm_duty(v, vdc)
+        } else {
+            Abc::new(T::lit(0.5), T::lit(0.5), T::lit(0.5))
+        };
+        Modulation {
+            duty,
+            v_ab: v,
+            saturated,
+        }
+    }
+
+    /// The configuration in use.
+    pub fn config(&self) -> &ModulatorConfig<T> {
+        &self.config
+    }
+}
+
+/// max − min of the three phase values (the line-to-line span a vector needs).
+#[inline]
+fn phase_span<T: Real>(v: Abc<T>) -> T {
+    let (hi, lo) = max_min(v);
+    hi - lo
+}
+
+#[inline]
+fn max_min<T: Real>(v: Abc<T>) -> (T, T) {
+    let hi = if v.a > v.b { v.a } else { v.b };
+    let hi = if hi > v.c { hi } else { v.c };
+    let lo = if v.a < v.b { v.a } else { v.b };
+    let lo = if lo < v.c { lo } else { v.c };
+    (hi, lo)
+}
+
+/// Min-max SVPWM [16] of a realisable α-β vector: d_x = ½ + (v_x − (max + min)/2)/Vdc,
+/// clamped to [0, 1] against rounding (a vector outside the hexagon is clipped per phase —
+/// limit it first). `vdc` must be positive; non-finite values give ½ on every phase.
+#[inline]
+pub fn svpwm_duty<T: Real>(v_ab: Ab<T>, vdc: T) -> Abc<T> {
+    let half = T::lit(0.5);
+    if !(v_ab.is_finite() && vdc.is_finite() && vdc > T::zero()) {
+        return Abc::new(half, half, half);
+    }
+    let v = v_ab.to_abc();
+    let (hi, lo) = max_min(v);
+    let v0 = -(hi + lo) * half;
+    let inv = T::one() / vdc;
+    let duty = |x: T| clamp(half + (x + v0) * inv, T::zero(), T::one());
+    Abc::new(duty(v.a), duty(v.b), duty(v.c))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn pole_ab(duty: Abc<f64>, vdc: f64) -> Ab<f64> {
+        (duty * vdc).to_ab()
+    }
+
+    #[test]
+    fn hexagon_radius_varies_between_inscribed_circle_and_vertex() {
+        let m = SpaceVectorModulator::new(ModulatorConfig::default()).unwrap();
+        let vdc = 300.0_f64;
+        // Along a vertex (phase a) the limit is 2/3·Vdc, between vertices Vdc/√3.
+        let (v, sat) = m.limit(Ab::new(1000.0, 0.0), vdc);
+        assert!(sat && (v.norm() - 200.0).abs() < 1e-9);
+        let dir = Ab::from_polar(1000.0, core::f64::consts::PI / 6.0);
+        let (v, _) = m.limit(dir, vdc);
+        assert!((v.norm() - vdc / 3f64.sqrt()).abs() < 1e-9);
+        let circle = SpaceVectorModulator::new(ModulatorConfig {
+            limit: VoltageLimit::InscribedCircle,
+            max_modulation: 1.0,
+        })
+        .unwrap();
+        let (v, _) = circle.limit(Ab::new(1000.0, 0.0), vdc);
+        assert!((v.norm() - vdc / 3f64.sqrt()).abs() < 1e-9);
+    }
+
+    #[test]
+    fn bad_vdc_gives_zero_vector_and_half_duty() {
+        let m = SpaceVectorModulator::new(ModulatorConfig::default()).unwrap();
+        for vdc in [0.0, -5.0, f64::NAN, f64::INFINITY] {
+            let out = m.step(Ab::new(10.0, 0.0), vdc);
+            assert_eq!(out.v_ab, Ab::zero());
+            assert_eq!(out.duty, Abc::new(0.5, 0.5, 0.5));
+        }
+        assert!(
+            SpaceVectorModulator::new(ModulatorConfig {
+                limit: VoltageLimit::Hexagon,
+                max_modulation: 1.2
+            })
+            .is_err()
+        );
+    }
+
+    proptest! {
+        #[test]
+        fn duties_realise_the_reference_inside_the_hexagon(
+            mag in 0.0..1.0_f64, ang in -4.0..4.0_f64, vdc in 1.0..800.0_f64,
+        ) {
+            let m = SpaceVectorModulator::new(ModulatorConfig::default()).unwrap();
+            // Scale so that the vector is inside: a fraction of the radius in that direction.
+            let unit = Ab::from_polar(1.0, ang);
+            let radius = vdc / phase_span(unit.to_abc());
+            let v = unit * (mag * radius);
+            let out = m.step(v, vdc);
+            prop_assert!(!out.saturated);
+            for d in [out.duty.a, out.duty.b, out.duty.c] {
+                prop_assert!((0.0..=1.0).contains(&d));
+            }
+            // Line-to-line averages equal the reference's.
+            let r = v.to_abc();
+            let tol = 1e-9 * vdc;
+            prop_assert!(((out.duty.a - out.duty.b) * vdc - (r.a - r.b)).abs() < tol);
+            prop_assert!(((out.duty.b - out.duty.c) * vdc - (r.b - r.c)).abs() < tol);
+            prop_assert!((pole_ab(out.duty, vdc) - v).norm() < tol);
+            // Min-max injection centres the duties.
+            let (hi, lo) = max_min(out.duty);
+            prop_assert!((hi + lo - 1.0).abs() < 1e-12);
+        }
+
+        #[test]
+        fn limiting_keeps_angle_and_lands_on_the_boundary(
+            mag in 0.0..5000.0_f64, ang in -4.0..4.0_f64, vdc in 1.0..800.0_f64,
+        ) {
+            let m = SpaceVectorModulator::new(ModulatorConfig::default()).unwrap();
+            let v = Ab::from_polar(mag, ang);
+            let out = m.step(v, vdc);
+            for d in [out.duty.a, out.duty.b, out.duty.c] {
+                prop_assert!((0.0..=1.0).contains(&d));
+            }
+            prop_assert!(out.v_ab.norm() <= v.norm() * (1.0 + 1e-12) + 1e-12);
+            prop_assert!(phase_span(out.v_ab.to_abc()) <= vdc * (1.0 + 1e-12));
+            prop_assert!((pole_ab(out.duty, vdc) - out.v_ab).norm() < 1e-9 * vdc);
+            if out.saturated {
+                // Same direction (cross product 0, dot product positive), on the boundary.
+                let cross = v.alpha * out.v_ab.beta - v.beta * out.v_ab.alpha;
+                prop_assert!(cross.abs() < 1e-9 * v.norm() * out.v_ab.norm() + 1e-12);
+                prop_assert!(v.alpha * out.v_ab.alpha + v.beta * out.v_ab.beta > 0.0);
+                prop_assert!((phase_span(out.v_ab.to_abc()) - vdc).abs() < 1e-9 * vdc);
+                let (hi, lo) = max_min(out.duty);
+                prop_assert!(hi > 1.0 - 1e-9 && lo < 1e-9);
+            } else {
+                prop_assert_eq!(out.v_ab, v);
+            }
+        }
+    }
+}

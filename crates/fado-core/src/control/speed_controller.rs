@@ -1,0 +1,238 @@
+//! Speed control of Fig. 5: a PI from the speed error to the q-axis current reference, and
+//! the current-vector limit shared with the d-axis injection of eq. (23).
+//!
+//! Gains (SPEC §6): Kp = Ĵ·ωsc/K̂t, Ki = Kp·ωsc/5 with ωsc = 2π·5 Hz (paper, V) and
+//! K̂t = 1.5·p·λ̂f. With an ideal current loop the open loop is ωsc·(s + ωsc/5)/s²: crossover
+//! ≈ ωsc and atan(5) = 79° of phase margin. Those gains are per *mechanical* rad/s; the
+//! controller works in electrical rad/s (the estimator's unit), so it divides Kp and Ki by p.
+
+use crate::control::pi::{Pi, PiConfig};
+use crate::error::{ConfigError, NonFiniteInput, check};
+use crate::{Dq, Real};
+
+/// Configuration of a [`SpeedController`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpeedControllerConfig<T> {
+    /// Sampling period Ts in s. Default 100 µs (paper, V: the loop runs every sample).
+    pub ts: T,
+    /// Pole pairs p. Default 4 (paper, V: 8 poles).
+    pub pole_pairs: T,
+    /// Inertia estimate Ĵ in kg·m². Default 0.012 (SPEC §6 [A]).
+    pub inertia_hat: T,
+    /// Magnet flux linkage estimate λ̂f in Wb, for K̂t = 1.5·p·λ̂f. Default 0.088 (SPEC §6 [A]).
+    pub flux_linkage_hat: T,
+    /// Speed-loop bandwidth in Hz. Default 5 Hz (paper, V).
+    pub bandwidth_hz: T,
+    /// Ratio ωsc/(Ki/Kp): the PI zero sits this many times below the crossover. Default 5
+    /// (SPEC §6: Ki = Kp·2π·5/5).
+    pub zero_ratio: T,
+    /// Current limit I_max in A (q-axis output limit). Default 40 A (SPEC §6 [A]).
+    pub i_max: T,
+    /// Back-calculation gain as a multiple of Ki/Kp (see [`PiConfig`]). Default 5, i.e. a
+    /// tracking time constant of 1/ωsc: with the realisable setting (1) the integral relaxes
+    /// only with 5/ωsc = 160 ms and a long saturated acceleration leaves it near I_max,
+    /// which costs a large speed overshoot [A].
+    pub anti_windup_ratio: T,
+}
+
+impl<T: Real> Default for SpeedControllerConfig<T> {
+    fn default() -> Self {
+        Self {
+            ts: T::lit(100e-6),
+            pole_pairs: T::lit(4.0),
+            inertia_hat: T::lit(0.012),
+            flux_linkage_hat: T::lit(0.088),
+            bandwidth_hz: T::lit(5.0),
+            zero_ratio: T::lit(5.0),
+            i_max: T::lit(40.0),
+            anti_windup_ratio: T::lit(5.0),
+        }
+    }
+}
+
+/// Speed PI: electrical speed error in, q-axis current reference out (module docs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpeedController<T> {
+    config: SpeedControllerConfig<T>,
+    pi: Pi<T>,
+}
+
+impl<T: Real> SpeedController<T> {
+    /// A new controller; every field is checked and a bad one named.
+    pub fn new(config: SpeedControllerConfig<T>) -> Result<Self, ConfigError> {
+        let ts = check::positive("ts", config.ts)?;
+        let p = check::positive("pole_pairs", config.pole_pairs)?;
+        let j = check::positive("inertia_hat", config.inertia_hat)?;
+        let lf = check::positive("flux_linkage_hat", config.flux_linkage_hat)?;
+        let wsc = T::two_pi() * check::positive("bandwidth_hz", config.bandwidth_hz)?;
+        check::below(
+            "bandwidth_hz",
+            wsc * ts,
+            T::lit(0.1),
+            "2π·bandwidth_hz·ts below 0.1",
+        )?;
+        let zr = check::positive("zero_ratio", config.zero_ratio)?;
+        let i_max = check::positive("i_max", config.i_max)?;
+        let ratio = check::non_negative("anti_windup_ratio", config.anti_windup_ratio)?;
+        let kt = T::lit(1.5) * p * lf;
+        let kp_mech = j * wsc / kt;
+        let kp = kp_mech / p;
+        let pi = Pi::new(PiConfig {
+            ts,
+            kp,
+            ki: kp * wsc / zr,
+            output_min: -i_max,
+            output_max: i_max,
+            anti_windup_ratio: ratio,
+        })
+        .map_err(|e| match e.field() {
+            "anti_windup_ratio" => e,
+            _ => ConfigError::OutOfRange {
+                field: "inertia_hat",
+                expected: "finite, non-zero speed PI gains",
+            },
+        })?;
+        Ok(Self { config, pi })
+    }
+
+    /// Integrator back to zero.
+    pub fn reset(&mut self) {
+        self.pi.reset();
+    }
+
+    /// One sample: reference and estimated speed in electrical rad/s (T2S-2 in the drive).
+    /// Returns i_q* in A, within ±I_max. A non-finite input is rejected, state untouched.
+    #[inline]
+    pub fn step(&mut self, omega_ref: T, omega: T) -> Result<T, NonFiniteInput> {
+        self.pi.step(omega_ref - omega, T::zero())
+    }
+
+    /// Anti-windup for a further limit of i_q* downstream (the current-vector limit with
+    /// the d-axis injection): the q current that was finally used.
+    #[inline]
+    pub fn realised(&mut self, iq_ref: T) {
+        self.pi.realised(iq_ref);
+    }
+
+    /// Kp in A per electrical rad/s.
+    pub fn kp(&self) -> T {
+        self.pi.config().kp
+    }
+
+    /// Ki in A per electrical rad.
+    pub fn ki(&self) -> T {
+        self.pi.config().ki
+    }
+
+    /// Integral state (A).
+    pub fn integral(&self) -> T {
+        self.pi.integral()
+    }
+
+    /// The configuration in use.
+    pub fn config(&self) -> &SpeedControllerConfig<T> {
+        &self.config
+    }
+}
+
+/// The current-vector limit |i_dq*| ≤ I_max with priority to d (SPEC §4, §6): i_d* (the
+/// injection of eq. (23)) is kept within ±I_max and i_q* is cut to √(I_max² − i_d*²).
+/// With I_min ≤ I_max the injection alone never needs the cut (|i_dq*| = I_min while it is
+/// active), but any larger d-axis demand does.
+#[inline]
+pub fn limit_current_d_priority<T: Real>(i_dq: Dq<T>, i_max: T) -> Dq<T> {
+    let d = crate::control::pi::clamp(i_dq.d, -i_max, i_max);
+    let room = (i_max * i_max - d * d).max(T::zero()).sqrt();
+    Dq::new(d, crate::control::pi::clamp(i_dq.q, -room, room))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::injection::{CurrentInjection, CurrentInjectionConfig};
+
+    #[test]
+    fn gains_follow_spec_6() {
+        let c = SpeedController::<f64>::new(SpeedControllerConfig::default()).unwrap();
+        let kt = 1.5 * 4.0 * 0.088;
+        let kp_mech = 0.012 * 2.0 * core::f64::consts::PI * 5.0 / kt;
+        assert!((kp_mech - 0.714).abs() < 1e-3, "SPEC §6 quotes 0.714");
+        assert!((c.kp() * 4.0 - kp_mech).abs() < 1e-12);
+        assert!((c.ki() / c.kp() - 2.0 * core::f64::consts::PI).abs() < 1e-12);
+    }
+
+    /// Speed loop around an ideal current loop and a rigid rotor: crossover at 5 Hz.
+    #[test]
+    fn small_step_matches_design_and_big_step_recovers() {
+        let run = |step_mech: f64, ratio: f64| {
+            let mut c = SpeedController::new(SpeedControllerConfig {
+                anti_windup_ratio: ratio,
+                ..SpeedControllerConfig::default()
+            })
+            .unwrap();
+            let (p, j, kt, ts) = (4.0, 0.012, 1.5 * 4.0 * 0.088, 100e-6);
+            let (mut w_mech, mut peak, mut t_rise) = (0.0_f64, 0.0_f64, None);
+            for n in 0..20_000 {
+                let iq = c.step(p * step_mech, p * w_mech).unwrap();
+                w_mech += ts * kt * iq / j;
+                peak = peak.max(w_mech);
+                if t_rise.is_none() && w_mech >= 0.9 * step_mech {
+                    t_rise = Some(n as f64 * ts);
+                }
+            }
+            assert!((w_mech - step_mech).abs() < 1e-3 * step_mech);
+            (peak / step_mech - 1.0, t_rise.unwrap())
+        };
+        // Linear: a 10 rad/s step needs 10·Kp·p = 23 A < 40 A.
+        let (overshoot, t90) = run(10.0, 5.0);
+        // ωsc(s + ωsc/5)/(s² + ωsc·s + ωsc²/5): overshoot ≈ 14 %, 90 % after ≈ 0.036 s.
+        assert!(overshoot > 0.05 && overshoot < 0.25, "{overshoot}");
+        assert!(t90 > 0.02 && t90 < 0.06, "{t90}");
+        // Saturated at 40 A for ~80 ms: anti-windup keeps the overshoot near the linear one.
+        let (big, _) = run(150.0, 5.0);
+        let (realisable, _) = run(150.0, 1.0);
+        let (naive, _) = run(150.0, 0.0);
+        assert!(big < 0.25, "{big}");
+        assert!(
+            big < realisable && realisable < naive,
+            "{big} {realisable} {naive}"
+        );
+    }
+
+    #[test]
+    fn injection_interplay_keeps_vector_within_limit() {
+        let inj = CurrentInjection::new(CurrentInjectionConfig { i_min: 4.0_f64 }).unwrap();
+        for k in -100..=100 {
+            let iq = 0.5 * k as f64;
+            let ref_dq = limit_current_d_priority(Dq::new(inj.step(iq), iq), 40.0);
+            assert!(ref_dq.norm() <= 40.0 + 1e-12);
+            if iq.abs() < 4.0 {
+                // eq. (23): the vector magnitude is exactly I_min, d positive.
+                assert!((ref_dq.norm() - 4.0).abs() < 1e-12 && ref_dq.d > 0.0);
+            } else {
+                assert_eq!(ref_dq.d, 0.0);
+            }
+        }
+        // A d demand near the limit cuts q, not d.
+        let cut = limit_current_d_priority(Dq::new(30.0, -40.0_f64), 40.0);
+        assert_eq!(cut.d, 30.0);
+        assert!((cut.q + (40.0_f64 * 40.0 - 900.0).sqrt()).abs() < 1e-12);
+        let over = limit_current_d_priority(Dq::new(50.0, 1.0_f64), 40.0);
+        assert_eq!(over, Dq::new(40.0, 0.0));
+    }
+
+    #[test]
+    fn bad_config_names_field() {
+        let bad = |f: fn(&mut SpeedControllerConfig<f64>)| {
+            let mut cfg = SpeedControllerConfig::default();
+            f(&mut cfg);
+            SpeedController::new(cfg).unwrap_err().field()
+        };
+        assert_eq!(bad(|c| c.pole_pairs = 0.0), "pole_pairs");
+        assert_eq!(bad(|c| c.inertia_hat = f64::NAN), "inertia_hat");
+        assert_eq!(bad(|c| c.i_max = -1.0), "i_max");
+        assert_eq!(bad(|c| c.bandwidth_hz = 1e3), "bandwidth_hz");
+        assert_eq!(bad(|c| c.zero_ratio = 0.0), "zero_ratio");
+        assert_eq!(bad(|c| c.anti_windup_ratio = 1e9), "anti_windup_ratio");
+    }
+}

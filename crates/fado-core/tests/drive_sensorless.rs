@@ -1,0 +1,450 @@
+//! The whole drive (Fig. 5): the timing contract checked with a spy estimator, robustness
+//! with proptest, protection, and a short sensorless closed loop around an ideal SMPMSM with
+//! an averaged inverter that has the dead-time error the compensation is meant for.
+
+use core::f64::consts::TAU;
+use std::vec::Vec;
+
+use fado_core::control::{DeadTimeMethod, DriveConfig, DriveOutput, SensorlessDrive};
+use fado_core::{
+    Ab, Abc, Diagnostics, Estimate, EstimatorConfig, Rotation, RotorAngleEstimator,
+    SensorlessEstimator,
+};
+use proptest::prelude::*;
+
+/// Records what the drive feeds it and answers with a scripted rotating estimate.
+#[derive(Default)]
+struct Spy {
+    v: Vec<Ab<f64>>,
+    i: Vec<Ab<f64>>,
+    theta: f64,
+    omega: f64,
+    aligned: Option<(f64, Ab<f64>)>,
+}
+
+impl RotorAngleEstimator<f64> for Spy {
+    fn step(&mut self, v_ab: Ab<f64>, i_ab: Ab<f64>) -> Estimate<f64> {
+        self.v.push(v_ab);
+        self.i.push(i_ab);
+        self.theta = fado_core::wrap_angle(self.theta + self.omega * 100e-6);
+        Estimate {
+            theta: self.theta,
+            omega: self.omega,
+            omega_control: 0.9 * self.omega,
+            diagnostics: Diagnostics::default(),
+        }
+    }
+    fn align(&mut self, theta0: f64, i_ab: Ab<f64>) {
+        self.aligned = Some((theta0, i_ab));
+        self.theta = theta0;
+    }
+    fn reset(&mut self) {
+        self.v.clear();
+        self.i.clear();
+    }
+    fn name(&self) -> &'static str {
+        "spy"
+    }
+}
+
+fn spy_drive() -> SensorlessDrive<f64, Spy> {
+    let spy = Spy {
+        omega: TAU * 30.0,
+        ..Spy::default()
+    };
+    SensorlessDrive::with_estimator(DriveConfig::default(), spy).unwrap()
+}
+
+fn currents(n: usize) -> Abc<f64> {
+    let th = 0.37 * n as f64;
+    Ab::new(3.0 * th.cos() + 0.5, 2.0 * th.sin()).to_abc()
+}
+
+#[test]
+fn estimator_gets_the_voltage_computed_two_samples_earlier() {
+    let mut drive = spy_drive();
+    drive.align(0.4);
+    let mut outs: Vec<DriveOutput<f64>> = Vec::new();
+    for n in 0..60 {
+        let i = if n == 20 || n == 33 {
+            Abc::new(f64::NAN, 0.0, 0.0) // rejected samples: the duty is held
+        } else {
+            currents(n)
+        };
+        let vdc = if n == 40 { f64::INFINITY } else { 300.0 };
+        outs.push(drive.step(i, vdc, 50.0 + n as f64));
+    }
+    let spy = drive.estimator();
+    assert_eq!(
+        spy.v.len(),
+        60,
+        "the estimator keeps time through rejected samples"
+    );
+    assert_eq!(spy.v[0], Ab::zero());
+    assert_eq!(spy.v[1], Ab::zero());
+    for n in 2..60 {
+        assert_eq!(spy.v[n], outs[n - 2].v_ref_ab, "sample {n}");
+    }
+    // The references are live, not zero.
+    assert!(outs.iter().filter(|o| o.v_ref_ab.norm() > 1.0).count() > 40);
+    for (n, o) in outs.iter().enumerate() {
+        if [20, 33, 40].contains(&n) {
+            assert!(o.input_fault);
+            assert_eq!(o.duty, outs[n - 1].duty, "duty held at {n}");
+            assert_eq!(o.v_ref_ab, outs[n - 1].v_ref_ab);
+            // The estimator integrated the interval with the last good current (or this
+            // sample's, when only Vdc was bad).
+            if n == 40 {
+                assert!((spy.i[n] - currents(n).to_ab()).norm() < 1e-12);
+            } else {
+                assert_eq!(spy.i[n], spy.i[n - 1]);
+            }
+            continue;
+        }
+        assert!(!o.input_fault);
+        // Clarke of the sampled phase currents, Park at θ̂ of this very sample.
+        let i_ab = currents(n).to_ab();
+        assert!((spy.i[n] - i_ab).norm() < 1e-12);
+        let i_dq = i_ab.to_dq(Rotation::from_angle(o.estimate.theta));
+        assert!((o.i_dq - i_dq).norm() < 1e-12);
+        // Delay compensation: the realised d-q voltage is in the frame θ̂ + 1.5·ω̂·Ts
+        // (ω̂ of T2S-1, not the control speed).
+        let adv = o.estimate.theta + 1.5 * o.estimate.omega * 100e-6;
+        let v_dq = o.v_ref_ab.to_dq(Rotation::from_angle(adv));
+        assert!((v_dq - o.v_dq_ref).norm() < 1e-9);
+    }
+}
+
+#[test]
+fn speed_reference_is_mechanical_and_loop_runs_on_control_speed() {
+    // ω̂_control = 0.9·2π·30 = 169.6 rad/s electrical = 42.4 mechanical rad/s with p = 4:
+    // a reference of exactly that gives zero speed error, so i_q* stays at zero.
+    let mut drive = spy_drive();
+    let w_mech = 0.9 * TAU * 30.0 / 4.0;
+    for n in 0..50 {
+        let out = drive.step(currents(n), 300.0, w_mech);
+        assert!(out.i_dq_ref.q.abs() < 1e-9);
+        // Injection (23) with i_q* = 0: i_d* = I_min.
+        assert!((out.i_dq_ref.d - 4.0).abs() < 1e-12);
+    }
+    let out = drive.step(currents(50), 300.0, w_mech + 1.0);
+    let kp_elec = 0.012 * TAU * 5.0 / (1.5 * 4.0 * 0.088) / 4.0;
+    assert!((out.i_dq_ref.q - kp_elec * 4.0).abs() < 1e-9);
+}
+
+#[test]
+fn over_current_trips_and_latches_until_reset() {
+    let mut drive = spy_drive();
+    drive.step(currents(0), 300.0, 10.0);
+    let out = drive.step(Abc::new(61.0, -30.0, -31.0), 300.0, 10.0);
+    assert!(out.tripped && !out.gates_enabled);
+    assert_eq!(out.duty, Abc::new(0.5, 0.5, 0.5));
+    for n in 0..10 {
+        let out = drive.step(currents(n), 300.0, 10.0);
+        assert!(out.tripped && !out.gates_enabled && drive.is_tripped());
+    }
+    drive.align(0.0);
+    assert!(
+        drive.step(currents(0), 300.0, 10.0).tripped,
+        "align does not clear a trip"
+    );
+    drive.reset();
+    let out = drive.step(currents(0), 300.0, 10.0);
+    assert!(!out.tripped && out.gates_enabled);
+}
+
+#[test]
+fn configuration_errors_name_the_field() {
+    let bad = |f: fn(&mut DriveConfig<f64>)| {
+        let mut cfg = DriveConfig::default();
+        f(&mut cfg);
+        SensorlessDrive::new(cfg, EstimatorConfig::default())
+            .unwrap_err()
+            .field()
+    };
+    assert_eq!(bad(|c| c.ts = 50e-6), "ts");
+    assert_eq!(bad(|c| c.i_min = 50.0), "i_min");
+    assert_eq!(bad(|c| c.trip_current = 30.0), "trip_current");
+    assert_eq!(bad(|c| c.pole_pairs = 0.0), "pole_pairs");
+    assert_eq!(bad(|c| c.inertia_hat = f64::NAN), "inertia_hat");
+    assert_eq!(
+        bad(|c| c.current_bandwidth_hz = 5e3),
+        "current_bandwidth_hz"
+    );
+    assert_eq!(bad(|c| c.speed_bandwidth_hz = -1.0), "speed_bandwidth_hz");
+    assert_eq!(
+        bad(|c| c.speed_anti_windup_ratio = 1e9),
+        "speed_anti_windup_ratio"
+    );
+    assert_eq!(
+        bad(|c| c.current_anti_windup_ratio = -1.0),
+        "current_anti_windup_ratio"
+    );
+    assert_eq!(
+        bad(|c| c.dead_time_current_band = 0.0),
+        "dead_time_current_band"
+    );
+    assert_eq!(
+        bad(|c| c.dead_time_threshold_voltage = -1.0),
+        "dead_time_threshold_voltage"
+    );
+    assert_eq!(
+        bad(|c| c.delay_compensation_factor = -1.0),
+        "delay_compensation_factor"
+    );
+    assert_eq!(bad(|c| c.max_modulation = 2.0), "max_modulation");
+    assert_eq!(bad(|c| c.ld_hat = 0.0), "ld_hat");
+    assert_eq!(bad(|c| c.rs_hat = f64::INFINITY), "rs_hat");
+    assert!(DriveConfig::<f32>::default().validate().is_ok());
+}
+
+fn any_value() -> impl Strategy<Value = f64> {
+    prop_oneof![
+        4 => -80.0..80.0_f64,
+        1 => any::<f64>(),
+        1 => Just(f64::NAN),
+        1 => Just(f64::INFINITY),
+        1 => Just(f64::NEG_INFINITY),
+        1 => Just(0.0),
+    ]
+}
+
+fn check_output<T: fado_core::Real>(o: &DriveOutput<T>) -> Result<(), TestCaseError> {
+    for d in [o.duty.a, o.duty.b, o.duty.c] {
+        prop_assert!(d >= T::zero() && d <= T::one(), "duty {:?}", o.duty);
+    }
+    prop_assert!(o.v_ref_ab.is_finite() && o.v_dq_ref.is_finite());
+    prop_assert!(o.i_dq.is_finite() && o.i_dq_ref.is_finite());
+    prop_assert!(o.i_dq_ref.norm() <= T::lit(40.0 * (1.0 + 1e-6)));
+    let e = &o.estimate;
+    prop_assert!(e.theta.is_finite() && e.omega.is_finite() && e.omega_control.is_finite());
+    prop_assert!(o.gates_enabled != o.tripped);
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    #[test]
+    fn arbitrary_inputs_never_panic_and_outputs_stay_sane(
+        samples in prop::collection::vec(
+            (any_value(), any_value(), any_value(), prop_oneof![3 => 0.0..600.0_f64, 1 => any_value()], any_value()),
+            1..300,
+        ),
+        method in prop_oneof![Just(DeadTimeMethod::Trapezoidal), Just(DeadTimeMethod::Sign)],
+    ) {
+        let cfg = DriveConfig { dead_time_method: method, ..DriveConfig::default() };
+        let mut d64 = SensorlessDrive::new(cfg, EstimatorConfig::default()).unwrap();
+        let mut d32 = SensorlessDrive::<f32>::new(
+            DriveConfig { dead_time_method: method, ..DriveConfig::default() },
+            EstimatorConfig::default(),
+        ).unwrap();
+        d64.align(0.3);
+        d32.align(0.3);
+        for (a, b, c, vdc, w) in samples {
+            let o = d64.step(Abc::new(a, b, c), vdc, w);
+            check_output(&o)?;
+            let finite = a.is_finite() && b.is_finite() && c.is_finite() && vdc.is_finite() && w.is_finite();
+            prop_assert!(o.input_fault != finite || o.tripped);
+            let o = d32.step(Abc::new(a as f32, b as f32, c as f32), vdc as f32, w as f32);
+            check_output(&o)?;
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Closed loop around an ideal SMPMSM (SPEC §6) fed by an averaged inverter whose pole voltages
+// fall short by V̂·sat(i_x/Ic) (SPEC §5 inverter model), with the real timing.
+
+const RS: f64 = 0.327;
+const L: f64 = 2.63e-3;
+const LF: f64 = 0.088;
+const PP: f64 = 4.0;
+const J: f64 = 0.012;
+const B: f64 = 1e-3;
+const TS: f64 = 100e-6;
+const VDC: f64 = 300.0;
+
+struct Motor {
+    lambda: Ab<f64>,
+    theta: f64,
+    omega_mech: f64,
+    /// Infinite for a speed-stiff load.
+    inertia: f64,
+}
+
+impl Motor {
+    fn current(&self) -> Ab<f64> {
+        (self.lambda - Ab::from_polar(LF, self.theta)) * (1.0 / L)
+    }
+    fn derivative(&self, duty: Abc<f64>, load: f64) -> (Ab<f64>, f64, f64) {
+        let i = self.current();
+        let i_abc = i.to_abc();
+        let v_hat = 2.5e-6 * 5e3 * VDC + 1.0;
+        let err = |ix: f64| v_hat * (ix / 0.3).clamp(-1.0, 1.0);
+        let pole = Abc::new(
+            duty.a * VDC - err(i_abc.a),
+            duty.b * VDC - err(i_abc.b),
+            duty.c * VDC - err(i_abc.c),
+        );
+        let v = pole.to_ab();
+        let iq = i.to_dq(Rotation::from_angle(self.theta)).q;
+        let torque = 1.5 * PP * LF * iq;
+        (
+            v - i * RS,
+            PP * self.omega_mech,
+            (torque - load - B * self.omega_mech) / self.inertia,
+        )
+    }
+    fn advance(&mut self, duty: Abc<f64>, load: f64) {
+        const N: usize = 10;
+        let h = TS / N as f64;
+        for _ in 0..N {
+            let (dl, dth, dw) = self.derivative(duty, load);
+            let mid = Motor {
+                lambda: self.lambda + dl * (0.5 * h),
+                theta: self.theta + 0.5 * h * dth,
+                omega_mech: self.omega_mech + 0.5 * h * dw,
+                inertia: self.inertia,
+            };
+            let (dl, dth, dw) = mid.derivative(duty, load);
+            self.lambda += dl * h;
+            self.theta += h * dth;
+            self.omega_mech += h * dw;
+        }
+    }
+}
+
+/// Runs the sensorless drive around the motor; `observe(t, motor, output)` sees each sample
+/// *before* the motor moves on, i.e. the true state at the instant the currents were sampled.
+fn closed_loop<E: RotorAngleEstimator<f64>>(
+    mut drive: SensorlessDrive<f64, E>,
+    samples: usize,
+    speed_ref_mech: impl Fn(f64) -> f64,
+    load: impl Fn(f64) -> f64,
+    inertia: f64,
+    mut observe: impl FnMut(f64, &Motor, &DriveOutput<f64>),
+) -> SensorlessDrive<f64, E> {
+    let theta0 = 0.7;
+    let mut motor = Motor {
+        lambda: Ab::from_polar(LF, theta0),
+        theta: theta0,
+        omega_mech: speed_ref_mech(0.0),
+        inertia,
+    };
+    drive.align(theta0);
+    let mut pending = Abc::new(0.5, 0.5, 0.5);
+    for n in 0..samples {
+        let t = n as f64 * TS;
+        let out = drive.step(motor.current().to_abc(), VDC, speed_ref_mech(t));
+        assert!(out.gates_enabled && !out.input_fault);
+        observe(t, &motor, &out);
+        motor.advance(pending, load(t)); // the duty computed at n−1 acts over [n, n+1]
+        pending = out.duty;
+    }
+    drive
+}
+
+fn angle_error(motor: &Motor, out: &DriveOutput<f64>) -> f64 {
+    fado_core::wrap_angle(motor.theta - out.estimate.theta)
+}
+
+/// Feeds the wrapped estimator the voltage one sample older than the drive hands it.
+struct OneSampleOlder {
+    inner: SensorlessEstimator<f64>,
+    previous: Ab<f64>,
+}
+
+impl RotorAngleEstimator<f64> for OneSampleOlder {
+    fn step(&mut self, v_ab: Ab<f64>, i_ab: Ab<f64>) -> Estimate<f64> {
+        let older = core::mem::replace(&mut self.previous, v_ab);
+        self.inner.step(older, i_ab)
+    }
+    fn align(&mut self, theta0: f64, i_ab: Ab<f64>) {
+        self.inner.align(theta0, i_ab)
+    }
+    fn reset(&mut self) {
+        self.inner.reset()
+    }
+    fn name(&self) -> &'static str {
+        "one sample older"
+    }
+}
+
+#[test]
+fn voltage_history_is_aligned_with_the_interval_it_acted_over() {
+    // At constant speed (a stiff load) the estimator is exact when the drive hands it the
+    // voltage that really acted over [n−1, n]; a voltage one sample off rotates the whole
+    // integrand by ω·Ts and the angle follows. So the mean angle error measures the timing.
+    let rpm = 300.0;
+    let w_mech = rpm * TAU / 60.0;
+    let w_ts = PP * w_mech * TS; // 0.0126 rad
+    let mean_error = |older: bool| {
+        let (mut sum, mut count) = (0.0, 0.0);
+        let observe = |t: f64, m: &Motor, o: &DriveOutput<f64>| {
+            if t > 0.5 {
+                sum += angle_error(m, o);
+                count += 1.0;
+            }
+        };
+        let estimator = SensorlessEstimator::new(EstimatorConfig::default()).unwrap();
+        if older {
+            let est = OneSampleOlder {
+                inner: estimator,
+                previous: Ab::zero(),
+            };
+            let drive = SensorlessDrive::with_estimator(DriveConfig::default(), est).unwrap();
+            closed_loop(drive, 10_000, |_| w_mech, |_| 0.0, f64::INFINITY, observe);
+        } else {
+            let drive = SensorlessDrive::with_estimator(DriveConfig::default(), estimator).unwrap();
+            closed_loop(drive, 10_000, |_| w_mech, |_| 0.0, f64::INFINITY, observe);
+        }
+        sum / count
+    };
+    let aligned = mean_error(false);
+    let off_by_one = mean_error(true);
+    assert!(
+        aligned.abs() < 0.05 * w_ts,
+        "aligned history: {aligned} rad"
+    );
+    assert!(
+        (off_by_one - w_ts).abs() < 0.3 * w_ts,
+        "one sample older: {off_by_one} rad vs ω·Ts = {w_ts}"
+    );
+}
+
+#[test]
+fn sensorless_closed_loop_follows_a_speed_ramp_under_load() {
+    let drive = SensorlessDrive::new(DriveConfig::default(), EstimatorConfig::default()).unwrap();
+    let target = 300.0 * TAU / 60.0; // 300 r/min
+    let (mut worst_start, mut worst_steady, mut speed_before_load) = (0.0_f64, 0.0_f64, 0.0);
+    let mut speed_end = 0.0;
+    let drive = closed_loop(
+        drive,
+        16_000,
+        |t| target * (t / 0.3).min(1.0),
+        |t| if t > 0.9 { 5.0 } else { 0.0 },
+        J,
+        |t, m, o| {
+            let e = angle_error(m, o).abs();
+            worst_start = worst_start.max(e);
+            if (0.7..0.9).contains(&t) {
+                worst_steady = worst_steady.max(e);
+                speed_before_load = m.omega_mech;
+            }
+            speed_end = m.omega_mech;
+        },
+    );
+    // From standstill through the limiter/k_df hand-over: the paper's 0.25 rad.
+    assert!(worst_start < 0.25, "angle error {worst_start}");
+    assert!(worst_steady < 0.02, "steady angle error {worst_steady}");
+    assert!((speed_before_load - target).abs() < 0.01 * target);
+    assert!((speed_end - target).abs() < 0.03 * target, "{speed_end}");
+    // Under 5 N·m the q current carries the load torque.
+    let iq = drive.last().i_dq_ref.q;
+    let expected = (5.0 + B * target) / (1.5 * PP * LF);
+    assert!(
+        (iq - expected).abs() < 0.05 * expected,
+        "i_q* = {iq} vs {expected}"
+    );
+}
