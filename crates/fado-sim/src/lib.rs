@@ -11,7 +11,6 @@
 
 pub mod config;
 pub mod controller;
-#[cfg(feature = "drive")]
 pub mod drive;
 pub mod error;
 mod fastmath;
@@ -19,7 +18,6 @@ pub mod inverter;
 pub mod load;
 pub mod motor;
 pub mod profile;
-#[cfg(feature = "drive")]
 pub mod scenario;
 pub mod sensors;
 pub mod sim;
