@@ -69,6 +69,7 @@ pub struct Load {
     kp: f64,
     ki: f64,
     integral: f64,
+    cursors: (usize, usize),
 }
 
 impl Load {
@@ -83,6 +84,7 @@ impl Load {
             kp,
             ki: kp * wb / 5.0,
             integral: 0.0,
+            cursors: (0, 0),
         })
     }
 
@@ -94,11 +96,13 @@ impl Load {
     /// The load torque T_L at time `t` for shaft speed `omega_mech` (rad/s), advancing the
     /// dynamometer's controller by `ts`.
     pub fn torque(&mut self, t: f64, omega_mech: f64, ts: f64) -> f64 {
-        let ff = self.params.torque.value(t);
+        let ff = self.params.torque.value_from(t, &mut self.cursors.0);
         match self.params.mode {
             LoadMode::Torque => ff,
             LoadMode::Speed => {
-                let w_ref = self.params.speed_rpm.value(t) * std::f64::consts::TAU / 60.0;
+                let w_ref = self.params.speed_rpm.value_from(t, &mut self.cursors.1)
+                    * std::f64::consts::TAU
+                    / 60.0;
                 let e = w_ref - omega_mech;
                 let lim = self.params.torque_limit;
                 // The dynamometer's own torque (positive accelerates) = PI − feed-forward load.

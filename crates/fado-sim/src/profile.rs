@@ -80,6 +80,34 @@ impl Profile {
         }
     }
 
+    /// [`value`](Self::value) for non-decreasing `t`, starting the search at `cursor` (kept
+    /// by the caller): O(1) per call along a run instead of a binary search.
+    #[inline]
+    pub fn value_from(&self, t: f64, cursor: &mut usize) -> f64 {
+        let pts = &self.points;
+        if *cursor > pts.len() || (*cursor > 0 && pts[*cursor - 1][0] > t) {
+            *cursor = 0; // time went back: restart
+        }
+        while *cursor < pts.len() && pts[*cursor][0] <= t {
+            *cursor += 1;
+        }
+        let k = *cursor;
+        match (k, pts.len()) {
+            (_, 0) => 0.0,
+            (0, _) => pts[0][1],
+            (k, n) if k >= n => pts[n - 1][1],
+            (k, _) => {
+                let (a, b) = (pts[k - 1], pts[k]);
+                let span = b[0] - a[0];
+                if span <= 0.0 {
+                    b[1]
+                } else {
+                    a[1] + (b[1] - a[1]) * (t - a[0]) / span
+                }
+            }
+        }
+    }
+
     /// Slope of the profile at `t` (0 on steps and outside the breakpoints).
     pub fn slope(&self, t: f64) -> f64 {
         let pts = &self.points;
@@ -114,6 +142,12 @@ mod tests {
         assert_eq!(p.value(2.0), -5.0);
         assert_eq!(p.value(10.0), -5.0);
         assert_eq!(p.slope(10.0), 0.0);
+        let mut cursor = 0;
+        for k in 0..400 {
+            let t = k as f64 * 0.01;
+            assert_eq!(p.value_from(t, &mut cursor), p.value(t), "t = {t}");
+        }
+        assert_eq!(p.value_from(0.5, &mut cursor), p.value(0.5));
     }
 
     #[test]

@@ -303,6 +303,7 @@ pub struct ScenarioProbe {
     pub max_lambda_r: f64,
     hold_n: u64,
     hold_flag: u64,
+    next_disturbance_sample: f64,
 }
 
 impl ScenarioProbe {
@@ -323,6 +324,7 @@ impl ScenarioProbe {
             max_lambda_r: 0.0,
             hold_n: 0,
             hold_flag: 0,
+            next_disturbance_sample: 0.0,
         }
     }
 
@@ -350,9 +352,9 @@ impl ScenarioProbe {
 impl Probe for ScenarioProbe {
     fn observe(&mut self, s: &Sample) {
         let d = &s.act.estimate.diagnostics;
-        let k = (s.time * 100.0).round();
-        if (s.time * 100.0 - k).abs() < 1e-6 {
+        if s.time >= self.next_disturbance_sample {
             self.disturbance.push((s.time, d.disturbance));
+            self.next_disturbance_sample += 0.01;
         }
         if let Some((a, b)) = self.hold
             && s.time >= a
@@ -362,9 +364,14 @@ impl Probe for ScenarioProbe {
             self.hold_flag += d.flag_limit as u64;
             self.max_lambda_r = self.max_lambda_r.max(d.lambda_r.norm());
         }
-        let dtheta = self
-            .last_theta
-            .map_or(0.0, |prev| fado_core::wrap_angle(s.theta - prev));
+        let dtheta = self.last_theta.map_or(0.0, |prev| {
+            let d = s.theta - prev;
+            if d.abs() > std::f64::consts::PI {
+                fado_core::wrap_angle(d)
+            } else {
+                d
+            }
+        });
         self.last_theta = Some(s.theta);
         if s.time < self.eval_start {
             return;

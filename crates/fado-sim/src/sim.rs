@@ -148,6 +148,21 @@ impl Plant {
     }
 }
 
+/// Wraps a difference of two wrapped angles (within ±3π) into [−π, π] without a division.
+#[inline]
+fn wrap_small(x: f64) -> f64 {
+    use std::f64::consts::{PI, TAU};
+    if x > PI {
+        x - TAU
+    } else if x < -PI {
+        x + TAU
+    } else if x.is_finite() {
+        x
+    } else {
+        wrap_angle(x)
+    }
+}
+
 /// Everything known about one sample: true plant state and the controller's view.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Sample {
@@ -179,6 +194,8 @@ pub struct Sample {
 pub trait Probe {
     /// Called once per sample.
     fn observe(&mut self, s: &Sample);
+    /// Called once at the end of [`Simulation::run`] (e.g. to form RMS values).
+    fn finish(&mut self) {}
 }
 
 /// The closed loop: plant + controller + speed reference + timed controller events.
@@ -188,6 +205,7 @@ pub struct Simulation<C> {
     speed_ref_rpm: Profile,
     events: Vec<(f64, ControlEvent)>,
     next_event: usize,
+    speed_cursor: usize,
     pole_pairs: f64,
     tripped: bool,
 }
@@ -212,6 +230,7 @@ impl<C: Controller> Simulation<C> {
             speed_ref_rpm,
             events: Vec::new(),
             next_event: 0,
+            speed_cursor: 0,
             pole_pairs,
             tripped: false,
         })
@@ -256,7 +275,7 @@ impl<C: Controller> Simulation<C> {
             self.next_event += 1;
         }
         let (i_abc, vdc, enc) = self.plant.measure();
-        let speed_ref_rpm = self.speed_ref_rpm.value(t);
+        let speed_ref_rpm = self.speed_ref_rpm.value_from(t, &mut self.speed_cursor);
         let m = Measurements {
             time: t,
             i_abc,
@@ -270,7 +289,7 @@ impl<C: Controller> Simulation<C> {
         let sample = Sample {
             time: t,
             theta: st.theta,
-            angle_error: wrap_angle(st.theta - act.estimate.theta),
+            angle_error: wrap_small(st.theta - act.estimate.theta),
             speed_rpm: st.omega_mech * RPM_PER_RAD_S,
             speed_ref_rpm,
             speed_hat_rpm: act.estimate.omega_control / self.pole_pairs * RPM_PER_RAD_S,
@@ -306,6 +325,9 @@ impl<C: Controller> Simulation<C> {
             {
                 cb((k + 1) as f64 / n as f64);
             }
+        }
+        for p in probes.iter_mut() {
+            p.finish();
         }
         RunStats {
             simulated_seconds: n as f64 * ts,
@@ -374,6 +396,12 @@ impl Metrics {
 }
 
 impl Probe for Metrics {
+    fn finish(&mut self) {
+        self.rms_angle_error = (self.sum_sq / self.samples.max(1) as f64).sqrt();
+        self.rms_angle_error_zero_speed =
+            (self.sum_sq_zero / self.zero_speed_samples.max(1) as f64).sqrt();
+    }
+
     fn observe(&mut self, s: &Sample) {
         self.tripped |= s.act.tripped;
         if s.time < self.eval_start {
@@ -383,13 +411,10 @@ impl Probe for Metrics {
         self.samples += 1;
         self.sum_sq += e * e;
         self.max_angle_error = self.max_angle_error.max(e.abs());
-        self.rms_angle_error = (self.sum_sq / self.samples as f64).sqrt();
         if s.speed_rpm.abs() < self.zero_speed_band_rpm {
             self.zero_speed_samples += 1;
             self.sum_sq_zero += e * e;
             self.max_angle_error_zero_speed = self.max_angle_error_zero_speed.max(e.abs());
-            self.rms_angle_error_zero_speed =
-                (self.sum_sq_zero / self.zero_speed_samples as f64).sqrt();
         }
         self.max_speed_error_rpm = self
             .max_speed_error_rpm
