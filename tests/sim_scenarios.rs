@@ -49,6 +49,17 @@ fn fig11_averaged_model_passes_and_agrees_with_the_switching_resolved_one() {
 }
 
 #[test]
+fn fig11_passes_with_the_drive_in_single_precision() {
+    let f64_run = run("fig11", None, false);
+    let f32_run = run("fig11", Some("[controller]\nprecision = \"f32\"\n"), false);
+    assert!(f32_run.passed, "{:?}", f32_run.checks);
+    let d = (f64_run.metrics.max_angle_error_zero_speed
+        - f32_run.metrics.max_angle_error_zero_speed)
+        .abs();
+    assert!(d < 0.02, "f32 and f64 drives differ by {d} rad");
+}
+
+#[test]
 fn fig9_kdf_off_drifts_then_recovers_with_the_2_s_time_constant() {
     let out = run("fig9", None, false);
     assert!(out.passed, "{:?}", out.checks);

@@ -100,11 +100,24 @@ pub enum VoltageLimitSetting {
     InscribedCircle,
 }
 
+/// Scalar type the drive runs in.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Precision {
+    /// f64 (analysis).
+    #[default]
+    F64,
+    /// f32, as on the paper's TMS320F28335 (single-precision FPU).
+    F32,
+}
+
 /// The drive's own settings (the model estimates come from `[mismatch]`). Defaults as in
 /// `fado_core::control::DriveConfig`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ControllerSettings {
+    /// Scalar type of the drive (estimator and control). Default f64.
+    pub precision: Precision,
     /// Current-loop bandwidth, Hz. Default 250 Hz (paper §V).
     pub current_bandwidth_hz: f64,
     /// Speed-loop bandwidth, Hz. Default 5 Hz (paper §V).
@@ -138,6 +151,7 @@ pub struct ControllerSettings {
 impl Default for ControllerSettings {
     fn default() -> Self {
         Self {
+            precision: Precision::F64,
             current_bandwidth_hz: 250.0,
             speed_bandwidth_hz: 5.0,
             speed_zero_ratio: 5.0,

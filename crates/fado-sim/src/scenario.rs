@@ -10,8 +10,8 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use crate::config::SimConfig;
-use crate::controller::ControlEvent;
+use crate::config::{Precision, SimConfig};
+use crate::controller::{ControlEvent, Controller};
 use crate::error::SimConfigError;
 use crate::inverter::InverterModel;
 use crate::profile::Profile;
@@ -427,6 +427,8 @@ pub struct Report {
     pub scenario: String,
     /// Inverter model run.
     pub inverter_model: InverterModel,
+    /// Scalar type of the drive.
+    pub precision: Precision,
     /// All criteria passed.
     pub passed: bool,
     /// max |θ − θ̂| over the evaluation window, rad.
@@ -458,6 +460,7 @@ impl Outcome {
         Report {
             scenario: self.scenario.clone(),
             inverter_model: self.config.inverter.model,
+            precision: self.config.controller.precision,
             passed: self.passed,
             max_angle_error: m.max_angle_error,
             rms_angle_error: m.rms_angle_error,
@@ -521,7 +524,25 @@ pub fn run_config(
         .ok_or_else(|| SimConfigError::new("scenario", format!("unknown `{scenario}`")))?;
     cfg.validate()?;
     let started = Instant::now();
-    let drive = cfg.build_drive()?;
+    match cfg.controller.precision {
+        Precision::F64 => {
+            let drive = cfg.build_drive()?;
+            run_with(sc, cfg, drive, started, progress)
+        }
+        Precision::F32 => {
+            let drive = cfg.build_drive_f32()?;
+            run_with(sc, cfg, drive, started, progress)
+        }
+    }
+}
+
+fn run_with<C: Controller>(
+    sc: &Scenario,
+    cfg: SimConfig,
+    drive: C,
+    started: Instant,
+    progress: Option<&mut dyn FnMut(f64)>,
+) -> Result<Outcome, SimConfigError> {
     let plant = Plant::new(&cfg.plant(), cfg.simulation.initial_angle)?;
     let mut events = Vec::new();
     for w in &cfg.simulation.disturbance_feedback_off {
