@@ -29,14 +29,14 @@ pub struct SimulationSettings {
     pub duration: f64,
     /// Keep one sample in this many in `traces.csv`. Default 10 (1 kHz).
     pub decimation: u32,
-    /// True initial electrical rotor angle in rad. Default 0.3 [A].
+    /// True initial electrical rotor angle in rad. Default 0.3 \[A\].
     pub initial_angle: f64,
     /// Error of the start-up alignment (the drive starts at θ0 + this), rad. Default 0.
     pub align_error: f64,
     /// Metrics are evaluated from this time on, s (start-up excluded). Default 0.
     pub eval_start: f64,
     /// "Near zero speed" means |true speed| below this, r/min. Default 30 r/min (2 Hz
-    /// electrical: just above the 1.5 Hz mode threshold) [A].
+    /// electrical: just above the 1.5 Hz mode threshold) \[A\].
     pub zero_speed_band_rpm: f64,
     /// Windows `[t_off, t_on]` in s during which the k_df feedback is switched off (Fig. 9).
     pub disturbance_feedback_off: Vec<[f64; 2]>,

@@ -71,27 +71,27 @@ pub enum Commutation {
 pub struct InverterParams {
     /// Which model to run. Default switching-resolved.
     pub model: InverterModel,
-    /// Mean DC-link voltage in V. Default 311 V (rectified 3-phase 220 Vrms, paper §V [P];
-    /// SPEC §5 says ≈ 300 V [A]).
+    /// Mean DC-link voltage in V. Default 311 V (rectified 3-phase 220 Vrms, paper §V \[P\];
+    /// SPEC §5 says ≈ 300 V \[A\]).
     pub dc_voltage: f64,
-    /// Peak amplitude of the DC-link ripple in V (sinusoidal model). Default 0 [A].
+    /// Peak amplitude of the DC-link ripple in V (sinusoidal model). Default 0 \[A\].
     pub dc_ripple_amplitude: f64,
-    /// Ripple frequency in Hz. Default 360 Hz (6-pulse rectifier on 60 Hz) [A].
+    /// Ripple frequency in Hz. Default 360 Hz (6-pulse rectifier on 60 Hz) \[A\].
     pub dc_ripple_frequency: f64,
     /// Switching (carrier) frequency in Hz; sampling is at twice this. Default 5 kHz (paper §V
-    /// [P]).
+    /// \[P\]).
     pub switching_frequency: f64,
-    /// Dead time Td in s. Default 2.5 µs (paper §V [P]).
+    /// Dead time Td in s. Default 2.5 µs (paper §V \[P\]).
     pub dead_time: f64,
     /// Current band Ic in A over which the dead-time and threshold errors go through zero
-    /// (parasitic capacitance). Default 0.3 A (SPEC §5 [A]).
+    /// (parasitic capacitance). Default 0.3 A (SPEC §5 \[A\]).
     pub current_band: f64,
     /// Commutation model of the helping edge (switching-resolved model). Default the SPEC §5
     /// linear band.
     pub commutation: Commutation,
-    /// Device threshold (knee) voltage V_th in V, IGBT and diode alike. Default 1 V (SPEC §5 [A]).
+    /// Device threshold (knee) voltage V_th in V, IGBT and diode alike. Default 1 V (SPEC §5 \[A\]).
     pub threshold_voltage: f64,
-    /// Device on-resistance r_on in Ω. Default 0 [A]: a linear drop is indistinguishable from
+    /// Device on-resistance r_on in Ω. Default 0 \[A\]: a linear drop is indistinguishable from
     /// Rs, so a non-zero value is an R̂s mismatch of the same size.
     pub on_resistance: f64,
 }

@@ -31,9 +31,9 @@ pub struct LoadParams {
     pub torque: Profile,
     /// Dynamometer speed reference in r/min (speed mode). Default 0.
     pub speed_rpm: Profile,
-    /// Dynamometer speed-loop bandwidth in Hz. Default 10 Hz [A].
+    /// Dynamometer speed-loop bandwidth in Hz. Default 10 Hz \[A\].
     pub speed_bandwidth_hz: f64,
-    /// Dynamometer torque limit in N·m. Default 30 N·m [A].
+    /// Dynamometer torque limit in N·m. Default 30 N·m \[A\].
     pub torque_limit: f64,
 }
 

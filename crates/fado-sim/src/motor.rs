@@ -32,20 +32,20 @@ use crate::error::{SimConfigError, check};
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct MotorParams {
-    /// Stator resistance Rs in Ω. Default 0.327 Ω (paper §V [P]).
+    /// Stator resistance Rs in Ω. Default 0.327 Ω (paper §V \[P\]).
     pub rs: f64,
-    /// d-axis inductance Ld in H. Default 2.63 mH (paper §V [P], SMPMSM: Ld = Lq).
+    /// d-axis inductance Ld in H. Default 2.63 mH (paper §V \[P\], SMPMSM: Ld = Lq).
     pub ld: f64,
-    /// q-axis inductance Lq in H. Default 2.63 mH (paper §V [P]).
+    /// q-axis inductance Lq in H. Default 2.63 mH (paper §V \[P\]).
     pub lq: f64,
-    /// Magnet flux linkage λf in Wb (peak, per phase). Default 0.088 Wb (SPEC §6 [A]).
+    /// Magnet flux linkage λf in Wb (peak, per phase). Default 0.088 Wb (SPEC §6 \[A\]).
     pub flux_linkage: f64,
-    /// Pole pairs p. Default 4 (8-pole motor, paper §V [P]).
+    /// Pole pairs p. Default 4 (8-pole motor, paper §V \[P\]).
     pub pole_pairs: u32,
     /// Total shaft inertia J in kg·m² (servo rotor + dynamometer + coupling). Default 0.012
-    /// (SPEC §6 [A]).
+    /// (SPEC §6 \[A\]).
     pub inertia: f64,
-    /// Viscous friction B in N·m·s/rad. Default 1e-3 (SPEC §6 [A]).
+    /// Viscous friction B in N·m·s/rad. Default 1e-3 (SPEC §6 \[A\]).
     pub viscous_friction: f64,
 }
 
@@ -235,7 +235,8 @@ fn expm_traceless(s: f64, h: f64) -> (f64, f64) {
 }
 
 /// The machine: parameters plus true state. Electrical intervals are applied by the inverter
-/// through [`Motor::advance_electrical`]; [`Motor::advance_mechanical`] closes each sample.
+/// through [`ElectricalPropagator`] and [`Motor::set_current`]; [`Motor::advance_mechanical`]
+/// closes each sample.
 #[derive(Clone, Debug)]
 pub struct Motor {
     params: MotorParams,

@@ -1,6 +1,6 @@
 //! The paper's experiments (Fig. 8–12) as named scenarios with their pass criteria checked in
-//! code (SPEC §7). Loads and rates are the paper's [P]; the exact profiles around them
-//! (start-up, load application, settling, hold times) are ours [A] and are stated per scenario.
+//! code (SPEC §7). Loads and rates are the paper's \[P\]; the exact profiles around them
+//! (start-up, load application, settling, hold times) are ours \[A\] and are stated per scenario.
 //!
 //! Every scenario starts at standstill with a known rotor angle (SPEC §1 step 6), brings the
 //! machine to the experiment's initial operating point without load, applies the load with a

@@ -1,5 +1,5 @@
 //! Measurement chain: phase-current sensing with offset, gain error, white noise and ADC
-//! quantisation (SPEC §6 [A]), DC-link voltage sensing, and the evaluation encoder.
+//! quantisation (SPEC §6 \[A\]), DC-link voltage sensing, and the evaluation encoder.
 //! Every non-ideality can be switched off on its own; the noise comes from a seeded
 //! xoshiro256++ generator, so a run is reproducible bit for bit for a given seed.
 
@@ -16,19 +16,19 @@ use crate::error::{SimConfigError, check};
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct CurrentSensorParams {
-    /// Offset of the phase-a sensor in A. Default 20 mA (SPEC §6 [A]).
+    /// Offset of the phase-a sensor in A. Default 20 mA (SPEC §6 \[A\]).
     pub offset_a: f64,
-    /// Offset of the phase-b sensor in A. Default −10 mA (SPEC §6 [A]).
+    /// Offset of the phase-b sensor in A. Default −10 mA (SPEC §6 \[A\]).
     pub offset_b: f64,
-    /// Relative gain error of the phase-a sensor. Default +0.5 % (SPEC §6 [A]).
+    /// Relative gain error of the phase-a sensor. Default +0.5 % (SPEC §6 \[A\]).
     pub gain_error_a: f64,
-    /// Relative gain error of the phase-b sensor. Default 0 (the 0.5 % is the mismatch) [A].
+    /// Relative gain error of the phase-b sensor. Default 0 (the 0.5 % is the mismatch) \[A\].
     pub gain_error_b: f64,
-    /// White noise per sensor, A rms. Default 10 mA (SPEC §6 [A]).
+    /// White noise per sensor, A rms. Default 10 mA (SPEC §6 \[A\]).
     pub noise_rms: f64,
-    /// ADC resolution in bits. Default 12 (SPEC §6 [A]).
+    /// ADC resolution in bits. Default 12 (SPEC §6 \[A\]).
     pub adc_bits: u32,
-    /// ADC full scale: the range is ±this, in A. Default 50 A (SPEC §6 [A]).
+    /// ADC full scale: the range is ±this, in A. Default 50 A (SPEC §6 \[A\]).
     pub adc_full_scale: f64,
     /// Apply the offsets. Default true.
     pub enable_offset: bool,
@@ -154,7 +154,7 @@ impl CurrentSensor {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct DcLinkSensorParams {
-    /// Relative gain error. Default 0 [A].
+    /// Relative gain error. Default 0 \[A\].
     pub gain_error: f64,
 }
 
@@ -178,7 +178,7 @@ impl DcLinkSensorParams {
 }
 
 /// Incremental encoder for evaluation and for sensored reference controllers: 5000 ppr
-/// (paper §V [P]) read in quadrature, i.e. 4·ppr counts per mechanical revolution.
+/// (paper §V \[P\]) read in quadrature, i.e. 4·ppr counts per mechanical revolution.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Encoder {
     /// Lines per mechanical revolution.
