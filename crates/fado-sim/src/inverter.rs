@@ -215,6 +215,14 @@ fn rotate(i: Dq<f64>, rot: Complex64) -> Ab<f64> {
     Ab::new(i.d * rot.re - i.q * rot.im, i.d * rot.im + i.q * rot.re)
 }
 
+#[inline]
+fn unrotate(i: Ab<f64>, rot: Complex64) -> Dq<f64> {
+    Dq::new(
+        i.alpha * rot.re + i.beta * rot.im,
+        -i.alpha * rot.im + i.beta * rot.re,
+    )
+}
+
 use crate::fastmath::cis;
 
 /// One inverter leg of the switching-resolved model.
@@ -254,6 +262,7 @@ pub struct SampleOutcome {
 pub struct Inverter {
     params: InverterParams,
     ts: f64,
+    inv_current_band: f64,
     /// Duty loaded at the last update, acting over the present sample.
     shadow: Abc<f64>,
     legs: [Leg; 3],
@@ -267,6 +276,7 @@ impl Inverter {
         params.validate()?;
         let ts = params.sample_period();
         Ok(Self {
+            inv_current_band: 1.0 / params.current_band,
             params,
             ts,
             shadow: Abc::new(0.5, 0.5, 0.5),
@@ -330,12 +340,13 @@ impl Inverter {
         out
     }
 
+    #[inline]
     fn pole_voltages(&self, poles: [bool; 3], i: [f64; 3], vdc: f64) -> Ab<f64> {
         let vth = self.params.threshold_voltage;
-        let ic = self.params.current_band;
+        let inv_ic = self.inv_current_band;
         let mut p = [0.0; 3];
         for k in 0..3 {
-            p[k] = if poles[k] { vdc } else { 0.0 } - vth * sat(i[k] / ic);
+            p[k] = if poles[k] { vdc } else { 0.0 } - vth * sat(i[k] * inv_ic);
         }
         clarke(p)
     }
@@ -419,10 +430,10 @@ impl Inverter {
         let mp = *motor.params();
         let omega = prop.omega();
         let mut rot = motor.rotation();
-        let mut i = motor.state().i_dq;
-        // Phase currents at time t, kept current: needed for the drops and at every edge.
-        let mut iph = phase_currents(rotate(i, rot));
-        let mut te_prev = mp.torque(i);
+        // The current is carried in α-β (phase currents at every edge), d-q only at the end.
+        let mut i = rotate(motor.state().i_dq, rot);
+        let mut iph = phase_currents(i);
+        let mut te_prev = mp.torque(motor.state().i_dq);
         let mut t = 0.0;
         let mut next_edge = 0;
         let (mut te_int, mut v_int) = (0.0, Ab::zero());
@@ -441,10 +452,10 @@ impl Inverter {
                 let poles = [self.legs[0].pole, self.legs[1].pole, self.legs[2].pole];
                 let v = self.pole_voltages(poles, iph, vdc);
                 let rot_h = cis(omega * h);
-                i = prop.advance(i, v, h, rot, rot_h);
+                i = prop.advance_ab(i, v, h, rot, rot_h);
                 rot *= rot_h;
-                iph = phase_currents(rotate(i, rot));
-                let te = mp.torque(i);
+                iph = phase_currents(i);
+                let te = mp.torque(unrotate(i, rot));
                 te_int += 0.5 * (te_prev + te) * h;
                 te_prev = te;
                 v_int += v * h;
@@ -476,6 +487,7 @@ impl Inverter {
                 }
             }
         }
+        let i = unrotate(i, rot);
         for leg in &mut self.legs {
             leg.pending -= ts; // ∞ stays ∞
         }
