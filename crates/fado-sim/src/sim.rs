@@ -485,6 +485,77 @@ pub struct TraceRow {
     pub load_torque: f64,
 }
 
+impl TraceRow {
+    /// Column names, in CSV order (for struct-of-arrays consumers such as the Python
+    /// bindings).
+    pub const COLUMNS: [&'static str; 29] = [
+        "time",
+        "theta",
+        "theta_hat",
+        "angle_error",
+        "speed_rpm",
+        "speed_hat_rpm",
+        "speed_ref_rpm",
+        "i_d",
+        "i_q",
+        "i_d_ref",
+        "i_q_ref",
+        "i_d_true",
+        "i_q_true",
+        "lambda1_alpha",
+        "lambda1_beta",
+        "dist_alpha",
+        "dist_beta",
+        "lambda2_alpha",
+        "lambda2_beta",
+        "lambda_r_alpha",
+        "lambda_r_beta",
+        "flux_alpha_true",
+        "flux_beta_true",
+        "flag_limit",
+        "limiter_clamping",
+        "tracker_hold",
+        "tripped",
+        "torque",
+        "load_torque",
+    ];
+
+    /// The row's values in [`COLUMNS`](Self::COLUMNS) order (flags as 0.0/1.0).
+    pub fn values(&self) -> [f64; 29] {
+        [
+            self.time,
+            self.theta,
+            self.theta_hat,
+            self.angle_error,
+            self.speed_rpm,
+            self.speed_hat_rpm,
+            self.speed_ref_rpm,
+            self.i_d,
+            self.i_q,
+            self.i_d_ref,
+            self.i_q_ref,
+            self.i_d_true,
+            self.i_q_true,
+            self.lambda1_alpha,
+            self.lambda1_beta,
+            self.dist_alpha,
+            self.dist_beta,
+            self.lambda2_alpha,
+            self.lambda2_beta,
+            self.lambda_r_alpha,
+            self.lambda_r_beta,
+            self.flux_alpha_true,
+            self.flux_beta_true,
+            self.flag_limit as f64,
+            self.limiter_clamping as f64,
+            self.tracker_hold as f64,
+            self.tripped as f64,
+            self.torque,
+            self.load_torque,
+        ]
+    }
+}
+
 impl From<&Sample> for TraceRow {
     fn from(s: &Sample) -> Self {
         let d = &s.act.estimate.diagnostics;
@@ -542,6 +613,12 @@ impl Trace {
         }
     }
 
+    /// One column of the trace by name (see [`TraceRow::COLUMNS`]).
+    pub fn column(&self, name: &str) -> Option<Vec<f64>> {
+        let k = TraceRow::COLUMNS.iter().position(|c| *c == name)?;
+        Some(self.rows.iter().map(|r| r.values()[k]).collect())
+    }
+
     /// Writes the rows as CSV with a header.
     pub fn write_csv<W: std::io::Write>(&self, w: W) -> Result<(), csv::Error> {
         let mut wr = csv::Writer::from_writer(w);
@@ -559,5 +636,39 @@ impl Probe for Trace {
             self.rows.push(TraceRow::from(s));
         }
         self.count += 1;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn csv_header_is_the_column_list_and_values_follow_it() {
+        let mut t = Trace::new(1);
+        let mut s = Sample {
+            time: 0.25,
+            speed_rpm: -12.0,
+            ..Default::default()
+        };
+        s.act.estimate.diagnostics.flag_limit = true;
+        s.act.i_dq_ref = Dq::new(4.0, -1.5);
+        t.observe(&s);
+        let mut buf = Vec::new();
+        t.write_csv(&mut buf).unwrap();
+        let text = String::from_utf8(buf).unwrap();
+        let mut lines = text.lines();
+        assert_eq!(lines.next().unwrap(), TraceRow::COLUMNS.join(","));
+        let values: Vec<f64> = lines
+            .next()
+            .unwrap()
+            .split(',')
+            .map(|v| v.parse().unwrap())
+            .collect();
+        assert_eq!(values, t.rows[0].values().to_vec());
+        assert_eq!(t.column("i_q_ref").unwrap(), vec![-1.5]);
+        assert_eq!(t.column("flag_limit").unwrap(), vec![1.0]);
+        assert_eq!(t.column("speed_rpm").unwrap(), vec![-12.0]);
+        assert!(t.column("nope").is_none());
     }
 }
