@@ -38,12 +38,22 @@ pub(crate) fn cis(x: f64) -> Complex64 {
 #[inline(always)]
 pub(crate) fn exp(x: f64) -> f64 {
     if x.abs() <= 0.1 {
-        // Horner to x¹⁰: remainder x¹¹/11! < 3e-19.
+        // Horner to x¹⁰: remainder x¹¹/11! < 3e-19. Reciprocal factorials as constants.
+        const K: [f64; 10] = [
+            1.0 / 362_880.0,
+            1.0 / 40_320.0,
+            1.0 / 5040.0,
+            1.0 / 720.0,
+            1.0 / 120.0,
+            1.0 / 24.0,
+            1.0 / 6.0,
+            1.0 / 2.0,
+            1.0,
+            1.0,
+        ];
         let mut p = 1.0 / 3_628_800.0;
-        for d in [
-            362_880.0, 40_320.0, 5040.0, 720.0, 120.0, 24.0, 6.0, 2.0, 1.0, 1.0,
-        ] {
-            p = p * x + 1.0 / d;
+        for k in K {
+            p = p * x + k;
         }
         p
     } else {

@@ -438,7 +438,36 @@ impl Inverter {
         let mut next_edge = 0;
         let (mut te_int, mut v_int) = (0.0, Ab::zero());
         let mut intervals = 0;
+        // Bound on |di_x/dt|: phase voltage ≤ 2/3·Vdc plus drops, back-EMF ≤ ω·λf. An edge whose
+        // current certainly keeps its sign until the edge, and opposes it, waits exactly Td
+        // whatever the current's value: no need to stop the integration at the edge itself.
+        let i_bound = i.norm() + 2.0 * vdc * ts / mp.ld.min(mp.lq);
+        let slew = (2.0 / 3.0 * vdc
+            + 2.0 * self.params.threshold_voltage
+            + omega.abs() * (mp.flux_linkage + (mp.ld - mp.lq).abs() * i_bound)
+            + (mp.rs + self.params.on_resistance) * i_bound)
+            / mp.ld.min(mp.lq);
         loop {
+            while let Some(&(te, k, g)) = edges.get(next_edge) {
+                let k = k as usize;
+                let margin = slew * (te - t);
+                let opposing = if g {
+                    iph[k] - margin > 0.0
+                } else {
+                    iph[k] + margin < 0.0
+                };
+                if !opposing || te >= ts {
+                    break;
+                }
+                next_edge += 1;
+                let leg = &mut self.legs[k];
+                leg.gate = g;
+                leg.pending = if leg.pole == g {
+                    f64::INFINITY
+                } else {
+                    te + self.params.dead_time
+                };
+            }
             let edge_t = edges.get(next_edge).map_or(f64::INFINITY, |e| e.0);
             let (mut pend_t, mut pend_leg) = (f64::INFINITY, 0);
             for (k, leg) in self.legs.iter().enumerate() {
