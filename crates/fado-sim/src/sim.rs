@@ -186,6 +186,11 @@ pub struct Sample {
     pub torque: f64,
     /// Load torque over the previous sample, N·m.
     pub load_torque: f64,
+    /// Pole pairs (to convert the controller's electrical speeds).
+    pub pole_pairs: f64,
+    /// Stator voltage the inverter actually applied over the previous sample [n−1, n]
+    /// (time average, α-β), V.
+    pub v_ab_applied: fado_core::Ab<f64>,
     /// The controller's output at this sample.
     pub act: Actuation,
 }
@@ -297,6 +302,8 @@ impl<C: Controller> Simulation<C> {
             flux_ab_true: self.plant.motor().flux_ab(),
             torque: self.plant.last_outcome().torque_avg,
             load_torque: self.plant.load_torque(),
+            v_ab_applied: self.plant.last_outcome().v_ab_avg,
+            pole_pairs: self.pole_pairs,
             act,
         };
         self.plant.step(act.duty, act.gates_enabled);
@@ -437,6 +444,8 @@ pub struct TraceRow {
     pub speed_rpm: f64,
     /// Estimated speed (T2S-2), r/min.
     pub speed_hat_rpm: f64,
+    /// Observer speed (T2S-1), r/min.
+    pub speed_hat1_rpm: f64,
     /// Speed reference, r/min.
     pub speed_ref_rpm: f64,
     /// d current in the controller's frame, A.
@@ -488,13 +497,14 @@ pub struct TraceRow {
 impl TraceRow {
     /// Column names, in CSV order (for struct-of-arrays consumers such as the Python
     /// bindings).
-    pub const COLUMNS: [&'static str; 29] = [
+    pub const COLUMNS: [&'static str; 30] = [
         "time",
         "theta",
         "theta_hat",
         "angle_error",
         "speed_rpm",
         "speed_hat_rpm",
+        "speed_hat1_rpm",
         "speed_ref_rpm",
         "i_d",
         "i_q",
@@ -521,7 +531,7 @@ impl TraceRow {
     ];
 
     /// The row's values in [`COLUMNS`](Self::COLUMNS) order (flags as 0.0/1.0).
-    pub fn values(&self) -> [f64; 29] {
+    pub fn values(&self) -> [f64; 30] {
         [
             self.time,
             self.theta,
@@ -529,6 +539,7 @@ impl TraceRow {
             self.angle_error,
             self.speed_rpm,
             self.speed_hat_rpm,
+            self.speed_hat1_rpm,
             self.speed_ref_rpm,
             self.i_d,
             self.i_q,
@@ -566,6 +577,7 @@ impl From<&Sample> for TraceRow {
             angle_error: s.angle_error,
             speed_rpm: s.speed_rpm,
             speed_hat_rpm: s.speed_hat_rpm,
+            speed_hat1_rpm: s.act.estimate.omega / s.pole_pairs * RPM_PER_RAD_S,
             speed_ref_rpm: s.speed_ref_rpm,
             i_d: s.act.i_dq.d,
             i_q: s.act.i_dq.q,
@@ -649,8 +661,10 @@ mod tests {
         let mut s = Sample {
             time: 0.25,
             speed_rpm: -12.0,
+            pole_pairs: 4.0,
             ..Default::default()
         };
+        s.act.estimate.omega = -2.0 * std::f64::consts::TAU; // −30 r/min with 4 pole pairs
         s.act.estimate.diagnostics.flag_limit = true;
         s.act.i_dq_ref = Dq::new(4.0, -1.5);
         t.observe(&s);
@@ -669,6 +683,7 @@ mod tests {
         assert_eq!(t.column("i_q_ref").unwrap(), vec![-1.5]);
         assert_eq!(t.column("flag_limit").unwrap(), vec![1.0]);
         assert_eq!(t.column("speed_rpm").unwrap(), vec![-12.0]);
+        assert!((t.column("speed_hat1_rpm").unwrap()[0] + 30.0).abs() < 1e-12);
         assert!(t.column("nope").is_none());
     }
 }
