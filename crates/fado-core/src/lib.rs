@@ -20,6 +20,7 @@
 #[cfg(test)]
 extern crate std;
 
+pub mod baselines;
 pub mod control;
 pub mod error;
 pub mod estimator;
@@ -32,6 +33,7 @@ pub mod real;
 pub mod rotor_flux;
 pub mod tracker;
 
+pub use baselines::{EmfObserverEstimator, LpfIntegratorEstimator, OrtegaEstimator};
 pub use control::{DriveConfig, DriveOutput, SensorlessDrive};
 pub use error::{ConfigError, NonFiniteInput};
 pub use estimator::{

@@ -5,7 +5,10 @@
 use core::f64::consts::TAU;
 use std::vec::Vec;
 
-use fado_core::control::{DeadTimeMethod, DriveConfig, DriveOutput, SensorlessDrive};
+use fado_core::control::{
+    DeadTimeCompensation, DeadTimeCompensationConfig, DeadTimeMethod, DriveConfig, DriveOutput,
+    SensorlessDrive,
+};
 use fado_core::{
     Ab, Abc, Diagnostics, Estimate, EstimatorConfig, Rotation, RotorAngleEstimator,
     SensorlessEstimator,
@@ -20,6 +23,8 @@ struct Spy {
     theta: f64,
     omega: f64,
     aligned: Option<(f64, Ab<f64>)>,
+    /// Answer NaN at this sample, like a broken estimator.
+    nan_at: Option<usize>,
 }
 
 impl RotorAngleEstimator<f64> for Spy {
@@ -27,8 +32,9 @@ impl RotorAngleEstimator<f64> for Spy {
         self.v.push(v_ab);
         self.i.push(i_ab);
         self.theta = fado_core::wrap_angle(self.theta + self.omega * 100e-6);
+        let broken = self.nan_at == Some(self.v.len() - 1);
         Estimate {
-            theta: self.theta,
+            theta: if broken { f64::NAN } else { self.theta },
             omega: self.omega,
             omega_control: 0.9 * self.omega,
             diagnostics: Diagnostics::default(),
@@ -116,6 +122,49 @@ fn estimator_gets_the_voltage_computed_two_samples_earlier() {
 }
 
 #[test]
+fn a_non_finite_estimate_holds_the_duty_and_steps_the_estimator_once() {
+    let mut drive = spy_drive();
+    drive.estimator_mut().nan_at = Some(7);
+    let outs: Vec<_> = (0..12)
+        .map(|n| drive.step(currents(n), 300.0, 20.0))
+        .collect();
+    assert_eq!(drive.estimator().v.len(), 12);
+    assert!(outs[7].input_fault && !outs[8].input_fault);
+    assert_eq!(outs[7].duty, outs[6].duty);
+    assert!(outs[7].estimate.theta.is_finite());
+    assert_eq!(drive.rejected_samples(), 1);
+}
+
+#[test]
+fn duties_realise_the_reference_plus_the_dead_time_compensation() {
+    // duty·Vdc (Clarke) = realised reference + Clarke of the per-phase compensation, which is
+    // the trapezoid of the reference current at θ̂ + 1.5·ω̂·Ts; at a low Vdc the sum is
+    // limited to the hexagon and the reported reference is what remains after compensation.
+    let mut drive = spy_drive();
+    let dtc = DeadTimeCompensation::new(DeadTimeCompensationConfig::default()).unwrap();
+    let mut saturated = 0;
+    for n in 0..200 {
+        let vdc = if n % 3 == 0 { 20.0 } else { 300.0 };
+        let i = currents(n);
+        let o = drive.step(i, vdc, 80.0);
+        let adv = Rotation::from_angle(o.estimate.theta + 1.5 * o.estimate.omega * 100e-6);
+        let comp = dtc.step(adv, o.i_dq_ref, i, vdc);
+        let applied = (o.duty * vdc).to_ab();
+        assert!((applied - (o.v_ref_ab + comp)).norm() < 1e-9, "sample {n}");
+        let span = |v: Ab<f64>| {
+            let p = v.to_abc();
+            p.a.max(p.b).max(p.c) - p.a.min(p.b).min(p.c)
+        };
+        assert!(span(applied) <= vdc * (1.0 + 1e-12));
+        if o.voltage_saturated {
+            saturated += 1;
+            assert!((span(applied) - vdc).abs() < 1e-9);
+        }
+    }
+    assert!(saturated > 30, "the 20 V samples saturate: {saturated}");
+}
+
+#[test]
 fn speed_reference_is_mechanical_and_loop_runs_on_control_speed() {
     // ω̂_control = 0.9·2π·30 = 169.6 rad/s electrical = 42.4 mechanical rad/s with p = 4:
     // a reference of exactly that gives zero speed error, so i_q* stays at zero.
@@ -200,7 +249,8 @@ fn configuration_errors_name_the_field() {
 
 fn any_value() -> impl Strategy<Value = f64> {
     prop_oneof![
-        4 => -80.0..80.0_f64,
+        8 => -20.0..20.0_f64,
+        2 => -80.0..80.0_f64,
         1 => any::<f64>(),
         1 => Just(f64::NAN),
         1 => Just(f64::INFINITY),
@@ -222,33 +272,61 @@ fn check_output<T: fado_core::Real>(o: &DriveOutput<T>) -> Result<(), TestCaseEr
     Ok(())
 }
 
+fn drives<T: fado_core::Real>(method: DeadTimeMethod) -> [SensorlessDrive<T>; 2] {
+    let cfg = DriveConfig {
+        dead_time_method: method,
+        ..DriveConfig::default()
+    };
+    // The second never trips, so that every input reaches the controllers.
+    let no_trip = DriveConfig {
+        trip_current: T::max_value().unwrap(),
+        ..cfg
+    };
+    [cfg, no_trip].map(|c| {
+        let mut d = SensorlessDrive::new(c, EstimatorConfig::default()).unwrap();
+        d.align(T::lit(0.3));
+        d
+    })
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
 
     #[test]
     fn arbitrary_inputs_never_panic_and_outputs_stay_sane(
         samples in prop::collection::vec(
-            (any_value(), any_value(), any_value(), prop_oneof![3 => 0.0..600.0_f64, 1 => any_value()], any_value()),
+            (
+                any_value(),
+                any_value(),
+                any_value(),
+                prop_oneof![3 => 0.0..600.0_f64, 1 => any_value()],
+                prop_oneof![3 => -200.0..200.0_f64, 1 => any_value()],
+            ),
             1..300,
         ),
         method in prop_oneof![Just(DeadTimeMethod::Trapezoidal), Just(DeadTimeMethod::Sign)],
     ) {
-        let cfg = DriveConfig { dead_time_method: method, ..DriveConfig::default() };
-        let mut d64 = SensorlessDrive::new(cfg, EstimatorConfig::default()).unwrap();
-        let mut d32 = SensorlessDrive::<f32>::new(
-            DriveConfig { dead_time_method: method, ..DriveConfig::default() },
-            EstimatorConfig::default(),
-        ).unwrap();
-        d64.align(0.3);
-        d32.align(0.3);
+        let mut d64 = drives::<f64>(method);
+        let mut d32 = drives::<f32>(method);
         for (a, b, c, vdc, w) in samples {
-            let o = d64.step(Abc::new(a, b, c), vdc, w);
-            check_output(&o)?;
-            let finite = a.is_finite() && b.is_finite() && c.is_finite() && vdc.is_finite() && w.is_finite();
-            prop_assert!(o.input_fault != finite || o.tripped);
-            let o = d32.step(Abc::new(a as f32, b as f32, c as f32), vdc as f32, w as f32);
-            check_output(&o)?;
+            let finite = [a, b, c, vdc, w].iter().all(|x| x.is_finite());
+            for d in &mut d64 {
+                let o = d.step(Abc::new(a, b, c), vdc, w);
+                check_output(&o)?;
+                // Non-finite inputs are always reported (finite ones only when absurd enough
+                // to overflow, e.g. a Clarke transform of ±1e308).
+                prop_assert!(finite || o.input_fault || o.tripped);
+                if finite && a.abs() < 1e6 && b.abs() < 1e6 && c.abs() < 1e6 && w.abs() < 1e6 {
+                    prop_assert!(!o.input_fault);
+                }
+            }
+            for d in &mut d32 {
+                let o = d.step(Abc::new(a as f32, b as f32, c as f32), vdc as f32, w as f32);
+                check_output(&o)?;
+                prop_assert!(finite || o.input_fault || o.tripped);
+            }
         }
+        prop_assert!(!d64[1].is_tripped() && !d32[1].is_tripped());
     }
 }
 

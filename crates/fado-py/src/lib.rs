@@ -1,1 +1,53 @@
-//! fado-py
+//! # fado-py
+//!
+//! Python bindings of fado, built by maturin from the top-level `pyproject.toml` into the
+//! native module `fado._fado`, which the pure-Python package `fado` (in `python/fado/`)
+//! re-exports. Layout, after pydantic-core and rust-numpy:
+//!
+//! - [`config`]: `EstimatorConfig`, keyword arguments with the Rust defaults.
+//! - [`estimator`]: `Estimator` (step by step or chunk by chunk) and `estimate` (a whole
+//!   recording with the GIL released).
+//! - [`outputs`]: `StepResult`, `EstimateResult` and the column buffers behind them.
+//! - [`inputs`]: checks of the signal arrays; [`replay`]: the Python-free replay loop.
+//! - [`errors`]: `FadoError` and its subclasses.
+//!
+//! The simulator (`fado-sim`) is wrapped here once its API settles; until then the module
+//! exposes the estimator only.
+
+pub mod config;
+pub mod errors;
+pub mod estimator;
+pub mod inputs;
+pub mod outputs;
+pub mod replay;
+pub mod scalar;
+
+use pyo3::prelude::*;
+
+/// Native core of the `fado` package: the sensorless estimator of Park & Sul
+/// ("Sensorless Control Method for PMSM Based on Frequency-Adaptive Disturbance Observer").
+/// Import from `fado`, not from here.
+#[pymodule]
+pub mod _fado {
+    #[pymodule_export]
+    use super::config::PyEstimatorConfig;
+    #[pymodule_export]
+    use super::estimator::{PyEstimator, estimate};
+    #[pymodule_export]
+    use super::outputs::{EstimateResult, StepResult};
+
+    #[pymodule_export]
+    const MODE_LIMITER: i8 = super::outputs::MODE_LIMITER;
+    #[pymodule_export]
+    const MODE_DISTURBANCE_FEEDBACK: i8 = super::outputs::MODE_DISTURBANCE_FEEDBACK;
+
+    use pyo3::prelude::*;
+
+    #[pymodule_init]
+    fn init(m: &Bound<'_, PyModule>) -> PyResult<()> {
+        super::errors::Exceptions::register(m)?;
+        m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+        m.add("OUTPUT_NAMES", super::outputs::OUTPUT_NAMES.to_vec())?;
+        Ok(())
+    }
+}

@@ -7,7 +7,7 @@
 //! and PWM hold (which [`DelayCompensation`](super::delay_compensation) keeps out of the
 //! rotating frame, but not out of the loop).
 //!
-//! Feed-forward (SPEC §6 [A]), from the machine model v_d = R·i_d + L_d·di_d/dt − ω·L_q·i_q,
+//! Feed-forward (SPEC §6 \[A\]), from the machine model v_d = R·i_d + L_d·di_d/dt − ω·L_q·i_q,
 //! v_q = R·i_q + L_q·di_q/dt + ω·(L_d·i_d + λ_f), with the measured currents:
 //! v_d,ff = −ω·L̂q·i_q, v_q,ff = ω·(L̂d·i_d + λ̂f). It turns the cross-coupled plant into two
 //! independent R-L branches.
@@ -32,18 +32,18 @@ pub struct CurrentControllerConfig<T> {
     /// q-axis inductance estimate L̂q in H. Default 2.63 mH (paper, V).
     pub lq_hat: T,
     /// Magnet flux linkage estimate λ̂f in Wb (back-EMF feed-forward). Default 0.088 Wb
-    /// (SPEC §6 [A]).
+    /// (SPEC §6 \[A\]).
     pub flux_linkage_hat: T,
     /// Closed-loop bandwidth in Hz. Default 250 Hz (paper, V). Limited to ωc·Ts ≤ 0.5 so the
     /// 1.5-sample loop delay leaves at least 47° of phase margin.
     pub bandwidth_hz: T,
-    /// Add the decoupling and back-EMF feed-forward. Default true (SPEC §6 [A]).
+    /// Add the decoupling and back-EMF feed-forward. Default true (SPEC §6 \[A\]).
     pub decoupling: bool,
     /// Back-calculation gain as a multiple of Ki/Kp = R̂s/L̂ (see [`PiConfig`]). Default 1, the
-    /// realisable reference [A].
+    /// realisable reference \[A\].
     pub anti_windup_ratio: T,
     /// Hard bound on each axis' voltage and integral in V, a last guard against absurd
-    /// estimates; the real limit is the inverter's (modulation). Default 1000 V [A].
+    /// estimates; the real limit is the inverter's (modulation). Default 1000 V \[A\].
     pub voltage_bound: T,
 }
 

@@ -1,4 +1,4 @@
-//! Compensation of the inverter non-linearity (paper IV-B, after refs. [14]-[15]; SPEC §5).
+//! Compensation of the inverter non-linearity (paper IV-B, after refs. \[14\]-\[15\]; SPEC §5).
 //!
 //! Dead time and device drops make each pole voltage fall short by about
 //! V̂·sat(i_x/Ic) in the direction of its phase current, V̂ = Td·f_sw·Vdc + V_th (the dead
@@ -10,7 +10,7 @@
 //! φx = 0, +2π/3, −2π/3 for a, b, c (phase b lags a),
 //!
 //! a trapezoid in the angle of the *reference* current vector, advanced like the voltage
-//! (SPEC §5 [A]): no chattering on noisy measured currents near their zero crossings.
+//! (SPEC §5 \[A\]): no chattering on noisy measured currents near their zero crossings.
 //! I*·cos(θi − φx) is just phase x of the reference current rotated to the advanced angle,
 //! which is how it is computed (no atan2). The classic sign(i_x) of the measured current is
 //! offered as [`DeadTimeMethod::Sign`]. The Clarke transform of v_comp (its zero sequence
@@ -35,15 +35,15 @@ pub enum DeadTimeMethod {
 pub struct DeadTimeCompensationConfig<T> {
     /// Compensate at all. Default true (paper IV-B).
     pub enabled: bool,
-    /// Shape. Default [`DeadTimeMethod::Trapezoidal`] (SPEC §5 [A]).
+    /// Shape. Default [`DeadTimeMethod::Trapezoidal`] (SPEC §5 \[A\]).
     pub method: DeadTimeMethod,
     /// Dead time Td in s. Default 2.5 µs (paper, V).
     pub dead_time: T,
     /// Switching frequency f_sw in Hz. Default 5 kHz (paper, V).
     pub switching_frequency: T,
-    /// Device threshold voltage V_th in V. Default 1 V (SPEC §5 [A]).
+    /// Device threshold voltage V_th in V. Default 1 V (SPEC §5 \[A\]).
     pub threshold_voltage: T,
-    /// Current band Ic of the trapezoid in A. Default 0.3 A (SPEC §5 [A]).
+    /// Current band Ic of the trapezoid in A. Default 0.3 A (SPEC §5 \[A\]).
     pub current_band: T,
 }
 

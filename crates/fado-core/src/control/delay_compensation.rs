@@ -1,8 +1,8 @@
-//! Compensation of the digital delay (paper IV-B, after ref. [13]; SPEC §5):
-//! v*_ab[n] = e^{j(θ̂[n] + k·ω̂·Ts)}·v*_dq[n], k = 1.5 by default.
+//! Compensation of the digital delay (paper IV-B, after ref. \[13\]; SPEC §5):
+//! v*_ab\[n\] = e^{j(θ̂\[n\] + k·ω̂·Ts)}·v*_dq\[n\], k = 1.5 by default.
 //!
 //! The reference computed at sample n is loaded at n+1 and held until n+2 (one sample of
-//! computation), so on average it acts 1.5 samples after the angle θ̂[n] it was computed
+//! computation), so on average it acts 1.5 samples after the angle θ̂\[n\] it was computed
 //! with. Rotating it by the angle the rotor turns meanwhile makes the d-q voltage the current
 //! controller asked for arrive in the d-q frame it meant; without it the voltage lags by
 //! 1.5·ω·Ts (0.094 rad at 1500 r/min), which couples the axes and, in the estimator, rotates
@@ -16,7 +16,7 @@ use crate::{Ab, Dq, Real, Rotation, wrap_angle};
 pub struct DelayCompensationConfig<T> {
     /// Sampling period Ts in s. Default 100 µs (paper, V).
     pub ts: T,
-    /// Advance in samples k: 1 of computation + ½ of PWM hold. Default 1.5 (SPEC §5 [A]);
+    /// Advance in samples k: 1 of computation + ½ of PWM hold. Default 1.5 (SPEC §5 \[A\]);
     /// 0 switches the compensation off.
     pub factor: T,
 }

@@ -8,7 +8,7 @@
 //! 2. Estimator with the α-β currents sampled now and the voltage that acted over
 //!    [n−1, n]: the realised reference computed at n−2 (computation delay: a duty computed at
 //!    n is loaded at n+1 and acts over [n+1, n+2]), before dead-time compensation.
-//! 3. Park of the measured current at θ̂[n] (T2S-1).
+//! 3. Park of the measured current at θ̂\[n\] (T2S-1).
 //! 4. Speed PI on ω̂ of T2S-2 → i_q*; injection (23) → i_d*; |i_dq*| ≤ I_max (d first).
 //! 5. Current PI with decoupling at ω̂ of T2S-2 → v*_dq.
 //! 6. Delay compensation: v*_ab = e^{j(θ̂ + 1.5·ω̂·Ts)}·v*_dq, with ω̂ of T2S-1 (the derivative
@@ -49,9 +49,9 @@ pub struct DriveConfig<T> {
     /// q-axis inductance estimate L̂q in H. Default 2.63 mH (paper, V).
     pub lq_hat: T,
     /// Magnet flux linkage estimate λ̂f in Wb (back-EMF feed-forward, K̂t). Default 0.088 Wb
-    /// (SPEC §6 [A]).
+    /// (SPEC §6 \[A\]).
     pub flux_linkage_hat: T,
-    /// Inertia estimate Ĵ in kg·m² (speed PI). Default 0.012 (SPEC §6 [A]).
+    /// Inertia estimate Ĵ in kg·m² (speed PI). Default 0.012 (SPEC §6 \[A\]).
     pub inertia_hat: T,
     /// Current-loop bandwidth in Hz. Default 250 Hz (paper, V).
     pub current_bandwidth_hz: T,
@@ -59,7 +59,7 @@ pub struct DriveConfig<T> {
     pub speed_bandwidth_hz: T,
     /// Speed PI zero as a fraction of its bandwidth, Ki = Kp·ωsc/ratio. Default 5 (SPEC §6).
     pub speed_zero_ratio: T,
-    /// Current limit I_max in A (|i_dq*|). Default 40 A (SPEC §6 [A]).
+    /// Current limit I_max in A (|i_dq*|). Default 40 A (SPEC §6 \[A\]).
     pub i_max: T,
     /// Minimum current I_min of the injection (23) in A; 0 disables it. Default 4 A (paper, V).
     pub i_min: T,
@@ -67,29 +67,29 @@ pub struct DriveConfig<T> {
     pub dead_time: T,
     /// Switching frequency in Hz. Default 5 kHz (paper, V).
     pub switching_frequency: T,
-    /// Device threshold voltage of the dead-time compensation in V. Default 1 V (SPEC §5 [A]).
+    /// Device threshold voltage of the dead-time compensation in V. Default 1 V (SPEC §5 \[A\]).
     pub dead_time_threshold_voltage: T,
-    /// Current band Ic of the trapezoidal compensation in A. Default 0.3 A (SPEC §5 [A]).
+    /// Current band Ic of the trapezoidal compensation in A. Default 0.3 A (SPEC §5 \[A\]).
     pub dead_time_current_band: T,
     /// Compensate the dead time at all. Default true (paper IV-B).
     pub dead_time_compensation: bool,
-    /// Trapezoidal (SPEC §5) or sign(i) compensation. Default trapezoidal [A].
+    /// Trapezoidal (SPEC §5) or sign(i) compensation. Default trapezoidal \[A\].
     pub dead_time_method: DeadTimeMethod,
-    /// Angle advance of the voltage in samples. Default 1.5 (SPEC §5 [A], ref. [13]).
+    /// Angle advance of the voltage in samples. Default 1.5 (SPEC §5 \[A\], ref. \[13\]).
     pub delay_compensation_factor: T,
     /// Over-current trip level on any phase current in A (latched until `reset`).
-    /// Default 60 A (1.5·I_max) [A].
+    /// Default 60 A (1.5·I_max) \[A\].
     pub trip_current: T,
-    /// Decoupling and back-EMF feed-forward in the current PI. Default true (SPEC §6 [A]).
+    /// Decoupling and back-EMF feed-forward in the current PI. Default true (SPEC §6 \[A\]).
     pub decoupling: bool,
-    /// Realisable voltage set. Default the hexagon (SVPWM [16]).
+    /// Realisable voltage set. Default the hexagon (SVPWM \[16\]).
     pub voltage_limit: VoltageLimit,
-    /// Usable fraction of the voltage limit (0, 1]. Default 1 [A].
+    /// Usable fraction of the voltage limit (0, 1]. Default 1 \[A\].
     pub max_modulation: T,
     /// Current PI back-calculation gain in units of Ki/Kp. Default 1 (realisable
-    /// reference) [A].
+    /// reference) \[A\].
     pub current_anti_windup_ratio: T,
-    /// Speed PI back-calculation gain in units of Ki/Kp. Default 5 (tracking at ωsc) [A].
+    /// Speed PI back-calculation gain in units of Ki/Kp. Default 5 (tracking at ωsc) \[A\].
     pub speed_anti_windup_ratio: T,
 }
 
@@ -439,8 +439,10 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         // 2. Estimator: voltage of [n−1, n] = realised reference computed at n−2.
         let estimate = self.estimator.step(self.history[1], i_ab);
         if !estimate_is_finite(&estimate) {
-            // An estimator that went non-finite cannot steer the drive: hold like a bad input.
-            return self.reject(i_abc);
+            // An estimator that went non-finite cannot steer the drive: hold like a bad input
+            // (it has had its sample).
+            let out = self.last;
+            return self.finish_reject(out);
         }
         self.last_i_ab = i_ab;
         // 3. Measured current in the estimated rotor frame.
@@ -467,16 +469,18 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         // 7. Dead-time compensation, hexagon limit, SVPWM.
         let v_comp = b.dead_time.step(rot, i_dq_ref, i_abc, vdc);
         let m = b.modulator.step(v_ab + v_comp, vdc);
-        let v_realised = if vdc > T::zero() {
-            m.v_ab - v_comp
+        let (v_realised, v_dq_realised) = if !m.saturated {
+            (v_ab, v_dq) // exactly what was asked for: nothing to back-calculate
+        } else if vdc > T::zero() {
+            let v = m.v_ab - v_comp;
+            (v, v.to_dq(rot))
         } else {
-            Ab::zero()
+            (Ab::zero(), Dq::zero())
         };
-        if !(v_realised.is_finite() && m.duty.is_finite()) {
+        if !(v_realised.is_finite() && v_dq_realised.is_finite() && m.duty.is_finite()) {
             return self.reject_after_estimate(backup, estimate, i_dq);
         }
         // 8. Anti-windup with the realised voltage in the same frame; speed loop too.
-        let v_dq_realised = v_realised.to_dq(rot);
         b.current.realised(v_dq_realised);
         b.speed.realised(i_dq_ref.q);
         self.history = [v_realised, self.history[0]];

@@ -1,5 +1,5 @@
 //! Voltage limiting to the inverter hexagon and space-vector PWM (paper, V: "synthesized by
-//! the space vector PWM (SVPWM) [16]").
+//! the space vector PWM (SVPWM) \[16\]").
 //!
 //! **Limit: keep the angle, scale the magnitude.** A two-level inverter with dc link Vdc can
 //! realise (on average over a period) exactly the α-β vectors whose phase voltages span at
@@ -10,7 +10,7 @@
 //! asked for; scaling keeps the direction the controller wants and is what the anti-windup and
 //! the estimator are told was applied. The inscribed circle Vdc/√3 is offered as an option.
 //!
-//! **SVPWM as min-max zero-sequence injection** [16]: v_x + v_0 with
+//! **SVPWM as min-max zero-sequence injection** \[16\]: v_x + v_0 with
 //! v_0 = −(max + min)/2 centres the three references in the carrier, which is equivalent to
 //! the symmetric placement of the two zero vectors in classical SVPWM. Duty d_x = ½ + (v_x +
 //! v_0)/Vdc ∈ [0, 1] for every realisable vector.
@@ -33,10 +33,10 @@ pub enum VoltageLimit {
 /// Configuration of a [`SpaceVectorModulator`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ModulatorConfig<T> {
-    /// Realisable set. Default [`VoltageLimit::Hexagon`] (SVPWM [16], paper V).
+    /// Realisable set. Default [`VoltageLimit::Hexagon`] (SVPWM \[16\], paper V).
     pub limit: VoltageLimit,
     /// Fraction (0, 1] of the limit that may be used, a margin e.g. for minimum pulses.
-    /// Default 1 [A].
+    /// Default 1 \[A\].
     pub max_modulation: T,
 }
 
@@ -148,7 +148,7 @@ fn max_min<T: Real>(v: Abc<T>) -> (T, T) {
     (hi, lo)
 }
 
-/// Min-max SVPWM [16] of a realisable α-β vector: d_x = ½ + (v_x − (max + min)/2)/Vdc,
+/// Min-max SVPWM \[16\] of a realisable α-β vector: d_x = ½ + (v_x − (max + min)/2)/Vdc,
 /// clamped to [0, 1] against rounding (a vector outside the hexagon is clipped per phase —
 /// limit it first). `vdc` must be positive; non-finite values give ½ on every phase.
 #[inline]

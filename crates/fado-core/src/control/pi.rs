@@ -20,7 +20,7 @@
 //! The tracking gain is K_aw = r·Ki/Kp with `anti_windup_ratio` r. With r = 1 the update
 //! becomes I ← I + Ts·(Ki/Kp)·(y − f − I): the integral relaxes monotonically towards the
 //! value that realises the limited output with zero error and can never wind beyond it
-//! (the "realisable reference" of Harnefors/Nee, K_a = 1/Kp in Sul's textbook) [A].
+//! (the "realisable reference" of Harnefors/Nee, K_a = 1/Kp in Sul's textbook) \[A\].
 //! r > 1 tracks faster (the output leaves the limit earlier, less overshoot); r = 0 disables
 //! anti-windup. The discrete update is a contraction for K_aw·Ts ≤ 1, which `new` enforces.
 
@@ -32,17 +32,17 @@ use crate::error::{ConfigError, NonFiniteInput, check};
 pub struct PiConfig<T> {
     /// Sampling period Ts in s. Default 100 µs (paper, V: 10 kHz sampling).
     pub ts: T,
-    /// Proportional gain Kp (> 0). Default 1 (neutral placeholder [A]; the loops set theirs
+    /// Proportional gain Kp (> 0). Default 1 (neutral placeholder \[A\]; the loops set theirs
     /// from SPEC §6).
     pub kp: T,
-    /// Integral gain Ki in s⁻¹ (≥ 0). Default 0 [A].
+    /// Integral gain Ki in s⁻¹ (≥ 0). Default 0 \[A\].
     pub ki: T,
-    /// Lower output limit. Default −1 [A].
+    /// Lower output limit. Default −1 \[A\].
     pub output_min: T,
-    /// Upper output limit (> `output_min`). Default 1 [A].
+    /// Upper output limit (> `output_min`). Default 1 \[A\].
     pub output_max: T,
     /// Back-calculation gain as a multiple r of Ki/Kp (≥ 0, with r·Ki/Kp·Ts ≤ 1). Default 1:
-    /// the realisable-reference setting, the integral never winds beyond the limit [A].
+    /// the realisable-reference setting, the integral never winds beyond the limit \[A\].
     pub anti_windup_ratio: T,
 }
 

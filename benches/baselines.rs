@@ -1,0 +1,93 @@
+//! Cost of one 10 kHz sample of each estimator in `f32` (the firmware type): fado's
+//! `SensorlessEstimator::step` next to the baselines. Inputs cycle through one electrical
+//! period of an ideal machine at 300 r/min under load, so every branch taken is the one taken
+//! in operation (no tracker hold, k_df mode for fado after the warm-up).
+//!
+//! Run: `cargo bench --bench baselines` (medians are criterion's point estimates).
+
+// `criterion_group!` generates an undocumented public function.
+#![allow(missing_docs)]
+
+use std::hint::black_box;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use fado_core::baselines::{
+    EmfObserverConfig, EmfObserverEstimator, LpfIntegratorConfig, LpfIntegratorEstimator,
+    OrtegaConfig, OrtegaEstimator,
+};
+use fado_core::{Ab, Dq, EstimatorConfig, Rotation, RotorAngleEstimator, SensorlessEstimator};
+
+const TS: f64 = 100e-6;
+/// 300 r/min, 4 pole pairs: 20 Hz electrical, 500 samples per period.
+const PERIOD: usize = 500;
+
+/// One electrical period of (v applied over the interval, i sampled at its end), SPEC §6 motor.
+fn inputs() -> Vec<(Ab<f32>, Ab<f32>)> {
+    let (rs, l, lf) = (0.327, 2.63e-3, 0.088);
+    let w = core::f64::consts::TAU / (PERIOD as f64 * TS);
+    let i_dq = Dq::new(0.0, 10.0);
+    let sample = |n: usize| {
+        let rot = Rotation::from_angle(w * TS * n as f64);
+        (
+            Dq::new(lf + l * i_dq.d, l * i_dq.q).to_ab(rot),
+            i_dq.to_ab(rot),
+        )
+    };
+    (1..=PERIOD)
+        .map(|n| {
+            let ((lambda0, i0), (lambda1, i1)) = (sample(n - 1), sample(n));
+            let v = (lambda1 - lambda0) * (1.0 / TS) + (i1 + i0) * (0.5 * rs);
+            (
+                Ab::new(v.alpha as f32, v.beta as f32),
+                Ab::new(i1.alpha as f32, i1.beta as f32),
+            )
+        })
+        .collect()
+}
+
+fn bench_one<E: RotorAngleEstimator<f32>>(
+    c: &mut Criterion,
+    mut est: E,
+    data: &[(Ab<f32>, Ab<f32>)],
+) {
+    // Warm up over two seconds so trackers are locked and fado is in k_df mode.
+    for k in 0..20_000 {
+        let (v, i) = data[k % data.len()];
+        est.step(v, i);
+    }
+    let mut k = 0;
+    c.bench_function(&format!("{}_step_f32", est.name()), |b| {
+        b.iter(|| {
+            let (v, i) = data[k];
+            k = if k + 1 == data.len() { 0 } else { k + 1 };
+            black_box(est.step(black_box(v), black_box(i)))
+        })
+    });
+}
+
+fn estimators(c: &mut Criterion) {
+    let data = inputs();
+    bench_one(
+        c,
+        SensorlessEstimator::<f32>::new(EstimatorConfig::default()).unwrap(),
+        &data,
+    );
+    bench_one(
+        c,
+        LpfIntegratorEstimator::<f32>::new(LpfIntegratorConfig::default()).unwrap(),
+        &data,
+    );
+    bench_one(
+        c,
+        OrtegaEstimator::<f32>::new(OrtegaConfig::default()).unwrap(),
+        &data,
+    );
+    bench_one(
+        c,
+        EmfObserverEstimator::<f32>::new(EmfObserverConfig::default()).unwrap(),
+        &data,
+    );
+}
+
+criterion_group!(benches, estimators);
+criterion_main!(benches);

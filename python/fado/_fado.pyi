@@ -1,0 +1,283 @@
+"""Type stubs of the native module ``fado._fado`` (built from ``crates/fado-py``).
+
+Import these names from ``fado``. ``tests/python/test_stubs.py`` runs ``mypy.stubtest`` on
+this file, so it cannot drift from the module.
+"""
+
+from typing import Any, ClassVar, Final, Literal, final
+
+import numpy as np
+import numpy.typing as npt
+
+__all__ = [
+    "EstimatorConfig",
+    "Estimator",
+    "estimate",
+    "EstimateResult",
+    "StepResult",
+    "MODE_LIMITER",
+    "MODE_DISTURBANCE_FEEDBACK",
+    "FadoError",
+    "ConfigError",
+    "InputError",
+    "SimulationError",
+    "__version__",
+    "OUTPUT_NAMES",
+]
+
+__version__: Final[str]
+OUTPUT_NAMES: Final[list[str]]
+MODE_LIMITER: Final[int]
+MODE_DISTURBANCE_FEEDBACK: Final[int]
+
+_FloatArray = npt.NDArray[np.float64] | npt.NDArray[np.float32]
+_DType = Literal["float64", "float32"]
+
+class FadoError(Exception):
+    """Base class of every error fado raises on purpose."""
+
+class ConfigError(FadoError, ValueError):
+    """A configuration field is invalid; ``.field`` names it."""
+
+    field: str
+
+class InputError(FadoError, ValueError):
+    """An input array or argument is unusable; ``.argument`` names it."""
+
+    argument: str
+
+class SimulationError(FadoError):
+    """A simulation could not be run or failed."""
+
+@final
+class EstimatorConfig:
+    """Configuration of the sensorless estimator; omitted fields take the Rust defaults."""
+
+    fields: ClassVar[tuple[str, ...]]
+    def __new__(
+        cls,
+        *,
+        ts: float | None = None,
+        rs_hat: float | None = None,
+        lq_hat: float | None = None,
+        flux_linkage_hat: float | None = None,
+        k_df: float | None = None,
+        k_df_ramp_time: float | None = None,
+        k_af: float | None = None,
+        limiter_radius_ratio: float | None = None,
+        mode_threshold_hz: float | None = None,
+        mode_hysteresis_hz: float | None = None,
+        t2s1_bandwidth_hz: float | None = None,
+        t2s2_bandwidth_hz: float | None = None,
+        tracker_damping: float | None = None,
+        bandwidth_definition: str | None = None,
+        tracker_hold_ratio: float | None = None,
+        average_current: bool | None = None,
+        initial_angle: float | None = None,
+    ) -> EstimatorConfig: ...
+    def replace(
+        self,
+        *,
+        ts: float | None = None,
+        rs_hat: float | None = None,
+        lq_hat: float | None = None,
+        flux_linkage_hat: float | None = None,
+        k_df: float | None = None,
+        k_df_ramp_time: float | None = None,
+        k_af: float | None = None,
+        limiter_radius_ratio: float | None = None,
+        mode_threshold_hz: float | None = None,
+        mode_hysteresis_hz: float | None = None,
+        t2s1_bandwidth_hz: float | None = None,
+        t2s2_bandwidth_hz: float | None = None,
+        tracker_damping: float | None = None,
+        bandwidth_definition: str | None = None,
+        tracker_hold_ratio: float | None = None,
+        average_current: bool | None = None,
+        initial_angle: float | None = None,
+    ) -> EstimatorConfig: ...
+    def to_dict(self) -> dict[str, float | str | bool]: ...
+    def __getnewargs_ex__(self) -> tuple[tuple[()], dict[str, float | str | bool]]: ...
+    def __eq__(self, value: object, /) -> bool: ...
+    def __ne__(self, value: object, /) -> bool: ...
+    @property
+    def ts(self) -> float:
+        """Sampling period Ts in s."""
+    @property
+    def rs_hat(self) -> float:
+        """Stator resistance estimate R̂s in Ω."""
+    @property
+    def lq_hat(self) -> float:
+        """q-axis inductance estimate L̂q in H."""
+    @property
+    def flux_linkage_hat(self) -> float:
+        """Magnet flux linkage estimate λ̂f in Wb."""
+    @property
+    def k_df(self) -> float:
+        """Disturbance feedback gain k_df in 1/s (Fig. 3)."""
+    @property
+    def k_df_ramp_time(self) -> float:
+        """Ramp time of k_df on activation in s."""
+    @property
+    def k_af(self) -> float:
+        """Limiter gain k_af in 1/s (Fig. 6)."""
+    @property
+    def limiter_radius_ratio(self) -> float:
+        """Limiter radius as a multiple of λ̂f."""
+    @property
+    def mode_threshold_hz(self) -> float:
+        """Speed threshold between limiter and k_df feedback in Hz electrical."""
+    @property
+    def mode_hysteresis_hz(self) -> float:
+        """Hysteresis half-band of the threshold in Hz."""
+    @property
+    def t2s1_bandwidth_hz(self) -> float:
+        """Bandwidth of T2S-1 in Hz."""
+    @property
+    def t2s2_bandwidth_hz(self) -> float:
+        """Bandwidth of T2S-2 in Hz."""
+    @property
+    def tracker_damping(self) -> float:
+        """Damping ratio of both trackers."""
+    @property
+    def bandwidth_definition(self) -> str:
+        """'-3dB' or 'natural'."""
+    @property
+    def tracker_hold_ratio(self) -> float:
+        """Trackers coast while |λ̂r| is below this fraction of λ̂f."""
+    @property
+    def average_current(self) -> bool:
+        """Average the current over the interval for the resistive drop."""
+    @property
+    def initial_angle(self) -> float:
+        """Rotor angle assumed at reset in rad."""
+
+@final
+class StepResult:
+    """One sample of the estimator's outputs and diagnostics (Fig. 5)."""
+
+    def to_dict(self) -> dict[str, float | int | bool]: ...
+    def __eq__(self, value: object, /) -> bool: ...
+    def __ne__(self, value: object, /) -> bool: ...
+    @property
+    def theta(self) -> float: ...
+    @property
+    def omega(self) -> float: ...
+    @property
+    def omega_control(self) -> float: ...
+    @property
+    def theta_direct(self) -> float: ...
+    @property
+    def lambda1_alpha(self) -> float: ...
+    @property
+    def lambda1_beta(self) -> float: ...
+    @property
+    def disturbance_alpha(self) -> float: ...
+    @property
+    def disturbance_beta(self) -> float: ...
+    @property
+    def lambda2_alpha(self) -> float: ...
+    @property
+    def lambda2_beta(self) -> float: ...
+    @property
+    def lambda_r_alpha(self) -> float: ...
+    @property
+    def lambda_r_beta(self) -> float: ...
+    @property
+    def mode(self) -> int: ...
+    @property
+    def flag_limit(self) -> bool: ...
+    @property
+    def limiter_clamping(self) -> bool: ...
+    @property
+    def tracker_hold(self) -> bool: ...
+    @property
+    def input_fault(self) -> bool: ...
+
+@final
+class EstimateResult:
+    """The estimator's outputs over a recording, one numpy array per field."""
+
+    def to_dict(self) -> dict[str, npt.NDArray[Any]]: ...
+    def keys(self) -> list[str]: ...
+    def to_pandas(self) -> Any: ...
+    def __getitem__(self, name: str, /) -> npt.NDArray[Any]: ...
+    def __len__(self) -> int: ...
+    @property
+    def time(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def ts(self) -> float: ...
+    @property
+    def dtype(self) -> _DType: ...
+    @property
+    def theta(self) -> _FloatArray: ...
+    @property
+    def omega(self) -> _FloatArray: ...
+    @property
+    def omega_control(self) -> _FloatArray: ...
+    @property
+    def theta_direct(self) -> _FloatArray: ...
+    @property
+    def lambda1_alpha(self) -> _FloatArray: ...
+    @property
+    def lambda1_beta(self) -> _FloatArray: ...
+    @property
+    def disturbance_alpha(self) -> _FloatArray: ...
+    @property
+    def disturbance_beta(self) -> _FloatArray: ...
+    @property
+    def lambda2_alpha(self) -> _FloatArray: ...
+    @property
+    def lambda2_beta(self) -> _FloatArray: ...
+    @property
+    def lambda_r_alpha(self) -> _FloatArray: ...
+    @property
+    def lambda_r_beta(self) -> _FloatArray: ...
+    @property
+    def mode(self) -> npt.NDArray[np.int8]: ...
+    @property
+    def flag_limit(self) -> npt.NDArray[np.bool_]: ...
+    @property
+    def limiter_clamping(self) -> npt.NDArray[np.bool_]: ...
+    @property
+    def tracker_hold(self) -> npt.NDArray[np.bool_]: ...
+    @property
+    def input_fault(self) -> npt.NDArray[np.bool_]: ...
+
+@final
+class Estimator:
+    """The sensorless estimator of Fig. 5, stepped sample by sample or chunk by chunk."""
+
+    def __new__(
+        cls, config: EstimatorConfig | None = None, *, dtype: npt.DTypeLike = "float64"
+    ) -> Estimator: ...
+    @property
+    def config(self) -> EstimatorConfig: ...
+    @property
+    def dtype(self) -> _DType: ...
+    @property
+    def last(self) -> StepResult: ...
+    @property
+    def rejected_samples(self) -> int: ...
+    def step(self, v_alpha: float, v_beta: float, i_alpha: float, i_beta: float) -> StepResult: ...
+    def run(
+        self, v_alpha: _FloatArray, v_beta: _FloatArray, i_alpha: _FloatArray, i_beta: _FloatArray
+    ) -> EstimateResult: ...
+    def reset(self) -> None: ...
+    def align(self, theta0: float, i_alpha: float = 0.0, i_beta: float = 0.0) -> None: ...
+    def set_disturbance_feedback_enabled(self, enabled: bool) -> None: ...
+    def set_rs_hat(self, rs_hat: float) -> None: ...
+    def copy(self) -> Estimator: ...
+
+def estimate(
+    v_alpha: _FloatArray,
+    v_beta: _FloatArray,
+    i_alpha: _FloatArray,
+    i_beta: _FloatArray,
+    *,
+    ts: float | None = None,
+    config: EstimatorConfig | None = None,
+    theta0: float | None = None,
+    dtype: npt.DTypeLike = "float64",
+) -> EstimateResult:
+    """Run the estimator over a whole recording in Rust (GIL released)."""

@@ -1,0 +1,225 @@
+"""`fado.estimate` and `Estimator.run` against `Estimator.step`, and against the motor."""
+
+from __future__ import annotations
+
+import threading
+import time
+
+import numpy as np
+import pytest
+from conftest import Recording, ramp_then_hold, synthetic_recording
+
+import fado
+from fado import Mode
+
+
+def wrap(x: np.ndarray) -> np.ndarray:
+    return np.angle(np.exp(1j * x))
+
+
+def stepped(est: fado.Estimator, *signals: np.ndarray) -> dict[str, np.ndarray]:
+    """Steps sample by sample from Python and stacks the results like `estimate` does."""
+    rows = [est.step(*map(float, sample)) for sample in zip(*signals)]
+    float_dtype = np.float32 if est.dtype == "float32" else np.float64
+    out = {}
+    for name in fado.OUTPUT_NAMES:
+        values = [getattr(r, name) for r in rows]
+        if name == "mode":
+            out[name] = np.array(values, dtype=np.int8)
+        elif isinstance(values[0], bool):
+            out[name] = np.array(values, dtype=bool)
+        else:
+            out[name] = np.array(values, dtype=float_dtype)
+    return out
+
+
+def assert_identical(result: fado.EstimateResult, expected: dict[str, np.ndarray]) -> None:
+    assert result.keys() == list(fado.OUTPUT_NAMES)
+    for name in fado.OUTPUT_NAMES:
+        got = result[name]
+        assert got.dtype == expected[name].dtype, name
+        # Bit for bit, NaN-free by construction: array_equal, not allclose.
+        np.testing.assert_array_equal(got, expected[name], err_msg=name, strict=True)
+
+
+def with_faults(rec: Recording) -> tuple[np.ndarray, ...]:
+    """The recording's signals with a few non-finite samples, as a glitching ADC would give."""
+    v_alpha, v_beta, i_alpha, i_beta = (s.copy() for s in rec.signals())
+    v_alpha[1234] = np.nan
+    i_beta[5678] = np.inf
+    v_beta[15000] = -np.inf
+    return v_alpha, v_beta, i_alpha, i_beta
+
+
+@pytest.mark.parametrize("dtype", ["float64", "float32"])
+def test_estimate_equals_stepping_sample_by_sample(spin_up: Recording, dtype: str) -> None:
+    signals = with_faults(spin_up)
+    result = fado.estimate(*signals, theta0=spin_up.theta0, dtype=dtype)
+    est = fado.Estimator(dtype=dtype)
+    est.align(spin_up.theta0, float(signals[2][0]), float(signals[3][0]))
+    assert_identical(result, stepped(est, *signals))
+    # The recording really exercises both feedbacks and the fault path.
+    assert set(np.unique(result.mode)) == {Mode.LIMITER, Mode.DISTURBANCE_FEEDBACK}
+    assert np.count_nonzero(result.input_fault) == 3
+    assert result.dtype == dtype and len(result) == len(signals[0])
+
+
+def test_run_in_chunks_equals_one_run(spin_up: Recording) -> None:
+    whole = fado.Estimator()
+    once = whole.run(*spin_up.signals())
+    chunked = fado.Estimator()
+    bounds = [0, 1, 700, 701, 9000, 20_000]
+    parts = [
+        chunked.run(*(s[a:b] for s in spin_up.signals())) for a, b in zip(bounds, bounds[1:])
+    ]
+    for name in fado.OUTPUT_NAMES:
+        np.testing.assert_array_equal(
+            once[name], np.concatenate([p[name] for p in parts]), strict=True
+        )
+    assert whole.last == chunked.last
+
+
+def test_estimate_defaults_equal_a_fresh_estimator(spin_up: Recording) -> None:
+    n = 3000
+    signals = [s[:n] for s in spin_up.signals()]
+    cfg = fado.EstimatorConfig(rs_hat=0.3, initial_angle=0.3)
+    by_function = fado.estimate(*signals, config=cfg)
+    by_object = fado.Estimator(cfg).run(*signals)
+    for name in fado.OUTPUT_NAMES:
+        np.testing.assert_array_equal(by_function[name], by_object[name], strict=True)
+
+
+def test_ts_argument_overrides_the_config(spin_up: Recording) -> None:
+    n = 2000
+    signals = [s[:n] for s in spin_up.signals()]
+    by_ts = fado.estimate(*signals, ts=50e-6, config=fado.EstimatorConfig(rs_hat=0.3))
+    by_config = fado.estimate(*signals, config=fado.EstimatorConfig(rs_hat=0.3, ts=50e-6))
+    np.testing.assert_array_equal(by_ts.theta, by_config.theta, strict=True)
+    assert by_ts.ts == 50e-6
+    np.testing.assert_allclose(by_ts.time[:3], [0.0, 50e-6, 100e-6])
+    different = fado.estimate(*signals, config=fado.EstimatorConfig(rs_hat=0.3))
+    assert not np.array_equal(by_ts.lambda1_alpha, different.lambda1_alpha)
+
+
+@pytest.mark.parametrize(("dtype", "tolerance"), [("float64", 1e-3), ("float32", 1e-3)])
+def test_tracks_the_rotor_angle_of_a_consistent_recording(
+    spin_up: Recording, dtype: str, tolerance: float
+) -> None:
+    """Matched R̂s, L̂q: after the spin-up the angle error is small and the modes are right."""
+    result = fado.estimate(*spin_up.signals(), theta0=spin_up.theta0, dtype=dtype)
+    settled = slice(15_000, None)  # the last 0.5 s, 1.2 s after the ramp ended
+    error = wrap(result.theta[settled] - spin_up.theta[settled])
+    assert np.max(np.abs(error)) < tolerance
+    np.testing.assert_allclose(result.omega_control[settled], spin_up.omega[settled], rtol=0.01)
+    assert np.all(result.mode[settled] == Mode.DISTURBANCE_FEEDBACK)
+    assert result.mode[0] == Mode.LIMITER
+    np.testing.assert_array_equal(result.flag_limit, result.mode == Mode.LIMITER)
+    # The paper's identities hold on the arrays: λ2 = λ1 − D̂ (eq. 20), λ̂r = λ2 − L̂q·i (eq. 5).
+    np.testing.assert_allclose(
+        result.lambda2_alpha, result.lambda1_alpha - result.disturbance_alpha, atol=1e-6
+    )
+    lq = fado.EstimatorConfig().lq_hat
+    np.testing.assert_allclose(
+        result.lambda_r_beta, result.lambda2_beta - lq * spin_up.i_beta, atol=1e-6
+    )
+
+
+def test_float32_inputs_in_float64_mode_are_widened_exactly(spin_up: Recording) -> None:
+    n = 3000
+    narrow = [s[:n].astype(np.float32) for s in spin_up.signals()]
+    widened = [s.astype(np.float64) for s in narrow]
+    a = fado.estimate(*narrow)
+    b = fado.estimate(*widened)
+    assert a.theta.dtype == np.float64
+    np.testing.assert_array_equal(a.theta, b.theta, strict=True)
+
+
+def test_float32_mode_rounds_float64_inputs_like_a_cast(spin_up: Recording) -> None:
+    n = 3000
+    wide = [s[:n] for s in spin_up.signals()]
+    a = fado.estimate(*wide, dtype="float32")
+    b = fado.estimate(*(s.astype(np.float32) for s in wide), dtype=np.float32)
+    assert a.theta.dtype == np.float32
+    np.testing.assert_array_equal(a.theta, b.theta, strict=True)
+
+
+def test_float32_and_float64_agree_to_single_precision(spin_up: Recording) -> None:
+    r64 = fado.estimate(*spin_up.signals(), theta0=spin_up.theta0)
+    r32 = fado.estimate(*spin_up.signals(), theta0=spin_up.theta0, dtype="float32")
+    assert not np.array_equal(r64.theta.astype(np.float32), r32.theta)
+    np.testing.assert_allclose(wrap(r32.theta - r64.theta), 0.0, atol=5e-3)
+
+
+def test_theta0_aligns_with_the_first_current_sample() -> None:
+    rec = synthetic_recording(np.full(500, 2 * np.pi * 10.0), theta0=-2.0)
+    result = fado.estimate(*rec.signals(), theta0=rec.theta0)
+    est = fado.Estimator()
+    est.align(rec.theta0, float(rec.i_alpha[0]), float(rec.i_beta[0]))
+    first = est.step(*(float(s[0]) for s in rec.signals()))
+    assert result.theta[0] == first.theta
+    assert result.lambda1_alpha[0] == first.lambda1_alpha
+    unaligned = fado.estimate(*rec.signals())
+    assert unaligned.lambda1_alpha[0] != first.lambda1_alpha
+
+
+def test_empty_recording_gives_empty_arrays() -> None:
+    empty = np.empty(0)
+    result = fado.estimate(empty, empty, empty, empty, theta0=1.0)
+    assert len(result) == 0
+    for name in fado.OUTPUT_NAMES:
+        assert result[name].shape == (0,)
+
+
+def test_result_containers(spin_up: Recording) -> None:
+    n = 100
+    result = fado.estimate(*(s[:n] for s in spin_up.signals()))
+    as_dict = result.to_dict()
+    assert list(as_dict) == list(fado.OUTPUT_NAMES)
+    assert as_dict["theta"] is result.theta  # shared, not copied
+    assert result.mode.dtype == np.int8
+    assert result.flag_limit.dtype == np.bool_
+    assert result.time.dtype == np.float64 and result.time[-1] == pytest.approx((n - 1) * 1e-4)
+    with pytest.raises(KeyError):
+        result["no_such_output"]
+    assert "samples=100" in repr(result)
+
+
+def test_to_pandas(spin_up: Recording) -> None:
+    pd = pytest.importorskip("pandas")
+    result = fado.estimate(*(s[:50] for s in spin_up.signals()))
+    frame = result.to_pandas()
+    assert isinstance(frame, pd.DataFrame)
+    assert list(frame.columns) == list(fado.OUTPUT_NAMES)
+    assert frame.index.name == "time_s"
+    np.testing.assert_array_equal(frame["theta"].to_numpy(), result.theta)
+
+
+def test_estimate_releases_the_gil() -> None:
+    """While `estimate` runs in one thread, another keeps running Python code.
+
+    With the GIL held the main loop would stall for the whole call; released, its longest
+    pause is a scheduling quantum, far shorter than the call.
+    """
+    n = 2_000_000
+    rng = np.random.default_rng(1)
+    signals = [rng.normal(size=n) for _ in range(4)]
+    done = threading.Event()
+    span: list[float] = []
+
+    def worker() -> None:
+        start = time.perf_counter()
+        fado.estimate(*signals)
+        span.extend([start, time.perf_counter()])
+        done.set()
+
+    thread = threading.Thread(target=worker)
+    last = time.perf_counter()
+    longest = 0.0
+    thread.start()
+    while not done.is_set():
+        now = time.perf_counter()
+        longest = max(longest, now - last)
+        last = now
+    thread.join()
+    duration = span[1] - span[0]
+    assert longest < 0.5 * duration, (longest, duration)
