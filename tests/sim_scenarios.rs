@@ -159,3 +159,31 @@ fn fig10_paper_criterion() {
     let out = run("fig10", None, false);
     assert!(out.passed, "{:?}", out.checks);
 }
+
+#[test]
+fn integrator_and_emf_baselines_lose_the_angle_at_the_loaded_reversal_where_fado_keeps_it() {
+    // The same drive, plant and profile with the estimator swapped (fado_core::baselines): the
+    // compensated LPF cannot integrate near zero frequency and the EMF observer has nothing
+    // to measure there, so both lose the angle crossing zero under 7.5 N·m.
+    let fado = run("fig11", None, false);
+    assert!(fado.metrics.max_angle_error_zero_speed < 0.25);
+    for kind in ["lpf_integrator", "emf_observer"] {
+        let cfg = format!("[estimator]\nkind = \"{kind}\"\n");
+        let out = run("fig11", Some(&cfg), false);
+        assert_eq!(out.report().estimator, out.config.estimator.kind);
+        assert!(!out.passed, "{kind} passed fig11");
+        assert!(
+            out.metrics.max_angle_error > 1.0,
+            "{kind}: {}",
+            out.metrics.max_angle_error
+        );
+    }
+    let e = fado::sim::simulate(
+        "fig11",
+        Some("[estimator]\nkind = \"ortega\"\n[controller]\nprecision = \"f32\"\n"),
+        false,
+        None,
+    )
+    .unwrap_err();
+    assert_eq!(e.key, "estimator.kind");
+}

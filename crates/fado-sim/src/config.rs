@@ -181,11 +181,29 @@ pub enum BandwidthSetting {
     NaturalFrequency,
 }
 
+/// Which rotor-angle estimator the drive runs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EstimatorKind {
+    /// The paper's estimator (`fado_core::SensorlessEstimator`).
+    #[default]
+    Fado,
+    /// Baseline: compensated low-pass integrator (`fado_core::LpfIntegratorEstimator`).
+    LpfIntegrator,
+    /// Baseline: Ortega–Praly nonlinear flux observer (`fado_core::OrtegaEstimator`).
+    Ortega,
+    /// Baseline: extended-EMF observer (`fado_core::EmfObserverEstimator`).
+    EmfObserver,
+}
+
 /// The estimator's own settings (the model estimates come from `[mismatch]`). Defaults as in
-/// `fado_core::EstimatorConfig` (paper §V, SPEC §1–3).
+/// `fado_core::EstimatorConfig` (paper §V, SPEC §1–3) and, for the baselines, in
+/// `fado_core::baselines`. The trackers' settings apply to every kind.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct EstimatorSettings {
+    /// Which estimator. Default fado. The baselines run with an f64 drive only.
+    pub kind: EstimatorKind,
     /// k_df, s⁻¹ (Fig. 3). Default 0.5.
     pub k_df: f64,
     /// k_df ramp-in time, s (0 = abrupt). Default 0.
@@ -210,11 +228,30 @@ pub struct EstimatorSettings {
     pub tracker_hold_ratio: f64,
     /// Interval-average current in the resistive drop. Default true.
     pub average_current: bool,
+    /// LPF baseline: cut-off of 1/(s + ωc), Hz. Default as `LpfIntegratorConfig`.
+    pub lpf_cutoff_hz: f64,
+    /// LPF baseline: speed below which its gain/phase compensation is frozen, Hz.
+    pub lpf_compensation_floor_hz: f64,
+    /// Ortega baseline: observer gain, s⁻¹ (when not scheduled on speed).
+    pub ortega_observer_bandwidth: f64,
+    /// Ortega baseline: gain scheduled as this × |ω̂| (0 = fixed gain).
+    pub ortega_observer_speed_ratio: f64,
+    /// Ortega baseline: lower bound of the scheduled gain, s⁻¹.
+    pub ortega_observer_bandwidth_min: f64,
+    /// Ortega baseline: λ̂f adaptation gain ratio (0 = off).
+    pub ortega_flux_adaptation_ratio: f64,
+    /// EMF baseline: observer bandwidth, Hz.
+    pub emf_bandwidth_hz: f64,
+    /// EMF baseline: speed below which the angle is held, Hz.
+    pub emf_speed_floor_hz: f64,
 }
 
 impl Default for EstimatorSettings {
     fn default() -> Self {
         let d = EstimatorConfig::<f64>::default();
+        let lpf = fado_core::baselines::LpfIntegratorConfig::<f64>::default();
+        let ortega = fado_core::baselines::OrtegaConfig::<f64>::default();
+        let emf = fado_core::baselines::EmfObserverConfig::<f64>::default();
         Self {
             k_df: d.k_df,
             k_df_ramp_time: d.k_df_ramp_time,
@@ -231,6 +268,15 @@ impl Default for EstimatorSettings {
             },
             tracker_hold_ratio: d.tracker_hold_ratio,
             average_current: d.average_current,
+            kind: EstimatorKind::Fado,
+            lpf_cutoff_hz: lpf.cutoff_hz,
+            lpf_compensation_floor_hz: lpf.compensation_floor_hz,
+            ortega_observer_bandwidth: ortega.observer_bandwidth,
+            ortega_observer_speed_ratio: ortega.observer_speed_ratio,
+            ortega_observer_bandwidth_min: ortega.observer_bandwidth_min,
+            ortega_flux_adaptation_ratio: ortega.flux_adaptation_ratio,
+            emf_bandwidth_hz: emf.emf_bandwidth_hz,
+            emf_speed_floor_hz: emf.speed_floor_hz,
         }
     }
 }
@@ -351,6 +397,12 @@ impl SimConfig {
         self.estimator_config()
             .validate()
             .map_err(|e| SimConfigError::from(e).in_section("estimator"))?;
+        match self.estimator.kind {
+            EstimatorKind::Fado => {}
+            EstimatorKind::LpfIntegrator => drop(self.lpf_estimator()?),
+            EstimatorKind::Ortega => drop(self.ortega_estimator()?),
+            EstimatorKind::EmfObserver => drop(self.emf_estimator()?),
+        }
         Ok(())
     }
 

@@ -17,6 +17,20 @@ impl<T: fado_core::Real> DisturbanceFeedbackSwitch for fado_core::SensorlessEsti
     }
 }
 
+/// The baselines have no k_df: the Fig. 9 event does nothing to them.
+macro_rules! no_disturbance_feedback {
+    ($($t:ty),*) => {$(
+        impl DisturbanceFeedbackSwitch for $t {
+            fn set_disturbance_feedback(&mut self, _enabled: bool) {}
+        }
+    )*};
+}
+no_disturbance_feedback!(
+    fado_core::LpfIntegratorEstimator<f64>,
+    fado_core::OrtegaEstimator<f64>,
+    fado_core::EmfObserverEstimator<f64>
+);
+
 impl<E> Controller for SensorlessDrive<f64, E>
 where
     E: RotorAngleEstimator<f64> + DisturbanceFeedbackSwitch,
@@ -98,6 +112,87 @@ impl SimConfig {
             current_anti_windup_ratio: c.current_anti_windup_ratio,
             speed_anti_windup_ratio: c.speed_anti_windup_ratio,
         }
+    }
+
+    /// The drive around a baseline estimator (`[estimator] kind`), f64.
+    pub fn build_baseline_drive<E>(
+        &self,
+        estimator: E,
+    ) -> Result<SensorlessDrive<f64, E>, SimConfigError>
+    where
+        E: RotorAngleEstimator<f64>,
+    {
+        let drive_cfg = self.drive_config();
+        SensorlessDrive::with_estimator(drive_cfg, estimator)
+            .map_err(|e| SimConfigError::from(e).in_section("controller"))
+    }
+
+    /// The compensated-LPF baseline of this configuration.
+    pub fn lpf_estimator(&self) -> Result<fado_core::LpfIntegratorEstimator<f64>, SimConfigError> {
+        let e = self.estimator_config();
+        let s = &self.estimator;
+        fado_core::LpfIntegratorEstimator::new(fado_core::baselines::LpfIntegratorConfig {
+            ts: e.ts,
+            rs_hat: e.rs_hat,
+            lq_hat: e.lq_hat,
+            flux_linkage_hat: e.flux_linkage_hat,
+            cutoff_hz: s.lpf_cutoff_hz,
+            compensation_floor_hz: s.lpf_compensation_floor_hz,
+            t2s1_bandwidth_hz: e.t2s1_bandwidth_hz,
+            t2s2_bandwidth_hz: e.t2s2_bandwidth_hz,
+            tracker_damping: e.tracker_damping,
+            bandwidth_definition: e.bandwidth_definition,
+            tracker_hold_ratio: e.tracker_hold_ratio,
+            average_current: e.average_current,
+            initial_angle: e.initial_angle,
+        })
+        .map_err(|e| SimConfigError::from(e).in_section("estimator"))
+    }
+
+    /// The Ortega–Praly baseline of this configuration.
+    pub fn ortega_estimator(&self) -> Result<fado_core::OrtegaEstimator<f64>, SimConfigError> {
+        let e = self.estimator_config();
+        let s = &self.estimator;
+        fado_core::OrtegaEstimator::new(fado_core::baselines::OrtegaConfig {
+            ts: e.ts,
+            rs_hat: e.rs_hat,
+            lq_hat: e.lq_hat,
+            flux_linkage_hat: e.flux_linkage_hat,
+            observer_bandwidth: s.ortega_observer_bandwidth,
+            observer_speed_ratio: s.ortega_observer_speed_ratio,
+            observer_bandwidth_min: s.ortega_observer_bandwidth_min,
+            flux_adaptation_ratio: s.ortega_flux_adaptation_ratio,
+            t2s1_bandwidth_hz: e.t2s1_bandwidth_hz,
+            t2s2_bandwidth_hz: e.t2s2_bandwidth_hz,
+            tracker_damping: e.tracker_damping,
+            bandwidth_definition: e.bandwidth_definition,
+            tracker_hold_ratio: e.tracker_hold_ratio,
+            average_current: e.average_current,
+            initial_angle: e.initial_angle,
+        })
+        .map_err(|e| SimConfigError::from(e).in_section("estimator"))
+    }
+
+    /// The extended-EMF baseline of this configuration.
+    pub fn emf_estimator(&self) -> Result<fado_core::EmfObserverEstimator<f64>, SimConfigError> {
+        let e = self.estimator_config();
+        let s = &self.estimator;
+        fado_core::EmfObserverEstimator::new(fado_core::baselines::EmfObserverConfig {
+            ts: e.ts,
+            rs_hat: e.rs_hat,
+            lq_hat: e.lq_hat,
+            flux_linkage_hat: e.flux_linkage_hat,
+            emf_bandwidth_hz: s.emf_bandwidth_hz,
+            speed_floor_hz: s.emf_speed_floor_hz,
+            t2s1_bandwidth_hz: e.t2s1_bandwidth_hz,
+            t2s2_bandwidth_hz: e.t2s2_bandwidth_hz,
+            tracker_damping: e.tracker_damping,
+            bandwidth_definition: e.bandwidth_definition,
+            tracker_hold_ratio: e.tracker_hold_ratio,
+            average_current: e.average_current,
+            initial_angle: e.initial_angle,
+        })
+        .map_err(|e| SimConfigError::from(e).in_section("estimator"))
     }
 
     /// The sensorless drive of this configuration (aligned by the simulation at start).

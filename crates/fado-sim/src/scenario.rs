@@ -10,7 +10,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use crate::config::{Precision, SimConfig};
+use crate::config::{EstimatorKind, Precision, SimConfig};
 use crate::controller::{ControlEvent, Controller};
 use crate::error::SimConfigError;
 use crate::inverter::InverterModel;
@@ -429,6 +429,8 @@ pub struct Report {
     pub inverter_model: InverterModel,
     /// Scalar type of the drive.
     pub precision: Precision,
+    /// Which rotor-angle estimator ran.
+    pub estimator: EstimatorKind,
     /// All criteria passed.
     pub passed: bool,
     /// max |θ − θ̂| over the evaluation window, rad.
@@ -461,6 +463,7 @@ impl Outcome {
             scenario: self.scenario.clone(),
             inverter_model: self.config.inverter.model,
             precision: self.config.controller.precision,
+            estimator: self.config.estimator.kind,
             passed: self.passed,
             max_angle_error: m.max_angle_error,
             rms_angle_error: m.rms_angle_error,
@@ -524,15 +527,31 @@ pub fn run_config(
         .ok_or_else(|| SimConfigError::new("scenario", format!("unknown `{scenario}`")))?;
     cfg.validate()?;
     let started = Instant::now();
-    match cfg.controller.precision {
-        Precision::F64 => {
+    match (cfg.controller.precision, cfg.estimator.kind) {
+        (Precision::F64, EstimatorKind::Fado) => {
             let drive = cfg.build_drive()?;
             run_with(sc, cfg, drive, started, progress)
         }
-        Precision::F32 => {
+        (Precision::F32, EstimatorKind::Fado) => {
             let drive = cfg.build_drive_f32()?;
             run_with(sc, cfg, drive, started, progress)
         }
+        (Precision::F64, EstimatorKind::LpfIntegrator) => {
+            let drive = cfg.build_baseline_drive(cfg.lpf_estimator()?)?;
+            run_with(sc, cfg, drive, started, progress)
+        }
+        (Precision::F64, EstimatorKind::Ortega) => {
+            let drive = cfg.build_baseline_drive(cfg.ortega_estimator()?)?;
+            run_with(sc, cfg, drive, started, progress)
+        }
+        (Precision::F64, EstimatorKind::EmfObserver) => {
+            let drive = cfg.build_baseline_drive(cfg.emf_estimator()?)?;
+            run_with(sc, cfg, drive, started, progress)
+        }
+        (Precision::F32, _) => Err(SimConfigError::new(
+            "estimator.kind",
+            "the baselines run with an f64 drive only (controller.precision = \"f64\")",
+        )),
     }
 }
 
