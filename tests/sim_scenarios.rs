@@ -187,3 +187,38 @@ fn integrator_and_emf_baselines_lose_the_angle_at_the_loaded_reversal_where_fado
     .unwrap_err();
     assert_eq!(e.key, "estimator.kind");
 }
+
+#[test]
+fn a_trip_disables_the_gates_and_the_machine_coasts_on_its_diodes() {
+    // A failed phase-a sensor reading 70 A trips the drive (60 A) at the first sample; the
+    // inverter's diodes block (the line back-EMF stays below Vdc), the currents stay zero, and
+    // the load torque drives the shaft backwards.
+    let cfg = "[current_sensor]\noffset_a = 70.0\nenable_quantization = false\n\
+               [simulation]\nduration = 1.5\n";
+    let out = run("fig11", Some(cfg), false);
+    assert!(out.metrics.tripped);
+    assert!(!out.passed);
+    let last = out.trace.rows.last().unwrap();
+    assert_eq!(last.tripped, 1);
+    assert!(
+        last.i_d_true.abs() < 1e-9 && last.i_q_true.abs() < 1e-9,
+        "{last:?}"
+    );
+    // Load torque 7.5 N·m with no drive torque: the shaft is driven negative.
+    assert!(last.speed_rpm < -100.0, "{}", last.speed_rpm);
+}
+
+#[test]
+fn fig9_without_its_kdf_window_reports_instead_of_panicking() {
+    let out = run(
+        "fig9",
+        Some("[simulation]\ndisturbance_feedback_off = []\nduration = 3.0\n"),
+        true,
+    );
+    assert!(!out.passed);
+    assert!(
+        out.checks
+            .iter()
+            .any(|c| c.name == "k_df-off windows configured" && !c.passed)
+    );
+}
