@@ -391,6 +391,14 @@ impl SimConfig {
             .validate()
             .map_err(|e| e.in_section("speed_reference"))?;
         self.plant().validate()?;
+        let rows = self.simulation.duration / self.inverter.sample_period()
+            / self.simulation.decimation as f64;
+        if rows > 2e7 {
+            return Err(SimConfigError::new(
+                "simulation.decimation",
+                format!("the trace would hold {rows:.3e} rows (limit 2e7): raise it"),
+            ));
+        }
         self.mismatch
             .validate()
             .map_err(|e| e.in_section("mismatch"))?;
@@ -550,6 +558,8 @@ mod tests {
         let e = SimConfig::from_toml("[estimator]\nt2s1_bandwidth_hz = -60.0\n").unwrap_err();
         assert_eq!(e.key, "estimator.t2s1_bandwidth_hz", "{e}");
         let e = SimConfig::from_toml("[simulation]\ndecimation = 0\n").unwrap_err();
+        assert_eq!(e.key, "simulation.decimation", "{e}");
+        let e = SimConfig::from_toml("[simulation]\nduration = 50000.0\n").unwrap_err();
         assert_eq!(e.key, "simulation.decimation", "{e}");
         let e = SimConfig::from_toml("[speed_reference]\npoints = [[1.0, 0.0], [0.0, 1.0]]\n")
             .unwrap_err();
