@@ -391,7 +391,8 @@ impl SimConfig {
             .validate()
             .map_err(|e| e.in_section("speed_reference"))?;
         self.plant().validate()?;
-        let rows = self.simulation.duration / self.inverter.sample_period()
+        let rows = self.simulation.duration
+            / self.inverter.sample_period()
             / self.simulation.decimation as f64;
         if rows > 2e7 {
             return Err(SimConfigError::new(

@@ -112,3 +112,40 @@ fn dump_config_round_trips_and_bad_keys_are_named() {
         .unwrap();
     assert!(String::from_utf8(out.stderr).unwrap().contains("motor.rs"));
 }
+
+#[test]
+fn sweep_runs_one_scenario_per_value_and_writes_a_csv() {
+    let dir = tmp_dir("sweep");
+    let cfg = dir.join("short.toml");
+    std::fs::write(&cfg, "[simulation]\nduration = 0.2\n").unwrap();
+    let out = bin()
+        .args([
+            "sweep",
+            "fig11",
+            "--averaged",
+            "--set",
+            "mismatch.rs_ratio=0.9,1.0,1.1",
+        ])
+        .arg("--config")
+        .arg(&cfg)
+        .arg("--out")
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let csv = std::fs::read_to_string(dir.join("sweep.csv")).unwrap();
+    let lines: Vec<_> = csv.lines().collect();
+    assert_eq!(lines.len(), 4, "{csv}");
+    assert!(lines[0].starts_with("mismatch.rs_ratio,passed"));
+    assert!(lines[1].starts_with("0.9,") && lines[3].starts_with("1.1,"));
+    let bad = bin()
+        .args(["sweep", "fig11", "--set", "mismatch.rs_rato=1.0"])
+        .output()
+        .unwrap();
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("mismatch.rs_rato"));
+}

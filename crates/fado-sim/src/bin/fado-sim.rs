@@ -3,12 +3,14 @@
 //! ```text
 //! fado-sim list
 //! fado-sim run fig11 [--config FILE] [--out DIR] [--averaged] [--dump-config]
+//! fado-sim sweep fig11 --set mismatch.rs_ratio=0.98,0.99,1,1.01,1.02 [--averaged]
 //! ```
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+use fado_sim::SimConfig;
 use fado_sim::scenario::{self, SCENARIOS};
 use indicatif::{ProgressBar, ProgressStyle};
 
@@ -43,6 +45,24 @@ enum Command {
         /// Print the effective configuration as TOML and exit without running.
         #[arg(long)]
         dump_config: bool,
+    },
+    /// Run a scenario once per value of one key and tabulate the results (robustness sweeps),
+    /// e.g. `sweep fig11 --set mismatch.rs_ratio=0.98,0.99,1,1.01,1.02`. Writes DIR/sweep.csv.
+    Sweep {
+        /// Scenario name.
+        scenario: String,
+        /// `section.key=v1,v2,...` (TOML values; bare words are taken as strings).
+        #[arg(long)]
+        set: String,
+        /// TOML file applied before the swept key.
+        #[arg(long)]
+        config: Option<PathBuf>,
+        /// Output directory. Default `out/<scenario>-sweep`.
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Use the averaged inverter model.
+        #[arg(long)]
+        averaged: bool,
     },
 }
 
@@ -123,7 +143,100 @@ fn run(cli: Cli) -> Result<ExitCode, Box<dyn std::error::Error>> {
                 ExitCode::from(1)
             })
         }
+        Command::Sweep {
+            scenario: name,
+            set,
+            config,
+            out,
+            averaged,
+        } => sweep(&name, &set, config, out, averaged),
     }
+}
+
+fn sweep(
+    name: &str,
+    set: &str,
+    config: Option<PathBuf>,
+    out: Option<PathBuf>,
+    averaged: bool,
+) -> Result<ExitCode, Box<dyn std::error::Error>> {
+    let (key, values) = set
+        .split_once('=')
+        .ok_or("--set must look like section.key=v1,v2,...")?;
+    let (section, field) = key
+        .rsplit_once('.')
+        .ok_or("--set key must be section.key")?;
+    let text = match &config {
+        Some(p) => Some(std::fs::read_to_string(p)?),
+        None => None,
+    };
+    let base = scenario::scenario_config(name, text.as_deref(), averaged)?;
+    let mut overrides = Vec::new();
+    for v in values.split(',').map(str::trim).filter(|v| !v.is_empty()) {
+        // A TOML value as written, else a bare word as a string.
+        let value = if format!("x = {v}").parse::<toml::Table>().is_ok() {
+            v.to_owned()
+        } else {
+            format!("{v:?}")
+        };
+        let snippet = format!("[{section}]\n{field} = {value}\n");
+        overrides.push((v.to_owned(), SimConfig::from_toml_over(&base, &snippet)?));
+    }
+    // Two at a time: the machine has two cores.
+    let results: Vec<_> = std::thread::scope(|sc| {
+        let handles: Vec<_> = overrides
+            .chunks(overrides.len().div_ceil(2).max(1))
+            .map(|chunk| {
+                sc.spawn(move || {
+                    chunk
+                        .iter()
+                        .map(|(v, cfg)| (v.clone(), scenario::run_config(name, cfg.clone(), None)))
+                        .collect::<Vec<_>>()
+                })
+            })
+            .collect();
+        handles
+            .into_iter()
+            .flat_map(|h| h.join().expect("sweep worker panicked"))
+            .collect()
+    });
+    let dir = out.unwrap_or_else(|| PathBuf::from("out").join(format!("{name}-sweep")));
+    std::fs::create_dir_all(&dir)?;
+    let mut csv = csv::Writer::from_path(dir.join("sweep.csv"))?;
+    csv.write_record([
+        key,
+        "passed",
+        "max_angle_error",
+        "max_angle_error_zero_speed",
+        "rms_angle_error_zero_speed",
+        "max_speed_error_rpm",
+        "tripped",
+    ])?;
+    println!("{key:>24}  passed  max|θ−θ̂|  near 0   rms near 0  speed err  tripped");
+    for (v, r) in results {
+        let r = r?.report();
+        println!(
+            "{v:>24}  {:<6}  {:>8.4}  {:>7.4}  {:>10.4}  {:>9.2}  {}",
+            r.passed,
+            r.max_angle_error,
+            r.max_angle_error_zero_speed,
+            r.rms_angle_error_zero_speed,
+            r.max_speed_error_rpm,
+            r.tripped
+        );
+        csv.write_record([
+            v,
+            r.passed.to_string(),
+            r.max_angle_error.to_string(),
+            r.max_angle_error_zero_speed.to_string(),
+            r.rms_angle_error_zero_speed.to_string(),
+            r.max_speed_error_rpm.to_string(),
+            r.tripped.to_string(),
+        ])?;
+    }
+    csv.flush()?;
+    println!("wrote {}/sweep.csv", dir.display());
+    Ok(ExitCode::SUCCESS)
 }
 
 fn print_table(r: &scenario::Report) {
