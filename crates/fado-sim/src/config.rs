@@ -1,0 +1,569 @@
+//! The whole simulation as one TOML document: plant sections (`[motor]`, `[inverter]`,
+//! `[current_sensor]`, `[dc_link_sensor]`, `[load]`), the speed reference
+//! (`[speed_reference]`), the drive (`[controller]`, `[estimator]`), the estimator's view of
+//! the plant (`[mismatch]`), and run settings (`[simulation]`).
+//!
+//! A file overrides a base configuration (a scenario's) key by key: tables merge, values and
+//! arrays replace. Unknown keys are errors naming the key (`inverter.dead_tme`), and so are
+//! impossible values (`motor.rs: must be > 0`). The estimator's model parameters are never
+//! given directly: they are the plant's times the `[mismatch]` ratios, so "matched" stays
+//! matched when the motor changes.
+
+use fado_core::EstimatorConfig;
+use fado_core::tracker::BandwidthDefinition;
+use serde::{Deserialize, Serialize};
+
+use crate::error::{SimConfigError, check};
+use crate::inverter::InverterParams;
+use crate::load::LoadParams;
+use crate::motor::MotorParams;
+use crate::profile::Profile;
+use crate::sensors::{CurrentSensorParams, DcLinkSensorParams};
+use crate::sim::PlantParams;
+
+/// Run settings.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SimulationSettings {
+    /// Simulated time in s. Default 5 s.
+    pub duration: f64,
+    /// Keep one sample in this many in `traces.csv`. Default 10 (1 kHz).
+    pub decimation: u32,
+    /// True initial electrical rotor angle in rad. Default 0.3 \[A\].
+    pub initial_angle: f64,
+    /// Error of the start-up alignment (the drive starts at θ0 + this), rad. Default 0.
+    pub align_error: f64,
+    /// Metrics are evaluated from this time on, s (start-up excluded). Default 0.
+    pub eval_start: f64,
+    /// "Near zero speed" means |true speed| below this, r/min. Default 30 r/min (2 Hz
+    /// electrical: just above the 1.5 Hz mode threshold) \[A\].
+    pub zero_speed_band_rpm: f64,
+    /// Windows `[t_off, t_on]` in s during which the k_df feedback is switched off (Fig. 9).
+    pub disturbance_feedback_off: Vec<[f64; 2]>,
+}
+
+impl Default for SimulationSettings {
+    fn default() -> Self {
+        Self {
+            duration: 5.0,
+            decimation: 10,
+            initial_angle: 0.3,
+            align_error: 0.0,
+            eval_start: 0.0,
+            zero_speed_band_rpm: 30.0,
+            disturbance_feedback_off: Vec::new(),
+        }
+    }
+}
+
+impl SimulationSettings {
+    fn validate(&self) -> Result<(), SimConfigError> {
+        check::in_range("duration", self.duration, 0.0, 1e5)?;
+        if self.decimation == 0 {
+            return Err(SimConfigError::new("decimation", "must be ≥ 1"));
+        }
+        check::finite("initial_angle", self.initial_angle)?;
+        check::finite("align_error", self.align_error)?;
+        check::non_negative("eval_start", self.eval_start)?;
+        check::positive("zero_speed_band_rpm", self.zero_speed_band_rpm)?;
+        for (k, w) in self.disturbance_feedback_off.iter().enumerate() {
+            if !(w[0].is_finite() && w[1].is_finite() && w[0] <= w[1]) {
+                return Err(SimConfigError::new(
+                    format!("disturbance_feedback_off[{k}]"),
+                    "must be [t_off, t_on] with t_off ≤ t_on",
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Dead-time compensation method (mirrors `fado_core::control::DeadTimeMethod`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DeadTimeMethodSetting {
+    /// V̂·sat(i*/Ic) trapezoid of the reference current (SPEC §5).
+    #[default]
+    Trapezoidal,
+    /// V̂·sign(i) of the measured current.
+    Sign,
+}
+
+/// Voltage limit (mirrors `fado_core::control::VoltageLimit`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum VoltageLimitSetting {
+    /// The inverter hexagon (SVPWM).
+    #[default]
+    Hexagon,
+    /// Its inscribed circle.
+    InscribedCircle,
+}
+
+/// Scalar type the drive runs in.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Precision {
+    /// f64 (analysis).
+    #[default]
+    F64,
+    /// f32, as on the paper's TMS320F28335 (single-precision FPU).
+    F32,
+}
+
+/// The drive's own settings (the model estimates come from `[mismatch]`). Defaults as in
+/// `fado_core::control::DriveConfig`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ControllerSettings {
+    /// Scalar type of the drive (estimator and control). Default f64.
+    pub precision: Precision,
+    /// Current-loop bandwidth, Hz. Default 250 Hz (paper §V).
+    pub current_bandwidth_hz: f64,
+    /// Speed-loop bandwidth, Hz. Default 5 Hz (paper §V).
+    pub speed_bandwidth_hz: f64,
+    /// Speed PI zero ratio (Ki = Kp·ωsc/ratio). Default 5 (SPEC §6).
+    pub speed_zero_ratio: f64,
+    /// Current limit I_max, A. Default 40 A (SPEC §6).
+    pub i_max: f64,
+    /// I_min of the injection (23), A; 0 disables it. Default 4 A (paper §V).
+    pub i_min: f64,
+    /// Dead-time compensation on. Default true.
+    pub dead_time_compensation: bool,
+    /// Compensation method. Default trapezoidal (SPEC §5).
+    pub dead_time_method: DeadTimeMethodSetting,
+    /// Voltage angle advance in samples. Default 1.5 (SPEC §5).
+    pub delay_compensation_factor: f64,
+    /// Over-current trip, A. Default 60 A.
+    pub trip_current: f64,
+    /// Decoupling and back-EMF feed-forward. Default true.
+    pub decoupling: bool,
+    /// Realisable voltage set. Default hexagon.
+    pub voltage_limit: VoltageLimitSetting,
+    /// Usable fraction of the voltage limit. Default 1.
+    pub max_modulation: f64,
+    /// Current PI back-calculation gain (×Ki/Kp). Default 1.
+    pub current_anti_windup_ratio: f64,
+    /// Speed PI back-calculation gain (×Ki/Kp). Default 5.
+    pub speed_anti_windup_ratio: f64,
+}
+
+impl Default for ControllerSettings {
+    fn default() -> Self {
+        Self {
+            precision: Precision::F64,
+            current_bandwidth_hz: 250.0,
+            speed_bandwidth_hz: 5.0,
+            speed_zero_ratio: 5.0,
+            i_max: 40.0,
+            i_min: 4.0,
+            dead_time_compensation: true,
+            dead_time_method: DeadTimeMethodSetting::Trapezoidal,
+            delay_compensation_factor: 1.5,
+            trip_current: 60.0,
+            decoupling: true,
+            voltage_limit: VoltageLimitSetting::Hexagon,
+            max_modulation: 1.0,
+            current_anti_windup_ratio: 1.0,
+            speed_anti_windup_ratio: 5.0,
+        }
+    }
+}
+
+/// Tracker bandwidth meaning (mirrors `fado_core::tracker::BandwidthDefinition`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BandwidthSetting {
+    /// −3 dB frequency of the closed loop (SPEC §3).
+    #[default]
+    Minus3Db,
+    /// Natural frequency ωn.
+    NaturalFrequency,
+}
+
+/// Which rotor-angle estimator the drive runs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EstimatorKind {
+    /// The paper's estimator (`fado_core::SensorlessEstimator`).
+    #[default]
+    Fado,
+    /// Baseline: compensated low-pass integrator (`fado_core::LpfIntegratorEstimator`).
+    LpfIntegrator,
+    /// Baseline: Ortega–Praly nonlinear flux observer (`fado_core::OrtegaEstimator`).
+    Ortega,
+    /// Baseline: extended-EMF observer (`fado_core::EmfObserverEstimator`).
+    EmfObserver,
+}
+
+/// The estimator's own settings (the model estimates come from `[mismatch]`). Defaults as in
+/// `fado_core::EstimatorConfig` (paper §V, SPEC §1–3) and, for the baselines, in
+/// `fado_core::baselines`. The trackers' settings apply to every kind.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct EstimatorSettings {
+    /// Which estimator. Default fado. The baselines run with an f64 drive only.
+    pub kind: EstimatorKind,
+    /// k_df, s⁻¹ (Fig. 3). Default 0.5.
+    pub k_df: f64,
+    /// k_df ramp-in time, s (0 = abrupt). Default 0.
+    pub k_df_ramp_time: f64,
+    /// k_af, s⁻¹ (Fig. 6). Default 2π·100.
+    pub k_af: f64,
+    /// Limiter radius / λ̂f. Default 1.15.
+    pub limiter_radius_ratio: f64,
+    /// Mode threshold, Hz electrical. Default 1.5.
+    pub mode_threshold_hz: f64,
+    /// Mode hysteresis half-band, Hz. Default 0.2.
+    pub mode_hysteresis_hz: f64,
+    /// T2S-1 bandwidth, Hz. Default 60.
+    pub t2s1_bandwidth_hz: f64,
+    /// T2S-2 bandwidth, Hz. Default 35.
+    pub t2s2_bandwidth_hz: f64,
+    /// Tracker damping. Default 1/√2.
+    pub tracker_damping: f64,
+    /// Bandwidth definition. Default −3 dB.
+    pub bandwidth_definition: BandwidthSetting,
+    /// Tracker hold below this |λ̂r|/λ̂f. Default 0.2.
+    pub tracker_hold_ratio: f64,
+    /// Interval-average current in the resistive drop. Default true.
+    pub average_current: bool,
+    /// LPF baseline: cut-off of 1/(s + ωc), Hz. Default as `LpfIntegratorConfig`.
+    pub lpf_cutoff_hz: f64,
+    /// LPF baseline: speed below which its gain/phase compensation is frozen, Hz.
+    pub lpf_compensation_floor_hz: f64,
+    /// Ortega baseline: observer gain, s⁻¹ (when not scheduled on speed).
+    pub ortega_observer_bandwidth: f64,
+    /// Ortega baseline: gain scheduled as this × |ω̂| (0 = fixed gain).
+    pub ortega_observer_speed_ratio: f64,
+    /// Ortega baseline: lower bound of the scheduled gain, s⁻¹.
+    pub ortega_observer_bandwidth_min: f64,
+    /// Ortega baseline: λ̂f adaptation gain ratio (0 = off).
+    pub ortega_flux_adaptation_ratio: f64,
+    /// EMF baseline: observer bandwidth, Hz.
+    pub emf_bandwidth_hz: f64,
+    /// EMF baseline: speed below which the angle is held, Hz.
+    pub emf_speed_floor_hz: f64,
+}
+
+impl Default for EstimatorSettings {
+    fn default() -> Self {
+        let d = EstimatorConfig::<f64>::default();
+        let lpf = fado_core::baselines::LpfIntegratorConfig::<f64>::default();
+        let ortega = fado_core::baselines::OrtegaConfig::<f64>::default();
+        let emf = fado_core::baselines::EmfObserverConfig::<f64>::default();
+        Self {
+            k_df: d.k_df,
+            k_df_ramp_time: d.k_df_ramp_time,
+            k_af: d.k_af,
+            limiter_radius_ratio: d.limiter_radius_ratio,
+            mode_threshold_hz: d.mode_threshold_hz,
+            mode_hysteresis_hz: d.mode_hysteresis_hz,
+            t2s1_bandwidth_hz: d.t2s1_bandwidth_hz,
+            t2s2_bandwidth_hz: d.t2s2_bandwidth_hz,
+            tracker_damping: d.tracker_damping,
+            bandwidth_definition: match d.bandwidth_definition {
+                BandwidthDefinition::Minus3Db => BandwidthSetting::Minus3Db,
+                BandwidthDefinition::NaturalFrequency => BandwidthSetting::NaturalFrequency,
+            },
+            tracker_hold_ratio: d.tracker_hold_ratio,
+            average_current: d.average_current,
+            kind: EstimatorKind::Fado,
+            lpf_cutoff_hz: lpf.cutoff_hz,
+            lpf_compensation_floor_hz: lpf.compensation_floor_hz,
+            ortega_observer_bandwidth: ortega.observer_bandwidth,
+            ortega_observer_speed_ratio: ortega.observer_speed_ratio,
+            ortega_observer_bandwidth_min: ortega.observer_bandwidth_min,
+            ortega_flux_adaptation_ratio: ortega.flux_adaptation_ratio,
+            emf_bandwidth_hz: emf.emf_bandwidth_hz,
+            emf_speed_floor_hz: emf.speed_floor_hz,
+        }
+    }
+}
+
+/// The drive's model of the plant as ratios to the true values (1 = matched). The robustness
+/// sweep of SPEC §7 varies these.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Mismatch {
+    /// R̂s / (Rs + r_on). Default 1.
+    pub rs_ratio: f64,
+    /// L̂d / Ld. Default 1.
+    pub ld_ratio: f64,
+    /// L̂q / Lq. Default 1.
+    pub lq_ratio: f64,
+    /// λ̂f / λf. Default 1.
+    pub flux_linkage_ratio: f64,
+    /// Ĵ / J. Default 1.
+    pub inertia_ratio: f64,
+    /// T̂d / Td of the dead-time compensation. Default 1.
+    pub dead_time_ratio: f64,
+    /// V̂_th / V_th of the dead-time compensation. Default 1.
+    pub threshold_voltage_ratio: f64,
+    /// Îc / Ic of the dead-time compensation. Default 1.
+    pub current_band_ratio: f64,
+}
+
+impl Default for Mismatch {
+    fn default() -> Self {
+        Self {
+            rs_ratio: 1.0,
+            ld_ratio: 1.0,
+            lq_ratio: 1.0,
+            flux_linkage_ratio: 1.0,
+            inertia_ratio: 1.0,
+            dead_time_ratio: 1.0,
+            threshold_voltage_ratio: 1.0,
+            current_band_ratio: 1.0,
+        }
+    }
+}
+
+impl Mismatch {
+    fn validate(&self) -> Result<(), SimConfigError> {
+        for (k, v) in [
+            ("rs_ratio", self.rs_ratio),
+            ("ld_ratio", self.ld_ratio),
+            ("lq_ratio", self.lq_ratio),
+            ("flux_linkage_ratio", self.flux_linkage_ratio),
+            ("inertia_ratio", self.inertia_ratio),
+            ("current_band_ratio", self.current_band_ratio),
+        ] {
+            check::positive(k, v)?;
+        }
+        check::non_negative("dead_time_ratio", self.dead_time_ratio)?;
+        check::non_negative("threshold_voltage_ratio", self.threshold_voltage_ratio)?;
+        Ok(())
+    }
+}
+
+/// The complete, serialisable simulation configuration.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SimConfig {
+    /// Run settings.
+    pub simulation: SimulationSettings,
+    /// Speed reference in r/min (mechanical).
+    pub speed_reference: Profile,
+    /// The PMSM.
+    pub motor: MotorParams,
+    /// Inverter and DC link.
+    pub inverter: InverterParams,
+    /// Phase-current sensors.
+    pub current_sensor: CurrentSensorParams,
+    /// DC-link sensor.
+    pub dc_link_sensor: DcLinkSensorParams,
+    /// Load machine.
+    pub load: LoadParams,
+    /// Drive settings.
+    pub controller: ControllerSettings,
+    /// Estimator settings.
+    pub estimator: EstimatorSettings,
+    /// The drive's model of the plant.
+    pub mismatch: Mismatch,
+}
+
+impl Default for Profile {
+    fn default() -> Self {
+        Profile::constant(0.0)
+    }
+}
+
+impl SimConfig {
+    /// The plant records.
+    pub fn plant(&self) -> PlantParams {
+        PlantParams {
+            motor: self.motor,
+            inverter: self.inverter.clone(),
+            current_sensor: self.current_sensor.clone(),
+            dc_link_sensor: self.dc_link_sensor.clone(),
+            load: self.load.clone(),
+        }
+    }
+
+    /// Checks every section, and the estimator and drive configurations derived from it; the
+    /// error names the key (`section.field`).
+    pub fn validate(&self) -> Result<(), SimConfigError> {
+        self.simulation
+            .validate()
+            .map_err(|e| e.in_section("simulation"))?;
+        self.speed_reference
+            .validate()
+            .map_err(|e| e.in_section("speed_reference"))?;
+        self.plant().validate()?;
+        let rows = self.simulation.duration
+            / self.inverter.sample_period()
+            / self.simulation.decimation as f64;
+        if rows > 2e7 {
+            return Err(SimConfigError::new(
+                "simulation.decimation",
+                format!("the trace would hold {rows:.3e} rows (limit 2e7): raise it"),
+            ));
+        }
+        self.mismatch
+            .validate()
+            .map_err(|e| e.in_section("mismatch"))?;
+        self.estimator_config()
+            .validate()
+            .map_err(|e| SimConfigError::from(e).in_section("estimator"))?;
+        match self.estimator.kind {
+            EstimatorKind::Fado => {}
+            EstimatorKind::LpfIntegrator => drop(self.lpf_estimator()?),
+            EstimatorKind::Ortega => drop(self.ortega_estimator()?),
+            EstimatorKind::EmfObserver => drop(self.emf_estimator()?),
+        }
+        Ok(())
+    }
+
+    /// The estimator configuration: settings of `[estimator]`, model from the plant and
+    /// `[mismatch]`, sampling period from the inverter.
+    pub fn estimator_config(&self) -> EstimatorConfig<f64> {
+        let e = &self.estimator;
+        let m = &self.mismatch;
+        EstimatorConfig {
+            ts: self.inverter.sample_period(),
+            rs_hat: (self.motor.rs + self.inverter.on_resistance) * m.rs_ratio,
+            lq_hat: self.motor.lq * m.lq_ratio,
+            flux_linkage_hat: self.motor.flux_linkage * m.flux_linkage_ratio,
+            k_df: e.k_df,
+            k_df_ramp_time: e.k_df_ramp_time,
+            k_af: e.k_af,
+            limiter_radius_ratio: e.limiter_radius_ratio,
+            mode_threshold_hz: e.mode_threshold_hz,
+            mode_hysteresis_hz: e.mode_hysteresis_hz,
+            t2s1_bandwidth_hz: e.t2s1_bandwidth_hz,
+            t2s2_bandwidth_hz: e.t2s2_bandwidth_hz,
+            tracker_damping: e.tracker_damping,
+            bandwidth_definition: match e.bandwidth_definition {
+                BandwidthSetting::Minus3Db => BandwidthDefinition::Minus3Db,
+                BandwidthSetting::NaturalFrequency => BandwidthDefinition::NaturalFrequency,
+            },
+            tracker_hold_ratio: e.tracker_hold_ratio,
+            average_current: e.average_current,
+            initial_angle: self.simulation.initial_angle + self.simulation.align_error,
+        }
+    }
+
+    /// This configuration as a TOML document.
+    pub fn to_toml(&self) -> String {
+        toml::to_string(self).expect("every field of SimConfig is representable in TOML")
+    }
+
+    /// Parses a complete or partial TOML document on top of `base`: tables merge, values and
+    /// arrays replace. The result is validated. Errors name the key.
+    pub fn from_toml_over(base: &SimConfig, text: &str) -> Result<SimConfig, SimConfigError> {
+        let user: toml::Table = text
+            .parse()
+            .map_err(|e: toml::de::Error| SimConfigError::new("<file>", e.to_string()))?;
+        // Check the user's document on its own first, so that errors (unknown keys, wrong
+        // types) name the key the user wrote.
+        SimConfig::deserialize(toml::Value::Table(user.clone())).map_err(key_error)?;
+        let mut merged = toml::Table::try_from(base)
+            .map_err(|e| SimConfigError::new("<base>", e.to_string()))?;
+        merge(&mut merged, user);
+        let cfg = SimConfig::deserialize(toml::Value::Table(merged)).map_err(key_error)?;
+        cfg.validate()?;
+        Ok(cfg)
+    }
+
+    /// Parses a TOML document over the defaults.
+    pub fn from_toml(text: &str) -> Result<SimConfig, SimConfigError> {
+        Self::from_toml_over(&SimConfig::default(), text)
+    }
+}
+
+fn merge(base: &mut toml::Table, over: toml::Table) {
+    for (k, v) in over {
+        match (base.get_mut(&k), v) {
+            (Some(toml::Value::Table(b)), toml::Value::Table(o)) => merge(b, o),
+            (_, v) => {
+                base.insert(k, v);
+            }
+        }
+    }
+}
+
+/// A serde error from a `toml::Value` carries "in `path`"; unknown fields name the field.
+fn key_error(e: toml::de::Error) -> SimConfigError {
+    let msg = e.to_string();
+    let path = msg
+        .split("in `")
+        .nth(1)
+        .and_then(|s| s.split('`').next())
+        .unwrap_or("")
+        .to_owned();
+    let field = msg
+        .split("unknown field `")
+        .nth(1)
+        .and_then(|s| s.split('`').next());
+    let key = match (field, path.is_empty()) {
+        (Some(f), true) => f.to_owned(),
+        (Some(f), false) => format!("{path}.{f}"),
+        (None, _) => path,
+    };
+    let first_line = msg.lines().next().unwrap_or("").to_owned();
+    SimConfigError::new(
+        if key.is_empty() { "<file>".into() } else { key },
+        first_line,
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::inverter::InverterModel;
+
+    #[test]
+    fn defaults_round_trip_through_toml() {
+        let cfg = SimConfig::default();
+        let text = cfg.to_toml();
+        let back = SimConfig::from_toml(&text).unwrap();
+        assert_eq!(back, cfg);
+    }
+
+    #[test]
+    fn partial_file_overrides_only_its_keys() {
+        let mut base = SimConfig::default();
+        base.load.torque = Profile::constant(7.5);
+        base.simulation.duration = 3.0;
+        let cfg = SimConfig::from_toml_over(
+            &base,
+            "[inverter]\nmodel = \"averaged\"\n[mismatch]\nrs_ratio = 1.02\n",
+        )
+        .unwrap();
+        assert_eq!(cfg.inverter.model, InverterModel::Averaged);
+        assert_eq!(cfg.inverter.dead_time, 2.5e-6);
+        assert_eq!(cfg.load.torque, Profile::constant(7.5));
+        assert_eq!(cfg.simulation.duration, 3.0);
+        assert!((cfg.estimator_config().rs_hat - 0.327 * 1.02).abs() < 1e-15);
+    }
+
+    #[test]
+    fn unknown_keys_are_errors_naming_the_key() {
+        let e = SimConfig::from_toml("[inverter]\ndead_tme = 1e-6\n").unwrap_err();
+        assert_eq!(e.key, "inverter.dead_tme", "{e}");
+        let e = SimConfig::from_toml("[motorr]\nrs = 1.0\n").unwrap_err();
+        assert_eq!(e.key, "motorr", "{e}");
+        let e = SimConfig::from_toml("[load.torque]\npoints = [[0.0, 1.0]]\nx = 1\n").unwrap_err();
+        assert_eq!(e.key, "load.torque.x", "{e}");
+    }
+
+    #[test]
+    fn wrong_types_and_impossible_values_name_the_key() {
+        let e = SimConfig::from_toml("[inverter]\nmodel = \"fast\"\n").unwrap_err();
+        assert_eq!(e.key, "inverter.model", "{e}");
+        let e = SimConfig::from_toml("[motor]\nrs = \"big\"\n").unwrap_err();
+        assert_eq!(e.key, "motor.rs", "{e}");
+        let e = SimConfig::from_toml("[motor]\nrs = -0.3\n").unwrap_err();
+        assert_eq!(e.key, "motor.rs", "{e}");
+        let e = SimConfig::from_toml("[estimator]\nt2s1_bandwidth_hz = -60.0\n").unwrap_err();
+        assert_eq!(e.key, "estimator.t2s1_bandwidth_hz", "{e}");
+        let e = SimConfig::from_toml("[simulation]\ndecimation = 0\n").unwrap_err();
+        assert_eq!(e.key, "simulation.decimation", "{e}");
+        let e = SimConfig::from_toml("[simulation]\nduration = 50000.0\n").unwrap_err();
+        assert_eq!(e.key, "simulation.decimation", "{e}");
+        let e = SimConfig::from_toml("[speed_reference]\npoints = [[1.0, 0.0], [0.0, 1.0]]\n")
+            .unwrap_err();
+        assert_eq!(e.key, "speed_reference.points[1]", "{e}");
+    }
+}

@@ -1,0 +1,62 @@
+//! What the closed loop needs from a controller: one call per sample with the measurements,
+//! returning the duty for the next update and what the controller believes (for the traces).
+//! The sensorless drive of `fado-core` implements it ([`crate::drive`]); so can sensored
+//! reference controllers in tests.
+
+use fado_core::{Ab, Abc, Dq, Estimate};
+
+/// Everything a controller may read at sample n.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Measurements {
+    /// Time of the sample in s.
+    pub time: f64,
+    /// Measured phase currents (through the sensor model), A.
+    pub i_abc: Abc<f64>,
+    /// Measured DC-link voltage, V.
+    pub vdc: f64,
+    /// Speed reference, mechanical rad/s.
+    pub speed_ref_mech: f64,
+    /// Encoder angle, mechanical rad (5000 ppr): for sensored reference controllers and
+    /// evaluation only — a sensorless controller must not read it.
+    pub encoder_angle_mech: f64,
+}
+
+/// A controller's answer at sample n.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Actuation {
+    /// Duties in [0, 1], loaded at n+1, acting over [n+1, n+2].
+    pub duty: Abc<f64>,
+    /// Gates enabled (false after a trip: the diodes conduct).
+    pub gates_enabled: bool,
+    /// The controller tripped.
+    pub tripped: bool,
+    /// The controller rejected this sample's inputs.
+    pub input_fault: bool,
+    /// Realised voltage reference (α-β), V.
+    pub v_ref_ab: Ab<f64>,
+    /// Measured current in the controller's (estimated) rotor frame, A.
+    pub i_dq: Dq<f64>,
+    /// Current reference, A.
+    pub i_dq_ref: Dq<f64>,
+    /// The rotor-angle estimate (a sensored controller reports its encoder angle here).
+    pub estimate: Estimate<f64>,
+}
+
+/// Scenario events a controller may act on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ControlEvent {
+    /// Switch the k_df disturbance feedback on or off (the experiment of Fig. 9).
+    DisturbanceFeedback(bool),
+}
+
+/// A closed-loop controller run by [`crate::sim::Simulation`].
+pub trait Controller {
+    /// Start-up at a known rotor angle θ0 (electrical rad), e.g. after an alignment.
+    fn align(&mut self, theta0: f64);
+    /// One sample.
+    fn step(&mut self, m: &Measurements) -> Actuation;
+    /// A scenario event; controllers without the feature ignore it.
+    fn handle(&mut self, _event: ControlEvent) {}
+    /// Short name for tables.
+    fn name(&self) -> &str;
+}

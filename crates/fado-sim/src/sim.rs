@@ -1,0 +1,689 @@
+//! The closed loop, one sample at a time: sense → control → switch → move.
+//!
+//! At sample n (time n·Ts, a carrier peak or valley) the sensors read the true currents and the
+//! DC link, the controller computes the duty for n+1, and the plant integrates [n, n+1] with
+//! the duty the controller computed at n−1 (one sample of computational delay). Each sample is
+//! handed to [`Probe`]s: the metrics, the decimated trace and the scenarios' criteria.
+
+use std::time::Instant;
+
+use fado_core::{Abc, Dq, wrap_angle};
+use serde::{Deserialize, Serialize};
+
+use crate::controller::{Actuation, ControlEvent, Controller, Measurements};
+use crate::error::SimConfigError;
+use crate::inverter::{Inverter, InverterParams, SampleOutcome};
+use crate::load::{Load, LoadParams};
+use crate::motor::{Motor, MotorParams};
+use crate::profile::Profile;
+use crate::sensors::{CurrentSensor, CurrentSensorParams, DcLinkSensorParams, Encoder};
+
+const RPM_PER_RAD_S: f64 = 60.0 / std::f64::consts::TAU;
+
+/// Everything physical: machine, inverter, sensors, load.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct PlantParams {
+    /// The PMSM.
+    pub motor: MotorParams,
+    /// Inverter and DC link.
+    pub inverter: InverterParams,
+    /// Phase-current sensors.
+    pub current_sensor: CurrentSensorParams,
+    /// DC-link voltage sensor.
+    pub dc_link_sensor: DcLinkSensorParams,
+    /// Load machine.
+    pub load: LoadParams,
+}
+
+impl PlantParams {
+    /// Checks every record; the error names the key as `section.field`.
+    pub fn validate(&self) -> Result<(), SimConfigError> {
+        self.motor.validate().map_err(|e| e.in_section("motor"))?;
+        self.inverter
+            .validate()
+            .map_err(|e| e.in_section("inverter"))?;
+        self.current_sensor
+            .validate()
+            .map_err(|e| e.in_section("current_sensor"))?;
+        self.dc_link_sensor
+            .validate()
+            .map_err(|e| e.in_section("dc_link_sensor"))?;
+        self.load.validate().map_err(|e| e.in_section("load"))?;
+        Ok(())
+    }
+}
+
+/// The plant: machine, inverter, sensors and load machine.
+#[derive(Clone, Debug)]
+pub struct Plant {
+    motor: Motor,
+    inverter: Inverter,
+    current_sensor: CurrentSensor,
+    dc_link_sensor: DcLinkSensorParams,
+    load: Load,
+    encoder: Encoder,
+    load_torque: f64,
+    last: SampleOutcome,
+}
+
+impl Plant {
+    /// A plant at rest at electrical angle `theta0`.
+    pub fn new(params: &PlantParams, theta0: f64) -> Result<Self, SimConfigError> {
+        params.validate()?;
+        let s = |e: SimConfigError, sec: &str| e.in_section(sec);
+        Ok(Self {
+            motor: Motor::new(params.motor, theta0).map_err(|e| s(e, "motor"))?,
+            inverter: Inverter::new(params.inverter.clone()).map_err(|e| s(e, "inverter"))?,
+            current_sensor: CurrentSensor::new(params.current_sensor.clone())
+                .map_err(|e| s(e, "current_sensor"))?,
+            dc_link_sensor: params.dc_link_sensor.clone(),
+            load: Load::new(params.load.clone(), params.motor.inertia).map_err(|e| s(e, "load"))?,
+            encoder: Encoder::default(),
+            load_torque: 0.0,
+            last: SampleOutcome::default(),
+        })
+    }
+
+    /// The machine (true state).
+    pub fn motor(&self) -> &Motor {
+        &self.motor
+    }
+
+    /// The machine, mutable (initial conditions).
+    pub fn motor_mut(&mut self) -> &mut Motor {
+        &mut self.motor
+    }
+
+    /// The inverter.
+    pub fn inverter(&self) -> &Inverter {
+        &self.inverter
+    }
+
+    /// Sampling period Ts.
+    pub fn sample_period(&self) -> f64 {
+        self.inverter.sample_period()
+    }
+
+    /// Time of the present sample.
+    pub fn time(&self) -> f64 {
+        self.inverter.time()
+    }
+
+    /// Load torque applied over the last sample (N·m, positive opposing positive rotation).
+    pub fn load_torque(&self) -> f64 {
+        self.load_torque
+    }
+
+    /// What the last sample did (average torque and voltage).
+    pub fn last_outcome(&self) -> &SampleOutcome {
+        &self.last
+    }
+
+    /// True phase currents.
+    pub fn phase_currents(&self) -> Abc<f64> {
+        self.motor.i_ab().to_abc()
+    }
+
+    /// Samples the sensors now: (currents, DC-link voltage, encoder mechanical angle).
+    pub fn measure(&mut self) -> (Abc<f64>, f64, f64) {
+        let i = self.current_sensor.measure(self.phase_currents());
+        let vdc = self.dc_link_sensor.measure(self.inverter.dc_voltage());
+        let enc = self.encoder.angle_mech(self.motor.state().theta_mech);
+        (i, vdc, enc)
+    }
+
+    /// Integrates one sample [n, n+1] and loads `duty_next` for [n+1, n+2].
+    pub fn step(&mut self, duty_next: Abc<f64>, gates_enabled: bool) -> SampleOutcome {
+        let ts = self.sample_period();
+        let t = self.time();
+        self.load_torque = self.load.torque(t, self.motor.state().omega_mech, ts);
+        let out = self
+            .inverter
+            .step(&mut self.motor, duty_next, gates_enabled);
+        self.motor
+            .advance_mechanical(ts, out.torque_avg, self.load_torque);
+        self.last = out;
+        out
+    }
+}
+
+/// Wraps a difference of two wrapped angles (within ±3π) into [−π, π] without a division.
+#[inline]
+fn wrap_small(x: f64) -> f64 {
+    use std::f64::consts::{PI, TAU};
+    if x > PI {
+        x - TAU
+    } else if x < -PI {
+        x + TAU
+    } else if x.is_finite() {
+        x
+    } else {
+        wrap_angle(x)
+    }
+}
+
+/// Everything known about one sample: true plant state and the controller's view.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Sample {
+    /// Time in s.
+    pub time: f64,
+    /// True electrical rotor angle θ, rad.
+    pub theta: f64,
+    /// Angle error wrap(θ − θ̂), rad.
+    pub angle_error: f64,
+    /// True speed, r/min (mechanical).
+    pub speed_rpm: f64,
+    /// Speed reference, r/min.
+    pub speed_ref_rpm: f64,
+    /// Estimated speed (T2S-2, for control), r/min.
+    pub speed_hat_rpm: f64,
+    /// True current in the true rotor frame, A.
+    pub i_dq_true: Dq<f64>,
+    /// True stator flux in α-β (what λ2 estimates), Wb.
+    pub flux_ab_true: fado_core::Ab<f64>,
+    /// Electromagnetic torque over the previous sample, N·m.
+    pub torque: f64,
+    /// Load torque over the previous sample, N·m.
+    pub load_torque: f64,
+    /// Pole pairs (to convert the controller's electrical speeds).
+    pub pole_pairs: f64,
+    /// Stator voltage the inverter actually applied over the previous sample [n−1, n]
+    /// (time average, α-β), V.
+    pub v_ab_applied: fado_core::Ab<f64>,
+    /// The controller's output at this sample.
+    pub act: Actuation,
+}
+
+/// Something that watches every sample (metrics, traces, scenario criteria).
+pub trait Probe {
+    /// Called once per sample.
+    fn observe(&mut self, s: &Sample);
+    /// Called once at the end of [`Simulation::run`] (e.g. to form RMS values).
+    fn finish(&mut self) {}
+}
+
+/// The closed loop: plant + controller + speed reference + timed controller events.
+pub struct Simulation<C> {
+    plant: Plant,
+    controller: C,
+    speed_ref_rpm: Profile,
+    events: Vec<(f64, ControlEvent)>,
+    next_event: usize,
+    speed_cursor: usize,
+    pole_pairs: f64,
+    tripped: bool,
+}
+
+impl<C: Controller> Simulation<C> {
+    /// A closed loop with the plant at rest at `theta0`; the controller is aligned to
+    /// `theta0 + align_error` (a known or aligned start, SPEC §1 step 6).
+    pub fn new(
+        plant: Plant,
+        mut controller: C,
+        speed_ref_rpm: Profile,
+        align_error: f64,
+    ) -> Result<Self, SimConfigError> {
+        speed_ref_rpm
+            .validate()
+            .map_err(|e| e.in_section("speed_reference"))?;
+        controller.align(plant.motor().state().theta + align_error);
+        let pole_pairs = plant.motor().params().pole_pairs as f64;
+        Ok(Self {
+            plant,
+            controller,
+            speed_ref_rpm,
+            events: Vec::new(),
+            next_event: 0,
+            speed_cursor: 0,
+            pole_pairs,
+            tripped: false,
+        })
+    }
+
+    /// Adds timed controller events (e.g. k_df off/on), any order.
+    pub fn with_events(mut self, mut events: Vec<(f64, ControlEvent)>) -> Self {
+        events.sort_by(|a, b| a.0.total_cmp(&b.0));
+        self.events = events;
+        self
+    }
+
+    /// The plant.
+    pub fn plant(&self) -> &Plant {
+        &self.plant
+    }
+
+    /// The controller.
+    pub fn controller(&self) -> &C {
+        &self.controller
+    }
+
+    /// The controller, mutable.
+    pub fn controller_mut(&mut self) -> &mut C {
+        &mut self.controller
+    }
+
+    /// Whether the controller has tripped at any sample so far.
+    pub fn tripped(&self) -> bool {
+        self.tripped
+    }
+
+    /// One sample: sense, control, record, integrate to the next sample.
+    #[inline]
+    pub fn step(&mut self) -> Sample {
+        let t = self.plant.time();
+        while let Some(&(te, ev)) = self.events.get(self.next_event) {
+            if te > t {
+                break;
+            }
+            self.controller.handle(ev);
+            self.next_event += 1;
+        }
+        let (i_abc, vdc, enc) = self.plant.measure();
+        let speed_ref_rpm = self.speed_ref_rpm.value_from(t, &mut self.speed_cursor);
+        let m = Measurements {
+            time: t,
+            i_abc,
+            vdc,
+            speed_ref_mech: speed_ref_rpm / RPM_PER_RAD_S,
+            encoder_angle_mech: enc,
+        };
+        let act = self.controller.step(&m);
+        self.tripped |= act.tripped;
+        let st = *self.plant.motor().state();
+        let sample = Sample {
+            time: t,
+            theta: st.theta,
+            angle_error: wrap_small(st.theta - act.estimate.theta),
+            speed_rpm: st.omega_mech * RPM_PER_RAD_S,
+            speed_ref_rpm,
+            speed_hat_rpm: act.estimate.omega_control / self.pole_pairs * RPM_PER_RAD_S,
+            i_dq_true: st.i_dq,
+            flux_ab_true: self.plant.motor().flux_ab(),
+            torque: self.plant.last_outcome().torque_avg,
+            load_torque: self.plant.load_torque(),
+            v_ab_applied: self.plant.last_outcome().v_ab_avg,
+            pole_pairs: self.pole_pairs,
+            act,
+        };
+        self.plant.step(act.duty, act.gates_enabled);
+        sample
+    }
+
+    /// Runs for `duration` seconds, handing every sample to the probes; `progress` (if any) is
+    /// called with the completed fraction about a hundred times. Returns the statistics.
+    pub fn run(
+        &mut self,
+        duration: f64,
+        probes: &mut [&mut dyn Probe],
+        mut progress: Option<&mut dyn FnMut(f64)>,
+    ) -> RunStats {
+        let ts = self.plant.sample_period();
+        let n = (duration / ts).round().max(0.0) as u64;
+        let chunk = (n / 100).max(1);
+        let start = Instant::now();
+        for k in 0..n {
+            let s = self.step();
+            for p in probes.iter_mut() {
+                p.observe(&s);
+            }
+            if let Some(cb) = progress.as_mut()
+                && (k + 1) % chunk == 0
+            {
+                cb((k + 1) as f64 / n as f64);
+            }
+        }
+        for p in probes.iter_mut() {
+            p.finish();
+        }
+        RunStats {
+            simulated_seconds: n as f64 * ts,
+            wall_seconds: start.elapsed().as_secs_f64(),
+            samples: n,
+        }
+    }
+}
+
+/// Timing of a run.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct RunStats {
+    /// Simulated time in s.
+    pub simulated_seconds: f64,
+    /// Wall-clock time in s.
+    pub wall_seconds: f64,
+    /// Samples run.
+    pub samples: u64,
+}
+
+impl RunStats {
+    /// Simulated seconds per wall-clock second.
+    pub fn real_time_factor(&self) -> f64 {
+        self.simulated_seconds / self.wall_seconds.max(1e-12)
+    }
+}
+
+/// Angle and speed accuracy over an evaluation window.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Metrics {
+    /// Evaluation starts at this time, s (start-up excluded).
+    pub eval_start: f64,
+    /// |speed| below this (true, r/min) counts as "near zero speed".
+    pub zero_speed_band_rpm: f64,
+    /// Samples evaluated.
+    pub samples: u64,
+    /// Samples near zero speed.
+    pub zero_speed_samples: u64,
+    /// max |θ − θ̂|, rad (electrical).
+    pub max_angle_error: f64,
+    /// RMS of θ − θ̂, rad.
+    pub rms_angle_error: f64,
+    /// max |θ − θ̂| near zero speed, rad.
+    pub max_angle_error_zero_speed: f64,
+    /// RMS of θ − θ̂ near zero speed, rad.
+    pub rms_angle_error_zero_speed: f64,
+    /// max |n* − n| (reference minus true speed), r/min.
+    pub max_speed_error_rpm: f64,
+    /// The controller tripped (at any time, also before the window).
+    pub tripped: bool,
+    #[serde(skip)]
+    sum_sq: f64,
+    #[serde(skip)]
+    sum_sq_zero: f64,
+}
+
+impl Metrics {
+    /// Metrics from `eval_start` on, with the given zero-speed band.
+    pub fn new(eval_start: f64, zero_speed_band_rpm: f64) -> Self {
+        Self {
+            eval_start,
+            zero_speed_band_rpm,
+            ..Self::default()
+        }
+    }
+}
+
+impl Probe for Metrics {
+    fn finish(&mut self) {
+        self.rms_angle_error = (self.sum_sq / self.samples.max(1) as f64).sqrt();
+        self.rms_angle_error_zero_speed =
+            (self.sum_sq_zero / self.zero_speed_samples.max(1) as f64).sqrt();
+    }
+
+    fn observe(&mut self, s: &Sample) {
+        self.tripped |= s.act.tripped;
+        if s.time < self.eval_start {
+            return;
+        }
+        let e = s.angle_error;
+        self.samples += 1;
+        self.sum_sq += e * e;
+        self.max_angle_error = self.max_angle_error.max(e.abs());
+        if s.speed_rpm.abs() < self.zero_speed_band_rpm {
+            self.zero_speed_samples += 1;
+            self.sum_sq_zero += e * e;
+            self.max_angle_error_zero_speed = self.max_angle_error_zero_speed.max(e.abs());
+        }
+        self.max_speed_error_rpm = self
+            .max_speed_error_rpm
+            .max((s.speed_ref_rpm - s.speed_rpm).abs());
+    }
+}
+
+/// One decimated row of the trace (the columns of `traces.csv`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct TraceRow {
+    /// Time, s.
+    pub time: f64,
+    /// True electrical angle, rad.
+    pub theta: f64,
+    /// Estimated electrical angle θ̂ (T2S-1), rad.
+    pub theta_hat: f64,
+    /// wrap(θ − θ̂), rad.
+    pub angle_error: f64,
+    /// True speed, r/min.
+    pub speed_rpm: f64,
+    /// Estimated speed (T2S-2), r/min.
+    pub speed_hat_rpm: f64,
+    /// Observer speed (T2S-1), r/min.
+    pub speed_hat1_rpm: f64,
+    /// Speed reference, r/min.
+    pub speed_ref_rpm: f64,
+    /// d current in the controller's frame, A.
+    pub i_d: f64,
+    /// q current in the controller's frame, A.
+    pub i_q: f64,
+    /// d current reference, A.
+    pub i_d_ref: f64,
+    /// q current reference, A.
+    pub i_q_ref: f64,
+    /// True d current, A.
+    pub i_d_true: f64,
+    /// True q current, A.
+    pub i_q_true: f64,
+    /// λ1 α, Wb.
+    pub lambda1_alpha: f64,
+    /// λ1 β, Wb.
+    pub lambda1_beta: f64,
+    /// D̂ α, Wb.
+    pub dist_alpha: f64,
+    /// D̂ β, Wb.
+    pub dist_beta: f64,
+    /// λ2 α, Wb.
+    pub lambda2_alpha: f64,
+    /// λ2 β, Wb.
+    pub lambda2_beta: f64,
+    /// λ̂r α, Wb.
+    pub lambda_r_alpha: f64,
+    /// λ̂r β, Wb.
+    pub lambda_r_beta: f64,
+    /// True stator flux α, Wb.
+    pub flux_alpha_true: f64,
+    /// True stator flux β, Wb.
+    pub flux_beta_true: f64,
+    /// FLAG_limit (limiter mode), 0/1.
+    pub flag_limit: u8,
+    /// Limiter clamping this sample, 0/1.
+    pub limiter_clamping: u8,
+    /// Trackers holding, 0/1.
+    pub tracker_hold: u8,
+    /// Tripped, 0/1.
+    pub tripped: u8,
+    /// Electromagnetic torque, N·m.
+    pub torque: f64,
+    /// Load torque, N·m.
+    pub load_torque: f64,
+}
+
+impl TraceRow {
+    /// Column names, in CSV order (for struct-of-arrays consumers such as the Python
+    /// bindings).
+    pub const COLUMNS: [&'static str; 30] = [
+        "time",
+        "theta",
+        "theta_hat",
+        "angle_error",
+        "speed_rpm",
+        "speed_hat_rpm",
+        "speed_hat1_rpm",
+        "speed_ref_rpm",
+        "i_d",
+        "i_q",
+        "i_d_ref",
+        "i_q_ref",
+        "i_d_true",
+        "i_q_true",
+        "lambda1_alpha",
+        "lambda1_beta",
+        "dist_alpha",
+        "dist_beta",
+        "lambda2_alpha",
+        "lambda2_beta",
+        "lambda_r_alpha",
+        "lambda_r_beta",
+        "flux_alpha_true",
+        "flux_beta_true",
+        "flag_limit",
+        "limiter_clamping",
+        "tracker_hold",
+        "tripped",
+        "torque",
+        "load_torque",
+    ];
+
+    /// The row's values in [`COLUMNS`](Self::COLUMNS) order (flags as 0.0/1.0).
+    pub fn values(&self) -> [f64; 30] {
+        [
+            self.time,
+            self.theta,
+            self.theta_hat,
+            self.angle_error,
+            self.speed_rpm,
+            self.speed_hat_rpm,
+            self.speed_hat1_rpm,
+            self.speed_ref_rpm,
+            self.i_d,
+            self.i_q,
+            self.i_d_ref,
+            self.i_q_ref,
+            self.i_d_true,
+            self.i_q_true,
+            self.lambda1_alpha,
+            self.lambda1_beta,
+            self.dist_alpha,
+            self.dist_beta,
+            self.lambda2_alpha,
+            self.lambda2_beta,
+            self.lambda_r_alpha,
+            self.lambda_r_beta,
+            self.flux_alpha_true,
+            self.flux_beta_true,
+            self.flag_limit as f64,
+            self.limiter_clamping as f64,
+            self.tracker_hold as f64,
+            self.tripped as f64,
+            self.torque,
+            self.load_torque,
+        ]
+    }
+}
+
+impl From<&Sample> for TraceRow {
+    fn from(s: &Sample) -> Self {
+        let d = &s.act.estimate.diagnostics;
+        Self {
+            time: s.time,
+            theta: s.theta,
+            theta_hat: s.act.estimate.theta,
+            angle_error: s.angle_error,
+            speed_rpm: s.speed_rpm,
+            speed_hat_rpm: s.speed_hat_rpm,
+            speed_hat1_rpm: s.act.estimate.omega / s.pole_pairs * RPM_PER_RAD_S,
+            speed_ref_rpm: s.speed_ref_rpm,
+            i_d: s.act.i_dq.d,
+            i_q: s.act.i_dq.q,
+            i_d_ref: s.act.i_dq_ref.d,
+            i_q_ref: s.act.i_dq_ref.q,
+            i_d_true: s.i_dq_true.d,
+            i_q_true: s.i_dq_true.q,
+            lambda1_alpha: d.lambda1.alpha,
+            lambda1_beta: d.lambda1.beta,
+            dist_alpha: d.disturbance.alpha,
+            dist_beta: d.disturbance.beta,
+            lambda2_alpha: d.lambda2.alpha,
+            lambda2_beta: d.lambda2.beta,
+            lambda_r_alpha: d.lambda_r.alpha,
+            lambda_r_beta: d.lambda_r.beta,
+            flux_alpha_true: s.flux_ab_true.alpha,
+            flux_beta_true: s.flux_ab_true.beta,
+            flag_limit: d.flag_limit as u8,
+            limiter_clamping: d.limiter_clamping as u8,
+            tracker_hold: d.tracker_hold as u8,
+            tripped: s.act.tripped as u8,
+            torque: s.torque,
+            load_torque: s.load_torque,
+        }
+    }
+}
+
+/// Keeps every `decimation`-th sample as a [`TraceRow`].
+#[derive(Clone, Debug, Default)]
+pub struct Trace {
+    /// Keep one sample in this many (≥ 1).
+    pub decimation: u32,
+    /// The rows kept.
+    pub rows: Vec<TraceRow>,
+    count: u64,
+}
+
+impl Trace {
+    /// An empty trace keeping one sample in `decimation`.
+    pub fn new(decimation: u32) -> Self {
+        Self {
+            decimation: decimation.max(1),
+            rows: Vec::new(),
+            count: 0,
+        }
+    }
+
+    /// One column of the trace by name (see [`TraceRow::COLUMNS`]).
+    pub fn column(&self, name: &str) -> Option<Vec<f64>> {
+        let k = TraceRow::COLUMNS.iter().position(|c| *c == name)?;
+        Some(self.rows.iter().map(|r| r.values()[k]).collect())
+    }
+
+    /// Writes the rows as CSV with a header.
+    pub fn write_csv<W: std::io::Write>(&self, w: W) -> Result<(), csv::Error> {
+        let mut wr = csv::Writer::from_writer(w);
+        for r in &self.rows {
+            wr.serialize(r)?;
+        }
+        wr.flush()?;
+        Ok(())
+    }
+}
+
+impl Probe for Trace {
+    fn observe(&mut self, s: &Sample) {
+        if self.count.is_multiple_of(self.decimation as u64) {
+            self.rows.push(TraceRow::from(s));
+        }
+        self.count += 1;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn csv_header_is_the_column_list_and_values_follow_it() {
+        let mut t = Trace::new(1);
+        let mut s = Sample {
+            time: 0.25,
+            speed_rpm: -12.0,
+            pole_pairs: 4.0,
+            ..Default::default()
+        };
+        s.act.estimate.omega = -2.0 * std::f64::consts::TAU; // −30 r/min with 4 pole pairs
+        s.act.estimate.diagnostics.flag_limit = true;
+        s.act.i_dq_ref = Dq::new(4.0, -1.5);
+        t.observe(&s);
+        let mut buf = Vec::new();
+        t.write_csv(&mut buf).unwrap();
+        let text = String::from_utf8(buf).unwrap();
+        let mut lines = text.lines();
+        assert_eq!(lines.next().unwrap(), TraceRow::COLUMNS.join(","));
+        let values: Vec<f64> = lines
+            .next()
+            .unwrap()
+            .split(',')
+            .map(|v| v.parse().unwrap())
+            .collect();
+        assert_eq!(values, t.rows[0].values().to_vec());
+        assert_eq!(t.column("i_q_ref").unwrap(), vec![-1.5]);
+        assert_eq!(t.column("flag_limit").unwrap(), vec![1.0]);
+        assert_eq!(t.column("speed_rpm").unwrap(), vec![-12.0]);
+        assert!((t.column("speed_hat1_rpm").unwrap()[0] + 30.0).abs() < 1e-12);
+        assert!(t.column("nope").is_none());
+    }
+}
