@@ -29,7 +29,7 @@ if [[ ! -d "$venv" ]]; then
 fi
 "$venv/bin/python" -m pip install --quiet --upgrade pip || echo "pip upgrade failed (offline?): keeping the venv's pip"
 # Builds the extension through its maturin build backend (pip fetches maturin as needed).
-"$venv/bin/python" -m pip install --quiet '.[plot,pandas]' pytest
+"$venv/bin/python" -m pip install --quiet '.[plot,pandas,test]'
 
 if [[ ! -d tests/python ]]; then
     echo "no tests/python: Python tests skipped"
