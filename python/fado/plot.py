@@ -77,6 +77,18 @@ def _angle_error(ax: Axes, r: SimResult, criterion: bool) -> None:
     t = _col(r, "time")
     ax.plot(t, _col(r, "angle_error"), color="C2", lw=1.0, label="θ − θ̂")
     if criterion:
+        band = float(r.metrics["zero_speed_band_rpm"])
+        ax.fill_between(
+            t,
+            0,
+            1,
+            where=np.abs(_col(r, "speed_rpm")) < band,
+            transform=ax.get_xaxis_transform(),
+            color="C1",
+            alpha=0.12,
+            lw=0,
+            label=f"|n| < {band:g} r/min",
+        )
         for sign in (1.0, -1.0):
             ax.axhline(
                 sign * ANGLE_CRITERION,
@@ -167,7 +179,7 @@ def _figure(
     shade: Sequence[tuple[float, float]] = (),
 ) -> Figure:
     Figure, FigureCanvasAgg = _matplotlib()
-    fig = Figure(figsize=(9.0, 1.9 * len(panels) + 0.9), layout="constrained")
+    fig = Figure(figsize=(10.0, 1.9 * len(panels) + 0.9), layout="constrained")
     FigureCanvasAgg(fig)
     axes = fig.subplots(len(panels), 1, sharex=True, squeeze=False)[:, 0]
     for ax, draw in zip(axes, panels):
@@ -175,7 +187,8 @@ def _figure(
         for t0, t1 in shade:
             ax.axvspan(t0, t1, color="C3", alpha=0.08, lw=0)
         ax.grid(True, lw=0.4, alpha=0.5)
-        ax.legend(loc="upper left", fontsize=7, ncol=4, framealpha=0.7)
+        # Channel labels beside the trace, as on an oscilloscope, never over it.
+        ax.legend(loc="upper left", bbox_to_anchor=(1.005, 1.0), fontsize=7, frameon=False)
     axes[-1].set_xlabel("time (s)")
     m = result.metrics
     verdict = "passed" if result.passed else "FAILED"
