@@ -17,7 +17,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 from fado._fado import FadoError, default_config, describe_scenario, scenarios
@@ -69,7 +69,7 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
-def _write_csv(path: Path, traces: dict[str, object]) -> None:
+def _write_csv(path: Path, traces: Mapping[str, object]) -> None:
     import numpy as np
 
     names = list(traces)

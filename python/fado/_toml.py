@@ -69,8 +69,8 @@ def _value(key: str, value: Any) -> str:
     if isinstance(value, str):
         return json.dumps(value)  # JSON string escapes are valid TOML basic-string escapes
     if isinstance(value, Mapping):
-        items = ", ".join(f"{_key(k)} = {_value(f'{key}.{k}', v)}" for k, v in value.items())
-        return "{" + items + "}"
+        pairs = ", ".join(f"{_key(k)} = {_value(f'{key}.{k}', v)}" for k, v in value.items())
+        return "{" + pairs + "}"
     if isinstance(value, Sequence) or _is_array(value):
         items = [_value(f"{key}[{i}]", v) for i, v in enumerate(_to_list(value))]
         return "[" + ", ".join(items) + "]"

@@ -178,9 +178,9 @@ def _figure(
     path: str | os.PathLike[str] | None,
     shade: Sequence[tuple[float, float]] = (),
 ) -> Figure:
-    Figure, FigureCanvasAgg = _matplotlib()
-    fig = Figure(figsize=(10.0, 1.9 * len(panels) + 0.9), layout="constrained")
-    FigureCanvasAgg(fig)
+    figure_class, canvas_class = _matplotlib()
+    fig = figure_class(figsize=(10.0, 1.9 * len(panels) + 0.9), layout="constrained")
+    canvas_class(fig)
     axes = fig.subplots(len(panels), 1, sharex=True, squeeze=False)[:, 0]
     for ax, draw in zip(axes, panels):
         draw(ax, result)
@@ -201,7 +201,8 @@ def _figure(
     )
     if path is not None:
         fig.savefig(os.fspath(path), dpi=110)
-    return fig
+    figure: Figure = fig
+    return figure
 
 
 def _title(result: SimResult) -> str:
@@ -283,4 +284,5 @@ def plot_scenario(result: SimResult, path: str | os.PathLike[str] | None = None)
         raise ValueError(
             f"no figure for scenario {result.scenario!r}; one of {sorted(_BY_SCENARIO)}"
         ) from None
-    return plot(result, path)
+    figure: Figure = plot(result, path)
+    return figure

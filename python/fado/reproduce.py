@@ -11,7 +11,7 @@ import json
 import os
 import sys
 import time
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any
@@ -83,9 +83,11 @@ def reproduce(
     unknown = [n for n in names if n not in known]
     if unknown:
         raise ValueError(f"unknown scenario(s) {unknown}; one of {sorted(known)}")
-    plot_scenario = None
+    plot: Callable[[Any, Path], object] | None = None
     if plots:
         from fado.plot import plot_scenario  # needs matplotlib: fail before the long runs
+
+        plot = plot_scenario
     out_dir = Path(out)
     out_dir.mkdir(parents=True, exist_ok=True)
     rows = []
@@ -99,9 +101,9 @@ def reproduce(
             json.dumps(metrics, indent=2) + "\n", encoding="utf-8"
         )
         figure = None
-        if plot_scenario is not None:
+        if plot is not None:
             figure = out_dir / f"{name}.png"
-            plot_scenario(result, figure)
+            plot(result, figure)
         rows.append(Row(name, metrics, wall, figure))
         verdict = "passed" if result.passed else "FAILED" + _failed_checks(metrics)
         print(
