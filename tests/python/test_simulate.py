@@ -123,10 +123,11 @@ def test_estimator_replay_reproduces_the_in_loop_estimate() -> None:
     out = est.run(
         delayed(tr["v_alpha_ref"]), delayed(tr["v_beta_ref"]), tr["i_alpha"], tr["i_beta"]
     )
-    diff = np.angle(np.exp(1j * (out.theta - tr["theta_hat"])))
-    assert np.max(np.abs(diff)) <= 1e-9
-    np.testing.assert_allclose(out.lambda1_alpha, tr["lambda1_alpha"], rtol=0, atol=1e-12)
-    np.testing.assert_allclose(out.disturbance_beta, tr["dist_beta"], rtol=0, atol=1e-12)
+    # Same code, same f64 inputs, same order of operations: bit for bit, not just ~1e-9.
+    np.testing.assert_array_equal(out.theta, tr["theta_hat"])
+    np.testing.assert_array_equal(out.lambda1_alpha, tr["lambda1_alpha"])
+    np.testing.assert_array_equal(out.disturbance_beta, tr["dist_beta"])
+    np.testing.assert_array_equal(out.lambda_r_alpha, tr["lambda_r_alpha"])
     assert np.array_equal(out.flag_limit, tr["flag_limit"] == 1.0)
     pole_pairs = 4.0
     rpm = out.omega / pole_pairs * 60.0 / (2.0 * math.pi)

@@ -141,9 +141,7 @@ pub fn simulate(
 ) -> PyResult<SimResult> {
     let finished = py
         .detach(|| run(scenario, config_toml, averaged, progress))
-        .map_err(|e| {
-            pyo3::exceptions::PyRuntimeError::new_err(format!("metrics to JSON: {e}"))
-        })?
+        .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(format!("metrics to JSON: {e}")))?
         .map_err(|e| sim_error(py, e))?;
     SimResult::new(py, scenario, finished)
 }
