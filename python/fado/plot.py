@@ -182,10 +182,11 @@ def _figure(
     fig = figure_class(figsize=(10.0, 1.9 * len(panels) + 0.9), layout="constrained")
     canvas_class(fig)
     axes = fig.subplots(len(panels), 1, sharex=True, squeeze=False)[:, 0]
-    for ax, draw in zip(axes, panels):
+    for k, (ax, draw) in enumerate(zip(axes, panels)):
         draw(ax, result)
-        for t0, t1 in shade:
-            ax.axvspan(t0, t1, color="C3", alpha=0.08, lw=0)
+        for j, (t0, t1) in enumerate(shade):
+            label = "k_df off" if k == 0 and j == 0 else None
+            ax.axvspan(t0, t1, color="C3", alpha=0.08, lw=0, label=label)
         ax.grid(True, lw=0.4, alpha=0.5)
         # Channel labels beside the trace, as on an oscilloscope, never over it.
         ax.legend(loc="upper left", bbox_to_anchor=(1.005, 1.0), fontsize=7, frameon=False)
