@@ -85,8 +85,9 @@ def reproduce(
         raise ValueError(f"unknown scenario(s) {unknown}; one of {sorted(known)}")
     plot: Callable[[Any, Path], object] | None = None
     if plots:
-        from fado.plot import plot_scenario  # needs matplotlib: fail before the long runs
+        from fado.plot import _matplotlib, plot_scenario
 
+        _matplotlib()  # no matplotlib: say so before the long runs, not after the first
         plot = plot_scenario
     out_dir = Path(out)
     out_dir.mkdir(parents=True, exist_ok=True)
