@@ -15,6 +15,15 @@ or step it yourself::
     est = fado.Estimator(fado.EstimatorConfig(rs_hat=0.33))
     out = est.step(v_alpha, v_beta, i_alpha, i_beta)
 
+Simulate the paper's experiments (Fig. 8–12) on the closed-loop drive model (Rust,
+``fado-sim``) and plot them like the paper's oscilloscope captures::
+
+    result = fado.simulate("fig11", {"simulation": {"duration": 5.5}}, averaged=False)
+    result.passed, result.metrics["max_angle_error_zero_speed"], result.traces["theta_hat"]
+    import fado.plot; fado.plot.plot_scenario(result, "fig11.png")   # needs fado[plot]
+
+``python -m fado reproduce --out DIR`` runs all five and writes the figures and a table.
+
 Errors derive from :class:`FadoError`; :class:`ConfigError` (a bad configuration field,
 named by ``.field``) and :class:`InputError` (a bad array or argument, named by
 ``.argument``) are also :class:`ValueError`.
@@ -24,21 +33,28 @@ from __future__ import annotations
 
 from fado._fado import (
     OUTPUT_NAMES,
+    TRACE_COLUMNS,
     ConfigError,
     EstimateResult,
     Estimator,
     EstimatorConfig,
     FadoError,
     InputError,
+    SimResult,
     SimulationError,
     StepResult,
     __version__,
+    default_config,
+    describe_scenario,
     estimate,
+    scenarios,
 )
 from fado._mode import Mode
+from fado._simulation import simulate
 
 __all__ = [
     "OUTPUT_NAMES",
+    "TRACE_COLUMNS",
     "ConfigError",
     "EstimateResult",
     "Estimator",
@@ -46,8 +62,13 @@ __all__ = [
     "FadoError",
     "InputError",
     "Mode",
+    "SimResult",
     "SimulationError",
     "StepResult",
     "__version__",
+    "default_config",
+    "describe_scenario",
     "estimate",
+    "scenarios",
+    "simulate",
 ]

@@ -23,10 +23,17 @@ __all__ = [
     "SimulationError",
     "__version__",
     "OUTPUT_NAMES",
+    "TRACE_COLUMNS",
+    "simulate",
+    "SimResult",
+    "scenarios",
+    "describe_scenario",
+    "default_config",
 ]
 
 __version__: Final[str]
 OUTPUT_NAMES: Final[list[str]]
+TRACE_COLUMNS: Final[list[str]]
 MODE_LIMITER: Final[int]
 MODE_DISTURBANCE_FEEDBACK: Final[int]
 
@@ -281,3 +288,47 @@ def estimate(
     dtype: npt.DTypeLike = "float64",
 ) -> EstimateResult:
     """Run the estimator over a whole recording in Rust (GIL released)."""
+
+@final
+class SimResult:
+    """A finished simulation: ``metrics.json`` and ``traces.csv`` of ``fado-sim run``."""
+
+    @property
+    def scenario(self) -> str: ...
+    @property
+    def passed(self) -> bool: ...
+    @property
+    def averaged(self) -> bool: ...
+    @property
+    def config_toml(self) -> str: ...
+    @property
+    def estimator_config(self) -> EstimatorConfig: ...
+    @property
+    def metrics(self) -> dict[str, Any]: ...
+    @property
+    def checks(self) -> list[dict[str, Any]]: ...
+    @property
+    def traces(self) -> dict[str, npt.NDArray[np.float64]]: ...
+    @property
+    def time(self) -> npt.NDArray[np.float64]: ...
+    def to_pandas(self) -> Any: ...
+    def __getitem__(self, name: str, /) -> npt.NDArray[np.float64]: ...
+    def __len__(self) -> int: ...
+
+def simulate(
+    scenario: str = "fig11",
+    config_toml: str | None = None,
+    averaged: bool = False,
+    *,
+    progress: bool = False,
+) -> SimResult:
+    """Run a scenario of the paper (Fig. 8–12) on the simulated drive (GIL released)."""
+
+def scenarios() -> list[str]:
+    """The scenario names."""
+
+def describe_scenario(scenario: str) -> dict[str, str]:
+    """Name, title, profile and pass criterion of a scenario."""
+
+def default_config(scenario: str = "fig11", averaged: bool = False) -> str:
+    """The scenario's configuration as TOML (``fado-sim run --dump-config``)."""

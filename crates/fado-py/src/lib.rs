@@ -9,10 +9,9 @@
 //!   recording with the GIL released).
 //! - [`outputs`]: `StepResult`, `EstimateResult` and the column buffers behind them.
 //! - [`inputs`]: checks of the signal arrays; [`replay`]: the Python-free replay loop.
+//! - [`simulate`]: `simulate`, `SimResult`, `scenarios`, `default_config`: the closed-loop
+//!   simulator of `fado-sim` (the paper's Fig. 8–12) with the GIL released.
 //! - [`errors`]: `FadoError` and its subclasses.
-//!
-//! The simulator (`fado-sim`) is wrapped here once its API settles; until then the module
-//! exposes the estimator only.
 
 pub mod config;
 pub mod errors;
@@ -21,6 +20,7 @@ pub mod inputs;
 pub mod outputs;
 pub mod replay;
 pub mod scalar;
+pub mod simulate;
 
 use pyo3::prelude::*;
 
@@ -35,6 +35,8 @@ pub mod _fado {
     use super::estimator::{PyEstimator, estimate};
     #[pymodule_export]
     use super::outputs::{EstimateResult, StepResult};
+    #[pymodule_export]
+    use super::simulate::{SimResult, default_config, describe_scenario, scenarios, simulate};
 
     #[pymodule_export]
     const MODE_LIMITER: i8 = super::outputs::MODE_LIMITER;
@@ -48,6 +50,7 @@ pub mod _fado {
         super::errors::Exceptions::register(m)?;
         m.add("__version__", env!("CARGO_PKG_VERSION"))?;
         m.add("OUTPUT_NAMES", super::outputs::OUTPUT_NAMES.to_vec())?;
+        m.add("TRACE_COLUMNS", super::simulate::trace_columns())?;
         Ok(())
     }
 }

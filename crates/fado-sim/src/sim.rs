@@ -191,6 +191,9 @@ pub struct Sample {
     /// Stator voltage the inverter actually applied over the previous sample [n−1, n]
     /// (time average, α-β), V.
     pub v_ab_applied: fado_core::Ab<f64>,
+    /// Measured current (sensor model) in α-β, as the controller computes it from the
+    /// measured phase currents, A.
+    pub i_ab_measured: fado_core::Ab<f64>,
     /// The controller's output at this sample.
     pub act: Actuation,
 }
@@ -303,6 +306,7 @@ impl<C: Controller> Simulation<C> {
             torque: self.plant.last_outcome().torque_avg,
             load_torque: self.plant.load_torque(),
             v_ab_applied: self.plant.last_outcome().v_ab_avg,
+            i_ab_measured: i_abc.to_ab(),
             pole_pairs: self.pole_pairs,
             act,
         };
@@ -492,12 +496,25 @@ pub struct TraceRow {
     pub torque: f64,
     /// Load torque, N·m.
     pub load_torque: f64,
+    /// Realised voltage reference α computed at this sample (before dead-time compensation),
+    /// V. The estimator integrates it two samples later (SPEC §1, one-sample delay + [n−1, n]).
+    pub v_alpha_ref: f64,
+    /// Realised voltage reference β, V.
+    pub v_beta_ref: f64,
+    /// Voltage the inverter actually applied over [n−1, n] (time average) α, V.
+    pub v_alpha_applied: f64,
+    /// Applied voltage β, V.
+    pub v_beta_applied: f64,
+    /// Measured current α (what the estimator sees at this sample), A.
+    pub i_alpha: f64,
+    /// Measured current β, A.
+    pub i_beta: f64,
 }
 
 impl TraceRow {
     /// Column names, in CSV order (for struct-of-arrays consumers such as the Python
     /// bindings).
-    pub const COLUMNS: [&'static str; 30] = [
+    pub const COLUMNS: [&'static str; 36] = [
         "time",
         "theta",
         "theta_hat",
@@ -528,10 +545,16 @@ impl TraceRow {
         "tripped",
         "torque",
         "load_torque",
+        "v_alpha_ref",
+        "v_beta_ref",
+        "v_alpha_applied",
+        "v_beta_applied",
+        "i_alpha",
+        "i_beta",
     ];
 
     /// The row's values in [`COLUMNS`](Self::COLUMNS) order (flags as 0.0/1.0).
-    pub fn values(&self) -> [f64; 30] {
+    pub fn values(&self) -> [f64; 36] {
         [
             self.time,
             self.theta,
@@ -563,6 +586,12 @@ impl TraceRow {
             self.tripped as f64,
             self.torque,
             self.load_torque,
+            self.v_alpha_ref,
+            self.v_beta_ref,
+            self.v_alpha_applied,
+            self.v_beta_applied,
+            self.i_alpha,
+            self.i_beta,
         ]
     }
 }
@@ -601,6 +630,12 @@ impl From<&Sample> for TraceRow {
             tripped: s.act.tripped as u8,
             torque: s.torque,
             load_torque: s.load_torque,
+            v_alpha_ref: s.act.v_ref_ab.alpha,
+            v_beta_ref: s.act.v_ref_ab.beta,
+            v_alpha_applied: s.v_ab_applied.alpha,
+            v_beta_applied: s.v_ab_applied.beta,
+            i_alpha: s.i_ab_measured.alpha,
+            i_beta: s.i_ab_measured.beta,
         }
     }
 }
@@ -667,6 +702,8 @@ mod tests {
         s.act.estimate.omega = -2.0 * std::f64::consts::TAU; // −30 r/min with 4 pole pairs
         s.act.estimate.diagnostics.flag_limit = true;
         s.act.i_dq_ref = Dq::new(4.0, -1.5);
+        s.act.v_ref_ab = fado_core::Ab::new(12.5, -3.0);
+        s.i_ab_measured = fado_core::Ab::new(0.75, 2.0);
         t.observe(&s);
         let mut buf = Vec::new();
         t.write_csv(&mut buf).unwrap();
@@ -683,6 +720,8 @@ mod tests {
         assert_eq!(t.column("i_q_ref").unwrap(), vec![-1.5]);
         assert_eq!(t.column("flag_limit").unwrap(), vec![1.0]);
         assert_eq!(t.column("speed_rpm").unwrap(), vec![-12.0]);
+        assert_eq!(t.column("v_beta_ref").unwrap(), vec![-3.0]);
+        assert_eq!(t.column("i_alpha").unwrap(), vec![0.75]);
         assert!((t.column("speed_hat1_rpm").unwrap()[0] + 30.0).abs() < 1e-12);
         assert!(t.column("nope").is_none());
     }

@@ -1,0 +1,318 @@
+//! `fado.simulate` and `fado.SimResult`: the closed-loop simulator of `fado-sim` (the paper's
+//! Fig. 8–12 as named scenarios) from Python, with the GIL released while it runs.
+//!
+//! The native function takes the configuration as TOML text only; `fado.simulate` (Python)
+//! also accepts a path or a `dict` and turns it into TOML. The result holds what the CLI
+//! `fado-sim run` writes: the metrics (`metrics.json`, parsed) and the trace columns
+//! (`traces.csv`, as float64 arrays under the same names, bit for bit).
+
+use std::io::Write;
+use std::time::Instant;
+
+use fado_sim::SimConfigError;
+use fado_sim::scenario::{self, SCENARIOS};
+use fado_sim::sim::TraceRow;
+use numpy::PyArray1;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+
+use crate::config::PyEstimatorConfig;
+use crate::errors::{config_error_message, input_error};
+
+/// Width of the progress bar printed to stderr.
+const BAR_WIDTH: usize = 30;
+
+/// The trace column names, in `traces.csv` order.
+pub fn trace_columns() -> Vec<&'static str> {
+    TraceRow::COLUMNS.to_vec()
+}
+
+/// A refused configuration or scenario as the Python exception it means: an unknown scenario
+/// is a bad argument (`InputError`), anything else a bad configuration key (`ConfigError`
+/// with `.field` = the TOML path, e.g. `inverter.dead_time`).
+fn sim_error(py: Python<'_>, e: SimConfigError) -> PyErr {
+    if e.key == "scenario" {
+        input_error(py, "scenario", e.message)
+    } else {
+        let message = e.to_string();
+        config_error_message(py, &e.key, message)
+    }
+}
+
+/// Prints a one-line progress bar to stderr (no GIL needed; Python's `sys.stderr` is not
+/// involved, so it shows even when Python output is captured).
+struct ProgressLine<'a> {
+    scenario: &'a str,
+    started: Instant,
+}
+
+impl ProgressLine<'_> {
+    fn draw(&self, fraction: f64) {
+        let filled = ((fraction.clamp(0.0, 1.0) * BAR_WIDTH as f64).round()) as usize;
+        let bar: String = "=".repeat(filled) + &" ".repeat(BAR_WIDTH - filled);
+        let mut err = std::io::stderr().lock();
+        // A failed write to stderr is not worth failing the simulation for.
+        let _ = write!(
+            err,
+            "\r{} [{bar}] {:>3.0}% {:>6.1} s",
+            self.scenario,
+            fraction * 100.0,
+            self.started.elapsed().as_secs_f64()
+        );
+        let _ = err.flush();
+    }
+
+    fn finish(&self) {
+        let _ = writeln!(std::io::stderr().lock());
+    }
+}
+
+/// The trace as one `Vec` per column (struct of arrays).
+fn columns_of(rows: &[TraceRow]) -> Vec<Vec<f64>> {
+    let mut columns = vec![Vec::with_capacity(rows.len()); TraceRow::COLUMNS.len()];
+    for row in rows {
+        for (column, value) in columns.iter_mut().zip(row.values()) {
+            column.push(value);
+        }
+    }
+    columns
+}
+
+/// What `fado_sim::simulate` returns, reduced to what crosses into Python.
+struct Finished {
+    report_json: String,
+    passed: bool,
+    averaged: bool,
+    config_toml: String,
+    estimator: fado_core::EstimatorConfig<f64>,
+    columns: Vec<Vec<f64>>,
+}
+
+fn run(
+    scenario: &str,
+    config_toml: Option<&str>,
+    averaged: bool,
+    progress: bool,
+) -> Result<Result<Finished, SimConfigError>, serde_json::Error> {
+    let line = ProgressLine {
+        scenario,
+        started: Instant::now(),
+    };
+    let mut draw = |f: f64| line.draw(f);
+    let callback: Option<&mut dyn FnMut(f64)> = if progress { Some(&mut draw) } else { None };
+    let outcome = match fado_sim::simulate(scenario, config_toml, averaged, callback) {
+        Ok(o) => o,
+        Err(e) => return Ok(Err(e)),
+    };
+    if progress {
+        line.finish();
+    }
+    let report = outcome.report();
+    Ok(Ok(Finished {
+        report_json: serde_json::to_string(&report)?,
+        passed: outcome.passed,
+        averaged: outcome.config.inverter.model == fado_sim::inverter::InverterModel::Averaged,
+        config_toml: outcome.config.to_toml(),
+        estimator: outcome.config.estimator_config(),
+        columns: columns_of(&outcome.trace.rows),
+    }))
+}
+
+/// Runs one of the paper's experiments (`scenarios()`) on the simulated drive and returns a
+/// `SimResult`. `config_toml` overrides the scenario's configuration key by key (the format
+/// of `default_config`); `averaged` selects the averaged inverter model (fast) instead of the
+/// switching-resolved one; `progress` prints a progress bar to stderr. The GIL is released
+/// while the simulation runs.
+///
+/// Bad keys or values raise `ConfigError` (`.field` is the TOML path), an unknown scenario
+/// `InputError` (both are `ValueError`s). Prefer `fado.simulate`, which also takes a path or
+/// a `dict`.
+#[pyfunction]
+#[pyo3(
+    signature = (scenario = "fig11", config_toml = None, averaged = false, *, progress = false),
+    text_signature = "(scenario='fig11', config_toml=None, averaged=False, *, progress=False)"
+)]
+pub fn simulate(
+    py: Python<'_>,
+    scenario: &str,
+    config_toml: Option<&str>,
+    averaged: bool,
+    progress: bool,
+) -> PyResult<SimResult> {
+    let finished = py
+        .detach(|| run(scenario, config_toml, averaged, progress))
+        .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(format!("metrics to JSON: {e}")))?
+        .map_err(|e| sim_error(py, e))?;
+    SimResult::new(py, scenario, finished)
+}
+
+/// The names of the scenarios `simulate` runs (the paper's Fig. 8–12).
+#[pyfunction]
+pub fn scenarios() -> Vec<&'static str> {
+    SCENARIOS.iter().map(|s| s.name).collect()
+}
+
+/// What a scenario does, as a dict with `name`, `title` (the paper's figure), `profile` and
+/// `criterion` (the pass criterion checked in code, SPEC §7).
+#[pyfunction]
+pub fn describe_scenario<'py>(py: Python<'py>, scenario: &str) -> PyResult<Bound<'py, PyDict>> {
+    let Some(s) = scenario::find(scenario) else {
+        return Err(input_error(
+            py,
+            "scenario",
+            format!("unknown `{scenario}`; one of {:?}", scenarios()),
+        ));
+    };
+    let dict = PyDict::new(py);
+    dict.set_item("name", s.name)?;
+    dict.set_item("title", s.title)?;
+    dict.set_item("profile", s.profile)?;
+    dict.set_item("criterion", s.criterion)?;
+    Ok(dict)
+}
+
+/// The configuration a scenario runs with, as the TOML document of `fado-sim run SCENARIO
+/// --dump-config [--averaged]`: edit it and pass it (or a part of it) to `simulate`.
+#[pyfunction]
+#[pyo3(signature = (scenario = "fig11", averaged = false))]
+pub fn default_config(py: Python<'_>, scenario: &str, averaged: bool) -> PyResult<String> {
+    scenario::scenario_config(scenario, None, averaged)
+        .map(|c| c.to_toml())
+        .map_err(|e| sim_error(py, e))
+}
+
+/// A finished simulation: the metrics and checks of `metrics.json` and the trace columns of
+/// `traces.csv` (float64 arrays, flags as 0.0/1.0), plus the configuration it ran with.
+#[pyclass(name = "SimResult", module = "fado", frozen)]
+pub struct SimResult {
+    /// Scenario name.
+    #[pyo3(get)]
+    scenario: String,
+    /// All pass criteria met.
+    #[pyo3(get)]
+    passed: bool,
+    /// The averaged inverter model ran (otherwise the switching-resolved one).
+    #[pyo3(get)]
+    averaged: bool,
+    /// The effective configuration as TOML (feed it back to `simulate` to rerun).
+    #[pyo3(get)]
+    config_toml: String,
+    /// The configuration of the estimator inside the drive (for replaying the trace with
+    /// `fado.Estimator`).
+    #[pyo3(get)]
+    estimator_config: Py<PyEstimatorConfig>,
+    metrics: Py<PyDict>,
+    traces: Py<PyDict>,
+    rows: usize,
+}
+
+impl SimResult {
+    fn new(py: Python<'_>, scenario: &str, f: Finished) -> PyResult<Self> {
+        let metrics = py
+            .import("json")?
+            .call_method1("loads", (f.report_json,))?
+            .cast_into::<PyDict>()?;
+        let traces = PyDict::new(py);
+        let rows = f.columns.first().map_or(0, Vec::len);
+        for (name, column) in TraceRow::COLUMNS.iter().zip(f.columns) {
+            traces.set_item(*name, PyArray1::from_vec(py, column))?;
+        }
+        Ok(Self {
+            scenario: scenario.to_owned(),
+            passed: f.passed,
+            averaged: f.averaged,
+            config_toml: f.config_toml,
+            estimator_config: Py::new(py, PyEstimatorConfig::from_core(&f.estimator))?,
+            metrics: metrics.unbind(),
+            traces: traces.unbind(),
+            rows,
+        })
+    }
+}
+
+#[pymethods]
+impl SimResult {
+    /// The content of `metrics.json`: scenario, inverter_model, precision, estimator, passed,
+    /// max/RMS angle error overall and near zero speed (rad), zero_speed_band_rpm,
+    /// max_speed_error_rpm, tripped, simulated_seconds, wall_seconds, checks. A fresh copy.
+    #[getter]
+    fn metrics<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        py.import("copy")?
+            .call_method1("deepcopy", (self.metrics.bind(py),))
+    }
+
+    /// The pass criteria: a list of dicts with `name`, `value`, `min`, `max`, `passed`.
+    #[getter]
+    fn checks<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+        Ok(self
+            .metrics(py)?
+            .get_item("checks")?
+            .cast_into::<PyList>()?)
+    }
+
+    /// The trace columns by their `traces.csv` names (`TRACE_COLUMNS`), as float64 arrays.
+    /// The dict is a fresh copy; the arrays are shared.
+    #[getter]
+    fn traces<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        self.traces.bind(py).copy()
+    }
+
+    /// Trace time in s (the `time` column).
+    #[getter]
+    fn time<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.__getitem__(py, "time")
+    }
+
+    /// A `pandas.DataFrame` of the trace indexed by time in s (needs the `pandas` extra).
+    fn to_pandas<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let pandas = py.import("pandas")?;
+        let columns = self.traces(py)?;
+        let time = columns
+            .get_item("time")?
+            .ok_or_else(|| pyo3::exceptions::PyKeyError::new_err("time"))?;
+        columns.del_item("time")?;
+        let index = pandas.call_method1("Index", (time,))?;
+        index.setattr("name", "time")?;
+        let kwargs = PyDict::new(py);
+        kwargs.set_item("index", index)?;
+        pandas.call_method("DataFrame", (columns,), Some(&kwargs))
+    }
+
+    /// One trace column by name.
+    fn __getitem__<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
+        self.traces
+            .bind(py)
+            .get_item(name)?
+            .ok_or_else(|| pyo3::exceptions::PyKeyError::new_err(name.to_owned()))
+    }
+
+    /// Number of trace rows.
+    fn __len__(&self) -> usize {
+        self.rows
+    }
+
+    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+        let m = self.metrics.bind(py);
+        let get = |k: &str| -> PyResult<String> {
+            Ok(match m.get_item(k)? {
+                Some(v) => v.repr()?.to_string(),
+                None => "?".to_owned(),
+            })
+        };
+        let near_zero: f64 = match m.get_item("max_angle_error_zero_speed")? {
+            Some(v) => v.extract()?,
+            None => f64::NAN,
+        };
+        Ok(format!(
+            "SimResult(scenario='{}', passed={}, inverter={}, max_angle_error_zero_speed={:.4}, \
+             tripped={}, simulated_seconds={}, rows={})",
+            self.scenario,
+            if self.passed { "True" } else { "False" },
+            get("inverter_model")?,
+            near_zero,
+            get("tripped")?,
+            get("simulated_seconds")?,
+            self.rows
+        ))
+    }
+}

@@ -1,0 +1,289 @@
+"""Figures of the paper's experiments (Fig. 8–12) from a :class:`fado.SimResult`.
+
+Laid out like the paper's oscilloscope captures: panels stacked on one shared time axis —
+speed (true, estimated, reference; r/min), the angle error θ − θ̂ (rad, with the ±0.25 rad
+criterion of Fig. 11/12), the fluxes (λ1 and D̂ for Fig. 8/9, λ̂r and the limiter radius
+1.15·λ̂f for Fig. 10), the d-q currents and the mode flags. Needs the ``plot`` extra
+(matplotlib); the figures are drawn with the Agg canvas, without pyplot, so importing this
+module changes no global matplotlib state::
+
+    import fado, fado.plot
+    fig = fado.plot.plot_scenario(fado.simulate("fig11"), "fig11.png")
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+    from fado._fado import SimResult
+
+__all__ = [
+    "ANGLE_CRITERION",
+    "plot_fig8",
+    "plot_fig9",
+    "plot_fig10",
+    "plot_fig11",
+    "plot_fig12",
+    "plot_scenario",
+]
+
+#: |θ − θ̂| criterion near zero speed of Fig. 11 and 12 (paper §V-B; SPEC §7), rad.
+ANGLE_CRITERION = 0.25
+
+
+def _matplotlib() -> tuple[Any, Any]:
+    """``(Figure, FigureCanvasAgg)``, or an ImportError saying how to get them."""
+    try:
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+        from matplotlib.figure import Figure
+    except ImportError as e:  # pragma: no cover - depends on the environment
+        raise ImportError(
+            "fado.plot needs matplotlib: pip install 'fado[plot]' (or pip install matplotlib)"
+        ) from e
+    return Figure, FigureCanvasAgg
+
+
+def _col(result: SimResult, name: str) -> np.ndarray:
+    return np.asarray(result[name])
+
+
+def _k_df_off_windows(result: SimResult) -> list[tuple[float, float]]:
+    """The ``simulation.disturbance_feedback_off`` windows (Fig. 9), from the config TOML."""
+    match = re.search(r"^disturbance_feedback_off\s*=\s*(\[.*\])\s*$", result.config_toml, re.M)
+    if not match:
+        return []
+    numbers = [float(x) for x in re.findall(r"[-+0-9.eE]+", match.group(1))]
+    return list(zip(numbers[0::2], numbers[1::2]))
+
+
+def _speed(ax: Axes, r: SimResult) -> None:
+    t = _col(r, "time")
+    ax.plot(t, _col(r, "speed_ref_rpm"), color="0.6", lw=1.0, ls="--", label="reference")
+    ax.plot(t, _col(r, "speed_rpm"), color="C0", lw=1.2, label="true n")
+    ax.plot(t, _col(r, "speed_hat_rpm"), color="C3", lw=1.0, label="estimated n̂ (T2S-2)")
+    ax.set_ylabel("speed\n(r/min)")
+
+
+def _angle_error(ax: Axes, r: SimResult, criterion: bool) -> None:
+    t = _col(r, "time")
+    ax.plot(t, _col(r, "angle_error"), color="C2", lw=1.0, label="θ − θ̂")
+    if criterion:
+        band = float(r.metrics["zero_speed_band_rpm"])
+        ax.fill_between(
+            t,
+            0,
+            1,
+            where=np.abs(_col(r, "speed_rpm")) < band,
+            transform=ax.get_xaxis_transform(),
+            color="C1",
+            alpha=0.12,
+            lw=0,
+            label=f"|n| < {band:g} r/min",
+        )
+        for sign in (1.0, -1.0):
+            ax.axhline(
+                sign * ANGLE_CRITERION,
+                color="C3",
+                ls=":",
+                lw=1.0,
+                label=f"±{ANGLE_CRITERION} rad" if sign > 0 else None,
+            )
+    ax.set_ylabel("θ − θ̂\n(rad)")
+
+
+def _angles(ax: Axes, r: SimResult) -> None:
+    t = _col(r, "time")
+    ax.plot(t, _col(r, "theta"), color="C0", lw=1.0, label="θ")
+    ax.plot(t, _col(r, "theta_hat"), color="C3", lw=1.0, ls="--", label="θ̂")
+    ax.set_ylabel("angle\n(rad)")
+
+
+def _flux_and_disturbance(ax: Axes, r: SimResult) -> None:
+    t = _col(r, "time")
+    ax.plot(t, _col(r, "lambda1_alpha"), color="C0", lw=1.0, label="λ1 α")
+    ax.plot(t, _col(r, "lambda1_beta"), color="C1", lw=1.0, label="λ1 β")
+    ax.plot(t, _col(r, "dist_alpha"), color="k", lw=1.4, label="D̂ α")
+    ax.plot(t, _col(r, "dist_beta"), color="C7", lw=1.4, label="D̂ β")
+    ax.set_ylabel("λ1, D̂\n(Wb)")
+
+
+def _lambda2(ax: Axes, r: SimResult) -> None:
+    t = _col(r, "time")
+    ax.plot(t, _col(r, "lambda2_alpha"), color="C0", lw=1.0, label="λ2 α")
+    ax.plot(t, _col(r, "lambda2_beta"), color="C1", lw=1.0, label="λ2 β")
+    ax.axhline(0.0, color="0.5", lw=0.6)
+    ax.set_ylabel("λ2 = λ1 − D̂\n(Wb)")
+
+
+def _rotor_flux(ax: Axes, r: SimResult) -> None:
+    t = _col(r, "time")
+    cfg = r.estimator_config
+    radius = cfg.limiter_radius_ratio * cfg.flux_linkage_hat
+    a, b = _col(r, "lambda_r_alpha"), _col(r, "lambda_r_beta")
+    ax.plot(t, a, color="C0", lw=1.0, label="λ̂r α")
+    ax.plot(t, b, color="C1", lw=1.0, label="λ̂r β")
+    ax.plot(t, np.hypot(a, b), color="k", lw=1.2, label="|λ̂r|")
+    for sign in (1.0, -1.0):
+        ax.axhline(
+            sign * radius,
+            color="C3",
+            ls=":",
+            lw=1.0,
+            label=f"±{cfg.limiter_radius_ratio:g}·λ̂f" if sign > 0 else None,
+        )
+    ax.set_ylabel("λ̂r\n(Wb)")
+
+
+def _currents(ax: Axes, r: SimResult) -> None:
+    t = _col(r, "time")
+    ax.plot(t, _col(r, "i_d"), color="C0", lw=1.0, label="i_d")
+    ax.plot(t, _col(r, "i_q"), color="C1", lw=1.0, label="i_q")
+    ax.plot(t, _col(r, "i_d_ref"), color="C0", lw=0.8, ls="--", label="i_d*")
+    ax.plot(t, _col(r, "i_q_ref"), color="C1", lw=0.8, ls="--", label="i_q*")
+    ax.set_ylabel("d-q current\n(A)")
+
+
+def _flags(ax: Axes, r: SimResult) -> None:
+    t = _col(r, "time")
+    ax.step(t, _col(r, "flag_limit"), where="post", color="C4", lw=1.0, label="FLAG_limit")
+    ax.step(
+        t,
+        0.5 * _col(r, "tracker_hold"),
+        where="post",
+        color="C5",
+        lw=0.8,
+        label="tracker hold (×0.5)",
+    )
+    tripped = _col(r, "tripped")
+    if tripped.any():
+        ax.step(t, tripped, where="post", color="C3", lw=1.2, label="tripped")
+    ax.set_ylim(-0.15, 1.25)
+    ax.set_yticks([0, 1])
+    ax.set_ylabel("flags")
+
+
+def _figure(
+    result: SimResult,
+    panels: Sequence[Callable[[Axes, SimResult], None]],
+    title: str,
+    path: str | os.PathLike[str] | None,
+    shade: Sequence[tuple[float, float]] = (),
+) -> Figure:
+    figure_class, canvas_class = _matplotlib()
+    fig = figure_class(figsize=(10.0, 1.9 * len(panels) + 0.9), layout="constrained")
+    canvas_class(fig)
+    axes = fig.subplots(len(panels), 1, sharex=True, squeeze=False)[:, 0]
+    for k, (ax, draw) in enumerate(zip(axes, panels)):
+        draw(ax, result)
+        for j, (t0, t1) in enumerate(shade):
+            label = "k_df off" if k == 0 and j == 0 else None
+            ax.axvspan(t0, t1, color="C3", alpha=0.08, lw=0, label=label)
+        ax.grid(True, lw=0.4, alpha=0.5)
+        # Channel labels beside the trace, as on an oscilloscope, never over it.
+        ax.legend(loc="upper left", bbox_to_anchor=(1.005, 1.0), fontsize=7, frameon=False)
+    axes[-1].set_xlabel("time (s)")
+    m = result.metrics
+    verdict = "passed" if result.passed else "FAILED"
+    inverter = "averaged" if result.averaged else "switching-resolved"
+    fig.suptitle(
+        f"{title}\n{result.scenario}, {inverter} inverter: {verdict}; "
+        f"max |θ−θ̂| near zero speed {m['max_angle_error_zero_speed']:.3f} rad, "
+        f"overall {m['max_angle_error']:.3f} rad",
+        fontsize=9,
+    )
+    if path is not None:
+        fig.savefig(os.fspath(path), dpi=110)
+    figure: Figure = fig
+    return figure
+
+
+def _title(result: SimResult) -> str:
+    from fado._fado import describe_scenario
+
+    return str(describe_scenario(result.scenario)["title"])
+
+
+def plot_fig8(result: SimResult, path: str | os.PathLike[str] | None = None) -> Figure:
+    """Fig. 8: λ1 and D̂ (the DC of λ1) and λ2 = λ1 − D̂ centred on zero, over the
+    +90 → −90 r/min reversal under 2 N·m. Saves a PNG at `path` if given."""
+    panels = [_speed, _flux_and_disturbance, _lambda2, _currents, _flags]
+    return _figure(result, panels, _title(result), path)
+
+
+def plot_fig9(result: SimResult, path: str | os.PathLike[str] | None = None) -> Figure:
+    """Fig. 9: λ1 drifts while k_df is off (shaded) and recovers after; D̂ follows."""
+    panels = [
+        _speed,
+        _flux_and_disturbance,
+        lambda ax, r: _angle_error(ax, r, criterion=False),
+        _currents,
+        _flags,
+    ]
+    return _figure(result, panels, _title(result), path, shade=_k_df_off_windows(result))
+
+
+def plot_fig10(result: SimResult, path: str | os.PathLike[str] | None = None) -> Figure:
+    """Fig. 10: no-load standstill held by the limiter: θ and θ̂, λ̂r inside the circle of
+    radius 1.15·λ̂f, positive i_d, FLAG_limit high."""
+    panels = [
+        _speed,
+        _angles,
+        lambda ax, r: _angle_error(ax, r, criterion=False),
+        _rotor_flux,
+        _currents,
+        _flags,
+    ]
+    return _figure(result, panels, _title(result), path)
+
+
+def plot_fig11(result: SimResult, path: str | os.PathLike[str] | None = None) -> Figure:
+    """Fig. 11: speed reversal −90 → +90 r/min under 7.5 N·m; θ − θ̂ against ±0.25 rad."""
+    panels = [
+        _speed,
+        lambda ax, r: _angle_error(ax, r, criterion=True),
+        _flux_and_disturbance,
+        _currents,
+        _flags,
+    ]
+    return _figure(result, panels, _title(result), path)
+
+
+def plot_fig12(result: SimResult, path: str | os.PathLike[str] | None = None) -> Figure:
+    """Fig. 12: repeated 300 ms stops under 7.5 N·m; θ − θ̂ against ±0.25 rad."""
+    panels = [
+        _speed,
+        lambda ax, r: _angle_error(ax, r, criterion=True),
+        _currents,
+        _flags,
+    ]
+    return _figure(result, panels, _title(result), path)
+
+
+_BY_SCENARIO = {
+    "fig8": plot_fig8,
+    "fig9": plot_fig9,
+    "fig10": plot_fig10,
+    "fig11": plot_fig11,
+    "fig12": plot_fig12,
+}
+
+
+def plot_scenario(result: SimResult, path: str | os.PathLike[str] | None = None) -> Figure:
+    """The figure of `result.scenario` (``plot_fig8`` … ``plot_fig12``)."""
+    try:
+        plot = _BY_SCENARIO[result.scenario]
+    except KeyError:
+        raise ValueError(
+            f"no figure for scenario {result.scenario!r}; one of {sorted(_BY_SCENARIO)}"
+        ) from None
+    figure: Figure = plot(result, path)
+    return figure
