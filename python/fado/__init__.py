@@ -15,6 +15,11 @@ or step it yourself::
     est = fado.Estimator(fado.EstimatorConfig(rs_hat=0.33))
     out = est.step(v_alpha, v_beta, i_alpha, i_beta)
 
+Compare fado with the baseline estimators in the simulator (same plant, seed, controllers)::
+
+    rows = fado.compare(scenarios=["fig11"], averaged=True)   # list of dicts
+    fado.compare.plot_angle_errors("fig11.png")                 # needs matplotlib
+
 Errors derive from :class:`FadoError`; :class:`ConfigError` (a bad configuration field,
 named by ``.field``) and :class:`InputError` (a bad array or argument, named by
 ``.argument``) are also :class:`ValueError`.
@@ -36,6 +41,7 @@ from fado._fado import (
     estimate,
 )
 from fado._mode import Mode
+from fado import compare
 
 __all__ = [
     "OUTPUT_NAMES",
@@ -49,5 +55,6 @@ __all__ = [
     "SimulationError",
     "StepResult",
     "__version__",
+    "compare",
     "estimate",
 ]

@@ -23,6 +23,7 @@ __all__ = [
     "SimulationError",
     "__version__",
     "OUTPUT_NAMES",
+    "compare",
 ]
 
 __version__: Final[str]
@@ -281,3 +282,14 @@ def estimate(
     dtype: npt.DTypeLike = "float64",
 ) -> EstimateResult:
     """Run the estimator over a whole recording in Rust (GIL released)."""
+
+def compare(
+    scenarios: list[str] | None = None,
+    estimators: list[str] | None = None,
+    averaged: bool = False,
+    *,
+    config: str | None = None,
+    traces: bool = False,
+    threads: int = 2,
+) -> list[dict[str, Any]]:
+    """Every estimator in every scenario on the same plant and seed (GIL released)."""

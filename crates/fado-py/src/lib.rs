@@ -10,10 +10,12 @@
 //! - [`outputs`]: `StepResult`, `EstimateResult` and the column buffers behind them.
 //! - [`inputs`]: checks of the signal arrays; [`replay`]: the Python-free replay loop.
 //! - [`errors`]: `FadoError` and its subclasses.
+//! - [`compare`]: `compare`, fado against the baseline estimators in the simulator.
 //!
 //! The simulator (`fado-sim`) is wrapped here once its API settles; until then the module
 //! exposes the estimator only.
 
+pub mod compare;
 pub mod config;
 pub mod errors;
 pub mod estimator;
@@ -29,6 +31,8 @@ use pyo3::prelude::*;
 /// Import from `fado`, not from here.
 #[pymodule]
 pub mod _fado {
+    #[pymodule_export]
+    use super::compare::compare;
     #[pymodule_export]
     use super::config::PyEstimatorConfig;
     #[pymodule_export]
