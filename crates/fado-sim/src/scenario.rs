@@ -38,7 +38,8 @@ pub const SCENARIOS: [Scenario; 7] = [
         title: "Flux and disturbance estimation under 2 N·m (Fig. 8)",
         profile: "0 → +90 r/min, T_L → 2 N·m, then +90 → −90 r/min at 90 r/min/s",
         criterion: "λ2 centred on zero: mean of λ2 − λs over every whole electrical \
-                    revolution spent above 30 r/min in HI mode < 2 % of λf; no trip",
+                    revolution spent above 30 r/min in HI mode < 2 % of λf; no trip; \
+                    speed error < 30 r/min",
     },
     Scenario {
         name: "fig9",
@@ -233,6 +234,13 @@ impl Scenario {
                     "revolutions evaluated",
                     p.blocks as f64,
                     4.0,
+                ));
+                // No loss of control: without it an estimator that runs the machine away
+                // (as the EMF baseline does) could still show a centred λ2.
+                checks.push(Check::at_most(
+                    "max speed error (r/min)",
+                    m.max_speed_error_rpm,
+                    30.0,
                 ));
             }
             "fig9" => {
