@@ -49,7 +49,7 @@ cpu=$(lscpu 2>/dev/null | sed -n 's/^Model name: *//p' | head -n1)
         echo "\`cargo bench --bench baselines\` saved (\`--skip-bench\`)."
     fi
     echo "Machine: ${cpu:-unknown CPU}, $(nproc) logical CPUs (shared), $(uname -sr), $(rustc -V);"
-    echo "load average before the run ${load_before} (criterion times are wall-clock: on a"
+    echo "load average when the script started ${load_before} (criterion times are wall-clock: on a"
     echo "loaded machine compare them with each other, not with other machines)."
     echo
     echo "## What is compared"
