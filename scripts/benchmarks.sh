@@ -36,6 +36,17 @@ cargo build --release -p fado-sim --bin fado-sim
 compare_cmd=(cargo run --release -q -p fado-sim -- compare $averaged --out "$out" --criterion "$target/criterion")
 "${compare_cmd[@]}"
 
+# The fig11 angle-error figure, when the Python package (built from this tree: `maturin
+# develop --release`, or scripts/test-all.sh's .venv) and matplotlib are available.
+python=${PYTHON:-.venv/bin/python}
+figure=""
+if "$python" -c "import fado.compare, matplotlib" >/dev/null 2>&1; then
+    "$python" -c "import fado; fado.compare.plot_angle_errors('docs/benchmarks-fig11.png', 'fig11'${averaged:+, averaged=True})"
+    figure=docs/benchmarks-fig11.png
+else
+    echo "no Python fado + matplotlib at $python: figure not regenerated" >&2
+fi
+
 cpu=$(lscpu 2>/dev/null | sed -n 's/^Model name: *//p' | head -n1)
 {
     echo "# Benchmarks: fado against the observers other drives use"
@@ -82,6 +93,13 @@ cpu=$(lscpu 2>/dev/null | sed -n 's/^Model name: *//p' | head -n1)
     echo
     cat "$out/compare.md"
     echo
+    if [[ -n $figure ]]; then
+        echo 'θ − θ̂ of every estimator through the fig11 reversal (`fado.compare.plot_angle_errors`,'
+        echo 'same runs as the table; grey: |n| < 30 r/min):'
+        echo
+        echo "![fig11 angle errors](benchmarks-fig11.png)"
+        echo
+    fi
     if [[ -f docs/benchmarks-analysis.md ]]; then
         cat docs/benchmarks-analysis.md
     fi
