@@ -24,6 +24,11 @@ Simulate the paper's experiments (Fig. 8–12) on the closed-loop drive model (R
 
 ``python -m fado reproduce --out DIR`` runs all five and writes the figures and a table.
 
+Compare fado with the baseline estimators in the simulator (same plant, seed, controllers)::
+
+    rows = fado.compare(scenarios=["fig11"], averaged=True)   # list of dicts
+    fado.compare.plot_angle_errors("fig11.png")                 # needs matplotlib
+
 Errors derive from :class:`FadoError`; :class:`ConfigError` (a bad configuration field,
 named by ``.field``) and :class:`InputError` (a bad array or argument, named by
 ``.argument``) are also :class:`ValueError`.
@@ -51,6 +56,7 @@ from fado._fado import (
 )
 from fado._mode import Mode
 from fado._simulation import simulate
+from fado import compare
 
 __all__ = [
     "OUTPUT_NAMES",
@@ -68,6 +74,7 @@ __all__ = [
     "__version__",
     "default_config",
     "describe_scenario",
+    "compare",
     "estimate",
     "scenarios",
     "simulate",

@@ -29,6 +29,7 @@ __all__ = [
     "scenarios",
     "describe_scenario",
     "default_config",
+    "compare",
 ]
 
 __version__: Final[str]
@@ -332,3 +333,14 @@ def describe_scenario(scenario: str) -> dict[str, str]:
 
 def default_config(scenario: str = "fig11", averaged: bool = False) -> str:
     """The scenario's configuration as TOML (``fado-sim run --dump-config``)."""
+
+def compare(
+    scenarios: list[str] | None = None,
+    estimators: list[str] | None = None,
+    averaged: bool = False,
+    *,
+    config: str | None = None,
+    traces: bool = False,
+    threads: int = 2,
+) -> list[dict[str, Any]]:
+    """Every estimator in every scenario on the same plant and seed (GIL released)."""

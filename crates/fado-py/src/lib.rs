@@ -12,7 +12,9 @@
 //! - [`simulate`]: `simulate`, `SimResult`, `scenarios`, `default_config`: the closed-loop
 //!   simulator of `fado-sim` (the paper's Fig. 8–12) with the GIL released.
 //! - [`errors`]: `FadoError` and its subclasses.
+//! - [`compare`]: `compare`, fado against the baseline estimators in the simulator.
 
+pub mod compare;
 pub mod config;
 pub mod errors;
 pub mod estimator;
@@ -29,6 +31,8 @@ use pyo3::prelude::*;
 /// Import from `fado`, not from here.
 #[pymodule]
 pub mod _fado {
+    #[pymodule_export]
+    use super::compare::compare;
     #[pymodule_export]
     use super::config::PyEstimatorConfig;
     #[pymodule_export]

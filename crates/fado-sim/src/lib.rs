@@ -8,6 +8,8 @@
 //!
 //! * [`scenario`]: the paper's Fig. 8–12 as named scenarios with coded pass criteria;
 //!   [`simulate`] is the one-call entry point (CLI `fado-sim run`, Python bindings).
+//! * [`compare`]: every estimator (fado and the `fado_core::baselines`) in every scenario on
+//!   the same plant, seed and controllers (CLI `fado-sim compare`).
 //! * [`config`]: the whole run as one TOML document ([`SimConfig`]), overriding a scenario key
 //!   by key; unknown keys and impossible values are errors naming the key.
 //! * [`sim`]: the loop ([`sim::Simulation`]), the plant aggregate ([`sim::Plant`]), metrics,
@@ -37,6 +39,7 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+pub mod compare;
 pub mod config;
 pub mod controller;
 pub mod drive;

@@ -30,14 +30,16 @@ pub struct Scenario {
     pub criterion: &'static str,
 }
 
-/// The five scenarios of SPEC §7.
-pub const SCENARIOS: [Scenario; 5] = [
+/// The five scenarios of SPEC §7, then two of ours for the estimator comparison
+/// ([`crate::compare`]): a medium-speed sanity check under load and a low-speed staircase.
+pub const SCENARIOS: [Scenario; 7] = [
     Scenario {
         name: "fig8",
         title: "Flux and disturbance estimation under 2 N·m (Fig. 8)",
         profile: "0 → +90 r/min, T_L → 2 N·m, then +90 → −90 r/min at 90 r/min/s",
         criterion: "λ2 centred on zero: mean of λ2 − λs over every whole electrical \
-                    revolution spent above 30 r/min in HI mode < 2 % of λf; no trip",
+                    revolution spent above 30 r/min in HI mode < 2 % of λf; no trip; \
+                    speed error < 30 r/min",
     },
     Scenario {
         name: "fig9",
@@ -67,7 +69,43 @@ pub const SCENARIOS: [Scenario; 5] = [
                   0 → 60, 500 ms at 60)",
         criterion: "no trip or instability [P]; |θ − θ̂| < 0.25 rad [A]; speed error < 30 r/min",
     },
+    Scenario {
+        name: "steady300",
+        title: "Steady 300 r/min under 7.5 N·m (sanity check of every estimator) [A]",
+        profile: "0 → 300 r/min in 1 s, T_L → 7.5 N·m over [1.5 s, 2 s], hold to 4 s",
+        criterion: "settled (from 2.5 s) |θ − θ̂| < 0.05 rad; speed error < 10 r/min; no trip",
+    },
+    Scenario {
+        name: "lowspeed",
+        title: "Lowest speed held under 7.5 N·m: a staircase 60, 30, 15, … r/min [A]",
+        profile: "0 → 60 r/min, T_L → 7.5 N·m, then 2 s at each of 60, 30, 15, 7.5, 3.75, \
+                  1.875, 0.9375 r/min (each reached by a 0.2 s ramp)",
+        criterion: "a level is held when, over its last 1.5 s, |θ − θ̂| < 0.25 rad, \
+                    |n − n*| < max(0.5·n*, 0.5 r/min) and no trip; the lowest speed held is \
+                    the lowest level held together with every level above it; the scenario \
+                    passes when every level is held",
+    },
 ];
+
+/// Speed levels of the `lowspeed` staircase, r/min: 60 r/min halved six times.
+pub const LOWSPEED_LEVELS_RPM: [f64; 7] = [60.0, 30.0, 15.0, 7.5, 3.75, 1.875, 0.9375];
+/// Time the `lowspeed` staircase spends at each level (ramp included), s.
+pub const LOWSPEED_LEVEL_SECONDS: f64 = 2.0;
+/// Ramp from one level to the next, s.
+const LOWSPEED_RAMP_SECONDS: f64 = 0.2;
+/// The last part of each level over which it is judged, s (the ramp and 0.3 s of settling
+/// excluded).
+pub const LOWSPEED_JUDGED_SECONDS: f64 = 1.5;
+/// The first level starts here, s (after the start-up to 60 r/min and the load ramp).
+const LOWSPEED_START: f64 = 2.0;
+/// Angle bound of a held level, rad (the paper's fig11 bound [P]).
+pub const LOWSPEED_ANGLE_BOUND: f64 = 0.25;
+
+/// Speed bound of a held level at `level_rpm`: the rotor turns in the commanded direction at
+/// no less than half the commanded speed (and within 0.5 r/min at the lowest levels).
+pub fn lowspeed_speed_bound(level_rpm: f64) -> f64 {
+    (0.5 * level_rpm.abs()).max(0.5)
+}
 
 /// The scenario called `name`.
 pub fn find(name: &str) -> Option<&'static Scenario> {
@@ -134,6 +172,27 @@ impl Scenario {
                 c.simulation.duration = t;
                 c.simulation.eval_start = 1.8;
             }
+            "steady300" => {
+                c.speed_reference = pts(&[(0.0, 0.0), (0.2, 0.0), (1.2, 300.0)]);
+                c.load.torque = pts(&[(1.5, 0.0), (2.0, 7.5)]);
+                c.simulation.duration = 4.0;
+                c.simulation.eval_start = 2.5;
+            }
+            "lowspeed" => {
+                let mut p = vec![(0.0, 0.0), (0.2, 0.0), (0.9, 60.0)];
+                let mut t = LOWSPEED_START;
+                let mut prev = 60.0;
+                for level in LOWSPEED_LEVELS_RPM {
+                    p.extend([(t, prev), (t + LOWSPEED_RAMP_SECONDS, level)]);
+                    prev = level;
+                    t += LOWSPEED_LEVEL_SECONDS;
+                }
+                p.push((t, prev));
+                c.speed_reference = pts(&p);
+                c.load.torque = pts(&[(0.9, 0.0), (1.4, 7.5)]);
+                c.simulation.duration = t;
+                c.simulation.eval_start = LOWSPEED_START;
+            }
             _ => unreachable!("every scenario in SCENARIOS has a profile"),
         }
         c
@@ -146,6 +205,16 @@ impl Scenario {
         );
         if self.name == "fig10" {
             p.hold = Some((2.0, cfg.simulation.duration));
+        }
+        if self.name == "lowspeed" {
+            p.levels = LOWSPEED_LEVELS_RPM
+                .iter()
+                .enumerate()
+                .map(|(k, &level)| {
+                    let to = LOWSPEED_START + (k + 1) as f64 * LOWSPEED_LEVEL_SECONDS;
+                    LevelStats::new(level, to - LOWSPEED_JUDGED_SECONDS, to)
+                })
+                .collect();
         }
         p
     }
@@ -165,6 +234,13 @@ impl Scenario {
                     "revolutions evaluated",
                     p.blocks as f64,
                     4.0,
+                ));
+                // No loss of control: without it an estimator that runs the machine away
+                // (as the EMF baseline does) could still show a centred λ2.
+                checks.push(Check::at_most(
+                    "max speed error (r/min)",
+                    m.max_speed_error_rpm,
+                    30.0,
                 ));
             }
             "fig9" => {
@@ -226,6 +302,25 @@ impl Scenario {
                     30.0,
                 ));
             }
+            "steady300" => {
+                checks.push(Check::at_most(
+                    "settled max |θ − θ̂| (rad)",
+                    m.max_angle_error,
+                    0.05,
+                ));
+                checks.push(Check::at_most(
+                    "max speed error (r/min)",
+                    m.max_speed_error_rpm,
+                    10.0,
+                ));
+            }
+            "lowspeed" => {
+                checks.push(Check::at_least(
+                    "levels held from 60 r/min down",
+                    p.levels_held_in_a_row() as f64,
+                    LOWSPEED_LEVELS_RPM.len() as f64,
+                ));
+            }
             _ => unreachable!(),
         }
         checks
@@ -277,6 +372,74 @@ impl Check {
     }
 }
 
+/// One level of the `lowspeed` staircase, judged over its last
+/// [`LOWSPEED_JUDGED_SECONDS`].
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct LevelStats {
+    /// Commanded speed, r/min.
+    pub level_rpm: f64,
+    /// Judged window start, s.
+    pub from: f64,
+    /// Judged window end, s.
+    pub to: f64,
+    /// Samples in the window.
+    pub samples: u64,
+    /// max |θ − θ̂| in the window, rad.
+    pub max_angle_error: f64,
+    /// max |n − n*| in the window, r/min.
+    pub max_speed_error_rpm: f64,
+    /// Mean true speed in the window, r/min.
+    pub mean_speed_rpm: f64,
+    /// The drive tripped at or before the end of the window.
+    pub tripped: bool,
+    #[serde(skip)]
+    speed_sum: f64,
+}
+
+impl LevelStats {
+    /// An empty window `[from, to]` at `level_rpm`.
+    pub fn new(level_rpm: f64, from: f64, to: f64) -> Self {
+        Self {
+            level_rpm,
+            from,
+            to,
+            samples: 0,
+            max_angle_error: 0.0,
+            max_speed_error_rpm: 0.0,
+            mean_speed_rpm: 0.0,
+            tripped: false,
+            speed_sum: 0.0,
+        }
+    }
+
+    /// Accumulates one sample (ignored outside the window; a trip before the window's end
+    /// counts).
+    pub fn observe(&mut self, time: f64, angle_error: f64, speed_rpm: f64, tripped: bool) {
+        if time <= self.to {
+            self.tripped |= tripped;
+        }
+        if time < self.from || time > self.to {
+            return;
+        }
+        self.samples += 1;
+        self.max_angle_error = self.max_angle_error.max(angle_error.abs());
+        self.max_speed_error_rpm = self
+            .max_speed_error_rpm
+            .max((speed_rpm - self.level_rpm).abs());
+        self.speed_sum += speed_rpm;
+        self.mean_speed_rpm = self.speed_sum / self.samples as f64;
+    }
+
+    /// Held: the whole window was seen, |θ − θ̂| < [`LOWSPEED_ANGLE_BOUND`], |n − n*| <
+    /// [`lowspeed_speed_bound`], no trip.
+    pub fn held(&self) -> bool {
+        self.samples > 0
+            && !self.tripped
+            && self.max_angle_error < LOWSPEED_ANGLE_BOUND
+            && self.max_speed_error_rpm < lowspeed_speed_bound(self.level_rpm)
+    }
+}
+
 /// Full-rate accumulations the criteria need beyond [`Metrics`].
 ///
 /// The DC of λ2 (Fig. 8) is the mean of λ2 − λs (estimate minus the true stator flux) over
@@ -305,6 +468,8 @@ pub struct ScenarioProbe {
     pub hold: Option<(f64, f64)>,
     /// Largest |λ̂r| in the hold window, Wb.
     pub max_lambda_r: f64,
+    /// The `lowspeed` staircase levels (empty for the other scenarios).
+    pub levels: Vec<LevelStats>,
     hold_n: u64,
     hold_flag: u64,
     next_disturbance_sample: f64,
@@ -326,6 +491,7 @@ impl ScenarioProbe {
             disturbance: Vec::new(),
             hold: None,
             max_lambda_r: 0.0,
+            levels: Vec::new(),
             hold_n: 0,
             hold_flag: 0,
             next_disturbance_sample: 0.0,
@@ -345,6 +511,20 @@ impl ScenarioProbe {
         self.hold_flag as f64 / self.hold_n.max(1) as f64
     }
 
+    /// Number of staircase levels held, counted from the top until the first one that is
+    /// not.
+    pub fn levels_held_in_a_row(&self) -> usize {
+        self.levels.iter().take_while(|l| l.held()).count()
+    }
+
+    /// The lowest speed held under load, r/min: the lowest staircase level held together
+    /// with every level above it; `None` when not even the first was held (or no staircase).
+    pub fn lowest_speed_held_rpm(&self) -> Option<f64> {
+        self.levels_held_in_a_row()
+            .checked_sub(1)
+            .map(|k| self.levels[k].level_rpm)
+    }
+
     fn restart_revolution(&mut self) {
         self.rev_angle = 0.0;
         self.rev_sum = fado_core::Ab::zero();
@@ -356,6 +536,9 @@ impl ScenarioProbe {
 impl Probe for ScenarioProbe {
     fn observe(&mut self, s: &Sample) {
         let d = &s.act.estimate.diagnostics;
+        for level in &mut self.levels {
+            level.observe(s.time, s.angle_error, s.speed_rpm, s.act.tripped);
+        }
         if s.time >= self.next_disturbance_sample {
             self.disturbance.push((s.time, d.disturbance));
             self.next_disturbance_sample += 0.01;
@@ -626,6 +809,55 @@ mod tests {
         assert_eq!(e.key, "scenario");
         let e = scenario_config("fig11", Some("[mismatch]\nrs_rato = 1.0\n"), false).unwrap_err();
         assert_eq!(e.key, "mismatch.rs_rato");
+    }
+
+    #[test]
+    fn lowspeed_staircase_levels_are_judged_on_their_settled_window() {
+        let cfg = find("lowspeed").unwrap().config();
+        let probe = find("lowspeed").unwrap().probe(&cfg);
+        assert_eq!(probe.levels.len(), LOWSPEED_LEVELS_RPM.len());
+        for (l, &level) in probe.levels.iter().zip(&LOWSPEED_LEVELS_RPM) {
+            // The reference sits at the level over the whole judged window, under full load.
+            for t in [l.from, 0.5 * (l.from + l.to), l.to] {
+                assert_eq!(cfg.speed_reference.value(t), level, "t = {t}");
+                assert_eq!(cfg.load.torque.value(t), 7.5);
+            }
+        }
+        assert!(cfg.simulation.duration >= probe.levels.last().unwrap().to);
+
+        // Synthetic runs: held down to 3.75 r/min, lost at 1.875, "held" again at 0.9375.
+        let mut p = probe.clone();
+        for (k, l) in probe.levels.iter().enumerate() {
+            let (err, speed) = match k {
+                0..=4 => (0.1, l.level_rpm * 1.2),
+                5 => (0.3, l.level_rpm),
+                _ => (0.0, l.level_rpm),
+            };
+            for n in 0..=100 {
+                let t = l.from + (l.to - l.from) * n as f64 / 100.0;
+                for level in &mut p.levels {
+                    level.observe(t, err, speed, false);
+                }
+            }
+        }
+        assert!(p.levels[4].held() && !p.levels[5].held() && p.levels[6].held());
+        assert_eq!(p.levels_held_in_a_row(), 5);
+        assert_eq!(p.lowest_speed_held_rpm(), Some(3.75));
+
+        // Too slow (below half the level) is not held, and neither is anything after a trip.
+        let mut q = probe.clone();
+        let first = q.levels[0].clone();
+        q.levels[0].observe(first.from, 0.0, 0.45 * first.level_rpm, false);
+        assert!(!q.levels[0].held());
+        assert_eq!(q.lowest_speed_held_rpm(), None);
+        let mut r = probe.clone();
+        let (t0, t1) = (r.levels[0].from, r.levels[1].from);
+        r.levels[1].observe(t0 - 1.0, 0.0, 0.0, true);
+        r.levels[1].observe(t1, 0.0, 30.0, false);
+        assert!(!r.levels[1].held());
+        // The speed bound floors at 0.5 r/min for the slowest levels.
+        assert_eq!(lowspeed_speed_bound(0.9375), 0.5);
+        assert_eq!(lowspeed_speed_bound(30.0), 15.0);
     }
 
     #[test]

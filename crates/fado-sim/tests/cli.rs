@@ -149,3 +149,43 @@ fn sweep_runs_one_scenario_per_value_and_writes_a_csv() {
     assert_eq!(bad.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&bad.stderr).contains("mismatch.rs_rato"));
 }
+
+#[test]
+fn compare_writes_json_and_markdown() {
+    let dir = tmp_dir("compare");
+    let cfg = dir.join("short.toml");
+    std::fs::write(&cfg, "[simulation]\nduration = 2.7\n").unwrap();
+    let out = bin()
+        .args([
+            "compare",
+            "--scenarios",
+            "steady300",
+            "--estimators",
+            "fado,ortega",
+            "--averaged",
+            "--config",
+        ])
+        .arg(&cfg)
+        .arg("--out")
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let md = std::fs::read_to_string(dir.join("compare.md")).unwrap();
+    assert!(md.contains("| steady300 | fado |") && md.contains("| steady300 | ortega |"));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("compare.json")).unwrap()).unwrap();
+    assert_eq!(json["rows"].as_array().unwrap().len(), 2);
+    assert_eq!(json["summary"][1]["estimator"], "ortega");
+    let bad = bin()
+        .args(["compare", "--estimators", "kalman", "--out"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("kalman"));
+}

@@ -4,6 +4,8 @@
 //! fado-sim list
 //! fado-sim run fig11 [--config FILE] [--out DIR] [--averaged] [--dump-config]
 //! fado-sim sweep fig11 --set mismatch.rs_ratio=0.98,0.99,1,1.01,1.02 [--averaged]
+//! fado-sim compare [--scenarios fig8,...] [--estimators fado,lpf-integrator,ortega,emf-observer]
+//!                  [--out DIR] [--averaged] [--config FILE] [--criterion target/criterion]
 //! ```
 
 use std::path::PathBuf;
@@ -11,6 +13,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use fado_sim::SimConfig;
+use fado_sim::compare;
 use fado_sim::scenario::{self, SCENARIOS};
 use indicatif::{ProgressBar, ProgressStyle};
 
@@ -63,6 +66,32 @@ enum Command {
         /// Use the averaged inverter model.
         #[arg(long)]
         averaged: bool,
+    },
+    /// Run every estimator in every scenario on the same plant, seed and controllers; print
+    /// the table, write DIR/compare.json and DIR/compare.md.
+    Compare {
+        /// Comma-separated scenario names. Default: all (see `list`).
+        #[arg(long, value_delimiter = ',')]
+        scenarios: Option<Vec<String>>,
+        /// Comma-separated estimators. Default: fado,lpf-integrator,ortega,emf-observer.
+        #[arg(long, value_delimiter = ',')]
+        estimators: Option<Vec<String>>,
+        /// TOML file applied over every scenario (its `[estimator] kind` is replaced).
+        #[arg(long)]
+        config: Option<PathBuf>,
+        /// Output directory. Default `out/compare`.
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Use the averaged inverter model.
+        #[arg(long)]
+        averaged: bool,
+        /// criterion's output directory of `cargo bench --bench baselines` (e.g.
+        /// `target/criterion`): the f32 step costs are read from its saved estimates.
+        #[arg(long)]
+        criterion: Option<PathBuf>,
+        /// Worker threads.
+        #[arg(long, default_value_t = 2)]
+        threads: usize,
     },
 }
 
@@ -150,6 +179,63 @@ fn run(cli: Cli) -> Result<ExitCode, Box<dyn std::error::Error>> {
             out,
             averaged,
         } => sweep(&name, &set, config, out, averaged),
+        Command::Compare {
+            scenarios,
+            estimators,
+            config,
+            out,
+            averaged,
+            criterion,
+            threads,
+        } => {
+            let mut opts = compare::CompareOptions {
+                averaged,
+                threads,
+                ..Default::default()
+            };
+            if let Some(s) = scenarios {
+                opts.scenarios = s;
+            }
+            if let Some(e) = estimators {
+                opts.estimators = e
+                    .iter()
+                    .map(|n| compare::parse_estimator(n))
+                    .collect::<Result<_, _>>()?;
+            }
+            if let Some(p) = &config {
+                opts.config_toml = Some(
+                    std::fs::read_to_string(p)
+                        .map_err(|e| format!("cannot read {}: {e}", p.display()))?,
+                );
+            }
+            let mut result = compare::compare(&opts)?;
+            if let Some(dir) = &criterion {
+                let costs = compare::read_criterion_step_costs(dir, &opts.estimators);
+                if costs.is_empty() {
+                    eprintln!(
+                        "warning: no criterion estimates under {} (run `cargo bench --bench baselines`)",
+                        dir.display()
+                    );
+                }
+                result.set_step_costs(costs);
+            }
+            let dir = out.unwrap_or_else(|| PathBuf::from("out").join("compare"));
+            std::fs::create_dir_all(&dir)?;
+            std::fs::write(
+                dir.join("compare.json"),
+                serde_json::to_string_pretty(&result)?,
+            )?;
+            let md = result.to_markdown();
+            std::fs::write(dir.join("compare.md"), &md)?;
+            print!("{md}");
+            println!(
+                "\n{} runs in {:.1} s; wrote {}/compare.json and compare.md",
+                result.rows.len(),
+                result.wall_seconds,
+                dir.display()
+            );
+            Ok(ExitCode::SUCCESS)
+        }
     }
 }
 
