@@ -218,7 +218,7 @@ def test_missing_config_file_is_reported() -> None:
 
 def test_sim_result_api() -> None:
     result = fado.simulate("fig10", {"simulation": {"duration": 0.3}}, averaged=True)
-    assert fado.scenarios() == ["fig8", "fig9", "fig10", "fig11", "fig12"]
+    assert fado.scenarios() == ["fig8", "fig9", "fig10", "fig11", "fig12", "steady300", "lowspeed"]
     assert "Fig. 10" in fado.describe_scenario("fig10")["title"]
     assert list(result.traces) == fado.TRACE_COLUMNS
     np.testing.assert_allclose(result.time, np.arange(len(result)) * 1e-3, rtol=0, atol=1e-12)
