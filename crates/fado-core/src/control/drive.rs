@@ -320,6 +320,11 @@ impl<T: Real> Blocks<T> {
 /// let mut drive =
 ///     SensorlessDrive::<f32>::new(DriveConfig::default(), EstimatorConfig::default()).unwrap();
 /// drive.align(0.0);
+/// // Power-up: the first samples run with the gates off and measure the sensor offsets.
+/// while drive.is_calibrating() {
+///     assert!(!drive.step(Abc::new(0.02, -0.01, -0.01), 300.0, 0.0).gates_enabled);
+/// }
+/// assert!((drive.current_offset().a - 0.02).abs() < 1e-6);
 /// // In the 10 kHz ISR: phase currents sampled now, dc-link voltage, speed reference.
 /// let out = drive.step(Abc::new(0.1, -0.05, -0.05), 300.0, 10.0);
 /// assert!(out.gates_enabled && (0.0..=1.0).contains(&out.duty.a));
