@@ -534,7 +534,8 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         }
         self.last_i_ab = i_ab;
         // 3. Measured current in the estimated rotor frame.
-        let i_dq = i_ab.to_dq(Rotation::from_angle(estimate.theta));
+        let rot_theta = Rotation::from_angle(estimate.theta);
+        let i_dq = i_ab.to_dq(rot_theta);
         let omega_ctrl = estimate.omega_control;
 
         // 4. Speed loop, injection (23) and current-vector limit.
@@ -553,7 +554,10 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             return self.reject_after_estimate(backup, estimate, i_dq);
         };
         // 6. Delay compensation with the advanced angle.
-        let (v_ab, rot) = b.delay.step(v_dq, estimate.theta, estimate.omega);
+        //    (reusing the Park rotation: one sin/cos per sample instead of two).
+        let (v_ab, rot) = b
+            .delay
+            .step_rotated(v_dq, rot_theta, estimate.theta, estimate.omega);
         // 7. Dead-time compensation, hexagon limit, SVPWM.
         let v_comp = b.dead_time.step(rot, i_dq_ref, i_abc, vdc);
         let m = b.modulator.step(v_ab + v_comp, vdc);
