@@ -42,7 +42,8 @@ pub const SCENARIOS: [Scenario; 5] = [
     Scenario {
         name: "fig9",
         title: "k_df switched off for 2 s at −300 r/min under −3 N·m (Fig. 9)",
-        profile: "0 → −300 r/min, T_L → −3 N·m, k_df off over [3 s, 5 s], run to 11 s",
+        profile: "0 → −300 r/min, T_L → −3 N·m, k_df off over [3 s, 5 s], run to 11 s \
+                  (no start-up offset calibration)",
         criterion: "λ1 drifts while off (|ΔD̂| > 2 mWb) and recovers with τ ≈ 2 s \
                     (residual after 2 s in [0.2, 0.55]); |θ − θ̂| < 0.05 rad",
     },
