@@ -80,8 +80,10 @@ pub struct EstimatorConfig<T> {
     /// observer exactly its model (λ̂r is a rotating vector plus the DC disturbance), so D̂ no
     /// longer responds to current transients. λ2 = λ1 − D̂ and λ̂r = λ2 − L̂q·i are unchanged
     /// in form (eq. (20), (5)); in steady state L̂q·i has no DC, so D̂ is the same. Measured
-    /// (fado-sim fig8, switching-resolved): the worst revolution's DC of λ2 − λs drops from 6 %
-    /// to below 1 % of λf (see crates/fado-sim/README.md).
+    /// (fado-sim fig8, switching-resolved, with the drive's offset calibration): the ≈ 5 Hz
+    /// oscillation after the 2 N·m step disappears and the worst revolution's DC of λ2 − λs
+    /// drops from 6.0 % to 2.1 % of λf, the rest being the LO→HI hand-over transient (see
+    /// crates/fado-sim/README.md).
     pub observer_on_rotor_flux: bool,
 }
 
