@@ -85,8 +85,9 @@ fn fig10_sensor_offset_walks_the_estimate_along_the_limiter_circle_at_e_t_over_r
     // rotor. Check that rate over the last two seconds of the hold. The disturbance observer,
     // still running at the tiny ω̂ of the creeping estimate, absorbs part of the error, so the
     // measured walk is somewhat slower than e_t/ρ (≈ 0.75× here); sign and size must agree.
+    // The start-up offset calibration is off here: it is what removes this walk (below).
     let cfg = "[current_sensor]\nenable_gain_error = false\nenable_noise = false\n\
-               enable_quantization = false\n";
+               enable_quantization = false\n[controller]\noffset_calibration_samples = 0\n";
     let out = run("fig10", Some(cfg), false);
     let c = &out.config;
     let rs_hat = c.estimator_config().rs_hat;
@@ -120,6 +121,17 @@ fn fig10_sensor_offset_walks_the_estimate_along_the_limiter_circle_at_e_t_over_r
         (0.6..=1.1).contains(&ratio),
         "measured {measured}, predicted {predicted}"
     );
+    // With the default start-up calibration (100 ms, gates off) the same offsets leave no
+    // walk worth the name.
+    let cfg = "[current_sensor]\nenable_gain_error = false\nenable_noise = false\n\
+               enable_quantization = false\n";
+    let cal = run("fig10", Some(cfg), false);
+    let rows: Vec<_> = cal.trace.rows.iter().filter(|r| r.time >= 3.5).collect();
+    let (first, last) = (rows[0], rows[rows.len() - 1]);
+    let walk =
+        fado::core::wrap_angle(last.angle_error - first.angle_error) / (last.time - first.time);
+    eprintln!("with calibration: d(θ − θ̂)/dt = {walk:.4} rad/s");
+    assert!(walk.abs() < 0.2 * predicted.abs(), "{walk} vs {predicted}");
 }
 
 #[test]
@@ -145,16 +157,17 @@ fn fig8_lambda2_is_centred_in_steady_state() {
 }
 
 #[test]
-#[ignore = "known failure with default sensors: λ2 DC reaches 4–6 % of λf in the revolutions \
-            after the load step and the LO→HI hand-over (SPEC: < 2 %)"]
+#[ignore = "known failure (switching-resolved): λ2 DC reaches 2.1 % of λf in the one \
+            revolution after the LO→HI hand-over (SPEC: < 2 %); 1.95 % averaged"]
 fn fig8_paper_criterion() {
     let out = run("fig8", None, false);
     assert!(out.passed, "{:?}", out.checks);
 }
 
 #[test]
-#[ignore = "known failure with default sensors: the offset/gain-error integrand walks θ̂ along \
-            the limiter circle (≈ 0.05 rad/s), max |θ − θ̂| ≈ 0.49 rad (SPEC threshold 0.35 [A])"]
+#[ignore = "known failure with default sensors: after the offset calibration the 0.5 % gain \
+            error's integrand walks θ̂ along the limiter circle, max |θ − θ̂| ≈ 0.69 rad (SPEC \
+            threshold 0.35 [A]; 0.33–0.70 over noise seeds)"]
 fn fig10_paper_criterion() {
     let out = run("fig10", None, false);
     assert!(out.passed, "{:?}", out.checks);

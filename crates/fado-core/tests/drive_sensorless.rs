@@ -53,12 +53,21 @@ impl RotorAngleEstimator<f64> for Spy {
     }
 }
 
+/// The default drive without the start-up offset calibration: these tests drive the
+/// controllers from the first sample (the calibration has its own tests in `improvements.rs`).
+fn no_calibration<T: fado_core::Real>() -> DriveConfig<T> {
+    DriveConfig {
+        offset_calibration_samples: 0,
+        ..DriveConfig::default()
+    }
+}
+
 fn spy_drive() -> SensorlessDrive<f64, Spy> {
     let spy = Spy {
         omega: TAU * 30.0,
         ..Spy::default()
     };
-    SensorlessDrive::with_estimator(DriveConfig::default(), spy).unwrap()
+    SensorlessDrive::with_estimator(no_calibration(), spy).unwrap()
 }
 
 fn currents(n: usize) -> Abc<f64> {
@@ -275,7 +284,7 @@ fn check_output<T: fado_core::Real>(o: &DriveOutput<T>) -> Result<(), TestCaseEr
 fn drives<T: fado_core::Real>(method: DeadTimeMethod) -> [SensorlessDrive<T>; 2] {
     let cfg = DriveConfig {
         dead_time_method: method,
-        ..DriveConfig::default()
+        ..no_calibration()
     };
     // The second never trips, so that every input reaches the controllers.
     let no_trip = DriveConfig {
@@ -471,10 +480,10 @@ fn voltage_history_is_aligned_with_the_interval_it_acted_over() {
                 inner: estimator,
                 previous: Ab::zero(),
             };
-            let drive = SensorlessDrive::with_estimator(DriveConfig::default(), est).unwrap();
+            let drive = SensorlessDrive::with_estimator(no_calibration(), est).unwrap();
             closed_loop(drive, 10_000, |_| w_mech, |_| 0.0, f64::INFINITY, observe);
         } else {
-            let drive = SensorlessDrive::with_estimator(DriveConfig::default(), estimator).unwrap();
+            let drive = SensorlessDrive::with_estimator(no_calibration(), estimator).unwrap();
             closed_loop(drive, 10_000, |_| w_mech, |_| 0.0, f64::INFINITY, observe);
         }
         sum / count
@@ -493,7 +502,7 @@ fn voltage_history_is_aligned_with_the_interval_it_acted_over() {
 
 #[test]
 fn sensorless_closed_loop_follows_a_speed_ramp_under_load() {
-    let drive = SensorlessDrive::new(DriveConfig::default(), EstimatorConfig::default()).unwrap();
+    let drive = SensorlessDrive::new(no_calibration(), EstimatorConfig::default()).unwrap();
     let target = 300.0 * TAU / 60.0; // 300 r/min
     let (mut worst_start, mut worst_steady, mut speed_before_load) = (0.0_f64, 0.0_f64, 0.0);
     let mut speed_end = 0.0;

@@ -210,6 +210,7 @@ impl PyEstimatorConfig {
             tracker_hold_ratio: T::lit(self.tracker_hold_ratio),
             average_current: self.average_current,
             initial_angle: T::lit(self.initial_angle),
+            ..EstimatorConfig::default()
         };
         config.validate().map_err(|e| config_error(py, e))?;
         Ok(config)

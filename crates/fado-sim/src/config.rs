@@ -146,6 +146,9 @@ pub struct ControllerSettings {
     pub current_anti_windup_ratio: f64,
     /// Speed PI back-calculation gain (×Ki/Kp). Default 5.
     pub speed_anti_windup_ratio: f64,
+    /// Current-sensor offset calibration at start-up, samples with the gates off (0 = none).
+    /// Default 1000 (100 ms) as `fado_core::control::DriveConfig` \[A\].
+    pub offset_calibration_samples: u32,
 }
 
 impl Default for ControllerSettings {
@@ -166,6 +169,7 @@ impl Default for ControllerSettings {
             max_modulation: 1.0,
             current_anti_windup_ratio: 1.0,
             speed_anti_windup_ratio: 5.0,
+            offset_calibration_samples: 1000,
         }
     }
 }
@@ -228,6 +232,9 @@ pub struct EstimatorSettings {
     pub tracker_hold_ratio: f64,
     /// Interval-average current in the resistive drop. Default true.
     pub average_current: bool,
+    /// Disturbance observer on λ1 − L̂q·i (true, our improvement) or on λ1 (false, the
+    /// paper's Fig. 5). Default as `EstimatorConfig::observer_on_rotor_flux`.
+    pub observer_on_rotor_flux: bool,
     /// LPF baseline: cut-off of 1/(s + ωc), Hz. Default as `LpfIntegratorConfig`.
     pub lpf_cutoff_hz: f64,
     /// LPF baseline: speed below which its gain/phase compensation is frozen, Hz.
@@ -268,6 +275,7 @@ impl Default for EstimatorSettings {
             },
             tracker_hold_ratio: d.tracker_hold_ratio,
             average_current: d.average_current,
+            observer_on_rotor_flux: d.observer_on_rotor_flux,
             kind: EstimatorKind::Fado,
             lpf_cutoff_hz: lpf.cutoff_hz,
             lpf_compensation_floor_hz: lpf.compensation_floor_hz,
@@ -440,6 +448,7 @@ impl SimConfig {
             },
             tracker_hold_ratio: e.tracker_hold_ratio,
             average_current: e.average_current,
+            observer_on_rotor_flux: e.observer_on_rotor_flux,
             initial_angle: self.simulation.initial_angle + self.simulation.align_error,
         }
     }

@@ -111,6 +111,7 @@ impl SimConfig {
             max_modulation: c.max_modulation,
             current_anti_windup_ratio: c.current_anti_windup_ratio,
             speed_anti_windup_ratio: c.speed_anti_windup_ratio,
+            offset_calibration_samples: c.offset_calibration_samples,
         }
     }
 
@@ -305,6 +306,7 @@ impl SimConfig {
             max_modulation: f(c.max_modulation),
             current_anti_windup_ratio: f(c.current_anti_windup_ratio),
             speed_anti_windup_ratio: f(c.speed_anti_windup_ratio),
+            offset_calibration_samples: c.offset_calibration_samples,
         };
         let e = self.estimator_config();
         let ec = EstimatorConfig::<f32> {
@@ -325,6 +327,7 @@ impl SimConfig {
             tracker_hold_ratio: f(e.tracker_hold_ratio),
             average_current: e.average_current,
             initial_angle: f(e.initial_angle),
+            observer_on_rotor_flux: e.observer_on_rotor_flux,
         };
         dc.validate()
             .map_err(|e| SimConfigError::from(e).in_section("controller"))?;
