@@ -121,7 +121,7 @@ mod tests {
         for &w in &[
             0.0, 50.0, -700.0, 1666.0, -1666.6, 1667.0, 5000.0, -20_000.0,
         ] {
-            for &theta in &[-3.14, -1.0, 0.0, 0.7, 3.1] {
+            for &theta in &[-3.0, -1.0, 0.0, 0.7, 3.1] {
                 let (a, ra) = dc.step(v, theta, w);
                 let (b, rb) = dc.step_rotated(v, Rotation::from_angle(theta), theta, w);
                 assert!((a - b).norm() < 1e-8, "w {w} θ {theta}: {a:?} vs {b:?}");
