@@ -81,6 +81,7 @@ class EstimatorConfig:
         bandwidth_definition: str | None = None,
         tracker_hold_ratio: float | None = None,
         average_current: bool | None = None,
+        observer_on_rotor_flux: bool | None = None,
         initial_angle: float | None = None,
     ) -> EstimatorConfig: ...
     def replace(
@@ -102,6 +103,7 @@ class EstimatorConfig:
         bandwidth_definition: str | None = None,
         tracker_hold_ratio: float | None = None,
         average_current: bool | None = None,
+        observer_on_rotor_flux: bool | None = None,
         initial_angle: float | None = None,
     ) -> EstimatorConfig: ...
     def to_dict(self) -> dict[str, float | str | bool]: ...
@@ -156,6 +158,9 @@ class EstimatorConfig:
     @property
     def average_current(self) -> bool:
         """Average the current over the interval for the resistive drop."""
+    @property
+    def observer_on_rotor_flux(self) -> bool:
+        """Observer fed with λ1 − L̂q·i (fado's improvement) instead of λ1 (the paper)."""
     @property
     def initial_angle(self) -> float:
         """Rotor angle assumed at reset in rad."""

@@ -31,6 +31,7 @@ PAPER_DEFAULTS = {
     "bandwidth_definition": "-3dB",  # SPEC §3
     "tracker_hold_ratio": 0.2,  # SPEC §3 [A]
     "average_current": True,  # SPEC §1 [A]
+    "observer_on_rotor_flux": True,  # fado's improvement [A]; False = paper's Fig. 5
     "initial_angle": 0.0,  # SPEC §1 [A]
 }
 

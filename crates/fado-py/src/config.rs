@@ -155,6 +155,9 @@ config_class! {
     tracker_hold_ratio: f64,
     /// Average the current over the interval for the resistive drop.
     average_current: bool,
+    /// Feed the disturbance observer with λ1 − L̂q·i instead of the paper's λ1 (our
+    /// improvement, default true; false is the paper's Fig. 5).
+    observer_on_rotor_flux: bool,
     /// Rotor angle assumed at reset in rad (electrical).
     initial_angle: f64,
 }
@@ -185,6 +188,7 @@ impl PyEstimatorConfig {
             bandwidth_definition: bandwidth_name(c.bandwidth_definition).to_owned(),
             tracker_hold_ratio: c.tracker_hold_ratio,
             average_current: c.average_current,
+            observer_on_rotor_flux: c.observer_on_rotor_flux,
             initial_angle: c.initial_angle,
         }
     }
@@ -209,8 +213,8 @@ impl PyEstimatorConfig {
             bandwidth_definition: parse_bandwidth(py, &self.bandwidth_definition)?,
             tracker_hold_ratio: T::lit(self.tracker_hold_ratio),
             average_current: self.average_current,
+            observer_on_rotor_flux: self.observer_on_rotor_flux,
             initial_angle: T::lit(self.initial_angle),
-            ..EstimatorConfig::default()
         };
         config.validate().map_err(|e| config_error(py, e))?;
         Ok(config)
