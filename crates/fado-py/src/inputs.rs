@@ -43,7 +43,7 @@ impl ColumnSlice<'_> {
 }
 
 impl Column<'_> {
-    /// The samples ([`column`] made sure that they form one slice).
+    /// The samples ([`column()`] made sure that they form one slice).
     pub fn slice(&self) -> ColumnSlice<'_> {
         match self {
             Column::F64(a) => ColumnSlice::F64(a.as_slice().unwrap_or(&[])),

@@ -99,7 +99,7 @@ const LOWSPEED_RAMP_SECONDS: f64 = 0.2;
 pub const LOWSPEED_JUDGED_SECONDS: f64 = 1.5;
 /// The first level starts here, s (after the start-up to 60 r/min and the load ramp).
 const LOWSPEED_START: f64 = 2.0;
-/// Angle bound of a held level, rad (the paper's fig11 bound [P]).
+/// Angle bound of a held level, rad (the paper's fig11 bound \[P\]).
 pub const LOWSPEED_ANGLE_BOUND: f64 = 0.25;
 
 /// Speed bound of a held level at `level_rpm`: the rotor turns in the commanded direction at
