@@ -45,7 +45,7 @@
 //!   |(Kp·s + Ki)/(s² + (Kp − Ki/p)·s + Ki)| (1.49 instead of 1.26 at 20 Hz; tested).
 //! - **Parameters.** L̂ errors act through L̂·di/dt (transients) and, as in fado, under load.
 
-use super::{AngleTrackers, Integrand, TrackerSettings};
+use super::{AngleTrackers, GuardedStep, Integrand, TrackerSettings};
 use crate::error::{ConfigError, check};
 use crate::estimator::{Diagnostics, Estimate, RotorAngleEstimator};
 use crate::tracker::BandwidthDefinition;
@@ -223,30 +223,31 @@ impl<T: Real> EmfObserverEstimator<T> {
     /// `input_fault` set.
     #[inline]
     pub fn step(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> Estimate<T> {
-        if !(v_ab.is_finite() && i_ab.is_finite()) {
-            return self.reject();
-        }
-        let backup = *self;
-        match self.step_unchecked(v_ab, i_ab) {
-            Some(out) => {
-                self.last = out;
-                out
-            }
-            None => {
-                // Finite but absurd inputs overflowed a state: roll back, never poison.
-                *self = backup;
-                self.reject()
-            }
-        }
+        self.guarded_step(v_ab, i_ab)
     }
 
-    fn reject(&mut self) -> Estimate<T> {
-        self.rejected_samples = self.rejected_samples.saturating_add(1);
-        let mut out = self.last;
-        out.diagnostics.input_fault = true;
-        out
+    /// ê: the filtered EMF (V), the interval mean ending at the last sample.
+    pub fn emf(&self) -> Ab<T> {
+        self.emf
     }
 
+    /// The last good estimate.
+    pub fn last(&self) -> &Estimate<T> {
+        &self.last
+    }
+
+    /// Number of samples rejected since the last reset.
+    pub fn rejected_samples(&self) -> u32 {
+        self.rejected_samples
+    }
+
+    /// The configuration in use.
+    pub fn config(&self) -> &EmfObserverConfig<T> {
+        &self.config
+    }
+}
+
+impl<T: Real> GuardedStep<T> for EmfObserverEstimator<T> {
     #[inline]
     fn step_unchecked(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> Option<Estimate<T>> {
         let ts = self.config.ts;
@@ -290,24 +291,8 @@ impl<T: Real> EmfObserverEstimator<T> {
         })
     }
 
-    /// ê: the filtered EMF (V), the interval mean ending at the last sample.
-    pub fn emf(&self) -> Ab<T> {
-        self.emf
-    }
-
-    /// The last good estimate.
-    pub fn last(&self) -> &Estimate<T> {
-        &self.last
-    }
-
-    /// Number of samples rejected since the last reset.
-    pub fn rejected_samples(&self) -> u32 {
-        self.rejected_samples
-    }
-
-    /// The configuration in use.
-    pub fn config(&self) -> &EmfObserverConfig<T> {
-        &self.config
+    fn record(&mut self) -> (&mut Estimate<T>, &mut u32) {
+        (&mut self.last, &mut self.rejected_samples)
     }
 }
 

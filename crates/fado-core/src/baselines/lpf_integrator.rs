@@ -50,7 +50,7 @@
 //!   a step decays with 1/ωc (160 ms at the default).
 //! - **Parameters.** Like fado, R̂s errors act at low speed and L̂q errors under load.
 
-use super::{AngleTrackers, Integrand, TrackerSettings};
+use super::{AngleTrackers, GuardedStep, Integrand, TrackerSettings};
 use crate::error::{ConfigError, check};
 use crate::estimator::{Diagnostics, Estimate, RotorAngleEstimator};
 use crate::tracker::BandwidthDefinition;
@@ -231,30 +231,31 @@ impl<T: Real> LpfIntegratorEstimator<T> {
     /// `input_fault` set.
     #[inline]
     pub fn step(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> Estimate<T> {
-        if !(v_ab.is_finite() && i_ab.is_finite()) {
-            return self.reject();
-        }
-        let backup = *self;
-        match self.step_unchecked(v_ab, i_ab) {
-            Some(out) => {
-                self.last = out;
-                out
-            }
-            None => {
-                // Finite but absurd inputs overflowed a state: roll back, never poison.
-                *self = backup;
-                self.reject()
-            }
-        }
+        self.guarded_step(v_ab, i_ab)
     }
 
-    fn reject(&mut self) -> Estimate<T> {
-        self.rejected_samples = self.rejected_samples.saturating_add(1);
-        let mut out = self.last;
-        out.diagnostics.input_fault = true;
-        out
+    /// ψ, the low-pass filtered integrand (before compensation).
+    pub fn filtered_flux(&self) -> Ab<T> {
+        self.psi
     }
 
+    /// The last good estimate.
+    pub fn last(&self) -> &Estimate<T> {
+        &self.last
+    }
+
+    /// Number of samples rejected since the last reset.
+    pub fn rejected_samples(&self) -> u32 {
+        self.rejected_samples
+    }
+
+    /// The configuration in use.
+    pub fn config(&self) -> &LpfIntegratorConfig<T> {
+        &self.config
+    }
+}
+
+impl<T: Real> GuardedStep<T> for LpfIntegratorEstimator<T> {
     #[inline]
     fn step_unchecked(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> Option<Estimate<T>> {
         let u = self.integrand.step(v_ab, i_ab);
@@ -282,24 +283,8 @@ impl<T: Real> LpfIntegratorEstimator<T> {
         })
     }
 
-    /// ψ, the low-pass filtered integrand (before compensation).
-    pub fn filtered_flux(&self) -> Ab<T> {
-        self.psi
-    }
-
-    /// The last good estimate.
-    pub fn last(&self) -> &Estimate<T> {
-        &self.last
-    }
-
-    /// Number of samples rejected since the last reset.
-    pub fn rejected_samples(&self) -> u32 {
-        self.rejected_samples
-    }
-
-    /// The configuration in use.
-    pub fn config(&self) -> &LpfIntegratorConfig<T> {
-        &self.config
+    fn record(&mut self) -> (&mut Estimate<T>, &mut u32) {
+        (&mut self.last, &mut self.rejected_samples)
     }
 }
 

@@ -38,6 +38,45 @@ pub use emf_observer::{EmfObserverConfig, EmfObserverEstimator};
 pub use lpf_integrator::{LpfIntegratorConfig, LpfIntegratorEstimator};
 pub use ortega::{OrtegaConfig, OrtegaEstimator};
 
+/// The sample-rejection rule every baseline shares (the same contract as
+/// [`crate::SensorlessEstimator::step`]): a non-finite input is refused, and a finite but absurd
+/// one that overflows a state is rolled back, so the state is never poisoned; either way the
+/// last good estimate is returned with `input_fault` set and the sample is counted.
+pub(crate) trait GuardedStep<T: Real>: Copy {
+    /// The estimator's own update; `None` when a new state came out non-finite.
+    fn step_unchecked(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> Option<crate::Estimate<T>>;
+    /// The last good estimate and the rejected-sample counter.
+    fn record(&mut self) -> (&mut crate::Estimate<T>, &mut u32);
+
+    /// One guarded sample.
+    #[inline]
+    fn guarded_step(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> crate::Estimate<T> {
+        if !(v_ab.is_finite() && i_ab.is_finite()) {
+            return self.reject();
+        }
+        let backup = *self;
+        match self.step_unchecked(v_ab, i_ab) {
+            Some(out) => {
+                *self.record().0 = out;
+                out
+            }
+            None => {
+                *self = backup;
+                self.reject()
+            }
+        }
+    }
+
+    /// Counts the sample and repeats the last good estimate, flagged.
+    fn reject(&mut self) -> crate::Estimate<T> {
+        let (last, rejected) = self.record();
+        *rejected = rejected.saturating_add(1);
+        let mut out = *last;
+        out.diagnostics.input_fault = true;
+        out
+    }
+}
+
 use crate::error::{ConfigError, check};
 use crate::tracker::{BandwidthDefinition, TrackerConfig, TypeTwoTracker};
 use crate::{Ab, Real};

@@ -80,7 +80,7 @@
 //!   the EMF observer only see a magnitude error; L̂ errors act under load as in fado; the
 //!   model assumes Ld = Lq.
 
-use super::{AngleTrackers, Integrand, TrackerSettings};
+use super::{AngleTrackers, GuardedStep, Integrand, TrackerSettings};
 use crate::error::{ConfigError, check};
 use crate::estimator::{Diagnostics, Estimate, RotorAngleEstimator};
 use crate::tracker::BandwidthDefinition;
@@ -289,30 +289,31 @@ impl<T: Real> OrtegaEstimator<T> {
     /// `input_fault` set.
     #[inline]
     pub fn step(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> Estimate<T> {
-        if !(v_ab.is_finite() && i_ab.is_finite()) {
-            return self.reject();
-        }
-        let backup = *self;
-        match self.step_unchecked(v_ab, i_ab) {
-            Some(out) => {
-                self.last = out;
-                out
-            }
-            None => {
-                // Finite but absurd inputs overflowed a state: roll back, never poison.
-                *self = backup;
-                self.reject()
-            }
-        }
+        self.guarded_step(v_ab, i_ab)
     }
 
-    fn reject(&mut self) -> Estimate<T> {
-        self.rejected_samples = self.rejected_samples.saturating_add(1);
-        let mut out = self.last;
-        out.diagnostics.input_fault = true;
-        out
+    /// λ̂: the radius η̂ is pulled to (λ̂f, or its adapted value).
+    pub fn flux_linkage_estimate(&self) -> T {
+        self.lambda
     }
 
+    /// The last good estimate.
+    pub fn last(&self) -> &Estimate<T> {
+        &self.last
+    }
+
+    /// Number of samples rejected since the last reset.
+    pub fn rejected_samples(&self) -> u32 {
+        self.rejected_samples
+    }
+
+    /// The configuration in use.
+    pub fn config(&self) -> &OrtegaConfig<T> {
+        &self.config
+    }
+}
+
+impl<T: Real> GuardedStep<T> for OrtegaEstimator<T> {
     #[inline]
     fn step_unchecked(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> Option<Estimate<T>> {
         let li = i_ab * self.config.lq_hat;
@@ -355,24 +356,8 @@ impl<T: Real> OrtegaEstimator<T> {
         })
     }
 
-    /// λ̂: the radius η̂ is pulled to (λ̂f, or its adapted value).
-    pub fn flux_linkage_estimate(&self) -> T {
-        self.lambda
-    }
-
-    /// The last good estimate.
-    pub fn last(&self) -> &Estimate<T> {
-        &self.last
-    }
-
-    /// Number of samples rejected since the last reset.
-    pub fn rejected_samples(&self) -> u32 {
-        self.rejected_samples
-    }
-
-    /// The configuration in use.
-    pub fn config(&self) -> &OrtegaConfig<T> {
-        &self.config
+    fn record(&mut self) -> (&mut Estimate<T>, &mut u32) {
+        (&mut self.last, &mut self.rejected_samples)
     }
 }
 
