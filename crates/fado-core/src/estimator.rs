@@ -22,6 +22,7 @@ use crate::flux::{
 use crate::mode::{Mode, ModeSelector, ModeSelectorConfig};
 use crate::observer::{DisturbanceObserver, DisturbanceObserverConfig};
 use crate::rotor_flux::{rotor_angle, rotor_flux, stator_flux};
+use crate::rs_adaptation::{AdaptationRegime, ResistanceAdaptation, ResistanceAdaptationConfig};
 use crate::tracker::{BandwidthDefinition, TrackerConfig, TypeTwoTracker};
 use crate::{Ab, Real};
 
@@ -85,10 +86,24 @@ pub struct EstimatorConfig<T> {
     /// drops from 6.0 % to 2.1 % of λf, the rest being the LO→HI hand-over transient (see
     /// crates/fado-sim/README.md).
     pub observer_on_rotor_flux: bool,
+    /// Adapt R̂s online from the flux-magnitude error (our extension \[A\], see
+    /// [`crate::rs_adaptation`]); `false` keeps R̂s fixed as in the paper. Default false.
+    pub rs_adaptation: bool,
+    /// γ of the R̂s adaptation in s⁻¹. Default as [`ResistanceAdaptationConfig::rate`].
+    pub rs_adaptation_rate: T,
+    /// χ0 of the R̂s adaptation. Default as [`ResistanceAdaptationConfig::excitation_floor`].
+    pub rs_adaptation_excitation_floor: T,
+    /// Lower bound of the adapted R̂s as a multiple of `rs_hat`. Default as
+    /// [`ResistanceAdaptationConfig::min_ratio`].
+    pub rs_adaptation_min_ratio: T,
+    /// Upper bound of the adapted R̂s as a multiple of `rs_hat`. Default as
+    /// [`ResistanceAdaptationConfig::max_ratio`].
+    pub rs_adaptation_max_ratio: T,
 }
 
 impl<T: Real> Default for EstimatorConfig<T> {
     fn default() -> Self {
+        let rs = ResistanceAdaptationConfig::<T>::default();
         Self {
             ts: T::lit(100e-6),
             rs_hat: T::lit(0.327),
@@ -108,6 +123,11 @@ impl<T: Real> Default for EstimatorConfig<T> {
             average_current: true,
             initial_angle: T::zero(),
             observer_on_rotor_flux: true,
+            rs_adaptation: false,
+            rs_adaptation_rate: rs.rate,
+            rs_adaptation_excitation_floor: rs.excitation_floor,
+            rs_adaptation_min_ratio: rs.min_ratio,
+            rs_adaptation_max_ratio: rs.max_ratio,
         }
     }
 }
@@ -116,6 +136,20 @@ impl<T: Real> EstimatorConfig<T> {
     /// Checks every field; the error names the first bad one.
     pub fn validate(&self) -> Result<(), ConfigError> {
         SensorlessEstimator::new(*self).map(|_| ())
+    }
+
+    fn rs_adaptation(&self) -> ResistanceAdaptationConfig<T> {
+        ResistanceAdaptationConfig {
+            ts: self.ts,
+            rs_initial: self.rs_hat,
+            flux_linkage_hat: self.flux_linkage_hat,
+            lq_hat: self.lq_hat,
+            rate: self.rs_adaptation_rate,
+            excitation_floor: self.rs_adaptation_excitation_floor,
+            min_ratio: self.rs_adaptation_min_ratio,
+            max_ratio: self.rs_adaptation_max_ratio,
+            ..ResistanceAdaptationConfig::default()
+        }
     }
 
     fn tracker(&self, bandwidth_hz: T) -> TrackerConfig<T> {
@@ -149,6 +183,9 @@ pub struct Diagnostics<T> {
     pub limiter_clamping: bool,
     /// The trackers coasted because |λ̂r| was too small.
     pub tracker_hold: bool,
+    /// R̂s used by the integrator this sample (Ω): the configured value, or the adapted one
+    /// with [`EstimatorConfig::rs_adaptation`].
+    pub rs_hat: T,
     /// This sample's inputs were non-finite and were rejected; the state is unchanged and the
     /// other fields repeat the last good sample.
     pub input_fault: bool,
@@ -187,6 +224,7 @@ pub struct SensorlessEstimator<T> {
     selector: ModeSelector<T>,
     t2s1: TypeTwoTracker<T>,
     t2s2: TypeTwoTracker<T>,
+    rs_adaptation: ResistanceAdaptation<T>,
     /// Feedback term computed at the end of the previous sample.
     feedback: Ab<T>,
     hold_level_sq: T,
@@ -247,6 +285,15 @@ impl<T: Real> SensorlessEstimator<T> {
             .map_err(rename("t2s1_bandwidth_hz"))?;
         let t2s2 = TypeTwoTracker::new(config.tracker(config.t2s2_bandwidth_hz))
             .map_err(rename("t2s2_bandwidth_hz"))?;
+        let rs_adaptation =
+            ResistanceAdaptation::new(config.rs_adaptation()).map_err(|e| match e.field() {
+                "rs_initial" => rename("rs_hat")(e),
+                "rate" => rename("rs_adaptation_rate")(e),
+                "excitation_floor" => rename("rs_adaptation_excitation_floor")(e),
+                "min_ratio" => rename("rs_adaptation_min_ratio")(e),
+                "max_ratio" => rename("rs_adaptation_max_ratio")(e),
+                _ => e,
+            })?;
         let hold_level = hold * lf;
         let mut est = Self {
             config,
@@ -257,6 +304,7 @@ impl<T: Real> SensorlessEstimator<T> {
             selector,
             t2s1,
             t2s2,
+            rs_adaptation,
             feedback: Ab::zero(),
             hold_level_sq: hold_level * hold_level,
             k_df_enabled: true,
@@ -267,13 +315,20 @@ impl<T: Real> SensorlessEstimator<T> {
         Ok(est)
     }
 
-    /// Back to the start-up state at `config.initial_angle` with zero current.
+    /// Back to the start-up state at `config.initial_angle` with zero current; an adapted R̂s
+    /// goes back to the configured value.
     pub fn reset(&mut self) {
+        if self.config.rs_adaptation {
+            self.rs_adaptation.reset();
+            self.integrator
+                .set_rs_hat_unchecked(self.rs_adaptation.rs_hat());
+        }
         self.align(self.config.initial_angle, Ab::zero());
     }
 
     /// Start-up at a known rotor angle θ0 with the present current (SPEC §1 step 6):
-    /// λ1 = λ̂f·e^{jθ0} + L̂q·i, D̂ = 0, θ̂ = θ0, ω̂ = 0, limiter mode.
+    /// λ1 = λ̂f·e^{jθ0} + L̂q·i, D̂ = 0, θ̂ = θ0, ω̂ = 0, limiter mode. An adapted R̂s is kept
+    /// (the winding is as warm as it was).
     pub fn align(&mut self, theta0: T, i_ab: Ab<T>) {
         let theta0 = if theta0.is_finite() {
             theta0
@@ -310,6 +365,7 @@ impl<T: Real> SensorlessEstimator<T> {
                 flag_limit: true,
                 limiter_clamping: false,
                 tracker_hold: false,
+                rs_hat: self.rs_adaptation.rs_hat(),
                 input_fault: false,
             },
         };
@@ -365,15 +421,41 @@ impl<T: Real> SensorlessEstimator<T> {
                 (l.feedback, l.clamping)
             }
         };
+        // 6. R̂s for the next sample, learned only in the k_df mode (see `rs_adaptation`).
+        let rs_state = if self.config.rs_adaptation {
+            let regime = match (self.selector.mode(), mode) {
+                _ if tracker_hold => AdaptationRegime::Frozen,
+                (Mode::DisturbanceFeedback, Mode::DisturbanceFeedback) => {
+                    AdaptationRegime::Rotating
+                }
+                (Mode::Limiter, Mode::Limiter) => AdaptationRegime::Standstill,
+                _ => AdaptationRegime::Frozen,
+            };
+            Some(self.rs_adaptation.next_state(
+                v_ab,
+                self.integrator.drop_current(i_ab),
+                lambda_r,
+                t2s1.omega,
+                regime,
+            ))
+        } else {
+            None
+        };
         let finite = lambda1.is_finite()
             & observer_flux.is_finite()
             & disturbance.is_finite()
             & lambda_r.is_finite()
             & feedback.is_finite()
             & t2s1.is_finite()
-            & t2s2.is_finite();
+            & t2s2.is_finite()
+            & rs_state.is_none_or(|r| r.is_finite());
         if !finite {
             return self.reject();
+        }
+        let rs_hat_used = self.integrator.config().rs_hat;
+        if let Some(r) = rs_state {
+            self.rs_adaptation.commit(r);
+            self.integrator.set_rs_hat_unchecked(r.rs_hat);
         }
         self.integrator.commit(lambda1, i_ab);
         self.observer.commit(observer_flux, disturbance);
@@ -396,6 +478,7 @@ impl<T: Real> SensorlessEstimator<T> {
                 flag_limit: mode == Mode::Limiter,
                 limiter_clamping: clamping,
                 tracker_hold,
+                rs_hat: rs_hat_used,
                 input_fault: false,
             },
         };
@@ -426,11 +509,25 @@ impl<T: Real> SensorlessEstimator<T> {
         self.k_df_enabled = enabled;
     }
 
-    /// Replaces R̂s at run time (for online resistance adaptation). Refuses bad values.
+    /// Replaces R̂s at run time (an external estimate, or a value saved from the last run).
+    /// Refuses bad values. Without [`EstimatorConfig::rs_adaptation`] it becomes the
+    /// configuration's `rs_hat`; with it, the adaptation continues from it (clamped to its
+    /// bounds) and the configuration keeps the start value that `reset` returns to.
     pub fn set_rs_hat(&mut self, rs_hat: T) -> Result<(), ConfigError> {
-        self.integrator.set_rs_hat(rs_hat)?;
-        self.config.rs_hat = rs_hat;
+        if self.config.rs_adaptation {
+            self.rs_adaptation.set_rs_hat(rs_hat)?;
+            self.integrator
+                .set_rs_hat_unchecked(self.rs_adaptation.rs_hat());
+        } else {
+            self.integrator.set_rs_hat(rs_hat)?;
+            self.config.rs_hat = rs_hat;
+        }
         Ok(())
+    }
+
+    /// R̂s in use now (Ω).
+    pub fn rs_hat(&self) -> T {
+        self.integrator.config().rs_hat
     }
 
     /// The configuration in use.

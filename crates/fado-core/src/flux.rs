@@ -85,12 +85,25 @@ impl<T: Real> FluxIntegrator<T> {
     /// λ1 after one more sample, computed without changing the state.
     #[inline]
     pub(crate) fn next_flux(&self, v_ab: Ab<T>, i_ab: Ab<T>, feedback: Ab<T>) -> Ab<T> {
-        let i_drop = if self.config.average_current && self.has_prev {
+        let i_drop = self.drop_current(i_ab);
+        self.lambda1 + (v_ab - i_drop * self.config.rs_hat - feedback) * self.config.ts
+    }
+
+    /// The current multiplied by R̂s in the sample ending with `i_ab`: the interval's average
+    /// (with `average_current`) or `i_ab`.
+    #[inline]
+    pub(crate) fn drop_current(&self, i_ab: Ab<T>) -> Ab<T> {
+        if self.config.average_current && self.has_prev {
             (i_ab + self.i_prev) * T::lit(0.5)
         } else {
             i_ab
-        };
-        self.lambda1 + (v_ab - i_drop * self.config.rs_hat - feedback) * self.config.ts
+        }
+    }
+
+    /// Sets R̂s from a value already checked (by the resistance adaptation's bounds).
+    #[inline]
+    pub(crate) fn set_rs_hat_unchecked(&mut self, rs_hat: T) {
+        self.config.rs_hat = rs_hat;
     }
 
     /// Takes λ1 computed by [`Self::next_flux`] for the sample with current `i_ab`.

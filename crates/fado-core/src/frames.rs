@@ -114,6 +114,20 @@ impl<T: Real> Ab<T> {
         )
     }
 
+    /// Scalar product α₁α₂ + β₁β₂: the component of `other` along `self` when `self` is a unit
+    /// vector (e.g. i_d for the unit flux vector).
+    #[inline]
+    pub fn dot(self, other: Self) -> T {
+        self.alpha * other.alpha + self.beta * other.beta
+    }
+
+    /// Cross product α₁β₂ − β₁α₂: the component of `other` along j·`self` (e.g. i_q for the
+    /// unit flux vector).
+    #[inline]
+    pub fn cross(self, other: Self) -> T {
+        self.alpha * other.beta - self.beta * other.alpha
+    }
+
     /// Multiplication by j (rotation by +90°).
     #[inline]
     pub fn mul_j(self) -> Self {

@@ -31,6 +31,7 @@ pub mod mode;
 pub mod observer;
 pub mod real;
 pub mod rotor_flux;
+pub mod rs_adaptation;
 pub mod tracker;
 
 pub use baselines::{EmfObserverEstimator, LpfIntegratorEstimator, OrtegaEstimator};

@@ -160,6 +160,16 @@ config_class! {
     observer_on_rotor_flux: bool,
     /// Rotor angle assumed at reset in rad (electrical).
     initial_angle: f64,
+    /// Adapt R̂s online (our extension; false = the paper's fixed R̂s).
+    rs_adaptation: bool,
+    /// Rate γ of the R̂s adaptation while turning, in 1/s.
+    rs_adaptation_rate: f64,
+    /// Excitation floor χ0 of the R̂s adaptation.
+    rs_adaptation_excitation_floor: f64,
+    /// Lower bound of the adapted R̂s as a multiple of `rs_hat`.
+    rs_adaptation_min_ratio: f64,
+    /// Upper bound of the adapted R̂s as a multiple of `rs_hat`.
+    rs_adaptation_max_ratio: f64,
 }
 
 impl Default for PyEstimatorConfig {
@@ -190,6 +200,11 @@ impl PyEstimatorConfig {
             average_current: c.average_current,
             observer_on_rotor_flux: c.observer_on_rotor_flux,
             initial_angle: c.initial_angle,
+            rs_adaptation: c.rs_adaptation,
+            rs_adaptation_rate: c.rs_adaptation_rate,
+            rs_adaptation_excitation_floor: c.rs_adaptation_excitation_floor,
+            rs_adaptation_min_ratio: c.rs_adaptation_min_ratio,
+            rs_adaptation_max_ratio: c.rs_adaptation_max_ratio,
         }
     }
 
@@ -215,6 +230,11 @@ impl PyEstimatorConfig {
             average_current: self.average_current,
             observer_on_rotor_flux: self.observer_on_rotor_flux,
             initial_angle: T::lit(self.initial_angle),
+            rs_adaptation: self.rs_adaptation,
+            rs_adaptation_rate: T::lit(self.rs_adaptation_rate),
+            rs_adaptation_excitation_floor: T::lit(self.rs_adaptation_excitation_floor),
+            rs_adaptation_min_ratio: T::lit(self.rs_adaptation_min_ratio),
+            rs_adaptation_max_ratio: T::lit(self.rs_adaptation_max_ratio),
         };
         config.validate().map_err(|e| config_error(py, e))?;
         Ok(config)

@@ -235,6 +235,17 @@ pub struct EstimatorSettings {
     /// Disturbance observer on λ1 − L̂q·i (true, our improvement) or on λ1 (false, the
     /// paper's Fig. 5). Default as `EstimatorConfig::observer_on_rotor_flux`.
     pub observer_on_rotor_flux: bool,
+    /// Online R̂s adaptation (our extension; false = the paper). Default as
+    /// `EstimatorConfig::rs_adaptation`.
+    pub rs_adaptation: bool,
+    /// R̂s adaptation rate γ, s⁻¹. Default as `EstimatorConfig::rs_adaptation_rate`.
+    pub rs_adaptation_rate: f64,
+    /// R̂s adaptation excitation floor χ0. Default as `EstimatorConfig`.
+    pub rs_adaptation_excitation_floor: f64,
+    /// Lower bound of the adapted R̂s / configured R̂s. Default as `EstimatorConfig`.
+    pub rs_adaptation_min_ratio: f64,
+    /// Upper bound of the adapted R̂s / configured R̂s. Default as `EstimatorConfig`.
+    pub rs_adaptation_max_ratio: f64,
     /// LPF baseline: cut-off of 1/(s + ωc), Hz. Default as `LpfIntegratorConfig`.
     pub lpf_cutoff_hz: f64,
     /// LPF baseline: speed below which its gain/phase compensation is frozen, Hz.
@@ -276,6 +287,11 @@ impl Default for EstimatorSettings {
             tracker_hold_ratio: d.tracker_hold_ratio,
             average_current: d.average_current,
             observer_on_rotor_flux: d.observer_on_rotor_flux,
+            rs_adaptation: d.rs_adaptation,
+            rs_adaptation_rate: d.rs_adaptation_rate,
+            rs_adaptation_excitation_floor: d.rs_adaptation_excitation_floor,
+            rs_adaptation_min_ratio: d.rs_adaptation_min_ratio,
+            rs_adaptation_max_ratio: d.rs_adaptation_max_ratio,
             kind: EstimatorKind::Fado,
             lpf_cutoff_hz: lpf.cutoff_hz,
             lpf_compensation_floor_hz: lpf.compensation_floor_hz,
@@ -449,6 +465,11 @@ impl SimConfig {
             tracker_hold_ratio: e.tracker_hold_ratio,
             average_current: e.average_current,
             observer_on_rotor_flux: e.observer_on_rotor_flux,
+            rs_adaptation: e.rs_adaptation,
+            rs_adaptation_rate: e.rs_adaptation_rate,
+            rs_adaptation_excitation_floor: e.rs_adaptation_excitation_floor,
+            rs_adaptation_min_ratio: e.rs_adaptation_min_ratio,
+            rs_adaptation_max_ratio: e.rs_adaptation_max_ratio,
             initial_angle: self.simulation.initial_angle + self.simulation.align_error,
         }
     }

@@ -256,6 +256,7 @@ impl Controller for DriveF32 {
                     flag_limit: d.flag_limit,
                     limiter_clamping: d.limiter_clamping,
                     tracker_hold: d.tracker_hold,
+                    rs_hat: d.rs_hat as f64,
                     input_fault: d.input_fault,
                 },
             },
@@ -328,6 +329,11 @@ impl SimConfig {
             average_current: e.average_current,
             initial_angle: f(e.initial_angle),
             observer_on_rotor_flux: e.observer_on_rotor_flux,
+            rs_adaptation: e.rs_adaptation,
+            rs_adaptation_rate: f(e.rs_adaptation_rate),
+            rs_adaptation_excitation_floor: f(e.rs_adaptation_excitation_floor),
+            rs_adaptation_min_ratio: f(e.rs_adaptation_min_ratio),
+            rs_adaptation_max_ratio: f(e.rs_adaptation_max_ratio),
         };
         dc.validate()
             .map_err(|e| SimConfigError::from(e).in_section("controller"))?;

@@ -509,12 +509,14 @@ pub struct TraceRow {
     pub i_alpha: f64,
     /// Measured current β, A.
     pub i_beta: f64,
+    /// R̂s the estimator integrated with, Ω (moves with `[estimator] rs_adaptation`).
+    pub rs_hat: f64,
 }
 
 impl TraceRow {
     /// Column names, in CSV order (for struct-of-arrays consumers such as the Python
     /// bindings).
-    pub const COLUMNS: [&'static str; 36] = [
+    pub const COLUMNS: [&'static str; 37] = [
         "time",
         "theta",
         "theta_hat",
@@ -551,10 +553,11 @@ impl TraceRow {
         "v_beta_applied",
         "i_alpha",
         "i_beta",
+        "rs_hat",
     ];
 
     /// The row's values in [`COLUMNS`](Self::COLUMNS) order (flags as 0.0/1.0).
-    pub fn values(&self) -> [f64; 36] {
+    pub fn values(&self) -> [f64; 37] {
         [
             self.time,
             self.theta,
@@ -592,6 +595,7 @@ impl TraceRow {
             self.v_beta_applied,
             self.i_alpha,
             self.i_beta,
+            self.rs_hat,
         ]
     }
 }
@@ -636,6 +640,7 @@ impl From<&Sample> for TraceRow {
             v_beta_applied: s.v_ab_applied.beta,
             i_alpha: s.i_ab_measured.alpha,
             i_beta: s.i_ab_measured.beta,
+            rs_hat: d.rs_hat,
         }
     }
 }
