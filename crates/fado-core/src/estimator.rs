@@ -414,15 +414,9 @@ impl<T: Real> SensorlessEstimator<T> {
         let mode = self.selector.next_mode(t2s2.omega);
         let kdf_active = mode == Mode::DisturbanceFeedback && self.k_df_enabled;
         let kdf_gain = self.disturbance_feedback.next_gain(kdf_active);
-        let (feedback, clamping) = match mode {
-            Mode::DisturbanceFeedback => (disturbance * kdf_gain, false),
-            Mode::Limiter => {
-                let l = self.limiter.step(lambda_r);
-                (l.feedback, l.clamping)
-            }
-        };
-        // 6. R̂s for the next sample, learned only in the k_df mode (see `rs_adaptation`).
-        let rs_state = if self.config.rs_adaptation {
+        // 6. R̂s for the next sample (see `rs_adaptation`): the flux-magnitude law in the k_df
+        //    mode, the d-axis DC test in the limiter mode.
+        let (rs_state, flux_pull) = if self.config.rs_adaptation {
             let regime = match (self.selector.mode(), mode) {
                 _ if tracker_hold => AdaptationRegime::Frozen,
                 (Mode::DisturbanceFeedback, Mode::DisturbanceFeedback) => {
@@ -431,15 +425,23 @@ impl<T: Real> SensorlessEstimator<T> {
                 (Mode::Limiter, Mode::Limiter) => AdaptationRegime::Standstill,
                 _ => AdaptationRegime::Frozen,
             };
-            Some(self.rs_adaptation.next_state(
+            let (state, pull) = self.rs_adaptation.next_state(
                 v_ab,
                 self.integrator.drop_current(i_ab),
                 lambda_r,
                 t2s1.omega,
                 regime,
-            ))
+            );
+            (Some(state), pull)
         } else {
-            None
+            (None, Ab::zero())
+        };
+        let (feedback, clamping) = match mode {
+            Mode::DisturbanceFeedback => (disturbance * kdf_gain, false),
+            Mode::Limiter => {
+                let l = self.limiter.step(lambda_r);
+                (l.feedback + flux_pull, l.clamping)
+            }
         };
         let finite = lambda1.is_finite()
             & observer_flux.is_finite()
