@@ -254,6 +254,11 @@ impl<T: Real> ResistanceAdaptation<T> {
         omega: T,
         regime: AdaptationRegime,
     ) -> T {
+        let inputs_finite =
+            v_ab.is_finite() && i_drop.is_finite() && lambda_r.is_finite() && omega.is_finite();
+        if !inputs_finite {
+            return self.state.rs_hat;
+        }
         let (next, _) = self.next_state(v_ab, i_drop, lambda_r, omega, regime);
         if next.is_finite() {
             self.commit(next);
@@ -297,7 +302,7 @@ impl<T: Real> ResistanceAdaptation<T> {
             }
         } else {
             // Standstill: only at standstill and while the current lies along the flux.
-            if i_d <= (i_q + i_q).abs() || !(omega.abs() <= self.standstill_omega) {
+            if i_d <= (i_q + i_q).abs() || omega.abs() > self.standstill_omega {
                 return (next, pull);
             }
             let ts = self.config.ts;

@@ -1,0 +1,308 @@
+//! Online R̂s adaptation (`fado_core::rs_adaptation`) against the ideal PMSM generator: the
+//! laws converge at the rate their analysis gives, freeze without excitation, and keep R̂s
+//! through a loaded zero-speed crossing.
+
+mod common;
+
+use common::*;
+use fado_core::rs_adaptation::{
+    AdaptationRegime, ResistanceAdaptation, ResistanceAdaptationConfig,
+};
+use fado_core::{Ab, Dq, EstimatorConfig, Mode, SensorlessEstimator, wrap_angle};
+use proptest::prelude::*;
+
+/// Rated-load q current for 7.5 N·m: T = 1.5·p·λf·i_q.
+const IQ_LOAD: f64 = 7.5 / (1.5 * PP * LF);
+
+fn estimator(rs_ratio: f64, theta0: f64) -> SensorlessEstimator<f64> {
+    SensorlessEstimator::new(EstimatorConfig {
+        rs_hat: RS * rs_ratio,
+        initial_angle: theta0,
+        rs_adaptation: true,
+        ..Default::default()
+    })
+    .unwrap()
+}
+
+/// R̂s/Rs − 1 sampled every `every` s while the estimator follows `speed(t)` with `i_dq(t)`.
+fn rs_error_history(
+    rs_ratio: f64,
+    seconds: f64,
+    speed: impl Fn(f64) -> f64,
+    i_dq: impl Fn(f64) -> Dq<f64>,
+) -> Vec<(f64, f64, f64, Mode)> {
+    let theta0 = 0.4;
+    let mut est = estimator(rs_ratio, theta0);
+    let (_, i0) = flux_and_current(theta0, i_dq(0.0));
+    est.align(theta0, i0);
+    let n = (seconds / TS) as usize;
+    profile(theta0, n, speed, i_dq, Ab::zero(), Ab::zero())
+        .enumerate()
+        .map(|(k, s)| {
+            let out = est.step(s.v, s.i);
+            let d = out.diagnostics;
+            (
+                (k + 1) as f64 * TS,
+                d.rs_hat / RS - 1.0,
+                wrap_angle(s.theta - out.theta),
+                d.mode,
+            )
+        })
+        .collect()
+}
+
+fn at(history: &[(f64, f64, f64, Mode)], t: f64) -> f64 {
+    history[((t / TS) as usize).min(history.len() - 1)].1
+}
+
+#[test]
+fn turning_law_converges_from_plus_minus_30_percent_at_the_analysed_rate() {
+    // −90 r/min under 7.5 N·m (Fig. 11's loaded segment): χ = R0·i_q/(|ω|·λ̂f) ≈ 1.4·R0/Rs, and
+    // the relative error decays at γ·χ²/(χ² + χ0²) with γ = 1 s⁻¹, χ0 = 0.2.
+    let omega = rpm_to_electrical(-90.0);
+    for ratio in [0.7, 1.3] {
+        let h = rs_error_history(ratio, 6.0, |_| omega, |_| Dq::new(0.0, IQ_LOAD));
+        let chi = RS * ratio * IQ_LOAD / (omega.abs() * LF);
+        let expected = chi * chi / (chi * chi + 0.04);
+        let (e1, e3) = (at(&h, 1.0), at(&h, 3.0));
+        let measured = (e1 / e3).ln() / 2.0;
+        assert!(
+            (measured / expected - 1.0).abs() < 0.25,
+            "R̂s/Rs = {ratio}: decay rate {measured:.3} s⁻¹, analysis {expected:.3} s⁻¹"
+        );
+        let last = at(&h, 6.0);
+        assert!(
+            last.abs() < 0.01,
+            "R̂s/Rs = {ratio}: error after 6 s {last:.4}"
+        );
+        // The angle is right throughout the k_df mode: the R̂s error only moves |λ̂r|.
+        let worst = h
+            .iter()
+            .filter(|s| s.0 > 0.5)
+            .map(|s| s.2.abs())
+            .fold(0.0, f64::max);
+        assert!(worst < 0.05, "R̂s/Rs = {ratio}: max |θ − θ̂| {worst:.3}");
+    }
+}
+
+#[test]
+fn turning_law_works_in_the_generating_quadrant() {
+    // +90 r/min with the load torque still positive... i.e. i_q < 0 at ω > 0: φ changes sign.
+    let omega = rpm_to_electrical(90.0);
+    let h = rs_error_history(0.75, 6.0, |_| omega, |_| Dq::new(0.0, -IQ_LOAD));
+    assert!(
+        at(&h, 6.0).abs() < 0.01,
+        "error after 6 s {:.4}",
+        at(&h, 6.0)
+    );
+}
+
+#[test]
+fn learned_resistance_is_kept_through_a_loaded_reversal() {
+    // 4 s at −90 r/min to learn, then −90 → +90 r/min in 2 s at 7.5 N·m (Fig. 11's ramp).
+    let w = rpm_to_electrical(90.0);
+    let speed = move |t: f64| {
+        if t < 4.0 {
+            -w
+        } else {
+            (-w + w * (t - 4.0)).min(w)
+        }
+    };
+    let h = rs_error_history(0.7, 7.0, speed, |_| Dq::new(0.0, IQ_LOAD));
+    let before = at(&h, 4.0);
+    assert!(
+        before.abs() < 0.03,
+        "not learned before the reversal: {before:.4}"
+    );
+    // Below the k_df threshold the load current lies along q: nothing is observable, the law
+    // must hold R̂s, and the angle survives the crossing.
+    let limiter: Vec<_> = h
+        .iter()
+        .filter(|s| s.0 > 4.0 && s.3 == Mode::Limiter)
+        .collect();
+    assert!(limiter.len() > 1000, "the crossing took the limiter mode");
+    let spread = limiter
+        .iter()
+        .map(|s| (s.1 - before).abs())
+        .fold(0.0, f64::max);
+    assert!(
+        spread < 0.005,
+        "R̂s moved by {spread:.4} in the limiter mode"
+    );
+    let worst = h
+        .iter()
+        .filter(|s| s.0 > 4.0)
+        .map(|s| s.2.abs())
+        .fold(0.0, f64::max);
+    assert!(worst < 0.25, "max |θ − θ̂| through the reversal {worst:.3}");
+    assert!(at(&h, 7.0).abs() < 0.03);
+}
+
+#[test]
+fn no_excitation_no_drift() {
+    // No load at 300 r/min with a 5 % λ̂f error: |λ̂r| − λ̂f is 5 % but χ = 0 (i = 0, or the
+    // eq. (23) injection along d), so R̂s must not move at all.
+    for i_dq in [Dq::new(0.0, 0.0), Dq::new(4.0, 0.0)] {
+        let mut est = SensorlessEstimator::new(EstimatorConfig {
+            flux_linkage_hat: LF * 1.05,
+            initial_angle: 0.4,
+            rs_adaptation: true,
+            ..Default::default()
+        })
+        .unwrap();
+        let n = (3.0 / TS) as usize;
+        let mut moved: f64 = 0.0;
+        for (v, i, _) in constant_speed(300.0, 0.4, i_dq, n, Ab::zero()) {
+            let d = est.step(v, i).diagnostics;
+            if d.mode == Mode::DisturbanceFeedback {
+                moved = moved.max((d.rs_hat - RS).abs());
+            }
+        }
+        assert_eq!(moved, 0.0, "{i_dq:?}: R̂s moved by {moved}");
+    }
+}
+
+#[test]
+fn standstill_dc_test_converges_and_restores_the_flux_magnitude() {
+    // The eq. (23) injection at standstill (no load): R̂s from ±30 % within 1 % in 0.3 s, and
+    // the radial flux error it integrated meanwhile pulled back to λ̂f.
+    for ratio in [0.7, 1.3] {
+        let theta0 = 0.4;
+        let mut est = estimator(ratio, theta0);
+        let i_dq = Dq::new(4.0, 0.0);
+        let (_, i0) = flux_and_current(theta0, i_dq);
+        est.align(theta0, i0);
+        let n = (0.3 / TS) as usize;
+        let mut last = None;
+        for (v, i, theta) in constant_speed(0.0, theta0, i_dq, n, Ab::zero()) {
+            last = Some((est.step(v, i), theta));
+        }
+        let (out, theta) = last.unwrap();
+        let d = out.diagnostics;
+        assert!(
+            (d.rs_hat / RS - 1.0).abs() < 0.01,
+            "{ratio}: R̂s/Rs = {}",
+            d.rs_hat / RS
+        );
+        let mag = d.lambda_r.norm();
+        assert!(
+            (mag / LF - 1.0).abs() < 0.01,
+            "{ratio}: |λ̂r|/λf = {}",
+            mag / LF
+        );
+        assert!(wrap_angle(theta - out.theta).abs() < 0.01);
+    }
+}
+
+#[test]
+fn standstill_law_freezes_under_q_current() {
+    // Load at standstill: the flux error goes into the angle, |λ̂r| does not see it.
+    let mut est = estimator(1.2, 0.4);
+    let i_dq = Dq::new(0.0, IQ_LOAD);
+    let (_, i0) = flux_and_current(0.4, i_dq);
+    est.align(0.4, i0);
+    for (v, i, _) in constant_speed(0.0, 0.4, i_dq, 2000, Ab::zero()) {
+        assert_eq!(est.step(v, i).diagnostics.rs_hat, RS * 1.2);
+    }
+}
+
+#[test]
+fn off_keeps_the_configured_resistance_and_reset_restores_it() {
+    let mut off = SensorlessEstimator::new(EstimatorConfig {
+        rs_hat: RS * 1.3,
+        rs_adaptation: false,
+        ..Default::default()
+    })
+    .unwrap();
+    let mut on = estimator(1.3, 0.0);
+    let i_dq = Dq::new(4.0, 0.0);
+    for (v, i, _) in constant_speed(0.0, 0.0, i_dq, 3000, Ab::zero()) {
+        assert_eq!(off.step(v, i).diagnostics.rs_hat, RS * 1.3);
+        on.step(v, i);
+    }
+    assert!((on.rs_hat() / RS - 1.0).abs() < 0.02);
+    on.reset();
+    assert_eq!(on.rs_hat(), RS * 1.3);
+}
+
+#[test]
+fn bad_configurations_name_their_field() {
+    let cases: [(&str, EstimatorConfig<f64>); 5] = [
+        (
+            "rs_adaptation_rate",
+            EstimatorConfig {
+                rs_adaptation_rate: f64::NAN,
+                ..Default::default()
+            },
+        ),
+        (
+            "rs_adaptation_rate",
+            EstimatorConfig {
+                rs_adaptation_rate: 2e4,
+                ..Default::default()
+            },
+        ),
+        (
+            "rs_adaptation_excitation_floor",
+            EstimatorConfig {
+                rs_adaptation_excitation_floor: 0.0,
+                ..Default::default()
+            },
+        ),
+        (
+            "rs_adaptation_min_ratio",
+            EstimatorConfig {
+                rs_adaptation_min_ratio: 1.5,
+                ..Default::default()
+            },
+        ),
+        (
+            "rs_adaptation_max_ratio",
+            EstimatorConfig {
+                rs_adaptation_max_ratio: 0.9,
+                ..Default::default()
+            },
+        ),
+    ];
+    for (field, config) in cases {
+        let e = SensorlessEstimator::new(config).unwrap_err();
+        assert_eq!(e.field(), field, "{e}");
+    }
+    let e = ResistanceAdaptation::new(ResistanceAdaptationConfig::<f64> {
+        standstill_memory_hz: -1.0,
+        ..Default::default()
+    })
+    .unwrap_err();
+    assert_eq!(e.field(), "standstill_memory_hz");
+}
+
+proptest! {
+    /// Whatever it is fed, R̂s stays finite and inside its bounds, and a non-finite sample
+    /// changes nothing.
+    #[test]
+    fn resistance_stays_finite_and_bounded(
+        samples in prop::collection::vec(
+            (-400.0f64..400.0, -400.0f64..400.0, -60.0f64..60.0, -60.0f64..60.0,
+             -0.2f64..0.2, -0.2f64..0.2, -1000.0f64..1000.0, 0usize..3, any::<bool>()),
+            1..300,
+        )
+    ) {
+        let config = ResistanceAdaptationConfig::<f64>::default();
+        let (lo, hi) = (config.min_ratio * config.rs_initial, config.max_ratio * config.rs_initial);
+        let mut a = ResistanceAdaptation::new(config).unwrap();
+        for (va, vb, ia, ib, la, lb, w, regime, poison) in samples {
+            let regime = [
+                AdaptationRegime::Frozen,
+                AdaptationRegime::Rotating,
+                AdaptationRegime::Standstill,
+            ][regime];
+            let before = *a.state();
+            let v = if poison { Ab::new(f64::NAN, vb) } else { Ab::new(va, vb) };
+            let r = a.step(v, Ab::new(ia, ib), Ab::new(la, lb), w, regime);
+            prop_assert!(r.is_finite() && r >= lo && r <= hi, "R̂s = {}", r);
+            if poison && regime == AdaptationRegime::Standstill {
+                prop_assert_eq!(*a.state(), before);
+            }
+        }
+    }
+}
