@@ -40,7 +40,7 @@ fn ab<T: Real>(x: Ab<f64>) -> Ab<T> {
 }
 
 /// The signal table and an estimator warmed up on it (two seconds, settled, k_df mode).
-fn setup<T: Real>() -> (Vec<Sample<T>>, SensorlessEstimator<T>) {
+fn setup<T: Real>(rs_adaptation: bool) -> (Vec<Sample<T>>, SensorlessEstimator<T>) {
     let f_elec = 8.0 / (TABLE as f64 * common::TS);
     let rpm = f_elec * 60.0 / common::PP;
     let theta0 = 0.3;
@@ -50,6 +50,7 @@ fn setup<T: Real>() -> (Vec<Sample<T>>, SensorlessEstimator<T>) {
         .collect();
     let mut est = SensorlessEstimator::<T>::new(EstimatorConfig {
         initial_angle: T::lit(theta0),
+        rs_adaptation,
         ..Default::default()
     })
     .expect("default config is valid");
@@ -76,12 +77,24 @@ fn setup<T: Real>() -> (Vec<Sample<T>>, SensorlessEstimator<T>) {
 }
 
 fn bench_precision<T: Real>(c: &mut Criterion, name: &str) {
-    let (table, warmed) = setup::<T>();
+    let (table, warmed) = setup::<T>(true);
+    let (_, warmed_fixed_rs) = setup::<T>(false);
     let ts = T::lit(common::TS);
     let mut group = c.benchmark_group(name);
 
     group.bench_function("estimator", |b| {
         let mut est = warmed;
+        let mut k = 0usize;
+        b.iter(|| {
+            let s = &table[k & MASK];
+            k += 1;
+            black_box(est.step(black_box(s.v), black_box(s.i)))
+        })
+    });
+
+    // The paper's estimator: R̂s fixed (`rs_adaptation: false`).
+    group.bench_function("estimator_fixed_rs", |b| {
+        let mut est = warmed_fixed_rs;
         let mut k = 0usize;
         b.iter(|| {
             let s = &table[k & MASK];

@@ -83,6 +83,11 @@ class EstimatorConfig:
         average_current: bool | None = None,
         observer_on_rotor_flux: bool | None = None,
         initial_angle: float | None = None,
+        rs_adaptation: bool | None = None,
+        rs_adaptation_rate: float | None = None,
+        rs_adaptation_excitation_floor: float | None = None,
+        rs_adaptation_min_ratio: float | None = None,
+        rs_adaptation_max_ratio: float | None = None,
     ) -> EstimatorConfig: ...
     def replace(
         self,
@@ -105,6 +110,11 @@ class EstimatorConfig:
         average_current: bool | None = None,
         observer_on_rotor_flux: bool | None = None,
         initial_angle: float | None = None,
+        rs_adaptation: bool | None = None,
+        rs_adaptation_rate: float | None = None,
+        rs_adaptation_excitation_floor: float | None = None,
+        rs_adaptation_min_ratio: float | None = None,
+        rs_adaptation_max_ratio: float | None = None,
     ) -> EstimatorConfig: ...
     def to_dict(self) -> dict[str, float | str | bool]: ...
     def __getnewargs_ex__(self) -> tuple[tuple[()], dict[str, float | str | bool]]: ...
@@ -164,6 +174,21 @@ class EstimatorConfig:
     @property
     def initial_angle(self) -> float:
         """Rotor angle assumed at reset in rad."""
+    @property
+    def rs_adaptation(self) -> bool:
+        """Adapt R̂s online (fado's extension, default True; False = the paper)."""
+    @property
+    def rs_adaptation_rate(self) -> float:
+        """Rate γ of the R̂s adaptation while turning, in 1/s."""
+    @property
+    def rs_adaptation_excitation_floor(self) -> float:
+        """Excitation floor χ0 of the R̂s adaptation."""
+    @property
+    def rs_adaptation_min_ratio(self) -> float:
+        """Lower bound of the adapted R̂s as a multiple of rs_hat."""
+    @property
+    def rs_adaptation_max_ratio(self) -> float:
+        """Upper bound of the adapted R̂s as a multiple of rs_hat."""
 
 @final
 class StepResult:
@@ -196,6 +221,8 @@ class StepResult:
     def lambda_r_alpha(self) -> float: ...
     @property
     def lambda_r_beta(self) -> float: ...
+    @property
+    def rs_hat(self) -> float: ...
     @property
     def mode(self) -> int: ...
     @property
@@ -246,6 +273,8 @@ class EstimateResult:
     def lambda_r_alpha(self) -> _FloatArray: ...
     @property
     def lambda_r_beta(self) -> _FloatArray: ...
+    @property
+    def rs_hat(self) -> _FloatArray: ...
     @property
     def mode(self) -> npt.NDArray[np.int8]: ...
     @property

@@ -33,6 +33,11 @@ PAPER_DEFAULTS = {
     "average_current": True,  # SPEC §1 [A]
     "observer_on_rotor_flux": True,  # fado's improvement [A]; False = paper's Fig. 5
     "initial_angle": 0.0,  # SPEC §1 [A]
+    "rs_adaptation": True,  # fado's extension [A]; False = the paper's fixed R̂s
+    "rs_adaptation_rate": 1.0,  # [A]
+    "rs_adaptation_excitation_floor": 0.2,  # [A]
+    "rs_adaptation_min_ratio": 0.5,  # [A]
+    "rs_adaptation_max_ratio": 2.0,  # [A]
 }
 
 

@@ -51,7 +51,11 @@ fn isr_step<T: Real>(est: &mut SensorlessEstimator<T>, v: Ab<T>, i: Ab<T>) -> Es
 
 fn run<T: Real>(steps: usize) -> f64 {
     let table = signal::<T>();
-    let mut est = SensorlessEstimator::<T>::new(EstimatorConfig::default()).expect("valid");
+    let mut est = SensorlessEstimator::<T>::new(EstimatorConfig {
+        rs_adaptation: std::env::var("FIXED_RS").is_err(),
+        ..Default::default()
+    })
+    .expect("valid");
     // Warm-up: one second, so that the counted steps run in the settled k_df mode.
     for &(v, i) in table.iter().cycle().take(10_000) {
         est.step(v, i);

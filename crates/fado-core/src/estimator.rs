@@ -295,13 +295,15 @@ impl<T: Real> SensorlessEstimator<T> {
         let t2s2 = TypeTwoTracker::new(config.tracker(config.t2s2_bandwidth_hz))
             .map_err(rename("t2s2_bandwidth_hz"))?;
         let rs_adaptation =
-            ResistanceAdaptation::new(config.rs_adaptation_config()).map_err(|e| match e.field() {
-                "rs_initial" => rename("rs_hat")(e),
-                "rate" => rename("rs_adaptation_rate")(e),
-                "excitation_floor" => rename("rs_adaptation_excitation_floor")(e),
-                "min_ratio" => rename("rs_adaptation_min_ratio")(e),
-                "max_ratio" => rename("rs_adaptation_max_ratio")(e),
-                _ => e,
+            ResistanceAdaptation::new(config.rs_adaptation_config()).map_err(|e| {
+                match e.field() {
+                    "rs_initial" => rename("rs_hat")(e),
+                    "rate" => rename("rs_adaptation_rate")(e),
+                    "excitation_floor" => rename("rs_adaptation_excitation_floor")(e),
+                    "min_ratio" => rename("rs_adaptation_min_ratio")(e),
+                    "max_ratio" => rename("rs_adaptation_max_ratio")(e),
+                    _ => e,
+                }
             })?;
         let hold_level = hold * lf;
         let mut est = Self {
@@ -423,33 +425,11 @@ impl<T: Real> SensorlessEstimator<T> {
         let mode = self.selector.next_mode(t2s2.omega);
         let kdf_active = mode == Mode::DisturbanceFeedback && self.k_df_enabled;
         let kdf_gain = self.disturbance_feedback.next_gain(kdf_active);
-        // 6. R̂s for the next sample (see `rs_adaptation`): the flux-magnitude law in the k_df
-        //    mode, the d-axis DC test in the limiter mode.
-        let (rs_state, flux_pull) = if self.config.rs_adaptation {
-            let regime = match (self.selector.mode(), mode) {
-                _ if tracker_hold => AdaptationRegime::Frozen,
-                (Mode::DisturbanceFeedback, Mode::DisturbanceFeedback) => {
-                    AdaptationRegime::Rotating
-                }
-                (Mode::Limiter, Mode::Limiter) => AdaptationRegime::Standstill,
-                _ => AdaptationRegime::Frozen,
-            };
-            let (state, pull) = self.rs_adaptation.next_state(
-                v_ab,
-                self.integrator.drop_current(i_ab),
-                lambda_r,
-                t2s1.omega,
-                regime,
-            );
-            (Some(state), pull)
-        } else {
-            (None, Ab::zero())
-        };
         let (feedback, clamping) = match mode {
             Mode::DisturbanceFeedback => (disturbance * kdf_gain, false),
             Mode::Limiter => {
                 let l = self.limiter.step(lambda_r);
-                (l.feedback + flux_pull, l.clamping)
+                (l.feedback, l.clamping)
             }
         };
         let finite = lambda1.is_finite()
@@ -458,16 +438,18 @@ impl<T: Real> SensorlessEstimator<T> {
             & lambda_r.is_finite()
             & feedback.is_finite()
             & t2s1.is_finite()
-            & t2s2.is_finite()
-            & rs_state.is_none_or(|r| r.is_finite());
+            & t2s2.is_finite();
         if !finite {
             return self.reject();
         }
         let rs_hat_used = self.integrator.config().rs_hat;
-        if let Some(r) = rs_state {
-            self.rs_adaptation.commit(r);
-            self.integrator.set_rs_hat_unchecked(r.rs_hat);
-        }
+        // (Read before the integrator's commit replaces the previous current.)
+        let i_drop = if self.config.rs_adaptation {
+            self.integrator.drop_current(i_ab)
+        } else {
+            Ab::zero()
+        };
+        let previous_mode = self.selector.mode();
         self.integrator.commit(lambda1, i_ab);
         self.observer.commit(observer_flux, disturbance);
         self.t2s1.commit(t2s1);
@@ -475,6 +457,27 @@ impl<T: Real> SensorlessEstimator<T> {
         self.selector.commit(mode);
         self.disturbance_feedback.commit(kdf_gain);
         self.feedback = feedback;
+        // 6. R̂s for the next sample (see `rs_adaptation`), after the commit so that the paper's
+        //    path is untouched by it. A non-finite result is dropped (R̂s stays).
+        if self.config.rs_adaptation {
+            let regime = match (previous_mode, mode) {
+                _ if tracker_hold => AdaptationRegime::Frozen,
+                (Mode::DisturbanceFeedback, Mode::DisturbanceFeedback) => {
+                    AdaptationRegime::Rotating
+                }
+                (Mode::Limiter, Mode::Limiter) => AdaptationRegime::Standstill,
+                _ => AdaptationRegime::Frozen,
+            };
+            let (state, pull) = self
+                .rs_adaptation
+                .next_state(v_ab, i_drop, lambda_r, t2s1.omega, regime);
+            let feedback = self.feedback + pull;
+            if state.is_finite() && feedback.is_finite() {
+                self.rs_adaptation.commit(state);
+                self.integrator.set_rs_hat_unchecked(state.rs_hat);
+                self.feedback = feedback;
+            }
+        }
         let out = Estimate {
             theta: t2s1.theta,
             omega: t2s1.omega,
@@ -520,19 +523,21 @@ impl<T: Real> SensorlessEstimator<T> {
         self.k_df_enabled = enabled;
     }
 
-    /// Replaces R̂s at run time (an external estimate, or a value saved from the last run).
-    /// Refuses bad values. Without [`EstimatorConfig::rs_adaptation`] it becomes the
-    /// configuration's `rs_hat`; with it, the adaptation continues from it (clamped to its
-    /// bounds) and the configuration keeps the start value that `reset` returns to.
+    /// Replaces R̂s at run time, as if it had been configured (an external estimate, or a
+    /// value saved from the last run): the integrator uses it from the next sample, and with
+    /// [`EstimatorConfig::rs_adaptation`] the adaptation restarts from it, scaled and bounded
+    /// around it. Refuses bad values and then changes nothing.
     pub fn set_rs_hat(&mut self, rs_hat: T) -> Result<(), ConfigError> {
-        if self.config.rs_adaptation {
-            self.rs_adaptation.set_rs_hat(rs_hat)?;
-            self.integrator
-                .set_rs_hat_unchecked(self.rs_adaptation.rs_hat());
-        } else {
-            self.integrator.set_rs_hat(rs_hat)?;
-            self.config.rs_hat = rs_hat;
-        }
+        let config = EstimatorConfig {
+            rs_hat,
+            ..self.config
+        };
+        check::non_negative("rs_hat", rs_hat)?;
+        let adaptation = ResistanceAdaptation::new(config.rs_adaptation_config())
+            .map_err(|_| ConfigError::Negative { field: "rs_hat" })?;
+        self.integrator.set_rs_hat(rs_hat)?;
+        self.rs_adaptation = adaptation;
+        self.config = config;
         Ok(())
     }
 

@@ -166,6 +166,8 @@ pub struct ResistanceAdaptation<T> {
     /// 2π·standstill_speed_hz.
     standstill_omega: T,
     chi_per_phi: T,
+    /// 1/λ̂f.
+    inv_flux_linkage: T,
     floor_sq: T,
     rs_min: T,
     rs_max: T,
@@ -176,7 +178,8 @@ impl<T: Real> ResistanceAdaptation<T> {
     /// Checks every field (the error names it) and starts at R̂s = R0.
     pub fn new(config: ResistanceAdaptationConfig<T>) -> Result<Self, ConfigError> {
         let ts = check::positive("ts", config.ts)?;
-        let r0 = check::positive("rs_initial", config.rs_initial)?;
+        // R0 = 0 is allowed: it scales the law and its bounds to nothing (R̂s stays 0).
+        let r0 = check::non_negative("rs_initial", config.rs_initial)?;
         let lf = check::positive("flux_linkage_hat", config.flux_linkage_hat)?;
         check::non_negative("lq_hat", config.lq_hat)?;
         let rate = check::non_negative("rate", config.rate)?;
@@ -226,6 +229,7 @@ impl<T: Real> ResistanceAdaptation<T> {
             forget: (-(memory_w * ts)).exp(),
             standstill_omega: T::two_pi() * standstill_hz,
             chi_per_phi: r0 / lf,
+            inv_flux_linkage: T::one() / lf,
             floor_sq: floor * floor,
             rs_min: min * r0,
             rs_max: max * r0,
@@ -286,22 +290,23 @@ impl<T: Real> ResistanceAdaptation<T> {
             return (next, pull);
         }
         let mag = mag_sq.sqrt();
-        let unit = lambda_r * (T::one() / mag);
-        // The current in the estimated rotor frame (d along λ̂r).
-        let i_d = unit.dot(i_drop);
-        let i_q = unit.cross(i_drop);
         if regime == AdaptationRegime::Rotating {
-            // χ = φ·R0/λ̂f with φ = ⟨−i/(jω̂), d⟩ = −i_q/ω̂. (A non-finite χ, from ω̂ ≈ 0,
-            // fails the excitation test.)
-            let chi = -i_q / omega * self.chi_per_phi;
-            let chi_sq = chi * chi;
-            if chi_sq >= self.floor_sq && chi_sq.is_finite() {
-                let lf = self.config.flux_linkage_hat;
-                let err = (mag - lf) / lf;
-                next.rs_hat -= self.gain * err * chi / (chi_sq + self.floor_sq);
+            // χ = φ·R0/λ̂f with φ = ⟨−i/(jω̂), d⟩ = −i_q/ω̂ and i_q = (λ̂r × i)/|λ̂r|, as
+            // χ = a/b: then χ/(χ² + χ0²) = a·b/(a² + χ0²·b²) costs one division, and
+            // χ² ≥ χ0² is a² ≥ χ0²·b² (false for ω̂ = 0, which also rules out 0/0).
+            let a = -lambda_r.cross(i_drop) * self.chi_per_phi;
+            let b = mag * omega;
+            let (a_sq, floor_b_sq) = (a * a, self.floor_sq * b * b);
+            if a_sq >= floor_b_sq && floor_b_sq > T::zero() {
+                let err = mag * self.inv_flux_linkage - T::one();
+                next.rs_hat -= self.gain * err * a * b / (a_sq + floor_b_sq);
             }
         } else {
-            // Standstill: only at standstill and while the current lies along the flux.
+            // Standstill: only at standstill and while the current lies along the flux (the
+            // estimated rotor frame: d along λ̂r).
+            let unit = lambda_r * (T::one() / mag);
+            let i_d = unit.dot(i_drop);
+            let i_q = unit.cross(i_drop);
             if i_d <= (i_q + i_q).abs() || omega.abs() > self.standstill_omega {
                 return (next, pull);
             }

@@ -166,6 +166,8 @@ outputs! {
         lambda_r_alpha => diagnostics.lambda_r.alpha,
         /// λ̂r β in Wb.
         lambda_r_beta => diagnostics.lambda_r.beta,
+        /// R̂s the integrator used in Ω (moves with `rs_adaptation`).
+        rs_hat => diagnostics.rs_hat,
     }
     mode {
         /// Active flux feedback: 0 = limiter (Fig. 6), 1 = disturbance feedback k_df (Fig. 3).
