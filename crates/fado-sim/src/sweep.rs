@@ -705,7 +705,7 @@ fn prepare_resume(
         let old: Sidecar = serde_json::from_str(&text).map_err(|e| io(&json_path, e))?;
         if old.fingerprint != fingerprint {
             return Err(SweepError::Mismatch(format!(
-                "{} holds a different sweep ({}, {} over {:?}); use another output directory or start afresh",
+                "{} holds a different sweep ({}, {} over {:?}); use another output directory or start afresh (`--fresh`, `fresh=True`)",
                 dir.display(),
                 old.spec.scenario,
                 old.spec.design,
@@ -1025,7 +1025,7 @@ fn axis_pass(rows: &[PointResult], k: usize) -> Vec<AxisPass> {
             })
             .collect();
     }
-    if let Some(_) = nums {
+    if nums.is_some() {
         distinct.sort_by(|a, b| {
             number("", a)
                 .unwrap_or(0.0)
@@ -1043,4 +1043,256 @@ fn axis_pass(rows: &[PointResult], k: usize) -> Vec<AxisPass> {
             }
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+
+    /// fig11 cut to its start-up (0.3 s) on the averaged plant: a point runs in milliseconds.
+    fn short(spec: SweepSpec) -> SweepSpec {
+        SweepSpec {
+            config_toml: Some("[simulation]\nduration = 0.3\neval_start = 0.0\n".to_owned()),
+            averaged: true,
+            ..spec
+        }
+    }
+
+    fn floats(v: &[f64]) -> Vec<Value> {
+        v.iter().map(|&x| Value::Float(x)).collect()
+    }
+
+    fn tmp_dir(name: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("fado-sweep-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        d
+    }
+
+    #[test]
+    fn grid_is_the_cartesian_product_first_axis_slowest() {
+        let spec = SweepSpec::grid(
+            "fig11",
+            vec![
+                ("rs_error".into(), parse_values("-0.5:0.5:3").unwrap()),
+                ("load_torque".into(), parse_values("0,7.5").unwrap()),
+            ],
+        );
+        assert_eq!(spec.design, "grid 3 × 2");
+        let got: Vec<(f64, f64)> = spec
+            .points
+            .iter()
+            .map(|p| (number("", &p[0]).unwrap(), number("", &p[1]).unwrap()))
+            .collect();
+        assert_eq!(
+            got,
+            [
+                (-0.5, 0.0),
+                (-0.5, 7.5),
+                (0.0, 0.0),
+                (0.0, 7.5),
+                (0.5, 0.0),
+                (0.5, 7.5)
+            ]
+        );
+        // linspace ends included, last-bit noise rounded off
+        assert_eq!(
+            parse_values("0:0.3:4").unwrap(),
+            floats(&[0.0, 0.1, 0.2, 0.3])
+        );
+        assert_eq!(
+            parse_values("a,true").unwrap()[0],
+            Value::String("a".into())
+        );
+        assert!(parse_values("0:1:0").is_err());
+        assert!(parse_range("1..0").is_err());
+        assert_eq!(parse_range("-0.5..0.5").unwrap(), (-0.5, 0.5));
+    }
+
+    #[test]
+    fn random_design_is_deterministic_and_inside_the_ranges() {
+        let ranges = [
+            ("rs_error".to_owned(), -0.5, 0.5),
+            ("load_torque".to_owned(), 0.0, 11.5),
+        ];
+        let a = SweepSpec::random("fig11", &ranges, 200, 7);
+        assert_eq!(a, SweepSpec::random("fig11", &ranges, 200, 7));
+        assert_ne!(a.points, SweepSpec::random("fig11", &ranges, 200, 8).points);
+        let xs: Vec<f64> = a
+            .points
+            .iter()
+            .map(|p| number("", &p[0]).unwrap())
+            .collect();
+        assert!(xs.iter().all(|x| (-0.5..0.5).contains(x)));
+        // uniform: both halves of the range are visited about equally
+        let below = xs.iter().filter(|x| **x < 0.0).count();
+        assert!(
+            (70..130).contains(&below),
+            "{below} of 200 below the middle"
+        );
+    }
+
+    #[test]
+    fn derived_parameters_set_the_configuration() {
+        let base = scenario::scenario_config("fig11", None, true).unwrap();
+        let names: Vec<String> = PARAMETERS.iter().map(|(n, _)| (*n).to_owned()).collect();
+        let values = floats(&[-0.1, 0.2, 0.05, -0.15, 0.3, 0.04, 0.01, 5.0, 45.0]);
+        let c = point_config(&base, &names, &values).unwrap();
+        let close = |a: f64, b: f64| (a - b).abs() < 1e-12;
+        assert!(close(c.mismatch.rs_ratio, 0.9));
+        assert!(close(c.mismatch.lq_ratio, 1.2));
+        assert!(close(c.mismatch.ld_ratio, 1.05));
+        assert!(close(c.mismatch.flux_linkage_ratio, 0.85));
+        assert!(close(c.mismatch.dead_time_ratio, 1.3));
+        assert_eq!(
+            (c.current_sensor.offset_a, c.current_sensor.offset_b),
+            (0.04, -0.02)
+        );
+        assert_eq!(
+            (c.current_sensor.gain_error_a, c.current_sensor.gain_error_b),
+            (0.01, 0.0)
+        );
+        assert_eq!(c.load.torque.points, vec![[1.2, 0.0], [1.7, 5.0]]);
+        // fig11 reverses −90 → 90 r/min from 2.5 s: at 45 r/min/s it takes 4 s, not 2.
+        assert_eq!(c.speed_reference.points[3], [2.5, -90.0]);
+        assert_eq!(c.speed_reference.points[4], [6.5, 90.0]);
+        assert!(close(c.simulation.duration, base.simulation.duration + 2.0));
+        // A TOML key as an axis.
+        let c = point_config(&base, &["estimator.k_df".into()], &[Value::Float(0.25)]).unwrap();
+        assert_eq!(c.estimator.k_df, 0.25);
+        // Bad values are errors naming the parameter.
+        let e = point_config(&base, &["rs_error".into()], &[Value::Float(-1.5)]).unwrap_err();
+        assert!(e.to_string().contains("rs_ratio"), "{e}");
+        let e = point_config(&base, &["reversal_ramp".into()], &[Value::Float(0.0)]).unwrap_err();
+        assert_eq!(e.key, "reversal_ramp");
+        let fig10 = scenario::scenario_config("fig10", None, true).unwrap();
+        assert!(point_config(&fig10, &["reversal_ramp".into()], &[Value::Float(90.0)]).is_err());
+    }
+
+    #[test]
+    fn failed_and_diverged_points_are_recorded_and_the_sweep_goes_on() {
+        // L̂q five times Lq makes a 700 Hz current loop unstable: it trips at 41 A.
+        let mut spec = short(SweepSpec::grid(
+            "fig11",
+            vec![
+                ("rs_error".into(), floats(&[-2.0, 0.0])),
+                ("lq_error".into(), floats(&[0.0, 4.0])),
+            ],
+        ));
+        spec.config_toml = Some(format!(
+            "{}[controller]\ncurrent_bandwidth_hz = 700.0\ntrip_current = 41.0\n",
+            spec.config_toml.unwrap()
+        ));
+        let out = run(&spec, &SweepOptions::default(), &|_, _| {}).unwrap();
+        let status: Vec<String> = out.rows.iter().map(|r| r.status.to_string()).collect();
+        assert!(
+            status[0].starts_with("failed: ") && status[0].contains("rs_ratio"),
+            "{status:?}"
+        );
+        assert!(status[1].starts_with("failed: "));
+        assert_eq!(out.rows[2].status, Status::Ok, "{status:?}");
+        assert!(out.rows[2].passed, "{:?}", out.rows[2]);
+        assert_eq!(out.rows[3].status, Status::Diverged);
+        assert!(out.rows[3].tripped && !out.rows[3].passed);
+        let s = &out.summary;
+        assert_eq!((s.failed, s.diverged, s.passed, s.finished), (2, 1, 1, 4));
+        assert_eq!(s.worst_index, Some(3));
+    }
+
+    #[test]
+    fn an_interrupted_sweep_resumes_without_rerunning_finished_points() {
+        let dir = tmp_dir("resume");
+        let spec = short(SweepSpec::grid(
+            "fig11",
+            vec![
+                ("rs_error".into(), floats(&[-0.02, 0.0, 0.02])),
+                ("load_torque".into(), floats(&[0.0, 7.5])),
+            ],
+        ));
+        let opts = SweepOptions {
+            threads: 2,
+            out: Some(dir.clone()),
+            fresh: false,
+        };
+        let runs = AtomicUsize::new(0);
+        let count = |_: &PointResult, _: usize| {
+            runs.fetch_add(1, Ordering::Relaxed);
+        };
+        let full = run(&spec, &opts, &count).unwrap();
+        assert_eq!(runs.load(Ordering::Relaxed), 6);
+        // Interrupt: keep the header, two finished rows and half of a third.
+        let csv_path = dir.join("sweep.csv");
+        let text = std::fs::read_to_string(&csv_path).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        let cut = format!(
+            "{}\n{}\n{}\n{}",
+            lines[0],
+            lines[2],
+            lines[5],
+            &lines[3][..10]
+        );
+        std::fs::write(&csv_path, cut).unwrap();
+        runs.store(0, Ordering::Relaxed);
+        let resumed = run(&spec, &opts, &count).unwrap();
+        assert_eq!(runs.load(Ordering::Relaxed), 4);
+        assert_eq!((resumed.resumed, resumed.ran), (2, 4));
+        // Seeded and deterministic: the same rows as the uninterrupted sweep.
+        let same = |a: &PointResult, b: &PointResult| {
+            (a.index, &a.status, a.passed, a.max_angle_error.to_bits())
+                == (b.index, &b.status, b.passed, b.max_angle_error.to_bits())
+        };
+        assert!(full.rows.iter().zip(&resumed.rows).all(|(a, b)| same(a, b)));
+        // Finished: nothing more to run.
+        runs.store(0, Ordering::Relaxed);
+        run(&spec, &opts, &count).unwrap();
+        assert_eq!(runs.load(Ordering::Relaxed), 0);
+        // A different sweep in the same directory is refused, unless fresh.
+        let other = short(SweepSpec::grid(
+            "fig11",
+            vec![("rs_error".into(), floats(&[0.1]))],
+        ));
+        assert!(matches!(
+            run(&other, &opts, &count),
+            Err(SweepError::Mismatch(_))
+        ));
+        let fresh = SweepOptions {
+            fresh: true,
+            ..opts
+        };
+        assert_eq!(run(&other, &fresh, &count).unwrap().ran, 1);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn csv_round_trips() {
+        let dir = tmp_dir("csv");
+        let spec = short(SweepSpec::grid(
+            "fig11",
+            vec![
+                ("rs_error".into(), floats(&[-2.0, 0.01])),
+                (
+                    "controller.precision".into(),
+                    vec![Value::String("f32".into())],
+                ),
+            ],
+        ));
+        let opts = SweepOptions {
+            threads: 1,
+            out: Some(dir.clone()),
+            fresh: false,
+        };
+        let out = run(&spec, &opts, &|_, _| {}).unwrap();
+        let back: Vec<PointResult> = read_csv(&dir.join("sweep.csv"), &spec)
+            .unwrap()
+            .into_values()
+            .collect();
+        assert_eq!(back.len(), 2);
+        for (a, b) in out.rows.iter().zip(&back) {
+            assert_eq!(csv_record(a), csv_record(b));
+            assert_eq!((&a.values, &a.status), (&b.values, &b.status));
+        }
+        assert!(matches!(back[0].status, Status::Failed(_)) && back[0].max_angle_error.is_nan());
+        assert_eq!(back[1], out.rows[1]);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }
