@@ -13,6 +13,7 @@
 //!   simulator of `fado-sim` (the paper's Fig. 8–12) with the GIL released.
 //! - [`errors`]: `FadoError` and its subclasses.
 //! - [`compare`]: `compare`, fado against the baseline estimators in the simulator.
+//! - [`sweep`]: `sweep` and `sweep_point`, operating-envelope sweeps of the simulator.
 
 pub mod compare;
 pub mod config;
@@ -23,6 +24,7 @@ pub mod outputs;
 pub mod replay;
 pub mod scalar;
 pub mod simulate;
+pub mod sweep;
 
 use pyo3::prelude::*;
 
@@ -41,6 +43,8 @@ pub mod _fado {
     use super::outputs::{EstimateResult, StepResult};
     #[pymodule_export]
     use super::simulate::{SimResult, default_config, describe_scenario, scenarios, simulate};
+    #[pymodule_export]
+    use super::sweep::{sweep, sweep_point};
 
     #[pymodule_export]
     const MODE_LIMITER: i8 = super::outputs::MODE_LIMITER;

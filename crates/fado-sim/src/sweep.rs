@@ -725,10 +725,10 @@ fn prepare_resume(
     Ok(done)
 }
 
-/// The CSV header: `index`, the axes, `status`, `passed`, `tripped`, the [`METRICS`],
+/// The CSV header: `point` (the index), the axes, `status`, `passed`, `tripped`, the [`METRICS`],
 /// `failed_checks`.
 pub fn csv_header(spec: &SweepSpec) -> Vec<String> {
-    let mut h = vec!["index".to_owned()];
+    let mut h = vec!["point".to_owned()];
     h.extend(spec.axes.iter().cloned());
     h.extend(["status", "passed", "tripped"].map(str::to_owned));
     h.extend(METRICS.map(str::to_owned));
