@@ -992,8 +992,8 @@ impl Summary {
     }
 }
 
-/// Pass counts per distinct value of axis `k` (at most 12 distinct values), else per fifth
-/// of its range.
+/// Pass counts per distinct value of axis `k` (at most 64 distinct values, as a grid has),
+/// else per fifth of its range (a random design).
 fn axis_pass(rows: &[PointResult], k: usize) -> Vec<AxisPass> {
     let mut distinct: Vec<&Value> = Vec::new();
     for r in rows {
@@ -1002,7 +1002,7 @@ fn axis_pass(rows: &[PointResult], k: usize) -> Vec<AxisPass> {
         }
     }
     let nums: Option<Vec<f64>> = rows.iter().map(|r| number("", &r.values[k]).ok()).collect();
-    if distinct.len() > 12
+    if distinct.len() > 64
         && let Some(nums) = nums
     {
         let lo = nums.iter().copied().fold(f64::INFINITY, f64::min);
