@@ -165,9 +165,13 @@ impl SweepSpec {
     /// Checks the definition (scenario known, axis names valid and distinct, one value per
     /// axis in every point) and returns the base configuration.
     pub fn base_config(&self) -> Result<SimConfig, SimConfigError> {
+        let base =
+            scenario::scenario_config(&self.scenario, self.config_toml.as_deref(), self.averaged)?;
+        let keys = toml::Table::try_from(&base)
+            .map_err(|e| SimConfigError::new("<base>", e.to_string()))?;
         let mut seen = Vec::new();
         for name in &self.axes {
-            check_parameter_name(name)?;
+            check_parameter_name(name, &keys)?;
             if seen.contains(&name) {
                 return Err(SimConfigError::new(name.clone(), "axis given twice"));
             }
@@ -183,7 +187,7 @@ impl SweepSpec {
                 ),
             ));
         }
-        scenario::scenario_config(&self.scenario, self.config_toml.as_deref(), self.averaged)
+        Ok(base)
     }
 
     /// A stable fingerprint of the definition and of the base configuration it resolves to
@@ -206,19 +210,36 @@ impl SweepSpec {
     }
 }
 
-fn check_parameter_name(name: &str) -> Result<(), SimConfigError> {
+/// A derived parameter, or a key of the configuration (`keys`: the base configuration as a
+/// TOML table, which holds every key): a misspelt axis is an error before anything runs.
+fn check_parameter_name(name: &str, keys: &toml::Table) -> Result<(), SimConfigError> {
     if PARAMETERS.iter().any(|(n, _)| *n == name) {
         return Ok(());
     }
-    let parts: Vec<_> = name.split('.').collect();
-    if parts.len() < 2 || parts.iter().any(|p| p.is_empty()) {
-        let names: Vec<_> = PARAMETERS.iter().map(|(n, _)| *n).collect();
-        return Err(SimConfigError::new(
-            name.to_owned(),
-            format!("not a TOML key `section.key` nor one of {names:?}"),
-        ));
+    let mut table = Some(keys);
+    let mut found = false;
+    for part in name.split('.') {
+        match table.and_then(|t| t.get(part)) {
+            Some(Value::Table(t)) => table = Some(t),
+            Some(_) => {
+                table = None;
+                found = true;
+            }
+            None => {
+                found = false;
+                table = None;
+                break;
+            }
+        }
     }
-    Ok(())
+    if found && name.contains('.') && !name.ends_with('.') {
+        return Ok(());
+    }
+    let names: Vec<_> = PARAMETERS.iter().map(|(n, _)| *n).collect();
+    Err(SimConfigError::new(
+        name.to_owned(),
+        format!("not a configuration key `section.key` (see --dump-config) nor one of {names:?}"),
+    ))
 }
 
 /// Parses one value list: `lo:hi:n` (n values evenly spaced, ends included) or `v1,v2,...`
@@ -1165,6 +1186,18 @@ mod tests {
         assert!(e.to_string().contains("rs_ratio"), "{e}");
         let e = point_config(&base, &["reversal_ramp".into()], &[Value::Float(0.0)]).unwrap_err();
         assert_eq!(e.key, "reversal_ramp");
+        // A misspelt axis is a definition error, before anything runs.
+        for bad in [
+            "mismatch.rs_rato",
+            "mismatch",
+            "rs_eror",
+            "mismatch.rs_ratio.x",
+        ] {
+            let spec = SweepSpec::grid("fig11", vec![(bad.into(), floats(&[1.0]))]);
+            assert_eq!(spec.base_config().unwrap_err().key, bad);
+        }
+        let spec = SweepSpec::grid("fig11", vec![("load.torque.points".into(), floats(&[1.0]))]);
+        assert!(spec.base_config().is_ok());
         let fig10 = scenario::scenario_config("fig10", None, true).unwrap();
         assert!(point_config(&fig10, &["reversal_ramp".into()], &[Value::Float(90.0)]).is_err());
     }
