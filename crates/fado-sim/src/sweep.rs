@@ -216,21 +216,18 @@ fn check_parameter_name(name: &str, keys: &toml::Table) -> Result<(), SimConfigE
     if PARAMETERS.iter().any(|(n, _)| *n == name) {
         return Ok(());
     }
+    // Walk the tables; the key must end on a value, not on a table or past a value.
     let mut table = Some(keys);
     let mut found = false;
     for part in name.split('.') {
-        match table.and_then(|t| t.get(part)) {
-            Some(Value::Table(t)) => table = Some(t),
-            Some(_) => {
-                table = None;
-                found = true;
-            }
-            None => {
-                found = false;
-                table = None;
-                break;
-            }
-        }
+        let Some(value) = table.and_then(|t| t.get(part)) else {
+            found = false;
+            break;
+        };
+        (table, found) = match value {
+            Value::Table(t) => (Some(t), false),
+            _ => (None, true),
+        };
     }
     if found && name.contains('.') && !name.ends_with('.') {
         return Ok(());
