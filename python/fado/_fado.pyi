@@ -25,6 +25,7 @@ __all__ = [
     "__version__",
     "OUTPUT_NAMES",
     "TRACE_COLUMNS",
+    "SWEEP_PARAMETERS",
     "simulate",
     "SimResult",
     "scenarios",
@@ -38,6 +39,7 @@ __all__ = [
 __version__: Final[str]
 OUTPUT_NAMES: Final[list[str]]
 TRACE_COLUMNS: Final[list[str]]
+SWEEP_PARAMETERS: Final[dict[str, str]]
 MODE_LIMITER: Final[int]
 MODE_DISTURBANCE_FEEDBACK: Final[int]
 

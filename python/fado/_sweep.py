@@ -17,17 +17,7 @@ from fado import _fado
 from fado._simulation import ConfigLike, config_text
 
 #: The derived parameters (besides any TOML key ``section.key``) and what they mean.
-PARAMETERS: dict[str, str] = {
-    "rs_error": "R̂s/(Rs + r_on) − 1 (mismatch.rs_ratio − 1)",
-    "lq_error": "L̂q/Lq − 1 (mismatch.lq_ratio − 1)",
-    "ld_error": "L̂d/Ld − 1 (mismatch.ld_ratio − 1)",
-    "flux_linkage_error": "λ̂f/λf − 1 (mismatch.flux_linkage_ratio − 1)",
-    "dead_time_comp_error": "T̂d/Td − 1 of the dead-time compensation",
-    "sensor_offset": "current-sensor offset, A: phase a +v, phase b −v/2",
-    "sensor_gain_error": "phase a sensor gain relative to phase b, −1",
-    "load_torque": "final load torque, N·m (the load profile scaled to end there)",
-    "reversal_ramp": "slope of the speed reference's reversal, r/min per s",
-}
+PARAMETERS: dict[str, str] = dict(_fado.SWEEP_PARAMETERS)
 
 
 class _Future(Protocol):

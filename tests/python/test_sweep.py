@@ -109,3 +109,26 @@ def test_envelope_draws_the_grid_and_a_random_design(tmp_path: Any) -> None:
     points = [{"rs_error": 0.1 * k - 0.3, "load_torque": 1.3 * k} for k in range(7)]
     fig = fado.plot.envelope(short_sweep(points), "rs_error", "load_torque")
     assert len(fig.axes[0].collections) == 2  # passed and failed markers
+
+
+def test_every_derived_parameter_is_accepted() -> None:
+    from fado._sweep import PARAMETERS
+
+    values = {
+        "rs_error": 0.01,
+        "lq_error": 0.1,
+        "ld_error": 0.1,
+        "flux_linkage_error": -0.05,
+        "dead_time_comp_error": 0.02,
+        "sensor_offset": 0.03,
+        "sensor_gain_error": 0.01,
+        "load_torque": 2.0,
+        "reversal_ramp": 180.0,
+    }
+    assert set(PARAMETERS) == set(values)
+    df = short_sweep([values])
+    assert df.loc[0, "status"] == "ok", df.loc[0, "status"]
+    # Each parameter moves the run (the matched short run differs from each one-off change).
+    matched = short_sweep({"rs_error": [0.0]}).loc[0, "rms_angle_error"]
+    for name in ["rs_error", "lq_error", "flux_linkage_error", "sensor_gain_error"]:
+        assert short_sweep({name: [values[name]]}).loc[0, "rms_angle_error"] != matched, name

@@ -59,6 +59,11 @@ pub mod _fado {
         m.add("__version__", env!("CARGO_PKG_VERSION"))?;
         m.add("OUTPUT_NAMES", super::outputs::OUTPUT_NAMES.to_vec())?;
         m.add("TRACE_COLUMNS", super::simulate::trace_columns())?;
+        let parameters = pyo3::types::PyDict::new(m.py());
+        for (name, meaning) in fado_sim::sweep::PARAMETERS {
+            parameters.set_item(name, meaning)?;
+        }
+        m.add("SWEEP_PARAMETERS", parameters)?;
         Ok(())
     }
 }
