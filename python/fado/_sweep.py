@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import itertools
 import os
+import sys
 from collections.abc import Mapping, Sequence
 from typing import Any, Protocol, Union
 
@@ -100,7 +101,8 @@ def sweep(
     interrupted there (``fresh=True`` starts over). With an `executor` (anything with
     ``submit(fn, *args)`` returning futures with ``.result()``: a
     ``concurrent.futures.ProcessPoolExecutor``, a Dask ``distributed.Client``), each point
-    is one task running :func:`run_point`; the rows are the same.
+    is one task running :func:`run_point`; the rows are the same. `progress` prints the
+    points done to stderr.
 
     Columns: ``point``, one per parameter, ``status`` (``ok``, ``diverged`` — tripped or
     non-finite — or ``failed: <message>``), ``passed`` (every criterion of the scenario),
@@ -135,7 +137,13 @@ def sweep(
             executor.submit(run_point, scenario, axes, p, text, averaged, k)
             for k, p in enumerate(points)
         ]
-        rows = [f.result() for f in futures]
+        rows = []
+        for k, f in enumerate(futures):
+            rows.append(f.result())
+            if progress:
+                print(f"\rsweep {k + 1}/{len(futures)}", end="", file=sys.stderr, flush=True)
+        if progress:
+            print(file=sys.stderr)
     columns = [
         "point",
         *axes,

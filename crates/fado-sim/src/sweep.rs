@@ -890,6 +890,15 @@ pub struct AxisPass {
     pub passed: usize,
 }
 
+/// Pass fractions along one axis.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct AxisSummary {
+    /// The axis (parameter name).
+    pub axis: String,
+    /// One entry per value (or bin), ascending for numbers.
+    pub values: Vec<AxisPass>,
+}
+
 /// What `summary.json` holds.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Summary {
@@ -919,7 +928,7 @@ pub struct Summary {
     /// Its max |θ − θ̂|, rad.
     pub worst_max_angle_error: Option<f64>,
     /// Pass fraction per value of each axis, in axis order.
-    pub per_axis: Vec<(String, Vec<AxisPass>)>,
+    pub per_axis: Vec<AxisSummary>,
     /// Sum of the points' wall times, s.
     pub point_seconds: f64,
 }
@@ -944,7 +953,10 @@ impl Summary {
                 ka.0.cmp(&kb.0).then(ka.1.total_cmp(&kb.1))
             });
         let per_axis = (spec.axes.iter().enumerate())
-            .map(|(k, name)| (name.clone(), axis_pass(rows, k)))
+            .map(|(k, name)| AxisSummary {
+                axis: name.clone(),
+                values: axis_pass(rows, k),
+            })
             .collect();
         Summary {
             scenario: spec.scenario.clone(),
@@ -993,7 +1005,11 @@ impl Summary {
                 self.worst_point
             );
         }
-        for (name, rows) in &self.per_axis {
+        for AxisSummary {
+            axis: name,
+            values: rows,
+        } in &self.per_axis
+        {
             s += &format!("| {name} | points | passed | pass fraction |\n|---|---:|---:|---:|\n");
             for r in rows {
                 s += &format!(
