@@ -955,7 +955,7 @@ impl Summary {
         let per_axis = (spec.axes.iter().enumerate())
             .map(|(k, name)| AxisSummary {
                 axis: name.clone(),
-                values: axis_pass(rows, k),
+                values: axis_pass(rows, k, spec.design.starts_with("random")),
             })
             .collect();
         Summary {
@@ -1026,9 +1026,9 @@ impl Summary {
     }
 }
 
-/// Pass counts per distinct value of axis `k` (at most 64 distinct values, as a grid has),
-/// else per fifth of its range (a random design).
-fn axis_pass(rows: &[PointResult], k: usize) -> Vec<AxisPass> {
+/// Pass counts per distinct value of axis `k`, or per fifth of its range for a random design
+/// (`binned`) or more than 64 distinct values.
+fn axis_pass(rows: &[PointResult], k: usize, binned: bool) -> Vec<AxisPass> {
     let mut distinct: Vec<&Value> = Vec::new();
     for r in rows {
         if !distinct.contains(&&r.values[k]) {
@@ -1036,7 +1036,7 @@ fn axis_pass(rows: &[PointResult], k: usize) -> Vec<AxisPass> {
         }
     }
     let nums: Option<Vec<f64>> = rows.iter().map(|r| number("", &r.values[k]).ok()).collect();
-    if distinct.len() > 64
+    if (binned || distinct.len() > 64)
         && let Some(nums) = nums
     {
         let lo = nums.iter().copied().fold(f64::INFINITY, f64::min);
