@@ -29,6 +29,12 @@ Compare fado with the baseline estimators in the simulator (same plant, seed, co
     rows = fado.compare(scenarios=["fig11"], averaged=True)   # list of dicts
     fado.compare.plot_angle_errors("fig11.png")                 # needs matplotlib
 
+Map the operating envelope: one run per point of a grid over model and sensor errors, load
+and profile (Rust on all cores, or one task per point on a process pool or Dask cluster)::
+
+    df = fado.sweep({"rs_error": [-0.1, 0, 0.1], "load_torque": [0, 7.5]}, "fig11")
+    fado.plot.envelope(df, "rs_error", "load_torque", path="envelope.png")
+
 Errors derive from :class:`FadoError`; :class:`ConfigError` (a bad configuration field,
 named by ``.field``) and :class:`InputError` (a bad array or argument, named by
 ``.argument``) are also :class:`ValueError`.
@@ -56,6 +62,7 @@ from fado._fado import (
 )
 from fado._mode import Mode
 from fado._simulation import simulate
+from fado._sweep import sweep
 from fado import compare
 
 __all__ = [
@@ -78,4 +85,5 @@ __all__ = [
     "estimate",
     "scenarios",
     "simulate",
+    "sweep",
 ]

@@ -4,6 +4,7 @@ Import these names from ``fado``. ``tests/python/test_stubs.py`` runs ``mypy.stu
 this file, so it cannot drift from the module.
 """
 
+import os
 from typing import Any, ClassVar, Final, Literal, final
 
 import numpy as np
@@ -24,17 +25,21 @@ __all__ = [
     "__version__",
     "OUTPUT_NAMES",
     "TRACE_COLUMNS",
+    "SWEEP_PARAMETERS",
     "simulate",
     "SimResult",
     "scenarios",
     "describe_scenario",
     "default_config",
     "compare",
+    "sweep",
+    "sweep_point",
 ]
 
 __version__: Final[str]
 OUTPUT_NAMES: Final[list[str]]
 TRACE_COLUMNS: Final[list[str]]
+SWEEP_PARAMETERS: Final[dict[str, str]]
 MODE_LIMITER: Final[int]
 MODE_DISTURBANCE_FEEDBACK: Final[int]
 
@@ -378,3 +383,28 @@ def compare(
     threads: int = 2,
 ) -> list[dict[str, Any]]:
     """Every estimator in every scenario on the same plant and seed (GIL released)."""
+
+def sweep(
+    scenario: str,
+    axes: list[str],
+    points: list[list[Any]],
+    *,
+    config: str | None = None,
+    averaged: bool = False,
+    threads: int = 0,
+    out: str | os.PathLike[str] | None = None,
+    fresh: bool = False,
+    progress: bool = False,
+) -> list[dict[str, Any]]:
+    """One scenario run per point on a rayon pool (GIL released); one row dict per point."""
+
+def sweep_point(
+    scenario: str,
+    axes: list[str],
+    values: list[Any],
+    *,
+    config: str | None = None,
+    averaged: bool = False,
+    index: int = 0,
+) -> dict[str, Any]:
+    """One point of a sweep (GIL released): its row dict."""

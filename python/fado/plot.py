@@ -28,6 +28,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "ANGLE_CRITERION",
+    "envelope",
     "plot_fig8",
     "plot_fig9",
     "plot_fig10",
@@ -286,4 +287,142 @@ def plot_scenario(result: SimResult, path: str | os.PathLike[str] | None = None)
             f"no figure for scenario {result.scenario!r}; one of {sorted(_BY_SCENARIO)}"
         ) from None
     figure: Figure = plot(result, path)
+    return figure
+
+
+def _axis(values: Any) -> tuple[np.ndarray, np.ndarray, list[str] | None]:
+    """Sorted distinct values of a swept column, the cell edges around them (midpoints) and,
+    for a non-numeric column, its tick labels (cells then sit at 0, 1, 2, …)."""
+    distinct = list(dict.fromkeys(values))
+    try:
+        centres = np.array(sorted(float(v) for v in distinct))
+    except (TypeError, ValueError):
+        labels = sorted(map(str, distinct))
+        return np.arange(len(labels), dtype=float), np.arange(len(labels) + 1) - 0.5, labels
+    if len(centres) == 1:
+        return centres, np.array([centres[0] - 0.5, centres[0] + 0.5]), None
+    mid = (centres[1:] + centres[:-1]) / 2
+    edges = np.concatenate(
+        [[centres[0] - (mid[0] - centres[0])], mid, [centres[-1] + (centres[-1] - mid[-1])]]
+    )
+    return centres, edges, None
+
+
+def _position(values: Any, centres: np.ndarray, labels: list[str] | None) -> np.ndarray:
+    if labels is not None:
+        return np.array([labels.index(str(v)) for v in values])
+    return np.searchsorted(centres, np.asarray(values, dtype=float))
+
+
+def envelope(
+    df: Any,
+    x: str,
+    y: str,
+    *,
+    metric: str = "max_angle_error",
+    path: str | os.PathLike[str] | None = None,
+    ax: Axes | None = None,
+    title: str | None = None,
+    vmax: float | None = None,
+) -> Figure:
+    """Heatmap of `metric` (default max |θ − θ̂|, rad) over two swept parameters of a
+    :func:`fado.sweep` DataFrame, with the points that failed the scenario's criteria
+    hatched and a line around the passing region; points that diverged (tripped) or failed
+    to run are drawn black. Several points in one cell (other swept parameters): the cell
+    shows the mean of `metric` and is hatched unless all of them passed. A design that is not
+    a grid (random samples) is drawn as a scatter instead (○ passed, × failed). `vmax` caps
+    the colour scale (default: the largest `metric` of the points that ran, at most π).
+    Returns the figure (drawn with the Agg canvas, without pyplot)."""
+    figure_class, canvas_class = _matplotlib()
+    from matplotlib.colors import ListedColormap
+
+    if ax is None:
+        fig = figure_class(figsize=(7.5, 4.8), layout="constrained")
+        canvas_class(fig)
+        ax = fig.subplots()
+    else:
+        fig = ax.figure
+    xs, xe, xl = _axis(df[x])
+    ys, ye, yl = _axis(df[y])
+    ix = _position(df[x], xs, xl)
+    iy = _position(df[y], ys, yl)
+    value = np.asarray(df[metric], dtype=float)
+    ran = np.asarray(df["status"] == "ok", dtype=bool)
+    passed = np.asarray(df["passed"], dtype=bool)
+    total = np.zeros((len(ys), len(xs)))
+    count = np.zeros_like(total)
+    n_pass = np.zeros_like(total)
+    n_bad = np.zeros_like(total)
+    for i, j, v, ok, p in zip(iy, ix, value, ran, passed):
+        count[i, j] += 1
+        n_pass[i, j] += p
+        if ok and np.isfinite(v):
+            total[i, j] += v
+        else:
+            n_bad[i, j] += 1
+    filled = count > 0
+    top = float(np.nanmax(np.where(ran, value, np.nan))) if ran.any() else 1.0
+    vmax = vmax if vmax is not None else min(max(top, 1e-9), np.pi)
+    cmap = "viridis"
+    if filled.mean() < 0.5:
+        # Not a grid: one marker per point.
+        sc = ax.scatter(
+            np.asarray(df[x], dtype=float) if xl is None else ix,
+            np.asarray(df[y], dtype=float) if yl is None else iy,
+            c=np.where(ran, value, np.nan),
+            cmap=cmap,
+            vmin=0.0,
+            vmax=vmax,
+            marker="o",
+            s=np.where(passed, 30, 0),
+            plotnonfinite=True,
+        )
+        ax.scatter(
+            np.asarray(df[x], dtype=float)[~passed] if xl is None else ix[~passed],
+            np.asarray(df[y], dtype=float)[~passed] if yl is None else iy[~passed],
+            c=np.where(ran, value, np.nan)[~passed],
+            cmap=cmap,
+            vmin=0.0,
+            vmax=vmax,
+            marker="x",
+            s=30,
+            plotnonfinite=True,
+        )
+        mesh = sc
+    else:
+        good = filled & (n_bad < count)
+        mean = np.where(good, total / np.maximum(count - n_bad, 1), np.nan)
+        mesh = ax.pcolormesh(xe, ye, np.ma.masked_invalid(mean), cmap=cmap, vmin=0.0, vmax=vmax)
+        bad = np.ma.masked_where(~(filled & (n_bad > 0)), np.ones_like(total))
+        ax.pcolormesh(xe, ye, bad, cmap=ListedColormap(["black"]), vmin=0, vmax=1)
+        failed = np.ma.masked_where(~(filled & (n_pass < count)), np.ones_like(total))
+        ax.pcolor(xe, ye, failed, hatch="//", facecolor="none", edgecolor="white", lw=0)
+        all_pass = (n_pass == count) & filled
+        if all_pass.any() and (~all_pass).any():
+            ax.contour(
+                xs if xl is None else np.arange(len(xs)),
+                ys if yl is None else np.arange(len(ys)),
+                all_pass.astype(float),
+                levels=[0.5],
+                colors="red",
+                linewidths=1.5,
+            )
+    fig.colorbar(mesh, ax=ax, label=f"{metric} (rad)" if "angle" in metric else metric,
+                 extend="max" if top > vmax else "neither")
+    if xl is not None:
+        ax.set_xticks(np.arange(len(xl)), xl)
+    if yl is not None:
+        ax.set_yticks(np.arange(len(yl)), yl)
+    ax.set_xlabel(x)
+    ax.set_ylabel(y)
+    n_ok = int(passed.sum())
+    ax.set_title(
+        title
+        or f"{len(df)} points: {n_ok} passed (hatched: failed the criteria, "
+        f"black: diverged or failed to run; red line: pass boundary)",
+        fontsize=8,
+    )
+    if path is not None:
+        fig.savefig(os.fspath(path), dpi=120)
+    figure: Figure = fig
     return figure

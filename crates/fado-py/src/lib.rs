@@ -13,6 +13,7 @@
 //!   simulator of `fado-sim` (the paper's Fig. 8–12) with the GIL released.
 //! - [`errors`]: `FadoError` and its subclasses.
 //! - [`compare`]: `compare`, fado against the baseline estimators in the simulator.
+//! - [`sweep`]: `sweep` and `sweep_point`, operating-envelope sweeps of the simulator.
 
 pub mod compare;
 pub mod config;
@@ -23,6 +24,7 @@ pub mod outputs;
 pub mod replay;
 pub mod scalar;
 pub mod simulate;
+pub mod sweep;
 
 use pyo3::prelude::*;
 
@@ -41,6 +43,8 @@ pub mod _fado {
     use super::outputs::{EstimateResult, StepResult};
     #[pymodule_export]
     use super::simulate::{SimResult, default_config, describe_scenario, scenarios, simulate};
+    #[pymodule_export]
+    use super::sweep::{sweep, sweep_point};
 
     #[pymodule_export]
     const MODE_LIMITER: i8 = super::outputs::MODE_LIMITER;
@@ -55,6 +59,11 @@ pub mod _fado {
         m.add("__version__", env!("CARGO_PKG_VERSION"))?;
         m.add("OUTPUT_NAMES", super::outputs::OUTPUT_NAMES.to_vec())?;
         m.add("TRACE_COLUMNS", super::simulate::trace_columns())?;
+        let parameters = pyo3::types::PyDict::new(m.py());
+        for (name, meaning) in fado_sim::sweep::PARAMETERS {
+            parameters.set_item(name, meaning)?;
+        }
+        m.add("SWEEP_PARAMETERS", parameters)?;
         Ok(())
     }
 }

@@ -30,7 +30,7 @@ pub fn trace_columns() -> Vec<&'static str> {
 /// A refused configuration or scenario as the Python exception it means: an unknown scenario
 /// is a bad argument (`InputError`), anything else a bad configuration key (`ConfigError`
 /// with `.field` = the TOML path, e.g. `inverter.dead_time`).
-fn sim_error(py: Python<'_>, e: SimConfigError) -> PyErr {
+pub(crate) fn sim_error(py: Python<'_>, e: SimConfigError) -> PyErr {
     if e.key == "scenario" {
         input_error(py, "scenario", e.message)
     } else {

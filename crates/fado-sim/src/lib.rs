@@ -10,6 +10,8 @@
 //!   [`simulate`] is the one-call entry point (CLI `fado-sim run`, Python bindings).
 //! * [`compare`]: every estimator (fado and the `fado_core::baselines`) in every scenario on
 //!   the same plant, seed and controllers (CLI `fado-sim compare`).
+//! * [`sweep`]: operating-envelope sweeps over model, sensor, load and profile errors, in
+//!   parallel, resumable, one CSV row per point (CLI `fado-sim sweep`, Python `fado.sweep`).
 //! * [`config`]: the whole run as one TOML document ([`SimConfig`]), overriding a scenario key
 //!   by key; unknown keys and impossible values are errors naming the key.
 //! * [`sim`]: the loop ([`sim::Simulation`]), the plant aggregate ([`sim::Plant`]), metrics,
@@ -52,6 +54,7 @@ pub mod profile;
 pub mod scenario;
 pub mod sensors;
 pub mod sim;
+pub mod sweep;
 
 pub use config::SimConfig;
 pub use error::SimConfigError;

@@ -118,20 +118,24 @@ fn sweep_runs_one_scenario_per_value_and_writes_a_csv() {
     let dir = tmp_dir("sweep");
     let cfg = dir.join("short.toml");
     std::fs::write(&cfg, "[simulation]\nduration = 0.2\n").unwrap();
-    let out = bin()
-        .args([
-            "sweep",
-            "fig11",
-            "--averaged",
-            "--set",
-            "mismatch.rs_ratio=0.9,1.0,1.1",
-        ])
-        .arg("--config")
-        .arg(&cfg)
-        .arg("--out")
-        .arg(&dir)
-        .output()
-        .unwrap();
+    // `--set` is the old name of `--axis`.
+    let sweep = |flag: &str| {
+        bin()
+            .args([
+                "sweep",
+                "fig11",
+                "--averaged",
+                flag,
+                "mismatch.rs_ratio=0.9,1.0,1.1",
+            ])
+            .arg("--config")
+            .arg(&cfg)
+            .arg("--out")
+            .arg(&dir)
+            .output()
+            .unwrap()
+    };
+    let out = sweep("--set");
     assert!(
         out.status.success(),
         "{}",
@@ -140,8 +144,12 @@ fn sweep_runs_one_scenario_per_value_and_writes_a_csv() {
     let csv = std::fs::read_to_string(dir.join("sweep.csv")).unwrap();
     let lines: Vec<_> = csv.lines().collect();
     assert_eq!(lines.len(), 4, "{csv}");
-    assert!(lines[0].starts_with("mismatch.rs_ratio,passed"));
-    assert!(lines[1].starts_with("0.9,") && lines[3].starts_with("1.1,"));
+    assert!(lines[0].starts_with("point,mismatch.rs_ratio,status,passed"));
+    assert!(lines[1].starts_with("0,0.9,ok,") && lines[3].starts_with("2,1.1,ok,"));
+    assert!(dir.join("summary.json").exists() && dir.join("summary.md").exists());
+    // Again on the same directory: everything is finished, nothing runs.
+    let again = sweep("--axis");
+    assert!(String::from_utf8_lossy(&again.stdout).contains("0 points run, 3 resumed"));
     let bad = bin()
         .args(["sweep", "fig11", "--set", "mismatch.rs_rato=1.0"])
         .output()

@@ -3,7 +3,9 @@
 //! ```text
 //! fado-sim list
 //! fado-sim run fig11 [--config FILE] [--out DIR] [--averaged] [--dump-config]
-//! fado-sim sweep fig11 --set mismatch.rs_ratio=0.98,0.99,1,1.01,1.02 [--averaged]
+//! fado-sim sweep fig11 --axis rs_error=-0.3:0.3:7 --axis load_torque=0,2.5,5,7.5
+//!                [--random N --seed S] [--config FILE] [--out DIR] [--averaged]
+//!                [--threads N] [--fresh]
 //! fado-sim compare [--scenarios fig8,...] [--estimators fado,lpf-integrator,ortega,emf-observer]
 //!                  [--out DIR] [--averaged] [--config FILE] [--criterion target/criterion]
 //! ```
@@ -12,9 +14,9 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use fado_sim::SimConfig;
 use fado_sim::compare;
 use fado_sim::scenario::{self, SCENARIOS};
+use fado_sim::sweep::{self, SweepOptions, SweepSpec};
 use indicatif::{ProgressBar, ProgressStyle};
 
 #[derive(Parser)]
@@ -49,15 +51,30 @@ enum Command {
         #[arg(long)]
         dump_config: bool,
     },
-    /// Run a scenario once per value of one key and tabulate the results (robustness sweeps),
-    /// e.g. `sweep fig11 --set mismatch.rs_ratio=0.98,0.99,1,1.01,1.02`. Writes DIR/sweep.csv.
+    /// Run a scenario once per point of a grid or random design over configuration keys and
+    /// derived parameters (operating-envelope sweeps); write DIR/sweep.csv (one row per point,
+    /// appended as points finish), DIR/sweep.json (the definition), DIR/summary.json and
+    /// DIR/summary.md. Started again on the same DIR with the same definition, it skips the
+    /// points already finished.
+    ///
+    /// Parameters: any TOML key `section.key`, or rs_error (R̂s/(Rs+r_on) − 1), lq_error,
+    /// ld_error, flux_linkage_error (λ̂f/λf − 1), dead_time_comp_error (T̂d/Td − 1),
+    /// sensor_offset (A), sensor_gain_error, load_torque (final value, N·m), reversal_ramp
+    /// (r/min per s). See `fado_sim::sweep`.
     Sweep {
         /// Scenario name.
         scenario: String,
-        /// `section.key=v1,v2,...` (TOML values; bare words are taken as strings).
+        /// `name=lo:hi:n` (n values, ends included) or `name=v1,v2,...` (TOML values); with
+        /// `--random`, `name=lo..hi`. Repeat for more axes (grid: the cartesian product).
+        #[arg(long = "axis", alias = "set", required = true)]
+        axes: Vec<String>,
+        /// Draw this many points uniformly in the `lo..hi` ranges instead of a grid.
         #[arg(long)]
-        set: String,
-        /// TOML file applied before the swept key.
+        random: Option<usize>,
+        /// Seed of `--random`.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// TOML file applied over the scenario before the axes (e.g. estimator settings).
         #[arg(long)]
         config: Option<PathBuf>,
         /// Output directory. Default `out/<scenario>-sweep`.
@@ -66,6 +83,12 @@ enum Command {
         /// Use the averaged inverter model.
         #[arg(long)]
         averaged: bool,
+        /// Worker threads (0: all cores).
+        #[arg(long, default_value_t = 0)]
+        threads: usize,
+        /// Discard the results of an earlier sweep in DIR instead of resuming it.
+        #[arg(long)]
+        fresh: bool,
     },
     /// Run every estimator in every scenario on the same plant, seed and controllers; print
     /// the table, write DIR/compare.json and DIR/compare.md.
@@ -173,12 +196,45 @@ fn run(cli: Cli) -> Result<ExitCode, Box<dyn std::error::Error>> {
             })
         }
         Command::Sweep {
-            scenario: name,
-            set,
+            scenario,
+            axes,
+            random,
+            seed,
             config,
             out,
             averaged,
-        } => sweep(&name, &set, config, out, averaged),
+            threads,
+            fresh,
+        } => {
+            let mut spec = match random {
+                None => {
+                    let mut grid = Vec::new();
+                    for a in &axes {
+                        let (name, values) = split_axis(a)?;
+                        grid.push((name.to_owned(), sweep::parse_values(values)?));
+                    }
+                    SweepSpec::grid(&scenario, grid)
+                }
+                Some(n) => {
+                    let mut ranges = Vec::new();
+                    for a in &axes {
+                        let (name, range) = split_axis(a)?;
+                        let (lo, hi) = sweep::parse_range(range)?;
+                        ranges.push((name.to_owned(), lo, hi));
+                    }
+                    SweepSpec::random(&scenario, &ranges, n, seed)
+                }
+            };
+            spec.averaged = averaged;
+            if let Some(p) = &config {
+                spec.config_toml = Some(
+                    std::fs::read_to_string(p)
+                        .map_err(|e| format!("cannot read {}: {e}", p.display()))?,
+                );
+            }
+            let dir = out.unwrap_or_else(|| PathBuf::from("out").join(format!("{scenario}-sweep")));
+            run_sweep(&spec, dir, threads, fresh)
+        }
         Command::Compare {
             scenarios,
             estimators,
@@ -239,89 +295,55 @@ fn run(cli: Cli) -> Result<ExitCode, Box<dyn std::error::Error>> {
     }
 }
 
-fn sweep(
-    name: &str,
-    set: &str,
-    config: Option<PathBuf>,
-    out: Option<PathBuf>,
-    averaged: bool,
+fn split_axis(arg: &str) -> Result<(&str, &str), String> {
+    arg.split_once('=')
+        .map(|(n, v)| (n.trim(), v))
+        .ok_or_else(|| format!("--axis `{arg}` must look like name=values"))
+}
+
+fn run_sweep(
+    spec: &SweepSpec,
+    dir: PathBuf,
+    threads: usize,
+    fresh: bool,
 ) -> Result<ExitCode, Box<dyn std::error::Error>> {
-    let (key, values) = set
-        .split_once('=')
-        .ok_or("--set must look like section.key=v1,v2,...")?;
-    let (section, field) = key
-        .rsplit_once('.')
-        .ok_or("--set key must be section.key")?;
-    let text = match &config {
-        Some(p) => Some(std::fs::read_to_string(p)?),
-        None => None,
+    spec.base_config()?;
+    let bar = ProgressBar::new(spec.points.len() as u64);
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{spinner} {msg} [{bar:40}] {pos}/{len} points, {elapsed} elapsed, eta {eta}",
+        )?
+        .progress_chars("=> "),
+    );
+    bar.set_message(format!("{} {}", spec.scenario, spec.design));
+    let opts = SweepOptions {
+        threads,
+        out: Some(dir.clone()),
+        fresh,
     };
-    let base = scenario::scenario_config(name, text.as_deref(), averaged)?;
-    let mut overrides = Vec::new();
-    for v in values.split(',').map(str::trim).filter(|v| !v.is_empty()) {
-        // A TOML value as written, else a bare word as a string.
-        let value = if format!("x = {v}").parse::<toml::Table>().is_ok() {
-            v.to_owned()
-        } else {
-            format!("{v:?}")
-        };
-        let snippet = format!("[{section}]\n{field} = {value}\n");
-        overrides.push((v.to_owned(), SimConfig::from_toml_over(&base, &snippet)?));
-    }
-    // Two at a time: the machine has two cores.
-    let results: Vec<_> = std::thread::scope(|sc| {
-        let handles: Vec<_> = overrides
-            .chunks(overrides.len().div_ceil(2).max(1))
-            .map(|chunk| {
-                sc.spawn(move || {
-                    chunk
-                        .iter()
-                        .map(|(v, cfg)| (v.clone(), scenario::run_config(name, cfg.clone(), None)))
-                        .collect::<Vec<_>>()
-                })
-            })
-            .collect();
-        handles
-            .into_iter()
-            .flat_map(|h| h.join().expect("sweep worker panicked"))
-            .collect()
+    let started_bar = std::sync::Once::new();
+    let outcome = sweep::run(spec, &opts, &|r, finished| {
+        if let sweep::Status::Failed(m) = &r.status {
+            bar.suspend(|| eprintln!("point {} failed: {m}", r.index));
+        }
+        // Resumed points do not count for the rate.
+        started_bar.call_once(|| {
+            bar.set_position(finished as u64 - 1);
+            bar.reset_eta();
+        });
+        bar.set_position(finished as u64);
     });
-    let dir = out.unwrap_or_else(|| PathBuf::from("out").join(format!("{name}-sweep")));
-    std::fs::create_dir_all(&dir)?;
-    let mut csv = csv::Writer::from_path(dir.join("sweep.csv"))?;
-    csv.write_record([
-        key,
-        "passed",
-        "max_angle_error",
-        "max_angle_error_zero_speed",
-        "rms_angle_error_zero_speed",
-        "max_speed_error_rpm",
-        "tripped",
-    ])?;
-    println!("{key:>24}  passed  max|θ−θ̂|  near 0   rms near 0  speed err  tripped");
-    for (v, r) in results {
-        let r = r?.report();
-        println!(
-            "{v:>24}  {:<6}  {:>8.4}  {:>7.4}  {:>10.4}  {:>9.2}  {}",
-            r.passed,
-            r.max_angle_error,
-            r.max_angle_error_zero_speed,
-            r.rms_angle_error_zero_speed,
-            r.max_speed_error_rpm,
-            r.tripped
-        );
-        csv.write_record([
-            v,
-            r.passed.to_string(),
-            r.max_angle_error.to_string(),
-            r.max_angle_error_zero_speed.to_string(),
-            r.rms_angle_error_zero_speed.to_string(),
-            r.max_speed_error_rpm.to_string(),
-            r.tripped.to_string(),
-        ])?;
-    }
-    csv.flush()?;
-    println!("wrote {}/sweep.csv", dir.display());
+    bar.finish_and_clear();
+    let outcome = outcome?;
+    print!("{}", outcome.summary.to_markdown());
+    println!(
+        "{} points run, {} resumed, in {:.1} s ({:.1} points/min); wrote {}/sweep.csv, summary.json, summary.md",
+        outcome.ran,
+        outcome.resumed,
+        outcome.wall_seconds,
+        outcome.ran as f64 * 60.0 / outcome.wall_seconds.max(1e-9),
+        dir.display()
+    );
     Ok(ExitCode::SUCCESS)
 }
 
