@@ -306,3 +306,68 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn flux_linkage_law_learns_lambda_f_where_resistance_is_unobservable() {
+    // λ̂f 10 % high, R̂s 20 % high: 2 s unloaded at 300 r/min (χ = 0: only λ̂f can explain
+    // |λ̂r| − λ̂f), then 4 s at −90 r/min under 7.5 N·m (χ ≈ 1.7: R̂s). With λ̂f learned the
+    // R̂s law is unbiased; with λ̂f fixed it settles where (R̂s − Rs)·φ cancels Δλf.
+    let fast = rpm_to_electrical(300.0);
+    let slow = rpm_to_electrical(-90.0);
+    let speed = move |t: f64| if t < 2.0 { fast } else { slow };
+    let current = |t: f64| {
+        if t < 2.0 {
+            Dq::new(0.0, 0.0)
+        } else {
+            Dq::new(0.0, IQ_LOAD)
+        }
+    };
+    let run = |rate: f64| {
+        let mut est = SensorlessEstimator::new(EstimatorConfig {
+            rs_hat: RS * 1.2,
+            flux_linkage_hat: LF * 1.1,
+            flux_linkage_adaptation_rate: rate,
+            initial_angle: 0.4,
+            ..Default::default()
+        })
+        .unwrap();
+        let mut at_2s = 0.0;
+        let mut last = Default::default();
+        for (k, s) in profile(
+            0.4,
+            (6.0 / TS) as usize,
+            speed,
+            current,
+            Ab::zero(),
+            Ab::zero(),
+        )
+        .enumerate()
+        {
+            last = est.step(s.v, s.i).diagnostics;
+            if k + 1 == (2.0 / TS) as usize {
+                at_2s = last.flux_linkage_hat;
+            }
+        }
+        (at_2s, last)
+    };
+    let (learned, end) = run(5.0);
+    assert!(
+        (learned / LF - 1.0).abs() < 0.01,
+        "λ̂f/λf after 2 s: {}",
+        learned / LF
+    );
+    assert!(
+        (end.rs_hat / RS - 1.0).abs() < 0.02,
+        "R̂s/Rs: {}",
+        end.rs_hat / RS
+    );
+    let (fixed, biased) = run(0.0);
+    assert_eq!(fixed, LF * 1.1);
+    // (R̂s − Rs)·φ = λ̂f − λf with φ = −i_q/ω̂ = 14.2/37.7 A·s: +0.023 Ω ≈ +7 % of Rs.
+    let bias = biased.rs_hat / RS - 1.0;
+    assert!(
+        (0.05..0.09).contains(&bias),
+        "R̂s/Rs with λ̂f fixed 10 % high: {}",
+        biased.rs_hat / RS
+    );
+}

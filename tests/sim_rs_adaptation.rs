@@ -71,3 +71,21 @@ fn adaptation_never_makes_a_passing_scenario_fail() {
         }
     }
 }
+
+#[test]
+fn flux_linkage_error_needs_the_flux_linkage_law() {
+    // A 10 % λ̂f error biases the turning R̂s law by Δλf·ω/i_q (7 % at −90 r/min, 7.5 N·m),
+    // which loses the reversal that a fixed, right R̂s survives; learning λ̂f unloaded
+    // (`flux_linkage_adaptation_rate`, off by default) restores it.
+    let lf = "[mismatch]\nflux_linkage_ratio = 0.9\n";
+    let fixed = run(
+        "fig11",
+        &format!("{lf}[estimator]\nrs_adaptation = false\n"),
+    );
+    let biased = run("fig11", lf);
+    let learned = run(
+        "fig11",
+        &format!("{lf}[estimator]\nflux_linkage_adaptation_rate = 5.0\n"),
+    );
+    assert!(fixed.passed && !biased.passed && learned.passed);
+}

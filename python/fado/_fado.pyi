@@ -93,6 +93,7 @@ class EstimatorConfig:
         rs_adaptation_excitation_floor: float | None = None,
         rs_adaptation_min_ratio: float | None = None,
         rs_adaptation_max_ratio: float | None = None,
+        flux_linkage_adaptation_rate: float | None = None,
     ) -> EstimatorConfig: ...
     def replace(
         self,
@@ -120,6 +121,7 @@ class EstimatorConfig:
         rs_adaptation_excitation_floor: float | None = None,
         rs_adaptation_min_ratio: float | None = None,
         rs_adaptation_max_ratio: float | None = None,
+        flux_linkage_adaptation_rate: float | None = None,
     ) -> EstimatorConfig: ...
     def to_dict(self) -> dict[str, float | str | bool]: ...
     def __getnewargs_ex__(self) -> tuple[tuple[()], dict[str, float | str | bool]]: ...
@@ -194,6 +196,9 @@ class EstimatorConfig:
     @property
     def rs_adaptation_max_ratio(self) -> float:
         """Upper bound of the adapted R̂s as a multiple of rs_hat."""
+    @property
+    def flux_linkage_adaptation_rate(self) -> float:
+        """Rate of the λ̂f learning where R̂s is unobservable, in 1/s (0 = fixed λ̂f)."""
 
 @final
 class StepResult:
@@ -228,6 +233,8 @@ class StepResult:
     def lambda_r_beta(self) -> float: ...
     @property
     def rs_hat(self) -> float: ...
+    @property
+    def flux_linkage_hat(self) -> float: ...
     @property
     def mode(self) -> int: ...
     @property
@@ -280,6 +287,8 @@ class EstimateResult:
     def lambda_r_beta(self) -> _FloatArray: ...
     @property
     def rs_hat(self) -> _FloatArray: ...
+    @property
+    def flux_linkage_hat(self) -> _FloatArray: ...
     @property
     def mode(self) -> npt.NDArray[np.int8]: ...
     @property

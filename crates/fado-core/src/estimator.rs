@@ -108,6 +108,10 @@ pub struct EstimatorConfig<T> {
     /// Upper bound of the adapted R̂s as a multiple of `rs_hat`. Default as
     /// [`ResistanceAdaptationConfig::max_ratio`].
     pub rs_adaptation_max_ratio: T,
+    /// With `rs_adaptation`: rate at which the flux-magnitude reference λ̂f is learned where R̂s
+    /// is not observable, s⁻¹ (0 = the configured λ̂f throughout). Default as
+    /// [`ResistanceAdaptationConfig::flux_linkage_rate`].
+    pub flux_linkage_adaptation_rate: T,
 }
 
 impl<T: Real> Default for EstimatorConfig<T> {
@@ -137,6 +141,7 @@ impl<T: Real> Default for EstimatorConfig<T> {
             rs_adaptation_excitation_floor: rs.excitation_floor,
             rs_adaptation_min_ratio: rs.min_ratio,
             rs_adaptation_max_ratio: rs.max_ratio,
+            flux_linkage_adaptation_rate: rs.flux_linkage_rate,
         }
     }
 }
@@ -153,6 +158,7 @@ impl<T: Real> EstimatorConfig<T> {
             rs_initial: self.rs_hat,
             flux_linkage_hat: self.flux_linkage_hat,
             lq_hat: self.lq_hat,
+            flux_linkage_rate: self.flux_linkage_adaptation_rate,
             rate: self.rs_adaptation_rate,
             excitation_floor: self.rs_adaptation_excitation_floor,
             min_ratio: self.rs_adaptation_min_ratio,
@@ -195,6 +201,9 @@ pub struct Diagnostics<T> {
     /// R̂s used by the integrator this sample (Ω): the configured value, or the adapted one
     /// with [`EstimatorConfig::rs_adaptation`].
     pub rs_hat: T,
+    /// The flux-magnitude reference λ̂f (Wb): the configured value, or the adapted one with
+    /// [`EstimatorConfig::rs_adaptation`].
+    pub flux_linkage_hat: T,
     /// This sample's inputs were non-finite and were rejected; the state is unchanged and the
     /// other fields repeat the last good sample.
     pub input_fault: bool,
@@ -302,6 +311,7 @@ impl<T: Real> SensorlessEstimator<T> {
                     "excitation_floor" => rename("rs_adaptation_excitation_floor")(e),
                     "min_ratio" => rename("rs_adaptation_min_ratio")(e),
                     "max_ratio" => rename("rs_adaptation_max_ratio")(e),
+                    "flux_linkage_rate" => rename("flux_linkage_adaptation_rate")(e),
                     _ => e,
                 }
             })?;
@@ -377,6 +387,7 @@ impl<T: Real> SensorlessEstimator<T> {
                 limiter_clamping: false,
                 tracker_hold: false,
                 rs_hat: self.rs_adaptation.rs_hat(),
+                flux_linkage_hat: self.rs_adaptation.flux_linkage_hat(),
                 input_fault: false,
             },
         };
@@ -443,6 +454,7 @@ impl<T: Real> SensorlessEstimator<T> {
             return self.reject();
         }
         let rs_hat_used = self.integrator.config().rs_hat;
+        let flux_linkage_used = self.rs_adaptation.flux_linkage_hat();
         // (Read before the integrator's commit replaces the previous current.)
         let i_drop = if self.config.rs_adaptation {
             self.integrator.drop_current(i_ab)
@@ -493,6 +505,7 @@ impl<T: Real> SensorlessEstimator<T> {
                 limiter_clamping: clamping,
                 tracker_hold,
                 rs_hat: rs_hat_used,
+                flux_linkage_hat: flux_linkage_used,
                 input_fault: false,
             },
         };

@@ -170,6 +170,9 @@ config_class! {
     rs_adaptation_min_ratio: f64,
     /// Upper bound of the adapted R̂s as a multiple of `rs_hat`.
     rs_adaptation_max_ratio: f64,
+    /// With `rs_adaptation`: rate of the λ̂f learning where R̂s is unobservable, in 1/s
+    /// (0 = fixed λ̂f).
+    flux_linkage_adaptation_rate: f64,
 }
 
 impl Default for PyEstimatorConfig {
@@ -205,6 +208,7 @@ impl PyEstimatorConfig {
             rs_adaptation_excitation_floor: c.rs_adaptation_excitation_floor,
             rs_adaptation_min_ratio: c.rs_adaptation_min_ratio,
             rs_adaptation_max_ratio: c.rs_adaptation_max_ratio,
+            flux_linkage_adaptation_rate: c.flux_linkage_adaptation_rate,
         }
     }
 
@@ -235,6 +239,7 @@ impl PyEstimatorConfig {
             rs_adaptation_excitation_floor: T::lit(self.rs_adaptation_excitation_floor),
             rs_adaptation_min_ratio: T::lit(self.rs_adaptation_min_ratio),
             rs_adaptation_max_ratio: T::lit(self.rs_adaptation_max_ratio),
+            flux_linkage_adaptation_rate: T::lit(self.flux_linkage_adaptation_rate),
         };
         config.validate().map_err(|e| config_error(py, e))?;
         Ok(config)

@@ -168,6 +168,8 @@ outputs! {
         lambda_r_beta => diagnostics.lambda_r.beta,
         /// R̂s the integrator used in Ω (moves with `rs_adaptation`).
         rs_hat => diagnostics.rs_hat,
+        /// The flux-magnitude reference λ̂f in Wb (moves with `rs_adaptation`).
+        flux_linkage_hat => diagnostics.flux_linkage_hat,
     }
     mode {
         /// Active flux feedback: 0 = limiter (Fig. 6), 1 = disturbance feedback k_df (Fig. 3).

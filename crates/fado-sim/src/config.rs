@@ -246,6 +246,9 @@ pub struct EstimatorSettings {
     pub rs_adaptation_min_ratio: f64,
     /// Upper bound of the adapted R̂s / configured R̂s. Default as `EstimatorConfig`.
     pub rs_adaptation_max_ratio: f64,
+    /// λ̂f learning rate where R̂s is unobservable, s⁻¹ (0 = fixed λ̂f). Default as
+    /// `EstimatorConfig::flux_linkage_adaptation_rate`.
+    pub flux_linkage_adaptation_rate: f64,
     /// LPF baseline: cut-off of 1/(s + ωc), Hz. Default as `LpfIntegratorConfig`.
     pub lpf_cutoff_hz: f64,
     /// LPF baseline: speed below which its gain/phase compensation is frozen, Hz.
@@ -292,6 +295,7 @@ impl Default for EstimatorSettings {
             rs_adaptation_excitation_floor: d.rs_adaptation_excitation_floor,
             rs_adaptation_min_ratio: d.rs_adaptation_min_ratio,
             rs_adaptation_max_ratio: d.rs_adaptation_max_ratio,
+            flux_linkage_adaptation_rate: d.flux_linkage_adaptation_rate,
             kind: EstimatorKind::Fado,
             lpf_cutoff_hz: lpf.cutoff_hz,
             lpf_compensation_floor_hz: lpf.compensation_floor_hz,
@@ -470,6 +474,7 @@ impl SimConfig {
             rs_adaptation_excitation_floor: e.rs_adaptation_excitation_floor,
             rs_adaptation_min_ratio: e.rs_adaptation_min_ratio,
             rs_adaptation_max_ratio: e.rs_adaptation_max_ratio,
+            flux_linkage_adaptation_rate: e.flux_linkage_adaptation_rate,
             initial_angle: self.simulation.initial_angle + self.simulation.align_error,
         }
     }

@@ -257,6 +257,7 @@ impl Controller for DriveF32 {
                     limiter_clamping: d.limiter_clamping,
                     tracker_hold: d.tracker_hold,
                     rs_hat: d.rs_hat as f64,
+                    flux_linkage_hat: d.flux_linkage_hat as f64,
                     input_fault: d.input_fault,
                 },
             },
@@ -334,6 +335,7 @@ impl SimConfig {
             rs_adaptation_excitation_floor: f(e.rs_adaptation_excitation_floor),
             rs_adaptation_min_ratio: f(e.rs_adaptation_min_ratio),
             rs_adaptation_max_ratio: f(e.rs_adaptation_max_ratio),
+            flux_linkage_adaptation_rate: f(e.flux_linkage_adaptation_rate),
         };
         dc.validate()
             .map_err(|e| SimConfigError::from(e).in_section("controller"))?;

@@ -511,12 +511,14 @@ pub struct TraceRow {
     pub i_beta: f64,
     /// R̂s the estimator integrated with, Ω (moves with `[estimator] rs_adaptation`).
     pub rs_hat: f64,
+    /// The estimator's flux-magnitude reference λ̂f, Wb (moves with `rs_adaptation`).
+    pub flux_linkage_hat: f64,
 }
 
 impl TraceRow {
     /// Column names, in CSV order (for struct-of-arrays consumers such as the Python
     /// bindings).
-    pub const COLUMNS: [&'static str; 37] = [
+    pub const COLUMNS: [&'static str; 38] = [
         "time",
         "theta",
         "theta_hat",
@@ -554,10 +556,11 @@ impl TraceRow {
         "i_alpha",
         "i_beta",
         "rs_hat",
+        "flux_linkage_hat",
     ];
 
     /// The row's values in [`COLUMNS`](Self::COLUMNS) order (flags as 0.0/1.0).
-    pub fn values(&self) -> [f64; 37] {
+    pub fn values(&self) -> [f64; 38] {
         [
             self.time,
             self.theta,
@@ -596,6 +599,7 @@ impl TraceRow {
             self.i_alpha,
             self.i_beta,
             self.rs_hat,
+            self.flux_linkage_hat,
         ]
     }
 }
@@ -641,6 +645,7 @@ impl From<&Sample> for TraceRow {
             i_alpha: s.i_ab_measured.alpha,
             i_beta: s.i_ab_measured.beta,
             rs_hat: d.rs_hat,
+            flux_linkage_hat: d.flux_linkage_hat,
         }
     }
 }
