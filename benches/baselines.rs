@@ -45,8 +45,15 @@ fn inputs() -> Vec<(Ab<f32>, Ab<f32>)> {
         .collect()
 }
 
-fn bench_one<E: RotorAngleEstimator<f32>>(
+fn bench_one<E: RotorAngleEstimator<f32>>(c: &mut Criterion, est: E, data: &[(Ab<f32>, Ab<f32>)]) {
+    let name = format!("{}_step_f32", est.name());
+    bench_named(c, &name, est, data);
+}
+
+/// `name` is what `fado-sim compare --criterion` looks for: `<estimator>_step_f32`.
+fn bench_named<E: RotorAngleEstimator<f32>>(
     c: &mut Criterion,
+    name: &str,
     mut est: E,
     data: &[(Ab<f32>, Ab<f32>)],
 ) {
@@ -56,7 +63,7 @@ fn bench_one<E: RotorAngleEstimator<f32>>(
         est.step(v, i);
     }
     let mut k = 0;
-    c.bench_function(&format!("{}_step_f32", est.name()), |b| {
+    c.bench_function(name, |b| {
         b.iter(|| {
             let (v, i) = data[k];
             k = if k + 1 == data.len() { 0 } else { k + 1 };
@@ -70,6 +77,17 @@ fn estimators(c: &mut Criterion) {
     bench_one(
         c,
         SensorlessEstimator::<f32>::new(EstimatorConfig::default()).unwrap(),
+        &data,
+    );
+    // fado as the paper has it: R̂s fixed (compare's `fado-fixed-rs`).
+    bench_named(
+        c,
+        "fado-fixed-rs_step_f32",
+        SensorlessEstimator::<f32>::new(EstimatorConfig {
+            rs_adaptation: false,
+            ..Default::default()
+        })
+        .unwrap(),
         &data,
     );
     bench_one(

@@ -59,7 +59,8 @@ def compare(
     """Runs every estimator in every scenario; see ``fado_sim::compare`` for the metrics.
 
     ``scenarios`` defaults to all (fig8 … fig12, steady300, lowspeed), ``estimators`` to
-    ``["fado", "lpf-integrator", "ortega", "emf-observer"]``. ``averaged`` selects the fast
+    ``["fado", "fado-fixed-rs", "lpf-integrator", "ortega", "emf-observer"]``
+    (``fado-fixed-rs``: fado with the paper's fixed R̂s). ``averaged`` selects the fast
     averaged inverter model. ``config`` is TOML applied over every scenario (its
     ``[estimator] kind`` is replaced by each estimator). ``traces`` keeps each run's 1 kHz
     trace (a dict of arrays) under ``"trace"``. Raises :class:`fado.ConfigError`.

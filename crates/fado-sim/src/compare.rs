@@ -35,12 +35,51 @@ use crate::inverter::InverterModel;
 use crate::scenario::{self, Check, LevelStats, SCENARIOS};
 use crate::sim::Trace;
 
-/// Every estimator the drive can run, fado first.
-pub const ESTIMATORS: [EstimatorKind; 4] = [
-    EstimatorKind::Fado,
-    EstimatorKind::LpfIntegrator,
-    EstimatorKind::Ortega,
-    EstimatorKind::EmfObserver,
+/// One compared estimator: a kind the drive can run, and for fado whether R̂s is held fixed as
+/// in the paper (`fado-fixed-rs`) instead of adapted (fado's default).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Contender {
+    /// `[estimator] kind`.
+    pub kind: EstimatorKind,
+    /// fado only: `[estimator] rs_adaptation = false`.
+    pub fixed_rs: bool,
+}
+
+impl Contender {
+    /// The estimator with its default settings.
+    pub const fn of(kind: EstimatorKind) -> Self {
+        Self {
+            kind,
+            fixed_rs: false,
+        }
+    }
+
+    /// Its name in tables (`fado`, `fado-fixed-rs`, `lpf-integrator`, ...).
+    pub fn name(self) -> &'static str {
+        match (self.kind, self.fixed_rs) {
+            (EstimatorKind::Fado, true) => "fado-fixed-rs",
+            (kind, _) => estimator_name(kind),
+        }
+    }
+}
+
+impl From<EstimatorKind> for Contender {
+    fn from(kind: EstimatorKind) -> Self {
+        Self::of(kind)
+    }
+}
+
+/// Every estimator compared by default: fado (with its R̂s adaptation), fado as the paper has
+/// it (fixed R̂s), then the baselines.
+pub const ESTIMATORS: [Contender; 5] = [
+    Contender::of(EstimatorKind::Fado),
+    Contender {
+        kind: EstimatorKind::Fado,
+        fixed_rs: true,
+    },
+    Contender::of(EstimatorKind::LpfIntegrator),
+    Contender::of(EstimatorKind::Ortega),
+    Contender::of(EstimatorKind::EmfObserver),
 ];
 
 /// Checks that read fado's own internal signals (D̂, FLAG_limit): a baseline has no such
@@ -61,14 +100,15 @@ pub fn estimator_name(kind: EstimatorKind) -> &'static str {
     }
 }
 
-/// Parses an estimator name, with `-` or `_` (`lpf-integrator`, `emf_observer`).
-pub fn parse_estimator(name: &str) -> Result<EstimatorKind, SimConfigError> {
+/// Parses an estimator name, with `-` or `_` (`lpf-integrator`, `emf_observer`,
+/// `fado-fixed-rs`).
+pub fn parse_estimator(name: &str) -> Result<Contender, SimConfigError> {
     let wanted = name.trim().replace('_', "-");
     ESTIMATORS
         .into_iter()
-        .find(|&k| estimator_name(k) == wanted)
+        .find(|c| c.name() == wanted)
         .ok_or_else(|| {
-            let names: Vec<_> = ESTIMATORS.into_iter().map(estimator_name).collect();
+            let names: Vec<_> = ESTIMATORS.into_iter().map(Contender::name).collect();
             SimConfigError::new("estimators", format!("unknown `{name}`; one of {names:?}"))
         })
 }
@@ -79,7 +119,7 @@ pub struct CompareOptions {
     /// Scenario names. Default: all of [`SCENARIOS`].
     pub scenarios: Vec<String>,
     /// Estimators. Default: [`ESTIMATORS`].
-    pub estimators: Vec<EstimatorKind>,
+    pub estimators: Vec<Contender>,
     /// Force the averaged inverter model (fast) instead of the switching-resolved one.
     pub averaged: bool,
     /// TOML applied over every scenario's configuration (its `[estimator] kind` is replaced
@@ -212,11 +252,14 @@ pub fn compare(opts: &CompareOptions) -> Result<Comparison, SimConfigError> {
     let mut jobs = Vec::new();
     for name in &opts.scenarios {
         let base = scenario::scenario_config(name, opts.config_toml.as_deref(), opts.averaged)?;
-        for &kind in &opts.estimators {
+        for &contender in &opts.estimators {
             let mut cfg = base.clone();
-            cfg.estimator.kind = kind;
+            cfg.estimator.kind = contender.kind;
+            if contender.fixed_rs {
+                cfg.estimator.rs_adaptation = false;
+            }
             cfg.validate()?;
-            jobs.push((name.clone(), kind, cfg));
+            jobs.push((name.clone(), contender, cfg));
         }
     }
     let first = &jobs[0].2;
@@ -234,11 +277,11 @@ pub fn compare(opts: &CompareOptions) -> Result<Comparison, SimConfigError> {
             sc.spawn(|| {
                 loop {
                     let k = next.fetch_add(1, Ordering::Relaxed);
-                    let Some((name, kind, cfg)) = jobs.get(k) else {
+                    let Some((name, contender, cfg)) = jobs.get(k) else {
                         break;
                     };
                     let row = scenario::run_config(name, cfg.clone(), None)
-                        .map(|o| row_of(name, *kind, o, opts.keep_traces));
+                        .map(|o| row_of(name, *contender, o, opts.keep_traces));
                     results.lock().expect("a compare worker panicked")[k] = Some(row);
                 }
             });
@@ -265,14 +308,14 @@ pub fn compare(opts: &CompareOptions) -> Result<Comparison, SimConfigError> {
 
 fn row_of(
     scenario: &str,
-    kind: EstimatorKind,
+    contender: Contender,
     o: scenario::Outcome,
     keep_trace: bool,
 ) -> CompareRow {
     let m = &o.metrics;
     CompareRow {
         scenario: scenario.to_owned(),
-        estimator: estimator_name(kind).to_owned(),
+        estimator: contender.name().to_owned(),
         passed: o.passed,
         passed_common: o
             .checks
@@ -298,14 +341,11 @@ fn row_of(
 /// Reads criterion's saved estimate of `<name>_step_f32` (benches/baselines.rs) for every
 /// estimator from `criterion_dir` (`target/criterion`): the median's point estimate and its
 /// confidence interval, in ns. Estimators without saved estimates are left out.
-pub fn read_criterion_step_costs(
-    criterion_dir: &Path,
-    estimators: &[EstimatorKind],
-) -> Vec<StepCost> {
+pub fn read_criterion_step_costs(criterion_dir: &Path, estimators: &[Contender]) -> Vec<StepCost> {
     estimators
         .iter()
         .filter_map(|&k| {
-            let name = estimator_name(k);
+            let name = k.name();
             let path = criterion_dir
                 .join(format!("{name}_step_f32"))
                 .join("new")
@@ -336,11 +376,11 @@ impl Comparison {
         self.summarise(&kinds);
     }
 
-    fn summarise(&mut self, estimators: &[EstimatorKind]) {
+    fn summarise(&mut self, estimators: &[Contender]) {
         self.summary = estimators
             .iter()
             .map(|&k| {
-                let name = estimator_name(k);
+                let name = k.name();
                 let rows: Vec<_> = self.rows.iter().filter(|r| r.estimator == name).collect();
                 EstimatorSummary {
                     estimator: name.to_owned(),
@@ -554,12 +594,13 @@ mod tests {
         use fado_core::RotorAngleEstimator;
         use fado_core::baselines::*;
         for k in ESTIMATORS {
-            assert_eq!(parse_estimator(estimator_name(k)).unwrap(), k);
+            assert_eq!(parse_estimator(k.name()).unwrap(), k);
         }
         assert_eq!(
             parse_estimator("emf_observer").unwrap(),
-            EstimatorKind::EmfObserver
+            EstimatorKind::EmfObserver.into()
         );
+        assert!(parse_estimator("fado_fixed_rs").unwrap().fixed_rs);
         assert_eq!(parse_estimator("kalman").unwrap_err().key, "estimators");
         let core = [
             fado_core::SensorlessEstimator::<f64>::new(Default::default())
@@ -575,9 +616,15 @@ mod tests {
                 .unwrap()
                 .name(),
         ];
+        let kinds = [
+            EstimatorKind::Fado,
+            EstimatorKind::LpfIntegrator,
+            EstimatorKind::Ortega,
+            EstimatorKind::EmfObserver,
+        ];
         assert_eq!(
             core.map(|n| n.to_owned()),
-            ESTIMATORS.map(estimator_name).map(str::to_owned)
+            kinds.map(estimator_name).map(str::to_owned)
         );
     }
 

@@ -20,7 +20,7 @@ fn compare_gives_the_numbers_of_individual_simulate_runs() {
     let short = "[simulation]\nduration = 3.8\n";
     let opts = CompareOptions {
         scenarios: vec!["fig11".into()],
-        estimators: vec![EstimatorKind::Fado, EstimatorKind::Ortega],
+        estimators: vec![EstimatorKind::Fado.into(), EstimatorKind::Ortega.into()],
         averaged: true,
         config_toml: Some(short.into()),
         ..Default::default()
@@ -85,7 +85,10 @@ fn every_estimator_holds_the_angle_at_300_rpm_under_load() {
 fn thread_count_does_not_change_the_numbers() {
     let opts = |threads| CompareOptions {
         scenarios: vec!["steady300".into()],
-        estimators: vec![EstimatorKind::LpfIntegrator, EstimatorKind::EmfObserver],
+        estimators: vec![
+            EstimatorKind::LpfIntegrator.into(),
+            EstimatorKind::EmfObserver.into(),
+        ],
         averaged: true,
         config_toml: Some("[simulation]\nduration = 2.7\n".into()),
         threads,

@@ -6,7 +6,7 @@
 //! fado-sim sweep fig11 --axis rs_error=-0.3:0.3:7 --axis load_torque=0,2.5,5,7.5
 //!                [--random N --seed S] [--config FILE] [--out DIR] [--averaged]
 //!                [--threads N] [--fresh]
-//! fado-sim compare [--scenarios fig8,...] [--estimators fado,lpf-integrator,ortega,emf-observer]
+//! fado-sim compare [--scenarios fig8,...] [--estimators fado,fado-fixed-rs,lpf-integrator,ortega,emf-observer]
 //!                  [--out DIR] [--averaged] [--config FILE] [--criterion target/criterion]
 //! ```
 
@@ -96,7 +96,8 @@ enum Command {
         /// Comma-separated scenario names. Default: all (see `list`).
         #[arg(long, value_delimiter = ',')]
         scenarios: Option<Vec<String>>,
-        /// Comma-separated estimators. Default: fado,lpf-integrator,ortega,emf-observer.
+        /// Comma-separated estimators. Default: fado,fado-fixed-rs,lpf-integrator,ortega,emf-observer
+        /// (fado-fixed-rs: fado with the paper's fixed R̂s).
         #[arg(long, value_delimiter = ',')]
         estimators: Option<Vec<String>>,
         /// TOML file applied over every scenario (its `[estimator] kind` is replaced).
