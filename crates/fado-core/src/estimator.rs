@@ -205,6 +205,28 @@ impl<T: Real> SensorlessEstimator<T> {
         let hold = check::non_negative("tracker_hold_ratio", config.tracker_hold_ratio)?;
         check::below("tracker_hold_ratio", hold, T::one(), "below 1")?;
         check::finite("initial_angle", config.initial_angle)?;
+        // A radius below λ̂f would clamp the magnet flux itself, not only drift (Fig. 6).
+        check::below(
+            "limiter_radius_ratio",
+            T::one(),
+            ratio + T::lit(1e-6),
+            "at least 1",
+        )?;
+        // One limiter step pulls the excess radius back by k_af·Ts of itself: above 1 it
+        // overshoots through the circle, above 2 it is unstable.
+        let k_af = check::non_negative("k_af", config.k_af)?;
+        check::below("k_af", k_af * ts, T::lit(1.0 + 1e-6), "k_af·ts at most 1")?;
+        // The mode switch compares |ω̂| with the band: it must lie below the Nyquist frequency.
+        let nyquist = |field, hz: T| {
+            let hz = check::finite(field, hz)?;
+            check::below(
+                field,
+                hz * ts,
+                T::lit(0.5),
+                "below the Nyquist frequency 1/(2·ts)",
+            )
+        };
+        nyquist("mode_threshold_hz", config.mode_threshold_hz)?;
         let rename = |field: &'static str| {
             move |e: ConfigError| match e {
                 ConfigError::OutOfRange { expected, .. } => {
@@ -242,6 +264,10 @@ impl<T: Real> SensorlessEstimator<T> {
             "threshold_hz" => rename("mode_threshold_hz")(e),
             _ => rename("mode_hysteresis_hz")(e),
         })?;
+        nyquist(
+            "mode_hysteresis_hz",
+            config.mode_threshold_hz + config.mode_hysteresis_hz,
+        )?;
         check::positive("tracker_damping", config.tracker_damping)?;
         let t2s1 = TypeTwoTracker::new(config.tracker(config.t2s1_bandwidth_hz))
             .map_err(rename("t2s1_bandwidth_hz"))?;
