@@ -1,0 +1,78 @@
+//! Inputs the fuzzer (fuzz/, scripts/fuzz.sh) found crashing, replayed as plain tests so that
+//! CI checks them without nightly. Each test is the decoded case (`cargo fuzz fmt`) of the
+//! file of the same name in fuzz/regressions/<target>/, with the fuzz targets' checks: every
+//! output finite, θ̂ in [−π, π].
+
+use fado_core::control::{DriveConfig, SensorlessDrive};
+use fado_core::estimator::{Estimate, EstimatorConfig, SensorlessEstimator};
+use fado_core::{Ab, Abc, Real};
+
+/// The fuzz targets' output check.
+fn check_estimate<T: Real>(e: &Estimate<T>) {
+    let d = &e.diagnostics;
+    let all = [
+        e.theta,
+        e.omega,
+        e.omega_control,
+        d.theta_direct,
+        d.lambda1.alpha,
+        d.lambda1.beta,
+        d.disturbance.alpha,
+        d.disturbance.beta,
+        d.lambda2.alpha,
+        d.lambda2.beta,
+        d.lambda_r.alpha,
+        d.lambda_r.beta,
+    ];
+    assert!(
+        all.iter().all(|x| x.is_finite()),
+        "non-finite output: {e:?}"
+    );
+    assert!(e.theta.abs() <= T::pi(), "θ̂ out of [−π, π]: {e:?}");
+    assert!(d.theta_direct.abs() <= T::pi(), "θm out of [−π, π]: {e:?}");
+}
+
+/// fuzz/regressions/estimator_step/huge-initial-angle: a finite but huge `initial_angle`
+/// was wrapped by x − 2π·round(x/2π), which has no precision left there: θ̂ = −6e234.
+#[test]
+fn huge_initial_angle_is_wrapped() {
+    for a0 in [-5.727778756618604e250, 9.112e30, f64::MAX] {
+        let mut est = SensorlessEstimator::new(EstimatorConfig {
+            initial_angle: a0,
+            observer_on_rotor_flux: false,
+            ..EstimatorConfig::default()
+        })
+        .unwrap();
+        check_estimate(est.last());
+        check_estimate(&est.step(Ab::new(1.0, 0.0), Ab::new(0.5, 0.0)));
+        est.align(a0, Ab::new(1.0, 2.0));
+        check_estimate(est.last());
+    }
+    let est = SensorlessEstimator::<f32>::new(EstimatorConfig {
+        initial_angle: f32::MAX,
+        ..EstimatorConfig::default()
+    })
+    .unwrap();
+    check_estimate(est.last());
+}
+
+/// fuzz/regressions/drive_step/huge-align-angle: `align(9.1e30)` during the offset
+/// calibration, then one sample: the drive reported θ̂ = 1.1e15.
+#[test]
+fn drive_align_to_a_huge_angle_is_wrapped() {
+    let config = DriveConfig {
+        current_bandwidth_hz: 0.16,
+        offset_calibration_samples: 219,
+        ..DriveConfig::default()
+    };
+    let mut drive = SensorlessDrive::new(config, EstimatorConfig::default()).unwrap();
+    let w = 2.0 * core::f64::consts::PI * -21.4;
+    for k in 0..16 {
+        let i = Ab::from_polar(107.0, w * 100e-6 * k as f64).to_abc();
+        let out = drive.step(i, 300.0, 0.0);
+        check_estimate(&out.estimate);
+    }
+    drive.align(9112.0 * 1e27);
+    let out = drive.step(Abc::new(0.0, 0.0, 0.0), 0.0, 0.0);
+    check_estimate(&out.estimate);
+}
