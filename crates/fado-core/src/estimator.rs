@@ -274,6 +274,19 @@ impl<T: Real> SensorlessEstimator<T> {
         let t2s2 = TypeTwoTracker::new(config.tracker(config.t2s2_bandwidth_hz))
             .map_err(rename("t2s2_bandwidth_hz"))?;
         let hold_level = hold * lf;
+        // Both circles are compared squared: in f32 a huge λ̂f would make them ∞.
+        let squared = |field, x: T| {
+            if (x * x).is_finite() {
+                Ok(())
+            } else {
+                Err(ConfigError::OutOfRange {
+                    field,
+                    expected: "a value whose square is finite in this precision",
+                })
+            }
+        };
+        squared("flux_linkage_hat", lf)?;
+        squared("limiter_radius_ratio", ratio * lf)?;
         let mut est = Self {
             config,
             integrator,
@@ -306,9 +319,15 @@ impl<T: Real> SensorlessEstimator<T> {
         } else {
             T::zero()
         };
-        let i_ab = if i_ab.is_finite() { i_ab } else { Ab::zero() };
         let lambda_r = Ab::from_polar(self.config.flux_linkage_hat, theta0);
+        // A current so large that L̂q·i overflows is as unusable as a NaN (found by fuzzing,
+        // f32: i = 3e37 A gave λ1 = ∞): start as with zero current.
         let lambda1 = lambda_r + i_ab * self.config.lq_hat;
+        let lambda1 = if lambda1.is_finite() {
+            lambda1
+        } else {
+            lambda_r
+        };
         self.integrator.reset_to(lambda1);
         self.observer
             .reset_to(if self.config.observer_on_rotor_flux {

@@ -76,3 +76,48 @@ fn drive_align_to_a_huge_angle_is_wrapped() {
     let out = drive.step(Abc::new(0.0, 0.0, 0.0), 0.0, 0.0);
     check_estimate(&out.estimate);
 }
+
+/// fuzz/regressions/estimator_step/align-current-overflow-f32: f32, L̂q = 69.39 H,
+/// `align(2.9e37, i = (2.9e37, 2.9e37))`: λ1 = λ̂f·e^{jθ0} + L̂q·i overflowed to ∞ and the
+/// start-up estimate carried it. (The fuzzer's λ̂f = 1.26e30 Wb is now refused, see below.)
+#[test]
+fn align_with_an_overflowing_current_starts_finite() {
+    let mut est = SensorlessEstimator::<f32>::new(EstimatorConfig {
+        lq_hat: 69.39,
+        initial_angle: -6.41,
+        average_current: false,
+        observer_on_rotor_flux: false,
+        ..EstimatorConfig::default()
+    })
+    .unwrap();
+    est.align(29041.0 * 1e33, Ab::new(29041.0 * 1e33, 29041.0 * 1e33));
+    check_estimate(est.last());
+    check_estimate(&est.step(Ab::new(69.39, 69.39), Ab::new(0.0, 0.0)));
+    check_estimate(&est.step(Ab::zero(), Ab::zero()));
+    // The same current in f64 is representable: it is used.
+    let mut est = SensorlessEstimator::<f64>::new(EstimatorConfig {
+        lq_hat: 69.39,
+        ..EstimatorConfig::default()
+    })
+    .unwrap();
+    est.align(0.0, Ab::new(1e37, 0.0));
+    assert!((est.last().diagnostics.lambda1.alpha - 69.39e37).abs() < 1e25);
+}
+
+/// A λ̂f so large that the limiter and hold circles overflow when squared (f32) is refused.
+#[test]
+fn flux_linkage_too_large_for_the_precision_is_refused() {
+    let c = EstimatorConfig::<f32> {
+        flux_linkage_hat: 1.26e30,
+        ..EstimatorConfig::default()
+    };
+    let e = SensorlessEstimator::new(c).err().unwrap();
+    assert_eq!(e.field(), "flux_linkage_hat");
+    let c = EstimatorConfig::<f32> {
+        flux_linkage_hat: 1e18,
+        limiter_radius_ratio: 1e3,
+        ..EstimatorConfig::default()
+    };
+    let e = SensorlessEstimator::new(c).err().unwrap();
+    assert_eq!(e.field(), "limiter_radius_ratio");
+}

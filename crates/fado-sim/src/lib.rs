@@ -52,6 +52,7 @@ pub mod profile;
 pub mod scenario;
 pub mod sensors;
 pub mod sim;
+pub mod source;
 
 pub use config::SimConfig;
 pub use error::SimConfigError;

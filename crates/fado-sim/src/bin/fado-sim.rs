@@ -12,9 +12,9 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use fado_sim::SimConfig;
 use fado_sim::compare;
 use fado_sim::scenario::{self, SCENARIOS};
+use fado_sim::{SimConfig, SimConfigError};
 use indicatif::{ProgressBar, ProgressStyle};
 
 #[derive(Parser)]
@@ -130,7 +130,8 @@ fn run(cli: Cli) -> Result<ExitCode, Box<dyn std::error::Error>> {
                 ),
                 None => None,
             };
-            let cfg = scenario::scenario_config(&name, text.as_deref(), averaged)?;
+            let cfg = scenario::scenario_config(&name, text.as_deref(), averaged)
+                .map_err(|e| in_file(e, &config))?;
             if dump_config {
                 print!("{}", cfg.to_toml());
                 return Ok(ExitCode::SUCCESS);
@@ -208,7 +209,7 @@ fn run(cli: Cli) -> Result<ExitCode, Box<dyn std::error::Error>> {
                         .map_err(|e| format!("cannot read {}: {e}", p.display()))?,
                 );
             }
-            let mut result = compare::compare(&opts)?;
+            let mut result = compare::compare(&opts).map_err(|e| in_file(e, &config))?;
             if let Some(dir) = &criterion {
                 let costs = compare::read_criterion_step_costs(dir, &opts.estimators);
                 if costs.is_empty() {
@@ -239,6 +240,14 @@ fn run(cli: Cli) -> Result<ExitCode, Box<dyn std::error::Error>> {
     }
 }
 
+/// A configuration error located in the `--config` file reads `FILE:LINE:COLUMN: `key`: …`.
+fn in_file(e: SimConfigError, config: &Option<PathBuf>) -> SimConfigError {
+    match config {
+        Some(p) => e.in_file(p.display().to_string()),
+        None => e,
+    }
+}
+
 fn sweep(
     name: &str,
     set: &str,
@@ -256,7 +265,8 @@ fn sweep(
         Some(p) => Some(std::fs::read_to_string(p)?),
         None => None,
     };
-    let base = scenario::scenario_config(name, text.as_deref(), averaged)?;
+    let base = scenario::scenario_config(name, text.as_deref(), averaged)
+        .map_err(|e| in_file(e, &config))?;
     let mut overrides = Vec::new();
     for v in values.split(',').map(str::trim).filter(|v| !v.is_empty()) {
         // A TOML value as written, else a bare word as a string.
