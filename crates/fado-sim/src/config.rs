@@ -414,13 +414,15 @@ impl SimConfig {
             .map_err(|e| e.in_section("mismatch"))?;
         self.estimator_config()
             .validate()
-            .map_err(|e| SimConfigError::from(e).in_section("estimator"))?;
-        match self.estimator.kind {
-            EstimatorKind::Fado => {}
-            EstimatorKind::LpfIntegrator => drop(self.lpf_estimator()?),
-            EstimatorKind::Ortega => drop(self.ortega_estimator()?),
-            EstimatorKind::EmfObserver => drop(self.emf_estimator()?),
-        }
+            .map_err(|e| core_error("estimator", e))?;
+        // Every key is checked whichever estimator runs: NaN in an unused key is still an
+        // error in the file.
+        self.lpf_estimator()?;
+        self.ortega_estimator()?;
+        self.emf_estimator()?;
+        self.drive_config()
+            .validate()
+            .map_err(|e| core_error("controller", e))?;
         Ok(())
     }
 
@@ -479,6 +481,44 @@ impl SimConfig {
     pub fn from_toml(text: &str) -> Result<SimConfig, SimConfigError> {
         Self::from_toml_over(&SimConfig::default(), text)
     }
+}
+
+/// A fado-core refusal of the `[section]` block (`estimator` or `controller`, including the
+/// baselines' `lpf_`/`ortega_`/`emf_` keys), named by the TOML key the user writes. The
+/// model estimates (R̂s, L̂q, λ̂f, …) and the timing are not keys of their own: they are plant
+/// keys times the `[mismatch]` ratios, so a refusal of one names the plant key.
+pub(crate) fn core_error(section: &str, e: fado_core::ConfigError) -> SimConfigError {
+    let derived = match e.field() {
+        "ts" | "switching_frequency" => Some("inverter.switching_frequency"),
+        "rs_hat" => Some("motor.rs"),
+        "ld_hat" => Some("motor.ld"),
+        "lq_hat" => Some("motor.lq"),
+        "flux_linkage_hat" => Some("motor.flux_linkage"),
+        "inertia_hat" => Some("motor.inertia"),
+        "pole_pairs" => Some("motor.pole_pairs"),
+        "dead_time" => Some("inverter.dead_time"),
+        "dead_time_threshold_voltage" => Some("inverter.threshold_voltage"),
+        "dead_time_current_band" => Some("inverter.current_band"),
+        "initial_angle" => Some("simulation.initial_angle"),
+        _ => None,
+    };
+    if let Some(key) = derived {
+        return SimConfigError::new(
+            key,
+            format!("{e} (the drive's value is derived from `{key}` and [mismatch])"),
+        );
+    }
+    let own = match e.field() {
+        "cutoff_hz" => "lpf_cutoff_hz",
+        "compensation_floor_hz" => "lpf_compensation_floor_hz",
+        "observer_bandwidth" => "ortega_observer_bandwidth",
+        "observer_speed_ratio" => "ortega_observer_speed_ratio",
+        "observer_bandwidth_min" => "ortega_observer_bandwidth_min",
+        "flux_adaptation_ratio" => "ortega_flux_adaptation_ratio",
+        "speed_floor_hz" => "emf_speed_floor_hz",
+        other => other,
+    };
+    SimConfigError::new(format!("{section}.{own}"), e.to_string())
 }
 
 fn merge(base: &mut toml::Table, over: toml::Table) {
