@@ -4,8 +4,8 @@
 #
 #   scripts/fuzz.sh [seconds-per-target] [target...]
 #
-# Defaults: 60 s for each of estimator_step and drive_step, one job each (the machine is
-# shared). A crash leaves its input in fuzz/artifacts/<target>/; `cargo +nightly fuzz fmt
+# Defaults: 60 s for each of estimator_step, drive_step and baseline_step, one job each (the
+# machine is shared). A crash leaves its input in fuzz/artifacts/<target>/; `cargo +nightly fuzz fmt
 # <target> <file>` prints the decoded case; copy the file to fuzz/regressions/<target>/ and
 # replay it as a test in crates/fado-core/tests/fuzz_regressions.rs. Every input already in
 # fuzz/regressions/ is replayed first, so a fixed crash stays fixed.
@@ -15,7 +15,7 @@ seconds="${1:-60}"
 shift || true
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
-    targets=(estimator_step drive_step)
+    targets=(estimator_step drive_step baseline_step)
 fi
 cargo +nightly fuzz build -O >/dev/null 2>&1
 status=0

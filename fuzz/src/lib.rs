@@ -11,7 +11,7 @@
 
 use arbitrary::Arbitrary;
 use fado_core::control::{DriveConfig, SensorlessDrive};
-use fado_core::estimator::{Estimate, EstimatorConfig, SensorlessEstimator};
+use fado_core::estimator::{Estimate, EstimatorConfig, RotorAngleEstimator, SensorlessEstimator};
 use fado_core::tracker::BandwidthDefinition;
 use fado_core::{Ab, Abc, Real};
 
@@ -381,5 +381,170 @@ pub fn drive_step_checked<T: Real>(
     );
     if !(i_abc.is_finite() && vdc.is_finite() && speed.is_finite()) {
         assert!(out.input_fault, "non-finite drive input accepted");
+    }
+}
+
+/// A reference estimator (compensated LPF, Ortega–Praly, extended EMF) and a run, with the
+/// same checks as the estimator's (the drive runs any of them).
+#[derive(Arbitrary, Clone, Debug)]
+pub struct BaselineCase {
+    /// Which: 0 LPF, 1 Ortega, 2 EMF (modulo 3).
+    pub which: u8,
+    /// Run in f32 instead of f64.
+    pub single: bool,
+    /// ts, rs_hat, lq_hat, flux_linkage_hat, t2s1/t2s2 bandwidths, damping, hold ratio,
+    /// initial angle (None = default).
+    pub shared: [Option<Num>; 9],
+    /// The estimator's own fields in declaration order (None = default).
+    pub own: [Option<Num>; 4],
+    /// `average_current`.
+    pub average_current: bool,
+    /// What to do (`SetRs` and `EnableKdf` do not apply and are skipped).
+    pub actions: Vec<EstimatorAction>,
+}
+
+macro_rules! shared_fields {
+    ($case:expr, $d:expr) => {{
+        let s = &$case.shared;
+        (
+            field(s[0], $d.ts),
+            field(s[1], $d.rs_hat),
+            field(s[2], $d.lq_hat),
+            field(s[3], $d.flux_linkage_hat),
+            field(s[4], $d.t2s1_bandwidth_hz),
+            field(s[5], $d.t2s2_bandwidth_hz),
+            field(s[6], $d.tracker_damping),
+            field(s[7], $d.tracker_hold_ratio),
+            field(s[8], $d.initial_angle),
+        )
+    }};
+}
+
+impl BaselineCase {
+    /// Runs the case; panics on a broken rule.
+    pub fn run(&self) {
+        if self.single {
+            self.run_in::<f32>();
+        } else {
+            self.run_in::<f64>();
+        }
+    }
+
+    fn run_in<T: Real>(&self) {
+        use fado_core::baselines::*;
+        let o = &self.own;
+        match self.which % 3 {
+            0 => {
+                let d = LpfIntegratorConfig::<T>::default();
+                let (ts, rs_hat, lq_hat, flux_linkage_hat, b1, b2, z, hold, a0) =
+                    shared_fields!(self, d);
+                let c = LpfIntegratorConfig {
+                    ts,
+                    rs_hat,
+                    lq_hat,
+                    flux_linkage_hat,
+                    t2s1_bandwidth_hz: b1,
+                    t2s2_bandwidth_hz: b2,
+                    tracker_damping: z,
+                    tracker_hold_ratio: hold,
+                    initial_angle: a0,
+                    cutoff_hz: field(o[0], d.cutoff_hz),
+                    compensation_floor_hz: field(o[1], d.compensation_floor_hz),
+                    average_current: self.average_current,
+                    ..d
+                };
+                if let Ok(e) = LpfIntegratorEstimator::new(c) {
+                    run_baseline(e, ts, &self.actions);
+                }
+            }
+            1 => {
+                let d = OrtegaConfig::<T>::default();
+                let (ts, rs_hat, lq_hat, flux_linkage_hat, b1, b2, z, hold, a0) =
+                    shared_fields!(self, d);
+                let c = OrtegaConfig {
+                    ts,
+                    rs_hat,
+                    lq_hat,
+                    flux_linkage_hat,
+                    t2s1_bandwidth_hz: b1,
+                    t2s2_bandwidth_hz: b2,
+                    tracker_damping: z,
+                    tracker_hold_ratio: hold,
+                    initial_angle: a0,
+                    observer_bandwidth: field(o[0], d.observer_bandwidth),
+                    observer_speed_ratio: field(o[1], d.observer_speed_ratio),
+                    observer_bandwidth_min: field(o[2], d.observer_bandwidth_min),
+                    flux_adaptation_ratio: field(o[3], d.flux_adaptation_ratio),
+                    average_current: self.average_current,
+                    ..d
+                };
+                if let Ok(e) = OrtegaEstimator::new(c) {
+                    run_baseline(e, ts, &self.actions);
+                }
+            }
+            _ => {
+                let d = EmfObserverConfig::<T>::default();
+                let (ts, rs_hat, lq_hat, flux_linkage_hat, b1, b2, z, hold, a0) =
+                    shared_fields!(self, d);
+                let c = EmfObserverConfig {
+                    ts,
+                    rs_hat,
+                    lq_hat,
+                    flux_linkage_hat,
+                    t2s1_bandwidth_hz: b1,
+                    t2s2_bandwidth_hz: b2,
+                    tracker_damping: z,
+                    tracker_hold_ratio: hold,
+                    initial_angle: a0,
+                    emf_bandwidth_hz: field(o[0], d.emf_bandwidth_hz),
+                    speed_floor_hz: field(o[1], d.speed_floor_hz),
+                    average_current: self.average_current,
+                    ..d
+                };
+                if let Ok(e) = EmfObserverEstimator::new(c) {
+                    run_baseline(e, ts, &self.actions);
+                }
+            }
+        }
+    }
+}
+
+fn run_baseline<T: Real, E: RotorAngleEstimator<T> + Copy>(
+    mut est: E,
+    ts: T,
+    actions: &[EstimatorAction],
+) {
+    let step = |est: &mut E, v: Ab<T>, i: Ab<T>| {
+        let before = *est;
+        let out = est.step(v, i);
+        check_estimate(&out);
+        if !(v.is_finite() && i.is_finite()) {
+            assert!(out.diagnostics.input_fault, "non-finite input accepted");
+        }
+        if out.diagnostics.input_fault {
+            let (mut a, mut b) = (*est, before);
+            let probe_v = Ab::new(T::lit(3.0), T::lit(-1.0));
+            let probe_i = Ab::new(T::lit(2.0), T::lit(0.5));
+            assert_eq!(
+                a.step(probe_v, probe_i),
+                b.step(probe_v, probe_i),
+                "a rejected sample changed the state"
+            );
+        }
+    };
+    for action in actions {
+        match *action {
+            EstimatorAction::Step { v, i } => step(&mut est, ab(v), ab(i)),
+            EstimatorAction::Rotate { v, i, hz, n } => {
+                let (v, i, w) = (v.get::<T>(), i.get::<T>(), T::two_pi() * hz.get::<T>());
+                for k in 0..n {
+                    let u = Ab::from_polar(T::one(), w * ts * T::lit(f64::from(k)));
+                    step(&mut est, u.mul_j() * v, u * i);
+                }
+            }
+            EstimatorAction::Align(theta, i) => est.align(theta.get(), ab(i)),
+            EstimatorAction::Reset => est.reset(),
+            EstimatorAction::SetRs(_) | EstimatorAction::EnableKdf(_) => {}
+        }
     }
 }

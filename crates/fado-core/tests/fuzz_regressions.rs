@@ -121,3 +121,41 @@ fn flux_linkage_too_large_for_the_precision_is_refused() {
     let e = SensorlessEstimator::new(c).err().unwrap();
     assert_eq!(e.field(), "limiter_radius_ratio");
 }
+
+/// fuzz/regressions/baseline_step/align-current-overflow-f32: the reference estimators had
+/// the same start-up overflow as `align_with_an_overflowing_current_starts_finite` (found on
+/// Ortega–Praly, f32, L̂q = 2.85e37 H).
+#[test]
+fn baselines_align_with_an_overflowing_current_start_finite() {
+    use fado_core::RotorAngleEstimator;
+    use fado_core::baselines::{
+        EmfObserverConfig, EmfObserverEstimator, LpfIntegratorConfig, LpfIntegratorEstimator,
+        OrtegaConfig, OrtegaEstimator,
+    };
+    fn run<E: RotorAngleEstimator<f32>>(mut e: E) {
+        e.align(28527.0 * 1e31, Ab::new(28527.0 * 1e31, 28527.0 * 1e31));
+        let out = e.step(Ab::zero(), Ab::zero());
+        check_estimate(&out);
+        let out = e.step(Ab::new(f32::NAN, 0.0), Ab::zero());
+        assert!(out.diagnostics.input_fault);
+        check_estimate(&out);
+    }
+    let lq = 28527.0 * 1e31;
+    run(OrtegaEstimator::new(OrtegaConfig {
+        lq_hat: lq,
+        observer_bandwidth_min: 285.27,
+        flux_adaptation_ratio: 28527.0 * 1e31,
+        ..OrtegaConfig::default()
+    })
+    .unwrap());
+    run(LpfIntegratorEstimator::new(LpfIntegratorConfig {
+        lq_hat: lq,
+        ..LpfIntegratorConfig::default()
+    })
+    .unwrap());
+    run(EmfObserverEstimator::new(EmfObserverConfig {
+        lq_hat: lq,
+        ..EmfObserverConfig::default()
+    })
+    .unwrap());
+}
