@@ -39,17 +39,20 @@ pub struct EstimatorConfig<T> {
     /// tracker hold level and the start-up flux only; the angle does not depend on it (eq. (6)).
     /// Default 0.088 Wb (SPEC §6 \[A\]).
     pub flux_linkage_hat: T,
-    /// Disturbance feedback gain k_df in s⁻¹ (Fig. 3). Default 0.5 (paper, V).
+    /// Disturbance feedback gain k_df in s⁻¹ (Fig. 3), at most 1/ts. Default 0.5 (paper, V).
     pub k_df: T,
     /// Ramp time of k_df on activation in s, 0 = abrupt as in the paper. Default 0 (SPEC §1 \[A\]).
     pub k_df_ramp_time: T,
-    /// Limiter gain k_af in s⁻¹ (Fig. 6). Default 2π·100 (paper, V).
+    /// Limiter gain k_af in s⁻¹ (Fig. 6), at most 1/ts (a larger step pulls λ̂r through the
+    /// circle). Default 2π·100 (paper, V).
     pub k_af: T,
-    /// Limiter radius as a multiple of λ̂f. Default 1.15 (paper, V).
+    /// Limiter radius as a multiple of λ̂f, at least 1. Default 1.15 (paper, V).
     pub limiter_radius_ratio: T,
-    /// Speed threshold between limiter and k_df in Hz electrical. Default 1.5 Hz (paper, V).
+    /// Speed threshold between limiter and k_df in Hz electrical; threshold + hysteresis below
+    /// the Nyquist frequency 1/(2·ts). Default 1.5 Hz (paper, V).
     pub mode_threshold_hz: T,
-    /// Hysteresis half-band of the threshold in Hz. Default 0.2 Hz (SPEC §1 \[A\]).
+    /// Hysteresis half-band of the threshold in Hz, at most the threshold. Default 0.2 Hz
+    /// (SPEC §1 \[A\]).
     pub mode_hysteresis_hz: T,
     /// Bandwidth of T2S-1 (angle, observer speed) in Hz. Default 60 Hz (paper, V).
     pub t2s1_bandwidth_hz: T,
