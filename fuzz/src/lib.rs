@@ -197,7 +197,10 @@ pub fn check_estimate<T: Real>(e: &Estimate<T>) {
         d.lambda_r.alpha,
         d.lambda_r.beta,
     ];
-    assert!(all.iter().all(|x| x.is_finite()), "non-finite output: {e:?}");
+    assert!(
+        all.iter().all(|x| x.is_finite()),
+        "non-finite output: {e:?}"
+    );
     assert!(e.theta.abs() <= T::pi(), "θ̂ out of [−π, π]: {e:?}");
 }
 
@@ -214,7 +217,11 @@ pub fn step_checked<T: Real>(est: &mut SensorlessEstimator<T>, v: Ab<T>, i: Ab<T
             est.rejected_samples(),
             before.rejected_samples().saturating_add(1)
         );
-        assert_eq!(est.last(), before.last(), "a rejected sample changed the estimate");
+        assert_eq!(
+            est.last(),
+            before.last(),
+            "a rejected sample changed the estimate"
+        );
         // The state is unchanged iff the next sample gives the same result from both.
         let (mut a, mut b) = (*est, before);
         let probe_v = Ab::new(T::lit(3.0), T::lit(-1.0));
@@ -373,7 +380,10 @@ pub fn drive_step_checked<T: Real>(
         out.v_dq_ref.d,
         out.v_dq_ref.q,
     ];
-    assert!(all.iter().all(|x| x.is_finite()), "non-finite drive output: {out:?}");
+    assert!(
+        all.iter().all(|x| x.is_finite()),
+        "non-finite drive output: {out:?}"
+    );
     let duty_ok = |d: T| d >= T::zero() && d <= T::one();
     assert!(
         duty_ok(out.duty.a) && duty_ok(out.duty.b) && duty_ok(out.duty.c),
