@@ -276,7 +276,13 @@ fn sweep(
             format!("{v:?}")
         };
         let snippet = format!("[{section}]\n{field} = {value}\n");
-        overrides.push((v.to_owned(), SimConfig::from_toml_over(&base, &snippet)?));
+        // The snippet is ours, not a file of the user's: no line numbers from it.
+        let cfg = SimConfig::from_toml_over(&base, &snippet).map_err(|mut e| {
+            e.location = None;
+            e.message = format!("--set {key}={v}: {}", e.message);
+            e
+        })?;
+        overrides.push((v.to_owned(), cfg));
     }
     // Two at a time: the machine has two cores.
     let results: Vec<_> = std::thread::scope(|sc| {
