@@ -632,7 +632,78 @@ mod properties {
             )
     }
 
+    /// Random drive configurations inside the documented ranges, bandwidths up to 90 % of
+    /// their sampling-rate limits.
+    fn valid_drive() -> impl Strategy<Value = DriveConfig<f64>> {
+        (
+            (
+                50e-6..200e-6f64,
+                1.0..8.0f64,
+                0.0..2.0f64,
+                1e-4..0.05f64,
+                1e-4..0.05f64,
+            ),
+            (
+                0.01..1.0f64,
+                1e-4..1.0f64,
+                0.01..0.9f64,
+                0.01..0.9f64,
+                1.0..20.0f64,
+            ),
+            (
+                1.0..200.0f64,
+                0.0..1.0f64,
+                1.01..3.0f64,
+                0.0..0.45f64,
+                0.0..10.0f64,
+            ),
+            (0.1..1.0f64, 0.0..1.0f64, 0.0..50.0f64),
+        )
+            .prop_map(
+                |(
+                    (ts, p, rs, ld, lq),
+                    (lf, j, cbw, sbw, zr),
+                    (imax, imin, trip, td, delay),
+                    (m, caw, saw),
+                )| {
+                    let two_pi_ts = 2.0 * std::f64::consts::PI * ts;
+                    // Back-calculation gains below their limit ratio·Ki/Kp·Ts ≤ 1 (PI docs):
+                    // Ki/Kp = R̂s/L̂ for the current PI, ωsc/zero_ratio for the speed PI.
+                    let caw = caw * ld.min(lq) / (rs * ts).max(1e-12);
+                    let saw = saw / 50.0 * zr / (sbw * 0.1);
+                    DriveConfig {
+                        ts,
+                        pole_pairs: p.round(),
+                        rs_hat: rs,
+                        ld_hat: ld,
+                        lq_hat: lq,
+                        flux_linkage_hat: lf,
+                        inertia_hat: j,
+                        current_bandwidth_hz: cbw * 0.5 / two_pi_ts,
+                        speed_bandwidth_hz: sbw * 0.1 / two_pi_ts,
+                        speed_zero_ratio: zr,
+                        i_max: imax,
+                        i_min: imin * imax,
+                        trip_current: trip * imax,
+                        dead_time: td * ts,
+                        switching_frequency: 0.5 / ts,
+                        delay_compensation_factor: delay,
+                        max_modulation: m,
+                        current_anti_windup_ratio: caw,
+                        speed_anti_windup_ratio: saw,
+                        ..DriveConfig::default()
+                    }
+                },
+            )
+    }
+
     proptest! {
+        #[test]
+        fn valid_drive_configs_construct(c in valid_drive()) {
+            let est = EstimatorConfig { ts: c.ts, ..EstimatorConfig::default() };
+            prop_assert_eq!(SensorlessDrive::new(c, est).err(), None);
+        }
+
         #[test]
         fn valid_estimator_configs_construct(c in valid_estimator()) {
             prop_assert_eq!(SensorlessEstimator::new(c).err(), None);
