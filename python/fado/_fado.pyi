@@ -50,9 +50,15 @@ class FadoError(Exception):
     """Base class of every error fado raises on purpose."""
 
 class ConfigError(FadoError, ValueError):
-    """A configuration field is invalid; ``.field`` names it."""
+    """A configuration field is invalid; ``.field`` names it.
+
+    Raised by :func:`fado.simulate` for a TOML key, it also has ``.line`` and ``.column``
+    (1-based) of the key's value in the TOML text, or ``None`` when the text does not set it.
+    """
 
     field: str
+    line: int | None
+    column: int | None
 
 class InputError(FadoError, ValueError):
     """An input array or argument is unusable; ``.argument`` names it."""

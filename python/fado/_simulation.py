@@ -57,7 +57,26 @@ def simulate(
     Returns a :class:`fado.SimResult` holding what ``fado-sim run`` writes: ``.metrics``
     (``metrics.json``), ``.traces`` (``traces.csv`` columns as float64 arrays), ``.passed``,
     ``.checks``, ``.config_toml``. A bad key or value raises :class:`fado.ConfigError` whose
-    ``.field`` is the TOML path (e.g. ``"inverter.dead_time"``); an unknown scenario raises
-    :class:`fado.InputError`; both are ``ValueError``.
+    ``.field`` is the TOML path (e.g. ``"inverter.dead_time"``) and ``.line``, ``.column`` the
+    place of its value in the TOML (for a file, the message reads ``FILE:LINE:COLUMN: ...``
+    as from ``fado-sim``); an unknown scenario raises :class:`fado.InputError`; both are
+    ``ValueError``.
     """
-    return _fado.simulate(scenario, config_text(config), averaged, progress=progress)
+    text = config_text(config)
+    try:
+        return _fado.simulate(scenario, text, averaged, progress=progress)
+    except _fado.ConfigError as e:
+        path = _config_path(config)
+        if path is not None and getattr(e, "line", None) is not None:
+            rest = str(e).split(": ", 1)[-1]
+            e.args = (f"{path}:{e.line}:{e.column}: {rest}",)
+        raise
+
+
+def _config_path(config: ConfigLike) -> str | None:
+    """The file `config` names, if it is a path rather than TOML text or a dict."""
+    if isinstance(config, os.PathLike):
+        return os.fspath(config)
+    if isinstance(config, str) and not _looks_like_toml(config) and config.strip():
+        return config
+    return None

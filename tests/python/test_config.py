@@ -6,6 +6,7 @@ import copy
 import inspect
 import math
 import pickle
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -207,3 +208,59 @@ def test_exception_hierarchy() -> None:
     assert fado.ConfigError.__module__ == "fado"
     err = pickle.loads(pickle.dumps(fado.ConfigError("`ts` must be positive")))
     assert type(err) is fado.ConfigError
+
+
+TS = 100e-6  # the default sampling period: 10 kHz
+
+
+@pytest.mark.parametrize(
+    ("field", "bad"),
+    [
+        # Above what the sampling rate allows (the discrete loops would be unstable).
+        ("t2s1_bandwidth_hz", 4000.0),
+        ("t2s2_bandwidth_hz", 4000.0),
+        ("k_af", 1.01 / TS),
+        ("k_df", 1.01 / TS),
+        ("mode_threshold_hz", 0.5 / TS),
+        # Out of order.
+        ("limiter_radius_ratio", 0.9),  # the limiter would clamp λ̂f itself
+        ("mode_hysteresis_hz", 1.6),  # wider than the 1.5 Hz threshold
+    ],
+)
+def test_sampling_rate_and_ordering_limits_name_the_field(field: str, bad: float) -> None:
+    with pytest.raises(ValueError, match=field) as info:
+        EstimatorConfig(**{field: bad})
+    assert isinstance(info.value, fado.ConfigError)
+    assert info.value.field == field
+
+
+@pytest.mark.parametrize(
+    ("text", "key", "line", "column"),
+    [
+        ("[simulation]\nduration = 0.1\n\n[motor]\nrs = -1\n", "motor.rs", 5, 6),
+        ("[inverter]\ndead_tme = 1e-6\n", "inverter.dead_tme", 2, 1),
+        ("[estimator]\n  k_df = 'half'\n", "estimator.k_df", 2, 10),
+        ("[estimator]\nt2s1_bandwidth_hz = 4000.0\n", "estimator.t2s1_bandwidth_hz", 2, 21),
+    ],
+)
+def test_simulate_bad_toml_names_key_and_line(
+    text: str, key: str, line: int, column: int, tmp_path: Path
+) -> None:
+    with pytest.raises(ValueError, match=f"line {line}, column {column}: `{key}`") as info:
+        fado.simulate("fig11", text, averaged=True)
+    assert isinstance(info.value, fado.ConfigError)
+    assert (info.value.field, info.value.line, info.value.column) == (key, line, column)
+    # From a file, the message reads like the CLI's: FILE:LINE:COLUMN: `key`: ...
+    path = tmp_path / "bad.toml"
+    path.write_text(text, encoding="utf-8")
+    with pytest.raises(fado.ConfigError, match=f":{line}:{column}: `{key}`") as info:
+        fado.simulate("fig11", path, averaged=True)
+    assert str(info.value).startswith(f"{path}:{line}:{column}: `{key}`: ")
+    assert info.value.field == key
+
+
+def test_dict_config_errors_are_located_in_its_toml() -> None:
+    with pytest.raises(fado.ConfigError) as info:
+        fado.simulate("fig11", {"mismatch": {"rs_ratio": -1.0}}, averaged=True)
+    assert info.value.field == "mismatch.rs_ratio"
+    assert info.value.line == 2

@@ -40,17 +40,20 @@ pub struct EstimatorConfig<T> {
     /// tracker hold level and the start-up flux only; the angle does not depend on it (eq. (6)).
     /// Default 0.088 Wb (SPEC §6 \[A\]).
     pub flux_linkage_hat: T,
-    /// Disturbance feedback gain k_df in s⁻¹ (Fig. 3). Default 0.5 (paper, V).
+    /// Disturbance feedback gain k_df in s⁻¹ (Fig. 3), at most 1/ts. Default 0.5 (paper, V).
     pub k_df: T,
     /// Ramp time of k_df on activation in s, 0 = abrupt as in the paper. Default 0 (SPEC §1 \[A\]).
     pub k_df_ramp_time: T,
-    /// Limiter gain k_af in s⁻¹ (Fig. 6). Default 2π·100 (paper, V).
+    /// Limiter gain k_af in s⁻¹ (Fig. 6), at most 1/ts (a larger step pulls λ̂r through the
+    /// circle). Default 2π·100 (paper, V).
     pub k_af: T,
-    /// Limiter radius as a multiple of λ̂f. Default 1.15 (paper, V).
+    /// Limiter radius as a multiple of λ̂f, at least 1. Default 1.15 (paper, V).
     pub limiter_radius_ratio: T,
-    /// Speed threshold between limiter and k_df in Hz electrical. Default 1.5 Hz (paper, V).
+    /// Speed threshold between limiter and k_df in Hz electrical; threshold + hysteresis below
+    /// the Nyquist frequency 1/(2·ts). Default 1.5 Hz (paper, V).
     pub mode_threshold_hz: T,
-    /// Hysteresis half-band of the threshold in Hz. Default 0.2 Hz (SPEC §1 \[A\]).
+    /// Hysteresis half-band of the threshold in Hz, at most the threshold. Default 0.2 Hz
+    /// (SPEC §1 \[A\]).
     pub mode_hysteresis_hz: T,
     /// Bandwidth of T2S-1 (angle, observer speed) in Hz. Default 60 Hz (paper, V).
     pub t2s1_bandwidth_hz: T,
@@ -261,6 +264,28 @@ impl<T: Real> SensorlessEstimator<T> {
         let hold = check::non_negative("tracker_hold_ratio", config.tracker_hold_ratio)?;
         check::below("tracker_hold_ratio", hold, T::one(), "below 1")?;
         check::finite("initial_angle", config.initial_angle)?;
+        // A radius below λ̂f would clamp the magnet flux itself, not only drift (Fig. 6).
+        check::below(
+            "limiter_radius_ratio",
+            T::one(),
+            ratio + T::lit(1e-6),
+            "at least 1",
+        )?;
+        // One limiter step pulls the excess radius back by k_af·Ts of itself: above 1 it
+        // overshoots through the circle, above 2 it is unstable.
+        let k_af = check::non_negative("k_af", config.k_af)?;
+        check::below("k_af", k_af * ts, T::lit(1.0 + 1e-6), "k_af·ts at most 1")?;
+        // The mode switch compares |ω̂| with the band: it must lie below the Nyquist frequency.
+        let nyquist = |field, hz: T| {
+            let hz = check::finite(field, hz)?;
+            check::below(
+                field,
+                hz * ts,
+                T::lit(0.5),
+                "below the Nyquist frequency 1/(2·ts)",
+            )
+        };
+        nyquist("mode_threshold_hz", config.mode_threshold_hz)?;
         let rename = |field: &'static str| {
             move |e: ConfigError| match e {
                 ConfigError::OutOfRange { expected, .. } => {
@@ -298,6 +323,10 @@ impl<T: Real> SensorlessEstimator<T> {
             "threshold_hz" => rename("mode_threshold_hz")(e),
             _ => rename("mode_hysteresis_hz")(e),
         })?;
+        nyquist(
+            "mode_hysteresis_hz",
+            config.mode_threshold_hz + config.mode_hysteresis_hz,
+        )?;
         check::positive("tracker_damping", config.tracker_damping)?;
         let t2s1 = TypeTwoTracker::new(config.tracker(config.t2s1_bandwidth_hz))
             .map_err(rename("t2s1_bandwidth_hz"))?;
@@ -316,6 +345,19 @@ impl<T: Real> SensorlessEstimator<T> {
                 }
             })?;
         let hold_level = hold * lf;
+        // Both circles are compared squared: in f32 a huge λ̂f would make them ∞.
+        let squared = |field, x: T| {
+            if (x * x).is_finite() {
+                Ok(())
+            } else {
+                Err(ConfigError::OutOfRange {
+                    field,
+                    expected: "a value whose square is finite in this precision",
+                })
+            }
+        };
+        squared("flux_linkage_hat", lf)?;
+        squared("limiter_radius_ratio", ratio * lf)?;
         let mut est = Self {
             config,
             integrator,
@@ -356,9 +398,15 @@ impl<T: Real> SensorlessEstimator<T> {
         } else {
             T::zero()
         };
-        let i_ab = if i_ab.is_finite() { i_ab } else { Ab::zero() };
         let lambda_r = Ab::from_polar(self.config.flux_linkage_hat, theta0);
+        // A current so large that L̂q·i overflows is as unusable as a NaN (found by fuzzing,
+        // f32: i = 3e37 A gave λ1 = ∞): start as with zero current.
         let lambda1 = lambda_r + i_ab * self.config.lq_hat;
+        let lambda1 = if lambda1.is_finite() {
+            lambda1
+        } else {
+            lambda_r
+        };
         self.integrator.reset_to(lambda1);
         self.observer
             .reset_to(if self.config.observer_on_rotor_flux {

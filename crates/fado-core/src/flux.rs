@@ -173,6 +173,8 @@ impl<T: Real> DisturbanceFeedback<T> {
         let ts = check::positive("ts", config.ts)?;
         let k_df = check::non_negative("k_df", config.k_df)?;
         let ramp = check::non_negative("ramp_time", config.ramp_time)?;
+        // k_df·D̂ is integrated with Ts: one step must not remove more than the disturbance.
+        check::below("k_df", k_df * ts, T::lit(1.0 + 1e-6), "k_df·ts at most 1")?;
         let ramp_increment = if ramp > T::zero() {
             k_df * ts / ramp
         } else {

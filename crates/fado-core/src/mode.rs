@@ -46,12 +46,12 @@ impl<T: Real> ModeSelector<T> {
     pub fn new(config: ModeSelectorConfig<T>) -> Result<Self, ConfigError> {
         let th = check::non_negative("threshold_hz", config.threshold_hz)?;
         let h = check::non_negative("hysteresis_hz", config.hysteresis_hz)?;
-        check::below(
-            "hysteresis_hz",
-            h,
-            th + T::lit(1e-30),
-            "at most threshold_hz",
-        )?;
+        if h > th {
+            return Err(ConfigError::OutOfRange {
+                field: "hysteresis_hz",
+                expected: "at most threshold_hz",
+            });
+        }
         Ok(Self {
             enter: T::two_pi() * (th + h),
             leave: T::two_pi() * (th - h),

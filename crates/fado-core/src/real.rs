@@ -57,7 +57,21 @@ pub fn wrap_angle<T: Real>(x: T) -> T {
     } else {
         return x;
     }
-    x - two_pi * (x / two_pi).round()
+    let r = x - two_pi * (x / two_pi).round();
+    if r.abs() <= pi {
+        return r;
+    }
+    // |x| beyond ~2^53·2π (f64) or ~2^24·2π (f32): the formula has lost all precision (found
+    // by fuzzing: θ0 = 1e30 gave θ̂ = 1e15). The remainder is exact in IEEE arithmetic; the
+    // angle is still arbitrary, but in range.
+    let r = x % two_pi;
+    if r > pi {
+        r - two_pi
+    } else if r < -pi {
+        r + two_pi
+    } else {
+        r
+    }
 }
 
 #[cfg(test)]
@@ -85,6 +99,27 @@ mod tests {
                 "{x}"
             );
         }
+        // Huge but finite angles land in range too (fuzz regression: the formula alone gave
+        // 1.1e15 for 9.1e30 and −6e234 for −5.7e250).
+        for x in [
+            9.112e30,
+            -5.727778756618604e250,
+            f64::MAX,
+            -f64::MAX,
+            1e17,
+            3.0e15,
+        ] {
+            assert!((-PI..=PI).contains(&wrap_angle(x)), "{x}");
+            let xf = x as f32;
+            if xf.is_finite() {
+                let w = wrap_angle(xf);
+                assert!(
+                    (-core::f32::consts::PI..=core::f32::consts::PI).contains(&w),
+                    "{x}"
+                );
+            }
+        }
+        assert!(wrap_angle(f32::MAX).abs() <= core::f32::consts::PI);
         assert!(wrap_angle(f64::NAN).is_nan());
         assert!(wrap_angle(f64::INFINITY).is_nan());
         assert!(wrap_angle(f32::NEG_INFINITY).is_nan());

@@ -29,13 +29,25 @@ pub fn trace_columns() -> Vec<&'static str> {
 
 /// A refused configuration or scenario as the Python exception it means: an unknown scenario
 /// is a bad argument (`InputError`), anything else a bad configuration key (`ConfigError`
-/// with `.field` = the TOML path, e.g. `inverter.dead_time`).
+/// with `.field` = the TOML path, e.g. `inverter.dead_time`, and `.line`, `.column` where
+/// the TOML text sets it).
 pub(crate) fn sim_error(py: Python<'_>, e: SimConfigError) -> PyErr {
     if e.key == "scenario" {
         input_error(py, "scenario", e.message)
     } else {
         let message = e.to_string();
-        config_error_message(py, &e.key, message)
+        let err = config_error_message(py, &e.key, message);
+        // Where the key is in the TOML text (1-based), or None for a value derived from
+        // other keys.
+        let (line, column) = e.location.map(|l| (l.line, l.column)).unzip();
+        let value = err.value(py);
+        match value
+            .setattr("line", line)
+            .and_then(|()| value.setattr("column", column))
+        {
+            Ok(()) => err,
+            Err(set_failed) => set_failed,
+        }
     }
 }
 

@@ -20,6 +20,7 @@ use crate::motor::MotorParams;
 use crate::profile::Profile;
 use crate::sensors::{CurrentSensorParams, DcLinkSensorParams};
 use crate::sim::PlantParams;
+use crate::source::SourceLocation;
 
 /// Run settings.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -433,13 +434,15 @@ impl SimConfig {
             .map_err(|e| e.in_section("mismatch"))?;
         self.estimator_config()
             .validate()
-            .map_err(|e| SimConfigError::from(e).in_section("estimator"))?;
-        match self.estimator.kind {
-            EstimatorKind::Fado => {}
-            EstimatorKind::LpfIntegrator => drop(self.lpf_estimator()?),
-            EstimatorKind::Ortega => drop(self.ortega_estimator()?),
-            EstimatorKind::EmfObserver => drop(self.emf_estimator()?),
-        }
+            .map_err(|e| core_error("estimator", e))?;
+        // Every key is checked whichever estimator runs: NaN in an unused key is still an
+        // error in the file.
+        self.lpf_estimator()?;
+        self.ortega_estimator()?;
+        self.emf_estimator()?;
+        self.drive_config()
+            .validate()
+            .map_err(|e| core_error("controller", e))?;
         Ok(())
     }
 
@@ -487,17 +490,16 @@ impl SimConfig {
     /// Parses a complete or partial TOML document on top of `base`: tables merge, values and
     /// arrays replace. The result is validated. Errors name the key.
     pub fn from_toml_over(base: &SimConfig, text: &str) -> Result<SimConfig, SimConfigError> {
-        let user: toml::Table = text
-            .parse()
-            .map_err(|e: toml::de::Error| SimConfigError::new("<file>", e.to_string()))?;
+        let user: toml::Table = text.parse().map_err(|e| located(text, e))?;
         // Check the user's document on its own first, so that errors (unknown keys, wrong
-        // types) name the key the user wrote.
-        SimConfig::deserialize(toml::Value::Table(user.clone())).map_err(key_error)?;
+        // types) name the key the user wrote and point at it.
+        toml::from_str::<SimConfig>(text).map_err(|e| located(text, e))?;
         let mut merged = toml::Table::try_from(base)
             .map_err(|e| SimConfigError::new("<base>", e.to_string()))?;
         merge(&mut merged, user);
-        let cfg = SimConfig::deserialize(toml::Value::Table(merged)).map_err(key_error)?;
-        cfg.validate()?;
+        let cfg = SimConfig::deserialize(toml::Value::Table(merged))
+            .map_err(|e| key_error(e).located_in(text))?;
+        cfg.validate().map_err(|e| e.located_in(text))?;
         Ok(cfg)
     }
 
@@ -505,6 +507,44 @@ impl SimConfig {
     pub fn from_toml(text: &str) -> Result<SimConfig, SimConfigError> {
         Self::from_toml_over(&SimConfig::default(), text)
     }
+}
+
+/// A fado-core refusal of the `[section]` block (`estimator` or `controller`, including the
+/// baselines' `lpf_`/`ortega_`/`emf_` keys), named by the TOML key the user writes. The
+/// model estimates (R̂s, L̂q, λ̂f, …) and the timing are not keys of their own: they are plant
+/// keys times the `[mismatch]` ratios, so a refusal of one names the plant key.
+pub(crate) fn core_error(section: &str, e: fado_core::ConfigError) -> SimConfigError {
+    let derived = match e.field() {
+        "ts" | "switching_frequency" => Some("inverter.switching_frequency"),
+        "rs_hat" => Some("motor.rs"),
+        "ld_hat" => Some("motor.ld"),
+        "lq_hat" => Some("motor.lq"),
+        "flux_linkage_hat" => Some("motor.flux_linkage"),
+        "inertia_hat" => Some("motor.inertia"),
+        "pole_pairs" => Some("motor.pole_pairs"),
+        "dead_time" => Some("inverter.dead_time"),
+        "dead_time_threshold_voltage" => Some("inverter.threshold_voltage"),
+        "dead_time_current_band" => Some("inverter.current_band"),
+        "initial_angle" => Some("simulation.initial_angle"),
+        _ => None,
+    };
+    if let Some(key) = derived {
+        return SimConfigError::new(
+            key,
+            format!("{e} (the drive's value is derived from `{key}` and [mismatch])"),
+        );
+    }
+    let own = match e.field() {
+        "cutoff_hz" => "lpf_cutoff_hz",
+        "compensation_floor_hz" => "lpf_compensation_floor_hz",
+        "observer_bandwidth" => "ortega_observer_bandwidth",
+        "observer_speed_ratio" => "ortega_observer_speed_ratio",
+        "observer_bandwidth_min" => "ortega_observer_bandwidth_min",
+        "flux_adaptation_ratio" => "ortega_flux_adaptation_ratio",
+        "speed_floor_hz" => "emf_speed_floor_hz",
+        other => other,
+    };
+    SimConfigError::new(format!("{section}.{own}"), e.to_string())
 }
 
 fn merge(base: &mut toml::Table, over: toml::Table) {
@@ -516,6 +556,23 @@ fn merge(base: &mut toml::Table, over: toml::Table) {
             }
         }
     }
+}
+
+/// An error of parsing or deserialising the user's `text`: named by the key at its span (or
+/// as `key_error` does), located at the span.
+fn located(text: &str, e: toml::de::Error) -> SimConfigError {
+    let start = e.span().map(|s| s.start);
+    let key = start.and_then(|at| crate::source::key_at(text, at));
+    let mut err = match key {
+        Some(key) => SimConfigError::new(key, e.message().trim_end().to_owned()),
+        None => {
+            let mut k = key_error(e.clone());
+            k.message = e.message().trim_end().to_owned();
+            k
+        }
+    };
+    err.location = start.map(|at| SourceLocation::at(text, at));
+    err
 }
 
 /// A serde error from a `toml::Value` carries "in `path`"; unknown fields name the field.
@@ -600,5 +657,86 @@ mod tests {
         let e = SimConfig::from_toml("[speed_reference]\npoints = [[1.0, 0.0], [0.0, 1.0]]\n")
             .unwrap_err();
         assert_eq!(e.key, "speed_reference.points[1]", "{e}");
+    }
+}
+
+#[cfg(test)]
+mod located_errors {
+    use super::*;
+
+    /// (key, line, column, message) of the error `text` gives.
+    fn err(text: &str) -> (String, usize, usize, String) {
+        let e = SimConfig::from_toml(text).unwrap_err();
+        let loc = e
+            .location
+            .clone()
+            .unwrap_or_else(|| panic!("not located: {e}"));
+        (e.key.clone(), loc.line, loc.column, e.to_string())
+    }
+
+    #[test]
+    fn semantic_errors_name_key_line_and_column() {
+        let text = "[simulation]\nduration = 1.0\n\n[motor]\nlq = 2e-3\nrs   = -1\n";
+        let (key, line, col, msg) = err(text);
+        assert_eq!((key.as_str(), line, col), ("motor.rs", 6, 8));
+        assert_eq!(msg, "line 6, column 8: `motor.rs`: must be > 0, got -1");
+        let e = SimConfig::from_toml(text)
+            .unwrap_err()
+            .in_file("config.toml");
+        assert_eq!(
+            e.to_string(),
+            "config.toml:6:8: `motor.rs`: must be > 0, got -1"
+        );
+        // Estimator and drive checks of fado-core, renamed to their TOML keys.
+        let (key, line, col, _) = err("[estimator]\nk_df = 0.5\nt2s1_bandwidth_hz = -60.0\n");
+        assert_eq!(
+            (key.as_str(), line, col),
+            ("estimator.t2s1_bandwidth_hz", 3, 21)
+        );
+        let (key, line, _, _) = err("[estimator]\nmode_hysteresis_hz = 3.0\n");
+        assert_eq!((key.as_str(), line), ("estimator.mode_hysteresis_hz", 2));
+        // Array elements and dotted keys.
+        let (key, line, col, _) =
+            err("[simulation]\ndisturbance_feedback_off = [[0.0, 1.0], [2.0, 1.0]]\n");
+        assert_eq!(
+            (key.as_str(), line, col),
+            ("simulation.disturbance_feedback_off[1]", 2, 41)
+        );
+        let (key, line, col, _) = err("motor.rs = nan\n");
+        assert_eq!((key.as_str(), line, col), ("motor.rs", 1, 12));
+    }
+
+    #[test]
+    fn type_errors_and_unknown_keys_name_key_line_and_column() {
+        let (key, line, col, msg) = err("[motor]\nrs = \"big\"\n");
+        assert_eq!((key.as_str(), line, col), ("motor.rs", 2, 6));
+        assert!(msg.starts_with("line 2, column 6: `motor.rs`: "), "{msg}");
+        let (key, line, col, _) = err("[inverter]\n\ndead_tme = 1e-6\n");
+        assert_eq!((key.as_str(), line, col), ("inverter.dead_tme", 3, 1));
+        let (key, line, _, msg) = err("[inverter]\nmodel = \"fast\"\n");
+        assert_eq!((key.as_str(), line), ("inverter.model", 2));
+        assert!(msg.contains("fast"), "{msg}");
+        let (key, line, col, _) = err("[motorr]\nrs = 1.0\n");
+        assert_eq!((key.as_str(), line, col), ("motorr", 1, 2));
+        let (key, line, _, _) = err("[simulation]\ndecimation = 2.5\n");
+        assert_eq!((key.as_str(), line), ("simulation.decimation", 2));
+    }
+
+    #[test]
+    fn syntax_errors_are_located() {
+        let (key, line, col, msg) = err("[motor]\nrs = 0.3\nlq = = 2\n");
+        assert_eq!((key.as_str(), line), ("<file>", 3));
+        assert!(col >= 5, "{msg}");
+    }
+
+    #[test]
+    fn derived_values_are_named_but_not_located() {
+        // rs_hat is motor.rs·mismatch.rs_ratio: nothing in the file to point at.
+        let e = SimConfig::from_toml("[estimator]\nk_af = 1e6\n").unwrap_err();
+        assert_eq!(e.key, "estimator.k_af");
+        assert_eq!(e.location.map(|l| l.line), Some(2));
+        let e = SimConfigError::new("estimator.rs_hat", "x").located_in("[motor]\nrs = 1\n");
+        assert_eq!(e.location, None);
+        assert_eq!(e.to_string(), "`estimator.rs_hat`: x");
     }
 }

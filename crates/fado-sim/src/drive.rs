@@ -69,7 +69,7 @@ where
 
 use fado_core::control::{DeadTimeMethod, DriveConfig, VoltageLimit};
 
-use crate::config::{DeadTimeMethodSetting, SimConfig, VoltageLimitSetting};
+use crate::config::{DeadTimeMethodSetting, SimConfig, VoltageLimitSetting, core_error};
 use crate::error::SimConfigError;
 
 impl SimConfig {
@@ -125,7 +125,7 @@ impl SimConfig {
     {
         let drive_cfg = self.drive_config();
         SensorlessDrive::with_estimator(drive_cfg, estimator)
-            .map_err(|e| SimConfigError::from(e).in_section("controller"))
+            .map_err(|e| core_error("controller", e))
     }
 
     /// The compensated-LPF baseline of this configuration.
@@ -147,7 +147,7 @@ impl SimConfig {
             average_current: e.average_current,
             initial_angle: e.initial_angle,
         })
-        .map_err(|e| SimConfigError::from(e).in_section("estimator"))
+        .map_err(|e| core_error("estimator", e))
     }
 
     /// The Ortega–Praly baseline of this configuration.
@@ -171,7 +171,7 @@ impl SimConfig {
             average_current: e.average_current,
             initial_angle: e.initial_angle,
         })
-        .map_err(|e| SimConfigError::from(e).in_section("estimator"))
+        .map_err(|e| core_error("estimator", e))
     }
 
     /// The extended-EMF baseline of this configuration.
@@ -193,7 +193,7 @@ impl SimConfig {
             average_current: e.average_current,
             initial_angle: e.initial_angle,
         })
-        .map_err(|e| SimConfigError::from(e).in_section("estimator"))
+        .map_err(|e| core_error("estimator", e))
     }
 
     /// The sensorless drive of this configuration (aligned by the simulation at start).
@@ -201,9 +201,9 @@ impl SimConfig {
         let drive_cfg = self.drive_config();
         drive_cfg
             .validate()
-            .map_err(|e| SimConfigError::from(e).in_section("controller"))?;
+            .map_err(|e| core_error("controller", e))?;
         SensorlessDrive::new(drive_cfg, self.estimator_config())
-            .map_err(|e| SimConfigError::from(e).in_section("estimator"))
+            .map_err(|e| core_error("estimator", e))
     }
 }
 
@@ -337,10 +337,9 @@ impl SimConfig {
             rs_adaptation_max_ratio: f(e.rs_adaptation_max_ratio),
             flux_linkage_adaptation_rate: f(e.flux_linkage_adaptation_rate),
         };
-        dc.validate()
-            .map_err(|e| SimConfigError::from(e).in_section("controller"))?;
+        dc.validate().map_err(|e| core_error("controller", e))?;
         SensorlessDrive::new(dc, ec)
             .map(DriveF32)
-            .map_err(|e| SimConfigError::from(e).in_section("estimator"))
+            .map_err(|e| core_error("estimator", e))
     }
 }

@@ -2,6 +2,8 @@
 
 use std::fmt;
 
+use crate::source::{self, SourceLocation};
+
 /// A configuration value was refused. `key` is the TOML path, e.g. `motor.rs`.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct SimConfigError {
@@ -9,6 +11,8 @@ pub struct SimConfigError {
     pub key: String,
     /// What is wrong with it.
     pub message: String,
+    /// Where the key's value is in the TOML text the user gave, when it is there.
+    pub location: Option<SourceLocation>,
 }
 
 impl SimConfigError {
@@ -17,7 +21,26 @@ impl SimConfigError {
         Self {
             key: key.into(),
             message: message.into(),
+            location: None,
         }
+    }
+
+    /// Locates the key in `text`, the TOML the user wrote (no change when it is not there,
+    /// e.g. a value derived from other keys, or already located).
+    pub fn located_in(mut self, text: &str) -> Self {
+        if self.location.is_none() {
+            self.location = source::value_span(text, &self.key)
+                .map(|span| SourceLocation::at(text, span.start));
+        }
+        self
+    }
+
+    /// Names the file the located text came from (for `file:line:column:` messages).
+    pub fn in_file(mut self, file: impl Into<String>) -> Self {
+        if let Some(loc) = &mut self.location {
+            loc.file = Some(file.into());
+        }
+        self
     }
 
     /// Prefixes the key with a section name (`field` → `section.field`).
@@ -33,6 +56,17 @@ impl SimConfigError {
 
 impl fmt::Display for SimConfigError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match &self.location {
+            Some(SourceLocation {
+                file: Some(file),
+                line,
+                column,
+            }) => write!(f, "{file}:{line}:{column}: ")?,
+            Some(SourceLocation { line, column, .. }) => {
+                write!(f, "line {line}, column {column}: ")?
+            }
+            None => {}
+        }
         write!(f, "`{}`: {}", self.key, self.message)
     }
 }

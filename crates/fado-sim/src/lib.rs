@@ -54,6 +54,7 @@ pub mod profile;
 pub mod scenario;
 pub mod sensors;
 pub mod sim;
+pub mod source;
 pub mod sweep;
 
 pub use config::SimConfig;

@@ -309,6 +309,7 @@ impl Motor {
     /// A machine at rest at electrical angle `theta0` with zero current.
     pub fn new(params: MotorParams, theta0: f64) -> Result<Self, SimConfigError> {
         params.validate()?;
+        check::finite("theta0", theta0)?;
         let mut m = Self {
             params,
             state: MotorState::default(),
@@ -585,5 +586,14 @@ mod tests {
             ..Default::default()
         };
         assert_eq!(bad.validate().unwrap_err().key, "lq");
+    }
+
+    #[test]
+    fn a_non_finite_start_angle_is_refused_naming_it() {
+        for bad in [f64::NAN, f64::INFINITY] {
+            let e = Motor::new(MotorParams::default(), bad).err().unwrap();
+            assert_eq!(e.key, "theta0");
+        }
+        assert!(Motor::new(MotorParams::default(), -2.0).is_ok());
     }
 }

@@ -695,7 +695,10 @@ pub fn scenario_config(
     if averaged {
         cfg.inverter.model = InverterModel::Averaged;
     }
-    cfg.validate()?;
+    cfg.validate().map_err(|e| match config_toml {
+        Some(text) => e.located_in(text),
+        None => e,
+    })?;
     Ok(cfg)
 }
 

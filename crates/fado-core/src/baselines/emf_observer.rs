@@ -198,7 +198,8 @@ impl<T: Real> EmfObserverEstimator<T> {
         } else {
             T::zero()
         };
-        let i_ab = if i_ab.is_finite() { i_ab } else { Ab::zero() };
+        let i_ab =
+            super::usable_align_current(i_ab, self.config.lq_hat, self.config.flux_linkage_hat);
         self.emf = Ab::zero();
         self.integrand.reset_to(i_ab);
         self.trackers.reset_to(theta0);

@@ -195,7 +195,8 @@ impl<T: Real> LpfIntegratorEstimator<T> {
         } else {
             T::zero()
         };
-        let i_ab = if i_ab.is_finite() { i_ab } else { Ab::zero() };
+        let i_ab =
+            super::usable_align_current(i_ab, self.config.lq_hat, self.config.flux_linkage_hat);
         let lambda_r = Ab::from_polar(self.config.flux_linkage_hat, theta0);
         self.psi = lambda_r + i_ab * self.config.lq_hat;
         self.integrand.reset();

@@ -264,7 +264,8 @@ impl<T: Real> OrtegaEstimator<T> {
         } else {
             T::zero()
         };
-        let i_ab = if i_ab.is_finite() { i_ab } else { Ab::zero() };
+        let i_ab =
+            super::usable_align_current(i_ab, self.config.lq_hat, self.config.flux_linkage_hat);
         self.lambda = self.config.flux_linkage_hat;
         let eta = Ab::from_polar(self.lambda, theta0);
         self.x = eta + i_ab * self.config.lq_hat;

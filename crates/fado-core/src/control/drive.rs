@@ -354,6 +354,7 @@ pub struct SensorlessDrive<T, E = SensorlessEstimator<T>> {
 impl<T: Real> SensorlessDrive<T, SensorlessEstimator<T>> {
     /// The drive with the paper's estimator. `estimator.ts` must equal `config.ts`.
     pub fn new(config: DriveConfig<T>, estimator: EstimatorConfig<T>) -> Result<Self, ConfigError> {
+        check::positive("ts", config.ts)?;
         if estimator.ts != config.ts {
             return Err(ConfigError::OutOfRange {
                 field: "ts",

@@ -14,6 +14,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+use fado_sim::SimConfigError;
 use fado_sim::compare;
 use fado_sim::scenario::{self, SCENARIOS};
 use fado_sim::sweep::{self, SweepOptions, SweepSpec};
@@ -154,7 +155,8 @@ fn run(cli: Cli) -> Result<ExitCode, Box<dyn std::error::Error>> {
                 ),
                 None => None,
             };
-            let cfg = scenario::scenario_config(&name, text.as_deref(), averaged)?;
+            let cfg = scenario::scenario_config(&name, text.as_deref(), averaged)
+                .map_err(|e| in_file(e, &config))?;
             if dump_config {
                 print!("{}", cfg.to_toml());
                 return Ok(ExitCode::SUCCESS);
@@ -233,6 +235,8 @@ fn run(cli: Cli) -> Result<ExitCode, Box<dyn std::error::Error>> {
                         .map_err(|e| format!("cannot read {}: {e}", p.display()))?,
                 );
             }
+            // A bad --config file is reported at its FILE:LINE:COLUMN before anything runs.
+            spec.base_config().map_err(|e| in_file(e, &config))?;
             let dir = out.unwrap_or_else(|| PathBuf::from("out").join(format!("{scenario}-sweep")));
             run_sweep(&spec, dir, threads, fresh)
         }
@@ -265,7 +269,7 @@ fn run(cli: Cli) -> Result<ExitCode, Box<dyn std::error::Error>> {
                         .map_err(|e| format!("cannot read {}: {e}", p.display()))?,
                 );
             }
-            let mut result = compare::compare(&opts)?;
+            let mut result = compare::compare(&opts).map_err(|e| in_file(e, &config))?;
             if let Some(dir) = &criterion {
                 let costs = compare::read_criterion_step_costs(dir, &opts.estimators);
                 if costs.is_empty() {
@@ -293,6 +297,14 @@ fn run(cli: Cli) -> Result<ExitCode, Box<dyn std::error::Error>> {
             );
             Ok(ExitCode::SUCCESS)
         }
+    }
+}
+
+/// A configuration error located in the `--config` file reads `FILE:LINE:COLUMN: `key`: …`.
+fn in_file(e: SimConfigError, config: &Option<PathBuf>) -> SimConfigError {
+    match config {
+        Some(p) => e.in_file(p.display().to_string()),
+        None => e,
     }
 }
 

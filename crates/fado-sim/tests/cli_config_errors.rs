@@ -1,0 +1,75 @@
+//! The CLI names the TOML key and its line and column in the `--config` file for syntax,
+//! type, unknown-key and validation errors, and exits with status 2.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+/// Writes `text` to a fresh file and runs `fado-sim run fig11 --config FILE --dump-config`
+/// (no simulation). Returns (exit code, stderr, file path).
+fn run_with(name: &str, text: &str) -> (Option<i32>, String, PathBuf) {
+    let dir = std::env::temp_dir().join(format!("fado-sim-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_fado-sim"))
+        .args(["run", "fig11", "--dump-config", "--config"])
+        .arg(&path)
+        .output()
+        .unwrap();
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+        path,
+    )
+}
+
+#[test]
+fn validation_error_names_file_line_column_and_key() {
+    let text = "# my motor\n[simulation]\nduration = 1.0\n\n[motor]\nlq = 2.63e-3\nrs = -1\n";
+    let (code, stderr, path) = run_with("bad-rs.toml", text);
+    assert_eq!(code, Some(2), "{stderr}");
+    assert_eq!(
+        stderr.trim_end(),
+        format!(
+            "error: {}:7:6: `motor.rs`: must be > 0, got -1",
+            path.display()
+        )
+    );
+}
+
+#[test]
+fn unknown_key_and_wrong_type_name_file_line_and_key() {
+    let (code, stderr, path) = run_with("unknown.toml", "[inverter]\n\n  dead_tme = 1e-6\n");
+    assert_eq!(code, Some(2), "{stderr}");
+    let prefix = format!("error: {}:3:3: `inverter.dead_tme`: ", path.display());
+    assert!(stderr.starts_with(&prefix), "{stderr}");
+    assert!(stderr.contains("unknown field"), "{stderr}");
+
+    let (code, stderr, path) = run_with("type.toml", "[estimator]\nk_df = \"half\"\n");
+    assert_eq!(code, Some(2), "{stderr}");
+    let prefix = format!("error: {}:2:8: `estimator.k_df`: ", path.display());
+    assert!(stderr.starts_with(&prefix), "{stderr}");
+}
+
+#[test]
+fn core_validation_and_syntax_errors_are_located() {
+    // A tracker bandwidth above what 10 kHz sampling allows (Jury's test in fado-core).
+    let (code, stderr, path) = run_with("bw.toml", "[estimator]\nt2s1_bandwidth_hz = 4000.0\n");
+    assert_eq!(code, Some(2), "{stderr}");
+    let prefix = format!(
+        "error: {}:2:21: `estimator.t2s1_bandwidth_hz`: ",
+        path.display()
+    );
+    assert!(stderr.starts_with(&prefix), "{stderr}");
+
+    let (code, stderr, path) = run_with("syntax.toml", "[motor]\nrs = 0.3\nlq = = 2\n");
+    assert_eq!(code, Some(2), "{stderr}");
+    let prefix = format!("error: {}:3:", path.display());
+    assert!(stderr.starts_with(&prefix), "{stderr}");
+}
+
+#[test]
+fn a_good_file_is_accepted() {
+    let (code, stderr, _) = run_with("good.toml", "[motor]\nrs = 0.3\n");
+    assert_eq!(code, Some(0), "{stderr}");
+}
