@@ -14,6 +14,7 @@ use fado_core::tracker::BandwidthDefinition;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{SimConfigError, check};
+use crate::faults::FaultParams;
 use crate::inverter::InverterParams;
 use crate::load::LoadParams;
 use crate::motor::MotorParams;
@@ -149,10 +150,25 @@ pub struct ControllerSettings {
     /// Current-sensor offset calibration at start-up, samples with the gates off (0 = none).
     /// Default 1000 (100 ms) as `fado_core::control::DriveConfig` \[A\].
     pub offset_calibration_samples: u32,
+    /// Stuck current-sensor detection band, A. Default 0.25 A as `DriveConfig`.
+    pub stuck_sensor_band: f64,
+    /// Stuck current-sensor detection: minimum reference in the phase, A. Default 2 A.
+    pub stuck_sensor_min_reference: f64,
+    /// Stuck current-sensor detection: samples in a row (0 = off). Default 5.
+    pub stuck_sensor_samples: u32,
+    /// Current-error monitor limit |i* − i|, A. Default 5 A.
+    pub current_error_limit: f64,
+    /// Current-error monitor: samples in a row (0 = off). Default 20.
+    pub current_error_samples: u32,
+    /// DC-link under-voltage warning level, V. Default 200 V.
+    pub dc_link_min_voltage: f64,
+    /// Rejected samples in a row that trip the drive (0 = never). Default 100.
+    pub input_fault_trip_samples: u32,
 }
 
 impl Default for ControllerSettings {
     fn default() -> Self {
+        let d = fado_core::control::DriveConfig::<f64>::default();
         Self {
             precision: Precision::F64,
             current_bandwidth_hz: 250.0,
@@ -170,6 +186,13 @@ impl Default for ControllerSettings {
             current_anti_windup_ratio: 1.0,
             speed_anti_windup_ratio: 5.0,
             offset_calibration_samples: 1000,
+            stuck_sensor_band: d.stuck_sensor_band,
+            stuck_sensor_min_reference: d.stuck_sensor_min_reference,
+            stuck_sensor_samples: d.stuck_sensor_samples,
+            current_error_limit: d.current_error_limit,
+            current_error_samples: d.current_error_samples,
+            dc_link_min_voltage: d.dc_link_min_voltage,
+            input_fault_trip_samples: d.input_fault_trip_samples,
         }
     }
 }
@@ -369,6 +392,8 @@ pub struct SimConfig {
     pub estimator: EstimatorSettings,
     /// The drive's model of the plant.
     pub mismatch: Mismatch,
+    /// Injected faults (`crate::faults`). Default none.
+    pub faults: FaultParams,
 }
 
 impl Default for Profile {
@@ -386,6 +411,7 @@ impl SimConfig {
             current_sensor: self.current_sensor.clone(),
             dc_link_sensor: self.dc_link_sensor.clone(),
             load: self.load.clone(),
+            faults: self.faults.clone(),
         }
     }
 
