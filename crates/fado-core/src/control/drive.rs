@@ -656,14 +656,16 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             return self.last;
         }
         // Stuck-channel check against the reference the loop was tracking, advanced by the
-        // rotation over one sample; a stuck channel is replaced by its reconstruction.
+        // rotation over one sample; an implausible channel is replaced by its reconstruction
+        // from the model prediction.
         let prev = self.last.estimate;
         let rot_ref = Rotation::from_angle(prev.theta + prev.omega * self.config.ts);
+        let i_model = self.predicted_current();
         let (ia, ib, stuck) =
             self.stuck_sensor
-                .step(i_abc.a, i_abc.b, self.last.i_dq_ref.to_ab(rot_ref));
+                .step(i_abc.a, i_abc.b, self.last.i_dq_ref.to_ab(rot_ref), i_model);
         self.sensor_stuck_now = stuck;
-        let i_abc = if stuck {
+        let i_abc = if ia != i_abc.a || ib != i_abc.b {
             Abc::new(ia, ib, -ia - ib)
         } else {
             i_abc
@@ -743,6 +745,21 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             flags: DriveFlags::NONE, // set by `step`
         };
         self.last
+    }
+
+    /// The current at this sample predicted from the last one used (measured or
+    /// reconstructed) by the machine model over [n−1, n]: L̂q·di/dt = v − R̂s·i − jω̂·λ̂r with
+    /// the voltage that acted (the realised reference computed at n−2) and the estimator's
+    /// last rotor flux and speed. Exact in form for the SPMSM (L̂d = L̂q); forward Euler is
+    /// enough at R̂s·Ts/L̂q ≈ 0.012.
+    fn predicted_current(&self) -> Ab<T> {
+        let c = &self.config;
+        let e = &self.last.estimate;
+        let lr = e.diagnostics.lambda_r;
+        let emf = Ab::new(-lr.beta, lr.alpha) * e.omega;
+        let i = self.last_i_ab;
+        let predicted = i + (self.history[1] - i * c.rs_hat - emf) * (c.ts / c.lq_hat);
+        if predicted.is_finite() { predicted } else { i }
     }
 
     /// Rejected sample: hold the duty, keep the estimator's clock with the last good current.

@@ -169,6 +169,11 @@ impl PersistenceMonitor {
     pub fn reset(&mut self) {
         self.run = 0;
     }
+
+    /// The condition held at the last sample (and the monitor is enabled).
+    pub fn is_running(&self) -> bool {
+        self.samples > 0 && self.run > 0
+    }
 }
 
 /// Unit vectors of the phase axes a and b in α-β (amplitude-invariant Clarke: the phase-x
@@ -196,10 +201,15 @@ fn phase_value<T: Real>(i: Ab<T>, k: usize) -> T {
 /// normal operation this does not persist. The channel is released as soon as it reads
 /// outside the band again.
 ///
-/// While a channel is stuck its value is reconstructed: the reference vector, corrected
-/// along the other (good) phase's axis so that it matches that phase's reading exactly; with
-/// both channels stuck, the reference itself. The current loop is then closed through one
-/// sensor and the model, which rides through a short fault.
+/// A channel is replaced by a reconstruction from the first implausible sample on (the
+/// flag waits for the persistence, the substitution does not, so that the current loop never
+/// acts on a zero reading): the caller's model prediction of the current vector (the drive
+/// propagates the machine model one sample from the last trusted current), corrected along
+/// the other (good) phase's axis so that it matches that phase's reading exactly; with both
+/// channels implausible, the prediction itself. The current loop and the estimator then run
+/// on one sensor and the model, which rides through a short fault. In normal operation a
+/// substitution of a sample or two (a transient with a large current error at a zero
+/// crossing) changes the current by the model's one-sample error only.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StuckChannelDetector<T> {
     band: T,
@@ -225,11 +235,13 @@ impl<T: Real> StuckChannelDetector<T> {
         self.stuck
     }
 
-    /// One sample: the (offset-corrected) readings of phases a and b and the current
-    /// reference in α-β. Returns the phase currents a and b to use (readings, or
-    /// reconstructions of the stuck channels) and whether any channel is stuck.
-    pub fn step(&mut self, i_a: T, i_b: T, i_ref_ab: Ab<T>) -> (T, T, bool) {
+    /// One sample: the (offset-corrected) readings of phases a and b, the current reference
+    /// and the model's prediction of the current, both in α-β. Returns the phase currents a
+    /// and b to use (readings, or reconstructions of the implausible channels) and whether
+    /// any channel is judged stuck (implausible for `samples` samples in a row).
+    pub fn step(&mut self, i_a: T, i_b: T, i_ref_ab: Ab<T>, i_model_ab: Ab<T>) -> (T, T, bool) {
         let reading = [i_a, i_b];
+        let mut suspect = [false; 2];
         for k in 0..2 {
             let near_zero = reading[k].abs() < self.band;
             if self.stuck[k] {
@@ -240,19 +252,21 @@ impl<T: Real> StuckChannelDetector<T> {
             } else {
                 let asked = phase_value(i_ref_ab, k).abs() >= self.min_reference;
                 self.stuck[k] = self.monitors[k].step(near_zero && asked);
+                suspect[k] = near_zero && asked && self.monitors[k].is_running();
             }
+            suspect[k] |= self.stuck[k];
         }
-        let i = match self.stuck {
+        let i = match suspect {
             [false, false] => return (i_a, i_b, false),
-            [true, true] => i_ref_ab,
-            [true, false] => i_ref_ab + phase_axis::<T>(1) * (i_b - phase_value(i_ref_ab, 1)),
-            [false, true] => i_ref_ab + phase_axis::<T>(0) * (i_a - phase_value(i_ref_ab, 0)),
+            [true, true] => i_model_ab,
+            [true, false] => i_model_ab + phase_axis::<T>(1) * (i_b - phase_value(i_model_ab, 1)),
+            [false, true] => i_model_ab + phase_axis::<T>(0) * (i_a - phase_value(i_model_ab, 0)),
         };
         let (a, b) = (phase_value(i, 0), phase_value(i, 1));
         (
-            if self.stuck[0] { a } else { i_a },
-            if self.stuck[1] { b } else { i_b },
-            true,
+            if suspect[0] { a } else { i_a },
+            if suspect[1] { b } else { i_b },
+            self.stuck[0] || self.stuck[1],
         )
     }
 
@@ -302,31 +316,34 @@ mod tests {
         let mut d = StuckChannelDetector::<f64>::new(0.25, 2.0, 5);
         // A reference of 10 A along α: phase a should carry 10 A, phase b −5 A.
         let i_ref = Ab::new(10.0, 0.0);
-        // Healthy readings close to the reference: never stuck.
+        // The model predicts 9.9 A along α.
+        let i_model = Ab::new(9.9, 0.0);
+        // Healthy readings close to the reference: never stuck, never replaced.
         for _ in 0..50 {
-            assert_eq!(d.step(9.8, -4.9, i_ref), (9.8, -4.9, false));
+            assert_eq!(d.step(9.8, -4.9, i_ref, i_model), (9.8, -4.9, false));
         }
-        // Channel a reads 0 while b still reads the true −4.9 A (true current 9.8 A along α).
+        // Channel a reads 0 while b still reads the true −4.9 A (true current 9.8 A along α):
+        // replaced from the first sample, flagged at the fifth.
         for n in 1..=5 {
-            let (a, b, stuck) = d.step(0.0, -4.9, i_ref);
+            let (a, b, stuck) = d.step(0.0, -4.9, i_ref, i_model);
             assert_eq!(stuck, n == 5, "sample {n}");
-            if stuck {
-                // Reconstruction: the reference corrected along b to match b's reading.
-                // i = (10, 0) + (−4.9 + 5)·(−0.5, √3/2): phase a = 10 − 0.05.
-                assert!((a - 9.95).abs() < 1e-12 && b == -4.9, "{a} {b}");
-            } else {
-                assert_eq!((a, b), (0.0, -4.9));
-            }
+            // The prediction corrected along b to match b's reading:
+            // i = (9.9, 0) + (−4.9 + 4.95)·(−0.5, √3/2): phase a = 9.9 − 0.025.
+            assert!((a - 9.875).abs() < 1e-12 && b == -4.9, "{a} {b}");
         }
         // Released as soon as the channel reads a current again.
-        assert_eq!(d.step(9.7, -4.9, i_ref), (9.7, -4.9, false));
-        // A phase legitimately at zero (reference perpendicular to its axis) is not stuck.
+        assert_eq!(d.step(9.7, -4.9, i_ref, i_model), (9.7, -4.9, false));
+        // A phase legitimately at zero (reference perpendicular to its axis) is not stuck
+        // and not replaced.
         let perpendicular = Ab::new(0.0, 10.0);
         for _ in 0..50 {
-            assert!(!d.step(0.01, 8.66, perpendicular).2);
+            assert_eq!(
+                d.step(0.01, 8.66, perpendicular, i_model),
+                (0.01, 8.66, false)
+            );
         }
-        // Disabled.
+        // Disabled: never replaced either.
         let mut off = StuckChannelDetector::<f64>::new(0.25, 2.0, 0);
-        assert!((0..50).all(|_| !off.step(0.0, 0.0, i_ref).2));
+        assert!((0..50).all(|_| off.step(0.0, 0.0, i_ref, i_model) == (0.0, 0.0, false)));
     }
 }
