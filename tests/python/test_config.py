@@ -32,6 +32,7 @@ PAPER_DEFAULTS = {
     "tracker_hold_ratio": 0.2,  # SPEC §3 [A]
     "average_current": True,  # SPEC §1 [A]
     "observer_on_rotor_flux": True,  # fado's improvement [A]; False = paper's Fig. 5
+    "limiter_recentring": True,  # fado's improvement [A]; False = the paper
     "initial_angle": 0.0,  # SPEC §1 [A]
 }
 

@@ -258,6 +258,9 @@ pub struct EstimatorSettings {
     /// Disturbance observer on λ1 − L̂q·i (true, our improvement) or on λ1 (false, the
     /// paper's Fig. 5). Default as `EstimatorConfig::observer_on_rotor_flux`.
     pub observer_on_rotor_flux: bool,
+    /// In limiter mode, re-centre the common mode of λ1 and D̂ (true, ours) or not (false,
+    /// the paper). Default as `EstimatorConfig::limiter_recentring`.
+    pub limiter_recentring: bool,
     /// LPF baseline: cut-off of 1/(s + ωc), Hz. Default as `LpfIntegratorConfig`.
     pub lpf_cutoff_hz: f64,
     /// LPF baseline: speed below which its gain/phase compensation is frozen, Hz.
@@ -299,6 +302,7 @@ impl Default for EstimatorSettings {
             tracker_hold_ratio: d.tracker_hold_ratio,
             average_current: d.average_current,
             observer_on_rotor_flux: d.observer_on_rotor_flux,
+            limiter_recentring: d.limiter_recentring,
             kind: EstimatorKind::Fado,
             lpf_cutoff_hz: lpf.cutoff_hz,
             lpf_compensation_floor_hz: lpf.compensation_floor_hz,
@@ -475,6 +479,7 @@ impl SimConfig {
             tracker_hold_ratio: e.tracker_hold_ratio,
             average_current: e.average_current,
             observer_on_rotor_flux: e.observer_on_rotor_flux,
+            limiter_recentring: e.limiter_recentring,
             initial_angle: self.simulation.initial_angle + self.simulation.align_error,
         }
     }

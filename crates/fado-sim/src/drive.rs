@@ -344,6 +344,7 @@ impl SimConfig {
             average_current: e.average_current,
             initial_angle: f(e.initial_angle),
             observer_on_rotor_flux: e.observer_on_rotor_flux,
+            limiter_recentring: e.limiter_recentring,
         };
         dc.validate()
             .map_err(|e| SimConfigError::from(e).in_section("controller"))?;

@@ -259,7 +259,10 @@ fn assert_no_drift(name: &str, w: &[Window]) {
         verdicts.join("\n")
     );
     println!("{report}\n");
-    assert!(!failed, "{name}: a drift criterion failed (see the verdicts above)");
+    assert!(
+        !failed,
+        "{name}: a drift criterion failed (see the verdicts above)"
+    );
 }
 
 fn seconds() -> f64 {

@@ -660,7 +660,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         // from the model prediction.
         let prev = self.last.estimate;
         let rot_ref = Rotation::from_angle(prev.theta + prev.omega * self.config.ts);
-        let i_model = self.predicted_current();
+        let i_model = self.predicted_current().unwrap_or_else(|| i_abc.to_ab());
         let (ia, ib, stuck) =
             self.stuck_sensor
                 .step(i_abc.a, i_abc.b, self.last.i_dq_ref.to_ab(rot_ref), i_model);
@@ -751,15 +751,17 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
     /// reconstructed) by the machine model over [n−1, n]: L̂q·di/dt = v − R̂s·i − jω̂·λ̂r with
     /// the voltage that acted (the realised reference computed at n−2) and the estimator's
     /// last rotor flux and speed. Exact in form for the SPMSM (L̂d = L̂q); forward Euler is
-    /// enough at R̂s·Ts/L̂q ≈ 0.012.
-    fn predicted_current(&self) -> Ab<T> {
+    /// enough at R̂s·Ts/L̂q ≈ 0.012. None when the prediction is no plausible current
+    /// (non-finite, or beyond the trip level after absurd inputs): the readings are used.
+    fn predicted_current(&self) -> Option<Ab<T>> {
         let c = &self.config;
         let e = &self.last.estimate;
         let lr = e.diagnostics.lambda_r;
         let emf = Ab::new(-lr.beta, lr.alpha) * e.omega;
         let i = self.last_i_ab;
         let predicted = i + (self.history[1] - i * c.rs_hat - emf) * (c.ts / c.lq_hat);
-        if predicted.is_finite() { predicted } else { i }
+        let n = predicted.norm();
+        (n.is_finite() && n <= c.trip_current).then_some(predicted)
     }
 
     /// Rejected sample: hold the duty, keep the estimator's clock with the last good current.
