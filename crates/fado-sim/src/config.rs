@@ -1,7 +1,8 @@
 //! The whole simulation as one TOML document: plant sections (`[motor]`, `[inverter]`,
 //! `[current_sensor]`, `[dc_link_sensor]`, `[load]`), the speed reference
 //! (`[speed_reference]`), the drive (`[controller]`, `[estimator]`), the estimator's view of
-//! the plant (`[mismatch]`), and run settings (`[simulation]`).
+//! the plant (`[mismatch]`), injected faults (`[faults]`, see [`crate::faults`]), and run
+//! settings (`[simulation]`).
 //!
 //! A file overrides a base configuration (a scenario's) key by key: tables merge, values and
 //! arrays replace. Unknown keys are errors naming the key (`inverter.dead_tme`), and so are
@@ -605,5 +606,20 @@ mod tests {
         let e = SimConfig::from_toml("[speed_reference]\npoints = [[1.0, 0.0], [0.0, 1.0]]\n")
             .unwrap_err();
         assert_eq!(e.key, "speed_reference.points[1]", "{e}");
+        let e = SimConfig::from_toml(
+            "[[faults.stuck_current]]\nchannel = \"a\"\nstart = 1.0\nduration = -0.01\n",
+        )
+        .unwrap_err();
+        assert_eq!(e.key, "faults.stuck_current[0].duration", "{e}");
+        let e = SimConfig::from_toml("[[faults.non_finite]]\ntime = 1.0\nsignal = \"dc\"\n")
+            .unwrap_err();
+        assert!(e.key.starts_with("faults.non_finite"), "{e}");
+        let ok = SimConfig::from_toml(
+            "[[faults.non_finite]]\ntime = 1.0\nsignal = \"dc_link\"\n\
+             [faults.dc_link_scale]\npoints = [[1.0, 1.0], [1.1, 0.5]]\n",
+        )
+        .unwrap();
+        assert_eq!(ok.faults.non_finite[0].samples, 1);
+        assert_eq!(ok, SimConfig::from_toml(&ok.to_toml()).unwrap());
     }
 }
