@@ -9,7 +9,6 @@
 
 use fado_core::DriveFlags;
 use fado_sim::controller::{Actuation, Controller};
-use fado_sim::sim::{Plant, Simulation};
 use fado_sim::{SimConfig, scenario_config};
 
 /// What the tests look at, per sample.
@@ -59,15 +58,8 @@ fn finite(a: &Actuation) -> bool {
 }
 
 fn run_with<C: Controller>(cfg: &SimConfig, drive: C) -> Run {
-    let plant = Plant::new(&cfg.plant(), cfg.simulation.initial_angle).unwrap();
-    let ts = plant.sample_period();
-    let mut sim = Simulation::new(
-        plant,
-        drive,
-        cfg.speed_reference.clone(),
-        cfg.simulation.align_error,
-    )
-    .unwrap();
+    let mut sim = cfg.simulation(drive).unwrap();
+    let ts = sim.plant().sample_period();
     let n = (cfg.simulation.duration / ts).round() as usize;
     let mut recs = Vec::with_capacity(n);
     for _ in 0..n {

@@ -19,7 +19,6 @@ use fado_sim::controller::Controller;
 use fado_sim::drive::DriveF32;
 use fado_sim::inverter::InverterModel;
 use fado_sim::profile::Profile;
-use fado_sim::sim::{Plant, Simulation};
 use fado_sim::{SimConfig, scenario_config};
 
 /// Start-up (alignment, offset calibration, acceleration, load ramp) excluded, s.
@@ -113,14 +112,7 @@ fn run_hour_with<C: Controller + PiIntegrals>(
     } else {
         (seconds / 20.0).max(1.0)
     };
-    let plant = Plant::new(&cfg.plant(), cfg.simulation.initial_angle).unwrap();
-    let mut sim = Simulation::new(
-        plant,
-        drive,
-        cfg.speed_reference.clone(),
-        cfg.simulation.align_error,
-    )
-    .unwrap();
+    let mut sim = cfg.simulation(drive).unwrap();
     let n = (seconds / sim.plant().sample_period()).round() as u64;
     let mut windows: Vec<Window> = Vec::new();
     let wall = std::time::Instant::now();
