@@ -3,8 +3,10 @@
 //!
 //! Order of operations at sample n (SPEC §1, §5):
 //!
-//! 1. Reject non-finite inputs; trip (gates off, latched) when a phase current exceeds
-//!    `trip_current`.
+//! 1. Reject non-finite inputs (trip after `input_fault_trip_samples` in a row); trip (gates
+//!    off, latched) when a phase current exceeds `trip_current`; replace a phase-current
+//!    channel that reads about zero against a clear reference by a model reconstruction
+//!    ([`StuckChannelDetector`]).
 //! 2. Estimator with the α-β currents sampled now and the voltage that acted over
 //!    [n−1, n]: the realised reference computed at n−2 (computation delay: a duty computed at
 //!    n is loaded at n+1 and acts over [n+1, n+2]), before dead-time compensation.
@@ -18,6 +20,7 @@
 //!    the inverter produces once its non-linearity has eaten v_comp.
 //! 8. Anti-windup: the realised reference, back in the same advanced d-q frame, feeds the
 //!    current PIs; it enters the two-deep history for the estimator.
+//! 9. The status word [`DriveFlags`] of the sample is formed and counted.
 
 use crate::control::current_controller::{CurrentController, CurrentControllerConfig};
 use crate::control::dead_time_compensation::{
@@ -221,9 +224,7 @@ impl<T: Real> DriveOutput<T> {
             && d.lambda_r.is_finite()
             && d.theta_direct.is_finite()
     }
-}
 
-impl<T: Real> DriveOutput<T> {
     fn idle(estimate: Estimate<T>) -> Self {
         let half = T::lit(0.5);
         Self {
