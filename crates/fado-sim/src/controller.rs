@@ -34,6 +34,9 @@ pub struct Actuation {
     pub input_fault: bool,
     /// The drive's status word (faults and warnings); empty for controllers without one.
     pub flags: DriveFlags,
+    /// The α-β current the controller's estimator was given (offset-corrected, a stuck
+    /// channel reconstructed), A; None for controllers that do not report it.
+    pub i_ab_used: Option<Ab<f64>>,
     /// Realised voltage reference (α-β), V.
     pub v_ref_ab: Ab<f64>,
     /// Measured current in the controller's (estimated) rotor frame, A.

@@ -5,7 +5,7 @@
 //!   replaced by NaN, +∞ or −∞ (a broken ADC read, a division by zero in a driver) for
 //!   `samples` samples from `time` on.
 //! * `[[faults.stuck_current]]`: a current-sensor channel (a or b) that reads `value`
-//!   (default 0 A) over `[start, start + duration]` (default 10 ms): a loose connector or a
+//!   (default 0 A) over `[start, start + duration)` (default 10 ms): a loose connector or a
 //!   sensor supply drop-out. Phase c is reconstructed from the stuck reading as −a − b, as the
 //!   drive's two-sensor hardware does.
 //! * `[faults.dc_link_scale]`: the DC-link voltage as a fraction of its nominal value over

@@ -215,8 +215,9 @@ pub struct Sample {
     /// Stator voltage the inverter actually applied over the previous sample [n−1, n]
     /// (time average, α-β), V.
     pub v_ab_applied: fado_core::Ab<f64>,
-    /// Measured current (sensor model) in α-β, as the controller computes it from the
-    /// measured phase currents, A.
+    /// Measured current in α-β as the controller's estimator was given it (offset-corrected,
+    /// a stuck channel reconstructed) when the controller reports it, else the Clarke
+    /// transform of the measured phase currents, A.
     pub i_ab_measured: fado_core::Ab<f64>,
     /// The controller's output at this sample.
     pub act: Actuation,
@@ -330,7 +331,7 @@ impl<C: Controller> Simulation<C> {
             torque: self.plant.last_outcome().torque_avg,
             load_torque: self.plant.load_torque(),
             v_ab_applied: self.plant.last_outcome().v_ab_avg,
-            i_ab_measured: i_abc.to_ab(),
+            i_ab_measured: act.i_ab_used.unwrap_or_else(|| i_abc.to_ab()),
             pole_pairs: self.pole_pairs,
             act,
         };
@@ -529,7 +530,8 @@ pub struct TraceRow {
     pub v_alpha_applied: f64,
     /// Applied voltage β, V.
     pub v_beta_applied: f64,
-    /// Measured current α (what the estimator sees at this sample), A.
+    /// Measured current α as the estimator sees it at this sample (offset-corrected, a stuck
+    /// channel reconstructed), A.
     pub i_alpha: f64,
     /// Measured current β, A.
     pub i_beta: f64,

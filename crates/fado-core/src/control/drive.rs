@@ -204,6 +204,10 @@ pub struct DriveOutput<T> {
     pub voltage_saturated: bool,
     /// The status word of this sample: faults and warnings (see [`DriveFlags`]).
     pub flags: DriveFlags,
+    /// The α-β current the estimator was given this sample (A): the measurement with the
+    /// calibrated offsets removed and a stuck channel reconstructed (the last good current
+    /// after a non-finite one; the raw measurement while calibrating or tripped).
+    pub i_ab: Ab<T>,
 }
 
 impl<T: Real> DriveOutput<T> {
@@ -215,6 +219,7 @@ impl<T: Real> DriveOutput<T> {
             && self.i_dq.is_finite()
             && self.i_dq_ref.is_finite()
             && self.v_dq_ref.is_finite()
+            && self.i_ab.is_finite()
             && self.estimate.theta.is_finite()
             && self.estimate.omega.is_finite()
             && self.estimate.omega_control.is_finite()
@@ -239,6 +244,7 @@ impl<T: Real> DriveOutput<T> {
             v_dq_ref: Dq::zero(),
             voltage_saturated: false,
             flags: DriveFlags::NONE,
+            i_ab: Ab::zero(),
         }
     }
 }
@@ -427,6 +433,8 @@ pub struct SensorlessDrive<T, E = SensorlessEstimator<T>> {
     consecutive_rejects: u32,
     /// Samples each flag was raised since the last reset.
     flag_counts: FlagCounts,
+    /// The α-β current of this sample as reported in [`DriveOutput::i_ab`].
+    i_ab_used: Ab<T>,
 }
 
 impl<T: Real> SensorlessDrive<T, SensorlessEstimator<T>> {
@@ -470,6 +478,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             current_error_now: false,
             consecutive_rejects: 0,
             flag_counts: FlagCounts::default(),
+            i_ab_used: Ab::zero(),
         };
         drive.reset();
         Ok(drive)
@@ -625,12 +634,17 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             out.estimate.diagnostics.flag_limit,
         );
         out.flags = flags;
+        out.i_ab = self.i_ab_used;
         self.last.flags = flags;
+        self.last.i_ab = self.i_ab_used;
         self.flag_counts.record(flags);
         out
     }
 
     fn step_control(&mut self, i_abc: Abc<T>, vdc: T, speed_ref_mech: T) -> DriveOutput<T> {
+        // What this sample reports as its current until the estimator is given another.
+        let raw = i_abc.to_ab();
+        self.i_ab_used = if raw.is_finite() { raw } else { self.last_i_ab };
         let finite = i_abc.is_finite() && vdc.is_finite() && speed_ref_mech.is_finite();
         if self.tripped {
             let mut out = self.last;
@@ -677,6 +691,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         }
 
         // 2. Estimator: voltage of [n−1, n] = realised reference computed at n−2.
+        self.i_ab_used = i_ab;
         let estimate = self.estimator.step(self.history[1], i_ab);
         if !estimate_is_finite(&estimate) {
             // An estimator that went non-finite cannot steer the drive: hold like a bad input
@@ -744,6 +759,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             v_dq_ref: v_dq_realised,
             voltage_saturated: m.saturated,
             flags: DriveFlags::NONE, // set by `step`
+            i_ab,
         };
         self.last
     }
@@ -773,6 +789,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         } else {
             self.last_i_ab
         };
+        self.i_ab_used = i_ab;
         let estimate = self.estimator.step(self.history[1], i_ab);
         let mut out = self.last;
         if estimate_is_finite(&estimate) {
