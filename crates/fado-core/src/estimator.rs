@@ -96,7 +96,9 @@ pub struct EstimatorConfig<T> {
     /// Measured (fado-sim long run, 0 r/min under 7.5 N·m, averaged plant, default sensors):
     /// 0.6 mWb/s, |λ1| ≈ |D̂| ≈ 2.1 Wb after an hour, f32 and f64 alike — in f32 the flux
     /// increments (≈ 0.5 mWb per sample at standstill) would drown in the rounding of λ1
-    /// after days. The shift keeps D̂ at rate/k_df instead and leaves θ̂ unchanged.
+    /// after days. The shift keeps D̂ at rate/k_df instead; θ̂ is unchanged while the
+    /// estimator stays in limiter mode (at a hand-over to HI mode D̂ is smaller, so the k_df
+    /// transient that follows differs).
     pub limiter_recentring: bool,
 }
 
