@@ -169,10 +169,9 @@ fn fig8_paper_criterion() {
 }
 
 #[test]
-#[ignore = "known failure with default sensors: the stop leaves ≈ 0.3 rad, then the 0.5 % gain \
-            error's integrand walks θ̂ along the flux circle, max |θ − θ̂| ≈ 0.39 rad (SPEC \
-            threshold 0.35 [A]; 0.09–0.44 over 8 noise seeds, 4 pass; 0.69 without R̂s \
-            adaptation, 0.33–0.70, 3 pass)"]
+#[ignore = "seed-dependent with default sensors: the stop leaves ≈ 0.3 rad, then the 0.5 % \
+            gain error's integrand walks θ̂ along the flux circle (SPEC threshold 0.35 [A]); \
+            figures per seed in the crate README"]
 fn fig10_paper_criterion() {
     let out = run("fig10", None, false);
     assert!(out.passed, "{:?}", out.checks);

@@ -93,6 +93,7 @@ class EstimatorConfig:
         tracker_hold_ratio: float | None = None,
         average_current: bool | None = None,
         observer_on_rotor_flux: bool | None = None,
+        limiter_recentring: bool | None = None,
         initial_angle: float | None = None,
         rs_adaptation: bool | None = None,
         rs_adaptation_rate: float | None = None,
@@ -121,6 +122,7 @@ class EstimatorConfig:
         tracker_hold_ratio: float | None = None,
         average_current: bool | None = None,
         observer_on_rotor_flux: bool | None = None,
+        limiter_recentring: bool | None = None,
         initial_angle: float | None = None,
         rs_adaptation: bool | None = None,
         rs_adaptation_rate: float | None = None,
@@ -184,6 +186,9 @@ class EstimatorConfig:
     @property
     def observer_on_rotor_flux(self) -> bool:
         """Observer fed with λ1 − L̂q·i (fado's improvement) instead of λ1 (the paper)."""
+    @property
+    def limiter_recentring(self) -> bool:
+        """In limiter mode, re-centre the common mode of λ1 and D̂ (fado's improvement)."""
     @property
     def initial_angle(self) -> float:
         """Rotor angle assumed at reset in rad."""

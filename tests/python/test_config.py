@@ -33,6 +33,7 @@ PAPER_DEFAULTS = {
     "tracker_hold_ratio": 0.2,  # SPEC §3 [A]
     "average_current": True,  # SPEC §1 [A]
     "observer_on_rotor_flux": True,  # fado's improvement [A]; False = paper's Fig. 5
+    "limiter_recentring": True,  # fado's improvement [A]; False = the paper
     "initial_angle": 0.0,  # SPEC §1 [A]
     "rs_adaptation": True,  # fado's extension [A]; False = the paper's fixed R̂s
     "rs_adaptation_rate": 1.0,  # [A]

@@ -35,7 +35,7 @@ pub mod rs_adaptation;
 pub mod tracker;
 
 pub use baselines::{EmfObserverEstimator, LpfIntegratorEstimator, OrtegaEstimator};
-pub use control::{DriveConfig, DriveOutput, SensorlessDrive};
+pub use control::{DriveConfig, DriveFlags, DriveOutput, SensorlessDrive};
 pub use error::{ConfigError, NonFiniteInput};
 pub use estimator::{
     Diagnostics, Estimate, EstimatorConfig, RotorAngleEstimator, SensorlessEstimator,

@@ -39,12 +39,17 @@
 //! ```
 //!
 //! in the estimated frame (d along λ̂r), while |ω̂| is below a small speed (an angle error δ
-//! leaks δ·ω·λf of back-EMF into v_d). Meanwhile the flux error the R̂s error integrated
-//! before it was corrected lies along d too (the current did), so the estimator pulls |λ̂r|
-//! back to λ̂f: a two-sided version of the Fig. 6 limiter, valid only under these conditions. It needs no flux estimate, so it also works while the
-//! limiter clamps, and at start-up it corrects R̂s before the first rotation. With a q-axis
-//! current (load at standstill) the flux error goes into the angle and nothing measures it:
-//! frozen there.
+//! leaks δ·ω·λf of back-EMF into v_d). It needs no flux estimate, so it also works while the
+//! limiter clamps, and at start-up it corrects R̂s before the first rotation. The flux error
+//! that the R̂s error integrated before it was corrected lies along d too (the current did):
+//! if it shrank |λ̂r|, the estimator pulls |λ̂r| back up to λ̂f (a grown one is already
+//! bounded by the Fig. 6 limiter's circle) — the inner side of the limiter, valid only under
+//! these conditions. With a q-axis current (load at standstill) the flux error goes into the
+//! angle and nothing measures it: frozen there.
+//!
+//! Besides, where the turning law is frozen for lack of excitation (|χ| < χ0/2: no load, high
+//! speed), the flux-magnitude reference λ̂f itself can be learned from |λ̂r|
+//! ([`ResistanceAdaptationConfig::flux_linkage_rate`], off by default).
 //!
 //! Both laws are frozen while the trackers coast, on a mode change and on rejected samples.
 //! Voltage errors in phase with the current (the dead-time compensation residual, device drops)
@@ -102,9 +107,10 @@ pub struct ResistanceAdaptationConfig<T> {
     /// \[A\]: with an angle error δ the back-EMF leaks δ·ω·λf into v_d; at 0.1 rad, 4 A and
     /// 0.25 Hz that reads as 1 % of R0).
     pub standstill_speed_hz: T,
-    /// k_m in s⁻¹: while the standstill law runs, the estimator also pulls |λ̂r| back to λ̂f at
-    /// this rate, removing the radial flux error that the R̂s error integrated before it was
-    /// corrected. Default 2π·5 s⁻¹ (ours \[A\]: 32 ms, within the start-up injection).
+    /// k_m in s⁻¹: while the standstill law runs, the estimator also pulls a shrunken |λ̂r|
+    /// back up to λ̂f at this rate, removing the radial flux error that the R̂s error
+    /// integrated before it was corrected. Default 2π·5 s⁻¹ (ours \[A\]: 32 ms, within the
+    /// start-up injection).
     pub standstill_flux_rate: T,
     /// Lower bound of R̂s as a multiple of R0. Default 0.5 (ours \[A\]).
     pub min_ratio: T,
@@ -362,8 +368,12 @@ impl<T: Real> ResistanceAdaptation<T> {
                 let r_dc = next.volt_seconds_d / next.charge_d;
                 next.rs_hat += self.standstill_gain * (r_dc - next.rs_hat);
             }
-            // The current only moved λ̂r radially, and the rotor flux is λf: pull back.
-            pull = unit * (self.config.standstill_flux_rate * (mag - self.state.flux_linkage_hat));
+            // The current only moved λ̂r radially, and the rotor flux is λf: pull a shrunken
+            // λ̂r back out (outside, the Fig. 6 limiter already bounds it at its circle;
+            // pulling it further in would only speed up the walk of a tangential integrand
+            // error along the circle, which goes as e_t/|λ̂r|).
+            let shortfall = (mag - self.state.flux_linkage_hat).min(T::zero());
+            pull = unit * (self.config.standstill_flux_rate * shortfall);
         }
         next.rs_hat = next.rs_hat.max(self.rs_min).min(self.rs_max);
         (next, pull)

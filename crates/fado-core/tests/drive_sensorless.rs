@@ -10,7 +10,7 @@ use fado_core::control::{
     SensorlessDrive,
 };
 use fado_core::{
-    Ab, Abc, Diagnostics, Estimate, EstimatorConfig, Rotation, RotorAngleEstimator,
+    Ab, Abc, Diagnostics, DriveFlags, Estimate, EstimatorConfig, Rotation, RotorAngleEstimator,
     SensorlessEstimator,
 };
 use proptest::prelude::*;
@@ -62,12 +62,22 @@ fn no_calibration<T: fado_core::Real>() -> DriveConfig<T> {
     }
 }
 
+/// As [`no_calibration`], and without the stuck-sensor check: the spy's synthetic currents do
+/// not follow the references, so a phase reading near zero while its reference asks for
+/// amps is (rightly) implausible and would be replaced by the model reconstruction.
+fn synthetic_currents<T: fado_core::Real>() -> DriveConfig<T> {
+    DriveConfig {
+        stuck_sensor_samples: 0,
+        ..no_calibration()
+    }
+}
+
 fn spy_drive() -> SensorlessDrive<f64, Spy> {
     let spy = Spy {
         omega: TAU * 30.0,
         ..Spy::default()
     };
-    SensorlessDrive::with_estimator(no_calibration(), spy).unwrap()
+    SensorlessDrive::with_estimator(synthetic_currents(), spy).unwrap()
 }
 
 fn currents(n: usize) -> Abc<f64> {
@@ -278,6 +288,10 @@ fn check_output<T: fado_core::Real>(o: &DriveOutput<T>) -> Result<(), TestCaseEr
     let e = &o.estimate;
     prop_assert!(e.theta.is_finite() && e.omega.is_finite() && e.omega_control.is_finite());
     prop_assert!(o.gates_enabled != o.tripped);
+    // Every number finite, and the status word agrees with the booleans.
+    prop_assert!(o.is_finite());
+    prop_assert_eq!(o.flags.contains(DriveFlags::INPUT_REJECTED), o.input_fault);
+    prop_assert_eq!(o.flags.contains(DriveFlags::TRIPPED), o.tripped);
     Ok(())
 }
 
@@ -289,6 +303,7 @@ fn drives<T: fado_core::Real>(method: DeadTimeMethod) -> [SensorlessDrive<T>; 2]
     // The second never trips, so that every input reaches the controllers.
     let no_trip = DriveConfig {
         trip_current: T::max_value().unwrap(),
+        input_fault_trip_samples: 0,
         ..cfg
     };
     [cfg, no_trip].map(|c| {
@@ -534,4 +549,31 @@ fn sensorless_closed_loop_follows_a_speed_ramp_under_load() {
         (iq - expected).abs() < 0.05 * expected,
         "i_q* = {iq} vs {expected}"
     );
+}
+
+#[test]
+fn status_word_reports_dc_link_low_and_persistent_bad_input_trips_and_is_counted() {
+    let mut d = SensorlessDrive::<f64>::new(no_calibration(), EstimatorConfig::default()).unwrap();
+    d.align(0.3);
+    let i = Abc::new(0.5, -0.25, -0.25);
+    let o = d.step(i, 300.0, 10.0);
+    assert!(!o.flags.intersects(DriveFlags::FAULTS), "{:?}", o.flags);
+    assert!(o.flags.contains(DriveFlags::LIMITER_MODE)); // standstill start: FLAG_limit
+    // 150 V is below the 200 V default: flagged, and the drive keeps modulating.
+    let o = d.step(i, 150.0, 10.0);
+    assert!(o.flags.contains(DriveFlags::DC_LINK_LOW) && o.gates_enabled && !o.input_fault);
+    // 99 rejected samples in a row are ridden through, the 100th trips (latched).
+    for n in 1..=100 {
+        let o = d.step(Abc::new(f64::NAN, 0.0, 0.0), 300.0, 10.0);
+        assert!(o.flags.contains(DriveFlags::INPUT_REJECTED) && o.is_finite());
+        assert_eq!(o.tripped, n == 100, "sample {n}");
+    }
+    let o = d.step(i, 300.0, 10.0);
+    assert!(o.tripped && !o.gates_enabled && o.flags.contains(DriveFlags::TRIPPED));
+    let c = d.flag_counts();
+    assert_eq!(c.count(DriveFlags::INPUT_REJECTED), 100);
+    assert_eq!(c.count(DriveFlags::DC_LINK_LOW), 1);
+    assert_eq!(c.count(DriveFlags::TRIPPED), 2);
+    d.reset();
+    assert_eq!(d.flag_counts().count(DriveFlags::INPUT_REJECTED), 0);
 }

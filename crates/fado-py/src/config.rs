@@ -158,6 +158,9 @@ config_class! {
     /// Feed the disturbance observer with λ1 − L̂q·i instead of the paper's λ1 (our
     /// improvement, default true; false is the paper's Fig. 5).
     observer_on_rotor_flux: bool,
+    /// In limiter mode, re-centre the common mode of λ1 and D̂ (our improvement, default
+    /// true; false is the paper).
+    limiter_recentring: bool,
     /// Rotor angle assumed at reset in rad (electrical).
     initial_angle: f64,
     /// Adapt R̂s online (our extension; false = the paper's fixed R̂s).
@@ -202,6 +205,7 @@ impl PyEstimatorConfig {
             tracker_hold_ratio: c.tracker_hold_ratio,
             average_current: c.average_current,
             observer_on_rotor_flux: c.observer_on_rotor_flux,
+            limiter_recentring: c.limiter_recentring,
             initial_angle: c.initial_angle,
             rs_adaptation: c.rs_adaptation,
             rs_adaptation_rate: c.rs_adaptation_rate,
@@ -233,6 +237,7 @@ impl PyEstimatorConfig {
             tracker_hold_ratio: T::lit(self.tracker_hold_ratio),
             average_current: self.average_current,
             observer_on_rotor_flux: self.observer_on_rotor_flux,
+            limiter_recentring: self.limiter_recentring,
             initial_angle: T::lit(self.initial_angle),
             rs_adaptation: self.rs_adaptation,
             rs_adaptation_rate: T::lit(self.rs_adaptation_rate),

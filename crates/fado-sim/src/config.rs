@@ -1,7 +1,8 @@
 //! The whole simulation as one TOML document: plant sections (`[motor]`, `[inverter]`,
 //! `[current_sensor]`, `[dc_link_sensor]`, `[load]`), the speed reference
 //! (`[speed_reference]`), the drive (`[controller]`, `[estimator]`), the estimator's view of
-//! the plant (`[mismatch]`), and run settings (`[simulation]`).
+//! the plant (`[mismatch]`), injected faults (`[faults]`, see [`crate::faults`]), and run
+//! settings (`[simulation]`).
 //!
 //! A file overrides a base configuration (a scenario's) key by key: tables merge, values and
 //! arrays replace. Unknown keys are errors naming the key (`inverter.dead_tme`), and so are
@@ -14,6 +15,7 @@ use fado_core::tracker::BandwidthDefinition;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{SimConfigError, check};
+use crate::faults::FaultParams;
 use crate::inverter::InverterParams;
 use crate::load::LoadParams;
 use crate::motor::MotorParams;
@@ -150,10 +152,25 @@ pub struct ControllerSettings {
     /// Current-sensor offset calibration at start-up, samples with the gates off (0 = none).
     /// Default 1000 (100 ms) as `fado_core::control::DriveConfig` \[A\].
     pub offset_calibration_samples: u32,
+    /// Stuck current-sensor detection band, A. Default 0.25 A as `DriveConfig`.
+    pub stuck_sensor_band: f64,
+    /// Stuck current-sensor detection: minimum reference in the phase, A. Default 2 A.
+    pub stuck_sensor_min_reference: f64,
+    /// Stuck current-sensor detection: samples in a row (0 = off). Default 5.
+    pub stuck_sensor_samples: u32,
+    /// Current-error monitor limit |i* − i|, A. Default 5 A.
+    pub current_error_limit: f64,
+    /// Current-error monitor: samples in a row (0 = off). Default 20.
+    pub current_error_samples: u32,
+    /// DC-link under-voltage warning level, V. Default 200 V.
+    pub dc_link_min_voltage: f64,
+    /// Rejected samples in a row that trip the drive (0 = never). Default 100.
+    pub input_fault_trip_samples: u32,
 }
 
 impl Default for ControllerSettings {
     fn default() -> Self {
+        let d = fado_core::control::DriveConfig::<f64>::default();
         Self {
             precision: Precision::F64,
             current_bandwidth_hz: 250.0,
@@ -171,6 +188,13 @@ impl Default for ControllerSettings {
             current_anti_windup_ratio: 1.0,
             speed_anti_windup_ratio: 5.0,
             offset_calibration_samples: 1000,
+            stuck_sensor_band: d.stuck_sensor_band,
+            stuck_sensor_min_reference: d.stuck_sensor_min_reference,
+            stuck_sensor_samples: d.stuck_sensor_samples,
+            current_error_limit: d.current_error_limit,
+            current_error_samples: d.current_error_samples,
+            dc_link_min_voltage: d.dc_link_min_voltage,
+            input_fault_trip_samples: d.input_fault_trip_samples,
         }
     }
 }
@@ -250,6 +274,9 @@ pub struct EstimatorSettings {
     /// λ̂f learning rate where R̂s is unobservable, s⁻¹ (0 = fixed λ̂f). Default as
     /// `EstimatorConfig::flux_linkage_adaptation_rate`.
     pub flux_linkage_adaptation_rate: f64,
+    /// In limiter mode, re-centre the common mode of λ1 and D̂ (true, ours) or not (false,
+    /// the paper). Default as `EstimatorConfig::limiter_recentring`.
+    pub limiter_recentring: bool,
     /// LPF baseline: cut-off of 1/(s + ωc), Hz. Default as `LpfIntegratorConfig`.
     pub lpf_cutoff_hz: f64,
     /// LPF baseline: speed below which its gain/phase compensation is frozen, Hz.
@@ -297,6 +324,7 @@ impl Default for EstimatorSettings {
             rs_adaptation_min_ratio: d.rs_adaptation_min_ratio,
             rs_adaptation_max_ratio: d.rs_adaptation_max_ratio,
             flux_linkage_adaptation_rate: d.flux_linkage_adaptation_rate,
+            limiter_recentring: d.limiter_recentring,
             kind: EstimatorKind::Fado,
             lpf_cutoff_hz: lpf.cutoff_hz,
             lpf_compensation_floor_hz: lpf.compensation_floor_hz,
@@ -390,6 +418,8 @@ pub struct SimConfig {
     pub estimator: EstimatorSettings,
     /// The drive's model of the plant.
     pub mismatch: Mismatch,
+    /// Injected faults (`crate::faults`). Default none.
+    pub faults: FaultParams,
 }
 
 impl Default for Profile {
@@ -407,6 +437,7 @@ impl SimConfig {
             current_sensor: self.current_sensor.clone(),
             dc_link_sensor: self.dc_link_sensor.clone(),
             load: self.load.clone(),
+            faults: self.faults.clone(),
         }
     }
 
@@ -478,6 +509,7 @@ impl SimConfig {
             rs_adaptation_min_ratio: e.rs_adaptation_min_ratio,
             rs_adaptation_max_ratio: e.rs_adaptation_max_ratio,
             flux_linkage_adaptation_rate: e.flux_linkage_adaptation_rate,
+            limiter_recentring: e.limiter_recentring,
             initial_angle: self.simulation.initial_angle + self.simulation.align_error,
         }
     }
@@ -657,6 +689,21 @@ mod tests {
         let e = SimConfig::from_toml("[speed_reference]\npoints = [[1.0, 0.0], [0.0, 1.0]]\n")
             .unwrap_err();
         assert_eq!(e.key, "speed_reference.points[1]", "{e}");
+        let e = SimConfig::from_toml(
+            "[[faults.stuck_current]]\nchannel = \"a\"\nstart = 1.0\nduration = -0.01\n",
+        )
+        .unwrap_err();
+        assert_eq!(e.key, "faults.stuck_current[0].duration", "{e}");
+        let e = SimConfig::from_toml("[[faults.non_finite]]\ntime = 1.0\nsignal = \"dc\"\n")
+            .unwrap_err();
+        assert!(e.key.starts_with("faults.non_finite"), "{e}");
+        let ok = SimConfig::from_toml(
+            "[[faults.non_finite]]\ntime = 1.0\nsignal = \"dc_link\"\n\
+             [faults.dc_link_scale]\npoints = [[1.0, 1.0], [1.1, 0.5]]\n",
+        )
+        .unwrap();
+        assert_eq!(ok.faults.non_finite[0].samples, 1);
+        assert_eq!(ok, SimConfig::from_toml(&ok.to_toml()).unwrap());
     }
 }
 

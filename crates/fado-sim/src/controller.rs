@@ -3,7 +3,7 @@
 //! The sensorless drive of `fado-core` implements it ([`crate::drive`]); so can sensored
 //! reference controllers in tests.
 
-use fado_core::{Ab, Abc, Dq, Estimate};
+use fado_core::{Ab, Abc, Dq, DriveFlags, Estimate};
 
 /// Everything a controller may read at sample n.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -32,6 +32,11 @@ pub struct Actuation {
     pub tripped: bool,
     /// The controller rejected this sample's inputs.
     pub input_fault: bool,
+    /// The drive's status word (faults and warnings); empty for controllers without one.
+    pub flags: DriveFlags,
+    /// The α-β current the controller's estimator was given (offset-corrected, a stuck
+    /// channel reconstructed), A; None for controllers that do not report it.
+    pub i_ab_used: Option<Ab<f64>>,
     /// Realised voltage reference (α-β), V.
     pub v_ref_ab: Ab<f64>,
     /// Measured current in the controller's (estimated) rotor frame, A.

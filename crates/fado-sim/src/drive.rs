@@ -47,6 +47,8 @@ where
             gates_enabled: out.gates_enabled,
             tripped: out.tripped,
             input_fault: out.input_fault,
+            flags: out.flags,
+            i_ab_used: Some(out.i_ab),
             v_ref_ab: out.v_ref_ab,
             i_dq: out.i_dq,
             i_dq_ref: out.i_dq_ref,
@@ -112,6 +114,13 @@ impl SimConfig {
             current_anti_windup_ratio: c.current_anti_windup_ratio,
             speed_anti_windup_ratio: c.speed_anti_windup_ratio,
             offset_calibration_samples: c.offset_calibration_samples,
+            stuck_sensor_band: c.stuck_sensor_band,
+            stuck_sensor_min_reference: c.stuck_sensor_min_reference,
+            stuck_sensor_samples: c.stuck_sensor_samples,
+            current_error_limit: c.current_error_limit,
+            current_error_samples: c.current_error_samples,
+            dc_link_min_voltage: c.dc_link_min_voltage,
+            input_fault_trip_samples: c.input_fault_trip_samples,
         }
     }
 
@@ -239,6 +248,8 @@ impl Controller for DriveF32 {
             gates_enabled: o.gates_enabled,
             tripped: o.tripped,
             input_fault: o.input_fault,
+            flags: o.flags,
+            i_ab_used: Some(ab64(o.i_ab)),
             v_ref_ab: ab64(o.v_ref_ab),
             i_dq: dq64(o.i_dq),
             i_dq_ref: dq64(o.i_dq_ref),
@@ -309,6 +320,13 @@ impl SimConfig {
             current_anti_windup_ratio: f(c.current_anti_windup_ratio),
             speed_anti_windup_ratio: f(c.speed_anti_windup_ratio),
             offset_calibration_samples: c.offset_calibration_samples,
+            stuck_sensor_band: f(c.stuck_sensor_band),
+            stuck_sensor_min_reference: f(c.stuck_sensor_min_reference),
+            stuck_sensor_samples: c.stuck_sensor_samples,
+            current_error_limit: f(c.current_error_limit),
+            current_error_samples: c.current_error_samples,
+            dc_link_min_voltage: f(c.dc_link_min_voltage),
+            input_fault_trip_samples: c.input_fault_trip_samples,
         };
         let e = self.estimator_config();
         let ec = EstimatorConfig::<f32> {
@@ -336,6 +354,7 @@ impl SimConfig {
             rs_adaptation_min_ratio: f(e.rs_adaptation_min_ratio),
             rs_adaptation_max_ratio: f(e.rs_adaptation_max_ratio),
             flux_linkage_adaptation_rate: f(e.flux_linkage_adaptation_rate),
+            limiter_recentring: e.limiter_recentring,
         };
         dc.validate().map_err(|e| core_error("controller", e))?;
         SensorlessDrive::new(dc, ec)

@@ -268,6 +268,8 @@ pub struct Inverter {
     legs: [Leg; 3],
     /// Sample counter: even samples see a falling carrier (peak → valley).
     sample: u64,
+    /// DC-link voltage as a fraction of its nominal value (fault injection, a supply dip).
+    dc_link_scale: f64,
 }
 
 impl Inverter {
@@ -282,6 +284,7 @@ impl Inverter {
             shadow: Abc::new(0.5, 0.5, 0.5),
             legs: [Leg::default(); 3],
             sample: 0,
+            dc_link_scale: 1.0,
         })
     }
 
@@ -300,9 +303,16 @@ impl Inverter {
         self.sample as f64 * self.ts
     }
 
-    /// DC-link voltage over the present sample.
+    /// DC-link voltage over the present sample (with the dip of
+    /// [`set_dc_link_scale`](Self::set_dc_link_scale)).
     pub fn dc_voltage(&self) -> f64 {
-        self.params.dc_voltage_at(self.time())
+        self.params.dc_voltage_at(self.time()) * self.dc_link_scale
+    }
+
+    /// Scales the DC-link voltage from the present sample on (1 = nominal; a supply dip of
+    /// `crate::faults`).
+    pub fn set_dc_link_scale(&mut self, scale: f64) {
+        self.dc_link_scale = scale;
     }
 
     /// Runs one sample [n, n+1]: the duty loaded at the previous update acts now, and

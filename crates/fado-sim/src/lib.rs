@@ -47,6 +47,7 @@ pub mod controller;
 pub mod drive;
 pub mod error;
 mod fastmath;
+pub mod faults;
 pub mod inverter;
 pub mod load;
 pub mod motor;

@@ -714,6 +714,30 @@ pub fn simulate(
     run_config(scenario, cfg, progress)
 }
 
+impl SimConfig {
+    /// The closed loop of this configuration around `controller`: the plant at rest at
+    /// `simulation.initial_angle`, the speed reference, the k_df-off events; the controller
+    /// aligned (with `simulation.align_error`). Step it or [`Simulation::run`] it.
+    pub fn simulation<C: Controller>(
+        &self,
+        controller: C,
+    ) -> Result<Simulation<C>, SimConfigError> {
+        let plant = Plant::new(&self.plant(), self.simulation.initial_angle)?;
+        let mut events = Vec::new();
+        for w in &self.simulation.disturbance_feedback_off {
+            events.push((w[0], ControlEvent::DisturbanceFeedback(false)));
+            events.push((w[1], ControlEvent::DisturbanceFeedback(true)));
+        }
+        Ok(Simulation::new(
+            plant,
+            controller,
+            self.speed_reference.clone(),
+            self.simulation.align_error,
+        )?
+        .with_events(events))
+    }
+}
+
 /// Runs a scenario's criteria on an explicit configuration.
 pub fn run_config(
     scenario: &str,
@@ -759,19 +783,7 @@ fn run_with<C: Controller>(
     started: Instant,
     progress: Option<&mut dyn FnMut(f64)>,
 ) -> Result<Outcome, SimConfigError> {
-    let plant = Plant::new(&cfg.plant(), cfg.simulation.initial_angle)?;
-    let mut events = Vec::new();
-    for w in &cfg.simulation.disturbance_feedback_off {
-        events.push((w[0], ControlEvent::DisturbanceFeedback(false)));
-        events.push((w[1], ControlEvent::DisturbanceFeedback(true)));
-    }
-    let mut sim = Simulation::new(
-        plant,
-        drive,
-        cfg.speed_reference.clone(),
-        cfg.simulation.align_error,
-    )?
-    .with_events(events);
+    let mut sim = cfg.simulation(drive)?;
     let mut metrics = Metrics::new(
         cfg.simulation.eval_start,
         cfg.simulation.zero_speed_band_rpm,

@@ -12,6 +12,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::controller::{Actuation, ControlEvent, Controller, Measurements};
 use crate::error::SimConfigError;
+use crate::faults::{FaultParams, Faults};
 use crate::inverter::{Inverter, InverterParams, SampleOutcome};
 use crate::load::{Load, LoadParams};
 use crate::motor::{Motor, MotorParams};
@@ -34,6 +35,8 @@ pub struct PlantParams {
     pub dc_link_sensor: DcLinkSensorParams,
     /// Load machine.
     pub load: LoadParams,
+    /// Injected faults (none by default).
+    pub faults: FaultParams,
 }
 
 impl PlantParams {
@@ -50,6 +53,7 @@ impl PlantParams {
             .validate()
             .map_err(|e| e.in_section("dc_link_sensor"))?;
         self.load.validate().map_err(|e| e.in_section("load"))?;
+        self.faults.validate().map_err(|e| e.in_section("faults"))?;
         Ok(())
     }
 }
@@ -65,6 +69,7 @@ pub struct Plant {
     encoder: Encoder,
     load_torque: f64,
     last: SampleOutcome,
+    faults: Option<Faults>,
 }
 
 impl Plant {
@@ -82,6 +87,14 @@ impl Plant {
             encoder: Encoder::default(),
             load_torque: 0.0,
             last: SampleOutcome::default(),
+            faults: if params.faults.is_empty() {
+                None
+            } else {
+                Some(
+                    Faults::new(params.faults.clone(), params.inverter.sample_period())
+                        .map_err(|e| s(e, "faults"))?,
+                )
+            },
         })
     }
 
@@ -125,12 +138,23 @@ impl Plant {
         self.motor.i_ab().to_abc()
     }
 
-    /// Samples the sensors now: (currents, DC-link voltage, encoder mechanical angle).
+    /// Samples the sensors now: (currents, DC-link voltage, encoder mechanical angle), with
+    /// the configured faults applied (a DC-link dip acts on the inverter from this sample on).
     pub fn measure(&mut self) -> (Abc<f64>, f64, f64) {
+        if let Some(f) = self.faults.as_mut() {
+            let k = f.dc_link_scale(self.inverter.time());
+            self.inverter.set_dc_link_scale(k);
+        }
         let i = self.current_sensor.measure(self.phase_currents());
         let vdc = self.dc_link_sensor.measure(self.inverter.dc_voltage());
         let enc = self.encoder.angle_mech(self.motor.state().theta_mech);
-        (i, vdc, enc)
+        match &self.faults {
+            Some(f) => {
+                let (i, vdc) = f.corrupt(self.inverter.time(), i, vdc);
+                (i, vdc, enc)
+            }
+            None => (i, vdc, enc),
+        }
     }
 
     /// Integrates one sample [n, n+1] and loads `duty_next` for [n+1, n+2].
@@ -191,8 +215,9 @@ pub struct Sample {
     /// Stator voltage the inverter actually applied over the previous sample [n−1, n]
     /// (time average, α-β), V.
     pub v_ab_applied: fado_core::Ab<f64>,
-    /// Measured current (sensor model) in α-β, as the controller computes it from the
-    /// measured phase currents, A.
+    /// Measured current in α-β as the controller's estimator was given it (offset-corrected,
+    /// a stuck channel reconstructed) when the controller reports it, else the Clarke
+    /// transform of the measured phase currents, A.
     pub i_ab_measured: fado_core::Ab<f64>,
     /// The controller's output at this sample.
     pub act: Actuation,
@@ -306,7 +331,7 @@ impl<C: Controller> Simulation<C> {
             torque: self.plant.last_outcome().torque_avg,
             load_torque: self.plant.load_torque(),
             v_ab_applied: self.plant.last_outcome().v_ab_avg,
-            i_ab_measured: i_abc.to_ab(),
+            i_ab_measured: act.i_ab_used.unwrap_or_else(|| i_abc.to_ab()),
             pole_pairs: self.pole_pairs,
             act,
         };
@@ -505,7 +530,8 @@ pub struct TraceRow {
     pub v_alpha_applied: f64,
     /// Applied voltage β, V.
     pub v_beta_applied: f64,
-    /// Measured current α (what the estimator sees at this sample), A.
+    /// Measured current α as the estimator sees it at this sample (offset-corrected, a stuck
+    /// channel reconstructed), A.
     pub i_alpha: f64,
     /// Measured current β, A.
     pub i_beta: f64,
@@ -513,12 +539,16 @@ pub struct TraceRow {
     pub rs_hat: f64,
     /// The estimator's flux-magnitude reference λ̂f, Wb (moves with `rs_adaptation`).
     pub flux_linkage_hat: f64,
+    /// The drive's status word (`fado_core::DriveFlags` bits: 1 input rejected, 2 tripped,
+    /// 4 voltage saturated, 8 current error, 16 sensor stuck, 32 DC link low, 64 limiter
+    /// mode).
+    pub fault_flags: u16,
 }
 
 impl TraceRow {
     /// Column names, in CSV order (for struct-of-arrays consumers such as the Python
     /// bindings).
-    pub const COLUMNS: [&'static str; 38] = [
+    pub const COLUMNS: [&'static str; 39] = [
         "time",
         "theta",
         "theta_hat",
@@ -557,10 +587,11 @@ impl TraceRow {
         "i_beta",
         "rs_hat",
         "flux_linkage_hat",
+        "fault_flags",
     ];
 
     /// The row's values in [`COLUMNS`](Self::COLUMNS) order (flags as 0.0/1.0).
-    pub fn values(&self) -> [f64; 38] {
+    pub fn values(&self) -> [f64; 39] {
         [
             self.time,
             self.theta,
@@ -600,6 +631,7 @@ impl TraceRow {
             self.i_beta,
             self.rs_hat,
             self.flux_linkage_hat,
+            self.fault_flags as f64,
         ]
     }
 }
@@ -646,6 +678,7 @@ impl From<&Sample> for TraceRow {
             i_beta: s.i_ab_measured.beta,
             rs_hat: d.rs_hat,
             flux_linkage_hat: d.flux_linkage_hat,
+            fault_flags: s.act.flags.bits(),
         }
     }
 }

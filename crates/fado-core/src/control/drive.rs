@@ -3,8 +3,10 @@
 //!
 //! Order of operations at sample n (SPEC §1, §5):
 //!
-//! 1. Reject non-finite inputs; trip (gates off, latched) when a phase current exceeds
-//!    `trip_current`.
+//! 1. Reject non-finite inputs (trip after `input_fault_trip_samples` in a row); trip (gates
+//!    off, latched) when a phase current exceeds `trip_current`; replace a phase-current
+//!    channel that reads about zero against a clear reference by a model reconstruction
+//!    ([`StuckChannelDetector`]).
 //! 2. Estimator with the α-β currents sampled now and the voltage that acted over
 //!    [n−1, n]: the realised reference computed at n−2 (computation delay: a duty computed at
 //!    n is loaded at n+1 and acts over [n+1, n+2]), before dead-time compensation.
@@ -18,6 +20,7 @@
 //!    the inverter produces once its non-linearity has eaten v_comp.
 //! 8. Anti-windup: the realised reference, back in the same advanced d-q frame, feeds the
 //!    current PIs; it enters the two-deep history for the estimator.
+//! 9. The status word [`DriveFlags`] of the sample is formed and counted.
 
 use crate::control::current_controller::{CurrentController, CurrentControllerConfig};
 use crate::control::dead_time_compensation::{
@@ -25,6 +28,7 @@ use crate::control::dead_time_compensation::{
 };
 use crate::control::delay_compensation::{DelayCompensation, DelayCompensationConfig};
 use crate::control::modulation::{ModulatorConfig, SpaceVectorModulator, VoltageLimit};
+use crate::control::monitor::{DriveFlags, FlagCounts, PersistenceMonitor, StuckChannelDetector};
 use crate::control::speed_controller::{
     SpeedController, SpeedControllerConfig, limit_current_d_priority,
 };
@@ -99,6 +103,31 @@ pub struct DriveConfig<T> {
     /// Fig. 6 removes only its radial part, its tangential part walks θ̂ (fado-sim fig10).
     /// 1000 samples reduce 10 mA rms noise to 0.3 mA.
     pub offset_calibration_samples: u32,
+    /// Stuck current-sensor detection: a channel reading within ±this of zero (A) while the
+    /// reference asks for at least `stuck_sensor_min_reference` in its phase. Default 0.25 A
+    /// \[A\]: 10 LSB of the 12-bit ±50 A ADC and 25σ of the 10 mA sensor noise (SPEC §6).
+    pub stuck_sensor_band: T,
+    /// Stuck current-sensor detection: the reference's phase component (A) from which a
+    /// near-zero reading is implausible. Default 2 A \[A\] (half of I_min: every running state
+    /// has |i_dq*| ≥ I_min, so some phase always carries ≥ 0.866·I_min).
+    pub stuck_sensor_min_reference: T,
+    /// Stuck current-sensor detection: samples in a row before a channel is judged stuck; 0
+    /// disables the detector. Default 5 (0.5 ms, < 1 current-loop time constant) \[A\].
+    pub stuck_sensor_samples: u32,
+    /// Current-error monitor: |i_dq* − i_dq| above this (A) counts as an error. Default 5 A
+    /// \[A\] (more than the 4 A injection step the loop takes at start-up).
+    pub current_error_limit: T,
+    /// Current-error monitor: samples in a row before `CURRENT_ERROR` is raised; 0 disables
+    /// it. Default 20 (2 ms ≈ 3 time constants of the 250 Hz current loop) \[A\].
+    pub current_error_samples: u32,
+    /// DC-link under-voltage warning level in V: `DC_LINK_LOW` below it. Default 200 V \[A\]
+    /// (about 2/3 of the 300–311 V link of SPEC §5; the modulation always uses the measured
+    /// voltage, the flag only reports it).
+    pub dc_link_min_voltage: T,
+    /// Consecutive rejected (non-finite) samples after which the drive trips; 0 never trips
+    /// on bad input. Default 100 (10 ms) \[A\]: a single bad sample is ridden through with the
+    /// duty held, a sensor chain that stays broken is a fault.
+    pub input_fault_trip_samples: u32,
 }
 
 impl<T: Real> Default for DriveConfig<T> {
@@ -130,6 +159,13 @@ impl<T: Real> Default for DriveConfig<T> {
             current_anti_windup_ratio: T::one(),
             speed_anti_windup_ratio: T::lit(5.0),
             offset_calibration_samples: 1000,
+            stuck_sensor_band: T::lit(0.25),
+            stuck_sensor_min_reference: T::lit(2.0),
+            stuck_sensor_samples: 5,
+            current_error_limit: T::lit(5.0),
+            current_error_samples: 20,
+            dc_link_min_voltage: T::lit(200.0),
+            input_fault_trip_samples: 100,
         }
     }
 }
@@ -166,9 +202,34 @@ pub struct DriveOutput<T> {
     pub v_dq_ref: Dq<T>,
     /// The voltage reference (with dead-time compensation) had to be limited.
     pub voltage_saturated: bool,
+    /// The status word of this sample: faults and warnings (see [`DriveFlags`]).
+    pub flags: DriveFlags,
+    /// The α-β current the estimator was given this sample (A): the measurement with the
+    /// calibrated offsets removed and a stuck channel reconstructed (the last good current
+    /// after a non-finite one; the raw measurement while calibrating or tripped).
+    pub i_ab: Ab<T>,
 }
 
 impl<T: Real> DriveOutput<T> {
+    /// True when every number in the output is finite (the drive guarantees it; tests check).
+    pub fn is_finite(&self) -> bool {
+        let d = &self.estimate.diagnostics;
+        self.duty.is_finite()
+            && self.v_ref_ab.is_finite()
+            && self.i_dq.is_finite()
+            && self.i_dq_ref.is_finite()
+            && self.v_dq_ref.is_finite()
+            && self.i_ab.is_finite()
+            && self.estimate.theta.is_finite()
+            && self.estimate.omega.is_finite()
+            && self.estimate.omega_control.is_finite()
+            && d.lambda1.is_finite()
+            && d.disturbance.is_finite()
+            && d.lambda2.is_finite()
+            && d.lambda_r.is_finite()
+            && d.theta_direct.is_finite()
+    }
+
     fn idle(estimate: Estimate<T>) -> Self {
         let half = T::lit(0.5);
         Self {
@@ -182,6 +243,8 @@ impl<T: Real> DriveOutput<T> {
             input_fault: false,
             v_dq_ref: Dq::zero(),
             voltage_saturated: false,
+            flags: DriveFlags::NONE,
+            i_ab: Ab::zero(),
         }
     }
 }
@@ -222,6 +285,16 @@ impl<T: Real> Blocks<T> {
                 expected: "above i_max",
             });
         }
+        let band = check::non_negative("stuck_sensor_band", c.stuck_sensor_band)?;
+        let min_ref = check::positive("stuck_sensor_min_reference", c.stuck_sensor_min_reference)?;
+        if min_ref <= band {
+            return Err(ConfigError::OutOfRange {
+                field: "stuck_sensor_min_reference",
+                expected: "above stuck_sensor_band",
+            });
+        }
+        check::positive("current_error_limit", c.current_error_limit)?;
+        check::non_negative("dc_link_min_voltage", c.dc_link_min_voltage)?;
         let rename = |map: &'static [(&'static str, &'static str)]| {
             move |e: ConfigError| {
                 let field = map
@@ -349,6 +422,19 @@ pub struct SensorlessDrive<T, E = SensorlessEstimator<T>> {
     current_offset: Abc<T>,
     /// The angle of the last `align`, re-applied when the calibration ends.
     aligned_angle: T,
+    /// Stuck phase-current channel detection and reconstruction.
+    stuck_sensor: StuckChannelDetector<T>,
+    /// Persistent current-control error.
+    current_error: PersistenceMonitor,
+    /// The latest verdicts of the two monitors (kept over rejected samples).
+    sensor_stuck_now: bool,
+    current_error_now: bool,
+    /// Rejected samples in a row (trips at `input_fault_trip_samples`).
+    consecutive_rejects: u32,
+    /// Samples each flag was raised since the last reset.
+    flag_counts: FlagCounts,
+    /// The α-β current of this sample as reported in [`DriveOutput::i_ab`].
+    i_ab_used: Ab<T>,
 }
 
 impl<T: Real> SensorlessDrive<T, SensorlessEstimator<T>> {
@@ -383,6 +469,17 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             calibration_sum: Abc::new(T::zero(), T::zero(), T::zero()),
             current_offset: Abc::new(T::zero(), T::zero(), T::zero()),
             aligned_angle: T::zero(),
+            stuck_sensor: StuckChannelDetector::new(
+                config.stuck_sensor_band,
+                config.stuck_sensor_min_reference,
+                config.stuck_sensor_samples,
+            ),
+            current_error: PersistenceMonitor::new(config.current_error_samples),
+            sensor_stuck_now: false,
+            current_error_now: false,
+            consecutive_rejects: 0,
+            flag_counts: FlagCounts::default(),
+            i_ab_used: Ab::zero(),
         };
         drive.reset();
         Ok(drive)
@@ -397,6 +494,8 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         self.last_i_ab = Ab::zero();
         self.tripped = false;
         self.rejected_samples = 0;
+        self.consecutive_rejects = 0;
+        self.flag_counts.reset();
         self.calibrate_offsets();
     }
 
@@ -468,6 +567,10 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
 
     fn clear_control(&mut self, theta: T) {
         self.blocks.reset();
+        self.stuck_sensor.reset();
+        self.current_error.reset();
+        self.sensor_stuck_now = false;
+        self.current_error_now = false;
         self.history = [Ab::zero(); 2];
         self.last = DriveOutput::idle(Estimate {
             theta,
@@ -494,7 +597,55 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
     /// the interval with the last good current so that it keeps time. A phase current above
     /// `trip_current` trips the drive: gates off, duties ½, latched until [`reset`](Self::reset);
     /// while tripped nothing is stepped.
+    ///
+    /// Every output carries the status word [`DriveOutput::flags`]; the drive also counts the
+    /// samples each flag was raised ([`flag_counts`](Self::flag_counts)). A stuck
+    /// phase-current channel (see [`StuckChannelDetector`]) is replaced by its reconstruction
+    /// while it lasts; `input_fault_trip_samples` rejected samples in a row trip the drive.
     pub fn step(&mut self, i_abc: Abc<T>, vdc: T, speed_ref_mech: T) -> DriveOutput<T> {
+        let mut out = self.step_control(i_abc, vdc, speed_ref_mech);
+        if out.input_fault && !out.tripped {
+            self.consecutive_rejects = self.consecutive_rejects.saturating_add(1);
+            let limit = self.config.input_fault_trip_samples;
+            if limit > 0 && self.consecutive_rejects >= limit {
+                self.tripped = true;
+                self.trip_output();
+                out = self.last;
+                out.input_fault = true;
+            }
+        } else {
+            self.consecutive_rejects = 0;
+        }
+        let mut flags = DriveFlags::NONE;
+        flags.set(DriveFlags::INPUT_REJECTED, out.input_fault);
+        flags.set(DriveFlags::TRIPPED, out.tripped);
+        let running = out.gates_enabled && !out.tripped;
+        flags.set(
+            DriveFlags::VOLTAGE_SATURATED,
+            running && out.voltage_saturated,
+        );
+        flags.set(DriveFlags::CURRENT_ERROR, running && self.current_error_now);
+        flags.set(DriveFlags::SENSOR_STUCK, running && self.sensor_stuck_now);
+        flags.set(
+            DriveFlags::DC_LINK_LOW,
+            vdc.is_finite() && vdc < self.config.dc_link_min_voltage,
+        );
+        flags.set(
+            DriveFlags::LIMITER_MODE,
+            out.estimate.diagnostics.flag_limit,
+        );
+        out.flags = flags;
+        out.i_ab = self.i_ab_used;
+        self.last.flags = flags;
+        self.last.i_ab = self.i_ab_used;
+        self.flag_counts.record(flags);
+        out
+    }
+
+    fn step_control(&mut self, i_abc: Abc<T>, vdc: T, speed_ref_mech: T) -> DriveOutput<T> {
+        // What this sample reports as its current until the estimator is given another.
+        let raw = i_abc.to_ab();
+        self.i_ab_used = if raw.is_finite() { raw } else { self.last_i_ab };
         let finite = i_abc.is_finite() && vdc.is_finite() && speed_ref_mech.is_finite();
         if self.tripped {
             let mut out = self.last;
@@ -520,12 +671,28 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             self.last.input_fault = false;
             return self.last;
         }
+        // Stuck-channel check against the reference the loop was tracking, advanced by the
+        // rotation over one sample; an implausible channel is replaced by its reconstruction
+        // from the model prediction.
+        let prev = self.last.estimate;
+        let rot_ref = Rotation::from_angle(prev.theta + prev.omega * self.config.ts);
+        let i_model = self.predicted_current().unwrap_or_else(|| i_abc.to_ab());
+        let (ia, ib, stuck) =
+            self.stuck_sensor
+                .step(i_abc.a, i_abc.b, self.last.i_dq_ref.to_ab(rot_ref), i_model);
+        self.sensor_stuck_now = stuck;
+        let i_abc = if ia != i_abc.a || ib != i_abc.b {
+            Abc::new(ia, ib, -ia - ib)
+        } else {
+            i_abc
+        };
         let i_ab = i_abc.to_ab();
         if !i_ab.is_finite() {
             return self.reject(i_abc);
         }
 
         // 2. Estimator: voltage of [n−1, n] = realised reference computed at n−2.
+        self.i_ab_used = i_ab;
         let estimate = self.estimator.step(self.history[1], i_ab);
         if !estimate_is_finite(&estimate) {
             // An estimator that went non-finite cannot steer the drive: hold like a bad input
@@ -538,6 +705,10 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         let rot_theta = Rotation::from_angle(estimate.theta);
         let i_dq = i_ab.to_dq(rot_theta);
         let omega_ctrl = estimate.omega_control;
+        let tracking_error = (self.last.i_dq_ref - i_dq).norm();
+        self.current_error_now = self
+            .current_error
+            .step(tracking_error > self.config.current_error_limit);
 
         // 4. Speed loop, injection (23) and current-vector limit.
         let backup = self.blocks;
@@ -588,8 +759,27 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             input_fault: false,
             v_dq_ref: v_dq_realised,
             voltage_saturated: m.saturated,
+            flags: DriveFlags::NONE, // set by `step`
+            i_ab,
         };
         self.last
+    }
+
+    /// The current at this sample predicted from the last one used (measured or
+    /// reconstructed) by the machine model over [n−1, n]: L̂q·di/dt = v − R̂s·i − jω̂·λ̂r with
+    /// the voltage that acted (the realised reference computed at n−2) and the estimator's
+    /// last rotor flux and speed. Exact in form for the SPMSM (L̂d = L̂q); forward Euler is
+    /// enough at R̂s·Ts/L̂q ≈ 0.012. None when the prediction is no plausible current
+    /// (non-finite, or beyond the trip level after absurd inputs): the readings are used.
+    fn predicted_current(&self) -> Option<Ab<T>> {
+        let c = &self.config;
+        let e = &self.last.estimate;
+        let lr = e.diagnostics.lambda_r;
+        let emf = Ab::new(-lr.beta, lr.alpha) * e.omega;
+        let i = self.last_i_ab;
+        let predicted = i + (self.history[1] - i * c.rs_hat - emf) * (c.ts / c.lq_hat);
+        let n = predicted.norm();
+        (n.is_finite() && n <= c.trip_current).then_some(predicted)
     }
 
     /// Rejected sample: hold the duty, keep the estimator's clock with the last good current.
@@ -600,6 +790,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         } else {
             self.last_i_ab
         };
+        self.i_ab_used = i_ab;
         let estimate = self.estimator.step(self.history[1], i_ab);
         let mut out = self.last;
         if estimate_is_finite(&estimate) {
@@ -659,6 +850,21 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
     /// Samples rejected since the last reset.
     pub fn rejected_samples(&self) -> u32 {
         self.rejected_samples
+    }
+
+    /// Samples each [`DriveFlags`] bit was raised since the last reset.
+    pub fn flag_counts(&self) -> &FlagCounts {
+        &self.flag_counts
+    }
+
+    /// The current PIs' integral states (V, d and q): bounded in any healthy run.
+    pub fn current_integral(&self) -> Dq<T> {
+        self.blocks.current.integral()
+    }
+
+    /// The speed PI's integral state (A of i_q*).
+    pub fn speed_integral(&self) -> T {
+        self.blocks.speed.integral()
     }
 
     /// The realised references computed at n−1 and n−2 (the latter is what the estimator

@@ -10,6 +10,7 @@ pub mod dead_time_compensation;
 pub mod delay_compensation;
 pub mod drive;
 pub mod modulation;
+pub mod monitor;
 pub mod pi;
 pub mod speed_controller;
 
@@ -20,5 +21,6 @@ pub use dead_time_compensation::{
 pub use delay_compensation::{DelayCompensation, DelayCompensationConfig};
 pub use drive::{DriveConfig, DriveOutput, SensorlessDrive};
 pub use modulation::{Modulation, ModulatorConfig, SpaceVectorModulator, VoltageLimit, svpwm_duty};
+pub use monitor::{DriveFlags, FlagCounts};
 pub use pi::{Pi, PiConfig};
 pub use speed_controller::{SpeedController, SpeedControllerConfig, limit_current_d_priority};
