@@ -696,7 +696,9 @@ mod tests {
         assert_eq!(e.key, "faults.stuck_current[0].duration", "{e}");
         let e = SimConfig::from_toml("[[faults.non_finite]]\ntime = 1.0\nsignal = \"dc\"\n")
             .unwrap_err();
-        assert!(e.key.starts_with("faults.non_finite"), "{e}");
+        // A serde type error: located at the bad value (line 3) rather than named by key.
+        assert_eq!(e.location.as_ref().map(|l| l.line), Some(3), "{e}");
+        assert!(e.message.contains("`dc`"), "{e}");
         let ok = SimConfig::from_toml(
             "[[faults.non_finite]]\ntime = 1.0\nsignal = \"dc_link\"\n\
              [faults.dc_link_scale]\npoints = [[1.0, 1.0], [1.1, 0.5]]\n",

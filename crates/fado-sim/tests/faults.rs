@@ -188,7 +188,11 @@ fn non_finite_samples_at_standstill_under_load_are_ridden_through() {
         [[faults.non_finite]]\ntime = 3.0\nsignal = \"current_a\"\nsamples = 5\n\
         [[faults.non_finite]]\ntime = 3.2\nsignal = \"dc_link\"\nvalue = \"neg_inf\"\n";
     let r = run("fig10", &format!("{STANDSTILL}{faults}"));
-    let before = r.max_angle_error(2.8, 3.0);
+    // The same run without the fault: a held-still rotor under load drifts by itself (the
+    // paper's standstill limit; with R̂s adaptation at 0.07 rad/s here), which is not the
+    // fault's doing.
+    let reference = run("fig10", STANDSTILL);
+    let before = reference.max_angle_error(3.0, 4.0);
     let after = r.max_angle_error(3.0, 4.0);
     println!(
         "non-finite, 0 r/min 7.5 N·m: {} rejected, max |θ−θ̂| before {before:.4}, after {after:.4} rad",
@@ -196,7 +200,7 @@ fn non_finite_samples_at_standstill_under_load_are_ridden_through() {
     );
     assert_eq!(r.flagged(DriveFlags::INPUT_REJECTED, 0.0, 10.0), 6);
     assert!(!r.tripped());
-    // The standstill error does not change by more than 0.01 rad through the fault.
+    // The fault adds less than 0.01 rad to the standstill error of the run without it.
     assert!(after < before + 0.01, "{before} → {after}");
 }
 
@@ -270,7 +274,8 @@ fn stuck_current_channel_is_detected_and_ridden_through_at_standstill_under_load
     for channel in ["a", "b"] {
         let r = run("fig10", &format!("{STANDSTILL}{}", stuck(channel, 3.0)));
         let detected = r.first_flag(DriveFlags::SENSOR_STUCK, 3.0).map(|t| t - 3.0);
-        let before = r.max_angle_error(2.8, 3.0);
+        // Against the same run without the fault (see the test above).
+        let before = run("fig10", STANDSTILL).max_angle_error(3.0, 4.0);
         let err = r.max_angle_error(3.0, 4.0);
         let peak = r.max_current(3.0, 3.02);
         println!(
@@ -282,8 +287,8 @@ fn stuck_current_channel_is_detected_and_ridden_through_at_standstill_under_load
         // At standstill the current vector stands still: with 14 A along q the stuck phase
         // carries ≥ 2 A unless the vector is within 8° of perpendicular to it.
         assert!(detected.is_some_and(|d| d < 1e-3), "{detected:?}");
-        // The standstill error does not change by more than 0.01 rad through the fault, nor
-        // the current by more than 10 %.
+        // The fault adds less than 0.01 rad to the standstill error of the run without it, and
+        // the current rises by less than 10 %.
         assert!(err < before + 0.01, "{before} → {err}");
         assert!(peak < 1.1 * r.max_current(2.8, 3.0), "{peak}");
         assert!(!r.tripped());
@@ -350,12 +355,16 @@ fn deep_dc_link_dip_at_rated_speed_saturates_is_flagged_and_recovers() {
 
 /// A sudden load step at zero speed: fig10's no-load standstill (0 r/min from 1.7 s), then
 /// T_L steps from 0 to `torque` at 3 s; run to 4.5 s.
+/// The step is applied after fig10's stop and 1.3 s of standstill, with the paper's fixed R̂s:
+/// with R̂s adaptation the seed-1 stop itself leaves ≈ 0.3 rad before the step (fig10 is
+/// seed-dependent either way, see tests/sim_rs_adaptation.rs), which is not what this measures.
 fn load_step(torque: f64) -> Run {
     run(
         "fig10",
         &format!(
             "[simulation]\nduration = 4.5\n\
-             [load.torque]\npoints = [[3.0, 0.0], [3.0, {torque}]]\n"
+             [load.torque]\npoints = [[3.0, 0.0], [3.0, {torque}]]\n\
+             [estimator]\nrs_adaptation = false\n"
         ),
     )
 }
