@@ -4,6 +4,7 @@
 //!
 //! ```text
 //! cargo run --release -p fado-core --example step_driver -- f32 100000
+//! FIXED_RS=1 cargo run ...   # the paper's fixed R̂s (rs_adaptation = false)
 //! ```
 
 use std::hint::black_box;
