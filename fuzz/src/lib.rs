@@ -86,6 +86,10 @@ pub struct EstimatorCase {
     pub fields: [Option<Num>; 15],
     /// `average_current`, `observer_on_rotor_flux`, natural-frequency bandwidths.
     pub flags: [bool; 3],
+    /// The R̂s-adaptation fields in the order of `EstimatorConfig` (None = default).
+    pub adaptation: [Option<Num>; 5],
+    /// `rs_adaptation`, `limiter_recentring` (None = default).
+    pub adaptation_flags: [Option<bool>; 2],
     /// What to do.
     pub actions: Vec<EstimatorAction>,
 }
@@ -118,6 +122,19 @@ impl EstimatorCase {
             } else {
                 BandwidthDefinition::Minus3Db
             },
+            rs_adaptation: self.adaptation_flags[0].unwrap_or(d.rs_adaptation),
+            rs_adaptation_rate: field(self.adaptation[0], d.rs_adaptation_rate),
+            rs_adaptation_excitation_floor: field(
+                self.adaptation[1],
+                d.rs_adaptation_excitation_floor,
+            ),
+            rs_adaptation_min_ratio: field(self.adaptation[2], d.rs_adaptation_min_ratio),
+            rs_adaptation_max_ratio: field(self.adaptation[3], d.rs_adaptation_max_ratio),
+            flux_linkage_adaptation_rate: field(
+                self.adaptation[4],
+                d.flux_linkage_adaptation_rate,
+            ),
+            limiter_recentring: self.adaptation_flags[1].unwrap_or(d.limiter_recentring),
         }
     }
 

@@ -92,7 +92,8 @@ pub struct ResistanceAdaptationConfig<T> {
     /// at start-up is the standstill law's.
     pub rate: T,
     /// χ0: the excitation (relative flux error per relative resistance error) below which the
-    /// adaptation slows down in proportion to χ². Default 0.2 (ours \[A\]: a 1 % R̂s error then
+    /// turning law is frozen, and the scale of its normalisation χ/(χ² + χ0²); the standstill
+    /// law waits until ∫i_d·R0/λ̂f reaches it. Default 0.2 (ours \[A\]: a 1 % R̂s error then
     /// moves |λ̂r| by 0.2 %, the size of the estimator's ripple).
     pub excitation_floor: T,
     /// L̂q in H, for the d-axis voltage at standstill. Default 2.63 mH (paper, V).
