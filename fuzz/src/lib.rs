@@ -130,10 +130,7 @@ impl EstimatorCase {
             ),
             rs_adaptation_min_ratio: field(self.adaptation[2], d.rs_adaptation_min_ratio),
             rs_adaptation_max_ratio: field(self.adaptation[3], d.rs_adaptation_max_ratio),
-            flux_linkage_adaptation_rate: field(
-                self.adaptation[4],
-                d.flux_linkage_adaptation_rate,
-            ),
+            flux_linkage_adaptation_rate: field(self.adaptation[4], d.flux_linkage_adaptation_rate),
             limiter_recentring: self.adaptation_flags[1].unwrap_or(d.limiter_recentring),
         }
     }
