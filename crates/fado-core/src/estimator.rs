@@ -241,6 +241,23 @@ pub struct Estimate<T> {
     pub diagnostics: Diagnostics<T>,
 }
 
+impl<T: Real> Estimate<T> {
+    /// True when every number in it (outputs and diagnostics) is finite.
+    pub fn is_finite(&self) -> bool {
+        let d = &self.diagnostics;
+        self.theta.is_finite()
+            && self.omega.is_finite()
+            && self.omega_control.is_finite()
+            && d.lambda1.is_finite()
+            && d.disturbance.is_finite()
+            && d.lambda2.is_finite()
+            && d.lambda_r.is_finite()
+            && d.theta_direct.is_finite()
+            && d.rs_hat.is_finite()
+            && d.flux_linkage_hat.is_finite()
+    }
+}
+
 /// The sensorless estimator of Fig. 5, generic over `f32` and `f64`, allocation-free.
 ///
 /// ```
@@ -357,6 +374,10 @@ impl<T: Real> SensorlessEstimator<T> {
                     "min_ratio" => rename("rs_adaptation_min_ratio")(e),
                     "max_ratio" => rename("rs_adaptation_max_ratio")(e),
                     "flux_linkage_rate" => rename("flux_linkage_adaptation_rate")(e),
+                    // Fixed rates of the block that only a sampling period can make unstable.
+                    "standstill_rate" | "standstill_memory_hz" | "standstill_flux_rate" => {
+                        rename("ts")(e)
+                    }
                     _ => e,
                 }
             })?;
@@ -610,18 +631,17 @@ impl<T: Real> SensorlessEstimator<T> {
     /// Replaces R̂s at run time, as if it had been configured (an external estimate, or a
     /// value saved from the last run): the integrator uses it from the next sample, and with
     /// [`EstimatorConfig::rs_adaptation`] the adaptation restarts from it, scaled and bounded
-    /// around it. Refuses bad values and then changes nothing.
+    /// around it (a learned λ̂f goes back to the configured one too). Refuses bad values and
+    /// then changes nothing.
     pub fn set_rs_hat(&mut self, rs_hat: T) -> Result<(), ConfigError> {
-        let config = EstimatorConfig {
-            rs_hat,
-            ..self.config
-        };
-        check::non_negative("rs_hat", rs_hat)?;
-        let adaptation = ResistanceAdaptation::new(config.rs_adaptation_config())
-            .map_err(|_| ConfigError::Negative { field: "rs_hat" })?;
         self.integrator.set_rs_hat(rs_hat)?;
-        self.rs_adaptation = adaptation;
-        self.config = config;
+        self.config.rs_hat = rs_hat;
+        if self.config.rs_adaptation {
+            // Cannot fail: R̂s ≥ 0 was just checked and nothing else changed.
+            if let Ok(adaptation) = ResistanceAdaptation::new(self.config.rs_adaptation_config()) {
+                self.rs_adaptation = adaptation;
+            }
+        }
         Ok(())
     }
 

@@ -25,7 +25,7 @@
 //! e = (R̂s − Rs)·φ the law gives d(R̂s − Rs)/dt = −γ·χ²/(χ²+χ0²)·(R̂s − Rs): a first-order
 //! decay at nearly γ wherever it runs, in both motoring and generating quadrants (φ follows the
 //! sign of ω·i_q). It is valid while the adaptation is slow against the flux dynamics (γ ≪ |ω̂|:
-//! 5 s⁻¹ against ≥ 8 rad/s in the k_df mode). Below χ0 it is frozen: there a flux-magnitude
+//! 1 s⁻¹ against ≥ 8 rad/s in the k_df mode). Below χ0 it is frozen: there a flux-magnitude
 //! error from any other cause (the hand-over transient, λ̂f or L̂q errors) would be read as a
 //! large resistance error, e/χ.
 //!
@@ -35,7 +35,7 @@
 //!
 //! ```text
 //!   R_dc = ∫(v_d + ω̂·L̂q·i_q − L̂q·di_d/dt) / ∫i_d    (both integrals forget at ω_m)
-//!   dR̂s/dt = γ_s·(R_dc − R̂s)                         while ∫i_d·R0/λ̂f ≥ χ0
+//!   dR̂s/dt = γ_s·(R_dc − R̂s)                         while ∫i_d·R0/λ̂f ≥ χ0 (configured λ̂f)
 //! ```
 //!
 //! in the estimated frame (d along λ̂r), while |ω̂| is below a small speed (an angle error δ
@@ -59,11 +59,13 @@
 use crate::error::{ConfigError, check};
 use crate::{Ab, Real};
 
-/// Lower bound of the adapted λ̂f as a multiple of the configured one (a sanity bound: NdFeB
-/// loses ≈ 0.1 %/K, so the physical range is ±15 %).
-pub const FLUX_LINKAGE_MIN_RATIO: f64 = 0.5;
-/// Upper bound of the adapted λ̂f as a multiple of the configured one.
-pub const FLUX_LINKAGE_MAX_RATIO: f64 = 1.5;
+/// Lower bound of the adapted λ̂f as a multiple of the configured one (NdFeB loses ≈ 0.1 %/K,
+/// so the physical range is about ±15 %).
+pub const FLUX_LINKAGE_MIN_RATIO: f64 = 0.85;
+/// Upper bound of the adapted λ̂f as a multiple of the configured one: below the Fig. 6
+/// limiter's 1.15, whose circle stays at the configured λ̂f, so that the standstill pull towards
+/// λ̂f never pushes against the limiter.
+pub const FLUX_LINKAGE_MAX_RATIO: f64 = 1.14;
 
 /// Configuration of [`ResistanceAdaptation`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -78,7 +80,7 @@ pub struct ResistanceAdaptationConfig<T> {
     pub flux_linkage_hat: T,
     /// γ_f in s⁻¹: rate at which the flux-magnitude reference λ̂f follows |λ̂r| while turning
     /// without resistance excitation (|χ| < χ0/2: no load, or high speed), 0 = fixed λ̂f
-    /// (bounds 0.5–1.5·λ̂f). Default 0 (ours \[A\]). A λ̂f error biases the turning law by
+    /// (bounds [`FLUX_LINKAGE_MIN_RATIO`]–[`FLUX_LINKAGE_MAX_RATIO`]·λ̂f). Default 0 (ours \[A\]). A λ̂f error biases the turning law by
     /// Δλf·ω/i_q; measured (fado-sim, plant Rs 0.8–1.3× × λf 0.9–1.1×, 15 cases each): at
     /// 5 s⁻¹ Fig. 11 passes 15/15 (5/15 at 0) and Fig. 12 8/15 (5/15), but with λ̂f right the
     /// no-load |λ̂r| it learns from is ≈ 0.7 % low, which costs Fig. 12 margin (0.09 → 0.16
@@ -93,7 +95,7 @@ pub struct ResistanceAdaptationConfig<T> {
     pub rate: T,
     /// χ0: the excitation (relative flux error per relative resistance error) below which the
     /// turning law is frozen, and the scale of its normalisation χ/(χ² + χ0²); the standstill
-    /// law waits until ∫i_d·R0/λ̂f reaches it. Default 0.2 (ours \[A\]: a 1 % R̂s error then
+    /// law waits until ∫i_d·R0/λ̂f (configured λ̂f) reaches it. Default 0.2 (ours \[A\]: a 1 % R̂s error then
     /// moves |λ̂r| by 0.2 %, the size of the estimator's ripple).
     pub excitation_floor: T,
     /// L̂q in H, for the d-axis voltage at standstill. Default 2.63 mH (paper, V).
@@ -335,8 +337,8 @@ impl<T: Real> ResistanceAdaptation<T> {
             let (a_sq, floor_b_sq) = (a * a, self.floor_sq * b * b);
             let lf = self.state.flux_linkage_hat;
             if a_sq >= floor_b_sq && floor_b_sq > T::zero() {
-                let err = (mag - lf) / lf;
-                next.rs_hat -= self.gain * err * a * b / (a_sq + floor_b_sq);
+                // ẽ·χ/(χ² + χ0²) with ẽ = (|λ̂r| − λ̂f)/λ̂f, in one division.
+                next.rs_hat -= self.gain * (mag - lf) * a * b / (lf * (a_sq + floor_b_sq));
             } else if a_sq * T::lit(4.0) < floor_b_sq {
                 // |χ| < χ0/2: R̂s explains too little of |λ̂r| − λ̂f; the rest is λ̂f's.
                 let lf0 = self.config.flux_linkage_hat;
@@ -401,13 +403,6 @@ impl<T: Real> ResistanceAdaptation<T> {
     /// The state now.
     pub fn state(&self) -> &ResistanceAdaptationState<T> {
         &self.state
-    }
-
-    /// Starts again from `rs_hat` (e.g. a value saved from the last run), clamped to the bounds.
-    pub fn set_rs_hat(&mut self, rs_hat: T) -> Result<(), ConfigError> {
-        let r = check::positive("rs_hat", rs_hat)?;
-        self.state.rs_hat = r.max(self.rs_min).min(self.rs_max);
-        Ok(())
     }
 
     /// The configuration in use.

@@ -213,6 +213,8 @@ impl<T: Real> EmfObserverEstimator<T> {
                 lambda2: lambda_s,
                 lambda_r,
                 theta_direct: self.trackers.angle(),
+                rs_hat: self.config.rs_hat,
+                flux_linkage_hat: self.config.flux_linkage_hat,
                 ..Diagnostics::default()
             },
             ..Estimate::default()
@@ -287,6 +289,8 @@ impl<T: Real> GuardedStep<T> for EmfObserverEstimator<T> {
                 lambda_r,
                 theta_direct: t.theta_direct,
                 tracker_hold: t.hold,
+                rs_hat: self.config.rs_hat,
+                flux_linkage_hat: self.config.flux_linkage_hat,
                 ..Diagnostics::default()
             },
         })

@@ -209,6 +209,8 @@ impl<T: Real> LpfIntegratorEstimator<T> {
                 lambda2: self.psi,
                 lambda_r,
                 theta_direct: self.trackers.angle(),
+                rs_hat: self.config.rs_hat,
+                flux_linkage_hat: self.config.flux_linkage_hat,
                 ..Diagnostics::default()
             },
             ..Estimate::default()
@@ -279,6 +281,8 @@ impl<T: Real> GuardedStep<T> for LpfIntegratorEstimator<T> {
                 lambda_r,
                 theta_direct: t.theta_direct,
                 tracker_hold: t.hold,
+                rs_hat: self.config.rs_hat,
+                flux_linkage_hat: self.config.flux_linkage_hat,
                 ..Diagnostics::default()
             },
         })

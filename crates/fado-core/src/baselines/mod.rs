@@ -38,10 +38,6 @@ pub use emf_observer::{EmfObserverConfig, EmfObserverEstimator};
 pub use lpf_integrator::{LpfIntegratorConfig, LpfIntegratorEstimator};
 pub use ortega::{OrtegaConfig, OrtegaEstimator};
 
-/// The sample-rejection rule every baseline shares (the same contract as
-/// [`crate::SensorlessEstimator::step`]): a non-finite input is refused, and a finite but absurd
-/// one that overflows a state is rolled back, so the state is never poisoned; either way the
-/// last good estimate is returned with `input_fault` set and the sample is counted.
 /// The current an `align` may start from: a non-finite one, or one so large that the start-up
 /// flux λ̂f·e^{jθ0} + L̂q·i would overflow (found by fuzzing, f32 with L̂q = 3e37 H), is
 /// taken as zero.
@@ -54,6 +50,10 @@ pub(crate) fn usable_align_current<T: Real>(i_ab: Ab<T>, lq_hat: T, flux_linkage
     if bound.is_finite() { i_ab } else { Ab::zero() }
 }
 
+/// The sample-rejection rule every baseline shares (the same contract as
+/// [`crate::SensorlessEstimator::step`]): a non-finite input is refused, and a finite but absurd
+/// one that overflows a state is rolled back, so the state is never poisoned; either way the
+/// last good estimate is returned with `input_fault` set and the sample is counted.
 pub(crate) trait GuardedStep<T: Real>: Copy {
     /// The estimator's own update; `None` when a new state came out non-finite.
     fn step_unchecked(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> Option<crate::Estimate<T>>;

@@ -279,6 +279,8 @@ impl<T: Real> OrtegaEstimator<T> {
                 lambda2: self.x,
                 lambda_r: eta,
                 theta_direct: self.trackers.angle(),
+                rs_hat: self.config.rs_hat,
+                flux_linkage_hat: self.config.flux_linkage_hat,
                 ..Diagnostics::default()
             },
             ..Estimate::default()
@@ -352,6 +354,8 @@ impl<T: Real> GuardedStep<T> for OrtegaEstimator<T> {
                 lambda_r: eta,
                 theta_direct: t.theta_direct,
                 tracker_hold: t.hold,
+                rs_hat: self.config.rs_hat,
+                flux_linkage_hat: self.config.flux_linkage_hat,
                 ..Diagnostics::default()
             },
         })

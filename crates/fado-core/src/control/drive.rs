@@ -213,21 +213,13 @@ pub struct DriveOutput<T> {
 impl<T: Real> DriveOutput<T> {
     /// True when every number in the output is finite (the drive guarantees it; tests check).
     pub fn is_finite(&self) -> bool {
-        let d = &self.estimate.diagnostics;
         self.duty.is_finite()
             && self.v_ref_ab.is_finite()
             && self.i_dq.is_finite()
             && self.i_dq_ref.is_finite()
             && self.v_dq_ref.is_finite()
             && self.i_ab.is_finite()
-            && self.estimate.theta.is_finite()
-            && self.estimate.omega.is_finite()
-            && self.estimate.omega_control.is_finite()
-            && d.lambda1.is_finite()
-            && d.disturbance.is_finite()
-            && d.lambda2.is_finite()
-            && d.lambda_r.is_finite()
-            && d.theta_direct.is_finite()
+            && self.estimate.is_finite()
     }
 
     fn idle(estimate: Estimate<T>) -> Self {
@@ -774,10 +766,15 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
     fn predicted_current(&self) -> Option<Ab<T>> {
         let c = &self.config;
         let e = &self.last.estimate;
-        let lr = e.diagnostics.lambda_r;
-        let emf = Ab::new(-lr.beta, lr.alpha) * e.omega;
+        let emf = e.diagnostics.lambda_r.mul_j() * e.omega;
+        // The estimator's R̂s when it reports one (it may adapt it), else the configured one.
+        let rs_hat = if e.diagnostics.rs_hat > T::zero() {
+            e.diagnostics.rs_hat
+        } else {
+            c.rs_hat
+        };
         let i = self.last_i_ab;
-        let predicted = i + (self.history[1] - i * c.rs_hat - emf) * (c.ts / c.lq_hat);
+        let predicted = i + (self.history[1] - i * rs_hat - emf) * (c.ts / c.lq_hat);
         let n = predicted.norm();
         (n.is_finite() && n <= c.trip_current).then_some(predicted)
     }
