@@ -666,12 +666,16 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         // Stuck-channel check against the reference the loop was tracking, advanced by the
         // rotation over one sample; an implausible channel is replaced by its reconstruction
         // from the model prediction.
-        let prev = self.last.estimate;
-        let rot_ref = Rotation::from_angle(prev.theta + prev.omega * self.config.ts);
-        let i_model = self.predicted_current().unwrap_or_else(|| i_abc.to_ab());
-        let (ia, ib, stuck) =
-            self.stuck_sensor
-                .step(i_abc.a, i_abc.b, self.last.i_dq_ref.to_ab(rot_ref), i_model);
+        // (Both are only needed when a reading is near zero or a channel is stuck.)
+        let (i_ref_ab, i_model) = if self.stuck_sensor.quiet(i_abc.a, i_abc.b) {
+            (Ab::zero(), Ab::zero())
+        } else {
+            let prev = self.last.estimate;
+            let rot_ref = Rotation::from_angle(prev.theta + prev.omega * self.config.ts);
+            let i_model = self.predicted_current().unwrap_or_else(|| i_abc.to_ab());
+            (self.last.i_dq_ref.to_ab(rot_ref), i_model)
+        };
+        let (ia, ib, stuck) = self.stuck_sensor.step(i_abc.a, i_abc.b, i_ref_ab, i_model);
         self.sensor_stuck_now = stuck;
         let i_abc = if ia != i_abc.a || ib != i_abc.b {
             Abc::new(ia, ib, -ia - ib)

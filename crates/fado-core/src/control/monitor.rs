@@ -235,6 +235,13 @@ impl<T: Real> StuckChannelDetector<T> {
         self.stuck
     }
 
+    /// True when neither reading is near zero and no channel is judged stuck: then `step` needs
+    /// neither the reference nor the model (the caller may pass zeros and skip computing them).
+    #[inline]
+    pub fn quiet(&self, i_a: T, i_b: T) -> bool {
+        i_a.abs() >= self.band && i_b.abs() >= self.band && !self.stuck[0] && !self.stuck[1]
+    }
+
     /// One sample: the (offset-corrected) readings of phases a and b, the current reference
     /// and the model's prediction of the current, both in α-β. Returns the phase currents a
     /// and b to use (readings, or reconstructions of the implausible channels) and whether
