@@ -493,7 +493,7 @@ impl<T: Real> SensorlessEstimator<T> {
         // absurd inputs can still overflow a state, and a rejected sample must leave none of it
         // changed. (Cheaper than copying the estimator as a backup every sample.)
         // 1. Integrate with the feedback of the previous sample (eq. (21) / (24)).
-        let lambda1 = self.integrator.next_flux(v_ab, i_ab, self.feedback);
+        let (lambda1, i_drop) = self.integrator.next_flux(v_ab, i_ab, self.feedback);
         // 2. Disturbance observer at ω̂ of T2S-1 (eq. (10), (16)), on λ1 or on λ1 − L̂q·i
         //    (see `EstimatorConfig::observer_on_rotor_flux`).
         let observer_input = if self.config.observer_on_rotor_flux {
@@ -540,12 +540,6 @@ impl<T: Real> SensorlessEstimator<T> {
         }
         let rs_hat_used = self.integrator.config().rs_hat;
         let flux_linkage_used = self.rs_adaptation.flux_linkage_hat();
-        // (Read before the integrator's commit replaces the previous current.)
-        let i_drop = if self.config.rs_adaptation {
-            self.integrator.drop_current(i_ab)
-        } else {
-            Ab::zero()
-        };
         let previous_mode = self.selector.mode();
         // Limiter mode: re-centre the common mode (see `EstimatorConfig::limiter_recentring`).
         let shift = if mode == Mode::Limiter && self.config.limiter_recentring {

@@ -77,16 +77,19 @@ impl<T: Real> FluxIntegrator<T> {
         if !(v_ab.is_finite() && i_ab.is_finite() && feedback.is_finite()) {
             return Err(NonFiniteInput);
         }
-        let lambda1 = self.next_flux(v_ab, i_ab, feedback);
+        let (lambda1, _) = self.next_flux(v_ab, i_ab, feedback);
         self.commit(lambda1, i_ab);
         Ok(lambda1)
     }
 
-    /// λ1 after one more sample, computed without changing the state.
+    /// λ1 after one more sample, computed without changing the state, and the current it
+    /// multiplied by R̂s (see [`Self::drop_current`]).
     #[inline]
-    pub(crate) fn next_flux(&self, v_ab: Ab<T>, i_ab: Ab<T>, feedback: Ab<T>) -> Ab<T> {
+    pub(crate) fn next_flux(&self, v_ab: Ab<T>, i_ab: Ab<T>, feedback: Ab<T>) -> (Ab<T>, Ab<T>) {
         let i_drop = self.drop_current(i_ab);
-        self.lambda1 + (v_ab - i_drop * self.config.rs_hat - feedback) * self.config.ts
+        let lambda1 =
+            self.lambda1 + (v_ab - i_drop * self.config.rs_hat - feedback) * self.config.ts;
+        (lambda1, i_drop)
     }
 
     /// The current multiplied by R̂s in the sample ending with `i_ab`: the interval's average
