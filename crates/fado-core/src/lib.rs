@@ -27,6 +27,7 @@ pub mod estimator;
 pub mod flux;
 pub mod frames;
 pub mod injection;
+pub mod machine;
 pub mod mode;
 pub mod observer;
 pub mod real;
@@ -41,5 +42,6 @@ pub use estimator::{
     Diagnostics, Estimate, EstimatorConfig, RotorAngleEstimator, SensorlessEstimator,
 };
 pub use frames::{Ab, Abc, Dq, Rotation};
+pub use machine::MachineModel;
 pub use mode::Mode;
 pub use real::{Real, wrap_angle};
