@@ -99,7 +99,7 @@ impl<T: Real> MachineModel<T> {
         // Ratios of well-scaled quantities: overflow-free for any finite positive inputs
         // within the plausible range, and any inf/NaN from an extreme one fails the test.
         let ratio = self.rated_torque / (self.torque_constant() * self.rated_current);
-        if !(ratio >= T::lit(0.3) && ratio <= T::lit(3.0)) {
+        if !(ratio.is_finite() && ratio > T::lit(0.3) && ratio < T::lit(3.0)) {
             return Err(ConfigError::OutOfRange {
                 field: "rated_torque",
                 expected: "0.3–3 × 1.5·p·λf·rated_current (check units: λf in Wb peak, current in A peak)",
@@ -107,7 +107,7 @@ impl<T: Real> MachineModel<T> {
         }
         let emf = self.rated_speed() * self.flux_linkage;
         let v_phase = self.dc_voltage / T::lit(1.732_050_807_568_877_2);
-        if !(emf <= T::lit(2.0) * v_phase) {
+        if !(emf.is_finite() && emf < T::lit(2.0) * v_phase) {
             return Err(ConfigError::OutOfRange {
                 field: "flux_linkage",
                 expected: "back-EMF at rated speed (ω·λf) at most 2 × Vdc/√3 (check units and the DC link)",
