@@ -24,22 +24,20 @@ use crate::observer::{DisturbanceObserver, DisturbanceObserverConfig};
 use crate::rotor_flux::{rotor_angle, rotor_flux, stator_flux};
 use crate::rs_adaptation::{AdaptationRegime, ResistanceAdaptation, ResistanceAdaptationConfig};
 use crate::tracker::{BandwidthDefinition, TrackerConfig, TypeTwoTracker};
-use crate::{Ab, Real};
+use crate::{Ab, MachineModel, Real};
 
-/// Everything the estimator needs, flat so that it maps one-to-one onto TOML and Python
-/// keyword arguments. Defaults are the paper's (section V) or SPEC.md's, as each field says.
+/// The estimator's tuning: every setting that is not the machine or the sampling period.
+/// Defaults are the paper's (section V) or SPEC.md's, as each field says; none depends on the
+/// motor (speeds are ratios of the rated electrical frequency). With the `serde` feature this
+/// is the `[estimator]` table of `fado-sim`'s TOML and the keyword set of Python's
+/// `fado.EstimatorConfig`.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct EstimatorConfig<T> {
-    /// Sampling period Ts in s. Default 100 µs (paper, V: 10 kHz).
-    pub ts: T,
-    /// Stator resistance estimate R̂s in Ω. Default 0.327 Ω (paper, V).
-    pub rs_hat: T,
-    /// q-axis inductance estimate L̂q in H. Default 2.63 mH (paper, V).
-    pub lq_hat: T,
-    /// Magnet flux linkage estimate λ̂f in Wb (peak, per phase). Sets the limiter radius, the
-    /// tracker hold level and the start-up flux only; the angle does not depend on it (eq. (6)).
-    /// Default 0.088 Wb (SPEC §6 \[A\]).
-    pub flux_linkage_hat: T,
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(deny_unknown_fields, default)
+)]
+pub struct EstimatorTuning<T> {
     /// Disturbance feedback gain k_df in s⁻¹ (Fig. 3), at most 1/ts. Default 0.5 (paper, V).
     pub k_df: T,
     /// Ramp time of k_df on activation in s, 0 = abrupt as in the paper. Default 0 (SPEC §1 \[A\]).
@@ -49,12 +47,13 @@ pub struct EstimatorConfig<T> {
     pub k_af: T,
     /// Limiter radius as a multiple of λ̂f, at least 1. Default 1.15 (paper, V).
     pub limiter_radius_ratio: T,
-    /// Speed threshold between limiter and k_df in Hz electrical; threshold + hysteresis below
-    /// the Nyquist frequency 1/(2·ts). Default 1.5 Hz (paper, V).
-    pub mode_threshold_hz: T,
-    /// Hysteresis half-band of the threshold in Hz, at most the threshold. Default 0.2 Hz
-    /// (SPEC §1 \[A\]).
-    pub mode_hysteresis_hz: T,
+    /// Speed threshold between limiter and k_df as a fraction of the rated electrical
+    /// frequency; threshold + hysteresis below the Nyquist frequency 1/(2·ts). Default 0.015
+    /// (paper, V: 1.5 Hz of its motor's 100 Hz).
+    pub mode_threshold_ratio: T,
+    /// Hysteresis half-band of the threshold as a fraction of the rated electrical frequency,
+    /// at most the threshold. Default 0.002 (SPEC §1 \[A\]: 0.2 Hz of 100 Hz).
+    pub mode_hysteresis_ratio: T,
     /// Bandwidth of T2S-1 (angle, observer speed) in Hz. Default 60 Hz (paper, V).
     pub t2s1_bandwidth_hz: T,
     /// Bandwidth of T2S-2 (speed for control) in Hz. Default 35 Hz (paper, V).
@@ -68,8 +67,6 @@ pub struct EstimatorConfig<T> {
     pub tracker_hold_ratio: T,
     /// Average the current over the interval for the resistive drop. Default true (SPEC §1 \[A\]).
     pub average_current: bool,
-    /// Rotor angle assumed at reset (rad), e.g. from an alignment. Default 0 (SPEC §1 \[A\]).
-    pub initial_angle: T,
     /// Feed the disturbance observer with λ1 − L̂q·i instead of λ1. Default true (our
     /// improvement \[A\]; `false` is the paper's Fig. 5, where the observer sees λ1).
     ///
@@ -132,27 +129,22 @@ pub struct EstimatorConfig<T> {
     pub limiter_recentring: bool,
 }
 
-impl<T: Real> Default for EstimatorConfig<T> {
+impl<T: Real> Default for EstimatorTuning<T> {
     fn default() -> Self {
         let rs = ResistanceAdaptationConfig::<T>::default();
         Self {
-            ts: T::lit(100e-6),
-            rs_hat: T::lit(0.327),
-            lq_hat: T::lit(2.63e-3),
-            flux_linkage_hat: T::lit(0.088),
             k_df: T::lit(0.5),
             k_df_ramp_time: T::zero(),
             k_af: T::lit(2.0 * core::f64::consts::PI * 100.0),
             limiter_radius_ratio: T::lit(1.15),
-            mode_threshold_hz: T::lit(1.5),
-            mode_hysteresis_hz: T::lit(0.2),
+            mode_threshold_ratio: T::lit(0.015),
+            mode_hysteresis_ratio: T::lit(0.002),
             t2s1_bandwidth_hz: T::lit(60.0),
             t2s2_bandwidth_hz: T::lit(35.0),
             tracker_damping: T::lit(core::f64::consts::FRAC_1_SQRT_2),
             bandwidth_definition: BandwidthDefinition::Minus3Db,
             tracker_hold_ratio: T::lit(0.2),
             average_current: true,
-            initial_angle: T::zero(),
             observer_on_rotor_flux: true,
             rs_adaptation: true,
             rs_adaptation_rate: rs.rate,
@@ -165,7 +157,45 @@ impl<T: Real> Default for EstimatorConfig<T> {
     }
 }
 
+/// Everything the estimator needs: the sampling period, the machine model (R̂s, L̂d, L̂q, λ̂f
+/// and the ratings the tuning's ratios refer to), the start-up angle and the tuning. Build it
+/// with [`EstimatorConfig::for_machine`]; nothing here assumes the paper's motor.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EstimatorConfig<T> {
+    /// Sampling period Ts in s (paper, V: 100 µs, 10 kHz).
+    pub ts: T,
+    /// The drive's model of the motor: R̂s of eq. (3), L̂q of eq. (5), λ̂f (limiter radius,
+    /// tracker hold level, start-up flux; the angle does not depend on it, eq. (6)), L̂d (the
+    /// active-flux magnitude λ̂f + (L̂d − L̂q)·i_d on salient rotors) and the rated speed that
+    /// scales the mode threshold.
+    pub machine: MachineModel<T>,
+    /// Rotor angle assumed at reset (rad), e.g. from an alignment (SPEC §1 \[A\]).
+    pub initial_angle: T,
+    /// Gains, bandwidths, thresholds and switches.
+    pub tuning: EstimatorTuning<T>,
+}
+
 impl<T: Real> EstimatorConfig<T> {
+    /// The default tuning around `machine`, sampled at 10 kHz (paper, V), starting at angle 0.
+    pub fn for_machine(machine: &MachineModel<T>) -> Self {
+        Self {
+            ts: T::lit(100e-6),
+            machine: *machine,
+            initial_angle: T::zero(),
+            tuning: EstimatorTuning::default(),
+        }
+    }
+
+    /// The mode threshold in Hz electrical: `mode_threshold_ratio` × the rated frequency.
+    pub fn mode_threshold_hz(&self) -> T {
+        self.tuning.mode_threshold_ratio * self.machine.rated_frequency_hz()
+    }
+
+    /// The mode hysteresis in Hz: `mode_hysteresis_ratio` × the rated frequency.
+    pub fn mode_hysteresis_hz(&self) -> T {
+        self.tuning.mode_hysteresis_ratio * self.machine.rated_frequency_hz()
+    }
+
     /// Checks every field; the error names the first bad one.
     pub fn validate(&self) -> Result<(), ConfigError> {
         SensorlessEstimator::new(*self).map(|_| ())
@@ -174,14 +204,14 @@ impl<T: Real> EstimatorConfig<T> {
     fn rs_adaptation_config(&self) -> ResistanceAdaptationConfig<T> {
         ResistanceAdaptationConfig {
             ts: self.ts,
-            rs_initial: self.rs_hat,
-            flux_linkage_hat: self.flux_linkage_hat,
-            lq_hat: self.lq_hat,
-            flux_linkage_rate: self.flux_linkage_adaptation_rate,
-            rate: self.rs_adaptation_rate,
-            excitation_floor: self.rs_adaptation_excitation_floor,
-            min_ratio: self.rs_adaptation_min_ratio,
-            max_ratio: self.rs_adaptation_max_ratio,
+            rs_initial: self.machine.rs,
+            flux_linkage_hat: self.machine.flux_linkage,
+            lq_hat: self.machine.lq,
+            flux_linkage_rate: self.tuning.flux_linkage_adaptation_rate,
+            rate: self.tuning.rs_adaptation_rate,
+            excitation_floor: self.tuning.rs_adaptation_excitation_floor,
+            min_ratio: self.tuning.rs_adaptation_min_ratio,
+            max_ratio: self.tuning.rs_adaptation_max_ratio,
             ..ResistanceAdaptationConfig::default()
         }
     }
@@ -190,8 +220,8 @@ impl<T: Real> EstimatorConfig<T> {
         TrackerConfig {
             ts: self.ts,
             bandwidth_hz,
-            damping: self.tracker_damping,
-            definition: self.bandwidth_definition,
+            damping: self.tuning.tracker_damping,
+            definition: self.tuning.bandwidth_definition,
         }
     }
 }
@@ -291,10 +321,10 @@ impl<T: Real> SensorlessEstimator<T> {
     /// Builds the estimator; every field of `config` is checked and a bad one is named.
     pub fn new(config: EstimatorConfig<T>) -> Result<Self, ConfigError> {
         let ts = check::positive("ts", config.ts)?;
-        check::non_negative("lq_hat", config.lq_hat)?;
-        let lf = check::positive("flux_linkage_hat", config.flux_linkage_hat)?;
-        let ratio = check::positive("limiter_radius_ratio", config.limiter_radius_ratio)?;
-        let hold = check::non_negative("tracker_hold_ratio", config.tracker_hold_ratio)?;
+        config.machine.validate()?;
+        let lf = config.machine.flux_linkage;
+        let ratio = check::positive("limiter_radius_ratio", config.tuning.limiter_radius_ratio)?;
+        let hold = check::non_negative("tracker_hold_ratio", config.tuning.tracker_hold_ratio)?;
         check::below("tracker_hold_ratio", hold, T::one(), "below 1")?;
         check::finite("initial_angle", config.initial_angle)?;
         // A radius below λ̂f would clamp the magnet flux itself, not only drift (Fig. 6).
@@ -306,7 +336,7 @@ impl<T: Real> SensorlessEstimator<T> {
         )?;
         // One limiter step pulls the excess radius back by k_af·Ts of itself: above 1 it
         // overshoots through the circle, above 2 it is unstable.
-        let k_af = check::non_negative("k_af", config.k_af)?;
+        let k_af = check::non_negative("k_af", config.tuning.k_af)?;
         check::below("k_af", k_af * ts, T::lit(1.0 + 1e-6), "k_af·ts at most 1")?;
         // The mode switch compares |ω̂| with the band: it must lie below the Nyquist frequency.
         let nyquist = |field, hz: T| {
@@ -318,7 +348,7 @@ impl<T: Real> SensorlessEstimator<T> {
                 "below the Nyquist frequency 1/(2·ts)",
             )
         };
-        nyquist("mode_threshold_hz", config.mode_threshold_hz)?;
+        nyquist("mode_threshold_ratio", config.mode_threshold_hz())?;
         let rename = |field: &'static str| {
             move |e: ConfigError| match e {
                 ConfigError::OutOfRange { expected, .. } => {
@@ -331,44 +361,44 @@ impl<T: Real> SensorlessEstimator<T> {
         };
         let integrator = FluxIntegrator::new(FluxIntegratorConfig {
             ts,
-            rs_hat: config.rs_hat,
-            average_current: config.average_current,
+            rs_hat: config.machine.rs,
+            average_current: config.tuning.average_current,
         })?;
         let observer = DisturbanceObserver::new(DisturbanceObserverConfig { ts })?;
         let disturbance_feedback = DisturbanceFeedback::new(DisturbanceFeedbackConfig {
             ts,
-            k_df: config.k_df,
-            ramp_time: config.k_df_ramp_time,
+            k_df: config.tuning.k_df,
+            ramp_time: config.tuning.k_df_ramp_time,
         })
         .map_err(|e| match e.field() {
             "ramp_time" => rename("k_df_ramp_time")(e),
             _ => e,
         })?;
         let limiter = FluxLimiter::new(FluxLimiterConfig {
-            k_af: config.k_af,
+            k_af: config.tuning.k_af,
             radius: ratio * lf,
         })?;
         let selector = ModeSelector::new(ModeSelectorConfig {
-            threshold_hz: config.mode_threshold_hz,
-            hysteresis_hz: config.mode_hysteresis_hz,
+            threshold_hz: config.mode_threshold_hz(),
+            hysteresis_hz: config.mode_hysteresis_hz(),
         })
         .map_err(|e| match e.field() {
-            "threshold_hz" => rename("mode_threshold_hz")(e),
-            _ => rename("mode_hysteresis_hz")(e),
+            "threshold_hz" => rename("mode_threshold_ratio")(e),
+            _ => rename("mode_hysteresis_ratio")(e),
         })?;
         nyquist(
-            "mode_hysteresis_hz",
-            config.mode_threshold_hz + config.mode_hysteresis_hz,
+            "mode_hysteresis_ratio",
+            config.mode_threshold_hz() + config.mode_hysteresis_hz(),
         )?;
-        check::positive("tracker_damping", config.tracker_damping)?;
-        let t2s1 = TypeTwoTracker::new(config.tracker(config.t2s1_bandwidth_hz))
+        check::positive("tracker_damping", config.tuning.tracker_damping)?;
+        let t2s1 = TypeTwoTracker::new(config.tracker(config.tuning.t2s1_bandwidth_hz))
             .map_err(rename("t2s1_bandwidth_hz"))?;
-        let t2s2 = TypeTwoTracker::new(config.tracker(config.t2s2_bandwidth_hz))
+        let t2s2 = TypeTwoTracker::new(config.tracker(config.tuning.t2s2_bandwidth_hz))
             .map_err(rename("t2s2_bandwidth_hz"))?;
         let rs_adaptation =
             ResistanceAdaptation::new(config.rs_adaptation_config()).map_err(|e| {
                 match e.field() {
-                    "rs_initial" => rename("rs_hat")(e),
+                    "rs_initial" => rename("rs")(e),
                     "rate" => rename("rs_adaptation_rate")(e),
                     "excitation_floor" => rename("rs_adaptation_excitation_floor")(e),
                     "min_ratio" => rename("rs_adaptation_min_ratio")(e),
@@ -393,7 +423,7 @@ impl<T: Real> SensorlessEstimator<T> {
                 })
             }
         };
-        squared("flux_linkage_hat", lf)?;
+        squared("flux_linkage", lf)?;
         squared("limiter_radius_ratio", ratio * lf)?;
         let mut est = Self {
             config,
@@ -418,7 +448,7 @@ impl<T: Real> SensorlessEstimator<T> {
     /// Back to the start-up state at `config.initial_angle` with zero current; an adapted R̂s
     /// goes back to the configured value.
     pub fn reset(&mut self) {
-        if self.config.rs_adaptation {
+        if self.config.tuning.rs_adaptation {
             self.rs_adaptation.reset();
             self.integrator
                 .set_rs_hat_unchecked(self.rs_adaptation.rs_hat());
@@ -435,10 +465,10 @@ impl<T: Real> SensorlessEstimator<T> {
         } else {
             T::zero()
         };
-        let lambda_r = Ab::from_polar(self.config.flux_linkage_hat, theta0);
+        let lambda_r = Ab::from_polar(self.config.machine.flux_linkage, theta0);
         // A current so large that L̂q·i overflows is as unusable as a NaN (found by fuzzing,
         // f32: i = 3e37 A gave λ1 = ∞): start as with zero current.
-        let lambda1 = lambda_r + i_ab * self.config.lq_hat;
+        let lambda1 = lambda_r + i_ab * self.config.machine.lq;
         let lambda1 = if lambda1.is_finite() {
             lambda1
         } else {
@@ -446,7 +476,7 @@ impl<T: Real> SensorlessEstimator<T> {
         };
         self.integrator.reset_to(lambda1);
         self.observer
-            .reset_to(if self.config.observer_on_rotor_flux {
+            .reset_to(if self.config.tuning.observer_on_rotor_flux {
                 lambda_r
             } else {
                 lambda1
@@ -496,8 +526,8 @@ impl<T: Real> SensorlessEstimator<T> {
         let (lambda1, i_drop) = self.integrator.next_flux(v_ab, i_ab, self.feedback);
         // 2. Disturbance observer at ω̂ of T2S-1 (eq. (10), (16)), on λ1 or on λ1 − L̂q·i
         //    (see `EstimatorConfig::observer_on_rotor_flux`).
-        let observer_input = if self.config.observer_on_rotor_flux {
-            rotor_flux(lambda1, i_ab, self.config.lq_hat)
+        let observer_input = if self.config.tuning.observer_on_rotor_flux {
+            rotor_flux(lambda1, i_ab, self.config.machine.lq)
         } else {
             lambda1
         };
@@ -505,7 +535,7 @@ impl<T: Real> SensorlessEstimator<T> {
             self.observer.next_state(observer_input, self.t2s1.speed());
         // 3. Rotor flux and direct angle (eq. (20), (5), (6)).
         let lambda2 = stator_flux(lambda1, disturbance);
-        let lambda_r = rotor_flux(lambda2, i_ab, self.config.lq_hat);
+        let lambda_r = rotor_flux(lambda2, i_ab, self.config.machine.lq);
         let tracker_hold = lambda_r.norm_squared() < self.hold_level_sq;
         let theta_direct = rotor_angle(lambda_r);
         // 4. Trackers (Fig. 1, Fig. 5).
@@ -542,8 +572,8 @@ impl<T: Real> SensorlessEstimator<T> {
         let flux_linkage_used = self.rs_adaptation.flux_linkage_hat();
         let previous_mode = self.selector.mode();
         // Limiter mode: re-centre the common mode (see `EstimatorConfig::limiter_recentring`).
-        let shift = if mode == Mode::Limiter && self.config.limiter_recentring {
-            disturbance * (self.config.k_df * self.config.ts)
+        let shift = if mode == Mode::Limiter && self.config.tuning.limiter_recentring {
+            disturbance * (self.config.tuning.k_df * self.config.ts)
         } else {
             Ab::zero()
         };
@@ -557,7 +587,7 @@ impl<T: Real> SensorlessEstimator<T> {
         self.feedback = feedback;
         // 6. R̂s for the next sample (see `rs_adaptation`), after the commit so that the paper's
         //    path is untouched by it. A non-finite result is dropped (R̂s stays).
-        if self.config.rs_adaptation {
+        if self.config.tuning.rs_adaptation {
             let regime = match (previous_mode, mode) {
                 _ if tracker_hold => AdaptationRegime::Frozen,
                 (Mode::DisturbanceFeedback, Mode::DisturbanceFeedback) => {
@@ -629,8 +659,8 @@ impl<T: Real> SensorlessEstimator<T> {
     /// then changes nothing.
     pub fn set_rs_hat(&mut self, rs_hat: T) -> Result<(), ConfigError> {
         self.integrator.set_rs_hat(rs_hat)?;
-        self.config.rs_hat = rs_hat;
-        if self.config.rs_adaptation {
+        self.config.machine.rs = rs_hat;
+        if self.config.tuning.rs_adaptation {
             // Cannot fail: R̂s ≥ 0 was just checked and nothing else changed.
             if let Ok(adaptation) = ResistanceAdaptation::new(self.config.rs_adaptation_config()) {
                 self.rs_adaptation = adaptation;

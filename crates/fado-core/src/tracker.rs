@@ -24,6 +24,11 @@ use crate::{Real, wrap_angle};
 
 /// How the tracker's bandwidth parameter is interpreted.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(rename_all = "snake_case")
+)]
 pub enum BandwidthDefinition {
     /// The −3 dB frequency of T(s) (SPEC §3 default): ωn = ω_bw / √(1 + 2ζ² + √((1+2ζ²)² + 1)),
     /// i.e. ωn = ω_bw / 2.058 for ζ = 1/√2.

@@ -57,9 +57,9 @@ use crate::{Ab, Real};
 pub struct EmfObserverConfig<T> {
     /// Sampling period Ts in s. Default 100 µs (paper, V).
     pub ts: T,
-    /// Stator resistance estimate R̂s in Ω. Default 0.327 Ω (paper, V).
+    /// Stator resistance estimate R̂s in Ω. From the machine model.
     pub rs_hat: T,
-    /// Inductance estimate L̂ = L̂d = L̂q in H. Default 2.63 mH (paper, V).
+    /// Inductance estimate L̂ = L̂d = L̂q in H. From the machine model.
     pub lq_hat: T,
     /// Magnet flux linkage estimate λ̂f in Wb: sets the tracker hold level only. Default
     /// 0.088 Wb (SPEC §6 \[A\]).
@@ -88,13 +88,14 @@ pub struct EmfObserverConfig<T> {
     pub initial_angle: T,
 }
 
-impl<T: Real> Default for EmfObserverConfig<T> {
-    fn default() -> Self {
+impl<T: Real> EmfObserverConfig<T> {
+    /// The default tuning around `machine` (its R̂s, L̂q and λ̂f), sampled at 10 kHz.
+    pub fn for_machine(machine: &crate::MachineModel<T>) -> Self {
         Self {
             ts: T::lit(100e-6),
-            rs_hat: T::lit(0.327),
-            lq_hat: T::lit(2.63e-3),
-            flux_linkage_hat: T::lit(0.088),
+            rs_hat: machine.rs,
+            lq_hat: machine.lq,
+            flux_linkage_hat: machine.flux_linkage,
             emf_bandwidth_hz: T::lit(100.0),
             speed_floor_hz: T::lit(2.0),
             t2s1_bandwidth_hz: T::lit(60.0),

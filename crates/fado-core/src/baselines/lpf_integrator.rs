@@ -62,12 +62,12 @@ use crate::{Ab, Real};
 pub struct LpfIntegratorConfig<T> {
     /// Sampling period Ts in s. Default 100 µs (paper, V).
     pub ts: T,
-    /// Stator resistance estimate R̂s in Ω. Default 0.327 Ω (paper, V).
+    /// Stator resistance estimate R̂s in Ω. From the machine model.
     pub rs_hat: T,
-    /// q-axis inductance estimate L̂q in H (eq. (5)). Default 2.63 mH (paper, V).
+    /// q-axis inductance estimate L̂q in H (eq. (5)). From the machine model.
     pub lq_hat: T,
     /// Magnet flux linkage estimate λ̂f in Wb; sets the start-up flux and the tracker hold
-    /// level only. Default 0.088 Wb (SPEC §6 \[A\]).
+    /// level only. From the machine model.
     pub flux_linkage_hat: T,
     /// Cutoff fc of the low-pass integrator 1/(s + 2π·fc) in Hz; 0 gives the open integrator
     /// of eq. (3). Default 1 Hz \[A\]: one sixth of the 6 Hz electrical speed of the paper's
@@ -95,13 +95,14 @@ pub struct LpfIntegratorConfig<T> {
     pub initial_angle: T,
 }
 
-impl<T: Real> Default for LpfIntegratorConfig<T> {
-    fn default() -> Self {
+impl<T: Real> LpfIntegratorConfig<T> {
+    /// The default tuning around `machine` (its R̂s, L̂q and λ̂f), sampled at 10 kHz.
+    pub fn for_machine(machine: &crate::MachineModel<T>) -> Self {
         Self {
             ts: T::lit(100e-6),
-            rs_hat: T::lit(0.327),
-            lq_hat: T::lit(2.63e-3),
-            flux_linkage_hat: T::lit(0.088),
+            rs_hat: machine.rs,
+            lq_hat: machine.lq,
+            flux_linkage_hat: machine.flux_linkage,
             cutoff_hz: T::lit(1.0),
             compensation_floor_hz: T::lit(1.0),
             t2s1_bandwidth_hz: T::lit(60.0),

@@ -95,13 +95,13 @@ const ADAPTATION_BOUNDS: (f64, f64) = (0.3, 2.5);
 pub struct OrtegaConfig<T> {
     /// Sampling period Ts in s. Default 100 µs (paper, V).
     pub ts: T,
-    /// Stator resistance estimate R̂s in Ω. Default 0.327 Ω (paper, V).
+    /// Stator resistance estimate R̂s in Ω. From the machine model.
     pub rs_hat: T,
     /// Inductance estimate L̂ = L̂d = L̂q in H (the observer assumes a non-salient machine).
-    /// Default 2.63 mH (paper, V).
+    /// From the machine model.
     pub lq_hat: T,
     /// Magnet flux linkage estimate λ̂f in Wb: the radius η̂ is pulled to. Unlike fado, the
-    /// angle depends on it (module docs). Default 0.088 Wb (SPEC §6 \[A\]).
+    /// angle depends on it (module docs). From the machine model.
     pub flux_linkage_hat: T,
     /// Radial (flux-magnitude) correction rate ω_obs = γ·λ̂f² in rad/s: the fixed value when
     /// `observer_speed_ratio` is 0, else the upper bound ω_max of the schedule; times `ts` it
@@ -134,13 +134,14 @@ pub struct OrtegaConfig<T> {
     pub initial_angle: T,
 }
 
-impl<T: Real> Default for OrtegaConfig<T> {
-    fn default() -> Self {
+impl<T: Real> OrtegaConfig<T> {
+    /// The default tuning around `machine` (its R̂s, L̂q and λ̂f), sampled at 10 kHz.
+    pub fn for_machine(machine: &crate::MachineModel<T>) -> Self {
         Self {
             ts: T::lit(100e-6),
-            rs_hat: T::lit(0.327),
-            lq_hat: T::lit(2.63e-3),
-            flux_linkage_hat: T::lit(0.088),
+            rs_hat: machine.rs,
+            lq_hat: machine.lq,
+            flux_linkage_hat: machine.flux_linkage,
             observer_bandwidth: T::lit(2.0 * core::f64::consts::TAU * 100.0),
             observer_speed_ratio: T::lit(2.0),
             observer_bandwidth_min: T::lit(2.0 * core::f64::consts::TAU * 1.5),

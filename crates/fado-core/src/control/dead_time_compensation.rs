@@ -22,6 +22,11 @@ use crate::{Ab, Abc, Dq, Real, Rotation};
 
 /// How the compensation voltage follows the current.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(rename_all = "snake_case")
+)]
 pub enum DeadTimeMethod {
     /// V̂·sat(i*_x/Ic) of the advanced reference current (SPEC §5). Default.
     #[default]

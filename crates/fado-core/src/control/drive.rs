@@ -33,47 +33,51 @@ use crate::control::speed_controller::{
     SpeedController, SpeedControllerConfig, limit_current_d_priority,
 };
 use crate::error::{ConfigError, check};
-use crate::estimator::{Estimate, EstimatorConfig, RotorAngleEstimator, SensorlessEstimator};
+use crate::estimator::{
+    Estimate, EstimatorConfig, EstimatorTuning, RotorAngleEstimator, SensorlessEstimator,
+};
 use crate::injection::{CurrentInjection, CurrentInjectionConfig};
-use crate::{Ab, Abc, Dq, Real, Rotation};
+use crate::machine::PAPER_RATED_CURRENT;
+use crate::{Ab, Abc, Dq, MachineModel, Real, Rotation};
 
-/// Everything the drive around the estimator needs, flat so that it maps one-to-one onto
-/// TOML and Python keyword arguments. Defaults are the paper's (section V) or SPEC's.
+/// The drive's tuning: every setting that is not the machine or the sampling period. Defaults
+/// are ratios of the machine's ratings or durations in seconds, chosen so that the paper's
+/// motor ([`MachineModel::paper`], 21.78 A rated) gets the paper's and SPEC's absolute values
+/// (written beside each ratio); the inverter data (dead time, switching frequency, threshold
+/// voltage, current band) are SPEC §5's. With the `serde` feature this is the `[controller]`
+/// table of `fado-sim`'s TOML.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct DriveConfig<T> {
-    /// Sampling period Ts in s. Default 100 µs (paper, V: 10 kHz); must equal the
-    /// estimator's.
-    pub ts: T,
-    /// Pole pairs p. Default 4 (paper, V: 8 poles).
-    pub pole_pairs: T,
-    /// Stator resistance estimate R̂s in Ω (current PI). Default 0.327 Ω (paper, V).
-    pub rs_hat: T,
-    /// d-axis inductance estimate L̂d in H. Default 2.63 mH (paper, V).
-    pub ld_hat: T,
-    /// q-axis inductance estimate L̂q in H. Default 2.63 mH (paper, V).
-    pub lq_hat: T,
-    /// Magnet flux linkage estimate λ̂f in Wb (back-EMF feed-forward, K̂t). Default 0.088 Wb
-    /// (SPEC §6 \[A\]).
-    pub flux_linkage_hat: T,
-    /// Inertia estimate Ĵ in kg·m² (speed PI). Default 0.012 (SPEC §6 \[A\]).
-    pub inertia_hat: T,
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(deny_unknown_fields, default)
+)]
+pub struct DriveTuning<T> {
     /// Current-loop bandwidth in Hz. Default 250 Hz (paper, V).
     pub current_bandwidth_hz: T,
     /// Speed-loop bandwidth in Hz. Default 5 Hz (paper, V).
     pub speed_bandwidth_hz: T,
     /// Speed PI zero as a fraction of its bandwidth, Ki = Kp·ωsc/ratio. Default 5 (SPEC §6).
     pub speed_zero_ratio: T,
-    /// Current limit I_max in A (|i_dq*|). Default 40 A (SPEC §6 \[A\]).
-    pub i_max: T,
-    /// Minimum current I_min of the injection (23) in A; 0 disables it. Default 4 A (paper, V).
-    pub i_min: T,
-    /// Dead time Td in s. Default 2.5 µs (paper, V).
+    /// Current limit I_max (|i_dq*|) as a multiple of the rated current. Default 40/21.78
+    /// (SPEC §6 \[A\]: 40 A on the paper's motor).
+    pub current_limit_ratio: T,
+    /// Minimum current I_min of the injection (23) as a fraction of the rated current; 0
+    /// disables it. Default 4/21.78 (paper, V: 4 A).
+    pub injection_current_ratio: T,
+    /// Maximum-torque-per-ampere d current on salient machines (L̂d ≠ L̂q; see
+    /// [`MachineModel::mtpa_id`]), added to the injection's. No effect on a surface-magnet
+    /// rotor. Default true.
+    pub mtpa: bool,
+    /// Dead time Td in s (inverter datum). Default 2.5 µs (paper, V).
     pub dead_time: T,
-    /// Switching frequency in Hz. Default 5 kHz (paper, V).
+    /// Switching frequency in Hz (inverter datum). Default 5 kHz (paper, V).
     pub switching_frequency: T,
-    /// Device threshold voltage of the dead-time compensation in V. Default 1 V (SPEC §5 \[A\]).
+    /// Device threshold voltage of the dead-time compensation in V (inverter datum). Default
+    /// 1 V (SPEC §5 \[A\]).
     pub dead_time_threshold_voltage: T,
-    /// Current band Ic of the trapezoidal compensation in A. Default 0.3 A (SPEC §5 \[A\]).
+    /// Current band Ic of the trapezoidal compensation in A (inverter datum). Default 0.3 A
+    /// (SPEC §5 \[A\]).
     pub dead_time_current_band: T,
     /// Compensate the dead time at all. Default true (paper IV-B).
     pub dead_time_compensation: bool,
@@ -81,9 +85,9 @@ pub struct DriveConfig<T> {
     pub dead_time_method: DeadTimeMethod,
     /// Angle advance of the voltage in samples. Default 1.5 (SPEC §5 \[A\], ref. \[13\]).
     pub delay_compensation_factor: T,
-    /// Over-current trip level on any phase current in A (latched until `reset`).
-    /// Default 60 A (1.5·I_max) \[A\].
-    pub trip_current: T,
+    /// Over-current trip level on any phase current, as a multiple of the rated current
+    /// (latched until `reset`). Default 60/21.78 (1.5·I_max: 60 A on the paper's motor) \[A\].
+    pub trip_current_ratio: T,
     /// Decoupling and back-EMF feed-forward in the current PI. Default true (SPEC §6 \[A\]).
     pub decoupling: bool,
     /// Realisable voltage set. Default the hexagon (SVPWM \[16\]).
@@ -95,56 +99,55 @@ pub struct DriveConfig<T> {
     pub current_anti_windup_ratio: T,
     /// Speed PI back-calculation gain in units of Ki/Kp. Default 5 (tracking at ωsc) \[A\].
     pub speed_anti_windup_ratio: T,
-    /// Current-sensor offset calibration at start-up: number of samples averaged with the
-    /// gates off (zero current) after `new`/`reset`, before the aligned start; 0 disables it.
-    /// The averages are subtracted from every later phase-current sample. Default 1000
-    /// (100 ms at 10 kHz) \[A\]: standard practice in real drives (the paper is silent). At
-    /// standstill an offset is a constant integrand error −R̂s·Δi of eq. (3); the limiter of
-    /// Fig. 6 removes only its radial part, its tangential part walks θ̂ (fado-sim fig10).
-    /// 1000 samples reduce 10 mA rms noise to 0.3 mA.
-    pub offset_calibration_samples: u32,
-    /// Stuck current-sensor detection: a channel reading within ±this of zero (A) while the
-    /// reference asks for at least `stuck_sensor_min_reference` in its phase. Default 0.25 A
-    /// \[A\]: 10 LSB of the 12-bit ±50 A ADC and 25σ of the 10 mA sensor noise (SPEC §6).
-    pub stuck_sensor_band: T,
-    /// Stuck current-sensor detection: the reference's phase component (A) from which a
-    /// near-zero reading is implausible. Default 2 A \[A\] (half of I_min: every running state
-    /// has |i_dq*| ≥ I_min, so some phase always carries ≥ 0.866·I_min).
-    pub stuck_sensor_min_reference: T,
-    /// Stuck current-sensor detection: samples in a row before a channel is judged stuck; 0
-    /// disables the detector. Default 5 (0.5 ms, < 1 current-loop time constant) \[A\].
-    pub stuck_sensor_samples: u32,
-    /// Current-error monitor: |i_dq* − i_dq| above this (A) counts as an error. Default 5 A
-    /// \[A\] (more than the 4 A injection step the loop takes at start-up).
-    pub current_error_limit: T,
-    /// Current-error monitor: samples in a row before `CURRENT_ERROR` is raised; 0 disables
-    /// it. Default 20 (2 ms ≈ 3 time constants of the 250 Hz current loop) \[A\].
-    pub current_error_samples: u32,
-    /// DC-link under-voltage warning level in V: `DC_LINK_LOW` below it. Default 200 V \[A\]
-    /// (about 2/3 of the 300–311 V link of SPEC §5; the modulation always uses the measured
-    /// voltage, the flag only reports it).
-    pub dc_link_min_voltage: T,
-    /// Consecutive rejected (non-finite) samples after which the drive trips; 0 never trips
-    /// on bad input. Default 100 (10 ms) \[A\]: a single bad sample is ridden through with the
+    /// Current-sensor offset calibration at start-up, in s: the gates stay off (zero current)
+    /// after `new`/`reset` while the phase currents are averaged, before the aligned start;
+    /// 0 disables it. The averages are subtracted from every later sample. Default 0.1 s
+    /// \[A\] (1000 samples at 10 kHz: 10 mA rms noise averages to 0.3 mA): standard practice in
+    /// real drives (the paper is silent). At standstill an offset is a constant integrand
+    /// error −R̂s·Δi of eq. (3); the limiter of Fig. 6 removes only its radial part, its
+    /// tangential part walks θ̂ (fado-sim fig10).
+    pub offset_calibration_time: T,
+    /// Stuck current-sensor detection: a channel reading within ±this fraction of the rated
+    /// current of zero while the reference asks for at least `stuck_sensor_reference_ratio`
+    /// in its phase. Default 0.25/21.78 \[A\] (0.25 A: 10 LSB of a 12-bit ±50 A ADC, 25σ of
+    /// 10 mA sensor noise, SPEC §6).
+    pub stuck_sensor_band_ratio: T,
+    /// Stuck current-sensor detection: the reference's phase component, as a fraction of the
+    /// rated current, from which a near-zero reading is implausible. Default 2/21.78 \[A\]
+    /// (half of I_min: every running state has |i_dq*| ≥ I_min, so some phase always carries
+    /// ≥ 0.866·I_min).
+    pub stuck_sensor_reference_ratio: T,
+    /// Stuck current-sensor detection: how long (s) a channel must look stuck; 0 disables
+    /// the detector. Default 0.5 ms (< 1 current-loop time constant) \[A\].
+    pub stuck_sensor_time: T,
+    /// Current-error monitor: |i_dq* − i_dq| above this fraction of the rated current counts
+    /// as an error. Default 5/21.78 \[A\] (more than the I_min injection step the loop takes at
+    /// start-up).
+    pub current_error_ratio: T,
+    /// Current-error monitor: how long (s) the error must last before `CURRENT_ERROR` is
+    /// raised; 0 disables it. Default 2 ms (≈ 3 time constants of the 250 Hz current loop)
+    /// \[A\].
+    pub current_error_time: T,
+    /// DC-link under-voltage warning level as a fraction of the machine's nominal DC-link
+    /// voltage: `DC_LINK_LOW` below it. Default 2/3 \[A\] (200 V of the paper's 300 V; the
+    /// modulation always uses the measured voltage, the flag only reports it).
+    pub dc_link_min_ratio: T,
+    /// How long (s) rejected samples may follow each other before the drive trips; 0 never
+    /// trips on bad input. Default 10 ms \[A\]: a single bad sample is ridden through with the
     /// duty held, a sensor chain that stays broken is a fault.
-    pub input_fault_trip_samples: u32,
+    pub input_fault_trip_time: T,
 }
 
-impl<T: Real> Default for DriveConfig<T> {
+impl<T: Real> Default for DriveTuning<T> {
     fn default() -> Self {
+        let per_rated = |amps: f64| T::lit(amps / PAPER_RATED_CURRENT);
         Self {
-            ts: T::lit(100e-6),
-            pole_pairs: T::lit(4.0),
-            rs_hat: T::lit(0.327),
-            ld_hat: T::lit(2.63e-3),
-            lq_hat: T::lit(2.63e-3),
-            flux_linkage_hat: T::lit(0.088),
-            inertia_hat: T::lit(0.012),
             current_bandwidth_hz: T::lit(250.0),
             speed_bandwidth_hz: T::lit(5.0),
             speed_zero_ratio: T::lit(5.0),
-            i_max: T::lit(40.0),
-            i_min: T::lit(4.0),
+            current_limit_ratio: per_rated(40.0),
+            injection_current_ratio: per_rated(4.0),
+            mtpa: true,
             dead_time: T::lit(2.5e-6),
             switching_frequency: T::lit(5e3),
             dead_time_threshold_voltage: T::one(),
@@ -152,28 +155,118 @@ impl<T: Real> Default for DriveConfig<T> {
             dead_time_compensation: true,
             dead_time_method: DeadTimeMethod::Trapezoidal,
             delay_compensation_factor: T::lit(1.5),
-            trip_current: T::lit(60.0),
+            trip_current_ratio: per_rated(60.0),
             decoupling: true,
             voltage_limit: VoltageLimit::Hexagon,
             max_modulation: T::one(),
             current_anti_windup_ratio: T::one(),
             speed_anti_windup_ratio: T::lit(5.0),
-            offset_calibration_samples: 1000,
-            stuck_sensor_band: T::lit(0.25),
-            stuck_sensor_min_reference: T::lit(2.0),
-            stuck_sensor_samples: 5,
-            current_error_limit: T::lit(5.0),
-            current_error_samples: 20,
-            dc_link_min_voltage: T::lit(200.0),
-            input_fault_trip_samples: 100,
+            offset_calibration_time: T::lit(0.1),
+            stuck_sensor_band_ratio: per_rated(0.25),
+            stuck_sensor_reference_ratio: per_rated(2.0),
+            stuck_sensor_time: T::lit(0.5e-3),
+            current_error_ratio: per_rated(5.0),
+            current_error_time: T::lit(2e-3),
+            dc_link_min_ratio: T::lit(2.0 / 3.0),
+            input_fault_trip_time: T::lit(10e-3),
         }
     }
 }
 
+/// Everything the drive around the estimator needs: the sampling period, the machine model
+/// (R̂s, L̂d, L̂q, λ̂f, Ĵ, pole pairs and the ratings the tuning's ratios refer to) and the
+/// tuning. Build it with [`DriveConfig::for_machine`]; the drive hands the same machine model
+/// to its estimator, so the model exists once.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DriveConfig<T> {
+    /// Sampling period Ts in s (paper, V: 100 µs, 10 kHz, twice the switching frequency).
+    pub ts: T,
+    /// The drive's model of the motor.
+    pub machine: MachineModel<T>,
+    /// Gains, limits, thresholds and switches.
+    pub tuning: DriveTuning<T>,
+}
+
 impl<T: Real> DriveConfig<T> {
+    /// The default tuning around `machine`, sampled at 10 kHz (paper, V).
+    pub fn for_machine(machine: &MachineModel<T>) -> Self {
+        Self {
+            ts: T::lit(100e-6),
+            machine: *machine,
+            tuning: DriveTuning::default(),
+        }
+    }
+
     /// Checks every field (without an estimator); the error names the first bad one.
     pub fn validate(&self) -> Result<(), ConfigError> {
-        Blocks::new(self).map(|_| ())
+        Resolved::new(self)
+            .and_then(|r| Blocks::new(self, &r))
+            .map(|_| ())
+    }
+
+    /// The configured current limit I_max in A.
+    pub fn i_max(&self) -> T {
+        self.tuning.current_limit_ratio * self.machine.rated_current
+    }
+
+    /// The configured injection level I_min of eq. (23) in A.
+    pub fn i_min(&self) -> T {
+        self.tuning.injection_current_ratio * self.machine.rated_current
+    }
+
+    /// The configured trip level in A.
+    pub fn trip_current(&self) -> T {
+        self.tuning.trip_current_ratio * self.machine.rated_current
+    }
+}
+
+/// The absolute limits and sample counts of a [`DriveConfig`], resolved once from its ratios
+/// and durations (nothing is recomputed per sample).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Resolved<T> {
+    i_max: T,
+    i_min: T,
+    trip_current: T,
+    current_error_limit: T,
+    dc_link_min_voltage: T,
+    offset_calibration_samples: u32,
+    stuck_sensor_samples: u32,
+    current_error_samples: u32,
+    input_fault_trip_samples: u32,
+    /// MTPA d current on (configured and the machine is salient).
+    mtpa: bool,
+}
+
+impl<T: Real> Resolved<T> {
+    fn new(c: &DriveConfig<T>) -> Result<Self, ConfigError> {
+        let ts = check::positive("ts", c.ts)?;
+        c.machine.validate()?;
+        let t = &c.tuning;
+        let rated = c.machine.rated_current;
+        // A duration as a whole number of samples (at most about 5 days at 10 kHz).
+        let samples = |field: &'static str, time: T| -> Result<u32, ConfigError> {
+            let n = check::non_negative(field, time)? / ts;
+            check::below(field, n, T::lit(4e9), "below 4e9 sampling periods")?;
+            Ok(n.round().to_f64() as u32)
+        };
+        Ok(Self {
+            i_max: check::positive("current_limit_ratio", t.current_limit_ratio)? * rated,
+            i_min: check::non_negative("injection_current_ratio", t.injection_current_ratio)?
+                * rated,
+            trip_current: check::positive("trip_current_ratio", t.trip_current_ratio)? * rated,
+            current_error_limit: check::positive("current_error_ratio", t.current_error_ratio)?
+                * rated,
+            dc_link_min_voltage: check::non_negative("dc_link_min_ratio", t.dc_link_min_ratio)?
+                * c.machine.dc_voltage,
+            offset_calibration_samples: samples(
+                "offset_calibration_time",
+                t.offset_calibration_time,
+            )?,
+            stuck_sensor_samples: samples("stuck_sensor_time", t.stuck_sensor_time)?,
+            current_error_samples: samples("current_error_time", t.current_error_time)?,
+            input_fault_trip_samples: samples("input_fault_trip_time", t.input_fault_trip_time)?,
+            mtpa: t.mtpa && c.machine.is_salient(),
+        })
     }
 }
 
@@ -260,33 +353,34 @@ struct Blocks<T> {
 }
 
 impl<T: Real> Blocks<T> {
-    fn new(c: &DriveConfig<T>) -> Result<Self, ConfigError> {
-        let ts = check::positive("ts", c.ts)?;
-        let i_max = check::positive("i_max", c.i_max)?;
-        let i_min = check::non_negative("i_min", c.i_min)?;
+    fn new(c: &DriveConfig<T>, r: &Resolved<T>) -> Result<Self, ConfigError> {
+        let ts = c.ts;
+        let t = &c.tuning;
+        let m = &c.machine;
+        let (i_max, i_min) = (r.i_max, r.i_min);
         if i_min > i_max {
             return Err(ConfigError::OutOfRange {
-                field: "i_min",
-                expected: "at most i_max",
+                field: "injection_current_ratio",
+                expected: "at most current_limit_ratio",
             });
         }
-        let trip = check::positive("trip_current", c.trip_current)?;
-        if trip <= i_max {
+        if r.trip_current <= i_max {
             return Err(ConfigError::OutOfRange {
-                field: "trip_current",
-                expected: "above i_max",
+                field: "trip_current_ratio",
+                expected: "above current_limit_ratio",
             });
         }
-        let band = check::non_negative("stuck_sensor_band", c.stuck_sensor_band)?;
-        let min_ref = check::positive("stuck_sensor_min_reference", c.stuck_sensor_min_reference)?;
+        let band = check::non_negative("stuck_sensor_band_ratio", t.stuck_sensor_band_ratio)?;
+        let min_ref = check::positive(
+            "stuck_sensor_reference_ratio",
+            t.stuck_sensor_reference_ratio,
+        )?;
         if min_ref <= band {
             return Err(ConfigError::OutOfRange {
-                field: "stuck_sensor_min_reference",
-                expected: "above stuck_sensor_band",
+                field: "stuck_sensor_reference_ratio",
+                expected: "above stuck_sensor_band_ratio",
             });
         }
-        check::positive("current_error_limit", c.current_error_limit)?;
-        check::non_negative("dc_link_min_voltage", c.dc_link_min_voltage)?;
         let rename = |map: &'static [(&'static str, &'static str)]| {
             move |e: ConfigError| {
                 let field = map
@@ -305,13 +399,13 @@ impl<T: Real> Blocks<T> {
         };
         let speed = SpeedController::new(SpeedControllerConfig {
             ts,
-            pole_pairs: c.pole_pairs,
-            inertia_hat: c.inertia_hat,
-            flux_linkage_hat: c.flux_linkage_hat,
-            bandwidth_hz: c.speed_bandwidth_hz,
-            zero_ratio: c.speed_zero_ratio,
+            pole_pairs: T::lit(m.pole_pairs as f64),
+            inertia_hat: m.inertia,
+            flux_linkage_hat: m.flux_linkage,
+            bandwidth_hz: t.speed_bandwidth_hz,
+            zero_ratio: t.speed_zero_ratio,
             i_max,
-            anti_windup_ratio: c.speed_anti_windup_ratio,
+            anti_windup_ratio: t.speed_anti_windup_ratio,
         })
         .map_err(rename(&[
             ("bandwidth_hz", "speed_bandwidth_hz"),
@@ -321,13 +415,13 @@ impl<T: Real> Blocks<T> {
         let injection = CurrentInjection::new(CurrentInjectionConfig { i_min })?;
         let current = CurrentController::new(CurrentControllerConfig {
             ts,
-            rs_hat: c.rs_hat,
-            ld_hat: c.ld_hat,
-            lq_hat: c.lq_hat,
-            flux_linkage_hat: c.flux_linkage_hat,
-            bandwidth_hz: c.current_bandwidth_hz,
-            decoupling: c.decoupling,
-            anti_windup_ratio: c.current_anti_windup_ratio,
+            rs_hat: m.rs,
+            ld_hat: m.ld,
+            lq_hat: m.lq,
+            flux_linkage_hat: m.flux_linkage,
+            bandwidth_hz: t.current_bandwidth_hz,
+            decoupling: t.decoupling,
+            anti_windup_ratio: t.current_anti_windup_ratio,
             ..CurrentControllerConfig::default()
         })
         .map_err(rename(&[
@@ -336,24 +430,24 @@ impl<T: Real> Blocks<T> {
         ]))?;
         let delay = DelayCompensation::new(DelayCompensationConfig {
             ts,
-            factor: c.delay_compensation_factor,
+            factor: t.delay_compensation_factor,
         })
         .map_err(rename(&[("factor", "delay_compensation_factor")]))?;
         let dead_time = DeadTimeCompensation::new(DeadTimeCompensationConfig {
-            enabled: c.dead_time_compensation,
-            method: c.dead_time_method,
-            dead_time: c.dead_time,
-            switching_frequency: c.switching_frequency,
-            threshold_voltage: c.dead_time_threshold_voltage,
-            current_band: c.dead_time_current_band,
+            enabled: t.dead_time_compensation,
+            method: t.dead_time_method,
+            dead_time: t.dead_time,
+            switching_frequency: t.switching_frequency,
+            threshold_voltage: t.dead_time_threshold_voltage,
+            current_band: t.dead_time_current_band,
         })
         .map_err(rename(&[
             ("threshold_voltage", "dead_time_threshold_voltage"),
             ("current_band", "dead_time_current_band"),
         ]))?;
         let modulator = SpaceVectorModulator::new(ModulatorConfig {
-            limit: c.voltage_limit,
-            max_modulation: c.max_modulation,
+            limit: t.voltage_limit,
+            max_modulation: t.max_modulation,
         })?;
         Ok(Self {
             speed,
@@ -397,6 +491,8 @@ impl<T: Real> Blocks<T> {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SensorlessDrive<T, E = SensorlessEstimator<T>> {
     config: DriveConfig<T>,
+    /// The config's limits and sample counts in absolute units.
+    resolved: Resolved<T>,
     estimator: E,
     blocks: Blocks<T>,
     /// Realised references (before dead-time compensation) computed at n−1 and n−2.
@@ -430,15 +526,16 @@ pub struct SensorlessDrive<T, E = SensorlessEstimator<T>> {
 }
 
 impl<T: Real> SensorlessDrive<T, SensorlessEstimator<T>> {
-    /// The drive with the paper's estimator. `estimator.ts` must equal `config.ts`.
-    pub fn new(config: DriveConfig<T>, estimator: EstimatorConfig<T>) -> Result<Self, ConfigError> {
-        check::positive("ts", config.ts)?;
-        if estimator.ts != config.ts {
-            return Err(ConfigError::OutOfRange {
-                field: "ts",
-                expected: "equal to the estimator's ts",
-            });
-        }
+    /// The drive with the paper's estimator, built with the drive's own sampling period and
+    /// machine model and the given estimator tuning (start-up angle 0; see
+    /// [`align`](Self::align)).
+    pub fn new(config: DriveConfig<T>, estimator: EstimatorTuning<T>) -> Result<Self, ConfigError> {
+        let estimator = EstimatorConfig {
+            ts: check::positive("ts", config.ts)?,
+            machine: config.machine,
+            initial_angle: T::zero(),
+            tuning: estimator,
+        };
         Self::with_estimator(config, SensorlessEstimator::new(estimator)?)
     }
 }
@@ -447,9 +544,11 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
     /// The drive around an estimator built by the caller (which must run at `config.ts`).
     /// The estimator is reset.
     pub fn with_estimator(config: DriveConfig<T>, estimator: E) -> Result<Self, ConfigError> {
-        let blocks = Blocks::new(&config)?;
+        let resolved = Resolved::new(&config)?;
+        let blocks = Blocks::new(&config, &resolved)?;
         let mut drive = Self {
             config,
+            resolved,
             estimator,
             blocks,
             history: [Ab::zero(); 2],
@@ -462,11 +561,11 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             current_offset: Abc::new(T::zero(), T::zero(), T::zero()),
             aligned_angle: T::zero(),
             stuck_sensor: StuckChannelDetector::new(
-                config.stuck_sensor_band,
-                config.stuck_sensor_min_reference,
-                config.stuck_sensor_samples,
+                config.tuning.stuck_sensor_band_ratio * config.machine.rated_current,
+                config.tuning.stuck_sensor_reference_ratio * config.machine.rated_current,
+                resolved.stuck_sensor_samples,
             ),
-            current_error: PersistenceMonitor::new(config.current_error_samples),
+            current_error: PersistenceMonitor::new(resolved.current_error_samples),
             sensor_stuck_now: false,
             current_error_now: false,
             consecutive_rejects: 0,
@@ -496,7 +595,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
     /// rest, so that the true current is zero) and average the raw phase currents; then the
     /// drive re-aligns at the angle of the last [`align`](Self::align) and starts.
     pub fn calibrate_offsets(&mut self) {
-        self.calibration_remaining = self.config.offset_calibration_samples;
+        self.calibration_remaining = self.resolved.offset_calibration_samples;
         self.calibration_sum = Abc::new(T::zero(), T::zero(), T::zero());
         if self.calibration_remaining > 0 {
             self.last.gates_enabled = false;
@@ -541,7 +640,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         );
         self.calibration_remaining -= 1;
         if self.calibration_remaining == 0 {
-            let k = T::one() / T::lit(self.config.offset_calibration_samples as f64);
+            let k = T::one() / T::lit(self.resolved.offset_calibration_samples as f64);
             let sum = self.calibration_sum;
             self.current_offset = Abc::new(sum.a * k, sum.b * k, sum.c * k);
             self.last_i_ab = Ab::zero();
@@ -598,7 +697,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         let mut out = self.step_control(i_abc, vdc, speed_ref_mech);
         if out.input_fault && !out.tripped {
             self.consecutive_rejects = self.consecutive_rejects.saturating_add(1);
-            let limit = self.config.input_fault_trip_samples;
+            let limit = self.resolved.input_fault_trip_samples;
             if limit > 0 && self.consecutive_rejects >= limit {
                 self.tripped = true;
                 self.trip_output();
@@ -620,7 +719,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         flags.set(DriveFlags::SENSOR_STUCK, running && self.sensor_stuck_now);
         flags.set(
             DriveFlags::DC_LINK_LOW,
-            vdc.is_finite() && vdc < self.config.dc_link_min_voltage,
+            vdc.is_finite() && vdc < self.resolved.dc_link_min_voltage,
         );
         flags.set(
             DriveFlags::LIMITER_MODE,
@@ -647,7 +746,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         if !finite {
             return self.reject(i_abc);
         }
-        let trip = self.config.trip_current;
+        let trip = self.resolved.trip_current;
         if self.calibration_remaining > 0
             && i_abc.a.abs() <= trip
             && i_abc.b.abs() <= trip
@@ -704,19 +803,22 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         let tracking_error = (self.last.i_dq_ref - i_dq).norm();
         self.current_error_now = self
             .current_error
-            .step(tracking_error > self.config.current_error_limit);
+            .step(tracking_error > self.resolved.current_error_limit);
 
         // 4. Speed loop, injection (23) and current-vector limit.
         let backup = self.blocks;
         let b = &mut self.blocks;
-        let Ok(iq_ref) = b
-            .speed
-            .step(speed_ref_mech * self.config.pole_pairs, omega_ctrl)
-        else {
+        let Ok(iq_ref) = b.speed.step(
+            speed_ref_mech * T::lit(self.config.machine.pole_pairs as f64),
+            omega_ctrl,
+        ) else {
             return self.reject_after_estimate(backup, estimate, i_dq);
         };
-        let i_dq_ref =
-            limit_current_d_priority(Dq::new(b.injection.step(iq_ref), iq_ref), self.config.i_max);
+        let mut id_ref = b.injection.step(iq_ref);
+        if self.resolved.mtpa {
+            id_ref += self.config.machine.mtpa_id(iq_ref);
+        }
+        let i_dq_ref = limit_current_d_priority(Dq::new(id_ref, iq_ref), self.resolved.i_max);
         // 5. Current loop (unlimited).
         let Ok(v_dq) = b.current.step(i_dq_ref, i_dq, omega_ctrl) else {
             return self.reject_after_estimate(backup, estimate, i_dq);
@@ -775,12 +877,12 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         let rs_hat = if e.diagnostics.rs_hat > T::zero() {
             e.diagnostics.rs_hat
         } else {
-            c.rs_hat
+            c.machine.rs
         };
         let i = self.last_i_ab;
-        let predicted = i + (self.history[1] - i * rs_hat - emf) * (c.ts / c.lq_hat);
+        let predicted = i + (self.history[1] - i * rs_hat - emf) * (c.ts / c.machine.lq);
         let n = predicted.norm();
-        (n.is_finite() && n <= c.trip_current).then_some(predicted)
+        (n.is_finite() && n <= self.resolved.trip_current).then_some(predicted)
     }
 
     /// Rejected sample: hold the duty, keep the estimator's clock with the last good current.

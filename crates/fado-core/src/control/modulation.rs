@@ -21,6 +21,11 @@ use crate::{Ab, Abc, Real};
 
 /// Which set of α-β vectors counts as realisable.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(rename_all = "snake_case")
+)]
 pub enum VoltageLimit {
     /// The inverter hexagon (linear SVPWM range plus the six sectors' corners), radius Vdc/√3
     /// to 2·Vdc/3 depending on angle. Default.
