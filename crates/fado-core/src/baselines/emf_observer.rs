@@ -119,9 +119,9 @@ impl<T: Real> EmfObserverConfig<T> {
 /// The stationary-frame EMF observer with type-2 trackers (see the module docs).
 ///
 /// ```
-/// use fado_core::Ab;
+/// use fado_core::{Ab, MachineModel};
 /// use fado_core::baselines::{EmfObserverConfig, EmfObserverEstimator};
-/// let mut est = EmfObserverEstimator::<f32>::new(EmfObserverConfig::default()).unwrap();
+/// let mut est = EmfObserverEstimator::<f32>::new(EmfObserverConfig::for_machine(&MachineModel::paper())).unwrap();
 /// let out = est.step(Ab::new(1.2, -0.3), Ab::new(4.0, 0.1));
 /// assert!(!out.diagnostics.input_fault);
 /// ```
@@ -321,6 +321,7 @@ impl<T: Real> RotorAngleEstimator<T> for EmfObserverEstimator<T> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::MachineModel;
 
     #[test]
     fn config_errors_name_the_field() {
@@ -329,42 +330,42 @@ mod tests {
             (
                 C {
                     ts: f64::NAN,
-                    ..C::default()
+                    ..C::for_machine(&MachineModel::paper())
                 },
                 "ts",
             ),
             (
                 C {
                     rs_hat: -0.1,
-                    ..C::default()
+                    ..C::for_machine(&MachineModel::paper())
                 },
                 "rs_hat",
             ),
             (
                 C {
                     lq_hat: f64::INFINITY,
-                    ..C::default()
+                    ..C::for_machine(&MachineModel::paper())
                 },
                 "lq_hat",
             ),
             (
                 C {
                     flux_linkage_hat: -0.088,
-                    ..C::default()
+                    ..C::for_machine(&MachineModel::paper())
                 },
                 "flux_linkage_hat",
             ),
             (
                 C {
                     emf_bandwidth_hz: 0.0,
-                    ..C::default()
+                    ..C::for_machine(&MachineModel::paper())
                 },
                 "emf_bandwidth_hz",
             ),
             (
                 C {
                     emf_bandwidth_hz: 2_000.0,
-                    ..C::default()
+                    ..C::for_machine(&MachineModel::paper())
                 },
                 "emf_bandwidth_hz",
             ),
@@ -372,42 +373,42 @@ mod tests {
             (
                 C {
                     emf_bandwidth_hz: 10.0,
-                    ..C::default()
+                    ..C::for_machine(&MachineModel::paper())
                 },
                 "emf_bandwidth_hz",
             ),
             (
                 C {
                     speed_floor_hz: 0.0,
-                    ..C::default()
+                    ..C::for_machine(&MachineModel::paper())
                 },
                 "speed_floor_hz",
             ),
             (
                 C {
                     t2s1_bandwidth_hz: -60.0,
-                    ..C::default()
+                    ..C::for_machine(&MachineModel::paper())
                 },
                 "t2s1_bandwidth_hz",
             ),
             (
                 C {
                     t2s2_bandwidth_hz: 0.0,
-                    ..C::default()
+                    ..C::for_machine(&MachineModel::paper())
                 },
                 "t2s2_bandwidth_hz",
             ),
             (
                 C {
                     tracker_damping: -1.0,
-                    ..C::default()
+                    ..C::for_machine(&MachineModel::paper())
                 },
                 "tracker_damping",
             ),
             (
                 C {
                     initial_angle: f64::NEG_INFINITY,
-                    ..C::default()
+                    ..C::for_machine(&MachineModel::paper())
                 },
                 "initial_angle",
             ),
@@ -415,12 +416,12 @@ mod tests {
         for (config, field) in cases {
             assert_eq!(config.validate().unwrap_err().field(), field);
         }
-        assert!(C::default().validate().is_ok());
+        assert!(C::for_machine(&MachineModel::paper()).validate().is_ok());
         // Just above the speed-feedback bound is accepted.
         assert!(
             C {
                 emf_bandwidth_hz: 21.0,
-                ..C::default()
+                ..C::for_machine(&MachineModel::paper())
             }
             .validate()
             .is_ok()
@@ -429,7 +430,10 @@ mod tests {
 
     #[test]
     fn no_emf_at_standstill_makes_the_trackers_coast() {
-        let mut est = EmfObserverEstimator::new(EmfObserverConfig::<f64>::default()).unwrap();
+        let mut est = EmfObserverEstimator::new(EmfObserverConfig::<f64>::for_machine(
+            &MachineModel::paper(),
+        ))
+        .unwrap();
         est.align(0.5, Ab::new(4.0, 0.0));
         for _ in 0..1_000 {
             // A standing current: v = R·i, no EMF.

@@ -126,9 +126,9 @@ impl<T: Real> LpfIntegratorConfig<T> {
 /// The compensated low-pass flux estimator (see the module docs), generic over `f32`/`f64`.
 ///
 /// ```
-/// use fado_core::Ab;
+/// use fado_core::{Ab, MachineModel};
 /// use fado_core::baselines::{LpfIntegratorConfig, LpfIntegratorEstimator};
-/// let mut est = LpfIntegratorEstimator::<f32>::new(LpfIntegratorConfig::default()).unwrap();
+/// let mut est = LpfIntegratorEstimator::<f32>::new(LpfIntegratorConfig::for_machine(&MachineModel::paper())).unwrap();
 /// let out = est.step(Ab::new(1.2, -0.3), Ab::new(4.0, 0.1));
 /// assert!(!out.diagnostics.input_fault);
 /// ```
@@ -313,6 +313,7 @@ impl<T: Real> RotorAngleEstimator<T> for LpfIntegratorEstimator<T> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::MachineModel;
 
     #[test]
     fn config_errors_name_the_field() {
@@ -321,91 +322,91 @@ mod tests {
             (
                 C {
                     ts: 0.0,
-                    ..C::default()
+                    ..C::for_machine(&MachineModel::paper())
                 },
                 "ts",
             ),
             (
                 C {
                     rs_hat: -1.0,
-                    ..C::default()
+                    ..C::for_machine(&MachineModel::paper())
                 },
                 "rs_hat",
             ),
             (
                 C {
                     lq_hat: f64::NAN,
-                    ..C::default()
+                    ..C::for_machine(&MachineModel::paper())
                 },
                 "lq_hat",
             ),
             (
                 C {
                     flux_linkage_hat: 0.0,
-                    ..C::default()
+                    ..C::for_machine(&MachineModel::paper())
                 },
                 "flux_linkage_hat",
             ),
             (
                 C {
                     cutoff_hz: -1.0,
-                    ..C::default()
+                    ..C::for_machine(&MachineModel::paper())
                 },
                 "cutoff_hz",
             ),
             (
                 C {
                     cutoff_hz: 2_000.0,
-                    ..C::default()
+                    ..C::for_machine(&MachineModel::paper())
                 },
                 "cutoff_hz",
             ),
             (
                 C {
                     compensation_floor_hz: 0.0,
-                    ..C::default()
+                    ..C::for_machine(&MachineModel::paper())
                 },
                 "compensation_floor_hz",
             ),
             (
                 C {
                     t2s1_bandwidth_hz: 5_000.0,
-                    ..C::default()
+                    ..C::for_machine(&MachineModel::paper())
                 },
                 "t2s1_bandwidth_hz",
             ),
             (
                 C {
                     t2s2_bandwidth_hz: f64::NAN,
-                    ..C::default()
+                    ..C::for_machine(&MachineModel::paper())
                 },
                 "t2s2_bandwidth_hz",
             ),
             (
                 C {
                     tracker_damping: 0.0,
-                    ..C::default()
+                    ..C::for_machine(&MachineModel::paper())
                 },
                 "tracker_damping",
             ),
             (
                 C {
                     tracker_hold_ratio: 1.0,
-                    ..C::default()
+                    ..C::for_machine(&MachineModel::paper())
                 },
                 "tracker_hold_ratio",
             ),
             (
                 C {
                     tracker_hold_ratio: -0.1,
-                    ..C::default()
+                    ..C::for_machine(&MachineModel::paper())
                 },
                 "tracker_hold_ratio",
             ),
             (
                 C {
                     initial_angle: f64::INFINITY,
-                    ..C::default()
+                    ..C::for_machine(&MachineModel::paper())
                 },
                 "initial_angle",
             ),
@@ -413,12 +414,12 @@ mod tests {
         for (config, field) in cases {
             assert_eq!(config.validate().unwrap_err().field(), field);
         }
-        assert!(C::default().validate().is_ok());
+        assert!(C::for_machine(&MachineModel::paper()).validate().is_ok());
         // ωc = 0 is the open integrator of eq. (3).
         assert!(
             C {
                 cutoff_hz: 0.0,
-                ..C::default()
+                ..C::for_machine(&MachineModel::paper())
             }
             .validate()
             .is_ok()
@@ -438,7 +439,7 @@ mod tests {
         let est = LpfIntegratorEstimator::new(LpfIntegratorConfig {
             cutoff_hz: 3.0,
             compensation_floor_hz: 1e-9,
-            ..Default::default()
+            ..LpfIntegratorConfig::for_machine(&MachineModel::paper())
         })
         .unwrap();
         let (ts, wc): (f64, f64) = (1e-4, core::f64::consts::TAU * 3.0);
@@ -458,7 +459,10 @@ mod tests {
 
     #[test]
     fn regularised_compensation_is_one_at_standstill_and_symmetric() {
-        let est = LpfIntegratorEstimator::new(LpfIntegratorConfig::<f64>::default()).unwrap();
+        let est = LpfIntegratorEstimator::new(LpfIntegratorConfig::<f64>::for_machine(
+            &MachineModel::paper(),
+        ))
+        .unwrap();
         assert_eq!(est.compensation(0.0), Ab::new(1.0, 0.0));
         for w in [0.5, 6.0, 40.0, 400.0] {
             let (p, n) = (est.compensation(w), est.compensation(-w));
@@ -473,7 +477,7 @@ mod tests {
         // The bounded drift that replaces the open integrator's ramp: ψ → ε/ωc.
         let mut est = LpfIntegratorEstimator::new(LpfIntegratorConfig::<f64> {
             flux_linkage_hat: 1e-3,
-            ..Default::default()
+            ..LpfIntegratorConfig::for_machine(&MachineModel::paper())
         })
         .unwrap();
         est.align(0.0, Ab::zero());

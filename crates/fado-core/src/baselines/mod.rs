@@ -261,6 +261,7 @@ impl<T: Real> AngleTrackers<T> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::MachineModel;
     use crate::RotorAngleEstimator;
 
     /// Warms `est` up on a rotating machine-like input, then checks that a non-finite and an
@@ -296,23 +297,35 @@ mod tests {
 
     #[test]
     fn every_baseline_rejects_non_finite_and_overflowing_samples() {
-        rejects_bad_samples(LpfIntegratorEstimator::new(LpfIntegratorConfig::default()).unwrap());
-        rejects_bad_samples(OrtegaEstimator::new(OrtegaConfig::default()).unwrap());
-        rejects_bad_samples(EmfObserverEstimator::new(EmfObserverConfig::default()).unwrap());
+        rejects_bad_samples(
+            LpfIntegratorEstimator::new(LpfIntegratorConfig::for_machine(&MachineModel::paper()))
+                .unwrap(),
+        );
+        rejects_bad_samples(
+            OrtegaEstimator::new(OrtegaConfig::for_machine(&MachineModel::paper())).unwrap(),
+        );
+        rejects_bad_samples(
+            EmfObserverEstimator::new(EmfObserverConfig::for_machine(&MachineModel::paper()))
+                .unwrap(),
+        );
     }
 
     #[test]
     fn names_are_distinct() {
         let names = [
-            LpfIntegratorEstimator::<f64>::new(LpfIntegratorConfig::default())
+            LpfIntegratorEstimator::<f64>::new(LpfIntegratorConfig::for_machine(
+                &MachineModel::paper(),
+            ))
+            .unwrap()
+            .name(),
+            OrtegaEstimator::<f64>::new(OrtegaConfig::for_machine(&MachineModel::paper()))
                 .unwrap()
                 .name(),
-            OrtegaEstimator::<f64>::new(OrtegaConfig::default())
-                .unwrap()
-                .name(),
-            EmfObserverEstimator::<f64>::new(EmfObserverConfig::default())
-                .unwrap()
-                .name(),
+            EmfObserverEstimator::<f64>::new(
+                EmfObserverConfig::for_machine(&MachineModel::paper()),
+            )
+            .unwrap()
+            .name(),
         ];
         assert_eq!(names, ["lpf-integrator", "ortega", "emf-observer"]);
     }
@@ -337,7 +350,7 @@ mod tests {
         check(
             LpfIntegratorEstimator::new(LpfIntegratorConfig {
                 initial_angle: 0.3,
-                ..Default::default()
+                ..LpfIntegratorConfig::for_machine(&MachineModel::paper())
             })
             .unwrap(),
             0.3,
@@ -345,7 +358,7 @@ mod tests {
         check(
             OrtegaEstimator::new(OrtegaConfig {
                 initial_angle: 0.3,
-                ..Default::default()
+                ..OrtegaConfig::for_machine(&MachineModel::paper())
             })
             .unwrap(),
             0.3,
@@ -353,7 +366,7 @@ mod tests {
         check(
             EmfObserverEstimator::new(EmfObserverConfig {
                 initial_angle: 0.3,
-                ..Default::default()
+                ..EmfObserverConfig::for_machine(&MachineModel::paper())
             })
             .unwrap(),
             0.3,

@@ -184,9 +184,9 @@ impl<T: Real> OrtegaConfig<T> {
 /// The Ortega–Praly nonlinear flux observer with type-2 trackers (see the module docs).
 ///
 /// ```
-/// use fado_core::Ab;
+/// use fado_core::{Ab, MachineModel};
 /// use fado_core::baselines::{OrtegaConfig, OrtegaEstimator};
-/// let mut est = OrtegaEstimator::<f32>::new(OrtegaConfig::default()).unwrap();
+/// let mut est = OrtegaEstimator::<f32>::new(OrtegaConfig::for_machine(&MachineModel::paper())).unwrap();
 /// let out = est.step(Ab::new(1.2, -0.3), Ab::new(4.0, 0.1));
 /// assert!(!out.diagnostics.input_fault);
 /// ```
@@ -386,6 +386,7 @@ impl<T: Real> RotorAngleEstimator<T> for OrtegaEstimator<T> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::MachineModel;
 
     #[test]
     fn config_errors_name_the_field() {
@@ -394,105 +395,105 @@ mod tests {
             (
                 C {
                     ts: -1e-4,
-                    ..C::default()
+                    ..C::for_machine(&MachineModel::paper())
                 },
                 "ts",
             ),
             (
                 C {
                     rs_hat: f64::NAN,
-                    ..C::default()
+                    ..C::for_machine(&MachineModel::paper())
                 },
                 "rs_hat",
             ),
             (
                 C {
                     lq_hat: -1e-3,
-                    ..C::default()
+                    ..C::for_machine(&MachineModel::paper())
                 },
                 "lq_hat",
             ),
             (
                 C {
                     flux_linkage_hat: 0.0,
-                    ..C::default()
+                    ..C::for_machine(&MachineModel::paper())
                 },
                 "flux_linkage_hat",
             ),
             (
                 C {
                     observer_bandwidth: 0.0,
-                    ..C::default()
+                    ..C::for_machine(&MachineModel::paper())
                 },
                 "observer_bandwidth",
             ),
             (
                 C {
                     observer_bandwidth: 10_000.0,
-                    ..C::default()
+                    ..C::for_machine(&MachineModel::paper())
                 },
                 "observer_bandwidth",
             ),
             (
                 C {
                     observer_speed_ratio: -1.0,
-                    ..C::default()
+                    ..C::for_machine(&MachineModel::paper())
                 },
                 "observer_speed_ratio",
             ),
             (
                 C {
                     observer_bandwidth_min: 0.0,
-                    ..C::default()
+                    ..C::for_machine(&MachineModel::paper())
                 },
                 "observer_bandwidth_min",
             ),
             (
                 C {
                     observer_bandwidth_min: 2_000.0,
-                    ..C::default()
+                    ..C::for_machine(&MachineModel::paper())
                 },
                 "observer_bandwidth_min",
             ),
             (
                 C {
                     flux_adaptation_ratio: -0.2,
-                    ..C::default()
+                    ..C::for_machine(&MachineModel::paper())
                 },
                 "flux_adaptation_ratio",
             ),
             (
                 C {
                     t2s1_bandwidth_hz: 0.0,
-                    ..C::default()
+                    ..C::for_machine(&MachineModel::paper())
                 },
                 "t2s1_bandwidth_hz",
             ),
             (
                 C {
                     t2s2_bandwidth_hz: 1e9,
-                    ..C::default()
+                    ..C::for_machine(&MachineModel::paper())
                 },
                 "t2s2_bandwidth_hz",
             ),
             (
                 C {
                     tracker_damping: f64::NAN,
-                    ..C::default()
+                    ..C::for_machine(&MachineModel::paper())
                 },
                 "tracker_damping",
             ),
             (
                 C {
                     tracker_hold_ratio: 2.0,
-                    ..C::default()
+                    ..C::for_machine(&MachineModel::paper())
                 },
                 "tracker_hold_ratio",
             ),
             (
                 C {
                     initial_angle: f64::NAN,
-                    ..C::default()
+                    ..C::for_machine(&MachineModel::paper())
                 },
                 "initial_angle",
             ),
@@ -500,13 +501,13 @@ mod tests {
         for (config, field) in cases {
             assert_eq!(config.validate().unwrap_err().field(), field);
         }
-        assert!(C::default().validate().is_ok());
+        assert!(C::for_machine(&MachineModel::paper()).validate().is_ok());
     }
 
     #[test]
     fn default_schedule_is_critically_damped_between_its_bounds() {
         // s² + ω_obs·s + ω² has a double root when ω_obs = 2|ω|.
-        let c = OrtegaConfig::<f64>::default();
+        let c = OrtegaConfig::<f64>::for_machine(&MachineModel::paper());
         let tau = core::f64::consts::TAU;
         for f in [-100.0, -20.0, -1.6, 1.6, 6.0, 20.0, 100.0] {
             let w = tau * f;
@@ -531,7 +532,7 @@ mod tests {
         for speed_ratio in [0.0, 2.0] {
             let c = OrtegaConfig::<f64> {
                 observer_speed_ratio: speed_ratio,
-                ..OrtegaConfig::default()
+                ..OrtegaConfig::for_machine(&MachineModel::paper())
             };
             let mut est = OrtegaEstimator::new(c).unwrap();
             est.align(0.7, Ab::zero());
@@ -556,7 +557,7 @@ mod tests {
         // The fixed ω_max gain, where the floor k ≥ −½ acts for |η̂| > 3·λ̂f.
         let mut est = OrtegaEstimator::new(OrtegaConfig::<f64> {
             observer_speed_ratio: 0.0,
-            ..OrtegaConfig::default()
+            ..OrtegaConfig::for_machine(&MachineModel::paper())
         })
         .unwrap();
         est.align(-2.0, Ab::zero());
@@ -581,7 +582,7 @@ mod tests {
         let c = OrtegaConfig::<f64> {
             observer_speed_ratio: 0.0,
             observer_bandwidth: 2.0 * core::f64::consts::TAU * 20.0,
-            ..OrtegaConfig::default()
+            ..OrtegaConfig::for_machine(&MachineModel::paper())
         };
         let (ts, lf) = (c.ts, c.flux_linkage_hat);
         for w in [
