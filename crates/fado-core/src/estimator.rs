@@ -248,10 +248,10 @@ pub struct Diagnostics<T> {
     /// The trackers coasted because |λ̂r| was too small.
     pub tracker_hold: bool,
     /// R̂s used by the integrator this sample (Ω): the configured value, or the adapted one
-    /// with [`EstimatorConfig::rs_adaptation`].
+    /// with [`EstimatorTuning::rs_adaptation`].
     pub rs_hat: T,
     /// The flux-magnitude reference λ̂f (Wb): the configured value, or the adapted one with
-    /// [`EstimatorConfig::rs_adaptation`].
+    /// [`EstimatorTuning::rs_adaptation`].
     pub flux_linkage_hat: T,
     /// This sample's inputs were non-finite and were rejected; the state is unchanged and the
     /// other fields repeat the last good sample.
@@ -291,8 +291,9 @@ impl<T: Real> Estimate<T> {
 /// The sensorless estimator of Fig. 5, generic over `f32` and `f64`, allocation-free.
 ///
 /// ```
-/// use fado_core::{Ab, EstimatorConfig, SensorlessEstimator};
-/// let mut est = SensorlessEstimator::<f32>::new(EstimatorConfig::default()).unwrap();
+/// use fado_core::{Ab, EstimatorConfig, MachineModel, SensorlessEstimator};
+/// let config = EstimatorConfig::for_machine(&MachineModel::paper());
+/// let mut est = SensorlessEstimator::<f32>::new(config).unwrap();
 /// // In the 10 kHz ISR: the voltage applied over the last interval and the sampled currents.
 /// let out = est.step(Ab::new(1.2, -0.3), Ab::new(4.0, 0.1));
 /// assert!(!out.diagnostics.input_fault);
@@ -525,7 +526,7 @@ impl<T: Real> SensorlessEstimator<T> {
         // 1. Integrate with the feedback of the previous sample (eq. (21) / (24)).
         let (lambda1, i_drop) = self.integrator.next_flux(v_ab, i_ab, self.feedback);
         // 2. Disturbance observer at ω̂ of T2S-1 (eq. (10), (16)), on λ1 or on λ1 − L̂q·i
-        //    (see `EstimatorConfig::observer_on_rotor_flux`).
+        //    (see `EstimatorTuning::observer_on_rotor_flux`).
         let observer_input = if self.config.tuning.observer_on_rotor_flux {
             rotor_flux(lambda1, i_ab, self.config.machine.lq)
         } else {
@@ -571,7 +572,7 @@ impl<T: Real> SensorlessEstimator<T> {
         let rs_hat_used = self.integrator.config().rs_hat;
         let flux_linkage_used = self.rs_adaptation.flux_linkage_hat();
         let previous_mode = self.selector.mode();
-        // Limiter mode: re-centre the common mode (see `EstimatorConfig::limiter_recentring`).
+        // Limiter mode: re-centre the common mode (see `EstimatorTuning::limiter_recentring`).
         let shift = if mode == Mode::Limiter && self.config.tuning.limiter_recentring {
             disturbance * (self.config.tuning.k_df * self.config.ts)
         } else {
@@ -654,7 +655,7 @@ impl<T: Real> SensorlessEstimator<T> {
 
     /// Replaces R̂s at run time, as if it had been configured (an external estimate, or a
     /// value saved from the last run): the integrator uses it from the next sample, and with
-    /// [`EstimatorConfig::rs_adaptation`] the adaptation restarts from it, scaled and bounded
+    /// [`EstimatorTuning::rs_adaptation`] the adaptation restarts from it, scaled and bounded
     /// around it (a learned λ̂f goes back to the configured one too). Refuses bad values and
     /// then changes nothing.
     pub fn set_rs_hat(&mut self, rs_hat: T) -> Result<(), ConfigError> {

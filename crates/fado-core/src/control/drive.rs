@@ -475,9 +475,9 @@ impl<T: Real> Blocks<T> {
 ///
 /// ```
 /// use fado_core::control::{DriveConfig, SensorlessDrive};
-/// use fado_core::{Abc, EstimatorConfig};
-/// let mut drive =
-///     SensorlessDrive::<f32>::new(DriveConfig::default(), EstimatorConfig::default()).unwrap();
+/// use fado_core::{Abc, EstimatorTuning, MachineModel};
+/// let config = DriveConfig::for_machine(&MachineModel::paper());
+/// let mut drive = SensorlessDrive::<f32>::new(config, EstimatorTuning::default()).unwrap();
 /// drive.align(0.0);
 /// // Power-up: the first samples run with the gates off and measure the sensor offsets.
 /// while drive.is_calibrating() {
