@@ -11,19 +11,22 @@
 //!
 //! Cross-field constraints (thresholds out of order, bandwidths above what the sampling rate
 //! allows) are tested one by one below the table.
+//!
+//! Nested fields (`machine.rs`, `tuning.k_df`) are named by their last component, as the
+//! errors name them.
 
-use fado_core::ConfigError;
 use fado_core::Real;
 use fado_core::baselines::{
     EmfObserverConfig, EmfObserverEstimator, LpfIntegratorConfig, LpfIntegratorEstimator,
     OrtegaConfig, OrtegaEstimator,
 };
+use fado_core::control::drive::DriveTuning;
 use fado_core::control::{
     CurrentController, CurrentControllerConfig, DeadTimeCompensation, DeadTimeCompensationConfig,
     DelayCompensation, DelayCompensationConfig, DriveConfig, ModulatorConfig, Pi, PiConfig,
     SensorlessDrive, SpaceVectorModulator, SpeedController, SpeedControllerConfig,
 };
-use fado_core::estimator::{EstimatorConfig, SensorlessEstimator};
+use fado_core::estimator::{EstimatorConfig, EstimatorTuning, SensorlessEstimator};
 use fado_core::flux::{
     DisturbanceFeedback, DisturbanceFeedbackConfig, FluxIntegrator, FluxIntegratorConfig,
     FluxLimiter, FluxLimiterConfig,
@@ -32,6 +35,7 @@ use fado_core::injection::{CurrentInjection, CurrentInjectionConfig};
 use fado_core::mode::{ModeSelector, ModeSelectorConfig};
 use fado_core::observer::{DisturbanceObserver, DisturbanceObserverConfig};
 use fado_core::tracker::{TrackerConfig, TypeTwoTracker};
+use fado_core::{ConfigError, MachineModel};
 
 /// What a field's valid range is.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -55,11 +59,16 @@ struct Field<C, T> {
     range: Range,
 }
 
+/// The last component of a field path: `tuning.k_df` → `k_df`.
+fn leaf(path: &'static str) -> &'static str {
+    path.rsplit('.').next().unwrap_or(path).trim()
+}
+
 macro_rules! fields {
-    ($c:ty, $t:ty; $($name:ident: $range:ident),* $(,)?) => {
+    ($c:ty, $t:ty; $($($path:ident).+: $range:ident),* $(,)?) => {
         [$(Field::<$c, $t> {
-            name: stringify!($name),
-            set: |c: &mut $c, v: $t| c.$name = v,
+            name: leaf(stringify!($($path).+)),
+            set: |c: &mut $c, v: $t| c.$($path).+ = v,
             range: Range::$range,
         }),*]
     };
@@ -117,76 +126,143 @@ fn ok<X>(r: Result<X, ConfigError>) -> Result<(), ConfigError> {
     r.map(|_| ())
 }
 
-fn run_all<T: Real>(failures: &mut Vec<String>) -> usize {
+/// The 2.2 kW IPMSM of the "any motor" issue (p 3, Rs 3.6 Ω, Ld 36 mH, Lq 51 mH, λf 0.545 Wb,
+/// 6 A peak, 1500 r/min, 540 V); rated torque 14.9 N·m = magnet plus reluctance torque at the
+/// MTPA point of 6 A (`drive_salient.rs` checks it).
+fn ipmsm<T: Real>() -> MachineModel<T> {
+    MachineModel {
+        rs: T::lit(3.6),
+        ld: T::lit(36e-3),
+        lq: T::lit(51e-3),
+        flux_linkage: T::lit(0.545),
+        pole_pairs: 3,
+        inertia: T::lit(0.02),
+        viscous_friction: T::lit(1e-3),
+        rated_current: T::lit(6.0),
+        rated_speed_rpm: T::lit(1500.0),
+        rated_torque: T::lit(14.9),
+        dc_voltage: T::lit(540.0),
+    }
+}
+
+fn run_all<T: Real>(failures: &mut Vec<String>, machine: MachineModel<T>) -> usize {
     let mut n = 0;
     n += probe(
         failures,
+        "MachineModel",
+        machine,
+        |c| c.validate(),
+        &fields!(MachineModel<T>, T;
+            rs: Positive,
+            ld: Positive,
+            lq: Positive,
+            // Huge λf, rated current or speed break the unit-slip checks, which name
+            // `rated_torque` or `flux_linkage`.
+            flux_linkage: Positive,
+            inertia: Positive,
+            viscous_friction: NonNegative,
+            rated_current: Positive,
+            rated_speed_rpm: Positive,
+            rated_torque: PositiveBounded,
+            dc_voltage: Positive,
+        ),
+    );
+    n += probe(
+        failures,
         "EstimatorConfig",
-        EstimatorConfig::<T>::default(),
+        EstimatorConfig::<T>::for_machine(&machine),
         |c| ok(SensorlessEstimator::new(c)),
         &fields!(EstimatorConfig<T>, T;
             ts: Positive,
-            rs_hat: NonNegative,
-            lq_hat: NonNegative,
-            flux_linkage_hat: Positive,
-            k_df: NonNegativeBounded,
-            k_df_ramp_time: NonNegative,
-            k_af: NonNegativeBounded,
-            limiter_radius_ratio: Positive,
-            mode_threshold_hz: NonNegativeBounded,
-            mode_hysteresis_hz: NonNegativeBounded,
-            t2s1_bandwidth_hz: PositiveBounded,
-            t2s2_bandwidth_hz: PositiveBounded,
-            tracker_damping: Positive,
-            tracker_hold_ratio: NonNegativeBounded,
+            machine.rs: Positive,
+            machine.ld: Positive,
+            machine.lq: Positive,
+            machine.flux_linkage: Positive,
+            machine.inertia: Positive,
+            machine.rated_current: Positive,
+            machine.rated_speed_rpm: Positive,
+            machine.rated_torque: PositiveBounded,
+            machine.dc_voltage: Positive,
+            tuning.k_df: NonNegativeBounded,
+            tuning.k_df_ramp_time: NonNegative,
+            tuning.k_af: NonNegativeBounded,
+            tuning.limiter_radius_ratio: Positive,
+            tuning.mode_threshold_ratio: NonNegativeBounded,
+            tuning.mode_hysteresis_ratio: NonNegativeBounded,
+            tuning.t2s1_bandwidth_hz: PositiveBounded,
+            tuning.t2s2_bandwidth_hz: PositiveBounded,
+            tuning.tracker_damping: Positive,
+            tuning.tracker_hold_ratio: NonNegativeBounded,
             initial_angle: Signed,
         ),
     );
     n += probe(
         failures,
         "DriveConfig",
-        DriveConfig::<T>::default(),
+        DriveConfig::<T>::for_machine(&machine),
         |c| c.validate(),
         &fields!(DriveConfig<T>, T;
             ts: Positive,
-            pole_pairs: Positive,
-            rs_hat: NonNegative,
-            ld_hat: Positive,
-            lq_hat: Positive,
-            flux_linkage_hat: Positive,
-            inertia_hat: Positive,
-            current_bandwidth_hz: PositiveBounded,
-            speed_bandwidth_hz: PositiveBounded,
-            speed_zero_ratio: Positive,
-            i_max: Positive,
-            i_min: NonNegativeBounded,
-            dead_time: NonNegativeBounded,
-            switching_frequency: Positive,
-            dead_time_threshold_voltage: NonNegative,
-            dead_time_current_band: Positive,
-            delay_compensation_factor: NonNegativeBounded,
-            trip_current: Positive,
-            max_modulation: PositiveBounded,
-            current_anti_windup_ratio: NonNegativeBounded,
-            speed_anti_windup_ratio: NonNegativeBounded,
+            machine.rs: Positive,
+            machine.ld: Positive,
+            machine.lq: Positive,
+            machine.flux_linkage: Positive,
+            machine.inertia: Positive,
+            machine.viscous_friction: NonNegative,
+            machine.rated_current: Positive,
+            machine.rated_speed_rpm: Positive,
+            machine.rated_torque: PositiveBounded,
+            machine.dc_voltage: Positive,
+            tuning.current_bandwidth_hz: PositiveBounded,
+            tuning.speed_bandwidth_hz: PositiveBounded,
+            tuning.speed_zero_ratio: Positive,
+            // A huge limit makes the trip level (a ratio of its own) fall below it.
+            tuning.current_limit_ratio: Positive,
+            tuning.injection_current_ratio: NonNegativeBounded,
+            tuning.dead_time: NonNegativeBounded,
+            tuning.switching_frequency: Positive,
+            tuning.dead_time_threshold_voltage: NonNegative,
+            tuning.dead_time_current_band: Positive,
+            tuning.delay_compensation_factor: NonNegativeBounded,
+            tuning.trip_current_ratio: Positive,
+            tuning.max_modulation: PositiveBounded,
+            tuning.current_anti_windup_ratio: NonNegativeBounded,
+            tuning.speed_anti_windup_ratio: NonNegativeBounded,
+            tuning.offset_calibration_time: NonNegativeBounded,
+            // A huge band is refused naming `stuck_sensor_reference_ratio`, which must exceed it.
+            tuning.stuck_sensor_band_ratio: NonNegative,
+            tuning.stuck_sensor_reference_ratio: Positive,
+            tuning.stuck_sensor_time: NonNegativeBounded,
+            tuning.current_error_ratio: Positive,
+            tuning.current_error_time: NonNegativeBounded,
+            tuning.dc_link_min_ratio: NonNegative,
+            tuning.input_fault_trip_time: NonNegativeBounded,
         ),
     );
-    // The drive with its estimator: the same checks reach `SensorlessDrive::new`.
+    // The drive with its estimator: the same checks reach `SensorlessDrive::new`, and so do
+    // the estimator's through the tuning.
     n += probe(
         failures,
         "SensorlessDrive",
-        DriveConfig::<T>::default(),
-        |c| {
-            let est = EstimatorConfig {
-                ts: c.ts,
-                ..EstimatorConfig::default()
-            };
-            ok(SensorlessDrive::new(c, est))
-        },
+        DriveConfig::<T>::for_machine(&machine),
+        |c| ok(SensorlessDrive::new(c, EstimatorTuning::default())),
         &fields!(DriveConfig<T>, T;
             ts: Positive,
-            i_max: Positive,
-            current_bandwidth_hz: PositiveBounded,
+            machine.rs: Positive,
+            machine.flux_linkage: Positive,
+            tuning.current_limit_ratio: Positive,
+            tuning.current_bandwidth_hz: PositiveBounded,
+        ),
+    );
+    n += probe(
+        failures,
+        "SensorlessDrive(EstimatorTuning)",
+        EstimatorTuning::<T>::default(),
+        |t| ok(SensorlessDrive::new(DriveConfig::for_machine(&machine), t)),
+        &fields!(EstimatorTuning<T>, T;
+            k_df: NonNegativeBounded,
+            mode_threshold_ratio: NonNegativeBounded,
+            t2s1_bandwidth_hz: PositiveBounded,
         ),
     );
     n += probe(
@@ -362,7 +438,7 @@ fn run_all<T: Real>(failures: &mut Vec<String>) -> usize {
     n += probe(
         failures,
         "LpfIntegratorConfig",
-        LpfIntegratorConfig::<T>::default(),
+        LpfIntegratorConfig::<T>::for_machine(&machine),
         |c| ok(LpfIntegratorEstimator::new(c)),
         &fields!(LpfIntegratorConfig<T>, T;
             ts: Positive,
@@ -381,7 +457,7 @@ fn run_all<T: Real>(failures: &mut Vec<String>) -> usize {
     n += probe(
         failures,
         "OrtegaConfig",
-        OrtegaConfig::<T>::default(),
+        OrtegaConfig::<T>::for_machine(&machine),
         |c| ok(OrtegaEstimator::new(c)),
         &fields!(OrtegaConfig<T>, T;
             ts: Positive,
@@ -402,7 +478,7 @@ fn run_all<T: Real>(failures: &mut Vec<String>) -> usize {
     n += probe(
         failures,
         "EmfObserverConfig",
-        EmfObserverConfig::<T>::default(),
+        EmfObserverConfig::<T>::for_machine(&machine),
         |c| ok(EmfObserverEstimator::new(c)),
         &fields!(EmfObserverConfig<T>, T;
             ts: Positive,
@@ -421,30 +497,43 @@ fn run_all<T: Real>(failures: &mut Vec<String>) -> usize {
     n
 }
 
-#[test]
-fn every_field_of_every_config_is_validated_f64() {
+fn check_all<T: Real>(machine: MachineModel<T>, which: &str) {
     let mut failures = Vec::new();
-    let n = run_all::<f64>(&mut failures);
+    let n = run_all::<T>(&mut failures, machine);
     assert!(
         failures.is_empty(),
-        "{} of {n} cases failed:\n{}",
+        "{which}: {} of {n} cases failed:\n{}",
         failures.len(),
         failures.join("\n")
     );
-    assert!(n > 300, "only {n} cases ran");
+    assert!(n > 500, "{which}: only {n} cases ran");
+}
+
+#[test]
+fn every_field_of_every_config_is_validated_f64() {
+    check_all::<f64>(MachineModel::paper(), "paper motor");
+    check_all::<f64>(ipmsm(), "2.2 kW IPMSM");
 }
 
 #[test]
 fn every_field_of_every_config_is_validated_f32() {
-    let mut failures = Vec::new();
-    let n = run_all::<f32>(&mut failures);
-    assert!(
-        failures.is_empty(),
-        "{} of {n} cases failed:\n{}",
-        failures.len(),
-        failures.join("\n")
+    check_all::<f32>(MachineModel::paper(), "paper motor");
+    check_all::<f32>(ipmsm(), "2.2 kW IPMSM");
+}
+
+#[test]
+fn zero_pole_pairs_are_refused_everywhere() {
+    let mut m = MachineModel::<f64>::paper();
+    m.pole_pairs = 0;
+    assert_eq!(refused_field(m.validate()), "pole_pairs");
+    let e = EstimatorConfig::for_machine(&m);
+    assert_eq!(refused_field(SensorlessEstimator::new(e)), "pole_pairs");
+    let d = DriveConfig::for_machine(&m);
+    assert_eq!(refused_field(d.validate()), "pole_pairs");
+    assert_eq!(
+        refused_field(SensorlessDrive::new(d, EstimatorTuning::default())),
+        "pole_pairs"
     );
-    assert!(n > 300, "only {n} cases ran");
 }
 
 /// The field a config is refused for, or "" when it is accepted.
@@ -454,14 +543,14 @@ fn refused_field<X>(r: Result<X, ConfigError>) -> &'static str {
 
 /// The field the default estimator config is refused for after `f`, or "".
 fn est(f: impl FnOnce(&mut EstimatorConfig<f64>)) -> &'static str {
-    let mut c = EstimatorConfig::default();
+    let mut c = EstimatorConfig::for_machine(&MachineModel::paper());
     f(&mut c);
     refused_field(SensorlessEstimator::new(c))
 }
 
 /// The field the default drive config is refused for after `f`, or "".
 fn drive(f: impl FnOnce(&mut DriveConfig<f64>)) -> &'static str {
-    let mut c = DriveConfig::default();
+    let mut c = DriveConfig::for_machine(&MachineModel::paper());
     f(&mut c);
     refused_field(c.validate())
 }
@@ -490,45 +579,62 @@ fn bandwidths_above_what_the_sampling_rate_allows_are_refused() {
         kp * ts >= 2.0 || 2.0 * kp * ts + ki * ts * ts >= 4.0,
         "refused at {limit} Hz although Jury's conditions hold"
     );
-    assert_eq!(est(|c| c.t2s1_bandwidth_hz = limit), "t2s1_bandwidth_hz");
-    assert_eq!(est(|c| c.t2s2_bandwidth_hz = limit), "t2s2_bandwidth_hz");
-    assert_eq!(est(|c| c.t2s1_bandwidth_hz = limit - 1.0), "");
+    assert_eq!(
+        est(|c| c.tuning.t2s1_bandwidth_hz = limit),
+        "t2s1_bandwidth_hz"
+    );
+    assert_eq!(
+        est(|c| c.tuning.t2s2_bandwidth_hz = limit),
+        "t2s2_bandwidth_hz"
+    );
+    assert_eq!(est(|c| c.tuning.t2s1_bandwidth_hz = limit - 1.0), "");
     // Limiter and disturbance feedback: one step must not remove more than the excess.
-    assert_eq!(est(|c| c.k_af = 1.0 / ts), "");
-    assert_eq!(est(|c| c.k_af = 1.01 / ts), "k_af");
-    assert_eq!(est(|c| c.k_df = 1.0 / ts), "");
-    assert_eq!(est(|c| c.k_df = 1.01 / ts), "k_df");
-    // The mode band must lie below Nyquist (5 kHz).
-    assert_eq!(est(|c| c.mode_threshold_hz = 5000.0), "mode_threshold_hz");
+    assert_eq!(est(|c| c.tuning.k_af = 1.0 / ts), "");
+    assert_eq!(est(|c| c.tuning.k_af = 1.01 / ts), "k_af");
+    assert_eq!(est(|c| c.tuning.k_df = 1.0 / ts), "");
+    assert_eq!(est(|c| c.tuning.k_df = 1.01 / ts), "k_df");
+    // The mode band must lie below Nyquist (5 kHz; the paper motor's rated frequency is
+    // 100 Hz, so the ratios are the old thresholds in Hz / 100).
+    assert_eq!(
+        est(|c| c.tuning.mode_threshold_ratio = 50.0),
+        "mode_threshold_ratio"
+    );
+    assert_eq!(est(|c| c.tuning.mode_threshold_ratio = 49.9), "");
     assert_eq!(
         est(|c| {
-            c.mode_threshold_hz = 4900.0;
-            c.mode_hysteresis_hz = 200.0;
+            c.tuning.mode_threshold_ratio = 49.0;
+            c.tuning.mode_hysteresis_ratio = 2.0;
         }),
-        "mode_hysteresis_hz"
+        "mode_hysteresis_ratio"
     );
+    // The same ratio is a lower frequency on a slower motor: 50 × 75 Hz (the 2.2 kW IPMSM,
+    // 3 pole pairs at 1500 r/min) is below Nyquist.
+    let mut slow = EstimatorConfig::for_machine(&ipmsm::<f64>());
+    slow.tuning.mode_threshold_ratio = 50.0;
+    assert!((slow.mode_threshold_hz() - 3750.0).abs() < 1e-9);
+    assert_eq!(refused_field(SensorlessEstimator::new(slow)), "");
     // Drive: current PI (2π·f·Ts ≤ 0.5) and speed PI (2π·f·Ts < 0.1).
     let f_cc = 0.5 / (2.0 * std::f64::consts::PI * ts);
-    assert_eq!(drive(|c| c.current_bandwidth_hz = 790.0), "");
+    assert_eq!(drive(|c| c.tuning.current_bandwidth_hz = 790.0), "");
     assert!(f_cc < 800.0);
     assert_eq!(
-        drive(|c| c.current_bandwidth_hz = 800.0),
+        drive(|c| c.tuning.current_bandwidth_hz = 800.0),
         "current_bandwidth_hz"
     );
     assert_eq!(
-        drive(|c| c.speed_bandwidth_hz = 160.0),
+        drive(|c| c.tuning.speed_bandwidth_hz = 160.0),
         "speed_bandwidth_hz"
     );
-    assert_eq!(drive(|c| c.speed_bandwidth_hz = 150.0), "");
+    assert_eq!(drive(|c| c.tuning.speed_bandwidth_hz = 150.0), "");
     // Baselines.
     let lpf = LpfIntegratorConfig::<f64> {
         cutoff_hz: 1600.0,
-        ..Default::default()
+        ..LpfIntegratorConfig::for_machine(&MachineModel::paper())
     };
     assert_eq!(refused_field(LpfIntegratorEstimator::new(lpf)), "cutoff_hz");
     let emf = EmfObserverConfig::<f64> {
         emf_bandwidth_hz: 1600.0,
-        ..Default::default()
+        ..EmfObserverConfig::for_machine(&MachineModel::paper())
     };
     assert_eq!(
         refused_field(EmfObserverEstimator::new(emf)),
@@ -536,7 +642,7 @@ fn bandwidths_above_what_the_sampling_rate_allows_are_refused() {
     );
     let ortega = OrtegaConfig::<f64> {
         observer_bandwidth: 1.0e4,
-        ..Default::default()
+        ..OrtegaConfig::for_machine(&MachineModel::paper())
     };
     assert_eq!(
         refused_field(OrtegaEstimator::new(ortega)),
@@ -546,19 +652,47 @@ fn bandwidths_above_what_the_sampling_rate_allows_are_refused() {
 
 #[test]
 fn thresholds_out_of_order_are_refused() {
-    assert_eq!(est(|c| c.mode_hysteresis_hz = 1.6), "mode_hysteresis_hz");
-    assert_eq!(est(|c| c.mode_hysteresis_hz = 1.5), "");
-    assert_eq!(est(|c| c.tracker_hold_ratio = 1.0), "tracker_hold_ratio");
+    // Hysteresis at most the threshold (1.5 Hz = 0.015 of the paper motor's 100 Hz).
     assert_eq!(
-        est(|c| c.limiter_radius_ratio = 0.9),
+        est(|c| c.tuning.mode_hysteresis_ratio = 0.016),
+        "mode_hysteresis_ratio"
+    );
+    assert_eq!(est(|c| c.tuning.mode_hysteresis_ratio = 0.015), "");
+    assert_eq!(
+        est(|c| c.tuning.tracker_hold_ratio = 1.0),
+        "tracker_hold_ratio"
+    );
+    assert_eq!(
+        est(|c| c.tuning.limiter_radius_ratio = 0.9),
         "limiter_radius_ratio"
     );
-    assert_eq!(est(|c| c.limiter_radius_ratio = 1.0), "");
-    assert_eq!(drive(|c| c.i_min = 41.0), "i_min");
-    assert_eq!(drive(|c| c.i_min = 40.0), "");
-    assert_eq!(drive(|c| c.trip_current = 40.0), "trip_current");
-    assert_eq!(drive(|c| c.max_modulation = 1.01), "max_modulation");
-    assert_eq!(drive(|c| c.dead_time = 1e-4), "dead_time");
+    assert_eq!(est(|c| c.tuning.limiter_radius_ratio = 1.0), "");
+    // Injection at most the current limit, the trip level above it (as ratios of the same
+    // rated current: 41 A, 40 A against the 40 A limit of the paper's motor).
+    let limit = DriveConfig::<f64>::for_machine(&MachineModel::paper())
+        .tuning
+        .current_limit_ratio;
+    assert_eq!(
+        drive(|c| c.tuning.injection_current_ratio = limit * 41.0 / 40.0),
+        "injection_current_ratio"
+    );
+    assert_eq!(drive(|c| c.tuning.injection_current_ratio = limit), "");
+    assert_eq!(
+        drive(|c| c.tuning.trip_current_ratio = limit),
+        "trip_current_ratio"
+    );
+    assert_eq!(
+        drive(|c| c.tuning.stuck_sensor_reference_ratio = c.tuning.stuck_sensor_band_ratio),
+        "stuck_sensor_reference_ratio"
+    );
+    // Durations: at most 4e9 sampling periods (a u32 count).
+    assert_eq!(
+        drive(|c| c.tuning.current_error_time = 4.1e5),
+        "current_error_time"
+    );
+    assert_eq!(drive(|c| c.tuning.current_error_time = 3.9e5), "");
+    assert_eq!(drive(|c| c.tuning.max_modulation = 1.01), "max_modulation");
+    assert_eq!(drive(|c| c.tuning.dead_time = 1e-4), "dead_time");
     let pi = PiConfig::<f64> {
         ts: 1e-4,
         kp: 1.0,
@@ -568,25 +702,21 @@ fn thresholds_out_of_order_are_refused() {
         anti_windup_ratio: 1.0,
     };
     assert_eq!(refused_field(Pi::new(pi)), "output_max");
-    // The drive and its estimator must share ts; a NaN ts is named as not finite.
-    let est_cfg = EstimatorConfig::<f64> {
+    // The drive builds its estimator with its own ts and machine (they cannot disagree); a
+    // NaN ts is named as not finite.
+    let c = DriveConfig::<f64> {
         ts: 50e-6,
-        ..Default::default()
+        ..DriveConfig::for_machine(&ipmsm())
     };
-    assert_eq!(
-        refused_field(SensorlessDrive::new(DriveConfig::default(), est_cfg)),
-        "ts"
-    );
+    let d = SensorlessDrive::new(c, EstimatorTuning::default()).unwrap();
+    assert_eq!(d.estimator().config().ts, 50e-6);
+    assert_eq!(d.estimator().config().machine, ipmsm());
     let nan_ts = DriveConfig::<f64> {
         ts: f64::NAN,
-        ..Default::default()
-    };
-    let nan_est = EstimatorConfig::<f64> {
-        ts: f64::NAN,
-        ..Default::default()
+        ..DriveConfig::for_machine(&MachineModel::paper())
     };
     assert_eq!(
-        SensorlessDrive::new(nan_ts, nan_est).err(),
+        SensorlessDrive::new(nan_ts, EstimatorTuning::default()).err(),
         Some(ConfigError::NotFinite { field: "ts" })
     );
 }
@@ -595,38 +725,62 @@ mod properties {
     use super::*;
     use proptest::prelude::*;
 
+    /// Random motors that pass the unit-slip checks: surface-magnet and salient (Lq/Ld 0.8–2),
+    /// 1–8 pole pairs, rated torque 0.4–2.5 × the magnet torque, DC link 0.6–3 × the
+    /// line-to-line back-EMF amplitude at rated speed.
+    fn valid_machine() -> impl Strategy<Value = MachineModel<f64>> {
+        (
+            (0.01..5.0f64, 1e-4..0.05f64, 0.8..2.0f64, 0.001..1.0f64),
+            (1u32..=8, 1e-4..1.0f64, 0.0..0.01f64, 0.5..200.0f64),
+            (100.0..6000.0f64, 0.4..2.5f64, 0.6..3.0f64),
+        )
+            .prop_map(
+                |((rs, ld, saliency, lf), (p, j, b, i_rated), (rpm, torque, dc))| {
+                    let w = rpm * std::f64::consts::PI / 30.0 * p as f64;
+                    MachineModel {
+                        rs,
+                        ld,
+                        lq: ld * saliency,
+                        flux_linkage: lf,
+                        pole_pairs: p,
+                        inertia: j,
+                        viscous_friction: b,
+                        rated_current: i_rated,
+                        rated_speed_rpm: rpm,
+                        rated_torque: torque * 1.5 * p as f64 * lf * i_rated,
+                        dc_voltage: dc * 3f64.sqrt() * w * lf,
+                    }
+                },
+            )
+    }
+
     /// Random configurations inside the documented ranges.
     fn valid_estimator() -> impl Strategy<Value = EstimatorConfig<f64>> {
         (
-            (20e-6..500e-6f64, 0.0..5.0f64, 0.0..0.05f64, 0.001..1.0f64),
+            (20e-6..500e-6f64, valid_machine()),
             (0.0..10.0f64, 0.0..0.1f64, 0.0..1.0f64, 1.0..3.0f64),
-            (0.0..20.0f64, 0.0..1.0f64, 1.0..100.0f64, 1.0..100.0f64),
+            (0.0..0.2f64, 0.0..1.0f64, 1.0..100.0f64, 1.0..100.0f64),
             (0.3..2.0f64, 0.0..0.9f64, -10.0..10.0f64),
         )
             .prop_map(
-                |(
-                    (ts, rs, lq, lf),
-                    (kdf, ramp, kaf_ts, ratio),
-                    (th, hy, b1, b2),
-                    (z, hold, a0),
-                )| {
+                |((ts, machine), (kdf, ramp, kaf_ts, ratio), (th, hy, b1, b2), (z, hold, a0))| {
                     EstimatorConfig {
                         ts,
-                        rs_hat: rs,
-                        lq_hat: lq,
-                        flux_linkage_hat: lf,
-                        k_df: kdf,
-                        k_df_ramp_time: ramp,
-                        k_af: kaf_ts / ts,
-                        limiter_radius_ratio: ratio,
-                        mode_threshold_hz: th,
-                        mode_hysteresis_hz: hy * th,
-                        t2s1_bandwidth_hz: b1,
-                        t2s2_bandwidth_hz: b2,
-                        tracker_damping: z,
-                        tracker_hold_ratio: hold,
+                        machine,
                         initial_angle: a0,
-                        ..EstimatorConfig::default()
+                        tuning: EstimatorTuning {
+                            k_df: kdf,
+                            k_df_ramp_time: ramp,
+                            k_af: kaf_ts / ts,
+                            limiter_radius_ratio: ratio,
+                            mode_threshold_ratio: th,
+                            mode_hysteresis_ratio: hy * th,
+                            t2s1_bandwidth_hz: b1,
+                            t2s2_bandwidth_hz: b2,
+                            tracker_damping: z,
+                            tracker_hold_ratio: hold,
+                            ..EstimatorTuning::default()
+                        },
                     }
                 },
             )
@@ -636,62 +790,61 @@ mod properties {
     /// their sampling-rate limits.
     fn valid_drive() -> impl Strategy<Value = DriveConfig<f64>> {
         (
+            (50e-6..200e-6f64, valid_machine()),
+            (0.01..0.9f64, 0.01..0.9f64, 1.0..20.0f64),
             (
-                50e-6..200e-6f64,
-                1.0..8.0f64,
-                0.0..2.0f64,
-                1e-4..0.05f64,
-                1e-4..0.05f64,
-            ),
-            (
-                0.01..1.0f64,
-                1e-4..1.0f64,
-                0.01..0.9f64,
-                0.01..0.9f64,
-                1.0..20.0f64,
-            ),
-            (
-                1.0..200.0f64,
+                0.1..5.0f64,
                 0.0..1.0f64,
                 1.01..3.0f64,
                 0.0..0.45f64,
                 0.0..10.0f64,
             ),
             (0.1..1.0f64, 0.0..1.0f64, 0.0..50.0f64),
+            (
+                (0.0..1.0f64, 0.0..0.05f64, 1e-3..0.5f64, 0.0..0.01f64),
+                (0.01..2.0f64, 0.0..0.1f64, 0.0..1.0f64, 0.0..1.0f64),
+            ),
         )
             .prop_map(
                 |(
-                    (ts, p, rs, ld, lq),
-                    (lf, j, cbw, sbw, zr),
-                    (imax, imin, trip, td, delay),
+                    (ts, machine),
+                    (cbw, sbw, zr),
+                    (limit, imin, trip, td, delay),
                     (m, caw, saw),
+                    ((cal, band, reference, stuck), (err, err_time, dc_min, fault)),
                 )| {
                     let two_pi_ts = 2.0 * std::f64::consts::PI * ts;
                     // Back-calculation gains below their limit ratio·Ki/Kp·Ts ≤ 1 (PI docs):
                     // Ki/Kp = R̂s/L̂ for the current PI, ωsc/zero_ratio for the speed PI.
+                    let (rs, ld, lq) = (machine.rs, machine.ld, machine.lq);
                     let caw = caw * ld.min(lq) / (rs * ts).max(1e-12);
                     let saw = saw / 50.0 * zr / (sbw * 0.1);
                     DriveConfig {
                         ts,
-                        pole_pairs: p.round(),
-                        rs_hat: rs,
-                        ld_hat: ld,
-                        lq_hat: lq,
-                        flux_linkage_hat: lf,
-                        inertia_hat: j,
-                        current_bandwidth_hz: cbw * 0.5 / two_pi_ts,
-                        speed_bandwidth_hz: sbw * 0.1 / two_pi_ts,
-                        speed_zero_ratio: zr,
-                        i_max: imax,
-                        i_min: imin * imax,
-                        trip_current: trip * imax,
-                        dead_time: td * ts,
-                        switching_frequency: 0.5 / ts,
-                        delay_compensation_factor: delay,
-                        max_modulation: m,
-                        current_anti_windup_ratio: caw,
-                        speed_anti_windup_ratio: saw,
-                        ..DriveConfig::default()
+                        machine,
+                        tuning: DriveTuning {
+                            current_bandwidth_hz: cbw * 0.5 / two_pi_ts,
+                            speed_bandwidth_hz: sbw * 0.1 / two_pi_ts,
+                            speed_zero_ratio: zr,
+                            current_limit_ratio: limit,
+                            injection_current_ratio: imin * limit,
+                            trip_current_ratio: trip * limit,
+                            dead_time: td * ts,
+                            switching_frequency: 0.5 / ts,
+                            delay_compensation_factor: delay,
+                            max_modulation: m,
+                            current_anti_windup_ratio: caw,
+                            speed_anti_windup_ratio: saw,
+                            offset_calibration_time: cal,
+                            stuck_sensor_band_ratio: band,
+                            stuck_sensor_reference_ratio: band + reference,
+                            stuck_sensor_time: stuck,
+                            current_error_ratio: err,
+                            current_error_time: err_time,
+                            dc_link_min_ratio: dc_min,
+                            input_fault_trip_time: fault,
+                            ..DriveTuning::default()
+                        },
                     }
                 },
             )
@@ -699,9 +852,13 @@ mod properties {
 
     proptest! {
         #[test]
+        fn valid_machines_validate(m in valid_machine()) {
+            prop_assert_eq!(m.validate().err(), None);
+        }
+
+        #[test]
         fn valid_drive_configs_construct(c in valid_drive()) {
-            let est = EstimatorConfig { ts: c.ts, ..EstimatorConfig::default() };
-            prop_assert_eq!(SensorlessDrive::new(c, est).err(), None);
+            prop_assert_eq!(SensorlessDrive::new(c, EstimatorTuning::default()).err(), None);
         }
 
         #[test]
@@ -710,20 +867,42 @@ mod properties {
         }
 
         #[test]
-        fn one_nan_field_is_refused_naming_it(c in valid_estimator(), which in 0usize..15) {
+        fn one_nan_field_is_refused_naming_it(c in valid_estimator(), which in 0usize..20) {
             let fields = fields!(EstimatorConfig<f64>, f64;
-                ts: Positive, rs_hat: NonNegative, lq_hat: NonNegative,
-                flux_linkage_hat: Positive, k_df: NonNegative, k_df_ramp_time: NonNegative,
-                k_af: NonNegative, limiter_radius_ratio: Positive,
-                mode_threshold_hz: NonNegative, mode_hysteresis_hz: NonNegative,
-                t2s1_bandwidth_hz: Positive, t2s2_bandwidth_hz: Positive,
-                tracker_damping: Positive, tracker_hold_ratio: NonNegative, initial_angle: Signed,
+                ts: Positive, machine.rs: Positive, machine.ld: Positive, machine.lq: Positive,
+                machine.flux_linkage: Positive, machine.inertia: Positive,
+                machine.rated_current: Positive, machine.rated_speed_rpm: Positive,
+                machine.rated_torque: Positive, machine.dc_voltage: Positive,
+                tuning.k_df: NonNegative, tuning.k_df_ramp_time: NonNegative,
+                tuning.k_af: NonNegative, tuning.limiter_radius_ratio: Positive,
+                tuning.mode_threshold_ratio: NonNegative, tuning.mode_hysteresis_ratio: NonNegative,
+                tuning.t2s1_bandwidth_hz: Positive, tuning.t2s2_bandwidth_hz: Positive,
+                tuning.tracker_damping: Positive, tuning.tracker_hold_ratio: NonNegative,
             );
             let f = &fields[which];
             let mut bad = c;
             (f.set)(&mut bad, f64::NAN);
             prop_assert_eq!(
                 SensorlessEstimator::new(bad).err(),
+                Some(ConfigError::NotFinite { field: f.name })
+            );
+        }
+
+        #[test]
+        fn one_nan_drive_field_is_refused_naming_it(c in valid_drive(), which in 0usize..12) {
+            let fields = fields!(DriveConfig<f64>, f64;
+                ts: Positive, machine.rs: Positive, machine.lq: Positive,
+                machine.rated_current: Positive, machine.dc_voltage: Positive,
+                tuning.current_limit_ratio: Positive, tuning.injection_current_ratio: NonNegative,
+                tuning.trip_current_ratio: Positive, tuning.offset_calibration_time: NonNegative,
+                tuning.stuck_sensor_band_ratio: NonNegative, tuning.current_error_time: NonNegative,
+                tuning.dc_link_min_ratio: NonNegative,
+            );
+            let f = &fields[which];
+            let mut bad = c;
+            (f.set)(&mut bad, f64::NAN);
+            prop_assert_eq!(
+                SensorlessDrive::new(bad, EstimatorTuning::default()).err(),
                 Some(ConfigError::NotFinite { field: f.name })
             );
         }
