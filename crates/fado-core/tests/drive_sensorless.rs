@@ -9,9 +9,10 @@ use fado_core::control::{
     DeadTimeCompensation, DeadTimeCompensationConfig, DeadTimeMethod, DriveConfig, DriveOutput,
     SensorlessDrive,
 };
+use fado_core::estimator::EstimatorTuning;
 use fado_core::{
-    Ab, Abc, Diagnostics, DriveFlags, Estimate, EstimatorConfig, Rotation, RotorAngleEstimator,
-    SensorlessEstimator,
+    Ab, Abc, Diagnostics, DriveFlags, Estimate, EstimatorConfig, MachineModel, Rotation,
+    RotorAngleEstimator, SensorlessEstimator,
 };
 use proptest::prelude::*;
 
@@ -56,20 +57,18 @@ impl RotorAngleEstimator<f64> for Spy {
 /// The default drive without the start-up offset calibration: these tests drive the
 /// controllers from the first sample (the calibration has its own tests in `improvements.rs`).
 fn no_calibration<T: fado_core::Real>() -> DriveConfig<T> {
-    DriveConfig {
-        offset_calibration_samples: 0,
-        ..DriveConfig::default()
-    }
+    let mut c = DriveConfig::for_machine(&MachineModel::paper());
+    c.tuning.offset_calibration_time = T::zero();
+    c
 }
 
 /// As [`no_calibration`], and without the stuck-sensor check: the spy's synthetic currents do
 /// not follow the references, so a phase reading near zero while its reference asks for
 /// amps is (rightly) implausible and would be replaced by the model reconstruction.
 fn synthetic_currents<T: fado_core::Real>() -> DriveConfig<T> {
-    DriveConfig {
-        stuck_sensor_samples: 0,
-        ..no_calibration()
-    }
+    let mut c = no_calibration();
+    c.tuning.stuck_sensor_time = T::zero();
+    c
 }
 
 fn spy_drive() -> SensorlessDrive<f64, Spy> {
@@ -224,46 +223,63 @@ fn over_current_trips_and_latches_until_reset() {
 #[test]
 fn configuration_errors_name_the_field() {
     let bad = |f: fn(&mut DriveConfig<f64>)| {
-        let mut cfg = DriveConfig::default();
+        let mut cfg = DriveConfig::for_machine(&MachineModel::paper());
         f(&mut cfg);
-        SensorlessDrive::new(cfg, EstimatorConfig::default())
+        SensorlessDrive::new(cfg, EstimatorTuning::default())
             .unwrap_err()
             .field()
     };
-    assert_eq!(bad(|c| c.ts = 50e-6), "ts");
-    assert_eq!(bad(|c| c.i_min = 50.0), "i_min");
-    assert_eq!(bad(|c| c.trip_current = 30.0), "trip_current");
-    assert_eq!(bad(|c| c.pole_pairs = 0.0), "pole_pairs");
-    assert_eq!(bad(|c| c.inertia_hat = f64::NAN), "inertia_hat");
+    // (A ts differing from the estimator's can no longer be configured: the drive builds its
+    // estimator with its own.)
+    assert_eq!(bad(|c| c.ts = 0.0), "ts");
+    // 50 A of injection against the 40 A limit, a 30 A trip level below it (paper motor,
+    // 21.78 A rated).
     assert_eq!(
-        bad(|c| c.current_bandwidth_hz = 5e3),
+        bad(|c| c.tuning.injection_current_ratio = 50.0 / c.machine.rated_current),
+        "injection_current_ratio"
+    );
+    assert_eq!(
+        bad(|c| c.tuning.trip_current_ratio = 30.0 / c.machine.rated_current),
+        "trip_current_ratio"
+    );
+    assert_eq!(bad(|c| c.machine.pole_pairs = 0), "pole_pairs");
+    assert_eq!(bad(|c| c.machine.inertia = f64::NAN), "inertia");
+    assert_eq!(
+        bad(|c| c.tuning.current_bandwidth_hz = 5e3),
         "current_bandwidth_hz"
     );
-    assert_eq!(bad(|c| c.speed_bandwidth_hz = -1.0), "speed_bandwidth_hz");
     assert_eq!(
-        bad(|c| c.speed_anti_windup_ratio = 1e9),
+        bad(|c| c.tuning.speed_bandwidth_hz = -1.0),
+        "speed_bandwidth_hz"
+    );
+    assert_eq!(
+        bad(|c| c.tuning.speed_anti_windup_ratio = 1e9),
         "speed_anti_windup_ratio"
     );
     assert_eq!(
-        bad(|c| c.current_anti_windup_ratio = -1.0),
+        bad(|c| c.tuning.current_anti_windup_ratio = -1.0),
         "current_anti_windup_ratio"
     );
     assert_eq!(
-        bad(|c| c.dead_time_current_band = 0.0),
+        bad(|c| c.tuning.dead_time_current_band = 0.0),
         "dead_time_current_band"
     );
     assert_eq!(
-        bad(|c| c.dead_time_threshold_voltage = -1.0),
+        bad(|c| c.tuning.dead_time_threshold_voltage = -1.0),
         "dead_time_threshold_voltage"
     );
     assert_eq!(
-        bad(|c| c.delay_compensation_factor = -1.0),
+        bad(|c| c.tuning.delay_compensation_factor = -1.0),
         "delay_compensation_factor"
     );
-    assert_eq!(bad(|c| c.max_modulation = 2.0), "max_modulation");
-    assert_eq!(bad(|c| c.ld_hat = 0.0), "ld_hat");
-    assert_eq!(bad(|c| c.rs_hat = f64::INFINITY), "rs_hat");
-    assert!(DriveConfig::<f32>::default().validate().is_ok());
+    assert_eq!(bad(|c| c.tuning.max_modulation = 2.0), "max_modulation");
+    assert_eq!(bad(|c| c.machine.ld = 0.0), "ld");
+    assert_eq!(bad(|c| c.machine.rs = f64::INFINITY), "rs");
+    assert!(
+        DriveConfig::<f32>::for_machine(&MachineModel::paper())
+            .validate()
+            .is_ok()
+    );
 }
 
 fn any_value() -> impl Strategy<Value = f64> {
@@ -296,18 +312,15 @@ fn check_output<T: fado_core::Real>(o: &DriveOutput<T>) -> Result<(), TestCaseEr
 }
 
 fn drives<T: fado_core::Real>(method: DeadTimeMethod) -> [SensorlessDrive<T>; 2] {
-    let cfg = DriveConfig {
-        dead_time_method: method,
-        ..no_calibration()
-    };
-    // The second never trips, so that every input reaches the controllers.
-    let no_trip = DriveConfig {
-        trip_current: T::max_value().unwrap(),
-        input_fault_trip_samples: 0,
-        ..cfg
-    };
+    let mut cfg = no_calibration();
+    cfg.tuning.dead_time_method = method;
+    // The second never trips, so that every input reaches the controllers (a trip level of
+    // about T::MAX amps).
+    let mut no_trip = cfg;
+    no_trip.tuning.trip_current_ratio = T::max_value().unwrap() / cfg.machine.rated_current;
+    no_trip.tuning.input_fault_trip_time = T::zero();
     [cfg, no_trip].map(|c| {
-        let mut d = SensorlessDrive::new(c, EstimatorConfig::default()).unwrap();
+        let mut d = SensorlessDrive::new(c, EstimatorTuning::default()).unwrap();
         d.align(T::lit(0.3));
         d
     })
@@ -489,7 +502,8 @@ fn voltage_history_is_aligned_with_the_interval_it_acted_over() {
                 count += 1.0;
             }
         };
-        let estimator = SensorlessEstimator::new(EstimatorConfig::default()).unwrap();
+        let config = EstimatorConfig::for_machine(&MachineModel::paper());
+        let estimator = SensorlessEstimator::new(config).unwrap();
         if older {
             let est = OneSampleOlder {
                 inner: estimator,
@@ -517,7 +531,7 @@ fn voltage_history_is_aligned_with_the_interval_it_acted_over() {
 
 #[test]
 fn sensorless_closed_loop_follows_a_speed_ramp_under_load() {
-    let drive = SensorlessDrive::new(no_calibration(), EstimatorConfig::default()).unwrap();
+    let drive = SensorlessDrive::new(no_calibration(), EstimatorTuning::default()).unwrap();
     let target = 300.0 * TAU / 60.0; // 300 r/min
     let (mut worst_start, mut worst_steady, mut speed_before_load) = (0.0_f64, 0.0_f64, 0.0);
     let mut speed_end = 0.0;
@@ -553,16 +567,16 @@ fn sensorless_closed_loop_follows_a_speed_ramp_under_load() {
 
 #[test]
 fn status_word_reports_dc_link_low_and_persistent_bad_input_trips_and_is_counted() {
-    let mut d = SensorlessDrive::<f64>::new(no_calibration(), EstimatorConfig::default()).unwrap();
+    let mut d = SensorlessDrive::<f64>::new(no_calibration(), EstimatorTuning::default()).unwrap();
     d.align(0.3);
     let i = Abc::new(0.5, -0.25, -0.25);
     let o = d.step(i, 300.0, 10.0);
     assert!(!o.flags.intersects(DriveFlags::FAULTS), "{:?}", o.flags);
     assert!(o.flags.contains(DriveFlags::LIMITER_MODE)); // standstill start: FLAG_limit
-    // 150 V is below the 200 V default: flagged, and the drive keeps modulating.
+    // 150 V is below the default 2/3 of the nominal link: flagged, the drive keeps modulating.
     let o = d.step(i, 150.0, 10.0);
     assert!(o.flags.contains(DriveFlags::DC_LINK_LOW) && o.gates_enabled && !o.input_fault);
-    // 99 rejected samples in a row are ridden through, the 100th trips (latched).
+    // 99 rejected samples in a row are ridden through, the 100th (10 ms) trips (latched).
     for n in 1..=100 {
         let o = d.step(Abc::new(f64::NAN, 0.0, 0.0), 300.0, 10.0);
         assert!(o.flags.contains(DriveFlags::INPUT_REJECTED) && o.is_finite());
