@@ -4,8 +4,13 @@
 //! output finite, θ̂ in [−π, π].
 
 use fado_core::control::{DriveConfig, SensorlessDrive};
-use fado_core::estimator::{Estimate, EstimatorConfig, SensorlessEstimator};
-use fado_core::{Ab, Abc, Real};
+use fado_core::estimator::{Estimate, EstimatorConfig, EstimatorTuning, SensorlessEstimator};
+use fado_core::{Ab, Abc, MachineModel, Real};
+
+/// The default estimator configuration around the paper's motor.
+fn paper<T: Real>() -> EstimatorConfig<T> {
+    EstimatorConfig::for_machine(&MachineModel::paper())
+}
 
 /// The fuzz targets' output check.
 fn check_estimate<T: Real>(e: &Estimate<T>) {
@@ -37,12 +42,10 @@ fn check_estimate<T: Real>(e: &Estimate<T>) {
 #[test]
 fn huge_initial_angle_is_wrapped() {
     for a0 in [-5.727778756618604e250, 9.112e30, f64::MAX] {
-        let mut est = SensorlessEstimator::new(EstimatorConfig {
-            initial_angle: a0,
-            observer_on_rotor_flux: false,
-            ..EstimatorConfig::default()
-        })
-        .unwrap();
+        let mut config = paper();
+        config.initial_angle = a0;
+        config.tuning.observer_on_rotor_flux = false;
+        let mut est = SensorlessEstimator::new(config).unwrap();
         check_estimate(est.last());
         check_estimate(&est.step(Ab::new(1.0, 0.0), Ab::new(0.5, 0.0)));
         est.align(a0, Ab::new(1.0, 2.0));
@@ -50,7 +53,7 @@ fn huge_initial_angle_is_wrapped() {
     }
     let est = SensorlessEstimator::<f32>::new(EstimatorConfig {
         initial_angle: f32::MAX,
-        ..EstimatorConfig::default()
+        ..paper()
     })
     .unwrap();
     check_estimate(est.last());
@@ -60,12 +63,10 @@ fn huge_initial_angle_is_wrapped() {
 /// calibration, then one sample: the drive reported θ̂ = 1.1e15.
 #[test]
 fn drive_align_to_a_huge_angle_is_wrapped() {
-    let config = DriveConfig {
-        current_bandwidth_hz: 0.16,
-        offset_calibration_samples: 219,
-        ..DriveConfig::default()
-    };
-    let mut drive = SensorlessDrive::new(config, EstimatorConfig::default()).unwrap();
+    let mut config = DriveConfig::for_machine(&MachineModel::paper());
+    config.tuning.current_bandwidth_hz = 0.16;
+    config.tuning.offset_calibration_time = 219.0 * config.ts; // 219 samples
+    let mut drive = SensorlessDrive::new(config, EstimatorTuning::default()).unwrap();
     let w = 2.0 * core::f64::consts::PI * -21.4;
     for k in 0..16 {
         let i = Ab::from_polar(107.0, w * 100e-6 * k as f64).to_abc();
@@ -82,24 +83,20 @@ fn drive_align_to_a_huge_angle_is_wrapped() {
 /// start-up estimate carried it. (The fuzzer's λ̂f = 1.26e30 Wb is now refused, see below.)
 #[test]
 fn align_with_an_overflowing_current_starts_finite() {
-    let mut est = SensorlessEstimator::<f32>::new(EstimatorConfig {
-        lq_hat: 69.39,
-        initial_angle: -6.41,
-        average_current: false,
-        observer_on_rotor_flux: false,
-        ..EstimatorConfig::default()
-    })
-    .unwrap();
+    let mut config = paper::<f32>();
+    config.machine.lq = 69.39;
+    config.initial_angle = -6.41;
+    config.tuning.average_current = false;
+    config.tuning.observer_on_rotor_flux = false;
+    let mut est = SensorlessEstimator::new(config).unwrap();
     est.align(29041.0 * 1e33, Ab::new(29041.0 * 1e33, 29041.0 * 1e33));
     check_estimate(est.last());
     check_estimate(&est.step(Ab::new(69.39, 69.39), Ab::new(0.0, 0.0)));
     check_estimate(&est.step(Ab::zero(), Ab::zero()));
     // The same current in f64 is representable: it is used.
-    let mut est = SensorlessEstimator::<f64>::new(EstimatorConfig {
-        lq_hat: 69.39,
-        ..EstimatorConfig::default()
-    })
-    .unwrap();
+    let mut config = paper::<f64>();
+    config.machine.lq = 69.39;
+    let mut est = SensorlessEstimator::new(config).unwrap();
     est.align(0.0, Ab::new(1e37, 0.0));
     assert!((est.last().diagnostics.lambda1.alpha - 69.39e37).abs() < 1e25);
 }
@@ -107,17 +104,25 @@ fn align_with_an_overflowing_current_starts_finite() {
 /// A λ̂f so large that the limiter and hold circles overflow when squared (f32) is refused.
 #[test]
 fn flux_linkage_too_large_for_the_precision_is_refused() {
-    let c = EstimatorConfig::<f32> {
-        flux_linkage_hat: 1.26e30,
-        ..EstimatorConfig::default()
-    };
+    // On the paper's motor such a λ̂f is a unit slip (its rated torque needs 0.088 Wb).
+    let mut c = paper::<f32>();
+    c.machine.flux_linkage = 1.26e30;
     let e = SensorlessEstimator::new(c).err().unwrap();
-    assert_eq!(e.field(), "flux_linkage_hat");
-    let c = EstimatorConfig::<f32> {
-        flux_linkage_hat: 1e18,
-        limiter_radius_ratio: 1e3,
-        ..EstimatorConfig::default()
+    assert_eq!(e.field(), "rated_torque");
+    // A machine whose ratings agree with it passes the unit-slip checks; the precision
+    // check refuses it.
+    let huge = |lf: f32| {
+        let mut c = paper::<f32>();
+        c.machine.flux_linkage = lf;
+        c.machine.rated_torque = c.machine.torque_constant() * c.machine.rated_current;
+        c.machine.dc_voltage = 2.0 * c.machine.rated_speed() * lf;
+        c.machine.validate().unwrap();
+        c
     };
+    let e = SensorlessEstimator::new(huge(1.26e30)).err().unwrap();
+    assert_eq!(e.field(), "flux_linkage");
+    let mut c = huge(1e18);
+    c.tuning.limiter_radius_ratio = 1e3;
     let e = SensorlessEstimator::new(c).err().unwrap();
     assert_eq!(e.field(), "limiter_radius_ratio");
 }
@@ -145,17 +150,17 @@ fn baselines_align_with_an_overflowing_current_start_finite() {
         lq_hat: lq,
         observer_bandwidth_min: 285.27,
         flux_adaptation_ratio: 28527.0 * 1e31,
-        ..OrtegaConfig::default()
+        ..OrtegaConfig::for_machine(&MachineModel::paper())
     })
     .unwrap());
     run(LpfIntegratorEstimator::new(LpfIntegratorConfig {
         lq_hat: lq,
-        ..LpfIntegratorConfig::default()
+        ..LpfIntegratorConfig::for_machine(&MachineModel::paper())
     })
     .unwrap());
     run(EmfObserverEstimator::new(EmfObserverConfig {
         lq_hat: lq,
-        ..EmfObserverConfig::default()
+        ..EmfObserverConfig::for_machine(&MachineModel::paper())
     })
     .unwrap());
 }
