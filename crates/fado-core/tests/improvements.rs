@@ -3,7 +3,8 @@
 //! calibration of the drive.
 
 use fado_core::control::{DriveConfig, SensorlessDrive};
-use fado_core::{Ab, Abc, Dq, EstimatorConfig, Rotation, SensorlessEstimator};
+use fado_core::estimator::EstimatorTuning;
+use fado_core::{Ab, Abc, Dq, EstimatorConfig, MachineModel, Rotation, SensorlessEstimator};
 
 /// Open loop at a constant 6 Hz electrical with a rotor-frame current that swings at 5 Hz
 /// (the fig8 oscillation): λs = λf·e^{jθ} + L·i, v = dλs/dt + R·i exactly (central
@@ -13,10 +14,8 @@ fn disturbance_excursion(observer_on_rotor_flux: bool) -> f64 {
     let (ts, lf, l, r) = (100e-6, 0.088, 2.63e-3, 0.327);
     let w = 2.0 * std::f64::consts::PI * 6.0;
     let wm = 2.0 * std::f64::consts::PI * 5.0;
-    let cfg = EstimatorConfig {
-        observer_on_rotor_flux,
-        ..EstimatorConfig::default()
-    };
+    let mut cfg = EstimatorConfig::for_machine(&MachineModel::paper());
+    cfg.tuning.observer_on_rotor_flux = observer_on_rotor_flux;
     let mut est = SensorlessEstimator::new(cfg).unwrap();
     let current = |t: f64| {
         let i_dq = Dq::new(1.3 + 1.0 * (wm * t).sin(), 3.8 + 0.3 * (wm * t).sin());
@@ -52,11 +51,9 @@ fn observer_on_rotor_flux_ignores_rotor_frame_current_swings() {
 
 #[test]
 fn offset_calibration_runs_with_gates_off_then_removes_the_offsets() {
-    let cfg = DriveConfig::<f64> {
-        offset_calibration_samples: 200,
-        ..DriveConfig::default()
-    };
-    let mut drive = SensorlessDrive::new(cfg, EstimatorConfig::default()).unwrap();
+    let mut cfg = DriveConfig::<f64>::for_machine(&MachineModel::paper());
+    cfg.tuning.offset_calibration_time = 20e-3; // 200 samples
+    let mut drive = SensorlessDrive::new(cfg, EstimatorTuning::default()).unwrap();
     drive.align(0.3);
     let offset = Abc::new(0.02, -0.01, -0.01);
     for k in 0..200 {
@@ -79,11 +76,9 @@ fn offset_calibration_runs_with_gates_off_then_removes_the_offsets() {
 
 #[test]
 fn offset_calibration_can_be_disabled_and_is_restarted_by_reset() {
-    let off = DriveConfig::<f64> {
-        offset_calibration_samples: 0,
-        ..DriveConfig::default()
-    };
-    let mut drive = SensorlessDrive::new(off, EstimatorConfig::default()).unwrap();
+    let mut off = DriveConfig::<f64>::for_machine(&MachineModel::paper());
+    off.tuning.offset_calibration_time = 0.0;
+    let mut drive = SensorlessDrive::new(off, EstimatorTuning::default()).unwrap();
     drive.align(0.0);
     assert!(!drive.is_calibrating());
     assert!(
@@ -91,16 +86,18 @@ fn offset_calibration_can_be_disabled_and_is_restarted_by_reset() {
             .step(Abc::new(0.0, 0.0, 0.0), 300.0, 0.0)
             .gates_enabled
     );
-    let mut drive =
-        SensorlessDrive::new(DriveConfig::<f64>::default(), EstimatorConfig::default()).unwrap();
+    let paper = DriveConfig::<f64>::for_machine(&MachineModel::paper());
+    let mut drive = SensorlessDrive::new(paper, EstimatorTuning::default()).unwrap();
     assert!(drive.is_calibrating());
+    // The default 0.1 s at 10 kHz.
     for _ in 0..1000 {
         drive.step(Abc::new(0.0, 0.0, 0.0), 300.0, 0.0);
     }
     assert!(!drive.is_calibrating());
     drive.reset();
     assert!(drive.is_calibrating());
-    // A current above the trip level during the calibration still trips.
+    // A current above the trip level (60 A on this motor) during the calibration still trips.
+    assert!((paper.trip_current() - 60.0).abs() < 1e-9);
     let out = drive.step(Abc::new(70.0, -35.0, -35.0), 300.0, 0.0);
     assert!(out.tripped && !out.gates_enabled);
 }
