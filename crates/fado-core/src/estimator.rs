@@ -129,6 +129,35 @@ pub struct EstimatorTuning<T> {
     pub limiter_recentring: bool,
 }
 
+impl<T: Real> EstimatorTuning<T> {
+    /// The same record in another precision (e.g. an f64 configuration for an f32 drive):
+    /// every real rounded to `U`.
+    pub fn cast<U: Real>(&self) -> EstimatorTuning<U> {
+        EstimatorTuning {
+            k_df: U::lit(self.k_df.to_f64()),
+            k_df_ramp_time: U::lit(self.k_df_ramp_time.to_f64()),
+            k_af: U::lit(self.k_af.to_f64()),
+            limiter_radius_ratio: U::lit(self.limiter_radius_ratio.to_f64()),
+            mode_threshold_ratio: U::lit(self.mode_threshold_ratio.to_f64()),
+            mode_hysteresis_ratio: U::lit(self.mode_hysteresis_ratio.to_f64()),
+            t2s1_bandwidth_hz: U::lit(self.t2s1_bandwidth_hz.to_f64()),
+            t2s2_bandwidth_hz: U::lit(self.t2s2_bandwidth_hz.to_f64()),
+            tracker_damping: U::lit(self.tracker_damping.to_f64()),
+            bandwidth_definition: self.bandwidth_definition,
+            tracker_hold_ratio: U::lit(self.tracker_hold_ratio.to_f64()),
+            average_current: self.average_current,
+            observer_on_rotor_flux: self.observer_on_rotor_flux,
+            rs_adaptation: self.rs_adaptation,
+            rs_adaptation_rate: U::lit(self.rs_adaptation_rate.to_f64()),
+            rs_adaptation_excitation_floor: U::lit(self.rs_adaptation_excitation_floor.to_f64()),
+            rs_adaptation_min_ratio: U::lit(self.rs_adaptation_min_ratio.to_f64()),
+            rs_adaptation_max_ratio: U::lit(self.rs_adaptation_max_ratio.to_f64()),
+            flux_linkage_adaptation_rate: U::lit(self.flux_linkage_adaptation_rate.to_f64()),
+            limiter_recentring: self.limiter_recentring,
+        }
+    }
+}
+
 impl<T: Real> Default for EstimatorTuning<T> {
     fn default() -> Self {
         let rs = ResistanceAdaptationConfig::<T>::default();

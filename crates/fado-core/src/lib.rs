@@ -36,10 +36,11 @@ pub mod rs_adaptation;
 pub mod tracker;
 
 pub use baselines::{EmfObserverEstimator, LpfIntegratorEstimator, OrtegaEstimator};
-pub use control::{DriveConfig, DriveFlags, DriveOutput, SensorlessDrive};
+pub use control::{DriveConfig, DriveFlags, DriveOutput, DriveTuning, SensorlessDrive};
 pub use error::{ConfigError, NonFiniteInput};
 pub use estimator::{
-    Diagnostics, Estimate, EstimatorConfig, RotorAngleEstimator, SensorlessEstimator,
+    Diagnostics, Estimate, EstimatorConfig, EstimatorTuning, RotorAngleEstimator,
+    SensorlessEstimator,
 };
 pub use frames::{Ab, Abc, Dq, Rotation};
 pub use machine::MachineModel;

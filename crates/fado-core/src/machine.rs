@@ -55,8 +55,26 @@ pub struct MachineModel<T> {
 }
 
 impl<T: Real> MachineModel<T> {
+    /// The same record in another precision (e.g. an f64 configuration for an f32 drive):
+    /// every real rounded to `U`.
+    pub fn cast<U: Real>(&self) -> MachineModel<U> {
+        MachineModel {
+            rs: U::lit(self.rs.to_f64()),
+            ld: U::lit(self.ld.to_f64()),
+            lq: U::lit(self.lq.to_f64()),
+            flux_linkage: U::lit(self.flux_linkage.to_f64()),
+            pole_pairs: self.pole_pairs,
+            inertia: U::lit(self.inertia.to_f64()),
+            viscous_friction: U::lit(self.viscous_friction.to_f64()),
+            rated_current: U::lit(self.rated_current.to_f64()),
+            rated_speed_rpm: U::lit(self.rated_speed_rpm.to_f64()),
+            rated_torque: U::lit(self.rated_torque.to_f64()),
+            dc_voltage: U::lit(self.dc_voltage.to_f64()),
+        }
+    }
+
     /// The paper's motor (section V \[P\]: 8-pole SMPMSM, 11.5 N·m, 1500 r/min, Rs = 0.327 Ω,
-    /// Ld = Lq = 2.63 mH; DC link rectified from 3 × 220 V: 300 V) with SPEC §6's assumptions
+    /// Ld = Lq = 2.63 mH; DC link rectified from 3 × 220 V rms: 311 V) with SPEC §6's assumptions
     /// (λf = 0.088 Wb, J = 0.012 kg·m², B = 1e-3 N·m·s/rad) and the rated current its torque
     /// implies, 11.5 N·m / (1.5·4·0.088 Wb) = 21.78 A peak.
     pub fn paper() -> Self {
@@ -71,7 +89,7 @@ impl<T: Real> MachineModel<T> {
             rated_current: T::lit(PAPER_RATED_CURRENT),
             rated_speed_rpm: T::lit(1500.0),
             rated_torque: T::lit(11.5),
-            dc_voltage: T::lit(300.0),
+            dc_voltage: T::lit(311.0),
         }
     }
 

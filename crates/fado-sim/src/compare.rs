@@ -254,7 +254,7 @@ pub fn compare(opts: &CompareOptions) -> Result<Comparison, SimConfigError> {
         let base = scenario::scenario_config(name, opts.config_toml.as_deref(), opts.averaged)?;
         for &contender in &opts.estimators {
             let mut cfg = base.clone();
-            cfg.estimator.kind = contender.kind;
+            cfg.simulation.estimator = contender.kind;
             if contender.fixed_rs {
                 cfg.estimator.rs_adaptation = false;
             }
@@ -266,7 +266,7 @@ pub fn compare(opts: &CompareOptions) -> Result<Comparison, SimConfigError> {
     let (inverter_model, seed, band) = (
         first.inverter.model,
         first.current_sensor.seed,
-        first.simulation.zero_speed_band_rpm,
+        first.zero_speed_band_rpm(),
     );
 
     let next = AtomicUsize::new(0);

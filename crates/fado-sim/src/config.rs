@@ -1,8 +1,11 @@
 //! The whole simulation as one TOML document: plant sections (`[motor]`, `[inverter]`,
 //! `[current_sensor]`, `[dc_link_sensor]`, `[load]`), the speed reference
-//! (`[speed_reference]`), the drive (`[controller]`, `[estimator]`), the estimator's view of
-//! the plant (`[mismatch]`), injected faults (`[faults]`, see [`crate::faults`]), and run
-//! settings (`[simulation]`).
+//! (`[speed_reference]`), the drive (`[controller]`, `[estimator]`, `[baselines]`), the
+//! drive's model of the motor (`[model]`, by default `[motor]` scaled by `[mismatch]`),
+//! injected faults (`[faults]`, see [`crate::faults`]), and run settings (`[simulation]`).
+//! `[motor]` and `[model]` are `fado_core::MachineModel`, `[controller]`
+//! `fado_core::control::DriveTuning` and `[estimator]` `fado_core::EstimatorTuning`, read
+//! directly through their serde derives (one schema).
 //!
 //! A file overrides a base configuration (a scenario's) key by key: tables merge, values and
 //! arrays replace. Unknown keys are errors naming the key (`inverter.dead_tme`), and so are
@@ -10,8 +13,8 @@
 //! given directly: they are the plant's times the `[mismatch]` ratios, so "matched" stays
 //! matched when the motor changes.
 
-use fado_core::EstimatorConfig;
-use fado_core::tracker::BandwidthDefinition;
+use fado_core::control::{DriveConfig, DriveTuning};
+use fado_core::{EstimatorConfig, EstimatorTuning, MachineModel};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{SimConfigError, check};
@@ -38,9 +41,15 @@ pub struct SimulationSettings {
     pub align_error: f64,
     /// Metrics are evaluated from this time on, s (start-up excluded). Default 0.
     pub eval_start: f64,
-    /// "Near zero speed" means |true speed| below this, r/min. Default 30 r/min (2 Hz
-    /// electrical: just above the 1.5 Hz mode threshold) \[A\].
-    pub zero_speed_band_rpm: f64,
+    /// "Near zero speed" means |true speed| below this fraction of the rated speed. Default
+    /// 0.02 \[A\] (30 r/min of the paper's 1500 r/min: 2 Hz electrical, just above its 1.5 Hz
+    /// mode threshold).
+    pub zero_speed_band_ratio: f64,
+    /// Scalar type of the drive (estimator and control). Default f64.
+    pub precision: Precision,
+    /// Which rotor-angle estimator the drive runs. Default fado; the baselines run with an
+    /// f64 drive only.
+    pub estimator: EstimatorKind,
     /// Windows `[t_off, t_on]` in s during which the k_df feedback is switched off (Fig. 9).
     pub disturbance_feedback_off: Vec<[f64; 2]>,
 }
@@ -53,7 +62,9 @@ impl Default for SimulationSettings {
             initial_angle: 0.3,
             align_error: 0.0,
             eval_start: 0.0,
-            zero_speed_band_rpm: 30.0,
+            zero_speed_band_ratio: 0.02,
+            precision: Precision::F64,
+            estimator: EstimatorKind::Fado,
             disturbance_feedback_off: Vec::new(),
         }
     }
@@ -68,7 +79,7 @@ impl SimulationSettings {
         check::finite("initial_angle", self.initial_angle)?;
         check::finite("align_error", self.align_error)?;
         check::non_negative("eval_start", self.eval_start)?;
-        check::positive("zero_speed_band_rpm", self.zero_speed_band_rpm)?;
+        check::positive("zero_speed_band_ratio", self.zero_speed_band_ratio)?;
         for (k, w) in self.disturbance_feedback_off.iter().enumerate() {
             if !(w[0].is_finite() && w[1].is_finite() && w[0] <= w[1]) {
                 return Err(SimConfigError::new(
@@ -81,28 +92,6 @@ impl SimulationSettings {
     }
 }
 
-/// Dead-time compensation method (mirrors `fado_core::control::DeadTimeMethod`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum DeadTimeMethodSetting {
-    /// V̂·sat(i*/Ic) trapezoid of the reference current (SPEC §5).
-    #[default]
-    Trapezoidal,
-    /// V̂·sign(i) of the measured current.
-    Sign,
-}
-
-/// Voltage limit (mirrors `fado_core::control::VoltageLimit`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum VoltageLimitSetting {
-    /// The inverter hexagon (SVPWM).
-    #[default]
-    Hexagon,
-    /// Its inscribed circle.
-    InscribedCircle,
-}
-
 /// Scalar type the drive runs in.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -112,102 +101,6 @@ pub enum Precision {
     F64,
     /// f32, as on the paper's TMS320F28335 (single-precision FPU).
     F32,
-}
-
-/// The drive's own settings (the model estimates come from `[mismatch]`). Defaults as in
-/// `fado_core::control::DriveConfig`.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct ControllerSettings {
-    /// Scalar type of the drive (estimator and control). Default f64.
-    pub precision: Precision,
-    /// Current-loop bandwidth, Hz. Default 250 Hz (paper §V).
-    pub current_bandwidth_hz: f64,
-    /// Speed-loop bandwidth, Hz. Default 5 Hz (paper §V).
-    pub speed_bandwidth_hz: f64,
-    /// Speed PI zero ratio (Ki = Kp·ωsc/ratio). Default 5 (SPEC §6).
-    pub speed_zero_ratio: f64,
-    /// Current limit I_max, A. Default 40 A (SPEC §6).
-    pub i_max: f64,
-    /// I_min of the injection (23), A; 0 disables it. Default 4 A (paper §V).
-    pub i_min: f64,
-    /// Dead-time compensation on. Default true.
-    pub dead_time_compensation: bool,
-    /// Compensation method. Default trapezoidal (SPEC §5).
-    pub dead_time_method: DeadTimeMethodSetting,
-    /// Voltage angle advance in samples. Default 1.5 (SPEC §5).
-    pub delay_compensation_factor: f64,
-    /// Over-current trip, A. Default 60 A.
-    pub trip_current: f64,
-    /// Decoupling and back-EMF feed-forward. Default true.
-    pub decoupling: bool,
-    /// Realisable voltage set. Default hexagon.
-    pub voltage_limit: VoltageLimitSetting,
-    /// Usable fraction of the voltage limit. Default 1.
-    pub max_modulation: f64,
-    /// Current PI back-calculation gain (×Ki/Kp). Default 1.
-    pub current_anti_windup_ratio: f64,
-    /// Speed PI back-calculation gain (×Ki/Kp). Default 5.
-    pub speed_anti_windup_ratio: f64,
-    /// Current-sensor offset calibration at start-up, samples with the gates off (0 = none).
-    /// Default 1000 (100 ms) as `fado_core::control::DriveConfig` \[A\].
-    pub offset_calibration_samples: u32,
-    /// Stuck current-sensor detection band, A. Default 0.25 A as `DriveConfig`.
-    pub stuck_sensor_band: f64,
-    /// Stuck current-sensor detection: minimum reference in the phase, A. Default 2 A.
-    pub stuck_sensor_min_reference: f64,
-    /// Stuck current-sensor detection: samples in a row (0 = off). Default 5.
-    pub stuck_sensor_samples: u32,
-    /// Current-error monitor limit |i* − i|, A. Default 5 A.
-    pub current_error_limit: f64,
-    /// Current-error monitor: samples in a row (0 = off). Default 20.
-    pub current_error_samples: u32,
-    /// DC-link under-voltage warning level, V. Default 200 V.
-    pub dc_link_min_voltage: f64,
-    /// Rejected samples in a row that trip the drive (0 = never). Default 100.
-    pub input_fault_trip_samples: u32,
-}
-
-impl Default for ControllerSettings {
-    fn default() -> Self {
-        let d = fado_core::control::DriveConfig::<f64>::default();
-        Self {
-            precision: Precision::F64,
-            current_bandwidth_hz: 250.0,
-            speed_bandwidth_hz: 5.0,
-            speed_zero_ratio: 5.0,
-            i_max: 40.0,
-            i_min: 4.0,
-            dead_time_compensation: true,
-            dead_time_method: DeadTimeMethodSetting::Trapezoidal,
-            delay_compensation_factor: 1.5,
-            trip_current: 60.0,
-            decoupling: true,
-            voltage_limit: VoltageLimitSetting::Hexagon,
-            max_modulation: 1.0,
-            current_anti_windup_ratio: 1.0,
-            speed_anti_windup_ratio: 5.0,
-            offset_calibration_samples: 1000,
-            stuck_sensor_band: d.stuck_sensor_band,
-            stuck_sensor_min_reference: d.stuck_sensor_min_reference,
-            stuck_sensor_samples: d.stuck_sensor_samples,
-            current_error_limit: d.current_error_limit,
-            current_error_samples: d.current_error_samples,
-            dc_link_min_voltage: d.dc_link_min_voltage,
-            input_fault_trip_samples: d.input_fault_trip_samples,
-        }
-    }
-}
-
-/// Tracker bandwidth meaning (mirrors `fado_core::tracker::BandwidthDefinition`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum BandwidthSetting {
-    /// −3 dB frequency of the closed loop (SPEC §3).
-    #[default]
-    Minus3Db,
-    /// Natural frequency ωn.
-    NaturalFrequency,
 }
 
 /// Which rotor-angle estimator the drive runs.
@@ -225,58 +118,12 @@ pub enum EstimatorKind {
     EmfObserver,
 }
 
-/// The estimator's own settings (the model estimates come from `[mismatch]`). Defaults as in
-/// `fado_core::EstimatorConfig` (paper §V, SPEC §1–3) and, for the baselines, in
-/// `fado_core::baselines`. The trackers' settings apply to every kind.
+/// The tuning of the reference observers (`[simulation] estimator = "lpf_integrator"`,
+/// `"ortega"`, `"emf_observer"`); their model estimates are the drive's `[model]` and their
+/// trackers use `[estimator]`'s settings. Defaults as in `fado_core::baselines`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
-pub struct EstimatorSettings {
-    /// Which estimator. Default fado. The baselines run with an f64 drive only.
-    pub kind: EstimatorKind,
-    /// k_df, s⁻¹ (Fig. 3). Default 0.5.
-    pub k_df: f64,
-    /// k_df ramp-in time, s (0 = abrupt). Default 0.
-    pub k_df_ramp_time: f64,
-    /// k_af, s⁻¹ (Fig. 6). Default 2π·100.
-    pub k_af: f64,
-    /// Limiter radius / λ̂f. Default 1.15.
-    pub limiter_radius_ratio: f64,
-    /// Mode threshold, Hz electrical. Default 1.5.
-    pub mode_threshold_hz: f64,
-    /// Mode hysteresis half-band, Hz. Default 0.2.
-    pub mode_hysteresis_hz: f64,
-    /// T2S-1 bandwidth, Hz. Default 60.
-    pub t2s1_bandwidth_hz: f64,
-    /// T2S-2 bandwidth, Hz. Default 35.
-    pub t2s2_bandwidth_hz: f64,
-    /// Tracker damping. Default 1/√2.
-    pub tracker_damping: f64,
-    /// Bandwidth definition. Default −3 dB.
-    pub bandwidth_definition: BandwidthSetting,
-    /// Tracker hold below this |λ̂r|/λ̂f. Default 0.2.
-    pub tracker_hold_ratio: f64,
-    /// Interval-average current in the resistive drop. Default true.
-    pub average_current: bool,
-    /// Disturbance observer on λ1 − L̂q·i (true, our improvement) or on λ1 (false, the
-    /// paper's Fig. 5). Default as `EstimatorConfig::observer_on_rotor_flux`.
-    pub observer_on_rotor_flux: bool,
-    /// Online R̂s adaptation (our extension; false = the paper). Default as
-    /// `EstimatorConfig::rs_adaptation`.
-    pub rs_adaptation: bool,
-    /// R̂s adaptation rate γ, s⁻¹. Default as `EstimatorConfig::rs_adaptation_rate`.
-    pub rs_adaptation_rate: f64,
-    /// R̂s adaptation excitation floor χ0. Default as `EstimatorConfig`.
-    pub rs_adaptation_excitation_floor: f64,
-    /// Lower bound of the adapted R̂s / configured R̂s. Default as `EstimatorConfig`.
-    pub rs_adaptation_min_ratio: f64,
-    /// Upper bound of the adapted R̂s / configured R̂s. Default as `EstimatorConfig`.
-    pub rs_adaptation_max_ratio: f64,
-    /// λ̂f learning rate where R̂s is unobservable, s⁻¹ (0 = fixed λ̂f). Default as
-    /// `EstimatorConfig::flux_linkage_adaptation_rate`.
-    pub flux_linkage_adaptation_rate: f64,
-    /// In limiter mode, re-centre the common mode of λ1 and D̂ (true, ours) or not (false,
-    /// the paper). Default as `EstimatorConfig::limiter_recentring`.
-    pub limiter_recentring: bool,
+pub struct BaselineSettings {
     /// LPF baseline: cut-off of 1/(s + ωc), Hz. Default as `LpfIntegratorConfig`.
     pub lpf_cutoff_hz: f64,
     /// LPF baseline: speed below which its gain/phase compensation is frozen, Hz.
@@ -295,37 +142,14 @@ pub struct EstimatorSettings {
     pub emf_speed_floor_hz: f64,
 }
 
-impl Default for EstimatorSettings {
+impl Default for BaselineSettings {
     fn default() -> Self {
-        let d = EstimatorConfig::<f64>::default();
-        let lpf = fado_core::baselines::LpfIntegratorConfig::<f64>::default();
-        let ortega = fado_core::baselines::OrtegaConfig::<f64>::default();
-        let emf = fado_core::baselines::EmfObserverConfig::<f64>::default();
+        // The tuning defaults do not depend on the machine: any valid one reads them out.
+        let m = MachineModel::<f64>::paper();
+        let lpf = fado_core::baselines::LpfIntegratorConfig::for_machine(&m);
+        let ortega = fado_core::baselines::OrtegaConfig::for_machine(&m);
+        let emf = fado_core::baselines::EmfObserverConfig::for_machine(&m);
         Self {
-            k_df: d.k_df,
-            k_df_ramp_time: d.k_df_ramp_time,
-            k_af: d.k_af,
-            limiter_radius_ratio: d.limiter_radius_ratio,
-            mode_threshold_hz: d.mode_threshold_hz,
-            mode_hysteresis_hz: d.mode_hysteresis_hz,
-            t2s1_bandwidth_hz: d.t2s1_bandwidth_hz,
-            t2s2_bandwidth_hz: d.t2s2_bandwidth_hz,
-            tracker_damping: d.tracker_damping,
-            bandwidth_definition: match d.bandwidth_definition {
-                BandwidthDefinition::Minus3Db => BandwidthSetting::Minus3Db,
-                BandwidthDefinition::NaturalFrequency => BandwidthSetting::NaturalFrequency,
-            },
-            tracker_hold_ratio: d.tracker_hold_ratio,
-            average_current: d.average_current,
-            observer_on_rotor_flux: d.observer_on_rotor_flux,
-            rs_adaptation: d.rs_adaptation,
-            rs_adaptation_rate: d.rs_adaptation_rate,
-            rs_adaptation_excitation_floor: d.rs_adaptation_excitation_floor,
-            rs_adaptation_min_ratio: d.rs_adaptation_min_ratio,
-            rs_adaptation_max_ratio: d.rs_adaptation_max_ratio,
-            flux_linkage_adaptation_rate: d.flux_linkage_adaptation_rate,
-            limiter_recentring: d.limiter_recentring,
-            kind: EstimatorKind::Fado,
             lpf_cutoff_hz: lpf.cutoff_hz,
             lpf_compensation_floor_hz: lpf.compensation_floor_hz,
             ortega_observer_bandwidth: ortega.observer_bandwidth,
@@ -395,14 +219,14 @@ impl Mismatch {
 }
 
 /// The complete, serialisable simulation configuration.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SimConfig {
     /// Run settings.
     pub simulation: SimulationSettings,
     /// Speed reference in r/min (mechanical).
     pub speed_reference: Profile,
-    /// The PMSM.
+    /// The PMSM (plant): parameters and ratings.
     pub motor: MotorParams,
     /// Inverter and DC link.
     pub inverter: InverterParams,
@@ -412,14 +236,42 @@ pub struct SimConfig {
     pub dc_link_sensor: DcLinkSensorParams,
     /// Load machine.
     pub load: LoadParams,
-    /// Drive settings.
-    pub controller: ControllerSettings,
-    /// Estimator settings.
-    pub estimator: EstimatorSettings,
-    /// The drive's model of the plant.
+    /// Drive tuning (`fado_core::control::DriveTuning`).
+    pub controller: DriveTuning<f64>,
+    /// Estimator tuning (`fado_core::EstimatorTuning`).
+    pub estimator: EstimatorTuning<f64>,
+    /// Tuning of the reference observers.
+    pub baselines: BaselineSettings,
+    /// The drive's model of the plant as ratios to the true values.
     pub mismatch: Mismatch,
+    /// The drive's model of the motor, key by key (same keys as `[motor]`); a key not given is
+    /// the plant's (R̂s: Rs + r_on) times its `[mismatch]` ratio.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub model: Option<toml::Table>,
     /// Injected faults (`crate::faults`). Default none.
     pub faults: FaultParams,
+}
+
+impl Default for SimConfig {
+    /// The paper's experiment set-up: its motor ([`MachineModel::paper`]) on SPEC §5–6's
+    /// inverter and sensors, standing still.
+    fn default() -> Self {
+        Self {
+            simulation: SimulationSettings::default(),
+            speed_reference: Profile::default(),
+            motor: MotorParams::paper(),
+            inverter: InverterParams::default(),
+            current_sensor: CurrentSensorParams::default(),
+            dc_link_sensor: DcLinkSensorParams::default(),
+            load: LoadParams::default(),
+            controller: DriveTuning::default(),
+            estimator: EstimatorTuning::default(),
+            baselines: BaselineSettings::default(),
+            mismatch: Mismatch::default(),
+            model: None,
+            faults: FaultParams::default(),
+        }
+    }
 }
 
 impl Default for Profile {
@@ -463,9 +315,17 @@ impl SimConfig {
         self.mismatch
             .validate()
             .map_err(|e| e.in_section("mismatch"))?;
+        crate::motor::validate_motor(&self.motor, self.inverter.dc_voltage).map_err(|e| {
+            if e.key == "dc_voltage" {
+                SimConfigError::new("inverter.dc_voltage", e.message)
+            } else {
+                e.in_section("motor")
+            }
+        })?;
+        self.model_checked()?;
         self.estimator_config()
             .validate()
-            .map_err(|e| core_error("estimator", e))?;
+            .map_err(|e| self.core_error("estimator", e))?;
         // Every key is checked whichever estimator runs: NaN in an unused key is still an
         // error in the file.
         self.lpf_estimator()?;
@@ -473,45 +333,132 @@ impl SimConfig {
         self.emf_estimator()?;
         self.drive_config()
             .validate()
-            .map_err(|e| core_error("controller", e))?;
+            .map_err(|e| self.core_error("controller", e))?;
         Ok(())
     }
 
-    /// The estimator configuration: settings of `[estimator]`, model from the plant and
-    /// `[mismatch]`, sampling period from the inverter.
+    /// The drive's model of the motor derived from the plant: `[motor]` (R̂s: Rs + r_on of
+    /// the inverter) scaled by `[mismatch]`, DC link from `[inverter]`.
+    fn derived_model(&self) -> MachineModel<f64> {
+        let (mo, inv, m) = (&self.motor, &self.inverter, &self.mismatch);
+        MachineModel {
+            rs: (mo.rs + inv.on_resistance) * m.rs_ratio,
+            ld: mo.ld * m.ld_ratio,
+            lq: mo.lq * m.lq_ratio,
+            flux_linkage: mo.flux_linkage * m.flux_linkage_ratio,
+            inertia: mo.inertia * m.inertia_ratio,
+            dc_voltage: inv.dc_voltage,
+            ..*mo
+        }
+    }
+
+    /// The drive's model: `[model]`'s keys over the derived one, checked; errors name
+    /// `model.<key>` for a key the file gives and the plant key it derives from otherwise.
+    fn model_checked(&self) -> Result<MachineModel<f64>, SimConfigError> {
+        let derived = self.derived_model();
+        let Some(table) = &self.model else {
+            return Ok(derived);
+        };
+        let mut merged = toml::Table::try_from(derived)
+            .map_err(|e| SimConfigError::new("model", e.to_string()))?;
+        merge(&mut merged, table.clone());
+        let mut model = MachineModel::<f64>::deserialize(toml::Value::Table(merged))
+            .map_err(|e| key_error(e).in_section("model"))?;
+        model.dc_voltage = self.inverter.dc_voltage;
+        model.validate().map_err(|e| self.core_error("model", e))?;
+        Ok(model)
+    }
+
+    /// The drive's model of the motor (`[model]`, or `[motor]` × `[mismatch]`). A `[model]`
+    /// table that [`validate`](Self::validate) refuses is ignored here.
+    pub fn machine_model(&self) -> MachineModel<f64> {
+        self.model_checked()
+            .unwrap_or_else(|_| self.derived_model())
+    }
+
+    /// The estimator configuration: `[estimator]` tuning, the drive's model, sampling period
+    /// from the inverter.
     pub fn estimator_config(&self) -> EstimatorConfig<f64> {
-        let e = &self.estimator;
-        let m = &self.mismatch;
         EstimatorConfig {
             ts: self.inverter.sample_period(),
-            rs_hat: (self.motor.rs + self.inverter.on_resistance) * m.rs_ratio,
-            lq_hat: self.motor.lq * m.lq_ratio,
-            flux_linkage_hat: self.motor.flux_linkage * m.flux_linkage_ratio,
-            k_df: e.k_df,
-            k_df_ramp_time: e.k_df_ramp_time,
-            k_af: e.k_af,
-            limiter_radius_ratio: e.limiter_radius_ratio,
-            mode_threshold_hz: e.mode_threshold_hz,
-            mode_hysteresis_hz: e.mode_hysteresis_hz,
-            t2s1_bandwidth_hz: e.t2s1_bandwidth_hz,
-            t2s2_bandwidth_hz: e.t2s2_bandwidth_hz,
-            tracker_damping: e.tracker_damping,
-            bandwidth_definition: match e.bandwidth_definition {
-                BandwidthSetting::Minus3Db => BandwidthDefinition::Minus3Db,
-                BandwidthSetting::NaturalFrequency => BandwidthDefinition::NaturalFrequency,
-            },
-            tracker_hold_ratio: e.tracker_hold_ratio,
-            average_current: e.average_current,
-            observer_on_rotor_flux: e.observer_on_rotor_flux,
-            rs_adaptation: e.rs_adaptation,
-            rs_adaptation_rate: e.rs_adaptation_rate,
-            rs_adaptation_excitation_floor: e.rs_adaptation_excitation_floor,
-            rs_adaptation_min_ratio: e.rs_adaptation_min_ratio,
-            rs_adaptation_max_ratio: e.rs_adaptation_max_ratio,
-            flux_linkage_adaptation_rate: e.flux_linkage_adaptation_rate,
-            limiter_recentring: e.limiter_recentring,
+            machine: self.machine_model(),
             initial_angle: self.simulation.initial_angle + self.simulation.align_error,
+            tuning: self.estimator,
         }
+    }
+
+    /// The drive configuration: `[controller]` tuning, the drive's model, timing and the
+    /// dead-time compensation's inverter data from `[inverter]` (× `[mismatch]`).
+    pub fn drive_config(&self) -> DriveConfig<f64> {
+        let (inv, m) = (&self.inverter, &self.mismatch);
+        DriveConfig {
+            ts: inv.sample_period(),
+            machine: self.machine_model(),
+            tuning: DriveTuning {
+                dead_time: inv.dead_time * m.dead_time_ratio,
+                switching_frequency: inv.switching_frequency,
+                dead_time_threshold_voltage: inv.threshold_voltage * m.threshold_voltage_ratio,
+                dead_time_current_band: inv.current_band * m.current_band_ratio,
+                ..self.controller
+            },
+        }
+    }
+
+    /// A fado-core refusal of the `[section]` block (`estimator`, `controller`, `model`, or a
+    /// baseline's `lpf_`/`ortega_`/`emf_` keys), named by the TOML key the user writes. The
+    /// machine model's fields are `model.<key>` where `[model]` gives them and otherwise the
+    /// plant key they derive from; the timing and the inverter data are `[inverter]` keys.
+    pub(crate) fn core_error(&self, section: &str, e: fado_core::ConfigError) -> SimConfigError {
+        let field = e.field();
+        let machine_key = |k: &str| -> String {
+            let given = self.model.as_ref().is_some_and(|t| t.contains_key(k));
+            if given {
+                format!("model.{k}")
+            } else {
+                format!("motor.{k}")
+            }
+        };
+        let derived = match field {
+            "ts" | "switching_frequency" => Some("inverter.switching_frequency".to_owned()),
+            "dc_voltage" => Some("inverter.dc_voltage".to_owned()),
+            "rs" | "rs_hat" => Some(machine_key("rs")),
+            "ld" | "ld_hat" => Some(machine_key("ld")),
+            "lq" | "lq_hat" => Some(machine_key("lq")),
+            "flux_linkage" | "flux_linkage_hat" => Some(machine_key("flux_linkage")),
+            "inertia" | "inertia_hat" => Some(machine_key("inertia")),
+            "pole_pairs" | "viscous_friction" | "rated_current" | "rated_speed_rpm"
+            | "rated_torque" => Some(machine_key(field)),
+            "dead_time" => Some("inverter.dead_time".to_owned()),
+            "dead_time_threshold_voltage" => Some("inverter.threshold_voltage".to_owned()),
+            "dead_time_current_band" => Some("inverter.current_band".to_owned()),
+            "initial_angle" => Some("simulation.initial_angle".to_owned()),
+            _ => None,
+        };
+        if let Some(key) = derived {
+            let note = if key.starts_with("model.") {
+                String::new()
+            } else {
+                format!(" (the drive's value is derived from `{key}` and [mismatch])")
+            };
+            return SimConfigError::new(key, format!("{e}{note}"));
+        }
+        let (section, own) = match field {
+            "cutoff_hz" => ("baselines", "lpf_cutoff_hz"),
+            "compensation_floor_hz" => ("baselines", "lpf_compensation_floor_hz"),
+            "observer_bandwidth" => ("baselines", "ortega_observer_bandwidth"),
+            "observer_speed_ratio" => ("baselines", "ortega_observer_speed_ratio"),
+            "observer_bandwidth_min" => ("baselines", "ortega_observer_bandwidth_min"),
+            "flux_adaptation_ratio" => ("baselines", "ortega_flux_adaptation_ratio"),
+            "emf_bandwidth_hz" => ("baselines", "emf_bandwidth_hz"),
+            "speed_floor_hz" => ("baselines", "emf_speed_floor_hz"),
+            other => (section, other),
+        };
+        SimConfigError::new(format!("{section}.{own}"), e.to_string())
+    }
+
+    /// "Near zero speed" in r/min: `zero_speed_band_ratio` × the motor's rated speed.
+    pub fn zero_speed_band_rpm(&self) -> f64 {
+        self.simulation.zero_speed_band_ratio * self.motor.rated_speed_rpm
     }
 
     /// This configuration as a TOML document.
@@ -539,44 +486,6 @@ impl SimConfig {
     pub fn from_toml(text: &str) -> Result<SimConfig, SimConfigError> {
         Self::from_toml_over(&SimConfig::default(), text)
     }
-}
-
-/// A fado-core refusal of the `[section]` block (`estimator` or `controller`, including the
-/// baselines' `lpf_`/`ortega_`/`emf_` keys), named by the TOML key the user writes. The
-/// model estimates (R̂s, L̂q, λ̂f, …) and the timing are not keys of their own: they are plant
-/// keys times the `[mismatch]` ratios, so a refusal of one names the plant key.
-pub(crate) fn core_error(section: &str, e: fado_core::ConfigError) -> SimConfigError {
-    let derived = match e.field() {
-        "ts" | "switching_frequency" => Some("inverter.switching_frequency"),
-        "rs_hat" => Some("motor.rs"),
-        "ld_hat" => Some("motor.ld"),
-        "lq_hat" => Some("motor.lq"),
-        "flux_linkage_hat" => Some("motor.flux_linkage"),
-        "inertia_hat" => Some("motor.inertia"),
-        "pole_pairs" => Some("motor.pole_pairs"),
-        "dead_time" => Some("inverter.dead_time"),
-        "dead_time_threshold_voltage" => Some("inverter.threshold_voltage"),
-        "dead_time_current_band" => Some("inverter.current_band"),
-        "initial_angle" => Some("simulation.initial_angle"),
-        _ => None,
-    };
-    if let Some(key) = derived {
-        return SimConfigError::new(
-            key,
-            format!("{e} (the drive's value is derived from `{key}` and [mismatch])"),
-        );
-    }
-    let own = match e.field() {
-        "cutoff_hz" => "lpf_cutoff_hz",
-        "compensation_floor_hz" => "lpf_compensation_floor_hz",
-        "observer_bandwidth" => "ortega_observer_bandwidth",
-        "observer_speed_ratio" => "ortega_observer_speed_ratio",
-        "observer_bandwidth_min" => "ortega_observer_bandwidth_min",
-        "flux_adaptation_ratio" => "ortega_flux_adaptation_ratio",
-        "speed_floor_hz" => "emf_speed_floor_hz",
-        other => other,
-    };
-    SimConfigError::new(format!("{section}.{own}"), e.to_string())
 }
 
 fn merge(base: &mut toml::Table, over: toml::Table) {

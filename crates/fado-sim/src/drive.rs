@@ -1,7 +1,7 @@
 //! The sensorless drive of `fado-core` (Fig. 5) as a [`Controller`] of the closed loop.
 
 use fado_core::control::SensorlessDrive;
-use fado_core::{Ab, Abc, Diagnostics, Dq, Estimate, EstimatorConfig, RotorAngleEstimator};
+use fado_core::{Ab, Abc, Diagnostics, Dq, Estimate, RotorAngleEstimator};
 
 use crate::controller::{Actuation, ControlEvent, Controller, Measurements};
 
@@ -69,62 +69,13 @@ where
     }
 }
 
-use fado_core::control::{DeadTimeMethod, DriveConfig, VoltageLimit};
+use fado_core::control::DriveConfig;
 
-use crate::config::{DeadTimeMethodSetting, SimConfig, VoltageLimitSetting, core_error};
+use crate::config::SimConfig;
 use crate::error::SimConfigError;
 
 impl SimConfig {
-    /// The drive configuration: `[controller]` settings, model estimates from the plant and
-    /// `[mismatch]`, timing from the inverter.
-    pub fn drive_config(&self) -> DriveConfig<f64> {
-        let c = &self.controller;
-        let m = &self.mismatch;
-        let (mo, inv) = (&self.motor, &self.inverter);
-        DriveConfig {
-            ts: inv.sample_period(),
-            pole_pairs: mo.pole_pairs as f64,
-            rs_hat: (mo.rs + inv.on_resistance) * m.rs_ratio,
-            ld_hat: mo.ld * m.ld_ratio,
-            lq_hat: mo.lq * m.lq_ratio,
-            flux_linkage_hat: mo.flux_linkage * m.flux_linkage_ratio,
-            inertia_hat: mo.inertia * m.inertia_ratio,
-            current_bandwidth_hz: c.current_bandwidth_hz,
-            speed_bandwidth_hz: c.speed_bandwidth_hz,
-            speed_zero_ratio: c.speed_zero_ratio,
-            i_max: c.i_max,
-            i_min: c.i_min,
-            dead_time: inv.dead_time * m.dead_time_ratio,
-            switching_frequency: inv.switching_frequency,
-            dead_time_threshold_voltage: inv.threshold_voltage * m.threshold_voltage_ratio,
-            dead_time_current_band: inv.current_band * m.current_band_ratio,
-            dead_time_compensation: c.dead_time_compensation,
-            dead_time_method: match c.dead_time_method {
-                DeadTimeMethodSetting::Trapezoidal => DeadTimeMethod::Trapezoidal,
-                DeadTimeMethodSetting::Sign => DeadTimeMethod::Sign,
-            },
-            delay_compensation_factor: c.delay_compensation_factor,
-            trip_current: c.trip_current,
-            decoupling: c.decoupling,
-            voltage_limit: match c.voltage_limit {
-                VoltageLimitSetting::Hexagon => VoltageLimit::Hexagon,
-                VoltageLimitSetting::InscribedCircle => VoltageLimit::InscribedCircle,
-            },
-            max_modulation: c.max_modulation,
-            current_anti_windup_ratio: c.current_anti_windup_ratio,
-            speed_anti_windup_ratio: c.speed_anti_windup_ratio,
-            offset_calibration_samples: c.offset_calibration_samples,
-            stuck_sensor_band: c.stuck_sensor_band,
-            stuck_sensor_min_reference: c.stuck_sensor_min_reference,
-            stuck_sensor_samples: c.stuck_sensor_samples,
-            current_error_limit: c.current_error_limit,
-            current_error_samples: c.current_error_samples,
-            dc_link_min_voltage: c.dc_link_min_voltage,
-            input_fault_trip_samples: c.input_fault_trip_samples,
-        }
-    }
-
-    /// The drive around a baseline estimator (`[estimator] kind`), f64.
+    /// The drive around a baseline estimator (`[simulation] estimator`), f64.
     pub fn build_baseline_drive<E>(
         &self,
         estimator: E,
@@ -134,75 +85,75 @@ impl SimConfig {
     {
         let drive_cfg = self.drive_config();
         SensorlessDrive::with_estimator(drive_cfg, estimator)
-            .map_err(|e| core_error("controller", e))
+            .map_err(|e| self.core_error("controller", e))
     }
 
     /// The compensated-LPF baseline of this configuration.
     pub fn lpf_estimator(&self) -> Result<fado_core::LpfIntegratorEstimator<f64>, SimConfigError> {
         let e = self.estimator_config();
-        let s = &self.estimator;
+        let s = &self.baselines;
         fado_core::LpfIntegratorEstimator::new(fado_core::baselines::LpfIntegratorConfig {
             ts: e.ts,
-            rs_hat: e.rs_hat,
-            lq_hat: e.lq_hat,
-            flux_linkage_hat: e.flux_linkage_hat,
+            rs_hat: e.machine.rs,
+            lq_hat: e.machine.lq,
+            flux_linkage_hat: e.machine.flux_linkage,
             cutoff_hz: s.lpf_cutoff_hz,
             compensation_floor_hz: s.lpf_compensation_floor_hz,
-            t2s1_bandwidth_hz: e.t2s1_bandwidth_hz,
-            t2s2_bandwidth_hz: e.t2s2_bandwidth_hz,
-            tracker_damping: e.tracker_damping,
-            bandwidth_definition: e.bandwidth_definition,
-            tracker_hold_ratio: e.tracker_hold_ratio,
-            average_current: e.average_current,
+            t2s1_bandwidth_hz: e.tuning.t2s1_bandwidth_hz,
+            t2s2_bandwidth_hz: e.tuning.t2s2_bandwidth_hz,
+            tracker_damping: e.tuning.tracker_damping,
+            bandwidth_definition: e.tuning.bandwidth_definition,
+            tracker_hold_ratio: e.tuning.tracker_hold_ratio,
+            average_current: e.tuning.average_current,
             initial_angle: e.initial_angle,
         })
-        .map_err(|e| core_error("estimator", e))
+        .map_err(|e| self.core_error("estimator", e))
     }
 
     /// The Ortega–Praly baseline of this configuration.
     pub fn ortega_estimator(&self) -> Result<fado_core::OrtegaEstimator<f64>, SimConfigError> {
         let e = self.estimator_config();
-        let s = &self.estimator;
+        let s = &self.baselines;
         fado_core::OrtegaEstimator::new(fado_core::baselines::OrtegaConfig {
             ts: e.ts,
-            rs_hat: e.rs_hat,
-            lq_hat: e.lq_hat,
-            flux_linkage_hat: e.flux_linkage_hat,
+            rs_hat: e.machine.rs,
+            lq_hat: e.machine.lq,
+            flux_linkage_hat: e.machine.flux_linkage,
             observer_bandwidth: s.ortega_observer_bandwidth,
             observer_speed_ratio: s.ortega_observer_speed_ratio,
             observer_bandwidth_min: s.ortega_observer_bandwidth_min,
             flux_adaptation_ratio: s.ortega_flux_adaptation_ratio,
-            t2s1_bandwidth_hz: e.t2s1_bandwidth_hz,
-            t2s2_bandwidth_hz: e.t2s2_bandwidth_hz,
-            tracker_damping: e.tracker_damping,
-            bandwidth_definition: e.bandwidth_definition,
-            tracker_hold_ratio: e.tracker_hold_ratio,
-            average_current: e.average_current,
+            t2s1_bandwidth_hz: e.tuning.t2s1_bandwidth_hz,
+            t2s2_bandwidth_hz: e.tuning.t2s2_bandwidth_hz,
+            tracker_damping: e.tuning.tracker_damping,
+            bandwidth_definition: e.tuning.bandwidth_definition,
+            tracker_hold_ratio: e.tuning.tracker_hold_ratio,
+            average_current: e.tuning.average_current,
             initial_angle: e.initial_angle,
         })
-        .map_err(|e| core_error("estimator", e))
+        .map_err(|e| self.core_error("estimator", e))
     }
 
     /// The extended-EMF baseline of this configuration.
     pub fn emf_estimator(&self) -> Result<fado_core::EmfObserverEstimator<f64>, SimConfigError> {
         let e = self.estimator_config();
-        let s = &self.estimator;
+        let s = &self.baselines;
         fado_core::EmfObserverEstimator::new(fado_core::baselines::EmfObserverConfig {
             ts: e.ts,
-            rs_hat: e.rs_hat,
-            lq_hat: e.lq_hat,
-            flux_linkage_hat: e.flux_linkage_hat,
+            rs_hat: e.machine.rs,
+            lq_hat: e.machine.lq,
+            flux_linkage_hat: e.machine.flux_linkage,
             emf_bandwidth_hz: s.emf_bandwidth_hz,
             speed_floor_hz: s.emf_speed_floor_hz,
-            t2s1_bandwidth_hz: e.t2s1_bandwidth_hz,
-            t2s2_bandwidth_hz: e.t2s2_bandwidth_hz,
-            tracker_damping: e.tracker_damping,
-            bandwidth_definition: e.bandwidth_definition,
-            tracker_hold_ratio: e.tracker_hold_ratio,
-            average_current: e.average_current,
+            t2s1_bandwidth_hz: e.tuning.t2s1_bandwidth_hz,
+            t2s2_bandwidth_hz: e.tuning.t2s2_bandwidth_hz,
+            tracker_damping: e.tuning.tracker_damping,
+            bandwidth_definition: e.tuning.bandwidth_definition,
+            tracker_hold_ratio: e.tuning.tracker_hold_ratio,
+            average_current: e.tuning.average_current,
             initial_angle: e.initial_angle,
         })
-        .map_err(|e| core_error("estimator", e))
+        .map_err(|e| self.core_error("estimator", e))
     }
 
     /// The sensorless drive of this configuration (aligned by the simulation at start).
@@ -210,9 +161,13 @@ impl SimConfig {
         let drive_cfg = self.drive_config();
         drive_cfg
             .validate()
-            .map_err(|e| core_error("controller", e))?;
-        SensorlessDrive::new(drive_cfg, self.estimator_config())
-            .map_err(|e| core_error("estimator", e))
+            .map_err(|e| self.core_error("controller", e))?;
+        // Validated with the whole estimator config (the drive starts at angle 0 and is
+        // aligned by the simulation).
+        self.estimator_config()
+            .validate()
+            .map_err(|e| self.core_error("estimator", e))?;
+        SensorlessDrive::new(drive_cfg, self.estimator).map_err(|e| self.core_error("estimator", e))
     }
 }
 
@@ -292,73 +247,15 @@ impl SimConfig {
     /// The drive of this configuration in single precision: every parameter rounded to f32.
     pub fn build_drive_f32(&self) -> Result<DriveF32, SimConfigError> {
         let c = self.drive_config();
-        let f = |x: f64| x as f32;
         let dc = DriveConfig::<f32> {
-            ts: f(c.ts),
-            pole_pairs: f(c.pole_pairs),
-            rs_hat: f(c.rs_hat),
-            ld_hat: f(c.ld_hat),
-            lq_hat: f(c.lq_hat),
-            flux_linkage_hat: f(c.flux_linkage_hat),
-            inertia_hat: f(c.inertia_hat),
-            current_bandwidth_hz: f(c.current_bandwidth_hz),
-            speed_bandwidth_hz: f(c.speed_bandwidth_hz),
-            speed_zero_ratio: f(c.speed_zero_ratio),
-            i_max: f(c.i_max),
-            i_min: f(c.i_min),
-            dead_time: f(c.dead_time),
-            switching_frequency: f(c.switching_frequency),
-            dead_time_threshold_voltage: f(c.dead_time_threshold_voltage),
-            dead_time_current_band: f(c.dead_time_current_band),
-            dead_time_compensation: c.dead_time_compensation,
-            dead_time_method: c.dead_time_method,
-            delay_compensation_factor: f(c.delay_compensation_factor),
-            trip_current: f(c.trip_current),
-            decoupling: c.decoupling,
-            voltage_limit: c.voltage_limit,
-            max_modulation: f(c.max_modulation),
-            current_anti_windup_ratio: f(c.current_anti_windup_ratio),
-            speed_anti_windup_ratio: f(c.speed_anti_windup_ratio),
-            offset_calibration_samples: c.offset_calibration_samples,
-            stuck_sensor_band: f(c.stuck_sensor_band),
-            stuck_sensor_min_reference: f(c.stuck_sensor_min_reference),
-            stuck_sensor_samples: c.stuck_sensor_samples,
-            current_error_limit: f(c.current_error_limit),
-            current_error_samples: c.current_error_samples,
-            dc_link_min_voltage: f(c.dc_link_min_voltage),
-            input_fault_trip_samples: c.input_fault_trip_samples,
+            ts: c.ts as f32,
+            machine: c.machine.cast(),
+            tuning: c.tuning.cast(),
         };
-        let e = self.estimator_config();
-        let ec = EstimatorConfig::<f32> {
-            ts: f(e.ts),
-            rs_hat: f(e.rs_hat),
-            lq_hat: f(e.lq_hat),
-            flux_linkage_hat: f(e.flux_linkage_hat),
-            k_df: f(e.k_df),
-            k_df_ramp_time: f(e.k_df_ramp_time),
-            k_af: f(e.k_af),
-            limiter_radius_ratio: f(e.limiter_radius_ratio),
-            mode_threshold_hz: f(e.mode_threshold_hz),
-            mode_hysteresis_hz: f(e.mode_hysteresis_hz),
-            t2s1_bandwidth_hz: f(e.t2s1_bandwidth_hz),
-            t2s2_bandwidth_hz: f(e.t2s2_bandwidth_hz),
-            tracker_damping: f(e.tracker_damping),
-            bandwidth_definition: e.bandwidth_definition,
-            tracker_hold_ratio: f(e.tracker_hold_ratio),
-            average_current: e.average_current,
-            initial_angle: f(e.initial_angle),
-            observer_on_rotor_flux: e.observer_on_rotor_flux,
-            rs_adaptation: e.rs_adaptation,
-            rs_adaptation_rate: f(e.rs_adaptation_rate),
-            rs_adaptation_excitation_floor: f(e.rs_adaptation_excitation_floor),
-            rs_adaptation_min_ratio: f(e.rs_adaptation_min_ratio),
-            rs_adaptation_max_ratio: f(e.rs_adaptation_max_ratio),
-            flux_linkage_adaptation_rate: f(e.flux_linkage_adaptation_rate),
-            limiter_recentring: e.limiter_recentring,
-        };
-        dc.validate().map_err(|e| core_error("controller", e))?;
-        SensorlessDrive::new(dc, ec)
+        dc.validate()
+            .map_err(|e| self.core_error("controller", e))?;
+        SensorlessDrive::new(dc, self.estimator.cast())
             .map(DriveF32)
-            .map_err(|e| core_error("estimator", e))
+            .map_err(|e| self.core_error("estimator", e))
     }
 }

@@ -609,7 +609,7 @@ mod tests {
     }
 
     fn motor_with(i_dq: Dq<f64>, theta: f64, omega_mech: f64) -> Motor {
-        let mut m = Motor::new(MotorParams::default(), 0.0).unwrap();
+        let mut m = Motor::new(MotorParams::paper(), 0.0).unwrap();
         m.set_state(i_dq, theta, omega_mech);
         m
     }

@@ -26,81 +26,24 @@
 //! one real exponential and one complex rotation per interval. Both short exponentials use
 //! degree-10 Taylor polynomials for arguments ≤ 0.1 (error < 3e-17), libm beyond.
 
-use fado_core::{Ab, Dq, wrap_angle};
+use fado_core::{Ab, Dq, MachineModel, wrap_angle};
 use num_complex::Complex64;
-use serde::{Deserialize, Serialize};
 
 use crate::error::{SimConfigError, check};
 
-/// Motor parameter record (SPEC §6). The estimator never sees these; its estimates are set
-/// separately (see [`crate::config::Mismatch`]).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct MotorParams {
-    /// Stator resistance Rs in Ω. Default 0.327 Ω (paper §V \[P\]).
-    pub rs: f64,
-    /// d-axis inductance Ld in H. Default 2.63 mH (paper §V \[P\], SMPMSM: Ld = Lq).
-    pub ld: f64,
-    /// q-axis inductance Lq in H. Default 2.63 mH (paper §V \[P\]).
-    pub lq: f64,
-    /// Magnet flux linkage λf in Wb (peak, per phase). Default 0.088 Wb (SPEC §6 \[A\]).
-    pub flux_linkage: f64,
-    /// Pole pairs p. Default 4 (8-pole motor, paper §V \[P\]).
-    pub pole_pairs: u32,
-    /// Total shaft inertia J in kg·m² (servo rotor + dynamometer + coupling). Default 0.012
-    /// (SPEC §6 \[A\]).
-    pub inertia: f64,
-    /// Viscous friction B in N·m·s/rad. Default 1e-3 (SPEC §6 \[A\]).
-    pub viscous_friction: f64,
-}
+/// The plant's motor: the same record as the drive's model of it, [`MachineModel`] (the
+/// motulator pattern), read from the `[motor]` TOML table. The simulator's default is the
+/// paper's motor ([`MachineModel::paper`]); `dc_voltage` of the record is not used by the
+/// plant (the inverter has its own, `[inverter] dc_voltage`).
+pub type MotorParams = MachineModel<f64>;
 
-impl Default for MotorParams {
-    fn default() -> Self {
-        Self {
-            rs: 0.327,
-            ld: 2.63e-3,
-            lq: 2.63e-3,
-            flux_linkage: 0.088,
-            pole_pairs: 4,
-            inertia: 0.012,
-            viscous_friction: 1e-3,
-        }
-    }
-}
-
-impl MotorParams {
-    /// Checks every field; the error names the key.
-    pub fn validate(&self) -> Result<(), SimConfigError> {
-        check::positive("rs", self.rs)?;
-        check::positive("ld", self.ld)?;
-        check::positive("lq", self.lq)?;
-        check::non_negative("flux_linkage", self.flux_linkage)?;
-        if self.pole_pairs == 0 {
-            return Err(SimConfigError::new("pole_pairs", "must be ≥ 1"));
-        }
-        check::positive("inertia", self.inertia)?;
-        check::non_negative("viscous_friction", self.viscous_friction)?;
-        Ok(())
-    }
-
-    /// Electromagnetic torque 1.5·p·(λf·iq + (Ld − Lq)·id·iq) in N·m.
-    #[inline]
-    pub fn torque(&self, i_dq: Dq<f64>) -> f64 {
-        1.5 * self.pole_pairs as f64
-            * (self.flux_linkage * i_dq.q + (self.ld - self.lq) * i_dq.d * i_dq.q)
-    }
-
-    /// Stator flux linkage in the rotor frame (Ld·id + λf, Lq·iq).
-    #[inline]
-    pub fn flux_dq(&self, i_dq: Dq<f64>) -> Dq<f64> {
-        Dq::new(self.ld * i_dq.d + self.flux_linkage, self.lq * i_dq.q)
-    }
-
-    /// Magnetic energy of the stator inductances, 1.5·(Ld·id² + Lq·iq²)/2, in J.
-    #[inline]
-    pub fn magnetic_energy(&self, i_dq: Dq<f64>) -> f64 {
-        0.75 * (self.ld * i_dq.d * i_dq.d + self.lq * i_dq.q * i_dq.q)
-    }
+/// Checks the plant record; the error names the `[motor]` key (the DC-link voltage the
+/// consistency check needs is the inverter's).
+pub fn validate_motor(motor: &MotorParams, dc_voltage: f64) -> Result<(), SimConfigError> {
+    let mut m = *motor;
+    m.dc_voltage = dc_voltage;
+    m.validate()
+        .map_err(|e| SimConfigError::new(e.field(), e.to_string()))
 }
 
 /// The true machine state (evaluation only: the drive never reads it).
@@ -308,7 +251,16 @@ pub struct Motor {
 impl Motor {
     /// A machine at rest at electrical angle `theta0` with zero current.
     pub fn new(params: MotorParams, theta0: f64) -> Result<Self, SimConfigError> {
-        params.validate()?;
+        // What the plant's physics needs (the ratings are checked with the whole config).
+        check::positive("rs", params.rs)?;
+        check::positive("ld", params.ld)?;
+        check::positive("lq", params.lq)?;
+        check::non_negative("flux_linkage", params.flux_linkage)?;
+        if params.pole_pairs == 0 {
+            return Err(SimConfigError::new("pole_pairs", "must be ≥ 1"));
+        }
+        check::positive("inertia", params.inertia)?;
+        check::non_negative("viscous_friction", params.viscous_friction)?;
         check::finite("theta0", theta0)?;
         let mut m = Self {
             params,
@@ -452,11 +404,11 @@ mod tests {
 
     #[test]
     fn closed_form_matches_fine_rk4_surface_and_interior() {
-        let spm = MotorParams::default();
+        let spm = MotorParams::paper();
         let ipm = MotorParams {
             ld: 2.0e-3,
             lq: 5.0e-3,
-            ..MotorParams::default()
+            ..MotorParams::paper()
         };
         for p in [spm, ipm] {
             for w in [0.0, 37.0, -400.0, 2500.0] {
@@ -475,9 +427,9 @@ mod tests {
         let ipm = MotorParams {
             ld: 2.0e-3,
             lq: 5.0e-3,
-            ..MotorParams::default()
+            ..MotorParams::paper()
         };
-        for p in [MotorParams::default(), ipm] {
+        for p in [MotorParams::paper(), ipm] {
             for w in [0.0, -55.0, 900.0] {
                 let prop = ElectricalPropagator::new(&p, p.rs + 0.01, w);
                 let (th0, h) = (-2.2, 63e-6);
@@ -508,9 +460,9 @@ mod tests {
         let ipm = MotorParams {
             ld: 2.0e-3,
             lq: 5.0e-3,
-            ..MotorParams::default()
+            ..MotorParams::paper()
         };
-        for p in [MotorParams::default(), ipm] {
+        for p in [MotorParams::paper(), ipm] {
             let w = 300.0;
             let r = p.rs;
             let prop = ElectricalPropagator::new(&p, r, w);
@@ -549,7 +501,7 @@ mod tests {
     fn steady_state_at_speed_has_back_emf_along_q() {
         // With no voltage applied at constant speed, currents settle to −x_c: the short-circuit
         // current of the magnet back-EMF.
-        let p = MotorParams::default();
+        let p = MotorParams::paper();
         let w = 200.0;
         let prop = ElectricalPropagator::new(&p, p.rs, w);
         let mut i = Dq::zero();
@@ -572,7 +524,7 @@ mod tests {
         let mut m = Motor::new(
             MotorParams {
                 viscous_friction: 0.0,
-                ..Default::default()
+                ..MotorParams::paper()
             },
             0.0,
         )
@@ -583,17 +535,17 @@ mod tests {
         assert!((m.state().omega_mech - 1.2 / 0.012).abs() < 1e-9);
         let bad = MotorParams {
             lq: -1.0,
-            ..Default::default()
+            ..MotorParams::paper()
         };
-        assert_eq!(bad.validate().unwrap_err().key, "lq");
+        assert_eq!(Motor::new(bad, 0.0).err().unwrap().key, "lq");
     }
 
     #[test]
     fn a_non_finite_start_angle_is_refused_naming_it() {
         for bad in [f64::NAN, f64::INFINITY] {
-            let e = Motor::new(MotorParams::default(), bad).err().unwrap();
+            let e = Motor::new(MotorParams::paper(), bad).err().unwrap();
             assert_eq!(e.key, "theta0");
         }
-        assert!(Motor::new(MotorParams::default(), -2.0).is_ok());
+        assert!(Motor::new(MotorParams::paper(), -2.0).is_ok());
     }
 }

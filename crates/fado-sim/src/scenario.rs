@@ -28,11 +28,18 @@ pub struct Scenario {
     pub profile: &'static str,
     /// Pass criterion in words.
     pub criterion: &'static str,
+    /// The profile is scaled by the motor's ratings (rated speed and torque of `[motor]`),
+    /// so that the scenario runs for any motor; otherwise it is the paper's in absolute
+    /// units (r/min, N·m of its motor).
+    pub scaled: bool,
 }
 
-/// The five scenarios of SPEC §7, then two of ours for the estimator comparison
-/// ([`crate::compare`]): a medium-speed sanity check under load and a low-speed staircase.
-pub const SCENARIOS: [Scenario; 7] = [
+/// The five scenarios of SPEC §7 in the paper's units, two of ours for the estimator
+/// comparison ([`crate::compare`]): a medium-speed sanity check under load and a low-speed
+/// staircase; then the paper's experiments scaled by the motor's ratings (its motor: 1500
+/// r/min, 11.5 N·m), which run for any motor: `reversal` (Fig. 11), `stops` (Fig. 12) and
+/// `rated-reversal` (Fig. 11 under the rated torque).
+pub const SCENARIOS: [Scenario; 10] = [
     Scenario {
         name: "fig8",
         title: "Flux and disturbance estimation under 2 N·m (Fig. 8)",
@@ -40,6 +47,7 @@ pub const SCENARIOS: [Scenario; 7] = [
         criterion: "λ2 centred on zero: mean of λ2 − λs over every whole electrical \
                     revolution spent above 30 r/min in HI mode < 2 % of λf; no trip; \
                     speed error < 30 r/min",
+        scaled: false,
     },
     Scenario {
         name: "fig9",
@@ -48,6 +56,7 @@ pub const SCENARIOS: [Scenario; 7] = [
                   (no start-up offset calibration)",
         criterion: "λ1 drifts while off (|ΔD̂| > 2 mWb) and recovers with τ ≈ 2 s \
                     (residual after 2 s in [0.2, 0.55]); |θ − θ̂| < 0.05 rad",
+        scaled: false,
     },
     Scenario {
         name: "fig10",
@@ -55,6 +64,7 @@ pub const SCENARIOS: [Scenario; 7] = [
         profile: "0 → 60 → 0 r/min without load, then 0 r/min from 1.7 s to 5.5 s",
         criterion: "|θ − θ̂| < 0.35 rad (does not diverge); |λ̂r| ≤ 1.15·λ̂f (+1 %); \
                     FLAG_limit high ≥ 95 % of the hold",
+        scaled: false,
     },
     Scenario {
         name: "fig11",
@@ -62,6 +72,7 @@ pub const SCENARIOS: [Scenario; 7] = [
         profile: "0 → −90 r/min, T_L → +7.5 N·m, then −90 → +90 r/min at 90 r/min/s",
         criterion: "|θ − θ̂| < 0.25 rad near zero speed (|n| < 30 r/min) [P]; no trip; \
                     speed error < 30 r/min",
+        scaled: false,
     },
     Scenario {
         name: "fig12",
@@ -69,12 +80,14 @@ pub const SCENARIOS: [Scenario; 7] = [
         profile: "60 r/min, T_L → +7.5 N·m, then 3 × (60 → 0 at 120 r/min/s, 300 ms at 0, \
                   0 → 60, 500 ms at 60)",
         criterion: "no trip or instability [P]; |θ − θ̂| < 0.25 rad [A]; speed error < 30 r/min",
+        scaled: false,
     },
     Scenario {
         name: "steady300",
         title: "Steady 300 r/min under 7.5 N·m (sanity check of every estimator) [A]",
         profile: "0 → 300 r/min in 1 s, T_L → 7.5 N·m over [1.5 s, 2 s], hold to 4 s",
         criterion: "settled (from 2.5 s) |θ − θ̂| < 0.05 rad; speed error < 10 r/min; no trip",
+        scaled: false,
     },
     Scenario {
         name: "lowspeed",
@@ -85,11 +98,55 @@ pub const SCENARIOS: [Scenario; 7] = [
                     |n − n*| < max(0.5·n*, 0.5 r/min) and no trip; the lowest speed held is \
                     the lowest level held together with every level above it; the scenario \
                     passes when every level is held",
+        scaled: false,
+    },
+    Scenario {
+        name: "reversal",
+        title: "Speed reversal under 65 % of rated torque (Fig. 11, scaled by the ratings)",
+        profile: "0 → −6 % of rated speed, T_L → 65.2 % of rated torque, then a reversal to \
+                  +6 % at 6 % of rated speed per second (the paper's motor: fig11)",
+        criterion: "|θ − θ̂| < 0.25 rad near zero speed (|n| < 2 % of rated) [P]; no trip; \
+                    speed error < 2 % of rated speed",
+        scaled: true,
+    },
+    Scenario {
+        name: "stops",
+        title: "Repeated 300 ms stops under 65 % of rated torque (Fig. 12, scaled)",
+        profile: "4 % of rated speed, T_L → 65.2 % of rated torque, then 3 × (ramp to 0 in \
+                  0.5 s, 300 ms at 0, back in 0.5 s, 500 ms at 4 %) (the paper's motor: fig12)",
+        criterion: "no trip or instability [P]; |θ − θ̂| < 0.25 rad [A]; speed error < 2 % \
+                    of rated speed",
+        scaled: true,
+    },
+    Scenario {
+        name: "rated-reversal",
+        title: "Speed reversal under the rated torque (Fig. 11 at 100 % load, scaled)",
+        profile: "as `reversal` with T_L → 100 % of rated torque",
+        criterion: "as `reversal`",
+        scaled: true,
     },
 ];
 
-/// Speed levels of the `lowspeed` staircase, r/min: 60 r/min halved six times.
-pub const LOWSPEED_LEVELS_RPM: [f64; 7] = [60.0, 30.0, 15.0, 7.5, 3.75, 1.875, 0.9375];
+/// Load of the scaled `reversal` and `stops`, as a fraction of the rated torque: the paper's
+/// 7.5 N·m of 11.5 N·m (65.2 %, section V \[P\]).
+pub const SCALED_LOAD_RATIO: f64 = 0.652;
+/// Speed of the scaled `reversal`, fraction of the rated speed: 90 of 1500 r/min (±6 %, the
+/// paper's "less than ±10 % of its rated speed" \[P\]); the reversal ramp is this per second.
+pub const REVERSAL_SPEED_RATIO: f64 = 0.06;
+/// Top speed of the scaled `stops`: 60 of 1500 r/min (4 %, Fig. 12 \[A\]).
+pub const STOPS_SPEED_RATIO: f64 = 0.04;
+/// Speed-error bound of the scaled scenarios, fraction of the rated speed: 30 of 1500 r/min.
+pub const SCALED_SPEED_ERROR_RATIO: f64 = 0.02;
+
+/// Speed levels of the `lowspeed` staircase, r/min: 4 % of the rated speed halved six times
+/// (the paper's motor: 60, 30, …, 0.9375 r/min).
+pub fn lowspeed_levels_rpm(rated_speed_rpm: f64) -> [f64; 7] {
+    let mut levels = [STOPS_SPEED_RATIO * rated_speed_rpm; 7];
+    for k in 1..7 {
+        levels[k] = 0.5 * levels[k - 1];
+    }
+    levels
+}
 /// Time the `lowspeed` staircase spends at each level (ramp included), s.
 pub const LOWSPEED_LEVEL_SECONDS: f64 = 2.0;
 /// Ramp from one level to the next, s.
@@ -114,10 +171,17 @@ pub fn find(name: &str) -> Option<&'static Scenario> {
 }
 
 impl Scenario {
-    /// The scenario's default configuration (SPEC §6 plant and drive, the profile above).
+    /// The scenario's default configuration (SPEC §6 plant and drive: the paper's motor, the
+    /// profile above).
     pub fn config(&self) -> SimConfig {
-        let mut c = SimConfig::default();
+        self.apply(SimConfig::default())
+    }
+
+    /// `base` with this scenario's profile, load, duration and evaluation window; a scaled
+    /// scenario takes them from `base.motor`'s ratings.
+    pub fn apply(&self, mut c: SimConfig) -> SimConfig {
         let pts = Profile::from_points;
+        let (n_rated, t_rated) = (c.motor.rated_speed_rpm, c.motor.rated_torque);
         match self.name {
             "fig8" => {
                 c.speed_reference = pts(&[
@@ -142,7 +206,7 @@ impl Scenario {
                 // provide one of visible size \[A\]. (Calibrated, λ1 drifts only 1–3 mWb in
                 // the 2 s: too little for the drift check, and the recovery ratio is then
                 // dominated by noise.)
-                c.controller.offset_calibration_samples = 0;
+                c.controller.offset_calibration_time = 0.0;
             }
             "fig10" => {
                 c.speed_reference =
@@ -186,19 +250,47 @@ impl Scenario {
                 c.simulation.eval_start = 2.5;
             }
             "lowspeed" => {
-                let mut p = vec![(0.0, 0.0), (0.2, 0.0), (0.9, 60.0)];
+                let levels = lowspeed_levels_rpm(n_rated);
+                let mut p = vec![(0.0, 0.0), (0.2, 0.0), (0.9, levels[0])];
                 let mut t = LOWSPEED_START;
-                let mut prev = 60.0;
-                for level in LOWSPEED_LEVELS_RPM {
+                let mut prev = levels[0];
+                for level in levels {
                     p.extend([(t, prev), (t + LOWSPEED_RAMP_SECONDS, level)]);
                     prev = level;
                     t += LOWSPEED_LEVEL_SECONDS;
                 }
                 p.push((t, prev));
                 c.speed_reference = pts(&p);
-                c.load.torque = pts(&[(0.9, 0.0), (1.4, 7.5)]);
+                c.load.torque = pts(&[(0.9, 0.0), (1.4, SCALED_LOAD_RATIO * t_rated)]);
                 c.simulation.duration = t;
                 c.simulation.eval_start = LOWSPEED_START;
+            }
+            "reversal" | "rated-reversal" => {
+                // fig11 in units of the ratings: 90 r/min = 6 %, 7.5 N·m = 65.2 %.
+                let n = REVERSAL_SPEED_RATIO * n_rated;
+                let load = if self.name == "reversal" {
+                    SCALED_LOAD_RATIO
+                } else {
+                    1.0
+                };
+                c.speed_reference = pts(&[(0.0, 0.0), (0.2, 0.0), (1.2, -n), (2.5, -n), (4.5, n)]);
+                c.load.torque = pts(&[(1.2, 0.0), (1.7, load * t_rated)]);
+                c.simulation.duration = 5.5;
+                c.simulation.eval_start = 2.0;
+            }
+            "stops" => {
+                // fig12 in units of the ratings: 60 r/min = 4 %, 7.5 N·m = 65.2 %.
+                let n = STOPS_SPEED_RATIO * n_rated;
+                let mut p = vec![(0.0, 0.0), (0.2, 0.0), (0.9, n), (2.0, n)];
+                let mut t = 2.0;
+                for _ in 0..3 {
+                    p.extend([(t + 0.5, 0.0), (t + 0.8, 0.0), (t + 1.3, n), (t + 1.8, n)]);
+                    t += 1.8;
+                }
+                c.speed_reference = pts(&p);
+                c.load.torque = pts(&[(0.9, 0.0), (1.4, SCALED_LOAD_RATIO * t_rated)]);
+                c.simulation.duration = t;
+                c.simulation.eval_start = 1.8;
             }
             _ => unreachable!("every scenario in SCENARIOS has a profile"),
         }
@@ -206,15 +298,12 @@ impl Scenario {
     }
 
     fn probe(&self, cfg: &SimConfig) -> ScenarioProbe {
-        let mut p = ScenarioProbe::new(
-            cfg.simulation.eval_start,
-            cfg.simulation.zero_speed_band_rpm,
-        );
+        let mut p = ScenarioProbe::new(cfg.simulation.eval_start, cfg.zero_speed_band_rpm());
         if self.name == "fig10" {
             p.hold = Some((2.0, cfg.simulation.duration));
         }
         if self.name == "lowspeed" {
-            p.levels = LOWSPEED_LEVELS_RPM
+            p.levels = lowspeed_levels_rpm(cfg.motor.rated_speed_rpm)
                 .iter()
                 .enumerate()
                 .map(|(k, &level)| {
@@ -274,8 +363,7 @@ impl Scenario {
                 checks.push(Check::at_most(
                     "max |λ̂r| / (1.15·λ̂f)",
                     p.max_lambda_r
-                        / (cfg.estimator.limiter_radius_ratio
-                            * cfg.estimator_config().flux_linkage_hat),
+                        / (cfg.estimator.limiter_radius_ratio * cfg.machine_model().flux_linkage),
                     1.01,
                 ));
                 checks.push(Check::at_least(
@@ -323,9 +411,37 @@ impl Scenario {
             }
             "lowspeed" => {
                 checks.push(Check::at_least(
-                    "levels held from 60 r/min down",
+                    "levels held from 4 % of rated speed down",
                     p.levels_held_in_a_row() as f64,
-                    LOWSPEED_LEVELS_RPM.len() as f64,
+                    p.levels.len() as f64,
+                ));
+            }
+            "reversal" | "rated-reversal" => {
+                let band = SCALED_SPEED_ERROR_RATIO * cfg.motor.rated_speed_rpm;
+                checks.push(Check::at_most(
+                    "max |θ − θ̂| near zero speed (rad)",
+                    m.max_angle_error_zero_speed,
+                    0.25,
+                ));
+                // 0.1 s of samples at least in the band (fig11: 0.67 s).
+                checks.push(Check::at_least(
+                    "samples near zero speed",
+                    m.zero_speed_samples as f64,
+                    0.1 / cfg.inverter.sample_period(),
+                ));
+                checks.push(Check::at_most(
+                    "max speed error (r/min)",
+                    m.max_speed_error_rpm,
+                    band,
+                ));
+            }
+            "stops" => {
+                let band = SCALED_SPEED_ERROR_RATIO * cfg.motor.rated_speed_rpm;
+                checks.push(Check::at_most("max |θ − θ̂| (rad)", m.max_angle_error, 0.25));
+                checks.push(Check::at_most(
+                    "max speed error (r/min)",
+                    m.max_speed_error_rpm,
+                    band,
                 ));
             }
             _ => unreachable!(),
@@ -656,8 +772,8 @@ impl Outcome {
         Report {
             scenario: self.scenario.clone(),
             inverter_model: self.config.inverter.model,
-            precision: self.config.controller.precision,
-            estimator: self.config.estimator.kind,
+            precision: self.config.simulation.precision,
+            estimator: self.config.simulation.estimator,
             passed: self.passed,
             max_angle_error: m.max_angle_error,
             rms_angle_error: m.rms_angle_error,
@@ -687,10 +803,14 @@ pub fn scenario_config(
             format!("unknown `{scenario}`; one of {names:?}"),
         )
     })?;
-    let base = sc.config();
     let mut cfg = match config_toml {
-        Some(text) => SimConfig::from_toml_over(&base, text)?,
-        None => base,
+        // The user's motor first (a scaled scenario needs its ratings), then the scenario,
+        // then the user's keys again, so that any of them wins over the scenario's.
+        Some(text) => {
+            let user = SimConfig::from_toml_over(&SimConfig::default(), text)?;
+            SimConfig::from_toml_over(&sc.apply(user), text)?
+        }
+        None => sc.config(),
     };
     if averaged {
         cfg.inverter.model = InverterModel::Averaged;
@@ -748,7 +868,7 @@ pub fn run_config(
         .ok_or_else(|| SimConfigError::new("scenario", format!("unknown `{scenario}`")))?;
     cfg.validate()?;
     let started = Instant::now();
-    match (cfg.controller.precision, cfg.estimator.kind) {
+    match (cfg.simulation.precision, cfg.simulation.estimator) {
         (Precision::F64, EstimatorKind::Fado) => {
             let drive = cfg.build_drive()?;
             run_with(sc, cfg, drive, started, progress)
@@ -770,8 +890,8 @@ pub fn run_config(
             run_with(sc, cfg, drive, started, progress)
         }
         (Precision::F32, _) => Err(SimConfigError::new(
-            "estimator.kind",
-            "the baselines run with an f64 drive only (controller.precision = \"f64\")",
+            "simulation.estimator",
+            "the baselines run with an f64 drive only (simulation.precision = \"f64\")",
         )),
     }
 }
@@ -784,10 +904,7 @@ fn run_with<C: Controller>(
     progress: Option<&mut dyn FnMut(f64)>,
 ) -> Result<Outcome, SimConfigError> {
     let mut sim = cfg.simulation(drive)?;
-    let mut metrics = Metrics::new(
-        cfg.simulation.eval_start,
-        cfg.simulation.zero_speed_band_rpm,
-    );
+    let mut metrics = Metrics::new(cfg.simulation.eval_start, cfg.zero_speed_band_rpm());
     let mut trace = Trace::new(cfg.simulation.decimation);
     let mut probe = sc.probe(&cfg);
     let mut stats = sim.run(
@@ -837,8 +954,8 @@ mod tests {
     fn lowspeed_staircase_levels_are_judged_on_their_settled_window() {
         let cfg = find("lowspeed").unwrap().config();
         let probe = find("lowspeed").unwrap().probe(&cfg);
-        assert_eq!(probe.levels.len(), LOWSPEED_LEVELS_RPM.len());
-        for (l, &level) in probe.levels.iter().zip(&LOWSPEED_LEVELS_RPM) {
+        assert_eq!(probe.levels.len(), lowspeed_levels_rpm(1500.0).len());
+        for (l, &level) in probe.levels.iter().zip(&lowspeed_levels_rpm(1500.0)) {
             // The reference sits at the level over the whole judged window, under full load.
             for t in [l.from, 0.5 * (l.from + l.to), l.to] {
                 assert_eq!(cfg.speed_reference.value(t), level, "t = {t}");

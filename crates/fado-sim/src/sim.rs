@@ -22,8 +22,8 @@ use crate::sensors::{CurrentSensor, CurrentSensorParams, DcLinkSensorParams, Enc
 const RPM_PER_RAD_S: f64 = 60.0 / std::f64::consts::TAU;
 
 /// Everything physical: machine, inverter, sensors, load.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct PlantParams {
     /// The PMSM.
     pub motor: MotorParams,
@@ -42,7 +42,13 @@ pub struct PlantParams {
 impl PlantParams {
     /// Checks every record; the error names the key as `section.field`.
     pub fn validate(&self) -> Result<(), SimConfigError> {
-        self.motor.validate().map_err(|e| e.in_section("motor"))?;
+        crate::motor::validate_motor(&self.motor, self.inverter.dc_voltage).map_err(|e| {
+            if e.key == "dc_voltage" {
+                SimConfigError::new("inverter.dc_voltage", e.message)
+            } else {
+                e.in_section("motor")
+            }
+        })?;
         self.inverter
             .validate()
             .map_err(|e| e.in_section("inverter"))?;

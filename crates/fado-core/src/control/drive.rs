@@ -44,7 +44,8 @@ use crate::{Ab, Abc, Dq, MachineModel, Real, Rotation};
 /// are ratios of the machine's ratings or durations in seconds, chosen so that the paper's
 /// motor ([`MachineModel::paper`], 21.78 A rated) gets the paper's and SPEC's absolute values
 /// (written beside each ratio); the inverter data (dead time, switching frequency, threshold
-/// voltage, current band) are SPEC §5's. With the `serde` feature this is the `[controller]`
+/// voltage, current band) are SPEC §5's; they are not serde keys (`fado-sim` derives them from
+/// its `[inverter]` and `[mismatch]`). With the `serde` feature this is the `[controller]`
 /// table of `fado-sim`'s TOML.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(
@@ -70,14 +71,18 @@ pub struct DriveTuning<T> {
     /// rotor. Default true.
     pub mtpa: bool,
     /// Dead time Td in s (inverter datum). Default 2.5 µs (paper, V).
+    #[cfg_attr(feature = "serde", serde(skip))]
     pub dead_time: T,
     /// Switching frequency in Hz (inverter datum). Default 5 kHz (paper, V).
+    #[cfg_attr(feature = "serde", serde(skip))]
     pub switching_frequency: T,
     /// Device threshold voltage of the dead-time compensation in V (inverter datum). Default
     /// 1 V (SPEC §5 \[A\]).
+    #[cfg_attr(feature = "serde", serde(skip))]
     pub dead_time_threshold_voltage: T,
     /// Current band Ic of the trapezoidal compensation in A (inverter datum). Default 0.3 A
     /// (SPEC §5 \[A\]).
+    #[cfg_attr(feature = "serde", serde(skip))]
     pub dead_time_current_band: T,
     /// Compensate the dead time at all. Default true (paper IV-B).
     pub dead_time_compensation: bool,
@@ -136,6 +141,42 @@ pub struct DriveTuning<T> {
     /// trips on bad input. Default 10 ms \[A\]: a single bad sample is ridden through with the
     /// duty held, a sensor chain that stays broken is a fault.
     pub input_fault_trip_time: T,
+}
+
+impl<T: Real> DriveTuning<T> {
+    /// The same record in another precision (e.g. an f64 configuration for an f32 drive):
+    /// every real rounded to `U`.
+    pub fn cast<U: Real>(&self) -> DriveTuning<U> {
+        DriveTuning {
+            current_bandwidth_hz: U::lit(self.current_bandwidth_hz.to_f64()),
+            speed_bandwidth_hz: U::lit(self.speed_bandwidth_hz.to_f64()),
+            speed_zero_ratio: U::lit(self.speed_zero_ratio.to_f64()),
+            current_limit_ratio: U::lit(self.current_limit_ratio.to_f64()),
+            injection_current_ratio: U::lit(self.injection_current_ratio.to_f64()),
+            mtpa: self.mtpa,
+            dead_time: U::lit(self.dead_time.to_f64()),
+            switching_frequency: U::lit(self.switching_frequency.to_f64()),
+            dead_time_threshold_voltage: U::lit(self.dead_time_threshold_voltage.to_f64()),
+            dead_time_current_band: U::lit(self.dead_time_current_band.to_f64()),
+            dead_time_compensation: self.dead_time_compensation,
+            dead_time_method: self.dead_time_method,
+            delay_compensation_factor: U::lit(self.delay_compensation_factor.to_f64()),
+            trip_current_ratio: U::lit(self.trip_current_ratio.to_f64()),
+            decoupling: self.decoupling,
+            voltage_limit: self.voltage_limit,
+            max_modulation: U::lit(self.max_modulation.to_f64()),
+            current_anti_windup_ratio: U::lit(self.current_anti_windup_ratio.to_f64()),
+            speed_anti_windup_ratio: U::lit(self.speed_anti_windup_ratio.to_f64()),
+            offset_calibration_time: U::lit(self.offset_calibration_time.to_f64()),
+            stuck_sensor_band_ratio: U::lit(self.stuck_sensor_band_ratio.to_f64()),
+            stuck_sensor_reference_ratio: U::lit(self.stuck_sensor_reference_ratio.to_f64()),
+            stuck_sensor_time: U::lit(self.stuck_sensor_time.to_f64()),
+            current_error_ratio: U::lit(self.current_error_ratio.to_f64()),
+            current_error_time: U::lit(self.current_error_time.to_f64()),
+            dc_link_min_ratio: U::lit(self.dc_link_min_ratio.to_f64()),
+            input_fault_trip_time: U::lit(self.input_fault_trip_time.to_f64()),
+        }
+    }
 }
 
 impl<T: Real> Default for DriveTuning<T> {

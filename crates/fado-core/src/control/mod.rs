@@ -19,7 +19,7 @@ pub use dead_time_compensation::{
     DeadTimeCompensation, DeadTimeCompensationConfig, DeadTimeMethod,
 };
 pub use delay_compensation::{DelayCompensation, DelayCompensationConfig};
-pub use drive::{DriveConfig, DriveOutput, SensorlessDrive};
+pub use drive::{DriveConfig, DriveOutput, DriveTuning, SensorlessDrive};
 pub use modulation::{Modulation, ModulatorConfig, SpaceVectorModulator, VoltageLimit, svpwm_duty};
 pub use monitor::{DriveFlags, FlagCounts};
 pub use pi::{Pi, PiConfig};
