@@ -7,7 +7,7 @@
 //! cargo run --release -p fado-core --example firmware_isr
 //! ```
 
-use fado_core::{Ab, Abc, Dq, EstimatorConfig, Rotation, SensorlessEstimator};
+use fado_core::{Ab, Abc, Dq, EstimatorConfig, MachineModel, Rotation, SensorlessEstimator};
 
 /// The estimator part of a drive's 10 kHz interrupt.
 pub struct Isr {
@@ -21,16 +21,27 @@ pub struct Isr {
 }
 
 impl Isr {
-    /// Set-up, before the interrupt is enabled: the motor's R̂s, L̂q and λ̂f, paper defaults
-    /// for everything else, and a start at a known (aligned) rotor angle with the phase
-    /// currents flowing then (SPEC §1 step 6: λ1 = λ̂f·e^{jθ0} + L̂q·i).
+    /// Set-up, before the interrupt is enabled: the motor's data (parameters and ratings, here
+    /// the paper's motor), the paper's tuning for everything else, and a start at a known
+    /// (aligned) rotor angle with the phase currents flowing then (SPEC §1 step 6:
+    /// λ1 = λ̂f·e^{jθ0} + L̂q·i).
     pub fn new(theta_aligned: f32, i_abc: Abc<f32>) -> Self {
+        let motor = MachineModel {
+            rs: 0.327,
+            ld: 2.63e-3,
+            lq: 2.63e-3,
+            flux_linkage: 0.088,
+            pole_pairs: 4,
+            inertia: 0.012,
+            viscous_friction: 1e-3,
+            rated_current: 21.78,
+            rated_speed_rpm: 1500.0,
+            rated_torque: 11.5,
+            dc_voltage: 311.0,
+        };
         let config = EstimatorConfig {
-            rs_hat: 0.327,
-            lq_hat: 2.63e-3,
-            flux_linkage_hat: 0.088,
             initial_angle: theta_aligned,
-            ..Default::default()
+            ..EstimatorConfig::for_machine(&motor)
         };
         let mut estimator = SensorlessEstimator::new(config).expect("motor data are valid");
         estimator.align(theta_aligned, i_abc.to_ab());

@@ -14,7 +14,9 @@
 use core::f64::consts::TAU;
 
 use fado_core::injection::{CurrentInjection, CurrentInjectionConfig};
-use fado_core::{Ab, Dq, EstimatorConfig, Mode, Rotation, SensorlessEstimator, wrap_angle};
+use fado_core::{
+    Ab, Dq, EstimatorConfig, MachineModel, Mode, Rotation, SensorlessEstimator, wrap_angle,
+};
 
 const TS: f64 = 100e-6;
 const RS: f64 = 0.327;
@@ -85,7 +87,7 @@ fn main() {
     let theta0 = 0.8;
     let mut est = SensorlessEstimator::<f32>::new(EstimatorConfig {
         initial_angle: theta0 as f32,
-        ..Default::default()
+        ..EstimatorConfig::for_machine(&MachineModel::paper())
     })
     .expect("the default configuration is valid");
     let (_, i0) = machine(theta0);

@@ -9,7 +9,7 @@
 
 use std::hint::black_box;
 
-use fado_core::{Ab, Estimate, EstimatorConfig, Real, SensorlessEstimator};
+use fado_core::{Ab, Estimate, EstimatorConfig, MachineModel, Real, SensorlessEstimator};
 
 /// Samples in the signal table: a power of two holding exactly 8 electrical periods.
 const TABLE: usize = 4096;
@@ -52,11 +52,9 @@ fn isr_step<T: Real>(est: &mut SensorlessEstimator<T>, v: Ab<T>, i: Ab<T>) -> Es
 
 fn run<T: Real>(steps: usize) -> f64 {
     let table = signal::<T>();
-    let mut est = SensorlessEstimator::<T>::new(EstimatorConfig {
-        rs_adaptation: std::env::var("FIXED_RS").is_err(),
-        ..Default::default()
-    })
-    .expect("valid");
+    let mut config = EstimatorConfig::for_machine(&MachineModel::paper());
+    config.tuning.rs_adaptation = std::env::var("FIXED_RS").is_err();
+    let mut est = SensorlessEstimator::<T>::new(config).expect("valid");
     // Warm-up: one second, so that the counted steps run in the settled k_df mode.
     for &(v, i) in table.iter().cycle().take(10_000) {
         est.step(v, i);
