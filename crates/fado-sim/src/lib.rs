@@ -51,6 +51,7 @@ pub mod faults;
 pub mod inverter;
 pub mod load;
 pub mod motor;
+pub mod presets;
 pub mod profile;
 pub mod scenario;
 pub mod sensors;

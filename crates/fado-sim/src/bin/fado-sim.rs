@@ -35,6 +35,8 @@ struct Cli {
 enum Command {
     /// List the scenarios.
     List,
+    /// List the motor presets of `motors/` (each a valid `--config` file), one line each.
+    Motors,
     /// Run a scenario, print its metrics, write DIR/metrics.json and DIR/traces.csv.
     Run {
         /// Scenario name (see `list`).
@@ -132,6 +134,12 @@ fn main() -> ExitCode {
 
 fn run(cli: Cli) -> Result<ExitCode, Box<dyn std::error::Error>> {
     match cli.command {
+        Command::Motors => {
+            for p in fado_sim::presets::PRESETS {
+                println!("{:<22} {}", p.name, p.description());
+            }
+            Ok(ExitCode::SUCCESS)
+        }
         Command::List => {
             for s in &SCENARIOS {
                 println!(
