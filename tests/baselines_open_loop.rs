@@ -10,7 +10,7 @@ use fado_core::baselines::{
     EmfObserverConfig, EmfObserverEstimator, LpfIntegratorConfig, LpfIntegratorEstimator,
     OrtegaConfig, OrtegaEstimator,
 };
-use fado_core::{Ab, Dq, RotorAngleEstimator, wrap_angle};
+use fado_core::{Ab, Dq, MachineModel, RotorAngleEstimator, wrap_angle};
 
 /// Runs `est` for `seconds` from an aligned start and returns the worst angle error over the
 /// last `tail` seconds.
@@ -56,17 +56,25 @@ fn medium_speed_sanity<E: RotorAngleEstimator<f64>>(est: &mut E) {
 
 #[test]
 fn lpf_integrator_settles_at_plus_minus_300_rpm() {
-    medium_speed_sanity(&mut LpfIntegratorEstimator::new(LpfIntegratorConfig::default()).unwrap());
+    medium_speed_sanity(
+        &mut LpfIntegratorEstimator::new(LpfIntegratorConfig::for_machine(&MachineModel::paper()))
+            .unwrap(),
+    );
 }
 
 #[test]
 fn ortega_settles_at_plus_minus_300_rpm() {
-    medium_speed_sanity(&mut OrtegaEstimator::new(OrtegaConfig::default()).unwrap());
+    medium_speed_sanity(
+        &mut OrtegaEstimator::new(OrtegaConfig::for_machine(&MachineModel::paper())).unwrap(),
+    );
 }
 
 #[test]
 fn emf_observer_settles_at_plus_minus_300_rpm() {
-    medium_speed_sanity(&mut EmfObserverEstimator::new(EmfObserverConfig::default()).unwrap());
+    medium_speed_sanity(
+        &mut EmfObserverEstimator::new(EmfObserverConfig::for_machine(&MachineModel::paper()))
+            .unwrap(),
+    );
 }
 
 #[test]
@@ -92,9 +100,22 @@ fn every_baseline_settles_in_f32() {
             assert!(worst < 0.01, "{} f32 at {rpm} r/min: {worst}", est.name());
         }
     }
-    run(&mut LpfIntegratorEstimator::<f32>::new(LpfIntegratorConfig::default()).unwrap());
-    run(&mut OrtegaEstimator::<f32>::new(OrtegaConfig::default()).unwrap());
-    run(&mut EmfObserverEstimator::<f32>::new(EmfObserverConfig::default()).unwrap());
+    run(
+        &mut LpfIntegratorEstimator::<f32>::new(LpfIntegratorConfig::for_machine(
+            &MachineModel::paper(),
+        ))
+        .unwrap(),
+    );
+    run(
+        &mut OrtegaEstimator::<f32>::new(OrtegaConfig::for_machine(&MachineModel::paper()))
+            .unwrap(),
+    );
+    run(
+        &mut EmfObserverEstimator::<f32>::new(EmfObserverConfig::for_machine(
+            &MachineModel::paper(),
+        ))
+        .unwrap(),
+    );
 }
 
 /// |T(jω)| of the continuous T2S-1 loop, through which a ripple of θm at the fundamental
@@ -129,7 +150,7 @@ fn assert_close(what: &str, measured: f64, predicted: f64, rel: f64) {
 fn lpf_turns_a_dc_voltage_error_into_the_predicted_ripple() {
     // A DC integrand error ε leaves ψ_dc = ε/ωc, compensated to ε/ωc·(1 − jωc/ω): an angle
     // ripple asin(|δλ|/λf) at the fundamental, passed to θ̂ with the tracker gain |T(jω)|.
-    let cfg = LpfIntegratorConfig::<f64>::default();
+    let cfg = LpfIntegratorConfig::<f64>::for_machine(&MachineModel::paper());
     let wc = core::f64::consts::TAU * cfg.cutoff_hz;
     let eps = Ab::new(0.03, -0.04); // 50 mV
     for rpm in [300.0, -300.0] {
@@ -146,7 +167,7 @@ fn lpf_turns_a_dc_voltage_error_into_the_predicted_ripple() {
 fn emf_observer_turns_a_dc_voltage_error_into_the_predicted_ripple() {
     // ε passes the rotating filter with gain p/√(p² + ω²) and is divided by ω; the ripple
     // reaches θ̂ through the tracker loop whose damping the filter's ω̂ feedback reduces.
-    let cfg = EmfObserverConfig::<f64>::default();
+    let cfg = EmfObserverConfig::<f64>::for_machine(&MachineModel::paper());
     let p = core::f64::consts::TAU * cfg.emf_bandwidth_hz;
     let eps = Ab::new(0.3, 0.4); // 0.5 V
     for rpm in [300.0, -300.0] {
@@ -163,7 +184,7 @@ fn emf_observer_turns_a_dc_voltage_error_into_the_predicted_ripple() {
 fn ortega_turns_a_dc_voltage_error_into_the_predicted_ripple() {
     // Rotor-frame error dynamics ε̇d = ud + ω·εq − ω_obs·εd, ε̇q = uq − ω·εd driven by ε
     // rotating at −ω: |εq| = |ε|·√(4ω² + ω_obs²)/(|ω|·ω_obs) (module docs, linearised).
-    let cfg = OrtegaConfig::<f64>::default();
+    let cfg = OrtegaConfig::<f64>::for_machine(&MachineModel::paper());
     let eps = Ab::new(0.12, -0.16); // 0.2 V
     for rpm in [300.0, -300.0] {
         let w = electrical_speed(rpm);
@@ -217,7 +238,7 @@ fn ortega_flux_linkage_error_gives_the_predicted_angle_error_and_adaptation_remo
             let w = electrical_speed(rpm);
             let cfg = OrtegaConfig {
                 flux_linkage_hat: ratio * LF,
-                ..OrtegaConfig::default()
+                ..OrtegaConfig::for_machine(&MachineModel::paper())
             };
             let mut est = OrtegaEstimator::new(cfg).unwrap();
             let err = settled_error(&mut est, rpm, Dq::new(0.0, 10.0), 1.5, 0.3, Ab::zero());
@@ -249,7 +270,7 @@ fn ortega_fixed_gain_loses_lock_where_predicted_and_the_schedule_keeps_it() {
     let fixed = OrtegaConfig::<f64> {
         observer_speed_ratio: 0.0,
         observer_bandwidth: 2.0 * core::f64::consts::TAU * 20.0,
-        ..OrtegaConfig::default()
+        ..OrtegaConfig::for_machine(&MachineModel::paper())
     };
     for (rpm, iq) in [(90.0, 14.2), (-90.0, -14.2)] {
         let w = electrical_speed(rpm);
@@ -297,7 +318,7 @@ fn ortega_fixed_gain_loses_lock_where_predicted_and_the_schedule_keeps_it() {
         println!("ortega fixed gain, 3 × limit: max {err:.3} rad");
         assert!(err > 2.5, "{err}");
         // The schedule at three times the limit holds, where predicted.
-        let sched = OrtegaConfig::<f64>::default();
+        let sched = OrtegaConfig::<f64>::for_machine(&MachineModel::paper());
         let x = 3.0 * x_limit;
         let predicted = ortega_steady_angle(w, sched.scheduled_bandwidth(w), a(x), LF);
         assert_close(

@@ -39,7 +39,7 @@ fn warmed_up<T: Real>(omega: f64, warm_up: usize) -> SensorlessEstimator<T> {
     let (_, i0) = flux_and_current(theta0, i_dq);
     let mut est = SensorlessEstimator::<T>::new(EstimatorConfig {
         initial_angle: T::lit(theta0),
-        ..Default::default()
+        ..default_config()
     })
     .unwrap();
     est.align(T::lit(theta0), ab(i0));
@@ -93,7 +93,7 @@ fn bounded_for_bounded_inputs<T: Real>(
         .to_f64()
         .max(start.diagnostics.disturbance.norm().to_f64());
     let (k1, k2) = (ki_ts(60.0) * PI, ki_ts(35.0) * PI);
-    let u_max = V_MAX + EstimatorConfig::<f64>::default().rs_hat * I_MAX;
+    let u_max = V_MAX + default_config::<f64>().machine.rs * I_MAX;
     let (mut w1, mut w2) = (start.omega.to_f64(), start.omega_control.to_f64());
     let slack = 1.0 + 1e-5; // f32 rounding of ω̂ itself
     for (n, &(v, i)) in inputs.iter().enumerate() {
@@ -138,7 +138,7 @@ fn bounded_near_the_machine<T: Real>(
     let (_, i0) = flux_and_current(theta0, i_dq);
     let mut est = SensorlessEstimator::<T>::new(EstimatorConfig {
         initial_angle: T::lit(theta0),
-        ..Default::default()
+        ..default_config()
     })
     .unwrap();
     est.align(T::lit(theta0), ab(i0 + i_off));

@@ -7,6 +7,7 @@
 mod common;
 
 use common::*;
+use fado_core::estimator::EstimatorTuning;
 use fado_core::{Ab, Dq, EstimatorConfig, Mode, Real, SensorlessEstimator, wrap_angle};
 
 const TAU: f64 = core::f64::consts::TAU;
@@ -96,14 +97,11 @@ fn k_df_bounds_the_drift_of_a_dc_integrand_error_and_a_pure_integrator_does_not(
     let e = Ab::new(0.04, -0.03); // |e| = 50 mV
     let seconds = 8.0;
     for rpm in [300.0, -300.0] {
-        let with = run_constant_speed(rpm, seconds, EstimatorConfig::default(), e, Ab::zero());
+        let with = run_constant_speed(rpm, seconds, default_config(), e, Ab::zero());
         let without = run_constant_speed(
             rpm,
             seconds,
-            EstimatorConfig {
-                k_df: 0.0,
-                ..Default::default()
-            },
+            config_with(|c| c.tuning.k_df = 0.0),
             e,
             Ab::zero(),
         );
@@ -183,10 +181,7 @@ fn standstill(
 /// The paper's estimator: these checks are of its limiter, so without our R̂s adaptation (which
 /// at standstill under i_d > 0 would correct R̂s and pull |λ̂r| back to λ̂f).
 fn paper() -> EstimatorConfig<f64> {
-    EstimatorConfig {
-        rs_adaptation: false,
-        ..Default::default()
-    }
+    config_with(|c| c.tuning.rs_adaptation = false)
 }
 
 #[test]
@@ -214,7 +209,10 @@ fn limiter_bounds_the_rotor_flux_at_standstill() {
             i_dq,
             seconds,
             EstimatorConfig {
-                k_af: 0.0,
+                tuning: EstimatorTuning {
+                    k_af: 0.0,
+                    ..paper().tuning
+                },
                 ..paper()
             },
             e,
@@ -232,10 +230,8 @@ fn positive_d_current_steers_standstill_errors_onto_the_rotor_flux() {
     // holds λ̂r on the circle in the right direction and the angle stays. With i_d < 0 the same
     // error points along −d: λ̂r shrinks through zero and re-forms reversed, an angle error of
     // π ("the driving system was always tripped").
-    let config = EstimatorConfig {
-        rs_hat: 0.9 * RS,
-        ..paper()
-    };
+    let mut config = paper();
+    config.machine.rs = 0.9 * RS;
     for theta in [0.3, -2.5] {
         let (worst, err, _, clamped) =
             standstill(theta, Dq::new(4.0, 0.0), 5.0, config, Ab::zero());
@@ -285,7 +281,7 @@ fn hand_over_between_limiter_and_k_df_does_not_jump() {
     let theta0 = 1.0;
     let i_dq = Dq::new(4.0, 2.0);
     let (_, i0) = flux_and_current(theta0, i_dq);
-    let mut est = estimator(theta0, i0, EstimatorConfig::<f64>::default());
+    let mut est = estimator(theta0, i0, default_config::<f64>());
     let n = (total / TS) as usize;
     let e = Ab::new(0.01, 0.0);
     let mut prev = (theta0, theta0); // (θ̂, θm)
@@ -346,7 +342,7 @@ fn notch_keeps_lambda2_centred_under_a_current_sensor_offset() {
     let i_off = Ab::new(0.2, -0.1); // 10× SPEC's sensor offsets
     let seconds = 8.0;
     for rpm in [300.0, -300.0] {
-        let run = run_constant_speed(rpm, seconds, EstimatorConfig::default(), Ab::zero(), i_off);
+        let run = run_constant_speed(rpm, seconds, default_config(), Ab::zero(), i_off);
         let dc_lambda1 = mean(&run.lambda1, PERIOD_300);
         let dc_d = mean(&run.disturbance, PERIOD_300);
         let dc_lambda2 = mean(&run.lambda2, PERIOD_300);
@@ -385,7 +381,7 @@ fn f32_estimator_settles_at_plus_minus_300_and_30_rpm() {
         for i_dq in [Dq::new(4.0, 0.0), Dq::new(0.0, 14.2), Dq::new(0.0, -14.2)] {
             let theta0 = 0.4;
             let (_, i0) = flux_and_current(theta0, i_dq);
-            let mut est = estimator(theta0, i0, EstimatorConfig::<f32>::default());
+            let mut est = estimator(theta0, i0, default_config::<f32>());
             let n = (4.0 / TS) as usize;
             let tail = (1.0 / TS) as usize;
             let omega = rpm_to_electrical(rpm);

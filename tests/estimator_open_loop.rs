@@ -10,7 +10,7 @@ fn settled_error(speed_rpm: f64, i_dq: Dq<f64>, seconds: f64, v_error: Ab<f64>) 
     let theta0 = 0.4;
     let mut est = SensorlessEstimator::<f64>::new(EstimatorConfig {
         initial_angle: theta0,
-        ..Default::default()
+        ..default_config()
     })
     .unwrap();
     let (_, i0) = flux_and_current(theta0, i_dq);
@@ -51,4 +51,14 @@ fn dc_integrand_error_is_absorbed_by_the_disturbance_observer() {
         let (err, _) = settled_error(rpm, Dq::new(0.0, 10.0), 8.0, Ab::new(0.05, -0.03));
         assert!(err < 0.02, "{rpm} r/min: {err}");
     }
+}
+
+#[test]
+fn machine_constants_are_the_paper_preset() {
+    // The signal generator's motor and the estimator's model of it (`default_config`) must be
+    // the same motor, or every check here would test a parameter mismatch.
+    let m = default_config::<f64>().machine;
+    assert_eq!((m.rs, m.ld, m.lq, m.flux_linkage), (RS, L, L, LF));
+    assert_eq!(f64::from(m.pole_pairs), PP);
+    assert_eq!(default_config::<f64>().ts, TS);
 }

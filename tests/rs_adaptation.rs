@@ -15,12 +15,11 @@ use proptest::prelude::*;
 const IQ_LOAD: f64 = 7.5 / (1.5 * PP * LF);
 
 fn estimator(rs_ratio: f64, theta0: f64) -> SensorlessEstimator<f64> {
-    SensorlessEstimator::new(EstimatorConfig {
-        rs_hat: RS * rs_ratio,
-        initial_angle: theta0,
-        rs_adaptation: true,
-        ..Default::default()
-    })
+    SensorlessEstimator::new(config_with(|c| {
+        c.machine.rs = RS * rs_ratio;
+        c.initial_angle = theta0;
+        c.tuning.rs_adaptation = true;
+    }))
     .unwrap()
 }
 
@@ -143,12 +142,11 @@ fn no_excitation_no_drift() {
     // No load at 300 r/min with a 5 % λ̂f error: |λ̂r| − λ̂f is 5 % but χ = 0 (i = 0, or the
     // eq. (23) injection along d), so R̂s must not move at all.
     for i_dq in [Dq::new(0.0, 0.0), Dq::new(4.0, 0.0)] {
-        let mut est = SensorlessEstimator::new(EstimatorConfig {
-            flux_linkage_hat: LF * 1.05,
-            initial_angle: 0.4,
-            rs_adaptation: true,
-            ..Default::default()
-        })
+        let mut est = SensorlessEstimator::new(config_with(|c| {
+            c.machine.flux_linkage = LF * 1.05;
+            c.initial_angle = 0.4;
+            c.tuning.rs_adaptation = true;
+        }))
         .unwrap();
         let n = (3.0 / TS) as usize;
         let mut moved: f64 = 0.0;
@@ -207,11 +205,10 @@ fn standstill_law_freezes_under_q_current() {
 
 #[test]
 fn off_keeps_the_configured_resistance_and_reset_restores_it() {
-    let mut off = SensorlessEstimator::new(EstimatorConfig {
-        rs_hat: RS * 1.3,
-        rs_adaptation: false,
-        ..Default::default()
-    })
+    let mut off = SensorlessEstimator::new(config_with(|c| {
+        c.machine.rs = RS * 1.3;
+        c.tuning.rs_adaptation = false;
+    }))
     .unwrap();
     let mut on = estimator(1.3, 0.0);
     let i_dq = Dq::new(4.0, 0.0);
@@ -229,38 +226,23 @@ fn bad_configurations_name_their_field() {
     let cases: [(&str, EstimatorConfig<f64>); 5] = [
         (
             "rs_adaptation_rate",
-            EstimatorConfig {
-                rs_adaptation_rate: f64::NAN,
-                ..Default::default()
-            },
+            config_with(|c| c.tuning.rs_adaptation_rate = f64::NAN),
         ),
         (
             "rs_adaptation_rate",
-            EstimatorConfig {
-                rs_adaptation_rate: 2e4,
-                ..Default::default()
-            },
+            config_with(|c| c.tuning.rs_adaptation_rate = 2e4),
         ),
         (
             "rs_adaptation_excitation_floor",
-            EstimatorConfig {
-                rs_adaptation_excitation_floor: 0.0,
-                ..Default::default()
-            },
+            config_with(|c| c.tuning.rs_adaptation_excitation_floor = 0.0),
         ),
         (
             "rs_adaptation_min_ratio",
-            EstimatorConfig {
-                rs_adaptation_min_ratio: 1.5,
-                ..Default::default()
-            },
+            config_with(|c| c.tuning.rs_adaptation_min_ratio = 1.5),
         ),
         (
             "rs_adaptation_max_ratio",
-            EstimatorConfig {
-                rs_adaptation_max_ratio: 0.9,
-                ..Default::default()
-            },
+            config_with(|c| c.tuning.rs_adaptation_max_ratio = 0.9),
         ),
     ];
     for (field, config) in cases {
@@ -322,13 +304,12 @@ fn flux_linkage_law_learns_lambda_f_where_resistance_is_unobservable() {
         }
     };
     let run = |rate: f64| {
-        let mut est = SensorlessEstimator::new(EstimatorConfig {
-            rs_hat: RS * 1.2,
-            flux_linkage_hat: LF * 1.1,
-            flux_linkage_adaptation_rate: rate,
-            initial_angle: 0.4,
-            ..Default::default()
-        })
+        let mut est = SensorlessEstimator::new(config_with(|c| {
+            c.machine.rs = RS * 1.2;
+            c.machine.flux_linkage = LF * 1.1;
+            c.tuning.flux_linkage_adaptation_rate = rate;
+            c.initial_angle = 0.4;
+        }))
         .unwrap();
         let mut at_2s = 0.0;
         let mut last = Default::default();

@@ -4,7 +4,7 @@
 
 #![allow(dead_code)]
 
-use fado_core::{Ab, Dq, Rotation};
+use fado_core::{Ab, Dq, EstimatorConfig, MachineModel, Real, Rotation};
 
 /// Motor of SPEC §6.
 pub const RS: f64 = 0.327;
@@ -16,6 +16,20 @@ pub const LF: f64 = 0.088;
 pub const PP: f64 = 4.0;
 /// Sampling period.
 pub const TS: f64 = 100e-6;
+
+/// The estimator's default configuration for this motor ([`MachineModel::paper`], whose
+/// parameters are the constants above; `machine_constants_are_the_paper_preset` in
+/// `estimator_open_loop.rs` checks it), at 10 kHz.
+pub fn default_config<T: Real>() -> EstimatorConfig<T> {
+    EstimatorConfig::for_machine(&MachineModel::paper())
+}
+
+/// [`default_config`] changed by `f`.
+pub fn config_with<T: Real>(f: impl FnOnce(&mut EstimatorConfig<T>)) -> EstimatorConfig<T> {
+    let mut c = default_config();
+    f(&mut c);
+    c
+}
 
 /// One sample of the ideal machine at electrical angle `theta` with rotor currents `i_dq`.
 pub fn flux_and_current(theta: f64, i_dq: Dq<f64>) -> (Ab<f64>, Ab<f64>) {
