@@ -15,7 +15,9 @@ use fado_core::baselines::{
     EmfObserverConfig, EmfObserverEstimator, LpfIntegratorConfig, LpfIntegratorEstimator,
     OrtegaConfig, OrtegaEstimator,
 };
-use fado_core::{Ab, Dq, EstimatorConfig, Rotation, RotorAngleEstimator, SensorlessEstimator};
+use fado_core::{
+    Ab, Dq, EstimatorConfig, MachineModel, Rotation, RotorAngleEstimator, SensorlessEstimator,
+};
 
 const TS: f64 = 100e-6;
 /// 300 r/min, 4 pole pairs: 20 Hz electrical, 500 samples per period.
@@ -76,33 +78,39 @@ fn estimators(c: &mut Criterion) {
     let data = inputs();
     bench_one(
         c,
-        SensorlessEstimator::<f32>::new(EstimatorConfig::default()).unwrap(),
+        SensorlessEstimator::<f32>::new(EstimatorConfig::for_machine(&MachineModel::paper()))
+            .unwrap(),
         &data,
     );
     // fado as the paper has it: R̂s fixed (compare's `fado-fixed-rs`).
     bench_named(
         c,
         "fado-fixed-rs_step_f32",
-        SensorlessEstimator::<f32>::new(EstimatorConfig {
-            rs_adaptation: false,
-            ..Default::default()
+        SensorlessEstimator::<f32>::new({
+            let mut config = EstimatorConfig::for_machine(&MachineModel::paper());
+            config.tuning.rs_adaptation = false;
+            config
         })
         .unwrap(),
         &data,
     );
     bench_one(
         c,
-        LpfIntegratorEstimator::<f32>::new(LpfIntegratorConfig::default()).unwrap(),
+        LpfIntegratorEstimator::<f32>::new(
+            LpfIntegratorConfig::for_machine(&MachineModel::paper()),
+        )
+        .unwrap(),
         &data,
     );
     bench_one(
         c,
-        OrtegaEstimator::<f32>::new(OrtegaConfig::default()).unwrap(),
+        OrtegaEstimator::<f32>::new(OrtegaConfig::for_machine(&MachineModel::paper())).unwrap(),
         &data,
     );
     bench_one(
         c,
-        EmfObserverEstimator::<f32>::new(EmfObserverConfig::default()).unwrap(),
+        EmfObserverEstimator::<f32>::new(EmfObserverConfig::for_machine(&MachineModel::paper()))
+            .unwrap(),
         &data,
     );
 }

@@ -8,7 +8,8 @@ use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use fado::core::control::{DriveConfig, SensorlessDrive};
-use fado::core::{Ab, Abc, EstimatorConfig, Real};
+use fado::core::estimator::EstimatorTuning;
+use fado::core::{Ab, Abc, MachineModel, Real};
 
 /// A steady 300 r/min operating point: a 10 A current vector turning at 20 Hz electrical.
 fn currents<T: Real>(samples: usize) -> Vec<Abc<T>> {
@@ -22,7 +23,8 @@ fn currents<T: Real>(samples: usize) -> Vec<Abc<T>> {
 }
 
 fn bench_step<T: Real>(c: &mut Criterion, name: &str) {
-    let mut drive = SensorlessDrive::<T>::new(DriveConfig::default(), EstimatorConfig::default())
+    let config = DriveConfig::for_machine(&MachineModel::paper());
+    let mut drive = SensorlessDrive::<T>::new(config, EstimatorTuning::default())
         .expect("default configuration is valid");
     drive.align(T::zero());
     let input = currents::<T>(5000);

@@ -48,12 +48,12 @@ fn setup<T: Real>(rs_adaptation: bool) -> (Vec<Sample<T>>, SensorlessEstimator<T
     let raw: Vec<_> = common::constant_speed(rpm, theta0, i_dq, TABLE, Ab::zero())
         .map(|(v, i, _)| (ab::<T>(v), ab::<T>(i)))
         .collect();
-    let mut est = SensorlessEstimator::<T>::new(EstimatorConfig {
-        initial_angle: T::lit(theta0),
-        rs_adaptation,
-        ..Default::default()
-    })
-    .expect("default config is valid");
+    let mut est =
+        SensorlessEstimator::<T>::new(common::config_with(|c: &mut EstimatorConfig<T>| {
+            c.initial_angle = T::lit(theta0);
+            c.tuning.rs_adaptation = rs_adaptation;
+        }))
+        .expect("default config is valid");
     let (_, i0) = common::flux_and_current(theta0, i_dq);
     est.align(T::lit(theta0), ab(i0));
     let mut table = Vec::with_capacity(TABLE);
