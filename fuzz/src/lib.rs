@@ -11,9 +11,11 @@
 
 use arbitrary::Arbitrary;
 use fado_core::control::{DriveConfig, SensorlessDrive};
-use fado_core::estimator::{Estimate, EstimatorConfig, RotorAngleEstimator, SensorlessEstimator};
+use fado_core::estimator::{
+    Estimate, EstimatorConfig, EstimatorTuning, RotorAngleEstimator, SensorlessEstimator,
+};
 use fado_core::tracker::BandwidthDefinition;
-use fado_core::{Ab, Abc, Real};
+use fado_core::{Ab, Abc, MachineModel, Real};
 
 /// A number as the fuzzer picks it: mostly plausible magnitudes, sometimes any bit pattern.
 #[derive(Arbitrary, Clone, Copy, Debug)]
@@ -43,6 +45,11 @@ impl Num {
 
 fn field<T: Real>(x: Option<Num>, default: T) -> T {
     x.map_or(default, Num::get)
+}
+
+/// A pole-pair count from a fuzzed number: truncated and saturated (NaN → 0, refused).
+fn count(x: Option<Num>, default: u32) -> u32 {
+    x.map_or(default, |n| n.value() as u32)
 }
 
 /// What the estimator is asked to do next.
@@ -82,11 +89,13 @@ pub enum EstimatorAction {
 pub struct EstimatorCase {
     /// Run in f32 instead of f64.
     pub single: bool,
-    /// Fields in the order of `EstimatorConfig` (None = default).
+    /// ts, machine R̂s, L̂q, λ̂f, then the numeric tuning fields in the order of
+    /// `EstimatorTuning` up to `tracker_hold_ratio`, then `initial_angle` (None = default; the
+    /// layout of the older flat config, so that the stored regressions decode as before).
     pub fields: [Option<Num>; 15],
     /// `average_current`, `observer_on_rotor_flux`, natural-frequency bandwidths.
     pub flags: [bool; 3],
-    /// The R̂s-adaptation fields in the order of `EstimatorConfig` (None = default).
+    /// The R̂s-adaptation fields in the order of `EstimatorTuning` (None = default).
     pub adaptation: [Option<Num>; 5],
     /// `rs_adaptation`, `limiter_recentring` (None = default).
     pub adaptation_flags: [Option<bool>; 2],
@@ -97,41 +106,50 @@ pub struct EstimatorCase {
 impl EstimatorCase {
     /// The configuration this case asks for.
     pub fn config<T: Real>(&self) -> EstimatorConfig<T> {
-        let d = EstimatorConfig::<T>::default();
+        let d = EstimatorConfig::<T>::for_machine(&MachineModel::paper());
+        let t = d.tuning;
         let f = &self.fields;
         EstimatorConfig {
             ts: field(f[0], d.ts),
-            rs_hat: field(f[1], d.rs_hat),
-            lq_hat: field(f[2], d.lq_hat),
-            flux_linkage_hat: field(f[3], d.flux_linkage_hat),
-            k_df: field(f[4], d.k_df),
-            k_df_ramp_time: field(f[5], d.k_df_ramp_time),
-            k_af: field(f[6], d.k_af),
-            limiter_radius_ratio: field(f[7], d.limiter_radius_ratio),
-            mode_threshold_hz: field(f[8], d.mode_threshold_hz),
-            mode_hysteresis_hz: field(f[9], d.mode_hysteresis_hz),
-            t2s1_bandwidth_hz: field(f[10], d.t2s1_bandwidth_hz),
-            t2s2_bandwidth_hz: field(f[11], d.t2s2_bandwidth_hz),
-            tracker_damping: field(f[12], d.tracker_damping),
-            tracker_hold_ratio: field(f[13], d.tracker_hold_ratio),
-            initial_angle: field(f[14], d.initial_angle),
-            average_current: self.flags[0],
-            observer_on_rotor_flux: self.flags[1],
-            bandwidth_definition: if self.flags[2] {
-                BandwidthDefinition::NaturalFrequency
-            } else {
-                BandwidthDefinition::Minus3Db
+            machine: MachineModel {
+                rs: field(f[1], d.machine.rs),
+                lq: field(f[2], d.machine.lq),
+                flux_linkage: field(f[3], d.machine.flux_linkage),
+                ..d.machine
             },
-            rs_adaptation: self.adaptation_flags[0].unwrap_or(d.rs_adaptation),
-            rs_adaptation_rate: field(self.adaptation[0], d.rs_adaptation_rate),
-            rs_adaptation_excitation_floor: field(
-                self.adaptation[1],
-                d.rs_adaptation_excitation_floor,
-            ),
-            rs_adaptation_min_ratio: field(self.adaptation[2], d.rs_adaptation_min_ratio),
-            rs_adaptation_max_ratio: field(self.adaptation[3], d.rs_adaptation_max_ratio),
-            flux_linkage_adaptation_rate: field(self.adaptation[4], d.flux_linkage_adaptation_rate),
-            limiter_recentring: self.adaptation_flags[1].unwrap_or(d.limiter_recentring),
+            initial_angle: field(f[14], d.initial_angle),
+            tuning: EstimatorTuning {
+                k_df: field(f[4], t.k_df),
+                k_df_ramp_time: field(f[5], t.k_df_ramp_time),
+                k_af: field(f[6], t.k_af),
+                limiter_radius_ratio: field(f[7], t.limiter_radius_ratio),
+                mode_threshold_ratio: field(f[8], t.mode_threshold_ratio),
+                mode_hysteresis_ratio: field(f[9], t.mode_hysteresis_ratio),
+                t2s1_bandwidth_hz: field(f[10], t.t2s1_bandwidth_hz),
+                t2s2_bandwidth_hz: field(f[11], t.t2s2_bandwidth_hz),
+                tracker_damping: field(f[12], t.tracker_damping),
+                tracker_hold_ratio: field(f[13], t.tracker_hold_ratio),
+                average_current: self.flags[0],
+                observer_on_rotor_flux: self.flags[1],
+                bandwidth_definition: if self.flags[2] {
+                    BandwidthDefinition::NaturalFrequency
+                } else {
+                    BandwidthDefinition::Minus3Db
+                },
+                rs_adaptation: self.adaptation_flags[0].unwrap_or(t.rs_adaptation),
+                rs_adaptation_rate: field(self.adaptation[0], t.rs_adaptation_rate),
+                rs_adaptation_excitation_floor: field(
+                    self.adaptation[1],
+                    t.rs_adaptation_excitation_floor,
+                ),
+                rs_adaptation_min_ratio: field(self.adaptation[2], t.rs_adaptation_min_ratio),
+                rs_adaptation_max_ratio: field(self.adaptation[3], t.rs_adaptation_max_ratio),
+                flux_linkage_adaptation_rate: field(
+                    self.adaptation[4],
+                    t.flux_linkage_adaptation_rate,
+                ),
+                limiter_recentring: self.adaptation_flags[1].unwrap_or(t.limiter_recentring),
+            },
         }
     }
 
@@ -284,11 +302,15 @@ pub enum DriveAction {
 pub struct DriveCase {
     /// Run in f32 instead of f64.
     pub single: bool,
-    /// Numeric fields in the order of `DriveConfig` (None = default).
+    /// ts; machine pole pairs (truncated to an integer), R̂s, L̂d, L̂q, λ̂f, Ĵ; tuning
+    /// bandwidths, speed zero ratio, current limit ratio, injection ratio, dead time,
+    /// switching frequency, threshold voltage, current band, delay factor, trip ratio, max
+    /// modulation, anti-windup ratios (None = default; the layout of the older flat config, so
+    /// that the stored regressions decode as before).
     pub fields: [Option<Num>; 21],
     /// `dead_time_compensation`, `decoupling`.
     pub flags: [bool; 2],
-    /// Offset calibration samples.
+    /// Offset calibration in sampling periods.
     pub calibration: u8,
     /// What to do.
     pub actions: Vec<DriveAction>,
@@ -297,34 +319,40 @@ pub struct DriveCase {
 impl DriveCase {
     /// The configuration this case asks for.
     pub fn config<T: Real>(&self) -> DriveConfig<T> {
-        let d = DriveConfig::<T>::default();
+        let d = DriveConfig::<T>::for_machine(&MachineModel::paper());
+        let (m, t) = (d.machine, d.tuning);
         let f = &self.fields;
+        let ts = field(f[0], d.ts);
+        let mut tuning = t;
+        tuning.current_bandwidth_hz = field(f[7], t.current_bandwidth_hz);
+        tuning.speed_bandwidth_hz = field(f[8], t.speed_bandwidth_hz);
+        tuning.speed_zero_ratio = field(f[9], t.speed_zero_ratio);
+        tuning.current_limit_ratio = field(f[10], t.current_limit_ratio);
+        tuning.injection_current_ratio = field(f[11], t.injection_current_ratio);
+        tuning.dead_time = field(f[12], t.dead_time);
+        tuning.switching_frequency = field(f[13], t.switching_frequency);
+        tuning.dead_time_threshold_voltage = field(f[14], t.dead_time_threshold_voltage);
+        tuning.dead_time_current_band = field(f[15], t.dead_time_current_band);
+        tuning.delay_compensation_factor = field(f[16], t.delay_compensation_factor);
+        tuning.trip_current_ratio = field(f[17], t.trip_current_ratio);
+        tuning.max_modulation = field(f[18], t.max_modulation);
+        tuning.current_anti_windup_ratio = field(f[19], t.current_anti_windup_ratio);
+        tuning.speed_anti_windup_ratio = field(f[20], t.speed_anti_windup_ratio);
+        tuning.dead_time_compensation = self.flags[0];
+        tuning.decoupling = self.flags[1];
+        tuning.offset_calibration_time = ts * T::lit(f64::from(self.calibration));
         DriveConfig {
-            ts: field(f[0], d.ts),
-            pole_pairs: field(f[1], d.pole_pairs),
-            rs_hat: field(f[2], d.rs_hat),
-            ld_hat: field(f[3], d.ld_hat),
-            lq_hat: field(f[4], d.lq_hat),
-            flux_linkage_hat: field(f[5], d.flux_linkage_hat),
-            inertia_hat: field(f[6], d.inertia_hat),
-            current_bandwidth_hz: field(f[7], d.current_bandwidth_hz),
-            speed_bandwidth_hz: field(f[8], d.speed_bandwidth_hz),
-            speed_zero_ratio: field(f[9], d.speed_zero_ratio),
-            i_max: field(f[10], d.i_max),
-            i_min: field(f[11], d.i_min),
-            dead_time: field(f[12], d.dead_time),
-            switching_frequency: field(f[13], d.switching_frequency),
-            dead_time_threshold_voltage: field(f[14], d.dead_time_threshold_voltage),
-            dead_time_current_band: field(f[15], d.dead_time_current_band),
-            delay_compensation_factor: field(f[16], d.delay_compensation_factor),
-            trip_current: field(f[17], d.trip_current),
-            max_modulation: field(f[18], d.max_modulation),
-            current_anti_windup_ratio: field(f[19], d.current_anti_windup_ratio),
-            speed_anti_windup_ratio: field(f[20], d.speed_anti_windup_ratio),
-            dead_time_compensation: self.flags[0],
-            decoupling: self.flags[1],
-            offset_calibration_samples: u32::from(self.calibration),
-            ..d
+            ts,
+            machine: MachineModel {
+                pole_pairs: count(f[1], m.pole_pairs),
+                rs: field(f[2], m.rs),
+                ld: field(f[3], m.ld),
+                lq: field(f[4], m.lq),
+                flux_linkage: field(f[5], m.flux_linkage),
+                inertia: field(f[6], m.inertia),
+                ..m
+            },
+            tuning,
         }
     }
 
@@ -339,18 +367,14 @@ impl DriveCase {
 
     fn run_in<T: Real>(&self) {
         let config = self.config::<T>();
-        let est = EstimatorConfig {
-            ts: config.ts,
-            ..EstimatorConfig::default()
-        };
-        let mut drive = match SensorlessDrive::new(config, est) {
+        let mut drive = match SensorlessDrive::new(config, EstimatorTuning::default()) {
             Ok(d) => d,
             Err(e) => {
                 assert!(!e.field().is_empty());
                 return;
             }
         };
-        let vdc_nominal = T::lit(300.0);
+        let vdc_nominal = config.machine.dc_voltage;
         for action in &self.actions {
             match *action {
                 DriveAction::Step { i, vdc, speed } => {
@@ -459,7 +483,7 @@ impl BaselineCase {
         let o = &self.own;
         match self.which % 3 {
             0 => {
-                let d = LpfIntegratorConfig::<T>::default();
+                let d = LpfIntegratorConfig::<T>::for_machine(&MachineModel::paper());
                 let (ts, rs_hat, lq_hat, flux_linkage_hat, b1, b2, z, hold, a0) =
                     shared_fields!(self, d);
                 let c = LpfIntegratorConfig {
@@ -482,7 +506,7 @@ impl BaselineCase {
                 }
             }
             1 => {
-                let d = OrtegaConfig::<T>::default();
+                let d = OrtegaConfig::<T>::for_machine(&MachineModel::paper());
                 let (ts, rs_hat, lq_hat, flux_linkage_hat, b1, b2, z, hold, a0) =
                     shared_fields!(self, d);
                 let c = OrtegaConfig {
@@ -507,7 +531,7 @@ impl BaselineCase {
                 }
             }
             _ => {
-                let d = EmfObserverConfig::<T>::default();
+                let d = EmfObserverConfig::<T>::for_machine(&MachineModel::paper());
                 let (ts, rs_hat, lq_hat, flux_linkage_hat, b1, b2, z, hold, a0) =
                     shared_fields!(self, d);
                 let c = EmfObserverConfig {
