@@ -14,7 +14,7 @@
 use core::hint::black_box;
 use core::panic::PanicInfo;
 
-use fado_core::{Ab, Estimate, EstimatorConfig, Rotation, SensorlessEstimator};
+use fado_core::{Ab, Estimate, EstimatorConfig, MachineModel, Rotation, SensorlessEstimator};
 
 /// Nothing to unwind to: a panic (there is none on the estimator's path) exits with status 101.
 #[panic_handler]
@@ -48,7 +48,9 @@ pub extern "C" fn _start() -> ! {
 /// The "firmware": set-up, then the ISR body in a loop.
 extern "C" fn firmware(initial_stack: *const usize) -> ! {
     let steps = steps_from_args(initial_stack);
-    let Ok(mut estimator) = SensorlessEstimator::<f32>::new(EstimatorConfig::default()) else {
+    let Ok(mut estimator) =
+        SensorlessEstimator::<f32>::new(EstimatorConfig::for_machine(&MachineModel::paper()))
+    else {
         panic!("default configuration is valid");
     };
     // A 20 Hz rotating flux (λf = 0.088 Wb) with 10 A on q, sampled at 10 kHz: the voltage
