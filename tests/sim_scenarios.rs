@@ -89,7 +89,7 @@ fn fig10_sensor_offset_walks_the_estimate_along_the_limiter_circle_at_e_t_over_r
     // checks the paper's limiter, so without our R̂s adaptation (whose standstill law pulls
     // |λ̂r| to λ̂f instead of the circle).
     let cfg = "[current_sensor]\nenable_gain_error = false\nenable_noise = false\n\
-               enable_quantization = false\n[controller]\noffset_calibration_samples = 0\n\
+               enable_quantization = false\n[controller]\noffset_calibration_time = 0.0\n\
                [estimator]\nrs_adaptation = false\n";
     let out = run("fig10", Some(cfg), false);
     let c = &out.config;

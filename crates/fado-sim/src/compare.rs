@@ -602,17 +602,18 @@ mod tests {
         );
         assert!(parse_estimator("fado_fixed_rs").unwrap().fixed_rs);
         assert_eq!(parse_estimator("kalman").unwrap_err().key, "estimators");
+        let m = fado_core::MachineModel::paper();
         let core = [
-            fado_core::SensorlessEstimator::<f64>::new(Default::default())
+            fado_core::SensorlessEstimator::<f64>::new(fado_core::EstimatorConfig::for_machine(&m))
                 .unwrap()
                 .name(),
-            LpfIntegratorEstimator::<f64>::new(LpfIntegratorConfig::default())
+            LpfIntegratorEstimator::<f64>::new(LpfIntegratorConfig::for_machine(&m))
                 .unwrap()
                 .name(),
-            OrtegaEstimator::<f64>::new(OrtegaConfig::default())
+            OrtegaEstimator::<f64>::new(OrtegaConfig::for_machine(&m))
                 .unwrap()
                 .name(),
-            EmfObserverEstimator::<f64>::new(EmfObserverConfig::default())
+            EmfObserverEstimator::<f64>::new(EmfObserverConfig::for_machine(&m))
                 .unwrap()
                 .name(),
         ];

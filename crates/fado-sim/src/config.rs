@@ -476,8 +476,10 @@ impl SimConfig {
         let mut merged = toml::Table::try_from(base)
             .map_err(|e| SimConfigError::new("<base>", e.to_string()))?;
         merge(&mut merged, user);
-        let cfg = SimConfig::deserialize(toml::Value::Table(merged))
+        let mut cfg = SimConfig::deserialize(toml::Value::Table(merged))
             .map_err(|e| key_error(e).located_in(text))?;
+        // `[motor]` has no DC link of its own (it is the inverter's).
+        cfg.motor.dc_voltage = cfg.inverter.dc_voltage;
         cfg.validate().map_err(|e| e.located_in(text))?;
         Ok(cfg)
     }
@@ -568,7 +570,7 @@ mod tests {
         assert_eq!(cfg.inverter.dead_time, 2.5e-6);
         assert_eq!(cfg.load.torque, Profile::constant(7.5));
         assert_eq!(cfg.simulation.duration, 3.0);
-        assert!((cfg.estimator_config().rs_hat - 0.327 * 1.02).abs() < 1e-15);
+        assert!((cfg.estimator_config().machine.rs - 0.327 * 1.02).abs() < 1e-15);
     }
 
     #[test]
@@ -651,8 +653,8 @@ mod located_errors {
             (key.as_str(), line, col),
             ("estimator.t2s1_bandwidth_hz", 3, 21)
         );
-        let (key, line, _, _) = err("[estimator]\nmode_hysteresis_hz = 3.0\n");
-        assert_eq!((key.as_str(), line), ("estimator.mode_hysteresis_hz", 2));
+        let (key, line, _, _) = err("[estimator]\nmode_hysteresis_ratio = 0.03\n");
+        assert_eq!((key.as_str(), line), ("estimator.mode_hysteresis_ratio", 2));
         // Array elements and dotted keys.
         let (key, line, col, _) =
             err("[simulation]\ndisturbance_feedback_off = [[0.0, 1.0], [2.0, 1.0]]\n");

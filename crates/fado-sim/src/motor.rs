@@ -37,9 +37,24 @@ use crate::error::{SimConfigError, check};
 /// plant (the inverter has its own, `[inverter] dc_voltage`).
 pub type MotorParams = MachineModel<f64>;
 
+/// What the plant's physics needs (the ratings are checked by [`validate_motor`]).
+fn check_physics(params: &MotorParams) -> Result<(), SimConfigError> {
+    check::positive("rs", params.rs)?;
+    check::positive("ld", params.ld)?;
+    check::positive("lq", params.lq)?;
+    check::non_negative("flux_linkage", params.flux_linkage)?;
+    if params.pole_pairs == 0 {
+        return Err(SimConfigError::new("pole_pairs", "must be ≥ 1"));
+    }
+    check::positive("inertia", params.inertia)?;
+    check::non_negative("viscous_friction", params.viscous_friction)?;
+    Ok(())
+}
+
 /// Checks the plant record; the error names the `[motor]` key (the DC-link voltage the
 /// consistency check needs is the inverter's).
 pub fn validate_motor(motor: &MotorParams, dc_voltage: f64) -> Result<(), SimConfigError> {
+    check_physics(motor)?;
     let mut m = *motor;
     m.dc_voltage = dc_voltage;
     m.validate()
@@ -251,16 +266,7 @@ pub struct Motor {
 impl Motor {
     /// A machine at rest at electrical angle `theta0` with zero current.
     pub fn new(params: MotorParams, theta0: f64) -> Result<Self, SimConfigError> {
-        // What the plant's physics needs (the ratings are checked with the whole config).
-        check::positive("rs", params.rs)?;
-        check::positive("ld", params.ld)?;
-        check::positive("lq", params.lq)?;
-        check::non_negative("flux_linkage", params.flux_linkage)?;
-        if params.pole_pairs == 0 {
-            return Err(SimConfigError::new("pole_pairs", "must be ≥ 1"));
-        }
-        check::positive("inertia", params.inertia)?;
-        check::non_negative("viscous_friction", params.viscous_friction)?;
+        check_physics(&params)?;
         check::finite("theta0", theta0)?;
         let mut m = Self {
             params,
@@ -357,6 +363,11 @@ impl Motor {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Magnetic energy of the stator inductances, 1.5·(Ld·id² + Lq·iq²)/2, in J.
+    fn magnetic_energy(p: &MotorParams, i_dq: Dq<f64>) -> f64 {
+        0.75 * (p.ld * i_dq.d * i_dq.d + p.lq * i_dq.q * i_dq.q)
+    }
 
     fn rotor_voltage(v_ab: Ab<f64>, theta: f64) -> Dq<f64> {
         let (s, c) = theta.sin_cos();
@@ -487,7 +498,7 @@ mod tests {
                 e_mech += wt * p.torque(i) * w / p.pole_pairs as f64;
             }
             let i_end = prop.advance(i0, v, h, cexp(th0), cexp(w * h));
-            let d_w = p.magnetic_energy(i_end) - p.magnetic_energy(i0);
+            let d_w = magnetic_energy(&p, i_end) - magnetic_energy(&p, i0);
             let balance = e_in - (e_cu + d_w + e_mech);
             assert!(
                 balance.abs() < 1e-9 * e_in.abs().max(1e-3),

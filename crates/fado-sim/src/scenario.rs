@@ -129,14 +129,14 @@ pub const SCENARIOS: [Scenario; 10] = [
 
 /// Load of the scaled `reversal` and `stops`, as a fraction of the rated torque: the paper's
 /// 7.5 N·m of 11.5 N·m (65.2 %, section V \[P\]).
-pub const SCALED_LOAD_RATIO: f64 = 0.652;
+pub const SCALED_LOAD_RATIO: f64 = 7.5 / 11.5;
 /// Speed of the scaled `reversal`, fraction of the rated speed: 90 of 1500 r/min (±6 %, the
 /// paper's "less than ±10 % of its rated speed" \[P\]); the reversal ramp is this per second.
-pub const REVERSAL_SPEED_RATIO: f64 = 0.06;
+pub const REVERSAL_SPEED_RATIO: f64 = 90.0 / 1500.0;
 /// Top speed of the scaled `stops`: 60 of 1500 r/min (4 %, Fig. 12 \[A\]).
-pub const STOPS_SPEED_RATIO: f64 = 0.04;
+pub const STOPS_SPEED_RATIO: f64 = 60.0 / 1500.0;
 /// Speed-error bound of the scaled scenarios, fraction of the rated speed: 30 of 1500 r/min.
-pub const SCALED_SPEED_ERROR_RATIO: f64 = 0.02;
+pub const SCALED_SPEED_ERROR_RATIO: f64 = 30.0 / 1500.0;
 
 /// Speed levels of the `lowspeed` staircase, r/min: 4 % of the rated speed halved six times
 /// (the paper's motor: 60, 30, …, 0.9375 r/min).

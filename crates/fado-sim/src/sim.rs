@@ -39,6 +39,21 @@ pub struct PlantParams {
     pub faults: FaultParams,
 }
 
+impl Default for PlantParams {
+    /// The paper's plant: its motor ([`MotorParams::paper`]), SPEC §5–6's inverter and
+    /// sensors, no load, no faults.
+    fn default() -> Self {
+        Self {
+            motor: MotorParams::paper(),
+            inverter: InverterParams::default(),
+            current_sensor: CurrentSensorParams::default(),
+            dc_link_sensor: DcLinkSensorParams::default(),
+            load: LoadParams::default(),
+            faults: FaultParams::default(),
+        }
+    }
+}
+
 impl PlantParams {
     /// Checks every record; the error names the key as `section.field`.
     pub fn validate(&self) -> Result<(), SimConfigError> {

@@ -1226,7 +1226,7 @@ mod tests {
             ],
         ));
         spec.config_toml = Some(format!(
-            "{}[controller]\ncurrent_bandwidth_hz = 700.0\ntrip_current = 41.0\n",
+            "{}[controller]\ncurrent_bandwidth_hz = 700.0\ntrip_current_ratio = 1.88\n",
             spec.config_toml.unwrap()
         ));
         let out = run(&spec, &SweepOptions::default(), &|_, _| {}).unwrap();
@@ -1317,7 +1317,7 @@ mod tests {
             vec![
                 ("rs_error".into(), floats(&[-2.0, 0.01])),
                 (
-                    "controller.precision".into(),
+                    "simulation.precision".into(),
                     vec![Value::String("f32".into())],
                 ),
             ],

@@ -30,10 +30,7 @@ fn compare_gives_the_numbers_of_individual_simulate_runs() {
     for kind in [EstimatorKind::Fado, EstimatorKind::Ortega] {
         let alone = simulate(
             "fig11",
-            Some(&format!(
-                "{short}[estimator]\nkind = \"{}\"\n",
-                kind_toml(kind)
-            )),
+            Some(&format!("{short}estimator = \"{}\"\n", kind_toml(kind))),
             true,
             None,
         )

@@ -210,7 +210,7 @@ fn persistent_non_finite_input_trips_safely() {
     let r = run("steady300", &format!("{STEADY}{faults}"));
     let trip = r.first_flag(DriveFlags::TRIPPED, 0.0).expect("tripped");
     println!("persistent NaN from 2.5 s: tripped at {trip:.4} s");
-    // input_fault_trip_samples = 100: the 100th rejected sample trips (latched).
+    // input_fault_trip_time = 10 ms: the 100th rejected sample trips (latched).
     assert!((trip - (2.5 + 99.0 * r.ts)).abs() < 0.5 * r.ts, "{trip}");
     assert_eq!(
         r.flagged(DriveFlags::TRIPPED, trip, 10.0),
@@ -229,7 +229,7 @@ fn stuck_current_channel_is_detected_and_ridden_through_at_300_rpm() {
         let off = run(
             "steady300",
             &format!(
-                "{STEADY}{}[controller]\nstuck_sensor_samples = 0\n",
+                "{STEADY}{}[controller]\nstuck_sensor_time = 0.0\n",
                 stuck(channel, 2.5)
             ),
         );

@@ -58,7 +58,7 @@ impl Window {
 fn long_config(base: &str, speed_rpm: f64, load_nm: f64, seconds: f64) -> SimConfig {
     let mut cfg = scenario_config(base, None, true).unwrap();
     cfg.inverter.model = InverterModel::Averaged;
-    cfg.controller.precision = Precision::F32;
+    cfg.simulation.precision = Precision::F32;
     cfg.simulation.duration = seconds;
     cfg.simulation.decimation = 1_000_000;
     // From rest (after the 0.1 s offset calibration): to the speed in 1 s, then the load over
