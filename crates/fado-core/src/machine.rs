@@ -25,7 +25,7 @@ use crate::{Dq, Real};
 #[cfg_attr(
     feature = "serde",
     derive(serde::Serialize, serde::Deserialize),
-    serde(deny_unknown_fields)
+    serde(deny_unknown_fields, default)
 )]
 pub struct MachineModel<T> {
     /// Stator resistance Rs in Ω (per phase).
@@ -40,8 +40,7 @@ pub struct MachineModel<T> {
     pub pole_pairs: u32,
     /// Shaft inertia J in kg·m² (motor and load).
     pub inertia: T,
-    /// Viscous friction B in N·m·s/rad. Default 0 in a TOML table.
-    #[cfg_attr(feature = "serde", serde(default))]
+    /// Viscous friction B in N·m·s/rad.
     pub viscous_friction: T,
     /// Rated current in A, peak of the phase current (= |i_dq| at rating).
     pub rated_current: T,
@@ -52,6 +51,27 @@ pub struct MachineModel<T> {
     /// Nominal DC-link voltage in V (the inverter's rating; not a TOML key of the motor).
     #[cfg_attr(feature = "serde", serde(skip))]
     pub dc_voltage: T,
+}
+
+/// The empty record: every field 0, which [`MachineModel::validate`] refuses naming the first
+/// field (`rs`). It exists for partial records (a serde table that gives some keys, merged over
+/// a base); nothing runs on it.
+impl<T: Real> Default for MachineModel<T> {
+    fn default() -> Self {
+        Self {
+            rs: T::zero(),
+            ld: T::zero(),
+            lq: T::zero(),
+            flux_linkage: T::zero(),
+            pole_pairs: 0,
+            inertia: T::zero(),
+            viscous_friction: T::zero(),
+            rated_current: T::zero(),
+            rated_speed_rpm: T::zero(),
+            rated_torque: T::zero(),
+            dc_voltage: T::zero(),
+        }
+    }
 }
 
 impl<T: Real> MachineModel<T> {
