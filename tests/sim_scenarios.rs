@@ -51,7 +51,7 @@ fn fig11_averaged_model_passes_and_agrees_with_the_switching_resolved_one() {
 #[test]
 fn fig11_passes_with_the_drive_in_single_precision() {
     let f64_run = run("fig11", None, false);
-    let f32_run = run("fig11", Some("[controller]\nprecision = \"f32\"\n"), false);
+    let f32_run = run("fig11", Some("[simulation]\nprecision = \"f32\"\n"), false);
     assert!(f32_run.passed, "{:?}", f32_run.checks);
     let d = (f64_run.metrics.max_angle_error_zero_speed
         - f32_run.metrics.max_angle_error_zero_speed)
@@ -93,8 +93,8 @@ fn fig10_sensor_offset_walks_the_estimate_along_the_limiter_circle_at_e_t_over_r
                [estimator]\nrs_adaptation = false\n";
     let out = run("fig10", Some(cfg), false);
     let c = &out.config;
-    let rs_hat = c.estimator_config().rs_hat;
-    let rho = c.estimator.limiter_radius_ratio * c.estimator_config().flux_linkage_hat;
+    let rs_hat = c.estimator_config().machine.rs;
+    let rho = c.estimator.limiter_radius_ratio * c.estimator_config().machine.flux_linkage;
     let (oa, ob) = (c.current_sensor.offset_a, c.current_sensor.offset_b);
     // Clarke of (a, b, −a−b): α = a, β = (a + 2b)/√3.
     let e = (-rs_hat * oa, -rs_hat * (oa + 2.0 * ob) / 3f64.sqrt());
@@ -185,9 +185,9 @@ fn integrator_and_emf_baselines_lose_the_angle_at_the_loaded_reversal_where_fado
     let fado = run("fig11", None, false);
     assert!(fado.metrics.max_angle_error_zero_speed < 0.25);
     for kind in ["lpf_integrator", "emf_observer"] {
-        let cfg = format!("[estimator]\nkind = \"{kind}\"\n");
+        let cfg = format!("[simulation]\nestimator = \"{kind}\"\n");
         let out = run("fig11", Some(&cfg), false);
-        assert_eq!(out.report().estimator, out.config.estimator.kind);
+        assert_eq!(out.report().estimator, out.config.simulation.estimator);
         assert!(!out.passed, "{kind} passed fig11");
         assert!(
             out.metrics.max_angle_error > 1.0,
@@ -197,12 +197,12 @@ fn integrator_and_emf_baselines_lose_the_angle_at_the_loaded_reversal_where_fado
     }
     let e = fado::sim::simulate(
         "fig11",
-        Some("[estimator]\nkind = \"ortega\"\n[controller]\nprecision = \"f32\"\n"),
+        Some("[simulation]\nestimator = \"ortega\"\nprecision = \"f32\"\n"),
         false,
         None,
     )
     .unwrap_err();
-    assert_eq!(e.key, "estimator.kind");
+    assert_eq!(e.key, "simulation.estimator");
 }
 
 #[test]
