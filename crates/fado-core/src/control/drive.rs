@@ -3,8 +3,8 @@
 //!
 //! Order of operations at sample n (SPEC §1, §5):
 //!
-//! 1. Reject non-finite inputs (trip after `input_fault_trip_samples` in a row); trip (gates
-//!    off, latched) when a phase current exceeds `trip_current`; replace a phase-current
+//! 1. Reject non-finite inputs (trip after `input_fault_trip_time` of them in a row); trip
+//!    (gates off, latched) when a phase current exceeds the trip level; replace a phase-current
 //!    channel that reads about zero against a clear reference by a model reconstruction
 //!    ([`StuckChannelDetector`]).
 //! 2. Estimator with the α-β currents sampled now and the voltage that acted over
@@ -631,8 +631,8 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         self.calibrate_offsets();
     }
 
-    /// (Re)starts the current-sensor offset calibration: the next
-    /// `offset_calibration_samples` samples run with the gates off (the machine must be at
+    /// (Re)starts the current-sensor offset calibration: for the next
+    /// `offset_calibration_time` the samples run with the gates off (the machine must be at
     /// rest, so that the true current is zero) and average the raw phase currents; then the
     /// drive re-aligns at the angle of the last [`align`](Self::align) and starts.
     pub fn calibrate_offsets(&mut self) {
@@ -733,7 +733,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
     /// Every output carries the status word [`DriveOutput::flags`]; the drive also counts the
     /// samples each flag was raised ([`flag_counts`](Self::flag_counts)). A stuck
     /// phase-current channel (see [`StuckChannelDetector`]) is replaced by its reconstruction
-    /// while it lasts; `input_fault_trip_samples` rejected samples in a row trip the drive.
+    /// while it lasts; rejected samples for `input_fault_trip_time` in a row trip the drive.
     pub fn step(&mut self, i_abc: Abc<T>, vdc: T, speed_ref_mech: T) -> DriveOutput<T> {
         let mut out = self.step_control(i_abc, vdc, speed_ref_mech);
         if out.input_fault && !out.tripped {
