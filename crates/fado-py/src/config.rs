@@ -1,22 +1,34 @@
-//! `fado.EstimatorConfig`: the flat estimator configuration with keyword arguments.
+//! `fado.EstimatorConfig`: the estimator's tuning (`fado_core::EstimatorTuning`) with keyword
+//! arguments.
 //!
-//! The Python class mirrors `fado_core::EstimatorConfig<f64>` field by field (the conversions
+//! The Python class mirrors `fado_core::EstimatorTuning<f64>` field by field (the conversions
 //! below are exhaustive struct literals, so a field added in the core fails to compile here
-//! until it is exposed). Every default is the Rust one; validation is the Rust one, and a
-//! refusal raises `fado.ConfigError` (a `ValueError`) naming the field.
+//! until it is exposed). The machine and the sampling period are not part of it: they are
+//! `fado.Machine` and the `ts` argument of `fado.Estimator`/`fado.estimate`. Every default is
+//! the Rust one; a refusal raises `fado.ConfigError` (a `ValueError`) naming the field.
+//!
+//! A tuning on its own is checked for what it alone decides (finite, signs, order of the
+//! thresholds, hold ratio below 1, …): [`PyEstimatorConfig::check`] validates it around the
+//! paper's motor at a sampling period so short that no rate limit binds. The limits that
+//! depend on the sampling period and the motor (k_af·ts ≤ 1, bandwidths and the mode
+//! threshold below the Nyquist frequency) are checked when an estimator is built with them.
 
-use fado_core::EstimatorConfig;
 use fado_core::tracker::BandwidthDefinition;
+use fado_core::{EstimatorConfig, EstimatorTuning, MachineModel};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 
 use crate::errors::{config_error, config_error_message};
 use crate::scalar::Scalar;
 
-/// The spelling of [`BandwidthDefinition::Minus3Db`] in Python.
-pub const MINUS_3DB: &str = "-3dB";
-/// The spelling of [`BandwidthDefinition::NaturalFrequency`] in Python.
-pub const NATURAL: &str = "natural";
+/// The spelling of [`BandwidthDefinition::Minus3Db`] (as in TOML: serde's snake case).
+pub const MINUS_3DB: &str = "minus3_db";
+/// The spelling of [`BandwidthDefinition::NaturalFrequency`] (as in TOML).
+pub const NATURAL: &str = "natural_frequency";
+
+/// Sampling period at which a tuning alone is checked: short enough (1 ns) that no limit
+/// tied to the sampling rate binds for any plausible gain or bandwidth.
+const CHECK_TS: f64 = 1e-9;
 
 fn bandwidth_name(definition: BandwidthDefinition) -> &'static str {
     match definition {
@@ -26,16 +38,14 @@ fn bandwidth_name(definition: BandwidthDefinition) -> &'static str {
 }
 
 fn parse_bandwidth(py: Python<'_>, name: &str) -> PyResult<BandwidthDefinition> {
-    if name.eq_ignore_ascii_case(MINUS_3DB) {
-        Ok(BandwidthDefinition::Minus3Db)
-    } else if name.eq_ignore_ascii_case(NATURAL) {
-        Ok(BandwidthDefinition::NaturalFrequency)
-    } else {
-        Err(config_error_message(
+    match name {
+        MINUS_3DB => Ok(BandwidthDefinition::Minus3Db),
+        NATURAL => Ok(BandwidthDefinition::NaturalFrequency),
+        _ => Err(config_error_message(
             py,
             "bandwidth_definition",
             format!("`bandwidth_definition` must be '{MINUS_3DB}' or '{NATURAL}', got {name:?}"),
-        ))
+        )),
     }
 }
 
@@ -43,10 +53,12 @@ fn parse_bandwidth(py: Python<'_>, name: &str) -> PyResult<BandwidthDefinition> 
 /// `to_dict`, `__repr__` and pickling can never disagree about which fields exist.
 macro_rules! config_class {
     ($($(#[doc = $doc:literal])* $field:ident: $ty:ty,)*) => {
-        /// Configuration of the sensorless estimator (paper, Fig. 5; SPEC §1–§3).
+        /// Tuning of the sensorless estimator (paper, Fig. 5; SPEC §1–§3): everything but the
+        /// machine and the sampling period.
         ///
         /// Every argument is keyword-only and optional: an omitted one takes the Rust default
-        /// (`EstimatorConfig()` shows them all). Instances are immutable; `replace(**changes)`
+        /// (`EstimatorConfig()` shows them all; speeds are ratios of the
+        /// machine's rated electrical frequency). Instances are immutable; `replace(**changes)`
         /// returns a modified copy. Invalid values raise `fado.ConfigError` (a `ValueError`)
         /// whose `.field` names the field.
         #[pyclass(name = "EstimatorConfig", module = "fado", frozen, eq, get_all)]
@@ -65,7 +77,8 @@ macro_rules! config_class {
                     $($field: $field.unwrap_or_else(|| self.$field.clone()),)*
                 };
                 // Validated, and with the bandwidth definition in its canonical spelling.
-                Ok(Self::from_core(&changed.to_core(py)?))
+                changed.check(py)?;
+                Ok(changed)
             }
 
             fn items<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
@@ -123,33 +136,26 @@ macro_rules! config_class {
 }
 
 config_class! {
-    /// Sampling period Ts in s (paper, V: 10 kHz).
-    ts: f64,
-    /// Stator resistance estimate R̂s in Ω.
-    rs_hat: f64,
-    /// q-axis inductance estimate L̂q in H.
-    lq_hat: f64,
-    /// Magnet flux linkage estimate λ̂f in Wb (limiter radius, hold level, start-up flux).
-    flux_linkage_hat: f64,
-    /// Disturbance feedback gain k_df in 1/s (Fig. 3).
+    /// Disturbance feedback gain k_df in 1/s (Fig. 3), at most 1/ts.
     k_df: f64,
     /// Ramp time of k_df on activation in s (0 = abrupt, as in the paper).
     k_df_ramp_time: f64,
-    /// Limiter gain k_af in 1/s (Fig. 6).
+    /// Limiter gain k_af in 1/s (Fig. 6), at most 1/ts.
     k_af: f64,
-    /// Limiter radius as a multiple of λ̂f.
+    /// Limiter radius as a multiple of λ̂f (at least 1).
     limiter_radius_ratio: f64,
-    /// Speed threshold between limiter and k_df feedback in Hz electrical.
-    mode_threshold_hz: f64,
-    /// Hysteresis half-band of the threshold in Hz.
-    mode_hysteresis_hz: f64,
+    /// Speed threshold between limiter and k_df feedback as a fraction of the machine's rated
+    /// electrical frequency (0.015: the paper's 1.5 Hz of its 100 Hz).
+    mode_threshold_ratio: f64,
+    /// Hysteresis half-band of the threshold as a fraction of the rated electrical frequency.
+    mode_hysteresis_ratio: f64,
     /// Bandwidth of T2S-1 (angle and observer speed) in Hz.
     t2s1_bandwidth_hz: f64,
     /// Bandwidth of T2S-2 (speed for control) in Hz.
     t2s2_bandwidth_hz: f64,
     /// Damping ratio of both trackers.
     tracker_damping: f64,
-    /// Meaning of the tracker bandwidths: '-3dB' or 'natural'.
+    /// Meaning of the tracker bandwidths: 'minus3_db' or 'natural_frequency' (as in TOML).
     bandwidth_definition: String,
     /// Trackers coast while |λ̂r| is below this fraction of λ̂f.
     tracker_hold_ratio: f64,
@@ -158,46 +164,40 @@ config_class! {
     /// Feed the disturbance observer with λ1 − L̂q·i instead of the paper's λ1 (our
     /// improvement, default true; false is the paper's Fig. 5).
     observer_on_rotor_flux: bool,
-    /// In limiter mode, re-centre the common mode of λ1 and D̂ (our improvement, default
-    /// true; false is the paper).
-    limiter_recentring: bool,
-    /// Rotor angle assumed at reset in rad (electrical).
-    initial_angle: f64,
     /// Adapt R̂s online (our extension; false = the paper's fixed R̂s).
     rs_adaptation: bool,
     /// Rate γ of the R̂s adaptation while turning, in 1/s.
     rs_adaptation_rate: f64,
     /// Excitation floor χ0 of the R̂s adaptation.
     rs_adaptation_excitation_floor: f64,
-    /// Lower bound of the adapted R̂s as a multiple of `rs_hat`.
+    /// Lower bound of the adapted R̂s as a multiple of the machine's `rs`.
     rs_adaptation_min_ratio: f64,
-    /// Upper bound of the adapted R̂s as a multiple of `rs_hat`.
+    /// Upper bound of the adapted R̂s as a multiple of the machine's `rs`.
     rs_adaptation_max_ratio: f64,
     /// With `rs_adaptation`: rate of the λ̂f learning where R̂s is unobservable, in 1/s
     /// (0 = fixed λ̂f).
     flux_linkage_adaptation_rate: f64,
+    /// In limiter mode, re-centre the common mode of λ1 and D̂ (our improvement, default
+    /// true; false is the paper).
+    limiter_recentring: bool,
 }
 
 impl Default for PyEstimatorConfig {
     fn default() -> Self {
-        Self::from_core(&EstimatorConfig::default())
+        Self::from_core(&EstimatorTuning::default())
     }
 }
 
 impl PyEstimatorConfig {
-    /// The Python view of a core configuration.
-    pub fn from_core(c: &EstimatorConfig<f64>) -> Self {
+    /// The Python view of a core tuning.
+    pub fn from_core(c: &EstimatorTuning<f64>) -> Self {
         Self {
-            ts: c.ts,
-            rs_hat: c.rs_hat,
-            lq_hat: c.lq_hat,
-            flux_linkage_hat: c.flux_linkage_hat,
             k_df: c.k_df,
             k_df_ramp_time: c.k_df_ramp_time,
             k_af: c.k_af,
             limiter_radius_ratio: c.limiter_radius_ratio,
-            mode_threshold_hz: c.mode_threshold_hz,
-            mode_hysteresis_hz: c.mode_hysteresis_hz,
+            mode_threshold_ratio: c.mode_threshold_ratio,
+            mode_hysteresis_ratio: c.mode_hysteresis_ratio,
             t2s1_bandwidth_hz: c.t2s1_bandwidth_hz,
             t2s2_bandwidth_hz: c.t2s2_bandwidth_hz,
             tracker_damping: c.tracker_damping,
@@ -205,31 +205,26 @@ impl PyEstimatorConfig {
             tracker_hold_ratio: c.tracker_hold_ratio,
             average_current: c.average_current,
             observer_on_rotor_flux: c.observer_on_rotor_flux,
-            limiter_recentring: c.limiter_recentring,
-            initial_angle: c.initial_angle,
             rs_adaptation: c.rs_adaptation,
             rs_adaptation_rate: c.rs_adaptation_rate,
             rs_adaptation_excitation_floor: c.rs_adaptation_excitation_floor,
             rs_adaptation_min_ratio: c.rs_adaptation_min_ratio,
             rs_adaptation_max_ratio: c.rs_adaptation_max_ratio,
             flux_linkage_adaptation_rate: c.flux_linkage_adaptation_rate,
+            limiter_recentring: c.limiter_recentring,
         }
     }
 
-    /// The core configuration in scalar type `T`, validated for that type (a value that is
-    /// fine in f64 can still underflow or overflow in f32).
-    pub fn to_core_as<T: Scalar>(&self, py: Python<'_>) -> PyResult<EstimatorConfig<T>> {
-        let config = EstimatorConfig {
-            ts: T::lit(self.ts),
-            rs_hat: T::lit(self.rs_hat),
-            lq_hat: T::lit(self.lq_hat),
-            flux_linkage_hat: T::lit(self.flux_linkage_hat),
+    /// The core tuning in scalar type `T` (not validated: see [`Self::check`] and
+    /// [`Self::estimator_config`]).
+    pub fn to_core_as<T: Scalar>(&self, py: Python<'_>) -> PyResult<EstimatorTuning<T>> {
+        Ok(EstimatorTuning {
             k_df: T::lit(self.k_df),
             k_df_ramp_time: T::lit(self.k_df_ramp_time),
             k_af: T::lit(self.k_af),
             limiter_radius_ratio: T::lit(self.limiter_radius_ratio),
-            mode_threshold_hz: T::lit(self.mode_threshold_hz),
-            mode_hysteresis_hz: T::lit(self.mode_hysteresis_hz),
+            mode_threshold_ratio: T::lit(self.mode_threshold_ratio),
+            mode_hysteresis_ratio: T::lit(self.mode_hysteresis_ratio),
             t2s1_bandwidth_hz: T::lit(self.t2s1_bandwidth_hz),
             t2s2_bandwidth_hz: T::lit(self.t2s2_bandwidth_hz),
             tracker_damping: T::lit(self.tracker_damping),
@@ -237,21 +232,116 @@ impl PyEstimatorConfig {
             tracker_hold_ratio: T::lit(self.tracker_hold_ratio),
             average_current: self.average_current,
             observer_on_rotor_flux: self.observer_on_rotor_flux,
-            limiter_recentring: self.limiter_recentring,
-            initial_angle: T::lit(self.initial_angle),
             rs_adaptation: self.rs_adaptation,
             rs_adaptation_rate: T::lit(self.rs_adaptation_rate),
             rs_adaptation_excitation_floor: T::lit(self.rs_adaptation_excitation_floor),
             rs_adaptation_min_ratio: T::lit(self.rs_adaptation_min_ratio),
             rs_adaptation_max_ratio: T::lit(self.rs_adaptation_max_ratio),
             flux_linkage_adaptation_rate: T::lit(self.flux_linkage_adaptation_rate),
+            limiter_recentring: self.limiter_recentring,
+        })
+    }
+
+    /// Checks what the tuning alone decides: validated around the paper's motor at a 1 ns
+    /// sampling period, where no rate limit binds (those are checked with the real `ts` and
+    /// machine by [`Self::estimator_config`]).
+    pub fn check(&self, py: Python<'_>) -> PyResult<()> {
+        self.estimator_config::<f64>(py, CHECK_TS, &MachineModel::paper(), 0.0)
+            .map(|_| ())
+    }
+
+    /// The complete core configuration in scalar type `T` around `machine`, sampled every
+    /// `ts`, starting at `initial_angle`; validated for that type (a value that is fine in
+    /// f64 can still underflow or overflow in f32).
+    pub fn estimator_config<T: Scalar>(
+        &self,
+        py: Python<'_>,
+        ts: f64,
+        machine: &MachineModel<f64>,
+        initial_angle: f64,
+    ) -> PyResult<EstimatorConfig<T>> {
+        let config = EstimatorConfig {
+            ts: T::lit(ts),
+            machine: machine.cast(),
+            initial_angle: T::lit(initial_angle),
+            tuning: self.to_core_as(py)?,
         };
         config.validate().map_err(|e| config_error(py, e))?;
         Ok(config)
     }
+}
 
-    /// The validated f64 core configuration.
-    pub fn to_core(&self, py: Python<'_>) -> PyResult<EstimatorConfig<f64>> {
-        self.to_core_as::<f64>(py)
+/// The section of a simulator configuration that is the estimator's tuning.
+const SECTION: &str = "estimator";
+
+impl PyEstimatorConfig {
+    /// `config` as given to `fado.estimate`/`fado.Estimator`: `None` (the defaults), an
+    /// `EstimatorConfig`, or a `dict` as `fado.simulate` takes it: flat tuning keys
+    /// (`{"k_df": 1.0}`), the `[estimator]` table (`{"estimator": {"k_df": 1.0}}`) or dotted
+    /// keys (`{"estimator.k_df": 1.0}`). The other tables of a simulator configuration
+    /// (`simulation`, `controller`, …) do not concern the estimator and are skipped; any other
+    /// key raises `ConfigError` naming it.
+    pub fn from_argument(py: Python<'_>, config: Option<&Bound<'_, PyAny>>) -> PyResult<Self> {
+        let Some(config) = config.filter(|c| !c.is_none()) else {
+            return Ok(Self::default());
+        };
+        if let Ok(c) = config.cast::<PyEstimatorConfig>() {
+            return Ok(c.get().clone());
+        }
+        let Ok(dict) = config.cast::<PyDict>() else {
+            return Err(pyo3::exceptions::PyTypeError::new_err(format!(
+                "config must be a fado.EstimatorConfig, a dict or None, got {}",
+                config.get_type().name()?
+            )));
+        };
+        let kwargs = PyDict::new(py);
+        let put = |key: &str, shown: &str, value: Bound<'_, PyAny>| -> PyResult<()> {
+            if !Self::FIELDS.contains(&key) {
+                return Err(config_error_message(
+                    py,
+                    shown,
+                    format!(
+                        "`{shown}` is not an estimator setting; one of {:?}",
+                        Self::FIELDS
+                    ),
+                ));
+            }
+            if kwargs.contains(key)? {
+                return Err(config_error_message(
+                    py,
+                    shown,
+                    format!("`{shown}` given twice"),
+                ));
+            }
+            kwargs.set_item(key, value)
+        };
+        for (key, value) in dict.iter() {
+            let key: String = key.extract()?;
+            if key == SECTION {
+                let Ok(table) = value.cast::<PyDict>() else {
+                    return Err(config_error_message(
+                        py,
+                        SECTION,
+                        format!("`{SECTION}` must be a table (dict) of estimator settings"),
+                    ));
+                };
+                for (k, v) in table.iter() {
+                    let k: String = k.extract()?;
+                    put(&k, &format!("{SECTION}.{k}"), v)?;
+                }
+            } else if let Some(k) = key.strip_prefix("estimator.") {
+                put(k, &key, value)?;
+            } else if value.cast::<PyDict>().is_ok() || key.contains('.') {
+                // Another table of a simulator configuration: not the estimator's.
+                continue;
+            } else {
+                put(&key, &key, value)?;
+            }
+        }
+        let made = py
+            .get_type::<PyEstimatorConfig>()
+            .call((), Some(&kwargs))?
+            .cast_into::<PyEstimatorConfig>()?;
+        Ok(made.get().clone())
     }
 }

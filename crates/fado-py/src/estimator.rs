@@ -8,6 +8,7 @@ use pyo3::prelude::*;
 use crate::config::PyEstimatorConfig;
 use crate::errors::{config_error, input_error};
 use crate::inputs::{ColumnSlice, Signals};
+use crate::machine::PyMachine;
 use crate::outputs::{EstimateResult, StepResult};
 use crate::replay::replay;
 use crate::scalar::{Dtype, Scalar};
@@ -41,6 +42,53 @@ impl<'a, 'py> FromPyObject<'a, 'py> for Dtype {
     }
 }
 
+/// A scalar argument, refused naming it unless finite.
+pub fn finite(py: Python<'_>, argument: &str, value: f64) -> PyResult<f64> {
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(input_error(
+            py,
+            argument,
+            format!("must be a finite number, got {value}"),
+        ))
+    }
+}
+
+/// What an estimator is built from: the machine, the tuning, the sampling period and the
+/// start-up angle.
+struct Setup {
+    machine: PyMachine,
+    tuning: PyEstimatorConfig,
+    ts: f64,
+    initial_angle: f64,
+}
+
+impl Setup {
+    fn new(
+        py: Python<'_>,
+        function: &str,
+        machine: Option<&Bound<'_, PyAny>>,
+        config: Option<&Bound<'_, PyAny>>,
+        ts: f64,
+        initial_angle: f64,
+    ) -> PyResult<Self> {
+        let machine = PyMachine::from_argument(py, machine, "machine", function)?;
+        let tuning = PyEstimatorConfig::from_argument(py, config)?;
+        Ok(Self {
+            machine,
+            tuning,
+            ts: finite(py, "ts", ts)?,
+            initial_angle,
+        })
+    }
+
+    fn core<T: Scalar>(&self, py: Python<'_>) -> PyResult<fado_core::EstimatorConfig<T>> {
+        self.tuning
+            .estimator_config(py, self.ts, &self.machine.to_core(), self.initial_angle)
+    }
+}
+
 /// The estimator in the arithmetic the user chose. Held once per Python object, so the
 /// f32 variant's unused bytes do not matter.
 #[allow(clippy::large_enum_variant)]
@@ -61,15 +109,13 @@ macro_rules! with_engine {
 }
 
 impl Engine {
-    fn new(py: Python<'_>, config: &PyEstimatorConfig, dtype: Dtype) -> PyResult<Self> {
+    fn new(py: Python<'_>, setup: &Setup, dtype: Dtype) -> PyResult<Self> {
         let engine = match dtype {
             Dtype::Float64 => Engine::F64(
-                SensorlessEstimator::new(config.to_core_as(py)?)
-                    .map_err(|e| config_error(py, e))?,
+                SensorlessEstimator::new(setup.core(py)?).map_err(|e| config_error(py, e))?,
             ),
             Dtype::Float32 => Engine::F32(
-                SensorlessEstimator::new(config.to_core_as(py)?)
-                    .map_err(|e| config_error(py, e))?,
+                SensorlessEstimator::new(setup.core(py)?).map_err(|e| config_error(py, e))?,
             ),
         };
         Ok(engine)
@@ -120,38 +166,82 @@ fn run_slices<T: Scalar>(
     replay(e, &va, &vb, &ia, &ib)
 }
 
-/// The sensorless estimator of Fig. 5 (SPEC §1), stepped one sample at a time with `step`
-/// or a chunk at a time with `run`; the state carries over between calls.
+/// The sensorless estimator of Fig. 5 (SPEC §1) around a machine model, stepped one sample
+/// at a time with `step` or a chunk at a time with `run`; the state carries over between
+/// calls.
 ///
-/// `dtype='float32'` runs the single-precision estimator, as firmware would; inputs are
-/// rounded to float32 and outputs widened back (exactly) to Python floats.
+/// `machine` (required) is the drive's model of the motor: a `fado.Machine`, a preset name
+/// (`fado.machine_presets()`; `'paper'` is the paper's motor) or a dict of `Machine` fields.
+/// `config` is the tuning: an `EstimatorConfig`, a dict as `fado.simulate` takes it, or None
+/// (the defaults). `ts` is the sampling period in s, `theta0` the rotor angle (rad,
+/// electrical) assumed at start-up and after `reset`. `dtype='float32'` runs the
+/// single-precision estimator, as firmware would; inputs are rounded to float32 and outputs
+/// widened back (exactly) to Python floats.
 #[pyclass(name = "Estimator", module = "fado")]
 pub struct PyEstimator {
     engine: Engine,
     config: Py<PyEstimatorConfig>,
+    machine: Py<PyMachine>,
+    ts: f64,
+    theta0: f64,
 }
 
 #[pymethods]
 impl PyEstimator {
     #[new]
-    #[pyo3(signature = (config = None, *, dtype = Dtype::Float64), text_signature = "(config=None, *, dtype='float64')")]
+    #[pyo3(
+        signature = (machine = None, config = None, *, ts = DEFAULT_TS, theta0 = 0.0, dtype = Dtype::Float64),
+        text_signature = "(machine, config=None, *, ts=0.0001, theta0=0.0, dtype='float64')"
+    )]
     fn py_new(
         py: Python<'_>,
-        config: Option<Bound<'_, PyEstimatorConfig>>,
+        machine: Option<Bound<'_, PyAny>>,
+        config: Option<Bound<'_, PyAny>>,
+        ts: f64,
+        theta0: f64,
         dtype: Dtype,
     ) -> PyResult<Self> {
-        let config = match config {
-            Some(c) => c.unbind(),
-            None => Py::new(py, PyEstimatorConfig::default())?,
-        };
-        let engine = Engine::new(py, config.get(), dtype)?;
-        Ok(Self { engine, config })
+        let theta0 = finite(py, "theta0", theta0)?;
+        let setup = Setup::new(
+            py,
+            "Estimator",
+            machine.as_ref(),
+            config.as_ref(),
+            ts,
+            theta0,
+        )?;
+        let engine = Engine::new(py, &setup, dtype)?;
+        Ok(Self {
+            engine,
+            config: Py::new(py, setup.tuning)?,
+            machine: Py::new(py, setup.machine)?,
+            ts,
+            theta0,
+        })
     }
 
-    /// The configuration in use (read-only; `set_rs_hat` updates its `rs_hat`).
+    /// The tuning in use (read-only).
     #[getter]
     fn config(&self, py: Python<'_>) -> Py<PyEstimatorConfig> {
         self.config.clone_ref(py)
+    }
+
+    /// The machine model in use (read-only; `set_rs_hat` updates its `rs`).
+    #[getter]
+    fn machine(&self, py: Python<'_>) -> Py<PyMachine> {
+        self.machine.clone_ref(py)
+    }
+
+    /// Sampling period Ts in s.
+    #[getter]
+    fn ts(&self) -> f64 {
+        self.ts
+    }
+
+    /// Rotor angle assumed at start-up and after `reset`, rad (electrical).
+    #[getter]
+    fn theta0(&self) -> f64 {
+        self.theta0
     }
 
     /// The arithmetic: 'float64' or 'float32'.
@@ -161,8 +251,9 @@ impl PyEstimator {
     }
 
     /// One sample: `v_alpha, v_beta` the voltage applied over the last sampling interval (V),
-    /// `i_alpha, i_beta` the currents sampled now (A). A non-finite input is rejected: the
-    /// state is untouched and the result repeats the last good one with `input_fault` set.
+    /// `i_alpha, i_beta` the currents sampled now (A). A non-finite sample is rejected as a
+    /// measurement fault: the state is untouched and the result repeats the last good one
+    /// with `input_fault` set.
     fn step(&mut self, v_alpha: f64, v_beta: f64, i_alpha: f64, i_beta: f64) -> StepResult {
         self.engine.step([v_alpha, v_beta], [i_alpha, i_beta])
     }
@@ -180,20 +271,26 @@ impl PyEstimator {
         i_beta: &Bound<'_, PyAny>,
     ) -> PyResult<EstimateResult> {
         let signals = Signals::new(v_alpha, v_beta, i_alpha, i_beta)?;
-        let ts = self.config.get().ts;
-        Ok(self.engine.run(py, &signals, ts))
+        Ok(self.engine.run(py, &signals, self.ts))
     }
 
-    /// Back to the start-up state at `config.initial_angle` with zero current.
+    /// Back to the start-up state at `theta0` with zero current.
     fn reset(&mut self) {
         with_engine!(&mut self.engine, e => e.reset())
     }
 
     /// Start-up at a known rotor angle `theta0` (rad, electrical) with the present current
     /// (SPEC §1 step 6): λ1 = λ̂f·e^{jθ0} + L̂q·i, D̂ = 0, θ̂ = θ0, ω̂ = 0, limiter mode.
+    /// Non-finite arguments raise `InputError` naming them.
     #[pyo3(signature = (theta0, i_alpha = 0.0, i_beta = 0.0))]
-    fn align(&mut self, theta0: f64, i_alpha: f64, i_beta: f64) {
-        self.engine.align(theta0, [i_alpha, i_beta]);
+    fn align(&mut self, py: Python<'_>, theta0: f64, i_alpha: f64, i_beta: f64) -> PyResult<()> {
+        let theta0 = finite(py, "theta0", theta0)?;
+        let i = [
+            finite(py, "i_alpha", i_alpha)?,
+            finite(py, "i_beta", i_beta)?,
+        ];
+        self.engine.align(theta0, i);
+        Ok(())
     }
 
     /// Enables or disables the k_df feedback regardless of speed (Fig. 9 switches it off).
@@ -209,9 +306,9 @@ impl PyEstimator {
             Engine::F32(e) => e.set_rs_hat(rs_hat as f32),
         }
         .map_err(|e| config_error(py, e))?;
-        let mut updated = self.config.get().clone();
-        updated.rs_hat = rs_hat;
-        self.config = Py::new(py, updated)?;
+        let mut updated = self.machine.get().clone();
+        updated.rs = rs_hat;
+        self.machine = Py::new(py, updated)?;
         Ok(())
     }
 
@@ -232,32 +329,44 @@ impl PyEstimator {
         Self {
             engine: self.engine.clone(),
             config: self.config.clone_ref(py),
+            machine: self.machine.clone_ref(py),
+            ts: self.ts,
+            theta0: self.theta0,
         }
     }
 
     fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
         Ok(format!(
-            "Estimator({}, dtype='{}')",
+            "Estimator({}, {}, ts={:?}, theta0={:?}, dtype='{}')",
+            self.machine.bind(py).repr()?,
             self.config.bind(py).repr()?,
+            self.ts,
+            self.theta0,
             self.engine.dtype().name()
         ))
     }
 }
+
+/// The default sampling period in s: 10 kHz, as the paper's drive (section V).
+pub const DEFAULT_TS: f64 = 1e-4;
 
 /// Runs the estimator over a whole recording in Rust with the GIL released and returns every
 /// output and diagnostic as numpy arrays (an `EstimateResult`).
 ///
 /// `v_alpha, v_beta`: voltage applied over each sampling interval (V); `i_alpha, i_beta`:
 /// currents sampled (A); 1-D contiguous float64 or float32 arrays of equal length.
-/// `ts` overrides `config.ts`; `theta0` aligns the estimator at that angle with the first
-/// current sample before the first step (otherwise it starts at `config.initial_angle`);
-/// `dtype='float32'` runs the single-precision estimator. Bad arrays raise `InputError`,
-/// bad settings `ConfigError` (both are `ValueError`s). The inputs are read in place, not
-/// copied: other threads must not write to them during the call.
+/// `machine` (required): the drive's model of the motor, a `fado.Machine`, a preset name
+/// (`fado.machine_presets()`) or a dict of `Machine` fields. `ts`: sampling period in s.
+/// `config`: the tuning (an `EstimatorConfig`, a dict as `fado.simulate` takes it, or None).
+/// `theta0` aligns the estimator at that angle with the first current sample before the first
+/// step (otherwise it starts at angle 0 with zero current). `dtype='float32'` runs the
+/// single-precision estimator. Bad arrays or arguments raise `InputError`, bad settings
+/// `ConfigError` (both are `ValueError`s). The inputs are read in place, not copied: other
+/// threads must not write to them during the call.
 #[pyfunction]
 #[pyo3(
-    signature = (v_alpha, v_beta, i_alpha, i_beta, *, ts = None, config = None, theta0 = None, dtype = Dtype::Float64),
-    text_signature = "(v_alpha, v_beta, i_alpha, i_beta, *, ts=None, config=None, theta0=None, dtype='float64')"
+    signature = (v_alpha, v_beta, i_alpha, i_beta, *, machine = None, ts = DEFAULT_TS, config = None, theta0 = None, dtype = Dtype::Float64),
+    text_signature = "(v_alpha, v_beta, i_alpha, i_beta, *, machine, ts=0.0001, config=None, theta0=None, dtype='float64')"
 )]
 #[allow(clippy::too_many_arguments)]
 pub fn estimate(
@@ -266,20 +375,16 @@ pub fn estimate(
     v_beta: &Bound<'_, PyAny>,
     i_alpha: &Bound<'_, PyAny>,
     i_beta: &Bound<'_, PyAny>,
-    ts: Option<f64>,
-    config: Option<Bound<'_, PyEstimatorConfig>>,
+    machine: Option<Bound<'_, PyAny>>,
+    ts: f64,
+    config: Option<Bound<'_, PyAny>>,
     theta0: Option<f64>,
     dtype: Dtype,
 ) -> PyResult<EstimateResult> {
+    let theta0 = theta0.map(|t| finite(py, "theta0", t)).transpose()?;
+    let setup = Setup::new(py, "estimate", machine.as_ref(), config.as_ref(), ts, 0.0)?;
     let signals = Signals::new(v_alpha, v_beta, i_alpha, i_beta)?;
-    let mut config = match config {
-        Some(c) => c.get().clone(),
-        None => PyEstimatorConfig::default(),
-    };
-    if let Some(ts) = ts {
-        config.ts = ts;
-    }
-    let mut engine = Engine::new(py, &config, dtype)?;
+    let mut engine = Engine::new(py, &setup, dtype)?;
     if let Some(theta0) = theta0 {
         let [_, _, ia, ib] = signals.slices();
         let first = |c: ColumnSlice<'_>| match c {
@@ -288,5 +393,5 @@ pub fn estimate(
         };
         engine.align(theta0, [first(ia), first(ib)]);
     }
-    Ok(engine.run(py, &signals, config.ts))
+    Ok(engine.run(py, &signals, setup.ts))
 }

@@ -4,7 +4,10 @@
 //! native module `fado._fado`, which the pure-Python package `fado` (in `python/fado/`)
 //! re-exports. Layout, after pydantic-core and rust-numpy:
 //!
-//! - [`config`]: `EstimatorConfig`, keyword arguments with the Rust defaults.
+//! - [`machine`]: `Machine` (the motor's parameters and ratings), its presets
+//!   (`machine_presets`).
+//! - [`config`]: `EstimatorConfig`, the estimator's tuning as keyword arguments with the Rust
+//!   defaults.
 //! - [`estimator`]: `Estimator` (step by step or chunk by chunk) and `estimate` (a whole
 //!   recording with the GIL released).
 //! - [`outputs`]: `StepResult`, `EstimateResult` and the column buffers behind them.
@@ -20,6 +23,7 @@ pub mod config;
 pub mod errors;
 pub mod estimator;
 pub mod inputs;
+pub mod machine;
 pub mod outputs;
 pub mod replay;
 pub mod scalar;
@@ -39,6 +43,8 @@ pub mod _fado {
     use super::config::PyEstimatorConfig;
     #[pymodule_export]
     use super::estimator::{PyEstimator, estimate};
+    #[pymodule_export]
+    use super::machine::{PyMachine, machine_presets};
     #[pymodule_export]
     use super::outputs::{EstimateResult, StepResult};
     #[pymodule_export]

@@ -9,15 +9,16 @@
 use std::io::Write;
 use std::time::Instant;
 
-use fado_sim::SimConfigError;
 use fado_sim::scenario::{self, SCENARIOS};
 use fado_sim::sim::TraceRow;
+use fado_sim::{SimConfig, SimConfigError};
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 use crate::config::PyEstimatorConfig;
 use crate::errors::{config_error_message, input_error};
+use crate::machine::PyMachine;
 
 /// Width of the progress bar printed to stderr.
 const BAR_WIDTH: usize = 30;
@@ -100,8 +101,101 @@ struct Finished {
     columns: Vec<Vec<f64>>,
 }
 
+/// The motor a simulation runs with, before the scenario and the user's configuration.
+pub(crate) enum Motor {
+    /// A preset of `motors/`: its whole file (`[motor]`, `[inverter]`) over the defaults.
+    Preset(&'static fado_sim::presets::Preset),
+    /// A machine: `[motor]` and `[inverter] dc_voltage`.
+    Machine(fado_core::MachineModel<f64>),
+}
+
+impl Motor {
+    /// `motor` as `simulate` takes it: None, a preset name or a `fado.Machine`.
+    pub(crate) fn from_argument(
+        py: Python<'_>,
+        motor: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Option<Self>> {
+        let Some(motor) = motor.filter(|m| !m.is_none()) else {
+            return Ok(None);
+        };
+        if let Ok(m) = motor.cast::<PyMachine>() {
+            return Ok(Some(Motor::Machine(m.get().to_core())));
+        }
+        if let Ok(name) = motor.extract::<String>() {
+            return match fado_sim::presets::find(&name) {
+                Some(p) => Ok(Some(Motor::Preset(p))),
+                None => Err(input_error(
+                    py,
+                    "motor",
+                    format!(
+                        "unknown motor preset {name:?}; one of {:?}",
+                        crate::machine::preset_names()
+                    ),
+                )),
+            };
+        }
+        Err(pyo3::exceptions::PyTypeError::new_err(format!(
+            "motor must be a preset name, a fado.Machine or None, got {}",
+            motor.get_type().name()?
+        )))
+    }
+
+    /// The defaults with this motor.
+    fn base(&self) -> Result<SimConfig, SimConfigError> {
+        match self {
+            Motor::Preset(p) => p.config(),
+            Motor::Machine(m) => {
+                let mut c = SimConfig::default();
+                c.motor = *m;
+                c.inverter.dc_voltage = m.dc_voltage;
+                c.validate()
+                    .map_err(|e| SimConfigError::new(format!("motor ({})", e.key), e.message))?;
+                Ok(c)
+            }
+        }
+    }
+}
+
+/// The configuration of `scenario`: the defaults, `motor` over them, the scenario (scaled by
+/// the motor's ratings), then the user's TOML, which wins over everything (as
+/// `fado_sim::scenario::scenario_config`, with the motor as a first layer).
+pub(crate) fn layered_config(
+    scenario: &str,
+    motor: Option<&Motor>,
+    config_toml: Option<&str>,
+    averaged: bool,
+) -> Result<SimConfig, SimConfigError> {
+    let Some(motor) = motor else {
+        return scenario::scenario_config(scenario, config_toml, averaged);
+    };
+    let sc = scenario::find(scenario).ok_or_else(|| {
+        let names: Vec<_> = SCENARIOS.iter().map(|s| s.name).collect();
+        SimConfigError::new(
+            "scenario",
+            format!("unknown `{scenario}`; one of {names:?}"),
+        )
+    })?;
+    let base = motor.base()?;
+    let mut cfg = match config_toml {
+        Some(text) => {
+            let user = SimConfig::from_toml_over(&base, text)?;
+            SimConfig::from_toml_over(&sc.apply(user), text)?
+        }
+        None => sc.apply(base),
+    };
+    if averaged {
+        cfg.inverter.model = fado_sim::inverter::InverterModel::Averaged;
+    }
+    cfg.validate().map_err(|e| match config_toml {
+        Some(text) => e.located_in(text),
+        None => e,
+    })?;
+    Ok(cfg)
+}
+
 fn run(
     scenario: &str,
+    motor: Option<&Motor>,
     config_toml: Option<&str>,
     averaged: bool,
     progress: bool,
@@ -112,7 +206,9 @@ fn run(
     };
     let mut draw = |f: f64| line.draw(f);
     let callback: Option<&mut dyn FnMut(f64)> = if progress { Some(&mut draw) } else { None };
-    let outcome = match fado_sim::simulate(scenario, config_toml, averaged, callback) {
+    let outcome = match layered_config(scenario, motor, config_toml, averaged)
+        .and_then(|cfg| scenario::run_config(scenario, cfg, callback))
+    {
         Ok(o) => o,
         Err(e) => return Ok(Err(e)),
     };
@@ -136,13 +232,17 @@ fn run(
 /// switching-resolved one; `progress` prints a progress bar to stderr. The GIL is released
 /// while the simulation runs.
 ///
+/// `motor` (a preset name of `machine_presets()` or a `Machine`) replaces the paper's motor
+/// before the scenario and `config_toml` are applied: a preset's whole file (`[motor]` and
+/// its `[inverter]`), a `Machine` as `[motor]` and `[inverter] dc_voltage`.
+///
 /// Bad keys or values raise `ConfigError` (`.field` is the TOML path), an unknown scenario
-/// `InputError` (both are `ValueError`s). Prefer `fado.simulate`, which also takes a path or
-/// a `dict`.
+/// or motor `InputError` (both are `ValueError`s). Prefer `fado.simulate`, which also takes a
+/// path or a `dict`.
 #[pyfunction]
 #[pyo3(
-    signature = (scenario = "fig11", config_toml = None, averaged = false, *, progress = false),
-    text_signature = "(scenario='fig11', config_toml=None, averaged=False, *, progress=False)"
+    signature = (scenario = "fig11", config_toml = None, averaged = false, *, progress = false, motor = None),
+    text_signature = "(scenario='fig11', config_toml=None, averaged=False, *, progress=False, motor=None)"
 )]
 pub fn simulate(
     py: Python<'_>,
@@ -150,15 +250,18 @@ pub fn simulate(
     config_toml: Option<&str>,
     averaged: bool,
     progress: bool,
+    motor: Option<Bound<'_, PyAny>>,
 ) -> PyResult<SimResult> {
+    let motor = Motor::from_argument(py, motor.as_ref())?;
     let finished = py
-        .detach(|| run(scenario, config_toml, averaged, progress))
+        .detach(|| run(scenario, motor.as_ref(), config_toml, averaged, progress))
         .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(format!("metrics to JSON: {e}")))?
         .map_err(|e| sim_error(py, e))?;
     SimResult::new(py, scenario, finished)
 }
 
-/// The names of the scenarios `simulate` runs (the paper's Fig. 8–12).
+/// The names of the scenarios `simulate` runs (the paper's Fig. 8–12, and the ones scaled by
+/// the motor's ratings).
 #[pyfunction]
 pub fn scenarios() -> Vec<&'static str> {
     SCENARIOS.iter().map(|s| s.name).collect()
@@ -185,10 +288,20 @@ pub fn describe_scenario<'py>(py: Python<'py>, scenario: &str) -> PyResult<Bound
 
 /// The configuration a scenario runs with, as the TOML document of `fado-sim run SCENARIO
 /// --dump-config [--averaged]`: edit it and pass it (or a part of it) to `simulate`.
+/// With `motor` (as in `simulate`), the configuration for that motor.
 #[pyfunction]
-#[pyo3(signature = (scenario = "fig11", averaged = false))]
-pub fn default_config(py: Python<'_>, scenario: &str, averaged: bool) -> PyResult<String> {
-    scenario::scenario_config(scenario, None, averaged)
+#[pyo3(
+    signature = (scenario = "fig11", averaged = false, *, motor = None),
+    text_signature = "(scenario='fig11', averaged=False, *, motor=None)"
+)]
+pub fn default_config(
+    py: Python<'_>,
+    scenario: &str,
+    averaged: bool,
+    motor: Option<Bound<'_, PyAny>>,
+) -> PyResult<String> {
+    let motor = Motor::from_argument(py, motor.as_ref())?;
+    layered_config(scenario, motor.as_ref(), None, averaged)
         .map(|c| c.to_toml())
         .map_err(|e| sim_error(py, e))
 }
@@ -209,10 +322,20 @@ pub struct SimResult {
     /// The effective configuration as TOML (feed it back to `simulate` to rerun).
     #[pyo3(get)]
     config_toml: String,
-    /// The configuration of the estimator inside the drive (for replaying the trace with
-    /// `fado.Estimator`).
+    /// The tuning of the estimator inside the drive (for replaying the trace with
+    /// `fado.Estimator(result.machine, result.estimator_config, ts=result.ts)`).
     #[pyo3(get)]
     estimator_config: Py<PyEstimatorConfig>,
+    /// The drive's model of the motor (`[model]`, or `[motor]` × `[mismatch]`).
+    #[pyo3(get)]
+    machine: Py<PyMachine>,
+    /// The drive's sampling period in s.
+    #[pyo3(get)]
+    ts: f64,
+    /// The rotor angle the drive's estimator starts from, rad (the plant's initial angle plus
+    /// the alignment error).
+    #[pyo3(get)]
+    theta0: f64,
     metrics: Py<PyDict>,
     traces: Py<PyDict>,
     rows: usize,
@@ -234,7 +357,10 @@ impl SimResult {
             passed: f.passed,
             averaged: f.averaged,
             config_toml: f.config_toml,
-            estimator_config: Py::new(py, PyEstimatorConfig::from_core(&f.estimator))?,
+            estimator_config: Py::new(py, PyEstimatorConfig::from_core(&f.estimator.tuning))?,
+            machine: Py::new(py, PyMachine::from_core(&f.estimator.machine))?,
+            ts: f.estimator.ts,
+            theta0: f.estimator.initial_angle,
             metrics: metrics.unbind(),
             traces: traces.unbind(),
             rows,
