@@ -4,21 +4,29 @@ Reference implementation of Y. Park and S.-K. Sul, "Sensorless Control Method fo
 Based on Frequency-Adaptive Disturbance Observer". The estimator runs in Rust
 (``fado._fado``); this package is its Python face.
 
-Replay a recording (1-D float64 or float32 arrays, one sample per sampling period)::
+Describe the motor (its parameters and ratings), or pick a preset of the repository's
+``motors/`` folder (:func:`machine_presets`; ``"paper"`` is the paper's motor)::
 
     import fado
-    result = fado.estimate(v_alpha, v_beta, i_alpha, i_beta, ts=100e-6)
+    motor = fado.Machine(rs=3.6, ld=36e-3, lq=51e-3, flux_linkage=0.545, pole_pairs=3,
+                         inertia=0.015, rated_current=6.08, rated_speed_rpm=1500.0,
+                         rated_torque=14.0, dc_voltage=540.0)
+
+Replay a recording (1-D float64 or float32 arrays, one sample per sampling period)::
+
+    result = fado.estimate(v_alpha, v_beta, i_alpha, i_beta, machine=motor, ts=100e-6)
     result.theta, result.omega_control, result.lambda1_alpha, result.mode, ...
 
 or step it yourself::
 
-    est = fado.Estimator(fado.EstimatorConfig(rs_hat=0.33))
+    est = fado.Estimator("paper", fado.EstimatorConfig(k_df=1.0))
     out = est.step(v_alpha, v_beta, i_alpha, i_beta)
 
 Simulate the paper's experiments (Fig. 8–12) on the closed-loop drive model (Rust,
 ``fado-sim``) and plot them like the paper's oscilloscope captures::
 
     result = fado.simulate("fig11", {"simulation": {"duration": 5.5}}, averaged=False)
+    result = fado.simulate("reversal", motor="ipmsm-2k2")   # scaled by any motor's ratings
     result.passed, result.metrics["max_angle_error_zero_speed"], result.traces["theta_hat"]
     import fado.plot; fado.plot.plot_scenario(result, "fig11.png")   # needs fado[plot]
 
@@ -51,6 +59,7 @@ from fado._fado import (
     EstimatorConfig,
     FadoError,
     InputError,
+    Machine,
     SimResult,
     SimulationError,
     StepResult,
@@ -58,6 +67,7 @@ from fado._fado import (
     default_config,
     describe_scenario,
     estimate,
+    machine_presets,
     scenarios,
 )
 from fado._mode import Mode
@@ -74,6 +84,7 @@ __all__ = [
     "EstimatorConfig",
     "FadoError",
     "InputError",
+    "Machine",
     "Mode",
     "SimResult",
     "SimulationError",
@@ -83,6 +94,7 @@ __all__ = [
     "describe_scenario",
     "compare",
     "estimate",
+    "machine_presets",
     "scenarios",
     "simulate",
     "sweep",

@@ -11,6 +11,8 @@ import numpy as np
 import numpy.typing as npt
 
 __all__ = [
+    "Machine",
+    "machine_presets",
     "EstimatorConfig",
     "Estimator",
     "estimate",
@@ -45,6 +47,8 @@ MODE_DISTURBANCE_FEEDBACK: Final[int]
 
 _FloatArray = npt.NDArray[np.float64] | npt.NDArray[np.float32]
 _DType = Literal["float64", "float32"]
+_MachineLike = Machine | str | dict[str, Any]
+_ConfigLike = EstimatorConfig | dict[str, Any] | None
 
 class FadoError(Exception):
     """Base class of every error fado raises on purpose."""
@@ -69,23 +73,104 @@ class SimulationError(FadoError):
     """A simulation could not be run or failed."""
 
 @final
-class EstimatorConfig:
-    """Configuration of the sensorless estimator; omitted fields take the Rust defaults."""
+class Machine:
+    """The motor's parameters and ratings (``fado_core::MachineModel``), validated."""
 
     fields: ClassVar[tuple[str, ...]]
     def __new__(
         cls,
         *,
-        ts: float | None = None,
-        rs_hat: float | None = None,
-        lq_hat: float | None = None,
-        flux_linkage_hat: float | None = None,
+        rs: float,
+        ld: float,
+        lq: float,
+        flux_linkage: float,
+        pole_pairs: int,
+        inertia: float,
+        rated_current: float,
+        rated_speed_rpm: float,
+        rated_torque: float,
+        dc_voltage: float,
+        viscous_friction: float = 0.0,
+    ) -> Machine: ...
+    def replace(
+        self,
+        *,
+        rs: float | None = None,
+        ld: float | None = None,
+        lq: float | None = None,
+        flux_linkage: float | None = None,
+        pole_pairs: int | None = None,
+        inertia: float | None = None,
+        rated_current: float | None = None,
+        rated_speed_rpm: float | None = None,
+        rated_torque: float | None = None,
+        dc_voltage: float | None = None,
+        viscous_friction: float | None = None,
+    ) -> Machine: ...
+    @staticmethod
+    def paper() -> Machine:
+        """The paper's motor."""
+    @staticmethod
+    def preset(name: str) -> Machine:
+        """A motor preset of the repository's ``motors/`` folder."""
+    def to_dict(self) -> dict[str, float | int]: ...
+    def __getnewargs_ex__(self) -> tuple[tuple[()], dict[str, float | int]]: ...
+    def __eq__(self, value: object, /) -> bool: ...
+    def __ne__(self, value: object, /) -> bool: ...
+    @property
+    def salient(self) -> bool:
+        """Ld and Lq differ by more than 2 %."""
+    @property
+    def rs(self) -> float:
+        """Stator resistance Rs in Ω (per phase)."""
+    @property
+    def ld(self) -> float:
+        """d-axis inductance Ld in H."""
+    @property
+    def lq(self) -> float:
+        """q-axis inductance Lq in H."""
+    @property
+    def flux_linkage(self) -> float:
+        """Magnet flux linkage λf in Wb (peak, per phase)."""
+    @property
+    def pole_pairs(self) -> int:
+        """Pole pairs p."""
+    @property
+    def inertia(self) -> float:
+        """Shaft inertia J in kg·m²."""
+    @property
+    def viscous_friction(self) -> float:
+        """Viscous friction B in N·m·s/rad."""
+    @property
+    def rated_current(self) -> float:
+        """Rated current in A peak."""
+    @property
+    def rated_speed_rpm(self) -> float:
+        """Rated speed in r/min (mechanical)."""
+    @property
+    def rated_torque(self) -> float:
+        """Rated torque in N·m."""
+    @property
+    def dc_voltage(self) -> float:
+        """Nominal DC-link voltage in V."""
+
+def machine_presets() -> list[str]:
+    """The names of the motor presets."""
+
+@final
+class EstimatorConfig:
+    """Tuning of the sensorless estimator; omitted fields take the Rust defaults."""
+
+    fields: ClassVar[tuple[str, ...]]
+    def __new__(
+        cls,
+        *,
         k_df: float | None = None,
         k_df_ramp_time: float | None = None,
         k_af: float | None = None,
         limiter_radius_ratio: float | None = None,
-        mode_threshold_hz: float | None = None,
-        mode_hysteresis_hz: float | None = None,
+        mode_threshold_ratio: float | None = None,
+        mode_hysteresis_ratio: float | None = None,
         t2s1_bandwidth_hz: float | None = None,
         t2s2_bandwidth_hz: float | None = None,
         tracker_damping: float | None = None,
@@ -93,28 +178,23 @@ class EstimatorConfig:
         tracker_hold_ratio: float | None = None,
         average_current: bool | None = None,
         observer_on_rotor_flux: bool | None = None,
-        limiter_recentring: bool | None = None,
-        initial_angle: float | None = None,
         rs_adaptation: bool | None = None,
         rs_adaptation_rate: float | None = None,
         rs_adaptation_excitation_floor: float | None = None,
         rs_adaptation_min_ratio: float | None = None,
         rs_adaptation_max_ratio: float | None = None,
         flux_linkage_adaptation_rate: float | None = None,
+        limiter_recentring: bool | None = None,
     ) -> EstimatorConfig: ...
     def replace(
         self,
         *,
-        ts: float | None = None,
-        rs_hat: float | None = None,
-        lq_hat: float | None = None,
-        flux_linkage_hat: float | None = None,
         k_df: float | None = None,
         k_df_ramp_time: float | None = None,
         k_af: float | None = None,
         limiter_radius_ratio: float | None = None,
-        mode_threshold_hz: float | None = None,
-        mode_hysteresis_hz: float | None = None,
+        mode_threshold_ratio: float | None = None,
+        mode_hysteresis_ratio: float | None = None,
         t2s1_bandwidth_hz: float | None = None,
         t2s2_bandwidth_hz: float | None = None,
         tracker_damping: float | None = None,
@@ -122,31 +202,18 @@ class EstimatorConfig:
         tracker_hold_ratio: float | None = None,
         average_current: bool | None = None,
         observer_on_rotor_flux: bool | None = None,
-        limiter_recentring: bool | None = None,
-        initial_angle: float | None = None,
         rs_adaptation: bool | None = None,
         rs_adaptation_rate: float | None = None,
         rs_adaptation_excitation_floor: float | None = None,
         rs_adaptation_min_ratio: float | None = None,
         rs_adaptation_max_ratio: float | None = None,
         flux_linkage_adaptation_rate: float | None = None,
+        limiter_recentring: bool | None = None,
     ) -> EstimatorConfig: ...
     def to_dict(self) -> dict[str, float | str | bool]: ...
     def __getnewargs_ex__(self) -> tuple[tuple[()], dict[str, float | str | bool]]: ...
     def __eq__(self, value: object, /) -> bool: ...
     def __ne__(self, value: object, /) -> bool: ...
-    @property
-    def ts(self) -> float:
-        """Sampling period Ts in s."""
-    @property
-    def rs_hat(self) -> float:
-        """Stator resistance estimate R̂s in Ω."""
-    @property
-    def lq_hat(self) -> float:
-        """q-axis inductance estimate L̂q in H."""
-    @property
-    def flux_linkage_hat(self) -> float:
-        """Magnet flux linkage estimate λ̂f in Wb."""
     @property
     def k_df(self) -> float:
         """Disturbance feedback gain k_df in 1/s (Fig. 3)."""
@@ -160,11 +227,11 @@ class EstimatorConfig:
     def limiter_radius_ratio(self) -> float:
         """Limiter radius as a multiple of λ̂f."""
     @property
-    def mode_threshold_hz(self) -> float:
-        """Speed threshold between limiter and k_df feedback in Hz electrical."""
+    def mode_threshold_ratio(self) -> float:
+        """Speed threshold between limiter and k_df feedback as a fraction of the rated electrical frequency."""
     @property
-    def mode_hysteresis_hz(self) -> float:
-        """Hysteresis half-band of the threshold in Hz."""
+    def mode_hysteresis_ratio(self) -> float:
+        """Hysteresis half-band of the threshold as a fraction of the rated electrical frequency."""
     @property
     def t2s1_bandwidth_hz(self) -> float:
         """Bandwidth of T2S-1 in Hz."""
@@ -176,7 +243,7 @@ class EstimatorConfig:
         """Damping ratio of both trackers."""
     @property
     def bandwidth_definition(self) -> str:
-        """'-3dB' or 'natural'."""
+        """'minus3_db' or 'natural_frequency'."""
     @property
     def tracker_hold_ratio(self) -> float:
         """Trackers coast while |λ̂r| is below this fraction of λ̂f."""
@@ -186,12 +253,6 @@ class EstimatorConfig:
     @property
     def observer_on_rotor_flux(self) -> bool:
         """Observer fed with λ1 − L̂q·i (fado's improvement) instead of λ1 (the paper)."""
-    @property
-    def limiter_recentring(self) -> bool:
-        """In limiter mode, re-centre the common mode of λ1 and D̂ (fado's improvement)."""
-    @property
-    def initial_angle(self) -> float:
-        """Rotor angle assumed at reset in rad."""
     @property
     def rs_adaptation(self) -> bool:
         """Adapt R̂s online (fado's extension, default True; False = the paper)."""
@@ -203,13 +264,16 @@ class EstimatorConfig:
         """Excitation floor χ0 of the R̂s adaptation."""
     @property
     def rs_adaptation_min_ratio(self) -> float:
-        """Lower bound of the adapted R̂s as a multiple of rs_hat."""
+        """Lower bound of the adapted R̂s as a multiple of the machine's rs."""
     @property
     def rs_adaptation_max_ratio(self) -> float:
-        """Upper bound of the adapted R̂s as a multiple of rs_hat."""
+        """Upper bound of the adapted R̂s as a multiple of the machine's rs."""
     @property
     def flux_linkage_adaptation_rate(self) -> float:
         """Rate of the λ̂f learning where R̂s is unobservable, in 1/s (0 = fixed λ̂f)."""
+    @property
+    def limiter_recentring(self) -> bool:
+        """In limiter mode, re-centre the common mode of λ1 and D̂ (fado's improvement)."""
 
 @final
 class StepResult:
@@ -316,10 +380,22 @@ class Estimator:
     """The sensorless estimator of Fig. 5, stepped sample by sample or chunk by chunk."""
 
     def __new__(
-        cls, config: EstimatorConfig | None = None, *, dtype: npt.DTypeLike = "float64"
+        cls,
+        machine: _MachineLike,
+        config: _ConfigLike = None,
+        *,
+        ts: float = 0.0001,
+        theta0: float = 0.0,
+        dtype: npt.DTypeLike = "float64",
     ) -> Estimator: ...
     @property
     def config(self) -> EstimatorConfig: ...
+    @property
+    def machine(self) -> Machine: ...
+    @property
+    def ts(self) -> float: ...
+    @property
+    def theta0(self) -> float: ...
     @property
     def dtype(self) -> _DType: ...
     @property
@@ -342,8 +418,9 @@ def estimate(
     i_alpha: _FloatArray,
     i_beta: _FloatArray,
     *,
-    ts: float | None = None,
-    config: EstimatorConfig | None = None,
+    machine: _MachineLike,
+    ts: float = 0.0001,
+    config: _ConfigLike = None,
     theta0: float | None = None,
     dtype: npt.DTypeLike = "float64",
 ) -> EstimateResult:
@@ -364,6 +441,12 @@ class SimResult:
     @property
     def estimator_config(self) -> EstimatorConfig: ...
     @property
+    def machine(self) -> Machine: ...
+    @property
+    def ts(self) -> float: ...
+    @property
+    def theta0(self) -> float: ...
+    @property
     def metrics(self) -> dict[str, Any]: ...
     @property
     def checks(self) -> list[dict[str, Any]]: ...
@@ -381,8 +464,9 @@ def simulate(
     averaged: bool = False,
     *,
     progress: bool = False,
+    motor: str | Machine | None = None,
 ) -> SimResult:
-    """Run a scenario of the paper (Fig. 8–12) on the simulated drive (GIL released)."""
+    """Run a scenario (the paper's Fig. 8–12, or one scaled by the motor's ratings) on the simulated drive (GIL released)."""
 
 def scenarios() -> list[str]:
     """The scenario names."""
@@ -390,7 +474,9 @@ def scenarios() -> list[str]:
 def describe_scenario(scenario: str) -> dict[str, str]:
     """Name, title, profile and pass criterion of a scenario."""
 
-def default_config(scenario: str = "fig11", averaged: bool = False) -> str:
+def default_config(
+    scenario: str = "fig11", averaged: bool = False, *, motor: str | Machine | None = None
+) -> str:
     """The scenario's configuration as TOML (``fado-sim run --dump-config``)."""
 
 def compare(

@@ -44,10 +44,15 @@ def simulate(
     averaged: bool = False,
     *,
     progress: bool = False,
+    motor: str | _fado.Machine | None = None,
 ) -> _fado.SimResult:
     """Runs one of the paper's experiments on the simulated drive (Rust, GIL released).
 
-    `scenario` is one of :func:`fado.scenarios` (``fig8`` … ``fig12``). `config` overrides
+    `scenario` is one of :func:`fado.scenarios` (``fig8`` … ``fig12`` in the paper's units;
+    ``reversal``, ``stops``, ``rated-reversal``, ``lowspeed`` scaled by the motor's ratings).
+    `motor` replaces the paper's motor first: a preset name of :func:`fado.machine_presets`
+    (its whole ``motors/`` file: ``[motor]`` and its ``[inverter]``) or a :class:`fado.Machine`
+    (as ``[motor]`` and ``[inverter] dc_voltage``). `config` then overrides
     the scenario's configuration key by key, given as TOML text, a path (``str`` or
     :class:`pathlib.Path`) to a TOML file, or a ``dict`` of tables such as
     ``{"simulation": {"duration": 1.0}, "mismatch.rs_ratio": 1.01}``; see
@@ -64,7 +69,7 @@ def simulate(
     """
     text = config_text(config)
     try:
-        return _fado.simulate(scenario, text, averaged, progress=progress)
+        return _fado.simulate(scenario, text, averaged, progress=progress, motor=motor)
     except _fado.ConfigError as e:
         path = _config_path(config)
         if path is not None and getattr(e, "line", None) is not None:

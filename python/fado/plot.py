@@ -127,8 +127,7 @@ def _lambda2(ax: Axes, r: SimResult) -> None:
 
 def _rotor_flux(ax: Axes, r: SimResult) -> None:
     t = _col(r, "time")
-    cfg = r.estimator_config
-    radius = cfg.limiter_radius_ratio * cfg.flux_linkage_hat
+    radius = r.estimator_config.limiter_radius_ratio * r.machine.flux_linkage
     a, b = _col(r, "lambda_r_alpha"), _col(r, "lambda_r_beta")
     ax.plot(t, a, color="C0", lw=1.0, label="λ̂r α")
     ax.plot(t, b, color="C1", lw=1.0, label="λ̂r β")

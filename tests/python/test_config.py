@@ -1,4 +1,5 @@
-"""`fado.EstimatorConfig`: defaults, immutability, round trips and field-naming errors."""
+"""`fado.EstimatorConfig` (the tuning) and `fado.Machine` (the motor): defaults, immutability,
+round trips and field-naming errors."""
 
 from __future__ import annotations
 
@@ -15,32 +16,57 @@ import fado
 from fado import EstimatorConfig
 
 # The values the paper (section V) and SPEC.md fix; the Rust `Default` must give exactly these.
+# Speeds are ratios of the rated electrical frequency (the paper's motor: 100 Hz).
 PAPER_DEFAULTS = {
-    "ts": 100e-6,  # 10 kHz sampling [P]
-    "rs_hat": 0.327,  # [P]
-    "lq_hat": 2.63e-3,  # [P]
-    "flux_linkage_hat": 0.088,  # SPEC §6 [A]
     "k_df": 0.5,  # [P]
     "k_df_ramp_time": 0.0,  # abrupt, as in the paper
     "k_af": 2 * math.pi * 100,  # [P]
     "limiter_radius_ratio": 1.15,  # [P]
-    "mode_threshold_hz": 1.5,  # [P]
-    "mode_hysteresis_hz": 0.2,  # SPEC §1 [A]
+    "mode_threshold_ratio": 0.015,  # [P]: 1.5 Hz of the paper motor's 100 Hz
+    "mode_hysteresis_ratio": 0.002,  # SPEC §1 [A]: 0.2 Hz of 100 Hz
     "t2s1_bandwidth_hz": 60.0,  # [P]
     "t2s2_bandwidth_hz": 35.0,  # [P]
     "tracker_damping": 1 / math.sqrt(2),  # SPEC §3 [A]
-    "bandwidth_definition": "-3dB",  # SPEC §3
+    "bandwidth_definition": "minus3_db",  # SPEC §3
     "tracker_hold_ratio": 0.2,  # SPEC §3 [A]
     "average_current": True,  # SPEC §1 [A]
     "observer_on_rotor_flux": True,  # fado's improvement [A]; False = paper's Fig. 5
-    "limiter_recentring": True,  # fado's improvement [A]; False = the paper
-    "initial_angle": 0.0,  # SPEC §1 [A]
     "rs_adaptation": True,  # fado's extension [A]; False = the paper's fixed R̂s
     "rs_adaptation_rate": 1.0,  # [A]
     "rs_adaptation_excitation_floor": 0.2,  # [A]
     "rs_adaptation_min_ratio": 0.5,  # [A]
     "rs_adaptation_max_ratio": 2.0,  # [A]
     "flux_linkage_adaptation_rate": 0.0,  # [A]
+    "limiter_recentring": True,  # fado's improvement [A]; False = the paper
+}
+
+# The paper's motor (section V; λf, J, B from SPEC §6; rated current from its rated torque).
+PAPER_MACHINE = {
+    "rs": 0.327,
+    "ld": 2.63e-3,
+    "lq": 2.63e-3,
+    "flux_linkage": 0.088,
+    "pole_pairs": 4,
+    "inertia": 0.012,
+    "viscous_friction": 1e-3,
+    "rated_current": 11.5 / (1.5 * 4 * 0.088),
+    "rated_speed_rpm": 1500.0,
+    "rated_torque": 11.5,
+    "dc_voltage": 311.0,
+}
+
+# The 2.2 kW interior-magnet motor of issue 11 (motulator's example), entered by hand.
+IPMSM = {
+    "rs": 3.6,
+    "ld": 36e-3,
+    "lq": 51e-3,
+    "flux_linkage": 0.545,
+    "pole_pairs": 3,
+    "inertia": 0.015,
+    "rated_current": 6.08,
+    "rated_speed_rpm": 1500.0,
+    "rated_torque": 14.0,
+    "dc_voltage": 540.0,
 }
 
 
@@ -71,12 +97,12 @@ def test_every_field_is_a_keyword_only_argument_and_an_attribute() -> None:
 @pytest.mark.parametrize(
     ("field", "value"),
     [
-        ("ts", 50e-6),
-        ("rs_hat", 0.4),
+        ("k_df_ramp_time", 0.1),
+        ("mode_threshold_ratio", 0.02),
         ("k_df", 1.0),
-        ("bandwidth_definition", "natural"),
+        ("bandwidth_definition", "natural_frequency"),
         ("average_current", False),
-        ("initial_angle", -1.0),
+        ("rs_adaptation", False),
     ],
 )
 def test_keyword_sets_only_that_field(field: str, value: object) -> None:
@@ -86,35 +112,46 @@ def test_keyword_sets_only_that_field(field: str, value: object) -> None:
 
 
 def test_immutable_and_replace() -> None:
-    cfg = EstimatorConfig(rs_hat=0.3)
+    cfg = EstimatorConfig(k_af=300.0)
     with pytest.raises(AttributeError):
-        cfg.rs_hat = 1.0  # type: ignore[misc]
+        cfg.k_af = 1.0  # type: ignore[misc]
     changed = cfg.replace(k_df=2.0)
-    assert changed.k_df == 2.0 and changed.rs_hat == 0.3
+    assert changed.k_df == 2.0 and changed.k_af == 300.0
     assert cfg.k_df == PAPER_DEFAULTS["k_df"]
-    assert cfg != changed and cfg == EstimatorConfig(rs_hat=0.3)
+    assert cfg != changed and cfg == EstimatorConfig(k_af=300.0)
     with pytest.raises(fado.ConfigError):
         cfg.replace(k_df=-1.0)
 
 
 def test_round_trips() -> None:
-    cfg = EstimatorConfig(rs_hat=0.31, bandwidth_definition="natural", average_current=False)
+    cfg = EstimatorConfig(
+        k_af=300.0, bandwidth_definition="natural_frequency", average_current=False
+    )
     assert EstimatorConfig(**cfg.to_dict()) == cfg
     assert eval(repr(cfg), {"EstimatorConfig": EstimatorConfig}) == cfg
     assert pickle.loads(pickle.dumps(cfg)) == cfg
     assert copy.deepcopy(cfg) == cfg
 
 
-def test_bandwidth_definition_is_case_insensitive_and_canonical() -> None:
-    assert EstimatorConfig(bandwidth_definition="-3DB").bandwidth_definition == "-3dB"
-    assert EstimatorConfig(bandwidth_definition="Natural").bandwidth_definition == "natural"
+def test_bandwidth_definition_has_one_spelling_per_value_the_tomls() -> None:
+    assert EstimatorConfig(bandwidth_definition="minus3_db").bandwidth_definition == "minus3_db"
+    natural = EstimatorConfig(bandwidth_definition="natural_frequency")
+    assert natural.bandwidth_definition == "natural_frequency"
+    # The spelling of the simulator's TOML ([estimator] bandwidth_definition), nothing else.
+    assert 'bandwidth_definition = "minus3_db"' in fado.default_config("fig11")
+    for other in ["-3dB", "natural", "Minus3_dB", "NATURAL_FREQUENCY"]:
+        with pytest.raises(fado.ConfigError) as info:
+            EstimatorConfig(bandwidth_definition=other)
+        assert info.value.field == "bandwidth_definition"
 
 
 def test_bandwidth_definition_changes_the_trackers() -> None:
     rng = np.random.default_rng(0)
     signals = [rng.normal(size=2000) for _ in range(4)]
-    a = fado.estimate(*signals, config=EstimatorConfig(bandwidth_definition="-3dB"))
-    b = fado.estimate(*signals, config=EstimatorConfig(bandwidth_definition="natural"))
+    minus3 = EstimatorConfig(bandwidth_definition="minus3_db")
+    natural = EstimatorConfig(bandwidth_definition="natural_frequency")
+    a = fado.estimate(*signals, machine="paper", config=minus3)
+    b = fado.estimate(*signals, machine="paper", config=natural)
     np.testing.assert_array_equal(a.theta_direct[:1], b.theta_direct[:1])
     assert not np.array_equal(a.theta, b.theta)
 
@@ -135,17 +172,12 @@ def test_non_finite_values_raise_naming_the_field(field: str, bad: float) -> Non
 @pytest.mark.parametrize(
     ("field", "bad"),
     [
-        ("ts", 0.0),
-        ("ts", -1e-4),
-        ("rs_hat", -0.1),
-        ("lq_hat", -1e-3),
-        ("flux_linkage_hat", 0.0),
         ("k_df", -0.5),
         ("k_df_ramp_time", -1.0),
         ("k_af", -1.0),
         ("limiter_radius_ratio", 0.0),
-        ("mode_threshold_hz", -1.5),
-        ("mode_hysteresis_hz", 2.0),  # wider than the threshold
+        ("mode_threshold_ratio", -0.015),
+        ("mode_hysteresis_ratio", 0.02),  # wider than the threshold
         ("t2s1_bandwidth_hz", 0.0),
         ("t2s2_bandwidth_hz", -35.0),
         ("tracker_damping", 0.0),
@@ -161,41 +193,53 @@ def test_out_of_range_values_raise_naming_the_field(field: str, bad: object) -> 
 
 def test_wrong_types_and_unknown_fields_are_type_errors() -> None:
     with pytest.raises(TypeError):
-        EstimatorConfig(ts="fast")  # type: ignore[arg-type]
+        EstimatorConfig(k_df="fast")  # type: ignore[arg-type]
     with pytest.raises(TypeError):
-        EstimatorConfig(rs=0.3)  # type: ignore[call-arg]
+        EstimatorConfig(rs_hat=0.3)  # type: ignore[call-arg]
     with pytest.raises(TypeError):
-        EstimatorConfig(100e-6)  # type: ignore[misc]
+        EstimatorConfig(0.5)  # type: ignore[misc]
 
 
-def test_ts_argument_of_estimate_is_validated() -> None:
+@pytest.mark.parametrize("bad", [0.0, -1e-4])
+def test_ts_argument_of_estimate_is_validated(bad: float) -> None:
     x = np.zeros(3)
     with pytest.raises(fado.ConfigError) as info:
-        fado.estimate(x, x, x, x, ts=0.0)
+        fado.estimate(x, x, x, x, machine="paper", ts=bad)
     assert info.value.field == "ts"
 
 
+@pytest.mark.parametrize("bad", [math.nan, math.inf, -math.inf])
+@pytest.mark.parametrize("argument", ["ts", "theta0"])
+def test_non_finite_scalar_arguments_raise_naming_them(argument: str, bad: float) -> None:
+    x = np.zeros(3)
+    with pytest.raises(ValueError, match=argument) as info:
+        fado.estimate(x, x, x, x, machine="paper", **{argument: bad})  # type: ignore[arg-type]
+    assert isinstance(info.value, fado.FadoError)
+    with pytest.raises(ValueError, match=argument):
+        fado.Estimator("paper", **{argument: bad})  # type: ignore[arg-type]
+
+
 def test_float32_validates_in_single_precision() -> None:
-    tiny = EstimatorConfig(ts=1e-50)  # fine in f64, zero in f32
-    fado.Estimator(tiny)
+    tiny = 1e-50  # a sampling period fine in f64, zero in f32
+    fado.Estimator("paper", ts=tiny)
     with pytest.raises(fado.ConfigError) as info:
-        fado.Estimator(tiny, dtype="float32")
+        fado.Estimator("paper", ts=tiny, dtype="float32")
     assert info.value.field == "ts"
 
 
 @pytest.mark.parametrize("spelling", ["float32", "f4", np.float32, np.dtype("float32")])
 def test_dtype_spellings(spelling: object) -> None:
-    assert fado.Estimator(dtype=spelling).dtype == "float32"  # type: ignore[arg-type]
+    assert fado.Estimator("paper", dtype=spelling).dtype == "float32"  # type: ignore[arg-type]
 
 
 @pytest.mark.parametrize("bad", ["float16", "int32", "double-ish", np.complex128])
 def test_bad_dtype_raises_input_error(bad: object) -> None:
     with pytest.raises(fado.InputError) as info:
-        fado.Estimator(dtype=bad)  # type: ignore[arg-type]
+        fado.Estimator("paper", dtype=bad)  # type: ignore[arg-type]
     assert info.value.argument == "dtype"
     x = np.zeros(3)
     with pytest.raises(fado.InputError):
-        fado.estimate(x, x, x, x, dtype=bad)  # type: ignore[arg-type]
+        fado.estimate(x, x, x, x, machine="paper", dtype=bad)  # type: ignore[arg-type]
 
 
 def test_exception_hierarchy() -> None:
@@ -212,23 +256,42 @@ def test_exception_hierarchy() -> None:
 
 
 TS = 100e-6  # the default sampling period: 10 kHz
+RATED_HZ = 100.0  # the paper motor's rated electrical frequency: 1500 r/min, 4 pole pairs
 
 
 @pytest.mark.parametrize(
     ("field", "bad"),
     [
-        # Above what the sampling rate allows (the discrete loops would be unstable).
+        # Above what the sampling rate allows (the discrete loops would be unstable): a
+        # tuning alone is fine, the estimator sampled at 10 kHz refuses it.
         ("t2s1_bandwidth_hz", 4000.0),
         ("t2s2_bandwidth_hz", 4000.0),
         ("k_af", 1.01 / TS),
         ("k_df", 1.01 / TS),
-        ("mode_threshold_hz", 0.5 / TS),
-        # Out of order.
-        ("limiter_radius_ratio", 0.9),  # the limiter would clamp λ̂f itself
-        ("mode_hysteresis_hz", 1.6),  # wider than the 1.5 Hz threshold
+        ("mode_threshold_ratio", 0.5 / TS / RATED_HZ),
     ],
 )
-def test_sampling_rate_and_ordering_limits_name_the_field(field: str, bad: float) -> None:
+def test_sampling_rate_limits_name_the_field(field: str, bad: float) -> None:
+    tuning = EstimatorConfig(**{field: bad})
+    fado.Estimator("paper", tuning, ts=TS / 10)  # ten times faster: fine
+    for make in (
+        lambda: fado.Estimator("paper", tuning, ts=TS),
+        lambda: fado.estimate(*[np.zeros(2)] * 4, machine="paper", config=tuning, ts=TS),
+    ):
+        with pytest.raises(ValueError, match=field) as info:
+            make()
+        assert isinstance(info.value, fado.ConfigError)
+        assert info.value.field == field
+
+
+@pytest.mark.parametrize(
+    ("field", "bad"),
+    [
+        ("limiter_radius_ratio", 0.9),  # the limiter would clamp λ̂f itself
+        ("mode_hysteresis_ratio", 0.016),  # wider than the 0.015 threshold
+    ],
+)
+def test_ordering_limits_name_the_field(field: str, bad: float) -> None:
     with pytest.raises(ValueError, match=field) as info:
         EstimatorConfig(**{field: bad})
     assert isinstance(info.value, fado.ConfigError)
@@ -265,3 +328,149 @@ def test_dict_config_errors_are_located_in_its_toml() -> None:
         fado.simulate("fig11", {"mismatch": {"rs_ratio": -1.0}}, averaged=True)
     assert info.value.field == "mismatch.rs_ratio"
     assert info.value.line == 2
+
+
+def test_config_as_a_dict_works_as_in_simulate() -> None:
+    """Flat tuning keys, the [estimator] table of a simulator config, or dotted keys: the same
+    tuning; the simulator's other tables are not the estimator's and are skipped."""
+    rng = np.random.default_rng(3)
+    signals = [rng.normal(size=500) for _ in range(4)]
+    expected = fado.estimate(*signals, machine="paper", config=EstimatorConfig(k_df=1.0))
+    for config in (
+        {"k_df": 1.0},
+        {"estimator": {"k_df": 1.0}},
+        {"estimator.k_df": 1.0},
+        {"estimator": {"k_df": 1.0}, "simulation": {"duration": 1.0}, "mismatch.rs_ratio": 1.1},
+    ):
+        got = fado.estimate(*signals, machine="paper", config=config)
+        np.testing.assert_array_equal(got.theta, expected.theta, strict=True)
+        assert fado.Estimator("paper", config).config == EstimatorConfig(k_df=1.0)
+    default = fado.estimate(*signals, machine="paper")
+    assert not np.array_equal(default.theta, expected.theta)
+    # The same dict drives the simulator's estimator.
+    sim_config = {"estimator": {"k_df": 1.0}, "simulation": {"duration": 0.05}}
+    assert fado.simulate("fig11", sim_config, averaged=True).estimator_config.k_df == 1.0
+
+
+@pytest.mark.parametrize(
+    ("config", "key"),
+    [({"k_dff": 1.0}, "k_dff"), ({"estimator": {"kdf": 1.0}}, "estimator.kdf")],
+)
+def test_unknown_dict_keys_raise_naming_them(config: dict[str, object], key: str) -> None:
+    with pytest.raises(fado.ConfigError) as info:
+        fado.Estimator("paper", config)
+    assert info.value.field == key
+
+
+def test_machine_fields_and_paper_preset() -> None:
+    paper = fado.Machine.paper()
+    assert_fields(paper.to_dict(), PAPER_MACHINE)
+    assert list(fado.Machine.fields) == list(PAPER_MACHINE)
+    assert fado.Machine.preset("paper") == paper
+    assert fado.Machine(**PAPER_MACHINE) == paper
+    assert not paper.salient
+
+
+def test_machine_is_keyword_only_with_required_fields() -> None:
+    params = inspect.signature(fado.Machine).parameters
+    assert set(params) == set(PAPER_MACHINE)
+    assert all(p.kind is inspect.Parameter.KEYWORD_ONLY for p in params.values())
+    required = {n for n, p in params.items() if p.default is inspect.Parameter.empty}
+    assert required == set(PAPER_MACHINE) - {"viscous_friction"}
+    assert fado.Machine(**IPMSM).viscous_friction == 0.0
+    for missing in required:
+        with pytest.raises(TypeError, match=missing):
+            fado.Machine(**{k: v for k, v in IPMSM.items() if k != missing})
+
+
+def test_machine_immutable_replace_and_round_trips() -> None:
+    m = fado.Machine(**IPMSM)
+    assert m.salient
+    with pytest.raises(AttributeError):
+        m.rs = 1.0  # type: ignore[misc]
+    hot = m.replace(rs=4.3)
+    assert hot.rs == 4.3 and hot.lq == m.lq and m.rs == 3.6
+    assert fado.Machine(**m.to_dict()) == m
+    assert eval(repr(m), {"Machine": fado.Machine}) == m
+    assert pickle.loads(pickle.dumps(m)) == m
+    assert copy.deepcopy(m) == m
+
+
+@pytest.mark.parametrize(
+    ("field", "bad"),
+    [
+        ("rs", -0.1),
+        ("ld", 0.0),
+        ("lq", math.nan),
+        ("flux_linkage", -0.5),
+        ("pole_pairs", 0),
+        ("pole_pairs", -3),
+        ("inertia", math.inf),
+        ("viscous_friction", -1e-3),
+        ("rated_current", 0.0),
+        ("rated_speed_rpm", -1500.0),
+        ("rated_torque", math.nan),
+        ("dc_voltage", 0.0),
+        # Unit slips: a flux linkage in mWb, a current in mA, a 24 V link for a 540 V motor.
+        ("flux_linkage", 545.0),
+        ("rated_current", 6080.0),
+        ("dc_voltage", 24.0),
+    ],
+)
+def test_machine_validation_names_the_field(field: str, bad: float) -> None:
+    with pytest.raises(ValueError) as info:
+        fado.Machine(**dict(IPMSM, **{field: bad}))
+    err = info.value
+    assert isinstance(err, fado.ConfigError)
+    # A unit slip shows as a rated torque or back-EMF that does not fit the other ratings.
+    slips = {"flux_linkage": {"flux_linkage", "rated_torque"}, "rated_current": {"rated_torque"},
+             "dc_voltage": {"dc_voltage", "flux_linkage"}}
+    assert err.field in slips.get(field, set()) | {field}
+    assert err.field in str(err)
+    with pytest.raises(fado.ConfigError):
+        fado.Machine(**IPMSM).replace(**{field: bad})
+
+
+def test_machine_presets() -> None:
+    names = fado.machine_presets()
+    assert names == sorted(names) and len(names) >= 5
+    assert {"paper", "ipmsm-2k2"} <= set(names)
+    for name in names:
+        m = fado.Machine.preset(name)
+        assert isinstance(m, fado.Machine) and m == fado.Machine(**m.to_dict())
+    ipm = fado.Machine.preset("ipmsm-2k2")
+    assert (ipm.ld, ipm.lq, ipm.pole_pairs, ipm.dc_voltage) == (0.036, 0.051, 3, 540.0)
+    with pytest.raises(ValueError, match="ipmsm-2k2") as info:
+        fado.Machine.preset("ipmsm")
+    assert isinstance(info.value, fado.ConfigError)
+
+
+def test_machine_argument_forms() -> None:
+    rng = np.random.default_rng(5)
+    signals = [rng.normal(size=300) for _ in range(4)]
+    by_object = fado.estimate(*signals, machine=fado.Machine(**IPMSM))
+    by_dict = fado.estimate(*signals, machine=IPMSM)
+    np.testing.assert_array_equal(by_object.theta, by_dict.theta, strict=True)
+    # The preset differs from IPMSM only by its viscous friction, which the estimator does not
+    # use; its resistance does matter.
+    by_preset = fado.estimate(*signals, machine="ipmsm-2k2")
+    np.testing.assert_array_equal(by_preset.theta, by_object.theta, strict=True)
+    hot = fado.estimate(*signals, machine=dict(IPMSM, rs=4.3))
+    assert not np.array_equal(hot.lambda1_alpha, by_object.lambda1_alpha)
+    with pytest.raises(fado.ConfigError) as info:
+        fado.estimate(*signals, machine=dict(IPMSM, rs_hat=3.6))
+    assert info.value.field == "rs_hat"
+    with pytest.raises(fado.ConfigError, match="paper"):
+        fado.estimate(*signals, machine="no-such-motor")
+    with pytest.raises(TypeError, match="machine"):
+        fado.estimate(*signals, machine=3.6)  # type: ignore[arg-type]
+
+
+def test_estimate_and_estimator_without_machine_raise_naming_it() -> None:
+    x = np.zeros(4)
+    with pytest.raises(TypeError, match="machine"):
+        fado.estimate(x, x, x, x)  # type: ignore[call-arg]
+    with pytest.raises(TypeError, match="machine"):
+        fado.estimate(x, x, x, x, machine=None)  # type: ignore[arg-type]
+    with pytest.raises(TypeError, match="machine"):
+        fado.Estimator()  # type: ignore[call-arg]

@@ -19,11 +19,11 @@ def good() -> list[np.ndarray]:
 
 
 def via_estimate(*signals: object) -> object:
-    return fado.estimate(*signals)  # type: ignore[arg-type]
+    return fado.estimate(*signals, machine="paper")  # type: ignore[arg-type]
 
 
 def via_run(*signals: object) -> object:
-    return fado.Estimator().run(*signals)  # type: ignore[arg-type]
+    return fado.Estimator("paper").run(*signals)  # type: ignore[arg-type]
 
 
 BAD = {
@@ -66,11 +66,11 @@ def test_bad_input_names_the_argument(
 def test_messages_say_how_to_fix_it() -> None:
     x = good()
     with pytest.raises(fado.InputError, match="ascontiguousarray"):
-        fado.estimate(x[0][::2], x[1][::2], x[2][::2], x[3][::2])
+        fado.estimate(x[0][::2], x[1][::2], x[2][::2], x[3][::2], machine="paper")
     with pytest.raises(fado.InputError, match="float64 or float32"):
-        fado.estimate(x[0].astype(int), *x[1:])
+        fado.estimate(x[0].astype(int), *x[1:], machine="paper")
     with pytest.raises(fado.InputError, match="length 63 differs from v_alpha's length 64"):
-        fado.estimate(x[0], x[1][:-1], *x[2:])
+        fado.estimate(x[0], x[1][:-1], *x[2:], machine="paper")
 
 
 def test_readonly_and_shared_arrays_are_accepted_and_untouched() -> None:
@@ -78,8 +78,8 @@ def test_readonly_and_shared_arrays_are_accepted_and_untouched() -> None:
     before = [a.copy() for a in x]
     for a in x:
         a.flags.writeable = False
-    result = fado.estimate(*x)
-    same = fado.estimate(x[0], x[0], x[0], x[0])  # one array for all four arguments
+    result = fado.estimate(*x, machine="paper")
+    same = fado.estimate(x[0], x[0], x[0], x[0], machine="paper")  # one array for all four arguments
     assert len(result) == len(same) == N
     for a, b in zip(x, before):
         np.testing.assert_array_equal(a, b, strict=True)
@@ -88,8 +88,8 @@ def test_readonly_and_shared_arrays_are_accepted_and_untouched() -> None:
 def test_contiguous_slice_of_a_larger_array_is_accepted() -> None:
     big = np.arange(4 * N, dtype=np.float64) * 1e-3
     parts = [big[k * N : (k + 1) * N] for k in range(4)]
-    a = fado.estimate(*parts)
-    b = fado.estimate(*(p.copy() for p in parts))
+    a = fado.estimate(*parts, machine="paper")
+    b = fado.estimate(*(p.copy() for p in parts), machine="paper")
     np.testing.assert_array_equal(a.theta, b.theta, strict=True)
 
 
@@ -98,5 +98,5 @@ def test_mixed_float_dtypes_are_accepted() -> None:
     mixed = [x[0], x[1].astype(np.float32), x[2], x[3].astype(np.float32)]
     converted = [np.asarray(a, dtype=np.float64) for a in mixed]
     np.testing.assert_array_equal(
-        fado.estimate(*mixed).theta, fado.estimate(*converted).theta, strict=True
+        fado.estimate(*mixed, machine="paper").theta, fado.estimate(*converted, machine="paper").theta, strict=True
     )
