@@ -1,10 +1,12 @@
 """Shared fixtures: a synthetic PMSM recording consistent with the estimator's model.
 
 The recording is generated from the motor equations, not from fado: a rotor turning at a
-prescribed electrical speed with a constant d-q current, flux λ = λf·e^{jθ} + L·i (surface
-magnets, Ld = Lq = L) and the voltage that the discrete integrator of SPEC §1 would need,
-v[k] = (λ[k] − λ[k−1])/Ts + R·(i[k] + i[k−1])/2. With matched R̂s, L̂q the estimator should
-recover θ; with any data the bindings must reproduce the Rust estimator bit for bit.
+prescribed electrical speed with a constant d-q current, flux λ = e^{jθ}·(λf + Ld·i_d + j·Lq·i_q)
+(= λf·e^{jθ} + L·i for surface magnets, Ld = Lq = L) and the voltage that the discrete
+integrator of SPEC §1 would need, v[k] = (λ[k] − λ[k−1])/Ts + R·(i[k] + i[k−1])/2. With a
+matched machine model the estimator should recover θ; with any data the bindings must
+reproduce the Rust estimator bit for bit. The default motor is the paper's
+(``fado.Machine.paper()``).
 """
 
 from __future__ import annotations
@@ -42,15 +44,22 @@ def synthetic_recording(
     i_d: float = 0.0,
     i_q: float = 10.0,
     theta0: float = 0.3,
+    *,
+    rs: float = RS,
+    ld: float = LQ,
+    lq: float = LQ,
+    flux: float = FLUX,
 ) -> Recording:
-    """The signals for electrical speed `omega[k]` (rad/s) at every sample k."""
+    """The signals for electrical speed `omega[k]` (rad/s) at every sample k, on a motor with
+    `rs`, `ld`, `lq`, `flux` (default: the paper's)."""
     theta_ext = theta0 + TS * np.concatenate(([0.0], np.cumsum(omega)))  # θ[-1], θ[0], ...
-    i_ext = (i_d + 1j * i_q) * np.exp(1j * theta_ext)
-    flux_ext = FLUX * np.exp(1j * theta_ext) + LQ * i_ext
+    rotor = np.exp(1j * theta_ext)
+    i_ext = (i_d + 1j * i_q) * rotor
+    flux_ext = (flux + ld * i_d + 1j * lq * i_q) * rotor
     i_now, i_prev = i_ext[1:], i_ext[:-1]
-    v = np.diff(flux_ext) / TS + RS * 0.5 * (i_now + i_prev)
+    v = np.diff(flux_ext) / TS + rs * 0.5 * (i_now + i_prev)
     # The estimator has no remembered current on its first sample and uses i[0] alone.
-    v[0] += RS * 0.5 * (i_now[0] - i_prev[0])
+    v[0] += rs * 0.5 * (i_now[0] - i_prev[0])
     return Recording(
         v_alpha=np.ascontiguousarray(v.real),
         v_beta=np.ascontiguousarray(v.imag),
