@@ -110,7 +110,7 @@ def test_estimator_replay_reproduces_the_in_loop_estimate() -> None:
     under 7.5 N·m)."""
     # Without the start-up offset calibration, so that the estimator runs from sample 0 on the
     # raw measured currents the trace records.
-    config = {"simulation": {"decimation": 1}, "controller": {"offset_calibration_samples": 0}}
+    config = {"simulation": {"decimation": 1}, "controller": {"offset_calibration_time": 0.0}}
     result = fado.simulate("fig11", config, averaged=True)
     tr = result.traces
     assert not tr["tripped"].any()
@@ -120,7 +120,9 @@ def test_estimator_replay_reproduces_the_in_loop_estimate() -> None:
     def delayed(x: np.ndarray) -> np.ndarray:
         return np.concatenate(([0.0, 0.0], x[:-2]))
 
-    est = fado.Estimator(result.estimator_config)
+    assert result.machine == fado.Machine.paper().replace(rs=result.machine.rs)
+    assert result.ts == 1e-4 and result.theta0 == 0.3
+    est = fado.Estimator(result.machine, result.estimator_config, ts=result.ts)
     # The drive aligns at the plant's initial angle (align_error = 0) with zero current.
     est.align(float(tr["theta"][0]), 0.0, 0.0)
     out = est.run(
@@ -132,7 +134,7 @@ def test_estimator_replay_reproduces_the_in_loop_estimate() -> None:
     np.testing.assert_array_equal(out.disturbance_beta, tr["dist_beta"])
     np.testing.assert_array_equal(out.lambda_r_alpha, tr["lambda_r_alpha"])
     assert np.array_equal(out.flag_limit, tr["flag_limit"] == 1.0)
-    pole_pairs = 4.0
+    pole_pairs = float(result.machine.pole_pairs)
     rpm = out.omega / pole_pairs * 60.0 / (2.0 * math.pi)
     np.testing.assert_allclose(rpm, tr["speed_hat1_rpm"], rtol=1e-12, atol=1e-9)
     # The replay is meaningful: the estimator did track the true angle near zero speed.
@@ -221,7 +223,18 @@ def test_missing_config_file_is_reported() -> None:
 
 def test_sim_result_api() -> None:
     result = fado.simulate("fig10", {"simulation": {"duration": 0.3}}, averaged=True)
-    assert fado.scenarios() == ["fig8", "fig9", "fig10", "fig11", "fig12", "steady300", "lowspeed"]
+    assert fado.scenarios() == [
+        "fig8",
+        "fig9",
+        "fig10",
+        "fig11",
+        "fig12",
+        "steady300",
+        "lowspeed",
+        "reversal",
+        "stops",
+        "rated-reversal",
+    ]
     assert "Fig. 10" in fado.describe_scenario("fig10")["title"]
     assert list(result.traces) == fado.TRACE_COLUMNS
     np.testing.assert_allclose(result.time, np.arange(len(result)) * 1e-3, rtol=0, atol=1e-12)
@@ -282,3 +295,44 @@ def test_simulation_releases_the_gil() -> None:
     gaps = np.diff(stamps)
     assert wall[0] > 0.05, "the simulation was too short to judge"
     assert gaps.max() < 0.5 * wall[0], (gaps.max(), wall[0])
+
+
+def test_motor_preset_is_the_cli_with_the_preset_file(fado_sim_cli: Path, tmp_path: Path) -> None:
+    """`simulate(motor="ipmsm-2k2")` is `fado-sim run --config motors/ipmsm-2k2.toml`: the
+    preset's file under the user's configuration, bit for bit."""
+    preset = (ROOT / "motors" / "ipmsm-2k2.toml").read_text(encoding="utf-8")
+    out = run_cli(fado_sim_cli, tmp_path, "reversal", preset + "\n" + SHORT, True)
+    result = fado.simulate("reversal", SHORT, averaged=True, motor="ipmsm-2k2")
+    _, columns = read_traces_csv(out / "traces.csv")
+    for name in ("theta", "theta_hat", "speed_rpm", "i_alpha", "v_alpha_ref"):
+        np.testing.assert_array_equal(result.traces[name], columns[name], err_msg=name)
+    cli_metrics = json.loads((out / "metrics.json").read_text(encoding="utf-8"))
+    ours = result.metrics
+    assert cli_metrics.pop("wall_seconds") > 0 and ours.pop("wall_seconds") > 0
+    assert ours == cli_metrics
+    ipm = fado.Machine.preset("ipmsm-2k2")
+    assert result.machine.pole_pairs == 3 and result.machine.lq == ipm.lq
+    assert result.machine.dc_voltage == 540.0
+
+
+def test_motor_machine_sets_motor_and_dc_link() -> None:
+    ipm = fado.Machine.preset("ipmsm-2k2")
+    short = {"simulation": {"duration": 0.05}}
+    by_machine = fado.simulate("reversal", short, averaged=True, motor=ipm)
+    assert by_machine.machine.ld == ipm.ld and by_machine.machine.dc_voltage == 540.0
+    assert "rated_torque = 14.0" in by_machine.config_toml
+    assert "dc_voltage = 540.0" in by_machine.config_toml
+    # The user's keys win over the motor's.
+    hot = fado.simulate("reversal", dict(short, motor={"rs": 4.0}), averaged=True, motor=ipm)
+    assert "rs = 4.0" in hot.config_toml
+    # The same motor as default_config sees it.
+    assert "rated_current = 6.08" in fado.default_config("reversal", motor=ipm)
+    assert "rated_current = 6.08" in fado.default_config("stops", motor="ipmsm-2k2")
+
+
+def test_bad_motor_raises_naming_it() -> None:
+    with pytest.raises(ValueError, match="ipmsm-2k2") as info:
+        fado.simulate("reversal", motor="no-such-motor")
+    assert isinstance(info.value, fado.InputError) and info.value.argument == "motor"
+    with pytest.raises(TypeError, match="motor"):
+        fado.simulate("reversal", motor=3.0)  # type: ignore[arg-type]
