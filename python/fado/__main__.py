@@ -5,8 +5,10 @@ table) and ``python -m fado simulate`` (one scenario).
 
     python -m fado reproduce --out out/repro [--averaged] [--scenarios fig8,fig11]
     python -m fado simulate fig11 [--config my.toml] [--averaged] [--out DIR] [--plot]
+    python -m fado simulate reversal --motor ipmsm-2k2
     python -m fado scenarios
-    python -m fado default-config fig11 [--averaged]
+    python -m fado motors
+    python -m fado default-config fig11 [--averaged] [--motor NAME]
 
 Exit codes: 0 success (``simulate``: criteria passed), 1 criteria failed (``simulate`` only;
 ``reproduce`` reports failures in its table), 2 usage or configuration error.
@@ -20,7 +22,14 @@ import sys
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
-from fado._fado import FadoError, default_config, describe_scenario, scenarios
+from fado._fado import (
+    FadoError,
+    Machine,
+    default_config,
+    describe_scenario,
+    machine_presets,
+    scenarios,
+)
 from fado._simulation import simulate
 
 
@@ -57,15 +66,18 @@ def _parser() -> argparse.ArgumentParser:
     s = sub.add_parser("simulate", help="run one scenario and print its metrics")
     s.add_argument("scenario", help="scenario name (see `scenarios`)")
     s.add_argument("--config", type=Path, help="TOML file overriding the scenario")
+    s.add_argument("--motor", help="motor preset (see `motors`) replacing the paper's motor")
     s.add_argument("--averaged", action="store_true", help="averaged inverter model (fast)")
     s.add_argument("--out", type=Path, help="write DIR/metrics.json and DIR/traces.csv")
     s.add_argument("--plot", action="store_true", help="also write DIR/SCENARIO.png")
 
     sub.add_parser("scenarios", help="list the scenarios")
+    sub.add_parser("motors", help="list the motor presets")
 
     d = sub.add_parser("default-config", help="print a scenario's configuration as TOML")
     d.add_argument("scenario")
     d.add_argument("--averaged", action="store_true")
+    d.add_argument("--motor", help="motor preset replacing the paper's motor")
     return p
 
 
@@ -89,8 +101,17 @@ def main(argv: Sequence[str] | None = None) -> int:
                 info = describe_scenario(name)
                 print(f"{name:<7} {info['title']}\n        criterion: {info['criterion']}")
             return 0
+        if args.command == "motors":
+            for name in machine_presets():
+                m = Machine.preset(name)
+                print(
+                    f"{name:<22} p={m.pole_pairs:<3} Rs={m.rs:g} Ω  Ld={m.ld:g} H  "
+                    f"Lq={m.lq:g} H  λf={m.flux_linkage:g} Wb  {m.rated_current:g} A  "
+                    f"{m.rated_speed_rpm:g} r/min  {m.rated_torque:g} N·m  {m.dc_voltage:g} V"
+                )
+            return 0
         if args.command == "default-config":
-            print(default_config(args.scenario, args.averaged), end="")
+            print(default_config(args.scenario, args.averaged, motor=args.motor), end="")
             return 0
         if args.command == "reproduce":
             from fado.reproduce import reproduce
@@ -104,7 +125,9 @@ def main(argv: Sequence[str] | None = None) -> int:
             )
             return 0
         # simulate
-        result = simulate(args.scenario, args.config, args.averaged, progress=True)
+        result = simulate(
+            args.scenario, args.config, args.averaged, progress=True, motor=args.motor
+        )
         metrics = result.metrics
         print(json.dumps({k: v for k, v in metrics.items() if k != "checks"}, indent=2))
         for c in result.checks:

@@ -62,7 +62,7 @@ def compare(
     ``["fado", "fado-fixed-rs", "lpf-integrator", "ortega", "emf-observer"]``
     (``fado-fixed-rs``: fado with the paper's fixed R̂s). ``averaged`` selects the fast
     averaged inverter model. ``config`` is TOML applied over every scenario (its
-    ``[estimator] kind`` is replaced by each estimator). ``traces`` keeps each run's 1 kHz
+    ``[simulation] estimator`` is replaced by each estimator). ``traces`` keeps each run's 1 kHz
     trace (a dict of arrays) under ``"trace"``. Raises :class:`fado.ConfigError`.
     """
     rows = _fado.compare(

@@ -127,7 +127,8 @@ def _lambda2(ax: Axes, r: SimResult) -> None:
 
 def _rotor_flux(ax: Axes, r: SimResult) -> None:
     t = _col(r, "time")
-    radius = r.estimator_config.limiter_radius_ratio * r.machine.flux_linkage
+    ratio = r.estimator_config.limiter_radius_ratio
+    radius = ratio * r.machine.flux_linkage
     a, b = _col(r, "lambda_r_alpha"), _col(r, "lambda_r_beta")
     ax.plot(t, a, color="C0", lw=1.0, label="λ̂r α")
     ax.plot(t, b, color="C1", lw=1.0, label="λ̂r β")
@@ -138,7 +139,7 @@ def _rotor_flux(ax: Axes, r: SimResult) -> None:
             color="C3",
             ls=":",
             lw=1.0,
-            label=f"±{cfg.limiter_radius_ratio:g}·λ̂f" if sign > 0 else None,
+            label=f"±{ratio:g}·λ̂f" if sign > 0 else None,
         )
     ax.set_ylabel("λ̂r\n(Wb)")
 

@@ -336,3 +336,15 @@ def test_bad_motor_raises_naming_it() -> None:
     assert isinstance(info.value, fado.InputError) and info.value.argument == "motor"
     with pytest.raises(TypeError, match="motor"):
         fado.simulate("reversal", motor=3.0)  # type: ignore[arg-type]
+
+
+def test_cli_lists_motors_and_simulates_one(capsys: pytest.CaptureFixture[str]) -> None:
+    from fado.__main__ import main
+
+    assert main(["motors"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert [line.split()[0] for line in lines] == fado.machine_presets()
+    assert main(["default-config", "reversal", "--motor", "ipmsm-2k2"]) == 0
+    assert "rated_current = 6.08" in capsys.readouterr().out
+    assert main(["default-config", "reversal", "--motor", "nope"]) == 2
+    assert "ipmsm-2k2" in capsys.readouterr().err

@@ -18,7 +18,7 @@ use crate::errors::config_error_message;
 /// max_speed_error_rpm, tripped, lowest_speed_held_rpm (``None`` outside ``lowspeed``),
 /// levels (list of dicts), checks (list of dicts), simulated_seconds, wall_seconds and, with
 /// ``traces=True``, trace (dict of 1-D float64 arrays, the ``traces.csv`` columns).
-/// ``config`` is TOML applied over every scenario (its ``[estimator] kind`` is replaced).
+/// ``config`` is TOML applied over every scenario (its ``[simulation] estimator`` is replaced).
 /// Raises ``ConfigError`` naming the key for an unknown scenario, estimator or bad TOML.
 #[pyfunction]
 #[pyo3(
