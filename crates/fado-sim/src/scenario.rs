@@ -18,7 +18,7 @@ use crate::profile::Profile;
 use crate::sim::{Metrics, Plant, Probe, RunStats, Sample, Simulation, Trace};
 
 /// A named experiment.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug)]
 pub struct Scenario {
     /// Name on the command line (`fig11`).
     pub name: &'static str,
@@ -32,7 +32,24 @@ pub struct Scenario {
     /// so that the scenario runs for any motor; otherwise it is the paper's in absolute
     /// units (r/min, N·m of its motor).
     pub scaled: bool,
+    /// Sets the profile, load, duration and evaluation window on a configuration (a scaled
+    /// scenario from its `[motor]` ratings).
+    pub setup: fn(&mut SimConfig),
+    /// Sets up what the scenario's probe records beyond the common metrics (a hold window,
+    /// staircase levels).
+    pub observe: fn(&SimConfig, &mut ScenarioProbe),
+    /// Appends the scenario's pass criteria for a finished run (after the common "tripped").
+    pub checks: fn(&SimConfig, &Metrics, &ScenarioProbe, &mut Vec<Check>),
 }
+
+impl PartialEq for Scenario {
+    /// Scenarios are named values: equal when their names are.
+    fn eq(&self, other: &Self) -> bool {
+        self.name == other.name
+    }
+}
+
+impl Eq for Scenario {}
 
 /// The five scenarios of SPEC §7 in the paper's units, two of ours for the estimator
 /// comparison ([`crate::compare`]): a medium-speed sanity check under load and a low-speed
@@ -48,6 +65,9 @@ pub const SCENARIOS: [Scenario; 10] = [
                     revolution spent above 30 r/min in HI mode < 2 % of λf; no trip; \
                     speed error < 30 r/min",
         scaled: false,
+        setup: setup_fig8,
+        observe: observe_nothing,
+        checks: checks_fig8,
     },
     Scenario {
         name: "fig9",
@@ -57,6 +77,9 @@ pub const SCENARIOS: [Scenario; 10] = [
         criterion: "λ1 drifts while off (|ΔD̂| > 2 mWb) and recovers with τ ≈ 2 s \
                     (residual after 2 s in [0.2, 0.55]); |θ − θ̂| < 0.05 rad",
         scaled: false,
+        setup: setup_fig9,
+        observe: observe_nothing,
+        checks: checks_fig9,
     },
     Scenario {
         name: "fig10",
@@ -65,6 +88,9 @@ pub const SCENARIOS: [Scenario; 10] = [
         criterion: "|θ − θ̂| < 0.35 rad (does not diverge); |λ̂r| ≤ 1.15·λ̂f (+1 %); \
                     FLAG_limit high ≥ 95 % of the hold",
         scaled: false,
+        setup: setup_fig10,
+        observe: observe_fig10,
+        checks: checks_fig10,
     },
     Scenario {
         name: "fig11",
@@ -73,6 +99,9 @@ pub const SCENARIOS: [Scenario; 10] = [
         criterion: "|θ − θ̂| < 0.25 rad near zero speed (|n| < 30 r/min) [P]; no trip; \
                     speed error < 30 r/min",
         scaled: false,
+        setup: setup_fig11,
+        observe: observe_nothing,
+        checks: checks_fig11,
     },
     Scenario {
         name: "fig12",
@@ -81,6 +110,9 @@ pub const SCENARIOS: [Scenario; 10] = [
                   0 → 60, 500 ms at 60)",
         criterion: "no trip or instability [P]; |θ − θ̂| < 0.25 rad [A]; speed error < 30 r/min",
         scaled: false,
+        setup: setup_fig12,
+        observe: observe_nothing,
+        checks: checks_fig12,
     },
     Scenario {
         name: "steady300",
@@ -88,6 +120,9 @@ pub const SCENARIOS: [Scenario; 10] = [
         profile: "0 → 300 r/min in 1 s, T_L → 7.5 N·m over [1.5 s, 2 s], hold to 4 s",
         criterion: "settled (from 2.5 s) |θ − θ̂| < 0.05 rad; speed error < 10 r/min; no trip",
         scaled: false,
+        setup: setup_steady300,
+        observe: observe_nothing,
+        checks: checks_steady300,
     },
     Scenario {
         name: "lowspeed",
@@ -99,6 +134,9 @@ pub const SCENARIOS: [Scenario; 10] = [
                     the lowest level held together with every level above it; the scenario \
                     passes when every level is held",
         scaled: false,
+        setup: setup_lowspeed,
+        observe: observe_lowspeed,
+        checks: checks_lowspeed,
     },
     Scenario {
         name: "reversal",
@@ -108,6 +146,9 @@ pub const SCENARIOS: [Scenario; 10] = [
         criterion: "|θ − θ̂| < 0.25 rad near zero speed (|n| < 2 % of rated) [P]; no trip; \
                     speed error < 2 % of rated speed",
         scaled: true,
+        setup: setup_reversal,
+        observe: observe_nothing,
+        checks: checks_reversal,
     },
     Scenario {
         name: "stops",
@@ -117,6 +158,9 @@ pub const SCENARIOS: [Scenario; 10] = [
         criterion: "no trip or instability [P]; |θ − θ̂| < 0.25 rad [A]; speed error < 2 % \
                     of rated speed",
         scaled: true,
+        setup: setup_stops,
+        observe: observe_nothing,
+        checks: checks_stops,
     },
     Scenario {
         name: "rated-reversal",
@@ -124,6 +168,9 @@ pub const SCENARIOS: [Scenario; 10] = [
         profile: "as `reversal` with T_L → 100 % of rated torque",
         criterion: "as `reversal`",
         scaled: true,
+        setup: setup_rated_reversal,
+        observe: observe_nothing,
+        checks: checks_rated_reversal,
     },
 ];
 
@@ -180,274 +227,360 @@ impl Scenario {
     /// `base` with this scenario's profile, load, duration and evaluation window; a scaled
     /// scenario takes them from `base.motor`'s ratings.
     pub fn apply(&self, mut c: SimConfig) -> SimConfig {
-        let pts = Profile::from_points;
-        let (n_rated, t_rated) = (c.motor.rated_speed_rpm, c.motor.rated_torque);
-        match self.name {
-            "fig8" => {
-                c.speed_reference = pts(&[
-                    (0.0, 0.0),
-                    (0.5, 0.0),
-                    (1.5, 90.0),
-                    (3.0, 90.0),
-                    (5.0, -90.0),
-                ]);
-                c.load.torque = pts(&[(1.5, 0.0), (2.0, 2.0)]);
-                c.simulation.duration = 6.5;
-                c.simulation.eval_start = 2.5;
-            }
-            "fig9" => {
-                c.speed_reference = pts(&[(0.0, 0.0), (0.3, 0.0), (1.3, -300.0)]);
-                c.load.torque = pts(&[(1.3, 0.0), (1.8, -3.0)]);
-                c.simulation.duration = 11.0;
-                c.simulation.eval_start = 2.0;
-                c.simulation.disturbance_feedback_off = vec![[3.0, 5.0]];
-                // Fig. 9 shows what k_df does against an integrand error; the start-up offset
-                // calibration is off so that the uncalibrated 20 / −10 mA sensor offsets
-                // provide one of visible size \[A\]. (Calibrated, λ1 drifts only 1–3 mWb in
-                // the 2 s: too little for the drift check, and the recovery ratio is then
-                // dominated by noise.)
-                c.controller.offset_calibration_time = 0.0;
-            }
-            "fig10" => {
-                c.speed_reference =
-                    pts(&[(0.0, 0.0), (0.2, 0.0), (0.7, 60.0), (1.2, 60.0), (1.7, 0.0)]);
-                c.simulation.duration = 5.5;
-                c.simulation.eval_start = 0.2;
-            }
-            "fig11" => {
-                c.speed_reference = pts(&[
-                    (0.0, 0.0),
-                    (0.2, 0.0),
-                    (1.2, -90.0),
-                    (2.5, -90.0),
-                    (4.5, 90.0),
-                ]);
-                c.load.torque = pts(&[(1.2, 0.0), (1.7, 7.5)]);
-                c.simulation.duration = 5.5;
-                c.simulation.eval_start = 2.0;
-            }
-            "fig12" => {
-                let mut p = vec![(0.0, 0.0), (0.2, 0.0), (0.9, 60.0), (2.0, 60.0)];
-                let mut t = 2.0;
-                for _ in 0..3 {
-                    p.extend([
-                        (t + 0.5, 0.0),
-                        (t + 0.8, 0.0),
-                        (t + 1.3, 60.0),
-                        (t + 1.8, 60.0),
-                    ]);
-                    t += 1.8;
-                }
-                c.speed_reference = pts(&p);
-                c.load.torque = pts(&[(0.9, 0.0), (1.4, 7.5)]);
-                c.simulation.duration = t;
-                c.simulation.eval_start = 1.8;
-            }
-            "steady300" => {
-                c.speed_reference = pts(&[(0.0, 0.0), (0.2, 0.0), (1.2, 300.0)]);
-                c.load.torque = pts(&[(1.5, 0.0), (2.0, 7.5)]);
-                c.simulation.duration = 4.0;
-                c.simulation.eval_start = 2.5;
-            }
-            "lowspeed" => {
-                let levels = lowspeed_levels_rpm(n_rated);
-                let mut p = vec![(0.0, 0.0), (0.2, 0.0), (0.9, levels[0])];
-                let mut t = LOWSPEED_START;
-                let mut prev = levels[0];
-                for level in levels {
-                    p.extend([(t, prev), (t + LOWSPEED_RAMP_SECONDS, level)]);
-                    prev = level;
-                    t += LOWSPEED_LEVEL_SECONDS;
-                }
-                p.push((t, prev));
-                c.speed_reference = pts(&p);
-                c.load.torque = pts(&[(0.9, 0.0), (1.4, SCALED_LOAD_RATIO * t_rated)]);
-                c.simulation.duration = t;
-                c.simulation.eval_start = LOWSPEED_START;
-            }
-            "reversal" | "rated-reversal" => {
-                // fig11 in units of the ratings: 90 r/min = 6 %, 7.5 N·m = 65.2 %.
-                let n = REVERSAL_SPEED_RATIO * n_rated;
-                let load = if self.name == "reversal" {
-                    SCALED_LOAD_RATIO
-                } else {
-                    1.0
-                };
-                c.speed_reference = pts(&[(0.0, 0.0), (0.2, 0.0), (1.2, -n), (2.5, -n), (4.5, n)]);
-                c.load.torque = pts(&[(1.2, 0.0), (1.7, load * t_rated)]);
-                c.simulation.duration = 5.5;
-                c.simulation.eval_start = 2.0;
-            }
-            "stops" => {
-                // fig12 in units of the ratings: 60 r/min = 4 %, 7.5 N·m = 65.2 %.
-                let n = STOPS_SPEED_RATIO * n_rated;
-                let mut p = vec![(0.0, 0.0), (0.2, 0.0), (0.9, n), (2.0, n)];
-                let mut t = 2.0;
-                for _ in 0..3 {
-                    p.extend([(t + 0.5, 0.0), (t + 0.8, 0.0), (t + 1.3, n), (t + 1.8, n)]);
-                    t += 1.8;
-                }
-                c.speed_reference = pts(&p);
-                c.load.torque = pts(&[(0.9, 0.0), (1.4, SCALED_LOAD_RATIO * t_rated)]);
-                c.simulation.duration = t;
-                c.simulation.eval_start = 1.8;
-            }
-            _ => unreachable!("every scenario in SCENARIOS has a profile"),
-        }
+        (self.setup)(&mut c);
         c
     }
 
     fn probe(&self, cfg: &SimConfig) -> ScenarioProbe {
         let mut p = ScenarioProbe::new(cfg.simulation.eval_start, cfg.zero_speed_band_rpm());
-        if self.name == "fig10" {
-            p.hold = Some((2.0, cfg.simulation.duration));
-        }
-        if self.name == "lowspeed" {
-            p.levels = lowspeed_levels_rpm(cfg.motor.rated_speed_rpm)
-                .iter()
-                .enumerate()
-                .map(|(k, &level)| {
-                    let to = LOWSPEED_START + (k + 1) as f64 * LOWSPEED_LEVEL_SECONDS;
-                    LevelStats::new(level, to - LOWSPEED_JUDGED_SECONDS, to)
-                })
-                .collect();
-        }
+        (self.observe)(cfg, &mut p);
         p
     }
 
     /// Checks the pass criteria on a finished run.
     pub fn evaluate(&self, cfg: &SimConfig, m: &Metrics, p: &ScenarioProbe) -> Vec<Check> {
-        let lf = cfg.motor.flux_linkage;
         let mut checks = vec![Check::at_most("tripped", m.tripped as u8 as f64, 0.0)];
-        match self.name {
-            "fig8" => {
-                checks.push(Check::at_most(
-                    "max |DC(λ2 − λs)| / λf",
-                    p.max_block_dc / lf,
-                    0.02,
-                ));
-                checks.push(Check::at_least(
-                    "revolutions evaluated",
-                    p.blocks as f64,
-                    4.0,
-                ));
-                // No loss of control: without it an estimator that runs the machine away
-                // (as the EMF baseline does) could still show a centred λ2.
-                checks.push(Check::at_most(
-                    "max speed error (r/min)",
-                    m.max_speed_error_rpm,
-                    30.0,
-                ));
-            }
-            "fig9" => {
-                if let Some(&[t_off, t_on]) = cfg.simulation.disturbance_feedback_off.first() {
-                    let d = |t: f64| p.disturbance_at(t);
-                    let end = d(cfg.simulation.duration);
-                    let drift = (d(t_on) - d(t_off)).norm();
-                    let residual = (d(t_on + 2.0) - end).norm() / (d(t_on) - end).norm().max(1e-12);
-                    checks.push(Check::at_least("λ1 drift while k_df off (Wb)", drift, 2e-3));
-                    checks.push(Check::within(
-                        "recovery residual after 2 s",
-                        residual,
-                        0.2,
-                        0.55,
-                    ));
-                } else {
-                    // Without the k_df-off window there is no Fig. 9 experiment to judge.
-                    checks.push(Check::at_least("k_df-off windows configured", 0.0, 1.0));
-                }
-                checks.push(Check::at_most("max |θ − θ̂| (rad)", m.max_angle_error, 0.05));
-            }
-            "fig10" => {
-                checks.push(Check::at_most("max |θ − θ̂| (rad)", m.max_angle_error, 0.35));
-                checks.push(Check::at_most(
-                    "max |λ̂r| / (1.15·λ̂f)",
-                    p.max_lambda_r
-                        / (cfg.estimator.limiter_radius_ratio * cfg.machine_model().flux_linkage),
-                    1.01,
-                ));
-                checks.push(Check::at_least(
-                    "FLAG_limit fraction of the hold",
-                    p.flag_fraction(),
-                    0.95,
-                ));
-            }
-            "fig11" => {
-                checks.push(Check::at_most(
-                    "max |θ − θ̂| near zero speed (rad)",
-                    m.max_angle_error_zero_speed,
-                    0.25,
-                ));
-                checks.push(Check::at_least(
-                    "samples near zero speed",
-                    m.zero_speed_samples as f64,
-                    1000.0,
-                ));
-                checks.push(Check::at_most(
-                    "max speed error (r/min)",
-                    m.max_speed_error_rpm,
-                    30.0,
-                ));
-            }
-            "fig12" => {
-                checks.push(Check::at_most("max |θ − θ̂| (rad)", m.max_angle_error, 0.25));
-                checks.push(Check::at_most(
-                    "max speed error (r/min)",
-                    m.max_speed_error_rpm,
-                    30.0,
-                ));
-            }
-            "steady300" => {
-                checks.push(Check::at_most(
-                    "settled max |θ − θ̂| (rad)",
-                    m.max_angle_error,
-                    0.05,
-                ));
-                checks.push(Check::at_most(
-                    "max speed error (r/min)",
-                    m.max_speed_error_rpm,
-                    10.0,
-                ));
-            }
-            "lowspeed" => {
-                checks.push(Check::at_least(
-                    "levels held from 4 % of rated speed down",
-                    p.levels_held_in_a_row() as f64,
-                    p.levels.len() as f64,
-                ));
-            }
-            "reversal" | "rated-reversal" => {
-                let band = SCALED_SPEED_ERROR_RATIO * cfg.motor.rated_speed_rpm;
-                checks.push(Check::at_most(
-                    "max |θ − θ̂| near zero speed (rad)",
-                    m.max_angle_error_zero_speed,
-                    0.25,
-                ));
-                // 0.1 s of samples at least in the band (fig11: 0.67 s).
-                checks.push(Check::at_least(
-                    "samples near zero speed",
-                    m.zero_speed_samples as f64,
-                    0.1 / cfg.inverter.sample_period(),
-                ));
-                checks.push(Check::at_most(
-                    "max speed error (r/min)",
-                    m.max_speed_error_rpm,
-                    band,
-                ));
-            }
-            "stops" => {
-                let band = SCALED_SPEED_ERROR_RATIO * cfg.motor.rated_speed_rpm;
-                checks.push(Check::at_most("max |θ − θ̂| (rad)", m.max_angle_error, 0.25));
-                checks.push(Check::at_most(
-                    "max speed error (r/min)",
-                    m.max_speed_error_rpm,
-                    band,
-                ));
-            }
-            _ => unreachable!(),
-        }
+        (self.checks)(cfg, m, p, &mut checks);
         checks
     }
+}
+
+/// No probe beyond the common one.
+fn observe_nothing(_cfg: &SimConfig, _p: &mut ScenarioProbe) {}
+
+/// `fig10`: the standstill hold, from 2 s to the end.
+fn observe_fig10(cfg: &SimConfig, p: &mut ScenarioProbe) {
+    p.hold = Some((2.0, cfg.simulation.duration));
+}
+
+/// `lowspeed`: the judged window of each staircase level.
+fn observe_lowspeed(cfg: &SimConfig, p: &mut ScenarioProbe) {
+    p.levels = lowspeed_levels_rpm(cfg.motor.rated_speed_rpm)
+        .iter()
+        .enumerate()
+        .map(|(k, &level)| {
+            let to = LOWSPEED_START + (k + 1) as f64 * LOWSPEED_LEVEL_SECONDS;
+            LevelStats::new(level, to - LOWSPEED_JUDGED_SECONDS, to)
+        })
+        .collect();
+}
+
+/// `fig8`: profile, load, duration, evaluation window.
+fn setup_fig8(c: &mut SimConfig) {
+    let pts = Profile::from_points;
+    c.speed_reference = pts(&[
+        (0.0, 0.0),
+        (0.5, 0.0),
+        (1.5, 90.0),
+        (3.0, 90.0),
+        (5.0, -90.0),
+    ]);
+    c.load.torque = pts(&[(1.5, 0.0), (2.0, 2.0)]);
+    c.simulation.duration = 6.5;
+    c.simulation.eval_start = 2.5;
+}
+
+/// `fig9`: profile, load, duration, evaluation window.
+fn setup_fig9(c: &mut SimConfig) {
+    let pts = Profile::from_points;
+    c.speed_reference = pts(&[(0.0, 0.0), (0.3, 0.0), (1.3, -300.0)]);
+    c.load.torque = pts(&[(1.3, 0.0), (1.8, -3.0)]);
+    c.simulation.duration = 11.0;
+    c.simulation.eval_start = 2.0;
+    c.simulation.disturbance_feedback_off = vec![[3.0, 5.0]];
+    // Fig. 9 shows what k_df does against an integrand error; the start-up offset
+    // calibration is off so that the uncalibrated 20 / −10 mA sensor offsets
+    // provide one of visible size \[A\]. (Calibrated, λ1 drifts only 1–3 mWb in
+    // the 2 s: too little for the drift check, and the recovery ratio is then
+    // dominated by noise.)
+    c.controller.offset_calibration_time = 0.0;
+}
+
+/// `fig10`: profile, load, duration, evaluation window.
+fn setup_fig10(c: &mut SimConfig) {
+    let pts = Profile::from_points;
+    c.speed_reference = pts(&[(0.0, 0.0), (0.2, 0.0), (0.7, 60.0), (1.2, 60.0), (1.7, 0.0)]);
+    c.simulation.duration = 5.5;
+    c.simulation.eval_start = 0.2;
+}
+
+/// `fig11`: profile, load, duration, evaluation window.
+fn setup_fig11(c: &mut SimConfig) {
+    let pts = Profile::from_points;
+    c.speed_reference = pts(&[
+        (0.0, 0.0),
+        (0.2, 0.0),
+        (1.2, -90.0),
+        (2.5, -90.0),
+        (4.5, 90.0),
+    ]);
+    c.load.torque = pts(&[(1.2, 0.0), (1.7, 7.5)]);
+    c.simulation.duration = 5.5;
+    c.simulation.eval_start = 2.0;
+}
+
+/// `fig12`: profile, load, duration, evaluation window.
+fn setup_fig12(c: &mut SimConfig) {
+    let pts = Profile::from_points;
+    let mut p = vec![(0.0, 0.0), (0.2, 0.0), (0.9, 60.0), (2.0, 60.0)];
+    let mut t = 2.0;
+    for _ in 0..3 {
+        p.extend([
+            (t + 0.5, 0.0),
+            (t + 0.8, 0.0),
+            (t + 1.3, 60.0),
+            (t + 1.8, 60.0),
+        ]);
+        t += 1.8;
+    }
+    c.speed_reference = pts(&p);
+    c.load.torque = pts(&[(0.9, 0.0), (1.4, 7.5)]);
+    c.simulation.duration = t;
+    c.simulation.eval_start = 1.8;
+}
+
+/// `steady300`: profile, load, duration, evaluation window.
+fn setup_steady300(c: &mut SimConfig) {
+    let pts = Profile::from_points;
+    c.speed_reference = pts(&[(0.0, 0.0), (0.2, 0.0), (1.2, 300.0)]);
+    c.load.torque = pts(&[(1.5, 0.0), (2.0, 7.5)]);
+    c.simulation.duration = 4.0;
+    c.simulation.eval_start = 2.5;
+}
+
+/// `lowspeed`: profile, load, duration, evaluation window.
+fn setup_lowspeed(c: &mut SimConfig) {
+    let pts = Profile::from_points;
+    let n_rated = c.motor.rated_speed_rpm;
+    let t_rated = c.motor.rated_torque;
+    let levels = lowspeed_levels_rpm(n_rated);
+    let mut p = vec![(0.0, 0.0), (0.2, 0.0), (0.9, levels[0])];
+    let mut t = LOWSPEED_START;
+    let mut prev = levels[0];
+    for level in levels {
+        p.extend([(t, prev), (t + LOWSPEED_RAMP_SECONDS, level)]);
+        prev = level;
+        t += LOWSPEED_LEVEL_SECONDS;
+    }
+    p.push((t, prev));
+    c.speed_reference = pts(&p);
+    c.load.torque = pts(&[(0.9, 0.0), (1.4, SCALED_LOAD_RATIO * t_rated)]);
+    c.simulation.duration = t;
+    c.simulation.eval_start = LOWSPEED_START;
+}
+
+/// `reversal`: profile, load, duration, evaluation window.
+fn setup_reversal(c: &mut SimConfig) {
+    let pts = Profile::from_points;
+    let n_rated = c.motor.rated_speed_rpm;
+    let t_rated = c.motor.rated_torque;
+    // fig11 in units of the ratings: 90 r/min = 6 %, 7.5 N·m = 65.2 %.
+    let n = REVERSAL_SPEED_RATIO * n_rated;
+    let load = SCALED_LOAD_RATIO;
+    c.speed_reference = pts(&[(0.0, 0.0), (0.2, 0.0), (1.2, -n), (2.5, -n), (4.5, n)]);
+    c.load.torque = pts(&[(1.2, 0.0), (1.7, load * t_rated)]);
+    c.simulation.duration = 5.5;
+    c.simulation.eval_start = 2.0;
+}
+
+/// `rated-reversal`: profile, load, duration, evaluation window.
+fn setup_rated_reversal(c: &mut SimConfig) {
+    let pts = Profile::from_points;
+    let n_rated = c.motor.rated_speed_rpm;
+    let t_rated = c.motor.rated_torque;
+    // fig11 in units of the ratings: 90 r/min = 6 %, 7.5 N·m = 65.2 %.
+    let n = REVERSAL_SPEED_RATIO * n_rated;
+    let load = 1.0;
+    c.speed_reference = pts(&[(0.0, 0.0), (0.2, 0.0), (1.2, -n), (2.5, -n), (4.5, n)]);
+    c.load.torque = pts(&[(1.2, 0.0), (1.7, load * t_rated)]);
+    c.simulation.duration = 5.5;
+    c.simulation.eval_start = 2.0;
+}
+
+/// `stops`: profile, load, duration, evaluation window.
+fn setup_stops(c: &mut SimConfig) {
+    let pts = Profile::from_points;
+    let n_rated = c.motor.rated_speed_rpm;
+    let t_rated = c.motor.rated_torque;
+    // fig12 in units of the ratings: 60 r/min = 4 %, 7.5 N·m = 65.2 %.
+    let n = STOPS_SPEED_RATIO * n_rated;
+    let mut p = vec![(0.0, 0.0), (0.2, 0.0), (0.9, n), (2.0, n)];
+    let mut t = 2.0;
+    for _ in 0..3 {
+        p.extend([(t + 0.5, 0.0), (t + 0.8, 0.0), (t + 1.3, n), (t + 1.8, n)]);
+        t += 1.8;
+    }
+    c.speed_reference = pts(&p);
+    c.load.torque = pts(&[(0.9, 0.0), (1.4, SCALED_LOAD_RATIO * t_rated)]);
+    c.simulation.duration = t;
+    c.simulation.eval_start = 1.8;
+}
+
+/// `fig8`: pass criteria.
+fn checks_fig8(cfg: &SimConfig, m: &Metrics, p: &ScenarioProbe, checks: &mut Vec<Check>) {
+    checks.push(Check::at_most(
+        "max |DC(λ2 − λs)| / λf",
+        p.max_block_dc / cfg.motor.flux_linkage,
+        0.02,
+    ));
+    checks.push(Check::at_least(
+        "revolutions evaluated",
+        p.blocks as f64,
+        4.0,
+    ));
+    // No loss of control: without it an estimator that runs the machine away
+    // (as the EMF baseline does) could still show a centred λ2.
+    checks.push(Check::at_most(
+        "max speed error (r/min)",
+        m.max_speed_error_rpm,
+        30.0,
+    ));
+}
+
+/// `fig9`: pass criteria.
+fn checks_fig9(cfg: &SimConfig, m: &Metrics, p: &ScenarioProbe, checks: &mut Vec<Check>) {
+    if let Some(&[t_off, t_on]) = cfg.simulation.disturbance_feedback_off.first() {
+        let d = |t: f64| p.disturbance_at(t);
+        let end = d(cfg.simulation.duration);
+        let drift = (d(t_on) - d(t_off)).norm();
+        let residual = (d(t_on + 2.0) - end).norm() / (d(t_on) - end).norm().max(1e-12);
+        checks.push(Check::at_least("λ1 drift while k_df off (Wb)", drift, 2e-3));
+        checks.push(Check::within(
+            "recovery residual after 2 s",
+            residual,
+            0.2,
+            0.55,
+        ));
+    } else {
+        // Without the k_df-off window there is no Fig. 9 experiment to judge.
+        checks.push(Check::at_least("k_df-off windows configured", 0.0, 1.0));
+    }
+    checks.push(Check::at_most("max |θ − θ̂| (rad)", m.max_angle_error, 0.05));
+}
+
+/// `fig10`: pass criteria.
+fn checks_fig10(cfg: &SimConfig, m: &Metrics, p: &ScenarioProbe, checks: &mut Vec<Check>) {
+    checks.push(Check::at_most("max |θ − θ̂| (rad)", m.max_angle_error, 0.35));
+    checks.push(Check::at_most(
+        "max |λ̂r| / (1.15·λ̂f)",
+        p.max_lambda_r / (cfg.estimator.limiter_radius_ratio * cfg.machine_model().flux_linkage),
+        1.01,
+    ));
+    checks.push(Check::at_least(
+        "FLAG_limit fraction of the hold",
+        p.flag_fraction(),
+        0.95,
+    ));
+}
+
+/// `fig11`: pass criteria.
+fn checks_fig11(_cfg: &SimConfig, m: &Metrics, _p: &ScenarioProbe, checks: &mut Vec<Check>) {
+    checks.push(Check::at_most(
+        "max |θ − θ̂| near zero speed (rad)",
+        m.max_angle_error_zero_speed,
+        0.25,
+    ));
+    checks.push(Check::at_least(
+        "samples near zero speed",
+        m.zero_speed_samples as f64,
+        1000.0,
+    ));
+    checks.push(Check::at_most(
+        "max speed error (r/min)",
+        m.max_speed_error_rpm,
+        30.0,
+    ));
+}
+
+/// `fig12`: pass criteria.
+fn checks_fig12(_cfg: &SimConfig, m: &Metrics, _p: &ScenarioProbe, checks: &mut Vec<Check>) {
+    checks.push(Check::at_most("max |θ − θ̂| (rad)", m.max_angle_error, 0.25));
+    checks.push(Check::at_most(
+        "max speed error (r/min)",
+        m.max_speed_error_rpm,
+        30.0,
+    ));
+}
+
+/// `steady300`: pass criteria.
+fn checks_steady300(_cfg: &SimConfig, m: &Metrics, _p: &ScenarioProbe, checks: &mut Vec<Check>) {
+    checks.push(Check::at_most(
+        "settled max |θ − θ̂| (rad)",
+        m.max_angle_error,
+        0.05,
+    ));
+    checks.push(Check::at_most(
+        "max speed error (r/min)",
+        m.max_speed_error_rpm,
+        10.0,
+    ));
+}
+
+/// `lowspeed`: pass criteria.
+fn checks_lowspeed(_cfg: &SimConfig, _m: &Metrics, p: &ScenarioProbe, checks: &mut Vec<Check>) {
+    checks.push(Check::at_least(
+        "levels held from 4 % of rated speed down",
+        p.levels_held_in_a_row() as f64,
+        p.levels.len() as f64,
+    ));
+}
+
+/// `reversal`: pass criteria.
+fn checks_reversal(cfg: &SimConfig, m: &Metrics, _p: &ScenarioProbe, checks: &mut Vec<Check>) {
+    let band = SCALED_SPEED_ERROR_RATIO * cfg.motor.rated_speed_rpm;
+    checks.push(Check::at_most(
+        "max |θ − θ̂| near zero speed (rad)",
+        m.max_angle_error_zero_speed,
+        0.25,
+    ));
+    // 0.1 s of samples at least in the band (fig11: 0.67 s).
+    checks.push(Check::at_least(
+        "samples near zero speed",
+        m.zero_speed_samples as f64,
+        0.1 / cfg.inverter.sample_period(),
+    ));
+    checks.push(Check::at_most(
+        "max speed error (r/min)",
+        m.max_speed_error_rpm,
+        band,
+    ));
+}
+
+/// `rated-reversal`: pass criteria.
+fn checks_rated_reversal(
+    cfg: &SimConfig,
+    m: &Metrics,
+    _p: &ScenarioProbe,
+    checks: &mut Vec<Check>,
+) {
+    let band = SCALED_SPEED_ERROR_RATIO * cfg.motor.rated_speed_rpm;
+    checks.push(Check::at_most(
+        "max |θ − θ̂| near zero speed (rad)",
+        m.max_angle_error_zero_speed,
+        0.25,
+    ));
+    // 0.1 s of samples at least in the band (fig11: 0.67 s).
+    checks.push(Check::at_least(
+        "samples near zero speed",
+        m.zero_speed_samples as f64,
+        0.1 / cfg.inverter.sample_period(),
+    ));
+    checks.push(Check::at_most(
+        "max speed error (r/min)",
+        m.max_speed_error_rpm,
+        band,
+    ));
+}
+
+/// `stops`: pass criteria.
+fn checks_stops(cfg: &SimConfig, m: &Metrics, _p: &ScenarioProbe, checks: &mut Vec<Check>) {
+    let band = SCALED_SPEED_ERROR_RATIO * cfg.motor.rated_speed_rpm;
+    checks.push(Check::at_most("max |θ − θ̂| (rad)", m.max_angle_error, 0.25));
+    checks.push(Check::at_most(
+        "max speed error (r/min)",
+        m.max_speed_error_rpm,
+        band,
+    ));
 }
 
 /// One pass criterion and how the run did against it.
