@@ -354,12 +354,19 @@ def test_config_as_a_dict_works_as_in_simulate() -> None:
 
 @pytest.mark.parametrize(
     ("config", "key"),
-    [({"k_dff": 1.0}, "k_dff"), ({"estimator": {"kdf": 1.0}}, "estimator.kdf")],
+    [
+        ({"k_dff": 1.0}, "k_dff"),
+        ({"estimator": {"kdf": 1.0}}, "estimator.kdf"),
+        ({"k_df": -1.0}, "k_df"),
+        ({"estimator": {"k_df": -1.0}}, "estimator.k_df"),
+        ({"estimator.k_af": math.nan}, "estimator.k_af"),
+    ],
 )
-def test_unknown_dict_keys_raise_naming_them(config: dict[str, object], key: str) -> None:
+def test_bad_dict_keys_raise_naming_them_as_written(config: dict[str, object], key: str) -> None:
     with pytest.raises(fado.ConfigError) as info:
         fado.Estimator("paper", config)
     assert info.value.field == key
+    assert f"`{key}`" in str(info.value)
 
 
 def test_machine_fields_and_paper_preset() -> None:

@@ -51,13 +51,13 @@ def main() -> None:
     signals = recording(n)
     print(f"{n} samples, best of {REPEATS}")
     for dtype in ("float64", "float32"):
-        t = best_of(lambda: fado.estimate(*signals, dtype=dtype))
+        t = best_of(lambda: fado.estimate(*signals, machine="paper", dtype=dtype))
         print(f"{dtype}: estimate() {t / n * 1e9:.1f} ns/sample")
     m = min(n, 100_000)
     rows = list(zip(*(s[:m].tolist() for s in signals)))
 
     def python_loop() -> None:
-        est = fado.Estimator()
+        est = fado.Estimator("paper")
         step = est.step
         for row in rows:
             step(*row)

@@ -14,10 +14,11 @@
 use std::hint::black_box;
 use std::time::Instant;
 
-use fado_core::{Ab, Estimate, EstimatorConfig, Real, SensorlessEstimator};
+use fado_core::{Ab, Estimate, EstimatorConfig, MachineModel, Real, SensorlessEstimator};
 use fado_py::outputs::Columns;
 use fado_py::replay::replay;
 
+// The paper's motor (`MachineModel::paper()`), at its 10 kHz sampling.
 const TS: f64 = 100e-6;
 const RS: f64 = 0.327;
 const LQ: f64 = 2.63e-3;
@@ -64,9 +65,9 @@ fn measure<T: Real>(label: &str, signals: &[Vec<f64>; 4]) {
         .each_ref()
         .map(|s| s.iter().map(|&x| T::lit(x)).collect::<Vec<T>>());
     let n = va.len() as f64;
-    let config = EstimatorConfig::<T>::default();
+    let config = EstimatorConfig::<T>::for_machine(&MachineModel::paper());
     let step_loop = best_of(|| {
-        let mut est = SensorlessEstimator::new(config).expect("default config is valid");
+        let mut est = SensorlessEstimator::new(config).expect("the paper motor's config is valid");
         let mut sum = T::zero();
         for k in 0..va.len() {
             let out = est.step(Ab::new(va[k], vb[k]), Ab::new(ia[k], ib[k]));
@@ -75,7 +76,7 @@ fn measure<T: Real>(label: &str, signals: &[Vec<f64>; 4]) {
         black_box(sum);
     });
     let columns = best_of(|| {
-        let mut est = SensorlessEstimator::new(config).expect("default config is valid");
+        let mut est = SensorlessEstimator::new(config).expect("the paper motor's config is valid");
         black_box(replay(&mut est, &va, &vb, &ia, &ib));
     });
     let fill = best_of(|| {

@@ -295,6 +295,8 @@ impl PyEstimatorConfig {
             )));
         };
         let kwargs = PyDict::new(py);
+        // The key as the user wrote it, for each field given.
+        let shown_as = PyDict::new(py);
         let put = |key: &str, shown: &str, value: Bound<'_, PyAny>| -> PyResult<()> {
             if !Self::FIELDS.contains(&key) {
                 return Err(config_error_message(
@@ -313,6 +315,7 @@ impl PyEstimatorConfig {
                     format!("`{shown}` given twice"),
                 ));
             }
+            shown_as.set_item(key, shown)?;
             kwargs.set_item(key, value)
         };
         for (key, value) in dict.iter() {
@@ -340,8 +343,34 @@ impl PyEstimatorConfig {
         }
         let made = py
             .get_type::<PyEstimatorConfig>()
-            .call((), Some(&kwargs))?
+            .call((), Some(&kwargs))
+            .map_err(|e| renamed(py, e, &shown_as))?
             .cast_into::<PyEstimatorConfig>()?;
         Ok(made.get().clone())
     }
+}
+
+/// A `ConfigError` on a field the user gave as `estimator.<field>` (nested or dotted), named
+/// that way; any other error unchanged.
+fn renamed(py: Python<'_>, err: PyErr, shown_as: &Bound<'_, PyDict>) -> PyErr {
+    let value = err.value(py);
+    let field = match value.getattr("field").and_then(|f| f.extract::<String>()) {
+        Ok(f) => f,
+        Err(_) => return err,
+    };
+    let shown = match shown_as.get_item(&field) {
+        Ok(Some(s)) => s.extract::<String>().unwrap_or_else(|_| field.clone()),
+        _ => return err,
+    };
+    if shown == field {
+        return err;
+    }
+    let message = value
+        .str()
+        .map(|m| {
+            m.to_string()
+                .replacen(&format!("`{field}`"), &format!("`{shown}`"), 1)
+        })
+        .unwrap_or_default();
+    config_error_message(py, &shown, message)
 }

@@ -164,7 +164,7 @@ impl PyMachine {
             }
             let made = py
                 .get_type::<PyMachine>()
-                .call((), Some(&dict))?
+                .call((), Some(dict))?
                 .cast_into::<PyMachine>()?;
             return Ok(made.get().clone());
         }

@@ -145,11 +145,13 @@ impl Motor {
         match self {
             Motor::Preset(p) => p.config(),
             Motor::Machine(m) => {
-                let mut c = SimConfig::default();
-                c.motor = *m;
+                let mut c = SimConfig {
+                    motor: *m,
+                    ..SimConfig::default()
+                };
                 c.inverter.dc_voltage = m.dc_voltage;
-                c.validate()
-                    .map_err(|e| SimConfigError::new(format!("motor ({})", e.key), e.message))?;
+                // Errors name the TOML key the machine's field became (`motor.rs`).
+                c.validate()?;
                 Ok(c)
             }
         }
