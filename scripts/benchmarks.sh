@@ -69,7 +69,7 @@ cpu=$(lscpu 2>/dev/null | sed -n 's/^Model name: *//p' | head -n1)
     echo "same plant (switching-resolved PWM inverter unless stated, 2.5 µs dead time, sensor"
     echo "offsets, gain error, noise with seed 1), same current and speed controllers, same"
     echo "dead-time and delay compensation, same d-axis injection (eq. 23), same type-2 trackers."
-    echo "Only \`[estimator] kind\` differs. Each estimator is tuned once with the documented"
+    echo "Only \`[simulation] estimator\` differs. Each estimator is tuned once with the documented"
     echo "defaults of its \`fado_core\` config; none is re-tuned per scenario."
     echo
     echo "* **passed**: the scenario's own criteria (\`fado-sim list\`). **passed (common checks)**"
