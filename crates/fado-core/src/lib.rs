@@ -21,6 +21,7 @@
 extern crate std;
 
 pub mod baselines;
+pub mod commissioning;
 pub mod control;
 pub mod error;
 pub mod estimator;

@@ -41,6 +41,7 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+pub mod commission;
 pub mod compare;
 pub mod config;
 pub mod controller;

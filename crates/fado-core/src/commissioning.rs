@@ -1,0 +1,1407 @@
+//! Commissioning: identification of the motor (R̂s, L̂d, L̂q, λ̂f, Ĵ, B̂) and of the inverter's
+//! voltage error, at standstill and in a short spin, as one state machine stepped at the
+//! control rate.
+//!
+//! # What the user gives
+//! A rough [`MachineModel`] (the *nameplate*): the **ratings are required and trusted**
+//! (`rated_current`, `rated_speed_rpm`, `rated_torque`, `dc_voltage`, `pole_pairs`: they set
+//! the current limit, the spin speed and the voltage limit); the **parameters** (`rs`, `ld`,
+//! `lq`, `flux_linkage`, `inertia`) are only used to size the tests (regulator gains,
+//! injection amplitude, ramp rate, plausibility bounds) and may be off by a factor of two.
+//! Also required: the sampling period and the inverter's dead time (a firmware setting; it
+//! splits the measured inverter voltage error into its dead-time and threshold parts).
+//!
+//! # Safety
+//! Every current reference is within `current_limit_ratio · rated_current` (checked by a
+//! property test); a measured current above `trip_ratio` times that limit aborts with the
+//! gates off. Every phase has a nominal and a maximum duration ([`CommissioningConfig::
+//! phase_timeout`]); every voltage is limited to `voltage_limit_ratio · Vdc/√3` at standstill.
+//! Aborts are typed ([`AbortReason`]): rotation where none is expected, current not following
+//! its reference, implausible result, over-current, over-speed, timeout, non-finite samples.
+//!
+//! # Procedure (phases in order) and why
+//! 1. **Offset calibration** ([`Phase::Offset`]), gates off: the mean of the current readings
+//!    is the sensor offset, subtracted from then on.
+//! 2. **Alignment** ([`Phase::Align`]): a current vector at 2π/3, then turned to 0 (α axis),
+//!    drags the rotor's d axis onto phase a. Two steps so that a rotor starting at the
+//!    unstable equilibrium of one is pulled by the other (the usual two-step alignment, e.g.
+//!    ST MCSDK's and TI InstaSPIN's). The standstill regulator is an *integral-only* loop
+//!    (v̇ = K·(i* − i), K = R̂²/L̂, a closed loop L·s² + R·s + K with ζ ≈ 0.5 on the nameplate):
+//!    it leaves the machine's own resistance as the damping of the rotor's swing (a fast
+//!    current loop would remove it and the rotor would ring for seconds).
+//! 3. **Resistance** ([`Phase::Resistance`]): DC current along α at two levels I₁ < I₂ (45 % and
+//!    90 % of the limit). With all three phase currents beyond the inverter's current band the
+//!    pole-voltage error is a constant V̂·sign(i_x) per phase, i.e. 4/3·V̂ on the α axis, so
+//!    v_α = Rs·i_α + 4/3·V̂: the slope of the two points is Rs, the intercept the inverter
+//!    error (the classic two-point DC test, e.g. Bertoluzzo, Buja & Menis, "Self-commissioning
+//!    of RFOC induction motor drives: one-line estimation of the stator resistance", and
+//!    the dead-time voltage identification of Guerrero et al., "Inverter nonlinearity effects
+//!    in high-frequency signal-injection-based sensorless control methods", IEEE TIA 41(2),
+//!    2005). V̂ = Td·f_sw·Vdc + V_th (SPEC §5) with the known dead time gives V_th.
+//! 4. **Inductances** ([`Phase::InductanceD`], [`Phase::InductanceQ`]): on top of the I₁ bias
+//!    along d (which holds the rotor), a square-wave voltage of ±V_h with a half period of 4
+//!    samples is injected along d, then along q (standstill voltage injection as in Bolognani,
+//!    Ortombina et al. and the VESC's inductance test). Over one sample the current changes by
+//!    Ts·v/L (the inverter error is constant because no phase current changes sign and the
+//!    resistive drop is uncorrelated with the square wave), so a least-squares line of the
+//!    sample-to-sample current change on the voltage applied over that sample gives Ts/L
+//!    regardless of any constant voltage. The q injection's torque alternates at 1.25 kHz
+//!    (at 10 kHz sampling) and moves the rotor by microradians. Saliency: L̂q/L̂d.
+//! 5. **Spin and back-EMF** ([`Phase::Spin`], [`Phase::Coast`]): an I-f start (a current vector
+//!    of 90 % of the limit turned at a speed ramped to `spin_speed_ratio` of the rated speed,
+//!    acceleration sized to use 10 % of the rated torque on the nameplate inertia), regulated
+//!    by a synchronous-frame PI tuned from the identified R̂s, L̂ (bandwidth 0.2/Ts), with the
+//!    identified inverter error compensated. The current is then regulated to zero and the
+//!    rotor coasts: the back-EMF E = v − R̂s·i − L̂q·di/dt (the active-flux EMF, Boldea et al.
+//!    2008, whose angle is the rotor's for any saliency) is tracked by a PLL; with i ≈ 0 the
+//!    result is almost free of R̂s, L̂ and inverter errors, and λ̂f = ∫E_q dt / ∫ω dt over the
+//!    coast (a ratio of integrals: exact for a slowly decelerating rotor).
+//! 6. **Inertia and friction** ([`Phase::Inertia`]): in closed loop on the PLL's angle (the
+//!    back-EMF observer is the sensorless angle), a q-current step of +90 % of the limit until
+//!    2× the spin speed, then the opposite step down to 0.5× (the current is sized so that
+//!    each step lasts 0.5 s on the nameplate inertia). Over windows of 40 ms,
+//!    Δω_mech = (1/J)·∫T̂e dt − (B/J)·∫ω_mech dt with T̂e = 1.5·p·(λ̂f·i_q + (L̂d − L̂q)·i_d·i_q);
+//!    least squares over the coast and both steps gives 1/Ĵ and B̂/Ĵ (the ST MCSDK profiler's
+//!    approach, with both acceleration and deceleration so that friction and inertia
+//!    separate). The noisy speed difference is the dependent variable: as a regressor its
+//!    noise would bias Ĵ low (errors in variables; −20 % measured on the IPMSM).
+//!    The procedure ends with the gates off and the rotor coasting at about 10 % of its rated
+//!    speed.
+//!
+//! # Confidence
+//! Each identified parameter comes with a relative 1-σ statistical uncertainty computed from
+//! the scatter of its own data (block means of 10 ms for the DC tests and the back-EMF, the
+//! residuals of the least-squares fits for L and J). It measures noise, not bias: the
+//! accuracy against ground truth is what the simulator's table (docs/commissioning.md) shows.
+
+use crate::error::{ConfigError, check};
+use crate::{Ab, Abc, Dq, MachineModel, Real, Rotation, wrap_angle};
+
+/// The phases of the procedure, in order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Phase {
+    /// Gates off, sensor offsets measured.
+    Offset,
+    /// Rotor aligned with the α axis (rotation expected).
+    Align,
+    /// Two-level DC test: Rs and the inverter voltage error.
+    Resistance,
+    /// Square-wave injection along d.
+    InductanceD,
+    /// Square-wave injection along q.
+    InductanceQ,
+    /// I-f open-loop acceleration.
+    Spin,
+    /// Zero current, rotor coasting: back-EMF and λf.
+    Coast,
+    /// Torque steps in closed loop: J and friction.
+    Inertia,
+    /// Finished; the result is available.
+    Done,
+    /// Aborted; see [`Commissioning::status`].
+    Aborted,
+}
+
+impl Phase {
+    /// Short name (for traces and progress bars).
+    pub fn name(self) -> &'static str {
+        match self {
+            Phase::Offset => "offset",
+            Phase::Align => "align",
+            Phase::Resistance => "resistance",
+            Phase::InductanceD => "inductance_d",
+            Phase::InductanceQ => "inductance_q",
+            Phase::Spin => "spin",
+            Phase::Coast => "coast",
+            Phase::Inertia => "inertia",
+            Phase::Done => "done",
+            Phase::Aborted => "aborted",
+        }
+    }
+
+    /// Index 0–9 in procedure order.
+    pub fn index(self) -> usize {
+        self as usize
+    }
+}
+
+/// A parameter of the result (for [`AbortReason::Implausible`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Parameter {
+    /// Stator resistance.
+    Rs,
+    /// Inverter voltage error.
+    InverterVoltage,
+    /// d-axis inductance.
+    Ld,
+    /// q-axis inductance.
+    Lq,
+    /// Magnet flux linkage.
+    FluxLinkage,
+    /// Inertia.
+    Inertia,
+    /// Viscous friction.
+    ViscousFriction,
+}
+
+/// Why the procedure stopped early. The gates are off from the sample it is reported on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AbortReason {
+    /// The rotor turned during a standstill phase (alternating current error with the voltage
+    /// unsaturated: a back-EMF the regulator cannot follow), e.g. a load that drives it.
+    RotationDetected {
+        /// Where.
+        phase: Phase,
+    },
+    /// The current did not reach its reference with the voltage at its limit (an open phase,
+    /// a missing motor, a far too high resistance), or it lost its reference in a spin.
+    CurrentNotFollowing {
+        /// Where.
+        phase: Phase,
+    },
+    /// A measured current beyond `trip_ratio` × the current limit.
+    OverCurrent {
+        /// Where.
+        phase: Phase,
+    },
+    /// The estimated speed beyond twice the highest test speed, or the rotor stalled / lost
+    /// in a spin.
+    Overspeed {
+        /// Where.
+        phase: Phase,
+    },
+    /// A phase ran past its maximum duration.
+    Timeout {
+        /// Where.
+        phase: Phase,
+    },
+    /// A result is non-finite, non-positive or outside 1/4–4× the nameplate (J: 1/10–10×).
+    Implausible {
+        /// Which parameter.
+        parameter: Parameter,
+    },
+    /// More than 10 ms of consecutive non-finite current or DC-link samples.
+    NonFiniteMeasurements {
+        /// Where.
+        phase: Phase,
+    },
+}
+
+/// Configuration. Build it with [`CommissioningConfig::for_machine`]; every default is a ratio
+/// of a rating or a duration in seconds (the brief's rule), stated on its field.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CommissioningConfig<T> {
+    /// The nameplate: ratings trusted, parameters rough (module docs). Required.
+    pub nameplate: MachineModel<T>,
+    /// Sampling (control) period Ts in s. Required.
+    pub sample_period: T,
+    /// Switching frequency in Hz (for V_th = V̂ − Td·f_sw·Vdc). Default 1/(2·Ts), double
+    /// update (paper §V).
+    pub switching_frequency: T,
+    /// The inverter's dead time Td in s (a firmware setting). Required.
+    pub dead_time: T,
+    /// Current limit as a fraction of the rated current. Default 0.5 (half the rated current:
+    /// the tests heat the winding at most a quarter of its rated loss).
+    pub current_limit_ratio: T,
+    /// Over-current trip as a multiple of the current limit. Default 1.5.
+    pub trip_ratio: T,
+    /// Standstill voltage limit as a fraction of Vdc/√3. Default 0.5.
+    pub voltage_limit_ratio: T,
+    /// Spin speed as a fraction of the rated speed. Default 0.2 (enough back-EMF against the
+    /// inverter error, little energy).
+    pub spin_speed_ratio: T,
+    /// Torque used for the I-f acceleration, as a fraction of the rated torque, on the
+    /// nameplate inertia. Default 0.1.
+    pub spin_torque_ratio: T,
+    /// Offset calibration in s. Default 0.1 s (1000 samples at 10 kHz).
+    pub offset_time: T,
+    /// Alignment in s (each of its two steps, and the hold after). Default 0.3 s.
+    pub align_time: T,
+    /// Settling before each measurement in s. Default 0.15 s (≥ 5 time constants of the
+    /// standstill loop on the nameplate's R/L for every preset).
+    pub settle_time: T,
+    /// Averaging window of each DC level, each injection and the coast, in s. Default 0.25 s.
+    pub measure_time: T,
+    /// Maximum duration of any phase, in s. Default 5 s.
+    pub phase_timeout: T,
+}
+
+impl<T: Real> CommissioningConfig<T> {
+    /// The defaults for a nameplate, sampling period and dead time.
+    pub fn for_machine(nameplate: MachineModel<T>, sample_period: T, dead_time: T) -> Self {
+        Self {
+            nameplate,
+            sample_period,
+            switching_frequency: T::lit(0.5) / sample_period,
+            dead_time,
+            current_limit_ratio: T::lit(0.5),
+            trip_ratio: T::lit(1.5),
+            voltage_limit_ratio: T::lit(0.5),
+            spin_speed_ratio: T::lit(0.2),
+            spin_torque_ratio: T::lit(0.1),
+            offset_time: T::lit(0.1),
+            align_time: T::lit(0.3),
+            settle_time: T::lit(0.15),
+            measure_time: T::lit(0.25),
+            phase_timeout: T::lit(5.0),
+        }
+    }
+
+    /// Checks every field; the error names the first bad one.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        self.nameplate.validate()?;
+        check::positive("sample_period", self.sample_period)?;
+        check::positive("switching_frequency", self.switching_frequency)?;
+        check::non_negative("dead_time", self.dead_time)?;
+        check::positive("current_limit_ratio", self.current_limit_ratio)?;
+        if self.current_limit_ratio > T::one() {
+            return Err(ConfigError::OutOfRange {
+                field: "current_limit_ratio",
+                expected: "at most 1 (the rated current)",
+            });
+        }
+        check::positive("trip_ratio", self.trip_ratio)?;
+        if self.trip_ratio <= T::one() {
+            return Err(ConfigError::OutOfRange {
+                field: "trip_ratio",
+                expected: "above 1",
+            });
+        }
+        check::positive("voltage_limit_ratio", self.voltage_limit_ratio)?;
+        if self.voltage_limit_ratio > T::one() {
+            return Err(ConfigError::OutOfRange {
+                field: "voltage_limit_ratio",
+                expected: "at most 1",
+            });
+        }
+        check::positive("spin_speed_ratio", self.spin_speed_ratio)?;
+        if self.spin_speed_ratio > T::lit(0.5) {
+            return Err(ConfigError::OutOfRange {
+                field: "spin_speed_ratio",
+                expected: "at most 0.5 (the inertia test reaches 1.5× it)",
+            });
+        }
+        check::positive("spin_torque_ratio", self.spin_torque_ratio)?;
+        check::positive("offset_time", self.offset_time)?;
+        check::positive("align_time", self.align_time)?;
+        check::positive("settle_time", self.settle_time)?;
+        check::positive("measure_time", self.measure_time)?;
+        check::positive("phase_timeout", self.phase_timeout)?;
+        let min_phase = T::lit(2.0) * self.align_time + self.settle_time + self.measure_time;
+        if self.phase_timeout < min_phase || self.phase_timeout < self.offset_time {
+            return Err(ConfigError::OutOfRange {
+                field: "phase_timeout",
+                expected: "at least the nominal duration of every phase",
+            });
+        }
+        if self.measure_time < T::lit(40.0) * self.sample_period {
+            return Err(ConfigError::OutOfRange {
+                field: "measure_time",
+                expected: "at least 40 samples",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Relative 1-σ statistical uncertainties of the result (module docs); `inverter_voltage` in V.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Confidence<T> {
+    /// Of R̂s, relative.
+    pub rs: T,
+    /// Of L̂d, relative.
+    pub ld: T,
+    /// Of L̂q, relative.
+    pub lq: T,
+    /// Of λ̂f, relative.
+    pub flux_linkage: T,
+    /// Of Ĵ, relative.
+    pub inertia: T,
+    /// Of B̂, absolute in N·m·s/rad.
+    pub viscous_friction: T,
+    /// Of the per-phase inverter voltage error V̂, absolute in V.
+    pub inverter_voltage: T,
+}
+
+/// The identified motor and inverter.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Identification<T> {
+    /// The identified model: parameters measured, ratings copied from the nameplate.
+    pub model: MachineModel<T>,
+    /// Statistical uncertainty of each parameter.
+    pub confidence: Confidence<T>,
+    /// Per-phase inverter voltage error V̂ = Td·f_sw·Vdc + V_th in V (SPEC §5): what the
+    /// dead-time compensation should add.
+    pub inverter_voltage: T,
+    /// Device threshold voltage V_th = V̂ − Td·f_sw·Vdc in V (for
+    /// [`crate::control::dead_time_compensation::DeadTimeCompensationConfig::threshold_voltage`]).
+    pub threshold_voltage: T,
+    /// Saliency ratio L̂q/L̂d (> 1: interior magnets).
+    pub saliency: T,
+    /// Mean DC-link voltage during the DC test, V.
+    pub dc_voltage: T,
+    /// Duration of the procedure in s.
+    pub duration: T,
+}
+
+/// Where the procedure stands.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Status {
+    /// Still running.
+    Running,
+    /// Finished: see [`Commissioning::result`].
+    Done,
+    /// Stopped early, gates off.
+    Aborted(AbortReason),
+}
+
+/// What one step returns.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CommissioningOutput<T> {
+    /// Voltage command for the next sample (α-β), V.
+    pub v_ab: Ab<T>,
+    /// The same as SVPWM duties (min-max, ½ when the gates are off).
+    pub duty: Abc<T>,
+    /// Gates on.
+    pub gates_enabled: bool,
+    /// The current reference (α-β) the command regulates to, A.
+    pub current_reference: Ab<T>,
+    /// Phase of this sample.
+    pub phase: Phase,
+    /// Completed fraction of the nominal procedure, 0–1.
+    pub progress: T,
+    /// Where it stands.
+    pub status: Status,
+    /// The back-EMF observer's speed (spin phases; 0 otherwise), rad/s electrical.
+    pub speed: T,
+    /// The back-EMF observer's rotor angle (spin phases; 0 otherwise), rad electrical.
+    pub angle: T,
+}
+
+/// Mean and standard error of a signal from block means (no allocation).
+#[derive(Clone, Copy, Debug, Default)]
+struct BlockStats<T> {
+    block: u32,
+    k: u32,
+    acc: T,
+    n: u32,
+    sum: T,
+    sum_sq: T,
+}
+
+impl<T: Real> BlockStats<T> {
+    fn new(block: u32) -> Self {
+        Self {
+            block: block.max(1),
+            k: 0,
+            acc: T::zero(),
+            n: 0,
+            sum: T::zero(),
+            sum_sq: T::zero(),
+        }
+    }
+    fn push(&mut self, x: T) {
+        self.acc += x;
+        self.k += 1;
+        if self.k == self.block {
+            let m = self.acc / T::lit(self.block as f64);
+            self.sum += m;
+            self.sum_sq += m * m;
+            self.n += 1;
+            self.k = 0;
+            self.acc = T::zero();
+        }
+    }
+    fn mean(&self) -> T {
+        if self.n == 0 {
+            T::zero()
+        } else {
+            self.sum / T::lit(self.n as f64)
+        }
+    }
+    /// Standard error of the mean.
+    fn sem(&self) -> T {
+        if self.n < 2 {
+            return T::lit(f64::INFINITY);
+        }
+        let n = T::lit(self.n as f64);
+        let m = self.sum / n;
+        let var = ((self.sum_sq - n * m * m) / (n - T::one())).max(T::zero());
+        (var / n).sqrt()
+    }
+}
+
+/// Least-squares line y = a·x + b, accumulated.
+#[derive(Clone, Copy, Debug, Default)]
+struct Line<T> {
+    n: T,
+    sx: T,
+    sy: T,
+    sxx: T,
+    sxy: T,
+    syy: T,
+}
+
+impl<T: Real> Line<T> {
+    fn push(&mut self, x: T, y: T) {
+        self.n += T::one();
+        self.sx += x;
+        self.sy += y;
+        self.sxx += x * x;
+        self.sxy += x * y;
+        self.syy += y * y;
+    }
+    /// (slope, standard error of the slope).
+    fn slope(&self) -> (T, T) {
+        let n = self.n;
+        if n < T::lit(3.0) {
+            return (T::zero(), T::lit(f64::INFINITY));
+        }
+        let cxx = self.sxx - self.sx * self.sx / n;
+        let cxy = self.sxy - self.sx * self.sy / n;
+        let cyy = self.syy - self.sy * self.sy / n;
+        if cxx <= T::zero() {
+            return (T::zero(), T::lit(f64::INFINITY));
+        }
+        let a = cxy / cxx;
+        let res = (cyy - a * cxy).max(T::zero()) / (n - T::lit(2.0));
+        (a, (res / cxx).sqrt())
+    }
+}
+
+/// Two-parameter least squares a·x1 + b·x2 = y, accumulated.
+#[derive(Clone, Copy, Debug, Default)]
+struct Ls2<T> {
+    a11: T,
+    a12: T,
+    a22: T,
+    b1: T,
+    b2: T,
+    yy: T,
+    n: T,
+}
+
+impl<T: Real> Ls2<T> {
+    fn push(&mut self, x1: T, x2: T, y: T) {
+        self.a11 += x1 * x1;
+        self.a12 += x1 * x2;
+        self.a22 += x2 * x2;
+        self.b1 += x1 * y;
+        self.b2 += x2 * y;
+        self.yy += y * y;
+        self.n += T::one();
+    }
+    /// ((a, b), (σ_a, σ_b)).
+    fn solve(&self) -> Option<((T, T), (T, T))> {
+        let det = self.a11 * self.a22 - self.a12 * self.a12;
+        if !(det > T::zero()) || self.n < T::lit(4.0) {
+            return None;
+        }
+        let j = (self.b1 * self.a22 - self.b2 * self.a12) / det;
+        let b = (self.a11 * self.b2 - self.a12 * self.b1) / det;
+        let res = (self.yy - j * self.b1 - b * self.b2).max(T::zero()) / (self.n - T::lit(2.0));
+        Some((
+            (j, b),
+            ((res * self.a22 / det).sqrt(), (res * self.a11 / det).sqrt()),
+        ))
+    }
+}
+
+#[inline]
+fn clamp<T: Real>(x: T, lo: T, hi: T) -> T {
+    x.max(lo).min(hi)
+}
+
+/// Limits a vector's magnitude.
+#[inline]
+fn limit<T: Real>(v: Ab<T>, max: T) -> Ab<T> {
+    let n = v.norm();
+    if n > max && n > T::zero() {
+        v * (max / n)
+    } else {
+        v
+    }
+}
+
+/// The commissioning state machine (module docs).
+#[derive(Clone, Debug)]
+pub struct Commissioning<T> {
+    cfg: CommissioningConfig<T>,
+    ts: T,
+    i_limit: T,
+    // Sizing from the nameplate.
+    k_int: T,
+    v_inj: T,
+    spin_speed: T,
+    spin_accel: T,
+    // Progress and phases.
+    phase: Phase,
+    sub: u8,
+    t_phase: T,
+    t_total: T,
+    nominal_total: T,
+    nominal_done: T,
+    status: Status,
+    bad_samples: u32,
+    // Offsets.
+    off_a: T,
+    off_b: T,
+    off_n: T,
+    // Delay line: commands of n−1 and n−2 (estimated applied voltage), current of n−1.
+    c1: Ab<T>,
+    c2: Ab<T>,
+    i_prev: Ab<T>,
+    have_prev: bool,
+    // Standstill regulator.
+    v_int: Ab<T>,
+    i_ref: Ab<T>,
+    err_par: T,
+    err_perp: T,
+    emf_lpf: Ab<T>,
+    saturated_time: T,
+    // Resistance.
+    v_lvl: [BlockStats<T>; 2],
+    i_lvl: [BlockStats<T>; 2],
+    vdc_stats: BlockStats<T>,
+    // Inductance.
+    line: Line<T>,
+    inj_count: u32,
+    inj_sign: T,
+    // Results so far.
+    rs: T,
+    rs_sigma: T,
+    v_inv: T,
+    v_inv_sigma: T,
+    ld: T,
+    ld_sigma: T,
+    lq: T,
+    lq_sigma: T,
+    flux: T,
+    flux_sigma: T,
+    // Spin: control frame, synchronous PI, PLL.
+    theta_f: T,
+    omega_f: T,
+    pi_int: Dq<T>,
+    kp: Dq<T>,
+    ki: T,
+    pll_theta: T,
+    pll_omega: T,
+    pll_on: bool,
+    pll_kp: T,
+    pll_ki: T,
+    // Coast accumulators.
+    e_int: T,
+    theta_int: T,
+    flux_blocks: BlockStats<T>,
+    // Inertia windows.
+    ls: Ls2<T>,
+    w_k: u32,
+    w_omega0: T,
+    w_int_omega: T,
+    w_int_te: T,
+    j_step: u8,
+    i_j: T,
+    result: Option<Identification<T>>,
+}
+
+const SQRT3_INV: f64 = 0.577_350_269_189_625_8;
+/// Half period of the injected square wave, in samples.
+const INJ_HALF: u32 = 4;
+/// Block length of the mean statistics, s.
+const BLOCK_TIME: f64 = 0.01;
+/// d current of the back-EMF measurement, as a fraction of the limit (module docs).
+const COAST_ID: f64 = 0.5;
+/// Speeds between which the inertia test's torque steps run, relative to the spin speed.
+const J_HIGH: f64 = 2.0;
+/// See [`J_HIGH`].
+const J_LOW: f64 = 0.5;
+/// Nominal duration of each torque step on the nameplate inertia, s.
+const J_STEP_TIME: f64 = 0.5;
+/// Window of the inertia regression, s.
+const J_WINDOW: f64 = 0.04;
+
+impl<T: Real> Commissioning<T> {
+    /// A new procedure; the configuration is checked (the error names the field).
+    pub fn new(cfg: CommissioningConfig<T>) -> Result<Self, ConfigError> {
+        cfg.validate()?;
+        let np = &cfg.nameplate;
+        let ts = cfg.sample_period;
+        let i_limit = cfg.current_limit_ratio * np.rated_current;
+        let l_avg_np = T::lit(0.5) * (np.ld + np.lq);
+        // Integral gain K = R²/L of the standstill loop (module docs), bounded so that the loop
+        // stays well below the sampling rate (K·Ts/L ≤ 0.01 gives ωn·Ts ≤ 0.1).
+        let k_int = (np.rs * np.rs / l_avg_np).min(T::lit(0.01) * l_avg_np / (ts * ts));
+        // Injection: a current ripple of 30 % of the I₁ bias (45 % of the limit), peak-peak.
+        let i1 = T::lit(0.45) * i_limit;
+        let v_inj = T::lit(0.3) * i1 * l_avg_np / (T::lit(INJ_HALF as f64) * ts);
+        let spin_speed = cfg.spin_speed_ratio * np.rated_speed();
+        // Electrical acceleration from spin_torque_ratio·T_rated on the nameplate J.
+        let p = T::lit(np.pole_pairs as f64);
+        let spin_accel = cfg.spin_torque_ratio * np.rated_torque / np.inertia * p;
+        let nominal_total = cfg.offset_time
+            + T::lit(3.0) * cfg.align_time
+            + T::lit(2.0) * (cfg.settle_time + cfg.measure_time)
+            + T::lit(2.0) * (T::lit(0.02) + cfg.measure_time)
+            + (spin_speed / spin_accel + cfg.settle_time)
+            + cfg.measure_time
+            + T::lit(1.0);
+        let block = libm_round(BLOCK_TIME / ts.to_f64());
+        let wc = T::lit(0.2) / ts;
+        let wn = T::lit(core::f64::consts::TAU * 40.0);
+        let mut s = Self {
+            ts,
+            i_limit,
+            k_int,
+            v_inj,
+            spin_speed,
+            spin_accel,
+            phase: Phase::Offset,
+            sub: 0,
+            t_phase: T::zero(),
+            t_total: T::zero(),
+            nominal_total,
+            nominal_done: T::zero(),
+            status: Status::Running,
+            bad_samples: 0,
+            off_a: T::zero(),
+            off_b: T::zero(),
+            off_n: T::zero(),
+            c1: Ab::zero(),
+            c2: Ab::zero(),
+            i_prev: Ab::zero(),
+            have_prev: false,
+            v_int: Ab::zero(),
+            i_ref: Ab::zero(),
+            err_par: T::zero(),
+            err_perp: T::zero(),
+            emf_lpf: Ab::zero(),
+            saturated_time: T::zero(),
+            v_lvl: [BlockStats::new(block); 2],
+            i_lvl: [BlockStats::new(block); 2],
+            vdc_stats: BlockStats::new(block),
+            line: Line::default(),
+            inj_count: 0,
+            inj_sign: T::one(),
+            rs: T::zero(),
+            rs_sigma: T::zero(),
+            v_inv: T::zero(),
+            v_inv_sigma: T::zero(),
+            ld: T::zero(),
+            ld_sigma: T::zero(),
+            lq: T::zero(),
+            lq_sigma: T::zero(),
+            flux: T::zero(),
+            flux_sigma: T::zero(),
+            theta_f: T::zero(),
+            omega_f: T::zero(),
+            pi_int: Dq::zero(),
+            kp: Dq::new(wc * np.ld, wc * np.lq),
+            ki: wc * np.rs,
+            pll_theta: T::zero(),
+            pll_omega: T::zero(),
+            pll_on: false,
+            pll_kp: T::lit(2.0) * wn,
+            pll_ki: wn * wn,
+            e_int: T::zero(),
+            theta_int: T::zero(),
+            flux_blocks: BlockStats::new(block),
+            ls: Ls2::default(),
+            w_k: 0,
+            w_omega0: T::zero(),
+            w_int_omega: T::zero(),
+            w_int_te: T::zero(),
+            j_step: 0,
+            i_j: T::zero(),
+            result: None,
+            cfg,
+        };
+        s.reset();
+        Ok(s)
+    }
+
+    /// Back to the start (offset calibration), results cleared.
+    pub fn reset(&mut self) {
+        let cfg = self.cfg;
+        // Rebuild from a validated config cannot fail.
+        self.phase = Phase::Offset;
+        self.sub = 0;
+        self.t_phase = T::zero();
+        self.t_total = T::zero();
+        self.nominal_done = T::zero();
+        self.status = Status::Running;
+        self.bad_samples = 0;
+        self.off_a = T::zero();
+        self.off_b = T::zero();
+        self.off_n = T::zero();
+        self.c1 = Ab::zero();
+        self.c2 = Ab::zero();
+        self.have_prev = false;
+        self.v_int = Ab::zero();
+        self.i_ref = Ab::zero();
+        self.err_par = T::zero();
+        self.err_perp = T::zero();
+        self.emf_lpf = Ab::zero();
+        self.saturated_time = T::zero();
+        let block = self.v_lvl[0].block;
+        self.v_lvl = [BlockStats::new(block); 2];
+        self.i_lvl = [BlockStats::new(block); 2];
+        self.vdc_stats = BlockStats::new(block);
+        self.flux_blocks = BlockStats::new(block);
+        self.line = Line::default();
+        self.ls = Ls2::default();
+        self.pll_on = false;
+        self.pi_int = Dq::zero();
+        self.theta_f = T::zero();
+        self.omega_f = T::zero();
+        self.j_step = 0;
+        self.w_k = 0;
+        self.result = None;
+        self.cfg = cfg;
+    }
+
+    /// The configuration in use.
+    pub fn config(&self) -> &CommissioningConfig<T> {
+        &self.cfg
+    }
+
+    /// The current limit in A (`current_limit_ratio · rated_current`).
+    pub fn current_limit(&self) -> T {
+        self.i_limit
+    }
+
+    /// Where the procedure stands.
+    pub fn status(&self) -> Status {
+        self.status
+    }
+
+    /// The phase running now.
+    pub fn phase(&self) -> Phase {
+        self.phase
+    }
+
+    /// The identification, once [`Status::Done`].
+    pub fn result(&self) -> Option<&Identification<T>> {
+        self.result.as_ref()
+    }
+
+    fn output(&self, v: Ab<T>, vdc: T, gates: bool, speed: T) -> CommissioningOutput<T> {
+        let gates = gates && self.status == Status::Running;
+        let v = if gates { v } else { Ab::zero() };
+        let duty = if gates {
+            crate::control::modulation::svpwm_duty(v, vdc)
+        } else {
+            Abc::new(T::lit(0.5), T::lit(0.5), T::lit(0.5))
+        };
+        CommissioningOutput {
+            v_ab: v,
+            duty,
+            gates_enabled: gates,
+            current_reference: if gates { self.i_ref } else { Ab::zero() },
+            phase: self.phase,
+            progress: self.progress(),
+            status: self.status,
+            speed,
+            angle: if self.pll_on {
+                self.pll_theta
+            } else {
+                T::zero()
+            },
+        }
+    }
+
+    fn progress(&self) -> T {
+        match self.status {
+            Status::Done => T::one(),
+            _ => clamp(
+                (self.nominal_done + self.t_phase) / self.nominal_total,
+                T::zero(),
+                T::lit(0.999),
+            ),
+        }
+    }
+
+    fn abort(&mut self, reason: AbortReason) {
+        self.status = Status::Aborted(reason);
+        self.phase = Phase::Aborted;
+        self.i_ref = Ab::zero();
+    }
+
+    fn next_phase(&mut self, p: Phase) {
+        self.nominal_done += self.t_phase;
+        self.phase = p;
+        self.sub = 0;
+        self.t_phase = T::zero();
+    }
+
+    /// One control sample: the measured phase currents (A, positive out of the inverter) and
+    /// DC-link voltage (V) at this sample; returns the command for the next one. After
+    /// [`Status::Done`] or an abort it returns gates off.
+    pub fn step(&mut self, i_abc: Abc<T>, vdc: T) -> CommissioningOutput<T> {
+        if self.status != Status::Running {
+            return self.output(Ab::zero(), vdc, false, T::zero());
+        }
+        let ts = self.ts;
+        self.t_phase += ts;
+        self.t_total += ts;
+        if !(i_abc.a.is_finite() && i_abc.b.is_finite() && vdc.is_finite() && vdc > T::zero()) {
+            // Hold the previous command; abort after 10 ms of bad samples.
+            self.bad_samples += 1;
+            if T::lit(self.bad_samples as f64) * ts > T::lit(0.01) {
+                self.abort(AbortReason::NonFiniteMeasurements { phase: self.phase });
+            }
+            let v = self.c1;
+            let vdc = if vdc.is_finite() && vdc > T::zero() {
+                vdc
+            } else {
+                self.cfg.nameplate.dc_voltage
+            };
+            return self.output(v, vdc, self.phase != Phase::Offset, T::zero());
+        }
+        self.bad_samples = 0;
+        if self.phase != Phase::Offset && self.t_phase > self.cfg.phase_timeout {
+            self.abort(AbortReason::Timeout { phase: self.phase });
+            return self.output(Ab::zero(), vdc, false, T::zero());
+        }
+        if self.phase == Phase::Offset {
+            self.off_a += i_abc.a;
+            self.off_b += i_abc.b;
+            self.off_n += T::one();
+            if self.t_phase >= self.cfg.offset_time {
+                self.off_a /= self.off_n;
+                self.off_b /= self.off_n;
+                self.next_phase(Phase::Align);
+            }
+            return self.output(Ab::zero(), vdc, false, T::zero());
+        }
+        // Offset-corrected current (two sensors, c = −a − b).
+        let a = i_abc.a - self.off_a;
+        let b = i_abc.b - self.off_b;
+        let i = Abc::new(a, b, -a - b).to_ab();
+        if i.norm() > self.cfg.trip_ratio * self.i_limit {
+            self.abort(AbortReason::OverCurrent { phase: self.phase });
+            return self.output(Ab::zero(), vdc, false, T::zero());
+        }
+        let (v, applied) = match self.phase {
+            Phase::Align | Phase::Resistance | Phase::InductanceD | Phase::InductanceQ => {
+                let v = self.standstill(i, vdc);
+                (v, v)
+            }
+            Phase::Spin | Phase::Coast | Phase::Inertia => self.spinning(i, vdc),
+            Phase::Offset | Phase::Done | Phase::Aborted => (Ab::zero(), Ab::zero()),
+        };
+        self.c2 = self.c1;
+        self.c1 = applied;
+        self.i_prev = i;
+        self.have_prev = true;
+        let speed = self.pll_omega;
+        let running = self.status == Status::Running && self.phase != Phase::Done;
+        self.output(v, vdc, running, speed)
+    }
+
+    // ------------------------------------------------------------------ standstill phases
+
+    /// The standstill phases: integral-only regulation of the α-β current to `i_ref`, plus
+    /// the square-wave injection; the measurements; the phase transitions.
+    fn standstill(&mut self, i: Ab<T>, vdc: T) -> Ab<T> {
+        let cfg = self.cfg;
+        let ts = self.ts;
+        let i1 = T::lit(0.45) * self.i_limit;
+        let i2 = T::lit(0.9) * self.i_limit;
+        let at = cfg.align_time;
+        let t = self.t_phase;
+        let settle = cfg.settle_time;
+        let meas = cfg.measure_time;
+        let mut inj = Ab::zero();
+        // Whether this sample is inside a measurement window (for the rotation check).
+        let mut window = false;
+        match self.phase {
+            Phase::Align => {
+                let ang = if t < at {
+                    T::lit(2.0 * core::f64::consts::FRAC_PI_3)
+                } else if t < T::lit(2.0) * at {
+                    T::lit(2.0 * core::f64::consts::FRAC_PI_3) * (T::lit(2.0) - t / at)
+                } else {
+                    T::zero()
+                };
+                // Current ramped up over the first 20 % of the first step.
+                let mag = i2 * (t / (T::lit(0.2) * at)).min(T::one());
+                self.i_ref = Ab::from_polar(mag, ang);
+                window = t >= T::lit(3.0) * at - T::lit(0.02);
+            }
+            Phase::Resistance => {
+                let (level, idx) = if self.sub == 0 { (i2, 1) } else { (i1, 0) };
+                self.i_ref = Ab::new(level, T::zero());
+                if t > settle {
+                    window = true;
+                    if self.have_prev {
+                        self.v_lvl[idx].push(self.c2.alpha);
+                        self.i_lvl[idx].push(T::lit(0.5) * (i.alpha + self.i_prev.alpha));
+                        self.vdc_stats.push(vdc);
+                    }
+                }
+            }
+            Phase::InductanceD | Phase::InductanceQ => {
+                self.i_ref = Ab::new(i1, T::zero());
+                self.inj_count += 1;
+                if self.inj_count >= INJ_HALF {
+                    self.inj_count = 0;
+                    self.inj_sign = -self.inj_sign;
+                }
+                let d_axis = self.phase == Phase::InductanceD;
+                let vh = self.v_inj * self.inj_sign;
+                inj = if d_axis {
+                    Ab::new(vh, T::zero())
+                } else {
+                    Ab::new(T::zero(), vh)
+                };
+                if t > T::lit(0.02) && self.have_prev {
+                    window = true;
+                    let (x, y) = if d_axis {
+                        (self.c2.alpha, i.alpha - self.i_prev.alpha)
+                    } else {
+                        (self.c2.beta, i.beta - self.i_prev.beta)
+                    };
+                    self.line.push(x, y);
+                }
+            }
+            _ => {}
+        }
+        // Integral-only regulator with clamping anti-windup; frozen (voltage mode, the
+        // machine's own resistance damping the rotor) in the alignment hold, the DC
+        // measurement windows and the injections.
+        let frozen = match self.phase {
+            Phase::Align => t >= T::lit(2.0) * at,
+            Phase::Resistance => t > T::lit(0.6) * settle,
+            _ => true,
+        };
+        let e = self.i_ref - i;
+        let v_max = cfg.voltage_limit_ratio * vdc * T::lit(SQRT3_INV);
+        let v_int = if frozen {
+            self.v_int
+        } else {
+            self.v_int + e * (self.k_int * ts)
+        };
+        let v = limit(v_int + inj, v_max);
+        if v != v_int + inj {
+            self.saturated_time += ts;
+        } else {
+            self.v_int = v_int;
+            self.saturated_time = T::zero();
+        }
+        // Following check: 20 ms low-pass of |i* − i| relative to |i*|.
+        let k = (ts / T::lit(0.02)).min(T::one());
+        self.err_par += k * (e.norm() - self.err_par);
+        // Rotation check: 20 ms low-pass of the back-EMF across the reference (the α axis
+        // after the alignment, where a turning rotor's EMF ω·λf lies), from the model with
+        // R̂s once known (the nameplate before) and the nameplate L.
+        if self.have_prev {
+            let np = cfg.nameplate;
+            let r = if self.rs > T::zero() { self.rs } else { np.rs };
+            let l = T::lit(0.5) * (np.ld + np.lq);
+            let emf =
+                self.c2 - (i + self.i_prev) * (T::lit(0.5) * r) - (i - self.i_prev) * (l / ts);
+            self.emf_lpf += (emf - self.emf_lpf) * k;
+        }
+        if self.saturated_time > T::lit(0.05) {
+            self.abort(AbortReason::CurrentNotFollowing { phase: self.phase });
+            return Ab::zero();
+        }
+        let iref = self.i_ref.norm();
+        let emf_limit = T::lit(0.02) * cfg.nameplate.rated_speed() * cfg.nameplate.flux_linkage;
+        if window && self.emf_lpf.beta.abs() > emf_limit {
+            self.abort(AbortReason::RotationDetected { phase: self.phase });
+            return Ab::zero();
+        }
+        if window && self.err_par > T::lit(0.25) * iref {
+            self.abort(AbortReason::CurrentNotFollowing { phase: self.phase });
+            return Ab::zero();
+        }
+        // Transitions.
+        match self.phase {
+            Phase::Align if t >= T::lit(3.0) * at => self.next_phase(Phase::Resistance),
+            Phase::Resistance if t >= settle + meas => {
+                if self.sub == 0 {
+                    self.sub = 1;
+                    self.nominal_done += self.t_phase;
+                    self.t_phase = T::zero();
+                } else {
+                    self.finish_resistance();
+                    if self.status == Status::Running {
+                        self.next_phase(Phase::InductanceD);
+                        self.inj_count = 0;
+                        self.inj_sign = T::one();
+                        self.line = Line::default();
+                    }
+                }
+            }
+            Phase::InductanceD if t >= T::lit(0.02) + meas => {
+                match self.finish_inductance(self.cfg.nameplate.ld, Parameter::Ld) {
+                    Some((l, s)) => {
+                        self.ld = l;
+                        self.ld_sigma = s;
+                        self.next_phase(Phase::InductanceQ);
+                        self.inj_count = 0;
+                        self.inj_sign = T::one();
+                        self.line = Line::default();
+                    }
+                    None => return Ab::zero(),
+                }
+            }
+            Phase::InductanceQ if t >= T::lit(0.02) + meas => {
+                match self.finish_inductance(self.cfg.nameplate.lq, Parameter::Lq) {
+                    Some((l, s)) => {
+                        self.lq = l;
+                        self.lq_sigma = s;
+                        self.start_spin();
+                    }
+                    None => return Ab::zero(),
+                }
+            }
+            _ => {}
+        }
+        v
+    }
+
+    fn finish_resistance(&mut self) {
+        let np = self.cfg.nameplate;
+        let (v1, v2) = (self.v_lvl[0].mean(), self.v_lvl[1].mean());
+        let (i1, i2) = (self.i_lvl[0].mean(), self.i_lvl[1].mean());
+        let di = i2 - i1;
+        let rs = (v2 - v1) / di;
+        let sq = |x: T| x * x;
+        // Voltage and current scatter of both levels (the voltage is frozen in the window,
+        // so the current carries the noise).
+        let s_v = (sq(self.v_lvl[0].sem())
+            + sq(self.v_lvl[1].sem())
+            + sq(rs * self.i_lvl[0].sem())
+            + sq(rs * self.i_lvl[1].sem()))
+        .sqrt();
+        self.rs = rs;
+        self.rs_sigma = s_v / di.abs() / rs.abs();
+        // α-axis intercept = 4/3 of the per-phase error (module docs).
+        self.v_inv = T::lit(0.75) * (v1 - rs * i1);
+        self.v_inv_sigma = T::lit(0.75) * (s_v + rs * self.rs_sigma * i1.abs());
+        if !(rs.is_finite() && rs > np.rs * T::lit(0.25) && rs < np.rs * T::lit(4.0)) {
+            self.abort(AbortReason::Implausible {
+                parameter: Parameter::Rs,
+            });
+            return;
+        }
+        let vdc = self.vdc_stats.mean();
+        if !(self.v_inv.is_finite()
+            && self.v_inv > T::lit(-0.01) * vdc
+            && self.v_inv < T::lit(0.1) * vdc)
+        {
+            self.abort(AbortReason::Implausible {
+                parameter: Parameter::InverterVoltage,
+            });
+        }
+    }
+
+    fn finish_inductance(&mut self, nameplate: T, parameter: Parameter) -> Option<(T, T)> {
+        let (a, sa) = self.line.slope();
+        let l = self.ts / a;
+        if !(l.is_finite()
+            && a > T::zero()
+            && l > nameplate * T::lit(0.25)
+            && l < nameplate * T::lit(4.0))
+        {
+            self.abort(AbortReason::Implausible { parameter });
+            return None;
+        }
+        Some((l, sa / a))
+    }
+
+    // ------------------------------------------------------------------ spinning phases
+
+    fn start_spin(&mut self) {
+        let wc = T::lit(0.2) / self.ts;
+        self.kp = Dq::new(wc * self.ld, wc * self.lq);
+        self.ki = wc * self.rs;
+        // Bumpless: the standstill voltage (rotor at θ = 0, frame at 0) becomes the integral,
+        // without the inverter error the compensation now supplies.
+        let comp = self.compensation(Dq::new(T::lit(0.45) * self.i_limit, T::zero()), T::zero());
+        self.pi_int = Dq::new(self.v_int.alpha - comp.alpha, self.v_int.beta - comp.beta);
+        self.theta_f = T::zero();
+        self.omega_f = T::zero();
+        self.pll_on = false;
+        self.err_perp = T::zero();
+        self.next_phase(Phase::Spin);
+    }
+
+    /// Dead-time compensation V̂·sat(i*_x/I_band) per phase of the reference current at the
+    /// frame angle `angle` (SPEC §5's trapezoid; I_band = 5 % of the limit).
+    fn compensation(&self, i_ref_dq: Dq<T>, angle: T) -> Ab<T> {
+        let i = i_ref_dq.to_ab(Rotation::from_angle(angle)).to_abc();
+        let band = T::lit(0.05) * self.i_limit;
+        let s = |x: T| clamp(x / band, -T::one(), T::one()) * self.v_inv;
+        Abc::new(s(i.a), s(i.b), s(i.c)).to_ab()
+    }
+
+    /// The inverter's voltage error V̂·sat(i_x/I_band) per phase of the measured current.
+    fn inverter_error(&self, i: Ab<T>) -> Ab<T> {
+        let i = i.to_abc();
+        let band = T::lit(0.05) * self.i_limit;
+        let s = |x: T| clamp(x / band, -T::one(), T::one()) * self.v_inv;
+        Abc::new(s(i.a), s(i.b), s(i.c)).to_ab()
+    }
+
+    /// Back-EMF over the last sample interval: E = v − R̂·i − L̂q·Δi/Ts (module docs).
+    fn emf(&self, i: Ab<T>) -> Ab<T> {
+        let i_mid = (i + self.i_prev) * T::lit(0.5);
+        self.c2 - i_mid * self.rs - (i - self.i_prev) * (self.lq / self.ts)
+    }
+
+    fn spinning(&mut self, i: Ab<T>, vdc: T) -> (Ab<T>, Ab<T>) {
+        let cfg = self.cfg;
+        let ts = self.ts;
+        let t = self.t_phase;
+        let i_if = T::lit(0.9) * self.i_limit;
+        let p = T::lit(cfg.nameplate.pole_pairs as f64);
+        // Back-EMF PLL.
+        let mut rate = self.omega_f;
+        let mut e_q = T::zero();
+        if self.pll_on {
+            let e = self.emf(i);
+            let half = T::lit(0.5) * self.pll_omega * ts;
+            let meas = e.angle() - T::frac_pi_2();
+            let err = clamp(
+                wrap_angle(meas - (self.pll_theta - half)),
+                -T::lit(0.5),
+                T::lit(0.5),
+            );
+            if err.is_finite() {
+                self.pll_omega += self.pll_ki * ts * err;
+                rate = self.pll_omega + self.pll_kp * err;
+            } else {
+                rate = self.pll_omega;
+            }
+            let rot_mid = Rotation::from_angle(self.pll_theta - half);
+            e_q = -e.alpha * rot_mid.sin + e.beta * rot_mid.cos;
+        } else if self.phase == Phase::Spin && self.omega_f >= self.spin_speed && self.have_prev {
+            // Start the PLL on the back-EMF's angle.
+            let e = self.emf(i);
+            self.pll_theta = wrap_angle(e.angle() - T::frac_pi_2());
+            self.pll_omega = self.omega_f;
+            self.pll_on = true;
+            rate = self.omega_f;
+        }
+        // Reference and frame.
+        let (theta_c, omega_c, i_ref_dq) = match self.phase {
+            Phase::Spin => {
+                self.omega_f = (self.omega_f + self.spin_accel * ts).min(self.spin_speed);
+                let ramp = (t / T::lit(0.02)).min(T::one());
+                let mag = T::lit(0.45) * self.i_limit + (i_if - T::lit(0.45) * self.i_limit) * ramp;
+                (self.theta_f, self.omega_f, Dq::new(mag, T::zero()))
+            }
+            Phase::Coast => (
+                self.pll_theta,
+                rate,
+                Dq::new(-T::lit(COAST_ID) * self.i_limit, T::zero()),
+            ),
+            _ => {
+                let iq = if self.j_step == 0 {
+                    self.i_j
+                } else {
+                    -self.i_j
+                };
+                (self.pll_theta, rate, Dq::new(T::zero(), iq))
+            }
+        };
+        let rot = Rotation::from_angle(theta_c);
+        let i_dq = i.to_dq(rot);
+        // Coast: λf accumulation after 20 ms of decay.
+        // The PLL's integral state is its speed (the proportional path's noise, kp·err, would
+        // bias any average conditioned on it).
+        let w = self.pll_omega;
+        if self.phase == Phase::Coast && t > T::lit(0.02) && w > T::zero() {
+            // E_q = ω·(λf + (Ld − Lq)·i_d) (active flux).
+            let e_f = e_q - w * (self.ld - self.lq) * i_dq.d;
+            self.e_int += e_f * ts;
+            self.theta_int += w * ts;
+            self.flux_blocks.push(e_f / w);
+        }
+        // Inertia windows (coast after 20 ms and the steps; 30 ms skipped after a step change).
+        let collect = match self.phase {
+            Phase::Coast => t > T::lit(0.02),
+            Phase::Inertia => t > T::lit(0.03),
+            _ => false,
+        };
+        if collect {
+            let te = T::lit(1.5) * p * (self.flux * i_dq.q + (self.ld - self.lq) * i_dq.d * i_dq.q);
+            if self.w_k == 0 {
+                self.w_omega0 = self.pll_omega / p;
+                self.w_int_omega = T::zero();
+                self.w_int_te = T::zero();
+            }
+            self.w_int_omega += w / p * ts;
+            self.w_int_te += te * ts;
+            self.w_k += 1;
+            if T::lit(self.w_k as f64) * ts >= T::lit(J_WINDOW) {
+                let d_omega = self.pll_omega / p - self.w_omega0;
+                // Δω = (1/J)·∫Te − (B/J)·∫ω: the noisy speed difference on the left, where its
+                // noise does not bias the fit (it would attenuate Ĵ as a regressor).
+                self.ls.push(self.w_int_te, -self.w_int_omega, d_omega);
+                self.w_k = 0;
+            }
+        } else {
+            self.w_k = 0;
+        }
+        // Synchronous PI with decoupling, output advanced by 1.5 samples.
+        let e = i_ref_dq - i_dq;
+        let ff = Dq::new(
+            -omega_c * self.lq * i_ref_dq.q,
+            omega_c * self.ld * i_ref_dq.d,
+        );
+        let int_new = self.pi_int + e * (self.ki * ts);
+        let v_dq = Dq::new(self.kp.d * e.d, self.kp.q * e.q) + int_new + ff;
+        let adv = theta_c + T::lit(1.5) * omega_c * ts;
+        let comp = self.compensation(i_ref_dq, adv);
+        let v_raw = v_dq.to_ab(Rotation::from_angle(adv)) + comp;
+        let v_max = T::lit(0.95) * vdc * T::lit(SQRT3_INV);
+        let v = limit(v_raw, v_max);
+        if v == v_raw {
+            self.pi_int = int_new;
+        }
+        // Following check (20 ms low-pass of the error against 30 % of the limit).
+        let k = (ts / T::lit(0.02)).min(T::one());
+        self.err_perp += k * (e.norm() - self.err_perp);
+        if self.err_perp > T::lit(0.3) * self.i_limit && t > T::lit(0.05) {
+            self.abort(AbortReason::CurrentNotFollowing { phase: self.phase });
+            return (Ab::zero(), Ab::zero());
+        }
+        // Advance frames.
+        self.theta_f = wrap_angle(self.theta_f + self.omega_f * ts);
+        if self.pll_on {
+            self.pll_theta = wrap_angle(self.pll_theta + rate * ts);
+            let w = self.pll_omega;
+            if self.phase != Phase::Spin
+                && t > T::lit(0.02)
+                && (w > T::lit(2.0 * J_HIGH) * self.spin_speed
+                    || w < T::lit(0.25) * self.spin_speed)
+            {
+                self.abort(AbortReason::Overspeed { phase: self.phase });
+                return (Ab::zero(), Ab::zero());
+            }
+        }
+        // Transitions.
+        let spin_time = self.spin_speed / self.spin_accel + cfg.settle_time;
+        match self.phase {
+            Phase::Spin if t >= spin_time && self.pll_on => {
+                // Re-express the integral in the PLL frame.
+                let int_ab = self.pi_int.to_ab(Rotation::from_angle(self.theta_f));
+                self.pi_int = int_ab.to_dq(Rotation::from_angle(self.pll_theta));
+                self.e_int = T::zero();
+                self.theta_int = T::zero();
+                self.next_phase(Phase::Coast);
+            }
+            Phase::Coast if t >= T::lit(0.02) + cfg.measure_time => {
+                self.flux = self.e_int / self.theta_int;
+                self.flux_sigma = self.flux_blocks.sem() / self.flux_blocks.mean().abs();
+                let np = cfg.nameplate.flux_linkage;
+                if !(self.flux.is_finite()
+                    && self.flux > T::lit(0.25) * np
+                    && self.flux < T::lit(4.0) * np)
+                {
+                    self.abort(AbortReason::Implausible {
+                        parameter: Parameter::FluxLinkage,
+                    });
+                    return (Ab::zero(), Ab::zero());
+                }
+                // q current of the torque steps: each step takes J_STEP_TIME on the nameplate
+                // inertia with the identified λ̂f, within 10–90 % of the limit.
+                let p = T::lit(cfg.nameplate.pole_pairs as f64);
+                let d_omega_mech = T::lit(J_HIGH - J_LOW) * self.spin_speed / p;
+                let kt = T::lit(1.5) * p * self.flux;
+                self.i_j = clamp(
+                    cfg.nameplate.inertia * d_omega_mech / (T::lit(J_STEP_TIME) * kt),
+                    T::lit(0.1) * self.i_limit,
+                    T::lit(0.9) * self.i_limit,
+                );
+                self.j_step = 0;
+                self.w_k = 0;
+                self.next_phase(Phase::Inertia);
+            }
+            Phase::Inertia => {
+                if self.j_step == 0 && self.pll_omega >= T::lit(J_HIGH) * self.spin_speed {
+                    self.j_step = 1;
+                    self.w_k = 0;
+                    self.nominal_done += self.t_phase;
+                    self.t_phase = T::zero();
+                } else if self.j_step == 1 && self.pll_omega <= T::lit(J_LOW) * self.spin_speed {
+                    self.finish_inertia();
+                }
+            }
+            _ => {}
+        }
+        // The voltage the inverter will apply: the command less its error, estimated from
+        // the measured phase currents (the compensation follows the reference and is wrong
+        // while the current is off it, e.g. at the start of the coast).
+        let applied = v - comp;
+        (v, applied)
+    }
+
+    fn finish_inertia(&mut self) {
+        let np = self.cfg.nameplate;
+        let Some(((inv_j, b_over_j), (s_inv_j, s_b_over_j))) = self.ls.solve() else {
+            self.abort(AbortReason::Implausible {
+                parameter: Parameter::Inertia,
+            });
+            return;
+        };
+        let j = T::one() / inv_j;
+        let b = b_over_j * j;
+        let sj = s_inv_j / inv_j * j;
+        let sb = s_b_over_j * j;
+        if !(j.is_finite() && j > T::lit(0.1) * np.inertia && j < T::lit(10.0) * np.inertia) {
+            self.abort(AbortReason::Implausible {
+                parameter: Parameter::Inertia,
+            });
+            return;
+        }
+        // Friction: B·ω at the rated speed must stay below the rated torque.
+        if !(b.is_finite() && b.abs() * np.rated_speed_mech() < np.rated_torque) {
+            self.abort(AbortReason::Implausible {
+                parameter: Parameter::ViscousFriction,
+            });
+            return;
+        }
+        let model = MachineModel {
+            rs: self.rs,
+            ld: self.ld,
+            lq: self.lq,
+            flux_linkage: self.flux,
+            inertia: j,
+            viscous_friction: b.max(T::zero()),
+            ..np
+        };
+        let vdc = self.vdc_stats.mean();
+        self.result = Some(Identification {
+            model,
+            confidence: Confidence {
+                rs: self.rs_sigma,
+                ld: self.ld_sigma,
+                lq: self.lq_sigma,
+                flux_linkage: self.flux_sigma,
+                inertia: sj / j,
+                viscous_friction: sb,
+                inverter_voltage: self.v_inv_sigma,
+            },
+            inverter_voltage: self.v_inv,
+            threshold_voltage: self.v_inv - self.cfg.dead_time * self.cfg.switching_frequency * vdc,
+            saliency: self.lq / self.ld,
+            dc_voltage: vdc,
+            duration: self.t_total,
+        });
+        self.status = Status::Done;
+        self.nominal_done += self.t_phase;
+        self.t_phase = T::zero();
+        self.phase = Phase::Done;
+        self.i_ref = Ab::zero();
+    }
+}
+
+fn libm_round(x: f64) -> u32 {
+    let r = x + 0.5;
+    if r < 1.0 { 1 } else { r as u32 }
+}

@@ -1,0 +1,190 @@
+//! Commissioning on the simulated plant against its truth (default non-idealities).
+
+use fado_core::MachineModel;
+use fado_core::commissioning::{AbortReason, Status};
+use fado_sim::commission::{CommissionOptions, commission};
+use fado_sim::sim::PlantParams;
+
+/// The 2.2 kW IPMSM of the "any motor" issue (p 3, Rs 3.6 Ω, Ld 36 mH, Lq 51 mH, λf 0.545 Wb,
+/// 540 V); J assumed 0.01 kg·m², B 2e-3, rated 6 A peak, 1500 r/min, 14.7 N·m.
+pub fn ipmsm() -> (PlantParams, MachineModel<f64>) {
+    let mut p = PlantParams::default();
+    p.motor.rs = 3.6;
+    p.motor.ld = 36e-3;
+    p.motor.lq = 51e-3;
+    p.motor.flux_linkage = 0.545;
+    p.motor.pole_pairs = 3;
+    p.motor.inertia = 0.01;
+    p.motor.viscous_friction = 2e-3;
+    p.inverter.dc_voltage = 540.0;
+    p.current_sensor.adc_full_scale = 6.0 * 50.0 / 21.78;
+    let m = MachineModel {
+        rs: 3.6,
+        ld: 36e-3,
+        lq: 51e-3,
+        flux_linkage: 0.545,
+        pole_pairs: 3,
+        inertia: 0.01,
+        viscous_friction: 2e-3,
+        rated_current: 6.0,
+        rated_speed_rpm: 1500.0,
+        rated_torque: 14.7,
+        dc_voltage: 540.0,
+    };
+    (p, m)
+}
+
+/// The paper's motor on the default plant.
+pub fn paper() -> (PlantParams, MachineModel<f64>) {
+    (PlantParams::default(), MachineModel::paper())
+}
+
+/// A nameplate off by the given factors.
+fn rough(m: MachineModel<f64>, k: f64) -> MachineModel<f64> {
+    MachineModel {
+        rs: m.rs * k,
+        ld: m.ld / k,
+        lq: m.lq * k,
+        flux_linkage: m.flux_linkage / k,
+        inertia: m.inertia * k,
+        ..m
+    }
+}
+
+fn report(
+    name: &str,
+    plant: &PlantParams,
+    np: MachineModel<f64>,
+) -> fado_sim::commission::CommissionOutcome {
+    let o = commission(
+        plant,
+        np,
+        CommissionOptions {
+            decimation: 1,
+            ..Default::default()
+        },
+        |_| {},
+        None,
+    )
+    .unwrap();
+    let t = o.truth;
+    if let Ok(dir) = std::env::var("FADO_TRACE") {
+        let mut w = String::from(
+            "time,phase,i_alpha,i_beta,v_alpha,v_beta,va_true,vb_true,speed_rpm,speed_hat_rpm,theta,theta_hat\n",
+        );
+        for r in &o.trace {
+            w += &format!(
+                "{},{},{},{},{},{},{},{},{},{},{},{}\n",
+                r.time,
+                r.phase,
+                r.i_alpha,
+                r.i_beta,
+                r.v_alpha,
+                r.v_beta,
+                r.v_applied_alpha,
+                r.v_applied_beta,
+                r.speed_rpm,
+                r.speed_hat_rpm,
+                r.theta,
+                r.theta_hat
+            );
+        }
+        std::fs::write(format!("{dir}/{}.csv", name.replace(' ', "_")), w).unwrap();
+    }
+    eprintln!(
+        "{name}: {:?} in {:.2} s sim ({:.1} s wall)",
+        o.status, o.simulated_seconds, o.wall_seconds
+    );
+    if let Some(id) = o.identification {
+        let m = id.model;
+        let e = |a: f64, b: f64| 100.0 * (a / b - 1.0);
+        eprintln!(
+            "  rs {:+.2}% ld {:+.2}% lq {:+.2}% flux {:+.2}% J {:+.2}% B {:.2e} (true {:.2e}) Vinv {:.3} (true {:.3}) Vth {:.3} (true {:.3})",
+            e(m.rs, t.rs),
+            e(m.ld, t.ld),
+            e(m.lq, t.lq),
+            e(m.flux_linkage, t.flux_linkage),
+            e(m.inertia, t.inertia),
+            m.viscous_friction,
+            t.viscous_friction,
+            id.inverter_voltage,
+            t.inverter_voltage,
+            id.threshold_voltage,
+            t.threshold_voltage
+        );
+        eprintln!("  confidence {:?}", id.confidence);
+    }
+    eprintln!(
+        "  max |i| {:.2} A, max |i*| {:.2} (limit {:.2}), rotor motion in L tests {:.2e} rad",
+        o.max_current, o.max_current_reference, o.current_limit, o.rotor_motion_inductance
+    );
+    o
+}
+
+fn check(o: &fado_sim::commission::CommissionOutcome) {
+    assert_eq!(o.status, Status::Done);
+    let id = o.identification.unwrap();
+    let (m, t) = (id.model, o.truth);
+    let rel = |a: f64, b: f64| (a / b - 1.0).abs();
+    assert!(rel(m.rs, t.rs) < 0.02, "rs {} vs {}", m.rs, t.rs);
+    assert!(rel(m.ld, t.ld) < 0.05, "ld {} vs {}", m.ld, t.ld);
+    assert!(rel(m.lq, t.lq) < 0.05, "lq {} vs {}", m.lq, t.lq);
+    assert!(
+        rel(m.flux_linkage, t.flux_linkage) < 0.02,
+        "flux {} vs {}",
+        m.flux_linkage,
+        t.flux_linkage
+    );
+    assert!(
+        rel(m.inertia, t.inertia) < 0.10,
+        "J {} vs {}",
+        m.inertia,
+        t.inertia
+    );
+    assert!(
+        (id.threshold_voltage - t.threshold_voltage).abs() < 0.1,
+        "Vth {} vs {}",
+        id.threshold_voltage,
+        t.threshold_voltage
+    );
+    assert!(o.simulated_seconds < 30.0);
+    assert!(o.max_current_reference <= o.current_limit * (1.0 + 1e-12));
+}
+
+#[test]
+fn paper_motor_is_identified_within_the_targets() {
+    let (p, m) = paper();
+    check(&report("paper", &p, m));
+}
+
+#[test]
+fn ipmsm_is_identified_within_the_targets() {
+    let (p, m) = ipmsm();
+    check(&report("ipmsm", &p, m));
+}
+
+#[test]
+fn a_rough_nameplate_is_enough() {
+    for k in [0.6, 1.6] {
+        let (p, m) = ipmsm();
+        check(&report("ipmsm rough", &p, rough(m, k)));
+        let (p, m) = paper();
+        check(&report("paper rough", &p, rough(m, k)));
+    }
+}
+
+#[test]
+fn a_motor_turned_by_its_load_aborts_with_rotation() {
+    let (mut p, m) = paper();
+    p.load.mode = fado_sim::load::LoadMode::Speed;
+    p.load.speed_rpm = fado_sim::profile::Profile::constant(75.0);
+    let o = report("paper driven", &p, m);
+    assert!(
+        matches!(
+            o.status,
+            Status::Aborted(AbortReason::RotationDetected { .. })
+        ),
+        "{:?}",
+        o.status
+    );
+}
