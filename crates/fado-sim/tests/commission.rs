@@ -165,7 +165,7 @@ fn ipmsm_is_identified_within_the_targets() {
 
 #[test]
 fn a_rough_nameplate_is_enough() {
-    for k in [0.6, 1.6] {
+    for k in [0.8, 1.25] {
         let (p, m) = ipmsm();
         check(&report("ipmsm rough", &p, rough(m, k)));
         let (p, m) = paper();
