@@ -633,7 +633,8 @@ impl<T: Real> Commissioning<T> {
         let l_avg_np = T::lit(0.5) * (np.ld + np.lq);
         // Integral gain K = R²/L of the standstill loop (module docs), bounded so that the loop
         // stays well below the sampling rate (K·Ts/L ≤ 0.01 gives ωn·Ts ≤ 0.1).
-        let k_int = (T::lit(0.5) * np.rs * np.rs / l_avg_np).min(T::lit(0.01) * l_avg_np / (ts * ts));
+        let k_int =
+            (T::lit(0.5) * np.rs * np.rs / l_avg_np).min(T::lit(0.01) * l_avg_np / (ts * ts));
         // Injection: a current ripple of 30 % of the I₁ bias (45 % of the limit), peak-peak.
         let i1 = T::lit(0.45) * i_limit;
         let v_inj = T::lit(0.3) * i1 * l_avg_np / (T::lit(INJ_HALF as f64) * ts);
@@ -1176,14 +1177,6 @@ impl<T: Real> Commissioning<T> {
         Abc::new(s(i.a), s(i.b), s(i.c)).to_ab()
     }
 
-    /// The inverter's voltage error V̂·sat(i_x/I_band) per phase of the measured current.
-    fn inverter_error(&self, i: Ab<T>) -> Ab<T> {
-        let i = i.to_abc();
-        let band = T::lit(0.05) * self.i_limit;
-        let s = |x: T| clamp(x / band, -T::one(), T::one()) * self.v_inv;
-        Abc::new(s(i.a), s(i.b), s(i.c)).to_ab()
-    }
-
     /// Back-EMF over the last sample interval: E = v − R̂·i − L̂q·Δi/Ts (module docs).
     fn emf(&self, i: Ab<T>) -> Ab<T> {
         let i_mid = (i + self.i_prev) * T::lit(0.5);
@@ -1372,9 +1365,8 @@ impl<T: Real> Commissioning<T> {
             }
             _ => {}
         }
-        // The voltage the inverter will apply: the command less its error, estimated from
-        // the measured phase currents (the compensation follows the reference and is wrong
-        // while the current is off it, e.g. at the start of the coast).
+        // The voltage the inverter will apply: the command less its error, i.e. less the
+        // compensation (which models it).
         let applied = v - comp;
         (v, applied)
     }

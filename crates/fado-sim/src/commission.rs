@@ -210,3 +210,106 @@ pub fn commission(
         rotor_motion_inductance: motion,
     })
 }
+
+/// The identified model as a TOML document with a `[model]` section (the keys of `[motor]`,
+/// i.e. of [`MachineModel`]) and an `[inverter_identified]` comment block.
+pub fn identified_toml(id: &Identification<f64>) -> String {
+    let m = id.model;
+    let c = id.confidence;
+    format!(
+        "# Identified by `fado-sim commission` (fado_core::commissioning) in {:.2} s.\n\
+         # Relative 1-sigma statistical uncertainty: rs {:.2e}, ld {:.2e}, lq {:.2e}, \
+         flux_linkage {:.2e}, inertia {:.2e}.\n\
+         # Inverter voltage error {:.4} V per phase (threshold {:.4} V at {:.1} V DC link), \
+         saliency Lq/Ld {:.4}.\n\
+         [model]\n\
+         rs = {:e}\nld = {:e}\nlq = {:e}\nflux_linkage = {:e}\npole_pairs = {}\n\
+         inertia = {:e}\nviscous_friction = {:e}\nrated_current = {:e}\n\
+         rated_speed_rpm = {:e}\nrated_torque = {:e}\n",
+        id.duration,
+        c.rs,
+        c.ld,
+        c.lq,
+        c.flux_linkage,
+        c.inertia,
+        id.inverter_voltage,
+        id.threshold_voltage,
+        id.dc_voltage,
+        id.saliency,
+        m.rs,
+        m.ld,
+        m.lq,
+        m.flux_linkage,
+        m.pole_pairs,
+        m.inertia,
+        m.viscous_friction,
+        m.rated_current,
+        m.rated_speed_rpm,
+        m.rated_torque,
+    )
+}
+
+/// One row of the identified-vs-truth comparison.
+#[derive(Clone, Debug, Serialize)]
+pub struct Comparison {
+    /// Parameter name (a `[model]` key, or `inverter_voltage`/`threshold_voltage`).
+    pub parameter: &'static str,
+    /// Identified value.
+    pub identified: f64,
+    /// The plant's value.
+    pub truth: f64,
+    /// identified/truth − 1 (absolute difference in V for the inverter voltages).
+    pub error: f64,
+    /// Relative 1-σ statistical uncertainty (absolute in V for the inverter voltage).
+    pub confidence: f64,
+}
+
+/// The identified values against the truth.
+pub fn compare(id: &Identification<f64>, t: &Truth) -> Vec<Comparison> {
+    let m = id.model;
+    let c = id.confidence;
+    let rel = |p, a: f64, b: f64, s| Comparison {
+        parameter: p,
+        identified: a,
+        truth: b,
+        error: a / b - 1.0,
+        confidence: s,
+    };
+    let abs = |p, a: f64, b: f64, s| Comparison {
+        parameter: p,
+        identified: a,
+        truth: b,
+        error: a - b,
+        confidence: s,
+    };
+    vec![
+        rel("rs", m.rs, t.rs, c.rs),
+        rel("ld", m.ld, t.ld, c.ld),
+        rel("lq", m.lq, t.lq, c.lq),
+        rel(
+            "flux_linkage",
+            m.flux_linkage,
+            t.flux_linkage,
+            c.flux_linkage,
+        ),
+        rel("inertia", m.inertia, t.inertia, c.inertia),
+        abs(
+            "viscous_friction",
+            m.viscous_friction,
+            t.viscous_friction,
+            c.viscous_friction,
+        ),
+        abs(
+            "inverter_voltage",
+            id.inverter_voltage,
+            t.inverter_voltage,
+            c.inverter_voltage,
+        ),
+        abs(
+            "threshold_voltage",
+            id.threshold_voltage,
+            t.threshold_voltage,
+            c.inverter_voltage,
+        ),
+    ]
+}

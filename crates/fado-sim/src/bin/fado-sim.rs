@@ -93,6 +93,24 @@ enum Command {
         #[arg(long)]
         fresh: bool,
     },
+    /// Identify the motor of FILE's `[motor]` (with `rated_current`, `rated_speed_rpm`,
+    /// `rated_torque`) on the simulated plant with `fado_core::commissioning`; print each
+    /// parameter against the plant's truth; write DIR/identified.toml (`[model]`),
+    /// DIR/metrics.json and DIR/traces.csv.
+    Commission {
+        /// TOML file: the plant (`[motor]` with its ratings, `[inverter]`, sensors, …).
+        #[arg(long)]
+        config: PathBuf,
+        /// Output directory. Default `out/commission`.
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Current-sensor noise seed.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Use the averaged inverter model.
+        #[arg(long)]
+        averaged: bool,
+    },
     /// Run every estimator in every scenario on the same plant, seed and controllers; print
     /// the table, write DIR/compare.json and DIR/compare.md.
     Compare {
@@ -248,6 +266,12 @@ fn run(cli: Cli) -> Result<ExitCode, Box<dyn std::error::Error>> {
             let dir = out.unwrap_or_else(|| PathBuf::from("out").join(format!("{scenario}-sweep")));
             run_sweep(&spec, dir, threads, fresh)
         }
+        Command::Commission {
+            config,
+            out,
+            seed,
+            averaged,
+        } => run_commission(&config, out, seed, averaged),
         Command::Compare {
             scenarios,
             estimators,
@@ -309,6 +333,153 @@ fn run(cli: Cli) -> Result<ExitCode, Box<dyn std::error::Error>> {
 }
 
 /// A configuration error located in the `--config` file reads `FILE:LINE:COLUMN: `key`: …`.
+fn run_commission(
+    config: &std::path::Path,
+    out: Option<PathBuf>,
+    seed: u64,
+    averaged: bool,
+) -> Result<ExitCode, Box<dyn std::error::Error>> {
+    use fado_sim::commission::{self, CommissionOptions};
+    let text = std::fs::read_to_string(config)
+        .map_err(|e| format!("cannot read {}: {e}", config.display()))?;
+    // The ratings are `[motor]` keys; until the simulator's config reads them itself they are
+    // taken out here (a missing one is named).
+    let mut table: toml::Table = text
+        .parse()
+        .map_err(|e| format!("{}: {e}", config.display()))?;
+    let mut rating = |key: &str| -> Result<f64, String> {
+        let motor = table
+            .get_mut("motor")
+            .and_then(|m| m.as_table_mut())
+            .ok_or_else(|| format!("{}: missing [motor]", config.display()))?;
+        match motor.remove(key) {
+            Some(toml::Value::Float(x)) => Ok(x),
+            Some(toml::Value::Integer(x)) => Ok(x as f64),
+            Some(_) => Err(format!(
+                "{}: motor.{key} must be a number",
+                config.display()
+            )),
+            None => Err(format!(
+                "{}: motor.{key} is required by commission",
+                config.display()
+            )),
+        }
+    };
+    let rated_current = rating("rated_current")?;
+    let rated_speed_rpm = rating("rated_speed_rpm")?;
+    let rated_torque = rating("rated_torque")?;
+    let rest = toml::to_string(&table)?;
+    let mut cfg =
+        fado_sim::SimConfig::from_toml(&rest).map_err(|e| format!("{}: {e}", config.display()))?;
+    cfg.current_sensor.seed = seed;
+    if averaged {
+        cfg.inverter.model = fado_sim::inverter::InverterModel::Averaged;
+    }
+    let plant = cfg.plant();
+    let m = plant.motor;
+    let nameplate = fado_core::MachineModel {
+        rs: m.rs,
+        ld: m.ld,
+        lq: m.lq,
+        flux_linkage: m.flux_linkage,
+        pole_pairs: m.pole_pairs,
+        inertia: m.inertia,
+        viscous_friction: m.viscous_friction,
+        rated_current,
+        rated_speed_rpm,
+        rated_torque,
+        dc_voltage: plant.inverter.dc_voltage,
+    };
+    let bar = ProgressBar::new(1000);
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} {msg:<14} [{bar:40}] {percent:>3}%")?
+            .progress_chars("=> "),
+    );
+    let mut cb = |f: f64, phase: fado_core::commissioning::Phase| {
+        bar.set_message(phase.name());
+        bar.set_position((f * 1000.0) as u64);
+    };
+    let o = commission::commission(
+        &plant,
+        nameplate,
+        CommissionOptions::default(),
+        |_| {},
+        Some(&mut cb),
+    )?;
+    bar.finish_and_clear();
+    let dir = out.unwrap_or_else(|| PathBuf::from("out").join("commission"));
+    std::fs::create_dir_all(&dir)?;
+    let rows = o
+        .identification
+        .as_ref()
+        .map(|id| commission::compare(id, &o.truth))
+        .unwrap_or_default();
+    let metrics = serde_json::json!({
+        "passed": o.identification.is_some(),
+        "status": format!("{:?}", o.status),
+        "simulated_seconds": o.simulated_seconds,
+        "wall_seconds": o.wall_seconds,
+        "max_current": o.max_current,
+        "max_current_reference": o.max_current_reference,
+        "current_limit": o.current_limit,
+        "rotor_motion_inductance": o.rotor_motion_inductance,
+        "seed": seed,
+        "parameters": rows,
+    });
+    std::fs::write(
+        dir.join("metrics.json"),
+        serde_json::to_string_pretty(&metrics)?,
+    )?;
+    let mut w = csv::Writer::from_path(dir.join("traces.csv"))?;
+    for r in &o.trace {
+        w.serialize(r)?;
+    }
+    w.flush()?;
+    println!(
+        "commissioning: {:?} after {:.2} s simulated",
+        o.status, o.simulated_seconds
+    );
+    if let Some(id) = &o.identification {
+        println!(
+            "{:<18} {:>14} {:>14} {:>10} {:>10}",
+            "parameter", "identified", "truth", "error", "1-sigma"
+        );
+        for r in &rows {
+            let rel = !matches!(
+                r.parameter,
+                "viscous_friction" | "inverter_voltage" | "threshold_voltage"
+            );
+            if rel {
+                println!(
+                    "{:<18} {:>14.6e} {:>14.6e} {:>+9.3}% {:>9.3}%",
+                    r.parameter,
+                    r.identified,
+                    r.truth,
+                    100.0 * r.error,
+                    100.0 * r.confidence
+                );
+            } else {
+                println!(
+                    "{:<18} {:>14.6e} {:>14.6e} {:>+10.3e} {:>10.3e}",
+                    r.parameter, r.identified, r.truth, r.error, r.confidence
+                );
+            }
+        }
+        // Written whole: to a temporary file, then renamed.
+        let tmp = dir.join("identified.toml.tmp");
+        std::fs::write(&tmp, commission::identified_toml(id))?;
+        std::fs::rename(&tmp, dir.join("identified.toml"))?;
+        println!(
+            "wrote {}/identified.toml, metrics.json and traces.csv",
+            dir.display()
+        );
+        Ok(ExitCode::SUCCESS)
+    } else {
+        println!("wrote {}/metrics.json and traces.csv", dir.display());
+        Ok(ExitCode::from(1))
+    }
+}
+
 fn in_file(e: SimConfigError, config: &Option<PathBuf>) -> SimConfigError {
     match config {
         Some(p) => e.in_file(p.display().to_string()),
