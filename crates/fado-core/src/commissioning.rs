@@ -496,7 +496,8 @@ impl<T: Real> Ls2<T> {
     /// ((a, b), (σ_a, σ_b)).
     fn solve(&self) -> Option<((T, T), (T, T))> {
         let det = self.a11 * self.a22 - self.a12 * self.a12;
-        if !(det > T::zero()) || self.n < T::lit(4.0) {
+        if det.partial_cmp(&T::zero()) != Some(core::cmp::Ordering::Greater) || self.n < T::lit(4.0)
+        {
             return None;
         }
         let j = (self.b1 * self.a22 - self.b2 * self.a12) / det;

@@ -165,7 +165,7 @@ pub fn commission(
             let t0 = *theta_l.get_or_insert(st.theta);
             motion = motion.max(fado_core::wrap_angle(st.theta - t0).abs());
         }
-        if k % options.decimation.max(1) as u64 == 0 {
+        if k.is_multiple_of(options.decimation.max(1) as u64) {
             let i = i_abc.to_ab();
             trace.push(TraceRow {
                 time: plant.time(),
