@@ -205,7 +205,8 @@ pub struct CommissioningConfig<T> {
     /// Current limit as a fraction of the rated current. Default 0.5 (half the rated current:
     /// the tests heat the winding at most a quarter of its rated loss).
     pub current_limit_ratio: T,
-    /// Over-current trip as a multiple of the current limit. Default 1.5.
+    /// Over-current trip as a multiple of the current limit. Default 2 (the rated current at
+    /// the default limit: the alignment's swing adds its EMF's current to the reference).
     pub trip_ratio: T,
     /// Standstill voltage limit as a fraction of Vdc/√3. Default 0.5.
     pub voltage_limit_ratio: T,
@@ -237,7 +238,7 @@ impl<T: Real> CommissioningConfig<T> {
             switching_frequency: T::lit(0.5) / sample_period,
             dead_time,
             current_limit_ratio: T::lit(0.5),
-            trip_ratio: T::lit(1.5),
+            trip_ratio: T::lit(2.0),
             voltage_limit_ratio: T::lit(0.5),
             spin_speed_ratio: T::lit(0.2),
             spin_torque_ratio: T::lit(0.1),
@@ -941,8 +942,10 @@ impl<T: Real> Commissioning<T> {
                 } else {
                     T::zero()
                 };
-                // Current ramped up over the first 20 % of the first step.
-                let mag = i2 * (t / (T::lit(0.2) * at)).min(T::one());
+                // Current ramped up over the whole first step: the rotor is pulled in
+                // quasi-statically rather than kicked (a kick's swing drives extra current
+                // through the slow loop by its EMF).
+                let mag = i2 * (t / at).min(T::one());
                 self.i_ref = Ab::from_polar(mag, ang);
                 // Rotation is expected here: checked from the DC test on.
             }
@@ -1035,7 +1038,14 @@ impl<T: Real> Commissioning<T> {
         }
         let iref = self.i_ref.norm();
         let emf_limit = self.emf_limit();
-        if window && self.emf_lpf.beta.abs() > emf_limit {
+        // The rotation check starts where the rotor must be still: after the alignment and
+        // 60 % of the first settling (whether or not the current has settled).
+        let still = match self.phase {
+            Phase::Align => false,
+            Phase::Resistance => t > T::lit(0.6) * settle,
+            _ => true,
+        };
+        if (window || still) && self.emf_lpf.beta.abs() > emf_limit {
             self.abort(AbortReason::RotationDetected { phase: self.phase });
             return Ab::zero();
         }

@@ -198,7 +198,7 @@ fn ideal_machines_are_identified() {
 #[test]
 fn the_inverter_voltage_error_is_separated_from_the_resistance() {
     let m = MachineModel::<f64>::paper();
-    let mut plant = Ideal::new(m, 1.0);
+    let mut plant = Ideal::new(m, -2.0);
     plant.v_err = 4.0;
     let cfg = config::<f64>(m);
     let (status, id, ..) = run(&mut plant, cfg);

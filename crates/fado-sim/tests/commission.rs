@@ -188,3 +188,25 @@ fn a_motor_turned_by_its_load_aborts_with_rotation() {
         o.status
     );
 }
+
+#[test]
+fn any_initial_rotor_angle() {
+    for (name, (p, m)) in [("paper", paper()), ("ipmsm", ipmsm())] {
+        for k in 0..8 {
+            let theta0 = -3.1 + k as f64 * 6.2 / 7.0;
+            let o = commission(
+                &p,
+                m,
+                CommissionOptions {
+                    theta0,
+                    ..Default::default()
+                },
+                |_| {},
+                None,
+            )
+            .unwrap();
+            eprintln!("{name} θ0 {theta0:+.2}: {:?}", o.status);
+            check(&o);
+        }
+    }
+}
