@@ -26,13 +26,16 @@
 //! 2. **Alignment** ([`Phase::Align`]): a current vector at 2π/3, then turned to 0 (α axis),
 //!    drags the rotor's d axis onto phase a. Two steps so that a rotor starting at the
 //!    unstable equilibrium of one is pulled by the other (the usual two-step alignment, e.g.
-//!    ST MCSDK's and TI InstaSPIN's). The standstill regulator is an *integral-only* loop
-//!    (v̇ = K·(i* − i), K = R̂²/(2L̂), a closed loop L·s² + R·s + K with ζ ≈ 0.7 on the
-//!    nameplate):
-//!    it leaves the machine's own resistance as the damping of the rotor's swing (a fast
-//!    current loop would remove it and the rotor would ring for seconds).
-//! 3. **Resistance** ([`Phase::Resistance`]): DC current along α at two levels I₁ < I₂ (45 % and
-//!    90 % of the limit). With all three phase currents beyond the inverter's current band the
+//!    ST MCSDK's and TI InstaSPIN's). The standstill regulator is an integral-only loop
+//!    (v̇ = K·(i* − i), K = R̂²/(2L̂): L·s² + R·s + K with ζ ≈ 0.7 on the nameplate), *frozen*
+//!    to a constant voltage in the alignment hold, the DC measurement windows and the
+//!    injections: voltage mode leaves the machine's own resistance as the damping of the
+//!    rotor's swing (a fast current loop would remove it and the rotor would ring for
+//!    seconds; measured: ±15 r/min still after 1 s on the paper's motor). Its speed scales
+//!    with R/L: a motor with L/R ≫ 10 ms (the 5 kW PM-SyRM preset, 52 ms) is too slow for the
+//!    default settling time (known limitation).
+//! 3. **Resistance** ([`Phase::Resistance`]): DC current along α at two levels I₁ = I₂/2, I₂ =
+//!    90 % of the limit (capped for reluctance rotors, see `dc_level`). With all three phase currents beyond the inverter's current band the
 //!    pole-voltage error is a constant V̂·sign(i_x) per phase, i.e. 4/3·V̂ on the α axis, so
 //!    v_α = Rs·i_α + 4/3·V̂: the slope of the two points is Rs, the intercept the inverter
 //!    error (the classic two-point DC test, e.g. Bertoluzzo, Buja & Menis, "Self-commissioning
@@ -535,6 +538,7 @@ pub struct Commissioning<T> {
     i_limit: T,
     // Sizing from the nameplate.
     k_int: T,
+    k_p: T,
     v_inj: T,
     spin_speed: T,
     spin_accel: T,
@@ -633,12 +637,15 @@ impl<T: Real> Commissioning<T> {
         let ts = cfg.sample_period;
         let i_limit = cfg.current_limit_ratio * np.rated_current;
         let l_avg_np = T::lit(0.5) * (np.ld + np.lq);
-        // Integral gain K = R²/L of the standstill loop (module docs), bounded so that the loop
-        // stays well below the sampling rate (K·Ts/L ≤ 0.01 gives ωn·Ts ≤ 0.1).
+        // Integral gain K = R²/(2L) of the standstill loop (module docs), bounded so that the
+        // loop stays well below the sampling rate (K·Ts/L ≤ 0.01 gives ωn·Ts ≤ 0.1). No
+        // proportional path: its impedance would take the damping of the rotor's swing.
         let k_int =
             (T::lit(0.5) * np.rs * np.rs / l_avg_np).min(T::lit(0.01) * l_avg_np / (ts * ts));
+        let k_p = T::zero();
         // Injection: a current ripple of 30 % of the I₁ bias (45 % of the limit), peak-peak.
-        let i1 = T::lit(0.45) * i_limit;
+        let i_dc = dc_level(&np, i_limit);
+        let i1 = T::lit(0.5) * i_dc;
         let v_inj = T::lit(0.3) * i1 * l_avg_np / (T::lit(INJ_HALF as f64) * ts);
         let spin_speed = cfg.spin_speed_ratio * np.rated_speed();
         // Electrical acceleration from spin_torque_ratio·T_rated on the nameplate J.
@@ -658,6 +665,7 @@ impl<T: Real> Commissioning<T> {
             ts,
             i_limit,
             k_int,
+            k_p,
             v_inj,
             spin_speed,
             spin_accel,
@@ -924,8 +932,8 @@ impl<T: Real> Commissioning<T> {
     fn standstill(&mut self, i: Ab<T>, vdc: T) -> Ab<T> {
         let cfg = self.cfg;
         let ts = self.ts;
-        let i1 = T::lit(0.45) * self.i_limit;
-        let i2 = T::lit(0.9) * self.i_limit;
+        let i2 = dc_level(&cfg.nameplate, self.i_limit);
+        let i1 = T::lit(0.5) * i2;
         let at = cfg.align_time;
         let t = self.t_phase;
         let settle = cfg.settle_time;
@@ -1011,8 +1019,9 @@ impl<T: Real> Commissioning<T> {
         } else {
             self.v_int + e * (self.k_int * ts)
         };
-        let v = limit(v_int + inj, v_max);
-        if v != v_int + inj {
+        let v_pi = if frozen { v_int } else { v_int + e * self.k_p };
+        let v = limit(v_pi + inj, v_max);
+        if v != v_pi + inj {
             self.saturated_time += ts;
         } else {
             self.v_int = v_int;
@@ -1170,7 +1179,8 @@ impl<T: Real> Commissioning<T> {
         self.ki = wc * self.rs;
         // Bumpless: the standstill voltage (rotor at θ = 0, frame at 0) becomes the integral,
         // without the inverter error the compensation now supplies.
-        let comp = self.compensation(Dq::new(T::lit(0.45) * self.i_limit, T::zero()), T::zero());
+        let i1 = T::lit(0.5) * dc_level(&self.cfg.nameplate, self.i_limit);
+        let comp = self.compensation(Dq::new(i1, T::zero()), T::zero());
         self.pi_int = Dq::new(self.v_int.alpha - comp.alpha, self.v_int.beta - comp.beta);
         self.theta_f = T::zero();
         self.omega_f = T::zero();
@@ -1233,7 +1243,8 @@ impl<T: Real> Commissioning<T> {
             Phase::Spin => {
                 self.omega_f = (self.omega_f + self.spin_accel * ts).min(self.spin_speed);
                 let ramp = (t / T::lit(0.02)).min(T::one());
-                let mag = T::lit(0.45) * self.i_limit + (i_if - T::lit(0.45) * self.i_limit) * ramp;
+                let i1 = T::lit(0.5) * dc_level(&cfg.nameplate, self.i_limit);
+                let mag = i1 + (i_if - i1) * ramp;
                 (self.theta_f, self.omega_f, Dq::new(mag, T::zero()))
             }
             Phase::Coast => (
@@ -1439,6 +1450,21 @@ impl<T: Real> Commissioning<T> {
         self.t_phase = T::zero();
         self.phase = Phase::Done;
         self.i_ref = Ab::zero();
+    }
+}
+
+/// The upper DC-test (and alignment) current: 90 % of the limit, and for a rotor with Lq > Ld
+/// at most half of λf/(Lq − Ld) (nameplate), so that the d-axis alignment keeps at least half
+/// the magnet's stiffness: the torque about it, 1.5·p·(λf + (Ld − Lq)·i_d)·i_q, would vanish
+/// at i_d = λf/(Lq − Ld) and a reluctance rotor turn to the q axis (measured: the 5 kW
+/// PM-SyRM preset turned during the DC test at 90 % of its limit).
+fn dc_level<T: Real>(np: &MachineModel<T>, i_limit: T) -> T {
+    let i = T::lit(0.9) * i_limit;
+    let dl = np.lq - np.ld;
+    if dl > T::zero() {
+        i.min(T::lit(0.5) * np.flux_linkage / dl)
+    } else {
+        i
     }
 }
 

@@ -211,21 +211,40 @@ pub fn commission(
     })
 }
 
-/// The identified model as a TOML document with a `[model]` section (the keys of `[motor]`,
-/// i.e. of [`MachineModel`]) and an `[inverter_identified]` comment block.
-pub fn identified_toml(id: &Identification<f64>) -> String {
+/// The configuration document `input` with its `[model]` table replaced by the identified
+/// model (the keys of `[motor]`, i.e. of [`MachineModel`]), headed by comments giving the
+/// uncertainties and the inverter's voltage error.
+pub fn identified_toml(input: &str, id: &Identification<f64>) -> Result<String, SimConfigError> {
+    let mut doc: toml::Table = input
+        .parse()
+        .map_err(|e: toml::de::Error| SimConfigError::new("<config>", e.to_string()))?;
     let m = id.model;
+    let mut model = toml::Table::new();
+    for (k, v) in [
+        ("rs", m.rs),
+        ("ld", m.ld),
+        ("lq", m.lq),
+        ("flux_linkage", m.flux_linkage),
+        ("inertia", m.inertia),
+        ("viscous_friction", m.viscous_friction),
+        ("rated_current", m.rated_current),
+        ("rated_speed_rpm", m.rated_speed_rpm),
+        ("rated_torque", m.rated_torque),
+    ] {
+        model.insert(k.into(), toml::Value::Float(v));
+    }
+    model.insert(
+        "pole_pairs".into(),
+        toml::Value::Integer(i64::from(m.pole_pairs)),
+    );
+    doc.insert("model".into(), toml::Value::Table(model));
     let c = id.confidence;
-    format!(
-        "# Identified by `fado-sim commission` (fado_core::commissioning) in {:.2} s.\n\
+    let head = format!(
+        "# [model] identified by `fado-sim commission` (fado_core::commissioning) in {:.2} s.\n\
          # Relative 1-sigma statistical uncertainty: rs {:.2e}, ld {:.2e}, lq {:.2e}, \
          flux_linkage {:.2e}, inertia {:.2e}.\n\
          # Inverter voltage error {:.4} V per phase (threshold {:.4} V at {:.1} V DC link), \
-         saliency Lq/Ld {:.4}.\n\
-         [model]\n\
-         rs = {:e}\nld = {:e}\nlq = {:e}\nflux_linkage = {:e}\npole_pairs = {}\n\
-         inertia = {:e}\nviscous_friction = {:e}\nrated_current = {:e}\n\
-         rated_speed_rpm = {:e}\nrated_torque = {:e}\n",
+         saliency Lq/Ld {:.4}.\n",
         id.duration,
         c.rs,
         c.ld,
@@ -236,17 +255,9 @@ pub fn identified_toml(id: &Identification<f64>) -> String {
         id.threshold_voltage,
         id.dc_voltage,
         id.saliency,
-        m.rs,
-        m.ld,
-        m.lq,
-        m.flux_linkage,
-        m.pole_pairs,
-        m.inertia,
-        m.viscous_friction,
-        m.rated_current,
-        m.rated_speed_rpm,
-        m.rated_torque,
-    )
+    );
+    let body = toml::to_string(&doc).map_err(|e| SimConfigError::new("<config>", e.to_string()))?;
+    Ok(head + &body)
 }
 
 /// One row of the identified-vs-truth comparison.

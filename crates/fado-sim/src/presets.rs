@@ -51,8 +51,7 @@ impl Preset {
 
     /// The preset as a simulation configuration (over the defaults).
     pub fn config(&self) -> Result<SimConfig, SimConfigError> {
-        SimConfig::from_toml(self.toml)
-            .map_err(|e| e.in_file(format!("motors/{}.toml", self.name)))
+        SimConfig::from_toml(self.toml).map_err(|e| e.in_file(format!("motors/{}.toml", self.name)))
     }
 
     /// The preset's motor as a drive's model, with the DC link of its inverter.

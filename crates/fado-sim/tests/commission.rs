@@ -9,13 +9,6 @@ use fado_sim::sim::PlantParams;
 /// 540 V); J assumed 0.01 kg·m², B 2e-3, rated 6 A peak, 1500 r/min, 14.7 N·m.
 pub fn ipmsm() -> (PlantParams, MachineModel<f64>) {
     let mut p = PlantParams::default();
-    p.motor.rs = 3.6;
-    p.motor.ld = 36e-3;
-    p.motor.lq = 51e-3;
-    p.motor.flux_linkage = 0.545;
-    p.motor.pole_pairs = 3;
-    p.motor.inertia = 0.01;
-    p.motor.viscous_friction = 2e-3;
     p.inverter.dc_voltage = 540.0;
     p.current_sensor.adc_full_scale = 6.0 * 50.0 / 21.78;
     let m = MachineModel {
@@ -31,6 +24,7 @@ pub fn ipmsm() -> (PlantParams, MachineModel<f64>) {
         rated_torque: 14.7,
         dc_voltage: 540.0,
     };
+    p.motor = m;
     (p, m)
 }
 

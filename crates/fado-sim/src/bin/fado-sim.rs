@@ -100,7 +100,10 @@ enum Command {
     Commission {
         /// TOML file: the plant (`[motor]` with its ratings, `[inverter]`, sensors, …).
         #[arg(long)]
-        config: PathBuf,
+        config: Option<PathBuf>,
+        /// Or a motor preset (see `motors`).
+        #[arg(long)]
+        motor: Option<String>,
         /// Output directory. Default `out/commission`.
         #[arg(long)]
         out: Option<PathBuf>,
@@ -268,10 +271,11 @@ fn run(cli: Cli) -> Result<ExitCode, Box<dyn std::error::Error>> {
         }
         Command::Commission {
             config,
+            motor,
             out,
             seed,
             averaged,
-        } => run_commission(&config, out, seed, averaged),
+        } => run_commission(config.as_deref(), motor.as_deref(), out, seed, averaged),
         Command::Compare {
             scenarios,
             estimators,
@@ -334,61 +338,38 @@ fn run(cli: Cli) -> Result<ExitCode, Box<dyn std::error::Error>> {
 
 /// A configuration error located in the `--config` file reads `FILE:LINE:COLUMN: `key`: …`.
 fn run_commission(
-    config: &std::path::Path,
+    config: Option<&std::path::Path>,
+    motor: Option<&str>,
     out: Option<PathBuf>,
     seed: u64,
     averaged: bool,
 ) -> Result<ExitCode, Box<dyn std::error::Error>> {
     use fado_sim::commission::{self, CommissionOptions};
-    let text = std::fs::read_to_string(config)
-        .map_err(|e| format!("cannot read {}: {e}", config.display()))?;
-    // The ratings are `[motor]` keys; until the simulator's config reads them itself they are
-    // taken out here (a missing one is named).
-    let mut table: toml::Table = text
-        .parse()
-        .map_err(|e| format!("{}: {e}", config.display()))?;
-    let mut rating = |key: &str| -> Result<f64, String> {
-        let motor = table
-            .get_mut("motor")
-            .and_then(|m| m.as_table_mut())
-            .ok_or_else(|| format!("{}: missing [motor]", config.display()))?;
-        match motor.remove(key) {
-            Some(toml::Value::Float(x)) => Ok(x),
-            Some(toml::Value::Integer(x)) => Ok(x as f64),
-            Some(_) => Err(format!(
-                "{}: motor.{key} must be a number",
-                config.display()
-            )),
-            None => Err(format!(
-                "{}: motor.{key} is required by commission",
-                config.display()
-            )),
+    let (text, mut cfg) = match (config, motor) {
+        (Some(path), None) => {
+            let text = std::fs::read_to_string(path)
+                .map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+            let cfg = fado_sim::SimConfig::from_toml(&text)
+                .map_err(|e| in_file(e, &Some(path.to_path_buf())))?;
+            (text, cfg)
         }
+        (None, Some(name)) => {
+            let preset = fado_sim::presets::find(name)
+                .ok_or_else(|| format!("no motor preset `{name}` (see `fado-sim motors`)"))?;
+            (preset.toml.to_owned(), preset.config()?)
+        }
+        _ => return Err("give exactly one of --config FILE and --motor PRESET".into()),
     };
-    let rated_current = rating("rated_current")?;
-    let rated_speed_rpm = rating("rated_speed_rpm")?;
-    let rated_torque = rating("rated_torque")?;
-    let rest = toml::to_string(&table)?;
-    let mut cfg =
-        fado_sim::SimConfig::from_toml(&rest).map_err(|e| format!("{}: {e}", config.display()))?;
     cfg.current_sensor.seed = seed;
     if averaged {
         cfg.inverter.model = fado_sim::inverter::InverterModel::Averaged;
     }
     let plant = cfg.plant();
-    let m = plant.motor;
+    // The nameplate the procedure is told: the [motor] record (parameters only size the
+    // tests) with the inverter's DC link.
     let nameplate = fado_core::MachineModel {
-        rs: m.rs,
-        ld: m.ld,
-        lq: m.lq,
-        flux_linkage: m.flux_linkage,
-        pole_pairs: m.pole_pairs,
-        inertia: m.inertia,
-        viscous_friction: m.viscous_friction,
-        rated_current,
-        rated_speed_rpm,
-        rated_torque,
         dc_voltage: plant.inverter.dc_voltage,
+        ..plant.motor
     };
     let bar = ProgressBar::new(1000);
     bar.set_style(
@@ -439,45 +420,47 @@ fn run_commission(
         "commissioning: {:?} after {:.2} s simulated",
         o.status, o.simulated_seconds
     );
-    if let Some(id) = &o.identification {
-        println!(
-            "{:<18} {:>14} {:>14} {:>10} {:>10}",
-            "parameter", "identified", "truth", "error", "1-sigma"
-        );
-        for r in &rows {
-            let rel = !matches!(
-                r.parameter,
-                "viscous_friction" | "inverter_voltage" | "threshold_voltage"
-            );
-            if rel {
-                println!(
-                    "{:<18} {:>14.6e} {:>14.6e} {:>+9.3}% {:>9.3}%",
-                    r.parameter,
-                    r.identified,
-                    r.truth,
-                    100.0 * r.error,
-                    100.0 * r.confidence
-                );
-            } else {
-                println!(
-                    "{:<18} {:>14.6e} {:>14.6e} {:>+10.3e} {:>10.3e}",
-                    r.parameter, r.identified, r.truth, r.error, r.confidence
-                );
-            }
-        }
-        // Written whole: to a temporary file, then renamed.
-        let tmp = dir.join("identified.toml.tmp");
-        std::fs::write(&tmp, commission::identified_toml(id))?;
-        std::fs::rename(&tmp, dir.join("identified.toml"))?;
-        println!(
-            "wrote {}/identified.toml, metrics.json and traces.csv",
-            dir.display()
-        );
-        Ok(ExitCode::SUCCESS)
-    } else {
+    let Some(id) = &o.identification else {
         println!("wrote {}/metrics.json and traces.csv", dir.display());
-        Ok(ExitCode::from(1))
+        return Ok(ExitCode::from(1));
+    };
+    println!(
+        "{:<18} {:>14} {:>14} {:>10} {:>10}",
+        "parameter", "identified", "truth", "error", "1-sigma"
+    );
+    for r in &rows {
+        let relative = !matches!(
+            r.parameter,
+            "viscous_friction" | "inverter_voltage" | "threshold_voltage"
+        );
+        if relative {
+            println!(
+                "{:<18} {:>14.6e} {:>14.6e} {:>+9.3}% {:>9.3}%",
+                r.parameter,
+                r.identified,
+                r.truth,
+                100.0 * r.error,
+                100.0 * r.confidence
+            );
+        } else {
+            println!(
+                "{:<18} {:>14.6e} {:>14.6e} {:>+10.3e} {:>10.3e}",
+                r.parameter, r.identified, r.truth, r.error, r.confidence
+            );
+        }
     }
+    // The input file with its [model] replaced by the identified one: runnable as is
+    // (`fado-sim run reversal --config DIR/identified.toml`). Written whole: to a temporary
+    // file, then renamed.
+    let doc = commission::identified_toml(&text, id)?;
+    let tmp = dir.join("identified.toml.tmp");
+    std::fs::write(&tmp, doc)?;
+    std::fs::rename(&tmp, dir.join("identified.toml"))?;
+    println!(
+        "wrote {}/identified.toml, metrics.json and traces.csv",
+        dir.display()
+    );
+    Ok(ExitCode::SUCCESS)
 }
 
 fn in_file(e: SimConfigError, config: &Option<PathBuf>) -> SimConfigError {
