@@ -1,14 +1,14 @@
 #!/usr/bin/env bash
-# Accuracy table of `fado-sim commission`: each motor config in docs/commissioning/, sensor
-# seeds 1-4, identified vs truth (switching-resolved inverter, default non-idealities).
+# Accuracy table of `fado-sim commission`: every motor preset (motors/*.toml), sensor seeds 1-4,
+# identified vs truth (switching-resolved inverter, default non-idealities).
 set -euo pipefail
 bin=${FADO_SIM:-target/release/fado-sim}
 out=${1:-out/commission-table}
 mkdir -p "$out"
-for cfg in docs/commissioning/*.toml; do
+for cfg in motors/*.toml; do
   name=$(basename "$cfg" .toml)
   for seed in 1 2 3 4; do
-    "$bin" commission --config "$cfg" --seed "$seed" --out "$out/$name-$seed" > /dev/null || true
+    "$bin" commission --motor "$name" --seed "$seed" --out "$out/$name-$seed" > /dev/null || true
   done
 done
 python3 - "$out" <<'PY'
