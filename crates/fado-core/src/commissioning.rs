@@ -644,7 +644,7 @@ impl<T: Real> Commissioning<T> {
             (T::lit(0.5) * np.rs * np.rs / l_avg_np).min(T::lit(0.01) * l_avg_np / (ts * ts));
         let k_p = T::zero();
         // Injection: a current ripple of 30 % of the I₁ bias (45 % of the limit), peak-peak.
-        let i_dc = dc_level(&np, i_limit);
+        let i_dc = dc_level(np, i_limit);
         let i1 = T::lit(0.5) * i_dc;
         let v_inj = T::lit(0.3) * i1 * l_avg_np / (T::lit(INJ_HALF as f64) * ts);
         let spin_speed = cfg.spin_speed_ratio * np.rated_speed();
