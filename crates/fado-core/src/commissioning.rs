@@ -14,9 +14,10 @@
 //!
 //! # Safety
 //! Every current reference is within `current_limit_ratio · rated_current` (checked by a
-//! property test); a measured current above `trip_ratio` times that limit aborts with the
-//! gates off. Every phase has a nominal and a maximum duration ([`CommissioningConfig::
-//! phase_timeout`]); every voltage is limited to `voltage_limit_ratio · Vdc/√3` at standstill.
+//! property test); a measured current above `trip_ratio` (2) times that limit aborts with the
+//! gates off. Every phase has a nominal and a maximum duration
+//! ([`CommissioningConfig::phase_timeout`]); every standstill voltage is limited to
+//! `voltage_limit_ratio · Vdc/√3`.
 //! Aborts are typed ([`AbortReason`]): rotation where none is expected, current not following
 //! its reference, implausible result, over-current, over-speed, timeout, non-finite samples.
 //!
