@@ -24,6 +24,7 @@ use crate::observer::{DisturbanceObserver, DisturbanceObserverConfig};
 use crate::rotor_flux::{rotor_angle, rotor_flux, stator_flux};
 use crate::rs_adaptation::{AdaptationRegime, ResistanceAdaptation, ResistanceAdaptationConfig};
 use crate::tracker::{BandwidthDefinition, TrackerConfig, TypeTwoTracker};
+use crate::real::all_finite;
 use crate::{Ab, MachineModel, Real};
 
 /// The estimator's tuning: every setting that is not the machine or the sampling period.
@@ -546,12 +547,12 @@ impl<T: Real> SensorlessEstimator<T> {
     /// is untouched and the previous estimate is returned with `input_fault` set.
     #[inline]
     pub fn step(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> Estimate<T> {
-        if !(v_ab.is_finite() && i_ab.is_finite()) {
-            return self.reject();
-        }
-        // The whole new state is computed first and committed only if it is finite: finite but
-        // absurd inputs can still overflow a state, and a rejected sample must leave none of it
-        // changed. (Cheaper than copying the estimator as a backup every sample.)
+        // The whole new state is computed first and committed only if it is finite: a
+        // non-finite input makes it non-finite (every input enters λ1 through Ts·v and the
+        // resistive drop, or λ̂r through L̂q·i, and NaN and ±∞ propagate, 0·∞ included), finite
+        // but absurd inputs can still overflow it, and a rejected sample must leave none of it
+        // changed. One test at the end covers all of this (cheaper than a test per input and
+        // per block, and than copying the estimator as a backup every sample).
         // 1. Integrate with the feedback of the previous sample (eq. (21) / (24)).
         let (lambda1, i_drop) = self.integrator.next_flux(v_ab, i_ab, self.feedback);
         // 2. Disturbance observer at ω̂ of T2S-1 (eq. (10), (16)), on λ1 or on λ1 − L̂q·i
@@ -588,13 +589,30 @@ impl<T: Real> SensorlessEstimator<T> {
                 (l.feedback, l.clamping)
             }
         };
-        let finite = lambda1.is_finite()
-            & observer_flux.is_finite()
-            & disturbance.is_finite()
-            & lambda_r.is_finite()
-            & feedback.is_finite()
-            & t2s1.is_finite()
-            & t2s2.is_finite();
+        // The inputs are in the test too, so that rejecting a non-finite input does not rest
+        // on the arithmetic above.
+        let finite = all_finite([
+            v_ab.alpha,
+            v_ab.beta,
+            i_ab.alpha,
+            i_ab.beta,
+            lambda1.alpha,
+            lambda1.beta,
+            observer_flux.alpha,
+            observer_flux.beta,
+            disturbance.alpha,
+            disturbance.beta,
+            lambda_r.alpha,
+            lambda_r.beta,
+            feedback.alpha,
+            feedback.beta,
+            t2s1.predicted,
+            t2s1.theta,
+            t2s1.omega,
+            t2s2.predicted,
+            t2s2.theta,
+            t2s2.omega,
+        ]);
         if !finite {
             return self.reject();
         }
@@ -630,7 +648,15 @@ impl<T: Real> SensorlessEstimator<T> {
                 .rs_adaptation
                 .next_state(v_ab, i_drop, lambda_r, t2s1.omega, regime);
             let feedback = self.feedback + pull;
-            if state.is_finite() && feedback.is_finite() {
+            if all_finite([
+                state.rs_hat,
+                state.flux_linkage_hat,
+                state.charge_d,
+                state.volt_seconds_d,
+                state.i_d_prev,
+                feedback.alpha,
+                feedback.beta,
+            ]) {
                 self.rs_adaptation.commit(state);
                 self.integrator.set_rs_hat_unchecked(state.rs_hat);
                 self.feedback = feedback;

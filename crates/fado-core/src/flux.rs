@@ -206,7 +206,7 @@ impl<T: Real> DisturbanceFeedback<T> {
     #[inline]
     pub(crate) fn next_gain(&self, active: bool) -> T {
         if active {
-            (self.gain + self.ramp_increment).min(self.k_df)
+            crate::real::min(self.gain + self.ramp_increment, self.k_df)
         } else {
             T::zero()
         }

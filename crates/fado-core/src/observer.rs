@@ -90,7 +90,8 @@ impl<T: Real> DiscreteGains<T> {
 }
 
 /// Largest |ω·Ts| (rad) served by the series in [`half_angle_terms`]: 398 Hz at 10 kHz, far
-/// above the motor's 100 Hz; beyond it the gains come from `libm`.
+/// above the motor's 100 Hz; beyond it the gains come from `libm` (`f64`) or from
+/// [`crate::approx`] (`f32`).
 const SERIES_LIMIT: f64 = 0.25;
 
 /// Taylor coefficients of sin(h)/h in h² (1, −1/3!, 1/5!, ...).
@@ -168,9 +169,13 @@ fn half_angle_terms<T: Real>(x: T) -> (T, T, T) {
         };
         (h * sin_over_h, cos, y * one_minus_exp_over_y)
     } else {
-        // Large speeds (and NaN, which propagates).
-        let (sh, ch) = (x * T::lit(0.5)).sin_cos();
-        (sh, ch, -(-y).exp_m1())
+        // Large speeds (and NaN, which propagates). a = e^{jx} is 2π-periodic in x and every
+        // gain depends on (sin(x/2), cos(x/2)) only through products of two of them, which a
+        // shift of x by 2π (both change sign) leaves alone: wrap x first, so that the f32
+        // approximation needs only [−π/2, π/2] (see `Real::step_sin_cos`). r depends on |x|
+        // itself.
+        let (sh, ch) = (crate::wrap_angle(x) * T::lit(0.5)).step_sin_cos();
+        (sh, ch, y.step_one_minus_exp_neg())
     }
 }
 

@@ -219,14 +219,6 @@ pub(crate) struct TrackerState<T> {
     pub omega: T,
 }
 
-impl<T: Real> TrackerState<T> {
-    /// True when every component is finite.
-    #[inline]
-    pub fn is_finite(&self) -> bool {
-        self.predicted.is_finite() & self.theta.is_finite() & self.omega.is_finite()
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
