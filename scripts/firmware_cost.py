@@ -200,7 +200,7 @@ def cycles(mnem, ops, taken, prev_single_ls):
     return 1, False
 
 
-def inline_files(elf, addrs):
+def inline_files(elf, addrs, symbol_of):
     """{address: innermost fado source 'file:function'} via addr2line -i."""
     if not addrs:
         return {}
@@ -222,8 +222,7 @@ def inline_files(elf, addrs):
                 label = loc.split("fado-core/src/")[1].split(":")[0]
                 break
         else:
-            if frames:
-                label = frames[0][0].split("::")[-1][:40] if frames[0][0] != "??" else "other"
+            label = symbol_of.get(cur, "other")
         result[cur] = label
 
     i = 0
@@ -272,7 +271,7 @@ def trace(elf, root, path, tail):
         steps.append(current)
     scenarios = [s for s in scenarios if s]
     pcs = sorted({pc for s in scenarios for st in s[-tail:] for pc in st})
-    files = inline_files(elf, pcs)
+    files = inline_files(elf, pcs, {pc: insns[pc][3] for pc in pcs if pc in insns})
     results = []
     for index, steps in enumerate(scenarios):
         measured = steps[-tail:]

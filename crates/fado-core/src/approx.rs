@@ -127,7 +127,9 @@ mod tests {
             let x = (k as f64 / n as f64 * PI64 / 2.0) as f32;
             let (s, c) = sin_cos(x);
             let (s64, c64) = (x as f64).sin_cos();
-            worst = worst.max((s as f64 - s64).abs()).max((c as f64 - c64).abs());
+            worst = worst
+                .max((s as f64 - s64).abs())
+                .max((c as f64 - c64).abs());
         }
         assert!(worst < 1.5e-7, "{worst}");
         assert!(sin_cos(f32::NAN).0.is_nan() && sin_cos(f32::NAN).1.is_nan());

@@ -21,10 +21,10 @@ use crate::flux::{
 };
 use crate::mode::{Mode, ModeSelector, ModeSelectorConfig};
 use crate::observer::{DisturbanceObserver, DisturbanceObserverConfig};
+use crate::real::all_finite;
 use crate::rotor_flux::{rotor_angle, rotor_flux, stator_flux};
 use crate::rs_adaptation::{AdaptationRegime, ResistanceAdaptation, ResistanceAdaptationConfig};
 use crate::tracker::{BandwidthDefinition, TrackerConfig, TypeTwoTracker};
-use crate::real::all_finite;
 use crate::{Ab, MachineModel, Real};
 
 /// The estimator's tuning: every setting that is not the machine or the sampling period.

@@ -57,8 +57,8 @@
 //! passage needs. A λ̂f error biases the rotating law by Δλf·ω/i_q.
 
 use crate::error::{ConfigError, check};
-use crate::{Ab, Real};
 use crate::real::{all_finite, max, min};
+use crate::{Ab, Real};
 
 /// Lower bound of the adapted λ̂f as a multiple of the configured one (NdFeB loses ≈ 0.1 %/K,
 /// so the physical range is about ±15 %).
