@@ -314,6 +314,36 @@ mod tests {
         m
     }
 
+    /// Above the series limit the f32 gains come from `crate::approx` (no f64 inside): they
+    /// agree with the f64 (`libm`) gains within f32 rounding for both signs, up to the Nyquist
+    /// speed |ω·Ts| = 3 and beyond it (there x is wrapped first; ℓ2 ∝ 1/sin(x/2) is
+    /// ill-conditioned near x = 2π, so the test stops at 5.5).
+    #[test]
+    fn f32_gains_beyond_the_series_match_f64() {
+        let ts = 1e-4;
+        let mut worst = 0.0_f64;
+        for k in 0..=5300 {
+            let x = 0.2 + k as f64 * 1e-3; // 0.2 … 5.5 rad per sample
+            for omega in [x / ts, -x / ts] {
+                let g64 = DiscreteGains::new(omega, ts);
+                let g32 = DiscreteGains::new(omega as f32, ts as f32);
+                let d = |a: Ab<f32>, b: Ab<f64>| {
+                    (a.alpha as f64 - b.alpha)
+                        .abs()
+                        .max((a.beta as f64 - b.beta).abs())
+                };
+                let scale = 1.0 + g64.l2.alpha.abs().max(g64.l2.beta.abs());
+                worst = worst
+                    .max(d(g32.a, g64.a))
+                    .max(d(g32.one_minus_a, g64.one_minus_a))
+                    .max(d(g32.l1, g64.l1))
+                    .max(d(g32.l2, g64.l2) / scale)
+                    .max((g32.r as f64 - g64.r).abs());
+            }
+        }
+        assert!(worst < 2e-6, "{worst}");
+    }
+
     #[test]
     fn discrete_poles_are_image_of_minus_abs_omega_both_signs() {
         let ts = 100e-6;

@@ -13,13 +13,13 @@ pub trait Real: RealField + Copy + Default {
     fn to_f64(self) -> f64;
     /// (sin x, cos x) for |x| ≤ π/2, as the estimator's step computes them: `libm` for `f64`,
     /// [`crate::approx::sin_cos`] for `f32` (no software double precision on a single-precision
-    /// FPU; error below 1.5e-7).
+    /// FPU; error below 2e-7).
     fn step_sin_cos(self) -> (Self, Self);
     /// 1 − e^{−y} for y ≥ 0, as the estimator's step computes it: `libm`'s `exp_m1` for `f64`,
     /// [`crate::approx::one_minus_exp_neg`] for `f32` (error below 1.5e-7).
     fn step_one_minus_exp_neg(self) -> Self;
     /// atan2(self, x), as the estimator's step computes it: `libm` for `f64`,
-    /// [`crate::approx::atan2`] for `f32` (error below 2.5e-7 rad).
+    /// [`crate::approx::atan2`] for `f32` (error below 3.5e-7 rad).
     fn step_atan2(self, x: Self) -> Self;
 }
 
