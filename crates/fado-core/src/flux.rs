@@ -292,7 +292,7 @@ impl<T: Real> FluxLimiter<T> {
         let n2 = lambda_r.norm_squared();
         let rho = self.config.radius;
         if n2 > rho * rho {
-            let n = n2.sqrt();
+            let n = n2.step_sqrt();
             LimiterOutput {
                 feedback: lambda_r * (self.config.k_af * (n - rho) / n),
                 clamping: true,

@@ -21,6 +21,9 @@ pub trait Real: RealField + Copy + Default {
     /// atan2(self, x), as the estimator's step computes it: `libm` for `f64`,
     /// [`crate::approx::atan2`] for `f32` (error below 3.5e-7 rad).
     fn step_atan2(self, x: Self) -> Self;
+    /// √x for x ≥ 0, as the estimator's step computes it: `libm` for `f64`,
+    /// [`crate::approx::sqrt`] for `f32` (within 1 ulp).
+    fn step_sqrt(self) -> Self;
 }
 
 impl Real for f32 {
@@ -44,6 +47,10 @@ impl Real for f32 {
     fn step_atan2(self, x: Self) -> Self {
         crate::approx::atan2(self, x)
     }
+    #[inline(always)]
+    fn step_sqrt(self) -> Self {
+        crate::approx::sqrt(self)
+    }
 }
 
 impl Real for f64 {
@@ -66,6 +73,10 @@ impl Real for f64 {
     #[inline(always)]
     fn step_atan2(self, x: Self) -> Self {
         RealField::atan2(self, x)
+    }
+    #[inline(always)]
+    fn step_sqrt(self) -> Self {
+        nalgebra::ComplexField::sqrt(self)
     }
 }
 

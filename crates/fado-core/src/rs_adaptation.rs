@@ -330,7 +330,7 @@ impl<T: Real> ResistanceAdaptation<T> {
         if regime == AdaptationRegime::Frozen || mag_sq <= T::zero() {
             return (next, pull);
         }
-        let mag = mag_sq.sqrt();
+        let mag = mag_sq.step_sqrt();
         if regime == AdaptationRegime::Rotating {
             // χ = φ·R0/λ̂f with φ = ⟨−i/(jω̂), d⟩ = −i_q/ω̂ and i_q = (λ̂r × i)/|λ̂r|, as
             // χ = a/b: then χ/(χ² + χ0²) = a·b/(a² + χ0²·b²) costs one division, and

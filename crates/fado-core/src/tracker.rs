@@ -85,6 +85,8 @@ impl<T: Real> TrackerConfig<T> {
 pub struct TypeTwoTracker<T> {
     ts: T,
     kp: T,
+    /// Ts·Kp, precomputed (the same product the recursion formed every sample).
+    kp_ts: T,
     ki_ts: T,
     /// θ̂⁻: the angle predicted for the next sample.
     predicted: T,
@@ -113,6 +115,7 @@ impl<T: Real> TypeTwoTracker<T> {
         Ok(Self {
             ts,
             kp,
+            kp_ts: ts * kp,
             ki_ts: ki * ts,
             predicted: T::zero(),
             theta: T::zero(),
@@ -157,7 +160,7 @@ impl<T: Real> TypeTwoTracker<T> {
     pub(crate) fn next_state(&self, theta_measured: T) -> TrackerState<T> {
         let e = wrap_angle(theta_measured - self.predicted);
         let omega = self.omega + self.ki_ts * e;
-        let theta = wrap_angle(self.predicted + self.ts * self.kp * e);
+        let theta = wrap_angle(self.predicted + self.kp_ts * e);
         TrackerState {
             predicted: wrap_angle(theta + self.ts * omega),
             theta,
