@@ -114,7 +114,7 @@ pub(crate) fn all_finite<T: Real, const N: usize>(values: [T; N]) -> bool {
 /// so the argument lies within ±3π; there one exact subtraction (Sterbenz: |x| ≥ π = 2π/2)
 /// gives the same result as the rounding formula without a call to `round`. Anything larger
 /// takes the general formula; NaN stays NaN and ±∞ becomes NaN as with the formula.
-#[inline]
+#[inline(always)]
 pub fn wrap_angle<T: Real>(x: T) -> T {
     let pi = T::pi();
     let two_pi = T::two_pi();
@@ -130,6 +130,15 @@ pub fn wrap_angle<T: Real>(x: T) -> T {
     } else {
         return x;
     }
+    wrap_far(x)
+}
+
+/// [`wrap_angle`] beyond ±3π (and NaN, ±∞): out of line, never taken in normal operation.
+#[cold]
+#[inline(never)]
+fn wrap_far<T: Real>(x: T) -> T {
+    let pi = T::pi();
+    let two_pi = T::two_pi();
     let r = x - two_pi * (x / two_pi).round();
     if r.abs() <= pi {
         return r;

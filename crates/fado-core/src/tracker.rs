@@ -156,7 +156,7 @@ impl<T: Real> TypeTwoTracker<T> {
     }
 
     /// The state after one sample with the measurement θm, without changing `self`.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn next_state(&self, theta_measured: T) -> TrackerState<T> {
         let e = wrap_angle(theta_measured - self.predicted);
         let omega = self.omega + self.ki_ts * e;
