@@ -589,13 +589,12 @@ impl<T: Real> SensorlessEstimator<T> {
                 (l.feedback, l.clamping)
             }
         };
-        // The inputs are in the test too, so that rejecting a non-finite input does not rest
-        // on the arithmetic above.
+        // Which values the one test needs (the others follow from them, so the test is
+        // exact, not approximate): a non-finite v or i makes λ1 non-finite (Ts·v, and R̂s·i
+        // with R̂s ≥ 0: ∞·R̂s = ∞, 0·∞ = NaN, ∞ − ∞ = NaN); a tracker's ω̂ = ω̂ + Ki·Ts·e is
+        // finite only if its phase error e = wrap(…) is, and then θ̂ and θ̂⁻ (wrapped sums of
+        // finite values) are finite too. λ̂r and the feedback can overflow on their own.
         let finite = all_finite([
-            v_ab.alpha,
-            v_ab.beta,
-            i_ab.alpha,
-            i_ab.beta,
             lambda1.alpha,
             lambda1.beta,
             observer_flux.alpha,
@@ -606,11 +605,7 @@ impl<T: Real> SensorlessEstimator<T> {
             lambda_r.beta,
             feedback.alpha,
             feedback.beta,
-            t2s1.predicted,
-            t2s1.theta,
             t2s1.omega,
-            t2s2.predicted,
-            t2s2.theta,
             t2s2.omega,
         ]);
         if !finite {
@@ -648,9 +643,9 @@ impl<T: Real> SensorlessEstimator<T> {
                 .rs_adaptation
                 .next_state(v_ab, i_drop, lambda_r, t2s1.omega, regime);
             let feedback = self.feedback + pull;
+            // R̂s and λ̂f leave the adaptation clamped by compare-and-select, which turns a
+            // NaN into the bound: always finite.
             if all_finite([
-                state.rs_hat,
-                state.flux_linkage_hat,
                 state.charge_d,
                 state.volt_seconds_d,
                 state.i_d_prev,
