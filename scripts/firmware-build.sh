@@ -14,10 +14,14 @@ if command -v rustup >/dev/null &&
     { rustup target list --installed 2>/dev/null | grep -qx "$target" ||
         timeout 120 rustup target add "$target" >&2; }; then
     (cd examples/cortex-m && cargo build --release --quiet --target-dir "$target_dir") >&2
-elif command -v cargo-web >/dev/null || [[ -x /usr/lib/rust-web/bin/cargo ]]; then
-    cargo_web=$(command -v cargo-web || echo /usr/lib/rust-web/bin/cargo)
-    echo "rustup target unavailable: building with Debian's toolchain and -Zbuild-std" >&2
-    (cd examples/cortex-m && RUSTC_BOOTSTRAP=1 "$cargo_web" build --release --quiet \
+elif [[ -x /usr/bin/cargo && -x /usr/bin/rustc ]] && /usr/bin/rustc --version >/dev/null 2>&1; then
+    # Debian's rustc-web/cargo-web install /usr/bin/rustc and /usr/bin/cargo; rust-web-src the
+    # core sources that -Zbuild-std compiles; lld-22 the linker (this route is written to the
+    # issue's recipe but was not exercised where rustup worked).
+    echo "rustup target unavailable: building with Debian's $(/usr/bin/rustc --version) and -Zbuild-std" >&2
+    linker=$(command -v ld.lld-22 || command -v ld.lld || echo rust-lld)
+    (cd examples/cortex-m && RUSTC=/usr/bin/rustc RUSTC_BOOTSTRAP=1 \
+        CARGO_TARGET_THUMBV7EM_NONE_EABIHF_LINKER="$linker" /usr/bin/cargo build --release --quiet \
         --target-dir "$target_dir" -Zbuild-std=core,compiler_builtins \
         -Zbuild-std-features=compiler-builtins-mem) >&2
 else
