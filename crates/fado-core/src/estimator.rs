@@ -284,7 +284,7 @@ pub struct Diagnostics<T> {
     /// [`EstimatorTuning::rs_adaptation`].
     pub flux_linkage_hat: T,
     /// This sample's inputs were non-finite and were rejected; the state is unchanged and the
-    /// other fields repeat the last good sample.
+    /// other fields are [`SensorlessEstimator::last`].
     pub input_fault: bool,
 }
 
@@ -344,7 +344,6 @@ pub struct SensorlessEstimator<T> {
     feedback: Ab<T>,
     hold_level_sq: T,
     k_df_enabled: bool,
-    last: Estimate<T>,
     rejected_samples: u32,
 }
 
@@ -469,7 +468,6 @@ impl<T: Real> SensorlessEstimator<T> {
             feedback: Ab::zero(),
             hold_level_sq: hold_level * hold_level,
             k_df_enabled: true,
-            last: Estimate::default(),
             rejected_samples: 0,
         };
         est.reset();
@@ -500,12 +498,13 @@ impl<T: Real> SensorlessEstimator<T> {
         // A current so large that L̂q·i overflows is as unusable as a NaN (found by fuzzing,
         // f32: i = 3e37 A gave λ1 = ∞): start as with zero current.
         let lambda1 = lambda_r + i_ab * self.config.machine.lq;
-        let lambda1 = if lambda1.is_finite() {
-            lambda1
+        let (lambda1, i_ab) = if lambda1.is_finite() {
+            (lambda1, i_ab)
         } else {
-            lambda_r
+            (lambda_r, Ab::zero())
         };
         self.integrator.reset_to(lambda1);
+        self.integrator.set_last_current(i_ab);
         self.observer
             .reset_to(if self.config.tuning.observer_on_rotor_flux {
                 lambda_r
@@ -518,25 +517,6 @@ impl<T: Real> SensorlessEstimator<T> {
         self.t2s2.reset_to(theta0, T::zero());
         self.feedback = Ab::zero();
         self.rejected_samples = 0;
-        self.last = Estimate {
-            theta: self.t2s1.angle(),
-            omega: T::zero(),
-            omega_control: T::zero(),
-            diagnostics: Diagnostics {
-                lambda1,
-                disturbance: Ab::zero(),
-                lambda2: lambda1,
-                lambda_r,
-                theta_direct: self.t2s1.angle(),
-                mode: Mode::Limiter,
-                flag_limit: true,
-                limiter_clamping: false,
-                tracker_hold: false,
-                rs_hat: self.rs_adaptation.rs_hat(),
-                flux_linkage_hat: self.rs_adaptation.flux_linkage_hat(),
-                input_fault: false,
-            },
-        };
     }
 
     /// One 10 kHz sample (Fig. 5).
@@ -544,7 +524,7 @@ impl<T: Real> SensorlessEstimator<T> {
     /// `v_ab` is the voltage reference that was applied over the last sampling interval (with
     /// a one-sample computational delay, the one computed two samples ago, before dead-time
     /// compensation); `i_ab` the currents sampled now. A non-finite input is rejected: the state
-    /// is untouched and the previous estimate is returned with `input_fault` set.
+    /// is untouched and [`Self::last`] is returned with `input_fault` set.
     #[inline]
     pub fn step(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> Estimate<T> {
         // The whole new state is computed first and committed only if it is finite: a
@@ -676,20 +656,51 @@ impl<T: Real> SensorlessEstimator<T> {
                 input_fault: false,
             },
         };
-        self.last = out;
         out
     }
 
+    #[cold]
     fn reject(&mut self) -> Estimate<T> {
         self.rejected_samples = self.rejected_samples.saturating_add(1);
-        let mut out = self.last;
+        let mut out = self.last();
         out.diagnostics.input_fault = true;
         out
     }
 
-    /// The last good estimate.
-    pub fn last(&self) -> &Estimate<T> {
-        &self.last
+    /// The estimate of the last good sample (or of the last `align`/`reset`), recomputed from
+    /// the state: the estimator keeps no copy of its output (64 bytes written every sample in
+    /// `f32`; a caller that needs the output keeps what `step` returned).
+    ///
+    /// θ̂, ω̂, ω̂ for control, the mode and FLAG_limit are those of that sample exactly. The
+    /// diagnostics are recomputed: λ1 and D̂ as stored (after the limiter re-centring, see
+    /// [`EstimatorConfig::limiter_recentring`]), λ2 = λ1 − D̂, λ̂r = λ2 − L̂q·i with that
+    /// sample's current, θm = ∠λ̂r, the limiter and hold flags from this λ̂r, R̂s and λ̂f as
+    /// they will be used next.
+    pub fn last(&self) -> Estimate<T> {
+        let lambda1 = self.integrator.flux();
+        let disturbance = self.observer.disturbance();
+        let lambda2 = stator_flux(lambda1, disturbance);
+        let lambda_r = rotor_flux(lambda2, self.integrator.last_current(), self.config.machine.lq);
+        let mode = self.selector.mode();
+        Estimate {
+            theta: self.t2s1.angle(),
+            omega: self.t2s1.speed(),
+            omega_control: self.t2s2.speed(),
+            diagnostics: Diagnostics {
+                lambda1,
+                disturbance,
+                lambda2,
+                lambda_r,
+                theta_direct: rotor_angle(lambda_r),
+                mode,
+                flag_limit: mode == Mode::Limiter,
+                limiter_clamping: mode == Mode::Limiter && self.limiter.step(lambda_r).clamping,
+                tracker_hold: lambda_r.norm_squared() < self.hold_level_sq,
+                rs_hat: self.integrator.config().rs_hat,
+                flux_linkage_hat: self.rs_adaptation.flux_linkage_hat(),
+                input_fault: false,
+            },
+        }
     }
 
     /// Number of samples rejected since the last reset.

@@ -123,6 +123,20 @@ impl<T: Real> FluxIntegrator<T> {
         self.lambda1
     }
 
+    /// The current of the last sample (zero after a reset, or what [`Self::set_last_current`]
+    /// set).
+    #[inline]
+    pub(crate) fn last_current(&self) -> Ab<T> {
+        self.i_prev
+    }
+
+    /// Records the current present at a reset, for reporting only: the first sample after a
+    /// reset still uses its own current alone for the resistive drop.
+    #[inline]
+    pub(crate) fn set_last_current(&mut self, i_ab: Ab<T>) {
+        self.i_prev = i_ab;
+    }
+
     /// The configuration in use.
     pub fn config(&self) -> &FluxIntegratorConfig<T> {
         &self.config
