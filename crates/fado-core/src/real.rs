@@ -119,6 +119,10 @@ pub fn wrap_angle<T: Real>(x: T) -> T {
     let pi = T::pi();
     let two_pi = T::two_pi();
     let three_pi = T::lit(3.0 * core::f64::consts::PI);
+    // The common case first, with one compare (false for NaN).
+    if x.abs() <= pi {
+        return x;
+    }
     if x > pi {
         if x <= three_pi {
             return x - two_pi;
