@@ -94,6 +94,12 @@ impl<T: Real> DiscreteGains<T> {
 /// [`crate::approx`] (`f32`).
 const SERIES_LIMIT: f64 = 0.25;
 
+/// The same limit for `f32`, whose shorter series stay below half an ulp further: at
+/// |x| = 0.5 (796 Hz at 10 kHz) the first omitted terms are h⁸/9! = 4e-11 (sin), h⁸/8! =
+/// 4e-10 (cos) and y⁸/9! = 1.1e-8 (1 − e^{−y}), against f32's half ulp of 6e-8. Covers the
+/// 700 Hz of docs/firmware.md without [`crate::approx`].
+const SERIES_LIMIT_F32: f64 = 0.5;
+
 /// Taylor coefficients of sin(h)/h in h² (1, −1/3!, 1/5!, ...).
 const SIN_OVER_H: [f64; 6] = [
     1.0,
@@ -141,7 +147,13 @@ const ONE_MINUS_EXP_OVER_Y: [f64; 13] = [
 #[inline]
 fn half_angle_terms<T: Real>(x: T) -> (T, T, T) {
     let y = x.abs();
-    if y <= T::lit(SERIES_LIMIT) {
+    let single = T::one() + T::lit(1e-12) == T::one();
+    let limit = if single {
+        SERIES_LIMIT_F32
+    } else {
+        SERIES_LIMIT
+    };
+    if y <= T::lit(limit) {
         let h = x * T::lit(0.5);
         let h2 = h * h;
         let h4 = h2 * h2;
@@ -149,7 +161,7 @@ fn half_angle_terms<T: Real>(x: T) -> (T, T, T) {
         let y4 = y2 * y2;
         // f32 needs fewer terms (the test folds to a constant per type); the sums are grouped
         // by Estrin's scheme (see `cubic`).
-        let (sin_over_h, cos, one_minus_exp_over_y) = if T::one() + T::lit(1e-12) == T::one() {
+        let (sin_over_h, cos, one_minus_exp_over_y) = if single {
             let (s, c, e) = (&SIN_OVER_H, &COS, &ONE_MINUS_EXP_OVER_Y);
             (
                 cubic(h2, h4, s),
@@ -473,6 +485,22 @@ mod tests {
             let m = 0.5 * omr * omr;
             assert!((g.l2.alpha - m).abs() <= 3.0 * f64::EPSILON * m, "{x}");
             assert!((g.r - (-x.abs()).exp()).abs() <= 2.3e-16, "{x}");
+            let gf = DiscreteGains::<f32>::new(x as f32, 1.0);
+            assert!((gf.a.alpha as f64 - c).abs() < 2e-7 && (gf.a.beta as f64 - s).abs() < 2e-7);
+            assert!((gf.l2.alpha as f64 - m).abs() <= 5e-7 * m, "{x}");
+            assert!((gf.r as f64 - (-x.abs()).exp()).abs() <= 1.2e-7, "{x}");
+            assert!(
+                (gf.l2.beta as f64 - g.l2.beta).abs() <= 1e-6 * g.l2.beta.abs(),
+                "{x}"
+            );
+        }
+        // f32 keeps its series to |x| = 0.5 (`SERIES_LIMIT_F32`), with the same accuracy.
+        for k in -550..=550 {
+            let x = k as f64 * 1e-3 + 1e-7;
+            let (s, c) = x.sin_cos();
+            let omr = -(-x.abs()).exp_m1();
+            let m = 0.5 * omr * omr;
+            let g = DiscreteGains::<f64>::new(x, 1.0);
             let gf = DiscreteGains::<f32>::new(x as f32, 1.0);
             assert!((gf.a.alpha as f64 - c).abs() < 2e-7 && (gf.a.beta as f64 - s).abs() < 2e-7);
             assert!((gf.l2.alpha as f64 - m).abs() <= 5e-7 * m, "{x}");
