@@ -22,7 +22,7 @@ use core::f32::consts::{FRAC_PI_2, PI};
 
 /// π/2 in two parts (Cody–Waite): `PIO2_HI` is the `f32` nearest π/2, and `PIO2_HI − x` is
 /// exact for x in [π/4, π/2] (Sterbenz); `PIO2_LO` = π/2 − `PIO2_HI` adds the rest.
-const PIO2_HI: f32 = 1.570_796_3;
+const PIO2_HI: f32 = FRAC_PI_2;
 const PIO2_LO: f32 = -4.371_139e-8;
 
 /// sin u and cos u for u in [0, π/4] (Taylor, see the module docs).

@@ -637,7 +637,7 @@ impl<T: Real> SensorlessEstimator<T> {
                 self.feedback = feedback;
             }
         }
-        let out = Estimate {
+        Estimate {
             theta: t2s1.theta,
             omega: t2s1.omega,
             omega_control: t2s2.omega,
@@ -655,8 +655,7 @@ impl<T: Real> SensorlessEstimator<T> {
                 flux_linkage_hat: flux_linkage_used,
                 input_fault: false,
             },
-        };
-        out
+        }
     }
 
     #[cold]
