@@ -29,7 +29,7 @@ use cortex_m::interrupt::{self, Mutex};
 use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m_rt::{entry, exception};
 use cortex_m_semihosting::{debug, hprintln};
-use fado_core::{Ab, Estimate, EstimatorConfig, SensorlessEstimator};
+use fado_core::{Ab, Estimate, EstimatorConfig, MachineModel, SensorlessEstimator};
 
 /// QEMU's MPS2 system clock (25 MHz), which clocks SysTick.
 const SYSCLK_HZ: u32 = 25_000_000;
@@ -38,13 +38,8 @@ const SAMPLE_HZ: u32 = 10_000;
 /// Sampling period in s.
 const TS: f32 = 1.0 / SAMPLE_HZ as f32;
 
-/// The machine the signal generator models: the paper's motor (section V), surface-mounted
-/// (Ld = Lq), so the generated flux is exactly the estimator's model.
-const RS: f32 = 0.327;
-const LQ: f32 = 2.63e-3;
-const FLUX_LINKAGE: f32 = 0.088;
-/// q-axis current of the generated operating point (A), 40 % of the paper motor's rated 25 A.
-const IQ: f32 = 10.0;
+/// q-axis current of the generated operating point as a fraction of the rated current.
+const IQ_RATIO: f32 = 0.4;
 
 /// One measured operating point.
 #[derive(Clone, Copy)]
@@ -90,8 +85,14 @@ const SCENARIOS: [Scenario; 4] = [
     },
 ];
 
-/// The generated machine: angle and speed of an ideal PMSM, its flux and current.
+/// The generated machine: angle and speed of an ideal PMSM, its flux and current. Its data are
+/// the paper's motor (`MachineModel::paper()`, section V), the same model the estimator is
+/// configured with; Ld = Lq there, so the generated flux is exactly the estimator's model.
 struct Machine {
+    rs: f32,
+    lq: f32,
+    flux_linkage: f32,
+    iq: f32,
     theta: f32,
     omega: f32,
     /// Speed increment per sample during the ramp (rad/s).
@@ -102,9 +103,13 @@ struct Machine {
 }
 
 impl Machine {
-    fn new(s: &Scenario) -> Self {
+    fn new(s: &Scenario, model: &MachineModel<f32>) -> Self {
         let omega_final = TAU * s.speed_hz;
         let mut m = Self {
+            rs: model.rs,
+            lq: model.lq,
+            flux_linkage: model.flux_linkage,
+            iq: IQ_RATIO * model.rated_current,
             theta: 0.0,
             omega: 0.0,
             d_omega: omega_final * TS / s.ramp_s,
@@ -119,8 +124,8 @@ impl Machine {
     /// Stator flux λ = (λf + j·Lq·iq)·e^{jθ} and current j·iq·e^{jθ} at the present angle.
     fn flux_and_current(&self) -> (Ab<f32>, Ab<f32>) {
         let unit = Ab::new(cos(self.theta), sin(self.theta));
-        let i = unit.mul_j() * IQ;
-        (unit * FLUX_LINKAGE + i * LQ, i)
+        let i = unit.mul_j() * self.iq;
+        (unit * self.flux_linkage + i * self.lq, i)
     }
 
     /// Advances one sample; returns (the average voltage over the interval, the current now).
@@ -132,7 +137,7 @@ impl Machine {
         }
         let (flux, current) = self.flux_and_current();
         // v = Rs·i + dλ/dt, averaged over the interval exactly for the flux term.
-        let v = (self.current + current) * (0.5 * RS) + (flux - self.flux) * (1.0 / TS);
+        let v = (self.current + current) * (0.5 * self.rs) + (flux - self.flux) * (1.0 / TS);
         self.flux = flux;
         self.current = current;
         (v, current)
@@ -293,15 +298,14 @@ fn main() -> ! {
     let mut all_locked = true;
     let (mut deepest_isr, mut deepest_step) = (0, 0);
     for (index, s) in SCENARIOS.iter().enumerate() {
-        let config = EstimatorConfig {
-            rs_adaptation: s.rs_adaptation,
-            ..EstimatorConfig::default()
-        };
+        let model = MachineModel::<f32>::paper();
+        let mut config = EstimatorConfig::for_machine(&model);
+        config.tuning.rs_adaptation = s.rs_adaptation;
         let Ok(estimator) = SensorlessEstimator::new(config) else {
             hprintln!("invalid configuration");
             exit(false)
         };
-        let machine = Machine::new(s);
+        let machine = Machine::new(s, &model);
         let total_samples = (s.ramp_s * SAMPLE_HZ as f32) as u32 + s.hold_samples;
         let app = App {
             estimator,
