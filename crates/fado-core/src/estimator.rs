@@ -679,7 +679,11 @@ impl<T: Real> SensorlessEstimator<T> {
         let lambda1 = self.integrator.flux();
         let disturbance = self.observer.disturbance();
         let lambda2 = stator_flux(lambda1, disturbance);
-        let lambda_r = rotor_flux(lambda2, self.integrator.last_current(), self.config.machine.lq);
+        let lambda_r = rotor_flux(
+            lambda2,
+            self.integrator.last_current(),
+            self.config.machine.lq,
+        );
         let mode = self.selector.mode();
         Estimate {
             theta: self.t2s1.angle(),
