@@ -775,3 +775,20 @@ impl<T: Real> RotorAngleEstimator<T> for SensorlessEstimator<T> {
         "fado"
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The firmware state budget (docs/firmware.md): no copy of the last estimate is kept, so
+    /// the state is the blocks plus the configuration. Prints both precisions' sizes.
+    #[test]
+    fn state_size() {
+        let (s32, s64) = (
+            core::mem::size_of::<SensorlessEstimator<f32>>(),
+            core::mem::size_of::<SensorlessEstimator<f64>>(),
+        );
+        std::println!("SensorlessEstimator<f32>: {s32} B, <f64>: {s64} B");
+        assert!(s32 <= 388, "{s32}");
+    }
+}
