@@ -21,6 +21,7 @@ use crate::flux::{
 };
 use crate::mode::{Mode, ModeSelector, ModeSelectorConfig};
 use crate::observer::{DisturbanceObserver, DisturbanceObserverConfig};
+use crate::real::all_finite;
 use crate::rotor_flux::{rotor_angle, rotor_flux, stator_flux};
 use crate::rs_adaptation::{AdaptationRegime, ResistanceAdaptation, ResistanceAdaptationConfig};
 use crate::tracker::{BandwidthDefinition, TrackerConfig, TypeTwoTracker};
@@ -283,7 +284,7 @@ pub struct Diagnostics<T> {
     /// [`EstimatorTuning::rs_adaptation`].
     pub flux_linkage_hat: T,
     /// This sample's inputs were non-finite and were rejected; the state is unchanged and the
-    /// other fields repeat the last good sample.
+    /// other fields are [`SensorlessEstimator::last`].
     pub input_fault: bool,
 }
 
@@ -343,7 +344,6 @@ pub struct SensorlessEstimator<T> {
     feedback: Ab<T>,
     hold_level_sq: T,
     k_df_enabled: bool,
-    last: Estimate<T>,
     rejected_samples: u32,
 }
 
@@ -468,7 +468,6 @@ impl<T: Real> SensorlessEstimator<T> {
             feedback: Ab::zero(),
             hold_level_sq: hold_level * hold_level,
             k_df_enabled: true,
-            last: Estimate::default(),
             rejected_samples: 0,
         };
         est.reset();
@@ -499,12 +498,13 @@ impl<T: Real> SensorlessEstimator<T> {
         // A current so large that L̂q·i overflows is as unusable as a NaN (found by fuzzing,
         // f32: i = 3e37 A gave λ1 = ∞): start as with zero current.
         let lambda1 = lambda_r + i_ab * self.config.machine.lq;
-        let lambda1 = if lambda1.is_finite() {
-            lambda1
+        let (lambda1, i_ab) = if lambda1.is_finite() {
+            (lambda1, i_ab)
         } else {
-            lambda_r
+            (lambda_r, Ab::zero())
         };
         self.integrator.reset_to(lambda1);
+        self.integrator.set_last_current(i_ab);
         self.observer
             .reset_to(if self.config.tuning.observer_on_rotor_flux {
                 lambda_r
@@ -517,25 +517,6 @@ impl<T: Real> SensorlessEstimator<T> {
         self.t2s2.reset_to(theta0, T::zero());
         self.feedback = Ab::zero();
         self.rejected_samples = 0;
-        self.last = Estimate {
-            theta: self.t2s1.angle(),
-            omega: T::zero(),
-            omega_control: T::zero(),
-            diagnostics: Diagnostics {
-                lambda1,
-                disturbance: Ab::zero(),
-                lambda2: lambda1,
-                lambda_r,
-                theta_direct: self.t2s1.angle(),
-                mode: Mode::Limiter,
-                flag_limit: true,
-                limiter_clamping: false,
-                tracker_hold: false,
-                rs_hat: self.rs_adaptation.rs_hat(),
-                flux_linkage_hat: self.rs_adaptation.flux_linkage_hat(),
-                input_fault: false,
-            },
-        };
     }
 
     /// One 10 kHz sample (Fig. 5).
@@ -543,15 +524,15 @@ impl<T: Real> SensorlessEstimator<T> {
     /// `v_ab` is the voltage reference that was applied over the last sampling interval (with
     /// a one-sample computational delay, the one computed two samples ago, before dead-time
     /// compensation); `i_ab` the currents sampled now. A non-finite input is rejected: the state
-    /// is untouched and the previous estimate is returned with `input_fault` set.
+    /// is untouched and [`Self::last`] is returned with `input_fault` set.
     #[inline]
     pub fn step(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> Estimate<T> {
-        if !(v_ab.is_finite() && i_ab.is_finite()) {
-            return self.reject();
-        }
-        // The whole new state is computed first and committed only if it is finite: finite but
-        // absurd inputs can still overflow a state, and a rejected sample must leave none of it
-        // changed. (Cheaper than copying the estimator as a backup every sample.)
+        // The whole new state is computed first and committed only if it is finite: a
+        // non-finite input makes it non-finite (every input enters λ1 through Ts·v and the
+        // resistive drop, or λ̂r through L̂q·i, and NaN and ±∞ propagate, 0·∞ included), finite
+        // but absurd inputs can still overflow it, and a rejected sample must leave none of it
+        // changed. One test at the end covers all of this (cheaper than a test per input and
+        // per block, and than copying the estimator as a backup every sample).
         // 1. Integrate with the feedback of the previous sample (eq. (21) / (24)).
         let (lambda1, i_drop) = self.integrator.next_flux(v_ab, i_ab, self.feedback);
         // 2. Disturbance observer at ω̂ of T2S-1 (eq. (10), (16)), on λ1 or on λ1 − L̂q·i
@@ -588,13 +569,25 @@ impl<T: Real> SensorlessEstimator<T> {
                 (l.feedback, l.clamping)
             }
         };
-        let finite = lambda1.is_finite()
-            & observer_flux.is_finite()
-            & disturbance.is_finite()
-            & lambda_r.is_finite()
-            & feedback.is_finite()
-            & t2s1.is_finite()
-            & t2s2.is_finite();
+        // Which values the one test needs (the others follow from them, so the test is
+        // exact, not approximate): a non-finite v or i makes λ1 non-finite (Ts·v, and R̂s·i
+        // with R̂s ≥ 0: ∞·R̂s = ∞, 0·∞ = NaN, ∞ − ∞ = NaN); a tracker's ω̂ = ω̂ + Ki·Ts·e is
+        // finite only if its phase error e = wrap(…) is, and then θ̂ and θ̂⁻ (wrapped sums of
+        // finite values) are finite too. λ̂r and the feedback can overflow on their own.
+        let finite = all_finite([
+            lambda1.alpha,
+            lambda1.beta,
+            observer_flux.alpha,
+            observer_flux.beta,
+            disturbance.alpha,
+            disturbance.beta,
+            lambda_r.alpha,
+            lambda_r.beta,
+            feedback.alpha,
+            feedback.beta,
+            t2s1.omega,
+            t2s2.omega,
+        ]);
         if !finite {
             return self.reject();
         }
@@ -630,13 +623,21 @@ impl<T: Real> SensorlessEstimator<T> {
                 .rs_adaptation
                 .next_state(v_ab, i_drop, lambda_r, t2s1.omega, regime);
             let feedback = self.feedback + pull;
-            if state.is_finite() && feedback.is_finite() {
+            // R̂s and λ̂f leave the adaptation clamped by compare-and-select, which turns a
+            // NaN into the bound: always finite.
+            if all_finite([
+                state.charge_d,
+                state.volt_seconds_d,
+                state.i_d_prev,
+                feedback.alpha,
+                feedback.beta,
+            ]) {
                 self.rs_adaptation.commit(state);
                 self.integrator.set_rs_hat_unchecked(state.rs_hat);
                 self.feedback = feedback;
             }
         }
-        let out = Estimate {
+        Estimate {
             theta: t2s1.theta,
             omega: t2s1.omega,
             omega_control: t2s2.omega,
@@ -654,21 +655,55 @@ impl<T: Real> SensorlessEstimator<T> {
                 flux_linkage_hat: flux_linkage_used,
                 input_fault: false,
             },
-        };
-        self.last = out;
-        out
+        }
     }
 
+    #[cold]
     fn reject(&mut self) -> Estimate<T> {
         self.rejected_samples = self.rejected_samples.saturating_add(1);
-        let mut out = self.last;
+        let mut out = self.last();
         out.diagnostics.input_fault = true;
         out
     }
 
-    /// The last good estimate.
-    pub fn last(&self) -> &Estimate<T> {
-        &self.last
+    /// The estimate of the last good sample (or of the last `align`/`reset`), recomputed from
+    /// the state: the estimator keeps no copy of its output (64 bytes written every sample in
+    /// `f32`; a caller that needs the output keeps what `step` returned).
+    ///
+    /// θ̂, ω̂, ω̂ for control, the mode and FLAG_limit are those of that sample exactly. The
+    /// diagnostics are recomputed: λ1 and D̂ as stored (after the limiter re-centring, see
+    /// [`EstimatorTuning::limiter_recentring`]), λ2 = λ1 − D̂, λ̂r = λ2 − L̂q·i with that
+    /// sample's current, θm = ∠λ̂r, the limiter and hold flags from this λ̂r, R̂s and λ̂f as
+    /// they will be used next.
+    pub fn last(&self) -> Estimate<T> {
+        let lambda1 = self.integrator.flux();
+        let disturbance = self.observer.disturbance();
+        let lambda2 = stator_flux(lambda1, disturbance);
+        let lambda_r = rotor_flux(
+            lambda2,
+            self.integrator.last_current(),
+            self.config.machine.lq,
+        );
+        let mode = self.selector.mode();
+        Estimate {
+            theta: self.t2s1.angle(),
+            omega: self.t2s1.speed(),
+            omega_control: self.t2s2.speed(),
+            diagnostics: Diagnostics {
+                lambda1,
+                disturbance,
+                lambda2,
+                lambda_r,
+                theta_direct: rotor_angle(lambda_r),
+                mode,
+                flag_limit: mode == Mode::Limiter,
+                limiter_clamping: mode == Mode::Limiter && self.limiter.step(lambda_r).clamping,
+                tracker_hold: lambda_r.norm_squared() < self.hold_level_sq,
+                rs_hat: self.integrator.config().rs_hat,
+                flux_linkage_hat: self.rs_adaptation.flux_linkage_hat(),
+                input_fault: false,
+            },
+        }
     }
 
     /// Number of samples rejected since the last reset.
@@ -738,5 +773,22 @@ impl<T: Real> RotorAngleEstimator<T> for SensorlessEstimator<T> {
     }
     fn name(&self) -> &'static str {
         "fado"
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The firmware state budget (docs/firmware.md): no copy of the last estimate is kept, so
+    /// the state is the blocks plus the configuration. Prints both precisions' sizes.
+    #[test]
+    fn state_size() {
+        let (s32, s64) = (
+            core::mem::size_of::<SensorlessEstimator<f32>>(),
+            core::mem::size_of::<SensorlessEstimator<f64>>(),
+        );
+        std::println!("SensorlessEstimator<f32>: {s32} B, <f64>: {s64} B");
+        assert!(s32 <= 388, "{s32}");
     }
 }

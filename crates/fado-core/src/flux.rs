@@ -123,6 +123,20 @@ impl<T: Real> FluxIntegrator<T> {
         self.lambda1
     }
 
+    /// The current of the last sample (zero after a reset, or what [`Self::set_last_current`]
+    /// set).
+    #[inline]
+    pub(crate) fn last_current(&self) -> Ab<T> {
+        self.i_prev
+    }
+
+    /// Records the current present at a reset, for reporting only: the first sample after a
+    /// reset still uses its own current alone for the resistive drop.
+    #[inline]
+    pub(crate) fn set_last_current(&mut self, i_ab: Ab<T>) {
+        self.i_prev = i_ab;
+    }
+
     /// The configuration in use.
     pub fn config(&self) -> &FluxIntegratorConfig<T> {
         &self.config
@@ -206,7 +220,7 @@ impl<T: Real> DisturbanceFeedback<T> {
     #[inline]
     pub(crate) fn next_gain(&self, active: bool) -> T {
         if active {
-            (self.gain + self.ramp_increment).min(self.k_df)
+            crate::real::min(self.gain + self.ramp_increment, self.k_df)
         } else {
             T::zero()
         }
@@ -292,7 +306,7 @@ impl<T: Real> FluxLimiter<T> {
         let n2 = lambda_r.norm_squared();
         let rho = self.config.radius;
         if n2 > rho * rho {
-            let n = n2.sqrt();
+            let n = n2.step_sqrt();
             LimiterOutput {
                 feedback: lambda_r * (self.config.k_af * (n - rho) / n),
                 clamping: true,

@@ -20,6 +20,7 @@
 #[cfg(test)]
 extern crate std;
 
+pub mod approx;
 pub mod baselines;
 pub mod commissioning;
 pub mod control;

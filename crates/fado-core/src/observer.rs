@@ -90,8 +90,15 @@ impl<T: Real> DiscreteGains<T> {
 }
 
 /// Largest |ω·Ts| (rad) served by the series in [`half_angle_terms`]: 398 Hz at 10 kHz, far
-/// above the motor's 100 Hz; beyond it the gains come from `libm`.
+/// above the motor's 100 Hz; beyond it the gains come from `libm` (`f64`) or from
+/// [`crate::approx`] (`f32`).
 const SERIES_LIMIT: f64 = 0.25;
+
+/// The same limit for `f32`, whose shorter series stay below half an ulp further: at
+/// |x| = 0.5 (796 Hz at 10 kHz) the first omitted terms are h⁸/9! = 4e-11 (sin), h⁸/8! =
+/// 4e-10 (cos) and y⁸/9! = 1.1e-8 (1 − e^{−y}), against f32's half ulp of 6e-8. Covers the
+/// 700 Hz of docs/firmware.md without [`crate::approx`].
+const SERIES_LIMIT_F32: f64 = 0.5;
 
 /// Taylor coefficients of sin(h)/h in h² (1, −1/3!, 1/5!, ...).
 const SIN_OVER_H: [f64; 6] = [
@@ -140,7 +147,13 @@ const ONE_MINUS_EXP_OVER_Y: [f64; 13] = [
 #[inline]
 fn half_angle_terms<T: Real>(x: T) -> (T, T, T) {
     let y = x.abs();
-    if y <= T::lit(SERIES_LIMIT) {
+    let single = T::one() + T::lit(1e-12) == T::one();
+    let limit = if single {
+        SERIES_LIMIT_F32
+    } else {
+        SERIES_LIMIT
+    };
+    if y <= T::lit(limit) {
         let h = x * T::lit(0.5);
         let h2 = h * h;
         let h4 = h2 * h2;
@@ -148,7 +161,7 @@ fn half_angle_terms<T: Real>(x: T) -> (T, T, T) {
         let y4 = y2 * y2;
         // f32 needs fewer terms (the test folds to a constant per type); the sums are grouped
         // by Estrin's scheme (see `cubic`).
-        let (sin_over_h, cos, one_minus_exp_over_y) = if T::one() + T::lit(1e-12) == T::one() {
+        let (sin_over_h, cos, one_minus_exp_over_y) = if single {
             let (s, c, e) = (&SIN_OVER_H, &COS, &ONE_MINUS_EXP_OVER_Y);
             (
                 cubic(h2, h4, s),
@@ -168,9 +181,13 @@ fn half_angle_terms<T: Real>(x: T) -> (T, T, T) {
         };
         (h * sin_over_h, cos, y * one_minus_exp_over_y)
     } else {
-        // Large speeds (and NaN, which propagates).
-        let (sh, ch) = (x * T::lit(0.5)).sin_cos();
-        (sh, ch, -(-y).exp_m1())
+        // Large speeds (and NaN, which propagates). a = e^{jx} is 2π-periodic in x and every
+        // gain depends on (sin(x/2), cos(x/2)) only through products of two of them, which a
+        // shift of x by 2π (both change sign) leaves alone: wrap x first, so that the f32
+        // approximation needs only [−π/2, π/2] (see `Real::step_sin_cos`). r depends on |x|
+        // itself.
+        let (sh, ch) = (crate::wrap_angle(x) * T::lit(0.5)).step_sin_cos();
+        (sh, ch, y.step_one_minus_exp_neg())
     }
 }
 
@@ -309,6 +326,36 @@ mod tests {
         m
     }
 
+    /// Above the series limit the f32 gains come from `crate::approx` (no f64 inside): they
+    /// agree with the f64 (`libm`) gains within f32 rounding for both signs, up to the Nyquist
+    /// speed |ω·Ts| = 3 and beyond it (there x is wrapped first; ℓ2 ∝ 1/sin(x/2) is
+    /// ill-conditioned near x = 2π, so the test stops at 5.5).
+    #[test]
+    fn f32_gains_beyond_the_series_match_f64() {
+        let ts = 1e-4;
+        let mut worst = 0.0_f64;
+        for k in 0..=5300 {
+            let x = 0.2 + k as f64 * 1e-3; // 0.2 … 5.5 rad per sample
+            for omega in [x / ts, -x / ts] {
+                let g64 = DiscreteGains::new(omega, ts);
+                let g32 = DiscreteGains::new(omega as f32, ts as f32);
+                let d = |a: Ab<f32>, b: Ab<f64>| {
+                    (a.alpha as f64 - b.alpha)
+                        .abs()
+                        .max((a.beta as f64 - b.beta).abs())
+                };
+                let scale = 1.0 + g64.l2.alpha.abs().max(g64.l2.beta.abs());
+                worst = worst
+                    .max(d(g32.a, g64.a))
+                    .max(d(g32.one_minus_a, g64.one_minus_a))
+                    .max(d(g32.l1, g64.l1))
+                    .max(d(g32.l2, g64.l2) / scale)
+                    .max((g32.r as f64 - g64.r).abs());
+            }
+        }
+        assert!(worst < 2e-6, "{worst}");
+    }
+
     #[test]
     fn discrete_poles_are_image_of_minus_abs_omega_both_signs() {
         let ts = 100e-6;
@@ -438,6 +485,22 @@ mod tests {
             let m = 0.5 * omr * omr;
             assert!((g.l2.alpha - m).abs() <= 3.0 * f64::EPSILON * m, "{x}");
             assert!((g.r - (-x.abs()).exp()).abs() <= 2.3e-16, "{x}");
+            let gf = DiscreteGains::<f32>::new(x as f32, 1.0);
+            assert!((gf.a.alpha as f64 - c).abs() < 2e-7 && (gf.a.beta as f64 - s).abs() < 2e-7);
+            assert!((gf.l2.alpha as f64 - m).abs() <= 5e-7 * m, "{x}");
+            assert!((gf.r as f64 - (-x.abs()).exp()).abs() <= 1.2e-7, "{x}");
+            assert!(
+                (gf.l2.beta as f64 - g.l2.beta).abs() <= 1e-6 * g.l2.beta.abs(),
+                "{x}"
+            );
+        }
+        // f32 keeps its series to |x| = 0.5 (`SERIES_LIMIT_F32`), with the same accuracy.
+        for k in -550..=550 {
+            let x = k as f64 * 1e-3 + 1e-7;
+            let (s, c) = x.sin_cos();
+            let omr = -(-x.abs()).exp_m1();
+            let m = 0.5 * omr * omr;
+            let g = DiscreteGains::<f64>::new(x, 1.0);
             let gf = DiscreteGains::<f32>::new(x as f32, 1.0);
             assert!((gf.a.alpha as f64 - c).abs() < 2e-7 && (gf.a.beta as f64 - s).abs() < 2e-7);
             assert!((gf.l2.alpha as f64 - m).abs() <= 5e-7 * m, "{x}");

@@ -11,6 +11,19 @@ pub trait Real: RealField + Copy + Default {
     fn lit(x: f64) -> Self;
     /// Converts this scalar to `f64` (for reporting and tests).
     fn to_f64(self) -> f64;
+    /// (sin x, cos x) for |x| ≤ π/2, as the estimator's step computes them: `libm` for `f64`,
+    /// [`crate::approx::sin_cos`] for `f32` (no software double precision on a single-precision
+    /// FPU; error below 2e-7).
+    fn step_sin_cos(self) -> (Self, Self);
+    /// 1 − e^{−y} for y ≥ 0, as the estimator's step computes it: `libm`'s `exp_m1` for `f64`,
+    /// [`crate::approx::one_minus_exp_neg`] for `f32` (error below 1.5e-7).
+    fn step_one_minus_exp_neg(self) -> Self;
+    /// atan2(self, x), as the estimator's step computes it: `libm` for `f64`,
+    /// [`crate::approx::atan2`] for `f32` (error below 3.5e-7 rad).
+    fn step_atan2(self, x: Self) -> Self;
+    /// √x for x ≥ 0, as the estimator's step computes it: `libm` for `f64`,
+    /// [`crate::approx::sqrt`] for `f32` (within 1 ulp).
+    fn step_sqrt(self) -> Self;
 }
 
 impl Real for f32 {
@@ -21,6 +34,22 @@ impl Real for f32 {
     #[inline(always)]
     fn to_f64(self) -> f64 {
         self as f64
+    }
+    #[inline(always)]
+    fn step_sin_cos(self) -> (Self, Self) {
+        crate::approx::sin_cos(self)
+    }
+    #[inline(always)]
+    fn step_one_minus_exp_neg(self) -> Self {
+        crate::approx::one_minus_exp_neg(self)
+    }
+    #[inline(always)]
+    fn step_atan2(self, x: Self) -> Self {
+        crate::approx::atan2(self, x)
+    }
+    #[inline(always)]
+    fn step_sqrt(self) -> Self {
+        crate::approx::sqrt(self)
     }
 }
 
@@ -33,6 +62,50 @@ impl Real for f64 {
     fn to_f64(self) -> f64 {
         self
     }
+    #[inline(always)]
+    fn step_sin_cos(self) -> (Self, Self) {
+        nalgebra::ComplexField::sin_cos(self)
+    }
+    #[inline(always)]
+    fn step_one_minus_exp_neg(self) -> Self {
+        -nalgebra::ComplexField::exp_m1(-self)
+    }
+    #[inline(always)]
+    fn step_atan2(self, x: Self) -> Self {
+        RealField::atan2(self, x)
+    }
+    #[inline(always)]
+    fn step_sqrt(self) -> Self {
+        nalgebra::ComplexField::sqrt(self)
+    }
+}
+
+/// min(x, y) for a `y` that is never NaN: a compare and a select (the FPU has no minimum
+/// instruction on a Cortex-M4; `libm`'s `fminf` is a call). Same result as `fmin` except for
+/// the sign of a zero result; a NaN `x` gives `y`, as `fmin` does.
+#[inline(always)]
+pub(crate) fn min<T: Real>(x: T, y: T) -> T {
+    if x < y { x } else { y }
+}
+
+/// max(x, y) for a `y` that is never NaN, as [`min`]: a NaN `x` gives `y`.
+#[inline(always)]
+pub(crate) fn max<T: Real>(x: T, y: T) -> T {
+    if x > y { x } else { y }
+}
+
+/// True when every value is finite, in one test: x·0 is ±0 for a finite x and NaN for ±∞
+/// and NaN, and a sum of such products is zero exactly when all of them are (no overflow,
+/// unlike a sum of the values themselves). Two FPU operations per value and one branch,
+/// instead of a compare and a branch per value.
+#[inline(always)]
+pub(crate) fn all_finite<T: Real, const N: usize>(values: [T; N]) -> bool {
+    let zero = T::zero();
+    let mut acc = zero;
+    for v in values {
+        acc += v * zero;
+    }
+    acc == zero
 }
 
 /// Wraps an angle into [−π, π]: `x − 2π·round(x / 2π)` (SPEC notation).
@@ -41,11 +114,15 @@ impl Real for f64 {
 /// so the argument lies within ±3π; there one exact subtraction (Sterbenz: |x| ≥ π = 2π/2)
 /// gives the same result as the rounding formula without a call to `round`. Anything larger
 /// takes the general formula; NaN stays NaN and ±∞ becomes NaN as with the formula.
-#[inline]
+#[inline(always)]
 pub fn wrap_angle<T: Real>(x: T) -> T {
     let pi = T::pi();
     let two_pi = T::two_pi();
     let three_pi = T::lit(3.0 * core::f64::consts::PI);
+    // The common case first, with one compare (false for NaN).
+    if x.abs() <= pi {
+        return x;
+    }
     if x > pi {
         if x <= three_pi {
             return x - two_pi;
@@ -57,6 +134,15 @@ pub fn wrap_angle<T: Real>(x: T) -> T {
     } else {
         return x;
     }
+    wrap_far(x)
+}
+
+/// [`wrap_angle`] beyond ±3π (and NaN, ±∞): out of line, never taken in normal operation.
+#[cold]
+#[inline(never)]
+fn wrap_far<T: Real>(x: T) -> T {
+    let pi = T::pi();
+    let two_pi = T::two_pi();
     let r = x - two_pi * (x / two_pi).round();
     if r.abs() <= pi {
         return r;

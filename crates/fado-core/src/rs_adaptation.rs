@@ -57,6 +57,7 @@
 //! passage needs. A λ̂f error biases the rotating law by Δλf·ω/i_q.
 
 use crate::error::{ConfigError, check};
+use crate::real::{all_finite, max, min};
 use crate::{Ab, Real};
 
 /// Lower bound of the adapted λ̂f as a multiple of the configured one (NdFeB loses ≈ 0.1 %/K,
@@ -173,11 +174,13 @@ impl<T: Real> ResistanceAdaptationState<T> {
     /// True when every field is finite.
     #[inline]
     pub fn is_finite(&self) -> bool {
-        self.rs_hat.is_finite()
-            && self.flux_linkage_hat.is_finite()
-            && self.charge_d.is_finite()
-            && self.volt_seconds_d.is_finite()
-            && self.i_d_prev.is_finite()
+        all_finite([
+            self.rs_hat,
+            self.flux_linkage_hat,
+            self.charge_d,
+            self.volt_seconds_d,
+            self.i_d_prev,
+        ])
     }
 }
 
@@ -327,7 +330,7 @@ impl<T: Real> ResistanceAdaptation<T> {
         if regime == AdaptationRegime::Frozen || mag_sq <= T::zero() {
             return (next, pull);
         }
-        let mag = mag_sq.sqrt();
+        let mag = mag_sq.step_sqrt();
         if regime == AdaptationRegime::Rotating {
             // χ = φ·R0/λ̂f with φ = ⟨−i/(jω̂), d⟩ = −i_q/ω̂ and i_q = (λ̂r × i)/|λ̂r|, as
             // χ = a/b: then χ/(χ² + χ0²) = a·b/(a² + χ0²·b²) costs one division, and
@@ -342,9 +345,13 @@ impl<T: Real> ResistanceAdaptation<T> {
             } else if a_sq * T::lit(4.0) < floor_b_sq {
                 // |χ| < χ0/2: R̂s explains too little of |λ̂r| − λ̂f; the rest is λ̂f's.
                 let lf0 = self.config.flux_linkage_hat;
-                next.flux_linkage_hat = (lf + self.flux_gain * (mag - lf))
-                    .max(lf0 * T::lit(FLUX_LINKAGE_MIN_RATIO))
-                    .min(lf0 * T::lit(FLUX_LINKAGE_MAX_RATIO));
+                next.flux_linkage_hat = min(
+                    max(
+                        lf + self.flux_gain * (mag - lf),
+                        lf0 * T::lit(FLUX_LINKAGE_MIN_RATIO),
+                    ),
+                    lf0 * T::lit(FLUX_LINKAGE_MAX_RATIO),
+                );
             }
         } else {
             // Standstill: only at standstill and while the current lies along the flux (the
@@ -375,10 +382,10 @@ impl<T: Real> ResistanceAdaptation<T> {
             // λ̂r back out (outside, the Fig. 6 limiter already bounds it at its circle;
             // pulling it further in would only speed up the walk of a tangential integrand
             // error along the circle, which goes as e_t/|λ̂r|).
-            let shortfall = (mag - self.state.flux_linkage_hat).min(T::zero());
+            let shortfall = min(mag - self.state.flux_linkage_hat, T::zero());
             pull = unit * (self.config.standstill_flux_rate * shortfall);
         }
-        next.rs_hat = next.rs_hat.max(self.rs_min).min(self.rs_max);
+        next.rs_hat = min(max(next.rs_hat, self.rs_min), self.rs_max);
         (next, pull)
     }
 

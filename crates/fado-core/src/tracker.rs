@@ -85,6 +85,8 @@ impl<T: Real> TrackerConfig<T> {
 pub struct TypeTwoTracker<T> {
     ts: T,
     kp: T,
+    /// Ts·Kp, precomputed (the same product the recursion formed every sample).
+    kp_ts: T,
     ki_ts: T,
     /// θ̂⁻: the angle predicted for the next sample.
     predicted: T,
@@ -113,6 +115,7 @@ impl<T: Real> TypeTwoTracker<T> {
         Ok(Self {
             ts,
             kp,
+            kp_ts: ts * kp,
             ki_ts: ki * ts,
             predicted: T::zero(),
             theta: T::zero(),
@@ -153,11 +156,11 @@ impl<T: Real> TypeTwoTracker<T> {
     }
 
     /// The state after one sample with the measurement θm, without changing `self`.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn next_state(&self, theta_measured: T) -> TrackerState<T> {
         let e = wrap_angle(theta_measured - self.predicted);
         let omega = self.omega + self.ki_ts * e;
-        let theta = wrap_angle(self.predicted + self.ts * self.kp * e);
+        let theta = wrap_angle(self.predicted + self.kp_ts * e);
         TrackerState {
             predicted: wrap_angle(theta + self.ts * omega),
             theta,
@@ -217,14 +220,6 @@ pub(crate) struct TrackerState<T> {
     pub theta: T,
     /// ω̂.
     pub omega: T,
-}
-
-impl<T: Real> TrackerState<T> {
-    /// True when every component is finite.
-    #[inline]
-    pub fn is_finite(&self) -> bool {
-        self.predicted.is_finite() & self.theta.is_finite() & self.omega.is_finite()
-    }
 }
 
 #[cfg(test)]

@@ -46,17 +46,17 @@ fn huge_initial_angle_is_wrapped() {
         config.initial_angle = a0;
         config.tuning.observer_on_rotor_flux = false;
         let mut est = SensorlessEstimator::new(config).unwrap();
-        check_estimate(est.last());
+        check_estimate(&est.last());
         check_estimate(&est.step(Ab::new(1.0, 0.0), Ab::new(0.5, 0.0)));
         est.align(a0, Ab::new(1.0, 2.0));
-        check_estimate(est.last());
+        check_estimate(&est.last());
     }
     let est = SensorlessEstimator::<f32>::new(EstimatorConfig {
         initial_angle: f32::MAX,
         ..paper()
     })
     .unwrap();
-    check_estimate(est.last());
+    check_estimate(&est.last());
 }
 
 /// fuzz/regressions/drive_step/huge-align-angle: `align(9.1e30)` during the offset
@@ -90,7 +90,7 @@ fn align_with_an_overflowing_current_starts_finite() {
     config.tuning.observer_on_rotor_flux = false;
     let mut est = SensorlessEstimator::new(config).unwrap();
     est.align(29041.0 * 1e33, Ab::new(29041.0 * 1e33, 29041.0 * 1e33));
-    check_estimate(est.last());
+    check_estimate(&est.last());
     check_estimate(&est.step(Ab::new(69.39, 69.39), Ab::new(0.0, 0.0)));
     check_estimate(&est.step(Ab::zero(), Ab::zero()));
     // The same current in f64 is representable: it is used.

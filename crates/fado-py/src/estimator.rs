@@ -315,7 +315,7 @@ impl PyEstimator {
     /// The last good result (the start-up state after `reset` or `align`).
     #[getter]
     fn last(&self) -> StepResult {
-        with_engine!(&self.engine, e => StepResult::from_estimate(e.last()))
+        with_engine!(&self.engine, e => StepResult::from_estimate(&e.last()))
     }
 
     /// Number of samples rejected (non-finite input) since the last reset.

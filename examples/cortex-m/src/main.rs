@@ -1,0 +1,394 @@
+//! fado's f32 estimator in a 10 kHz interrupt on a Cortex-M4F: the firmware user's starting
+//! point, and the image `scripts/firmware-cost.sh` measures.
+//!
+//! `main` configures SysTick for 10 kHz and, for each scenario, builds a
+//! [`SensorlessEstimator`] and hands it to the interrupt. The SysTick handler stands in for the
+//! PWM/ADC interrupt of a drive: it reads the "ADC" (here a generated machine signal: an ideal
+//! surface PMSM turning at a speed that ramps up and then holds), runs one estimator step and
+//! keeps the worst angle error of the last samples. Results are printed over semihosting, and
+//! the program exits with status 0 when every scenario kept lock (QEMU passes the status on).
+//!
+//! # Sharing the estimator with the interrupt (static-init pattern)
+//! The estimator is built (and its configuration checked) in `main`, outside the interrupt,
+//! and moved into a `static Mutex<RefCell<Option<App>>>`. The interrupt borrows it with
+//! `try_borrow_mut`, so nothing on its path can panic; `Option::None` and a failed borrow
+//! simply skip the sample. No `unsafe`, no allocation, and the configuration validation
+//! (which the interrupt never needs) stays out of the interrupt's code.
+//!
+//! The cost script finds the step as the out-of-line function [`estimator_step`] and counts
+//! the instructions executed from its entry to its return.
+
+#![no_std]
+#![no_main]
+
+use core::cell::{Cell, RefCell};
+use core::f32::consts::TAU;
+use core::panic::PanicInfo;
+
+use cortex_m::interrupt::{self, Mutex};
+use cortex_m::peripheral::syst::SystClkSource;
+use cortex_m_rt::{entry, exception};
+use cortex_m_semihosting::{debug, hprintln};
+use fado_core::{Ab, Estimate, EstimatorConfig, MachineModel, SensorlessEstimator};
+
+/// QEMU's MPS2 system clock (25 MHz), which clocks SysTick.
+const SYSCLK_HZ: u32 = 25_000_000;
+/// The estimator's sampling frequency (paper, section V).
+const SAMPLE_HZ: u32 = 10_000;
+/// Sampling period in s.
+const TS: f32 = 1.0 / SAMPLE_HZ as f32;
+
+/// q-axis current of the generated operating point as a fraction of the rated current.
+const IQ_RATIO: f32 = 0.4;
+
+/// One measured operating point.
+#[derive(Clone, Copy)]
+struct Scenario {
+    name: &'static str,
+    /// Final electrical speed (Hz).
+    speed_hz: f32,
+    /// Ramp time from standstill to `speed_hz` (s): slow enough for T2S-1 to stay locked.
+    ramp_s: f32,
+    /// Samples held at `speed_hz` after the ramp.
+    hold_samples: u32,
+    rs_adaptation: bool,
+}
+
+const SCENARIOS: [Scenario; 4] = [
+    Scenario {
+        name: "low speed, R^s adaptation",
+        speed_hz: 19.5,
+        ramp_s: 0.05,
+        hold_samples: 1000,
+        rs_adaptation: true,
+    },
+    Scenario {
+        name: "high speed, R^s adaptation",
+        speed_hz: 700.0,
+        ramp_s: 0.4,
+        hold_samples: 1000,
+        rs_adaptation: true,
+    },
+    Scenario {
+        name: "low speed, fixed R^s (paper)",
+        speed_hz: 19.5,
+        ramp_s: 0.05,
+        hold_samples: 1000,
+        rs_adaptation: false,
+    },
+    Scenario {
+        name: "high speed, fixed R^s (paper)",
+        speed_hz: 700.0,
+        ramp_s: 0.4,
+        hold_samples: 1000,
+        rs_adaptation: false,
+    },
+];
+
+/// The generated machine: angle and speed of an ideal PMSM, its flux and current. Its data are
+/// the paper's motor (`MachineModel::paper()`, section V), the same model the estimator is
+/// configured with; Ld = Lq there, so the generated flux is exactly the estimator's model.
+struct Machine {
+    rs: f32,
+    lq: f32,
+    flux_linkage: f32,
+    iq: f32,
+    theta: f32,
+    omega: f32,
+    /// Speed increment per sample during the ramp (rad/s).
+    d_omega: f32,
+    omega_final: f32,
+    flux: Ab<f32>,
+    current: Ab<f32>,
+}
+
+impl Machine {
+    fn new(s: &Scenario, model: &MachineModel<f32>) -> Self {
+        let omega_final = TAU * s.speed_hz;
+        let mut m = Self {
+            rs: model.rs,
+            lq: model.lq,
+            flux_linkage: model.flux_linkage,
+            iq: IQ_RATIO * model.rated_current,
+            theta: 0.0,
+            omega: 0.0,
+            d_omega: omega_final * TS / s.ramp_s,
+            omega_final,
+            flux: Ab::new(0.0, 0.0),
+            current: Ab::new(0.0, 0.0),
+        };
+        (m.flux, m.current) = m.flux_and_current();
+        m
+    }
+
+    /// Stator flux λ = (λf + j·Lq·iq)·e^{jθ} and current j·iq·e^{jθ} at the present angle.
+    fn flux_and_current(&self) -> (Ab<f32>, Ab<f32>) {
+        let unit = Ab::new(cos(self.theta), sin(self.theta));
+        let i = unit.mul_j() * self.iq;
+        (unit * self.flux_linkage + i * self.lq, i)
+    }
+
+    /// Advances one sample; returns (the average voltage over the interval, the current now).
+    fn sample(&mut self) -> (Ab<f32>, Ab<f32>) {
+        self.omega = (self.omega + self.d_omega).min(self.omega_final);
+        self.theta += self.omega * TS;
+        if self.theta > core::f32::consts::PI {
+            self.theta -= TAU;
+        }
+        let (flux, current) = self.flux_and_current();
+        // v = Rs·i + dλ/dt, averaged over the interval exactly for the flux term.
+        let v = (self.current + current) * (0.5 * self.rs) + (flux - self.flux) * (1.0 / TS);
+        self.flux = flux;
+        self.current = current;
+        (v, current)
+    }
+}
+
+/// sin on [−π, π] for the signal generator (not the estimator): a degree-11 odd Taylor
+/// polynomial after folding into [−π/2, π/2], error below 1e-6 — plenty for a test signal.
+fn sin(x: f32) -> f32 {
+    let half_pi = core::f32::consts::FRAC_PI_2;
+    let x = if x > half_pi {
+        core::f32::consts::PI - x
+    } else if x < -half_pi {
+        -core::f32::consts::PI - x
+    } else {
+        x
+    };
+    let x2 = x * x;
+    x * (1.0
+        + x2 * (-1.0 / 6.0
+            + x2 * (1.0 / 120.0
+                + x2 * (-1.0 / 5040.0 + x2 * (1.0 / 362_880.0 - x2 / 39_916_800.0)))))
+}
+
+fn cos(x: f32) -> f32 {
+    let shifted = x + core::f32::consts::FRAC_PI_2;
+    sin(if shifted > core::f32::consts::PI {
+        shifted - TAU
+    } else {
+        shifted
+    })
+}
+
+/// Everything the interrupt owns.
+struct App {
+    estimator: SensorlessEstimator<f32>,
+    machine: Machine,
+    samples: u32,
+    total_samples: u32,
+    /// Worst |θ̂ − θ| (rad) over the last `hold_samples / 2` samples.
+    worst_error: f32,
+    rejected: u32,
+    done: bool,
+}
+
+static APP: Mutex<RefCell<Option<App>>> = Mutex::new(RefCell::new(None));
+
+/// Lowest stack pointer seen just before calling [`estimator_step`] (stack measurement).
+static STEP_SP: Mutex<Cell<u32>> = Mutex::new(Cell::new(u32::MAX));
+
+/// How much stack below the present stack pointer is painted and checked.
+const PAINTED: u32 = 8 * 1024;
+/// The paint: any word the program writes differs from it in practice.
+const PAINT: u32 = 0xA5C3_5A3C;
+
+/// Paints `PAINTED` bytes below the stack pointer (less a margin for this function's own
+/// frame) and returns the stack pointer. Measurement only: not part of a firmware.
+#[inline(never)]
+fn paint_stack() -> u32 {
+    let sp = cortex_m::register::msp::read();
+    let top = (sp - 64) & !3;
+    let mut a = top - PAINTED;
+    while a < top {
+        // SAFETY: RAM below the live stack pointer, within the 4 MiB RAM region, unused.
+        unsafe { core::ptr::write_volatile(a as *mut u32, PAINT) };
+        a += 4;
+    }
+    interrupt::free(|cs| STEP_SP.borrow(cs).set(u32::MAX));
+    sp
+}
+
+/// The lowest address whose paint was overwritten since [`paint_stack`].
+#[inline(never)]
+fn lowest_touched_stack() -> u32 {
+    let sp = cortex_m::register::msp::read();
+    let top = (sp - 64) & !3;
+    let mut a = top - PAINTED;
+    while a < top {
+        // SAFETY: as in `paint_stack`.
+        if unsafe { core::ptr::read_volatile(a as *const u32) } != PAINT {
+            return a;
+        }
+        a += 4;
+    }
+    top
+}
+
+/// One estimator step, out of line: the unit the cost script measures.
+#[inline(never)]
+#[unsafe(no_mangle)]
+pub fn estimator_step(
+    estimator: &mut SensorlessEstimator<f32>,
+    v_ab: Ab<f32>,
+    i_ab: Ab<f32>,
+) -> Estimate<f32> {
+    estimator.step(v_ab, i_ab)
+}
+
+impl App {
+    /// The interrupt's work for one sample.
+    fn on_sample(&mut self) {
+        if self.done {
+            return;
+        }
+        let (v, i) = self.machine.sample();
+        let sp = cortex_m::register::msp::read();
+        interrupt::free(|cs| {
+            let cell = STEP_SP.borrow(cs);
+            cell.set(cell.get().min(sp));
+        });
+        let out = estimator_step(&mut self.estimator, v, i);
+        self.samples += 1;
+        if out.diagnostics.input_fault {
+            self.rejected += 1;
+        }
+        if self.samples > self.total_samples - self.total_samples / 8 {
+            let mut e = out.theta - self.machine.theta;
+            if e > core::f32::consts::PI {
+                e -= TAU;
+            } else if e < -core::f32::consts::PI {
+                e += TAU;
+            }
+            self.worst_error = self.worst_error.max(e.abs());
+        }
+        if self.samples >= self.total_samples {
+            self.done = true;
+        }
+    }
+}
+
+#[exception]
+fn SysTick() {
+    interrupt::free(|cs| {
+        if let Ok(mut app) = APP.borrow(cs).try_borrow_mut()
+            && let Some(app) = app.as_mut()
+        {
+            app.on_sample();
+        }
+    });
+}
+
+#[entry]
+fn main() -> ! {
+    let Some(mut core) = cortex_m::Peripherals::take() else {
+        exit(false)
+    };
+    core.SYST.set_clock_source(SystClkSource::Core);
+    core.SYST.set_reload(SYSCLK_HZ / SAMPLE_HZ - 1);
+    core.SYST.clear_current();
+    core.SYST.enable_counter();
+    core.SYST.enable_interrupt();
+
+    hprintln!(
+        "size_of::<SensorlessEstimator<f32>>() = {} B, size_of::<Estimate<f32>>() = {} B",
+        core::mem::size_of::<SensorlessEstimator<f32>>(),
+        core::mem::size_of::<Estimate<f32>>()
+    );
+    let mut all_locked = true;
+    let (mut deepest_isr, mut deepest_step) = (0, 0);
+    for (index, s) in SCENARIOS.iter().enumerate() {
+        let model = MachineModel::<f32>::paper();
+        let mut config = EstimatorConfig::for_machine(&model);
+        config.tuning.rs_adaptation = s.rs_adaptation;
+        let Ok(estimator) = SensorlessEstimator::new(config) else {
+            hprintln!("invalid configuration");
+            exit(false)
+        };
+        let machine = Machine::new(s, &model);
+        let total_samples = (s.ramp_s * SAMPLE_HZ as f32) as u32 + s.hold_samples;
+        let app = App {
+            estimator,
+            machine,
+            samples: 0,
+            total_samples,
+            worst_error: 0.0,
+            rejected: 0,
+            done: false,
+        };
+        // The scenario marker the cost script splits the trace at.
+        scenario_marker(index as u32);
+        let idle_sp = paint_stack();
+        interrupt::free(|cs| {
+            if let Ok(mut slot) = APP.borrow(cs).try_borrow_mut() {
+                *slot = Some(app);
+            }
+        });
+        let (worst, rejected, samples) = loop {
+            cortex_m::asm::wfi();
+            let finished = interrupt::free(|cs| match APP.borrow(cs).try_borrow_mut() {
+                Ok(mut slot) => match slot.as_mut() {
+                    Some(app) if app.done => {
+                        let r = (app.worst_error, app.rejected, app.samples);
+                        *slot = None;
+                        Some(r)
+                    }
+                    _ => None,
+                },
+                Err(_) => None,
+            });
+            if let Some(r) = finished {
+                break r;
+            }
+        };
+        let lowest = lowest_touched_stack();
+        let step_sp = interrupt::free(|cs| STEP_SP.borrow(cs).get());
+        deepest_isr = deepest_isr.max(idle_sp - lowest);
+        deepest_step = deepest_step.max(step_sp.saturating_sub(lowest));
+        let locked = worst < 0.1 && rejected == 0;
+        all_locked &= locked;
+        hprintln!(
+            "scenario {}: {} at {} Hz electrical: {} samples, worst |θ̂ − θ| over the last {} = {} rad, {} rejected{}",
+            index,
+            s.name,
+            s.speed_hz,
+            samples,
+            samples / 8,
+            worst,
+            rejected,
+            if locked { "" } else { "  NOT LOCKED" }
+        );
+    }
+    hprintln!(
+        "deepest stack: {} B below the idle loop's stack pointer (interrupt entry with FPU \
+         context included), {} B below the caller of estimator_step",
+        deepest_isr,
+        deepest_step
+    );
+    scenario_marker(u32::MAX);
+    exit(all_locked)
+}
+
+/// A no-op the cost script sees in the instruction trace: it separates the scenarios.
+#[inline(never)]
+#[unsafe(no_mangle)]
+pub fn scenario_marker(index: u32) {
+    core::hint::black_box(index);
+}
+
+fn exit(success: bool) -> ! {
+    debug::exit(if success {
+        debug::EXIT_SUCCESS
+    } else {
+        debug::EXIT_FAILURE
+    });
+    loop {
+        cortex_m::asm::wfi();
+    }
+}
+
+/// Nothing on the interrupt's path panics (the CI check proves it); anything else halts.
+#[panic_handler]
+fn panic(_: &PanicInfo) -> ! {
+    exit(false)
+}

@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# Cost of fado's f32 estimator step on a Cortex-M4F, measured on the firmware image itself:
+# builds examples/cortex-m (scripts/firmware-build.sh), runs it in QEMU (mps2-an386,
+# cortex-m4, semihosting) and reports, per scenario (low and high electrical speed, with and
+# without the R̂s adaptation): the instructions and the Cortex-M4 cycle estimate per step (an
+# instruction trace weighted by the TRM's cycle timings, see scripts/firmware_cost.py and
+# docs/firmware.md), the .text reachable from the step and from the ISR, the deepest stack
+# (painted stack, measured in the image) and size_of the state.
+# Needs qemu-system-arm and binutils-arm-none-eabi (Debian packages of those names).
+# Usage: bash scripts/firmware-cost.sh [STEPS_MEASURED_PER_SCENARIO (default 300)]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+tail_steps="${1:-300}"
+
+for tool in qemu-system-arm arm-none-eabi-objdump; do
+    command -v "$tool" >/dev/null || {
+        echo "missing $tool: apt-get install qemu-system-arm binutils-arm-none-eabi" >&2
+        exit 2
+    }
+done
+image=$(bash scripts/firmware-build.sh)
+qemu=(qemu-system-arm -machine mps2-an386 -cpu cortex-m4 -nographic
+    -semihosting-config enable=on,target=native -icount shift=2,sleep=off -kernel "$image")
+
+echo "== image: $image"
+arm-none-eabi-size "$image"
+echo "== run (semihosting output of the image)"
+timeout 300 "${qemu[@]}"
+
+echo "== code reachable from the step and from the interrupt"
+for root in estimator_step SysTick; do
+    { python3 scripts/firmware_cost.py graph "$image" "$root" || true; } |
+        grep -E '^(\.text reachable|OK:|FORBIDDEN)' || true
+done
+
+echo "== instruction trace (QEMU -d exec,nochain -singlestep, filtered to the step's code)"
+log=$(mktemp /tmp/fado-firmware-trace.XXXXXX)
+trap 'rm -f "$log"' EXIT
+filter=$(python3 scripts/firmware_cost.py ranges "$image" estimator_step scenario_marker)
+timeout 900 "${qemu[@]}" -singlestep -d exec,nochain -dfilter "$filter" -D "$log" >/dev/null
+python3 scripts/firmware_cost.py trace "$image" estimator_step "$log" "$tail_steps"
