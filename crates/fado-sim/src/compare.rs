@@ -273,7 +273,7 @@ pub fn compare(opts: &CompareOptions) -> Result<Comparison, SimConfigError> {
     let results: Mutex<Vec<Option<Result<CompareRow, SimConfigError>>>> =
         Mutex::new((0..jobs.len()).map(|_| None).collect());
     std::thread::scope(|sc| {
-        for _ in 0..opts.threads.clamp(1, jobs.len()) {
+        for _ in 0..crate::threads::capped(opts.threads).0.clamp(1, jobs.len()) {
             sc.spawn(|| {
                 loop {
                     let k = next.fetch_add(1, Ordering::Relaxed);

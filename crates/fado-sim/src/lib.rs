@@ -52,6 +52,7 @@ pub mod faults;
 pub mod inverter;
 pub mod load;
 pub mod motor;
+pub mod output;
 pub mod presets;
 pub mod profile;
 pub mod scenario;
@@ -59,6 +60,7 @@ pub mod sensors;
 pub mod sim;
 pub mod source;
 pub mod sweep;
+pub mod threads;
 
 pub use config::SimConfig;
 pub use error::SimConfigError;

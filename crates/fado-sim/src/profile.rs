@@ -15,6 +15,11 @@ pub struct Profile {
     pub points: Vec<[f64; 2]>,
 }
 
+/// Most breakpoints a profile may have. The paper's profiles have fewer than ten; 10,000 is
+/// room for a recorded drive cycle at 1 s resolution over almost three hours, and keeps a
+/// configuration's memory and parse time small (an input-size cap, not a physical limit).
+pub const MAX_POINTS: usize = 10_000;
+
 impl Profile {
     /// A constant profile.
     pub fn constant(value: f64) -> Self {
@@ -34,6 +39,15 @@ impl Profile {
     pub fn validate(&self) -> Result<(), SimConfigError> {
         if self.points.is_empty() {
             return Err(SimConfigError::new("points", "needs at least one point"));
+        }
+        if self.points.len() > MAX_POINTS {
+            return Err(SimConfigError::new(
+                "points",
+                format!(
+                    "has {} breakpoints, more than the {MAX_POINTS} a piecewise-linear profile may have",
+                    self.points.len()
+                ),
+            ));
         }
         for (k, p) in self.points.iter().enumerate() {
             if !(p[0].is_finite() && p[1].is_finite()) {

@@ -6,6 +6,7 @@
 //! machine to the experiment's initial operating point without load, applies the load with a
 //! 0.5 s ramp, lets it settle, then runs the experiment. Metrics are taken from `eval_start`.
 
+use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
 use serde::Serialize;
@@ -15,7 +16,9 @@ use crate::controller::{ControlEvent, Controller};
 use crate::error::SimConfigError;
 use crate::inverter::InverterModel;
 use crate::profile::Profile;
-use crate::sim::{Metrics, Plant, Probe, RunStats, Sample, Simulation, Trace};
+use crate::sim::{
+    Decimated, Metrics, Plant, Probe, RunStats, Sample, Simulation, Trace, TraceSink,
+};
 
 /// A named experiment.
 #[derive(Clone, Copy, Debug)]
@@ -936,6 +939,17 @@ pub fn scenario_config(
             format!("unknown `{scenario}`; one of {names:?}"),
         )
     })?;
+    if let Some(text) = config_toml
+        && text.len() > MAX_CONFIG_BYTES
+    {
+        return Err(SimConfigError::new(
+            "<config>",
+            format!(
+                "is {} bytes long, more than the {MAX_CONFIG_BYTES} accepted",
+                text.len()
+            ),
+        ));
+    }
     let mut cfg = match config_toml {
         // The user's motor first (a scaled scenario needs its ratings), then the scenario,
         // then the user's keys again, so that any of them wins over the scenario's.
@@ -991,11 +1005,74 @@ impl SimConfig {
     }
 }
 
-/// Runs a scenario's criteria on an explicit configuration.
+/// Where a run's decimated trace goes.
+pub enum TraceOutput<'a> {
+    /// Kept in memory in [`Outcome::trace`].
+    Keep,
+    /// Not kept at all (sweeps: only the metrics matter).
+    Discard,
+    /// Handed row by row to a sink as it is produced (a file for the CLI, columns for
+    /// Python); [`Outcome::trace`] stays empty and memory does not grow with the duration.
+    Sink(&'a mut dyn TraceSink),
+}
+
+/// How [`run_config_with`] runs.
+pub struct RunOptions<'a> {
+    /// Called with the completed fraction about a hundred times.
+    pub progress: Option<&'a mut dyn FnMut(f64)>,
+    /// Where the trace goes.
+    pub trace: TraceOutput<'a>,
+    /// Stops the run early once set ([`Simulation::run_until`]): the outcome then has
+    /// `stats.cancelled` and its checks are not evaluated.
+    pub cancel: Option<&'a AtomicBool>,
+}
+
+impl Default for RunOptions<'_> {
+    fn default() -> Self {
+        Self {
+            progress: None,
+            trace: TraceOutput::Keep,
+            cancel: None,
+        }
+    }
+}
+
+/// Number of rows the trace of `cfg` will have (one sample in `simulation.decimation`).
+pub fn trace_rows(cfg: &SimConfig) -> u64 {
+    let samples = (cfg.simulation.duration / cfg.inverter.sample_period())
+        .round()
+        .max(0.0) as u64;
+    samples.div_ceil(cfg.simulation.decimation.max(1) as u64)
+}
+
+/// Largest configuration text accepted (bytes): a thousand times the largest scenario's
+/// `--dump-config`, and small enough that parsing it takes well under a second and a few
+/// hundred MB at most (an input-size cap; profiles are capped at [`crate::profile::MAX_POINTS`]
+/// breakpoints as well).
+pub const MAX_CONFIG_BYTES: usize = 4 << 20;
+
+/// Runs a scenario's criteria on an explicit configuration, keeping the trace in memory.
 pub fn run_config(
     scenario: &str,
     cfg: SimConfig,
     progress: Option<&mut dyn FnMut(f64)>,
+) -> Result<Outcome, SimConfigError> {
+    run_config_with(
+        scenario,
+        cfg,
+        RunOptions {
+            progress,
+            ..Default::default()
+        },
+    )
+}
+
+/// Runs a scenario's criteria on an explicit configuration, with the trace going where
+/// `opts` says and an optional cancel flag.
+pub fn run_config_with(
+    scenario: &str,
+    cfg: SimConfig,
+    opts: RunOptions<'_>,
 ) -> Result<Outcome, SimConfigError> {
     let sc = find(scenario)
         .ok_or_else(|| SimConfigError::new("scenario", format!("unknown `{scenario}`")))?;
@@ -1004,23 +1081,23 @@ pub fn run_config(
     match (cfg.simulation.precision, cfg.simulation.estimator) {
         (Precision::F64, EstimatorKind::Fado) => {
             let drive = cfg.build_drive()?;
-            run_with(sc, cfg, drive, started, progress)
+            run_with(sc, cfg, drive, started, opts)
         }
         (Precision::F32, EstimatorKind::Fado) => {
             let drive = cfg.build_drive_f32()?;
-            run_with(sc, cfg, drive, started, progress)
+            run_with(sc, cfg, drive, started, opts)
         }
         (Precision::F64, EstimatorKind::LpfIntegrator) => {
             let drive = cfg.build_baseline_drive(cfg.lpf_estimator()?)?;
-            run_with(sc, cfg, drive, started, progress)
+            run_with(sc, cfg, drive, started, opts)
         }
         (Precision::F64, EstimatorKind::Ortega) => {
             let drive = cfg.build_baseline_drive(cfg.ortega_estimator()?)?;
-            run_with(sc, cfg, drive, started, progress)
+            run_with(sc, cfg, drive, started, opts)
         }
         (Precision::F64, EstimatorKind::EmfObserver) => {
             let drive = cfg.build_baseline_drive(cfg.emf_estimator()?)?;
-            run_with(sc, cfg, drive, started, progress)
+            run_with(sc, cfg, drive, started, opts)
         }
         (Precision::F32, _) => Err(SimConfigError::new(
             "simulation.estimator",
@@ -1034,23 +1111,46 @@ fn run_with<C: Controller>(
     cfg: SimConfig,
     drive: C,
     started: Instant,
-    progress: Option<&mut dyn FnMut(f64)>,
+    opts: RunOptions<'_>,
 ) -> Result<Outcome, SimConfigError> {
     let mut sim = cfg.simulation(drive)?;
     let mut metrics = Metrics::new(cfg.simulation.eval_start, cfg.zero_speed_band_rpm());
     let mut trace = Trace::new(cfg.simulation.decimation);
     let mut probe = sc.probe(&cfg);
-    let mut stats = sim.run(
-        cfg.simulation.duration,
-        &mut [&mut metrics, &mut trace, &mut probe],
-        progress,
-    );
+    let duration = cfg.simulation.duration;
+    let mut stats = match opts.trace {
+        TraceOutput::Keep => sim.run_until(
+            duration,
+            &mut [&mut metrics, &mut trace, &mut probe],
+            opts.progress,
+            opts.cancel,
+        ),
+        TraceOutput::Discard => sim.run_until(
+            duration,
+            &mut [&mut metrics, &mut probe],
+            opts.progress,
+            opts.cancel,
+        ),
+        TraceOutput::Sink(sink) => {
+            let mut rows = Decimated::new(cfg.simulation.decimation, sink);
+            sim.run_until(
+                duration,
+                &mut [&mut metrics, &mut rows, &mut probe],
+                opts.progress,
+                opts.cancel,
+            )
+        }
+    };
     stats.wall_seconds = started.elapsed().as_secs_f64();
-    let checks = sc.evaluate(&cfg, &metrics, &probe);
+    let checks = if stats.cancelled {
+        Vec::new()
+    } else {
+        sc.evaluate(&cfg, &metrics, &probe)
+    };
     Ok(Outcome {
         probe,
         scenario: sc.name.to_owned(),
-        passed: checks.iter().all(|c| c.passed),
+        passed: !stats.cancelled && checks.iter().all(|c| c.passed),
         checks,
         metrics,
         stats,

@@ -5,6 +5,7 @@
 //! the duty the controller computed at n−1 (one sample of computational delay). Each sample is
 //! handed to [`Probe`]s: the metrics, the decimated trace and the scenarios' criteria.
 
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use fado_core::{Abc, Dq, wrap_angle};
@@ -366,13 +367,37 @@ impl<C: Controller> Simulation<C> {
         &mut self,
         duration: f64,
         probes: &mut [&mut dyn Probe],
+        progress: Option<&mut dyn FnMut(f64)>,
+    ) -> RunStats {
+        self.run_until(duration, probes, progress, None)
+    }
+
+    /// [`run`](Self::run) that stops early, within [`CANCEL_CHECK_SAMPLES`] samples, once
+    /// `cancel` is set (by another thread: Ctrl-C in the Python bindings); the statistics then
+    /// say [`RunStats::cancelled`] and the probes are not finished.
+    pub fn run_until(
+        &mut self,
+        duration: f64,
+        probes: &mut [&mut dyn Probe],
         mut progress: Option<&mut dyn FnMut(f64)>,
+        cancel: Option<&AtomicBool>,
     ) -> RunStats {
         let ts = self.plant.sample_period();
         let n = (duration / ts).round().max(0.0) as u64;
         let chunk = (n / 100).max(1);
         let start = Instant::now();
         for k in 0..n {
+            if let Some(flag) = cancel
+                && k % CANCEL_CHECK_SAMPLES == 0
+                && flag.load(Ordering::Relaxed)
+            {
+                return RunStats {
+                    simulated_seconds: k as f64 * ts,
+                    wall_seconds: start.elapsed().as_secs_f64(),
+                    samples: k,
+                    cancelled: true,
+                };
+            }
             let s = self.step();
             for p in probes.iter_mut() {
                 p.observe(&s);
@@ -390,9 +415,15 @@ impl<C: Controller> Simulation<C> {
             simulated_seconds: n as f64 * ts,
             wall_seconds: start.elapsed().as_secs_f64(),
             samples: n,
+            cancelled: false,
         }
     }
 }
+
+/// [`Simulation::run_until`] looks at its cancel flag once per this many samples: 1024
+/// samples are 0.1 s of simulated time at 10 kHz and about 1 ms of wall time with the
+/// switching-resolved inverter, far inside the 0.5 s a Ctrl-C may take.
+pub const CANCEL_CHECK_SAMPLES: u64 = 1024;
 
 /// Timing of a run.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -403,6 +434,9 @@ pub struct RunStats {
     pub wall_seconds: f64,
     /// Samples run.
     pub samples: u64,
+    /// The run was stopped early by its cancel flag ([`Simulation::run_until`]).
+    #[serde(default)]
+    pub cancelled: bool,
 }
 
 impl RunStats {
@@ -704,7 +738,136 @@ impl From<&Sample> for TraceRow {
     }
 }
 
-/// Keeps every `decimation`-th sample as a [`TraceRow`].
+/// Where the rows of a trace go as they are produced: memory ([`Vec`], [`TraceColumns`]) or
+/// a file ([`CsvTraceWriter`]), so that a run's memory need not grow with its duration.
+pub trait TraceSink {
+    /// Takes one row.
+    fn push(&mut self, row: &TraceRow);
+}
+
+impl TraceSink for Vec<TraceRow> {
+    fn push(&mut self, row: &TraceRow) {
+        Vec::push(self, *row);
+    }
+}
+
+/// The trace as one `Vec<f64>` per column of [`TraceRow::COLUMNS`] (struct of arrays, flags
+/// as 0.0/1.0): what the Python bindings hand to numpy without another copy.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TraceColumns {
+    /// One vector per column, in [`TraceRow::COLUMNS`] order.
+    pub columns: Vec<Vec<f64>>,
+}
+
+impl TraceColumns {
+    /// Empty columns with room for `rows` rows.
+    pub fn with_capacity(rows: usize) -> Self {
+        Self {
+            columns: vec![Vec::with_capacity(rows); TraceRow::COLUMNS.len()],
+        }
+    }
+
+    /// Number of rows.
+    pub fn len(&self) -> usize {
+        self.columns.first().map_or(0, Vec::len)
+    }
+
+    /// True without rows.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+impl TraceSink for TraceColumns {
+    fn push(&mut self, row: &TraceRow) {
+        for (column, value) in self.columns.iter_mut().zip(row.values()) {
+            column.push(value);
+        }
+    }
+}
+
+/// Writes rows as CSV (header first) as they come. A write error is kept, the following rows
+/// are dropped, and [`finish`](Self::finish) reports it.
+pub struct CsvTraceWriter<W: std::io::Write> {
+    writer: csv::Writer<W>,
+    error: Option<csv::Error>,
+    rows: u64,
+}
+
+impl<W: std::io::Write> CsvTraceWriter<W> {
+    /// A writer onto `w` (buffer `w` yourself if it is a file; csv adds its own 8 KiB).
+    pub fn new(w: W) -> Self {
+        Self {
+            writer: csv::Writer::from_writer(w),
+            error: None,
+            rows: 0,
+        }
+    }
+
+    /// Rows written.
+    pub fn rows(&self) -> u64 {
+        self.rows
+    }
+
+    /// A write failed (the rest of the rows are dropped; [`finish`](Self::finish) says why).
+    pub fn failed(&self) -> bool {
+        self.error.is_some()
+    }
+
+    /// Flushes and returns the inner writer, or the first error.
+    pub fn finish(mut self) -> Result<W, csv::Error> {
+        if let Some(e) = self.error.take() {
+            return Err(e);
+        }
+        if self.rows == 0 {
+            // The header alone, as `Trace::write_csv` writes for an empty trace.
+            self.writer.write_record(TraceRow::COLUMNS)?;
+        }
+        self.writer
+            .into_inner()
+            .map_err(|e| csv::Error::from(e.into_error()))
+    }
+}
+
+impl<W: std::io::Write> TraceSink for CsvTraceWriter<W> {
+    fn push(&mut self, row: &TraceRow) {
+        if self.error.is_none() {
+            match self.writer.serialize(row) {
+                Ok(()) => self.rows += 1,
+                Err(e) => self.error = Some(e),
+            }
+        }
+    }
+}
+
+/// Hands every `decimation`-th sample to a [`TraceSink`] as a [`TraceRow`].
+pub struct Decimated<'a> {
+    decimation: u64,
+    count: u64,
+    sink: &'a mut dyn TraceSink,
+}
+
+impl<'a> Decimated<'a> {
+    /// Keeps one sample in `decimation` (at least 1), starting with the first.
+    pub fn new(decimation: u32, sink: &'a mut dyn TraceSink) -> Self {
+        Self {
+            decimation: decimation.max(1) as u64,
+            count: 0,
+            sink,
+        }
+    }
+}
+
+impl Probe for Decimated<'_> {
+    fn observe(&mut self, s: &Sample) {
+        if self.count.is_multiple_of(self.decimation) {
+            self.sink.push(&TraceRow::from(s));
+        }
+        self.count += 1;
+    }
+}
+
+/// Keeps every `decimation`-th sample as a [`TraceRow`] in memory.
 #[derive(Clone, Debug, Default)]
 pub struct Trace {
     /// Keep one sample in this many (≥ 1).
@@ -732,11 +895,11 @@ impl Trace {
 
     /// Writes the rows as CSV with a header.
     pub fn write_csv<W: std::io::Write>(&self, w: W) -> Result<(), csv::Error> {
-        let mut wr = csv::Writer::from_writer(w);
+        let mut wr = CsvTraceWriter::new(w);
         for r in &self.rows {
-            wr.serialize(r)?;
+            wr.push(r);
         }
-        wr.flush()?;
+        wr.finish()?.flush()?;
         Ok(())
     }
 }

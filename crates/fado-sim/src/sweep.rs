@@ -33,7 +33,8 @@ use std::collections::BTreeMap;
 use std::fs::{File, OpenOptions};
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
+use std::sync::atomic::AtomicBool;
+use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 use rand_xoshiro::Xoshiro256PlusPlus;
@@ -44,6 +45,7 @@ pub use toml::Value;
 
 use crate::config::SimConfig;
 use crate::error::SimConfigError;
+use crate::output::{AtomicFile, DirLock, OutputError};
 use crate::profile::Profile;
 use crate::scenario;
 
@@ -507,25 +509,55 @@ pub fn run_point(
     values: &[Value],
     index: usize,
 ) -> PointResult {
+    run_point_until(scenario, base, names, values, index, None)
+        .expect("a run without a cancel flag is never cancelled")
+}
+
+/// [`run_point`] that gives up (None) once `cancel` is set, before or during the run.
+pub fn run_point_until(
+    scenario: &str,
+    base: &SimConfig,
+    names: &[String],
+    values: &[Value],
+    index: usize,
+    cancel: Option<&AtomicBool>,
+) -> Option<PointResult> {
+    if cancel.is_some_and(|c| c.load(std::sync::atomic::Ordering::Relaxed)) {
+        return None;
+    }
     let started = Instant::now();
     let cfg = match point_config(base, names, values) {
         Ok(c) => c,
-        Err(e) => return PointResult::failed(index, values, e.to_string(), 0.0),
+        Err(e) => return Some(PointResult::failed(index, values, e.to_string(), 0.0)),
     };
     let run = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        scenario::run_config(scenario, cfg, None)
+        scenario::run_config_with(
+            scenario,
+            cfg,
+            scenario::RunOptions {
+                trace: scenario::TraceOutput::Discard,
+                cancel,
+                ..Default::default()
+            },
+        )
     }));
     let wall = started.elapsed().as_secs_f64();
     let outcome = match run {
+        Ok(Ok(o)) if o.stats.cancelled => return None,
         Ok(Ok(o)) => o,
-        Ok(Err(e)) => return PointResult::failed(index, values, e.to_string(), wall),
+        Ok(Err(e)) => return Some(PointResult::failed(index, values, e.to_string(), wall)),
         Err(panic) => {
             let msg = panic
                 .downcast_ref::<&str>()
                 .map(|s| (*s).to_owned())
                 .or_else(|| panic.downcast_ref::<String>().cloned())
                 .unwrap_or_else(|| "unknown panic".to_owned());
-            return PointResult::failed(index, values, format!("panic: {msg}"), wall);
+            return Some(PointResult::failed(
+                index,
+                values,
+                format!("panic: {msg}"),
+                wall,
+            ));
         }
     };
     let m = &outcome.metrics;
@@ -558,14 +590,19 @@ pub fn run_point(
         r.status = Status::Diverged;
         r.passed = false;
     }
-    r
+    Some(r)
 }
 
 /// How to run a sweep.
 #[derive(Clone, Debug, Default)]
 pub struct SweepOptions {
-    /// Worker threads; 0 = all cores.
+    /// Worker threads; 0 = all cores; capped at the cores there are ([`crate::threads`]).
     pub threads: usize,
+    /// Once set (from another thread: Ctrl-C in Python), the points not started are skipped
+    /// and those running stop within [`crate::sim::CANCEL_CHECK_SAMPLES`] samples; neither is
+    /// recorded, so the sweep resumes where it stopped. [`run`] then returns
+    /// [`SweepError::Cancelled`].
+    pub cancel: Option<Arc<AtomicBool>>,
     /// Directory for `sweep.csv`, `sweep.json`, `summary.json`, `summary.md` (None: in
     /// memory only, nothing resumed).
     pub out: Option<PathBuf>,
@@ -578,17 +615,23 @@ pub struct SweepOptions {
 pub enum SweepError {
     /// The definition is invalid (unknown scenario, bad axis name, base TOML).
     Config(SimConfigError),
-    /// Reading or writing the output directory.
-    Io(String),
+    /// Reading or writing the output directory, or another sweep holds it.
+    Io(OutputError),
     /// The output directory holds a different sweep.
     Mismatch(String),
+    /// The worker threads could not be started.
+    Threads(String),
+    /// Stopped by [`SweepOptions::cancel`]; the points finished are recorded.
+    Cancelled,
 }
 
 impl std::fmt::Display for SweepError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             SweepError::Config(e) => write!(f, "{e}"),
-            SweepError::Io(m) | SweepError::Mismatch(m) => f.write_str(m),
+            SweepError::Io(e) => write!(f, "{e}"),
+            SweepError::Mismatch(m) | SweepError::Threads(m) => f.write_str(m),
+            SweepError::Cancelled => f.write_str("sweep interrupted"),
         }
     }
 }
@@ -601,8 +644,14 @@ impl From<SimConfigError> for SweepError {
     }
 }
 
-fn io(path: &Path, e: impl std::fmt::Display) -> SweepError {
-    SweepError::Io(format!("{}: {e}", path.display()))
+impl From<OutputError> for SweepError {
+    fn from(e: OutputError) -> Self {
+        SweepError::Io(e)
+    }
+}
+
+fn io(action: &'static str, path: &Path, e: impl Into<std::io::Error>) -> SweepError {
+    SweepError::Io(OutputError::new(action, path, e.into()))
 }
 
 /// A finished sweep.
@@ -634,15 +683,16 @@ pub fn run(
     let base = spec.base_config()?;
     let mut done: BTreeMap<usize, PointResult> = BTreeMap::new();
     let mut sink = None;
+    let mut lock = None;
     if let Some(dir) = &opts.out {
-        std::fs::create_dir_all(dir).map_err(|e| io(dir, e))?;
+        lock = Some(DirLock::acquire(dir)?);
         done = prepare_resume(spec, dir, opts.fresh)?;
         let csv_path = dir.join("sweep.csv");
         write_csv(&csv_path, spec, done.values())?;
         let file = OpenOptions::new()
             .append(true)
             .open(&csv_path)
-            .map_err(|e| io(&csv_path, e))?;
+            .map_err(|e| io("open", &csv_path, e))?;
         sink = Some(Mutex::new((csv_path, file)));
     }
     let resumed = done.len();
@@ -650,32 +700,45 @@ pub fn run(
         .filter(|k| !done.contains_key(k))
         .collect();
     let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(opts.threads)
+        .num_threads(crate::threads::capped(opts.threads).0)
         .build()
-        .map_err(|e| SweepError::Io(format!("thread pool: {e}")))?;
+        .map_err(|e| SweepError::Threads(format!("thread pool: {e}")))?;
     let write_error = Mutex::new(None);
     let finished = std::sync::atomic::AtomicUsize::new(resumed);
+    let cancel = opts.cancel.as_deref();
     let new_rows: Vec<PointResult> = pool.install(|| {
         todo.par_iter()
             .with_max_len(1)
-            .map(|&k| {
-                let r = run_point(&spec.scenario, &base, &spec.axes, &spec.points[k], k);
+            .filter_map(|&k| {
+                let r = run_point_until(
+                    &spec.scenario,
+                    &base,
+                    &spec.axes,
+                    &spec.points[k],
+                    k,
+                    cancel,
+                )?;
                 if let Some(sink) = &sink {
                     let mut guard = sink.lock().unwrap_or_else(|p| p.into_inner());
                     let (path, file) = &mut *guard;
                     let line = csv_line(&r);
                     if let Err(e) = file.write_all(line.as_bytes()).and_then(|_| file.flush()) {
-                        *write_error.lock().unwrap_or_else(|p| p.into_inner()) = Some(io(path, e));
+                        *write_error.lock().unwrap_or_else(|p| p.into_inner()) =
+                            Some(io("write", path, e));
                     }
                 }
                 let n = finished.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
                 on_point(&r, n);
-                r
+                Some(r)
             })
             .collect()
     });
     if let Some(e) = write_error.into_inner().unwrap_or(None) {
         return Err(e);
+    }
+    if cancel.is_some_and(|c| c.load(std::sync::atomic::Ordering::Relaxed)) {
+        // The finished points are in sweep.csv (appended and flushed one by one).
+        return Err(SweepError::Cancelled);
     }
     let ran = new_rows.len();
     done.extend(new_rows.into_iter().map(|r| (r.index, r)));
@@ -693,11 +756,15 @@ pub fn run(
         // The final CSV is in index order.
         write_csv(&dir.join("sweep.csv"), spec, outcome.rows.iter())?;
         let json_path = dir.join("summary.json");
-        let json = serde_json::to_string_pretty(&outcome.summary).map_err(|e| io(&json_path, e))?;
-        std::fs::write(&json_path, json).map_err(|e| io(&json_path, e))?;
-        let md_path = dir.join("summary.md");
-        std::fs::write(&md_path, outcome.summary.to_markdown()).map_err(|e| io(&md_path, e))?;
+        let json = serde_json::to_string_pretty(&outcome.summary)
+            .map_err(|e| io("write", &json_path, e))?;
+        AtomicFile::write(
+            &dir.join("summary.md"),
+            outcome.summary.to_markdown().as_bytes(),
+        )?;
+        AtomicFile::write(&json_path, json.as_bytes())?;
     }
+    drop(lock);
     Ok(outcome)
 }
 
@@ -708,7 +775,8 @@ struct Sidecar {
 }
 
 /// Reads the finished points of an earlier run of the same sweep in `dir` and writes
-/// `sweep.json` for this one.
+/// `sweep.json` for this one. A `sweep.csv` without its `sweep.json` cannot be told apart
+/// from another sweep's rows: refused unless `fresh`.
 fn prepare_resume(
     spec: &SweepSpec,
     dir: &Path,
@@ -719,8 +787,8 @@ fn prepare_resume(
     let fingerprint = spec.fingerprint();
     let mut done = BTreeMap::new();
     if !fresh && json_path.exists() {
-        let text = std::fs::read_to_string(&json_path).map_err(|e| io(&json_path, e))?;
-        let old: Sidecar = serde_json::from_str(&text).map_err(|e| io(&json_path, e))?;
+        let text = std::fs::read_to_string(&json_path).map_err(|e| io("read", &json_path, e))?;
+        let old: Sidecar = serde_json::from_str(&text).map_err(|e| io("parse", &json_path, e))?;
         if old.fingerprint != fingerprint {
             return Err(SweepError::Mismatch(format!(
                 "{} holds a different sweep ({}, {} over {:?}); use another output directory or start afresh (`--fresh`, `fresh=True`)",
@@ -733,13 +801,20 @@ fn prepare_resume(
         if csv_path.exists() {
             done = read_csv(&csv_path, spec)?;
         }
+    } else if !fresh && csv_path.exists() {
+        return Err(SweepError::Mismatch(format!(
+            "{} holds a sweep.csv without its definition (sweep.json), so its rows cannot be \
+             matched to this sweep; use another output directory or start afresh (`--fresh`, \
+             `fresh=True`) to discard them",
+            dir.display()
+        )));
     }
     let sidecar = Sidecar {
         fingerprint,
         spec: spec.clone(),
     };
-    let text = serde_json::to_string_pretty(&sidecar).map_err(|e| io(&json_path, e))?;
-    std::fs::write(&json_path, text).map_err(|e| io(&json_path, e))?;
+    let text = serde_json::to_string_pretty(&sidecar).map_err(|e| io("write", &json_path, e))?;
+    AtomicFile::write(&json_path, text.as_bytes())?;
     Ok(done)
 }
 
@@ -795,26 +870,30 @@ fn write_csv<'a>(
     spec: &SweepSpec,
     rows: impl Iterator<Item = &'a PointResult>,
 ) -> Result<(), SweepError> {
-    let tmp = path.with_extension("csv.tmp");
-    let mut w = csv::Writer::from_path(&tmp).map_err(|e| io(&tmp, e))?;
-    w.write_record(csv_header(spec)).map_err(|e| io(&tmp, e))?;
+    let csv_error = |e: csv::Error| match e.into_kind() {
+        csv::ErrorKind::Io(e) => io("write", path, e),
+        other => io("write", path, std::io::Error::other(format!("{other:?}"))),
+    };
+    let mut w = csv::Writer::from_writer(AtomicFile::create(path)?);
+    w.write_record(csv_header(spec)).map_err(csv_error)?;
     for r in rows {
-        w.write_record(csv_record(r)).map_err(|e| io(&tmp, e))?;
+        w.write_record(csv_record(r)).map_err(csv_error)?;
     }
-    w.flush().map_err(|e| io(&tmp, e))?;
-    drop(w);
-    std::fs::rename(&tmp, path).map_err(|e| io(path, e))
+    let file = w
+        .into_inner()
+        .map_err(|e| io("write", path, e.into_error()))?;
+    Ok(file.commit()?)
 }
 
 /// Reads the rows of `sweep.csv` written for `spec`: the finished points by index. Rows cut
 /// short by an interruption, or not belonging to `spec`, are dropped (they will be rerun).
 /// The point values come from `spec`, so they round-trip exactly.
 pub fn read_csv(path: &Path, spec: &SweepSpec) -> Result<BTreeMap<usize, PointResult>, SweepError> {
-    let file = File::open(path).map_err(|e| io(path, e))?;
+    let file = File::open(path).map_err(|e| io("open", path, e))?;
     let mut rd = csv::ReaderBuilder::new().flexible(true).from_reader(file);
     let header: Vec<String> = rd
         .headers()
-        .map_err(|e| io(path, e))?
+        .map_err(|e| io("read", path, std::io::Error::other(e)))?
         .iter()
         .map(str::to_owned)
         .collect();

@@ -10,14 +10,18 @@
 //!                  [--out DIR] [--averaged] [--config FILE] [--criterion target/criterion]
 //! ```
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use clap::{Parser, Subcommand};
 use fado_sim::SimConfigError;
 use fado_sim::compare;
+use fado_sim::output::{self, AtomicFile, DirLock, OutputError};
 use fado_sim::scenario::{self, SCENARIOS};
-use fado_sim::sweep::{self, SweepOptions, SweepSpec};
+use fado_sim::scenario::{RunOptions, TraceOutput};
+use fado_sim::sim::{CsvTraceWriter, TraceRow, TraceSink};
+use fado_sim::sweep::{self, SweepError, SweepOptions, SweepSpec};
 use indicatif::{ProgressBar, ProgressStyle};
 
 #[derive(Parser)]
@@ -143,14 +147,47 @@ enum Command {
     },
 }
 
+/// Exit code of a configuration or usage error (a bad key, value, scenario or axis).
+const EXIT_CONFIG: u8 = 2;
+/// Exit code of an output error: a file that cannot be read or written (the message names
+/// it), or an output directory that another run holds.
+const EXIT_IO: u8 = 3;
+
 fn main() -> ExitCode {
     match run(Cli::parse()) {
         Ok(code) => code,
         Err(e) => {
             eprintln!("error: {e}");
-            ExitCode::from(2)
+            let io = e.downcast_ref::<OutputError>().is_some()
+                || matches!(e.downcast_ref::<SweepError>(), Some(SweepError::Io(_)));
+            ExitCode::from(if io { EXIT_IO } else { EXIT_CONFIG })
         }
     }
+}
+
+/// The trace file of `run`: rows go to disk as they are produced; a failed write stops the
+/// run at once (through its cancel flag) instead of simulating on for nothing.
+struct FileSink<'a> {
+    csv: CsvTraceWriter<AtomicFile>,
+    failed: &'a AtomicBool,
+}
+
+impl TraceSink for FileSink<'_> {
+    fn push(&mut self, row: &TraceRow) {
+        self.csv.push(row);
+        if self.csv.failed() {
+            self.failed.store(true, Ordering::Relaxed);
+        }
+    }
+}
+
+/// A CSV write error as the output error naming `path`.
+fn csv_error(e: csv::Error, path: &Path) -> OutputError {
+    let source = match e.into_kind() {
+        csv::ErrorKind::Io(e) => e,
+        other => std::io::Error::other(format!("{other:?}")),
+    };
+    OutputError::new("write", path, source)
 }
 
 fn run(cli: Cli) -> Result<ExitCode, Box<dyn std::error::Error>> {
@@ -207,18 +244,40 @@ fn run(cli: Cli) -> Result<ExitCode, Box<dyn std::error::Error>> {
                 }
                 bar.set_position((f * 1000.0) as u64);
             };
-            let outcome = scenario::run_config(&name, cfg, Some(&mut cb))?;
-            bar.finish_and_clear();
             let dir = out.unwrap_or_else(|| PathBuf::from("out").join(&name));
-            std::fs::create_dir_all(&dir)?;
-            let report = outcome.report();
-            std::fs::write(
-                dir.join("metrics.json"),
-                serde_json::to_string_pretty(&report)?,
+            let lock = DirLock::acquire(&dir)?;
+            let traces_path = dir.join("traces.csv");
+            let stop = AtomicBool::new(false);
+            let mut sink = FileSink {
+                csv: CsvTraceWriter::new(AtomicFile::create(&traces_path)?),
+                failed: &stop,
+            };
+            let outcome = scenario::run_config_with(
+                &name,
+                cfg,
+                RunOptions {
+                    progress: Some(&mut cb),
+                    trace: TraceOutput::Sink(&mut sink),
+                    cancel: Some(&stop),
+                },
             )?;
-            outcome
-                .trace
-                .write_csv(std::fs::File::create(dir.join("traces.csv"))?)?;
+            bar.finish_and_clear();
+            // Every output is complete and on disk before any is renamed into place; the old
+            // metrics.json goes first, so a metrics.json always sits beside its own traces.
+            let traces = sink
+                .csv
+                .finish()
+                .map_err(|e| csv_error(e, &traces_path))?
+                .finish()?;
+            let report = outcome.report();
+            let mut metrics = AtomicFile::create(&dir.join("metrics.json"))?;
+            serde_json::to_writer_pretty(&mut metrics, &report)
+                .map_err(|e| metrics.error(e.into()))?;
+            let metrics = metrics.finish()?;
+            output::remove_if_present(&dir.join("metrics.json"))?;
+            traces.rename()?;
+            metrics.rename()?;
+            drop(lock);
             print_table(&report);
             println!("wrote {}/metrics.json and traces.csv", dir.display());
             Ok(if report.passed {
@@ -285,6 +344,10 @@ fn run(cli: Cli) -> Result<ExitCode, Box<dyn std::error::Error>> {
             criterion,
             threads,
         } => {
+            let (threads, warning) = fado_sim::threads::capped(threads);
+            if let Some(w) = warning {
+                eprintln!("warning: {w}");
+            }
             let mut opts = compare::CompareOptions {
                 averaged,
                 threads,
@@ -317,13 +380,13 @@ fn run(cli: Cli) -> Result<ExitCode, Box<dyn std::error::Error>> {
                 result.set_step_costs(costs);
             }
             let dir = out.unwrap_or_else(|| PathBuf::from("out").join("compare"));
-            std::fs::create_dir_all(&dir)?;
-            std::fs::write(
-                dir.join("compare.json"),
-                serde_json::to_string_pretty(&result)?,
-            )?;
+            let _lock = DirLock::acquire(&dir)?;
             let md = result.to_markdown();
-            std::fs::write(dir.join("compare.md"), &md)?;
+            AtomicFile::write(&dir.join("compare.md"), md.as_bytes())?;
+            AtomicFile::write(
+                &dir.join("compare.json"),
+                serde_json::to_string_pretty(&result)?.as_bytes(),
+            )?;
             print!("{md}");
             println!(
                 "\n{} runs in {:.1} s; wrote {}/compare.json and compare.md",
@@ -491,10 +554,15 @@ fn run_sweep(
         .progress_chars("=> "),
     );
     bar.set_message(format!("{} {}", spec.scenario, spec.design));
+    let (threads, warning) = fado_sim::threads::capped(threads);
+    if let Some(w) = warning {
+        eprintln!("warning: {w}");
+    }
     let opts = SweepOptions {
         threads,
         out: Some(dir.clone()),
         fresh,
+        cancel: None,
     };
     let started_bar = std::sync::Once::new();
     let outcome = sweep::run(spec, &opts, &|r, finished| {
