@@ -38,7 +38,7 @@ pub fn compare(
         averaged,
         config_toml: config,
         keep_traces: traces,
-        threads,
+        threads: crate::sweep::capped_threads(py, threads)?,
         ..Default::default()
     };
     if let Some(s) = scenarios {

@@ -1,6 +1,8 @@
 //! `fado.Estimator` (sample by sample, or a chunk of samples at a time) and `fado.estimate`
 //! (a whole recording in one call).
 
+use std::sync::atomic::AtomicBool;
+
 use fado_core::{Ab, SensorlessEstimator};
 use numpy::{PyArrayDescr, PyArrayDescrMethods, dtype};
 use pyo3::prelude::*;
@@ -8,9 +10,10 @@ use pyo3::prelude::*;
 use crate::config::PyEstimatorConfig;
 use crate::errors::{config_error, input_error};
 use crate::inputs::{ColumnSlice, Signals};
+use crate::interrupt;
 use crate::machine::PyMachine;
 use crate::outputs::{EstimateResult, StepResult};
-use crate::replay::replay;
+use crate::replay::replay_until;
 use crate::scalar::{Dtype, Scalar};
 
 impl<'a, 'py> FromPyObject<'a, 'py> for Dtype {
@@ -136,12 +139,16 @@ impl Engine {
         with_engine!(self, e => align_one(e, theta0, i_ab))
     }
 
-    /// Replays the signals with the GIL released.
-    fn run(&mut self, py: Python<'_>, signals: &Signals<'_>, ts: f64) -> EstimateResult {
+    /// Replays the signals with the GIL released; Ctrl-C stops it ([`interrupt::run`]).
+    fn run(&mut self, py: Python<'_>, signals: &Signals<'_>, ts: f64) -> PyResult<EstimateResult> {
         let slices = signals.slices();
         with_engine!(self, e => {
-            let columns = py.detach(|| run_slices(e, slices));
-            EstimateResult::from_columns(py, columns, ts)
+            let columns = interrupt::run(py, |cancel| run_slices(e, slices, cancel.as_ref()))?;
+            // None only when cancelled, and then `interrupt::run` raised.
+            let columns = columns.ok_or_else(|| {
+                pyo3::exceptions::PyKeyboardInterrupt::new_err("estimate interrupted")
+            })?;
+            Ok(EstimateResult::from_columns(py, columns, ts))
         })
     }
 }
@@ -161,9 +168,10 @@ fn align_one<T: Scalar>(e: &mut SensorlessEstimator<T>, theta0: f64, i: [f64; 2]
 fn run_slices<T: Scalar>(
     e: &mut SensorlessEstimator<T>,
     [va, vb, ia, ib]: [ColumnSlice<'_>; 4],
-) -> crate::outputs::Columns<T> {
+    cancel: &AtomicBool,
+) -> Option<crate::outputs::Columns<T>> {
     let (va, vb, ia, ib) = (T::column(va), T::column(vb), T::column(ia), T::column(ib));
-    replay(e, &va, &vb, &ia, &ib)
+    replay_until(e, &va, &vb, &ia, &ib, Some(cancel))
 }
 
 /// The sensorless estimator of Fig. 5 (SPEC §1) around a machine model, stepped one sample
@@ -261,7 +269,8 @@ impl PyEstimator {
     /// Steps through whole arrays (1-D, contiguous, float64 or float32, equal lengths) with the
     /// GIL released, continuing from the present state; returns every output as arrays.
     /// Other threads keep running meanwhile: they must not write to the input arrays, and
-    /// using this estimator from another thread raises until the call returns.
+    /// using this estimator from another thread raises until the call returns. Ctrl-C stops
+    /// it within a few milliseconds (`KeyboardInterrupt`), the state then part-way through.
     fn run(
         &mut self,
         py: Python<'_>,
@@ -271,7 +280,7 @@ impl PyEstimator {
         i_beta: &Bound<'_, PyAny>,
     ) -> PyResult<EstimateResult> {
         let signals = Signals::new(v_alpha, v_beta, i_alpha, i_beta)?;
-        Ok(self.engine.run(py, &signals, self.ts))
+        self.engine.run(py, &signals, self.ts)
     }
 
     /// Back to the start-up state at `theta0` with zero current.
@@ -362,7 +371,8 @@ pub const DEFAULT_TS: f64 = 1e-4;
 /// step (otherwise it starts at angle 0 with zero current). `dtype='float32'` runs the
 /// single-precision estimator. Bad arrays or arguments raise `InputError`, bad settings
 /// `ConfigError` (both are `ValueError`s). The inputs are read in place, not copied: other
-/// threads must not write to them during the call.
+/// threads must not write to them during the call. Ctrl-C stops it within a
+/// few milliseconds (`KeyboardInterrupt`).
 #[pyfunction]
 #[pyo3(
     signature = (v_alpha, v_beta, i_alpha, i_beta, *, machine = None, ts = DEFAULT_TS, config = None, theta0 = None, dtype = Dtype::Float64),
@@ -393,5 +403,5 @@ pub fn estimate(
         };
         engine.align(theta0, [first(ia), first(ib)]);
     }
-    Ok(engine.run(py, &signals, setup.ts))
+    engine.run(py, &signals, setup.ts)
 }

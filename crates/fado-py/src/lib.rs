@@ -15,6 +15,7 @@
 //! - [`simulate`]: `simulate`, `SimResult`, `scenarios`, `default_config`: the closed-loop
 //!   simulator of `fado-sim` (the paper's Fig. 8–12) with the GIL released.
 //! - [`errors`]: `FadoError` and its subclasses.
+//! - [`interrupt`]: long calls run without the GIL and stop on Ctrl-C.
 //! - [`compare`]: `compare`, fado against the baseline estimators in the simulator.
 //! - [`sweep`]: `sweep` and `sweep_point`, operating-envelope sweeps of the simulator.
 
@@ -23,6 +24,7 @@ pub mod config;
 pub mod errors;
 pub mod estimator;
 pub mod inputs;
+pub mod interrupt;
 pub mod machine;
 pub mod outputs;
 pub mod replay;

@@ -7,10 +7,11 @@
 //! (`traces.csv`, as float64 arrays under the same names, bit for bit).
 
 use std::io::Write;
+use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
-use fado_sim::scenario::{self, SCENARIOS};
-use fado_sim::sim::TraceRow;
+use fado_sim::scenario::{self, RunOptions, SCENARIOS, TraceOutput};
+use fado_sim::sim::{TraceColumns, TraceRow};
 use fado_sim::{SimConfig, SimConfigError};
 use numpy::PyArray1;
 use pyo3::prelude::*;
@@ -18,6 +19,7 @@ use pyo3::types::{PyDict, PyList};
 
 use crate::config::PyEstimatorConfig;
 use crate::errors::{config_error_message, input_error};
+use crate::interrupt;
 use crate::machine::PyMachine;
 
 /// Width of the progress bar printed to stderr.
@@ -80,15 +82,16 @@ impl ProgressLine<'_> {
     }
 }
 
-/// The trace as one `Vec` per column (struct of arrays).
-fn columns_of(rows: &[TraceRow]) -> Vec<Vec<f64>> {
-    let mut columns = vec![Vec::with_capacity(rows.len()); TraceRow::COLUMNS.len()];
-    for row in rows {
-        for (column, value) in columns.iter_mut().zip(row.values()) {
-            column.push(value);
-        }
-    }
-    columns
+/// Most trace rows `simulate` keeps in memory: 4 million rows × 39 float64 columns = 1.25 GB
+/// (400 s at 10 kHz without decimation). Longer traces are refused before the run; raise
+/// `simulation.decimation`, or use `fado-sim run`, which streams the trace to disk.
+pub const MAX_TRACE_ROWS_IN_MEMORY: u64 = 4_000_000;
+
+/// Why a run gave no result.
+enum Failed {
+    Config(SimConfigError),
+    Json(serde_json::Error),
+    Cancelled,
 }
 
 /// What `fado_sim::simulate` returns, reduced to what crosses into Python.
@@ -201,31 +204,57 @@ fn run(
     config_toml: Option<&str>,
     averaged: bool,
     progress: bool,
-) -> Result<Result<Finished, SimConfigError>, serde_json::Error> {
+    cancel: &AtomicBool,
+) -> Result<Finished, Failed> {
+    let cfg = layered_config(scenario, motor, config_toml, averaged).map_err(Failed::Config)?;
+    let rows = scenario::trace_rows(&cfg);
+    if rows > MAX_TRACE_ROWS_IN_MEMORY {
+        let e = SimConfigError::new(
+            "simulation.decimation",
+            format!(
+                "the trace would hold {rows} rows, more than the {MAX_TRACE_ROWS_IN_MEMORY} \
+                 `simulate` keeps in memory: raise it (or shorten simulation.duration, or run \
+                 `fado-sim run`, which streams the trace to disk)"
+            ),
+        );
+        return Err(Failed::Config(match config_toml {
+            Some(text) => e.located_in(text),
+            None => e,
+        }));
+    }
     let line = ProgressLine {
         scenario,
         started: Instant::now(),
     };
     let mut draw = |f: f64| line.draw(f);
     let callback: Option<&mut dyn FnMut(f64)> = if progress { Some(&mut draw) } else { None };
-    let outcome = match layered_config(scenario, motor, config_toml, averaged)
-        .and_then(|cfg| scenario::run_config(scenario, cfg, callback))
-    {
-        Ok(o) => o,
-        Err(e) => return Ok(Err(e)),
-    };
+    // The rows go straight into the columns numpy will own: no second copy of the trace.
+    let mut columns = TraceColumns::with_capacity(rows as usize);
+    let outcome = scenario::run_config_with(
+        scenario,
+        cfg,
+        RunOptions {
+            progress: callback,
+            trace: TraceOutput::Sink(&mut columns),
+            cancel: Some(cancel),
+        },
+    )
+    .map_err(Failed::Config)?;
     if progress {
         line.finish();
     }
+    if outcome.stats.cancelled {
+        return Err(Failed::Cancelled);
+    }
     let report = outcome.report();
-    Ok(Ok(Finished {
-        report_json: serde_json::to_string(&report)?,
+    Ok(Finished {
+        report_json: serde_json::to_string(&report).map_err(Failed::Json)?,
         passed: outcome.passed,
         averaged: outcome.config.inverter.model == fado_sim::inverter::InverterModel::Averaged,
         config_toml: outcome.config.to_toml(),
         estimator: outcome.config.estimator_config(),
-        columns: columns_of(&outcome.trace.rows),
-    }))
+        columns: columns.columns,
+    })
 }
 
 /// Runs one of the paper's experiments (`scenarios()`) on the simulated drive and returns a
@@ -255,11 +284,27 @@ pub fn simulate(
     motor: Option<Bound<'_, PyAny>>,
 ) -> PyResult<SimResult> {
     let motor = Motor::from_argument(py, motor.as_ref())?;
-    let finished = py
-        .detach(|| run(scenario, motor.as_ref(), config_toml, averaged, progress))
-        .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(format!("metrics to JSON: {e}")))?
-        .map_err(|e| sim_error(py, e))?;
-    SimResult::new(py, scenario, finished)
+    let finished = interrupt::run(py, |cancel| {
+        run(
+            scenario,
+            motor.as_ref(),
+            config_toml,
+            averaged,
+            progress,
+            cancel.as_ref(),
+        )
+    })?;
+    match finished {
+        Ok(f) => SimResult::new(py, scenario, f),
+        Err(Failed::Config(e)) => Err(sim_error(py, e)),
+        Err(Failed::Json(e)) => Err(pyo3::exceptions::PyRuntimeError::new_err(format!(
+            "metrics to JSON: {e}"
+        ))),
+        // Only when a signal handler raised, which `interrupt::run` already returned.
+        Err(Failed::Cancelled) => Err(pyo3::exceptions::PyKeyboardInterrupt::new_err(
+            "simulation interrupted",
+        )),
+    }
 }
 
 /// The names of the scenarios `simulate` runs (the paper's Fig. 8–12, and the ones scaled by

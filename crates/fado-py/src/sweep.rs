@@ -4,6 +4,7 @@
 //! spread the points over processes or machines. Both return the same row dicts.
 
 use std::io::Write;
+use std::sync::Arc;
 
 use fado_sim::sweep::{self as engine, PointResult, SweepError, SweepOptions, SweepSpec, Value};
 use pyo3::exceptions::{PyOSError, PyValueError};
@@ -11,13 +12,25 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString};
 
 use crate::errors::input_error;
+use crate::interrupt;
 use crate::simulate::sim_error;
 
 fn sweep_error(py: Python<'_>, e: SweepError) -> PyErr {
     match e {
         SweepError::Config(e) => sim_error(py, e),
-        SweepError::Io(m) => PyOSError::new_err(m),
+        SweepError::Io(e) => {
+            let errno = e.source.raw_os_error();
+            let message = e.to_string();
+            match errno {
+                Some(n) => PyOSError::new_err((n, message, e.path.display().to_string())),
+                None => PyOSError::new_err(message),
+            }
+        }
         SweepError::Mismatch(m) => PyValueError::new_err(m),
+        SweepError::Threads(m) => pyo3::exceptions::PyRuntimeError::new_err(m),
+        SweepError::Cancelled => {
+            pyo3::exceptions::PyKeyboardInterrupt::new_err("sweep interrupted")
+        }
     }
 }
 
@@ -90,6 +103,21 @@ fn spec_of(
     })
 }
 
+/// `requested` worker threads capped at the machine's cores ([`fado_sim::threads`]), with a
+/// `RuntimeWarning` when more were asked for.
+pub(crate) fn capped_threads(py: Python<'_>, requested: usize) -> PyResult<usize> {
+    let (threads, warning) = fado_sim::threads::capped(requested);
+    if let Some(w) = warning {
+        PyErr::warn(
+            py,
+            &py.get_type::<pyo3::exceptions::PyRuntimeWarning>(),
+            &std::ffi::CString::new(w).unwrap_or_default(),
+            1,
+        )?;
+    }
+    Ok(threads)
+}
+
 /// One row: point, the axes, status, passed, tripped, the metrics, failed_checks.
 fn row_dict<'py>(
     py: Python<'py>,
@@ -121,7 +149,10 @@ fn row_dict<'py>(
 /// ``sensor_offset``, ``sensor_gain_error``, ``load_torque``, ``reversal_ramp``. With
 /// ``out``, writes ``sweep.csv``/``sweep.json``/``summary.*`` there and resumes a sweep
 /// interrupted in it (``fresh=True``: start over). A point that fails or diverges is a row
-/// with that ``status``, never an exception.
+/// with that ``status``, never an exception. ``threads`` above the machine's cores is capped
+/// with a ``RuntimeWarning``. Ctrl-C stops the sweep within milliseconds
+/// (``KeyboardInterrupt``); the points finished are in ``out``'s ``sweep.csv`` and the same
+/// call resumes from them.
 #[pyfunction]
 #[pyo3(
     signature = (scenario, axes, points, *, config = None, averaged = false, threads = 0, out = None, fresh = false, progress = false),
@@ -141,21 +172,22 @@ pub fn sweep(
     progress: bool,
 ) -> PyResult<Py<PyList>> {
     let spec = spec_of(py, scenario, axes, &points, config, averaged)?;
-    let opts = SweepOptions {
-        threads,
-        out,
-        fresh,
-    };
+    let threads = capped_threads(py, threads)?;
     let total = spec.points.len();
-    let outcome = py
-        .detach(|| {
-            engine::run(&spec, &opts, &|_, finished| {
-                if progress {
-                    let _ = write!(std::io::stderr().lock(), "\rsweep {finished}/{total}");
-                }
-            })
+    let outcome = interrupt::run(py, |cancel| {
+        let opts = SweepOptions {
+            threads,
+            out,
+            fresh,
+            cancel: Some(Arc::clone(cancel)),
+        };
+        engine::run(&spec, &opts, &|_, finished| {
+            if progress {
+                let _ = write!(std::io::stderr().lock(), "\rsweep {finished}/{total}");
+            }
         })
-        .map_err(|e| sweep_error(py, e))?;
+    })?
+    .map_err(|e| sweep_error(py, e))?;
     if progress {
         let _ = writeln!(std::io::stderr().lock());
     }
