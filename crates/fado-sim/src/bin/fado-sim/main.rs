@@ -10,6 +10,8 @@
 //!                  [--out DIR] [--averaged] [--config FILE] [--criterion target/criterion]
 //! ```
 
+mod axes;
+
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -302,7 +304,7 @@ fn run(cli: Cli) -> Result<ExitCode, Box<dyn std::error::Error>> {
                     let mut grid = Vec::new();
                     for a in &axes {
                         let (name, values) = split_axis(a)?;
-                        grid.push((name.to_owned(), sweep::parse_values(values)?));
+                        grid.push((name.to_owned(), axes::parse_values(values)?));
                     }
                     SweepSpec::grid(&scenario, grid)
                 }
@@ -310,7 +312,7 @@ fn run(cli: Cli) -> Result<ExitCode, Box<dyn std::error::Error>> {
                     let mut ranges = Vec::new();
                     for a in &axes {
                         let (name, range) = split_axis(a)?;
-                        let (lo, hi) = sweep::parse_range(range)?;
+                        let (lo, hi) = axes::parse_range(range)?;
                         ranges.push((name.to_owned(), lo, hi));
                     }
                     SweepSpec::random(&scenario, &ranges, n, seed)
