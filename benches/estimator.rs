@@ -1,13 +1,13 @@
 //! Criterion benchmarks of the estimator step and of each of its blocks, in `f32` and `f64`.
 //!
-//! Inputs are a precomputed ideal PMSM signal (tests/common) at 293 r/min (19.53 Hz electrical,
+//! Inputs are a precomputed ideal PMSM signal (crates/fado-core/tests/common) at 293 r/min (19.53 Hz electrical,
 //! so that the 4096-sample table holds exactly 8 electrical periods and wraps seamlessly),
 //! 10 A on q: the estimator runs in its disturbance-feedback mode as it would in a drive.
 //! The blocks are fed the signals the estimator itself produced on that table.
 //!
 //! Run with `cargo bench -p fado --bench estimator`; `-- estimator/f32` selects one.
 
-#[path = "../tests/common/mod.rs"]
+#[path = "../crates/fado-core/tests/common/mod.rs"]
 mod common;
 
 use std::hint::black_box;
