@@ -24,7 +24,9 @@ def _error(key: str, message: str) -> ConfigError:
 
 
 def _nest(table: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
-    """Expands dotted keys into nested dicts (merging with tables given the other way)."""
+    """Expands dotted keys into nested dicts, merging tables given both ways
+    (``{"motor.rs": 1}`` and ``{"motor": {"ld": 2}}``); a key set both ways is refused,
+    whichever comes first."""
     out: dict[str, Any] = {}
     for key, value in table.items():
         if not isinstance(key, str) or not key:
@@ -41,12 +43,24 @@ def _nest(table: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
             value = _nest(value, prefix + key + ".")
             existing = node.get(last)
             if isinstance(existing, dict):
-                existing.update(value)
+                _merge(existing, value, prefix + key + ".")
                 continue
         if last in node:
-            raise _error(prefix + key, "given twice")
+            raise _error(prefix + key, "given twice (as a dotted key and inside a table)")
         node[last] = value
     return out
+
+
+def _merge(into: dict[str, Any], extra: dict[str, Any], prefix: str) -> None:
+    """Adds `extra`'s keys to `into`, recursing into tables both have; a value in both is
+    refused."""
+    for key, value in extra.items():
+        if key not in into:
+            into[key] = value
+        elif isinstance(into[key], dict) and isinstance(value, dict):
+            _merge(into[key], value, prefix + key + ".")
+        else:
+            raise _error(prefix + key, "given twice (as a dotted key and inside a table)")
 
 
 def _key(key: str) -> str:

@@ -154,3 +154,16 @@ def test_toml_writer() -> None:
     with pytest.raises(fado.ConfigError) as info:
         _toml.dumps({"x": {"y": 1}, "x.y": 2})
     assert info.value.field == "x.y"
+    # The same key both ways is refused in either order (one order used to win silently).
+    for both in (
+        {"motor.rs": 0.3, "motor": {"rs": 0.4}},
+        {"motor": {"rs": 0.4}, "motor.rs": 0.3},
+        {"a.b.c": 1, "a": {"b": {"c": 2}}},
+        {"a": {"b.c": 1}, "a.b": {"c": 2}},
+    ):
+        with pytest.raises(fado.ConfigError, match="given twice") as info:
+            _toml.dumps(both)
+        assert info.value.field in ("motor.rs", "a.b.c"), both
+    # Different keys given both ways merge.
+    merged = tomllib.loads(_toml.dumps({"motor.rs": 0.3, "motor": {"ld": 1e-3}}))
+    assert merged["motor"] == {"rs": 0.3, "ld": 1e-3}
