@@ -14,6 +14,8 @@
 //!   parallel, resumable, one CSV row per point (CLI `fado-sim sweep`, Python `fado.sweep`).
 //! * [`config`]: the whole run as one TOML document ([`SimConfig`]), overriding a scenario key
 //!   by key; unknown keys and impossible values are errors naming the key.
+//! * [`output`]: outputs written whole or not at all (temporary file + rename) under a lock on
+//!   the output directory; [`threads`]: worker counts capped at the machine's cores.
 //! * [`sim`]: the loop ([`sim::Simulation`]), the plant aggregate ([`sim::Plant`]), metrics,
 //!   the decimated trace and the [`sim::Probe`] hook for custom measurements.
 //!

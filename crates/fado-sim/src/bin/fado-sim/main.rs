@@ -30,7 +30,10 @@ use indicatif::{ProgressBar, ProgressStyle};
 #[command(
     name = "fado-sim",
     version,
-    about = "Closed-loop simulation of the FADO sensorless PMSM drive (Park & Sul)"
+    about = "Closed-loop simulation of the FADO sensorless PMSM drive (Park & Sul)",
+    after_help = "Exit codes: 0 passed, 1 ran but missed the scenario's criteria, 2 configuration \
+                  or usage error, 3 a file could not be read or written (named in the message) \
+                  or another run holds the output directory."
 )]
 struct Cli {
     #[command(subcommand)]
@@ -183,6 +186,11 @@ impl TraceSink for FileSink<'_> {
     }
 }
 
+/// The text of an input file; an error names it (exit 3).
+fn read_file(path: &Path) -> Result<String, OutputError> {
+    std::fs::read_to_string(path).map_err(|e| OutputError::new("read", path, e))
+}
+
 /// A CSV write error as the output error naming `path`.
 fn csv_error(e: csv::Error, path: &Path) -> OutputError {
     let source = match e.into_kind() {
@@ -217,10 +225,7 @@ fn run(cli: Cli) -> Result<ExitCode, Box<dyn std::error::Error>> {
             dump_config,
         } => {
             let text = match &config {
-                Some(p) => Some(
-                    std::fs::read_to_string(p)
-                        .map_err(|e| format!("cannot read {}: {e}", p.display()))?,
-                ),
+                Some(p) => Some(read_file(p)?),
                 None => None,
             };
             let cfg = scenario::scenario_config(&name, text.as_deref(), averaged)
@@ -320,10 +325,7 @@ fn run(cli: Cli) -> Result<ExitCode, Box<dyn std::error::Error>> {
             };
             spec.averaged = averaged;
             if let Some(p) = &config {
-                spec.config_toml = Some(
-                    std::fs::read_to_string(p)
-                        .map_err(|e| format!("cannot read {}: {e}", p.display()))?,
-                );
+                spec.config_toml = Some(read_file(p)?);
             }
             // A bad --config file is reported at its FILE:LINE:COLUMN before anything runs.
             spec.base_config().map_err(|e| in_file(e, &config))?;
@@ -365,10 +367,7 @@ fn run(cli: Cli) -> Result<ExitCode, Box<dyn std::error::Error>> {
                     .collect::<Result<_, _>>()?;
             }
             if let Some(p) = &config {
-                opts.config_toml = Some(
-                    std::fs::read_to_string(p)
-                        .map_err(|e| format!("cannot read {}: {e}", p.display()))?,
-                );
+                opts.config_toml = Some(read_file(p)?);
             }
             let mut result = compare::compare(&opts).map_err(|e| in_file(e, &config))?;
             if let Some(dir) = &criterion {
