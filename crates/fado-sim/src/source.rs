@@ -85,7 +85,10 @@ pub fn key_at(text: &str, offset: usize) -> Option<String> {
 fn find_in_table(table: &DeTable<'_>, offset: usize, path: &mut Vec<String>) -> bool {
     for (k, v) in table.iter() {
         let in_key = k.span().contains(&offset);
-        if in_key || v.span().contains(&offset) || matches!(v.get_ref(), DeValue::Table(_)) {
+        // An array of tables (`[[faults.non_finite]]`) has no span of its own around its
+        // tables' keys: look inside arrays as inside tables.
+        let container = matches!(v.get_ref(), DeValue::Table(_) | DeValue::Array(_));
+        if in_key || v.span().contains(&offset) || container {
             path.push(k.get_ref().to_string());
             if find_in_value(v, offset, path) || in_key || v.span().contains(&offset) {
                 return true;
@@ -158,5 +161,21 @@ mod tests {
         let text = "[motor]\n# λ̂f\nrs = -1\n";
         let s = SourceLocation::at(text, value_span(text, "motor.rs").unwrap().start);
         assert_eq!((s.line, s.column), (3, 6));
+    }
+
+    #[test]
+    fn keys_inside_arrays_of_tables_get_their_full_path() {
+        let text = "[motor]\nrs = 0.3\n\n[[faults.non_finite]]\ntime = 1.0\nsignal = \"x\"\n\n\
+                    [[faults.non_finite]]\ntime = 2.0\nsignl = \"current_a\"\n";
+        let at = |needle: &str| text.find(needle).unwrap();
+        assert_eq!(
+            key_at(text, at("\"x\"")).as_deref(),
+            Some("faults.non_finite[0].signal")
+        );
+        assert_eq!(
+            key_at(text, at("signl")).as_deref(),
+            Some("faults.non_finite[1].signl")
+        );
+        assert_eq!(key_at(text, at("0.3")).as_deref(), Some("motor.rs"));
     }
 }
