@@ -59,6 +59,11 @@ def simulate(
     :func:`fado.default_config` for every key. `averaged` selects the averaged inverter model
     (fast) instead of the switching-resolved one. `progress` prints a progress bar to stderr.
 
+    Ctrl-C stops the run within milliseconds (``KeyboardInterrupt``). The trace is kept in
+    memory, so a run whose trace would exceed 4 million rows (1.25 GB) is refused before it
+    starts (:class:`fado.ConfigError` on ``simulation.decimation``); ``fado-sim run`` streams
+    longer traces to disk.
+
     Returns a :class:`fado.SimResult` holding what ``fado-sim run`` writes: ``.metrics``
     (``metrics.json``), ``.traces`` (``traces.csv`` columns as float64 arrays), ``.passed``,
     ``.checks``, ``.config_toml``. A bad key or value raises :class:`fado.ConfigError` whose

@@ -95,8 +95,10 @@ def sweep(
     `config` (TOML text, path or dict, as for :func:`fado.simulate`) applies before the
     parameters; `averaged` selects the averaged inverter model.
 
-    With ``executor=None`` the points run in Rust on `threads` threads (0: all cores), with
-    the GIL released; `out` then keeps ``sweep.csv`` (rows appended as points finish),
+    With ``executor=None`` the points run in Rust on `threads` threads (0: all cores; more
+    than the machine's cores are capped, with a ``RuntimeWarning``), with the GIL released;
+    Ctrl-C stops them within milliseconds (``KeyboardInterrupt``), the finished points kept
+    in `out` for the same call to resume from; `out` then keeps ``sweep.csv`` (rows appended as points finish),
     ``sweep.json``, ``summary.json`` and ``summary.md`` in that directory and resumes a sweep
     interrupted there (``fresh=True`` starts over). With an `executor` (anything with
     ``submit(fn, *args)`` returning futures with ``.result()``: a
