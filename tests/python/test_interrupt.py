@@ -111,3 +111,13 @@ def test_simulate_refuses_a_trace_too_long_for_memory_before_running() -> None:
     assert e.value.line == 3
     assert "rows" in str(e.value)
     assert time.perf_counter() - started < 1.0
+
+
+def test_a_single_sweep_point_stops_on_ctrl_c() -> None:
+    # What `fado.sweep(..., executor=...)` runs per task: 60 s of the averaged plant.
+    def one_point() -> Any:
+        return fado._fado.sweep_point(
+            "fig11", ["simulation.duration"], [60.0], averaged=True
+        )
+
+    assert interrupted_after(one_point) < BUDGET

@@ -199,7 +199,7 @@ pub fn sweep(
 }
 
 /// Runs one point of a sweep (what `sweep` does for each point) and returns its row dict,
-/// with ``point`` = ``index``. The GIL is released while it runs.
+/// with ``point`` = ``index``. The GIL is released while it runs; Ctrl-C stops it.
 #[pyfunction]
 #[pyo3(
     signature = (scenario, axes, values, *, config = None, averaged = false, index = 0),
@@ -216,7 +216,17 @@ pub fn sweep_point(
 ) -> PyResult<Py<PyDict>> {
     let spec = spec_of(py, scenario, axes, &[values], config, averaged)?;
     let base = spec.base_config().map_err(|e| sim_error(py, e))?;
-    let r =
-        py.detach(|| engine::run_point(&spec.scenario, &base, &spec.axes, &spec.points[0], index));
+    let r = interrupt::run(py, |cancel| {
+        engine::run_point_until(
+            &spec.scenario,
+            &base,
+            &spec.axes,
+            &spec.points[0],
+            index,
+            Some(cancel.as_ref()),
+        )
+    })?
+    // None only when cancelled, and then `interrupt::run` raised.
+    .ok_or_else(|| pyo3::exceptions::PyKeyboardInterrupt::new_err("sweep point interrupted"))?;
     Ok(row_dict(py, &spec.axes, &r)?.unbind())
 }
