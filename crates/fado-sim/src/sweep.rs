@@ -79,13 +79,16 @@ pub const PARAMETERS: [(&str, &str); 9] = [
 ];
 
 /// Metric columns of a row, after the axes and `status`, `passed`.
-pub const METRICS: [&str; 6] = [
+pub const METRICS: [&str; 9] = [
     "max_angle_error",
     "rms_angle_error",
     "max_angle_error_zero_speed",
     "rms_angle_error_zero_speed",
     "max_speed_error_rpm",
     "wall_seconds",
+    "max_angle_error_run",
+    "angle_error_exceeded_time",
+    "lock_lost_time",
 ];
 
 /// A sweep definition: base scenario and configuration, axes and points.
@@ -466,6 +469,12 @@ pub struct PointResult {
     pub tripped: bool,
     /// Wall time of the point, s.
     pub wall_seconds: f64,
+    /// max |θ − θ̂| over the whole run with the gates on, rad (loss-of-lock label).
+    pub max_angle_error_run: f64,
+    /// First time |θ − θ̂| > 0.5 rad, s (NaN: never).
+    pub angle_error_exceeded_time: f64,
+    /// First time the drive reported the rotor lost, s (NaN: never).
+    pub lock_lost_time: f64,
 }
 
 impl PointResult {
@@ -483,10 +492,13 @@ impl PointResult {
             max_speed_error_rpm: f64::NAN,
             tripped: false,
             wall_seconds,
+            max_angle_error_run: f64::NAN,
+            angle_error_exceeded_time: f64::NAN,
+            lock_lost_time: f64::NAN,
         }
     }
 
-    fn metrics(&self) -> [f64; 6] {
+    fn metrics(&self) -> [f64; 9] {
         [
             self.max_angle_error,
             self.rms_angle_error,
@@ -494,6 +506,9 @@ impl PointResult {
             self.rms_angle_error_zero_speed,
             self.max_speed_error_rpm,
             self.wall_seconds,
+            self.max_angle_error_run,
+            self.angle_error_exceeded_time,
+            self.lock_lost_time,
         ]
     }
 }
@@ -548,6 +563,9 @@ pub fn run_point(
         max_speed_error_rpm: m.max_speed_error_rpm,
         tripped: m.tripped,
         wall_seconds: wall,
+        max_angle_error_run: m.max_angle_error_run,
+        angle_error_exceeded_time: m.angle_error_exceeded_time.unwrap_or(f64::NAN),
+        lock_lost_time: m.lock_lost_time.unwrap_or(f64::NAN),
     };
     // The zero-speed metrics are NaN-free by construction only when the band was visited;
     // judge divergence on the overall ones.
@@ -873,6 +891,9 @@ pub fn read_csv(path: &Path, spec: &SweepSpec) -> Result<BTreeMap<usize, PointRe
                 max_speed_error_rpm: m[4],
                 tripped,
                 wall_seconds: m[5],
+                max_angle_error_run: m[6],
+                angle_error_exceeded_time: m[7],
+                lock_lost_time: m[8],
             },
         );
     }
@@ -1338,7 +1359,8 @@ mod tests {
             assert_eq!((&a.values, &a.status), (&b.values, &b.status));
         }
         assert!(matches!(back[0].status, Status::Failed(_)) && back[0].max_angle_error.is_nan());
-        assert_eq!(back[1], out.rows[1]);
+        // NaN-aware equality (the loss-of-lock times of a run that never lost lock are NaN).
+        assert_eq!(format!("{:?}", back[1]), format!("{:?}", out.rows[1]));
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }
