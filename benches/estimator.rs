@@ -126,7 +126,8 @@ fn bench_precision<T: Real>(c: &mut Criterion, name: &str) {
 
     // The detector alone (its symptoms and counter; the innovation's wrap is in `wrap_angle`).
     group.bench_function("lock_detector", |b| {
-        let d = EstimatorConfig::<T>::default();
+        let d = fado_core::EstimatorTuning::<T>::default();
+        let lf = T::lit(0.088);
         let mut det = LockDetector::new(LockDetectorConfig {
             ts,
             flux_low_ratio: d.lock_flux_low_ratio,
@@ -136,7 +137,7 @@ fn bench_precision<T: Real>(c: &mut Criterion, name: &str) {
             limiter_clamping: true,
         })
         .unwrap();
-        let flux_sq = d.flux_linkage_hat * d.flux_linkage_hat;
+        let flux_sq = lf * lf;
         let mut k = 0usize;
         b.iter(|| {
             let s = &table[k & MASK];
@@ -154,9 +155,8 @@ fn bench_precision<T: Real>(c: &mut Criterion, name: &str) {
 
     // The plausibility check of a sample (magnitudes and current step).
     group.bench_function("plausibility", |b| {
-        let d = EstimatorConfig::<T>::default();
-        let bounds =
-            SampleBounds::new(d.plausible_current, d.plausible_voltage, T::lit(34.0)).unwrap();
+        // The paper motor's bounds: 4 × 21.78 A, 1.5 × 311 V, 2·466 V·Ts/L̂q.
+        let bounds = SampleBounds::new(T::lit(87.1), T::lit(466.5), T::lit(34.0)).unwrap();
         let mut k = 0usize;
         b.iter(|| {
             let s = &table[k & MASK];
