@@ -160,7 +160,7 @@ pub struct EstimatorTuning<T> {
     /// Default false \[A\]: a rotor lost in limiter mode clamps continuously (fig11 with
     /// λ̂f +10 %) and a matched drive never clamps, but an adapted R̂s biased by a λ̂f error
     /// makes the limiter clamp through passages it survives; on the fig11 envelope it raises
-    /// detection from 36 % to 78 % and false alarms from 9 % to 33 % (docs/lock.md).
+    /// detection from 35 % to 75 % and false alarms from 7 % to 37 % (docs/lock.md).
     pub lock_limiter_clamping: bool,
 }
 
