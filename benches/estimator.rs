@@ -15,7 +15,9 @@ use std::time::Duration;
 
 use criterion::Criterion;
 use fado_core::flux::{FluxIntegrator, FluxIntegratorConfig, FluxLimiter, FluxLimiterConfig};
+use fado_core::lock::{LockDetector, LockDetectorConfig};
 use fado_core::observer::{DiscreteGains, DisturbanceObserver, DisturbanceObserverConfig};
+use fado_core::plausibility::SampleBounds;
 use fado_core::rotor_flux::rotor_angle;
 use fado_core::tracker::{TrackerConfig, TypeTwoTracker};
 use fado_core::{Ab, Dq, EstimatorConfig, Real, SensorlessEstimator, wrap_angle};
@@ -40,7 +42,10 @@ fn ab<T: Real>(x: Ab<f64>) -> Ab<T> {
 }
 
 /// The signal table and an estimator warmed up on it (two seconds, settled, k_df mode).
-fn setup<T: Real>(rs_adaptation: bool) -> (Vec<Sample<T>>, SensorlessEstimator<T>) {
+fn setup<T: Real>(
+    rs_adaptation: bool,
+    lock_detection: bool,
+) -> (Vec<Sample<T>>, SensorlessEstimator<T>) {
     let f_elec = 8.0 / (TABLE as f64 * common::TS);
     let rpm = f_elec * 60.0 / common::PP;
     let theta0 = 0.3;
@@ -52,6 +57,9 @@ fn setup<T: Real>(rs_adaptation: bool) -> (Vec<Sample<T>>, SensorlessEstimator<T
         SensorlessEstimator::<T>::new(common::config_with(|c: &mut EstimatorConfig<T>| {
             c.initial_angle = T::lit(theta0);
             c.tuning.rs_adaptation = rs_adaptation;
+            if !lock_detection {
+                c.tuning.lock_detection_time = T::zero();
+            }
         }))
         .expect("default config is valid");
     let (_, i0) = common::flux_and_current(theta0, i_dq);
@@ -77,8 +85,9 @@ fn setup<T: Real>(rs_adaptation: bool) -> (Vec<Sample<T>>, SensorlessEstimator<T
 }
 
 fn bench_precision<T: Real>(c: &mut Criterion, name: &str) {
-    let (table, warmed) = setup::<T>(true);
-    let (_, warmed_fixed_rs) = setup::<T>(false);
+    let (table, warmed) = setup::<T>(true, true);
+    let (_, warmed_fixed_rs) = setup::<T>(false, true);
+    let (_, warmed_no_lock) = setup::<T>(true, false);
     let ts = T::lit(common::TS);
     let mut group = c.benchmark_group(name);
 
@@ -100,6 +109,60 @@ fn bench_precision<T: Real>(c: &mut Criterion, name: &str) {
             let s = &table[k & MASK];
             k += 1;
             black_box(est.step(black_box(s.v), black_box(s.i)))
+        })
+    });
+
+    // The default estimator with the loss-of-lock detector off (`lock_detection_time = 0`):
+    // the difference to `estimator` is the detector's cost inside the step.
+    group.bench_function("estimator_no_lock_detector", |b| {
+        let mut est = warmed_no_lock;
+        let mut k = 0usize;
+        b.iter(|| {
+            let s = &table[k & MASK];
+            k += 1;
+            black_box(est.step(black_box(s.v), black_box(s.i)))
+        })
+    });
+
+    // The detector alone (its symptoms and counter; the innovation's wrap is in `wrap_angle`).
+    group.bench_function("lock_detector", |b| {
+        let d = fado_core::EstimatorTuning::<T>::default();
+        let lf = T::lit(0.088);
+        let mut det = LockDetector::new(LockDetectorConfig {
+            ts,
+            flux_low_ratio: d.lock_flux_low_ratio,
+            flux_high_ratio: d.lock_flux_high_ratio,
+            innovation_limit: d.lock_innovation_limit,
+            detection_time: d.lock_detection_time,
+            limiter_clamping: true,
+        })
+        .unwrap();
+        let flux_sq = lf * lf;
+        let mut k = 0usize;
+        b.iter(|| {
+            let s = &table[k & MASK];
+            k += 1;
+            let next = det.next_state(
+                black_box(s.lambda_r.norm_squared()),
+                black_box(flux_sq),
+                black_box(s.theta_direct - s.omega * ts),
+                false,
+            );
+            det.commit(next);
+            black_box(next)
+        })
+    });
+
+    // The plausibility check of a sample (magnitudes and current step).
+    group.bench_function("plausibility", |b| {
+        // The paper motor's bounds: 4 × 21.78 A, 1.5 × 311 V, 2·466 V·Ts/L̂q.
+        let bounds = SampleBounds::new(T::lit(87.1), T::lit(466.5), T::lit(34.0)).unwrap();
+        let mut k = 0usize;
+        b.iter(|| {
+            let s = &table[k & MASK];
+            let p = &table[k.wrapping_sub(1) & MASK];
+            k += 1;
+            black_box(bounds.check(black_box(s.v), black_box(s.i), black_box(p.i), T::lit(34.0)))
         })
     });
 

@@ -149,6 +149,7 @@ impl EstimatorCase {
                     t.flux_linkage_adaptation_rate,
                 ),
                 limiter_recentring: self.adaptation_flags[1].unwrap_or(t.limiter_recentring),
+                ..t
             },
         }
     }

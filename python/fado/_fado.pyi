@@ -185,6 +185,14 @@ class EstimatorConfig:
         rs_adaptation_max_ratio: float | None = None,
         flux_linkage_adaptation_rate: float | None = None,
         limiter_recentring: bool | None = None,
+        plausible_current_ratio: float | None = None,
+        plausible_voltage_ratio: float | None = None,
+        plausible_current_step_ratio: float | None = None,
+        lock_flux_low_ratio: float | None = None,
+        lock_flux_high_ratio: float | None = None,
+        lock_innovation_limit: float | None = None,
+        lock_detection_time: float | None = None,
+        lock_limiter_clamping: bool | None = None,
     ) -> EstimatorConfig: ...
     def replace(
         self,
@@ -209,6 +217,14 @@ class EstimatorConfig:
         rs_adaptation_max_ratio: float | None = None,
         flux_linkage_adaptation_rate: float | None = None,
         limiter_recentring: bool | None = None,
+        plausible_current_ratio: float | None = None,
+        plausible_voltage_ratio: float | None = None,
+        plausible_current_step_ratio: float | None = None,
+        lock_flux_low_ratio: float | None = None,
+        lock_flux_high_ratio: float | None = None,
+        lock_innovation_limit: float | None = None,
+        lock_detection_time: float | None = None,
+        lock_limiter_clamping: bool | None = None,
     ) -> EstimatorConfig: ...
     def to_dict(self) -> dict[str, float | str | bool]: ...
     def __getnewargs_ex__(self) -> tuple[tuple[()], dict[str, float | str | bool]]: ...
@@ -274,6 +290,30 @@ class EstimatorConfig:
     @property
     def limiter_recentring(self) -> bool:
         """In limiter mode, re-centre the common mode of λ1 and D̂ (fado's improvement)."""
+    @property
+    def plausible_current_ratio(self) -> float:
+        """Samples with an α-β current component beyond ± this × the rated current are refused."""
+    @property
+    def plausible_voltage_ratio(self) -> float:
+        """Samples with an α-β voltage component beyond ± this × the DC-link voltage are refused."""
+    @property
+    def plausible_current_step_ratio(self) -> float:
+        """Current-step bound in units of (plausible voltage)·ts/L̂q per sample (0 = off)."""
+    @property
+    def lock_flux_low_ratio(self) -> float:
+        """Loss of lock: |λ̂r|/λ̂f below this is a symptom."""
+    @property
+    def lock_flux_high_ratio(self) -> float:
+        """Loss of lock: |λ̂r|/λ̂f above this is a symptom."""
+    @property
+    def lock_innovation_limit(self) -> float:
+        """Loss of lock: T2S-1 innovation above this (rad) is a symptom."""
+    @property
+    def lock_detection_time(self) -> float:
+        """Loss of lock: net symptomatic time (s) before lock = 2 (0 = off)."""
+    @property
+    def lock_limiter_clamping(self) -> bool:
+        """Loss of lock: limiter clamping in limiter mode is a symptom."""
 
 @final
 class StepResult:
@@ -312,6 +352,8 @@ class StepResult:
     def flux_linkage_hat(self) -> float: ...
     @property
     def mode(self) -> int: ...
+    @property
+    def lock(self) -> int: ...
     @property
     def flag_limit(self) -> bool: ...
     @property
@@ -366,6 +408,8 @@ class EstimateResult:
     def flux_linkage_hat(self) -> _FloatArray: ...
     @property
     def mode(self) -> npt.NDArray[np.int8]: ...
+    @property
+    def lock(self) -> npt.NDArray[np.int8]: ...
     @property
     def flag_limit(self) -> npt.NDArray[np.bool_]: ...
     @property

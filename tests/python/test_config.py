@@ -38,6 +38,15 @@ PAPER_DEFAULTS = {
     "rs_adaptation_max_ratio": 2.0,  # [A]
     "flux_linkage_adaptation_rate": 0.0,  # [A]
     "limiter_recentring": True,  # fado's improvement [A]; False = the paper
+    # Issue 14: plausibility bounds (ratios of the ratings) and the loss-of-lock detector.
+    "plausible_current_ratio": 4.0,  # [A]
+    "plausible_voltage_ratio": 1.5,  # [A]
+    "plausible_current_step_ratio": 2.0,  # [A]
+    "lock_flux_low_ratio": 0.7,  # [A]
+    "lock_flux_high_ratio": 1.2,  # [A]
+    "lock_innovation_limit": 0.5,  # [A]
+    "lock_detection_time": 5e-3,  # [A]
+    "lock_limiter_clamping": False,  # [A]
 }
 
 # The paper's motor (section V; λf, J, B from SPEC §6; rated current from its rated torque).

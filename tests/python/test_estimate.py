@@ -24,7 +24,7 @@ def stepped(est: fado.Estimator, *signals: np.ndarray) -> dict[str, np.ndarray]:
     out = {}
     for name in fado.OUTPUT_NAMES:
         values = [getattr(r, name) for r in rows]
-        if name == "mode":
+        if name in ("mode", "lock"):
             out[name] = np.array(values, dtype=np.int8)
         elif isinstance(values[0], bool):
             out[name] = np.array(values, dtype=bool)

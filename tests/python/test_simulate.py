@@ -247,7 +247,7 @@ def test_sim_result_api() -> None:
     # Copies: mutating them does not change the result.
     result.metrics["scenario"] = "x"
     result.traces.clear()
-    assert result.metrics["scenario"] == "fig10" and len(result.traces) == 39
+    assert result.metrics["scenario"] == "fig10" and len(result.traces) == 40
     text = repr(result)
     assert "fig10" in text and "rows=300" in text
     with pytest.raises(KeyError):

@@ -19,8 +19,10 @@ use crate::flux::{
     DisturbanceFeedback, DisturbanceFeedbackConfig, FluxIntegrator, FluxIntegratorConfig,
     FluxLimiter, FluxLimiterConfig,
 };
+use crate::lock::{LockDetector, LockDetectorConfig, LockStatus};
 use crate::mode::{Mode, ModeSelector, ModeSelectorConfig};
 use crate::observer::{DisturbanceObserver, DisturbanceObserverConfig};
+use crate::plausibility::{self, SampleBounds};
 use crate::real::all_finite;
 use crate::rotor_flux::{rotor_angle, rotor_flux, stator_flux};
 use crate::rs_adaptation::{AdaptationRegime, ResistanceAdaptation, ResistanceAdaptationConfig};
@@ -128,6 +130,38 @@ pub struct EstimatorTuning<T> {
     /// estimator stays in limiter mode (at a hand-over to HI mode D̂ is smaller, so the k_df
     /// transient that follows differs).
     pub limiter_recentring: bool,
+    /// A sample whose α-β current has a component beyond ± this multiple of the rated current
+    /// is refused like a non-finite one (see [`crate::plausibility`]). Default
+    /// [`plausibility::CURRENT_RATIO`] (4; 87.1 A for the paper's motor) \[A\].
+    pub plausible_current_ratio: T,
+    /// A sample whose α-β voltage has a component beyond ± this multiple of the DC-link
+    /// voltage is refused. Default [`plausibility::VOLTAGE_RATIO`] (1.5; 450 V for the
+    /// paper's 300 V link) \[A\].
+    pub plausible_voltage_ratio: T,
+    /// A current component that moved more than this × (plausible voltage)·ts/L̂q per sample
+    /// since the last accepted one is refused; 0 disables the test. Default
+    /// [`plausibility::STEP_RATIO`] (2) \[A\].
+    pub plausible_current_step_ratio: T,
+    /// Loss of lock (see [`crate::lock`]): |λ̂r| below this multiple of λ̂f is a symptom.
+    /// Default 0.7 \[A\] (chosen on the fig11 envelope sweep, docs/lock.md).
+    pub lock_flux_low_ratio: T,
+    /// Loss of lock: |λ̂r| above this multiple of λ̂f is a symptom. Default 1.2 \[A\] (just
+    /// above the limiter circle 1.15; 1.15 detects more and false-alarms far more,
+    /// docs/lock.md).
+    pub lock_flux_high_ratio: T,
+    /// Loss of lock: a T2S-1 innovation |θm − θ̂⁻| above this (rad) is a symptom. Default
+    /// 0.5 rad \[A\] (the angle error the drive must not reach, docs/lock.md).
+    pub lock_innovation_limit: T,
+    /// Loss of lock: net symptomatic time (s) before [`LockStatus::Lost`]; 0 disables the
+    /// detector. Default 5 ms \[A\] (a quarter of the 20 ms detection target; 5–20 ms made
+    /// no difference on the envelope, docs/lock.md).
+    pub lock_detection_time: T,
+    /// Loss of lock: in limiter mode, a sample in which the limiter clamps is a symptom.
+    /// Default false \[A\]: a rotor lost in limiter mode clamps continuously (fig11 with
+    /// λ̂f +10 %) and a matched drive never clamps, but an adapted R̂s biased by a λ̂f error
+    /// makes the limiter clamp through passages it survives; on the fig11 envelope it raises
+    /// detection from 35 % to 75 % and false alarms from 7 % to 37 % (docs/lock.md).
+    pub lock_limiter_clamping: bool,
 }
 
 impl<T: Real> EstimatorTuning<T> {
@@ -155,6 +189,14 @@ impl<T: Real> EstimatorTuning<T> {
             rs_adaptation_max_ratio: U::lit(self.rs_adaptation_max_ratio.to_f64()),
             flux_linkage_adaptation_rate: U::lit(self.flux_linkage_adaptation_rate.to_f64()),
             limiter_recentring: self.limiter_recentring,
+            plausible_current_ratio: U::lit(self.plausible_current_ratio.to_f64()),
+            plausible_voltage_ratio: U::lit(self.plausible_voltage_ratio.to_f64()),
+            plausible_current_step_ratio: U::lit(self.plausible_current_step_ratio.to_f64()),
+            lock_flux_low_ratio: U::lit(self.lock_flux_low_ratio.to_f64()),
+            lock_flux_high_ratio: U::lit(self.lock_flux_high_ratio.to_f64()),
+            lock_innovation_limit: U::lit(self.lock_innovation_limit.to_f64()),
+            lock_detection_time: U::lit(self.lock_detection_time.to_f64()),
+            lock_limiter_clamping: self.lock_limiter_clamping,
         }
     }
 }
@@ -183,6 +225,14 @@ impl<T: Real> Default for EstimatorTuning<T> {
             rs_adaptation_max_ratio: rs.max_ratio,
             flux_linkage_adaptation_rate: rs.flux_linkage_rate,
             limiter_recentring: true,
+            plausible_current_ratio: T::lit(plausibility::CURRENT_RATIO),
+            plausible_voltage_ratio: T::lit(plausibility::VOLTAGE_RATIO),
+            plausible_current_step_ratio: T::lit(plausibility::STEP_RATIO),
+            lock_flux_low_ratio: T::lit(0.7),
+            lock_flux_high_ratio: T::lit(1.2),
+            lock_innovation_limit: T::lit(0.5),
+            lock_detection_time: T::lit(5e-3),
+            lock_limiter_clamping: false,
         }
     }
 }
@@ -246,6 +296,48 @@ impl<T: Real> EstimatorConfig<T> {
         }
     }
 
+    fn lock_detector(&self) -> LockDetectorConfig<T> {
+        LockDetectorConfig {
+            ts: self.ts,
+            flux_low_ratio: self.tuning.lock_flux_low_ratio,
+            flux_high_ratio: self.tuning.lock_flux_high_ratio,
+            innovation_limit: self.tuning.lock_innovation_limit,
+            detection_time: self.tuning.lock_detection_time,
+            limiter_clamping: self.tuning.lock_limiter_clamping,
+        }
+    }
+
+    /// The sample bounds of [`crate::plausibility`] from the machine's ratings and the
+    /// `plausible_*` ratios.
+    fn sample_bounds(&self) -> Result<SampleBounds<T>, ConfigError> {
+        let t = &self.tuning;
+        let ratio = check::non_negative(
+            "plausible_current_step_ratio",
+            t.plausible_current_step_ratio,
+        )?;
+        let current = check::positive("plausible_current_ratio", t.plausible_current_ratio)?
+            * self.machine.rated_current;
+        let voltage = check::positive("plausible_voltage_ratio", t.plausible_voltage_ratio)?
+            * self.machine.dc_voltage;
+        let step = ratio * voltage * self.ts / self.machine.lq;
+        let step = if ratio > T::zero() && step.is_finite() {
+            step
+        } else {
+            T::lit(f64::INFINITY)
+        };
+        SampleBounds::new(current, voltage, step).map_err(|e| match e.field() {
+            "plausible_current" => ConfigError::OutOfRange {
+                field: "plausible_current_ratio",
+                expected: "a finite bound in this precision",
+            },
+            "plausible_voltage" => ConfigError::OutOfRange {
+                field: "plausible_voltage_ratio",
+                expected: "a finite bound in this precision",
+            },
+            _ => e,
+        })
+    }
+
     fn tracker(&self, bandwidth_hz: T) -> TrackerConfig<T> {
         TrackerConfig {
             ts: self.ts,
@@ -283,9 +375,11 @@ pub struct Diagnostics<T> {
     /// The flux-magnitude reference λ̂f (Wb): the configured value, or the adapted one with
     /// [`EstimatorTuning::rs_adaptation`].
     pub flux_linkage_hat: T,
-    /// This sample's inputs were non-finite and were rejected; the state is unchanged and the
-    /// other fields are [`SensorlessEstimator::last`].
+    /// This sample's inputs were non-finite or implausible (see [`crate::plausibility`]) and
+    /// were rejected; the state is unchanged and the other fields repeat the last good sample.
     pub input_fault: bool,
+    /// Whether the estimate is trusted (see [`crate::lock`]).
+    pub lock: LockStatus,
 }
 
 /// The estimator's outputs for one sample.
@@ -345,6 +439,12 @@ pub struct SensorlessEstimator<T> {
     hold_level_sq: T,
     k_df_enabled: bool,
     rejected_samples: u32,
+    bounds: SampleBounds<T>,
+    /// The last accepted current, and the step it may have moved by since (grows by one
+    /// step per rejected sample).
+    i_prev: Ab<T>,
+    step_allowance: T,
+    lock: LockDetector<T>,
 }
 
 impl<T: Real> SensorlessEstimator<T> {
@@ -455,6 +555,8 @@ impl<T: Real> SensorlessEstimator<T> {
         };
         squared("flux_linkage", lf)?;
         squared("limiter_radius_ratio", ratio * lf)?;
+        let bounds = config.sample_bounds()?;
+        let lock = LockDetector::new(config.lock_detector())?;
         let mut est = Self {
             config,
             integrator,
@@ -469,6 +571,10 @@ impl<T: Real> SensorlessEstimator<T> {
             hold_level_sq: hold_level * hold_level,
             k_df_enabled: true,
             rejected_samples: 0,
+            bounds,
+            i_prev: Ab::zero(),
+            step_allowance: bounds.step(),
+            lock,
         };
         est.reset();
         Ok(est)
@@ -517,16 +623,31 @@ impl<T: Real> SensorlessEstimator<T> {
         self.t2s2.reset_to(theta0, T::zero());
         self.feedback = Ab::zero();
         self.rejected_samples = 0;
+        self.lock.reset();
+        self.i_prev = if self.bounds.current_ok(i_ab) {
+            i_ab
+        } else {
+            Ab::zero()
+        };
+        self.step_allowance = self.bounds.step();
     }
 
     /// One 10 kHz sample (Fig. 5).
     ///
     /// `v_ab` is the voltage reference that was applied over the last sampling interval (with
     /// a one-sample computational delay, the one computed two samples ago, before dead-time
-    /// compensation); `i_ab` the currents sampled now. A non-finite input is rejected: the state
-    /// is untouched and [`Self::last`] is returned with `input_fault` set.
+    /// compensation); `i_ab` the currents sampled now. A non-finite or implausible input (see
+    /// [`crate::plausibility`]) is rejected: the state is untouched and [`Self::last`] is
+    /// returned with `input_fault` set.
     #[inline]
     pub fn step(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> Estimate<T> {
+        // Plausibility first (a few compares; false for NaN/∞ too, see `crate::plausibility`).
+        if !self
+            .bounds
+            .check(v_ab, i_ab, self.i_prev, self.step_allowance)
+        {
+            return self.reject();
+        }
         // The whole new state is computed first and committed only if it is finite: a
         // non-finite input makes it non-finite (every input enters λ1 through Ts·v and the
         // resistive drop, or λ̂r through L̂q·i, and NaN and ±∞ propagate, 0·∞ included), finite
@@ -549,6 +670,13 @@ impl<T: Real> SensorlessEstimator<T> {
         let lambda_r = rotor_flux(lambda2, i_ab, self.config.machine.lq);
         let tracker_hold = lambda_r.norm_squared() < self.hold_level_sq;
         let theta_direct = rotor_angle(lambda_r);
+        // Loss-of-lock symptoms (see `lock`): |λ̂r| against λ̂f, the T2S-1 innovation.
+        let innovation = if tracker_hold {
+            T::zero()
+        } else {
+            crate::wrap_angle(theta_direct - self.t2s1.predicted_angle())
+        };
+        let flux_hat = self.rs_adaptation.flux_linkage_hat();
         // 4. Trackers (Fig. 1, Fig. 5).
         let (t2s1, t2s2) = if tracker_hold {
             (self.t2s1.coasted_state(), self.t2s2.coasted_state())
@@ -569,6 +697,12 @@ impl<T: Real> SensorlessEstimator<T> {
                 (l.feedback, l.clamping)
             }
         };
+        let lock = self.lock.next_state(
+            lambda_r.norm_squared(),
+            flux_hat * flux_hat,
+            innovation,
+            clamping,
+        );
         // Which values the one test needs (the others follow from them, so the test is
         // exact, not approximate): a non-finite v or i makes λ1 non-finite (Ts·v, and R̂s·i
         // with R̂s ≥ 0: ∞·R̂s = ∞, 0·∞ = NaN, ∞ − ∞ = NaN); a tracker's ω̂ = ω̂ + Ki·Ts·e is
@@ -608,6 +742,9 @@ impl<T: Real> SensorlessEstimator<T> {
         self.selector.commit(mode);
         self.disturbance_feedback.commit(kdf_gain);
         self.feedback = feedback;
+        self.lock.commit(lock);
+        self.i_prev = i_ab;
+        self.step_allowance = self.bounds.step();
         // 6. R̂s for the next sample (see `rs_adaptation`), after the commit so that the paper's
         //    path is untouched by it. A non-finite result is dropped (R̂s stays).
         if self.config.tuning.rs_adaptation {
@@ -654,6 +791,7 @@ impl<T: Real> SensorlessEstimator<T> {
                 rs_hat: rs_hat_used,
                 flux_linkage_hat: flux_linkage_used,
                 input_fault: false,
+                lock: lock.1,
             },
         }
     }
@@ -661,6 +799,7 @@ impl<T: Real> SensorlessEstimator<T> {
     #[cold]
     fn reject(&mut self) -> Estimate<T> {
         self.rejected_samples = self.rejected_samples.saturating_add(1);
+        self.step_allowance += self.bounds.step();
         let mut out = self.last();
         out.diagnostics.input_fault = true;
         out
@@ -702,6 +841,7 @@ impl<T: Real> SensorlessEstimator<T> {
                 rs_hat: self.integrator.config().rs_hat,
                 flux_linkage_hat: self.rs_adaptation.flux_linkage_hat(),
                 input_fault: false,
+                lock: self.lock.status(),
             },
         }
     }
@@ -758,6 +898,10 @@ pub trait RotorAngleEstimator<T: Real> {
     fn reset(&mut self);
     /// A short name for tables and plots.
     fn name(&self) -> &'static str;
+    /// Clears a latched loss-of-lock verdict ([`Diagnostics::lock`]) without touching the
+    /// estimate, so that the detector judges afresh (the drive's recovery, see
+    /// [`crate::control::lock_reaction`]). Default: nothing to clear.
+    fn rearm_lock_detector(&mut self) {}
 }
 
 impl<T: Real> RotorAngleEstimator<T> for SensorlessEstimator<T> {
@@ -774,6 +918,9 @@ impl<T: Real> RotorAngleEstimator<T> for SensorlessEstimator<T> {
     fn name(&self) -> &'static str {
         "fado"
     }
+    fn rearm_lock_detector(&mut self) {
+        self.lock.reset();
+    }
 }
 
 #[cfg(test)]
@@ -789,6 +936,8 @@ mod tests {
             core::mem::size_of::<SensorlessEstimator<f64>>(),
         );
         std::println!("SensorlessEstimator<f32>: {s32} B, <f64>: {s64} B");
-        assert!(s32 <= 388, "{s32}");
+        // 388 B before issue 14; its sample bounds, last accepted current, step allowance,
+        // loss-of-lock detector and their tuning fields add 76 B.
+        assert!(s32 <= 464, "{s32}");
     }
 }

@@ -29,9 +29,11 @@ pub mod estimator;
 pub mod flux;
 pub mod frames;
 pub mod injection;
+pub mod lock;
 pub mod machine;
 pub mod mode;
 pub mod observer;
+pub mod plausibility;
 pub mod real;
 pub mod rotor_flux;
 pub mod rs_adaptation;
@@ -45,6 +47,7 @@ pub use estimator::{
     SensorlessEstimator,
 };
 pub use frames::{Ab, Abc, Dq, Rotation};
+pub use lock::LockStatus;
 pub use machine::MachineModel;
 pub use mode::Mode;
 pub use real::{Real, wrap_angle};

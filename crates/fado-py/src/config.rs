@@ -180,6 +180,22 @@ config_class! {
     /// In limiter mode, re-centre the common mode of λ1 and D̂ (our improvement, default
     /// true; false is the paper).
     limiter_recentring: bool,
+    /// Samples with an α-β current component beyond ± this × the rated current are refused like non-finite ones.
+    plausible_current_ratio: f64,
+    /// Samples with an α-β voltage component beyond ± this × the DC-link voltage are refused.
+    plausible_voltage_ratio: f64,
+    /// A current moving more than this × (plausible voltage)·ts/L̂q per sample is refused (0 = off).
+    plausible_current_step_ratio: f64,
+    /// Loss of lock: |λ̂r|/λ̂f below this is a symptom.
+    lock_flux_low_ratio: f64,
+    /// Loss of lock: |λ̂r|/λ̂f above this is a symptom.
+    lock_flux_high_ratio: f64,
+    /// Loss of lock: a T2S-1 innovation above this (rad) is a symptom.
+    lock_innovation_limit: f64,
+    /// Loss of lock: net symptomatic time (s) before `lock` = 2 (0 = detector off).
+    lock_detection_time: f64,
+    /// Loss of lock: limiter clamping in limiter mode is a symptom.
+    lock_limiter_clamping: bool,
 }
 
 impl Default for PyEstimatorConfig {
@@ -212,6 +228,14 @@ impl PyEstimatorConfig {
             rs_adaptation_max_ratio: c.rs_adaptation_max_ratio,
             flux_linkage_adaptation_rate: c.flux_linkage_adaptation_rate,
             limiter_recentring: c.limiter_recentring,
+            plausible_current_ratio: c.plausible_current_ratio,
+            plausible_voltage_ratio: c.plausible_voltage_ratio,
+            plausible_current_step_ratio: c.plausible_current_step_ratio,
+            lock_flux_low_ratio: c.lock_flux_low_ratio,
+            lock_flux_high_ratio: c.lock_flux_high_ratio,
+            lock_innovation_limit: c.lock_innovation_limit,
+            lock_detection_time: c.lock_detection_time,
+            lock_limiter_clamping: c.lock_limiter_clamping,
         }
     }
 
@@ -239,6 +263,14 @@ impl PyEstimatorConfig {
             rs_adaptation_max_ratio: T::lit(self.rs_adaptation_max_ratio),
             flux_linkage_adaptation_rate: T::lit(self.flux_linkage_adaptation_rate),
             limiter_recentring: self.limiter_recentring,
+            plausible_current_ratio: T::lit(self.plausible_current_ratio),
+            plausible_voltage_ratio: T::lit(self.plausible_voltage_ratio),
+            plausible_current_step_ratio: T::lit(self.plausible_current_step_ratio),
+            lock_flux_low_ratio: T::lit(self.lock_flux_low_ratio),
+            lock_flux_high_ratio: T::lit(self.lock_flux_high_ratio),
+            lock_innovation_limit: T::lit(self.lock_innovation_limit),
+            lock_detection_time: T::lit(self.lock_detection_time),
+            lock_limiter_clamping: self.lock_limiter_clamping,
         })
     }
 

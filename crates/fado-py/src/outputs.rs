@@ -3,9 +3,10 @@
 //!
 //! Floats are in the estimator's arithmetic (float64 or float32 arrays; Python floats for a
 //! single step), `mode` is an `int8` code ([`MODE_LIMITER`], [`MODE_DISTURBANCE_FEEDBACK`]),
-//! the flags are `bool`.
+//! `lock` an `int8` code (0 locked, 1 suspect, 2 lost: `fado_core::LockStatus`), the flags
+//! are `bool`.
 
-use fado_core::{Estimate, Mode, Real};
+use fado_core::{Estimate, LockStatus, Mode, Real};
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
@@ -25,22 +26,41 @@ pub fn mode_code(mode: Mode) -> i8 {
     }
 }
 
+/// An `int8` status code of the outputs.
+pub trait Code {
+    /// The code.
+    fn code(self) -> i8;
+}
+
+impl Code for Mode {
+    fn code(self) -> i8 {
+        mode_code(self)
+    }
+}
+
+impl Code for LockStatus {
+    fn code(self) -> i8 {
+        LockStatus::code(self) as i8
+    }
+}
+
 macro_rules! outputs {
     (
         floats { $($(#[doc = $fdoc:literal])* $float:ident => $($fpath:ident).+,)* }
-        mode { $(#[doc = $mdoc:literal])* $mode:ident => $($mpath:ident).+, }
+        codes { $($(#[doc = $mdoc:literal])* $mode:ident => $($mpath:ident).+,)* }
         flags { $($(#[doc = $bdoc:literal])* $flag:ident => $($bpath:ident).+,)* }
     ) => {
-        /// The output field names, in order: floats, then `mode`, then the flags.
+        /// The output field names, in order: floats, then the codes (`mode`, `lock`), then
+        /// the flags.
         pub const OUTPUT_NAMES: &[&str] =
-            &[$(stringify!($float),)* stringify!($mode), $(stringify!($flag),)*];
+            &[$(stringify!($float),)* $(stringify!($mode),)* $(stringify!($flag),)*];
 
         /// One sample of the estimator's outputs and diagnostics (Fig. 5).
         #[pyclass(name = "StepResult", module = "fado", frozen, eq, get_all)]
         #[derive(Clone, Debug, PartialEq)]
         pub struct StepResult {
             $($(#[doc = $fdoc])* pub $float: f64,)*
-            $(#[doc = $mdoc])* pub $mode: i8,
+            $($(#[doc = $mdoc])* pub $mode: i8,)*
             $($(#[doc = $bdoc])* pub $flag: bool,)*
         }
 
@@ -49,7 +69,7 @@ macro_rules! outputs {
             pub fn from_estimate<T: Real>(e: &Estimate<T>) -> Self {
                 Self {
                     $($float: e.$($fpath).+.to_f64(),)*
-                    $mode: mode_code(e.$($mpath).+),
+                    $($mode: Code::code(e.$($mpath).+),)*
                     $($flag: e.$($bpath).+,)*
                 }
             }
@@ -57,7 +77,7 @@ macro_rules! outputs {
             fn items<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
                 let dict = PyDict::new(py);
                 $(dict.set_item(stringify!($float), self.$float)?;)*
-                dict.set_item(stringify!($mode), self.$mode)?;
+                $(dict.set_item(stringify!($mode), self.$mode)?;)*
                 $(dict.set_item(stringify!($flag), self.$flag)?;)*
                 Ok(dict)
             }
@@ -67,7 +87,7 @@ macro_rules! outputs {
         #[derive(Clone, Debug, Default, PartialEq)]
         pub struct Columns<T> {
             $($(#[doc = $fdoc])* pub $float: Vec<T>,)*
-            $(#[doc = $mdoc])* pub $mode: Vec<i8>,
+            $($(#[doc = $mdoc])* pub $mode: Vec<i8>,)*
             $($(#[doc = $bdoc])* pub $flag: Vec<bool>,)*
         }
 
@@ -76,7 +96,7 @@ macro_rules! outputs {
             pub fn with_capacity(n: usize) -> Self {
                 Self {
                     $($float: Vec::with_capacity(n),)*
-                    $mode: Vec::with_capacity(n),
+                    $($mode: Vec::with_capacity(n),)*
                     $($flag: Vec::with_capacity(n),)*
                 }
             }
@@ -85,27 +105,28 @@ macro_rules! outputs {
             #[inline]
             pub fn push(&mut self, e: &Estimate<T>) {
                 $(self.$float.push(e.$($fpath).+);)*
-                self.$mode.push(mode_code(e.$($mpath).+));
+                $(self.$mode.push(Code::code(e.$($mpath).+));)*
                 $(self.$flag.push(e.$($bpath).+);)*
             }
 
             /// Number of samples.
             pub fn len(&self) -> usize {
-                self.$mode.len()
+                self.theta.len()
             }
 
             /// True when no sample was pushed.
             pub fn is_empty(&self) -> bool {
-                self.$mode.is_empty()
+                self.theta.is_empty()
             }
         }
 
         /// The estimator's outputs over a recording as numpy arrays, one per field of
-        /// `StepResult` (floats in the estimator's dtype, `mode` as int8, flags as bool).
+        /// `StepResult` (floats in the estimator's dtype, `mode` and `lock` as int8, flags as
+        /// bool).
         #[pyclass(name = "EstimateResult", module = "fado", frozen, get_all)]
         pub struct EstimateResult {
             $($(#[doc = $fdoc])* pub $float: Py<PyAny>,)*
-            $(#[doc = $mdoc])* pub $mode: Py<PyAny>,
+            $($(#[doc = $mdoc])* pub $mode: Py<PyAny>,)*
             $($(#[doc = $bdoc])* pub $flag: Py<PyAny>,)*
             /// Sampling period Ts in s of the recording.
             pub ts: f64,
@@ -118,7 +139,7 @@ macro_rules! outputs {
             pub fn from_columns<T: Scalar>(py: Python<'_>, c: Columns<T>, ts: f64) -> Self {
                 Self {
                     $($float: PyArray1::from_vec(py, c.$float).into_any().unbind(),)*
-                    $mode: PyArray1::from_vec(py, c.$mode).into_any().unbind(),
+                    $($mode: PyArray1::from_vec(py, c.$mode).into_any().unbind(),)*
                     $($flag: PyArray1::from_vec(py, c.$flag).into_any().unbind(),)*
                     ts,
                     dtype: PyString::new(py, T::DTYPE.name()).unbind(),
@@ -128,13 +149,13 @@ macro_rules! outputs {
             fn items<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
                 let dict = PyDict::new(py);
                 $(dict.set_item(stringify!($float), self.$float.bind(py))?;)*
-                dict.set_item(stringify!($mode), self.$mode.bind(py))?;
+                $(dict.set_item(stringify!($mode), self.$mode.bind(py))?;)*
                 $(dict.set_item(stringify!($flag), self.$flag.bind(py))?;)*
                 Ok(dict)
             }
 
             fn samples(&self, py: Python<'_>) -> PyResult<usize> {
-                self.$mode.bind(py).len()
+                self.theta.bind(py).len()
             }
         }
     };
@@ -171,9 +192,12 @@ outputs! {
         /// The flux-magnitude reference λ̂f in Wb (moves with `rs_adaptation`).
         flux_linkage_hat => diagnostics.flux_linkage_hat,
     }
-    mode {
+    codes {
         /// Active flux feedback: 0 = limiter (Fig. 6), 1 = disturbance feedback k_df (Fig. 3).
         mode => diagnostics.mode,
+        /// Loss-of-lock status (`fado_core::lock`): 0 locked, 1 suspect, 2 lost (latched
+        /// until `align`/`reset`).
+        lock => diagnostics.lock,
     }
     flags {
         /// FLAG_limit of Fig. 10: the limiter mode is active.
@@ -182,8 +206,9 @@ outputs! {
         limiter_clamping => diagnostics.limiter_clamping,
         /// The trackers coasted because |λ̂r| was too small.
         tracker_hold => diagnostics.tracker_hold,
-        /// The sample's inputs were non-finite and were rejected (state unchanged, the other
-        /// fields repeat the last good sample).
+        /// The sample's inputs were non-finite or implausible (beyond `plausible_current`,
+        /// `plausible_voltage` or the current-step bound) and were rejected (state unchanged,
+        /// the other fields repeat the last good sample).
         input_fault => diagnostics.input_fault,
     }
 }

@@ -225,6 +225,7 @@ impl Controller for DriveF32 {
                     rs_hat: d.rs_hat as f64,
                     flux_linkage_hat: d.flux_linkage_hat as f64,
                     input_fault: d.input_fault,
+                    lock: d.lock,
                 },
             },
         }

@@ -469,6 +469,13 @@ pub struct Metrics {
     pub max_speed_error_rpm: f64,
     /// The controller tripped (at any time, also before the window).
     pub tripped: bool,
+    /// max |θ − θ̂| over the whole run while the gates are on (start-up included), rad:
+    /// the label of the loss-of-lock evaluation (docs/lock.md).
+    pub max_angle_error_run: f64,
+    /// First time |θ − θ̂| exceeded 0.5 rad with the gates on, s (None: never).
+    pub angle_error_exceeded_time: Option<f64>,
+    /// First time the drive reported the rotor lost (`DriveFlags::LOCK_LOST`), s.
+    pub lock_lost_time: Option<f64>,
     #[serde(skip)]
     sum_sq: f64,
     #[serde(skip)]
@@ -495,6 +502,16 @@ impl Probe for Metrics {
 
     fn observe(&mut self, s: &Sample) {
         self.tripped |= s.act.tripped;
+        if s.act.gates_enabled {
+            let e = s.angle_error.abs();
+            self.max_angle_error_run = self.max_angle_error_run.max(e);
+            if e > 0.5 && self.angle_error_exceeded_time.is_none() {
+                self.angle_error_exceeded_time = Some(s.time);
+            }
+        }
+        if self.lock_lost_time.is_none() && s.act.flags.contains(fado_core::DriveFlags::LOCK_LOST) {
+            self.lock_lost_time = Some(s.time);
+        }
         if s.time < self.eval_start {
             return;
         }
@@ -596,14 +613,17 @@ pub struct TraceRow {
     pub flux_linkage_hat: f64,
     /// The drive's status word (`fado_core::DriveFlags` bits: 1 input rejected, 2 tripped,
     /// 4 voltage saturated, 8 current error, 16 sensor stuck, 32 DC link low, 64 limiter
-    /// mode).
+    /// mode, 128 lock lost, 256 coasting, 512 input implausible).
     pub fault_flags: u16,
+    /// The estimator's loss-of-lock status (`fado_core::LockStatus`): 0 locked, 1 suspect,
+    /// 2 lost.
+    pub lock: u8,
 }
 
 impl TraceRow {
     /// Column names, in CSV order (for struct-of-arrays consumers such as the Python
     /// bindings).
-    pub const COLUMNS: [&'static str; 39] = [
+    pub const COLUMNS: [&'static str; 40] = [
         "time",
         "theta",
         "theta_hat",
@@ -643,10 +663,11 @@ impl TraceRow {
         "rs_hat",
         "flux_linkage_hat",
         "fault_flags",
+        "lock",
     ];
 
     /// The row's values in [`COLUMNS`](Self::COLUMNS) order (flags as 0.0/1.0).
-    pub fn values(&self) -> [f64; 39] {
+    pub fn values(&self) -> [f64; 40] {
         [
             self.time,
             self.theta,
@@ -687,6 +708,7 @@ impl TraceRow {
             self.rs_hat,
             self.flux_linkage_hat,
             self.fault_flags as f64,
+            self.lock as f64,
         ]
     }
 }
@@ -734,6 +756,7 @@ impl From<&Sample> for TraceRow {
             rs_hat: d.rs_hat,
             flux_linkage_hat: d.flux_linkage_hat,
             fault_flags: s.act.flags.bits(),
+            lock: d.lock.code(),
         }
     }
 }

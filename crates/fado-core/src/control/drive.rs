@@ -27,6 +27,7 @@ use crate::control::dead_time_compensation::{
     DeadTimeCompensation, DeadTimeCompensationConfig, DeadTimeMethod,
 };
 use crate::control::delay_compensation::{DelayCompensation, DelayCompensationConfig};
+use crate::control::lock_reaction::{LockAction, LockReaction, LockSupervisor};
 use crate::control::modulation::{ModulatorConfig, SpaceVectorModulator, VoltageLimit};
 use crate::control::monitor::{DriveFlags, FlagCounts, PersistenceMonitor, StuckChannelDetector};
 use crate::control::speed_controller::{
@@ -37,7 +38,9 @@ use crate::estimator::{
     Estimate, EstimatorConfig, EstimatorTuning, RotorAngleEstimator, SensorlessEstimator,
 };
 use crate::injection::{CurrentInjection, CurrentInjectionConfig};
+use crate::lock::LockStatus;
 use crate::machine::PAPER_RATED_CURRENT;
+use crate::mode::Mode;
 use crate::{Ab, Abc, Dq, MachineModel, Real, Rotation};
 
 /// The drive's tuning: every setting that is not the machine or the sampling period. Defaults
@@ -141,6 +144,27 @@ pub struct DriveTuning<T> {
     /// trips on bad input. Default 10 ms \[A\]: a single bad sample is ridden through with the
     /// duty held, a sensor chain that stays broken is a fault.
     pub input_fault_trip_time: T,
+    /// A phase current beyond ± this multiple of the trip level is no measurement of the
+    /// machine (a glitch, an ADC or bus error) and is refused like a non-finite sample,
+    /// instead of tripping; a real over-current passes the trip level first and trips.
+    /// Default 2 \[A\] (see [`crate::plausibility`]).
+    pub plausible_current_ratio: T,
+    /// A DC-link reading above this multiple of the nominal DC-link voltage is refused like a
+    /// non-finite sample. Default [`crate::plausibility::VOLTAGE_RATIO`] (1.5) \[A\].
+    pub dc_link_max_ratio: T,
+    /// Reaction to the estimator's [`LockStatus::Lost`]. Default report only \[A\] (the
+    /// paper's behaviour plus the flag).
+    pub lock_reaction: LockReaction,
+    /// With `Recover`: time without symptoms in disturbance-feedback mode after which the
+    /// coasting drive restarts, s. Default 20 ms \[A\] (the detection target: the detector
+    /// has had as long to object as it gets to detect a loss).
+    pub lock_recovery_time: T,
+    /// With `Recover`: coasting time after which a machine that has not turned fast enough
+    /// for the estimator is re-aligned and restarted, s. Default 0.5 s \[A\].
+    pub lock_recovery_timeout: T,
+    /// With `Recover`: recoveries since `reset` before the drive coasts for good. Default 3
+    /// \[A\].
+    pub lock_recovery_attempts: u32,
 }
 
 impl<T: Real> DriveTuning<T> {
@@ -175,6 +199,12 @@ impl<T: Real> DriveTuning<T> {
             current_error_time: U::lit(self.current_error_time.to_f64()),
             dc_link_min_ratio: U::lit(self.dc_link_min_ratio.to_f64()),
             input_fault_trip_time: U::lit(self.input_fault_trip_time.to_f64()),
+            plausible_current_ratio: U::lit(self.plausible_current_ratio.to_f64()),
+            dc_link_max_ratio: U::lit(self.dc_link_max_ratio.to_f64()),
+            lock_reaction: self.lock_reaction,
+            lock_recovery_time: U::lit(self.lock_recovery_time.to_f64()),
+            lock_recovery_timeout: U::lit(self.lock_recovery_timeout.to_f64()),
+            lock_recovery_attempts: self.lock_recovery_attempts,
         }
     }
 }
@@ -210,6 +240,12 @@ impl<T: Real> Default for DriveTuning<T> {
             current_error_time: T::lit(2e-3),
             dc_link_min_ratio: T::lit(2.0 / 3.0),
             input_fault_trip_time: T::lit(10e-3),
+            plausible_current_ratio: T::lit(2.0),
+            dc_link_max_ratio: T::lit(crate::plausibility::VOLTAGE_RATIO),
+            lock_reaction: LockReaction::ReportOnly,
+            lock_recovery_time: T::lit(20e-3),
+            lock_recovery_timeout: T::lit(0.5),
+            lock_recovery_attempts: 3,
         }
     }
 }
@@ -274,6 +310,10 @@ struct Resolved<T> {
     stuck_sensor_samples: u32,
     current_error_samples: u32,
     input_fault_trip_samples: u32,
+    /// Phase currents beyond ± this (A) are refused as implausible.
+    plausible_current: T,
+    /// DC-link readings above this (V) are refused as implausible.
+    dc_link_max_voltage: T,
     /// MTPA d current on (configured and the machine is salient).
     mtpa: bool,
 }
@@ -306,6 +346,8 @@ impl<T: Real> Resolved<T> {
             stuck_sensor_samples: samples("stuck_sensor_time", t.stuck_sensor_time)?,
             current_error_samples: samples("current_error_time", t.current_error_time)?,
             input_fault_trip_samples: samples("input_fault_trip_time", t.input_fault_trip_time)?,
+            plausible_current: t.plausible_current_ratio * t.trip_current_ratio * rated,
+            dc_link_max_voltage: t.dc_link_max_ratio * c.machine.dc_voltage,
             mtpa: t.mtpa && c.machine.is_salient(),
         })
     }
@@ -422,6 +464,20 @@ impl<T: Real> Blocks<T> {
                 expected: "above stuck_sensor_band_ratio",
             });
         }
+        check::below(
+            "plausible_current_ratio",
+            T::one(),
+            check::finite("plausible_current_ratio", c.tuning.plausible_current_ratio)?,
+            "above 1",
+        )?;
+        check::positive("dc_link_max_ratio", c.tuning.dc_link_max_ratio)?;
+        LockSupervisor::new(
+            c.tuning.lock_reaction,
+            c.ts,
+            c.tuning.lock_recovery_time,
+            c.tuning.lock_recovery_timeout,
+            0,
+        )?;
         let rename = |map: &'static [(&'static str, &'static str)]| {
             move |e: ConfigError| {
                 let field = map
@@ -564,6 +620,10 @@ pub struct SensorlessDrive<T, E = SensorlessEstimator<T>> {
     flag_counts: FlagCounts,
     /// The α-β current of this sample as reported in [`DriveOutput::i_ab`].
     i_ab_used: Ab<T>,
+    /// Reaction to a lost rotor.
+    lock: LockSupervisor,
+    /// This sample was refused as implausible.
+    implausible_now: bool,
 }
 
 impl<T: Real> SensorlessDrive<T, SensorlessEstimator<T>> {
@@ -612,6 +672,14 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             consecutive_rejects: 0,
             flag_counts: FlagCounts::default(),
             i_ab_used: Ab::zero(),
+            lock: LockSupervisor::new(
+                config.tuning.lock_reaction,
+                config.ts,
+                config.tuning.lock_recovery_time,
+                config.tuning.lock_recovery_timeout,
+                config.tuning.lock_recovery_attempts,
+            )?,
+            implausible_now: false,
         };
         drive.reset();
         Ok(drive)
@@ -628,6 +696,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         self.rejected_samples = 0;
         self.consecutive_rejects = 0;
         self.flag_counts.reset();
+        self.lock.reset();
         self.calibrate_offsets();
     }
 
@@ -665,6 +734,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             T::zero()
         };
         self.clear_control(theta0);
+        self.lock.restart();
         if self.tripped {
             self.trip_output();
         } else if self.calibration_remaining > 0 {
@@ -766,6 +836,13 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             DriveFlags::LIMITER_MODE,
             out.estimate.diagnostics.flag_limit,
         );
+        // The reason stays up while the drive coasts, also after the detector was re-armed.
+        flags.set(
+            DriveFlags::LOCK_LOST,
+            out.estimate.diagnostics.lock == LockStatus::Lost || self.lock.coasting(),
+        );
+        flags.set(DriveFlags::COASTING, running && self.lock.coasting());
+        flags.set(DriveFlags::INPUT_IMPLAUSIBLE, self.implausible_now);
         out.flags = flags;
         out.i_ab = self.i_ab_used;
         self.last.flags = flags;
@@ -777,8 +854,20 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
     fn step_control(&mut self, i_abc: Abc<T>, vdc: T, speed_ref_mech: T) -> DriveOutput<T> {
         // What this sample reports as its current until the estimator is given another.
         let raw = i_abc.to_ab();
-        self.i_ab_used = if raw.is_finite() { raw } else { self.last_i_ab };
-        let finite = i_abc.is_finite() && vdc.is_finite() && speed_ref_mech.is_finite();
+        // Plausible: finite and within what the machine and inverter can produce (false
+        // for NaN/∞, so it subsumes the finite test; see `crate::plausibility`).
+        let lim = self.resolved.plausible_current;
+        let current_ok = (i_abc.a.abs() < lim) & (i_abc.b.abs() < lim) & (i_abc.c.abs() < lim);
+        self.i_ab_used = if current_ok && raw.is_finite() {
+            raw
+        } else {
+            self.last_i_ab
+        };
+        let finite = current_ok
+            && vdc.abs() < self.resolved.dc_link_max_voltage
+            && speed_ref_mech.is_finite();
+        self.implausible_now =
+            !finite && i_abc.is_finite() && vdc.is_finite() && speed_ref_mech.is_finite();
         if self.tripped {
             let mut out = self.last;
             out.input_fault = !finite;
@@ -836,6 +925,14 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             let out = self.last;
             return self.finish_reject(out);
         }
+        if estimate.diagnostics.input_fault {
+            // The estimator refused the sample (its current step is implausible for L̂q and
+            // the DC link, see `crate::plausibility`): hold like a bad input of the drive.
+            self.implausible_now = true;
+            let mut out = self.last;
+            out.estimate = estimate;
+            return self.finish_reject(out);
+        }
         self.last_i_ab = i_ab;
         // 3. Measured current in the estimated rotor frame.
         let rot_theta = Rotation::from_angle(estimate.theta);
@@ -846,20 +943,47 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             .current_error
             .step(tracking_error > self.resolved.current_error_limit);
 
-        // 4. Speed loop, injection (23) and current-vector limit.
+        // Reaction to a lost rotor (see `lock_reaction`).
+        let diag = &estimate.diagnostics;
+        let healthy = diag.lock == LockStatus::Locked && diag.mode == Mode::DisturbanceFeedback;
+        let action = self.lock.step(diag.lock == LockStatus::Lost, healthy);
+        match action {
+            LockAction::Realign => {
+                self.align(estimate.theta);
+                self.last.estimate = estimate;
+                return self.last;
+            }
+            LockAction::Rearm => self.estimator.rearm_lock_detector(),
+            // While recovering, the detector judges each sample afresh (its verdict is not
+            // latched), so that "healthy" means no symptom now.
+            LockAction::Coast if self.lock.recovering() && diag.lock == LockStatus::Lost => {
+                self.estimator.rearm_lock_detector()
+            }
+            LockAction::Restart => self.blocks.speed.reset(),
+            LockAction::Run | LockAction::Coast => {}
+        }
+        let action = match action {
+            LockAction::Rearm => LockAction::Coast,
+            a => a,
+        };
+        // 4. Speed loop, injection (23) and current-vector limit (zero current when coasting).
         let backup = self.blocks;
         let b = &mut self.blocks;
-        let Ok(iq_ref) = b.speed.step(
-            speed_ref_mech * T::lit(self.config.machine.pole_pairs as f64),
-            omega_ctrl,
-        ) else {
-            return self.reject_after_estimate(backup, estimate, i_dq);
+        let i_dq_ref = if action == LockAction::Coast {
+            Dq::zero()
+        } else {
+            let Ok(iq_ref) = b.speed.step(
+                speed_ref_mech * T::lit(self.config.machine.pole_pairs as f64),
+                omega_ctrl,
+            ) else {
+                return self.reject_after_estimate(backup, estimate, i_dq);
+            };
+            let mut id_ref = b.injection.step(iq_ref);
+            if self.resolved.mtpa {
+                id_ref += self.config.machine.mtpa_id(iq_ref);
+            }
+            limit_current_d_priority(Dq::new(id_ref, iq_ref), self.resolved.i_max)
         };
-        let mut id_ref = b.injection.step(iq_ref);
-        if self.resolved.mtpa {
-            id_ref += self.config.machine.mtpa_id(iq_ref);
-        }
-        let i_dq_ref = limit_current_d_priority(Dq::new(id_ref, iq_ref), self.resolved.i_max);
         // 5. Current loop (unlimited).
         let Ok(v_dq) = b.current.step(i_dq_ref, i_dq, omega_ctrl) else {
             return self.reject_after_estimate(backup, estimate, i_dq);
@@ -929,7 +1053,9 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
     /// Rejected sample: hold the duty, keep the estimator's clock with the last good current.
     fn reject(&mut self, i_abc: Abc<T>) -> DriveOutput<T> {
         let i_ab = i_abc.to_ab();
-        let i_ab = if i_ab.is_finite() {
+        let lim = self.resolved.plausible_current;
+        let plausible = (i_abc.a.abs() < lim) & (i_abc.b.abs() < lim) & (i_abc.c.abs() < lim);
+        let i_ab = if plausible && i_ab.is_finite() {
             i_ab
         } else {
             self.last_i_ab
@@ -994,6 +1120,11 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
     /// Samples rejected since the last reset.
     pub fn rejected_samples(&self) -> u32 {
         self.rejected_samples
+    }
+
+    /// Recoveries from a lost rotor started since the last reset (`lock_reaction` recover).
+    pub fn lock_recoveries(&self) -> u32 {
+        self.lock.attempts()
     }
 
     /// Samples each [`DriveFlags`] bit was raised since the last reset.

@@ -40,9 +40,18 @@ impl DriveFlags {
     pub const DC_LINK_LOW: Self = Self(1 << 5);
     /// FLAG_limit of the paper's Fig. 10: the estimator runs in limiter mode (not a fault).
     pub const LIMITER_MODE: Self = Self(1 << 6);
+    /// The estimator reports the rotor lost ([`crate::lock`], latched until the estimator is
+    /// re-aligned): the reason for [`COASTING`](Self::COASTING).
+    pub const LOCK_LOST: Self = Self(1 << 7);
+    /// The drive holds zero current (speed loop off) because the rotor was lost
+    /// (`lock_reaction` coast or recover; see [`crate::control::lock_reaction`]).
+    pub const COASTING: Self = Self(1 << 8);
+    /// This sample was refused as implausible (finite but beyond what the machine and
+    /// inverter can produce, see [`crate::plausibility`]); `INPUT_REJECTED` is set too.
+    pub const INPUT_IMPLAUSIBLE: Self = Self(1 << 9);
 
     /// Every flag with its name, in bit order (for tables and trace decoding).
-    pub const ALL: [(Self, &'static str); 7] = [
+    pub const ALL: [(Self, &'static str); 10] = [
         (Self::INPUT_REJECTED, "input_rejected"),
         (Self::TRIPPED, "tripped"),
         (Self::VOLTAGE_SATURATED, "voltage_saturated"),
@@ -50,6 +59,9 @@ impl DriveFlags {
         (Self::SENSOR_STUCK, "sensor_stuck"),
         (Self::DC_LINK_LOW, "dc_link_low"),
         (Self::LIMITER_MODE, "limiter_mode"),
+        (Self::LOCK_LOST, "lock_lost"),
+        (Self::COASTING, "coasting"),
+        (Self::INPUT_IMPLAUSIBLE, "input_implausible"),
     ];
 
     /// The flags that are faults (everything but saturation and limiter mode, which occur in
@@ -59,7 +71,10 @@ impl DriveFlags {
             | Self::TRIPPED.0
             | Self::CURRENT_ERROR.0
             | Self::SENSOR_STUCK.0
-            | Self::DC_LINK_LOW.0,
+            | Self::DC_LINK_LOW.0
+            | Self::LOCK_LOST.0
+            | Self::COASTING.0
+            | Self::INPUT_IMPLAUSIBLE.0,
     );
 
     /// The raw bits.

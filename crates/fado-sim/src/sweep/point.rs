@@ -14,13 +14,16 @@ use crate::profile::Profile;
 use crate::scenario;
 
 /// Metric columns of a row, after the axes and `status`, `passed`.
-pub const METRICS: [&str; 6] = [
+pub const METRICS: [&str; 9] = [
     "max_angle_error",
     "rms_angle_error",
     "max_angle_error_zero_speed",
     "rms_angle_error_zero_speed",
     "max_speed_error_rpm",
     "wall_seconds",
+    "max_angle_error_run",
+    "angle_error_exceeded_time",
+    "lock_lost_time",
 ];
 
 /// The configuration of one point: `base` with each `(name, value)` applied in order, then
@@ -187,6 +190,12 @@ pub struct PointResult {
     pub tripped: bool,
     /// Wall time of the point, s.
     pub wall_seconds: f64,
+    /// max |θ − θ̂| over the whole run with the gates on, rad (loss-of-lock label).
+    pub max_angle_error_run: f64,
+    /// First time |θ − θ̂| > 0.5 rad, s (NaN: never).
+    pub angle_error_exceeded_time: f64,
+    /// First time the drive reported the rotor lost, s (NaN: never).
+    pub lock_lost_time: f64,
 }
 
 impl PointResult {
@@ -209,10 +218,13 @@ impl PointResult {
             max_speed_error_rpm: f64::NAN,
             tripped: false,
             wall_seconds,
+            max_angle_error_run: f64::NAN,
+            angle_error_exceeded_time: f64::NAN,
+            lock_lost_time: f64::NAN,
         }
     }
 
-    pub(crate) fn metrics(&self) -> [f64; 6] {
+    pub(crate) fn metrics(&self) -> [f64; 9] {
         [
             self.max_angle_error,
             self.rms_angle_error,
@@ -220,6 +232,9 @@ impl PointResult {
             self.rms_angle_error_zero_speed,
             self.max_speed_error_rpm,
             self.wall_seconds,
+            self.max_angle_error_run,
+            self.angle_error_exceeded_time,
+            self.lock_lost_time,
         ]
     }
 }
@@ -304,6 +319,9 @@ pub fn run_point_until(
         max_speed_error_rpm: m.max_speed_error_rpm,
         tripped: m.tripped,
         wall_seconds: wall,
+        max_angle_error_run: m.max_angle_error_run,
+        angle_error_exceeded_time: m.angle_error_exceeded_time.unwrap_or(f64::NAN),
+        lock_lost_time: m.lock_lost_time.unwrap_or(f64::NAN),
     };
     // The zero-speed metrics are NaN-free by construction only when the band was visited;
     // judge divergence on the overall ones.
