@@ -34,7 +34,7 @@
 //! moves î_d = i_d·cos ε + i_q·sin ε, hence the reference, by (L̂d − L̂q)·i_q·ε. Together
 //! ∂e/∂R̂s = −(i_q/ω)·(1 + (L̂d − L̂q)·i_d/λa) = φ above. For L̂d = L̂q both reduce to the
 //! surface-magnet law (bit for bit: the branch that needs î_d is skipped). The estimator takes
-//! L̂d from the drive's model (`SensorlessEstimator::set_ld_hat`).
+//! L̂d from its machine model (`EstimatorConfig::machine`, `MachineModel::ld`).
 //!
 //! χ is the relative flux error a relative resistance error causes ("% of λf per % of Rs"):
 //! 1.4 at −90 r/min under 7.5 N·m for the paper's motor, 0.07 at 60 r/min without load. With
@@ -475,16 +475,6 @@ impl<T: Real> ResistanceAdaptation<T> {
     #[inline]
     pub(crate) fn commit(&mut self, state: ResistanceAdaptationState<T>) {
         self.state = state;
-    }
-
-    /// Replaces L̂d (H), keeping the state: the machine model's d-axis inductance for a salient
-    /// rotor. Refuses a negative or non-finite value and then changes nothing.
-    pub fn set_ld_hat(&mut self, ld_hat: T) -> Result<(), ConfigError> {
-        let ld = check::non_negative("ld_hat", ld_hat)?;
-        let saliency = check::finite("ld_hat", ld - self.config.lq_hat)?;
-        self.config.ld_hat = ld;
-        self.saliency = saliency;
-        Ok(())
     }
 
     /// R̂s now, Ω.
