@@ -878,6 +878,9 @@ mod tests {
             core::mem::size_of::<SensorlessEstimator<f64>>(),
         );
         std::println!("SensorlessEstimator<f32>: {s32} B, <f64>: {s64} B");
-        assert!(s32 <= 388, "{s32}");
+        // 388 B before issue 13; the integrand-offset law (ê, D̂ of the last sample, its
+        // config and counters), ∂R̂s/∂ê and L̂d in the R̂s adaptation add 76 B (measured 464 B;
+        // docs/firmware.md still gives the 388 B figure and the cycle counts before it).
+        assert!(s32 <= 464, "{s32}");
     }
 }
