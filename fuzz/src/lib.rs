@@ -148,6 +148,7 @@ impl EstimatorCase {
                     self.adaptation[4],
                     t.flux_linkage_adaptation_rate,
                 ),
+                offset_adaptation_rate: t.offset_adaptation_rate,
                 limiter_recentring: self.adaptation_flags[1].unwrap_or(t.limiter_recentring),
                 ..t
             },

@@ -184,6 +184,7 @@ class EstimatorConfig:
         rs_adaptation_min_ratio: float | None = None,
         rs_adaptation_max_ratio: float | None = None,
         flux_linkage_adaptation_rate: float | None = None,
+        offset_adaptation_rate: float | None = None,
         limiter_recentring: bool | None = None,
         plausible_current_ratio: float | None = None,
         plausible_voltage_ratio: float | None = None,
@@ -216,6 +217,7 @@ class EstimatorConfig:
         rs_adaptation_min_ratio: float | None = None,
         rs_adaptation_max_ratio: float | None = None,
         flux_linkage_adaptation_rate: float | None = None,
+        offset_adaptation_rate: float | None = None,
         limiter_recentring: bool | None = None,
         plausible_current_ratio: float | None = None,
         plausible_voltage_ratio: float | None = None,
@@ -287,6 +289,9 @@ class EstimatorConfig:
     @property
     def flux_linkage_adaptation_rate(self) -> float:
         """Rate of the λ̂f learning where R̂s is unobservable, in 1/s (0 = fixed λ̂f)."""
+    @property
+    def offset_adaptation_rate(self) -> float:
+        """With rs_adaptation: rate of the integrand-offset (voltage-offset) estimate while turning, in 1/s (0 = off)."""
     @property
     def limiter_recentring(self) -> bool:
         """In limiter mode, re-centre the common mode of λ1 and D̂ (fado's improvement)."""

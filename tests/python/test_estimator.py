@@ -137,14 +137,17 @@ def test_align_refuses_non_finite_arguments_naming_them() -> None:
 
 
 def test_salient_machine_uses_its_ld_and_lq() -> None:
-    """On an interior-magnet motor the start-up flux is λ̂f·e^{jθ0} + L̂q·i and the rotor
-    flux λ̂r = λ2 − L̂q·i (active flux): L̂q, not L̂d, multiplies the current."""
+    """On an interior-magnet motor the start-up flux is λ̂a·e^{jθ0} + L̂q·i with the active
+    flux λ̂a = λ̂f + (L̂d − L̂q)·i_d, and the rotor flux λ̂r = λ2 − L̂q·i: L̂q, not L̂d,
+    multiplies the current vector; L̂d only sets the magnitude of λ̂r."""
     ipm = fado.Machine.preset("ipmsm-2k2")
     assert ipm.salient and ipm.ld != ipm.lq
     est = fado.Estimator(ipm, theta0=0.2)
     est.align(0.2, i_alpha=2.0, i_beta=-1.0)
-    assert est.last.lambda1_alpha == pytest.approx(ipm.flux_linkage * math.cos(0.2) + ipm.lq * 2.0)
-    assert est.last.lambda1_beta == pytest.approx(ipm.flux_linkage * math.sin(0.2) - ipm.lq * 1.0)
+    i_d = 2.0 * math.cos(0.2) - 1.0 * math.sin(0.2)
+    active = ipm.flux_linkage + (ipm.ld - ipm.lq) * i_d
+    assert est.last.lambda1_alpha == pytest.approx(active * math.cos(0.2) + ipm.lq * 2.0)
+    assert est.last.lambda1_beta == pytest.approx(active * math.sin(0.2) - ipm.lq * 1.0)
     out = est.step(0.0, 0.0, 2.0, -1.0)
     assert out.lambda_r_alpha == pytest.approx(out.lambda2_alpha - ipm.lq * 2.0)
     assert out.lambda_r_beta == pytest.approx(out.lambda2_beta + ipm.lq * 1.0)

@@ -29,6 +29,7 @@ pub mod estimator;
 pub mod flux;
 pub mod frames;
 pub mod injection;
+pub mod integrand_offset;
 pub mod lock;
 pub mod machine;
 pub mod mode;

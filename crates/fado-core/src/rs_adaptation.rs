@@ -14,11 +14,27 @@
 //! (Åström & Wittenmark, *Adaptive Control*, 2nd ed., §5.2):
 //!
 //! ```text
-//!   φ  = ⟨−i/(jω̂), λ̂r/|λ̂r|⟩ ≈ −i_q/ω̂     (∂|λ̂r|/∂R̂s: the observer removes the DC part of −∫i)
-//!   e  = |λ̂r| − λ̂f ≈ (R̂s − Rs)·φ
+//!   λ̂a = λ̂f + (L̂d − L̂q)·î_d               (the active flux, the true |λ̂r| of eq. (5))
+//!   φ  = −(î_q/ω̂)·(1 + (L̂d − L̂q)·î_d/λ̂a)  (∂e/∂R̂s, derived below)
+//!   e  = |λ̂r| − λ̂a ≈ (R̂s − Rs)·φ
 //!   χ  = φ·R0/λ̂f,  ẽ = e/λ̂f                (dimensionless; R0 = configured R̂s)
 //!   dR̂s/dt = −γ·R0·ẽ·χ/(χ² + χ0²)   while |χ| ≥ χ0
 //! ```
+//!
+//! **General rotor, i_d ≠ 0** (î_d, î_q: the current in the estimated frame, d along λ̂r).
+//! The stator flux is e^{jθ}·(λf + Ld·i_d + j·Lq·i_q), so λ̂r = λ2 − L̂q·i of eq. (5) is
+//! e^{jθ}·λa with the active flux λa = λf + (Ld − Lq)·i_d (Boldea, Paicu & Andreescu, IEEE
+//! TPEL 23(5), 2008): on a salient rotor |λ̂r| is not λf, and a reference λ̂f would read
+//! (Ld − Lq)·i_d (MTPA, field weakening, the eq. (23) injection) as a resistance error of
+//! −(Ld − Lq)·i_d/φ — 9 % of Rs at −i_d = half the rated current on the 2.2 kW IPMSM of the
+//! tests. So the reference is λ̂a. The regressor: turning at ω, the integrand error
+//! −(R̂s − Rs)·i leaves the synchronous flux error −(R̂s − Rs)·i/(jω) (the observer removes
+//! only its DC part), in the rotor frame (R̂s − Rs)·(−i_q + j·i_d)/ω: along d it changes
+//! |λ̂r| by (R̂s − Rs)·(−i_q/ω); along q it turns λ̂r by ε = (R̂s − Rs)·i_d/(ω·λa), which
+//! moves î_d = i_d·cos ε + i_q·sin ε, hence the reference, by (L̂d − L̂q)·i_q·ε. Together
+//! ∂e/∂R̂s = −(i_q/ω)·(1 + (L̂d − L̂q)·i_d/λa) = φ above. For L̂d = L̂q both reduce to the
+//! surface-magnet law (bit for bit: the branch that needs î_d is skipped). The estimator takes
+//! L̂d from its machine model (`EstimatorConfig::machine`, `MachineModel::ld`).
 //!
 //! χ is the relative flux error a relative resistance error causes ("% of λf per % of Rs"):
 //! 1.4 at −90 r/min under 7.5 N·m for the paper's motor, 0.07 at 60 r/min without load. With
@@ -31,10 +47,10 @@
 //!
 //! **Standstill** (limiter mode, current along the flux, i.e. the eq. (23) injection at light
 //! load): the DC test of drive commissioning, done online. At standstill v_d = Rs·i_d +
-//! L·di_d/dt − ω·Lq·i_q, and the rotor flux induces nothing along d, so
+//! Ld·di_d/dt − ω·Lq·i_q, and the rotor flux induces nothing along d, so
 //!
 //! ```text
-//!   R_dc = ∫(v_d + ω̂·L̂q·i_q − L̂q·di_d/dt) / ∫i_d    (both integrals forget at ω_m)
+//!   R_dc = ∫(v_d + ω̂·L̂q·i_q − L̂d·di_d/dt) / ∫i_d    (both integrals forget at ω_m)
 //!   dR̂s/dt = γ_s·(R_dc − R̂s)                         while ∫i_d·R0/λ̂f ≥ χ0 (configured λ̂f)
 //! ```
 //!
@@ -42,13 +58,13 @@
 //! leaks δ·ω·λf of back-EMF into v_d). It needs no flux estimate, so it also works while the
 //! limiter clamps, and at start-up it corrects R̂s before the first rotation. The flux error
 //! that the R̂s error integrated before it was corrected lies along d too (the current did):
-//! if it shrank |λ̂r|, the estimator pulls |λ̂r| back up to λ̂f (a grown one is already
+//! if it shrank |λ̂r|, the estimator pulls |λ̂r| back up to λ̂a (a grown one is already
 //! bounded by the Fig. 6 limiter's circle) — the inner side of the limiter, valid only under
 //! these conditions. With a q-axis current (load at standstill) the flux error goes into the
 //! angle and nothing measures it: frozen there.
 //!
 //! Besides, where the turning law is frozen for lack of excitation (|χ| < χ0/2: no load, high
-//! speed), the flux-magnitude reference λ̂f itself can be learned from |λ̂r|
+//! speed), the flux-magnitude reference λ̂f itself can be learned from |λ̂r| − (L̂d − L̂q)·î_d
 //! ([`ResistanceAdaptationConfig::flux_linkage_rate`], off by default).
 //!
 //! Both laws are frozen while the trackers coast, on a mode change and on rejected samples.
@@ -99,8 +115,13 @@ pub struct ResistanceAdaptationConfig<T> {
     /// law waits until ∫i_d·R0/λ̂f (configured λ̂f) reaches it. Default 0.2 (ours \[A\]: a 1 % R̂s error then
     /// moves |λ̂r| by 0.2 %, the size of the estimator's ripple).
     pub excitation_floor: T,
-    /// L̂q in H, for the d-axis voltage at standstill. Default 2.63 mH (paper, V).
+    /// L̂q in H, for the d-axis voltage at standstill (the ω̂·L̂q·i_q term). Default 2.63 mH
+    /// (paper, V).
     pub lq_hat: T,
+    /// L̂d in H: the active flux λ̂f + (L̂d − L̂q)·i_d is the flux-magnitude reference of both
+    /// laws, and L̂d·di_d/dt the inductive d-axis voltage at standstill. Default 2.63 mH (paper,
+    /// V; = L̂q for the surface-magnet rotor).
+    pub ld_hat: T,
     /// γ_s in s⁻¹: rate at which R̂s follows the standstill estimate R_dc. Default 20 s⁻¹ (ours
     /// \[A\]: settles within the 0.1 s of injection before the paper's profiles start to turn).
     pub standstill_rate: T,
@@ -133,6 +154,7 @@ impl<T: Real> Default for ResistanceAdaptationConfig<T> {
             rate: T::lit(1.0),
             excitation_floor: T::lit(0.2),
             lq_hat: T::lit(2.63e-3),
+            ld_hat: T::lit(2.63e-3),
             standstill_rate: T::lit(20.0),
             standstill_memory_hz: T::lit(0.5),
             standstill_speed_hz: T::lit(0.25),
@@ -141,6 +163,15 @@ impl<T: Real> Default for ResistanceAdaptationConfig<T> {
             max_ratio: T::lit(2.0),
         }
     }
+}
+
+/// What the integrand-offset law (`crate::integrand_offset`) tells the adaptation each sample.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct OffsetContext<T> {
+    /// Δê this sample (V): R̂s drops what standstill tests read of it.
+    pub offset_change: Ab<T>,
+    /// The k_df mode has lasted long enough for the λ̂f law (past the hand-over transient).
+    pub flux_settled: bool,
 }
 
 /// Which law applies this sample (chosen by the estimator from its mode).
@@ -164,10 +195,15 @@ pub struct ResistanceAdaptationState<T> {
     pub flux_linkage_hat: T,
     /// Standstill: forgetting integral of i_d, A·s.
     pub charge_d: T,
-    /// Standstill: forgetting integral of v_d + ω̂·L̂q·i_q − L̂q·di_d/dt, V·s.
+    /// Standstill: forgetting integral of v_d + ω̂·L̂q·i_q − L̂d·di_d/dt, V·s.
     pub volt_seconds_d: T,
     /// Standstill: i_d of the last sample, A (for di_d/dt).
     pub i_d_prev: T,
+    /// ∂R̂s/∂ê in 1/A: how much of R̂s still comes from standstill DC tests, each of which
+    /// read a voltage offset ê along its d axis as ⟨ê, d̂⟩/i_d of resistance. Built by the
+    /// standstill law (unit/i_d at its rate), forgotten at the turning law's rate; when the
+    /// integrand-offset estimate ê moves by Δê, R̂s moves by −⟨Δê, ∂R̂s/∂ê⟩ (issue 13).
+    pub offset_sensitivity: Ab<T>,
 }
 
 impl<T: Real> ResistanceAdaptationState<T> {
@@ -180,6 +216,8 @@ impl<T: Real> ResistanceAdaptationState<T> {
             self.charge_d,
             self.volt_seconds_d,
             self.i_d_prev,
+            self.offset_sensitivity.alpha,
+            self.offset_sensitivity.beta,
         ])
     }
 }
@@ -191,6 +229,8 @@ pub struct ResistanceAdaptation<T> {
     config: ResistanceAdaptationConfig<T>,
     /// γ·Ts·R0.
     gain: T,
+    /// γ·Ts.
+    rate_ts: T,
     /// γ_s·Ts.
     standstill_gain: T,
     /// e^{−ω_m·Ts}.
@@ -198,6 +238,8 @@ pub struct ResistanceAdaptation<T> {
     /// 2π·standstill_speed_hz.
     standstill_omega: T,
     chi_per_phi: T,
+    /// L̂d − L̂q.
+    saliency: T,
     /// γ_f·Ts.
     flux_gain: T,
     floor_sq: T,
@@ -214,6 +256,8 @@ impl<T: Real> ResistanceAdaptation<T> {
         let r0 = check::non_negative("rs_initial", config.rs_initial)?;
         let lf = check::positive("flux_linkage_hat", config.flux_linkage_hat)?;
         check::non_negative("lq_hat", config.lq_hat)?;
+        check::non_negative("ld_hat", config.ld_hat)?;
+        check::finite("ld_hat", config.ld_hat - config.lq_hat)?;
         let flux_rate_f = check::non_negative("flux_linkage_rate", config.flux_linkage_rate)?;
         check::below(
             "flux_linkage_rate",
@@ -264,10 +308,12 @@ impl<T: Real> ResistanceAdaptation<T> {
         let mut a = Self {
             config,
             gain: rate * ts * r0,
+            rate_ts: rate * ts,
             standstill_gain: rate_s * ts,
             forget: (-(memory_w * ts)).exp(),
             standstill_omega: T::two_pi() * standstill_hz,
             chi_per_phi: r0 / lf,
+            saliency: config.ld_hat - config.lq_hat,
             flux_gain: flux_rate_f * ts,
             floor_sq: floor * floor,
             rs_min: min * r0,
@@ -303,7 +349,11 @@ impl<T: Real> ResistanceAdaptation<T> {
         if !inputs_finite {
             return self.state.rs_hat;
         }
-        let (next, _) = self.next_state(v_ab, i_drop, lambda_r, omega, regime);
+        let context = OffsetContext {
+            offset_change: Ab::zero(),
+            flux_settled: true,
+        };
+        let (next, _) = self.next_state(v_ab, i_drop, lambda_r, omega, regime, context);
         if next.is_finite() {
             self.commit(next);
         }
@@ -319,11 +369,20 @@ impl<T: Real> ResistanceAdaptation<T> {
         lambda_r: Ab<T>,
         omega: T,
         regime: AdaptationRegime,
+        context: OffsetContext<T>,
     ) -> (ResistanceAdaptationState<T>, Ab<T>) {
+        let (offset_change, settled) = (context.offset_change, context.flux_settled);
         let mut pull = Ab::zero();
         let mut next = ResistanceAdaptationState {
-            rs_hat: self.state.rs_hat,
+            rs_hat: min(
+                max(
+                    self.state.rs_hat - offset_change.dot(self.state.offset_sensitivity),
+                    self.rs_min,
+                ),
+                self.rs_max,
+            ),
             flux_linkage_hat: self.state.flux_linkage_hat,
+            offset_sensitivity: self.state.offset_sensitivity,
             ..ResistanceAdaptationState::default()
         };
         let mag_sq = lambda_r.norm_squared();
@@ -331,23 +390,43 @@ impl<T: Real> ResistanceAdaptation<T> {
             return (next, pull);
         }
         let mag = mag_sq.step_sqrt();
+        let lf = self.state.flux_linkage_hat;
+        let dl = self.saliency;
         if regime == AdaptationRegime::Rotating {
-            // χ = φ·R0/λ̂f with φ = ⟨−i/(jω̂), d⟩ = −i_q/ω̂ and i_q = (λ̂r × i)/|λ̂r|, as
+            // The reference is the active flux λ̂a = λ̂f + (L̂d − L̂q)·î_d and φ carries the
+            // sensitivity factor 1 + (L̂d − L̂q)·î_d/λ̂a (module docs); for L̂d = L̂q both are
+            // exactly λ̂f and 1, and the division for î_d is skipped.
+            let (reference, sensitivity) = if dl == T::zero() {
+                (lf, T::one())
+            } else {
+                let i_d = lambda_r.dot(i_drop) / mag;
+                let active = lf + dl * i_d;
+                // A non-positive (or NaN) reference: nothing to compare with.
+                if active.partial_cmp(&T::zero()) != Some(core::cmp::Ordering::Greater) {
+                    return (next, pull);
+                }
+                (active, T::one() + dl * i_d / active)
+            };
+            // χ = φ·R0/λ̂f with φ = −(i_q/ω̂)·sensitivity and i_q = (λ̂r × i)/|λ̂r|, as
             // χ = a/b: then χ/(χ² + χ0²) = a·b/(a² + χ0²·b²) costs one division, and
             // χ² ≥ χ0² is a² ≥ χ0²·b² (false for ω̂ = 0, which also rules out 0/0).
-            let a = -lambda_r.cross(i_drop) * self.chi_per_phi;
+            let a = -lambda_r.cross(i_drop) * self.chi_per_phi * sensitivity;
             let b = mag * omega;
             let (a_sq, floor_b_sq) = (a * a, self.floor_sq * b * b);
-            let lf = self.state.flux_linkage_hat;
             if a_sq >= floor_b_sq && floor_b_sq > T::zero() {
-                // ẽ·χ/(χ² + χ0²) with ẽ = (|λ̂r| − λ̂f)/λ̂f, in one division.
-                next.rs_hat -= self.gain * (mag - lf) * a * b / (lf * (a_sq + floor_b_sq));
-            } else if a_sq * T::lit(4.0) < floor_b_sq {
-                // |χ| < χ0/2: R̂s explains too little of |λ̂r| − λ̂f; the rest is λ̂f's.
+                // ẽ·χ/(χ² + χ0²) with ẽ = (|λ̂r| − λ̂a)/λ̂f, in one division.
+                let weight = a_sq / (a_sq + floor_b_sq);
+                next.rs_hat -= self.gain * (mag - reference) * a * b / (lf * (a_sq + floor_b_sq));
+                // The turning law replaces what the standstill tests contributed.
+                next.offset_sensitivity =
+                    self.state.offset_sensitivity * (T::one() - self.rate_ts * weight);
+            } else if a_sq * T::lit(4.0) < floor_b_sq && settled {
+                // |χ| < χ0/2: R̂s explains too little of |λ̂r| − λ̂a; the rest is λ̂f's (once
+                // the hand-over transient of |λ̂r| has passed: `settled`).
                 let lf0 = self.config.flux_linkage_hat;
                 next.flux_linkage_hat = min(
                     max(
-                        lf + self.flux_gain * (mag - lf),
+                        lf + self.flux_gain * (mag - reference),
                         lf0 * T::lit(FLUX_LINKAGE_MIN_RATIO),
                     ),
                     lf0 * T::lit(FLUX_LINKAGE_MAX_RATIO),
@@ -363,8 +442,7 @@ impl<T: Real> ResistanceAdaptation<T> {
                 return (next, pull);
             }
             let ts = self.config.ts;
-            let lq = self.config.lq_hat;
-            let v_d = unit.dot(v_ab) + omega * lq * i_q;
+            let v_d = unit.dot(v_ab) + omega * self.config.lq_hat * i_q;
             let first = self.state.charge_d == T::zero();
             let di_d = if first {
                 T::zero()
@@ -372,17 +450,21 @@ impl<T: Real> ResistanceAdaptation<T> {
                 i_d - self.state.i_d_prev
             };
             next.charge_d = self.state.charge_d * self.forget + i_d * ts;
-            next.volt_seconds_d = self.state.volt_seconds_d * self.forget + v_d * ts - lq * di_d;
+            next.volt_seconds_d =
+                self.state.volt_seconds_d * self.forget + v_d * ts - self.config.ld_hat * di_d;
             next.i_d_prev = i_d;
             if next.charge_d * self.chi_per_phi >= self.config.excitation_floor {
                 let r_dc = next.volt_seconds_d / next.charge_d;
                 next.rs_hat += self.standstill_gain * (r_dc - next.rs_hat);
+                let sensitivity = unit * (T::one() / i_d);
+                next.offset_sensitivity +=
+                    (sensitivity - next.offset_sensitivity) * self.standstill_gain;
             }
-            // The current only moved λ̂r radially, and the rotor flux is λf: pull a shrunken
-            // λ̂r back out (outside, the Fig. 6 limiter already bounds it at its circle;
-            // pulling it further in would only speed up the walk of a tangential integrand
-            // error along the circle, which goes as e_t/|λ̂r|).
-            let shortfall = min(mag - self.state.flux_linkage_hat, T::zero());
+            // The current only moved λ̂r radially, and the rotor flux is the active flux λ̂a:
+            // pull a shrunken λ̂r back out (outside, the Fig. 6 limiter already bounds it at
+            // its circle; pulling it further in would only speed up the walk of a tangential
+            // integrand error along the circle, which goes as e_t/|λ̂r|).
+            let shortfall = min(mag - (lf + dl * i_d), T::zero());
             pull = unit * (self.config.standstill_flux_rate * shortfall);
         }
         next.rs_hat = min(max(next.rs_hat, self.rs_min), self.rs_max);

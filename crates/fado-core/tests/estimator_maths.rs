@@ -97,11 +97,16 @@ fn k_df_bounds_the_drift_of_a_dc_integrand_error_and_a_pure_integrator_does_not(
     let e = Ab::new(0.04, -0.03); // |e| = 50 mV
     let seconds = 8.0;
     for rpm in [300.0, -300.0] {
-        let with = run_constant_speed(rpm, seconds, default_config(), e, Ab::zero());
+        // The paper's loop alone: the learned integrand offset (`offset_adaptation_rate`,
+        // ours) would remove e before k_df sees it (tests/integrand_offset.rs).
+        let with = run_constant_speed(rpm, seconds, paper_loop(), e, Ab::zero());
         let without = run_constant_speed(
             rpm,
             seconds,
-            config_with(|c| c.tuning.k_df = 0.0),
+            config_with(|c| {
+                c.tuning.k_df = 0.0;
+                c.tuning.offset_adaptation_rate = 0.0;
+            }),
             e,
             Ab::zero(),
         );
@@ -342,7 +347,9 @@ fn notch_keeps_lambda2_centred_under_a_current_sensor_offset() {
     let i_off = Ab::new(0.2, -0.1); // 10× SPEC's sensor offsets
     let seconds = 8.0;
     for rpm in [300.0, -300.0] {
-        let run = run_constant_speed(rpm, seconds, default_config(), Ab::zero(), i_off);
+        // The paper's loop alone (the learned integrand offset, ours, would take −R̂s·i_off
+        // out of the integrand instead of leaving it to D̂).
+        let run = run_constant_speed(rpm, seconds, paper_loop(), Ab::zero(), i_off);
         let dc_lambda1 = mean(&run.lambda1, PERIOD_300);
         let dc_d = mean(&run.disturbance, PERIOD_300);
         let dc_lambda2 = mean(&run.lambda2, PERIOD_300);
@@ -408,4 +415,10 @@ fn f32_estimator_settles_at_plus_minus_300_and_30_rpm() {
             assert_eq!(mode, Mode::DisturbanceFeedback);
         }
     }
+}
+
+/// The default configuration without the learned integrand offset (ours), for the paper's
+/// eq. (22) DC loop.
+fn paper_loop() -> EstimatorConfig<f64> {
+    config_with(|c| c.tuning.offset_adaptation_rate = 0.0)
 }

@@ -177,6 +177,9 @@ config_class! {
     /// With `rs_adaptation`: rate of the λ̂f learning where R̂s is unobservable, in 1/s
     /// (0 = fixed λ̂f).
     flux_linkage_adaptation_rate: f64,
+    /// With `rs_adaptation`: rate of the integrand-offset (voltage-offset) estimate while
+    /// turning, in 1/s (0 = off).
+    offset_adaptation_rate: f64,
     /// In limiter mode, re-centre the common mode of λ1 and D̂ (our improvement, default
     /// true; false is the paper).
     limiter_recentring: bool,
@@ -227,6 +230,7 @@ impl PyEstimatorConfig {
             rs_adaptation_min_ratio: c.rs_adaptation_min_ratio,
             rs_adaptation_max_ratio: c.rs_adaptation_max_ratio,
             flux_linkage_adaptation_rate: c.flux_linkage_adaptation_rate,
+            offset_adaptation_rate: c.offset_adaptation_rate,
             limiter_recentring: c.limiter_recentring,
             plausible_current_ratio: c.plausible_current_ratio,
             plausible_voltage_ratio: c.plausible_voltage_ratio,
@@ -262,6 +266,7 @@ impl PyEstimatorConfig {
             rs_adaptation_min_ratio: T::lit(self.rs_adaptation_min_ratio),
             rs_adaptation_max_ratio: T::lit(self.rs_adaptation_max_ratio),
             flux_linkage_adaptation_rate: T::lit(self.flux_linkage_adaptation_rate),
+            offset_adaptation_rate: T::lit(self.offset_adaptation_rate),
             limiter_recentring: self.limiter_recentring,
             plausible_current_ratio: T::lit(self.plausible_current_ratio),
             plausible_voltage_ratio: T::lit(self.plausible_voltage_ratio),

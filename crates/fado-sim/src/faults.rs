@@ -8,6 +8,10 @@
 //!   (default 0 A) over `[start, start + duration)` (default 10 ms): a loose connector or a
 //!   sensor supply drop-out. Phase c is reconstructed from the stuck reading as −a − b, as the
 //!   drive's two-sensor hardware does.
+//! * `voltage_offset = [α, β]`: a constant stationary-frame voltage error in V, added to the
+//!   voltage the drive (and so its estimator) believes it applies — a phase-voltage or DC-link
+//!   measurement offset, an uncompensated inverter asymmetry. The plant receives the
+//!   inverter's voltage minus it while the gates are enabled (issue 13).
 //! * `[faults.dc_link_scale]`: the DC-link voltage as a fraction of its nominal value over
 //!   time, a piecewise-linear [`Profile`] (steps or ramps): a supply dip. It scales the
 //!   voltage the inverter applies and what the DC-link sensor reads alike.
@@ -16,6 +20,9 @@
 //! profile with two points at the same time.
 //!
 //! ```toml
+//! [faults]
+//! voltage_offset = [0.1, 0.0]
+//!
 //! [[faults.non_finite]]
 //! time = 2.0
 //! signal = "current_a"   # current_a | current_b | dc_link
@@ -133,6 +140,9 @@ pub struct FaultParams {
     pub non_finite: Vec<NonFiniteFault>,
     /// Stuck current-sensor channels.
     pub stuck_current: Vec<StuckCurrentFault>,
+    /// Constant α-β voltage error of the drive's voltage, V (the true voltage is the drive's
+    /// minus this). Default [0, 0].
+    pub voltage_offset: [f64; 2],
 }
 
 impl Default for FaultParams {
@@ -141,6 +151,7 @@ impl Default for FaultParams {
             dc_link_scale: Profile::constant(1.0),
             non_finite: Vec::new(),
             stuck_current: Vec::new(),
+            voltage_offset: [0.0, 0.0],
         }
     }
 }
@@ -158,6 +169,10 @@ impl FaultParams {
                     "the scale must be in (0, 2]",
                 ));
             }
+        }
+        for (k, v) in self.voltage_offset.iter().enumerate() {
+            check::finite("voltage_offset", *v)
+                .map_err(|e| SimConfigError::new(format!("voltage_offset[{k}]"), e.message))?;
         }
         for (k, f) in self.non_finite.iter().enumerate() {
             let key = |field: &str| format!("non_finite[{k}].{field}");
@@ -187,6 +202,7 @@ impl FaultParams {
         self.non_finite.is_empty()
             && self.stuck_current.is_empty()
             && self.dc_link_scale.points.iter().all(|p| p[1] == 1.0)
+            && self.voltage_offset == [0.0, 0.0]
     }
 }
 
@@ -207,6 +223,11 @@ impl Faults {
             ts,
             scale_cursor: 0,
         })
+    }
+
+    /// The constant α-β voltage error of the drive's voltage, V.
+    pub fn voltage_offset(&self) -> fado_core::Ab<f64> {
+        fado_core::Ab::new(self.params.voltage_offset[0], self.params.voltage_offset[1])
     }
 
     /// The parameters.
@@ -275,7 +296,21 @@ mod tests {
                 duration: 0.01,
                 value: 0.0,
             }],
+            voltage_offset: [0.0, 0.0],
         }
+    }
+
+    #[test]
+    fn voltage_offset_is_a_fault_and_must_be_finite() {
+        let mut p = FaultParams {
+            voltage_offset: [0.1, 0.0],
+            ..FaultParams::default()
+        };
+        assert!(!p.is_empty());
+        let f = Faults::new(p.clone(), 1e-4).unwrap();
+        assert_eq!(f.voltage_offset(), fado_core::Ab::new(0.1, 0.0));
+        p.voltage_offset[1] = f64::NAN;
+        assert_eq!(p.validate().unwrap_err().key, "voltage_offset[1]");
     }
 
     #[test]

@@ -270,6 +270,9 @@ pub struct Inverter {
     sample: u64,
     /// DC-link voltage as a fraction of its nominal value (fault injection, a supply dip).
     dc_link_scale: f64,
+    /// Subtracted from the applied α-β voltage while the gates are enabled (fault injection,
+    /// `[faults] voltage_offset`: the drive's voltage is this much above the true one), V.
+    voltage_offset: Ab<f64>,
 }
 
 impl Inverter {
@@ -285,6 +288,7 @@ impl Inverter {
             legs: [Leg::default(); 3],
             sample: 0,
             dc_link_scale: 1.0,
+            voltage_offset: Ab::zero(),
         })
     }
 
@@ -313,6 +317,13 @@ impl Inverter {
     /// `crate::faults`).
     pub fn set_dc_link_scale(&mut self, scale: f64) {
         self.dc_link_scale = scale;
+    }
+
+    /// A constant α-β voltage error: while the gates are enabled the machine receives the
+    /// inverter's voltage minus `offset`, so the drive's (and its estimator's) voltage is the
+    /// true one plus `offset` (`crate::faults`). With the gates off nothing changes.
+    pub fn set_voltage_offset(&mut self, offset: Ab<f64>) {
+        self.voltage_offset = offset;
     }
 
     /// Runs one sample [n, n+1]: the duty loaded at the previous update acts now, and
@@ -376,7 +387,7 @@ impl Inverter {
         for k in 0..3 {
             p[k] = d[k] * vdc + self.params.averaged_error(iph[k], vdc);
         }
-        let v = clarke(p);
+        let v = clarke(p) - self.voltage_offset;
         let rot_h = cis(prop.omega() * self.ts);
         let i1 = prop.advance(i0, v, self.ts, rot0, rot_h);
         let mp = motor.params();
@@ -489,7 +500,7 @@ impl Inverter {
             let h = t_next - t;
             if h > 0.0 {
                 let poles = [self.legs[0].pole, self.legs[1].pole, self.legs[2].pole];
-                let v = self.pole_voltages(poles, iph, vdc);
+                let v = self.pole_voltages(poles, iph, vdc) - self.voltage_offset;
                 let rot_h = cis(omega * h);
                 i = prop.advance_ab(i, v, h, rot, rot_h);
                 rot *= rot_h;

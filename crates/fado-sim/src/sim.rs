@@ -99,7 +99,7 @@ impl Plant {
     pub fn new(params: &PlantParams, theta0: f64) -> Result<Self, SimConfigError> {
         params.validate()?;
         let s = |e: SimConfigError, sec: &str| e.in_section(sec);
-        Ok(Self {
+        let mut plant = Self {
             motor: Motor::new(params.motor, theta0).map_err(|e| s(e, "motor"))?,
             inverter: Inverter::new(params.inverter.clone()).map_err(|e| s(e, "inverter"))?,
             current_sensor: CurrentSensor::new(params.current_sensor.clone())
@@ -117,7 +117,11 @@ impl Plant {
                         .map_err(|e| s(e, "faults"))?,
                 )
             },
-        })
+        };
+        if let Some(f) = &plant.faults {
+            plant.inverter.set_voltage_offset(f.voltage_offset());
+        }
+        Ok(plant)
     }
 
     /// The machine (true state).

@@ -1,0 +1,230 @@
+//! Online estimate of a constant integrand error ê (a stationary-frame voltage offset, beyond
+//! the paper), learned while turning and subtracted from the flux integrand in both modes.
+//!
+//! Why: a constant error e in the voltage the estimator is given (a phase-voltage or DC-link
+//! measurement offset, an inverter asymmetry, R̂s times a current-sensor offset) is a DC
+//! integrand error. Turning, the disturbance observer takes it as the DC disturbance and the
+//! k_df feedback balances it (D̂ → e/k_df, eq. (21)-(22)); but below the Fig. 3 threshold the
+//! limiter mode has nothing against it: its radial part is clamped by the Fig. 6 circle, its
+//! tangential part turns λ̂r at e_t/|λ̂r| (0.1 V on the paper's motor: 1.1 rad/s), so a
+//! 0.1 V offset costs the Fig. 11 reversal over a radian.
+//!
+//! The error is observable while turning, where the observer separates the DC from the rotating
+//! flux: with the integrand v − R̂s·i − k_df·D̂ − ê, the DC balance of λ1 (which D̂ tracks,
+//! its observer poles being at |ω̂| ≫ the rates here) is dD̂/dt = e − ê − k_df·D̂, so
+//! dD̂/dt + k_df·D̂ measures e − ê. The law
+//!
+//! ```text
+//!   ê[n] = ê[n−1] + k_e·((D̂[n] − D̂[n−1]) + k_df·Ts·D̂[n])      (k_df mode, turning)
+//! ```
+//!
+//! gives dê/dt = k_e·(e − ê): a first-order estimate of e at rate k_e, independent of k_df.
+//! Seen from λ1 it is a PI disturbance feedback (k_df + k_e)·D̂ + k_e·k_df·∫D̂ whose DC loop
+//! (s + k_df)(s + k_e) has two real poles — the integral action that drift-compensated flux
+//! estimators add against offsets (Holtz & Quan, "Drift- and parameter-compensated flux
+//! estimator for persistent zero-stator-frequency operation of sensorless-controlled
+//! induction motors", IEEE TIA 39(4), 2003, estimate the offset vector from the flux
+//! trajectory's centre the same way). At the rotating frequency D̂ does not respond, so the
+//! paper's exact integration at ω (SPEC §2) is kept. In the limiter mode ê is held and still
+//! subtracted: the offset learned at speed no longer walks the angle at standstill. What it
+//! cannot know are DC errors that appear only at standstill (the dead-time residual and R̂s
+//! errors times a current that is constant in α-β there); those are the limiter's, as before.
+//!
+//! |ê| is bounded by the back-EMF at the Fig. 3 threshold speed, λ̂f·2π·f_th: a larger offset
+//! would make the limiter mode useless anyway, and the bound keeps a hand-over transient from
+//! leaving a large ê behind.
+
+use crate::error::{ConfigError, check};
+use crate::{Ab, Real};
+
+/// Configuration of [`IntegrandOffset`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct IntegrandOffsetConfig<T> {
+    /// Sampling period Ts in s. Default 100 µs (paper, V).
+    pub ts: T,
+    /// k_e in s⁻¹: the rate at which ê follows the integrand's DC error while turning, 0 = off.
+    /// Default 2 s⁻¹ (ours \[A\]: ≈ 5 time constants within the 2.5 s the Fig. 11 profile
+    /// turns before its reversal; well below the observer's |ω̂| ≥ 2π·1.3 rad/s in the k_df
+    /// mode, so that D̂ tracks the DC of λ1 as the law assumes).
+    pub rate: T,
+    /// The law starts only after this long in the k_df mode without interruption, s: D̂
+    /// re-converges after each hand-over with the observer's poles at |ω̂| (SPEC §2), and
+    /// that transient is not an integrand error. Default 0.53 s = 5/(2π·1.5 Hz), five
+    /// observer time constants at the Fig. 3 threshold (ours \[A\]; the estimator sets it
+    /// from its threshold).
+    pub settle_time: T,
+    /// Bound of |ê| in V. Default 0.83 V = λ̂f·2π·1.5 Hz (the paper's motor at the Fig. 3
+    /// threshold; the estimator sets it from its λ̂f and threshold).
+    pub limit: T,
+}
+
+impl<T: Real> Default for IntegrandOffsetConfig<T> {
+    fn default() -> Self {
+        Self {
+            ts: T::lit(100e-6),
+            rate: T::lit(2.0),
+            settle_time: T::lit(5.0 / (2.0 * core::f64::consts::PI * 1.5)),
+            limit: T::lit(0.088 * 2.0 * core::f64::consts::PI * 1.5),
+        }
+    }
+}
+
+/// State of the offset estimate after one sample.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct IntegrandOffsetState<T> {
+    /// ê in V (α-β).
+    pub offset: Ab<T>,
+    /// D̂ of the last learning sample, Wb.
+    pub disturbance_prev: Ab<T>,
+    /// Samples in the learning regime without interruption (saturating).
+    pub learning_samples: u32,
+}
+
+impl<T: Real> IntegrandOffsetState<T> {
+    /// True when every field is finite.
+    #[inline]
+    pub fn is_finite(&self) -> bool {
+        self.offset.is_finite() && self.disturbance_prev.is_finite()
+    }
+}
+
+/// The law of the module docs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct IntegrandOffset<T> {
+    config: IntegrandOffsetConfig<T>,
+    limit_sq: T,
+    /// `settle_time` in samples (at least 1, so that `disturbance_prev` is valid).
+    settle_samples: u32,
+    state: IntegrandOffsetState<T>,
+}
+
+impl<T: Real> IntegrandOffset<T> {
+    /// Checks every field (the error names it) and starts at ê = 0.
+    pub fn new(config: IntegrandOffsetConfig<T>) -> Result<Self, ConfigError> {
+        let ts = check::positive("ts", config.ts)?;
+        let rate = check::non_negative("rate", config.rate)?;
+        check::below("rate", rate * ts, T::one(), "with rate·ts below 1")?;
+        let limit = check::non_negative("limit", config.limit)?;
+        // A float-to-integer `as` saturates: an absurdly long wait is u32::MAX samples.
+        let settle = check::non_negative("settle_time", config.settle_time)? / ts;
+        Ok(Self {
+            config,
+            limit_sq: limit * limit,
+            settle_samples: (settle.ceil().to_f64() as u32).max(1),
+            state: IntegrandOffsetState::default(),
+        })
+    }
+
+    /// ê back to 0.
+    pub fn reset(&mut self) {
+        self.state = IntegrandOffsetState::default();
+    }
+
+    /// The state after one more sample: `disturbance` is D̂ of this sample, `feedback_gain`
+    /// the k_df gain in effect, `shift` the common-mode shift the estimator then applies to
+    /// λ1, the observer and D̂ (D̂ after this sample is `disturbance − shift`), `learning`
+    /// whether the law runs (the k_df mode, turning).
+    #[inline]
+    pub fn next_state(
+        &self,
+        disturbance: Ab<T>,
+        feedback_gain: T,
+        shift: Ab<T>,
+        learning: bool,
+    ) -> IntegrandOffsetState<T> {
+        let mut next = IntegrandOffsetState {
+            offset: self.state.offset,
+            disturbance_prev: disturbance - shift,
+            learning_samples: if learning {
+                self.state.learning_samples.saturating_add(1)
+            } else {
+                0
+            },
+        };
+        if learning
+            && self.state.learning_samples >= self.settle_samples
+            && self.config.rate > T::zero()
+        {
+            let innovation = (disturbance - self.state.disturbance_prev)
+                + disturbance * (feedback_gain * self.config.ts);
+            let offset = self.state.offset + innovation * self.config.rate;
+            let n2 = offset.norm_squared();
+            next.offset = if n2 > self.limit_sq {
+                offset * (self.limit_sq / n2).sqrt()
+            } else {
+                offset
+            };
+        }
+        next
+    }
+
+    /// Takes a state computed by [`Self::next_state`] (which the caller checked is finite).
+    #[inline]
+    pub fn commit(&mut self, state: IntegrandOffsetState<T>) {
+        self.state = state;
+    }
+
+    /// True once the k_df mode has lasted `settle_time` without interruption (D̂ and |λ̂r|
+    /// are past the hand-over transient).
+    #[inline]
+    pub fn settled(&self) -> bool {
+        self.state.learning_samples >= self.settle_samples
+    }
+
+    /// Samples in the k_df mode without interruption so far (saturating).
+    #[inline]
+    pub fn learning_samples(&self) -> u32 {
+        self.state.learning_samples
+    }
+
+    /// ê now, V.
+    #[inline]
+    pub fn offset(&self) -> Ab<T> {
+        self.state.offset
+    }
+
+    /// The configuration in use.
+    pub fn config(&self) -> &IntegrandOffsetConfig<T> {
+        &self.config
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn follows_the_dc_balance_at_its_rate_and_is_bounded() {
+        // A pure DC loop: dλ/dt = e − ê − k_df·λ, D̂ = λ. ê must reach e at rate k_e.
+        let (ts, k_df, e) = (1e-4_f64, 0.5, Ab::new(0.1, -0.05));
+        let mut law = IntegrandOffset::new(IntegrandOffsetConfig {
+            ts,
+            settle_time: 0.0,
+            ..Default::default()
+        })
+        .unwrap();
+        let mut lambda = Ab::zero();
+        let n = (1.0 / ts) as usize;
+        for _ in 0..n {
+            lambda += (e - law.offset() - lambda * k_df) * ts;
+            let s = law.next_state(lambda, k_df, Ab::zero(), true);
+            law.commit(s);
+        }
+        // After 1 s at k_e = 2 s⁻¹ the error is e^{−2} of e (to the Euler step).
+        let left = (e - law.offset()).norm() / e.norm();
+        assert!((left - (-2.0f64).exp()).abs() < 0.01, "{left}");
+        // Bounded: a huge error saturates at the limit.
+        let s = law.next_state(Ab::new(1e3, 0.0), k_df, Ab::zero(), true);
+        assert!((s.offset.norm() - law.config().limit).abs() < 1e-12);
+        // Not learning: held.
+        let s = law.next_state(Ab::new(1e3, 0.0), k_df, Ab::zero(), false);
+        assert_eq!(s.offset, law.offset());
+        assert!(
+            IntegrandOffset::<f64>::new(IntegrandOffsetConfig {
+                rate: -1.0,
+                ..Default::default()
+            })
+            .is_err()
+        );
+    }
+}
