@@ -181,7 +181,7 @@ impl AtomicFile {
         OutputError::new("write", &self.target, e)
     }
 
-    /// Flushes and syncs the data to disk, without renaming yet (see [`rename`](Self::rename)):
+    /// Flushes and syncs the data to disk, without renaming yet (see `rename`):
     /// after this, only the rename is left, which needs no space.
     pub fn finish(mut self) -> Result<Finished, OutputError> {
         let w = self.writer.take().expect("written once");

@@ -1,5 +1,5 @@
 //! One point of a sweep: its values applied to the base configuration (TOML keys and the
-//! derived [`PARAMETERS`](super::PARAMETERS)), run guarded, its outcome a [`PointResult`].
+//! derived [`PARAMETERS`]), run guarded, its outcome a [`PointResult`].
 
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
@@ -166,7 +166,7 @@ impl Status {
 /// One point's outcome: a row of `sweep.csv`.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct PointResult {
-    /// Index of the point in [`SweepSpec::points`].
+    /// Index of the point in [`SweepSpec::points`](super::SweepSpec::points).
     pub index: usize,
     /// The point's values, one per axis.
     pub values: Vec<Value>,
