@@ -8,7 +8,7 @@ use std::time::{Duration, Instant};
 
 const BIN: &str = env!("CARGO_BIN_EXE_fado-sim");
 /// Columns of traces.csv.
-const COLUMNS: usize = 39;
+const COLUMNS: usize = fado_sim::sim::TraceRow::COLUMNS.len();
 
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("fado-cli-{name}-{}", std::process::id()));
