@@ -73,6 +73,12 @@ impl Default for SimulationSettings {
 impl SimulationSettings {
     fn validate(&self) -> Result<(), SimConfigError> {
         check::in_range("duration", self.duration, 0.0, 1e5)?;
+        if self.duration <= 0.0 {
+            return Err(SimConfigError::new(
+                "duration",
+                format!("must be > 0, got {}", self.duration),
+            ));
+        }
         if self.decimation == 0 {
             return Err(SimConfigError::new("decimation", "must be ≥ 1"));
         }
@@ -322,7 +328,10 @@ impl SimConfig {
                 e.in_section("motor")
             }
         })?;
-        self.model_checked()?;
+        let ts = self.inverter.sample_period();
+        check_time_constant(&self.motor, ts, |k| format!("motor.{k}"))?;
+        let model = self.model_checked()?;
+        check_time_constant(&model, ts, |k| self.model_key(k))?;
         self.estimator_config()
             .validate()
             .map_err(|e| self.core_error("estimator", e))?;
@@ -367,6 +376,26 @@ impl SimConfig {
         model.dc_voltage = self.inverter.dc_voltage;
         model.validate().map_err(|e| self.core_error("model", e))?;
         Ok(model)
+    }
+
+    /// The key a user wrote for the model's field `k`: `model.k` when `[model]` gives it,
+    /// else `mismatch.k_ratio` when that ratio is not 1, else the plant's `motor.k`.
+    fn model_key(&self, k: &str) -> String {
+        if self.model.as_ref().is_some_and(|t| t.contains_key(k)) {
+            return format!("model.{k}");
+        }
+        let m = &self.mismatch;
+        let ratio = match k {
+            "rs" => m.rs_ratio,
+            "ld" => m.ld_ratio,
+            "lq" => m.lq_ratio,
+            _ => 1.0,
+        };
+        if ratio != 1.0 {
+            format!("mismatch.{k}_ratio")
+        } else {
+            format!("motor.{k}")
+        }
     }
 
     /// The drive's model of the motor (`[model]`, or `[motor]` × `[mismatch]`). A `[model]`
@@ -488,6 +517,35 @@ impl SimConfig {
     pub fn from_toml(text: &str) -> Result<SimConfig, SimConfigError> {
         Self::from_toml_over(&SimConfig::default(), text)
     }
+}
+
+/// The electrical time constant min(Ld, Lq)/Rs must span at least two sampling periods: a
+/// faster machine cannot be current-controlled at this rate (and the controllers' derived
+/// limits would otherwise refuse a key the user never wrote). The error names the field that
+/// is off: an inductance below 0.1 µH, else the resistance.
+fn check_time_constant(
+    m: &MachineModel<f64>,
+    ts: f64,
+    key: impl Fn(&str) -> String,
+) -> Result<(), SimConfigError> {
+    let l = m.ld.min(m.lq);
+    let tau = l / m.rs;
+    if tau >= 2.0 * ts {
+        return Ok(());
+    }
+    let field = if l < 1e-7 {
+        if m.ld <= m.lq { "ld" } else { "lq" }
+    } else {
+        "rs"
+    };
+    Err(SimConfigError::new(
+        key(field),
+        format!(
+            "the electrical time constant min(Ld, Lq)/Rs = {tau:.3e} s must be at least two \
+             sampling periods ({:.3e} s): check the units of rs, ld and lq",
+            2.0 * ts
+        ),
+    ))
 }
 
 fn merge(base: &mut toml::Table, over: toml::Table) {
@@ -680,6 +738,19 @@ mod located_errors {
         assert_eq!((key.as_str(), line, col), ("motorr", 1, 2));
         let (key, line, _, _) = err("[simulation]\ndecimation = 2.5\n");
         assert_eq!((key.as_str(), line), ("simulation.decimation", 2));
+    }
+
+    #[test]
+    fn derived_limits_name_the_users_own_key() {
+        // Issue 15's probes: before, each was refused as `controller.current_anti_windup_ratio`.
+        let (key, line, col, _) = err("[motor]\nrs = 1e300\n");
+        assert_eq!((key.as_str(), line, col), ("motor.rs", 2, 6));
+        let (key, line, _, _) = err("[motor]\nld = 1e-300\n");
+        assert_eq!((key.as_str(), line), ("motor.ld", 2));
+        let (key, line, _, _) = err("[mismatch]\nrs_ratio = 1e300\n");
+        assert_eq!((key.as_str(), line), ("mismatch.rs_ratio", 2));
+        let (key, line, _, msg) = err("[simulation]\nduration = 0.0\n");
+        assert_eq!((key.as_str(), line), ("simulation.duration", 2), "{msg}");
     }
 
     #[test]
