@@ -105,8 +105,8 @@ fn scaled_to_end_at(p: &Profile, end: f64) -> Profile {
 }
 
 /// Rewrites the speed reference's reversal (the first segment whose end points have opposite
-/// signs) to slope `rate` r/min per s, keeping its start; later points and the run's end move
-/// by the change of its duration.
+/// signs) to slope `rate` r/min per s, keeping its start; later points, and the run's end if
+/// it lies after the reversal, move by the change of its duration.
 fn set_reversal_ramp(cfg: &mut SimConfig, rate: f64) -> Result<(), SimConfigError> {
     if rate <= 0.0 {
         return Err(SimConfigError::new(
@@ -128,7 +128,10 @@ fn set_reversal_ramp(cfg: &mut SimConfig, rate: f64) -> Result<(), SimConfigErro
     for p in &mut pts[k..] {
         p[0] += shift;
     }
-    cfg.simulation.duration = (cfg.simulation.duration + shift).max(0.0);
+    // A run that ends before the reversal's end keeps its duration (it never sees the change).
+    if cfg.simulation.duration >= b[0] {
+        cfg.simulation.duration += shift;
+    }
     Ok(())
 }
 
