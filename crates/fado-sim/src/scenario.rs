@@ -173,7 +173,7 @@ pub const SCENARIOS: [Scenario; 10] = [
         scaled: true,
         setup: setup_rated_reversal,
         observe: observe_nothing,
-        checks: checks_rated_reversal,
+        checks: checks_reversal,
     },
 ];
 
@@ -376,32 +376,27 @@ fn setup_lowspeed(c: &mut SimConfig) {
     c.simulation.eval_start = LOWSPEED_START;
 }
 
-/// `reversal`: profile, load, duration, evaluation window.
-fn setup_reversal(c: &mut SimConfig) {
+/// fig11 in units of the ratings under `load` × the rated torque.
+fn setup_reversal_under(c: &mut SimConfig, load: f64) {
     let pts = Profile::from_points;
     let n_rated = c.motor.rated_speed_rpm;
     let t_rated = c.motor.rated_torque;
     // fig11 in units of the ratings: 90 r/min = 6 %, 7.5 N·m = 65.2 %.
     let n = REVERSAL_SPEED_RATIO * n_rated;
-    let load = SCALED_LOAD_RATIO;
     c.speed_reference = pts(&[(0.0, 0.0), (0.2, 0.0), (1.2, -n), (2.5, -n), (4.5, n)]);
     c.load.torque = pts(&[(1.2, 0.0), (1.7, load * t_rated)]);
     c.simulation.duration = 5.5;
     c.simulation.eval_start = 2.0;
 }
 
-/// `rated-reversal`: profile, load, duration, evaluation window.
+/// `reversal`: fig11 scaled, 65.2 % load.
+fn setup_reversal(c: &mut SimConfig) {
+    setup_reversal_under(c, SCALED_LOAD_RATIO);
+}
+
+/// `rated-reversal`: fig11 scaled, 100 % load.
 fn setup_rated_reversal(c: &mut SimConfig) {
-    let pts = Profile::from_points;
-    let n_rated = c.motor.rated_speed_rpm;
-    let t_rated = c.motor.rated_torque;
-    // fig11 in units of the ratings: 90 r/min = 6 %, 7.5 N·m = 65.2 %.
-    let n = REVERSAL_SPEED_RATIO * n_rated;
-    let load = 1.0;
-    c.speed_reference = pts(&[(0.0, 0.0), (0.2, 0.0), (1.2, -n), (2.5, -n), (4.5, n)]);
-    c.load.torque = pts(&[(1.2, 0.0), (1.7, load * t_rated)]);
-    c.simulation.duration = 5.5;
-    c.simulation.eval_start = 2.0;
+    setup_reversal_under(c, 1.0);
 }
 
 /// `stops`: profile, load, duration, evaluation window.
@@ -534,32 +529,6 @@ fn checks_lowspeed(_cfg: &SimConfig, _m: &Metrics, p: &ScenarioProbe, checks: &m
 
 /// `reversal`: pass criteria.
 fn checks_reversal(cfg: &SimConfig, m: &Metrics, _p: &ScenarioProbe, checks: &mut Vec<Check>) {
-    let band = SCALED_SPEED_ERROR_RATIO * cfg.motor.rated_speed_rpm;
-    checks.push(Check::at_most(
-        "max |θ − θ̂| near zero speed (rad)",
-        m.max_angle_error_zero_speed,
-        0.25,
-    ));
-    // 0.1 s of samples at least in the band (fig11: 0.67 s).
-    checks.push(Check::at_least(
-        "samples near zero speed",
-        m.zero_speed_samples as f64,
-        0.1 / cfg.inverter.sample_period(),
-    ));
-    checks.push(Check::at_most(
-        "max speed error (r/min)",
-        m.max_speed_error_rpm,
-        band,
-    ));
-}
-
-/// `rated-reversal`: pass criteria.
-fn checks_rated_reversal(
-    cfg: &SimConfig,
-    m: &Metrics,
-    _p: &ScenarioProbe,
-    checks: &mut Vec<Check>,
-) {
     let band = SCALED_SPEED_ERROR_RATIO * cfg.motor.rated_speed_rpm;
     checks.push(Check::at_most(
         "max |θ − θ̂| near zero speed (rad)",
