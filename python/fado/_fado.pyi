@@ -4,6 +4,7 @@ Import these names from ``fado``. ``tests/python/test_stubs.py`` runs ``mypy.stu
 this file, so it cannot drift from the module.
 """
 
+import inspect
 import os
 from typing import Any, ClassVar, Final, Literal, final
 
@@ -77,6 +78,7 @@ class Machine:
     """The motor's parameters and ratings (``fado_core::MachineModel``), validated."""
 
     fields: ClassVar[tuple[str, ...]]
+    __signature__: ClassVar[inspect.Signature]
     def __new__(
         cls,
         *,
@@ -162,6 +164,7 @@ class EstimatorConfig:
     """Tuning of the sensorless estimator; omitted fields take the Rust defaults."""
 
     fields: ClassVar[tuple[str, ...]]
+    __signature__: ClassVar[inspect.Signature]
     def __new__(
         cls,
         *,

@@ -491,3 +491,45 @@ def test_estimate_and_estimator_without_machine_raise_naming_it() -> None:
         fado.estimate(x, x, x, x, machine=None)  # type: ignore[arg-type]
     with pytest.raises(TypeError, match="machine"):
         fado.Estimator()  # type: ignore[call-arg]
+
+
+def test_fields_are_the_simulator_tables_keys() -> None:
+    # One schema: the Python fields are the serde records' keys, i.e. the keys fado-sim writes
+    # for its `[estimator]` and `[motor]` tables (plus the inverter's dc_voltage for a Machine).
+    import tomllib
+
+    dumped = tomllib.loads(fado.default_config("fig11"))
+    assert list(EstimatorConfig.fields) == list(dumped["estimator"])
+    assert list(fado.Machine.fields) == [*dumped["motor"], "dc_voltage"]
+    machine = fado.Machine.paper()
+    assert machine.dc_voltage == dumped["inverter"]["dc_voltage"]
+
+
+@pytest.mark.parametrize(
+    ("changes", "error", "field"),
+    [
+        ({"k_df": math.nan}, fado.ConfigError, "k_df"),
+        ({"bandwidth_definition": "minus3db"}, fado.ConfigError, "bandwidth_definition"),
+        ({"rs_adaptation": 1.0}, TypeError, "rs_adaptation"),
+        ({"k_af": [1.0]}, TypeError, "k_af"),
+    ],
+)
+def test_replace_refuses_naming_the_field(
+    changes: dict[str, object], error: type[Exception], field: str
+) -> None:
+    cfg = EstimatorConfig()
+    with pytest.raises(error, match=field):
+        cfg.replace(**changes)  # type: ignore[arg-type]
+    assert cfg == EstimatorConfig()
+
+
+def test_machine_counts_and_voltages_by_type() -> None:
+    paper = fado.Machine.paper()
+    with pytest.raises(TypeError, match="pole_pairs"):
+        paper.replace(pole_pairs=4.5)  # type: ignore[arg-type]
+    with pytest.raises(fado.ConfigError, match="pole_pairs"):
+        paper.replace(pole_pairs=-4)
+    with pytest.raises(TypeError, match="dc_voltage"):
+        paper.replace(dc_voltage="311")  # type: ignore[arg-type]
+    assert paper.replace(dc_voltage=540).dc_voltage == 540.0
+    assert paper.replace(rs=0.4).dc_voltage == paper.dc_voltage

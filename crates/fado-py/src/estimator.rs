@@ -315,9 +315,7 @@ impl PyEstimator {
             Engine::F32(e) => e.set_rs_hat(rs_hat as f32),
         }
         .map_err(|e| config_error(py, e))?;
-        let mut updated = self.machine.get().clone();
-        updated.rs = rs_hat;
-        self.machine = Py::new(py, updated)?;
+        self.machine = Py::new(py, self.machine.get().with_rs(rs_hat))?;
         Ok(())
     }
 

@@ -14,6 +14,7 @@
 //! - [`inputs`]: checks of the signal arrays; [`replay`]: the Python-free replay loop.
 //! - [`simulate`]: `simulate`, `SimResult`, `scenarios`, `default_config`: the closed-loop
 //!   simulator of `fado-sim` (the paper's Fig. 8–12) with the GIL released.
+//! - [`record`]: the Python view of a serde record of the core (fields, attributes, `dict`).
 //! - [`errors`]: `FadoError` and its subclasses.
 //! - [`interrupt`]: long calls run without the GIL and stop on Ctrl-C.
 //! - [`compare`]: `compare`, fado against the baseline estimators in the simulator.
@@ -27,6 +28,7 @@ pub mod inputs;
 pub mod interrupt;
 pub mod machine;
 pub mod outputs;
+pub mod record;
 pub mod replay;
 pub mod scalar;
 pub mod simulate;
@@ -72,6 +74,16 @@ pub mod _fado {
             parameters.set_item(name, meaning)?;
         }
         m.add("SWEEP_PARAMETERS", parameters)?;
+        // The records' attributes and signatures, named by their serde derive (`record`).
+        let py = m.py();
+        super::record::install(
+            &py.get_type::<super::config::PyEstimatorConfig>(),
+            super::config::PyEstimatorConfig::signature(py)?,
+        )?;
+        super::record::install(
+            &py.get_type::<super::machine::PyMachine>(),
+            super::machine::PyMachine::signature(py)?,
+        )?;
         Ok(())
     }
 }
