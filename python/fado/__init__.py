@@ -43,6 +43,13 @@ and profile (Rust on all cores, or one task per point on a process pool or Dask 
     df = fado.sweep({"rs_error": [-0.1, 0, 0.1], "load_torque": [0, 7.5]}, "fig11")
     fado.plot.envelope(df, "rs_error", "load_torque", path="envelope.png")
 
+Identify a motor with the commissioning procedure on the simulated plant (Rs, Ld, Lq, λf,
+J, B and the inverter's voltage error, each against the plant's truth)::
+
+    result = fado.commission("ipmsm-2k2")
+    result.machine, result.errors["rs"], result["i_alpha"]
+    fado.commissioning.plot(result, "commission.png")            # needs fado[plot]
+
 Errors derive from :class:`FadoError`; :class:`ConfigError` (a bad configuration field,
 named by ``.field``) and :class:`InputError` (a bad array or argument, named by
 ``.argument``) are also :class:`ValueError`.
@@ -51,8 +58,11 @@ named by ``.field``) and :class:`InputError` (a bad array or argument, named by
 from __future__ import annotations
 
 from fado._fado import (
+    COMMISSION_PHASES,
+    COMMISSION_TRACE_COLUMNS,
     OUTPUT_NAMES,
     TRACE_COLUMNS,
+    CommissionResult,
     ConfigError,
     EstimateResult,
     Estimator,
@@ -73,9 +83,13 @@ from fado._fado import (
 from fado._mode import Mode
 from fado._simulation import simulate
 from fado._sweep import sweep
-from fado import compare
+from fado import commissioning, compare
+from fado.commissioning import commission
 
 __all__ = [
+    "COMMISSION_PHASES",
+    "COMMISSION_TRACE_COLUMNS",
+    "CommissionResult",
     "OUTPUT_NAMES",
     "TRACE_COLUMNS",
     "ConfigError",
@@ -92,6 +106,8 @@ __all__ = [
     "__version__",
     "default_config",
     "describe_scenario",
+    "commission",
+    "commissioning",
     "compare",
     "estimate",
     "machine_presets",

@@ -37,11 +37,17 @@ __all__ = [
     "compare",
     "sweep",
     "sweep_point",
+    "commission",
+    "CommissionResult",
+    "COMMISSION_TRACE_COLUMNS",
+    "COMMISSION_PHASES",
 ]
 
 __version__: Final[str]
 OUTPUT_NAMES: Final[list[str]]
 TRACE_COLUMNS: Final[list[str]]
+COMMISSION_TRACE_COLUMNS: Final[list[str]]
+COMMISSION_PHASES: Final[list[str]]
 SWEEP_PARAMETERS: Final[dict[str, str]]
 MODE_LIMITER: Final[int]
 MODE_DISTURBANCE_FEEDBACK: Final[int]
@@ -566,3 +572,61 @@ def sweep_point(
     index: int = 0,
 ) -> dict[str, Any]:
     """One point of a sweep (GIL released): its row dict."""
+
+@final
+class CommissionResult:
+    """A commissioning run on the simulated plant: ``fado-sim commission``'s output."""
+
+    @property
+    def passed(self) -> bool: ...
+    @property
+    def status(self) -> str: ...
+    @property
+    def machine(self) -> Machine | None: ...
+    @property
+    def inverter_voltage(self) -> float | None: ...
+    @property
+    def threshold_voltage(self) -> float | None: ...
+    @property
+    def saliency(self) -> float | None: ...
+    @property
+    def simulated_seconds(self) -> float: ...
+    @property
+    def wall_seconds(self) -> float: ...
+    @property
+    def max_current(self) -> float: ...
+    @property
+    def max_current_reference(self) -> float: ...
+    @property
+    def current_limit(self) -> float: ...
+    @property
+    def rotor_motion_inductance(self) -> float: ...
+    @property
+    def config_toml(self) -> str: ...
+    @property
+    def identified_toml(self) -> str | None: ...
+    @property
+    def truth(self) -> dict[str, float]: ...
+    @property
+    def parameters(self) -> list[dict[str, Any]]: ...
+    @property
+    def errors(self) -> dict[str, float]: ...
+    @property
+    def confidence(self) -> dict[str, float]: ...
+    @property
+    def traces(self) -> dict[str, npt.NDArray[np.float64]]: ...
+    def __getitem__(self, name: str, /) -> npt.NDArray[np.float64]: ...
+    def __len__(self) -> int: ...
+
+def commission(
+    motor: _MachineLike,
+    *,
+    nameplate: _MachineLike | None = None,
+    config_toml: str | None = None,
+    seed: int = 1,
+    averaged: bool = False,
+    theta0: float = 1.0,
+    decimation: int = 10,
+    progress: bool = False,
+) -> CommissionResult:
+    """Run the commissioning procedure on the simulated plant (GIL released)."""

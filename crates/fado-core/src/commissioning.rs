@@ -32,9 +32,17 @@
 //!    to a constant voltage in the alignment hold, the DC measurement windows and the
 //!    injections: voltage mode leaves the machine's own resistance as the damping of the
 //!    rotor's swing (a fast current loop would remove it and the rotor would ring for
-//!    seconds; measured: ±15 r/min still after 1 s on the paper's motor). Its speed scales
-//!    with R/L: a motor with L/R ≫ 10 ms (the 5 kW PM-SyRM preset, 52 ms) is too slow for the
-//!    default settling time (known limitation).
+//!    seconds; measured: ±15 r/min still after 1 s on the paper's motor). A feedforward of the
+//!    reference, R̂·i* (nameplate) plus the dead-time part Td·f_sw·Vdc of the inverter error
+//!    (the configured dead time, SPEC §5's trapezoid), carries the bulk of the voltage, so
+//!    the integral only makes up the nameplate's error and the device threshold; being a
+//!    function of i*, not of i, it leaves the swing's damping unchanged. Without it a motor
+//!    whose inverter error dwarfs R·I (the 5 kW PM-SyRM preset: 4.9 V against 1 V) waits
+//!    for the integral to climb through the dead-time band while a fraction of an ampere
+//!    already swings the rotor (measured: `RotationDetected` in the DC test). The loop's
+//!    speed scales with R/L, so the alignment steps and the settling scale with the
+//!    nameplate's τ = L̄/R (defaults of [`CommissioningConfig::align_time`] and
+//!    [`CommissioningConfig::settle_time`]).
 //! 3. **Resistance** ([`Phase::Resistance`]): DC current along α at two levels I₁ = I₂/2, I₂ =
 //!    90 % of the limit (capped for reluctance rotors, see `dc_level`). With all three phase currents beyond the inverter's current band the
 //!    pole-voltage error is a constant V̂·sign(i_x) per phase, i.e. 4/3·V̂ on the α axis, so
@@ -222,10 +230,14 @@ pub struct CommissioningConfig<T> {
     pub spin_torque_ratio: T,
     /// Offset calibration in s. Default 0.1 s (1000 samples at 10 kHz).
     pub offset_time: T,
-    /// Alignment in s (each of its two steps, and the hold after). Default 0.3 s.
+    /// Alignment in s (each of its two steps, and the hold after). Default the larger of
+    /// 0.3 s and 12·τ, τ = ½(Ld + Lq)/Rs of the nameplate: the standstill loop's 2 % settling
+    /// time is 8·τ (ζ = 0.7, ωn = R/(√2·L)), plus margin for the rotor's swing.
     pub align_time: T,
-    /// Settling before each measurement in s. Default 0.25 s (the standstill loop settles
-    /// within 0.6 of it for a nameplate R/L off by 1.6× either way on every tested motor).
+    /// Settling before each measurement in s. Default the larger of 0.25 s (the standstill
+    /// loop settles within 0.6 of it for a nameplate R/L off by 1.6× either way on every
+    /// tested motor with τ ≤ 25 ms) and 10·τ (τ as for `align_time`; the 5 kW PM-SyRM
+    /// preset's τ = 52 ms).
     pub settle_time: T,
     /// Averaging window of each DC level, each injection and the coast, in s. Default 0.25 s.
     pub measure_time: T,
@@ -236,6 +248,7 @@ pub struct CommissioningConfig<T> {
 impl<T: Real> CommissioningConfig<T> {
     /// The defaults for a nameplate, sampling period and dead time.
     pub fn for_machine(nameplate: MachineModel<T>, sample_period: T, dead_time: T) -> Self {
+        let tau = T::lit(0.5) * (nameplate.ld + nameplate.lq) / nameplate.rs;
         Self {
             nameplate,
             sample_period,
@@ -247,8 +260,8 @@ impl<T: Real> CommissioningConfig<T> {
             spin_speed_ratio: T::lit(0.2),
             spin_torque_ratio: T::lit(0.1),
             offset_time: T::lit(0.1),
-            align_time: T::lit(0.3),
-            settle_time: T::lit(0.25),
+            align_time: T::lit(0.3).max(T::lit(12.0) * tau),
+            settle_time: T::lit(0.25).max(T::lit(10.0) * tau),
             measure_time: T::lit(0.25),
             phase_timeout: T::lit(5.0),
         }
@@ -563,6 +576,7 @@ pub struct Commissioning<T> {
     have_prev: bool,
     // Standstill regulator.
     v_int: Ab<T>,
+    v_ff: Ab<T>,
     i_ref: Ab<T>,
     err_par: T,
     err_perp: T,
@@ -686,6 +700,7 @@ impl<T: Real> Commissioning<T> {
             i_prev: Ab::zero(),
             have_prev: false,
             v_int: Ab::zero(),
+            v_ff: Ab::zero(),
             i_ref: Ab::zero(),
             err_par: T::zero(),
             err_perp: T::zero(),
@@ -753,6 +768,7 @@ impl<T: Real> Commissioning<T> {
         self.c2 = Ab::zero();
         self.have_prev = false;
         self.v_int = Ab::zero();
+        self.v_ff = Ab::zero();
         self.i_ref = Ab::zero();
         self.err_par = T::zero();
         self.err_perp = T::zero();
@@ -1020,7 +1036,13 @@ impl<T: Real> Commissioning<T> {
         } else {
             self.v_int + e * (self.k_int * ts)
         };
-        let v_pi = if frozen { v_int } else { v_int + e * self.k_p };
+        // Feedforward of the reference (module docs): the nameplate R·i* and the dead-time part
+        // Td·f_sw·Vdc of the inverter error, so that the slow integral only makes up the
+        // nameplate's error and the device threshold. It follows i*, not i: the rotor's swing
+        // still sees the machine's own resistance as damping.
+        let ff = self.standstill_feedforward();
+        let v_pi = if frozen { v_int } else { v_int + e * self.k_p } + ff;
+        self.v_ff = ff;
         let v = limit(v_pi + inj, v_max);
         if v != v_pi + inj {
             self.saturated_time += ts;
@@ -1116,6 +1138,14 @@ impl<T: Real> Commissioning<T> {
         v
     }
 
+    /// Standstill feedforward R̂·i* + Td·f_sw·Vdc·sat(i*_x/I_band) per phase (nameplate R̂ and
+    /// DC link, the configured dead time; I_band = 5 % of the limit).
+    fn standstill_feedforward(&self) -> Ab<T> {
+        let np = &self.cfg.nameplate;
+        let v_dt = self.cfg.dead_time * self.cfg.switching_frequency * np.dc_voltage;
+        self.i_ref * np.rs + dead_time_voltage(self.i_ref, T::lit(0.05) * self.i_limit, v_dt)
+    }
+
     /// The back-EMF that counts as rotation at standstill: that of 2 % of the rated speed on
     /// the nameplate flux.
     fn emf_limit(&self) -> T {
@@ -1182,7 +1212,8 @@ impl<T: Real> Commissioning<T> {
         // without the inverter error the compensation now supplies.
         let i1 = T::lit(0.5) * dc_level(&self.cfg.nameplate, self.i_limit);
         let comp = self.compensation(Dq::new(i1, T::zero()), T::zero());
-        self.pi_int = Dq::new(self.v_int.alpha - comp.alpha, self.v_int.beta - comp.beta);
+        let v0 = self.v_int + self.v_ff;
+        self.pi_int = Dq::new(v0.alpha - comp.alpha, v0.beta - comp.beta);
         self.theta_f = T::zero();
         self.omega_f = T::zero();
         self.pll_on = false;
@@ -1193,10 +1224,8 @@ impl<T: Real> Commissioning<T> {
     /// Dead-time compensation V̂·sat(i*_x/I_band) per phase of the reference current at the
     /// frame angle `angle` (SPEC §5's trapezoid; I_band = 5 % of the limit).
     fn compensation(&self, i_ref_dq: Dq<T>, angle: T) -> Ab<T> {
-        let i = i_ref_dq.to_ab(Rotation::from_angle(angle)).to_abc();
-        let band = T::lit(0.05) * self.i_limit;
-        let s = |x: T| clamp(x / band, -T::one(), T::one()) * self.v_inv;
-        Abc::new(s(i.a), s(i.b), s(i.c)).to_ab()
+        let i = i_ref_dq.to_ab(Rotation::from_angle(angle));
+        dead_time_voltage(i, T::lit(0.05) * self.i_limit, self.v_inv)
     }
 
     /// Back-EMF over the last sample interval: E = v − R̂·i − L̂q·Δi/Ts (module docs).
@@ -1452,6 +1481,14 @@ impl<T: Real> Commissioning<T> {
         self.phase = Phase::Done;
         self.i_ref = Ab::zero();
     }
+}
+
+/// The per-phase inverter voltage error model v·sat(i_x/band) of a current (SPEC §5's
+/// trapezoid), in α-β.
+fn dead_time_voltage<T: Real>(i_ab: Ab<T>, band: T, v: T) -> Ab<T> {
+    let i = i_ab.to_abc();
+    let s = |x: T| clamp(x / band, -T::one(), T::one()) * v;
+    Abc::new(s(i.a), s(i.b), s(i.c)).to_ab()
 }
 
 /// The upper DC-test (and alignment) current: 90 % of the limit, and for a rotor with Lq > Ld

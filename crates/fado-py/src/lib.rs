@@ -19,7 +19,10 @@
 //! - [`interrupt`]: long calls run without the GIL and stop on Ctrl-C.
 //! - [`compare`]: `compare`, fado against the baseline estimators in the simulator.
 //! - [`sweep`]: `sweep` and `sweep_point`, operating-envelope sweeps of the simulator.
+//! - [`commission`]: `commission`, `CommissionResult`: the commissioning procedure on the
+//!   simulated plant, identified against the plant's truth.
 
+pub mod commission;
 pub mod compare;
 pub mod config;
 pub mod errors;
@@ -41,6 +44,8 @@ use pyo3::prelude::*;
 /// Import from `fado`, not from here.
 #[pymodule]
 pub mod _fado {
+    #[pymodule_export]
+    use super::commission::{CommissionResult, commission};
     #[pymodule_export]
     use super::compare::compare;
     #[pymodule_export]
@@ -69,6 +74,11 @@ pub mod _fado {
         m.add("__version__", env!("CARGO_PKG_VERSION"))?;
         m.add("OUTPUT_NAMES", super::outputs::OUTPUT_NAMES.to_vec())?;
         m.add("TRACE_COLUMNS", super::simulate::trace_columns())?;
+        m.add(
+            "COMMISSION_TRACE_COLUMNS",
+            super::commission::COMMISSION_TRACE_COLUMNS.to_vec(),
+        )?;
+        m.add("COMMISSION_PHASES", super::commission::phase_names())?;
         let parameters = pyo3::types::PyDict::new(m.py());
         for (name, meaning) in fado_sim::sweep::PARAMETERS {
             parameters.set_item(name, meaning)?;

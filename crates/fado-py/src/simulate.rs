@@ -144,7 +144,7 @@ impl Motor {
     }
 
     /// The defaults with this motor.
-    fn base(&self) -> Result<SimConfig, SimConfigError> {
+    pub(crate) fn base(&self) -> Result<SimConfig, SimConfigError> {
         match self {
             Motor::Preset(p) => p.config(),
             Motor::Machine(m) => {

@@ -6,6 +6,8 @@
 //! phase currents and the measured DC-link voltage; it commands duties with the usual one
 //! sample of computational delay (see [`crate::sim`]).
 
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use fado_core::MachineModel;
@@ -106,10 +108,12 @@ pub struct CommissionOutcome {
     pub current_limit: f64,
     /// Largest |Δθ| of the rotor during the inductance tests, rad (electrical).
     pub rotor_motion_inductance: f64,
+    /// Stopped early by [`CommissionOptions::cancel`] (`status` is then `Running`).
+    pub cancelled: bool,
 }
 
 /// Options of a run.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct CommissionOptions {
     /// Initial rotor angle (electrical), rad. Default 1.0.
     pub theta0: f64,
@@ -117,6 +121,9 @@ pub struct CommissionOptions {
     pub decimation: usize,
     /// Hard stop in simulated seconds (beyond the procedure's own time-outs). Default 60 s.
     pub max_seconds: f64,
+    /// Set from another thread to stop the run within [`crate::sim::CANCEL_CHECK_SAMPLES`]
+    /// samples (Ctrl-C in Python). Default none.
+    pub cancel: Option<Arc<AtomicBool>>,
 }
 
 impl Default for CommissionOptions {
@@ -125,6 +132,7 @@ impl Default for CommissionOptions {
             theta0: 1.0,
             decimation: 10,
             max_seconds: 60.0,
+            cancel: None,
         }
     }
 }
@@ -155,6 +163,7 @@ pub fn commission(
     let mut theta_l: Option<f64> = None;
     let mut last_progress = -1.0;
     let mut k = 0u64;
+    let mut cancelled = false;
     let status = loop {
         let (i_abc, vdc, _) = plant.measure();
         let out = proc.step(i_abc, vdc);
@@ -196,6 +205,13 @@ pub fn commission(
         if k >= n_max {
             break Status::Running;
         }
+        if let Some(flag) = &options.cancel
+            && k.is_multiple_of(crate::sim::CANCEL_CHECK_SAMPLES)
+            && flag.load(Ordering::Relaxed)
+        {
+            cancelled = true;
+            break Status::Running;
+        }
     };
     Ok(CommissionOutcome {
         status,
@@ -208,6 +224,7 @@ pub fn commission(
         max_current_reference: max_ref,
         current_limit: proc.current_limit(),
         rotor_motion_inductance: motion,
+        cancelled,
     })
 }
 

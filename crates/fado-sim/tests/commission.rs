@@ -157,6 +157,23 @@ fn ipmsm_is_identified_within_the_targets() {
     check(&report("ipmsm", &p, m));
 }
 
+/// The strongly salient PM-SyRM preset (Lq/Ld 4.25, L/R 52 ms, inverter error 4.9 V against
+/// R·I 1 V): the standstill feedforward and the L/R-scaled settling (module docs of
+/// `fado_core::commissioning`) let it finish; it used to abort with `RotationDetected`.
+#[test]
+fn salient_pmsyrm_preset_is_identified_within_the_targets() {
+    let cfg = fado_sim::presets::find("pmsyrm-5k")
+        .unwrap()
+        .config()
+        .unwrap();
+    let p = cfg.plant();
+    let m = MachineModel {
+        dc_voltage: p.inverter.dc_voltage,
+        ..p.motor
+    };
+    check(&report("pmsyrm-5k", &p, m));
+}
+
 #[test]
 fn a_rough_nameplate_is_enough() {
     for k in [0.8, 1.25] {
@@ -203,4 +220,42 @@ fn any_initial_rotor_angle() {
             check(&o);
         }
     }
+}
+
+/// The cancel flag (Ctrl-C from Python) stops the run within `CANCEL_CHECK_SAMPLES` samples,
+/// reported as cancelled, without a result.
+#[test]
+fn cancel_flag_stops_the_run() {
+    use std::sync::Arc;
+    use std::sync::atomic::AtomicBool;
+    let (p, m) = paper();
+    let o = commission(
+        &p,
+        m,
+        CommissionOptions {
+            cancel: Some(Arc::new(AtomicBool::new(true))),
+            ..Default::default()
+        },
+        |_| {},
+        None,
+    )
+    .unwrap();
+    assert!(o.cancelled);
+    assert_eq!(o.status, Status::Running);
+    assert!(o.identification.is_none());
+    assert!(o.simulated_seconds <= fado_sim::sim::CANCEL_CHECK_SAMPLES as f64 * 1e-4 + 1e-9);
+    // Without the flag set, the same run finishes.
+    let o = commission(
+        &p,
+        m,
+        CommissionOptions {
+            cancel: Some(Arc::new(AtomicBool::new(false))),
+            ..Default::default()
+        },
+        |_| {},
+        None,
+    )
+    .unwrap();
+    assert!(!o.cancelled);
+    assert_eq!(o.status, Status::Done);
 }
