@@ -7,6 +7,10 @@ drive runs with, the trace, and bad input named by the user's own field or argum
 
 from __future__ import annotations
 
+import os
+import signal
+import threading
+import time
 from pathlib import Path
 
 import numpy as np
@@ -158,3 +162,27 @@ def test_plot_shows_every_phase(paper: fado.CommissionResult, tmp_path: Path) ->
     assert len(fig.axes) == 4
     labels = {t.get_text() for t in fig.axes[0].texts}
     assert {"resistance", "inductance_q", "coast", "inertia"} <= labels
+
+
+@pytest.mark.skipif(not hasattr(signal, "SIGINT") or os.name != "posix", reason="needs POSIX signals")
+def test_ctrl_c_stops_the_run() -> None:
+    # A 1 MHz switching plant (2 MHz sampling): 2.3 s of work on one core until its typed
+    # abort at 2 s simulated, over four times the 0.5 s budget (the default plant takes
+    # 50 ms, too short to interrupt).
+    fast = {"inverter": {"switching_frequency": 1.0e6, "dead_time": 0.1e-6}}
+    sent: dict[str, float] = {}
+
+    def fire() -> None:
+        sent["at"] = time.perf_counter()
+        os.kill(os.getpid(), signal.SIGINT)
+
+    timer = threading.Timer(0.4, fire)
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            fado.commission("paper", config=fast, decimation=1000)
+    finally:
+        timer.cancel()
+    assert time.perf_counter() - sent["at"] < 0.5
+    # The module still works afterwards.
+    assert fado.commission("paper").passed
