@@ -16,6 +16,7 @@ the plant's truth is known, so every identified parameter comes with its error::
 
 from __future__ import annotations
 
+import os
 from typing import TYPE_CHECKING, Any, Union
 
 import numpy as np
@@ -24,12 +25,9 @@ from fado import _fado
 from fado._simulation import ConfigLike, _config_path, config_text
 
 if TYPE_CHECKING:
-    import os
-    from collections.abc import Mapping
-
     from matplotlib.figure import Figure
 
-    MotorLike = Union[str, _fado.Machine, Mapping[str, Any]]
+    MotorLike = Union[str, _fado.Machine, dict[str, Any]]
 
 __all__ = ["PHASES", "commission", "plot"]
 
@@ -109,12 +107,15 @@ def plot(
     from fado.plot import _matplotlib
 
     figure_class, canvas_class = _matplotlib()
-    fig = figure_class(figsize=(11, 9))
+    fig = figure_class(figsize=(11.0, 9.0))
     canvas_class(fig)
-    axes = fig.subplots(4, 1, sharex=True)
+    axes = list(fig.subplots(4, 1, sharex=True))
     t = np.asarray(result["time"])
     phase = np.asarray(result["phase"]).astype(int)
-    col = lambda name: np.asarray(result[name])  # noqa: E731
+
+    def col(name: str) -> np.ndarray:
+        return np.asarray(result[name])
+
     ax_i, ax_v, ax_n, ax_th = axes
     ax_i.plot(t, col("i_alpha"), lw=0.8, label="i_α")
     ax_i.plot(t, col("i_beta"), lw=0.8, label="i_β")
@@ -150,5 +151,6 @@ def plot(
     fig.suptitle(f"{title} ({result.simulated_seconds:.2f} s)", fontsize=9)
     fig.tight_layout()
     if path is not None:
-        fig.savefig(path, dpi=120)
-    return fig
+        fig.savefig(os.fspath(path), dpi=120)
+    figure: Figure = fig
+    return figure
