@@ -958,6 +958,26 @@ impl<T: Real> SensorlessEstimator<T> {
         Ok(())
     }
 
+    /// Switches the R̂s adaptation ([`EstimatorTuning::rs_adaptation`], with its integrand-
+    /// offset law) on at run time, starting from the R̂s in use now; nothing changes if it is
+    /// on already. The drive's `recover` reaction does this after the paper's fixed R̂s lost
+    /// the rotor (see [`crate::control::lock_reaction`]). It stays on through
+    /// [`Self::reset`] and [`Self::align`] (the configuration now says so); a rebuilt
+    /// estimator starts as configured.
+    pub fn enable_rs_adaptation(&mut self) {
+        if self.config.tuning.rs_adaptation {
+            return;
+        }
+        self.config.machine.rs = self.integrator.config().rs_hat;
+        self.config.tuning.rs_adaptation = true;
+        self.offset_recentring_gain = self.config.tuning.offset_adaptation_rate * self.config.ts;
+        // Cannot fail: the same configuration was accepted by `new` with R̂s from it.
+        if let Ok(adaptation) = ResistanceAdaptation::new(self.config.rs_adaptation_config()) {
+            self.rs_adaptation = adaptation;
+        }
+        self.offset.reset();
+    }
+
     /// ê, the learned integrand offset (V, α-β; zero without `rs_adaptation`).
     pub fn integrand_offset(&self) -> Ab<T> {
         self.offset.offset()
@@ -991,6 +1011,10 @@ pub trait RotorAngleEstimator<T: Real> {
     /// estimate, so that the detector judges afresh (the drive's recovery, see
     /// [`crate::control::lock_reaction`]). Default: nothing to clear.
     fn rearm_lock_detector(&mut self) {}
+    /// Switches an online R̂s adaptation on, if the estimator has one (the drive's recovery
+    /// after a loss with a fixed R̂s, see [`crate::control::lock_reaction`]). Default:
+    /// nothing to switch.
+    fn enable_rs_adaptation(&mut self) {}
 }
 
 impl<T: Real> RotorAngleEstimator<T> for SensorlessEstimator<T> {
@@ -1009,6 +1033,9 @@ impl<T: Real> RotorAngleEstimator<T> for SensorlessEstimator<T> {
     }
     fn rearm_lock_detector(&mut self) {
         self.lock.reset();
+    }
+    fn enable_rs_adaptation(&mut self) {
+        SensorlessEstimator::enable_rs_adaptation(self)
     }
 }
 

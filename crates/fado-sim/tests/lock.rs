@@ -77,3 +77,49 @@ fn a_lost_rotor_is_flagged_and_a_matched_run_is_not() {
     assert!(matched.passed);
     assert_eq!(matched.metrics.lock_lost_time, None);
 }
+
+/// Issue 14's "recover" criterion: fig11 with the paper's fixed R̂s at +10 % error, reaction
+/// `recover` (defaults: the recovery switches the R̂s adaptation on), ends at the reference
+/// speed with the reason (`LOCK_LOST`, `COASTING`) in the flags; without switching the
+/// adaptation on, the restarted fixed-R̂s drive meets the same passage and does not.
+#[test]
+fn recover_ends_at_the_reference_speed_with_the_reason_logged() {
+    let run = |extra: &str| {
+        let toml = format!(
+            "[estimator]\nrs_adaptation = false\n[mismatch]\nrs_ratio = 1.1\n\
+             [controller]\nlock_reaction = \"recover\"\n{extra}"
+        );
+        let cfg = scenario_config("fig11", Some(&toml), false).unwrap();
+        let out = run_config("fig11", cfg, None).unwrap();
+        let time = out.trace.column("time").unwrap();
+        let speed = out.trace.column("speed_rpm").unwrap();
+        let reference = out.trace.column("speed_ref_rpm").unwrap();
+        let end = time.last().copied().unwrap();
+        let last: Vec<f64> = time
+            .iter()
+            .zip(speed.iter().zip(&reference))
+            .filter(|(t, _)| **t >= end - 0.2)
+            .map(|(_, (n, r))| n - r)
+            .collect();
+        let worst = last.iter().fold(0.0_f64, |m, e| m.max(e.abs()));
+        let flags = out.trace.rows.iter().fold(DriveFlags::NONE, |acc, r| {
+            acc | DriveFlags::from_bits(r.fault_flags)
+        });
+        (worst, flags, out.metrics)
+    };
+    let (worst, flags, m) = run("");
+    println!(
+        "recover: LOCK_LOST at {:?} s, |n − n*| over the last 0.2 s ≤ {worst:.1} r/min",
+        m.lock_lost_time
+    );
+    assert!(!m.tripped);
+    assert!(m.lock_lost_time.is_some());
+    assert!(
+        flags.contains(DriveFlags::LOCK_LOST | DriveFlags::COASTING),
+        "{flags:?}"
+    );
+    assert!(worst < 5.0, "{worst} r/min off the reference at the end");
+    let (worst_fixed, _, _) = run("lock_recovery_rs_adaptation = false\n");
+    println!("recover with the fixed R̂s: ≤ {worst_fixed:.1} r/min");
+    assert!(worst_fixed > 30.0, "{worst_fixed}");
+}

@@ -165,6 +165,11 @@ pub struct DriveTuning<T> {
     /// With `Recover`: recoveries since `reset` before the drive coasts for good. Default 3
     /// \[A\].
     pub lock_recovery_attempts: u32,
+    /// With `Recover`: switch the estimator's online R̂s adaptation on when a recovery starts
+    /// (see [`crate::control::lock_reaction`]). Default on \[A\]: the paper's fixed R̂s is
+    /// what loses the rotor in the loaded zero-speed passage (docs/lock.md), and restarting
+    /// with the same R̂s meets the same passage with the same error.
+    pub lock_recovery_rs_adaptation: bool,
 }
 
 impl<T: Real> DriveTuning<T> {
@@ -205,6 +210,7 @@ impl<T: Real> DriveTuning<T> {
             lock_recovery_time: U::lit(self.lock_recovery_time.to_f64()),
             lock_recovery_timeout: U::lit(self.lock_recovery_timeout.to_f64()),
             lock_recovery_attempts: self.lock_recovery_attempts,
+            lock_recovery_rs_adaptation: self.lock_recovery_rs_adaptation,
         }
     }
 }
@@ -246,6 +252,7 @@ impl<T: Real> Default for DriveTuning<T> {
             lock_recovery_time: T::lit(20e-3),
             lock_recovery_timeout: T::lit(0.5),
             lock_recovery_attempts: 3,
+            lock_recovery_rs_adaptation: true,
         }
     }
 }
@@ -953,7 +960,12 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
                 self.last.estimate = estimate;
                 return self.last;
             }
-            LockAction::Rearm => self.estimator.rearm_lock_detector(),
+            LockAction::Rearm => {
+                self.estimator.rearm_lock_detector();
+                if self.config.tuning.lock_recovery_rs_adaptation {
+                    self.estimator.enable_rs_adaptation();
+                }
+            }
             // While recovering, the detector judges each sample afresh (its verdict is not
             // latched), so that "healthy" means no symptom now.
             LockAction::Coast if self.lock.recovering() && diag.lock == LockStatus::Lost => {
