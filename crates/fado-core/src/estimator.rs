@@ -159,9 +159,11 @@ pub struct EstimatorTuning<T> {
     /// Loss of lock (see [`crate::lock`]): |λ̂r| below this multiple of λ̂f is a symptom.
     /// Default 0.7 \[A\] (chosen on the fig11 envelope sweep, docs/lock.md).
     pub lock_flux_low_ratio: T,
-    /// Loss of lock: |λ̂r| above this multiple of λ̂f is a symptom. Default 1.2 \[A\] (just
-    /// above the limiter circle 1.15; 1.15 detects more and false-alarms far more,
-    /// docs/lock.md).
+    /// Loss of lock: |λ̂r| above this multiple of λ̂f is a symptom; 0 switches it off.
+    /// Default 0 (off) \[A\]: on the fig11 envelope every alarm it raised alone was in a run
+    /// that kept the rotor (|λ̂r| overshoots to 1.2·λ̂f right after the limiter → k_df
+    /// hand-over) or 3 s before a loss it had nothing to do with; at 1.2 it added 8 points
+    /// of false alarms for 5 points of detection (docs/lock.md).
     pub lock_flux_high_ratio: T,
     /// Loss of lock: a T2S-1 innovation |θm − θ̂⁻| above this (rad) is a symptom. Default
     /// 0.5 rad \[A\] (the angle error the drive must not reach, docs/lock.md).
@@ -173,8 +175,7 @@ pub struct EstimatorTuning<T> {
     /// Loss of lock: in limiter mode, a sample in which the limiter clamps is a symptom.
     /// Default false \[A\]: a rotor lost in limiter mode clamps continuously (fig11 with
     /// λ̂f +10 %) and a matched drive never clamps, but an adapted R̂s biased by a λ̂f error
-    /// makes the limiter clamp through passages it survives; on the fig11 envelope it raises
-    /// detection from 35 % to 75 % and false alarms from 7 % to 37 % (docs/lock.md).
+    /// makes the limiter clamp through passages it survives (false alarms, docs/lock.md).
     pub lock_limiter_clamping: bool,
 }
 
@@ -245,7 +246,7 @@ impl<T: Real> Default for EstimatorTuning<T> {
             plausible_voltage_ratio: T::lit(plausibility::VOLTAGE_RATIO),
             plausible_current_step_ratio: T::lit(plausibility::STEP_RATIO),
             lock_flux_low_ratio: T::lit(0.7),
-            lock_flux_high_ratio: T::lit(1.2),
+            lock_flux_high_ratio: T::zero(),
             lock_innovation_limit: T::lit(0.5),
             lock_detection_time: T::lit(5e-3),
             lock_limiter_clamping: false,

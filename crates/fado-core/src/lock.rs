@@ -59,7 +59,7 @@ pub struct LockDetectorConfig<T> {
     pub ts: T,
     /// |λ̂r| below this multiple of λ̂f is suspicious.
     pub flux_low_ratio: T,
-    /// |λ̂r| above this multiple of λ̂f is suspicious.
+    /// |λ̂r| above this multiple of λ̂f is suspicious; 0 switches this half of the test off.
     pub flux_high_ratio: T,
     /// |θm − θ̂⁻| above this (rad) is suspicious.
     pub innovation_limit: T,
@@ -88,16 +88,27 @@ impl<T: Real> LockDetector<T> {
     pub fn new(c: LockDetectorConfig<T>) -> Result<Self, ConfigError> {
         let ts = check::positive("ts", c.ts)?;
         let low = check::non_negative("lock_flux_low_ratio", c.flux_low_ratio)?;
-        let high = check::positive("lock_flux_high_ratio", c.flux_high_ratio)?;
+        let high = check::non_negative("lock_flux_high_ratio", c.flux_high_ratio)?;
         check::below("lock_flux_low_ratio", low, T::one(), "below 1")?;
-        check::below("lock_flux_high_ratio", T::one(), high, "above 1")?;
+        // 0 = off: an infinite bound that no |λ̂r| exceeds (the compare stays, no branch).
+        let high_sq = if high == T::zero() {
+            T::infinity()
+        } else {
+            check::below(
+                "lock_flux_high_ratio",
+                T::one(),
+                high,
+                "above 1, or 0 (off)",
+            )?;
+            high * high
+        };
         let innovation = check::positive("lock_innovation_limit", c.innovation_limit)?;
         let time = check::non_negative("lock_detection_time", c.detection_time)?;
         // Longer than 2^32 samples (5 days at 10 kHz) is "never": saturate.
         let n = (time / ts).round().to_f64().min(u32::MAX as f64);
         Ok(Self {
             low_sq: low * low,
-            high_sq: high * high,
+            high_sq,
             innovation_limit: innovation,
             limit: n as u32,
             count: 0,
@@ -162,16 +173,19 @@ impl<T: Real> LockDetector<T> {
 mod tests {
     use super::*;
 
-    fn detector(time: f64) -> LockDetector<f64> {
-        LockDetector::new(LockDetectorConfig {
+    fn detector_config(time: f64) -> LockDetectorConfig<f64> {
+        LockDetectorConfig {
             ts: 1e-4,
             flux_low_ratio: 0.5,
             flux_high_ratio: 1.3,
             innovation_limit: 0.5,
             detection_time: time,
             limiter_clamping: true,
-        })
-        .unwrap()
+        }
+    }
+
+    fn detector(time: f64) -> LockDetector<f64> {
+        LockDetector::new(detector_config(time)).unwrap()
     }
 
     fn step(d: &mut LockDetector<f64>, ratio: f64, innovation: f64) -> LockStatus {
@@ -207,6 +221,14 @@ mod tests {
         assert_eq!(step(&mut d, 1.0, -0.51), LockStatus::Lost);
         let mut d = detector(0.0);
         assert_eq!(step(&mut d, 0.0, 3.0), LockStatus::Locked); // disabled
+        // The high half of the flux test off (0): only the low half and the innovation.
+        let mut d = LockDetector::new(LockDetectorConfig {
+            flux_high_ratio: 0.0,
+            ..detector_config(1e-4)
+        })
+        .unwrap();
+        assert_eq!(step(&mut d, 100.0, 0.0), LockStatus::Locked);
+        assert_eq!(step(&mut d, 0.49, 0.0), LockStatus::Lost);
     }
 
     #[test]

@@ -170,6 +170,16 @@ pub struct DriveTuning<T> {
     /// what loses the rotor in the loaded zero-speed passage (docs/lock.md), and restarting
     /// with the same R̂s meets the same passage with the same error.
     pub lock_recovery_rs_adaptation: bool,
+    /// Stall symptom of the loss-of-lock detection (see [`crate::lock`], "speed-loop stall"):
+    /// in limiter mode, a speed error |ω* − ω̂| above this multiple of the rated speed for
+    /// `lock_stall_time` raises `LOCK_LOST` like the estimator's own verdict. Default 0.005
+    /// \[A\] (7.5 r/min at 1500 r/min rated, a third of the default Fig. 3 threshold
+    /// `mode_threshold_ratio` 0.015; chosen on the fig11 envelope, docs/lock.md: 0.004
+    /// false-alarms 3× more, 0.006 detects 5 points less); 0 disables.
+    pub lock_stall_speed_ratio: T,
+    /// Time (s) the stall condition must hold in a row. Default 5 ms \[A\] (the estimator's
+    /// `lock_detection_time`).
+    pub lock_stall_time: T,
 }
 
 impl<T: Real> DriveTuning<T> {
@@ -211,6 +221,8 @@ impl<T: Real> DriveTuning<T> {
             lock_recovery_timeout: U::lit(self.lock_recovery_timeout.to_f64()),
             lock_recovery_attempts: self.lock_recovery_attempts,
             lock_recovery_rs_adaptation: self.lock_recovery_rs_adaptation,
+            lock_stall_speed_ratio: U::lit(self.lock_stall_speed_ratio.to_f64()),
+            lock_stall_time: U::lit(self.lock_stall_time.to_f64()),
         }
     }
 }
@@ -253,6 +265,8 @@ impl<T: Real> Default for DriveTuning<T> {
             lock_recovery_timeout: T::lit(0.5),
             lock_recovery_attempts: 3,
             lock_recovery_rs_adaptation: true,
+            lock_stall_speed_ratio: T::lit(0.005),
+            lock_stall_time: T::lit(5e-3),
         }
     }
 }
@@ -317,6 +331,10 @@ struct Resolved<T> {
     stuck_sensor_samples: u32,
     current_error_samples: u32,
     input_fault_trip_samples: u32,
+    /// Stall symptom: speed error (electrical rad/s) in limiter mode, and samples in a row
+    /// (0 samples or speed 0: off).
+    stall_speed: T,
+    stall_samples: u32,
     /// Phase currents beyond ± this (A) are refused as implausible.
     plausible_current: T,
     /// DC-link readings above this (V) are refused as implausible.
@@ -353,6 +371,13 @@ impl<T: Real> Resolved<T> {
             stuck_sensor_samples: samples("stuck_sensor_time", t.stuck_sensor_time)?,
             current_error_samples: samples("current_error_time", t.current_error_time)?,
             input_fault_trip_samples: samples("input_fault_trip_time", t.input_fault_trip_time)?,
+            stall_speed: check::non_negative("lock_stall_speed_ratio", t.lock_stall_speed_ratio)?
+                * c.machine.rated_speed(),
+            stall_samples: if t.lock_stall_speed_ratio > T::zero() {
+                samples("lock_stall_time", t.lock_stall_time)?.max(1)
+            } else {
+                0
+            },
             plausible_current: t.plausible_current_ratio * t.trip_current_ratio * rated,
             dc_link_max_voltage: t.dc_link_max_ratio * c.machine.dc_voltage,
             mtpa: t.mtpa && c.machine.is_salient(),
@@ -629,6 +654,10 @@ pub struct SensorlessDrive<T, E = SensorlessEstimator<T>> {
     i_ab_used: Ab<T>,
     /// Reaction to a lost rotor.
     lock: LockSupervisor,
+    /// The stall symptom (see `DriveTuning::lock_stall_speed_ratio`) and its latched verdict
+    /// (cleared like the estimator's: `align`, `reset`, a recovery's re-arming).
+    stall: PersistenceMonitor,
+    stalled: bool,
     /// This sample was refused as implausible.
     implausible_now: bool,
 }
@@ -674,6 +703,8 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
                 resolved.stuck_sensor_samples,
             ),
             current_error: PersistenceMonitor::new(resolved.current_error_samples),
+            stall: PersistenceMonitor::new(resolved.stall_samples),
+            stalled: false,
             sensor_stuck_now: false,
             current_error_now: false,
             consecutive_rejects: 0,
@@ -778,6 +809,8 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         self.blocks.reset();
         self.stuck_sensor.reset();
         self.current_error.reset();
+        self.stall.reset();
+        self.stalled = false;
         self.sensor_stuck_now = false;
         self.current_error_now = false;
         self.history = [Ab::zero(); 2];
@@ -846,7 +879,9 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         // The reason stays up while the drive coasts, also after the detector was re-armed.
         flags.set(
             DriveFlags::LOCK_LOST,
-            out.estimate.diagnostics.lock == LockStatus::Lost || self.lock.coasting(),
+            out.estimate.diagnostics.lock == LockStatus::Lost
+                || self.stalled
+                || self.lock.coasting(),
         );
         flags.set(DriveFlags::COASTING, running && self.lock.coasting());
         flags.set(DriveFlags::INPUT_IMPLAUSIBLE, self.implausible_now);
@@ -952,8 +987,14 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
 
         // Reaction to a lost rotor (see `lock_reaction`).
         let diag = &estimate.diagnostics;
+        // The stall symptom: in limiter mode the speed loop cannot hold ω̂ near ω*.
+        let speed_ref = speed_ref_mech * T::lit(self.config.machine.pole_pairs as f64);
+        let stall_now = diag.mode == Mode::Limiter
+            && (speed_ref - omega_ctrl).abs() > self.resolved.stall_speed;
+        self.stalled |= self.stall.step(stall_now);
+        let lost = diag.lock == LockStatus::Lost || self.stalled;
         let healthy = diag.lock == LockStatus::Locked && diag.mode == Mode::DisturbanceFeedback;
-        let action = self.lock.step(diag.lock == LockStatus::Lost, healthy);
+        let action = self.lock.step(lost, healthy);
         match action {
             LockAction::Realign => {
                 self.align(estimate.theta);
@@ -962,14 +1003,18 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             }
             LockAction::Rearm => {
                 self.estimator.rearm_lock_detector();
+                self.stall.reset();
+                self.stalled = false;
                 if self.config.tuning.lock_recovery_rs_adaptation {
                     self.estimator.enable_rs_adaptation();
                 }
             }
             // While recovering, the detector judges each sample afresh (its verdict is not
             // latched), so that "healthy" means no symptom now.
-            LockAction::Coast if self.lock.recovering() && diag.lock == LockStatus::Lost => {
-                self.estimator.rearm_lock_detector()
+            LockAction::Coast if self.lock.recovering() && lost => {
+                self.estimator.rearm_lock_detector();
+                self.stall.reset();
+                self.stalled = false;
             }
             LockAction::Restart => self.blocks.speed.reset(),
             LockAction::Run | LockAction::Coast => {}
@@ -984,10 +1029,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         let i_dq_ref = if action == LockAction::Coast {
             Dq::zero()
         } else {
-            let Ok(iq_ref) = b.speed.step(
-                speed_ref_mech * T::lit(self.config.machine.pole_pairs as f64),
-                omega_ctrl,
-            ) else {
+            let Ok(iq_ref) = b.speed.step(speed_ref, omega_ctrl) else {
                 return self.reject_after_estimate(backup, estimate, i_dq);
             };
             let mut id_ref = b.injection.step(iq_ref);
