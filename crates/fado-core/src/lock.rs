@@ -92,7 +92,7 @@ impl<T: Real> LockDetector<T> {
         check::below("lock_flux_low_ratio", low, T::one(), "below 1")?;
         // 0 = off: an infinite bound that no |λ̂r| exceeds (the compare stays, no branch).
         let high_sq = if high == T::zero() {
-            T::infinity()
+            T::lit(f64::INFINITY)
         } else {
             check::below(
                 "lock_flux_high_ratio",

@@ -658,6 +658,7 @@ pub struct SensorlessDrive<T, E = SensorlessEstimator<T>> {
     /// (cleared like the estimator's: `align`, `reset`, a recovery's re-arming).
     stall: PersistenceMonitor,
     stalled: bool,
+    stall_armed: bool,
     /// This sample was refused as implausible.
     implausible_now: bool,
 }
@@ -705,6 +706,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             current_error: PersistenceMonitor::new(resolved.current_error_samples),
             stall: PersistenceMonitor::new(resolved.stall_samples),
             stalled: false,
+            stall_armed: false,
             sensor_stuck_now: false,
             current_error_now: false,
             consecutive_rejects: 0,
@@ -811,6 +813,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         self.current_error.reset();
         self.stall.reset();
         self.stalled = false;
+        self.stall_armed = false;
         self.sensor_stuck_now = false;
         self.current_error_now = false;
         self.history = [Ab::zero(); 2];
@@ -987,10 +990,18 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
 
         // Reaction to a lost rotor (see `lock_reaction`).
         let diag = &estimate.diagnostics;
-        // The stall symptom: in limiter mode the speed loop cannot hold ω̂ near ω*.
+        // The stall symptom: in limiter mode the speed loop loses a reference it had caught
+        // (armed once |ω* − ω̂| was within the band since the last start), although its
+        // current reference is below the limit (at the limit, a speed error is the machine's
+        // torque limit, not evidence against the estimate; within 1 % counts as at the
+        // limit).
         let speed_ref = speed_ref_mech * T::lit(self.config.machine.pole_pairs as f64);
-        let stall_now = diag.mode == Mode::Limiter
-            && (speed_ref - omega_ctrl).abs() > self.resolved.stall_speed;
+        let off_reference = (speed_ref - omega_ctrl).abs() > self.resolved.stall_speed;
+        self.stall_armed |= !off_reference && !self.lock.coasting();
+        let stall_now = self.stall_armed
+            && off_reference
+            && diag.mode == Mode::Limiter
+            && self.last.i_dq_ref.norm() < self.resolved.i_max * T::lit(0.99);
         self.stalled |= self.stall.step(stall_now);
         let lost = diag.lock == LockStatus::Lost || self.stalled;
         let healthy = diag.lock == LockStatus::Locked && diag.mode == Mode::DisturbanceFeedback;
@@ -1016,7 +1027,10 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
                 self.stall.reset();
                 self.stalled = false;
             }
-            LockAction::Restart => self.blocks.speed.reset(),
+            LockAction::Restart => {
+                self.blocks.speed.reset();
+                self.stall_armed = false;
+            }
             LockAction::Run | LockAction::Coast => {}
         }
         let action = match action {
