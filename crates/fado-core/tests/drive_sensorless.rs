@@ -604,3 +604,66 @@ fn status_word_reports_dc_link_low_and_persistent_bad_input_trips_and_is_counted
     d.reset();
     assert_eq!(d.flag_counts().count(DriveFlags::INPUT_REJECTED), 0);
 }
+
+/// The stall symptom of the loss-of-lock detection (`DriveTuning::lock_stall_speed_ratio`):
+/// a spy estimator in limiter mode that reports a standing rotor. Not armed until the speed
+/// loop has caught its reference; then a reference beyond the band (7.5 r/min on the paper's
+/// motor) for `lock_stall_time` (50 samples) raises `LOCK_LOST`, latched until `align`;
+/// a speed error with the current reference at its limit does not; ratio 0 never does.
+#[test]
+fn stall_symptom_flags_a_lost_reference_below_the_current_limit() {
+    let run = |tune: &dyn Fn(&mut DriveConfig<f64>), refs: &[(usize, f64)]| {
+        let mut c = synthetic_currents();
+        tune(&mut c);
+        let mut drive = SensorlessDrive::with_estimator(c, Spy::default()).unwrap();
+        drive.align(0.0);
+        let mut first = None;
+        let mut n = 0;
+        for &(samples, speed) in refs {
+            for _ in 0..samples {
+                let out = drive.step(Abc::new(0.0, 0.0, 0.0), 300.0, speed);
+                if first.is_none() && out.flags.contains(DriveFlags::LOCK_LOST) {
+                    first = Some(n);
+                }
+                n += 1;
+            }
+        }
+        (first, drive)
+    };
+    // The band is 0.005 × 1500 r/min = 7.5 r/min = 0.785 rad/s (the drive's reference is in
+    // mechanical rad/s); the current limit is raised so that the speed loop's reference
+    // for a 1 rad/s error stays below it.
+    let high_limit = |c: &mut DriveConfig<f64>| {
+        c.tuning.current_limit_ratio = 100.0;
+        c.tuning.trip_current_ratio = 200.0;
+    };
+    // Never caught (1 rad/s from the first sample): not armed, no flag.
+    assert_eq!(run(&high_limit, &[(500, 1.0)]).0, None);
+    // Caught at 0, then 1 rad/s: flagged after 50 samples in a row.
+    let (first, mut drive) = run(&high_limit, &[(20, 0.0), (200, 1.0)]);
+    assert_eq!(first, Some(20 + 49), "{first:?}");
+    // Latched while the condition is gone, cleared by align.
+    assert!(
+        drive
+            .step(Abc::new(0.0, 0.0, 0.0), 300.0, 0.0)
+            .flags
+            .contains(DriveFlags::LOCK_LOST)
+    );
+    drive.align(0.0);
+    assert!(
+        !drive
+            .step(Abc::new(0.0, 0.0, 0.0), 300.0, 0.0)
+            .flags
+            .contains(DriveFlags::LOCK_LOST)
+    );
+    // Within the band: nothing.
+    assert_eq!(run(&high_limit, &[(20, 0.0), (500, 0.7)]).0, None);
+    // At the current limit (a large error saturates the default limit): nothing.
+    assert_eq!(run(&|_| {}, &[(20, 0.0), (500, 1000.0)]).0, None);
+    // Off.
+    let off = |c: &mut DriveConfig<f64>| {
+        high_limit(c);
+        c.tuning.lock_stall_speed_ratio = 0.0;
+    };
+    assert_eq!(run(&off, &[(20, 0.0), (500, 1.0)]).0, None);
+}
