@@ -22,8 +22,11 @@ fn currents<T: Real>(samples: usize) -> Vec<Abc<T>> {
         .collect()
 }
 
-fn bench_step<T: Real>(c: &mut Criterion, name: &str) {
-    let config = DriveConfig::for_machine(&MachineModel::paper());
+fn bench_step<T: Real>(c: &mut Criterion, name: &str, stall_symptom: bool) {
+    let mut config = DriveConfig::for_machine(&MachineModel::paper());
+    if !stall_symptom {
+        config.tuning.lock_stall_speed_ratio = T::zero();
+    }
     let mut drive = SensorlessDrive::<T>::new(config, EstimatorTuning::default())
         .expect("default configuration is valid");
     drive.align(T::zero());
@@ -43,8 +46,10 @@ fn bench_step<T: Real>(c: &mut Criterion, name: &str) {
 }
 
 fn drive_step(c: &mut Criterion) {
-    bench_step::<f32>(c, "drive_step_f32");
-    bench_step::<f64>(c, "drive_step_f64");
+    bench_step::<f32>(c, "drive_step_f32", true);
+    bench_step::<f64>(c, "drive_step_f64", true);
+    // The loss-of-lock stall symptom's share (issue 14): the same step without it.
+    bench_step::<f32>(c, "drive_step_f32_no_stall_symptom", false);
 }
 
 criterion_group!(benches, drive_step);
