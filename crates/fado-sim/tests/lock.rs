@@ -81,13 +81,14 @@ fn a_lost_rotor_is_flagged_and_a_matched_run_is_not() {
 /// Issue 14's "recover" criterion: fig11 with the paper's fixed R̂s at +10 % error, reaction
 /// `recover` (defaults: the recovery switches the R̂s adaptation on), ends at the reference
 /// speed with the reason (`LOCK_LOST`, `COASTING`) in the flags; without switching the
-/// adaptation on, the restarted fixed-R̂s drive meets the same passage and does not.
+/// adaptation on, the restarted fixed-R̂s drive meets the same passage and does not. The
+/// `adapt` reaction (switch the adaptation on, no coasting) ends there too.
 #[test]
 fn recover_ends_at_the_reference_speed_with_the_reason_logged() {
     let run = |extra: &str| {
         let toml = format!(
             "[estimator]\nrs_adaptation = false\n[mismatch]\nrs_ratio = 1.1\n\
-             [controller]\nlock_reaction = \"recover\"\n{extra}"
+             [controller]\n{extra}"
         );
         let cfg = scenario_config("fig11", Some(&toml), false).unwrap();
         let out = run_config("fig11", cfg, None).unwrap();
@@ -107,7 +108,7 @@ fn recover_ends_at_the_reference_speed_with_the_reason_logged() {
         });
         (worst, flags, out.metrics)
     };
-    let (worst, flags, m) = run("");
+    let (worst, flags, m) = run("lock_reaction = \"recover\"\n");
     println!(
         "recover: LOCK_LOST at {:?} s, |n − n*| over the last 0.2 s ≤ {worst:.1} r/min",
         m.lock_lost_time
@@ -119,7 +120,18 @@ fn recover_ends_at_the_reference_speed_with_the_reason_logged() {
         "{flags:?}"
     );
     assert!(worst < 5.0, "{worst} r/min off the reference at the end");
-    let (worst_fixed, _, _) = run("lock_recovery_rs_adaptation = false\n");
+    let (worst_fixed, _, _) =
+        run("lock_reaction = \"recover\"\nlock_recovery_rs_adaptation = false\n");
     println!("recover with the fixed R̂s: ≤ {worst_fixed:.1} r/min");
     assert!(worst_fixed > 30.0, "{worst_fixed}");
+    // `adapt`: no coasting, the R̂s adaptation switched on at the first verdict.
+    let (worst_adapt, flags, m) = run("lock_reaction = \"adapt\"\n");
+    println!("adapt: |n − n*| over the last 0.2 s ≤ {worst_adapt:.1} r/min");
+    assert!(!m.tripped && m.lock_lost_time.is_some());
+    assert!(flags.contains(DriveFlags::LOCK_LOST), "{flags:?}");
+    assert!(!flags.contains(DriveFlags::COASTING), "{flags:?}");
+    assert!(
+        worst_adapt < 5.0,
+        "{worst_adapt} r/min off the reference at the end"
+    );
 }

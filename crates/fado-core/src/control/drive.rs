@@ -1006,6 +1006,9 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         let lost = diag.lock == LockStatus::Lost || self.stalled;
         let healthy = diag.lock == LockStatus::Locked && diag.mode == Mode::DisturbanceFeedback;
         let action = self.lock.step(lost, healthy);
+        if lost && self.config.tuning.lock_reaction == LockReaction::Adapt {
+            self.estimator.enable_rs_adaptation();
+        }
         match action {
             LockAction::Realign => {
                 self.align(estimate.theta);

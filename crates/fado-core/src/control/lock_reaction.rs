@@ -1,5 +1,5 @@
 //! What the drive does when the estimator reports the rotor lost ([`crate::lock`]): report
-//! only, coast at zero current, or recover (coast until the estimator has found the rotor
+//! only, switch the R̂s adaptation on and carry on (adapt), coast at zero current, or recover (coast until the estimator has found the rotor
 //! again, else re-align with the start-up procedure, then restart).
 //!
 //! Ours \[A\], after the usual fault reactions of drive firmware: a warning, a coast-to-stop,
@@ -24,6 +24,10 @@ pub enum LockReaction {
     /// Raise `DriveFlags::LOCK_LOST` and carry on.
     #[default]
     ReportOnly,
+    /// Raise the flag, switch the estimator's online R̂s adaptation on (if it has one and it
+    /// is off) and carry on without coasting: for an active load, which a coasting drive
+    /// lets run the machine away (docs/lock.md).
+    Adapt,
     /// Raise the flag and hold zero current (speed loop off) until `reset`/`align`.
     Coast,
     /// Coast at zero current with the detector re-armed; restart the speed loop once the
@@ -133,7 +137,7 @@ impl LockSupervisor {
             }
             State::Running if !lost => LockAction::Run,
             State::Running => match self.reaction {
-                LockReaction::ReportOnly => LockAction::Run,
+                LockReaction::ReportOnly | LockReaction::Adapt => LockAction::Run,
                 LockReaction::Recover if self.attempts < self.max_attempts => {
                     self.attempts += 1;
                     self.state = State::Recovering {
@@ -199,6 +203,9 @@ mod tests {
         assert_eq!(s.step(false, true), LockAction::Run);
         let mut r = LockSupervisor::new(LockReaction::ReportOnly, 1e-4, 0.0, 0.0, 1).unwrap();
         assert_eq!(r.step(true, false), LockAction::Run);
+        let mut a = LockSupervisor::new(LockReaction::Adapt, 1e-4, 0.0, 0.0, 1).unwrap();
+        assert_eq!(a.step(true, false), LockAction::Run);
+        assert!(!a.coasting());
         let mut c = LockSupervisor::new(LockReaction::Coast, 1e-4, 0.0, 0.0, 1).unwrap();
         assert_eq!(c.step(true, false), LockAction::Coast);
         assert_eq!(c.step(false, true), LockAction::Coast);
