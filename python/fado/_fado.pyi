@@ -318,7 +318,7 @@ class EstimatorConfig:
         """Loss of lock: |λ̂r|/λ̂f below this is a symptom."""
     @property
     def lock_flux_high_ratio(self) -> float:
-        """Loss of lock: |λ̂r|/λ̂f above this is a symptom (0: off, the default)."""
+        """Loss of lock: |λ̂r|/λ̂f above this is a symptom (0: off)."""
     @property
     def lock_innovation_limit(self) -> float:
         """Loss of lock: T2S-1 innovation above this (rad) is a symptom."""

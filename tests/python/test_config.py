@@ -44,7 +44,7 @@ PAPER_DEFAULTS = {
     "plausible_voltage_ratio": 1.5,  # [A]
     "plausible_current_step_ratio": 2.0,  # [A]
     "lock_flux_low_ratio": 0.7,  # [A]
-    "lock_flux_high_ratio": 0.0,  # [A] 0 = off
+    "lock_flux_high_ratio": 2.0,  # [A] gross inconsistency only
     "lock_innovation_limit": 0.5,  # [A]
     "lock_detection_time": 5e-3,  # [A]
     "lock_limiter_clamping": False,  # [A]

@@ -22,9 +22,9 @@
 //!    "phase detector" lock indicator of PLL practice (Gardner, *Phaselock Techniques*, 3rd
 //!    ed., ch. 8, lock detection).
 //!
-//! The upper half of symptom 1 (|λ̂r| above the band) is off by default: on the fig11
-//! envelope its alarms came from the |λ̂r| overshoot after a limiter → k_df hand-over in runs
-//! that kept the rotor (docs/lock.md). Near zero speed, where a surface-magnet rotor's angle
+//! The upper half of symptom 1 (|λ̂r| above the band) is set wide by default (2·λ̂f, gross
+//! inconsistency only): on the fig11 envelope a tight bound's alarms came from the |λ̂r|
+//! overshoot after a limiter → k_df hand-over in runs that kept the rotor (docs/lock.md). Near zero speed, where a surface-magnet rotor's angle
 //! is not observable from v and i, a loss shows first on the mechanical side; the drive adds
 //! that symptom (a speed-loop stall in limiter mode, `DriveTuning::lock_stall_speed_ratio`,
 //! see [`crate::control::SensorlessDrive`]) and raises `LOCK_LOST` on either.
