@@ -29,7 +29,7 @@ use cortex_m::interrupt::{self, Mutex};
 use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m_rt::{entry, exception};
 use cortex_m_semihosting::{debug, hprintln};
-use fado_core::{Ab, Estimate, EstimatorConfig, MachineModel, SensorlessEstimator};
+use fado_core::{Ab, Estimate, EstimatorConfig, LeanEstimate, MachineModel, SensorlessEstimator};
 
 /// QEMU's MPS2 system clock (25 MHz), which clocks SysTick.
 const SYSCLK_HZ: u32 = 25_000_000;
@@ -225,15 +225,19 @@ fn lowest_touched_stack() -> u32 {
     top
 }
 
-/// One estimator step, out of line: the unit the cost script measures.
+/// One estimator step, out of line: the unit the cost script measures. Firmware uses
+/// `step_lean` (θ̂, ω̂, mode, lock, fault flag); `step` also returns the diagnostics of
+/// `Estimate` (λ1, D̂, λ̂r, θm, …), about 65 cycles more (docs/firmware.md), and
+/// `SensorlessEstimator::last` recomputes them for the last sample when a debugger or a
+/// telemetry task wants them.
 #[inline(never)]
 #[unsafe(no_mangle)]
 pub fn estimator_step(
     estimator: &mut SensorlessEstimator<f32>,
     v_ab: Ab<f32>,
     i_ab: Ab<f32>,
-) -> Estimate<f32> {
-    estimator.step(v_ab, i_ab)
+) -> LeanEstimate<f32> {
+    estimator.step_lean(v_ab, i_ab)
 }
 
 impl App {
@@ -250,7 +254,7 @@ impl App {
         });
         let out = estimator_step(&mut self.estimator, v, i);
         self.samples += 1;
-        if out.diagnostics.input_fault {
+        if out.input_fault {
             self.rejected += 1;
         }
         if self.samples > self.total_samples - self.total_samples / 8 {
