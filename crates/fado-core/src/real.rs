@@ -15,6 +15,10 @@ pub trait Real: RealField + Copy + Default {
     /// [`crate::approx::sin_cos`] for `f32` (no software double precision on a single-precision
     /// FPU; error below 2e-7).
     fn step_sin_cos(self) -> (Self, Self);
+    /// (sin x, cos x) for any x, as the drive's Park transforms compute it
+    /// (`Rotation::from_angle`): `libm` for `f64`, [`crate::approx::sin_cos_any`] for `f32`
+    /// (error below 2.5e-7 up to ±3π).
+    fn step_sin_cos_any(self) -> (Self, Self);
     /// 1 − e^{−y} for y ≥ 0, as the estimator's step computes it: `libm`'s `exp_m1` for `f64`,
     /// [`crate::approx::one_minus_exp_neg`] for `f32` (error below 1.5e-7).
     fn step_one_minus_exp_neg(self) -> Self;
@@ -38,6 +42,10 @@ impl Real for f32 {
     #[inline(always)]
     fn step_sin_cos(self) -> (Self, Self) {
         crate::approx::sin_cos(self)
+    }
+    #[inline(always)]
+    fn step_sin_cos_any(self) -> (Self, Self) {
+        crate::approx::sin_cos_any(self)
     }
     #[inline(always)]
     fn step_one_minus_exp_neg(self) -> Self {
@@ -64,6 +72,10 @@ impl Real for f64 {
     }
     #[inline(always)]
     fn step_sin_cos(self) -> (Self, Self) {
+        nalgebra::ComplexField::sin_cos(self)
+    }
+    #[inline(always)]
+    fn step_sin_cos_any(self) -> (Self, Self) {
         nalgebra::ComplexField::sin_cos(self)
     }
     #[inline(always)]
@@ -95,7 +107,7 @@ pub(crate) fn max<T: Real>(x: T, y: T) -> T {
 }
 
 /// True when every value is finite, in one test: the sum s of the values is finite exactly
-/// when all of them are (an ∞ or NaN makes it ∞ or NaN), and s − s is 0 for a finite s and
+/// when all of them are (an ∞ or NaN makes it ∞ or NaN), and s·0 is ±0 for a finite s and
 /// NaN otherwise. One FPU add per value and one compare, instead of a compare and a branch
 /// per value (or a multiply and an add, for x·0 summed).
 ///
@@ -109,7 +121,7 @@ pub(crate) fn all_finite<T: Real, const N: usize>(values: [T; N]) -> bool {
     for v in values {
         sum += v;
     }
-    sum - sum == T::zero()
+    sum * T::zero() == T::zero()
 }
 
 /// Wraps an angle into [−π, π]: `x − 2π·round(x / 2π)` (SPEC notation).
