@@ -169,7 +169,9 @@ mod tests {
             let x = k as f32 * (3.0 * core::f32::consts::PI / 300_000.0);
             let (s, c) = sin_cos_any(x);
             let (s64, c64) = (x as f64).sin_cos();
-            worst = worst.max((s as f64 - s64).abs()).max((c as f64 - c64).abs());
+            worst = worst
+                .max((s as f64 - s64).abs())
+                .max((c as f64 - c64).abs());
         }
         assert!(worst < 2.5e-7, "{worst}");
         for x in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
@@ -178,7 +180,10 @@ mod tests {
         }
         // Far arguments take wrap_angle's general path and stay accurate to its reduction.
         let (s, c) = sin_cos_any(1000.0);
-        assert!((s as f64 - 1000.0_f64.sin()).abs() < 1e-4 && (c as f64 - 1000.0_f64.cos()).abs() < 1e-4);
+        assert!(
+            (s as f64 - 1000.0_f64.sin()).abs() < 1e-4
+                && (c as f64 - 1000.0_f64.cos()).abs() < 1e-4
+        );
     }
 
     #[test]

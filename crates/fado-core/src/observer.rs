@@ -63,7 +63,7 @@ pub struct DiscreteGains<T> {
 
 impl<T: Real> DiscreteGains<T> {
     /// Gains for the flux speed `omega` (rad/s, signed) and sampling period `ts`.
-    #[inline]
+    #[inline(always)]
     pub fn new(omega: T, ts: T) -> Self {
         let x = omega * ts;
         let half = T::lit(0.5);
@@ -159,7 +159,7 @@ const H_COT_H: [f64; 4] = [1.0, -1.0 / 3.0, -1.0 / 45.0, -2.0 / 945.0];
 /// type (|h| ≤ 1/8: h¹²/13! = 2e-22 for sin, h¹⁴/14! = 3e-24 for cos, y¹³/14! = 2e-19 for
 /// 1 − e^{−y}; `f32` stops earlier at terms below 2e-9), so the results differ from `libm`'s
 /// by float rounding only.
-#[inline]
+#[inline(always)]
 fn half_angle_terms<T: Real>(x: T) -> (T, T, T, Option<T>) {
     let y = x.abs();
     let single = T::one() + T::lit(1e-12) == T::one();
@@ -284,7 +284,7 @@ impl<T: Real> DisturbanceObserver<T> {
 
     /// (λ̂1, D̂) after one more sample, computed without changing the state, so that the
     /// estimator can check the whole new state before committing any of it.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn next_state(&self, lambda1: Ab<T>, omega: T) -> (Ab<T>, Ab<T>) {
         let g = DiscreteGains::new(omega, self.ts);
         let e = lambda1 - self.z;
