@@ -2,8 +2,9 @@
 # CI gate for the firmware build: builds examples/cortex-m for thumbv7em-none-eabihf
 # (Cortex-M4F, single-precision FPU) and fails when any software double-precision routine
 # (__aeabi_d*, __muldf3, __adddf3, __divdf3, ...) or any panic or formatting function is
-# reachable from the 10 kHz interrupt (SysTick) of the f32 build. Reachability is the call
-# graph of the disassembly (scripts/firmware_cost.py graph).
+# reachable from the 10 kHz interrupt (SysTick) of the f32 build, or from `drive_step` (the
+# f32 SensorlessDrive's step, which the image runs once). Reachability is the call graph of
+# the disassembly (scripts/firmware_cost.py graph).
 # Without a Cortex-M toolchain (no rustup target, no Debian rustc-web) or binutils it says so
 # loudly and runs the host no_std check (scripts/check-no-std.sh) instead.
 set -euo pipefail
@@ -36,4 +37,8 @@ elif [[ $status -ne 0 ]]; then
     exit 1
 fi
 echo "== symbols reachable from the interrupt of $image"
-python3 scripts/firmware_cost.py graph "$image" SysTick
+status=0
+python3 scripts/firmware_cost.py graph "$image" SysTick || status=1
+echo "== symbols reachable from the drive's step (drive_step)"
+python3 scripts/firmware_cost.py graph "$image" drive_step || status=1
+exit $status

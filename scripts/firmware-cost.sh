@@ -28,7 +28,7 @@ echo "== run (semihosting output of the image)"
 timeout 300 "${qemu[@]}"
 
 echo "== code reachable from the step and from the interrupt"
-for root in estimator_step SysTick; do
+for root in estimator_step SysTick drive_step; do
     { python3 scripts/firmware_cost.py graph "$image" "$root" || true; } |
         grep -E '^(\.text reachable|OK:|FORBIDDEN)' || true
 done

@@ -55,6 +55,31 @@ pub fn sin_cos(x: f32) -> (f32, f32) {
     (if x < 0.0 { -s } else { s }, c)
 }
 
+/// π in two parts (Cody–Waite): `PI_HI − x` is exact for x in [π/2, π] (Sterbenz) and
+/// `PI_LO` = π − `PI_HI` adds the rest.
+const PI_HI: f32 = PI;
+const PI_LO: f32 = 2.0 * PIO2_LO;
+
+/// (sin x, cos x) for any finite x: wrapped into [−π, π] ([`crate::wrap_angle`]: one
+/// compare for |x| ≤ π, one subtraction up to ±3π), then reflected into [−π/2, π/2]
+/// (sin x = sin(±π − x), cos x = −cos(±π − x)) for [`sin_cos`]. Error below 2.5e-7 for
+/// |x| ≤ 3π (tested; the reflection adds the rounding of ±π − x). NaN and ±∞ give NaN.
+/// The Park transforms of the drive use it (`Rotation::from_angle` for `f32`), so that no
+/// software double precision is left on the `f32` drive's path either.
+#[inline]
+pub fn sin_cos_any(x: f32) -> (f32, f32) {
+    let x = crate::wrap_angle(x);
+    if x > FRAC_PI_2 {
+        let (s, c) = sin_cos((PI_HI - x) + PI_LO);
+        (s, -c)
+    } else if x < -FRAC_PI_2 {
+        let (s, c) = sin_cos((-PI_HI - x) - PI_LO);
+        (s, -c)
+    } else {
+        sin_cos(x)
+    }
+}
+
 /// 1 − e^{−y} for y ≥ 0 (and for y ≥ 0.25 at full relative accuracy; below, use a series
 /// in y as the observer does, which keeps the relative accuracy as y → 0). NaN propagates,
 /// +∞ gives 1.
@@ -136,6 +161,30 @@ pub fn atan2(y: f32, x: f32) -> f32 {
 mod tests {
     use super::*;
     use core::f64::consts::PI as PI64;
+
+    #[test]
+    fn sin_cos_any_error_below_2_5e_7_to_three_pi() {
+        let mut worst = 0.0_f64;
+        for k in -300_000..=300_000 {
+            let x = k as f32 * (3.0 * core::f32::consts::PI / 300_000.0);
+            let (s, c) = sin_cos_any(x);
+            let (s64, c64) = (x as f64).sin_cos();
+            worst = worst
+                .max((s as f64 - s64).abs())
+                .max((c as f64 - c64).abs());
+        }
+        assert!(worst < 2.5e-7, "{worst}");
+        for x in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+            let (s, c) = sin_cos_any(x);
+            assert!(s.is_nan() && c.is_nan(), "{x}");
+        }
+        // Far arguments take wrap_angle's general path and stay accurate to its reduction.
+        let (s, c) = sin_cos_any(1000.0);
+        assert!(
+            (s as f64 - 1000.0_f64.sin()).abs() < 1e-4
+                && (c as f64 - 1000.0_f64.cos()).abs() < 1e-4
+        );
+    }
 
     #[test]
     fn sin_cos_error_below_2e_7_on_half_turn() {

@@ -294,7 +294,7 @@ impl<T: Real> FluxLimiter<T> {
         let n2 = lambda_r.norm_squared();
         let rho = self.config.radius;
         if n2 > rho * rho {
-            lambda_r * (rho / n2.sqrt())
+            lambda_r * (rho / n2.step_sqrt())
         } else {
             lambda_r
         }

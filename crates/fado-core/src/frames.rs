@@ -48,10 +48,12 @@ pub struct Rotation<T> {
 }
 
 impl<T: Real> Rotation<T> {
-    /// The rotation by `angle` (rad).
+    /// The rotation by `angle` (rad). `f64` uses `libm`; `f32` uses
+    /// [`crate::approx::sin_cos_any`] (error below 2.5e-7; `libm`'s `f32` kernels run in
+    /// `f64`, software on a single-precision FPU).
     #[inline]
     pub fn from_angle(angle: T) -> Self {
-        let (sin, cos) = angle.sin_cos();
+        let (sin, cos) = angle.step_sin_cos_any();
         Self { cos, sin }
     }
 

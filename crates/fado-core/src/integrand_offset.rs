@@ -150,7 +150,7 @@ impl<T: Real> IntegrandOffset<T> {
             let offset = self.state.offset + innovation * self.config.rate;
             let n2 = offset.norm_squared();
             next.offset = if n2 > self.limit_sq {
-                offset * (self.limit_sq / n2).sqrt()
+                offset * (self.limit_sq / n2).step_sqrt()
             } else {
                 offset
             };

@@ -44,7 +44,7 @@ pub use baselines::{EmfObserverEstimator, LpfIntegratorEstimator, OrtegaEstimato
 pub use control::{DriveConfig, DriveFlags, DriveOutput, DriveTuning, SensorlessDrive};
 pub use error::{ConfigError, NonFiniteInput};
 pub use estimator::{
-    Diagnostics, Estimate, EstimatorConfig, EstimatorTuning, RotorAngleEstimator,
+    Diagnostics, Estimate, EstimatorConfig, EstimatorTuning, LeanEstimate, RotorAngleEstimator,
     SensorlessEstimator,
 };
 pub use frames::{Ab, Abc, Dq, Rotation};

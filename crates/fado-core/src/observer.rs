@@ -63,21 +63,23 @@ pub struct DiscreteGains<T> {
 
 impl<T: Real> DiscreteGains<T> {
     /// Gains for the flux speed `omega` (rad/s, signed) and sampling period `ts`.
-    #[inline]
+    #[inline(always)]
     pub fn new(omega: T, ts: T) -> Self {
         let x = omega * ts;
         let half = T::lit(0.5);
         let two = T::lit(2.0);
-        let (sh, ch, one_minus_r) = half_angle_terms(x);
+        let (sh, ch, one_minus_r, l2_beta) = half_angle_terms(x);
         let a = Ab::new(ch * ch - sh * sh, two * sh * ch);
         let one_minus_a = Ab::new(two * sh * sh, -two * sh * ch);
         let l1 = Ab::new(two * one_minus_r - one_minus_a.alpha, -one_minus_a.beta);
         // (1 − r)²/(1 − a) = (1 − r)²·(sh + j·ch)/(2·sh); exactly zero at ω = 0.
         let m = one_minus_r * one_minus_r * half;
-        let l2 = if sh == T::zero() {
-            Ab::zero()
-        } else {
-            Ab::new(m, m * ch / sh)
+        let l2 = match l2_beta {
+            // f32 series range: m·ch/sh from its own series, no division (see
+            // `half_angle_terms`).
+            Some(beta) => Ab::new(m, beta),
+            None if sh == T::zero() => Ab::zero(),
+            None => Ab::new(m, m * ch / sh),
         };
         Self {
             a,
@@ -136,7 +138,20 @@ const ONE_MINUS_EXP_OVER_Y: [f64; 13] = [
     1.0 / 6_227_020_800.0,
 ];
 
-/// (sin(x/2), cos(x/2), 1 − e^{−|x|}) for x = ω·Ts.
+/// Taylor coefficients of h·cot(h) in h² (1, −1/3, −1/45, −2/945): the `f32` ℓ2 without a
+/// division (see [`half_angle_terms`]).
+const H_COT_H: [f64; 4] = [1.0, -1.0 / 3.0, -1.0 / 45.0, -2.0 / 945.0];
+
+/// (sin(x/2), cos(x/2), 1 − e^{−|x|}, ℓ2's imaginary part or `None`) for x = ω·Ts.
+///
+/// ℓ2 = m·(1 + j·cos(h)/sin(h)) with h = x/2 and m = (1 − r)²/2 needs a division by sin h
+/// (14 cycles on a Cortex-M4F, `vdiv`). In the `f32` series range it comes from a series
+/// instead: with sin h = h·S(h²), 1 − r = y·E(y) (y = |x| = 2|h|), m = 2h²·E², so
+/// m·cos h/sin h = 2h·E²·(h·cot h), and h·cot h = 1 − h²/3 − h⁴/45 − 2h⁶/945 − h⁸/4725 − …
+/// (Abramowitz & Stegun 4.3.70), truncated after h⁶: the first omitted term is below
+/// 0.25⁸/4725 = 3.2e-9 at |h| ≤ 0.25, under `f32`'s half ulp of 6e-8 (tested against `f64`
+/// in `series_gains_match_libm_to_rounding`). It is exactly 0 at x = 0, as before. `f64`
+/// and the range beyond the series keep the division (`None`).
 ///
 /// The observer needs these every sample because ω̂ changes every sample. In the operating
 /// range |x| ≤ 0.25 truncated Taylor series replace `sin_cos` and `exp_m1` (a third of the
@@ -144,8 +159,8 @@ const ONE_MINUS_EXP_OVER_Y: [f64; 13] = [
 /// type (|h| ≤ 1/8: h¹²/13! = 2e-22 for sin, h¹⁴/14! = 3e-24 for cos, y¹³/14! = 2e-19 for
 /// 1 − e^{−y}; `f32` stops earlier at terms below 2e-9), so the results differ from `libm`'s
 /// by float rounding only.
-#[inline]
-fn half_angle_terms<T: Real>(x: T) -> (T, T, T) {
+#[inline(always)]
+fn half_angle_terms<T: Real>(x: T) -> (T, T, T, Option<T>) {
     let y = x.abs();
     let single = T::one() + T::lit(1e-12) == T::one();
     let limit = if single {
@@ -161,25 +176,27 @@ fn half_angle_terms<T: Real>(x: T) -> (T, T, T) {
         let y4 = y2 * y2;
         // f32 needs fewer terms (the test folds to a constant per type); the sums are grouped
         // by Estrin's scheme (see `cubic`).
-        let (sin_over_h, cos, one_minus_exp_over_y) = if single {
-            let (s, c, e) = (&SIN_OVER_H, &COS, &ONE_MINUS_EXP_OVER_Y);
-            (
-                cubic(h2, h4, s),
+        let (s, c, e) = (&SIN_OVER_H, &COS, &ONE_MINUS_EXP_OVER_Y);
+        if single {
+            let one_minus_exp_over_y = cubic(y, y2, e) + y4 * cubic(y, y2, &e[4..]);
+            let l2_beta =
+                (h + h) * (one_minus_exp_over_y * one_minus_exp_over_y) * cubic(h2, h4, &H_COT_H);
+            return (
+                h * cubic(h2, h4, s),
                 cubic(h2, h4, c),
-                cubic(y, y2, e) + y4 * cubic(y, y2, &e[4..]),
-            )
-        } else {
-            let (s, c, e) = (&SIN_OVER_H, &COS, &ONE_MINUS_EXP_OVER_Y);
-            let lit = T::lit;
-            let y8 = y4 * y4;
-            (
-                cubic(h2, h4, s) + h4 * h4 * (lit(s[4]) + lit(s[5]) * h2),
-                cubic(h2, h4, c) + h4 * h4 * ((lit(c[4]) + lit(c[5]) * h2) + h4 * lit(c[6])),
-                (cubic(y, y2, e) + y4 * cubic(y, y2, &e[4..]))
-                    + y8 * (cubic(y, y2, &e[8..]) + y4 * lit(e[12])),
-            )
-        };
-        (h * sin_over_h, cos, y * one_minus_exp_over_y)
+                y * one_minus_exp_over_y,
+                Some(l2_beta),
+            );
+        }
+        let lit = T::lit;
+        let y8 = y4 * y4;
+        let (sin_over_h, cos, one_minus_exp_over_y) = (
+            cubic(h2, h4, s) + h4 * h4 * (lit(s[4]) + lit(s[5]) * h2),
+            cubic(h2, h4, c) + h4 * h4 * ((lit(c[4]) + lit(c[5]) * h2) + h4 * lit(c[6])),
+            (cubic(y, y2, e) + y4 * cubic(y, y2, &e[4..]))
+                + y8 * (cubic(y, y2, &e[8..]) + y4 * lit(e[12])),
+        );
+        (h * sin_over_h, cos, y * one_minus_exp_over_y, None)
     } else {
         // Large speeds (and NaN, which propagates). a = e^{jx} is 2π-periodic in x and every
         // gain depends on (sin(x/2), cos(x/2)) only through products of two of them, which a
@@ -187,7 +204,7 @@ fn half_angle_terms<T: Real>(x: T) -> (T, T, T) {
         // approximation needs only [−π/2, π/2] (see `Real::step_sin_cos`). r depends on |x|
         // itself.
         let (sh, ch) = (crate::wrap_angle(x) * T::lit(0.5)).step_sin_cos();
-        (sh, ch, y.step_one_minus_exp_neg())
+        (sh, ch, y.step_one_minus_exp_neg(), None)
     }
 }
 
@@ -267,7 +284,7 @@ impl<T: Real> DisturbanceObserver<T> {
 
     /// (λ̂1, D̂) after one more sample, computed without changing the state, so that the
     /// estimator can check the whole new state before committing any of it.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn next_state(&self, lambda1: Ab<T>, omega: T) -> (Ab<T>, Ab<T>) {
         let g = DiscreteGains::new(omega, self.ts);
         let e = lambda1 - self.z;

@@ -15,6 +15,10 @@ pub trait Real: RealField + Copy + Default {
     /// [`crate::approx::sin_cos`] for `f32` (no software double precision on a single-precision
     /// FPU; error below 2e-7).
     fn step_sin_cos(self) -> (Self, Self);
+    /// (sin x, cos x) for any x, as the drive's Park transforms compute it
+    /// (`Rotation::from_angle`): `libm` for `f64`, [`crate::approx::sin_cos_any`] for `f32`
+    /// (error below 2.5e-7 up to ±3π).
+    fn step_sin_cos_any(self) -> (Self, Self);
     /// 1 − e^{−y} for y ≥ 0, as the estimator's step computes it: `libm`'s `exp_m1` for `f64`,
     /// [`crate::approx::one_minus_exp_neg`] for `f32` (error below 1.5e-7).
     fn step_one_minus_exp_neg(self) -> Self;
@@ -38,6 +42,10 @@ impl Real for f32 {
     #[inline(always)]
     fn step_sin_cos(self) -> (Self, Self) {
         crate::approx::sin_cos(self)
+    }
+    #[inline(always)]
+    fn step_sin_cos_any(self) -> (Self, Self) {
+        crate::approx::sin_cos_any(self)
     }
     #[inline(always)]
     fn step_one_minus_exp_neg(self) -> Self {
@@ -64,6 +72,10 @@ impl Real for f64 {
     }
     #[inline(always)]
     fn step_sin_cos(self) -> (Self, Self) {
+        nalgebra::ComplexField::sin_cos(self)
+    }
+    #[inline(always)]
+    fn step_sin_cos_any(self) -> (Self, Self) {
         nalgebra::ComplexField::sin_cos(self)
     }
     #[inline(always)]
@@ -94,18 +106,22 @@ pub(crate) fn max<T: Real>(x: T, y: T) -> T {
     if x > y { x } else { y }
 }
 
-/// True when every value is finite, in one test: x·0 is ±0 for a finite x and NaN for ±∞
-/// and NaN, and a sum of such products is zero exactly when all of them are (no overflow,
-/// unlike a sum of the values themselves). Two FPU operations per value and one branch,
-/// instead of a compare and a branch per value.
+/// True when every value is finite, in one test: the sum s of the values is finite exactly
+/// when all of them are (an ∞ or NaN makes it ∞ or NaN), and s·0 is ±0 for a finite s and
+/// NaN otherwise. One FPU add per value and one compare, instead of a compare and a branch
+/// per value (or a multiply and an add, for x·0 summed).
+///
+/// The one difference from testing each value: a sum of finite values can overflow, which
+/// needs values of about 1e38 (`f32`) — the estimator's state is in Wb, A, V, Ω and rad/s,
+/// some 35 orders of magnitude below. A state that large is refused like a non-finite one,
+/// which still never lets a non-finite value into the state.
 #[inline(always)]
 pub(crate) fn all_finite<T: Real, const N: usize>(values: [T; N]) -> bool {
-    let zero = T::zero();
-    let mut acc = zero;
+    let mut sum = T::zero();
     for v in values {
-        acc += v * zero;
+        sum += v;
     }
-    acc == zero
+    sum * T::zero() == T::zero()
 }
 
 /// Wraps an angle into [−π, π]: `x − 2π·round(x / 2π)` (SPEC notation).
@@ -164,6 +180,25 @@ fn wrap_far<T: Real>(x: T) -> T {
 mod tests {
     use super::*;
     use core::f64::consts::PI;
+
+    #[test]
+    fn all_finite_is_the_per_value_test() {
+        let values = [0.0_f32, -0.0, 1e-45, -3.5, 1e30, -1e30, f32::MIN_POSITIVE];
+        assert!(all_finite(values));
+        for bad in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+            for k in 0..values.len() {
+                let mut v = values;
+                v[k] = bad;
+                assert!(!all_finite(v), "{bad} at {k}");
+            }
+        }
+        // +∞ and −∞ together sum to NaN, still refused.
+        assert!(!all_finite([f32::INFINITY, f32::NEG_INFINITY, 1.0]));
+        assert!(!all_finite([f64::NAN, 0.0]));
+        assert!(all_finite([1e300_f64, -1e300]));
+        // The documented difference: an overflowing sum of finite values is refused.
+        assert!(!all_finite([f32::MAX, f32::MAX]));
+    }
 
     #[test]
     fn wrap_agrees_with_the_rounding_formula() {

@@ -360,8 +360,10 @@ impl<T: Real> ResistanceAdaptation<T> {
         self.state.rs_hat
     }
 
-    /// The state after one more sample, computed without changing this one.
-    #[inline]
+    /// The state after one more sample, computed without changing this one. Always inlined:
+    /// the estimator's step is the one caller that runs every sample (an out-of-line copy
+    /// costs a call and the spills around it on a Cortex-M4F, docs/firmware.md).
+    #[inline(always)]
     pub(crate) fn next_state(
         &self,
         v_ab: Ab<T>,
