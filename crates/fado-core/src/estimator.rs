@@ -504,6 +504,11 @@ pub struct SensorlessEstimator<T> {
     i_prev: Ab<T>,
     step_allowance: T,
     lock: LockDetector<T>,
+    /// L̂d − L̂q (0 for a surface-magnet rotor): the slope of the active flux in i_d.
+    saliency: T,
+    /// λ̂r of the last accepted sample: its direction is the d axis the active-flux swing
+    /// (L̂d − L̂q)·î_d is taken along (see `active_flux_swing`).
+    lambda_r_prev: Ab<T>,
 }
 
 impl<T: Real> SensorlessEstimator<T> {
@@ -655,6 +660,8 @@ impl<T: Real> SensorlessEstimator<T> {
             i_prev: Ab::zero(),
             step_allowance: bounds.step(),
             lock,
+            saliency: config.machine.ld - config.machine.lq,
+            lambda_r_prev: Ab::zero(),
         };
         est.reset();
         Ok(est)
@@ -703,7 +710,7 @@ impl<T: Real> SensorlessEstimator<T> {
         self.integrator.set_last_current(i_ab);
         self.observer
             .reset_to(if self.config.tuning.observer_on_rotor_flux {
-                lambda_r
+                Ab::from_polar(m.flux_linkage, theta0)
             } else {
                 lambda1
             });
@@ -714,6 +721,7 @@ impl<T: Real> SensorlessEstimator<T> {
         self.feedback = Ab::zero();
         self.rejected_samples = 0;
         self.lock.reset();
+        self.lambda_r_prev = lambda_r;
         self.i_prev = if self.bounds.current_ok(i_ab) {
             i_ab
         } else {
@@ -768,7 +776,12 @@ impl<T: Real> SensorlessEstimator<T> {
         // 2. Disturbance observer at ω̂ of T2S-1 (eq. (10), (16)), on λ1 or on λ1 − L̂q·i
         //    (see `EstimatorTuning::observer_on_rotor_flux`).
         let observer_input = if self.config.tuning.observer_on_rotor_flux {
-            rotor_flux(lambda1, i_ab, self.config.machine.lq)
+            let active = rotor_flux(lambda1, i_ab, self.config.machine.lq);
+            if self.saliency != T::zero() {
+                active - self.active_flux_swing(i_ab)
+            } else {
+                active
+            }
         } else {
             lambda1
         };
@@ -786,6 +799,15 @@ impl<T: Real> SensorlessEstimator<T> {
             crate::wrap_angle(theta_direct - self.t2s1.predicted_angle())
         };
         let flux_hat = self.rs_adaptation.flux_linkage_hat();
+        // λ̂a/λ̂f, the active flux the limiter circle and the lock detector's bounds refer to
+        // (1 on a surface-magnet rotor).
+        let active_ratio = if self.saliency != T::zero() && !tracker_hold {
+            let i_d = i_ab.dot(lambda_r) / lambda_r.norm_squared().step_sqrt();
+            let ratio = T::one() + self.saliency * i_d / self.config.machine.flux_linkage;
+            ratio.max(self.config.tuning.tracker_hold_ratio)
+        } else {
+            T::one()
+        };
         // 4. Trackers (Fig. 1, Fig. 5).
         let (t2s1, t2s2) = if tracker_hold {
             (self.t2s1.coasted_state(), self.t2s2.coasted_state())
@@ -802,13 +824,13 @@ impl<T: Real> SensorlessEstimator<T> {
         let (feedback, clamping) = match mode {
             Mode::DisturbanceFeedback => (disturbance * kdf_gain, false),
             Mode::Limiter => {
-                let l = self.limiter.step(lambda_r);
+                let l = self.limiter.step_scaled(lambda_r, active_ratio);
                 (l.feedback, l.clamping)
             }
         };
         let lock = self.lock.next_state(
             lambda_r.norm_squared(),
-            flux_hat * flux_hat,
+            flux_hat * flux_hat * active_ratio * active_ratio,
             innovation,
             clamping,
         );
@@ -858,6 +880,7 @@ impl<T: Real> SensorlessEstimator<T> {
         self.feedback = feedback;
         self.lock.commit(lock);
         self.i_prev = i_ab;
+        self.lambda_r_prev = lambda_r;
         self.step_allowance = self.bounds.step();
         // 6. R̂s for the next sample (see `rs_adaptation`), after the commit so that the paper's
         //    path is untouched by it. A non-finite result is dropped (R̂s stays).
@@ -933,6 +956,21 @@ impl<T: Real> SensorlessEstimator<T> {
             },
         };
         estimate.into()
+    }
+
+    /// (L̂d − L̂q)·î_d·e^{jθ̂}: the part of the active flux λ̂a·e^{jθ} = (λ̂f + (L̂d − L̂q)·i_d)·e^{jθ}
+    /// that the drive's own i_d moves (the eq. (23) injection, MTPA, a load change under MTPA),
+    /// with î_d and the d axis taken from the last λ̂r. Zero while |λ̂r| is below the
+    /// tracker's hold level (no usable axis).
+    #[inline]
+    fn active_flux_swing(&self, i_ab: Ab<T>) -> Ab<T> {
+        let axis = self.lambda_r_prev;
+        let n2 = axis.norm_squared();
+        if n2 > self.hold_level_sq {
+            axis * (self.saliency * i_ab.dot(axis) / n2)
+        } else {
+            Ab::zero()
+        }
     }
 
     #[cold]

@@ -303,8 +303,16 @@ impl<T: Real> FluxLimiter<T> {
     /// The feedback for the next integration step.
     #[inline]
     pub fn step(&self, lambda_r: Ab<T>) -> LimiterOutput<T> {
+        self.step_scaled(lambda_r, T::one())
+    }
+
+    /// [`Self::step`] with the radius scaled by `scale`: on a salient rotor the circle follows
+    /// the active flux λ̂a = λ̂f + (L̂d − L̂q)·i_d that |λ̂r| equals (the paper sets the radius
+    /// "under the consideration of λ_em in (5)"), `scale` = λ̂a/λ̂f.
+    #[inline]
+    pub fn step_scaled(&self, lambda_r: Ab<T>, scale: T) -> LimiterOutput<T> {
         let n2 = lambda_r.norm_squared();
-        let rho = self.config.radius;
+        let rho = self.config.radius * scale;
         if n2 > rho * rho {
             let n = n2.step_sqrt();
             LimiterOutput {
