@@ -95,7 +95,11 @@ fn fig10_sensor_offset_walks_the_estimate_along_the_limiter_circle_at_e_t_over_r
     let c = &out.config;
     let rs_hat = c.estimator_config().machine.rs;
     let rho = c.estimator.limiter_radius_ratio * c.estimator_config().machine.flux_linkage;
-    let (oa, ob) = (c.current_sensor.offset_a, c.current_sensor.offset_b);
+    let rated = c.motor.rated_current;
+    let (oa, ob) = (
+        c.current_sensor.offset_a_ratio * rated,
+        c.current_sensor.offset_b_ratio * rated,
+    );
     // Clarke of (a, b, −a−b): α = a, β = (a + 2b)/√3.
     let e = (-rs_hat * oa, -rs_hat * (oa + 2.0 * ob) / 3f64.sqrt());
     let rows: Vec<_> = out.trace.rows.iter().filter(|r| r.time >= 3.5).collect();

@@ -4,6 +4,7 @@
 //! xoshiro256++ generator, so a run is reproducible bit for bit for a given seed.
 
 use fado_core::Abc;
+use fado_core::machine::PAPER_RATED_CURRENT;
 use rand_distr::{Distribution, Normal};
 use rand_xoshiro::Xoshiro256PlusPlus;
 use rand_xoshiro::rand_core::SeedableRng;
@@ -16,20 +17,26 @@ use crate::error::{SimConfigError, check};
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct CurrentSensorParams {
-    /// Offset of the phase-a sensor in A. Default 20 mA (SPEC §6 \[A\]).
-    pub offset_a: f64,
-    /// Offset of the phase-b sensor in A. Default −10 mA (SPEC §6 \[A\]).
-    pub offset_b: f64,
+    /// Offset of the phase-a sensor as a fraction of the motor's rated current. Default
+    /// 20 mA of the paper's 21.78 A (SPEC §6 \[A\]), 9.2e-4.
+    pub offset_a_ratio: f64,
+    /// Offset of the phase-b sensor as a fraction of the rated current. Default −10 mA of
+    /// the paper's 21.78 A (SPEC §6 \[A\]), −4.6e-4.
+    pub offset_b_ratio: f64,
     /// Relative gain error of the phase-a sensor. Default +0.5 % (SPEC §6 \[A\]).
     pub gain_error_a: f64,
     /// Relative gain error of the phase-b sensor. Default 0 (the 0.5 % is the mismatch) \[A\].
     pub gain_error_b: f64,
-    /// White noise per sensor, A rms. Default 10 mA (SPEC §6 \[A\]).
-    pub noise_rms: f64,
+    /// White noise per sensor, rms, as a fraction of the rated current. Default 10 mA of the
+    /// paper's 21.78 A (SPEC §6 \[A\]), 4.6e-4.
+    pub noise_rms_ratio: f64,
     /// ADC resolution in bits. Default 12 (SPEC §6 \[A\]).
     pub adc_bits: u32,
-    /// ADC full scale: the range is ±this, in A. Default 50 A (SPEC §6 \[A\]).
-    pub adc_full_scale: f64,
+    /// ADC full scale as a multiple of the rated current: the range is ±this × rated current.
+    /// Default 50 A of the paper's 21.78 A (SPEC §6 \[A\]), 2.296: a sensor sized for the
+    /// motor, not one fixed range (50 A would clip a 240 A motor at a fifth of its rating and
+    /// give a 6 A one a 4 % LSB).
+    pub adc_full_scale_ratio: f64,
     /// Apply the offsets. Default true.
     pub enable_offset: bool,
     /// Apply the gain errors. Default true.
@@ -45,13 +52,13 @@ pub struct CurrentSensorParams {
 impl Default for CurrentSensorParams {
     fn default() -> Self {
         Self {
-            offset_a: 0.020,
-            offset_b: -0.010,
+            offset_a_ratio: 0.020 / PAPER_RATED_CURRENT,
+            offset_b_ratio: -0.010 / PAPER_RATED_CURRENT,
             gain_error_a: 0.005,
             gain_error_b: 0.0,
-            noise_rms: 0.010,
+            noise_rms_ratio: 0.010 / PAPER_RATED_CURRENT,
             adc_bits: 12,
-            adc_full_scale: 50.0,
+            adc_full_scale_ratio: 50.0 / PAPER_RATED_CURRENT,
             enable_offset: true,
             enable_gain_error: true,
             enable_noise: true,
@@ -75,15 +82,15 @@ impl CurrentSensorParams {
 
     /// Checks every field; the error names the key.
     pub fn validate(&self) -> Result<(), SimConfigError> {
-        check::finite("offset_a", self.offset_a)?;
-        check::finite("offset_b", self.offset_b)?;
+        check::finite("offset_a_ratio", self.offset_a_ratio)?;
+        check::finite("offset_b_ratio", self.offset_b_ratio)?;
         check::in_range("gain_error_a", self.gain_error_a, -0.5, 0.5)?;
         check::in_range("gain_error_b", self.gain_error_b, -0.5, 0.5)?;
-        check::non_negative("noise_rms", self.noise_rms)?;
+        check::non_negative("noise_rms_ratio", self.noise_rms_ratio)?;
         if !(2..=24).contains(&self.adc_bits) {
             return Err(SimConfigError::new("adc_bits", "must be in 2..=24"));
         }
-        check::positive("adc_full_scale", self.adc_full_scale)?;
+        check::positive("adc_full_scale_ratio", self.adc_full_scale_ratio)?;
         Ok(())
     }
 }
@@ -95,17 +102,30 @@ pub struct CurrentSensor {
     rng: Xoshiro256PlusPlus,
     noise: Normal<f64>,
     lsb: f64,
+    /// The ratios resolved against the rated current (A).
+    offset_a: f64,
+    offset_b: f64,
+    noise_rms: f64,
+    full_scale: f64,
 }
 
 impl CurrentSensor {
-    /// Sensors from a validated record.
-    pub fn new(params: CurrentSensorParams) -> Result<Self, SimConfigError> {
+    /// Sensors from a validated record, for a motor of `rated_current` (A peak) that the
+    /// record's ratios refer to.
+    pub fn new(params: CurrentSensorParams, rated_current: f64) -> Result<Self, SimConfigError> {
         params.validate()?;
-        let noise = Normal::new(0.0, params.noise_rms)
-            .map_err(|e| SimConfigError::new("noise_rms", e.to_string()))?;
-        let lsb = 2.0 * params.adc_full_scale / (1u64 << params.adc_bits) as f64;
+        check::positive("rated_current", rated_current)?;
+        let noise_rms = params.noise_rms_ratio * rated_current;
+        let noise = Normal::new(0.0, noise_rms)
+            .map_err(|e| SimConfigError::new("noise_rms_ratio", e.to_string()))?;
+        let full_scale = params.adc_full_scale_ratio * rated_current;
+        let lsb = 2.0 * full_scale / (1u64 << params.adc_bits) as f64;
         Ok(Self {
             rng: Xoshiro256PlusPlus::seed_from_u64(params.seed),
+            offset_a: params.offset_a_ratio * rated_current,
+            offset_b: params.offset_b_ratio * rated_current,
+            noise_rms,
+            full_scale,
             params,
             noise,
             lsb,
@@ -126,11 +146,11 @@ impl CurrentSensor {
         if p.enable_offset {
             x += offset;
         }
-        if p.enable_noise && p.noise_rms > 0.0 {
+        if p.enable_noise && self.noise_rms > 0.0 {
             x += self.noise.sample(&mut self.rng);
         }
         if p.enable_quantization {
-            let fs = p.adc_full_scale;
+            let fs = self.full_scale;
             x = ((x / self.lsb).round() * self.lsb).clamp(-fs, fs - self.lsb);
         }
         x
@@ -139,8 +159,8 @@ impl CurrentSensor {
     /// Samples the true phase currents; returns (a, b, −a−b) as the drive sees them.
     pub fn measure(&mut self, i_true: Abc<f64>) -> Abc<f64> {
         let (oa, ob, ga, gb) = (
-            self.params.offset_a,
-            self.params.offset_b,
+            self.offset_a,
+            self.offset_b,
             self.params.gain_error_a,
             self.params.gain_error_b,
         );
@@ -210,7 +230,7 @@ mod tests {
             enable_quantization: false,
             ..Default::default()
         };
-        let mut s = CurrentSensor::new(p).unwrap();
+        let mut s = CurrentSensor::new(p, PAPER_RATED_CURRENT).unwrap();
         let n = 200_000;
         let (mut sa, mut sa2, mut sb) = (0.0, 0.0, 0.0);
         for _ in 0..n {
@@ -233,11 +253,12 @@ mod tests {
 
     #[test]
     fn ideal_is_transparent_and_seed_is_deterministic() {
-        let mut s = CurrentSensor::new(CurrentSensorParams::ideal()).unwrap();
+        let mut s = CurrentSensor::new(CurrentSensorParams::ideal(), PAPER_RATED_CURRENT).unwrap();
         let m = s.measure(Abc::new(1.234_567, -0.5, -0.734_567));
         assert_eq!((m.a, m.b), (1.234_567, -0.5));
         let run = || {
-            let mut s = CurrentSensor::new(CurrentSensorParams::default()).unwrap();
+            let mut s =
+                CurrentSensor::new(CurrentSensorParams::default(), PAPER_RATED_CURRENT).unwrap();
             (0..10)
                 .map(|_| s.measure(Abc::new(0.3, 0.1, -0.4)).a)
                 .collect::<Vec<_>>()
@@ -253,7 +274,7 @@ mod tests {
             enable_gain_error: false,
             ..Default::default()
         };
-        let mut s = CurrentSensor::new(p).unwrap();
+        let mut s = CurrentSensor::new(p, PAPER_RATED_CURRENT).unwrap();
         let lsb = 100.0 / 4096.0;
         let m = s.measure(Abc::new(1.0, 80.0, 0.0));
         assert!(((m.a / lsb) - (m.a / lsb).round()).abs() < 1e-9);

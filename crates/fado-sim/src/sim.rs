@@ -102,8 +102,11 @@ impl Plant {
         let mut plant = Self {
             motor: Motor::new(params.motor, theta0).map_err(|e| s(e, "motor"))?,
             inverter: Inverter::new(params.inverter.clone()).map_err(|e| s(e, "inverter"))?,
-            current_sensor: CurrentSensor::new(params.current_sensor.clone())
-                .map_err(|e| s(e, "current_sensor"))?,
+            current_sensor: CurrentSensor::new(
+                params.current_sensor.clone(),
+                params.motor.rated_current,
+            )
+            .map_err(|e| s(e, "current_sensor"))?,
             dc_link_sensor: params.dc_link_sensor.clone(),
             load: Load::new(params.load.clone(), params.motor.inertia).map_err(|e| s(e, "load"))?,
             encoder: Encoder::default(),

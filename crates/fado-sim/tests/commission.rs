@@ -10,7 +10,6 @@ use fado_sim::sim::PlantParams;
 pub fn ipmsm() -> (PlantParams, MachineModel<f64>) {
     let mut p = PlantParams::default();
     p.inverter.dc_voltage = 540.0;
-    p.current_sensor.adc_full_scale = 6.0 * 50.0 / 21.78;
     let m = MachineModel {
         rs: 3.6,
         ld: 36e-3,

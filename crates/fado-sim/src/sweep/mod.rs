@@ -16,7 +16,7 @@
 //! | `ld_error` | L̂d/Ld − 1 | `mismatch.ld_ratio` |
 //! | `flux_linkage_error` | λ̂f/λf − 1 | `mismatch.flux_linkage_ratio` |
 //! | `dead_time_comp_error` | T̂d/Td − 1 of the dead-time compensation | `mismatch.dead_time_ratio` |
-//! | `sensor_offset` | current-sensor offset, A: phase a +v, phase b −v/2 | `current_sensor.offset_a/_b` |
+//! | `sensor_offset` | current-sensor offset, A: phase a +v, phase b −v/2 | `current_sensor.offset_a_ratio/_b_ratio` (÷ rated current) |
 //! | `sensor_gain_error` | gain of phase a's sensor relative to phase b's, −1 | `current_sensor.gain_error_a/_b` |
 //! | `load_torque` | final load torque, N·m (the load profile scaled to end there) | `load.torque` |
 //! | `reversal_ramp` | slope of the speed reference's reversal, r/min per s | `speed_reference`, `simulation.duration` |

@@ -73,8 +73,8 @@ pub(crate) fn apply(
         "flux_linkage_error" => cfg.mismatch.flux_linkage_ratio = 1.0 + v,
         "dead_time_comp_error" => cfg.mismatch.dead_time_ratio = 1.0 + v,
         "sensor_offset" => {
-            cfg.current_sensor.offset_a = v;
-            cfg.current_sensor.offset_b = -0.5 * v;
+            cfg.current_sensor.offset_a_ratio = v / cfg.motor.rated_current;
+            cfg.current_sensor.offset_b_ratio = -0.5 * v / cfg.motor.rated_current;
             cfg.current_sensor.enable_offset = true;
         }
         "sensor_gain_error" => {
@@ -356,10 +356,9 @@ mod tests {
         assert!(close(c.mismatch.ld_ratio, 1.05));
         assert!(close(c.mismatch.flux_linkage_ratio, 0.85));
         assert!(close(c.mismatch.dead_time_ratio, 1.3));
-        assert_eq!(
-            (c.current_sensor.offset_a, c.current_sensor.offset_b),
-            (0.04, -0.02)
-        );
+        let rated = c.motor.rated_current;
+        assert!(close(c.current_sensor.offset_a_ratio * rated, 0.04));
+        assert!(close(c.current_sensor.offset_b_ratio * rated, -0.02));
         assert_eq!(
             (c.current_sensor.gain_error_a, c.current_sensor.gain_error_b),
             (0.01, 0.0)
