@@ -1045,33 +1045,23 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             a => a,
         };
         // 4. Speed loop, injection (23) and current-vector limit (zero current when coasting).
-        // The speed PI's output is a torque in units of the magnet's q current (its gain
-        // assumes Kt = 1.5·p·λ̂f); on a salient rotor the torque per q ampere is 1.5·p·λ̂a with
-        // the active flux λ̂a = λ̂f + (L̂d − L̂q)·i_d (Boldea et al. 2008), 0.6–2.4 λ̂f on the
-        // pmsyrm-5k preset between the eq. (23) injection and MTPA at 1.8× rated current.
-        // Scaling by λ̂f/λ̂a (with the last sample's i_d*) keeps the loop at its bandwidth.
-        let torque_scale = if self.resolved.salient {
-            let m = &self.config.machine;
-            let active = m.active_flux(self.last.i_dq_ref.d);
-            m.flux_linkage / active.max(T::lit(0.1) * m.flux_linkage)
-        } else {
-            T::one()
-        };
+        // The speed PI's output is a torque demand in units of the magnet's q current i_q,t
+        // (its gain assumes Kt = 1.5·p·λ̂f). On a salient rotor the torque per q ampere is
+        // 1.5·p·λ̂a with the active flux λ̂a = λ̂f + (L̂d − L̂q)·i_d (Boldea et al. 2008), which
+        // the eq. (23) injection and MTPA move by 0.45–2.9 λ̂f on the salient presets: the
+        // currents are solved for that torque (see `currents_for_torque`).
         let backup = self.blocks;
-        let b = &mut self.blocks;
+        let guess = self.last.i_dq_ref.q;
         let i_dq_ref = if action == LockAction::Coast {
             Dq::zero()
         } else {
-            let Ok(iq_torque) = b.speed.step(speed_ref, omega_ctrl) else {
+            let Ok(iq_torque) = self.blocks.speed.step(speed_ref, omega_ctrl) else {
                 return self.reject_after_estimate(backup, estimate, i_dq);
             };
-            let iq_ref = iq_torque * torque_scale;
-            let mut id_ref = b.injection.step(iq_ref);
-            if self.resolved.mtpa {
-                id_ref += self.config.machine.mtpa_id(iq_ref);
-            }
-            limit_current_d_priority(Dq::new(id_ref, iq_ref), self.resolved.i_max)
+            let i = self.currents_for_torque(iq_torque, guess);
+            limit_current_d_priority(i, self.resolved.i_max)
         };
+        let b = &mut self.blocks;
         // 5. Current loop (unlimited).
         let Ok(v_dq) = b.current.step(i_dq_ref, i_dq, omega_ctrl) else {
             return self.reject_after_estimate(backup, estimate, i_dq);
@@ -1097,7 +1087,13 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         }
         // 8. Anti-windup with the realised voltage in the same frame; speed loop too.
         b.current.realised(v_dq_realised);
-        b.speed.realised(i_dq_ref.q / torque_scale);
+        let realised_torque = if self.resolved.salient {
+            let m = &self.config.machine;
+            m.active_flux(i_dq_ref.d) * i_dq_ref.q / m.flux_linkage
+        } else {
+            i_dq_ref.q
+        };
+        b.speed.realised(realised_torque);
         self.history = [v_realised, self.history[0]];
         self.last = DriveOutput {
             duty: m.duty,
@@ -1114,6 +1110,46 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             i_ab,
         };
         self.last
+    }
+
+    /// (i_d*, i_q*) for a torque demand `iq_torque` in units of the magnet's q current
+    /// (torque / (1.5·p·λ̂f)): i_d* = the eq. (23) injection + MTPA of i_q*, and i_q* solves
+    /// (λ̂f + (L̂d − L̂q)·i_d*(i_q*))·i_q* = λ̂f·i_q,t by three Newton steps from `guess` (the
+    /// last sample's i_q*; a secant over 0.1 % of the rated current for the slope). On a
+    /// surface-magnet rotor i_q* = i_q,t, as in the paper. Taking i_d* from the last
+    /// sample's i_q* instead (no solve) closes an algebraic loop through the injection that
+    /// oscillates sample by sample under load (measured on ipmsm-gem-50k `stops`).
+    fn currents_for_torque(&self, iq_torque: T, guess: T) -> Dq<T> {
+        let m = &self.config.machine;
+        let injection = &self.blocks.injection;
+        let mtpa = self.resolved.mtpa;
+        let id_of = |iq: T| {
+            let id = injection.step(iq);
+            if mtpa { id + m.mtpa_id(iq) } else { id }
+        };
+        if !self.resolved.salient {
+            return Dq::new(id_of(iq_torque), iq_torque);
+        }
+        let target = m.flux_linkage * iq_torque;
+        let f = |iq: T| m.active_flux(id_of(iq)) * iq - target;
+        let h = T::lit(1e-3) * m.rated_current;
+        let mut iq = if guess.is_finite() && guess * iq_torque > T::zero() {
+            guess
+        } else {
+            iq_torque
+        };
+        for _ in 0..3 {
+            let f0 = f(iq);
+            let slope = (f(iq + h) - f0) / h;
+            if !(slope > T::lit(1e-3) * m.flux_linkage) {
+                break;
+            }
+            iq -= f0 / slope;
+        }
+        if !iq.is_finite() {
+            iq = iq_torque;
+        }
+        Dq::new(id_of(iq), iq)
     }
 
     /// The current at this sample predicted from the last one used (measured or
