@@ -504,11 +504,6 @@ pub struct SensorlessEstimator<T> {
     i_prev: Ab<T>,
     step_allowance: T,
     lock: LockDetector<T>,
-    /// L̂d − L̂q (0 for a surface-magnet rotor): the slope of the active flux in i_d.
-    saliency: T,
-    /// λ̂r of the last accepted sample: its direction is the d axis the active-flux swing
-    /// (L̂d − L̂q)·î_d is taken along (see `active_flux_swing`).
-    lambda_r_prev: Ab<T>,
 }
 
 impl<T: Real> SensorlessEstimator<T> {
@@ -660,8 +655,6 @@ impl<T: Real> SensorlessEstimator<T> {
             i_prev: Ab::zero(),
             step_allowance: bounds.step(),
             lock,
-            saliency: config.machine.ld - config.machine.lq,
-            lambda_r_prev: Ab::zero(),
         };
         est.reset();
         Ok(est)
@@ -721,7 +714,6 @@ impl<T: Real> SensorlessEstimator<T> {
         self.feedback = Ab::zero();
         self.rejected_samples = 0;
         self.lock.reset();
-        self.lambda_r_prev = lambda_r;
         self.i_prev = if self.bounds.current_ok(i_ab) {
             i_ab
         } else {
@@ -777,8 +769,9 @@ impl<T: Real> SensorlessEstimator<T> {
         //    (see `EstimatorTuning::observer_on_rotor_flux`).
         let observer_input = if self.config.tuning.observer_on_rotor_flux {
             let active = rotor_flux(lambda1, i_ab, self.config.machine.lq);
-            if self.saliency != T::zero() {
-                active - self.active_flux_swing(i_ab)
+            let saliency = self.config.machine.ld - self.config.machine.lq;
+            if saliency != T::zero() {
+                active - self.active_flux_swing(i_ab, saliency)
             } else {
                 active
             }
@@ -801,9 +794,10 @@ impl<T: Real> SensorlessEstimator<T> {
         let flux_hat = self.rs_adaptation.flux_linkage_hat();
         // λ̂a/λ̂f, the active flux the limiter circle and the lock detector's bounds refer to
         // (1 on a surface-magnet rotor).
-        let active_ratio = if self.saliency != T::zero() && !tracker_hold {
+        let saliency = self.config.machine.ld - self.config.machine.lq;
+        let active_ratio = if saliency != T::zero() && !tracker_hold {
             let i_d = i_ab.dot(lambda_r) / lambda_r.norm_squared().step_sqrt();
-            let ratio = T::one() + self.saliency * i_d / self.config.machine.flux_linkage;
+            let ratio = T::one() + saliency * i_d / self.config.machine.flux_linkage;
             ratio.max(self.config.tuning.tracker_hold_ratio)
         } else {
             T::one()
@@ -880,7 +874,6 @@ impl<T: Real> SensorlessEstimator<T> {
         self.feedback = feedback;
         self.lock.commit(lock);
         self.i_prev = i_ab;
-        self.lambda_r_prev = lambda_r;
         self.step_allowance = self.bounds.step();
         // 6. R̂s for the next sample (see `rs_adaptation`), after the commit so that the paper's
         //    path is untouched by it. A non-finite result is dropped (R̂s stays).
@@ -959,15 +952,16 @@ impl<T: Real> SensorlessEstimator<T> {
     }
 
     /// (L̂d − L̂q)·î_d·e^{jθ̂}: the part of the active flux λ̂a·e^{jθ} = (λ̂f + (L̂d − L̂q)·i_d)·e^{jθ}
-    /// that the drive's own i_d moves (the eq. (23) injection, MTPA, a load change under MTPA),
-    /// with î_d and the d axis taken from the last λ̂r. Zero while |λ̂r| is below the
-    /// tracker's hold level (no usable axis).
+    /// that the drive's own i_d moves (the eq. (23) injection, MTPA, a load change under
+    /// MTPA). The d axis is the observer's own rotating vector λ̂1 − D̂ of the last sample
+    /// (≈ λ̂f·e^{jθ̂}, no extra state), î_d the current along it. Zero while that vector is
+    /// below the tracker's hold level (no usable axis).
     #[inline]
-    fn active_flux_swing(&self, i_ab: Ab<T>) -> Ab<T> {
-        let axis = self.lambda_r_prev;
+    fn active_flux_swing(&self, i_ab: Ab<T>, saliency: T) -> Ab<T> {
+        let axis = self.observer.flux() - self.observer.disturbance();
         let n2 = axis.norm_squared();
         if n2 > self.hold_level_sq {
-            axis * (self.saliency * i_ab.dot(axis) / n2)
+            axis * (saliency * i_ab.dot(axis) / n2)
         } else {
             Ab::zero()
         }

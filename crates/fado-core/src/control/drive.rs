@@ -530,6 +530,20 @@ impl<T: Real> Blocks<T> {
                 }
             }
         };
+        // The speed PI's output is a torque in units of the magnet's q current (see
+        // `currents_for_torque`): with MTPA on a salient rotor its limit is the torque of the
+        // MTPA point on the current circle |i| = I_max, i_d = (λ̂f − √(λ̂f² + 8·ΔL²·I_max²))/(4·ΔL)
+        // with ΔL = L̂q − L̂d (Morimoto et al. 1990), so that saturation still reaches I_max.
+        let dl = m.lq - m.ld;
+        let torque_limit = if t.mtpa && m.is_salient() && dl > T::zero() {
+            let lf = m.flux_linkage;
+            let id = (lf - (lf * lf + T::lit(8.0) * dl * dl * i_max * i_max).sqrt())
+                / (T::lit(4.0) * dl);
+            let iq = (i_max * i_max - id * id).max(T::zero()).sqrt();
+            (m.active_flux(id) * iq / lf).max(i_max)
+        } else {
+            i_max
+        };
         let speed = SpeedController::new(SpeedControllerConfig {
             ts,
             pole_pairs: T::lit(m.pole_pairs as f64),
@@ -537,7 +551,7 @@ impl<T: Real> Blocks<T> {
             flux_linkage_hat: m.flux_linkage,
             bandwidth_hz: t.speed_bandwidth_hz,
             zero_ratio: t.speed_zero_ratio,
-            i_max,
+            i_max: torque_limit,
             anti_windup_ratio: t.speed_anti_windup_ratio,
         })
         .map_err(rename(&[
