@@ -30,6 +30,7 @@ macro_rules! presets {
 presets!(
     "hub-hoverboard-48v",
     "ipmsm-2k2",
+    "ipmsm-gem-50k",
     "outrunner-cheetah-24v",
     "paper",
     "pmsyrm-5k",
@@ -96,5 +97,8 @@ mod tests {
             core
         );
         assert!(find("ipmsm-2k2").unwrap().machine().unwrap().is_salient());
+        // The interior-magnet motor with Lq/Ld ≥ 1.5.
+        let gem = find("ipmsm-gem-50k").unwrap().machine().unwrap();
+        assert!(gem.lq / gem.ld >= 1.5, "{gem:?}");
     }
 }
