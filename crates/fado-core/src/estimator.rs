@@ -606,6 +606,7 @@ impl<T: Real> SensorlessEstimator<T> {
             rate: config.tuning.offset_adaptation_rate,
             settle_time: T::lit(5.0) / (T::two_pi() * threshold_hz),
             limit: lf * T::two_pi() * threshold_hz,
+            rated_current: config.machine.rated_current,
         })
         .map_err(|e| match e.field() {
             "rate" => rename("offset_adaptation_rate")(e),
@@ -891,6 +892,8 @@ impl<T: Real> SensorlessEstimator<T> {
                 kdf_gain,
                 shift,
                 regime == AdaptationRegime::Rotating,
+                i_ab,
+                t2s1.omega,
             );
             // The standstill law sees the voltage without the learned offset, and R̂s drops
             // what earlier standstill tests read of the offset ê learns now.
@@ -906,7 +909,7 @@ impl<T: Real> SensorlessEstimator<T> {
                     flux_settled: self.offset.learning_samples() >= self.flux_settle_samples,
                 },
             );
-            let feedback = self.feedback + pull + offset.offset;
+            let feedback = self.feedback + pull + IntegrandOffset::error(&offset, i_ab);
             // R̂s and λ̂f leave the adaptation clamped by compare-and-select, which turns a
             // NaN into the bound: always finite.
             if all_finite([
@@ -917,6 +920,8 @@ impl<T: Real> SensorlessEstimator<T> {
                 state.offset_sensitivity.beta,
                 offset.offset.alpha,
                 offset.offset.beta,
+                offset.negative.alpha,
+                offset.negative.beta,
                 offset.disturbance_prev.alpha,
                 offset.disturbance_prev.beta,
                 feedback.alpha,

@@ -56,6 +56,9 @@ pub struct IntegrandOffsetConfig<T> {
     /// Bound of |ê| in V. Default 0.83 V = λ̂f·2π·1.5 Hz (the paper's motor at the Fig. 3
     /// threshold; the estimator sets it from its λ̂f and threshold).
     pub limit: T,
+    /// Rated current in A peak: the negative-sequence gain ĉ is learned only while
+    /// |i| > 0.1 × this (a regressor floor) and bounded by |ĉ|·this ≤ `limit`.
+    pub rated_current: T,
 }
 
 impl<T: Real> Default for IntegrandOffsetConfig<T> {
@@ -65,6 +68,7 @@ impl<T: Real> Default for IntegrandOffsetConfig<T> {
             rate: T::lit(2.0),
             settle_time: T::lit(5.0 / (2.0 * core::f64::consts::PI * 1.5)),
             limit: T::lit(0.088 * 2.0 * core::f64::consts::PI * 1.5),
+            rated_current: T::lit(crate::machine::PAPER_RATED_CURRENT),
         }
     }
 }
@@ -74,6 +78,10 @@ impl<T: Real> Default for IntegrandOffsetConfig<T> {
 pub struct IntegrandOffsetState<T> {
     /// ê in V (α-β).
     pub offset: Ab<T>,
+    /// ĉ in V/A (a complex gain, α-β as real and imaginary part): the integrand error
+    /// ĉ·conj(i) that rotates against the rotor (a phase-gain mismatch of the current
+    /// sensors times R̂s).
+    pub negative: Ab<T>,
     /// D̂ of the last learning sample, Wb.
     pub disturbance_prev: Ab<T>,
     /// Samples in the learning regime without interruption (saturating).
@@ -84,7 +92,7 @@ impl<T: Real> IntegrandOffsetState<T> {
     /// True when every field is finite.
     #[inline]
     pub fn is_finite(&self) -> bool {
-        self.offset.is_finite() && self.disturbance_prev.is_finite()
+        self.offset.is_finite() && self.disturbance_prev.is_finite() && self.negative.is_finite()
     }
 }
 
@@ -131,9 +139,12 @@ impl<T: Real> IntegrandOffset<T> {
         feedback_gain: T,
         shift: Ab<T>,
         learning: bool,
+        i_ab: Ab<T>,
+        omega: T,
     ) -> IntegrandOffsetState<T> {
         let mut next = IntegrandOffsetState {
             offset: self.state.offset,
+            negative: self.state.negative,
             disturbance_prev: disturbance - shift,
             learning_samples: if learning {
                 self.state.learning_samples.saturating_add(1)
@@ -148,6 +159,31 @@ impl<T: Real> IntegrandOffset<T> {
             let innovation = (disturbance - self.state.disturbance_prev)
                 + disturbance * (feedback_gain * self.config.ts);
             let offset = self.state.offset + innovation * self.config.rate;
+            let i2 = i_ab.norm_squared();
+            let floor = T::lit(0.1) * self.config.rated_current;
+            if i2 > floor * floor {
+                // The observer passes the sequence at −ω with d/y = j·sgn(ω) (SPEC §2 at
+                // s = −jω), so the residual there is j·sgn(ω)·(c − ĉ)·conj(i)·Ts: turned back
+                // by −j·sgn(ω) and regressed on conj(i) (·i/|i|²), dĉ/dt = k_e·(c − ĉ).
+                let k = if omega < T::zero() {
+                    -self.config.rate
+                } else {
+                    self.config.rate
+                } / i2;
+                let p = Ab::new(
+                    innovation.alpha * i_ab.alpha - innovation.beta * i_ab.beta,
+                    innovation.alpha * i_ab.beta + innovation.beta * i_ab.alpha,
+                );
+                let g = Ab::new(p.beta, -p.alpha) * k;
+                let c = self.state.negative + g;
+                let bound = self.config.limit / self.config.rated_current;
+                let c2 = c.norm_squared();
+                next.negative = if c2 > bound * bound {
+                    c * (bound * bound / c2).sqrt()
+                } else {
+                    c
+                };
+            }
             let n2 = offset.norm_squared();
             next.offset = if n2 > self.limit_sq {
                 offset * (self.limit_sq / n2).step_sqrt()
@@ -183,6 +219,17 @@ impl<T: Real> IntegrandOffset<T> {
         self.state.offset
     }
 
+    /// The whole learned integrand error for the current `i_ab`: ê + ĉ·conj(i), V.
+    #[inline]
+    pub fn error(state: &IntegrandOffsetState<T>, i_ab: Ab<T>) -> Ab<T> {
+        let c = state.negative;
+        state.offset
+            + Ab::new(
+                c.alpha * i_ab.alpha + c.beta * i_ab.beta,
+                c.beta * i_ab.alpha - c.alpha * i_ab.beta,
+            )
+    }
+
     /// The configuration in use.
     pub fn config(&self) -> &IntegrandOffsetConfig<T> {
         &self.config
@@ -207,17 +254,17 @@ mod tests {
         let n = (1.0 / ts) as usize;
         for _ in 0..n {
             lambda += (e - law.offset() - lambda * k_df) * ts;
-            let s = law.next_state(lambda, k_df, Ab::zero(), true);
+            let s = law.next_state(lambda, k_df, Ab::zero(), true, Ab::zero(), 1.0);
             law.commit(s);
         }
         // After 1 s at k_e = 2 s⁻¹ the error is e^{−2} of e (to the Euler step).
         let left = (e - law.offset()).norm() / e.norm();
         assert!((left - (-2.0f64).exp()).abs() < 0.01, "{left}");
         // Bounded: a huge error saturates at the limit.
-        let s = law.next_state(Ab::new(1e3, 0.0), k_df, Ab::zero(), true);
+        let s = law.next_state(Ab::new(1e3, 0.0), k_df, Ab::zero(), true, Ab::zero(), 1.0);
         assert!((s.offset.norm() - law.config().limit).abs() < 1e-12);
         // Not learning: held.
-        let s = law.next_state(Ab::new(1e3, 0.0), k_df, Ab::zero(), false);
+        let s = law.next_state(Ab::new(1e3, 0.0), k_df, Ab::zero(), false, Ab::zero(), 1.0);
         assert_eq!(s.offset, law.offset());
         assert!(
             IntegrandOffset::<f64>::new(IntegrandOffsetConfig {
