@@ -895,11 +895,11 @@ impl<T: Real> SensorlessEstimator<T> {
                 i_ab,
                 t2s1.omega,
             );
-            // The standstill law sees the voltage without the learned offset, and R̂s drops
-            // what earlier standstill tests read of the offset ê learns now.
+            // The standstill law sees the voltage without the learned error (ê + ĉ·conj(i)),
+            // and R̂s drops what earlier standstill tests read of the offset ê learns now.
             let offset_before = self.offset.offset();
             let (state, pull) = self.rs_adaptation.next_state(
-                v_ab - offset_before,
+                v_ab - self.offset.error_now(i_drop),
                 i_drop,
                 lambda_r,
                 t2s1.omega,

@@ -213,6 +213,12 @@ impl<T: Real> IntegrandOffset<T> {
         self.state.learning_samples
     }
 
+    /// The learned integrand error now for the current `i_ab`: ê + ĉ·conj(i), V.
+    #[inline]
+    pub fn error_now(&self, i_ab: Ab<T>) -> Ab<T> {
+        Self::error(&self.state, i_ab)
+    }
+
     /// ê now, V.
     #[inline]
     pub fn offset(&self) -> Ab<T> {
