@@ -1155,10 +1155,12 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         for _ in 0..3 {
             let f0 = f(iq);
             let slope = (f(iq + h) - f0) / h;
-            if !(slope > T::lit(1e-3) * m.flux_linkage) {
+            // A flat or non-finite slope (NaN compares false): keep the last iterate.
+            if slope > T::lit(1e-3) * m.flux_linkage {
+                iq -= f0 / slope;
+            } else {
                 break;
             }
-            iq -= f0 / slope;
         }
         if !iq.is_finite() {
             iq = iq_torque;
