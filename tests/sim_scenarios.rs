@@ -214,7 +214,8 @@ fn a_trip_disables_the_gates_and_the_machine_coasts_on_its_diodes() {
     // A failed phase-a sensor reading 70 A trips the drive (60 A) at the first sample; the
     // inverter's diodes block (the line back-EMF stays below Vdc), the currents stay zero, and
     // the load torque drives the shaft backwards.
-    let cfg = "[current_sensor]\noffset_a = 70.0\nenable_quantization = false\n\
+    // 70 A of the paper's 21.78 A rated current.
+    let cfg = "[current_sensor]\noffset_a_ratio = 3.2139\nenable_quantization = false\n\
                [simulation]\nduration = 1.5\n";
     let out = run("fig11", Some(cfg), false);
     assert!(out.metrics.tripped);
