@@ -899,7 +899,11 @@ impl<T: Real> SensorlessEstimator<T> {
             // and R̂s drops what earlier standstill tests read of the offset ê learns now.
             let offset_before = self.offset.offset();
             let (state, pull) = self.rs_adaptation.next_state(
-                v_ab - self.offset.error_now(i_drop),
+                v_ab - if mode == Mode::Limiter {
+                    self.offset.error_now(i_drop)
+                } else {
+                    offset_before
+                },
                 i_drop,
                 lambda_r,
                 t2s1.omega,
@@ -909,7 +913,14 @@ impl<T: Real> SensorlessEstimator<T> {
                     flux_settled: self.offset.learning_samples() >= self.flux_settle_samples,
                 },
             );
-            let feedback = self.feedback + pull + IntegrandOffset::error(&offset, i_ab);
+            // ĉ·conj(i) only in the limiter mode: turning, D̂ carries the −ω sequence (and
+            // the law measures c there without it, see `crate::integrand_offset`).
+            let learned = if mode == Mode::Limiter {
+                IntegrandOffset::error(&offset, i_ab)
+            } else {
+                offset.offset
+            };
+            let feedback = self.feedback + pull + learned;
             // R̂s and λ̂f leave the adaptation clamped by compare-and-select, which turns a
             // NaN into the bound: always finite.
             if all_finite([

@@ -43,9 +43,13 @@
 //!   ĉ[n] = ĉ[n−1] + k_e·(−j·sgn(ω̂))·r[n]·i/|i|²,   r = (D̂[n] − D̂[n−1]) + k_df·Ts·D̂[n]
 //! ```
 //!
-//! gives dĉ/dt = k_e·(c − ĉ) (learned only while |i| > 0.1 × rated current), and ê + ĉ·conj(i)
-//! is what is subtracted. Measured (`bash scripts/presets.sh`): the outrunner's reversal goes from
-//! 1.20 to 0.19 rad, the paper motor's from 0.13 to 0.05 rad.
+//! low-passed as dĉ/dt = k_e·(c − ĉ) (learned only while |i| > 0.1 × rated current). ĉ·conj(i)
+//! is subtracted in the limiter mode only, where nothing else holds it; turning, D̂ carries
+//! the −ω sequence as in the paper (subtracting ĉ there too measured better at the zero
+//! crossings, 0.05 rad on the paper's reversal, but its step at each hand-over raised the Fig. 8
+//! λ2 DC from 1.1 % to 2.7 % of λf; limiter-only: 1.9 %). Measured (`bash scripts/presets.sh`,
+//! seed 1): the outrunner's reversal goes from 1.20 to 0.18 rad, the paper motor's from 0.13
+//! to 0.10 rad.
 //!
 //! |ê| is bounded by the back-EMF at the Fig. 3 threshold speed, λ̂f·2π·f_th: a larger offset
 //! would make the limiter mode useless anyway, and the bound keeps a hand-over transient from
@@ -180,8 +184,9 @@ impl<T: Real> IntegrandOffset<T> {
             let floor = T::lit(0.1) * rated_current;
             if i2 > floor * floor {
                 // The observer passes the sequence at −ω with d/y = j·sgn(ω) (SPEC §2 at
-                // s = −jω), so the residual there is j·sgn(ω)·(c − ĉ)·conj(i)·Ts: turned back
-                // by −j·sgn(ω) and regressed on conj(i) (·i/|i|²), dĉ/dt = k_e·(c − ĉ).
+                // s = −jω), so the residual there is j·sgn(ω)·c·conj(i)·Ts (ĉ is not applied
+                // while turning): turned back by −j·sgn(ω), regressed on conj(i) (·i/|i|²)
+                // and low-passed, dĉ/dt = k_e·(c − ĉ).
                 let k = if omega < T::zero() {
                     -self.config.rate
                 } else {
@@ -192,7 +197,8 @@ impl<T: Real> IntegrandOffset<T> {
                     innovation.alpha * i_ab.beta + innovation.beta * i_ab.alpha,
                 );
                 let g = Ab::new(p.beta, -p.alpha) * k;
-                let c = self.state.negative + g;
+                let c = self.state.negative + g
+                    - self.state.negative * (self.config.rate * self.config.ts);
                 let bound = self.config.limit / rated_current;
                 let c2 = c.norm_squared();
                 next.negative = if c2 > bound * bound {
@@ -242,7 +248,8 @@ impl<T: Real> IntegrandOffset<T> {
         self.state.offset
     }
 
-    /// The whole learned integrand error for the current `i_ab`: ê + ĉ·conj(i), V.
+    /// The learned integrand error for the current `i_ab` in the limiter mode: ê + ĉ·conj(i), V
+    /// (turning, only ê is subtracted: D̂ carries the −ω sequence, see the module docs).
     #[inline]
     pub fn error(state: &IntegrandOffsetState<T>, i_ab: Ab<T>) -> Ab<T> {
         let c = state.negative;
@@ -316,7 +323,7 @@ mod tests {
 
     #[test]
     fn learns_a_negative_sequence_error_through_the_observer_for_either_direction() {
-        // λ1 = λf·e^{jωt} + x, dx/dt = c·conj(i) − (ê + ĉ·conj(i)) − k_df·D̂, i = I·j·e^{jωt}
+        // λ1 = λf·e^{jωt} + x, dx/dt = c·conj(i) − ê − k_df·D̂, i = I·j·e^{jωt}
         // (a phase-gain mismatch times R̂s): the observer passes the −ω sequence with phase
         // j·sgn(ω), which the law turns back; ĉ must reach c and ê stay near 0.
         use crate::observer::{DisturbanceObserver, DisturbanceObserverConfig};
@@ -346,8 +353,8 @@ mod tests {
                         v.beta * i.alpha - v.alpha * i.beta,
                     )
                 };
-                x += (conj(c, i) - IntegrandOffset::error(&state, i) - obs.disturbance() * k_df)
-                    * ts;
+                // Turning, only ê is subtracted (ĉ is the limiter mode's).
+                x += (conj(c, i) - state.offset - obs.disturbance() * k_df) * ts;
                 let lambda1 = Ab::new(lf * th.cos(), lf * th.sin()) + x;
                 let d = obs.step(lambda1, omega).unwrap();
                 state = law.next_state(d, k_df, Ab::zero(), true, i, omega, 20.0);
