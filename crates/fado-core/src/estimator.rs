@@ -891,19 +891,12 @@ impl<T: Real> SensorlessEstimator<T> {
                 kdf_gain,
                 shift,
                 regime == AdaptationRegime::Rotating,
-                i_ab,
-                t2s1.omega,
-                self.config.machine.rated_current,
             );
-            // The standstill law sees the voltage without the learned error (ê + ĉ·conj(i)),
-            // and R̂s drops what earlier standstill tests read of the offset ê learns now.
+            // The standstill law sees the voltage without the learned offset, and R̂s drops
+            // what earlier standstill tests read of the offset ê learns now.
             let offset_before = self.offset.offset();
             let (state, pull) = self.rs_adaptation.next_state(
-                v_ab - if mode == Mode::Limiter {
-                    self.offset.error_now(i_drop)
-                } else {
-                    offset_before
-                },
+                v_ab - offset_before,
                 i_drop,
                 lambda_r,
                 t2s1.omega,
@@ -913,14 +906,7 @@ impl<T: Real> SensorlessEstimator<T> {
                     flux_settled: self.offset.learning_samples() >= self.flux_settle_samples,
                 },
             );
-            // ĉ·conj(i) only in the limiter mode: turning, D̂ carries the −ω sequence (and
-            // the law measures c there without it, see `crate::integrand_offset`).
-            let learned = if mode == Mode::Limiter {
-                IntegrandOffset::error(&offset, i_ab)
-            } else {
-                offset.offset
-            };
-            let feedback = self.feedback + pull + learned;
+            let feedback = self.feedback + pull + offset.offset;
             // R̂s and λ̂f leave the adaptation clamped by compare-and-select, which turns a
             // NaN into the bound: always finite.
             if all_finite([
@@ -931,8 +917,6 @@ impl<T: Real> SensorlessEstimator<T> {
                 state.offset_sensitivity.beta,
                 offset.offset.alpha,
                 offset.offset.beta,
-                offset.negative.alpha,
-                offset.negative.beta,
                 offset.disturbance_prev.alpha,
                 offset.disturbance_prev.beta,
                 feedback.alpha,
@@ -1200,8 +1184,7 @@ mod tests {
         std::println!("SensorlessEstimator<f32>: {s32} B, <f64>: {s64} B");
         // 388 B after issue 16; issue 14 (sample bounds, last accepted current, step
         // allowance, loss-of-lock detector) and issue 13 (integrand-offset law, ∂R̂s/∂ê, L̂d in
-        // the R̂s adaptation) add 76 B each; issue 11 the integrand law's negative-sequence
-        // gain ĉ (8 B).
-        assert!(s32 <= 548, "{s32}");
+        // the R̂s adaptation) add 76 B each.
+        assert!(s32 <= 540, "{s32}");
     }
 }

@@ -30,27 +30,6 @@
 //! cannot know are DC errors that appear only at standstill (the dead-time residual and R̂s
 //! errors times a current that is constant in α-β there); those are the limiter's, as before.
 //!
-//! The same residual also carries the integrand error that rotates *against* the rotor, c·conj(i):
-//! a gain mismatch between the two current sensors (phase a read (1 + g)·i_a, phase c
-//! reconstructed) gives the measured α-β current an error (g/2)·(1 + j/√3)·(i + conj(i)), and
-//! R̂s times its conj(i) part is such a term. At standstill it is a DC error whose direction
-//! depends on the angle the rotor stopped at, so neither ê nor R̂s can hold it, and it walks the
-//! angle at |c·i|/λ̂f: 2.5 rad/s for g = 0.5 % on the 2.4 mWb outrunner preset. Turning, it is
-//! at −ω, where the observer passes it into D̂ with d/y = j·sgn(ω) (SPEC §2 at s = −jω), so the
-//! residual is j·sgn(ω)·(c − ĉ)·conj(i)·Ts; turned back by −j·sgn(ω) and regressed on conj(i),
-//!
-//! ```text
-//!   ĉ[n] = ĉ[n−1] + k_e·(−j·sgn(ω̂))·r[n]·i/|i|²,   r = (D̂[n] − D̂[n−1]) + k_df·Ts·D̂[n]
-//! ```
-//!
-//! low-passed as dĉ/dt = k_e·(c − ĉ) (learned only while |i| > 0.1 × rated current). ĉ·conj(i)
-//! is subtracted in the limiter mode only, where nothing else holds it; turning, D̂ carries
-//! the −ω sequence as in the paper (subtracting ĉ there too measured better at the zero
-//! crossings, 0.05 rad on the paper's reversal, but its step at each hand-over raised the Fig. 8
-//! λ2 DC from 1.1 % to 2.7 % of λf; limiter-only: 1.9 %). Measured (`bash scripts/presets.sh`,
-//! seed 1): the outrunner's reversal goes from 1.20 to 0.18 rad, the paper motor's from 0.13
-//! to 0.10 rad.
-//!
 //! |ê| is bounded by the back-EMF at the Fig. 3 threshold speed, λ̂f·2π·f_th: a larger offset
 //! would make the limiter mode useless anyway, and the bound keeps a hand-over transient from
 //! leaving a large ê behind.
@@ -95,10 +74,6 @@ impl<T: Real> Default for IntegrandOffsetConfig<T> {
 pub struct IntegrandOffsetState<T> {
     /// ê in V (α-β).
     pub offset: Ab<T>,
-    /// ĉ in V/A (a complex gain, α-β as real and imaginary part): the integrand error
-    /// ĉ·conj(i) that rotates against the rotor (a phase-gain mismatch of the current
-    /// sensors times R̂s).
-    pub negative: Ab<T>,
     /// D̂ of the last learning sample, Wb.
     pub disturbance_prev: Ab<T>,
     /// Samples in the learning regime without interruption (saturating).
@@ -109,11 +84,11 @@ impl<T: Real> IntegrandOffsetState<T> {
     /// True when every field is finite.
     #[inline]
     pub fn is_finite(&self) -> bool {
-        self.offset.is_finite() && self.disturbance_prev.is_finite() && self.negative.is_finite()
+        self.offset.is_finite() && self.disturbance_prev.is_finite()
     }
 }
 
-/// The law of the module docs (ê and ĉ).
+/// The law of the module docs.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct IntegrandOffset<T> {
     config: IntegrandOffsetConfig<T>,
@@ -148,24 +123,17 @@ impl<T: Real> IntegrandOffset<T> {
     /// The state after one more sample: `disturbance` is D̂ of this sample, `feedback_gain`
     /// the k_df gain in effect, `shift` the common-mode shift the estimator then applies to
     /// λ1, the observer and D̂ (D̂ after this sample is `disturbance − shift`), `learning`
-    /// whether the law runs (the k_df mode, turning), `i_ab` the current of this sample (A),
-    /// `omega` ω̂ of T2S-1 (rad/s, its sign turns the −ω residual back) and `rated_current`
-    /// (A peak: the regressor floor 0.1 × it, and |ĉ|·it ≤ `limit`).
+    /// whether the law runs (the k_df mode, turning).
     #[inline]
-    #[allow(clippy::too_many_arguments)]
     pub fn next_state(
         &self,
         disturbance: Ab<T>,
         feedback_gain: T,
         shift: Ab<T>,
         learning: bool,
-        i_ab: Ab<T>,
-        omega: T,
-        rated_current: T,
     ) -> IntegrandOffsetState<T> {
         let mut next = IntegrandOffsetState {
             offset: self.state.offset,
-            negative: self.state.negative,
             disturbance_prev: disturbance - shift,
             learning_samples: if learning {
                 self.state.learning_samples.saturating_add(1)
@@ -180,33 +148,6 @@ impl<T: Real> IntegrandOffset<T> {
             let innovation = (disturbance - self.state.disturbance_prev)
                 + disturbance * (feedback_gain * self.config.ts);
             let offset = self.state.offset + innovation * self.config.rate;
-            let i2 = i_ab.norm_squared();
-            let floor = T::lit(0.1) * rated_current;
-            if i2 > floor * floor {
-                // The observer passes the sequence at −ω with d/y = j·sgn(ω) (SPEC §2 at
-                // s = −jω), so the residual there is j·sgn(ω)·c·conj(i)·Ts (ĉ is not applied
-                // while turning): turned back by −j·sgn(ω), regressed on conj(i) (·i/|i|²)
-                // and low-passed, dĉ/dt = k_e·(c − ĉ).
-                let k = if omega < T::zero() {
-                    -self.config.rate
-                } else {
-                    self.config.rate
-                } / i2;
-                let p = Ab::new(
-                    innovation.alpha * i_ab.alpha - innovation.beta * i_ab.beta,
-                    innovation.alpha * i_ab.beta + innovation.beta * i_ab.alpha,
-                );
-                let g = Ab::new(p.beta, -p.alpha) * k;
-                let c = self.state.negative + g
-                    - self.state.negative * (self.config.rate * self.config.ts);
-                let bound = self.config.limit / rated_current;
-                let c2 = c.norm_squared();
-                next.negative = if c2 > bound * bound {
-                    c * (bound * bound / c2).sqrt()
-                } else {
-                    c
-                };
-            }
             let n2 = offset.norm_squared();
             next.offset = if n2 > self.limit_sq {
                 offset * (self.limit_sq / n2).step_sqrt()
@@ -236,28 +177,10 @@ impl<T: Real> IntegrandOffset<T> {
         self.state.learning_samples
     }
 
-    /// The learned integrand error now for the current `i_ab`: ê + ĉ·conj(i), V.
-    #[inline]
-    pub fn error_now(&self, i_ab: Ab<T>) -> Ab<T> {
-        Self::error(&self.state, i_ab)
-    }
-
     /// ê now, V.
     #[inline]
     pub fn offset(&self) -> Ab<T> {
         self.state.offset
-    }
-
-    /// The learned integrand error for the current `i_ab` in the limiter mode: ê + ĉ·conj(i), V
-    /// (turning, only ê is subtracted: D̂ carries the −ω sequence, see the module docs).
-    #[inline]
-    pub fn error(state: &IntegrandOffsetState<T>, i_ab: Ab<T>) -> Ab<T> {
-        let c = state.negative;
-        state.offset
-            + Ab::new(
-                c.alpha * i_ab.alpha + c.beta * i_ab.beta,
-                c.beta * i_ab.alpha - c.alpha * i_ab.beta,
-            )
     }
 
     /// The configuration in use.
@@ -284,33 +207,17 @@ mod tests {
         let n = (1.0 / ts) as usize;
         for _ in 0..n {
             lambda += (e - law.offset() - lambda * k_df) * ts;
-            let s = law.next_state(lambda, k_df, Ab::zero(), true, Ab::zero(), 1.0, 20.0);
+            let s = law.next_state(lambda, k_df, Ab::zero(), true);
             law.commit(s);
         }
         // After 1 s at k_e = 2 s⁻¹ the error is e^{−2} of e (to the Euler step).
         let left = (e - law.offset()).norm() / e.norm();
         assert!((left - (-2.0f64).exp()).abs() < 0.01, "{left}");
         // Bounded: a huge error saturates at the limit.
-        let s = law.next_state(
-            Ab::new(1e3, 0.0),
-            k_df,
-            Ab::zero(),
-            true,
-            Ab::zero(),
-            1.0,
-            20.0,
-        );
+        let s = law.next_state(Ab::new(1e3, 0.0), k_df, Ab::zero(), true);
         assert!((s.offset.norm() - law.config().limit).abs() < 1e-12);
         // Not learning: held.
-        let s = law.next_state(
-            Ab::new(1e3, 0.0),
-            k_df,
-            Ab::zero(),
-            false,
-            Ab::zero(),
-            1.0,
-            20.0,
-        );
+        let s = law.next_state(Ab::new(1e3, 0.0), k_df, Ab::zero(), false);
         assert_eq!(s.offset, law.offset());
         assert!(
             IntegrandOffset::<f64>::new(IntegrandOffsetConfig {
@@ -319,54 +226,5 @@ mod tests {
             })
             .is_err()
         );
-    }
-
-    #[test]
-    fn learns_a_negative_sequence_error_through_the_observer_for_either_direction() {
-        // λ1 = λf·e^{jωt} + x, dx/dt = c·conj(i) − ê − k_df·D̂, i = I·j·e^{jωt}
-        // (a phase-gain mismatch times R̂s): the observer passes the −ω sequence with phase
-        // j·sgn(ω), which the law turns back; ĉ must reach c and ê stay near 0.
-        use crate::observer::{DisturbanceObserver, DisturbanceObserverConfig};
-        let (ts, k_df, lf, amp) = (1e-4_f64, 0.5, 0.088, 15.0);
-        let c = Ab::new(-2.6e-4, -1.5e-4);
-        for omega in [
-            2.0 * core::f64::consts::PI * 20.0,
-            -2.0 * core::f64::consts::PI * 20.0,
-        ] {
-            let mut law = IntegrandOffset::new(IntegrandOffsetConfig {
-                ts,
-                settle_time: 0.0,
-                ..Default::default()
-            })
-            .unwrap();
-            let mut obs = DisturbanceObserver::new(DisturbanceObserverConfig { ts }).unwrap();
-            obs.reset_to(Ab::new(lf, 0.0));
-            let mut x = Ab::zero();
-            let n = (4.0 / ts) as usize;
-            let mut state = law.state;
-            for k in 0..n {
-                let th = omega * k as f64 * ts;
-                let i = Ab::new(-amp * th.sin(), amp * th.cos());
-                let conj = |v: Ab<f64>, i: Ab<f64>| {
-                    Ab::new(
-                        v.alpha * i.alpha + v.beta * i.beta,
-                        v.beta * i.alpha - v.alpha * i.beta,
-                    )
-                };
-                // Turning, only ê is subtracted (ĉ is the limiter mode's).
-                x += (conj(c, i) - state.offset - obs.disturbance() * k_df) * ts;
-                let lambda1 = Ab::new(lf * th.cos(), lf * th.sin()) + x;
-                let d = obs.step(lambda1, omega).unwrap();
-                state = law.next_state(d, k_df, Ab::zero(), true, i, omega, 20.0);
-                law.commit(state);
-            }
-            let err = (state.negative - c).norm() / c.norm();
-            assert!(err < 0.05, "ω {omega}: ĉ {:?} vs {c:?}", state.negative);
-            assert!(
-                state.offset.norm() < 0.05 * c.norm() * amp,
-                "{:?}",
-                state.offset
-            );
-        }
     }
 }
