@@ -40,7 +40,7 @@ struct Window {
     max_omega2_err: f64,
     max_current_integral: f64,
     max_speed_integral: f64,
-    flags: [u64; 7],
+    flags: [u64; DriveFlags::ALL.len()],
 }
 
 impl Window {
