@@ -194,6 +194,7 @@ class EstimatorConfig:
         rs_adaptation_max_ratio: float | None = None,
         flux_linkage_adaptation_rate: float | None = None,
         offset_adaptation_rate: float | None = None,
+        standstill_angle_rate: float | None = None,
         limiter_recentring: bool | None = None,
         plausible_current_ratio: float | None = None,
         plausible_voltage_ratio: float | None = None,
@@ -227,6 +228,7 @@ class EstimatorConfig:
         rs_adaptation_max_ratio: float | None = None,
         flux_linkage_adaptation_rate: float | None = None,
         offset_adaptation_rate: float | None = None,
+        standstill_angle_rate: float | None = None,
         limiter_recentring: bool | None = None,
         plausible_current_ratio: float | None = None,
         plausible_voltage_ratio: float | None = None,
@@ -301,6 +303,9 @@ class EstimatorConfig:
     @property
     def offset_adaptation_rate(self) -> float:
         """With rs_adaptation: rate of the integrand-offset (voltage-offset) estimate while turning, in 1/s (0 = off)."""
+    @property
+    def standstill_angle_rate(self) -> float:
+        """With rs_adaptation: rate at which λ̂r turns towards the current at standstill under the eq. (23) injection, in 1/s (0 = off)."""
     @property
     def limiter_recentring(self) -> bool:
         """In limiter mode, re-centre the common mode of λ1 and D̂ (fado's improvement)."""

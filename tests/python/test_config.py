@@ -38,6 +38,7 @@ PAPER_DEFAULTS = {
     "rs_adaptation_max_ratio": 2.0,  # [A]
     "flux_linkage_adaptation_rate": 0.0,  # [A]
     "offset_adaptation_rate": 2.0,  # [A]
+    "standstill_angle_rate": 2.0,  # [A]
     "limiter_recentring": True,  # fado's improvement [A]; False = the paper
     # Issue 14: plausibility bounds (ratios of the ratings) and the loss-of-lock detector.
     "plausible_current_ratio": 4.0,  # [A]

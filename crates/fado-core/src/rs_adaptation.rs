@@ -137,6 +137,12 @@ pub struct ResistanceAdaptationConfig<T> {
     /// integrated before it was corrected. Default 2π·5 s⁻¹ (ours \[A\]: 32 ms, within the
     /// start-up injection).
     pub standstill_flux_rate: T,
+    /// k_θ in s⁻¹: while the standstill DC test runs, the estimator also turns λ̂r towards
+    /// the stator current at this rate (see the module docs: with the eq. (23) injection and
+    /// no load, the speed loop holds the torque at zero, so the current lies along the rotor's
+    /// d axis). 0 = off. Default 2 s⁻¹ (ours \[A\]: a 0.5 s time constant, a tenth of the
+    /// 5 Hz speed loop's 31 rad/s, so that the loop re-balances the torque as θ̂ turns).
+    pub standstill_angle_rate: T,
     /// Lower bound of R̂s as a multiple of R0. Default 0.5 (ours \[A\]).
     pub min_ratio: T,
     /// Upper bound of R̂s as a multiple of R0. Default 2 (ours \[A\]: copper from −40 °C to
@@ -159,6 +165,7 @@ impl<T: Real> Default for ResistanceAdaptationConfig<T> {
             standstill_memory_hz: T::lit(0.5),
             standstill_speed_hz: T::lit(0.25),
             standstill_flux_rate: T::lit(2.0 * core::f64::consts::PI * 5.0),
+            standstill_angle_rate: T::lit(2.0),
             min_ratio: T::lit(0.5),
             max_ratio: T::lit(2.0),
         }
@@ -290,6 +297,13 @@ impl<T: Real> ResistanceAdaptation<T> {
             flux_rate * ts,
             T::one(),
             "with standstill_flux_rate·ts below 1",
+        )?;
+        let angle_rate = check::non_negative("standstill_angle_rate", config.standstill_angle_rate)?;
+        check::below(
+            "standstill_angle_rate",
+            angle_rate * ts,
+            T::one(),
+            "with standstill_angle_rate·ts below 1",
         )?;
         let min = check::positive("min_ratio", config.min_ratio)?;
         if min > T::one() {
@@ -468,6 +482,11 @@ impl<T: Real> ResistanceAdaptation<T> {
             // integrand error along the circle, which goes as e_t/|λ̂r|).
             let shortfall = min(mag - (lf + dl * i_d), T::zero());
             pull = unit * (self.config.standstill_flux_rate * shortfall);
+            // The injection's current response: at standstill with no load the speed loop
+            // holds the torque at zero, so the current lies along the rotor's d axis; turn
+            // λ̂r towards it at k_θ·tan(∠(i, λ̂r)) = k_θ·i_q/i_d (module docs).
+            let turn = self.config.standstill_angle_rate * mag * i_q / i_d;
+            pull += Ab::new(unit.beta, -unit.alpha) * turn;
         }
         next.rs_hat = min(max(next.rs_hat, self.rs_min), self.rs_max);
         (next, pull)
