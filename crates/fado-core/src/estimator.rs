@@ -35,6 +35,10 @@ use crate::{Ab, MachineModel, Real};
 /// Observer time constants 1/(2π·f_th) the λ̂f law waits after a LO→HI hand-over.
 const FLUX_SETTLE_TIME_CONSTANTS: f64 = 2.0;
 
+/// The λ̂f law runs above this multiple of the Fig. 3 threshold speed (see
+/// [`ResistanceAdaptationConfig::flux_linkage_min_speed`]).
+const FLUX_LINKAGE_SPEED_THRESHOLDS: f64 = 3.0;
+
 /// The estimator's tuning: every setting that is not the machine or the sampling period.
 /// Defaults are the paper's (section V) or SPEC.md's, as each field says; none depends on the
 /// motor (speeds are ratios of the rated electrical frequency). With the `serde` feature this
@@ -323,6 +327,9 @@ impl<T: Real> EstimatorConfig<T> {
             min_ratio: self.tuning.rs_adaptation_min_ratio,
             max_ratio: self.tuning.rs_adaptation_max_ratio,
             standstill_angle_rate: self.tuning.standstill_angle_rate,
+            flux_linkage_min_speed: T::lit(FLUX_LINKAGE_SPEED_THRESHOLDS)
+                * T::two_pi()
+                * self.mode_threshold_hz(),
             ..ResistanceAdaptationConfig::default()
         }
     }
@@ -607,6 +614,7 @@ impl<T: Real> SensorlessEstimator<T> {
                     "flux_linkage_rate" => rename("flux_linkage_adaptation_rate")(e),
                     // Fixed rates of the block that only a sampling period can make unstable.
                     "standstill_angle_rate" => e,
+                    "flux_linkage_min_speed" => rename("mode_threshold_ratio")(e),
                     "standstill_rate" | "standstill_memory_hz" | "standstill_flux_rate" => {
                         rename("ts")(e)
                     }

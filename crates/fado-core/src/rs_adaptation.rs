@@ -137,6 +137,11 @@ pub struct ResistanceAdaptationConfig<T> {
     /// integrated before it was corrected. Default 2π·5 s⁻¹ (ours \[A\]: 32 ms, within the
     /// start-up injection).
     pub standstill_flux_rate: T,
+    /// The λ̂f law runs only above this |ω̂|, rad/s: below it the voltage errors' share of
+    /// |λ̂r| − λ̂f (the dead-time residual and the other voltage errors over ω) is not small
+    /// against a λ̂f error. Default 2π·4.5 Hz (ours \[A\]: three times the Fig. 3 threshold
+    /// of the paper's motor; the estimator sets it from its threshold).
+    pub flux_linkage_min_speed: T,
     /// k_θ in s⁻¹: while the standstill DC test runs, the estimator also turns λ̂r towards
     /// the stator current at this rate (see the module docs: with the eq. (23) injection and
     /// no load, the speed loop holds the torque at zero, so the current lies along the rotor's
@@ -166,6 +171,7 @@ impl<T: Real> Default for ResistanceAdaptationConfig<T> {
             standstill_speed_hz: T::lit(0.25),
             standstill_flux_rate: T::lit(2.0 * core::f64::consts::PI * 5.0),
             standstill_angle_rate: T::lit(2.0),
+            flux_linkage_min_speed: T::lit(2.0 * core::f64::consts::PI * 4.5),
             min_ratio: T::lit(0.5),
             max_ratio: T::lit(2.0),
         }
@@ -305,6 +311,7 @@ impl<T: Real> ResistanceAdaptation<T> {
             T::one(),
             "with standstill_angle_rate·ts below 1",
         )?;
+        check::non_negative("flux_linkage_min_speed", config.flux_linkage_min_speed)?;
         let min = check::positive("min_ratio", config.min_ratio)?;
         if min > T::one() {
             return Err(ConfigError::OutOfRange {
@@ -436,7 +443,10 @@ impl<T: Real> ResistanceAdaptation<T> {
                 // The turning law replaces what the standstill tests contributed.
                 next.offset_sensitivity =
                     self.state.offset_sensitivity * (T::one() - self.rate_ts * weight);
-            } else if a_sq * T::lit(4.0) < floor_b_sq && settled {
+            } else if a_sq * T::lit(4.0) < floor_b_sq
+                && settled
+                && omega.abs() >= self.config.flux_linkage_min_speed
+            {
                 // |χ| < χ0/2: R̂s explains too little of |λ̂r| − λ̂a; the rest is λ̂f's (once
                 // the hand-over transient of |λ̂r| has passed: `settled`).
                 let lf0 = self.config.flux_linkage_hat;
