@@ -304,7 +304,8 @@ impl<T: Real> ResistanceAdaptation<T> {
             T::one(),
             "with standstill_flux_rate·ts below 1",
         )?;
-        let angle_rate = check::non_negative("standstill_angle_rate", config.standstill_angle_rate)?;
+        let angle_rate =
+            check::non_negative("standstill_angle_rate", config.standstill_angle_rate)?;
         check::below(
             "standstill_angle_rate",
             angle_rate * ts,

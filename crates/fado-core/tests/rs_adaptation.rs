@@ -203,6 +203,76 @@ fn standstill_law_freezes_under_q_current() {
     }
 }
 
+/// Angle error (true − estimated) after `seconds` at standstill with the eq. (23) injection
+/// along the true d axis (no load: the speed loop holds the torque at zero), the estimator
+/// started `error0` rad off.
+fn standstill_angle_error(angle_rate: f64, error0: f64, seconds: f64) -> f64 {
+    let theta0 = 0.4;
+    let mut est = SensorlessEstimator::new(config_with(|c| {
+        c.tuning.rs_adaptation = true;
+        c.tuning.standstill_angle_rate = angle_rate;
+    }))
+    .unwrap();
+    let i_dq = Dq::new(4.0, 0.0);
+    let (_, i0) = flux_and_current(theta0, i_dq);
+    est.align(theta0 - error0, i0);
+    let mut error = error0;
+    for (v, i, theta) in constant_speed(0.0, theta0, i_dq, (seconds / TS) as usize, Ab::zero()) {
+        error = wrap_angle(theta - est.step(v, i).theta);
+    }
+    error
+}
+
+#[test]
+fn standstill_angle_law_turns_the_flux_onto_the_current_at_its_rate() {
+    // k_θ = 2 s⁻¹: dδ/dt = −k_θ·tan δ ≈ −k_θ·δ, so ±0.3 rad decays to ≈ 0.3·e^{−2} in 1 s
+    // (tan δ > δ makes it a little faster), and to nothing in 3 s.
+    for error0 in [0.3, -0.3] {
+        let after_1s = standstill_angle_error(2.0, error0, 1.0);
+        let expected = error0 * (-2.0f64).exp();
+        assert!(
+            after_1s * error0 > 0.0 && after_1s.abs() < expected.abs() * 1.05,
+            "{error0}: {after_1s} against ≤ {expected}"
+        );
+        assert!(
+            after_1s.abs() > expected.abs() * 0.6,
+            "{error0}: {after_1s}"
+        );
+        let after_3s = standstill_angle_error(2.0, error0, 3.0);
+        assert!(after_3s.abs() < 0.01, "{error0}: {after_3s}");
+        // Off: nothing observes the angle at standstill, the error stays.
+        let off = standstill_angle_error(0.0, error0, 1.0);
+        assert!((off - error0).abs() < 0.01, "{error0}: off {off}");
+    }
+}
+
+#[test]
+fn flux_linkage_law_runs_only_above_its_speed() {
+    // No load (χ = 0, R̂s unobservable), |λ̂r| 5 % above λ̂f: λ̂f moves only at |ω̂| above
+    // flux_linkage_min_speed.
+    let config = ResistanceAdaptationConfig {
+        flux_linkage_rate: 5.0,
+        ..ResistanceAdaptationConfig::default()
+    };
+    let min_speed = config.flux_linkage_min_speed;
+    for (omega, moves) in [(0.5 * min_speed, false), (2.0 * min_speed, true)] {
+        let mut law = ResistanceAdaptation::new(config).unwrap();
+        let lambda_r = Ab::new(1.05 * LF, 0.0);
+        for _ in 0..1000 {
+            law.step(
+                Ab::zero(),
+                Ab::zero(),
+                lambda_r,
+                omega,
+                AdaptationRegime::Rotating,
+            );
+        }
+        let moved = law.flux_linkage_hat() / LF - 1.0;
+        assert_eq!(moved > 0.002, moves, "ω̂ = {omega}: λ̂f/λf − 1 = {moved}");
+        assert!(moved < 0.05);
+    }
+}
+
 #[test]
 fn off_keeps_the_configured_resistance_and_reset_restores_it() {
     let mut off = SensorlessEstimator::new(config_with(|c| {
