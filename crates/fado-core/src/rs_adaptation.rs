@@ -63,6 +63,28 @@
 //! these conditions. With a q-axis current (load at standstill) the flux error goes into the
 //! angle and nothing measures it: frozen there.
 //!
+//! **Standstill angle** (same conditions as the DC test: limiter mode, |ω̂| below the
+//! standstill speed, current along the estimated d axis). At standstill the fundamental model
+//! does not observe the angle of a surface-magnet rotor (Koteich, Maloum, Duc & Sandou,
+//! "Permanent magnet synchronous drives observability analysis for motion-sensorless
+//! control", arXiv:1601.06130, 2016): any tangential integrand error (the 0.5 % gain error
+//! of one current sensor times Rs·i is ≈ 3 mV at 4 A, 0.035 rad/s on the paper's motor)
+//! walks λ̂r along its circle without bound. The eq. (23) injection's current response does
+//! observe it: with no load the speed loop holds the torque at zero, so the stator current
+//! settles along the rotor's d axis, and in the estimated frame i_q/i_d = −tan δ for an angle
+//! error δ = θ − θ̂ (the torque balance that I-f start-up relies on, e.g. Wang, Lu &
+//! Blaabjerg, IEEE TPEL 27(8), 2012). So λ̂r is turned towards the current:
+//!
+//! ```text
+//!   dλ̂r/dt ∋ k_θ·|λ̂r|·(i_q/i_d)·j·λ̂r/|λ̂r|      (i.e. dθ̂/dt = k_θ·tan(∠(i, λ̂r)))
+//! ```
+//!
+//! a first-order decay of δ at k_θ (`standstill_angle_rate`). Under a light load i_L it
+//! settles at δ = atan(i_L/i_d) instead (the torque balance then needs that angle): the law
+//! assumes the eq. (23) regime, and stops where the DC test stops (i_d ≤ 2|i_q|, so at most
+//! atan(½) of bias). Under load (no injection) nothing observes the angle: see
+//! docs/zero-speed-errors.md for the loaded standstill.
+//!
 //! Besides, where the turning law is frozen for lack of excitation (|χ| < χ0/2: no load, high
 //! speed), the flux-magnitude reference λ̂f itself can be learned from |λ̂r| − (L̂d − L̂q)·î_d
 //! ([`ResistanceAdaptationConfig::flux_linkage_rate`], off by default).
