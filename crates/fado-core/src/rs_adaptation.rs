@@ -76,10 +76,14 @@
 //! Blaabjerg, IEEE TPEL 27(8), 2012). So λ̂r is turned towards the current:
 //!
 //! ```text
-//!   dλ̂r/dt ∋ k_θ·|λ̂r|·(i_q/i_d)·j·λ̂r/|λ̂r|      (i.e. dθ̂/dt = k_θ·tan(∠(i, λ̂r)))
+//!   x = i_q/i_d = tan(∠(i, λ̂r))
+//!   dλ̂r/dt ∋ k_θ·|λ̂r|·x·(1 − 4x²)·j·λ̂r/|λ̂r|     (i.e. dθ̂/dt = k_θ·x·(1 − 4x²))
 //! ```
 //!
-//! a first-order decay of δ at k_θ (`standstill_angle_rate`). Under a light load i_L it
+//! (times 1 − ω̂²/ω_s², ω_s the standstill speed) near δ = 0 a first-order decay of δ at k_θ
+//! (`standstill_angle_rate`); the factors 1 − 4x² and 1 − ω̂²/ω_s² take the law continuously
+//! to zero where the DC test's conditions i_d > 2|i_q| and |ω̂| ≤ ω_s end (no jump in dθ̂/dt
+//! when the current or the speed crosses them). Under a light load i_L it
 //! settles at δ = atan(i_L/i_d) instead (the torque balance then needs that angle): the law
 //! assumes the eq. (23) regime, and stops where the DC test stops (i_d ≤ 2|i_q|, so at most
 //! atan(½) of bias). Under load (no injection) nothing observes the angle: see
@@ -270,8 +274,8 @@ pub struct ResistanceAdaptation<T> {
     standstill_gain: T,
     /// e^{−ω_m·Ts}.
     forget: T,
-    /// 2π·standstill_speed_hz.
-    standstill_omega: T,
+    /// 1/(2π·standstill_speed_hz)².
+    standstill_inv_omega_sq: T,
     chi_per_phi: T,
     /// L̂d − L̂q.
     saliency: T,
@@ -355,7 +359,13 @@ impl<T: Real> ResistanceAdaptation<T> {
             rate_ts: rate * ts,
             standstill_gain: rate_s * ts,
             forget: (-(memory_w * ts)).exp(),
-            standstill_omega: T::two_pi() * standstill_hz,
+            // |ω̂| ≤ ω_s is ω̂²·(1/ω_s²) ≤ 1; ω_s = 0 allows ω̂ = 0 only (1e30: no ∞·0).
+            standstill_inv_omega_sq: if standstill_hz > T::zero() {
+                let w = T::two_pi() * standstill_hz;
+                T::one() / (w * w)
+            } else {
+                T::lit(1e30)
+            },
             chi_per_phi: r0 / lf,
             saliency: config.ld_hat - config.lq_hat,
             flux_gain: flux_rate_f * ts,
@@ -487,10 +497,12 @@ impl<T: Real> ResistanceAdaptation<T> {
             let unit = lambda_r * (T::one() / mag);
             let i_d = unit.dot(i_drop);
             let i_q = unit.cross(i_drop);
-            if i_d <= (i_q + i_q).abs() || omega.abs() > self.standstill_omega {
+            let speed_sq = omega * omega * self.standstill_inv_omega_sq;
+            if i_d <= (i_q + i_q).abs() || speed_sq > T::one() {
                 return (next, pull);
             }
             let ts = self.config.ts;
+            let inv_i_d = T::one() / i_d;
             let v_d = unit.dot(v_ab) + omega * self.config.lq_hat * i_q;
             let first = self.state.charge_d == T::zero();
             let di_d = if first {
@@ -505,7 +517,7 @@ impl<T: Real> ResistanceAdaptation<T> {
             if next.charge_d * self.chi_per_phi >= self.config.excitation_floor {
                 let r_dc = next.volt_seconds_d / next.charge_d;
                 next.rs_hat += self.standstill_gain * (r_dc - next.rs_hat);
-                let sensitivity = unit * (T::one() / i_d);
+                let sensitivity = unit * inv_i_d;
                 next.offset_sensitivity +=
                     (sensitivity - next.offset_sensitivity) * self.standstill_gain;
             }
@@ -517,8 +529,13 @@ impl<T: Real> ResistanceAdaptation<T> {
             pull = unit * (self.config.standstill_flux_rate * shortfall);
             // The injection's current response: at standstill with no load the speed loop
             // holds the torque at zero, so the current lies along the rotor's d axis; turn
-            // λ̂r towards it at k_θ·tan(∠(i, λ̂r)) = k_θ·i_q/i_d (module docs).
-            let turn = self.config.standstill_angle_rate * mag * i_q / i_d;
+            // λ̂r towards it at k_θ·x·(1 − 4x²), x = i_q/i_d = tan(∠(i, λ̂r)) (module docs).
+            let x = i_q * inv_i_d;
+            let turn = self.config.standstill_angle_rate
+                * mag
+                * x
+                * (T::one() - T::lit(4.0) * x * x)
+                * (T::one() - speed_sq);
             pull += Ab::new(unit.beta, -unit.alpha) * turn;
         }
         next.rs_hat = min(max(next.rs_hat, self.rs_min), self.rs_max);
