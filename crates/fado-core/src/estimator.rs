@@ -328,9 +328,6 @@ impl<T: Real> EstimatorConfig<T> {
             min_ratio: self.tuning.rs_adaptation_min_ratio,
             max_ratio: self.tuning.rs_adaptation_max_ratio,
             standstill_angle_rate: self.tuning.standstill_angle_rate,
-            flux_linkage_min_speed: T::lit(FLUX_LINKAGE_SPEED_THRESHOLDS)
-                * T::two_pi()
-                * self.mode_threshold_hz(),
             ..ResistanceAdaptationConfig::default()
         }
     }
@@ -604,24 +601,29 @@ impl<T: Real> SensorlessEstimator<T> {
             .map_err(rename("t2s1_bandwidth_hz"))?;
         let t2s2 = TypeTwoTracker::new(config.tracker(config.tuning.t2s2_bandwidth_hz))
             .map_err(rename("t2s2_bandwidth_hz"))?;
-        let rs_adaptation =
-            ResistanceAdaptation::new(config.rs_adaptation_config()).map_err(|e| {
-                match e.field() {
-                    "rs_initial" => rename("rs")(e),
-                    "rate" => rename("rs_adaptation_rate")(e),
-                    "excitation_floor" => rename("rs_adaptation_excitation_floor")(e),
-                    "min_ratio" => rename("rs_adaptation_min_ratio")(e),
-                    "max_ratio" => rename("rs_adaptation_max_ratio")(e),
-                    "flux_linkage_rate" => rename("flux_linkage_adaptation_rate")(e),
-                    // Fixed rates of the block that only a sampling period can make unstable.
-                    "standstill_angle_rate" => e,
-                    "flux_linkage_min_speed" => rename("mode_threshold_ratio")(e),
-                    "standstill_rate" | "standstill_memory_hz" | "standstill_flux_rate" => {
-                        rename("ts")(e)
-                    }
-                    _ => e,
+        let rs_adaptation = ResistanceAdaptation::new(ResistanceAdaptationConfig {
+            flux_linkage_min_speed: T::lit(FLUX_LINKAGE_SPEED_THRESHOLDS)
+                * T::two_pi()
+                * config.mode_threshold_hz(),
+            ..config.rs_adaptation_config()
+        })
+        .map_err(|e| {
+            match e.field() {
+                "rs_initial" => rename("rs")(e),
+                "rate" => rename("rs_adaptation_rate")(e),
+                "excitation_floor" => rename("rs_adaptation_excitation_floor")(e),
+                "min_ratio" => rename("rs_adaptation_min_ratio")(e),
+                "max_ratio" => rename("rs_adaptation_max_ratio")(e),
+                "flux_linkage_rate" => rename("flux_linkage_adaptation_rate")(e),
+                // Fixed rates of the block that only a sampling period can make unstable.
+                "standstill_angle_rate" => e,
+                "flux_linkage_min_speed" => rename("mode_threshold_ratio")(e),
+                "standstill_rate" | "standstill_memory_hz" | "standstill_flux_rate" => {
+                    rename("ts")(e)
                 }
-            })?;
+                _ => e,
+            }
+        })?;
         let threshold_hz = config.mode_threshold_hz();
         let offset = IntegrandOffset::new(IntegrandOffsetConfig {
             ts,
@@ -1060,7 +1062,7 @@ impl<T: Real> SensorlessEstimator<T> {
         self.config.machine.rs = rs_hat;
         if self.config.tuning.rs_adaptation {
             // Cannot fail: R̂s ≥ 0 was just checked and nothing else changed.
-            if let Ok(adaptation) = ResistanceAdaptation::new(self.config.rs_adaptation_config()) {
+            if let Ok(adaptation) = ResistanceAdaptation::new(self.rs_adaptation_config()) {
                 self.rs_adaptation = adaptation;
             }
         }
@@ -1081,10 +1083,20 @@ impl<T: Real> SensorlessEstimator<T> {
         self.config.tuning.rs_adaptation = true;
         self.offset_recentring_gain = self.config.tuning.offset_adaptation_rate * self.config.ts;
         // Cannot fail: the same configuration was accepted by `new` with R̂s from it.
-        if let Ok(adaptation) = ResistanceAdaptation::new(self.config.rs_adaptation_config()) {
+        if let Ok(adaptation) = ResistanceAdaptation::new(self.rs_adaptation_config()) {
             self.rs_adaptation = adaptation;
         }
         self.offset.reset();
+    }
+
+    /// The R̂s adaptation's configuration from the present one, with the λ̂f law's speed kept
+    /// from `new` (recomputing it from the ratings would bring soft f64 into the f32 drive's
+    /// reachable code: `scripts/check-firmware-symbols.sh`).
+    fn rs_adaptation_config(&self) -> ResistanceAdaptationConfig<T> {
+        ResistanceAdaptationConfig {
+            flux_linkage_min_speed: self.rs_adaptation.config().flux_linkage_min_speed,
+            ..self.config.rs_adaptation_config()
+        }
     }
 
     /// ê, the learned integrand offset (V, α-β; zero without `rs_adaptation`).
