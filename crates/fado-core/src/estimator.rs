@@ -139,7 +139,7 @@ pub struct EstimatorTuning<T> {
     /// [`ResistanceAdaptationConfig::standstill_angle_rate`] (2 s⁻¹).
     ///
     /// Measured (fado-sim fig10, switching-resolved, sensor seeds 1–8): the worst angle error
-    /// over the run drops from 0.371 rad (off) to 0.306 rad, and during the hold the error
+    /// over the run drops from 0.384 rad (off) to 0.308 rad, and during the hold the error
     /// decays instead of walking; what remains is the swing at the stop, before the law acts
     /// (0.5, 1, 4 and 8 s⁻¹ and a 1 Hz filter on i_q/i_d were worse: docs/zero-speed-errors.md).
     pub standstill_angle_rate: T,
