@@ -6,6 +6,9 @@ the detection-delay distribution.
 Labels (per run, from the true angle error over the whole run with the gates on):
   lost  = max |θ − θ̂| > 1 rad; detected = LOCK_LOST raised no later than 20 ms after
           |θ − θ̂| first exceeded 0.5 rad (raised earlier counts as detected);
+  detected in the window = raised no earlier than 0.5 s before and no later than 20 ms after
+          (the verdict latches: a flag raised at start-up, seconds before a loss, says nothing
+          about that loss);
   clean = max |θ − θ̂| < 0.25 rad; false alarm = LOCK_LOST raised at all in a clean run.
 Also: runs passing the paper's criteria (sweep `passed`) that raised the flag.
 
@@ -37,6 +40,7 @@ def stats(rows):
     lost = [r for r in rows if r["max_run"] > 1.0]
     delays = [r["flagged"] - r["exceeded"] for r in lost if not math.isnan(r["flagged"])]
     detected = sum(1 for d in delays if d <= 0.020)
+    in_window = sum(1 for d in delays if -0.5 <= d <= 0.020)
     never = sum(1 for r in lost if math.isnan(r["flagged"]))
     clean = [r for r in rows if r["max_run"] < 0.25]
     fa = sum(1 for r in clean if not math.isnan(r["flagged"]))
@@ -44,7 +48,7 @@ def stats(rows):
     fap = sum(1 for r in passed if not math.isnan(r["flagged"]))
     late = sorted(d for d in delays if d > 0.020)
     return dict(
-        runs=len(rows), lost=len(lost), detected=detected, never=never, clean=len(clean),
+        runs=len(rows), lost=len(lost), detected=detected, in_window=in_window, never=never, clean=len(clean),
         fa=fa, passed=len(passed), fap=fap, delays=delays,
         late_median=late[len(late) // 2] if late else math.nan,
     )
@@ -62,15 +66,15 @@ def main(argv):
         argv = argv[:k] + argv[k + 2 :]
     results = []
     print("| configuration | runs | lost (> 1 rad) | flagged ≤ 20 ms after 0.5 rad | never flagged "
-          "| median delay of the late ones | clean (< 0.25 rad) | false alarms | pass paper criteria | flagged |")
-    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+          "| raised in the window −0.5 s … +20 ms | median delay of the late ones | clean (< 0.25 rad) | false alarms | pass paper criteria | flagged |")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for arg in argv:
         label, path = arg.split("=", 1)
         s = stats(load(path))
         results.append((label, s))
         late = f"{1000 * s['late_median']:.0f} ms" if not math.isnan(s["late_median"]) else "—"
         print(f"| {label} | {s['runs']} | {s['lost']} | {s['detected']} ({pct(s['detected'], s['lost'])}) "
-              f"| {s['never']} | {late} | {s['clean']} | {s['fa']} ({pct(s['fa'], s['clean'])}) "
+              f"| {s['never']} | {s['in_window']} ({pct(s['in_window'], s['lost'])}) | {late} | {s['clean']} | {s['fa']} ({pct(s['fa'], s['clean'])}) "
               f"| {s['passed']} | {s['fap']} ({pct(s['fap'], s['passed'])}) |")
     if fig:
         import matplotlib
