@@ -822,7 +822,7 @@ impl<T: Real> SensorlessEstimator<T> {
         let active_ratio = if saliency != T::zero() && !tracker_hold {
             let i_d = i_ab.dot(lambda_r) / lambda_r.norm_squared().step_sqrt();
             let ratio = T::one() + saliency * i_d / self.config.machine.flux_linkage;
-            ratio.max(self.config.tuning.tracker_hold_ratio)
+            crate::real::max(ratio, self.config.tuning.tracker_hold_ratio)
         } else {
             T::one()
         };
