@@ -631,6 +631,11 @@ pub struct Commissioning<T> {
     w_int_te: T,
     j_step: u8,
     i_j: T,
+    /// d-current reference of the inertia test, released from the coast's level to 0 at a
+    /// bounded rate ([`ID_RELEASE_EMF`]), A.
+    id_j: T,
+    /// Its rate, A/s.
+    id_j_rate: T,
     result: Option<Identification<T>>,
 }
 
@@ -654,6 +659,12 @@ const J_STEP_TIME: f64 = 0.5;
 const PLL_EMF_FILTER: f64 = 0.001;
 /// Window of the inertia regression, s.
 const J_WINDOW: f64 = 0.04;
+/// Bound on the active-flux EMF's d component (L̂d − L̂q)·di_d/dt while the coast's d
+/// current is released at the start of the inertia test, relative to the EMF ω̂·λ̂f: the
+/// PLL's phase detector reads that component as an angle error of about this many rad.
+/// A step there (0.75 λ̂f of flux change on the 50 kW IPMSM preset, (Lq − Ld)·60 A) threw
+/// the PLL 0.5 rad off within 5 ms (measured: `Overspeed` in `Inertia`).
+const ID_RELEASE_EMF: f64 = 0.2;
 
 impl<T: Real> Commissioning<T> {
     /// A new procedure; the configuration is checked (the error names the field).
@@ -755,6 +766,8 @@ impl<T: Real> Commissioning<T> {
             w_int_te: T::zero(),
             j_step: 0,
             i_j: T::zero(),
+            id_j: T::zero(),
+            id_j_rate: T::zero(),
             result: None,
             cfg,
         };
@@ -1028,7 +1041,17 @@ impl<T: Real> Commissioning<T> {
         // machine's own resistance damping the rotor) in the alignment hold, the DC
         // measurement windows and the injections.
         let frozen = match self.phase {
-            Phase::Align => t >= T::lit(2.0) * at,
+            // The hold: frozen only once the current has settled at its reference (the
+            // criterion of the DC test below), not at a fixed time.
+            Phase::Align => {
+                if !self.frozen
+                    && t >= T::lit(2.0) * at
+                    && self.err_par < T::lit(0.03) * self.i_ref.norm()
+                {
+                    self.frozen = true;
+                }
+                self.frozen
+            }
             // Frozen once settled: after 60 % of the settling time and within 3 % of i*.
             Phase::Resistance => {
                 if !self.frozen
@@ -1101,7 +1124,10 @@ impl<T: Real> Commissioning<T> {
         }
         // Transitions.
         match self.phase {
-            Phase::Align if t >= T::lit(3.0) * at => self.next_phase(Phase::Resistance),
+            Phase::Align if t >= T::lit(3.0) * at => {
+                self.frozen = false;
+                self.next_phase(Phase::Resistance);
+            }
             Phase::Resistance if t >= settle + meas && !self.frozen => {
                 self.abort(AbortReason::CurrentNotFollowing { phase: self.phase });
                 return Ab::zero();
@@ -1310,7 +1336,10 @@ impl<T: Real> Commissioning<T> {
                 } else {
                     -self.i_j
                 };
-                (self.pll_theta, rate, Dq::new(T::zero(), iq))
+                // The coast's d current released towards 0 at the bounded rate.
+                let step = self.id_j_rate * ts;
+                self.id_j = clamp(T::zero(), self.id_j - step, self.id_j + step);
+                (self.pll_theta, rate, Dq::new(self.id_j, iq))
             }
         };
         let rot = Rotation::from_angle(theta_c);
@@ -1329,7 +1358,7 @@ impl<T: Real> Commissioning<T> {
         // Inertia windows (coast after 20 ms and the steps; 30 ms skipped after a step change).
         let collect = match self.phase {
             Phase::Coast => t > T::lit(0.02),
-            Phase::Inertia => t > T::lit(0.03),
+            Phase::Inertia => t > T::lit(0.03) && self.id_j == T::zero(),
             _ => false,
         };
         if collect {
@@ -1423,6 +1452,16 @@ impl<T: Real> Commissioning<T> {
                     T::lit(0.1) * self.i_limit,
                     T::lit(0.9) * self.i_limit,
                 );
+                // Release rate of the coast's d current: |(L̂d − L̂q)·di_d/dt| ≤
+                // ID_RELEASE_EMF·ω̂·λ̂f.
+                self.id_j = -T::lit(COAST_ID) * self.i_limit;
+                let dl = (self.ld - self.lq).abs();
+                let emf = T::lit(ID_RELEASE_EMF) * self.pll_omega.abs() * self.flux;
+                self.id_j_rate = if dl * self.i_limit < emf * ts {
+                    self.i_limit / ts
+                } else {
+                    emf / dl
+                };
                 self.j_step = 0;
                 self.w_k = 0;
                 self.next_phase(Phase::Inertia);
