@@ -29,8 +29,11 @@
 //!    unstable equilibrium of one is pulled by the other (the usual two-step alignment, e.g.
 //!    ST MCSDK's and TI InstaSPIN's). The standstill regulator is an integral-only loop
 //!    (v̇ = K·(i* − i), K = R̂²/(2L̂): L·s² + R·s + K with ζ ≈ 0.7 on the nameplate), *frozen*
-//!    to a constant voltage in the alignment hold, the DC measurement windows and the
-//!    injections: voltage mode leaves the machine's own resistance as the damping of the
+//!    to a constant voltage in the alignment hold (once the current has settled within 3 %
+//!    of its reference, as in the DC test: frozen at a fixed time, mid-swing, the 50 kW IPMSM
+//!    preset's hold parked a phase current inside the dead-time band, whose dead zone took
+//!    the resistive damping away, and the rotor swung ±50 r/min undamped into the DC test),
+//!    the DC measurement windows and the injections: voltage mode leaves the machine's own resistance as the damping of the
 //!    rotor's swing (a fast current loop would remove it and the rotor would ring for
 //!    seconds; measured: ±15 r/min still after 1 s on the paper's motor). A feedforward of the
 //!    reference, R̂·i* (nameplate) plus the dead-time part Td·f_sw·Vdc of the inverter error
@@ -81,7 +84,9 @@
 //!    Δω_mech = (1/J)·∫T̂e dt − (B/J)·∫ω_mech dt with T̂e = 1.5·p·(λ̂f·i_q + (L̂d − L̂q)·i_d·i_q);
 //!    least squares over the coast and both steps gives 1/Ĵ and B̂/Ĵ (the ST MCSDK profiler's
 //!    approach, with both acceleration and deceleration so that friction and inertia
-//!    separate). The noisy speed difference is the dependent variable: as a regressor its
+//!    separate). The coast's d current is released to 0 at a bounded rate at the start of
+//!    the steps (`ID_RELEASE_EMF`): the active-flux EMF has a d component (L̂d − L̂q)·di_d/dt
+//!    that the PLL reads as an angle error. The noisy speed difference is the dependent variable: as a regressor its
 //!    noise would bias Ĵ low (errors in variables; −20 % measured on the IPMSM).
 //!    The procedure ends with the gates off and the rotor coasting at about 10 % of its rated
 //!    speed.
