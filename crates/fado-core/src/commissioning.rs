@@ -29,8 +29,11 @@
 //!    unstable equilibrium of one is pulled by the other (the usual two-step alignment, e.g.
 //!    ST MCSDK's and TI InstaSPIN's). The standstill regulator is an integral-only loop
 //!    (v̇ = K·(i* − i), K = R̂²/(2L̂): L·s² + R·s + K with ζ ≈ 0.7 on the nameplate), *frozen*
-//!    to a constant voltage in the alignment hold, the DC measurement windows and the
-//!    injections: voltage mode leaves the machine's own resistance as the damping of the
+//!    to a constant voltage in the alignment hold (once the current has settled within 3 %
+//!    of its reference, as in the DC test: frozen at a fixed time, mid-swing, the 50 kW IPMSM
+//!    preset's hold parked a phase current inside the dead-time band, whose dead zone took
+//!    the resistive damping away, and the rotor swung ±50 r/min undamped into the DC test),
+//!    the DC measurement windows and the injections: voltage mode leaves the machine's own resistance as the damping of the
 //!    rotor's swing (a fast current loop would remove it and the rotor would ring for
 //!    seconds; measured: ±15 r/min still after 1 s on the paper's motor). A feedforward of the
 //!    reference, R̂·i* (nameplate) plus the dead-time part Td·f_sw·Vdc of the inverter error
@@ -81,7 +84,9 @@
 //!    Δω_mech = (1/J)·∫T̂e dt − (B/J)·∫ω_mech dt with T̂e = 1.5·p·(λ̂f·i_q + (L̂d − L̂q)·i_d·i_q);
 //!    least squares over the coast and both steps gives 1/Ĵ and B̂/Ĵ (the ST MCSDK profiler's
 //!    approach, with both acceleration and deceleration so that friction and inertia
-//!    separate). The noisy speed difference is the dependent variable: as a regressor its
+//!    separate). The coast's d current is released to 0 at a bounded rate at the start of
+//!    the steps (`ID_RELEASE_EMF`): the active-flux EMF has a d component (L̂d − L̂q)·di_d/dt
+//!    that the PLL reads as an angle error. The noisy speed difference is the dependent variable: as a regressor its
 //!    noise would bias Ĵ low (errors in variables; −20 % measured on the IPMSM).
 //!    The procedure ends with the gates off and the rotor coasting at about 10 % of its rated
 //!    speed.
@@ -631,6 +636,11 @@ pub struct Commissioning<T> {
     w_int_te: T,
     j_step: u8,
     i_j: T,
+    /// d-current reference of the inertia test, released from the coast's level to 0 at a
+    /// bounded rate ([`ID_RELEASE_EMF`]), A.
+    id_j: T,
+    /// Its rate, A/s.
+    id_j_rate: T,
     result: Option<Identification<T>>,
 }
 
@@ -654,6 +664,12 @@ const J_STEP_TIME: f64 = 0.5;
 const PLL_EMF_FILTER: f64 = 0.001;
 /// Window of the inertia regression, s.
 const J_WINDOW: f64 = 0.04;
+/// Bound on the active-flux EMF's d component (L̂d − L̂q)·di_d/dt while the coast's d
+/// current is released at the start of the inertia test, relative to the EMF ω̂·λ̂f: the
+/// PLL's phase detector reads that component as an angle error of about this many rad.
+/// A step there (0.75 λ̂f of flux change on the 50 kW IPMSM preset, (Lq − Ld)·60 A) threw
+/// the PLL 0.5 rad off within 5 ms (measured: `Overspeed` in `Inertia`).
+const ID_RELEASE_EMF: f64 = 0.2;
 
 impl<T: Real> Commissioning<T> {
     /// A new procedure; the configuration is checked (the error names the field).
@@ -755,6 +771,8 @@ impl<T: Real> Commissioning<T> {
             w_int_te: T::zero(),
             j_step: 0,
             i_j: T::zero(),
+            id_j: T::zero(),
+            id_j_rate: T::zero(),
             result: None,
             cfg,
         };
@@ -1028,7 +1046,17 @@ impl<T: Real> Commissioning<T> {
         // machine's own resistance damping the rotor) in the alignment hold, the DC
         // measurement windows and the injections.
         let frozen = match self.phase {
-            Phase::Align => t >= T::lit(2.0) * at,
+            // The hold: frozen only once the current has settled at its reference (the
+            // criterion of the DC test below), not at a fixed time.
+            Phase::Align => {
+                if !self.frozen
+                    && t >= T::lit(2.0) * at
+                    && self.err_par < T::lit(0.03) * self.i_ref.norm()
+                {
+                    self.frozen = true;
+                }
+                self.frozen
+            }
             // Frozen once settled: after 60 % of the settling time and within 3 % of i*.
             Phase::Resistance => {
                 if !self.frozen
@@ -1101,7 +1129,10 @@ impl<T: Real> Commissioning<T> {
         }
         // Transitions.
         match self.phase {
-            Phase::Align if t >= T::lit(3.0) * at => self.next_phase(Phase::Resistance),
+            Phase::Align if t >= T::lit(3.0) * at => {
+                self.frozen = false;
+                self.next_phase(Phase::Resistance);
+            }
             Phase::Resistance if t >= settle + meas && !self.frozen => {
                 self.abort(AbortReason::CurrentNotFollowing { phase: self.phase });
                 return Ab::zero();
@@ -1310,7 +1341,10 @@ impl<T: Real> Commissioning<T> {
                 } else {
                     -self.i_j
                 };
-                (self.pll_theta, rate, Dq::new(T::zero(), iq))
+                // The coast's d current released towards 0 at the bounded rate.
+                let step = self.id_j_rate * ts;
+                self.id_j = clamp(T::zero(), self.id_j - step, self.id_j + step);
+                (self.pll_theta, rate, Dq::new(self.id_j, iq))
             }
         };
         let rot = Rotation::from_angle(theta_c);
@@ -1329,7 +1363,7 @@ impl<T: Real> Commissioning<T> {
         // Inertia windows (coast after 20 ms and the steps; 30 ms skipped after a step change).
         let collect = match self.phase {
             Phase::Coast => t > T::lit(0.02),
-            Phase::Inertia => t > T::lit(0.03),
+            Phase::Inertia => t > T::lit(0.03) && self.id_j == T::zero(),
             _ => false,
         };
         if collect {
@@ -1423,6 +1457,16 @@ impl<T: Real> Commissioning<T> {
                     T::lit(0.1) * self.i_limit,
                     T::lit(0.9) * self.i_limit,
                 );
+                // Release rate of the coast's d current: |(L̂d − L̂q)·di_d/dt| ≤
+                // ID_RELEASE_EMF·ω̂·λ̂f.
+                self.id_j = -T::lit(COAST_ID) * self.i_limit;
+                let dl = (self.ld - self.lq).abs();
+                let emf = T::lit(ID_RELEASE_EMF) * self.pll_omega.abs() * self.flux;
+                self.id_j_rate = if dl * self.i_limit < emf * ts {
+                    self.i_limit / ts
+                } else {
+                    emf / dl
+                };
                 self.j_step = 0;
                 self.w_k = 0;
                 self.next_phase(Phase::Inertia);
