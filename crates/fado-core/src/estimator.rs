@@ -787,13 +787,14 @@ impl<T: Real> SensorlessEstimator<T> {
         // but absurd inputs can still overflow it, and a rejected sample must leave none of it
         // changed. One test at the end covers all of this (cheaper than a test per input and
         // per block, and than copying the estimator as a backup every sample).
+        // L̂d − L̂q: zero on a surface-magnet rotor, where the active-flux terms vanish.
+        let saliency = self.config.machine.ld - self.config.machine.lq;
         // 1. Integrate with the feedback of the previous sample (eq. (21) / (24)).
         let (lambda1, i_drop) = self.integrator.next_flux(v_ab, i_ab, self.feedback);
         // 2. Disturbance observer at ω̂ of T2S-1 (eq. (10), (16)), on λ1 or on λ1 − L̂q·i
         //    (see `EstimatorTuning::observer_on_rotor_flux`).
         let observer_input = if self.config.tuning.observer_on_rotor_flux {
             let active = rotor_flux(lambda1, i_ab, self.config.machine.lq);
-            let saliency = self.config.machine.ld - self.config.machine.lq;
             if saliency != T::zero() {
                 active - self.active_flux_swing(i_ab, saliency)
             } else {
@@ -818,7 +819,6 @@ impl<T: Real> SensorlessEstimator<T> {
         let flux_hat = self.rs_adaptation.flux_linkage_hat();
         // λ̂a/λ̂f, the active flux the limiter circle and the lock detector's bounds refer to
         // (1 on a surface-magnet rotor).
-        let saliency = self.config.machine.ld - self.config.machine.lq;
         let active_ratio = if saliency != T::zero() && !tracker_hold {
             let i_d = i_ab.dot(lambda_r) / lambda_r.norm_squared().step_sqrt();
             let ratio = T::one() + saliency * i_d / self.config.machine.flux_linkage;
