@@ -22,20 +22,7 @@ use crate::machine::PyMachine;
 use crate::simulate::{Motor, sim_error};
 
 /// The trace columns of a `CommissionResult`, in `traces.csv` order.
-pub const COMMISSION_TRACE_COLUMNS: [&str; 12] = [
-    "time",
-    "phase",
-    "i_alpha",
-    "i_beta",
-    "v_alpha",
-    "v_beta",
-    "v_applied_alpha",
-    "v_applied_beta",
-    "speed_rpm",
-    "speed_hat_rpm",
-    "theta",
-    "theta_hat",
-];
+pub const COMMISSION_TRACE_COLUMNS: [&str; 12] = sim_commission::TraceRow::COLUMNS;
 
 /// The procedure's phase names, by `Phase::index` (the `phase` trace column).
 pub fn phase_names() -> Vec<&'static str> {
@@ -290,20 +277,7 @@ impl CommissionResult {
             .map(|_| Vec::with_capacity(n))
             .collect();
         for r in &o.trace {
-            for (c, v) in cols.iter_mut().zip([
-                r.time,
-                f64::from(r.phase),
-                r.i_alpha,
-                r.i_beta,
-                r.v_alpha,
-                r.v_beta,
-                r.v_applied_alpha,
-                r.v_applied_beta,
-                r.speed_rpm,
-                r.speed_hat_rpm,
-                r.theta,
-                r.theta_hat,
-            ]) {
+            for (c, v) in cols.iter_mut().zip(r.values()) {
                 c.push(v);
             }
         }

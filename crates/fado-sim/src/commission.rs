@@ -85,6 +85,42 @@ pub struct TraceRow {
     pub theta_hat: f64,
 }
 
+impl TraceRow {
+    /// The column names, in field order (the `traces.csv` header, from the serde derive).
+    pub const COLUMNS: [&'static str; 12] = [
+        "time",
+        "phase",
+        "i_alpha",
+        "i_beta",
+        "v_alpha",
+        "v_beta",
+        "v_applied_alpha",
+        "v_applied_beta",
+        "speed_rpm",
+        "speed_hat_rpm",
+        "theta",
+        "theta_hat",
+    ];
+
+    /// The row's values in [`Self::COLUMNS`] order (the phase index as a number).
+    pub fn values(&self) -> [f64; 12] {
+        [
+            self.time,
+            f64::from(self.phase),
+            self.i_alpha,
+            self.i_beta,
+            self.v_alpha,
+            self.v_beta,
+            self.v_applied_alpha,
+            self.v_applied_beta,
+            self.speed_rpm,
+            self.speed_hat_rpm,
+            self.theta,
+            self.theta_hat,
+        ]
+    }
+}
+
 /// What a simulated commissioning run gives.
 #[derive(Clone, Debug)]
 pub struct CommissionOutcome {
@@ -340,4 +376,26 @@ pub fn compare(id: &Identification<f64>, t: &Truth) -> Vec<Comparison> {
             c.inverter_voltage,
         ),
     ]
+}
+
+#[cfg(test)]
+mod trace_row_tests {
+    use super::TraceRow;
+
+    #[test]
+    fn columns_are_the_csv_header_and_values_follow_them() {
+        let mut w = csv::Writer::from_writer(Vec::new());
+        let row = TraceRow {
+            time: 1.0,
+            phase: 2,
+            theta_hat: 3.0,
+            ..Default::default()
+        };
+        w.serialize(row).unwrap();
+        let text = String::from_utf8(w.into_inner().unwrap()).unwrap();
+        let header = text.lines().next().unwrap();
+        assert_eq!(header, TraceRow::COLUMNS.join(","));
+        let v = row.values();
+        assert_eq!((v[0], v[1], v[11]), (1.0, 2.0, 3.0));
+    }
 }

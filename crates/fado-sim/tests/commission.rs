@@ -62,27 +62,12 @@ fn report(
     .unwrap();
     let t = o.truth;
     if let Ok(dir) = std::env::var("FADO_TRACE") {
-        let mut w = String::from(
-            "time,phase,i_alpha,i_beta,v_alpha,v_beta,va_true,vb_true,speed_rpm,speed_hat_rpm,theta,theta_hat\n",
-        );
+        let path = format!("{dir}/{}.csv", name.replace(' ', "_"));
+        let mut w = csv::Writer::from_path(path).unwrap();
         for r in &o.trace {
-            w += &format!(
-                "{},{},{},{},{},{},{},{},{},{},{},{}\n",
-                r.time,
-                r.phase,
-                r.i_alpha,
-                r.i_beta,
-                r.v_alpha,
-                r.v_beta,
-                r.v_applied_alpha,
-                r.v_applied_beta,
-                r.speed_rpm,
-                r.speed_hat_rpm,
-                r.theta,
-                r.theta_hat
-            );
+            w.serialize(r).unwrap();
         }
-        std::fs::write(format!("{dir}/{}.csv", name.replace(' ', "_")), w).unwrap();
+        w.flush().unwrap();
     }
     eprintln!(
         "{name}: {:?} in {:.2} s sim ({:.1} s wall)",
