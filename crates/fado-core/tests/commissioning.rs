@@ -3,6 +3,8 @@
 //! load. Property tests: the current reference never exceeds the limit, the procedure
 //! always terminates.
 
+mod common;
+
 use fado_core::commissioning::{
     AbortReason, Commissioning, CommissioningConfig, Identification, Status,
 };
@@ -14,17 +16,9 @@ const VDC: f64 = 300.0;
 
 fn ipmsm() -> MachineModel<f64> {
     MachineModel {
-        rs: 3.6,
-        ld: 36e-3,
-        lq: 51e-3,
-        flux_linkage: 0.545,
-        pole_pairs: 3,
         inertia: 0.01,
-        viscous_friction: 2e-3,
-        rated_current: 6.0,
-        rated_speed_rpm: 1500.0,
         rated_torque: 14.7,
-        dc_voltage: 540.0,
+        ..common::ipmsm_model()
     }
 }
 

@@ -15,6 +15,8 @@
 //! Nested fields (`machine.rs`, `tuning.k_df`) are named by their last component, as the
 //! errors name them.
 
+mod common;
+
 use fado_core::Real;
 use fado_core::baselines::{
     EmfObserverConfig, EmfObserverEstimator, LpfIntegratorConfig, LpfIntegratorEstimator,
@@ -131,18 +133,10 @@ fn ok<X>(r: Result<X, ConfigError>) -> Result<(), ConfigError> {
 /// MTPA point of 6 A (`drive_salient.rs` checks it).
 fn ipmsm<T: Real>() -> MachineModel<T> {
     MachineModel {
-        rs: T::lit(3.6),
-        ld: T::lit(36e-3),
-        lq: T::lit(51e-3),
-        flux_linkage: T::lit(0.545),
-        pole_pairs: 3,
-        inertia: T::lit(0.02),
-        viscous_friction: T::lit(1e-3),
-        rated_current: T::lit(6.0),
-        rated_speed_rpm: T::lit(1500.0),
-        rated_torque: T::lit(14.9),
-        dc_voltage: T::lit(540.0),
+        viscous_friction: 1e-3,
+        ..common::ipmsm_model()
     }
+    .cast()
 }
 
 fn run_all<T: Real>(failures: &mut Vec<String>, machine: MachineModel<T>) -> usize {

@@ -8,6 +8,8 @@
 //!   d current of `MachineModel::mtpa_id` (Morimoto et al., IEEE TIA 26(5), 1990), and the
 //!   MTPA d current really lowers the current the load takes.
 
+mod common;
+
 use core::f64::consts::TAU;
 
 use fado_core::control::{DriveConfig, DriveOutput, SensorlessDrive};
@@ -29,19 +31,7 @@ fn mtpa_id_on_circle(m: &MachineModel<f64>, i: f64) -> f64 {
 /// 1500 r/min, 540 V DC link), rated torque = magnet + reluctance torque at the MTPA point of
 /// the rated current (14.9 N·m).
 fn ipmsm() -> MachineModel<f64> {
-    let mut m = MachineModel {
-        rs: 3.6,
-        ld: 36e-3,
-        lq: 51e-3,
-        flux_linkage: 0.545,
-        pole_pairs: 3,
-        inertia: 0.02,
-        viscous_friction: 2e-3,
-        rated_current: 6.0,
-        rated_speed_rpm: 1500.0,
-        rated_torque: 0.0,
-        dc_voltage: 540.0,
-    };
+    let mut m = common::ipmsm_model();
     let id = mtpa_id_on_circle(&m, m.rated_current);
     let iq = (m.rated_current.powi(2) - id * id).sqrt();
     m.rated_torque = m.torque(Dq::new(id, iq));
