@@ -110,6 +110,9 @@ pub const FLUX_LINKAGE_MIN_RATIO: f64 = 0.85;
 /// λ̂f never pushes against the limiter.
 pub const FLUX_LINKAGE_MAX_RATIO: f64 = 1.14;
 
+/// Dead zone of the λ̂f law as a multiple of the configured λ̂f (see the module docs).
+pub const FLUX_LINKAGE_DEAD_ZONE: f64 = 0.01;
+
 /// Configuration of [`ResistanceAdaptation`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ResistanceAdaptationConfig<T> {
@@ -187,7 +190,7 @@ impl<T: Real> Default for ResistanceAdaptationConfig<T> {
             ts: T::lit(100e-6),
             rs_initial: T::lit(0.327),
             flux_linkage_hat: T::lit(0.088),
-            flux_linkage_rate: T::zero(),
+            flux_linkage_rate: T::lit(5.0),
             rate: T::lit(1.0),
             excitation_floor: T::lit(0.2),
             lq_hat: T::lit(2.63e-3),
@@ -243,6 +246,12 @@ pub struct ResistanceAdaptationState<T> {
     /// standstill law (unit/i_d at its rate), forgotten at the turning law's rate; when the
     /// integrand-offset estimate ê moves by Δê, R̂s moves by −⟨Δê, ∂R̂s/∂ê⟩ (issue 13).
     pub offset_sensitivity: Ab<T>,
+    /// λ̂f law: ∫(|λ̂r| − λ̂a)·|ω̂|dt over the revolution under way, Wb·rad.
+    pub flux_error_angle: T,
+    /// λ̂f law: ∫|ω̂|dt, the angle of the revolution under way, rad.
+    pub flux_angle: T,
+    /// λ̂f law: the time of the revolution under way, s.
+    pub flux_time: T,
 }
 
 impl<T: Real> ResistanceAdaptationState<T> {
@@ -257,6 +266,9 @@ impl<T: Real> ResistanceAdaptationState<T> {
             self.i_d_prev,
             self.offset_sensitivity.alpha,
             self.offset_sensitivity.beta,
+            self.flux_error_angle,
+            self.flux_angle,
+            self.flux_time,
         ])
     }
 }
@@ -279,8 +291,6 @@ pub struct ResistanceAdaptation<T> {
     chi_per_phi: T,
     /// L̂d − L̂q.
     saliency: T,
-    /// γ_f·Ts.
-    flux_gain: T,
     floor_sq: T,
     rs_min: T,
     rs_max: T,
@@ -368,7 +378,6 @@ impl<T: Real> ResistanceAdaptation<T> {
             },
             chi_per_phi: r0 / lf,
             saliency: config.ld_hat - config.lq_hat,
-            flux_gain: flux_rate_f * ts,
             floor_sq: floor * floor,
             rs_min: min * r0,
             rs_max: max * r0,
@@ -482,14 +491,31 @@ impl<T: Real> ResistanceAdaptation<T> {
             {
                 // |χ| < χ0/2: R̂s explains too little of |λ̂r| − λ̂a; the rest is λ̂f's (once
                 // the hand-over transient of |λ̂r| has passed: `settled`).
-                let lf0 = self.config.flux_linkage_hat;
-                next.flux_linkage_hat = min(
-                    max(
-                        lf + self.flux_gain * (mag - reference),
-                        lf0 * T::lit(FLUX_LINKAGE_MIN_RATIO),
-                    ),
-                    lf0 * T::lit(FLUX_LINKAGE_MAX_RATIO),
-                );
+                // The mean of |λ̂r| − λ̂a over one electrical revolution (angle-weighted, so
+                // exact at a changing speed): a DC error left in λ2 by the observer's
+                // transient makes |λ̂r| swing at ω̂, which the mean removes.
+                let step_angle = omega.abs() * self.config.ts;
+                next.flux_error_angle = self.state.flux_error_angle + (mag - reference) * step_angle;
+                next.flux_angle = self.state.flux_angle + step_angle;
+                next.flux_time = self.state.flux_time + self.config.ts;
+                if next.flux_angle >= T::two_pi() {
+                    let lf0 = self.config.flux_linkage_hat;
+                    let error = next.flux_error_angle / next.flux_angle;
+                    // Dead zone (module docs): the part of the mean beyond ±zone.
+                    let zone = lf0 * T::lit(FLUX_LINKAGE_DEAD_ZONE);
+                    let excess = error - min(max(error, -zone), zone);
+                    let gain = min(self.config.flux_linkage_rate * next.flux_time, T::one());
+                    next.flux_linkage_hat = min(
+                        max(
+                            lf + gain * excess,
+                            lf0 * T::lit(FLUX_LINKAGE_MIN_RATIO),
+                        ),
+                        lf0 * T::lit(FLUX_LINKAGE_MAX_RATIO),
+                    );
+                    next.flux_error_angle = T::zero();
+                    next.flux_angle = T::zero();
+                    next.flux_time = T::zero();
+                }
             }
         } else {
             // Standstill: only at standstill and while the current lies along the flux (the
