@@ -36,7 +36,7 @@ PAPER_DEFAULTS = {
     "rs_adaptation_excitation_floor": 0.2,  # [A]
     "rs_adaptation_min_ratio": 0.5,  # [A]
     "rs_adaptation_max_ratio": 2.0,  # [A]
-    "flux_linkage_adaptation_rate": 0.0,  # [A]
+    "flux_linkage_adaptation_rate": 5.0,  # [A] (issue 13: revolution mean, 1 % dead zone)
     "offset_adaptation_rate": 2.0,  # [A]
     "standstill_angle_rate": 2.0,  # [A]
     "limiter_recentring": True,  # fado's improvement [A]; False = the paper
