@@ -89,8 +89,9 @@
 //! atan(½) of bias). Under load (no injection) nothing observes the angle: see
 //! docs/zero-speed-errors.md for the loaded standstill.
 //!
-//! **Flux linkage** (k_df mode, |χ| < χ0/2: no load or high speed, where R̂s explains little
-//! of the flux magnitude; |ω̂| above 3× the Fig. 3 threshold; past the hand-over transient).
+//! **Flux linkage** (k_df mode, |ω̂| above 3× the Fig. 3 threshold, past the hand-over
+//! transient, and where the revolution's mean χ is below χ0/2: no load or high speed, where
+//! R̂s explains little of the flux magnitude).
 //! A λ̂f error biases the turning law by Δλf·ω/i_q (0.7 % of Rs per 1 % of λf at −90 r/min
 //! under 7.5 N·m on the paper's motor), so λ̂f is learned where its own error dominates
 //! |λ̂r| − λ̂a, each law where its parameter is observable. Two things bias that regressor
@@ -117,8 +118,11 @@
 //!   λ̂f += min(γ_f·T_rev, 1)·D(ē),   D(ē) = ē − clamp(ē, −ε·λ̂f0, +ε·λ̂f0)
 //! ```
 //!
-//! once per revolution (T_rev its duration; the sums restart whenever a condition fails):
-//! the angle-weighted mean removes the first harmonic of a DC error in λ2 exactly, also at a
+//! once per revolution (T_rev its duration; the sums restart whenever a condition fails),
+//! if the revolution's mean χ (signed, ∮χ·dθ/∮dθ) is below χ0/2 in magnitude: tested per
+//! sample, the current noise of a motor whose no-load current gives χ ≈ 0.1 (the hub motor
+//! preset) crossed the bound every few samples and no revolution completed. The
+//! angle-weighted mean removes the first harmonic of a DC error in λ2 exactly, also at a
 //! changing speed, and the dead zone D (the dead-zone modification of robust adaptive
 //! control: Peterson & Narendra, "Bounded error adaptive control", IEEE TAC 27(6), 1982;
 //! Ioannou & Sun, *Robust Adaptive Control*, 1996, §8.5.4) ignores what a bounded
@@ -557,10 +561,7 @@ impl<T: Real> ResistanceAdaptation<T> {
                         min(self.config.flux_linkage_rate * next.flux_time, T::one())
                     };
                     next.flux_linkage_hat = min(
-                        max(
-                            lf + gain * excess,
-                            lf0 * T::lit(FLUX_LINKAGE_MIN_RATIO),
-                        ),
+                        max(lf + gain * excess, lf0 * T::lit(FLUX_LINKAGE_MIN_RATIO)),
                         lf0 * T::lit(FLUX_LINKAGE_MAX_RATIO),
                     );
                     next.flux_error_angle = T::zero();

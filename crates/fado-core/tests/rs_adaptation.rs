@@ -250,6 +250,16 @@ fn standstill_angle_law_turns_the_flux_onto_the_current_at_its_rate() {
 /// The λ̂f law alone (no load: χ = 0, R̂s unobservable) fed |λ̂r| = `magnitude(angle)` while
 /// λ̂r turns at ω̂ for `seconds`; returns λ̂f/λf − 1.
 fn flux_linkage_law_moves(omega: f64, seconds: f64, magnitude: impl Fn(f64) -> f64) -> f64 {
+    flux_linkage_law_moves_with_current(omega, seconds, magnitude, |_| 0.0)
+}
+
+/// As [`flux_linkage_law_moves`] with a q-axis current `i_q(sample)` (A).
+fn flux_linkage_law_moves_with_current(
+    omega: f64,
+    seconds: f64,
+    magnitude: impl Fn(f64) -> f64,
+    i_q: impl Fn(usize) -> f64,
+) -> f64 {
     let config = ResistanceAdaptationConfig {
         flux_linkage_rate: 5.0,
         ..ResistanceAdaptationConfig::default()
@@ -260,7 +270,7 @@ fn flux_linkage_law_moves(omega: f64, seconds: f64, magnitude: impl Fn(f64) -> f
         let lambda_r = Ab::from_polar(magnitude(angle), angle);
         law.step(
             Ab::zero(),
-            Ab::zero(),
+            Ab::from_polar(i_q(k), angle + core::f64::consts::FRAC_PI_2),
             lambda_r,
             omega,
             AdaptationRegime::Rotating,
@@ -279,9 +289,31 @@ fn flux_linkage_law_runs_only_above_its_speed() {
         assert_eq!(moved > 0.002, moves, "ω̂ = {omega}: λ̂f/λf − 1 = {moved}");
         if moves {
             let expected = 0.05 - FLUX_LINKAGE_DEAD_ZONE;
-            assert!((moved - expected).abs() < 1e-3, "{moved} against {expected}");
+            assert!(
+                (moved - expected).abs() < 1e-3,
+                "{moved} against {expected}"
+            );
         }
     }
+}
+
+#[test]
+fn flux_linkage_law_runs_where_the_revolution_mean_excitation_is_small() {
+    // χ = −i_q·R0/(λ̂f·ω̂). A steady |χ| = 0.3 (above χ0/2 = 0.1: R̂s explains the flux
+    // error there) keeps λ̂f; a current swinging between χ = ±0.3 every other sample (zero
+    // mean: what current noise does to a nearly unloaded motor) does not.
+    let config = ResistanceAdaptationConfig::<f64>::default();
+    let omega = 2.0 * config.flux_linkage_min_speed;
+    let i_chi = 0.3 * LF * omega / config.rs_initial;
+    let loaded = flux_linkage_law_moves_with_current(omega, 1.0, |_| 1.05 * LF, |_| i_chi);
+    assert_eq!(loaded, 0.0);
+    let noisy = flux_linkage_law_moves_with_current(
+        omega,
+        1.0,
+        |_| 1.05 * LF,
+        |k| if k % 2 == 0 { i_chi } else { -i_chi },
+    );
+    assert!(noisy > 0.03, "{noisy}");
 }
 
 #[test]
