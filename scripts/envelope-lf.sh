@@ -19,8 +19,8 @@ axes=(--axis flux_linkage_error=-0.1:0.1:9 --axis load_torque=0:7.5:7)
 off=$(mktemp /tmp/fado-lf-off.XXXXXX.toml)
 trap 'rm -f "$off"' EXIT
 printf '[estimator]\nflux_linkage_adaptation_rate = 0.0\n' >"$off"
-"$sim" sweep fig11 "${axes[@]}" --out out/envelope-lf-load-default "$@" >/dev/null
-"$sim" sweep fig11 "${axes[@]}" --config "$off" --out out/envelope-lf-load-law-off "$@" >/dev/null
+"$sim" sweep fig11 "${axes[@]}" --fresh --out out/envelope-lf-load-default "$@" >/dev/null
+"$sim" sweep fig11 "${axes[@]}" --config "$off" --fresh --out out/envelope-lf-load-law-off "$@" >/dev/null
 cp out/envelope-lf-load-default/sweep.csv docs/envelope-fig11-lf-load-default.csv
 cp out/envelope-lf-load-law-off/sweep.csv docs/envelope-fig11-lf-load-law-off.csv
 "$python" - <<'PY'

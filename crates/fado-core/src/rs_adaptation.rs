@@ -155,6 +155,10 @@ pub const FLUX_LINKAGE_MAX_RATIO: f64 = 1.14;
 /// of about ±2 % (docs/zero-speed-errors.md).
 pub const FLUX_LINKAGE_DEAD_ZONE: f64 = 0.01;
 
+/// Once a revolution mean has left the dead zone, the λ̂f law follows the whole mean until one
+/// is within this multiple of the configured λ̂f (module docs). 0.25 % (ours \[A\]).
+pub const FLUX_LINKAGE_DEAD_ZONE_OFF: f64 = 0.0025;
+
 /// Configuration of [`ResistanceAdaptation`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ResistanceAdaptationConfig<T> {
@@ -297,6 +301,9 @@ pub struct ResistanceAdaptationState<T> {
     pub flux_angle: T,
     /// λ̂f law: the time of the revolution under way, s.
     pub flux_time: T,
+    /// λ̂f law: a revolution mean left the dead zone and has not yet come within
+    /// [`FLUX_LINKAGE_DEAD_ZONE_OFF`] of λ̂f.
+    pub flux_learning: bool,
 }
 
 impl<T: Real> ResistanceAdaptationState<T> {
@@ -493,6 +500,7 @@ impl<T: Real> ResistanceAdaptation<T> {
                 self.rs_max,
             ),
             flux_linkage_hat: self.state.flux_linkage_hat,
+            flux_learning: self.state.flux_learning,
             offset_sensitivity: self.state.offset_sensitivity,
             ..ResistanceAdaptationState::default()
         };
@@ -552,16 +560,23 @@ impl<T: Real> ResistanceAdaptation<T> {
                     let excess_chi = next.flux_excitation.abs() >= bound;
                     let lf0 = self.config.flux_linkage_hat;
                     let error = next.flux_error_angle / next.flux_angle;
-                    // Dead zone (module docs): the part of the mean beyond ±zone.
+                    // Dead zone with hysteresis (module docs): a mean beyond ±ε starts the
+                    // law, which then follows the whole mean until it is within ±ε_off.
                     let zone = lf0 * T::lit(FLUX_LINKAGE_DEAD_ZONE);
                     let excess = error - min(max(error, -zone), zone);
+                    let on = self.state.flux_learning || error.abs() > zone + zone;
                     let gain = if excess_chi {
                         T::zero()
                     } else {
                         min(self.config.flux_linkage_rate * next.flux_time, T::one())
                     };
+                    if !excess_chi {
+                        next.flux_learning =
+                            on && error.abs() > lf0 * T::lit(FLUX_LINKAGE_DEAD_ZONE_OFF);
+                    }
+                    let step = if on { error } else { excess };
                     next.flux_linkage_hat = min(
-                        max(lf + gain * excess, lf0 * T::lit(FLUX_LINKAGE_MIN_RATIO)),
+                        max(lf + gain * step, lf0 * T::lit(FLUX_LINKAGE_MIN_RATIO)),
                         lf0 * T::lit(FLUX_LINKAGE_MAX_RATIO),
                     );
                     next.flux_error_angle = T::zero();
