@@ -127,7 +127,7 @@ pub struct EstimatorTuning<T> {
     ///
     /// Measured (fado-sim fig11, switching-resolved, default settings otherwise): with λ̂f
     /// −10 % / +10 % / −5 % and R̂s +10 % the worst near-zero-speed angle error drops from
-    /// 1.02 / 1.21 / 0.98 rad (off) to 0.15 / 0.17 / 0.04 rad; with λ̂f right nothing moves
+    /// 1.02 / 1.21 / 0.98 rad (off) to 0.03 / 0.15 / 0.09 rad; with λ̂f right nothing moves
     /// (fig8, fig10 on seeds 1–8, fig12: the same results, the revolution means stay inside
     /// the law's 1 % dead zone; docs/zero-speed-errors.md).
     pub flux_linkage_adaptation_rate: T,

@@ -182,8 +182,9 @@ pub struct ResistanceAdaptationConfig<T> {
     /// [`FLUX_LINKAGE_MIN_RATIO`]–[`FLUX_LINKAGE_MAX_RATIO`]·λ̂f). Default 5 s⁻¹ (ours \[A\]:
     /// 0.83 of the error per revolution at the 6 Hz of the paper's ±90 r/min, so that the
     /// ≈ 0.25 s at no load above the gate speed before fig11's load learns a 10 % error;
-    /// measured there: 10 and 20 s⁻¹, deadbeat at 6 Hz, gave 0.141 / 0.165 rad with λ̂f
-    /// −10 / +10 %, 5 s⁻¹ 0.147 / 0.171, docs/zero-speed-errors.md).
+    /// measured there with λ̂f −10 % / +10 % / −5 % and R̂s +10 %: 2 s⁻¹ 0.94 / 0.46 / 0.13
+    /// rad (two fail), 5 s⁻¹ 0.028 / 0.152 / 0.087, 10 s⁻¹ (deadbeat at 6 Hz) 0.033 / 0.151 /
+    /// 0.094; docs/zero-speed-errors.md).
     pub flux_linkage_rate: T,
     /// γ in s⁻¹: decay rate of the relative R̂s error under full excitation while turning.
     /// Default 1 s⁻¹ (ours \[A\]: the winding heats over minutes, so the law can be slow; at
