@@ -176,9 +176,9 @@ pub struct ResistanceAdaptationConfig<T> {
     /// \[A\]).
     pub flux_linkage_hat: T,
     /// γ_f in s⁻¹: rate at which the flux-magnitude reference λ̂f follows the revolution
-    /// mean of |λ̂r| − λ̂a beyond the dead zone while turning without resistance excitation
-    /// (|χ| < χ0/2: no load, or high speed); λ̂f moves once per electrical revolution by
-    /// min(γ_f·T_rev, 1) of it (module docs). 0 = fixed λ̂f (bounds
+    /// mean of |λ̂r| − λ̂a (beyond its dead zone) while turning without resistance excitation
+    /// (the revolution's mean |χ| < χ0/2: no load, or high speed); λ̂f moves once per
+    /// electrical revolution by min(γ_f·T_rev, 1) of it (module docs). 0 = fixed λ̂f (bounds
     /// [`FLUX_LINKAGE_MIN_RATIO`]–[`FLUX_LINKAGE_MAX_RATIO`]·λ̂f). Default 5 s⁻¹ (ours \[A\]:
     /// 0.83 of the error per revolution at the 6 Hz of the paper's ±90 r/min, so that the
     /// ≈ 0.25 s at no load above the gate speed before fig11's load learns a 10 % error;
