@@ -47,7 +47,7 @@ def grid(name):
 panels = [
     ("law-off", "λ̂f law off (flux_linkage_adaptation_rate = 0)"),
     ("after-lf5", "issue 13 second pass: per-sample λ̂f law, 5 s⁻¹"),
-    ("default", "defaults: revolution-mean λ̂f law, 1 % dead zone"),
+    ("default", "defaults: revolution-mean λ̂f law (dead zone 1 %, following beyond 2 %)"),
 ]
 fig = Figure(figsize=(16.5, 5.0), layout="constrained")
 FigureCanvasAgg(fig)
