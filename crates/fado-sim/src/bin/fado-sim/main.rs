@@ -448,7 +448,11 @@ fn run_commission(
         &plant,
         nameplate,
         CommissionOptions::default(),
-        |_| {},
+        |c| {
+            if let Some(x) = std::env::var("SCRATCH_SPIN").ok().and_then(|v| v.parse().ok()) {
+                c.spin_speed_ratio = x;
+            }
+        },
         Some(&mut cb),
     )?;
     bar.finish_and_clear();
