@@ -511,15 +511,6 @@ struct Ls2<T> {
 }
 
 impl<T: Real> Ls2<T> {
-    fn push(&mut self, x1: T, x2: T, y: T) {
-        self.a11 += x1 * x1;
-        self.a12 += x1 * x2;
-        self.a22 += x2 * x2;
-        self.b1 += x1 * y;
-        self.b2 += x2 * y;
-        self.yy += y * y;
-        self.n += T::one();
-    }
     /// ((a, b), (σ_a, σ_b)).
     fn solve(&self) -> Option<((T, T), (T, T))> {
         let det = self.a11 * self.a22 - self.a12 * self.a12;
@@ -534,6 +525,143 @@ impl<T: Real> Ls2<T> {
             (j, b),
             ((res * self.a22 / det).sqrt(), (res * self.a11 / det).sqrt()),
         ))
+    }
+}
+
+/// The inertia regression Δω = a·x1 + b·x2 with x1 = ∫T̂e = λ̂f·u + r split into its
+/// magnet part (u = ∫1.5·p·i_q dt) and reluctance part (r = ∫1.5·p·(L̂d − L̂q)·i_d·i_q dt),
+/// so that it can be solved with the λ̂f known only at the end (the second back-EMF window
+/// lies between the torque steps).
+#[derive(Clone, Copy, Debug, Default)]
+struct JFit<T> {
+    uu: T,
+    ur: T,
+    rr: T,
+    ux: T,
+    rx: T,
+    xx: T,
+    uy: T,
+    ry: T,
+    xy: T,
+    yy: T,
+    n: T,
+}
+
+impl<T: Real> JFit<T> {
+    fn push(&mut self, u: T, r: T, x2: T, y: T) {
+        self.uu += u * u;
+        self.ur += u * r;
+        self.rr += r * r;
+        self.ux += u * x2;
+        self.rx += r * x2;
+        self.xx += x2 * x2;
+        self.uy += u * y;
+        self.ry += r * y;
+        self.xy += x2 * y;
+        self.yy += y * y;
+        self.n += T::one();
+    }
+    /// The normal equations with x1 = λ·u + r.
+    fn with_flux(&self, flux: T) -> Ls2<T> {
+        Ls2 {
+            a11: flux * flux * self.uu + T::lit(2.0) * flux * self.ur + self.rr,
+            a12: flux * self.ux + self.rx,
+            a22: self.xx,
+            b1: flux * self.uy + self.ry,
+            b2: self.xy,
+            yy: self.yy,
+            n: self.n,
+        }
+    }
+}
+
+/// The inertia test's data reduction: within each contiguous stretch of collected samples
+/// (a segment), the running integrals U(t) = ∫1.5·p·i_q, R(t) = ∫1.5·p·(L̂d − L̂q)·i_d·i_q
+/// and W(t) = ∫ω̂_mech from the segment's start, and, per window of `J_WINDOW`, the means
+/// of ω̂_mech, U, R and W. Since ω(t) = ω(t₀) + (λf·U + R)/J − (B/J)·W at every instant,
+/// the difference of two consecutive windows' means obeys the same equation with ω(t₀)
+/// gone; the speed enters as a mean over a window, not as two samples (the PLL's speed
+/// ripple at six times the electrical frequency, ±30 r/min on the 50 kW IPMSM preset at a
+/// quarter of its rated speed, otherwise lands on Δω sample by sample).
+#[derive(Clone, Copy, Debug, Default)]
+struct JWindows<T> {
+    run_u: T,
+    run_r: T,
+    run_w: T,
+    k: u32,
+    sum: [T; 4],
+    prev: Option<[T; 4]>,
+}
+
+impl<T: Real> JWindows<T> {
+    /// A break in the data: the next sample starts a new segment.
+    fn reset(&mut self) {
+        *self = Self::default();
+    }
+    /// One sample: the mechanical speed ω̂ (rad/s), the rates 1.5·p·i_q and
+    /// 1.5·p·(L̂d − L̂q)·i_d·i_q; a finished window goes into `fit`.
+    fn push(&mut self, omega: T, u: T, r: T, ts: T, n: u32, fit: &mut JFit<T>) {
+        self.run_u += u * ts;
+        self.run_r += r * ts;
+        self.run_w += omega * ts;
+        for (s, x) in self
+            .sum
+            .iter_mut()
+            .zip([omega, self.run_u, self.run_r, self.run_w])
+        {
+            *s += x;
+        }
+        self.k += 1;
+        if self.k >= n {
+            let kk = T::lit(self.k as f64);
+            let m = self.sum.map(|x| x / kk);
+            if let Some(p) = self.prev {
+                // Δω̄ = (λf·ΔŪ + ΔR̄)/J − (B/J)·ΔW̄.
+                fit.push(m[1] - p[1], m[2] - p[2], -(m[3] - p[3]), m[0] - p[0]);
+            }
+            self.prev = Some(m);
+            self.sum = [T::zero(); 4];
+            self.k = 0;
+        }
+    }
+}
+
+/// One back-EMF window: ∫e_f dt and ∫ω̂ dt (e_f = E_q − ω̂·(L̂d − L̂q)·i_d, the magnet's EMF),
+/// the time, and block means of e_f/ω̂ for the scatter.
+#[derive(Clone, Copy, Debug)]
+struct EmfWindow<T> {
+    e: T,
+    w: T,
+    time: T,
+    blocks: BlockStats<T>,
+}
+
+impl<T: Real> EmfWindow<T> {
+    fn new(block: u32) -> Self {
+        Self {
+            e: T::zero(),
+            w: T::zero(),
+            time: T::zero(),
+            blocks: BlockStats::new(block),
+        }
+    }
+    fn push(&mut self, e_f: T, w: T, ts: T) {
+        self.e += e_f * ts;
+        self.w += w * ts;
+        self.time += ts;
+        self.blocks.push(e_f / w);
+    }
+    /// Mean speed ω̄, rad/s.
+    fn speed(&self) -> T {
+        self.w / self.time
+    }
+    /// Mean EMF ē_f, V.
+    fn emf(&self) -> T {
+        self.e / self.time
+    }
+    /// Standard error of ē_f, V (from the block means of e_f/ω̂ at the mean speed).
+    fn emf_sem(&self) -> T {
+        self.blocks.sem() * self.speed()
     }
 }
 
@@ -624,17 +752,16 @@ pub struct Commissioning<T> {
     e_filt: Dq<T>,
     pll_kp: T,
     pll_ki: T,
-    // Coast accumulators.
-    e_int: T,
-    theta_int: T,
-    flux_blocks: BlockStats<T>,
+    /// The two back-EMF windows: the coast at the spin speed and the one at J_HIGH × it.
+    emf_win: [EmfWindow<T>; 2],
     // Inertia windows.
-    ls: Ls2<T>,
-    w_k: u32,
-    w_omega0: T,
-    w_int_omega: T,
-    w_int_te: T,
+    jfit: JFit<T>,
+    jwin: JWindows<T>,
+    /// Inertia test stage: 0 the step up, 1 the second back-EMF window at the top, 2 the
+    /// step down.
     j_step: u8,
+    /// Time since the d current reached its coast level in stage 1, s.
+    t_coast2: T,
     i_j: T,
     /// d-current reference of the inertia test, released from the coast's level to 0 at a
     /// bounded rate ([`ID_RELEASE_EMF`]), A.
@@ -695,14 +822,15 @@ impl<T: Real> Commissioning<T> {
         // lags the current vector by about 30°, far from the pull-out.
         let p = T::lit(np.pole_pairs as f64);
         let magnet_torque = T::lit(1.5) * p * np.flux_linkage * if_level(np, i_limit);
-        let spin_torque = (cfg.spin_torque_ratio * np.rated_torque).min(T::lit(0.5) * magnet_torque);
+        let spin_torque =
+            (cfg.spin_torque_ratio * np.rated_torque).min(T::lit(0.5) * magnet_torque);
         let spin_accel = spin_torque / np.inertia * p;
         let nominal_total = cfg.offset_time
             + T::lit(3.0) * cfg.align_time
             + T::lit(2.0) * (cfg.settle_time + cfg.measure_time)
             + T::lit(2.0) * (T::lit(0.02) + cfg.measure_time)
             + (spin_speed / spin_accel + cfg.settle_time)
-            + cfg.measure_time
+            + T::lit(2.0) * (T::lit(0.02) + cfg.measure_time)
             + T::lit(1.0);
         let block = libm_round(BLOCK_TIME / ts.to_f64());
         let wc = T::lit(0.2) / ts;
@@ -765,15 +893,11 @@ impl<T: Real> Commissioning<T> {
             e_filt: Dq::zero(),
             pll_kp: T::lit(2.0) * wn,
             pll_ki: wn * wn,
-            e_int: T::zero(),
-            theta_int: T::zero(),
-            flux_blocks: BlockStats::new(block),
-            ls: Ls2::default(),
-            w_k: 0,
-            w_omega0: T::zero(),
-            w_int_omega: T::zero(),
-            w_int_te: T::zero(),
+            emf_win: [EmfWindow::new(block); 2],
+            jfit: JFit::default(),
+            jwin: JWindows::default(),
             j_step: 0,
+            t_coast2: T::zero(),
             i_j: T::zero(),
             id_j: T::zero(),
             id_j_rate: T::zero(),
@@ -813,15 +937,16 @@ impl<T: Real> Commissioning<T> {
         self.v_lvl = [BlockStats::new(block); 2];
         self.i_lvl = [BlockStats::new(block); 2];
         self.vdc_stats = BlockStats::new(block);
-        self.flux_blocks = BlockStats::new(block);
+        self.emf_win = [EmfWindow::new(block); 2];
         self.line = Line::default();
-        self.ls = Ls2::default();
+        self.jfit = JFit::default();
         self.pll_on = false;
         self.pi_int = Dq::zero();
         self.theta_f = T::zero();
         self.omega_f = T::zero();
         self.j_step = 0;
-        self.w_k = 0;
+        self.t_coast2 = T::zero();
+        self.jwin.reset();
         self.result = None;
         self.cfg = cfg;
     }
@@ -1340,14 +1465,19 @@ impl<T: Real> Commissioning<T> {
                 Dq::new(-T::lit(COAST_ID) * self.i_limit, T::zero()),
             ),
             _ => {
-                let iq = if self.j_step == 0 {
-                    self.i_j
-                } else {
-                    -self.i_j
+                // Step up, second back-EMF window (no torque, the coast's d current), step
+                // down; the d current moved between 0 and the coast's level at the bounded
+                // rate.
+                let (iq, id_target) = match self.j_step {
+                    0 => (self.i_j, T::zero()),
+                    1 => (T::zero(), -T::lit(COAST_ID) * self.i_limit),
+                    _ => (-self.i_j, T::zero()),
                 };
-                // The coast's d current released towards 0 at the bounded rate.
                 let step = self.id_j_rate * ts;
-                self.id_j = clamp(T::zero(), self.id_j - step, self.id_j + step);
+                self.id_j = clamp(id_target, self.id_j - step, self.id_j + step);
+                if self.j_step == 1 && self.id_j == id_target {
+                    self.t_coast2 += ts;
+                }
                 (self.pll_theta, rate, Dq::new(self.id_j, iq))
             }
         };
@@ -1357,38 +1487,50 @@ impl<T: Real> Commissioning<T> {
         // The PLL's integral state is its speed (the proportional path's noise, kp·err, would
         // bias any average conditioned on it).
         let w = self.pll_omega;
-        if self.phase == Phase::Coast && t > T::lit(0.02) && w > T::zero() {
+        // The back-EMF windows: the coast after 20 ms of decay, and the top of the inertia
+        // test 20 ms after the d current has reached the coast's level.
+        let emf_window = match self.phase {
+            Phase::Coast => Some(0),
+            Phase::Inertia
+                if self.j_step == 1
+                    && self.t_coast2 > T::lit(0.02)
+                    && self.t_coast2 <= T::lit(0.02) + cfg.measure_time =>
+            {
+                Some(1)
+            }
+            _ => None,
+        };
+        if let Some(k) = emf_window
+            && t > T::lit(0.02)
+            && w > T::zero()
+        {
             // E_q = ω·(λf + (Ld − Lq)·i_d) (active flux).
             let e_f = e_q - w * (self.ld - self.lq) * i_dq.d;
-            self.e_int += e_f * ts;
-            self.theta_int += w * ts;
-            self.flux_blocks.push(e_f / w);
+            self.emf_win[k].push(e_f, w, ts);
         }
-        // Inertia windows (coast after 20 ms and the steps; 30 ms skipped after a step change).
+        // Inertia windows (the back-EMF windows and the steps; 30 ms skipped after a step
+        // change).
         let collect = match self.phase {
             Phase::Coast => t > T::lit(0.02),
-            Phase::Inertia => t > T::lit(0.03) && self.id_j == T::zero(),
+            Phase::Inertia => {
+                emf_window.is_some()
+                    || (self.j_step != 1 && t > T::lit(0.03) && self.id_j == T::zero())
+            }
             _ => false,
         };
         if collect {
-            let te = T::lit(1.5) * p * (self.flux * i_dq.q + (self.ld - self.lq) * i_dq.d * i_dq.q);
-            if self.w_k == 0 {
-                self.w_omega0 = self.pll_omega / p;
-                self.w_int_omega = T::zero();
-                self.w_int_te = T::zero();
-            }
-            self.w_int_omega += w / p * ts;
-            self.w_int_te += te * ts;
-            self.w_k += 1;
-            if T::lit(self.w_k as f64) * ts >= T::lit(J_WINDOW) {
-                let d_omega = self.pll_omega / p - self.w_omega0;
-                // Δω = (1/J)·∫Te − (B/J)·∫ω: the noisy speed difference on the left, where its
-                // noise does not bias the fit (it would attenuate Ĵ as a regressor).
-                self.ls.push(self.w_int_te, -self.w_int_omega, d_omega);
-                self.w_k = 0;
-            }
+            // T̂e = λ̂f·(1.5·p·i_q) + 1.5·p·(L̂d − L̂q)·i_d·i_q, its two parts apart (JFit).
+            let n = libm_round(J_WINDOW / ts.to_f64());
+            self.jwin.push(
+                w / p,
+                T::lit(1.5) * p * i_dq.q,
+                T::lit(1.5) * p * (self.ld - self.lq) * i_dq.d * i_dq.q,
+                ts,
+                n,
+                &mut self.jfit,
+            );
         } else {
-            self.w_k = 0;
+            self.jwin.reset();
         }
         // Synchronous PI with decoupling, output advanced by 1.5 samples.
         let e = i_ref_dq - i_dq;
@@ -1434,13 +1576,12 @@ impl<T: Real> Commissioning<T> {
                 // Re-express the integral in the PLL frame.
                 let int_ab = self.pi_int.to_ab(Rotation::from_angle(self.theta_f));
                 self.pi_int = int_ab.to_dq(Rotation::from_angle(self.pll_theta));
-                self.e_int = T::zero();
-                self.theta_int = T::zero();
                 self.next_phase(Phase::Coast);
             }
             Phase::Coast if t >= T::lit(0.02) + cfg.measure_time => {
-                self.flux = self.e_int / self.theta_int;
-                self.flux_sigma = self.flux_blocks.sem() / self.flux_blocks.mean().abs();
+                // Provisional λ̂f from the first window alone (sizes the torque steps); the
+                // final one comes from both windows (`finish_flux`).
+                self.flux = self.emf_win[0].e / self.emf_win[0].w;
                 let np = cfg.nameplate.flux_linkage;
                 if !(self.flux.is_finite()
                     && self.flux > T::lit(0.25) * np
@@ -1472,16 +1613,25 @@ impl<T: Real> Commissioning<T> {
                     emf / dl
                 };
                 self.j_step = 0;
-                self.w_k = 0;
+                self.t_coast2 = T::zero();
+                self.jwin.reset();
                 self.next_phase(Phase::Inertia);
             }
             Phase::Inertia => {
                 if self.j_step == 0 && self.pll_omega >= T::lit(J_HIGH) * self.spin_speed {
                     self.j_step = 1;
-                    self.w_k = 0;
+                    self.jwin.reset();
                     self.nominal_done += self.t_phase;
                     self.t_phase = T::zero();
-                } else if self.j_step == 1 && self.pll_omega <= T::lit(J_LOW) * self.spin_speed {
+                } else if self.j_step == 1 && self.t_coast2 > T::lit(0.02) + cfg.measure_time {
+                    if !self.finish_flux() {
+                        return (Ab::zero(), Ab::zero());
+                    }
+                    self.j_step = 2;
+                    self.jwin.reset();
+                    self.nominal_done += self.t_phase;
+                    self.t_phase = T::zero();
+                } else if self.j_step == 2 && self.pll_omega <= T::lit(J_LOW) * self.spin_speed {
                     self.finish_inertia();
                 }
             }
@@ -1493,9 +1643,36 @@ impl<T: Real> Commissioning<T> {
         (v, applied)
     }
 
+    /// λ̂f from the two back-EMF windows (module docs, step 5): the line ē_f = λf·ω̄ + e₀
+    /// through them. False (and aborted) when implausible.
+    fn finish_flux(&mut self) -> bool {
+        let [w1, w2] = self.emf_win;
+        let (s1, s2) = (w1.speed(), w2.speed());
+        let ds = s2 - s1;
+        let flux = (w2.emf() - w1.emf()) / ds;
+        let np = self.cfg.nameplate.flux_linkage;
+        // The windows must be apart in speed (the torque step doubles it).
+        if !(flux.is_finite()
+            && ds > T::lit(0.25) * s1
+            && flux > T::lit(0.25) * np
+            && flux < T::lit(4.0) * np)
+        {
+            self.abort(AbortReason::Implausible {
+                parameter: Parameter::FluxLinkage,
+            });
+            return false;
+        }
+        self.flux = flux;
+        let se = (w1.emf_sem() * w1.emf_sem() + w2.emf_sem() * w2.emf_sem()).sqrt();
+        self.flux_sigma = se / ds / flux.abs();
+        true
+    }
+
     fn finish_inertia(&mut self) {
         let np = self.cfg.nameplate;
-        let Some(((inv_j, b_over_j), (s_inv_j, s_b_over_j))) = self.ls.solve() else {
+        let Some(((inv_j, b_over_j), (s_inv_j, s_b_over_j))) =
+            self.jfit.with_flux(self.flux).solve()
+        else {
             self.abort(AbortReason::Implausible {
                 parameter: Parameter::Inertia,
             });

@@ -166,7 +166,7 @@ impl Default for CommissionOptions {
     fn default() -> Self {
         Self {
             theta0: 1.0,
-            decimation: std::env::var("SCRATCH_DECIM").ok().and_then(|v| v.parse().ok()).unwrap_or(10),
+            decimation: 10,
             max_seconds: 60.0,
             cancel: None,
         }

@@ -448,11 +448,7 @@ fn run_commission(
         &plant,
         nameplate,
         CommissionOptions::default(),
-        |c| {
-            if let Some(x) = std::env::var("SCRATCH_SPIN").ok().and_then(|v| v.parse().ok()) {
-                c.spin_speed_ratio = x;
-            }
-        },
+        |_| {},
         Some(&mut cb),
     )?;
     bar.finish_and_clear();
