@@ -151,31 +151,38 @@ fn salient_pmsyrm_preset_is_identified_within_the_targets() {
 }
 
 /// The 50 kW automotive IPMSM preset (Rs 18 mΩ, 240 A, inverter error 14 V against R·I
-/// 0.7 V, Lq/Ld 3.24, J 0.039 kg·m²): it used to abort with `CurrentNotFollowing` in the DC
-/// test (the alignment hold frozen mid-swing, a phase current parked in the dead-time band:
-/// an undamped ±50 r/min swing), then with `Overspeed` in the inertia test (the coast's i_d
-/// step thrown at the PLL through (Ld − Lq)·di_d/dt). Every target but λf's is checked; λ̂f
-/// is −5.5 … −5.9 % on this preset (open).
+/// 0.7 V and a back-EMF of 12 V at the spin speed, Lq/Ld 3.24, J 0.039 kg·m²), sensor seeds
+/// 1–4, every target. It used to abort with `CurrentNotFollowing` in the DC test (the
+/// alignment hold frozen mid-swing), then with `Overspeed` in the inertia test (the coast's
+/// i_d step thrown at the PLL), then finished with λ̂f −5.5 … −5.9 %: its I-f current
+/// (90 % of the limit, (Lq − Ld)·I = 1.36 λf) was beyond the reluctance stability limit,
+/// the rotor hunted ±1 rad about a lag where the active flux vanishes, the PLL slipped and
+/// the coast's speed estimate was 6 % high; and the inverter's speed-independent EMF error
+/// (−0.24 V against 12 V) took another −2 % (module docs of `fado_core::commissioning`,
+/// steps 5 and 6). Also checked: the back-EMF speed in the coast is the rotor's.
 #[test]
-fn gem_50k_preset_completes_within_the_standstill_and_inertia_targets() {
-    let (p, m) = preset("ipmsm-gem-50k");
-    let o = report("ipmsm-gem-50k", &p, m);
-    assert_eq!(o.status, Status::Done);
-    let id = o.identification.unwrap();
-    let (m, t) = (id.model, o.truth);
-    let rel = |a: f64, b: f64| (a / b - 1.0).abs();
-    assert!(rel(m.rs, t.rs) < 0.02, "rs {} vs {}", m.rs, t.rs);
-    assert!(rel(m.ld, t.ld) < 0.05, "ld {} vs {}", m.ld, t.ld);
-    assert!(rel(m.lq, t.lq) < 0.05, "lq {} vs {}", m.lq, t.lq);
-    assert!(
-        rel(m.inertia, t.inertia) < 0.10,
-        "J {} vs {}",
-        m.inertia,
-        t.inertia
-    );
-    assert!((id.threshold_voltage - t.threshold_voltage).abs() < 0.1);
-    assert!(o.simulated_seconds < 30.0);
-    assert!(o.max_current_reference <= o.current_limit * (1.0 + 1e-12));
+fn gem_50k_preset_is_identified_within_the_targets() {
+    for seed in 1..=4 {
+        let (mut p, m) = preset("ipmsm-gem-50k");
+        p.current_sensor.seed = seed;
+        let o = report(&format!("ipmsm-gem-50k seed {seed}"), &p, m);
+        check(&o);
+        let coast: Vec<_> = o
+            .trace
+            .iter()
+            .filter(|r| r.phase as usize == fado_core::commissioning::Phase::Coast.index())
+            .collect();
+        assert!(coast.len() > 1000, "seed {seed}: {} samples", coast.len());
+        let mean = |f: &dyn Fn(&fado_sim::commission::TraceRow) -> f64| {
+            coast.iter().map(|r| f(r)).sum::<f64>() / coast.len() as f64
+        };
+        let speed_error = mean(&|r| r.speed_hat_rpm) / mean(&|r| r.speed_rpm) - 1.0;
+        assert!(
+            speed_error.abs() < 0.005,
+            "seed {seed}: coast speed estimate off by {:+.2} %",
+            100.0 * speed_error
+        );
+    }
 }
 
 /// The PM-SyRM preset's plant and its own record as the nameplate.
