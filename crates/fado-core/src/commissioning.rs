@@ -65,31 +65,62 @@
 //!    regardless of any constant voltage. The q injection's torque alternates at 1.25 kHz
 //!    (at 10 kHz sampling) and moves the rotor by microradians. Saliency: L̂q/L̂d.
 //! 5. **Spin and back-EMF** ([`Phase::Spin`], [`Phase::Coast`]): an I-f start (a current vector
-//!    of 90 % of the limit turned at a speed ramped to `spin_speed_ratio` of the rated speed,
-//!    acceleration sized to use 10 % of the rated torque on the nameplate inertia), regulated
-//!    by a synchronous-frame PI tuned from the identified R̂s, L̂ (bandwidth 0.2/Ts), with the
-//!    identified inverter error compensated. The current is then regulated to zero and the
-//!    rotor coasts: the back-EMF E = v − R̂s·i − L̂q·di/dt (the active-flux EMF, Boldea et al.
-//!    2008, whose angle is the rotor's for any saliency) is tracked by a PLL (40 Hz, its phase
-//!    detector on E low-passed by 1 ms in the PLL's own frame: the sample-to-sample noise of
-//!    L̂q·Δi/Ts, 170 Ω on the PM-SyRM preset, fed straight into atan2 and the current loop
-//!    locked onto it, biased the angle by 0.2–0.35 rad with the torque's sign and Ĵ by up
-//!    to +11 %; filtered: 0.075 rad rms, Ĵ within 8 %); with i ≈ 0 the
-//!    result is almost free of R̂s, L̂ and inverter errors, and λ̂f = ∫E_q dt / ∫ω dt over the
-//!    coast (a ratio of integrals: exact for a slowly decelerating rotor).
+//!    turned at a speed ramped to `spin_speed_ratio` of the rated speed), regulated by a
+//!    synchronous-frame PI tuned from the identified R̂s, L̂ (bandwidth 0.2/Ts), with the
+//!    identified inverter error compensated (V̂·sat(i*ₓ/I_band) per phase of the reference,
+//!    I_band = 5 % of the limit). Its current is the DC test's upper level (90 % of the
+//!    limit, at most λf/(2(Lq − Ld)): `if_level`), because the rotor lags the I-f vector by
+//!    δ and the torque 1.5·p·I·sin δ·(λf − (Lq − Ld)·I·cos δ) is stable about δ ≈ 0 only for
+//!    I < λf/(Lq − Ld); the acceleration uses 10 % of the rated torque on the nameplate
+//!    inertia, at most half the magnet torque of that current. (At 90 % of the limit the 50 kW
+//!    IPMSM preset, (Lq − Ld)·I = 1.36 λf, hunted ±1 rad between the two stable lags ±0.74
+//!    rad where its active flux vanishes; the PLL slipped by π, the coast started 2 rad off
+//!    and its speed estimate was 6 % high: λ̂f −5.5 … −5.9 %.) Then the q current is regulated
+//!    to zero and the rotor coasts with a d current of −½ the limit (`COAST_ID`: every phase
+//!    current outside the inverter's dead-time band most of the time, so that its error is
+//!    the compensated V̂·sign(i) rather than the dead zone of i ≈ 0). The back-EMF
+//!    E = v − R̂s·i − L̂q·di/dt (the active-flux EMF, Boldea et al. 2008, whose angle is the
+//!    rotor's for any saliency) is tracked by a PLL (40 Hz, its phase detector on E low-passed
+//!    by 1 ms in the PLL's own frame: the sample-to-sample noise of L̂q·Δi/Ts, 170 Ω on the
+//!    PM-SyRM preset, fed straight into atan2 and the current loop locked onto it, biased the
+//!    angle by 0.2–0.35 rad with the torque's sign; filtered: 0.075 rad rms). The magnet's
+//!    EMF e_f = E_q − ω̂·(L̂d − L̂q)·i_d is averaged, with ω̂ (the PLL's integral state), over
+//!    a window of `measure_time` in this coast and over a second one at the top of the
+//!    inertia test (step 6), at twice the speed, same currents; λ̂f is the slope of the line
+//!    ē_f = λf·ω̄ + e₀ through the two. The intercept e₀ takes what of the EMF error does not
+//!    grow with the speed: the residual of the inverter's error after its compensation.
+//!    Measured on the 50 kW IPMSM preset (its 14 V per phase against a magnet EMF of 12 V at
+//!    the spin speed): e₀ ≈ −0.24 V, −2.3 % of λf when read as a single ratio ∫e_f/∫ω̂
+//!    (−1.5 % at 0.3, −1.1 % at 0.4 of the rated speed: the error falls as 1/ω), 0 to −0.3 %
+//!    through the line (the paper motor's −0.5 % and the PM-SyRM's −0.4 % went to ±0.1 %
+//!    with it; the servo preset's −0.5 % stayed, another cause). It comes from the
+//!    phase currents' zero crossings, where the compensation's trapezoid (I_band) and the
+//!    inverter's sharp error differ and the current loop distorts the crossing (measured:
+//!    λ̂f −0.3 % with no dead time, −0.65 % with I_band = 1 % of the limit).
+//!    What is left is proportional to the speed: the L̂d − L̂q error times i_d
+//!    (0.4 % of (Lq − Ld) at 60 A is 0.3 % of λf on that preset), R̂s·i and the current
+//!    sensors' gain error (the PLL frame's d current), and the inverter error's part that
+//!    grows with the speed (timing).
 //! 6. **Inertia and friction** ([`Phase::Inertia`]): in closed loop on the PLL's angle (the
-//!    back-EMF observer is the sensorless angle), a q-current step of +90 % of the limit until
-//!    2× the spin speed, then the opposite step down to 0.5× (the current is sized so that
-//!    each step lasts 0.5 s on the nameplate inertia). Over windows of 40 ms,
-//!    Δω_mech = (1/J)·∫T̂e dt − (B/J)·∫ω_mech dt with T̂e = 1.5·p·(λ̂f·i_q + (L̂d − L̂q)·i_d·i_q);
-//!    least squares over the coast and both steps gives 1/Ĵ and B̂/Ĵ (the ST MCSDK profiler's
-//!    approach, with both acceleration and deceleration so that friction and inertia
-//!    separate). The coast's d current is released to 0 at a bounded rate at the start of
-//!    the steps (`ID_RELEASE_EMF`): the active-flux EMF has a d component (L̂d − L̂q)·di_d/dt
-//!    that the PLL reads as an angle error. The noisy speed difference is the dependent variable: as a regressor its
-//!    noise would bias Ĵ low (errors in variables; −20 % measured on the IPMSM).
-//!    The procedure ends with the gates off and the rotor coasting at about 10 % of its rated
-//!    speed.
+//!    back-EMF observer is the sensorless angle), a q-current step (sized so that each step
+//!    lasts 0.5 s on the nameplate inertia, 10–90 % of the limit) up to 2× the spin speed;
+//!    there, the second back-EMF window (no q current, the coast's d current); then the
+//!    opposite step down to 0.5×. Since ω_mech(t) = ω(t₀) + (1/J)·∫T̂e − (B/J)·∫ω_mech with
+//!    T̂e = 1.5·p·(λ̂f·i_q + (L̂d − L̂q)·i_d·i_q), the means over consecutive windows of 40 ms
+//!    of ω̂_mech and of the running integrals give Δω̄ = (1/J)·Δ∫T̂e − (B/J)·Δ∫ω (`JWindows`);
+//!    least squares over the coasts and both steps gives 1/Ĵ and B̂/Ĵ (the ST MCSDK
+//!    profiler's approach, with both acceleration and deceleration so that friction and
+//!    inertia separate), solved at the end with the final λ̂f (`JFit` keeps the magnet and
+//!    reluctance parts of ∫T̂e apart). Window means rather than the speed at the windows'
+//!    ends: the PLL's speed ripple (±30 r/min at six times the electrical frequency on the
+//!    50 kW IPMSM preset below 650 r/min, where its 14 V of inverter error dwarfs a 10 V
+//!    EMF at 25 A) otherwise lands on each Δω (measured there: Ĵ −7 … −13 %, σ 10 %;
+//!    with the means −1.2 … −1.6 %, σ 1.2 %). The d current moves between 0 and the coast's
+//!    level at a bounded rate (`ID_RELEASE_EMF`): the active-flux EMF has a d component
+//!    (L̂d − L̂q)·di_d/dt that the PLL reads as an angle error. The noisy speed difference is
+//!    the dependent variable: as a regressor its noise would bias Ĵ low (errors in
+//!    variables; −20 % measured on the IPMSM). The procedure ends with the gates off and the
+//!    rotor coasting at about 10 % of its rated speed.
 //!
 //! # Confidence
 //! Each identified parameter comes with a relative 1-σ statistical uncertainty computed from
