@@ -146,9 +146,11 @@ pub enum Phase {
     InductanceQ,
     /// I-f open-loop acceleration.
     Spin,
-    /// Zero current, rotor coasting: back-EMF and λf.
+    /// No q current (the d current at −½ the limit), rotor coasting: the first back-EMF
+    /// window.
     Coast,
-    /// Torque steps in closed loop: J and friction.
+    /// Torque steps in closed loop, with the second back-EMF window between them: λf, J and
+    /// friction.
     Inertia,
     /// Finished; the result is available.
     Done,
