@@ -68,11 +68,14 @@
 //!    turned at a speed ramped to `spin_speed_ratio` of the rated speed), regulated by a
 //!    synchronous-frame PI tuned from the identified R̂s, L̂ (bandwidth 0.2/Ts), with the
 //!    identified inverter error compensated (V̂·sat(i*ₓ/I_band) per phase of the reference,
-//!    I_band = 5 % of the limit). Its current is the DC test's upper level (90 % of the
-//!    limit, at most λf/(2(Lq − Ld)): `if_level`), because the rotor lags the I-f vector by
+//!    I_band = 5 % of the limit). Its current is 90 % of the limit, at most λf/(2(L̂q − L̂d))
+//!    (nameplate λf, identified L̂: `if_level`), because the rotor lags the I-f vector by
 //!    δ and the torque 1.5·p·I·sin δ·(λf − (Lq − Ld)·I·cos δ) is stable about δ ≈ 0 only for
 //!    I < λf/(Lq − Ld); the acceleration uses 10 % of the rated torque on the nameplate
-//!    inertia, at most half the magnet torque of that current. (At 90 % of the limit the 50 kW
+//!    inertia, at most a quarter of the magnet torque of that current (`spin_sizing`: half
+//!    of it, with a nameplate λf 1.25× and J 0.8× the truth, pulled the 50 kW IPMSM preset
+//!    out of step, `Overspeed`; the quarter also leaves it hunting ±15 r/min instead of
+//!    ±115: open-loop I-f has no damping). (At 90 % of the limit the 50 kW
 //!    IPMSM preset, (Lq − Ld)·I = 1.36 λf, hunted ±1 rad between the two stable lags ±0.74
 //!    rad where its active flux vanishes; the PLL slipped by π, the coast started 2 rad off
 //!    and its speed estimate was 6 % high: λ̂f −5.5 … −5.9 %.) Then the q current is regulated
@@ -91,8 +94,8 @@
 //!    grow with the speed: the residual of the inverter's error after its compensation.
 //!    Measured on the 50 kW IPMSM preset (its 14 V per phase against a magnet EMF of 12 V at
 //!    the spin speed): e₀ ≈ −0.24 V, −2.3 % of λf when read as a single ratio ∫e_f/∫ω̂
-//!    (−1.5 % at 0.3, −1.1 % at 0.4 of the rated speed: the error falls as 1/ω), 0 to −0.3 %
-//!    through the line (the paper motor's −0.5 % and the PM-SyRM's −0.4 % went to ±0.1 %
+//!    (−1.5 % at 0.3, −1.1 % at 0.4 of the rated speed: the error falls as 1/ω), +0.2 to
+//!    +0.3 % through the line (the paper motor's −0.5 % and the PM-SyRM's −0.4 % went to ±0.1 %
 //!    with it; the servo preset's −0.5 % stayed, another cause). It comes from the
 //!    phase currents' zero crossings, where the compensation's trapezoid (I_band) and the
 //!    inverter's sharp error differ and the current loop distorts the crossing (measured:
@@ -735,6 +738,8 @@ pub struct Commissioning<T> {
     v_inj: T,
     spin_speed: T,
     spin_accel: T,
+    /// The I-f current amplitude, A (`if_level`).
+    i_if: T,
     // Progress and phases.
     phase: Phase,
     sub: u8,
@@ -859,14 +864,9 @@ impl<T: Real> Commissioning<T> {
         let i1 = T::lit(0.5) * i_dc;
         let v_inj = T::lit(0.3) * i1 * l_avg_np / (T::lit(INJ_HALF as f64) * ts);
         let spin_speed = cfg.spin_speed_ratio * np.rated_speed();
-        // Electrical acceleration from spin_torque_ratio·T_rated on the nameplate J, at most
-        // half the magnet torque 1.5·p·λf·I_if of the I-f current (`if_level`): the rotor then
-        // lags the current vector by about 30°, far from the pull-out.
-        let p = T::lit(np.pole_pairs as f64);
-        let magnet_torque = T::lit(1.5) * p * np.flux_linkage * if_level(np, i_limit);
-        let spin_torque =
-            (cfg.spin_torque_ratio * np.rated_torque).min(T::lit(0.5) * magnet_torque);
-        let spin_accel = spin_torque / np.inertia * p;
+        // The I-f current and acceleration on the nameplate's inductances (set again from the
+        // identified ones at the start of the spin; here for the nominal duration).
+        let (i_if, spin_accel) = spin_sizing(np, np.ld, np.lq, i_limit, cfg.spin_torque_ratio);
         let nominal_total = cfg.offset_time
             + T::lit(3.0) * cfg.align_time
             + T::lit(2.0) * (cfg.settle_time + cfg.measure_time)
@@ -885,6 +885,7 @@ impl<T: Real> Commissioning<T> {
             v_inj,
             spin_speed,
             spin_accel,
+            i_if,
             phase: Phase::Offset,
             sub: 0,
             t_phase: T::zero(),
@@ -1422,6 +1423,14 @@ impl<T: Real> Commissioning<T> {
     // ------------------------------------------------------------------ spinning phases
 
     fn start_spin(&mut self) {
+        // The I-f current and acceleration from the identified L̂d, L̂q (the nameplate's λf).
+        (self.i_if, self.spin_accel) = spin_sizing(
+            &self.cfg.nameplate,
+            self.ld,
+            self.lq,
+            self.i_limit,
+            self.cfg.spin_torque_ratio,
+        );
         let wc = T::lit(0.2) / self.ts;
         self.kp = Dq::new(wc * self.ld, wc * self.lq);
         self.ki = wc * self.rs;
@@ -1455,7 +1464,7 @@ impl<T: Real> Commissioning<T> {
         let cfg = self.cfg;
         let ts = self.ts;
         let t = self.t_phase;
-        let i_if = if_level(&cfg.nameplate, self.i_limit);
+        let i_if = self.i_if;
         let p = T::lit(cfg.nameplate.pole_pairs as f64);
         // Back-EMF PLL.
         let mut rate = self.omega_f;
@@ -1798,9 +1807,23 @@ fn dc_level<T: Real>(np: &MachineModel<T>, i_limit: T) -> T {
 /// PLL locks onto, stays above λf/2 for any lag. Measured at 90 % of the limit on the 50 kW
 /// IPMSM preset ((Lq − Ld)·I = 1.36 λf): the rotor hunted ±1 rad (±60 r/min) between the
 /// two stable lags δ = ±0.74 rad, where the active flux is zero, the PLL slipped to π, and
-/// the coast started 2 rad off (λ̂f −5.8 %).
-fn if_level<T: Real>(np: &MachineModel<T>, i_limit: T) -> T {
-    dc_level(np, i_limit)
+/// the coast started 2 rad off (λ̂f −5.8 %). `ld`, `lq`: the identified inductances (the
+/// nameplate's λf: off by 1.25× it still leaves the lag stable, (Lq − Ld)·I ≤ 0.63 λf; the
+/// nameplate's inductances 0.8×/1.25× off gave 1.05 λf on that preset, `Overspeed`).
+fn if_level<T: Real>(np: &MachineModel<T>, ld: T, lq: T, i_limit: T) -> T {
+    dc_level(&MachineModel { ld, lq, ..*np }, i_limit)
+}
+
+/// The I-f current (`if_level`) and the spin's electrical acceleration: spin_torque_ratio ×
+/// the rated torque on the nameplate J, at most a quarter of the magnet torque 1.5·p·λf·I_if
+/// (the rotor then lags the current vector by about 15°, far from the pull-out even with the
+/// nameplate's λf 1.25× and J 0.8× the truth; module docs, step 5).
+fn spin_sizing<T: Real>(np: &MachineModel<T>, ld: T, lq: T, i_limit: T, ratio: T) -> (T, T) {
+    let i_if = if_level(np, ld, lq, i_limit);
+    let p = T::lit(np.pole_pairs as f64);
+    let magnet_torque = T::lit(1.5) * p * np.flux_linkage * i_if;
+    let torque = (ratio * np.rated_torque).min(T::lit(0.25) * magnet_torque);
+    (i_if, torque / np.inertia * p)
 }
 
 fn libm_round(x: f64) -> u32 {
@@ -1915,13 +1938,13 @@ mod tests {
             flux_linkage: 0.066,
             ..MachineModel::<f64>::paper()
         };
-        let i = if_level(&gem, 120.0);
+        let i = if_level(&gem, gem.ld, gem.lq, 120.0);
         assert!(
             i <= 0.5 * gem.flux_linkage / (gem.lq - gem.ld) + 1e-12,
             "{i}"
         );
         assert!(gem.flux_linkage + (gem.ld - gem.lq) * i >= 0.5 * gem.flux_linkage - 1e-12);
         let paper = MachineModel::<f64>::paper();
-        assert_eq!(if_level(&paper, 10.0), 9.0);
+        assert_eq!(if_level(&paper, paper.ld, paper.lq, 10.0), 9.0);
     }
 }

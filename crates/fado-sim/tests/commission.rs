@@ -231,6 +231,8 @@ fn a_rough_nameplate_is_enough() {
         check(&report("ipmsm rough", &p, rough(m, k)));
         let (p, m) = paper();
         check(&report("paper rough", &p, rough(m, k)));
+        let (p, m) = preset("ipmsm-gem-50k");
+        check(&report("ipmsm-gem-50k rough", &p, rough(m, k)));
     }
 }
 
