@@ -95,8 +95,9 @@
 //!    Measured on the 50 kW IPMSM preset (its 14 V per phase against a magnet EMF of 12 V at
 //!    the spin speed): e₀ ≈ −0.24 V, −2.3 % of λf when read as a single ratio ∫e_f/∫ω̂
 //!    (−1.5 % at 0.3, −1.1 % at 0.4 of the rated speed: the error falls as 1/ω), +0.2 to
-//!    +0.3 % through the line (the paper motor's −0.5 % and the PM-SyRM's −0.4 % went to ±0.1 %
-//!    with it; the servo preset's −0.5 % stayed, another cause). It comes from the
+//!    +0.3 % through the line (the paper motor's −0.5 % and the PM-SyRM's −0.4 % went to
+//!    ±0.1 % with it; the servo preset's −0.5 % stayed: the inverter error's part that grows
+//!    with the speed, −0.14 % there without dead time). It comes from the
 //!    phase currents' zero crossings, where the compensation's trapezoid (I_band) and the
 //!    inverter's sharp error differ and the current loop distorts the crossing (measured:
 //!    λ̂f −0.3 % with no dead time, −0.65 % with I_band = 1 % of the limit).
