@@ -9,6 +9,7 @@ pub mod current_controller;
 pub mod dead_time_compensation;
 pub mod delay_compensation;
 pub mod drive;
+pub mod gain_calibration;
 pub mod lock_reaction;
 pub mod modulation;
 pub mod monitor;
@@ -21,6 +22,7 @@ pub use dead_time_compensation::{
 };
 pub use delay_compensation::{DelayCompensation, DelayCompensationConfig};
 pub use drive::{DriveConfig, DriveOutput, DriveTuning, SensorlessDrive};
+pub use gain_calibration::{GainCalibration, GainCalibrationConfig, GainCalibrationStatus};
 pub use lock_reaction::{LockAction, LockReaction, LockSupervisor};
 pub use modulation::{Modulation, ModulatorConfig, SpaceVectorModulator, VoltageLimit, svpwm_duty};
 pub use monitor::{DriveFlags, FlagCounts};

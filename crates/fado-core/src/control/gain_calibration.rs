@@ -1,0 +1,499 @@
+//! Start-up calibration of the current sensors' gain mismatch: the ratio k = (1 + g_a)/(1 + g_b)
+//! of the phase-a and phase-b channels' gains, measured with two DC current levels along the
+//! aligned rotor's d axis (no torque), as drives calibrate the sensor offsets.
+//!
+//! # Why
+//! Two sensors measure phases a and b; c = −(a + b). With phase a read as (1 + g)·i_a (g the
+//! relative mismatch), the α-β current reads i + g·i_a·(1 + j/√3) =
+//! i + (g/2)(1 + j/√3)·i + (g/2)(1 + j/√3)·conj(i): a small scale and turn of the current, and
+//! a negative-sequence part (g/2)(1 + j/√3)·conj(i). Times R̂s the latter is an integrand
+//! error of eq. (3), DC at standstill; under load nothing observes the angle at standstill and it walks θ̂ at
+//! about R̂s·|Δi|/λ̂f: ≈ 2.5 rad/s on a 2.4 mWb motor with a 0.5 % mismatch (the
+//! `outrunner-cheetah-24v` preset). A common gain of both channels is harmless (it scales the
+//! current like an R̂s scale and is unobservable without a reference); only k is measured.
+//!
+//! # The measurement
+//! At DC steady state the machine is a symmetric resistance, so each phase obeys
+//! v_x = Rs·i_x + u_x, with u_x the inverter's voltage error in phase x (dead time, device
+//! drops; the phase voltages are those of the α-β vector, zero sequence removed). u_x depends
+//! on the sign of i_x (and, within the inverter's current band and the ripple, on its size):
+//! two current levels I₁ = I₂/2 and I₂ along the **same** axis, both with every phase well
+//! outside that band, have the same u_x, and the difference of the two levels is purely
+//! resistive: Δv_x = Rs·Δi_x (the classic two-point DC test, as in
+//! [`crate::commissioning`]). A sensor of gain (1 + g_x) reads Δi_x,meas = (1 + g_x)·Δi_x, so
+//! each phase's apparent conductance is (1 + g_x)/Rs and
+//!
+//! k = (Δi_a,meas / Δv_a) / (Δi_b,meas / Δv_b)
+//!
+//! exactly, whatever Rs (and with no small-mismatch approximation). Equivalently: the true
+//! current difference is parallel to Δv; the measured one is turned from it by
+//! (k − 1)·(2/√3)·cos φ·cos(φ + π/3) rad (φ the axis angle), the form of the cross-product
+//! estimator. The drive applies 1/k to phase a (c following from KCL), after the offsets and
+//! before everything else.
+//!
+//! Δv is the drive's realised voltage reference (the voltage it tells the estimator acted,
+//! after its dead-time compensation), averaged over a window after the current has settled;
+//! Δi is the average of the measured current over the same window. The excitation is the
+//! drive's own current loop with the reference (I, 0) in the d-q frame of the aligned angle θ0
+//! and ω = 0: the current stays at its configured level whatever R̂s, and a d current makes no
+//! torque (on a salient rotor too, i_q = 0).
+//!
+//! # Observability and error bound
+//! Phase x carries the fraction cos(φ − φ_x) of the axis current (φ_a = 0, φ_b = 2π/3). With
+//! δv_x the part of the voltage error that does not cancel between the levels (inverter error
+//! that changes with the level, rounding) and σ the averaged noise, to first order
+//!
+//! |δk|/k ≤ |δv_a|/|Δv_a| + |δv_b|/|Δv_b| + σ_i/|Δi_a| + σ_i/|Δi_b|,
+//! |Δv_x| = Rs·(I₂ − I₁)·|cos(φ − φ_x)|,
+//!
+//! so the error grows as 1/|cos(φ − φ_x)| where phase a or b carries little current
+//! (φ = ±π/2: phase a; φ = π/6, −5π/6: phase b), and where that phase's current at I₁ comes
+//! near the inverter's current band or its ripple, where u_x stops being constant. The
+//! calibration is **skipped** (status [`GainCalibrationStatus::Unobservable`], k unchanged)
+//! when min(|cos φ|, |cos(φ − 2π/3)|) is below `min_observability`, before any current flows,
+//! and a result is refused ([`GainCalibrationStatus::Implausible`]) when the measured
+//! currents say the same, when a conductance comes out non-positive or non-finite, or when
+//! |k − 1| exceeds `max_mismatch`. On the simulator's inverter (dead time with the SPEC §5
+//! linear band, device drops, ripple resolved edge by edge) the measured accuracy is in
+//! `crates/fado-sim/tests/gain_calibration.rs`; an inverter whose error keeps growing well
+//! beyond the current band (a capacitive commutation tail, fado-sim's
+//! `Commutation::Capacitor`) breaks the cancellation and biases k.
+//!
+//! # Sequence
+//! Settle at I₁ (`settle_time`), average (`window_time`), settle at I₂, average, then the
+//! reference returns to zero and settles once more; then [`GainCalibration::finished`] holds.
+//! Every state ends after a fixed number of samples: the calibration always terminates, in
+//! 3·settle + 2·window. The reference is never above I₂ (the drive checks I₂ ≤ its current
+//! limit).
+
+use crate::error::{ConfigError, check};
+use crate::{Ab, Real};
+
+/// The unit vector of phase b in α-β, (cos 2π/3, sin 2π/3) (amplitude-invariant Clarke: the
+/// phase-b value of a vector is its projection on it).
+const PHASE_B_ALPHA: f64 = -0.5;
+const PHASE_B_BETA: f64 = 0.866_025_403_784_438_6;
+
+/// Configuration of a [`GainCalibration`], in absolute units (the drive derives it from its
+/// [`DriveTuning`](super::DriveTuning) ratios and its machine model).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GainCalibrationConfig<T> {
+    /// Sampling period in s.
+    pub ts: T,
+    /// Lower current level I₁ in A, set by the current loop; the upper one is reached with
+    /// the voltage step R̂s·I₁ (I₂ ≈ 2·I₁).
+    pub current: T,
+    /// R̂s in Ω: sizes the voltage step to the upper level.
+    pub rs_hat: T,
+    /// Settling of the current loop at I₁, of each voltage step and of the return to zero, s.
+    pub settle_time: T,
+    /// Time for the rotor's swing to die out after the voltage is frozen, s (at least
+    /// `settle_time` is used).
+    pub hold_time: T,
+    /// Longest hold accepted, s: a rotor needing a longer `hold_time` is not calibrated
+    /// ([`GainCalibrationStatus::SwingTooSlow`]).
+    pub max_hold_time: T,
+    /// Averaging window of each level, s; 0 disables the calibration.
+    pub window_time: T,
+    /// Smallest share min(|cos φ|, |cos(φ − 2π/3)|) of the axis current in phases a and b,
+    /// and |cos(φ + 2π/3)| in phase c, with which the calibration runs, in [0, 1).
+    pub min_observability: T,
+    /// Largest |k − 1| accepted as a measurement of the sensors (a larger one is refused).
+    pub max_mismatch: T,
+    /// A measured current above this (A) in voltage mode aborts the calibration (R̂s far
+    /// above the machine's resistance).
+    pub current_limit: T,
+}
+
+/// Where the calibration stands.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GainCalibrationStatus {
+    /// Disabled by the configuration (window 0): the ratio stays as it is (1 at first).
+    Off,
+    /// Armed: runs at the next sample the drive gives it.
+    Pending,
+    /// Current levels being applied and averaged.
+    Running,
+    /// Measured: the ratio is the new one.
+    Calibrated,
+    /// Skipped: the axis leaves a phase with less than `min_observability` of the current
+    /// (ratio unchanged, no current applied).
+    Unobservable,
+    /// Skipped: the rotor's swing about the d current dies out too slowly (`hold_time` above
+    /// `max_hold_time`; ratio unchanged, no current applied).
+    SwingTooSlow,
+    /// Measured but refused: non-finite, a non-positive conductance, too few finite samples,
+    /// a current above `current_limit` in voltage mode, or |k − 1| above `max_mismatch`
+    /// (ratio unchanged).
+    Implausible,
+}
+
+/// What the drive applies at a sample of the calibration.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GainCalibrationCommand<T> {
+    /// The d-axis current (A) in the frame of the calibration's angle: the current loop's
+    /// reference, or (with `voltage`) the level the dead-time compensation is set for.
+    pub current_d: T,
+    /// Voltage mode: this α-β voltage reference (V), before dead-time compensation, instead
+    /// of the current loop's.
+    pub voltage: Option<Ab<T>>,
+}
+
+/// The sequence's states.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Stage {
+    Idle,
+    /// Current loop at I₁ (its voltage averaged over the second half into V₁).
+    Settle,
+    /// Voltage V₁ (lower level): swing decay, then averaging.
+    HoldLower,
+    AverageLower,
+    /// Voltage V₁ + R̂s·I₁ along the axis (upper level): swing decay, then averaging.
+    HoldUpper,
+    AverageUpper,
+    /// Current loop at 0.
+    Release,
+}
+
+/// The two-level gain-mismatch calibration (module docs). Allocation-free; `step` once per
+/// sample while [`running`](Self::running).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GainCalibration<T> {
+    config: GainCalibrationConfig<T>,
+    settle_samples: u32,
+    hold_samples: u32,
+    max_hold_samples: u32,
+    window_samples: u32,
+    stage: Stage,
+    /// Samples left in the current stage.
+    remaining: u32,
+    /// Unit vector of the axis.
+    axis: Ab<T>,
+    /// The frozen lower-level voltage V₁ (its sum while the current loop settles).
+    v_lower: Ab<T>,
+    v_lower_count: u32,
+    /// Per level (0 lower, 1 upper): sums of the measured current and of the voltage, and
+    /// finite samples.
+    sum_i: [Ab<T>; 2],
+    sum_v: [Ab<T>; 2],
+    count: [u32; 2],
+    /// Voltage mode ended by an over-current.
+    aborted: bool,
+    status: GainCalibrationStatus,
+    ratio: T,
+    /// The last measured ratio, also when refused (NaN before any).
+    measured: T,
+}
+
+impl<T: Real> GainCalibration<T> {
+    /// A new calibration (armed unless disabled); every field is checked and a bad one named.
+    pub fn new(config: GainCalibrationConfig<T>) -> Result<Self, ConfigError> {
+        let ts = check::positive("ts", config.ts)?;
+        check::positive("current", config.current)?;
+        check::positive("rs_hat", config.rs_hat)?;
+        let samples = |field: &'static str, time: T| -> Result<u32, ConfigError> {
+            let n = check::non_negative(field, time)? / ts;
+            check::below(field, n, T::lit(4e9), "below 4e9 sampling periods")?;
+            Ok(n.round().to_f64() as u32)
+        };
+        let settle_samples = samples("settle_time", config.settle_time)?;
+        let hold_samples = samples("hold_time", config.hold_time)?.max(settle_samples);
+        let max_hold_samples = samples("max_hold_time", config.max_hold_time)?;
+        let window_samples = samples("window_time", config.window_time)?;
+        check::below(
+            "min_observability",
+            check::non_negative("min_observability", config.min_observability)?,
+            T::one(),
+            "in [0, 1)",
+        )?;
+        check::positive("max_mismatch", config.max_mismatch)?;
+        check::positive("current_limit", config.current_limit)?;
+        if T::lit(2.0) * config.current > config.current_limit {
+            return Err(ConfigError::OutOfRange {
+                field: "current",
+                expected: "at most half of current_limit",
+            });
+        }
+        let status = if window_samples == 0 {
+            GainCalibrationStatus::Off
+        } else {
+            GainCalibrationStatus::Pending
+        };
+        Ok(Self {
+            config,
+            settle_samples,
+            hold_samples,
+            max_hold_samples,
+            window_samples,
+            stage: Stage::Idle,
+            remaining: 0,
+            axis: Ab::new(T::one(), T::zero()),
+            v_lower: Ab::zero(),
+            v_lower_count: 0,
+            sum_i: [Ab::zero(); 2],
+            sum_v: [Ab::zero(); 2],
+            count: [0; 2],
+            aborted: false,
+            status,
+            ratio: T::one(),
+            measured: T::zero() / T::zero(),
+        })
+    }
+
+    /// The configuration in use.
+    pub fn config(&self) -> &GainCalibrationConfig<T> {
+        &self.config
+    }
+
+    /// The whole sequence's duration in samples when it runs: settle at I₁, hold and window
+    /// at each level, release.
+    pub fn duration_samples(&self) -> u32 {
+        self.settle_samples
+            .saturating_mul(2)
+            .saturating_add(self.hold_samples.saturating_mul(2))
+            .saturating_add(self.window_samples.saturating_mul(2))
+    }
+
+    /// Arms the calibration (unless disabled): it starts at the next [`step`](Self::step).
+    /// The ratio measured before is kept until a new one is.
+    pub fn arm(&mut self) {
+        self.stage = Stage::Idle;
+        if self.window_samples > 0 {
+            self.status = GainCalibrationStatus::Pending;
+        }
+    }
+
+    /// Armed and waiting for its first sample.
+    pub fn pending(&self) -> bool {
+        self.status == GainCalibrationStatus::Pending
+    }
+
+    /// Armed or applying current.
+    pub fn running(&self) -> bool {
+        matches!(
+            self.status,
+            GainCalibrationStatus::Pending | GainCalibrationStatus::Running
+        )
+    }
+
+    /// The status.
+    pub fn status(&self) -> GainCalibrationStatus {
+        self.status
+    }
+
+    /// The ratio k = (1 + g_a)/(1 + g_b) in use: the last accepted measurement, 1 before any.
+    /// The drive divides the phase-a reading by it.
+    pub fn ratio(&self) -> T {
+        self.ratio
+    }
+
+    /// The last measured ratio, accepted or not (NaN before any measurement).
+    pub fn measured_ratio(&self) -> T {
+        self.measured
+    }
+
+    /// The smallest share of the axis current in any phase, min over x of |cos(φ − φ_x)|,
+    /// for an axis at `angle` (electrical rad): phases a and b for the observability, c for
+    /// the inverter error's cancellation (module docs).
+    pub fn observability(angle: T) -> T {
+        let (s, c) = angle.step_sin_cos_any();
+        let b = c * T::lit(PHASE_B_ALPHA) + s * T::lit(PHASE_B_BETA);
+        let phase_c = -c - b;
+        crate::real::min(crate::real::min(c.abs(), b.abs()), phase_c.abs())
+    }
+
+    /// Starts the sequence along the axis at `angle` (the aligned rotor's d axis): skipped
+    /// at once (no current) when unobservable. Returns whether it runs.
+    pub fn start(&mut self, angle: T) -> bool {
+        if self.window_samples == 0 {
+            self.status = GainCalibrationStatus::Off;
+            return false;
+        }
+        if self.hold_samples > self.max_hold_samples {
+            self.stage = Stage::Idle;
+            self.status = GainCalibrationStatus::SwingTooSlow;
+            return false;
+        }
+        let share = Self::observability(angle);
+        // NaN compares false: a non-finite angle is unobservable too.
+        if !(share >= self.config.min_observability && share > T::zero()) {
+            self.stage = Stage::Idle;
+            self.status = GainCalibrationStatus::Unobservable;
+            return false;
+        }
+        let (s, c) = angle.step_sin_cos_any();
+        self.axis = Ab::new(c, s);
+        self.sum_i = [Ab::zero(); 2];
+        self.sum_v = [Ab::zero(); 2];
+        self.count = [0; 2];
+        self.aborted = false;
+        self.v_lower = Ab::zero();
+        self.v_lower_count = 0;
+        self.stage = Stage::Settle;
+        self.remaining = self.settle_samples;
+        self.status = GainCalibrationStatus::Running;
+        true
+    }
+
+    /// The command of the present stage.
+    pub fn command(&self) -> GainCalibrationCommand<T> {
+        let i1 = self.config.current;
+        match self.stage {
+            Stage::Settle => GainCalibrationCommand {
+                current_d: i1,
+                voltage: None,
+            },
+            Stage::HoldUpper | Stage::AverageUpper => GainCalibrationCommand {
+                current_d: i1 + i1,
+                voltage: Some(self.v_lower + self.axis * (self.config.rs_hat * i1)),
+            },
+            Stage::HoldLower | Stage::AverageLower => GainCalibrationCommand {
+                current_d: i1,
+                voltage: Some(self.v_lower),
+            },
+            Stage::Idle | Stage::Release => GainCalibrationCommand {
+                current_d: T::zero(),
+                voltage: None,
+            },
+        }
+    }
+
+    /// One sample while running: `i_ab` the measured current now (offsets removed, no gain
+    /// correction), `v_ab` the voltage that acted over the last sampling period (the drive's
+    /// realised reference). Returns what to apply at this sample. A non-finite pair is left
+    /// out of the averages; every sample advances the sequence, so it always ends (after
+    /// [`duration_samples`](Self::duration_samples) at most).
+    pub fn step(&mut self, i_ab: Ab<T>, v_ab: Ab<T>) -> GainCalibrationCommand<T> {
+        if self.status != GainCalibrationStatus::Running {
+            return GainCalibrationCommand {
+                current_d: T::zero(),
+                voltage: None,
+            };
+        }
+        let finite = i_ab.is_finite() && v_ab.is_finite();
+        let voltage_mode = !matches!(self.stage, Stage::Settle | Stage::Release | Stage::Idle);
+        // NaN compares false: a non-finite current in voltage mode does not abort by itself.
+        if voltage_mode && i_ab.norm() > self.config.current_limit {
+            self.aborted = true;
+            self.stage = Stage::Release;
+            self.remaining = self.settle_samples;
+        }
+        let level = match self.stage {
+            Stage::AverageLower => Some(0),
+            Stage::AverageUpper => Some(1),
+            _ => None,
+        };
+        if let Some(level) = level
+            && finite
+        {
+            self.sum_i[level] += i_ab;
+            self.sum_v[level] += v_ab;
+            self.count[level] += 1;
+        }
+        if self.stage == Stage::Settle && self.remaining <= self.settle_samples / 2 && finite {
+            // The current loop's voltage at I₁, averaged over the second half of its settling
+            // (the loop's response to the current noise averages out), becomes V₁.
+            self.v_lower += v_ab;
+            self.v_lower_count += 1;
+        }
+        if self.stage == Stage::Settle && self.remaining <= 1 {
+            self.v_lower = if self.v_lower_count > 0 {
+                self.v_lower * reciprocal_of_count::<T>(self.v_lower_count)
+            } else {
+                self.axis * (self.config.rs_hat * self.config.current)
+            };
+        }
+        self.remaining = self.remaining.saturating_sub(1);
+        while self.remaining == 0 && self.stage != Stage::Idle {
+            self.advance();
+        }
+        self.command()
+    }
+
+    fn advance(&mut self) {
+        let (next, samples) = match self.stage {
+            Stage::Settle => (Stage::HoldLower, self.hold_samples),
+            Stage::HoldLower => (Stage::AverageLower, self.window_samples),
+            Stage::AverageLower => (Stage::HoldUpper, self.hold_samples),
+            Stage::HoldUpper => (Stage::AverageUpper, self.window_samples),
+            Stage::AverageUpper => (Stage::Release, self.settle_samples),
+            Stage::Release | Stage::Idle => {
+                self.stage = Stage::Idle;
+                self.finish();
+                return;
+            }
+        };
+        self.stage = next;
+        self.remaining = samples;
+    }
+
+    /// The ratio from the two levels' averages, or why not.
+    fn finish(&mut self) {
+        self.measured = T::zero() / T::zero();
+        let min_count = (self.window_samples / 2).max(1);
+        if self.aborted || self.count[0] < min_count || self.count[1] < min_count {
+            self.status = GainCalibrationStatus::Implausible;
+            return;
+        }
+        let inv = [
+            reciprocal_of_count::<T>(self.count[0]),
+            reciprocal_of_count::<T>(self.count[1]),
+        ];
+        let di = self.sum_i[1] * inv[1] - self.sum_i[0] * inv[0];
+        let dv = self.sum_v[1] * inv[1] - self.sum_v[0] * inv[0];
+        match ratio_of(di, dv, self.config.min_observability) {
+            Some(k) => {
+                self.measured = k;
+                if (k - T::one()).abs() <= self.config.max_mismatch {
+                    self.ratio = k;
+                    self.status = GainCalibrationStatus::Calibrated;
+                } else {
+                    self.status = GainCalibrationStatus::Implausible;
+                }
+            }
+            None => self.status = GainCalibrationStatus::Implausible,
+        }
+    }
+}
+
+/// 1/n for a sample count n, n built as a real by binary decomposition (adds of powers of
+/// two, exact below 2^24 in f32): no integer-to-float conversion, which a Cortex-M4's f32
+/// build would do through software double for `T::lit(n as f64)`.
+fn reciprocal_of_count<T: Real>(n: u32) -> T {
+    let mut x = T::zero();
+    let mut bit = T::one();
+    let mut m = n;
+    while m > 0 {
+        if m & 1 == 1 {
+            x += bit;
+        }
+        bit += bit;
+        m >>= 1;
+    }
+    if x > T::zero() {
+        T::one() / x
+    } else {
+        T::zero()
+    }
+}
+
+/// k = (Δi_a/Δv_a)/(Δi_b/Δv_b) from the α-β differences of the measured current and the
+/// voltage between two levels (module docs), or None when phase a or b carries less than
+/// `min_share` of |Δi|, a conductance is not positive, or anything is non-finite.
+pub fn ratio_of<T: Real>(di: Ab<T>, dv: Ab<T>, min_share: T) -> Option<T> {
+    let pb = |x: Ab<T>| x.alpha * T::lit(PHASE_B_ALPHA) + x.beta * T::lit(PHASE_B_BETA);
+    let (ia, ib) = (di.alpha, pb(di));
+    let (va, vb) = (dv.alpha, pb(dv));
+    let share = crate::real::min(ia.abs(), ib.abs());
+    // Positive conductances (a current difference in the voltage's direction, per phase)
+    // and enough of the current in both measured phases; NaN fails every comparison.
+    let ok = share >= min_share * di.norm()
+        && share > T::zero()
+        && ia * va > T::zero()
+        && ib * vb > T::zero();
+    if !ok {
+        return None;
+    }
+    let k = (ia * vb) / (ib * va);
+    k.is_finite().then_some(k)
+}
