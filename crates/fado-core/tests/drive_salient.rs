@@ -72,6 +72,8 @@ fn ratings_derived_limits_scale_with_the_motor() {
     let drive = || {
         let mut c = c;
         c.tuning.offset_calibration_time = 0.0;
+        c.tuning.gain_calibration_time = 0.0;
+        c.tuning.gain_calibration_time = 0.0;
         let mut d = SensorlessDrive::new(c, EstimatorTuning::default()).unwrap();
         d.align(0.0);
         d
@@ -200,6 +202,7 @@ fn run(mtpa: bool, rpm: f64, ramp: f64, load: f64, seconds: f64) -> Settled {
     let m = ipmsm();
     let mut c = DriveConfig::for_machine(&m);
     c.tuning.offset_calibration_time = 0.0;
+    c.tuning.gain_calibration_time = 0.0;
     c.tuning.dead_time_compensation = false;
     c.tuning.mtpa = mtpa;
     let i_max = c.i_max();

@@ -54,11 +54,12 @@ impl RotorAngleEstimator<f64> for Spy {
     }
 }
 
-/// The default drive without the start-up offset calibration: these tests drive the
+/// The default drive without the start-up offset and gain calibrations: these tests drive the
 /// controllers from the first sample (the calibration has its own tests in `improvements.rs`).
 fn no_calibration<T: fado_core::Real>() -> DriveConfig<T> {
     let mut c = DriveConfig::for_machine(&MachineModel::paper());
     c.tuning.offset_calibration_time = T::zero();
+    c.tuning.gain_calibration_time = T::zero();
     c
 }
 

@@ -43,39 +43,73 @@ fn start_up(preset: &str, angle: f64, extra: &str) -> (f64, f64, GainCalibration
 }
 
 #[test]
-fn explore_sources() {
-    let extras = [
-        ("default", ""),
-        (
-            "ideal sensors",
-            "[current_sensor]\nenable_noise = false\nenable_quantization = false\nenable_offset = false\n",
-        ),
-        ("no dead time", "[inverter]\ndead_time = 0.0\n"),
-        (
-            "no dead time, vth",
-            "[inverter]\ndead_time = 0.0\nthreshold_voltage = 0.0\n",
-        ),
-        ("averaged", "[inverter]\nmodel = \"averaged\"\n"),
-        ("huge inertia", "[motor]\ninertia = 1000.0\n"),
-    ];
-    for name in ["paper", "servo-1ft6084", "ipmsm-gem-50k", "pmsyrm-5k"] {
-        for (what, extra) in extras {
-            let (k, kt, st, _, _) = start_up(name, 0.0, extra);
-            println!("{name:24} {what:20}: err {:+.2e} {st:?}", k - kt);
+fn the_mismatch_is_measured_on_every_calibrated_preset_and_skipped_where_it_should_be() {
+    // Default non-idealities (0.5 % on phase a, offsets, noise, ADC, dead time, ripple),
+    // switching-resolved, rotor at rest at θ0. Measured (this code): |k − k_true| ≤ 1.1e-3
+    // on the calibrated presets at these angles (ipmsm-2k2 the worst), i.e. at least 78 % of
+    // the 5e-3 mismatch removed.
+    let mut calibrated = 0;
+    for p in PRESETS {
+        for angle in [0.3, 0.0, 1.0, 2.0] {
+            let (k, k_true, status, peak, t) = start_up(p.name, angle, "");
+            println!(
+                "{:24} θ0 {angle:4.1}: k {k:.5} (true {k_true:.5}, error {:+.1e}) {status:?}, \
+                 peak {peak:.1} A, start-up {t:.3} s",
+                p.name,
+                k - k_true
+            );
+            let machine = p.machine().unwrap();
+            let limit = fado_core::control::DriveTuning::<f64>::default().current_limit_ratio
+                * machine.rated_current;
+            assert!(
+                peak <= limit,
+                "{}: {peak} A above the limit {limit} A",
+                p.name
+            );
+            match status {
+                GainCalibrationStatus::Calibrated => {
+                    calibrated += 1;
+                    assert!((k - k_true).abs() < 1.5e-3, "{} at {angle}: k {k}", p.name);
+                }
+                // The hub motor's weakly damped swing and the salient rotors' reduced
+                // stiffness need more than the hold budget: skipped, k untouched.
+                GainCalibrationStatus::TooSlow => {
+                    assert_eq!(k, 1.0);
+                    assert!(peak < 1e-6 * limit);
+                }
+                s => panic!("{} at {angle}: {s:?}", p.name),
+            }
+        }
+    }
+    // The outrunner (whose failure motivated the calibration), the paper's motor, the servo
+    // and the 2.2 kW IPMSM are calibrated at every angle.
+    assert_eq!(calibrated, 16);
+}
+
+#[test]
+fn an_axis_without_current_in_a_phase_is_reported_unobservable() {
+    // θ0 = π/2: phase a carries no current; −π/6: phase c (inverter error would not cancel).
+    for angle in [std::f64::consts::FRAC_PI_2, -std::f64::consts::FRAC_PI_6] {
+        for name in ["outrunner-cheetah-24v", "paper"] {
+            let (k, _, status, peak, _) = start_up(name, angle, "");
+            assert_eq!(
+                status,
+                GainCalibrationStatus::Unobservable,
+                "{name} {angle}"
+            );
+            assert_eq!(k, 1.0);
+            assert!(peak < 1e-9);
         }
     }
 }
 
 #[test]
-fn explore() {
-    for p in PRESETS {
-        for angle in [0.3, 0.0, 1.0, -0.5, 2.0, -2.5, 0.52] {
-            let (k, kt, st, peak, t) = start_up(p.name, angle, "");
-            println!(
-                "{:24} θ0 {angle:5.2}: k {k:.5} true {kt:.5} err {:+.2e} {st:?} peak {peak:.2} A t {t:.3} s",
-                p.name,
-                k - kt
-            );
-        }
-    }
+fn the_calibration_can_be_switched_off() {
+    let (k, _, status, peak, t) = start_up(
+        "outrunner-cheetah-24v",
+        0.3,
+        "[controller]\ngain_calibration_time = 0.0\n",
+    );
+    assert_eq!((k, status), (1.0, GainCalibrationStatus::Off));
+    assert!(peak < 1e-9 && t < 0.101, "{peak} {t}");
 }

@@ -130,7 +130,8 @@ pub struct DriveTuning<T> {
     /// standstill on a low-flux motor (docs: outrunner preset, 1.2 rad).
     pub gain_calibration_time: T,
     /// Upper current level of the gain calibration as a multiple of the rated current (the
-    /// lower level is half of it). Default 1 \[A\]: the continuous rating (the larger the
+    /// lower level is half of it; at most `current_limit_ratio`, and on a rotor with L̂q > L̂d
+    /// at most half of λ̂f/(L̂q − L̂d), see [`DriveConfig::gain_calibration_config`]). Default 1 \[A\]: the continuous rating (the larger the
     /// levels, the smaller the inverter error and the noise against the resistive drop; the
     /// lower level must keep every phase clear of the dead-time band and the current ripple).
     pub gain_calibration_current_ratio: T,
@@ -352,12 +353,7 @@ impl<T: Real> DriveConfig<T> {
             "gain_calibration_current_ratio",
             t.gain_calibration_current_ratio,
         )?;
-        if ratio > t.current_limit_ratio {
-            return Err(ConfigError::OutOfRange {
-                field: "gain_calibration_current_ratio",
-                expected: "at most current_limit_ratio",
-            });
-        }
+        let ratio = crate::real::min(ratio, t.current_limit_ratio);
         let omega_c =
             T::two_pi() * check::positive("current_bandwidth_hz", t.current_bandwidth_hz)?;
         let tau_stator = m.ld / m.rs;
@@ -436,7 +432,7 @@ const GAIN_CALIBRATION_HOLD_TIME_CONSTANTS: f64 = 4.0;
 
 /// Longest hold of a gain-calibration level, s \[A\]: a start-up budget (with it the whole
 /// calibration takes at most about 0.5 s plus the settling). A rotor whose swing needs longer
-/// is not calibrated (status `SwingTooSlow`): averaged before the swing has died out, the
+/// is not calibrated (status `TooSlow`): averaged before the swing has died out, the
 /// 5 kW PM-SyRM and 50 kW IPMSM presets (held at reduced active flux) measured k off by up to
 /// 1.7e-2 with a 0.15 s hold, more than the 5e-3 mismatch itself.
 const GAIN_CALIBRATION_MAX_HOLD_TIME: f64 = 0.2;
