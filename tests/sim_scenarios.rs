@@ -85,12 +85,13 @@ fn fig10_sensor_offset_walks_the_estimate_along_the_limiter_circle_at_e_t_over_r
     // rotor. Check that rate over the last two seconds of the hold. The disturbance observer,
     // still running at the tiny ω̂ of the creeping estimate, absorbs part of the error, so the
     // measured walk is somewhat slower than e_t/ρ (≈ 0.75× here); sign and size must agree.
-    // The start-up offset calibration is off here: it is what removes this walk (below). This
+    // The start-up offset calibration is off here: it is what removes this walk (below); so is
+    // the gain calibration (its later start changes the hold this measures). This
     // checks the paper's limiter, so without our R̂s adaptation (whose standstill law pulls
     // |λ̂r| to λ̂f instead of the circle).
     let cfg = "[current_sensor]\nenable_gain_error = false\nenable_noise = false\n\
                enable_quantization = false\n[controller]\noffset_calibration_time = 0.0\n\
-               [estimator]\nrs_adaptation = false\n";
+               gain_calibration_time = 0.0\n[estimator]\nrs_adaptation = false\n";
     let out = run("fig10", Some(cfg), false);
     let c = &out.config;
     let rs_hat = c.estimator_config().machine.rs;

@@ -271,11 +271,15 @@ fn stuck_current_channel_is_detected_and_ridden_through_at_300_rpm() {
 
 #[test]
 fn stuck_current_channel_is_detected_and_ridden_through_at_standstill_under_load() {
+    // The start-up gain calibration is off: it starts the drive 0.52 s later, which changes
+    // the standstill this test was set up on (measured with it: stuck a detected after
+    // 0.4 ms, 0.075 rad; stuck b after 5 ms, 0.30 rad against 0.074 without the fault).
+    let standstill = format!("{STANDSTILL}[controller]\ngain_calibration_time = 0.0\n");
     for channel in ["a", "b"] {
-        let r = run("fig10", &format!("{STANDSTILL}{}", stuck(channel, 3.0)));
+        let r = run("fig10", &format!("{standstill}{}", stuck(channel, 3.0)));
         let detected = r.first_flag(DriveFlags::SENSOR_STUCK, 3.0).map(|t| t - 3.0);
         // Against the same run without the fault (see the test above).
-        let before = run("fig10", STANDSTILL).max_angle_error(3.0, 4.0);
+        let before = run("fig10", &standstill).max_angle_error(3.0, 4.0);
         let err = r.max_angle_error(3.0, 4.0);
         let peak = r.max_current(3.0, 3.02);
         println!(

