@@ -223,6 +223,11 @@ fn run_all<T: Real>(failures: &mut Vec<String>, machine: MachineModel<T>) -> usi
             tuning.current_anti_windup_ratio: NonNegativeBounded,
             tuning.speed_anti_windup_ratio: NonNegativeBounded,
             tuning.offset_calibration_time: NonNegativeBounded,
+            tuning.gain_calibration_time: NonNegativeBounded,
+            // A huge level is capped at current_limit_ratio, a huge mismatch bound accepted.
+            tuning.gain_calibration_current_ratio: Positive,
+            tuning.gain_calibration_min_observability: NonNegativeBounded,
+            tuning.gain_calibration_max_mismatch: Positive,
             // A huge band is refused naming `stuck_sensor_reference_ratio`, which must exceed it.
             tuning.stuck_sensor_band_ratio: NonNegative,
             tuning.stuck_sensor_reference_ratio: Positive,
