@@ -3,8 +3,11 @@
 //!
 //! Order of operations at sample n (SPEC §1, §5):
 //!
-//! 1. Reject non-finite inputs (trip after `input_fault_trip_time` of them in a row); trip
-//!    (gates off, latched) when a phase current exceeds the trip level; replace a phase-current
+//! 1. Reject non-finite inputs (trip after `input_fault_trip_time` of them in a row); remove
+//!    the calibrated offsets; trip (gates off, latched) when a phase current exceeds the trip
+//!    level; divide phase a by the calibrated gain ratio (see
+//!    [`gain_calibration`](crate::control::gain_calibration); while that calibration runs, its
+//!    sample replaces steps 2–8); replace a phase-current
 //!    channel that reads about zero against a clear reference by a model reconstruction
 //!    ([`StuckChannelDetector`]).
 //! 2. Estimator with the α-β currents sampled now and the voltage that acted over
@@ -122,12 +125,15 @@ pub struct DriveTuning<T> {
     /// [`gain_calibration`](crate::control::gain_calibration)): after the offset calibration,
     /// two DC current levels along the aligned d axis measure the ratio of the phase-a and
     /// phase-b channel gains, which then corrects phase a. This is each level's averaging
-    /// window in s; 0 disables the calibration. Each level (and the return to zero) first
-    /// settles for 5·max(L̂d/R̂s, 1/ωc) (five time constants of the stator or of the current
-    /// loop, whichever is slower). Default 0.05 s \[A\] (500 samples at 10 kHz: 10 mA rms of
-    /// noise averages to 0.45 mA, 0.02 % of the lower level's phase-b current at the
-    /// observability limit on the paper's motor). A 0.5 % mismatch walks θ̂ at loaded
-    /// standstill on a low-flux motor (docs: outrunner preset, 1.2 rad).
+    /// window in s; 0 disables the calibration. The current loop settles for
+    /// 5·max(L̂d/R̂s, 1/ωc) (five time constants of the stator or of the current loop,
+    /// whichever is slower), and each level holds 4 time constants of the rotor's swing
+    /// (`swing_time_constant`) before it is averaged; a machine needing a hold above 0.2 s is
+    /// skipped. Default 0.05 s \[A\] (500 samples at 10 kHz: 10 mA rms of noise averages to
+    /// 0.45 mA, 0.02 % of the lower level's phase-b current at the observability limit on the
+    /// paper's motor). A 0.5 % mismatch walks θ̂ at loaded standstill on a low-flux motor
+    /// (README: the outrunner preset lost `reversal` and `stops`, 1.2 rad). Start-up added on
+    /// the presets: 0.33 s (outrunner-cheetah-24v) to 0.52 s (paper).
     pub gain_calibration_time: T,
     /// Upper current level of the gain calibration as a multiple of the rated current (the
     /// lower level is half of it; at most `current_limit_ratio`, and on a rotor with L̂q > L̂d
@@ -135,10 +141,12 @@ pub struct DriveTuning<T> {
     /// levels, the smaller the inverter error and the noise against the resistive drop; the
     /// lower level must keep every phase clear of the dead-time band and the current ripple).
     pub gain_calibration_current_ratio: T,
-    /// Smallest share min(|cos θ0|, |cos(θ0 − 2π/3)|) of the calibration current in phases a
-    /// and b with which the gain calibration runs; at an aligned angle closer to a phase-a or
-    /// phase-b null it is skipped (status `Unobservable`). Default 0.2 \[A\] (the error grows
-    /// as 1/share; skips 26 % of the angles).
+    /// Smallest share min over the phases of |cos(θ0 − φ_x)| of the calibration current with
+    /// which the gain calibration runs (a and b for the observability, c for the inverter
+    /// error's cancellation); at an aligned angle closer to a phase null it is skipped (status
+    /// `Unobservable`). Default 0.2 \[A\] (the error grows as 1/share; at θ0 = −0.5, share
+    /// 0.023, an earlier version measured k 1.2e-2 to 5.4e-2 off on four presets; 0.2 skips
+    /// 38 % of the angles).
     pub gain_calibration_min_observability: T,
     /// Largest gain mismatch |k − 1| accepted from the calibration; a larger result is refused
     /// (status `Implausible`, k unchanged). Default 0.05 \[A\] (two sensors of ±2.5 % gain
@@ -569,7 +577,8 @@ pub struct DriveOutput<T> {
     /// The status word of this sample: faults and warnings (see [`DriveFlags`]).
     pub flags: DriveFlags,
     /// The α-β current the estimator was given this sample (A): the measurement with the
-    /// calibrated offsets removed and a stuck channel reconstructed (the last good current
+    /// calibrated offsets removed, phase a divided by the calibrated gain ratio, and a stuck
+    /// channel reconstructed (the last good current
     /// after a non-finite one; the raw measurement while calibrating or tripped).
     pub i_ab: Ab<T>,
 }
