@@ -108,9 +108,12 @@ def test_estimator_replay_reproduces_the_in_loop_estimate() -> None:
     delay), the current is sampled at n (SPEC §1). Replaying them through `fado.Estimator`
     must give the drive's θ̂ (the whole fig11 run: start-up, both modes, the zero crossing
     under 7.5 N·m)."""
-    # Without the start-up offset calibration, so that the estimator runs from sample 0 on the
-    # raw measured currents the trace records.
-    config = {"simulation": {"decimation": 1}, "controller": {"offset_calibration_time": 0.0}}
+    # Without the start-up offset and gain calibrations, so that the estimator runs from sample 0
+    # on the raw measured currents the trace records.
+    config = {
+        "simulation": {"decimation": 1},
+        "controller": {"offset_calibration_time": 0.0, "gain_calibration_time": 0.0},
+    }
     result = fado.simulate("fig11", config, averaged=True)
     tr = result.traces
     assert not tr["tripped"].any()
