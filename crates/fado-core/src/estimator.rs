@@ -1146,6 +1146,11 @@ pub trait RotorAngleEstimator<T: Real> {
     /// after a loss with a fixed R̂s, see [`crate::control::lock_reaction`]). Default:
     /// nothing to switch.
     fn enable_rs_adaptation(&mut self) {}
+    /// The stator resistance measured at start-up (Ω; the drive's two-point DC test, see
+    /// [`crate::control::gain_calibration`]): an estimator that adapts R̂s online starts its
+    /// adaptation from it. Default: nothing (a fixed R̂s stays as configured, so the paper's
+    /// path is unchanged).
+    fn start_from_measured_rs(&mut self, _rs: T) {}
 }
 
 impl<T: Real> RotorAngleEstimator<T> for SensorlessEstimator<T> {
@@ -1167,6 +1172,13 @@ impl<T: Real> RotorAngleEstimator<T> for SensorlessEstimator<T> {
     }
     fn enable_rs_adaptation(&mut self) {
         SensorlessEstimator::enable_rs_adaptation(self)
+    }
+    /// With [`EstimatorTuning::rs_adaptation`]: [`SensorlessEstimator::set_rs_hat`] (a bad
+    /// value changes nothing); with the paper's fixed R̂s: nothing.
+    fn start_from_measured_rs(&mut self, rs: T) {
+        if self.config.tuning.rs_adaptation {
+            let _ = self.set_rs_hat(rs);
+        }
     }
 }
 

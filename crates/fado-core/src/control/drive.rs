@@ -1056,6 +1056,16 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             } else {
                 T::one()
             };
+            // The same two levels are the classic DC test of Rs: the estimator's R̂s
+            // adaptation starts from it (within its own 0.5–2× band of the model's R̂s; a
+            // value outside says something else is wrong, and the model's R̂s is kept).
+            if self.gain.status() == GainCalibrationStatus::Calibrated {
+                let r = self.gain.resistance();
+                let r0 = self.config.machine.rs;
+                if r >= r0 * T::lit(0.5) && r <= r0 + r0 {
+                    self.estimator.start_from_measured_rs(r);
+                }
+            }
             let a = i_abc.a * self.gain_correction;
             self.last_i_ab = Abc::new(a, i_abc.b, i_abc.c + (i_abc.a - a)).to_ab();
             let theta0 = self.aligned_angle;

@@ -40,6 +40,16 @@
 //! V₁ + R̂s·I₁ along the axis (≈ 2·I₁; a wrong R̂s only moves the level). A d current makes no
 //! torque on a rotor at θ0 (on a salient one too, i_q = 0).
 //!
+//! # Rs, from the same levels
+//! The two levels are also the classic two-point DC test of the resistance:
+//! R = Δv·Δi′/|Δi′|² along the axis, with Δi′ the measured difference corrected by k
+//! ([`resistance_of`], [`GainCalibration::resistance`]). The inverter's constant error cancels
+//! as for k; what remains of the settling is e^(−hold/τ)·τ/window of the step (τ = L/R). The
+//! drive hands it to the estimator's R̂s adaptation as its start value (within 0.5–2× of the
+//! model's R̂s; the paper's fixed R̂s is left as configured): a winding warmer than the model
+//! is then known before the rotor turns, which the scenarios with the plant's Rs 1.3× the
+//! model's need now that the drive starts later.
+//!
 //! # The rotor's swing
 //! The loop regulates the *measured* current onto the axis; the true one is off it by an angle
 //! of order g, so the rotor, held only by the d current's stiffness, swings towards it. Its
@@ -204,6 +214,8 @@ pub struct GainCalibration<T> {
     ratio: T,
     /// The last measured ratio, also when refused (NaN before any).
     measured: T,
+    /// The resistance of the last accepted measurement (NaN before any), Ω.
+    resistance: T,
 }
 
 impl<T: Real> GainCalibration<T> {
@@ -269,6 +281,7 @@ impl<T: Real> GainCalibration<T> {
             status,
             ratio: T::one(),
             measured: T::zero() / T::zero(),
+            resistance: T::zero() / T::zero(),
         })
     }
 
@@ -322,6 +335,17 @@ impl<T: Real> GainCalibration<T> {
     /// The last measured ratio, accepted or not (NaN before any measurement).
     pub fn measured_ratio(&self) -> T {
         self.measured
+    }
+
+    /// The stator resistance the last accepted measurement gives, Ω (NaN before any): the
+    /// two-point DC test R = Δv·Δi′/|Δi′|² along the axis, Δi′ the current difference with
+    /// phase a corrected by the measured k ([`resistance_of`]). The inverter's constant
+    /// error cancels between the levels as it does for k; what grows with the current (the
+    /// devices' on-resistance) is in it, as it is in the voltage the estimator integrates.
+    /// The drive starts its R̂s adaptation from it (TI's InstaSPIN re-measures Rs at every
+    /// start the same way, "Rs recalibration", SPRUHJ1, §"Rs Online and Rs Recalibration").
+    pub fn resistance(&self) -> T {
+        self.resistance
     }
 
     /// The smallest share of the axis current in any phase, min over x of |cos(φ − φ_x)|,
@@ -478,6 +502,7 @@ impl<T: Real> GainCalibration<T> {
                 self.measured = k;
                 if (k - T::one()).abs() <= self.config.max_mismatch {
                     self.ratio = k;
+                    self.resistance = resistance_of(di, dv, k);
                     self.status = GainCalibrationStatus::Calibrated;
                 } else {
                     self.status = GainCalibrationStatus::Implausible;
@@ -487,6 +512,25 @@ impl<T: Real> GainCalibration<T> {
         }
     }
 }
+
+/// R = Δv·Δi′/|Δi′|² (Ω): the resistance along the current difference `di` of two DC levels
+/// and their voltage difference `dv` (α-β), with phase a of `di` divided by the ratio `k`
+/// (phase b as measured; i_β = (i_a + 2·i_b)/√3, amplitude-invariant Clarke). NaN when the
+/// difference is zero or anything is non-finite.
+pub fn resistance_of<T: Real>(di: Ab<T>, dv: Ab<T>, k: T) -> T {
+    let ib = di.alpha * T::lit(PHASE_B_ALPHA) + di.beta * T::lit(PHASE_B_BETA);
+    let ia = di.alpha / k;
+    let corrected = Ab::new(ia, (ia + ib + ib) * T::lit(1.0 / SQRT_3));
+    let den = corrected.dot(corrected);
+    if den > T::zero() {
+        dv.dot(corrected) / den
+    } else {
+        T::zero() / T::zero()
+    }
+}
+
+/// √3.
+const SQRT_3: f64 = 1.732_050_807_568_877_2;
 
 /// 1/n for a sample count n, n built as a real by binary decomposition (adds of powers of
 /// two, exact below 2^24 in f32): no integer-to-float conversion, which a Cortex-M4's f32
@@ -629,6 +673,18 @@ mod tests {
                     (cal.ratio() - k_true).abs() < 1e-5,
                     "θ {angle}: k {} against {k_true}",
                     cal.ratio()
+                );
+                // The resistance, as phase b's sensor sees it (the common gain is not
+                // observable), with the inverter's 1.5 V error cancelled between the levels.
+                // Unlike k (a ratio of two phases settling alike), R keeps the settling
+                // residue: the step to the upper level decays as e^(−t/τ), τ = L/R = 10 ms,
+                // so after a 5τ hold the window of 50 ms = 5τ averages e^(−5)·(1 − e^(−5))/5
+                // ≈ 1.3e-3 of the step (measured 1.3e-3 at θ 0).
+                let r_seen = 0.3 / (1.0 + gb);
+                assert!(
+                    (cal.resistance() - r_seen).abs() < 1.5e-3 * r_seen,
+                    "θ {angle}: R {} against {r_seen}",
+                    cal.resistance()
                 );
                 assert!(peak <= cal.config().current_limit, "{peak}");
                 assert!(n <= cal.duration_samples() + 1, "{n}");
