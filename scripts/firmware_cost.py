@@ -302,6 +302,7 @@ def trace(elf, root, path, tail):
                 "insn_max": max(n_insn),
                 "cyc_mean": sum(n_cyc) / k,
                 "cyc_max": max(n_cyc),
+                "cyc_last": n_cyc[-8:],
                 "by_file": {f: c / k for f, c in by_file.items()},
                 "by_file_insn": {f: c / k for f, c in by_file_insn.items()},
             }
@@ -329,6 +330,9 @@ def main():
                 f"{r['insn_mean']:.0f} instructions (max {r['insn_max']}), "
                 f"{r['cyc_mean']:.0f} cycles (max {r['cyc_max']})"
             )
+            # The estimator runs its slow laws round-robin, one per sample (docs/firmware.md):
+            # the last steps show each slot's cost.
+            print("    cycles of the last 8 steps: " + " ".join(str(c) for c in r["cyc_last"]))
             for f, c in sorted(r["by_file"].items(), key=lambda x: -x[1]):
                 print(f"    {c:7.1f} cycles {r['by_file_insn'][f]:7.1f} insns  {f}")
     else:

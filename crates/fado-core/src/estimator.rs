@@ -27,13 +27,41 @@ use crate::plausibility::{self, SampleBounds};
 use crate::real::all_finite;
 use crate::rotor_flux::{rotor_angle, rotor_flux, stator_flux};
 use crate::rs_adaptation::{
-    AdaptationRegime, OffsetContext, ResistanceAdaptation, ResistanceAdaptationConfig,
+    AdaptationRegime, ResistanceAdaptation, ResistanceAdaptationConfig,
 };
 use crate::tracker::{BandwidthDefinition, TrackerConfig, TypeTwoTracker};
 use crate::{Ab, MachineModel, Real};
 
 /// Observer time constants 1/(2π·f_th) the λ̂f law waits after a LO→HI hand-over.
 const FLUX_SETTLE_TIME_CONSTANTS: f64 = 2.0;
+
+/// The slow laws — the R̂s adaptation (with its λ̂f law), the integrand-offset law and the
+/// loss-of-lock detector — run once every `SLOW_PERIOD` samples, each in its own slot of a
+/// round-robin ([`SLOT_RS`], [`SLOT_OFFSET`], [`SLOT_LOCK`], one slot free), so that one
+/// sample runs at most one of them (the worst-case step is what a firmware interrupt budgets
+/// for, not the mean).
+///
+/// Why this is a valid discretisation: their rates are 0.5–31 s⁻¹ (γ = 1, γ_s = 20, ω_m =
+/// 2π·0.5, k_m = 2π·5, k_θ = 2, k_e = 2 s⁻¹, the detector's 5 ms), against 10 kHz. Each law
+/// is a forward-Euler step of period N·Ts with its gains for that period (every law's
+/// configuration takes its period as `ts`), so its pole sits at 1 − rate·N·Ts instead of
+/// 1 − rate·Ts: for the fastest default rate, k_m = 31.4 s⁻¹, at 0.987 (N = 4, Ts = 100 µs),
+/// where the relative error of forward Euler against the exact e^{−rate·N·Ts} is below
+/// rate·N·Ts/2 = 0.6 % of the decay per period (`slow_laws_poles_stay_near_one` checks every
+/// default rate on several motors and sampling periods). The inputs are sampled, not
+/// averaged, over the period: what they carry near the decimated Nyquist frequency
+/// (1.25 kHz) is noise that the laws' 0.5–31 s⁻¹ bandwidth rejects either way.
+const SLOW_PERIOD: u8 = 4;
+/// Slot of the R̂s adaptation (and its λ̂f law) in the round-robin of [`SLOW_PERIOD`].
+const SLOT_RS: u8 = 0;
+/// Slot of the integrand-offset law.
+const SLOT_OFFSET: u8 = 1;
+/// Slot of the loss-of-lock detector.
+const SLOT_LOCK: u8 = 2;
+/// `slow_broken` bits: the regime was interrupted (a mode change, the trackers coasting)
+/// since the R̂s adaptation's / the offset law's last run, which then does not adapt.
+const BROKEN_RS: u8 = 1;
+const BROKEN_OFFSET: u8 = 2;
 
 /// The λ̂f law runs above this multiple of the Fig. 3 threshold speed (see
 /// [`ResistanceAdaptationConfig::flux_linkage_min_speed`]).
@@ -321,9 +349,14 @@ impl<T: Real> EstimatorConfig<T> {
         SensorlessEstimator::new(*self).map(|_| ())
     }
 
+    /// The period of the slow laws, [`SLOW_PERIOD`]·Ts.
+    fn slow_ts(&self) -> T {
+        self.ts * T::lit(SLOW_PERIOD as f64)
+    }
+
     fn rs_adaptation_config(&self) -> ResistanceAdaptationConfig<T> {
         ResistanceAdaptationConfig {
-            ts: self.ts,
+            ts: self.slow_ts(),
             rs_initial: self.machine.rs,
             flux_linkage_hat: self.machine.flux_linkage,
             lq_hat: self.machine.lq,
@@ -340,7 +373,7 @@ impl<T: Real> EstimatorConfig<T> {
 
     fn lock_detector(&self) -> LockDetectorConfig<T> {
         LockDetectorConfig {
-            ts: self.ts,
+            ts: self.slow_ts(),
             flux_low_ratio: self.tuning.lock_flux_low_ratio,
             flux_high_ratio: self.tuning.lock_flux_high_ratio,
             innovation_limit: self.tuning.lock_innovation_limit,
@@ -511,9 +544,10 @@ pub struct SensorlessEstimator<T> {
     rs_adaptation: ResistanceAdaptation<T>,
     /// ê, the learned integrand offset (with `rs_adaptation`).
     offset: IntegrandOffset<T>,
-    /// The λ̂f law waits this many samples of the k_df mode after a hand-over (see
-    /// `rs_adaptation`): two observer time constants at the Fig. 3 threshold, 2/(2π·f_th).
-    flux_settle_samples: u32,
+    /// The λ̂f law waits this many periods of the slow laws ([`SLOW_PERIOD`] samples) of the
+    /// k_df mode after a hand-over (see `rs_adaptation`): two observer time constants at the
+    /// Fig. 3 threshold, 2/(2π·f_th).
+    flux_settle_periods: u32,
     /// k_e·Ts with `rs_adaptation` (the k_df mode's re-centring), else 0.
     offset_recentring_gain: T,
     /// Feedback term computed at the end of the previous sample.
@@ -527,6 +561,17 @@ pub struct SensorlessEstimator<T> {
     i_prev: Ab<T>,
     step_allowance: T,
     lock: LockDetector<T>,
+    /// This sample's slot in the slow laws' round-robin (see [`SLOW_PERIOD`]).
+    slot: u8,
+    /// `BROKEN_*` bits: which slow law's regime was interrupted since it last ran.
+    slow_broken: u8,
+    /// Σ v and Σ i (the integrator's current) over the samples since the R̂s adaptation
+    /// last ran: the standstill law integrates their means (see [`SLOW_PERIOD`]).
+    v_sum: Ab<T>,
+    i_sum: Ab<T>,
+    /// The slow laws' share of the feedback, held between their runs: the learned integrand
+    /// offset ê plus the R̂s adaptation's standstill pull (V, see `rs_adaptation`).
+    slow_feedback: Ab<T>,
 }
 
 impl<T: Real> SensorlessEstimator<T> {
@@ -632,7 +677,7 @@ impl<T: Real> SensorlessEstimator<T> {
         })?;
         let threshold_hz = config.mode_threshold_hz();
         let offset = IntegrandOffset::new(IntegrandOffsetConfig {
-            ts,
+            ts: config.slow_ts(),
             rate: config.tuning.offset_adaptation_rate,
             settle_time: T::lit(5.0) / (T::two_pi() * threshold_hz),
             limit: lf * T::two_pi() * threshold_hz,
@@ -668,8 +713,8 @@ impl<T: Real> SensorlessEstimator<T> {
             t2s2,
             rs_adaptation,
             offset,
-            flux_settle_samples: (T::lit(FLUX_SETTLE_TIME_CONSTANTS)
-                / (T::two_pi() * threshold_hz * ts))
+            flux_settle_periods: (T::lit(FLUX_SETTLE_TIME_CONSTANTS)
+                / (T::two_pi() * threshold_hz * config.slow_ts()))
                 .ceil()
                 .to_f64() as u32,
             offset_recentring_gain: if config.tuning.rs_adaptation {
@@ -685,6 +730,11 @@ impl<T: Real> SensorlessEstimator<T> {
             i_prev: Ab::zero(),
             step_allowance: bounds.step(),
             lock,
+            slot: 0,
+            slow_broken: 0,
+            v_sum: Ab::zero(),
+            i_sum: Ab::zero(),
+            slow_feedback: Ab::zero(),
         };
         est.reset();
         Ok(est)
@@ -744,6 +794,11 @@ impl<T: Real> SensorlessEstimator<T> {
         self.feedback = Ab::zero();
         self.rejected_samples = 0;
         self.lock.reset();
+        self.slot = 0;
+        self.slow_broken = 0;
+        self.v_sum = Ab::zero();
+        self.i_sum = Ab::zero();
+        self.slow_feedback = self.offset.offset();
         self.i_prev = if self.bounds.current_ok(i_ab) {
             i_ab
         } else {
@@ -816,12 +871,7 @@ impl<T: Real> SensorlessEstimator<T> {
         let lambda_r = rotor_flux(lambda2, i_ab, self.config.machine.lq);
         let tracker_hold = lambda_r.norm_squared() < self.hold_level_sq;
         let theta_direct = rotor_angle(lambda_r);
-        // Loss-of-lock symptoms (see `lock`): |λ̂r| against λ̂f, the T2S-1 innovation.
-        let innovation = if tracker_hold {
-            T::zero()
-        } else {
-            crate::wrap_angle(theta_direct - self.t2s1.predicted_angle())
-        };
+        let slot = self.slot;
         let flux_hat = self.rs_adaptation.flux_linkage_hat();
         // λ̂a/λ̂f, the active flux the limiter circle and the lock detector's bounds refer to
         // (1 on a surface-magnet rotor).
@@ -845,19 +895,37 @@ impl<T: Real> SensorlessEstimator<T> {
         let mode = self.selector.next_mode(t2s2.omega);
         let kdf_active = mode == Mode::DisturbanceFeedback && self.k_df_enabled;
         let kdf_gain = self.disturbance_feedback.next_gain(kdf_active);
-        let (feedback, clamping) = match mode {
+        let (base_feedback, clamping) = match mode {
             Mode::DisturbanceFeedback => (disturbance * kdf_gain, false),
             Mode::Limiter => {
                 let l = self.limiter.step_scaled(lambda_r, active_ratio);
                 (l.feedback, l.clamping)
             }
         };
-        let lock = self.lock.next_state(
-            lambda_r.norm_squared(),
-            flux_hat * flux_hat * active_ratio * active_ratio,
-            innovation,
-            clamping,
-        );
+        // Loss-of-lock symptoms (see `lock`), in the detector's slot: |λ̂r| against λ̂f, the
+        // T2S-1 innovation.
+        let lock = if slot == SLOT_LOCK {
+            let innovation = if tracker_hold {
+                T::zero()
+            } else {
+                crate::wrap_angle(theta_direct - self.t2s1.predicted_angle())
+            };
+            self.lock.next_state(
+                lambda_r.norm_squared(),
+                flux_hat * flux_hat * active_ratio * active_ratio,
+                innovation,
+                clamping,
+            )
+        } else {
+            self.lock.state()
+        };
+        // The learned integrand offset ê is subtracted from the integrand in both modes, with
+        // the standstill pull of the R̂s adaptation (both held between the slow laws' runs).
+        let feedback = if self.config.tuning.rs_adaptation {
+            base_feedback + self.slow_feedback
+        } else {
+            base_feedback
+        };
         // Which values the one test needs (the others follow from them, so the test is
         // exact, not approximate): a non-finite v or i makes λ1 non-finite (Ts·v, and R̂s·i
         // with R̂s ≥ 0: ∞·R̂s = ∞, 0·∞ = NaN, ∞ − ∞ = NaN); a tracker's ω̂ = ω̂ + Ki·Ts·e is
@@ -905,61 +973,105 @@ impl<T: Real> SensorlessEstimator<T> {
         self.lock.commit(lock);
         self.i_prev = i_ab;
         self.step_allowance = self.bounds.step();
-        // 6. R̂s for the next sample (see `rs_adaptation`), after the commit so that the paper's
-        //    path is untouched by it. A non-finite result is dropped (R̂s stays).
+        self.slot = if slot + 1 == SLOW_PERIOD { 0 } else { slot + 1 };
+        // 6. The slow laws in their slots (see [`SLOW_PERIOD`]): R̂s and ê for the next
+        //    sample (see `rs_adaptation`, `integrand_offset`), after the commit so that the
+        //    paper's path is untouched by them. A non-finite result is dropped (R̂s, ê stay).
         if self.config.tuning.rs_adaptation {
-            let regime = match (previous_mode, mode) {
-                _ if tracker_hold => AdaptationRegime::Frozen,
-                (Mode::DisturbanceFeedback, Mode::DisturbanceFeedback) => {
-                    AdaptationRegime::Rotating
+            let interrupted = tracker_hold || previous_mode != mode;
+            let broken = self.slow_broken
+                | if interrupted {
+                    BROKEN_RS | BROKEN_OFFSET
+                } else {
+                    0
+                };
+            if slot == SLOT_RS {
+                let regime = if broken & BROKEN_RS != 0 {
+                    AdaptationRegime::Frozen
+                } else {
+                    match mode {
+                        Mode::DisturbanceFeedback => AdaptationRegime::Rotating,
+                        Mode::Limiter => AdaptationRegime::Standstill,
+                    }
+                };
+                // The standstill law sees the voltage without the learned offset, and the
+                // voltage and current averaged over the period.
+                let per_sample = T::one() / T::lit(SLOW_PERIOD as f64);
+                let v_mean = (self.v_sum + v_ab) * per_sample;
+                let i_mean = (self.i_sum + i_drop) * per_sample;
+                self.v_sum = Ab::zero();
+                self.i_sum = Ab::zero();
+                let (state, pull) = self.rs_adaptation.next_state(
+                    v_mean - self.offset.offset(),
+                    i_drop,
+                    i_mean,
+                    i_ab,
+                    lambda_r,
+                    t2s1.omega,
+                    regime,
+                    self.offset.learning_samples() >= self.flux_settle_periods,
+                );
+                // The pull acts until the law runs again (one period), with ê.
+                let slow_feedback = self.offset.offset() + pull;
+                let feedback = base_feedback + slow_feedback;
+                // R̂s and λ̂f leave the adaptation clamped by compare-and-select, which turns
+                // a NaN into the bound: always finite.
+                if all_finite([
+                    state.charge_d,
+                    state.volt_seconds_d,
+                    state.i_d_prev,
+                    state.offset_sensitivity.alpha,
+                    state.offset_sensitivity.beta,
+                    state.flux_error_angle,
+                    state.flux_excitation,
+                    state.flux_angle,
+                    state.flux_time,
+                    feedback.alpha,
+                    feedback.beta,
+                ]) {
+                    self.rs_adaptation.commit(state);
+                    self.integrator.set_rs_hat_unchecked(state.rs_hat);
+                    self.feedback = feedback;
+                    self.slow_feedback = slow_feedback;
                 }
-                (Mode::Limiter, Mode::Limiter) => AdaptationRegime::Standstill,
-                _ => AdaptationRegime::Frozen,
-            };
-            let offset = self.offset.next_state(
-                disturbance,
-                kdf_gain,
-                shift,
-                regime == AdaptationRegime::Rotating,
-            );
-            // The standstill law sees the voltage without the learned offset, and R̂s drops
-            // what earlier standstill tests read of the offset ê learns now.
-            let offset_before = self.offset.offset();
-            let (state, pull) = self.rs_adaptation.next_state(
-                v_ab - offset_before,
-                i_drop,
-                lambda_r,
-                t2s1.omega,
-                regime,
-                OffsetContext {
-                    offset_change: offset.offset - offset_before,
-                    flux_settled: self.offset.learning_samples() >= self.flux_settle_samples,
-                },
-            );
-            let feedback = self.feedback + pull + offset.offset;
-            // R̂s and λ̂f leave the adaptation clamped by compare-and-select, which turns a
-            // NaN into the bound: always finite.
-            if all_finite([
-                state.charge_d,
-                state.volt_seconds_d,
-                state.i_d_prev,
-                state.offset_sensitivity.alpha,
-                state.offset_sensitivity.beta,
-                state.flux_error_angle,
-                state.flux_excitation,
-                state.flux_angle,
-                state.flux_time,
-                offset.offset.alpha,
-                offset.offset.beta,
-                offset.disturbance_prev.alpha,
-                offset.disturbance_prev.beta,
-                feedback.alpha,
-                feedback.beta,
-            ]) {
-                self.rs_adaptation.commit(state);
-                self.offset.commit(offset);
-                self.integrator.set_rs_hat_unchecked(state.rs_hat);
-                self.feedback = feedback;
+                self.slow_broken = broken & !BROKEN_RS;
+            } else if mode == Mode::Limiter {
+                // Only the standstill law uses the means, and only after a whole period in
+                // the limiter mode (else its regime is `Frozen`).
+                self.v_sum += v_ab;
+                self.i_sum += i_drop;
+            }
+            if slot == SLOT_OFFSET {
+                // D̂ decays over the period by k_df·N·Ts, and by the N − 1 re-centring shifts
+                // k_e·Ts·D̂ of the samples since the law last ran (see
+                // `IntegrandOffset::next_state`).
+                let n = T::lit(SLOW_PERIOD as f64);
+                let decay = kdf_gain * (self.config.ts * n)
+                    + self.offset_recentring_gain * (n - T::one());
+                let learning = broken & BROKEN_OFFSET == 0 && mode == Mode::DisturbanceFeedback;
+                let offset = self.offset.next_state(disturbance, decay, shift, learning);
+                // R̂s drops what earlier standstill tests read of the offset ê learns now.
+                let change = offset.offset - self.offset.offset();
+                let rs_hat = self.rs_adaptation.rs_after_offset_change(change);
+                let slow_feedback = self.slow_feedback + change;
+                let feedback = base_feedback + slow_feedback;
+                if all_finite([
+                    offset.offset.alpha,
+                    offset.offset.beta,
+                    offset.disturbance_prev.alpha,
+                    offset.disturbance_prev.beta,
+                    feedback.alpha,
+                    feedback.beta,
+                ]) {
+                    self.offset.commit(offset);
+                    self.rs_adaptation.commit_rs_hat(rs_hat);
+                    self.integrator.set_rs_hat_unchecked(rs_hat);
+                    self.feedback = feedback;
+                    self.slow_feedback = slow_feedback;
+                }
+                self.slow_broken = broken & !BROKEN_OFFSET;
+            } else if slot != SLOT_RS {
+                self.slow_broken = broken;
             }
         }
         let estimate = Estimate {
@@ -1097,6 +1209,7 @@ impl<T: Real> SensorlessEstimator<T> {
             self.rs_adaptation = adaptation;
         }
         self.offset.reset();
+        self.slow_feedback = Ab::zero();
     }
 
     /// The R̂s adaptation's configuration from the present one, with the λ̂f law's speed kept

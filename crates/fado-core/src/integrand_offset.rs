@@ -40,7 +40,9 @@ use crate::{Ab, Real};
 /// Configuration of [`IntegrandOffset`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct IntegrandOffsetConfig<T> {
-    /// Sampling period Ts in s. Default 100 µs (paper, V).
+    /// Period of the law in s: the sampling period Ts if it runs every sample, N·Ts in the
+    /// estimator, which runs it once every N samples (see `SensorlessEstimator`'s slow
+    /// laws). Default 100 µs (paper, V).
     pub ts: T,
     /// k_e in s⁻¹: the rate at which ê follows the integrand's DC error while turning, 0 = off.
     /// Default 2 s⁻¹ (ours \[A\]: ≈ 5 time constants within the 2.5 s the Fig. 11 profile
@@ -120,15 +122,24 @@ impl<T: Real> IntegrandOffset<T> {
         self.state = IntegrandOffsetState::default();
     }
 
-    /// The state after one more sample: `disturbance` is D̂ of this sample, `feedback_gain`
-    /// the k_df gain in effect, `shift` the common-mode shift the estimator then applies to
-    /// λ1, the observer and D̂ (D̂ after this sample is `disturbance − shift`), `learning`
-    /// whether the law runs (the k_df mode, turning).
+    /// The state after one more period `ts` of the law: `disturbance` is D̂ now, `decay`
+    /// what D̂ lost over the period besides its own dynamics, as a fraction of D̂ (the k_df
+    /// feedback, k_df·ts, plus the estimator's common-mode shifts between two runs of the
+    /// law, see below), `shift` the common-mode shift the estimator applies to λ1, the
+    /// observer and D̂ now (D̂ afterwards is `disturbance − shift`), `learning` whether the
+    /// law runs (the k_df mode, turning, throughout the period).
+    ///
+    /// Run once per sample (ts = the sampling period), `decay` = k_df·Ts. The estimator runs
+    /// it once every N samples (ts = N·Ts, see `SensorlessEstimator`'s slow laws): then
+    /// D̂ − D̂_prev telescopes over the N samples exactly, except for the N − 1 shifts
+    /// k_e·Ts·D̂ applied in between, which `decay` adds back with the k_df term
+    /// (k_df·N·Ts + (N − 1)·k_e·Ts, with D̂ now for the intermediate samples' D̂: the
+    /// error is second order in the law's step k_e·N·Ts).
     #[inline]
     pub fn next_state(
         &self,
         disturbance: Ab<T>,
-        feedback_gain: T,
+        decay: T,
         shift: Ab<T>,
         learning: bool,
     ) -> IntegrandOffsetState<T> {
@@ -145,8 +156,7 @@ impl<T: Real> IntegrandOffset<T> {
             && self.state.learning_samples >= self.settle_samples
             && self.config.rate > T::zero()
         {
-            let innovation = (disturbance - self.state.disturbance_prev)
-                + disturbance * (feedback_gain * self.config.ts);
+            let innovation = (disturbance - self.state.disturbance_prev) + disturbance * decay;
             let offset = self.state.offset + innovation * self.config.rate;
             let n2 = offset.norm_squared();
             next.offset = if n2 > self.limit_sq {
@@ -207,17 +217,17 @@ mod tests {
         let n = (1.0 / ts) as usize;
         for _ in 0..n {
             lambda += (e - law.offset() - lambda * k_df) * ts;
-            let s = law.next_state(lambda, k_df, Ab::zero(), true);
+            let s = law.next_state(lambda, k_df * ts, Ab::zero(), true);
             law.commit(s);
         }
         // After 1 s at k_e = 2 s⁻¹ the error is e^{−2} of e (to the Euler step).
         let left = (e - law.offset()).norm() / e.norm();
         assert!((left - (-2.0f64).exp()).abs() < 0.01, "{left}");
         // Bounded: a huge error saturates at the limit.
-        let s = law.next_state(Ab::new(1e3, 0.0), k_df, Ab::zero(), true);
+        let s = law.next_state(Ab::new(1e3, 0.0), k_df * ts, Ab::zero(), true);
         assert!((s.offset.norm() - law.config().limit).abs() < 1e-12);
         // Not learning: held.
-        let s = law.next_state(Ab::new(1e3, 0.0), k_df, Ab::zero(), false);
+        let s = law.next_state(Ab::new(1e3, 0.0), k_df * ts, Ab::zero(), false);
         assert_eq!(s.offset, law.offset());
         assert!(
             IntegrandOffset::<f64>::new(IntegrandOffsetConfig {

@@ -62,7 +62,9 @@ impl LockStatus {
 /// [`EstimatorConfig`](crate::EstimatorConfig)'s `lock_*` fields.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LockDetectorConfig<T> {
-    /// Sampling period in s.
+    /// Period at which the detector judges a sample, s: the sampling period, or N·Ts when
+    /// the estimator runs it once every N samples (each verdict then stands for N·Ts of
+    /// symptomatic or clean time).
     pub ts: T,
     /// |λ̂r| below this multiple of λ̂f is suspicious.
     pub flux_low_ratio: T,
@@ -168,6 +170,13 @@ impl<T: Real> LockDetector<T> {
     pub fn commit(&mut self, (count, status): (u32, LockStatus)) {
         self.count = count;
         self.status = status;
+    }
+
+    /// The committed state, as [`Self::next_state`] returns it (for a sample the detector
+    /// does not judge).
+    #[inline]
+    pub fn state(&self) -> (u32, LockStatus) {
+        (self.count, self.status)
     }
 
     /// The status after the last committed sample.

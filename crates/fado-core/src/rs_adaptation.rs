@@ -167,7 +167,9 @@ pub const FLUX_LINKAGE_DEAD_ZONE_OFF: f64 = 0.0025;
 /// Configuration of [`ResistanceAdaptation`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ResistanceAdaptationConfig<T> {
-    /// Sampling period Ts in s. Default 100 µs (paper, V).
+    /// Period of the law in s: the sampling period Ts if it runs every sample, N·Ts in the
+    /// estimator, which runs it once every N samples (see `SensorlessEstimator`'s slow
+    /// laws). Default 100 µs (paper, V).
     pub ts: T,
     /// Initial (configured) R̂s = R0 in Ω, the start value and the scale of the law. Default
     /// 0.327 Ω (paper, V).
@@ -260,14 +262,6 @@ impl<T: Real> Default for ResistanceAdaptationConfig<T> {
     }
 }
 
-/// What the integrand-offset law (`crate::integrand_offset`) tells the adaptation each sample.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct OffsetContext<T> {
-    /// Δê this sample (V): R̂s drops what standstill tests read of it.
-    pub offset_change: Ab<T>,
-    /// The k_df mode has lasted long enough for the λ̂f law (past the hand-over transient).
-    pub flux_settled: bool,
-}
 
 /// Which law applies this sample (chosen by the estimator from its mode).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -292,7 +286,8 @@ pub struct ResistanceAdaptationState<T> {
     pub charge_d: T,
     /// Standstill: forgetting integral of v_d + ω̂·L̂q·i_q − L̂d·di_d/dt, V·s.
     pub volt_seconds_d: T,
-    /// Standstill: i_d of the last sample, A (for di_d/dt).
+    /// Standstill: i_d sampled at the end of the last period, A (for L̂d·Δi_d); 0 = none
+    /// yet (a test starts by recording it).
     pub i_d_prev: T,
     /// ∂R̂s/∂ê in 1/A: how much of R̂s still comes from standstill DC tests, each of which
     /// read a voltage offset ê along its d axis as ⟨ê, d̂⟩/i_d of resistance. Built by the
@@ -471,40 +466,62 @@ impl<T: Real> ResistanceAdaptation<T> {
         if !inputs_finite {
             return self.state.rs_hat;
         }
-        let context = OffsetContext {
-            offset_change: Ab::zero(),
-            flux_settled: true,
-        };
-        let (next, _) = self.next_state(v_ab, i_drop, lambda_r, omega, regime, context);
+        let (next, _) = self.next_state(v_ab, i_drop, i_drop, i_drop, lambda_r, omega, regime, true);
         if next.is_finite() {
             self.commit(next);
         }
         self.state.rs_hat
     }
 
-    /// The state after one more sample, computed without changing this one. Always inlined:
-    /// the estimator's step is the one caller that runs every sample (an out-of-line copy
-    /// costs a call and the spills around it on a Cortex-M4F, docs/firmware.md).
+    /// R̂s after the integrand-offset estimate ê (`crate::integrand_offset`) moved by
+    /// `offset_change` (V): R̂s drops what standstill tests read of it, −⟨Δê, ∂R̂s/∂ê⟩,
+    /// within its bounds (compare-and-select: a NaN becomes a bound, so R̂s stays finite).
     #[inline(always)]
+    pub(crate) fn rs_after_offset_change(&self, offset_change: Ab<T>) -> T {
+        min(
+            max(
+                self.state.rs_hat - offset_change.dot(self.state.offset_sensitivity),
+                self.rs_min,
+            ),
+            self.rs_max,
+        )
+    }
+
+    /// Takes R̂s computed by [`Self::rs_after_offset_change`].
+    #[inline(always)]
+    pub(crate) fn commit_rs_hat(&mut self, rs_hat: T) {
+        self.state.rs_hat = rs_hat;
+    }
+
+    /// The state after one more period of the law (`ts`), computed without changing this
+    /// one. `i_drop` is the current now (the turning law compares it with λ̂r now);
+    /// `i_now` the current sampled now (its d component at the ends of the period gives
+    /// the inductive voltage's integral L̂d·Δi_d); `v_ab` and `i_mean` are the voltage and
+    /// current averaged over the period (the
+    /// standstill law integrates them: run once per sample, the samples themselves; run once
+    /// every N samples, their means over the N samples, so that its integrals stay those of
+    /// every sample — a sampled v_d would add the noise of the samples left out, and alias
+    /// whatever the current loop puts at multiples of 1/(N·Ts) to DC). `settled`: the k_df
+    /// mode has lasted long enough for the λ̂f law (past the hand-over transient). The
+    /// returned pull (V) acts until the next run (the estimator holds it over the period).
+    /// Always inlined: the estimator's step is its one caller per sample (an out-of-line
+    /// copy costs a call and the spills around it on a Cortex-M4F, docs/firmware.md).
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
     pub(crate) fn next_state(
         &self,
         v_ab: Ab<T>,
         i_drop: Ab<T>,
+        i_mean: Ab<T>,
+        i_now: Ab<T>,
         lambda_r: Ab<T>,
         omega: T,
         regime: AdaptationRegime,
-        context: OffsetContext<T>,
+        settled: bool,
     ) -> (ResistanceAdaptationState<T>, Ab<T>) {
-        let (offset_change, settled) = (context.offset_change, context.flux_settled);
         let mut pull = Ab::zero();
         let mut next = ResistanceAdaptationState {
-            rs_hat: min(
-                max(
-                    self.state.rs_hat - offset_change.dot(self.state.offset_sensitivity),
-                    self.rs_min,
-                ),
-                self.rs_max,
-            ),
+            rs_hat: self.state.rs_hat,
             flux_linkage_hat: self.state.flux_linkage_hat,
             flux_learning: self.state.flux_learning,
             offset_sensitivity: self.state.offset_sensitivity,
@@ -595,8 +612,8 @@ impl<T: Real> ResistanceAdaptation<T> {
             // Standstill: only at standstill and while the current lies along the flux (the
             // estimated rotor frame: d along λ̂r).
             let unit = lambda_r * (T::one() / mag);
-            let i_d = unit.dot(i_drop);
-            let i_q = unit.cross(i_drop);
+            let i_d = unit.dot(i_mean);
+            let i_q = unit.cross(i_mean);
             let speed_sq = omega * omega * self.standstill_inv_omega_sq;
             if i_d <= (i_q + i_q).abs() || speed_sq > T::one() {
                 return (next, pull);
@@ -604,16 +621,17 @@ impl<T: Real> ResistanceAdaptation<T> {
             let ts = self.config.ts;
             let inv_i_d = T::one() / i_d;
             let v_d = unit.dot(v_ab) + omega * self.config.lq_hat * i_q;
-            let first = self.state.charge_d == T::zero();
-            let di_d = if first {
-                T::zero()
-            } else {
-                i_d - self.state.i_d_prev
-            };
-            next.charge_d = self.state.charge_d * self.forget + i_d * ts;
-            next.volt_seconds_d =
-                self.state.volt_seconds_d * self.forget + v_d * ts - self.config.ld_hat * di_d;
-            next.i_d_prev = i_d;
+            // L̂d·di_d/dt integrates to L̂d·Δi_d between the ends of the period, from the
+            // current sampled there (`i_now`); the first period of a test only records it
+            // (its inductive voltage would otherwise be read as resistance).
+            let i_d_now = unit.dot(i_now);
+            next.i_d_prev = i_d_now;
+            if self.state.i_d_prev != T::zero() {
+                let di_d = i_d_now - self.state.i_d_prev;
+                next.charge_d = self.state.charge_d * self.forget + i_d * ts;
+                next.volt_seconds_d = self.state.volt_seconds_d * self.forget + v_d * ts
+                    - self.config.ld_hat * di_d;
+            }
             if next.charge_d * self.chi_per_phi >= self.config.excitation_floor {
                 let r_dc = next.volt_seconds_d / next.charge_d;
                 next.rs_hat += self.standstill_gain * (r_dc - next.rs_hat);
