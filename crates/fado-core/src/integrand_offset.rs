@@ -223,6 +223,27 @@ mod tests {
         // After 1 s at k_e = 2 s⁻¹ the error is e^{−2} of e (to the Euler step).
         let left = (e - law.offset()).norm() / e.norm();
         assert!((left - (-2.0f64).exp()).abs() < 0.01, "{left}");
+        // Run once every 4 samples with its period 4·ts (as the estimator does), the same
+        // continuous-time rate: D̂ − D̂_prev telescopes, k_df·4·ts·D̂ the decay.
+        let mut slow = IntegrandOffset::new(IntegrandOffsetConfig {
+            ts: 4.0 * ts,
+            settle_time: 0.0,
+            ..Default::default()
+        })
+        .unwrap();
+        let mut lambda = Ab::zero();
+        for k in 0..n {
+            lambda += (e - slow.offset() - lambda * k_df) * ts;
+            if k % 4 == 3 {
+                let s = slow.next_state(lambda, k_df * 4.0 * ts, Ab::zero(), true);
+                slow.commit(s);
+            }
+        }
+        let left_slow = (e - slow.offset()).norm() / e.norm();
+        assert!(
+            (left_slow - left).abs() < 0.005,
+            "{left_slow} against {left}"
+        );
         // Bounded: a huge error saturates at the limit.
         let s = law.next_state(Ab::new(1e3, 0.0), k_df * ts, Ab::zero(), true);
         assert!((s.offset.norm() - law.config().limit).abs() < 1e-12);

@@ -262,7 +262,6 @@ impl<T: Real> Default for ResistanceAdaptationConfig<T> {
     }
 }
 
-
 /// Which law applies this sample (chosen by the estimator from its mode).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum AdaptationRegime {
@@ -466,7 +465,8 @@ impl<T: Real> ResistanceAdaptation<T> {
         if !inputs_finite {
             return self.state.rs_hat;
         }
-        let (next, _) = self.next_state(v_ab, i_drop, i_drop, i_drop, lambda_r, omega, regime, true);
+        let (next, _) =
+            self.next_state(v_ab, i_drop, i_drop, i_drop, lambda_r, omega, regime, true);
         if next.is_finite() {
             self.commit(next);
         }
@@ -629,8 +629,8 @@ impl<T: Real> ResistanceAdaptation<T> {
             if self.state.i_d_prev != T::zero() {
                 let di_d = i_d_now - self.state.i_d_prev;
                 next.charge_d = self.state.charge_d * self.forget + i_d * ts;
-                next.volt_seconds_d = self.state.volt_seconds_d * self.forget + v_d * ts
-                    - self.config.ld_hat * di_d;
+                next.volt_seconds_d =
+                    self.state.volt_seconds_d * self.forget + v_d * ts - self.config.ld_hat * di_d;
             }
             if next.charge_d * self.chi_per_phi >= self.config.excitation_floor {
                 let r_dc = next.volt_seconds_d / next.charge_d;
