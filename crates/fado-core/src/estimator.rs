@@ -531,7 +531,28 @@ impl<T> From<Estimate<T>> for LeanEstimate<T> {
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SensorlessEstimator<T> {
-    config: EstimatorConfig<T>,
+    // What the step and `reset`/`align` need of the `EstimatorConfig` (the whole record, 156 B
+    // in `f32`, is the caller's to keep: it is not state).
+    /// Sampling period Ts, s.
+    ts: T,
+    /// L̂q (eq. (5)), H.
+    lq: T,
+    /// L̂d − L̂q, H (0 on a surface-magnet rotor).
+    saliency: T,
+    /// The configured λ̂f, Wb.
+    flux_linkage: T,
+    /// `EstimatorTuning::tracker_hold_ratio`.
+    tracker_hold_ratio: T,
+    /// k_df·Ts with `EstimatorTuning::limiter_recentring`, else 0.
+    limiter_recentring_gain: T,
+    /// k_e in s⁻¹ (`EstimatorTuning::offset_adaptation_rate`).
+    offset_adaptation_rate: T,
+    /// `EstimatorConfig::initial_angle`, rad.
+    initial_angle: T,
+    /// `EstimatorTuning::observer_on_rotor_flux`.
+    observer_on_rotor_flux: bool,
+    /// `EstimatorTuning::rs_adaptation`, or switched on by [`Self::enable_rs_adaptation`].
+    rs_adaptation_on: bool,
     integrator: FluxIntegrator<T>,
     observer: DisturbanceObserver<T>,
     disturbance_feedback: DisturbanceFeedback<T>,
@@ -701,7 +722,20 @@ impl<T: Real> SensorlessEstimator<T> {
         let bounds = config.sample_bounds()?;
         let lock = LockDetector::new(config.lock_detector())?;
         let mut est = Self {
-            config,
+            ts,
+            lq: config.machine.lq,
+            saliency: config.machine.ld - config.machine.lq,
+            flux_linkage: lf,
+            tracker_hold_ratio: hold,
+            limiter_recentring_gain: if config.tuning.limiter_recentring {
+                config.tuning.k_df * ts
+            } else {
+                T::zero()
+            },
+            offset_adaptation_rate: config.tuning.offset_adaptation_rate,
+            initial_angle: config.initial_angle,
+            observer_on_rotor_flux: config.tuning.observer_on_rotor_flux,
+            rs_adaptation_on: config.tuning.rs_adaptation,
             integrator,
             observer,
             disturbance_feedback,
@@ -741,13 +775,13 @@ impl<T: Real> SensorlessEstimator<T> {
     /// Back to the start-up state at `config.initial_angle` with zero current; an adapted R̂s
     /// goes back to the configured value.
     pub fn reset(&mut self) {
-        if self.config.tuning.rs_adaptation {
+        if self.rs_adaptation_on {
             self.rs_adaptation.reset();
             self.offset.reset();
             self.integrator
                 .set_rs_hat_unchecked(self.rs_adaptation.rs_hat());
         }
-        self.align(self.config.initial_angle, Ab::zero());
+        self.align(self.initial_angle, Ab::zero());
     }
 
     /// Start-up at a known rotor angle θ0 with the present current (SPEC §1 step 6):
@@ -760,18 +794,17 @@ impl<T: Real> SensorlessEstimator<T> {
             T::zero()
         };
         // The active flux λ̂f + (L̂d − L̂q)·i_d (λ̂f exactly for L̂d = L̂q).
-        let m = &self.config.machine;
         let rotor = Ab::from_polar(T::one(), theta0);
-        let active = m.flux_linkage + (m.ld - m.lq) * rotor.dot(i_ab);
+        let active = self.flux_linkage + self.saliency * rotor.dot(i_ab);
         let active = if active.is_finite() && active > T::zero() {
             active
         } else {
-            m.flux_linkage
+            self.flux_linkage
         };
         let lambda_r = Ab::from_polar(active, theta0);
         // A current so large that L̂q·i overflows is as unusable as a NaN (found by fuzzing,
         // f32: i = 3e37 A gave λ1 = ∞): start as with zero current.
-        let lambda1 = lambda_r + i_ab * self.config.machine.lq;
+        let lambda1 = lambda_r + i_ab * self.lq;
         let (lambda1, i_ab) = if lambda1.is_finite() {
             (lambda1, i_ab)
         } else {
@@ -779,12 +812,11 @@ impl<T: Real> SensorlessEstimator<T> {
         };
         self.integrator.reset_to(lambda1);
         self.integrator.set_last_current(i_ab);
-        self.observer
-            .reset_to(if self.config.tuning.observer_on_rotor_flux {
-                Ab::from_polar(m.flux_linkage, theta0)
-            } else {
-                lambda1
-            });
+        self.observer.reset_to(if self.observer_on_rotor_flux {
+            Ab::from_polar(self.flux_linkage, theta0)
+        } else {
+            lambda1
+        });
         self.disturbance_feedback.reset();
         self.selector.reset();
         self.t2s1.reset_to(theta0, T::zero());
@@ -847,13 +879,13 @@ impl<T: Real> SensorlessEstimator<T> {
         // changed. One test at the end covers all of this (cheaper than a test per input and
         // per block, and than copying the estimator as a backup every sample).
         // L̂d − L̂q: zero on a surface-magnet rotor, where the active-flux terms vanish.
-        let saliency = self.config.machine.ld - self.config.machine.lq;
+        let saliency = self.saliency;
         // 1. Integrate with the feedback of the previous sample (eq. (21) / (24)).
         let (lambda1, i_drop) = self.integrator.next_flux(v_ab, i_ab, self.feedback);
         // 2. Disturbance observer at ω̂ of T2S-1 (eq. (10), (16)), on λ1 or on λ1 − L̂q·i
         //    (see `EstimatorTuning::observer_on_rotor_flux`).
-        let observer_input = if self.config.tuning.observer_on_rotor_flux {
-            let active = rotor_flux(lambda1, i_ab, self.config.machine.lq);
+        let observer_input = if self.observer_on_rotor_flux {
+            let active = rotor_flux(lambda1, i_ab, self.lq);
             if saliency != T::zero() {
                 active - self.active_flux_swing(i_ab, saliency)
             } else {
@@ -866,7 +898,7 @@ impl<T: Real> SensorlessEstimator<T> {
             self.observer.next_state(observer_input, self.t2s1.speed());
         // 3. Rotor flux and direct angle (eq. (20), (5), (6)).
         let lambda2 = stator_flux(lambda1, disturbance);
-        let lambda_r = rotor_flux(lambda2, i_ab, self.config.machine.lq);
+        let lambda_r = rotor_flux(lambda2, i_ab, self.lq);
         let tracker_hold = lambda_r.norm_squared() < self.hold_level_sq;
         let theta_direct = rotor_angle(lambda_r);
         let slot = self.slot;
@@ -875,8 +907,8 @@ impl<T: Real> SensorlessEstimator<T> {
         // (1 on a surface-magnet rotor).
         let active_ratio = if saliency != T::zero() && !tracker_hold {
             let i_d = i_ab.dot(lambda_r) / lambda_r.norm_squared().step_sqrt();
-            let ratio = T::one() + saliency * i_d / self.config.machine.flux_linkage;
-            crate::real::max(ratio, self.config.tuning.tracker_hold_ratio)
+            let ratio = T::one() + saliency * i_d / self.flux_linkage;
+            crate::real::max(ratio, self.tracker_hold_ratio)
         } else {
             T::one()
         };
@@ -919,7 +951,7 @@ impl<T: Real> SensorlessEstimator<T> {
         };
         // The learned integrand offset ê is subtracted from the integrand in both modes, with
         // the standstill pull of the R̂s adaptation (both held between the slow laws' runs).
-        let feedback = if self.config.tuning.rs_adaptation {
+        let feedback = if self.rs_adaptation_on {
             base_feedback + self.slow_feedback
         } else {
             base_feedback
@@ -953,8 +985,8 @@ impl<T: Real> SensorlessEstimator<T> {
         // With the integrand-offset law, the k_df mode re-centres too, at k_e (see
         // `crate::integrand_offset`: D̂ then decays at k_df + k_e instead of k_df, and the
         // ramp k_df·D̂ that the observer has to follow goes with it).
-        let shift = if mode == Mode::Limiter && self.config.tuning.limiter_recentring {
-            disturbance * (self.config.tuning.k_df * self.config.ts)
+        let shift = if mode == Mode::Limiter && self.limiter_recentring_gain > T::zero() {
+            disturbance * self.limiter_recentring_gain
         } else if mode == Mode::DisturbanceFeedback && self.offset_recentring_gain > T::zero() {
             disturbance * self.offset_recentring_gain
         } else {
@@ -975,7 +1007,7 @@ impl<T: Real> SensorlessEstimator<T> {
         // 6. The slow laws in their slots (see [`SLOW_PERIOD`]): R̂s and ê for the next
         //    sample (see `rs_adaptation`, `integrand_offset`), after the commit so that the
         //    paper's path is untouched by them. A non-finite result is dropped (R̂s, ê stay).
-        if self.config.tuning.rs_adaptation {
+        if self.rs_adaptation_on {
             let interrupted = tracker_hold || previous_mode != mode;
             let broken = self.slow_broken
                 | if interrupted {
@@ -1044,8 +1076,7 @@ impl<T: Real> SensorlessEstimator<T> {
                 // k_e·Ts·D̂ of the samples since the law last ran (see
                 // `IntegrandOffset::next_state`).
                 let n = T::lit(SLOW_PERIOD as f64);
-                let decay =
-                    kdf_gain * (self.config.ts * n) + self.offset_recentring_gain * (n - T::one());
+                let decay = kdf_gain * (self.ts * n) + self.offset_recentring_gain * (n - T::one());
                 let learning = broken & BROKEN_OFFSET == 0 && mode == Mode::DisturbanceFeedback;
                 let offset = self.offset.next_state(disturbance, decay, shift, learning);
                 // R̂s drops what earlier standstill tests read of the offset ê learns now.
@@ -1133,11 +1164,7 @@ impl<T: Real> SensorlessEstimator<T> {
         let lambda1 = self.integrator.flux();
         let disturbance = self.observer.disturbance();
         let lambda2 = stator_flux(lambda1, disturbance);
-        let lambda_r = rotor_flux(
-            lambda2,
-            self.integrator.last_current(),
-            self.config.machine.lq,
-        );
+        let lambda_r = rotor_flux(lambda2, self.integrator.last_current(), self.lq);
         let mode = self.selector.mode();
         Estimate {
             theta: self.t2s1.angle(),
@@ -1179,10 +1206,9 @@ impl<T: Real> SensorlessEstimator<T> {
     /// then changes nothing.
     pub fn set_rs_hat(&mut self, rs_hat: T) -> Result<(), ConfigError> {
         self.integrator.set_rs_hat(rs_hat)?;
-        self.config.machine.rs = rs_hat;
-        if self.config.tuning.rs_adaptation {
+        if self.rs_adaptation_on {
             // Cannot fail: R̂s ≥ 0 was just checked and nothing else changed.
-            if let Ok(adaptation) = ResistanceAdaptation::new(self.rs_adaptation_config()) {
+            if let Ok(adaptation) = ResistanceAdaptation::new(self.rs_adaptation_config(rs_hat)) {
                 self.rs_adaptation = adaptation;
             }
         }
@@ -1196,27 +1222,27 @@ impl<T: Real> SensorlessEstimator<T> {
     /// [`Self::reset`] and [`Self::align`] (the configuration now says so); a rebuilt
     /// estimator starts as configured.
     pub fn enable_rs_adaptation(&mut self) {
-        if self.config.tuning.rs_adaptation {
+        if self.rs_adaptation_on {
             return;
         }
-        self.config.machine.rs = self.integrator.config().rs_hat;
-        self.config.tuning.rs_adaptation = true;
-        self.offset_recentring_gain = self.config.tuning.offset_adaptation_rate * self.config.ts;
+        self.rs_adaptation_on = true;
+        self.offset_recentring_gain = self.offset_adaptation_rate * self.ts;
         // Cannot fail: the same configuration was accepted by `new` with R̂s from it.
-        if let Ok(adaptation) = ResistanceAdaptation::new(self.rs_adaptation_config()) {
+        let rs_hat = self.integrator.config().rs_hat;
+        if let Ok(adaptation) = ResistanceAdaptation::new(self.rs_adaptation_config(rs_hat)) {
             self.rs_adaptation = adaptation;
         }
         self.offset.reset();
         self.slow_feedback = Ab::zero();
     }
 
-    /// The R̂s adaptation's configuration from the present one, with the λ̂f law's speed kept
-    /// from `new` (recomputing it from the ratings would bring soft f64 into the f32 drive's
-    /// reachable code: `scripts/check-firmware-symbols.sh`).
-    fn rs_adaptation_config(&self) -> ResistanceAdaptationConfig<T> {
+    /// The R̂s adaptation's configuration around R0 = `rs_hat`, the rest as built by `new`
+    /// (recomputing the λ̂f law's speed from the ratings would bring soft f64 into the f32
+    /// drive's reachable code: `scripts/check-firmware-symbols.sh`).
+    fn rs_adaptation_config(&self, rs_hat: T) -> ResistanceAdaptationConfig<T> {
         ResistanceAdaptationConfig {
-            flux_linkage_min_speed: self.rs_adaptation.config().flux_linkage_min_speed,
-            ..self.config.rs_adaptation_config()
+            rs_initial: rs_hat,
+            ..*self.rs_adaptation.config()
         }
     }
 
@@ -1230,9 +1256,22 @@ impl<T: Real> SensorlessEstimator<T> {
         self.integrator.config().rs_hat
     }
 
-    /// The configuration in use.
-    pub fn config(&self) -> &EstimatorConfig<T> {
-        &self.config
+    /// The sampling period Ts in use, s. (The estimator keeps what its step needs of its
+    /// [`EstimatorConfig`], not the record: the caller keeps that.)
+    pub fn ts(&self) -> T {
+        self.ts
+    }
+
+    /// Whether the R̂s adaptation runs ([`EstimatorTuning::rs_adaptation`], or switched on
+    /// by [`Self::enable_rs_adaptation`]).
+    pub fn rs_adaptation_enabled(&self) -> bool {
+        self.rs_adaptation_on
+    }
+
+    /// The Fig. 3 mode threshold in use and its hysteresis half-band, Hz electrical
+    /// ([`EstimatorConfig::mode_threshold_hz`], [`EstimatorConfig::mode_hysteresis_hz`]).
+    pub fn mode_threshold_hz(&self) -> (T, T) {
+        self.selector.threshold_hz()
     }
 }
 
@@ -1340,8 +1379,9 @@ mod tests {
         lean_matches_full::<f64>(false);
     }
 
-    /// The firmware state budget (docs/firmware.md): no copy of the last estimate is kept, so
-    /// the state is the blocks plus the configuration. Prints both precisions' sizes.
+    /// The firmware state budget (docs/firmware.md): no copy of the last estimate and no copy
+    /// of the configuration is kept, so the state is the blocks and the constants the step
+    /// needs. Prints both precisions' sizes.
     #[test]
     fn state_size() {
         let (s32, s64) = (
@@ -1356,8 +1396,9 @@ mod tests {
         // 16 B (the λ̂f law's revolution sums of error·angle, excitation, angle and time, and
         // its hysteresis flag; γ_f·Ts no longer kept); issue 16's slow-law round-robin 24 B
         // (the slot, the interrupted-regime bits, Σv and Σi over the period, the held slow
-        // feedback).
-        assert!(s32 <= 592, "{s32}");
+        // feedback), and without the stored `EstimatorConfig` (156 B; the step keeps the 8
+        // words and 2 flags it needs): 472 B.
+        assert!(s32 <= 472, "{s32}");
     }
 
     /// The reason the slow laws may run every [`SLOW_PERIOD`] samples (see its docs): at

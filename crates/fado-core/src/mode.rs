@@ -59,6 +59,15 @@ impl<T: Real> ModeSelector<T> {
         })
     }
 
+    /// The threshold and the hysteresis half-band, Hz (from the stored bounds, to rounding).
+    pub fn threshold_hz(&self) -> (T, T) {
+        let two = T::lit(2.0) * T::two_pi();
+        (
+            (self.enter + self.leave) / two,
+            (self.enter - self.leave) / two,
+        )
+    }
+
     /// Back to [`Mode::Limiter`].
     pub fn reset(&mut self) {
         self.mode = Mode::Limiter;

@@ -708,8 +708,12 @@ fn thresholds_out_of_order_are_refused() {
         ..DriveConfig::for_machine(&ipmsm())
     };
     let d = SensorlessDrive::new(c, EstimatorTuning::default()).unwrap();
-    assert_eq!(d.estimator().config().ts, 50e-6);
-    assert_eq!(d.estimator().config().machine, ipmsm());
+    assert_eq!(d.estimator().ts(), 50e-6);
+    assert_eq!(d.estimator().rs_hat(), ipmsm().rs);
+    assert_eq!(
+        d.estimator().last().diagnostics.flux_linkage_hat,
+        ipmsm().flux_linkage
+    );
     let nan_ts = DriveConfig::<f64> {
         ts: f64::NAN,
         ..DriveConfig::for_machine(&MachineModel::paper())

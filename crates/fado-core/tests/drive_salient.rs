@@ -79,10 +79,11 @@ fn ratings_derived_limits_scale_with_the_motor() {
         d
     };
     // The estimator's mode threshold: 1.5 % of this motor's 75 Hz (the paper's 1.5 Hz of 100).
-    let est = *drive().estimator().config();
-    assert_eq!(est.machine, m);
-    assert!((est.mode_threshold_hz() - 1.125).abs() < 1e-12);
-    assert!((est.mode_hysteresis_hz() - 0.15).abs() < 1e-12);
+    let est = *drive().estimator();
+    assert_eq!(est.rs_hat(), m.rs);
+    let (threshold, hysteresis) = est.mode_threshold_hz();
+    assert!((threshold - 1.125).abs() < 1e-12);
+    assert!((hysteresis - 0.15).abs() < 1e-12);
 
     // The trip level acts at 60/21.78 × 6 A = 16.5 A, not at the paper motor's 60 A.
     let phase = |amps: f64| Abc::new(amps, -0.5 * amps, -0.5 * amps);

@@ -529,7 +529,7 @@ fn switched_on_at_run_time_the_fixed_estimator_learns_rs() {
             rs_at_switch = est.rs_hat();
             est.enable_rs_adaptation();
             assert_eq!(est.rs_hat(), rs_at_switch);
-            assert!(est.config().tuning.rs_adaptation);
+            assert!(est.rs_adaptation_enabled());
         }
         est.step(s.v, s.i);
     }
