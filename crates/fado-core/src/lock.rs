@@ -33,7 +33,8 @@
 //! DEM, "Specification of Diagnostic Event Manager", §7.7.4.1): +1 per suspicious sample,
 //! −1 per clean one (floored at 0); [`LockStatus::Lost`] when it reaches
 //! `detection_time/ts`, latched until `reset` (a lost estimate is a fault the drive must
-//! act on, not a warning that comes and goes).
+//! act on, not a warning that comes and goes). The estimator judges every fourth sample
+//! (its slow laws' round-robin), with `ts` = 4 sampling periods: the same time to a verdict.
 
 use crate::Real;
 use crate::error::{ConfigError, check};
