@@ -1326,7 +1326,7 @@ impl<T: Real> RotorAngleEstimator<T> for SensorlessEstimator<T> {
     /// With [`EstimatorTuning::rs_adaptation`]: [`SensorlessEstimator::set_rs_hat`] (a bad
     /// value changes nothing); with the paper's fixed R̂s: nothing.
     fn start_from_measured_rs(&mut self, rs: T) {
-        if self.config.tuning.rs_adaptation {
+        if self.rs_adaptation_on {
             let _ = self.set_rs_hat(rs);
         }
     }
