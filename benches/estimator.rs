@@ -134,6 +134,7 @@ fn bench_precision<T: Real>(c: &mut Criterion, name: &str) {
             flux_high_ratio: d.lock_flux_high_ratio,
             innovation_limit: d.lock_innovation_limit,
             detection_time: d.lock_detection_time,
+            heal_time: d.lock_heal_time,
             limiter_clamping: true,
         })
         .unwrap();

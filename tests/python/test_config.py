@@ -48,6 +48,7 @@ PAPER_DEFAULTS = {
     "lock_flux_high_ratio": 2.0,  # [A] gross inconsistency only
     "lock_innovation_limit": 0.5,  # [A]
     "lock_detection_time": 5e-3,  # [A]
+    "lock_heal_time": 0.1,  # [A]
     "lock_limiter_clamping": False,  # [A]
 }
 

@@ -219,6 +219,12 @@ pub struct EstimatorTuning<T> {
     /// detector. Default 5 ms \[A\] (a quarter of the 20 ms detection target; 5–20 ms made
     /// no difference on the envelope, docs/lock.md).
     pub lock_detection_time: T,
+    /// Loss of lock: net clean time (s) after which [`LockStatus::Lost`] clears (the status
+    /// is live; the drive's reaction latches, [`crate::control::lock_reaction`]). Default
+    /// 0.1 s \[A\]: twenty detection times, so that the intermittent symptoms of a lost
+    /// estimate keep it up, and short against the seconds between a start-up transient and a
+    /// later loss (docs/lock.md).
+    pub lock_heal_time: T,
     /// Loss of lock: in limiter mode, a sample in which the limiter clamps is a symptom.
     /// Default false \[A\]: a rotor lost in limiter mode clamps continuously (fig11 with
     /// λ̂f +10 %) and a matched drive never clamps, but an adapted R̂s biased by a λ̂f error
@@ -260,6 +266,7 @@ impl<T: Real> EstimatorTuning<T> {
             lock_flux_high_ratio: U::lit(self.lock_flux_high_ratio.to_f64()),
             lock_innovation_limit: U::lit(self.lock_innovation_limit.to_f64()),
             lock_detection_time: U::lit(self.lock_detection_time.to_f64()),
+            lock_heal_time: U::lit(self.lock_heal_time.to_f64()),
             lock_limiter_clamping: self.lock_limiter_clamping,
         }
     }
@@ -298,6 +305,7 @@ impl<T: Real> Default for EstimatorTuning<T> {
             lock_flux_high_ratio: T::lit(2.0),
             lock_innovation_limit: T::lit(0.5),
             lock_detection_time: T::lit(5e-3),
+            lock_heal_time: T::lit(0.1),
             lock_limiter_clamping: false,
         }
     }
@@ -376,6 +384,7 @@ impl<T: Real> EstimatorConfig<T> {
             flux_high_ratio: self.tuning.lock_flux_high_ratio,
             innovation_limit: self.tuning.lock_innovation_limit,
             detection_time: self.tuning.lock_detection_time,
+            heal_time: self.tuning.lock_heal_time,
             limiter_clamping: self.tuning.lock_limiter_clamping,
         }
     }
@@ -1120,7 +1129,7 @@ impl<T: Real> SensorlessEstimator<T> {
                 rs_hat: rs_hat_used,
                 flux_linkage_hat: flux_linkage_used,
                 input_fault: false,
-                lock: lock.1,
+                lock: lock.status(),
             },
         };
         estimate.into()
@@ -1288,7 +1297,7 @@ pub trait RotorAngleEstimator<T: Real> {
     fn reset(&mut self);
     /// A short name for tables and plots.
     fn name(&self) -> &'static str;
-    /// Clears a latched loss-of-lock verdict ([`Diagnostics::lock`]) without touching the
+    /// Clears a loss-of-lock verdict ([`Diagnostics::lock`]) without touching the
     /// estimate, so that the detector judges afresh (the drive's recovery, see
     /// [`crate::control::lock_reaction`]). Default: nothing to clear.
     fn rearm_lock_detector(&mut self) {}

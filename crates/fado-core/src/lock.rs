@@ -30,11 +30,16 @@
 //! see [`crate::control::SensorlessDrive`]) and raises `LOCK_LOST` on either.
 //!
 //! The verdicts feed an up/down debouncing counter (the counter-based debouncing of AUTOSAR
-//! DEM, "Specification of Diagnostic Event Manager", §7.7.4.1): +1 per suspicious sample,
-//! −1 per clean one (floored at 0); [`LockStatus::Lost`] when it reaches
-//! `detection_time/ts`, latched until `reset` (a lost estimate is a fault the drive must
-//! act on, not a warning that comes and goes). The estimator judges every fourth sample
-//! (its slow laws' round-robin), with `ts` = 4 sampling periods: the same time to a verdict.
+//! DEM, "Specification of Diagnostic Event Manager", §7.7.4.1, with its separate "passed"
+//! threshold for healing): +1 per suspicious sample, −1 per clean one (floored at 0);
+//! [`LockStatus::Lost`] when it reaches `detection_time/ts`. The status is **live**: once
+//! lost, the counter restarts from `heal_time/ts` (and saturates there), and the status
+//! returns to [`LockStatus::Locked`] when a net `heal_time` of clean samples has brought it
+//! to 0. A start-up transient that raised it heals, so that a later loss raises it anew; the
+//! drive's *reaction* (coast, recover) latches separately
+//! ([`crate::control::lock_reaction`]). The same [`Debouncer`] turns the drive's stall
+//! symptom into a live status. The estimator judges every fourth sample (its slow laws'
+//! round-robin), with `ts` = 4 sampling periods: the same times to a verdict and to healing.
 
 use crate::Real;
 use crate::error::{ConfigError, check};
@@ -48,7 +53,8 @@ pub enum LockStatus {
     Locked = 0,
     /// Symptoms seen, not yet for long enough to call the rotor lost.
     Suspect = 1,
-    /// The estimate is judged lost (latched until the detector is reset, e.g. by `align`).
+    /// The estimate is judged lost (until a net `lock_heal_time` of clean samples, or a
+    /// reset, e.g. by `align`).
     Lost = 2,
 }
 
@@ -57,6 +63,96 @@ impl LockStatus {
     pub fn code(self) -> u8 {
         self as u8
     }
+}
+
+/// Up/down debouncing counter with a healing threshold (see the module docs): raised after a
+/// net `limit` symptomatic samples, cleared after a net `heal` clean ones. `limit` 0 never
+/// raises.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Debouncer {
+    limit: u32,
+    heal: u32,
+    count: u32,
+    up: bool,
+}
+
+impl Debouncer {
+    /// Raised after `limit` net symptomatic samples, cleared after `heal` (at least 1) net
+    /// clean ones.
+    pub const fn new(limit: u32, heal: u32) -> Self {
+        Self {
+            limit,
+            heal: if heal == 0 { 1 } else { heal },
+            count: 0,
+            up: false,
+        }
+    }
+
+    /// The state after one sample (`symptom`: this sample is suspicious); `self` unchanged.
+    #[inline]
+    #[must_use]
+    pub fn next(self, symptom: bool) -> Self {
+        if self.limit == 0 {
+            return self;
+        }
+        let count = if symptom {
+            self.count.saturating_add(1)
+        } else {
+            self.count.saturating_sub(1)
+        };
+        if self.up {
+            let count = count.min(self.heal);
+            Self {
+                count,
+                up: count > 0,
+                ..self
+            }
+        } else if count >= self.limit {
+            Self {
+                count: self.heal,
+                up: true,
+                ..self
+            }
+        } else {
+            Self { count, ..self }
+        }
+    }
+
+    /// One sample, committed; returns whether the status is raised.
+    #[inline]
+    pub fn step(&mut self, symptom: bool) -> bool {
+        *self = self.next(symptom);
+        self.up
+    }
+
+    /// Raised (the condition has held for a net `limit` samples and not yet healed).
+    pub fn is_up(&self) -> bool {
+        self.up
+    }
+
+    /// [`LockStatus::Lost`] while raised, [`LockStatus::Suspect`] while counting up.
+    pub fn status(&self) -> LockStatus {
+        if self.up {
+            LockStatus::Lost
+        } else if self.count > 0 {
+            LockStatus::Suspect
+        } else {
+            LockStatus::Locked
+        }
+    }
+
+    /// Back to cleared, count 0.
+    pub fn reset(&mut self) {
+        self.count = 0;
+        self.up = false;
+    }
+}
+
+/// Samples in `time` s at period `ts`, saturating (longer than 2^32 samples, 5 days at 10 kHz,
+/// is "never"); errors name `field`.
+pub(crate) fn samples<T: Real>(field: &'static str, time: T, ts: T) -> Result<u32, ConfigError> {
+    let time = check::non_negative(field, time)?;
+    Ok((time / ts).round().to_f64().min(u32::MAX as f64) as u32)
 }
 
 /// Configuration of a [`LockDetector`]; the tuning is in
@@ -75,6 +171,8 @@ pub struct LockDetectorConfig<T> {
     pub innovation_limit: T,
     /// Net suspicious time (s) after which the rotor is lost; 0 disables the detector.
     pub detection_time: T,
+    /// Net clean time (s) after which a lost status clears.
+    pub heal_time: T,
     /// In limiter mode, a sample in which the limiter clamps (|λ̂r| beyond its circle) is
     /// suspicious.
     pub limiter_clamping: bool,
@@ -86,14 +184,12 @@ pub struct LockDetector<T> {
     low_sq: T,
     high_sq: T,
     innovation_limit: T,
-    limit: u32,
-    count: u32,
-    status: LockStatus,
+    counter: Debouncer,
     clamping: bool,
 }
 
 impl<T: Real> LockDetector<T> {
-    /// Checks and precomputes (squared ratios, the sample count); errors name the
+    /// Checks and precomputes (squared ratios, the sample counts); errors name the
     /// [`EstimatorConfig`](crate::EstimatorConfig) field.
     pub fn new(c: LockDetectorConfig<T>) -> Result<Self, ConfigError> {
         let ts = check::positive("ts", c.ts)?;
@@ -113,24 +209,20 @@ impl<T: Real> LockDetector<T> {
             high * high
         };
         let innovation = check::positive("lock_innovation_limit", c.innovation_limit)?;
-        let time = check::non_negative("lock_detection_time", c.detection_time)?;
-        // Longer than 2^32 samples (5 days at 10 kHz) is "never": saturate.
-        let n = (time / ts).round().to_f64().min(u32::MAX as f64);
+        let limit = samples("lock_detection_time", c.detection_time, ts)?;
+        let heal = samples("lock_heal_time", c.heal_time, ts)?;
         Ok(Self {
             low_sq: low * low,
             high_sq,
             innovation_limit: innovation,
-            limit: n as u32,
-            count: 0,
-            status: LockStatus::Locked,
+            counter: Debouncer::new(limit, heal),
             clamping: c.limiter_clamping,
         })
     }
 
     /// Back to [`LockStatus::Locked`].
     pub fn reset(&mut self) {
-        self.count = 0;
-        self.status = LockStatus::Locked;
+        self.counter.reset();
     }
 
     /// The state after one sample, without changing `self`: `lambda_r_sq` = |λ̂r|²,
@@ -143,46 +235,30 @@ impl<T: Real> LockDetector<T> {
         flux_sq: T,
         innovation: T,
         clamping: bool,
-    ) -> (u32, LockStatus) {
-        if self.limit == 0 {
-            return (0, LockStatus::Locked);
-        }
+    ) -> Debouncer {
         let suspicious = (lambda_r_sq < self.low_sq * flux_sq)
             | (lambda_r_sq > self.high_sq * flux_sq)
             | (innovation.abs() > self.innovation_limit)
             | (clamping & self.clamping);
-        let count = if suspicious {
-            self.count.saturating_add(1)
-        } else {
-            self.count.saturating_sub(1)
-        };
-        let status = if self.status == LockStatus::Lost || count >= self.limit {
-            LockStatus::Lost
-        } else if count > 0 {
-            LockStatus::Suspect
-        } else {
-            LockStatus::Locked
-        };
-        (count, status)
+        self.counter.next(suspicious)
     }
 
     /// Takes a state computed by [`Self::next_state`].
     #[inline]
-    pub fn commit(&mut self, (count, status): (u32, LockStatus)) {
-        self.count = count;
-        self.status = status;
+    pub fn commit(&mut self, state: Debouncer) {
+        self.counter = state;
     }
 
     /// The committed state, as [`Self::next_state`] returns it (for a sample the detector
     /// does not judge).
     #[inline]
-    pub fn state(&self) -> (u32, LockStatus) {
-        (self.count, self.status)
+    pub fn state(&self) -> Debouncer {
+        self.counter
     }
 
     /// The status after the last committed sample.
     pub fn status(&self) -> LockStatus {
-        self.status
+        self.counter.status()
     }
 }
 
@@ -197,6 +273,7 @@ mod tests {
             flux_high_ratio: 1.3,
             innovation_limit: 0.5,
             detection_time: time,
+            heal_time: 2e-3,
             limiter_clamping: true,
         }
     }
@@ -208,12 +285,12 @@ mod tests {
     fn step(d: &mut LockDetector<f64>, ratio: f64, innovation: f64) -> LockStatus {
         let s = d.next_state(ratio * ratio, 1.0, innovation, false);
         d.commit(s);
-        s.1
+        d.status()
     }
 
     #[test]
-    fn debounces_then_latches() {
-        let mut d = detector(10e-3); // 100 samples
+    fn debounces_then_heals() {
+        let mut d = detector(10e-3); // 100 samples to raise, 20 to heal
         // Alternating symptoms never accumulate.
         for k in 0..10_000 {
             let r = if k % 2 == 0 { 1.4 } else { 1.0 };
@@ -224,8 +301,24 @@ mod tests {
             assert_eq!(step(&mut d, 0.3, 0.0), LockStatus::Suspect, "{k}");
         }
         assert_eq!(step(&mut d, 1.0, 1.0), LockStatus::Lost); // innovation counts too
+        // However long the symptom lasted, a net 20 clean samples clear the status (the
+        // counter saturates at the healing threshold)…
         for _ in 0..1000 {
-            assert_eq!(step(&mut d, 1.0, 0.0), LockStatus::Lost);
+            assert_eq!(step(&mut d, 0.3, 0.0), LockStatus::Lost);
+        }
+        for k in 1..20 {
+            assert_eq!(step(&mut d, 1.0, 0.0), LockStatus::Lost, "{k}");
+        }
+        assert_eq!(step(&mut d, 1.0, 0.0), LockStatus::Locked);
+        // …and a later loss raises it anew after the full detection time.
+        for k in 1..100 {
+            assert_eq!(step(&mut d, 0.3, 0.0), LockStatus::Suspect, "{k}");
+        }
+        assert_eq!(step(&mut d, 0.3, 0.0), LockStatus::Lost);
+        // Intermittent symptoms while lost keep it up (net count).
+        for k in 0..1000 {
+            let r = if k % 2 == 0 { 0.3 } else { 1.0 };
+            assert_eq!(step(&mut d, r, 0.0), LockStatus::Lost);
         }
         d.reset();
         assert_eq!(d.status(), LockStatus::Locked);
@@ -249,6 +342,15 @@ mod tests {
     }
 
     #[test]
+    fn debouncer_heal_zero_clears_at_the_first_clean_sample() {
+        let mut b = Debouncer::new(3, 0);
+        assert!(!b.step(true) && !b.step(true) && b.step(true));
+        assert!(b.step(true));
+        assert!(!b.step(false));
+        assert!(!Debouncer::new(0, 5).step(true));
+    }
+
+    #[test]
     fn errors_name_the_estimator_field() {
         let c = LockDetectorConfig {
             ts: 1e-4,
@@ -256,6 +358,7 @@ mod tests {
             flux_high_ratio: 1.3,
             innovation_limit: 0.5,
             detection_time: 0.01,
+            heal_time: 0.1,
             limiter_clamping: true,
         };
         let e = |c| LockDetector::<f64>::new(c).unwrap_err().field();
@@ -286,6 +389,13 @@ mod tests {
                 ..c
             }),
             "lock_detection_time"
+        );
+        assert_eq!(
+            e(LockDetectorConfig {
+                heal_time: f64::NAN,
+                ..c
+            }),
+            "lock_heal_time"
         );
     }
 }

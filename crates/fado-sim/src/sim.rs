@@ -483,6 +483,21 @@ pub struct Metrics {
     pub angle_error_exceeded_time: Option<f64>,
     /// First time the drive reported the rotor lost (`DriveFlags::LOCK_LOST`), s.
     pub lock_lost_time: Option<f64>,
+    /// Onset of the loss, s: the first time |θ − θ̂| exceeded 0.5 rad in the excursion (from
+    /// the last time below 0.25 rad on) that first took it beyond 1 rad (None: it never
+    /// exceeded 1 rad). Equal to `angle_error_exceeded_time` unless an earlier excursion
+    /// beyond 0.5 rad came back below 0.25 rad.
+    pub loss_onset_time: Option<f64>,
+    /// Detection of that loss (docs/lock.md): `LOCK_LOST` is up 20 ms after the onset and rose
+    /// after the last time |θ − θ̂| was below 0.25 rad; the time of that rise minus the onset,
+    /// s (negative: raised before the error reached 0.5 rad). None: not detected.
+    pub lock_detection_delay: Option<f64>,
+    /// First rise of `LOCK_LOST` in the loss's excursion (from the last time below 0.25 rad
+    /// until the error is below 0.25 rad again) minus the onset, s, late rises included
+    /// (the detection-delay distribution of docs/lock-detection.png). None: no rise.
+    pub lock_first_rise_delay: Option<f64>,
+    #[serde(skip)]
+    loss: LossTracker,
     #[serde(skip)]
     sum_sq: f64,
     #[serde(skip)]
@@ -516,8 +531,16 @@ impl Probe for Metrics {
                 self.angle_error_exceeded_time = Some(s.time);
             }
         }
-        if self.lock_lost_time.is_none() && s.act.flags.contains(fado_core::DriveFlags::LOCK_LOST) {
+        let flag = s.act.flags.contains(fado_core::DriveFlags::LOCK_LOST);
+        if self.lock_lost_time.is_none() && flag {
             self.lock_lost_time = Some(s.time);
+        }
+        let e = s.act.gates_enabled.then(|| s.angle_error.abs());
+        self.loss.observe(s.time, e, flag);
+        if let Some(onset) = self.loss.onset {
+            self.loss_onset_time = Some(onset.onset);
+            self.lock_detection_delay = onset.detected.flatten().map(|t| t - onset.onset);
+            self.lock_first_rise_delay = onset.first_rise.map(|t| t - onset.onset);
         }
         if s.time < self.eval_start {
             return;
@@ -534,6 +557,102 @@ impl Probe for Metrics {
         self.max_speed_error_rpm = self
             .max_speed_error_rpm
             .max((s.speed_ref_rpm - s.speed_rpm).abs());
+    }
+}
+
+/// Angle-error thresholds and deadline of the loss-of-lock evaluation (issue 14, docs/lock.md):
+/// the loss starts when |θ − θ̂| rises through 0.5 rad, it is a loss if it then exceeds 1 rad,
+/// the estimate was consistent while below 0.25 rad, and the flag must be up 20 ms after the
+/// start.
+const LOSS_START: f64 = 0.5;
+const LOSS_LOST: f64 = 1.0;
+const LOSS_SETTLED: f64 = 0.25;
+const LOSS_DEADLINE: f64 = 0.020;
+
+/// An excursion of |θ − θ̂| above [`LOSS_SETTLED`] that reached [`LOSS_START`].
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct Excursion {
+    /// Time of the rise through 0.5 rad.
+    onset: f64,
+    /// Last time below 0.25 rad before it (−∞: never, e.g. a start-up error).
+    settled: f64,
+    /// First rise of the flag since `settled` (this excursion's first alarm).
+    first_rise: Option<f64>,
+    /// At onset + 20 ms: Some(Some(rise)) if the flag was up then, having last risen at `rise`
+    /// ≥ `settled`; Some(None) if not; None before the deadline.
+    detected: Option<Option<f64>>,
+}
+
+/// Streaming labels of [`Metrics`]' loss-of-lock fields: flag edges against the angle error.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct LossTracker {
+    flag: bool,
+    last_rise: Option<f64>,
+    /// Last time below 0.25 rad, and the first flag rise since.
+    settled: f64,
+    first_rise: Option<f64>,
+    /// The open excursion above 0.5 rad, if any.
+    current: Option<Excursion>,
+    /// The excursion that first exceeded 1 rad; `open` while the error has not come back
+    /// below 0.25 rad.
+    onset: Option<Excursion>,
+    open: bool,
+}
+
+impl Default for LossTracker {
+    fn default() -> Self {
+        Self {
+            flag: false,
+            last_rise: None,
+            settled: f64::NEG_INFINITY,
+            first_rise: None,
+            current: None,
+            onset: None,
+            open: false,
+        }
+    }
+}
+
+impl LossTracker {
+    /// One sample: time, |θ − θ̂| (None while the gates are off), the flag.
+    fn observe(&mut self, t: f64, error: Option<f64>, flag: bool) {
+        if flag && !self.flag {
+            self.last_rise = Some(t);
+            self.first_rise.get_or_insert(t);
+        }
+        self.flag = flag;
+        if let Some(e) = error {
+            if e < LOSS_SETTLED {
+                self.settled = t;
+                self.first_rise = None;
+                self.open = false;
+                self.current = None;
+            }
+            // The first 0.5 rad crossing since the error was last below 0.25 rad.
+            if e > LOSS_START {
+                self.current.get_or_insert(Excursion {
+                    onset: t,
+                    settled: self.settled,
+                    first_rise: None,
+                    detected: None,
+                });
+            }
+            if e > LOSS_LOST && self.onset.is_none() {
+                self.onset = self.current;
+                self.open = true;
+            }
+        }
+        for x in [self.current.as_mut(), self.onset.as_mut()].into_iter().flatten() {
+            if x.detected.is_none() && t >= x.onset + LOSS_DEADLINE {
+                let rise = self.last_rise.filter(|r| flag && *r >= x.settled);
+                x.detected = Some(rise);
+            }
+        }
+        if self.open
+            && let Some(x) = self.onset.as_mut()
+        {
+            x.first_rise = self.first_rise;
+        }
     }
 }
 

@@ -44,7 +44,7 @@ use crate::estimator::{
     Estimate, EstimatorConfig, EstimatorTuning, RotorAngleEstimator, SensorlessEstimator,
 };
 use crate::injection::{CurrentInjection, CurrentInjectionConfig};
-use crate::lock::LockStatus;
+use crate::lock::{Debouncer, LockStatus};
 use crate::machine::PAPER_RATED_CURRENT;
 use crate::mode::Mode;
 use crate::{Ab, Abc, Dq, MachineModel, Real, Rotation};
@@ -214,9 +214,14 @@ pub struct DriveTuning<T> {
     /// `mode_threshold_ratio` 0.015; chosen on the fig11 envelope, docs/lock.md: 0.004
     /// false-alarms 3× more, 0.006 detects 5 points less); 0 disables.
     pub lock_stall_speed_ratio: T,
-    /// Time (s) the stall condition must hold in a row. Default 5 ms \[A\] (the estimator's
+    /// Net time (s) the stall condition must hold (up/down count, [`crate::lock::Debouncer`]).
+    /// Default 5 ms \[A\] (the estimator's
     /// `lock_detection_time`).
     pub lock_stall_time: T,
+    /// Net time (s) without the stall condition after which the stall symptom clears (it is
+    /// a live status like the estimator's, see [`crate::lock::Debouncer`]; the reaction
+    /// latches). Default 0.1 s \[A\] (the estimator's `lock_heal_time`).
+    pub lock_stall_heal_time: T,
 }
 
 impl<T: Real> DriveTuning<T> {
@@ -266,6 +271,7 @@ impl<T: Real> DriveTuning<T> {
             lock_recovery_rs_adaptation: self.lock_recovery_rs_adaptation,
             lock_stall_speed_ratio: U::lit(self.lock_stall_speed_ratio.to_f64()),
             lock_stall_time: U::lit(self.lock_stall_time.to_f64()),
+            lock_stall_heal_time: U::lit(self.lock_stall_heal_time.to_f64()),
         }
     }
 }
@@ -314,6 +320,7 @@ impl<T: Real> Default for DriveTuning<T> {
             lock_recovery_rs_adaptation: true,
             lock_stall_speed_ratio: T::lit(0.005),
             lock_stall_time: T::lit(5e-3),
+            lock_stall_heal_time: T::lit(0.1),
         }
     }
 }
@@ -495,6 +502,7 @@ struct Resolved<T> {
     /// (0 samples or speed 0: off).
     stall_speed: T,
     stall_samples: u32,
+    stall_heal_samples: u32,
     /// Phase currents beyond ± this (A) are refused as implausible.
     plausible_current: T,
     /// DC-link readings above this (V) are refused as implausible.
@@ -541,6 +549,7 @@ impl<T: Real> Resolved<T> {
             } else {
                 0
             },
+            stall_heal_samples: samples("lock_stall_heal_time", t.lock_stall_heal_time)?,
             plausible_current: t.plausible_current_ratio * t.trip_current_ratio * rated,
             dc_link_max_voltage: t.dc_link_max_ratio * c.machine.dc_voltage,
             mtpa: t.mtpa && c.machine.is_salient(),
@@ -837,10 +846,9 @@ pub struct SensorlessDrive<T, E = SensorlessEstimator<T>> {
     i_ab_used: Ab<T>,
     /// Reaction to a lost rotor.
     lock: LockSupervisor,
-    /// The stall symptom (see `DriveTuning::lock_stall_speed_ratio`) and its latched verdict
-    /// (cleared like the estimator's: `align`, `reset`, a recovery's re-arming).
-    stall: PersistenceMonitor,
-    stalled: bool,
+    /// The stall symptom (see `DriveTuning::lock_stall_speed_ratio`) as a live status (heals
+    /// like the estimator's; cleared by `align`, `reset`, a recovery's re-arming).
+    stall: Debouncer,
     stall_armed: bool,
     /// This sample was refused as implausible.
     implausible_now: bool,
@@ -889,8 +897,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
                 resolved.stuck_sensor_samples,
             ),
             current_error: PersistenceMonitor::new(resolved.current_error_samples),
-            stall: PersistenceMonitor::new(resolved.stall_samples),
-            stalled: false,
+            stall: Debouncer::new(resolved.stall_samples, resolved.stall_heal_samples),
             stall_armed: false,
             sensor_stuck_now: false,
             current_error_now: false,
@@ -1133,7 +1140,6 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         self.stuck_sensor.reset();
         self.current_error.reset();
         self.stall.reset();
-        self.stalled = false;
         self.stall_armed = false;
         self.sensor_stuck_now = false;
         self.current_error_now = false;
@@ -1204,7 +1210,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         flags.set(
             DriveFlags::LOCK_LOST,
             out.estimate.diagnostics.lock == LockStatus::Lost
-                || self.stalled
+                || self.stall.is_up()
                 || self.lock.coasting(),
         );
         flags.set(DriveFlags::COASTING, running && self.lock.coasting());
@@ -1338,8 +1344,8 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             && off_reference
             && diag.mode == Mode::Limiter
             && self.last.i_dq_ref.norm() < self.resolved.i_max * T::lit(0.99);
-        self.stalled |= self.stall.step(stall_now);
-        let lost = diag.lock == LockStatus::Lost || self.stalled;
+        let stalled = self.stall.step(stall_now);
+        let lost = diag.lock == LockStatus::Lost || stalled;
         let healthy = diag.lock == LockStatus::Locked && diag.mode == Mode::DisturbanceFeedback;
         let action = self.lock.step(lost, healthy);
         if lost && self.config.tuning.lock_reaction == LockReaction::Adapt {
@@ -1354,7 +1360,6 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             LockAction::Rearm => {
                 self.estimator.rearm_lock_detector();
                 self.stall.reset();
-                self.stalled = false;
                 if self.config.tuning.lock_recovery_rs_adaptation {
                     self.estimator.enable_rs_adaptation();
                 }
@@ -1364,7 +1369,6 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             LockAction::Coast if self.lock.recovering() && lost => {
                 self.estimator.rearm_lock_detector();
                 self.stall.reset();
-                self.stalled = false;
             }
             LockAction::Restart => {
                 self.blocks.speed.reset();

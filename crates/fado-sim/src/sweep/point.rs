@@ -14,7 +14,7 @@ use crate::profile::Profile;
 use crate::scenario;
 
 /// Metric columns of a row, after the axes and `status`, `passed`.
-pub const METRICS: [&str; 9] = [
+pub const METRICS: [&str; 12] = [
     "max_angle_error",
     "rms_angle_error",
     "max_angle_error_zero_speed",
@@ -24,6 +24,9 @@ pub const METRICS: [&str; 9] = [
     "max_angle_error_run",
     "angle_error_exceeded_time",
     "lock_lost_time",
+    "loss_onset_time",
+    "lock_detection_delay",
+    "lock_first_rise_delay",
 ];
 
 /// The configuration of one point: `base` with each `(name, value)` applied in order, then
@@ -199,6 +202,13 @@ pub struct PointResult {
     pub angle_error_exceeded_time: f64,
     /// First time the drive reported the rotor lost, s (NaN: never).
     pub lock_lost_time: f64,
+    /// Onset of the loss (0.5 rad crossing of the excursion beyond 1 rad), s (NaN: no loss).
+    pub loss_onset_time: f64,
+    /// Detection delay of the loss (rise of the flag up at onset + 20 ms, minus the onset),
+    /// s (NaN: not detected); see [`crate::Metrics::lock_detection_delay`].
+    pub lock_detection_delay: f64,
+    /// First rise of the flag in the loss's excursion minus the onset, s (NaN: none).
+    pub lock_first_rise_delay: f64,
 }
 
 impl PointResult {
@@ -224,10 +234,13 @@ impl PointResult {
             max_angle_error_run: f64::NAN,
             angle_error_exceeded_time: f64::NAN,
             lock_lost_time: f64::NAN,
+            loss_onset_time: f64::NAN,
+            lock_detection_delay: f64::NAN,
+            lock_first_rise_delay: f64::NAN,
         }
     }
 
-    pub(crate) fn metrics(&self) -> [f64; 9] {
+    pub(crate) fn metrics(&self) -> [f64; 12] {
         [
             self.max_angle_error,
             self.rms_angle_error,
@@ -238,6 +251,9 @@ impl PointResult {
             self.max_angle_error_run,
             self.angle_error_exceeded_time,
             self.lock_lost_time,
+            self.loss_onset_time,
+            self.lock_detection_delay,
+            self.lock_first_rise_delay,
         ]
     }
 }
@@ -325,6 +341,9 @@ pub fn run_point_until(
         max_angle_error_run: m.max_angle_error_run,
         angle_error_exceeded_time: m.angle_error_exceeded_time.unwrap_or(f64::NAN),
         lock_lost_time: m.lock_lost_time.unwrap_or(f64::NAN),
+        loss_onset_time: m.loss_onset_time.unwrap_or(f64::NAN),
+        lock_detection_delay: m.lock_detection_delay.unwrap_or(f64::NAN),
+        lock_first_rise_delay: m.lock_first_rise_delay.unwrap_or(f64::NAN),
     };
     // The zero-speed metrics are NaN-free by construction only when the band was visited;
     // judge divergence on the overall ones.

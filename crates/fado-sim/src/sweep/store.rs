@@ -149,6 +149,9 @@ pub fn read_csv(path: &Path, spec: &SweepSpec) -> Result<BTreeMap<usize, PointRe
                 max_angle_error_run: m[6],
                 angle_error_exceeded_time: m[7],
                 lock_lost_time: m[8],
+                loss_onset_time: m[9],
+                lock_detection_delay: m[10],
+                lock_first_rise_delay: m[11],
             },
         );
     }
