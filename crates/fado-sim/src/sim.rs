@@ -488,14 +488,15 @@ pub struct Metrics {
     /// exceeded 1 rad). Equal to `angle_error_exceeded_time` unless an earlier excursion
     /// beyond 0.5 rad came back below 0.25 rad.
     pub loss_onset_time: Option<f64>,
-    /// Detection of that loss (docs/lock.md): `LOCK_LOST` is up 20 ms after the onset and rose
-    /// after the last time |θ − θ̂| was below 0.25 rad; the time of that rise minus the onset,
-    /// s (negative: raised before the error reached 0.5 rad). None: not detected.
+    /// The last time |θ − θ̂| was below 0.25 rad before that onset, s (None: never).
+    pub loss_settled_time: Option<f64>,
+    /// If `LOCK_LOST` (a live status) is up 20 ms after the onset: the time it last rose
+    /// minus the onset, s (negative: raised before the error reached 0.5 rad; docs/lock.md
+    /// counts it as a detection if it rose less than 0.5 s before). None: down then.
     pub lock_detection_delay: Option<f64>,
-    /// First rise of `LOCK_LOST` in the loss's excursion (from the last time below 0.25 rad
-    /// until the error is below 0.25 rad again) minus the onset, s, late rises included
-    /// (the detection-delay distribution of docs/lock-detection.png). None: no rise.
-    pub lock_first_rise_delay: Option<f64>,
+    /// First rise of `LOCK_LOST` at or after the onset, while the error has not come back
+    /// below 0.25 rad, minus the onset, s (the late detections). None: no rise.
+    pub lock_late_delay: Option<f64>,
     #[serde(skip)]
     loss: LossTracker,
     #[serde(skip)]
@@ -537,10 +538,11 @@ impl Probe for Metrics {
         }
         let e = s.act.gates_enabled.then(|| s.angle_error.abs());
         self.loss.observe(s.time, e, flag);
-        if let Some(onset) = self.loss.onset {
-            self.loss_onset_time = Some(onset.onset);
-            self.lock_detection_delay = onset.detected.flatten().map(|t| t - onset.onset);
-            self.lock_first_rise_delay = onset.first_rise.map(|t| t - onset.onset);
+        if let Some(x) = self.loss.loss {
+            self.loss_onset_time = Some(x.onset);
+            self.loss_settled_time = x.settled.is_finite().then_some(x.settled);
+            self.lock_detection_delay = x.up_at_deadline.flatten().map(|t| t - x.onset);
+            self.lock_late_delay = x.first_rise.map(|t| t - x.onset);
         }
         if s.time < self.eval_start {
             return;
@@ -561,9 +563,9 @@ impl Probe for Metrics {
 }
 
 /// Angle-error thresholds and deadline of the loss-of-lock evaluation (issue 14, docs/lock.md):
-/// the loss starts when |θ − θ̂| rises through 0.5 rad, it is a loss if it then exceeds 1 rad,
-/// the estimate was consistent while below 0.25 rad, and the flag must be up 20 ms after the
-/// start.
+/// an excursion starts when |θ − θ̂| leaves 0.25 rad (the clean-run level), the loss's onset is
+/// its first crossing of 0.5 rad, it is a loss if it then exceeds 1 rad, and the flag must be
+/// up 20 ms after the onset.
 const LOSS_START: f64 = 0.5;
 const LOSS_LOST: f64 = 1.0;
 const LOSS_SETTLED: f64 = 0.25;
@@ -572,15 +574,15 @@ const LOSS_DEADLINE: f64 = 0.020;
 /// An excursion of |θ − θ̂| above [`LOSS_SETTLED`] that reached [`LOSS_START`].
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 struct Excursion {
-    /// Time of the rise through 0.5 rad.
+    /// First time above 0.5 rad in the excursion.
     onset: f64,
     /// Last time below 0.25 rad before it (−∞: never, e.g. a start-up error).
     settled: f64,
-    /// First rise of the flag since `settled` (this excursion's first alarm).
+    /// At onset + 20 ms: Some(Some(rise)) if the flag was up then, having last risen at
+    /// `rise`; Some(None) if it was down; None before the deadline.
+    up_at_deadline: Option<Option<f64>>,
+    /// First rise of the flag at or after the onset, while the excursion lasts.
     first_rise: Option<f64>,
-    /// At onset + 20 ms: Some(Some(rise)) if the flag was up then, having last risen at `rise`
-    /// ≥ `settled`; Some(None) if not; None before the deadline.
-    detected: Option<Option<f64>>,
 }
 
 /// Streaming labels of [`Metrics`]' loss-of-lock fields: flag edges against the angle error.
@@ -588,14 +590,13 @@ struct Excursion {
 struct LossTracker {
     flag: bool,
     last_rise: Option<f64>,
-    /// Last time below 0.25 rad, and the first flag rise since.
+    /// Last time below 0.25 rad.
     settled: f64,
-    first_rise: Option<f64>,
-    /// The open excursion above 0.5 rad, if any.
+    /// The open excursion that reached 0.5 rad, if any.
     current: Option<Excursion>,
-    /// The excursion that first exceeded 1 rad; `open` while the error has not come back
-    /// below 0.25 rad.
-    onset: Option<Excursion>,
+    /// The excursion that first exceeded 1 rad; `open` until the error is below 0.25 rad
+    /// again.
+    loss: Option<Excursion>,
     open: bool,
 }
 
@@ -605,9 +606,8 @@ impl Default for LossTracker {
             flag: false,
             last_rise: None,
             settled: f64::NEG_INFINITY,
-            first_rise: None,
             current: None,
-            onset: None,
+            loss: None,
             open: false,
         }
     }
@@ -616,42 +616,40 @@ impl Default for LossTracker {
 impl LossTracker {
     /// One sample: time, |θ − θ̂| (None while the gates are off), the flag.
     fn observe(&mut self, t: f64, error: Option<f64>, flag: bool) {
-        if flag && !self.flag {
+        let rise = flag && !self.flag;
+        if rise {
             self.last_rise = Some(t);
-            self.first_rise.get_or_insert(t);
         }
         self.flag = flag;
         if let Some(e) = error {
             if e < LOSS_SETTLED {
                 self.settled = t;
-                self.first_rise = None;
-                self.open = false;
                 self.current = None;
+                self.open = false;
             }
-            // The first 0.5 rad crossing since the error was last below 0.25 rad.
             if e > LOSS_START {
                 self.current.get_or_insert(Excursion {
                     onset: t,
                     settled: self.settled,
+                    up_at_deadline: None,
                     first_rise: None,
-                    detected: None,
                 });
             }
-            if e > LOSS_LOST && self.onset.is_none() {
-                self.onset = self.current;
+            if e > LOSS_LOST && self.loss.is_none() {
+                self.loss = self.current;
                 self.open = true;
             }
         }
-        for x in [self.current.as_mut(), self.onset.as_mut()].into_iter().flatten() {
-            if x.detected.is_none() && t >= x.onset + LOSS_DEADLINE {
-                let rise = self.last_rise.filter(|r| flag && *r >= x.settled);
-                x.detected = Some(rise);
+        let open = self.open;
+        let current = self.current.as_mut();
+        let loss = self.loss.as_mut().filter(|_| open);
+        for x in [current, loss].into_iter().flatten() {
+            if rise && x.first_rise.is_none() {
+                x.first_rise = Some(t);
             }
-        }
-        if self.open
-            && let Some(x) = self.onset.as_mut()
-        {
-            x.first_rise = self.first_rise;
+            if x.up_at_deadline.is_none() && t >= x.onset + LOSS_DEADLINE {
+                x.up_at_deadline = Some(self.last_rise.filter(|_| flag));
+            }
         }
     }
 }

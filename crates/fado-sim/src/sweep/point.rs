@@ -14,7 +14,7 @@ use crate::profile::Profile;
 use crate::scenario;
 
 /// Metric columns of a row, after the axes and `status`, `passed`.
-pub const METRICS: [&str; 12] = [
+pub const METRICS: [&str; 13] = [
     "max_angle_error",
     "rms_angle_error",
     "max_angle_error_zero_speed",
@@ -25,8 +25,9 @@ pub const METRICS: [&str; 12] = [
     "angle_error_exceeded_time",
     "lock_lost_time",
     "loss_onset_time",
+    "loss_settled_time",
     "lock_detection_delay",
-    "lock_first_rise_delay",
+    "lock_late_delay",
 ];
 
 /// The configuration of one point: `base` with each `(name, value)` applied in order, then
@@ -204,11 +205,13 @@ pub struct PointResult {
     pub lock_lost_time: f64,
     /// Onset of the loss (0.5 rad crossing of the excursion beyond 1 rad), s (NaN: no loss).
     pub loss_onset_time: f64,
-    /// Detection delay of the loss (rise of the flag up at onset + 20 ms, minus the onset),
-    /// s (NaN: not detected); see [`crate::Metrics::lock_detection_delay`].
+    /// Last time |θ − θ̂| < 0.25 rad before the onset, s (NaN: none).
+    pub loss_settled_time: f64,
+    /// Rise of the flag up at onset + 20 ms minus the onset, s (NaN: down then); see
+    /// [`crate::Metrics::lock_detection_delay`].
     pub lock_detection_delay: f64,
-    /// First rise of the flag in the loss's excursion minus the onset, s (NaN: none).
-    pub lock_first_rise_delay: f64,
+    /// First rise of the flag after the onset minus the onset, s (NaN: none).
+    pub lock_late_delay: f64,
 }
 
 impl PointResult {
@@ -235,12 +238,13 @@ impl PointResult {
             angle_error_exceeded_time: f64::NAN,
             lock_lost_time: f64::NAN,
             loss_onset_time: f64::NAN,
+            loss_settled_time: f64::NAN,
             lock_detection_delay: f64::NAN,
-            lock_first_rise_delay: f64::NAN,
+            lock_late_delay: f64::NAN,
         }
     }
 
-    pub(crate) fn metrics(&self) -> [f64; 12] {
+    pub(crate) fn metrics(&self) -> [f64; 13] {
         [
             self.max_angle_error,
             self.rms_angle_error,
@@ -252,8 +256,9 @@ impl PointResult {
             self.angle_error_exceeded_time,
             self.lock_lost_time,
             self.loss_onset_time,
+            self.loss_settled_time,
             self.lock_detection_delay,
-            self.lock_first_rise_delay,
+            self.lock_late_delay,
         ]
     }
 }
@@ -342,8 +347,9 @@ pub fn run_point_until(
         angle_error_exceeded_time: m.angle_error_exceeded_time.unwrap_or(f64::NAN),
         lock_lost_time: m.lock_lost_time.unwrap_or(f64::NAN),
         loss_onset_time: m.loss_onset_time.unwrap_or(f64::NAN),
+        loss_settled_time: m.loss_settled_time.unwrap_or(f64::NAN),
         lock_detection_delay: m.lock_detection_delay.unwrap_or(f64::NAN),
-        lock_first_rise_delay: m.lock_first_rise_delay.unwrap_or(f64::NAN),
+        lock_late_delay: m.lock_late_delay.unwrap_or(f64::NAN),
     };
     // The zero-speed metrics are NaN-free by construction only when the band was visited;
     // judge divergence on the overall ones.

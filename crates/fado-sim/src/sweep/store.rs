@@ -150,8 +150,9 @@ pub fn read_csv(path: &Path, spec: &SweepSpec) -> Result<BTreeMap<usize, PointRe
                 angle_error_exceeded_time: m[7],
                 lock_lost_time: m[8],
                 loss_onset_time: m[9],
-                lock_detection_delay: m[10],
-                lock_first_rise_delay: m[11],
+                loss_settled_time: m[10],
+                lock_detection_delay: m[11],
+                lock_late_delay: m[12],
             },
         );
     }
