@@ -609,7 +609,8 @@ fn status_word_reports_dc_link_low_and_persistent_bad_input_trips_and_is_counted
 /// The stall symptom of the loss-of-lock detection (`DriveTuning::lock_stall_speed_ratio`):
 /// a spy estimator in limiter mode that reports a standing rotor. Not armed until the speed
 /// loop has caught its reference; then a reference beyond the band (7.5 r/min on the paper's
-/// motor) for `lock_stall_time` (50 samples) raises `LOCK_LOST`, latched until `align`;
+/// motor) for `lock_stall_time` (50 samples) raises `LOCK_LOST`, a live status that clears
+/// after `lock_stall_heal_time` without the condition (or at `align`);
 /// a speed error with the current reference at its limit does not; ratio 0 never does.
 #[test]
 fn stall_symptom_flags_a_lost_reference_below_the_current_limit() {
@@ -643,13 +644,24 @@ fn stall_symptom_flags_a_lost_reference_below_the_current_limit() {
     // Caught at 0, then 1 rad/s: flagged after 50 samples in a row.
     let (first, mut drive) = run(&high_limit, &[(20, 0.0), (200, 1.0)]);
     assert_eq!(first, Some(20 + 49), "{first:?}");
-    // Latched while the condition is gone, cleared by align.
-    assert!(
-        drive
+    // A live status: still up while the condition has been gone for less than
+    // `lock_stall_heal_time` (0.1 s = 1000 samples, net of the 200 − 49 symptomatic samples
+    // after the rise, capped at the healing count), clear after it; align clears it at once.
+    let ts = drive.config().ts;
+    let heal = (drive.config().tuning.lock_stall_heal_time / ts).round() as usize;
+    let mut cleared = None;
+    for k in 1..=2 * heal {
+        let up = drive
             .step(Abc::new(0.0, 0.0, 0.0), 300.0, 0.0)
             .flags
-            .contains(DriveFlags::LOCK_LOST)
-    );
+            .contains(DriveFlags::LOCK_LOST);
+        if !up {
+            cleared = Some(k);
+            break;
+        }
+    }
+    assert_eq!(cleared, Some(heal), "{cleared:?}");
+    let (_, mut drive) = run(&high_limit, &[(20, 0.0), (200, 1.0)]);
     drive.align(0.0);
     assert!(
         !drive
