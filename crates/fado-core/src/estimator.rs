@@ -206,11 +206,12 @@ pub struct EstimatorTuning<T> {
     /// Default 0.7 \[A\] (chosen on the fig11 envelope sweep, docs/lock.md).
     pub lock_flux_low_ratio: T,
     /// Loss of lock: |λ̂r| above this multiple of λ̂f is a symptom; 0 switches it off.
-    /// Default 2 \[A\]: gross inconsistency only (v of a machine turning the other way gives
-    /// |λ̂r| ≈ 1.3–4.8·λ̂f). A tight bound false-alarms: on the fig11 envelope |λ̂r| overshoots
-    /// to 1.20–1.22·λ̂f right after the limiter → k_df hand-over in runs that keep the rotor;
-    /// at 1.2 the bound added 8 points of false alarms for 5 points of detection, at 1.3
-    /// still 2–3 false alarms per 400 runs (docs/lock.md).
+    /// Default 1.4 \[A\]: above the limiter circle (1.15) and the 1.20–1.22·λ̂f overshoot
+    /// after a limiter → k_df hand-over in runs that keep the rotor (a bound of 1.2
+    /// false-alarmed there, 1.3 still 2–3 times per 400 runs), below the 1.4–1.6·λ̂f of a
+    /// fixed-R̂s drive that an active load runs away with in k_df mode (docs/lock.md: 1.4
+    /// instead of 2 detects 14 more of 208 fixed-R̂s losses, no false alarm more). The voltage
+    /// of a machine turning the other way gives 1.3–4.8·λ̂f.
     pub lock_flux_high_ratio: T,
     /// Loss of lock: a T2S-1 innovation |θm − θ̂⁻| above this (rad) is a symptom. Default
     /// 0.5 rad \[A\] (the angle error the drive must not reach, docs/lock.md).
@@ -302,7 +303,7 @@ impl<T: Real> Default for EstimatorTuning<T> {
             plausible_voltage_ratio: T::lit(plausibility::VOLTAGE_RATIO),
             plausible_current_step_ratio: T::lit(plausibility::STEP_RATIO),
             lock_flux_low_ratio: T::lit(0.7),
-            lock_flux_high_ratio: T::lit(2.0),
+            lock_flux_high_ratio: T::lit(1.4),
             lock_innovation_limit: T::lit(0.5),
             lock_detection_time: T::lit(5e-3),
             lock_heal_time: T::lit(0.1),

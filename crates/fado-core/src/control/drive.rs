@@ -222,6 +222,15 @@ pub struct DriveTuning<T> {
     /// a live status like the estimator's, see [`crate::lock::Debouncer`]; the reaction
     /// latches). Default 0.1 s \[A\] (the estimator's `lock_heal_time`).
     pub lock_stall_heal_time: T,
+    /// The stall symptom counts only where the estimate cannot see the angle: while |ω̂| is
+    /// below this multiple of the rated speed, or while ω̂ turns against ω*; 0: at any speed.
+    /// Default 0.0075 \[A\] (11 r/min at 1500 r/min rated: half the default Fig. 3 mode
+    /// threshold `mode_threshold_ratio` 0.015, the band in which the voltage model has next to
+    /// no back-EMF). Near the mode threshold the speed loop lags a ramp through the limiter ↔
+    /// k_df hand-over, and after a swing of ω̂ it overshoots the reference; every false alarm
+    /// of the stall symptom on the fig11 envelope was one of these (|n̂| 12–25 r/min,
+    /// docs/lock.md), every loss it caught had ω̂ stuck near zero or turning the wrong way.
+    pub lock_stall_max_speed_ratio: T,
 }
 
 impl<T: Real> DriveTuning<T> {
@@ -272,6 +281,7 @@ impl<T: Real> DriveTuning<T> {
             lock_stall_speed_ratio: U::lit(self.lock_stall_speed_ratio.to_f64()),
             lock_stall_time: U::lit(self.lock_stall_time.to_f64()),
             lock_stall_heal_time: U::lit(self.lock_stall_heal_time.to_f64()),
+            lock_stall_max_speed_ratio: U::lit(self.lock_stall_max_speed_ratio.to_f64()),
         }
     }
 }
@@ -321,6 +331,7 @@ impl<T: Real> Default for DriveTuning<T> {
             lock_stall_speed_ratio: T::lit(0.005),
             lock_stall_time: T::lit(5e-3),
             lock_stall_heal_time: T::lit(0.1),
+            lock_stall_max_speed_ratio: T::lit(0.0075),
         }
     }
 }
@@ -503,6 +514,8 @@ struct Resolved<T> {
     stall_speed: T,
     stall_samples: u32,
     stall_heal_samples: u32,
+    /// The stall symptom counts below this |ω̂| (electrical rad/s; ∞: always).
+    stall_max_speed: T,
     /// Phase currents beyond ± this (A) are refused as implausible.
     plausible_current: T,
     /// DC-link readings above this (V) are refused as implausible.
@@ -550,6 +563,13 @@ impl<T: Real> Resolved<T> {
                 0
             },
             stall_heal_samples: samples("lock_stall_heal_time", t.lock_stall_heal_time)?,
+            stall_max_speed: match check::non_negative(
+                "lock_stall_max_speed_ratio",
+                t.lock_stall_max_speed_ratio,
+            )? {
+                r if r == T::zero() => T::lit(f64::INFINITY),
+                r => r * c.machine.rated_speed(),
+            },
             plausible_current: t.plausible_current_ratio * t.trip_current_ratio * rated,
             dc_link_max_voltage: t.dc_link_max_ratio * c.machine.dc_voltage,
             mtpa: t.mtpa && c.machine.is_salient(),
@@ -1336,12 +1356,15 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         // (armed once |ω* − ω̂| was within the band since the last start), although its
         // current reference is below the limit (at the limit, a speed error is the machine's
         // torque limit, not evidence against the estimate; within 1 % counts as at the
-        // limit).
+        // limit), while ω̂ is near zero or turns against ω* (see
+        // `DriveTuning::lock_stall_max_speed_ratio`).
         let speed_ref = speed_ref_mech * T::lit(self.config.machine.pole_pairs as f64);
         let off_reference = (speed_ref - omega_ctrl).abs() > self.resolved.stall_speed;
         self.stall_armed |= !off_reference && !self.lock.coasting();
         let stall_now = self.stall_armed
             && off_reference
+            && (omega_ctrl.abs() < self.resolved.stall_max_speed
+                || omega_ctrl * speed_ref < T::zero())
             && diag.mode == Mode::Limiter
             && self.last.i_dq_ref.norm() < self.resolved.i_max * T::lit(0.99);
         let stalled = self.stall.step(stall_now);
