@@ -203,6 +203,7 @@ class EstimatorConfig:
         lock_flux_high_ratio: float | None = None,
         lock_innovation_limit: float | None = None,
         lock_detection_time: float | None = None,
+        lock_heal_time: float | None = None,
         lock_limiter_clamping: bool | None = None,
     ) -> EstimatorConfig: ...
     def replace(
@@ -237,6 +238,7 @@ class EstimatorConfig:
         lock_flux_high_ratio: float | None = None,
         lock_innovation_limit: float | None = None,
         lock_detection_time: float | None = None,
+        lock_heal_time: float | None = None,
         lock_limiter_clamping: bool | None = None,
     ) -> EstimatorConfig: ...
     def to_dict(self) -> dict[str, float | str | bool]: ...
@@ -330,6 +332,9 @@ class EstimatorConfig:
     @property
     def lock_detection_time(self) -> float:
         """Loss of lock: net symptomatic time (s) before lock = 2 (0 = off)."""
+    @property
+    def lock_heal_time(self) -> float:
+        """Loss of lock: net clean time (s) after which lock = 2 clears (a live status)."""
     @property
     def lock_limiter_clamping(self) -> bool:
         """Loss of lock: limiter clamping in limiter mode is a symptom."""

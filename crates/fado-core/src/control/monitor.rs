@@ -40,8 +40,9 @@ impl DriveFlags {
     pub const DC_LINK_LOW: Self = Self(1 << 5);
     /// FLAG_limit of the paper's Fig. 10: the estimator runs in limiter mode (not a fault).
     pub const LIMITER_MODE: Self = Self(1 << 6);
-    /// The estimator reports the rotor lost ([`crate::lock`], latched until the estimator is
-    /// re-aligned): the reason for [`COASTING`](Self::COASTING).
+    /// The estimator reports the rotor lost, or the drive's stall symptom is up ([`crate::lock`];
+    /// live statuses that heal), or the drive coasts because of a loss: the reason for
+    /// [`COASTING`](Self::COASTING).
     pub const LOCK_LOST: Self = Self(1 << 7);
     /// The drive holds zero current (speed loop off) because the rotor was lost
     /// (`lock_reaction` coast or recover; see [`crate::control::lock_reaction`]).
