@@ -1064,6 +1064,63 @@ impl Probe for Trace {
 mod tests {
     use super::*;
 
+    /// Feeds (time, |θ − θ̂|, flag) at 1 ms steps to a tracker.
+    fn track(samples: &[(f64, f64, bool)]) -> LossTracker {
+        let mut l = LossTracker::default();
+        for &(t, e, flag) in samples {
+            l.observe(t, Some(e), flag);
+        }
+        l
+    }
+
+    /// A piecewise-linear error and a flag window, sampled every ms from 0 to `end`.
+    fn run(error: &dyn Fn(f64) -> f64, flag: (f64, f64), end: f64) -> LossTracker {
+        let n = (end * 1000.0).round() as usize;
+        let s: Vec<_> = (0..=n)
+            .map(|k| {
+                let t = k as f64 * 1e-3;
+                (t, error(t), t >= flag.0 && t < flag.1)
+            })
+            .collect();
+        track(&s)
+    }
+
+    #[test]
+    fn loss_labels_follow_the_definition() {
+        // Error ramps 0 → 2 rad between 1 s and 2 s: onset (0.5 rad) at 1.25 s, last below
+        // 0.25 rad at 1.124 s.
+        let ramp = |t: f64| ((t - 1.0) * 2.0).clamp(0.0, 2.0);
+        // Flag up from 1.2 s on: rose 50 ms before the onset, up at the deadline.
+        let l = run(&ramp, (1.2, 9.0), 3.0);
+        let x = l.loss.unwrap();
+        assert!((x.onset - 1.251).abs() < 1e-9, "{x:?}");
+        assert!((x.settled - 1.124).abs() < 1e-9, "{x:?}");
+        assert_eq!(x.up_at_deadline, Some(Some(1.2)));
+        assert_eq!(x.first_rise, None); // no rise after the onset
+        // Flag rising 30 ms after the onset: down at the deadline, a late rise.
+        let x = run(&ramp, (1.281, 9.0), 3.0).loss.unwrap();
+        assert_eq!(x.up_at_deadline, Some(None));
+        assert_eq!(x.first_rise, Some(1.281));
+        // A flag that rose at start-up and stayed up: up at the deadline, risen at 0.1 s
+        // (the evaluation's window then refuses it).
+        let x = run(&ramp, (0.1, 9.0), 3.0).loss.unwrap();
+        assert_eq!(x.up_at_deadline, Some(Some(0.1)));
+        // A start-up excursion beyond 0.5 rad that came back below 0.25 rad does not move the
+        // onset of the later loss.
+        let bump = |t: f64| {
+            if (0.3..0.4).contains(&t) {
+                0.6
+            } else {
+                ramp(t)
+            }
+        };
+        let x = run(&bump, (0.3, 0.35), 3.0).loss.unwrap();
+        assert!((x.onset - 1.251).abs() < 1e-9, "{x:?}");
+        assert_eq!(x.up_at_deadline, Some(None));
+        // Never beyond 1 rad: no loss.
+        assert!(run(&|_| 0.7, (0.0, 9.0), 1.0).loss.is_none());
+    }
+
     #[test]
     fn csv_header_is_the_column_list_and_values_follow_it() {
         let mut t = Trace::new(1);
