@@ -661,7 +661,50 @@ struct Blocks<T> {
     modulator: SpaceVectorModulator<T>,
 }
 
+/// What the modulator applies at a sample: the duties, and the voltage that acts (α-β and in
+/// the frame of the rotation used), which is the reference itself unless the hexagon limited
+/// it.
+#[derive(Clone, Copy)]
+struct Applied<T> {
+    duty: Abc<T>,
+    v_ab: Ab<T>,
+    v_dq: Dq<T>,
+    saturated: bool,
+}
+
 impl<T: Real> Blocks<T> {
+    /// Dead-time compensation, hexagon limit and SVPWM of the reference `v_ab` (`v_dq` in the
+    /// frame of `rot`), and the voltage that then acts, back-calculated without the
+    /// compensation where the modulator limited it (zero without a DC link). None when
+    /// anything is non-finite.
+    #[inline(always)]
+    fn modulate(
+        &mut self,
+        rot: Rotation<T>,
+        v_ab: Ab<T>,
+        v_dq: Dq<T>,
+        i_dq_ref: Dq<T>,
+        i_abc: Abc<T>,
+        vdc: T,
+    ) -> Option<Applied<T>> {
+        let v_comp = self.dead_time.step(rot, i_dq_ref, i_abc, vdc);
+        let m = self.modulator.step(v_ab + v_comp, vdc);
+        let (v_ab, v_dq) = if !m.saturated {
+            (v_ab, v_dq) // exactly what was asked for: nothing to back-calculate
+        } else if vdc > T::zero() {
+            let v = m.v_ab - v_comp;
+            (v, v.to_dq(rot))
+        } else {
+            (Ab::zero(), Dq::zero())
+        };
+        (v_ab.is_finite() && v_dq.is_finite() && m.duty.is_finite()).then_some(Applied {
+            duty: m.duty,
+            v_ab,
+            v_dq,
+            saturated: m.saturated,
+        })
+    }
+
     fn new(c: &DriveConfig<T>, r: &Resolved<T>) -> Result<Self, ConfigError> {
         let ts = c.ts;
         let t = &c.tuning;
@@ -1121,38 +1164,13 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
                 (v_dq.to_ab(rot), v_dq)
             }
         };
-        let v_comp = b.dead_time.step(rot, i_dq_ref, i_abc, vdc);
-        let m = b.modulator.step(v_ab + v_comp, vdc);
-        let (v_realised, v_dq_realised) = if !m.saturated {
-            (v_ab, v_dq)
-        } else if vdc > T::zero() {
-            let v = m.v_ab - v_comp;
-            (v, v.to_dq(rot))
-        } else {
-            (Ab::zero(), Dq::zero())
-        };
-        if !(v_realised.is_finite() && v_dq_realised.is_finite() && m.duty.is_finite()) {
+        let Some(applied) = b.modulate(rot, v_ab, v_dq, i_dq_ref, i_abc, vdc) else {
             return self.reject_after_estimate(backup, estimate, i_dq);
-        }
-        if command.voltage.is_none() {
-            b.current.realised(v_dq_realised);
-        }
-        self.history = [v_realised, self.history[0]];
-        self.last = DriveOutput {
-            duty: m.duty,
-            gates_enabled: true,
-            v_ref_ab: v_realised,
-            i_dq,
-            i_dq_ref,
-            estimate,
-            tripped: false,
-            input_fault: false,
-            v_dq_ref: v_dq_realised,
-            voltage_saturated: m.saturated,
-            flags: DriveFlags::NONE, // set by `step`
-            i_ab,
         };
-        self.last
+        if command.voltage.is_none() {
+            b.current.realised(applied.v_dq);
+        }
+        self.record(applied, i_dq, i_dq_ref, estimate, i_ab)
     }
 
     fn clear_control(&mut self, theta: T) {
@@ -1431,21 +1449,11 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             .delay
             .step_rotated(v_dq, rot_theta, estimate.theta, estimate.omega);
         // 7. Dead-time compensation, hexagon limit, SVPWM.
-        let v_comp = b.dead_time.step(rot, i_dq_ref, i_abc, vdc);
-        let m = b.modulator.step(v_ab + v_comp, vdc);
-        let (v_realised, v_dq_realised) = if !m.saturated {
-            (v_ab, v_dq) // exactly what was asked for: nothing to back-calculate
-        } else if vdc > T::zero() {
-            let v = m.v_ab - v_comp;
-            (v, v.to_dq(rot))
-        } else {
-            (Ab::zero(), Dq::zero())
-        };
-        if !(v_realised.is_finite() && v_dq_realised.is_finite() && m.duty.is_finite()) {
+        let Some(applied) = b.modulate(rot, v_ab, v_dq, i_dq_ref, i_abc, vdc) else {
             return self.reject_after_estimate(backup, estimate, i_dq);
-        }
+        };
         // 8. Anti-windup with the realised voltage in the same frame; speed loop too.
-        b.current.realised(v_dq_realised);
+        b.current.realised(applied.v_dq);
         let realised_torque = if self.resolved.salient {
             let m = &self.config.machine;
             m.active_flux(i_dq_ref.d) * i_dq_ref.q / m.flux_linkage
@@ -1453,18 +1461,32 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             i_dq_ref.q
         };
         b.speed.realised(realised_torque);
-        self.history = [v_realised, self.history[0]];
+        self.record(applied, i_dq, i_dq_ref, estimate, i_ab)
+    }
+
+    /// The sample's output with the modulated voltage `applied`, which also enters the
+    /// voltage history (the estimator's input one and two samples on).
+    #[inline(always)]
+    fn record(
+        &mut self,
+        applied: Applied<T>,
+        i_dq: Dq<T>,
+        i_dq_ref: Dq<T>,
+        estimate: Estimate<T>,
+        i_ab: Ab<T>,
+    ) -> DriveOutput<T> {
+        self.history = [applied.v_ab, self.history[0]];
         self.last = DriveOutput {
-            duty: m.duty,
+            duty: applied.duty,
             gates_enabled: true,
-            v_ref_ab: v_realised,
+            v_ref_ab: applied.v_ab,
             i_dq,
             i_dq_ref,
             estimate,
             tripped: false,
             input_fault: false,
-            v_dq_ref: v_dq_realised,
-            voltage_saturated: m.saturated,
+            v_dq_ref: applied.v_dq,
+            voltage_saturated: applied.saturated,
             flags: DriveFlags::NONE, // set by `step`
             i_ab,
         };

@@ -208,7 +208,7 @@ pub struct PointResult {
     /// Last time |θ − θ̂| < 0.25 rad before the onset, s (NaN: none).
     pub loss_settled_time: f64,
     /// Rise of the flag up at onset + 20 ms minus the onset, s (NaN: down then); see
-    /// [`crate::Metrics::lock_detection_delay`].
+    /// [`crate::sim::Metrics::lock_detection_delay`].
     pub lock_detection_delay: f64,
     /// First rise of the flag after the onset minus the onset, s (NaN: none).
     pub lock_late_delay: f64,
