@@ -1,15 +1,12 @@
 //! The drive's start-up current-sensor gain calibration (fado_core::control::gain_calibration)
 //! in closed loop with the simulator's plant, switching-resolved inverter and sensors.
 
-use fado_core::control::GainCalibrationStatus;
+use fado_core::control::{GainCalibrationStatus, SensorlessDrive};
 use fado_sim::presets::PRESETS;
 use fado_sim::profile::Profile;
 
-/// Runs the start-up of `preset` (with the TOML `extra` over it) at rest at `angle`, speed
-/// reference 0, until the offset and gain calibrations are over; returns the drive's ratio,
-/// the sensors' true ratio (1 + g_a)/(1 + g_b), the calibration's status, the largest true
-/// |i_dq| seen (A) and the time the drive starts (s).
-fn start_up(preset: &str, angle: f64, extra: &str) -> (f64, f64, GainCalibrationStatus, f64, f64) {
+/// `preset` with the TOML `extra` over it, at rest at `angle`, speed reference 0.
+fn config(preset: &str, angle: f64, extra: &str) -> fado_sim::config::SimConfig {
     let p = fado_sim::presets::find(preset).unwrap();
     let base = fado_sim::config::SimConfig::from_toml(&format!(
         "{}\n[simulation]\ninitial_angle = {angle}\n",
@@ -18,9 +15,13 @@ fn start_up(preset: &str, angle: f64, extra: &str) -> (f64, f64, GainCalibration
     .unwrap();
     let mut cfg = fado_sim::config::SimConfig::from_toml_over(&base, extra).unwrap();
     cfg.speed_reference = Profile::constant(0.0);
-    let k_true = (1.0 + cfg.current_sensor.gain_error_a) / (1.0 + cfg.current_sensor.gain_error_b);
-    let drive = cfg.build_drive().unwrap();
-    let mut sim = cfg.simulation(drive).unwrap();
+    cfg
+}
+
+/// Steps the drive of `cfg` until the offset and gain calibrations are over; returns the drive,
+/// the largest true |i_dq| seen (A) and the time the drive starts (s).
+fn run_start_up(cfg: &fado_sim::config::SimConfig) -> (SensorlessDrive<f64>, f64, f64) {
+    let mut sim = cfg.simulation(cfg.build_drive().unwrap()).unwrap();
     let mut peak: f64 = 0.0;
     let mut t = 0.0;
     for _ in 0..2_000_000 {
@@ -33,7 +34,17 @@ fn start_up(preset: &str, angle: f64, extra: &str) -> (f64, f64, GainCalibration
             break;
         }
     }
-    let d = sim.controller();
+    (*sim.controller(), peak, t)
+}
+
+/// Runs the start-up of `preset` (with the TOML `extra` over it) at rest at `angle`, speed
+/// reference 0, until the offset and gain calibrations are over; returns the drive's ratio,
+/// the sensors' true ratio (1 + g_a)/(1 + g_b), the calibration's status, the largest true
+/// |i_dq| seen (A) and the time the drive starts (s).
+fn start_up(preset: &str, angle: f64, extra: &str) -> (f64, f64, GainCalibrationStatus, f64, f64) {
+    let cfg = config(preset, angle, extra);
+    let k_true = (1.0 + cfg.current_sensor.gain_error_a) / (1.0 + cfg.current_sensor.gain_error_b);
+    let (d, peak, t) = run_start_up(&cfg);
     (
         d.current_gain_ratio(),
         k_true,
@@ -138,29 +149,13 @@ fn the_start_up_dc_test_hands_its_resistance_to_the_adaptation_and_not_to_the_fi
     // at 0.3 rad.
     for preset in ["paper", "outrunner-cheetah-24v"] {
         for adaptation in [true, false] {
-            let p = fado_sim::presets::find(preset).unwrap();
-            let base = fado_sim::config::SimConfig::from_toml(&format!(
-                "{}\n[simulation]\ninitial_angle = 0.3\n",
-                p.toml
-            ))
-            .unwrap();
             let extra = format!(
                 "[mismatch]\nrs_ratio = 0.7692307692307693\n[estimator]\nrs_adaptation = {adaptation}\n"
             );
-            let mut cfg = fado_sim::config::SimConfig::from_toml_over(&base, &extra).unwrap();
-            cfg.speed_reference = Profile::constant(0.0);
+            let cfg = config(preset, 0.3, &extra);
             let rs_motor = cfg.motor.rs;
             let rs_model = rs_motor * 0.7692307692307693;
-            let drive = cfg.build_drive().unwrap();
-            let mut sim = cfg.simulation(drive).unwrap();
-            for _ in 0..2_000_000 {
-                sim.step();
-                let d = sim.controller();
-                if !d.is_calibrating() && !d.is_calibrating_gain() {
-                    break;
-                }
-            }
-            let d = sim.controller();
+            let (d, _, _) = run_start_up(&cfg);
             assert_eq!(
                 d.gain_calibration_status(),
                 GainCalibrationStatus::Calibrated,

@@ -1127,8 +1127,8 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
                 T::one()
             };
             // The same two levels are the classic DC test of Rs: the estimator's R̂s
-            // adaptation starts from it (within its own 0.5–2× band of the model's R̂s; a
-            // value outside says something else is wrong, and the model's R̂s is kept).
+            // adaptation starts from it if it lies within 0.5–2× of the model's R̂s (a value
+            // outside says something else is wrong, and the model's R̂s is kept).
             if self.gain.status() == GainCalibrationStatus::Calibrated {
                 let r = self.gain.resistance();
                 let r0 = self.config.machine.rs;
@@ -1136,8 +1136,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
                     self.estimator.start_from_measured_rs(r);
                 }
             }
-            let a = i_abc.a * self.gain_correction;
-            self.last_i_ab = Abc::new(a, i_abc.b, i_abc.c + (i_abc.a - a)).to_ab();
+            self.last_i_ab = self.gain_corrected(i_abc).to_ab();
             let theta0 = self.aligned_angle;
             self.realign(theta0);
             return self.last;
@@ -1171,6 +1170,18 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             b.current.realised(applied.v_dq);
         }
         self.record(applied, i_dq, i_dq_ref, estimate, i_ab)
+    }
+
+    /// The phase currents with the measured gain ratio applied to phase a; c keeps the sum of
+    /// the three readings (c = −a − b stays so for two sensors). Untouched while k = 1.
+    #[inline(always)]
+    fn gain_corrected(&self, i_abc: Abc<T>) -> Abc<T> {
+        if self.gain_correction != T::one() {
+            let a = i_abc.a * self.gain_correction;
+            Abc::new(a, i_abc.b, i_abc.c + (i_abc.a - a))
+        } else {
+            i_abc
+        }
     }
 
     fn clear_control(&mut self, theta: T) {
@@ -1309,14 +1320,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         if self.gain.running() {
             return self.gain_calibration_step(i_abc, vdc);
         }
-        // The gain ratio on phase a; c keeps the sum of the three readings (c = −a − b stays
-        // so for two sensors).
-        let i_abc = if self.gain_correction != T::one() {
-            let a = i_abc.a * self.gain_correction;
-            Abc::new(a, i_abc.b, i_abc.c + (i_abc.a - a))
-        } else {
-            i_abc
-        };
+        let i_abc = self.gain_corrected(i_abc);
         // Stuck-channel check against the reference the loop was tracking, advanced by the
         // rotation over one sample; an implausible channel is replaced by its reconstruction
         // from the model prediction.

@@ -518,9 +518,9 @@ impl<T: Real> GainCalibration<T> {
 /// (phase b as measured; i_β = (i_a + 2·i_b)/√3, amplitude-invariant Clarke). NaN when the
 /// difference is zero or anything is non-finite.
 pub fn resistance_of<T: Real>(di: Ab<T>, dv: Ab<T>, k: T) -> T {
-    let ib = di.alpha * T::lit(PHASE_B_ALPHA) + di.beta * T::lit(PHASE_B_BETA);
+    let ib = di.to_abc().b;
     let ia = di.alpha / k;
-    let corrected = Ab::new(ia, (ia + ib + ib) * T::lit(1.0 / SQRT_3));
+    let corrected = crate::Abc::new(ia, ib, -ia - ib).to_ab();
     let den = corrected.dot(corrected);
     if den > T::zero() {
         dv.dot(corrected) / den
@@ -528,9 +528,6 @@ pub fn resistance_of<T: Real>(di: Ab<T>, dv: Ab<T>, k: T) -> T {
         T::zero() / T::zero()
     }
 }
-
-/// √3.
-const SQRT_3: f64 = 1.732_050_807_568_877_2;
 
 /// 1/n for a sample count n, n built as a real by binary decomposition (adds of powers of
 /// two, exact below 2^24 in f32): no integer-to-float conversion, which a Cortex-M4's f32
