@@ -55,6 +55,22 @@
 //!    the dead-time voltage identification of Guerrero et al., "Inverter nonlinearity effects
 //!    in high-frequency signal-injection-based sensorless control methods", IEEE TIA 41(2),
 //!    2005). V̂ = Td·f_sw·Vdc + V_th (SPEC §5) with the known dead time gives V_th.
+//!    The same two levels give the current sensors' gain ratio k = (1 + g_a)/(1 + g_b) =
+//!    (Δi_a/Δv_a)/(Δi_b/Δv_b), the drive's start-up calibration
+//!    ([`crate::control::gain_calibration`]: its [`ratio_of`], and R̂s as its
+//!    [`resistance_of`] along the level difference with phase a corrected by k). From the
+//!    inductance tests on, phase a is divided by k, so R̂s, L̂d, L̂q and λ̂f are all in phase
+//!    b's scale: the one the drive works in once its own calibration has run. Uncorrected,
+//!    R̂s came out in phase a's scale (the α axis *is* phase a's): −0.50 % with the
+//!    simulator's default +0.5 % gain error of that sensor, and with that R̂s fixed the
+//!    `outrunner-cheetah-24v` preset (2.4 mWb) lost `reversal` and `stops` (0.45–0.54 rad;
+//!    R̂s × 1.005 passed). The calibration's own sequence is not run as a phase of its own:
+//!    the DC test already is that sequence (two frozen-voltage levels, one half the other,
+//!    along one axis), and on the α axis every phase carries at least half of the current,
+//!    the best observability the calibration can have (its `min_observability` is 0.2).
+//!    k is refused (left 1, [`Identification::current_gain_ratio`]) where the drive would
+//!    refuse it: beyond [`CommissioningConfig::max_gain_mismatch`], a non-positive
+//!    conductance or too little of the current in phase a or b.
 //! 4. **Inductances** ([`Phase::InductanceD`], [`Phase::InductanceQ`]): on top of the I₁ bias
 //!    along d (which holds the rotor), a square-wave voltage of ±V_h with a half period of 4
 //!    samples is injected along d, then along q (standstill voltage injection as in Bolognani,
@@ -132,6 +148,8 @@
 //! residuals of the least-squares fits for L and J). It measures noise, not bias: the
 //! accuracy against ground truth is what the simulator's table (docs/commissioning.md) shows.
 
+use crate::control::DriveTuning;
+use crate::control::gain_calibration::{ratio_of, resistance_of};
 use crate::error::{ConfigError, check};
 use crate::{Ab, Abc, Dq, MachineModel, Real, Rotation, wrap_angle};
 
@@ -289,6 +307,11 @@ pub struct CommissioningConfig<T> {
     pub measure_time: T,
     /// Maximum duration of any phase, in s. Default 5 s.
     pub phase_timeout: T,
+    /// Largest current-sensor gain mismatch |k − 1| the DC test accepts as a measurement
+    /// (module docs, step 3); a larger one leaves phase a uncorrected. Default the drive's
+    /// [`DriveTuning::gain_calibration_max_mismatch`] (0.05), so that the procedure works in
+    /// the scale the drive will.
+    pub max_gain_mismatch: T,
 }
 
 impl<T: Real> CommissioningConfig<T> {
@@ -310,6 +333,7 @@ impl<T: Real> CommissioningConfig<T> {
             settle_time: T::lit(0.25).max(T::lit(10.0) * tau),
             measure_time: T::lit(0.25),
             phase_timeout: T::lit(5.0),
+            max_gain_mismatch: DriveTuning::<T>::default().gain_calibration_max_mismatch,
         }
     }
 
@@ -353,6 +377,7 @@ impl<T: Real> CommissioningConfig<T> {
         check::positive("settle_time", self.settle_time)?;
         check::positive("measure_time", self.measure_time)?;
         check::positive("phase_timeout", self.phase_timeout)?;
+        check::positive("max_gain_mismatch", self.max_gain_mismatch)?;
         let min_phase = T::lit(2.0) * self.align_time + self.settle_time + self.measure_time;
         if self.phase_timeout < min_phase || self.phase_timeout < self.offset_time {
             return Err(ConfigError::OutOfRange {
@@ -387,6 +412,8 @@ pub struct Confidence<T> {
     pub viscous_friction: T,
     /// Of the per-phase inverter voltage error V̂, absolute in V.
     pub inverter_voltage: T,
+    /// Of the current sensors' gain ratio k, relative (∞ when none was measured).
+    pub current_gain_ratio: T,
 }
 
 /// The identified motor and inverter.
@@ -402,6 +429,11 @@ pub struct Identification<T> {
     /// Device threshold voltage V_th = V̂ − Td·f_sw·Vdc in V (for
     /// [`crate::control::dead_time_compensation::DeadTimeCompensationConfig::threshold_voltage`]).
     pub threshold_voltage: T,
+    /// The current sensors' gain ratio k = (1 + g_a)/(1 + g_b) measured in the DC test
+    /// (module docs, step 3), by which phase a was divided from then on: R̂s, L̂d, L̂q and λ̂f
+    /// are in phase b's scale, the drive's after its start-up calibration
+    /// ([`crate::control::gain_calibration`]). 1 when the DC test gave no plausible k.
+    pub current_gain_ratio: T,
     /// Saliency ratio L̂q/L̂d (> 1: interior magnets).
     pub saliency: T,
     /// Mean DC-link voltage during the DC test, V.
@@ -767,11 +799,25 @@ pub struct Commissioning<T> {
     err_perp: T,
     emf_lpf: Ab<T>,
     frozen: bool,
+    /// Time in the DC level at which its voltage was frozen, s.
+    t_frozen: T,
+    /// Hold after the freeze before a DC level is averaged, s (`dc_window_start`).
+    dc_hold: T,
+    /// The swing dies out within [`DC_MAX_HOLD`]: k may be measured.
+    gain_swing_settled: bool,
     saturated_time: T,
-    // Resistance.
+    // Resistance (α components; the β ones for the sensors' gain ratio).
     v_lvl: [BlockStats<T>; 2],
     i_lvl: [BlockStats<T>; 2],
+    v_lvl_beta: [BlockStats<T>; 2],
+    i_lvl_beta: [BlockStats<T>; 2],
     vdc_stats: BlockStats<T>,
+    /// 1/k, applied to the offset-corrected phase-a current from the inductance tests on
+    /// (1 before the DC test and when it gave no plausible k).
+    gain_correction: T,
+    /// The measured k (NaN before the DC test or when not plausible) and its relative 1-σ.
+    gain_ratio: T,
+    gain_ratio_sigma: T,
     // Inductance.
     line: Line<T>,
     inj_count: u32,
@@ -837,6 +883,20 @@ const J_STEP_TIME: f64 = 0.5;
 /// phase lag at the loop's crossover while averaging ten samples of the L̂q·Δi/Ts noise
 /// (module docs, step 5).
 const PLL_EMF_FILTER: f64 = 0.001;
+/// Hold of each DC level after its voltage is frozen, before it is averaged, in time
+/// constants of the rotor's swing about the d current in voltage mode
+/// ([`swing_time_constant`](crate::control::drive), the drive's gain calibration's sizing):
+/// e⁻⁶ = 0.25 % of the swing's back-EMF left. The sensors' gain ratio k is read through phase
+/// b, i.e. through the β axis, across which the swing's back-EMF lies (R̂s along α does not
+/// see it). Without the hold (averaged from `settle_time`, 0.25 s) the swing of the
+/// hoverboard hub (15 pole pairs, τ = 0.22 s, still ±1 r/min in the window) biased k by
+/// −5.0e-3, the 5 kW PM-SyRM's (τ = 0.25 s) by −3.6e-2, the 50 kW IPMSM's (τ = 0.17 s) by
+/// +1.1e-2, against a 5e-3 mismatch.
+const DC_HOLD_SWING_TIME_CONSTANTS: f64 = 6.0;
+/// Longest hold of a DC level, s: the 5 s phase time-out leaves room for it, the settling and
+/// the window. A swing needing longer is held this long and k is not measured (phase a left
+/// uncorrected, as the drive's calibration skips it: `TooSlow`).
+const DC_MAX_HOLD: f64 = 2.0;
 /// Window of the inertia regression, s.
 const J_WINDOW: f64 = 0.04;
 /// Bound on the active-flux EMF's d component (L̂d − L̂q)·di_d/dt while the coast's d
@@ -868,9 +928,24 @@ impl<T: Real> Commissioning<T> {
         // The I-f current and acceleration on the nameplate's inductances (set again from the
         // identified ones at the start of the spin; here for the nominal duration).
         let (i_if, spin_accel) = spin_sizing(np, np.ld, np.lq, i_limit, cfg.spin_torque_ratio);
+        // The DC levels' hold: the rotor's swing about the d current (of the nameplate) in
+        // voltage mode, at either level, as the drive's gain calibration sizes it.
+        // A swing slower than DC_MAX_HOLD allows is held that long and k not used (`dc_hold`
+        // is then not finite-or-within: `gain_swing_settled` false).
+        let swing = crate::control::drive::swing_time_constant(np, i_dc)
+            .max(crate::control::drive::swing_time_constant(np, i1));
+        let dc_hold_wanted = T::lit(DC_HOLD_SWING_TIME_CONSTANTS) * swing;
+        let gain_swing_settled = dc_hold_wanted <= T::lit(DC_MAX_HOLD);
+        let dc_hold = if gain_swing_settled {
+            dc_hold_wanted
+        } else {
+            T::lit(DC_MAX_HOLD)
+        };
+        let dc_level_time =
+            cfg.settle_time.max(T::lit(0.6) * cfg.settle_time + dc_hold) + cfg.measure_time;
         let nominal_total = cfg.offset_time
             + T::lit(3.0) * cfg.align_time
-            + T::lit(2.0) * (cfg.settle_time + cfg.measure_time)
+            + T::lit(2.0) * dc_level_time
             + T::lit(2.0) * (T::lit(0.02) + cfg.measure_time)
             + (spin_speed / spin_accel + cfg.settle_time)
             + T::lit(2.0) * (T::lit(0.02) + cfg.measure_time)
@@ -909,10 +984,18 @@ impl<T: Real> Commissioning<T> {
             err_perp: T::zero(),
             emf_lpf: Ab::zero(),
             frozen: false,
+            t_frozen: T::zero(),
+            dc_hold,
+            gain_swing_settled,
             saturated_time: T::zero(),
             v_lvl: [BlockStats::new(block); 2],
             i_lvl: [BlockStats::new(block); 2],
+            v_lvl_beta: [BlockStats::new(block); 2],
+            i_lvl_beta: [BlockStats::new(block); 2],
             vdc_stats: BlockStats::new(block),
+            gain_correction: T::one(),
+            gain_ratio: T::zero() / T::zero(),
+            gain_ratio_sigma: T::lit(f64::INFINITY),
             line: Line::default(),
             inj_count: 0,
             inj_sign: T::one(),
@@ -976,11 +1059,17 @@ impl<T: Real> Commissioning<T> {
         self.err_perp = T::zero();
         self.emf_lpf = Ab::zero();
         self.frozen = false;
+        self.t_frozen = T::zero();
         self.saturated_time = T::zero();
         let block = self.v_lvl[0].block;
         self.v_lvl = [BlockStats::new(block); 2];
         self.i_lvl = [BlockStats::new(block); 2];
+        self.v_lvl_beta = [BlockStats::new(block); 2];
+        self.i_lvl_beta = [BlockStats::new(block); 2];
         self.vdc_stats = BlockStats::new(block);
+        self.gain_correction = T::one();
+        self.gain_ratio = T::zero() / T::zero();
+        self.gain_ratio_sigma = T::lit(f64::INFINITY);
         self.emf_win = [EmfWindow::new(block); 2];
         self.line = Line::default();
         self.jfit = JFit::default();
@@ -1109,8 +1198,10 @@ impl<T: Real> Commissioning<T> {
             }
             return self.output(Ab::zero(), vdc, false, T::zero());
         }
-        // Offset-corrected current (two sensors, c = −a − b).
-        let a = i_abc.a - self.off_a;
+        // Offset-corrected current (two sensors, c = −a − b), phase a divided by the sensors'
+        // gain ratio k once the DC test has measured it (the drive's correction, in phase b's
+        // scale: module docs, step 3).
+        let a = (i_abc.a - self.off_a) * self.gain_correction;
         let b = i_abc.b - self.off_b;
         let i = Abc::new(a, b, -a - b).to_ab();
         if i.norm() > self.cfg.trip_ratio * self.i_limit {
@@ -1180,11 +1271,13 @@ impl<T: Real> Commissioning<T> {
             Phase::Resistance => {
                 let (level, idx) = if self.sub == 0 { (i2, 1) } else { (i1, 0) };
                 self.i_ref = Ab::new(level, T::zero());
-                if t > settle && self.frozen {
+                if self.frozen && t > self.dc_window_start() {
                     window = true;
                     if self.have_prev {
                         self.v_lvl[idx].push(self.c2.alpha);
                         self.i_lvl[idx].push(T::lit(0.5) * (i.alpha + self.i_prev.alpha));
+                        self.v_lvl_beta[idx].push(self.c2.beta);
+                        self.i_lvl_beta[idx].push(T::lit(0.5) * (i.beta + self.i_prev.beta));
                         self.vdc_stats.push(vdc);
                     }
                 }
@@ -1237,6 +1330,7 @@ impl<T: Real> Commissioning<T> {
                     && self.err_par < T::lit(0.03) * self.i_ref.norm()
                 {
                     self.frozen = true;
+                    self.t_frozen = t;
                 }
                 self.frozen
             }
@@ -1310,7 +1404,7 @@ impl<T: Real> Commissioning<T> {
                 self.abort(AbortReason::CurrentNotFollowing { phase: self.phase });
                 return Ab::zero();
             }
-            Phase::Resistance if t >= settle + meas => {
+            Phase::Resistance if t >= self.dc_window_start() + meas => {
                 self.frozen = false;
                 if self.sub == 0 {
                     self.sub = 1;
@@ -1354,6 +1448,13 @@ impl<T: Real> Commissioning<T> {
         v
     }
 
+    /// Start of a DC level's measurement window (time in the level, once frozen): the
+    /// settling time, and at least [`DC_HOLD_SWING_TIME_CONSTANTS`] of the rotor's swing after
+    /// the voltage was frozen (module docs, step 3).
+    fn dc_window_start(&self) -> T {
+        self.cfg.settle_time.max(self.t_frozen + self.dc_hold)
+    }
+
     /// Standstill feedforward R̂·i* + Td·f_sw·Vdc·sat(i*_x/I_band) per phase (the nameplate's
     /// Rs and DC link, the configured dead time; I_band = 5 % of the limit). The full
     /// nameplate Rs: 0.75 × it (no overshoot for a nameplate up to 1.33× too high) left the
@@ -1375,18 +1476,37 @@ impl<T: Real> Commissioning<T> {
         let np = self.cfg.nameplate;
         let (v1, v2) = (self.v_lvl[0].mean(), self.v_lvl[1].mean());
         let (i1, i2) = (self.i_lvl[0].mean(), self.i_lvl[1].mean());
+        // The sensors' gain ratio k from the same two levels (module docs, step 3), and R̂s
+        // along the current difference with phase a corrected by it: in phase b's scale, the
+        // drive's once it has calibrated.
+        let di_ab = Ab::new(
+            i2 - i1,
+            self.i_lvl_beta[1].mean() - self.i_lvl_beta[0].mean(),
+        );
+        let dv_ab = Ab::new(
+            v2 - v1,
+            self.v_lvl_beta[1].mean() - self.v_lvl_beta[0].mean(),
+        );
+        let (k, k_sigma) = self.gain_ratio_of(di_ab, dv_ab);
+        let k_used = if k.is_finite() { k } else { T::one() };
+        self.gain_ratio = k;
+        self.gain_ratio_sigma = k_sigma;
+        let rs = resistance_of(di_ab, dv_ab, k_used);
+        // The α current levels in the corrected scale (i_α is phase a's reading).
+        let (i1, i2) = (i1 / k_used, i2 / k_used);
         let di = i2 - i1;
-        let rs = (v2 - v1) / di;
         let sq = |x: T| x * x;
         // Voltage and current scatter of both levels (the voltage is frozen in the window,
         // so the current carries the noise).
         let s_v = (sq(self.v_lvl[0].sem())
             + sq(self.v_lvl[1].sem())
-            + sq(rs * self.i_lvl[0].sem())
-            + sq(rs * self.i_lvl[1].sem()))
+            + sq(rs * self.i_lvl[0].sem() / k_used)
+            + sq(rs * self.i_lvl[1].sem() / k_used))
         .sqrt();
         self.rs = rs;
         self.rs_sigma = s_v / di.abs() / rs.abs();
+        // From now on phase a is read in phase b's scale.
+        self.gain_correction = T::one() / k_used;
         // α-axis intercept = 4/3 of the per-phase error (module docs).
         self.v_inv = T::lit(0.75) * (v1 - rs * i1);
         self.v_inv_sigma = T::lit(0.75) * (s_v + rs * self.rs_sigma * i1.abs());
@@ -1405,6 +1525,39 @@ impl<T: Real> Commissioning<T> {
                 parameter: Parameter::InverterVoltage,
             });
         }
+    }
+
+    /// The current sensors' gain ratio k = (Δi_a/Δv_a)/(Δi_b/Δv_b) of the DC test's two
+    /// levels ([`ratio_of`], the drive's start-up calibration's formula) and its relative
+    /// 1-σ from the levels' block scatter; (NaN, ∞) when the levels do not give one (a
+    /// current off the α axis, a non-positive conductance) or when |k − 1| is beyond
+    /// `max_gain_mismatch` (which the drive would refuse too).
+    fn gain_ratio_of(&self, di: Ab<T>, dv: Ab<T>) -> (T, T) {
+        let none = (T::zero() / T::zero(), T::lit(f64::INFINITY));
+        if !self.gain_swing_settled {
+            return none;
+        }
+        let min_share = DriveTuning::<T>::default().gain_calibration_min_observability;
+        let Some(k) = ratio_of(di, dv, min_share) else {
+            return none;
+        };
+        if (k - T::one()).abs() > self.cfg.max_gain_mismatch {
+            return none;
+        }
+        // Variances of the level differences, α and β, of the current and the voltage; a
+        // phase-b value is −½·α + (√3/2)·β.
+        let sq = |x: T| x * x;
+        let var = |s: &[BlockStats<T>; 2]| sq(s[0].sem()) + sq(s[1].sem());
+        let (ia, ib) = (var(&self.i_lvl), var(&self.i_lvl_beta));
+        let (va, vb) = (var(&self.v_lvl), var(&self.v_lvl_beta));
+        let phase_b = |a: T, b: T| T::lit(0.25) * a + T::lit(0.75) * b;
+        let dib = (di.to_abc()).b;
+        let dvb = (dv.to_abc()).b;
+        let rel = ia / sq(di.alpha)
+            + phase_b(ia, ib) / sq(dib)
+            + va / sq(dv.alpha)
+            + phase_b(va, vb) / sq(dvb);
+        (k, rel.sqrt())
     }
 
     fn finish_inductance(&mut self, nameplate: T, parameter: Parameter) -> Option<(T, T)> {
@@ -1763,9 +1916,11 @@ impl<T: Real> Commissioning<T> {
                 inertia: sj / j,
                 viscous_friction: sb,
                 inverter_voltage: self.v_inv_sigma,
+                current_gain_ratio: self.gain_ratio_sigma,
             },
             inverter_voltage: self.v_inv,
             threshold_voltage: self.v_inv - self.cfg.dead_time * self.cfg.switching_frequency * vdc,
+            current_gain_ratio: T::one() / self.gain_correction,
             saliency: self.lq / self.ld,
             dc_voltage: vdc,
             duration: self.t_total,

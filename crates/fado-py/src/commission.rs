@@ -257,6 +257,7 @@ impl CommissionResult {
             ("viscous_friction", t.viscous_friction),
             ("inverter_voltage", t.inverter_voltage),
             ("threshold_voltage", t.threshold_voltage),
+            ("current_gain_ratio", t.current_gain_ratio),
         ] {
             truth.set_item(k, v)?;
         }

@@ -36,6 +36,8 @@ pub struct Truth {
     pub inverter_voltage: f64,
     /// Device threshold V_th, V.
     pub threshold_voltage: f64,
+    /// The current sensors' gain ratio (1 + g_a)/(1 + g_b) (1 with the gain errors off).
+    pub current_gain_ratio: f64,
 }
 
 impl Truth {
@@ -52,6 +54,14 @@ impl Truth {
             inverter_voltage: inv.dead_time * inv.switching_frequency * inv.dc_voltage
                 + inv.threshold_voltage,
             threshold_voltage: inv.threshold_voltage,
+            current_gain_ratio: {
+                let s = &p.current_sensor;
+                if s.enable_gain_error {
+                    (1.0 + s.gain_error_a) / (1.0 + s.gain_error_b)
+                } else {
+                    1.0
+                }
+            },
         }
     }
 }
@@ -297,7 +307,9 @@ pub fn identified_toml(input: &str, id: &Identification<f64>) -> Result<String, 
          # Relative 1-sigma statistical uncertainty: rs {:.2e}, ld {:.2e}, lq {:.2e}, \
          flux_linkage {:.2e}, inertia {:.2e}.\n\
          # Inverter voltage error {:.4} V per phase (threshold {:.4} V at {:.1} V DC link), \
-         saliency Lq/Ld {:.4}.\n",
+         saliency Lq/Ld {:.4}.\n\
+         # Current sensors' gain ratio k = {:.5} (1-sigma {:.1e}): phase a was divided by it, \
+         so the model is in phase b's scale, the drive's after its start-up gain calibration.\n",
         id.duration,
         c.rs,
         c.ld,
@@ -308,6 +320,8 @@ pub fn identified_toml(input: &str, id: &Identification<f64>) -> Result<String, 
         id.threshold_voltage,
         id.dc_voltage,
         id.saliency,
+        id.current_gain_ratio,
+        c.current_gain_ratio,
     );
     let body = toml::to_string(&doc).map_err(|e| SimConfigError::new("<config>", e.to_string()))?;
     Ok(head + &body)
@@ -316,7 +330,8 @@ pub fn identified_toml(input: &str, id: &Identification<f64>) -> Result<String, 
 /// One row of the identified-vs-truth comparison.
 #[derive(Clone, Debug, Serialize)]
 pub struct Comparison {
-    /// Parameter name (a `[model]` key, or `inverter_voltage`/`threshold_voltage`).
+    /// Parameter name (a `[model]` key, `inverter_voltage`/`threshold_voltage`, or
+    /// `current_gain_ratio`).
     pub parameter: &'static str,
     /// Identified value.
     pub identified: f64,
@@ -374,6 +389,12 @@ pub fn compare(id: &Identification<f64>, t: &Truth) -> Vec<Comparison> {
             id.threshold_voltage,
             t.threshold_voltage,
             c.inverter_voltage,
+        ),
+        rel(
+            "current_gain_ratio",
+            id.current_gain_ratio,
+            t.current_gain_ratio,
+            c.current_gain_ratio,
         ),
     ]
 }

@@ -469,7 +469,7 @@ const GAIN_CALIBRATION_MAX_HOLD_TIME: f64 = 0.2;
 /// c = 1.5·p²·λ̂a·λ̂f/R̂s (the back-EMF's q current through R̂s, electrical lag neglected):
 /// 2J/c when under-damped, 2J/(c − √(c² − 4JK)) otherwise. Friction is left out (it only
 /// damps more).
-fn swing_time_constant<T: Real>(m: &MachineModel<T>, i_d: T) -> T {
+pub(crate) fn swing_time_constant<T: Real>(m: &MachineModel<T>, i_d: T) -> T {
     let p2 = T::lit((m.pole_pairs as f64) * (m.pole_pairs as f64));
     let flux = crate::real::max(m.active_flux(i_d), T::lit(0.1) * m.flux_linkage);
     let c = T::lit(1.5) * p2 * flux * m.flux_linkage / m.rs;
