@@ -275,8 +275,9 @@ pub fn commission(
 }
 
 /// The configuration document `input` with its `[model]` table replaced by the identified
-/// model (the keys of `[motor]`, i.e. of [`MachineModel`]), headed by comments giving the
-/// uncertainties and the inverter's voltage error.
+/// model (the keys of `[motor]`, i.e. of [`MachineModel`]) and its `[inverter_model]` by the
+/// identified threshold voltage (for the drive's dead-time compensation), headed by comments
+/// giving the uncertainties, the inverter's voltage error and the sensors' gain ratio.
 pub fn identified_toml(input: &str, id: &Identification<f64>) -> Result<String, SimConfigError> {
     let mut doc: toml::Table = input
         .parse()
@@ -301,6 +302,15 @@ pub fn identified_toml(input: &str, id: &Identification<f64>) -> Result<String, 
         toml::Value::Integer(i64::from(m.pole_pairs)),
     );
     doc.insert("model".into(), toml::Value::Table(model));
+    // The identified threshold to the drive's dead-time compensation (its dead time is the
+    // configured one, as the procedure's); a slightly negative result (noise about a zero
+    // threshold) is written as 0, the least the compensation accepts.
+    let mut inverter_model = toml::Table::new();
+    inverter_model.insert(
+        "threshold_voltage".into(),
+        toml::Value::Float(id.threshold_voltage.max(0.0)),
+    );
+    doc.insert("inverter_model".into(), toml::Value::Table(inverter_model));
     let c = id.confidence;
     let head = format!(
         "# [model] identified by `fado-sim commission` (fado_core::commissioning) in {:.2} s.\n\

@@ -168,6 +168,26 @@ impl Default for BaselineSettings {
     }
 }
 
+/// `[inverter_model]`: what the drive's dead-time compensation is told of the inverter, as
+/// identified (e.g. by `fado_core::commissioning`) rather than derived from the plant.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct InverterModel {
+    /// Device threshold voltage V̂_th of the compensation, V (instead of `[inverter]
+    /// threshold_voltage` × `[mismatch] threshold_voltage_ratio`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub threshold_voltage: Option<f64>,
+}
+
+impl InverterModel {
+    fn validate(&self) -> Result<(), SimConfigError> {
+        if let Some(v) = self.threshold_voltage {
+            check::non_negative("threshold_voltage", v)?;
+        }
+        Ok(())
+    }
+}
+
 /// The drive's model of the plant as ratios to the true values (1 = matched). The robustness
 /// sweep of SPEC §7 varies these.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -254,6 +274,11 @@ pub struct SimConfig {
     /// the plant's (R̂s: Rs + r_on) times its `[mismatch]` ratio.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub model: Option<toml::Table>,
+    /// The drive's data of the inverter for its dead-time compensation, key by key; a key not
+    /// given is `[inverter]`'s times its `[mismatch]` ratio. `fado-sim commission` writes the
+    /// identified threshold voltage here.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub inverter_model: Option<InverterModel>,
     /// Injected faults (`crate::faults`). Default none.
     pub faults: FaultParams,
 }
@@ -275,6 +300,7 @@ impl Default for SimConfig {
             baselines: BaselineSettings::default(),
             mismatch: Mismatch::default(),
             model: None,
+            inverter_model: None,
             faults: FaultParams::default(),
         }
     }
@@ -321,6 +347,9 @@ impl SimConfig {
         self.mismatch
             .validate()
             .map_err(|e| e.in_section("mismatch"))?;
+        if let Some(im) = &self.inverter_model {
+            im.validate().map_err(|e| e.in_section("inverter_model"))?;
+        }
         crate::motor::validate_motor(&self.motor, self.inverter.dc_voltage).map_err(|e| {
             if e.key == "dc_voltage" {
                 SimConfigError::new("inverter.dc_voltage", e.message)
@@ -417,16 +446,22 @@ impl SimConfig {
     }
 
     /// The drive configuration: `[controller]` tuning, the drive's model, timing and the
-    /// dead-time compensation's inverter data from `[inverter]` (× `[mismatch]`).
+    /// dead-time compensation's inverter data from `[inverter]` (× `[mismatch]`), its
+    /// threshold voltage from `[inverter_model]` when that gives it.
     pub fn drive_config(&self) -> DriveConfig<f64> {
         let (inv, m) = (&self.inverter, &self.mismatch);
+        let threshold = self
+            .inverter_model
+            .as_ref()
+            .and_then(|im| im.threshold_voltage)
+            .unwrap_or(inv.threshold_voltage * m.threshold_voltage_ratio);
         DriveConfig {
             ts: inv.sample_period(),
             machine: self.machine_model(),
             tuning: DriveTuning {
                 dead_time: inv.dead_time * m.dead_time_ratio,
                 switching_frequency: inv.switching_frequency,
-                dead_time_threshold_voltage: inv.threshold_voltage * m.threshold_voltage_ratio,
+                dead_time_threshold_voltage: threshold,
                 dead_time_current_band: inv.current_band * m.current_band_ratio,
                 ..self.controller
             },
@@ -458,7 +493,18 @@ impl SimConfig {
             "pole_pairs" | "viscous_friction" | "rated_current" | "rated_speed_rpm"
             | "rated_torque" => Some(machine_key(field)),
             "dead_time" => Some("inverter.dead_time".to_owned()),
-            "dead_time_threshold_voltage" => Some("inverter.threshold_voltage".to_owned()),
+            "dead_time_threshold_voltage" => Some(
+                if self
+                    .inverter_model
+                    .as_ref()
+                    .is_some_and(|im| im.threshold_voltage.is_some())
+                {
+                    "inverter_model.threshold_voltage"
+                } else {
+                    "inverter.threshold_voltage"
+                }
+                .to_owned(),
+            ),
             "dead_time_current_band" => Some("inverter.current_band".to_owned()),
             "initial_angle" => Some("simulation.initial_angle".to_owned()),
             _ => None,
