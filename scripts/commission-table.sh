@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Accuracy table of `fado-sim commission`: every motor preset (motors/*.toml), sensor seeds 1-4,
-# identified vs truth (switching-resolved inverter, default non-idealities).
+# identified vs truth (switching-resolved inverter, default non-idealities); k is the current
+# sensors' gain ratio (1 + g_a)/(1 + g_b) the DC test measures (true 1.005 by default).
 set -euo pipefail
 bin=${FADO_SIM:-target/release/fado-sim}
 out=${1:-out/commission-table}
@@ -14,17 +15,18 @@ done
 python3 - "$out" <<'PY'
 import json, sys, glob, os
 out = sys.argv[1]
-print("| motor | seed | Rs | Ld | Lq | λf | J | B (N·m·s/rad) | V_th error (V) | time (s) |")
-print("|---|---|---|---|---|---|---|---|---|---|")
+print("| motor | seed | Rs | Ld | Lq | λf | J | B (N·m·s/rad) | V_th error (V) | k | time (s) |")
+print("|---|---|---|---|---|---|---|---|---|---|---|")
 for d in sorted(glob.glob(os.path.join(out, "*-[1-4]"))):
     m = json.load(open(os.path.join(d, "metrics.json")))
     name, seed = os.path.basename(d).rsplit("-", 1)
     if not m["passed"]:
-        print(f"| {name} | {seed} | {m['status']} | | | | | | | {m['simulated_seconds']:.2f} |")
+        print(f"| {name} | {seed} | {m['status']} | | | | | | | | {m['simulated_seconds']:.2f} |")
         continue
     p = {r["parameter"]: r for r in m["parameters"]}
     pc = lambda k: f"{100*p[k]['error']:+.2f} %"
     b = p["viscous_friction"]
     print(f"| {name} | {seed} | {pc('rs')} | {pc('ld')} | {pc('lq')} | {pc('flux_linkage')} | {pc('inertia')} "
-          f"| {b['identified']:.2e} (true {b['truth']:.1e}) | {p['threshold_voltage']['error']:+.3f} | {m['simulated_seconds']:.2f} |")
+          f"| {b['identified']:.2e} (true {b['truth']:.1e}) | {p['threshold_voltage']['error']:+.3f} "
+          f"| {pc('current_gain_ratio')} | {m['simulated_seconds']:.2f} |")
 PY
