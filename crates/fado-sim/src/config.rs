@@ -799,6 +799,36 @@ mod located_errors {
         assert_eq!((key.as_str(), line), ("simulation.duration", 2), "{msg}");
     }
 
+    /// `[inverter_model] threshold_voltage` (what `fado-sim commission` writes) replaces the
+    /// compensation's V̂th derived from `[inverter]` × `[mismatch]`; a bad one is refused by
+    /// its own key.
+    #[test]
+    fn the_inverter_model_sets_the_compensation_threshold() {
+        let cfg = SimConfig::from_toml(
+            "[inverter]\nthreshold_voltage = 1.0\n[mismatch]\nthreshold_voltage_ratio = 2.0\n",
+        )
+        .unwrap();
+        assert_eq!(cfg.drive_config().tuning.dead_time_threshold_voltage, 2.0);
+        let cfg = SimConfig::from_toml(
+            "[mismatch]\nthreshold_voltage_ratio = 2.0\n[inverter_model]\nthreshold_voltage = 0.93\n",
+        )
+        .unwrap();
+        assert_eq!(cfg.drive_config().tuning.dead_time_threshold_voltage, 0.93);
+        assert_eq!(cfg.inverter.threshold_voltage, 1.0);
+        let (key, line, col, _) = err("[inverter_model]\nthreshold_voltage = -0.1\n");
+        assert_eq!(
+            (key.as_str(), line, col),
+            ("inverter_model.threshold_voltage", 2, 21)
+        );
+        let (key, line, _, _) = err("[inverter_model]\nthreshold_voltage = nan\n");
+        assert_eq!(
+            (key.as_str(), line),
+            ("inverter_model.threshold_voltage", 2)
+        );
+        let (key, ..) = err("[inverter_model]\ndead_time = 1e-6\n");
+        assert_eq!(key, "inverter_model.dead_time");
+    }
+
     #[test]
     fn syntax_errors_are_located() {
         let (key, line, col, msg) = err("[motor]\nrs = 0.3\nlq = = 2\n");
