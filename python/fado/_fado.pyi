@@ -187,6 +187,7 @@ class EstimatorConfig:
         tracker_hold_ratio: float | None = None,
         average_current: bool | None = None,
         observer_on_rotor_flux: bool | None = None,
+        observer_lag_compensation: bool | None = None,
         rs_adaptation: bool | None = None,
         rs_adaptation_rate: float | None = None,
         rs_adaptation_excitation_floor: float | None = None,
@@ -222,6 +223,7 @@ class EstimatorConfig:
         tracker_hold_ratio: float | None = None,
         average_current: bool | None = None,
         observer_on_rotor_flux: bool | None = None,
+        observer_lag_compensation: bool | None = None,
         rs_adaptation: bool | None = None,
         rs_adaptation_rate: float | None = None,
         rs_adaptation_excitation_floor: float | None = None,
@@ -284,6 +286,9 @@ class EstimatorConfig:
     @property
     def observer_on_rotor_flux(self) -> bool:
         """Observer fed with λ1 − L̂q·i (fado's improvement) instead of λ1 (the paper)."""
+    @property
+    def observer_lag_compensation(self) -> bool:
+        """Observer speed ω̂1 plus T2S-1's low-passed Kp·e (fado's improvement); False = the paper's ω̂1."""
     @property
     def rs_adaptation(self) -> bool:
         """Adapt R̂s online (fado's extension, default True; False = the paper)."""

@@ -31,6 +31,7 @@ PAPER_DEFAULTS = {
     "tracker_hold_ratio": 0.2,  # SPEC §3 [A]
     "average_current": True,  # SPEC §1 [A]
     "observer_on_rotor_flux": True,  # fado's improvement [A]; False = paper's Fig. 5
+    "observer_lag_compensation": True,  # fado's improvement [A] (issue 13); False = the paper
     "rs_adaptation": True,  # fado's extension [A]; False = the paper's fixed R̂s
     "rs_adaptation_rate": 1.0,  # [A]
     "rs_adaptation_excitation_floor": 0.2,  # [A]

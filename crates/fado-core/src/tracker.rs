@@ -93,6 +93,7 @@ pub struct TypeTwoTracker<T> {
     /// θ̂: the angle estimate for the last sample.
     theta: T,
     omega: T,
+    rate: T,
 }
 
 impl<T: Real> TypeTwoTracker<T> {
@@ -120,6 +121,7 @@ impl<T: Real> TypeTwoTracker<T> {
             predicted: T::zero(),
             theta: T::zero(),
             omega: T::zero(),
+            rate: T::zero(),
         })
     }
 
@@ -133,6 +135,7 @@ impl<T: Real> TypeTwoTracker<T> {
         self.theta = wrap_angle(theta);
         self.predicted = self.theta;
         self.omega = omega;
+        self.rate = omega;
     }
 
     /// One sample with the measured angle θm (rad, any range). Returns (θ̂, ω̂).
@@ -165,6 +168,7 @@ impl<T: Real> TypeTwoTracker<T> {
             predicted: wrap_angle(theta + self.ts * omega),
             theta,
             omega,
+            rate: omega + self.kp * e,
         }
     }
 
@@ -176,6 +180,7 @@ impl<T: Real> TypeTwoTracker<T> {
             predicted: wrap_angle(theta + self.ts * self.omega),
             theta,
             omega: self.omega,
+            rate: self.omega,
         }
     }
 
@@ -185,6 +190,7 @@ impl<T: Real> TypeTwoTracker<T> {
         self.predicted = next.predicted;
         self.theta = next.theta;
         self.omega = next.omega;
+        self.rate = next.rate;
     }
 
     /// θ̂ for the last sample, in [−π, π].
@@ -205,6 +211,12 @@ impl<T: Real> TypeTwoTracker<T> {
         self.omega
     }
 
+    /// The rate of θ̂ over the last sample, ω̂ + Kp·e (rad/s).
+    #[inline]
+    pub fn phase_rate(&self) -> T {
+        self.rate
+    }
+
     /// (Kp, Ki) in use.
     pub fn gains(&self) -> (T, T) {
         (self.kp, self.ki_ts / self.ts)
@@ -220,6 +232,8 @@ pub(crate) struct TrackerState<T> {
     pub theta: T,
     /// ω̂.
     pub omega: T,
+    /// ω̂ + Kp·e.
+    pub rate: T,
 }
 
 #[cfg(test)]
