@@ -211,7 +211,9 @@ impl<T: Real> TypeTwoTracker<T> {
         self.omega
     }
 
-    /// The rate of θ̂ over the last sample, ω̂ + Kp·e (rad/s).
+    /// The rate of θ̂ over the last sample, ω̂ + Kp·e (rad/s; ω̂ after a reset or a coasting
+    /// sample). Under a constant acceleration α it is the input's rate, while ω̂ lags it by
+    /// Kp·α/Ki (see the module docs).
     #[inline]
     pub fn phase_rate(&self) -> T {
         self.rate
@@ -316,6 +318,14 @@ mod tests {
             (t.speed() - (w0 + alpha * tn - lag)).abs() < 0.02,
             "{}",
             t.speed()
+        );
+        // The rate of θ̂, ω̂ + Kp·e, does not lag (what the estimator's observer
+        // lag compensation uses): within 1 % of the lag.
+        assert!(
+            (t.phase_rate() - (w0 + alpha * tn)).abs() < 0.01 * lag,
+            "{} vs {}",
+            t.phase_rate(),
+            w0 + alpha * tn
         );
     }
 
