@@ -93,7 +93,6 @@ pub struct TypeTwoTracker<T> {
     /// θ̂: the angle estimate for the last sample.
     theta: T,
     omega: T,
-    rate: T,
 }
 
 impl<T: Real> TypeTwoTracker<T> {
@@ -121,7 +120,6 @@ impl<T: Real> TypeTwoTracker<T> {
             predicted: T::zero(),
             theta: T::zero(),
             omega: T::zero(),
-            rate: T::zero(),
         })
     }
 
@@ -135,7 +133,6 @@ impl<T: Real> TypeTwoTracker<T> {
         self.theta = wrap_angle(theta);
         self.predicted = self.theta;
         self.omega = omega;
-        self.rate = omega;
     }
 
     /// One sample with the measured angle θm (rad, any range). Returns (θ̂, ω̂).
@@ -168,7 +165,7 @@ impl<T: Real> TypeTwoTracker<T> {
             predicted: wrap_angle(theta + self.ts * omega),
             theta,
             omega,
-            rate: omega + self.kp * e,
+            innovation: e,
         }
     }
 
@@ -180,7 +177,7 @@ impl<T: Real> TypeTwoTracker<T> {
             predicted: wrap_angle(theta + self.ts * self.omega),
             theta,
             omega: self.omega,
-            rate: self.omega,
+            innovation: T::zero(),
         }
     }
 
@@ -190,7 +187,6 @@ impl<T: Real> TypeTwoTracker<T> {
         self.predicted = next.predicted;
         self.theta = next.theta;
         self.omega = next.omega;
-        self.rate = next.rate;
     }
 
     /// θ̂ for the last sample, in [−π, π].
@@ -211,12 +207,12 @@ impl<T: Real> TypeTwoTracker<T> {
         self.omega
     }
 
-    /// The rate of θ̂ over the last sample, ω̂ + Kp·e (rad/s; ω̂ after a reset or a coasting
-    /// sample). Under a constant acceleration α it is the input's rate, while ω̂ lags it by
-    /// Kp·α/Ki (see the module docs).
+    /// Kp in s⁻¹. The rate of θ̂ over a sample is ω̂ + Kp·e (θ̂⁻ advances by Ts·(ω̂ + Kp·e)):
+    /// under a constant acceleration α it is the input's rate, while ω̂ lags it by Kp·α/Ki
+    /// (see the module docs).
     #[inline]
-    pub fn phase_rate(&self) -> T {
-        self.rate
+    pub fn kp(&self) -> T {
+        self.kp
     }
 
     /// (Kp, Ki) in use.
@@ -234,8 +230,8 @@ pub(crate) struct TrackerState<T> {
     pub theta: T,
     /// ω̂.
     pub omega: T,
-    /// ω̂ + Kp·e.
-    pub rate: T,
+    /// The phase error e = wrap(θm − θ̂⁻) of this sample (0 when coasting).
+    pub innovation: T,
 }
 
 #[cfg(test)]
@@ -319,13 +315,17 @@ mod tests {
             "{}",
             t.speed()
         );
-        // The rate of θ̂, ω̂ + Kp·e, does not lag (what the estimator's observer
-        // lag compensation uses): within 1 % of the lag.
+        // The rate of θ̂, ω̂ + Kp·e (the advance of θ̂⁻ over one more sample, divided by Ts),
+        // does not lag (what the estimator's observer lag compensation uses): within 1 % of
+        // the lag, against the input's rate half a sample later (the trapezoid of θ̂⁻).
+        let before = t.predicted_angle();
+        let th = w0 * (tn + ts) + 0.5 * alpha * (tn + ts) * (tn + ts);
+        t.step(wrap_angle(th)).unwrap();
+        let rate = wrap_angle(t.predicted_angle() - before) / ts;
         assert!(
-            (t.phase_rate() - (w0 + alpha * tn)).abs() < 0.01 * lag,
-            "{} vs {}",
-            t.phase_rate(),
-            w0 + alpha * tn
+            (rate - (w0 + alpha * (tn + ts))).abs() < 0.01 * lag,
+            "{rate} vs {}",
+            w0 + alpha * (tn + ts)
         );
     }
 
