@@ -484,18 +484,18 @@ pub struct Metrics {
     /// First time the drive reported the rotor lost (`DriveFlags::LOCK_LOST`), s.
     pub lock_lost_time: Option<f64>,
     /// Onset of the loss, s: the first time |θ − θ̂| exceeded 0.5 rad in the excursion (from
-    /// the last time below 0.25 rad on) that first took it beyond 1 rad (None: it never
-    /// exceeded 1 rad). Equal to `angle_error_exceeded_time` unless an earlier excursion
-    /// beyond 0.5 rad came back below 0.25 rad.
+    /// the last time it had settled below 0.25 rad, i.e. stayed there for 0.1 s, on) that
+    /// first took it beyond 1 rad (None: it never exceeded 1 rad). Equal to
+    /// `angle_error_exceeded_time` unless an earlier excursion beyond 0.5 rad settled again.
     pub loss_onset_time: Option<f64>,
     /// The last time |θ − θ̂| was below 0.25 rad before that onset, s (None: never).
     pub loss_settled_time: Option<f64>,
     /// If `LOCK_LOST` (a live status) is up 20 ms after the onset: the time it last rose
     /// minus the onset, s (negative: raised before the error reached 0.5 rad; docs/lock.md
-    /// counts it as a detection if it rose less than 0.5 s before). None: down then.
+    /// counts it as a detection if it rose less than 1 s before). None: down then.
     pub lock_detection_delay: Option<f64>,
-    /// First rise of `LOCK_LOST` at or after the onset, while the error has not come back
-    /// below 0.25 rad, minus the onset, s (the late detections). None: no rise.
+    /// First rise of `LOCK_LOST` at or after the onset, while the error has not settled
+    /// below 0.25 rad again, minus the onset, s (the late detections). None: no rise.
     pub lock_late_delay: Option<f64>,
     #[serde(skip)]
     loss: LossTracker,
@@ -565,11 +565,20 @@ impl Probe for Metrics {
 /// Angle-error thresholds and deadline of the loss-of-lock evaluation (issue 14, docs/lock.md):
 /// an excursion starts when |θ − θ̂| leaves 0.25 rad (the clean-run level), the loss's onset is
 /// its first crossing of 0.5 rad, it is a loss if it then exceeds 1 rad, and the flag must be
-/// up 20 ms after the onset.
+/// up 20 ms after the onset. An excursion ends when the error has stayed below 0.25 rad for
+/// [`LOSS_SETTLE_TIME`].
 const LOSS_START: f64 = 0.5;
 const LOSS_LOST: f64 = 1.0;
 const LOSS_SETTLED: f64 = 0.25;
 const LOSS_DEADLINE: f64 = 0.020;
+/// How long |θ − θ̂| must stay below [`LOSS_SETTLED`] for an excursion to end, s: 0.1 s (the
+/// detector's default healing time). An estimate that slips poles makes the *wrapped* error
+/// pass through zero once per slip cycle; that is no return to lock. Below 0.25 rad for
+/// 0.1 s at a time means a slip slower than 0.5 rad / 0.1 s = 5 rad/s electrical (12 r/min
+/// mechanical on the paper's 4 pole pairs), i.e. the estimate following the rotor. (Without
+/// the dwell, 8 fixed-R̂s losses of the fig11 envelope ended their excursion in a wrap before
+/// the deadline and counted as "not raised" with the flag up throughout; docs/lock.md.)
+const LOSS_SETTLE_TIME: f64 = 0.1;
 
 /// An excursion of |θ − θ̂| above [`LOSS_SETTLED`] that reached [`LOSS_START`].
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -592,10 +601,12 @@ struct LossTracker {
     last_rise: Option<f64>,
     /// Last time below 0.25 rad.
     settled: f64,
+    /// Since when the error has been below 0.25 rad (NaN: above it now).
+    below_since: f64,
     /// The open excursion that reached 0.5 rad, if any.
     current: Option<Excursion>,
-    /// The excursion that first exceeded 1 rad; `open` until the error is below 0.25 rad
-    /// again.
+    /// The excursion that first exceeded 1 rad; `open` until the error has been below
+    /// 0.25 rad for [`LOSS_SETTLE_TIME`] again.
     loss: Option<Excursion>,
     open: bool,
 }
@@ -606,6 +617,7 @@ impl Default for LossTracker {
             flag: false,
             last_rise: None,
             settled: f64::NEG_INFINITY,
+            below_since: f64::NAN,
             current: None,
             loss: None,
             open: false,
@@ -624,8 +636,15 @@ impl LossTracker {
         if let Some(e) = error {
             if e < LOSS_SETTLED {
                 self.settled = t;
-                self.current = None;
-                self.open = false;
+                if self.below_since.is_nan() {
+                    self.below_since = t;
+                }
+                if t - self.below_since >= LOSS_SETTLE_TIME {
+                    self.current = None;
+                    self.open = false;
+                }
+            } else {
+                self.below_since = f64::NAN;
             }
             if e > LOSS_START {
                 self.current.get_or_insert(Excursion {
@@ -1119,6 +1138,25 @@ mod tests {
         assert_eq!(x.up_at_deadline, Some(None));
         // Never beyond 1 rad: no loss.
         assert!(run(&|_| 0.7, (0.0, 9.0), 1.0).loss.is_none());
+        // An estimate slipping poles (the error growing at 300 rad/s from 1.2 s on, its
+        // wrapped value through zero every 21 ms, first at 1.220 s, before the deadline): one
+        // excursion, not ended by the wrapped error passing below 0.25 rad for 2 ms at a
+        // time; the flag up since 1.0 s is up at its deadline. Only 0.1 s below 0.25 rad ends
+        // it.
+        let slip = |t: f64| {
+            if t < 1.2 {
+                0.0
+            } else {
+                fado_core::wrap_angle(0.3 + 300.0 * (t - 1.2)).abs()
+            }
+        };
+        let x = run(&slip, (1.0, 9.0), 3.0).loss.unwrap();
+        assert!((x.onset - 1.201).abs() < 1e-9, "{x:?}");
+        assert_eq!(x.up_at_deadline, Some(Some(1.0)));
+        let settles = |t: f64| if (1.5..1.7).contains(&t) { 0.1 } else { slip(t) };
+        let l = run(&settles, (1.0, 1.25), 3.0);
+        assert!(!l.open, "{l:?}"); // settled at 1.6 s: the loss is over
+        assert_eq!(l.loss.unwrap().first_rise, None);
     }
 
     #[test]
