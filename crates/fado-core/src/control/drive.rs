@@ -231,6 +231,14 @@ pub struct DriveTuning<T> {
     /// of the stall symptom on the fig11 envelope was one of these (|n̂| 12–25 r/min,
     /// docs/lock.md), every loss it caught had ω̂ stuck near zero or turning the wrong way.
     pub lock_stall_max_speed_ratio: T,
+    /// The stall symptom counts only while the speed loop asks for a torque: |i_q*| at least
+    /// this multiple of the rated current. Default 0.15 \[A\] (see docs/lock.md). A lost
+    /// estimate shows on the mechanical side through the torque the drive commands and the
+    /// rotor does not answer; with next to no torque commanded the rotor's motion is the
+    /// load's and the inertia's, and a swing of ω̂ past the band is no evidence against the
+    /// angle (every false alarm of the symptom without the speed restriction on the fig11
+    /// envelope had |i_q*| below 0.1 of rated, every loss it caught above 0.25). 0: always.
+    pub lock_stall_min_current_ratio: T,
 }
 
 impl<T: Real> DriveTuning<T> {
@@ -282,6 +290,7 @@ impl<T: Real> DriveTuning<T> {
             lock_stall_time: U::lit(self.lock_stall_time.to_f64()),
             lock_stall_heal_time: U::lit(self.lock_stall_heal_time.to_f64()),
             lock_stall_max_speed_ratio: U::lit(self.lock_stall_max_speed_ratio.to_f64()),
+            lock_stall_min_current_ratio: U::lit(self.lock_stall_min_current_ratio.to_f64()),
         }
     }
 }
@@ -332,6 +341,7 @@ impl<T: Real> Default for DriveTuning<T> {
             lock_stall_time: T::lit(5e-3),
             lock_stall_heal_time: T::lit(0.1),
             lock_stall_max_speed_ratio: T::lit(0.0075),
+            lock_stall_min_current_ratio: T::lit(0.15),
         }
     }
 }
@@ -516,6 +526,8 @@ struct Resolved<T> {
     stall_heal_samples: u32,
     /// The stall symptom counts below this |ω̂| (electrical rad/s; ∞: always).
     stall_max_speed: T,
+    /// The stall symptom counts from this |i_q*| on (A).
+    stall_min_current: T,
     /// Phase currents beyond ± this (A) are refused as implausible.
     plausible_current: T,
     /// DC-link readings above this (V) are refused as implausible.
@@ -570,6 +582,10 @@ impl<T: Real> Resolved<T> {
                 r if r == T::zero() => T::lit(f64::INFINITY),
                 r => r * c.machine.rated_speed(),
             },
+            stall_min_current: check::non_negative(
+                "lock_stall_min_current_ratio",
+                t.lock_stall_min_current_ratio,
+            )? * rated,
             plausible_current: t.plausible_current_ratio * t.trip_current_ratio * rated,
             dc_link_max_voltage: t.dc_link_max_ratio * c.machine.dc_voltage,
             mtpa: t.mtpa && c.machine.is_salient(),
@@ -1378,8 +1394,9 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         // (armed once |ω* − ω̂| was within the band since the last start), although its
         // current reference is below the limit (at the limit, a speed error is the machine's
         // torque limit, not evidence against the estimate; within 1 % counts as at the
-        // limit), while ω̂ is near zero or turns against ω* (see
-        // `DriveTuning::lock_stall_max_speed_ratio`).
+        // limit) and it asks for a torque (see `DriveTuning::lock_stall_min_current_ratio`),
+        // while ω̂ is near zero or turns against ω* (`DriveTuning::lock_stall_max_speed_ratio`;
+        // off by default).
         let speed_ref = speed_ref_mech * T::lit(self.config.machine.pole_pairs as f64);
         let off_reference = (speed_ref - omega_ctrl).abs() > self.resolved.stall_speed;
         self.stall_armed |= !off_reference && !self.lock.coasting();
@@ -1388,6 +1405,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             && (omega_ctrl.abs() < self.resolved.stall_max_speed
                 || omega_ctrl * speed_ref < T::zero())
             && diag.mode == Mode::Limiter
+            && self.last.i_dq_ref.q.abs() >= self.resolved.stall_min_current
             && self.last.i_dq_ref.norm() < self.resolved.i_max * T::lit(0.99);
         let stalled = self.stall.step(stall_now);
         let lost = diag.lock == LockStatus::Lost || stalled;
