@@ -227,15 +227,19 @@ pub struct EstimatorTuning<T> {
     /// [`plausibility::STEP_RATIO`] (2) \[A\].
     pub plausible_current_step_ratio: T,
     /// Loss of lock (see [`crate::lock`]): |λ̂r| below this multiple of λ̂f is a symptom.
-    /// Default 0.7 \[A\] (chosen on the fig11 envelope sweep, docs/lock.md).
+    /// Default 0.65 \[A\] (chosen on the fig11 envelope sweeps, docs/lock.md: 0.7 flagged a
+    /// run that passes the paper's criteria, |λ̂r| 0.69·λ̂f in limiter mode at 15–20 r/min with
+    /// a 0.30 rad error; with the drive's stall symptom as it now is, 0.65 detects as many
+    /// losses).
     pub lock_flux_low_ratio: T,
     /// Loss of lock: |λ̂r| above this multiple of λ̂f is a symptom; 0 switches it off.
-    /// Default 1.4 \[A\]: above the limiter circle (1.15) and the 1.20–1.22·λ̂f overshoot
+    /// Default 1.5 \[A\]: above the limiter circle (1.15) and the 1.20–1.22·λ̂f overshoot
     /// after a limiter → k_df hand-over in runs that keep the rotor (a bound of 1.2
-    /// false-alarmed there, 1.3 still 2–3 times per 400 runs), below the 1.4–1.6·λ̂f of a
-    /// fixed-R̂s drive that an active load runs away with in k_df mode (docs/lock.md: 1.4
-    /// instead of 2 detects 14 more of 208 fixed-R̂s losses, no false alarm more). The voltage
-    /// of a machine turning the other way gives 1.3–4.8·λ̂f.
+    /// false-alarmed there, 1.3 still 2–3 times per 400 runs, 1.4 once per 400 after the
+    /// reversal, |λ̂r| 1.41·λ̂f with a 0.26 rad error), within the 1.4–1.6·λ̂f of a fixed-R̂s
+    /// drive that an active load runs away with in k_df mode (those losses the drive's stall
+    /// symptom now sees too: 1.5 detects as many as 1.4, docs/lock.md). The voltage of a
+    /// machine turning the other way gives 1.3–4.8·λ̂f.
     pub lock_flux_high_ratio: T,
     /// Loss of lock: a T2S-1 innovation |θm − θ̂⁻| above this (rad) is a symptom. Default
     /// 0.5 rad \[A\] (the angle error the drive must not reach, docs/lock.md).
@@ -328,8 +332,8 @@ impl<T: Real> Default for EstimatorTuning<T> {
             plausible_current_ratio: T::lit(plausibility::CURRENT_RATIO),
             plausible_voltage_ratio: T::lit(plausibility::VOLTAGE_RATIO),
             plausible_current_step_ratio: T::lit(plausibility::STEP_RATIO),
-            lock_flux_low_ratio: T::lit(0.7),
-            lock_flux_high_ratio: T::lit(1.4),
+            lock_flux_low_ratio: T::lit(0.65),
+            lock_flux_high_ratio: T::lit(1.5),
             lock_innovation_limit: T::lit(0.5),
             lock_detection_time: T::lit(5e-3),
             lock_heal_time: T::lit(0.1),

@@ -608,18 +608,22 @@ fn status_word_reports_dc_link_low_and_persistent_bad_input_trips_and_is_counted
 
 /// The stall symptom of the loss-of-lock detection (`DriveTuning::lock_stall_speed_ratio`):
 /// a spy estimator in limiter mode that reports a standing rotor. Not armed until the speed
-/// loop has caught its reference; then a reference beyond the band (7.5 r/min on the paper's
-/// motor) for `lock_stall_time` (50 samples) raises `LOCK_LOST`, a live status that clears
-/// after `lock_stall_heal_time` without the condition (or at `align`);
-/// a speed error with the current reference at its limit does not; ratio 0 never does.
+/// loop has caught its reference; then a reference beyond the band (6 r/min on the paper's
+/// motor) for `lock_stall_time` (50 samples) while the speed loop asks for at least
+/// `lock_stall_min_current_ratio` (0.2) of the rated current raises `LOCK_LOST`, a live status
+/// that clears after `lock_stall_heal_time` without the condition (or at `align`); a speed
+/// error with the current reference at its limit does not; ratio 0 never does.
 #[test]
 fn stall_symptom_flags_a_lost_reference_below_the_current_limit() {
+    // (first sample with LOCK_LOST, first sample with |i_q*| ≥ 0.2·rated, the drive)
     let run = |tune: &dyn Fn(&mut DriveConfig<f64>), refs: &[(usize, f64)]| {
         let mut c = synthetic_currents();
         tune(&mut c);
+        let gate = 0.2 * c.machine.rated_current;
         let mut drive = SensorlessDrive::with_estimator(c, Spy::default()).unwrap();
         drive.align(0.0);
         let mut first = None;
+        let mut torque = None;
         let mut n = 0;
         for &(samples, speed) in refs {
             for _ in 0..samples {
@@ -627,23 +631,40 @@ fn stall_symptom_flags_a_lost_reference_below_the_current_limit() {
                 if first.is_none() && out.flags.contains(DriveFlags::LOCK_LOST) {
                     first = Some(n);
                 }
+                if torque.is_none() && out.i_dq_ref.q.abs() >= gate {
+                    torque = Some(n);
+                }
                 n += 1;
             }
         }
-        (first, drive)
+        (first, torque, drive)
     };
-    // The band is 0.005 × 1500 r/min = 7.5 r/min = 0.785 rad/s (the drive's reference is in
+    // The band is 0.004 × 1500 r/min = 6 r/min = 0.63 rad/s (the drive's reference is in
     // mechanical rad/s); the current limit is raised so that the speed loop's reference
-    // for a 1 rad/s error stays below it.
+    // for the errors below stays below it.
     let high_limit = |c: &mut DriveConfig<f64>| {
         c.tuning.current_limit_ratio = 100.0;
         c.tuning.trip_current_ratio = 200.0;
     };
-    // Never caught (1 rad/s from the first sample): not armed, no flag.
-    assert_eq!(run(&high_limit, &[(500, 1.0)]).0, None);
-    // Caught at 0, then 1 rad/s: flagged after 50 samples in a row.
-    let (first, mut drive) = run(&high_limit, &[(20, 0.0), (200, 1.0)]);
-    assert_eq!(first, Some(20 + 49), "{first:?}");
+    // Never caught (8 rad/s from the first sample): not armed, no flag.
+    assert_eq!(run(&high_limit, &[(500, 8.0)]).0, None);
+    // Caught at 0, then 8 rad/s: the speed loop asks for more than 0.2·rated at once (its
+    // proportional part; the symptom reads the reference of the sample before): flagged
+    // after 50 samples of both.
+    let (first, torque, mut drive) = run(&high_limit, &[(20, 0.0), (200, 8.0)]);
+    assert_eq!(torque, Some(20), "{torque:?}");
+    assert_eq!(first, Some(20 + 50), "{first:?}");
+    // 4 rad/s: beyond the band, but the loop asks for less than 0.2·rated until its integral
+    // has grown; the symptom counts from then on (without the gate: after 50 samples).
+    let (first, torque, _) = run(&high_limit, &[(20, 0.0), (3000, 4.0)]);
+    let torque = torque.expect("the integral reaches the gate");
+    assert!(torque > 20 + 100, "{torque}");
+    assert_eq!(first, Some(torque + 50), "{first:?} {torque}");
+    let no_gate = |c: &mut DriveConfig<f64>| {
+        high_limit(c);
+        c.tuning.lock_stall_min_current_ratio = 0.0;
+    };
+    assert_eq!(run(&no_gate, &[(20, 0.0), (200, 4.0)]).0, Some(20 + 49));
     // A live status: still up while the condition has been gone for less than
     // `lock_stall_heal_time` (0.1 s = 1000 samples, net of the 200 − 49 symptomatic samples
     // after the rise, capped at the healing count), clear after it; align clears it at once.
@@ -661,7 +682,7 @@ fn stall_symptom_flags_a_lost_reference_below_the_current_limit() {
         }
     }
     assert_eq!(cleared, Some(heal), "{cleared:?}");
-    let (_, mut drive) = run(&high_limit, &[(20, 0.0), (200, 1.0)]);
+    let (_, _, mut drive) = run(&high_limit, &[(20, 0.0), (200, 8.0)]);
     drive.align(0.0);
     assert!(
         !drive
@@ -670,7 +691,7 @@ fn stall_symptom_flags_a_lost_reference_below_the_current_limit() {
             .contains(DriveFlags::LOCK_LOST)
     );
     // Within the band: nothing.
-    assert_eq!(run(&high_limit, &[(20, 0.0), (500, 0.7)]).0, None);
+    assert_eq!(run(&high_limit, &[(20, 0.0), (500, 0.5)]).0, None);
     // At the current limit (a large error saturates the default limit): nothing.
     assert_eq!(run(&|_| {}, &[(20, 0.0), (500, 1000.0)]).0, None);
     // Off.
@@ -678,5 +699,5 @@ fn stall_symptom_flags_a_lost_reference_below_the_current_limit() {
         high_limit(c);
         c.tuning.lock_stall_speed_ratio = 0.0;
     };
-    assert_eq!(run(&off, &[(20, 0.0), (500, 1.0)]).0, None);
+    assert_eq!(run(&off, &[(20, 0.0), (500, 8.0)]).0, None);
 }

@@ -209,10 +209,12 @@ pub struct DriveTuning<T> {
     pub lock_recovery_rs_adaptation: bool,
     /// Stall symptom of the loss-of-lock detection (see [`crate::lock`], "speed-loop stall"):
     /// in limiter mode, a speed error |ω* − ω̂| above this multiple of the rated speed for
-    /// `lock_stall_time` raises `LOCK_LOST` like the estimator's own verdict. Default 0.005
-    /// \[A\] (7.5 r/min at 1500 r/min rated, a third of the default Fig. 3 threshold
-    /// `mode_threshold_ratio` 0.015; chosen on the fig11 envelope, docs/lock.md: 0.004
-    /// false-alarms 3× more, 0.006 detects 5 points less); 0 disables.
+    /// `lock_stall_time` raises `LOCK_LOST` like the estimator's own verdict. Default 0.004
+    /// \[A\] (6 r/min at 1500 r/min rated, a quarter of the default Fig. 3 threshold
+    /// `mode_threshold_ratio` 0.015; chosen on the fig11 envelope with the current gate
+    /// `lock_stall_min_current_ratio`, docs/lock.md: 0.005 reaches the band 20–60 ms after
+    /// the error passes 0.5 rad in 10 of 208 fixed-R̂s losses, 0.0035 false-alarms in runs
+    /// that pass the paper's criteria); 0 disables.
     pub lock_stall_speed_ratio: T,
     /// Net time (s) the stall condition must hold (up/down count, [`crate::lock::Debouncer`]).
     /// Default 5 ms \[A\] (the estimator's
@@ -222,22 +224,24 @@ pub struct DriveTuning<T> {
     /// a live status like the estimator's, see [`crate::lock::Debouncer`]; the reaction
     /// latches). Default 0.1 s \[A\] (the estimator's `lock_heal_time`).
     pub lock_stall_heal_time: T,
-    /// The stall symptom counts only where the estimate cannot see the angle: while |ω̂| is
-    /// below this multiple of the rated speed, or while ω̂ turns against ω*; 0: at any speed.
-    /// Default 0.0075 \[A\] (11 r/min at 1500 r/min rated: half the default Fig. 3 mode
-    /// threshold `mode_threshold_ratio` 0.015, the band in which the voltage model has next to
-    /// no back-EMF). Near the mode threshold the speed loop lags a ramp through the limiter ↔
-    /// k_df hand-over, and after a swing of ω̂ it overshoots the reference; every false alarm
-    /// of the stall symptom on the fig11 envelope was one of these (|n̂| 12–25 r/min,
-    /// docs/lock.md), every loss it caught had ω̂ stuck near zero or turning the wrong way.
+    /// The stall symptom counts only while |ω̂| is below this multiple of the rated speed, or
+    /// while ω̂ turns against ω*; 0: at any speed. Default 0 (off) \[A\]. The first round's
+    /// false alarms of the symptom (|n̂| 12–25 r/min around the limiter ↔ k_df hand-over)
+    /// were swings of ω̂ at light load; the current gate `lock_stall_min_current_ratio`
+    /// removes them without this restriction, which missed the losses in which ω̂ sticks
+    /// at 12–20 r/min while the reference passes (docs/lock.md: 0.0075 detects 81.7 % of the
+    /// fixed-R̂s losses, off 94.2 %, both at the 0.005 band).
     pub lock_stall_max_speed_ratio: T,
     /// The stall symptom counts only while the speed loop asks for a torque: |i_q*| at least
-    /// this multiple of the rated current. Default 0.15 \[A\] (see docs/lock.md). A lost
+    /// this multiple of the rated current. Default 0.2 \[A\] (docs/lock.md). A lost
     /// estimate shows on the mechanical side through the torque the drive commands and the
     /// rotor does not answer; with next to no torque commanded the rotor's motion is the
     /// load's and the inertia's, and a swing of ω̂ past the band is no evidence against the
-    /// angle (every false alarm of the symptom without the speed restriction on the fig11
-    /// envelope had |i_q*| below 0.1 of rated, every loss it caught above 0.25). 0: always.
+    /// angle. On the fig11 envelope every false alarm of the symptom without the speed
+    /// restriction had |i_q*| of 0.05–0.15 of rated (light loads; the lag of ω̂ behind the
+    /// ramp at the limiter → k_df hand-over after the reversal, one at start-up), every
+    /// loss it caught that the restriction had missed 0.26 or more; 0.15 still false-alarmed
+    /// at 0.151 (docs/lock.md). 0: always.
     pub lock_stall_min_current_ratio: T,
 }
 
@@ -337,11 +341,11 @@ impl<T: Real> Default for DriveTuning<T> {
             lock_recovery_timeout: T::lit(0.5),
             lock_recovery_attempts: 3,
             lock_recovery_rs_adaptation: true,
-            lock_stall_speed_ratio: T::lit(0.005),
+            lock_stall_speed_ratio: T::lit(0.004),
             lock_stall_time: T::lit(5e-3),
             lock_stall_heal_time: T::lit(0.1),
-            lock_stall_max_speed_ratio: T::lit(0.0075),
-            lock_stall_min_current_ratio: T::lit(0.15),
+            lock_stall_max_speed_ratio: T::lit(0.0),
+            lock_stall_min_current_ratio: T::lit(0.2),
         }
     }
 }
