@@ -227,10 +227,12 @@ pub struct EstimatorTuning<T> {
     /// [`plausibility::STEP_RATIO`] (2) \[A\].
     pub plausible_current_step_ratio: T,
     /// Loss of lock (see [`crate::lock`]): |λ̂r| below this multiple of λ̂f is a symptom.
-    /// Default 0.65 \[A\] (chosen on the fig11 envelope sweeps, docs/lock.md: 0.7 flagged a
-    /// run that passes the paper's criteria, |λ̂r| 0.69·λ̂f in limiter mode at 15–20 r/min with
-    /// a 0.30 rad error; with the drive's stall symptom as it now is, 0.65 detects as many
-    /// losses).
+    /// Default 0.7 \[A\] (chosen on the fig11 envelope sweep, docs/lock.md). 0.65 detects as
+    /// many losses and flags one run fewer that passes the paper's criteria, but no longer
+    /// flags the start-up of fig11 with R̂s +10 % (|λ̂r| down to 0.68·λ̂f at 0.30–0.37 s), the flag
+    /// with which the `recover` reaction switches the R̂s adaptation on in time for the
+    /// loaded reversal; flagged only at the loss, that run coasts under its active load and
+    /// runs away.
     pub lock_flux_low_ratio: T,
     /// Loss of lock: |λ̂r| above this multiple of λ̂f is a symptom; 0 switches it off.
     /// Default 1.5 \[A\]: above the limiter circle (1.15) and the 1.20–1.22·λ̂f overshoot
@@ -332,7 +334,7 @@ impl<T: Real> Default for EstimatorTuning<T> {
             plausible_current_ratio: T::lit(plausibility::CURRENT_RATIO),
             plausible_voltage_ratio: T::lit(plausibility::VOLTAGE_RATIO),
             plausible_current_step_ratio: T::lit(plausibility::STEP_RATIO),
-            lock_flux_low_ratio: T::lit(0.65),
+            lock_flux_low_ratio: T::lit(0.7),
             lock_flux_high_ratio: T::lit(1.5),
             lock_innovation_limit: T::lit(0.5),
             lock_detection_time: T::lit(5e-3),

@@ -22,12 +22,14 @@
 //!    "phase detector" lock indicator of PLL practice (Gardner, *Phaselock Techniques*, 3rd
 //!    ed., ch. 8, lock detection).
 //!
-//! The upper half of symptom 1 (|λ̂r| above the band) is set wide by default (2·λ̂f, gross
-//! inconsistency only): on the fig11 envelope a tight bound's alarms came from the |λ̂r|
-//! overshoot after a limiter → k_df hand-over in runs that kept the rotor (docs/lock.md). Near zero speed, where a surface-magnet rotor's angle
-//! is not observable from v and i, a loss shows first on the mechanical side; the drive adds
-//! that symptom (a speed-loop stall in limiter mode, `DriveTuning::lock_stall_speed_ratio`,
-//! see [`crate::control::SensorlessDrive`]) and raises `LOCK_LOST` on either.
+//! The upper half of symptom 1 (|λ̂r| above the band) is set wide by default (1.5·λ̂f): on
+//! the fig11 envelope a tight bound's alarms came from the |λ̂r| overshoot after a limiter →
+//! k_df hand-over in runs that kept the rotor (docs/lock.md). Near zero speed, where a
+//! surface-magnet rotor's angle is not observable from v and i (an integrand error ΔR̂s·i
+//! along q̂ turns λ̂r without changing |λ̂r|), a loss shows first on the mechanical side; the
+//! drive adds that symptom (a speed-loop stall in limiter mode while the loop commands a
+//! torque, `DriveTuning::lock_stall_speed_ratio` and `lock_stall_min_current_ratio`, see
+//! [`crate::control::SensorlessDrive`]) and raises `LOCK_LOST` on either.
 //!
 //! The verdicts feed an up/down debouncing counter (the counter-based debouncing of AUTOSAR
 //! DEM, "Specification of Diagnostic Event Manager", §7.7.4.1, with its separate "passed"

@@ -1153,7 +1153,13 @@ mod tests {
         let x = run(&slip, (1.0, 9.0), 3.0).loss.unwrap();
         assert!((x.onset - 1.201).abs() < 1e-9, "{x:?}");
         assert_eq!(x.up_at_deadline, Some(Some(1.0)));
-        let settles = |t: f64| if (1.5..1.7).contains(&t) { 0.1 } else { slip(t) };
+        let settles = |t: f64| {
+            if (1.5..1.7).contains(&t) {
+                0.1
+            } else {
+                slip(t)
+            }
+        };
         let l = run(&settles, (1.0, 1.25), 3.0);
         assert!(!l.open, "{l:?}"); // settled at 1.6 s: the loss is over
         assert_eq!(l.loss.unwrap().first_rise, None);
