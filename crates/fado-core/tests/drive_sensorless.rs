@@ -665,6 +665,34 @@ fn stall_symptom_flags_a_lost_reference_below_the_current_limit() {
         c.tuning.lock_stall_min_current_ratio = 0.0;
     };
     assert_eq!(run(&no_gate, &[(20, 0.0), (200, 4.0)]).0, Some(20 + 49));
+    // The gate is a ratio of the machine's rating: on the 2.2 kW IPMSM (6 A rated, so 1.2 A;
+    // salient, its speed loop scaled by λ̂f/λ̂a) the same 4 rad/s error counts from the sample
+    // its smaller i_q* reaches 0.2·6 A on.
+    let ipmsm = |c: &mut DriveConfig<f64>| {
+        let machine = MachineModel {
+            rs: 3.6,
+            ld: 36e-3,
+            lq: 51e-3,
+            flux_linkage: 0.545,
+            pole_pairs: 3,
+            inertia: 0.02,
+            viscous_friction: 2e-3,
+            rated_current: 6.0,
+            rated_speed_rpm: 1500.0,
+            rated_torque: 14.9,
+            dc_voltage: 540.0,
+        };
+        let mut d = DriveConfig::for_machine(&machine);
+        d.tuning.offset_calibration_time = 0.0;
+        d.tuning.gain_calibration_time = 0.0;
+        d.tuning.stuck_sensor_time = 0.0;
+        *c = d;
+        high_limit(c);
+    };
+    let (first, torque, _) = run(&ipmsm, &[(20, 0.0), (3000, 4.0)]);
+    let torque = torque.expect("the integral reaches the gate");
+    assert!(torque > 20, "{torque}");
+    assert_eq!(first, Some(torque + 50), "{first:?} {torque}");
     // A live status: still up while the condition has been gone for less than
     // `lock_stall_heal_time` (0.1 s = 1000 samples, net of the 200 − 49 symptomatic samples
     // after the rise, capped at the healing count), clear after it; align clears it at once.
