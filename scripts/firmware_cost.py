@@ -26,6 +26,7 @@ Not modelled: interrupt entry/exit (12 cycles, + lazy FPU stacking), flash wait 
 contention, load-use and FPU register hazards.
 """
 
+import os
 import re
 import subprocess
 import sys
@@ -200,8 +201,9 @@ def cycles(mnem, ops, taken, prev_single_ls):
     return 1, False
 
 
-def inline_files(elf, addrs, symbol_of):
-    """{address: innermost fado source 'file:function'} via addr2line -i."""
+def inline_files(elf, addrs, symbol_of, lines=False):
+    """{address: innermost fado-core source file (or 'file:line' with `lines`)} via
+    addr2line -i."""
     if not addrs:
         return {}
     out = subprocess.run(
@@ -219,7 +221,9 @@ def inline_files(elf, addrs, symbol_of):
         # Innermost frame that lies in fado-core (frames are listed innermost first).
         for func, loc in frames:
             if "fado-core/src/" in loc:
-                label = loc.split("fado-core/src/")[1].split(":")[0]
+                label = loc.split("fado-core/src/")[1].split(" ")[0]
+                if not lines:
+                    label = label.split(":")[0]
                 break
         else:
             label = symbol_of.get(cur, "other")
@@ -241,7 +245,7 @@ def inline_files(elf, addrs, symbol_of):
     return result
 
 
-def trace(elf, root, path, tail):
+def trace(elf, root, path, tail, lines=False):
     insns, funcs = disassemble(elf)
     entry = funcs[root][0]
     marker = funcs["scenario_marker"][0] if "scenario_marker" in funcs else None
@@ -271,7 +275,7 @@ def trace(elf, root, path, tail):
         steps.append(current)
     scenarios = [s for s in scenarios if s]
     pcs = sorted({pc for s in scenarios for st in s[-tail:] for pc in st})
-    files = inline_files(elf, pcs, {pc: insns[pc][3] for pc in pcs if pc in insns})
+    files = inline_files(elf, pcs, {pc: insns[pc][3] for pc in pcs if pc in insns}, lines)
     results = []
     for index, steps in enumerate(scenarios):
         measured = steps[-tail:]
@@ -324,7 +328,9 @@ def main():
         print(ranges(sys.argv[2], sys.argv[3], sys.argv[4:]))
     elif cmd == "trace":
         tail = int(sys.argv[5]) if len(sys.argv) > 5 else 300
-        for r in trace(sys.argv[2], sys.argv[3], sys.argv[4], tail):
+        # FADO_COST_LINES=N: attribute to fado-core source lines and print the N dearest.
+        top = int(os.environ.get("FADO_COST_LINES", "0"))
+        for r in trace(sys.argv[2], sys.argv[3], sys.argv[4], tail, top > 0):
             print(
                 f"scenario {r['scenario']}: {r['measured']} of {r['steps']} steps measured: "
                 f"{r['insn_mean']:.0f} instructions (max {r['insn_max']}), "
@@ -333,7 +339,8 @@ def main():
             # The estimator runs its slow laws round-robin, one per sample (docs/firmware.md):
             # the last steps show each slot's cost.
             print("    cycles of the last 8 steps: " + " ".join(str(c) for c in r["cyc_last"]))
-            for f, c in sorted(r["by_file"].items(), key=lambda x: -x[1]):
+            rows = sorted(r["by_file"].items(), key=lambda x: -x[1])
+            for f, c in rows[: top or None]:
                 print(f"    {c:7.1f} cycles {r['by_file_insn'][f]:7.1f} insns  {f}")
     else:
         sys.exit(__doc__)
