@@ -1000,20 +1000,21 @@ impl<T: Real> SensorlessEstimator<T> {
         };
         // Loss-of-lock symptoms (see `lock`), in the detector's slot: |λ̂r| against λ̂f, the
         // T2S-1 innovation.
+        // (Outside its slot the detector's state is neither copied nor written back.)
         let lock = if slot == SLOT_LOCK {
             let innovation = if tracker_hold {
                 T::zero()
             } else {
                 crate::wrap_angle(theta_direct - self.t2s1.predicted_angle())
             };
-            self.lock.next_state(
+            Some(self.lock.next_state(
                 lambda_r.norm_squared(),
                 flux_hat * flux_hat * active_ratio * active_ratio,
                 innovation,
                 clamping,
-            )
+            ))
         } else {
-            self.lock.state()
+            None
         };
         // The learned integrand offset ê is subtracted from the integrand in both modes, with
         // the standstill pull of the R̂s adaptation (both held between the slow laws' runs).
@@ -1070,7 +1071,9 @@ impl<T: Real> SensorlessEstimator<T> {
         self.selector.commit(mode);
         self.disturbance_feedback.commit(kdf_gain);
         self.feedback = feedback;
-        self.lock.commit(lock);
+        if let Some(lock) = lock {
+            self.lock.commit(lock);
+        }
         self.i_prev = i_ab;
         self.step_allowance = self.bounds.step();
         self.slot = if slot + 1 == SLOW_PERIOD { 0 } else { slot + 1 };
@@ -1190,7 +1193,7 @@ impl<T: Real> SensorlessEstimator<T> {
                 rs_hat: rs_hat_used,
                 flux_linkage_hat: flux_linkage_used,
                 input_fault: false,
-                lock: lock.status(),
+                lock: self.lock.status(),
             },
         };
         estimate.into()
