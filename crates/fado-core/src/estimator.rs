@@ -1005,7 +1005,7 @@ impl<T: Real> SensorlessEstimator<T> {
             let innovation = if tracker_hold {
                 T::zero()
             } else {
-                crate::wrap_angle(theta_direct - self.t2s1.predicted_angle())
+                self.t2s1.phase_error(theta_direct)
             };
             Some(self.lock.next_state(
                 lambda_r.norm_squared(),
@@ -1177,7 +1177,7 @@ impl<T: Real> SensorlessEstimator<T> {
             }
         }
         let estimate = Estimate {
-            theta: t2s1.theta,
+            theta: t2s1.angle(),
             omega: t2s1.omega,
             omega_control: t2s2.omega,
             diagnostics: Diagnostics {
@@ -1472,7 +1472,8 @@ mod tests {
         // feedback), and without the stored `EstimatorConfig` (156 B; the step keeps the 8
         // words and 2 flags it needs): 472 B; the live lock status (issue 14 follow-up:
         // healing count and time) 12 B; the observer's lag compensation (issue 13 fourth
-        // pass: the low-pass's two gains and its state) 12 B.
+        // pass: the low-pass's two gains and its state) 12 B. Issue 16's fixed-point tracker
+        // angles (`f32`) keep the trackers' size.
         assert!(s32 <= 492, "{s32}");
     }
 

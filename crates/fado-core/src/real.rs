@@ -28,9 +28,23 @@ pub trait Real: RealField + Copy + Default {
     /// √x for x ≥ 0, as the estimator's step computes it: `libm` for `f64`,
     /// [`crate::approx::sqrt`] for `f32` (within 1 ulp).
     fn step_sqrt(self) -> Self;
+    /// Rounds towards zero to an `i32`, saturating at `i32::MIN`/`i32::MAX`; NaN gives 0
+    /// (Rust's `as`: one `vcvt` on a Cortex-M4F). For the trackers' fixed-point angles.
+    fn to_i32_saturating(self) -> i32;
+    /// The `i32` as this scalar (exact in `f64`, rounded to nearest in `f32`); named apart
+    /// from `num`'s `FromPrimitive::from_i32`, which returns an `Option`.
+    fn of_i32(i: i32) -> Self;
 }
 
 impl Real for f32 {
+    #[inline(always)]
+    fn to_i32_saturating(self) -> i32 {
+        self as i32
+    }
+    #[inline(always)]
+    fn of_i32(i: i32) -> Self {
+        i as Self
+    }
     #[inline(always)]
     fn lit(x: f64) -> Self {
         x as f32
@@ -62,6 +76,14 @@ impl Real for f32 {
 }
 
 impl Real for f64 {
+    #[inline(always)]
+    fn to_i32_saturating(self) -> i32 {
+        self as i32
+    }
+    #[inline(always)]
+    fn of_i32(i: i32) -> Self {
+        i as Self
+    }
     #[inline(always)]
     fn lit(x: f64) -> Self {
         x

@@ -18,9 +18,36 @@
 //! the corrected one before the prediction, θ̂ = θ̂⁻ + Kp·Ts·e (then θ̂⁻ = θ̂ + Ts·ω̂): the same
 //! recursion and poles, but without the one-sample lag ω·Ts the predicted value would carry
 //! (1.3e-2 rad at 20 Hz).
+//!
+//! **Angles in wrapping fixed point.** θ̂ and θ̂⁻ are kept as `i32` with 2³² units = 2π (one
+//! unit is 1.46e-9 rad), so every wrap of the recursion is the integer overflow of an add or
+//! a subtract: e = θm − θ̂⁻ is exact modulo 2π with no compare, and so are θ̂ and θ̂⁻ (the
+//! float recursion needed three `wrap_angle` per tracker and sample, each a compare and a
+//! branch). θm enters as ⌊θm·2³²/2π⌋ (θm ∈ [−π, π], from eq. (6)); the corrections Kp·Ts·e
+//! and Ts·ω̂ are converted towards zero and saturate at ±π per sample (|ω̂|·Ts beyond π is
+//! above the Nyquist frequency, where the angle is aliased anyway). The quantisation is
+//! 1.46e-9 rad per conversion: below an `f32` ulp of π (2.4e-7), and 10⁶ times below any
+//! angle the estimator resolves in `f64` (docs/firmware.md).
 
 use crate::error::{ConfigError, NonFiniteInput, check};
 use crate::{Real, wrap_angle};
+
+/// Fixed-point angle units per radian: 2³²/2π.
+const UNITS_PER_RAD: f64 = 4_294_967_296.0 / core::f64::consts::TAU;
+/// Radians per fixed-point angle unit: 2π/2³².
+const RAD_PER_UNIT: f64 = core::f64::consts::TAU / 4_294_967_296.0;
+
+/// An angle in [−π, π] (saturating beyond) as wrapping fixed point, 2³² = 2π.
+#[inline(always)]
+fn to_fixed<T: Real>(angle: T) -> i32 {
+    (angle * T::lit(UNITS_PER_RAD)).to_i32_saturating()
+}
+
+/// A fixed-point angle in radians, in [−π, π).
+#[inline(always)]
+fn from_fixed<T: Real>(angle: i32) -> T {
+    T::of_i32(angle) * T::lit(RAD_PER_UNIT)
+}
 
 /// How the tracker's bandwidth parameter is interpreted.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -80,18 +107,22 @@ impl<T: Real> TrackerConfig<T> {
     }
 }
 
-/// Type-2 angle and speed tracker (Fig. 1).
+/// Type-2 angle and speed tracker (Fig. 1), its angles in wrapping fixed point (module docs).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TypeTwoTracker<T> {
-    ts: T,
-    kp: T,
-    /// Ts·Kp, precomputed (the same product the recursion formed every sample).
-    kp_ts: T,
-    ki_ts: T,
-    /// θ̂⁻: the angle predicted for the next sample.
-    predicted: T,
-    /// θ̂: the angle estimate for the last sample.
-    theta: T,
+    /// Kp·Ts = `kp_ts_whole` + `kp_ts_frac`, the whole part 0 or 1 and the fraction in
+    /// [0, 1): the correction Kp·Ts·e is e (exact, an `i32`) times the whole part plus the
+    /// fraction's share, which fits an `i32` for |e| ≤ π.
+    kp_ts_whole: i32,
+    kp_ts_frac: T,
+    /// Ki·Ts per fixed-point unit of phase error, rad/s.
+    ki_ts_per_unit: T,
+    /// Ts in fixed-point units per rad/s.
+    ts_units: T,
+    /// θ̂⁻: the angle predicted for the next sample (fixed point).
+    predicted: i32,
+    /// θ̂: the angle estimate for the last sample (fixed point).
+    theta: i32,
     omega: T,
 }
 
@@ -112,13 +143,17 @@ impl<T: Real> TypeTwoTracker<T> {
                 expected: "a bandwidth whose discrete tracker poles stay inside the unit circle",
             });
         }
+        // Ts·Kp as the recursion formed it, split exactly (Sterbenz) at 1.
+        let kp_ts = ts * kp;
+        let kp_ts_whole = if kp_ts >= T::one() { 1 } else { 0 };
+        let ki_ts = ki * ts;
         Ok(Self {
-            ts,
-            kp,
-            kp_ts: ts * kp,
-            ki_ts: ki * ts,
-            predicted: T::zero(),
-            theta: T::zero(),
+            kp_ts_whole,
+            kp_ts_frac: kp_ts - T::of_i32(kp_ts_whole),
+            ki_ts_per_unit: ki_ts * T::lit(RAD_PER_UNIT),
+            ts_units: ts * T::lit(UNITS_PER_RAD),
+            predicted: 0,
+            theta: 0,
             omega: T::zero(),
         })
     }
@@ -130,7 +165,7 @@ impl<T: Real> TypeTwoTracker<T> {
 
     /// Starts from a known angle and speed.
     pub fn reset_to(&mut self, theta: T, omega: T) {
-        self.theta = wrap_angle(theta);
+        self.theta = to_fixed(wrap_angle(theta));
         self.predicted = self.theta;
         self.omega = omega;
     }
@@ -141,9 +176,9 @@ impl<T: Real> TypeTwoTracker<T> {
         if !theta_measured.is_finite() {
             return Err(NonFiniteInput);
         }
-        let next = self.next_state(theta_measured);
+        let next = self.next_state(wrap_angle(theta_measured));
         self.commit(next);
-        Ok((next.theta, next.omega))
+        Ok((next.angle(), next.omega))
     }
 
     /// One sample without a measurement: θ̂ coasts at ω̂ and the integrator holds (used when
@@ -152,21 +187,34 @@ impl<T: Real> TypeTwoTracker<T> {
     pub fn coast(&mut self) -> (T, T) {
         let next = self.coasted_state();
         self.commit(next);
-        (next.theta, next.omega)
+        (next.angle(), next.omega)
     }
 
-    /// The state after one sample with the measurement θm, without changing `self`.
+    /// The state after one sample with the measurement θm ∈ [−π, π] (eq. (6)'s range; a
+    /// NaN counts as 0, so the caller checks it), without changing `self`.
     #[inline(always)]
     pub(crate) fn next_state(&self, theta_measured: T) -> TrackerState<T> {
-        let e = wrap_angle(theta_measured - self.predicted);
-        let omega = self.omega + self.ki_ts * e;
-        let theta = wrap_angle(self.predicted + self.kp_ts * e);
+        // e = θm − θ̂⁻, wrapped by the integer subtraction.
+        let e = to_fixed(theta_measured).wrapping_sub(self.predicted);
+        let e_units = T::of_i32(e);
+        let omega = self.omega + self.ki_ts_per_unit * e_units;
+        let theta = self
+            .predicted
+            .wrapping_add(e.wrapping_mul(self.kp_ts_whole))
+            .wrapping_add((self.kp_ts_frac * e_units).to_i32_saturating());
         TrackerState {
-            predicted: wrap_angle(theta + self.ts * omega),
+            predicted: theta.wrapping_add((self.ts_units * omega).to_i32_saturating()),
             theta,
             omega,
             innovation: e,
         }
+    }
+
+    /// wrap(θm − θ̂⁻) in rad for θm ∈ [−π, π]: the phase error the next sample's update
+    /// would use (the loss-of-lock detector's innovation).
+    #[inline(always)]
+    pub(crate) fn phase_error(&self, theta_measured: T) -> T {
+        from_fixed(to_fixed(theta_measured).wrapping_sub(self.predicted))
     }
 
     /// The state after one coasting sample, without changing `self`.
@@ -174,7 +222,7 @@ impl<T: Real> TypeTwoTracker<T> {
     pub(crate) fn coasted_state(&self) -> TrackerState<T> {
         let theta = self.predicted;
         TrackerState {
-            predicted: wrap_angle(theta + self.ts * self.omega),
+            predicted: theta.wrapping_add((self.ts_units * self.omega).to_i32_saturating()),
             theta,
             omega: self.omega,
             innovation: T::zero(),
@@ -192,13 +240,13 @@ impl<T: Real> TypeTwoTracker<T> {
     /// θ̂ for the last sample, in [−π, π].
     #[inline]
     pub fn angle(&self) -> T {
-        self.theta
+        from_fixed(self.theta)
     }
 
     /// θ̂⁻, the angle predicted for the next sample, in [−π, π].
     #[inline]
     pub fn predicted_angle(&self) -> T {
-        self.predicted
+        from_fixed(self.predicted)
     }
 
     /// ω̂ in rad/s.
@@ -217,21 +265,33 @@ impl<T: Real> TypeTwoTracker<T> {
 
     /// (Kp, Ki) in use.
     pub fn gains(&self) -> (T, T) {
-        (self.kp, self.ki_ts / self.ts)
+        // Recovered from the step's precomputed products (to rounding: the tracker keeps no
+        // copy of Ts, Kp and Ki).
+        let ts = self.ts_units * T::lit(RAD_PER_UNIT);
+        let kp_ts = T::of_i32(self.kp_ts_whole) + self.kp_ts_frac;
+        (kp_ts / ts, self.ki_ts_per_unit * T::lit(UNITS_PER_RAD) / ts)
     }
 }
 
 /// The tracker's state after a sample, computed before it is committed.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct TrackerState<T> {
-    /// θ̂⁻ for the next sample.
-    pub predicted: T,
-    /// θ̂.
-    pub theta: T,
+    /// θ̂⁻ for the next sample (fixed point, 2³² = 2π).
+    pub predicted: i32,
+    /// θ̂ (fixed point).
+    pub theta: i32,
     /// ω̂.
     pub omega: T,
     /// The phase error e = wrap(θm − θ̂⁻) of this sample (0 when coasting).
     pub innovation: T,
+}
+
+impl<T: Real> TrackerState<T> {
+    /// θ̂ in rad, in [−π, π).
+    #[inline(always)]
+    pub fn angle(&self) -> T {
+        from_fixed(self.theta)
+    }
 }
 
 #[cfg(test)]
@@ -280,8 +340,12 @@ mod tests {
             err = wrap_angle(th - est).abs();
             assert!(est.abs() <= PI + 1e-12);
         }
-        assert!(err < 1e-9, "{err}");
-        assert!((t.speed() - w).abs() < 1e-6);
+        // Zero to the fixed-point resolution: θ̂ moves in units of 2π/2³² = 1.46e-9 rad, so a
+        // phase error below 1/(Kp·Ts) units (5.6e-8 rad at 60 Hz) corrects nothing and
+        // the integrator alone settles it (module docs).
+        assert!(err < 6e-8, "{err}");
+        // ω̂ to within the speed of one unit per sample, 1.46e-9 rad/Ts = 1.5e-5 rad/s.
+        assert!((t.speed() - w).abs() < 1.5e-5, "{}", t.speed() - w);
     }
 
     #[test]
@@ -342,16 +406,19 @@ mod tests {
             t.step(0.0).unwrap();
             (t.predicted_angle(), t.speed())
         };
-        let (m00, m10) = column(1e-3, 0.0);
-        let (m01, m11) = column(0.0, 1.0);
-        let (m00, m10) = (m00 / 1e-3, m10 / 1e-3);
+        // Probes large against the fixed-point angle's 1.46e-9 rad (module docs), which
+        // bounds how linear the map is.
+        let (m00, m10) = column(0.1, 0.0);
+        let (m01, m11) = column(0.0, 100.0);
+        let (m00, m10) = (m00 / 0.1, m10 / 0.1);
+        let (m01, m11) = (m01 / 100.0, m11 / 100.0);
         let trace = m00 + m11;
         let det = m00 * m11 - m01 * m10;
         assert!(
-            (trace - (2.0 - kp * ts - ki * ts * ts)).abs() < 1e-12,
+            (trace - (2.0 - kp * ts - ki * ts * ts)).abs() < 1e-7,
             "{trace}"
         );
-        assert!((det - (1.0 - kp * ts)).abs() < 1e-12, "{det}");
+        assert!((det - (1.0 - kp * ts)).abs() < 1e-7, "{det}");
     }
 
     #[test]
