@@ -572,7 +572,7 @@ impl<T> From<Estimate<T>> for LeanEstimate<T> {
 /// let _angle = out.theta;
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SensorlessEstimator<T> {
+pub struct SensorlessEstimator<T: Real> {
     // What the step and `reset`/`align` need of the `EstimatorConfig` (the whole record, 156 B
     // in `f32`, is the caller's to keep: it is not state).
     /// Sampling period Ts, s.

@@ -28,22 +28,40 @@ pub trait Real: RealField + Copy + Default {
     /// √x for x ≥ 0, as the estimator's step computes it: `libm` for `f64`,
     /// [`crate::approx::sqrt`] for `f32` (within 1 ulp).
     fn step_sqrt(self) -> Self;
-    /// Rounds towards zero to an `i32`, saturating at `i32::MIN`/`i32::MAX`; NaN gives 0
-    /// (Rust's `as`: one `vcvt` on a Cortex-M4F). For the trackers' fixed-point angles.
-    fn to_i32_saturating(self) -> i32;
-    /// The `i32` as this scalar (exact in `f64`, rounded to nearest in `f32`); named apart
-    /// from `num`'s `FromPrimitive::from_i32`, which returns an `Option`.
-    fn of_i32(i: i32) -> Self;
+    /// How the T2S trackers keep their angles ([`crate::tracker`]): `f64` as a float in
+    /// [−π, π] wrapped by [`wrap_angle`] (the paper's recursion as written), `f32` as wrapping
+    /// fixed point, an `i32` with 2³² units = 2π, wrapped by integer overflow (no compare or
+    /// branch per wrap on a Cortex-M4F; resolution 1.46e-9 rad, finer than an `f32` ulp of π).
+    type Angle: Copy + core::fmt::Debug + PartialEq + Default;
+    /// An angle in [−π, π] as a tracker angle (`f32`: saturating beyond ±π).
+    fn angle_from(x: Self) -> Self::Angle;
+    /// A tracker angle in rad, in [−π, π].
+    fn angle_to(a: Self::Angle) -> Self;
+    /// wrap(a − b) in rad.
+    fn angle_diff(a: Self::Angle, b: Self::Angle) -> Self;
+    /// wrap(a + d) for a step |d| ≤ π (`f32`: saturating at ±π beyond; `f64`: exact up to
+    /// ±2π, see [`wrap_angle`]).
+    fn angle_add(a: Self::Angle, d: Self) -> Self::Angle;
 }
 
 impl Real for f32 {
+    type Angle = i32;
     #[inline(always)]
-    fn to_i32_saturating(self) -> i32 {
-        self as i32
+    fn angle_from(x: Self) -> i32 {
+        // Towards zero, saturating (Rust's `as`, one `vcvt`); NaN gives 0.
+        (x * (FIXED_ANGLE_UNITS_PER_RAD as f32)) as i32
     }
     #[inline(always)]
-    fn of_i32(i: i32) -> Self {
-        i as Self
+    fn angle_to(a: i32) -> Self {
+        a as f32 * (FIXED_ANGLE_RAD_PER_UNIT as f32)
+    }
+    #[inline(always)]
+    fn angle_diff(a: i32, b: i32) -> Self {
+        Self::angle_to(a.wrapping_sub(b))
+    }
+    #[inline(always)]
+    fn angle_add(a: i32, d: Self) -> i32 {
+        a.wrapping_add(Self::angle_from(d))
     }
     #[inline(always)]
     fn lit(x: f64) -> Self {
@@ -76,13 +94,22 @@ impl Real for f32 {
 }
 
 impl Real for f64 {
+    type Angle = f64;
     #[inline(always)]
-    fn to_i32_saturating(self) -> i32 {
-        self as i32
+    fn angle_from(x: Self) -> f64 {
+        x
     }
     #[inline(always)]
-    fn of_i32(i: i32) -> Self {
-        i as Self
+    fn angle_to(a: f64) -> Self {
+        a
+    }
+    #[inline(always)]
+    fn angle_diff(a: f64, b: f64) -> Self {
+        wrap_angle(a - b)
+    }
+    #[inline(always)]
+    fn angle_add(a: f64, d: Self) -> f64 {
+        wrap_angle(a + d)
     }
     #[inline(always)]
     fn lit(x: f64) -> Self {
@@ -113,6 +140,11 @@ impl Real for f64 {
         nalgebra::ComplexField::sqrt(self)
     }
 }
+
+/// Fixed-point tracker angle units per radian (`f32`'s [`Real::Angle`]): 2³²/2π.
+const FIXED_ANGLE_UNITS_PER_RAD: f64 = 4_294_967_296.0 / core::f64::consts::TAU;
+/// Radians per fixed-point tracker angle unit: 2π/2³² = 1.46e-9 rad.
+const FIXED_ANGLE_RAD_PER_UNIT: f64 = core::f64::consts::TAU / 4_294_967_296.0;
 
 /// min(x, y) for a `y` that is never NaN: a compare and a select (the FPU has no minimum
 /// instruction on a Cortex-M4; `libm`'s `fminf` is a call). Same result as `fmin` except for

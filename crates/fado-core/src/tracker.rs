@@ -19,35 +19,20 @@
 //! recursion and poles, but without the one-sample lag ω·Ts the predicted value would carry
 //! (1.3e-2 rad at 20 Hz).
 //!
-//! **Angles in wrapping fixed point.** θ̂ and θ̂⁻ are kept as `i32` with 2³² units = 2π (one
-//! unit is 1.46e-9 rad), so every wrap of the recursion is the integer overflow of an add or
-//! a subtract: e = θm − θ̂⁻ is exact modulo 2π with no compare, and so are θ̂ and θ̂⁻ (the
-//! float recursion needed three `wrap_angle` per tracker and sample, each a compare and a
-//! branch). θm enters as ⌊θm·2³²/2π⌋ (θm ∈ [−π, π], from eq. (6)); the corrections Kp·Ts·e
-//! and Ts·ω̂ are converted towards zero and saturate at ±π per sample (|ω̂|·Ts beyond π is
-//! above the Nyquist frequency, where the angle is aliased anyway). The quantisation is
-//! 1.46e-9 rad per conversion: below an `f32` ulp of π (2.4e-7), and 10⁶ times below any
-//! angle the estimator resolves in `f64` (docs/firmware.md).
+//! **Angles in `f32`: wrapping fixed point** ([`Real::Angle`]). In `f32` θ̂ and θ̂⁻ are kept
+//! as `i32` with 2³² units = 2π (one unit is 1.46e-9 rad), so every wrap of the recursion is
+//! the overflow of an integer add or subtract: e = θm − θ̂⁻ is exact modulo 2π without a
+//! compare, and so are θ̂ and θ̂⁻ (the float recursion needs three [`wrap_angle`] per tracker
+//! and sample, each a compare and a branch on a Cortex-M4F; docs/firmware.md). θm enters
+//! rounded towards zero to a unit, the steps Kp·Ts·e and Ts·ω̂ too, saturating at ±π (a step
+//! beyond π is above the Nyquist frequency, aliased anyway; Kp·Ts·e reaches it only for
+//! Kp·Ts > 1, a bandwidth above a fifth of the sampling rate). One unit is 1/165 of an
+//! `f32` ulp of π, so the `f32` tracker is at least as fine as the float one; its resolution
+//! is tested in `f32_fixed_point_tracker_locks_and_wraps`. `f64` keeps the float recursion
+//! exactly as written above (its results unchanged to the bit).
 
 use crate::error::{ConfigError, NonFiniteInput, check};
 use crate::{Real, wrap_angle};
-
-/// Fixed-point angle units per radian: 2³²/2π.
-const UNITS_PER_RAD: f64 = 4_294_967_296.0 / core::f64::consts::TAU;
-/// Radians per fixed-point angle unit: 2π/2³².
-const RAD_PER_UNIT: f64 = core::f64::consts::TAU / 4_294_967_296.0;
-
-/// An angle in [−π, π] (saturating beyond) as wrapping fixed point, 2³² = 2π.
-#[inline(always)]
-fn to_fixed<T: Real>(angle: T) -> i32 {
-    (angle * T::lit(UNITS_PER_RAD)).to_i32_saturating()
-}
-
-/// A fixed-point angle in radians, in [−π, π).
-#[inline(always)]
-fn from_fixed<T: Real>(angle: i32) -> T {
-    T::of_i32(angle) * T::lit(RAD_PER_UNIT)
-}
 
 /// How the tracker's bandwidth parameter is interpreted.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -107,22 +92,18 @@ impl<T: Real> TrackerConfig<T> {
     }
 }
 
-/// Type-2 angle and speed tracker (Fig. 1), its angles in wrapping fixed point (module docs).
+/// Type-2 angle and speed tracker (Fig. 1).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct TypeTwoTracker<T> {
-    /// Kp·Ts = `kp_ts_whole` + `kp_ts_frac`, the whole part 0 or 1 and the fraction in
-    /// [0, 1): the correction Kp·Ts·e is e (exact, an `i32`) times the whole part plus the
-    /// fraction's share, which fits an `i32` for |e| ≤ π.
-    kp_ts_whole: i32,
-    kp_ts_frac: T,
-    /// Ki·Ts per fixed-point unit of phase error, rad/s.
-    ki_ts_per_unit: T,
-    /// Ts in fixed-point units per rad/s.
-    ts_units: T,
-    /// θ̂⁻: the angle predicted for the next sample (fixed point).
-    predicted: i32,
-    /// θ̂: the angle estimate for the last sample (fixed point).
-    theta: i32,
+pub struct TypeTwoTracker<T: Real> {
+    ts: T,
+    kp: T,
+    /// Ts·Kp, precomputed (the same product the recursion formed every sample).
+    kp_ts: T,
+    ki_ts: T,
+    /// θ̂⁻: the angle predicted for the next sample ([`Real::Angle`]).
+    predicted: T::Angle,
+    /// θ̂: the angle estimate for the last sample.
+    theta: T::Angle,
     omega: T,
 }
 
@@ -143,17 +124,13 @@ impl<T: Real> TypeTwoTracker<T> {
                 expected: "a bandwidth whose discrete tracker poles stay inside the unit circle",
             });
         }
-        // Ts·Kp as the recursion formed it, split exactly (Sterbenz) at 1.
-        let kp_ts = ts * kp;
-        let kp_ts_whole = if kp_ts >= T::one() { 1 } else { 0 };
-        let ki_ts = ki * ts;
         Ok(Self {
-            kp_ts_whole,
-            kp_ts_frac: kp_ts - T::of_i32(kp_ts_whole),
-            ki_ts_per_unit: ki_ts * T::lit(RAD_PER_UNIT),
-            ts_units: ts * T::lit(UNITS_PER_RAD),
-            predicted: 0,
-            theta: 0,
+            ts,
+            kp,
+            kp_ts: ts * kp,
+            ki_ts: ki * ts,
+            predicted: T::Angle::default(),
+            theta: T::Angle::default(),
             omega: T::zero(),
         })
     }
@@ -165,7 +142,7 @@ impl<T: Real> TypeTwoTracker<T> {
 
     /// Starts from a known angle and speed.
     pub fn reset_to(&mut self, theta: T, omega: T) {
-        self.theta = to_fixed(wrap_angle(theta));
+        self.theta = T::angle_from(wrap_angle(theta));
         self.predicted = self.theta;
         self.omega = omega;
     }
@@ -190,31 +167,26 @@ impl<T: Real> TypeTwoTracker<T> {
         (next.angle(), next.omega)
     }
 
-    /// The state after one sample with the measurement θm ∈ [−π, π] (eq. (6)'s range; a
-    /// NaN counts as 0, so the caller checks it), without changing `self`.
+    /// The state after one sample with the measurement θm ∈ [−π, π] (eq. (6)'s range),
+    /// without changing `self`.
     #[inline(always)]
     pub(crate) fn next_state(&self, theta_measured: T) -> TrackerState<T> {
-        // e = θm − θ̂⁻, wrapped by the integer subtraction.
-        let e = to_fixed(theta_measured).wrapping_sub(self.predicted);
-        let e_units = T::of_i32(e);
-        let omega = self.omega + self.ki_ts_per_unit * e_units;
-        let theta = self
-            .predicted
-            .wrapping_add(e.wrapping_mul(self.kp_ts_whole))
-            .wrapping_add((self.kp_ts_frac * e_units).to_i32_saturating());
+        let e = self.phase_error(theta_measured);
+        let omega = self.omega + self.ki_ts * e;
+        let theta = T::angle_add(self.predicted, self.kp_ts * e);
         TrackerState {
-            predicted: theta.wrapping_add((self.ts_units * omega).to_i32_saturating()),
+            predicted: T::angle_add(theta, self.ts * omega),
             theta,
             omega,
             innovation: e,
         }
     }
 
-    /// wrap(θm − θ̂⁻) in rad for θm ∈ [−π, π]: the phase error the next sample's update
-    /// would use (the loss-of-lock detector's innovation).
+    /// wrap(θm − θ̂⁻) for θm ∈ [−π, π]: the phase error of the next update (also the
+    /// loss-of-lock detector's innovation).
     #[inline(always)]
     pub(crate) fn phase_error(&self, theta_measured: T) -> T {
-        from_fixed(to_fixed(theta_measured).wrapping_sub(self.predicted))
+        T::angle_diff(T::angle_from(theta_measured), self.predicted)
     }
 
     /// The state after one coasting sample, without changing `self`.
@@ -222,7 +194,7 @@ impl<T: Real> TypeTwoTracker<T> {
     pub(crate) fn coasted_state(&self) -> TrackerState<T> {
         let theta = self.predicted;
         TrackerState {
-            predicted: theta.wrapping_add((self.ts_units * self.omega).to_i32_saturating()),
+            predicted: T::angle_add(theta, self.ts * self.omega),
             theta,
             omega: self.omega,
             innovation: T::zero(),
@@ -240,13 +212,13 @@ impl<T: Real> TypeTwoTracker<T> {
     /// θ̂ for the last sample, in [−π, π].
     #[inline]
     pub fn angle(&self) -> T {
-        from_fixed(self.theta)
+        T::angle_to(self.theta)
     }
 
     /// θ̂⁻, the angle predicted for the next sample, in [−π, π].
     #[inline]
     pub fn predicted_angle(&self) -> T {
-        from_fixed(self.predicted)
+        T::angle_to(self.predicted)
     }
 
     /// ω̂ in rad/s.
@@ -265,21 +237,17 @@ impl<T: Real> TypeTwoTracker<T> {
 
     /// (Kp, Ki) in use.
     pub fn gains(&self) -> (T, T) {
-        // Recovered from the step's precomputed products (to rounding: the tracker keeps no
-        // copy of Ts, Kp and Ki).
-        let ts = self.ts_units * T::lit(RAD_PER_UNIT);
-        let kp_ts = T::of_i32(self.kp_ts_whole) + self.kp_ts_frac;
-        (kp_ts / ts, self.ki_ts_per_unit * T::lit(UNITS_PER_RAD) / ts)
+        (self.kp, self.ki_ts / self.ts)
     }
 }
 
 /// The tracker's state after a sample, computed before it is committed.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct TrackerState<T> {
-    /// θ̂⁻ for the next sample (fixed point, 2³² = 2π).
-    pub predicted: i32,
-    /// θ̂ (fixed point).
-    pub theta: i32,
+pub(crate) struct TrackerState<T: Real> {
+    /// θ̂⁻ for the next sample.
+    pub predicted: T::Angle,
+    /// θ̂.
+    pub theta: T::Angle,
     /// ω̂.
     pub omega: T,
     /// The phase error e = wrap(θm − θ̂⁻) of this sample (0 when coasting).
@@ -287,10 +255,10 @@ pub(crate) struct TrackerState<T> {
 }
 
 impl<T: Real> TrackerState<T> {
-    /// θ̂ in rad, in [−π, π).
+    /// θ̂ in rad, in [−π, π].
     #[inline(always)]
     pub fn angle(&self) -> T {
-        from_fixed(self.theta)
+        T::angle_to(self.theta)
     }
 }
 
@@ -340,12 +308,8 @@ mod tests {
             err = wrap_angle(th - est).abs();
             assert!(est.abs() <= PI + 1e-12);
         }
-        // Zero to the fixed-point resolution: θ̂ moves in units of 2π/2³² = 1.46e-9 rad, so a
-        // phase error below 1/(Kp·Ts) units (5.6e-8 rad at 60 Hz) corrects nothing and
-        // the integrator alone settles it (module docs).
-        assert!(err < 6e-8, "{err}");
-        // ω̂ to within the speed of one unit per sample, 1.46e-9 rad/Ts = 1.5e-5 rad/s.
-        assert!((t.speed() - w).abs() < 1.5e-5, "{}", t.speed() - w);
+        assert!(err < 1e-9, "{err}");
+        assert!((t.speed() - w).abs() < 1e-6);
     }
 
     #[test]
@@ -406,19 +370,79 @@ mod tests {
             t.step(0.0).unwrap();
             (t.predicted_angle(), t.speed())
         };
-        // Probes large against the fixed-point angle's 1.46e-9 rad (module docs), which
-        // bounds how linear the map is.
-        let (m00, m10) = column(0.1, 0.0);
-        let (m01, m11) = column(0.0, 100.0);
-        let (m00, m10) = (m00 / 0.1, m10 / 0.1);
-        let (m01, m11) = (m01 / 100.0, m11 / 100.0);
+        let (m00, m10) = column(1e-3, 0.0);
+        let (m01, m11) = column(0.0, 1.0);
+        let (m00, m10) = (m00 / 1e-3, m10 / 1e-3);
         let trace = m00 + m11;
         let det = m00 * m11 - m01 * m10;
         assert!(
-            (trace - (2.0 - kp * ts - ki * ts * ts)).abs() < 1e-7,
+            (trace - (2.0 - kp * ts - ki * ts * ts)).abs() < 1e-12,
             "{trace}"
         );
-        assert!((det - (1.0 - kp * ts)).abs() < 1e-7, "{det}");
+        assert!((det - (1.0 - kp * ts)).abs() < 1e-12, "{det}");
+    }
+
+    #[test]
+    fn f32_fixed_point_tracker_locks_and_wraps() {
+        // The fixed-point angle arithmetic is the wrap of the float formula: differences and
+        // steps across ±π, against f64, to the rounding of the f32 conversions (each rounds
+        // x·2³²/2π to 24 bits: at most 1.9e-7 rad, an f32 half-ulp of π) and a unit each.
+        let unit = 2.0 * PI / 4_294_967_296.0;
+        for k in -200..=200 {
+            let a = wrap_angle(k as f64 * 0.0157 * PI);
+            for d in [-3.1, -1.0, -1e-3, -1e-7, 0.0, 2e-6, 0.3, 3.1] {
+                let (af, df) = (a as f32, d as f32);
+                let fa = <f32 as Real>::angle_from(af);
+                let sum = <f32 as Real>::angle_to(<f32 as Real>::angle_add(fa, df)) as f64;
+                let exact = wrap_angle(af as f64 + df as f64);
+                let err = wrap_angle(sum - exact).abs();
+                assert!(err <= 3.0 * unit + 5e-7, "{a} + {d}: {sum} vs {exact}");
+                let fb = <f32 as Real>::angle_from(df);
+                let diff = <f32 as Real>::angle_diff(fa, fb) as f64;
+                let exact = wrap_angle(af as f64 - df as f64);
+                assert!(
+                    wrap_angle(diff - exact).abs() <= 3.0 * unit + 5e-7,
+                    "{a} - {d}"
+                );
+                assert!(diff.abs() <= core::f32::consts::PI as f64);
+            }
+        }
+        // The f32 tracker locks on a constant speed through thousands of ±π wraps, both
+        // directions, as closely as the same recursion in f32 floats with `wrap_angle` (what
+        // f32 ran before), over the last 2000 samples.
+        for w in [
+            -2.0 * PI * 700.0,
+            -2.0 * PI * 20.0,
+            2.0 * PI * 1.5,
+            2.0 * PI * 400.0,
+        ] {
+            let mut t = TypeTwoTracker::new(TrackerConfig::<f32>::default()).unwrap();
+            let (kp, ki) = t.gains();
+            let ts = 1e-4_f32;
+            let (kp_ts, ki_ts) = (ts * kp, ki * ts);
+            let (mut predicted, mut omega) = (0.0_f32, 0.0_f32);
+            let (mut err, mut err_float) = (0.0_f64, 0.0_f64);
+            for n in 0..20_000 {
+                let th = wrap_angle(w * 1e-4 * n as f64);
+                let (est, _) = t.step(th as f32).unwrap();
+                assert!(est.abs() <= core::f32::consts::PI);
+                let e = wrap_angle(th as f32 - predicted);
+                omega += ki_ts * e;
+                let theta = wrap_angle(predicted + kp_ts * e);
+                predicted = wrap_angle(theta + ts * omega);
+                if n >= 18_000 {
+                    err = err.max(wrap_angle(th - est as f64).abs());
+                    err_float = err_float.max(wrap_angle(th - theta as f64).abs());
+                }
+            }
+            // At speed f32's ω̂ sets both: its ulp (4.9e-4 rad/s at 700 Hz) leaves Ts·ω̂
+            // off by up to half of it per sample, which the proportional path corrects.
+            assert!(
+                err <= 1.5 * err_float + 1e-7,
+                "{w}: {err} vs float {err_float}"
+            );
+            assert!((t.speed() as f64 - w).abs() < 1e-2, "{w}: {}", t.speed());
+        }
     }
 
     #[test]

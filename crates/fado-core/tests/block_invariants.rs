@@ -264,11 +264,8 @@ proptest! {
             t.step(wrap_angle(theta0 + omega * TS * k as f64)).unwrap();
         }
         let th = wrap_angle(theta0 + omega * TS * (n - 1) as f64);
-        // To the fixed-point resolution (fado_core::tracker docs): θ̂ moves in units of
-        // 2π/2³² = 1.46e-9 rad, so a phase error below 1/(Kp·Ts) units (9.7e-8 rad at 35 Hz)
-        // is left to the integrator, and ω̂ settles within one unit per sample (1.5e-5 rad/s).
-        prop_assert!(wrap_angle(th - t.angle()).abs() < 1.5e-7, "θ error {}", wrap_angle(th - t.angle()));
-        prop_assert!((t.speed() - omega).abs() < 3e-5, "ω̂ = {} vs {omega}", t.speed());
+        prop_assert!(wrap_angle(th - t.angle()).abs() < 1e-9, "θ error {}", wrap_angle(th - t.angle()));
+        prop_assert!((t.speed() - omega).abs() < 1e-6, "ω̂ = {} vs {omega}", t.speed());
     }
 
     #[test]

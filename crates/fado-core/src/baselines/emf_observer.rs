@@ -126,7 +126,7 @@ impl<T: Real> EmfObserverConfig<T> {
 /// assert!(!out.diagnostics.input_fault);
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct EmfObserverEstimator<T> {
+pub struct EmfObserverEstimator<T: Real> {
     config: EmfObserverConfig<T>,
     integrand: Integrand<T>,
     trackers: AngleTrackers<T>,
@@ -439,8 +439,7 @@ mod tests {
             // A standing current: v = R·i, no EMF.
             let out = est.step(Ab::new(0.327 * 4.0, 0.0), Ab::new(4.0, 0.0));
             assert!(out.diagnostics.tracker_hold);
-            // The trackers' fixed-point angle holds 0.5 rad to its unit 2π/2³² = 1.46e-9 rad.
-            assert!((out.theta - 0.5).abs() < 1.5e-9);
+            assert!((out.theta - 0.5).abs() < 1e-12);
         }
         assert!(est.emf().norm() < 1e-9);
     }

@@ -133,7 +133,7 @@ impl<T: Real> LpfIntegratorConfig<T> {
 /// assert!(!out.diagnostics.input_fault);
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct LpfIntegratorEstimator<T> {
+pub struct LpfIntegratorEstimator<T: Real> {
     config: LpfIntegratorConfig<T>,
     integrand: Integrand<T>,
     trackers: AngleTrackers<T>,

@@ -187,7 +187,7 @@ struct Tracked<T> {
 /// fed with ∠λ̂r and coasting while |λ̂r| is below the hold level (SPEC §3), exactly as in
 /// [`crate::SensorlessEstimator`].
 #[derive(Clone, Copy, Debug, PartialEq)]
-struct AngleTrackers<T> {
+struct AngleTrackers<T: Real> {
     t2s1: TypeTwoTracker<T>,
     t2s2: TypeTwoTracker<T>,
     hold_level_sq: T,

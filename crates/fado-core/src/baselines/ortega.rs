@@ -191,7 +191,7 @@ impl<T: Real> OrtegaConfig<T> {
 /// assert!(!out.diagnostics.input_fault);
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct OrtegaEstimator<T> {
+pub struct OrtegaEstimator<T: Real> {
     config: OrtegaConfig<T>,
     integrand: Integrand<T>,
     trackers: AngleTrackers<T>,
