@@ -629,6 +629,9 @@ pub struct SensorlessEstimator<T: Real> {
     i_prev: Ab<T>,
     step_allowance: T,
     lock: LockDetector<T>,
+    /// `lock.status()`, kept where the detector's slot commits it (one byte to read per
+    /// sample instead of the debouncer's state).
+    lock_status: LockStatus,
     /// This sample's slot in the slow laws' round-robin (see [`SLOW_PERIOD`]).
     slot: u8,
     /// `BROKEN_*` bits: which slow law's regime was interrupted since it last ran.
@@ -825,6 +828,7 @@ impl<T: Real> SensorlessEstimator<T> {
             i_prev: Ab::zero(),
             step_allowance: bounds.step(),
             lock,
+            lock_status: LockStatus::Locked,
             slot: 0,
             slow_broken: 0,
             v_sum: Ab::zero(),
@@ -888,6 +892,7 @@ impl<T: Real> SensorlessEstimator<T> {
         self.feedback = Ab::zero();
         self.rejected_samples = 0;
         self.lock.reset();
+        self.lock_status = self.lock.status();
         self.slot = 0;
         self.slow_broken = 0;
         self.v_sum = Ab::zero();
@@ -1073,10 +1078,12 @@ impl<T: Real> SensorlessEstimator<T> {
         self.feedback = feedback;
         if let Some(lock) = lock {
             self.lock.commit(lock);
+            self.lock_status = lock.status();
         }
         self.i_prev = i_ab;
         self.step_allowance = self.bounds.step();
-        self.slot = if slot + 1 == SLOW_PERIOD { 0 } else { slot + 1 };
+        // SLOW_PERIOD is a power of two: the modulo is a mask.
+        self.slot = (slot + 1) % SLOW_PERIOD;
         // 6. The slow laws in their slots (see [`SLOW_PERIOD`]): R̂s and ê for the next
         //    sample (see `rs_adaptation`, `integrand_offset`), after the commit so that the
         //    paper's path is untouched by them. A non-finite result is dropped (R̂s, ê stay).
@@ -1193,7 +1200,7 @@ impl<T: Real> SensorlessEstimator<T> {
                 rs_hat: rs_hat_used,
                 flux_linkage_hat: flux_linkage_used,
                 input_fault: false,
-                lock: self.lock.status(),
+                lock: self.lock_status,
             },
         };
         estimate.into()
@@ -1392,6 +1399,7 @@ impl<T: Real> RotorAngleEstimator<T> for SensorlessEstimator<T> {
     }
     fn rearm_lock_detector(&mut self) {
         self.lock.reset();
+        self.lock_status = self.lock.status();
     }
     fn enable_rs_adaptation(&mut self) {
         SensorlessEstimator::enable_rs_adaptation(self)
