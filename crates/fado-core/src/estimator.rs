@@ -624,9 +624,8 @@ pub struct SensorlessEstimator<T: Real> {
     k_df_enabled: bool,
     rejected_samples: u32,
     bounds: SampleBounds<T>,
-    /// The last accepted current, and the step it may have moved by since (grows by one
-    /// step per rejected sample).
-    i_prev: Ab<T>,
+    /// The step the current may have moved by since the last accepted one (the integrator's
+    /// last current; grows by one step per rejected sample).
     step_allowance: T,
     lock: LockDetector<T>,
     /// `lock.status()`, kept where the detector's slot commits it (one byte to read per
@@ -825,7 +824,6 @@ impl<T: Real> SensorlessEstimator<T> {
             k_df_enabled: true,
             rejected_samples: 0,
             bounds,
-            i_prev: Ab::zero(),
             step_allowance: bounds.step(),
             lock,
             lock_status: LockStatus::Locked,
@@ -878,7 +876,14 @@ impl<T: Real> SensorlessEstimator<T> {
             (lambda_r, Ab::zero())
         };
         self.integrator.reset_to(lambda1);
-        self.integrator.set_last_current(i_ab);
+        // The last current is also what the first sample's current step is checked against
+        // (see `crate::plausibility`): an implausible one is not kept.
+        self.integrator
+            .set_last_current(if self.bounds.current_ok(i_ab) {
+                i_ab
+            } else {
+                Ab::zero()
+            });
         self.observer.reset_to(if self.observer_on_rotor_flux {
             Ab::from_polar(self.flux_linkage, theta0)
         } else {
@@ -898,11 +903,6 @@ impl<T: Real> SensorlessEstimator<T> {
         self.v_sum = Ab::zero();
         self.i_sum = Ab::zero();
         self.slow_feedback = self.offset.offset();
-        self.i_prev = if self.bounds.current_ok(i_ab) {
-            i_ab
-        } else {
-            Ab::zero()
-        };
         self.step_allowance = self.bounds.step();
     }
 
@@ -935,10 +935,12 @@ impl<T: Real> SensorlessEstimator<T> {
     #[inline(always)]
     fn advance<O: From<Estimate<T>>>(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> O {
         // Plausibility first (a few compares; false for NaN/∞ too, see `crate::plausibility`).
-        if !self
-            .bounds
-            .check(v_ab, i_ab, self.i_prev, self.step_allowance)
-        {
+        if !self.bounds.check(
+            v_ab,
+            i_ab,
+            self.integrator.last_current(),
+            self.step_allowance,
+        ) {
             return self.reject().into();
         }
         // The whole new state is computed first and committed only if it is finite: a
@@ -1080,7 +1082,6 @@ impl<T: Real> SensorlessEstimator<T> {
             self.lock.commit(lock);
             self.lock_status = lock.status();
         }
-        self.i_prev = i_ab;
         self.step_allowance = self.bounds.step();
         // SLOW_PERIOD is a power of two: the modulo is a mask.
         self.slot = (slot + 1) % SLOW_PERIOD;

@@ -130,8 +130,9 @@ impl<T: Real> FluxIntegrator<T> {
         self.i_prev
     }
 
-    /// Records the current present at a reset, for reporting only: the first sample after a
-    /// reset still uses its own current alone for the resistive drop.
+    /// Records the current present at a reset, not for the resistive drop (the first sample
+    /// after a reset still uses its own current alone): the estimator reports it and checks
+    /// the first sample's current step against it.
     #[inline]
     pub(crate) fn set_last_current(&mut self, i_ab: Ab<T>) {
         self.i_prev = i_ab;
