@@ -953,10 +953,13 @@ impl<T: Real> SensorlessEstimator<T> {
         let saliency = self.saliency;
         // 1. Integrate with the feedback of the previous sample (eq. (21) / (24)).
         let (lambda1, i_drop) = self.integrator.next_flux(v_ab, i_ab, self.feedback);
+        // L̂q·i of eq. (5), formed once for both of its uses (λ̂r, and the observer's input
+        // on the rotor flux): what `rotor_flux` computes, bit for bit.
+        let lq_i = i_ab * self.lq;
         // 2. Disturbance observer at ω̂ of T2S-1 (eq. (10), (16)), on λ1 or on λ1 − L̂q·i
         //    (see `EstimatorTuning::observer_on_rotor_flux`).
         let observer_input = if self.observer_on_rotor_flux {
-            let active = rotor_flux(lambda1, i_ab, self.lq);
+            let active = lambda1 - lq_i;
             if saliency != T::zero() {
                 active - self.active_flux_swing(i_ab, saliency)
             } else {
@@ -971,7 +974,7 @@ impl<T: Real> SensorlessEstimator<T> {
         let (observer_flux, disturbance) = self.observer.next_state(observer_input, observer_speed);
         // 3. Rotor flux and direct angle (eq. (20), (5), (6)).
         let lambda2 = stator_flux(lambda1, disturbance);
-        let lambda_r = rotor_flux(lambda2, i_ab, self.lq);
+        let lambda_r = lambda2 - lq_i;
         let tracker_hold = lambda_r.norm_squared() < self.hold_level_sq;
         let theta_direct = rotor_angle(lambda_r);
         let slot = self.slot;
