@@ -1028,11 +1028,9 @@ impl<T: Real> SensorlessEstimator<T> {
         };
         // The learned integrand offset ê is subtracted from the integrand in both modes, with
         // the standstill pull of the R̂s adaptation (both held between the slow laws' runs).
-        let feedback = if self.rs_adaptation_on {
-            base_feedback + self.slow_feedback
-        } else {
-            base_feedback
-        };
+        // Without the R̂s adaptation both are exactly zero (nothing learns them; it cannot be
+        // switched off once on), so the sum needs no test of the flag.
+        let feedback = base_feedback + self.slow_feedback;
         // Which values the one test needs (the others follow from them, so the test is
         // exact, not approximate): a non-finite v or i makes λ1 non-finite (Ts·v, and R̂s·i
         // with R̂s ≥ 0: ∞·R̂s = ∞, 0·∞ = NaN, ∞ − ∞ = NaN); a tracker's ω̂ = ω̂ + Ki·Ts·e is
