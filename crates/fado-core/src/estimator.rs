@@ -1060,13 +1060,12 @@ impl<T: Real> SensorlessEstimator<T> {
         // With the integrand-offset law, the k_df mode re-centres too, at k_e (see
         // `crate::integrand_offset`: D̂ then decays at k_df + k_e instead of k_df, and the
         // ramp k_df·D̂ that the observer has to follow goes with it).
-        let shift = if mode == Mode::Limiter && self.limiter_recentring_gain > T::zero() {
-            disturbance * self.limiter_recentring_gain
-        } else if mode == Mode::DisturbanceFeedback && self.offset_recentring_gain > T::zero() {
-            disturbance * self.offset_recentring_gain
-        } else {
-            Ab::zero()
-        };
+        // A gain switched off is 0 and its shift D̂·0 = 0 changes nothing: no test of it.
+        let shift = disturbance
+            * match mode {
+                Mode::Limiter => self.limiter_recentring_gain,
+                Mode::DisturbanceFeedback => self.offset_recentring_gain,
+            };
         self.integrator.commit(lambda1 - shift, i_ab);
         self.observer
             .commit(observer_flux - shift, disturbance - shift);
