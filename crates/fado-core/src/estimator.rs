@@ -1011,16 +1011,12 @@ impl<T: Real> SensorlessEstimator<T> {
         // Loss-of-lock symptoms (see `lock`), in the detector's slot: |λ̂r| against λ̂f, the
         // T2S-1 innovation.
         // (Outside its slot the detector's state is neither copied nor written back.)
+        // The innovation is T2S-1's phase error of this sample (0 when the trackers coasted).
         let lock = if slot == SLOT_LOCK {
-            let innovation = if tracker_hold {
-                T::zero()
-            } else {
-                self.t2s1.phase_error(theta_direct)
-            };
             Some(self.lock.next_state(
                 lambda_r.norm_squared(),
                 flux_hat * flux_hat * active_ratio * active_ratio,
-                innovation,
+                t2s1.innovation,
                 clamping,
             ))
         } else {

@@ -182,10 +182,9 @@ impl<T: Real> TypeTwoTracker<T> {
         }
     }
 
-    /// wrap(θm − θ̂⁻) for θm ∈ [−π, π]: the phase error of the next update (also the
-    /// loss-of-lock detector's innovation).
+    /// wrap(θm − θ̂⁻) for θm ∈ [−π, π]: the phase error of the next update.
     #[inline(always)]
-    pub(crate) fn phase_error(&self, theta_measured: T) -> T {
+    fn phase_error(&self, theta_measured: T) -> T {
         T::angle_diff(T::angle_from(theta_measured), self.predicted)
     }
 
