@@ -82,10 +82,12 @@ fn adaptation_never_makes_a_passing_scenario_fail() {
 }
 
 #[test]
-fn fig10_over_eight_noise_seeds_adaptation_passes_more_and_its_worst_is_better() {
-    // Measured: fixed R̂s passes 4/8 (worst 0.68 rad), adapted 5/8 (worst 0.43 rad); seed 1
-    // is one that flips from 0.32 (pass) to 0.39 rad (fail): the stop transient, not the walk,
-    // which adaptation slows (the DC test holds |λ̂r|).
+fn fig10_over_eight_noise_seeds_both_paths_stay_within_issue_13s_bound() {
+    // Issue 13: fig10 < 0.25 rad on sensor seeds 1–8. Measured on main 967edfd (observer lag
+    // compensation): fixed R̂s 8/8, worst 0.0613 rad; adapted 8/8, worst 0.0619 rad. Before
+    // the compensation the adapted path was the better one (worst 0.43 against 0.68 rad when
+    // the stop transient decided it); now both sit at the sensor-noise floor, so the adapted
+    // path may not be worse than the fixed one by more than that noise (0.01 rad).
     let mut passed = [0, 0];
     let mut worst = [0.0f64, 0.0];
     for seed in 1..=8 {
@@ -98,14 +100,16 @@ fn fig10_over_eight_noise_seeds_adaptation_passes_more_and_its_worst_is_better()
         }
     }
     eprintln!("fig10 over 8 seeds: fixed R̂s {passed:?} passed, worst {worst:?} rad");
-    assert!(
-        passed[1] >= passed[0],
-        "passed: fixed {}, adapted {}",
-        passed[0],
-        passed[1]
+    assert_eq!(
+        passed,
+        [8, 8],
+        "worst: fixed {}, adapted {}",
+        worst[0],
+        worst[1]
     );
+    assert!(worst[0] < 0.25 && worst[1] < 0.25, "worst {worst:?}");
     assert!(
-        worst[1] <= worst[0],
+        worst[1] <= worst[0] + 0.01,
         "worst: fixed {}, adapted {}",
         worst[0],
         worst[1]

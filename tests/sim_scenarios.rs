@@ -3,8 +3,8 @@
 //! gain error, noise, ADC), matched model parameters. Each run is a few tenths of a second in
 //! release mode, so every scenario runs switching-resolved.
 //!
-//! fig8 and fig10 do not meet their SPEC criteria with the default sensors (see the ignored
-//! tests and the crate report); what they do meet is asserted here.
+//! Every scenario's SPEC criteria are asserted here; fig8 and fig10, which sit nearest their
+//! thresholds, on eight sensor-noise seeds.
 
 use fado::sim::scenario::{Outcome, simulate};
 
@@ -88,11 +88,14 @@ fn fig10_sensor_offset_walks_the_estimate_along_the_limiter_circle_at_e_t_over_r
     // The start-up offset calibration is off here: it is what removes this walk (below); so is
     // the gain calibration (its later start changes the hold this measures). This
     // checks the paper's limiter, so without our R̂s adaptation (whose standstill law pulls
-    // |λ̂r| to λ̂f instead of the circle).
-    let cfg = "[current_sensor]\nenable_gain_error = false\nenable_noise = false\n\
+    // |λ̂r| to λ̂f instead of the circle) and with the paper's observer input ω̂1 (our
+    // `observer_lag_compensation` feeds the observer T2S-1's proportional term as well, and
+    // the observer then absorbs most of the offset: checked at the end).
+    let paper = "[current_sensor]\nenable_gain_error = false\nenable_noise = false\n\
                enable_quantization = false\n[controller]\noffset_calibration_time = 0.0\n\
                gain_calibration_time = 0.0\n[estimator]\nrs_adaptation = false\n";
-    let out = run("fig10", Some(cfg), false);
+    let cfg = format!("{paper}observer_lag_compensation = false\n");
+    let out = run("fig10", Some(&cfg), false);
     let c = &out.config;
     let rs_hat = c.estimator_config().machine.rs;
     let rho = c.estimator.limiter_radius_ratio * c.estimator_config().machine.flux_linkage;
@@ -140,6 +143,16 @@ fn fig10_sensor_offset_walks_the_estimate_along_the_limiter_circle_at_e_t_over_r
         fado::core::wrap_angle(last.angle_error - first.angle_error) / (last.time - first.time);
     eprintln!("with calibration: d(θ − θ̂)/dt = {walk:.4} rad/s");
     assert!(walk.abs() < 0.2 * predicted.abs(), "{walk} vs {predicted}");
+    // Uncalibrated again, with the lag compensation (the default): the observer, fed the
+    // creeping estimate's phase rate, takes up the offset as a disturbance and the walk
+    // slows (measured 0.07× e_t/ρ on main e01a9cd).
+    let comp = run("fig10", Some(paper), false);
+    let rows: Vec<_> = comp.trace.rows.iter().filter(|r| r.time >= 3.5).collect();
+    let (first, last) = (rows[0], rows[rows.len() - 1]);
+    let walk =
+        fado::core::wrap_angle(last.angle_error - first.angle_error) / (last.time - first.time);
+    eprintln!("with lag compensation: d(θ − θ̂)/dt = {walk:.4} rad/s");
+    assert!(walk.abs() < 0.5 * measured.abs(), "{walk} vs {measured}");
 }
 
 #[test]
@@ -164,22 +177,34 @@ fn fig8_lambda2_is_centred_in_steady_state() {
     }
 }
 
-#[test]
-#[ignore = "known failure (switching-resolved): λ2 DC reaches 2.03 % of λf in the one \
-            revolution after the LO→HI hand-over (SPEC: < 2 %; 2.12 % without R̂s adaptation); \
-            passes for 3 of 8 noise seeds"]
-fn fig8_paper_criterion() {
-    let out = run("fig8", None, false);
-    assert!(out.passed, "{:?}", out.checks);
+/// The configuration of sensor-noise seed `seed` with every other setting at its default.
+fn seed(seed: u64) -> String {
+    format!("[current_sensor]\nseed = {seed}\n")
 }
 
 #[test]
-#[ignore = "seed-dependent with default sensors: the stop leaves ≈ 0.3 rad, then the 0.5 % \
-            gain error's integrand walks θ̂ along the flux circle (SPEC threshold 0.35 [A]); \
-            figures per seed in the crate README"]
-fn fig10_paper_criterion() {
-    let out = run("fig10", None, false);
-    assert!(out.passed, "{:?}", out.checks);
+fn fig8_paper_criterion_on_eight_sensor_seeds() {
+    // Issue 13: fig8 < 2 % on seeds 1–8 (the worst revolution's DC of λ2 − λs over λf). It
+    // failed on 2–3 of 8 seeds (2.03–2.23 %) until the observer's speed input carried
+    // T2S-1's proportional term (`observer_lag_compensation`): 0.29–0.72 % measured since.
+    for s in 1..=8 {
+        let out = run("fig8", Some(&seed(s)), false);
+        assert!(out.passed, "seed {s}: {:?}", out.checks);
+    }
+}
+
+#[test]
+fn fig10_paper_criterion_on_eight_sensor_seeds_and_issue_13s_bound() {
+    // SPEC's 0.35 rad [A] and issue 13's tighter 0.25 rad, seeds 1–8 (measured 0.059–0.062).
+    for s in 1..=8 {
+        let out = run("fig10", Some(&seed(s)), false);
+        assert!(out.passed, "seed {s}: {:?}", out.checks);
+        assert!(
+            out.metrics.max_angle_error < 0.25,
+            "seed {s}: {}",
+            out.metrics.max_angle_error
+        );
+    }
 }
 
 #[test]
