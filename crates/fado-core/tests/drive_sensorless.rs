@@ -159,7 +159,15 @@ fn duties_realise_the_reference_plus_the_dead_time_compensation() {
     // duty·Vdc (Clarke) = realised reference + Clarke of the per-phase compensation, which is
     // the trapezoid of the reference current at θ̂ + 1.5·ω̂·Ts; at a low Vdc the sum is
     // limited to the hexagon and the reported reference is what remains after compensation.
-    let mut drive = spy_drive();
+    // (The trapezoid: it depends on the current only; the edge-current default also on the
+    // unlimited reference, checked against the switching-resolved inverter in fado-sim.)
+    let mut cfg = synthetic_currents();
+    cfg.tuning.dead_time_method = DeadTimeMethod::Trapezoidal;
+    let spy = Spy {
+        omega: TAU * 30.0,
+        ..Spy::default()
+    };
+    let mut drive = SensorlessDrive::with_estimator(cfg, spy).unwrap();
     let dtc = DeadTimeCompensation::new(DeadTimeCompensationConfig::default()).unwrap();
     let mut saturated = 0;
     for n in 0..200 {
@@ -352,7 +360,11 @@ proptest! {
             ),
             1..300,
         ),
-        method in prop_oneof![Just(DeadTimeMethod::Trapezoidal), Just(DeadTimeMethod::Sign)],
+        method in prop_oneof![
+            Just(DeadTimeMethod::Trapezoidal),
+            Just(DeadTimeMethod::Sign),
+            Just(DeadTimeMethod::EdgeCurrent)
+        ],
     ) {
         let mut d64 = drives::<f64>(method);
         let mut d32 = drives::<f32>(method);
@@ -518,15 +530,19 @@ fn voltage_history_is_aligned_with_the_interval_it_acted_over() {
         };
         let config = EstimatorConfig::for_machine(&MachineModel::paper());
         let estimator = SensorlessEstimator::new(config).unwrap();
+        // The model plant is the averaged SPEC §5 inverter (no ripple): the trapezoid is its
+        // exact inverse.
+        let mut drive_config = no_calibration();
+        drive_config.tuning.dead_time_method = DeadTimeMethod::Trapezoidal;
         if older {
             let est = OneSampleOlder {
                 inner: estimator,
                 previous: Ab::zero(),
             };
-            let drive = SensorlessDrive::with_estimator(no_calibration(), est).unwrap();
+            let drive = SensorlessDrive::with_estimator(drive_config, est).unwrap();
             closed_loop(drive, 10_000, |_| w_mech, |_| 0.0, f64::INFINITY, observe);
         } else {
-            let drive = SensorlessDrive::with_estimator(no_calibration(), estimator).unwrap();
+            let drive = SensorlessDrive::with_estimator(drive_config, estimator).unwrap();
             closed_loop(drive, 10_000, |_| w_mech, |_| 0.0, f64::INFINITY, observe);
         }
         sum / count

@@ -13,7 +13,7 @@
 //! given directly: they are the plant's times the `[mismatch]` ratios, so "matched" stays
 //! matched when the motor changes.
 
-use fado_core::control::{DriveConfig, DriveTuning};
+use fado_core::control::{DeadTimeMethod, DriveConfig, DriveTuning};
 use fado_core::{EstimatorConfig, EstimatorTuning, MachineModel};
 use serde::{Deserialize, Serialize};
 
@@ -447,7 +447,9 @@ impl SimConfig {
 
     /// The drive configuration: `[controller]` tuning, the drive's model, timing and the
     /// dead-time compensation's inverter data from `[inverter]` (× `[mismatch]`), its
-    /// threshold voltage from `[inverter_model]` when that gives it.
+    /// threshold voltage from `[inverter_model]` when that gives it. With the averaged
+    /// inverter, which has no PWM ripple, `dead_time_method = "edge_current"` becomes the
+    /// trapezoid it then equals (its exact inverse), so that "matched" stays matched.
     pub fn drive_config(&self) -> DriveConfig<f64> {
         let (inv, m) = (&self.inverter, &self.mismatch);
         let threshold = self
@@ -463,6 +465,12 @@ impl SimConfig {
                 switching_frequency: inv.switching_frequency,
                 dead_time_threshold_voltage: threshold,
                 dead_time_current_band: inv.current_band * m.current_band_ratio,
+                dead_time_method: match (inv.model, self.controller.dead_time_method) {
+                    (crate::inverter::InverterModel::Averaged, DeadTimeMethod::EdgeCurrent) => {
+                        DeadTimeMethod::Trapezoidal
+                    }
+                    (_, method) => method,
+                },
                 ..self.controller
             },
         }
@@ -845,5 +853,30 @@ mod located_errors {
         let e = SimConfigError::new("estimator.rs_hat", "x").located_in("[motor]\nrs = 1\n");
         assert_eq!(e.location, None);
         assert_eq!(e.to_string(), "`estimator.rs_hat`: x");
+    }
+}
+
+#[cfg(test)]
+mod dead_time_method {
+    use super::*;
+    use crate::inverter::InverterModel as Plant;
+    use fado_core::control::DeadTimeMethod::{EdgeCurrent, Sign, Trapezoidal};
+
+    #[test]
+    fn edge_current_is_the_trapezoid_on_the_ripple_free_averaged_plant() {
+        let method = |model: Plant, asked| {
+            let mut c = SimConfig::default();
+            c.inverter.model = model;
+            c.controller.dead_time_method = asked;
+            c.drive_config().tuning.dead_time_method
+        };
+        assert_eq!(
+            SimConfig::default().drive_config().tuning.dead_time_method,
+            EdgeCurrent
+        );
+        assert_eq!(method(Plant::SwitchingResolved, EdgeCurrent), EdgeCurrent);
+        assert_eq!(method(Plant::Averaged, EdgeCurrent), Trapezoidal);
+        assert_eq!(method(Plant::Averaged, Sign), Sign);
+        assert_eq!(method(Plant::SwitchingResolved, Trapezoidal), Trapezoidal);
     }
 }

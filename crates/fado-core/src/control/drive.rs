@@ -95,7 +95,10 @@ pub struct DriveTuning<T> {
     pub dead_time_current_band: T,
     /// Compensate the dead time at all. Default true (paper IV-B).
     pub dead_time_compensation: bool,
-    /// Trapezoidal (SPEC §5) or sign(i) compensation. Default trapezoidal \[A\].
+    /// Shape of the compensation. Default [`DeadTimeMethod::EdgeCurrent`] \[A\]: the SPEC §5
+    /// trapezoid evaluated at each switching edge's predicted current (PWM ripple included,
+    /// L̂ = (L̂d + L̂q)/2 of the machine model); it keeps |λ̂r| from shrinking while a phase
+    /// current sits in the band at standstill under load (docs/zero-speed-errors.md).
     pub dead_time_method: DeadTimeMethod,
     /// Angle advance of the voltage in samples. Default 1.5 (SPEC §5 \[A\], ref. \[13\]).
     pub delay_compensation_factor: T,
@@ -314,7 +317,7 @@ impl<T: Real> Default for DriveTuning<T> {
             dead_time_threshold_voltage: T::one(),
             dead_time_current_band: T::lit(0.3),
             dead_time_compensation: true,
-            dead_time_method: DeadTimeMethod::Trapezoidal,
+            dead_time_method: DeadTimeMethod::EdgeCurrent,
             delay_compensation_factor: T::lit(1.5),
             trip_current_ratio: per_rated(60.0),
             decoupling: true,
@@ -707,7 +710,7 @@ impl<T: Real> Blocks<T> {
         i_abc: Abc<T>,
         vdc: T,
     ) -> Option<Applied<T>> {
-        let v_comp = self.dead_time.step(rot, i_dq_ref, i_abc, vdc);
+        let v_comp = self.dead_time.step_for(rot, i_dq_ref, i_abc, v_ab, vdc);
         let m = self.modulator.step(v_ab + v_comp, vdc);
         let (v_ab, v_dq) = if !m.saturated {
             (v_ab, v_dq) // exactly what was asked for: nothing to back-calculate
@@ -840,6 +843,7 @@ impl<T: Real> Blocks<T> {
             switching_frequency: t.switching_frequency,
             threshold_voltage: t.dead_time_threshold_voltage,
             current_band: t.dead_time_current_band,
+            ripple_inductance: T::lit(0.5) * (m.ld + m.lq),
         })
         .map_err(rename(&[
             ("threshold_voltage", "dead_time_threshold_voltage"),
