@@ -806,7 +806,7 @@ mod tests {
             switching_frequency: p.switching_frequency,
             threshold_voltage: p.threshold_voltage,
             current_band: p.current_band,
-            ripple_inductance: 0.5 * (mp.ld + mp.lq),
+            ripple_inductance: Dq::new(mp.ld, mp.lq),
             ..DeadTimeCompensationConfig::default()
         })
         .unwrap();

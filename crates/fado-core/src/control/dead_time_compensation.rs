@@ -31,11 +31,11 @@
 //! standstill under 7.5 N·m (test `edge_current_compensation_matches_…` in fado-sim's
 //! inverter), a d-axis error that shrank |λ̂r| by 20 % in a 100 ms stop and put `stops` at
 //! 0.25 rad (docs/zero-speed-errors.md). This method predicts, from the voltage reference,
-//! the DC link and L̂ = (L̂d + L̂q)/2, the gate times of both half carrier periods (symmetric
+//! the DC link and the inductance matrix (L̂d, L̂q at θ̂), the gate times of both half carrier periods (symmetric
 //! carrier, min-max zero sequence as [`crate::control::modulation`]), each pole's edge delayed
 //! by the band model, the current of each phase at its own gate edge (the piecewise-linear
-//! ripple: each other pole already switched adds ∓Vdc/(3L̂) to its slope, the mean slope
-//! v̄_x/L̂ removed, the peak sample i − Δ/2 and the valley sample i + Δ/2 with Δ the swing the
+//! ripple: each other pole already switched adds the current response of its α-β voltage
+//! step ±(2/3)·Vdc·u_k, −Vdc/(3L̂) on a round rotor, the mean slope removed, the peak sample i − Δ/2 and the valley sample i + Δ/2 with Δ the swing the
 //! pattern predicts), the two edges' delays and so the period-average pole error
 //! Vdc·f_sw·(t_fall − t_rise) − V_th·sat(i/Ic), two fixed-point passes; < 0.1 V left in the
 //! same test. Outside the band it is the trapezoid exactly. Cost: ≈ 150 flops and five
@@ -82,9 +82,10 @@ pub struct DeadTimeCompensationConfig<T> {
     pub threshold_voltage: T,
     /// Current band Ic of the trapezoid in A. Default 0.3 A (SPEC §5 \[A\]).
     pub current_band: T,
-    /// Phase inductance L̂ of the ripple prediction of [`DeadTimeMethod::EdgeCurrent`] in H
-    /// (the drive gives (L̂d + L̂q)/2 of its machine model). Default 0: no ripple.
-    pub ripple_inductance: T,
+    /// Inductances (L̂d, L̂q) of the ripple prediction of [`DeadTimeMethod::EdgeCurrent`] in H,
+    /// in the rotor frame of the rotation it is given (the drive gives its machine model's).
+    /// Default 0: no ripple.
+    pub ripple_inductance: Dq<T>,
 }
 
 impl<T: Real> Default for DeadTimeCompensationConfig<T> {
@@ -96,7 +97,7 @@ impl<T: Real> Default for DeadTimeCompensationConfig<T> {
             switching_frequency: T::lit(5e3),
             threshold_voltage: T::one(),
             current_band: T::lit(0.3),
-            ripple_inductance: T::zero(),
+            ripple_inductance: Dq::zero(),
         }
     }
 }
@@ -121,7 +122,8 @@ impl<T: Real> DeadTimeCompensation<T> {
         )?;
         check::non_negative("threshold_voltage", config.threshold_voltage)?;
         let ic = check::positive("current_band", config.current_band)?;
-        check::non_negative("ripple_inductance", config.ripple_inductance)?;
+        check::non_negative("ripple_inductance", config.ripple_inductance.d)?;
+        check::non_negative("ripple_inductance", config.ripple_inductance.q)?;
         Ok(Self {
             config,
             inv_band: T::one() / ic,
@@ -202,18 +204,30 @@ impl<T: Real> DeadTimeCompensation<T> {
         if !(self.config.enabled && self.config.method == DeadTimeMethod::EdgeCurrent) {
             return self.phase_voltages(rotation, i_dq_ref, i_abc, vdc);
         }
-        let out = self.edge_current(i_dq_ref.to_ab(rotation).to_abc(), v_ab.to_abc(), vdc);
+        let out = self.edge_current(
+            rotation,
+            i_dq_ref.to_ab(rotation).to_abc(),
+            v_ab.to_abc(),
+            vdc,
+        );
         if out.is_finite() { out } else { Abc::default() }
     }
 
     /// [`DeadTimeMethod::EdgeCurrent`] for phase currents `i_abc` (A) and the phase voltage
-    /// reference `v_abc` (V, before compensation): −(period-average pole error) per phase
-    /// (module docs). The trapezoid without a positive DC link or inductance.
-    pub fn edge_current(&self, i_abc: Abc<T>, v_abc: Abc<T>, vdc: T) -> Abc<T> {
+    /// reference `v_abc` (V, before compensation), the rotor frame `rotation` setting the
+    /// inductance matrix: −(period-average pole error) per phase (module docs). The trapezoid
+    /// without a positive DC link or inductance.
+    pub fn edge_current(
+        &self,
+        rotation: Rotation<T>,
+        i_abc: Abc<T>,
+        v_abc: Abc<T>,
+        vdc: T,
+    ) -> Abc<T> {
         let c = &self.config;
         let l = c.ripple_inductance;
         let first = self.trapezoid(i_abc, vdc);
-        if !(vdc > T::zero() && l > T::zero()) {
+        if !(vdc > T::zero() && l.d > T::zero() && l.q > T::zero()) {
             return first;
         }
         let zero = T::zero();
@@ -246,40 +260,50 @@ impl<T: Real> DeadTimeCompensation<T> {
                 td * (one - ie.abs() * band).max(zero)
             }
         };
-        let third = vdc / T::lit(3.0);
-        let inv_l = one / l;
+        // Phase axes u_x and the current response L⁻¹·w of a volt-second vector w (α-β, the
+        // rotor frame's 1/L̂d, 1/L̂q).
+        let k3 = T::lit(0.866_025_403_784_438_6);
+        let axes = [
+            Ab::new(one, zero),
+            Ab::new(T::lit(-0.5), k3),
+            Ab::new(T::lit(-0.5), -k3),
+        ];
+        let (inv_ld, inv_lq) = (one / l.d, one / l.q);
+        let respond = |w: Ab<T>| {
+            let w = w.to_dq(rotation);
+            Dq::new(w.d * inv_ld, w.q * inv_lq).to_ab(rotation)
+        };
+        let pole_step = T::lit(2.0 / 3.0) * vdc; // α-β step of one pole moving by Vdc
         let mut d_rise = i.map(|x| delay(true, x));
         let mut d_fall = i.map(|x| delay(false, x));
         for _ in 0..2 {
             let pr = [0, 1, 2].map(|k| (tg_rise[k] + d_rise[k]).min(half));
             let pf = [0, 1, 2].map(|k| (tg_fall[k] + d_fall[k]).min(half));
-            // Volt-seconds of each phase (to the star point) over each half: poles low → high
-            // at pr while the carrier falls, high → low at pf while it rises.
-            let (sum_r, sum_f) = (
-                pr.iter().fold(zero, |a, &t| a + (half - t)),
-                pf.iter().fold(zero, |a, &t| a + t),
-            );
+            // Volt-seconds over each half: poles low → high at pr while the carrier falls,
+            // high → low at pf while it rises (zero vectors at the samples).
+            let (mut int_r, mut int_f) = (Ab::zero(), Ab::zero());
+            for k in 0..3 {
+                int_r += axes[k] * (pole_step * (half - pr[k]));
+                int_f += axes[k] * (-pole_step * (half - pf[k]));
+            }
+            // Mean voltage over the period (the back-EMF and R·i it balances) and the
+            // current's swing between the carrier's peak and valley samples, whose mean is the
+            // reference: i(peak) = i − Δ/2, i(valley) = i + Δ/2.
+            let vbar = (int_r + int_f) * (one / (half + half));
+            let half_swing = respond((int_r - int_f) * T::lit(0.25));
             let mut nr = d_rise;
             let mut nf = d_fall;
             for x in 0..3 {
-                let int_r = third * (T::lit(3.0) * (half - pr[x]) - sum_r);
-                let int_f = third * (T::lit(3.0) * pf[x] - sum_f);
-                // Mean voltage over the period (the back-EMF and R·i it balances) and the
-                // current's swing between the carrier's peak and valley samples, whose mean is
-                // the reference: i(peak) = i − Δ/2, i(valley) = i + Δ/2.
-                let vbar = (int_r + int_f) / (half + half);
-                let swing = (int_r - int_f) * T::lit(0.5) * inv_l;
-                let (mut sr, mut sf) = (zero, zero);
+                // Volt-seconds (mean removed) up to x's own gate edge, x not yet switched.
+                let (mut wr, mut wf) = (vbar * -tg_rise[x], vbar * -tg_fall[x]);
                 for k in 0..3 {
                     if k != x {
-                        sr += (tg_rise[x] - pr[k]).max(zero);
-                        sf += (tg_fall[x] - pf[k]).max(zero);
+                        wr += axes[k] * (pole_step * (tg_rise[x] - pr[k]).max(zero));
+                        wf += axes[k] * (-pole_step * (tg_fall[x] - pf[k]).max(zero));
                     }
                 }
-                // Rising edges: x still low, each pole already high pulls it by −Vdc/3;
-                // falling edges: x still high, each pole already low pushes it by +Vdc/3.
-                let ie_r = i[x] - T::lit(0.5) * swing - (third * sr + vbar * tg_rise[x]) * inv_l;
-                let ie_f = i[x] + T::lit(0.5) * swing + (third * sf - vbar * tg_fall[x]) * inv_l;
+                let ie_r = i[x] + axes[x].dot(respond(wr) - half_swing);
+                let ie_f = i[x] + axes[x].dot(respond(wf) + half_swing);
                 nr[x] = delay(true, ie_r);
                 nf[x] = delay(false, ie_f);
             }
@@ -415,6 +439,7 @@ mod tests {
     }
 
     fn edge(l: f64) -> DeadTimeCompensation<f64> {
+        let l = Dq::new(l, l);
         DeadTimeCompensation::new(DeadTimeCompensationConfig {
             method: DeadTimeMethod::EdgeCurrent,
             ripple_inductance: l,
@@ -477,6 +502,9 @@ mod tests {
         assert_eq!(bad(|c| c.switching_frequency = 0.0), "switching_frequency");
         assert_eq!(bad(|c| c.threshold_voltage = f64::NAN), "threshold_voltage");
         assert_eq!(bad(|c| c.current_band = 0.0), "current_band");
-        assert_eq!(bad(|c| c.ripple_inductance = -1e-3), "ripple_inductance");
+        assert_eq!(
+            bad(|c| c.ripple_inductance = Dq::new(1e-3, -1e-3)),
+            "ripple_inductance"
+        );
     }
 }

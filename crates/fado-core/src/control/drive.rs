@@ -97,7 +97,7 @@ pub struct DriveTuning<T> {
     pub dead_time_compensation: bool,
     /// Shape of the compensation. Default [`DeadTimeMethod::EdgeCurrent`] \[A\]: the SPEC §5
     /// trapezoid evaluated at each switching edge's predicted current (PWM ripple included,
-    /// L̂ = (L̂d + L̂q)/2 of the machine model); it keeps |λ̂r| from shrinking while a phase
+    /// L̂d, L̂q of the machine model); it keeps |λ̂r| from shrinking while a phase
     /// current sits in the band at standstill under load (docs/zero-speed-errors.md).
     pub dead_time_method: DeadTimeMethod,
     /// Angle advance of the voltage in samples. Default 1.5 (SPEC §5 \[A\], ref. \[13\]).
@@ -843,7 +843,7 @@ impl<T: Real> Blocks<T> {
             switching_frequency: t.switching_frequency,
             threshold_voltage: t.dead_time_threshold_voltage,
             current_band: t.dead_time_current_band,
-            ripple_inductance: T::lit(0.5) * (m.ld + m.lq),
+            ripple_inductance: Dq::new(m.ld, m.lq),
         })
         .map_err(rename(&[
             ("threshold_voltage", "dead_time_threshold_voltage"),
