@@ -795,11 +795,12 @@ mod tests {
     /// that the peak and valley samples average to i (Δ = their measured swing).
     fn standstill_compensation_error(
         method: fado_core::control::DeadTimeMethod,
+        mp: MotorParams,
+        theta: f64,
         i_abc: [f64; 3],
     ) -> Ab<f64> {
         use fado_core::control::{DeadTimeCompensation, DeadTimeCompensationConfig};
         let p = InverterParams::default();
-        let mp = MotorParams::paper();
         let comp = DeadTimeCompensation::new(DeadTimeCompensationConfig {
             method,
             dead_time: p.dead_time,
@@ -813,8 +814,8 @@ mod tests {
         let vdc = p.dc_voltage;
         let i_ab = clarke(i_abc);
         let v_ref = i_ab * mp.rs;
-        let rot = fado_core::Rotation::from_angle(0.0);
-        let i_dq = Dq::new(i_ab.alpha, i_ab.beta);
+        let rot = fado_core::Rotation::from_angle(theta);
+        let i_dq = i_ab.to_dq(rot);
         let c = comp.phase_voltages_for(rot, i_dq, Abc::default(), v_ref, vdc);
         let v = v_ref.to_abc();
         let pole = [v.a + c.a, v.b + c.b, v.c + c.c];
@@ -825,13 +826,14 @@ mod tests {
             0.5 + (pole[2] + v0) / vdc,
         );
         let mut inv = Inverter::new(p).unwrap();
-        let mut m = motor_with(i_dq, 0.0, 0.0);
+        let mut m = Motor::new(mp, 0.0).unwrap();
+        m.set_state(i_dq, theta, 0.0);
         inv.step(&mut m, duty, true); // load the duty
         inv.step(&mut m, duty, true); // now at a carrier peak
         let mut start = i_dq;
         let mut err = Ab::zero();
         for _ in 0..3 {
-            m.set_state(start, 0.0, 0.0);
+            m.set_state(start, theta, 0.0);
             let a = inv.step(&mut m, duty, true);
             let valley = m.state().i_dq;
             let b = inv.step(&mut m, duty, true);
@@ -843,43 +845,55 @@ mod tests {
 
     #[test]
     fn edge_current_compensation_matches_the_switching_resolved_error_in_the_band() {
-        // The paper's motor at standstill under ≈ 7.5 N·m, phase b's current swept through the
-        // band Ic = 0.3 A (the restart of `stops`): the trapezoid on the average current
+        // Standstill under ≈ 12 A, phase b's current swept through the band Ic = 0.3 A (the
+        // restart of `stops`). The paper's round rotor: the trapezoid on the average current
         // leaves up to 0.64 V on phase b (measured: the ripple moves its helping edge's
         // current away from zero, the peak-valley swing towards it); the edge-current
-        // prediction leaves < 0.1 V (0.097). Outside the band both are exact.
+        // prediction < 0.1 V (0.097). A salient rotor (0.37/1.2 mH as ipmsm-gem-50k) at
+        // 0.4 rad, ripple ≈ 7× larger: trapezoid 1.12 V, edge current 0.84 V — only a little
+        // better: there the peak-valley swing's dependence on the phase's own edge delay has
+        // a loop gain Vdc·Td/(6·L̂·Ic) ≈ 1.2 > 1, the two-pass prediction does not converge
+        // (docs/zero-speed-errors.md). Outside the band both are exact.
         use fado_core::control::DeadTimeMethod;
-        let (mut worst_trap, mut worst_edge) = (0.0_f64, 0.0_f64);
-        for k in -8..=8 {
-            let ib = k as f64 * 0.05;
-            let i_abc = [-12.2 - 0.5 * ib, ib, 12.2 - 0.5 * ib];
-            // Phase b's share of the α-β error: 1.5·(e·u_b).
-            let on_b = |e: Ab<f64>| 1.5 * (-0.5 * e.alpha + 0.866_025_403_784_438_6 * e.beta);
-            let trap = on_b(standstill_compensation_error(
-                DeadTimeMethod::Trapezoidal,
-                i_abc,
-            ));
-            let edge = on_b(standstill_compensation_error(
-                DeadTimeMethod::EdgeCurrent,
-                i_abc,
-            ));
-            if ib.abs() > 0.3 {
-                assert!(
-                    trap.abs() < 0.02 && edge.abs() < 0.02,
-                    "{ib}: {trap} {edge}"
+        let salient = MotorParams {
+            rs: 0.018,
+            ld: 0.37e-3,
+            lq: 1.2e-3,
+            ..MotorParams::paper()
+        };
+        for (mp, theta, trap_min, edge_max) in [
+            (MotorParams::paper(), 0.0, 0.5, 0.12),
+            (salient, 0.4, 1.0, 0.9),
+        ] {
+            let (mut worst_trap, mut worst_edge) = (0.0_f64, 0.0_f64);
+            for k in -8..=8 {
+                let ib = k as f64 * 0.05;
+                let i_abc = [-12.2 - 0.5 * ib, ib, 12.2 - 0.5 * ib];
+                // Phase b's share of the α-β error: 1.5·(e·u_b).
+                let on_b = |e: Ab<f64>| 1.5 * (-0.5 * e.alpha + 0.866_025_403_784_438_6 * e.beta);
+                let err = |m| on_b(standstill_compensation_error(m, mp, theta, i_abc));
+                let (trap, edge) = (
+                    err(DeadTimeMethod::Trapezoidal),
+                    err(DeadTimeMethod::EdgeCurrent),
                 );
+                if ib.abs() > 0.3 {
+                    assert!(
+                        trap.abs() < 0.02 && edge.abs() < 0.02,
+                        "{ib}: {trap} {edge}"
+                    );
+                }
+                worst_trap = worst_trap.max(trap.abs());
+                worst_edge = worst_edge.max(edge.abs());
             }
-            worst_trap = worst_trap.max(trap.abs());
-            worst_edge = worst_edge.max(edge.abs());
+            assert!(
+                worst_trap > trap_min,
+                "trapezoid's worst in-band error {worst_trap} V"
+            );
+            assert!(
+                worst_edge < edge_max,
+                "edge-current's worst in-band error {worst_edge} V"
+            );
         }
-        assert!(
-            worst_trap > 0.5,
-            "trapezoid's worst in-band error {worst_trap} V"
-        );
-        assert!(
-            worst_edge < 0.12,
-            "edge-current's worst in-band error {worst_edge} V"
-        );
     }
 
     #[test]
