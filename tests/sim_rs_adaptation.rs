@@ -84,7 +84,8 @@ fn adaptation_never_makes_a_passing_scenario_fail() {
 #[test]
 fn fig10_over_eight_noise_seeds_both_paths_stay_within_issue_13s_bound() {
     // Issue 13: fig10 < 0.25 rad on sensor seeds 1–8. Measured on main 967edfd (observer lag
-    // compensation): fixed R̂s 8/8, worst 0.0613 rad; adapted 8/8, worst 0.0619 rad. Before
+    // compensation): fixed R̂s 8/8, worst 0.0613 rad; adapted 8/8, worst 0.0619 rad (0.0568 /
+    // 0.0570 with the edge-current dead-time compensation, branch issue-restart). Before
     // the compensation the adapted path was the better one (worst 0.43 against 0.68 rad when
     // the stop transient decided it); now both sit at the sensor-noise floor, so the adapted
     // path may not be worse than the fixed one by more than that noise (0.01 rad).
