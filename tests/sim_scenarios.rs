@@ -89,8 +89,8 @@ fn fig10_sensor_offset_walks_the_estimate_along_the_limiter_circle_at_e_t_over_r
     // the gain calibration (its later start changes the hold this measures). This
     // checks the paper's limiter, so without our R̂s adaptation (whose standstill law pulls
     // |λ̂r| to λ̂f instead of the circle) and with the paper's observer input ω̂1 (our
-    // `observer_lag_compensation` feeds the observer T2S-1's proportional term as well, and
-    // the observer then absorbs most of the offset: checked at the end).
+    // `observer_lag_compensation` feeds the observer T2S-1's proportional term as well; checked
+    // at the end that it does not speed the walk up).
     let paper = "[current_sensor]\nenable_gain_error = false\nenable_noise = false\n\
                enable_quantization = false\n[controller]\noffset_calibration_time = 0.0\n\
                gain_calibration_time = 0.0\n[estimator]\nrs_adaptation = false\n";
@@ -143,16 +143,33 @@ fn fig10_sensor_offset_walks_the_estimate_along_the_limiter_circle_at_e_t_over_r
         fado::core::wrap_angle(last.angle_error - first.angle_error) / (last.time - first.time);
     eprintln!("with calibration: d(θ − θ̂)/dt = {walk:.4} rad/s");
     assert!(walk.abs() < 0.2 * predicted.abs(), "{walk} vs {predicted}");
-    // Uncalibrated again, with the lag compensation (the default): the observer, fed the
-    // creeping estimate's phase rate, takes up the offset as a disturbance and the walk
-    // slows (measured 0.07× e_t/ρ on main e01a9cd).
+    // Uncalibrated again, with the lag compensation (the default). Its walk, as the
+    // least-squares slope of θ − θ̂ over the last 1.5 s (after the hold's transients): 0.91×
+    // the paper input's with the trapezoidal dead-time compensation, 0.99× with the
+    // edge-current one (branch issue-restart). The end-point difference from 3.5 s read 0.07×
+    // on main e01a9cd only because a stop transient (−0.06 → −0.38 → −0.34 rad) ended there:
+    // the compensation does not slow this walk; it must not speed it up.
     let comp = run("fig10", Some(paper), false);
-    let rows: Vec<_> = comp.trace.rows.iter().filter(|r| r.time >= 3.5).collect();
-    let (first, last) = (rows[0], rows[rows.len() - 1]);
-    let walk =
-        fado::core::wrap_angle(last.angle_error - first.angle_error) / (last.time - first.time);
+    let rows: Vec<_> = comp.trace.rows.iter().filter(|r| r.time >= 4.0).collect();
+    let n = rows.len() as f64;
+    let t_mean = rows.iter().map(|r| r.time).sum::<f64>() / n;
+    let (mut e_prev, mut e_acc, mut unwrapped) = (rows[0].angle_error, 0.0, Vec::new());
+    for r in &rows {
+        e_acc += fado::core::wrap_angle(r.angle_error - e_prev);
+        e_prev = r.angle_error;
+        unwrapped.push(e_acc);
+    }
+    let e_mean = unwrapped.iter().sum::<f64>() / n;
+    let (sxy, sxx) = rows
+        .iter()
+        .zip(&unwrapped)
+        .fold((0.0, 0.0), |(a, b), (r, e)| {
+            let dt = r.time - t_mean;
+            (a + dt * (e - e_mean), b + dt * dt)
+        });
+    let walk = sxy / sxx;
     eprintln!("with lag compensation: d(θ − θ̂)/dt = {walk:.4} rad/s");
-    assert!(walk.abs() < 0.5 * measured.abs(), "{walk} vs {measured}");
+    assert!(walk.abs() < 1.1 * measured.abs(), "{walk} vs {measured}");
 }
 
 #[test]
