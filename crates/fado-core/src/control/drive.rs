@@ -39,6 +39,7 @@ use crate::control::monitor::{DriveFlags, FlagCounts, PersistenceMonitor, StuckC
 use crate::control::speed_controller::{
     SpeedController, SpeedControllerConfig, limit_current_d_priority,
 };
+use crate::control::standstill_probe::{StandstillProbe, StandstillProbeConfig};
 use crate::error::{ConfigError, check};
 use crate::estimator::{
     Estimate, EstimatorConfig, EstimatorTuning, RotorAngleEstimator, SensorlessEstimator,
@@ -246,6 +247,39 @@ pub struct DriveTuning<T> {
     /// loss it caught that the restriction had missed 0.26 or more; 0.15 still false-alarmed
     /// at 0.151 (docs/lock.md). 0: always.
     pub lock_stall_min_current_ratio: T,
+    /// The loaded-standstill angle probe (see [`crate::control::standstill_probe`]): at a
+    /// loaded standstill a slow square-wave d current, read through the speed loop's torque
+    /// balance, turns θ̂ towards the rotor. Default true \[A\] (without it the one-hour loaded
+    /// standstill drifts to the current limit on 4 of 5 sensor seeds, docs/long-run.md).
+    pub standstill_probe: bool,
+    /// Probe amplitude Δi_d as a fraction of the rated current. Default 0.1 \[A\] (2.2 A on
+    /// the paper's motor: no torque at δ = 0, 0.5 % more copper loss at rated load; the
+    /// reading Δi_d·tan δ is 0.2 A at δ = 0.1 rad against a speed-loop ripple the
+    /// demodulation averages over a whole period).
+    pub standstill_probe_current_ratio: T,
+    /// Probe period T_p in s. Default 0.5 s \[A\]: each half holds 0.25 s, 8 time constants
+    /// 1/(2π·f_sc) of the 5 Hz speed loop (1.6 of its PI zero's ratio/(2π·f_sc) = 0.16 s), the
+    /// correlation reads the second half of each half, after 4 loop time constants. Measured
+    /// on the loaded hour's configuration (docs/zero-speed-errors.md, fifth pass): a longer
+    /// period lets the probe's own Δi_d move the angle more within a half (the inverter
+    /// residual's tangential part depends on the current vector): worst |θ − θ̂| over five
+    /// sensor seeds 0.51 rad at 2 s, 0.095 at 1 s, 0.065 at 0.5 s.
+    pub standstill_probe_period: T,
+    /// Correction gain g in s⁻¹: θ̂ turns at g·δ̂. Default 1 s⁻¹ \[A\]: g·T_p = 1/2 with
+    /// the default period (a first-order loop per period with the measurement half a period
+    /// late: half the deadbeat gain), a steady error c/g = 0.01–0.02 rad under the measured
+    /// 0.01–0.02 rad/s creep.
+    pub standstill_probe_gain: T,
+    /// The probe's gate: the speed reference |ω*| at most this multiple of the rated speed.
+    /// Default 0.0005 \[A\] (0.75 r/min at 1500 r/min): a standstill reference. The probe
+    /// moves the rotor by ±1–1.5 r/min on the paper's motor, a speed error at a low non-zero
+    /// reference: with 0.0075 (11 r/min) the `lowspeed` staircase lost its 1.9 and 0.94 r/min
+    /// levels on the 0.5 r/min speed criterion (7 → 4 levels held).
+    pub standstill_probe_speed_ratio: T,
+    /// The probe's gate: the speed loop's torque demand |τ| at least this fraction of the
+    /// rated current. Default 0.25 \[A\] (above the eq. (23) injection level 4/21.78, where the
+    /// R̂s adaptation's no-load angle law takes over).
+    pub standstill_probe_load_ratio: T,
 }
 
 impl<T: Real> DriveTuning<T> {
@@ -298,6 +332,12 @@ impl<T: Real> DriveTuning<T> {
             lock_stall_heal_time: U::lit(self.lock_stall_heal_time.to_f64()),
             lock_stall_max_speed_ratio: U::lit(self.lock_stall_max_speed_ratio.to_f64()),
             lock_stall_min_current_ratio: U::lit(self.lock_stall_min_current_ratio.to_f64()),
+            standstill_probe: self.standstill_probe,
+            standstill_probe_current_ratio: U::lit(self.standstill_probe_current_ratio.to_f64()),
+            standstill_probe_period: U::lit(self.standstill_probe_period.to_f64()),
+            standstill_probe_gain: U::lit(self.standstill_probe_gain.to_f64()),
+            standstill_probe_speed_ratio: U::lit(self.standstill_probe_speed_ratio.to_f64()),
+            standstill_probe_load_ratio: U::lit(self.standstill_probe_load_ratio.to_f64()),
         }
     }
 }
@@ -349,6 +389,12 @@ impl<T: Real> Default for DriveTuning<T> {
             lock_stall_heal_time: T::lit(0.1),
             lock_stall_max_speed_ratio: T::lit(0.0),
             lock_stall_min_current_ratio: T::lit(0.2),
+            standstill_probe: true,
+            standstill_probe_current_ratio: T::lit(0.1),
+            standstill_probe_period: T::lit(0.5),
+            standstill_probe_gain: T::one(),
+            standstill_probe_speed_ratio: T::lit(0.0005),
+            standstill_probe_load_ratio: T::lit(0.25),
         }
     }
 }
@@ -681,6 +727,7 @@ struct Blocks<T> {
     current: CurrentController<T>,
     delay: DelayCompensation<T>,
     dead_time: DeadTimeCompensation<T>,
+    probe: StandstillProbe<T>,
     modulator: SpaceVectorModulator<T>,
 }
 
@@ -853,6 +900,28 @@ impl<T: Real> Blocks<T> {
             limit: t.voltage_limit,
             max_modulation: t.max_modulation,
         })?;
+        let rated = m.rated_current;
+        let probe = StandstillProbe::new(StandstillProbeConfig {
+            ts,
+            amplitude: if t.standstill_probe {
+                check::non_negative(
+                    "standstill_probe_current_ratio",
+                    t.standstill_probe_current_ratio,
+                )? * rated
+            } else {
+                T::zero()
+            },
+            period: t.standstill_probe_period,
+            gain: t.standstill_probe_gain,
+            max_speed: check::non_negative(
+                "standstill_probe_speed_ratio",
+                t.standstill_probe_speed_ratio,
+            )? * m.rated_speed(),
+            min_load: check::non_negative(
+                "standstill_probe_load_ratio",
+                t.standstill_probe_load_ratio,
+            )? * rated,
+        })?;
         Ok(Self {
             speed,
             injection,
@@ -860,6 +929,7 @@ impl<T: Real> Blocks<T> {
             delay,
             dead_time,
             modulator,
+            probe,
         })
     }
 
@@ -870,6 +940,7 @@ impl<T: Real> Blocks<T> {
         self.delay.reset();
         self.dead_time.reset();
         self.modulator.reset();
+        self.probe.reset();
     }
 }
 
@@ -1465,9 +1536,32 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             let Ok(iq_torque) = self.blocks.speed.step(speed_ref, omega_ctrl) else {
                 return self.reject_after_estimate(backup, estimate, i_dq);
             };
-            let i = self.currents_for_torque(iq_torque, guess);
+            // The loaded-standstill probe (see `standstill_probe`): Δi_d on the d reference,
+            // and the turn of θ̂ its reading implies (from the next sample).
+            let probe = &mut self.blocks.probe;
+            let gate = probe.gate(
+                speed_ref,
+                iq_torque,
+                diag.mode == Mode::Limiter,
+                action == LockAction::Run,
+            );
+            let m = &self.config.machine;
+            let last = self.last.i_dq_ref;
+            let probe_id = probe.step(
+                gate,
+                iq_torque,
+                (last.d, last.q),
+                m.flux_linkage,
+                m.ld - m.lq,
+            );
+            let i = self.currents_for_torque(iq_torque, guess, probe_id);
             limit_current_d_priority(i, self.resolved.i_max)
         };
+        if action == LockAction::Coast {
+            self.blocks.probe.reset();
+        }
+        self.estimator
+            .set_angle_correction_rate(self.blocks.probe.rate());
         let b = &mut self.blocks;
         // 5. Current loop (unlimited).
         let Ok(v_dq) = b.current.step(i_dq_ref, i_dq, omega_ctrl) else {
@@ -1524,18 +1618,19 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
     }
 
     /// (i_d*, i_q*) for a torque demand `iq_torque` in units of the magnet's q current
-    /// (torque / (1.5·p·λ̂f)): i_d* = the eq. (23) injection + MTPA of i_q*, and i_q* solves
+    /// (torque / (1.5·p·λ̂f)): i_d* = the eq. (23) injection + MTPA of i_q* + the
+    /// standstill probe's `probe_id`, and i_q* solves
     /// (λ̂f + (L̂d − L̂q)·i_d*(i_q*))·i_q* = λ̂f·i_q,t by three Newton steps from `guess` (the
     /// last sample's i_q*; a secant over 0.1 % of the rated current for the slope). On a
     /// surface-magnet rotor i_q* = i_q,t, as in the paper. Taking i_d* from the last
     /// sample's i_q* instead (no solve) closes an algebraic loop through the injection that
     /// oscillates sample by sample under load (measured on ipmsm-gem-50k `stops`).
-    fn currents_for_torque(&self, iq_torque: T, guess: T) -> Dq<T> {
+    fn currents_for_torque(&self, iq_torque: T, guess: T, probe_id: T) -> Dq<T> {
         let m = &self.config.machine;
         let injection = &self.blocks.injection;
         let mtpa = self.resolved.mtpa;
         let id_of = |iq: T| {
-            let id = injection.step(iq);
+            let id = injection.step(iq) + probe_id;
             if mtpa { id + m.mtpa_id(iq) } else { id }
         };
         if !self.resolved.salient {

@@ -15,6 +15,7 @@ pub mod modulation;
 pub mod monitor;
 pub mod pi;
 pub mod speed_controller;
+pub mod standstill_probe;
 
 pub use current_controller::{CurrentController, CurrentControllerConfig};
 pub use dead_time_compensation::{
@@ -28,3 +29,4 @@ pub use modulation::{Modulation, ModulatorConfig, SpaceVectorModulator, VoltageL
 pub use monitor::{DriveFlags, FlagCounts};
 pub use pi::{Pi, PiConfig};
 pub use speed_controller::{SpeedController, SpeedControllerConfig, limit_current_d_priority};
+pub use standstill_probe::{StandstillProbe, StandstillProbeConfig};

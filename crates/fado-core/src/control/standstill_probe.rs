@@ -1,0 +1,446 @@
+//! The loaded-standstill angle probe: a slow square-wave d current read through the speed
+//! loop's torque balance, demodulated into the angle error, and fed back to the estimator as
+//! a slow turn of θ̂.
+//!
+//! **Why.** At a loaded standstill the speed loop holds ω̂ ≈ 0, so the estimator's q-axis
+//! integrand is zero and a tangential integrand error ε_q (an R̂s error of 0.01 %, an inverter
+//! residual) makes the *rotor* creep unseen at ω = −ε_q/λf; the speed loop answers with
+//! i_q = i_L/cos δ and the angle either stops at 0.6–0.7 rad or runs to the current limit
+//! (docs/zero-speed-errors.md, fourth pass). The fundamental voltage model cannot observe δ
+//! there; the torque balance can, under a probe.
+//!
+//! **Torque balance.** With δ = θ − θ̂ (the reported angle error), the currents in the
+//! estimated frame (i_d̂, i_q̂) are, in the rotor's frame, i_d = i_d̂·cos δ + i_q̂·sin δ and
+//! i_q = i_q̂·cos δ − i_d̂·sin δ. The speed loop holds the torque
+//! 1.5·p·(λf + (Ld − Lq)·i_d)·i_q at the load. The drive turns its torque demand τ (the speed
+//! PI's output, in units of the magnet's q current) into currents with its own model in the
+//! estimated frame (`currents_for_torque`: λ̂a(i_d̂)·i_q̂ = λ̂f·τ), so a step Δi_d added to i_d̂
+//! changes the model's torque by nothing, and the speed loop's τ moves only by what the model
+//! gets wrong about the angle. Small-signal, at the operating point (i_d̂, i_q̂) with
+//! λa = λf + ΔL·i_d̂, ΔL = Ld − Lq, b = ΔL·i_q̂ and tan φ = b/λa:
+//!
+//! λ̂f·Δτ/Δi_d = b + λa·tan(δ − φ),
+//!
+//! zero at δ = 0 on any rotor, λa·δ/cos²φ to first order; on a surface-magnet rotor (b = 0)
+//! Δτ/Δi_d = tan δ exactly. So δ̂ = φ + atan(λ̂f·Δτ/(λ̂a·Δi_d) − tan φ) reads the angle's sign
+//! and scale on a salient rotor too (the reluctance term only shifts the reading by the known
+//! b, which the model's own feed-forward already removed).
+//!
+//! **Demodulation** (synchronous detection, Ariyur & Krstić, *Real-Time Optimization by
+//! Extremum-Seeking Control*, Wiley 2003, ch. 1–2: a periodic probe, correlation with the
+//! probe over whole periods): Δi_d = +A over the first half of each period, −A over the
+//! second, each level reached by a ramp over the first quarter of its half (a trapezoid: a
+//! step kicks the rotor through the speed loop); τ is correlated with the sign over the second half of each half-period (the speed
+//! loop has settled there; a constant load and a slow ramp of τ cancel over the period), so
+//! that Δτ = mean(τ·s) and δ̂ follows at the end of each period.
+//!
+//! **Correction.** The estimator turns θ̂ at the rate g·δ̂ (rad/s, held over the next
+//! period; [`crate::estimator::SensorlessEstimator::set_angle_correction_rate`], the same
+//! mechanism as the no-load standstill angle law of `crate::rs_adaptation`, of which this is
+//! the loaded counterpart): a first-order loop per period with g·T_p = 1/2 (half the
+//! deadbeat gain, with the half-period lag of the measurement), whose steady error under a
+//! creep c is c/g. Bounded at |δ̂| ≤ 0.5 rad (the first-order reading's range).
+//!
+//! **Gate.** Only at a loaded standstill: |ω*| below a small fraction of the rated speed,
+//! |τ| above a fraction of the rated current, the estimator in limiter mode, the lock
+//! supervisor running normally; the probe starts after the gate has held for one period
+//! (not during a start-up or a load step), and stops (Δi_d = 0, no turn) the sample the gate
+//! opens.
+
+use crate::Real;
+use crate::error::{ConfigError, check};
+
+/// The probe's settings in absolute units (the drive resolves them from
+/// [`crate::control::DriveTuning`]'s ratios, see its `standstill_probe_*` fields).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StandstillProbeConfig<T> {
+    /// Sampling period, s.
+    pub ts: T,
+    /// Probe amplitude A (A, d current).
+    pub amplitude: T,
+    /// Probe period T_p (s).
+    pub period: T,
+    /// Correction gain g (s⁻¹): θ̂ turns at g·δ̂.
+    pub gain: T,
+    /// The gate's speed bound on the reference |ω*| (electrical rad/s).
+    pub max_speed: T,
+    /// The gate's load bound on |τ| (A, in units of the magnet's q current).
+    pub min_load: T,
+}
+
+/// Largest angle reading (rad) the correction acts on (the small-signal reading's range).
+const MAX_READING: f64 = 0.5;
+
+/// The probe's state (see the module docs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StandstillProbe<T> {
+    config: StandstillProbeConfig<T>,
+    /// Samples per period (even, ≥ 4).
+    period_samples: u32,
+    /// Samples the gate has held since it last opened (saturating).
+    gated: u32,
+    /// Sample index within the running period.
+    phase: u32,
+    /// Σ s·τ and the number of samples in it (settled windows only).
+    sum: T,
+    count: u32,
+    /// Σ i_d̂*, Σ i_q̂* over the period (the operating point of the reading).
+    sum_id: T,
+    sum_iq: T,
+    /// The last period's reading δ̂ (rad) and the turn rate in use (rad/s).
+    reading: T,
+    rate: T,
+}
+
+impl<T: Real> StandstillProbe<T> {
+    /// Checks the configuration (amplitude, gain, bounds ≥ 0 and finite; the period at least
+    /// four samples).
+    pub fn new(config: StandstillProbeConfig<T>) -> Result<Self, ConfigError> {
+        let ts = check::positive("ts", config.ts)?;
+        check::non_negative("standstill_probe_current_ratio", config.amplitude)?;
+        check::non_negative("standstill_probe_gain", config.gain)?;
+        check::non_negative("standstill_probe_speed_ratio", config.max_speed)?;
+        check::non_negative("standstill_probe_load_ratio", config.min_load)?;
+        let n = check::positive("standstill_probe_period", config.period)? / ts;
+        check::below(
+            "standstill_probe_period",
+            n,
+            T::lit(4e9),
+            "below 4e9 sampling periods",
+        )?;
+        let half = (n * T::lit(0.5)).round().to_f64() as u32;
+        if half < 2 {
+            return Err(ConfigError::OutOfRange {
+                field: "standstill_probe_period",
+                expected: "at least four sampling periods",
+            });
+        }
+        Ok(Self::new_idle(config, 2 * half))
+    }
+
+    /// Back to idle (no probe, no turn).
+    pub fn reset(&mut self) {
+        *self = Self::new_idle(self.config, self.period_samples);
+    }
+
+    fn new_idle(config: StandstillProbeConfig<T>, period_samples: u32) -> Self {
+        Self {
+            config,
+            period_samples,
+            gated: 0,
+            phase: 0,
+            sum: T::zero(),
+            count: 0,
+            sum_id: T::zero(),
+            sum_iq: T::zero(),
+            reading: T::zero(),
+            rate: T::zero(),
+        }
+    }
+
+    /// Whether the drive is at a loaded standstill: |ω*| ≤ the speed bound, |τ| ≥ the load
+    /// bound, `limiter_mode` (which bounds |ω̂| by the Fig. 3 threshold) and `running` (the
+    /// lock supervisor's normal run). Not |ω̂| itself: the probe moves the rotor by
+    /// ±1–1.5 r/min on the paper's motor, which a tight bound on ω̂ would read as motion.
+    pub fn gate(&self, omega_ref: T, tau: T, limiter_mode: bool, running: bool) -> bool {
+        let c = &self.config;
+        c.amplitude > T::zero()
+            && running
+            && limiter_mode
+            && omega_ref.abs() <= c.max_speed
+            && tau.abs() >= c.min_load
+    }
+
+    /// One sample: `gate` from [`Self::gate`], `tau` the speed loop's torque demand of this
+    /// sample (units of the magnet's q current), `i_dq_prev` the last sample's current
+    /// reference (d, q) in the estimated frame, `flux_linkage` λ̂f, `saliency` L̂d − L̂q.
+    /// Returns Δi_d for this sample's d-current reference (A); [`Self::rate`] is the turn
+    /// for the estimator.
+    pub fn step(
+        &mut self,
+        gate: bool,
+        tau: T,
+        i_dq_prev: (T, T),
+        flux_linkage: T,
+        saliency: T,
+    ) -> T {
+        if !gate || !tau.is_finite() {
+            if self.gated != 0 || self.rate != T::zero() {
+                self.reset();
+            }
+            return T::zero();
+        }
+        let n = self.period_samples;
+        if self.gated < n {
+            // Armed after one quiet period: no probe yet.
+            self.gated += 1;
+            return T::zero();
+        }
+        let half = n / 2;
+        let (sign, in_half) = if self.phase < half {
+            (T::one(), self.phase)
+        } else {
+            (-T::one(), self.phase - half)
+        };
+        // Correlate over the settled second half of each half-period (the first sample of
+        // the period sees last period's probe through the one-sample delay of τ; it lies in
+        // the skipped part).
+        if in_half >= half / 2 {
+            self.sum += sign * tau;
+            self.count += 1;
+        }
+        self.sum_id += i_dq_prev.0;
+        self.sum_iq += i_dq_prev.1;
+        self.phase += 1;
+        if self.phase == n {
+            self.finish_period(flux_linkage, saliency);
+        }
+        // The reference ramps from the last half's level to this half's over the first
+        // quarter of the half-period (a step kicks the rotor: the torque error A·sin δ
+        // steps with it, and the 5 Hz speed loop lets the rotor swing ±9 r/min on the
+        // paper's motor); it is flat where the correlation runs.
+        let ramp = half / 4;
+        let level = if in_half < ramp {
+            T::lit(2.0 * (in_half + 1) as f64 / (ramp + 1) as f64) - T::one()
+        } else {
+            T::one()
+        };
+        sign * level * self.config.amplitude
+    }
+
+    /// δ̂ from the period's correlation and the new turn rate.
+    fn finish_period(&mut self, flux_linkage: T, saliency: T) {
+        let n = T::lit(self.period_samples as f64);
+        let delta_tau = self.sum / T::lit(self.count.max(1) as f64);
+        let (i_d, i_q) = (self.sum_id / n, self.sum_iq / n);
+        let reading = angle_reading(
+            delta_tau,
+            self.config.amplitude,
+            i_d,
+            i_q,
+            flux_linkage,
+            saliency,
+        );
+        let bound = T::lit(MAX_READING);
+        let reading = if reading.is_finite() {
+            reading.max(-bound).min(bound)
+        } else {
+            T::zero()
+        };
+        self.reading = reading;
+        self.rate = self.config.gain * reading;
+        self.phase = 0;
+        self.sum = T::zero();
+        self.count = 0;
+        self.sum_id = T::zero();
+        self.sum_iq = T::zero();
+    }
+
+    /// The turn rate of θ̂ for the estimator (rad/s; 0 when idle).
+    pub fn rate(&self) -> T {
+        self.rate
+    }
+
+    /// The last period's angle reading δ̂ = θ − θ̂ (rad; 0 when idle).
+    pub fn reading(&self) -> T {
+        self.reading
+    }
+
+    /// Probing now (the gate has held for a period).
+    pub fn active(&self) -> bool {
+        self.gated >= self.period_samples
+    }
+}
+
+/// The angle error δ = θ − θ̂ the torque balance implies for a speed-loop response `delta_tau`
+/// (torque demand in units of the magnet's q current, per probe step `amplitude` of i_d) at
+/// the operating point (`i_d`, `i_q`) of the estimated frame, with λ̂f = `flux_linkage` and
+/// L̂d − L̂q = `saliency` (module docs): δ = φ + atan(λ̂f·Δτ/(λ̂a·A) − tan φ),
+/// tan φ = (L̂d − L̂q)·i_q/λ̂a.
+pub fn angle_reading<T: Real>(
+    delta_tau: T,
+    amplitude: T,
+    i_d: T,
+    i_q: T,
+    flux_linkage: T,
+    saliency: T,
+) -> T {
+    let lambda_a = flux_linkage + saliency * i_d;
+    let tan_phi = saliency * i_q / lambda_a;
+    let x = flux_linkage * delta_tau / (lambda_a * amplitude) - tan_phi;
+    x.step_atan2(T::one()) + tan_phi.step_atan2(T::one())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A synthetic loaded standstill: a rotor (λf, Ld − Lq) at angle error δ = θ − θ̂ under a
+    /// load `load` (torque in units of 1.5·p, i.e. Wb·A), with the drive's model feed-forward
+    /// λ̂a(i_d̂)·i_q̂ = λf·τ and a settled speed loop: τ is whatever makes the true torque
+    /// (λf + ΔL·i_d)·i_q equal the load, i_d = i_d̂·cos δ + i_q̂·sin δ,
+    /// i_q = i_q̂·cos δ − i_d̂·sin δ.
+    struct Balance {
+        flux: f64,
+        saliency: f64,
+        delta: f64,
+        load: f64,
+    }
+
+    impl Balance {
+        fn currents(&self, tau: f64, i_d_hat: f64) -> (f64, f64) {
+            let i_q_hat = self.flux * tau / (self.flux + self.saliency * i_d_hat);
+            (i_d_hat, i_q_hat)
+        }
+        fn torque(&self, tau: f64, i_d_hat: f64) -> f64 {
+            let (dh, qh) = self.currents(tau, i_d_hat);
+            let (s, c) = self.delta.sin_cos();
+            let (i_d, i_q) = (dh * c + qh * s, qh * c - dh * s);
+            (self.flux + self.saliency * i_d) * i_q
+        }
+        /// The settled torque demand for a d reference `i_d_hat` (bisection).
+        fn tau(&self, i_d_hat: f64) -> f64 {
+            let (mut lo, mut hi) = (0.0, 10.0 * self.load / self.flux);
+            for _ in 0..200 {
+                let mid = 0.5 * (lo + hi);
+                if self.torque(mid, i_d_hat) < self.load {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            0.5 * (lo + hi)
+        }
+    }
+
+    fn probe(amplitude: f64) -> StandstillProbe<f64> {
+        StandstillProbe::new(StandstillProbeConfig {
+            ts: 1e-3,
+            amplitude,
+            period: 0.2,
+            gain: 0.25,
+            max_speed: 1.0,
+            min_load: 1.0,
+        })
+        .unwrap()
+    }
+
+    /// Runs the probe against the balance (τ lags the settled value with a first-order
+    /// time constant `lag` in samples, the speed loop) for the arming period and one probe
+    /// period; returns the reading.
+    fn read(b: &Balance, i_d0: f64, amplitude: f64, lag: f64) -> f64 {
+        let mut p = probe(amplitude);
+        let mut tau = b.tau(i_d0);
+        let mut id = i_d0;
+        for _ in 0..400 {
+            let iq = b.currents(tau, id).1;
+            let did = p.step(true, tau, (id, iq), b.flux, b.saliency);
+            id = i_d0 + did;
+            tau += (b.tau(id) - tau) / lag;
+        }
+        assert!(p.active());
+        p.reading()
+    }
+
+    #[test]
+    fn surface_magnet_reading_is_the_angle_error_with_its_sign() {
+        // The paper's motor: λf 0.1 Wb, 14 A of load, 2.2 A probe.
+        for delta in [-0.4, -0.2, -0.05, 0.0, 0.05, 0.2, 0.4] {
+            let b = Balance {
+                flux: 0.1,
+                saliency: 0.0,
+                delta,
+                load: 1.4,
+            };
+            let r = read(&b, 0.0, 2.2, 1.0);
+            assert!(
+                (r - delta).abs() < 0.01 * delta.abs() + 1e-6,
+                "δ {delta}: read {r}"
+            );
+            // With the speed loop's lag (time constant 10 of the 100-sample half-period):
+            let r = read(&b, 0.0, 2.2, 10.0);
+            assert!(
+                (r - delta).abs() < 0.02 * delta.abs() + 1e-6,
+                "δ {delta}: lagged {r}"
+            );
+        }
+        // No response to the probe (δ = 0 held by a stiff τ): no reading, no turn.
+        let mut p = probe(2.2);
+        let tau = b_tau_zero();
+        for _ in 0..400 {
+            p.step(true, tau, (0.0, tau), 0.1, 0.0);
+        }
+        assert!(p.active() && p.reading() == 0.0 && p.rate() == 0.0);
+    }
+
+    fn b_tau_zero() -> f64 {
+        14.0
+    }
+
+    #[test]
+    fn interior_magnet_reading_accounts_for_the_reluctance_torque() {
+        // The 2.2 kW IPMSM: λf 0.545 Wb, Ld − Lq = −15 mH, half load (3.3 A) with
+        // i_d = −0.5 A, a 0.6 A probe. The reluctance torque alone would read
+        // atan(ΔL·i_q/λa) = −0.09 rad at δ = 0; the reading removes it. The ±A step is a
+        // finite difference of the balance, not its derivative: 3.5 % of δ at δ = −0.3.
+        for delta in [-0.3, -0.1, 0.0, 0.1, 0.3] {
+            let b = Balance {
+                flux: 0.545,
+                saliency: -0.015,
+                delta,
+                load: 0.545 * 3.3,
+            };
+            let r = read(&b, -0.5, 0.6, 1.0);
+            assert!(
+                (r - delta).abs() < 0.05 * delta.abs() + 1e-4,
+                "δ {delta}: read {r}"
+            );
+            let r = read(&b, -0.5, 0.6, 10.0);
+            assert!(
+                (r - delta).abs() < 0.06 * delta.abs() + 1e-4,
+                "δ {delta}: lagged {r}"
+            );
+        }
+    }
+
+    #[test]
+    fn angle_reading_inverts_the_small_signal_balance() {
+        // λ̂f·Δτ/Δi_d = b + λa·tan(δ − φ) (module docs), for both rotors.
+        for (flux, saliency, i_d, i_q) in [(0.1, 0.0, 0.0, 14.0), (0.545, -0.015, -0.5, 3.3)] {
+            let lambda_a: f64 = flux + saliency * i_d;
+            let b = saliency * i_q;
+            let phi = (b / lambda_a).atan();
+            for delta in [-0.4, 0.0, 0.25] {
+                let dtau = (b + lambda_a * (delta - phi).tan()) / flux;
+                let r = angle_reading(dtau, 1.0, i_d, i_q, flux, saliency);
+                assert!((r - delta).abs() < 1e-12, "{r} vs {delta}");
+            }
+        }
+    }
+
+    #[test]
+    fn the_gate_stops_the_probe_and_the_turn() {
+        let b = Balance {
+            flux: 0.1,
+            saliency: 0.0,
+            delta: 0.3,
+            load: 1.4,
+        };
+        let mut p = probe(2.2);
+        let mut id = 0.0;
+        let mut tau = b.tau(0.0);
+        for _ in 0..400 {
+            id = p.step(true, tau, (id, tau), 0.1, 0.0);
+            tau = b.tau(id);
+        }
+        assert!(p.rate() > 0.0 && (p.rate() - 0.25 * p.reading()).abs() < 1e-12);
+        assert!(p.gate(0.5, 5.0, true, true) && p.gate(-0.5, -5.0, true, true));
+        assert!(!p.gate(2.0, 5.0, true, true) && !p.gate(0.0, 0.5, true, true));
+        assert!(!p.gate(0.0, 5.0, false, true) && !p.gate(0.0, 5.0, true, false));
+        assert_eq!(p.step(false, tau, (0.0, tau), 0.1, 0.0), 0.0);
+        assert_eq!((p.rate(), p.active()), (0.0, false));
+        assert_eq!(p.step(true, f64::NAN, (0.0, tau), 0.1, 0.0), 0.0);
+        // Off (amplitude 0): never gated.
+        assert!(!probe(0.0).gate(0.0, 5.0, true, true));
+    }
+}
