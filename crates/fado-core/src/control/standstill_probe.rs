@@ -81,15 +81,21 @@ pub struct StandstillProbe<T> {
     gated: u32,
     /// Sample index within the running period.
     phase: u32,
-    /// Σ s·τ and the number of samples in it (settled windows only).
+    /// Σ s·τ over the settled windows.
     sum: T,
-    count: u32,
     /// Σ i_d̂*, Σ i_q̂* over the period (the operating point of the reading).
     sum_id: T,
     sum_iq: T,
     /// The last period's reading δ̂ (rad) and the turn rate in use (rad/s).
     reading: T,
     rate: T,
+    /// The trapezoid's level in units of A, and its step per sample on the ramp.
+    level: T,
+    ramp_step: T,
+    /// 1/(samples per period) and 1/(samples correlated per period), resolved once (no
+    /// integer-to-float conversion in the step: no soft double on the f32 path).
+    inv_period: T,
+    inv_count: T,
 }
 
 impl<T: Real> StandstillProbe<T> {
@@ -115,12 +121,21 @@ impl<T: Real> StandstillProbe<T> {
                 expected: "at least four sampling periods",
             });
         }
-        Ok(Self::new_idle(config, 2 * half))
+        let mut probe = Self::new_idle(config, 2 * half);
+        probe.ramp_step = T::lit(2.0 / ((half / 4) + 1) as f64);
+        probe.inv_period = T::lit(1.0 / (2 * half) as f64);
+        probe.inv_count = T::lit(1.0 / (2 * (half - half / 2)) as f64);
+        Ok(probe)
     }
 
     /// Back to idle (no probe, no turn).
     pub fn reset(&mut self) {
-        *self = Self::new_idle(self.config, self.period_samples);
+        *self = Self {
+            ramp_step: self.ramp_step,
+            inv_period: self.inv_period,
+            inv_count: self.inv_count,
+            ..Self::new_idle(self.config, self.period_samples)
+        };
     }
 
     fn new_idle(config: StandstillProbeConfig<T>, period_samples: u32) -> Self {
@@ -130,11 +145,14 @@ impl<T: Real> StandstillProbe<T> {
             gated: 0,
             phase: 0,
             sum: T::zero(),
-            count: 0,
             sum_id: T::zero(),
             sum_iq: T::zero(),
             reading: T::zero(),
             rate: T::zero(),
+            level: T::zero(),
+            ramp_step: T::zero(),
+            inv_period: T::zero(),
+            inv_count: T::zero(),
         }
     }
 
@@ -187,7 +205,6 @@ impl<T: Real> StandstillProbe<T> {
         // the skipped part).
         if in_half >= half / 2 {
             self.sum += sign * tau;
-            self.count += 1;
         }
         self.sum_id += i_dq_prev.0;
         self.sum_iq += i_dq_prev.1;
@@ -199,20 +216,21 @@ impl<T: Real> StandstillProbe<T> {
         // quarter of the half-period (a step kicks the rotor: the torque error A·sin δ
         // steps with it, and the 5 Hz speed loop lets the rotor swing ±9 r/min on the
         // paper's motor); it is flat where the correlation runs.
-        let ramp = half / 4;
-        let level = if in_half < ramp {
-            T::lit(2.0 * (in_half + 1) as f64 / (ramp + 1) as f64) - T::one()
+        if in_half == 0 {
+            self.level = -T::one();
+        }
+        self.level = if in_half < half / 4 {
+            self.level + self.ramp_step
         } else {
             T::one()
         };
-        sign * level * self.config.amplitude
+        sign * self.level * self.config.amplitude
     }
 
     /// δ̂ from the period's correlation and the new turn rate.
     fn finish_period(&mut self, flux_linkage: T, saliency: T) {
-        let n = T::lit(self.period_samples as f64);
-        let delta_tau = self.sum / T::lit(self.count.max(1) as f64);
-        let (i_d, i_q) = (self.sum_id / n, self.sum_iq / n);
+        let delta_tau = self.sum * self.inv_count;
+        let (i_d, i_q) = (self.sum_id * self.inv_period, self.sum_iq * self.inv_period);
         let reading = angle_reading(
             delta_tau,
             self.config.amplitude,
@@ -231,7 +249,6 @@ impl<T: Real> StandstillProbe<T> {
         self.rate = self.config.gain * reading;
         self.phase = 0;
         self.sum = T::zero();
-        self.count = 0;
         self.sum_id = T::zero();
         self.sum_iq = T::zero();
     }
