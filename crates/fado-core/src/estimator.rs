@@ -642,9 +642,6 @@ pub struct SensorlessEstimator<T: Real> {
     /// The slow laws' share of the feedback, held between their runs: the learned integrand
     /// offset ê plus the R̂s adaptation's standstill pull (V, see `rs_adaptation`).
     slow_feedback: Ab<T>,
-    /// An external turn of θ̂ in limiter mode (rad/s, see
-    /// [`Self::set_angle_correction_rate`]; 0: none).
-    angle_rate: T,
 }
 
 impl<T: Real> SensorlessEstimator<T> {
@@ -835,7 +832,6 @@ impl<T: Real> SensorlessEstimator<T> {
             v_sum: Ab::zero(),
             i_sum: Ab::zero(),
             slow_feedback: Ab::zero(),
-            angle_rate: T::zero(),
         };
         est.reset();
         Ok(est)
@@ -907,7 +903,6 @@ impl<T: Real> SensorlessEstimator<T> {
         self.v_sum = Ab::zero();
         self.i_sum = Ab::zero();
         self.slow_feedback = self.offset.offset();
-        self.angle_rate = T::zero();
         self.step_allowance = self.bounds.step();
     }
 
@@ -1012,14 +1007,6 @@ impl<T: Real> SensorlessEstimator<T> {
                 let l = self.limiter.step_scaled(lambda_r, active_ratio);
                 (l.feedback, l.clamping)
             }
-        };
-        // An external angle correction (the drive's loaded-standstill probe): a tangential
-        // feedback −j·λ̂r·rate turns λ1, and with it θ̂, at `rate` (the mechanism of the
-        // standstill angle law of `rs_adaptation`). Limiter mode only.
-        let base_feedback = if self.angle_rate != T::zero() && mode == Mode::Limiter {
-            base_feedback + Ab::new(lambda_r.beta, -lambda_r.alpha) * self.angle_rate
-        } else {
-            base_feedback
         };
         // Loss-of-lock symptoms (see `lock`), in the detector's slot: |λ̂r| against λ̂f, the
         // T2S-1 innovation.
@@ -1336,13 +1323,25 @@ impl<T: Real> SensorlessEstimator<T> {
         }
     }
 
-    /// Turns θ̂ at `rate` (rad/s, positive: θ̂ increases) from the next sample on, in limiter
-    /// mode only, until changed: an external angle correction such as the drive's
-    /// loaded-standstill probe ([`crate::control::standstill_probe`]). It acts as a tangential
-    /// integrand feedback −j·λ̂r·rate, the mechanism of the R̂s adaptation's no-load standstill
-    /// angle law (`rs_adaptation`). A non-finite rate is taken as 0; `align`/`reset` clear it.
-    pub fn set_angle_correction_rate(&mut self, rate: T) {
-        self.angle_rate = if rate.is_finite() { rate } else { T::zero() };
+    /// Turns θ̂ by `angle` (rad, positive: θ̂ increases) in limiter mode: an external angle
+    /// correction such as the drive's loaded-standstill probe
+    /// ([`crate::control::standstill_probe`]), called once per sample with rate·Ts. λ1 moves by
+    /// j·λ̂r·angle, tangentially to the last λ̂r = λ1 − D̂ − L̂q·i, as the tangential integrand
+    /// feedback of the R̂s adaptation's no-load standstill angle law (`rs_adaptation`) moves
+    /// it; θ̂ follows through the trackers. Off the step's path (no cost in the step); does
+    /// nothing outside limiter mode or for a non-finite angle or result.
+    pub fn turn_angle(&mut self, angle: T) {
+        if !angle.is_finite() || self.selector.mode() != Mode::Limiter {
+            return;
+        }
+        let lambda1 = self.integrator.flux();
+        let lambda2 = stator_flux(lambda1, self.observer.disturbance());
+        let lambda_r = rotor_flux(lambda2, self.integrator.last_current(), self.lq);
+        let turned = lambda1 + lambda_r.mul_j() * angle;
+        if turned.is_finite() {
+            self.integrator
+                .commit(turned, self.integrator.last_current());
+        }
     }
 
     /// ê, the learned integrand offset (V, α-β; zero without `rs_adaptation`).
@@ -1400,9 +1399,9 @@ pub trait RotorAngleEstimator<T: Real> {
     /// adaptation from it. Default: nothing (a fixed R̂s stays as configured, so the paper's
     /// path is unchanged).
     fn start_from_measured_rs(&mut self, _rs: T) {}
-    /// Turns θ̂ at `rate` (rad/s) until changed, if the estimator can (the drive's
-    /// loaded-standstill probe, see [`crate::control::standstill_probe`]). Default: nothing.
-    fn set_angle_correction_rate(&mut self, _rate: T) {}
+    /// Turns θ̂ by `angle` (rad) now, if the estimator can (the drive's loaded-standstill
+    /// probe, see [`crate::control::standstill_probe`]). Default: nothing.
+    fn turn_angle(&mut self, _angle: T) {}
 }
 
 impl<T: Real> RotorAngleEstimator<T> for SensorlessEstimator<T> {
@@ -1426,8 +1425,8 @@ impl<T: Real> RotorAngleEstimator<T> for SensorlessEstimator<T> {
     fn enable_rs_adaptation(&mut self) {
         SensorlessEstimator::enable_rs_adaptation(self)
     }
-    fn set_angle_correction_rate(&mut self, rate: T) {
-        SensorlessEstimator::set_angle_correction_rate(self, rate);
+    fn turn_angle(&mut self, angle: T) {
+        SensorlessEstimator::turn_angle(self, angle);
     }
     /// With [`EstimatorTuning::rs_adaptation`]: [`SensorlessEstimator::set_rs_hat`] (a bad
     /// value changes nothing); with the paper's fixed R̂s: nothing.
@@ -1508,9 +1507,8 @@ mod tests {
         // pass: the low-pass's two gains and its state) 12 B. Issue 16's fourth pass: the
         // fixed-point tracker angles (`f32`) keep the trackers' size, the plausibility's copy
         // of the last current goes (−8 B; the integrator's is the one), the cached lock
-        // status fits in padding: 484 B. The external angle-correction rate (issue 13 fifth
-        // pass, the drive's loaded-standstill probe) 4 B: 488 B.
-        assert!(s32 <= 488, "{s32}");
+        // status fits in padding: 484 B.
+        assert!(s32 <= 484, "{s32}");
     }
 
     /// The reason the slow laws may run every [`SLOW_PERIOD`] samples (see its docs): at

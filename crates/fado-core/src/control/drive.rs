@@ -1560,8 +1560,10 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         if action == LockAction::Coast {
             self.blocks.probe.reset();
         }
-        self.estimator
-            .set_angle_correction_rate(self.blocks.probe.rate());
+        let turn = self.blocks.probe.rate();
+        if turn != T::zero() {
+            self.estimator.turn_angle(turn * self.config.ts);
+        }
         let b = &mut self.blocks;
         // 5. Current loop (unlimited).
         let Ok(v_dq) = b.current.step(i_dq_ref, i_dq, omega_ctrl) else {

@@ -35,8 +35,8 @@
 //! that Δτ = mean(τ·s) and δ̂ follows at the end of each period.
 //!
 //! **Correction.** The estimator turns θ̂ at the rate g·δ̂ (rad/s, held over the next
-//! period; [`crate::estimator::SensorlessEstimator::set_angle_correction_rate`], the same
-//! mechanism as the no-load standstill angle law of `crate::rs_adaptation`, of which this is
+//! period, by g·δ̂·Ts per sample through
+//! [`crate::estimator::SensorlessEstimator::turn_angle`], the same mechanism as the no-load standstill angle law of `crate::rs_adaptation`, of which this is
 //! the loaded counterpart): a first-order loop per period with g·T_p = 1/2 (half the
 //! deadbeat gain, with the half-period lag of the measurement), whose steady error under a
 //! creep c is c/g. Bounded at |δ̂| ≤ 0.5 rad (the first-order reading's range).
