@@ -30,22 +30,23 @@
 //! Extremum-Seeking Control*, Wiley 2003, ch. 1–2: a periodic probe, correlation with the
 //! probe over whole periods): Δi_d = +A over the first half of each period, −A over the
 //! second, each level reached by a ramp over the first quarter of its half (a trapezoid: a
-//! step kicks the rotor through the speed loop); τ is correlated with the sign over the second half of each half-period (the speed
-//! loop has settled there; a constant load and a slow ramp of τ cancel over the period), so
-//! that Δτ = mean(τ·s) and δ̂ follows at the end of each period.
+//! step kicks the rotor through the speed loop); τ is correlated with the sign over the
+//! second half of each half-period (the speed loop has settled there; a constant load and a
+//! slow ramp of τ cancel over the period), so that Δτ = mean(τ·s) and δ̂ follows at the end
+//! of each period.
 //!
-//! **Correction.** The estimator turns θ̂ at the rate g·δ̂ (rad/s, held over the next
-//! period, by g·δ̂·Ts per sample through
-//! [`crate::estimator::SensorlessEstimator::turn_angle`], the same mechanism as the no-load standstill angle law of `crate::rs_adaptation`, of which this is
-//! the loaded counterpart): a first-order loop per period with g·T_p = 1/2 (half the
-//! deadbeat gain, with the half-period lag of the measurement), whose steady error under a
-//! creep c is c/g. Bounded at |δ̂| ≤ 0.5 rad (the first-order reading's range).
+//! **Correction.** The estimator turns θ̂ at the rate g·δ̂ (rad/s, held over the next period),
+//! by g·δ̂·Ts per sample through [`crate::estimator::SensorlessEstimator::turn_angle`], the
+//! mechanism of the no-load standstill angle law of `crate::rs_adaptation`, of which this is
+//! the loaded counterpart: a first-order loop per period with g·T_p = 1/2 (half the deadbeat
+//! gain, with the half-period lag of the measurement), whose steady error under a creep c is
+//! c/g. Bounded at |δ̂| ≤ 0.5 rad (the first-order reading's range).
 //!
 //! **Gate.** Only at a loaded standstill: |ω*| below a small fraction of the rated speed,
 //! |τ| above a fraction of the rated current, the estimator in limiter mode, the lock
-//! supervisor running normally; the probe starts after the gate has held for one period
-//! (not during a start-up or a load step), and stops (Δi_d = 0, no turn) the sample the gate
-//! opens.
+//! supervisor running normally; the probe starts after the gate has held for one period (not
+//! in a passage through zero or a short stop), and stops (Δi_d = 0, no turn) the sample the
+//! gate opens.
 
 use crate::Real;
 use crate::error::{ConfigError, check};
