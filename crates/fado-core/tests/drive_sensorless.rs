@@ -745,3 +745,79 @@ fn stall_symptom_flags_a_lost_reference_below_the_current_limit() {
     };
     assert_eq!(run(&off, &[(20, 0.0), (500, 8.0)]).0, None);
 }
+
+/// Reports k_df mode and a fixed ω̂ (`omega_control`, electrical rad/s), like an estimate that
+/// has lost the rotor just above the mode threshold.
+struct KdfSpy {
+    omega: f64,
+}
+
+impl RotorAngleEstimator<f64> for KdfSpy {
+    fn step(&mut self, _v_ab: Ab<f64>, _i_ab: Ab<f64>) -> Estimate<f64> {
+        Estimate {
+            theta: 0.0,
+            omega: self.omega,
+            omega_control: self.omega,
+            diagnostics: Diagnostics {
+                mode: fado_core::Mode::DisturbanceFeedback,
+                ..Diagnostics::default()
+            },
+        }
+    }
+    fn align(&mut self, _theta0: f64, _i_ab: Ab<f64>) {}
+    fn reset(&mut self) {}
+    fn name(&self) -> &'static str {
+        "kdf-spy"
+    }
+}
+
+/// The stall symptom also counts in k_df mode below `lock_stall_kdf_speed_ratio` (0.02) of
+/// the rated speed (docs/lock.md: heavy-load losses in k_df mode just above the 0.015 mode
+/// threshold): ω̂ held at 0.0175·rated in k_df mode, the speed loop catches a reference equal
+/// to it, then loses one 8 rad/s (mechanical) away, below the current limit: `LOCK_LOST`
+/// after `lock_stall_time` (50 samples). Not at 0.03·rated (above the band), nor with the
+/// ratio 0 (limiter mode only, the symptom before issue 14b), on the paper's motor and on
+/// the 2.2 kW IPMSM.
+#[test]
+fn stall_symptom_counts_in_kdf_mode_just_above_the_threshold() {
+    let ipmsm = MachineModel {
+        rs: 3.6,
+        ld: 36e-3,
+        lq: 51e-3,
+        flux_linkage: 0.545,
+        pole_pairs: 3,
+        inertia: 0.02,
+        viscous_friction: 2e-3,
+        rated_current: 6.0,
+        rated_speed_rpm: 1500.0,
+        rated_torque: 14.9,
+        dc_voltage: 540.0,
+    };
+    for machine in [MachineModel::paper(), ipmsm] {
+        let run = |speed_ratio: f64, kdf_ratio: f64| {
+            let mut c = DriveConfig::for_machine(&machine);
+            c.tuning.offset_calibration_time = 0.0;
+            c.tuning.gain_calibration_time = 0.0;
+            c.tuning.stuck_sensor_time = 0.0;
+            c.tuning.current_limit_ratio = 100.0;
+            c.tuning.trip_current_ratio = 200.0;
+            c.tuning.lock_stall_kdf_speed_ratio = kdf_ratio;
+            let omega = speed_ratio * machine.rated_speed();
+            let caught = omega / machine.pole_pairs as f64;
+            let mut drive = SensorlessDrive::with_estimator(c, KdfSpy { omega }).unwrap();
+            drive.align(0.0);
+            let mut first = None;
+            for n in 0..520 {
+                let speed = if n < 20 { caught } else { caught + 8.0 };
+                let out = drive.step(Abc::new(0.0, 0.0, 0.0), 300.0, speed);
+                if first.is_none() && out.flags.contains(DriveFlags::LOCK_LOST) {
+                    first = Some(n);
+                }
+            }
+            first
+        };
+        assert_eq!(run(0.0175, 0.02), Some(20 + 50), "{}", machine.pole_pairs);
+        assert_eq!(run(0.03, 0.02), None, "{}", machine.pole_pairs);
+        assert_eq!(run(0.0175, 0.0), None, "{}", machine.pole_pairs);
+    }
+}

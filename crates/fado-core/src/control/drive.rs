@@ -247,6 +247,16 @@ pub struct DriveTuning<T> {
     /// loss it caught that the restriction had missed 0.26 or more; 0.15 still false-alarmed
     /// at 0.151 (docs/lock.md). 0: always.
     pub lock_stall_min_current_ratio: T,
+    /// The stall symptom also counts in k_df mode while |ω̂| is below this multiple of the
+    /// rated speed (the limiter ↔ k_df threshold `mode_threshold_ratio` is 0.015, so the
+    /// default is a band of 0.005·rated, 7.5 r/min at 1500 r/min, above it); 0: limiter
+    /// mode only. Default 0.02 \[A\], chosen on the fig11 envelope (docs/lock.md): under
+    /// heavy load the estimate is lost in k_df mode just above the threshold (n̂ −23 …
+    /// −28 r/min), where a limiter-only symptom does not look; 0.02 detects 5 more of 826
+    /// fixed-R̂s losses on seeds 7–10 in time and flags no further fixed-R̂s run, but 8 of
+    /// 1461 clean runs with the R̂s adaptation (0 before; ≤ 0.8 % per seed); 0.03 the same
+    /// losses with 6 more fixed-R̂s false alarms, any speed 40–60 % false alarms.
+    pub lock_stall_kdf_speed_ratio: T,
     /// The loaded-standstill angle probe (see [`crate::control::standstill_probe`]): at a
     /// loaded standstill a slow square-wave d current, read through the speed loop's torque
     /// balance, turns θ̂ towards the rotor. Default true \[A\] (without it the one-hour loaded
@@ -332,6 +342,7 @@ impl<T: Real> DriveTuning<T> {
             lock_stall_heal_time: U::lit(self.lock_stall_heal_time.to_f64()),
             lock_stall_max_speed_ratio: U::lit(self.lock_stall_max_speed_ratio.to_f64()),
             lock_stall_min_current_ratio: U::lit(self.lock_stall_min_current_ratio.to_f64()),
+            lock_stall_kdf_speed_ratio: U::lit(self.lock_stall_kdf_speed_ratio.to_f64()),
             standstill_probe: self.standstill_probe,
             standstill_probe_current_ratio: U::lit(self.standstill_probe_current_ratio.to_f64()),
             standstill_probe_period: U::lit(self.standstill_probe_period.to_f64()),
@@ -389,6 +400,7 @@ impl<T: Real> Default for DriveTuning<T> {
             lock_stall_heal_time: T::lit(0.1),
             lock_stall_max_speed_ratio: T::lit(0.0),
             lock_stall_min_current_ratio: T::lit(0.2),
+            lock_stall_kdf_speed_ratio: T::lit(0.02),
             standstill_probe: true,
             standstill_probe_current_ratio: T::lit(0.1),
             standstill_probe_period: T::lit(0.5),
@@ -579,6 +591,9 @@ struct Resolved<T> {
     stall_heal_samples: u32,
     /// The stall symptom counts below this |ω̂| (electrical rad/s; ∞: always).
     stall_max_speed: T,
+    /// The stall symptom also counts in k_df mode below this |ω̂| (electrical rad/s; 0: only
+    /// in limiter mode).
+    stall_kdf_band: T,
     /// The stall symptom counts from this |i_q*| on (A).
     stall_min_current: T,
     /// Phase currents beyond ± this (A) are refused as implausible.
@@ -635,6 +650,10 @@ impl<T: Real> Resolved<T> {
                 r if r == T::zero() => T::lit(f64::INFINITY),
                 r => r * c.machine.rated_speed(),
             },
+            stall_kdf_band: check::non_negative(
+                "lock_stall_kdf_speed_ratio",
+                t.lock_stall_kdf_speed_ratio,
+            )? * c.machine.rated_speed(),
             stall_min_current: check::non_negative(
                 "lock_stall_min_current_ratio",
                 t.lock_stall_min_current_ratio,
@@ -1469,7 +1488,8 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
 
         // Reaction to a lost rotor (see `lock_reaction`).
         let diag = &estimate.diagnostics;
-        // The stall symptom: in limiter mode the speed loop loses a reference it had caught
+        // The stall symptom: in limiter mode (or in k_df mode just above its threshold,
+        // `DriveTuning::lock_stall_kdf_speed_ratio`) the speed loop loses a reference it had caught
         // (armed once |ω* − ω̂| was within the band since the last start), although its
         // current reference is below the limit (at the limit, a speed error is the machine's
         // torque limit, not evidence against the estimate; within 1 % counts as at the
@@ -1483,7 +1503,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             && off_reference
             && (omega_ctrl.abs() < self.resolved.stall_max_speed
                 || omega_ctrl * speed_ref < T::zero())
-            && diag.mode == Mode::Limiter
+            && (diag.mode == Mode::Limiter || omega_ctrl.abs() < self.resolved.stall_kdf_band)
             && self.last.i_dq_ref.q.abs() >= self.resolved.stall_min_current
             && self.last.i_dq_ref.norm() < self.resolved.i_max * T::lit(0.99);
         let stalled = self.stall.step(stall_now);
