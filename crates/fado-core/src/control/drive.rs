@@ -255,7 +255,7 @@ pub struct DriveTuning<T> {
     /// −28 r/min), where a limiter-only symptom does not look; 0.02 detects 5 more of 826
     /// fixed-R̂s losses on seeds 7–10 in time and flags no further fixed-R̂s run, but 8 of
     /// 1461 clean runs with the R̂s adaptation (0 before; ≤ 0.8 % per seed); 0.03 the same
-    /// losses with 6 more fixed-R̂s false alarms, any speed 40–60 % false alarms.
+    /// losses with 7 more fixed-R̂s false alarms, any speed 40–60 % false alarms.
     pub lock_stall_kdf_speed_ratio: T,
     /// The loaded-standstill angle probe (see [`crate::control::standstill_probe`]): at a
     /// loaded standstill a slow square-wave d current, read through the speed loop's torque
