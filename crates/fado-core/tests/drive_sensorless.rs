@@ -2,6 +2,8 @@
 //! with proptest, protection, and a short sensorless closed loop around an ideal SMPMSM with
 //! an averaged inverter that has the dead-time error the compensation is meant for.
 
+mod common;
+
 use core::f64::consts::TAU;
 use std::vec::Vec;
 
@@ -685,19 +687,7 @@ fn stall_symptom_flags_a_lost_reference_below_the_current_limit() {
     // salient, its speed loop scaled by λ̂f/λ̂a) the same 4 rad/s error counts from the sample
     // its smaller i_q* reaches 0.2·6 A on.
     let ipmsm = |c: &mut DriveConfig<f64>| {
-        let machine = MachineModel {
-            rs: 3.6,
-            ld: 36e-3,
-            lq: 51e-3,
-            flux_linkage: 0.545,
-            pole_pairs: 3,
-            inertia: 0.02,
-            viscous_friction: 2e-3,
-            rated_current: 6.0,
-            rated_speed_rpm: 1500.0,
-            rated_torque: 14.9,
-            dc_voltage: 540.0,
-        };
+        let machine = common::ipmsm_model();
         let mut d = DriveConfig::for_machine(&machine);
         d.tuning.offset_calibration_time = 0.0;
         d.tuning.gain_calibration_time = 0.0;
@@ -780,19 +770,7 @@ impl RotorAngleEstimator<f64> for KdfSpy {
 /// the 2.2 kW IPMSM.
 #[test]
 fn stall_symptom_counts_in_kdf_mode_just_above_the_threshold() {
-    let ipmsm = MachineModel {
-        rs: 3.6,
-        ld: 36e-3,
-        lq: 51e-3,
-        flux_linkage: 0.545,
-        pole_pairs: 3,
-        inertia: 0.02,
-        viscous_friction: 2e-3,
-        rated_current: 6.0,
-        rated_speed_rpm: 1500.0,
-        rated_torque: 14.9,
-        dc_voltage: 540.0,
-    };
+    let ipmsm = common::ipmsm_model();
     for machine in [MachineModel::paper(), ipmsm] {
         let run = |speed_ratio: f64, kdf_ratio: f64| {
             let mut c = DriveConfig::for_machine(&machine);
