@@ -111,6 +111,12 @@ impl<T: Real> Default for DeadTimeCompensationConfig<T> {
 pub struct DeadTimeCompensation<T> {
     config: DeadTimeCompensationConfig<T>,
     inv_band: T,
+    /// Half the carrier period (= the sample period), s: 0.5/f_sw.
+    half: T,
+    /// 1/(2·half), 1/s: the mean over one carrier period.
+    inv_period: T,
+    /// 1/L̂d, 1/L̂q of `ripple_inductance` (zero where it is zero: edge current off).
+    inv_ripple: Dq<T>,
 }
 
 impl<T: Real> DeadTimeCompensation<T> {
@@ -128,9 +134,23 @@ impl<T: Real> DeadTimeCompensation<T> {
         let ic = check::positive("current_band", config.current_band)?;
         check::non_negative("ripple_inductance", config.ripple_inductance.d)?;
         check::non_negative("ripple_inductance", config.ripple_inductance.q)?;
+        let half = T::lit(0.5) / fsw;
+        let inv = |l: T| {
+            if l > T::zero() {
+                T::one() / l
+            } else {
+                T::zero()
+            }
+        };
         Ok(Self {
             config,
             inv_band: T::one() / ic,
+            half,
+            inv_period: T::one() / (half + half),
+            inv_ripple: Dq::new(
+                inv(config.ripple_inductance.d),
+                inv(config.ripple_inductance.q),
+            ),
         })
     }
 
@@ -237,7 +257,7 @@ impl<T: Real> DeadTimeCompensation<T> {
         let zero = T::zero();
         let one = T::one();
         let td = c.dead_time;
-        let half = T::lit(0.5) / c.switching_frequency; // half carrier period = sample period
+        let half = self.half; // half carrier period = sample period
         let i = [i_abc.a, i_abc.b, i_abc.c];
         // Pole voltages the modulator will realise: reference + first-guess compensation,
         // min-max zero sequence (SVPWM), as offsets from the DC-link mid-point.
@@ -272,7 +292,7 @@ impl<T: Real> DeadTimeCompensation<T> {
             Ab::new(T::lit(-0.5), k3),
             Ab::new(T::lit(-0.5), -k3),
         ];
-        let (inv_ld, inv_lq) = (one / l.d, one / l.q);
+        let (inv_ld, inv_lq) = (self.inv_ripple.d, self.inv_ripple.q);
         let respond = |w: Ab<T>| {
             let w = w.to_dq(rotation);
             Dq::new(w.d * inv_ld, w.q * inv_lq).to_ab(rotation)
@@ -293,7 +313,7 @@ impl<T: Real> DeadTimeCompensation<T> {
             // Mean voltage over the period (the back-EMF and R·i it balances) and the
             // current's swing between the carrier's peak and valley samples, whose mean is the
             // reference: i(peak) = i − Δ/2, i(valley) = i + Δ/2.
-            let vbar = (int_r + int_f) * (one / (half + half));
+            let vbar = (int_r + int_f) * self.inv_period;
             let half_swing = respond((int_r - int_f) * T::lit(0.25));
             let mut nr = d_rise;
             let mut nf = d_fall;
