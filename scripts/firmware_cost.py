@@ -201,6 +201,33 @@ def cycles(mnem, ops, taken, prev_single_ls):
     return 1, False
 
 
+def klass(mnem):
+    """The instruction class of one mnemonic, for the report's mix of the step."""
+    base = mnem.split(".")[0]
+    if base.startswith("v"):
+        core = base[1:]
+        if core.startswith(("div", "sqrt")):
+            return "fp div/sqrt"
+        if core.startswith(("mla", "mls", "nmla", "nmls", "fma", "fms", "fnma", "fnms")):
+            return "fp multiply-add"
+        if core.startswith(("add", "sub", "mul", "nmul", "neg", "abs")):
+            return "fp arithmetic"
+        if core.startswith(("ldr", "str", "ldm", "stm", "push", "pop")):
+            return "fp load/store"
+        if core.startswith(("cmp", "mrs")):
+            return "fp compare"
+        if core.startswith("cvt"):
+            return "fp convert"
+        return "fp move"
+    if base.startswith(("ldr", "str", "ldm", "stm", "push", "pop")):
+        return "load/store"
+    if base in ("b", "bl", "bx", "blx", "cbz", "cbnz") or base.startswith("it") or (
+        base.startswith("b") and len(base) == 3 and base not in ("bic", "bfi", "bfc")
+    ):
+        return "branch/IT"
+    return "integer"
+
+
 def inline_files(elf, addrs, symbol_of, lines=False):
     """{address: innermost fado-core source file (or 'file:line' with `lines`)} via
     addr2line -i."""
@@ -282,6 +309,7 @@ def trace(elf, root, path, tail, lines=False):
         n_insn, n_cyc = [], []
         by_file = Counter()
         by_file_insn = Counter()
+        by_class = Counter()
         for st in measured:
             c_total = 0
             prev_ls = False
@@ -294,6 +322,7 @@ def trace(elf, root, path, tail, lines=False):
                 label = files.get(pc, "other")
                 by_file[label] += c
                 by_file_insn[label] += 1
+                by_class[klass(mnem)] += c
             n_insn.append(len(st))
             n_cyc.append(c_total)
         k = len(measured)
@@ -309,6 +338,7 @@ def trace(elf, root, path, tail, lines=False):
                 "cyc_last": n_cyc[-8:],
                 "by_file": {f: c / k for f, c in by_file.items()},
                 "by_file_insn": {f: c / k for f, c in by_file_insn.items()},
+                "by_class": {f: c / k for f, c in by_class.items()},
             }
         )
     return results
@@ -339,6 +369,8 @@ def main():
             # The estimator runs its slow laws round-robin, one per sample (docs/firmware.md):
             # the last steps show each slot's cost.
             print("    cycles of the last 8 steps: " + " ".join(str(c) for c in r["cyc_last"]))
+            mix = sorted(r["by_class"].items(), key=lambda x: -x[1])
+            print("    cycles by instruction class: " + ", ".join(f"{k} {c:.0f}" for k, c in mix))
             rows = sorted(r["by_file"].items(), key=lambda x: -x[1])
             for f, c in rows[: top or None]:
                 print(f"    {c:7.1f} cycles {r['by_file_insn'][f]:7.1f} insns  {f}")
