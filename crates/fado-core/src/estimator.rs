@@ -16,18 +16,21 @@
 
 use crate::error::{ConfigError, check};
 use crate::flux::{
-    DisturbanceFeedback, DisturbanceFeedbackConfig, FluxIntegrator, FluxIntegratorConfig,
-    FluxLimiter, FluxLimiterConfig,
+    DisturbanceFeedbackConfig, DisturbanceFeedbackParams, FluxIntegratorConfig,
+    FluxIntegratorParams, FluxIntegratorState, FluxLimiter, FluxLimiterConfig,
 };
-use crate::integrand_offset::{IntegrandOffset, IntegrandOffsetConfig};
-use crate::lock::{LockDetector, LockDetectorConfig, LockStatus};
-use crate::mode::{Mode, ModeSelector, ModeSelectorConfig};
-use crate::observer::{DisturbanceObserver, DisturbanceObserverConfig};
+use crate::integrand_offset::{IntegrandOffsetConfig, IntegrandOffsetParams, IntegrandOffsetState};
+use crate::lock::{DebouncerState, LockDetectorConfig, LockDetectorParams, LockStatus};
+use crate::mode::{Mode, ModeSelectorConfig, ModeSelectorParams};
+use crate::observer::{DisturbanceObserverConfig, DisturbanceObserverParams, ObserverState};
 use crate::plausibility::{self, SampleBounds};
 use crate::real::all_finite;
 use crate::rotor_flux::{rotor_angle, rotor_flux, stator_flux};
-use crate::rs_adaptation::{AdaptationRegime, ResistanceAdaptation, ResistanceAdaptationConfig};
-use crate::tracker::{BandwidthDefinition, TrackerConfig, TypeTwoTracker};
+use crate::rs_adaptation::{
+    AdaptationRegime, ResistanceAdaptationConfig, ResistanceAdaptationParams,
+    ResistanceAdaptationState, ResistanceScale,
+};
+use crate::tracker::{BandwidthDefinition, TrackerConfig, TrackerParams, TrackerState};
 use crate::{Ab, MachineModel, Real};
 
 /// Observer time constants 1/(2π·f_th) the λ̂f law waits after a LO→HI hand-over.
@@ -385,7 +388,7 @@ impl<T: Real> EstimatorConfig<T> {
 
     /// Checks every field; the error names the first bad one.
     pub fn validate(&self) -> Result<(), ConfigError> {
-        SensorlessEstimator::new(*self).map(|_| ())
+        EstimatorParams::new(*self).map(|_| ())
     }
 
     /// The period of the slow laws, [`SLOW_PERIOD`]·Ts.
@@ -560,21 +563,20 @@ impl<T> From<Estimate<T>> for LeanEstimate<T> {
     }
 }
 
-/// The sensorless estimator of Fig. 5, generic over `f32` and `f64`, allocation-free.
+/// The estimator's immutable parameters: every constant its step needs, precomputed and
+/// checked once from an [`EstimatorConfig`] by [`EstimatorParams::new`] (Ts, L̂q, L̂d − L̂q,
+/// λ̂f, the gains and limits of every block, the slow laws' constants, the sample bounds, the
+/// lock detector's thresholds). Nothing in it changes after construction, so firmware can
+/// build it once and keep it where the interrupt reads it (a `static`, see the module docs
+/// of the `examples/cortex-m` image and docs/firmware.md); the mutable half is
+/// [`EstimatorState`].
 ///
-/// ```
-/// use fado_core::{Ab, EstimatorConfig, MachineModel, SensorlessEstimator};
-/// let config = EstimatorConfig::for_machine(&MachineModel::paper());
-/// let mut est = SensorlessEstimator::<f32>::new(config).unwrap();
-/// // In the 10 kHz ISR: the voltage applied over the last interval and the sampled currents.
-/// let out = est.step(Ab::new(1.2, -0.3), Ab::new(4.0, 0.1));
-/// assert!(!out.diagnostics.input_fault);
-/// let _angle = out.theta;
-/// ```
+/// The split follows quartiq's `idsp` (`iir::Stateful`/`StatefulRef`, src/iir/process.rs:
+/// a processor is its configuration plus its state, and the firmware path steps a state with
+/// a borrowed configuration). [`SensorlessEstimator`] is the owner of both, with the same
+/// step.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SensorlessEstimator<T: Real> {
-    // What the step and `reset`/`align` need of the `EstimatorConfig` (the whole record, 156 B
-    // in `f32`, is the caller's to keep: it is not state).
+pub struct EstimatorParams<T: Real> {
     /// Sampling period Ts, s.
     ts: T,
     /// L̂q (eq. (5)), H.
@@ -585,56 +587,75 @@ pub struct SensorlessEstimator<T: Real> {
     flux_linkage: T,
     /// `EstimatorTuning::tracker_hold_ratio`.
     tracker_hold_ratio: T,
+    /// (λ̂f·`tracker_hold_ratio`)²: the trackers coast below this |λ̂r|².
+    hold_level_sq: T,
     /// k_df·Ts with `EstimatorTuning::limiter_recentring`, else 0.
     limiter_recentring_gain: T,
-    /// k_e in s⁻¹ (`EstimatorTuning::offset_adaptation_rate`).
-    offset_adaptation_rate: T,
+    /// k_e·Ts (k_e = `EstimatorTuning::offset_adaptation_rate`): the k_df mode's re-centring
+    /// while the R̂s adaptation runs (the state holds it, or 0, since the adaptation can be
+    /// switched on at run time).
+    offset_recentring_gain: T,
     /// `EstimatorConfig::initial_angle`, rad.
     initial_angle: T,
-    /// `EstimatorTuning::observer_on_rotor_flux`.
-    observer_on_rotor_flux: bool,
+    /// The configured R̂s (`MachineModel::rs`), Ω: the start-up R̂s.
+    rs_initial: T,
     /// e^{−2π·f_th·Ts} and (1 − e^{−2π·f_th·Ts})·Kp of T2S-1 with
     /// `EstimatorTuning::observer_lag_compensation` (f_th the Fig. 3 threshold), else 0 and 0:
     /// the low-pass c ← keep·c + input·e.
     lag_keep: T,
     lag_input: T,
-    /// The low-passed Kp·e of T2S-1 added to ω̂1 for the observer, rad/s.
-    lag_compensation: T,
-    /// `EstimatorTuning::rs_adaptation`, or switched on by [`Self::enable_rs_adaptation`].
-    rs_adaptation_on: bool,
-    integrator: FluxIntegrator<T>,
-    observer: DisturbanceObserver<T>,
-    disturbance_feedback: DisturbanceFeedback<T>,
-    limiter: FluxLimiter<T>,
-    selector: ModeSelector<T>,
-    t2s1: TypeTwoTracker<T>,
-    t2s2: TypeTwoTracker<T>,
-    rs_adaptation: ResistanceAdaptation<T>,
-    /// ê, the learned integrand offset (with `rs_adaptation`).
-    offset: IntegrandOffset<T>,
     /// The λ̂f law waits this many periods of the slow laws ([`SLOW_PERIOD`] samples) of the
     /// k_df mode after a hand-over (see `rs_adaptation`): two observer time constants at the
     /// Fig. 3 threshold, 2/(2π·f_th).
     flux_settle_periods: u32,
-    /// k_e·Ts with `rs_adaptation` (the k_df mode's re-centring), else 0.
-    offset_recentring_gain: T,
+    /// `EstimatorTuning::observer_on_rotor_flux`.
+    observer_on_rotor_flux: bool,
+    /// `EstimatorTuning::rs_adaptation`: whether the start-up state adapts R̂s.
+    rs_adaptation: bool,
+    integrator: FluxIntegratorParams<T>,
+    observer: DisturbanceObserverParams<T>,
+    disturbance_feedback: DisturbanceFeedbackParams<T>,
+    limiter: FluxLimiter<T>,
+    selector: ModeSelectorParams<T>,
+    t2s1: TrackerParams<T>,
+    t2s2: TrackerParams<T>,
+    rs_adaptation_params: ResistanceAdaptationParams<T>,
+    offset: IntegrandOffsetParams<T>,
+    bounds: SampleBounds<T>,
+    lock: LockDetectorParams<T>,
+}
+
+/// The estimator's mutable state: λ1, the observer's λ̂1 and D̂, both trackers, the mode and
+/// the k_df gain, the feedback for the next sample, the slow laws' state (R̂s with the R0 it
+/// scales with, λ̂f, ê, their sums, slot and flags), the lock detector's count, the sample
+/// counters. Run-time settings live here too: R̂s (`set_rs_hat`, the adaptation), λ̂f (its
+/// law), the adaptation's on switch (`enable_rs_adaptation`) and the k_df switch. Stepped
+/// with [`EstimatorState::step`] / [`EstimatorState::step_lean`] and the
+/// [`EstimatorParams`] it was made for; `size_of` is 256 B or less in `f32`
+/// (docs/firmware.md).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EstimatorState<T: Real> {
+    integrator: FluxIntegratorState<T>,
+    observer: ObserverState<T>,
+    t2s1: TrackerState<T>,
+    t2s2: TrackerState<T>,
+    /// The k_df gain in effect (it ramps on activation, `EstimatorTuning::k_df_ramp_time`).
+    kdf_gain: T,
+    /// The low-passed Kp·e of T2S-1 added to ω̂1 for the observer, rad/s.
+    lag_compensation: T,
     /// Feedback term computed at the end of the previous sample.
     feedback: Ab<T>,
-    hold_level_sq: T,
-    k_df_enabled: bool,
-    rejected_samples: u32,
-    bounds: SampleBounds<T>,
     /// The step the current may have moved by since the last accepted one (the integrator's
     /// last current; grows by one step per rejected sample).
     step_allowance: T,
-    lock: LockDetector<T>,
-    /// `lock.status()`, kept where the detector's slot commits it (one byte to read per
-    /// sample instead of the debouncer's state).
-    lock_status: LockStatus,
-    /// This sample's slot in the slow laws' round-robin (see [`SLOW_PERIOD`]).
-    slot: u8,
-    /// `BROKEN_*` bits: which slow law's regime was interrupted since it last ran.
-    slow_broken: u8,
+    /// k_e·Ts while the R̂s adaptation runs (the k_df mode's re-centring), else 0.
+    offset_recentring_gain: T,
+    /// What the R̂s adaptation derives from the R0 it started from (replaced by
+    /// `set_rs_hat`).
+    rs_scale: ResistanceScale<T>,
+    rs_adaptation: ResistanceAdaptationState<T>,
+    /// ê, the learned integrand offset (with the R̂s adaptation).
+    offset: IntegrandOffsetState<T>,
     /// Σ v and Σ i (the integrator's current) over the samples since the R̂s adaptation
     /// last ran: the standstill law integrates their means (see [`SLOW_PERIOD`]).
     v_sum: Ab<T>,
@@ -642,10 +663,26 @@ pub struct SensorlessEstimator<T: Real> {
     /// The slow laws' share of the feedback, held between their runs: the learned integrand
     /// offset ê plus the R̂s adaptation's standstill pull (V, see `rs_adaptation`).
     slow_feedback: Ab<T>,
+    lock: DebouncerState,
+    rejected_samples: u32,
+    mode: Mode,
+    /// `lock`'s status, kept where the detector's slot commits it (one byte to read per
+    /// sample instead of the debouncer's state).
+    lock_status: LockStatus,
+    /// This sample's slot in the slow laws' round-robin (see [`SLOW_PERIOD`]).
+    slot: u8,
+    /// `BROKEN_*` bits: which slow law's regime was interrupted since it last ran.
+    slow_broken: u8,
+    /// The R̂s adaptation runs: `EstimatorTuning::rs_adaptation`, or switched on by
+    /// [`EstimatorState::enable_rs_adaptation`].
+    rs_adaptation_on: bool,
+    k_df_enabled: bool,
 }
 
-impl<T: Real> SensorlessEstimator<T> {
-    /// Builds the estimator; every field of `config` is checked and a bad one is named.
+impl<T: Real> EstimatorParams<T> {
+    /// Builds the parameters; every field of `config` is checked and a bad one is named.
+    /// Not `const`: the checks and the derived gains go through [`Real`]'s trait methods
+    /// (√, e^x, the tracker gains), which stable Rust cannot call in a `const fn`.
     pub fn new(config: EstimatorConfig<T>) -> Result<Self, ConfigError> {
         let ts = check::positive("ts", config.ts)?;
         config.machine.validate()?;
@@ -686,13 +723,13 @@ impl<T: Real> SensorlessEstimator<T> {
                 ConfigError::Negative { .. } => ConfigError::Negative { field },
             }
         };
-        let integrator = FluxIntegrator::new(FluxIntegratorConfig {
+        let (integrator, _) = FluxIntegratorParams::new(FluxIntegratorConfig {
             ts,
             rs_hat: config.machine.rs,
             average_current: config.tuning.average_current,
         })?;
-        let observer = DisturbanceObserver::new(DisturbanceObserverConfig { ts })?;
-        let disturbance_feedback = DisturbanceFeedback::new(DisturbanceFeedbackConfig {
+        let observer = DisturbanceObserverParams::new(DisturbanceObserverConfig { ts })?;
+        let disturbance_feedback = DisturbanceFeedbackParams::new(DisturbanceFeedbackConfig {
             ts,
             k_df: config.tuning.k_df,
             ramp_time: config.tuning.k_df_ramp_time,
@@ -705,7 +742,7 @@ impl<T: Real> SensorlessEstimator<T> {
             k_af: config.tuning.k_af,
             radius: ratio * lf,
         })?;
-        let selector = ModeSelector::new(ModeSelectorConfig {
+        let selector = ModeSelectorParams::new(ModeSelectorConfig {
             threshold_hz: config.mode_threshold_hz(),
             hysteresis_hz: config.mode_hysteresis_hz(),
         })
@@ -718,11 +755,11 @@ impl<T: Real> SensorlessEstimator<T> {
             config.mode_threshold_hz() + config.mode_hysteresis_hz(),
         )?;
         check::positive("tracker_damping", config.tuning.tracker_damping)?;
-        let t2s1 = TypeTwoTracker::new(config.tracker(config.tuning.t2s1_bandwidth_hz))
+        let t2s1 = TrackerParams::new(config.tracker(config.tuning.t2s1_bandwidth_hz))
             .map_err(rename("t2s1_bandwidth_hz"))?;
-        let t2s2 = TypeTwoTracker::new(config.tracker(config.tuning.t2s2_bandwidth_hz))
+        let t2s2 = TrackerParams::new(config.tracker(config.tuning.t2s2_bandwidth_hz))
             .map_err(rename("t2s2_bandwidth_hz"))?;
-        let rs_adaptation = ResistanceAdaptation::new(ResistanceAdaptationConfig {
+        let rs_adaptation = ResistanceAdaptationParams::new(ResistanceAdaptationConfig {
             flux_linkage_min_speed: T::lit(FLUX_LINKAGE_SPEED_THRESHOLDS)
                 * T::two_pi()
                 * config.mode_threshold_hz(),
@@ -746,7 +783,7 @@ impl<T: Real> SensorlessEstimator<T> {
             }
         })?;
         let threshold_hz = config.mode_threshold_hz();
-        let offset = IntegrandOffset::new(IntegrandOffsetConfig {
+        let offset = IntegrandOffsetParams::new(IntegrandOffsetConfig {
             ts: config.slow_ts(),
             rate: config.tuning.offset_adaptation_rate,
             settle_time: T::lit(5.0) / (T::two_pi() * threshold_hz),
@@ -774,8 +811,8 @@ impl<T: Real> SensorlessEstimator<T> {
         squared("flux_linkage", lf)?;
         squared("limiter_radius_ratio", ratio * lf)?;
         let bounds = config.sample_bounds()?;
-        let lock = LockDetector::new(config.lock_detector())?;
-        let mut est = Self {
+        let lock = LockDetectorParams::new(config.lock_detector())?;
+        Ok(Self {
             ts,
             lq: config.machine.lq,
             saliency: config.machine.ld - config.machine.lq,
@@ -786,7 +823,7 @@ impl<T: Real> SensorlessEstimator<T> {
             } else {
                 T::zero()
             },
-            offset_adaptation_rate: config.tuning.offset_adaptation_rate,
+            offset_recentring_gain: config.tuning.offset_adaptation_rate * ts,
             initial_angle: config.initial_angle,
             observer_on_rotor_flux: config.tuning.observer_on_rotor_flux,
             lag_keep: if config.tuning.observer_lag_compensation {
@@ -799,8 +836,13 @@ impl<T: Real> SensorlessEstimator<T> {
             } else {
                 T::zero()
             },
-            lag_compensation: T::zero(),
-            rs_adaptation_on: config.tuning.rs_adaptation,
+            rs_adaptation: config.tuning.rs_adaptation,
+            rs_initial: config.machine.rs,
+            hold_level_sq: hold_level * hold_level,
+            flux_settle_periods: (T::lit(FLUX_SETTLE_TIME_CONSTANTS)
+                / (T::two_pi() * threshold_hz * config.slow_ts()))
+            .ceil()
+            .to_f64() as u32,
             integrator,
             observer,
             disturbance_feedback,
@@ -808,51 +850,84 @@ impl<T: Real> SensorlessEstimator<T> {
             selector,
             t2s1,
             t2s2,
-            rs_adaptation,
+            rs_adaptation_params: rs_adaptation,
             offset,
-            flux_settle_periods: (T::lit(FLUX_SETTLE_TIME_CONSTANTS)
-                / (T::two_pi() * threshold_hz * config.slow_ts()))
-            .ceil()
-            .to_f64() as u32,
-            offset_recentring_gain: if config.tuning.rs_adaptation {
-                config.tuning.offset_adaptation_rate * ts
+            bounds,
+            lock,
+        })
+    }
+
+    /// The start-up state ([`EstimatorState::reset`]: θ̂ = `initial_angle`, zero current,
+    /// R̂s and λ̂f as configured).
+    pub fn initial_state(&self) -> EstimatorState<T> {
+        let rs_scale = self.rs_adaptation_params.scale(self.rs_initial);
+        let mut state = EstimatorState {
+            integrator: FluxIntegratorState::new(self.rs_initial),
+            observer: ObserverState::zero(),
+            t2s1: self.t2s1.state_at(T::zero(), T::zero()),
+            t2s2: self.t2s2.state_at(T::zero(), T::zero()),
+            kdf_gain: T::zero(),
+            lag_compensation: T::zero(),
+            feedback: Ab::zero(),
+            step_allowance: self.bounds.step(),
+            offset_recentring_gain: if self.rs_adaptation {
+                self.offset_recentring_gain
             } else {
                 T::zero()
             },
-            feedback: Ab::zero(),
-            hold_level_sq: hold_level * hold_level,
-            k_df_enabled: true,
-            rejected_samples: 0,
-            bounds,
-            step_allowance: bounds.step(),
-            lock,
-            lock_status: LockStatus::Locked,
-            slot: 0,
-            slow_broken: 0,
+            rs_scale,
+            rs_adaptation: self.rs_adaptation_params.initial_state(&rs_scale),
+            offset: IntegrandOffsetState::default(),
             v_sum: Ab::zero(),
             i_sum: Ab::zero(),
             slow_feedback: Ab::zero(),
+            lock: DebouncerState::default(),
+            rejected_samples: 0,
+            mode: Mode::Limiter,
+            lock_status: LockStatus::Locked,
+            slot: 0,
+            slow_broken: 0,
+            rs_adaptation_on: self.rs_adaptation,
+            k_df_enabled: true,
         };
-        est.reset();
-        Ok(est)
+        state.reset(self);
+        state
+    }
+
+    /// The sampling period Ts in use, s.
+    pub fn ts(&self) -> T {
+        self.ts
+    }
+
+    /// The Fig. 3 mode threshold in use and its hysteresis half-band, Hz electrical
+    /// ([`EstimatorConfig::mode_threshold_hz`], [`EstimatorConfig::mode_hysteresis_hz`]).
+    pub fn mode_threshold_hz(&self) -> (T, T) {
+        self.selector.threshold_hz()
+    }
+}
+
+impl<T: Real> EstimatorState<T> {
+    /// The start-up state for `params` (as [`EstimatorParams::initial_state`]).
+    pub fn new(params: &EstimatorParams<T>) -> Self {
+        params.initial_state()
     }
 
     /// Back to the start-up state at `config.initial_angle` with zero current; an adapted R̂s
-    /// goes back to the configured value.
-    pub fn reset(&mut self) {
+    /// goes back to the value the adaptation started from.
+    pub fn reset(&mut self, p: &EstimatorParams<T>) {
         if self.rs_adaptation_on {
-            self.rs_adaptation.reset();
-            self.offset.reset();
+            self.rs_adaptation = p.rs_adaptation_params.initial_state(&self.rs_scale);
+            self.offset = IntegrandOffsetState::default();
             self.integrator
-                .set_rs_hat_unchecked(self.rs_adaptation.rs_hat());
+                .set_rs_hat_unchecked(self.rs_adaptation.rs_hat);
         }
-        self.align(self.initial_angle, Ab::zero());
+        self.align(p, p.initial_angle, Ab::zero());
     }
 
     /// Start-up at a known rotor angle θ0 with the present current (SPEC §1 step 6):
-    /// λ1 = λ̂a·e^{jθ0} + L̂q·i with the active flux λ̂a = λ̂f + (L̂d − L̂q)·i_d, D̂ = 0, θ̂ = θ0, ω̂ = 0, limiter mode. An adapted R̂s is kept
-    /// (the winding is as warm as it was).
-    pub fn align(&mut self, theta0: T, i_ab: Ab<T>) {
+    /// λ1 = λ̂a·e^{jθ0} + L̂q·i with the active flux λ̂a = λ̂f + (L̂d − L̂q)·i_d, D̂ = 0, θ̂ = θ0,
+    /// ω̂ = 0, limiter mode. An adapted R̂s is kept (the winding is as warm as it was).
+    pub fn align(&mut self, p: &EstimatorParams<T>, theta0: T, i_ab: Ab<T>) {
         let theta0 = if theta0.is_finite() {
             theta0
         } else {
@@ -860,16 +935,16 @@ impl<T: Real> SensorlessEstimator<T> {
         };
         // The active flux λ̂f + (L̂d − L̂q)·i_d (λ̂f exactly for L̂d = L̂q).
         let rotor = Ab::from_polar(T::one(), theta0);
-        let active = self.flux_linkage + self.saliency * rotor.dot(i_ab);
+        let active = p.flux_linkage + p.saliency * rotor.dot(i_ab);
         let active = if active.is_finite() && active > T::zero() {
             active
         } else {
-            self.flux_linkage
+            p.flux_linkage
         };
         let lambda_r = Ab::from_polar(active, theta0);
         // A current so large that L̂q·i overflows is as unusable as a NaN (found by fuzzing,
         // f32: i = 3e37 A gave λ1 = ∞): start as with zero current.
-        let lambda1 = lambda_r + i_ab * self.lq;
+        let lambda1 = lambda_r + i_ab * p.lq;
         let (lambda1, i_ab) = if lambda1.is_finite() {
             (lambda1, i_ab)
         } else {
@@ -879,69 +954,70 @@ impl<T: Real> SensorlessEstimator<T> {
         // The last current is also what the first sample's current step is checked against
         // (see `crate::plausibility`): an implausible one is not kept.
         self.integrator
-            .set_last_current(if self.bounds.current_ok(i_ab) {
+            .set_last_current(if p.bounds.current_ok(i_ab) {
                 i_ab
             } else {
                 Ab::zero()
             });
-        self.observer.reset_to(if self.observer_on_rotor_flux {
-            Ab::from_polar(self.flux_linkage, theta0)
+        self.observer = ObserverState::at(if p.observer_on_rotor_flux {
+            Ab::from_polar(p.flux_linkage, theta0)
         } else {
             lambda1
         });
-        self.disturbance_feedback.reset();
-        self.selector.reset();
-        self.t2s1.reset_to(theta0, T::zero());
-        self.t2s2.reset_to(theta0, T::zero());
+        self.kdf_gain = T::zero();
+        self.mode = Mode::Limiter;
+        self.t2s1 = p.t2s1.state_at(theta0, T::zero());
+        self.t2s2 = p.t2s2.state_at(theta0, T::zero());
         self.lag_compensation = T::zero();
         self.feedback = Ab::zero();
         self.rejected_samples = 0;
-        self.lock.reset();
+        self.lock = DebouncerState::default();
         self.lock_status = self.lock.status();
         self.slot = 0;
         self.slow_broken = 0;
         self.v_sum = Ab::zero();
         self.i_sum = Ab::zero();
-        self.slow_feedback = self.offset.offset();
-        self.step_allowance = self.bounds.step();
+        self.slow_feedback = self.offset.offset;
+        self.step_allowance = p.bounds.step();
     }
 
-    /// One 10 kHz sample (Fig. 5).
-    ///
-    /// `v_ab` is the voltage reference that was applied over the last sampling interval (with
-    /// a one-sample computational delay, the one computed two samples ago, before dead-time
-    /// compensation); `i_ab` the currents sampled now. A non-finite or implausible input (see
-    /// [`crate::plausibility`]) is rejected: the state is untouched and [`Self::last`] is
-    /// returned with `input_fault` set.
+    /// One sample (Fig. 5) with the parameters `p` this state was made for: as
+    /// [`SensorlessEstimator::step`].
     #[inline]
-    pub fn step(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> Estimate<T> {
-        self.advance(v_ab, i_ab)
+    pub fn step(&mut self, p: &EstimatorParams<T>, v_ab: Ab<T>, i_ab: Ab<T>) -> Estimate<T> {
+        self.advance(p, v_ab, i_ab)
     }
 
-    /// [`Self::step`] for firmware: the same sample, the same new state, but only the
-    /// outputs a control loop uses ([`LeanEstimate`]: θ̂, ω̂, ω̂ for control, the mode, the
-    /// lock status and the input-fault flag). The diagnostics of [`Estimate`] (λ1, D̂, λ2,
-    /// λ̂r, θm, R̂s, λ̂f, flags) are not formed: on a Cortex-M4F that saves about 65 of the
-    /// step's cycles (docs/firmware.md). [`Self::last`] still gives them for the last sample
-    /// (recomputed from the state).
+    /// [`Self::step`] without the diagnostics: as [`SensorlessEstimator::step_lean`], the
+    /// firmware step.
     #[inline]
-    pub fn step_lean(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> LeanEstimate<T> {
-        self.advance(v_ab, i_ab)
+    pub fn step_lean(
+        &mut self,
+        p: &EstimatorParams<T>,
+        v_ab: Ab<T>,
+        i_ab: Ab<T>,
+    ) -> LeanEstimate<T> {
+        self.advance(p, v_ab, i_ab)
     }
 
     /// The step itself, for any output that is a projection of [`Estimate`]: inlined into
     /// [`Self::step`] and [`Self::step_lean`], so that the compiler drops what the output
     /// does not keep.
     #[inline(always)]
-    fn advance<O: From<Estimate<T>>>(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> O {
+    fn advance<O: From<Estimate<T>>>(
+        &mut self,
+        p: &EstimatorParams<T>,
+        v_ab: Ab<T>,
+        i_ab: Ab<T>,
+    ) -> O {
         // Plausibility first (a few compares; false for NaN/∞ too, see `crate::plausibility`).
-        if !self.bounds.check(
+        if !p.bounds.check(
             v_ab,
             i_ab,
             self.integrator.last_current(),
             self.step_allowance,
         ) {
-            return self.reject().into();
+            return self.reject(p).into();
         }
         // The whole new state is computed first and committed only if it is finite: a
         // non-finite input makes it non-finite (every input enters λ1 through Ts·v and the
@@ -950,18 +1026,20 @@ impl<T: Real> SensorlessEstimator<T> {
         // changed. One test at the end covers all of this (cheaper than a test per input and
         // per block, and than copying the estimator as a backup every sample).
         // L̂d − L̂q: zero on a surface-magnet rotor, where the active-flux terms vanish.
-        let saliency = self.saliency;
+        let saliency = p.saliency;
         // 1. Integrate with the feedback of the previous sample (eq. (21) / (24)).
-        let (lambda1, i_drop) = self.integrator.next_flux(v_ab, i_ab, self.feedback);
+        let (lambda1, i_drop) = p
+            .integrator
+            .next_flux(&self.integrator, v_ab, i_ab, self.feedback);
         // L̂q·i of eq. (5), formed once for both of its uses (λ̂r, and the observer's input
         // on the rotor flux): what `rotor_flux` computes, bit for bit.
-        let lq_i = i_ab * self.lq;
+        let lq_i = i_ab * p.lq;
         // 2. Disturbance observer at ω̂ of T2S-1 (eq. (10), (16)), on λ1 or on λ1 − L̂q·i
         //    (see `EstimatorTuning::observer_on_rotor_flux`).
-        let observer_input = if self.observer_on_rotor_flux {
+        let observer_input = if p.observer_on_rotor_flux {
             let active = lambda1 - lq_i;
             if saliency != T::zero() {
-                active - self.active_flux_swing(i_ab, saliency)
+                active - self.active_flux_swing(p, i_ab, saliency)
             } else {
                 active
             }
@@ -971,40 +1049,45 @@ impl<T: Real> SensorlessEstimator<T> {
         //    With `observer_lag_compensation` ω̂1 plus T2S-1's low-passed Kp·e (the rate of
         //    θ̂), not the lagging ω̂1 alone.
         let observer_speed = self.t2s1.speed() + self.lag_compensation;
-        let (observer_flux, disturbance) = self.observer.next_state(observer_input, observer_speed);
+        let (observer_flux, disturbance) =
+            p.observer
+                .next_state(&self.observer, observer_input, observer_speed);
         // 3. Rotor flux and direct angle (eq. (20), (5), (6)).
         let lambda2 = stator_flux(lambda1, disturbance);
         let lambda_r = lambda2 - lq_i;
-        let tracker_hold = lambda_r.norm_squared() < self.hold_level_sq;
+        let tracker_hold = lambda_r.norm_squared() < p.hold_level_sq;
         let theta_direct = rotor_angle(lambda_r);
         let slot = self.slot;
-        let flux_hat = self.rs_adaptation.flux_linkage_hat();
+        let flux_hat = self.rs_adaptation.flux_linkage_hat;
         // λ̂a/λ̂f, the active flux the limiter circle and the lock detector's bounds refer to
         // (1 on a surface-magnet rotor).
         let active_ratio = if saliency != T::zero() && !tracker_hold {
             let i_d = i_ab.dot(lambda_r) / lambda_r.norm_squared().step_sqrt();
-            let ratio = T::one() + saliency * i_d / self.flux_linkage;
-            crate::real::max(ratio, self.tracker_hold_ratio)
+            let ratio = T::one() + saliency * i_d / p.flux_linkage;
+            crate::real::max(ratio, p.tracker_hold_ratio)
         } else {
             T::one()
         };
         // 4. Trackers (Fig. 1, Fig. 5).
         let (t2s1, t2s2) = if tracker_hold {
-            (self.t2s1.coasted_state(), self.t2s2.coasted_state())
+            (
+                p.t2s1.coasted_state(&self.t2s1),
+                p.t2s2.coasted_state(&self.t2s2),
+            )
         } else {
             (
-                self.t2s1.next_state(theta_direct),
-                self.t2s2.next_state(theta_direct),
+                p.t2s1.next_state(&self.t2s1, theta_direct),
+                p.t2s2.next_state(&self.t2s2, theta_direct),
             )
         };
         // 5. Mode from the control speed, and the feedback for the next sample.
-        let mode = self.selector.next_mode(t2s2.omega);
+        let mode = p.selector.next_mode(self.mode, t2s2.omega);
         let kdf_active = mode == Mode::DisturbanceFeedback && self.k_df_enabled;
-        let kdf_gain = self.disturbance_feedback.next_gain(kdf_active);
+        let kdf_gain = p.disturbance_feedback.next_gain(self.kdf_gain, kdf_active);
         let (base_feedback, clamping) = match mode {
             Mode::DisturbanceFeedback => (disturbance * kdf_gain, false),
             Mode::Limiter => {
-                let l = self.limiter.step_scaled(lambda_r, active_ratio);
+                let l = p.limiter.step_scaled(lambda_r, active_ratio);
                 (l.feedback, l.clamping)
             }
         };
@@ -1013,7 +1096,8 @@ impl<T: Real> SensorlessEstimator<T> {
         // (Outside its slot the detector's state is neither copied nor written back.)
         // The innovation is T2S-1's phase error of this sample (0 when the trackers coasted).
         let lock = if slot == SLOT_LOCK {
-            Some(self.lock.next_state(
+            Some(p.lock.next_state(
+                self.lock,
                 lambda_r.norm_squared(),
                 flux_hat * flux_hat * active_ratio * active_ratio,
                 t2s1.innovation,
@@ -1047,11 +1131,11 @@ impl<T: Real> SensorlessEstimator<T> {
             t2s2.omega,
         ]);
         if !finite {
-            return self.reject().into();
+            return self.reject(p).into();
         }
-        let rs_hat_used = self.integrator.config().rs_hat;
-        let flux_linkage_used = self.rs_adaptation.flux_linkage_hat();
-        let previous_mode = self.selector.mode();
+        let rs_hat_used = self.integrator.rs_hat();
+        let flux_linkage_used = self.rs_adaptation.flux_linkage_hat;
+        let previous_mode = self.mode;
         // Limiter mode: re-centre the common mode (see `EstimatorTuning::limiter_recentring`).
         // With the integrand-offset law, the k_df mode re-centres too, at k_e (see
         // `crate::integrand_offset`: D̂ then decays at k_df + k_e instead of k_df, and the
@@ -1059,7 +1143,7 @@ impl<T: Real> SensorlessEstimator<T> {
         // A gain switched off is 0 and its shift D̂·0 = 0 changes nothing: no test of it.
         let shift = disturbance
             * match mode {
-                Mode::Limiter => self.limiter_recentring_gain,
+                Mode::Limiter => p.limiter_recentring_gain,
                 Mode::DisturbanceFeedback => self.offset_recentring_gain,
             };
         self.integrator.commit(lambda1 - shift, i_ab);
@@ -1067,18 +1151,17 @@ impl<T: Real> SensorlessEstimator<T> {
             .commit(observer_flux - shift, disturbance - shift);
         // The observer's lag compensation: Kp·e of T2S-1 through the first-order low-pass
         // (see `EstimatorTuning::observer_lag_compensation_hz`).
-        self.lag_compensation =
-            self.lag_keep * self.lag_compensation + self.lag_input * t2s1.innovation;
+        self.lag_compensation = p.lag_keep * self.lag_compensation + p.lag_input * t2s1.innovation;
         self.t2s1.commit(t2s1);
         self.t2s2.commit(t2s2);
-        self.selector.commit(mode);
-        self.disturbance_feedback.commit(kdf_gain);
+        self.mode = mode;
+        self.kdf_gain = kdf_gain;
         self.feedback = feedback;
         if let Some(lock) = lock {
-            self.lock.commit(lock);
+            self.lock = lock;
             self.lock_status = lock.status();
         }
-        self.step_allowance = self.bounds.step();
+        self.step_allowance = p.bounds.step();
         // SLOW_PERIOD is a power of two: the modulo is a mask.
         self.slot = (slot + 1) % SLOW_PERIOD;
         // 6. The slow laws in their slots (see [`SLOW_PERIOD`]): R̂s and ê for the next
@@ -1108,18 +1191,20 @@ impl<T: Real> SensorlessEstimator<T> {
                 let i_mean = (self.i_sum + i_drop) * per_sample;
                 self.v_sum = Ab::zero();
                 self.i_sum = Ab::zero();
-                let (state, pull) = self.rs_adaptation.next_state(
-                    v_mean - self.offset.offset(),
+                let (state, pull) = p.rs_adaptation_params.next_state(
+                    &self.rs_scale,
+                    &self.rs_adaptation,
+                    v_mean - self.offset.offset,
                     i_drop,
                     i_mean,
                     i_ab,
                     lambda_r,
                     t2s1.omega,
                     regime,
-                    self.offset.learning_samples() >= self.flux_settle_periods,
+                    self.offset.learning_samples >= p.flux_settle_periods,
                 );
                 // The pull acts until the law runs again (one period), with ê.
-                let slow_feedback = self.offset.offset() + pull;
+                let slow_feedback = self.offset.offset + pull;
                 let feedback = base_feedback + slow_feedback;
                 // R̂s and λ̂f leave the adaptation clamped by compare-and-select, which turns
                 // a NaN into the bound: always finite.
@@ -1136,7 +1221,7 @@ impl<T: Real> SensorlessEstimator<T> {
                     feedback.alpha,
                     feedback.beta,
                 ]) {
-                    self.rs_adaptation.commit(state);
+                    self.rs_adaptation = state;
                     self.integrator.set_rs_hat_unchecked(state.rs_hat);
                     self.feedback = feedback;
                     self.slow_feedback = slow_feedback;
@@ -1153,12 +1238,16 @@ impl<T: Real> SensorlessEstimator<T> {
                 // k_e·Ts·D̂ of the samples since the law last ran (see
                 // `IntegrandOffset::next_state`).
                 let n = T::lit(SLOW_PERIOD as f64);
-                let decay = kdf_gain * (self.ts * n) + self.offset_recentring_gain * (n - T::one());
+                let decay = kdf_gain * (p.ts * n) + self.offset_recentring_gain * (n - T::one());
                 let learning = broken & BROKEN_OFFSET == 0 && mode == Mode::DisturbanceFeedback;
-                let offset = self.offset.next_state(disturbance, decay, shift, learning);
+                let offset = p
+                    .offset
+                    .next_state(&self.offset, disturbance, decay, shift, learning);
                 // R̂s drops what earlier standstill tests read of the offset ê learns now.
-                let change = offset.offset - self.offset.offset();
-                let rs_hat = self.rs_adaptation.rs_after_offset_change(change);
+                let change = offset.offset - self.offset.offset;
+                let rs_hat = self
+                    .rs_adaptation
+                    .rs_after_offset_change(&self.rs_scale, change);
                 let slow_feedback = self.slow_feedback + change;
                 let feedback = base_feedback + slow_feedback;
                 if all_finite([
@@ -1169,8 +1258,8 @@ impl<T: Real> SensorlessEstimator<T> {
                     feedback.alpha,
                     feedback.beta,
                 ]) {
-                    self.offset.commit(offset);
-                    self.rs_adaptation.commit_rs_hat(rs_hat);
+                    self.offset = offset;
+                    self.rs_adaptation.rs_hat = rs_hat;
                     self.integrator.set_rs_hat_unchecked(rs_hat);
                     self.feedback = feedback;
                     self.slow_feedback = slow_feedback;
@@ -1209,10 +1298,10 @@ impl<T: Real> SensorlessEstimator<T> {
     /// (≈ λ̂f·e^{jθ̂}, no extra state), î_d the current along it. Zero while that vector is
     /// below the tracker's hold level (no usable axis).
     #[inline]
-    fn active_flux_swing(&self, i_ab: Ab<T>, saliency: T) -> Ab<T> {
+    fn active_flux_swing(&self, p: &EstimatorParams<T>, i_ab: Ab<T>, saliency: T) -> Ab<T> {
         let axis = self.observer.flux() - self.observer.disturbance();
         let n2 = axis.norm_squared();
-        if n2 > self.hold_level_sq {
+        if n2 > p.hold_level_sq {
             axis * (saliency * i_ab.dot(axis) / n2)
         } else {
             Ab::zero()
@@ -1220,29 +1309,22 @@ impl<T: Real> SensorlessEstimator<T> {
     }
 
     #[cold]
-    fn reject(&mut self) -> Estimate<T> {
+    fn reject(&mut self, p: &EstimatorParams<T>) -> Estimate<T> {
         self.rejected_samples = self.rejected_samples.saturating_add(1);
-        self.step_allowance += self.bounds.step();
-        let mut out = self.last();
+        self.step_allowance += p.bounds.step();
+        let mut out = self.last(p);
         out.diagnostics.input_fault = true;
         out
     }
 
     /// The estimate of the last good sample (or of the last `align`/`reset`), recomputed from
-    /// the state: the estimator keeps no copy of its output (64 bytes written every sample in
-    /// `f32`; a caller that needs the output keeps what `step` returned).
-    ///
-    /// θ̂, ω̂, ω̂ for control, the mode and FLAG_limit are those of that sample exactly. The
-    /// diagnostics are recomputed: λ1 and D̂ as stored (after the limiter re-centring, see
-    /// [`EstimatorTuning::limiter_recentring`]), λ2 = λ1 − D̂, λ̂r = λ2 − L̂q·i with that
-    /// sample's current, θm = ∠λ̂r, the limiter and hold flags from this λ̂r, R̂s and λ̂f as
-    /// they will be used next.
-    pub fn last(&self) -> Estimate<T> {
+    /// the state: as [`SensorlessEstimator::last`].
+    pub fn last(&self, p: &EstimatorParams<T>) -> Estimate<T> {
         let lambda1 = self.integrator.flux();
         let disturbance = self.observer.disturbance();
         let lambda2 = stator_flux(lambda1, disturbance);
-        let lambda_r = rotor_flux(lambda2, self.integrator.last_current(), self.lq);
-        let mode = self.selector.mode();
+        let lambda_r = rotor_flux(lambda2, self.integrator.last_current(), p.lq);
+        let mode = self.mode;
         Estimate {
             theta: self.t2s1.angle(),
             omega: self.t2s1.speed(),
@@ -1255,10 +1337,10 @@ impl<T: Real> SensorlessEstimator<T> {
                 theta_direct: rotor_angle(lambda_r),
                 mode,
                 flag_limit: mode == Mode::Limiter,
-                limiter_clamping: mode == Mode::Limiter && self.limiter.step(lambda_r).clamping,
-                tracker_hold: lambda_r.norm_squared() < self.hold_level_sq,
-                rs_hat: self.integrator.config().rs_hat,
-                flux_linkage_hat: self.rs_adaptation.flux_linkage_hat(),
+                limiter_clamping: mode == Mode::Limiter && p.limiter.step(lambda_r).clamping,
+                tracker_hold: lambda_r.norm_squared() < p.hold_level_sq,
+                rs_hat: self.integrator.rs_hat(),
+                flux_linkage_hat: self.rs_adaptation.flux_linkage_hat,
                 input_fault: false,
                 lock: self.lock.status(),
             },
@@ -1270,10 +1352,182 @@ impl<T: Real> SensorlessEstimator<T> {
         self.rejected_samples
     }
 
+    /// As [`SensorlessEstimator::set_disturbance_feedback_enabled`].
+    pub fn set_disturbance_feedback_enabled(&mut self, enabled: bool) {
+        self.k_df_enabled = enabled;
+    }
+
+    /// As [`SensorlessEstimator::set_rs_hat`].
+    pub fn set_rs_hat(&mut self, p: &EstimatorParams<T>, rs_hat: T) -> Result<(), ConfigError> {
+        self.integrator.set_rs_hat(rs_hat)?;
+        if self.rs_adaptation_on {
+            // R̂s ≥ 0 was just checked: the adaptation restarts around it.
+            self.rs_scale = p.rs_adaptation_params.scale(rs_hat);
+            self.rs_adaptation = p.rs_adaptation_params.initial_state(&self.rs_scale);
+        }
+        Ok(())
+    }
+
+    /// As [`SensorlessEstimator::enable_rs_adaptation`].
+    pub fn enable_rs_adaptation(&mut self, p: &EstimatorParams<T>) {
+        if self.rs_adaptation_on {
+            return;
+        }
+        self.rs_adaptation_on = true;
+        self.offset_recentring_gain = p.offset_recentring_gain;
+        let rs_hat = self.integrator.rs_hat();
+        self.rs_scale = p.rs_adaptation_params.scale(rs_hat);
+        self.rs_adaptation = p.rs_adaptation_params.initial_state(&self.rs_scale);
+        self.offset = IntegrandOffsetState::default();
+        self.slow_feedback = Ab::zero();
+    }
+
+    /// As [`SensorlessEstimator::turn_angle`].
+    pub fn turn_angle(&mut self, p: &EstimatorParams<T>, angle: T) {
+        if !angle.is_finite() || self.mode != Mode::Limiter {
+            return;
+        }
+        let lambda1 = self.integrator.flux();
+        let lambda2 = stator_flux(lambda1, self.observer.disturbance());
+        let lambda_r = rotor_flux(lambda2, self.integrator.last_current(), p.lq);
+        let turned = lambda1 + lambda_r.mul_j() * angle;
+        if turned.is_finite() {
+            self.integrator
+                .commit(turned, self.integrator.last_current());
+        }
+    }
+
+    /// Clears a loss-of-lock verdict (as [`RotorAngleEstimator::rearm_lock_detector`]).
+    pub fn rearm_lock_detector(&mut self) {
+        self.lock = DebouncerState::default();
+        self.lock_status = self.lock.status();
+    }
+
+    /// ê, the learned integrand offset (V, α-β; zero without `rs_adaptation`).
+    pub fn integrand_offset(&self) -> Ab<T> {
+        self.offset.offset
+    }
+
+    /// R̂s in use now (Ω).
+    pub fn rs_hat(&self) -> T {
+        self.integrator.rs_hat()
+    }
+
+    /// Whether the R̂s adaptation runs.
+    pub fn rs_adaptation_enabled(&self) -> bool {
+        self.rs_adaptation_on
+    }
+}
+
+/// The sensorless estimator of Fig. 5, generic over `f32` and `f64`, allocation-free: the
+/// owner of its [`EstimatorParams`] and its [`EstimatorState`] (firmware may keep the two
+/// apart, the parameters in a `static`; both step identically).
+///
+/// ```
+/// use fado_core::{Ab, EstimatorConfig, MachineModel, SensorlessEstimator};
+/// let config = EstimatorConfig::for_machine(&MachineModel::paper());
+/// let mut est = SensorlessEstimator::<f32>::new(config).unwrap();
+/// // In the 10 kHz ISR: the voltage applied over the last interval and the sampled currents.
+/// let out = est.step(Ab::new(1.2, -0.3), Ab::new(4.0, 0.1));
+/// assert!(!out.diagnostics.input_fault);
+/// let _angle = out.theta;
+/// ```
+///
+/// The same with the parameters apart from the state (the firmware pattern):
+///
+/// ```
+/// use fado_core::{Ab, EstimatorConfig, EstimatorParams, EstimatorState, MachineModel};
+/// let config = EstimatorConfig::for_machine(&MachineModel::paper());
+/// let params = EstimatorParams::<f32>::new(config).unwrap(); // once, e.g. into a `static`
+/// let mut state = EstimatorState::new(&params);
+/// let out = state.step_lean(&params, Ab::new(1.2, -0.3), Ab::new(4.0, 0.1));
+/// assert!(!out.input_fault);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SensorlessEstimator<T: Real> {
+    params: EstimatorParams<T>,
+    state: EstimatorState<T>,
+}
+
+impl<T: Real> SensorlessEstimator<T> {
+    /// Builds the estimator; every field of `config` is checked and a bad one is named.
+    pub fn new(config: EstimatorConfig<T>) -> Result<Self, ConfigError> {
+        let params = EstimatorParams::new(config)?;
+        Ok(Self {
+            params,
+            state: params.initial_state(),
+        })
+    }
+
+    /// The estimator's parameters (immutable after `new`).
+    pub fn params(&self) -> &EstimatorParams<T> {
+        &self.params
+    }
+
+    /// The estimator's state.
+    pub fn state(&self) -> &EstimatorState<T> {
+        &self.state
+    }
+
+    /// Back to the start-up state at `config.initial_angle` with zero current; an adapted R̂s
+    /// goes back to the value the adaptation started from (the configured one, or the last
+    /// [`Self::set_rs_hat`]).
+    pub fn reset(&mut self) {
+        self.state.reset(&self.params);
+    }
+
+    /// Start-up at a known rotor angle θ0 with the present current (SPEC §1 step 6):
+    /// λ1 = λ̂a·e^{jθ0} + L̂q·i with the active flux λ̂a = λ̂f + (L̂d − L̂q)·i_d, D̂ = 0, θ̂ = θ0, ω̂ = 0, limiter mode. An adapted R̂s is kept
+    /// (the winding is as warm as it was).
+    pub fn align(&mut self, theta0: T, i_ab: Ab<T>) {
+        self.state.align(&self.params, theta0, i_ab);
+    }
+
+    /// One 10 kHz sample (Fig. 5).
+    ///
+    /// `v_ab` is the voltage reference that was applied over the last sampling interval (with
+    /// a one-sample computational delay, the one computed two samples ago, before dead-time
+    /// compensation); `i_ab` the currents sampled now. A non-finite or implausible input (see
+    /// [`crate::plausibility`]) is rejected: the state is untouched and [`Self::last`] is
+    /// returned with `input_fault` set.
+    #[inline]
+    pub fn step(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> Estimate<T> {
+        self.state.advance(&self.params, v_ab, i_ab)
+    }
+
+    /// [`Self::step`] for firmware: the same sample, the same new state, but only the
+    /// outputs a control loop uses ([`LeanEstimate`]: θ̂, ω̂, ω̂ for control, the mode, the
+    /// lock status and the input-fault flag). The diagnostics of [`Estimate`] (λ1, D̂, λ2,
+    /// λ̂r, θm, R̂s, λ̂f, flags) are not formed: on a Cortex-M4F that saves about 65 of the
+    /// step's cycles (docs/firmware.md). [`Self::last`] still gives them for the last sample
+    /// (recomputed from the state).
+    #[inline]
+    pub fn step_lean(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> LeanEstimate<T> {
+        self.state.advance(&self.params, v_ab, i_ab)
+    }
+
+    /// The estimate of the last good sample (or of the last `align`/`reset`), recomputed from
+    /// the state: the estimator keeps no copy of its output (64 bytes written every sample in
+    /// `f32`; a caller that needs the output keeps what `step` returned).
+    ///
+    /// θ̂, ω̂, ω̂ for control, the mode and FLAG_limit are those of that sample exactly. The
+    /// diagnostics are recomputed: λ1 and D̂ as stored (after the limiter re-centring, see
+    /// [`EstimatorTuning::limiter_recentring`]), λ2 = λ1 − D̂, λ̂r = λ2 − L̂q·i with that
+    /// sample's current, θm = ∠λ̂r, the limiter and hold flags from this λ̂r, R̂s and λ̂f as
+    /// they will be used next.
+    pub fn last(&self) -> Estimate<T> {
+        self.state.last(&self.params)
+    }
+
+    /// Number of samples rejected since the last reset.
+    pub fn rejected_samples(&self) -> u32 {
+        self.state.rejected_samples()
+    }
+
     /// Enables or disables the k_df feedback at run time regardless of speed (the experiment
     /// of Fig. 9 switches it off on purpose). Enabled after `new`.
     pub fn set_disturbance_feedback_enabled(&mut self, enabled: bool) {
-        self.k_df_enabled = enabled;
+        self.state.set_disturbance_feedback_enabled(enabled);
     }
 
     /// Replaces R̂s at run time, as if it had been configured (an external estimate, or a
@@ -1282,45 +1536,16 @@ impl<T: Real> SensorlessEstimator<T> {
     /// around it (a learned λ̂f goes back to the configured one too). Refuses bad values and
     /// then changes nothing.
     pub fn set_rs_hat(&mut self, rs_hat: T) -> Result<(), ConfigError> {
-        self.integrator.set_rs_hat(rs_hat)?;
-        if self.rs_adaptation_on {
-            // Cannot fail: R̂s ≥ 0 was just checked and nothing else changed.
-            if let Ok(adaptation) = ResistanceAdaptation::new(self.rs_adaptation_config(rs_hat)) {
-                self.rs_adaptation = adaptation;
-            }
-        }
-        Ok(())
+        self.state.set_rs_hat(&self.params, rs_hat)
     }
 
     /// Switches the R̂s adaptation ([`EstimatorTuning::rs_adaptation`], with its integrand-
     /// offset law) on at run time, starting from the R̂s in use now; nothing changes if it is
     /// on already. The drive's `recover` reaction does this after the paper's fixed R̂s lost
     /// the rotor (see [`crate::control::lock_reaction`]). It stays on through
-    /// [`Self::reset`] and [`Self::align`] (the configuration now says so); a rebuilt
-    /// estimator starts as configured.
+    /// [`Self::reset`] and [`Self::align`]; a rebuilt estimator starts as configured.
     pub fn enable_rs_adaptation(&mut self) {
-        if self.rs_adaptation_on {
-            return;
-        }
-        self.rs_adaptation_on = true;
-        self.offset_recentring_gain = self.offset_adaptation_rate * self.ts;
-        // Cannot fail: the same configuration was accepted by `new` with R̂s from it.
-        let rs_hat = self.integrator.config().rs_hat;
-        if let Ok(adaptation) = ResistanceAdaptation::new(self.rs_adaptation_config(rs_hat)) {
-            self.rs_adaptation = adaptation;
-        }
-        self.offset.reset();
-        self.slow_feedback = Ab::zero();
-    }
-
-    /// The R̂s adaptation's configuration around R0 = `rs_hat`, the rest as built by `new`
-    /// (recomputing the λ̂f law's speed from the ratings would bring soft f64 into the f32
-    /// drive's reachable code: `scripts/check-firmware-symbols.sh`).
-    fn rs_adaptation_config(&self, rs_hat: T) -> ResistanceAdaptationConfig<T> {
-        ResistanceAdaptationConfig {
-            rs_initial: rs_hat,
-            ..*self.rs_adaptation.config()
-        }
+        self.state.enable_rs_adaptation(&self.params);
     }
 
     /// Turns θ̂ by `angle` (rad, positive: θ̂ increases) in limiter mode: an external angle
@@ -1331,45 +1556,35 @@ impl<T: Real> SensorlessEstimator<T> {
     /// it; θ̂ follows through the trackers. Off the step's path (no cost in the step); does
     /// nothing outside limiter mode or for a non-finite angle or result.
     pub fn turn_angle(&mut self, angle: T) {
-        if !angle.is_finite() || self.selector.mode() != Mode::Limiter {
-            return;
-        }
-        let lambda1 = self.integrator.flux();
-        let lambda2 = stator_flux(lambda1, self.observer.disturbance());
-        let lambda_r = rotor_flux(lambda2, self.integrator.last_current(), self.lq);
-        let turned = lambda1 + lambda_r.mul_j() * angle;
-        if turned.is_finite() {
-            self.integrator
-                .commit(turned, self.integrator.last_current());
-        }
+        self.state.turn_angle(&self.params, angle);
     }
 
     /// ê, the learned integrand offset (V, α-β; zero without `rs_adaptation`).
     pub fn integrand_offset(&self) -> Ab<T> {
-        self.offset.offset()
+        self.state.integrand_offset()
     }
 
     /// R̂s in use now (Ω).
     pub fn rs_hat(&self) -> T {
-        self.integrator.config().rs_hat
+        self.state.rs_hat()
     }
 
     /// The sampling period Ts in use, s. (The estimator keeps what its step needs of its
     /// [`EstimatorConfig`], not the record: the caller keeps that.)
     pub fn ts(&self) -> T {
-        self.ts
+        self.params.ts
     }
 
     /// Whether the R̂s adaptation runs ([`EstimatorTuning::rs_adaptation`], or switched on
     /// by [`Self::enable_rs_adaptation`]).
     pub fn rs_adaptation_enabled(&self) -> bool {
-        self.rs_adaptation_on
+        self.state.rs_adaptation_enabled()
     }
 
     /// The Fig. 3 mode threshold in use and its hysteresis half-band, Hz electrical
     /// ([`EstimatorConfig::mode_threshold_hz`], [`EstimatorConfig::mode_hysteresis_hz`]).
     pub fn mode_threshold_hz(&self) -> (T, T) {
-        self.selector.threshold_hz()
+        self.params.mode_threshold_hz()
     }
 }
 
@@ -1419,8 +1634,7 @@ impl<T: Real> RotorAngleEstimator<T> for SensorlessEstimator<T> {
         "fado"
     }
     fn rearm_lock_detector(&mut self) {
-        self.lock.reset();
-        self.lock_status = self.lock.status();
+        self.state.rearm_lock_detector();
     }
     fn enable_rs_adaptation(&mut self) {
         SensorlessEstimator::enable_rs_adaptation(self)
@@ -1431,7 +1645,7 @@ impl<T: Real> RotorAngleEstimator<T> for SensorlessEstimator<T> {
     /// With [`EstimatorTuning::rs_adaptation`]: [`SensorlessEstimator::set_rs_hat`] (a bad
     /// value changes nothing); with the paper's fixed R̂s: nothing.
     fn start_from_measured_rs(&mut self, rs: T) {
-        if self.rs_adaptation_on {
+        if self.state.rs_adaptation_on {
             let _ = self.set_rs_hat(rs);
         }
     }
@@ -1484,31 +1698,33 @@ mod tests {
         lean_matches_full::<f64>(false);
     }
 
-    /// The firmware state budget (docs/firmware.md): no copy of the last estimate and no copy
-    /// of the configuration is kept, so the state is the blocks and the constants the step
-    /// needs. Prints both precisions' sizes.
+    /// The firmware state budget (docs/firmware.md, issue 16: ≤ 256 B in `f32`): the mutable
+    /// state alone, the parameters apart (they can live in flash or a `static` the step
+    /// borrows). Prints both precisions' sizes.
     #[test]
     fn state_size() {
+        use core::mem::size_of;
         let (s32, s64) = (
-            core::mem::size_of::<SensorlessEstimator<f32>>(),
-            core::mem::size_of::<SensorlessEstimator<f64>>(),
+            size_of::<EstimatorState<f32>>(),
+            size_of::<EstimatorState<f64>>(),
         );
-        std::println!("SensorlessEstimator<f32>: {s32} B, <f64>: {s64} B");
-        // 388 B after issue 16; issue 14 (sample bounds, last accepted current, step
-        // allowance, loss-of-lock detector) and issue 13 (integrand-offset law, ∂R̂s/∂ê, L̂d in
-        // the R̂s adaptation) add 76 B each; the issue 13 follow-up 12 B (k_θ in the tuning and
-        // in the R̂s adaptation's configuration, the λ̂f law's speed); its second follow-up
-        // 16 B (the λ̂f law's revolution sums of error·angle, excitation, angle and time, and
-        // its hysteresis flag; γ_f·Ts no longer kept); issue 16's slow-law round-robin 24 B
-        // (the slot, the interrupted-regime bits, Σv and Σi over the period, the held slow
-        // feedback), and without the stored `EstimatorConfig` (156 B; the step keeps the 8
-        // words and 2 flags it needs): 472 B; the live lock status (issue 14 follow-up:
-        // healing count and time) 12 B; the observer's lag compensation (issue 13 fourth
-        // pass: the low-pass's two gains and its state) 12 B. Issue 16's fourth pass: the
-        // fixed-point tracker angles (`f32`) keep the trackers' size, the plausibility's copy
-        // of the last current goes (−8 B; the integrator's is the one), the cached lock
-        // status fits in padding: 484 B.
-        assert!(s32 <= 484, "{s32}");
+        let (p32, p64) = (
+            size_of::<EstimatorParams<f32>>(),
+            size_of::<EstimatorParams<f64>>(),
+        );
+        let (o32, o64) = (
+            size_of::<SensorlessEstimator<f32>>(),
+            size_of::<SensorlessEstimator<f64>>(),
+        );
+        std::println!(
+            "EstimatorState<f32>: {s32} B, <f64>: {s64} B; EstimatorParams<f32>: {p32} B, \
+             <f64>: {p64} B; SensorlessEstimator<f32>: {o32} B, <f64>: {o64} B"
+        );
+        // Before the split (issue 16's fourth pass) the one record was 484 B in `f32`, its
+        // constants and its state mixed. The state now holds what changes (and R0's 20 B of
+        // scaled constants, since `set_rs_hat` replaces R0 at run time).
+        assert!(s32 <= 256, "{s32}");
+        assert_eq!(o32, s32 + p32);
     }
 
     /// The reason the slow laws may run every [`SLOW_PERIOD`] samples (see its docs): at
@@ -1549,8 +1765,8 @@ mod tests {
                 assert!(t.lock_detection_time / period >= 6.0, "ts {ts}");
                 // The estimator is built with these periods.
                 let est = SensorlessEstimator::new(config).unwrap();
-                assert_eq!(est.rs_adaptation.config().ts, period);
-                assert_eq!(est.offset.config().ts, period);
+                assert_eq!(est.params.rs_adaptation_params.config().ts, period);
+                assert_eq!(est.params.offset.config().ts, period);
             }
         }
     }
@@ -1572,10 +1788,10 @@ mod tests {
                 1.1 * 0.327 * i.alpha - w * 0.088 * s - w * 2.63e-3 * 8.0 * c,
                 1.1 * 0.327 * i.beta + w * 0.088 * c - w * 2.63e-3 * 8.0 * s,
             );
-            let slot = est.slot;
+            let slot = est.state.slot;
             let (rs_before, offset_before) = (est.rs_hat(), est.integrand_offset());
             est.step(v, i);
-            assert_eq!(est.slot, (slot + 1) % SLOW_PERIOD);
+            assert_eq!(est.state.slot, (slot + 1) % SLOW_PERIOD);
             if est.rs_hat() != rs_before {
                 rs_changes[slot as usize] += 1;
             }
@@ -1588,8 +1804,8 @@ mod tests {
         assert_eq!(rs_changes[SLOT_LOCK as usize], 0);
         assert_eq!(rs_changes[3], 0);
         // A rejected sample does not advance the slot.
-        let slot = est.slot;
+        let slot = est.state.slot;
         est.step(Ab::new(f64::NAN, 0.0), Ab::zero());
-        assert_eq!(est.slot, slot);
+        assert_eq!(est.state.slot, slot);
     }
 }

@@ -30,86 +30,104 @@ impl<T: Real> Default for FluxIntegratorConfig<T> {
     }
 }
 
-/// The voltage-model integrator λ1 ← λ1 + Ts·(v* − R̂s·i − fb) (eq. (3), (21), (24)),
-/// forward rectangle: v* is the voltage that acted over the *last* interval.
+/// The integrator's constants (the immutable half of [`FluxIntegrator`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct FluxIntegrator<T> {
-    config: FluxIntegratorConfig<T>,
+pub(crate) struct FluxIntegratorParams<T> {
+    ts: T,
+    average_current: bool,
+}
+
+/// The integrator's state: λ1, the last current and R̂s (which the resistance adaptation and
+/// [`FluxIntegrator::set_rs_hat`] change at run time, so it is state, not a constant).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct FluxIntegratorState<T> {
+    rs_hat: T,
     lambda1: Ab<T>,
     i_prev: Ab<T>,
     has_prev: bool,
 }
 
-impl<T: Real> FluxIntegrator<T> {
-    /// A new integrator at λ1 = 0.
-    pub fn new(config: FluxIntegratorConfig<T>) -> Result<Self, ConfigError> {
+impl<T: Real> FluxIntegratorParams<T> {
+    /// The constants of `config` and the state at λ1 = 0 with its R̂s.
+    pub(crate) fn new(
+        config: FluxIntegratorConfig<T>,
+    ) -> Result<(Self, FluxIntegratorState<T>), ConfigError> {
         check::positive("ts", config.ts)?;
         check::non_negative("rs_hat", config.rs_hat)?;
-        Ok(Self {
-            config,
-            lambda1: Ab::zero(),
-            i_prev: Ab::zero(),
-            has_prev: false,
-        })
-    }
-
-    /// λ1 = 0, no remembered current.
-    pub fn reset(&mut self) {
-        self.reset_to(Ab::zero());
-    }
-
-    /// Starts from a known flux λ1 (SPEC §1 step 6: λf·e^{jθ0} + L̂q·i).
-    pub fn reset_to(&mut self, lambda1: Ab<T>) {
-        self.lambda1 = lambda1;
-        self.i_prev = Ab::zero();
-        self.has_prev = false;
-    }
-
-    /// One sample: `v_ab` applied over the last interval, `i_ab` sampled now, `feedback` the
-    /// k_df·D̂ or k_af·(λ̂r − λ̂r_lim) term (V). Returns λ1\[n\].
-    #[inline]
-    pub fn step(
-        &mut self,
-        v_ab: Ab<T>,
-        i_ab: Ab<T>,
-        feedback: Ab<T>,
-    ) -> Result<Ab<T>, NonFiniteInput> {
-        if !(v_ab.is_finite() && i_ab.is_finite() && feedback.is_finite()) {
-            return Err(NonFiniteInput);
-        }
-        let (lambda1, _) = self.next_flux(v_ab, i_ab, feedback);
-        self.commit(lambda1, i_ab);
-        Ok(lambda1)
+        Ok((
+            Self {
+                ts: config.ts,
+                average_current: config.average_current,
+            },
+            FluxIntegratorState::new(config.rs_hat),
+        ))
     }
 
     /// λ1 after one more sample, computed without changing the state, and the current it
     /// multiplied by R̂s (see [`Self::drop_current`]).
     #[inline]
-    pub(crate) fn next_flux(&self, v_ab: Ab<T>, i_ab: Ab<T>, feedback: Ab<T>) -> (Ab<T>, Ab<T>) {
-        let i_drop = self.drop_current(i_ab);
-        let lambda1 =
-            self.lambda1 + (v_ab - i_drop * self.config.rs_hat - feedback) * self.config.ts;
+    pub(crate) fn next_flux(
+        &self,
+        s: &FluxIntegratorState<T>,
+        v_ab: Ab<T>,
+        i_ab: Ab<T>,
+        feedback: Ab<T>,
+    ) -> (Ab<T>, Ab<T>) {
+        let i_drop = self.drop_current(s, i_ab);
+        let lambda1 = s.lambda1 + (v_ab - i_drop * s.rs_hat - feedback) * self.ts;
         (lambda1, i_drop)
     }
 
     /// The current multiplied by R̂s in the sample ending with `i_ab`: the interval's average
     /// (with `average_current`) or `i_ab`.
     #[inline]
-    pub(crate) fn drop_current(&self, i_ab: Ab<T>) -> Ab<T> {
-        if self.config.average_current && self.has_prev {
-            (i_ab + self.i_prev) * T::lit(0.5)
+    pub(crate) fn drop_current(&self, s: &FluxIntegratorState<T>, i_ab: Ab<T>) -> Ab<T> {
+        if self.average_current && s.has_prev {
+            (i_ab + s.i_prev) * T::lit(0.5)
         } else {
             i_ab
         }
+    }
+}
+
+impl<T: Real> FluxIntegratorState<T> {
+    /// λ1 = 0, no remembered current, R̂s = `rs_hat` (checked by the caller).
+    pub(crate) fn new(rs_hat: T) -> Self {
+        Self {
+            rs_hat,
+            lambda1: Ab::zero(),
+            i_prev: Ab::zero(),
+            has_prev: false,
+        }
+    }
+
+    /// Starts from a known flux λ1 (SPEC §1 step 6: λf·e^{jθ0} + L̂q·i), R̂s kept.
+    pub(crate) fn reset_to(&mut self, lambda1: Ab<T>) {
+        self.lambda1 = lambda1;
+        self.i_prev = Ab::zero();
+        self.has_prev = false;
     }
 
     /// Sets R̂s from a value already checked (by the resistance adaptation's bounds).
     #[inline]
     pub(crate) fn set_rs_hat_unchecked(&mut self, rs_hat: T) {
-        self.config.rs_hat = rs_hat;
+        self.rs_hat = rs_hat;
     }
 
-    /// Takes λ1 computed by [`Self::next_flux`] for the sample with current `i_ab`.
+    /// Replaces R̂s. Refuses non-finite or negative values.
+    pub(crate) fn set_rs_hat(&mut self, rs_hat: T) -> Result<(), ConfigError> {
+        self.rs_hat = check::non_negative("rs_hat", rs_hat)?;
+        Ok(())
+    }
+
+    /// R̂s in use (Ω).
+    #[inline]
+    pub(crate) fn rs_hat(&self) -> T {
+        self.rs_hat
+    }
+
+    /// Takes λ1 computed by [`FluxIntegratorParams::next_flux`] for the sample with current
+    /// `i_ab`.
     #[inline]
     pub(crate) fn commit(&mut self, lambda1: Ab<T>, i_ab: Ab<T>) {
         self.lambda1 = lambda1;
@@ -119,7 +137,7 @@ impl<T: Real> FluxIntegrator<T> {
 
     /// λ1, the integrated stator flux.
     #[inline]
-    pub fn flux(&self) -> Ab<T> {
+    pub(crate) fn flux(&self) -> Ab<T> {
         self.lambda1
     }
 
@@ -137,16 +155,68 @@ impl<T: Real> FluxIntegrator<T> {
     pub(crate) fn set_last_current(&mut self, i_ab: Ab<T>) {
         self.i_prev = i_ab;
     }
+}
 
-    /// The configuration in use.
-    pub fn config(&self) -> &FluxIntegratorConfig<T> {
-        &self.config
+/// The voltage-model integrator λ1 ← λ1 + Ts·(v* − R̂s·i − fb) (eq. (3), (21), (24)),
+/// forward rectangle: v* is the voltage that acted over the *last* interval.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FluxIntegrator<T> {
+    params: FluxIntegratorParams<T>,
+    state: FluxIntegratorState<T>,
+}
+
+impl<T: Real> FluxIntegrator<T> {
+    /// A new integrator at λ1 = 0.
+    pub fn new(config: FluxIntegratorConfig<T>) -> Result<Self, ConfigError> {
+        let (params, state) = FluxIntegratorParams::new(config)?;
+        Ok(Self { params, state })
+    }
+
+    /// λ1 = 0, no remembered current.
+    pub fn reset(&mut self) {
+        self.reset_to(Ab::zero());
+    }
+
+    /// Starts from a known flux λ1 (SPEC §1 step 6: λf·e^{jθ0} + L̂q·i).
+    pub fn reset_to(&mut self, lambda1: Ab<T>) {
+        self.state.reset_to(lambda1);
+    }
+
+    /// One sample: `v_ab` applied over the last interval, `i_ab` sampled now, `feedback` the
+    /// k_df·D̂ or k_af·(λ̂r − λ̂r_lim) term (V). Returns λ1\[n\].
+    #[inline]
+    pub fn step(
+        &mut self,
+        v_ab: Ab<T>,
+        i_ab: Ab<T>,
+        feedback: Ab<T>,
+    ) -> Result<Ab<T>, NonFiniteInput> {
+        if !(v_ab.is_finite() && i_ab.is_finite() && feedback.is_finite()) {
+            return Err(NonFiniteInput);
+        }
+        let (lambda1, _) = self.params.next_flux(&self.state, v_ab, i_ab, feedback);
+        self.state.commit(lambda1, i_ab);
+        Ok(lambda1)
+    }
+
+    /// λ1, the integrated stator flux.
+    #[inline]
+    pub fn flux(&self) -> Ab<T> {
+        self.state.flux()
+    }
+
+    /// The configuration in use (with the R̂s in use now).
+    pub fn config(&self) -> FluxIntegratorConfig<T> {
+        FluxIntegratorConfig {
+            ts: self.params.ts,
+            rs_hat: self.state.rs_hat,
+            average_current: self.params.average_current,
+        }
     }
 
     /// Replaces R̂s (for online resistance adaptation). Refuses non-finite or negative values.
     pub fn set_rs_hat(&mut self, rs_hat: T) -> Result<(), ConfigError> {
-        self.config.rs_hat = check::non_negative("rs_hat", rs_hat)?;
-        Ok(())
+        self.state.set_rs_hat(rs_hat)
     }
 }
 
@@ -173,21 +243,17 @@ impl<T: Real> Default for DisturbanceFeedbackConfig<T> {
     }
 }
 
-/// The k_df·D̂ feedback of Fig. 3 with an optional activation ramp.
-///
-/// With it the flux loop is λ1 = u / (s + k_df·G(s)), G = D̂/λ1 (eq. (22)): stable for all
-/// ±ω, a DC gain 1/k_df instead of an integrator's infinite one (bounded drift), and an
-/// exact integrator at ω (SPEC §2).
+/// The k_df feedback's constants (the immutable half of [`DisturbanceFeedback`]; its state
+/// is the gain in effect alone).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct DisturbanceFeedback<T> {
+pub(crate) struct DisturbanceFeedbackParams<T> {
     k_df: T,
     ramp_increment: T,
-    gain: T,
 }
 
-impl<T: Real> DisturbanceFeedback<T> {
-    /// A new feedback, inactive.
-    pub fn new(config: DisturbanceFeedbackConfig<T>) -> Result<Self, ConfigError> {
+impl<T: Real> DisturbanceFeedbackParams<T> {
+    /// The constants of `config`, checked.
+    pub(crate) fn new(config: DisturbanceFeedbackConfig<T>) -> Result<Self, ConfigError> {
         let ts = check::positive("ts", config.ts)?;
         let k_df = check::non_negative("k_df", config.k_df)?;
         let ramp = check::non_negative("ramp_time", config.ramp_time)?;
@@ -201,6 +267,36 @@ impl<T: Real> DisturbanceFeedback<T> {
         Ok(Self {
             k_df,
             ramp_increment,
+        })
+    }
+
+    /// The gain the next sample uses after `gain`.
+    #[inline]
+    pub(crate) fn next_gain(&self, gain: T, active: bool) -> T {
+        if active {
+            crate::real::min(gain + self.ramp_increment, self.k_df)
+        } else {
+            T::zero()
+        }
+    }
+}
+
+/// The k_df·D̂ feedback of Fig. 3 with an optional activation ramp.
+///
+/// With it the flux loop is λ1 = u / (s + k_df·G(s)), G = D̂/λ1 (eq. (22)): stable for all
+/// ±ω, a DC gain 1/k_df instead of an integrator's infinite one (bounded drift), and an
+/// exact integrator at ω (SPEC §2).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DisturbanceFeedback<T> {
+    params: DisturbanceFeedbackParams<T>,
+    gain: T,
+}
+
+impl<T: Real> DisturbanceFeedback<T> {
+    /// A new feedback, inactive.
+    pub fn new(config: DisturbanceFeedbackConfig<T>) -> Result<Self, ConfigError> {
+        Ok(Self {
+            params: DisturbanceFeedbackParams::new(config)?,
             gain: T::zero(),
         })
     }
@@ -213,24 +309,8 @@ impl<T: Real> DisturbanceFeedback<T> {
     /// One sample: returns k_df·D̂ when `active`, 0 otherwise (the gain ramps on activation).
     #[inline]
     pub fn step(&mut self, active: bool, disturbance: Ab<T>) -> Ab<T> {
-        self.gain = self.next_gain(active);
+        self.gain = self.params.next_gain(self.gain, active);
         disturbance * self.gain
-    }
-
-    /// The gain the next sample would use, without changing the state.
-    #[inline]
-    pub(crate) fn next_gain(&self, active: bool) -> T {
-        if active {
-            crate::real::min(self.gain + self.ramp_increment, self.k_df)
-        } else {
-            T::zero()
-        }
-    }
-
-    /// Takes a gain computed by [`Self::next_gain`].
-    #[inline]
-    pub(crate) fn commit(&mut self, gain: T) {
-        self.gain = gain;
     }
 
     /// The gain in effect after the last step.

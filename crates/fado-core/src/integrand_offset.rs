@@ -90,19 +90,19 @@ impl<T: Real> IntegrandOffsetState<T> {
     }
 }
 
-/// The law of the module docs.
+/// The law's constants, precomputed once from an [`IntegrandOffsetConfig`] (the immutable
+/// half of [`IntegrandOffset`]; its state is [`IntegrandOffsetState`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct IntegrandOffset<T> {
+pub(crate) struct IntegrandOffsetParams<T> {
     config: IntegrandOffsetConfig<T>,
     limit_sq: T,
     /// `settle_time` in samples (at least 1, so that `disturbance_prev` is valid).
     settle_samples: u32,
-    state: IntegrandOffsetState<T>,
 }
 
-impl<T: Real> IntegrandOffset<T> {
-    /// Checks every field (the error names it) and starts at ê = 0.
-    pub fn new(config: IntegrandOffsetConfig<T>) -> Result<Self, ConfigError> {
+impl<T: Real> IntegrandOffsetParams<T> {
+    /// Checks every field of `config` (the error names it).
+    pub(crate) fn new(config: IntegrandOffsetConfig<T>) -> Result<Self, ConfigError> {
         let ts = check::positive("ts", config.ts)?;
         let rate = check::non_negative("rate", config.rate)?;
         check::below("rate", rate * ts, T::one(), "with rate·ts below 1")?;
@@ -113,13 +113,12 @@ impl<T: Real> IntegrandOffset<T> {
             config,
             limit_sq: limit * limit,
             settle_samples: (settle.ceil().to_f64() as u32).max(1),
-            state: IntegrandOffsetState::default(),
         })
     }
 
-    /// ê back to 0.
-    pub fn reset(&mut self) {
-        self.state = IntegrandOffsetState::default();
+    /// The configuration the constants were computed from.
+    pub(crate) fn config(&self) -> &IntegrandOffsetConfig<T> {
+        &self.config
     }
 
     /// The state after one more period `ts` of the law: `disturbance` is D̂ now, `decay`
@@ -136,28 +135,26 @@ impl<T: Real> IntegrandOffset<T> {
     /// (k_df·N·Ts + (N − 1)·k_e·Ts, with D̂ now for the intermediate samples' D̂: the
     /// error is second order in the law's step k_e·N·Ts).
     #[inline]
-    pub fn next_state(
+    pub(crate) fn next_state(
         &self,
+        st: &IntegrandOffsetState<T>,
         disturbance: Ab<T>,
         decay: T,
         shift: Ab<T>,
         learning: bool,
     ) -> IntegrandOffsetState<T> {
         let mut next = IntegrandOffsetState {
-            offset: self.state.offset,
+            offset: st.offset,
             disturbance_prev: disturbance - shift,
             learning_samples: if learning {
-                self.state.learning_samples.saturating_add(1)
+                st.learning_samples.saturating_add(1)
             } else {
                 0
             },
         };
-        if learning
-            && self.state.learning_samples >= self.settle_samples
-            && self.config.rate > T::zero()
-        {
-            let innovation = (disturbance - self.state.disturbance_prev) + disturbance * decay;
-            let offset = self.state.offset + innovation * self.config.rate;
+        if learning && st.learning_samples >= self.settle_samples && self.config.rate > T::zero() {
+            let innovation = (disturbance - st.disturbance_prev) + disturbance * decay;
+            let offset = st.offset + innovation * self.config.rate;
             let n2 = offset.norm_squared();
             next.offset = if n2 > self.limit_sq {
                 offset * (self.limit_sq / n2).step_sqrt()
@@ -166,6 +163,42 @@ impl<T: Real> IntegrandOffset<T> {
             };
         }
         next
+    }
+}
+
+/// The law of the module docs: its constants and its state together.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct IntegrandOffset<T> {
+    params: IntegrandOffsetParams<T>,
+    state: IntegrandOffsetState<T>,
+}
+
+impl<T: Real> IntegrandOffset<T> {
+    /// Checks every field (the error names it) and starts at ê = 0.
+    pub fn new(config: IntegrandOffsetConfig<T>) -> Result<Self, ConfigError> {
+        Ok(Self {
+            params: IntegrandOffsetParams::new(config)?,
+            state: IntegrandOffsetState::default(),
+        })
+    }
+
+    /// ê back to 0.
+    pub fn reset(&mut self) {
+        self.state = IntegrandOffsetState::default();
+    }
+
+    /// The state after one more period `ts` of the law, without changing this one (see
+    /// the module docs; the arguments are those of the estimator's use, described there).
+    #[inline]
+    pub fn next_state(
+        &self,
+        disturbance: Ab<T>,
+        decay: T,
+        shift: Ab<T>,
+        learning: bool,
+    ) -> IntegrandOffsetState<T> {
+        self.params
+            .next_state(&self.state, disturbance, decay, shift, learning)
     }
 
     /// Takes a state computed by [`Self::next_state`] (which the caller checked is finite).
@@ -178,7 +211,7 @@ impl<T: Real> IntegrandOffset<T> {
     /// are past the hand-over transient).
     #[inline]
     pub fn settled(&self) -> bool {
-        self.state.learning_samples >= self.settle_samples
+        self.state.learning_samples >= self.params.settle_samples
     }
 
     /// Samples in the k_df mode without interruption so far (saturating).
@@ -195,7 +228,7 @@ impl<T: Real> IntegrandOffset<T> {
 
     /// The configuration in use.
     pub fn config(&self) -> &IntegrandOffsetConfig<T> {
-        &self.config
+        self.params.config()
     }
 }
 

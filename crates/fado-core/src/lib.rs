@@ -44,8 +44,8 @@ pub use baselines::{EmfObserverEstimator, LpfIntegratorEstimator, OrtegaEstimato
 pub use control::{DriveConfig, DriveFlags, DriveOutput, DriveTuning, SensorlessDrive};
 pub use error::{ConfigError, NonFiniteInput};
 pub use estimator::{
-    Diagnostics, Estimate, EstimatorConfig, EstimatorTuning, LeanEstimate, RotorAngleEstimator,
-    SensorlessEstimator,
+    Diagnostics, Estimate, EstimatorConfig, EstimatorParams, EstimatorState, EstimatorTuning,
+    LeanEstimate, RotorAngleEstimator, SensorlessEstimator,
 };
 pub use frames::{Ab, Abc, Dq, Rotation};
 pub use lock::LockStatus;

@@ -148,6 +148,41 @@ impl Debouncer {
         self.count = 0;
         self.up = false;
     }
+
+    /// The counter's mutable part (its limits are constants).
+    #[inline(always)]
+    pub(crate) fn counter_state(&self) -> DebouncerState {
+        DebouncerState {
+            count: self.count,
+            up: self.up,
+        }
+    }
+
+    /// This counter's limits with the mutable part `s`.
+    #[inline(always)]
+    pub(crate) fn with_state(self, s: DebouncerState) -> Self {
+        Self {
+            count: s.count,
+            up: s.up,
+            ..self
+        }
+    }
+}
+
+/// The mutable part of a [`Debouncer`]: the count and whether it is raised (its limits are
+/// in the detector's parameters).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct DebouncerState {
+    count: u32,
+    up: bool,
+}
+
+impl DebouncerState {
+    /// The status this state means (as [`Debouncer::status`]).
+    #[inline]
+    pub(crate) fn status(&self) -> LockStatus {
+        Debouncer::new(0, 1).with_state(*self).status()
+    }
 }
 
 /// Samples in `time` s at period `ts`, saturating (longer than 2^32 samples, 5 days at 10 kHz,
@@ -180,20 +215,22 @@ pub struct LockDetectorConfig<T> {
     pub limiter_clamping: bool,
 }
 
-/// The loss-of-lock state machine (see the module docs).
+/// The detector's constants, precomputed once from a [`LockDetectorConfig`] (the immutable
+/// half of [`LockDetector`]; its state is the debouncer's count and flag).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct LockDetector<T> {
+pub(crate) struct LockDetectorParams<T> {
     low_sq: T,
     high_sq: T,
     innovation_limit: T,
+    /// The debouncer's limits, with its state cleared.
     counter: Debouncer,
     clamping: bool,
 }
 
-impl<T: Real> LockDetector<T> {
+impl<T: Real> LockDetectorParams<T> {
     /// Checks and precomputes (squared ratios, the sample counts); errors name the
     /// [`EstimatorConfig`](crate::EstimatorConfig) field.
-    pub fn new(c: LockDetectorConfig<T>) -> Result<Self, ConfigError> {
+    pub(crate) fn new(c: LockDetectorConfig<T>) -> Result<Self, ConfigError> {
         let ts = check::positive("ts", c.ts)?;
         let low = check::non_negative("lock_flux_low_ratio", c.flux_low_ratio)?;
         let high = check::non_negative("lock_flux_high_ratio", c.flux_high_ratio)?;
@@ -222,9 +259,46 @@ impl<T: Real> LockDetector<T> {
         })
     }
 
+    /// The state after one sample `s`: `lambda_r_sq` = |λ̂r|², `flux_sq` = λ̂f²,
+    /// `innovation` = wrap(θm − θ̂⁻) (0 when the trackers coasted), `clamping` = the limiter
+    /// clamped this sample. Four multiplications, five compares.
+    #[inline]
+    pub(crate) fn next_state(
+        &self,
+        s: DebouncerState,
+        lambda_r_sq: T,
+        flux_sq: T,
+        innovation: T,
+        clamping: bool,
+    ) -> DebouncerState {
+        let suspicious = (lambda_r_sq < self.low_sq * flux_sq)
+            | (lambda_r_sq > self.high_sq * flux_sq)
+            | (innovation.abs() > self.innovation_limit)
+            | (clamping & self.clamping);
+        self.counter.with_state(s).next(suspicious).counter_state()
+    }
+}
+
+/// The loss-of-lock state machine (see the module docs): its constants and its state.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LockDetector<T> {
+    params: LockDetectorParams<T>,
+    state: DebouncerState,
+}
+
+impl<T: Real> LockDetector<T> {
+    /// Checks and precomputes (squared ratios, the sample counts); errors name the
+    /// [`EstimatorConfig`](crate::EstimatorConfig) field.
+    pub fn new(c: LockDetectorConfig<T>) -> Result<Self, ConfigError> {
+        Ok(Self {
+            params: LockDetectorParams::new(c)?,
+            state: DebouncerState::default(),
+        })
+    }
+
     /// Back to [`LockStatus::Locked`].
     pub fn reset(&mut self) {
-        self.counter.reset();
+        self.state = DebouncerState::default();
     }
 
     /// The state after one sample, without changing `self`: `lambda_r_sq` = |λ̂r|²,
@@ -238,29 +312,28 @@ impl<T: Real> LockDetector<T> {
         innovation: T,
         clamping: bool,
     ) -> Debouncer {
-        let suspicious = (lambda_r_sq < self.low_sq * flux_sq)
-            | (lambda_r_sq > self.high_sq * flux_sq)
-            | (innovation.abs() > self.innovation_limit)
-            | (clamping & self.clamping);
-        self.counter.next(suspicious)
+        let next = self
+            .params
+            .next_state(self.state, lambda_r_sq, flux_sq, innovation, clamping);
+        self.params.counter.with_state(next)
     }
 
     /// Takes a state computed by [`Self::next_state`].
     #[inline]
     pub fn commit(&mut self, state: Debouncer) {
-        self.counter = state;
+        self.state = state.counter_state();
     }
 
     /// The committed state, as [`Self::next_state`] returns it (for a sample the detector
     /// does not judge).
     #[inline]
     pub fn state(&self) -> Debouncer {
-        self.counter
+        self.params.counter.with_state(self.state)
     }
 
     /// The status after the last committed sample.
     pub fn status(&self) -> LockStatus {
-        self.counter.status()
+        self.state().status()
     }
 }
 

@@ -33,17 +33,17 @@ impl<T: Real> Default for ModeSelectorConfig<T> {
     }
 }
 
-/// Hysteretic speed comparator choosing [`Mode`].
+/// The selector's constants: the speeds (rad/s) at which it enters and leaves the k_df mode
+/// (the immutable half of [`ModeSelector`]; its state is the [`Mode`] alone).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ModeSelector<T> {
+pub(crate) struct ModeSelectorParams<T> {
     enter: T,
     leave: T,
-    mode: Mode,
 }
 
-impl<T: Real> ModeSelector<T> {
-    /// A new selector, starting in [`Mode::Limiter`].
-    pub fn new(config: ModeSelectorConfig<T>) -> Result<Self, ConfigError> {
+impl<T: Real> ModeSelectorParams<T> {
+    /// The bounds of `config`, checked.
+    pub(crate) fn new(config: ModeSelectorConfig<T>) -> Result<Self, ConfigError> {
         let th = check::non_negative("threshold_hz", config.threshold_hz)?;
         let h = check::non_negative("hysteresis_hz", config.hysteresis_hz)?;
         if h > th {
@@ -55,17 +55,49 @@ impl<T: Real> ModeSelector<T> {
         Ok(Self {
             enter: T::two_pi() * (th + h),
             leave: T::two_pi() * (th - h),
+        })
+    }
+
+    /// The threshold and the hysteresis half-band, Hz (from the stored bounds, to rounding).
+    pub(crate) fn threshold_hz(&self) -> (T, T) {
+        let two = T::lit(2.0) * T::two_pi();
+        (
+            (self.enter + self.leave) / two,
+            (self.enter - self.leave) / two,
+        )
+    }
+
+    /// The mode after `mode` for the speed estimate ω̂ (rad/s, electrical, signed).
+    #[inline]
+    pub(crate) fn next_mode(&self, mode: Mode, omega: T) -> Mode {
+        let w = omega.abs();
+        match mode {
+            Mode::Limiter if w > self.enter => Mode::DisturbanceFeedback,
+            Mode::DisturbanceFeedback if w < self.leave => Mode::Limiter,
+            m => m,
+        }
+    }
+}
+
+/// Hysteretic speed comparator choosing [`Mode`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ModeSelector<T> {
+    params: ModeSelectorParams<T>,
+    mode: Mode,
+}
+
+impl<T: Real> ModeSelector<T> {
+    /// A new selector, starting in [`Mode::Limiter`].
+    pub fn new(config: ModeSelectorConfig<T>) -> Result<Self, ConfigError> {
+        Ok(Self {
+            params: ModeSelectorParams::new(config)?,
             mode: Mode::Limiter,
         })
     }
 
     /// The threshold and the hysteresis half-band, Hz (from the stored bounds, to rounding).
     pub fn threshold_hz(&self) -> (T, T) {
-        let two = T::lit(2.0) * T::two_pi();
-        (
-            (self.enter + self.leave) / two,
-            (self.enter - self.leave) / two,
-        )
+        self.params.threshold_hz()
     }
 
     /// Back to [`Mode::Limiter`].
@@ -76,25 +108,8 @@ impl<T: Real> ModeSelector<T> {
     /// One sample with the speed estimate ω̂ (rad/s, electrical, signed).
     #[inline]
     pub fn step(&mut self, omega: T) -> Mode {
-        self.mode = self.next_mode(omega);
+        self.mode = self.params.next_mode(self.mode, omega);
         self.mode
-    }
-
-    /// The mode the next sample would select, without changing the state.
-    #[inline]
-    pub(crate) fn next_mode(&self, omega: T) -> Mode {
-        let w = omega.abs();
-        match self.mode {
-            Mode::Limiter if w > self.enter => Mode::DisturbanceFeedback,
-            Mode::DisturbanceFeedback if w < self.leave => Mode::Limiter,
-            m => m,
-        }
-    }
-
-    /// Takes a mode computed by [`Self::next_mode`].
-    #[inline]
-    pub(crate) fn commit(&mut self, mode: Mode) {
-        self.mode = mode;
     }
 
     /// The current mode.

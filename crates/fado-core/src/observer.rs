@@ -233,39 +233,112 @@ pub fn continuous_gains<T: Real>(omega: T) -> [T; 8] {
     ]
 }
 
-/// Frequency-adaptive disturbance observer (paper eq. (9)-(10), gains (16), Fig. 2),
-/// discretised as described in the module docs.
+/// The observer's constant: the sampling period (the immutable half of
+/// [`DisturbanceObserver`]; its gains depend on ω̂ and are formed every sample).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct DisturbanceObserver<T> {
+pub(crate) struct DisturbanceObserverParams<T> {
     ts: T,
+}
+
+/// The observer's state: λ̂1 and D̂.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct ObserverState<T> {
     /// λ̂1: the observer's copy of the stator flux.
     z: Ab<T>,
     /// D̂: the estimated disturbance.
     d: Ab<T>,
 }
 
+impl<T: Real> DisturbanceObserverParams<T> {
+    /// The constant of `config`, checked.
+    pub(crate) fn new(config: DisturbanceObserverConfig<T>) -> Result<Self, ConfigError> {
+        Ok(Self {
+            ts: check::positive("ts", config.ts)?,
+        })
+    }
+
+    /// (λ̂1, D̂) after one more sample from the state `s`, so that the estimator can check
+    /// the whole new state before committing any of it.
+    #[inline(always)]
+    pub(crate) fn next_state(
+        &self,
+        s: &ObserverState<T>,
+        lambda1: Ab<T>,
+        omega: T,
+    ) -> (Ab<T>, Ab<T>) {
+        let g = DiscreteGains::new(omega, self.ts);
+        let e = lambda1 - s.z;
+        // a·z + (1 − a)·d = d + a·(z − d): one complex product fewer.
+        let z = s.d + g.a.complex_mul(s.z - s.d) + g.l1.complex_mul(e);
+        let d = s.d + g.l2.complex_mul(e);
+        (z, d)
+    }
+}
+
+impl<T: Real> ObserverState<T> {
+    /// λ̂1 = D̂ = 0.
+    pub(crate) fn zero() -> Self {
+        Self {
+            z: Ab::zero(),
+            d: Ab::zero(),
+        }
+    }
+
+    /// A known flux with no disturbance: λ̂1 = `lambda1`, D̂ = 0, so that the first samples
+    /// see no innovation step.
+    pub(crate) fn at(lambda1: Ab<T>) -> Self {
+        Self {
+            z: lambda1,
+            d: Ab::zero(),
+        }
+    }
+
+    /// Takes the state computed by [`DisturbanceObserverParams::next_state`].
+    #[inline]
+    pub(crate) fn commit(&mut self, z: Ab<T>, d: Ab<T>) {
+        self.z = z;
+        self.d = d;
+    }
+
+    /// D̂.
+    #[inline]
+    pub(crate) fn disturbance(&self) -> Ab<T> {
+        self.d
+    }
+
+    /// λ̂1.
+    #[inline]
+    pub(crate) fn flux(&self) -> Ab<T> {
+        self.z
+    }
+}
+
+/// Frequency-adaptive disturbance observer (paper eq. (9)-(10), gains (16), Fig. 2),
+/// discretised as described in the module docs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DisturbanceObserver<T> {
+    params: DisturbanceObserverParams<T>,
+    state: ObserverState<T>,
+}
+
 impl<T: Real> DisturbanceObserver<T> {
     /// A new observer with zero state.
     pub fn new(config: DisturbanceObserverConfig<T>) -> Result<Self, ConfigError> {
-        let ts = check::positive("ts", config.ts)?;
         Ok(Self {
-            ts,
-            z: Ab::zero(),
-            d: Ab::zero(),
+            params: DisturbanceObserverParams::new(config)?,
+            state: ObserverState::zero(),
         })
     }
 
     /// Clears the state (λ̂1 = D̂ = 0).
     pub fn reset(&mut self) {
-        self.z = Ab::zero();
-        self.d = Ab::zero();
+        self.state = ObserverState::zero();
     }
 
     /// Starts from a known flux with no disturbance: λ̂1 = `lambda1`, D̂ = 0, so that the
     /// first samples see no innovation step.
     pub fn reset_to(&mut self, lambda1: Ab<T>) {
-        self.z = lambda1;
-        self.d = Ab::zero();
+        self.state = ObserverState::at(lambda1);
     }
 
     /// One sample: `lambda1` is λ1\[n\] (the integrator output), `omega` the signed flux speed
@@ -277,34 +350,15 @@ impl<T: Real> DisturbanceObserver<T> {
         if !(lambda1.is_finite() && omega.is_finite()) {
             return Err(NonFiniteInput);
         }
-        let (z, d) = self.next_state(lambda1, omega);
-        self.commit(z, d);
+        let (z, d) = self.params.next_state(&self.state, lambda1, omega);
+        self.state.commit(z, d);
         Ok(d)
-    }
-
-    /// (λ̂1, D̂) after one more sample, computed without changing the state, so that the
-    /// estimator can check the whole new state before committing any of it.
-    #[inline(always)]
-    pub(crate) fn next_state(&self, lambda1: Ab<T>, omega: T) -> (Ab<T>, Ab<T>) {
-        let g = DiscreteGains::new(omega, self.ts);
-        let e = lambda1 - self.z;
-        // a·z + (1 − a)·d = d + a·(z − d): one complex product fewer.
-        let z = self.d + g.a.complex_mul(self.z - self.d) + g.l1.complex_mul(e);
-        let d = self.d + g.l2.complex_mul(e);
-        (z, d)
-    }
-
-    /// Takes the state computed by [`Self::next_state`].
-    #[inline]
-    pub(crate) fn commit(&mut self, z: Ab<T>, d: Ab<T>) {
-        self.z = z;
-        self.d = d;
     }
 
     /// D̂, the current disturbance estimate.
     #[inline]
     pub fn disturbance(&self) -> Ab<T> {
-        self.d
+        self.state.d
     }
 
     /// λ̂1, the observer's estimate of the stator flux including the disturbance. After a
@@ -312,12 +366,12 @@ impl<T: Real> DisturbanceObserver<T> {
     /// by one sample), which is what the next innovation is measured against.
     #[inline]
     pub fn flux(&self) -> Ab<T> {
-        self.z
+        self.state.z
     }
 
     /// The sampling period.
     pub fn ts(&self) -> T {
-        self.ts
+        self.params.ts
     }
 }
 

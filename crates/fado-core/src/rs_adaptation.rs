@@ -326,13 +326,12 @@ impl<T: Real> ResistanceAdaptationState<T> {
     }
 }
 
-/// The two laws of the module docs. `step` advances them; the estimator uses the
-/// `next_state`/`commit` pair so that a rejected sample changes nothing.
+/// The laws' constants, precomputed once from a [`ResistanceAdaptationConfig`] (the
+/// immutable half of [`ResistanceAdaptation`]). What scales with R0 is in
+/// [`ResistanceScale`]: R0 changes at run time (the estimator's `set_rs_hat`).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ResistanceAdaptation<T> {
+pub(crate) struct ResistanceAdaptationParams<T> {
     config: ResistanceAdaptationConfig<T>,
-    /// γ·Ts·R0.
-    gain: T,
     /// γ·Ts.
     rate_ts: T,
     /// γ_s·Ts.
@@ -341,22 +340,32 @@ pub struct ResistanceAdaptation<T> {
     forget: T,
     /// 1/(2π·standstill_speed_hz)².
     standstill_inv_omega_sq: T,
-    chi_per_phi: T,
     /// L̂d − L̂q.
     saliency: T,
     floor_sq: T,
-    rs_min: T,
-    rs_max: T,
-    state: ResistanceAdaptationState<T>,
 }
 
-impl<T: Real> ResistanceAdaptation<T> {
-    /// Checks every field (the error names it) and starts at R̂s = R0.
-    pub fn new(config: ResistanceAdaptationConfig<T>) -> Result<Self, ConfigError> {
+/// What the laws derive from R0, the resistance they start from and scale with: mutable
+/// (R0 is replaced at run time), so kept with the state.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct ResistanceScale<T> {
+    /// R0, Ω.
+    r0: T,
+    /// γ·Ts·R0.
+    gain: T,
+    /// R0/λ̂f (the configured λ̂f).
+    chi_per_phi: T,
+    rs_min: T,
+    rs_max: T,
+}
+
+impl<T: Real> ResistanceAdaptationParams<T> {
+    /// Checks every field of `config` (the error names it) and precomputes the constants.
+    pub(crate) fn new(config: ResistanceAdaptationConfig<T>) -> Result<Self, ConfigError> {
         let ts = check::positive("ts", config.ts)?;
         // R0 = 0 is allowed: it scales the law and its bounds to nothing (R̂s stays 0).
-        let r0 = check::non_negative("rs_initial", config.rs_initial)?;
-        let lf = check::positive("flux_linkage_hat", config.flux_linkage_hat)?;
+        check::non_negative("rs_initial", config.rs_initial)?;
+        check::positive("flux_linkage_hat", config.flux_linkage_hat)?;
         check::non_negative("lq_hat", config.lq_hat)?;
         check::non_negative("ld_hat", config.ld_hat)?;
         check::finite("ld_hat", config.ld_hat - config.lq_hat)?;
@@ -416,9 +425,8 @@ impl<T: Real> ResistanceAdaptation<T> {
                 expected: "at least 1",
             });
         }
-        let mut a = Self {
+        Ok(Self {
             config,
-            gain: rate * ts * r0,
             rate_ts: rate * ts,
             standstill_gain: rate_s * ts,
             forget: (-(memory_w * ts)).exp(),
@@ -429,68 +437,36 @@ impl<T: Real> ResistanceAdaptation<T> {
             } else {
                 T::lit(1e30)
             },
-            chi_per_phi: r0 / lf,
             saliency: config.ld_hat - config.lq_hat,
             floor_sq: floor * floor,
-            rs_min: min * r0,
-            rs_max: max * r0,
-            state: ResistanceAdaptationState::default(),
-        };
-        a.reset();
-        Ok(a)
+        })
     }
 
-    /// R̂s back to R0, the standstill integrals to zero.
-    pub fn reset(&mut self) {
-        self.state = ResistanceAdaptationState {
-            rs_hat: self.config.rs_initial,
+    /// The values scaled by R0 = `r0` (checked non-negative by the caller; the products are
+    /// the ones the unsplit block formed, bit for bit).
+    pub(crate) fn scale(&self, r0: T) -> ResistanceScale<T> {
+        let c = &self.config;
+        ResistanceScale {
+            r0,
+            gain: c.rate * c.ts * r0,
+            chi_per_phi: r0 / c.flux_linkage_hat,
+            rs_min: c.min_ratio * r0,
+            rs_max: c.max_ratio * r0,
+        }
+    }
+
+    /// The state at R̂s = R0 of `scale`, λ̂f as configured, the standstill integrals zero.
+    pub(crate) fn initial_state(&self, scale: &ResistanceScale<T>) -> ResistanceAdaptationState<T> {
+        ResistanceAdaptationState {
+            rs_hat: scale.r0,
             flux_linkage_hat: self.config.flux_linkage_hat,
             ..ResistanceAdaptationState::default()
-        };
-    }
-
-    /// One sample: `v_ab` and `i_drop` the voltage and current the integrator used this sample,
-    /// `lambda_r` the rotor flux it produced, `omega` the estimated speed (rad/s), `regime`
-    /// which law applies. Returns R̂s for the next sample. Non-finite inputs change nothing.
-    pub fn step(
-        &mut self,
-        v_ab: Ab<T>,
-        i_drop: Ab<T>,
-        lambda_r: Ab<T>,
-        omega: T,
-        regime: AdaptationRegime,
-    ) -> T {
-        let inputs_finite =
-            v_ab.is_finite() && i_drop.is_finite() && lambda_r.is_finite() && omega.is_finite();
-        if !inputs_finite {
-            return self.state.rs_hat;
         }
-        let (next, _) =
-            self.next_state(v_ab, i_drop, i_drop, i_drop, lambda_r, omega, regime, true);
-        if next.is_finite() {
-            self.commit(next);
-        }
-        self.state.rs_hat
     }
 
-    /// R̂s after the integrand-offset estimate ê (`crate::integrand_offset`) moved by
-    /// `offset_change` (V): R̂s drops what standstill tests read of it, −⟨Δê, ∂R̂s/∂ê⟩,
-    /// within its bounds (compare-and-select: a NaN becomes a bound, so R̂s stays finite).
-    #[inline(always)]
-    pub(crate) fn rs_after_offset_change(&self, offset_change: Ab<T>) -> T {
-        min(
-            max(
-                self.state.rs_hat - offset_change.dot(self.state.offset_sensitivity),
-                self.rs_min,
-            ),
-            self.rs_max,
-        )
-    }
-
-    /// Takes R̂s computed by [`Self::rs_after_offset_change`].
-    #[inline(always)]
-    pub(crate) fn commit_rs_hat(&mut self, rs_hat: T) {
-        self.state.rs_hat = rs_hat;
+    /// The configuration the constants were computed from.
+    pub(crate) fn config(&self) -> &ResistanceAdaptationConfig<T> {
+        &self.config
     }
 
     /// The state after one more period of the law (`ts`), computed without changing this
@@ -510,6 +486,8 @@ impl<T: Real> ResistanceAdaptation<T> {
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn next_state(
         &self,
+        scale: &ResistanceScale<T>,
+        st: &ResistanceAdaptationState<T>,
         v_ab: Ab<T>,
         i_drop: Ab<T>,
         i_mean: Ab<T>,
@@ -521,10 +499,10 @@ impl<T: Real> ResistanceAdaptation<T> {
     ) -> (ResistanceAdaptationState<T>, Ab<T>) {
         let mut pull = Ab::zero();
         let mut next = ResistanceAdaptationState {
-            rs_hat: self.state.rs_hat,
-            flux_linkage_hat: self.state.flux_linkage_hat,
-            flux_learning: self.state.flux_learning,
-            offset_sensitivity: self.state.offset_sensitivity,
+            rs_hat: st.rs_hat,
+            flux_linkage_hat: st.flux_linkage_hat,
+            flux_learning: st.flux_learning,
+            offset_sensitivity: st.offset_sensitivity,
             ..ResistanceAdaptationState::default()
         };
         let mag_sq = lambda_r.norm_squared();
@@ -532,7 +510,7 @@ impl<T: Real> ResistanceAdaptation<T> {
             return (next, pull);
         }
         let mag = mag_sq.step_sqrt();
-        let lf = self.state.flux_linkage_hat;
+        let lf = st.flux_linkage_hat;
         let dl = self.saliency;
         if regime == AdaptationRegime::Rotating {
             // The reference is the active flux λ̂a = λ̂f + (L̂d − L̂q)·î_d and φ carries the
@@ -552,16 +530,16 @@ impl<T: Real> ResistanceAdaptation<T> {
             // χ = φ·R0/λ̂f with φ = −(i_q/ω̂)·sensitivity and i_q = (λ̂r × i)/|λ̂r|, as
             // χ = a/b: then χ/(χ² + χ0²) = a·b/(a² + χ0²·b²) costs one division, and
             // χ² ≥ χ0² is a² ≥ χ0²·b² (false for ω̂ = 0, which also rules out 0/0).
-            let a = -lambda_r.cross(i_drop) * self.chi_per_phi * sensitivity;
+            let a = -lambda_r.cross(i_drop) * scale.chi_per_phi * sensitivity;
             let b = mag * omega;
             let (a_sq, floor_b_sq) = (a * a, self.floor_sq * b * b);
             if a_sq >= floor_b_sq && floor_b_sq > T::zero() {
                 // ẽ·χ/(χ² + χ0²) with ẽ = (|λ̂r| − λ̂a)/λ̂f, in one division.
                 let weight = a_sq / (a_sq + floor_b_sq);
-                next.rs_hat -= self.gain * (mag - reference) * a * b / (lf * (a_sq + floor_b_sq));
+                next.rs_hat -= scale.gain * (mag - reference) * a * b / (lf * (a_sq + floor_b_sq));
                 // The turning law replaces what the standstill tests contributed.
                 next.offset_sensitivity =
-                    self.state.offset_sensitivity * (T::one() - self.rate_ts * weight);
+                    st.offset_sensitivity * (T::one() - self.rate_ts * weight);
             }
             if settled && omega.abs() >= self.config.flux_linkage_min_speed {
                 // The λ̂f law (module docs): the mean of |λ̂r| − λ̂a over one electrical
@@ -573,11 +551,10 @@ impl<T: Real> ResistanceAdaptation<T> {
                 // compared with χ0/2·λ̂f·∮dθ at the end, no division per sample.
                 let step_angle = omega.abs() * self.config.ts;
                 let chi_step = if omega < T::zero() { -a } else { a } * self.config.ts;
-                next.flux_error_angle =
-                    self.state.flux_error_angle + (mag - reference) * step_angle;
-                next.flux_excitation = self.state.flux_excitation + chi_step;
-                next.flux_angle = self.state.flux_angle + step_angle;
-                next.flux_time = self.state.flux_time + self.config.ts;
+                next.flux_error_angle = st.flux_error_angle + (mag - reference) * step_angle;
+                next.flux_excitation = st.flux_excitation + chi_step;
+                next.flux_angle = st.flux_angle + step_angle;
+                next.flux_time = st.flux_time + self.config.ts;
                 if next.flux_angle >= T::two_pi() {
                     let bound = T::lit(0.5) * self.config.excitation_floor * lf * next.flux_angle;
                     let excess_chi = next.flux_excitation.abs() >= bound;
@@ -587,7 +564,7 @@ impl<T: Real> ResistanceAdaptation<T> {
                     // law, which then follows the whole mean until it is within ±ε_off.
                     let zone = lf0 * T::lit(FLUX_LINKAGE_DEAD_ZONE);
                     let excess = error - min(max(error, -zone), zone);
-                    let on = self.state.flux_learning || error.abs() > zone + zone;
+                    let on = st.flux_learning || error.abs() > zone + zone;
                     let gain = if excess_chi {
                         T::zero()
                     } else {
@@ -626,13 +603,13 @@ impl<T: Real> ResistanceAdaptation<T> {
             // (its inductive voltage would otherwise be read as resistance).
             let i_d_now = unit.dot(i_now);
             next.i_d_prev = i_d_now;
-            if self.state.i_d_prev != T::zero() {
-                let di_d = i_d_now - self.state.i_d_prev;
-                next.charge_d = self.state.charge_d * self.forget + i_d * ts;
+            if st.i_d_prev != T::zero() {
+                let di_d = i_d_now - st.i_d_prev;
+                next.charge_d = st.charge_d * self.forget + i_d * ts;
                 next.volt_seconds_d =
-                    self.state.volt_seconds_d * self.forget + v_d * ts - self.config.ld_hat * di_d;
+                    st.volt_seconds_d * self.forget + v_d * ts - self.config.ld_hat * di_d;
             }
-            if next.charge_d * self.chi_per_phi >= self.config.excitation_floor {
+            if next.charge_d * scale.chi_per_phi >= self.config.excitation_floor {
                 let r_dc = next.volt_seconds_d / next.charge_d;
                 next.rs_hat += self.standstill_gain * (r_dc - next.rs_hat);
                 let sensitivity = unit * inv_i_d;
@@ -656,14 +633,90 @@ impl<T: Real> ResistanceAdaptation<T> {
                 * (T::one() - speed_sq);
             pull += Ab::new(unit.beta, -unit.alpha) * turn;
         }
-        next.rs_hat = min(max(next.rs_hat, self.rs_min), self.rs_max);
+        next.rs_hat = min(max(next.rs_hat, scale.rs_min), scale.rs_max);
         (next, pull)
     }
+}
 
-    /// Takes a state computed by [`Self::next_state`] (which the caller checked is finite).
-    #[inline]
-    pub(crate) fn commit(&mut self, state: ResistanceAdaptationState<T>) {
-        self.state = state;
+impl<T: Real> ResistanceAdaptationState<T> {
+    /// R̂s after the integrand-offset estimate ê (`crate::integrand_offset`) moved by
+    /// `offset_change` (V): R̂s drops what standstill tests read of it, −⟨Δê, ∂R̂s/∂ê⟩,
+    /// within its bounds (compare-and-select: a NaN becomes a bound, so R̂s stays finite).
+    #[inline(always)]
+    pub(crate) fn rs_after_offset_change(
+        &self,
+        scale: &ResistanceScale<T>,
+        offset_change: Ab<T>,
+    ) -> T {
+        min(
+            max(
+                self.rs_hat - offset_change.dot(self.offset_sensitivity),
+                scale.rs_min,
+            ),
+            scale.rs_max,
+        )
+    }
+}
+
+/// The two laws of the module docs: their constants, their R0 scaling and their state
+/// together. `step` advances them; the estimator uses the parameters' `next_state` on its own
+/// state so that a rejected sample changes nothing.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ResistanceAdaptation<T> {
+    params: ResistanceAdaptationParams<T>,
+    scale: ResistanceScale<T>,
+    state: ResistanceAdaptationState<T>,
+}
+
+impl<T: Real> ResistanceAdaptation<T> {
+    /// Checks every field (the error names it) and starts at R̂s = R0.
+    pub fn new(config: ResistanceAdaptationConfig<T>) -> Result<Self, ConfigError> {
+        let params = ResistanceAdaptationParams::new(config)?;
+        let scale = params.scale(config.rs_initial);
+        Ok(Self {
+            params,
+            scale,
+            state: params.initial_state(&scale),
+        })
+    }
+
+    /// R̂s back to R0, the standstill integrals to zero.
+    pub fn reset(&mut self) {
+        self.state = self.params.initial_state(&self.scale);
+    }
+
+    /// One sample: `v_ab` and `i_drop` the voltage and current the integrator used this sample,
+    /// `lambda_r` the rotor flux it produced, `omega` the estimated speed (rad/s), `regime`
+    /// which law applies. Returns R̂s for the next sample. Non-finite inputs change nothing.
+    pub fn step(
+        &mut self,
+        v_ab: Ab<T>,
+        i_drop: Ab<T>,
+        lambda_r: Ab<T>,
+        omega: T,
+        regime: AdaptationRegime,
+    ) -> T {
+        let inputs_finite =
+            v_ab.is_finite() && i_drop.is_finite() && lambda_r.is_finite() && omega.is_finite();
+        if !inputs_finite {
+            return self.state.rs_hat;
+        }
+        let (next, _) = self.params.next_state(
+            &self.scale,
+            &self.state,
+            v_ab,
+            i_drop,
+            i_drop,
+            i_drop,
+            lambda_r,
+            omega,
+            regime,
+            true,
+        );
+        if next.is_finite() {
+            self.state = next;
+        }
+        self.state.rs_hat
     }
 
     /// R̂s now, Ω.
@@ -685,6 +738,6 @@ impl<T: Real> ResistanceAdaptation<T> {
 
     /// The configuration in use.
     pub fn config(&self) -> &ResistanceAdaptationConfig<T> {
-        &self.config
+        self.params.config()
     }
 }

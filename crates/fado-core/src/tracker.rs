@@ -92,14 +92,20 @@ impl<T: Real> TrackerConfig<T> {
     }
 }
 
-/// Type-2 angle and speed tracker (Fig. 1).
+/// The tracker's constants, precomputed once from a [`TrackerConfig`] (the immutable half of
+/// [`TypeTwoTracker`], see [`crate::estimator`]'s "parameters and state").
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct TypeTwoTracker<T: Real> {
+pub(crate) struct TrackerParams<T> {
     ts: T,
     kp: T,
     /// Ts·Kp, precomputed (the same product the recursion formed every sample).
     kp_ts: T,
     ki_ts: T,
+}
+
+/// The tracker's mutable state: θ̂⁻, θ̂ and ω̂.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct TrackerState<T: Real> {
     /// θ̂⁻: the angle predicted for the next sample ([`Real::Angle`]).
     predicted: T::Angle,
     /// θ̂: the angle estimate for the last sample.
@@ -107,11 +113,11 @@ pub struct TypeTwoTracker<T: Real> {
     omega: T,
 }
 
-impl<T: Real> TypeTwoTracker<T> {
-    /// A new tracker at θ̂ = 0, ω̂ = 0. Refuses gains whose discrete poles leave the unit
-    /// circle (Jury's test on the polynomial in the module docs: 0 < Kp·Ts < 2 and
+impl<T: Real> TrackerParams<T> {
+    /// The constants of `config`. Refuses gains whose discrete poles leave the unit circle
+    /// (Jury's test on the polynomial in the module docs: 0 < Kp·Ts < 2 and
     /// 2·Kp·Ts + Ki·Ts² < 4).
-    pub fn new(config: TrackerConfig<T>) -> Result<Self, ConfigError> {
+    pub(crate) fn new(config: TrackerConfig<T>) -> Result<Self, ConfigError> {
         let ts = check::positive("ts", config.ts)?;
         check::positive("bandwidth_hz", config.bandwidth_hz)?;
         check::positive("damping", config.damping)?;
@@ -129,9 +135,91 @@ impl<T: Real> TypeTwoTracker<T> {
             kp,
             kp_ts: ts * kp,
             ki_ts: ki * ts,
-            predicted: T::Angle::default(),
-            theta: T::Angle::default(),
-            omega: T::zero(),
+        })
+    }
+
+    /// The state at a known angle and speed.
+    pub(crate) fn state_at(&self, theta: T, omega: T) -> TrackerState<T> {
+        let theta = T::angle_from(wrap_angle(theta));
+        TrackerState {
+            predicted: theta,
+            theta,
+            omega,
+        }
+    }
+
+    /// The update after one sample with the measurement θm ∈ [−π, π] (eq. (6)'s range).
+    #[inline(always)]
+    pub(crate) fn next_state(&self, s: &TrackerState<T>, theta_measured: T) -> TrackerUpdate<T> {
+        let e = T::angle_diff(T::angle_from(theta_measured), s.predicted);
+        let omega = s.omega + self.ki_ts * e;
+        let theta = T::angle_add(s.predicted, self.kp_ts * e);
+        TrackerUpdate {
+            predicted: T::angle_add(theta, self.ts * omega),
+            theta,
+            omega,
+            innovation: e,
+        }
+    }
+
+    /// The update after one coasting sample.
+    #[inline]
+    pub(crate) fn coasted_state(&self, s: &TrackerState<T>) -> TrackerUpdate<T> {
+        let theta = s.predicted;
+        TrackerUpdate {
+            predicted: T::angle_add(theta, self.ts * s.omega),
+            theta,
+            omega: s.omega,
+            innovation: T::zero(),
+        }
+    }
+
+    /// Kp in s⁻¹ (see [`TypeTwoTracker::kp`]).
+    #[inline]
+    pub(crate) fn kp(&self) -> T {
+        self.kp
+    }
+}
+
+impl<T: Real> TrackerState<T> {
+    /// Takes an update computed by [`TrackerParams::next_state`] or
+    /// [`TrackerParams::coasted_state`].
+    #[inline]
+    pub(crate) fn commit(&mut self, next: TrackerUpdate<T>) {
+        self.predicted = next.predicted;
+        self.theta = next.theta;
+        self.omega = next.omega;
+    }
+
+    /// θ̂ for the last sample, in [−π, π].
+    #[inline]
+    pub(crate) fn angle(&self) -> T {
+        T::angle_to(self.theta)
+    }
+
+    /// ω̂ in rad/s.
+    #[inline]
+    pub(crate) fn speed(&self) -> T {
+        self.omega
+    }
+}
+
+/// Type-2 angle and speed tracker (Fig. 1): its constants and its state together.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TypeTwoTracker<T: Real> {
+    params: TrackerParams<T>,
+    state: TrackerState<T>,
+}
+
+impl<T: Real> TypeTwoTracker<T> {
+    /// A new tracker at θ̂ = 0, ω̂ = 0. Refuses gains whose discrete poles leave the unit
+    /// circle (Jury's test on the polynomial in the module docs: 0 < Kp·Ts < 2 and
+    /// 2·Kp·Ts + Ki·Ts² < 4).
+    pub fn new(config: TrackerConfig<T>) -> Result<Self, ConfigError> {
+        let params = TrackerParams::new(config)?;
+        Ok(Self {
+            params,
+            state: params.state_at(T::zero(), T::zero()),
         })
     }
 
@@ -142,9 +230,7 @@ impl<T: Real> TypeTwoTracker<T> {
 
     /// Starts from a known angle and speed.
     pub fn reset_to(&mut self, theta: T, omega: T) {
-        self.theta = T::angle_from(wrap_angle(theta));
-        self.predicted = self.theta;
-        self.omega = omega;
+        self.state = self.params.state_at(theta, omega);
     }
 
     /// One sample with the measured angle θm (rad, any range). Returns (θ̂, ω̂).
@@ -153,8 +239,10 @@ impl<T: Real> TypeTwoTracker<T> {
         if !theta_measured.is_finite() {
             return Err(NonFiniteInput);
         }
-        let next = self.next_state(wrap_angle(theta_measured));
-        self.commit(next);
+        let next = self
+            .params
+            .next_state(&self.state, wrap_angle(theta_measured));
+        self.state.commit(next);
         Ok((next.angle(), next.omega))
     }
 
@@ -162,68 +250,27 @@ impl<T: Real> TypeTwoTracker<T> {
     /// |λ̂r| is too small for eq. (6) to mean anything, SPEC §3 \[A\]).
     #[inline]
     pub fn coast(&mut self) -> (T, T) {
-        let next = self.coasted_state();
-        self.commit(next);
+        let next = self.params.coasted_state(&self.state);
+        self.state.commit(next);
         (next.angle(), next.omega)
-    }
-
-    /// The state after one sample with the measurement θm ∈ [−π, π] (eq. (6)'s range),
-    /// without changing `self`.
-    #[inline(always)]
-    pub(crate) fn next_state(&self, theta_measured: T) -> TrackerState<T> {
-        let e = self.phase_error(theta_measured);
-        let omega = self.omega + self.ki_ts * e;
-        let theta = T::angle_add(self.predicted, self.kp_ts * e);
-        TrackerState {
-            predicted: T::angle_add(theta, self.ts * omega),
-            theta,
-            omega,
-            innovation: e,
-        }
-    }
-
-    /// wrap(θm − θ̂⁻) for θm ∈ [−π, π]: the phase error of the next update.
-    #[inline(always)]
-    fn phase_error(&self, theta_measured: T) -> T {
-        T::angle_diff(T::angle_from(theta_measured), self.predicted)
-    }
-
-    /// The state after one coasting sample, without changing `self`.
-    #[inline]
-    pub(crate) fn coasted_state(&self) -> TrackerState<T> {
-        let theta = self.predicted;
-        TrackerState {
-            predicted: T::angle_add(theta, self.ts * self.omega),
-            theta,
-            omega: self.omega,
-            innovation: T::zero(),
-        }
-    }
-
-    /// Takes a state computed by [`Self::next_state`] or [`Self::coasted_state`].
-    #[inline]
-    pub(crate) fn commit(&mut self, next: TrackerState<T>) {
-        self.predicted = next.predicted;
-        self.theta = next.theta;
-        self.omega = next.omega;
     }
 
     /// θ̂ for the last sample, in [−π, π].
     #[inline]
     pub fn angle(&self) -> T {
-        T::angle_to(self.theta)
+        self.state.angle()
     }
 
     /// θ̂⁻, the angle predicted for the next sample, in [−π, π].
     #[inline]
     pub fn predicted_angle(&self) -> T {
-        T::angle_to(self.predicted)
+        T::angle_to(self.state.predicted)
     }
 
     /// ω̂ in rad/s.
     #[inline]
     pub fn speed(&self) -> T {
-        self.omega
+        self.state.omega
     }
 
     /// Kp in s⁻¹. The rate of θ̂ over a sample is ω̂ + Kp·e (θ̂⁻ advances by Ts·(ω̂ + Kp·e)):
@@ -231,18 +278,19 @@ impl<T: Real> TypeTwoTracker<T> {
     /// (see the module docs).
     #[inline]
     pub fn kp(&self) -> T {
-        self.kp
+        self.params.kp
     }
 
     /// (Kp, Ki) in use.
     pub fn gains(&self) -> (T, T) {
-        (self.kp, self.ki_ts / self.ts)
+        (self.params.kp, self.params.ki_ts / self.params.ts)
     }
 }
 
-/// The tracker's state after a sample, computed before it is committed.
+/// The tracker's state after a sample, computed before it is committed, with the sample's
+/// phase error.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct TrackerState<T: Real> {
+pub(crate) struct TrackerUpdate<T: Real> {
     /// θ̂⁻ for the next sample.
     pub predicted: T::Angle,
     /// θ̂.
@@ -253,7 +301,7 @@ pub(crate) struct TrackerState<T: Real> {
     pub innovation: T,
 }
 
-impl<T: Real> TrackerState<T> {
+impl<T: Real> TrackerUpdate<T> {
     /// θ̂ in rad, in [−π, π].
     #[inline(always)]
     pub fn angle(&self) -> T {
