@@ -1,27 +1,40 @@
 //! fado's f32 estimator in a 10 kHz interrupt on a Cortex-M4F: the firmware user's starting
 //! point, and the image `scripts/firmware-cost.sh` measures.
 //!
-//! `main` configures SysTick for 10 kHz and, for each scenario, builds a
-//! [`SensorlessEstimator`] and hands it to the interrupt. The SysTick handler stands in for the
+//! `main` configures SysTick for 10 kHz, builds the estimator's parameters once
+//! ([`EstimatorParams`], one set per scenario kind) into a write-once `static`, and for each
+//! scenario hands a fresh [`EstimatorState`] to the interrupt. The SysTick handler stands in for the
 //! PWM/ADC interrupt of a drive: it reads the "ADC" (here a generated machine signal: an ideal
 //! surface PMSM turning at a speed that ramps up and then holds), runs one estimator step and
 //! keeps the worst angle error of the last samples. Results are printed over semihosting, and
 //! the program exits with status 0 when every scenario kept lock (QEMU passes the status on).
 //!
 //! # Sharing the estimator with the interrupt (static-init pattern)
-//! The estimator is built (and its configuration checked) in `main`, outside the interrupt,
-//! and moved into a `static Mutex<RefCell<Option<App>>>`. The interrupt borrows it with
-//! `try_borrow_mut`, so nothing on its path can panic; `Option::None` and a failed borrow
-//! simply skip the sample. No `unsafe`, no allocation, and the configuration validation
-//! (which the interrupt never needs) stays out of the interrupt's code.
+//! The estimator is two records (docs/firmware.md, "Fifth pass"): its parameters, every
+//! constant of the step, immutable once built, and its state, what the step changes.
 //!
-//! The cost script finds the step as the out-of-line function [`estimator_step`] and counts
-//! the instructions executed from its entry to its return.
+//! - The parameters are built (and the configuration checked) once in `main`, outside the
+//!   interrupt, and stored in `static PARAMS: Mutex<OnceCell<…>>`: written once before the
+//!   interrupt runs, read-only afterwards. `EstimatorParams::new` cannot be a `const fn` (the
+//!   checks and the derived gains call the generic `Real` trait's methods — √, eˣ, the
+//!   tracker gains — which stable Rust does not allow in a `const fn`), so a `static`
+//!   initialised at run time is the pattern; the step borrows it, so the parameters are never
+//!   copied into the state.
+//! - The state (`size_of` printed below, ≤ 256 B) lives in the interrupt's
+//!   `static Mutex<RefCell<Option<App>>>`, borrowed with `try_borrow_mut`.
+//!
+//! Nothing on the interrupt's path can panic: an unset `OnceCell`, `Option::None` or a
+//! failed borrow simply skip the sample. No `unsafe`, no allocation, and the configuration
+//! validation (which the interrupt never needs) stays out of the interrupt's code.
+//!
+//! The cost script finds the step as the out-of-line function [`estimator_step`] (the split
+//! step, `EstimatorState::step_lean` with the borrowed parameters) and counts the
+//! instructions executed from its entry to its return.
 
 #![no_std]
 #![no_main]
 
-use core::cell::{Cell, RefCell};
+use core::cell::{Cell, OnceCell, RefCell};
 use core::f32::consts::TAU;
 use core::panic::PanicInfo;
 
@@ -30,8 +43,9 @@ use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m_rt::{entry, exception};
 use cortex_m_semihosting::{debug, hprintln};
 use fado_core::{
-    Ab, Abc, DriveConfig, DriveOutput, Estimate, EstimatorConfig, EstimatorTuning, LeanEstimate,
-    MachineModel, SensorlessDrive, SensorlessEstimator,
+    Ab, Abc, DriveConfig, DriveOutput, Estimate, EstimatorConfig, EstimatorParams,
+    EstimatorState, EstimatorTuning, LeanEstimate, MachineModel, SensorlessDrive,
+    SensorlessEstimator,
 };
 
 /// QEMU's MPS2 system clock (25 MHz), which clocks SysTick.
@@ -176,7 +190,9 @@ fn cos(x: f32) -> f32 {
 
 /// Everything the interrupt owns.
 struct App {
-    estimator: SensorlessEstimator<f32>,
+    /// Which of [`PARAMS`] the state was made for.
+    params: usize,
+    state: EstimatorState<f32>,
     machine: Machine,
     samples: u32,
     total_samples: u32,
@@ -187,6 +203,10 @@ struct App {
 }
 
 static APP: Mutex<RefCell<Option<App>>> = Mutex::new(RefCell::new(None));
+
+/// The estimator's parameters, written once by `main` before the interrupt runs (index 0 with
+/// the default R̂s adaptation, 1 with the paper's fixed R̂s); read-only afterwards.
+static PARAMS: Mutex<OnceCell<[EstimatorParams<f32>; 2]>> = Mutex::new(OnceCell::new());
 
 /// Lowest stack pointer seen just before calling [`estimator_step`] (stack measurement).
 static STEP_SP: Mutex<Cell<u32>> = Mutex::new(Cell::new(u32::MAX));
@@ -229,18 +249,20 @@ fn lowest_touched_stack() -> u32 {
 }
 
 /// One estimator step, out of line: the unit the cost script measures. Firmware uses
-/// `step_lean` (θ̂, ω̂, mode, lock, fault flag); `step` also returns the diagnostics of
-/// `Estimate` (λ1, D̂, λ̂r, θm, …), about 65 cycles more (docs/firmware.md), and
-/// `SensorlessEstimator::last` recomputes them for the last sample when a debugger or a
-/// telemetry task wants them.
+/// `step_lean` (θ̂, ω̂, mode, lock, fault flag) on its state with the borrowed parameters;
+/// `step` also returns the diagnostics of `Estimate` (λ1, D̂, λ̂r, θm, …), about 65 cycles
+/// more (docs/firmware.md), and `EstimatorState::last` recomputes them for the last sample
+/// when a debugger or a telemetry task wants them. (`SensorlessEstimator`, the owner of both
+/// records, steps identically: `split_step_is_the_owners_step` in fado-core.)
 #[inline(never)]
 #[unsafe(no_mangle)]
 pub fn estimator_step(
-    estimator: &mut SensorlessEstimator<f32>,
+    params: &EstimatorParams<f32>,
+    state: &mut EstimatorState<f32>,
     v_ab: Ab<f32>,
     i_ab: Ab<f32>,
 ) -> LeanEstimate<f32> {
-    estimator.step_lean(v_ab, i_ab)
+    state.step_lean(params, v_ab, i_ab)
 }
 
 /// One drive step (Clarke/Park, current and speed control, the estimator, modulation),
@@ -260,8 +282,8 @@ pub fn drive_step(
 }
 
 impl App {
-    /// The interrupt's work for one sample.
-    fn on_sample(&mut self) {
+    /// The interrupt's work for one sample, with the parameters the state was made for.
+    fn on_sample(&mut self, params: &EstimatorParams<f32>) {
         if self.done {
             return;
         }
@@ -271,7 +293,7 @@ impl App {
             let cell = STEP_SP.borrow(cs);
             cell.set(cell.get().min(sp));
         });
-        let out = estimator_step(&mut self.estimator, v, i);
+        let out = estimator_step(params, &mut self.state, v, i);
         self.samples += 1;
         if out.input_fault {
             self.rejected += 1;
@@ -294,10 +316,12 @@ impl App {
 #[exception]
 fn SysTick() {
     interrupt::free(|cs| {
-        if let Ok(mut app) = APP.borrow(cs).try_borrow_mut()
+        if let Some(params) = PARAMS.borrow(cs).get()
+            && let Ok(mut app) = APP.borrow(cs).try_borrow_mut()
             && let Some(app) = app.as_mut()
+            && let Some(params) = params.get(app.params)
         {
-            app.on_sample();
+            app.on_sample(params);
         }
     });
 }
@@ -313,11 +337,39 @@ fn main() -> ! {
     core.SYST.enable_counter();
     core.SYST.enable_interrupt();
 
-    hprintln!(
-        "size_of::<SensorlessEstimator<f32>>() = {} B, size_of::<Estimate<f32>>() = {} B",
-        core::mem::size_of::<SensorlessEstimator<f32>>(),
-        core::mem::size_of::<Estimate<f32>>()
-    );
+    {
+        use core::mem::size_of;
+        hprintln!(
+            "size_of: EstimatorState<f32> = {} B (f64: {} B), EstimatorParams<f32> = {} B \
+             (f64: {} B), SensorlessEstimator<f32> = {} B (f64: {} B), Estimate<f32> = {} B",
+            size_of::<EstimatorState<f32>>(),
+            size_of::<EstimatorState<f64>>(),
+            size_of::<EstimatorParams<f32>>(),
+            size_of::<EstimatorParams<f64>>(),
+            size_of::<SensorlessEstimator<f32>>(),
+            size_of::<SensorlessEstimator<f64>>(),
+            size_of::<Estimate<f32>>()
+        );
+    }
+    // The estimator's parameters, once (configuration checked here, not in the interrupt).
+    let params = {
+        let model = MachineModel::<f32>::paper();
+        let build = |rs_adaptation| {
+            let mut config = EstimatorConfig::for_machine(&model);
+            config.tuning.rs_adaptation = rs_adaptation;
+            EstimatorParams::new(config)
+        };
+        match (build(true), build(false)) {
+            (Ok(adaptive), Ok(fixed)) => [adaptive, fixed],
+            _ => {
+                hprintln!("invalid configuration");
+                exit(false)
+            }
+        }
+    };
+    if interrupt::free(|cs| PARAMS.borrow(cs).set(params)).is_err() {
+        exit(false)
+    }
     // The drive's step runs on the target too (see `drive_step`): one sample at standstill.
     let model = MachineModel::<f32>::paper();
     let Ok(mut drive) =
@@ -342,16 +394,13 @@ fn main() -> ! {
     let (mut deepest_isr, mut deepest_step) = (0, 0);
     for (index, s) in SCENARIOS.iter().enumerate() {
         let model = MachineModel::<f32>::paper();
-        let mut config = EstimatorConfig::for_machine(&model);
-        config.tuning.rs_adaptation = s.rs_adaptation;
-        let Ok(estimator) = SensorlessEstimator::new(config) else {
-            hprintln!("invalid configuration");
-            exit(false)
-        };
+        let which = if s.rs_adaptation { 0 } else { 1 };
+        let state = EstimatorState::new(&params[which]);
         let machine = Machine::new(s, &model);
         let total_samples = (s.ramp_s * SAMPLE_HZ as f32) as u32 + s.hold_samples;
         let app = App {
-            estimator,
+            params: which,
+            state,
             machine,
             samples: 0,
             total_samples,
