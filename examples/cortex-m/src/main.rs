@@ -43,9 +43,8 @@ use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m_rt::{entry, exception};
 use cortex_m_semihosting::{debug, hprintln};
 use fado_core::{
-    Ab, Abc, DriveConfig, DriveOutput, Estimate, EstimatorConfig, EstimatorParams,
-    EstimatorState, EstimatorTuning, LeanEstimate, MachineModel, SensorlessDrive,
-    SensorlessEstimator,
+    Ab, Abc, DriveConfig, DriveOutput, Estimate, EstimatorConfig, EstimatorParams, EstimatorState,
+    EstimatorTuning, LeanEstimate, MachineModel, SensorlessDrive, SensorlessEstimator,
 };
 
 /// QEMU's MPS2 system clock (25 MHz), which clocks SysTick.
