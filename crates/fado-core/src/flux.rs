@@ -65,7 +65,7 @@ impl<T: Real> FluxIntegratorParams<T> {
 
     /// λ1 after one more sample, computed without changing the state, and the current it
     /// multiplied by R̂s (see [`Self::drop_current`]).
-    #[inline]
+    #[inline(always)]
     pub(crate) fn next_flux(
         &self,
         s: &FluxIntegratorState<T>,
@@ -80,7 +80,7 @@ impl<T: Real> FluxIntegratorParams<T> {
 
     /// The current multiplied by R̂s in the sample ending with `i_ab`: the interval's average
     /// (with `average_current`) or `i_ab`.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn drop_current(&self, s: &FluxIntegratorState<T>, i_ab: Ab<T>) -> Ab<T> {
         if self.average_current && s.has_prev {
             (i_ab + s.i_prev) * T::lit(0.5)
@@ -109,7 +109,7 @@ impl<T: Real> FluxIntegratorState<T> {
     }
 
     /// Sets R̂s from a value already checked (by the resistance adaptation's bounds).
-    #[inline]
+    #[inline(always)]
     pub(crate) fn set_rs_hat_unchecked(&mut self, rs_hat: T) {
         self.rs_hat = rs_hat;
     }
@@ -121,14 +121,14 @@ impl<T: Real> FluxIntegratorState<T> {
     }
 
     /// R̂s in use (Ω).
-    #[inline]
+    #[inline(always)]
     pub(crate) fn rs_hat(&self) -> T {
         self.rs_hat
     }
 
     /// Takes λ1 computed by [`FluxIntegratorParams::next_flux`] for the sample with current
     /// `i_ab`.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn commit(&mut self, lambda1: Ab<T>, i_ab: Ab<T>) {
         self.lambda1 = lambda1;
         self.i_prev = i_ab;
@@ -136,14 +136,14 @@ impl<T: Real> FluxIntegratorState<T> {
     }
 
     /// λ1, the integrated stator flux.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn flux(&self) -> Ab<T> {
         self.lambda1
     }
 
     /// The current of the last sample (zero after a reset, or what [`Self::set_last_current`]
     /// set).
-    #[inline]
+    #[inline(always)]
     pub(crate) fn last_current(&self) -> Ab<T> {
         self.i_prev
     }
@@ -151,7 +151,7 @@ impl<T: Real> FluxIntegratorState<T> {
     /// Records the current present at a reset, not for the resistive drop (the first sample
     /// after a reset still uses its own current alone): the estimator reports it and checks
     /// the first sample's current step against it.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn set_last_current(&mut self, i_ab: Ab<T>) {
         self.i_prev = i_ab;
     }
@@ -271,7 +271,7 @@ impl<T: Real> DisturbanceFeedbackParams<T> {
     }
 
     /// The gain the next sample uses after `gain`.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn next_gain(&self, gain: T, active: bool) -> T {
         if active {
             crate::real::min(gain + self.ramp_increment, self.k_df)

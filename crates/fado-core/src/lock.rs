@@ -179,7 +179,7 @@ pub(crate) struct DebouncerState {
 
 impl DebouncerState {
     /// The status this state means (as [`Debouncer::status`]).
-    #[inline]
+    #[inline(always)]
     pub(crate) fn status(&self) -> LockStatus {
         Debouncer::new(0, 1).with_state(*self).status()
     }
@@ -262,7 +262,7 @@ impl<T: Real> LockDetectorParams<T> {
     /// The state after one sample `s`: `lambda_r_sq` = |λ̂r|², `flux_sq` = λ̂f²,
     /// `innovation` = wrap(θm − θ̂⁻) (0 when the trackers coasted), `clamping` = the limiter
     /// clamped this sample. Four multiplications, five compares.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn next_state(
         &self,
         s: DebouncerState,

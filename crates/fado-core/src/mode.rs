@@ -68,7 +68,7 @@ impl<T: Real> ModeSelectorParams<T> {
     }
 
     /// The mode after `mode` for the speed estimate ω̂ (rad/s, electrical, signed).
-    #[inline]
+    #[inline(always)]
     pub(crate) fn next_mode(&self, mode: Mode, omega: T) -> Mode {
         let w = omega.abs();
         match mode {

@@ -294,20 +294,20 @@ impl<T: Real> ObserverState<T> {
     }
 
     /// Takes the state computed by [`DisturbanceObserverParams::next_state`].
-    #[inline]
+    #[inline(always)]
     pub(crate) fn commit(&mut self, z: Ab<T>, d: Ab<T>) {
         self.z = z;
         self.d = d;
     }
 
     /// D̂.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn disturbance(&self) -> Ab<T> {
         self.d
     }
 
     /// λ̂1.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn flux(&self) -> Ab<T> {
         self.z
     }

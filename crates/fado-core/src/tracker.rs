@@ -163,7 +163,7 @@ impl<T: Real> TrackerParams<T> {
     }
 
     /// The update after one coasting sample.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn coasted_state(&self, s: &TrackerState<T>) -> TrackerUpdate<T> {
         let theta = s.predicted;
         TrackerUpdate {
@@ -175,7 +175,7 @@ impl<T: Real> TrackerParams<T> {
     }
 
     /// Kp in s⁻¹ (see [`TypeTwoTracker::kp`]).
-    #[inline]
+    #[inline(always)]
     pub(crate) fn kp(&self) -> T {
         self.kp
     }
@@ -184,7 +184,7 @@ impl<T: Real> TrackerParams<T> {
 impl<T: Real> TrackerState<T> {
     /// Takes an update computed by [`TrackerParams::next_state`] or
     /// [`TrackerParams::coasted_state`].
-    #[inline]
+    #[inline(always)]
     pub(crate) fn commit(&mut self, next: TrackerUpdate<T>) {
         self.predicted = next.predicted;
         self.theta = next.theta;
@@ -192,13 +192,13 @@ impl<T: Real> TrackerState<T> {
     }
 
     /// θ̂ for the last sample, in [−π, π].
-    #[inline]
+    #[inline(always)]
     pub(crate) fn angle(&self) -> T {
         T::angle_to(self.theta)
     }
 
     /// ω̂ in rad/s.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn speed(&self) -> T {
         self.omega
     }
