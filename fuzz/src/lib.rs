@@ -197,11 +197,11 @@ impl EstimatorCase {
                     check_estimate(&est.last());
                 }
                 EstimatorAction::SetRs(rs) => {
-                    let before = *est.config();
+                    let before = *est.state();
                     let rs = rs.get::<T>();
                     match est.set_rs_hat(rs) {
                         Ok(()) => assert!(rs.is_finite() && rs >= T::zero()),
-                        Err(_) => assert_eq!(*est.config(), before),
+                        Err(_) => assert_eq!(*est.state(), before),
                     }
                 }
                 EstimatorAction::EnableKdf(on) => est.set_disturbance_feedback_enabled(on),
