@@ -5,7 +5,8 @@
 # without the R̂s adaptation): the instructions and the Cortex-M4 cycle estimate per step (an
 # instruction trace weighted by the TRM's cycle timings, see scripts/firmware_cost.py and
 # docs/firmware.md), the .text reachable from the step and from the ISR, the deepest stack
-# (painted stack, measured in the image) and size_of the state.
+# (painted stack, measured in the image) and size_of the estimator's state and parameters
+# (EstimatorState, EstimatorParams, in f32 and f64) and of their owner SensorlessEstimator.
 # Needs qemu-system-arm and binutils-arm-none-eabi (Debian packages of those names).
 # Usage: bash scripts/firmware-cost.sh [STEPS_MEASURED_PER_SCENARIO (default 300)]
 set -euo pipefail
@@ -25,7 +26,12 @@ qemu=(qemu-system-arm -machine mps2-an386 -cpu cortex-m4 -nographic
 echo "== image: $image"
 arm-none-eabi-size "$image"
 echo "== run (semihosting output of the image)"
-timeout 300 "${qemu[@]}"
+run_log=$(mktemp /tmp/fado-firmware-run.XXXXXX)
+trap 'rm -f "$run_log"' EXIT
+timeout 300 "${qemu[@]}" | tee "$run_log"
+echo "== state and parameters (size_of, printed by the image)"
+grep -o 'EstimatorState<f32> = .*' "$run_log" | tr ',' '\n' | sed 's/^ */    /' || true
+grep -o 'deepest stack: .*' "$run_log" | sed 's/^/    /' || true
 
 echo "== code reachable from the step and from the interrupt"
 for root in estimator_step SysTick drive_step; do
@@ -35,7 +41,7 @@ done
 
 echo "== instruction trace (QEMU -d exec,nochain -singlestep, filtered to the step's code)"
 log=$(mktemp /tmp/fado-firmware-trace.XXXXXX)
-trap 'rm -f "$log"' EXIT
+trap 'rm -f "$log" "$run_log"' EXIT
 filter=$(python3 scripts/firmware_cost.py ranges "$image" estimator_step scenario_marker)
 timeout 900 "${qemu[@]}" -singlestep -d exec,nochain -dfilter "$filter" -D "$log" >/dev/null
 python3 scripts/firmware_cost.py trace "$image" estimator_step "$log" "$tail_steps"

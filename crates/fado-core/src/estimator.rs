@@ -13,6 +13,31 @@
 //! Order of operations at sample n (SPEC §1): integrate with the feedback from sample n−1,
 //! run the observer with ω̂ of T2S-1, form λ2, λ̂r and θm, update both trackers, then choose
 //! the mode from |ω̂| of T2S-2 and compute the feedback for sample n+1.
+//!
+//! # Parameters and state
+//!
+//! The estimator is two records, as quartiq's `idsp` keeps a filter's configuration apart from
+//! its state (`iir::Stateful { config, state }`, stepped through `StatefulRef { &config,
+//! &mut state }`, src/iir/process.rs):
+//!
+//! - [`EstimatorParams`]: every constant of the step — Ts, L̂q, L̂d − L̂q, λ̂f, the gains and
+//!   limits, the lag filter's coefficients, the slow laws' and the lock detector's
+//!   configuration, the sample bounds — precomputed and checked once from an
+//!   [`EstimatorConfig`] by [`EstimatorParams::new`]. Each block keeps its constants in its
+//!   own parameter record (`FluxIntegratorParams`, `TrackerParams`,
+//!   `ResistanceAdaptationParams`, …), built from its own configuration: one place defines
+//!   each of them.
+//! - [`EstimatorState`]: what the step changes (λ1, λ̂1 and D̂, the trackers, the mode, the
+//!   slow laws' state and sums, the counters and flags) and what the user changes at run
+//!   time: R̂s ([`EstimatorState::set_rs_hat`], the adaptation) with what the adaptation
+//!   derives from the R0 it restarts from, λ̂f (its law), the adaptation's and the k_df
+//!   switches. At most 256 B in `f32` (`state_size`, docs/firmware.md).
+//!
+//! [`EstimatorState::step`] / [`EstimatorState::step_lean`] take the parameters by
+//! reference: the firmware path, with the parameters built once (in a `static`, never copied
+//! into the state; `EstimatorParams::new` is not a `const fn`, see its docs).
+//! [`SensorlessEstimator`] owns one of each and steps them with the same code, bit for bit
+//! (`tests/estimator_split.rs`).
 
 use crate::error::{ConfigError, check};
 use crate::flux::{
