@@ -799,3 +799,120 @@ fn stall_symptom_counts_in_kdf_mode_just_above_the_threshold() {
         assert_eq!(run(0.0175, 0.0), None, "{}", machine.pole_pairs);
     }
 }
+
+/// An estimator whose speed ramps from `omega0` at `accel` (electrical rad/s, rad/s²) in
+/// limiter mode, its angle held: what the drive's stall symptom sees of an estimate that
+/// follows (or does not follow) the torque.
+struct RampSpy {
+    omega0: f64,
+    accel: f64,
+    ts: f64,
+    n: u32,
+}
+
+impl RampSpy {
+    fn omega(&self) -> f64 {
+        self.omega0 + self.accel * self.ts * self.n.saturating_sub(CATCH) as f64
+    }
+}
+
+impl RotorAngleEstimator<f64> for RampSpy {
+    fn step(&mut self, _v_ab: Ab<f64>, _i_ab: Ab<f64>) -> Estimate<f64> {
+        let omega = self.omega();
+        self.n += 1;
+        Estimate {
+            theta: 0.0,
+            omega,
+            omega_control: omega,
+            diagnostics: Diagnostics {
+                mode: fado_core::Mode::Limiter,
+                ..Diagnostics::default()
+            },
+        }
+    }
+    fn align(&mut self, _theta0: f64, _i_ab: Ab<f64>) {}
+    fn reset(&mut self) {}
+    fn name(&self) -> &'static str {
+        "ramp-spy"
+    }
+}
+
+/// Samples the speed loop holds the reference equal to ω̂ before `RampSpy` ramps.
+const CATCH: u32 = 600;
+
+/// The stall symptom does not count while the estimated rotor answers the torque
+/// (`lock_stall_follow_time`, docs/lock.md fifth session): ω̂ beyond the stall band in the
+/// direction of the speed error and accelerating in it. The speed loop catches a reference
+/// equal to ω̂ (`CATCH` samples, 60 ms: six time constants of the ω̂ low-pass, which starts
+/// from zero at `align`), then the reference runs 3 bands ahead of ω̂ (away from zero) while ω̂ ramps. An
+/// estimate accelerating towards the reference at 2 bands beyond zero is not flagged; the
+/// same run with the exception off is, after `lock_stall_time` (50 samples); so are an
+/// estimate that sticks, one that falls away from the reference, one that accelerates but
+/// within the band of zero, one that accelerates slower than the exception's least
+/// acceleration, and one that accelerates below the exception's current gate.
+/// On the paper's motor and on the 2.2 kW IPMSM.
+#[test]
+fn stall_symptom_spares_an_estimate_that_answers_the_torque() {
+    let ipmsm = common::ipmsm_model();
+    for machine in [MachineModel::paper(), ipmsm] {
+        let band = 0.004 * machine.rated_speed();
+        // 0.3 of the rated speed per second: ω̂ stays far inside the k_df threshold.
+        let ramp = 0.3 * machine.rated_speed();
+        let run = |omega0: f64, accel: f64, follow_time: f64, gate: f64| {
+            let mut c = DriveConfig::for_machine(&machine);
+            c.tuning.offset_calibration_time = 0.0;
+            c.tuning.gain_calibration_time = 0.0;
+            c.tuning.stuck_sensor_time = 0.0;
+            c.tuning.current_limit_ratio = 100.0;
+            c.tuning.trip_current_ratio = 200.0;
+            c.tuning.lock_stall_min_current_ratio = 0.0;
+            c.tuning.lock_stall_follow_time = follow_time;
+            c.tuning.lock_stall_follow_min_current_ratio = gate;
+            let ts = c.ts;
+            c.tuning.lock_stall_follow_accel_ratio = 0.005;
+            let spy = RampSpy {
+                omega0,
+                accel,
+                ts,
+                n: 0,
+            };
+            let p = machine.pole_pairs as f64;
+            let mut drive = SensorlessDrive::with_estimator(c, spy).unwrap();
+            drive.align(0.0);
+            let mut first = None;
+            for n in 0..CATCH + 500 {
+                let omega = omega0 + accel * ts * n.saturating_sub(CATCH) as f64;
+                let speed = if n < CATCH {
+                    omega
+                } else {
+                    omega + 3.0 * band * omega0.signum()
+                };
+                let out = drive.step(Abc::new(0.0, 0.0, 0.0), 300.0, speed / p);
+                if first.is_none() && out.flags.contains(DriveFlags::LOCK_LOST) {
+                    first = Some(n);
+                }
+            }
+            first
+        };
+        let p = machine.pole_pairs;
+        // Answers: 2 bands out, accelerating towards the reference.
+        assert_eq!(run(2.0 * band, ramp, 10e-3, 0.0), None, "{p}");
+        assert_eq!(run(-2.0 * band, -ramp, 10e-3, 0.0), None, "{p}");
+        // The same without the exception, and with its current gate above |i_q*|.
+        let n = run(2.0 * band, ramp, 0.0, 0.0).unwrap_or(0);
+        assert!((CATCH + 49..=CATCH + 50).contains(&n), "{p}: {n}");
+        let n = run(2.0 * band, ramp, 10e-3, 1e3).unwrap_or(0);
+        assert!((CATCH + 49..=CATCH + 50).contains(&n), "{p}: {n}");
+        // Sticks, falls away, or accelerates within the band of zero.
+        let n = run(2.0 * band, 0.0, 10e-3, 0.0).unwrap_or(0);
+        assert!((CATCH + 49..=CATCH + 50).contains(&n), "{p}: {n}");
+        let n = run(2.0 * band, -0.01 * ramp, 10e-3, 0.0).unwrap_or(0);
+        assert!((CATCH + 49..=CATCH + 50).contains(&n), "{p}: {n}");
+        let rated = machine.rated_speed();
+        let n = run(0.2 * band, 0.02 * rated, 10e-3, 0.0).unwrap_or(0);
+        assert!((CATCH + 49..=CATCH + 50).contains(&n), "{p}: {n}");
+        // Accelerates, but slower than `lock_stall_follow_accel_ratio` (0.005·rated/s).
+        let n = run(2.0 * band, 0.002 * rated, 10e-3, 0.0).unwrap_or(0);
+        assert!((CATCH + 49..=CATCH + 50).contains(&n), "{p}: {n}");
+    }
+}
