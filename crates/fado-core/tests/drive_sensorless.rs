@@ -626,8 +626,8 @@ fn status_word_reports_dc_link_low_and_persistent_bad_input_trips_and_is_counted
 
 /// The stall symptom of the loss-of-lock detection (`DriveTuning::lock_stall_speed_ratio`):
 /// a spy estimator in limiter mode that reports a standing rotor. Not armed until the speed
-/// loop has caught its reference; then a reference beyond the band (6 r/min on the paper's
-/// motor) for `lock_stall_time` (50 samples) while the speed loop asks for at least
+/// loop has caught its reference; then a reference beyond the band (4.5 r/min on the
+/// paper's motor) for `lock_stall_time` (50 samples) while the speed loop asks for at least
 /// `lock_stall_min_current_ratio` (0.2) of the rated current raises `LOCK_LOST`, a live status
 /// that clears after `lock_stall_heal_time` without the condition (or at `align`); a speed
 /// error with the current reference at its limit does not; ratio 0 never does.
@@ -657,7 +657,7 @@ fn stall_symptom_flags_a_lost_reference_below_the_current_limit() {
         }
         (first, torque, drive)
     };
-    // The band is 0.004 × 1500 r/min = 6 r/min = 0.63 rad/s (the drive's reference is in
+    // The band is 0.003 × 1500 r/min = 4.5 r/min = 0.47 rad/s (the drive's reference is in
     // mechanical rad/s); the current limit is raised so that the speed loop's reference
     // for the errors below stays below it.
     let high_limit = |c: &mut DriveConfig<f64>| {
@@ -855,7 +855,10 @@ const CATCH: u32 = 600;
 fn stall_symptom_spares_an_estimate_that_answers_the_torque() {
     let ipmsm = common::ipmsm_model();
     for machine in [MachineModel::paper(), ipmsm] {
-        let band = 0.004 * machine.rated_speed();
+        let band = DriveConfig::<f64>::for_machine(&machine)
+            .tuning
+            .lock_stall_speed_ratio
+            * machine.rated_speed();
         // 0.3 of the rated speed per second: ω̂ stays far inside the k_df threshold.
         let ramp = 0.3 * machine.rated_speed();
         let run = |omega0: f64, accel: f64, follow_time: f64, gate: f64| {

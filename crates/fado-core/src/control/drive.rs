@@ -213,12 +213,14 @@ pub struct DriveTuning<T> {
     pub lock_recovery_rs_adaptation: bool,
     /// Stall symptom of the loss-of-lock detection (see [`crate::lock`], "speed-loop stall"):
     /// in limiter mode, a speed error |ω* − ω̂| above this multiple of the rated speed for
-    /// `lock_stall_time` raises `LOCK_LOST` like the estimator's own verdict. Default 0.004
-    /// \[A\] (6 r/min at 1500 r/min rated, a quarter of the default Fig. 3 threshold
+    /// `lock_stall_time` raises `LOCK_LOST` like the estimator's own verdict. Default 0.003
+    /// \[A\] (4.5 r/min at 1500 r/min rated, a fifth of the default Fig. 3 threshold
     /// `mode_threshold_ratio` 0.015; chosen on the fig11 envelope with the current gate
-    /// `lock_stall_min_current_ratio`, docs/lock.md: 0.005 reaches the band 20–60 ms after
-    /// the error passes 0.5 rad in 10 of 208 fixed-R̂s losses, 0.0035 false-alarms in runs
-    /// that pass the paper's criteria); 0 disables.
+    /// `lock_stall_min_current_ratio` and the exception `lock_stall_follow_time`,
+    /// docs/lock.md: 0.005 reaches the band 20–60 ms after the error passes 0.5 rad in 10
+    /// of 208 fixed-R̂s losses; the light-load losses that 0.004 saw late reach
+    /// 0.0034–0.0038·rated by 15 ms after the error passes 0.5 rad; below 0.004 the rotor
+    /// lagging the ramp under heavy load false-alarmed until the exception); 0 disables.
     pub lock_stall_speed_ratio: T,
     /// Net time (s) the stall condition must hold (up/down count, [`crate::lock::Debouncer`]).
     /// Default 5 ms \[A\] (the estimator's
@@ -434,7 +436,7 @@ impl<T: Real> Default for DriveTuning<T> {
             lock_recovery_timeout: T::lit(0.5),
             lock_recovery_attempts: 3,
             lock_recovery_rs_adaptation: true,
-            lock_stall_speed_ratio: T::lit(0.004),
+            lock_stall_speed_ratio: T::lit(0.003),
             lock_stall_time: T::lit(5e-3),
             lock_stall_heal_time: T::lit(0.1),
             lock_stall_max_speed_ratio: T::lit(0.0),
