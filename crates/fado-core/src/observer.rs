@@ -66,20 +66,24 @@ impl<T: Real> DiscreteGains<T> {
     #[inline(always)]
     pub fn new(omega: T, ts: T) -> Self {
         let x = omega * ts;
+        // `f32` in its series range: the short minimax polynomials of `f32_gains` (the test
+        // folds to a constant per type; `f64` never takes this branch).
+        let single = T::one() + T::lit(1e-12) == T::one();
+        if single && x.abs() <= T::lit(SERIES_LIMIT_F32) {
+            return f32_gains(x);
+        }
         let half = T::lit(0.5);
         let two = T::lit(2.0);
-        let (sh, ch, one_minus_r, l2_beta) = half_angle_terms(x);
+        let (sh, ch, one_minus_r) = half_angle_terms(x);
         let a = Ab::new(ch * ch - sh * sh, two * sh * ch);
         let one_minus_a = Ab::new(two * sh * sh, -two * sh * ch);
         let l1 = Ab::new(two * one_minus_r - one_minus_a.alpha, -one_minus_a.beta);
         // (1 − r)²/(1 − a) = (1 − r)²·(sh + j·ch)/(2·sh); exactly zero at ω = 0.
         let m = one_minus_r * one_minus_r * half;
-        let l2 = match l2_beta {
-            // f32 series range: m·ch/sh from its own series, no division (see
-            // `half_angle_terms`).
-            Some(beta) => Ab::new(m, beta),
-            None if sh == T::zero() => Ab::zero(),
-            None => Ab::new(m, m * ch / sh),
+        let l2 = if sh == T::zero() {
+            Ab::zero()
+        } else {
+            Ab::new(m, m * ch / sh)
         };
         Self {
             a,
@@ -91,15 +95,13 @@ impl<T: Real> DiscreteGains<T> {
     }
 }
 
-/// Largest |ω·Ts| (rad) served by the series in [`half_angle_terms`]: 398 Hz at 10 kHz, far
-/// above the motor's 100 Hz; beyond it the gains come from `libm` (`f64`) or from
-/// [`crate::approx`] (`f32`).
+/// Largest |ω·Ts| (rad) served by the `f64` series in [`half_angle_terms`]: 398 Hz at 10 kHz,
+/// far above the motor's 100 Hz; beyond it the gains come from `libm`.
 const SERIES_LIMIT: f64 = 0.25;
 
-/// The same limit for `f32`, whose shorter series stay below half an ulp further: at
-/// |x| = 0.5 (796 Hz at 10 kHz) the first omitted terms are h⁸/9! = 4e-11 (sin), h⁸/8! =
-/// 4e-10 (cos) and y⁸/9! = 1.1e-8 (1 − e^{−y}), against f32's half ulp of 6e-8. Covers the
-/// 700 Hz of docs/firmware.md without [`crate::approx`].
+/// Largest |ω·Ts| (rad) served by the `f32` polynomials of [`f32_gains`]: 796 Hz at 10 kHz,
+/// which covers the 700 Hz of docs/firmware.md; beyond it the gains come from
+/// [`crate::approx`].
 const SERIES_LIMIT_F32: f64 = 0.5;
 
 /// Taylor coefficients of sin(h)/h in h² (1, −1/3!, 1/5!, ...).
@@ -138,56 +140,98 @@ const ONE_MINUS_EXP_OVER_Y: [f64; 13] = [
     1.0 / 6_227_020_800.0,
 ];
 
-/// Taylor coefficients of h·cot(h) in h² (1, −1/3, −1/45, −2/945): the `f32` ℓ2 without a
-/// division (see [`half_angle_terms`]).
-const H_COT_H: [f64; 4] = [1.0, -1.0 / 3.0, -1.0 / 45.0, -2.0 / 945.0];
+/// sin(x)/x ≈ S(x²) on |x| ≤ 0.5 (`f32`): minimax for the relative error (Lawson-weighted
+/// least squares, coefficients rounded to `f32` one at a time and the rest refitted,
+/// `scripts/fit_approx.py`); 1.1e-7 fitted, 1.4e-7 evaluated in `f32`.
+const F32_SIN_OVER_X: [f32; 3] = [0.999_999_94, -0.166_660_3, 0.008_261];
+/// (1 − cos x)/x² ≈ C(x²) on |x| ≤ 0.5 (`f32`, as [`F32_SIN_OVER_X`]): 3.0e-8 fitted,
+/// 6.2e-8 evaluated.
+const F32_ONE_MINUS_COS_OVER_X2: [f32; 3] = [0.5, -0.041_665_997, 0.001_380_260_1];
+/// (1 − e^{−y})/y ≈ E(y) on 0 ≤ y ≤ 0.5 (`f32`, as [`F32_SIN_OVER_X`]): 8.0e-8 fitted, 1.4e-7
+/// evaluated.
+const F32_ONE_MINUS_EXP_OVER_Y: [f32; 5] = [
+    0.999_999_94,
+    -0.499_992_97,
+    0.166_551_49,
+    -0.041_010_085,
+    0.006_778_805_5,
+];
+/// (x/2)·cot(x/2) ≈ K(x²) on |x| ≤ 0.5 (`f32`, as [`F32_SIN_OVER_X`]): 2.1e-8 fitted, 5.2e-8
+/// evaluated.
+const F32_HALF_X_COT_HALF_X: [f32; 3] = [1.0, -0.083_332_43, -0.001_400_523_4];
 
-/// (sin(x/2), cos(x/2), 1 − e^{−|x|}, ℓ2's imaginary part or `None`) for x = ω·Ts.
+/// The gains for `f32` in |x| ≤ 0.5 (x = ω·Ts), from four short polynomials and no division:
 ///
-/// ℓ2 = m·(1 + j·cos(h)/sin(h)) with h = x/2 and m = (1 − r)²/2 needs a division by sin h
-/// (14 cycles on a Cortex-M4F, `vdiv`). In the `f32` series range it comes from a series
-/// instead: with sin h = h·S(h²), 1 − r = y·E(y) (y = |x| = 2|h|), m = 2h²·E², so
-/// m·cos h/sin h = 2h·E²·(h·cot h), and h·cot h = 1 − h²/3 − h⁴/45 − 2h⁶/945 − h⁸/4725 − …
-/// (Abramowitz & Stegun 4.3.70), truncated after h⁶: the first omitted term is below
-/// 0.25⁸/4725 = 3.2e-9 at |h| ≤ 0.25, under `f32`'s half ulp of 6e-8 (tested against `f64`
-/// in `series_gains_match_libm_to_rounding`). It is exactly 0 at x = 0, as before. `f64`
-/// and the range beyond the series keep the division (`None`).
+/// ```text
+/// a  = (1 − x²·C, x·S)            ℓ1 = (2u − x²·C, x·S)          u = 1 − r = y·E,  y = |x|
+/// ℓ2 = u²·(1 + j·cot(x/2))/2 = (x²·E²/2, x·E²·K)
+/// ```
+///
+/// (u² = x²·E², and u²·cot(x/2)/2 = x²·E²·(2K/x)/2 = x·E²·K.) Each gain is exactly 0 at
+/// x = 0, so the observer still freezes at standstill. Why these errors are harmless, with
+/// the criteria tested in `f32_gains_keep_the_poles_and_the_notch`:
+/// - the notch sits where a = e^{jωTs}: S and C put a within 7.9e-8 of e^{jx} (arg a − x,
+///   i.e. a notch displaced by |Δω|·Ts ≤ 7.9e-8 rad per sample, and ||a| − 1| ≤ 5.1e-8), the
+///   size of `f32`'s own rounding of a (half an ulp of 1 is 6e-8; the half-angle Taylor
+///   products gave 7.2e-8 and 1.7e-7);
+/// - an error of E is a different u, and every gain is built from that same u: the poles stay a
+///   quadruple at r' = 1 − u' within 1.4e-7·u of r, a pole at −|ω|·(1 ± 1.4e-7);
+/// - errors of S, C, K that do not match each other split the double poles by about the square
+///   root of the mismatch (a 2×2 Jordan block); so does `f32`'s rounding of each gain, by
+///   √(6e-8/|x|) relative. The poles stay within 1.3e-2·(1 − r) of r (1.9e-3·(1 − r) above
+///   |x| = 0.01, 16 Hz at 10 kHz), where the previous Taylor gains, accurate to rounding, put
+///   them within 1.6e-2·(1 − r) (2.8e-3).
+///
+/// Measured against the closed forms: |a − e^{jx}| ≤ 7.9e-8, ℓ1 and ℓ2 within 1.8e-7 and
+/// 3.6e-7 relative, |r − e^{−|x|}| ≤ 8.2e-8 (Taylor: 1.7e-7, 1.7e-7, 3.1e-7, 7.3e-8).
+///
+/// The previous Taylor polynomials in the half angle (degrees 7, 6, 7 and 6) were accurate to
+/// `f32` rounding and cost 20 coefficients and the half-angle products; these cost 14.
+#[inline(always)]
+fn f32_gains<T: Real>(x: T) -> DiscreteGains<T> {
+    let lit = |c: f32| T::lit(c as f64);
+    let y = x.abs();
+    let t = x * x;
+    let (s, c, e, k) = (
+        &F32_SIN_OVER_X,
+        &F32_ONE_MINUS_COS_OVER_X2,
+        &F32_ONE_MINUS_EXP_OVER_Y,
+        &F32_HALF_X_COT_HALF_X,
+    );
+    let sin = x * (lit(s[0]) + t * (lit(s[1]) + t * lit(s[2])));
+    let one_minus_cos = t * (lit(c[0]) + t * (lit(c[1]) + t * lit(c[2])));
+    let e = lit(e[0]) + y * (lit(e[1]) + y * (lit(e[2]) + y * (lit(e[3]) + y * lit(e[4]))));
+    let k = lit(k[0]) + t * (lit(k[1]) + t * lit(k[2]));
+    let one_minus_r = y * e;
+    let e2 = e * e;
+    DiscreteGains {
+        a: Ab::new(T::one() - one_minus_cos, sin),
+        one_minus_a: Ab::new(one_minus_cos, -sin),
+        l1: Ab::new(one_minus_r + one_minus_r - one_minus_cos, sin),
+        l2: Ab::new(t * e2 * T::lit(0.5), x * e2 * k),
+        r: T::one() - one_minus_r,
+    }
+}
+
+/// (sin(x/2), cos(x/2), 1 − e^{−|x|}) for x = ω·Ts, outside the `f32` range of [`f32_gains`].
 ///
 /// The observer needs these every sample because ω̂ changes every sample. In the operating
-/// range |x| ≤ 0.25 truncated Taylor series replace `sin_cos` and `exp_m1` (a third of the
-/// estimator's instructions otherwise): the first omitted term is below half an ulp of the
-/// type (|h| ≤ 1/8: h¹²/13! = 2e-22 for sin, h¹⁴/14! = 3e-24 for cos, y¹³/14! = 2e-19 for
-/// 1 − e^{−y}; `f32` stops earlier at terms below 2e-9), so the results differ from `libm`'s
-/// by float rounding only.
+/// range |x| ≤ 0.25 `f64` evaluates truncated Taylor series instead of `sin_cos` and `exp_m1`
+/// (a third of the estimator's instructions otherwise): the first omitted term is below half
+/// an ulp (|h| ≤ 1/8: h¹²/13! = 2e-22 for sin, h¹⁴/14! = 3e-24 for cos, y¹³/14! = 2e-19 for
+/// 1 − e^{−y}), so the results differ from `libm`'s by float rounding only.
 #[inline(always)]
-fn half_angle_terms<T: Real>(x: T) -> (T, T, T, Option<T>) {
+fn half_angle_terms<T: Real>(x: T) -> (T, T, T) {
     let y = x.abs();
     let single = T::one() + T::lit(1e-12) == T::one();
-    let limit = if single {
-        SERIES_LIMIT_F32
-    } else {
-        SERIES_LIMIT
-    };
-    if y <= T::lit(limit) {
+    if !single && y <= T::lit(SERIES_LIMIT) {
         let h = x * T::lit(0.5);
         let h2 = h * h;
         let h4 = h2 * h2;
         let y2 = y * y;
         let y4 = y2 * y2;
-        // f32 needs fewer terms (the test folds to a constant per type); the sums are grouped
-        // by Estrin's scheme (see `cubic`).
+        // The sums are grouped by Estrin's scheme (see `cubic`).
         let (s, c, e) = (&SIN_OVER_H, &COS, &ONE_MINUS_EXP_OVER_Y);
-        if single {
-            let one_minus_exp_over_y = cubic(y, y2, e) + y4 * cubic(y, y2, &e[4..]);
-            let l2_beta =
-                (h + h) * (one_minus_exp_over_y * one_minus_exp_over_y) * cubic(h2, h4, &H_COT_H);
-            return (
-                h * cubic(h2, h4, s),
-                cubic(h2, h4, c),
-                y * one_minus_exp_over_y,
-                Some(l2_beta),
-            );
-        }
         let lit = T::lit;
         let y8 = y4 * y4;
         let (sin_over_h, cos, one_minus_exp_over_y) = (
@@ -196,7 +240,7 @@ fn half_angle_terms<T: Real>(x: T) -> (T, T, T, Option<T>) {
             (cubic(y, y2, e) + y4 * cubic(y, y2, &e[4..]))
                 + y8 * (cubic(y, y2, &e[8..]) + y4 * lit(e[12])),
         );
-        (h * sin_over_h, cos, y * one_minus_exp_over_y, None)
+        (h * sin_over_h, cos, y * one_minus_exp_over_y)
     } else {
         // Large speeds (and NaN, which propagates). a = e^{jx} is 2π-periodic in x and every
         // gain depends on (sin(x/2), cos(x/2)) only through products of two of them, which a
@@ -204,7 +248,7 @@ fn half_angle_terms<T: Real>(x: T) -> (T, T, T, Option<T>) {
         // approximation needs only [−π/2, π/2] (see `Real::step_sin_cos`). r depends on |x|
         // itself.
         let (sh, ch) = (crate::wrap_angle(x) * T::lit(0.5)).step_sin_cos();
-        (sh, ch, y.step_one_minus_exp_neg(), None)
+        (sh, ch, y.step_one_minus_exp_neg())
     }
 }
 
@@ -586,6 +630,70 @@ mod tests {
         assert!((g.r - (-0.6f64).exp()).abs() <= 2.3e-16);
     }
 
+    /// The criteria of `f32_gains` (see its docs), from the `f32` gains evaluated exactly in
+    /// `f64` over |x| ≤ 0.5 down to x = 1e-6: each gain against its closed form, the notch
+    /// (the internal model a against e^{jx}) and the four poles of the error dynamics against
+    /// r = e^{−|x|}. The error dynamics of (e_z, e_d) are [[a − ℓ1, 1 − a], [−ℓ2, 1]]; with
+    /// λ = r + μ their characteristic polynomial is μ² − δB·μ + (δC − r·δB) with
+    /// δB = 2u − p − ℓ1 and δC = u(2 − u) − p − ℓ1 + ℓ2·p (p = 1 − a, u = 1 − r): both vanish
+    /// for exact gains (a quadruple pole at r), and in this form they are computed without
+    /// cancellation down to the smallest speeds. The pole bounds are those `f32` rounding
+    /// alone gives (the previous Taylor gains, accurate to rounding, measured 1.6e-2 over the
+    /// whole range, the worst at small |x|, and 2.8e-3 above |x| = 0.01: a double pole splits
+    /// by the square root of a rounding error relative to |x|).
+    #[test]
+    fn f32_gains_keep_the_poles_and_the_notch() {
+        use nalgebra::{Complex, ComplexField};
+        let (mut notch, mut modulus) = (0.0_f64, 0.0_f64);
+        let (mut pole, mut pole_above) = (0.0_f64, 0.0_f64);
+        let (mut ea, mut el1, mut el2, mut er) = (0.0_f64, 0.0_f64, 0.0_f64, 0.0_f64);
+        let mut xs: std::vec::Vec<f64> = (1..=5000).map(|k| k as f64 * 1e-4).collect();
+        for d in [1e-6, 1e-5, 1e-4, 1e-3] {
+            xs.extend((0..300).map(|k| d * (1.0 + k as f64 * 0.03)));
+        }
+        for x0 in xs {
+            for x in [x0, -x0] {
+                let g = DiscreteGains::<f32>::new(x as f32, 1.0);
+                let x = (x as f32) as f64;
+                let cx = |v: Ab<f32>| Complex::new(v.alpha as f64, v.beta as f64);
+                let (a, l1, l2) = (cx(g.a), cx(g.l1), cx(g.l2));
+                // Closed forms in f64.
+                let u = -(-x.abs()).exp_m1();
+                let a_exact = Complex::new(x.cos(), x.sin());
+                let l1_exact = Complex::new(1.0 + x.cos() - 2.0 * (1.0 - u), x.sin());
+                let h = 0.5 * x;
+                let l2_exact = Complex::new(1.0, h.cos() / h.sin()) * (0.5 * u * u);
+                ea = ea.max((a - a_exact).modulus());
+                el1 = el1.max((l1 - l1_exact).modulus() / l1_exact.modulus());
+                el2 = el2.max((l2 - l2_exact).modulus() / l2_exact.modulus());
+                er = er.max((g.r as f64 - (1.0 - u)).abs());
+                notch = notch.max((a.argument() - x).abs());
+                modulus = modulus.max((a.modulus() - 1.0).abs());
+                let p = Complex::new(1.0 - g.a.alpha as f64, -(g.a.beta as f64));
+                let db = Complex::new(2.0 * u, 0.0) - p - l1;
+                let dc = Complex::new(u * (2.0 - u), 0.0) - p - l1 + l2 * p;
+                let root = (db * db - (dc - db * (1.0 - u)) * 4.0).sqrt();
+                for mu in [(db + root) * 0.5, (db - root) * 0.5] {
+                    pole = pole.max(mu.modulus() / u);
+                    if x.abs() >= 0.01 {
+                        pole_above = pole_above.max(mu.modulus() / u);
+                    }
+                }
+            }
+        }
+        std::eprintln!(
+            "a {ea:.2e}, l1 {el1:.2e}, l2 {el2:.2e}, r {er:.2e}; notch {notch:.2e} rad, \
+             |a| - 1 {modulus:.2e}, poles {pole:.2e} / {pole_above:.2e} (|x| >= 0.01)"
+        );
+        assert!(ea <= 1e-7, "|a - e^jx| = {ea}");
+        assert!(el1 <= 3e-7 && el2 <= 5e-7, "relative errors l1 {el1}, l2 {el2}");
+        assert!(er <= 1e-7, "|r - e^-|x|| = {er}");
+        assert!(notch <= 1e-7, "notch displaced by {notch} rad per sample");
+        assert!(modulus <= 1e-7, "|a| - 1 = {modulus}");
+        assert!(pole <= 2e-2, "poles {pole}·(1 - r) from r");
+        assert!(pole_above <= 3e-3, "poles {pole_above}·(1 - r) from r above |x| = 0.01");
+    }
+
     #[test]
     fn small_speed_gains_are_accurate_in_f32() {
         let w = 1e-3_f32;
@@ -605,3 +713,4 @@ mod tests {
         assert!(DisturbanceObserver::new(DisturbanceObserverConfig { ts: -1.0 }).is_err());
     }
 }
+
