@@ -686,12 +686,18 @@ mod tests {
              |a| - 1 {modulus:.2e}, poles {pole:.2e} / {pole_above:.2e} (|x| >= 0.01)"
         );
         assert!(ea <= 1e-7, "|a - e^jx| = {ea}");
-        assert!(el1 <= 3e-7 && el2 <= 5e-7, "relative errors l1 {el1}, l2 {el2}");
+        assert!(
+            el1 <= 3e-7 && el2 <= 5e-7,
+            "relative errors l1 {el1}, l2 {el2}"
+        );
         assert!(er <= 1e-7, "|r - e^-|x|| = {er}");
         assert!(notch <= 1e-7, "notch displaced by {notch} rad per sample");
         assert!(modulus <= 1e-7, "|a| - 1 = {modulus}");
         assert!(pole <= 2e-2, "poles {pole}·(1 - r) from r");
-        assert!(pole_above <= 3e-3, "poles {pole_above}·(1 - r) from r above |x| = 0.01");
+        assert!(
+            pole_above <= 3e-3,
+            "poles {pole_above}·(1 - r) from r above |x| = 0.01"
+        );
     }
 
     #[test]
@@ -713,4 +719,3 @@ mod tests {
         assert!(DisturbanceObserver::new(DisturbanceObserverConfig { ts: -1.0 }).is_err());
     }
 }
-

@@ -23,7 +23,7 @@ pub trait Real: RealField + Copy + Default {
     /// [`crate::approx::one_minus_exp_neg`] for `f32` (error below 1.5e-7).
     fn step_one_minus_exp_neg(self) -> Self;
     /// atan2(self, x), as the estimator's step computes it: `libm` for `f64`,
-    /// [`crate::approx::atan2`] for `f32` (error below 3.5e-7 rad).
+    /// [`crate::approx::atan2`] for `f32` (error below 2.2e-6 rad).
     fn step_atan2(self, x: Self) -> Self;
     /// √x for x ≥ 0, as the estimator's step computes it: `libm` for `f64`,
     /// [`crate::approx::sqrt`] for `f32` (within 1 ulp).
