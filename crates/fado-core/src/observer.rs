@@ -142,19 +142,21 @@ const ONE_MINUS_EXP_OVER_Y: [f64; 13] = [
 
 /// sin(x)/x ≈ S(x²) on |x| ≤ 0.5 (`f32`): minimax for the relative error (Lawson-weighted
 /// least squares, coefficients rounded to `f32` one at a time and the rest refitted,
-/// `scripts/fit_approx.py`); 1.1e-7 fitted, 1.4e-7 evaluated in `f32`.
-const F32_SIN_OVER_X: [f32; 3] = [0.999_999_94, -0.166_660_3, 0.008_261];
+/// `scripts/fit_approx.py`), its leading coefficient held at the Taylor value 1 (exact as
+/// x → 0, and an FPU immediate instead of a literal-pool load); 1.2e-7 fitted, 1.6e-7
+/// evaluated in `f32`.
+const F32_SIN_OVER_X: [f32; 3] = [1.0, -0.166_661_3, 0.008_264_322];
 /// (1 − cos x)/x² ≈ C(x²) on |x| ≤ 0.5 (`f32`, as [`F32_SIN_OVER_X`]): 3.0e-8 fitted,
 /// 6.2e-8 evaluated.
 const F32_ONE_MINUS_COS_OVER_X2: [f32; 3] = [0.5, -0.041_665_997, 0.001_380_260_1];
-/// (1 − e^{−y})/y ≈ E(y) on 0 ≤ y ≤ 0.5 (`f32`, as [`F32_SIN_OVER_X`]): 8.0e-8 fitted, 1.4e-7
+/// (1 − e^{−y})/y ≈ E(y) on 0 ≤ y ≤ 0.5 (`f32`, as [`F32_SIN_OVER_X`]): 8.8e-8 fitted, 1.5e-7
 /// evaluated.
 const F32_ONE_MINUS_EXP_OVER_Y: [f32; 5] = [
-    0.999_999_94,
-    -0.499_992_97,
-    0.166_551_49,
-    -0.041_010_085,
-    0.006_778_805_5,
+    1.0,
+    -0.499_994_64,
+    0.166_563_66,
+    -0.041_042_678,
+    0.006_807_800_4,
 ];
 /// (x/2)·cot(x/2) ≈ K(x²) on |x| ≤ 0.5 (`f32`, as [`F32_SIN_OVER_X`]): 2.1e-8 fitted, 5.2e-8
 /// evaluated.
@@ -170,20 +172,20 @@ const F32_HALF_X_COT_HALF_X: [f32; 3] = [1.0, -0.083_332_43, -0.001_400_523_4];
 /// (u² = x²·E², and u²·cot(x/2)/2 = x²·E²·(2K/x)/2 = x·E²·K.) Each gain is exactly 0 at
 /// x = 0, so the observer still freezes at standstill. Why these errors are harmless, with
 /// the criteria tested in `f32_gains_keep_the_poles_and_the_notch`:
-/// - the notch sits where a = e^{jωTs}: S and C put a within 7.9e-8 of e^{jx} (arg a − x,
-///   i.e. a notch displaced by |Δω|·Ts ≤ 7.9e-8 rad per sample, and ||a| − 1| ≤ 5.1e-8), the
+/// - the notch sits where a = e^{jωTs}: S and C put a within 8.1e-8 of e^{jx} (arg a − x,
+///   i.e. a notch displaced by |Δω|·Ts ≤ 7.9e-8 rad per sample, and ||a| − 1| ≤ 5.6e-8), the
 ///   size of `f32`'s own rounding of a (half an ulp of 1 is 6e-8; the half-angle Taylor
 ///   products gave 7.2e-8 and 1.7e-7);
 /// - an error of E is a different u, and every gain is built from that same u: the poles stay a
-///   quadruple at r' = 1 − u' within 1.4e-7·u of r, a pole at −|ω|·(1 ± 1.4e-7);
+///   quadruple at r' = 1 − u' within 1.5e-7·u of r, a pole at −|ω|·(1 ± 1.5e-7);
 /// - errors of S, C, K that do not match each other split the double poles by about the square
 ///   root of the mismatch (a 2×2 Jordan block); so does `f32`'s rounding of each gain, by
 ///   √(6e-8/|x|) relative. The poles stay within 1.3e-2·(1 − r) of r (1.9e-3·(1 − r) above
 ///   |x| = 0.01, 16 Hz at 10 kHz), where the previous Taylor gains, accurate to rounding, put
 ///   them within 1.6e-2·(1 − r) (2.8e-3).
 ///
-/// Measured against the closed forms: |a − e^{jx}| ≤ 7.9e-8, ℓ1 and ℓ2 within 1.8e-7 and
-/// 3.6e-7 relative, |r − e^{−|x|}| ≤ 8.2e-8 (Taylor: 1.7e-7, 1.7e-7, 3.1e-7, 7.3e-8).
+/// Measured against the closed forms: |a − e^{jx}| ≤ 8.1e-8, ℓ1 and ℓ2 within 2.1e-7 and
+/// 4.0e-7 relative, |r − e^{−|x|}| ≤ 8.7e-8 (Taylor: 1.7e-7, 1.7e-7, 3.1e-7, 7.3e-8).
 ///
 /// The previous Taylor polynomials in the half angle (degrees 7, 6, 7 and 6) were accurate to
 /// `f32` rounding and cost 20 coefficients and the half-angle products; these cost 14.
