@@ -26,9 +26,11 @@
 //!
 //! so the four real poles sit at r for every ω (tested up to |ω|·Ts = 3), the map is
 //! symmetric in the sign of ω, the notch is exactly at e^{jωTs}, and all gains vanish at
-//! ω = 0 so the observer freezes at standstill (paper, Fig. 2 discussion). The gains are
-//! evaluated through the half angle, 1 − a = −2j·sin(x/2)·e^{jx/2} with x = ωTs, which stays
-//! accurate in `f32` at the smallest speeds (ℓ2 → jωTs as ωTs → 0).
+//! ω = 0 so the observer freezes at standstill (paper, Fig. 2 discussion). `f64` evaluates the
+//! gains through the half angle, 1 − a = −2j·sin(x/2)·e^{jx/2} with x = ωTs; `f32` from short
+//! polynomials in x itself (`f32_gains`: 1 − cos x, sin x, 1 − r and x·cot(x/2)/2 as x², x, |x|
+//! and 1 times a polynomial), which keeps them accurate at the smallest speeds
+//! (ℓ2 → jωTs as ωTs → 0).
 
 use crate::error::{ConfigError, NonFiniteInput, check};
 use crate::{Ab, Real};
