@@ -140,21 +140,26 @@ const ATAN: [f32; 6] = [
 ];
 
 /// atan2(y, x) in [−π, π], with atan2(±0, +0) = ±0, atan2(±0, −0) = ±π as in IEEE; NaN
-/// propagates. Infinite arguments give NaN (the estimator never passes them: it rejects a
-/// non-finite state before using the angle).
+/// propagates. Infinite arguments are outside the tested range (one infinite argument gives
+/// the axis' angle, two give NaN; the estimator never passes them: it rejects a non-finite
+/// state before using the angle).
 #[inline]
 pub fn atan2(y: f32, x: f32) -> f32 {
     let (ax, ay) = (x.abs(), y.abs());
+    // Above the diagonal atan(ay/ax) = π/2 − atan(ax/ay): the quotient negated and π/2 added,
+    // chosen with the operands (one select, no second test of `swap`); bit for bit the
+    // same as π/2 − atan(ax/ay).
     let swap = ay > ax;
-    let (num, den) = if swap { (ax, ay) } else { (ay, ax) };
+    let (num, den, offset) = if swap {
+        (-ax, ay, FRAC_PI_2)
+    } else {
+        (ay, ax, 0.0)
+    };
     let t = if den == 0.0 { 0.0 } else { num / den };
     let t2 = t * t;
     let p = ATAN;
     let poly = p[0] + t2 * (p[1] + t2 * (p[2] + t2 * (p[3] + t2 * (p[4] + t2 * p[5]))));
-    let mut a = t * poly;
-    if swap {
-        a = FRAC_PI_2 - a;
-    }
+    let mut a = offset + t * poly;
     if x.is_sign_negative() {
         a = PI - a;
     }
