@@ -21,7 +21,7 @@
 //!   a deterministic error of 2e-6 rad is below a thousandth of the estimator's angle error
 //!   in every `f32` scenario (rms |θ − θ̂| 1.2e-3 to 1.9e-2 rad in fig8–fig12), and the
 //!   trackers filter it further; the degree-15 version (3.5e-7) cost 8 cycles more per step
-//!   on a Cortex-M4F (docs/firmware.md, fifth pass).
+//!   on a Cortex-M4F (docs/firmware.md, sixth pass).
 
 use core::f32::consts::{FRAC_PI_2, PI};
 
