@@ -189,8 +189,9 @@ const F32_HALF_X_COT_HALF_X: [f32; 3] = [1.0, -0.083_332_43, -0.001_400_523_4];
 /// Measured against the closed forms: |a − e^{jx}| ≤ 8.1e-8, ℓ1 and ℓ2 within 2.1e-7 and
 /// 4.0e-7 relative, |r − e^{−|x|}| ≤ 8.7e-8 (Taylor: 1.7e-7, 1.7e-7, 3.1e-7, 7.3e-8).
 ///
-/// The previous Taylor polynomials in the half angle (degrees 7, 6, 7 and 6) were accurate to
-/// `f32` rounding and cost 20 coefficients and the half-angle products; these cost 14.
+/// The previous Taylor polynomials in the half angle h (sin h/h and cos h to degree 6 in h,
+/// (1 − e^{−y})/y to degree 7 in y, h·cot h to h⁶) were accurate to `f32` rounding and cost 20
+/// coefficients and the half-angle products; these cost 14, four of them FPU immediates.
 #[inline(always)]
 fn f32_gains<T: Real>(x: T) -> DiscreteGains<T> {
     let lit = |c: f32| T::lit(c as f64);
