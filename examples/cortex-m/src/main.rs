@@ -34,6 +34,8 @@
 #![no_std]
 #![no_main]
 
+mod paper_kernel;
+
 use core::cell::{Cell, OnceCell, RefCell};
 use core::f32::consts::TAU;
 use core::panic::PanicInfo;
@@ -44,8 +46,9 @@ use cortex_m_rt::{entry, exception};
 use cortex_m_semihosting::{debug, hprintln};
 use fado_core::{
     Ab, Abc, DriveConfig, DriveOutput, Estimate, EstimatorConfig, EstimatorParams, EstimatorState,
-    EstimatorTuning, LeanEstimate, MachineModel, SensorlessDrive, SensorlessEstimator,
+    EstimatorTuning, LeanEstimate, MachineModel, Mode, SensorlessDrive, SensorlessEstimator,
 };
+use paper_kernel::{PaperKernel, paper_kernel_step};
 
 /// QEMU's MPS2 system clock (25 MHz), which clocks SysTick.
 const SYSCLK_HZ: u32 = 25_000_000;
@@ -67,37 +70,73 @@ struct Scenario {
     ramp_s: f32,
     /// Samples held at `speed_hz` after the ramp.
     hold_samples: u32,
-    rs_adaptation: bool,
+    /// Which of [`PARAMS`]: [`ADAPTIVE`], [`FIXED_RS`] or [`PAPER_PATH`].
+    params: usize,
+    /// Also step the paper's estimator alone ([`paper_kernel`]) on the same samples, and
+    /// check that it gives fado's angle (with [`PAPER_PATH`]).
+    kernel: bool,
 }
 
-const SCENARIOS: [Scenario; 4] = [
+/// Index in [`PARAMS`]: the default configuration (R̂s adaptation on).
+const ADAPTIVE: usize = 0;
+/// The default configuration with the paper's fixed R̂s (`rs_adaptation = false`).
+const FIXED_RS: usize = 1;
+/// The paper's path: fixed R̂s, and fado's other additions to the method that a switch turns
+/// off (`observer_lag_compensation`, `observer_on_rotor_flux`, `limiter_recentring` false).
+const PAPER_PATH: usize = 2;
+
+/// Largest |θ̂ − θ̂| between the paper's kernel and fado's paper's path allowed (rad): `f32`
+/// rounding level (they are meant to agree to the bit).
+const KERNEL_TOLERANCE: f32 = 1e-4;
+
+const SCENARIOS: [Scenario; 6] = [
     Scenario {
         name: "low speed, R^s adaptation",
         speed_hz: 19.5,
         ramp_s: 0.05,
         hold_samples: 1000,
-        rs_adaptation: true,
+        params: ADAPTIVE,
+        kernel: false,
     },
     Scenario {
         name: "high speed, R^s adaptation",
         speed_hz: 700.0,
         ramp_s: 0.4,
         hold_samples: 1000,
-        rs_adaptation: true,
+        params: ADAPTIVE,
+        kernel: false,
     },
     Scenario {
         name: "low speed, fixed R^s (paper)",
         speed_hz: 19.5,
         ramp_s: 0.05,
         hold_samples: 1000,
-        rs_adaptation: false,
+        params: FIXED_RS,
+        kernel: false,
     },
     Scenario {
         name: "high speed, fixed R^s (paper)",
         speed_hz: 700.0,
         ramp_s: 0.4,
         hold_samples: 1000,
-        rs_adaptation: false,
+        params: FIXED_RS,
+        kernel: false,
+    },
+    Scenario {
+        name: "low speed, paper's path (fado and the paper's kernel)",
+        speed_hz: 19.5,
+        ramp_s: 0.05,
+        hold_samples: 1000,
+        params: PAPER_PATH,
+        kernel: true,
+    },
+    Scenario {
+        name: "high speed, paper's path (fado and the paper's kernel)",
+        speed_hz: 700.0,
+        ramp_s: 0.4,
+        hold_samples: 1000,
+        params: PAPER_PATH,
+        kernel: true,
     },
 ];
 
@@ -199,13 +238,24 @@ struct App {
     worst_error: f32,
     rejected: u32,
     done: bool,
+    /// The paper's estimator alone, stepped on the same samples ([`Scenario::kernel`]).
+    kernel: Option<PaperKernel>,
+    /// Largest |θ̂_kernel − θ̂_fado| over all samples (rad).
+    kernel_diff: f32,
+    /// Largest |ω̂_kernel − ω̂_fado| of T2S-1 and T2S-2 over all samples (rad/s), and the
+    /// number of samples whose mode differs.
+    kernel_omega_diff: f32,
+    kernel_mode_diff: u32,
+    /// The kernel's worst |θ̂ − θ| over the last `hold_samples / 2` samples.
+    kernel_worst: f32,
 }
 
 static APP: Mutex<RefCell<Option<App>>> = Mutex::new(RefCell::new(None));
 
 /// The estimator's parameters, written once by `main` before the interrupt runs (index 0 with
-/// the default R̂s adaptation, 1 with the paper's fixed R̂s); read-only afterwards.
-static PARAMS: Mutex<OnceCell<[EstimatorParams<f32>; 2]>> = Mutex::new(OnceCell::new());
+/// the default R̂s adaptation, 1 with the paper's fixed R̂s, 2 the paper's path: see
+/// [`PAPER_PATH`]); read-only afterwards.
+static PARAMS: Mutex<OnceCell<[EstimatorParams<f32>; 3]>> = Mutex::new(OnceCell::new());
 
 /// Lowest stack pointer seen just before calling [`estimator_step`] (stack measurement).
 static STEP_SP: Mutex<Cell<u32>> = Mutex::new(Cell::new(u32::MAX));
@@ -293,22 +343,49 @@ impl App {
             cell.set(cell.get().min(sp));
         });
         let out = estimator_step(params, &mut self.state, v, i);
+        let kernel = self.kernel.as_mut().map(|k| {
+            if self.samples == 0 {
+                k.prime(i);
+            }
+            paper_kernel_step(k, v, i)
+        });
         self.samples += 1;
+        if let Some(k) = kernel {
+            self.kernel_diff = self.kernel_diff.max(wrap(k.theta - out.theta).abs());
+            self.kernel_omega_diff = self
+                .kernel_omega_diff
+                .max((k.omega - out.omega).abs())
+                .max((k.omega_control - out.omega_control).abs());
+            if k.limiter != (out.mode == Mode::Limiter) {
+                self.kernel_mode_diff += 1;
+            }
+        }
         if out.input_fault {
             self.rejected += 1;
         }
         if self.samples > self.total_samples - self.total_samples / 8 {
-            let mut e = out.theta - self.machine.theta;
-            if e > core::f32::consts::PI {
-                e -= TAU;
-            } else if e < -core::f32::consts::PI {
-                e += TAU;
-            }
+            let e = wrap(out.theta - self.machine.theta);
             self.worst_error = self.worst_error.max(e.abs());
+            if let Some(k) = kernel {
+                self.kernel_worst = self
+                    .kernel_worst
+                    .max(wrap(k.theta - self.machine.theta).abs());
+            }
         }
         if self.samples >= self.total_samples {
             self.done = true;
         }
+    }
+}
+
+/// A difference of two angles in [−π, π], wrapped into [−π, π].
+fn wrap(e: f32) -> f32 {
+    if e > core::f32::consts::PI {
+        e - TAU
+    } else if e < -core::f32::consts::PI {
+        e + TAU
+    } else {
+        e
     }
 }
 
@@ -349,8 +426,22 @@ fn main() -> ! {
             size_of::<SensorlessEstimator<f64>>(),
             size_of::<Estimate<f32>>()
         );
+        hprintln!(
+            "size_of: PaperKernel = {} B (constants and state of the paper's estimator alone)",
+            size_of::<PaperKernel>()
+        );
     }
     // The estimator's parameters, once (configuration checked here, not in the interrupt).
+    let paper_config = {
+        let mut config = EstimatorConfig::for_machine(&MachineModel::<f32>::paper());
+        let t = &mut config.tuning;
+        t.rs_adaptation = false;
+        t.observer_lag_compensation = false;
+        t.observer_on_rotor_flux = false;
+        t.limiter_recentring = false;
+        t.k_df_ramp_time = 0.0;
+        config
+    };
     let params = {
         let model = MachineModel::<f32>::paper();
         let build = |rs_adaptation| {
@@ -358,8 +449,12 @@ fn main() -> ! {
             config.tuning.rs_adaptation = rs_adaptation;
             EstimatorParams::new(config)
         };
-        match (build(true), build(false)) {
-            (Ok(adaptive), Ok(fixed)) => [adaptive, fixed],
+        match (
+            build(true),
+            build(false),
+            EstimatorParams::new(paper_config),
+        ) {
+            (Ok(adaptive), Ok(fixed), Ok(paper)) => [adaptive, fixed, paper],
             _ => {
                 hprintln!("invalid configuration");
                 exit(false)
@@ -393,7 +488,7 @@ fn main() -> ! {
     let (mut deepest_isr, mut deepest_step) = (0, 0);
     for (index, s) in SCENARIOS.iter().enumerate() {
         let model = MachineModel::<f32>::paper();
-        let which = if s.rs_adaptation { 0 } else { 1 };
+        let which = s.params;
         let state = EstimatorState::new(&params[which]);
         let machine = Machine::new(s, &model);
         let total_samples = (s.ramp_s * SAMPLE_HZ as f32) as u32 + s.hold_samples;
@@ -406,6 +501,11 @@ fn main() -> ! {
             worst_error: 0.0,
             rejected: 0,
             done: false,
+            kernel: s.kernel.then(|| PaperKernel::new(&paper_config)),
+            kernel_diff: 0.0,
+            kernel_omega_diff: 0.0,
+            kernel_mode_diff: 0,
+            kernel_worst: 0.0,
         };
         // The scenario marker the cost script splits the trace at.
         scenario_marker(index as u32);
@@ -415,12 +515,24 @@ fn main() -> ! {
                 *slot = Some(app);
             }
         });
-        let (worst, rejected, samples) = loop {
+        let (worst, rejected, samples, kernel) = loop {
             cortex_m::asm::wfi();
             let finished = interrupt::free(|cs| match APP.borrow(cs).try_borrow_mut() {
                 Ok(mut slot) => match slot.as_mut() {
                     Some(app) if app.done => {
-                        let r = (app.worst_error, app.rejected, app.samples);
+                        let r = (
+                            app.worst_error,
+                            app.rejected,
+                            app.samples,
+                            app.kernel.map(|_| {
+                                (
+                                    app.kernel_diff,
+                                    app.kernel_omega_diff,
+                                    app.kernel_mode_diff,
+                                    app.kernel_worst,
+                                )
+                            }),
+                        );
                         *slot = None;
                         Some(r)
                     }
@@ -449,6 +561,21 @@ fn main() -> ! {
             rejected,
             if locked { "" } else { "  NOT LOCKED" }
         );
+        if let Some((diff, omega_diff, mode_diff, kernel_worst)) = kernel {
+            let same = diff <= KERNEL_TOLERANCE && mode_diff == 0 && kernel_worst < 0.1;
+            all_locked &= same;
+            hprintln!(
+                "scenario {}: the paper's kernel: over all {} samples max |θ̂_kernel − θ̂_fado| = {} rad, max |ω̂_kernel − ω̂_fado| = {} rad/s, {} samples of another mode; worst |θ̂ − θ| over the last {} = {} rad{}",
+                index,
+                samples,
+                diff,
+                omega_diff,
+                mode_diff,
+                samples / 8,
+                kernel_worst,
+                if same { "" } else { "  NOT THE SAME METHOD" }
+            );
+        }
     }
     hprintln!(
         "deepest stack: {} B below the idle loop's stack pointer (interrupt entry with FPU \
