@@ -7,6 +7,9 @@
 # docs/firmware.md), the .text reachable from the step and from the ISR, the deepest stack
 # (painted stack, measured in the image) and size_of the estimator's state and parameters
 # (EstimatorState, EstimatorParams, in f32 and f64) and of their owner SensorlessEstimator.
+# Scenarios 4 and 5 run fado's paper's path and, beside it on the same samples, the paper's
+# estimator alone (paper_kernel_step, examples/cortex-m/src/paper_kernel.rs): both are traced
+# in the same run and reported apart (docs/firmware.md, "Seventh pass").
 # Needs qemu-system-arm and binutils-arm-none-eabi (Debian packages of those names).
 # Usage: bash scripts/firmware-cost.sh [STEPS_MEASURED_PER_SCENARIO (default 300)]
 set -euo pipefail
@@ -34,7 +37,7 @@ grep -o 'EstimatorState<f32> = .*' "$run_log" | tr ',' '\n' | sed 's/^ */    /' 
 grep -o 'deepest stack: .*' "$run_log" | sed 's/^/    /' || true
 
 echo "== code reachable from the step and from the interrupt"
-for root in estimator_step SysTick drive_step; do
+for root in estimator_step paper_kernel_step SysTick drive_step; do
     { python3 scripts/firmware_cost.py graph "$image" "$root" || true; } |
         grep -E '^(\.text reachable|OK:|FORBIDDEN)' || true
 done
@@ -42,6 +45,12 @@ done
 echo "== instruction trace (QEMU -d exec,nochain -singlestep, filtered to the step's code)"
 log=$(mktemp /tmp/fado-firmware-trace.XXXXXX)
 trap 'rm -f "$log" "$run_log"' EXIT
-filter=$(python3 scripts/firmware_cost.py ranges "$image" estimator_step scenario_marker)
+filter=$(python3 scripts/firmware_cost.py ranges "$image" estimator_step,paper_kernel_step \
+    scenario_marker)
 timeout 900 "${qemu[@]}" -singlestep -d exec,nochain -dfilter "$filter" -D "$log" >/dev/null
-python3 scripts/firmware_cost.py trace "$image" estimator_step "$log" "$tail_steps"
+echo "-- fado's step (estimator_step: scenarios 0-1 default, 2-3 fixed R̂s, 4-5 the paper's path)"
+python3 scripts/firmware_cost.py trace "$image" estimator_step "$log" "$tail_steps" \
+    paper_kernel_step
+echo "-- the paper's estimator alone (paper_kernel_step, beside fado's paper's path: scenarios 4-5)"
+python3 scripts/firmware_cost.py trace "$image" paper_kernel_step "$log" "$tail_steps" \
+    estimator_step

@@ -8,8 +8,12 @@ docs/firmware.md.
   firmware_cost.py graph ELF ROOT            functions reachable from ROOT, their .text size,
                                              and any forbidden (soft-f64, panic, fmt) symbol;
                                              exit 1 if one is reachable
-  firmware_cost.py ranges ELF ROOT EXTRA...  QEMU -dfilter ranges of ROOT's reachable code
-  firmware_cost.py trace ELF ROOT TRACE      per-step instructions and cycle estimate
+  firmware_cost.py ranges ELF ROOT[,ROOT...] EXTRA...
+                                             QEMU -dfilter ranges of the ROOTs' reachable code
+  firmware_cost.py trace ELF ROOT TRACE [TAIL [OTHER_ROOT...]]
+                                             per-step instructions and cycle estimate of ROOT
+                                             (a step ends at ROOT's next entry, or at the entry
+                                             of an OTHER_ROOT traced in the same run)
 
 Cycle model (Cortex-M4 Technical Reference Manual r0p1, table 3-1 "Cortex-M4 instruction
 set summary" and table 7-1 "FPU instruction set"), zero wait states:
@@ -139,10 +143,12 @@ def graph(elf, root):
     return bad
 
 
-def ranges(elf, root, extra):
+def ranges(elf, roots, extra):
     insns, funcs = disassemble(elf)
     calls, _ = call_graph(insns)
-    names = reachable(calls, root) | set(extra)
+    names = set(extra)
+    for root in roots.split(","):
+        names |= reachable(calls, root)
     return ",".join(
         f"0x{funcs[f][0]:x}..0x{funcs[f][1] - 1:x}" for f in sorted(names) if f in funcs
     )
@@ -245,10 +251,14 @@ def inline_files(elf, addrs, symbol_of, lines=False):
         if cur is None:
             return
         label = "other"
-        # Innermost frame that lies in fado-core (frames are listed innermost first).
+        # Innermost frame that lies in fado-core, or else in the image's own source (the
+        # paper's kernel), frames listed innermost first.
         for func, loc in frames:
-            if "fado-core/src/" in loc:
-                label = loc.split("fado-core/src/")[1].split(" ")[0]
+            src = next((d for d in ("fado-core/src/", "cortex-m/src/") if d in loc), None)
+            if src is not None:
+                label = loc.split(src)[1].split(" ")[0]
+                if src == "cortex-m/src/":
+                    label = "image:" + label
                 if not lines:
                     label = label.split(":")[0]
                 break
@@ -272,9 +282,10 @@ def inline_files(elf, addrs, symbol_of, lines=False):
     return result
 
 
-def trace(elf, root, path, tail, lines=False):
+def trace(elf, root, path, tail, lines=False, others=()):
     insns, funcs = disassemble(elf)
     entry = funcs[root][0]
+    other_entries = {funcs[o][0] for o in others if o in funcs}
     marker = funcs["scenario_marker"][0] if "scenario_marker" in funcs else None
     scenarios = []  # list of steps (list of pc lists)
     steps = None
@@ -292,19 +303,20 @@ def trace(elf, root, path, tail, lines=False):
                 steps = []
                 scenarios.append(steps)
                 continue
-            if pc == entry:
+            if pc == entry or pc in other_entries:
                 if current is not None and steps is not None:
                     steps.append(current)
-                current = [pc]
+                current = [pc] if pc == entry else None
             elif current is not None:
                 current.append(pc)
     if current is not None and steps is not None:
         steps.append(current)
-    scenarios = [s for s in scenarios if s]
     pcs = sorted({pc for s in scenarios for st in s[-tail:] for pc in st})
     files = inline_files(elf, pcs, {pc: insns[pc][3] for pc in pcs if pc in insns}, lines)
     results = []
     for index, steps in enumerate(scenarios):
+        if not steps:
+            continue  # ROOT did not run in this scenario
         measured = steps[-tail:]
         n_insn, n_cyc = [], []
         by_file = Counter()
@@ -360,7 +372,8 @@ def main():
         tail = int(sys.argv[5]) if len(sys.argv) > 5 else 300
         # FADO_COST_LINES=N: attribute to fado-core source lines and print the N dearest.
         top = int(os.environ.get("FADO_COST_LINES", "0"))
-        for r in trace(sys.argv[2], sys.argv[3], sys.argv[4], tail, top > 0):
+        others = sys.argv[6:]
+        for r in trace(sys.argv[2], sys.argv[3], sys.argv[4], tail, top > 0, others):
             print(
                 f"scenario {r['scenario']}: {r['measured']} of {r['steps']} steps measured: "
                 f"{r['insn_mean']:.0f} instructions (max {r['insn_max']}), "
