@@ -4,8 +4,12 @@
 //! Exactly the method fado's `EstimatorState::step_lean` runs on its paper's path
 //! (`rs_adaptation`, `observer_lag_compensation`, `observer_on_rotor_flux` and
 //! `limiter_recentring` all `false`, `k_df_ramp_time` 0), with the same discretisation and the
-//! same arithmetic in the same order, so that both give the same angle to the bit on the same
-//! samples (the image checks it, see `main.rs`):
+//! same arithmetic in the same order but for one thing: the trackers' conversions between
+//! radians and fixed-point units are folded into their gains (Ki·Ts·2π/2³², Ts·2³²/2π; fado
+//! multiplies by the unit at each conversion), which changes θ̂ at the `f32` rounding level.
+//! The image checks, sample by sample, that the kernel's θ̂ stays within 1e-4 rad of fado's
+//! and its mode equal (measured: within 1e-6 rad; with fado's conversions verbatim the two
+//! agreed to the bit, and cost 14 cycles more: docs/firmware.md, "Seventh pass"):
 //!
 //! - the flux integrator with the feedback of the previous sample (eq. (21) / (24)), the
 //!   resistive drop on the interval's average current (SPEC §1 \[A\]);
@@ -40,7 +44,7 @@ fn two_pi<T: Real>() -> T {
     T::two_pi()
 }
 
-/// Constants and state of the paper's estimator: 30 `f32`/`i32` fields and the mode.
+/// Constants and state of the paper's estimator: 28 `f32`/`i32` fields and the mode.
 #[derive(Clone, Copy)]
 pub struct PaperKernel {
     // Constants (from the configuration, computed as fado computes them).
@@ -54,6 +58,9 @@ pub struct PaperKernel {
     /// |ω̂2| above which the k_df mode starts, below which the limiter mode does (rad/s).
     enter: f32,
     leave: f32,
+    /// Ts·2³²/2π: θ̂⁻ − θ̂ in fixed-point units per rad/s of ω̂.
+    ts_units: f32,
+    /// Kp·Ts (units per unit of phase error) and Ki·Ts·2π/2³² (rad/s per unit) of T2S-1, T2S-2.
     kp_ts1: f32,
     ki_ts1: f32,
     kp_ts2: f32,
@@ -79,7 +86,7 @@ pub struct PaperKernel {
     kdf_mode: bool,
 }
 
-/// What the kernel returns: θ̂ and ω̂ of T2S-1, ω̂ of T2S-2, the mode.
+/// θ̂ and ω̂ of T2S-1, ω̂ of T2S-2 and the mode after a step ([`PaperKernel::output`]).
 #[derive(Clone, Copy)]
 pub struct PaperOutput {
     pub theta: f32,
@@ -104,7 +111,7 @@ impl PaperKernel {
                 definition: t.bandwidth_definition,
             }
             .gains();
-            (ts * kp, ki * ts)
+            (ts * kp, ki * ts * RAD_PER_UNIT)
         };
         let (kp_ts1, ki_ts1) = tracker(t.t2s1_bandwidth_hz);
         let (kp_ts2, ki_ts2) = tracker(t.t2s2_bandwidth_hz);
@@ -122,6 +129,7 @@ impl PaperKernel {
             leave: two_pi::<f32>() * (th - h),
             kp_ts1,
             ki_ts1,
+            ts_units: ts * UNITS_PER_RAD,
             kp_ts2,
             ki_ts2,
             lambda1_a: m.flux_linkage,
@@ -150,10 +158,10 @@ impl PaperKernel {
 }
 
 /// One sample of the paper's estimator (Fig. 5): `v_ab` the voltage over the last interval,
-/// `i_ab` the current now.
+/// `i_ab` the current now; returns θ̂ (rad, in [−π, π]).
 #[inline(never)]
 #[unsafe(no_mangle)]
-pub fn paper_kernel_step(k: &mut PaperKernel, v_ab: Ab<f32>, i_ab: Ab<f32>) -> PaperOutput {
+pub fn paper_kernel_step(k: &mut PaperKernel, v_ab: Ab<f32>, i_ab: Ab<f32>) -> f32 {
     let (va, vb, ia, ib) = (v_ab.alpha, v_ab.beta, i_ab.alpha, i_ab.beta);
     // Flux integrator, eq. (21)/(24): λ1 += Ts·(v − R̂s·ī − feedback).
     let da = (ia + k.i_prev_a) * 0.5;
@@ -173,15 +181,15 @@ pub fn paper_kernel_step(k: &mut PaperKernel, v_ab: Ab<f32>, i_ab: Ab<f32>) -> P
     let rb = (l1b - dnb) - ib * k.lq;
     let theta_m = (atan2(rb, ra) * UNITS_PER_RAD) as i32;
     // T2S-1 and T2S-2 (Fig. 1), fixed point: e = θm − θ̂⁻, ω̂ += Ki·Ts·e, θ̂ = θ̂⁻ + Kp·Ts·e,
-    // θ̂⁻ = θ̂ + Ts·ω̂.
-    let e1 = theta_m.wrapping_sub(k.pred1) as f32 * RAD_PER_UNIT;
+    // θ̂⁻ = θ̂ + Ts·ω̂, e in units (the unit conversions are in the gains).
+    let e1 = theta_m.wrapping_sub(k.pred1) as f32;
     let omega1 = k.omega1 + k.ki_ts1 * e1;
-    let theta1 = k.pred1.wrapping_add((k.kp_ts1 * e1 * UNITS_PER_RAD) as i32);
-    let e2 = theta_m.wrapping_sub(k.pred2) as f32 * RAD_PER_UNIT;
+    let theta1 = k.pred1.wrapping_add((k.kp_ts1 * e1) as i32);
+    let e2 = theta_m.wrapping_sub(k.pred2) as f32;
     let omega2 = k.omega2 + k.ki_ts2 * e2;
-    let theta2 = k.pred2.wrapping_add((k.kp_ts2 * e2 * UNITS_PER_RAD) as i32);
-    k.pred1 = theta1.wrapping_add((k.ts * omega1 * UNITS_PER_RAD) as i32);
-    k.pred2 = theta2.wrapping_add((k.ts * omega2 * UNITS_PER_RAD) as i32);
+    let theta2 = k.pred2.wrapping_add((k.kp_ts2 * e2) as i32);
+    k.pred1 = theta1.wrapping_add((k.ts_units * omega1) as i32);
+    k.pred2 = theta2.wrapping_add((k.ts_units * omega2) as i32);
     k.omega1 = omega1;
     k.omega2 = omega2;
     // Mode (Fig. 3) with hysteresis, and the feedback for the next sample.
@@ -219,10 +227,18 @@ pub fn paper_kernel_step(k: &mut PaperKernel, v_ab: Ab<f32>, i_ab: Ab<f32>) -> P
     k.z_b = zb;
     k.d_a = dna;
     k.d_b = dnb;
-    PaperOutput {
-        theta: theta1 as f32 * RAD_PER_UNIT,
-        omega: omega1,
-        omega_control: omega2,
-        limiter: !kdf_mode,
+    theta1 as f32 * RAD_PER_UNIT
+}
+
+impl PaperKernel {
+    /// The outputs of the last step, `theta` the θ̂ it returned (the step returns θ̂ alone;
+    /// the speeds and the mode are state).
+    pub fn output(&self, theta: f32) -> PaperOutput {
+        PaperOutput {
+            theta,
+            omega: self.omega1,
+            omega_control: self.omega2,
+            limiter: !self.kdf_mode,
+        }
     }
 }
