@@ -629,6 +629,9 @@ pub struct EstimatorParams<T: Real> {
     /// the low-pass c ← keep·c + input·e.
     lag_keep: T,
     lag_input: T,
+    /// `EstimatorTuning::observer_lag_compensation`: without it the low-pass is not stepped
+    /// (its state stays 0, which keep·0 + input·e with keep = input = 0 would also give).
+    lag_compensation: bool,
     /// The λ̂f law waits this many periods of the slow laws ([`SLOW_PERIOD`] samples) of the
     /// k_df mode after a hand-over (see `rs_adaptation`): two observer time constants at the
     /// Fig. 3 threshold, 2/(2π·f_th).
@@ -851,6 +854,7 @@ impl<T: Real> EstimatorParams<T> {
             offset_recentring_gain: config.tuning.offset_adaptation_rate * ts,
             initial_angle: config.initial_angle,
             observer_on_rotor_flux: config.tuning.observer_on_rotor_flux,
+            lag_compensation: config.tuning.observer_lag_compensation,
             lag_keep: if config.tuning.observer_lag_compensation {
                 T::one() - lag_gain
             } else {
@@ -1176,7 +1180,10 @@ impl<T: Real> EstimatorState<T> {
             .commit(observer_flux - shift, disturbance - shift);
         // The observer's lag compensation: Kp·e of T2S-1 through the first-order low-pass
         // (see `EstimatorTuning::observer_lag_compensation_hz`).
-        self.lag_compensation = p.lag_keep * self.lag_compensation + p.lag_input * t2s1.innovation;
+        if p.lag_compensation {
+            self.lag_compensation =
+                p.lag_keep * self.lag_compensation + p.lag_input * t2s1.innovation;
+        }
         self.t2s1.commit(t2s1);
         self.t2s2.commit(t2s2);
         self.mode = mode;

@@ -249,6 +249,10 @@ impl<T: Real> Default for DisturbanceFeedbackConfig<T> {
 pub(crate) struct DisturbanceFeedbackParams<T> {
     k_df: T,
     ramp_increment: T,
+    /// A ramp is configured (`ramp_time` > 0). Without one the gain is k_df at once:
+    /// min(g + k_df, k_df) = k_df exactly for every g ≥ 0, so the step skips the add and the
+    /// compare.
+    ramped: bool,
 }
 
 impl<T: Real> DisturbanceFeedbackParams<T> {
@@ -267,16 +271,20 @@ impl<T: Real> DisturbanceFeedbackParams<T> {
         Ok(Self {
             k_df,
             ramp_increment,
+            ramped: ramp > T::zero(),
         })
     }
 
     /// The gain the next sample uses after `gain`.
     #[inline(always)]
     pub(crate) fn next_gain(&self, gain: T, active: bool) -> T {
-        if active {
+        if !active {
+            T::zero()
+        } else if self.ramped {
             crate::real::min(gain + self.ramp_increment, self.k_df)
         } else {
-            T::zero()
+            // The gain is never negative: min(g + k_df, k_df) is k_df.
+            self.k_df
         }
     }
 }
