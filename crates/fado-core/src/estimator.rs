@@ -242,16 +242,16 @@ pub struct EstimatorTuning<T> {
     /// estimator stays in limiter mode (at a hand-over to HI mode D̂ is smaller, so the k_df
     /// transient that follows differs).
     pub limiter_recentring: bool,
-    /// A sample whose α-β current has a component beyond ± this multiple of the rated current
-    /// is refused like a non-finite one (see [`crate::plausibility`]). Default
+    /// A sample whose α-β current's magnitude reaches this multiple of the rated current is
+    /// refused like a non-finite one (see [`crate::plausibility`]). Default
     /// [`plausibility::CURRENT_RATIO`] (4; 87.1 A for the paper's motor) \[A\].
     pub plausible_current_ratio: T,
-    /// A sample whose α-β voltage has a component beyond ± this multiple of the DC-link
-    /// voltage is refused. Default [`plausibility::VOLTAGE_RATIO`] (1.5; 450 V for the
+    /// A sample whose α-β voltage's magnitude reaches this multiple of the DC-link voltage
+    /// is refused. Default [`plausibility::VOLTAGE_RATIO`] (1.5; 450 V for the
     /// paper's 300 V link) \[A\].
     pub plausible_voltage_ratio: T,
-    /// A current component that moved more than this × (plausible voltage)·ts/L̂q per sample
-    /// since the last accepted one is refused; 0 disables the test. Default
+    /// A current whose α-β vector moved by this × (plausible voltage)·ts/L̂q per sample or
+    /// more since the last accepted one is refused; 0 disables the test. Default
     /// [`plausibility::STEP_RATIO`] (2) \[A\].
     pub plausible_current_step_ratio: T,
     /// Loss of lock (see [`crate::lock`]): |λ̂r| below this multiple of λ̂f is a symptom.

@@ -1,18 +1,24 @@
 //! Plausibility of measured samples: a current or voltage the machine and inverter cannot
 //! produce is refused exactly like a non-finite one (flagged, state untouched).
 //!
-//! Three bounds, precomputed at construction so that a sample costs a few compares (no
-//! division, no square root — the same budget as the non-finite test it replaces, since
-//! `x.abs() < bound` is false for NaN and ±∞):
+//! Three bounds on magnitudes, squared at construction so that a sample costs three compares
+//! of squared magnitudes (no division, no square root, no absolute value; `x² < bound²` is
+//! false for NaN and ±∞):
 //!
-//! * every α-β current component within ±`current` (a multiple of the rated current),
-//! * every α-β voltage component within ±`voltage` (a multiple of the DC link),
-//! * every α-β current component within ±`step` of the last accepted one, per sample since
-//!   it was accepted (L·di/dt = v − R·i − e bounds the change per sample by
-//!   (|v| + |e|)·Ts/L; see [`STEP_RATIO`]).
+//! * the α-β current's magnitude |i| below `current` (a multiple of the rated current),
+//! * the α-β voltage's magnitude |v| below `voltage` (a multiple of the DC link),
+//! * the change of the α-β current since the last accepted sample, |i − i_prev|, below
+//!   `step` per sample since it was accepted (L·di/dt = v − R·i − e bounds the change per
+//!   sample by (|v| + |e|)·Ts/L; see [`STEP_RATIO`]).
 //!
-//! Components are compared, not magnitudes: the box holds the circle of the same radius, so
-//! nothing plausible is refused, and it costs no square root. The method is the ordinary
+//! Magnitudes are what the physics bounds (the rated current is a peak magnitude, the
+//! inverter's voltage a hexagon of vertex 2/3·Vdc, the change a magnitude): the disc refuses
+//! nothing the ratios below call plausible. Until 2026-11-24 (docs/firmware.md, eighth pass)
+//! each α-β component was compared instead (the square around the same disc, which also let
+//! through magnitudes up to √2 × the bound along the diagonals); three squared magnitudes cost
+//! five Cortex-M4 cycles fewer than six absolute values. A finite value whose square
+//! overflows (|x| above ≈ 1.8e19 in `f32`, 1.3e154 in `f64`) is refused like ∞, even by
+//! [`SampleBounds::unbounded`]. The method is the ordinary
 //! range-and-rate check of sensor validation (e.g. IEC 61508-7, A.7.7/A.13 "plausibility
 //! checks"; ISO 26262-5 Annex D.2.10.3 "sensor rationality check"): a value outside what
 //! the physics allows is a measurement fault, not a state of the machine. \[A\]
@@ -21,19 +27,19 @@ use crate::error::{ConfigError, check};
 use crate::machine::MachineModel;
 use crate::{Ab, Real};
 
-/// Default current bound as a multiple of the rated (peak) current: 4 \[A\]. Above the
+/// Default bound on |i| as a multiple of the rated (peak) current: 4 \[A\]. Above the
 /// over-current trip of any drive (short-time overload is 1.5–3× rated; the drive's
 /// `trip_current` acts first on anything real) and below what a 12-bit ADC front end
 /// scaled for the drive could ever report.
 pub const CURRENT_RATIO: f64 = 4.0;
 
-/// Default voltage bound as a multiple of the DC-link voltage: 1.5 \[A\]. A two-level
-/// inverter realises at most 2/3·Vdc per α-β component (hexagon vertex), so 1.5·Vdc leaves
+/// Default bound on |v| as a multiple of the DC-link voltage: 1.5 \[A\]. A two-level
+/// inverter realises at most |v| = 2/3·Vdc (the hexagon's vertex), so 1.5·Vdc leaves
 /// more than 2× margin for DC-link over-voltage and still refuses every sensor glitch of
 /// the order of kV.
 pub const VOLTAGE_RATIO: f64 = 1.5;
 
-/// Default current-step bound, in units of `voltage·Ts/L̂q`: 2 \[A\]. One sample changes the
+/// Default bound on |Δi| per sample, in units of `voltage·Ts/L̂q`: 2 \[A\]. One sample changes the
 /// current by at most (|v| + |e|)·Ts/L; |v| ≤ 2/3·Vdc and the back-EMF at rated speed
 /// |e| ≤ 2·Vdc/√3 ([`MachineModel::validate`]) give (0.67 + 1.15)·Vdc = 1.2·(1.5·Vdc), so 2
 /// covers it with 65 % margin (also L̂d down to 0.6·L̂q, noise and ADC steps).
@@ -45,12 +51,14 @@ pub struct SampleBounds<T> {
     current: T,
     voltage: T,
     step: T,
+    current_sq: T,
+    voltage_sq: T,
 }
 
 impl<T: Real> SampleBounds<T> {
-    /// Bounds from their values: `current` (A) and `voltage` (V) per α-β component (finite,
-    /// positive), `step` (A per sample) per component (positive; +∞ switches the step test
-    /// off).
+    /// Bounds from their values: `current` (A) and `voltage` (V) on the α-β magnitudes
+    /// (finite, positive), `step` (A per sample) on the magnitude of the current's change
+    /// (positive; +∞ switches the step test off).
     pub fn new(current: T, voltage: T, step: T) -> Result<Self, ConfigError> {
         let step = if step > T::zero() {
             step
@@ -59,10 +67,14 @@ impl<T: Real> SampleBounds<T> {
                 field: "plausible_current_step_ratio",
             });
         };
+        let current = check::positive("plausible_current", current)?;
+        let voltage = check::positive("plausible_voltage", voltage)?;
         Ok(Self {
-            current: check::positive("plausible_current", current)?,
-            voltage: check::positive("plausible_voltage", voltage)?,
+            current,
+            voltage,
             step,
+            current_sq: current * current,
+            voltage_sq: voltage * voltage,
         })
     }
 
@@ -79,47 +91,47 @@ impl<T: Real> SampleBounds<T> {
         )
     }
 
-    /// Only non-finite samples are refused.
+    /// Only non-finite samples are refused (and finite ones whose squared magnitude
+    /// overflows, see the module docs).
     pub fn unbounded() -> Self {
         let inf = T::lit(f64::INFINITY);
         Self {
             current: inf,
             voltage: inf,
             step: inf,
+            current_sq: inf,
+            voltage_sq: inf,
         }
     }
 
-    /// True when `v_ab` and `i_ab` are finite and within the magnitude bounds, and `i_ab`
-    /// within `samples`·step of `i_prev` (`samples` ≥ 1: samples since `i_prev` was taken).
-    /// Six compares and two subtractions; false for any NaN or ±∞.
+    /// True when |`v_ab`| < voltage, |`i_ab`| < current and |`i_ab` − `i_prev`| <
+    /// `step_allowance` (the step times the samples since `i_prev` was taken), compared
+    /// squared: three compares, seven multiplies, four additions and subtractions; false for
+    /// any NaN or ±∞.
     #[inline]
     pub fn check(&self, v_ab: Ab<T>, i_ab: Ab<T>, i_prev: Ab<T>, step_allowance: T) -> bool {
-        let (i, v) = (self.current, self.voltage);
-        (v_ab.alpha.abs() < v)
-            & (v_ab.beta.abs() < v)
-            & (i_ab.alpha.abs() < i)
-            & (i_ab.beta.abs() < i)
-            & ((i_ab.alpha - i_prev.alpha).abs() < step_allowance)
-            & ((i_ab.beta - i_prev.beta).abs() < step_allowance)
+        (v_ab.norm_squared() < self.voltage_sq)
+            & (i_ab.norm_squared() < self.current_sq)
+            & ((i_ab - i_prev).norm_squared() < step_allowance * step_allowance)
     }
 
-    /// True when `i_ab` is finite and within the current bound.
+    /// True when `i_ab` is finite and |`i_ab`| below the current bound.
     #[inline]
     pub fn current_ok(&self, i_ab: Ab<T>) -> bool {
-        (i_ab.alpha.abs() < self.current) & (i_ab.beta.abs() < self.current)
+        i_ab.norm_squared() < self.current_sq
     }
 
-    /// The current bound per component (A).
+    /// The bound on the current's magnitude (A).
     pub fn current(&self) -> T {
         self.current
     }
 
-    /// The voltage bound per component (V).
+    /// The bound on the voltage's magnitude (V).
     pub fn voltage(&self) -> T {
         self.voltage
     }
 
-    /// The current-step bound per component and sample (A).
+    /// The bound on the current's change per sample, a magnitude (A).
     pub fn step(&self) -> T {
         self.step
     }
@@ -163,9 +175,11 @@ mod tests {
             s
         ));
         let u = SampleBounds::<f32>::unbounded();
+        // (1e19)² is finite in f32; (1e20)² is not and is refused like ∞.
+        assert!(!u.check(Ab::new(1e20, 0.0), Ab::zero(), Ab::zero(), f32::INFINITY));
         assert!(u.check(
-            Ab::new(1e30, 0.0),
-            Ab::new(1e30, 0.0),
+            Ab::new(1e19, 0.0),
+            Ab::new(1e19, 0.0),
             Ab::zero(),
             f32::INFINITY
         ));
@@ -175,6 +189,49 @@ mod tests {
             Ab::zero(),
             f32::INFINITY
         ));
+    }
+
+    #[test]
+    fn bounds_are_on_magnitudes() {
+        // Each component 0.8 of the bound: inside the square, outside the disc (|x| = 1.13×).
+        let b = SampleBounds::new(10.0, 100.0, 1.0).unwrap();
+        let z = Ab::<f64>::zero();
+        assert!(!b.check(z, Ab::new(8.0, -8.0), Ab::new(8.0, -8.0), 1.0));
+        assert!(!b.check(Ab::new(-80.0, 80.0), z, z, 1.0));
+        assert!(!b.check(z, Ab::new(0.8, 0.8), z, 1.0));
+        assert!(!b.current_ok(Ab::new(8.0, 8.0)));
+        // Just inside the disc, at any angle; and exactly on it is refused (strict).
+        for k in 0..64 {
+            let a = k as f64 * core::f64::consts::TAU / 64.0;
+            let i = Ab::from_polar(9.99, a);
+            assert!(b.check(
+                Ab::from_polar(99.9, a),
+                i,
+                i - Ab::from_polar(0.999, a),
+                1.0
+            ));
+            assert!(b.current_ok(i));
+            assert!(!b.check(z, Ab::from_polar(0.999, a) * 3.0, z, 2.0), "{k}");
+            assert!(b.check(z, Ab::from_polar(0.999, a) * 3.0, z, 3.0), "{k}");
+        }
+        assert!(!b.check(Ab::new(100.0, 0.0), z, z, 1.0));
+        assert!(!b.check(z, Ab::new(0.0, 10.0), z, 1.0));
+        assert!(!b.check(z, Ab::new(1.0, 0.0), z, 1.0));
+        // f32: the same, and NaN in either component of any vector.
+        let b = SampleBounds::<f32>::new(10.0, 100.0, 1.0).unwrap();
+        let z = Ab::<f32>::zero();
+        assert!(!b.check(z, Ab::new(8.0, 8.0), Ab::new(8.0, 8.0), 1.0));
+        assert!(b.check(
+            Ab::new(70.0, 70.0),
+            Ab::new(7.0, 7.0),
+            Ab::new(6.5, 6.5),
+            1.0
+        ));
+        for n in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+            assert!(!b.check(Ab::new(0.0, n), z, z, 1.0));
+            assert!(!b.check(z, Ab::new(n, 0.0), Ab::new(n, 0.0), f32::INFINITY));
+            assert!(!b.check(z, z, Ab::new(0.0, n), 1.0));
+        }
     }
 
     #[test]
