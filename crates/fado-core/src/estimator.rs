@@ -1145,13 +1145,12 @@ impl<T: Real> EstimatorState<T> {
         // with R̂s ≥ 0: ∞·R̂s = ∞, 0·∞ = NaN, ∞ − ∞ = NaN); a tracker's ω̂ = ω̂ + Ki·Ts·e is
         // finite only if its phase error e = wrap(…) is, and then θ̂ and θ̂⁻ (wrapped sums of
         // finite values) are finite too. λ̂r and the feedback can overflow on their own.
+        // λ1 and D̂ need no test of their own: λ̂r = (λ1 − D̂) − L̂q·i (eq. (20), (5)) with a
+        // finite L̂q·i (the bounds passed) is finite only if both are (a difference with an
+        // ∞ or NaN operand is ∞ or NaN).
         let finite = all_finite([
-            lambda1.alpha,
-            lambda1.beta,
             observer_flux.alpha,
             observer_flux.beta,
-            disturbance.alpha,
-            disturbance.beta,
             lambda_r.alpha,
             lambda_r.beta,
             feedback.alpha,
