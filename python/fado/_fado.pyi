@@ -318,13 +318,13 @@ class EstimatorConfig:
         """In limiter mode, re-centre the common mode of λ1 and D̂ (fado's improvement)."""
     @property
     def plausible_current_ratio(self) -> float:
-        """Samples with an α-β current component beyond ± this × the rated current are refused."""
+        """Samples whose α-β current magnitude reaches this × the rated current are refused."""
     @property
     def plausible_voltage_ratio(self) -> float:
-        """Samples with an α-β voltage component beyond ± this × the DC-link voltage are refused."""
+        """Samples whose α-β voltage magnitude reaches this × the DC-link voltage are refused."""
     @property
     def plausible_current_step_ratio(self) -> float:
-        """Current-step bound in units of (plausible voltage)·ts/L̂q per sample (0 = off)."""
+        """Bound on |Δi| in units of (plausible voltage)·ts/L̂q per sample (0 = off)."""
     @property
     def lock_flux_low_ratio(self) -> float:
         """Loss of lock: |λ̂r|/λ̂f below this is a symptom."""
