@@ -131,6 +131,8 @@ fn bench_precision<T: Real>(c: &mut Criterion, name: &str) {
         let mut det = LockDetector::new(LockDetectorConfig {
             ts,
             flux_low_ratio: d.lock_flux_low_ratio,
+            flux_low_fast_ratio: d.lock_flux_low_fast_ratio,
+            fast_speed: T::lit(2.0 * core::f64::consts::PI * 1.3),
             flux_high_ratio: d.lock_flux_high_ratio,
             innovation_limit: d.lock_innovation_limit,
             detection_time: d.lock_detection_time,
@@ -147,6 +149,7 @@ fn bench_precision<T: Real>(c: &mut Criterion, name: &str) {
                 black_box(s.lambda_r.norm_squared()),
                 black_box(flux_sq),
                 black_box(s.theta_direct - s.omega * ts),
+                black_box(s.omega),
                 false,
             );
             det.commit(next);

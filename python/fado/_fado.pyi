@@ -201,6 +201,7 @@ class EstimatorConfig:
         plausible_voltage_ratio: float | None = None,
         plausible_current_step_ratio: float | None = None,
         lock_flux_low_ratio: float | None = None,
+        lock_flux_low_fast_ratio: float | None = None,
         lock_flux_high_ratio: float | None = None,
         lock_innovation_limit: float | None = None,
         lock_detection_time: float | None = None,
@@ -237,6 +238,7 @@ class EstimatorConfig:
         plausible_voltage_ratio: float | None = None,
         plausible_current_step_ratio: float | None = None,
         lock_flux_low_ratio: float | None = None,
+        lock_flux_low_fast_ratio: float | None = None,
         lock_flux_high_ratio: float | None = None,
         lock_innovation_limit: float | None = None,
         lock_detection_time: float | None = None,
@@ -327,7 +329,10 @@ class EstimatorConfig:
         """Bound on |Δi| in units of (plausible voltage)·ts/L̂q per sample (0 = off)."""
     @property
     def lock_flux_low_ratio(self) -> float:
-        """Loss of lock: |λ̂r|/λ̂f below this is a symptom."""
+        """Loss of lock: |λ̂r|/λ̂f below this is a symptom below the mode hand-over band."""
+    @property
+    def lock_flux_low_fast_ratio(self) -> float:
+        """Loss of lock: |λ̂r|/λ̂f below this is a symptom from the mode hand-over band up."""
     @property
     def lock_flux_high_ratio(self) -> float:
         """Loss of lock: |λ̂r|/λ̂f above this is a symptom (0: off)."""

@@ -46,6 +46,7 @@ PAPER_DEFAULTS = {
     "plausible_voltage_ratio": 1.5,  # [A]
     "plausible_current_step_ratio": 2.0,  # [A]
     "lock_flux_low_ratio": 0.7,  # [A]
+    "lock_flux_low_fast_ratio": 0.6,  # [A]
     "lock_flux_high_ratio": 1.5,  # [A]
     "lock_innovation_limit": 0.5,  # [A]
     "lock_detection_time": 5e-3,  # [A]

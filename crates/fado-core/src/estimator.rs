@@ -254,14 +254,27 @@ pub struct EstimatorTuning<T> {
     /// more since the last accepted one is refused; 0 disables the test. Default
     /// [`plausibility::STEP_RATIO`] (2) \[A\].
     pub plausible_current_step_ratio: T,
-    /// Loss of lock (see [`crate::lock`]): |λ̂r| below this multiple of λ̂f is a symptom.
-    /// Default 0.7 \[A\] (chosen on the fig11 envelope sweep, docs/lock.md). 0.65 detects as
-    /// many losses and flags one run fewer that passes the paper's criteria, but no longer
-    /// flags the start-up of fig11 with R̂s +10 % (|λ̂r| down to 0.68·λ̂f at 0.30–0.37 s), the flag
+    /// Loss of lock (see [`crate::lock`]): |λ̂r| below this multiple of λ̂f is a symptom while
+    /// |ω̂| is below the mode hand-over band (`mode_threshold_ratio` −
+    /// `mode_hysteresis_ratio`, 0.013 of the rated speed; above it,
+    /// `lock_flux_low_fast_ratio`). Default 0.7 \[A\] (chosen on the fig11 envelope sweep,
+    /// docs/lock.md). 0.65 no longer flags the start-up of fig11 with R̂s +10 % (|λ̂r| below
+    /// 0.7·λ̂f from 0.298 s at ω̂ −12 r/min, down to 0.67·λ̂f; the error passes 0.5 rad at
+    /// 0.40 s), the flag
     /// with which the `recover` reaction switches the R̂s adaptation on in time for the
     /// loaded reversal; flagged only at the loss, that run coasts under its active load and
-    /// runs away.
+    /// runs away. The same start-up dip precedes the 0.5 rad start-up excursions of the
+    /// envelope (57 of 67 flagged within 20 ms on seeds 7–14).
     pub lock_flux_low_ratio: T,
+    /// Loss of lock: |λ̂r| below this multiple of λ̂f is a symptom while |ω̂| is at or above
+    /// the lower edge of the mode hand-over band (`mode_threshold_ratio` −
+    /// `mode_hysteresis_ratio`). Default 0.6 \[A\] (docs/lock.md, 2026-11-24): accelerating
+    /// out of the reversal at light load, runs that keep the rotor dip to 0.67–0.70·λ̂f
+    /// around the limiter → k_df hand-over (at 17–29 r/min on the paper's motor; 0.7 flagged
+    /// them: 3 of 809 passing runs on seeds 7–14), while the losses this half of the symptom
+    /// alone catches go through 0.42–0.53·λ̂f; 0.55–0.65 measured alike, 0 missed 4 losses.
+    /// Equal to `lock_flux_low_ratio`, one bound at every speed (before 2026-11-24).
+    pub lock_flux_low_fast_ratio: T,
     /// Loss of lock: |λ̂r| above this multiple of λ̂f is a symptom; 0 switches it off.
     /// Default 1.5 \[A\]: above the limiter circle (1.15) and the 1.20–1.22·λ̂f overshoot
     /// after a limiter → k_df hand-over in runs that keep the rotor (a bound of 1.2
@@ -323,6 +336,7 @@ impl<T: Real> EstimatorTuning<T> {
             plausible_voltage_ratio: U::lit(self.plausible_voltage_ratio.to_f64()),
             plausible_current_step_ratio: U::lit(self.plausible_current_step_ratio.to_f64()),
             lock_flux_low_ratio: U::lit(self.lock_flux_low_ratio.to_f64()),
+            lock_flux_low_fast_ratio: U::lit(self.lock_flux_low_fast_ratio.to_f64()),
             lock_flux_high_ratio: U::lit(self.lock_flux_high_ratio.to_f64()),
             lock_innovation_limit: U::lit(self.lock_innovation_limit.to_f64()),
             lock_detection_time: U::lit(self.lock_detection_time.to_f64()),
@@ -363,6 +377,7 @@ impl<T: Real> Default for EstimatorTuning<T> {
             plausible_voltage_ratio: T::lit(plausibility::VOLTAGE_RATIO),
             plausible_current_step_ratio: T::lit(plausibility::STEP_RATIO),
             lock_flux_low_ratio: T::lit(0.7),
+            lock_flux_low_fast_ratio: T::lit(0.6),
             lock_flux_high_ratio: T::lit(1.5),
             lock_innovation_limit: T::lit(0.5),
             lock_detection_time: T::lit(5e-3),
@@ -442,6 +457,13 @@ impl<T: Real> EstimatorConfig<T> {
         LockDetectorConfig {
             ts: self.slow_ts(),
             flux_low_ratio: self.tuning.lock_flux_low_ratio,
+            flux_low_fast_ratio: self.tuning.lock_flux_low_fast_ratio,
+            // The speed below which the estimator is in limiter mode whatever its history
+            // (the mode selector's exit speed).
+            fast_speed: crate::real::max(
+                T::two_pi() * (self.mode_threshold_hz() - self.mode_hysteresis_hz()),
+                T::zero(),
+            ),
             flux_high_ratio: self.tuning.lock_flux_high_ratio,
             innovation_limit: self.tuning.lock_innovation_limit,
             detection_time: self.tuning.lock_detection_time,
@@ -1120,8 +1142,9 @@ impl<T: Real> EstimatorState<T> {
                 (l.feedback, l.clamping)
             }
         };
-        // Loss-of-lock symptoms (see `lock`), in the detector's slot: |λ̂r| against λ̂f, the
-        // T2S-1 innovation.
+        // Loss-of-lock symptoms (see `lock`), in the detector's slot: |λ̂r| against λ̂f (the
+        // lower bound chosen by the control speed ω̂ of the mode selector), the T2S-1
+        // innovation.
         // (Outside its slot the detector's state is neither copied nor written back.)
         // The innovation is T2S-1's phase error of this sample (0 when the trackers coasted).
         let lock = if slot == SLOT_LOCK {
@@ -1130,6 +1153,7 @@ impl<T: Real> EstimatorState<T> {
                 lambda_r.norm_squared(),
                 flux_hat * flux_hat * active_ratio * active_ratio,
                 t2s1.innovation,
+                t2s2.omega,
                 clamping,
             ))
         } else {

@@ -24,7 +24,12 @@
 //!
 //! The upper half of symptom 1 (|λ̂r| above the band) is set wide by default (1.5·λ̂f): on
 //! the fig11 envelope a tight bound's alarms came from the |λ̂r| overshoot after a limiter →
-//! k_df hand-over in runs that kept the rotor (docs/lock.md). Near zero speed, where a
+//! k_df hand-over in runs that kept the rotor (docs/lock.md). The lower half depends on the
+//! speed estimate: 0.7·λ̂f below the mode hand-over band (where the start-up dip that
+//! precedes a 0.5 rad start-up excursion sits), 0.6·λ̂f from the band's lower edge up, where
+//! runs that keep the rotor dip to 0.67–0.70·λ̂f accelerating out of the reversal at light
+//! load and the losses that only this symptom catches go through 0.42–0.53·λ̂f
+//! (docs/lock.md, 2026-11-24). Near zero speed, where a
 //! surface-magnet rotor's angle is not observable from v and i (an integrand error ΔR̂s·i
 //! along q̂ turns λ̂r without changing |λ̂r|), a loss shows first on the mechanical side; the
 //! drive adds that symptom (a speed-loop stall in limiter mode while the loop commands a
@@ -200,8 +205,13 @@ pub struct LockDetectorConfig<T> {
     /// the estimator runs it once every N samples (each verdict then stands for N·Ts of
     /// symptomatic or clean time).
     pub ts: T,
-    /// |λ̂r| below this multiple of λ̂f is suspicious.
+    /// |λ̂r| below this multiple of λ̂f is suspicious while |ω̂| is below `fast_speed`.
     pub flux_low_ratio: T,
+    /// |λ̂r| below this multiple of λ̂f is suspicious while |ω̂| is at or above `fast_speed`.
+    pub flux_low_fast_ratio: T,
+    /// Speed (rad/s, electrical) from which `flux_low_fast_ratio` applies instead of
+    /// `flux_low_ratio`; the estimator passes the lower edge of its mode hand-over band.
+    pub fast_speed: T,
     /// |λ̂r| above this multiple of λ̂f is suspicious; 0 switches this half of the test off.
     pub flux_high_ratio: T,
     /// |θm − θ̂⁻| above this (rad) is suspicious.
@@ -220,6 +230,8 @@ pub struct LockDetectorConfig<T> {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct LockDetectorParams<T> {
     low_sq: T,
+    low_fast_sq: T,
+    fast_speed: T,
     high_sq: T,
     innovation_limit: T,
     /// The debouncer's limits, with its state cleared.
@@ -235,6 +247,9 @@ impl<T: Real> LockDetectorParams<T> {
         let low = check::non_negative("lock_flux_low_ratio", c.flux_low_ratio)?;
         let high = check::non_negative("lock_flux_high_ratio", c.flux_high_ratio)?;
         check::below("lock_flux_low_ratio", low, T::one(), "below 1")?;
+        let low_fast = check::non_negative("lock_flux_low_fast_ratio", c.flux_low_fast_ratio)?;
+        check::below("lock_flux_low_fast_ratio", low_fast, T::one(), "below 1")?;
+        let fast_speed = check::non_negative("mode_threshold_ratio", c.fast_speed)?;
         // 0 = off: an infinite bound that no |λ̂r| exceeds (the compare stays, no branch).
         let high_sq = if high == T::zero() {
             T::lit(f64::INFINITY)
@@ -252,6 +267,8 @@ impl<T: Real> LockDetectorParams<T> {
         let heal = samples("lock_heal_time", c.heal_time, ts)?;
         Ok(Self {
             low_sq: low * low,
+            low_fast_sq: low_fast * low_fast,
+            fast_speed,
             high_sq,
             innovation_limit: innovation,
             counter: Debouncer::new(limit, heal),
@@ -260,8 +277,9 @@ impl<T: Real> LockDetectorParams<T> {
     }
 
     /// The state after one sample `s`: `lambda_r_sq` = |λ̂r|², `flux_sq` = λ̂f²,
-    /// `innovation` = wrap(θm − θ̂⁻) (0 when the trackers coasted), `clamping` = the limiter
-    /// clamped this sample. Four multiplications, five compares.
+    /// `innovation` = wrap(θm − θ̂⁻) (0 when the trackers coasted), `omega` = ω̂ (rad/s,
+    /// electrical; it picks the lower flux bound), `clamping` = the limiter clamped this
+    /// sample. Four multiplications, six compares.
     #[inline(always)]
     pub(crate) fn next_state(
         &self,
@@ -269,9 +287,15 @@ impl<T: Real> LockDetectorParams<T> {
         lambda_r_sq: T,
         flux_sq: T,
         innovation: T,
+        omega: T,
         clamping: bool,
     ) -> DebouncerState {
-        let suspicious = (lambda_r_sq < self.low_sq * flux_sq)
+        let low_sq = if omega.abs() < self.fast_speed {
+            self.low_sq
+        } else {
+            self.low_fast_sq
+        };
+        let suspicious = (lambda_r_sq < low_sq * flux_sq)
             | (lambda_r_sq > self.high_sq * flux_sq)
             | (innovation.abs() > self.innovation_limit)
             | (clamping & self.clamping);
@@ -303,18 +327,25 @@ impl<T: Real> LockDetector<T> {
 
     /// The state after one sample, without changing `self`: `lambda_r_sq` = |λ̂r|²,
     /// `flux_sq` = λ̂f², `innovation` = wrap(θm − θ̂⁻) (0 when the trackers coasted),
-    /// `clamping` = the limiter clamped this sample. Four multiplications, five compares.
+    /// `omega` = ω̂ (rad/s, electrical), `clamping` = the limiter clamped this sample. Four
+    /// multiplications, six compares.
     #[inline]
     pub fn next_state(
         &self,
         lambda_r_sq: T,
         flux_sq: T,
         innovation: T,
+        omega: T,
         clamping: bool,
     ) -> Debouncer {
-        let next = self
-            .params
-            .next_state(self.state, lambda_r_sq, flux_sq, innovation, clamping);
+        let next = self.params.next_state(
+            self.state,
+            lambda_r_sq,
+            flux_sq,
+            innovation,
+            omega,
+            clamping,
+        );
         self.params.counter.with_state(next)
     }
 
@@ -345,6 +376,8 @@ mod tests {
         LockDetectorConfig {
             ts: 1e-4,
             flux_low_ratio: 0.5,
+            flux_low_fast_ratio: 0.5,
+            fast_speed: 10.0,
             flux_high_ratio: 1.3,
             innovation_limit: 0.5,
             detection_time: time,
@@ -358,7 +391,11 @@ mod tests {
     }
 
     fn step(d: &mut LockDetector<f64>, ratio: f64, innovation: f64) -> LockStatus {
-        let s = d.next_state(ratio * ratio, 1.0, innovation, false);
+        step_at(d, ratio, innovation, 0.0)
+    }
+
+    fn step_at(d: &mut LockDetector<f64>, ratio: f64, innovation: f64, omega: f64) -> LockStatus {
+        let s = d.next_state(ratio * ratio, 1.0, innovation, omega, false);
         d.commit(s);
         d.status()
     }
@@ -417,6 +454,47 @@ mod tests {
     }
 
     #[test]
+    fn the_lower_flux_bound_depends_on_the_speed() {
+        // 0.7 below |ω̂| = 10 rad/s, 0.6 from there on (either sign of ω̂).
+        let c = LockDetectorConfig {
+            flux_low_ratio: 0.7,
+            flux_low_fast_ratio: 0.6,
+            ..detector_config(1e-4)
+        };
+        for omega in [0.0, 9.99, -9.99] {
+            let mut d = LockDetector::new(c).unwrap();
+            assert_eq!(
+                step_at(&mut d, 0.65, 0.0, omega),
+                LockStatus::Lost,
+                "{omega}"
+            );
+            let mut d = LockDetector::new(c).unwrap();
+            assert_eq!(
+                step_at(&mut d, 0.71, 0.0, omega),
+                LockStatus::Locked,
+                "{omega}"
+            );
+        }
+        for omega in [10.0, -10.0, 1e4] {
+            let mut d = LockDetector::new(c).unwrap();
+            assert_eq!(
+                step_at(&mut d, 0.65, 0.0, omega),
+                LockStatus::Locked,
+                "{omega}"
+            );
+            let mut d = LockDetector::new(c).unwrap();
+            assert_eq!(
+                step_at(&mut d, 0.59, 0.0, omega),
+                LockStatus::Lost,
+                "{omega}"
+            );
+        }
+        // A NaN speed takes the fast bound (the estimator refuses such a sample anyway).
+        let mut d = LockDetector::new(c).unwrap();
+        assert_eq!(step_at(&mut d, 0.59, 0.0, f64::NAN), LockStatus::Lost);
+    }
+
+    #[test]
     fn debouncer_heal_zero_clears_at_the_first_clean_sample() {
         let mut b = Debouncer::new(3, 0);
         assert!(!b.step(true) && !b.step(true) && b.step(true));
@@ -430,6 +508,8 @@ mod tests {
         let c = LockDetectorConfig {
             ts: 1e-4,
             flux_low_ratio: 0.5,
+            flux_low_fast_ratio: 0.5,
+            fast_speed: 10.0,
             flux_high_ratio: 1.3,
             innovation_limit: 0.5,
             detection_time: 0.01,
@@ -443,6 +523,13 @@ mod tests {
                 ..c
             }),
             "lock_flux_low_ratio"
+        );
+        assert_eq!(
+            e(LockDetectorConfig {
+                flux_low_fast_ratio: -0.1,
+                ..c
+            }),
+            "lock_flux_low_fast_ratio"
         );
         assert_eq!(
             e(LockDetectorConfig {
