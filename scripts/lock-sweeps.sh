@@ -3,7 +3,8 @@
 # adaptation, each with and without the limiter-clamping symptom; 400 random points, seed 7.
 # usage: [SEED=N] [VARIANTS="fixed-rs adaptive"] scripts/lock-sweeps.sh OUT_DIR
 #        (then scripts/lock-eval.py, see docs/lock.md). SEED (default 7) draws other points of
-#        the same design (seeds 7-10 tuned the detector, 11-12 are the hold-out); VARIANTS
+#        the same design (seeds 7-14 tuned the detector, 15-16 were seen, 17-20 are the
+#        hold-out of the speed-dependent lower flux bound, docs/lock.md); VARIANTS
 #        (default all four) picks the configurations.
 set -euo pipefail
 out=${1:?usage: scripts/lock-sweeps.sh OUT_DIR}
