@@ -736,31 +736,6 @@ fn stall_symptom_flags_a_lost_reference_below_the_current_limit() {
     assert_eq!(run(&off, &[(20, 0.0), (500, 8.0)]).0, None);
 }
 
-/// Reports k_df mode and a fixed ω̂ (`omega_control`, electrical rad/s), like an estimate that
-/// has lost the rotor just above the mode threshold.
-struct KdfSpy {
-    omega: f64,
-}
-
-impl RotorAngleEstimator<f64> for KdfSpy {
-    fn step(&mut self, _v_ab: Ab<f64>, _i_ab: Ab<f64>) -> Estimate<f64> {
-        Estimate {
-            theta: 0.0,
-            omega: self.omega,
-            omega_control: self.omega,
-            diagnostics: Diagnostics {
-                mode: fado_core::Mode::DisturbanceFeedback,
-                ..Diagnostics::default()
-            },
-        }
-    }
-    fn align(&mut self, _theta0: f64, _i_ab: Ab<f64>) {}
-    fn reset(&mut self) {}
-    fn name(&self) -> &'static str {
-        "kdf-spy"
-    }
-}
-
 /// The stall symptom also counts in k_df mode below `lock_stall_kdf_speed_ratio` (0.02) of
 /// the rated speed (docs/lock.md: heavy-load losses in k_df mode just above the 0.015 mode
 /// threshold): ω̂ held at 0.0175·rated in k_df mode, the speed loop catches a reference equal
@@ -782,7 +757,17 @@ fn stall_symptom_counts_in_kdf_mode_just_above_the_threshold() {
             c.tuning.lock_stall_kdf_speed_ratio = kdf_ratio;
             let omega = speed_ratio * machine.rated_speed();
             let caught = omega / machine.pole_pairs as f64;
-            let mut drive = SensorlessDrive::with_estimator(c, KdfSpy { omega }).unwrap();
+            let mut drive = SensorlessDrive::with_estimator(
+                c,
+                SpeedSpy {
+                    omega0: omega,
+                    accel: 0.0,
+                    ts: 0.0,
+                    n: 0,
+                    mode: fado_core::Mode::DisturbanceFeedback,
+                },
+            )
+            .unwrap();
             drive.align(0.0);
             let mut first = None;
             for n in 0..520 {
@@ -800,23 +785,25 @@ fn stall_symptom_counts_in_kdf_mode_just_above_the_threshold() {
     }
 }
 
-/// An estimator whose speed ramps from `omega0` at `accel` (electrical rad/s, rad/s²) in
-/// limiter mode, its angle held: what the drive's stall symptom sees of an estimate that
-/// follows (or does not follow) the torque.
-struct RampSpy {
+/// An estimator whose speed ramps from `omega0` at `accel` (electrical rad/s, rad/s²) after
+/// `CATCH` samples, in the given mode, its angle held: what the drive's stall symptom sees of
+/// an estimate that follows (or does not follow) the torque; with `accel` 0 in k_df mode, an
+/// estimate that has lost the rotor just above the mode threshold.
+struct SpeedSpy {
     omega0: f64,
     accel: f64,
     ts: f64,
     n: u32,
+    mode: fado_core::Mode,
 }
 
-impl RampSpy {
+impl SpeedSpy {
     fn omega(&self) -> f64 {
         self.omega0 + self.accel * self.ts * self.n.saturating_sub(CATCH) as f64
     }
 }
 
-impl RotorAngleEstimator<f64> for RampSpy {
+impl RotorAngleEstimator<f64> for SpeedSpy {
     fn step(&mut self, _v_ab: Ab<f64>, _i_ab: Ab<f64>) -> Estimate<f64> {
         let omega = self.omega();
         self.n += 1;
@@ -825,7 +812,7 @@ impl RotorAngleEstimator<f64> for RampSpy {
             omega,
             omega_control: omega,
             diagnostics: Diagnostics {
-                mode: fado_core::Mode::Limiter,
+                mode: self.mode,
                 ..Diagnostics::default()
             },
         }
@@ -833,11 +820,11 @@ impl RotorAngleEstimator<f64> for RampSpy {
     fn align(&mut self, _theta0: f64, _i_ab: Ab<f64>) {}
     fn reset(&mut self) {}
     fn name(&self) -> &'static str {
-        "ramp-spy"
+        "speed-spy"
     }
 }
 
-/// Samples the speed loop holds the reference equal to ω̂ before `RampSpy` ramps.
+/// Samples the speed loop holds the reference equal to ω̂ before `SpeedSpy` ramps.
 const CATCH: u32 = 600;
 
 /// The stall symptom does not count while the estimated rotor answers the torque
@@ -873,11 +860,12 @@ fn stall_symptom_spares_an_estimate_that_answers_the_torque() {
             c.tuning.lock_stall_follow_min_current_ratio = gate;
             let ts = c.ts;
             c.tuning.lock_stall_follow_accel_ratio = 0.005;
-            let spy = RampSpy {
+            let spy = SpeedSpy {
                 omega0,
                 accel,
                 ts,
                 n: 0,
+                mode: fado_core::Mode::Limiter,
             };
             let p = machine.pole_pairs as f64;
             let mut drive = SensorlessDrive::with_estimator(c, spy).unwrap();
