@@ -25,7 +25,11 @@ columns are computed by `fado_sim::Metrics`):
   clean    = max |θ − θ̂| < 0.25 rad; false alarm = LOCK_LOST raised at all in a clean run.
 Also: runs passing the paper's criteria (sweep `passed`) in which LOCK_LOST was raised.
 
-usage: scripts/lock-eval.py LABEL=DIR/sweep.csv ... [--figure docs/lock-detection.png]
+Runs that tripped (sweep status `diverged`) are left out unless --with-tripped (they keep their
+angle-error and LOCK_LOST columns up to the trip; on fig11 there is at most one a seed, on other
+motors' envelopes many, docs/lock.md "Other motors").
+
+usage: scripts/lock-eval.py LABEL=DIR/sweep.csv ... [--with-tripped] [--figure docs/lock-detection.png]
 """
 
 import csv
@@ -36,8 +40,12 @@ DEADLINE = 0.020
 LEAD = 1.0  # X: earliest rise that counts, s before t0
 
 
+WITH_TRIPPED = False
+
+
 def load(path):
-    rows = [r for r in csv.DictReader(open(path)) if r["status"] == "ok"]
+    keep = ("ok", "diverged") if WITH_TRIPPED else ("ok",)
+    rows = [r for r in csv.DictReader(open(path)) if r["status"] in keep]
 
     def f(r, k):
         return float(r[k]) if r.get(k, "") != "" else math.nan
@@ -98,6 +106,10 @@ def ms(x):
 
 
 def main(argv):
+    global WITH_TRIPPED
+    if "--with-tripped" in argv:
+        WITH_TRIPPED = True
+        argv = [a for a in argv if a != "--with-tripped"]
     fig = None
     if "--figure" in argv:
         k = argv.index("--figure")
