@@ -736,6 +736,18 @@ fn stall_symptom_flags_a_lost_reference_below_the_current_limit() {
     assert_eq!(run(&off, &[(20, 0.0), (500, 8.0)]).0, None);
 }
 
+/// `machine`'s drive with the start-up calibrations and the stuck-sensor check off and the
+/// current limits out of the way, for the stall-symptom tests with a spy estimator.
+fn stall_test_config(machine: &MachineModel<f64>) -> DriveConfig<f64> {
+    let mut c = DriveConfig::for_machine(machine);
+    c.tuning.offset_calibration_time = 0.0;
+    c.tuning.gain_calibration_time = 0.0;
+    c.tuning.stuck_sensor_time = 0.0;
+    c.tuning.current_limit_ratio = 100.0;
+    c.tuning.trip_current_ratio = 200.0;
+    c
+}
+
 /// The stall symptom also counts in k_df mode below `lock_stall_kdf_speed_ratio` (0.02) of
 /// the rated speed (docs/lock.md: heavy-load losses in k_df mode just above the 0.015 mode
 /// threshold): ω̂ held at 0.0175·rated in k_df mode, the speed loop catches a reference equal
@@ -748,12 +760,7 @@ fn stall_symptom_counts_in_kdf_mode_just_above_the_threshold() {
     let ipmsm = common::ipmsm_model();
     for machine in [MachineModel::paper(), ipmsm] {
         let run = |speed_ratio: f64, kdf_ratio: f64| {
-            let mut c = DriveConfig::for_machine(&machine);
-            c.tuning.offset_calibration_time = 0.0;
-            c.tuning.gain_calibration_time = 0.0;
-            c.tuning.stuck_sensor_time = 0.0;
-            c.tuning.current_limit_ratio = 100.0;
-            c.tuning.trip_current_ratio = 200.0;
+            let mut c = stall_test_config(&machine);
             c.tuning.lock_stall_kdf_speed_ratio = kdf_ratio;
             let omega = speed_ratio * machine.rated_speed();
             let caught = omega / machine.pole_pairs as f64;
@@ -849,12 +856,7 @@ fn stall_symptom_spares_an_estimate_that_answers_the_torque() {
         // 0.3 of the rated speed per second: ω̂ stays far inside the k_df threshold.
         let ramp = 0.3 * machine.rated_speed();
         let run = |omega0: f64, accel: f64, follow_time: f64, gate: f64| {
-            let mut c = DriveConfig::for_machine(&machine);
-            c.tuning.offset_calibration_time = 0.0;
-            c.tuning.gain_calibration_time = 0.0;
-            c.tuning.stuck_sensor_time = 0.0;
-            c.tuning.current_limit_ratio = 100.0;
-            c.tuning.trip_current_ratio = 200.0;
+            let mut c = stall_test_config(&machine);
             c.tuning.lock_stall_min_current_ratio = 0.0;
             c.tuning.lock_stall_follow_time = follow_time;
             c.tuning.lock_stall_follow_min_current_ratio = gate;
