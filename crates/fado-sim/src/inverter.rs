@@ -816,7 +816,7 @@ mod tests {
         let v_ref = i_ab * mp.rs;
         let rot = fado_core::Rotation::from_angle(theta);
         let i_dq = i_ab.to_dq(rot);
-        let c = comp.phase_voltages_for(rot, i_dq, Abc::default(), v_ref, vdc);
+        let c = comp.phase_voltages(rot, i_dq, Abc::default(), v_ref, vdc);
         let v = v_ref.to_abc();
         let pole = [v.a + c.a, v.b + c.b, v.c + c.c];
         let v0 = -0.5 * (pole[0].max(pole[1]).max(pole[2]) + pole[0].min(pole[1]).min(pole[2]));

@@ -194,30 +194,11 @@ impl<T: Real> DeadTimeCompensation<T> {
 
     /// The compensation for one sample as per-phase voltages: `rotation` is e^{j(θ̂+1.5ω̂Ts)}
     /// (the delay-compensated angle), `i_dq_ref` the current reference, `i_abc` the measured
-    /// phase currents (used by [`DeadTimeMethod::Sign`] only). Zero when disabled; a
-    /// non-finite input gives zero.
+    /// phase currents (used by [`DeadTimeMethod::Sign`] only), `v_ab` the voltage reference
+    /// (V, before compensation; used by [`DeadTimeMethod::EdgeCurrent`] only, for the ripple).
+    /// Zero when disabled; a non-finite input gives zero.
     #[inline]
     pub fn phase_voltages(
-        &self,
-        rotation: Rotation<T>,
-        i_dq_ref: Dq<T>,
-        i_abc: Abc<T>,
-        vdc: T,
-    ) -> Abc<T> {
-        let out = match self.config.method {
-            _ if !self.config.enabled => return Abc::default(),
-            DeadTimeMethod::Trapezoidal | DeadTimeMethod::EdgeCurrent => {
-                self.trapezoid(i_dq_ref.to_ab(rotation).to_abc(), vdc)
-            }
-            DeadTimeMethod::Sign => self.sign(i_abc, vdc),
-        };
-        if out.is_finite() { out } else { Abc::default() }
-    }
-
-    /// As [`phase_voltages`](Self::phase_voltages), with the voltage reference `v_ab` (V,
-    /// before compensation) that [`DeadTimeMethod::EdgeCurrent`] needs for the ripple.
-    #[inline]
-    pub fn phase_voltages_for(
         &self,
         rotation: Rotation<T>,
         i_dq_ref: Dq<T>,
@@ -225,15 +206,17 @@ impl<T: Real> DeadTimeCompensation<T> {
         v_ab: Ab<T>,
         vdc: T,
     ) -> Abc<T> {
-        if !(self.config.enabled && self.config.method == DeadTimeMethod::EdgeCurrent) {
-            return self.phase_voltages(rotation, i_dq_ref, i_abc, vdc);
-        }
-        let out = self.edge_current(
-            rotation,
-            i_dq_ref.to_ab(rotation).to_abc(),
-            v_ab.to_abc(),
-            vdc,
-        );
+        let out = match self.config.method {
+            _ if !self.config.enabled => return Abc::default(),
+            DeadTimeMethod::Trapezoidal => self.trapezoid(i_dq_ref.to_ab(rotation).to_abc(), vdc),
+            DeadTimeMethod::EdgeCurrent => self.edge_current(
+                rotation,
+                i_dq_ref.to_ab(rotation).to_abc(),
+                v_ab.to_abc(),
+                vdc,
+            ),
+            DeadTimeMethod::Sign => self.sign(i_abc, vdc),
+        };
         if out.is_finite() { out } else { Abc::default() }
     }
 
@@ -344,14 +327,7 @@ impl<T: Real> DeadTimeCompensation<T> {
     /// The compensation as an α-β vector (Clarke of [`phase_voltages`](Self::phase_voltages)),
     /// to add to v*_ab before modulation.
     #[inline]
-    pub fn step(&self, rotation: Rotation<T>, i_dq_ref: Dq<T>, i_abc: Abc<T>, vdc: T) -> Ab<T> {
-        self.phase_voltages(rotation, i_dq_ref, i_abc, vdc).to_ab()
-    }
-
-    /// As [`step`](Self::step) with the voltage reference `v_ab` (V, before compensation):
-    /// the drive's call ([`phase_voltages_for`](Self::phase_voltages_for)).
-    #[inline]
-    pub fn step_for(
+    pub fn step(
         &self,
         rotation: Rotation<T>,
         i_dq_ref: Dq<T>,
@@ -359,7 +335,7 @@ impl<T: Real> DeadTimeCompensation<T> {
         v_ab: Ab<T>,
         vdc: T,
     ) -> Ab<T> {
-        self.phase_voltages_for(rotation, i_dq_ref, i_abc, v_ab, vdc)
+        self.phase_voltages(rotation, i_dq_ref, i_abc, v_ab, vdc)
             .to_ab()
     }
 
@@ -395,7 +371,13 @@ mod tests {
         assert_eq!(off.amplitude(300.0), 0.0);
         let rot = Rotation::from_angle(0.2);
         assert_eq!(
-            off.step(rot, Dq::new(0.0, 10.0), Abc::new(1.0, 2.0, -3.0), 300.0),
+            off.step(
+                rot,
+                Dq::new(0.0, 10.0),
+                Abc::new(1.0, 2.0, -3.0),
+                Ab::zero(),
+                300.0
+            ),
             Ab::zero()
         );
     }
@@ -406,7 +388,7 @@ mod tests {
         let vhat = c.amplitude(300.0);
         let (theta_adv, i_ref) = (0.4, Dq::new(1.0, 5.0));
         let rot = Rotation::from_angle(theta_adv);
-        let v = c.phase_voltages(rot, i_ref, Abc::default(), 300.0);
+        let v = c.phase_voltages(rot, i_ref, Abc::default(), Ab::zero(), 300.0);
         let theta_i = theta_adv + 5.0_f64.atan2(1.0);
         let mag = i_ref.norm();
         for (vx, phi) in [(v.a, 0.0), (v.b, 2.0 * PI / 3.0), (v.c, -2.0 * PI / 3.0)] {
@@ -424,6 +406,7 @@ mod tests {
                     Rotation::from_angle(th),
                     Dq::new(2.0, 0.0),
                     Abc::default(),
+                    Ab::zero(),
                     300.0,
                 )
                 .a;
@@ -449,6 +432,7 @@ mod tests {
             Rotation::from_angle(0.0),
             Dq::new(10.0, 0.0),
             Abc::new(0.01, -0.02, 0.0),
+            Ab::zero(),
             300.0,
         );
         assert_eq!(v, Abc::new(4.75, -4.75, 0.0));
@@ -457,6 +441,7 @@ mod tests {
             Rotation::from_angle(0.0),
             Dq::zero(),
             Abc::new(1.0, -0.5, -0.5),
+            Ab::zero(),
             300.0,
         );
         assert!((ab.alpha - 4.75 * (2.0 + 2.0) / 3.0).abs() < 1e-12 && ab.beta.abs() < 1e-12);
@@ -483,8 +468,8 @@ mod tests {
             (Ab::new(-2.0, 8.0), Ab::new(-60.0, 90.0)),
         ] {
             let i_dq = Dq::new(i.alpha, i.beta);
-            let e = c.phase_voltages_for(rot, i_dq, Abc::default(), v, 300.0);
-            let p = t.phase_voltages(rot, i_dq, Abc::default(), 300.0);
+            let e = c.phase_voltages(rot, i_dq, Abc::default(), v, 300.0);
+            let p = t.phase_voltages(rot, i_dq, Abc::default(), v, 300.0);
             assert!((e.a - p.a).abs() < 1e-12 && (e.b - p.b).abs() < 1e-12);
             assert!((e.c - p.c).abs() < 1e-12, "{e:?} vs {p:?}");
         }
@@ -496,8 +481,8 @@ mod tests {
             let v = i * 0.327;
             let i_dq = Dq::new(i.alpha, i.beta);
             let neg = Dq::new(-i.alpha, -i.beta);
-            let e = c.phase_voltages_for(rot, i_dq, Abc::default(), v, 300.0);
-            let f = c.phase_voltages_for(rot, neg, Abc::default(), v * -1.0, 300.0);
+            let e = c.phase_voltages(rot, i_dq, Abc::default(), v, 300.0);
+            let f = c.phase_voltages(rot, neg, Abc::default(), v * -1.0, 300.0);
             assert!(
                 (e.a + f.a).abs() < 1e-9 && (e.b + f.b).abs() < 1e-9,
                 "{e:?} {f:?}"
@@ -506,10 +491,13 @@ mod tests {
         }
         // No inductance or no DC link: the trapezoid.
         let i = Dq::new(-0.1, 0.2);
-        let e = edge(0.0).phase_voltages_for(rot, i, Abc::default(), Ab::new(1.0, 0.0), 300.0);
-        assert_eq!(e, t.phase_voltages(rot, i, Abc::default(), 300.0));
+        let e = edge(0.0).phase_voltages(rot, i, Abc::default(), Ab::new(1.0, 0.0), 300.0);
         assert_eq!(
-            c.phase_voltages_for(rot, i, Abc::default(), Ab::new(1.0, 0.0), -1.0),
+            e,
+            t.phase_voltages(rot, i, Abc::default(), Ab::zero(), 300.0)
+        );
+        assert_eq!(
+            c.phase_voltages(rot, i, Abc::default(), Ab::new(1.0, 0.0), -1.0),
             Abc::default()
         );
     }

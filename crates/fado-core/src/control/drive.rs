@@ -844,7 +844,7 @@ impl<T: Real> Blocks<T> {
         i_abc: Abc<T>,
         vdc: T,
     ) -> Option<Applied<T>> {
-        let v_comp = self.dead_time.step_for(rot, i_dq_ref, i_abc, v_ab, vdc);
+        let v_comp = self.dead_time.step(rot, i_dq_ref, i_abc, v_ab, vdc);
         let m = self.modulator.step(v_ab + v_comp, vdc);
         let (v_ab, v_dq) = if !m.saturated {
             (v_ab, v_dq) // exactly what was asked for: nothing to back-calculate
