@@ -170,14 +170,18 @@ fn duties_realise_the_reference_plus_the_dead_time_compensation() {
         ..Spy::default()
     };
     let mut drive = SensorlessDrive::with_estimator(cfg, spy).unwrap();
-    let dtc = DeadTimeCompensation::new(DeadTimeCompensationConfig::default()).unwrap();
+    let dtc = DeadTimeCompensation::new(DeadTimeCompensationConfig {
+        method: DeadTimeMethod::Trapezoidal,
+        ..DeadTimeCompensationConfig::default()
+    })
+    .unwrap();
     let mut saturated = 0;
     for n in 0..200 {
         let vdc = if n % 3 == 0 { 20.0 } else { 300.0 };
         let i = currents(n);
         let o = drive.step(i, vdc, 80.0);
         let adv = Rotation::from_angle(o.estimate.theta + 1.5 * o.estimate.omega * 100e-6);
-        let comp = dtc.step(adv, o.i_dq_ref, i, vdc);
+        let comp = dtc.step(adv, o.i_dq_ref, i, o.v_ref_ab, vdc);
         let applied = (o.duty * vdc).to_ab();
         assert!((applied - (o.v_ref_ab + comp)).norm() < 1e-9, "sample {n}");
         let span = |v: Ab<f64>| {
