@@ -469,13 +469,7 @@ fn lag_compensation_keeps_lambda2_centred_after_an_accelerated_reversal() {
     // ≈ λf·|Δω|/(2|ω|) of it near zero speed, which the LO→HI hand-over leaves as a DC in λ2
     // (`EstimatorTuning::observer_lag_compensation`). Two motors: the paper's SPMSM (6 Hz/s
     // electrical through ±6 Hz) and the 2.2 kW IPMSM (the same ramp in Hz/s through ±4.5 Hz).
-    let paper = Machine {
-        rs: RS,
-        ld: L,
-        lq: L,
-        lf: LF,
-        pp: PP,
-    };
+    let paper = Machine::PAPER;
     let cases = [
         (paper, default_config::<f64>(), 6.0 * TAU, Dq::new(0.0, 4.0)),
         (

@@ -52,13 +52,7 @@ fn lost_at(
 
 #[test]
 fn the_lower_flux_bound_is_0_7_below_the_hand_over_band_and_0_6_above() {
-    let paper = Machine {
-        rs: RS,
-        ld: L,
-        lq: L,
-        lf: LF,
-        pp: PP,
-    };
+    let paper = Machine::PAPER;
     for (m, model) in [
         (paper, MachineModel::paper()),
         (Machine::IPMSM, ipmsm_model()),

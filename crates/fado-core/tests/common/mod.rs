@@ -148,6 +148,14 @@ pub fn ipmsm_model() -> MachineModel<f64> {
 }
 
 impl Machine {
+    /// The paper's surface-magnet motor ([`RS`], [`L`], [`LF`], [`PP`]).
+    pub const PAPER: Machine = Machine {
+        rs: RS,
+        ld: L,
+        lq: L,
+        lf: LF,
+        pp: PP,
+    };
     /// The 2.2 kW interior-magnet motor of issue 11 (p 3, Rs 3.6 Ω, Ld 36 mH, Lq 51 mH,
     /// λf 0.545 Wb, 6 A peak rated, 1500 r/min).
     pub const IPMSM: Machine = Machine {
