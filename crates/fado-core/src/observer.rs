@@ -70,8 +70,7 @@ impl<T: Real> DiscreteGains<T> {
         let x = omega * ts;
         // `f32` in its series range: the short minimax polynomials of `f32_gains` (the test
         // folds to a constant per type; `f64` never takes this branch).
-        let single = T::one() + T::lit(1e-12) == T::one();
-        if single && x.abs() <= T::lit(SERIES_LIMIT_F32) {
+        if single_precision::<T>() && x.abs() <= T::lit(SERIES_LIMIT_F32) {
             return f32_gains(x);
         }
         let half = T::lit(0.5);
@@ -95,6 +94,13 @@ impl<T: Real> DiscreteGains<T> {
             r: T::one() - one_minus_r,
         }
     }
+}
+
+/// Whether `T` is `f32` (1 + 1e-12 rounds to 1): a constant per type, folded by the compiler,
+/// that selects the `f32` polynomials of [`f32_gains`] or the `f64` series.
+#[inline(always)]
+fn single_precision<T: Real>() -> bool {
+    T::one() + T::lit(1e-12) == T::one()
 }
 
 /// Largest |ω·Ts| (rad) served by the `f64` series in [`half_angle_terms`]: 398 Hz at 10 kHz,
@@ -228,8 +234,7 @@ fn f32_gains<T: Real>(x: T) -> DiscreteGains<T> {
 #[inline(always)]
 fn half_angle_terms<T: Real>(x: T) -> (T, T, T) {
     let y = x.abs();
-    let single = T::one() + T::lit(1e-12) == T::one();
-    if !single && y <= T::lit(SERIES_LIMIT) {
+    if !single_precision::<T>() && y <= T::lit(SERIES_LIMIT) {
         let h = x * T::lit(0.5);
         let h2 = h * h;
         let h4 = h2 * h2;
