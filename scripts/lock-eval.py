@@ -8,7 +8,12 @@ columns are computed by `fado_sim::Metrics`):
   lost     = max |θ − θ̂| > 1 rad. Its onset t0 (`loss_onset_time`) = the first time
              |θ − θ̂| exceeded 0.5 rad in the excursion (from the last time it was below
              0.25 rad, `loss_settled_time`) that first went beyond 1 rad.
-  detected = LOCK_LOST (a live status) is up at t0 + 20 ms and rose no earlier than
+  The flag is the drive's loss evidence: LOCK_LOST (the estimator's verdict) or STALLED (the
+  drive's stall symptom), either up; the sweep's `lock_detection_delay`/`lock_late_delay` judge
+  that, `lock_lost_time` and `stall_time` are each flag's first rise. The false-alarm columns
+  are given for either flag and for LOCK_LOST alone (detection by LOCK_LOST alone: a sweep with
+  `[controller] lock_stall_speed_ratio = 0.0`, docs/lock.md).
+  detected = the flag (a live status) is up at t0 + 20 ms and rose no earlier than
              t0 − X (`lock_detection_delay` = its last rise − t0 ≥ −X), X = 1 s: the time
              fig11's reference takes from its steady −90 r/min to the reversal (2.5 → 3.5 s),
              the passage in which the fixed-R̂s integrand error shrinks |λ̂r| (the precursor the
@@ -54,7 +59,8 @@ def load(path):
         dict(
             max_run=f(r, "max_angle_error_run"),
             exceeded=f(r, "angle_error_exceeded_time"),
-            flagged=f(r, "lock_lost_time"),
+            flagged=min(f(r, "lock_lost_time"), f(r, "stall_time"), key=lambda x: (math.isnan(x), x)),
+            lock_lost=f(r, "lock_lost_time"),
             onset=f(r, "loss_onset_time"),
             settled=f(r, "loss_settled_time"),
             delay=f(r, "lock_detection_delay"),
@@ -88,11 +94,13 @@ def stats(rows):
     fa = sum(1 for r in clean if not math.isnan(r["flagged"]))
     passed = [r for r in rows if r["passed"]]
     fap = sum(1 for r in passed if not math.isnan(r["flagged"]))
+    fa_lock = sum(1 for r in clean if not math.isnan(r["lock_lost"]))
+    fap_lock = sum(1 for r in passed if not math.isnan(r["lock_lost"]))
     return dict(
         runs=len(rows), lost=len(lost), detected=len(detected), any_earlier=any_earlier, since_settled=since_settled, half=half,
         median_delay=median([r["delay"] for r in detected]), late=len(late),
         late_median=median(late), never=never, clean=len(clean), fa=fa, passed=len(passed),
-        fap=fap, delays=delays,
+        fap=fap, fa_lock=fa_lock, fap_lock=fap_lock, delays=delays,
         onset_moved=sum(1 for r in lost if r["onset"] != r["exceeded"]),
     )
 
@@ -118,8 +126,9 @@ def main(argv):
     results = []
     print("| configuration | runs | lost (> 1 rad) | **detected** (up at t0 + 20 ms, risen ≥ t0 − 1 s) "
           "| median delay | risen ≥ t0 − 0.5 s | risen since < 0.25 rad | raised late (median) | not raised "
-          "| flagged ≤ 20 ms counting earlier flags | clean (< 0.25 rad) | **false alarms** | pass paper criteria | flagged |")
-    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+          "| flagged ≤ 20 ms counting earlier flags | clean (< 0.25 rad) | **false alarms** | pass paper criteria | flagged "
+          "| LOCK_LOST alone: clean / passing flagged |")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for arg in argv:
         label, path = arg.split("=", 1)
         s = stats(load(path))
@@ -127,7 +136,8 @@ def main(argv):
         print(f"| {label} | {s['runs']} | {s['lost']} | {s['detected']} ({pct(s['detected'], s['lost'])}) "
               f"| {ms(s['median_delay'])} | {s['half']} ({pct(s['half'], s['lost'])}) | {s['since_settled']} ({pct(s['since_settled'], s['lost'])}) | {s['late']} ({ms(s['late_median'])}) | {s['never']} "
               f"| {s['any_earlier']} ({pct(s['any_earlier'], s['lost'])}) | {s['clean']} "
-              f"| {s['fa']} ({pct(s['fa'], s['clean'])}) | {s['passed']} | {s['fap']} ({pct(s['fap'], s['passed'])}) |")
+              f"| {s['fa']} ({pct(s['fa'], s['clean'])}) | {s['passed']} | {s['fap']} ({pct(s['fap'], s['passed'])}) "
+              f"| {s['fa_lock']} / {s['fap_lock']} |")
     for label, s in results:
         if s["onset_moved"]:
             print(f"({label}: in {s['onset_moved']} lost runs the onset is a later 0.5 rad crossing "

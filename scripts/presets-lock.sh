@@ -2,8 +2,9 @@
 # Loss-of-lock false alarms on every motor preset (issue 14, docs/lock.md "Other motors"): runs
 # each preset of motors/ through the ratings-scaled scenarios (default: reversal and stops) for
 # sensor-noise seeds 1-4, as scripts/presets.sh does, with full-rate traces, and prints per run
-# the paper's verdict, max |θ − θ̂| over the whole run, whether LOCK_LOST (drive flag 128) was
-# ever raised and when, and the highest `lock` status (0 locked, 1 suspect, 2 lost).
+# the paper's verdict, max |θ − θ̂| over the whole run, whether LOCK_LOST (drive flag 128, the
+# estimator's verdict) and STALLED (flag 1024, the drive's stall symptom) were ever raised and
+# when, and the highest `lock` status (0 locked, 1 suspect, 2 lost).
 # Usage: bash scripts/presets-lock.sh [scenario ...]  (env SEEDS="1 2 3 4", EXTRA=toml snippet,
 #        KEEP=DIR keeps each run's metrics in DIR/<preset>-<scenario>-<seed>; full-rate traces
 #        are 20-40 MB a run and are deleted once read unless KEEP_TRACES=1)
@@ -17,7 +18,7 @@ bin=target/release/fado-sim
 tmp=${KEEP:-$(mktemp -d)}
 mkdir -p "$tmp"
 [[ -n ${KEEP:-} ]] || trap 'rm -rf "$tmp"' EXIT
-printf 'preset,scenario,seed,passed,max_angle_error_run,lock_lost,lock_lost_time,max_lock_status\n'
+printf 'preset,scenario,seed,passed,max_angle_error_run,lock_lost,lock_lost_time,stalled,stall_time,max_lock_status\n'
 for file in motors/*.toml; do
     name=$(basename "$file" .toml)
     for sc in "${scenarios[@]}"; do
@@ -38,15 +39,19 @@ name, sc, seed, out = sys.argv[1:]
 try:
     m = json.load(open(f"{out}/metrics.json"))
 except OSError:
-    print(f"{name},{sc},{seed},error,,,,")
+    print(f"{name},{sc},{seed},error,,,,,,")
     sys.exit()
-worst, t_lost, status = 0.0, "", 0
+worst, t_lost, t_stall, status = 0.0, "", "", 0
 for r in csv.DictReader(open(f"{out}/traces.csv")):
     worst = max(worst, abs(float(r["angle_error"])))
     status = max(status, int(float(r["lock"])))
-    if not t_lost and int(float(r["fault_flags"])) & 128:
+    flags = int(float(r["fault_flags"]))
+    if not t_lost and flags & 128:
         t_lost = r["time"]
-print(f"{name},{sc},{seed},{str(m['passed']).lower()},{worst:.4f},{'yes' if t_lost else 'no'},{t_lost},{status}")
+    if not t_stall and flags & 1024:
+        t_stall = r["time"]
+yn = lambda t: "yes" if t else "no"
+print(f"{name},{sc},{seed},{str(m['passed']).lower()},{worst:.4f},{yn(t_lost)},{t_lost},{yn(t_stall)},{t_stall},{status}")
 PY
             [[ -n ${KEEP_TRACES:-} ]] || rm -f "$out/traces.csv"
         done

@@ -34,7 +34,11 @@
 //! along q̂ turns λ̂r without changing |λ̂r|), a loss shows first on the mechanical side; the
 //! drive adds that symptom (a speed-loop stall in limiter mode while the loop commands a
 //! torque, `DriveTuning::lock_stall_speed_ratio` and `lock_stall_min_current_ratio`, see
-//! [`crate::control::SensorlessDrive`]) and raises `LOCK_LOST` on either.
+//! [`crate::control::SensorlessDrive`]). The drive reports the two apart: `LOCK_LOST` for the
+//! estimator's verdict, `STALLED` for the stall symptom, which cannot tell an estimate that has
+//! left the rotor from a rotor that really stalls or lags under its load (docs/lock.md, "The
+//! stall symptom as its own flag"); either starts the drive's reaction
+//! (`DriveTuning::lock_reaction_on_stall`).
 //!
 //! The verdicts feed an up/down debouncing counter (the counter-based debouncing of AUTOSAR
 //! DEM, "Specification of Diagnostic Event Manager", §7.7.4.1, with its separate "passed"

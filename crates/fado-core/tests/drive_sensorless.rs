@@ -632,12 +632,12 @@ fn status_word_reports_dc_link_low_and_persistent_bad_input_trips_and_is_counted
 /// a spy estimator in limiter mode that reports a standing rotor. Not armed until the speed
 /// loop has caught its reference; then a reference beyond the band (4.5 r/min on the
 /// paper's motor) for `lock_stall_time` (50 samples) while the speed loop asks for at least
-/// `lock_stall_min_current_ratio` (0.2) of the rated current raises `LOCK_LOST`, a live status
+/// `lock_stall_min_current_ratio` (0.2) of the rated current raises `STALLED`, a live status
 /// that clears after `lock_stall_heal_time` without the condition (or at `align`); a speed
 /// error with the current reference at its limit does not; ratio 0 never does.
 #[test]
 fn stall_symptom_flags_a_lost_reference_below_the_current_limit() {
-    // (first sample with LOCK_LOST, first sample with |i_q*| ≥ 0.2·rated, the drive)
+    // (first sample with STALLED, first sample with |i_q*| ≥ 0.2·rated, the drive)
     let run = |tune: &dyn Fn(&mut DriveConfig<f64>), refs: &[(usize, f64)]| {
         let mut c = synthetic_currents();
         tune(&mut c);
@@ -650,7 +650,7 @@ fn stall_symptom_flags_a_lost_reference_below_the_current_limit() {
         for &(samples, speed) in refs {
             for _ in 0..samples {
                 let out = drive.step(Abc::new(0.0, 0.0, 0.0), 300.0, speed);
-                if first.is_none() && out.flags.contains(DriveFlags::LOCK_LOST) {
+                if first.is_none() && out.flags.contains(DriveFlags::STALLED) {
                     first = Some(n);
                 }
                 if torque.is_none() && out.i_dq_ref.q.abs() >= gate {
@@ -713,7 +713,7 @@ fn stall_symptom_flags_a_lost_reference_below_the_current_limit() {
         let up = drive
             .step(Abc::new(0.0, 0.0, 0.0), 300.0, 0.0)
             .flags
-            .contains(DriveFlags::LOCK_LOST);
+            .contains(DriveFlags::STALLED);
         if !up {
             cleared = Some(k);
             break;
@@ -726,7 +726,7 @@ fn stall_symptom_flags_a_lost_reference_below_the_current_limit() {
         !drive
             .step(Abc::new(0.0, 0.0, 0.0), 300.0, 0.0)
             .flags
-            .contains(DriveFlags::LOCK_LOST)
+            .contains(DriveFlags::STALLED)
     );
     // Within the band: nothing.
     assert_eq!(run(&high_limit, &[(20, 0.0), (500, 0.5)]).0, None);
@@ -738,6 +738,62 @@ fn stall_symptom_flags_a_lost_reference_below_the_current_limit() {
         c.tuning.lock_stall_speed_ratio = 0.0;
     };
     assert_eq!(run(&off, &[(20, 0.0), (500, 8.0)]).0, None);
+}
+
+/// The stall symptom is reported as `STALLED`, apart from the estimator's `LOCK_LOST` (a spy
+/// estimator whose own verdict is "locked" throughout: a stall is no evidence against the
+/// angle, docs/lock.md); with `lock_reaction` coast it starts the reaction, `COASTING` with
+/// `STALLED` as the reason and `LOCK_LOST` down, the reason kept while the drive coasts after
+/// the symptom itself has healed; with `lock_reaction_on_stall` off it is only reported. On
+/// the paper's motor and the 2.2 kW IPMSM.
+#[test]
+fn stall_is_its_own_flag_and_starts_the_reaction_when_asked() {
+    use fado_core::control::LockReaction;
+    for machine in [MachineModel::paper(), common::ipmsm_model()] {
+        let run = |reaction: LockReaction, on_stall: bool| {
+            let mut c = stall_test_config(&machine);
+            c.tuning.lock_reaction = reaction;
+            c.tuning.lock_reaction_on_stall = on_stall;
+            let heal = (c.tuning.lock_stall_heal_time / c.ts).round() as usize;
+            let mut drive = SensorlessDrive::with_estimator(c, Spy::default()).unwrap();
+            drive.align(0.0);
+            // Caught at 0, then 8 rad/s (mechanical) away for 200 samples, then the
+            // reference back at 0 for twice the healing time.
+            let refs = [(20, 0.0), (200, 8.0), (2 * heal, 0.0)];
+            let mut seen = DriveFlags::NONE;
+            let mut last = DriveFlags::NONE;
+            for (samples, speed) in refs {
+                for _ in 0..samples {
+                    last = drive.step(Abc::new(0.0, 0.0, 0.0), 300.0, speed).flags;
+                    seen |= last;
+                }
+            }
+            (seen, last)
+        };
+        let (seen, last) = run(LockReaction::ReportOnly, true);
+        assert!(seen.contains(DriveFlags::STALLED), "{seen:?}");
+        assert!(
+            !seen.intersects(DriveFlags::LOCK_LOST | DriveFlags::COASTING),
+            "{seen:?}"
+        );
+        assert!(!last.contains(DriveFlags::STALLED), "healed: {last:?}");
+        let (seen, last) = run(LockReaction::Coast, true);
+        assert!(
+            seen.contains(DriveFlags::STALLED | DriveFlags::COASTING),
+            "{seen:?}"
+        );
+        assert!(!seen.contains(DriveFlags::LOCK_LOST), "{seen:?}");
+        assert!(
+            last.contains(DriveFlags::STALLED | DriveFlags::COASTING),
+            "{last:?}"
+        );
+        let (seen, _) = run(LockReaction::Coast, false);
+        assert!(seen.contains(DriveFlags::STALLED), "{seen:?}");
+        assert!(
+            !seen.intersects(DriveFlags::COASTING | DriveFlags::LOCK_LOST),
+            "{seen:?}"
+        );
+    }
 }
 
 /// `machine`'s drive with the start-up calibrations and the stuck-sensor check off and the
@@ -755,7 +811,7 @@ fn stall_test_config(machine: &MachineModel<f64>) -> DriveConfig<f64> {
 /// The stall symptom also counts in k_df mode below `lock_stall_kdf_speed_ratio` (0.02) of
 /// the rated speed (docs/lock.md: heavy-load losses in k_df mode just above the 0.015 mode
 /// threshold): ω̂ held at 0.0175·rated in k_df mode, the speed loop catches a reference equal
-/// to it, then loses one 8 rad/s (mechanical) away, below the current limit: `LOCK_LOST`
+/// to it, then loses one 8 rad/s (mechanical) away, below the current limit: `STALLED`
 /// after `lock_stall_time` (50 samples). Not at 0.03·rated (above the band), nor with the
 /// ratio 0 (limiter mode only, the symptom before issue 14b), on the paper's motor and on
 /// the 2.2 kW IPMSM.
@@ -784,7 +840,7 @@ fn stall_symptom_counts_in_kdf_mode_just_above_the_threshold() {
             for n in 0..520 {
                 let speed = if n < 20 { caught } else { caught + 8.0 };
                 let out = drive.step(Abc::new(0.0, 0.0, 0.0), 300.0, speed);
-                if first.is_none() && out.flags.contains(DriveFlags::LOCK_LOST) {
+                if first.is_none() && out.flags.contains(DriveFlags::STALLED) {
                     first = Some(n);
                 }
             }
@@ -885,7 +941,7 @@ fn stall_symptom_spares_an_estimate_that_answers_the_torque() {
                     omega + 3.0 * band * omega0.signum()
                 };
                 let out = drive.step(Abc::new(0.0, 0.0, 0.0), 300.0, speed / p);
-                if first.is_none() && out.flags.contains(DriveFlags::LOCK_LOST) {
+                if first.is_none() && out.flags.contains(DriveFlags::STALLED) {
                     first = Some(n);
                 }
             }

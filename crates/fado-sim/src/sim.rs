@@ -481,8 +481,11 @@ pub struct Metrics {
     pub max_angle_error_run: f64,
     /// First time |θ − θ̂| exceeded 0.5 rad with the gates on, s (None: never).
     pub angle_error_exceeded_time: Option<f64>,
-    /// First time the drive reported the rotor lost (`DriveFlags::LOCK_LOST`), s.
+    /// First time the drive reported the estimate lost (`DriveFlags::LOCK_LOST`), s.
     pub lock_lost_time: Option<f64>,
+    /// First time the drive reported a stall (`DriveFlags::STALLED`: the speed does not
+    /// follow the torque; a real stall or an estimate lost near zero speed), s.
+    pub stall_time: Option<f64>,
     /// Onset of the loss, s: the first time |θ − θ̂| exceeded 0.5 rad in the excursion (from
     /// the last time it had settled below 0.25 rad, i.e. stayed there for 0.1 s, on) that
     /// first took it beyond 1 rad (None: it never exceeded 1 rad). Equal to
@@ -490,11 +493,14 @@ pub struct Metrics {
     pub loss_onset_time: Option<f64>,
     /// The last time |θ − θ̂| was below 0.25 rad before that onset, s (None: never).
     pub loss_settled_time: Option<f64>,
-    /// If `LOCK_LOST` (a live status) is up 20 ms after the onset: the time it last rose
+    /// The loss-of-lock labels below judge the drive's loss evidence, `LOCK_LOST` or
+    /// `STALLED` (either up counts as the flag; docs/lock.md).
+    ///
+    /// If the flag (a live status) is up 20 ms after the onset: the time it last rose
     /// minus the onset, s (negative: raised before the error reached 0.5 rad; docs/lock.md
     /// counts it as a detection if it rose less than 1 s before). None: down then.
     pub lock_detection_delay: Option<f64>,
-    /// First rise of `LOCK_LOST` at or after the onset, while the error has not settled
+    /// First rise of the flag at or after the onset, while the error has not settled
     /// below 0.25 rad again, minus the onset, s (the late detections). None: no rise.
     pub lock_late_delay: Option<f64>,
     #[serde(skip)]
@@ -532,10 +538,15 @@ impl Probe for Metrics {
                 self.angle_error_exceeded_time = Some(s.time);
             }
         }
-        let flag = s.act.flags.contains(fado_core::DriveFlags::LOCK_LOST);
-        if self.lock_lost_time.is_none() && flag {
+        use fado_core::DriveFlags;
+        let flags = s.act.flags;
+        if self.lock_lost_time.is_none() && flags.contains(DriveFlags::LOCK_LOST) {
             self.lock_lost_time = Some(s.time);
         }
+        if self.stall_time.is_none() && flags.contains(DriveFlags::STALLED) {
+            self.stall_time = Some(s.time);
+        }
+        let flag = flags.intersects(DriveFlags::LOCK_LOST | DriveFlags::STALLED);
         let e = s.act.gates_enabled.then(|| s.angle_error.abs());
         self.loss.observe(s.time, e, flag);
         if let Some(x) = self.loss.loss {
@@ -756,7 +767,7 @@ pub struct TraceRow {
     pub flux_linkage_hat: f64,
     /// The drive's status word (`fado_core::DriveFlags` bits: 1 input rejected, 2 tripped,
     /// 4 voltage saturated, 8 current error, 16 sensor stuck, 32 DC link low, 64 limiter
-    /// mode, 128 lock lost, 256 coasting, 512 input implausible).
+    /// mode, 128 lock lost, 256 coasting, 512 input implausible, 1024 stalled).
     pub fault_flags: u16,
     /// The estimator's loss-of-lock status (`fado_core::LockStatus`): 0 locked, 1 suspect,
     /// 2 lost.

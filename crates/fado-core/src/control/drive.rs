@@ -193,9 +193,17 @@ pub struct DriveTuning<T> {
     /// A DC-link reading above this multiple of the nominal DC-link voltage is refused like a
     /// non-finite sample. Default [`crate::plausibility::VOLTAGE_RATIO`] (1.5) \[A\].
     pub dc_link_max_ratio: T,
-    /// Reaction to the estimator's [`LockStatus::Lost`]. Default report only \[A\] (the
-    /// paper's behaviour plus the flag).
+    /// Reaction to the estimator's [`LockStatus::Lost`] (`DriveFlags::LOCK_LOST`) and, with
+    /// `lock_reaction_on_stall`, to the stall symptom (`DriveFlags::STALLED`). Default report
+    /// only \[A\] (the paper's behaviour plus the flags).
     pub lock_reaction: LockReaction,
+    /// Whether the stall symptom (`DriveFlags::STALLED`, see `lock_stall_speed_ratio`) starts
+    /// `lock_reaction` like the estimator's own verdict. Default on \[A\]: near zero speed a
+    /// lost estimate shows first, and on the fig11 envelope in 39 % of the fixed-R̂s losses
+    /// only, as a stall (docs/lock.md), and a drive that coasts, re-aligns and restarts
+    /// from a real stall under its load does what a stall asks for too. Off: the stall is
+    /// reported and the drive carries on.
+    pub lock_reaction_on_stall: bool,
     /// With `Recover`: time without symptoms in disturbance-feedback mode after which the
     /// coasting drive restarts, s. Default 20 ms \[A\] (the detection target: the detector
     /// has had as long to object as it gets to detect a loss).
@@ -213,7 +221,8 @@ pub struct DriveTuning<T> {
     pub lock_recovery_rs_adaptation: bool,
     /// Stall symptom of the loss-of-lock detection (see [`crate::lock`], "speed-loop stall"):
     /// in limiter mode, a speed error |ω* − ω̂| above this multiple of the rated speed for
-    /// `lock_stall_time` raises `LOCK_LOST` like the estimator's own verdict. Default 0.003
+    /// `lock_stall_time` raises `STALLED` (and starts the lock reaction, see
+    /// `lock_reaction_on_stall`). Default 0.003
     /// \[A\] (4.5 r/min at 1500 r/min rated, a fifth of the default Fig. 3 threshold
     /// `mode_threshold_ratio` 0.015; chosen on the fig11 envelope with the current gate
     /// `lock_stall_min_current_ratio` and the exception `lock_stall_follow_time`,
@@ -369,6 +378,7 @@ impl<T: Real> DriveTuning<T> {
             plausible_current_ratio: U::lit(self.plausible_current_ratio.to_f64()),
             dc_link_max_ratio: U::lit(self.dc_link_max_ratio.to_f64()),
             lock_reaction: self.lock_reaction,
+            lock_reaction_on_stall: self.lock_reaction_on_stall,
             lock_recovery_time: U::lit(self.lock_recovery_time.to_f64()),
             lock_recovery_timeout: U::lit(self.lock_recovery_timeout.to_f64()),
             lock_recovery_attempts: self.lock_recovery_attempts,
@@ -432,6 +442,7 @@ impl<T: Real> Default for DriveTuning<T> {
             plausible_current_ratio: T::lit(2.0),
             dc_link_max_ratio: T::lit(crate::plausibility::VOLTAGE_RATIO),
             lock_reaction: LockReaction::ReportOnly,
+            lock_reaction_on_stall: true,
             lock_recovery_time: T::lit(20e-3),
             lock_recovery_timeout: T::lit(0.5),
             lock_recovery_attempts: 3,
@@ -1095,6 +1106,9 @@ pub struct SensorlessDrive<T, E = SensorlessEstimator<T>> {
     /// like the estimator's; cleared by `align`, `reset`, a recovery's re-arming).
     stall: Debouncer,
     stall_armed: bool,
+    /// Why the drive coasts (`LOCK_LOST`, `STALLED` or both): the symptoms up when the
+    /// reaction started, kept while it coasts.
+    coast_reason: DriveFlags,
     /// ω̂ low-passed with `DriveTuning::lock_stall_follow_time` (electrical rad/s).
     omega_slow: T,
     /// This sample was refused as implausible.
@@ -1146,6 +1160,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             current_error: PersistenceMonitor::new(resolved.current_error_samples),
             stall: Debouncer::new(resolved.stall_samples, resolved.stall_heal_samples),
             stall_armed: false,
+            coast_reason: DriveFlags::NONE,
             omega_slow: T::zero(),
             sensor_stuck_now: false,
             current_error_now: false,
@@ -1442,11 +1457,15 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             out.estimate.diagnostics.flag_limit,
         );
         // The reason stays up while the drive coasts, also after the detector was re-armed.
+        let coasting = self.lock.coasting();
         flags.set(
             DriveFlags::LOCK_LOST,
             out.estimate.diagnostics.lock == LockStatus::Lost
-                || self.stall.is_up()
-                || self.lock.coasting(),
+                || (coasting && self.coast_reason.contains(DriveFlags::LOCK_LOST)),
+        );
+        flags.set(
+            DriveFlags::STALLED,
+            self.stall.is_up() || (coasting && self.coast_reason.contains(DriveFlags::STALLED)),
         );
         flags.set(DriveFlags::COASTING, running && self.lock.coasting());
         flags.set(DriveFlags::INPUT_IMPLAUSIBLE, self.implausible_now);
@@ -1590,7 +1609,8 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             && self.last.i_dq_ref.norm() < self.resolved.i_max * T::lit(0.99)
             && !answers_torque;
         let stalled = self.stall.step(stall_now);
-        let lost = diag.lock == LockStatus::Lost || stalled;
+        let estimate_lost = diag.lock == LockStatus::Lost;
+        let lost = estimate_lost || (stalled && self.config.tuning.lock_reaction_on_stall);
         let healthy = diag.lock == LockStatus::Locked && diag.mode == Mode::DisturbanceFeedback;
         let action = self.lock.step(lost, healthy);
         if lost && self.config.tuning.lock_reaction == LockReaction::Adapt {
@@ -1620,6 +1640,13 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
                 self.stall_armed = false;
             }
             LockAction::Run | LockAction::Coast => {}
+        }
+        // The reason the drive coasts: the symptoms seen since the loss that started it.
+        if !self.lock.coasting() {
+            self.coast_reason = DriveFlags::NONE;
+        } else if lost {
+            self.coast_reason.set(DriveFlags::LOCK_LOST, estimate_lost);
+            self.coast_reason.set(DriveFlags::STALLED, stalled);
         }
         let action = match action {
             LockAction::Rearm => LockAction::Coast,

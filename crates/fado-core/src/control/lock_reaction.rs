@@ -21,7 +21,7 @@ use crate::error::{ConfigError, check};
     serde(rename_all = "snake_case")
 )]
 pub enum LockReaction {
-    /// Raise `DriveFlags::LOCK_LOST` and carry on.
+    /// Raise the flag (`DriveFlags::LOCK_LOST` or `STALLED`) and carry on.
     #[default]
     ReportOnly,
     /// Raise the flag, switch the estimator's online R̂s adaptation on (if it has one and it

@@ -40,8 +40,8 @@ impl DriveFlags {
     pub const DC_LINK_LOW: Self = Self(1 << 5);
     /// FLAG_limit of the paper's Fig. 10: the estimator runs in limiter mode (not a fault).
     pub const LIMITER_MODE: Self = Self(1 << 6);
-    /// The estimator reports the rotor lost, or the drive's stall symptom is up ([`crate::lock`];
-    /// live statuses that heal), or the drive coasts because of a loss: the reason for
+    /// The estimator reports its estimate lost ([`crate::lock`]'s flux and tracker symptoms; a
+    /// live status that heals), or the drive coasts because of it: a reason for
     /// [`COASTING`](Self::COASTING).
     pub const LOCK_LOST: Self = Self(1 << 7);
     /// The drive holds zero current (speed loop off) because the rotor was lost
@@ -50,9 +50,19 @@ impl DriveFlags {
     /// This sample was refused as implausible (finite but beyond what the machine and
     /// inverter can produce, see [`crate::plausibility`]); `INPUT_REJECTED` is set too.
     pub const INPUT_IMPLAUSIBLE: Self = Self(1 << 9);
+    /// The speed does not follow the torque: the speed loop asks for a torque below the
+    /// current limit and ω̂ has left a reference it had caught without answering that torque
+    /// (the drive's stall symptom, `DriveTuning::lock_stall_speed_ratio`; a live status that
+    /// heals), or the drive coasts because of it: a reason for [`COASTING`](Self::COASTING).
+    /// Either the rotor itself stalls or lags under its load, or the estimate has left the
+    /// rotor near zero speed, where a back-EMF estimator cannot tell the two apart from v and
+    /// i (docs/lock.md, "The stall symptom as its own flag"). Reported apart from
+    /// [`LOCK_LOST`](Self::LOCK_LOST) so that a real stall is not called a lost estimate; it
+    /// starts the lock reaction too unless `DriveTuning::lock_reaction_on_stall` is off.
+    pub const STALLED: Self = Self(1 << 10);
 
     /// Every flag with its name, in bit order (for tables and trace decoding).
-    pub const ALL: [(Self, &'static str); 10] = [
+    pub const ALL: [(Self, &'static str); 11] = [
         (Self::INPUT_REJECTED, "input_rejected"),
         (Self::TRIPPED, "tripped"),
         (Self::VOLTAGE_SATURATED, "voltage_saturated"),
@@ -63,6 +73,7 @@ impl DriveFlags {
         (Self::LOCK_LOST, "lock_lost"),
         (Self::COASTING, "coasting"),
         (Self::INPUT_IMPLAUSIBLE, "input_implausible"),
+        (Self::STALLED, "stalled"),
     ];
 
     /// The flags that are faults (everything but saturation and limiter mode, which occur in
@@ -75,7 +86,8 @@ impl DriveFlags {
             | Self::DC_LINK_LOW.0
             | Self::LOCK_LOST.0
             | Self::COASTING.0
-            | Self::INPUT_IMPLAUSIBLE.0,
+            | Self::INPUT_IMPLAUSIBLE.0
+            | Self::STALLED.0,
     );
 
     /// The raw bits.

@@ -14,7 +14,7 @@ use crate::profile::Profile;
 use crate::scenario;
 
 /// Metric columns of a row, after the axes and `status`, `passed`.
-pub const METRICS: [&str; 13] = [
+pub const METRICS: [&str; 14] = [
     "max_angle_error",
     "rms_angle_error",
     "max_angle_error_zero_speed",
@@ -28,6 +28,7 @@ pub const METRICS: [&str; 13] = [
     "loss_settled_time",
     "lock_detection_delay",
     "lock_late_delay",
+    "stall_time",
 ];
 
 /// The configuration of one point: `base` with each `(name, value)` applied in order, then
@@ -201,7 +202,7 @@ pub struct PointResult {
     pub max_angle_error_run: f64,
     /// First time |θ − θ̂| > 0.5 rad, s (NaN: never).
     pub angle_error_exceeded_time: f64,
-    /// First time the drive reported the rotor lost, s (NaN: never).
+    /// First time the drive reported the estimate lost (`LOCK_LOST`), s (NaN: never).
     pub lock_lost_time: f64,
     /// Onset of the loss (0.5 rad crossing of the excursion beyond 1 rad), s (NaN: no loss).
     pub loss_onset_time: f64,
@@ -212,6 +213,8 @@ pub struct PointResult {
     pub lock_detection_delay: f64,
     /// First rise of the flag after the onset minus the onset, s (NaN: none).
     pub lock_late_delay: f64,
+    /// First time the drive reported a stall (`STALLED`), s (NaN: never).
+    pub stall_time: f64,
 }
 
 impl PointResult {
@@ -241,10 +244,11 @@ impl PointResult {
             loss_settled_time: f64::NAN,
             lock_detection_delay: f64::NAN,
             lock_late_delay: f64::NAN,
+            stall_time: f64::NAN,
         }
     }
 
-    pub(crate) fn metrics(&self) -> [f64; 13] {
+    pub(crate) fn metrics(&self) -> [f64; 14] {
         [
             self.max_angle_error,
             self.rms_angle_error,
@@ -259,6 +263,7 @@ impl PointResult {
             self.loss_settled_time,
             self.lock_detection_delay,
             self.lock_late_delay,
+            self.stall_time,
         ]
     }
 }
@@ -350,6 +355,7 @@ pub fn run_point_until(
         loss_settled_time: m.loss_settled_time.unwrap_or(f64::NAN),
         lock_detection_delay: m.lock_detection_delay.unwrap_or(f64::NAN),
         lock_late_delay: m.lock_late_delay.unwrap_or(f64::NAN),
+        stall_time: m.stall_time.unwrap_or(f64::NAN),
     };
     // The zero-speed metrics are NaN-free by construction only when the band was visited;
     // judge divergence on the overall ones.

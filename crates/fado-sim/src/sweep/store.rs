@@ -153,6 +153,7 @@ pub fn read_csv(path: &Path, spec: &SweepSpec) -> Result<BTreeMap<usize, PointRe
                 loss_settled_time: m[10],
                 lock_detection_delay: m[11],
                 lock_late_delay: m[12],
+                stall_time: m[13],
             },
         );
     }
