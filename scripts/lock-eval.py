@@ -11,8 +11,8 @@ columns are computed by `fado_sim::Metrics`):
   The flag is the drive's loss evidence: LOCK_LOST (the estimator's verdict) or STALLED (the
   drive's stall symptom), either up; the sweep's `lock_detection_delay`/`lock_late_delay` judge
   that, `lock_lost_time` and `stall_time` are each flag's first rise. The false-alarm columns
-  are given for either flag and for LOCK_LOST alone (detection by LOCK_LOST alone: a sweep with
-  `[controller] lock_stall_speed_ratio = 0.0`, docs/lock.md).
+  and detection are given for either flag and for LOCK_LOST alone (`lock_lost_detection_delay`;
+  older sweeps without that column: run one with `[controller] lock_stall_speed_ratio = 0.0`).
   detected = the flag (a live status) is up at t0 + 20 ms and rose no earlier than
              t0 − X (`lock_detection_delay` = its last rise − t0 ≥ −X), X = 1 s: the time
              fig11's reference takes from its steady −90 r/min to the reversal (2.5 → 3.5 s),
@@ -64,6 +64,7 @@ def load(path):
             onset=f(r, "loss_onset_time"),
             settled=f(r, "loss_settled_time"),
             delay=f(r, "lock_detection_delay"),
+            delay_lock=f(r, "lock_lost_detection_delay"),
             late=f(r, "lock_late_delay"),
             passed=r["passed"] == "true",
         )
@@ -79,6 +80,7 @@ def median(xs):
 def stats(rows):
     lost = [r for r in rows if r["max_run"] > 1.0]
     detected = [r for r in lost if r["delay"] >= -LEAD]
+    detected_lock = sum(1 for r in lost if r["delay_lock"] >= -LEAD)
     half = sum(1 for r in lost if r["delay"] >= -0.5)
     since_settled = sum(
         1 for r in lost if r["delay"] >= -LEAD and (math.isnan(r["settled"]) or r["delay"] >= r["settled"] - r["onset"])
@@ -100,7 +102,7 @@ def stats(rows):
         runs=len(rows), lost=len(lost), detected=len(detected), any_earlier=any_earlier, since_settled=since_settled, half=half,
         median_delay=median([r["delay"] for r in detected]), late=len(late),
         late_median=median(late), never=never, clean=len(clean), fa=fa, passed=len(passed),
-        fap=fap, fa_lock=fa_lock, fap_lock=fap_lock, delays=delays,
+        fap=fap, detected_lock=detected_lock, fa_lock=fa_lock, fap_lock=fap_lock, delays=delays,
         onset_moved=sum(1 for r in lost if r["onset"] != r["exceeded"]),
     )
 
@@ -127,7 +129,7 @@ def main(argv):
     print("| configuration | runs | lost (> 1 rad) | **detected** (up at t0 + 20 ms, risen ≥ t0 − 1 s) "
           "| median delay | risen ≥ t0 − 0.5 s | risen since < 0.25 rad | raised late (median) | not raised "
           "| flagged ≤ 20 ms counting earlier flags | clean (< 0.25 rad) | **false alarms** | pass paper criteria | flagged "
-          "| LOCK_LOST alone: clean / passing flagged |")
+          "| LOCK_LOST alone: detected / clean flagged / passing flagged |")
     print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for arg in argv:
         label, path = arg.split("=", 1)
@@ -137,7 +139,7 @@ def main(argv):
               f"| {ms(s['median_delay'])} | {s['half']} ({pct(s['half'], s['lost'])}) | {s['since_settled']} ({pct(s['since_settled'], s['lost'])}) | {s['late']} ({ms(s['late_median'])}) | {s['never']} "
               f"| {s['any_earlier']} ({pct(s['any_earlier'], s['lost'])}) | {s['clean']} "
               f"| {s['fa']} ({pct(s['fa'], s['clean'])}) | {s['passed']} | {s['fap']} ({pct(s['fap'], s['passed'])}) "
-              f"| {s['fa_lock']} / {s['fap_lock']} |")
+              f"| {s['detected_lock']} ({pct(s['detected_lock'], s['lost'])}) / {s['fa_lock']} / {s['fap_lock']} |")
     for label, s in results:
         if s["onset_moved"]:
             print(f"({label}: in {s['onset_moved']} lost runs the onset is a later 0.5 rad crossing "

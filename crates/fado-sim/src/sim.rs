@@ -503,8 +503,13 @@ pub struct Metrics {
     /// First rise of the flag at or after the onset, while the error has not settled
     /// below 0.25 rad again, minus the onset, s (the late detections). None: no rise.
     pub lock_late_delay: Option<f64>,
+    /// `lock_detection_delay` for `LOCK_LOST` alone (the estimator's verdict, without the
+    /// drive's stall symptom), s.
+    pub lock_lost_detection_delay: Option<f64>,
     #[serde(skip)]
     loss: LossTracker,
+    #[serde(skip)]
+    loss_lock_only: LossTracker,
     #[serde(skip)]
     sum_sq: f64,
     #[serde(skip)]
@@ -549,6 +554,11 @@ impl Probe for Metrics {
         let flag = flags.intersects(DriveFlags::LOCK_LOST | DriveFlags::STALLED);
         let e = s.act.gates_enabled.then(|| s.angle_error.abs());
         self.loss.observe(s.time, e, flag);
+        self.loss_lock_only
+            .observe(s.time, e, flags.contains(DriveFlags::LOCK_LOST));
+        if let Some(x) = self.loss_lock_only.loss {
+            self.lock_lost_detection_delay = x.up_at_deadline.flatten().map(|t| t - x.onset);
+        }
         if let Some(x) = self.loss.loss {
             self.loss_onset_time = Some(x.onset);
             self.loss_settled_time = x.settled.is_finite().then_some(x.settled);

@@ -14,7 +14,7 @@ use crate::profile::Profile;
 use crate::scenario;
 
 /// Metric columns of a row, after the axes and `status`, `passed`.
-pub const METRICS: [&str; 14] = [
+pub const METRICS: [&str; 15] = [
     "max_angle_error",
     "rms_angle_error",
     "max_angle_error_zero_speed",
@@ -29,6 +29,7 @@ pub const METRICS: [&str; 14] = [
     "lock_detection_delay",
     "lock_late_delay",
     "stall_time",
+    "lock_lost_detection_delay",
 ];
 
 /// The configuration of one point: `base` with each `(name, value)` applied in order, then
@@ -215,6 +216,8 @@ pub struct PointResult {
     pub lock_late_delay: f64,
     /// First time the drive reported a stall (`STALLED`), s (NaN: never).
     pub stall_time: f64,
+    /// `lock_detection_delay` for `LOCK_LOST` alone, s (NaN: down then).
+    pub lock_lost_detection_delay: f64,
 }
 
 impl PointResult {
@@ -245,10 +248,11 @@ impl PointResult {
             lock_detection_delay: f64::NAN,
             lock_late_delay: f64::NAN,
             stall_time: f64::NAN,
+            lock_lost_detection_delay: f64::NAN,
         }
     }
 
-    pub(crate) fn metrics(&self) -> [f64; 14] {
+    pub(crate) fn metrics(&self) -> [f64; 15] {
         [
             self.max_angle_error,
             self.rms_angle_error,
@@ -264,6 +268,7 @@ impl PointResult {
             self.lock_detection_delay,
             self.lock_late_delay,
             self.stall_time,
+            self.lock_lost_detection_delay,
         ]
     }
 }
@@ -356,6 +361,7 @@ pub fn run_point_until(
         lock_detection_delay: m.lock_detection_delay.unwrap_or(f64::NAN),
         lock_late_delay: m.lock_late_delay.unwrap_or(f64::NAN),
         stall_time: m.stall_time.unwrap_or(f64::NAN),
+        lock_lost_detection_delay: m.lock_lost_detection_delay.unwrap_or(f64::NAN),
     };
     // The zero-speed metrics are NaN-free by construction only when the band was visited;
     // judge divergence on the overall ones.

@@ -154,6 +154,7 @@ pub fn read_csv(path: &Path, spec: &SweepSpec) -> Result<BTreeMap<usize, PointRe
                 lock_detection_delay: m[11],
                 lock_late_delay: m[12],
                 stall_time: m[13],
+                lock_lost_detection_delay: m[14],
             },
         );
     }
