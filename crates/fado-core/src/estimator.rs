@@ -47,7 +47,9 @@ use crate::flux::{
 use crate::integrand_offset::{IntegrandOffsetConfig, IntegrandOffsetParams, IntegrandOffsetState};
 use crate::lock::{DebouncerState, LockDetectorConfig, LockDetectorParams, LockStatus};
 use crate::mode::{Mode, ModeSelectorConfig, ModeSelectorParams};
-use crate::observer::{DisturbanceObserverConfig, DisturbanceObserverParams, ObserverState};
+use crate::observer::{
+    DisturbanceObserverConfig, DisturbanceObserverParams, ObserverGains, ObserverState,
+};
 use crate::plausibility::{self, SampleBounds};
 use crate::real::all_finite;
 use crate::rotor_flux::{rotor_angle, rotor_flux, stator_flux};
@@ -88,6 +90,9 @@ const SLOT_LOCK: u8 = 2;
 /// since the R̂s adaptation's / the offset law's last run, which then does not adapt.
 const BROKEN_RS: u8 = 1;
 const BROKEN_OFFSET: u8 = 2;
+
+/// Default of [`EstimatorTuning::observer_gain_period`], s.
+const OBSERVER_GAIN_PERIOD: f64 = 4e-4;
 
 /// The λ̂f law runs above this multiple of the Fig. 3 threshold speed (see
 /// [`ResistanceAdaptationConfig::flux_linkage_min_speed`]).
@@ -177,6 +182,21 @@ pub struct EstimatorTuning<T> {
     /// sensor seeds 1–8 (0.27–0.87 % with a fixed R̂s); the loaded one-hour standstill then
     /// runs to the current limit on four of five seeds instead of one (docs/zero-speed-errors.md).
     pub observer_lag_compensation: bool,
+    /// The observer's gains (16) are recomputed from its speed once every this many seconds
+    /// (rounded to whole samples, at least every sample) and held in between; 0 = every
+    /// sample, as in the paper. Default 0.4 ms (4 samples at the paper's 10 kHz) \[A\].
+    ///
+    /// The gains depend only on the speed the observer runs at, ω̂1 (+ the lag
+    /// compensation), which T2S-1's 60 Hz bandwidth keeps from moving much within a
+    /// millisecond; forming them (four polynomials, 19 multiplies) is a tenth of the `f32`
+    /// step on a Cortex-M4F (docs/firmware.md). Held over N samples, the internal model
+    /// rotates and the notch sits at the speed of the last update: under an acceleration α
+    /// they lag the speed by at most α·(N − 1)·Ts, 0.3 ms × α by default, 4 % of the lag
+    /// 2ζ/ωn·α = 7.5 ms × α of T2S-1's own ω̂1 that `observer_lag_compensation` corrects
+    /// (through a 106 ms low-pass). The poles stay at the held speed's r = e^{−|ω|Ts}: the
+    /// observer is a fixed stable filter between updates. Measured: fado-sim fig8–fig12
+    /// within their seed-to-seed noise (docs/firmware.md, "Sixth session").
+    pub observer_gain_period: T,
     /// Adapt R̂s online (our extension \[A\], see [`crate::rs_adaptation`]): from the d-axis
     /// voltage at standstill under the eq. (23) injection, and from the flux-magnitude error
     /// while turning. `false` keeps R̂s fixed as in the paper. Default true.
@@ -323,6 +343,7 @@ impl<T: Real> EstimatorTuning<T> {
             average_current: self.average_current,
             observer_on_rotor_flux: self.observer_on_rotor_flux,
             observer_lag_compensation: self.observer_lag_compensation,
+            observer_gain_period: U::lit(self.observer_gain_period.to_f64()),
             rs_adaptation: self.rs_adaptation,
             rs_adaptation_rate: U::lit(self.rs_adaptation_rate.to_f64()),
             rs_adaptation_excitation_floor: U::lit(self.rs_adaptation_excitation_floor.to_f64()),
@@ -364,6 +385,7 @@ impl<T: Real> Default for EstimatorTuning<T> {
             average_current: true,
             observer_on_rotor_flux: true,
             observer_lag_compensation: true,
+            observer_gain_period: T::lit(OBSERVER_GAIN_PERIOD),
             rs_adaptation: true,
             rs_adaptation_rate: rs.rate,
             rs_adaptation_excitation_floor: rs.excitation_floor,
@@ -660,6 +682,9 @@ pub struct EstimatorParams<T: Real> {
     flux_settle_periods: u32,
     /// `EstimatorTuning::observer_on_rotor_flux`.
     observer_on_rotor_flux: bool,
+    /// The observer's gains are held over this many samples after the one that computes
+    /// them: `EstimatorTuning::observer_gain_period`/Ts rounded, less one.
+    gain_hold: u8,
     /// `EstimatorTuning::rs_adaptation`: whether the start-up state adapts R̂s.
     rs_adaptation: bool,
     integrator: FluxIntegratorParams<T>,
@@ -693,6 +718,9 @@ pub struct EstimatorState<T: Real> {
     kdf_gain: T,
     /// The low-passed Kp·e of T2S-1 added to ω̂1 for the observer, rad/s.
     lag_compensation: T,
+    /// The observer's gains, held between their updates
+    /// (`EstimatorTuning::observer_gain_period`).
+    observer_gains: ObserverGains<T>,
     /// Feedback term computed at the end of the previous sample.
     feedback: Ab<T>,
     /// The step the current may have moved by since the last accepted one (the integrator's
@@ -721,6 +749,8 @@ pub struct EstimatorState<T: Real> {
     lock_status: LockStatus,
     /// This sample's slot in the slow laws' round-robin (see [`SLOW_PERIOD`]).
     slot: u8,
+    /// Samples left before the observer's gains are computed again (0: this sample).
+    gain_countdown: u8,
     /// `BROKEN_*` bits: which slow law's regime was interrupted since it last ran.
     slow_broken: u8,
     /// The R̂s adaptation runs: `EstimatorTuning::rs_adaptation`, or switched on by
@@ -779,6 +809,18 @@ impl<T: Real> EstimatorParams<T> {
             average_current: config.tuning.average_current,
         })?;
         let observer = DisturbanceObserverParams::new(DisturbanceObserverConfig { ts })?;
+        let gain_period = check::non_negative(
+            "observer_gain_period",
+            config.tuning.observer_gain_period,
+        )?;
+        let gain_samples = (gain_period / ts).round();
+        check::below(
+            "observer_gain_period",
+            gain_samples,
+            T::lit(f64::from(u8::MAX) + 0.5),
+            "at most 255 sampling periods",
+        )?;
+        let gain_hold = crate::real::max(gain_samples - T::one(), T::zero()).to_f64() as u8;
         let disturbance_feedback = DisturbanceFeedbackParams::new(DisturbanceFeedbackConfig {
             ts,
             k_df: config.tuning.k_df,
@@ -876,6 +918,7 @@ impl<T: Real> EstimatorParams<T> {
             offset_recentring_gain: config.tuning.offset_adaptation_rate * ts,
             initial_angle: config.initial_angle,
             observer_on_rotor_flux: config.tuning.observer_on_rotor_flux,
+            gain_hold,
             lag_compensation: config.tuning.observer_lag_compensation,
             lag_keep: if config.tuning.observer_lag_compensation {
                 T::one() - lag_gain
@@ -919,6 +962,7 @@ impl<T: Real> EstimatorParams<T> {
             t2s2: self.t2s2.state_at(T::zero(), T::zero()),
             kdf_gain: T::zero(),
             lag_compensation: T::zero(),
+            observer_gains: ObserverGains::standstill(),
             feedback: Ab::zero(),
             step_allowance: self.bounds.step(),
             offset_recentring_gain: if self.rs_adaptation {
@@ -937,6 +981,7 @@ impl<T: Real> EstimatorParams<T> {
             mode: Mode::Limiter,
             lock_status: LockStatus::Locked,
             slot: 0,
+            gain_countdown: 0,
             slow_broken: 0,
             rs_adaptation_on: self.rs_adaptation,
             k_df_enabled: true,
@@ -1020,6 +1065,10 @@ impl<T: Real> EstimatorState<T> {
         self.t2s1 = p.t2s1.state_at(theta0, T::zero());
         self.t2s2 = p.t2s2.state_at(theta0, T::zero());
         self.lag_compensation = T::zero();
+        // The observer's gains for ω̂ = 0, held as after any update (so that with the
+        // default period they are formed in the free slot of the slow laws' round-robin).
+        self.observer_gains = p.observer.gains(T::zero());
+        self.gain_countdown = p.gain_hold;
         self.feedback = Ab::zero();
         self.rejected_samples = 0;
         self.lock = DebouncerState::default();
@@ -1099,10 +1148,11 @@ impl<T: Real> EstimatorState<T> {
         };
         //    With `observer_lag_compensation` ω̂1 plus T2S-1's low-passed Kp·e (the rate of
         //    θ̂), not the lagging ω̂1 alone.
-        let observer_speed = self.t2s1.speed() + self.lag_compensation;
+        //    Its gains were formed for that speed at the end of a previous sample (the last
+        //    one, or up to `observer_gain_period` earlier).
         let (observer_flux, disturbance) =
             p.observer
-                .next_state(&self.observer, observer_input, observer_speed);
+                .next_state_with(&self.observer, &self.observer_gains, observer_input);
         // 3. Rotor flux and direct angle (eq. (20), (5), (6)).
         let lambda2 = stator_flux(lambda1, disturbance);
         let lambda_r = lambda2 - lq_i;
@@ -1206,6 +1256,14 @@ impl<T: Real> EstimatorState<T> {
         if p.lag_compensation {
             self.lag_compensation =
                 p.lag_keep * self.lag_compensation + p.lag_input * t2s1.innovation;
+        }
+        // The observer's gains for the next sample's speed, once every `gain_hold` + 1
+        // samples (see `EstimatorTuning::observer_gain_period`).
+        if self.gain_countdown == 0 {
+            self.observer_gains = p.observer.gains(t2s1.omega + self.lag_compensation);
+            self.gain_countdown = p.gain_hold;
+        } else {
+            self.gain_countdown -= 1;
         }
         self.t2s1.commit(t2s1);
         self.t2s2.commit(t2s2);

@@ -320,12 +320,66 @@ impl<T: Real> DisturbanceObserverParams<T> {
         lambda1: Ab<T>,
         omega: T,
     ) -> (Ab<T>, Ab<T>) {
-        let g = DiscreteGains::new(omega, self.ts);
+        self.next_state_with(s, &self.gains(omega), lambda1)
+    }
+
+    /// The gains of the update for the flux speed `omega` (rad/s), as
+    /// [`DisturbanceObserverParams::next_state_with`] uses them.
+    #[inline(always)]
+    pub(crate) fn gains(&self, omega: T) -> ObserverGains<T> {
+        DiscreteGains::new(omega, self.ts).into()
+    }
+
+    /// [`Self::next_state`] with gains computed beforehand (by [`Self::gains`], possibly for
+    /// an earlier sample's speed: the estimator holds them over
+    /// `EstimatorTuning::observer_gain_period`).
+    #[inline(always)]
+    pub(crate) fn next_state_with(
+        &self,
+        s: &ObserverState<T>,
+        g: &ObserverGains<T>,
+        lambda1: Ab<T>,
+    ) -> (Ab<T>, Ab<T>) {
         let e = lambda1 - s.z;
         // a·z + (1 − a)·d = d + a·(z − d): one complex product fewer.
-        let z = s.d + g.a.complex_mul(s.z - s.d) + g.l1.complex_mul(e);
+        let z = s.d + g.a.complex_mul(s.z - s.d) + Ab::new(g.l1_alpha, g.a.beta).complex_mul(e);
         let d = s.d + g.l2.complex_mul(e);
         (z, d)
+    }
+}
+
+/// The gains the update uses, a, ℓ1 and ℓ2 of [`DiscreteGains`], in five numbers: Im ℓ1 =
+/// Im a exactly (ℓ1 = 1 + a − 2r with r real; both paths of [`DiscreteGains::new`] form the
+/// two from the same product). The estimator keeps them in its state between updates.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct ObserverGains<T> {
+    /// a = e^{jωTs}.
+    a: Ab<T>,
+    /// Re ℓ1.
+    l1_alpha: T,
+    /// ℓ2.
+    l2: Ab<T>,
+}
+
+impl<T: Real> ObserverGains<T> {
+    /// The gains at ω = 0: a = 1, ℓ1 = ℓ2 = 0 (the observer freezes).
+    pub(crate) fn standstill() -> Self {
+        Self {
+            a: Ab::new(T::one(), T::zero()),
+            l1_alpha: T::zero(),
+            l2: Ab::zero(),
+        }
+    }
+}
+
+impl<T: Real> From<DiscreteGains<T>> for ObserverGains<T> {
+    #[inline(always)]
+    fn from(g: DiscreteGains<T>) -> Self {
+        Self {
+            a: g.a,
+            l1_alpha: g.l1.alpha,
+            l2: g.l2,
+        }
     }
 }
 

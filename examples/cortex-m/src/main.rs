@@ -82,7 +82,8 @@ const ADAPTIVE: usize = 0;
 /// The default configuration with the paper's fixed R̂s (`rs_adaptation = false`).
 const FIXED_RS: usize = 1;
 /// The paper's path: fixed R̂s, and fado's other additions to the method that a switch turns
-/// off (`observer_lag_compensation`, `observer_on_rotor_flux`, `limiter_recentring` false).
+/// off (`observer_lag_compensation`, `observer_on_rotor_flux`, `limiter_recentring` false,
+/// `observer_gain_period` 0).
 const PAPER_PATH: usize = 2;
 
 /// Largest |θ̂_kernel − θ̂_fado| allowed between the paper's kernel and fado's paper's path
@@ -443,6 +444,8 @@ fn main() -> ! {
         t.observer_on_rotor_flux = false;
         t.limiter_recentring = false;
         t.k_df_ramp_time = 0.0;
+        // The paper forms the gains (16) every sample.
+        t.observer_gain_period = 0.0;
         config
     };
     let params = {
