@@ -188,6 +188,7 @@ class EstimatorConfig:
         average_current: bool | None = None,
         observer_on_rotor_flux: bool | None = None,
         observer_lag_compensation: bool | None = None,
+        observer_gain_period: float | None = None,
         rs_adaptation: bool | None = None,
         rs_adaptation_rate: float | None = None,
         rs_adaptation_excitation_floor: float | None = None,
@@ -225,6 +226,7 @@ class EstimatorConfig:
         average_current: bool | None = None,
         observer_on_rotor_flux: bool | None = None,
         observer_lag_compensation: bool | None = None,
+        observer_gain_period: float | None = None,
         rs_adaptation: bool | None = None,
         rs_adaptation_rate: float | None = None,
         rs_adaptation_excitation_floor: float | None = None,
@@ -291,6 +293,9 @@ class EstimatorConfig:
     @property
     def observer_lag_compensation(self) -> bool:
         """Observer speed ω̂1 plus T2S-1's low-passed Kp·e (fado's improvement); False = the paper's ω̂1."""
+    @property
+    def observer_gain_period(self) -> float:
+        """Period (s) at which the observer's gains are recomputed and held in between; 0 = every sample (the paper)."""
     @property
     def rs_adaptation(self) -> bool:
         """Adapt R̂s online (fado's extension, default True; False = the paper)."""

@@ -32,6 +32,7 @@ PAPER_DEFAULTS = {
     "average_current": True,  # SPEC §1 [A]
     "observer_on_rotor_flux": True,  # fado's improvement [A]; False = paper's Fig. 5
     "observer_lag_compensation": True,  # fado's improvement [A] (issue 13); False = the paper
+    "observer_gain_period": 4e-4,  # [A] (issue 16: gains held over 4 samples at 10 kHz); 0 = the paper
     "rs_adaptation": True,  # fado's extension [A]; False = the paper's fixed R̂s
     "rs_adaptation_rate": 1.0,  # [A]
     "rs_adaptation_excitation_floor": 0.2,  # [A]

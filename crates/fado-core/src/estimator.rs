@@ -809,10 +809,8 @@ impl<T: Real> EstimatorParams<T> {
             average_current: config.tuning.average_current,
         })?;
         let observer = DisturbanceObserverParams::new(DisturbanceObserverConfig { ts })?;
-        let gain_period = check::non_negative(
-            "observer_gain_period",
-            config.tuning.observer_gain_period,
-        )?;
+        let gain_period =
+            check::non_negative("observer_gain_period", config.tuning.observer_gain_period)?;
         let gain_samples = (gain_period / ts).round();
         check::below(
             "observer_gain_period",
@@ -1920,5 +1918,70 @@ mod tests {
         let slot = est.state.slot;
         est.step(Ab::new(f64::NAN, 0.0), Ab::zero());
         assert_eq!(est.state.slot, slot);
+    }
+
+    /// `observer_gain_period` (see its docs): the gains the observer uses are those of the
+    /// speed (ω̂1 + the lag compensation) at the end of the sample that last updated them,
+    /// updated once every N = period/Ts accepted samples (N = 4 by default at 10 kHz, in the
+    /// free slot of the slow laws' round-robin), every sample with period 0; a rejected sample
+    /// does not advance the count; `align` forms them for ω̂ = 0.
+    #[test]
+    fn observer_gains_are_held_over_their_period() {
+        fn check<T: Real>(period: f64, samples_per_update: u8) {
+            let mut config = EstimatorConfig::<T>::for_machine(&MachineModel::paper());
+            config.tuning.observer_gain_period = T::lit(period);
+            let mut est = SensorlessEstimator::new(config).unwrap();
+            let p = est.params;
+            assert_eq!(p.gain_hold, samples_per_update - 1);
+            assert_eq!(est.state.observer_gains, p.observer.gains(T::zero()));
+            let (w, ts) = (2.0 * core::f64::consts::PI * 20.0, 1e-4);
+            let mut updates = 0;
+            for n in 0..4000 {
+                let th = w * ts * n as f64;
+                let (c, s) = (th.cos(), th.sin());
+                let i = Ab::new(-4.0 * s, 4.0 * c);
+                let v = Ab::new(
+                    0.327 * i.alpha - w * 0.088 * s - w * 2.63e-3 * 4.0 * c,
+                    0.327 * i.beta + w * 0.088 * c - w * 2.63e-3 * 4.0 * s,
+                );
+                let v = if n == 1001 { Ab::new(f64::NAN, 0.0) } else { v };
+                let v = Ab::new(T::lit(v.alpha), T::lit(v.beta));
+                let i = Ab::new(T::lit(i.alpha), T::lit(i.beta));
+                let before = est.state;
+                est.step(v, i);
+                let after = est.state;
+                if n == 1001 {
+                    assert_eq!(after.observer_gains, before.observer_gains);
+                    assert_eq!(after.gain_countdown, before.gain_countdown);
+                    assert_eq!(after.rejected_samples, before.rejected_samples + 1);
+                    continue;
+                }
+                let speed = after.t2s1.speed() + after.lag_compensation;
+                if before.gain_countdown == 0 {
+                    updates += 1;
+                    assert_eq!(after.observer_gains, p.observer.gains(speed), "sample {n}");
+                    assert_eq!(after.gain_countdown, p.gain_hold);
+                    if samples_per_update == SLOW_PERIOD {
+                        // The free slot: the one after the lock detector's.
+                        assert_eq!(before.slot, SLOT_LOCK + 1);
+                    }
+                } else {
+                    assert_eq!(after.observer_gains, before.observer_gains, "sample {n}");
+                    assert_eq!(after.gain_countdown, before.gain_countdown - 1);
+                }
+            }
+            assert_eq!(updates, 3999 / usize::from(samples_per_update));
+            est.state.align(&p, T::one(), Ab::zero());
+            assert_eq!(est.state.observer_gains, p.observer.gains(T::zero()));
+            assert_eq!(est.state.gain_countdown, p.gain_hold);
+        }
+        for (period, n) in [(0.0, 1), (1e-4, 1), (1.4e-4, 1), (4e-4, 4), (8e-4, 8)] {
+            check::<f32>(period, n);
+            check::<f64>(period, n);
+        }
+        assert_eq!(
+            EstimatorTuning::<f64>::default().observer_gain_period,
+            OBSERVER_GAIN_PERIOD
+        );
     }
 }

@@ -187,6 +187,7 @@ fn run_all<T: Real>(failures: &mut Vec<String>, machine: MachineModel<T>) -> usi
             tuning.t2s2_bandwidth_hz: PositiveBounded,
             tuning.tracker_damping: Positive,
             tuning.tracker_hold_ratio: NonNegativeBounded,
+            tuning.observer_gain_period: NonNegativeBounded,
             initial_angle: Signed,
         ),
     );
@@ -592,6 +593,12 @@ fn bandwidths_above_what_the_sampling_rate_allows_are_refused() {
     assert_eq!(est(|c| c.tuning.k_af = 1.01 / ts), "k_af");
     assert_eq!(est(|c| c.tuning.k_df = 1.0 / ts), "");
     assert_eq!(est(|c| c.tuning.k_df = 1.01 / ts), "k_df");
+    // The observer's gains are held over at most 255 samples (a u8 count).
+    assert_eq!(est(|c| c.tuning.observer_gain_period = 255.0 * ts), "");
+    assert_eq!(
+        est(|c| c.tuning.observer_gain_period = 256.0 * ts),
+        "observer_gain_period"
+    );
     // The mode band must lie below Nyquist (5 kHz; the paper motor's rated frequency is
     // 100 Hz, so the ratios are the old thresholds in Hz / 100).
     assert_eq!(
