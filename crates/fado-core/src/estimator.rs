@@ -677,7 +677,7 @@ pub struct EstimatorParams<T: Real> {
     initial_angle: T,
     /// The configured R̂s (`MachineModel::rs`), Ω: the start-up R̂s.
     rs_initial: T,
-    /// e^{−2π·f_th·Ts} and (1 − e^{−2π·f_th·Ts})·Kp of T2S-1 with
+    /// e^{−2π·f_th·Ts} and (1 − e^{−2π·f_th·Ts})·Kp·(rad per tracker angle unit) of T2S-1 with
     /// `EstimatorTuning::observer_lag_compensation` (f_th the Fig. 3 threshold), else 0 and 0:
     /// the low-pass c ← keep·c + input·e.
     lag_keep: T,
@@ -932,8 +932,9 @@ impl<T: Real> EstimatorParams<T> {
             } else {
                 T::zero()
             },
+            // The innovation it low-passes is in tracker angle units: × rad per unit.
             lag_input: if config.tuning.observer_lag_compensation {
-                lag_gain * t2s1.kp()
+                lag_gain * t2s1.kp() * T::angle_unit()
             } else {
                 T::zero()
             },
@@ -1210,7 +1211,7 @@ impl<T: Real> EstimatorState<T> {
                 self.lock,
                 lambda_r.norm_squared(),
                 flux_hat * flux_hat * active_ratio * active_ratio,
-                t2s1.innovation,
+                t2s1.innovation * T::angle_unit(),
                 t2s2.omega,
                 clamping,
             ))

@@ -42,6 +42,17 @@ pub trait Real: RealField + Copy + Default {
     /// wrap(a + d) for a step |d| ≤ π (`f32`: saturating at ±π beyond; `f64`: exact up to
     /// ±2π, see [`wrap_angle`]).
     fn angle_add(a: Self::Angle, d: Self) -> Self::Angle;
+    /// Radians per tracker angle unit (`f32`: 2π/2³²; `f64`: 1, its angles are radians).
+    /// The trackers fold it into their gains ([`crate::tracker`]), so that a step converts
+    /// no phase error and no increment between radians and units.
+    fn angle_unit() -> Self;
+    /// Tracker angle units per radian, 1/[`Self::angle_unit`] (`f32`: 2³²/2π; `f64`: 1).
+    fn angle_units_per_rad() -> Self;
+    /// wrap(a − b) in tracker angle units ([`Self::angle_diff`] / [`Self::angle_unit`]).
+    fn angle_diff_units(a: Self::Angle, b: Self::Angle) -> Self;
+    /// wrap(a + d) for a step d in tracker angle units, |d| ≤ π/[`Self::angle_unit`]
+    /// (`f32`: saturating beyond; `f64`: as [`Self::angle_add`]).
+    fn angle_add_units(a: Self::Angle, d: Self) -> Self::Angle;
 }
 
 impl Real for f32 {
@@ -62,6 +73,23 @@ impl Real for f32 {
     #[inline(always)]
     fn angle_add(a: i32, d: Self) -> i32 {
         a.wrapping_add(Self::angle_from(d))
+    }
+    #[inline(always)]
+    fn angle_unit() -> Self {
+        FIXED_ANGLE_RAD_PER_UNIT as f32
+    }
+    #[inline(always)]
+    fn angle_units_per_rad() -> Self {
+        FIXED_ANGLE_UNITS_PER_RAD as f32
+    }
+    #[inline(always)]
+    fn angle_diff_units(a: i32, b: i32) -> Self {
+        a.wrapping_sub(b) as f32
+    }
+    #[inline(always)]
+    fn angle_add_units(a: i32, d: Self) -> i32 {
+        // Towards zero, saturating (one `vcvt`); NaN gives 0.
+        a.wrapping_add(d as i32)
     }
     #[inline(always)]
     fn lit(x: f64) -> Self {
@@ -110,6 +138,22 @@ impl Real for f64 {
     #[inline(always)]
     fn angle_add(a: f64, d: Self) -> f64 {
         wrap_angle(a + d)
+    }
+    #[inline(always)]
+    fn angle_unit() -> Self {
+        1.0
+    }
+    #[inline(always)]
+    fn angle_units_per_rad() -> Self {
+        1.0
+    }
+    #[inline(always)]
+    fn angle_diff_units(a: f64, b: f64) -> Self {
+        Self::angle_diff(a, b)
+    }
+    #[inline(always)]
+    fn angle_add_units(a: f64, d: Self) -> f64 {
+        Self::angle_add(a, d)
     }
     #[inline(always)]
     fn lit(x: f64) -> Self {

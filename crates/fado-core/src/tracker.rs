@@ -101,6 +101,10 @@ pub(crate) struct TrackerParams<T> {
     /// Ts·Kp, precomputed (the same product the recursion formed every sample).
     kp_ts: T,
     ki_ts: T,
+    /// Ts in angle units per rad/s and Ki·Ts in rad/s per angle unit ([`Real::angle_unit`]):
+    /// the unit conversions of the recursion folded into its gains (`f64`: Ts and Ki·Ts).
+    ts_units: T,
+    ki_ts_units: T,
 }
 
 /// The tracker's mutable state: θ̂⁻, θ̂ and ω̂.
@@ -135,6 +139,8 @@ impl<T: Real> TrackerParams<T> {
             kp,
             kp_ts: ts * kp,
             ki_ts: ki * ts,
+            ts_units: ts * T::angle_units_per_rad(),
+            ki_ts_units: ki * ts * T::angle_unit(),
         })
     }
 
@@ -151,11 +157,14 @@ impl<T: Real> TrackerParams<T> {
     /// The update after one sample with the measurement θm ∈ [−π, π] (eq. (6)'s range).
     #[inline(always)]
     pub(crate) fn next_state(&self, s: &TrackerState<T>, theta_measured: T) -> TrackerUpdate<T> {
-        let e = T::angle_diff(T::angle_from(theta_measured), s.predicted);
-        let omega = s.omega + self.ki_ts * e;
-        let theta = T::angle_add(s.predicted, self.kp_ts * e);
+        // In angle units ([`Real::angle_unit`]): Kp·Ts is dimensionless, the conversions of
+        // Ki·Ts·e and Ts·ω̂ are in `ki_ts_units` and `ts_units` (`f32`: one rounding fewer
+        // than converting e and the increments, and no multiply per conversion).
+        let e = T::angle_diff_units(T::angle_from(theta_measured), s.predicted);
+        let omega = s.omega + self.ki_ts_units * e;
+        let theta = T::angle_add_units(s.predicted, self.kp_ts * e);
         TrackerUpdate {
-            predicted: T::angle_add(theta, self.ts * omega),
+            predicted: T::angle_add_units(theta, self.ts_units * omega),
             theta,
             omega,
             innovation: e,
@@ -167,7 +176,7 @@ impl<T: Real> TrackerParams<T> {
     pub(crate) fn coasted_state(&self, s: &TrackerState<T>) -> TrackerUpdate<T> {
         let theta = s.predicted;
         TrackerUpdate {
-            predicted: T::angle_add(theta, self.ts * s.omega),
+            predicted: T::angle_add_units(theta, self.ts_units * s.omega),
             theta,
             omega: s.omega,
             innovation: T::zero(),
@@ -297,7 +306,8 @@ pub(crate) struct TrackerUpdate<T: Real> {
     pub theta: T::Angle,
     /// ω̂.
     pub omega: T,
-    /// The phase error e = wrap(θm − θ̂⁻) of this sample (0 when coasting).
+    /// The phase error e = wrap(θm − θ̂⁻) of this sample in angle units (0 when coasting):
+    /// × [`Real::angle_unit`] for radians.
     pub innovation: T,
 }
 
