@@ -87,9 +87,9 @@ const FIXED_RS: usize = 1;
 const PAPER_PATH: usize = 2;
 
 /// Largest |θ̂_kernel − θ̂_fado| allowed between the paper's kernel and fado's paper's path
-/// (rad): the `f32` rounding level (the kernel folds the trackers' unit conversions into their
-/// gains; measured within 1e-6 rad, see `paper_kernel`). Method differences give 1e-3 rad and
-/// more: the paper's path and fado's default fixed-R̂s path differ by 2e-2 rad here.
+/// (rad): the `f32` rounding level (measured: 0, the two compute the same operations in the same
+/// order, see `paper_kernel`). Method differences give 1e-3 rad and more: the paper's path and
+/// fado's default fixed-R̂s path differ by 2e-2 rad here.
 const KERNEL_TOLERANCE: f32 = 1e-4;
 
 const SCENARIOS: [Scenario; 6] = [

@@ -3,13 +3,13 @@
 //!
 //! Exactly the method fado's `EstimatorState::step_lean` runs on its paper's path
 //! (`rs_adaptation`, `observer_lag_compensation`, `observer_on_rotor_flux` and
-//! `limiter_recentring` all `false`, `k_df_ramp_time` 0), with the same discretisation and the
-//! same arithmetic in the same order but for one thing: the trackers' conversions between
-//! radians and fixed-point units are folded into their gains (Ki·Ts·2π/2³², Ts·2³²/2π; fado
-//! multiplies by the unit at each conversion), which changes θ̂ at the `f32` rounding level.
+//! `limiter_recentring` all `false`, `k_df_ramp_time` and `observer_gain_period` 0), with the
+//! same discretisation and the same arithmetic in the same order, the trackers' conversions
+//! between radians and fixed-point units folded into their gains (Ki·Ts·2π/2³², Ts·2³²/2π) as
+//! fado's trackers fold them since issue 16's sixth session (before, fado multiplied by the
+//! unit at each conversion and the two differed at the `f32` rounding level, within 1e-6 rad).
 //! The image checks, sample by sample, that the kernel's θ̂ stays within 1e-4 rad of fado's
-//! and its mode equal (measured: within 1e-6 rad; with fado's conversions verbatim the two
-//! agreed to the bit, and cost 14 cycles more: docs/firmware.md, "Seventh pass"):
+//! and its mode equal (measured: the same θ̂ and ω̂ to the bit, docs/firmware.md):
 //!
 //! - the flux integrator with the feedback of the previous sample (eq. (21) / (24)), the
 //!   resistive drop on the interval's average current (SPEC §1 \[A\]);
