@@ -171,7 +171,7 @@ pub struct EstimatorTuning<T> {
     /// Drive the observer's gains (16) and its internal model's rotation with ω̂1 + c, c the
     /// T2S-1 proportional term Kp·e through a first-order low-pass at the Fig. 3 threshold
     /// frequency, instead of ω̂1 alone. Default true (ours \[A\]; `false` is the paper's
-    /// Fig. 5, and gives its results bit for bit).
+    /// Fig. 5, and gives its results bit for bit with `observer_gain_period` = 0).
     ///
     /// The observer's model (eq. (9)) rotates the flux by ω between samples and places its
     /// notch (eq. (18)-(19)) at ω. Under a constant acceleration α the type-2 tracker's
