@@ -256,8 +256,9 @@ mod tests {
         // After 1 s at k_e = 2 s⁻¹ the error is e^{−2} of e (to the Euler step).
         let left = (e - law.offset()).norm() / e.norm();
         assert!((left - (-2.0f64).exp()).abs() < 0.01, "{left}");
-        // Run once every 4 samples with its period 4·ts (as the estimator does), the same
-        // continuous-time rate: D̂ − D̂_prev telescopes, k_df·4·ts·D̂ the decay.
+        // Run once every 4 samples with its period 4·ts (the estimator runs it every 8 with
+        // 8·ts, the same construction), the same continuous-time rate: D̂ − D̂_prev
+        // telescopes, k_df·4·ts·D̂ the decay.
         let mut slow = IntegrandOffset::new(IntegrandOffsetConfig {
             ts: 4.0 * ts,
             settle_time: 0.0,
