@@ -102,6 +102,8 @@ const BROKEN_OFFSET: u8 = 2;
 
 /// Default of [`EstimatorTuning::observer_gain_period`], s.
 const OBSERVER_GAIN_PERIOD: f64 = 4e-4;
+/// Largest [`EstimatorTuning::observer_gain_period`] accepted, s.
+const MAX_OBSERVER_GAIN_PERIOD: f64 = 1.0;
 
 /// The λ̂f law runs above this multiple of the Fig. 3 threshold speed (see
 /// [`ResistanceAdaptationConfig::flux_linkage_min_speed`]).
@@ -203,7 +205,9 @@ pub struct EstimatorTuning<T> {
     /// they lag the speed by at most α·(N − 1)·Ts, 0.3 ms × α by default, 4 % of the lag
     /// 2ζ/ωn·α = 7.7 ms × α of T2S-1's own ω̂1 that `observer_lag_compensation` corrects
     /// (through a 106 ms low-pass). The poles stay at the held speed's r = e^{−|ω|Ts}: the
-    /// observer is a fixed stable filter between updates. Measured (fado-sim fig8–fig12,
+    /// observer is a fixed stable filter between updates. Keep it well below T2S-1's time
+    /// constant 1/(2π·`t2s1_bandwidth_hz`) (2.7 ms at 60 Hz); above 1 s it is refused as a
+    /// mistake. Measured (fado-sim fig8–fig12,
     /// sensor seeds 1–8): every run passes, the means of the worst angle error move by at
     /// most 1.1e-3 rad (fig10 0.0562 → 0.0573 rad; docs/firmware.md, "Sixth session").
     pub observer_gain_period: T,
@@ -694,7 +698,7 @@ pub struct EstimatorParams<T: Real> {
     observer_on_rotor_flux: bool,
     /// The observer's gains are held over this many samples after the one that computes
     /// them: `EstimatorTuning::observer_gain_period`/Ts rounded, less one.
-    gain_hold: u8,
+    gain_hold: u32,
     /// `EstimatorTuning::rs_adaptation`: whether the start-up state adapts R̂s.
     rs_adaptation: bool,
     integrator: FluxIntegratorParams<T>,
@@ -760,7 +764,7 @@ pub struct EstimatorState<T: Real> {
     /// This sample's slot in the slow laws' round-robin (see [`SLOW_PERIOD`]).
     slot: u8,
     /// Samples left before the observer's gains are computed again (0: this sample).
-    gain_countdown: u8,
+    gain_countdown: u32,
     /// `BROKEN_*` bits: which slow law's regime was interrupted since it last ran.
     slow_broken: u8,
     /// The R̂s adaptation runs: `EstimatorTuning::rs_adaptation`, or switched on by
@@ -819,16 +823,6 @@ impl<T: Real> EstimatorParams<T> {
             average_current: config.tuning.average_current,
         })?;
         let observer = DisturbanceObserverParams::new(DisturbanceObserverConfig { ts })?;
-        let gain_period =
-            check::non_negative("observer_gain_period", config.tuning.observer_gain_period)?;
-        let gain_samples = (gain_period / ts).round();
-        check::below(
-            "observer_gain_period",
-            gain_samples,
-            T::lit(f64::from(u8::MAX) + 0.5),
-            "at most 255 sampling periods",
-        )?;
-        let gain_hold = crate::real::max(gain_samples - T::one(), T::zero()).to_f64() as u8;
         let disturbance_feedback = DisturbanceFeedbackParams::new(DisturbanceFeedbackConfig {
             ts,
             k_df: config.tuning.k_df,
@@ -859,6 +853,20 @@ impl<T: Real> EstimatorParams<T> {
             .map_err(rename("t2s1_bandwidth_hz"))?;
         let t2s2 = TrackerParams::new(config.tracker(config.tuning.t2s2_bandwidth_hz))
             .map_err(rename("t2s2_bandwidth_hz"))?;
+        // A hold beyond a second is refused as a mistake (the observer would be a fixed
+        // filter through any speed change; see the field's docs).
+        let gain_period =
+            check::non_negative("observer_gain_period", config.tuning.observer_gain_period)?;
+        check::below(
+            "observer_gain_period",
+            gain_period,
+            T::lit(MAX_OBSERVER_GAIN_PERIOD * (1.0 + 1e-9)),
+            "at most 1 s",
+        )?;
+        // Whole samples, at least one (`as` saturates: a count beyond u32 would need a
+        // sampling period below 1e-12 s).
+        let gain_hold =
+            crate::real::max((gain_period / ts).round() - T::one(), T::zero()).to_f64() as u32;
         let rs_adaptation = ResistanceAdaptationParams::new(ResistanceAdaptationConfig {
             flux_linkage_min_speed: T::lit(FLUX_LINKAGE_SPEED_THRESHOLDS)
                 * T::two_pi()
@@ -1939,11 +1947,11 @@ mod tests {
     /// `observer_gain_period` (see its docs): the gains the observer uses are those of the
     /// speed (ω̂1 + the lag compensation) at the end of the sample that last updated them,
     /// updated once every N = period/Ts accepted samples (N = 4 by default at 10 kHz, in the
-    /// free slot of the slow laws' round-robin), every sample with period 0; a rejected sample
+    /// slots after the lock detector's), every sample with period 0; a rejected sample
     /// does not advance the count; `align` forms them for ω̂ = 0.
     #[test]
     fn observer_gains_are_held_over_their_period() {
-        fn check<T: Real>(period: f64, samples_per_update: u8) {
+        fn check<T: Real>(period: f64, samples_per_update: u32) {
             let mut config = EstimatorConfig::<T>::for_machine(&MachineModel::paper());
             config.tuning.observer_gain_period = T::lit(period);
             let mut est = SensorlessEstimator::new(config).unwrap();
@@ -1977,7 +1985,7 @@ mod tests {
                     updates += 1;
                     assert_eq!(after.observer_gains, p.observer.gains(speed), "sample {n}");
                     assert_eq!(after.gain_countdown, p.gain_hold);
-                    if samples_per_update == LOCK_PERIOD {
+                    if samples_per_update == u32::from(LOCK_PERIOD) {
                         // The slots after the lock detector's, free of the slow laws.
                         assert_eq!(before.slot % LOCK_PERIOD, SLOT_LOCK + 1);
                         assert!(before.slot != SLOT_RS && before.slot != SLOT_OFFSET);
@@ -1987,7 +1995,7 @@ mod tests {
                     assert_eq!(after.gain_countdown, before.gain_countdown - 1);
                 }
             }
-            assert_eq!(updates, 3999 / usize::from(samples_per_update));
+            assert_eq!(updates, 3999 / samples_per_update);
             est.state.align(&p, T::one(), Ab::zero());
             assert_eq!(est.state.observer_gains, p.observer.gains(T::zero()));
             assert_eq!(est.state.gain_countdown, p.gain_hold);

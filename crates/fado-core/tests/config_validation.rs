@@ -593,11 +593,18 @@ fn bandwidths_above_what_the_sampling_rate_allows_are_refused() {
     assert_eq!(est(|c| c.tuning.k_af = 1.01 / ts), "k_af");
     assert_eq!(est(|c| c.tuning.k_df = 1.0 / ts), "");
     assert_eq!(est(|c| c.tuning.k_df = 1.01 / ts), "k_df");
-    // The observer's gains are held over at most 255 samples (a u8 count).
-    assert_eq!(est(|c| c.tuning.observer_gain_period = 255.0 * ts), "");
+    // The observer's gains are held at most 1 s, whatever ts (a u32 count of samples).
+    assert_eq!(est(|c| c.tuning.observer_gain_period = 1.0), "");
     assert_eq!(
-        est(|c| c.tuning.observer_gain_period = 256.0 * ts),
+        est(|c| c.tuning.observer_gain_period = 1.01),
         "observer_gain_period"
+    );
+    assert_eq!(
+        est(|c| {
+            c.tuning.observer_gain_period = 1.0;
+            c.ts = 1e-9;
+        }),
+        ""
     );
     // The mode band must lie below Nyquist (5 kHz; the paper motor's rated frequency is
     // 100 Hz, so the ratios are the old thresholds in Hz / 100).
