@@ -105,10 +105,6 @@ const OBSERVER_GAIN_PERIOD: f64 = 4e-4;
 /// Largest [`EstimatorTuning::observer_gain_period`] accepted, s.
 const MAX_OBSERVER_GAIN_PERIOD: f64 = 1.0;
 
-/// The λ̂f law runs above this multiple of the Fig. 3 threshold speed (see
-/// [`ResistanceAdaptationConfig::flux_linkage_min_speed`]).
-const FLUX_LINKAGE_SPEED_THRESHOLDS: f64 = 3.0;
-
 /// The estimator's tuning: every setting that is not the machine or the sampling period.
 /// Defaults are the paper's (section V) or SPEC.md's, as each field says; none depends on the
 /// motor (speeds are ratios of the rated electrical frequency). With the `serde` feature this
@@ -383,7 +379,6 @@ impl<T: Real> EstimatorTuning<T> {
 
 impl<T: Real> Default for EstimatorTuning<T> {
     fn default() -> Self {
-        let rs = ResistanceAdaptationConfig::<T>::default();
         Self {
             k_df: T::lit(0.5),
             k_df_ramp_time: T::zero(),
@@ -401,13 +396,13 @@ impl<T: Real> Default for EstimatorTuning<T> {
             observer_lag_compensation: true,
             observer_gain_period: T::lit(OBSERVER_GAIN_PERIOD),
             rs_adaptation: true,
-            rs_adaptation_rate: rs.rate,
-            rs_adaptation_excitation_floor: rs.excitation_floor,
-            rs_adaptation_min_ratio: rs.min_ratio,
-            rs_adaptation_max_ratio: rs.max_ratio,
-            flux_linkage_adaptation_rate: rs.flux_linkage_rate,
-            offset_adaptation_rate: IntegrandOffsetConfig::<T>::default().rate,
-            standstill_angle_rate: rs.standstill_angle_rate,
+            rs_adaptation_rate: T::one(),
+            rs_adaptation_excitation_floor: T::lit(0.2),
+            rs_adaptation_min_ratio: T::lit(0.5),
+            rs_adaptation_max_ratio: T::lit(2.0),
+            flux_linkage_adaptation_rate: T::lit(5.0),
+            offset_adaptation_rate: T::lit(2.0),
+            standstill_angle_rate: T::lit(2.0),
             limiter_recentring: true,
             plausible_current_ratio: T::lit(plausibility::CURRENT_RATIO),
             plausible_voltage_ratio: T::lit(plausibility::VOLTAGE_RATIO),
@@ -473,20 +468,7 @@ impl<T: Real> EstimatorConfig<T> {
     }
 
     fn rs_adaptation_config(&self) -> ResistanceAdaptationConfig<T> {
-        ResistanceAdaptationConfig {
-            ts: self.slow_ts(),
-            rs_initial: self.machine.rs,
-            flux_linkage_hat: self.machine.flux_linkage,
-            lq_hat: self.machine.lq,
-            ld_hat: self.machine.ld,
-            flux_linkage_rate: self.tuning.flux_linkage_adaptation_rate,
-            rate: self.tuning.rs_adaptation_rate,
-            excitation_floor: self.tuning.rs_adaptation_excitation_floor,
-            min_ratio: self.tuning.rs_adaptation_min_ratio,
-            max_ratio: self.tuning.rs_adaptation_max_ratio,
-            standstill_angle_rate: self.tuning.standstill_angle_rate,
-            ..ResistanceAdaptationConfig::default()
-        }
+        ResistanceAdaptationConfig::with_tuning(&self.machine, &self.tuning, self.slow_ts())
     }
 
     fn lock_detector(&self) -> LockDetectorConfig<T> {
@@ -540,12 +522,7 @@ impl<T: Real> EstimatorConfig<T> {
     }
 
     fn tracker(&self, bandwidth_hz: T) -> TrackerConfig<T> {
-        TrackerConfig {
-            ts: self.ts,
-            bandwidth_hz,
-            damping: self.tuning.tracker_damping,
-            definition: self.tuning.bandwidth_definition,
-        }
+        TrackerConfig::with_tuning(&self.tuning, bandwidth_hz, self.ts)
     }
 }
 
@@ -817,29 +794,27 @@ impl<T: Real> EstimatorParams<T> {
                 ConfigError::Negative { .. } => ConfigError::Negative { field },
             }
         };
-        let (integrator, _) = FluxIntegratorParams::new(FluxIntegratorConfig {
+        let (integrator, _) = FluxIntegratorParams::new(FluxIntegratorConfig::with_tuning(
+            &config.machine,
+            &config.tuning,
             ts,
-            rs_hat: config.machine.rs,
-            average_current: config.tuning.average_current,
-        })?;
+        ))?;
         let observer = DisturbanceObserverParams::new(DisturbanceObserverConfig { ts })?;
-        let disturbance_feedback = DisturbanceFeedbackParams::new(DisturbanceFeedbackConfig {
-            ts,
-            k_df: config.tuning.k_df,
-            ramp_time: config.tuning.k_df_ramp_time,
-        })
+        let disturbance_feedback = DisturbanceFeedbackParams::new(
+            DisturbanceFeedbackConfig::with_tuning(&config.tuning, ts),
+        )
         .map_err(|e| match e.field() {
             "ramp_time" => rename("k_df_ramp_time")(e),
             _ => e,
         })?;
-        let limiter = FluxLimiter::new(FluxLimiterConfig {
-            k_af: config.tuning.k_af,
-            radius: ratio * lf,
-        })?;
-        let selector = ModeSelectorParams::new(ModeSelectorConfig {
-            threshold_hz: config.mode_threshold_hz(),
-            hysteresis_hz: config.mode_hysteresis_hz(),
-        })
+        let limiter = FluxLimiter::new(FluxLimiterConfig::with_tuning(
+            &config.machine,
+            &config.tuning,
+        ))?;
+        let selector = ModeSelectorParams::new(ModeSelectorConfig::with_tuning(
+            &config.machine,
+            &config.tuning,
+        ))
         .map_err(|e| match e.field() {
             "threshold_hz" => rename("mode_threshold_ratio")(e),
             _ => rename("mode_hysteresis_ratio")(e),
@@ -867,36 +842,30 @@ impl<T: Real> EstimatorParams<T> {
         // sampling period below 1e-12 s).
         let gain_hold =
             crate::real::max((gain_period / ts).round() - T::one(), T::zero()).to_f64() as u32;
-        let rs_adaptation = ResistanceAdaptationParams::new(ResistanceAdaptationConfig {
-            flux_linkage_min_speed: T::lit(FLUX_LINKAGE_SPEED_THRESHOLDS)
-                * T::two_pi()
-                * config.mode_threshold_hz(),
-            ..config.rs_adaptation_config()
-        })
-        .map_err(|e| {
-            match e.field() {
-                "rs_initial" => rename("rs")(e),
-                "rate" => rename("rs_adaptation_rate")(e),
-                "excitation_floor" => rename("rs_adaptation_excitation_floor")(e),
-                "min_ratio" => rename("rs_adaptation_min_ratio")(e),
-                "max_ratio" => rename("rs_adaptation_max_ratio")(e),
-                "flux_linkage_rate" => rename("flux_linkage_adaptation_rate")(e),
-                // Fixed rates of the block that only a sampling period can make unstable.
-                "standstill_angle_rate" => e,
-                "flux_linkage_min_speed" => rename("mode_threshold_ratio")(e),
-                "standstill_rate" | "standstill_memory_hz" | "standstill_flux_rate" => {
-                    rename("ts")(e)
+        let rs_adaptation = ResistanceAdaptationParams::new(config.rs_adaptation_config())
+            .map_err(|e| {
+                match e.field() {
+                    "rs_initial" => rename("rs")(e),
+                    "rate" => rename("rs_adaptation_rate")(e),
+                    "excitation_floor" => rename("rs_adaptation_excitation_floor")(e),
+                    "min_ratio" => rename("rs_adaptation_min_ratio")(e),
+                    "max_ratio" => rename("rs_adaptation_max_ratio")(e),
+                    "flux_linkage_rate" => rename("flux_linkage_adaptation_rate")(e),
+                    // Fixed rates of the block that only a sampling period can make unstable.
+                    "standstill_angle_rate" => e,
+                    "flux_linkage_min_speed" => rename("mode_threshold_ratio")(e),
+                    "standstill_rate" | "standstill_memory_hz" | "standstill_flux_rate" => {
+                        rename("ts")(e)
+                    }
+                    _ => e,
                 }
-                _ => e,
-            }
-        })?;
+            })?;
         let threshold_hz = config.mode_threshold_hz();
-        let offset = IntegrandOffsetParams::new(IntegrandOffsetConfig {
-            ts: config.slow_ts(),
-            rate: config.tuning.offset_adaptation_rate,
-            settle_time: T::lit(5.0) / (T::two_pi() * threshold_hz),
-            limit: lf * T::two_pi() * threshold_hz,
-        })
+        let offset = IntegrandOffsetParams::new(IntegrandOffsetConfig::with_tuning(
+            &config.machine,
+            &config.tuning,
+            config.slow_ts(),
+        ))
         .map_err(|e| match e.field() {
             "rate" => rename("offset_adaptation_rate")(e),
             _ => rename("mode_threshold_ratio")(e),

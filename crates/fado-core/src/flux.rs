@@ -6,26 +6,40 @@
 //! changes the integrand, so λ̂r changes slope but never jumps, and neither does the angle.
 
 use crate::error::{ConfigError, NonFiniteInput, check};
-use crate::{Ab, Real};
+use crate::estimator::EstimatorTuning;
+use crate::{Ab, MachineModel, Real};
 
 /// Configuration of a [`FluxIntegrator`].
+///
+/// No `Default`: R̂s is the motor's and Ts the set-up's. Build it with
+/// [`for_machine`](Self::for_machine); each field's "Default" is what it gives.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FluxIntegratorConfig<T> {
-    /// Sampling period Ts in s. Default 100 µs (paper, section V).
+    /// Sampling period Ts in s (paper, V: 100 µs). No default: the caller's.
     pub ts: T,
-    /// Stator resistance estimate R̂s in Ω. Default 0.327 Ω (paper, section V).
+    /// Stator resistance estimate R̂s in Ω: the machine model's (the paper's motor: 0.327 Ω,
+    /// paper V).
     pub rs_hat: T,
     /// Use (i\[n\] + i[n−1])/2 for the resistive drop, which matches the interval the applied
-    /// voltage acted over (SPEC §1, \[A\]). Default `true`.
+    /// voltage acted over (SPEC §1, \[A\]). Default `true`
+    /// ([`EstimatorTuning::average_current`]).
     pub average_current: bool,
 }
 
-impl<T: Real> Default for FluxIntegratorConfig<T> {
-    fn default() -> Self {
+impl<T: Real> FluxIntegratorConfig<T> {
+    /// The integrator around `machine` (R̂s = [`MachineModel::rs`]) sampled every `ts`, with
+    /// the estimator's default `average_current` ([`EstimatorTuning::default`]).
+    pub fn for_machine(machine: &MachineModel<T>, ts: T) -> Self {
+        Self::with_tuning(machine, &EstimatorTuning::default(), ts)
+    }
+
+    /// The integrator around `machine` with `tuning`'s `average_current`, sampled every
+    /// `ts`: what the estimator builds.
+    pub fn with_tuning(machine: &MachineModel<T>, tuning: &EstimatorTuning<T>, ts: T) -> Self {
         Self {
-            ts: T::lit(100e-6),
-            rs_hat: T::lit(0.327),
-            average_current: true,
+            ts,
+            rs_hat: machine.rs,
+            average_current: tuning.average_current,
         }
     }
 }
@@ -221,11 +235,15 @@ impl<T: Real> FluxIntegrator<T> {
 }
 
 /// Configuration of a [`DisturbanceFeedback`].
+///
+/// No `Default`: Ts is the set-up's. Build it with [`with_ts`](Self::with_ts); each field's
+/// "Default" is what it gives.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DisturbanceFeedbackConfig<T> {
-    /// Sampling period Ts in s. Default 100 µs (paper, section V).
+    /// Sampling period Ts in s (paper, V: 100 µs). No default: the caller's.
     pub ts: T,
-    /// Disturbance feedback gain k_df in s⁻¹ (Fig. 3, eq. (21)). Default 0.5 (paper, V).
+    /// Disturbance feedback gain k_df in s⁻¹ (Fig. 3, eq. (21)). Default 0.5 (paper, V;
+    /// [`EstimatorTuning::k_df`]).
     pub k_df: T,
     /// Time to ramp k_df from 0 to its value on activation, s; 0 switches it abruptly as the
     /// paper does. A ramp softens the re-activation distortion of Fig. 9 (SPEC §1 \[A\]).
@@ -233,12 +251,20 @@ pub struct DisturbanceFeedbackConfig<T> {
     pub ramp_time: T,
 }
 
-impl<T: Real> Default for DisturbanceFeedbackConfig<T> {
-    fn default() -> Self {
+impl<T: Real> DisturbanceFeedbackConfig<T> {
+    /// The feedback sampled every `ts` with the estimator's default k_df and ramp
+    /// ([`EstimatorTuning::default`]: 0.5 s⁻¹, paper V; no ramp, as the paper).
+    pub fn with_ts(ts: T) -> Self {
+        Self::with_tuning(&EstimatorTuning::default(), ts)
+    }
+
+    /// The feedback with `tuning`'s `k_df` and `k_df_ramp_time`, sampled every `ts`: what
+    /// the estimator builds.
+    pub fn with_tuning(tuning: &EstimatorTuning<T>, ts: T) -> Self {
         Self {
-            ts: T::lit(100e-6),
-            k_df: T::lit(0.5),
-            ramp_time: T::zero(),
+            ts,
+            k_df: tuning.k_df,
+            ramp_time: tuning.k_df_ramp_time,
         }
     }
 }
@@ -328,20 +354,31 @@ impl<T: Real> DisturbanceFeedback<T> {
 }
 
 /// Configuration of a [`FluxLimiter`].
+///
+/// No `Default`: the radius is the motor's. Build it with [`for_machine`](Self::for_machine);
+/// each field's "Default" is what it gives.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FluxLimiterConfig<T> {
     /// Convergence gain k_af in s⁻¹ (Fig. 6, eq. (24)-(25)). Default 2π·100 (paper, V).
     pub k_af: T,
-    /// Radius ρ of the limiting circle in Wb. Default 1.15·0.088 = 0.1012 Wb (paper, V:
-    /// 1.15 times the flux linkage; λf = 0.088 Wb is SPEC §6 \[A\]).
+    /// Radius ρ of the limiting circle in Wb. Default 1.15·λ̂f (paper, V: 1.15 times the flux
+    /// linkage; [`EstimatorTuning::limiter_radius_ratio`]), 0.1012 Wb on the paper's motor.
     pub radius: T,
 }
 
-impl<T: Real> Default for FluxLimiterConfig<T> {
-    fn default() -> Self {
+impl<T: Real> FluxLimiterConfig<T> {
+    /// The limiter around `machine` with the estimator's default tuning
+    /// ([`EstimatorTuning::default`]): k_af = 2π·100 s⁻¹ and ρ = 1.15·λ̂f (paper, V).
+    pub fn for_machine(machine: &MachineModel<T>) -> Self {
+        Self::with_tuning(machine, &EstimatorTuning::default())
+    }
+
+    /// The limiter around `machine` with `tuning`: k_af = `k_af`, ρ = `limiter_radius_ratio`
+    /// × λ̂f ([`MachineModel::flux_linkage`]); what the estimator builds.
+    pub fn with_tuning(machine: &MachineModel<T>, tuning: &EstimatorTuning<T>) -> Self {
         Self {
-            k_af: T::lit(2.0 * core::f64::consts::PI * 100.0),
-            radius: T::lit(1.15 * 0.088),
+            k_af: tuning.k_af,
+            radius: tuning.limiter_radius_ratio * machine.flux_linkage,
         }
     }
 }

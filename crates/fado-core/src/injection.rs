@@ -4,19 +4,33 @@
 //! observable, and steers the integrand errors at standstill towards the positive d-axis where
 //! the rotor flux lies (paper, section V, Fig. 10 discussion).
 
-use crate::Real;
+use crate::control::DriveTuning;
 use crate::error::{ConfigError, check};
+use crate::{MachineModel, Real};
 
 /// Configuration of [`CurrentInjection`].
+///
+/// No `Default`: I_min is a current of the motor. Build it with
+/// [`for_machine`](Self::for_machine); the field's "Default" is what it gives.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CurrentInjectionConfig<T> {
-    /// Minimum current magnitude I_min in A. Default 4 A (paper, section V).
+    /// Minimum current magnitude I_min in A. Default 4/21.78 of the rated current
+    /// ([`DriveTuning::injection_current_ratio`]; paper, section V: 4 A on its motor).
     pub i_min: T,
 }
 
-impl<T: Real> Default for CurrentInjectionConfig<T> {
-    fn default() -> Self {
-        Self { i_min: T::lit(4.0) }
+impl<T: Real> CurrentInjectionConfig<T> {
+    /// I_min for `machine` with the drive's default ratio ([`DriveTuning::default`]'s
+    /// `injection_current_ratio`, 4/21.78 of the rated current: the paper's 4 A, V).
+    pub fn for_machine(machine: &MachineModel<T>) -> Self {
+        Self::with_tuning(machine, &DriveTuning::default())
+    }
+
+    /// I_min = `injection_current_ratio` × [`MachineModel::rated_current`].
+    pub fn with_tuning(machine: &MachineModel<T>, tuning: &DriveTuning<T>) -> Self {
+        Self {
+            i_min: tuning.injection_current_ratio * machine.rated_current,
+        }
     }
 }
 

@@ -35,38 +35,55 @@
 //! leaving a large ê behind.
 
 use crate::error::{ConfigError, check};
-use crate::{Ab, Real};
+use crate::estimator::EstimatorTuning;
+use crate::{Ab, MachineModel, Real};
 
 /// Configuration of [`IntegrandOffset`].
+///
+/// No `Default`: the bound is the motor's. Build it with [`for_machine`](Self::for_machine)
+/// (or [`with_tuning`](Self::with_tuning)); each field's "Default" is what they give.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct IntegrandOffsetConfig<T> {
     /// Period of the law in s: the sampling period Ts if it runs every sample, N·Ts in the
     /// estimator, which runs it once every N samples (see `SensorlessEstimator`'s slow
-    /// laws). Default 100 µs (paper, V).
+    /// laws). No default: the caller's sampling period.
     pub ts: T,
     /// k_e in s⁻¹: the rate at which ê follows the integrand's DC error while turning, 0 = off.
-    /// Default 2 s⁻¹ (ours \[A\]: ≈ 5 time constants within the 2.5 s the Fig. 11 profile
+    /// Default ([`EstimatorTuning::offset_adaptation_rate`]) 2 s⁻¹ (ours \[A\]: ≈ 5 time constants within the 2.5 s the Fig. 11 profile
     /// turns before its reversal; well below the observer's |ω̂| ≥ 2π·1.3 rad/s in the k_df
     /// mode, so that D̂ tracks the DC of λ1 as the law assumes).
     pub rate: T,
     /// The law starts only after this long in the k_df mode without interruption, s: D̂
     /// re-converges after each hand-over with the observer's poles at |ω̂| (SPEC §2), and
-    /// that transient is not an integrand error. Default 0.53 s = 5/(2π·1.5 Hz), five
-    /// observer time constants at the Fig. 3 threshold (ours \[A\]; the estimator sets it
-    /// from its threshold).
+    /// that transient is not an integrand error. Default 5/(2π·f_th), five observer
+    /// time constants at the Fig. 3 threshold f_th (ours \[A\]; 0.53 s on the paper's motor,
+    /// f_th = 1.5 Hz).
     pub settle_time: T,
-    /// Bound of |ê| in V. Default 0.83 V = λ̂f·2π·1.5 Hz (the paper's motor at the Fig. 3
-    /// threshold; the estimator sets it from its λ̂f and threshold).
+    /// Bound of |ê| in V. Default λ̂f·2π·f_th, the back-EMF at the Fig. 3 threshold (0.83 V
+    /// on the paper's motor).
     pub limit: T,
 }
 
-impl<T: Real> Default for IntegrandOffsetConfig<T> {
-    fn default() -> Self {
+impl<T: Real> IntegrandOffsetConfig<T> {
+    /// The law around `machine` with the estimator's default tuning
+    /// ([`EstimatorTuning::default`]), run with period `ts`. Same as
+    /// [`with_tuning`](Self::with_tuning)`(machine, &EstimatorTuning::default(), ts)`.
+    pub fn for_machine(machine: &MachineModel<T>, ts: T) -> Self {
+        Self::with_tuning(machine, &EstimatorTuning::default(), ts)
+    }
+
+    /// The law around `machine` with `tuning`, run with period `ts`: what the estimator
+    /// builds. With the Fig. 3 threshold f_th = `mode_threshold_ratio`·f_rated: `rate` is the
+    /// tuning's `offset_adaptation_rate` (default 2 s⁻¹, see the field), `settle_time`
+    /// 5/(2π·f_th) (five observer time constants at the threshold, ours \[A\]) and `limit`
+    /// λ̂f·2π·f_th (the back-EMF at the threshold, module docs).
+    pub fn with_tuning(machine: &MachineModel<T>, tuning: &EstimatorTuning<T>, ts: T) -> Self {
+        let threshold_hz = tuning.mode_threshold_ratio * machine.rated_frequency_hz();
         Self {
-            ts: T::lit(100e-6),
-            rate: T::lit(2.0),
-            settle_time: T::lit(5.0 / (2.0 * core::f64::consts::PI * 1.5)),
-            limit: T::lit(0.088 * 2.0 * core::f64::consts::PI * 1.5),
+            ts,
+            rate: tuning.offset_adaptation_rate,
+            settle_time: T::lit(5.0) / (T::two_pi() * threshold_hz),
+            limit: machine.flux_linkage * T::two_pi() * threshold_hz,
         }
     }
 }
@@ -241,9 +258,8 @@ mod tests {
         // A pure DC loop: dλ/dt = e − ê − k_df·λ, D̂ = λ. ê must reach e at rate k_e.
         let (ts, k_df, e) = (1e-4_f64, 0.5, Ab::new(0.1, -0.05));
         let mut law = IntegrandOffset::new(IntegrandOffsetConfig {
-            ts,
             settle_time: 0.0,
-            ..Default::default()
+            ..IntegrandOffsetConfig::for_machine(&MachineModel::paper(), ts)
         })
         .unwrap();
         let mut lambda = Ab::zero();
@@ -260,9 +276,8 @@ mod tests {
         // 8·ts, the same construction), the same continuous-time rate: D̂ − D̂_prev
         // telescopes, k_df·4·ts·D̂ the decay.
         let mut slow = IntegrandOffset::new(IntegrandOffsetConfig {
-            ts: 4.0 * ts,
             settle_time: 0.0,
-            ..Default::default()
+            ..IntegrandOffsetConfig::for_machine(&MachineModel::paper(), 4.0 * ts)
         })
         .unwrap();
         let mut lambda = Ab::zero();
@@ -287,7 +302,7 @@ mod tests {
         assert!(
             IntegrandOffset::<f64>::new(IntegrandOffsetConfig {
                 rate: -1.0,
-                ..Default::default()
+                ..IntegrandOffsetConfig::for_machine(&MachineModel::paper(), 1e-4)
             })
             .is_err()
         );

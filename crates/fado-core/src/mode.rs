@@ -1,8 +1,9 @@
 //! Selection between the two flux feedbacks by speed (paper, section V: k_df above 1.5 Hz
 //! electrical, the limiter k_af below), with hysteresis so that noise on ω̂ cannot chatter.
 
-use crate::Real;
 use crate::error::{ConfigError, check};
+use crate::estimator::EstimatorTuning;
+use crate::{MachineModel, Real};
 
 /// Which feedback closes the flux integrator.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -15,20 +16,38 @@ pub enum Mode {
 }
 
 /// Configuration of a [`ModeSelector`].
+///
+/// No `Default`: the threshold scales with the motor's rated speed. Build it with
+/// [`for_machine`](Self::for_machine); each field's "Default" is what it gives.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ModeSelectorConfig<T> {
-    /// Threshold on |ω̂|/2π in Hz, electrical. Default 1.5 Hz (paper, section V).
+    /// Threshold on |ω̂|/2π in Hz, electrical. Default 0.015 of the rated electrical
+    /// frequency ([`EstimatorTuning::mode_threshold_ratio`]; paper, section V: 1.5 Hz of its
+    /// motor's 100 Hz).
     pub threshold_hz: T,
     /// Half-width of the hysteresis band in Hz: enter above threshold + h, leave below
-    /// threshold − h. Default 0.2 Hz (SPEC §1 \[A\]).
+    /// threshold − h. Default 0.002 of the rated electrical frequency
+    /// ([`EstimatorTuning::mode_hysteresis_ratio`]; SPEC §1 \[A\]: 0.2 Hz on the paper's
+    /// motor).
     pub hysteresis_hz: T,
 }
 
-impl<T: Real> Default for ModeSelectorConfig<T> {
-    fn default() -> Self {
+impl<T: Real> ModeSelectorConfig<T> {
+    /// The selector for `machine` with the estimator's default tuning
+    /// ([`EstimatorTuning::default`]): threshold 0.015 and hysteresis 0.002 of the rated
+    /// electrical frequency (1.5 Hz and 0.2 Hz on the paper's motor: paper V, SPEC §1 \[A\]).
+    pub fn for_machine(machine: &MachineModel<T>) -> Self {
+        Self::with_tuning(machine, &EstimatorTuning::default())
+    }
+
+    /// The selector for `machine` with `tuning`: `mode_threshold_ratio` and
+    /// `mode_hysteresis_ratio` times [`MachineModel::rated_frequency_hz`]; what the
+    /// estimator builds.
+    pub fn with_tuning(machine: &MachineModel<T>, tuning: &EstimatorTuning<T>) -> Self {
+        let rated_hz = machine.rated_frequency_hz();
         Self {
-            threshold_hz: T::lit(1.5),
-            hysteresis_hz: T::lit(0.2),
+            threshold_hz: tuning.mode_threshold_ratio * rated_hz,
+            hysteresis_hz: tuning.mode_hysteresis_ratio * rated_hz,
         }
     }
 }
@@ -125,10 +144,24 @@ mod tests {
 
     #[test]
     fn hysteresis() {
-        let mut s = ModeSelector::new(ModeSelectorConfig::<f64>::default()).unwrap();
+        // The paper's motor: 100 Hz rated, threshold 1.5 Hz, hysteresis 0.2 Hz (paper, V).
+        let paper = ModeSelectorConfig::<f64>::for_machine(&MachineModel::paper());
+        let mut s = ModeSelector::new(paper).unwrap();
         assert_eq!(s.step(TAU * 1.6), Mode::Limiter);
         assert_eq!(s.step(-TAU * 1.71), Mode::DisturbanceFeedback);
         assert_eq!(s.step(TAU * 1.31), Mode::DisturbanceFeedback);
         assert_eq!(s.step(TAU * 1.29), Mode::Limiter);
+        // A 6-pole motor rated 1500 r/min: 75 Hz, so 1.125 Hz ± 0.15 Hz (the same ratios).
+        let six_pole = MachineModel {
+            pole_pairs: 3,
+            ..MachineModel::paper()
+        };
+        let c = ModeSelectorConfig::<f64>::for_machine(&six_pole);
+        assert!((c.threshold_hz - 1.125).abs() < 1e-12 && (c.hysteresis_hz - 0.15).abs() < 1e-12);
+        let mut s = ModeSelector::new(c).unwrap();
+        assert_eq!(s.step(TAU * 1.26), Mode::Limiter);
+        assert_eq!(s.step(TAU * 1.29), Mode::DisturbanceFeedback);
+        assert_eq!(s.step(-TAU * 0.99), Mode::DisturbanceFeedback);
+        assert_eq!(s.step(TAU * 0.96), Mode::Limiter);
     }
 }

@@ -38,14 +38,9 @@ use crate::{Ab, Real};
 /// Configuration of a [`DisturbanceObserver`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DisturbanceObserverConfig<T> {
-    /// Sampling period Ts in s. Default 100 µs (paper, section V: 10 kHz sampling).
+    /// Sampling period Ts in s (paper, section V: 100 µs, 10 kHz sampling). No default: the
+    /// set-up's.
     pub ts: T,
-}
-
-impl<T: Real> Default for DisturbanceObserverConfig<T> {
-    fn default() -> Self {
-        Self { ts: T::lit(100e-6) }
-    }
 }
 
 /// The discrete observer gains for one value of ω·Ts (see the module docs).

@@ -142,8 +142,9 @@
 //! passage needs.
 
 use crate::error::{ConfigError, check};
+use crate::estimator::EstimatorTuning;
 use crate::real::{all_finite, max, min};
-use crate::{Ab, Real};
+use crate::{Ab, MachineModel, Real};
 
 /// Lower bound of the adapted λ̂f as a multiple of the configured one (NdFeB loses ≈ 0.1 %/K,
 /// so the physical range is about ±15 %).
@@ -152,6 +153,10 @@ pub const FLUX_LINKAGE_MIN_RATIO: f64 = 0.85;
 /// limiter's 1.15, whose circle stays at the configured λ̂f, so that the standstill pull towards
 /// λ̂f never pushes against the limiter.
 pub const FLUX_LINKAGE_MAX_RATIO: f64 = 1.14;
+
+/// The λ̂f law runs above this multiple of the Fig. 3 threshold speed (see
+/// [`ResistanceAdaptationConfig::flux_linkage_min_speed`]).
+pub const FLUX_LINKAGE_SPEED_THRESHOLDS: f64 = 3.0;
 
 /// Dead zone ε of the λ̂f law as a multiple of the configured λ̂f: a revolution mean of
 /// |λ̂r| − λ̂a within ±ε moves nothing (module docs). 1 % (ours \[A\]): twice the largest
@@ -165,17 +170,21 @@ pub const FLUX_LINKAGE_DEAD_ZONE: f64 = 0.01;
 pub const FLUX_LINKAGE_DEAD_ZONE_OFF: f64 = 0.0025;
 
 /// Configuration of [`ResistanceAdaptation`].
+///
+/// No `Default`: R0, λ̂f, L̂d and L̂q are the motor's. Build it with
+/// [`for_machine`](Self::for_machine) (or [`with_tuning`](Self::with_tuning)); the
+/// "Default" of each field below is what those constructors give.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ResistanceAdaptationConfig<T> {
     /// Period of the law in s: the sampling period Ts if it runs every sample, N·Ts in the
     /// estimator, which runs it once every N samples (see `SensorlessEstimator`'s slow
-    /// laws). Default 100 µs (paper, V).
+    /// laws). No default: the caller's sampling period.
     pub ts: T,
-    /// Initial (configured) R̂s = R0 in Ω, the start value and the scale of the law. Default
-    /// 0.327 Ω (paper, V).
+    /// Initial (configured) R̂s = R0 in Ω, the start value and the scale of the law. From the
+    /// machine model ([`MachineModel::rs`]; the paper's motor: 0.327 Ω, paper V).
     pub rs_initial: T,
-    /// λ̂f in Wb: the start value of the flux-magnitude reference. Default 0.088 Wb (SPEC §6
-    /// \[A\]).
+    /// λ̂f in Wb: the start value of the flux-magnitude reference. From the machine model
+    /// ([`MachineModel::flux_linkage`]; the paper's motor: 0.088 Wb, SPEC §6 \[A\]).
     pub flux_linkage_hat: T,
     /// γ_f in s⁻¹: rate at which the flux-magnitude reference λ̂f follows the revolution
     /// mean of |λ̂r| − λ̂a (beyond its dead zone) while turning without resistance excitation
@@ -199,12 +208,13 @@ pub struct ResistanceAdaptationConfig<T> {
     /// law waits until ∫i_d·R0/λ̂f (configured λ̂f) reaches it. Default 0.2 (ours \[A\]: a 1 % R̂s error then
     /// moves |λ̂r| by 0.2 %, the size of the estimator's ripple).
     pub excitation_floor: T,
-    /// L̂q in H, for the d-axis voltage at standstill (the ω̂·L̂q·i_q term). Default 2.63 mH
-    /// (paper, V).
+    /// L̂q in H, for the d-axis voltage at standstill (the ω̂·L̂q·i_q term). From the machine
+    /// model ([`MachineModel::lq`]; the paper's motor: 2.63 mH, paper V).
     pub lq_hat: T,
     /// L̂d in H: the active flux λ̂f + (L̂d − L̂q)·i_d is the flux-magnitude reference of both
-    /// laws, and L̂d·di_d/dt the inductive d-axis voltage at standstill. Default 2.63 mH (paper,
-    /// V; = L̂q for the surface-magnet rotor).
+    /// laws, and L̂d·di_d/dt the inductive d-axis voltage at standstill. From the machine model
+    /// ([`MachineModel::ld`]; the paper's motor: 2.63 mH, paper V, = L̂q for its surface-magnet
+    /// rotor).
     pub ld_hat: T,
     /// γ_s in s⁻¹: rate at which R̂s follows the standstill estimate R_dc. Default 20 s⁻¹ (ours
     /// \[A\]: settles within the 0.1 s of injection before the paper's profiles start to turn).
@@ -223,8 +233,9 @@ pub struct ResistanceAdaptationConfig<T> {
     pub standstill_flux_rate: T,
     /// The λ̂f law runs only above this |ω̂|, rad/s: below it the voltage errors' share of
     /// |λ̂r| − λ̂f (the dead-time residual and the other voltage errors over ω) is not small
-    /// against a λ̂f error. Default 2π·4.5 Hz (ours \[A\]: three times the Fig. 3 threshold
-    /// of the paper's motor; the estimator sets it from its threshold).
+    /// against a λ̂f error. Default [`FLUX_LINKAGE_SPEED_THRESHOLDS`] (3) times the Fig. 3
+    /// threshold speed 2π·`mode_threshold_ratio`·f_rated (ours \[A\]; 2π·4.5 Hz on the
+    /// paper's motor).
     pub flux_linkage_min_speed: T,
     /// k_θ in s⁻¹: while the standstill DC test runs, the estimator also turns λ̂r towards
     /// the stator current at this rate (see the module docs: with the eq. (23) injection and
@@ -239,25 +250,48 @@ pub struct ResistanceAdaptationConfig<T> {
     pub max_ratio: T,
 }
 
-impl<T: Real> Default for ResistanceAdaptationConfig<T> {
-    fn default() -> Self {
+impl<T: Real> ResistanceAdaptationConfig<T> {
+    /// The laws around `machine` with the estimator's default tuning
+    /// ([`EstimatorTuning::default`]), run with period `ts` (the sampling period if the law
+    /// runs every sample; the estimator runs it every `SLOW_PERIOD` samples). Same as
+    /// [`with_tuning`](Self::with_tuning)`(machine, &EstimatorTuning::default(), ts)`.
+    pub fn for_machine(machine: &MachineModel<T>, ts: T) -> Self {
+        Self::with_tuning(machine, &EstimatorTuning::default(), ts)
+    }
+
+    /// The laws around `machine` with `tuning`, run with period `ts`: what the estimator
+    /// builds. Where each value comes from:
+    /// - `rs_initial`, `flux_linkage_hat`, `lq_hat`, `ld_hat`: the machine model (R̂s, λ̂f,
+    ///   L̂q, L̂d).
+    /// - `rate`, `excitation_floor`, `min_ratio`, `max_ratio`, `flux_linkage_rate`,
+    ///   `standstill_angle_rate`: the tuning's `rs_adaptation_*`, `flux_linkage_adaptation_rate`
+    ///   and `standstill_angle_rate` (defaults and their reasons in the fields' docs here).
+    /// - `flux_linkage_min_speed`: three times the Fig. 3 threshold speed,
+    ///   3·2π·`mode_threshold_ratio`·f_rated (ours \[A\], see the field).
+    /// - `standstill_rate` 20 s⁻¹, `standstill_memory_hz` 0.5 Hz, `standstill_speed_hz`
+    ///   0.25 Hz, `standstill_flux_rate` 2π·5 s⁻¹: fixed rates and durations of the standstill
+    ///   law (ours \[A\], see the fields), the same for every motor.
+    pub fn with_tuning(machine: &MachineModel<T>, tuning: &EstimatorTuning<T>, ts: T) -> Self {
+        let threshold_hz = tuning.mode_threshold_ratio * machine.rated_frequency_hz();
         Self {
-            ts: T::lit(100e-6),
-            rs_initial: T::lit(0.327),
-            flux_linkage_hat: T::lit(0.088),
-            flux_linkage_rate: T::lit(5.0),
-            rate: T::lit(1.0),
-            excitation_floor: T::lit(0.2),
-            lq_hat: T::lit(2.63e-3),
-            ld_hat: T::lit(2.63e-3),
+            ts,
+            rs_initial: machine.rs,
+            flux_linkage_hat: machine.flux_linkage,
+            flux_linkage_rate: tuning.flux_linkage_adaptation_rate,
+            rate: tuning.rs_adaptation_rate,
+            excitation_floor: tuning.rs_adaptation_excitation_floor,
+            lq_hat: machine.lq,
+            ld_hat: machine.ld,
             standstill_rate: T::lit(20.0),
             standstill_memory_hz: T::lit(0.5),
             standstill_speed_hz: T::lit(0.25),
             standstill_flux_rate: T::lit(2.0 * core::f64::consts::PI * 5.0),
-            standstill_angle_rate: T::lit(2.0),
-            flux_linkage_min_speed: T::lit(2.0 * core::f64::consts::PI * 4.5),
-            min_ratio: T::lit(0.5),
-            max_ratio: T::lit(2.0),
+            standstill_angle_rate: tuning.standstill_angle_rate,
+            flux_linkage_min_speed: T::lit(FLUX_LINKAGE_SPEED_THRESHOLDS)
+                * T::two_pi()
+                * threshold_hz,
+            min_ratio: tuning.rs_adaptation_min_ratio,
+            max_ratio: tuning.rs_adaptation_max_ratio,
         }
     }
 }

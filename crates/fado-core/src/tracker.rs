@@ -32,6 +32,7 @@
 //! exactly as written above (its results unchanged to the bit).
 
 use crate::error::{ConfigError, NonFiniteInput, check};
+use crate::estimator::EstimatorTuning;
 use crate::{Real, wrap_angle};
 
 /// How the tracker's bandwidth parameter is interpreted.
@@ -51,30 +52,41 @@ pub enum BandwidthDefinition {
 }
 
 /// Configuration of a [`TypeTwoTracker`].
+///
+/// No `Default`: the sampling period is the set-up's and the bandwidth the loop's. Build it
+/// with [`new`](Self::new); "Default" below is what it gives.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TrackerConfig<T> {
-    /// Sampling period Ts in s. Default 100 µs (paper, V).
+    /// Sampling period Ts in s (paper, V: 100 µs).
     pub ts: T,
-    /// Bandwidth in Hz. Default 60 Hz (paper, V: T2S-1); T2S-2 uses 35 Hz.
+    /// Bandwidth in Hz (paper, V: 60 Hz for T2S-1, 35 Hz for T2S-2; the estimator's
+    /// [`EstimatorTuning::t2s1_bandwidth_hz`], [`EstimatorTuning::t2s2_bandwidth_hz`]).
     pub bandwidth_hz: T,
-    /// Damping ratio ζ. Default 1/√2 (SPEC §3 \[A\]).
+    /// Damping ratio ζ. Default 1/√2 (SPEC §3 \[A\]; [`EstimatorTuning::tracker_damping`]).
     pub damping: T,
-    /// How `bandwidth_hz` is defined. Default −3 dB (SPEC §3).
+    /// How `bandwidth_hz` is defined. Default −3 dB (SPEC §3;
+    /// [`EstimatorTuning::bandwidth_definition`]).
     pub definition: BandwidthDefinition,
 }
 
-impl<T: Real> Default for TrackerConfig<T> {
-    fn default() -> Self {
+impl<T: Real> TrackerConfig<T> {
+    /// A tracker of `bandwidth_hz` sampled every `ts`, with the estimator's default damping
+    /// and bandwidth definition ([`EstimatorTuning::default`]: ζ = 1/√2, −3 dB; SPEC §3).
+    pub fn new(bandwidth_hz: T, ts: T) -> Self {
+        Self::with_tuning(&EstimatorTuning::default(), bandwidth_hz, ts)
+    }
+
+    /// A tracker of `bandwidth_hz` sampled every `ts` with `tuning`'s `tracker_damping` and
+    /// `bandwidth_definition`: what the estimator builds for T2S-1 and T2S-2.
+    pub fn with_tuning(tuning: &EstimatorTuning<T>, bandwidth_hz: T, ts: T) -> Self {
         Self {
-            ts: T::lit(100e-6),
-            bandwidth_hz: T::lit(60.0),
-            damping: T::lit(core::f64::consts::FRAC_1_SQRT_2),
-            definition: BandwidthDefinition::Minus3Db,
+            ts,
+            bandwidth_hz,
+            damping: tuning.tracker_damping,
+            definition: tuning.bandwidth_definition,
         }
     }
-}
 
-impl<T: Real> TrackerConfig<T> {
     /// The PI gains (Kp in s⁻¹, Ki in s⁻²) this configuration gives.
     pub fn gains(&self) -> (T, T) {
         let w_bw = T::two_pi() * self.bandwidth_hz;
@@ -326,7 +338,7 @@ mod tests {
 
     #[test]
     fn paper_bandwidths_give_spec_gains() {
-        let t1 = TrackerConfig::<f64>::default();
+        let t1 = TrackerConfig::<f64>::new(60.0, 100e-6);
         let (kp, ki) = t1.gains();
         assert!(
             (kp - 259.0).abs() < 0.5 && (ki - 33_551.0).abs() < 30.0,
@@ -345,7 +357,7 @@ mod tests {
 
     #[test]
     fn minus_3db_point_is_at_the_bandwidth() {
-        let c = TrackerConfig::<f64>::default();
+        let c = TrackerConfig::<f64>::new(60.0, 100e-6);
         let (kp, ki) = c.gains();
         let w = 2.0 * PI * 60.0;
         // |T(jw)|² = (Ki² + Kp²w²)/((Ki − w²)² + Kp²w²)
@@ -355,7 +367,7 @@ mod tests {
 
     #[test]
     fn constant_speed_zero_error_and_wraps() {
-        let mut t = TypeTwoTracker::new(TrackerConfig::<f64>::default()).unwrap();
+        let mut t = TypeTwoTracker::new(TrackerConfig::<f64>::new(60.0, 100e-6)).unwrap();
         let w = -2.0 * PI * 20.0;
         let ts = 1e-4;
         let mut err = 1.0;
@@ -372,7 +384,7 @@ mod tests {
     #[test]
     fn speed_ramp_gives_constant_lag_alpha_over_ki() {
         // Type 2: a constant acceleration α leaves the constant angle error α/Ki and ω̂ tracks.
-        let mut t = TypeTwoTracker::new(TrackerConfig::<f64>::default()).unwrap();
+        let mut t = TypeTwoTracker::new(TrackerConfig::<f64>::new(60.0, 100e-6)).unwrap();
         let (_, ki) = t.gains();
         let ts = 1e-4;
         let alpha = 37.7; // 90 r/min/s, 4 pole pairs
@@ -418,7 +430,7 @@ mod tests {
     fn discrete_poles_match_formula() {
         // The map (θ̂⁻, ω̂) → (θ̂⁻⁺, ω̂⁺) with θm = 0 is linear: probe its matrix and check its
         // characteristic polynomial is z² − (2 − KpTs − KiTs²)z + (1 − KpTs).
-        let c = TrackerConfig::<f64>::default();
+        let c = TrackerConfig::<f64>::new(60.0, 100e-6);
         let (kp, ki) = c.gains();
         let ts = c.ts;
         let mut t = TypeTwoTracker::new(c).unwrap();
@@ -473,7 +485,7 @@ mod tests {
             2.0 * PI * 1.5,
             2.0 * PI * 400.0,
         ] {
-            let mut t = TypeTwoTracker::new(TrackerConfig::<f32>::default()).unwrap();
+            let mut t = TypeTwoTracker::new(TrackerConfig::<f32>::new(60.0, 100e-6)).unwrap();
             let (kp, ki) = t.gains();
             let ts = 1e-4_f32;
             let (kp_ts, ki_ts) = (ts * kp, ki * ts);
@@ -506,7 +518,7 @@ mod tests {
     fn rejects_unstable_bandwidth() {
         let c = TrackerConfig {
             bandwidth_hz: 5_000.0,
-            ..TrackerConfig::<f64>::default()
+            ..TrackerConfig::<f64>::new(60.0, 100e-6)
         };
         assert_eq!(TypeTwoTracker::new(c).unwrap_err().field(), "bandwidth_hz");
     }

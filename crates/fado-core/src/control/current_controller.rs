@@ -16,49 +16,75 @@
 //! voltage, the caller limits it (to the hexagon, after rotation and compensation) and hands
 //! the realisable d-q voltage back through [`CurrentController::realised`].
 
+use crate::control::DriveTuning;
 use crate::control::pi::{Pi, PiConfig};
 use crate::error::{ConfigError, NonFiniteInput, check};
-use crate::{Dq, Real};
+use crate::{Dq, MachineModel, Real};
+
+/// Hard bound of the current PIs' voltage and integral in V, default of
+/// [`CurrentControllerConfig::voltage_bound`] \[A\]: a last guard against absurd estimates,
+/// far above what the modulation lets through for the DC links fado has been run with
+/// (24–565 V). An absolute voltage, not a ratio of the DC link: it only ever acts on estimates
+/// that are wrong, and changing it would change no result of a working drive.
+pub const CURRENT_VOLTAGE_BOUND: f64 = 1000.0;
 
 /// Configuration of a [`CurrentController`].
+///
+/// No `Default`: R̂s, L̂d, L̂q and λ̂f are the motor's. Build it with
+/// [`for_machine`](Self::for_machine); each field's "Default" is what it gives.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CurrentControllerConfig<T> {
-    /// Sampling period Ts in s. Default 100 µs (paper, V).
+    /// Sampling period Ts in s (paper, V: 100 µs).
     pub ts: T,
-    /// Stator resistance estimate R̂s in Ω. Default 0.327 Ω (paper, V).
+    /// Stator resistance estimate R̂s in Ω: the machine model's (the paper's motor: 0.327 Ω,
+    /// paper V).
     pub rs_hat: T,
-    /// d-axis inductance estimate L̂d in H. Default 2.63 mH (paper, V).
+    /// d-axis inductance estimate L̂d in H: the machine model's (the paper's motor: 2.63 mH).
     pub ld_hat: T,
-    /// q-axis inductance estimate L̂q in H. Default 2.63 mH (paper, V).
+    /// q-axis inductance estimate L̂q in H: the machine model's (the paper's motor: 2.63 mH).
     pub lq_hat: T,
-    /// Magnet flux linkage estimate λ̂f in Wb (back-EMF feed-forward). Default 0.088 Wb
-    /// (SPEC §6 \[A\]).
+    /// Magnet flux linkage estimate λ̂f in Wb (back-EMF feed-forward): the machine model's
+    /// (the paper's motor: 0.088 Wb, SPEC §6 \[A\]).
     pub flux_linkage_hat: T,
-    /// Closed-loop bandwidth in Hz. Default 250 Hz (paper, V). Limited to ωc·Ts ≤ 0.5 so the
-    /// 1.5-sample loop delay leaves at least 47° of phase margin.
+    /// Closed-loop bandwidth in Hz. Default 250 Hz (paper, V;
+    /// [`DriveTuning::current_bandwidth_hz`]). Limited to ωc·Ts ≤ 0.5 so the 1.5-sample loop
+    /// delay leaves at least 47° of phase margin.
     pub bandwidth_hz: T,
-    /// Add the decoupling and back-EMF feed-forward. Default true (SPEC §6 \[A\]).
+    /// Add the decoupling and back-EMF feed-forward. Default true (SPEC §6 \[A\];
+    /// [`DriveTuning::decoupling`]).
     pub decoupling: bool,
     /// Back-calculation gain as a multiple of Ki/Kp = R̂s/L̂ (see [`PiConfig`]). Default 1, the
-    /// realisable reference \[A\].
+    /// realisable reference \[A\] ([`DriveTuning::current_anti_windup_ratio`]).
     pub anti_windup_ratio: T,
     /// Hard bound on each axis' voltage and integral in V, a last guard against absurd
-    /// estimates; the real limit is the inverter's (modulation). Default 1000 V \[A\].
+    /// estimates; the real limit is the inverter's (modulation). Default
+    /// [`CURRENT_VOLTAGE_BOUND`].
     pub voltage_bound: T,
 }
 
-impl<T: Real> Default for CurrentControllerConfig<T> {
-    fn default() -> Self {
+impl<T: Real> CurrentControllerConfig<T> {
+    /// The current loop for `machine` sampled every `ts`, with the drive's default tuning
+    /// ([`DriveTuning::default`]). Same as [`with_tuning`](Self::with_tuning)`(machine,
+    /// &DriveTuning::default(), ts)`.
+    pub fn for_machine(machine: &MachineModel<T>, ts: T) -> Self {
+        Self::with_tuning(machine, &DriveTuning::default(), ts)
+    }
+
+    /// The current loop for `machine` with `tuning`, sampled every `ts`: what the drive
+    /// builds. R̂s, L̂d, L̂q and λ̂f are the machine model's; `bandwidth_hz`, `decoupling` and
+    /// `anti_windup_ratio` the tuning's `current_bandwidth_hz`, `decoupling` and
+    /// `current_anti_windup_ratio`; `voltage_bound` is [`CURRENT_VOLTAGE_BOUND`].
+    pub fn with_tuning(machine: &MachineModel<T>, tuning: &DriveTuning<T>, ts: T) -> Self {
         Self {
-            ts: T::lit(100e-6),
-            rs_hat: T::lit(0.327),
-            ld_hat: T::lit(2.63e-3),
-            lq_hat: T::lit(2.63e-3),
-            flux_linkage_hat: T::lit(0.088),
-            bandwidth_hz: T::lit(250.0),
-            decoupling: true,
-            anti_windup_ratio: T::one(),
-            voltage_bound: T::lit(1000.0),
+            ts,
+            rs_hat: machine.rs,
+            ld_hat: machine.ld,
+            lq_hat: machine.lq,
+            flux_linkage_hat: machine.flux_linkage,
+            bandwidth_hz: tuning.current_bandwidth_hz,
+            decoupling: tuning.decoupling,
+            anti_windup_ratio: tuning.current_anti_windup_ratio,
+            voltage_bound: T::lit(CURRENT_VOLTAGE_BOUND),
         }
     }
 }

@@ -48,9 +48,10 @@
 //! voltage/current distortion in PWM VSI systems operating
 //! with low output voltages", IEEE Trans. Ind. Appl. 31(5), 1995.
 
+use crate::control::DriveTuning;
 use crate::control::pi::clamp;
 use crate::error::{ConfigError, check};
-use crate::{Ab, Abc, Dq, Real, Rotation};
+use crate::{Ab, Abc, Dq, MachineModel, Real, Rotation};
 
 /// How the compensation voltage follows the current.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -72,36 +73,54 @@ pub enum DeadTimeMethod {
 }
 
 /// Configuration of a [`DeadTimeCompensation`].
+///
+/// No `Default`: the dead time, switching frequency, threshold and band are the inverter's and
+/// the ripple inductances the motor's. Build it with [`for_machine`](Self::for_machine) or
+/// [`with_tuning`](Self::with_tuning); each field's "Default" is what `for_machine` gives.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DeadTimeCompensationConfig<T> {
-    /// Compensate at all. Default true (paper IV-B).
+    /// Compensate at all. Default true (paper IV-B; [`DriveTuning::dead_time_compensation`]).
     pub enabled: bool,
-    /// Shape. Default [`DeadTimeMethod::Trapezoidal`] (SPEC §5 \[A\]).
+    /// Shape. Default [`DeadTimeMethod::EdgeCurrent`] ([`DriveTuning::dead_time_method`]).
     pub method: DeadTimeMethod,
-    /// Dead time Td in s. Default 2.5 µs (paper, V).
+    /// Dead time Td in s (inverter datum). Default 2.5 µs (paper, V; [`DriveTuning::dead_time`]).
     pub dead_time: T,
-    /// Switching frequency f_sw in Hz. Default 5 kHz (paper, V).
+    /// Switching frequency f_sw in Hz (inverter datum). Default 5 kHz (paper, V;
+    /// [`DriveTuning::switching_frequency`]).
     pub switching_frequency: T,
-    /// Device threshold voltage V_th in V. Default 1 V (SPEC §5 \[A\]).
+    /// Device threshold voltage V_th in V (inverter datum). Default 1 V (SPEC §5 \[A\];
+    /// [`DriveTuning::dead_time_threshold_voltage`]).
     pub threshold_voltage: T,
-    /// Current band Ic of the trapezoid in A. Default 0.3 A (SPEC §5 \[A\]).
+    /// Current band Ic of the trapezoid in A (inverter datum). Default 0.3 A (SPEC §5 \[A\];
+    /// [`DriveTuning::dead_time_current_band`]).
     pub current_band: T,
     /// Inductances (L̂d, L̂q) of the ripple prediction of [`DeadTimeMethod::EdgeCurrent`] in H,
-    /// in the rotor frame of the rotation it is given (the drive gives its machine model's).
-    /// Default 0: no ripple.
+    /// in the rotor frame of the rotation it is given; 0: no ripple (the trapezoid). Default
+    /// the machine model's (L̂d, L̂q).
     pub ripple_inductance: Dq<T>,
 }
 
-impl<T: Real> Default for DeadTimeCompensationConfig<T> {
-    fn default() -> Self {
+impl<T: Real> DeadTimeCompensationConfig<T> {
+    /// The compensation for `machine` (ripple inductances L̂d, L̂q of the edge-current method)
+    /// on the drive's default inverter data and method ([`DriveTuning::default`]: 2.5 µs,
+    /// 5 kHz (paper, V), 1 V, 0.3 A (SPEC §5 \[A\]), [`DeadTimeMethod::EdgeCurrent`]).
+    /// Those inverter data are the paper's set-up: give your inverter's through
+    /// [`with_tuning`](Self::with_tuning) or the fields.
+    pub fn for_machine(machine: &MachineModel<T>) -> Self {
+        Self::with_tuning(machine, &DriveTuning::default())
+    }
+
+    /// The compensation for `machine` with `tuning`'s `dead_time*` and `switching_frequency`
+    /// fields: what the drive builds.
+    pub fn with_tuning(machine: &MachineModel<T>, tuning: &DriveTuning<T>) -> Self {
         Self {
-            enabled: true,
-            method: DeadTimeMethod::Trapezoidal,
-            dead_time: T::lit(2.5e-6),
-            switching_frequency: T::lit(5e3),
-            threshold_voltage: T::one(),
-            current_band: T::lit(0.3),
-            ripple_inductance: Dq::zero(),
+            enabled: tuning.dead_time_compensation,
+            method: tuning.dead_time_method,
+            dead_time: tuning.dead_time,
+            switching_frequency: tuning.switching_frequency,
+            threshold_voltage: tuning.dead_time_threshold_voltage,
+            current_band: tuning.dead_time_current_band,
+            ripple_inductance: Dq::new(machine.ld, machine.lq),
         }
     }
 }
@@ -353,7 +372,8 @@ mod tests {
     fn comp(method: DeadTimeMethod) -> DeadTimeCompensation<f64> {
         DeadTimeCompensation::new(DeadTimeCompensationConfig {
             method,
-            ..DeadTimeCompensationConfig::default()
+            ripple_inductance: Dq::zero(),
+            ..DeadTimeCompensationConfig::for_machine(&MachineModel::paper())
         })
         .unwrap()
     }
@@ -365,7 +385,7 @@ mod tests {
         assert!((c.amplitude(300.0) - 4.75).abs() < 1e-12);
         let off = DeadTimeCompensation::new(DeadTimeCompensationConfig {
             enabled: false,
-            ..DeadTimeCompensationConfig::<f64>::default()
+            ..DeadTimeCompensationConfig::<f64>::for_machine(&MachineModel::paper())
         })
         .unwrap();
         assert_eq!(off.amplitude(300.0), 0.0);
@@ -452,7 +472,7 @@ mod tests {
         DeadTimeCompensation::new(DeadTimeCompensationConfig {
             method: DeadTimeMethod::EdgeCurrent,
             ripple_inductance: l,
-            ..DeadTimeCompensationConfig::default()
+            ..DeadTimeCompensationConfig::for_machine(&MachineModel::paper())
         })
         .unwrap()
     }
@@ -505,7 +525,7 @@ mod tests {
     #[test]
     fn bad_config_names_field() {
         let bad = |f: fn(&mut DeadTimeCompensationConfig<f64>)| {
-            let mut cfg = DeadTimeCompensationConfig::default();
+            let mut cfg = DeadTimeCompensationConfig::for_machine(&MachineModel::paper());
             f(&mut cfg);
             DeadTimeCompensation::new(cfg).unwrap_err().field()
         };

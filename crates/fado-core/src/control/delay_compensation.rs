@@ -8,24 +8,36 @@
 //! 1.5·ω·Ts (0.094 rad at 1500 r/min), which couples the axes and, in the estimator, rotates
 //! the integrand.
 
+use crate::control::DriveTuning;
 use crate::error::{ConfigError, check};
 use crate::{Ab, Dq, Real, Rotation, wrap_angle};
 
 /// Configuration of a [`DelayCompensation`].
+///
+/// No `Default`: Ts is the set-up's. Build it with [`with_ts`](Self::with_ts).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DelayCompensationConfig<T> {
-    /// Sampling period Ts in s. Default 100 µs (paper, V).
+    /// Sampling period Ts in s (paper, V: 100 µs). No default: the set-up's.
     pub ts: T,
-    /// Advance in samples k: 1 of computation + ½ of PWM hold. Default 1.5 (SPEC §5 \[A\]);
+    /// Advance in samples k: 1 of computation + ½ of PWM hold. Default 1.5 (SPEC §5 \[A\];
+    /// [`DriveTuning::delay_compensation_factor`]);
     /// 0 switches the compensation off.
     pub factor: T,
 }
 
-impl<T: Real> Default for DelayCompensationConfig<T> {
-    fn default() -> Self {
+impl<T: Real> DelayCompensationConfig<T> {
+    /// The compensation sampled every `ts` with the drive's default advance
+    /// ([`DriveTuning::default`]'s `delay_compensation_factor`, 1.5 samples).
+    pub fn with_ts(ts: T) -> Self {
+        Self::with_tuning(&DriveTuning::default(), ts)
+    }
+
+    /// The compensation sampled every `ts` with `tuning`'s `delay_compensation_factor`: what
+    /// the drive builds.
+    pub fn with_tuning(tuning: &DriveTuning<T>, ts: T) -> Self {
         Self {
-            ts: T::lit(100e-6),
-            factor: T::lit(1.5),
+            ts,
+            factor: tuning.delay_compensation_factor,
         }
     }
 }
@@ -115,7 +127,7 @@ mod tests {
 
     #[test]
     fn reused_rotation_matches_the_direct_one() {
-        let dc = DelayCompensation::new(DelayCompensationConfig::<f64>::default()).unwrap();
+        let dc = DelayCompensation::new(DelayCompensationConfig::<f64>::with_ts(100e-6)).unwrap();
         let v = Dq::new(3.0, -7.0);
         // Polynomial branch up to |δ| = 0.25 (ω = 0.25 / 150 µs) and the fallback beyond.
         for &w in &[
@@ -132,7 +144,7 @@ mod tests {
 
     #[test]
     fn advances_by_one_and_a_half_samples() {
-        let dc = DelayCompensation::new(DelayCompensationConfig::<f64>::default()).unwrap();
+        let dc = DelayCompensation::new(DelayCompensationConfig::<f64>::with_ts(100e-6)).unwrap();
         let w = 2.0 * core::f64::consts::PI * 100.0;
         let (v, rot) = dc.step(Dq::new(0.0, 10.0), 0.3, w);
         let expected = 0.3 + 1.5 * w * 100e-6;

@@ -933,67 +933,27 @@ impl<T: Real> Blocks<T> {
         };
         // The speed PI's output is a torque in units of the magnet's q current (see
         // `currents_for_torque`): with MTPA on a salient rotor its limit is the torque of the
-        // MTPA point on the current circle |i| = I_max, i_d = (λ̂f − √(λ̂f² + 8·ΔL²·I_max²))/(4·ΔL)
-        // with ΔL = L̂q − L̂d (Morimoto et al. 1990), so that saturation still reaches I_max.
-        let dl = m.lq - m.ld;
-        let torque_limit = if t.mtpa && m.is_salient() && dl > T::zero() {
-            let lf = m.flux_linkage;
-            let id = (lf - (lf * lf + T::lit(8.0) * dl * dl * i_max * i_max).sqrt())
-                / (T::lit(4.0) * dl);
-            let iq = (i_max * i_max - id * id).max(T::zero()).sqrt();
-            (m.active_flux(id) * iq / lf).max(i_max)
-        } else {
-            i_max
-        };
-        let speed = SpeedController::new(SpeedControllerConfig {
-            ts,
-            pole_pairs: T::lit(m.pole_pairs as f64),
-            inertia_hat: m.inertia,
-            flux_linkage_hat: m.flux_linkage,
-            bandwidth_hz: t.speed_bandwidth_hz,
-            zero_ratio: t.speed_zero_ratio,
-            i_max: torque_limit,
-            anti_windup_ratio: t.speed_anti_windup_ratio,
-        })
-        .map_err(rename(&[
-            ("bandwidth_hz", "speed_bandwidth_hz"),
-            ("zero_ratio", "speed_zero_ratio"),
-            ("anti_windup_ratio", "speed_anti_windup_ratio"),
-        ]))?;
-        let injection = CurrentInjection::new(CurrentInjectionConfig { i_min })?;
-        let current = CurrentController::new(CurrentControllerConfig {
-            ts,
-            rs_hat: m.rs,
-            ld_hat: m.ld,
-            lq_hat: m.lq,
-            flux_linkage_hat: m.flux_linkage,
-            bandwidth_hz: t.current_bandwidth_hz,
-            decoupling: t.decoupling,
-            anti_windup_ratio: t.current_anti_windup_ratio,
-            ..CurrentControllerConfig::default()
-        })
-        .map_err(rename(&[
-            ("bandwidth_hz", "current_bandwidth_hz"),
-            ("anti_windup_ratio", "current_anti_windup_ratio"),
-        ]))?;
-        let delay = DelayCompensation::new(DelayCompensationConfig {
-            ts,
-            factor: t.delay_compensation_factor,
-        })
-        .map_err(rename(&[("factor", "delay_compensation_factor")]))?;
-        let dead_time = DeadTimeCompensation::new(DeadTimeCompensationConfig {
-            enabled: t.dead_time_compensation,
-            method: t.dead_time_method,
-            dead_time: t.dead_time,
-            switching_frequency: t.switching_frequency,
-            threshold_voltage: t.dead_time_threshold_voltage,
-            current_band: t.dead_time_current_band,
-            ripple_inductance: Dq::new(m.ld, m.lq),
-        })
-        .map_err(rename(&[
-            ("threshold_voltage", "dead_time_threshold_voltage"),
-            ("current_band", "dead_time_current_band"),
-        ]))?;
+        // MTPA point on the current circle |i| = I_max (`SpeedControllerConfig::with_tuning`).
+        let speed = SpeedController::new(SpeedControllerConfig::with_tuning(m, t, ts)).map_err(
+            rename(&[
+                ("bandwidth_hz", "speed_bandwidth_hz"),
+                ("zero_ratio", "speed_zero_ratio"),
+                ("anti_windup_ratio", "speed_anti_windup_ratio"),
+            ]),
+        )?;
+        let injection = CurrentInjection::new(CurrentInjectionConfig::with_tuning(m, t))?;
+        let current = CurrentController::new(CurrentControllerConfig::with_tuning(m, t, ts))
+            .map_err(rename(&[
+                ("bandwidth_hz", "current_bandwidth_hz"),
+                ("anti_windup_ratio", "current_anti_windup_ratio"),
+            ]))?;
+        let delay = DelayCompensation::new(DelayCompensationConfig::with_tuning(t, ts))
+            .map_err(rename(&[("factor", "delay_compensation_factor")]))?;
+        let dead_time = DeadTimeCompensation::new(DeadTimeCompensationConfig::with_tuning(m, t))
+            .map_err(rename(&[
+                ("threshold_voltage", "dead_time_threshold_voltage"),
+                ("current_band", "dead_time_current_band"),
+            ]))?;
         let modulator = SpaceVectorModulator::new(ModulatorConfig {
             limit: t.voltage_limit,
             max_modulation: t.max_modulation,

@@ -28,35 +28,24 @@ use crate::Real;
 use crate::error::{ConfigError, NonFiniteInput, check};
 
 /// Configuration of a [`Pi`].
+///
+/// No `Default`: every field is the loop's (the current and speed controllers set theirs from
+/// SPEC §6 and the machine model).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PiConfig<T> {
-    /// Sampling period Ts in s. Default 100 µs (paper, V: 10 kHz sampling).
+    /// Sampling period Ts in s (paper, V: 100 µs, 10 kHz sampling).
     pub ts: T,
-    /// Proportional gain Kp (> 0). Default 1 (neutral placeholder \[A\]; the loops set theirs
-    /// from SPEC §6).
+    /// Proportional gain Kp (> 0).
     pub kp: T,
-    /// Integral gain Ki in s⁻¹ (≥ 0). Default 0 \[A\].
+    /// Integral gain Ki in s⁻¹ (≥ 0).
     pub ki: T,
-    /// Lower output limit. Default −1 \[A\].
+    /// Lower output limit.
     pub output_min: T,
-    /// Upper output limit (> `output_min`). Default 1 \[A\].
+    /// Upper output limit (> `output_min`).
     pub output_max: T,
-    /// Back-calculation gain as a multiple r of Ki/Kp (≥ 0, with r·Ki/Kp·Ts ≤ 1). Default 1:
-    /// the realisable-reference setting, the integral never winds beyond the limit \[A\].
+    /// Back-calculation gain as a multiple r of Ki/Kp (≥ 0, with r·Ki/Kp·Ts ≤ 1). 1 is the
+    /// realisable-reference setting: the integral never winds beyond the limit \[A\].
     pub anti_windup_ratio: T,
-}
-
-impl<T: Real> Default for PiConfig<T> {
-    fn default() -> Self {
-        Self {
-            ts: T::lit(100e-6),
-            kp: T::one(),
-            ki: T::zero(),
-            output_min: -T::one(),
-            output_max: T::one(),
-            anti_windup_ratio: T::one(),
-        }
-    }
 }
 
 /// Discrete PI controller with limits and back-calculation anti-windup (module docs).
@@ -287,7 +276,14 @@ mod tests {
         c.realised(f64::NAN);
         assert_eq!(c, before);
         let bad = |f: fn(&mut PiConfig<f64>)| {
-            let mut cfg = PiConfig::default();
+            let mut cfg = PiConfig {
+                ts: 100e-6,
+                kp: 1.0,
+                ki: 0.0,
+                output_min: -1.0,
+                output_max: 1.0,
+                anti_windup_ratio: 1.0,
+            };
             f(&mut cfg);
             Pi::new(cfg).unwrap_err().field()
         };

@@ -6,46 +6,81 @@
 //! ≈ ωsc and atan(5) = 79° of phase margin. Those gains are per *mechanical* rad/s; the
 //! controller works in electrical rad/s (the estimator's unit), so it divides Kp and Ki by p.
 
+use crate::control::DriveTuning;
 use crate::control::pi::{Pi, PiConfig};
 use crate::error::{ConfigError, NonFiniteInput, check};
-use crate::{Dq, Real};
+use crate::{Dq, MachineModel, Real};
 
 /// Configuration of a [`SpeedController`].
+///
+/// No `Default`: Ĵ, λ̂f, p and the current limit are the motor's. Build it with
+/// [`for_machine`](Self::for_machine); each field's "Default" is what it gives.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SpeedControllerConfig<T> {
-    /// Sampling period Ts in s. Default 100 µs (paper, V: the loop runs every sample).
+    /// Sampling period Ts in s (paper, V: 100 µs; the loop runs every sample).
     pub ts: T,
-    /// Pole pairs p. Default 4 (paper, V: 8 poles).
+    /// Pole pairs p: the machine model's (the paper's motor: 4, 8 poles).
     pub pole_pairs: T,
-    /// Inertia estimate Ĵ in kg·m². Default 0.012 (SPEC §6 \[A\]).
+    /// Inertia estimate Ĵ in kg·m²: the machine model's (the paper's motor: 0.012, SPEC §6
+    /// \[A\]).
     pub inertia_hat: T,
-    /// Magnet flux linkage estimate λ̂f in Wb, for K̂t = 1.5·p·λ̂f. Default 0.088 (SPEC §6 \[A\]).
+    /// Magnet flux linkage estimate λ̂f in Wb, for K̂t = 1.5·p·λ̂f: the machine model's (the
+    /// paper's motor: 0.088, SPEC §6 \[A\]).
     pub flux_linkage_hat: T,
-    /// Speed-loop bandwidth in Hz. Default 5 Hz (paper, V).
+    /// Speed-loop bandwidth in Hz. Default 5 Hz (paper, V; [`DriveTuning::speed_bandwidth_hz`]).
     pub bandwidth_hz: T,
     /// Ratio ωsc/(Ki/Kp): the PI zero sits this many times below the crossover. Default 5
-    /// (SPEC §6: Ki = Kp·2π·5/5).
+    /// (SPEC §6: Ki = Kp·2π·5/5; [`DriveTuning::speed_zero_ratio`]).
     pub zero_ratio: T,
-    /// Current limit I_max in A (q-axis output limit). Default 40 A (SPEC §6 \[A\]).
+    /// Output limit in A of q current (in units of the magnet's q current on a salient rotor
+    /// with MTPA). Default [`DriveTuning::current_limit_ratio`] × the rated current (SPEC §6
+    /// \[A\]: 40 A on the paper's motor), see [`with_tuning`](Self::with_tuning).
     pub i_max: T,
-    /// Back-calculation gain as a multiple of Ki/Kp (see [`PiConfig`]). Default 5, i.e. a
+    /// Back-calculation gain as a multiple of Ki/Kp (see [`PiConfig`]; default
+    /// [`DriveTuning::speed_anti_windup_ratio`]). Default 5, i.e. a
     /// tracking time constant of 1/ωsc: with the realisable setting (1) the integral relaxes
     /// only with 5/ωsc = 160 ms and a long saturated acceleration leaves it near I_max,
     /// which costs a large speed overshoot \[A\].
     pub anti_windup_ratio: T,
 }
 
-impl<T: Real> Default for SpeedControllerConfig<T> {
-    fn default() -> Self {
+impl<T: Real> SpeedControllerConfig<T> {
+    /// The speed loop for `machine` sampled every `ts`, with the drive's default tuning
+    /// ([`DriveTuning::default`]). Same as [`with_tuning`](Self::with_tuning)`(machine,
+    /// &DriveTuning::default(), ts)`.
+    pub fn for_machine(machine: &MachineModel<T>, ts: T) -> Self {
+        Self::with_tuning(machine, &DriveTuning::default(), ts)
+    }
+
+    /// The speed loop for `machine` with `tuning`, sampled every `ts`: what the drive builds.
+    /// p, Ĵ and λ̂f are the machine model's; `bandwidth_hz`, `zero_ratio` and
+    /// `anti_windup_ratio` the tuning's `speed_*` fields; `i_max` is the current limit
+    /// `current_limit_ratio` × the rated current, raised on a salient rotor with `mtpa` to the
+    /// torque of the MTPA point on the circle |i| = I_max, in units of the magnet's q current
+    /// (see the field), so that saturation still reaches I_max.
+    pub fn with_tuning(machine: &MachineModel<T>, tuning: &DriveTuning<T>, ts: T) -> Self {
+        let m = machine;
+        let i_max = tuning.current_limit_ratio * m.rated_current;
+        // i_d = (λ̂f − √(λ̂f² + 8·ΔL²·I_max²))/(4·ΔL), ΔL = L̂q − L̂d (Morimoto et al. 1990).
+        let dl = m.lq - m.ld;
+        let torque_limit = if tuning.mtpa && m.is_salient() && dl > T::zero() {
+            let lf = m.flux_linkage;
+            let id = (lf - (lf * lf + T::lit(8.0) * dl * dl * i_max * i_max).sqrt())
+                / (T::lit(4.0) * dl);
+            let iq = (i_max * i_max - id * id).max(T::zero()).sqrt();
+            (m.active_flux(id) * iq / lf).max(i_max)
+        } else {
+            i_max
+        };
         Self {
-            ts: T::lit(100e-6),
-            pole_pairs: T::lit(4.0),
-            inertia_hat: T::lit(0.012),
-            flux_linkage_hat: T::lit(0.088),
-            bandwidth_hz: T::lit(5.0),
-            zero_ratio: T::lit(5.0),
-            i_max: T::lit(40.0),
-            anti_windup_ratio: T::lit(5.0),
+            ts,
+            pole_pairs: T::lit(m.pole_pairs as f64),
+            inertia_hat: m.inertia,
+            flux_linkage_hat: m.flux_linkage,
+            bandwidth_hz: tuning.speed_bandwidth_hz,
+            zero_ratio: tuning.speed_zero_ratio,
+            i_max: torque_limit,
+            anti_windup_ratio: tuning.speed_anti_windup_ratio,
         }
     }
 }
@@ -153,7 +188,11 @@ mod tests {
 
     #[test]
     fn gains_follow_spec_6() {
-        let c = SpeedController::<f64>::new(SpeedControllerConfig::default()).unwrap();
+        let c = SpeedController::<f64>::new(SpeedControllerConfig::for_machine(
+            &MachineModel::paper(),
+            100e-6,
+        ))
+        .unwrap();
         let kt = 1.5 * 4.0 * 0.088;
         let kp_mech = 0.012 * 2.0 * core::f64::consts::PI * 5.0 / kt;
         assert!((kp_mech - 0.714).abs() < 1e-3, "SPEC §6 quotes 0.714");
@@ -167,7 +206,7 @@ mod tests {
         let run = |step_mech: f64, ratio: f64| {
             let mut c = SpeedController::new(SpeedControllerConfig {
                 anti_windup_ratio: ratio,
-                ..SpeedControllerConfig::default()
+                ..SpeedControllerConfig::for_machine(&MachineModel::paper(), 100e-6)
             })
             .unwrap();
             let (p, j, kt, ts) = (4.0, 0.012, 1.5 * 4.0 * 0.088, 100e-6);
@@ -203,7 +242,10 @@ mod tests {
 
     #[test]
     fn injection_interplay_keeps_vector_within_limit() {
-        let inj = CurrentInjection::new(CurrentInjectionConfig { i_min: 4.0_f64 }).unwrap();
+        let inj = CurrentInjection::new(CurrentInjectionConfig::<f64>::for_machine(
+            &MachineModel::paper(),
+        ))
+        .unwrap();
         for k in -100..=100 {
             let iq = 0.5 * k as f64;
             let ref_dq = limit_current_d_priority(Dq::new(inj.step(iq), iq), 40.0);
@@ -226,7 +268,7 @@ mod tests {
     #[test]
     fn bad_config_names_field() {
         let bad = |f: fn(&mut SpeedControllerConfig<f64>)| {
-            let mut cfg = SpeedControllerConfig::default();
+            let mut cfg = SpeedControllerConfig::for_machine(&MachineModel::paper(), 100e-6);
             f(&mut cfg);
             SpeedController::new(cfg).unwrap_err().field()
         };
