@@ -20,7 +20,7 @@ use fado_core::observer::{DiscreteGains, DisturbanceObserver, DisturbanceObserve
 use fado_core::plausibility::SampleBounds;
 use fado_core::rotor_flux::rotor_angle;
 use fado_core::tracker::{TrackerConfig, TypeTwoTracker};
-use fado_core::{Ab, Dq, EstimatorConfig, Real, SensorlessEstimator, wrap_angle};
+use fado_core::{Ab, Dq, EstimatorConfig, MachineModel, Real, SensorlessEstimator, wrap_angle};
 
 /// Samples in the signal table: a power of two, 8 electrical periods.
 const TABLE: usize = 4096;
@@ -171,7 +171,11 @@ fn bench_precision<T: Real>(c: &mut Criterion, name: &str) {
     });
 
     group.bench_function("integrator", |b| {
-        let mut int = FluxIntegrator::new(FluxIntegratorConfig::<T>::default()).unwrap();
+        let mut int = FluxIntegrator::new(FluxIntegratorConfig::<T>::for_machine(
+            &MachineModel::paper(),
+            ts,
+        ))
+        .unwrap();
         let mut k = 0usize;
         b.iter(|| {
             let s = &table[k & MASK];
@@ -181,7 +185,7 @@ fn bench_precision<T: Real>(c: &mut Criterion, name: &str) {
     });
 
     group.bench_function("observer", |b| {
-        let mut obs = DisturbanceObserver::new(DisturbanceObserverConfig::<T>::default()).unwrap();
+        let mut obs = DisturbanceObserver::new(DisturbanceObserverConfig::<T> { ts }).unwrap();
         let mut k = 0usize;
         b.iter(|| {
             let s = &table[k & MASK];
@@ -200,7 +204,11 @@ fn bench_precision<T: Real>(c: &mut Criterion, name: &str) {
     });
 
     group.bench_function("tracker", |b| {
-        let mut t2s = TypeTwoTracker::new(TrackerConfig::<T>::default()).unwrap();
+        let mut t2s = TypeTwoTracker::new(TrackerConfig::<T>::new(
+            fado_core::EstimatorTuning::<T>::default().t2s1_bandwidth_hz,
+            ts,
+        ))
+        .unwrap();
         let mut k = 0usize;
         b.iter(|| {
             let s = &table[k & MASK];
@@ -211,7 +219,8 @@ fn bench_precision<T: Real>(c: &mut Criterion, name: &str) {
 
     // The limiter's working path: |λ̂r| 30 % beyond the circle, so it projects every sample.
     group.bench_function("limiter", |b| {
-        let lim = FluxLimiter::new(FluxLimiterConfig::<T>::default()).unwrap();
+        let lim =
+            FluxLimiter::new(FluxLimiterConfig::<T>::for_machine(&MachineModel::paper())).unwrap();
         let scale = T::lit(1.3 * 1.15);
         let mut k = 0usize;
         b.iter(|| {

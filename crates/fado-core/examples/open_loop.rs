@@ -74,7 +74,9 @@ struct Stats {
 }
 
 fn main() {
-    let injection = CurrentInjection::new(CurrentInjectionConfig::default()).expect("valid");
+    let injection =
+        CurrentInjection::new(CurrentInjectionConfig::for_machine(&MachineModel::paper()))
+            .expect("valid");
     let i_dq = Dq::new(injection.step(IQ), IQ);
     let machine = |theta: f64| {
         let rot = Rotation::from_angle(theta);

@@ -127,7 +127,7 @@ fn tracker_gain(omega: f64) -> f64 {
 /// The same when θm also carries (ω̂ − ω)/p (the EMF filter's phase off its tuning): the loop
 /// becomes (Kp·s + Ki)/(s² + (Kp − Ki/p)·s + Ki) (emf_observer module docs).
 fn tracker_gain_with_speed_feedback(omega: f64, p: f64) -> f64 {
-    let (kp, ki) = fado_core::tracker::TrackerConfig::<f64>::default().gains();
+    let (kp, ki) = fado_core::tracker::TrackerConfig::<f64>::new(60.0, TS).gains();
     let w2 = omega * omega;
     let damping = kp - ki / p;
     ((ki * ki + kp * kp * w2) / ((ki - w2).powi(2) + damping * damping * w2)).sqrt()

@@ -25,7 +25,7 @@ fn conj<T: Real>(x: Ab<T>) -> Ab<T> {
 }
 
 fn observer<T: Real>() -> DisturbanceObserver<T> {
-    DisturbanceObserver::new(DisturbanceObserverConfig::default()).unwrap()
+    DisturbanceObserver::new(DisturbanceObserverConfig { ts: T::lit(TS) }).unwrap()
 }
 
 fn signed_speed(lo_hz: f64, hi_hz: f64) -> impl Strategy<Value = f64> {
@@ -181,11 +181,7 @@ proptest! {
 }
 
 fn tracker<T: Real>(bandwidth_hz: f64) -> TypeTwoTracker<T> {
-    TypeTwoTracker::new(TrackerConfig {
-        bandwidth_hz: T::lit(bandwidth_hz),
-        ..Default::default()
-    })
-    .unwrap()
+    TypeTwoTracker::new(TrackerConfig::new(T::lit(bandwidth_hz), T::lit(TS))).unwrap()
 }
 
 /// Any finite measurement sequence, of any size: θ̂ and θ̂⁻ stay in [−π, π] and ω̂ moves by at

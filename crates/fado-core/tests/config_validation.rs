@@ -268,7 +268,7 @@ fn run_all<T: Real>(failures: &mut Vec<String>, machine: MachineModel<T>) -> usi
     n += probe(
         failures,
         "TrackerConfig",
-        TrackerConfig::<T>::default(),
+        TrackerConfig::<T>::new(T::lit(60.0), T::lit(1e-4)),
         |c| ok(TypeTwoTracker::new(c)),
         &fields!(TrackerConfig<T>, T;
             ts: Positive,
@@ -279,22 +279,14 @@ fn run_all<T: Real>(failures: &mut Vec<String>, machine: MachineModel<T>) -> usi
     n += probe(
         failures,
         "FluxIntegratorConfig",
-        FluxIntegratorConfig::<T> {
-            ts: T::lit(1e-4),
-            rs_hat: T::lit(0.3),
-            average_current: true,
-        },
+        FluxIntegratorConfig::<T>::for_machine(&machine, T::lit(1e-4)),
         |c| ok(FluxIntegrator::new(c)),
         &fields!(FluxIntegratorConfig<T>, T; ts: Positive, rs_hat: NonNegative),
     );
     n += probe(
         failures,
         "DisturbanceFeedbackConfig",
-        DisturbanceFeedbackConfig::<T> {
-            ts: T::lit(1e-4),
-            k_df: T::lit(0.5),
-            ramp_time: T::zero(),
-        },
+        DisturbanceFeedbackConfig::<T>::with_ts(T::lit(1e-4)),
         |c| ok(DisturbanceFeedback::new(c)),
         &fields!(DisturbanceFeedbackConfig<T>, T;
             ts: Positive, k_df: NonNegativeBounded, ramp_time: NonNegative),
@@ -302,20 +294,14 @@ fn run_all<T: Real>(failures: &mut Vec<String>, machine: MachineModel<T>) -> usi
     n += probe(
         failures,
         "FluxLimiterConfig",
-        FluxLimiterConfig::<T> {
-            k_af: T::lit(628.0),
-            radius: T::lit(0.1),
-        },
+        FluxLimiterConfig::<T>::for_machine(&machine),
         |c| ok(FluxLimiter::new(c)),
         &fields!(FluxLimiterConfig<T>, T; k_af: NonNegative, radius: Positive),
     );
     n += probe(
         failures,
         "ModeSelectorConfig",
-        ModeSelectorConfig::<T> {
-            threshold_hz: T::lit(1.5),
-            hysteresis_hz: T::lit(0.2),
-        },
+        ModeSelectorConfig::<T>::for_machine(&machine),
         |c| ok(ModeSelector::new(c)),
         &fields!(ModeSelectorConfig<T>, T;
             threshold_hz: NonNegative, hysteresis_hz: NonNegativeBounded),
@@ -330,7 +316,7 @@ fn run_all<T: Real>(failures: &mut Vec<String>, machine: MachineModel<T>) -> usi
     n += probe(
         failures,
         "CurrentInjectionConfig",
-        CurrentInjectionConfig::<T> { i_min: T::lit(4.0) },
+        CurrentInjectionConfig::<T>::for_machine(&machine),
         |c| ok(CurrentInjection::new(c)),
         &fields!(CurrentInjectionConfig<T>, T; i_min: NonNegative),
     );
@@ -358,17 +344,7 @@ fn run_all<T: Real>(failures: &mut Vec<String>, machine: MachineModel<T>) -> usi
     n += probe(
         failures,
         "CurrentControllerConfig",
-        CurrentControllerConfig::<T> {
-            ts: T::lit(1e-4),
-            rs_hat: T::lit(0.327),
-            ld_hat: T::lit(2.63e-3),
-            lq_hat: T::lit(2.63e-3),
-            flux_linkage_hat: T::lit(0.088),
-            bandwidth_hz: T::lit(250.0),
-            decoupling: true,
-            anti_windup_ratio: T::one(),
-            voltage_bound: T::lit(180.0),
-        },
+        CurrentControllerConfig::<T>::for_machine(&machine, T::lit(1e-4)),
         |c| ok(CurrentController::new(c)),
         &fields!(CurrentControllerConfig<T>, T;
             ts: Positive,
@@ -384,16 +360,7 @@ fn run_all<T: Real>(failures: &mut Vec<String>, machine: MachineModel<T>) -> usi
     n += probe(
         failures,
         "SpeedControllerConfig",
-        SpeedControllerConfig::<T> {
-            ts: T::lit(1e-4),
-            pole_pairs: T::lit(4.0),
-            inertia_hat: T::lit(0.012),
-            flux_linkage_hat: T::lit(0.088),
-            bandwidth_hz: T::lit(5.0),
-            zero_ratio: T::lit(5.0),
-            i_max: T::lit(40.0),
-            anti_windup_ratio: T::lit(5.0),
-        },
+        SpeedControllerConfig::<T>::for_machine(&machine, T::lit(1e-4)),
         |c| ok(SpeedController::new(c)),
         &fields!(SpeedControllerConfig<T>, T;
             ts: Positive,
@@ -409,17 +376,14 @@ fn run_all<T: Real>(failures: &mut Vec<String>, machine: MachineModel<T>) -> usi
     n += probe(
         failures,
         "DelayCompensationConfig",
-        DelayCompensationConfig::<T> {
-            ts: T::lit(1e-4),
-            factor: T::lit(1.5),
-        },
+        DelayCompensationConfig::<T>::with_ts(T::lit(1e-4)),
         |c| ok(DelayCompensation::new(c)),
         &fields!(DelayCompensationConfig<T>, T; ts: Positive, factor: NonNegativeBounded),
     );
     n += probe(
         failures,
         "DeadTimeCompensationConfig",
-        DeadTimeCompensationConfig::<T>::default(),
+        DeadTimeCompensationConfig::<T>::for_machine(&machine),
         |c| ok(DeadTimeCompensation::new(c)),
         &fields!(DeadTimeCompensationConfig<T>, T;
             dead_time: NonNegativeBounded,
@@ -565,14 +529,14 @@ fn bandwidths_above_what_the_sampling_rate_allows_are_refused() {
         .find(|&f| {
             TypeTwoTracker::new(TrackerConfig {
                 bandwidth_hz: f,
-                ..TrackerConfig::default()
+                ..TrackerConfig::new(60.0, ts)
             })
             .is_err()
         })
         .expect("some bandwidth below 20 kHz must be unstable at 10 kHz");
     let (kp, ki) = TrackerConfig {
         bandwidth_hz: limit,
-        ..TrackerConfig::<f64>::default()
+        ..TrackerConfig::<f64>::new(60.0, ts)
     }
     .gains();
     assert!(

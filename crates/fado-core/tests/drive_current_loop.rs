@@ -8,7 +8,7 @@ use core::f64::consts::{PI, TAU};
 use fado_core::control::{
     CurrentController, CurrentControllerConfig, DelayCompensation, DelayCompensationConfig,
 };
-use fado_core::{Ab, Dq, Rotation};
+use fado_core::{Ab, Dq, MachineModel, Rotation};
 
 const RS: f64 = 0.327;
 const L: f64 = 2.63e-3;
@@ -16,6 +16,8 @@ const LF: f64 = 0.088;
 const TS: f64 = 100e-6;
 const SUBSTEPS: usize = 20;
 
+/// The paper's motor (`MachineModel::paper()`, which the controller is built for).
+///
 /// Ideal SMPMSM in α-β: dλ/dt = v − R·i, i = (λ − λf·e^{jθ})/L, θ' = ω (constant speed).
 struct Motor {
     lambda: Ab<f64>,
@@ -64,7 +66,7 @@ impl Loop {
             motor: Motor::at_rest_current(omega),
             cc: CurrentController::new(CurrentControllerConfig {
                 decoupling,
-                ..CurrentControllerConfig::default()
+                ..CurrentControllerConfig::for_machine(&MachineModel::paper(), TS)
             })
             .unwrap(),
             delay: DelayCompensation::new(DelayCompensationConfig {
@@ -250,7 +252,7 @@ fn anti_windup_against_a_voltage_circle_recovers_without_overshoot_blow_up() {
     let run = |ratio: f64| {
         let mut cc = CurrentController::new(CurrentControllerConfig {
             anti_windup_ratio: ratio,
-            ..CurrentControllerConfig::<f64>::default()
+            ..CurrentControllerConfig::<f64>::for_machine(&MachineModel::paper(), TS)
         })
         .unwrap();
         let mut motor = Motor::at_rest_current(0.0);

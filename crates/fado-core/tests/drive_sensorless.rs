@@ -170,10 +170,11 @@ fn duties_realise_the_reference_plus_the_dead_time_compensation() {
         ..Spy::default()
     };
     let mut drive = SensorlessDrive::with_estimator(cfg, spy).unwrap();
-    let dtc = DeadTimeCompensation::new(DeadTimeCompensationConfig {
-        method: DeadTimeMethod::Trapezoidal,
-        ..DeadTimeCompensationConfig::default()
-    })
+    // The drive's own compensation, built from the same machine model and tuning.
+    let dtc = DeadTimeCompensation::new(DeadTimeCompensationConfig::with_tuning(
+        &cfg.machine,
+        &cfg.tuning,
+    ))
     .unwrap();
     let mut saturated = 0;
     for n in 0..200 {

@@ -56,10 +56,7 @@ fn warmed_up<T: Real>(omega: f64, warm_up: usize) -> SensorlessEstimator<T> {
 /// Ki·Ts of a tracker with this bandwidth: the most ω̂ can move in one sample is Ki·Ts·π,
 /// because the wrapped phase error never exceeds π.
 fn ki_ts(bandwidth_hz: f64) -> f64 {
-    let c = TrackerConfig::<f64> {
-        bandwidth_hz,
-        ..Default::default()
-    };
+    let c = TrackerConfig::<f64>::new(bandwidth_hz, TS);
     c.gains().1 * c.ts
 }
 

@@ -9,11 +9,17 @@ use fado_core::rs_adaptation::{
     AdaptationRegime, FLUX_LINKAGE_DEAD_ZONE, FLUX_LINKAGE_DEAD_ZONE_OFF, ResistanceAdaptation,
     ResistanceAdaptationConfig,
 };
-use fado_core::{Ab, Dq, EstimatorConfig, Mode, SensorlessEstimator, wrap_angle};
+use fado_core::{Ab, Dq, EstimatorConfig, MachineModel, Mode, SensorlessEstimator, wrap_angle};
 use proptest::prelude::*;
 
 /// Rated-load q current for 7.5 N·m: T = 1.5·p·λf·i_q.
 const IQ_LOAD: f64 = 7.5 / (1.5 * PP * LF);
+
+/// The laws on the paper's motor (whose R0, λf and inductances the generator here uses), run
+/// every sample.
+fn paper_law() -> ResistanceAdaptationConfig<f64> {
+    ResistanceAdaptationConfig::for_machine(&MachineModel::paper(), TS)
+}
 
 fn estimator(rs_ratio: f64, theta0: f64) -> SensorlessEstimator<f64> {
     SensorlessEstimator::new(config_with(|c| {
@@ -263,7 +269,7 @@ fn flux_linkage_law_moves_with_current(
 ) -> f64 {
     let config = ResistanceAdaptationConfig {
         flux_linkage_rate: 5.0,
-        ..ResistanceAdaptationConfig::default()
+        ..paper_law()
     };
     let mut law = ResistanceAdaptation::new(config).unwrap();
     for k in 0..(seconds / TS) as usize {
@@ -284,7 +290,7 @@ fn flux_linkage_law_moves_with_current(
 fn flux_linkage_law_runs_only_above_its_speed() {
     // |λ̂r| 5 % above λ̂f (beyond twice the dead zone): λ̂f moves only at |ω̂| above
     // flux_linkage_min_speed, and then follows |λ̂r| to within FLUX_LINKAGE_DEAD_ZONE_OFF.
-    let min_speed = ResistanceAdaptationConfig::<f64>::default().flux_linkage_min_speed;
+    let min_speed = paper_law().flux_linkage_min_speed;
     for (omega, moves) in [(0.5 * min_speed, false), (2.0 * min_speed, true)] {
         let moved = flux_linkage_law_moves(omega, 1.0, |_| 1.05 * LF);
         assert_eq!(moved > 0.002, moves, "ω̂ = {omega}: λ̂f/λf − 1 = {moved}");
@@ -301,7 +307,7 @@ fn flux_linkage_law_runs_only_above_its_speed() {
 fn flux_linkage_law_between_one_and_two_dead_zones_moves_by_the_excess() {
     // |λ̂r| 1.5 % above λ̂f: beyond the 1 % dead zone but not beyond twice it (a transient
     // as likely as a λ̂f error): λ̂f takes only the 0.5 % beyond the dead zone.
-    let omega = 2.0 * ResistanceAdaptationConfig::<f64>::default().flux_linkage_min_speed;
+    let omega = 2.0 * paper_law().flux_linkage_min_speed;
     let moved = flux_linkage_law_moves(omega, 1.0, |_| 1.015 * LF);
     let expected = 0.015 - FLUX_LINKAGE_DEAD_ZONE;
     assert!(
@@ -315,7 +321,7 @@ fn flux_linkage_law_runs_where_the_revolution_mean_excitation_is_small() {
     // χ = −i_q·R0/(λ̂f·ω̂). A steady |χ| = 0.3 (above χ0/2 = 0.1: R̂s explains the flux
     // error there) keeps λ̂f; a current swinging between χ = ±0.3 every other sample (zero
     // mean: what current noise does to a nearly unloaded motor) does not.
-    let config = ResistanceAdaptationConfig::<f64>::default();
+    let config = paper_law();
     let omega = 2.0 * config.flux_linkage_min_speed;
     let i_chi = 0.3 * LF * omega / config.rs_initial;
     let loaded = flux_linkage_law_moves_with_current(omega, 1.0, |_| 1.05 * LF, |_| i_chi);
@@ -336,7 +342,7 @@ fn flux_linkage_law_ignores_errors_inside_its_dead_zone_and_swings_at_the_rotor_
     // the dead zone λ̂f stays. A DC error c left in λ2 makes |λ̂r| swing by ±c at ω̂: the
     // revolution mean ignores it, a per-sample law at the same rate would move λ̂f by
     // ≈ γ_f·c/ω̂ at whatever phase it stops.
-    let omega = 2.0 * ResistanceAdaptationConfig::<f64>::default().flux_linkage_min_speed;
+    let omega = 2.0 * paper_law().flux_linkage_min_speed;
     for bias in [-0.007, 0.007] {
         let moved = flux_linkage_law_moves(omega, 1.0, |_| (1.0 + bias) * LF);
         assert_eq!(moved, 0.0, "bias {bias}");
@@ -395,7 +401,7 @@ fn bad_configurations_name_their_field() {
     }
     let e = ResistanceAdaptation::new(ResistanceAdaptationConfig::<f64> {
         standstill_memory_hz: -1.0,
-        ..Default::default()
+        ..paper_law()
     })
     .unwrap_err();
     assert_eq!(e.field(), "standstill_memory_hz");
@@ -412,7 +418,7 @@ proptest! {
             1..300,
         )
     ) {
-        let config = ResistanceAdaptationConfig::<f64>::default();
+        let config = paper_law();
         let (lo, hi) = (config.min_ratio * config.rs_initial, config.max_ratio * config.rs_initial);
         let mut a = ResistanceAdaptation::new(config).unwrap();
         for (va, vb, ia, ib, la, lb, w, regime, poison) in samples {

@@ -802,13 +802,13 @@ mod tests {
         use fado_core::control::{DeadTimeCompensation, DeadTimeCompensationConfig};
         let p = InverterParams::default();
         let comp = DeadTimeCompensation::new(DeadTimeCompensationConfig {
+            enabled: true,
             method,
             dead_time: p.dead_time,
             switching_frequency: p.switching_frequency,
             threshold_voltage: p.threshold_voltage,
             current_band: p.current_band,
             ripple_inductance: Dq::new(mp.ld, mp.lq),
-            ..DeadTimeCompensationConfig::default()
         })
         .unwrap();
         let vdc = p.dc_voltage;
