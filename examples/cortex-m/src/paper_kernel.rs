@@ -104,13 +104,7 @@ impl PaperKernel {
         let m = &config.machine;
         let t = &config.tuning;
         let tracker = |bandwidth_hz| {
-            let (kp, ki) = TrackerConfig {
-                ts,
-                bandwidth_hz,
-                damping: t.tracker_damping,
-                definition: t.bandwidth_definition,
-            }
-            .gains();
+            let (kp, ki) = TrackerConfig::with_tuning(t, bandwidth_hz, ts).gains();
             (ts * kp, ki * ts * RAD_PER_UNIT)
         };
         let (kp_ts1, ki_ts1) = tracker(t.t2s1_bandwidth_hz);
