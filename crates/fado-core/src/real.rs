@@ -205,9 +205,10 @@ pub(crate) fn max<T: Real>(x: T, y: T) -> T {
 }
 
 /// True when every value is finite, in one test: the sum s of the values is finite exactly
-/// when all of them are (an ∞ or NaN makes it ∞ or NaN), and s·0 is ±0 for a finite s and
-/// NaN otherwise. One FPU add per value and one compare, instead of a compare and a branch
-/// per value (or a multiply and an add, for x·0 summed).
+/// when all of them are (an ∞ or NaN makes it ∞ or NaN), and s − s is +0 for a finite s and
+/// NaN otherwise. One FPU add per value after the first and one compare, instead of a
+/// compare and a branch per value (or a multiply and an add, for x·0 summed); s − s needs no
+/// zero constant loaded, as s·0 did.
 ///
 /// The one difference from testing each value: a sum of finite values can overflow, which
 /// needs values of about 1e38 (`f32`) — the estimator's state is in Wb, A, V, Ω and rad/s,
@@ -215,11 +216,14 @@ pub(crate) fn max<T: Real>(x: T, y: T) -> T {
 /// which still never lets a non-finite value into the state.
 #[inline(always)]
 pub(crate) fn all_finite<T: Real, const N: usize>(values: [T; N]) -> bool {
-    let mut sum = T::zero();
-    for v in values {
+    let Some((&first, rest)) = values.split_first() else {
+        return true;
+    };
+    let mut sum = first;
+    for &v in rest {
         sum += v;
     }
-    sum * T::zero() == T::zero()
+    sum - sum == T::zero()
 }
 
 /// Wraps an angle into [−π, π]: `x − 2π·round(x / 2π)` (SPEC notation).
