@@ -1146,7 +1146,6 @@ impl<T: Real> EstimatorState<T> {
         let tracker_hold = lambda_r.norm_squared() < p.hold_level_sq;
         let theta_direct = rotor_angle(lambda_r);
         let slot = self.slot;
-        let flux_hat = self.rs_adaptation.flux_linkage_hat;
         // λ̂a/λ̂f, the active flux the limiter circle and the lock detector's bounds refer to
         // (1 on a surface-magnet rotor).
         let active_ratio = if saliency != T::zero() && !tracker_hold {
@@ -1178,23 +1177,6 @@ impl<T: Real> EstimatorState<T> {
                 let l = p.limiter.step_scaled(lambda_r, active_ratio);
                 (l.feedback, l.clamping)
             }
-        };
-        // Loss-of-lock symptoms (see `lock`), in the detector's slot: |λ̂r| against λ̂f (the
-        // lower bound chosen by the control speed ω̂ of the mode selector), the T2S-1
-        // innovation.
-        // (Outside its slot the detector's state is neither copied nor written back.)
-        // The innovation is T2S-1's phase error of this sample (0 when the trackers coasted).
-        let lock = if slot % LOCK_PERIOD == SLOT_LOCK {
-            Some(p.lock.next_state(
-                self.lock,
-                lambda_r.norm_squared(),
-                flux_hat * flux_hat * active_ratio * active_ratio,
-                t2s1.innovation * T::angle_unit(),
-                t2s2.omega,
-                clamping,
-            ))
-        } else {
-            None
         };
         // The learned integrand offset ê is subtracted from the integrand in both modes, with
         // the standstill pull of the R̂s adaptation (both held between the slow laws' runs).
@@ -1257,7 +1239,23 @@ impl<T: Real> EstimatorState<T> {
         self.mode = mode;
         self.kdf_gain = kdf_gain;
         self.feedback = feedback;
-        if let Some(lock) = lock {
+        // Loss-of-lock symptoms (see `lock`), in the detector's slot: |λ̂r| against λ̂f (the
+        // lower bound chosen by the control speed ω̂ of the mode selector), the T2S-1
+        // innovation. Stepped here, after the finite test, so that one slot test both
+        // computes and commits it (a rejected sample never reaches this point).
+        // (Outside its slot the detector's state is neither copied nor written back.)
+        // The innovation is T2S-1's phase error of this sample (0 when the trackers coasted).
+        if slot % LOCK_PERIOD == SLOT_LOCK {
+            // λ̂f as this sample used it (the slow laws below have not run yet).
+            let flux_hat = self.rs_adaptation.flux_linkage_hat;
+            let lock = p.lock.next_state(
+                self.lock,
+                lambda_r.norm_squared(),
+                flux_hat * flux_hat * active_ratio * active_ratio,
+                t2s1.innovation * T::angle_unit(),
+                t2s2.omega,
+                clamping,
+            );
             self.lock = lock;
             self.lock_status = lock.status();
         }
