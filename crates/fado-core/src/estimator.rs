@@ -1145,7 +1145,6 @@ impl<T: Real> EstimatorState<T> {
         let lambda_r = lambda2 - lq_i;
         let tracker_hold = lambda_r.norm_squared() < p.hold_level_sq;
         let theta_direct = rotor_angle(lambda_r);
-        let slot = self.slot;
         // λ̂a/λ̂f, the active flux the limiter circle and the lock detector's bounds refer to
         // (1 on a surface-magnet rotor).
         let active_ratio = if saliency != T::zero() && !tracker_hold {
@@ -1245,6 +1244,8 @@ impl<T: Real> EstimatorState<T> {
         // computes and commits it (a rejected sample never reaches this point).
         // (Outside its slot the detector's state is neither copied nor written back.)
         // The innovation is T2S-1's phase error of this sample (0 when the trackers coasted).
+        // The round-robin's slot, read only now: nothing before the commit needs it.
+        let slot = self.slot;
         if slot % LOCK_PERIOD == SLOT_LOCK {
             // λ̂f as this sample used it (the slow laws below have not run yet).
             let flux_hat = self.rs_adaptation.flux_linkage_hat;
