@@ -1267,13 +1267,13 @@ impl<T: Real> EstimatorState<T> {
         //    sample (see `rs_adaptation`, `integrand_offset`), after the commit so that the
         //    paper's path is untouched by them. A non-finite result is dropped (R̂s, ê stay).
         if self.rs_adaptation_on {
-            let interrupted = tracker_hold || previous_mode != mode;
-            let broken = self.slow_broken
-                | if interrupted {
-                    BROKEN_RS | BROKEN_OFFSET
-                } else {
-                    0
-                };
+            // An interruption marks both laws' periods broken: with the two bits there are,
+            // slow_broken | (both) is both, so the byte is written only then (and by the
+            // law that runs in its slot), not in every free slot.
+            if tracker_hold || previous_mode != mode {
+                self.slow_broken = BROKEN_RS | BROKEN_OFFSET;
+            }
+            let broken = self.slow_broken;
             if slot == SLOT_RS {
                 let regime = if broken & BROKEN_RS != 0 {
                     AdaptationRegime::Frozen
@@ -1364,8 +1364,6 @@ impl<T: Real> EstimatorState<T> {
                     self.slow_feedback = slow_feedback;
                 }
                 self.slow_broken = broken & !BROKEN_OFFSET;
-            } else if slot != SLOT_RS {
-                self.slow_broken = broken;
             }
         }
         let estimate = Estimate {
