@@ -1234,7 +1234,8 @@ impl<T: Real> EstimatorState<T> {
             self.gain_countdown -= 1;
         }
         self.t2s1.commit(t2s1);
-        self.t2s2.commit(t2s2);
+        // T2S-2's θ̂ is never read (its ω̂ is the control speed): not stored.
+        self.t2s2.commit_speed(t2s2);
         self.mode = mode;
         self.kdf_gain = kdf_gain;
         self.feedback = feedback;

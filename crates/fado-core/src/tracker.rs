@@ -212,6 +212,15 @@ impl<T: Real> TrackerState<T> {
         self.omega = next.omega;
     }
 
+    /// [`Self::commit`] without θ̂: for a tracker whose angle nobody reads (the estimator's
+    /// T2S-2, whose ω̂ alone is used; its θ̂ stays the one set by `state_at`). One store and
+    /// one live register fewer.
+    #[inline(always)]
+    pub(crate) fn commit_speed(&mut self, next: TrackerUpdate<T>) {
+        self.predicted = next.predicted;
+        self.omega = next.omega;
+    }
+
     /// θ̂ for the last sample, in [−π, π].
     #[inline(always)]
     pub(crate) fn angle(&self) -> T {
