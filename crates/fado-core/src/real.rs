@@ -223,7 +223,10 @@ pub(crate) fn all_finite<T: Real, const N: usize>(values: [T; N]) -> bool {
     for &v in rest {
         sum += v;
     }
-    sum - sum == T::zero()
+    // s − s on purpose: +0 for a finite s, NaN for ±∞ and NaN (see above).
+    #[allow(clippy::eq_op)]
+    let zero_if_finite = sum - sum;
+    zero_if_finite == T::zero()
 }
 
 /// Wraps an angle into [−π, π]: `x − 2π·round(x / 2π)` (SPEC notation).
