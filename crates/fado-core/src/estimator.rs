@@ -1163,7 +1163,9 @@ impl<T: Real> EstimatorState<T> {
         } else {
             (
                 p.t2s1.next_state(&self.t2s1, theta_direct),
-                p.t2s2.next_state(&self.t2s2, theta_direct),
+                // Both trackers have the same Ts: T2S-1's Ts in angle units, loaded once.
+                p.t2s2
+                    .next_state_with(&self.t2s2, theta_direct, p.t2s1.ts_units()),
             )
         };
         // 5. Mode from the control speed, and the feedback for the next sample.

@@ -169,6 +169,19 @@ impl<T: Real> TrackerParams<T> {
     /// The update after one sample with the measurement θm ∈ [−π, π] (eq. (6)'s range).
     #[inline(always)]
     pub(crate) fn next_state(&self, s: &TrackerState<T>, theta_measured: T) -> TrackerUpdate<T> {
+        self.next_state_with(s, theta_measured, self.ts_units)
+    }
+
+    /// [`Self::next_state`] with Ts in angle units given: `ts_units` must be this tracker's
+    /// own (the estimator passes T2S-1's to T2S-2, the same product of the same Ts, so that
+    /// it is loaded once).
+    #[inline(always)]
+    pub(crate) fn next_state_with(
+        &self,
+        s: &TrackerState<T>,
+        theta_measured: T,
+        ts_units: T,
+    ) -> TrackerUpdate<T> {
         // In angle units ([`Real::angle_unit`]): Kp·Ts is dimensionless, the conversions of
         // Ki·Ts·e and Ts·ω̂ are in `ki_ts_units` and `ts_units` (`f32`: one rounding fewer
         // than converting e and the increments, and no multiply per conversion).
@@ -176,7 +189,7 @@ impl<T: Real> TrackerParams<T> {
         let omega = s.omega + self.ki_ts_units * e;
         let theta = T::angle_add_units(s.predicted, self.kp_ts * e);
         TrackerUpdate {
-            predicted: T::angle_add_units(theta, self.ts_units * omega),
+            predicted: T::angle_add_units(theta, ts_units * omega),
             theta,
             omega,
             innovation: e,
@@ -193,6 +206,12 @@ impl<T: Real> TrackerParams<T> {
             omega: s.omega,
             innovation: T::zero(),
         }
+    }
+
+    /// Ts in tracker angle units per rad/s (Ts·2³²/2π in `f32`, Ts in `f64`).
+    #[inline(always)]
+    pub(crate) fn ts_units(&self) -> T {
+        self.ts_units
     }
 
     /// Kp in s⁻¹ (see [`TypeTwoTracker::kp`]).
