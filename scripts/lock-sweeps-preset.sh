@@ -4,7 +4,9 @@
 # motors/, with the same design as scripts/lock-sweeps.sh: R̂s error ±10 %, λ̂f error ±10 %,
 # L̂q error ±30 %, final load 0 … the preset's rated torque (fig11's 0 … 11.5 N·m is 0 … rated on
 # the paper's motor); N random points (default 400), seed SEED (default 7).
-# usage: [SEED=N] [N=400] [SCENARIO=reversal] [VARIANTS="fixed-rs adaptive"] \
+# EXTRA: TOML text appended to each variant's configuration (printf escapes, e.g.
+# EXTRA='\n[controller]\nlock_stall_follow_min_current_ratio = 0.3\n'), to try a setting.
+# usage: [SEED=N] [N=400] [SCENARIO=reversal] [VARIANTS="fixed-rs adaptive"] [EXTRA=...] \
 #        scripts/lock-sweeps-preset.sh PRESET OUT_DIR      (then scripts/lock-eval.py)
 set -euo pipefail
 preset=${1:?usage: scripts/lock-sweeps-preset.sh PRESET OUT_DIR}
@@ -22,7 +24,8 @@ mkdir -p "$out"
 for variant in $variants; do
     case $variant in fixed-rs*) adapt=false ;; *) adapt=true ;; esac
     case $variant in *clamping) clamp=true ;; *) clamp=false ;; esac
-    { cat "$file"; printf '\n[estimator]\nrs_adaptation = %s\nlock_limiter_clamping = %s\n' "$adapt" "$clamp"; } \
+    { cat "$file"; printf '\n[estimator]\nrs_adaptation = %s\nlock_limiter_clamping = %s\n' "$adapt" "$clamp"
+      printf "${EXTRA:-}"; } \
         >"$out/$variant.toml"
     rm -rf "${out:?}/$variant"
     nice -n 10 target/release/fado-sim sweep "$scenario" --config "$out/$variant.toml" \

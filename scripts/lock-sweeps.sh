@@ -5,7 +5,9 @@
 #        (then scripts/lock-eval.py, see docs/lock.md). SEED (default 7) draws other points of
 #        the same design (seeds 7-14 tuned the detector, 15-16 were seen, 17-20 are the
 #        hold-out of the speed-dependent lower flux bound, docs/lock.md); VARIANTS
-#        (default all four) picks the configurations.
+#        (default all four) picks the configurations; EXTRA (TOML text, printf escapes,
+#        appended to each variant's configuration, e.g. EXTRA='[controller]\nx = 1\n') tries a
+#        setting.
 set -euo pipefail
 out=${1:?usage: scripts/lock-sweeps.sh OUT_DIR}
 cd "$(dirname "$0")/.."
@@ -16,8 +18,8 @@ mkdir -p "$out"
 for variant in $variants; do
     case $variant in fixed-rs*) adapt=false ;; *) adapt=true ;; esac
     case $variant in *clamping) clamp=true ;; *) clamp=false ;; esac
-    printf '[estimator]\nrs_adaptation = %s\nlock_limiter_clamping = %s\n' "$adapt" "$clamp" \
-        >"$out/$variant.toml"
+    { printf '[estimator]\nrs_adaptation = %s\nlock_limiter_clamping = %s\n' "$adapt" "$clamp"
+      printf "${EXTRA:-}"; } >"$out/$variant.toml"
     rm -rf "${out:?}/$variant"
     nice -n 10 target/release/fado-sim sweep fig11 --config "$out/$variant.toml" \
         --random 400 --seed "$seed" \
