@@ -970,3 +970,53 @@ fn stall_symptom_spares_an_estimate_that_answers_the_torque() {
         assert!((CATCH + 49..=CATCH + 50).contains(&n), "{p}: {n}");
     }
 }
+
+/// The stall band widens with the commanded torque (`lock_stall_torque_band_ratio`,
+/// docs/lock.md sixth session): it is the larger of the fixed band and ε·|T*|/(Ĵ·ω_s), the
+/// speed error whose proportional action alone commands T* (kp = Ĵ·ω_s/K_t), so that after a
+/// step of the speed error e it is max(band, ε·e·(1 + the integral's share)). An estimate
+/// stuck 2 bands out while the reference runs 1.5 bands ahead (the speed loop's current below
+/// the limit): flagged after `lock_stall_time` (50 samples) with ε = 0 and with ε = 0.5
+/// (the widened band stays below e), never with ε = 1.5 (above e from the sample after the
+/// step on). On the paper's motor and on the 2.2 kW IPMSM (the torque read from the salient
+/// model's currents).
+#[test]
+fn stall_band_widens_with_the_commanded_torque() {
+    let ipmsm = common::ipmsm_model();
+    for machine in [MachineModel::paper(), ipmsm] {
+        let band = DriveConfig::<f64>::for_machine(&machine)
+            .tuning
+            .lock_stall_speed_ratio
+            * machine.rated_speed();
+        let run = |ratio: f64| {
+            let mut c = stall_test_config(&machine);
+            c.tuning.lock_stall_min_current_ratio = 0.0;
+            c.tuning.lock_stall_torque_band_ratio = ratio;
+            let spy = SpeedSpy {
+                omega0: 2.0 * band,
+                accel: 0.0,
+                ts: c.ts,
+                n: 0,
+                mode: fado_core::Mode::Limiter,
+            };
+            let p = machine.pole_pairs as f64;
+            let mut drive = SensorlessDrive::with_estimator(c, spy).unwrap();
+            drive.align(0.0);
+            let mut first = None;
+            for n in 0..CATCH + 500 {
+                let speed = if n < CATCH { 2.0 * band } else { 3.5 * band };
+                let out = drive.step(Abc::new(0.0, 0.0, 0.0), 300.0, speed / p);
+                if first.is_none() && out.flags.contains(DriveFlags::STALLED) {
+                    first = Some(n);
+                }
+            }
+            first
+        };
+        let p = machine.pole_pairs;
+        for ratio in [0.0, 0.5] {
+            let n = run(ratio).unwrap_or(0);
+            assert!((CATCH + 49..=CATCH + 50).contains(&n), "{p} {ratio}: {n}");
+        }
+        assert_eq!(run(1.5), None, "{p}");
+    }
+}
