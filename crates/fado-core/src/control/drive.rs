@@ -260,16 +260,17 @@ pub struct DriveTuning<T> {
     /// at 0.151 (docs/lock.md). 0: always.
     pub lock_stall_min_current_ratio: T,
     /// The stall symptom also counts in k_df mode while |ω̂| is below this multiple of the
-    /// rated speed (the limiter ↔ k_df threshold `mode_threshold_ratio` is 0.015; 0.02 is a
-    /// band of 0.005·rated above it); 0: limiter mode only. Default 0 \[A\] since the
-    /// sixth session (docs/lock.md, "The stall symptom on other motors"): issue 14b's 0.02
-    /// detected 5 more of 826 fixed-R̂s losses on the fig11 envelope (seeds 7–10) with the
-    /// detector of then (band 0.005, no "answers the torque" exception); with today's
-    /// detector it detects none more on seed 7 of any of the seven presets of `motors/`, and it
-    /// flagged 10 of 11 passing runs on servo-1ft6084 (the estimate's speed swinging ±0.003
-    /// of rated around ω* just after the limiter → k_df hand-over, |θ − θ̂| < 0.25 rad), 8
-    /// of 25 on outrunner-cheetah-24v with the R̂s adaptation and both on
-    /// hub-hoverboard-48v with it; off, one loss of 220 on hub-hoverboard-48v goes late.
+    /// rated speed (the limiter ↔ k_df threshold `mode_threshold_ratio` is 0.015, so the
+    /// default is a band of 0.0025·rated, 3.75 r/min at 1500 r/min, above it); 0: limiter
+    /// mode only. Default 0.0175 \[A\] since the sixth session (docs/lock.md, "The stall
+    /// symptom on other motors"); issue 14b's 0.02 (chosen on the fig11 envelope: under heavy
+    /// load the estimate is lost in k_df mode just above the threshold, where a limiter-only
+    /// symptom does not look) also flagged passing runs on servo-1ft6084 (11 of 259, seed 7),
+    /// outrunner-cheetah-24v and hub-hoverboard-48v in which ω̂ swings ±0.003 of rated around
+    /// ω* just after the limiter → k_df hand-over at 0.0176–0.0197·rated (0.0175: 4 of 259 on
+    /// servo-1ft6084, seed 7; 1 of 254 on seed 8, 12 before); off (0), one fig11 loss in
+    /// 2173 (seeds 7–16) and 1–2 of 220–229 hub-hoverboard-48v losses went late, which
+    /// 0.0175 keeps.
     pub lock_stall_kdf_speed_ratio: T,
     /// The stall symptom does not count while the estimated rotor *answers the torque*: ω̂
     /// turns in the direction the speed loop drives it (ω̂·(ω* − ω̂) > 0) faster than the
@@ -319,9 +320,10 @@ pub struct DriveTuning<T> {
     /// (docs/lock.md, "The stall symptom on other motors", seed 7 of the seven presets: the
     /// largest tried that leaves the paper's motor as it was, whose band it would widen only
     /// above 1.03 × the rated torque; 0.02 delays the stall flag in 92 of the paper's 205
-    /// losses and 0.025 misses one; 0.015 takes the passing runs flagged from 22 to 17 of 153
-    /// on pmsyrm-5k (14 to 9 of 95 adapted), and with `lock_stall_kdf_speed_ratio` 0 from 25
-    /// to 14 of 183 on outrunner-cheetah-24v adapted; detection unchanged on every preset).
+    /// losses and 0.025 misses one; with `lock_stall_kdf_speed_ratio` 0.0175, seeds 7 and 8,
+    /// the passing runs flagged go from 50 to 34 of 315 on pmsyrm-5k (27 to 18 of 204
+    /// adapted) and from 45 to 27 of 349 on outrunner-cheetah-24v adapted, 4 to 0 of 58 with
+    /// fixed R̂s; no detection lost on any preset, nor on fig11's seeds 7–20).
     pub lock_stall_torque_band_ratio: T,
     /// The loaded-standstill angle probe (see [`crate::control::standstill_probe`]): at a
     /// loaded standstill a slow square-wave d current, read through the speed loop's torque
@@ -474,7 +476,7 @@ impl<T: Real> Default for DriveTuning<T> {
             lock_stall_heal_time: T::lit(0.1),
             lock_stall_max_speed_ratio: T::lit(0.0),
             lock_stall_min_current_ratio: T::lit(0.2),
-            lock_stall_kdf_speed_ratio: T::zero(),
+            lock_stall_kdf_speed_ratio: T::lit(0.0175),
             lock_stall_follow_time: T::lit(10e-3),
             lock_stall_follow_min_current_ratio: T::lit(0.5),
             lock_stall_follow_accel_ratio: T::lit(0.005),
