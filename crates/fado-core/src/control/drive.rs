@@ -684,7 +684,9 @@ struct Resolved<T> {
     /// ω̂ − ω̂_lp (electrical rad/s) beyond which ω̂ accelerates: the least acceleration
     /// times τ.
     stall_follow_lead: T,
-    /// Band widening per N·m of the commanded torque (electrical rad/s per N·m).
+    /// Band widening per unit of (λ̂f + (L̂d − L̂q)·i_d*)·i_q* (electrical rad/s per Wb·A): the
+    /// torque ratio of `lock_stall_torque_band_ratio` times 1.5·p (torque) times p (electrical
+    /// speed) over Ĵ·ω_s.
     stall_torque_band: T,
     /// Phase currents beyond ± this (A) are refused as implausible.
     plausible_current: T,
@@ -767,8 +769,11 @@ impl<T: Real> Resolved<T> {
             stall_torque_band: check::non_negative(
                 "lock_stall_torque_band_ratio",
                 t.lock_stall_torque_band_ratio,
-            )? * T::lit(c.machine.pole_pairs as f64)
-                / (c.machine.inertia * T::lit(core::f64::consts::TAU) * t.speed_bandwidth_hz),
+            )? * T::lit(
+                1.5 * (c.machine.pole_pairs as f64) * (c.machine.pole_pairs as f64),
+            ) / (c.machine.inertia
+                * T::lit(core::f64::consts::TAU)
+                * t.speed_bandwidth_hz),
             plausible_current: t.plausible_current_ratio * t.trip_current_ratio * rated,
             dc_link_max_voltage: t.dc_link_max_ratio * c.machine.dc_voltage,
             mtpa: t.mtpa && c.machine.is_salient(),
@@ -1585,8 +1590,12 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         // (`DriveTuning::lock_stall_follow_time`).
         let speed_ref = speed_ref_mech * T::lit(self.config.machine.pole_pairs as f64);
         let speed_error = speed_ref - omega_ctrl;
+        let (m, i_ref) = (&self.config.machine, self.last.i_dq_ref);
         let band = self.resolved.stall_speed.max(
-            self.resolved.stall_torque_band * self.config.machine.torque(self.last.i_dq_ref).abs(),
+            // The model's torque over 1.5·p (folded into the band factor at construction, so
+            // that the step does no integer-to-float or double-precision arithmetic).
+            self.resolved.stall_torque_band
+                * ((m.flux_linkage + (m.ld - m.lq) * i_ref.d) * i_ref.q).abs(),
         );
         let off_reference = speed_error.abs() > band;
         let follow_gain = self.resolved.stall_follow_gain;
