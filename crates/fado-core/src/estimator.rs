@@ -1755,6 +1755,20 @@ impl<T: Real> RotorAngleEstimator<T> for SensorlessEstimator<T> {
 mod tests {
     use super::*;
 
+    /// Sample `n` (Ts = 100 µs) of the paper's surface PMSM turning at 20 Hz electrical:
+    /// i = j·4 A·e^{jθ}, v = Rs·i + d/dt of the flux (paper V's Rs, Ls, λf), in f64.
+    fn paper_sample(n: u32) -> (Ab<f64>, Ab<f64>) {
+        let (w, ts) = (2.0 * core::f64::consts::PI * 20.0, 1e-4);
+        let th = w * ts * n as f64;
+        let (c, s) = (th.cos(), th.sin());
+        let i = Ab::new(-4.0 * s, 4.0 * c);
+        let v = Ab::new(
+            0.327 * i.alpha - w * 0.088 * s - w * 2.63e-3 * 4.0 * c,
+            0.327 * i.beta + w * 0.088 * c - w * 2.63e-3 * 4.0 * s,
+        );
+        (v, i)
+    }
+
     /// `step_lean` is `step` without the diagnostics: the same state after every sample and
     /// the same θ̂, ω̂, mode, lock and fault flag, accepted and rejected samples alike, with
     /// and without the R̂s adaptation, in both precisions.
@@ -1764,16 +1778,8 @@ mod tests {
         config.tuning.rs_adaptation = rs_adaptation;
         let mut full = SensorlessEstimator::new(config).unwrap();
         let mut lean = full;
-        let (w, ts) = (2.0 * core::f64::consts::PI * 20.0, 1e-4);
         for n in 0..6000 {
-            let th = w * ts * n as f64;
-            let (c, s) = (th.cos(), th.sin());
-            // i = j·4 A·e^{jθ}, v = Rs·i + d/dt of the flux.
-            let i = Ab::new(-4.0 * s, 4.0 * c);
-            let v = Ab::new(
-                0.327 * i.alpha - w * 0.088 * s - w * 2.63e-3 * 4.0 * c,
-                0.327 * i.beta + w * 0.088 * c - w * 2.63e-3 * 4.0 * s,
-            );
+            let (v, i) = paper_sample(n);
             let (v, i) = match n {
                 1000 => (Ab::new(f64::NAN, 0.0), i),
                 2000 => (v, Ab::new(1e6, 0.0)),
@@ -1927,16 +1933,9 @@ mod tests {
             let p = est.params;
             assert_eq!(p.gain_hold, samples_per_update - 1);
             assert_eq!(est.state.observer_gains, p.observer.gains(T::zero()));
-            let (w, ts) = (2.0 * core::f64::consts::PI * 20.0, 1e-4);
             let mut updates = 0;
             for n in 0..4000 {
-                let th = w * ts * n as f64;
-                let (c, s) = (th.cos(), th.sin());
-                let i = Ab::new(-4.0 * s, 4.0 * c);
-                let v = Ab::new(
-                    0.327 * i.alpha - w * 0.088 * s - w * 2.63e-3 * 4.0 * c,
-                    0.327 * i.beta + w * 0.088 * c - w * 2.63e-3 * 4.0 * s,
-                );
+                let (v, i) = paper_sample(n);
                 let v = if n == 1001 { Ab::new(f64::NAN, 0.0) } else { v };
                 let v = Ab::new(T::lit(v.alpha), T::lit(v.beta));
                 let i = Ab::new(T::lit(i.alpha), T::lit(i.beta));

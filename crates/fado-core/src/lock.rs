@@ -465,33 +465,19 @@ mod tests {
             flux_low_fast_ratio: 0.6,
             ..detector_config(1e-4)
         };
-        for omega in [0.0, 9.99, -9.99] {
-            let mut d = LockDetector::new(c).unwrap();
-            assert_eq!(
-                step_at(&mut d, 0.65, 0.0, omega),
-                LockStatus::Lost,
-                "{omega}"
-            );
-            let mut d = LockDetector::new(c).unwrap();
-            assert_eq!(
-                step_at(&mut d, 0.71, 0.0, omega),
-                LockStatus::Locked,
-                "{omega}"
-            );
-        }
-        for omega in [10.0, -10.0, 1e4] {
-            let mut d = LockDetector::new(c).unwrap();
-            assert_eq!(
-                step_at(&mut d, 0.65, 0.0, omega),
-                LockStatus::Locked,
-                "{omega}"
-            );
-            let mut d = LockDetector::new(c).unwrap();
-            assert_eq!(
-                step_at(&mut d, 0.59, 0.0, omega),
-                LockStatus::Lost,
-                "{omega}"
-            );
+        let slow = [0.0, 9.99, -9.99];
+        let fast = [10.0, -10.0, 1e4];
+        let cases = [
+            (slow, 0.65, LockStatus::Lost),
+            (slow, 0.71, LockStatus::Locked),
+            (fast, 0.65, LockStatus::Locked),
+            (fast, 0.59, LockStatus::Lost),
+        ];
+        for (speeds, flux, status) in cases {
+            for omega in speeds {
+                let mut d = LockDetector::new(c).unwrap();
+                assert_eq!(step_at(&mut d, flux, 0.0, omega), status, "{omega} {flux}");
+            }
         }
         // A NaN speed takes the fast bound (the estimator refuses such a sample anyway).
         let mut d = LockDetector::new(c).unwrap();

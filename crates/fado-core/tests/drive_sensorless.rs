@@ -824,28 +824,16 @@ fn stall_symptom_counts_in_kdf_mode_just_above_the_threshold() {
             let mut c = stall_test_config(&machine);
             c.tuning.lock_stall_kdf_speed_ratio = kdf_ratio;
             let omega = speed_ratio * machine.rated_speed();
-            let caught = omega / machine.pole_pairs as f64;
-            let mut drive = SensorlessDrive::with_estimator(
-                c,
-                SpeedSpy {
-                    omega0: omega,
-                    accel: 0.0,
-                    ts: 0.0,
-                    n: 0,
-                    mode: fado_core::Mode::DisturbanceFeedback,
-                },
-            )
-            .unwrap();
-            drive.align(0.0);
-            let mut first = None;
-            for n in 0..520 {
-                let speed = if n < 20 { caught } else { caught + 8.0 };
-                let out = drive.step(Abc::new(0.0, 0.0, 0.0), 300.0, speed);
-                if first.is_none() && out.flags.contains(DriveFlags::STALLED) {
-                    first = Some(n);
-                }
-            }
-            first
+            let spy = SpeedSpy {
+                omega0: omega,
+                accel: 0.0,
+                ts: 0.0,
+                n: 0,
+                mode: fado_core::Mode::DisturbanceFeedback,
+            };
+            // 8 rad/s mechanical away after 20 samples.
+            let away = 8.0 * machine.pole_pairs as f64;
+            first_stalled(c, spy, 520, |n| if n < 20 { omega } else { omega + away })
         };
         assert_eq!(run(0.0175, 0.02), Some(20 + 50), "{}", machine.pole_pairs);
         assert_eq!(run(0.03, 0.02), None, "{}", machine.pole_pairs);
@@ -895,6 +883,26 @@ impl RotorAngleEstimator<f64> for SpeedSpy {
 /// Samples the speed loop holds the reference equal to ω̂ before `SpeedSpy` ramps.
 const CATCH: u32 = 600;
 
+/// Drives `c` with `spy` for `samples` samples at the speed reference `speed(n)` (electrical
+/// rad/s; the drive takes it in mechanical rad/s) and returns the first sample with
+/// `STALLED` up.
+fn first_stalled(
+    c: DriveConfig<f64>,
+    spy: SpeedSpy,
+    samples: u32,
+    speed: impl Fn(u32) -> f64,
+) -> Option<u32> {
+    let p = c.machine.pole_pairs as f64;
+    let mut drive = SensorlessDrive::with_estimator(c, spy).unwrap();
+    drive.align(0.0);
+    (0..samples).find(|&n| {
+        drive
+            .step(Abc::new(0.0, 0.0, 0.0), 300.0, speed(n) / p)
+            .flags
+            .contains(DriveFlags::STALLED)
+    })
+}
+
 /// The stall symptom does not count while the estimated rotor answers the torque
 /// (`lock_stall_follow_time`, docs/lock.md fifth session): ω̂ beyond the stall band in the
 /// direction of the speed error and accelerating in it. The speed loop catches a reference
@@ -930,23 +938,14 @@ fn stall_symptom_spares_an_estimate_that_answers_the_torque() {
                 n: 0,
                 mode: fado_core::Mode::Limiter,
             };
-            let p = machine.pole_pairs as f64;
-            let mut drive = SensorlessDrive::with_estimator(c, spy).unwrap();
-            drive.align(0.0);
-            let mut first = None;
-            for n in 0..CATCH + 500 {
+            first_stalled(c, spy, CATCH + 500, |n| {
                 let omega = omega0 + accel * ts * n.saturating_sub(CATCH) as f64;
-                let speed = if n < CATCH {
+                if n < CATCH {
                     omega
                 } else {
                     omega + 3.0 * band * omega0.signum()
-                };
-                let out = drive.step(Abc::new(0.0, 0.0, 0.0), 300.0, speed / p);
-                if first.is_none() && out.flags.contains(DriveFlags::STALLED) {
-                    first = Some(n);
                 }
-            }
-            first
+            })
         };
         let p = machine.pole_pairs;
         // Answers: 2 bands out, accelerating towards the reference.
@@ -999,18 +998,9 @@ fn stall_band_widens_with_the_commanded_torque() {
                 n: 0,
                 mode: fado_core::Mode::Limiter,
             };
-            let p = machine.pole_pairs as f64;
-            let mut drive = SensorlessDrive::with_estimator(c, spy).unwrap();
-            drive.align(0.0);
-            let mut first = None;
-            for n in 0..CATCH + 500 {
-                let speed = if n < CATCH { 2.0 * band } else { 3.5 * band };
-                let out = drive.step(Abc::new(0.0, 0.0, 0.0), 300.0, speed / p);
-                if first.is_none() && out.flags.contains(DriveFlags::STALLED) {
-                    first = Some(n);
-                }
-            }
-            first
+            first_stalled(c, spy, CATCH + 500, |n| {
+                if n < CATCH { 2.0 * band } else { 3.5 * band }
+            })
         };
         let p = machine.pole_pairs;
         for ratio in [0.0, 0.5] {
