@@ -94,6 +94,19 @@ fn estimators(c: &mut Criterion) {
         .unwrap(),
         &data,
     );
+    // fado on the paper's path (`EstimatorTuning::paper_path`, the Cortex-M image's scenarios
+    // 4-5, docs/firmware.md): the paper's method inside fado's step, against the baselines.
+    bench_named(
+        c,
+        "fado-paper-path_step_f32",
+        SensorlessEstimator::<f32>::new({
+            let mut config = EstimatorConfig::for_machine(&MachineModel::paper());
+            config.tuning = config.tuning.paper_path();
+            config
+        })
+        .unwrap(),
+        &data,
+    );
     bench_one(
         c,
         LpfIntegratorEstimator::<f32>::new(

@@ -5,11 +5,16 @@
 //! ```text
 //! cargo run --release -p fado-core --example step_driver -- f32 100000
 //! FIXED_RS=1 cargo run ...   # the paper's fixed R̂s (rs_adaptation = false)
+//! PAPER_PATH=1 cargo run ...  # fado on the paper's path (every fado addition that can be off)
+//! ESTIMATOR=ortega cargo run ...  # the Ortega baseline, for the host ratio of issue 16
 //! ```
 
 use std::hint::black_box;
 
-use fado_core::{Ab, Estimate, EstimatorConfig, MachineModel, Real, SensorlessEstimator};
+use fado_core::baselines::{OrtegaConfig, OrtegaEstimator};
+use fado_core::{
+    Ab, Estimate, EstimatorConfig, MachineModel, Real, RotorAngleEstimator, SensorlessEstimator,
+};
 
 /// Samples in the signal table: a power of two holding exactly 8 electrical periods.
 const TABLE: usize = 4096;
@@ -46,15 +51,26 @@ fn signal<T: Real>() -> Vec<(Ab<T>, Ab<T>)> {
 /// One estimator step behind a call, as a firmware ISR makes it; not inlined, so that callgrind
 /// can count exactly the instructions inside (`--toggle-collect=*isr_step*`).
 #[inline(never)]
-fn isr_step<T: Real>(est: &mut SensorlessEstimator<T>, v: Ab<T>, i: Ab<T>) -> Estimate<T> {
+fn isr_step<T: Real, E: RotorAngleEstimator<T>>(est: &mut E, v: Ab<T>, i: Ab<T>) -> Estimate<T> {
     est.step(v, i)
 }
 
 fn run<T: Real>(steps: usize) -> f64 {
-    let table = signal::<T>();
-    let mut config = EstimatorConfig::for_machine(&MachineModel::paper());
+    let machine = MachineModel::paper();
+    if std::env::var("ESTIMATOR").is_ok_and(|e| e == "ortega") {
+        let est = OrtegaEstimator::<T>::new(OrtegaConfig::for_machine(&machine)).expect("valid");
+        return run_with(est, steps);
+    }
+    let mut config = EstimatorConfig::for_machine(&machine);
     config.tuning.rs_adaptation = std::env::var("FIXED_RS").is_err();
-    let mut est = SensorlessEstimator::<T>::new(config).expect("valid");
+    if std::env::var("PAPER_PATH").is_ok() {
+        config.tuning = config.tuning.paper_path();
+    }
+    run_with(SensorlessEstimator::<T>::new(config).expect("valid"), steps)
+}
+
+fn run_with<T: Real, E: RotorAngleEstimator<T>>(mut est: E, steps: usize) -> f64 {
+    let table = signal::<T>();
     // Warm-up: one second, so that the counted steps run in the settled k_df mode.
     for &(v, i) in table.iter().cycle().take(10_000) {
         est.step(v, i);

@@ -335,6 +335,26 @@ pub struct EstimatorTuning<T> {
 }
 
 impl<T: Real> EstimatorTuning<T> {
+    /// This tuning on the paper's path: every addition of fado's to the estimator of Fig. 5
+    /// that can be switched off is off — the fixed R̂s (no [`Self::rs_adaptation`], hence no
+    /// λ̂f or integrand-offset law), the observer on λ1 with ω̂ of T2S-1 alone
+    /// ([`Self::observer_on_rotor_flux`], [`Self::observer_lag_compensation`]), no
+    /// [`Self::limiter_recentring`], an abrupt k_df ([`Self::k_df_ramp_time`] 0) and the gains
+    /// (16) formed every sample ([`Self::observer_gain_period`] 0). The sample bounds, the
+    /// finite test and the loss-of-lock detector stay. What the cost comparisons call "the
+    /// paper's path" (docs/firmware.md; `benches/baselines.rs`).
+    pub fn paper_path(self) -> Self {
+        Self {
+            rs_adaptation: false,
+            observer_lag_compensation: false,
+            observer_on_rotor_flux: false,
+            limiter_recentring: false,
+            k_df_ramp_time: T::zero(),
+            observer_gain_period: T::zero(),
+            ..self
+        }
+    }
+
     /// The same record in another precision (e.g. an f64 configuration for an f32 drive):
     /// every real rounded to `U`.
     pub fn cast<U: Real>(&self) -> EstimatorTuning<U> {

@@ -438,14 +438,8 @@ fn main() -> ! {
     // The estimator's parameters, once (configuration checked here, not in the interrupt).
     let paper_config = {
         let mut config = EstimatorConfig::for_machine(&MachineModel::<f32>::paper());
-        let t = &mut config.tuning;
-        t.rs_adaptation = false;
-        t.observer_lag_compensation = false;
-        t.observer_on_rotor_flux = false;
-        t.limiter_recentring = false;
-        t.k_df_ramp_time = 0.0;
-        // The paper forms the gains (16) every sample.
-        t.observer_gain_period = 0.0;
+        // Every fado addition that can be off, off; the gains (16) every sample, as the paper.
+        config.tuning = config.tuning.paper_path();
         config
     };
     let params = {

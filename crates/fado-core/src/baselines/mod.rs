@@ -240,7 +240,9 @@ impl<T: Real> AngleTrackers<T> {
     #[inline]
     fn step(&mut self, lambda_r: Ab<T>) -> Option<Tracked<T>> {
         let hold = lambda_r.norm_squared() < self.hold_level_sq;
-        let theta_direct = lambda_r.angle();
+        // eq. (6)'s atan2 as fado's step computes it (`libm` in `f64`, the tested `f32`
+        // approximation in `f32`): the baselines and fado pay the same for the same angle.
+        let theta_direct = crate::rotor_flux::rotor_angle(lambda_r);
         let (theta, omega, omega_control) = if hold {
             let (th, w) = self.t2s1.coast();
             (th, w, self.t2s2.coast().1)
