@@ -6,8 +6,9 @@
 #    only the instructions inside the out-of-line `isr_step` call (--toggle-collect);
 #  - the freestanding firmware image of tests/embedded (f32, libm maths, LTO), whole program
 #    (its loop adds ~15 instructions of input generation per step);
-#  - f32 inside the step for fado with fixed R̂s, on the paper's path, and the Ortega baseline
-#    (examples/step_driver.rs: FIXED_RS, PAPER_PATH, ESTIMATOR=ortega).
+#  - f32 inside the step for fado with fixed R̂s, on the paper's path, the paper's method alone
+#    (the Cortex-M image's kernel) and the Ortega baseline (examples/step_driver.rs: FIXED_RS,
+#    PAPER_PATH, ESTIMATOR=paper-kernel, ESTIMATOR=ortega).
 # Usage: bash scripts/callgrind.sh   (N1, N2 from the environment; defaults 20000 and 40000)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -52,7 +53,7 @@ per_step "firmware image f32 (libm, LTO), whole program" "$image"
 # shares fado's trackers and atan2, so the ratio is the cost of what each method adds).
 echo "f32 inside isr_step, fado's variants and the Ortega baseline"
 for v in "default (R̂s adaptation)=" "fixed R̂s=FIXED_RS=1" "paper's path=PAPER_PATH=1" \
-    "Ortega baseline=ESTIMATOR=ortega"; do
+    "the paper's method alone=ESTIMATOR=paper-kernel" "Ortega baseline=ESTIMATOR=ortega"; do
     (
         [[ -n ${v#*=} ]] && export "${v#*=}"
         per_step "host f32, ${v%%=*}" --toggle-collect='*isr_step*' "$driver" f32

@@ -154,7 +154,9 @@ impl PaperKernel {
 /// One sample of the paper's estimator (Fig. 5): `v_ab` the voltage over the last interval,
 /// `i_ab` the current now; returns θ̂ (rad, in [−π, π]).
 #[inline(never)]
-#[unsafe(no_mangle)]
+// Unmangled in the image, where the cost script finds it by name; the host build
+// (`crates/fado-core/examples/step_driver.rs`, `ESTIMATOR=paper-kernel`) has no such need.
+#[cfg_attr(target_os = "none", unsafe(no_mangle))]
 pub fn paper_kernel_step(k: &mut PaperKernel, v_ab: Ab<f32>, i_ab: Ab<f32>) -> f32 {
     let (va, vb, ia, ib) = (v_ab.alpha, v_ab.beta, i_ab.alpha, i_ab.beta);
     // Flux integrator, eq. (21)/(24): λ1 += Ts·(v − R̂s·ī − feedback).
