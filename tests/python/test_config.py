@@ -538,3 +538,20 @@ def test_machine_counts_and_voltages_by_type() -> None:
         paper.replace(dc_voltage="311")  # type: ignore[arg-type]
     assert paper.replace(dc_voltage=540).dc_voltage == 540.0
     assert paper.replace(rs=0.4).dc_voltage == paper.dc_voltage
+
+
+def test_paper_path_switches_off_fados_additions_and_keeps_the_rest() -> None:
+    cfg = EstimatorConfig(k_af=300.0, rs_adaptation_rate=2.0)
+    paper = cfg.paper_path()
+    off = {
+        "rs_adaptation": False,
+        "observer_lag_compensation": False,
+        "observer_on_rotor_flux": False,
+        "limiter_recentring": False,
+        "k_df_ramp_time": 0.0,
+        "observer_gain_period": 0.0,
+    }
+    assert_fields(paper.to_dict(), dict(cfg.to_dict(), **off))
+    # The defaults have every one of them on (a test that the switch changes something).
+    assert all(cfg.to_dict()[k] != v for k, v in off.items() if k != "k_df_ramp_time")
+    assert paper.paper_path() == paper and EstimatorConfig(**paper.to_dict()) == paper

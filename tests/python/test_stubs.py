@@ -79,7 +79,7 @@ def test_output_fields_agree_everywhere() -> None:
 
 def test_config_fields_agree_everywhere() -> None:
     fields = list(fado.EstimatorConfig.fields)
-    props = stub_classes()["EstimatorConfig"] - {"replace", "to_dict", "fields"}
+    props = stub_classes()["EstimatorConfig"] - {"replace", "to_dict", "paper_path", "fields"}
     assert set(fields) == props
     for node in stub_tree().body:
         if isinstance(node, ast.ClassDef) and node.name == "EstimatorConfig":

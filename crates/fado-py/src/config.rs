@@ -111,6 +111,13 @@ impl PyEstimatorConfig {
     fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         self.items(py)
     }
+
+    /// A copy on the paper's path (`fado_core::EstimatorTuning::paper_path`): fixed R̂s, the
+    /// observer on λ1 at T2S-1's ω̂, no limiter re-centring, an abrupt k_df and the gains (16)
+    /// every sample; the sample bounds and the lock detector stay.
+    fn paper_path(&self) -> Self {
+        Self::from_core(&self.tuning.paper_path())
+    }
 }
 
 impl PyEstimatorConfig {
