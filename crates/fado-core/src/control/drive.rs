@@ -338,8 +338,8 @@ pub struct DriveTuning<T> {
     /// right (docs/lock.md). Zero on a surface-magnet model (L̂d = L̂q). Default 0.05 \[A\]
     /// (docs/lock.md, "A band for the reluctance torque": on seed 7 of the seven presets
     /// 0.15 loses 10 of 96 detections on ipmsm-gem-50k and 12 of 53 on pmsyrm-5k, 0.05 none;
-    /// over seeds 7, 8 and 21 it takes the passing runs flagged from 76 to 7 of 778 on
-    /// pmsyrm-5k and from 170 to 127 of 440 on ipmsm-gem-50k, with no detection lost on any
+    /// over seeds 7, 8, 21 and 22 it takes the passing runs flagged from 100 to 10 of 1012 on
+    /// pmsyrm-5k and from 213 to 158 of 564 on ipmsm-gem-50k, with no detection lost on any
     /// preset, and leaves fig11's hold-out seeds 17–20 at 856/856 detected, 0 of 418 flagged).
     pub lock_stall_reluctance_band_ratio: T,
     /// The loaded-standstill angle probe (see [`crate::control::standstill_probe`]): at a
