@@ -797,6 +797,78 @@ fn stall_is_its_own_flag_and_starts_the_reaction_when_asked() {
     }
 }
 
+/// The stall band widens with the model's reluctance torque (`lock_stall_reluctance_band_ratio`,
+/// docs/lock.md "A band for the reluctance torque"): ε_r·|1.5·p·(L̂d − L̂q)·i_d*·i_q*|/(Ĵ·ω_s)
+/// on top of the band. An estimate stuck 2 bands out while the reference runs 4 bands ahead
+/// (the torque band off): flagged after `lock_stall_time` (50 samples) with ε_r = 0 on every
+/// motor; with ε_r = 200 never on the salient ones (the 2.2 kW IPMSM, L̂q/L̂d 1.42, and the
+/// 5 kW PM-assisted reluctance motor of motors/pmsyrm-5k.toml, 4.25), whose MTPA d current
+/// makes a reluctance torque, but still on the paper's surface-magnet motor, where it is zero
+/// whatever the ratio.
+#[test]
+fn stall_band_widens_with_the_reluctance_torque() {
+    let pmsyrm = MachineModel {
+        rs: 0.2,
+        ld: 4e-3,
+        lq: 17e-3,
+        flux_linkage: 0.134,
+        pole_pairs: 2,
+        inertia: 0.0042,
+        viscous_friction: 7.1e-4,
+        rated_current: 22.06,
+        rated_speed_rpm: 2550.0,
+        rated_torque: 19.0,
+        dc_voltage: 310.0,
+    };
+    for (machine, salient) in [
+        (MachineModel::paper(), false),
+        (common::ipmsm_model(), true),
+        (pmsyrm, true),
+    ] {
+        let band = DriveConfig::<f64>::for_machine(&machine)
+            .tuning
+            .lock_stall_speed_ratio
+            * machine.rated_speed();
+        let run = |ratio: f64| stuck_estimate_stalls(&machine, 0.0, ratio, 6.0 * band);
+        let p = machine.pole_pairs;
+        let n = run(0.0).unwrap_or(0);
+        assert!((CATCH + 49..=CATCH + 50).contains(&n), "{p}: {n}");
+        if salient {
+            assert_eq!(run(200.0), None, "{p}");
+        } else {
+            let n = run(200.0).unwrap_or(0);
+            assert!((CATCH + 49..=CATCH + 50).contains(&n), "{p}: {n}");
+        }
+    }
+}
+
+/// The first `STALLED` sample of `machine`'s drive (current gate off, torque band ratio
+/// `torque`, reluctance band ratio `reluctance`) with an estimate stuck 2 fixed bands out in
+/// limiter mode while the reference, equal to it for `CATCH` samples, then runs at `ahead`
+/// (electrical rad/s).
+fn stuck_estimate_stalls(
+    machine: &MachineModel<f64>,
+    torque: f64,
+    reluctance: f64,
+    ahead: f64,
+) -> Option<u32> {
+    let mut c = stall_test_config(machine);
+    let band = c.tuning.lock_stall_speed_ratio * machine.rated_speed();
+    c.tuning.lock_stall_min_current_ratio = 0.0;
+    c.tuning.lock_stall_torque_band_ratio = torque;
+    c.tuning.lock_stall_reluctance_band_ratio = reluctance;
+    let spy = SpeedSpy {
+        omega0: 2.0 * band,
+        accel: 0.0,
+        ts: c.ts,
+        n: 0,
+        mode: fado_core::Mode::Limiter,
+    };
+    first_stalled(c, spy, CATCH + 500, |n| {
+        if n < CATCH { 2.0 * band } else { ahead }
+    })
+}
+
 /// `machine`'s drive with the start-up calibrations and the stuck-sensor check off and the
 /// current limits out of the way, for the stall-symptom tests with a spy estimator.
 fn stall_test_config(machine: &MachineModel<f64>) -> DriveConfig<f64> {
@@ -987,21 +1059,7 @@ fn stall_band_widens_with_the_commanded_torque() {
             .tuning
             .lock_stall_speed_ratio
             * machine.rated_speed();
-        let run = |ratio: f64| {
-            let mut c = stall_test_config(&machine);
-            c.tuning.lock_stall_min_current_ratio = 0.0;
-            c.tuning.lock_stall_torque_band_ratio = ratio;
-            let spy = SpeedSpy {
-                omega0: 2.0 * band,
-                accel: 0.0,
-                ts: c.ts,
-                n: 0,
-                mode: fado_core::Mode::Limiter,
-            };
-            first_stalled(c, spy, CATCH + 500, |n| {
-                if n < CATCH { 2.0 * band } else { 3.5 * band }
-            })
-        };
+        let run = |ratio: f64| stuck_estimate_stalls(&machine, ratio, 0.0, 3.5 * band);
         let p = machine.pole_pairs;
         for ratio in [0.0, 0.5] {
             let n = run(ratio).unwrap_or(0);
