@@ -70,46 +70,46 @@ fn isr_step_kernel(k: &mut paper_kernel::PaperKernel, v: Ab<f32>, i: Ab<f32>) ->
 
 /// The paper's method alone, `f32`, on the paper's motor (as the Cortex-M image runs it).
 fn run_kernel(steps: usize) -> f64 {
-    let table = signal::<f32>();
     let config = EstimatorConfig::for_machine(&MachineModel::paper());
     let mut k = paper_kernel::PaperKernel::new(&config);
+    let table = signal::<f32>();
     k.prime(table[TABLE - 1].1);
-    for &(v, i) in table.iter().cycle().take(10_000) {
-        paper_kernel::paper_kernel_step(&mut k, v, i);
-    }
-    let mut acc = 0.0_f32;
-    for n in 0..steps {
-        let (v, i) = table[n & (TABLE - 1)];
-        acc += black_box(isr_step_kernel(&mut k, black_box(v), black_box(i)));
-    }
-    f64::from(acc)
+    run_steps(&table, steps, |v, i| isr_step_kernel(&mut k, v, i))
 }
 
-fn run<T: Real>(steps: usize) -> f64 {
+/// fado's estimator (default, `FIXED_RS`, `PAPER_PATH`) or the Ortega baseline.
+fn run<T: Real>(steps: usize, ortega: bool) -> f64 {
     let machine = MachineModel::paper();
-    if std::env::var("ESTIMATOR").is_ok_and(|e| e == "ortega") {
-        let est = OrtegaEstimator::<T>::new(OrtegaConfig::for_machine(&machine)).expect("valid");
-        return run_with(est, steps);
+    let table = signal::<T>();
+    if ortega {
+        let mut est =
+            OrtegaEstimator::<T>::new(OrtegaConfig::for_machine(&machine)).expect("valid");
+        return run_steps(&table, steps, |v, i| isr_step(&mut est, v, i).theta);
     }
     let mut config = EstimatorConfig::for_machine(&machine);
     config.tuning.rs_adaptation = std::env::var("FIXED_RS").is_err();
     if std::env::var("PAPER_PATH").is_ok() {
         config.tuning = config.tuning.paper_path();
     }
-    run_with(SensorlessEstimator::<T>::new(config).expect("valid"), steps)
+    let mut est = SensorlessEstimator::<T>::new(config).expect("valid");
+    run_steps(&table, steps, |v, i| isr_step(&mut est, v, i).theta)
 }
 
-fn run_with<T: Real, E: RotorAngleEstimator<T>>(mut est: E, steps: usize) -> f64 {
-    let table = signal::<T>();
-    // Warm-up: one second, so that the counted steps run in the settled k_df mode.
+/// One second of warm-up over `table` (so that the counted steps run in the settled k_df
+/// mode), then `steps` calls of `step`; returns the sum of the angles (a checksum that keeps
+/// the work alive).
+fn run_steps<T: Real>(
+    table: &[(Ab<T>, Ab<T>)],
+    steps: usize,
+    mut step: impl FnMut(Ab<T>, Ab<T>) -> T,
+) -> f64 {
     for &(v, i) in table.iter().cycle().take(10_000) {
-        est.step(v, i);
+        step(v, i);
     }
     let mut acc = T::zero();
     for k in 0..steps {
         let (v, i) = table[k & (TABLE - 1)];
-        let out = isr_step(&mut est, black_box(v), black_box(i));
-        acc += black_box(out).theta;
+        acc += black_box(step(black_box(v), black_box(i)));
     }
     acc.to_f64()
 }
@@ -121,10 +121,12 @@ fn main() {
         .next()
         .map(|s| s.parse().expect("N must be an integer"))
         .unwrap_or(100_000);
+    let estimator = std::env::var("ESTIMATOR").unwrap_or_default();
+    let ortega = estimator == "ortega";
     let acc = match precision.as_str() {
-        "f32" if std::env::var("ESTIMATOR").is_ok_and(|e| e == "paper-kernel") => run_kernel(steps),
-        "f32" => run::<f32>(steps),
-        "f64" => run::<f64>(steps),
+        "f32" if estimator == "paper-kernel" => run_kernel(steps),
+        "f32" => run::<f32>(steps, ortega),
+        "f64" => run::<f64>(steps, ortega),
         other => {
             eprintln!("usage: step_driver <f32|f64> <N>  (got {other:?})");
             std::process::exit(2);

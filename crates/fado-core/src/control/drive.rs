@@ -1626,11 +1626,10 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         // The model's torque and its reluctance part over 1.5·p (folded into the band
         // factors at construction, so that the step does no integer-to-float or
         // double-precision arithmetic).
+        let reluctance_flux = (m.ld - m.lq) * i_ref.d;
         let band = self.resolved.stall_speed.max(
-            self.resolved.stall_torque_band
-                * ((m.flux_linkage + (m.ld - m.lq) * i_ref.d) * i_ref.q).abs(),
-        ) + self.resolved.stall_reluctance_band
-            * ((m.ld - m.lq) * i_ref.d * i_ref.q).abs();
+            self.resolved.stall_torque_band * ((m.flux_linkage + reluctance_flux) * i_ref.q).abs(),
+        ) + self.resolved.stall_reluctance_band * (reluctance_flux * i_ref.q).abs();
         let off_reference = speed_error.abs() > band;
         let follow_gain = self.resolved.stall_follow_gain;
         self.omega_slow += follow_gain * (omega_ctrl - self.omega_slow);
