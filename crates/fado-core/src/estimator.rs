@@ -512,33 +512,17 @@ impl<T: Real> EstimatorConfig<T> {
 
     /// The sample bounds of [`crate::plausibility`] from the machine's ratings and the
     /// `plausible_*` ratios.
-    fn sample_bounds(&self) -> Result<SampleBounds<T>, ConfigError> {
+    pub fn sample_bounds(&self) -> Result<SampleBounds<T>, ConfigError> {
         let t = &self.tuning;
-        let ratio = check::non_negative(
-            "plausible_current_step_ratio",
+        SampleBounds::from_ratios(
+            t.plausible_current_ratio,
+            t.plausible_voltage_ratio,
             t.plausible_current_step_ratio,
-        )?;
-        let current = check::positive("plausible_current_ratio", t.plausible_current_ratio)?
-            * self.machine.rated_current;
-        let voltage = check::positive("plausible_voltage_ratio", t.plausible_voltage_ratio)?
-            * self.machine.dc_voltage;
-        let step = ratio * voltage * self.ts / self.machine.lq;
-        let step = if ratio > T::zero() && step.is_finite() {
-            step
-        } else {
-            T::lit(f64::INFINITY)
-        };
-        SampleBounds::new(current, voltage, step).map_err(|e| match e.field() {
-            "plausible_current" => ConfigError::OutOfRange {
-                field: "plausible_current_ratio",
-                expected: "a finite bound in this precision",
-            },
-            "plausible_voltage" => ConfigError::OutOfRange {
-                field: "plausible_voltage_ratio",
-                expected: "a finite bound in this precision",
-            },
-            _ => e,
-        })
+            self.machine.rated_current,
+            self.machine.dc_voltage,
+            self.machine.lq,
+            self.ts,
+        )
     }
 
     fn tracker(&self, bandwidth_hz: T) -> TrackerConfig<T> {

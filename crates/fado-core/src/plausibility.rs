@@ -78,6 +78,42 @@ impl<T: Real> SampleBounds<T> {
         })
     }
 
+    /// The bounds of the `plausible_*` ratios (the fields of [`crate::EstimatorTuning`] and of
+    /// the baselines' configurations, which errors name): |i| below `current_ratio` ×
+    /// `rated_current`, |v| below `voltage_ratio` × `dc_voltage`, |Δi| per sample below
+    /// `step_ratio` × (the plausible voltage)·`ts`/`lq` (0, or a step that overflows, switches
+    /// the step test off).
+    pub fn from_ratios(
+        current_ratio: T,
+        voltage_ratio: T,
+        step_ratio: T,
+        rated_current: T,
+        dc_voltage: T,
+        lq: T,
+        ts: T,
+    ) -> Result<Self, ConfigError> {
+        let ratio = check::non_negative("plausible_current_step_ratio", step_ratio)?;
+        let current = check::positive("plausible_current_ratio", current_ratio)? * rated_current;
+        let voltage = check::positive("plausible_voltage_ratio", voltage_ratio)? * dc_voltage;
+        let step = ratio * voltage * ts / lq;
+        let step = if ratio > T::zero() && step.is_finite() {
+            step
+        } else {
+            T::lit(f64::INFINITY)
+        };
+        Self::new(current, voltage, step).map_err(|e| match e.field() {
+            "plausible_current" => ConfigError::OutOfRange {
+                field: "plausible_current_ratio",
+                expected: "a finite bound in this precision",
+            },
+            "plausible_voltage" => ConfigError::OutOfRange {
+                field: "plausible_voltage_ratio",
+                expected: "a finite bound in this precision",
+            },
+            _ => e,
+        })
+    }
+
     /// The bounds of a machine with the default ratios ([`CURRENT_RATIO`],
     /// [`VOLTAGE_RATIO`], [`STEP_RATIO`]) at sampling period `ts`.
     pub fn for_machine(machine: &MachineModel<T>, ts: T) -> Result<Self, ConfigError> {

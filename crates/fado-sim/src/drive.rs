@@ -105,6 +105,11 @@ impl SimConfig {
             bandwidth_definition: e.tuning.bandwidth_definition,
             tracker_hold_ratio: e.tuning.tracker_hold_ratio,
             average_current: e.tuning.average_current,
+            rated_current: e.machine.rated_current,
+            dc_voltage: e.machine.dc_voltage,
+            plausible_current_ratio: e.tuning.plausible_current_ratio,
+            plausible_voltage_ratio: e.tuning.plausible_voltage_ratio,
+            plausible_current_step_ratio: e.tuning.plausible_current_step_ratio,
             initial_angle: e.initial_angle,
         })
         .map_err(|e| self.core_error("estimator", e))
@@ -129,6 +134,11 @@ impl SimConfig {
             bandwidth_definition: e.tuning.bandwidth_definition,
             tracker_hold_ratio: e.tuning.tracker_hold_ratio,
             average_current: e.tuning.average_current,
+            rated_current: e.machine.rated_current,
+            dc_voltage: e.machine.dc_voltage,
+            plausible_current_ratio: e.tuning.plausible_current_ratio,
+            plausible_voltage_ratio: e.tuning.plausible_voltage_ratio,
+            plausible_current_step_ratio: e.tuning.plausible_current_step_ratio,
             initial_angle: e.initial_angle,
         })
         .map_err(|e| self.core_error("estimator", e))
@@ -151,6 +161,11 @@ impl SimConfig {
             bandwidth_definition: e.tuning.bandwidth_definition,
             tracker_hold_ratio: e.tuning.tracker_hold_ratio,
             average_current: e.tuning.average_current,
+            rated_current: e.machine.rated_current,
+            dc_voltage: e.machine.dc_voltage,
+            plausible_current_ratio: e.tuning.plausible_current_ratio,
+            plausible_voltage_ratio: e.tuning.plausible_voltage_ratio,
+            plausible_current_step_ratio: e.tuning.plausible_current_step_ratio,
             initial_angle: e.initial_angle,
         })
         .map_err(|e| self.core_error("estimator", e))

@@ -84,6 +84,20 @@ pub struct EmfObserverConfig<T> {
     /// Average the current over the interval for the resistive drop. Default true (SPEC §1
     /// \[A\]).
     pub average_current: bool,
+    /// Rated (peak) phase current in A, the unit of `plausible_current_ratio`. From the
+    /// machine model.
+    pub rated_current: T,
+    /// DC-link voltage in V, the unit of `plausible_voltage_ratio`. From the machine model.
+    pub dc_voltage: T,
+    /// Samples with |i| above this × `rated_current` are refused (see
+    /// [`crate::plausibility`]). Default 4, as fado's
+    /// ([`crate::EstimatorTuning::plausible_current_ratio`]).
+    pub plausible_current_ratio: T,
+    /// Samples with |v| above this × `dc_voltage` are refused. Default 1.5, as fado's.
+    pub plausible_voltage_ratio: T,
+    /// A current that moved by more than this × (plausible voltage)·ts/L̂q per sample is
+    /// refused; 0 switches the test off. Default 2, as fado's.
+    pub plausible_current_step_ratio: T,
     /// Rotor angle assumed at reset (rad). Default 0 (SPEC §1 \[A\]).
     pub initial_angle: T,
 }
@@ -104,6 +118,11 @@ impl<T: Real> EmfObserverConfig<T> {
             bandwidth_definition: BandwidthDefinition::Minus3Db,
             tracker_hold_ratio: T::lit(0.2),
             average_current: true,
+            rated_current: machine.rated_current,
+            dc_voltage: machine.dc_voltage,
+            plausible_current_ratio: T::lit(crate::plausibility::CURRENT_RATIO),
+            plausible_voltage_ratio: T::lit(crate::plausibility::VOLTAGE_RATIO),
+            plausible_current_step_ratio: T::lit(crate::plausibility::STEP_RATIO),
             initial_angle: T::zero(),
         }
     }
@@ -144,8 +163,8 @@ impl<T: Real> EmfObserverEstimator<T> {
     /// Builds the estimator; every field of `config` is checked and a bad one is named.
     pub fn new(config: EmfObserverConfig<T>) -> Result<Self, ConfigError> {
         let ts = check::positive("ts", config.ts)?;
-        let integrand = Integrand::new(config.rs_hat, config.average_current)?;
         check::non_negative("lq_hat", config.lq_hat)?;
+        let integrand = integrand_of!(config, ts)?;
         let lf = check::positive("flux_linkage_hat", config.flux_linkage_hat)?;
         let p = T::two_pi() * check::positive("emf_bandwidth_hz", config.emf_bandwidth_hz)?;
         check::below(
@@ -257,7 +276,7 @@ impl<T: Real> GuardedStep<T> for EmfObserverEstimator<T> {
         let ts = self.config.ts;
         let lq = self.config.lq_hat;
         let di = i_ab - self.integrand.previous_current().unwrap_or(i_ab);
-        let emf_measured = self.integrand.step(v_ab, i_ab) - di * (lq / ts);
+        let emf_measured = self.integrand.next(v_ab, i_ab) - di * (lq / ts);
         // Half a sample of rotation at ω̂; a = half².
         let (sin_half, cos_half) = (self.trackers.speed() * ts * T::lit(0.5)).sin_cos();
         let half = Ab::new(cos_half, sin_half);
@@ -277,7 +296,10 @@ impl<T: Real> GuardedStep<T> for EmfObserverEstimator<T> {
         if !(emf.is_finite() && lambda_r.is_finite()) {
             return None;
         }
-        let t = self.trackers.step(lambda_r)?;
+        let mut trackers = self.trackers;
+        let t = trackers.step(lambda_r)?;
+        self.trackers = trackers;
+        self.integrand.accept(i_ab);
         self.emf = emf;
         let lambda_s = lambda_r + i_ab * lq;
         Some(Estimate {
@@ -299,6 +321,9 @@ impl<T: Real> GuardedStep<T> for EmfObserverEstimator<T> {
 
     fn record(&mut self) -> (&mut Estimate<T>, &mut u32) {
         (&mut self.last, &mut self.rejected_samples)
+    }
+    fn integrand(&mut self) -> &mut Integrand<T> {
+        &mut self.integrand
     }
 }
 

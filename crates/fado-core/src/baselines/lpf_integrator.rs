@@ -91,6 +91,20 @@ pub struct LpfIntegratorConfig<T> {
     /// Average the current over the interval for the resistive drop. Default true (SPEC §1
     /// \[A\]).
     pub average_current: bool,
+    /// Rated (peak) phase current in A, the unit of `plausible_current_ratio`. From the
+    /// machine model.
+    pub rated_current: T,
+    /// DC-link voltage in V, the unit of `plausible_voltage_ratio`. From the machine model.
+    pub dc_voltage: T,
+    /// Samples with |i| above this × `rated_current` are refused (see
+    /// [`crate::plausibility`]). Default 4, as fado's
+    /// ([`crate::EstimatorTuning::plausible_current_ratio`]).
+    pub plausible_current_ratio: T,
+    /// Samples with |v| above this × `dc_voltage` are refused. Default 1.5, as fado's.
+    pub plausible_voltage_ratio: T,
+    /// A current that moved by more than this × (plausible voltage)·ts/L̂q per sample is
+    /// refused; 0 switches the test off. Default 2, as fado's.
+    pub plausible_current_step_ratio: T,
     /// Rotor angle assumed at reset (rad). Default 0 (SPEC §1 \[A\]).
     pub initial_angle: T,
 }
@@ -111,6 +125,11 @@ impl<T: Real> LpfIntegratorConfig<T> {
             bandwidth_definition: BandwidthDefinition::Minus3Db,
             tracker_hold_ratio: T::lit(0.2),
             average_current: true,
+            rated_current: machine.rated_current,
+            dc_voltage: machine.dc_voltage,
+            plausible_current_ratio: T::lit(crate::plausibility::CURRENT_RATIO),
+            plausible_voltage_ratio: T::lit(crate::plausibility::VOLTAGE_RATIO),
+            plausible_current_step_ratio: T::lit(crate::plausibility::STEP_RATIO),
             initial_angle: T::zero(),
         }
     }
@@ -151,8 +170,8 @@ impl<T: Real> LpfIntegratorEstimator<T> {
     /// Builds the estimator; every field of `config` is checked and a bad one is named.
     pub fn new(config: LpfIntegratorConfig<T>) -> Result<Self, ConfigError> {
         let ts = check::positive("ts", config.ts)?;
-        let integrand = Integrand::new(config.rs_hat, config.average_current)?;
         check::non_negative("lq_hat", config.lq_hat)?;
+        let integrand = integrand_of!(config, ts)?;
         let lf = check::positive("flux_linkage_hat", config.flux_linkage_hat)?;
         let fc = check::non_negative("cutoff_hz", config.cutoff_hz)?;
         let wc = T::two_pi() * fc;
@@ -201,6 +220,7 @@ impl<T: Real> LpfIntegratorEstimator<T> {
         let lambda_r = Ab::from_polar(self.config.flux_linkage_hat, theta0);
         self.psi = lambda_r + i_ab * self.config.lq_hat;
         self.integrand.reset();
+        self.integrand.note_current(i_ab);
         self.trackers.reset_to(theta0);
         self.rejected_samples = 0;
         self.last = Estimate {
@@ -262,16 +282,18 @@ impl<T: Real> LpfIntegratorEstimator<T> {
 impl<T: Real> GuardedStep<T> for LpfIntegratorEstimator<T> {
     #[inline]
     fn step_unchecked(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> Option<Estimate<T>> {
-        let u = self.integrand.step(v_ab, i_ab);
-        self.psi += (u - self.psi * self.wc) * self.config.ts;
-        let lambda_s = self
-            .psi
-            .complex_mul(self.compensation(self.trackers.speed()));
+        let u = self.integrand.next(v_ab, i_ab);
+        let psi = self.psi + (u - self.psi * self.wc) * self.config.ts;
+        let lambda_s = psi.complex_mul(self.compensation(self.trackers.speed()));
         let lambda_r = lambda_s - i_ab * self.config.lq_hat;
-        if !lambda_r.is_finite() {
+        if !(psi.is_finite() && lambda_r.is_finite()) {
             return None;
         }
-        let t = self.trackers.step(lambda_r)?;
+        let mut trackers = self.trackers;
+        let t = trackers.step(lambda_r)?;
+        self.trackers = trackers;
+        self.integrand.accept(i_ab);
+        self.psi = psi;
         Some(Estimate {
             theta: t.theta,
             omega: t.omega,
@@ -291,6 +313,9 @@ impl<T: Real> GuardedStep<T> for LpfIntegratorEstimator<T> {
 
     fn record(&mut self) -> (&mut Estimate<T>, &mut u32) {
         (&mut self.last, &mut self.rejected_samples)
+    }
+    fn integrand(&mut self) -> &mut Integrand<T> {
+        &mut self.integrand
     }
 }
 

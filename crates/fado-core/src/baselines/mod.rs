@@ -11,8 +11,13 @@
 //! Every baseline implements [`RotorAngleEstimator`](crate::RotorAngleEstimator) and follows
 //! the crate's rules: a flat config with documented defaults, `new(config)` naming a bad
 //! field, `step`/`align`/`reset`, allocation-free, generic over `f32`/`f64`, and a rejected
-//! non-finite (or overflowing) sample leaves the state untouched and sets
-//! `diagnostics.input_fault`. [`Diagnostics`](crate::Diagnostics) fields a baseline has no
+//! sample leaves the state untouched and sets `diagnostics.input_fault`. A sample is rejected
+//! when it is non-finite, when it lies outside what the machine and inverter can produce (the
+//! bounds of [`crate::plausibility`], with fado's `plausible_*` ratios and defaults, from each
+//! config's `rated_current`, `dc_voltage` and `lq_hat`: until 2026-11-28 a finite 1e6 A sample
+//! went through and left a baseline's angle off), or when the new state it gives overflows
+//! (each step computes its whole new state and commits it only if finite, as fado's does; until
+//! 2026-11-28 each step copied the whole estimator as a backup instead). [`Diagnostics`](crate::Diagnostics) fields a baseline has no
 //! counterpart for stay at their defaults (`mode`, `flag_limit`, `limiter_clamping`,
 //! `disturbance`).
 //!
@@ -29,6 +34,26 @@
 //!   ω_obs = 2|ω̂|, as VESC does in spirit); at standstill it is an open integrator;
 //! - the EMF observer has nothing to measure at zero speed (e = jω·λf) and needs the sign of
 //!   ω̂, so a reversal through zero flips its angle reference.
+
+/// The [`Integrand`] of a baseline's config (every baseline config has the fields of the same
+/// names): R̂s, the current averaging and the sample bounds.
+macro_rules! integrand_of {
+    ($config:expr, $ts:expr) => {
+        super::Integrand::new(
+            $config.rs_hat,
+            $config.average_current,
+            super::PlausibilitySettings {
+                rated_current: $config.rated_current,
+                dc_voltage: $config.dc_voltage,
+                current_ratio: $config.plausible_current_ratio,
+                voltage_ratio: $config.plausible_voltage_ratio,
+                step_ratio: $config.plausible_current_step_ratio,
+                lq_hat: $config.lq_hat,
+                ts: $ts,
+            },
+        )
+    };
+}
 
 pub mod emf_observer;
 pub mod lpf_integrator;
@@ -51,36 +76,37 @@ pub(crate) fn usable_align_current<T: Real>(i_ab: Ab<T>, lq_hat: T, flux_linkage
 }
 
 /// The sample-rejection rule every baseline shares (the same contract as
-/// [`crate::SensorlessEstimator::step`]): a non-finite input is refused, and a finite but absurd
-/// one that overflows a state is rolled back, so the state is never poisoned; either way the
+/// [`crate::SensorlessEstimator::step`]): a non-finite input, or one outside what the machine
+/// and the inverter can produce ([`crate::plausibility`], the same bounds as fado's), is
+/// refused, and a finite one that still overflows a state is not committed, so the state is never poisoned; either way the
 /// last good estimate is returned with `input_fault` set and the sample is counted.
-pub(crate) trait GuardedStep<T: Real>: Copy {
-    /// The estimator's own update; `None` when a new state came out non-finite.
+pub(crate) trait GuardedStep<T: Real> {
+    /// The estimator's own update: it computes the whole new state first and commits it only
+    /// if it is finite, returning `None` (and changing nothing) when it is not.
     fn step_unchecked(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> Option<crate::Estimate<T>>;
     /// The last good estimate and the rejected-sample counter.
     fn record(&mut self) -> (&mut crate::Estimate<T>, &mut u32);
+    /// The integrand, which holds the sample bounds and the last accepted current.
+    fn integrand(&mut self) -> &mut Integrand<T>;
 
     /// One guarded sample.
     #[inline]
     fn guarded_step(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> crate::Estimate<T> {
-        if !(v_ab.is_finite() && i_ab.is_finite()) {
+        if !self.integrand().plausible(v_ab, i_ab) {
             return self.reject();
         }
-        let backup = *self;
         match self.step_unchecked(v_ab, i_ab) {
             Some(out) => {
                 *self.record().0 = out;
                 out
             }
-            None => {
-                *self = backup;
-                self.reject()
-            }
+            None => self.reject(),
         }
     }
 
     /// Counts the sample and repeats the last good estimate, flagged.
     fn reject(&mut self) -> crate::Estimate<T> {
+        self.integrand().refused();
         let (last, rejected) = self.record();
         *rejected = rejected.saturating_add(1);
         let mut out = *last;
@@ -90,6 +116,7 @@ pub(crate) trait GuardedStep<T: Real>: Copy {
 }
 
 use crate::error::{ConfigError, check};
+use crate::plausibility::SampleBounds;
 use crate::tracker::{BandwidthDefinition, TrackerConfig, TypeTwoTracker};
 use crate::{Ab, Real};
 
@@ -106,33 +133,98 @@ fn renamed(field: &'static str) -> impl Fn(ConfigError) -> ConfigError {
 /// The integrand v* − R̂s·i of eq. (3) over one sampling interval, with the same forward
 /// rectangle and optional current averaging as [`crate::flux::FluxIntegrator`] (SPEC §1), so
 /// that every estimator sees the same voltage-model input.
+///
+/// It is also where the measured samples enter, so it holds their plausibility bounds
+/// ([`crate::plausibility`]) and the last accepted current the current step is checked
+/// against, as [`crate::SensorlessEstimator`] does.
 #[derive(Clone, Copy, Debug, PartialEq)]
-struct Integrand<T> {
+pub(crate) struct Integrand<T> {
     rs_hat: T,
     average_current: bool,
+    /// The last accepted current (zero, or the `align` current, after a reset).
     i_prev: Ab<T>,
+    /// Whether `i_prev` was sampled at the start of the coming interval (averaging uses it).
     has_prev: bool,
+    bounds: SampleBounds<T>,
+    /// The current step the next sample may take from `i_prev`: one bound per sample since
+    /// `i_prev` was accepted (so that a burst of refused samples cannot lock the estimator out).
+    allowance: T,
+}
+
+/// The machine data and ratios a baseline's plausibility bounds are made of (its config's
+/// fields of the same names).
+pub(crate) struct PlausibilitySettings<T> {
+    pub(crate) rated_current: T,
+    pub(crate) dc_voltage: T,
+    pub(crate) current_ratio: T,
+    pub(crate) voltage_ratio: T,
+    pub(crate) step_ratio: T,
+    pub(crate) lq_hat: T,
+    pub(crate) ts: T,
 }
 
 impl<T: Real> Integrand<T> {
-    fn new(rs_hat: T, average_current: bool) -> Result<Self, ConfigError> {
+    fn new(
+        rs_hat: T,
+        average_current: bool,
+        p: PlausibilitySettings<T>,
+    ) -> Result<Self, ConfigError> {
+        let rs_hat = check::non_negative("rs_hat", rs_hat)?;
+        let rated = check::positive("rated_current", p.rated_current)?;
+        let dc = check::positive("dc_voltage", p.dc_voltage)?;
+        let bounds = SampleBounds::from_ratios(
+            p.current_ratio,
+            p.voltage_ratio,
+            p.step_ratio,
+            rated,
+            dc,
+            p.lq_hat,
+            p.ts,
+        )?;
         Ok(Self {
-            rs_hat: check::non_negative("rs_hat", rs_hat)?,
+            rs_hat,
             average_current,
             i_prev: Ab::zero(),
             has_prev: false,
+            bounds,
+            allowance: bounds.step(),
         })
     }
 
     fn reset(&mut self) {
         self.i_prev = Ab::zero();
         self.has_prev = false;
+        self.allowance = self.bounds.step();
     }
 
-    /// Starts with a known current at the beginning of the first interval.
+    /// After [`Self::reset`]: the current present at the reset, which the first sample's
+    /// current step is checked against (not used for the resistive drop); an implausible one
+    /// is not kept.
+    fn note_current(&mut self, i_ab: Ab<T>) {
+        if self.bounds.current_ok(i_ab) {
+            self.i_prev = i_ab;
+        }
+    }
+
+    /// Starts with a known current at the beginning of the first interval (an implausible one
+    /// is not kept: the first interval then uses its own current alone).
     fn reset_to(&mut self, i_ab: Ab<T>) {
-        self.i_prev = i_ab;
-        self.has_prev = true;
+        self.reset();
+        if self.bounds.current_ok(i_ab) {
+            self.i_prev = i_ab;
+            self.has_prev = true;
+        }
+    }
+
+    /// Whether a sample is plausible (and finite): see [`SampleBounds::check`].
+    #[inline]
+    fn plausible(&self, v_ab: Ab<T>, i_ab: Ab<T>) -> bool {
+        self.bounds.check(v_ab, i_ab, self.i_prev, self.allowance)
+    }
+
+    /// A sample was refused: the next may move one more step from the last accepted current.
+    fn refused(&mut self) {
+        self.allowance += self.bounds.step();
     }
 
     /// The current sampled at the start of the coming interval, when known.
@@ -142,22 +234,28 @@ impl<T: Real> Integrand<T> {
 
     /// The current the resistive drop of the last interval is computed with.
     #[inline]
-    fn interval_current(&mut self, i_ab: Ab<T>) -> Ab<T> {
-        let i = if self.average_current && self.has_prev {
+    fn interval_current(&self, i_ab: Ab<T>) -> Ab<T> {
+        if self.average_current && self.has_prev {
             (i_ab + self.i_prev) * T::lit(0.5)
         } else {
             i_ab
-        };
-        self.i_prev = i_ab;
-        self.has_prev = true;
-        i
+        }
     }
 
-    /// v* − R̂s·i for the interval that ends at this sample.
+    /// v* − R̂s·i for the interval that ends at this sample (the state is not changed: see
+    /// [`Self::accept`]).
     #[inline]
-    fn step(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> Ab<T> {
-        let i = self.interval_current(i_ab);
-        v_ab - i * self.rs_hat
+    fn next(&self, v_ab: Ab<T>, i_ab: Ab<T>) -> Ab<T> {
+        v_ab - self.interval_current(i_ab) * self.rs_hat
+    }
+
+    /// Commits an accepted sample's current: the start of the next interval, and what the
+    /// next sample's current step is checked against.
+    #[inline]
+    fn accept(&mut self, i_ab: Ab<T>) {
+        self.i_prev = i_ab;
+        self.has_prev = true;
+        self.allowance = self.bounds.step();
     }
 }
 
@@ -266,8 +364,8 @@ mod tests {
     use crate::MachineModel;
     use crate::RotorAngleEstimator;
 
-    /// Warms `est` up on a rotating machine-like input, then checks that a non-finite and an
-    /// overflowing sample are both refused with the state left exactly as it was.
+    /// Warms `est` up on a rotating machine-like input, then checks that non-finite,
+    /// overflowing and implausible samples are refused with the state left exactly as it was.
     fn rejects_bad_samples<E: RotorAngleEstimator<f32> + Clone>(mut est: E) {
         let (w, ts) = (125.0_f32, 1e-4_f32);
         let mut last = None;
@@ -283,6 +381,14 @@ mod tests {
             (Ab::new(1.0, 0.0), Ab::new(0.0, f32::INFINITY)),
             // Finite but absurd: v − R̂s·i overflows f32.
             (Ab::new(3e38, 0.0), Ab::new(-3e38, 0.0)),
+            // Finite, no overflow, but beyond what the machine and inverter can produce (issue
+            // 14: before the bounds, 1e6 A left the baselines' angle off for good): 4 × the
+            // rated current, 1.5 × the DC link, a 50 A jump in 100 µs on 2.63 mH.
+            (Ab::new(1.0, 0.0), Ab::new(1e4, 0.0)),
+            (Ab::new(1.0, 0.0), Ab::new(0.0, -1e5)),
+            (Ab::new(1.0, 0.0), Ab::new(1e6, 1e6)),
+            (Ab::new(1e4, 0.0), Ab::new(1.0, -1.0)),
+            (Ab::new(2.0, 3.0), Ab::new(51.0, -1.0)),
         ] {
             let mut twin = est.clone();
             let out = est.step(v, i);
@@ -295,10 +401,16 @@ mod tests {
             assert!(!next.diagnostics.input_fault);
             last = next;
         }
+        // A real step refused for one sample (its allowance grows per refused sample) is
+        // accepted once the allowance covers it: a burst of refusals cannot lock it out.
+        let far = Ab::new(40.0, -1.0);
+        let v = Ab::new(2.0, 3.0);
+        assert!(est.step(v, far).diagnostics.input_fault, "{}", est.name());
+        assert!(!est.step(v, far).diagnostics.input_fault, "{}", est.name());
     }
 
     #[test]
-    fn every_baseline_rejects_non_finite_and_overflowing_samples() {
+    fn every_baseline_rejects_non_finite_overflowing_and_implausible_samples() {
         rejects_bad_samples(
             LpfIntegratorEstimator::new(LpfIntegratorConfig::for_machine(&MachineModel::paper()))
                 .unwrap(),

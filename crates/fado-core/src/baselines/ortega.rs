@@ -130,6 +130,20 @@ pub struct OrtegaConfig<T> {
     /// Average the current over the interval for the resistive drop. Default true (SPEC §1
     /// \[A\]).
     pub average_current: bool,
+    /// Rated (peak) phase current in A, the unit of `plausible_current_ratio`. From the
+    /// machine model.
+    pub rated_current: T,
+    /// DC-link voltage in V, the unit of `plausible_voltage_ratio`. From the machine model.
+    pub dc_voltage: T,
+    /// Samples with |i| above this × `rated_current` are refused (see
+    /// [`crate::plausibility`]). Default 4, as fado's
+    /// ([`crate::EstimatorTuning::plausible_current_ratio`]).
+    pub plausible_current_ratio: T,
+    /// Samples with |v| above this × `dc_voltage` are refused. Default 1.5, as fado's.
+    pub plausible_voltage_ratio: T,
+    /// A current that moved by more than this × (plausible voltage)·ts/L̂q per sample is
+    /// refused; 0 switches the test off. Default 2, as fado's.
+    pub plausible_current_step_ratio: T,
     /// Rotor angle assumed at reset (rad). Default 0 (SPEC §1 \[A\]).
     pub initial_angle: T,
 }
@@ -152,6 +166,11 @@ impl<T: Real> OrtegaConfig<T> {
             bandwidth_definition: BandwidthDefinition::Minus3Db,
             tracker_hold_ratio: T::lit(0.2),
             average_current: true,
+            rated_current: machine.rated_current,
+            dc_voltage: machine.dc_voltage,
+            plausible_current_ratio: T::lit(crate::plausibility::CURRENT_RATIO),
+            plausible_voltage_ratio: T::lit(crate::plausibility::VOLTAGE_RATIO),
+            plausible_current_step_ratio: T::lit(crate::plausibility::STEP_RATIO),
             initial_angle: T::zero(),
         }
     }
@@ -209,8 +228,8 @@ impl<T: Real> OrtegaEstimator<T> {
     /// Builds the estimator; every field of `config` is checked and a bad one is named.
     pub fn new(config: OrtegaConfig<T>) -> Result<Self, ConfigError> {
         let ts = check::positive("ts", config.ts)?;
-        let integrand = Integrand::new(config.rs_hat, config.average_current)?;
         check::non_negative("lq_hat", config.lq_hat)?;
+        let integrand = integrand_of!(config, ts)?;
         let lf = check::positive("flux_linkage_hat", config.flux_linkage_hat)?;
         let w_obs = check::positive("observer_bandwidth", config.observer_bandwidth)?;
         check::below(
@@ -271,6 +290,7 @@ impl<T: Real> OrtegaEstimator<T> {
         let eta = Ab::from_polar(self.lambda, theta0);
         self.x = eta + i_ab * self.config.lq_hat;
         self.integrand.reset();
+        self.integrand.note_current(i_ab);
         self.trackers.reset_to(theta0);
         self.rejected_samples = 0;
         self.last = Estimate {
@@ -322,7 +342,7 @@ impl<T: Real> GuardedStep<T> for OrtegaEstimator<T> {
     fn step_unchecked(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> Option<Estimate<T>> {
         let li = i_ab * self.config.lq_hat;
         // Predict with the voltage model, then correct radially with the fresh current.
-        let x_pred = self.x + self.integrand.step(v_ab, i_ab) * self.config.ts;
+        let x_pred = self.x + self.integrand.next(v_ab, i_ab) * self.config.ts;
         let eta_pred = x_pred - li;
         let radius_error = self.lambda * self.lambda - eta_pred.norm_squared();
         let k_ts = self.ts_half_over_lf2 * self.config.scheduled_bandwidth(self.trackers.speed());
@@ -342,7 +362,10 @@ impl<T: Real> GuardedStep<T> for OrtegaEstimator<T> {
         if !(x.is_finite() && eta.is_finite() && lambda.is_finite()) {
             return None;
         }
-        let t = self.trackers.step(eta)?;
+        let mut trackers = self.trackers;
+        let t = trackers.step(eta)?;
+        self.trackers = trackers;
+        self.integrand.accept(i_ab);
         self.x = x;
         self.lambda = lambda;
         Some(Estimate {
@@ -364,6 +387,9 @@ impl<T: Real> GuardedStep<T> for OrtegaEstimator<T> {
 
     fn record(&mut self) -> (&mut Estimate<T>, &mut u32) {
         (&mut self.last, &mut self.rejected_samples)
+    }
+    fn integrand(&mut self) -> &mut Integrand<T> {
+        &mut self.integrand
     }
 }
 
@@ -391,7 +417,42 @@ mod tests {
     #[test]
     fn config_errors_name_the_field() {
         type C = OrtegaConfig<f64>;
-        let cases: [(C, &str); 15] = [
+        let cases: [(C, &str); 20] = [
+            (
+                C {
+                    rated_current: f64::NAN,
+                    ..C::for_machine(&MachineModel::paper())
+                },
+                "rated_current",
+            ),
+            (
+                C {
+                    dc_voltage: 0.0,
+                    ..C::for_machine(&MachineModel::paper())
+                },
+                "dc_voltage",
+            ),
+            (
+                C {
+                    plausible_current_ratio: -4.0,
+                    ..C::for_machine(&MachineModel::paper())
+                },
+                "plausible_current_ratio",
+            ),
+            (
+                C {
+                    plausible_voltage_ratio: f64::INFINITY,
+                    ..C::for_machine(&MachineModel::paper())
+                },
+                "plausible_voltage_ratio",
+            ),
+            (
+                C {
+                    plausible_current_step_ratio: f64::NAN,
+                    ..C::for_machine(&MachineModel::paper())
+                },
+                "plausible_current_step_ratio",
+            ),
             (
                 C {
                     ts: -1e-4,
