@@ -26,19 +26,7 @@ fn ipmsm() -> MachineModel<f64> {
 /// PMSM: 18 mΩ, Lq/Ld 3.24, 240 A): its I-f current at 90 % of the limit would be beyond the
 /// reluctance stability limit λf/(Lq − Ld).
 fn gem() -> MachineModel<f64> {
-    MachineModel {
-        rs: 0.018,
-        ld: 0.37e-3,
-        lq: 1.2e-3,
-        flux_linkage: 0.066,
-        pole_pairs: 3,
-        inertia: 0.03883,
-        viscous_friction: 5.1e-3,
-        rated_current: 240.0,
-        rated_speed_rpm: 3000.0,
-        rated_torque: 160.6,
-        dc_voltage: VDC,
-    }
+    common::gem_50k_model(VDC)
 }
 
 /// The ideal machine.

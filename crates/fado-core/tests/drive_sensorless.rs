@@ -1068,3 +1068,48 @@ fn stall_band_widens_with_the_commanded_torque() {
         assert_eq!(run(1.5), None, "{p}");
     }
 }
+
+/// A gross speed error against the reference waives the current gate
+/// (`lock_stall_gross_error_ratio`, docs/lock.md "A gross speed error against the reference"):
+/// an estimate stuck at +1 band in limiter mode while the reference, caught there, moves to
+/// −3 bands asks, through the speed loop's proportional gain, for a current below the gate
+/// (`lock_stall_min_current_ratio` 0.2 of rated) on every motor here, so the gated symptom
+/// never rises; with the speed error (4 bands, ω̂ turning against ω*) beyond the ratio 3 it
+/// rises after `lock_stall_time` (50 samples). Not with the reference at −1.5 bands (2.5 bands
+/// of error), nor at +5 bands (4 bands of error, but ω̂ turns with ω*). On the paper's motor,
+/// the 2.2 kW IPMSM and the 50 kW automotive IPMSM of motors/ipmsm-gem-50k.toml, whose small
+/// inertia for its torque puts its 0.2·rated current gate at a speed error of 28 bands.
+#[test]
+fn a_gross_speed_error_against_the_reference_waives_the_current_gate() {
+    let gem = common::gem_50k_model(520.0);
+    for machine in [MachineModel::paper(), common::ipmsm_model(), gem] {
+        let run = |gross: f64, reference_bands: f64| {
+            let mut c = stall_test_config(&machine);
+            c.tuning.lock_stall_gross_error_ratio = gross;
+            c.tuning.lock_stall_torque_band_ratio = 0.0;
+            c.tuning.lock_stall_reluctance_band_ratio = 0.0;
+            c.tuning.lock_stall_follow_time = 0.0;
+            let band = c.tuning.lock_stall_speed_ratio * machine.rated_speed();
+            let spy = SpeedSpy {
+                omega0: band,
+                accel: 0.0,
+                ts: c.ts,
+                n: 0,
+                mode: fado_core::Mode::Limiter,
+            };
+            first_stalled(c, spy, CATCH + 500, |n| {
+                if n < CATCH {
+                    band
+                } else {
+                    reference_bands * band
+                }
+            })
+        };
+        let p = machine.pole_pairs;
+        assert_eq!(run(0.0, -3.0), None, "{p}: the gate holds");
+        let n = run(3.0, -3.0).unwrap_or(0);
+        assert!((CATCH + 49..=CATCH + 50).contains(&n), "{p}: {n}");
+        assert_eq!(run(3.0, -1.5), None, "{p}: within 3 bands");
+        assert_eq!(run(3.0, 5.0), None, "{p}: ω̂ turns with ω*");
+    }
+}

@@ -147,6 +147,25 @@ pub fn ipmsm_model() -> MachineModel<f64> {
     }
 }
 
+/// The 50 kW automotive IPMSM of motors/ipmsm-gem-50k.toml (gym-electric-motor's default
+/// PMSM: 18 mΩ, Lq/Ld 3.24, 240 A, 3000 r/min, 160.6 N·m, its inertia small for its torque)
+/// on a `dc_voltage` link.
+pub fn gem_50k_model(dc_voltage: f64) -> MachineModel<f64> {
+    MachineModel {
+        rs: 0.018,
+        ld: 0.37e-3,
+        lq: 1.2e-3,
+        flux_linkage: 0.066,
+        pole_pairs: 3,
+        inertia: 0.03883,
+        viscous_friction: 5.1e-3,
+        rated_current: 240.0,
+        rated_speed_rpm: 3000.0,
+        rated_torque: 160.6,
+        dc_voltage,
+    }
+}
+
 impl Machine {
     /// The paper's surface-magnet motor ([`RS`], [`L`], [`LF`], [`PP`]).
     pub const PAPER: Machine = Machine {
