@@ -223,8 +223,7 @@ pub struct DriveTuning<T> {
     /// in limiter mode, a speed error |ω* − ω̂| above this multiple of the rated speed for
     /// `lock_stall_time` raises `STALLED` (and starts the lock reaction, see
     /// `lock_reaction_on_stall`; widened with the commanded torque on motors of small inertia
-    /// for their torque, `lock_stall_torque_band_ratio`; near zero speed narrowed on motors
-    /// of large inertia for their torque, `lock_stall_inertia_floor_ratio`). Default 0.003
+    /// for their torque, `lock_stall_torque_band_ratio`). Default 0.003
     /// \[A\] (4.5 r/min at 1500 r/min rated, a fifth of the default Fig. 3 threshold
     /// `mode_threshold_ratio` 0.015; chosen on the fig11 envelope with the current gate
     /// `lock_stall_min_current_ratio` and the exception `lock_stall_follow_time`,
@@ -343,36 +342,6 @@ pub struct DriveTuning<T> {
     /// pmsyrm-5k and from 213 to 158 of 564 on ipmsm-gem-50k, with no detection lost on any
     /// preset, and leaves fig11's hold-out seeds 17–20 at 856/856 detected, 0 of 418 flagged).
     pub lock_stall_reluctance_band_ratio: T,
-    /// Near zero speed (|ω̂| below `lock_stall_floor_speed_ratio` × the rated speed) the stall
-    /// band's floor follows the motor's mechanics: b_T·T_rated/(Ĵ·ω_s) (electrical, T_rated
-    /// the rated torque, Ĵ the model's inertia, ω_s = 2π·`speed_bandwidth_hz`), the speed
-    /// error through which the speed loop's proportional action commands b_T × the rated
-    /// torque, clamped to [`lock_stall_min_floor_ratio`, `lock_stall_speed_ratio`] × the rated
-    /// speed; above that speed, and with b_T = 0, the floor is `lock_stall_speed_ratio` ×
-    /// the rated speed. How far a rotor that really lags its reference falls behind scales
-    /// with T/(Ĵ·ω_s), and T_rated/(Ĵ·ω_s·ω_rated) is 0.194 on the paper's motor, where the
-    /// fixed floor 0.003 was tuned, but 0.043 on the hub motor (motors/hub-hoverboard-48v)
-    /// and 0.065 on the servo: there, a lost estimate held near the reference in limiter mode
-    /// reached the fixed floor 20–60 ms after the error passed 0.5 rad. Default 0.0155 \[A\]
-    /// (= 0.003/0.194: the paper's motor keeps 0.003, and the clamp keeps the fixed floor on
-    /// the motors of small inertia for their torque, outrunner-cheetah-24v, ipmsm-gem-50k,
-    /// pmsyrm-5k, whose rotors lag the reversal ramp by more; docs/lock.md, "A floor that
-    /// follows the mechanics near zero speed"). 0: the fixed floor at every speed.
-    pub lock_stall_inertia_floor_ratio: T,
-    /// The least floor of `lock_stall_inertia_floor_ratio`, × the rated speed. Default 0.001
-    /// \[A\] (docs/lock.md, eighth session: on hub-hoverboard-48v, seed 7, a floor of 0.001 at
-    /// every speed flags 17 of 83 passing runs, rotors lagging the ramp by 0.001·rated at
-    /// |ω̂| 0.0085–0.0175·rated, none below; restricted to |ω̂| < 0.005·rated it flags none).
-    pub lock_stall_min_floor_ratio: T,
-    /// The mechanical floor of `lock_stall_inertia_floor_ratio` holds only while |ω̂| is
-    /// below this multiple of the rated speed (a third of the limiter ↔ k_df threshold
-    /// `mode_threshold_ratio` 0.015); 0: at any speed. Default 0.005 \[A\] (docs/lock.md,
-    /// eighth session: the hub motor's misses sit at |ω̂| ≤ 0.004·rated; around the hand-over
-    /// ω̂ swings 0.0015–0.0018·rated past ω* on the hub motor, and on servo-1ft6084 the
-    /// estimate lags the rotor accelerating out of the reversal by 0.001–0.0015·rated at
-    /// |ω̂| 0.0054–0.0070·rated: 0.0075 flagged 1–14 more of its 259 passing runs on seed 7,
-    /// 0.005 none).
-    pub lock_stall_floor_speed_ratio: T,
     /// The loaded-standstill angle probe (see [`crate::control::standstill_probe`]): at a
     /// loaded standstill a slow square-wave d current, read through the speed loop's torque
     /// balance, turns θ̂ towards the rotor. Default true \[A\] (without it the one-hour loaded
@@ -469,9 +438,6 @@ impl<T: Real> DriveTuning<T> {
             lock_stall_reluctance_band_ratio: U::lit(
                 self.lock_stall_reluctance_band_ratio.to_f64(),
             ),
-            lock_stall_inertia_floor_ratio: U::lit(self.lock_stall_inertia_floor_ratio.to_f64()),
-            lock_stall_min_floor_ratio: U::lit(self.lock_stall_min_floor_ratio.to_f64()),
-            lock_stall_floor_speed_ratio: U::lit(self.lock_stall_floor_speed_ratio.to_f64()),
             standstill_probe: self.standstill_probe,
             standstill_probe_current_ratio: U::lit(self.standstill_probe_current_ratio.to_f64()),
             standstill_probe_period: U::lit(self.standstill_probe_period.to_f64()),
@@ -536,9 +502,6 @@ impl<T: Real> Default for DriveTuning<T> {
             lock_stall_follow_accel_ratio: T::lit(0.005),
             lock_stall_torque_band_ratio: T::lit(0.015),
             lock_stall_reluctance_band_ratio: T::lit(0.05),
-            lock_stall_inertia_floor_ratio: T::lit(0.0155),
-            lock_stall_min_floor_ratio: T::lit(0.001),
-            lock_stall_floor_speed_ratio: T::lit(0.005),
             standstill_probe: true,
             standstill_probe_current_ratio: T::lit(0.1),
             standstill_probe_period: T::lit(0.5),
@@ -725,10 +688,6 @@ struct Resolved<T> {
     /// Stall symptom: speed error (electrical rad/s) in limiter mode, and samples in a row
     /// (0 samples or speed 0: off).
     stall_speed: T,
-    /// The stall band's floor near zero speed (`lock_stall_inertia_floor_ratio`, electrical
-    /// rad/s) and the |ω̂| below which it holds (∞: always).
-    stall_floor: T,
-    stall_floor_speed: T,
     stall_samples: u32,
     stall_heal_samples: u32,
     /// The stall symptom counts below this |ω̂| (electrical rad/s; ∞: always).
@@ -779,13 +738,6 @@ impl<T: Real> Resolved<T> {
         // A stall-band ratio ε per unit of torque over 1.5·p (Wb·A): ε·1.5·p (torque) times
         // p (electrical speed) over Ĵ·ω_s, the speed error whose proportional action commands
         // that torque.
-        // A speed limit as a multiple of the rated speed, 0: none (∞).
-        let speed_or_off = |field: &'static str, ratio: T| -> Result<T, ConfigError> {
-            Ok(match check::non_negative(field, ratio)? {
-                r if r == T::zero() => T::lit(f64::INFINITY),
-                r => r * c.machine.rated_speed(),
-            })
-        };
         let torque_band = |field: &'static str, ratio: T| -> Result<T, ConfigError> {
             Ok(check::non_negative(field, ratio)?
                 * T::lit(1.5 * (c.machine.pole_pairs as f64) * (c.machine.pole_pairs as f64))
@@ -809,42 +761,19 @@ impl<T: Real> Resolved<T> {
             input_fault_trip_samples: samples("input_fault_trip_time", t.input_fault_trip_time)?,
             stall_speed: check::non_negative("lock_stall_speed_ratio", t.lock_stall_speed_ratio)?
                 * c.machine.rated_speed(),
-            stall_floor: {
-                let fixed = t.lock_stall_speed_ratio * c.machine.rated_speed();
-                let b = check::non_negative(
-                    "lock_stall_inertia_floor_ratio",
-                    t.lock_stall_inertia_floor_ratio,
-                )?;
-                if b > T::zero() {
-                    let mech = b * c.machine.rated_torque
-                        / (c.machine.inertia
-                            * T::lit(core::f64::consts::TAU)
-                            * t.speed_bandwidth_hz)
-                        * T::lit(c.machine.pole_pairs as f64);
-                    mech.min(fixed).max(
-                        check::non_negative(
-                            "lock_stall_min_floor_ratio",
-                            t.lock_stall_min_floor_ratio,
-                        )? * c.machine.rated_speed(),
-                    )
-                } else {
-                    fixed
-                }
-            },
-            stall_floor_speed: speed_or_off(
-                "lock_stall_floor_speed_ratio",
-                t.lock_stall_floor_speed_ratio,
-            )?,
             stall_samples: if t.lock_stall_speed_ratio > T::zero() {
                 samples("lock_stall_time", t.lock_stall_time)?.max(1)
             } else {
                 0
             },
             stall_heal_samples: samples("lock_stall_heal_time", t.lock_stall_heal_time)?,
-            stall_max_speed: speed_or_off(
+            stall_max_speed: match check::non_negative(
                 "lock_stall_max_speed_ratio",
                 t.lock_stall_max_speed_ratio,
-            )?,
+            )? {
+                r if r == T::zero() => T::lit(f64::INFINITY),
+                r => r * c.machine.rated_speed(),
+            },
             stall_kdf_band: check::non_negative(
                 "lock_stall_kdf_speed_ratio",
                 t.lock_stall_kdf_speed_ratio,
@@ -1698,14 +1627,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         // factors at construction, so that the step does no integer-to-float or
         // double-precision arithmetic).
         let reluctance_flux = (m.ld - m.lq) * i_ref.d;
-        // Near zero speed the floor follows the motor's mechanics
-        // (`DriveTuning::lock_stall_inertia_floor_ratio`).
-        let floor = if omega_ctrl.abs() < self.resolved.stall_floor_speed {
-            self.resolved.stall_floor
-        } else {
-            self.resolved.stall_speed
-        };
-        let band = floor.max(
+        let band = self.resolved.stall_speed.max(
             self.resolved.stall_torque_band * ((m.flux_linkage + reluctance_flux) * i_ref.q).abs(),
         ) + self.resolved.stall_reluctance_band * (reluctance_flux * i_ref.q).abs();
         let off_reference = speed_error.abs() > band;
