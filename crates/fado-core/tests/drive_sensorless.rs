@@ -956,20 +956,21 @@ impl RotorAngleEstimator<f64> for SpeedSpy {
 const CATCH: u32 = 600;
 
 /// Drives `c` with `spy` for `samples` samples at the speed reference `speed(n)` (electrical
-/// rad/s; the drive takes it in mechanical rad/s) and returns the first sample with
-/// `STALLED` up.
+/// rad/s; the drive takes it in mechanical rad/s) with the DC link at the machine's own
+/// voltage (a fixed 300 V is refused as implausible on a 48 V motor, whose drive then never
+/// runs), and returns the first sample with `STALLED` up.
 fn first_stalled(
     c: DriveConfig<f64>,
     spy: SpeedSpy,
     samples: u32,
     speed: impl Fn(u32) -> f64,
 ) -> Option<u32> {
-    let p = c.machine.pole_pairs as f64;
+    let (p, dc) = (c.machine.pole_pairs as f64, c.machine.dc_voltage);
     let mut drive = SensorlessDrive::with_estimator(c, spy).unwrap();
     drive.align(0.0);
     (0..samples).find(|&n| {
         drive
-            .step(Abc::new(0.0, 0.0, 0.0), 300.0, speed(n) / p)
+            .step(Abc::new(0.0, 0.0, 0.0), dc, speed(n) / p)
             .flags
             .contains(DriveFlags::STALLED)
     })
