@@ -82,7 +82,8 @@ impl<T: Real> SampleBounds<T> {
     /// the baselines' configurations, which errors name): |i| below `current_ratio` ×
     /// `rated_current`, |v| below `voltage_ratio` × `dc_voltage`, |Δi| per sample below
     /// `step_ratio` × (the plausible voltage)·`ts`/`lq` (0, or a step that overflows, switches
-    /// the step test off).
+    /// the step test off). `rated_current` and `dc_voltage` must be positive (errors name
+    /// them).
     pub fn from_ratios(
         current_ratio: T,
         voltage_ratio: T,
@@ -92,6 +93,8 @@ impl<T: Real> SampleBounds<T> {
         lq: T,
         ts: T,
     ) -> Result<Self, ConfigError> {
+        let rated_current = check::positive("rated_current", rated_current)?;
+        let dc_voltage = check::positive("dc_voltage", dc_voltage)?;
         let ratio = check::non_negative("plausible_current_step_ratio", step_ratio)?;
         let current = check::positive("plausible_current_ratio", current_ratio)? * rated_current;
         let voltage = check::positive("plausible_voltage_ratio", voltage_ratio)? * dc_voltage;
@@ -118,12 +121,14 @@ impl<T: Real> SampleBounds<T> {
     /// [`VOLTAGE_RATIO`], [`STEP_RATIO`]) at sampling period `ts`.
     pub fn for_machine(machine: &MachineModel<T>, ts: T) -> Result<Self, ConfigError> {
         machine.validate()?;
-        let ts = check::positive("ts", ts)?;
-        let voltage = T::lit(VOLTAGE_RATIO) * machine.dc_voltage;
-        Self::new(
-            T::lit(CURRENT_RATIO) * machine.rated_current,
-            voltage,
-            T::lit(STEP_RATIO) * voltage * ts / machine.lq,
+        Self::from_ratios(
+            T::lit(CURRENT_RATIO),
+            T::lit(VOLTAGE_RATIO),
+            T::lit(STEP_RATIO),
+            machine.rated_current,
+            machine.dc_voltage,
+            machine.lq,
+            check::positive("ts", ts)?,
         )
     }
 

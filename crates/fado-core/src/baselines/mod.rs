@@ -42,15 +42,15 @@ macro_rules! integrand_of {
         super::Integrand::new(
             $config.rs_hat,
             $config.average_current,
-            super::PlausibilitySettings {
-                rated_current: $config.rated_current,
-                dc_voltage: $config.dc_voltage,
-                current_ratio: $config.plausible_current_ratio,
-                voltage_ratio: $config.plausible_voltage_ratio,
-                step_ratio: $config.plausible_current_step_ratio,
-                lq_hat: $config.lq_hat,
-                ts: $ts,
-            },
+            crate::plausibility::SampleBounds::from_ratios(
+                $config.plausible_current_ratio,
+                $config.plausible_voltage_ratio,
+                $config.plausible_current_step_ratio,
+                $config.rated_current,
+                $config.dc_voltage,
+                $config.lq_hat,
+                $ts,
+            )?,
         )
     };
 }
@@ -151,36 +151,9 @@ pub(crate) struct Integrand<T> {
     allowance: T,
 }
 
-/// The machine data and ratios a baseline's plausibility bounds are made of (its config's
-/// fields of the same names).
-pub(crate) struct PlausibilitySettings<T> {
-    pub(crate) rated_current: T,
-    pub(crate) dc_voltage: T,
-    pub(crate) current_ratio: T,
-    pub(crate) voltage_ratio: T,
-    pub(crate) step_ratio: T,
-    pub(crate) lq_hat: T,
-    pub(crate) ts: T,
-}
-
 impl<T: Real> Integrand<T> {
-    fn new(
-        rs_hat: T,
-        average_current: bool,
-        p: PlausibilitySettings<T>,
-    ) -> Result<Self, ConfigError> {
+    fn new(rs_hat: T, average_current: bool, bounds: SampleBounds<T>) -> Result<Self, ConfigError> {
         let rs_hat = check::non_negative("rs_hat", rs_hat)?;
-        let rated = check::positive("rated_current", p.rated_current)?;
-        let dc = check::positive("dc_voltage", p.dc_voltage)?;
-        let bounds = SampleBounds::from_ratios(
-            p.current_ratio,
-            p.voltage_ratio,
-            p.step_ratio,
-            rated,
-            dc,
-            p.lq_hat,
-            p.ts,
-        )?;
         Ok(Self {
             rs_hat,
             average_current,

@@ -1666,14 +1666,14 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             && (omega_ctrl - self.omega_slow) * speed_error
                 > self.resolved.stall_follow_lead * speed_error.abs();
         self.stall_armed |= !off_reference && !self.lock.coasting();
+        // ω̂ turns against the reference.
+        let against = omega_ctrl * speed_ref < T::zero();
         let stall_now = self.stall_armed
             && off_reference
-            && (omega_ctrl.abs() < self.resolved.stall_max_speed
-                || omega_ctrl * speed_ref < T::zero())
+            && (omega_ctrl.abs() < self.resolved.stall_max_speed || against)
             && (diag.mode == Mode::Limiter || omega_ctrl.abs() < self.resolved.stall_kdf_band)
             && (self.last.i_dq_ref.q.abs() >= self.resolved.stall_min_current
-                || (speed_error.abs() > self.resolved.stall_gross_ratio * band
-                    && omega_ctrl * speed_ref < T::zero()))
+                || (against && speed_error.abs() > self.resolved.stall_gross_ratio * band))
             && self.last.i_dq_ref.norm() < self.resolved.i_max * T::lit(0.99)
             && !answers_torque;
         let stalled = self.stall.step(stall_now);
