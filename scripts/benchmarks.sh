@@ -4,6 +4,8 @@
 #      saves its estimates under $CARGO_TARGET_DIR/criterion/<estimator>_step_f32/new/);
 #   2. `fado-sim compare` (switching-resolved inverter, every scenario, every estimator,
 #      same plant and seed), which reads those estimates back;
+#   2b. `cargo bench --bench paired`: fado's f32 step against Ortega's, timed in alternation
+#      (the ratio of two criterion medians moves with the shared machine's state);
 #   3. docs/benchmarks.md = header (command, date, machine) + the compare table + the
 #      hand-written analysis in docs/benchmarks-analysis.md.
 # Usage: scripts/benchmarks.sh [--averaged] [--skip-bench]
@@ -29,6 +31,10 @@ load_before=$(cut -d' ' -f1-3 /proc/loadavg 2>/dev/null || echo unknown)
 if [[ $skip_bench -eq 0 ]]; then
     cargo bench --bench baselines 2>&1 | tee "$out.bench.log" >/dev/null || {
         echo "cargo bench failed: see $out.bench.log" >&2
+        exit 1
+    }
+    cargo bench --bench paired 2>"$out.paired.log" | tee "$out.paired.txt" >/dev/null || {
+        echo "cargo bench --bench paired failed: see $out.paired.log" >&2
         exit 1
     }
 fi
@@ -93,6 +99,19 @@ cpu=$(lscpu 2>/dev/null | sed -n 's/^Model name: *//p' | head -n1)
     echo
     cat "$out/compare.md"
     echo
+    if [[ $skip_bench -eq 0 ]]; then
+        echo "## fado's step against Ortega's, timed in alternation"
+        echo
+        echo "\`cargo bench --bench paired\` (\`benches/paired.rs\`): the same inputs and estimators as"
+        echo "the f32 step column, each round timing 1000 steps of every estimator in a random order,"
+        echo "the ratio taken within the round (a paired design: the machine's drift cancels). Issue"
+        echo "16's host target is fado's default step ≤ 1.2× Ortega's."
+        echo
+        echo '```text'
+        grep -v '^$' "$out.paired.txt"
+        echo '```'
+        echo
+    fi
     if [[ -n $figure ]]; then
         echo 'θ − θ̂ of every estimator through the fig11 reversal (`fado.compare.plot_angle_errors`,'
         echo 'same runs as the table; grey: |n| < 30 r/min):'
