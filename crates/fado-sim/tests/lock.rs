@@ -182,3 +182,54 @@ fn a_real_stall_is_reported_as_stalled_not_as_a_lost_estimate() {
         assert!(out.metrics.stall_time.is_some(), "{scenario}");
     }
 }
+
+const OUTRUNNER: &str = include_str!("../../../motors/outrunner-cheetah-24v.toml");
+
+/// The stall band tolerates the lag of a rotor whose estimate is off by less than issue 14's
+/// clean threshold (`lock_stall_torque_band_ratio` = 1 − cos 0.25 rad, docs/lock.md "A band
+/// from the clean threshold"), and still sees a rotor that stalls. Two points of the
+/// outrunner's reversal envelope (seed 7, R̂s adaptation, `scripts/lock-sweeps-preset.sh`),
+/// a 21-pole-pair motor whose inertia is small for its torque:
+/// * #130 (L̂q −14 %, 0.56 N·m): the rotor and the estimate lag the ramp out of zero speed by
+///   up to 0.004 of rated speed with the estimate 0.21 rad off, and catch up. It passes, stays
+///   below 0.25 rad and raises neither flag (with the sixth session's ratio 0.015 it raised
+///   `STALLED` at 3.593 s);
+/// * #218 (R̂s +4 %, L̂q +9 %, 0.44 N·m): the rotor stalls at the same passage and the angle
+///   is lost 124 ms later. A flag is up 20 ms after |θ − θ̂| first exceeds 0.5 rad (and rose
+///   less than 1 s before: docs/lock.md's detection).
+#[test]
+fn the_outrunner_lagging_under_a_clean_estimate_is_not_flagged_and_a_stall_is() {
+    let run = |rs: f64, flux: f64, lq: f64, load: f64| {
+        let toml = format!(
+            "{OUTRUNNER}\n[mismatch]\nrs_ratio = {}\nflux_linkage_ratio = {}\nlq_ratio = {}\n\
+             [load.torque]\npoints = [[1.2, 0.0], [1.7, {load}]]\n",
+            1.0 + rs,
+            1.0 + flux,
+            1.0 + lq
+        );
+        let cfg = scenario_config("reversal", Some(&toml), false).unwrap();
+        run_config("reversal", cfg, None).unwrap()
+    };
+    let clean = run(-0.000_94, -0.009_12, -0.143_06, 0.558_86);
+    let m = &clean.metrics;
+    println!(
+        "#130: max |θ − θ̂| {:.3} rad, STALLED {:?}, LOCK_LOST {:?}",
+        m.max_angle_error_run, m.stall_time, m.lock_lost_time
+    );
+    assert!(clean.passed, "{m:?}");
+    assert!(m.max_angle_error_run < 0.25, "{m:?}");
+    assert_eq!((m.stall_time, m.lock_lost_time), (None, None), "{m:?}");
+    let lost = run(0.040_45, 0.019_55, 0.086_33, 0.436_14);
+    let m = &lost.metrics;
+    // docs/lock.md's detection: a flag up 20 ms after the onset that rose less than 1 s
+    // before it.
+    let delay = m
+        .lock_detection_delay
+        .expect("no flag up 20 ms after the onset");
+    println!(
+        "#218: onset {:?} s, the flag rose {delay:+.3} s from it",
+        m.loss_onset_time
+    );
+    assert!(m.max_angle_error_run > 1.0, "{m:?}");
+    assert!(delay > -1.0, "{m:?}");
+}
