@@ -35,33 +35,6 @@ mod common;
 
 use common::inputs;
 
-/// fado's firmware call, [`SensorlessEstimator::step_lean`] (no diagnostics), behind the
-/// trait the harness steps: the trait's full [`fado_core::Estimate`] is rebuilt from it
-/// outside the timed call only in name (its fields are the lean ones, the rest default).
-struct Lean(SensorlessEstimator<f32>);
-
-impl RotorAngleEstimator<f32> for Lean {
-    #[inline]
-    fn step(&mut self, v: Ab<f32>, i: Ab<f32>) -> fado_core::Estimate<f32> {
-        let e = self.0.step_lean(v, i);
-        fado_core::Estimate {
-            theta: e.theta,
-            omega: e.omega,
-            omega_control: e.omega_control,
-            ..Default::default()
-        }
-    }
-    fn align(&mut self, theta0: f32, i_ab: Ab<f32>) {
-        self.0.align(theta0, i_ab)
-    }
-    fn reset(&mut self) {
-        self.0.reset()
-    }
-    fn name(&self) -> &'static str {
-        "fado step_lean"
-    }
-}
-
 /// An estimator under test, with its place in the input period.
 struct Subject {
     name: &'static str,
@@ -70,16 +43,17 @@ struct Subject {
     ns: Vec<f64>,
 }
 
-/// Warms `est` up as `baselines.rs` does (two seconds: trackers locked, fado in k_df mode) and
-/// returns a closure that times `block` steps and gives nanoseconds per step.
-fn subject<E: RotorAngleEstimator<f32> + 'static>(
+/// Warms an estimator up as `baselines.rs` does (two seconds: trackers locked, fado in k_df
+/// mode) through `step`, its call under test, and returns a closure that times `block` calls
+/// and gives nanoseconds per step. Each call's output goes through `black_box` whole.
+fn subject<R: 'static>(
     name: &'static str,
-    mut est: E,
+    mut step: impl FnMut(Ab<f32>, Ab<f32>) -> R + 'static,
     data: std::rc::Rc<Vec<(Ab<f32>, Ab<f32>)>>,
 ) -> Subject {
     for k in 0..20_000 {
         let (v, i) = data[k % data.len()];
-        est.step(v, i);
+        step(v, i);
     }
     let mut k = 0;
     Subject {
@@ -89,12 +63,19 @@ fn subject<E: RotorAngleEstimator<f32> + 'static>(
             for _ in 0..block {
                 let (v, i) = data[k];
                 k = if k + 1 == data.len() { 0 } else { k + 1 };
-                black_box(est.step(black_box(v), black_box(i)));
+                black_box(step(black_box(v), black_box(i)));
             }
             start.elapsed().as_nanos() as f64 / block as f64
         }),
         ns: Vec::new(),
     }
+}
+
+/// The trait's step of an estimator: what criterion times in `baselines.rs`.
+fn trait_step<E: RotorAngleEstimator<f32> + 'static>(
+    mut est: E,
+) -> impl FnMut(Ab<f32>, Ab<f32>) -> fado_core::Estimate<f32> + 'static {
+    move |v, i| est.step(v, i)
 }
 
 /// The median and its distribution-free 95 % interval (order statistics at n/2 ∓ 0.98·√n).
@@ -132,22 +113,32 @@ fn main() {
     let mut subjects = vec![
         subject(
             "ortega",
-            OrtegaEstimator::<f32>::new(OrtegaConfig::for_machine(&machine))
-                .expect("the paper's motor is a valid config"),
+            trait_step(
+                OrtegaEstimator::<f32>::new(OrtegaConfig::for_machine(&machine))
+                    .expect("the paper's motor is a valid config"),
+            ),
             data.clone(),
         ),
-        subject("fado", fado(|_| {}), data.clone()),
+        subject("fado", trait_step(fado(|_| {})), data.clone()),
         subject(
             "fado-fixed-rs",
-            fado(|c| c.tuning.rs_adaptation = false),
+            trait_step(fado(|c| c.tuning.rs_adaptation = false)),
             data.clone(),
         ),
         subject(
             "fado-paper-path",
-            fado(|c| c.tuning = c.tuning.paper_path()),
+            trait_step(fado(|c| c.tuning = c.tuning.paper_path())),
             data.clone(),
         ),
-        subject("fado step_lean", Lean(fado(|_| {})), data.clone()),
+        // fado's firmware call, without the diagnostics (`LeanEstimate`).
+        subject(
+            "fado step_lean",
+            {
+                let mut est = fado(|_| {});
+                move |v, i| est.step_lean(v, i)
+            },
+            data.clone(),
+        ),
     ];
     // xorshift64*: a random order of the subjects in each round, reproducible.
     let mut seed: u64 = 0x9E37_79B9_7F4A_7C15;
