@@ -15,11 +15,11 @@ use fado_core::baselines::{
     EmfObserverConfig, EmfObserverEstimator, LpfIntegratorConfig, LpfIntegratorEstimator,
     OrtegaConfig, OrtegaEstimator,
 };
-use fado_core::{Ab, EstimatorConfig, MachineModel, RotorAngleEstimator, SensorlessEstimator};
+use fado_core::{Ab, MachineModel, RotorAngleEstimator};
 
 mod common;
 
-use common::inputs;
+use common::{fado, inputs};
 
 fn bench_one<E: RotorAngleEstimator<f32>>(c: &mut Criterion, est: E, data: &[(Ab<f32>, Ab<f32>)]) {
     let name = format!("{}_step_f32", est.name());
@@ -50,22 +50,12 @@ fn bench_named<E: RotorAngleEstimator<f32>>(
 
 fn estimators(c: &mut Criterion) {
     let data = inputs();
-    bench_one(
-        c,
-        SensorlessEstimator::<f32>::new(EstimatorConfig::for_machine(&MachineModel::paper()))
-            .unwrap(),
-        &data,
-    );
+    bench_one(c, fado(|_| {}), &data);
     // fado as the paper has it: R̂s fixed (compare's `fado-fixed-rs`).
     bench_named(
         c,
         "fado-fixed-rs_step_f32",
-        SensorlessEstimator::<f32>::new({
-            let mut config = EstimatorConfig::for_machine(&MachineModel::paper());
-            config.tuning.rs_adaptation = false;
-            config
-        })
-        .unwrap(),
+        fado(|c| c.tuning.rs_adaptation = false),
         &data,
     );
     // fado on the paper's path (`EstimatorTuning::paper_path`, the Cortex-M image's scenarios
@@ -73,12 +63,7 @@ fn estimators(c: &mut Criterion) {
     bench_named(
         c,
         "fado-paper-path_step_f32",
-        SensorlessEstimator::<f32>::new({
-            let mut config = EstimatorConfig::for_machine(&MachineModel::paper());
-            config.tuning = config.tuning.paper_path();
-            config
-        })
-        .unwrap(),
+        fado(|c| c.tuning = c.tuning.paper_path()),
         &data,
     );
     bench_one(

@@ -29,11 +29,11 @@ use std::hint::black_box;
 use std::time::Instant;
 
 use fado_core::baselines::{OrtegaConfig, OrtegaEstimator};
-use fado_core::{Ab, EstimatorConfig, MachineModel, RotorAngleEstimator, SensorlessEstimator};
+use fado_core::{Ab, MachineModel, RotorAngleEstimator};
 
 mod common;
 
-use common::inputs;
+use common::{fado, inputs};
 
 /// An estimator under test, with its place in the input period.
 struct Subject {
@@ -105,11 +105,6 @@ fn main() {
     let block = numbers.get(2).copied().unwrap_or(1000).max(1);
     let data = std::rc::Rc::new(inputs());
     let machine = MachineModel::paper();
-    let fado = |tuning: fn(&mut EstimatorConfig<f32>)| {
-        let mut config = EstimatorConfig::for_machine(&machine);
-        tuning(&mut config);
-        SensorlessEstimator::<f32>::new(config).expect("the paper's motor is a valid config")
-    };
     let mut subjects = vec![
         subject(
             "ortega",

@@ -1,7 +1,7 @@
 //! The samples the estimator benchmarks step through (`baselines.rs`, `paired.rs`): one
 //! electrical period of an ideal machine at 300 r/min under load, SPEC §6 motor.
 
-use fado_core::{Ab, Dq, Rotation};
+use fado_core::{Ab, Dq, EstimatorConfig, MachineModel, Rotation, SensorlessEstimator};
 
 /// Sampling period, s (10 kHz, the paper's).
 pub const TS: f64 = 100e-6;
@@ -30,4 +30,13 @@ pub fn inputs() -> Vec<(Ab<f32>, Ab<f32>)> {
             )
         })
         .collect()
+}
+
+/// fado on the paper's motor in `f32`, its configuration changed by `tuning`: `|_| {}` for the
+/// default, `|c| c.tuning.rs_adaptation = false` for the paper's fixed R̂s (compare's
+/// `fado-fixed-rs`), `|c| c.tuning = c.tuning.paper_path()` for the paper's path.
+pub fn fado(tuning: impl FnOnce(&mut EstimatorConfig<f32>)) -> SensorlessEstimator<f32> {
+    let mut config = EstimatorConfig::for_machine(&MachineModel::paper());
+    tuning(&mut config);
+    SensorlessEstimator::new(config).expect("the paper's motor is a valid configuration")
 }
