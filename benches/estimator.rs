@@ -138,6 +138,8 @@ fn bench_precision<T: Real>(c: &mut Criterion, name: &str) {
             detection_time: d.lock_detection_time,
             heal_time: d.lock_heal_time,
             limiter_clamping: true,
+            handover_count: T::lit(5.0),
+            handover_time: d.lock_handover_time,
         })
         .unwrap();
         let flux_sq = lf * lf;
@@ -151,6 +153,7 @@ fn bench_precision<T: Real>(c: &mut Criterion, name: &str) {
                 black_box(s.theta_direct - s.omega * ts),
                 black_box(s.omega),
                 false,
+                k % 64 == 0,
             );
             det.commit(next);
             black_box(next)

@@ -208,6 +208,8 @@ class EstimatorConfig:
         lock_detection_time: float | None = None,
         lock_heal_time: float | None = None,
         lock_limiter_clamping: bool | None = None,
+        lock_handover_count: float | None = None,
+        lock_handover_time: float | None = None,
     ) -> EstimatorConfig: ...
     def replace(
         self,
@@ -246,6 +248,8 @@ class EstimatorConfig:
         lock_detection_time: float | None = None,
         lock_heal_time: float | None = None,
         lock_limiter_clamping: bool | None = None,
+        lock_handover_count: float | None = None,
+        lock_handover_time: float | None = None,
     ) -> EstimatorConfig: ...
     def to_dict(self) -> dict[str, float | str | bool]: ...
     def paper_path(self) -> EstimatorConfig:
@@ -356,6 +360,12 @@ class EstimatorConfig:
     @property
     def lock_limiter_clamping(self) -> bool:
         """Loss of lock: limiter clamping in limiter mode is a symptom."""
+    @property
+    def lock_handover_count(self) -> float:
+        """Loss of lock: this many mode hand-overs per lock_handover_time is a symptom (0: off)."""
+    @property
+    def lock_handover_time(self) -> float:
+        """Loss of lock: time constant (s) of the mode hand-over count's decay."""
 
 @final
 class StepResult:

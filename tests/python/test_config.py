@@ -53,6 +53,8 @@ PAPER_DEFAULTS = {
     "lock_detection_time": 5e-3,  # [A]
     "lock_heal_time": 0.1,  # [A]
     "lock_limiter_clamping": False,  # [A]
+    "lock_handover_count": 5.0,  # [A] (docs/lock.md "Mode hand-over chatter")
+    "lock_handover_time": 0.1,  # [A]
 }
 
 # The paper's motor (section V; λf, J, B from SPEC §6; rated current from its rated torque).

@@ -21,6 +21,19 @@
 //!    collapsing through the origin, a π jump) makes it large at once. This is the
 //!    "phase detector" lock indicator of PLL practice (Gardner, *Phaselock Techniques*, 3rd
 //!    ed., ch. 8, lock detection).
+//! 3. **Mode hand-over chatter** — the rate of the mode selector's hand-overs (Fig. 3). The
+//!    selector's hysteresis (SPEC §1) exists so that noise on ω̂ cannot make it chatter: one
+//!    hand-over needs ω̂ to cross the whole band (0.004 of the rated speed by default), so a
+//!    run that passes through the band once hands over once or twice. An estimate caught in a
+//!    limit cycle swings ω̂ across the band tens of times a second (ipmsm-gem-50k's start-up
+//!    with L̂q over-estimated by 20–30 %: 13–18 hand-overs in 0.25 s, with |θ − θ̂| swinging
+//!    ±0.5 rad before the rotor is lost; runs that keep the rotor below 0.25 rad: at most 3,
+//!    docs/lock.md "Mode hand-over chatter"). The rate is a leaky count: each hand-over adds
+//!    1, and the level decays with the time constant `handover_time` (forward Euler at the
+//!    detector's period, pole 1 − ts/`handover_time`); at steady rate r it settles at
+//!    r·`handover_time`. Hysteresis switching that keeps switching is the classic sign of a
+//!    system that does not settle in either mode (Liberzon, *Switching in Systems and
+//!    Control*, Birkhäuser 2003, §1.2.3 on hysteresis switching and chattering).
 //!
 //! The upper half of symptom 1 (|λ̂r| above the band) is set wide by default (1.5·λ̂f): on
 //! the fig11 envelope a tight bound's alarms came from the |λ̂r| overshoot after a limiter →
@@ -227,6 +240,11 @@ pub struct LockDetectorConfig<T> {
     /// In limiter mode, a sample in which the limiter clamps (|λ̂r| beyond its circle) is
     /// suspicious.
     pub limiter_clamping: bool,
+    /// A hand-over rate (the leaky count of symptom 3) at or above this many hand-overs is
+    /// suspicious; 0 switches the symptom off.
+    pub handover_count: T,
+    /// Time constant of the hand-over count's decay, s (longer than `ts`).
+    pub handover_time: T,
 }
 
 /// The detector's constants, precomputed once from a [`LockDetectorConfig`] (the immutable
@@ -241,6 +259,31 @@ pub(crate) struct LockDetectorParams<T> {
     /// The debouncer's limits, with its state cleared.
     counter: Debouncer,
     clamping: bool,
+    /// 1 − ts/`handover_time`: the hand-over count's decay per judged sample.
+    handover_keep: T,
+    /// The hand-over count that is suspicious (+∞ when off).
+    handover_limit: T,
+}
+
+/// The detector's state: the debouncer and the hand-over count (symptom 3). The estimator
+/// keeps it in its state; [`LockDetector`] around its constants.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LockState<T> {
+    counter: DebouncerState,
+    handovers: T,
+}
+
+impl<T: Real> LockState<T> {
+    /// The status this state means.
+    #[inline(always)]
+    pub fn status(&self) -> LockStatus {
+        self.counter.status()
+    }
+
+    /// The hand-over count (symptom 3): hand-overs, decaying with `handover_time`.
+    pub fn handovers(&self) -> T {
+        self.handovers
+    }
 }
 
 impl<T: Real> LockDetectorParams<T> {
@@ -269,6 +312,15 @@ impl<T: Real> LockDetectorParams<T> {
         let innovation = check::positive("lock_innovation_limit", c.innovation_limit)?;
         let limit = samples("lock_detection_time", c.detection_time, ts)?;
         let heal = samples("lock_heal_time", c.heal_time, ts)?;
+        let handover_count = check::non_negative("lock_handover_count", c.handover_count)?;
+        let handover_time = check::positive("lock_handover_time", c.handover_time)?;
+        // Forward Euler needs ts < τ for a pole in (0, 1); any useful τ is hundreds of ts.
+        check::below(
+            "lock_handover_time",
+            ts,
+            handover_time,
+            "longer than the detector's period (4 sampling periods)",
+        )?;
         Ok(Self {
             low_sq: low * low,
             low_fast_sq: low_fast * low_fast,
@@ -277,33 +329,56 @@ impl<T: Real> LockDetectorParams<T> {
             innovation_limit: innovation,
             counter: Debouncer::new(limit, heal),
             clamping: c.limiter_clamping,
+            handover_keep: T::one() - ts / handover_time,
+            handover_limit: if handover_count == T::zero() {
+                T::lit(f64::INFINITY)
+            } else {
+                handover_count
+            },
         })
     }
 
     /// The state after one sample `s`: `lambda_r_sq` = |λ̂r|², `flux_sq` = λ̂f²,
     /// `innovation` = wrap(θm − θ̂⁻) (0 when the trackers coasted), `omega` = ω̂ (rad/s,
     /// electrical; it picks the lower flux bound), `clamping` = the limiter clamped this
-    /// sample. Four multiplications, six compares.
+    /// sample, `handover` = the mode changed since the last judged sample. Five
+    /// multiplications, seven compares.
+    #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     pub(crate) fn next_state(
         &self,
-        s: DebouncerState,
+        s: LockState<T>,
         lambda_r_sq: T,
         flux_sq: T,
         innovation: T,
         omega: T,
         clamping: bool,
-    ) -> DebouncerState {
+        handover: bool,
+    ) -> LockState<T> {
         let low_sq = if omega.abs() < self.fast_speed {
             self.low_sq
         } else {
             self.low_fast_sq
         };
+        let decayed = s.handovers * self.handover_keep;
+        let handovers = if handover {
+            decayed + T::one()
+        } else {
+            decayed
+        };
         let suspicious = (lambda_r_sq < low_sq * flux_sq)
             | (lambda_r_sq > self.high_sq * flux_sq)
             | (innovation.abs() > self.innovation_limit)
-            | (clamping & self.clamping);
-        self.counter.with_state(s).next(suspicious).counter_state()
+            | (clamping & self.clamping)
+            | (handovers >= self.handover_limit);
+        LockState {
+            counter: self
+                .counter
+                .with_state(s.counter)
+                .next(suspicious)
+                .counter_state(),
+            handovers,
+        }
     }
 }
 
@@ -311,7 +386,7 @@ impl<T: Real> LockDetectorParams<T> {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LockDetector<T> {
     params: LockDetectorParams<T>,
-    state: DebouncerState,
+    state: LockState<T>,
 }
 
 impl<T: Real> LockDetector<T> {
@@ -320,19 +395,21 @@ impl<T: Real> LockDetector<T> {
     pub fn new(c: LockDetectorConfig<T>) -> Result<Self, ConfigError> {
         Ok(Self {
             params: LockDetectorParams::new(c)?,
-            state: DebouncerState::default(),
+            state: LockState::default(),
         })
     }
 
-    /// Back to [`LockStatus::Locked`].
+    /// Back to [`LockStatus::Locked`], no hand-overs counted.
     pub fn reset(&mut self) {
-        self.state = DebouncerState::default();
+        self.state = LockState::default();
     }
 
     /// The state after one sample, without changing `self`: `lambda_r_sq` = |λ̂r|²,
     /// `flux_sq` = λ̂f², `innovation` = wrap(θm − θ̂⁻) (0 when the trackers coasted),
-    /// `omega` = ω̂ (rad/s, electrical), `clamping` = the limiter clamped this sample. Four
-    /// multiplications, six compares.
+    /// `omega` = ω̂ (rad/s, electrical), `clamping` = the limiter clamped this sample,
+    /// `handover` = the mode changed since the last judged sample. Five multiplications,
+    /// seven compares.
+    #[allow(clippy::too_many_arguments)]
     #[inline]
     pub fn next_state(
         &self,
@@ -341,29 +418,30 @@ impl<T: Real> LockDetector<T> {
         innovation: T,
         omega: T,
         clamping: bool,
-    ) -> Debouncer {
-        let next = self.params.next_state(
+        handover: bool,
+    ) -> LockState<T> {
+        self.params.next_state(
             self.state,
             lambda_r_sq,
             flux_sq,
             innovation,
             omega,
             clamping,
-        );
-        self.params.counter.with_state(next)
+            handover,
+        )
     }
 
     /// Takes a state computed by [`Self::next_state`].
     #[inline]
-    pub fn commit(&mut self, state: Debouncer) {
-        self.state = state.counter_state();
+    pub fn commit(&mut self, state: LockState<T>) {
+        self.state = state;
     }
 
     /// The committed state, as [`Self::next_state`] returns it (for a sample the detector
     /// does not judge).
     #[inline]
-    pub fn state(&self) -> Debouncer {
-        self.params.counter.with_state(self.state)
+    pub fn state(&self) -> LockState<T> {
+        self.state
     }
 
     /// The status after the last committed sample.
@@ -387,6 +465,8 @@ mod tests {
             detection_time: time,
             heal_time: 2e-3,
             limiter_clamping: true,
+            handover_count: 0.0,
+            handover_time: 0.1,
         }
     }
 
@@ -399,7 +479,7 @@ mod tests {
     }
 
     fn step_at(d: &mut LockDetector<f64>, ratio: f64, innovation: f64, omega: f64) -> LockStatus {
-        let s = d.next_state(ratio * ratio, 1.0, innovation, omega, false);
+        let s = d.next_state(ratio * ratio, 1.0, innovation, omega, false, false);
         d.commit(s);
         d.status()
     }
@@ -505,6 +585,8 @@ mod tests {
             detection_time: 0.01,
             heal_time: 0.1,
             limiter_clamping: true,
+            handover_count: 4.0,
+            handover_time: 0.1,
         };
         let e = |c| LockDetector::<f64>::new(c).unwrap_err().field();
         assert_eq!(
@@ -549,5 +631,84 @@ mod tests {
             }),
             "lock_heal_time"
         );
+        assert_eq!(
+            e(LockDetectorConfig {
+                handover_count: -1.0,
+                ..c
+            }),
+            "lock_handover_count"
+        );
+        assert_eq!(
+            e(LockDetectorConfig {
+                handover_time: 1e-4,
+                ..c
+            }),
+            "lock_handover_time"
+        );
+    }
+
+    /// Symptom 3: the leaky hand-over count. At a steady rate r it settles at r·τ (so the
+    /// limit N is a rate N/τ), a burst of k hand-overs counts k, and it decays with τ.
+    #[test]
+    fn handover_chatter_is_a_rate_with_its_time_constant() {
+        let ts = 4e-4;
+        let c = LockDetectorConfig {
+            ts,
+            flux_low_ratio: 0.5,
+            flux_low_fast_ratio: 0.5,
+            fast_speed: 10.0,
+            flux_high_ratio: 1.3,
+            innovation_limit: 0.5,
+            detection_time: 2e-3,
+            heal_time: 0.1,
+            limiter_clamping: false,
+            handover_count: 5.0,
+            handover_time: 0.1,
+        };
+        let run = |period: usize, samples: usize| {
+            let mut d = LockDetector::new(c).unwrap();
+            let mut lost_at = None;
+            for k in 0..samples {
+                let s = d.next_state(1.0, 1.0, 0.0, 0.0, false, k % period == period - 1);
+                d.commit(s);
+                if lost_at.is_none() && d.status() == LockStatus::Lost {
+                    lost_at = Some(k);
+                }
+            }
+            (d.state().handovers(), lost_at)
+        };
+        // 40 hand-overs a second (one every 62 judged samples): r·τ ≈ 4, between 3.5 and 4.5
+        // over a period, < 5.
+        let (level, lost) = run(62, 5000);
+        assert!((3.0..4.6).contains(&level), "{level}");
+        assert_eq!(lost, None);
+        // 62.5 a second (every 40 judged samples): r·τ ≈ 6.25, 5.75–6.75 over a period, raised
+        // once the count stays above 5 (after about nine hand-overs) and the detection time.
+        let (level, lost) = run(40, 5000);
+        assert!((5.5..7.0).contains(&level), "{level}");
+        let lost = lost.unwrap() as f64 * ts;
+        assert!((0.05..0.3).contains(&lost), "{lost}");
+        // Off (count 0): never.
+        let mut d = LockDetector::new(LockDetectorConfig {
+            handover_count: 0.0,
+            ..c
+        })
+        .unwrap();
+        for _ in 0..5000 {
+            let s = d.next_state(1.0, 1.0, 0.0, 0.0, false, true);
+            d.commit(s);
+        }
+        assert_eq!(d.status(), LockStatus::Locked);
+        // The decay: one hand-over is 1, τ later e^{-1} within the Euler error.
+        let mut d = LockDetector::new(c).unwrap();
+        let s = d.next_state(1.0, 1.0, 0.0, 0.0, false, true);
+        d.commit(s);
+        assert_eq!(d.state().handovers(), 1.0);
+        for _ in 0..250 {
+            let s = d.next_state(1.0, 1.0, 0.0, 0.0, false, false);
+            d.commit(s);
+        }
+        let h = d.state().handovers();
+        assert!((h - (-1.0f64).exp()).abs() < 2e-3, "{h}");
     }
 }

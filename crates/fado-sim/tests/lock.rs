@@ -233,3 +233,52 @@ fn the_outrunner_lagging_under_a_clean_estimate_is_not_flagged_and_a_stall_is() 
     assert!(m.max_angle_error_run > 1.0, "{m:?}");
     assert!(delay > -1.0, "{m:?}");
 }
+
+const GEM: &str = include_str!("../../../motors/ipmsm-gem-50k.toml");
+
+/// The mode hand-over chatter (`lock` symptom 3, docs/lock.md "Mode hand-over chatter") on
+/// ipmsm-gem-50k's reversal envelope with the paper's fixed R̂s, seed 7:
+/// * #125 (L̂q +25 %): the start-up ends in a limit cycle — ω̂ swinging across the mode
+///   hand-over band tens of times a second, |θ − θ̂| ±0.5 rad — and the rotor is lost at
+///   0.40 s. The chatter raises `LOCK_LOST` in it, before the loss; without the symptom
+///   (`lock_handover_count = 0`) the flag comes late (not up 20 ms after the onset).
+/// * #257 (L̂q +11 %): a start-up that hands over several times and keeps the rotor within
+///   0.25 rad is not flagged.
+#[test]
+fn a_start_up_limit_cycle_on_a_salient_rotor_is_flagged_by_its_mode_chatter() {
+    let run = |rs: f64, flux: f64, lq: f64, load: f64, extra: &str| {
+        let toml = format!(
+            "{GEM}\n[estimator]\nrs_adaptation = false\n{extra}\n[mismatch]\nrs_ratio = {}\n\
+             flux_linkage_ratio = {}\nlq_ratio = {}\n[load.torque]\npoints = [[1.2, 0.0], [1.7, {load}]]\n",
+            1.0 + rs,
+            1.0 + flux,
+            1.0 + lq
+        );
+        let cfg = scenario_config("reversal", Some(&toml), false).unwrap();
+        run_config("reversal", cfg, None).unwrap().metrics
+    };
+    let lost = |extra| run(0.005_789, 0.018_911, 0.251_589, 19.965, extra);
+    let m = lost("");
+    println!(
+        "#125: onset {:?} s, LOCK_LOST first {:?} s, detection {:?} s",
+        m.loss_onset_time, m.lock_lost_time, m.lock_detection_delay
+    );
+    assert!(m.max_angle_error_run > 1.0, "{m:?}");
+    let delay = m
+        .lock_detection_delay
+        .expect("no flag up 20 ms after the onset");
+    assert!(delay > -1.0, "{m:?}");
+    let m = lost("lock_handover_count = 0.0");
+    println!(
+        "#125 without the symptom: LOCK_LOST first {:?} s, detection {:?}",
+        m.lock_lost_time, m.lock_detection_delay
+    );
+    assert_eq!(m.lock_detection_delay, None, "{m:?}");
+    let m = run(0.022_722, -0.081_766, 0.105_866, 5.4847, "");
+    println!(
+        "#257: max |θ − θ̂| {:.3} rad, LOCK_LOST {:?}, STALLED {:?}",
+        m.max_angle_error_run, m.lock_lost_time, m.stall_time
+    );
+    assert!(m.max_angle_error_run < 0.25, "{m:?}");
+    assert_eq!((m.lock_lost_time, m.stall_time), (None, None), "{m:?}");
+}
