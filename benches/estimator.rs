@@ -153,7 +153,7 @@ fn bench_precision<T: Real>(c: &mut Criterion, name: &str) {
                 black_box(s.theta_direct - s.omega * ts),
                 black_box(s.omega),
                 false,
-                k % 64 == 0,
+                k.is_multiple_of(64),
             );
             det.commit(next);
             black_box(next)
