@@ -214,6 +214,9 @@ pub(crate) fn samples<T: Real>(field: &'static str, time: T, ts: T) -> Result<u3
     Ok((time / ts).round().to_f64().min(u32::MAX as f64) as u32)
 }
 
+/// A hand-over count below this is 0 (symptom 3; see [`LockDetectorParams::next_state`]).
+const HANDOVER_FLOOR: f64 = 1e-6;
+
 /// Configuration of a [`LockDetector`]; the tuning is in
 /// [`EstimatorConfig`](crate::EstimatorConfig)'s `lock_*` fields.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -360,7 +363,16 @@ impl<T: Real> LockDetectorParams<T> {
         } else {
             self.low_fast_sq
         };
+        // Below 1e-6 hand-overs the count is 0: the decay alone would take it into the
+        // subnormal range and hold it at the smallest subnormal for ever (0.996 times it
+        // rounds back to it), and a multiplication by a subnormal is a microcode assist on
+        // x86 (it cost 5 % of the whole step there, docs/lock.md "Mode hand-over chatter").
         let decayed = s.handovers * self.handover_keep;
+        let decayed = if decayed < T::lit(HANDOVER_FLOOR) {
+            T::zero()
+        } else {
+            decayed
+        };
         let handovers = if handover {
             decayed + T::one()
         } else {
@@ -710,5 +722,34 @@ mod tests {
         }
         let h = d.state().handovers();
         assert!((h - (-1.0f64).exp()).abs() < 2e-3, "{h}");
+        // Quiet for long, it is exactly 0, not a subnormal that the decay would hold (in
+        // f32 too: 0.996 times the smallest subnormal rounds back to it).
+        for _ in 0..20_000 {
+            let s = d.next_state(1.0, 1.0, 0.0, 0.0, false, false);
+            d.commit(s);
+        }
+        assert_eq!(d.state().handovers(), 0.0);
+        let mut d = LockDetector::<f32>::new(LockDetectorConfig {
+            ts: ts as f32,
+            flux_low_ratio: 0.5,
+            flux_low_fast_ratio: 0.5,
+            fast_speed: 10.0,
+            flux_high_ratio: 1.3,
+            innovation_limit: 0.5,
+            detection_time: 2e-3,
+            heal_time: 0.1,
+            limiter_clamping: false,
+            handover_count: 5.0,
+            handover_time: 0.1,
+        })
+        .unwrap();
+        let s = d.next_state(1.0, 1.0, 0.0, 0.0, false, true);
+        d.commit(s);
+        for _ in 0..40_000 {
+            let s = d.next_state(1.0, 1.0, 0.0, 0.0, false, false);
+            d.commit(s);
+            assert!(d.state().handovers().is_normal() || d.state().handovers() == 0.0);
+        }
+        assert_eq!(d.state().handovers(), 0.0);
     }
 }
