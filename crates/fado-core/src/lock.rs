@@ -26,8 +26,9 @@
 //!    hand-over needs ω̂ to cross the whole band (0.004 of the rated speed by default), so a
 //!    run that passes through the band once hands over once or twice. An estimate caught in a
 //!    limit cycle swings ω̂ across the band tens of times a second (ipmsm-gem-50k's start-up
-//!    with L̂q over-estimated by 20–30 %: 13–18 hand-overs in 0.25 s, with |θ − θ̂| swinging
-//!    ±0.5 rad before the rotor is lost; runs that keep the rotor below 0.25 rad: at most 3,
+//!    with L̂q over-estimated by 20–30 %: typically 13–18 hand-overs in 0.25 s, with
+//!    |θ − θ̂| swinging ±0.5 rad before the rotor is lost; runs that keep the rotor below
+//!    0.25 rad: 1–2 on five presets, up to 9 at the start-up of the two salient ones,
 //!    docs/lock.md "Mode hand-over chatter"). The rate is a leaky count: each hand-over adds
 //!    1, and the level decays with the time constant `handover_time` (forward Euler at the
 //!    detector's period, pole 1 − ts/`handover_time`); at steady rate r it settles at
