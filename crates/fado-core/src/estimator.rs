@@ -336,9 +336,9 @@ pub struct EstimatorTuning<T> {
     /// `lock_handover_time` is a symptom (a leaky count, see [`crate::lock`], symptom 3);
     /// 0 switches it off. Default 5 \[A\] (docs/lock.md "Mode hand-over chatter"): a
     /// sustained 50 hand-overs a second, or a burst of five. On the reversal envelopes of the
-    /// seven presets the count of runs that keep the rotor within 0.25 rad stays at 1.0–1.9,
-    /// and up to 4.0 on ipmsm-gem-50k; the start-up limit cycles that lose that motor's rotor
-    /// reach 5–28.
+    /// seven presets the count of runs that keep the rotor within 0.25 rad stays at 1.0–1.9
+    /// on five, and reaches 3.9 on pmsyrm-5k and 4.0 on ipmsm-gem-50k; most start-up limit
+    /// cycles that lose ipmsm-gem-50k's rotor reach 5–28.
     pub lock_handover_count: T,
     /// Loss of lock: the time constant of the hand-over count's decay, s. Default 0.1 s
     /// \[A\] (docs/lock.md "Mode hand-over chatter").
