@@ -323,7 +323,7 @@ impl<T: Real> LockDetectorParams<T> {
             "lock_handover_time",
             ts,
             handover_time,
-            "longer than the detector's period (4 sampling periods)",
+            "longer than the detector's period (the estimator's is 4 sampling periods)",
         )?;
         Ok(Self {
             low_sq: low * low,
@@ -660,24 +660,31 @@ mod tests {
         );
     }
 
+    /// The detector judging every 0.4 ms (the estimator's period at 10 kHz) with the hand-over
+    /// count at its defaults (5 per 0.1 s); the flux and innovation symptoms never fire on the
+    /// inputs of the test below.
+    fn chatter_config<T: Real>() -> LockDetectorConfig<T> {
+        LockDetectorConfig {
+            ts: T::lit(4e-4),
+            flux_low_ratio: T::lit(0.5),
+            flux_low_fast_ratio: T::lit(0.5),
+            fast_speed: T::lit(10.0),
+            flux_high_ratio: T::lit(1.3),
+            innovation_limit: T::lit(0.5),
+            detection_time: T::lit(2e-3),
+            heal_time: T::lit(0.1),
+            limiter_clamping: false,
+            handover_count: T::lit(5.0),
+            handover_time: T::lit(0.1),
+        }
+    }
+
     /// Symptom 3: the leaky hand-over count. At a steady rate r it settles at r·τ (so the
     /// limit N is a rate N/τ), a burst of k hand-overs counts k, and it decays with τ.
     #[test]
     fn handover_chatter_is_a_rate_with_its_time_constant() {
         let ts = 4e-4;
-        let c = LockDetectorConfig {
-            ts,
-            flux_low_ratio: 0.5,
-            flux_low_fast_ratio: 0.5,
-            fast_speed: 10.0,
-            flux_high_ratio: 1.3,
-            innovation_limit: 0.5,
-            detection_time: 2e-3,
-            heal_time: 0.1,
-            limiter_clamping: false,
-            handover_count: 5.0,
-            handover_time: 0.1,
-        };
+        let c = chatter_config::<f64>();
         let run = |period: usize, samples: usize| {
             let mut d = LockDetector::new(c).unwrap();
             let mut lost_at = None;
@@ -730,20 +737,7 @@ mod tests {
             d.commit(s);
         }
         assert_eq!(d.state().handovers(), 0.0);
-        let mut d = LockDetector::<f32>::new(LockDetectorConfig {
-            ts: ts as f32,
-            flux_low_ratio: 0.5,
-            flux_low_fast_ratio: 0.5,
-            fast_speed: 10.0,
-            flux_high_ratio: 1.3,
-            innovation_limit: 0.5,
-            detection_time: 2e-3,
-            heal_time: 0.1,
-            limiter_clamping: false,
-            handover_count: 5.0,
-            handover_time: 0.1,
-        })
-        .unwrap();
+        let mut d = LockDetector::new(chatter_config::<f32>()).unwrap();
         let s = d.next_state(1.0, 1.0, 0.0, 0.0, false, true);
         d.commit(s);
         for _ in 0..40_000 {

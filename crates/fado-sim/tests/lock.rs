@@ -185,6 +185,28 @@ fn a_real_stall_is_reported_as_stalled_not_as_a_lost_estimate() {
 
 const OUTRUNNER: &str = include_str!("../../../motors/outrunner-cheetah-24v.toml");
 
+/// One point of a preset's reversal envelope (`scripts/lock-sweeps-preset.sh`): the preset's
+/// TOML, `extra` TOML after it, the model's relative errors of R̂s, λ̂f and L̂q, and the load
+/// ramped from 0 at 1.2 s to `load` N·m at 1.7 s.
+fn reversal_point(
+    preset: &str,
+    extra: &str,
+    rs: f64,
+    flux: f64,
+    lq: f64,
+    load: f64,
+) -> fado_sim::Outcome {
+    let toml = format!(
+        "{preset}\n{extra}\n[mismatch]\nrs_ratio = {}\nflux_linkage_ratio = {}\nlq_ratio = {}\n\
+         [load.torque]\npoints = [[1.2, 0.0], [1.7, {load}]]\n",
+        1.0 + rs,
+        1.0 + flux,
+        1.0 + lq
+    );
+    let cfg = scenario_config("reversal", Some(&toml), false).unwrap();
+    run_config("reversal", cfg, None).unwrap()
+}
+
 /// The stall band tolerates the lag of a rotor whose estimate is off by less than issue 14's
 /// clean threshold (`lock_stall_torque_band_ratio` = 1 − cos 0.25 rad, docs/lock.md "A band
 /// from the clean threshold"), and still sees a rotor that stalls. Two points of the
@@ -199,17 +221,7 @@ const OUTRUNNER: &str = include_str!("../../../motors/outrunner-cheetah-24v.toml
 ///   less than 1 s before: docs/lock.md's detection).
 #[test]
 fn the_outrunner_lagging_under_a_clean_estimate_is_not_flagged_and_a_stall_is() {
-    let run = |rs: f64, flux: f64, lq: f64, load: f64| {
-        let toml = format!(
-            "{OUTRUNNER}\n[mismatch]\nrs_ratio = {}\nflux_linkage_ratio = {}\nlq_ratio = {}\n\
-             [load.torque]\npoints = [[1.2, 0.0], [1.7, {load}]]\n",
-            1.0 + rs,
-            1.0 + flux,
-            1.0 + lq
-        );
-        let cfg = scenario_config("reversal", Some(&toml), false).unwrap();
-        run_config("reversal", cfg, None).unwrap()
-    };
+    let run = |rs, flux, lq, load| reversal_point(OUTRUNNER, "", rs, flux, lq, load);
     let clean = run(-0.000_94, -0.009_12, -0.143_06, 0.558_86);
     let m = &clean.metrics;
     println!(
@@ -246,16 +258,9 @@ const GEM: &str = include_str!("../../../motors/ipmsm-gem-50k.toml");
 ///   0.25 rad is not flagged.
 #[test]
 fn a_start_up_limit_cycle_on_a_salient_rotor_is_flagged_by_its_mode_chatter() {
-    let run = |rs: f64, flux: f64, lq: f64, load: f64, extra: &str| {
-        let toml = format!(
-            "{GEM}\n[estimator]\nrs_adaptation = false\n{extra}\n[mismatch]\nrs_ratio = {}\n\
-             flux_linkage_ratio = {}\nlq_ratio = {}\n[load.torque]\npoints = [[1.2, 0.0], [1.7, {load}]]\n",
-            1.0 + rs,
-            1.0 + flux,
-            1.0 + lq
-        );
-        let cfg = scenario_config("reversal", Some(&toml), false).unwrap();
-        run_config("reversal", cfg, None).unwrap().metrics
+    let run = |rs, flux, lq, load, extra: &str| {
+        let estimator = format!("[estimator]\nrs_adaptation = false\n{extra}\n");
+        reversal_point(GEM, &estimator, rs, flux, lq, load).metrics
     };
     let lost = |extra| run(0.005_789, 0.018_911, 0.251_589, 19.965, extra);
     let m = lost("");
