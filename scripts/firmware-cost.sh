@@ -37,7 +37,7 @@ grep -o 'EstimatorState<f32> = .*' "$run_log" | tr ',' '\n' | sed 's/^ */    /' 
 grep -o 'deepest stack: .*' "$run_log" | sed 's/^/    /' || true
 
 echo "== code reachable from the step and from the interrupt"
-for root in estimator_step paper_kernel_step SysTick drive_step; do
+for root in estimator_step paper_kernel_step paper_kernel_held_step SysTick drive_step; do
     { python3 scripts/firmware_cost.py graph "$image" "$root" || true; } |
         grep -E '^(\.text reachable|OK:|FORBIDDEN)' || true
 done
@@ -45,12 +45,17 @@ done
 echo "== instruction trace (QEMU -d exec,nochain -singlestep, filtered to the step's code)"
 log=$(mktemp /tmp/fado-firmware-trace.XXXXXX)
 trap 'rm -f "$log" "$run_log"' EXIT
-filter=$(python3 scripts/firmware_cost.py ranges "$image" estimator_step,paper_kernel_step \
+filter=$(python3 scripts/firmware_cost.py ranges "$image" \
+    estimator_step,paper_kernel_step,paper_kernel_held_step \
     scenario_marker)
 timeout 900 "${qemu[@]}" -singlestep -d exec,nochain -dfilter "$filter" -D "$log" >/dev/null
-echo "-- fado's step (estimator_step: scenarios 0-1 default, 2-3 fixed R̂s, 4-5 the paper's path)"
+echo "-- fado's step (estimator_step: scenarios 0-1 default, 2-3 fixed R̂s, 4-5 the paper's path,"
+echo "   6-7 the paper's path with the gains held over fado's default period)"
 python3 scripts/firmware_cost.py trace "$image" estimator_step "$log" "$tail_steps" \
-    paper_kernel_step
+    paper_kernel_step paper_kernel_held_step
 echo "-- the paper's estimator alone (paper_kernel_step, beside fado's paper's path: scenarios 4-5)"
 python3 scripts/firmware_cost.py trace "$image" paper_kernel_step "$log" "$tail_steps" \
-    estimator_step
+    estimator_step paper_kernel_held_step
+echo "-- the same with the gains held (paper_kernel_held_step, beside scenarios 6-7)"
+python3 scripts/firmware_cost.py trace "$image" paper_kernel_held_step "$log" "$tail_steps" \
+    estimator_step paper_kernel_step

@@ -48,7 +48,7 @@ use fado_core::{
     Ab, Abc, DriveConfig, DriveOutput, Estimate, EstimatorConfig, EstimatorParams, EstimatorState,
     EstimatorTuning, LeanEstimate, MachineModel, Mode, SensorlessDrive, SensorlessEstimator,
 };
-use paper_kernel::{PaperKernel, paper_kernel_step};
+use paper_kernel::{PaperKernel, paper_kernel_held_step, paper_kernel_step};
 
 /// QEMU's MPS2 system clock (25 MHz), which clocks SysTick.
 const SYSCLK_HZ: u32 = 25_000_000;
@@ -70,7 +70,7 @@ struct Scenario {
     ramp_s: f32,
     /// Samples held at `speed_hz` after the ramp.
     hold_samples: u32,
-    /// Which of [`PARAMS`]: [`ADAPTIVE`], [`FIXED_RS`] or [`PAPER_PATH`].
+    /// Which of [`PARAMS`]: [`ADAPTIVE`], [`FIXED_RS`], [`PAPER_PATH`] or [`PAPER_PATH_HELD`].
     params: usize,
     /// Also step the paper's estimator alone ([`paper_kernel`]) on the same samples, and
     /// check that it gives fado's angle (with [`PAPER_PATH`]).
@@ -85,6 +85,9 @@ const FIXED_RS: usize = 1;
 /// off (`observer_lag_compensation`, `observer_on_rotor_flux`, `limiter_recentring` false,
 /// `observer_gain_period` 0).
 const PAPER_PATH: usize = 2;
+/// The paper's path with the observer's gains held as fado holds them by default
+/// (`observer_gain_period` 0.4 ms): the kernel beside it is [`paper_kernel_held_step`].
+const PAPER_PATH_HELD: usize = 3;
 
 /// Largest |θ̂_kernel − θ̂_fado| allowed between the paper's kernel and fado's paper's path
 /// (rad): the `f32` rounding level (measured: 0, the two compute the same operations in the same
@@ -92,7 +95,7 @@ const PAPER_PATH: usize = 2;
 /// fado's default fixed-R̂s path differ by 2e-2 rad here.
 const KERNEL_TOLERANCE: f32 = 1e-4;
 
-const SCENARIOS: [Scenario; 6] = [
+const SCENARIOS: [Scenario; 8] = [
     Scenario {
         name: "low speed, R^s adaptation",
         speed_hz: 19.5,
@@ -139,6 +142,22 @@ const SCENARIOS: [Scenario; 6] = [
         ramp_s: 0.4,
         hold_samples: 1000,
         params: PAPER_PATH,
+        kernel: true,
+    },
+    Scenario {
+        name: "low speed, paper's path, gains held (fado and the paper's kernel)",
+        speed_hz: 19.5,
+        ramp_s: 0.05,
+        hold_samples: 1000,
+        params: PAPER_PATH_HELD,
+        kernel: true,
+    },
+    Scenario {
+        name: "high speed, paper's path, gains held (fado and the paper's kernel)",
+        speed_hz: 700.0,
+        ramp_s: 0.4,
+        hold_samples: 1000,
+        params: PAPER_PATH_HELD,
         kernel: true,
     },
 ];
@@ -256,9 +275,9 @@ struct App {
 static APP: Mutex<RefCell<Option<App>>> = Mutex::new(RefCell::new(None));
 
 /// The estimator's parameters, written once by `main` before the interrupt runs (index 0 with
-/// the default R̂s adaptation, 1 with the paper's fixed R̂s, 2 the paper's path: see
-/// [`PAPER_PATH`]); read-only afterwards.
-static PARAMS: Mutex<OnceCell<[EstimatorParams<f32>; 3]>> = Mutex::new(OnceCell::new());
+/// the default R̂s adaptation, 1 with the paper's fixed R̂s, 2 the paper's path and 3 the same
+/// with the gains held: see [`PAPER_PATH`], [`PAPER_PATH_HELD`]); read-only afterwards.
+static PARAMS: Mutex<OnceCell<[EstimatorParams<f32>; 4]>> = Mutex::new(OnceCell::new());
 
 /// Lowest stack pointer seen just before calling [`estimator_step`] (stack measurement).
 static STEP_SP: Mutex<Cell<u32>> = Mutex::new(Cell::new(u32::MAX));
@@ -350,7 +369,11 @@ impl App {
             if self.samples == 0 {
                 k.prime(i);
             }
-            let theta = paper_kernel_step(k, v, i);
+            let theta = if k.holds_gains() {
+                paper_kernel_held_step(k, v, i)
+            } else {
+                paper_kernel_step(k, v, i)
+            };
             k.output(theta)
         });
         self.samples += 1;
@@ -442,6 +465,13 @@ fn main() -> ! {
         config.tuning = config.tuning.paper_path();
         config
     };
+    // The same with the gains held over fado's default period.
+    let paper_held_config = {
+        let mut config = paper_config;
+        config.tuning.observer_gain_period = EstimatorTuning::default().observer_gain_period;
+        config
+    };
+    let kernel_configs = [paper_config, paper_config, paper_config, paper_held_config];
     let params = {
         let model = MachineModel::<f32>::paper();
         let build = |rs_adaptation| {
@@ -453,8 +483,9 @@ fn main() -> ! {
             build(true),
             build(false),
             EstimatorParams::new(paper_config),
+            EstimatorParams::new(paper_held_config),
         ) {
-            (Ok(adaptive), Ok(fixed), Ok(paper)) => [adaptive, fixed, paper],
+            (Ok(adaptive), Ok(fixed), Ok(paper), Ok(held)) => [adaptive, fixed, paper, held],
             _ => {
                 hprintln!("invalid configuration");
                 exit(false)
@@ -501,7 +532,7 @@ fn main() -> ! {
             worst_error: 0.0,
             rejected: 0,
             done: false,
-            kernel: s.kernel.then(|| PaperKernel::new(&paper_config)),
+            kernel: s.kernel.then(|| PaperKernel::new(&kernel_configs[which])),
             kernel_diff: 0.0,
             kernel_omega_diff: 0.0,
             kernel_mode_diff: 0,
