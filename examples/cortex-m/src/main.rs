@@ -5,7 +5,8 @@
 //! ([`EstimatorParams`], one set per scenario kind) into a write-once `static`, and for each
 //! scenario hands a fresh [`EstimatorState`] to the interrupt. The SysTick handler stands in for the
 //! PWM/ADC interrupt of a drive: it reads the "ADC" (here a generated machine signal: an ideal
-//! surface PMSM turning at a speed that ramps up and then holds), runs one estimator step and
+//! PMSM at i_d = 0, the paper's surface-magnet motor or a salient IPMSM, turning at a speed that
+//! ramps up and then holds), runs one estimator step and
 //! keeps the worst angle error of the last samples. Results are printed over semihosting, and
 //! the program exits with status 0 when every scenario kept lock (QEMU passes the status on).
 //!
@@ -75,6 +76,9 @@ struct Scenario {
     /// Also step the paper's estimator alone ([`paper_kernel`]) on the same samples, and
     /// check that it gives fado's angle (with [`PAPER_PATH`]).
     kernel: bool,
+    /// The generated machine and the estimator's model: the paper's surface-magnet motor
+    /// (false) or the salient [`ipmsm_2k2`] (true).
+    salient: bool,
 }
 
 /// Index in [`PARAMS`]: the default configuration (R̂s adaptation on).
@@ -88,6 +92,37 @@ const PAPER_PATH: usize = 2;
 /// The paper's path with the observer's gains held as fado holds them by default
 /// (`observer_gain_period` 0.4 ms): the kernel beside it is [`paper_kernel_held_step`].
 const PAPER_PATH_HELD: usize = 3;
+/// The default configuration (R̂s adaptation on) for the salient [`ipmsm_2k2`]: the step with
+/// the active-flux terms of a salient rotor, which the paper's motor (Ld = Lq) never runs.
+const SALIENT: usize = 4;
+
+/// The 2.2 kW interior-magnet motor of `motors/ipmsm-2k2.toml` (motulator's example motor,
+/// Lq/Ld 1.42): a salient rotor, whose active-flux terms cost cycles the paper's motor does
+/// not show. Rated 1500 r/min with 3 pole pairs, i.e. 75 Hz electrical.
+fn ipmsm_2k2() -> MachineModel<f32> {
+    MachineModel {
+        rs: 3.6,
+        ld: 0.036,
+        lq: 0.051,
+        flux_linkage: 0.545,
+        pole_pairs: 3,
+        inertia: 0.015,
+        viscous_friction: 8.9e-4,
+        rated_current: 6.08,
+        rated_speed_rpm: 1500.0,
+        rated_torque: 14.0,
+        dc_voltage: 540.0,
+    }
+}
+
+/// The generated machine and the estimator's model of scenario `s`.
+fn model_of(s: &Scenario) -> MachineModel<f32> {
+    if s.salient {
+        ipmsm_2k2()
+    } else {
+        MachineModel::paper()
+    }
+}
 
 /// Largest |θ̂_kernel − θ̂_fado| allowed between the paper's kernel and fado's paper's path
 /// (rad): the `f32` rounding level (measured: 0, the two compute the same operations in the same
@@ -95,7 +130,7 @@ const PAPER_PATH_HELD: usize = 3;
 /// fado's default fixed-R̂s path differ by 2e-2 rad here.
 const KERNEL_TOLERANCE: f32 = 1e-4;
 
-const SCENARIOS: [Scenario; 8] = [
+const SCENARIOS: [Scenario; 10] = [
     Scenario {
         name: "low speed, R^s adaptation",
         speed_hz: 19.5,
@@ -103,6 +138,7 @@ const SCENARIOS: [Scenario; 8] = [
         hold_samples: 1000,
         params: ADAPTIVE,
         kernel: false,
+        salient: false,
     },
     Scenario {
         name: "high speed, R^s adaptation",
@@ -111,6 +147,7 @@ const SCENARIOS: [Scenario; 8] = [
         hold_samples: 1000,
         params: ADAPTIVE,
         kernel: false,
+        salient: false,
     },
     Scenario {
         name: "low speed, fixed R^s (paper)",
@@ -119,6 +156,7 @@ const SCENARIOS: [Scenario; 8] = [
         hold_samples: 1000,
         params: FIXED_RS,
         kernel: false,
+        salient: false,
     },
     Scenario {
         name: "high speed, fixed R^s (paper)",
@@ -127,6 +165,7 @@ const SCENARIOS: [Scenario; 8] = [
         hold_samples: 1000,
         params: FIXED_RS,
         kernel: false,
+        salient: false,
     },
     Scenario {
         name: "low speed, paper's path (fado and the paper's kernel)",
@@ -135,6 +174,7 @@ const SCENARIOS: [Scenario; 8] = [
         hold_samples: 1000,
         params: PAPER_PATH,
         kernel: true,
+        salient: false,
     },
     Scenario {
         name: "high speed, paper's path (fado and the paper's kernel)",
@@ -143,6 +183,7 @@ const SCENARIOS: [Scenario; 8] = [
         hold_samples: 1000,
         params: PAPER_PATH,
         kernel: true,
+        salient: false,
     },
     Scenario {
         name: "low speed, paper's path, gains held (fado and the paper's kernel)",
@@ -151,6 +192,7 @@ const SCENARIOS: [Scenario; 8] = [
         hold_samples: 1000,
         params: PAPER_PATH_HELD,
         kernel: true,
+        salient: false,
     },
     Scenario {
         name: "high speed, paper's path, gains held (fado and the paper's kernel)",
@@ -159,12 +201,32 @@ const SCENARIOS: [Scenario; 8] = [
         hold_samples: 1000,
         params: PAPER_PATH_HELD,
         kernel: true,
+        salient: false,
+    },
+    Scenario {
+        name: "low speed, R^s adaptation, salient ipmsm-2k2",
+        speed_hz: 19.5,
+        ramp_s: 0.05,
+        hold_samples: 1000,
+        params: SALIENT,
+        kernel: false,
+        salient: true,
+    },
+    Scenario {
+        name: "rated speed, R^s adaptation, salient ipmsm-2k2",
+        speed_hz: 75.0,
+        ramp_s: 0.2,
+        hold_samples: 1000,
+        params: SALIENT,
+        kernel: false,
+        salient: true,
     },
 ];
 
 /// The generated machine: angle and speed of an ideal PMSM, its flux and current. Its data are
-/// the paper's motor (`MachineModel::paper()`, section V), the same model the estimator is
-/// configured with; Ld = Lq there, so the generated flux is exactly the estimator's model.
+/// the scenario's motor ([`model_of`]: the paper's, section V, or [`ipmsm_2k2`]), the same model
+/// the estimator is configured with. The current is on the q axis (i_d = 0), so the stator flux
+/// (λf + j·Lq·iq)·e^{jθ} is exact for a salient rotor too (Ld multiplies i_d = 0).
 struct Machine {
     rs: f32,
     lq: f32,
@@ -276,8 +338,9 @@ static APP: Mutex<RefCell<Option<App>>> = Mutex::new(RefCell::new(None));
 
 /// The estimator's parameters, written once by `main` before the interrupt runs (index 0 with
 /// the default R̂s adaptation, 1 with the paper's fixed R̂s, 2 the paper's path and 3 the same
-/// with the gains held: see [`PAPER_PATH`], [`PAPER_PATH_HELD`]); read-only afterwards.
-static PARAMS: Mutex<OnceCell<[EstimatorParams<f32>; 4]>> = Mutex::new(OnceCell::new());
+/// with the gains held, 4 the default on a salient motor: see [`PAPER_PATH`],
+/// [`PAPER_PATH_HELD`], [`SALIENT`]); read-only afterwards.
+static PARAMS: Mutex<OnceCell<[EstimatorParams<f32>; 5]>> = Mutex::new(OnceCell::new());
 
 /// Lowest stack pointer seen just before calling [`estimator_step`] (stack measurement).
 static STEP_SP: Mutex<Cell<u32>> = Mutex::new(Cell::new(u32::MAX));
@@ -471,7 +534,13 @@ fn main() -> ! {
         config.tuning.observer_gain_period = EstimatorTuning::default().observer_gain_period;
         config
     };
-    let kernel_configs = [paper_config, paper_config, paper_config, paper_held_config];
+    let kernel_configs = [
+        paper_config,
+        paper_config,
+        paper_config,
+        paper_held_config,
+        paper_config,
+    ];
     let params = {
         let model = MachineModel::<f32>::paper();
         let build = |rs_adaptation| {
@@ -484,8 +553,11 @@ fn main() -> ! {
             build(false),
             EstimatorParams::new(paper_config),
             EstimatorParams::new(paper_held_config),
+            EstimatorParams::new(EstimatorConfig::for_machine(&ipmsm_2k2())),
         ) {
-            (Ok(adaptive), Ok(fixed), Ok(paper), Ok(held)) => [adaptive, fixed, paper, held],
+            (Ok(adaptive), Ok(fixed), Ok(paper), Ok(held), Ok(salient)) => {
+                [adaptive, fixed, paper, held, salient]
+            }
             _ => {
                 hprintln!("invalid configuration");
                 exit(false)
@@ -518,7 +590,7 @@ fn main() -> ! {
     let mut all_locked = true;
     let (mut deepest_isr, mut deepest_step) = (0, 0);
     for (index, s) in SCENARIOS.iter().enumerate() {
-        let model = MachineModel::<f32>::paper();
+        let model = model_of(s);
         let which = s.params;
         let state = EstimatorState::new(&params[which]);
         let machine = Machine::new(s, &model);
