@@ -1171,15 +1171,6 @@ impl<T: Real> EstimatorState<T> {
         let lambda_r = lambda2 - lq_i;
         let tracker_hold = lambda_r.norm_squared() < p.hold_level_sq;
         let theta_direct = rotor_angle(lambda_r);
-        // λ̂a/λ̂f, the active flux the limiter circle and the lock detector's bounds refer to
-        // (1 on a surface-magnet rotor).
-        let active_ratio = if saliency != T::zero() && !tracker_hold {
-            let i_d = i_ab.dot(lambda_r) / lambda_r.norm_squared().step_sqrt();
-            let ratio = T::one() + saliency * i_d / p.flux_linkage;
-            crate::real::max(ratio, p.tracker_hold_ratio)
-        } else {
-            T::one()
-        };
         // 4. Trackers (Fig. 1, Fig. 5).
         let (t2s1, t2s2) = if tracker_hold {
             (
@@ -1201,7 +1192,8 @@ impl<T: Real> EstimatorState<T> {
         let (base_feedback, clamping) = match mode {
             Mode::DisturbanceFeedback => (disturbance * kdf_gain, false),
             Mode::Limiter => {
-                let l = p.limiter.step_scaled(lambda_r, active_ratio);
+                let ratio = Self::active_ratio(p, i_ab, lambda_r, saliency, tracker_hold);
+                let l = p.limiter.step_scaled(lambda_r, ratio);
                 (l.feedback, l.clamping)
             }
         };
@@ -1278,6 +1270,7 @@ impl<T: Real> EstimatorState<T> {
         if slot % LOCK_PERIOD == SLOT_LOCK {
             // λ̂f as this sample used it (the slow laws below have not run yet).
             let flux_hat = self.rs_adaptation.flux_linkage_hat;
+            let active_ratio = Self::active_ratio(p, i_ab, lambda_r, saliency, tracker_hold);
             // A hand-over since the last judged sample (the mode sampled every
             // LOCK_PERIOD samples: two hand-overs within them would need ω̂ to cross the
             // hysteresis band twice in 0.4 ms, and count as none).
@@ -1422,6 +1415,28 @@ impl<T: Real> EstimatorState<T> {
             },
         };
         estimate.into()
+    }
+
+    /// λ̂a/λ̂f = 1 + (L̂d − L̂q)·î_d/λ̂f, the active flux the limiter circle and the lock
+    /// detector's bounds refer to (1 on a surface-magnet rotor, and while the trackers hold),
+    /// î_d the current along λ̂r; at least the tracker's hold ratio. Formed where it is used
+    /// (the limiter mode, the detector's slot), so that a salient rotor's k_df mode skips its
+    /// √ and two divisions in three samples of four.
+    #[inline(always)]
+    fn active_ratio(
+        p: &EstimatorParams<T>,
+        i_ab: Ab<T>,
+        lambda_r: Ab<T>,
+        saliency: T,
+        tracker_hold: bool,
+    ) -> T {
+        if saliency != T::zero() && !tracker_hold {
+            let i_d = i_ab.dot(lambda_r) / lambda_r.norm_squared().step_sqrt();
+            let ratio = T::one() + saliency * i_d / p.flux_linkage;
+            crate::real::max(ratio, p.tracker_hold_ratio)
+        } else {
+            T::one()
+        }
     }
 
     /// (L̂d − L̂q)·î_d·e^{jθ̂}: the part of the active flux λ̂a·e^{jθ} = (λ̂f + (L̂d − L̂q)·i_d)·e^{jθ}
