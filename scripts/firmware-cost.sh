@@ -9,7 +9,9 @@
 # (EstimatorState, EstimatorParams, in f32 and f64) and of their owner SensorlessEstimator.
 # Scenarios 4 and 5 run fado's paper's path and, beside it on the same samples, the paper's
 # estimator alone (paper_kernel_step, examples/cortex-m/src/paper_kernel.rs): both are traced
-# in the same run and reported apart (docs/firmware.md, "Seventh pass").
+# in the same run and reported apart (docs/firmware.md, "Seventh pass"); scenarios 6 and 7 the
+# same with the observer's gains held as fado's default holds them (paper_kernel_held_step),
+# 8 and 9 the default step on a salient IPMSM (docs/firmware.md, "Eleventh session").
 # Needs qemu-system-arm and binutils-arm-none-eabi (Debian packages of those names).
 # Usage: bash scripts/firmware-cost.sh [STEPS_MEASURED_PER_SCENARIO (default 300)]
 set -euo pipefail
