@@ -52,7 +52,8 @@ per_step "firmware image f32 (libm, LTO), whole program" "$image"
 # Issue 16's host ratio, f32 inside the step: fado's variants against the Ortega baseline (which
 # shares fado's trackers and atan2, so the ratio is the cost of what each method adds).
 echo "f32 inside isr_step, fado's variants and the Ortega baseline"
-for v in "default (R̂s adaptation)=" "fixed R̂s=FIXED_RS=1" "paper's path=PAPER_PATH=1" \
+for v in "default (R̂s adaptation)=" "default, step_lean (firmware's call)=LEAN=1" \
+    "fixed R̂s=FIXED_RS=1" "paper's path=PAPER_PATH=1" \
     "the paper's method alone=ESTIMATOR=paper-kernel" "Ortega baseline=ESTIMATOR=ortega"; do
     (
         [[ -n ${v#*=} ]] && export "${v#*=}"

@@ -6,6 +6,7 @@
 //! cargo run --release -p fado-core --example step_driver -- f32 100000
 //! FIXED_RS=1 cargo run ...   # the paper's fixed R̂s (rs_adaptation = false)
 //! PAPER_PATH=1 cargo run ...  # fado on the paper's path (every fado addition that can be off)
+//! LEAN=1 cargo run ...        # `step_lean`, the firmware's call (no diagnostics record)
 //! ESTIMATOR=ortega cargo run ...  # the Ortega baseline, for the host ratio of issue 16
 //! ESTIMATOR=paper-kernel cargo run ...  # the paper's method alone (f32 only; docs/firmware.md)
 //! ```
@@ -14,7 +15,8 @@ use std::hint::black_box;
 
 use fado_core::baselines::{OrtegaConfig, OrtegaEstimator};
 use fado_core::{
-    Ab, Estimate, EstimatorConfig, MachineModel, Real, RotorAngleEstimator, SensorlessEstimator,
+    Ab, Estimate, EstimatorConfig, LeanEstimate, MachineModel, Real, RotorAngleEstimator,
+    SensorlessEstimator,
 };
 
 /// Samples in the signal table: a power of two holding exactly 8 electrical periods.
@@ -56,6 +58,12 @@ fn isr_step<T: Real, E: RotorAngleEstimator<T>>(est: &mut E, v: Ab<T>, i: Ab<T>)
     est.step(v, i)
 }
 
+/// fado's firmware call, `step_lean` (no diagnostics record), behind the same kind of call.
+#[inline(never)]
+fn isr_step_lean<T: Real>(est: &mut SensorlessEstimator<T>, v: Ab<T>, i: Ab<T>) -> LeanEstimate<T> {
+    est.step_lean(v, i)
+}
+
 /// The Cortex-M image's hand-lean paper's estimator (`examples/cortex-m`), the same source.
 #[path = "../../../examples/cortex-m/src/paper_kernel.rs"]
 #[allow(dead_code)]
@@ -77,7 +85,8 @@ fn run_kernel(steps: usize) -> f64 {
     run_steps(&table, steps, |v, i| isr_step_kernel(&mut k, v, i))
 }
 
-/// fado's estimator (default, `FIXED_RS`, `PAPER_PATH`) or the Ortega baseline.
+/// fado's estimator (default, `FIXED_RS`, `PAPER_PATH`; `LEAN` for `step_lean`) or the Ortega
+/// baseline.
 fn run<T: Real>(steps: usize, ortega: bool) -> f64 {
     let machine = MachineModel::paper();
     let table = signal::<T>();
@@ -92,6 +101,9 @@ fn run<T: Real>(steps: usize, ortega: bool) -> f64 {
         config.tuning = config.tuning.paper_path();
     }
     let mut est = SensorlessEstimator::<T>::new(config).expect("valid");
+    if std::env::var("LEAN").is_ok() {
+        return run_steps(&table, steps, |v, i| isr_step_lean(&mut est, v, i).theta);
+    }
     run_steps(&table, steps, |v, i| isr_step(&mut est, v, i).theta)
 }
 
