@@ -11,7 +11,8 @@
 # estimator alone (paper_kernel_step, examples/cortex-m/src/paper_kernel.rs): both are traced
 # in the same run and reported apart (docs/firmware.md, "Seventh pass"); scenarios 6 and 7 the
 # same with the observer's gains held as fado's default holds them (paper_kernel_held_step),
-# 8 and 9 the default step on a salient IPMSM (docs/firmware.md, "Eleventh session").
+# 8 and 9 the default step on a salient IPMSM, and scenario 10 the whole drive
+# (drive_step) around a simulated motor (docs/firmware.md, "Eleventh session").
 # Needs qemu-system-arm and binutils-arm-none-eabi (Debian packages of those names).
 # Usage: bash scripts/firmware-cost.sh [STEPS_MEASURED_PER_SCENARIO (default 300)]
 set -euo pipefail
@@ -48,16 +49,19 @@ echo "== instruction trace (QEMU -d exec,nochain -singlestep, filtered to the st
 log=$(mktemp /tmp/fado-firmware-trace.XXXXXX)
 trap 'rm -f "$log" "$run_log"' EXIT
 filter=$(python3 scripts/firmware_cost.py ranges "$image" \
-    estimator_step,paper_kernel_step,paper_kernel_held_step \
+    estimator_step,paper_kernel_step,paper_kernel_held_step,drive_step \
     scenario_marker)
 timeout 900 "${qemu[@]}" -singlestep -d exec,nochain -dfilter "$filter" -D "$log" >/dev/null
 echo "-- fado's step (estimator_step: scenarios 0-1 default, 2-3 fixed R̂s, 4-5 the paper's path,"
 echo "   6-7 the paper's path with the gains held over fado's default period)"
 python3 scripts/firmware_cost.py trace "$image" estimator_step "$log" "$tail_steps" \
-    paper_kernel_step paper_kernel_held_step
+    paper_kernel_step paper_kernel_held_step drive_step
 echo "-- the paper's estimator alone (paper_kernel_step, beside fado's paper's path: scenarios 4-5)"
 python3 scripts/firmware_cost.py trace "$image" paper_kernel_step "$log" "$tail_steps" \
-    estimator_step paper_kernel_held_step
+    estimator_step paper_kernel_held_step drive_step
 echo "-- the same with the gains held (paper_kernel_held_step, beside scenarios 6-7)"
 python3 scripts/firmware_cost.py trace "$image" paper_kernel_held_step "$log" "$tail_steps" \
-    estimator_step paper_kernel_step
+    estimator_step paper_kernel_step drive_step
+echo "-- the whole drive (drive_step: SensorlessDrive<f32>::step, fado's estimator inside; scenario 10)"
+python3 scripts/firmware_cost.py trace "$image" drive_step "$log" "$tail_steps" \
+    estimator_step paper_kernel_step paper_kernel_held_step

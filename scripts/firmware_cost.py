@@ -13,7 +13,10 @@ docs/firmware.md.
   firmware_cost.py trace ELF ROOT TRACE [TAIL [OTHER_ROOT...]]
                                              per-step instructions and cycle estimate of ROOT
                                              (a step ends at ROOT's next entry, or at the entry
-                                             of an OTHER_ROOT traced in the same run)
+                                             of an OTHER_ROOT traced in the same run; only
+                                             instructions of functions reachable from ROOT
+                                             count, so that a function another root shares,
+                                             called by the image between steps, is not)
 
 Cycle model (Cortex-M4 Technical Reference Manual r0p1, table 3-1 "Cortex-M4 instruction
 set summary" and table 7-1 "FPU instruction set"), zero wait states:
@@ -286,6 +289,11 @@ def trace(elf, root, path, tail, lines=False, others=()):
     insns, funcs = disassemble(elf)
     entry = funcs[root][0]
     other_entries = {funcs[o][0] for o in others if o in funcs}
+    # Only ROOT's own call graph counts: the trace filter holds every root's functions, and
+    # one another root shares (memcpy, fminf, ...) may also be called by the image's own code
+    # between two steps, which is not the step's work.
+    calls, _ = call_graph(insns)
+    own = reachable(calls, root)
     marker = funcs["scenario_marker"][0] if "scenario_marker" in funcs else None
     scenarios = []  # list of steps (list of pc lists)
     steps = None
@@ -307,7 +315,7 @@ def trace(elf, root, path, tail, lines=False, others=()):
                 if current is not None and steps is not None:
                     steps.append(current)
                 current = [pc] if pc == entry else None
-            elif current is not None:
+            elif current is not None and pc in insns and insns[pc][3] in own:
                 current.append(pc)
     if current is not None and steps is not None:
         steps.append(current)

@@ -35,6 +35,7 @@
 #![no_std]
 #![no_main]
 
+mod drive_loop;
 mod paper_kernel;
 
 use core::cell::{Cell, OnceCell, RefCell};
@@ -45,8 +46,9 @@ use cortex_m::interrupt::{self, Mutex};
 use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m_rt::{entry, exception};
 use cortex_m_semihosting::{debug, hprintln};
+use drive_loop::DriveApp;
 use fado_core::{
-    Ab, Abc, DriveConfig, DriveOutput, Estimate, EstimatorConfig, EstimatorParams, EstimatorState,
+    Ab, Abc, DriveOutput, Estimate, EstimatorConfig, EstimatorParams, EstimatorState,
     EstimatorTuning, LeanEstimate, MachineModel, Mode, SensorlessDrive, SensorlessEstimator,
 };
 use paper_kernel::{PaperKernel, paper_kernel_held_step, paper_kernel_step};
@@ -336,14 +338,29 @@ struct App {
 
 static APP: Mutex<RefCell<Option<App>>> = Mutex::new(RefCell::new(None));
 
+/// The whole drive around a simulated motor ([`drive_loop`]), run after the estimator's
+/// scenarios.
+static DRIVE: Mutex<RefCell<Option<DriveApp>>> = Mutex::new(RefCell::new(None));
+
 /// The estimator's parameters, written once by `main` before the interrupt runs (index 0 with
 /// the default R̂s adaptation, 1 with the paper's fixed R̂s, 2 the paper's path and 3 the same
 /// with the gains held, 4 the default on a salient motor: see [`PAPER_PATH`],
 /// [`PAPER_PATH_HELD`], [`SALIENT`]); read-only afterwards.
 static PARAMS: Mutex<OnceCell<[EstimatorParams<f32>; 5]>> = Mutex::new(OnceCell::new());
 
-/// Lowest stack pointer seen just before calling [`estimator_step`] (stack measurement).
+/// Lowest stack pointer seen just before calling [`estimator_step`] or [`drive_step`] (stack
+/// measurement).
 static STEP_SP: Mutex<Cell<u32>> = Mutex::new(Cell::new(u32::MAX));
+
+/// Records the stack pointer just before a measured step ([`estimator_step`] or
+/// [`drive_step`]) is called, for the depth below the step's caller.
+fn note_step_sp() {
+    let sp = cortex_m::register::msp::read();
+    interrupt::free(|cs| {
+        let cell = STEP_SP.borrow(cs);
+        cell.set(cell.get().min(sp));
+    });
+}
 
 /// How much stack below the present stack pointer is painted and checked.
 const PAINTED: u32 = 8 * 1024;
@@ -422,11 +439,7 @@ impl App {
             return;
         }
         let (v, i) = self.machine.sample();
-        let sp = cortex_m::register::msp::read();
-        interrupt::free(|cs| {
-            let cell = STEP_SP.borrow(cs);
-            cell.set(cell.get().min(sp));
-        });
+        note_step_sp();
         let out = estimator_step(params, &mut self.state, v, i);
         let kernel = self.kernel.as_mut().map(|k| {
             if self.samples == 0 {
@@ -489,7 +502,19 @@ fn SysTick() {
         {
             app.on_sample(params);
         }
+        drive_sample(cs);
     });
+}
+
+/// The drive scenario's share of the interrupt, out of line: its larger frame is then not
+/// allocated on the estimator scenarios' interrupts (their stack figure is the estimator's).
+#[inline(never)]
+fn drive_sample(cs: &interrupt::CriticalSection) {
+    if let Ok(mut app) = DRIVE.borrow(cs).try_borrow_mut()
+        && let Some(app) = app.as_mut()
+    {
+        app.on_sample();
+    }
 }
 
 #[entry]
@@ -567,25 +592,9 @@ fn main() -> ! {
     if !interrupt::free(|cs| PARAMS.borrow(cs).set(params).is_ok()) {
         exit(false)
     }
-    // The drive's step runs on the target too (see `drive_step`): one sample at standstill.
-    let model = MachineModel::<f32>::paper();
-    let Ok(mut drive) =
-        SensorlessDrive::new(DriveConfig::for_machine(&model), EstimatorTuning::default())
-    else {
-        hprintln!("invalid drive configuration");
-        exit(false)
-    };
-    drive.align(0.0);
-    let out = drive_step(
-        &mut drive,
-        Abc::new(0.0, 0.0, 0.0),
-        model.dc_voltage,
-        core::hint::black_box(0.0),
-    );
     hprintln!(
-        "size_of::<SensorlessDrive<f32>>() = {} B; one drive step: duties finite {}",
-        core::mem::size_of::<SensorlessDrive<f32>>(),
-        out.duty.a.is_finite() && out.duty.b.is_finite() && out.duty.c.is_finite()
+        "size_of::<SensorlessDrive<f32>>() = {} B",
+        core::mem::size_of::<SensorlessDrive<f32>>()
     );
     let mut all_locked = true;
     let (mut deepest_isr, mut deepest_step) = (0, 0);
@@ -685,6 +694,56 @@ fn main() -> ! {
          context included), {} B below the caller of estimator_step",
         deepest_isr,
         deepest_step
+    );
+    // The whole drive in the interrupt, around a simulated motor (scenario SCENARIOS.len()).
+    let Some(drive_app) = DriveApp::new() else {
+        hprintln!("invalid drive configuration");
+        exit(false)
+    };
+    scenario_marker(SCENARIOS.len() as u32);
+    let idle_sp = paint_stack();
+    interrupt::free(|cs| {
+        if let Ok(mut slot) = DRIVE.borrow(cs).try_borrow_mut() {
+            *slot = Some(drive_app);
+        }
+    });
+    let drive_result = loop {
+        cortex_m::asm::wfi();
+        let finished = interrupt::free(|cs| match DRIVE.borrow(cs).try_borrow_mut() {
+            Ok(mut slot) => match slot.as_ref() {
+                Some(app) if app.done => slot.take(),
+                _ => None,
+            },
+            Err(_) => None,
+        });
+        if let Some(app) = finished {
+            break app;
+        }
+    };
+    let lowest = lowest_touched_stack();
+    let deepest_drive = idle_sp - lowest;
+    let drive_sp = interrupt::free(|cs| STEP_SP.borrow(cs).get());
+    let deepest_drive_step = drive_sp.saturating_sub(lowest);
+    let r = &drive_result;
+    let drive_ok = !r.tripped
+        && r.input_faults == 0
+        && r.worst_start < 0.25
+        && r.worst_end < 0.05
+        && (r.speed_rpm - drive_loop::SPEED_RPM).abs() < 0.03 * drive_loop::SPEED_RPM;
+    all_locked &= drive_ok;
+    hprintln!(
+        "scenario {}: the whole drive (SensorlessDrive<f32>, drive_step) around a simulated paper's motor, 0 -> {} r/min, {} x rated torque: worst |θ̂ − θ| {} rad over the ramp, {} rad over the last 0.1 s, speed {} r/min, tripped {}, {} input faults; deepest stack {} B below the idle loop (with the simulated motor's frames), {} B below the caller of drive_step{}",
+        SCENARIOS.len(),
+        drive_loop::SPEED_RPM,
+        drive_loop::LOAD_RATIO,
+        r.worst_start,
+        r.worst_end,
+        r.speed_rpm,
+        r.tripped,
+        r.input_faults,
+        deepest_drive,
+        deepest_drive_step,
+        if drive_ok { "" } else { "  FAILED" }
     );
     scenario_marker(u32::MAX);
     exit(all_locked)
