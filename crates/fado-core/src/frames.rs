@@ -92,7 +92,7 @@ impl<T: Real> Ab<T> {
     /// Magnitude.
     #[inline]
     pub fn norm(self) -> T {
-        self.norm_squared().sqrt()
+        self.norm_squared().step_sqrt()
     }
 
     /// Angle `atan2(β, α)` in (−π, π].
@@ -174,7 +174,7 @@ impl<T: Real> Dq<T> {
     /// Magnitude.
     #[inline]
     pub fn norm(self) -> T {
-        (self.d * self.d + self.q * self.q).sqrt()
+        (self.d * self.d + self.q * self.q).step_sqrt()
     }
 
     /// True when both components are finite.

@@ -57,7 +57,7 @@ impl<T: Real> CurrentInjection<T> {
     pub fn step(&self, iq_ref: T) -> T {
         let rest = self.i_min * self.i_min - iq_ref * iq_ref;
         if rest > T::zero() {
-            rest.sqrt()
+            rest.step_sqrt()
         } else {
             T::zero()
         }

@@ -195,7 +195,7 @@ impl<T: Real> MachineModel<T> {
 
     /// True when Ld and Lq differ by more than 2 % (an interior-magnet rotor).
     pub fn is_salient(&self) -> bool {
-        (self.lq - self.ld).abs() > T::lit(0.02) * self.ld.max(self.lq)
+        (self.lq - self.ld).abs() > T::lit(0.02) * self.ld.step_max(self.lq)
     }
 
     /// The maximum-torque-per-ampere d current for a q current `i_q` (Morimoto et al.,
@@ -212,7 +212,7 @@ impl<T: Real> MachineModel<T> {
         }
         let a = self.flux_linkage / (T::lit(2.0) * dl);
         let h = i_q * i_q;
-        -h / (a + (a * a + h).sqrt())
+        -h / (a + (a * a + h).step_sqrt())
     }
 }
 

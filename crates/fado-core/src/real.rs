@@ -28,6 +28,13 @@ pub trait Real: RealField + Copy + Default {
     /// √x for x ≥ 0, as the estimator's step computes it: `libm` for `f64`,
     /// [`crate::approx::sqrt`] for `f32` (within 1 ulp).
     fn step_sqrt(self) -> Self;
+    /// The larger of `self` and `y`, as the drive's step computes it: `f64`'s `max` (IEEE
+    /// maxNum, a NaN operand ignored); for `f32` a compare and a select (`if self > y`), which
+    /// gives `y` when either is NaN. On a Cortex-M4F (no VMAXNM) `f32::max` is a call of
+    /// `libm`'s `fmaxf`, 10–20 cycles; the select is 2–3 (docs/firmware.md, "Eleventh session").
+    fn step_max(self, y: Self) -> Self;
+    /// The smaller of `self` and `y`: as [`Real::step_max`] (`f32`: `if self < y`).
+    fn step_min(self, y: Self) -> Self;
     /// How the T2S trackers keep their angles ([`crate::tracker`]): `f64` as a float in
     /// [−π, π] wrapped by [`wrap_angle`] (the paper's recursion as written), `f32` as wrapping
     /// fixed point, an `i32` with 2³² units = 2π, wrapped by integer overflow (no compare or
@@ -119,6 +126,14 @@ impl Real for f32 {
     fn step_sqrt(self) -> Self {
         crate::approx::sqrt(self)
     }
+    #[inline(always)]
+    fn step_max(self, y: Self) -> Self {
+        if self > y { self } else { y }
+    }
+    #[inline(always)]
+    fn step_min(self, y: Self) -> Self {
+        if self < y { self } else { y }
+    }
 }
 
 impl Real for f64 {
@@ -182,6 +197,14 @@ impl Real for f64 {
     #[inline(always)]
     fn step_sqrt(self) -> Self {
         nalgebra::ComplexField::sqrt(self)
+    }
+    #[inline(always)]
+    fn step_max(self, y: Self) -> Self {
+        RealField::max(self, y)
+    }
+    #[inline(always)]
+    fn step_min(self, y: Self) -> Self {
+        RealField::min(self, y)
     }
 }
 

@@ -209,7 +209,7 @@ impl<T: Real> CurrentController<T> {
             return Err(NonFiniteInput);
         }
         let v = self.step(reference, measured, omega)?;
-        let v_max = v_max.max(T::zero());
+        let v_max = v_max.step_max(T::zero());
         let n = v.norm();
         let limited = if n > v_max { v * (v_max / n) } else { v };
         self.realised(limited);

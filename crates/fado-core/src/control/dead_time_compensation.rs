@@ -264,7 +264,10 @@ impl<T: Real> DeadTimeCompensation<T> {
         // Pole voltages the modulator will realise: reference + first-guess compensation,
         // min-max zero sequence (SVPWM), as offsets from the DC-link mid-point.
         let mut vp = [v_abc.a + first.a, v_abc.b + first.b, v_abc.c + first.c];
-        let (mx, mn) = (vp[0].max(vp[1]).max(vp[2]), vp[0].min(vp[1]).min(vp[2]));
+        let (mx, mn) = (
+            vp[0].step_max(vp[1]).step_max(vp[2]),
+            vp[0].step_min(vp[1]).step_min(vp[2]),
+        );
         let v0 = -(mx + mn) * T::lit(0.5);
         for v in &mut vp {
             *v += v0;
@@ -283,7 +286,7 @@ impl<T: Real> DeadTimeCompensation<T> {
             if opposes {
                 td
             } else {
-                td * (one - ie.abs() * band).max(zero)
+                td * (one - ie.abs() * band).step_max(zero)
             }
         };
         // Phase axes u_x and the current response L⁻¹·w of a volt-second vector w (α-β, the
@@ -303,8 +306,8 @@ impl<T: Real> DeadTimeCompensation<T> {
         let mut d_rise = i.map(|x| delay(true, x));
         let mut d_fall = i.map(|x| delay(false, x));
         for _ in 0..2 {
-            let pr = [0, 1, 2].map(|k| (tg_rise[k] + d_rise[k]).min(half));
-            let pf = [0, 1, 2].map(|k| (tg_fall[k] + d_fall[k]).min(half));
+            let pr = [0, 1, 2].map(|k| (tg_rise[k] + d_rise[k]).step_min(half));
+            let pf = [0, 1, 2].map(|k| (tg_fall[k] + d_fall[k]).step_min(half));
             // Volt-seconds over each half: poles low → high at pr while the carrier falls,
             // high → low at pf while it rises (zero vectors at the samples).
             let (mut int_r, mut int_f) = (Ab::zero(), Ab::zero());
@@ -324,8 +327,8 @@ impl<T: Real> DeadTimeCompensation<T> {
                 let (mut wr, mut wf) = (vbar * -tg_rise[x], vbar * -tg_fall[x]);
                 for k in 0..3 {
                     if k != x {
-                        wr += axes[k] * (pole_step * (tg_rise[x] - pr[k]).max(zero));
-                        wf += axes[k] * (-pole_step * (tg_fall[x] - pf[k]).max(zero));
+                        wr += axes[k] * (pole_step * (tg_rise[x] - pr[k]).step_max(zero));
+                        wf += axes[k] * (-pole_step * (tg_fall[x] - pf[k]).step_max(zero));
                     }
                 }
                 let ie_r = i[x] + axes[x].dot(respond(wr) - half_swing);

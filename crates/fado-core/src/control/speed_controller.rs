@@ -65,10 +65,10 @@ impl<T: Real> SpeedControllerConfig<T> {
         let dl = m.lq - m.ld;
         let torque_limit = if tuning.mtpa && m.is_salient() && dl > T::zero() {
             let lf = m.flux_linkage;
-            let id = (lf - (lf * lf + T::lit(8.0) * dl * dl * i_max * i_max).sqrt())
+            let id = (lf - (lf * lf + T::lit(8.0) * dl * dl * i_max * i_max).step_sqrt())
                 / (T::lit(4.0) * dl);
-            let iq = (i_max * i_max - id * id).max(T::zero()).sqrt();
-            (m.active_flux(id) * iq / lf).max(i_max)
+            let iq = (i_max * i_max - id * id).step_max(T::zero()).step_sqrt();
+            (m.active_flux(id) * iq / lf).step_max(i_max)
         } else {
             i_max
         };
@@ -177,7 +177,7 @@ impl<T: Real> SpeedController<T> {
 #[inline]
 pub fn limit_current_d_priority<T: Real>(i_dq: Dq<T>, i_max: T) -> Dq<T> {
     let d = crate::control::pi::clamp(i_dq.d, -i_max, i_max);
-    let room = (i_max * i_max - d * d).max(T::zero()).sqrt();
+    let room = (i_max * i_max - d * d).step_max(T::zero()).step_sqrt();
     Dq::new(d, crate::control::pi::clamp(i_dq.q, -room, room))
 }
 

@@ -242,7 +242,7 @@ impl<T: Real> StandstillProbe<T> {
         );
         let bound = T::lit(MAX_READING);
         let reading = if reading.is_finite() {
-            reading.max(-bound).min(bound)
+            reading.step_max(-bound).step_min(bound)
         } else {
             T::zero()
         };
