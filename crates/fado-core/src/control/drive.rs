@@ -686,7 +686,7 @@ pub(crate) fn swing_time_constant<T: Real>(m: &MachineModel<T>, i_d: T) -> T {
     let disc = c * c - T::lit(4.0) * m.inertia * k;
     let two_j = m.inertia + m.inertia;
     if disc > T::zero() {
-        two_j / (c - disc.sqrt())
+        two_j / (c - disc.step_sqrt())
     } else {
         two_j / c
     }
@@ -1669,7 +1669,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         // factors at construction, so that the step does no integer-to-float or
         // double-precision arithmetic).
         let reluctance_flux = (m.ld - m.lq) * i_ref.d;
-        let band = self.resolved.stall_speed.max(
+        let band = self.resolved.stall_speed.step_max(
             self.resolved.stall_torque_band * ((m.flux_linkage + reluctance_flux) * i_ref.q).abs(),
         ) + self.resolved.stall_reluctance_band * (reluctance_flux * i_ref.q).abs();
         let off_reference = speed_error.abs() > band;
