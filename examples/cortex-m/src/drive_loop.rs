@@ -103,6 +103,18 @@ impl Motor {
     }
 }
 
+/// What the run records ([`DriveApp::result`]).
+#[derive(Clone, Copy)]
+pub struct DriveResult {
+    /// Worst |θ̂ − θ| (rad) over the start (to the end of the ramp) and over the last 0.1 s.
+    pub worst_start: f32,
+    pub worst_end: f32,
+    /// Speed at the end (r/min).
+    pub speed_rpm: f32,
+    pub tripped: bool,
+    pub input_faults: u32,
+}
+
 /// The drive, its motor and what the run records.
 pub struct DriveApp {
     drive: SensorlessDrive<f32>,
@@ -113,13 +125,11 @@ pub struct DriveApp {
     ts: f32,
     samples: u32,
     total_samples: u32,
-    /// Worst |θ̂ − θ| (rad) over the start (to the end of the ramp) and over the last 0.1 s.
-    pub worst_start: f32,
-    pub worst_end: f32,
-    /// Speed at the end (r/min).
-    pub speed_rpm: f32,
-    pub tripped: bool,
-    pub input_faults: u32,
+    worst_start: f32,
+    worst_end: f32,
+    speed_rpm: f32,
+    tripped: bool,
+    input_faults: u32,
     pub done: bool,
 }
 
@@ -168,6 +178,17 @@ impl DriveApp {
             input_faults: 0,
             done: false,
         })
+    }
+
+    /// What the run recorded.
+    pub fn result(&self) -> DriveResult {
+        DriveResult {
+            worst_start: self.worst_start,
+            worst_end: self.worst_end,
+            speed_rpm: self.speed_rpm,
+            tripped: self.tripped,
+            input_faults: self.input_faults,
+        }
     }
 
     /// The interrupt's work for one sample: sample the currents, step the drive, record,

@@ -710,8 +710,14 @@ fn main() -> ! {
     let drive_result = loop {
         cortex_m::asm::wfi();
         let finished = interrupt::free(|cs| match DRIVE.borrow(cs).try_borrow_mut() {
+            // The result alone leaves the cell (moving the whole `DriveApp` out would be a
+            // `memcpy`, a function the drive's step shares, counted as the step's work).
             Ok(mut slot) => match slot.as_ref() {
-                Some(app) if app.done => slot.take(),
+                Some(app) if app.done => {
+                    let result = app.result();
+                    *slot = None;
+                    Some(result)
+                }
                 _ => None,
             },
             Err(_) => None,
