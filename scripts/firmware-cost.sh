@@ -49,19 +49,18 @@ echo "== instruction trace (QEMU -d exec,nochain -singlestep, filtered to the st
 log=$(mktemp /tmp/fado-firmware-trace.XXXXXX)
 trap 'rm -f "$log" "$run_log"' EXIT
 filter=$(python3 scripts/firmware_cost.py ranges "$image" \
-    estimator_step,paper_kernel_step,paper_kernel_held_step,drive_step \
-    scenario_marker)
+    estimator_step,paper_kernel_step,paper_kernel_held_step,drive_step scenario_marker)
 timeout 900 "${qemu[@]}" -singlestep -d exec,nochain -dfilter "$filter" -D "$log" >/dev/null
-echo "-- fado's step (estimator_step: scenarios 0-1 default, 2-3 fixed R̂s, 4-5 the paper's path,"
-echo "   6-7 the paper's path with the gains held over fado's default period)"
-python3 scripts/firmware_cost.py trace "$image" estimator_step "$log" "$tail_steps" \
-    paper_kernel_step paper_kernel_held_step drive_step
-echo "-- the paper's estimator alone (paper_kernel_step, beside fado's paper's path: scenarios 4-5)"
-python3 scripts/firmware_cost.py trace "$image" paper_kernel_step "$log" "$tail_steps" \
-    estimator_step paper_kernel_held_step drive_step
-echo "-- the same with the gains held (paper_kernel_held_step, beside scenarios 6-7)"
-python3 scripts/firmware_cost.py trace "$image" paper_kernel_held_step "$log" "$tail_steps" \
-    estimator_step paper_kernel_step drive_step
-echo "-- the whole drive (drive_step: SensorlessDrive<f32>::step, fado's estimator inside; scenario 10)"
-python3 scripts/firmware_cost.py trace "$image" drive_step "$log" "$tail_steps" \
-    estimator_step paper_kernel_step paper_kernel_held_step
+roots=(estimator_step paper_kernel_step paper_kernel_held_step drive_step)
+titles=(
+    "fado's step (estimator_step: scenarios 0-1 default, 2-3 fixed R̂s, 4-5 the paper's path, 6-7 the paper's path with the gains held over fado's default period, 8-9 a salient IPMSM)"
+    "the paper's estimator alone (paper_kernel_step, beside fado's paper's path: scenarios 4-5)"
+    "the same with the gains held (paper_kernel_held_step, beside scenarios 6-7)"
+    "the whole drive (drive_step: SensorlessDrive<f32>::step, fado's estimator inside; scenario 10)"
+)
+# Each root's steps end at the entry of any other root traced in the same run.
+for k in "${!roots[@]}"; do
+    echo "-- ${titles[$k]}"
+    python3 scripts/firmware_cost.py trace "$image" "${roots[$k]}" "$log" "$tail_steps" \
+        "${roots[@]:0:$k}" "${roots[@]:$((k + 1))}"
+done

@@ -29,8 +29,8 @@ pub trait Real: RealField + Copy + Default {
     /// [`crate::approx::sqrt`] for `f32` (within 1 ulp).
     fn step_sqrt(self) -> Self;
     /// The larger of `self` and `y`, as the drive's step computes it: `f64`'s `max` (IEEE
-    /// maxNum, a NaN operand ignored); for `f32` a compare and a select (`if self > y`), which
-    /// gives `y` when either is NaN. On a Cortex-M4F (no VMAXNM) `f32::max` is a call of
+    /// maxNum, a NaN operand ignored); for `f32` a compare and a select ([`max`]: `if self > y`),
+    /// which gives `y` when either is NaN. On a Cortex-M4F (no VMAXNM) `f32::max` is a call of
     /// `libm`'s `fmaxf`, 10–20 cycles; the select is 2–3 (docs/firmware.md, "Eleventh session").
     fn step_max(self, y: Self) -> Self;
     /// The smaller of `self` and `y`: as [`Real::step_max`] (`f32`: `if self < y`).
@@ -128,11 +128,11 @@ impl Real for f32 {
     }
     #[inline(always)]
     fn step_max(self, y: Self) -> Self {
-        if self > y { self } else { y }
+        max(self, y)
     }
     #[inline(always)]
     fn step_min(self, y: Self) -> Self {
-        if self < y { self } else { y }
+        min(self, y)
     }
 }
 

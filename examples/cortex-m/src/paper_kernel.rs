@@ -179,21 +179,24 @@ impl PaperKernel {
     }
 }
 
-/// One sample of the paper's estimator (Fig. 5): `v_ab` the voltage over the last interval,
-/// `i_ab` the current now; returns θ̂ (rad, in [−π, π]).
-#[inline(never)]
-// Unmangled in the image, where the cost script finds it by name; the host build
-// (`crates/fado-core/examples/step_driver.rs`, `ESTIMATOR=paper-kernel`) has no such need.
-#[cfg_attr(target_os = "none", unsafe(no_mangle))]
-pub fn paper_kernel_step(k: &mut PaperKernel, v_ab: Ab<f32>, i_ab: Ab<f32>) -> f32 {
+/// a, ℓ1, ℓ2 of eq. (16), the gains the observer's update uses.
+struct Gains {
+    a: Ab<f32>,
+    l1: Ab<f32>,
+    l2: Ab<f32>,
+}
+
+/// The sample both kernels compute, with the observer's gains (16) `g` (a, ℓ1, ℓ2) given:
+/// formed for this sample ([`paper_kernel_step`]) or held ([`paper_kernel_held_step`]).
+#[inline(always)]
+fn kernel_sample(k: &mut PaperKernel, v_ab: Ab<f32>, i_ab: Ab<f32>, g: &Gains) -> f32 {
     let (va, vb, ia, ib) = (v_ab.alpha, v_ab.beta, i_ab.alpha, i_ab.beta);
     // Flux integrator, eq. (21)/(24): λ1 += Ts·(v − R̂s·ī − feedback).
     let da = (ia + k.i_prev_a) * 0.5;
     let db = (ib + k.i_prev_b) * 0.5;
     let l1a = k.lambda1_a + (va - da * k.rs - k.fb_a) * k.ts;
     let l1b = k.lambda1_b + (vb - db * k.rs - k.fb_b) * k.ts;
-    // Disturbance observer, eq. (10) with the gains (16) at ω̂1.
-    let g = DiscreteGains::new(k.omega1, k.ts);
+    // Disturbance observer, eq. (10) with the gains (16) `g`.
     let (ea, eb) = (l1a - k.z_a, l1b - k.z_b);
     let (wa, wb) = (k.z_a - k.d_a, k.z_b - k.d_b);
     let za = k.d_a + (g.a.alpha * wa - g.a.beta * wb) + (g.l1.alpha * ea - g.l1.beta * eb);
@@ -254,6 +257,26 @@ pub fn paper_kernel_step(k: &mut PaperKernel, v_ab: Ab<f32>, i_ab: Ab<f32>) -> f
     theta1 as f32 * RAD_PER_UNIT
 }
 
+/// One sample of the paper's estimator (Fig. 5): `v_ab` the voltage over the last interval,
+/// `i_ab` the current now; returns θ̂ (rad, in [−π, π]).
+#[inline(never)]
+// Unmangled in the image, where the cost script finds it by name; the host build
+// (`crates/fado-core/examples/step_driver.rs`, `ESTIMATOR=paper-kernel`) has no such need.
+#[cfg_attr(target_os = "none", unsafe(no_mangle))]
+pub fn paper_kernel_step(k: &mut PaperKernel, v_ab: Ab<f32>, i_ab: Ab<f32>) -> f32 {
+    let g = DiscreteGains::new(k.omega1, k.ts);
+    kernel_sample(
+        k,
+        v_ab,
+        i_ab,
+        &Gains {
+            a: g.a,
+            l1: g.l1,
+            l2: g.l2,
+        },
+    )
+}
+
 /// [`paper_kernel_step`] with the observer's gains (16) held over `observer_gain_period`, as
 /// fado holds them by default (0.4 ms: formed once in four samples at 10 kHz, at the end of
 /// the sample, from the new ω̂ of T2S-1): the floor of the method at fado's default gain
@@ -263,80 +286,21 @@ pub fn paper_kernel_step(k: &mut PaperKernel, v_ab: Ab<f32>, i_ab: Ab<f32>) -> f
 // (`crates/fado-core/examples/step_driver.rs`, `ESTIMATOR=paper-kernel`) has no such need.
 #[cfg_attr(target_os = "none", unsafe(no_mangle))]
 pub fn paper_kernel_held_step(k: &mut PaperKernel, v_ab: Ab<f32>, i_ab: Ab<f32>) -> f32 {
-    let (va, vb, ia, ib) = (v_ab.alpha, v_ab.beta, i_ab.alpha, i_ab.beta);
-    // Flux integrator, eq. (21)/(24): λ1 += Ts·(v − R̂s·ī − feedback).
-    let da = (ia + k.i_prev_a) * 0.5;
-    let db = (ib + k.i_prev_b) * 0.5;
-    let l1a = k.lambda1_a + (va - da * k.rs - k.fb_a) * k.ts;
-    let l1b = k.lambda1_b + (vb - db * k.rs - k.fb_b) * k.ts;
-    // Disturbance observer, eq. (10) with the gains (16) at ω̂1.
-    let (ga, gl1, gl2) = (k.g_a, k.g_l1, k.g_l2);
-    let (ea, eb) = (l1a - k.z_a, l1b - k.z_b);
-    let (wa, wb) = (k.z_a - k.d_a, k.z_b - k.d_b);
-    let za = k.d_a + (ga.alpha * wa - ga.beta * wb) + (gl1.alpha * ea - gl1.beta * eb);
-    let zb = k.d_b + (ga.alpha * wb + ga.beta * wa) + (gl1.alpha * eb + gl1.beta * ea);
-    let dna = k.d_a + (gl2.alpha * ea - gl2.beta * eb);
-    let dnb = k.d_b + (gl2.alpha * eb + gl2.beta * ea);
-    // λ2 = λ1 − D̂ (20), λ̂r = λ2 − L̂q·i (5), θm = ∠λ̂r (6).
-    let ra = (l1a - dna) - ia * k.lq;
-    let rb = (l1b - dnb) - ib * k.lq;
-    let theta_m = (atan2(rb, ra) * UNITS_PER_RAD) as i32;
-    // T2S-1 and T2S-2 (Fig. 1), fixed point: e = θm − θ̂⁻, ω̂ += Ki·Ts·e, θ̂ = θ̂⁻ + Kp·Ts·e,
-    // θ̂⁻ = θ̂ + Ts·ω̂, e in units (the unit conversions are in the gains).
-    let e1 = theta_m.wrapping_sub(k.pred1) as f32;
-    let omega1 = k.omega1 + k.ki_ts1 * e1;
-    let theta1 = k.pred1.wrapping_add((k.kp_ts1 * e1) as i32);
-    let e2 = theta_m.wrapping_sub(k.pred2) as f32;
-    let omega2 = k.omega2 + k.ki_ts2 * e2;
-    let theta2 = k.pred2.wrapping_add((k.kp_ts2 * e2) as i32);
-    k.pred1 = theta1.wrapping_add((k.ts_units * omega1) as i32);
-    k.pred2 = theta2.wrapping_add((k.ts_units * omega2) as i32);
-    k.omega1 = omega1;
-    k.omega2 = omega2;
+    let held = Gains {
+        a: k.g_a,
+        l1: k.g_l1,
+        l2: k.g_l2,
+    };
+    let theta = kernel_sample(k, v_ab, i_ab, &held);
     // The gains for the next samples' speed, once every `gain_hold` + 1 samples.
     if k.gain_countdown == 0 {
-        let g = DiscreteGains::new(omega1, k.ts);
+        let g = DiscreteGains::new(k.omega1, k.ts);
         (k.g_a, k.g_l1, k.g_l2) = (g.a, g.l1, g.l2);
         k.gain_countdown = k.gain_hold;
     } else {
         k.gain_countdown -= 1;
     }
-    // Mode (Fig. 3) with hysteresis, and the feedback for the next sample.
-    let w = omega2.abs();
-    // (`!(w < leave)`, not `w >= leave`: a NaN keeps the mode, as in fado.)
-    #[allow(clippy::neg_cmp_op_on_partial_ord)]
-    let kdf_mode = if k.kdf_mode {
-        !(w < k.leave)
-    } else {
-        w > k.enter
-    };
-    k.kdf_mode = kdf_mode;
-    if kdf_mode {
-        // k_df·D̂ (21).
-        k.fb_a = dna * k.k_df;
-        k.fb_b = dnb * k.k_df;
-    } else {
-        // The limiter (24)-(25): k_af·(|λ̂r| − ρ)·λ̂r/|λ̂r| outside the circle.
-        let n2 = ra * ra + rb * rb;
-        if n2 > k.radius_sq {
-            let n = fado_core::approx::sqrt(n2);
-            let s = k.k_af * (n - k.radius) / n;
-            k.fb_a = ra * s;
-            k.fb_b = rb * s;
-        } else {
-            k.fb_a = 0.0;
-            k.fb_b = 0.0;
-        }
-    }
-    k.lambda1_a = l1a;
-    k.lambda1_b = l1b;
-    k.i_prev_a = ia;
-    k.i_prev_b = ib;
-    k.z_a = za;
-    k.z_b = zb;
-    k.d_a = dna;
-    k.d_b = dnb;
-    theta1 as f32 * RAD_PER_UNIT
+    theta
 }
 
 impl PaperKernel {
