@@ -29,7 +29,7 @@ pub trait Real: RealField + Copy + Default {
     /// [`crate::approx::sqrt`] for `f32` (within 1 ulp).
     fn step_sqrt(self) -> Self;
     /// The larger of `self` and `y`, as the drive's step computes it: `f64`'s `max` (IEEE
-    /// maxNum, a NaN operand ignored); for `f32` a compare and a select ([`max`]: `if self > y`),
+    /// maxNum, a NaN operand ignored); for `f32` a compare and a select (`real::max`: `if self > y`),
     /// which gives `y` when either is NaN. On a Cortex-M4F (no VMAXNM) `f32::max` is a call of
     /// `libm`'s `fmaxf`, 10–20 cycles; the select is 2–3 (docs/firmware.md, "Eleventh session").
     fn step_max(self, y: Self) -> Self;
