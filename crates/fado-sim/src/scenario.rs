@@ -35,6 +35,9 @@ pub struct Scenario {
     /// so that the scenario runs for any motor; otherwise it is the paper's in absolute
     /// units (r/min, N·m of its motor).
     pub scaled: bool,
+    /// Judges nothing of its own, not even a trip: only the user's `[criteria]` (the
+    /// `custom` scenario). Left out of `compare`'s default scenario list.
+    pub neutral: bool,
     /// Sets the profile, load, duration and evaluation window on a configuration (a scaled
     /// scenario from its `[motor]` ratings).
     pub setup: fn(&mut SimConfig),
@@ -59,7 +62,7 @@ impl Eq for Scenario {}
 /// staircase; then the paper's experiments scaled by the motor's ratings (its motor: 1500
 /// r/min, 11.5 N·m), which run for any motor: `reversal` (Fig. 11), `stops` (Fig. 12) and
 /// `rated-reversal` (Fig. 11 under the rated torque).
-pub const SCENARIOS: [Scenario; 10] = [
+pub const SCENARIOS: [Scenario; 11] = [
     Scenario {
         name: "fig8",
         title: "Flux and disturbance estimation under 2 N·m (Fig. 8)",
@@ -68,6 +71,7 @@ pub const SCENARIOS: [Scenario; 10] = [
                     revolution spent above 30 r/min in HI mode < 2 % of λf; no trip; \
                     speed error < 30 r/min",
         scaled: false,
+        neutral: false,
         setup: setup_fig8,
         observe: observe_nothing,
         checks: checks_fig8,
@@ -80,6 +84,7 @@ pub const SCENARIOS: [Scenario; 10] = [
         criterion: "λ1 drifts while off (|ΔD̂| > 2 mWb) and recovers with τ ≈ 2 s \
                     (residual after 2 s in [0.2, 0.55]); |θ − θ̂| < 0.05 rad",
         scaled: false,
+        neutral: false,
         setup: setup_fig9,
         observe: observe_nothing,
         checks: checks_fig9,
@@ -91,6 +96,7 @@ pub const SCENARIOS: [Scenario; 10] = [
         criterion: "|θ − θ̂| < 0.35 rad (does not diverge); |λ̂r| ≤ 1.15·λ̂f (+1 %); \
                     FLAG_limit high ≥ 95 % of the hold",
         scaled: false,
+        neutral: false,
         setup: setup_fig10,
         observe: observe_fig10,
         checks: checks_fig10,
@@ -102,6 +108,7 @@ pub const SCENARIOS: [Scenario; 10] = [
         criterion: "|θ − θ̂| < 0.25 rad near zero speed (|n| < 30 r/min) [P]; no trip; \
                     speed error < 30 r/min",
         scaled: false,
+        neutral: false,
         setup: setup_fig11,
         observe: observe_nothing,
         checks: checks_reversal,
@@ -113,6 +120,7 @@ pub const SCENARIOS: [Scenario; 10] = [
                   0 → 60, 500 ms at 60)",
         criterion: "no trip or instability [P]; |θ − θ̂| < 0.25 rad [A]; speed error < 30 r/min",
         scaled: false,
+        neutral: false,
         setup: setup_fig12,
         observe: observe_nothing,
         checks: checks_stops,
@@ -123,6 +131,7 @@ pub const SCENARIOS: [Scenario; 10] = [
         profile: "0 → 300 r/min in 1 s, T_L → 7.5 N·m over [1.5 s, 2 s], hold to 4 s",
         criterion: "settled (from 2.5 s) |θ − θ̂| < 0.05 rad; speed error < 10 r/min; no trip",
         scaled: false,
+        neutral: false,
         setup: setup_steady300,
         observe: observe_nothing,
         checks: checks_steady300,
@@ -137,6 +146,7 @@ pub const SCENARIOS: [Scenario; 10] = [
                     the lowest level held together with every level above it; the scenario \
                     passes when every level is held",
         scaled: false,
+        neutral: false,
         setup: setup_lowspeed,
         observe: observe_lowspeed,
         checks: checks_lowspeed,
@@ -149,6 +159,7 @@ pub const SCENARIOS: [Scenario; 10] = [
         criterion: "|θ − θ̂| < 0.25 rad near zero speed (|n| < 2 % of rated) [P]; no trip; \
                     speed error < 2 % of rated speed",
         scaled: true,
+        neutral: false,
         setup: setup_reversal,
         observe: observe_nothing,
         checks: checks_reversal,
@@ -161,6 +172,7 @@ pub const SCENARIOS: [Scenario; 10] = [
         criterion: "no trip or instability [P]; |θ − θ̂| < 0.25 rad [A]; speed error < 2 % \
                     of rated speed",
         scaled: true,
+        neutral: false,
         setup: setup_stops,
         observe: observe_nothing,
         checks: checks_stops,
@@ -171,9 +183,22 @@ pub const SCENARIOS: [Scenario; 10] = [
         profile: "as `reversal` with T_L → 100 % of rated torque",
         criterion: "as `reversal`",
         scaled: true,
+        neutral: false,
         setup: setup_rated_reversal,
         observe: observe_nothing,
         checks: checks_reversal,
+    },
+    Scenario {
+        name: "custom",
+        title: "The user's own experiment: `[speed_reference]`, `[load]`, `[criteria]`",
+        profile: "the configuration's `[speed_reference] points` and `[load]`; it runs to 1 s \
+                  after the last breakpoint unless `[simulation] duration` is given",
+        criterion: "only the `[criteria]` written (none: it reports and passes)",
+        scaled: false,
+        neutral: true,
+        setup: setup_custom,
+        observe: observe_nothing,
+        checks: checks_nothing,
     },
 ];
 
@@ -242,8 +267,13 @@ impl Scenario {
 
     /// Checks the pass criteria on a finished run.
     pub fn evaluate(&self, cfg: &SimConfig, m: &Metrics, p: &ScenarioProbe) -> Vec<Check> {
-        let mut checks = vec![Check::at_most("tripped", m.tripped as u8 as f64, 0.0)];
+        let mut checks = if self.neutral {
+            Vec::new()
+        } else {
+            vec![Check::at_most("tripped", m.tripped as u8 as f64, 0.0)]
+        };
         (self.checks)(cfg, m, p, &mut checks);
+        checks.extend(cfg.criteria.checks(cfg.motor.rated_speed_rpm, m));
         checks
     }
 }
@@ -267,6 +297,26 @@ fn observe_lowspeed(cfg: &SimConfig, p: &mut ScenarioProbe) {
         })
         .collect();
 }
+
+/// `custom`: the user's profiles as they are; the run lasts until 1 s after the last
+/// breakpoint of the speed reference or the load (the user's `[simulation] duration`, applied
+/// after this, wins).
+fn setup_custom(c: &mut SimConfig) {
+    let end = [
+        c.speed_reference.end_time(),
+        c.load.torque.end_time(),
+        c.load.speed_rpm.end_time(),
+    ]
+    .into_iter()
+    .fold(0.0, f64::max);
+    c.simulation.duration = end + CUSTOM_TAIL_SECONDS;
+}
+
+/// What `custom` runs after the last breakpoint of its profiles, s: the settling of a step.
+pub const CUSTOM_TAIL_SECONDS: f64 = 1.0;
+
+/// No criterion of the scenario's own.
+fn checks_nothing(_cfg: &SimConfig, _m: &Metrics, _p: &ScenarioProbe, _checks: &mut Vec<Check>) {}
 
 /// `fig8`: profile, load, duration, evaluation window.
 fn setup_fig8(c: &mut SimConfig) {
@@ -547,7 +597,7 @@ pub struct Check {
 }
 
 impl Check {
-    fn at_most(name: &str, value: f64, max: f64) -> Self {
+    pub(crate) fn at_most(name: &str, value: f64, max: f64) -> Self {
         Self {
             name: name.into(),
             value,
@@ -556,7 +606,7 @@ impl Check {
             passed: value <= max,
         }
     }
-    fn at_least(name: &str, value: f64, min: f64) -> Self {
+    pub(crate) fn at_least(name: &str, value: f64, min: f64) -> Self {
         Self {
             name: name.into(),
             value,
@@ -838,6 +888,10 @@ pub struct Report {
     pub max_speed_error_rpm: f64,
     /// Tripped.
     pub tripped: bool,
+    /// Highest true DC-link voltage over the run, V.
+    pub max_dc_voltage: f64,
+    /// Lowest true DC-link voltage over the run, V.
+    pub min_dc_voltage: f64,
     /// Simulated seconds.
     pub simulated_seconds: f64,
     /// Wall seconds.
@@ -863,6 +917,8 @@ impl Outcome {
             zero_speed_band_rpm: m.zero_speed_band_rpm,
             max_speed_error_rpm: m.max_speed_error_rpm,
             tripped: m.tripped,
+            max_dc_voltage: m.max_dc_voltage,
+            min_dc_voltage: m.min_dc_voltage,
             simulated_seconds: self.stats.simulated_seconds,
             wall_seconds: self.stats.wall_seconds,
             checks: self.checks.clone(),
