@@ -26,6 +26,7 @@
 //! 9. The status word [`DriveFlags`] of the sample is formed and counted.
 
 use crate::control::current_controller::{CurrentController, CurrentControllerConfig};
+use crate::control::dc_link_limit::{DcLinkLimit, DcLinkTuning};
 use crate::control::dead_time_compensation::{
     DeadTimeCompensation, DeadTimeCompensationConfig, DeadTimeMethod,
 };
@@ -193,6 +194,13 @@ pub struct DriveTuning<T> {
     /// A DC-link reading above this multiple of the nominal DC-link voltage is refused like a
     /// non-finite sample. Default [`crate::plausibility::VOLTAGE_RATIO`] (1.5) \[A\].
     pub dc_link_max_ratio: T,
+    /// The DC-link limits: source current limits, over-voltage controller and trip
+    /// (`[controller.dc_link]`, see [`DcLinkTuning`]).
+    #[cfg_attr(
+        feature = "serde",
+        serde(bound(deserialize = "T: Real + serde::Deserialize<'de>"))
+    )]
+    pub dc_link: DcLinkTuning<T>,
     /// Reaction to the estimator's [`LockStatus::Lost`] (`DriveFlags::LOCK_LOST`) and, with
     /// `lock_reaction_on_stall`, to the stall symptom (`DriveFlags::STALLED`). Default report
     /// only \[A\] (the paper's behaviour plus the flags).
@@ -444,6 +452,7 @@ impl<T: Real> DriveTuning<T> {
             input_fault_trip_time: U::lit(self.input_fault_trip_time.to_f64()),
             plausible_current_ratio: U::lit(self.plausible_current_ratio.to_f64()),
             dc_link_max_ratio: U::lit(self.dc_link_max_ratio.to_f64()),
+            dc_link: self.dc_link.cast(),
             lock_reaction: self.lock_reaction,
             lock_reaction_on_stall: self.lock_reaction_on_stall,
             lock_recovery_time: U::lit(self.lock_recovery_time.to_f64()),
@@ -513,6 +522,7 @@ impl<T: Real> Default for DriveTuning<T> {
             input_fault_trip_time: T::lit(10e-3),
             plausible_current_ratio: T::lit(2.0),
             dc_link_max_ratio: T::lit(crate::plausibility::VOLTAGE_RATIO),
+            dc_link: DcLinkTuning::default(),
             lock_reaction: LockReaction::ReportOnly,
             lock_reaction_on_stall: true,
             lock_recovery_time: T::lit(20e-3),
@@ -938,6 +948,7 @@ struct Blocks<T> {
     dead_time: DeadTimeCompensation<T>,
     probe: StandstillProbe<T>,
     modulator: SpaceVectorModulator<T>,
+    dc_link: DcLinkLimit<T>,
 }
 
 /// What the modulator applies at a sample: the duties, and the voltage that acts (α-β and in
@@ -1045,13 +1056,13 @@ impl<T: Real> Blocks<T> {
         // The speed PI's output is a torque in units of the magnet's q current (see
         // `currents_for_torque`): with MTPA on a salient rotor its limit is the torque of the
         // MTPA point on the current circle |i| = I_max (`SpeedControllerConfig::with_tuning`).
-        let speed = SpeedController::new(SpeedControllerConfig::with_tuning(m, t, ts)).map_err(
-            rename(&[
-                ("bandwidth_hz", "speed_bandwidth_hz"),
-                ("zero_ratio", "speed_zero_ratio"),
-                ("anti_windup_ratio", "speed_anti_windup_ratio"),
-            ]),
-        )?;
+        let speed_config = SpeedControllerConfig::with_tuning(m, t, ts);
+        let dc_link = DcLinkLimit::new(&t.dc_link, m, speed_config.i_max, r.i_max, ts)?;
+        let speed = SpeedController::new(speed_config).map_err(rename(&[
+            ("bandwidth_hz", "speed_bandwidth_hz"),
+            ("zero_ratio", "speed_zero_ratio"),
+            ("anti_windup_ratio", "speed_anti_windup_ratio"),
+        ]))?;
         let injection = CurrentInjection::new(CurrentInjectionConfig::with_tuning(m, t))?;
         let current = CurrentController::new(CurrentControllerConfig::with_tuning(m, t, ts))
             .map_err(rename(&[
@@ -1099,6 +1110,7 @@ impl<T: Real> Blocks<T> {
             dead_time,
             modulator,
             probe,
+            dc_link,
         })
     }
 
@@ -1110,6 +1122,7 @@ impl<T: Real> Blocks<T> {
         self.dead_time.reset();
         self.modulator.reset();
         self.probe.reset();
+        self.dc_link.reset();
     }
 }
 
@@ -1583,7 +1596,8 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         }
         let o = self.current_offset;
         let i_abc = Abc::new(i_abc.a - o.a, i_abc.b - o.b, i_abc.c - o.c);
-        if i_abc.a.abs() > trip || i_abc.b.abs() > trip || i_abc.c.abs() > trip {
+        let over_voltage = self.blocks.dc_link.over_voltage(vdc);
+        if i_abc.a.abs() > trip || i_abc.b.abs() > trip || i_abc.c.abs() > trip || over_voltage {
             self.tripped = true;
             self.trip_output();
             self.last.input_fault = false;
@@ -1749,6 +1763,10 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             let Ok(iq_torque) = self.blocks.speed.step(speed_ref, omega_ctrl) else {
                 return self.reject_after_estimate(backup, estimate, i_dq);
             };
+            let (iq_torque, brake_id) =
+                self.blocks
+                    .dc_link
+                    .limit(iq_torque, vdc, omega_ctrl, self.last.i_dq_ref.norm());
             // The loaded-standstill probe (see `standstill_probe`): Δi_d on the d reference,
             // and the turn of θ̂ its reading implies (from the next sample).
             let probe = &mut self.blocks.probe;
@@ -1767,7 +1785,12 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
                 m.flux_linkage,
                 m.ld - m.lq,
             );
-            let i = self.currents_for_torque(iq_torque, guess, probe_id);
+            let id_added = if brake_id != T::zero() {
+                probe_id + brake_id
+            } else {
+                probe_id
+            };
+            let i = self.currents_for_torque(iq_torque, guess, id_added);
             limit_current_d_priority(i, self.resolved.i_max)
         };
         if action == LockAction::Coast {

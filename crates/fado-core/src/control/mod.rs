@@ -6,6 +6,7 @@
 //! `reset`), is allocation-free, generic over [`Real`](crate::Real) and never panics.
 
 pub mod current_controller;
+pub mod dc_link_limit;
 pub mod dead_time_compensation;
 pub mod delay_compensation;
 pub mod drive;
@@ -18,6 +19,7 @@ pub mod speed_controller;
 pub mod standstill_probe;
 
 pub use current_controller::{CurrentController, CurrentControllerConfig};
+pub use dc_link_limit::{DcLinkLimit, DcLinkTuning};
 pub use dead_time_compensation::{
     DeadTimeCompensation, DeadTimeCompensationConfig, DeadTimeMethod,
 };
