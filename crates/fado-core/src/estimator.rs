@@ -144,6 +144,12 @@ pub struct EstimatorTuning<T> {
     /// Trackers coast (no update) while |λ̂r| is below this fraction of λ̂f. Default 0.2
     /// (SPEC §3 \[A\]).
     pub tracker_hold_ratio: T,
+    /// The trackers' third (load-acceleration) integrator, as the ratio c of its real pole
+    /// to ωn (see [`crate::tracker`], "Acceleration feed-forward"). Default 0: the paper's
+    /// type-2 trackers; 0.25 \[A\] with the drive's `acceleration_feedforward` (a load
+    /// pole at a quarter of ωn: 4 Hz… on T2S-2's 35 Hz, fast enough for a rated load step,
+    /// slow enough to leave the pair's damping).
+    pub tracker_load_pole_ratio: T,
     /// Average the current over the interval for the resistive drop. Default true (SPEC §1 \[A\]).
     pub average_current: bool,
     /// Feed the disturbance observer with λ1 − L̂q·i instead of λ1. Default true (our
@@ -381,6 +387,7 @@ impl<T: Real> EstimatorTuning<T> {
             tracker_damping: U::lit(self.tracker_damping.to_f64()),
             bandwidth_definition: self.bandwidth_definition,
             tracker_hold_ratio: U::lit(self.tracker_hold_ratio.to_f64()),
+            tracker_load_pole_ratio: U::lit(self.tracker_load_pole_ratio.to_f64()),
             average_current: self.average_current,
             observer_on_rotor_flux: self.observer_on_rotor_flux,
             observer_lag_compensation: self.observer_lag_compensation,
@@ -424,6 +431,7 @@ impl<T: Real> Default for EstimatorTuning<T> {
             tracker_damping: T::lit(core::f64::consts::FRAC_1_SQRT_2),
             bandwidth_definition: BandwidthDefinition::Minus3Db,
             tracker_hold_ratio: T::lit(0.2),
+            tracker_load_pole_ratio: T::zero(),
             average_current: true,
             observer_on_rotor_flux: true,
             observer_lag_compensation: true,
@@ -848,10 +856,17 @@ impl<T: Real> EstimatorParams<T> {
             config.mode_threshold_hz() + config.mode_hysteresis_hz(),
         )?;
         check::positive("tracker_damping", config.tuning.tracker_damping)?;
-        let t2s1 = TrackerParams::new(config.tracker(config.tuning.t2s1_bandwidth_hz))
-            .map_err(rename("t2s1_bandwidth_hz"))?;
-        let t2s2 = TrackerParams::new(config.tracker(config.tuning.t2s2_bandwidth_hz))
-            .map_err(rename("t2s2_bandwidth_hz"))?;
+        let load_pole = config.tuning.tracker_load_pole_ratio;
+        let (c1, c2) = (
+            config.tracker(config.tuning.t2s1_bandwidth_hz),
+            config.tracker(config.tuning.t2s2_bandwidth_hz),
+        );
+        let t2s1 = TrackerParams::new(c1)
+            .map_err(rename("t2s1_bandwidth_hz"))?
+            .with_load_pole(&c1, load_pole)?;
+        let t2s2 = TrackerParams::new(c2)
+            .map_err(rename("t2s2_bandwidth_hz"))?
+            .with_load_pole(&c2, load_pole)?;
         // A hold beyond a second is refused as a mistake (the observer would be a fixed
         // filter through any speed change; see the field's docs).
         let gain_period =
@@ -1765,6 +1780,9 @@ pub trait RotorAngleEstimator<T: Real> {
     /// Turns θ̂ by `angle` (rad) now, if the estimator can (the drive's loaded-standstill
     /// probe, see [`crate::control::standstill_probe`]). Default: nothing.
     fn turn_angle(&mut self, _angle: T) {}
+    /// The acceleration the drive commands, rad/s² (electrical), for the estimator's speed
+    /// trackers to feed forward (see [`crate::tracker`]). Default: not used.
+    fn set_acceleration(&mut self, _acceleration: T) {}
 }
 
 impl<T: Real> RotorAngleEstimator<T> for SensorlessEstimator<T> {
@@ -1780,6 +1798,10 @@ impl<T: Real> RotorAngleEstimator<T> for SensorlessEstimator<T> {
     }
     fn name(&self) -> &'static str {
         "fado"
+    }
+    fn set_acceleration(&mut self, acceleration: T) {
+        self.state.t2s1.set_acceleration(acceleration);
+        self.state.t2s2.set_acceleration(acceleration);
     }
     fn rearm_lock_detector(&mut self) {
         self.state.rearm_lock_detector();

@@ -81,6 +81,11 @@ pub struct DriveTuning<T> {
     /// [`MachineModel::mtpa_id`]), added to the injection's. No effect on a surface-magnet
     /// rotor. Default true.
     pub mtpa: bool,
+    /// Give the estimator's speed trackers the acceleration the commanded torque causes,
+    /// p·T*/Ĵ (a mechanical-model feed-forward, see [`crate::tracker`]); use with the
+    /// estimator's `tracker_load_pole_ratio` > 0, whose third integrator takes up the load.
+    /// Default false (the paper's trackers) \[A\].
+    pub acceleration_feedforward: bool,
     /// Dead time Td in s (inverter datum). Default 2.5 µs (paper, V).
     #[cfg_attr(feature = "serde", serde(skip))]
     pub dead_time: T,
@@ -423,6 +428,7 @@ impl<T: Real> DriveTuning<T> {
             current_limit_ratio: U::lit(self.current_limit_ratio.to_f64()),
             injection_current_ratio: U::lit(self.injection_current_ratio.to_f64()),
             mtpa: self.mtpa,
+            acceleration_feedforward: self.acceleration_feedforward,
             dead_time: U::lit(self.dead_time.to_f64()),
             switching_frequency: U::lit(self.switching_frequency.to_f64()),
             dead_time_threshold_voltage: U::lit(self.dead_time_threshold_voltage.to_f64()),
@@ -495,6 +501,7 @@ impl<T: Real> Default for DriveTuning<T> {
             current_limit_ratio: per_rated(40.0),
             injection_current_ratio: per_rated(4.0),
             mtpa: true,
+            acceleration_feedforward: false,
             dead_time: T::lit(2.5e-6),
             switching_frequency: T::lit(5e3),
             dead_time_threshold_voltage: T::one(),
@@ -1637,6 +1644,14 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
 
         // 2. Estimator: voltage of [n−1, n] = realised reference computed at n−2.
         self.i_ab_used = i_ab;
+        if self.config.tuning.acceleration_feedforward {
+            // p·T*/Ĵ with the model's torque of the last reference, 1.5·p·λ̂a·i_q*.
+            let m = &self.config.machine;
+            let p = T::lit(m.pole_pairs as f64);
+            let i = self.last.i_dq_ref;
+            let torque = T::lit(1.5) * p * m.active_flux(i.d) * i.q;
+            self.estimator.set_acceleration(p * torque / m.inertia);
+        }
         let estimate = self.estimator.step(self.history[1], i_ab);
         if !estimate_is_finite(&estimate) {
             // An estimator that went non-finite cannot steer the drive: hold like a bad input
