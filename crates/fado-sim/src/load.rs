@@ -68,8 +68,10 @@ pub struct LoadParams {
     /// Default 0.
     pub power: f64,
     /// Constant-power mode: corner speed ω_c below which the load torque is held at
-    /// `power`/ω_c, as a fraction of the motor's rated speed. Default 0.1 \[A\] (a tenth of
-    /// the rated speed: ten times the rated torque's worth of P/ω is not a load but a stall).
+    /// `power`/ω_c, as a fraction of the motor's rated speed. Default 1 \[A\]: the motor's
+    /// own characteristic (a load of the rated power asks the rated torque up to the rated
+    /// speed and the rated power above it; a lower corner asks more than the rated torque
+    /// at low speed, `power`/ω_c).
     pub corner_speed_ratio: f64,
 }
 
@@ -83,7 +85,7 @@ impl Default for LoadParams {
             torque_limit: 30.0,
             coefficient: 0.0,
             power: 0.0,
-            corner_speed_ratio: 0.1,
+            corner_speed_ratio: 1.0,
         }
     }
 }
@@ -270,6 +272,7 @@ mod tests {
         let params = LoadParams {
             mode: LoadMode::ConstantPower,
             power: 1500.0,
+            corner_speed_ratio: 0.1,
             ..Default::default()
         };
         let mut load = Load::new(params, 0.012, 1500.0).unwrap();

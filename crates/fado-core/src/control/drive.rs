@@ -31,6 +31,7 @@ use crate::control::dead_time_compensation::{
     DeadTimeCompensation, DeadTimeCompensationConfig, DeadTimeMethod,
 };
 use crate::control::delay_compensation::{DelayCompensation, DelayCompensationConfig};
+use crate::control::field_weakening::{FieldWeakening, FieldWeakeningTuning};
 use crate::control::gain_calibration::{
     GainCalibration, GainCalibrationConfig, GainCalibrationStatus,
 };
@@ -206,6 +207,13 @@ pub struct DriveTuning<T> {
         serde(bound(deserialize = "T: Real + serde::Deserialize<'de>"))
     )]
     pub dc_link: DcLinkTuning<T>,
+    /// Field weakening and the MTPV limit at the voltage limit (`[controller.field_weakening]`,
+    /// see [`FieldWeakeningTuning`]).
+    #[cfg_attr(
+        feature = "serde",
+        serde(bound(deserialize = "T: Real + serde::Deserialize<'de>"))
+    )]
+    pub field_weakening: FieldWeakeningTuning<T>,
     /// Reaction to the estimator's [`LockStatus::Lost`] (`DriveFlags::LOCK_LOST`) and, with
     /// `lock_reaction_on_stall`, to the stall symptom (`DriveFlags::STALLED`). Default report
     /// only \[A\] (the paper's behaviour plus the flags).
@@ -459,6 +467,7 @@ impl<T: Real> DriveTuning<T> {
             plausible_current_ratio: U::lit(self.plausible_current_ratio.to_f64()),
             dc_link_max_ratio: U::lit(self.dc_link_max_ratio.to_f64()),
             dc_link: self.dc_link.cast(),
+            field_weakening: self.field_weakening.cast(),
             lock_reaction: self.lock_reaction,
             lock_reaction_on_stall: self.lock_reaction_on_stall,
             lock_recovery_time: U::lit(self.lock_recovery_time.to_f64()),
@@ -530,6 +539,7 @@ impl<T: Real> Default for DriveTuning<T> {
             plausible_current_ratio: T::lit(2.0),
             dc_link_max_ratio: T::lit(crate::plausibility::VOLTAGE_RATIO),
             dc_link: DcLinkTuning::default(),
+            field_weakening: FieldWeakeningTuning::default(),
             lock_reaction: LockReaction::ReportOnly,
             lock_reaction_on_stall: true,
             lock_recovery_time: T::lit(20e-3),
@@ -956,6 +966,7 @@ struct Blocks<T> {
     probe: StandstillProbe<T>,
     modulator: SpaceVectorModulator<T>,
     dc_link: DcLinkLimit<T>,
+    field_weakening: FieldWeakening<T>,
 }
 
 /// What the modulator applies at a sample: the duties, and the voltage that acts (α-β and in
@@ -1065,6 +1076,7 @@ impl<T: Real> Blocks<T> {
         // MTPA point on the current circle |i| = I_max (`SpeedControllerConfig::with_tuning`).
         let speed_config = SpeedControllerConfig::with_tuning(m, t, ts);
         let dc_link = DcLinkLimit::new(&t.dc_link, m, speed_config.i_max, r.i_max, ts)?;
+        let field_weakening = FieldWeakening::new(&t.field_weakening, m, r.i_max, ts)?;
         let speed = SpeedController::new(speed_config).map_err(rename(&[
             ("bandwidth_hz", "speed_bandwidth_hz"),
             ("zero_ratio", "speed_zero_ratio"),
@@ -1118,6 +1130,7 @@ impl<T: Real> Blocks<T> {
             modulator,
             probe,
             dc_link,
+            field_weakening,
         })
     }
 
@@ -1130,6 +1143,7 @@ impl<T: Real> Blocks<T> {
         self.modulator.reset();
         self.probe.reset();
         self.dc_link.reset();
+        self.field_weakening.reset();
     }
 }
 
@@ -1800,13 +1814,21 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
                 m.flux_linkage,
                 m.ld - m.lq,
             );
-            let id_added = if brake_id != T::zero() {
-                probe_id + brake_id
+            let fw_id = self.blocks.field_weakening.delta_id();
+            let id_added = if brake_id != T::zero() || fw_id != T::zero() {
+                probe_id + brake_id.step_min(fw_id)
             } else {
                 probe_id
             };
             let i = self.currents_for_torque(iq_torque, guess, id_added);
-            limit_current_d_priority(i, self.resolved.i_max)
+            let i = limit_current_d_priority(i, self.resolved.i_max);
+            let fw = &self.blocks.field_weakening;
+            let iq_max = fw.iq_limit(i.d, vdc, omega_ctrl);
+            if i.q.abs() > iq_max {
+                Dq::new(i.d, iq_max * i.q.signum())
+            } else {
+                i
+            }
         };
         if action == LockAction::Coast {
             self.blocks.probe.reset();
@@ -1820,6 +1842,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         let Ok(v_dq) = b.current.step(i_dq_ref, i_dq, omega_ctrl) else {
             return self.reject_after_estimate(backup, estimate, i_dq);
         };
+        b.field_weakening.update(v_dq.norm(), vdc, omega_ctrl);
         // 6. Delay compensation with the advanced angle.
         //    (reusing the Park rotation: one sin/cos per sample instead of two).
         let (v_ab, rot) = b

@@ -10,6 +10,7 @@ pub mod dc_link_limit;
 pub mod dead_time_compensation;
 pub mod delay_compensation;
 pub mod drive;
+pub mod field_weakening;
 pub mod gain_calibration;
 pub mod lock_reaction;
 pub mod modulation;
@@ -25,6 +26,7 @@ pub use dead_time_compensation::{
 };
 pub use delay_compensation::{DelayCompensation, DelayCompensationConfig};
 pub use drive::{DriveConfig, DriveOutput, DriveTuning, SensorlessDrive};
+pub use field_weakening::{FieldWeakening, FieldWeakeningTuning};
 pub use gain_calibration::{GainCalibration, GainCalibrationConfig, GainCalibrationStatus};
 pub use lock_reaction::{LockAction, LockReaction, LockSupervisor};
 pub use modulation::{Modulation, ModulatorConfig, SpaceVectorModulator, VoltageLimit, svpwm_duty};
