@@ -62,6 +62,7 @@ pub mod motor;
 pub mod output;
 pub mod presets;
 pub mod profile;
+pub mod range;
 pub mod scenario;
 pub mod sensors;
 pub mod sim;

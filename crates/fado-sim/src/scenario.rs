@@ -62,7 +62,7 @@ impl Eq for Scenario {}
 /// staircase; then the paper's experiments scaled by the motor's ratings (its motor: 1500
 /// r/min, 11.5 N·m), which run for any motor: `reversal` (Fig. 11), `stops` (Fig. 12) and
 /// `rated-reversal` (Fig. 11 under the rated torque).
-pub const SCENARIOS: [Scenario; 11] = [
+pub const SCENARIOS: [Scenario; 13] = [
     Scenario {
         name: "fig8",
         title: "Flux and disturbance estimation under 2 N·m (Fig. 8)",
@@ -189,6 +189,35 @@ pub const SCENARIOS: [Scenario; 11] = [
         checks: checks_reversal,
     },
     Scenario {
+        name: "fullrange",
+        title: "The whole operating range, scaled by the ratings and the model's limits",
+        profile: "standstill under 50 % of rated torque; to rated speed at the current limit; \
+                  rated load step; field weakening to the top speed the voltage and current \
+                  limits allow (≤ 2× rated; half the rated power still available) holding \
+                  min(rated power, 80 % of the limits' power); brake at the current limit \
+                  through zero; 1 s at zero under 65 % of rated torque; to −rated speed",
+        criterion: "|θ − θ̂| < 0.25 rad over the whole run; in each settled window speed within \
+                    2 % of its target (of the rated speed near zero); no trip; DC voltage within \
+                    the drive's limits",
+        scaled: true,
+        neutral: false,
+        setup: setup_fullrange,
+        observe: observe_fullrange,
+        checks: checks_range,
+    },
+    Scenario {
+        name: "regen-stop",
+        title: "Stops regenerating into a rectifier-fed DC link (with a brake chopper)",
+        profile: "rated speed, stop at the current limit; rated speed again under an overhauling \
+                  rated load, stop and hold it (rectifier, chopper at 1.05 × the bus)",
+        criterion: "as `fullrange`",
+        scaled: true,
+        neutral: false,
+        setup: setup_regen_stop,
+        observe: observe_regen_stop,
+        checks: checks_range,
+    },
+    Scenario {
         name: "custom",
         title: "The user's own experiment: `[speed_reference]`, `[load]`, `[criteria]`",
         profile: "the configuration's `[speed_reference] points` and `[load]`; it runs to 1 s \
@@ -296,6 +325,82 @@ fn observe_lowspeed(cfg: &SimConfig, p: &mut ScenarioProbe) {
             LevelStats::new(level, to - LOWSPEED_JUDGED_SECONDS, to)
         })
         .collect();
+}
+
+/// `fullrange`: see [`crate::range`].
+fn setup_fullrange(c: &mut SimConfig) {
+    crate::range::setup_fullrange(c);
+}
+
+/// `regen-stop`: see [`crate::range`].
+fn setup_regen_stop(c: &mut SimConfig) {
+    crate::range::setup_regen_stop(c);
+}
+
+fn holds_to_levels(holds: Vec<crate::range::Hold>) -> Vec<LevelStats> {
+    holds
+        .into_iter()
+        .map(|(level, from, to)| LevelStats::new(level, from, to))
+        .collect()
+}
+
+/// `fullrange`: its settled windows.
+fn observe_fullrange(cfg: &SimConfig, p: &mut ScenarioProbe) {
+    p.levels = holds_to_levels(crate::range::fullrange_holds(cfg));
+}
+
+/// `regen-stop`: its settled windows.
+fn observe_regen_stop(cfg: &SimConfig, p: &mut ScenarioProbe) {
+    p.levels = holds_to_levels(crate::range::regen_stop_holds(cfg));
+}
+
+/// `fullrange` and `regen-stop`: the angle over the run, the speed in each settled window
+/// within 2 % of its target (of the rated speed near zero), the DC link within the drive's
+/// limits.
+fn checks_range(cfg: &SimConfig, m: &Metrics, p: &ScenarioProbe, checks: &mut Vec<Check>) {
+    let rated = cfg.motor.rated_speed_rpm;
+    checks.push(Check::at_most("max |θ − θ̂| (rad)", m.max_angle_error, 0.25));
+    for l in &p.levels {
+        let bound = 0.02 * l.level_rpm.abs().max(rated);
+        checks.push(Check::at_most(
+            &format!(
+                "speed error at {:.0} r/min, {:.1}–{:.1} s (r/min)",
+                l.level_rpm, l.from, l.to
+            ),
+            l.max_speed_error_rpm,
+            bound,
+        ));
+    }
+    let v = cfg.inverter.dc_voltage;
+    checks.push(Check::at_most(
+        "max DC-link voltage (V)",
+        m.max_dc_voltage,
+        cfg.controller.dc_link.over_voltage_trip_ratio * v,
+    ));
+    checks.push(Check::at_least(
+        "min DC-link voltage (V)",
+        m.min_dc_voltage,
+        cfg.controller.dc_link_min_ratio * v,
+    ));
+    if p.levels.len() == 5 {
+        let t = crate::range::targets(cfg);
+        checks.push(Check::at_least(
+            &format!(
+                "mean speed at the top (r/min; model: {:.0})",
+                t.top_speed_rpm
+            ),
+            p.levels[2].mean_speed_rpm,
+            0.98 * t.top_speed_rpm,
+        ));
+        checks.push(Check::at_least(
+            &format!(
+                "power held at the top (W; model limit {:.0}, rated {:.0})",
+                t.limit_power_at_top, t.rated_power
+            ),
+            cfg.load.torque.value(7.5) * p.levels[2].mean_speed_rpm * std::f64::consts::TAU / 60.0,
+            0.98 * t.hold_power,
+        ));
+    }
 }
 
 /// `custom`: the user's profiles as they are; the run lasts until 1 s after the last
