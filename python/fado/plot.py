@@ -247,16 +247,19 @@ def plot_fig10(result: SimResult, path: str | os.PathLike[str] | None = None) ->
     return _figure(result, panels, _title(result), path)
 
 
+#: Speed, θ − θ̂ against ±0.25 rad, λ1 and D̂, d-q currents, flags: Fig. 11 and any run.
+_RUN_PANELS: list[Callable[[Axes, SimResult], None]] = [
+    _speed,
+    lambda ax, r: _angle_error(ax, r, criterion=True),
+    _flux_and_disturbance,
+    _currents,
+    _flags,
+]
+
+
 def plot_fig11(result: SimResult, path: str | os.PathLike[str] | None = None) -> Figure:
     """Fig. 11: speed reversal −90 → +90 r/min under 7.5 N·m; θ − θ̂ against ±0.25 rad."""
-    panels = [
-        _speed,
-        lambda ax, r: _angle_error(ax, r, criterion=True),
-        _flux_and_disturbance,
-        _currents,
-        _flags,
-    ]
-    return _figure(result, panels, _title(result), path)
+    return _figure(result, _RUN_PANELS, _title(result), path)
 
 
 def plot_fig12(result: SimResult, path: str | os.PathLike[str] | None = None) -> Figure:
@@ -272,8 +275,9 @@ def plot_fig12(result: SimResult, path: str | os.PathLike[str] | None = None) ->
 
 def plot_run(result: SimResult, path: str | os.PathLike[str] | None = None) -> Figure:
     """Any run: speed, θ − θ̂ against ±0.25 rad, λ1 and D̂, d-q currents and the mode flags
-    (the layout of Fig. 11, for a scenario of one's own or a run with a custom profile)."""
-    return plot_fig11(result, path)
+    (the layout of Fig. 11, for a scenario of one's own or a run with a custom profile), titled
+    with the scenario it started from."""
+    return _figure(result, _RUN_PANELS, f"a run based on {result.scenario}", path)
 
 
 _BY_SCENARIO = {
