@@ -6,7 +6,7 @@ CHANGELOG.md and in commit messages. Flagged (case-insensitive):
 
 - "session" (a work session), except pytest's ``scope="session"`` and ``session`` fixtures;
 - "pass" as a round of work: "second pass", "fifth pass", "pass 2";
-- "issue <N>", "issue #N" and "#N" references to the tracker;
+- "issue <N>", "issue #N", "PR #N": references to the tracker;
 - "main <hash>", "on main", "commit <hash>": versions of the repository;
 - "SPEC §" citations of a working note that is not in the repository;
 - "before … now" / "was … until" narration on one line.
@@ -31,7 +31,7 @@ ORDINAL = r"(first|second|third|fourth|fifth|sixth|seventh|eighth|ninth|tenth|el
 PATTERNS = [
     ("session", re.compile(r"\bsessions?\b", re.I)),
     ("pass (a round of work)", re.compile(rf"\b{ORDINAL}\s+pass(es)?\b|\bpass\s+\d+\b(?![.,]\d)", re.I)),
-    ("issue number", re.compile(r"\bissues?\s+#?\d+|(?<![\w&/])#\d+\b(?!\])", re.I)),
+    ("issue number", re.compile(r"\b(issues?|PR|pull request)\s+#?\d+", re.I)),
     ("repository version", re.compile(r"\b(main|commit|branch)\s+[0-9a-f]{7,40}\b|\bon main\b", re.I)),
     ("SPEC citation", re.compile(r"\bSPEC\s*§")),
     ("before … now", re.compile(r"\bbefore\b.{0,80}\bnow\b|\bwas\b.{0,80}\buntil\b", re.I)),
@@ -43,6 +43,10 @@ ALLOW = [
     re.compile(r"#\[|#!\[|\"#[0-9a-fA-F]{3,8}\"|'#[0-9a-fA-F]{3,8}'|color=\"#"),  # Rust attributes, colours
     re.compile(r"&#\d+;"),  # HTML character references
 ]
+
+
+def rel(f: Path) -> Path:
+    return f.relative_to(ROOT) if f.is_relative_to(ROOT) else f
 
 
 def files(args: list[str]) -> list[Path]:
@@ -57,7 +61,7 @@ def files(args: list[str]) -> list[Path]:
                 for f in sorted(p.rglob("*"))
                 if f.is_file()
                 and f.suffix in SUFFIXES
-                and not SKIP_PARTS & set(f.relative_to(ROOT).parts)
+                and not SKIP_PARTS & set(rel(f).parts)
             )
     return out
 
@@ -72,7 +76,7 @@ def main(argv: list[str]) -> int:
                 m = pattern.search(line)
                 if m:
                     hits += 1
-                    print(f"{f.relative_to(ROOT)}:{n}: {name}: {m.group(0)!r}: {line.strip()[:120]}")
+                    print(f"{rel(f)}:{n}: {name}: {m.group(0)!r}: {line.strip()[:120]}")
                     break
     if hits:
         print(
