@@ -271,6 +271,7 @@ def test_sim_result_api() -> None:
         "reversal",
         "stops",
         "rated-reversal",
+        "loaded-start",
     ]
     assert "Fig. 10" in fado.describe_scenario("fig10")["title"]
     assert list(result.traces) == fado.TRACE_COLUMNS

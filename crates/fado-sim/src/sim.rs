@@ -92,6 +92,9 @@ pub struct Plant {
     load_torque: f64,
     last: SampleOutcome,
     faults: Option<Faults>,
+    /// A holding brake on the shaft: while engaged the rotor stays where it is and the load
+    /// acts on the brake.
+    brake: bool,
 }
 
 impl Plant {
@@ -111,6 +114,7 @@ impl Plant {
             load: Load::new(params.load.clone(), params.motor.inertia).map_err(|e| s(e, "load"))?,
             encoder: Encoder::default(),
             load_torque: 0.0,
+            brake: false,
             last: SampleOutcome::default(),
             faults: if params.faults.is_empty() {
                 None
@@ -186,6 +190,21 @@ impl Plant {
         }
     }
 
+    /// Engages the holding brake (the rotor must be at rest: it is held where it is).
+    pub fn engage_brake(&mut self) {
+        self.brake = true;
+    }
+
+    /// Releases the holding brake.
+    pub fn release_brake(&mut self) {
+        self.brake = false;
+    }
+
+    /// Whether the holding brake holds the rotor.
+    pub fn brake_engaged(&self) -> bool {
+        self.brake
+    }
+
     /// Integrates one sample [n, n+1] and loads `duty_next` for [n+1, n+2].
     pub fn step(&mut self, duty_next: Abc<f64>, gates_enabled: bool) -> SampleOutcome {
         let ts = self.sample_period();
@@ -194,8 +213,13 @@ impl Plant {
         let out = self
             .inverter
             .step(&mut self.motor, duty_next, gates_enabled);
-        self.motor
-            .advance_mechanical(ts, out.torque_avg, self.load_torque);
+        if self.brake {
+            // The brake takes both torques: the rotor (at rest) does not move.
+            self.motor.advance_mechanical(ts, 0.0, 0.0);
+        } else {
+            self.motor
+                .advance_mechanical(ts, out.torque_avg, self.load_torque);
+        }
         self.last = out;
         out
     }
@@ -248,6 +272,8 @@ pub struct Sample {
     /// a stuck channel reconstructed) when the controller reports it, else the Clarke
     /// transform of the measured phase currents, A.
     pub i_ab_measured: fado_core::Ab<f64>,
+    /// The plant's holding brake holds the rotor over this sample.
+    pub brake_engaged: bool,
     /// The controller's output at this sample.
     pub act: Actuation,
 }
@@ -347,6 +373,9 @@ impl<C: Controller> Simulation<C> {
         };
         let act = self.controller.step(&m);
         self.tripped |= act.tripped;
+        if self.plant.brake_engaged() && self.controller.ready() {
+            self.plant.release_brake();
+        }
         let st = *self.plant.motor().state();
         let sample = Sample {
             time: t,
@@ -362,6 +391,7 @@ impl<C: Controller> Simulation<C> {
             v_ab_applied: self.plant.last_outcome().v_ab_avg,
             i_ab_measured: act.i_ab_used.unwrap_or_else(|| i_abc.to_ab()),
             pole_pairs: self.pole_pairs,
+            brake_engaged: self.plant.brake_engaged(),
             act,
         };
         self.plant.step(act.duty, act.gates_enabled);
