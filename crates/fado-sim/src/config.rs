@@ -54,6 +54,10 @@ pub struct SimulationSettings {
     pub estimator: EstimatorKind,
     /// Windows `[t_off, t_on]` in s during which the k_df feedback is switched off (Fig. 9).
     pub disturbance_feedback_off: Vec<[f64; 2]>,
+    /// A holding brake holds the rotor from the start until the drive reports ready (its
+    /// calibrations over, gates on); the load acts on the brake until then (a hoist, a
+    /// vehicle on a slope). Default false.
+    pub brake: bool,
 }
 
 impl Default for SimulationSettings {
@@ -68,6 +72,7 @@ impl Default for SimulationSettings {
             precision: Precision::F64,
             estimator: EstimatorKind::Fado,
             disturbance_feedback_off: Vec::new(),
+            brake: false,
         }
     }
 }
