@@ -322,6 +322,7 @@ impl SimConfig {
             dc_link_sensor: self.dc_link_sensor.clone(),
             load: self.load.clone(),
             faults: self.faults.clone(),
+            magnetics: None,
         }
     }
 

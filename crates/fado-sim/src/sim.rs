@@ -38,6 +38,11 @@ pub struct PlantParams {
     pub load: LoadParams,
     /// Injected faults (none by default).
     pub faults: FaultParams,
+    /// The machine's saturating magnetics (`[motor.saturation]` or `[motor] flux_map`); None:
+    /// the constant inductances of `motor`. Not a TOML table of its own (the configuration
+    /// keeps it under `[motor]`).
+    #[serde(skip)]
+    pub magnetics: Option<std::sync::Arc<crate::magnetics::PlantMagnetics>>,
 }
 
 impl Default for PlantParams {
@@ -51,6 +56,7 @@ impl Default for PlantParams {
             dc_link_sensor: DcLinkSensorParams::default(),
             load: LoadParams::default(),
             faults: FaultParams::default(),
+            magnetics: None,
         }
     }
 }
@@ -100,7 +106,8 @@ impl Plant {
         params.validate()?;
         let s = |e: SimConfigError, sec: &str| e.in_section(sec);
         let mut plant = Self {
-            motor: Motor::new(params.motor, theta0).map_err(|e| s(e, "motor"))?,
+            motor: Motor::with_magnetics(params.motor, params.magnetics.clone(), theta0)
+                .map_err(|e| s(e, "motor"))?,
             inverter: Inverter::new(params.inverter.clone()).map_err(|e| s(e, "inverter"))?,
             current_sensor: CurrentSensor::new(
                 params.current_sensor.clone(),

@@ -129,11 +129,9 @@ impl<'a, T: Real> FluxMap<'a, T> {
     ) -> Result<Self, FluxMapError> {
         check_axis("i_d", i_d)?;
         check_axis("i_q", i_q)?;
+        let map = Self::from_checked_parts(i_d, i_q, psi_d, psi_q)?;
         let nq = i_q.len();
         for (table, t) in [("psi_d", psi_d), ("psi_q", psi_q)] {
-            if t.len() != i_d.len() * nq {
-                return Err(FluxMapError::Ragged { table });
-            }
             if let Some(at) = t.iter().position(|v| !v.is_finite()) {
                 return Err(FluxMapError::NotFinite {
                     table,
@@ -154,6 +152,31 @@ impl<'a, T: Real> FluxMap<'a, T> {
                     let table = "psi_q";
                     return Err(FluxMapError::NotMonotonic { table, k, m });
                 }
+            }
+        }
+        Ok(map)
+    }
+
+    /// A map from parts whose shapes alone are checked (two nodes or more per axis, one value
+    /// per node): no lookup can index out of bounds, and a map built from the parts of one
+    /// that [`FluxMap::new`] accepted behaves identically. For a host program that keeps the
+    /// checked parts in its own storage and borrows them per use (an O(1) check instead of
+    /// [`FluxMap::new`]'s O(n)); unchecked values give wrong inverses, never a panic.
+    pub fn from_checked_parts(
+        i_d: &'a [T],
+        i_q: &'a [T],
+        psi_d: &'a [T],
+        psi_q: &'a [T],
+    ) -> Result<Self, FluxMapError> {
+        if i_d.len() < 2 {
+            return Err(FluxMapError::TooFewNodes { axis: "i_d" });
+        }
+        if i_q.len() < 2 {
+            return Err(FluxMapError::TooFewNodes { axis: "i_q" });
+        }
+        for (table, t) in [("psi_d", psi_d), ("psi_q", psi_q)] {
+            if t.len() != i_d.len() * i_q.len() {
+                return Err(FluxMapError::Ragged { table });
             }
         }
         Ok(Self {
