@@ -377,7 +377,7 @@ impl Inverter {
         let rot_h = cis(prop.omega() * self.ts);
         let i1 = prop.advance(i0, v, self.ts, rot0, rot_h);
         let mp = motor.params();
-        let te = 0.5 * (prop.torque_dq(mp, i0, rot0) + prop.torque_dq(mp, i1, rot0 * rot_h));
+        let te = 0.5 * (prop.torque_dq(mp, i0) + prop.torque_dq(mp, i1));
         motor.set_current_from(prop, i1);
         // Keep the leg states coherent for a later switch to the resolved model.
         for (leg, dk) in self.legs.iter_mut().zip(d) {
@@ -440,7 +440,7 @@ impl Inverter {
         // The current is carried in α-β (phase currents at every edge), d-q only at the end.
         let mut i = rotate(motor.state().i_dq, rot);
         let mut iph = phase_currents(i);
-        let mut te_prev = prop.torque_dq(&mp, motor.state().i_dq, rot);
+        let mut te_prev = prop.torque_dq(&mp, motor.state().i_dq);
         let mut t = 0.0;
         let mut next_edge = 0;
         let (mut te_int, mut v_int) = (0.0, Ab::zero());
@@ -556,7 +556,7 @@ impl Inverter {
         let emf_line_peak = 3f64.sqrt() * omega.abs() * mp.flux_linkage;
         for _ in 0..SUBSTEPS {
             let iph = phase_currents(rotate(i, rot));
-            let te0 = prop.torque_dq(&mp, i, rot);
+            let te0 = prop.torque_dq(&mp, i);
             let v = if iph.iter().all(|x| x.abs() < blocking_current) && emf_line_peak < vdc {
                 // Diodes blocking: the machine is open-circuited.
                 i = Dq::zero();
@@ -569,7 +569,7 @@ impl Inverter {
                 v
             };
             rot *= rot_h;
-            te_int += 0.5 * (te0 + prop.torque_dq(&mp, i, rot)) * h;
+            te_int += 0.5 * (te0 + prop.torque_dq(&mp, i)) * h;
             v_int += v * h;
         }
         for leg in &mut self.legs {

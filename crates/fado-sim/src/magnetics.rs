@@ -106,10 +106,12 @@ impl PlantMagnetics {
                 }
             }
         }
+        let psi_zero = m.flux(Dq::zero());
         MagneticBounds {
             l_min,
             l_max,
-            psi0: m.magnet_flux(),
+            psi0: psi_zero.d,
+            psi_zero,
         }
     }
 }
@@ -123,6 +125,8 @@ pub struct MagneticBounds {
     pub l_max: f64,
     /// Magnet flux ψd(0, 0) in Wb.
     pub psi0: f64,
+    /// ψ(0) in Wb (a blocked inverter's current).
+    pub psi_zero: Dq<f64>,
 }
 
 /// The end of the last interval: current and flux in α-β and the rotor's e^{jθ} there.
@@ -131,6 +135,8 @@ pub(crate) struct FluxPoint {
     pub i_ab: Ab<f64>,
     pub psi_ab: Ab<f64>,
     pub rot: Complex64,
+    /// `i_ab` in the rotor frame at `rot` (what the rotor-frame callers pass back).
+    pub i_dq: Dq<f64>,
 }
 
 impl FluxPoint {
@@ -140,6 +146,7 @@ impl FluxPoint {
             i_ab: rotate(i_dq, rot),
             psi_ab: rotate(psi_dq, rot),
             rot,
+            i_dq,
         }
     }
 }
@@ -185,6 +192,8 @@ impl FluxPropagator {
         let last = self.last.get();
         if last.i_ab == i_ab {
             last.psi_ab
+        } else if i_ab == Ab::zero() {
+            rotate(self.bounds.psi_zero, rot)
         } else {
             rotate(self.mag.model().flux(unrotate(i_ab, rot)), rot)
         }
@@ -247,6 +256,7 @@ impl FluxPropagator {
             i_ab: i,
             psi_ab: psi,
             rot,
+            i_dq: unrotate(i, rot),
         });
         i
     }
@@ -260,8 +270,16 @@ impl FluxPropagator {
         rot0: Complex64,
         rot_h: Complex64,
     ) -> Dq<f64> {
-        let i1 = self.advance_ab(rotate(i, rot0), v_ab, h, rot0, rot_h);
-        unrotate(i1, self.last.get().rot)
+        // The last interval's end, passed back in the rotor frame: its own α-β current (a
+        // round trip through the rotation would change the last bits and lose the flux).
+        let last = self.last.get();
+        let i_ab = if i == last.i_dq && rot0 == last.rot {
+            last.i_ab
+        } else {
+            rotate(i, rot0)
+        };
+        self.advance_ab(i_ab, v_ab, h, rot0, rot_h);
+        self.last.get().i_dq
     }
 
     /// Torque 1.5·p·(ψ × i) at the current `i_ab`, rotor at `rot`.
@@ -273,8 +291,16 @@ impl FluxPropagator {
 
     /// Torque at the rotor-frame current `i_dq`, rotor at `rot`.
     #[inline]
-    pub fn torque_dq(&self, i_dq: Dq<f64>, rot: Complex64) -> f64 {
-        self.torque_ab(rotate(i_dq, rot), rot)
+    pub fn torque_dq(&self, i_dq: Dq<f64>) -> f64 {
+        let last = self.last.get();
+        let psi = if i_dq == last.i_dq {
+            unrotate(last.psi_ab, last.rot)
+        } else if i_dq == Dq::zero() {
+            self.bounds.psi_zero
+        } else {
+            self.mag.model().flux(i_dq)
+        };
+        1.5 * self.pole_pairs * (psi.d * i_dq.q - psi.q * i_dq.d)
     }
 }
 

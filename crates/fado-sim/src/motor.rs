@@ -219,9 +219,9 @@ impl ElectricalPropagator {
 
     /// As [`ElectricalPropagator::torque_ab`] for a rotor-frame current.
     #[inline]
-    pub fn torque_dq(&self, p: &MotorParams, i_dq: Dq<f64>, rot: Complex64) -> f64 {
+    pub fn torque_dq(&self, p: &MotorParams, i_dq: Dq<f64>) -> f64 {
         match &self.flux {
-            Some(f) => f.torque_dq(i_dq, rot),
+            Some(f) => f.torque_dq(i_dq),
             None => p.torque(i_dq),
         }
     }
@@ -474,7 +474,7 @@ impl Motor {
         self.state.i_dq = i_dq;
         if let Some(f) = &prop.flux {
             let last = f.last();
-            self.psi_dq = if unrotate(last.i_ab, last.rot) == i_dq {
+            self.psi_dq = if last.i_dq == i_dq {
                 unrotate(last.psi_ab, last.rot)
             } else {
                 self.flux_of(i_dq)
