@@ -13,7 +13,10 @@
 //! given directly: they are the plant's times the `[mismatch]` ratios, so "matched" stays
 //! matched when the motor changes.
 
+use std::sync::Arc;
+
 use fado_core::control::{DeadTimeMethod, DriveConfig, DriveTuning};
+use fado_core::magnetics::Saturation;
 use fado_core::{EstimatorConfig, EstimatorTuning, MachineModel};
 use serde::{Deserialize, Serialize};
 
@@ -23,6 +26,7 @@ use crate::error::{SimConfigError, check};
 use crate::faults::FaultParams;
 use crate::inverter::InverterParams;
 use crate::load::LoadParams;
+use crate::magnetics::PlantMagnetics;
 use crate::motor::MotorParams;
 use crate::profile::Profile;
 use crate::sensors::{CurrentSensorParams, DcLinkSensorParams};
@@ -295,6 +299,11 @@ pub struct SimConfig {
     /// judged after their own by the others. Default none.
     #[serde(skip_serializing_if = "Criteria::is_empty")]
     pub criteria: Criteria,
+    /// The plant's saturating magnetics, `[motor.saturation]` (the algebraic model of
+    /// [`fado_core::magnetics::Saturation`]); None: the constant inductances of `[motor]`,
+    /// whose `ld`, `lq` and `flux_linkage` then stay the datasheet's (the drive's default model).
+    #[serde(skip)]
+    pub motor_saturation: Option<Saturation<f64>>,
 }
 
 impl Default for SimConfig {
@@ -318,6 +327,7 @@ impl Default for SimConfig {
             faults: FaultParams::default(),
             dc_link: DcLinkParams::default(),
             criteria: Criteria::default(),
+            motor_saturation: None,
         }
     }
 }
@@ -339,6 +349,9 @@ impl SimConfig {
             load: self.load.clone(),
             faults: self.faults.clone(),
             dc_link: self.dc_link.clone(),
+            magnetics: self
+                .motor_saturation
+                .map(|s| Arc::new(PlantMagnetics::Saturation(s))),
         }
     }
 
@@ -351,6 +364,11 @@ impl SimConfig {
         self.speed_reference
             .validate()
             .map_err(|e| e.in_section("speed_reference"))?;
+        if let Some(sat) = &self.motor_saturation {
+            sat.validate().map_err(|e| {
+                SimConfigError::new(format!("motor.saturation.{}", e.field()), e.to_string())
+            })?;
+        }
         self.plant().validate()?;
         let rows = self.simulation.duration
             / self.inverter.sample_period()
@@ -566,16 +584,31 @@ impl SimConfig {
 
     /// This configuration as a TOML document.
     pub fn to_toml(&self) -> String {
-        toml::to_string(self).expect("every field of SimConfig is representable in TOML")
+        let Some(sat) = &self.motor_saturation else {
+            return toml::to_string(self)
+                .expect("every field of SimConfig is representable in TOML");
+        };
+        let mut table = toml::Table::try_from(self).expect("SimConfig is a TOML table");
+        if let Some(toml::Value::Table(motor)) = table.get_mut("motor") {
+            let sat = toml::Table::try_from(sat).expect("Saturation is a TOML table");
+            motor.insert("saturation".into(), toml::Value::Table(sat));
+        }
+        toml::to_string(&table).expect("every field of SimConfig is representable in TOML")
     }
 
     /// Parses a complete or partial TOML document on top of `base`: tables merge, values and
     /// arrays replace. The result is validated. Errors name the key.
     pub fn from_toml_over(base: &SimConfig, text: &str) -> Result<SimConfig, SimConfigError> {
-        let user: toml::Table = text.parse().map_err(|e| located(text, e))?;
+        let mut user: toml::Table = text.parse().map_err(|e| located(text, e))?;
+        let saturation = take_saturation(&mut user).map_err(|e| e.located_in(text))?;
         // Check the user's document on its own first, so that errors (unknown keys, wrong
         // types) name the key the user wrote and point at it.
-        toml::from_str::<SimConfig>(text).map_err(|e| located(text, e))?;
+        if saturation.is_some() {
+            SimConfig::deserialize(toml::Value::Table(user.clone()))
+                .map_err(|e| key_error(e).located_in(text))?;
+        } else {
+            toml::from_str::<SimConfig>(text).map_err(|e| located(text, e))?;
+        }
         let mut merged = toml::Table::try_from(base)
             .map_err(|e| SimConfigError::new("<base>", e.to_string()))?;
         merge(&mut merged, user);
@@ -583,6 +616,7 @@ impl SimConfig {
             .map_err(|e| key_error(e).located_in(text))?;
         // `[motor]` has no DC link of its own (it is the inverter's).
         cfg.motor.dc_voltage = cfg.inverter.dc_voltage;
+        cfg.motor_saturation = saturation.or(base.motor_saturation);
         cfg.validate().map_err(|e| e.located_in(text))?;
         Ok(cfg)
     }
@@ -620,6 +654,20 @@ fn check_time_constant(
             2.0 * ts
         ),
     ))
+}
+
+/// Takes `[motor.saturation]` out of the user's document (`[motor]` itself is
+/// [`MachineModel`], whose keys are the linear machine's), parsed.
+fn take_saturation(user: &mut toml::Table) -> Result<Option<Saturation<f64>>, SimConfigError> {
+    let Some(toml::Value::Table(motor)) = user.get_mut("motor") else {
+        return Ok(None);
+    };
+    let Some(table) = motor.remove("saturation") else {
+        return Ok(None);
+    };
+    Saturation::<f64>::deserialize(table)
+        .map(Some)
+        .map_err(|e| key_error(e).in_section("motor.saturation"))
 }
 
 fn merge(base: &mut toml::Table, over: toml::Table) {
@@ -898,6 +946,35 @@ mod dead_time_method {
         assert_eq!(method(Plant::Averaged, EdgeCurrent), Trapezoidal);
         assert_eq!(method(Plant::Averaged, Sign), Sign);
         assert_eq!(method(Plant::SwitchingResolved, Trapezoidal), Trapezoidal);
+    }
+
+    #[test]
+    fn motor_saturation_is_read_checked_and_written_back() {
+        let text =
+            "[motor.saturation]\na_d0 = 380.2\na_q0 = 380.2\npsi_f = 0.088\na_qq = 1e5\nt = 2\n";
+        let cfg = SimConfig::from_toml(text).unwrap();
+        let sat = cfg.motor_saturation.unwrap();
+        assert_eq!((sat.a_qq, sat.t, sat.psi_f), (1e5, 2.0, 0.088));
+        assert!(cfg.plant().magnetics.is_some());
+        // --dump-config round trip keeps it.
+        let back = SimConfig::from_toml(&cfg.to_toml()).unwrap();
+        assert_eq!(back.motor_saturation, cfg.motor_saturation);
+        // Without the table the plant keeps its constant inductances.
+        assert!(SimConfig::default().plant().magnetics.is_none());
+        // Errors name the key and point at it.
+        let e =
+            SimConfig::from_toml("[motor.saturation]\na_d0 = 380.2\na_q0 = -1.0\n").unwrap_err();
+        assert_eq!(e.key, "motor.saturation.a_q0", "{e}");
+        assert_eq!(e.location.as_ref().map(|l| l.line), Some(3), "{e}");
+        let e =
+            SimConfig::from_toml("[motor.saturation]\na_d0 = 380.2\na_qqq = 1.0\n").unwrap_err();
+        assert!(e.key.starts_with("motor.saturation"), "{e}");
+        assert!(e.to_string().contains("a_qqq"), "{e}");
+        let e = SimConfig::from_toml(
+            "[motor]\nrs = -1.0\n[motor.saturation]\na_d0 = 1.0\na_q0 = 1.0\n",
+        )
+        .unwrap_err();
+        assert_eq!(e.key, "motor.rs", "{e}");
     }
 }
 

@@ -58,6 +58,7 @@ mod fastmath;
 pub mod faults;
 pub mod inverter;
 pub mod load;
+pub mod magnetics;
 pub mod motor;
 pub mod output;
 pub mod presets;

@@ -42,6 +42,11 @@ pub struct PlantParams {
     /// The DC link behind the inverter (stiff by default).
     #[serde(default)]
     pub dc_link: DcLinkParams,
+    /// The machine's saturating magnetics (`[motor.saturation]` or `[motor] flux_map`); None:
+    /// the constant inductances of `motor`. Not a TOML table of its own (the configuration
+    /// keeps it under `[motor]`).
+    #[serde(skip)]
+    pub magnetics: Option<std::sync::Arc<crate::magnetics::PlantMagnetics>>,
 }
 
 impl Default for PlantParams {
@@ -56,6 +61,7 @@ impl Default for PlantParams {
             load: LoadParams::default(),
             faults: FaultParams::default(),
             dc_link: DcLinkParams::default(),
+            magnetics: None,
         }
     }
 }
@@ -117,7 +123,8 @@ impl Plant {
             .map_err(|e| s(e, "dc_link"))?;
         let mut plant = Self {
             dc_link,
-            motor: Motor::new(params.motor, theta0).map_err(|e| s(e, "motor"))?,
+            motor: Motor::with_magnetics(params.motor, params.magnetics.clone(), theta0)
+                .map_err(|e| s(e, "motor"))?,
             inverter: Inverter::new(params.inverter.clone()).map_err(|e| s(e, "inverter"))?,
             current_sensor: CurrentSensor::new(
                 params.current_sensor.clone(),
