@@ -1765,6 +1765,9 @@ pub trait RotorAngleEstimator<T: Real> {
     /// Turns θ̂ by `angle` (rad) now, if the estimator can (the drive's loaded-standstill
     /// probe, see [`crate::control::standstill_probe`]). Default: nothing.
     fn turn_angle(&mut self, _angle: T) {}
+    /// Switches a disturbance feedback (fado's k_df, Fig. 9) on or off, if the estimator has
+    /// one. Default: nothing to switch.
+    fn set_disturbance_feedback(&mut self, _enabled: bool) {}
 }
 
 impl<T: Real> RotorAngleEstimator<T> for SensorlessEstimator<T> {
@@ -1789,6 +1792,9 @@ impl<T: Real> RotorAngleEstimator<T> for SensorlessEstimator<T> {
     }
     fn turn_angle(&mut self, angle: T) {
         SensorlessEstimator::turn_angle(self, angle);
+    }
+    fn set_disturbance_feedback(&mut self, enabled: bool) {
+        self.set_disturbance_feedback_enabled(enabled);
     }
     /// With [`EstimatorTuning::rs_adaptation`]: [`SensorlessEstimator::set_rs_hat`] (a bad
     /// value changes nothing); with the paper's fixed R̂s: nothing.
