@@ -13,6 +13,7 @@ use std::hint::black_box;
 use criterion::{Criterion, criterion_group, criterion_main};
 use fado_core::baselines::{
     Baseline, CommonTuning, EmfObserverEstimator, LpfIntegratorEstimator, OrtegaEstimator,
+    ReducedOrderEstimator,
 };
 use fado_core::{Ab, MachineModel, RotorAngleEstimator};
 
@@ -81,6 +82,7 @@ fn estimators(c: &mut Criterion) {
     bench_baseline::<LpfIntegratorEstimator<f32>>(c, &data);
     bench_baseline::<OrtegaEstimator<f32>>(c, &data);
     bench_baseline::<EmfObserverEstimator<f32>>(c, &data);
+    bench_baseline::<ReducedOrderEstimator<f32>>(c, &data);
 }
 
 criterion_group!(benches, estimators);

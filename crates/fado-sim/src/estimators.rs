@@ -18,6 +18,7 @@
 
 use fado_core::baselines::{
     Baseline, CommonTuning, EmfObserverEstimator, LpfIntegratorEstimator, OrtegaEstimator,
+    ReducedOrderEstimator,
 };
 use serde::Serialize;
 use serde::de::DeserializeOwned;
@@ -91,6 +92,9 @@ pub const ESTIMATORS: &[Estimator] = &[
     ),
     baseline::<OrtegaEstimator<f64>>("Ortega–Praly nonlinear flux observer (Lee et al., 2010)"),
     baseline::<EmfObserverEstimator<f64>>("extended-EMF observer in α-β"),
+    baseline::<ReducedOrderEstimator<f64>>(
+        "reduced-order flux observer (Hinkkanen et al., 2018; motulator's sensorless observer)",
+    ),
 ];
 
 /// The registry row of a baseline: named by [`Baseline::NAME`], its settings under

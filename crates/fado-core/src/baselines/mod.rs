@@ -7,6 +7,7 @@
 //! | [`lpf_integrator`] | 1/(s + ωc) with gain/phase compensation at ω̂ | the low-pass pole ωc |
 //! | [`ortega`] | Lee, Hong, Nam, Ortega, Praly, Astolfi (2010) nonlinear observer | pulling \|λs − L̂·i\| to λ̂f |
 //! | [`emf_observer`] | extended-EMF observer in α-β, angle = ∠ê − sgn(ω̂)·π/2 | none needed: no integrator |
+//! | [`reduced_order`] | Hinkkanen et al. (2018) reduced-order observer in estimated rotor coordinates, with its own angle and speed loop | correcting ψ̂ with the flux read from the current |
 //!
 //! Every baseline implements [`RotorAngleEstimator`](crate::RotorAngleEstimator) and
 //! [`Baseline`], and follows the crate's rules: its config is the [`MachineModel`], the
@@ -59,10 +60,12 @@ macro_rules! integrand_of {
 pub mod emf_observer;
 pub mod lpf_integrator;
 pub mod ortega;
+pub mod reduced_order;
 
 pub use emf_observer::{EmfObserverConfig, EmfObserverEstimator, EmfObserverSettings};
 pub use lpf_integrator::{LpfIntegratorConfig, LpfIntegratorEstimator, LpfIntegratorSettings};
 pub use ortega::{OrtegaConfig, OrtegaEstimator, OrtegaSettings};
+pub use reduced_order::{ReducedOrderConfig, ReducedOrderEstimator, ReducedOrderSettings};
 
 /// What every baseline shares with [`crate::EstimatorConfig`] besides the machine model: the
 /// sampling period, the two type-2 trackers, the current averaging of the integrand, the
@@ -460,7 +463,7 @@ mod tests {
 
     /// Warms `est` up on a rotating machine-like input, then checks that non-finite,
     /// overflowing and implausible samples are refused with the state left exactly as it was.
-    fn rejects_bad_samples<E: RotorAngleEstimator<f32> + Clone>(mut est: E) {
+    pub(super) fn rejects_bad_samples<E: RotorAngleEstimator<f32> + Clone>(mut est: E) {
         let (w, ts) = (125.0_f32, 1e-4_f32);
         let mut last = None;
         for n in 0..200 {
