@@ -71,3 +71,21 @@ pub trait Controller {
         true
     }
 }
+
+/// A boxed controller (an estimator chosen at run time from
+/// [`crate::estimators::ESTIMATORS`]) is a controller.
+impl<C: Controller + ?Sized> Controller for Box<C> {
+    fn align(&mut self, theta0: f64) {
+        (**self).align(theta0);
+    }
+    #[inline]
+    fn step(&mut self, m: &Measurements) -> Actuation {
+        (**self).step(m)
+    }
+    fn handle(&mut self, event: ControlEvent) {
+        (**self).handle(event);
+    }
+    fn name(&self) -> &str {
+        (**self).name()
+    }
+}

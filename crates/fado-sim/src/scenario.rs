@@ -1331,34 +1331,13 @@ pub fn run_config_with(
 ) -> Result<Outcome, SimConfigError> {
     let sc = find(scenario)
         .ok_or_else(|| SimConfigError::new("scenario", format!("unknown `{scenario}`")))?;
+    let estimator = cfg.simulation.estimator.estimator();
+    let mut cfg = cfg;
+    (estimator.prepare)(&mut cfg);
     cfg.validate()?;
     let started = Instant::now();
-    match (cfg.simulation.precision, cfg.simulation.estimator) {
-        (Precision::F64, EstimatorKind::Fado) => {
-            let drive = cfg.build_drive()?;
-            run_with(sc, cfg, drive, started, opts)
-        }
-        (Precision::F32, EstimatorKind::Fado) => {
-            let drive = cfg.build_drive_f32()?;
-            run_with(sc, cfg, drive, started, opts)
-        }
-        (Precision::F64, EstimatorKind::LpfIntegrator) => {
-            let drive = cfg.build_baseline_drive(cfg.lpf_estimator()?)?;
-            run_with(sc, cfg, drive, started, opts)
-        }
-        (Precision::F64, EstimatorKind::Ortega) => {
-            let drive = cfg.build_baseline_drive(cfg.ortega_estimator()?)?;
-            run_with(sc, cfg, drive, started, opts)
-        }
-        (Precision::F64, EstimatorKind::EmfObserver) => {
-            let drive = cfg.build_baseline_drive(cfg.emf_estimator()?)?;
-            run_with(sc, cfg, drive, started, opts)
-        }
-        (Precision::F32, _) => Err(SimConfigError::new(
-            "simulation.estimator",
-            "the baselines run with an f64 drive only (simulation.precision = \"f64\")",
-        )),
-    }
+    let drive = (estimator.build)(&cfg)?;
+    run_with(sc, cfg, drive, started, opts)
 }
 
 fn run_with<C: Controller>(
