@@ -9,7 +9,7 @@
 //! | [`emf_observer`] | extended-EMF observer in α-β, angle = ∠ê − sgn(ω̂)·π/2 | none needed: no integrator |
 //! | [`reduced_order`] | Hinkkanen et al. (2018) reduced-order observer in estimated rotor coordinates, with its own angle and speed loop | correcting ψ̂ with the flux read from the current |
 //!
-//! Every baseline implements [`RotorAngleEstimator`](crate::RotorAngleEstimator) and
+//! Every baseline implements [`RotorAngleEstimator`] and
 //! [`Baseline`], and follows the crate's rules: its config is the [`MachineModel`], the
 //! [`CommonTuning`] every estimator shares and a small record of its own settings (plain
 //! numbers with documented defaults), `new(config)` naming a bad field, `step`/`align`/`reset`, allocation-free, generic over `f32`/`f64`, and a rejected
