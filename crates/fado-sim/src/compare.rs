@@ -53,7 +53,7 @@ pub fn parse_estimator(name: &str) -> Result<&'static Estimator, SimConfigError>
 /// What to compare.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CompareOptions {
-    /// Scenario names. Default: all of [`SCENARIOS`].
+    /// Scenario names. Default: all of [`SCENARIOS`] but the neutral `custom`.
     pub scenarios: Vec<String>,
     /// Estimators. Default: all of [`ESTIMATORS`].
     pub estimators: Vec<&'static Estimator>,
@@ -72,7 +72,11 @@ pub struct CompareOptions {
 impl Default for CompareOptions {
     fn default() -> Self {
         Self {
-            scenarios: SCENARIOS.iter().map(|s| s.name.to_owned()).collect(),
+            scenarios: SCENARIOS
+                .iter()
+                .filter(|s| !s.neutral)
+                .map(|s| s.name.to_owned())
+                .collect(),
             estimators: ESTIMATORS.iter().collect(),
             averaged: false,
             config_toml: None,

@@ -13,16 +13,22 @@
 //! given directly: they are the plant's times the `[mismatch]` ratios, so "matched" stays
 //! matched when the motor changes.
 
+use std::sync::Arc;
+
 use fado_core::control::{DeadTimeMethod, DriveConfig, DriveTuning};
+use fado_core::magnetics::Saturation;
 use fado_core::{EstimatorConfig, EstimatorTuning, MachineModel};
 use serde::{Deserialize, Serialize};
 
+use crate::criteria::Criteria;
+use crate::dc_link::DcLinkParams;
 use crate::error::{SimConfigError, check};
 pub use crate::estimators::EstimatorKind;
 use crate::estimators::{check_baseline_keys, default_baselines};
 use crate::faults::FaultParams;
 use crate::inverter::InverterParams;
 use crate::load::LoadParams;
+use crate::magnetics::PlantMagnetics;
 use crate::motor::MotorParams;
 use crate::profile::Profile;
 use crate::sensors::{CurrentSensorParams, DcLinkSensorParams};
@@ -54,6 +60,10 @@ pub struct SimulationSettings {
     pub estimator: EstimatorKind,
     /// Windows `[t_off, t_on]` in s during which the k_df feedback is switched off (Fig. 9).
     pub disturbance_feedback_off: Vec<[f64; 2]>,
+    /// A holding brake holds the rotor from the start until the drive reports ready (its
+    /// calibrations over, gates on); the load acts on the brake until then (a hoist, a
+    /// vehicle on a slope). Default false.
+    pub brake: bool,
 }
 
 impl Default for SimulationSettings {
@@ -68,6 +78,7 @@ impl Default for SimulationSettings {
             precision: Precision::F64,
             estimator: EstimatorKind::FADO,
             disturbance_feedback_off: Vec::new(),
+            brake: false,
         }
     }
 }
@@ -227,6 +238,18 @@ pub struct SimConfig {
     pub inverter_model: Option<InverterModel>,
     /// Injected faults (`crate::faults`). Default none.
     pub faults: FaultParams,
+    /// The DC link behind the inverter (`crate::dc_link`). Default a stiff source.
+    #[serde(skip_serializing_if = "is_default")]
+    pub dc_link: DcLinkParams,
+    /// The user's pass criteria (`crate::criteria`): all the `custom` scenario judges, and
+    /// judged after their own by the others. Default none.
+    #[serde(skip_serializing_if = "Criteria::is_empty")]
+    pub criteria: Criteria,
+    /// The plant's saturating magnetics, `[motor.saturation]` (the algebraic model of
+    /// [`fado_core::magnetics::Saturation`]); None: the constant inductances of `[motor]`,
+    /// whose `ld`, `lq` and `flux_linkage` then stay the datasheet's (the drive's default model).
+    #[serde(skip)]
+    pub motor_saturation: Option<Saturation<f64>>,
 }
 
 impl Default for SimConfig {
@@ -248,6 +271,9 @@ impl Default for SimConfig {
             model: None,
             inverter_model: None,
             faults: FaultParams::default(),
+            dc_link: DcLinkParams::default(),
+            criteria: Criteria::default(),
+            motor_saturation: None,
         }
     }
 }
@@ -268,6 +294,10 @@ impl SimConfig {
             dc_link_sensor: self.dc_link_sensor.clone(),
             load: self.load.clone(),
             faults: self.faults.clone(),
+            dc_link: self.dc_link.clone(),
+            magnetics: self
+                .motor_saturation
+                .map(|s| Arc::new(PlantMagnetics::Saturation(s))),
         }
     }
 
@@ -280,6 +310,11 @@ impl SimConfig {
         self.speed_reference
             .validate()
             .map_err(|e| e.in_section("speed_reference"))?;
+        if let Some(sat) = &self.motor_saturation {
+            sat.validate().map_err(|e| {
+                SimConfigError::new(format!("motor.saturation.{}", e.field()), e.to_string())
+            })?;
+        }
         self.plant().validate()?;
         let rows = self.simulation.duration
             / self.inverter.sample_period()
@@ -293,6 +328,9 @@ impl SimConfig {
         self.mismatch
             .validate()
             .map_err(|e| e.in_section("mismatch"))?;
+        self.criteria
+            .validate()
+            .map_err(|e| e.in_section("criteria"))?;
         if let Some(im) = &self.inverter_model {
             im.validate().map_err(|e| e.in_section("inverter_model"))?;
         }
@@ -482,16 +520,31 @@ impl SimConfig {
 
     /// This configuration as a TOML document.
     pub fn to_toml(&self) -> String {
-        toml::to_string(self).expect("every field of SimConfig is representable in TOML")
+        let Some(sat) = &self.motor_saturation else {
+            return toml::to_string(self)
+                .expect("every field of SimConfig is representable in TOML");
+        };
+        let mut table = toml::Table::try_from(self).expect("SimConfig is a TOML table");
+        if let Some(toml::Value::Table(motor)) = table.get_mut("motor") {
+            let sat = toml::Table::try_from(sat).expect("Saturation is a TOML table");
+            motor.insert("saturation".into(), toml::Value::Table(sat));
+        }
+        toml::to_string(&table).expect("every field of SimConfig is representable in TOML")
     }
 
     /// Parses a complete or partial TOML document on top of `base`: tables merge, values and
     /// arrays replace. The result is validated. Errors name the key.
     pub fn from_toml_over(base: &SimConfig, text: &str) -> Result<SimConfig, SimConfigError> {
-        let user: toml::Table = text.parse().map_err(|e| located(text, e))?;
+        let mut user: toml::Table = text.parse().map_err(|e| located(text, e))?;
+        let saturation = take_saturation(&mut user).map_err(|e| e.located_in(text))?;
         // Check the user's document on its own first, so that errors (unknown keys, wrong
         // types) name the key the user wrote and point at it.
-        toml::from_str::<SimConfig>(text).map_err(|e| located(text, e))?;
+        if saturation.is_some() {
+            SimConfig::deserialize(toml::Value::Table(user.clone()))
+                .map_err(|e| key_error(e).located_in(text))?;
+        } else {
+            toml::from_str::<SimConfig>(text).map_err(|e| located(text, e))?;
+        }
         let mut merged = toml::Table::try_from(base)
             .map_err(|e| SimConfigError::new("<base>", e.to_string()))?;
         merge(&mut merged, user);
@@ -499,6 +552,7 @@ impl SimConfig {
             .map_err(|e| key_error(e).located_in(text))?;
         // `[motor]` has no DC link of its own (it is the inverter's).
         cfg.motor.dc_voltage = cfg.inverter.dc_voltage;
+        cfg.motor_saturation = saturation.or(base.motor_saturation);
         cfg.validate().map_err(|e| e.located_in(text))?;
         Ok(cfg)
     }
@@ -536,6 +590,20 @@ fn check_time_constant(
             2.0 * ts
         ),
     ))
+}
+
+/// Takes `[motor.saturation]` out of the user's document (`[motor]` itself is
+/// [`MachineModel`], whose keys are the linear machine's), parsed.
+fn take_saturation(user: &mut toml::Table) -> Result<Option<Saturation<f64>>, SimConfigError> {
+    let Some(toml::Value::Table(motor)) = user.get_mut("motor") else {
+        return Ok(None);
+    };
+    let Some(table) = motor.remove("saturation") else {
+        return Ok(None);
+    };
+    Saturation::<f64>::deserialize(table)
+        .map(Some)
+        .map_err(|e| key_error(e).in_section("motor.saturation"))
 }
 
 fn merge(base: &mut toml::Table, over: toml::Table) {
@@ -855,4 +923,38 @@ mod dead_time_method {
         assert_eq!(method(Plant::Averaged, Sign), Sign);
         assert_eq!(method(Plant::SwitchingResolved, Trapezoidal), Trapezoidal);
     }
+
+    #[test]
+    fn motor_saturation_is_read_checked_and_written_back() {
+        let text =
+            "[motor.saturation]\na_d0 = 380.2\na_q0 = 380.2\npsi_f = 0.088\na_qq = 1e5\nt = 2\n";
+        let cfg = SimConfig::from_toml(text).unwrap();
+        let sat = cfg.motor_saturation.unwrap();
+        assert_eq!((sat.a_qq, sat.t, sat.psi_f), (1e5, 2.0, 0.088));
+        assert!(cfg.plant().magnetics.is_some());
+        // --dump-config round trip keeps it.
+        let back = SimConfig::from_toml(&cfg.to_toml()).unwrap();
+        assert_eq!(back.motor_saturation, cfg.motor_saturation);
+        // Without the table the plant keeps its constant inductances.
+        assert!(SimConfig::default().plant().magnetics.is_none());
+        // Errors name the key and point at it.
+        let e =
+            SimConfig::from_toml("[motor.saturation]\na_d0 = 380.2\na_q0 = -1.0\n").unwrap_err();
+        assert_eq!(e.key, "motor.saturation.a_q0", "{e}");
+        assert_eq!(e.location.as_ref().map(|l| l.line), Some(3), "{e}");
+        let e =
+            SimConfig::from_toml("[motor.saturation]\na_d0 = 380.2\na_qqq = 1.0\n").unwrap_err();
+        assert!(e.key.starts_with("motor.saturation"), "{e}");
+        assert!(e.to_string().contains("a_qqq"), "{e}");
+        let e = SimConfig::from_toml(
+            "[motor]\nrs = -1.0\n[motor.saturation]\na_d0 = 1.0\na_q0 = 1.0\n",
+        )
+        .unwrap_err();
+        assert_eq!(e.key, "motor.rs", "{e}");
+    }
+}
+
+/// Whether `x` is its type's default (sections left out of the written TOML when untouched).
+fn is_default<T: Default + PartialEq>(x: &T) -> bool {
+    *x == T::default()
 }

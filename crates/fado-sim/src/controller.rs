@@ -64,6 +64,12 @@ pub trait Controller {
     fn handle(&mut self, _event: ControlEvent) {}
     /// Short name for tables.
     fn name(&self) -> &str;
+    /// The controller holds the rotor and runs: its start-up (calibrations) is over, its
+    /// gates are on and it has not tripped. A plant brake (`simulation.brake`) releases at the
+    /// first sample this is true. Default: always (controllers without a start-up).
+    fn ready(&self) -> bool {
+        true
+    }
 }
 
 /// A boxed controller (an estimator chosen at run time from

@@ -13,6 +13,11 @@ where
         SensorlessDrive::align(self, theta0);
     }
 
+    fn ready(&self) -> bool {
+        let last = self.last();
+        !self.is_calibrating() && !self.is_calibrating_gain() && last.gates_enabled && !last.tripped
+    }
+
     #[inline]
     fn step(&mut self, m: &Measurements) -> Actuation {
         let out = SensorlessDrive::step(self, m.i_abc, m.vdc, m.speed_ref_mech);
@@ -95,6 +100,14 @@ fn dq64(x: Dq<f32>) -> Dq<f64> {
 impl Controller for DriveF32 {
     fn align(&mut self, theta0: f64) {
         self.0.align(theta0 as f32);
+    }
+
+    fn ready(&self) -> bool {
+        let last = self.0.last();
+        !self.0.is_calibrating()
+            && !self.0.is_calibrating_gain()
+            && last.gates_enabled
+            && !last.tripped
     }
 
     #[inline]
