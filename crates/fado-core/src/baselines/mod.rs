@@ -57,6 +57,41 @@ macro_rules! integrand_of {
     };
 }
 
+/// A baseline's [`GuardedStep`] bookkeeping: its `last` estimate, `rejected_samples` counter and
+/// `integrand`.
+macro_rules! guarded_state {
+    () => {
+        fn record(&mut self) -> (&mut Estimate<T>, &mut u32) {
+            (&mut self.last, &mut self.rejected_samples)
+        }
+        fn integrand(&mut self) -> &mut Integrand<T> {
+            &mut self.integrand
+        }
+    };
+}
+
+/// [`RotorAngleEstimator`] of a baseline through its own `step`, `align` and `reset`, named
+/// by [`Baseline::NAME`].
+macro_rules! rotor_angle_estimator {
+    ($ty:ident) => {
+        impl<T: Real> RotorAngleEstimator<T> for $ty<T> {
+            #[inline]
+            fn step(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> Estimate<T> {
+                $ty::step(self, v_ab, i_ab)
+            }
+            fn align(&mut self, theta0: T, i_ab: Ab<T>) {
+                $ty::align(self, theta0, i_ab)
+            }
+            fn reset(&mut self) {
+                $ty::reset(self)
+            }
+            fn name(&self) -> &'static str {
+                <Self as Baseline<T>>::NAME
+            }
+        }
+    };
+}
+
 pub mod emf_observer;
 pub mod lpf_integrator;
 pub mod ortega;
