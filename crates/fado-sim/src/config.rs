@@ -565,7 +565,8 @@ impl SimConfig {
     /// This configuration as a TOML document.
     pub fn to_toml(&self) -> String {
         let Some(sat) = &self.motor_saturation else {
-            return toml::to_string(self).expect("every field of SimConfig is representable in TOML");
+            return toml::to_string(self)
+                .expect("every field of SimConfig is representable in TOML");
         };
         let mut table = toml::Table::try_from(self).expect("SimConfig is a TOML table");
         if let Some(toml::Value::Table(motor)) = table.get_mut("motor") {
@@ -929,7 +930,8 @@ mod dead_time_method {
 
     #[test]
     fn motor_saturation_is_read_checked_and_written_back() {
-        let text = "[motor.saturation]\na_d0 = 380.2\na_q0 = 380.2\npsi_f = 0.088\na_qq = 1e5\nt = 2\n";
+        let text =
+            "[motor.saturation]\na_d0 = 380.2\na_q0 = 380.2\npsi_f = 0.088\na_qq = 1e5\nt = 2\n";
         let cfg = SimConfig::from_toml(text).unwrap();
         let sat = cfg.motor_saturation.unwrap();
         assert_eq!((sat.a_qq, sat.t, sat.psi_f), (1e5, 2.0, 0.088));
@@ -940,14 +942,18 @@ mod dead_time_method {
         // Without the table the plant keeps its constant inductances.
         assert!(SimConfig::default().plant().magnetics.is_none());
         // Errors name the key and point at it.
-        let e = SimConfig::from_toml("[motor.saturation]\na_d0 = 380.2\na_q0 = -1.0\n").unwrap_err();
+        let e =
+            SimConfig::from_toml("[motor.saturation]\na_d0 = 380.2\na_q0 = -1.0\n").unwrap_err();
         assert_eq!(e.key, "motor.saturation.a_q0", "{e}");
         assert_eq!(e.location.as_ref().map(|l| l.line), Some(3), "{e}");
-        let e = SimConfig::from_toml("[motor.saturation]\na_d0 = 380.2\na_qqq = 1.0\n").unwrap_err();
+        let e =
+            SimConfig::from_toml("[motor.saturation]\na_d0 = 380.2\na_qqq = 1.0\n").unwrap_err();
         assert!(e.key.starts_with("motor.saturation"), "{e}");
         assert!(e.to_string().contains("a_qqq"), "{e}");
-        let e = SimConfig::from_toml("[motor]\nrs = -1.0\n[motor.saturation]\na_d0 = 1.0\na_q0 = 1.0\n")
-            .unwrap_err();
+        let e = SimConfig::from_toml(
+            "[motor]\nrs = -1.0\n[motor.saturation]\na_d0 = 1.0\na_q0 = 1.0\n",
+        )
+        .unwrap_err();
         assert_eq!(e.key, "motor.rs", "{e}");
     }
 }
