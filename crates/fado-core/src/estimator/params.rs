@@ -222,10 +222,17 @@ impl<T: Real> SampleBlocks<T> {
             ts,
         )?;
         check::positive("tracker_damping", config.tuning.tracker_damping)?;
-        let t2s1 = TrackerParams::new(config.tracker(config.tuning.t2s1_bandwidth_hz))
-            .map_err(rename("t2s1_bandwidth_hz"))?;
-        let t2s2 = TrackerParams::new(config.tracker(config.tuning.t2s2_bandwidth_hz))
-            .map_err(rename("t2s2_bandwidth_hz"))?;
+        let load_pole = config.tuning.tracker_load_pole_ratio;
+        let (c1, c2) = (
+            config.tracker(config.tuning.t2s1_bandwidth_hz),
+            config.tracker(config.tuning.t2s2_bandwidth_hz),
+        );
+        let t2s1 = TrackerParams::new(c1)
+            .map_err(rename("t2s1_bandwidth_hz"))?
+            .with_load_pole(&c1, load_pole)?;
+        let t2s2 = TrackerParams::new(c2)
+            .map_err(rename("t2s2_bandwidth_hz"))?
+            .with_load_pole(&c2, load_pole)?;
         Ok(Self {
             integrator,
             observer,
