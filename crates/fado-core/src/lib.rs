@@ -18,6 +18,7 @@ pub mod injection;
 pub mod integrand_offset;
 pub mod lock;
 pub mod machine;
+pub mod magnetics;
 pub mod mode;
 pub mod observer;
 pub mod plausibility;
@@ -36,5 +37,6 @@ pub use estimator::{
 pub use frames::{Ab, Abc, Dq, Rotation};
 pub use lock::LockStatus;
 pub use machine::MachineModel;
+pub use magnetics::{MagneticModel, Magnetics};
 pub use mode::Mode;
 pub use real::{Real, wrap_angle};
