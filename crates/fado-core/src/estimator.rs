@@ -781,6 +781,9 @@ impl<T: Real> EstimatorParams<T> {
     pub fn new(config: EstimatorConfig<T>) -> Result<Self, ConfigError> {
         let ts = check::positive("ts", config.ts)?;
         config.machine.validate()?;
+        // The sampling period against the rated speed (a period in ms given as s), before any
+        // gain derived from it is refused in its stead.
+        crate::machine_checks::validate(&config.machine.cast::<f64>(), Some(ts.to_f64()))?;
         let lf = config.machine.flux_linkage;
         let ratio = check::positive("limiter_radius_ratio", config.tuning.limiter_radius_ratio)?;
         let hold = check::non_negative("tracker_hold_ratio", config.tuning.tracker_hold_ratio)?;

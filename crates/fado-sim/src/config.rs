@@ -281,6 +281,10 @@ pub struct SimConfig {
     pub inverter_model: Option<InverterModel>,
     /// Injected faults (`crate::faults`). Default none.
     pub faults: FaultParams,
+    /// The keys the configuration file left out whose values were derived from the motor's
+    /// ratings (`crate::derive`), with their rules; not a TOML table.
+    #[serde(skip)]
+    pub derived: Vec<crate::derive::Derived>,
 }
 
 impl Default for SimConfig {
@@ -302,6 +306,7 @@ impl Default for SimConfig {
             model: None,
             inverter_model: None,
             faults: FaultParams::default(),
+            derived: Vec::new(),
         }
     }
 }
@@ -335,6 +340,15 @@ impl SimConfig {
             .validate()
             .map_err(|e| e.in_section("speed_reference"))?;
         self.plant().validate()?;
+        // The machine's cross-checks, with every key involved named (before the single-key
+        // refusals of `validate_motor` below).
+        if let Some((_, key, text)) = self
+            .machine_findings()
+            .into_iter()
+            .find(|(s, ..)| *s == fado_core::machine_checks::Severity::Error)
+        {
+            return Err(SimConfigError::new(key, text));
+        }
         let rows = self.simulation.duration
             / self.inverter.sample_period()
             / self.simulation.decimation as f64;
@@ -549,27 +563,142 @@ impl SimConfig {
         toml::to_string(self).expect("every field of SimConfig is representable in TOML")
     }
 
-    /// Parses a complete or partial TOML document on top of `base`: tables merge, values and
-    /// arrays replace. The result is validated. Errors name the key.
+    /// Parses a partial TOML document on top of `base`, an explicit configuration (a
+    /// scenario's with the user's motor, a sweep point's): tables merge, values and arrays
+    /// replace, so `[motor]\nrs = 0.5` changes one key of `base`'s motor. The result is
+    /// validated. Errors name the key.
     pub fn from_toml_over(base: &SimConfig, text: &str) -> Result<SimConfig, SimConfigError> {
-        let user: toml::Table = text.parse().map_err(|e| located(text, e))?;
+        Self::parse_over(base, text, false)
+    }
+
+    /// Parses a user's configuration file on top of `base`: as
+    /// [`from_toml_over`](Self::from_toml_over), except that a `[motor]` table describes the
+    /// whole motor — every circuit key and rating required, the others derived from the
+    /// ratings with the `[inverter]` keys they give (`crate::derive`), none taken from
+    /// `base`'s motor.
+    pub fn from_user_toml(base: &SimConfig, text: &str) -> Result<SimConfig, SimConfigError> {
+        Self::parse_over(base, text, true)
+    }
+
+    fn parse_over(
+        base: &SimConfig,
+        text: &str,
+        whole_motor: bool,
+    ) -> Result<SimConfig, SimConfigError> {
+        let mut user: toml::Table = text.parse().map_err(|e| located(text, e))?;
         // Check the user's document on its own first, so that errors (unknown keys, wrong
         // types) name the key the user wrote and point at it.
         toml::from_str::<SimConfig>(text).map_err(|e| located(text, e))?;
+        let derived = if whole_motor {
+            crate::derive::complete_motor(&mut user, text)?
+        } else {
+            Vec::new()
+        };
+        let given = user.clone();
         let mut merged = toml::Table::try_from(base)
             .map_err(|e| SimConfigError::new("<base>", e.to_string()))?;
         merge(&mut merged, user);
         let mut cfg = SimConfig::deserialize(toml::Value::Table(merged))
             .map_err(|e| key_error(e).located_in(text))?;
+        // What `base` derived stays derived unless the document gives it now.
+        cfg.derived = base
+            .derived
+            .iter()
+            .filter(|d| {
+                let (section, key) = d.key.split_once('.').unwrap_or(("", ""));
+                !given
+                    .get(section)
+                    .and_then(|t| t.as_table())
+                    .is_some_and(|t| t.contains_key(key))
+            })
+            .filter(|d| !derived.iter().any(|n| n.key == d.key))
+            .cloned()
+            .collect();
+        cfg.derived.extend(derived);
         // `[motor]` has no DC link of its own (it is the inverter's).
         cfg.motor.dc_voltage = cfg.inverter.dc_voltage;
         cfg.validate().map_err(|e| e.located_in(text))?;
         Ok(cfg)
     }
 
-    /// Parses a TOML document over the defaults.
+    /// Parses a user's TOML document over the defaults (see
+    /// [`from_user_toml`](Self::from_user_toml)).
     pub fn from_toml(text: &str) -> Result<SimConfig, SimConfigError> {
-        Self::from_toml_over(&SimConfig::default(), text)
+        Self::from_user_toml(&SimConfig::default(), text)
+    }
+
+    /// The defaults with `machine` as the motor and its `dc_voltage` as the DC link; the
+    /// other `[inverter]` keys its ratings give are derived (`crate::derive`) and recorded.
+    pub fn for_machine(machine: &MachineModel<f64>) -> SimConfig {
+        let mut c = SimConfig {
+            motor: *machine,
+            ..SimConfig::default()
+        };
+        let mut given = toml::Table::new();
+        given.insert("dc_voltage".into(), toml::Value::Float(machine.dc_voltage));
+        c.inverter.dc_voltage = machine.dc_voltage;
+        for (key, value) in crate::derive::inverter_values(machine, &given) {
+            match key {
+                "switching_frequency" => c.inverter.switching_frequency = value,
+                "dead_time" => c.inverter.dead_time = value,
+                "threshold_voltage" => c.inverter.threshold_voltage = value,
+                "current_band" => c.inverter.current_band = value,
+                _ => continue,
+            }
+            let full = format!("inverter.{key}");
+            c.derived.push(crate::derive::Derived {
+                rule: fado_core::ratings::rule(&full).unwrap_or(""),
+                key: full,
+                value,
+            });
+        }
+        c
+    }
+
+    /// This configuration as TOML with each derived key's rule beside it (`--dump-config`).
+    pub fn to_toml_annotated(&self) -> String {
+        crate::derive::annotate(&self.to_toml(), &self.derived)
+    }
+
+    /// The plausibility findings of the motor against its ratings, the DC link and the
+    /// sampling period (`fado_core::machine_checks`), each with its message naming the TOML
+    /// keys involved: errors first.
+    pub fn machine_findings(&self) -> Vec<(fado_core::machine_checks::Severity, String, String)> {
+        let m = MachineModel {
+            dc_voltage: self.inverter.dc_voltage,
+            ..self.motor
+        };
+        fado_core::machine_checks::check(&m, Some(self.inverter.sample_period()))
+            .iter()
+            .map(|f| {
+                let mut text = f.to_string();
+                for k in f.keys() {
+                    let full = plant_key(k);
+                    text = text.replace(&format!("`{k}`"), &format!("`{full}`"));
+                }
+                (f.severity(), plant_key(f.key()), text)
+            })
+            .collect()
+    }
+
+    /// The plausibility warnings of [`machine_findings`](Self::machine_findings), as
+    /// `key: message` lines.
+    pub fn warnings(&self) -> Vec<String> {
+        self.machine_findings()
+            .into_iter()
+            .filter(|(s, ..)| *s == fado_core::machine_checks::Severity::Warning)
+            .map(|(_, _, text)| text)
+            .collect()
+    }
+}
+
+/// The TOML key of a machine-check field: `[inverter]`'s for the DC link and the sampling
+/// period, `[motor]`'s otherwise.
+fn plant_key(field: &str) -> String {
+    match field {
+        "dc_voltage" => "inverter.dc_voltage".to_owned(),
+        "ts" => "inverter.switching_frequency".to_owned(),
+        k => format!("motor.{k}"),
     }
 }
 

@@ -47,6 +47,7 @@ pub mod commission;
 pub mod compare;
 pub mod config;
 pub mod controller;
+pub mod derive;
 pub mod drive;
 pub mod error;
 mod fastmath;
