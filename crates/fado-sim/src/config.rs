@@ -923,12 +923,42 @@ mod located_errors {
         assert_eq!((key.as_str(), line), ("simulation.decimation", 2));
     }
 
+    /// The paper's motor as a whole `[motor]` table whose first key is `first` (which
+    /// replaces the paper's value of that key).
+    pub(crate) fn paper_motor_with(first: &str) -> String {
+        let key = first.split('=').next().unwrap_or("").trim();
+        let m = MachineModel::<f64>::paper();
+        let mut text = format!("[motor]\n{first}\n");
+        for (k, v) in [
+            ("rs", m.rs),
+            ("ld", m.ld),
+            ("lq", m.lq),
+            ("flux_linkage", m.flux_linkage),
+            ("pole_pairs", m.pole_pairs as f64),
+            ("inertia", m.inertia),
+            ("viscous_friction", m.viscous_friction),
+            ("rated_current", m.rated_current),
+            ("rated_speed_rpm", m.rated_speed_rpm),
+            ("rated_torque", m.rated_torque),
+        ] {
+            if k != key {
+                if k == "pole_pairs" {
+                    text.push_str(&format!("{k} = {}\n", v as u32));
+                } else {
+                    text.push_str(&format!("{k} = {v:?}\n"));
+                }
+            }
+        }
+        text.push_str("[inverter]\ndc_voltage = 311.0\nswitching_frequency = 5000.0\n");
+        text
+    }
+
     #[test]
     fn derived_limits_name_the_users_own_key() {
         // Issue 15's probes: before, each was refused as `controller.current_anti_windup_ratio`.
-        let (key, line, col, _) = err("[motor]\nrs = 1e300\n");
+        let (key, line, col, _) = err(&paper_motor_with("rs = 1e300"));
         assert_eq!((key.as_str(), line, col), ("motor.rs", 2, 6));
-        let (key, line, _, _) = err("[motor]\nld = 1e-300\n");
+        let (key, line, _, _) = err(&paper_motor_with("ld = 1e-300"));
         assert_eq!((key.as_str(), line), ("motor.ld", 2));
         let (key, line, _, _) = err("[mismatch]\nrs_ratio = 1e300\n");
         assert_eq!((key.as_str(), line), ("mismatch.rs_ratio", 2));

@@ -64,7 +64,13 @@ pub fn complete_motor(user: &mut toml::Table, text: &str) -> Result<Vec<Derived>
     };
     let mut motor = motor.clone();
     // A given value that is not usable is named by the validation at its own value.
-    let given_ok = |k: &str| number(&motor, k).is_some_and(|x| x.is_finite() && x > 0.0);
+    let given_ok = |k: &str| {
+        let max = fado_core::machine_checks::RANGES
+            .iter()
+            .find(|(key, ..)| *key == k)
+            .map_or(f64::INFINITY, |r| r.1);
+        number(&motor, k).is_some_and(|x| x.is_finite() && x > 0.0 && x <= max)
+    };
     for key in ratings::REQUIRED_MOTOR_KEYS {
         if motor.contains_key(key) && !given_ok(key) {
             return Ok(Vec::new());
