@@ -339,9 +339,8 @@ impl SimConfig {
         self.speed_reference
             .validate()
             .map_err(|e| e.in_section("speed_reference"))?;
-        self.plant().validate()?;
         // The machine's cross-checks, with every key involved named (before the single-key
-        // refusals of `validate_motor` below).
+        // refusals of the plant's and the model's validation).
         if let Some((_, key, text)) = self
             .machine_findings()
             .into_iter()
@@ -349,6 +348,7 @@ impl SimConfig {
         {
             return Err(SimConfigError::new(key, text));
         }
+        self.plant().validate()?;
         let rows = self.simulation.duration
             / self.inverter.sample_period()
             / self.simulation.decimation as f64;
