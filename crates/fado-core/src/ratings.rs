@@ -259,18 +259,14 @@ mod tests {
 
     #[test]
     fn mtpa_current_maximises_the_torque_on_the_circle() {
-        let m = MachineModel::<f64> {
+        // The 2.2 kW IPMSM: p 3, Ld 36 mH, Lq 51 mH, λf 0.545 Wb.
+        let m = MachineModel {
             rs: 3.6,
             ld: 36e-3,
             lq: 51e-3,
             flux_linkage: 0.545,
             pole_pairs: 3,
-            inertia: 0.01,
-            viscous_friction: 0.0,
-            rated_current: 6.0,
-            rated_speed_rpm: 1500.0,
-            rated_torque: 14.7,
-            dc_voltage: 540.0,
+            ..MachineModel::<f64>::paper()
         };
         let (id, iq) = mtpa_current(&m, 6.0);
         assert!((id * id + iq * iq - 36.0).abs() < 1e-9);

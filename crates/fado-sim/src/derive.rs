@@ -6,6 +6,11 @@
 //! motor (the scenario's or the paper's). Each derived value is recorded with its rule
 //! ([`Derived`]), which `fado-sim run --dump-config` prints beside it.
 //!
+//! The rules apply to the file as read (`SimConfig::from_user_toml`, what `fado-sim --config`,
+//! the presets and `fado.simulate(config=…)` use); a later override of one key
+//! (`SimConfig::from_toml_over`: a sweep axis `motor.rated_torque`, a Python `config` over a
+//! `Machine`) changes that key alone and keeps the values derived before.
+//!
 //! The other `[inverter]` keys are simulation settings with a neutral default, not a property
 //! of another motor's inverter: `model` (switching-resolved), `commutation` (linear band),
 //! `dc_ripple_amplitude` 0 (no ripple; `dc_ripple_frequency` then unused), `on_resistance` 0

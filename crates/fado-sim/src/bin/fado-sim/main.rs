@@ -105,7 +105,9 @@ enum Command {
     /// Identify the motor of FILE's `[motor]` (with `rated_current`, `rated_speed_rpm`,
     /// `rated_torque`) on the simulated plant with `fado_core::commissioning`; print each
     /// parameter against the plant's truth; write DIR/identified.toml (`[model]`),
-    /// DIR/metrics.json and DIR/traces.csv.
+    /// DIR/metrics.json and DIR/traces.csv, as `run` writes: under the directory's lock, each
+    /// whole or not at all. Refused before it runs when the set-up cannot be measured
+    /// (ω_rated·Ts above 0.2, a current sensor coarser than 1 % of its current limit).
     Commission {
         /// TOML file: the plant (`[motor]` with its ratings, `[inverter]`, sensors, …).
         #[arg(long)]
