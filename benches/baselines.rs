@@ -59,7 +59,7 @@ fn estimators(c: &mut Criterion) {
         &data,
     );
     // fado on the paper's path (`EstimatorTuning::paper_path`, the Cortex-M image's scenarios
-    // 4-5, docs/firmware.md): the paper's method inside fado's step, against the baselines.
+    // 4-5, docs/results/firmware-cost.md): the paper's method inside fado's step, against the baselines.
     bench_named(
         c,
         "fado-paper-path_step_f32",

@@ -104,8 +104,7 @@ cpu=$(lscpu 2>/dev/null | sed -n 's/^Model name: *//p' | head -n1)
         echo
         echo "\`cargo bench --bench paired\` (\`benches/paired.rs\`): the same inputs and estimators as"
         echo "the f32 step column, each round timing 1000 steps of every estimator in a random order,"
-        echo "the ratio taken within the round (a paired design: the machine's drift cancels). Issue"
-        echo "16's host target is fado's default step ≤ 1.2× Ortega's."
+        echo "the ratio taken within the round (a paired design: the machine's drift cancels)."
         echo
         echo '```text'
         grep -v '^$' "$out.paired.txt"

@@ -53,7 +53,7 @@ PAPER_DEFAULTS = {
     "lock_detection_time": 5e-3,  # [A]
     "lock_heal_time": 0.1,  # [A]
     "lock_limiter_clamping": False,  # [A]
-    "lock_handover_count": 5.0,  # [A] (docs/lock.md "Mode hand-over chatter")
+    "lock_handover_count": 5.0,  # [A] (docs/method/lock.md)
     "lock_handover_time": 0.1,  # [A]
 }
 

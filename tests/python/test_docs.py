@@ -1,4 +1,5 @@
-"""Every Python and shell code block of README.md and docs/*.md runs as written.
+"""Every Python and shell code block of README.md and the documentation pages (docs/**/*.md)
+runs as written.
 
 A block is a fenced ```python, ```py, ```sh, ```bash or ```console block. The line right
 before its fence may say
@@ -27,7 +28,14 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
-DOCS = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+# Generated pages (the gallery's, the API reference's) are not hand-written documentation.
+GENERATED = {"auto_examples", "api", "_build"}
+DOCS = [
+    ROOT / "README.md",
+    *sorted(
+        p for p in (ROOT / "docs").rglob("*.md") if not GENERATED & set(p.relative_to(ROOT).parts)
+    ),
+]
 PYTHON = {"python", "py"}
 SHELL = {"sh", "bash", "console", "shell"}
 NOT_RUN = re.compile(r"^<!--\s*not run:\s*(\S.*?)\s*-->$")
@@ -53,7 +61,8 @@ def blocks(path: Path) -> list[Block]:
     lines = path.read_text(encoding="utf-8").splitlines()
     k = 0
     while k < len(lines):
-        fence = re.match(r"^```(\w*)\s*$", lines[k])
+        # A language (```python) or a MyST directive (```{toctree}, never run).
+        fence = re.match(r"^```(\{[\w-]+\}|\w*)(\s.*)?$", lines[k])
         if not fence:
             k += 1
             continue

@@ -116,7 +116,7 @@ pub fn parse_estimator(name: &str) -> Result<Contender, SimConfigError> {
 /// What to compare.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CompareOptions {
-    /// Scenario names. Default: all of [`SCENARIOS`].
+    /// Scenario names. Default: all of [`SCENARIOS`] but the neutral `custom`.
     pub scenarios: Vec<String>,
     /// Estimators. Default: [`ESTIMATORS`].
     pub estimators: Vec<Contender>,
@@ -135,7 +135,11 @@ pub struct CompareOptions {
 impl Default for CompareOptions {
     fn default() -> Self {
         Self {
-            scenarios: SCENARIOS.iter().map(|s| s.name.to_owned()).collect(),
+            scenarios: SCENARIOS
+                .iter()
+                .filter(|s| !s.neutral)
+                .map(|s| s.name.to_owned())
+                .collect(),
             estimators: ESTIMATORS.to_vec(),
             averaged: false,
             config_toml: None,

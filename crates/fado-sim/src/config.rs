@@ -17,6 +17,8 @@ use fado_core::control::{DeadTimeMethod, DriveConfig, DriveTuning};
 use fado_core::{EstimatorConfig, EstimatorTuning, MachineModel};
 use serde::{Deserialize, Serialize};
 
+use crate::criteria::Criteria;
+use crate::dc_link::DcLinkParams;
 use crate::error::{SimConfigError, check};
 use crate::faults::FaultParams;
 use crate::inverter::InverterParams;
@@ -281,6 +283,13 @@ pub struct SimConfig {
     pub inverter_model: Option<InverterModel>,
     /// Injected faults (`crate::faults`). Default none.
     pub faults: FaultParams,
+    /// The DC link behind the inverter (`crate::dc_link`). Default a stiff source.
+    #[serde(skip_serializing_if = "is_default")]
+    pub dc_link: DcLinkParams,
+    /// The user's pass criteria (`crate::criteria`): all the `custom` scenario judges, and
+    /// judged after their own by the others. Default none.
+    #[serde(skip_serializing_if = "Criteria::is_empty")]
+    pub criteria: Criteria,
     /// The keys the configuration file left out whose values were derived from the motor's
     /// ratings (`crate::derive`), with their rules; not a TOML table.
     #[serde(skip)]
@@ -306,6 +315,8 @@ impl Default for SimConfig {
             model: None,
             inverter_model: None,
             faults: FaultParams::default(),
+            dc_link: DcLinkParams::default(),
+            criteria: Criteria::default(),
             derived: Vec::new(),
         }
     }
@@ -327,6 +338,7 @@ impl SimConfig {
             dc_link_sensor: self.dc_link_sensor.clone(),
             load: self.load.clone(),
             faults: self.faults.clone(),
+            dc_link: self.dc_link.clone(),
         }
     }
 
@@ -361,6 +373,9 @@ impl SimConfig {
         self.mismatch
             .validate()
             .map_err(|e| e.in_section("mismatch"))?;
+        self.criteria
+            .validate()
+            .map_err(|e| e.in_section("criteria"))?;
         if let Some(im) = &self.inverter_model {
             im.validate().map_err(|e| e.in_section("inverter_model"))?;
         }
@@ -1038,4 +1053,9 @@ mod dead_time_method {
         assert_eq!(method(Plant::Averaged, Sign), Sign);
         assert_eq!(method(Plant::SwitchingResolved, Trapezoidal), Trapezoidal);
     }
+}
+
+/// Whether `x` is its type's default (sections left out of the written TOML when untouched).
+fn is_default<T: Default + PartialEq>(x: &T) -> bool {
+    *x == T::default()
 }

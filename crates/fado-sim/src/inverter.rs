@@ -270,6 +270,9 @@ pub struct Inverter {
     sample: u64,
     /// DC-link voltage as a fraction of its nominal value (fault injection, a supply dip).
     dc_link_scale: f64,
+    /// The bus voltage of a DC link that is not stiff (`crate::dc_link`), V; `None`: the
+    /// source's.
+    bus_voltage: Option<f64>,
     /// Subtracted from the applied α-β voltage while the gates are enabled (fault injection,
     /// `[faults] voltage_offset`: the drive's voltage is this much above the true one), V.
     voltage_offset: Ab<f64>,
@@ -288,6 +291,7 @@ impl Inverter {
             legs: [Leg::default(); 3],
             sample: 0,
             dc_link_scale: 1.0,
+            bus_voltage: None,
             voltage_offset: Ab::zero(),
         })
     }
@@ -310,7 +314,22 @@ impl Inverter {
     /// DC-link voltage over the present sample (with the dip of
     /// [`set_dc_link_scale`](Self::set_dc_link_scale)).
     pub fn dc_voltage(&self) -> f64 {
+        match self.bus_voltage {
+            Some(v) => v,
+            None => self.source_voltage(),
+        }
+    }
+
+    /// Voltage of the DC source over the present sample (nominal, ripple, the dip of
+    /// [`set_dc_link_scale`](Self::set_dc_link_scale)), V: the bus voltage of a stiff link.
+    pub fn source_voltage(&self) -> f64 {
         self.params.dc_voltage_at(self.time()) * self.dc_link_scale
+    }
+
+    /// Sets the bus voltage the inverter switches from the present sample on (a DC link
+    /// with a capacitor, `crate::dc_link`).
+    pub fn set_bus_voltage(&mut self, v: f64) {
+        self.bus_voltage = Some(v);
     }
 
     /// Scales the DC-link voltage from the present sample on (1 = nominal; a supply dip of

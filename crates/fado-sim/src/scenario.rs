@@ -35,6 +35,9 @@ pub struct Scenario {
     /// so that the scenario runs for any motor; otherwise it is the paper's in absolute
     /// units (r/min, N·m of its motor).
     pub scaled: bool,
+    /// Judges nothing of its own, not even a trip: only the user's `[criteria]` (the
+    /// `custom` scenario). Left out of `compare`'s default scenario list.
+    pub neutral: bool,
     /// Sets the profile, load, duration and evaluation window on a configuration (a scaled
     /// scenario from its `[motor]` ratings).
     pub setup: fn(&mut SimConfig),
@@ -59,7 +62,7 @@ impl Eq for Scenario {}
 /// staircase; then the paper's experiments scaled by the motor's ratings (its motor: 1500
 /// r/min, 11.5 N·m), which run for any motor: `reversal` (Fig. 11), `stops` (Fig. 12) and
 /// `rated-reversal` (Fig. 11 under the rated torque).
-pub const SCENARIOS: [Scenario; 10] = [
+pub const SCENARIOS: [Scenario; 13] = [
     Scenario {
         name: "fig8",
         title: "Flux and disturbance estimation under 2 N·m (Fig. 8)",
@@ -68,6 +71,7 @@ pub const SCENARIOS: [Scenario; 10] = [
                     revolution spent above 30 r/min in HI mode < 2 % of λf; no trip; \
                     speed error < 30 r/min",
         scaled: false,
+        neutral: false,
         setup: setup_fig8,
         observe: observe_nothing,
         checks: checks_fig8,
@@ -80,6 +84,7 @@ pub const SCENARIOS: [Scenario; 10] = [
         criterion: "λ1 drifts while off (|ΔD̂| > 2 mWb) and recovers with τ ≈ 2 s \
                     (residual after 2 s in [0.2, 0.55]); |θ − θ̂| < 0.05 rad",
         scaled: false,
+        neutral: false,
         setup: setup_fig9,
         observe: observe_nothing,
         checks: checks_fig9,
@@ -91,6 +96,7 @@ pub const SCENARIOS: [Scenario; 10] = [
         criterion: "|θ − θ̂| < 0.35 rad (does not diverge); |λ̂r| ≤ 1.15·λ̂f (+1 %); \
                     FLAG_limit high ≥ 95 % of the hold",
         scaled: false,
+        neutral: false,
         setup: setup_fig10,
         observe: observe_fig10,
         checks: checks_fig10,
@@ -102,6 +108,7 @@ pub const SCENARIOS: [Scenario; 10] = [
         criterion: "|θ − θ̂| < 0.25 rad near zero speed (|n| < 30 r/min) [P]; no trip; \
                     speed error < 30 r/min",
         scaled: false,
+        neutral: false,
         setup: setup_fig11,
         observe: observe_nothing,
         checks: checks_reversal,
@@ -113,6 +120,7 @@ pub const SCENARIOS: [Scenario; 10] = [
                   0 → 60, 500 ms at 60)",
         criterion: "no trip or instability [P]; |θ − θ̂| < 0.25 rad [A]; speed error < 30 r/min",
         scaled: false,
+        neutral: false,
         setup: setup_fig12,
         observe: observe_nothing,
         checks: checks_stops,
@@ -123,6 +131,7 @@ pub const SCENARIOS: [Scenario; 10] = [
         profile: "0 → 300 r/min in 1 s, T_L → 7.5 N·m over [1.5 s, 2 s], hold to 4 s",
         criterion: "settled (from 2.5 s) |θ − θ̂| < 0.05 rad; speed error < 10 r/min; no trip",
         scaled: false,
+        neutral: false,
         setup: setup_steady300,
         observe: observe_nothing,
         checks: checks_steady300,
@@ -137,6 +146,7 @@ pub const SCENARIOS: [Scenario; 10] = [
                     the lowest level held together with every level above it; the scenario \
                     passes when every level is held",
         scaled: false,
+        neutral: false,
         setup: setup_lowspeed,
         observe: observe_lowspeed,
         checks: checks_lowspeed,
@@ -149,6 +159,7 @@ pub const SCENARIOS: [Scenario; 10] = [
         criterion: "|θ − θ̂| < 0.25 rad near zero speed (|n| < 2 % of rated) [P]; no trip; \
                     speed error < 2 % of rated speed",
         scaled: true,
+        neutral: false,
         setup: setup_reversal,
         observe: observe_nothing,
         checks: checks_reversal,
@@ -161,6 +172,7 @@ pub const SCENARIOS: [Scenario; 10] = [
         criterion: "no trip or instability [P]; |θ − θ̂| < 0.25 rad [A]; speed error < 2 % \
                     of rated speed",
         scaled: true,
+        neutral: false,
         setup: setup_stops,
         observe: observe_nothing,
         checks: checks_stops,
@@ -171,9 +183,51 @@ pub const SCENARIOS: [Scenario; 10] = [
         profile: "as `reversal` with T_L → 100 % of rated torque",
         criterion: "as `reversal`",
         scaled: true,
+        neutral: false,
         setup: setup_rated_reversal,
         observe: observe_nothing,
         checks: checks_reversal,
+    },
+    Scenario {
+        name: "fullrange",
+        title: "The whole operating range, scaled by the ratings and the model's limits",
+        profile: "standstill under 50 % of rated torque; to rated speed at the current limit; \
+                  rated load step; field weakening to the top speed the voltage and current \
+                  limits allow (≤ 2× rated; half the rated power still available) holding \
+                  min(rated power, 80 % of the limits' power); brake at the current limit \
+                  through zero; 1 s at zero under 65 % of rated torque; to −rated speed",
+        criterion: "|θ − θ̂| < 0.25 rad over the whole run; in each settled window speed within \
+                    2 % of its target (of the rated speed near zero); no trip; DC voltage within \
+                    the drive's limits",
+        scaled: true,
+        neutral: false,
+        setup: setup_fullrange,
+        observe: observe_fullrange,
+        checks: checks_range,
+    },
+    Scenario {
+        name: "regen-stop",
+        title: "Stops regenerating into a rectifier-fed DC link (with a brake chopper)",
+        profile: "rated speed, stop at the current limit; rated speed again under an overhauling \
+                  rated load, stop and hold it (rectifier, chopper at 1.05 × the bus)",
+        criterion: "as `fullrange`",
+        scaled: true,
+        neutral: false,
+        setup: setup_regen_stop,
+        observe: observe_regen_stop,
+        checks: checks_range,
+    },
+    Scenario {
+        name: "custom",
+        title: "The user's own experiment: `[speed_reference]`, `[load]`, `[criteria]`",
+        profile: "the configuration's `[speed_reference] points` and `[load]`; it runs to 1 s \
+                  after the last breakpoint unless `[simulation] duration` is given",
+        criterion: "only the `[criteria]` written (none: it reports and passes)",
+        scaled: false,
+        neutral: true,
+        setup: setup_custom,
+        observe: observe_nothing,
+        checks: checks_nothing,
     },
 ];
 
@@ -242,8 +296,13 @@ impl Scenario {
 
     /// Checks the pass criteria on a finished run.
     pub fn evaluate(&self, cfg: &SimConfig, m: &Metrics, p: &ScenarioProbe) -> Vec<Check> {
-        let mut checks = vec![Check::at_most("tripped", m.tripped as u8 as f64, 0.0)];
+        let mut checks = if self.neutral {
+            Vec::new()
+        } else {
+            vec![Check::at_most("tripped", m.tripped as u8 as f64, 0.0)]
+        };
         (self.checks)(cfg, m, p, &mut checks);
+        checks.extend(cfg.criteria.checks(cfg.motor.rated_speed_rpm, m));
         checks
     }
 }
@@ -267,6 +326,102 @@ fn observe_lowspeed(cfg: &SimConfig, p: &mut ScenarioProbe) {
         })
         .collect();
 }
+
+/// `fullrange`: see [`crate::range`].
+fn setup_fullrange(c: &mut SimConfig) {
+    crate::range::setup_fullrange(c);
+}
+
+/// `regen-stop`: see [`crate::range`].
+fn setup_regen_stop(c: &mut SimConfig) {
+    crate::range::setup_regen_stop(c);
+}
+
+fn holds_to_levels(holds: Vec<crate::range::Hold>) -> Vec<LevelStats> {
+    holds
+        .into_iter()
+        .map(|(level, from, to)| LevelStats::new(level, from, to))
+        .collect()
+}
+
+/// `fullrange`: its settled windows.
+fn observe_fullrange(cfg: &SimConfig, p: &mut ScenarioProbe) {
+    p.levels = holds_to_levels(crate::range::fullrange_holds(cfg));
+}
+
+/// `regen-stop`: its settled windows.
+fn observe_regen_stop(cfg: &SimConfig, p: &mut ScenarioProbe) {
+    p.levels = holds_to_levels(crate::range::regen_stop_holds(cfg));
+}
+
+/// `fullrange` and `regen-stop`: the angle over the run, the speed in each settled window
+/// within 2 % of its target (of the rated speed near zero), the DC link within the drive's
+/// limits.
+fn checks_range(cfg: &SimConfig, m: &Metrics, p: &ScenarioProbe, checks: &mut Vec<Check>) {
+    let rated = cfg.motor.rated_speed_rpm;
+    checks.push(Check::at_most("max |θ − θ̂| (rad)", m.max_angle_error, 0.25));
+    for l in &p.levels {
+        let bound = 0.02 * l.level_rpm.abs().max(rated);
+        checks.push(Check::at_most(
+            &format!(
+                "speed error at {:.0} r/min, {:.1}–{:.1} s (r/min)",
+                l.level_rpm, l.from, l.to
+            ),
+            l.max_speed_error_rpm,
+            bound,
+        ));
+    }
+    let v = cfg.inverter.dc_voltage;
+    checks.push(Check::at_most(
+        "max DC-link voltage (V)",
+        m.max_dc_voltage,
+        cfg.controller.dc_link.over_voltage_trip_ratio * v,
+    ));
+    checks.push(Check::at_least(
+        "min DC-link voltage (V)",
+        m.min_dc_voltage,
+        cfg.controller.dc_link_min_ratio * v,
+    ));
+    if p.levels.len() == 5 {
+        let t = crate::range::targets(cfg);
+        checks.push(Check::at_least(
+            &format!(
+                "mean speed at the top (r/min; model: {:.0})",
+                t.top_speed_rpm
+            ),
+            p.levels[2].mean_speed_rpm,
+            0.98 * t.top_speed_rpm,
+        ));
+        checks.push(Check::at_least(
+            &format!(
+                "power held at the top (W; model limit {:.0}, rated {:.0})",
+                t.limit_power_at_top, t.rated_power
+            ),
+            cfg.load.torque.value(7.5) * p.levels[2].mean_speed_rpm * std::f64::consts::TAU / 60.0,
+            0.98 * t.hold_power,
+        ));
+    }
+}
+
+/// `custom`: the user's profiles as they are; the run lasts until 1 s after the last
+/// breakpoint of the speed reference or the load (the user's `[simulation] duration`, applied
+/// after this, wins).
+fn setup_custom(c: &mut SimConfig) {
+    let end = [
+        c.speed_reference.end_time(),
+        c.load.torque.end_time(),
+        c.load.speed_rpm.end_time(),
+    ]
+    .into_iter()
+    .fold(0.0, f64::max);
+    c.simulation.duration = end + CUSTOM_TAIL_SECONDS;
+}
+
+/// What `custom` runs after the last breakpoint of its profiles, s: the settling of a step.
+pub const CUSTOM_TAIL_SECONDS: f64 = 1.0;
+
+/// No criterion of the scenario's own.
+fn checks_nothing(_cfg: &SimConfig, _m: &Metrics, _p: &ScenarioProbe, _checks: &mut Vec<Check>) {}
 
 /// `fig8`: profile, load, duration, evaluation window.
 fn setup_fig8(c: &mut SimConfig) {
@@ -547,7 +702,7 @@ pub struct Check {
 }
 
 impl Check {
-    fn at_most(name: &str, value: f64, max: f64) -> Self {
+    pub(crate) fn at_most(name: &str, value: f64, max: f64) -> Self {
         Self {
             name: name.into(),
             value,
@@ -556,7 +711,7 @@ impl Check {
             passed: value <= max,
         }
     }
-    fn at_least(name: &str, value: f64, min: f64) -> Self {
+    pub(crate) fn at_least(name: &str, value: f64, min: f64) -> Self {
         Self {
             name: name.into(),
             value,
@@ -838,6 +993,10 @@ pub struct Report {
     pub max_speed_error_rpm: f64,
     /// Tripped.
     pub tripped: bool,
+    /// Highest true DC-link voltage over the run, V.
+    pub max_dc_voltage: f64,
+    /// Lowest true DC-link voltage over the run, V.
+    pub min_dc_voltage: f64,
     /// Simulated seconds.
     pub simulated_seconds: f64,
     /// Wall seconds.
@@ -863,6 +1022,8 @@ impl Outcome {
             zero_speed_band_rpm: m.zero_speed_band_rpm,
             max_speed_error_rpm: m.max_speed_error_rpm,
             tripped: m.tripped,
+            max_dc_voltage: m.max_dc_voltage,
+            min_dc_voltage: m.min_dc_voltage,
             simulated_seconds: self.stats.simulated_seconds,
             wall_seconds: self.stats.wall_seconds,
             checks: self.checks.clone(),

@@ -256,13 +256,26 @@ impl<T: Real> DeadTimeCompensation<T> {
         if !(vdc > T::zero() && l.d > T::zero() && l.q > T::zero()) {
             return first;
         }
-        let zero = T::zero();
         let one = T::one();
-        let td = c.dead_time;
-        let half = self.half; // half carrier period = sample period
         let i = [i_abc.a, i_abc.b, i_abc.c];
-        // Pole voltages the modulator will realise: reference + first-guess compensation,
-        // min-max zero sequence (SVPWM), as offsets from the DC-link mid-point.
+        let gates = self.gate_times(v_abc, first, vdc);
+        let (d_rise, d_fall) = self.edge_delays(rotation, i, gates, vdc);
+        let band = self.inv_band;
+        let vth = c.threshold_voltage;
+        let per_second = vdc * c.switching_frequency;
+        let f =
+            |k: usize| per_second * (d_rise[k] - d_fall[k]) + vth * clamp(i[k] * band, -one, one);
+        Abc::new(f(0), f(1), f(2))
+    }
+
+    /// The gate times within each half period of the pole voltages the modulator will
+    /// realise (reference `v_abc` + first-guess compensation `first`, min-max zero sequence
+    /// as SVPWM, as offsets from the DC-link mid-point): legs go high at half/2 − v·half/Vdc
+    /// while the carrier falls (rising edges), low at half/2 + v·half/Vdc while it rises.
+    #[inline(always)]
+    fn gate_times(&self, v_abc: Abc<T>, first: Abc<T>, vdc: T) -> ([T; 3], [T; 3]) {
+        let zero = T::zero();
+        let half = self.half; // half carrier period = sample period
         let mut vp = [v_abc.a + first.a, v_abc.b + first.b, v_abc.c + first.c];
         let (mx, mn) = (
             vp[0].step_max(vp[1]).step_max(vp[2]),
@@ -274,21 +287,59 @@ impl<T: Real> DeadTimeCompensation<T> {
         }
         let secs_per_volt = half / vdc;
         let h = T::lit(0.5) * half;
-        // Gate times within each half period: legs go high at half/2 − v·half/Vdc while the
-        // carrier falls (rising edges), low at half/2 + v·half/Vdc while it rises.
         let tg_rise = vp.map(|v| clamp(h - v * secs_per_volt, zero, half));
         let tg_fall = vp.map(|v| clamp(h + v * secs_per_volt, zero, half));
-        let band = self.inv_band;
-        // Delay of one edge (band model): the opposing current waits Td, the helping one
-        // Td·(1 − |i|/Ic)⁺.
-        let delay = |rising: bool, ie: T| {
-            let opposes = if rising { ie > zero } else { ie < zero };
-            if opposes {
-                td
-            } else {
-                td * (one - ie.abs() * band).step_max(zero)
-            }
-        };
+        (tg_rise, tg_fall)
+    }
+
+    /// Delay of one edge (band model): the opposing current waits Td, the helping one
+    /// Td·(1 − |i|/Ic)⁺.
+    #[inline(always)]
+    fn edge_delay(&self, rising: bool, ie: T) -> T {
+        let zero = T::zero();
+        let td = self.config.dead_time;
+        let opposes = if rising { ie > zero } else { ie < zero };
+        if opposes {
+            td
+        } else {
+            td * (T::one() - ie.abs() * self.inv_band).step_max(zero)
+        }
+    }
+
+    /// Each edge's delay, from the current at the edge: the sampled currents `i`, then twice
+    /// refined with the ripple the gate times `gates` (rising, falling) and those delays
+    /// imply.
+    #[inline(always)]
+    fn edge_delays(
+        &self,
+        rotation: Rotation<T>,
+        i: [T; 3],
+        gates: ([T; 3], [T; 3]),
+        vdc: T,
+    ) -> ([T; 3], [T; 3]) {
+        let mut delays = (
+            i.map(|x| self.edge_delay(true, x)),
+            i.map(|x| self.edge_delay(false, x)),
+        );
+        for _ in 0..2 {
+            delays = self.refined_delays(rotation, i, gates, delays, vdc);
+        }
+        delays
+    }
+
+    /// One refinement of the edges' delays (rising, falling): the current at each edge is
+    /// the sampled one plus the ripple of the volt-seconds applied up to it.
+    #[inline(always)]
+    fn refined_delays(
+        &self,
+        rotation: Rotation<T>,
+        i: [T; 3],
+        (tg_rise, tg_fall): ([T; 3], [T; 3]),
+        (d_rise, d_fall): ([T; 3], [T; 3]),
+        vdc: T,
+    ) -> ([T; 3], [T; 3]) {
+        let (zero, one) = (T::zero(), T::one());
+        let half = self.half;
         // Phase axes u_x and the current response L⁻¹·w of a volt-second vector w (α-β, the
         // rotor frame's 1/L̂d, 1/L̂q).
         let k3 = T::lit(0.866_025_403_784_438_6);
@@ -303,47 +354,37 @@ impl<T: Real> DeadTimeCompensation<T> {
             Dq::new(w.d * inv_ld, w.q * inv_lq).to_ab(rotation)
         };
         let pole_step = T::lit(2.0 / 3.0) * vdc; // α-β step of one pole moving by Vdc
-        let mut d_rise = i.map(|x| delay(true, x));
-        let mut d_fall = i.map(|x| delay(false, x));
-        for _ in 0..2 {
-            let pr = [0, 1, 2].map(|k| (tg_rise[k] + d_rise[k]).step_min(half));
-            let pf = [0, 1, 2].map(|k| (tg_fall[k] + d_fall[k]).step_min(half));
-            // Volt-seconds over each half: poles low → high at pr while the carrier falls,
-            // high → low at pf while it rises (zero vectors at the samples).
-            let (mut int_r, mut int_f) = (Ab::zero(), Ab::zero());
-            for k in 0..3 {
-                int_r += axes[k] * (pole_step * (half - pr[k]));
-                int_f += axes[k] * (-pole_step * (half - pf[k]));
-            }
-            // Mean voltage over the period (the back-EMF and R·i it balances) and the
-            // current's swing between the carrier's peak and valley samples, whose mean is the
-            // reference: i(peak) = i − Δ/2, i(valley) = i + Δ/2.
-            let vbar = (int_r + int_f) * self.inv_period;
-            let half_swing = respond((int_r - int_f) * T::lit(0.25));
-            let mut nr = d_rise;
-            let mut nf = d_fall;
-            for x in 0..3 {
-                // Volt-seconds (mean removed) up to x's own gate edge, x not yet switched.
-                let (mut wr, mut wf) = (vbar * -tg_rise[x], vbar * -tg_fall[x]);
-                for k in 0..3 {
-                    if k != x {
-                        wr += axes[k] * (pole_step * (tg_rise[x] - pr[k]).step_max(zero));
-                        wf += axes[k] * (-pole_step * (tg_fall[x] - pf[k]).step_max(zero));
-                    }
-                }
-                let ie_r = i[x] + axes[x].dot(respond(wr) - half_swing);
-                let ie_f = i[x] + axes[x].dot(respond(wf) + half_swing);
-                nr[x] = delay(true, ie_r);
-                nf[x] = delay(false, ie_f);
-            }
-            d_rise = nr;
-            d_fall = nf;
+        let pr = [0, 1, 2].map(|k| (tg_rise[k] + d_rise[k]).step_min(half));
+        let pf = [0, 1, 2].map(|k| (tg_fall[k] + d_fall[k]).step_min(half));
+        // Volt-seconds over each half: poles low → high at pr while the carrier falls,
+        // high → low at pf while it rises (zero vectors at the samples).
+        let (mut int_r, mut int_f) = (Ab::zero(), Ab::zero());
+        for k in 0..3 {
+            int_r += axes[k] * (pole_step * (half - pr[k]));
+            int_f += axes[k] * (-pole_step * (half - pf[k]));
         }
-        let vth = c.threshold_voltage;
-        let per_second = vdc * c.switching_frequency;
-        let f =
-            |k: usize| per_second * (d_rise[k] - d_fall[k]) + vth * clamp(i[k] * band, -one, one);
-        Abc::new(f(0), f(1), f(2))
+        // Mean voltage over the period (the back-EMF and R·i it balances) and the current's
+        // swing between the carrier's peak and valley samples, whose mean is the reference:
+        // i(peak) = i − Δ/2, i(valley) = i + Δ/2.
+        let vbar = (int_r + int_f) * self.inv_period;
+        let half_swing = respond((int_r - int_f) * T::lit(0.25));
+        let mut nr = d_rise;
+        let mut nf = d_fall;
+        for x in 0..3 {
+            // Volt-seconds (mean removed) up to x's own gate edge, x not yet switched.
+            let (mut wr, mut wf) = (vbar * -tg_rise[x], vbar * -tg_fall[x]);
+            for k in 0..3 {
+                if k != x {
+                    wr += axes[k] * (pole_step * (tg_rise[x] - pr[k]).step_max(zero));
+                    wf += axes[k] * (-pole_step * (tg_fall[x] - pf[k]).step_max(zero));
+                }
+            }
+            let ie_r = i[x] + axes[x].dot(respond(wr) - half_swing);
+            let ie_f = i[x] + axes[x].dot(respond(wf) + half_swing);
+            nr[x] = self.edge_delay(true, ie_r);
+            nf[x] = self.edge_delay(false, ie_f);
+        }
+        (nr, nf)
     }
 
     /// The compensation as an α-β vector (Clarke of [`phase_voltages`](Self::phase_voltages)),

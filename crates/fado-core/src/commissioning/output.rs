@@ -1,0 +1,75 @@
+//! What the procedure reports: the identification with its confidence, and each sample's
+//! output.
+
+use super::{Phase, Status};
+use crate::{Ab, Abc, MachineModel};
+
+/// Relative 1-σ statistical uncertainties of the result (module docs); `inverter_voltage` in V.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Confidence<T> {
+    /// Of R̂s, relative.
+    pub rs: T,
+    /// Of L̂d, relative.
+    pub ld: T,
+    /// Of L̂q, relative.
+    pub lq: T,
+    /// Of λ̂f, relative.
+    pub flux_linkage: T,
+    /// Of Ĵ, relative.
+    pub inertia: T,
+    /// Of B̂, absolute in N·m·s/rad.
+    pub viscous_friction: T,
+    /// Of the per-phase inverter voltage error V̂, absolute in V.
+    pub inverter_voltage: T,
+    /// Of the current sensors' gain ratio k, relative (∞ when none was measured).
+    pub current_gain_ratio: T,
+}
+
+/// The identified motor and inverter.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Identification<T> {
+    /// The identified model: parameters measured, ratings copied from the nameplate.
+    pub model: MachineModel<T>,
+    /// Statistical uncertainty of each parameter.
+    pub confidence: Confidence<T>,
+    /// Per-phase inverter voltage error V̂ = Td·f_sw·Vdc + V_th in V (SPEC §5): what the
+    /// dead-time compensation should add.
+    pub inverter_voltage: T,
+    /// Device threshold voltage V_th = V̂ − Td·f_sw·Vdc in V (for
+    /// [`crate::control::dead_time_compensation::DeadTimeCompensationConfig::threshold_voltage`]).
+    pub threshold_voltage: T,
+    /// The current sensors' gain ratio k = (1 + g_a)/(1 + g_b) measured in the DC test
+    /// (module docs, step 3), by which phase a was divided from then on: R̂s, L̂d, L̂q and λ̂f
+    /// are in phase b's scale, the drive's after its start-up calibration
+    /// ([`crate::control::gain_calibration`]). 1 when the DC test gave no plausible k.
+    pub current_gain_ratio: T,
+    /// Saliency ratio L̂q/L̂d (> 1: interior magnets).
+    pub saliency: T,
+    /// Mean DC-link voltage during the DC test, V.
+    pub dc_voltage: T,
+    /// Duration of the procedure in s.
+    pub duration: T,
+}
+
+/// What one step returns.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CommissioningOutput<T> {
+    /// Voltage command for the next sample (α-β), V.
+    pub v_ab: Ab<T>,
+    /// The same as SVPWM duties (min-max, ½ when the gates are off).
+    pub duty: Abc<T>,
+    /// Gates on.
+    pub gates_enabled: bool,
+    /// The current reference (α-β) the command regulates to, A.
+    pub current_reference: Ab<T>,
+    /// Phase of this sample.
+    pub phase: Phase,
+    /// Completed fraction of the nominal procedure, 0–1.
+    pub progress: T,
+    /// Where it stands.
+    pub status: Status,
+    /// The back-EMF observer's speed (spin phases; 0 otherwise), rad/s electrical.
+    pub speed: T,
+    /// The back-EMF observer's rotor angle (spin phases; 0 otherwise), rad electrical.
+    pub angle: T,
+}

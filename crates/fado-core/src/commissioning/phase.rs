@@ -1,0 +1,124 @@
+//! The procedure's phases, the parameters it identifies, why it aborts and where it stands.
+
+/// The phases of the procedure, in order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Phase {
+    /// Gates off, sensor offsets measured.
+    Offset,
+    /// Rotor aligned with the α axis (rotation expected).
+    Align,
+    /// Two-level DC test: Rs and the inverter voltage error.
+    Resistance,
+    /// Square-wave injection along d.
+    InductanceD,
+    /// Square-wave injection along q.
+    InductanceQ,
+    /// I-f open-loop acceleration.
+    Spin,
+    /// No q current (the d current at −½ the limit), rotor coasting: the first back-EMF
+    /// window.
+    Coast,
+    /// Torque steps in closed loop, with the second back-EMF window between them: λf, J and
+    /// friction.
+    Inertia,
+    /// Finished; the result is available.
+    Done,
+    /// Aborted; see [`Commissioning::status`](crate::commissioning::Commissioning::status).
+    Aborted,
+}
+
+impl Phase {
+    /// Short name (for traces and progress bars).
+    pub fn name(self) -> &'static str {
+        match self {
+            Phase::Offset => "offset",
+            Phase::Align => "align",
+            Phase::Resistance => "resistance",
+            Phase::InductanceD => "inductance_d",
+            Phase::InductanceQ => "inductance_q",
+            Phase::Spin => "spin",
+            Phase::Coast => "coast",
+            Phase::Inertia => "inertia",
+            Phase::Done => "done",
+            Phase::Aborted => "aborted",
+        }
+    }
+
+    /// Index 0–9 in procedure order.
+    pub fn index(self) -> usize {
+        self as usize
+    }
+}
+
+/// A parameter of the result (for [`AbortReason::Implausible`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Parameter {
+    /// Stator resistance.
+    Rs,
+    /// Inverter voltage error.
+    InverterVoltage,
+    /// d-axis inductance.
+    Ld,
+    /// q-axis inductance.
+    Lq,
+    /// Magnet flux linkage.
+    FluxLinkage,
+    /// Inertia.
+    Inertia,
+    /// Viscous friction.
+    ViscousFriction,
+}
+
+/// Why the procedure stopped early. The gates are off from the sample it is reported on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AbortReason {
+    /// The rotor turned during a standstill phase (alternating current error with the voltage
+    /// unsaturated: a back-EMF the regulator cannot follow), e.g. a load that drives it.
+    RotationDetected {
+        /// Where.
+        phase: Phase,
+    },
+    /// The current did not reach its reference with the voltage at its limit (an open phase,
+    /// a missing motor, a far too high resistance), or it lost its reference in a spin.
+    CurrentNotFollowing {
+        /// Where.
+        phase: Phase,
+    },
+    /// A measured current beyond `trip_ratio` × the current limit.
+    OverCurrent {
+        /// Where.
+        phase: Phase,
+    },
+    /// The estimated speed beyond twice the highest test speed, or the rotor stalled / lost
+    /// in a spin.
+    Overspeed {
+        /// Where.
+        phase: Phase,
+    },
+    /// A phase ran past its maximum duration.
+    Timeout {
+        /// Where.
+        phase: Phase,
+    },
+    /// A result is non-finite, non-positive or outside 1/4–4× the nameplate (J: 1/10–10×).
+    Implausible {
+        /// Which parameter.
+        parameter: Parameter,
+    },
+    /// More than 10 ms of consecutive non-finite current or DC-link samples.
+    NonFiniteMeasurements {
+        /// Where.
+        phase: Phase,
+    },
+}
+
+/// Where the procedure stands.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Status {
+    /// Still running.
+    Running,
+    /// Finished: see [`Commissioning::result`](crate::commissioning::Commissioning::result).
+    Done,
+    /// Stopped early, gates off.
+    Aborted(AbortReason),
+}

@@ -1,0 +1,79 @@
+//! Test levels sized from the nameplate, and small numeric helpers.
+
+use crate::{Ab, Abc, MachineModel, Real};
+
+#[inline]
+pub(super) fn clamp<T: Real>(x: T, lo: T, hi: T) -> T {
+    x.max(lo).min(hi)
+}
+
+/// Limits a vector's magnitude.
+#[inline]
+pub(super) fn limit<T: Real>(v: Ab<T>, max: T) -> Ab<T> {
+    let n = v.norm();
+    if n > max && n > T::zero() {
+        v * (max / n)
+    } else {
+        v
+    }
+}
+
+/// The per-phase inverter voltage error model v·sat(i_x/band) of a current (SPEC §5's
+/// trapezoid), in α-β.
+pub(super) fn dead_time_voltage<T: Real>(i_ab: Ab<T>, band: T, v: T) -> Ab<T> {
+    let i = i_ab.to_abc();
+    let s = |x: T| clamp(x / band, -T::one(), T::one()) * v;
+    Abc::new(s(i.a), s(i.b), s(i.c)).to_ab()
+}
+
+/// The upper DC-test (and alignment) current: 90 % of the limit, and for a rotor with Lq > Ld
+/// at most half of λf/(Lq − Ld) (nameplate), so that the d-axis alignment keeps at least half
+/// the magnet's stiffness: the torque about it, 1.5·p·(λf + (Ld − Lq)·i_d)·i_q, would vanish
+/// at i_d = λf/(Lq − Ld) and a reluctance rotor turn to the q axis (measured: the 5 kW
+/// PM-SyRM preset turned during the DC test at 90 % of its limit).
+pub(super) fn dc_level<T: Real>(np: &MachineModel<T>, i_limit: T) -> T {
+    let i = T::lit(0.9) * i_limit;
+    let dl = np.lq - np.ld;
+    if dl > T::zero() {
+        i.min(T::lit(0.5) * np.flux_linkage / dl)
+    } else {
+        i
+    }
+}
+
+/// The I-f spin's current amplitude: the DC test's upper level ([`dc_level`]), for the same
+/// reason. The rotor lags the I-f vector by δ, with i_d = I·cos δ, and the torque
+/// 1.5·p·I·sin δ·(λf − (Lq − Ld)·I·cos δ) is stable about δ ≈ 0 only for
+/// I < λf/(Lq − Ld); at half that, the active flux λf + (Ld − Lq)·i_d, whose EMF the spin's
+/// PLL locks onto, stays above λf/2 for any lag. Measured at 90 % of the limit on the 50 kW
+/// IPMSM preset ((Lq − Ld)·I = 1.36 λf): the rotor hunted ±1 rad (±60 r/min) between the
+/// two stable lags δ = ±0.74 rad, where the active flux is zero, the PLL slipped to π, and
+/// the coast started 2 rad off (λ̂f −5.8 %). `ld`, `lq`: the identified inductances (the
+/// nameplate's λf: off by 1.25× it still leaves the lag stable, (Lq − Ld)·I ≤ 0.63 λf; the
+/// nameplate's inductances 0.8×/1.25× off gave 1.05 λf on that preset, `Overspeed`).
+pub(super) fn if_level<T: Real>(np: &MachineModel<T>, ld: T, lq: T, i_limit: T) -> T {
+    dc_level(&MachineModel { ld, lq, ..*np }, i_limit)
+}
+
+/// The I-f current (`if_level`) and the spin's electrical acceleration: spin_torque_ratio ×
+/// the rated torque on the nameplate J, at most a quarter of the magnet torque 1.5·p·λf·I_if
+/// (the rotor then lags the current vector by about 15°, far from the pull-out even with the
+/// nameplate's λf 1.25× and J 0.8× the truth; module docs, step 5).
+pub(super) fn spin_sizing<T: Real>(
+    np: &MachineModel<T>,
+    ld: T,
+    lq: T,
+    i_limit: T,
+    ratio: T,
+) -> (T, T) {
+    let i_if = if_level(np, ld, lq, i_limit);
+    let p = T::lit(np.pole_pairs as f64);
+    let magnet_torque = T::lit(1.5) * p * np.flux_linkage * i_if;
+    let torque = (ratio * np.rated_torque).min(T::lit(0.25) * magnet_torque);
+    (i_if, torque / np.inertia * p)
+}
+
+pub(super) fn libm_round(x: f64) -> u32 {
+    let r = x + 0.5;
+    if r < 1.0 { 1 } else { r as u32 }
+}

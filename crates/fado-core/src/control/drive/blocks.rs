@@ -1,0 +1,197 @@
+//! The control blocks around the estimator, built from a [`DriveConfig`], and the
+//! modulation of a voltage reference through them.
+
+use super::{Applied, Blocks, DriveConfig, Resolved};
+use crate::control::current_controller::{CurrentController, CurrentControllerConfig};
+use crate::control::dc_link_limit::DcLinkLimit;
+use crate::control::dead_time_compensation::{DeadTimeCompensation, DeadTimeCompensationConfig};
+use crate::control::delay_compensation::{DelayCompensation, DelayCompensationConfig};
+use crate::control::field_weakening::FieldWeakening;
+use crate::control::lock_reaction::LockSupervisor;
+use crate::control::modulation::{ModulatorConfig, SpaceVectorModulator};
+use crate::control::speed_controller::{SpeedController, SpeedControllerConfig};
+use crate::control::standstill_probe::{StandstillProbe, StandstillProbeConfig};
+use crate::error::{ConfigError, check};
+use crate::injection::{CurrentInjection, CurrentInjectionConfig};
+use crate::{Ab, Abc, Dq, Real, Rotation};
+
+impl<T: Real> Blocks<T> {
+    /// Dead-time compensation, hexagon limit and SVPWM of the reference `v_ab` (`v_dq` in the
+    /// frame of `rot`), and the voltage that then acts, back-calculated without the
+    /// compensation where the modulator limited it (zero without a DC link). None when
+    /// anything is non-finite.
+    #[inline(always)]
+    pub(super) fn modulate(
+        &mut self,
+        rot: Rotation<T>,
+        v_ab: Ab<T>,
+        v_dq: Dq<T>,
+        i_dq_ref: Dq<T>,
+        i_abc: Abc<T>,
+        vdc: T,
+    ) -> Option<Applied<T>> {
+        let v_comp = self.dead_time.step(rot, i_dq_ref, i_abc, v_ab, vdc);
+        let m = self.modulator.step(v_ab + v_comp, vdc);
+        let (v_ab, v_dq) = if !m.saturated {
+            (v_ab, v_dq) // exactly what was asked for: nothing to back-calculate
+        } else if vdc > T::zero() {
+            let v = m.v_ab - v_comp;
+            (v, v.to_dq(rot))
+        } else {
+            (Ab::zero(), Dq::zero())
+        };
+        (v_ab.is_finite() && v_dq.is_finite() && m.duty.is_finite()).then_some(Applied {
+            duty: m.duty,
+            v_ab,
+            v_dq,
+            saturated: m.saturated,
+        })
+    }
+
+    pub(super) fn new(c: &DriveConfig<T>, r: &Resolved<T>) -> Result<Self, ConfigError> {
+        check_limits(c, r)?;
+        let ts = c.ts;
+        let t = &c.tuning;
+        let m = &c.machine;
+        // The speed PI's output is a torque in units of the magnet's q current (see
+        // `currents_for_torque`): with MTPA on a salient rotor its limit is the torque of the
+        // MTPA point on the current circle |i| = I_max (`SpeedControllerConfig::with_tuning`).
+        let speed_config = SpeedControllerConfig::with_tuning(m, t, ts);
+        let dc_link = DcLinkLimit::new(&t.dc_link, m, speed_config.i_max, r.i_max, ts)?;
+        let field_weakening = FieldWeakening::new(&t.field_weakening, m, r.i_max, ts)?;
+        let speed = SpeedController::new(speed_config).map_err(rename(&[
+            ("bandwidth_hz", "speed_bandwidth_hz"),
+            ("zero_ratio", "speed_zero_ratio"),
+            ("anti_windup_ratio", "speed_anti_windup_ratio"),
+        ]))?;
+        let injection = CurrentInjection::new(CurrentInjectionConfig::with_tuning(m, t))?;
+        let current = CurrentController::new(CurrentControllerConfig::with_tuning(m, t, ts))
+            .map_err(rename(&[
+                ("bandwidth_hz", "current_bandwidth_hz"),
+                ("anti_windup_ratio", "current_anti_windup_ratio"),
+            ]))?;
+        let delay = DelayCompensation::new(DelayCompensationConfig::with_tuning(t, ts))
+            .map_err(rename(&[("factor", "delay_compensation_factor")]))?;
+        let dead_time = DeadTimeCompensation::new(DeadTimeCompensationConfig::with_tuning(m, t))
+            .map_err(rename(&[
+                ("threshold_voltage", "dead_time_threshold_voltage"),
+                ("current_band", "dead_time_current_band"),
+            ]))?;
+        let modulator = SpaceVectorModulator::new(ModulatorConfig {
+            limit: t.voltage_limit,
+            max_modulation: t.max_modulation,
+        })?;
+        let probe = StandstillProbe::new(probe_config(c)?)?;
+        Ok(Self {
+            speed,
+            injection,
+            current,
+            delay,
+            dead_time,
+            modulator,
+            probe,
+            dc_link,
+            field_weakening,
+        })
+    }
+
+    pub(super) fn reset(&mut self) {
+        self.speed.reset();
+        self.injection.reset();
+        self.current.reset();
+        self.delay.reset();
+        self.dead_time.reset();
+        self.modulator.reset();
+        self.probe.reset();
+        self.dc_link.reset();
+        self.field_weakening.reset();
+    }
+}
+
+/// The limits that involve several fields: the injection within the current limit, the trip
+/// above it, the stuck-sensor thresholds, the plausibility ratios and the lock supervisor.
+fn check_limits<T: Real>(c: &DriveConfig<T>, r: &Resolved<T>) -> Result<(), ConfigError> {
+    let t = &c.tuning;
+    let (i_max, i_min) = (r.i_max, r.i_min);
+    if i_min > i_max {
+        return Err(ConfigError::OutOfRange {
+            field: "injection_current_ratio",
+            expected: "at most current_limit_ratio",
+        });
+    }
+    if r.trip_current <= i_max {
+        return Err(ConfigError::OutOfRange {
+            field: "trip_current_ratio",
+            expected: "above current_limit_ratio",
+        });
+    }
+    let band = check::non_negative("stuck_sensor_band_ratio", t.stuck_sensor_band_ratio)?;
+    let min_ref = check::positive(
+        "stuck_sensor_reference_ratio",
+        t.stuck_sensor_reference_ratio,
+    )?;
+    if min_ref <= band {
+        return Err(ConfigError::OutOfRange {
+            field: "stuck_sensor_reference_ratio",
+            expected: "above stuck_sensor_band_ratio",
+        });
+    }
+    check::below(
+        "plausible_current_ratio",
+        T::one(),
+        check::finite("plausible_current_ratio", c.tuning.plausible_current_ratio)?,
+        "above 1",
+    )?;
+    check::positive("dc_link_max_ratio", c.tuning.dc_link_max_ratio)?;
+    LockSupervisor::new(
+        c.tuning.lock_reaction,
+        c.ts,
+        c.tuning.lock_recovery_time,
+        c.tuning.lock_recovery_timeout,
+        0,
+    )?;
+    Ok(())
+}
+
+/// A block's error renamed by `map` (block field → drive field).
+fn rename(map: &'static [(&'static str, &'static str)]) -> impl Fn(ConfigError) -> ConfigError {
+    move |e: ConfigError| {
+        let field = map
+            .iter()
+            .find(|(from, _)| *from == e.field())
+            .map_or(e.field(), |(_, to)| *to);
+        match e {
+            ConfigError::NotFinite { .. } => ConfigError::NotFinite { field },
+            ConfigError::NotPositive { .. } => ConfigError::NotPositive { field },
+            ConfigError::Negative { .. } => ConfigError::Negative { field },
+            ConfigError::OutOfRange { expected, .. } => ConfigError::OutOfRange { field, expected },
+        }
+    }
+}
+
+/// The loaded-standstill probe's configuration in absolute units (amplitude 0: off).
+fn probe_config<T: Real>(c: &DriveConfig<T>) -> Result<StandstillProbeConfig<T>, ConfigError> {
+    let (t, m) = (&c.tuning, &c.machine);
+    let rated = m.rated_current;
+    Ok(StandstillProbeConfig {
+        ts: c.ts,
+        amplitude: if t.standstill_probe {
+            check::non_negative(
+                "standstill_probe_current_ratio",
+                t.standstill_probe_current_ratio,
+            )? * rated
+        } else {
+            T::zero()
+        },
+        period: t.standstill_probe_period,
+        gain: t.standstill_probe_gain,
+        max_speed: check::non_negative(
+            "standstill_probe_speed_ratio",
+            t.standstill_probe_speed_ratio,
+        )? * m.rated_speed(),
+        min_load: check::non_negative(
+            "standstill_probe_load_ratio",
+            t.standstill_probe_load_ratio,
+        )? * rated,
+    })
+}

@@ -1,0 +1,112 @@
+//! The start-up calibrations' samples: current-sensor offsets (gates off) and the gain
+//! ratio (a d current held along the aligned axis).
+
+use super::{DriveOutput, SensorlessDrive};
+use crate::control::gain_calibration::GainCalibrationStatus;
+use crate::estimator::RotorAngleEstimator;
+use crate::{Ab, Abc, Dq, Real, Rotation};
+
+impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
+    /// One sample of the offset calibration: gates off, duties ½, nothing else stepped.
+    pub(super) fn calibration_step(&mut self, i_abc: Abc<T>) -> DriveOutput<T> {
+        self.calibration_sum = Abc::new(
+            self.calibration_sum.a + i_abc.a,
+            self.calibration_sum.b + i_abc.b,
+            self.calibration_sum.c + i_abc.c,
+        );
+        self.calibration_remaining -= 1;
+        if self.calibration_remaining == 0 {
+            let k = T::one() / T::lit(self.resolved.offset_calibration_samples as f64);
+            let sum = self.calibration_sum;
+            self.current_offset = Abc::new(sum.a * k, sum.b * k, sum.c * k);
+            self.last_i_ab = Ab::zero();
+            let theta0 = self.aligned_angle;
+            self.realign(theta0);
+            let mut out = self.last;
+            out.gates_enabled = false;
+            return out;
+        }
+        let mut out = self.last;
+        out.gates_enabled = false;
+        out.input_fault = false;
+        out
+    }
+
+    /// One sample of the gain calibration (offsets removed, no gain correction): the current
+    /// loop holds the calibration's d current in the frame of the aligned angle at ω = 0, with
+    /// the usual dead-time compensation and modulation; the estimator is not stepped (the
+    /// drive re-aligns at the end). The calibration gets the realised voltage that acted over
+    /// the last period, as the estimator would.
+    pub(super) fn gain_calibration_step(&mut self, i_abc: Abc<T>, vdc: T) -> DriveOutput<T> {
+        let i_ab = i_abc.to_ab();
+        if !i_ab.is_finite() {
+            return self.reject(i_abc);
+        }
+        self.i_ab_used = i_ab;
+        let command = self.gain.step(i_ab, self.history[1]);
+        if !self.gain.running() {
+            // Done (zero current after the release): the ratio, then the aligned start.
+            let k = self.gain.ratio();
+            self.gain_correction = if k.is_finite() && k > T::zero() {
+                T::one() / k
+            } else {
+                T::one()
+            };
+            // The same two levels are the classic DC test of Rs: the estimator's R̂s
+            // adaptation starts from it if it lies within 0.5–2× of the model's R̂s (a value
+            // outside says something else is wrong, and the model's R̂s is kept).
+            if self.gain.status() == GainCalibrationStatus::Calibrated {
+                let r = self.gain.resistance();
+                let r0 = self.config.machine.rs;
+                if r >= r0 * T::lit(0.5) && r <= r0 + r0 {
+                    self.estimator.start_from_measured_rs(r);
+                }
+            }
+            self.last_i_ab = self.gain_corrected(i_abc).to_ab();
+            let theta0 = self.aligned_angle;
+            self.realign(theta0);
+            return self.last;
+        }
+        let theta0 = if self.aligned_angle.is_finite() {
+            self.aligned_angle
+        } else {
+            T::zero()
+        };
+        let rot = Rotation::from_angle(theta0);
+        let i_dq = i_ab.to_dq(rot);
+        let i_dq_ref = Dq::new(command.current_d, T::zero());
+        let backup = self.blocks;
+        let estimate = self.last.estimate;
+        let b = &mut self.blocks;
+        let (v_ab, v_dq) = match command.voltage {
+            // Voltage mode: the current loop is not stepped (its state is kept for the
+            // return to zero).
+            Some(v) => (v, v.to_dq(rot)),
+            None => {
+                let Ok(v_dq) = b.current.step(i_dq_ref, i_dq, T::zero()) else {
+                    return self.reject_after_estimate(backup, estimate, i_dq);
+                };
+                (v_dq.to_ab(rot), v_dq)
+            }
+        };
+        let Some(applied) = b.modulate(rot, v_ab, v_dq, i_dq_ref, i_abc, vdc) else {
+            return self.reject_after_estimate(backup, estimate, i_dq);
+        };
+        if command.voltage.is_none() {
+            b.current.realised(applied.v_dq);
+        }
+        self.record(applied, i_dq, i_dq_ref, estimate, i_ab)
+    }
+
+    /// The phase currents with the measured gain ratio applied to phase a; c keeps the sum of
+    /// the three readings (c = −a − b stays so for two sensors). Untouched while k = 1.
+    #[inline(always)]
+    pub(super) fn gain_corrected(&self, i_abc: Abc<T>) -> Abc<T> {
+        if self.gain_correction != T::one() {
+            let a = i_abc.a * self.gain_correction;
+            Abc::new(a, i_abc.b, i_abc.c + (i_abc.a - a))
+        } else {
+            i_abc
+        }
+    }
+}

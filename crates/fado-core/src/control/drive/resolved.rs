@@ -1,0 +1,132 @@
+//! The drive's limits and sample counts in absolute units, resolved once from the tuning's
+//! ratios and durations.
+
+use super::{DriveConfig, Resolved, StallResolved};
+use crate::Real;
+use crate::error::{ConfigError, check};
+
+/// Largest `current_limit_ratio`: 5 (a drive's short-time overload is 1.5–3 × the rated
+/// current; above 5 the limit is a typo, and the trip level above it would be refused in its
+/// stead).
+const MAX_CURRENT_LIMIT_RATIO: f64 = 5.0;
+
+impl<T: Real> Resolved<T> {
+    pub(super) fn new(c: &DriveConfig<T>) -> Result<Self, ConfigError> {
+        let ts = check::positive("ts", c.ts)?;
+        c.machine.validate()?;
+        let t = &c.tuning;
+        let rated = c.machine.rated_current;
+        // A duration as a whole number of samples (at most about 5 days at 10 kHz).
+        let samples = &|field: &'static str, time: T| -> Result<u32, ConfigError> {
+            let n = check::non_negative(field, time)? / ts;
+            check::below(field, n, T::lit(4e9), "below 4e9 sampling periods")?;
+            Ok(n.round().to_f64() as u32)
+        };
+        Ok(Self {
+            i_max: check::below(
+                "current_limit_ratio",
+                check::positive("current_limit_ratio", t.current_limit_ratio)?,
+                T::lit(MAX_CURRENT_LIMIT_RATIO),
+                "at most 5 × the rated current (drives' short-time overload is 1.5–3×)",
+            )? * rated,
+            i_min: check::non_negative("injection_current_ratio", t.injection_current_ratio)?
+                * rated,
+            trip_current: check::positive("trip_current_ratio", t.trip_current_ratio)? * rated,
+            current_error_limit: check::positive("current_error_ratio", t.current_error_ratio)?
+                * rated,
+            dc_link_min_voltage: check::below(
+                "dc_link_min_ratio",
+                check::non_negative("dc_link_min_ratio", t.dc_link_min_ratio)?,
+                T::one(),
+                "below 1 (a fraction of the nominal DC link: at or above it the warning never clears)",
+            )? * c.machine.dc_voltage,
+            offset_calibration_samples: samples(
+                "offset_calibration_time",
+                t.offset_calibration_time,
+            )?,
+            stuck_sensor_samples: samples("stuck_sensor_time", t.stuck_sensor_time)?,
+            current_error_samples: samples("current_error_time", t.current_error_time)?,
+            input_fault_trip_samples: samples("input_fault_trip_time", t.input_fault_trip_time)?,
+            stall: StallResolved::new(c, samples)?,
+            plausible_current: t.plausible_current_ratio * t.trip_current_ratio * rated,
+            dc_link_max_voltage: t.dc_link_max_ratio * c.machine.dc_voltage,
+            mtpa: t.mtpa && c.machine.is_salient(),
+            salient: c.machine.is_salient(),
+        })
+    }
+}
+
+impl<T: Real> StallResolved<T> {
+    /// The stall symptom's thresholds; `samples` turns a duration field into samples.
+    fn new(
+        c: &DriveConfig<T>,
+        samples: &dyn Fn(&'static str, T) -> Result<u32, ConfigError>,
+    ) -> Result<Self, ConfigError> {
+        let t = &c.tuning;
+        let rated = c.machine.rated_current;
+        // A stall-band ratio ε per unit of torque over 1.5·p (Wb·A): ε·1.5·p (torque) times
+        // p (electrical speed) over Ĵ·ω_s, the speed error whose proportional action commands
+        // that torque.
+        let torque_band = |field: &'static str, ratio: T| -> Result<T, ConfigError> {
+            Ok(check::non_negative(field, ratio)?
+                * T::lit(1.5 * (c.machine.pole_pairs as f64) * (c.machine.pole_pairs as f64))
+                / (c.machine.inertia * T::lit(core::f64::consts::TAU) * t.speed_bandwidth_hz))
+        };
+        Ok(Self {
+            speed: check::non_negative("lock_stall_speed_ratio", t.lock_stall_speed_ratio)?
+                * c.machine.rated_speed(),
+            samples: if t.lock_stall_speed_ratio > T::zero() {
+                samples("lock_stall_time", t.lock_stall_time)?.max(1)
+            } else {
+                0
+            },
+            heal_samples: samples("lock_stall_heal_time", t.lock_stall_heal_time)?,
+            max_speed: match check::non_negative(
+                "lock_stall_max_speed_ratio",
+                t.lock_stall_max_speed_ratio,
+            )? {
+                r if r == T::zero() => T::lit(f64::INFINITY),
+                r => r * c.machine.rated_speed(),
+            },
+            kdf_band: check::non_negative(
+                "lock_stall_kdf_speed_ratio",
+                t.lock_stall_kdf_speed_ratio,
+            )? * c.machine.rated_speed(),
+            min_current: check::non_negative(
+                "lock_stall_min_current_ratio",
+                t.lock_stall_min_current_ratio,
+            )? * rated,
+            gross_ratio: match check::non_negative(
+                "lock_stall_gross_error_ratio",
+                t.lock_stall_gross_error_ratio,
+            )? {
+                k if k == T::zero() => T::lit(f64::INFINITY),
+                k => k,
+            },
+            follow_gain: match check::non_negative(
+                "lock_stall_follow_time",
+                t.lock_stall_follow_time,
+            )? {
+                tau if tau == T::zero() => T::zero(),
+                tau => T::one() - (-c.ts / tau).exp(),
+            },
+            follow_min_current: check::non_negative(
+                "lock_stall_follow_min_current_ratio",
+                t.lock_stall_follow_min_current_ratio,
+            )? * rated,
+            follow_lead: check::non_negative(
+                "lock_stall_follow_accel_ratio",
+                t.lock_stall_follow_accel_ratio,
+            )? * c.machine.rated_speed()
+                * check::non_negative("lock_stall_follow_time", t.lock_stall_follow_time)?,
+            torque_band: torque_band(
+                "lock_stall_torque_band_ratio",
+                t.lock_stall_torque_band_ratio,
+            )?,
+            reluctance_band: torque_band(
+                "lock_stall_reluctance_band_ratio",
+                t.lock_stall_reluctance_band_ratio,
+            )?,
+        })
+    }
+}

@@ -1,0 +1,266 @@
+//! [`EstimatorState`]'s start-up, alignment and run-time settings, and the estimate of the
+//! last good sample.
+
+use super::{Diagnostics, Estimate, EstimatorParams, EstimatorState, LeanEstimate};
+use crate::error::ConfigError;
+use crate::integrand_offset::IntegrandOffsetState;
+use crate::lock::LockState;
+use crate::mode::Mode;
+use crate::observer::ObserverState;
+use crate::rotor_flux::{rotor_angle, rotor_flux, stator_flux};
+use crate::{Ab, Real};
+
+impl<T: Real> EstimatorState<T> {
+    /// The start-up state for `params` (as [`EstimatorParams::initial_state`]).
+    pub fn new(params: &EstimatorParams<T>) -> Self {
+        params.initial_state()
+    }
+
+    /// Back to the start-up state at `config.initial_angle` with zero current; an adapted R̂s
+    /// goes back to the value the adaptation started from.
+    pub fn reset(&mut self, p: &EstimatorParams<T>) {
+        if self.rs_adaptation_on {
+            self.rs_adaptation = p.rs_adaptation_params.initial_state(&self.rs_scale);
+            self.offset = IntegrandOffsetState::default();
+            self.integrator
+                .set_rs_hat_unchecked(self.rs_adaptation.rs_hat);
+        }
+        self.align(p, p.initial_angle, Ab::zero());
+    }
+
+    /// Start-up at a known rotor angle θ0 with the present current (SPEC §1 step 6):
+    /// λ1 = λ̂a·e^{jθ0} + L̂q·i with the active flux λ̂a = λ̂f + (L̂d − L̂q)·i_d, D̂ = 0, θ̂ = θ0,
+    /// ω̂ = 0, limiter mode. An adapted R̂s is kept (the winding is as warm as it was).
+    pub fn align(&mut self, p: &EstimatorParams<T>, theta0: T, i_ab: Ab<T>) {
+        let theta0 = if theta0.is_finite() {
+            theta0
+        } else {
+            T::zero()
+        };
+        // The active flux λ̂f + (L̂d − L̂q)·i_d (λ̂f exactly for L̂d = L̂q).
+        let rotor = Ab::from_polar(T::one(), theta0);
+        let active = p.flux_linkage + p.saliency * rotor.dot(i_ab);
+        let active = if active.is_finite() && active > T::zero() {
+            active
+        } else {
+            p.flux_linkage
+        };
+        let lambda_r = Ab::from_polar(active, theta0);
+        // A current so large that L̂q·i overflows is as unusable as a NaN (found by fuzzing,
+        // f32: i = 3e37 A gave λ1 = ∞): start as with zero current.
+        let lambda1 = lambda_r + i_ab * p.lq;
+        let (lambda1, i_ab) = if lambda1.is_finite() {
+            (lambda1, i_ab)
+        } else {
+            (lambda_r, Ab::zero())
+        };
+        self.integrator.reset_to(lambda1);
+        // The last current is also what the first sample's current step is checked against
+        // (see `crate::plausibility`): an implausible one is not kept.
+        self.integrator
+            .set_last_current(if p.bounds.current_ok(i_ab) {
+                i_ab
+            } else {
+                Ab::zero()
+            });
+        self.observer = ObserverState::at(if p.observer_on_rotor_flux {
+            Ab::from_polar(p.flux_linkage, theta0)
+        } else {
+            lambda1
+        });
+        self.kdf_gain = T::zero();
+        self.mode = Mode::Limiter;
+        self.t2s1 = p.t2s1.state_at(theta0, T::zero());
+        self.t2s2 = p.t2s2.state_at(theta0, T::zero());
+        self.lag_compensation = T::zero();
+        // The observer's gains for ω̂ = 0, held as after any update (so that with the
+        // default period they are formed in the slots after the lock detector's, which no
+        // slow law uses: see `SLOW_PERIOD`).
+        self.observer_gains = p.observer.gains(T::zero());
+        self.gain_countdown = p.gain_hold;
+        self.feedback = Ab::zero();
+        self.rejected_samples = 0;
+        self.lock = LockState::default();
+        self.lock_status = self.lock.status();
+        self.lock_mode = Mode::Limiter;
+        self.slot = 0;
+        self.slow_broken = 0;
+        self.v_sum = Ab::zero();
+        self.i_sum = Ab::zero();
+        self.slow_feedback = self.offset.offset;
+        self.step_allowance = p.bounds.step();
+    }
+
+    /// One sample (Fig. 5) with the parameters `p` this state was made for: as
+    /// [`SensorlessEstimator::step`](crate::SensorlessEstimator::step).
+    #[inline]
+    pub fn step(&mut self, p: &EstimatorParams<T>, v_ab: Ab<T>, i_ab: Ab<T>) -> Estimate<T> {
+        self.advance(p, v_ab, i_ab)
+    }
+
+    /// [`Self::step`] without the diagnostics: as [`SensorlessEstimator::step_lean`](crate::SensorlessEstimator::step_lean), the
+    /// firmware step.
+    #[inline]
+    pub fn step_lean(
+        &mut self,
+        p: &EstimatorParams<T>,
+        v_ab: Ab<T>,
+        i_ab: Ab<T>,
+    ) -> LeanEstimate<T> {
+        self.advance(p, v_ab, i_ab)
+    }
+
+    /// λ̂a/λ̂f = 1 + (L̂d − L̂q)·î_d/λ̂f, the active flux the limiter circle and the lock
+    /// detector's bounds refer to (1 on a surface-magnet rotor, and while the trackers hold),
+    /// î_d the current along λ̂r; at least the tracker's hold ratio. Formed where it is used
+    /// (the limiter mode, the detector's slot), so that a salient rotor's k_df mode skips its
+    /// √ and two divisions in three samples of four.
+    #[inline(always)]
+    pub(super) fn active_ratio(
+        p: &EstimatorParams<T>,
+        i_ab: Ab<T>,
+        lambda_r: Ab<T>,
+        saliency: T,
+        tracker_hold: bool,
+    ) -> T {
+        if saliency != T::zero() && !tracker_hold {
+            let i_d = i_ab.dot(lambda_r) / lambda_r.norm_squared().step_sqrt();
+            let ratio = T::one() + saliency * i_d / p.flux_linkage;
+            crate::real::max(ratio, p.tracker_hold_ratio)
+        } else {
+            T::one()
+        }
+    }
+
+    /// (L̂d − L̂q)·î_d·e^{jθ̂}: the part of the active flux λ̂a·e^{jθ} = (λ̂f + (L̂d − L̂q)·i_d)·e^{jθ}
+    /// that the drive's own i_d moves (the eq. (23) injection, MTPA, a load change under
+    /// MTPA). The d axis is the observer's own rotating vector λ̂1 − D̂ of the last sample
+    /// (≈ λ̂f·e^{jθ̂}, no extra state), î_d the current along it. Zero while that vector is
+    /// below the tracker's hold level (no usable axis).
+    #[inline]
+    pub(super) fn active_flux_swing(
+        &self,
+        p: &EstimatorParams<T>,
+        i_ab: Ab<T>,
+        saliency: T,
+    ) -> Ab<T> {
+        let axis = self.observer.flux() - self.observer.disturbance();
+        let n2 = axis.norm_squared();
+        if n2 > p.hold_level_sq {
+            axis * (saliency * i_ab.dot(axis) / n2)
+        } else {
+            Ab::zero()
+        }
+    }
+
+    #[cold]
+    pub(super) fn reject(&mut self, p: &EstimatorParams<T>) -> Estimate<T> {
+        self.rejected_samples = self.rejected_samples.saturating_add(1);
+        self.step_allowance += p.bounds.step();
+        let mut out = self.last(p);
+        out.diagnostics.input_fault = true;
+        out
+    }
+
+    /// The estimate of the last good sample (or of the last `align`/`reset`), recomputed from
+    /// the state: as [`SensorlessEstimator::last`](crate::SensorlessEstimator::last).
+    pub fn last(&self, p: &EstimatorParams<T>) -> Estimate<T> {
+        let lambda1 = self.integrator.flux();
+        let disturbance = self.observer.disturbance();
+        let lambda2 = stator_flux(lambda1, disturbance);
+        let lambda_r = rotor_flux(lambda2, self.integrator.last_current(), p.lq);
+        let mode = self.mode;
+        Estimate {
+            theta: self.t2s1.angle(),
+            omega: self.t2s1.speed(),
+            omega_control: self.t2s2.speed(),
+            diagnostics: Diagnostics {
+                lambda1,
+                disturbance,
+                lambda2,
+                lambda_r,
+                theta_direct: rotor_angle(lambda_r),
+                mode,
+                flag_limit: mode == Mode::Limiter,
+                limiter_clamping: mode == Mode::Limiter && p.limiter.step(lambda_r).clamping,
+                tracker_hold: lambda_r.norm_squared() < p.hold_level_sq,
+                rs_hat: self.integrator.rs_hat(),
+                flux_linkage_hat: self.rs_adaptation.flux_linkage_hat,
+                input_fault: false,
+                lock: self.lock.status(),
+            },
+        }
+    }
+
+    /// Number of samples rejected since the last reset.
+    pub fn rejected_samples(&self) -> u32 {
+        self.rejected_samples
+    }
+
+    /// As [`SensorlessEstimator::set_disturbance_feedback_enabled`](crate::SensorlessEstimator::set_disturbance_feedback_enabled).
+    pub fn set_disturbance_feedback_enabled(&mut self, enabled: bool) {
+        self.k_df_enabled = enabled;
+    }
+
+    /// As [`SensorlessEstimator::set_rs_hat`](crate::SensorlessEstimator::set_rs_hat).
+    pub fn set_rs_hat(&mut self, p: &EstimatorParams<T>, rs_hat: T) -> Result<(), ConfigError> {
+        self.integrator.set_rs_hat(rs_hat)?;
+        if self.rs_adaptation_on {
+            // R̂s ≥ 0 was just checked: the adaptation restarts around it.
+            self.rs_scale = p.rs_adaptation_params.scale(rs_hat);
+            self.rs_adaptation = p.rs_adaptation_params.initial_state(&self.rs_scale);
+        }
+        Ok(())
+    }
+
+    /// As [`SensorlessEstimator::enable_rs_adaptation`](crate::SensorlessEstimator::enable_rs_adaptation).
+    pub fn enable_rs_adaptation(&mut self, p: &EstimatorParams<T>) {
+        if self.rs_adaptation_on {
+            return;
+        }
+        self.rs_adaptation_on = true;
+        self.offset_recentring_gain = p.offset_recentring_gain;
+        let rs_hat = self.integrator.rs_hat();
+        self.rs_scale = p.rs_adaptation_params.scale(rs_hat);
+        self.rs_adaptation = p.rs_adaptation_params.initial_state(&self.rs_scale);
+        self.offset = IntegrandOffsetState::default();
+        self.slow_feedback = Ab::zero();
+    }
+
+    /// As [`SensorlessEstimator::turn_angle`](crate::SensorlessEstimator::turn_angle).
+    pub fn turn_angle(&mut self, p: &EstimatorParams<T>, angle: T) {
+        if !angle.is_finite() || self.mode != Mode::Limiter {
+            return;
+        }
+        let lambda1 = self.integrator.flux();
+        let lambda2 = stator_flux(lambda1, self.observer.disturbance());
+        let lambda_r = rotor_flux(lambda2, self.integrator.last_current(), p.lq);
+        let turned = lambda1 + lambda_r.mul_j() * angle;
+        if turned.is_finite() {
+            self.integrator
+                .commit(turned, self.integrator.last_current());
+        }
+    }
+
+    /// Clears a loss-of-lock verdict (as [`RotorAngleEstimator::rearm_lock_detector`](crate::estimator::RotorAngleEstimator::rearm_lock_detector)).
+    pub fn rearm_lock_detector(&mut self) {
+        self.lock = LockState::default();
+        self.lock_status = self.lock.status();
+        self.lock_mode = self.mode;
+    }
+
+    /// ê, the learned integrand offset (V, α-β; zero without `rs_adaptation`).
+    pub fn integrand_offset(&self) -> Ab<T> {
+        self.offset.offset
+    }
+
+    /// R̂s in use now (Ω).
+    pub fn rs_hat(&self) -> T {
+        self.integrator.rs_hat()
+    }
+
+    /// Whether the R̂s adaptation runs.
+    pub fn rs_adaptation_enabled(&self) -> bool {
+        self.rs_adaptation_on
+    }
+}

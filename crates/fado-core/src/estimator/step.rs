@@ -1,0 +1,464 @@
+//! One sample of Fig. 5, in the order of the module docs: integrate, observe, form λ̂r,
+//! track, select the mode and the feedback, commit, then the lock detector and the slow laws
+//! in their slots.
+//!
+//! Each phase is a function of its own, inlined into [`EstimatorState::advance`]: the
+//! sample is computed first into a [`Candidate`] and committed only if it is finite.
+
+use super::{
+    BROKEN_OFFSET, BROKEN_RS, Diagnostics, Estimate, EstimatorParams, EstimatorState, LOCK_PERIOD,
+    SLOT_LOCK, SLOT_OFFSET, SLOT_RS, SLOW_PERIOD,
+};
+use crate::mode::Mode;
+use crate::real::all_finite;
+use crate::rotor_flux::{rotor_angle, stator_flux};
+use crate::rs_adaptation::AdaptationRegime;
+use crate::tracker::TrackerUpdate;
+use crate::{Ab, Real};
+
+/// The new state of one sample, computed before anything is committed.
+struct Candidate<T: Real> {
+    /// λ1 integrated with the previous sample's feedback (eq. (21) / (24)).
+    lambda1: Ab<T>,
+    /// The current the integrator's resistive drop used (the slow laws' current).
+    i_drop: Ab<T>,
+    /// The observer's λ̂1 and D̂ (eq. (10), (16)).
+    observer_flux: Ab<T>,
+    disturbance: Ab<T>,
+    /// λ2 = λ1 − D̂ (eq. (20)), λ̂r = λ2 − L̂q·i (eq. (5)) and its angle θm (eq. (6)).
+    lambda2: Ab<T>,
+    lambda_r: Ab<T>,
+    theta_direct: T,
+    /// |λ̂r| below the hold level: the trackers coast.
+    tracker_hold: bool,
+    t2s1: TrackerUpdate<T>,
+    t2s2: TrackerUpdate<T>,
+    mode: Mode,
+    kdf_gain: T,
+    /// The mode's own feedback (k_df·D̂ or the limiter's), without the slow laws' share.
+    base_feedback: Ab<T>,
+    /// The limiter clamps λ̂r this sample.
+    clamping: bool,
+    /// The feedback for the next sample: `base_feedback` plus the slow laws' share.
+    feedback: Ab<T>,
+}
+
+impl<T: Real> EstimatorState<T> {
+    /// The step itself, for any output that is a projection of [`Estimate`]: inlined into
+    /// [`Self::step`] and [`Self::step_lean`], so that the compiler drops what the output
+    /// does not keep.
+    #[inline(always)]
+    pub(super) fn advance<O: From<Estimate<T>>>(
+        &mut self,
+        p: &EstimatorParams<T>,
+        v_ab: Ab<T>,
+        i_ab: Ab<T>,
+    ) -> O {
+        // Plausibility first (a few compares; false for NaN/∞ too, see `crate::plausibility`).
+        if !p.bounds.check(
+            v_ab,
+            i_ab,
+            self.integrator.last_current(),
+            self.step_allowance,
+        ) {
+            return self.reject(p).into();
+        }
+        // The whole new state is computed first and committed only if it is finite: a
+        // non-finite input makes it non-finite (every input enters λ1 through Ts·v and the
+        // resistive drop, or λ̂r through L̂q·i, and NaN and ±∞ propagate, 0·∞ included), finite
+        // but absurd inputs can still overflow it, and a rejected sample must leave none of it
+        // changed. One test at the end covers all of this (cheaper than a test per input and
+        // per block, and than copying the estimator as a backup every sample).
+        let c = self.candidate(p, v_ab, i_ab);
+        if !Self::is_committable(&c) {
+            return self.reject(p).into();
+        }
+        let rs_hat_used = self.integrator.rs_hat();
+        let flux_linkage_used = self.rs_adaptation.flux_linkage_hat;
+        let previous_mode = self.mode;
+        let shift = self.commit(p, &c, i_ab);
+        self.judge_lock(p, &c, i_ab);
+        self.step_allowance = p.bounds.step();
+        let slot = self.slot;
+        // SLOW_PERIOD is a power of two: the modulo is a mask.
+        self.slot = (slot + 1) % SLOW_PERIOD;
+        // 6. The slow laws in their slots (see [`SLOW_PERIOD`]): R̂s and ê for the next
+        //    sample (see `rs_adaptation`, `integrand_offset`), after the commit so that the
+        //    paper's path is untouched by them. A non-finite result is dropped (R̂s, ê stay).
+        if self.rs_adaptation_on {
+            self.run_slow_laws(p, &c, slot, previous_mode, shift, v_ab, i_ab);
+        }
+        Self::estimate(&c, rs_hat_used, flux_linkage_used, self.lock_status).into()
+    }
+
+    /// Phases 1–5 of the sample: integrate, observe, form λ̂r, track, select the mode and
+    /// the feedback for the next sample. Nothing is committed.
+    #[inline(always)]
+    fn candidate(&self, p: &EstimatorParams<T>, v_ab: Ab<T>, i_ab: Ab<T>) -> Candidate<T> {
+        // L̂d − L̂q: zero on a surface-magnet rotor, where the active-flux terms vanish.
+        let saliency = p.saliency;
+        // 1. Integrate with the feedback of the previous sample (eq. (21) / (24)).
+        let (lambda1, i_drop) = p
+            .integrator
+            .next_flux(&self.integrator, v_ab, i_ab, self.feedback);
+        // L̂q·i of eq. (5), formed once for both of its uses (λ̂r, and the observer's input
+        // on the rotor flux): what `rotor_flux` computes, bit for bit.
+        let lq_i = i_ab * p.lq;
+        // 2. Disturbance observer.
+        let (observer_flux, disturbance) = self.observe(p, lambda1, lq_i, i_ab, saliency);
+        // 3. Rotor flux and direct angle (eq. (20), (5), (6)).
+        let lambda2 = stator_flux(lambda1, disturbance);
+        let lambda_r = lambda2 - lq_i;
+        let tracker_hold = lambda_r.norm_squared() < p.hold_level_sq;
+        let theta_direct = rotor_angle(lambda_r);
+        // 4. Trackers (Fig. 1, Fig. 5).
+        let (t2s1, t2s2) = self.track(p, theta_direct, tracker_hold);
+        // 5. Mode from the control speed, and the feedback for the next sample.
+        let mode = p.selector.next_mode(self.mode, t2s2.omega);
+        let kdf_active = mode == Mode::DisturbanceFeedback && self.k_df_enabled;
+        let kdf_gain = p.disturbance_feedback.next_gain(self.kdf_gain, kdf_active);
+        let (base_feedback, clamping) = match mode {
+            Mode::DisturbanceFeedback => (disturbance * kdf_gain, false),
+            Mode::Limiter => {
+                let ratio = Self::active_ratio(p, i_ab, lambda_r, saliency, tracker_hold);
+                let l = p.limiter.step_scaled(lambda_r, ratio);
+                (l.feedback, l.clamping)
+            }
+        };
+        // The learned integrand offset ê is subtracted from the integrand in both modes, with
+        // the standstill pull of the R̂s adaptation (both held between the slow laws' runs).
+        // Without the R̂s adaptation both are exactly zero (nothing learns them; it cannot be
+        // switched off once on), so the sum needs no test of the flag.
+        let feedback = base_feedback + self.slow_feedback;
+        Candidate {
+            lambda1,
+            i_drop,
+            observer_flux,
+            disturbance,
+            lambda2,
+            lambda_r,
+            theta_direct,
+            tracker_hold,
+            t2s1,
+            t2s2,
+            mode,
+            kdf_gain,
+            base_feedback,
+            clamping,
+            feedback,
+        }
+    }
+
+    /// Step 2: the disturbance observer at ω̂ of T2S-1 (eq. (10), (16)), on λ1 or on λ1 − L̂q·i (see
+    /// `EstimatorTuning::observer_on_rotor_flux`): (λ̂1, D̂).
+    #[inline(always)]
+    fn observe(
+        &self,
+        p: &EstimatorParams<T>,
+        lambda1: Ab<T>,
+        lq_i: Ab<T>,
+        i_ab: Ab<T>,
+        saliency: T,
+    ) -> (Ab<T>, Ab<T>) {
+        let observer_input = if p.observer_on_rotor_flux {
+            let active = lambda1 - lq_i;
+            if saliency != T::zero() {
+                active - self.active_flux_swing(p, i_ab, saliency)
+            } else {
+                active
+            }
+        } else {
+            lambda1
+        };
+        // With `observer_lag_compensation` ω̂1 plus T2S-1's low-passed Kp·e (the rate of
+        // θ̂), not the lagging ω̂1 alone. Its gains were formed for that speed at the end of
+        // a previous sample (the last one, or up to `observer_gain_period` earlier).
+        p.observer
+            .next_state_with(&self.observer, &self.observer_gains, observer_input)
+    }
+
+    /// Step 4: both trackers on the direct angle θm, or coasting while |λ̂r| is below the hold
+    /// level.
+    #[inline(always)]
+    fn track(
+        &self,
+        p: &EstimatorParams<T>,
+        theta_direct: T,
+        tracker_hold: bool,
+    ) -> (TrackerUpdate<T>, TrackerUpdate<T>) {
+        if tracker_hold {
+            (
+                p.t2s1.coasted_state(&self.t2s1),
+                p.t2s2.coasted_state(&self.t2s2),
+            )
+        } else {
+            (
+                p.t2s1.next_state(&self.t2s1, theta_direct),
+                // Both trackers have the same Ts: T2S-1's Ts in angle units, loaded once.
+                p.t2s2
+                    .next_state_with(&self.t2s2, theta_direct, p.t2s1.ts_units()),
+            )
+        }
+    }
+
+    /// The one finite test of the sample.
+    #[inline(always)]
+    fn is_committable(c: &Candidate<T>) -> bool {
+        // Which values the one test needs (the others follow from them, so the test is
+        // exact, not approximate): a non-finite v or i makes λ1 non-finite (Ts·v, and R̂s·i
+        // with R̂s ≥ 0: ∞·R̂s = ∞, 0·∞ = NaN, ∞ − ∞ = NaN); a tracker's ω̂ = ω̂ + Ki·Ts·e is
+        // finite only if its phase error e = wrap(…) is, and then θ̂ and θ̂⁻ (wrapped sums of
+        // finite values) are finite too. λ̂r and the feedback can overflow on their own.
+        // λ1 and D̂ need no test of their own: λ̂r = (λ1 − D̂) − L̂q·i (eq. (20), (5)) with a
+        // finite L̂q·i (the bounds passed) is finite only if both are (a difference with an
+        // ∞ or NaN operand is ∞ or NaN).
+        all_finite([
+            c.observer_flux.alpha,
+            c.observer_flux.beta,
+            c.lambda_r.alpha,
+            c.lambda_r.beta,
+            c.feedback.alpha,
+            c.feedback.beta,
+            c.t2s1.omega,
+            c.t2s2.omega,
+        ])
+    }
+
+    /// Commits the candidate: λ1 and the observer (re-centred), the lag compensation, the
+    /// observer's gains when due, the trackers, the mode and the feedback. Returns the
+    /// re-centring shift of D̂.
+    #[inline(always)]
+    fn commit(&mut self, p: &EstimatorParams<T>, c: &Candidate<T>, i_ab: Ab<T>) -> Ab<T> {
+        // Limiter mode: re-centre the common mode (see `EstimatorTuning::limiter_recentring`).
+        // With the integrand-offset law, the k_df mode re-centres too, at k_e (see
+        // `crate::integrand_offset`: D̂ then decays at k_df + k_e instead of k_df, and the
+        // ramp k_df·D̂ that the observer has to follow goes with it).
+        // A gain switched off is 0 and its shift D̂·0 = 0 changes nothing: no test of it.
+        let shift = c.disturbance
+            * match c.mode {
+                Mode::Limiter => p.limiter_recentring_gain,
+                Mode::DisturbanceFeedback => self.offset_recentring_gain,
+            };
+        self.integrator.commit(c.lambda1 - shift, i_ab);
+        self.observer
+            .commit(c.observer_flux - shift, c.disturbance - shift);
+        // The observer's lag compensation: Kp·e of T2S-1 through the first-order low-pass
+        // (see `EstimatorTuning::observer_lag_compensation_hz`).
+        if p.lag_compensation {
+            self.lag_compensation =
+                p.lag_keep * self.lag_compensation + p.lag_input * c.t2s1.innovation;
+        }
+        // The observer's gains for the next sample's speed, once every `gain_hold` + 1
+        // samples (see `EstimatorTuning::observer_gain_period`).
+        if self.gain_countdown == 0 {
+            self.observer_gains = p.observer.gains(c.t2s1.omega + self.lag_compensation);
+            self.gain_countdown = p.gain_hold;
+        } else {
+            self.gain_countdown -= 1;
+        }
+        self.t2s1.commit(c.t2s1);
+        // T2S-2's θ̂ is never read (its ω̂ is the control speed): not stored.
+        self.t2s2.commit_speed(c.t2s2);
+        self.mode = c.mode;
+        self.kdf_gain = c.kdf_gain;
+        self.feedback = c.feedback;
+        shift
+    }
+
+    /// Loss-of-lock symptoms (see `lock`), in the detector's slot: |λ̂r| against λ̂f (the
+    /// lower bound chosen by the control speed ω̂ of the mode selector), the T2S-1
+    /// innovation. Stepped after the finite test, so that one slot test both computes and
+    /// commits it (a rejected sample never reaches this point). Outside its slot the
+    /// detector's state is neither copied nor written back.
+    #[inline(always)]
+    fn judge_lock(&mut self, p: &EstimatorParams<T>, c: &Candidate<T>, i_ab: Ab<T>) {
+        // The innovation is T2S-1's phase error of this sample (0 when the trackers coasted).
+        // The round-robin's slot, read only now: nothing before the commit needs it.
+        if self.slot % LOCK_PERIOD != SLOT_LOCK {
+            return;
+        }
+        // λ̂f as this sample used it (the slow laws have not run yet).
+        let flux_hat = self.rs_adaptation.flux_linkage_hat;
+        let active_ratio = Self::active_ratio(p, i_ab, c.lambda_r, p.saliency, c.tracker_hold);
+        // A hand-over since the last judged sample (the mode sampled every LOCK_PERIOD
+        // samples: two hand-overs within them would need ω̂ to cross the hysteresis band
+        // twice in 0.4 ms, and count as none).
+        let handover = c.mode != self.lock_mode;
+        self.lock_mode = c.mode;
+        let lock = p.lock.next_state(
+            self.lock,
+            c.lambda_r.norm_squared(),
+            flux_hat * flux_hat * active_ratio * active_ratio,
+            c.t2s1.innovation * T::angle_unit(),
+            c.t2s2.omega,
+            c.clamping,
+            handover,
+        );
+        self.lock = lock;
+        self.lock_status = lock.status();
+    }
+
+    /// Step 6: the R̂s adaptation (with its λ̂f law) and the integrand-offset law, each in its
+    /// slot of the round-robin (see [`SLOW_PERIOD`]).
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn run_slow_laws(
+        &mut self,
+        p: &EstimatorParams<T>,
+        c: &Candidate<T>,
+        slot: u8,
+        previous_mode: Mode,
+        shift: Ab<T>,
+        v_ab: Ab<T>,
+        i_ab: Ab<T>,
+    ) {
+        // An interruption marks both laws' periods broken: with the two bits there are,
+        // slow_broken | (both) is both, so the byte is written only then (and by the law
+        // that runs in its slot), not in every free slot.
+        if c.tracker_hold || previous_mode != c.mode {
+            self.slow_broken = BROKEN_RS | BROKEN_OFFSET;
+        }
+        let broken = self.slow_broken;
+        if slot == SLOT_RS {
+            self.adapt_resistance(p, c, broken, v_ab, i_ab);
+        } else if c.mode == Mode::Limiter {
+            // Only the standstill law uses the means, and only after a whole period in the
+            // limiter mode (else its regime is `Frozen`).
+            self.v_sum += v_ab;
+            self.i_sum += c.i_drop;
+        }
+        if slot == SLOT_OFFSET {
+            self.learn_offset(p, c, broken, shift);
+        }
+    }
+
+    /// The R̂s adaptation's slot: R̂s, λ̂f and the standstill pull for the next period.
+    #[inline(always)]
+    fn adapt_resistance(
+        &mut self,
+        p: &EstimatorParams<T>,
+        c: &Candidate<T>,
+        broken: u8,
+        v_ab: Ab<T>,
+        i_ab: Ab<T>,
+    ) {
+        let regime = if broken & BROKEN_RS != 0 {
+            AdaptationRegime::Frozen
+        } else {
+            match c.mode {
+                Mode::DisturbanceFeedback => AdaptationRegime::Rotating,
+                Mode::Limiter => AdaptationRegime::Standstill,
+            }
+        };
+        // The standstill law sees the voltage without the learned offset, and the voltage
+        // and current averaged over the period.
+        let per_sample = T::one() / T::lit(SLOW_PERIOD as f64);
+        let v_mean = (self.v_sum + v_ab) * per_sample;
+        let i_mean = (self.i_sum + c.i_drop) * per_sample;
+        self.v_sum = Ab::zero();
+        self.i_sum = Ab::zero();
+        let (state, pull) = p.rs_adaptation_params.next_state(
+            &self.rs_scale,
+            &self.rs_adaptation,
+            v_mean - self.offset.offset,
+            c.i_drop,
+            i_mean,
+            i_ab,
+            c.lambda_r,
+            c.t2s1.omega,
+            regime,
+            self.offset.learning_samples >= p.flux_settle_periods,
+        );
+        // The pull acts until the law runs again (one period), with ê.
+        let slow_feedback = self.offset.offset + pull;
+        let feedback = c.base_feedback + slow_feedback;
+        // R̂s and λ̂f leave the adaptation clamped by compare-and-select, which turns a NaN
+        // into the bound: always finite.
+        if all_finite([
+            state.charge_d,
+            state.volt_seconds_d,
+            state.i_d_prev,
+            state.offset_sensitivity.alpha,
+            state.offset_sensitivity.beta,
+            state.flux_error_angle,
+            state.flux_excitation,
+            state.flux_angle,
+            state.flux_time,
+            feedback.alpha,
+            feedback.beta,
+        ]) {
+            self.rs_adaptation = state;
+            self.integrator.set_rs_hat_unchecked(state.rs_hat);
+            self.feedback = feedback;
+            self.slow_feedback = slow_feedback;
+        }
+        self.slow_broken = broken & !BROKEN_RS;
+    }
+
+    /// The integrand-offset law's slot: ê, and R̂s without what earlier standstill tests
+    /// read of it.
+    #[inline(always)]
+    fn learn_offset(&mut self, p: &EstimatorParams<T>, c: &Candidate<T>, broken: u8, shift: Ab<T>) {
+        // D̂ decays over the period by k_df·N·Ts, and by the N − 1 re-centring shifts
+        // k_e·Ts·D̂ of the samples since the law last ran (see
+        // `IntegrandOffset::next_state`).
+        let n = T::lit(SLOW_PERIOD as f64);
+        let decay = c.kdf_gain * (p.ts * n) + self.offset_recentring_gain * (n - T::one());
+        let learning = broken & BROKEN_OFFSET == 0 && c.mode == Mode::DisturbanceFeedback;
+        let offset = p
+            .offset
+            .next_state(&self.offset, c.disturbance, decay, shift, learning);
+        // R̂s drops what earlier standstill tests read of the offset ê learns now.
+        let change = offset.offset - self.offset.offset;
+        let rs_hat = self
+            .rs_adaptation
+            .rs_after_offset_change(&self.rs_scale, change);
+        let slow_feedback = self.slow_feedback + change;
+        let feedback = c.base_feedback + slow_feedback;
+        if all_finite([
+            offset.offset.alpha,
+            offset.offset.beta,
+            offset.disturbance_prev.alpha,
+            offset.disturbance_prev.beta,
+            feedback.alpha,
+            feedback.beta,
+        ]) {
+            self.offset = offset;
+            self.rs_adaptation.rs_hat = rs_hat;
+            self.integrator.set_rs_hat_unchecked(rs_hat);
+            self.feedback = feedback;
+            self.slow_feedback = slow_feedback;
+        }
+        self.slow_broken = broken & !BROKEN_OFFSET;
+    }
+
+    /// The sample's estimate, with the R̂s and λ̂f it used.
+    #[inline(always)]
+    fn estimate(
+        c: &Candidate<T>,
+        rs_hat: T,
+        flux_linkage_hat: T,
+        lock: crate::LockStatus,
+    ) -> Estimate<T> {
+        Estimate {
+            theta: c.t2s1.angle(),
+            omega: c.t2s1.omega,
+            omega_control: c.t2s2.omega,
+            diagnostics: Diagnostics {
+                lambda1: c.lambda1,
+                disturbance: c.disturbance,
+                lambda2: c.lambda2,
+                lambda_r: c.lambda_r,
+                theta_direct: c.theta_direct,
+                mode: c.mode,
+                flag_limit: c.mode == Mode::Limiter,
+                limiter_clamping: c.clamping,
+                tracker_hold: c.tracker_hold,
+                rs_hat,
+                flux_linkage_hat,
+                input_fault: false,
+                lock,
+            },
+        }
+    }
+}

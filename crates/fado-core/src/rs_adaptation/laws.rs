@@ -1,0 +1,404 @@
+//! The two laws' constants ([`ResistanceAdaptationParams`]), what they derive from R0
+//! ([`ResistanceScale`]) and one period of each law.
+
+use super::{
+    AdaptationRegime, FLUX_LINKAGE_DEAD_ZONE, FLUX_LINKAGE_DEAD_ZONE_OFF, FLUX_LINKAGE_MAX_RATIO,
+    FLUX_LINKAGE_MIN_RATIO, ResistanceAdaptationConfig, ResistanceAdaptationState,
+};
+use crate::error::{ConfigError, check};
+use crate::real::{max, min};
+use crate::{Ab, Real};
+
+/// The laws' constants, precomputed once from a [`ResistanceAdaptationConfig`] (the
+/// immutable half of [`ResistanceAdaptation`]). What scales with R0 is in
+/// [`ResistanceScale`]: R0 changes at run time (the estimator's `set_rs_hat`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct ResistanceAdaptationParams<T> {
+    config: ResistanceAdaptationConfig<T>,
+    /// γ·Ts.
+    rate_ts: T,
+    /// γ_s·Ts.
+    standstill_gain: T,
+    /// e^{−ω_m·Ts}.
+    forget: T,
+    /// 1/(2π·standstill_speed_hz)².
+    standstill_inv_omega_sq: T,
+    /// L̂d − L̂q.
+    saliency: T,
+    floor_sq: T,
+}
+
+/// What the laws derive from R0, the resistance they start from and scale with: mutable
+/// (R0 is replaced at run time), so kept with the state.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct ResistanceScale<T> {
+    /// R0, Ω.
+    r0: T,
+    /// γ·Ts·R0.
+    gain: T,
+    /// R0/λ̂f (the configured λ̂f).
+    chi_per_phi: T,
+    rs_min: T,
+    rs_max: T,
+}
+
+impl<T: Real> ResistanceAdaptationParams<T> {
+    /// Checks every field of `config` (the error names it) and precomputes the constants.
+    pub(crate) fn new(config: ResistanceAdaptationConfig<T>) -> Result<Self, ConfigError> {
+        let ts = check::positive("ts", config.ts)?;
+        // R0 = 0 is allowed: it scales the law and its bounds to nothing (R̂s stays 0).
+        check::non_negative("rs_initial", config.rs_initial)?;
+        check::positive("flux_linkage_hat", config.flux_linkage_hat)?;
+        check::non_negative("lq_hat", config.lq_hat)?;
+        check::non_negative("ld_hat", config.ld_hat)?;
+        check::finite("ld_hat", config.ld_hat - config.lq_hat)?;
+        let flux_rate_f = check::non_negative("flux_linkage_rate", config.flux_linkage_rate)?;
+        check::below(
+            "flux_linkage_rate",
+            flux_rate_f * ts,
+            T::one(),
+            "with flux_linkage_rate·ts below 1",
+        )?;
+        let rate = check::non_negative("rate", config.rate)?;
+        check::below("rate", rate * ts, T::one(), "with rate·ts below 1")?;
+        let floor = check::positive("excitation_floor", config.excitation_floor)?;
+        let rate_s = check::non_negative("standstill_rate", config.standstill_rate)?;
+        check::below(
+            "standstill_rate",
+            rate_s * ts,
+            T::one(),
+            "with standstill_rate·ts below 1",
+        )?;
+        let memory_w =
+            T::two_pi() * check::positive("standstill_memory_hz", config.standstill_memory_hz)?;
+        check::below(
+            "standstill_memory_hz",
+            memory_w * ts,
+            T::one(),
+            "with 2π·f·ts below 1",
+        )?;
+        let standstill_hz = check::non_negative("standstill_speed_hz", config.standstill_speed_hz)?;
+        let flux_rate = check::non_negative("standstill_flux_rate", config.standstill_flux_rate)?;
+        check::below(
+            "standstill_flux_rate",
+            flux_rate * ts,
+            T::one(),
+            "with standstill_flux_rate·ts below 1",
+        )?;
+        let angle_rate =
+            check::non_negative("standstill_angle_rate", config.standstill_angle_rate)?;
+        check::below(
+            "standstill_angle_rate",
+            angle_rate * ts,
+            T::one(),
+            "with standstill_angle_rate·ts below 1",
+        )?;
+        check::non_negative("flux_linkage_min_speed", config.flux_linkage_min_speed)?;
+        let min = check::positive("min_ratio", config.min_ratio)?;
+        if min > T::one() {
+            return Err(ConfigError::OutOfRange {
+                field: "min_ratio",
+                expected: "at most 1",
+            });
+        }
+        let max = check::finite("max_ratio", config.max_ratio)?;
+        if max < T::one() {
+            return Err(ConfigError::OutOfRange {
+                field: "max_ratio",
+                expected: "at least 1",
+            });
+        }
+        Ok(Self {
+            config,
+            rate_ts: rate * ts,
+            standstill_gain: rate_s * ts,
+            forget: (-(memory_w * ts)).exp(),
+            // |ω̂| ≤ ω_s is ω̂²·(1/ω_s²) ≤ 1; ω_s = 0 allows ω̂ = 0 only (1e30: no ∞·0).
+            standstill_inv_omega_sq: if standstill_hz > T::zero() {
+                let w = T::two_pi() * standstill_hz;
+                T::one() / (w * w)
+            } else {
+                T::lit(1e30)
+            },
+            saliency: config.ld_hat - config.lq_hat,
+            floor_sq: floor * floor,
+        })
+    }
+
+    /// The values scaled by R0 = `r0` (checked non-negative by the caller; the products are
+    /// the ones the unsplit block formed, bit for bit).
+    pub(crate) fn scale(&self, r0: T) -> ResistanceScale<T> {
+        let c = &self.config;
+        ResistanceScale {
+            r0,
+            gain: c.rate * c.ts * r0,
+            chi_per_phi: r0 / c.flux_linkage_hat,
+            rs_min: c.min_ratio * r0,
+            rs_max: c.max_ratio * r0,
+        }
+    }
+
+    /// The state at R̂s = R0 of `scale`, λ̂f as configured, the standstill integrals zero.
+    pub(crate) fn initial_state(&self, scale: &ResistanceScale<T>) -> ResistanceAdaptationState<T> {
+        ResistanceAdaptationState {
+            rs_hat: scale.r0,
+            flux_linkage_hat: self.config.flux_linkage_hat,
+            ..ResistanceAdaptationState::default()
+        }
+    }
+
+    /// The configuration the constants were computed from.
+    pub(crate) fn config(&self) -> &ResistanceAdaptationConfig<T> {
+        &self.config
+    }
+
+    /// The state after one more period of the law (`ts`), computed without changing this
+    /// one. `i_drop` is the current now (the turning law compares it with λ̂r now);
+    /// `i_now` the current sampled now (its d component at the ends of the period gives
+    /// the inductive voltage's integral L̂d·Δi_d); `v_ab` and `i_mean` are the voltage and
+    /// current averaged over the period (the
+    /// standstill law integrates them: run once per sample, the samples themselves; run once
+    /// every N samples, their means over the N samples, so that its integrals stay those of
+    /// every sample — a sampled v_d would add the noise of the samples left out, and alias
+    /// whatever the current loop puts at multiples of 1/(N·Ts) to DC). `settled`: the k_df
+    /// mode has lasted long enough for the λ̂f law (past the hand-over transient). The
+    /// returned pull (V) acts until the next run (the estimator holds it over the period).
+    /// Always inlined: the estimator's step is its one caller per sample (an out-of-line
+    /// copy costs a call and the spills around it on a Cortex-M4F, docs/firmware.md).
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn next_state(
+        &self,
+        scale: &ResistanceScale<T>,
+        st: &ResistanceAdaptationState<T>,
+        v_ab: Ab<T>,
+        i_drop: Ab<T>,
+        i_mean: Ab<T>,
+        i_now: Ab<T>,
+        lambda_r: Ab<T>,
+        omega: T,
+        regime: AdaptationRegime,
+        settled: bool,
+    ) -> (ResistanceAdaptationState<T>, Ab<T>) {
+        let mut next = ResistanceAdaptationState {
+            rs_hat: st.rs_hat,
+            flux_linkage_hat: st.flux_linkage_hat,
+            flux_learning: st.flux_learning,
+            offset_sensitivity: st.offset_sensitivity,
+            ..ResistanceAdaptationState::default()
+        };
+        let mag_sq = lambda_r.norm_squared();
+        if regime == AdaptationRegime::Frozen || mag_sq <= T::zero() {
+            return (next, Ab::zero());
+        }
+        let mag = mag_sq.step_sqrt();
+        let pull = if regime == AdaptationRegime::Rotating {
+            if !self.rotating(scale, st, &mut next, i_drop, lambda_r, mag, omega, settled) {
+                return (next, Ab::zero());
+            }
+            Ab::zero()
+        } else {
+            let standstill = self.standstill(
+                scale, st, &mut next, v_ab, i_mean, i_now, lambda_r, mag, omega,
+            );
+            match standstill {
+                Some(pull) => pull,
+                None => return (next, Ab::zero()),
+            }
+        };
+        next.rs_hat = min(max(next.rs_hat, scale.rs_min), scale.rs_max);
+        (next, pull)
+    }
+
+    /// The turning law (and, settled and fast enough, the flux-linkage law) into `next`;
+    /// false when the active flux is no usable reference (nothing adapts).
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn rotating(
+        &self,
+        scale: &ResistanceScale<T>,
+        st: &ResistanceAdaptationState<T>,
+        next: &mut ResistanceAdaptationState<T>,
+        i_drop: Ab<T>,
+        lambda_r: Ab<T>,
+        mag: T,
+        omega: T,
+        settled: bool,
+    ) -> bool {
+        let lf = st.flux_linkage_hat;
+        let dl = self.saliency;
+        // The reference is the active flux λ̂a = λ̂f + (L̂d − L̂q)·î_d and φ carries the
+        // sensitivity factor 1 + (L̂d − L̂q)·î_d/λ̂a (module docs); for L̂d = L̂q both are
+        // exactly λ̂f and 1, and the division for î_d is skipped.
+        let (reference, sensitivity) = if dl == T::zero() {
+            (lf, T::one())
+        } else {
+            let i_d = lambda_r.dot(i_drop) / mag;
+            let active = lf + dl * i_d;
+            // A non-positive (or NaN) reference: nothing to compare with.
+            if active.partial_cmp(&T::zero()) != Some(core::cmp::Ordering::Greater) {
+                return false;
+            }
+            (active, T::one() + dl * i_d / active)
+        };
+        // χ = φ·R0/λ̂f with φ = −(i_q/ω̂)·sensitivity and i_q = (λ̂r × i)/|λ̂r|, as
+        // χ = a/b: then χ/(χ² + χ0²) = a·b/(a² + χ0²·b²) costs one division, and
+        // χ² ≥ χ0² is a² ≥ χ0²·b² (false for ω̂ = 0, which also rules out 0/0).
+        let a = -lambda_r.cross(i_drop) * scale.chi_per_phi * sensitivity;
+        let b = mag * omega;
+        let (a_sq, floor_b_sq) = (a * a, self.floor_sq * b * b);
+        if a_sq >= floor_b_sq && floor_b_sq > T::zero() {
+            // ẽ·χ/(χ² + χ0²) with ẽ = (|λ̂r| − λ̂a)/λ̂f, in one division.
+            let weight = a_sq / (a_sq + floor_b_sq);
+            next.rs_hat -= scale.gain * (mag - reference) * a * b / (lf * (a_sq + floor_b_sq));
+            // The turning law replaces what the standstill tests contributed.
+            next.offset_sensitivity = st.offset_sensitivity * (T::one() - self.rate_ts * weight);
+        }
+        if settled && omega.abs() >= self.config.flux_linkage_min_speed {
+            self.flux_law(st, next, a, mag - reference, omega);
+        }
+        true
+    }
+
+    /// The flux-linkage law's step into `next`: `a` the turning law's numerator of χ,
+    /// `deviation` the sample's |λ̂r| − λ̂a.
+    #[inline(always)]
+    fn flux_law(
+        &self,
+        st: &ResistanceAdaptationState<T>,
+        next: &mut ResistanceAdaptationState<T>,
+        a: T,
+        deviation: T,
+        omega: T,
+    ) {
+        let lf = st.flux_linkage_hat;
+        // The λ̂f law (module docs): the mean of |λ̂r| − λ̂a over one electrical
+        // revolution (angle-weighted, so exact at a changing speed: a DC error left in
+        // λ2 by the observer's transient makes |λ̂r| swing at ω̂, which the mean
+        // removes), used where the revolution's mean |χ| is below χ0/2 (R̂s explains
+        // too little of it; per sample, current noise would cross any bound).
+        // χ·dθ = a/(|λ̂r|·ω̂)·|ω̂|·Ts ≈ a·sgn(ω̂)·Ts/λ̂f: the sum of a·sgn(ω̂)·Ts is
+        // compared with χ0/2·λ̂f·∮dθ at the end, no division per sample.
+        let step_angle = omega.abs() * self.config.ts;
+        let chi_step = if omega < T::zero() { -a } else { a } * self.config.ts;
+        next.flux_error_angle = st.flux_error_angle + deviation * step_angle;
+        next.flux_excitation = st.flux_excitation + chi_step;
+        next.flux_angle = st.flux_angle + step_angle;
+        next.flux_time = st.flux_time + self.config.ts;
+        if next.flux_angle >= T::two_pi() {
+            let bound = T::lit(0.5) * self.config.excitation_floor * lf * next.flux_angle;
+            let excess_chi = next.flux_excitation.abs() >= bound;
+            let lf0 = self.config.flux_linkage_hat;
+            let error = next.flux_error_angle / next.flux_angle;
+            // Dead zone with hysteresis (module docs): a mean beyond ±ε starts the
+            // law, which then follows the whole mean until it is within ±ε_off.
+            let zone = lf0 * T::lit(FLUX_LINKAGE_DEAD_ZONE);
+            let excess = error - min(max(error, -zone), zone);
+            let on = st.flux_learning || error.abs() > zone + zone;
+            let gain = if excess_chi {
+                T::zero()
+            } else {
+                min(self.config.flux_linkage_rate * next.flux_time, T::one())
+            };
+            if !excess_chi {
+                next.flux_learning = on && error.abs() > lf0 * T::lit(FLUX_LINKAGE_DEAD_ZONE_OFF);
+            }
+            let step = if on { error } else { excess };
+            next.flux_linkage_hat = min(
+                max(lf + gain * step, lf0 * T::lit(FLUX_LINKAGE_MIN_RATIO)),
+                lf0 * T::lit(FLUX_LINKAGE_MAX_RATIO),
+            );
+            next.flux_error_angle = T::zero();
+            next.flux_excitation = T::zero();
+            next.flux_angle = T::zero();
+            next.flux_time = T::zero();
+        }
+    }
+
+    /// The standstill law into `next`, and its pull (V); None outside its conditions
+    /// (nothing adapts, no pull).
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn standstill(
+        &self,
+        scale: &ResistanceScale<T>,
+        st: &ResistanceAdaptationState<T>,
+        next: &mut ResistanceAdaptationState<T>,
+        v_ab: Ab<T>,
+        i_mean: Ab<T>,
+        i_now: Ab<T>,
+        lambda_r: Ab<T>,
+        mag: T,
+        omega: T,
+    ) -> Option<Ab<T>> {
+        let lf = st.flux_linkage_hat;
+        let dl = self.saliency;
+        // Standstill: only at standstill and while the current lies along the flux (the
+        // estimated rotor frame: d along λ̂r).
+        let unit = lambda_r * (T::one() / mag);
+        let i_d = unit.dot(i_mean);
+        let i_q = unit.cross(i_mean);
+        let speed_sq = omega * omega * self.standstill_inv_omega_sq;
+        if i_d <= (i_q + i_q).abs() || speed_sq > T::one() {
+            return None;
+        }
+        let ts = self.config.ts;
+        let inv_i_d = T::one() / i_d;
+        let v_d = unit.dot(v_ab) + omega * self.config.lq_hat * i_q;
+        // L̂d·di_d/dt integrates to L̂d·Δi_d between the ends of the period, from the
+        // current sampled there (`i_now`); the first period of a test only records it
+        // (its inductive voltage would otherwise be read as resistance).
+        let i_d_now = unit.dot(i_now);
+        next.i_d_prev = i_d_now;
+        if st.i_d_prev != T::zero() {
+            let di_d = i_d_now - st.i_d_prev;
+            next.charge_d = st.charge_d * self.forget + i_d * ts;
+            next.volt_seconds_d =
+                st.volt_seconds_d * self.forget + v_d * ts - self.config.ld_hat * di_d;
+        }
+        if next.charge_d * scale.chi_per_phi >= self.config.excitation_floor {
+            let r_dc = next.volt_seconds_d / next.charge_d;
+            next.rs_hat += self.standstill_gain * (r_dc - next.rs_hat);
+            let sensitivity = unit * inv_i_d;
+            next.offset_sensitivity +=
+                (sensitivity - next.offset_sensitivity) * self.standstill_gain;
+        }
+        // The current only moved λ̂r radially, and the rotor flux is the active flux λ̂a:
+        // pull a shrunken λ̂r back out (outside, the Fig. 6 limiter already bounds it at
+        // its circle; pulling it further in would only speed up the walk of a tangential
+        // integrand error along the circle, which goes as e_t/|λ̂r|).
+        let shortfall = min(mag - (lf + dl * i_d), T::zero());
+        let mut pull = unit * (self.config.standstill_flux_rate * shortfall);
+        // The injection's current response: at standstill with no load the speed loop
+        // holds the torque at zero, so the current lies along the rotor's d axis; turn
+        // λ̂r towards it at k_θ·x·(1 − 4x²), x = i_q/i_d = tan(∠(i, λ̂r)) (module docs).
+        let x = i_q * inv_i_d;
+        let turn = self.config.standstill_angle_rate
+            * mag
+            * x
+            * (T::one() - T::lit(4.0) * x * x)
+            * (T::one() - speed_sq);
+        pull += Ab::new(unit.beta, -unit.alpha) * turn;
+        Some(pull)
+    }
+}
+
+impl<T: Real> ResistanceAdaptationState<T> {
+    /// R̂s after the integrand-offset estimate ê (`crate::integrand_offset`) moved by
+    /// `offset_change` (V): R̂s drops what standstill tests read of it, −⟨Δê, ∂R̂s/∂ê⟩,
+    /// within its bounds (compare-and-select: a NaN becomes a bound, so R̂s stays finite).
+    #[inline(always)]
+    pub(crate) fn rs_after_offset_change(
+        &self,
+        scale: &ResistanceScale<T>,
+        offset_change: Ab<T>,
+    ) -> T {
+        min(
+            max(
+                self.rs_hat - offset_change.dot(self.offset_sensitivity),
+                scale.rs_min,
+            ),
+            scale.rs_max,
+        )
+    }
+}
