@@ -81,6 +81,12 @@ pub fn complete_motor(user: &mut toml::Table, text: &str) -> Result<Vec<Derived>
             return Ok(Vec::new());
         }
     }
+    let given_bad = |k: &str| {
+        motor.contains_key(k) && !number(&motor, k).is_some_and(|x| x.is_finite() && x >= 0.0)
+    };
+    if DERIVABLE_MOTOR_KEYS.iter().any(|k| given_bad(k)) {
+        return Ok(Vec::new());
+    }
     let missing: Vec<&str> = ratings::REQUIRED_MOTOR_KEYS
         .iter()
         .copied()
