@@ -575,6 +575,9 @@ def default_config(
 ) -> str:
     """The scenario's configuration as TOML (``fado-sim run --dump-config``)."""
 
+def estimators() -> list[str]:
+    """The estimator names ``compare`` runs by default, in its order."""
+
 def compare(
     scenarios: list[str] | None = None,
     estimators: list[str] | None = None,

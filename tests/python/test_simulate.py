@@ -271,6 +271,7 @@ def test_sim_result_api() -> None:
         "reversal",
         "stops",
         "rated-reversal",
+        "loaded-start",
         "fullrange",
         "regen-stop",
         "custom",

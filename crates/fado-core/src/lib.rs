@@ -19,6 +19,7 @@ pub mod integrand_offset;
 pub mod lock;
 pub mod machine;
 pub mod machine_checks;
+pub mod magnetics;
 pub mod mode;
 pub mod observer;
 pub mod plausibility;
@@ -38,5 +39,6 @@ pub use estimator::{
 pub use frames::{Ab, Abc, Dq, Rotation};
 pub use lock::LockStatus;
 pub use machine::MachineModel;
+pub use magnetics::{MagneticModel, Magnetics};
 pub use mode::Mode;
 pub use real::{Real, wrap_angle};

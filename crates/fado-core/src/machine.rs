@@ -13,6 +13,7 @@
 //! the datasheet's r/min (a rating, converted once by [`MachineModel::rated_speed`]).
 
 use crate::error::{ConfigError, check};
+use crate::magnetics::ConstantInductance;
 use crate::{Dq, Real};
 
 /// The motor's parameters and ratings (a drive's model of it, or a simulated plant).
@@ -170,6 +171,16 @@ impl<T: Real> MachineModel<T> {
     /// Stator flux linkage in the rotor frame (Ld·i_d + λf, Lq·i_q) in Wb.
     pub fn flux_dq(&self, i_dq: Dq<T>) -> Dq<T> {
         Dq::new(self.ld * i_dq.d + self.flux_linkage, self.lq * i_dq.q)
+    }
+
+    /// This record's inductances and magnet flux as a [`ConstantInductance`] magnetic model
+    /// (the same arithmetic as [`MachineModel::flux_dq`]).
+    pub fn constant_inductance(&self) -> ConstantInductance<T> {
+        ConstantInductance {
+            ld: self.ld,
+            lq: self.lq,
+            flux_linkage: self.flux_linkage,
+        }
     }
 
     /// Magnitude of the active flux λf + (Ld − Lq)·i_d (Boldea, Paicu & Andreescu, "Active

@@ -13,16 +13,21 @@
 //! given directly: they are the plant's times the `[mismatch]` ratios, so "matched" stays
 //! matched when the motor changes.
 
+use std::sync::Arc;
+
 use fado_core::control::{DeadTimeMethod, DriveConfig, DriveTuning};
+use fado_core::magnetics::Saturation;
 use fado_core::{EstimatorConfig, EstimatorTuning, MachineModel};
 use serde::{Deserialize, Serialize};
 
 use crate::criteria::Criteria;
 use crate::dc_link::DcLinkParams;
 use crate::error::{SimConfigError, check};
+use crate::estimators::Estimator;
 use crate::faults::FaultParams;
 use crate::inverter::InverterParams;
 use crate::load::LoadParams;
+use crate::magnetics::PlantMagnetics;
 use crate::motor::MotorParams;
 use crate::profile::Profile;
 use crate::sensors::{CurrentSensorParams, DcLinkSensorParams};
@@ -54,6 +59,10 @@ pub struct SimulationSettings {
     pub estimator: EstimatorKind,
     /// Windows `[t_off, t_on]` in s during which the k_df feedback is switched off (Fig. 9).
     pub disturbance_feedback_off: Vec<[f64; 2]>,
+    /// A holding brake holds the rotor from the start until the drive reports ready (its
+    /// calibrations over, gates on); the load acts on the brake until then (a hoist, a
+    /// vehicle on a slope). Default false.
+    pub brake: bool,
 }
 
 impl Default for SimulationSettings {
@@ -66,8 +75,9 @@ impl Default for SimulationSettings {
             eval_start: 0.0,
             zero_speed_band_ratio: 0.02,
             precision: Precision::F64,
-            estimator: EstimatorKind::Fado,
+            estimator: EstimatorKind::FADO,
             disturbance_feedback_off: Vec::new(),
+            brake: false,
         }
     }
 }
@@ -111,63 +121,128 @@ pub enum Precision {
     F32,
 }
 
-/// Which rotor-angle estimator the drive runs.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum EstimatorKind {
-    /// The paper's estimator (`fado_core::SensorlessEstimator`).
-    #[default]
-    Fado,
-    /// Baseline: compensated low-pass integrator (`fado_core::LpfIntegratorEstimator`).
-    LpfIntegrator,
-    /// Baseline: Ortega–Praly nonlinear flux observer (`fado_core::OrtegaEstimator`).
-    Ortega,
-    /// Baseline: extended-EMF observer (`fado_core::EmfObserverEstimator`).
-    EmfObserver,
+/// Which rotor-angle estimator the drive runs: a row of [`crate::estimators::ESTIMATORS`],
+/// written in TOML by its key (`"fado"`, `"ortega"`, `"lpf_integrator"`; `-` is accepted
+/// for `_`).
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub struct EstimatorKind(&'static Estimator);
+
+impl EstimatorKind {
+    /// fado, the default.
+    pub const FADO: Self = Self(&crate::estimators::ESTIMATORS[0]);
+
+    /// The estimator of the registry row.
+    pub const fn of(estimator: &'static Estimator) -> Self {
+        Self(estimator)
+    }
+
+    /// Its registry row.
+    pub const fn estimator(self) -> &'static Estimator {
+        self.0
+    }
+
+    /// Its name (`lpf-integrator`).
+    pub const fn name(self) -> &'static str {
+        self.0.name
+    }
 }
 
-/// The tuning of the reference observers (`[simulation] estimator = "lpf_integrator"`,
-/// `"ortega"`, `"emf_observer"`); their model estimates are the drive's `[model]` and their
-/// trackers use `[estimator]`'s settings. Defaults as in `fado_core::baselines`.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct BaselineSettings {
-    /// LPF baseline: cut-off of 1/(s + ωc), Hz. Default as `LpfIntegratorConfig`.
-    pub lpf_cutoff_hz: f64,
-    /// LPF baseline: speed below which its gain/phase compensation is frozen, Hz.
-    pub lpf_compensation_floor_hz: f64,
-    /// Ortega baseline: observer gain, s⁻¹ (when not scheduled on speed).
-    pub ortega_observer_bandwidth: f64,
-    /// Ortega baseline: gain scheduled as this × |ω̂| (0 = fixed gain).
-    pub ortega_observer_speed_ratio: f64,
-    /// Ortega baseline: lower bound of the scheduled gain, s⁻¹.
-    pub ortega_observer_bandwidth_min: f64,
-    /// Ortega baseline: λ̂f adaptation gain ratio (0 = off).
-    pub ortega_flux_adaptation_ratio: f64,
-    /// EMF baseline: observer bandwidth, Hz.
-    pub emf_bandwidth_hz: f64,
-    /// EMF baseline: speed below which the angle is held, Hz.
-    pub emf_speed_floor_hz: f64,
-}
-
-impl Default for BaselineSettings {
+impl Default for EstimatorKind {
     fn default() -> Self {
-        // The tuning defaults do not depend on the machine: any valid one reads them out.
-        let m = MachineModel::<f64>::paper();
-        let lpf = fado_core::baselines::LpfIntegratorConfig::for_machine(&m);
-        let ortega = fado_core::baselines::OrtegaConfig::for_machine(&m);
-        let emf = fado_core::baselines::EmfObserverConfig::for_machine(&m);
-        Self {
-            lpf_cutoff_hz: lpf.cutoff_hz,
-            lpf_compensation_floor_hz: lpf.compensation_floor_hz,
-            ortega_observer_bandwidth: ortega.observer_bandwidth,
-            ortega_observer_speed_ratio: ortega.observer_speed_ratio,
-            ortega_observer_bandwidth_min: ortega.observer_bandwidth_min,
-            ortega_flux_adaptation_ratio: ortega.flux_adaptation_ratio,
-            emf_bandwidth_hz: emf.emf_bandwidth_hz,
-            emf_speed_floor_hz: emf.speed_floor_hz,
+        Self::FADO
+    }
+}
+
+impl std::fmt::Debug for EstimatorKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.0.name)
+    }
+}
+
+impl Serialize for EstimatorKind {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(&self.0.key())
+    }
+}
+
+impl<'de> Deserialize<'de> for EstimatorKind {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let name = String::deserialize(d)?;
+        crate::estimators::find(&name).map(Self).ok_or_else(|| {
+            let keys: Vec<_> = crate::estimators::ESTIMATORS
+                .iter()
+                .map(|e| e.key())
+                .collect();
+            serde::de::Error::custom(format!("unknown estimator `{name}`; one of {keys:?}"))
+        })
+    }
+}
+
+/// `[baselines]` keys that name a setting of one baseline directly, and the table and key
+/// each lives under now.
+const MOVED_BASELINE_KEYS: [(&str, &str, &str); 8] = [
+    ("lpf_cutoff_hz", "lpf_integrator", "cutoff_hz"),
+    (
+        "lpf_compensation_floor_hz",
+        "lpf_integrator",
+        "compensation_floor_hz",
+    ),
+    ("ortega_observer_bandwidth", "ortega", "observer_bandwidth"),
+    (
+        "ortega_observer_speed_ratio",
+        "ortega",
+        "observer_speed_ratio",
+    ),
+    (
+        "ortega_observer_bandwidth_min",
+        "ortega",
+        "observer_bandwidth_min",
+    ),
+    (
+        "ortega_flux_adaptation_ratio",
+        "ortega",
+        "flux_adaptation_ratio",
+    ),
+    ("emf_bandwidth_hz", "emf_observer", "emf_bandwidth_hz"),
+    ("emf_speed_floor_hz", "emf_observer", "speed_floor_hz"),
+];
+
+/// The settings of the baselines, one table per baseline of the registry
+/// (`[baselines.ortega]`, `[baselines.lpf_integrator]`, ...), each with its defaults.
+fn default_baselines() -> toml::Table {
+    crate::estimators::ESTIMATORS
+        .iter()
+        .filter(|e| e.own_settings)
+        .map(|e| (e.key(), toml::Value::Table((e.defaults)())))
+        .collect()
+}
+
+/// Every key of `[baselines]` names a baseline of the registry; a setting written there
+/// directly is refused with the place it lives now.
+fn check_baseline_keys(baselines: &toml::Table) -> Result<(), SimConfigError> {
+    for key in baselines.keys() {
+        if let Some((_, table, field)) = MOVED_BASELINE_KEYS.iter().find(|m| m.0 == key) {
+            return Err(SimConfigError::new(
+                format!("baselines.{key}"),
+                format!("moved: write it as `{field}` in `[baselines.{table}]`"),
+            ));
+        }
+        let known = crate::estimators::ESTIMATORS
+            .iter()
+            .any(|e| e.own_settings && e.key() == *key);
+        if !known {
+            let keys: Vec<_> = crate::estimators::ESTIMATORS
+                .iter()
+                .filter(|e| e.own_settings)
+                .map(|e| e.key())
+                .collect();
+            return Err(SimConfigError::new(
+                format!("baselines.{key}"),
+                format!("unknown baseline; one of {keys:?}"),
+            ));
         }
     }
+    Ok(())
 }
 
 /// `[inverter_model]`: what the drive's dead-time compensation is told of the inverter, as
@@ -268,8 +343,11 @@ pub struct SimConfig {
     pub controller: DriveTuning<f64>,
     /// Estimator tuning (`fado_core::EstimatorTuning`).
     pub estimator: EstimatorTuning<f64>,
-    /// Tuning of the reference observers.
-    pub baselines: BaselineSettings,
+    /// Settings of the reference observers, one table per baseline of
+    /// [`crate::estimators::ESTIMATORS`] (`[baselines.ortega]`, ...); their machine model is
+    /// the drive's `[model]` and their shared settings (trackers, sample bounds) are
+    /// `[estimator]`'s.
+    pub baselines: toml::Table,
     /// The drive's model of the plant as ratios to the true values.
     pub mismatch: Mismatch,
     /// The drive's model of the motor, key by key (same keys as `[motor]`); a key not given is
@@ -294,6 +372,11 @@ pub struct SimConfig {
     /// ratings (`crate::derive`), with their rules; not a TOML table.
     #[serde(skip)]
     pub derived: Vec<crate::derive::Derived>,
+    /// The plant's saturating magnetics, `[motor.saturation]` (the algebraic model of
+    /// [`fado_core::magnetics::Saturation`]); None: the constant inductances of `[motor]`,
+    /// whose `ld`, `lq` and `flux_linkage` then stay the datasheet's (the drive's default model).
+    #[serde(skip)]
+    pub motor_saturation: Option<Saturation<f64>>,
 }
 
 impl Default for SimConfig {
@@ -310,7 +393,7 @@ impl Default for SimConfig {
             load: LoadParams::default(),
             controller: DriveTuning::default(),
             estimator: EstimatorTuning::default(),
-            baselines: BaselineSettings::default(),
+            baselines: default_baselines(),
             mismatch: Mismatch::default(),
             model: None,
             inverter_model: None,
@@ -318,6 +401,7 @@ impl Default for SimConfig {
             dc_link: DcLinkParams::default(),
             criteria: Criteria::default(),
             derived: Vec::new(),
+            motor_saturation: None,
         }
     }
 }
@@ -339,6 +423,9 @@ impl SimConfig {
             load: self.load.clone(),
             faults: self.faults.clone(),
             dc_link: self.dc_link.clone(),
+            magnetics: self
+                .motor_saturation
+                .map(|s| Arc::new(PlantMagnetics::Saturation(s))),
         }
     }
 
@@ -359,6 +446,11 @@ impl SimConfig {
             .find(|(s, ..)| *s == fado_core::machine_checks::Severity::Error)
         {
             return Err(SimConfigError::new(key, text));
+        }
+        if let Some(sat) = &self.motor_saturation {
+            sat.validate().map_err(|e| {
+                SimConfigError::new(format!("motor.saturation.{}", e.field()), e.to_string())
+            })?;
         }
         self.plant().validate()?;
         let rows = self.simulation.duration
@@ -395,9 +487,10 @@ impl SimConfig {
             .map_err(|e| self.core_error("estimator", e))?;
         // Every key is checked whichever estimator runs: NaN in an unused key is still an
         // error in the file.
-        self.lpf_estimator()?;
-        self.ortega_estimator()?;
-        self.emf_estimator()?;
+        check_baseline_keys(&self.baselines)?;
+        for e in crate::estimators::ESTIMATORS {
+            (e.check)(self)?;
+        }
         self.drive_config()
             .validate()
             .map_err(|e| self.core_error("controller", e))?;
@@ -554,18 +647,7 @@ impl SimConfig {
             };
             return SimConfigError::new(key, format!("{e}{note}"));
         }
-        let (section, own) = match field {
-            "cutoff_hz" => ("baselines", "lpf_cutoff_hz"),
-            "compensation_floor_hz" => ("baselines", "lpf_compensation_floor_hz"),
-            "observer_bandwidth" => ("baselines", "ortega_observer_bandwidth"),
-            "observer_speed_ratio" => ("baselines", "ortega_observer_speed_ratio"),
-            "observer_bandwidth_min" => ("baselines", "ortega_observer_bandwidth_min"),
-            "flux_adaptation_ratio" => ("baselines", "ortega_flux_adaptation_ratio"),
-            "emf_bandwidth_hz" => ("baselines", "emf_bandwidth_hz"),
-            "speed_floor_hz" => ("baselines", "emf_speed_floor_hz"),
-            other => (section, other),
-        };
-        SimConfigError::new(format!("{section}.{own}"), e.to_string())
+        SimConfigError::new(format!("{section}.{field}"), e.to_string())
     }
 
     /// "Near zero speed" in r/min: `zero_speed_band_ratio` × the motor's rated speed.
@@ -575,7 +657,16 @@ impl SimConfig {
 
     /// This configuration as a TOML document.
     pub fn to_toml(&self) -> String {
-        toml::to_string(self).expect("every field of SimConfig is representable in TOML")
+        let Some(sat) = &self.motor_saturation else {
+            return toml::to_string(self)
+                .expect("every field of SimConfig is representable in TOML");
+        };
+        let mut table = toml::Table::try_from(self).expect("SimConfig is a TOML table");
+        if let Some(toml::Value::Table(motor)) = table.get_mut("motor") {
+            let sat = toml::Table::try_from(sat).expect("Saturation is a TOML table");
+            motor.insert("saturation".into(), toml::Value::Table(sat));
+        }
+        toml::to_string(&table).expect("every field of SimConfig is representable in TOML")
     }
 
     /// Parses a partial TOML document on top of `base`, an explicit configuration (a
@@ -601,9 +692,15 @@ impl SimConfig {
         whole_motor: bool,
     ) -> Result<SimConfig, SimConfigError> {
         let mut user: toml::Table = text.parse().map_err(|e| located(text, e))?;
+        let saturation = take_saturation(&mut user).map_err(|e| e.located_in(text))?;
         // Check the user's document on its own first, so that errors (unknown keys, wrong
         // types) name the key the user wrote and point at it.
-        toml::from_str::<SimConfig>(text).map_err(|e| located(text, e))?;
+        if saturation.is_some() {
+            SimConfig::deserialize(toml::Value::Table(user.clone()))
+                .map_err(|e| key_error(e).located_in(text))?;
+        } else {
+            toml::from_str::<SimConfig>(text).map_err(|e| located(text, e))?;
+        }
         let derived = if whole_motor {
             crate::derive::complete_motor(&mut user, text)?
         } else {
@@ -632,6 +729,7 @@ impl SimConfig {
         cfg.derived.extend(derived);
         // `[motor]` has no DC link of its own (it is the inverter's).
         cfg.motor.dc_voltage = cfg.inverter.dc_voltage;
+        cfg.motor_saturation = saturation.or(base.motor_saturation);
         cfg.validate().map_err(|e| e.located_in(text))?;
         Ok(cfg)
     }
@@ -746,6 +844,20 @@ fn check_time_constant(
     ))
 }
 
+/// Takes `[motor.saturation]` out of the user's document (`[motor]` itself is
+/// [`MachineModel`], whose keys are the linear machine's), parsed.
+fn take_saturation(user: &mut toml::Table) -> Result<Option<Saturation<f64>>, SimConfigError> {
+    let Some(toml::Value::Table(motor)) = user.get_mut("motor") else {
+        return Ok(None);
+    };
+    let Some(table) = motor.remove("saturation") else {
+        return Ok(None);
+    };
+    Saturation::<f64>::deserialize(table)
+        .map(Some)
+        .map_err(|e| key_error(e).in_section("motor.saturation"))
+}
+
 fn merge(base: &mut toml::Table, over: toml::Table) {
     for (k, v) in over {
         match (base.get_mut(&k), v) {
@@ -775,7 +887,7 @@ fn located(text: &str, e: toml::de::Error) -> SimConfigError {
 }
 
 /// A serde error from a `toml::Value` carries "in `path`"; unknown fields name the field.
-fn key_error(e: toml::de::Error) -> SimConfigError {
+pub(crate) fn key_error(e: toml::de::Error) -> SimConfigError {
     let msg = e.to_string();
     let path = msg
         .split("in `")
@@ -1011,6 +1123,46 @@ mod located_errors {
         assert_eq!(key, "inverter_model.dead_time");
     }
 
+    /// A baseline's settings are its table `[baselines.<name>]`; errors name the key there,
+    /// and a setting in the old flat place is refused with its new one.
+    #[test]
+    fn baseline_settings_live_in_their_own_tables() {
+        let cfg = SimConfig::from_toml(
+            "[simulation]\nestimator = \"ortega\"\n[baselines.ortega]\nobserver_speed_ratio = 0.0\n",
+        )
+        .unwrap();
+        assert_eq!(cfg.simulation.estimator.name(), "ortega");
+        assert_eq!(
+            cfg.baselines["ortega"]["observer_speed_ratio"].as_float(),
+            Some(0.0)
+        );
+        // The other settings of the table keep their defaults (tables merge).
+        assert!(cfg.baselines["ortega"].get("observer_bandwidth").is_some());
+        assert_eq!(SimConfig::from_toml(&cfg.to_toml()).unwrap(), cfg);
+        let (key, line, col, _) = err("[baselines.ortega]\nobserver_bandwidth = -1.0\n");
+        assert_eq!(
+            (key.as_str(), line, col),
+            ("baselines.ortega.observer_bandwidth", 2, 22)
+        );
+        let (key, line, _, _) = err("[baselines.lpf_integrator]\ncutoff = 1.0\n");
+        assert_eq!((key.as_str(), line), ("baselines.lpf_integrator.cutoff", 2));
+        let (key, line, _, msg) = err("[baselines]\nlpf_cutoff_hz = 3.0\n");
+        assert_eq!((key.as_str(), line), ("baselines.lpf_cutoff_hz", 2));
+        assert!(
+            msg.contains("`cutoff_hz` in `[baselines.lpf_integrator]`"),
+            "{msg}"
+        );
+        let (key, _, _, msg) = err("[baselines.kalman]\ngain = 1.0\n");
+        assert_eq!(key, "baselines.kalman");
+        assert!(msg.contains("ortega"), "{msg}");
+        let (key, line, _, msg) = err("[simulation]\nestimator = \"kalman\"\n");
+        assert_eq!((key.as_str(), line), ("simulation.estimator", 2));
+        assert!(msg.contains("lpf_integrator"), "{msg}");
+        // A machine-model field a baseline refuses is named by the user's own key.
+        let e = SimConfig::from_toml("[motor]\nflux_linkage = 0.0\n").unwrap_err();
+        assert!(e.key.starts_with("motor."), "{e}");
+    }
+
     #[test]
     fn syntax_errors_are_located() {
         let (key, line, col, msg) = err("[motor]\nrs = 0.3\nlq = = 2\n");
@@ -1052,6 +1204,35 @@ mod dead_time_method {
         assert_eq!(method(Plant::Averaged, EdgeCurrent), Trapezoidal);
         assert_eq!(method(Plant::Averaged, Sign), Sign);
         assert_eq!(method(Plant::SwitchingResolved, Trapezoidal), Trapezoidal);
+    }
+
+    #[test]
+    fn motor_saturation_is_read_checked_and_written_back() {
+        let text =
+            "[motor.saturation]\na_d0 = 380.2\na_q0 = 380.2\npsi_f = 0.088\na_qq = 1e5\nt = 2\n";
+        let cfg = SimConfig::from_toml(text).unwrap();
+        let sat = cfg.motor_saturation.unwrap();
+        assert_eq!((sat.a_qq, sat.t, sat.psi_f), (1e5, 2.0, 0.088));
+        assert!(cfg.plant().magnetics.is_some());
+        // --dump-config round trip keeps it.
+        let back = SimConfig::from_toml(&cfg.to_toml()).unwrap();
+        assert_eq!(back.motor_saturation, cfg.motor_saturation);
+        // Without the table the plant keeps its constant inductances.
+        assert!(SimConfig::default().plant().magnetics.is_none());
+        // Errors name the key and point at it.
+        let e =
+            SimConfig::from_toml("[motor.saturation]\na_d0 = 380.2\na_q0 = -1.0\n").unwrap_err();
+        assert_eq!(e.key, "motor.saturation.a_q0", "{e}");
+        assert_eq!(e.location.as_ref().map(|l| l.line), Some(3), "{e}");
+        let e =
+            SimConfig::from_toml("[motor.saturation]\na_d0 = 380.2\na_qqq = 1.0\n").unwrap_err();
+        assert!(e.key.starts_with("motor.saturation"), "{e}");
+        assert!(e.to_string().contains("a_qqq"), "{e}");
+        let e = SimConfig::from_toml(
+            "[motor]\nrs = -1.0\n[motor.saturation]\na_d0 = 1.0\na_q0 = 1.0\n",
+        )
+        .unwrap_err();
+        assert_eq!(e.key, "motor.rs", "{e}");
     }
 }
 

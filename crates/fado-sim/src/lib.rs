@@ -8,8 +8,9 @@
 //!
 //! * [`scenario`]: the paper's Fig. 8–12 as named scenarios with coded pass criteria;
 //!   [`simulate`] is the one-call entry point (CLI `fado-sim run`, Python bindings).
-//! * [`compare`]: every estimator (fado and the `fado_core::baselines`) in every scenario on
-//!   the same plant, seed and controllers (CLI `fado-sim compare`).
+//! * [`estimators`]: the registry of estimators (fado and the `fado_core::baselines`), one
+//!   row each; [`compare`]: every estimator in every scenario on the same plant, seed and
+//!   controllers (CLI `fado-sim compare`).
 //! * [`sweep`]: operating-envelope sweeps over model, sensor, load and profile errors, in
 //!   parallel, resumable, one CSV row per point (CLI `fado-sim sweep`, Python `fado.sweep`).
 //! * [`criteria`]: the pass criteria a user writes (`[criteria]`), all the `custom` scenario
@@ -55,10 +56,12 @@ pub mod dc_link;
 pub mod derive;
 pub mod drive;
 pub mod error;
+pub mod estimators;
 mod fastmath;
 pub mod faults;
 pub mod inverter;
 pub mod load;
+pub mod magnetics;
 pub mod motor;
 pub mod output;
 pub mod presets;

@@ -61,8 +61,10 @@ impl Eq for Scenario {}
 /// comparison ([`crate::compare`]): a medium-speed sanity check under load and a low-speed
 /// staircase; then the paper's experiments scaled by the motor's ratings (its motor: 1500
 /// r/min, 11.5 N·m), which run for any motor: `reversal` (Fig. 11), `stops` (Fig. 12) and
-/// `rated-reversal` (Fig. 11 under the rated torque).
-pub const SCENARIOS: [Scenario; 13] = [
+/// `rated-reversal` (Fig. 11 under the rated torque); `loaded-start`, a start under the
+/// rated torque held by a brake until the drive is ready; `fullrange` and `regen-stop`, the
+/// whole operating range and regenerating stops; and `custom`, the user's own profiles.
+pub const SCENARIOS: [Scenario; 14] = [
     Scenario {
         name: "fig8",
         title: "Flux and disturbance estimation under 2 N·m (Fig. 8)",
@@ -189,6 +191,23 @@ pub const SCENARIOS: [Scenario; 13] = [
         checks: checks_reversal,
     },
     Scenario {
+        name: "loaded-start",
+        title: "Start under the rated torque, the rotor held by a brake until the drive is ready",
+        profile: "rotor at rest at a seeded random angle, a brake holding it and a constant \
+                  100 % of rated torque (gravity-like) on it; the brake releases at the \
+                  drive's first ready sample (calibrations over); 0 r/min until 1 s, then a \
+                  ramp to +6 % of rated speed (lifting) by 2 s, held to 3 s. The drive starts \
+                  from the rotor's angle (`align`)",
+        criterion: "released; backward travel after the release ≤ 0.5 rad electrical; \
+                    |θ − θ̂| < 0.25 rad from the release on; commanded speed reached \
+                    (|n − n*| < 2 % of rated speed over the last 0.5 s); no trip",
+        scaled: true,
+        neutral: false,
+        setup: setup_loaded_start,
+        observe: observe_loaded_start,
+        checks: checks_loaded_start,
+    },
+    Scenario {
         name: "fullrange",
         title: "The whole operating range, scaled by the ratings and the model's limits",
         profile: "standstill under 50 % of rated torque; to rated speed at the current limit; \
@@ -230,6 +249,25 @@ pub const SCENARIOS: [Scenario; 13] = [
         checks: checks_nothing,
     },
 ];
+
+/// Load of `loaded-start`, fraction of the rated torque: a full load (a hoist at its rated
+/// load, a vehicle on its steepest slope).
+pub const LOADED_START_LOAD_RATIO: f64 = 1.0;
+/// Largest backward travel of the rotor after the brake's release in `loaded-start`,
+/// electrical rad.
+pub const LOADED_START_MAX_BACK: f64 = 0.5;
+/// `loaded-start`: the speed reference is 0 until this time (s), longer than every preset's
+/// start-up (offset and gain calibrations), then ramps to the target in 1 s.
+const LOADED_START_RAMP_AT: f64 = 1.0;
+/// `loaded-start`: duration (s); the speed is judged over its last 0.5 s.
+const LOADED_START_DURATION: f64 = 3.0;
+
+/// The rotor's start angle of `loaded-start` for a seed: electrical rad in [−π, π), spread by
+/// the golden ratio (seeds 1, 2, 3, 4: 0.74, −1.49, 2.57, 0.33 rad).
+pub fn loaded_start_angle(seed: u64) -> f64 {
+    let x = (seed as f64 * 0.618_033_988_749_894_9).fract();
+    std::f64::consts::TAU * x - std::f64::consts::PI
+}
 
 /// Load of the scaled `reversal` and `stops`, as a fraction of the rated torque: the paper's
 /// 7.5 N·m of 11.5 N·m (65.2 %, section V \[P\]).
@@ -316,6 +354,10 @@ fn observe_fig10(cfg: &SimConfig, p: &mut ScenarioProbe) {
 }
 
 /// `lowspeed`: the judged window of each staircase level.
+fn observe_loaded_start(cfg: &SimConfig, p: &mut ScenarioProbe) {
+    p.start = Some(StartStats::new(cfg.simulation.duration - 0.5));
+}
+
 fn observe_lowspeed(cfg: &SimConfig, p: &mut ScenarioProbe) {
     p.levels = lowspeed_levels_rpm(cfg.motor.rated_speed_rpm)
         .iter()
@@ -554,6 +596,19 @@ fn setup_rated_reversal(c: &mut SimConfig) {
     setup_reversal_under(c, 1.0);
 }
 
+/// `loaded-start`: brake, seeded angle, the rated torque from t = 0 (on the brake until the
+/// release), the lifting ramp.
+fn setup_loaded_start(c: &mut SimConfig) {
+    let n = REVERSAL_SPEED_RATIO * c.motor.rated_speed_rpm;
+    let t0 = LOADED_START_RAMP_AT;
+    c.simulation.brake = true;
+    c.simulation.initial_angle = loaded_start_angle(c.current_sensor.seed);
+    c.speed_reference = Profile::from_points(&[(0.0, 0.0), (t0, 0.0), (t0 + 1.0, n)]);
+    c.load.torque = Profile::constant(LOADED_START_LOAD_RATIO * c.motor.rated_torque);
+    c.simulation.duration = LOADED_START_DURATION;
+    c.simulation.eval_start = 0.0;
+}
+
 /// `stops`: profile, load, duration, evaluation window.
 fn setup_stops(c: &mut SimConfig) {
     let pts = Profile::from_points;
@@ -684,6 +739,89 @@ fn checks_stops(cfg: &SimConfig, m: &Metrics, _p: &ScenarioProbe, checks: &mut V
         m.max_speed_error_rpm,
         band,
     ));
+}
+
+/// `loaded-start`: pass criteria.
+fn checks_loaded_start(cfg: &SimConfig, _m: &Metrics, p: &ScenarioProbe, checks: &mut Vec<Check>) {
+    let band = SCALED_SPEED_ERROR_RATIO * cfg.motor.rated_speed_rpm;
+    let st = p.start.clone().unwrap_or_default();
+    let bounds = [
+        (
+            "brake released (time, s; never: ∞)",
+            st.release_time.unwrap_or(f64::INFINITY),
+            cfg.simulation.duration,
+        ),
+        (
+            "backward travel after the release (rad)",
+            st.max_backward,
+            LOADED_START_MAX_BACK,
+        ),
+        (
+            "max |θ − θ̂| from the release on (rad)",
+            st.max_angle_error,
+            0.25,
+        ),
+        ("speed error at the end (r/min)", st.end_speed_error(), band),
+    ];
+    checks.extend(bounds.map(|(name, value, max)| Check::at_most(name, value, max)));
+}
+
+/// What `loaded-start` measures about the start-up and the release.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct StartStats {
+    /// When the brake released (the drive's first ready sample), s.
+    pub release_time: Option<f64>,
+    /// Largest backward travel of the rotor after the release (electrical rad, ≥ 0; backward
+    /// is against the lifting direction, negative angles).
+    pub max_backward: f64,
+    /// Largest |θ − θ̂| from the release on, rad.
+    pub max_angle_error: f64,
+    /// Largest |n − n*| from `end_from` on, r/min (see [`end_speed_error`](Self::end_speed_error)).
+    pub max_end_speed_error_rpm: f64,
+    /// Start of the end window, s.
+    pub end_from: f64,
+    travel: f64,
+    last_theta: Option<f64>,
+    end_samples: u64,
+}
+
+impl StartStats {
+    fn new(end_from: f64) -> Self {
+        Self {
+            end_from,
+            ..Self::default()
+        }
+    }
+
+    fn observe(&mut self, s: &Sample) {
+        if s.brake_engaged {
+            return;
+        }
+        if self.release_time.is_none() {
+            self.release_time = Some(s.time);
+        }
+        if let Some(prev) = self.last_theta {
+            self.travel += fado_core::wrap_angle(s.theta - prev);
+        }
+        self.last_theta = Some(s.theta);
+        self.max_backward = self.max_backward.max(-self.travel);
+        self.max_angle_error = self.max_angle_error.max(s.angle_error.abs());
+        if s.time >= self.end_from {
+            self.end_samples += 1;
+            self.max_end_speed_error_rpm = self
+                .max_end_speed_error_rpm
+                .max((s.speed_rpm - s.speed_ref_rpm).abs());
+        }
+    }
+
+    /// The end window's largest speed error, r/min; ∞ when the run never got there released.
+    pub fn end_speed_error(&self) -> f64 {
+        if self.end_samples == 0 {
+            f64::INFINITY
+        } else {
+            self.max_end_speed_error_rpm
+        }
+    }
 }
 
 /// One pass criterion and how the run did against it.
@@ -829,6 +967,8 @@ pub struct ScenarioProbe {
     pub max_lambda_r: f64,
     /// The `lowspeed` staircase levels (empty for the other scenarios).
     pub levels: Vec<LevelStats>,
+    /// The `loaded-start` start-up and release (None for the other scenarios).
+    pub start: Option<StartStats>,
     hold_n: u64,
     hold_flag: u64,
     next_disturbance_sample: f64,
@@ -851,6 +991,7 @@ impl ScenarioProbe {
             hold: None,
             max_lambda_r: 0.0,
             levels: Vec::new(),
+            start: None,
             hold_n: 0,
             hold_flag: 0,
             next_disturbance_sample: 0.0,
@@ -897,6 +1038,9 @@ impl Probe for ScenarioProbe {
         let d = &s.act.estimate.diagnostics;
         for level in &mut self.levels {
             level.observe(s.time, s.angle_error, s.speed_rpm, s.act.tripped);
+        }
+        if let Some(st) = &mut self.start {
+            st.observe(s);
         }
         if s.time >= self.next_disturbance_sample {
             self.disturbance.push((s.time, d.disturbance));
@@ -1097,7 +1241,10 @@ impl SimConfig {
         &self,
         controller: C,
     ) -> Result<Simulation<C>, SimConfigError> {
-        let plant = Plant::new(&self.plant(), self.simulation.initial_angle)?;
+        let mut plant = Plant::new(&self.plant(), self.simulation.initial_angle)?;
+        if self.simulation.brake {
+            plant.engage_brake();
+        }
         let mut events = Vec::new();
         for w in &self.simulation.disturbance_feedback_off {
             events.push((w[0], ControlEvent::DisturbanceFeedback(false)));
@@ -1184,34 +1331,13 @@ pub fn run_config_with(
 ) -> Result<Outcome, SimConfigError> {
     let sc = find(scenario)
         .ok_or_else(|| SimConfigError::new("scenario", format!("unknown `{scenario}`")))?;
+    let estimator = cfg.simulation.estimator.estimator();
+    let mut cfg = cfg;
+    (estimator.prepare)(&mut cfg);
     cfg.validate()?;
     let started = Instant::now();
-    match (cfg.simulation.precision, cfg.simulation.estimator) {
-        (Precision::F64, EstimatorKind::Fado) => {
-            let drive = cfg.build_drive()?;
-            run_with(sc, cfg, drive, started, opts)
-        }
-        (Precision::F32, EstimatorKind::Fado) => {
-            let drive = cfg.build_drive_f32()?;
-            run_with(sc, cfg, drive, started, opts)
-        }
-        (Precision::F64, EstimatorKind::LpfIntegrator) => {
-            let drive = cfg.build_baseline_drive(cfg.lpf_estimator()?)?;
-            run_with(sc, cfg, drive, started, opts)
-        }
-        (Precision::F64, EstimatorKind::Ortega) => {
-            let drive = cfg.build_baseline_drive(cfg.ortega_estimator()?)?;
-            run_with(sc, cfg, drive, started, opts)
-        }
-        (Precision::F64, EstimatorKind::EmfObserver) => {
-            let drive = cfg.build_baseline_drive(cfg.emf_estimator()?)?;
-            run_with(sc, cfg, drive, started, opts)
-        }
-        (Precision::F32, _) => Err(SimConfigError::new(
-            "simulation.estimator",
-            "the baselines run with an f64 drive only (simulation.precision = \"f64\")",
-        )),
-    }
+    let drive = (estimator.build)(&cfg)?;
+    run_with(sc, cfg, drive, started, opts)
 }
 
 fn run_with<C: Controller>(

@@ -42,6 +42,11 @@ pub struct PlantParams {
     /// The DC link behind the inverter (stiff by default).
     #[serde(default)]
     pub dc_link: DcLinkParams,
+    /// The machine's saturating magnetics (`[motor.saturation]` or `[motor] flux_map`); None:
+    /// the constant inductances of `motor`. Not a TOML table of its own (the configuration
+    /// keeps it under `[motor]`).
+    #[serde(skip)]
+    pub magnetics: Option<std::sync::Arc<crate::magnetics::PlantMagnetics>>,
 }
 
 impl Default for PlantParams {
@@ -56,6 +61,7 @@ impl Default for PlantParams {
             load: LoadParams::default(),
             faults: FaultParams::default(),
             dc_link: DcLinkParams::default(),
+            magnetics: None,
         }
     }
 }
@@ -101,6 +107,9 @@ pub struct Plant {
     last: SampleOutcome,
     faults: Option<Faults>,
     dc_link: DcLink,
+    /// A holding brake on the shaft: while engaged the rotor stays where it is and the load
+    /// acts on the brake.
+    brake: bool,
 }
 
 impl Plant {
@@ -114,7 +123,8 @@ impl Plant {
             .map_err(|e| s(e, "dc_link"))?;
         let mut plant = Self {
             dc_link,
-            motor: Motor::new(params.motor, theta0).map_err(|e| s(e, "motor"))?,
+            motor: Motor::with_magnetics(params.motor, params.magnetics.clone(), theta0)
+                .map_err(|e| s(e, "motor"))?,
             inverter: Inverter::new(params.inverter.clone()).map_err(|e| s(e, "inverter"))?,
             current_sensor: CurrentSensor::new(
                 params.current_sensor.clone(),
@@ -130,6 +140,7 @@ impl Plant {
             .map_err(|e| s(e, "load"))?,
             encoder: Encoder::default(),
             load_torque: 0.0,
+            brake: false,
             last: SampleOutcome::default(),
             faults: if params.faults.is_empty() {
                 None
@@ -205,6 +216,21 @@ impl Plant {
         }
     }
 
+    /// Engages the holding brake (the rotor must be at rest: it is held where it is).
+    pub fn engage_brake(&mut self) {
+        self.brake = true;
+    }
+
+    /// Releases the holding brake.
+    pub fn release_brake(&mut self) {
+        self.brake = false;
+    }
+
+    /// Whether the holding brake holds the rotor.
+    pub fn brake_engaged(&self) -> bool {
+        self.brake
+    }
+
     /// Integrates one sample [n, n+1] and loads `duty_next` for [n+1, n+2].
     pub fn step(&mut self, duty_next: Abc<f64>, gates_enabled: bool) -> SampleOutcome {
         let ts = self.sample_period();
@@ -221,8 +247,13 @@ impl Plant {
             let v = self.dc_link.step(self.inverter.source_voltage(), power, ts);
             self.inverter.set_bus_voltage(v);
         }
-        self.motor
-            .advance_mechanical(ts, out.torque_avg, self.load_torque);
+        if self.brake {
+            // The brake takes both torques: the rotor (at rest) does not move.
+            self.motor.advance_mechanical(ts, 0.0, 0.0);
+        } else {
+            self.motor
+                .advance_mechanical(ts, out.torque_avg, self.load_torque);
+        }
         self.last = out;
         out
     }
@@ -277,6 +308,8 @@ pub struct Sample {
     /// a stuck channel reconstructed) when the controller reports it, else the Clarke
     /// transform of the measured phase currents, A.
     pub i_ab_measured: fado_core::Ab<f64>,
+    /// The plant's holding brake holds the rotor over this sample.
+    pub brake_engaged: bool,
     /// The controller's output at this sample.
     pub act: Actuation,
 }
@@ -376,6 +409,9 @@ impl<C: Controller> Simulation<C> {
         };
         let act = self.controller.step(&m);
         self.tripped |= act.tripped;
+        if self.plant.brake_engaged() && self.controller.ready() {
+            self.plant.release_brake();
+        }
         let st = *self.plant.motor().state();
         let sample = Sample {
             time: t,
@@ -392,6 +428,7 @@ impl<C: Controller> Simulation<C> {
             i_ab_measured: act.i_ab_used.unwrap_or_else(|| i_abc.to_ab()),
             pole_pairs: self.pole_pairs,
             dc_voltage: self.plant.inverter().dc_voltage(),
+            brake_engaged: self.plant.brake_engaged(),
             act,
         };
         self.plant.step(act.duty, act.gates_enabled);

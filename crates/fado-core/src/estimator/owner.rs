@@ -206,6 +206,9 @@ pub trait RotorAngleEstimator<T: Real> {
     /// The acceleration the drive commands, rad/s² (electrical), for the estimator's speed
     /// trackers to feed forward (see [`crate::tracker`]). Default: not used.
     fn set_acceleration(&mut self, _acceleration: T) {}
+    /// Switches a disturbance feedback (fado's k_df, Fig. 9) on or off, if the estimator has
+    /// one. Default: nothing to switch.
+    fn set_disturbance_feedback(&mut self, _enabled: bool) {}
 }
 
 impl<T: Real> RotorAngleEstimator<T> for SensorlessEstimator<T> {
@@ -234,6 +237,9 @@ impl<T: Real> RotorAngleEstimator<T> for SensorlessEstimator<T> {
     }
     fn turn_angle(&mut self, angle: T) {
         SensorlessEstimator::turn_angle(self, angle);
+    }
+    fn set_disturbance_feedback(&mut self, enabled: bool) {
+        self.set_disturbance_feedback_enabled(enabled);
     }
     /// With [`EstimatorTuning::rs_adaptation`](crate::EstimatorTuning::rs_adaptation): [`SensorlessEstimator::set_rs_hat`] (a bad
     /// value changes nothing); with the paper's fixed R̂s: nothing.

@@ -6,7 +6,7 @@
 //! fado-sim sweep fig11 --axis rs_error=-0.3:0.3:7 --axis load_torque=0,2.5,5,7.5
 //!                [--random N --seed S] [--config FILE] [--out DIR] [--averaged]
 //!                [--threads N] [--fresh]
-//! fado-sim compare [--scenarios fig8,...] [--estimators fado,fado-fixed-rs,lpf-integrator,ortega,emf-observer]
+//! fado-sim compare [--scenarios fig8,...] [--estimators fado,ortega,...]
 //!                  [--out DIR] [--averaged] [--config FILE] [--criterion target/criterion]
 //! ```
 
@@ -19,6 +19,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use clap::{Parser, Subcommand};
 use fado_sim::SimConfigError;
 use fado_sim::compare;
+use fado_sim::estimators::ESTIMATORS;
 use fado_sim::output::{self, AtomicFile, DirLock, OutputError};
 use fado_sim::scenario::{self, SCENARIOS};
 use fado_sim::scenario::{RunOptions, TraceOutput};
@@ -42,7 +43,7 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// List the scenarios.
+    /// List the scenarios and the estimators.
     List,
     /// List the motor presets of `motors/` (each a valid `--config` file), one line each.
     Motors,
@@ -131,9 +132,8 @@ enum Command {
         /// Comma-separated scenario names. Default: all (see `list`).
         #[arg(long, value_delimiter = ',')]
         scenarios: Option<Vec<String>>,
-        /// Comma-separated estimators. Default: fado,fado-fixed-rs,lpf-integrator,ortega,emf-observer
-        /// (fado-fixed-rs: fado with the paper's fixed R̂s).
-        #[arg(long, value_delimiter = ',')]
+        /// Comma-separated estimators (see `list`). Default: all.
+        #[arg(long, value_delimiter = ',', help = estimators_help())]
         estimators: Option<Vec<String>>,
         /// TOML file applied over every scenario (its `[estimator] kind` is replaced).
         #[arg(long)]
@@ -152,6 +152,15 @@ enum Command {
         #[arg(long, default_value_t = 2)]
         threads: usize,
     },
+}
+
+/// `compare --estimators`' help: the names of the registry.
+fn estimators_help() -> String {
+    format!(
+        "Comma-separated estimators. Default: all of {} (fado-fixed-rs: fado with the paper's \
+         fixed R̂s; see `list`)",
+        fado_sim::estimators::names().join(",")
+    )
 }
 
 /// Exit code of a configuration or usage error (a bad key, value, scenario or axis).
@@ -295,6 +304,15 @@ fn run(cli: Cli) -> Result<ExitCode, Box<dyn std::error::Error>> {
                     s.profile,
                     s.criterion
                 );
+            }
+            println!("\nEstimators (`[simulation] estimator`, `compare --estimators`):");
+            for e in ESTIMATORS {
+                let settings = if e.own_settings {
+                    format!("[baselines.{}]", e.key())
+                } else {
+                    "[estimator]".to_owned()
+                };
+                println!("{:<15} {} — settings {settings}", e.name, e.summary);
             }
             Ok(ExitCode::SUCCESS)
         }
