@@ -1085,9 +1085,11 @@ mod dead_time_method {
 
     #[test]
     fn motor_saturation_is_read_checked_and_written_back() {
+        // A whole [motor] (9 lines) with its saturation.
+        const M: &str = "[motor]\nrs = 0.327\nld = 2.63e-3\nlq = 2.63e-3\nflux_linkage = 0.088\npole_pairs = 4\nrated_current = 21.78\nrated_speed_rpm = 1500.0\nrated_torque = 11.5\n";
         let text =
             "[motor.saturation]\na_d0 = 380.2\na_q0 = 380.2\npsi_f = 0.088\na_qq = 1e5\nt = 2\n";
-        let cfg = SimConfig::from_toml(text).unwrap();
+        let cfg = SimConfig::from_toml(&format!("{M}{text}")).unwrap();
         let sat = cfg.motor_saturation.unwrap();
         assert_eq!((sat.a_qq, sat.t, sat.psi_f), (1e5, 2.0, 0.088));
         assert!(cfg.plant().magnetics.is_some());
@@ -1097,12 +1099,16 @@ mod dead_time_method {
         // Without the table the plant keeps its constant inductances.
         assert!(SimConfig::default().plant().magnetics.is_none());
         // Errors name the key and point at it.
-        let e =
-            SimConfig::from_toml("[motor.saturation]\na_d0 = 380.2\na_q0 = -1.0\n").unwrap_err();
+        let e = SimConfig::from_toml(&format!(
+            "{M}[motor.saturation]\na_d0 = 380.2\na_q0 = -1.0\n"
+        ))
+        .unwrap_err();
         assert_eq!(e.key, "motor.saturation.a_q0", "{e}");
-        assert_eq!(e.location.as_ref().map(|l| l.line), Some(3), "{e}");
-        let e =
-            SimConfig::from_toml("[motor.saturation]\na_d0 = 380.2\na_qqq = 1.0\n").unwrap_err();
+        assert_eq!(e.location.as_ref().map(|l| l.line), Some(12), "{e}");
+        let e = SimConfig::from_toml(&format!(
+            "{M}[motor.saturation]\na_d0 = 380.2\na_qqq = 1.0\n"
+        ))
+        .unwrap_err();
         assert!(e.key.starts_with("motor.saturation"), "{e}");
         assert!(e.to_string().contains("a_qqq"), "{e}");
         let e = SimConfig::from_toml(
