@@ -93,12 +93,12 @@ class Machine:
         lq: float,
         flux_linkage: float,
         pole_pairs: int,
-        inertia: float,
         rated_current: float,
         rated_speed_rpm: float,
         rated_torque: float,
         dc_voltage: float,
-        viscous_friction: float = 0.0,
+        inertia: float | None = None,
+        viscous_friction: float | None = None,
     ) -> Machine: ...
     def replace(
         self,

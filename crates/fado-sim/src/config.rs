@@ -23,7 +23,8 @@ use serde::{Deserialize, Serialize};
 use crate::criteria::Criteria;
 use crate::dc_link::DcLinkParams;
 use crate::error::{SimConfigError, check};
-use crate::estimators::Estimator;
+pub use crate::estimators::EstimatorKind;
+use crate::estimators::{check_baseline_keys, default_baselines};
 use crate::faults::FaultParams;
 use crate::inverter::InverterParams;
 use crate::load::LoadParams;
@@ -119,130 +120,6 @@ pub enum Precision {
     F64,
     /// f32, as on the paper's TMS320F28335 (single-precision FPU).
     F32,
-}
-
-/// Which rotor-angle estimator the drive runs: a row of [`crate::estimators::ESTIMATORS`],
-/// written in TOML by its key (`"fado"`, `"ortega"`, `"lpf_integrator"`; `-` is accepted
-/// for `_`).
-#[derive(Clone, Copy, PartialEq, Eq)]
-pub struct EstimatorKind(&'static Estimator);
-
-impl EstimatorKind {
-    /// fado, the default.
-    pub const FADO: Self = Self(&crate::estimators::ESTIMATORS[0]);
-
-    /// The estimator of the registry row.
-    pub const fn of(estimator: &'static Estimator) -> Self {
-        Self(estimator)
-    }
-
-    /// Its registry row.
-    pub const fn estimator(self) -> &'static Estimator {
-        self.0
-    }
-
-    /// Its name (`lpf-integrator`).
-    pub const fn name(self) -> &'static str {
-        self.0.name
-    }
-}
-
-impl Default for EstimatorKind {
-    fn default() -> Self {
-        Self::FADO
-    }
-}
-
-impl std::fmt::Debug for EstimatorKind {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.0.name)
-    }
-}
-
-impl Serialize for EstimatorKind {
-    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        s.serialize_str(&self.0.key())
-    }
-}
-
-impl<'de> Deserialize<'de> for EstimatorKind {
-    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        let name = String::deserialize(d)?;
-        crate::estimators::find(&name).map(Self).ok_or_else(|| {
-            let keys: Vec<_> = crate::estimators::ESTIMATORS
-                .iter()
-                .map(|e| e.key())
-                .collect();
-            serde::de::Error::custom(format!("unknown estimator `{name}`; one of {keys:?}"))
-        })
-    }
-}
-
-/// `[baselines]` keys that name a setting of one baseline directly, and the table and key
-/// each lives under now.
-const MOVED_BASELINE_KEYS: [(&str, &str, &str); 8] = [
-    ("lpf_cutoff_hz", "lpf_integrator", "cutoff_hz"),
-    (
-        "lpf_compensation_floor_hz",
-        "lpf_integrator",
-        "compensation_floor_hz",
-    ),
-    ("ortega_observer_bandwidth", "ortega", "observer_bandwidth"),
-    (
-        "ortega_observer_speed_ratio",
-        "ortega",
-        "observer_speed_ratio",
-    ),
-    (
-        "ortega_observer_bandwidth_min",
-        "ortega",
-        "observer_bandwidth_min",
-    ),
-    (
-        "ortega_flux_adaptation_ratio",
-        "ortega",
-        "flux_adaptation_ratio",
-    ),
-    ("emf_bandwidth_hz", "emf_observer", "emf_bandwidth_hz"),
-    ("emf_speed_floor_hz", "emf_observer", "speed_floor_hz"),
-];
-
-/// The settings of the baselines, one table per baseline of the registry
-/// (`[baselines.ortega]`, `[baselines.lpf_integrator]`, ...), each with its defaults.
-fn default_baselines() -> toml::Table {
-    crate::estimators::ESTIMATORS
-        .iter()
-        .filter(|e| e.own_settings)
-        .map(|e| (e.key(), toml::Value::Table((e.defaults)())))
-        .collect()
-}
-
-/// Every key of `[baselines]` names a baseline of the registry; a setting written there
-/// directly is refused with the place it lives now.
-fn check_baseline_keys(baselines: &toml::Table) -> Result<(), SimConfigError> {
-    for key in baselines.keys() {
-        if let Some((_, table, field)) = MOVED_BASELINE_KEYS.iter().find(|m| m.0 == key) {
-            return Err(SimConfigError::new(
-                format!("baselines.{key}"),
-                format!("moved: write it as `{field}` in `[baselines.{table}]`"),
-            ));
-        }
-        let known = crate::estimators::ESTIMATORS
-            .iter()
-            .any(|e| e.own_settings && e.key() == *key);
-        if !known {
-            let keys: Vec<_> = crate::estimators::ESTIMATORS
-                .iter()
-                .filter(|e| e.own_settings)
-                .map(|e| e.key())
-                .collect();
-            return Err(SimConfigError::new(
-                format!("baselines.{key}"),
-                format!("unknown baseline; one of {keys:?}"),
-            ));
-        }
-    }
-    Ok(())
 }
 
 /// `[inverter_model]`: what the drive's dead-time compensation is told of the inverter, as
@@ -368,6 +245,10 @@ pub struct SimConfig {
     /// judged after their own by the others. Default none.
     #[serde(skip_serializing_if = "Criteria::is_empty")]
     pub criteria: Criteria,
+    /// The keys the configuration file left out whose values were derived from the motor's
+    /// ratings (`crate::derive`), with their rules; not a TOML table.
+    #[serde(skip)]
+    pub derived: Vec<crate::derive::Derived>,
     /// The plant's saturating magnetics, `[motor.saturation]` (the algebraic model of
     /// [`fado_core::magnetics::Saturation`]); None: the constant inductances of `[motor]`,
     /// whose `ld`, `lq` and `flux_linkage` then stay the datasheet's (the drive's default model).
@@ -396,6 +277,7 @@ impl Default for SimConfig {
             faults: FaultParams::default(),
             dc_link: DcLinkParams::default(),
             criteria: Criteria::default(),
+            derived: Vec::new(),
             motor_saturation: None,
         }
     }
@@ -433,6 +315,15 @@ impl SimConfig {
         self.speed_reference
             .validate()
             .map_err(|e| e.in_section("speed_reference"))?;
+        // The machine's cross-checks, with every key involved named (before the single-key
+        // refusals of the plant's and the model's validation).
+        if let Some((_, key, text)) = self
+            .machine_findings()
+            .into_iter()
+            .find(|(s, ..)| *s == fado_core::machine_checks::Severity::Error)
+        {
+            return Err(SimConfigError::new(key, text));
+        }
         if let Some(sat) = &self.motor_saturation {
             sat.validate().map_err(|e| {
                 SimConfigError::new(format!("motor.saturation.{}", e.field()), e.to_string())
@@ -655,9 +546,28 @@ impl SimConfig {
         toml::to_string(&table).expect("every field of SimConfig is representable in TOML")
     }
 
-    /// Parses a complete or partial TOML document on top of `base`: tables merge, values and
-    /// arrays replace. The result is validated. Errors name the key.
+    /// Parses a partial TOML document on top of `base`, an explicit configuration (a
+    /// scenario's with the user's motor, a sweep point's): tables merge, values and arrays
+    /// replace, so `[motor]\nrs = 0.5` changes one key of `base`'s motor. The result is
+    /// validated. Errors name the key.
     pub fn from_toml_over(base: &SimConfig, text: &str) -> Result<SimConfig, SimConfigError> {
+        Self::parse_over(base, text, false)
+    }
+
+    /// Parses a user's configuration file on top of `base`: as
+    /// [`from_toml_over`](Self::from_toml_over), except that a `[motor]` table describes the
+    /// whole motor — every circuit key and rating required, the others derived from the
+    /// ratings with the `[inverter]` keys they give (`crate::derive`), none taken from
+    /// `base`'s motor.
+    pub fn from_user_toml(base: &SimConfig, text: &str) -> Result<SimConfig, SimConfigError> {
+        Self::parse_over(base, text, true)
+    }
+
+    fn parse_over(
+        base: &SimConfig,
+        text: &str,
+        whole_motor: bool,
+    ) -> Result<SimConfig, SimConfigError> {
         let mut user: toml::Table = text.parse().map_err(|e| located(text, e))?;
         let saturation = take_saturation(&mut user).map_err(|e| e.located_in(text))?;
         // Check the user's document on its own first, so that errors (unknown keys, wrong
@@ -668,11 +578,32 @@ impl SimConfig {
         } else {
             toml::from_str::<SimConfig>(text).map_err(|e| located(text, e))?;
         }
+        let derived = if whole_motor {
+            crate::derive::complete_motor(&mut user, text)?
+        } else {
+            Vec::new()
+        };
+        let given = user.clone();
         let mut merged = toml::Table::try_from(base)
             .map_err(|e| SimConfigError::new("<base>", e.to_string()))?;
         merge(&mut merged, user);
         let mut cfg = SimConfig::deserialize(toml::Value::Table(merged))
             .map_err(|e| key_error(e).located_in(text))?;
+        // What `base` derived stays derived unless the document gives it now.
+        cfg.derived = base
+            .derived
+            .iter()
+            .filter(|d| {
+                let (section, key) = d.key.split_once('.').unwrap_or(("", ""));
+                !given
+                    .get(section)
+                    .and_then(|t| t.as_table())
+                    .is_some_and(|t| t.contains_key(key))
+            })
+            .filter(|d| !derived.iter().any(|n| n.key == d.key))
+            .cloned()
+            .collect();
+        cfg.derived.extend(derived);
         // `[motor]` has no DC link of its own (it is the inverter's).
         cfg.motor.dc_voltage = cfg.inverter.dc_voltage;
         cfg.motor_saturation = saturation.or(base.motor_saturation);
@@ -680,9 +611,84 @@ impl SimConfig {
         Ok(cfg)
     }
 
-    /// Parses a TOML document over the defaults.
+    /// Parses a user's TOML document over the defaults (see
+    /// [`from_user_toml`](Self::from_user_toml)).
     pub fn from_toml(text: &str) -> Result<SimConfig, SimConfigError> {
-        Self::from_toml_over(&SimConfig::default(), text)
+        Self::from_user_toml(&SimConfig::default(), text)
+    }
+
+    /// The defaults with `machine` as the motor and its `dc_voltage` as the DC link; the
+    /// other `[inverter]` keys its ratings give are derived (`crate::derive`) and recorded.
+    pub fn for_machine(machine: &MachineModel<f64>) -> SimConfig {
+        let mut c = SimConfig {
+            motor: *machine,
+            ..SimConfig::default()
+        };
+        let mut given = toml::Table::new();
+        given.insert("dc_voltage".into(), toml::Value::Float(machine.dc_voltage));
+        c.inverter.dc_voltage = machine.dc_voltage;
+        for (key, value) in crate::derive::inverter_values(machine, &given) {
+            match key {
+                "switching_frequency" => c.inverter.switching_frequency = value,
+                "dead_time" => c.inverter.dead_time = value,
+                "threshold_voltage" => c.inverter.threshold_voltage = value,
+                "current_band" => c.inverter.current_band = value,
+                _ => continue,
+            }
+            let full = format!("inverter.{key}");
+            c.derived.push(crate::derive::Derived {
+                rule: fado_core::ratings::rule(&full).unwrap_or(""),
+                key: full,
+                value,
+            });
+        }
+        c
+    }
+
+    /// This configuration as TOML with each derived key's rule beside it (`--dump-config`).
+    pub fn to_toml_annotated(&self) -> String {
+        crate::derive::annotate(&self.to_toml(), &self.derived)
+    }
+
+    /// The plausibility findings of the motor against its ratings, the DC link and the
+    /// sampling period (`fado_core::machine_checks`), each with its message naming the TOML
+    /// keys involved: errors first.
+    pub fn machine_findings(&self) -> Vec<(fado_core::machine_checks::Severity, String, String)> {
+        let m = MachineModel {
+            dc_voltage: self.inverter.dc_voltage,
+            ..self.motor
+        };
+        fado_core::machine_checks::check(&m, Some(self.inverter.sample_period()))
+            .iter()
+            .map(|f| {
+                let mut text = f.to_string();
+                for k in f.keys() {
+                    let full = plant_key(k);
+                    text = text.replace(&format!("`{k}`"), &format!("`{full}`"));
+                }
+                (f.severity(), plant_key(f.key()), text)
+            })
+            .collect()
+    }
+
+    /// The plausibility warnings of [`machine_findings`](Self::machine_findings), as
+    /// `key: message` lines.
+    pub fn warnings(&self) -> Vec<String> {
+        self.machine_findings()
+            .into_iter()
+            .filter(|(s, ..)| *s == fado_core::machine_checks::Severity::Warning)
+            .map(|(_, _, text)| text)
+            .collect()
+    }
+}
+
+/// The TOML key of a machine-check field: `[inverter]`'s for the DC link and the sampling
+/// period, `[motor]`'s otherwise.
+fn plant_key(field: &str) -> String {
+    match field {
+        "dc_voltage" => "inverter.dc_voltage".to_owned(),
+        "ts" => "inverter.switching_frequency".to_owned(),
+        k => format!("motor.{k}"),
     }
 }
 
@@ -921,12 +927,42 @@ mod located_errors {
         assert_eq!((key.as_str(), line), ("simulation.decimation", 2));
     }
 
+    /// The paper's motor as a whole `[motor]` table whose first key is `first` (which
+    /// replaces the paper's value of that key).
+    pub(crate) fn paper_motor_with(first: &str) -> String {
+        let key = first.split('=').next().unwrap_or("").trim();
+        let m = MachineModel::<f64>::paper();
+        let mut text = format!("[motor]\n{first}\n");
+        for (k, v) in [
+            ("rs", m.rs),
+            ("ld", m.ld),
+            ("lq", m.lq),
+            ("flux_linkage", m.flux_linkage),
+            ("pole_pairs", m.pole_pairs as f64),
+            ("inertia", m.inertia),
+            ("viscous_friction", m.viscous_friction),
+            ("rated_current", m.rated_current),
+            ("rated_speed_rpm", m.rated_speed_rpm),
+            ("rated_torque", m.rated_torque),
+        ] {
+            if k != key {
+                if k == "pole_pairs" {
+                    text.push_str(&format!("{k} = {}\n", v as u32));
+                } else {
+                    text.push_str(&format!("{k} = {v:?}\n"));
+                }
+            }
+        }
+        text.push_str("[inverter]\ndc_voltage = 311.0\nswitching_frequency = 5000.0\n");
+        text
+    }
+
     #[test]
     fn derived_limits_name_the_users_own_key() {
         // Issue 15's probes: before, each was refused as `controller.current_anti_windup_ratio`.
-        let (key, line, col, _) = err("[motor]\nrs = 1e300\n");
+        let (key, line, col, _) = err(&paper_motor_with("rs = 1e300"));
         assert_eq!((key.as_str(), line, col), ("motor.rs", 2, 6));
-        let (key, line, _, _) = err("[motor]\nld = 1e-300\n");
+        let (key, line, _, _) = err(&paper_motor_with("ld = 1e-300"));
         assert_eq!((key.as_str(), line), ("motor.ld", 2));
         let (key, line, _, _) = err("[mismatch]\nrs_ratio = 1e300\n");
         assert_eq!((key.as_str(), line), ("mismatch.rs_ratio", 2));

@@ -53,6 +53,7 @@ pub mod config;
 pub mod controller;
 pub mod criteria;
 pub mod dc_link;
+pub mod derive;
 pub mod drive;
 pub mod error;
 pub mod estimators;

@@ -1206,7 +1206,7 @@ pub fn scenario_config(
         // The user's motor first (a scaled scenario needs its ratings), then the scenario,
         // then the user's keys again, so that any of them wins over the scenario's.
         Some(text) => {
-            let user = SimConfig::from_toml_over(&SimConfig::default(), text)?;
+            let user = SimConfig::from_user_toml(&SimConfig::default(), text)?;
             SimConfig::from_toml_over(&sc.apply(user), text)?
         }
         None => sc.config(),

@@ -28,6 +28,9 @@ impl<T: Real> EstimatorParams<T> {
     pub fn new(config: EstimatorConfig<T>) -> Result<Self, ConfigError> {
         let ts = check::positive("ts", config.ts)?;
         config.machine.validate()?;
+        // The sampling period against the rated speed (a period in ms given as s), before any
+        // gain derived from it is refused in its stead.
+        crate::machine_checks::validate(&config.machine.cast::<f64>(), Some(ts.to_f64()))?;
         let (ratio, hold) = check_limits(&config, ts)?;
         let blocks = SampleBlocks::new(&config, ts)?;
         let (rs_adaptation, offset) = slow_laws(&config)?;
