@@ -10,7 +10,9 @@ before its fence may say
   for names the prose supplies (a lab recording, a file the reader has).
 
 The Python blocks of one file run in order in one namespace (later blocks use earlier
-results, as a reader would), in a scratch directory (the figures they save land there).
+results, as a reader would), in a scratch directory (the figures they save land there) that
+links the repository's `examples/` and `motors/`, the input files a reader in the repository
+root has.
 Shell blocks run line by line with bash from the repository root, `python` being this
 interpreter; each line must exit 0 (or 1 for ``fado-sim run``, whose 1 means criteria
 missed, see README "Exit codes").
@@ -109,6 +111,9 @@ def test_python_blocks_run(path: Path, tmp_path: Path, monkeypatch: pytest.Monke
     pytest.importorskip("pandas")
     pytest.importorskip("matplotlib")
     monkeypatch.chdir(tmp_path)
+    # A reader runs the blocks from the repository root: its input files are there too.
+    for shared in ("examples", "motors"):
+        (tmp_path / shared).symlink_to(ROOT / shared)
     namespace: dict[str, object] = {"__name__": "__doc__"}
     ran = 0
     for b in blocks(path):

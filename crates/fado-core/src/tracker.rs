@@ -360,7 +360,7 @@ impl<T: Real> TypeTwoTracker<T> {
     }
 
     /// A new tracker of the type-3 form with a load pole at `ratio`·ωn (see
-    /// [`TrackerParams::with_load_pole`] in the module docs), for an acceleration
+    /// `TrackerParams::with_load_pole` in the module docs), for an acceleration
     /// feed-forward ([`Self::set_acceleration`]).
     pub fn with_load_pole(config: TrackerConfig<T>, ratio: T) -> Result<Self, ConfigError> {
         let params = TrackerParams::new(config)?.with_load_pole(&config, ratio)?;

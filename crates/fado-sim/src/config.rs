@@ -23,7 +23,8 @@ use serde::{Deserialize, Serialize};
 use crate::criteria::Criteria;
 use crate::dc_link::DcLinkParams;
 use crate::error::{SimConfigError, check};
-use crate::estimators::Estimator;
+pub use crate::estimators::EstimatorKind;
+use crate::estimators::{check_baseline_keys, default_baselines};
 use crate::faults::FaultParams;
 use crate::inverter::InverterParams;
 use crate::load::LoadParams;
@@ -119,130 +120,6 @@ pub enum Precision {
     F64,
     /// f32, as on the paper's TMS320F28335 (single-precision FPU).
     F32,
-}
-
-/// Which rotor-angle estimator the drive runs: a row of [`crate::estimators::ESTIMATORS`],
-/// written in TOML by its key (`"fado"`, `"ortega"`, `"lpf_integrator"`; `-` is accepted
-/// for `_`).
-#[derive(Clone, Copy, PartialEq, Eq)]
-pub struct EstimatorKind(&'static Estimator);
-
-impl EstimatorKind {
-    /// fado, the default.
-    pub const FADO: Self = Self(&crate::estimators::ESTIMATORS[0]);
-
-    /// The estimator of the registry row.
-    pub const fn of(estimator: &'static Estimator) -> Self {
-        Self(estimator)
-    }
-
-    /// Its registry row.
-    pub const fn estimator(self) -> &'static Estimator {
-        self.0
-    }
-
-    /// Its name (`lpf-integrator`).
-    pub const fn name(self) -> &'static str {
-        self.0.name
-    }
-}
-
-impl Default for EstimatorKind {
-    fn default() -> Self {
-        Self::FADO
-    }
-}
-
-impl std::fmt::Debug for EstimatorKind {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.0.name)
-    }
-}
-
-impl Serialize for EstimatorKind {
-    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        s.serialize_str(&self.0.key())
-    }
-}
-
-impl<'de> Deserialize<'de> for EstimatorKind {
-    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        let name = String::deserialize(d)?;
-        crate::estimators::find(&name).map(Self).ok_or_else(|| {
-            let keys: Vec<_> = crate::estimators::ESTIMATORS
-                .iter()
-                .map(|e| e.key())
-                .collect();
-            serde::de::Error::custom(format!("unknown estimator `{name}`; one of {keys:?}"))
-        })
-    }
-}
-
-/// `[baselines]` keys that name a setting of one baseline directly, and the table and key
-/// each lives under now.
-const MOVED_BASELINE_KEYS: [(&str, &str, &str); 8] = [
-    ("lpf_cutoff_hz", "lpf_integrator", "cutoff_hz"),
-    (
-        "lpf_compensation_floor_hz",
-        "lpf_integrator",
-        "compensation_floor_hz",
-    ),
-    ("ortega_observer_bandwidth", "ortega", "observer_bandwidth"),
-    (
-        "ortega_observer_speed_ratio",
-        "ortega",
-        "observer_speed_ratio",
-    ),
-    (
-        "ortega_observer_bandwidth_min",
-        "ortega",
-        "observer_bandwidth_min",
-    ),
-    (
-        "ortega_flux_adaptation_ratio",
-        "ortega",
-        "flux_adaptation_ratio",
-    ),
-    ("emf_bandwidth_hz", "emf_observer", "emf_bandwidth_hz"),
-    ("emf_speed_floor_hz", "emf_observer", "speed_floor_hz"),
-];
-
-/// The settings of the baselines, one table per baseline of the registry
-/// (`[baselines.ortega]`, `[baselines.lpf_integrator]`, ...), each with its defaults.
-fn default_baselines() -> toml::Table {
-    crate::estimators::ESTIMATORS
-        .iter()
-        .filter(|e| e.own_settings)
-        .map(|e| (e.key(), toml::Value::Table((e.defaults)())))
-        .collect()
-}
-
-/// Every key of `[baselines]` names a baseline of the registry; a setting written there
-/// directly is refused with the place it lives now.
-fn check_baseline_keys(baselines: &toml::Table) -> Result<(), SimConfigError> {
-    for key in baselines.keys() {
-        if let Some((_, table, field)) = MOVED_BASELINE_KEYS.iter().find(|m| m.0 == key) {
-            return Err(SimConfigError::new(
-                format!("baselines.{key}"),
-                format!("moved: write it as `{field}` in `[baselines.{table}]`"),
-            ));
-        }
-        let known = crate::estimators::ESTIMATORS
-            .iter()
-            .any(|e| e.own_settings && e.key() == *key);
-        if !known {
-            let keys: Vec<_> = crate::estimators::ESTIMATORS
-                .iter()
-                .filter(|e| e.own_settings)
-                .map(|e| e.key())
-                .collect();
-            return Err(SimConfigError::new(
-                format!("baselines.{key}"),
-                format!("unknown baseline; one of {keys:?}"),
-            ));
-        }
-    }
-    Ok(())
 }
 
 /// `[inverter_model]`: what the drive's dead-time compensation is told of the inverter, as

@@ -20,8 +20,8 @@ use fado_core::baselines::{
     Baseline, CommonTuning, EmfObserverEstimator, LpfIntegratorEstimator, OrtegaEstimator,
     ReducedOrderEstimator,
 };
-use serde::Serialize;
 use serde::de::DeserializeOwned;
+use serde::{Deserialize, Serialize};
 
 use crate::config::{Precision, SimConfig};
 use crate::controller::Controller;
@@ -239,6 +239,125 @@ where
     }
     let estimator = estimator_of::<B>(cfg)?;
     Ok(Box::new(cfg.build_baseline_drive(estimator)?))
+}
+
+/// Which rotor-angle estimator the drive runs: a row of [`ESTIMATORS`],
+/// written in TOML by its key (`"fado"`, `"ortega"`, `"lpf_integrator"`; `-` is accepted
+/// for `_`).
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub struct EstimatorKind(&'static Estimator);
+
+impl EstimatorKind {
+    /// fado, the default.
+    pub const FADO: Self = Self(&ESTIMATORS[0]);
+
+    /// The estimator of the registry row.
+    pub const fn of(estimator: &'static Estimator) -> Self {
+        Self(estimator)
+    }
+
+    /// Its registry row.
+    pub const fn estimator(self) -> &'static Estimator {
+        self.0
+    }
+
+    /// Its name (`lpf-integrator`).
+    pub const fn name(self) -> &'static str {
+        self.0.name
+    }
+}
+
+impl Default for EstimatorKind {
+    fn default() -> Self {
+        Self::FADO
+    }
+}
+
+impl std::fmt::Debug for EstimatorKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.0.name)
+    }
+}
+
+impl Serialize for EstimatorKind {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(&self.0.key())
+    }
+}
+
+impl<'de> Deserialize<'de> for EstimatorKind {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let name = String::deserialize(d)?;
+        find(&name).map(Self).ok_or_else(|| {
+            let keys: Vec<_> = ESTIMATORS.iter().map(|e| e.key()).collect();
+            serde::de::Error::custom(format!("unknown estimator `{name}`; one of {keys:?}"))
+        })
+    }
+}
+
+/// `[baselines]` keys that name a setting of one baseline directly, and the table and key
+/// each lives under now.
+const MOVED_BASELINE_KEYS: [(&str, &str, &str); 8] = [
+    ("lpf_cutoff_hz", "lpf_integrator", "cutoff_hz"),
+    (
+        "lpf_compensation_floor_hz",
+        "lpf_integrator",
+        "compensation_floor_hz",
+    ),
+    ("ortega_observer_bandwidth", "ortega", "observer_bandwidth"),
+    (
+        "ortega_observer_speed_ratio",
+        "ortega",
+        "observer_speed_ratio",
+    ),
+    (
+        "ortega_observer_bandwidth_min",
+        "ortega",
+        "observer_bandwidth_min",
+    ),
+    (
+        "ortega_flux_adaptation_ratio",
+        "ortega",
+        "flux_adaptation_ratio",
+    ),
+    ("emf_bandwidth_hz", "emf_observer", "emf_bandwidth_hz"),
+    ("emf_speed_floor_hz", "emf_observer", "speed_floor_hz"),
+];
+
+/// The settings of the baselines, one table per baseline of the registry
+/// (`[baselines.ortega]`, `[baselines.lpf_integrator]`, ...), each with its defaults.
+pub(crate) fn default_baselines() -> toml::Table {
+    ESTIMATORS
+        .iter()
+        .filter(|e| e.own_settings)
+        .map(|e| (e.key(), toml::Value::Table((e.defaults)())))
+        .collect()
+}
+
+/// Every key of `[baselines]` names a baseline of the registry; a setting written there
+/// directly is refused with the place it lives now.
+pub(crate) fn check_baseline_keys(baselines: &toml::Table) -> Result<(), SimConfigError> {
+    for key in baselines.keys() {
+        if let Some((_, table, field)) = MOVED_BASELINE_KEYS.iter().find(|m| m.0 == key) {
+            return Err(SimConfigError::new(
+                format!("baselines.{key}"),
+                format!("moved: write it as `{field}` in `[baselines.{table}]`"),
+            ));
+        }
+        let known = ESTIMATORS.iter().any(|e| e.own_settings && e.key() == *key);
+        if !known {
+            let keys: Vec<_> = ESTIMATORS
+                .iter()
+                .filter(|e| e.own_settings)
+                .map(|e| e.key())
+                .collect();
+            return Err(SimConfigError::new(
+                format!("baselines.{key}"),
+                format!("unknown baseline; one of {keys:?}"),
+            ));
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -270,29 +270,10 @@ impl<T: Real> GuardedStep<T> for LpfIntegratorEstimator<T> {
         })
     }
 
-    fn record(&mut self) -> (&mut Estimate<T>, &mut u32) {
-        (&mut self.last, &mut self.rejected_samples)
-    }
-    fn integrand(&mut self) -> &mut Integrand<T> {
-        &mut self.integrand
-    }
+    guarded_state!();
 }
 
-impl<T: Real> RotorAngleEstimator<T> for LpfIntegratorEstimator<T> {
-    #[inline]
-    fn step(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> Estimate<T> {
-        LpfIntegratorEstimator::step(self, v_ab, i_ab)
-    }
-    fn align(&mut self, theta0: T, i_ab: Ab<T>) {
-        LpfIntegratorEstimator::align(self, theta0, i_ab)
-    }
-    fn reset(&mut self) {
-        LpfIntegratorEstimator::reset(self)
-    }
-    fn name(&self) -> &'static str {
-        Self::NAME
-    }
-}
+rotor_angle_estimator!(LpfIntegratorEstimator);
 
 #[cfg(test)]
 mod tests {

@@ -9,7 +9,7 @@
 //! | [`emf_observer`] | extended-EMF observer in α-β, angle = ∠ê − sgn(ω̂)·π/2 | none needed: no integrator |
 //! | [`reduced_order`] | Hinkkanen et al. (2018) reduced-order observer in estimated rotor coordinates, with its own angle and speed loop | correcting ψ̂ with the flux read from the current |
 //!
-//! Every baseline implements [`RotorAngleEstimator`](crate::RotorAngleEstimator) and
+//! Every baseline implements [`RotorAngleEstimator`] and
 //! [`Baseline`], and follows the crate's rules: its config is the [`MachineModel`], the
 //! [`CommonTuning`] every estimator shares and a small record of its own settings (plain
 //! numbers with documented defaults), `new(config)` naming a bad field, `step`/`align`/`reset`, allocation-free, generic over `f32`/`f64`, and a rejected
@@ -54,6 +54,41 @@ macro_rules! integrand_of {
                 $ts,
             )?,
         )
+    };
+}
+
+/// A baseline's [`GuardedStep`] bookkeeping: its `last` estimate, `rejected_samples` counter and
+/// `integrand`.
+macro_rules! guarded_state {
+    () => {
+        fn record(&mut self) -> (&mut Estimate<T>, &mut u32) {
+            (&mut self.last, &mut self.rejected_samples)
+        }
+        fn integrand(&mut self) -> &mut Integrand<T> {
+            &mut self.integrand
+        }
+    };
+}
+
+/// [`RotorAngleEstimator`] of a baseline through its own `step`, `align` and `reset`, named
+/// by [`Baseline::NAME`].
+macro_rules! rotor_angle_estimator {
+    ($ty:ident) => {
+        impl<T: Real> RotorAngleEstimator<T> for $ty<T> {
+            #[inline]
+            fn step(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> Estimate<T> {
+                $ty::step(self, v_ab, i_ab)
+            }
+            fn align(&mut self, theta0: T, i_ab: Ab<T>) {
+                $ty::align(self, theta0, i_ab)
+            }
+            fn reset(&mut self) {
+                $ty::reset(self)
+            }
+            fn name(&self) -> &'static str {
+                <Self as Baseline<T>>::NAME
+            }
+        }
     };
 }
 

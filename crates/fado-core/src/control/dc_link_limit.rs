@@ -236,7 +236,9 @@ impl<T: Real> DcLinkLimit<T> {
             self.last_vdc = vdc;
         }
         let w = omega.abs();
-        if !(w > self.min_speed) || !vdc.is_finite() {
+        // (NaN speeds compare false: no limit then either.)
+        if w.partial_cmp(&self.min_speed) != Some(core::cmp::Ordering::Greater) || !vdc.is_finite()
+        {
             return (tau, T::zero());
         }
         let per_ampere = self.power_per_torque * w;

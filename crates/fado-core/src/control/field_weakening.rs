@@ -138,7 +138,7 @@ impl<T: Real> FieldWeakening<T> {
     /// (V), the measured bus `vdc` (V) and the speed `omega` (rad/s, electrical).
     #[inline]
     pub fn update(&mut self, v_ref_norm: T, vdc: T, omega: T) {
-        if !self.enabled || !(v_ref_norm.is_finite() && vdc.is_finite() && omega.is_finite()) {
+        if !(self.enabled && v_ref_norm.is_finite() && vdc.is_finite() && omega.is_finite()) {
             return;
         }
         let error = self.margin * vdc - v_ref_norm;

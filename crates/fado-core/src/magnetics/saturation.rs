@@ -10,7 +10,7 @@ use crate::{Dq, Real};
 ///
 /// ```text
 ///   ψd' = ψd − ψf
-///   i_d = [a_d0 + a_dd·|ψd'|^S + a_dq/(V+2)·|ψd'|^U·|ψq|^(V+2)]·ψd' + G_b·ψb
+///   i_d = [a_d0 + a_dd·|ψd'|^S + a_dq/(V+2)·|ψd'|^U·|ψq|^(V+2)]·ψd' + G_b·ψb − i_f
 ///   i_q = [a_q0 + a_qq·|ψq|^T  + a_dq/(U+2)·|ψd'|^(U+2)·|ψq|^V]·ψq  + k_q·G_b·ψq
 ///   ψb = ψd − ψn,  ρ = √(ψb² + k_q·ψq²),  G_b = a_b·ρ^W / (1 + a_bp·ρ^W)
 /// ```
@@ -22,7 +22,14 @@ use crate::{Dq, Real};
 ///        + a_dq·|ψd'|^(U+2)·|ψq|^(V+2)/((U+2)(V+2)) + ∫₀^ρ a_b·r^(W+1)/(1 + a_bp·r^W) dr,
 /// ```
 ///
-/// so that the model is reciprocal (∂i_d/∂ψq = ∂i_q/∂ψd) and conserves energy.
+/// (minus i_f·ψd), so that the model is reciprocal (∂i_d/∂ψq = ∂i_q/∂ψd) and conserves energy.
+///
+/// The magnet enters in one of two ways. As a flux ψf (`psi_f`), d saturates symmetrically
+/// around it and ψd = ψf at i_d = 0 whatever i_q. As a magnetomotive force i_f (`i_f`, the
+/// magnet's equivalent d current, with `psi_f` = 0), the magnet's flux is where the d branch
+/// carries i_f: d self-saturation then makes positive i_d saturate and negative i_d relieve it
+/// (the asymmetry of surface magnets), and cross-saturation lowers ψd with i_q at i_d = 0
+/// (the interior-magnet machine's cross-saturation).
 ///
 /// Special cases: a_dd = a_qq = a_dq = a_b = 0 is the linear machine with Ld = 1/a_d0,
 /// Lq = 1/a_q0, λf = ψf; ψf = 0 with a_b = 0 is the synchronous reluctance machine of
@@ -65,6 +72,8 @@ pub struct Saturation<T> {
     pub w: T,
     /// Rib's share of the q flux k_q (≥ 0).
     pub k_q: T,
+    /// The magnet as a magnetomotive force: its equivalent d current i_f in A (0: none).
+    pub i_f: T,
 }
 
 /// The empty record (every coefficient 0, exponents 0, the rib's exponent 2): a partial TOML
@@ -88,6 +97,7 @@ impl<T: Real> Default for Saturation<T> {
             a_bp: z,
             w: T::lit(2.0),
             k_q: z,
+            i_f: z,
         }
     }
 }
@@ -142,6 +152,7 @@ impl<T: Real> Saturation<T> {
             });
         }
         check::non_negative("k_q", self.k_q)?;
+        check::finite("i_f", self.i_f)?;
         Ok(())
     }
 
@@ -164,6 +175,7 @@ impl<T: Real> Saturation<T> {
             a_bp: c(self.a_bp),
             w: c(self.w),
             k_q: c(self.k_q),
+            i_f: c(self.i_f),
         }
     }
 
@@ -181,7 +193,7 @@ impl<T: Real> Saturation<T> {
         // G_d·x and G_q·y; |x|^(U+2) = |x|^U·x², |y|^(V+2) = |y|^V·y².
         let g_d = self.a_d0 + self.a_dd * xs + cv * xu * yv * y2;
         let g_q = self.a_q0 + self.a_qq * yt + cu * xu * x2 * yv;
-        let mut i = Dq::new(g_d * x, g_q * y);
+        let mut i = Dq::new(g_d * x - self.i_f, g_q * y);
         let cross = self.a_dq * xu * x * yv * y;
         let mut jac = InductanceMatrix {
             dd: self.a_d0 + self.a_dd * (self.s + one) * xs + cv * (self.u + one) * xu * yv * y2,
@@ -210,15 +222,16 @@ impl<T: Real> Saturation<T> {
         (i, jac)
     }
 
-    /// The magnetically linear guess ψ(i) ≈ (ψf + i_d/a_d0, i_q/a_q0).
+    /// The magnetically linear guess ψ(i) ≈ (ψf + (i_d + i_f)/a_d0, i_q/a_q0).
     fn linear_flux(&self, i: Dq<T>) -> Dq<T> {
-        Dq::new(self.psi_f + i.d / self.a_d0, i.q / self.a_q0)
+        Dq::new(self.psi_f + (i.d + self.i_f) / self.a_d0, i.q / self.a_q0)
     }
 }
 
 impl<T: Real> MagneticModel<T> for Saturation<T> {
     fn flux(&self, i: Dq<T>) -> Dq<T> {
-        let scale = self.psi_f.abs() + self.psi_n.abs() + T::lit(1e-6);
+        let scale =
+            self.psi_f.abs() + self.psi_n.abs() + (self.i_f / self.a_d0).abs() + T::lit(1e-6);
         newton(i, self.linear_flux(i), scale, |psi| {
             self.current_and_jacobian(psi)
         })

@@ -53,13 +53,44 @@ fn ipm() -> Saturation<f64> {
     }
 }
 
-fn models() -> [(&'static str, Saturation<f64>, f64); 3] {
+/// The same interior-magnet machine with the magnet as an MMF (i_f = λf/Ld) and d
+/// self-saturation: ψd falls with i_q at i_d = 0 (cross-saturation) and positive i_d saturates.
+fn ipm_mmf() -> Saturation<f64> {
+    Saturation {
+        a_d0: 1.0 / 0.036,
+        a_dd: 20.0,
+        s: 2.0,
+        a_q0: 11.0,
+        a_qq: 4000.0,
+        t: 4.0,
+        a_dq: 58.0,
+        i_f: 0.545 / 0.036,
+        ..Saturation::default()
+    }
+}
+
+fn models() -> [(&'static str, Saturation<f64>, f64); 4] {
     // (name, model, rated-ish current in A)
     [
         ("syrm", syrm(), 22.0),
         ("pmsyrm", pmsyrm(), 12.5),
         ("ipm", ipm(), 6.0),
+        ("ipm_mmf", ipm_mmf(), 6.0),
     ]
+}
+
+#[test]
+fn a_magnet_mmf_gives_cross_saturation_and_asymmetric_d_saturation() {
+    let m = ipm_mmf();
+    m.validate().unwrap();
+    let psi0 = m.flux(Dq::zero()).d;
+    // ψd at i_d = 0 falls with i_q.
+    let psi_q6 = m.flux(Dq::new(0.0, 6.0)).d;
+    assert!(psi_q6 < 0.99 * psi0, "{psi0} -> {psi_q6}");
+    // Positive d current meets a lower incremental inductance than negative.
+    let up = m.incremental_inductance(Dq::new(6.0, 0.0)).dd;
+    let down = m.incremental_inductance(Dq::new(-6.0, 0.0)).dd;
+    assert!(up < 0.95 * down, "{up} vs {down}");
 }
 
 fn currents(i_max: f64) -> impl Iterator<Item = Dq<f64>> {
