@@ -12,14 +12,26 @@ use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use fado_core::baselines::{
-    EmfObserverConfig, EmfObserverEstimator, LpfIntegratorConfig, LpfIntegratorEstimator,
-    OrtegaConfig, OrtegaEstimator,
+    Baseline, CommonTuning, EmfObserverEstimator, LpfIntegratorEstimator, OrtegaEstimator,
+    ReducedOrderEstimator,
 };
 use fado_core::{Ab, MachineModel, RotorAngleEstimator};
 
 mod common;
 
 use common::{fado, inputs};
+
+/// A baseline with its default settings around the paper's machine, as `fado-sim compare`
+/// runs it.
+fn bench_baseline<B: Baseline<f32>>(c: &mut Criterion, data: &[(Ab<f32>, Ab<f32>)]) {
+    let est = B::build(
+        &MachineModel::paper(),
+        &CommonTuning::default(),
+        &B::Settings::default(),
+    )
+    .unwrap();
+    bench_one(c, est, data);
+}
 
 fn bench_one<E: RotorAngleEstimator<f32>>(c: &mut Criterion, est: E, data: &[(Ab<f32>, Ab<f32>)]) {
     let name = format!("{}_step_f32", est.name());
@@ -59,32 +71,18 @@ fn estimators(c: &mut Criterion) {
         &data,
     );
     // fado on the paper's path (`EstimatorTuning::paper_path`, the Cortex-M image's scenarios
-    // 4-5, docs/firmware.md): the paper's method inside fado's step, against the baselines.
+    // 4-5, docs/results/firmware-cost.md): the paper's method inside fado's step, against the baselines.
     bench_named(
         c,
         "fado-paper-path_step_f32",
         fado(|c| c.tuning = c.tuning.paper_path()),
         &data,
     );
-    bench_one(
-        c,
-        LpfIntegratorEstimator::<f32>::new(
-            LpfIntegratorConfig::for_machine(&MachineModel::paper()),
-        )
-        .unwrap(),
-        &data,
-    );
-    bench_one(
-        c,
-        OrtegaEstimator::<f32>::new(OrtegaConfig::for_machine(&MachineModel::paper())).unwrap(),
-        &data,
-    );
-    bench_one(
-        c,
-        EmfObserverEstimator::<f32>::new(EmfObserverConfig::for_machine(&MachineModel::paper()))
-            .unwrap(),
-        &data,
-    );
+    // One line per baseline of fado-sim's registry (`fado_sim::estimators::ESTIMATORS`).
+    bench_baseline::<LpfIntegratorEstimator<f32>>(c, &data);
+    bench_baseline::<OrtegaEstimator<f32>>(c, &data);
+    bench_baseline::<EmfObserverEstimator<f32>>(c, &data);
+    bench_baseline::<ReducedOrderEstimator<f32>>(c, &data);
 }
 
 criterion_group!(benches, estimators);

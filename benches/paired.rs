@@ -4,7 +4,7 @@
 //!
 //! criterion times each estimator in its own few seconds, one after the other; on a shared
 //! virtual machine the speed of the host moves by 10–20 % between those windows, and the ratio
-//! of two criterion medians moves with it (docs/firmware.md, "Eighth session": 0.96–1.41× over
+//! of two criterion medians moves with it (docs/results/firmware-cost.md: 0.96–1.41× over
 //! nine runs). Here every round times one block of steps of *each* estimator, in a random
 //! order, back to back, and the statistic is the median over rounds of the per-round ratio:
 //! a paired design (the two blocks of a round share the machine's state; what changes between
@@ -20,7 +20,7 @@
 //! `black_box` as there. It is a measured report, not a test: run
 //! `cargo bench --bench paired` (`-- REPEATS ROUNDS BLOCK` to change the design, default
 //! 5 × 2000 × 1000: about 15 s). Each repeat prints its own ratios: between repeats the host's
-//! state can change (docs/firmware.md, "Ninth session"), and the ratio with it.
+//! state can change (docs/results/firmware-cost.md), and the ratio with it.
 
 // A benchmark binary: it prints its report.
 #![allow(missing_docs)]

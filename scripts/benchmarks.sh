@@ -6,8 +6,11 @@
 #      same plant and seed), which reads those estimates back;
 #   2b. `cargo bench --bench paired`: fado's f32 step against Ortega's, timed in alternation
 #      (the ratio of two criterion medians moves with the shared machine's state);
-#   3. docs/benchmarks.md = header (command, date, machine) + the compare table + the
+#   2c. `fado-sim compare --scenarios reversal,stops --config motors/<preset>.toml` for every
+#      motor preset (the scenarios scaled by the motor's ratings);
+#   3. docs/benchmarks.md = header (command, date, machine) + the compare tables + the
 #      hand-written analysis in docs/benchmarks-analysis.md.
+# The estimators are every row of fado-sim's registry (`fado-sim list`).
 # Usage: scripts/benchmarks.sh [--averaged] [--skip-bench]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -41,6 +44,13 @@ fi
 cargo build --release -p fado-sim --bin fado-sim
 compare_cmd=(cargo run --release -q -p fado-sim -- compare $averaged --out "$out" --criterion "$target/criterion")
 "${compare_cmd[@]}"
+presets=()
+for preset in motors/*.toml; do
+    name=$(basename "$preset" .toml)
+    cargo run --release -q -p fado-sim -- compare $averaged --scenarios reversal,stops \
+        --config "$preset" --out "$out-presets/$name" >/dev/null
+    presets+=("$name")
+done
 
 # The fig11 angle-error figure, when the Python package (built from this tree: `maturin
 # develop --release`, or scripts/test-all.sh's .venv) and matplotlib are available.
@@ -99,13 +109,26 @@ cpu=$(lscpu 2>/dev/null | sed -n 's/^Model name: *//p' | head -n1)
     echo
     cat "$out/compare.md"
     echo
+    echo "## Every motor preset: \`reversal\` and \`stops\`"
+    echo
+    echo "The two scenarios scaled by the motor's ratings (\`fado-sim list\`: a reversal through"
+    echo "±6 % of the rated speed and three 300 ms stops from 4 %, both under 65 % of the rated"
+    echo "torque; near zero speed = |n| < 2 % of the rated speed), run for every preset of"
+    echo "\`motors/\` by \`fado-sim compare --scenarios reversal,stops --config motors/<preset>.toml\`."
+    echo
+    for name in "${presets[@]}"; do
+        echo "### \`$name\`"
+        echo
+        # The per-run table of that comparison (its summary is the preset's two rows).
+        awk '/^\| scenario \| estimator/{on=1} on&&/^$/{exit} on' "$out-presets/$name/compare.md"
+        echo
+    done
     if [[ $skip_bench -eq 0 ]]; then
         echo "## fado's step against Ortega's, timed in alternation"
         echo
         echo "\`cargo bench --bench paired\` (\`benches/paired.rs\`): the same inputs and estimators as"
         echo "the f32 step column, each round timing 1000 steps of every estimator in a random order,"
-        echo "the ratio taken within the round (a paired design: the machine's drift cancels). Issue"
-        echo "16's host target is fado's default step ≤ 1.2× Ortega's."
+        echo "the ratio taken within the round (a paired design: the machine's drift cancels)."
         echo
         echo '```text'
         grep -v '^$' "$out.paired.txt"

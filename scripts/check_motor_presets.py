@@ -54,7 +54,7 @@ def mtpa_currents(m: dict, i: float) -> tuple[float, float]:
     return i_d, math.sqrt(max(i * i - i_d * i_d, 0.0))
 
 
-INVERTER_OPTIONAL_KEYS = {"dead_time", "threshold_voltage"}
+INVERTER_OPTIONAL_KEYS = {"dead_time", "threshold_voltage", "current_band"}
 
 
 def torque(m: dict, i_d: float, i_q: float) -> float:

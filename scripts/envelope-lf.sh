@@ -6,7 +6,7 @@
 #   2. docs/envelope-fig11-lf-load-{law-off,default}.csv, and docs/envelope-fig11-lf-load.png
 #      drawn from them (with the issue 13 second pass's per-sample law at 5 s⁻¹,
 #      docs/envelope-fig11-lf-load-after-lf5.csv, as the middle panel);
-#   3. the two markdown tables of docs/zero-speed-errors.md on stdout.
+#   3. the two markdown tables of the envelope on stdout (docs/results/envelopes.md).
 # Usage: bash scripts/envelope-lf.sh [fado-sim sweep options, e.g. --threads 1]
 # Needs: cargo; a python3 with numpy and matplotlib (PYTHON, default python3).
 set -euo pipefail

@@ -4,15 +4,15 @@
 # cortex-m4, semihosting) and reports, per scenario (low and high electrical speed, with and
 # without the R̂s adaptation): the instructions and the Cortex-M4 cycle estimate per step (an
 # instruction trace weighted by the TRM's cycle timings, see scripts/firmware_cost.py and
-# docs/firmware.md), the .text reachable from the step and from the ISR, the deepest stack
+# docs/results/firmware-cost.md), the .text reachable from the step and from the ISR, the deepest stack
 # (painted stack, measured in the image) and size_of the estimator's state and parameters
 # (EstimatorState, EstimatorParams, in f32 and f64) and of their owner SensorlessEstimator.
 # Scenarios 4 and 5 run fado's paper's path and, beside it on the same samples, the paper's
 # estimator alone (paper_kernel_step, examples/cortex-m/src/paper_kernel.rs): both are traced
-# in the same run and reported apart (docs/firmware.md, "Seventh pass"); scenarios 6 and 7 the
+# in the same run and reported apart (docs/results/firmware-cost.md); scenarios 6 and 7 the
 # same with the observer's gains held as fado's default holds them (paper_kernel_held_step),
 # 8 and 9 the default step on a salient IPMSM, and scenario 10 the whole drive
-# (drive_step) around a simulated motor (docs/firmware.md, "Eleventh session").
+# (drive_step) around a simulated motor (docs/results/firmware-cost.md).
 # Needs qemu-system-arm and binutils-arm-none-eabi (Debian packages of those names).
 # Usage: bash scripts/firmware-cost.sh [STEPS_MEASURED_PER_SCENARIO (default 300)]
 set -euo pipefail

@@ -3,7 +3,7 @@
 
 Used by scripts/firmware-cost.sh (which builds the image and runs QEMU) and by
 scripts/check-firmware-symbols.sh (which needs only the call graph). Method and assumptions:
-docs/firmware.md.
+docs/results/firmware-cost.md.
 
   firmware_cost.py graph ELF ROOT            functions reachable from ROOT, their .text size,
                                              and any forbidden (soft-f64, panic, fmt) symbol;
@@ -387,7 +387,7 @@ def main():
                 f"{r['insn_mean']:.0f} instructions (max {r['insn_max']}), "
                 f"{r['cyc_mean']:.0f} cycles (max {r['cyc_max']})"
             )
-            # The estimator runs its slow laws round-robin, one per sample (docs/firmware.md):
+            # The estimator runs its slow laws round-robin, one per sample (docs/results/firmware-cost.md):
             # the last steps show each slot's cost.
             print("    cycles of the last 8 steps: " + " ".join(str(c) for c in r["cyc_last"]))
             mix = sorted(r["by_class"].items(), key=lambda x: -x[1])

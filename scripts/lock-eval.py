@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Loss-of-lock detector evaluation (issue 14): reads `fado-sim sweep` CSVs of the fig11
-envelope and prints the detection/false-alarm table of docs/lock.md; with --figure PNG draws
+envelope and prints the detection/false-alarm table of docs/method/lock.md; with --figure PNG draws
 the detection-delay distribution.
 
 Labels (per run, from the true angle error over the whole run with the gates on; the sweep's
@@ -34,7 +34,7 @@ passing runs with a false alarm (flagged and clean) over passing runs.
 
 Runs that tripped (sweep status `diverged`) are left out unless --with-tripped (they keep their
 angle-error and LOCK_LOST columns up to the trip; on fig11 there is at most one a seed, on other
-motors' envelopes many, docs/lock.md "Other motors").
+motors' envelopes many, docs/method/lock.md).
 
 usage: scripts/lock-eval.py LABEL=DIR/sweep.csv ... [--with-tripped] [--figure docs/lock-detection.png]
 """

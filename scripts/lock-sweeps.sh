@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
-# The four fig11 envelope sweeps of docs/lock.md (issue 14): the paper's fixed R̂s and the R̂s
+# The four fig11 envelope sweeps of docs/method/lock.md (issue 14): the paper's fixed R̂s and the R̂s
 # adaptation, each with and without the limiter-clamping symptom; 400 random points, seed 7.
 # usage: [SEED=N] [VARIANTS="fixed-rs adaptive"] scripts/lock-sweeps.sh OUT_DIR
-#        (then scripts/lock-eval.py, see docs/lock.md). SEED (default 7) draws other points of
+#        (then scripts/lock-eval.py, see docs/method/lock.md). SEED (default 7) draws other points of
 #        the same design (seeds 7-14 tuned the detector, 15-16 were seen, 17-20 are the
-#        hold-out of the speed-dependent lower flux bound, docs/lock.md); VARIANTS
+#        hold-out of the speed-dependent lower flux bound, docs/method/lock.md); VARIANTS
 #        (default all four) picks the configurations; EXTRA (TOML text, printf escapes,
 #        appended to each variant's configuration, e.g. EXTRA='[controller]\nx = 1\n') tries a
 #        setting.

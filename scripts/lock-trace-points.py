@@ -3,7 +3,7 @@
 full-rate traces and prints the state at the loss onset t0, at t0 + 20 ms and at the first
 LOCK_LOST: angle error, true/estimated/reference speed as fractions of the rated speed,
 |n* − n̂|, i_q* / rated current, mode (limiter or k_df), LOCK_LOST and the estimator's `lock`
-status (0 locked, 1 suspect, 2 lost) (docs/lock.md "Other motors"). The point's load profile is
+status (0 locked, 1 suspect, 2 lost) (docs/method/lock.md). The point's load profile is
 the reversal's ramp [1.2 s, 0] → [1.7 s, T_L], as the sweep's `load_torque` axis scales it.
 
 usage: scripts/lock-trace-points.py PRESET OUT/VARIANT.toml OUT/VARIANT/sweep.csv POINT...

@@ -2,7 +2,8 @@
 # Runs every motor preset of motors/ through the ratings-scaled scenarios (default: reversal and
 # stops) for sensor-noise seeds 1-4, switching-resolved, default non-idealities, and prints a
 # markdown table of the worst |θ − θ̂| (near zero speed for the reversals) and the verdicts.
-# Usage: bash scripts/presets.sh [scenario ...]     (env SEEDS="1 2 3 4", EXTRA=toml snippet)
+# Usage: bash scripts/presets.sh [scenario ...]     (env SEEDS="1 2 3 4", EXTRA=toml snippet,
+#        MOTORS='motors/saturated/*.toml' for another set of motor files)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scenarios=("$@")
@@ -20,7 +21,7 @@ for s in $seeds; do printf ' seed %s |' "$s"; done
 printf ' passed |\n|---|---|'
 for _ in $seeds; do printf -- '---:|'; done
 printf -- '---|\n'
-for file in motors/*.toml; do
+for file in ${MOTORS:-motors/*.toml}; do
     name=$(basename "$file" .toml)
     for sc in "${scenarios[@]}"; do
         printf '| %s | %s |' "$name" "$sc"

@@ -458,23 +458,6 @@ pub struct BaselineCase {
     pub actions: Vec<EstimatorAction>,
 }
 
-macro_rules! shared_fields {
-    ($case:expr, $d:expr) => {{
-        let s = &$case.shared;
-        (
-            field(s[0], $d.ts),
-            field(s[1], $d.rs_hat),
-            field(s[2], $d.lq_hat),
-            field(s[3], $d.flux_linkage_hat),
-            field(s[4], $d.t2s1_bandwidth_hz),
-            field(s[5], $d.t2s2_bandwidth_hz),
-            field(s[6], $d.tracker_damping),
-            field(s[7], $d.tracker_hold_ratio),
-            field(s[8], $d.initial_angle),
-        )
-    }};
-}
-
 impl BaselineCase {
     /// Runs the case; panics on a broken rule.
     pub fn run(&self) {
@@ -485,78 +468,65 @@ impl BaselineCase {
         }
     }
 
+    /// The machine model and the shared record with the case's `shared` fields.
+    fn shared<T: Real>(&self) -> (MachineModel<T>, fado_core::baselines::CommonTuning<T>) {
+        let s = &self.shared;
+        let m = MachineModel::<T>::paper();
+        let d = fado_core::baselines::CommonTuning::<T>::default();
+        let machine = MachineModel {
+            rs: field(s[1], m.rs),
+            lq: field(s[2], m.lq),
+            flux_linkage: field(s[3], m.flux_linkage),
+            ..m
+        };
+        let common = fado_core::baselines::CommonTuning {
+            ts: field(s[0], d.ts),
+            t2s1_bandwidth_hz: field(s[4], d.t2s1_bandwidth_hz),
+            t2s2_bandwidth_hz: field(s[5], d.t2s2_bandwidth_hz),
+            tracker_damping: field(s[6], d.tracker_damping),
+            tracker_hold_ratio: field(s[7], d.tracker_hold_ratio),
+            initial_angle: field(s[8], d.initial_angle),
+            average_current: self.average_current,
+            ..d
+        };
+        (machine, common)
+    }
+
     fn run_in<T: Real>(&self) {
         use fado_core::baselines::*;
         let o = &self.own;
+        let (machine, common) = self.shared::<T>();
+        let ts = common.ts;
         match self.which % 3 {
             0 => {
-                let d = LpfIntegratorConfig::<T>::for_machine(&MachineModel::paper());
-                let (ts, rs_hat, lq_hat, flux_linkage_hat, b1, b2, z, hold, a0) =
-                    shared_fields!(self, d);
-                let c = LpfIntegratorConfig {
-                    ts,
-                    rs_hat,
-                    lq_hat,
-                    flux_linkage_hat,
-                    t2s1_bandwidth_hz: b1,
-                    t2s2_bandwidth_hz: b2,
-                    tracker_damping: z,
-                    tracker_hold_ratio: hold,
-                    initial_angle: a0,
+                let d = LpfIntegratorSettings::<T>::default();
+                let settings = LpfIntegratorSettings {
                     cutoff_hz: field(o[0], d.cutoff_hz),
                     compensation_floor_hz: field(o[1], d.compensation_floor_hz),
-                    average_current: self.average_current,
-                    ..d
                 };
-                if let Ok(e) = LpfIntegratorEstimator::new(c) {
+                if let Ok(e) = LpfIntegratorEstimator::build(&machine, &common, &settings) {
                     run_baseline(e, ts, &self.actions);
                 }
             }
             1 => {
-                let d = OrtegaConfig::<T>::for_machine(&MachineModel::paper());
-                let (ts, rs_hat, lq_hat, flux_linkage_hat, b1, b2, z, hold, a0) =
-                    shared_fields!(self, d);
-                let c = OrtegaConfig {
-                    ts,
-                    rs_hat,
-                    lq_hat,
-                    flux_linkage_hat,
-                    t2s1_bandwidth_hz: b1,
-                    t2s2_bandwidth_hz: b2,
-                    tracker_damping: z,
-                    tracker_hold_ratio: hold,
-                    initial_angle: a0,
+                let d = OrtegaSettings::<T>::default();
+                let settings = OrtegaSettings {
                     observer_bandwidth: field(o[0], d.observer_bandwidth),
                     observer_speed_ratio: field(o[1], d.observer_speed_ratio),
                     observer_bandwidth_min: field(o[2], d.observer_bandwidth_min),
                     flux_adaptation_ratio: field(o[3], d.flux_adaptation_ratio),
-                    average_current: self.average_current,
-                    ..d
                 };
-                if let Ok(e) = OrtegaEstimator::new(c) {
+                if let Ok(e) = OrtegaEstimator::build(&machine, &common, &settings) {
                     run_baseline(e, ts, &self.actions);
                 }
             }
             _ => {
-                let d = EmfObserverConfig::<T>::for_machine(&MachineModel::paper());
-                let (ts, rs_hat, lq_hat, flux_linkage_hat, b1, b2, z, hold, a0) =
-                    shared_fields!(self, d);
-                let c = EmfObserverConfig {
-                    ts,
-                    rs_hat,
-                    lq_hat,
-                    flux_linkage_hat,
-                    t2s1_bandwidth_hz: b1,
-                    t2s2_bandwidth_hz: b2,
-                    tracker_damping: z,
-                    tracker_hold_ratio: hold,
-                    initial_angle: a0,
+                let d = EmfObserverSettings::<T>::default();
+                let settings = EmfObserverSettings {
                     emf_bandwidth_hz: field(o[0], d.emf_bandwidth_hz),
                     speed_floor_hz: field(o[1], d.speed_floor_hz),
-                    average_current: self.average_current,
-                    ..d
                 };
-                if let Ok(e) = EmfObserverEstimator::new(c) {
+                if let Ok(e) = EmfObserverEstimator::build(&machine, &common, &settings) {
                     run_baseline(e, ts, &self.actions);
                 }
             }

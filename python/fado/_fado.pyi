@@ -93,12 +93,12 @@ class Machine:
         lq: float,
         flux_linkage: float,
         pole_pairs: int,
-        inertia: float,
         rated_current: float,
         rated_speed_rpm: float,
         rated_torque: float,
         dc_voltage: float,
-        viscous_friction: float = 0.0,
+        inertia: float | None = None,
+        viscous_friction: float | None = None,
     ) -> Machine: ...
     def replace(
         self,
@@ -574,6 +574,9 @@ def default_config(
     scenario: str = "fig11", averaged: bool = False, *, motor: str | Machine | None = None
 ) -> str:
     """The scenario's configuration as TOML (``fado-sim run --dump-config``)."""
+
+def estimators() -> list[str]:
+    """The estimator names ``compare`` runs by default, in its order."""
 
 def compare(
     scenarios: list[str] | None = None,

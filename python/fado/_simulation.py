@@ -49,7 +49,9 @@ def simulate(
     """Runs one of the paper's experiments on the simulated drive (Rust, GIL released).
 
     `scenario` is one of :func:`fado.scenarios` (``fig8`` … ``fig12`` in the paper's units;
-    ``reversal``, ``stops``, ``rated-reversal``, ``lowspeed`` scaled by the motor's ratings).
+    ``reversal``, ``stops``, ``rated-reversal``, ``lowspeed``, ``loaded-start``,
+    ``fullrange``, ``regen-stop`` scaled by the motor's ratings; ``custom``: the
+    configuration's own profiles, judged only by its ``[criteria]``).
     `motor` replaces the paper's motor first: a preset name of :func:`fado.machine_presets`
     (its whole ``motors/`` file: ``[motor]`` and its ``[inverter]``) or a :class:`fado.Machine`
     (as ``[motor]`` and ``[inverter] dc_voltage``). `config` then overrides

@@ -1,9 +1,9 @@
 """fado against the observers other drives use, in the closed-loop simulator.
 
-Every estimator (fado and the baselines of ``fado_core::baselines``: ``lpf-integrator``,
-``ortega``, ``emf-observer``) runs every scenario on the same plant, with the same
-non-idealities, controllers and sensor-noise seed; each is tuned once with its documented
-defaults. The work runs in Rust (``fado_sim::compare``) with the GIL released::
+Every estimator of the simulator's registry (:data:`ESTIMATORS`: fado and the baselines of
+``fado_core::baselines``) runs every scenario (:data:`SCENARIOS`) on the same plant, with the
+same non-idealities, controllers and sensor-noise seed; each is tuned once with its
+documented defaults. The work runs in Rust (``fado_sim::compare``) with the GIL released::
 
     import fado
     result = fado.compare(scenarios=["fig11", "lowspeed"], averaged=True)
@@ -26,7 +26,13 @@ from typing import Any
 
 from fado import _fado
 
-__all__ = ["CompareResult", "compare", "plot_angle_errors"]
+__all__ = ["ESTIMATORS", "SCENARIOS", "CompareResult", "compare", "plot_angle_errors"]
+
+#: Every estimator name, in the order ``compare`` runs them by default (read from the
+#: simulator's registry, ``fado_sim::estimators::ESTIMATORS``).
+ESTIMATORS: tuple[str, ...] = tuple(_fado.estimators())
+#: Every scenario name, in the simulator's order (``fado_sim::scenario::SCENARIOS``).
+SCENARIOS: tuple[str, ...] = tuple(_fado.scenarios())
 
 
 class CompareResult(list[dict[str, Any]]):
@@ -58,9 +64,8 @@ def compare(
 ) -> CompareResult:
     """Runs every estimator in every scenario; see ``fado_sim::compare`` for the metrics.
 
-    ``scenarios`` defaults to all (fig8 … fig12, steady300, lowspeed), ``estimators`` to
-    ``["fado", "fado-fixed-rs", "lpf-integrator", "ortega", "emf-observer"]``
-    (``fado-fixed-rs``: fado with the paper's fixed R̂s). ``averaged`` selects the fast
+    ``scenarios`` defaults to all of :data:`SCENARIOS`, ``estimators`` to all of
+    :data:`ESTIMATORS` (``fado-fixed-rs``: fado with the paper's fixed R̂s). ``averaged`` selects the fast
     averaged inverter model. ``config`` is TOML applied over every scenario (its
     ``[simulation] estimator`` is replaced by each estimator). ``traces`` keeps each run's 1 kHz
     trace (a dict of arrays) under ``"trace"``. Raises :class:`fado.ConfigError`.

@@ -34,6 +34,7 @@ __all__ = [
     "plot_fig10",
     "plot_fig11",
     "plot_fig12",
+    "plot_run",
     "plot_scenario",
 ]
 
@@ -246,16 +247,19 @@ def plot_fig10(result: SimResult, path: str | os.PathLike[str] | None = None) ->
     return _figure(result, panels, _title(result), path)
 
 
+#: Speed, θ − θ̂ against ±0.25 rad, λ1 and D̂, d-q currents, flags: Fig. 11 and any run.
+_RUN_PANELS: list[Callable[[Axes, SimResult], None]] = [
+    _speed,
+    lambda ax, r: _angle_error(ax, r, criterion=True),
+    _flux_and_disturbance,
+    _currents,
+    _flags,
+]
+
+
 def plot_fig11(result: SimResult, path: str | os.PathLike[str] | None = None) -> Figure:
     """Fig. 11: speed reversal −90 → +90 r/min under 7.5 N·m; θ − θ̂ against ±0.25 rad."""
-    panels = [
-        _speed,
-        lambda ax, r: _angle_error(ax, r, criterion=True),
-        _flux_and_disturbance,
-        _currents,
-        _flags,
-    ]
-    return _figure(result, panels, _title(result), path)
+    return _figure(result, _RUN_PANELS, _title(result), path)
 
 
 def plot_fig12(result: SimResult, path: str | os.PathLike[str] | None = None) -> Figure:
@@ -269,23 +273,38 @@ def plot_fig12(result: SimResult, path: str | os.PathLike[str] | None = None) ->
     return _figure(result, panels, _title(result), path)
 
 
+def plot_run(result: SimResult, path: str | os.PathLike[str] | None = None) -> Figure:
+    """Any run: speed, θ − θ̂ against ±0.25 rad, λ1 and D̂, d-q currents and the mode flags
+    (the layout of Fig. 11, for a scenario of one's own or a run with a custom profile), titled
+    with the scenario it started from."""
+    return _figure(result, _RUN_PANELS, f"a run based on {result.scenario}", path)
+
+
 _BY_SCENARIO = {
     "fig8": plot_fig8,
     "fig9": plot_fig9,
     "fig10": plot_fig10,
     "fig11": plot_fig11,
     "fig12": plot_fig12,
+    # The paper's experiments scaled by a motor's ratings take their original's layout.
+    "reversal": plot_fig11,
+    "rated-reversal": plot_fig11,
+    "stops": plot_fig12,
+    "lowspeed": plot_fig12,
 }
 
 
 def plot_scenario(result: SimResult, path: str | os.PathLike[str] | None = None) -> Figure:
-    """The figure of `result.scenario` (``plot_fig8`` … ``plot_fig12``)."""
-    try:
-        plot = _BY_SCENARIO[result.scenario]
-    except KeyError:
-        raise ValueError(
-            f"no figure for scenario {result.scenario!r}; one of {sorted(_BY_SCENARIO)}"
-        ) from None
+    """The figure of `result.scenario`: ``plot_fig8`` … ``plot_fig12`` for the paper's
+    experiments, the layout of the original for the ratings-scaled ones (``reversal`` and
+    ``rated-reversal`` as Fig. 11, ``stops`` and ``lowspeed`` as Fig. 12), and
+    :func:`plot_run` for any other scenario of :func:`fado.scenarios`."""
+    from fado._fado import scenarios
+
+    known = scenarios()
+    if result.scenario not in known:
+        raise ValueError(f"no figure for scenario {result.scenario!r}; one of {sorted(known)}")
+    plot = _BY_SCENARIO.get(result.scenario, plot_run)
     figure: Figure = plot(result, path)
     return figure
 

@@ -112,8 +112,12 @@ def test_identified_toml_runs_in_the_simulator(paper: fado.CommissionResult) -> 
 
 
 def test_an_abort_is_reported_not_raised() -> None:
-    # A nameplate 10× the real resistance: the DC test finds Rs outside 1/4–4× of it.
-    r = fado.commission("paper", nameplate=dict(fado.Machine.preset("paper").to_dict(), rs=33.0))
+    # A nameplate 10× the real resistance: the DC test finds Rs outside 1/4–4× of it (the
+    # nameplate itself is unusual, 1.3 × the rated back-EMF dropped at rated current: a warning;
+    # 100× would be refused before the run as a unit slip).
+    with pytest.warns(UserWarning, match="rs"):
+        nameplate = dict(fado.Machine.preset("paper").to_dict(), rs=3.3)
+        r = fado.commission("paper", nameplate=nameplate)
     assert not r.passed
     assert r.machine is None and r.errors == {} and r.identified_toml is None
     assert "Aborted" in r.status

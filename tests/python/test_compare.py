@@ -32,6 +32,18 @@ def test_compare_returns_one_row_per_scenario_and_estimator() -> None:
         result.row("fig11", "fado")
 
 
+def test_the_default_lists_are_the_registries() -> None:
+    assert fado.compare.ESTIMATORS == tuple(fado._fado.estimators())
+    assert fado.compare.ESTIMATORS[:2] == ("fado", "fado-fixed-rs")
+    assert "ortega" in fado.compare.ESTIMATORS
+    assert fado.compare.SCENARIOS == tuple(fado.scenarios())
+    assert {"fig8", "fig12", "steady300", "lowspeed", "reversal", "stops"} <= set(
+        fado.compare.SCENARIOS
+    )
+    with pytest.raises(fado.ConfigError, match="one of"):
+        fado.compare(["steady300"], ["kalman"], averaged=True, config=SHORT)
+
+
 def test_compare_matches_the_native_call_and_is_deterministic() -> None:
     a = fado.compare.compare(["steady300"], ["emf-observer"], True, config=SHORT)
     b = fado._fado.compare(["steady300"], ["emf_observer"], True, config=SHORT)

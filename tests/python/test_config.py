@@ -53,7 +53,7 @@ PAPER_DEFAULTS = {
     "lock_detection_time": 5e-3,  # [A]
     "lock_heal_time": 0.1,  # [A]
     "lock_limiter_clamping": False,  # [A]
-    "lock_handover_count": 5.0,  # [A] (docs/lock.md "Mode hand-over chatter")
+    "lock_handover_count": 5.0,  # [A] (docs/method/lock.md)
     "lock_handover_time": 0.1,  # [A]
 }
 
@@ -349,7 +349,8 @@ def test_dict_config_errors_are_located_in_its_toml() -> None:
 
 def test_config_as_a_dict_works_as_in_simulate() -> None:
     """Flat tuning keys, the [estimator] table of a simulator config, or dotted keys: the same
-    tuning; the simulator's other tables are not the estimator's and are skipped."""
+    tuning; the simulator's other tables are not the estimator's and are refused, naming the
+    functions that take them."""
     rng = np.random.default_rng(3)
     signals = [rng.normal(size=500) for _ in range(4)]
     expected = fado.estimate(*signals, machine="paper", config=EstimatorConfig(k_df=1.0))
@@ -357,13 +358,19 @@ def test_config_as_a_dict_works_as_in_simulate() -> None:
         {"k_df": 1.0},
         {"estimator": {"k_df": 1.0}},
         {"estimator.k_df": 1.0},
-        {"estimator": {"k_df": 1.0}, "simulation": {"duration": 1.0}, "mismatch.rs_ratio": 1.1},
     ):
         got = fado.estimate(*signals, machine="paper", config=config)
         np.testing.assert_array_equal(got.theta, expected.theta, strict=True)
         assert fado.Estimator("paper", config).config == EstimatorConfig(k_df=1.0)
     default = fado.estimate(*signals, machine="paper")
     assert not np.array_equal(default.theta, expected.theta)
+    for extra, key in (
+        ({"simulation": {"duration": 1.0}}, "simulation"),
+        ({"mismatch.rs_ratio": 1.1}, "mismatch.rs_ratio"),
+    ):
+        with pytest.raises(fado.ConfigError, match="fado.simulate") as info:
+            fado.estimate(*signals, machine="paper", config={"estimator": {"k_df": 1.0}, **extra})
+        assert info.value.field == key
     # The same dict drives the simulator's estimator.
     sim_config = {"estimator": {"k_df": 1.0}, "simulation": {"duration": 0.05}}
     assert fado.simulate("fig11", sim_config, averaged=True).estimator_config.k_df == 1.0
@@ -400,8 +407,12 @@ def test_machine_is_keyword_only_with_required_fields() -> None:
     assert set(params) == set(PAPER_MACHINE)
     assert all(p.kind is inspect.Parameter.KEYWORD_ONLY for p in params.values())
     required = {n for n, p in params.items() if p.default is inspect.Parameter.empty}
-    assert required == set(PAPER_MACHINE) - {"viscous_friction"}
-    assert fado.Machine(**IPMSM).viscous_friction == 0.0
+    assert required == set(PAPER_MACHINE) - {"viscous_friction", "inertia"}
+    # Left out, friction and inertia come from the ratings (fado_core::ratings), not 0.
+    derived = fado.Machine(**{k: v for k, v in IPMSM.items() if k != "inertia"})
+    omega_mech = IPMSM["rated_speed_rpm"] * math.pi / 30
+    assert derived.viscous_friction == pytest.approx(0.01 * IPMSM["rated_torque"] / omega_mech)
+    assert derived.inertia == pytest.approx(0.15 * IPMSM["rated_torque"] / omega_mech)
     for missing in required:
         with pytest.raises(TypeError, match=missing):
             fado.Machine(**{k: v for k, v in IPMSM.items() if k != missing})

@@ -1,4 +1,5 @@
-"""Every Python and shell code block of README.md and docs/*.md runs as written.
+"""Every Python and shell code block of README.md and the documentation pages (docs/**/*.md)
+runs as written.
 
 A block is a fenced ```python, ```py, ```sh, ```bash or ```console block. The line right
 before its fence may say
@@ -9,7 +10,9 @@ before its fence may say
   for names the prose supplies (a lab recording, a file the reader has).
 
 The Python blocks of one file run in order in one namespace (later blocks use earlier
-results, as a reader would), in a scratch directory (the figures they save land there).
+results, as a reader would), in a scratch directory (the figures they save land there) that
+links the repository's `examples/` and `motors/`, the input files a reader in the repository
+root has.
 Shell blocks run line by line with bash from the repository root, `python` being this
 interpreter; each line must exit 0 (or 1 for ``fado-sim run``, whose 1 means criteria
 missed, see README "Exit codes").
@@ -27,7 +30,14 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
-DOCS = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+# Generated pages (the gallery's, the API reference's) are not hand-written documentation.
+GENERATED = {"auto_examples", "api", "_build"}
+DOCS = [
+    ROOT / "README.md",
+    *sorted(
+        p for p in (ROOT / "docs").rglob("*.md") if not GENERATED & set(p.relative_to(ROOT).parts)
+    ),
+]
 PYTHON = {"python", "py"}
 SHELL = {"sh", "bash", "console", "shell"}
 NOT_RUN = re.compile(r"^<!--\s*not run:\s*(\S.*?)\s*-->$")
@@ -53,7 +63,8 @@ def blocks(path: Path) -> list[Block]:
     lines = path.read_text(encoding="utf-8").splitlines()
     k = 0
     while k < len(lines):
-        fence = re.match(r"^```(\w*)\s*$", lines[k])
+        # A language (```python) or a MyST directive (```{toctree}, never run).
+        fence = re.match(r"^```(\{[\w-]+\}|\w*)(\s.*)?$", lines[k])
         if not fence:
             k += 1
             continue
@@ -100,6 +111,9 @@ def test_python_blocks_run(path: Path, tmp_path: Path, monkeypatch: pytest.Monke
     pytest.importorskip("pandas")
     pytest.importorskip("matplotlib")
     monkeypatch.chdir(tmp_path)
+    # A reader runs the blocks from the repository root: its input files are there too.
+    for shared in ("examples", "motors"):
+        (tmp_path / shared).symlink_to(ROOT / shared)
     namespace: dict[str, object] = {"__name__": "__doc__"}
     ran = 0
     for b in blocks(path):

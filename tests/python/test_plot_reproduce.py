@@ -167,3 +167,22 @@ def test_toml_writer() -> None:
     # Different keys given both ways merge.
     merged = tomllib.loads(_toml.dumps({"motor.rs": 0.3, "motor": {"ld": 1e-3}}))
     assert merged["motor"] == {"rs": 0.3, "ld": 1e-3}
+
+
+def test_plot_scenario_draws_every_scenario(tmp_path: Path) -> None:
+    """Every scenario has a figure, the ratings-scaled ones on a motor other than the paper's
+    included (a short run: the figure, not the result, is under test)."""
+    pytest.importorskip("matplotlib")
+    import fado.plot
+
+    for name in fado.scenarios():
+        result = fado.simulate(
+            name,
+            {"simulation": {"duration": 0.3, "decimation": 20}},
+            averaged=True,
+            motor="ipmsm-2k2",
+        )
+        path = tmp_path / f"{name}.png"
+        fig = fado.plot.plot_scenario(result, path)
+        assert path.read_bytes().startswith(PNG_MAGIC), name
+        assert len(fig.get_axes()) >= 4, name

@@ -271,6 +271,10 @@ def test_sim_result_api() -> None:
         "reversal",
         "stops",
         "rated-reversal",
+        "loaded-start",
+        "fullrange",
+        "regen-stop",
+        "custom",
     ]
     assert "Fig. 10" in fado.describe_scenario("fig10")["title"]
     assert list(result.traces) == fado.TRACE_COLUMNS

@@ -1,18 +1,4 @@
-//! # fado-core
-//!
-//! Sensorless control of permanent-magnet synchronous motors with the stator-flux estimator and
-//! frequency-adaptive disturbance observer of Y. Park and S.-K. Sul, "Sensorless Control Method
-//! for PMSM Based on Frequency-Adaptive Disturbance Observer" (the paper). Equation and figure
-//! numbers in the docs are the paper's; "SPEC" is the project's reconstruction of what the
-//! paper leaves out.
-//!
-//! Every block is an allocation-free state machine generic over `f32` (firmware) and `f64`
-//! (analysis): `new(config) -> Result<Self, ConfigError>`, `step(..)`, `reset()`. The crate is
-//! `#![no_std]`, uses no `alloc` and no `unsafe`, and never panics on bad numbers: a non-finite
-//! input is rejected for that sample and reported, leaving the state untouched.
-//!
-//! Units are SI; angles and speeds are electrical unless a name says `_mech`.
-
+#![doc = include_str!("../README.md")]
 #![no_std]
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
@@ -32,9 +18,12 @@ pub mod injection;
 pub mod integrand_offset;
 pub mod lock;
 pub mod machine;
+pub mod machine_checks;
+pub mod magnetics;
 pub mod mode;
 pub mod observer;
 pub mod plausibility;
+pub mod ratings;
 pub mod real;
 pub mod rotor_flux;
 pub mod rs_adaptation;
@@ -50,5 +39,6 @@ pub use estimator::{
 pub use frames::{Ab, Abc, Dq, Rotation};
 pub use lock::LockStatus;
 pub use machine::MachineModel;
+pub use magnetics::{MagneticModel, Magnetics};
 pub use mode::Mode;
 pub use real::{Real, wrap_angle};

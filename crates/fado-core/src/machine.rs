@@ -13,6 +13,7 @@
 //! the datasheet's r/min (a rating, converted once by [`MachineModel::rated_speed`]).
 
 use crate::error::{ConfigError, check};
+use crate::magnetics::ConstantInductance;
 use crate::{Dq, Real};
 
 /// The motor's parameters and ratings (a drive's model of it, or a simulated plant).
@@ -114,9 +115,11 @@ impl<T: Real> MachineModel<T> {
     }
 
     /// Checks every field; the error names the first bad one. Besides signs and finiteness it
-    /// catches unit slips: the rated torque must be within 0.3–3× of what the magnet torque
-    /// 1.5·p·λf·I_rated gives (λf in Wb peak, current in A peak), and the back-EMF at rated
-    /// speed ω·λf at most twice the phase voltage the DC link can make (Vdc/√3).
+    /// refuses what [`crate::machine_checks::check`] finds an error: a field beyond any motor,
+    /// the rated torque outside 0.3–3× of what the model gives at rated current (or half of it
+    /// with an even pole-pair count: a pole count), the back-EMF at rated speed above twice
+    /// the phase voltage the DC link can make (Vdc/√3), an inductance or resistance hundreds
+    /// of times its plausible per-unit value, ratings that use under a tenth of the DC link.
     pub fn validate(&self) -> Result<(), ConfigError> {
         check::positive("rs", self.rs)?;
         check::positive("ld", self.ld)?;
@@ -134,24 +137,9 @@ impl<T: Real> MachineModel<T> {
         check::positive("rated_speed_rpm", self.rated_speed_rpm)?;
         check::positive("rated_torque", self.rated_torque)?;
         check::positive("dc_voltage", self.dc_voltage)?;
-        // Ratios of well-scaled quantities: overflow-free for any finite positive inputs
-        // within the plausible range, and any inf/NaN from an extreme one fails the test.
-        let ratio = self.rated_torque / (self.torque_constant() * self.rated_current);
-        if !(ratio.is_finite() && ratio > T::lit(0.3) && ratio < T::lit(3.0)) {
-            return Err(ConfigError::OutOfRange {
-                field: "rated_torque",
-                expected: "0.3–3 × 1.5·p·λf·rated_current (check units: λf in Wb peak, current in A peak)",
-            });
-        }
-        let emf = self.rated_speed() * self.flux_linkage;
-        let v_phase = self.dc_voltage / T::lit(1.732_050_807_568_877_2);
-        if !(emf.is_finite() && emf < T::lit(2.0) * v_phase) {
-            return Err(ConfigError::OutOfRange {
-                field: "flux_linkage",
-                expected: "back-EMF at rated speed (ω·λf) at most 2 × Vdc/√3 (check units and the DC link)",
-            });
-        }
-        Ok(())
+        // The cross-checks of the data against each other and the DC link
+        // (`crate::machine_checks`): its errors, named by the likeliest culprit.
+        crate::machine_checks::validate_real(self)
     }
 
     /// Rated speed in rad/s mechanical.
@@ -183,6 +171,16 @@ impl<T: Real> MachineModel<T> {
     /// Stator flux linkage in the rotor frame (Ld·i_d + λf, Lq·i_q) in Wb.
     pub fn flux_dq(&self, i_dq: Dq<T>) -> Dq<T> {
         Dq::new(self.ld * i_dq.d + self.flux_linkage, self.lq * i_dq.q)
+    }
+
+    /// This record's inductances and magnet flux as a [`ConstantInductance`] magnetic model
+    /// (the same arithmetic as [`MachineModel::flux_dq`]).
+    pub fn constant_inductance(&self) -> ConstantInductance<T> {
+        ConstantInductance {
+            ld: self.ld,
+            lq: self.lq,
+            flux_linkage: self.flux_linkage,
+        }
     }
 
     /// Magnitude of the active flux λf + (Ld − Lq)·i_d (Boldea, Paicu & Andreescu, "Active

@@ -19,6 +19,19 @@
 //! recursion and poles, but without the one-sample lag ω·Ts the predicted value would carry
 //! (1.3e-2 rad at 20 Hz).
 //!
+//! **Acceleration feed-forward (type 3).** Under a constant acceleration α the type-2 loop
+//! lags by α/Ki in angle and Kp·α/Ki in speed: 0.1 rad and 70 r/min on the paper's motor
+//! accelerating at its current limit (60 Hz T2S-1). A drive knows the torque it commands, so
+//! the tracker can be given the acceleration p·T*/Ĵ that torque causes (the mechanical model of
+//! motulator's speed observer and of Lorenz's acceleration feed-forward): ω̂ ← ω̂ + Ki·Ts·e +
+//! Ts·(a* + â). What the model misses, the load's torque, Ĵ's error and friction, is a slowly
+//! varying acceleration â, integrated from the phase error (â ← â + K3·Ts·e): a third
+//! integrator, so a constant load leaves no angle error (with the feed-forward alone it would
+//! leave p·T_L/(Ĵ·Ki), 0.11 rad at the paper's rated load). The poles are the type-2 pair
+//! with a real pole added at c·ωn (`EstimatorTuning::tracker_load_pole_ratio`; c = 0 keeps the
+//! type-2 loop to the bit). The feed-forward removes the lag under the commanded torque; a
+//! load step is a disturbance the third integrator removes at c·ωn.
+//!
 //! **Angles in `f32`: wrapping fixed point** ([`Real::Angle`]). In `f32` θ̂ and θ̂⁻ are kept
 //! as `i32` with 2³² units = 2π (one unit is 1.46e-9 rad), so every wrap of the recursion is
 //! the overflow of an integer add or subtract: e = θm − θ̂⁻ is exact modulo 2π without a
@@ -117,9 +130,13 @@ pub(crate) struct TrackerParams<T> {
     /// the unit conversions of the recursion folded into its gains (`f64`: Ts and Ki·Ts).
     ts_units: T,
     ki_ts_units: T,
+    /// K3·Ts in rad/s² per angle unit: the load-acceleration integrator of the type-3 form
+    /// ([`TrackerParams::with_load_pole`]); 0 keeps the type-2 loop.
+    k3_ts_units: T,
 }
 
-/// The tracker's mutable state: θ̂⁻, θ̂ and ω̂.
+/// The tracker's mutable state: θ̂⁻, θ̂ and ω̂; the commanded acceleration fed forward and
+/// the integrated load acceleration â of the type-3 form.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct TrackerState<T: Real> {
     /// θ̂⁻: the angle predicted for the next sample ([`Real::Angle`]).
@@ -127,6 +144,10 @@ pub(crate) struct TrackerState<T: Real> {
     /// θ̂: the angle estimate for the last sample.
     theta: T::Angle,
     omega: T,
+    /// The acceleration the drive commands, rad/s² (electrical), fed forward into ω̂.
+    acceleration: T,
+    /// â: what the feed-forward misses (the load's acceleration), rad/s².
+    load: T,
 }
 
 impl<T: Real> TrackerParams<T> {
@@ -153,7 +174,47 @@ impl<T: Real> TrackerParams<T> {
             ki_ts: ki * ts,
             ts_units: ts * T::angle_units_per_rad(),
             ki_ts_units: ki * ts * T::angle_unit(),
+            k3_ts_units: T::zero(),
         })
+    }
+
+    /// The type-3 form for an acceleration feed-forward (see the module docs): a third
+    /// integrator â ← â + K3·Ts·e of the acceleration the feed-forward misses, with the poles
+    /// of the type-2 loop kept and a real pole added at `ratio`·ωn: (s² + 2ζωn·s + ωn²)·
+    /// (s + c·ωn) gives Kp = (2ζ + c)·ωn, Ki = (1 + 2ζc)·ωn², K3 = c·ωn³. `ratio` = 0 leaves
+    /// the type-2 tracker unchanged (to the bit).
+    pub(crate) fn with_load_pole(
+        mut self,
+        config: &TrackerConfig<T>,
+        ratio: T,
+    ) -> Result<Self, ConfigError> {
+        let c = check::non_negative("tracker_load_pole_ratio", ratio)?;
+        if c == T::zero() {
+            return Ok(self);
+        }
+        let (kp0, ki0) = config.gains();
+        let wn = ki0.sqrt();
+        let zeta2 = kp0 / wn;
+        let kp = (zeta2 + c) * wn;
+        let ki = (T::one() + zeta2 * c) * wn * wn;
+        let k3 = c * wn * wn * wn;
+        let ts = self.ts;
+        let (a1, a2, a3) = (kp * ts, ki * ts * ts, k3 * ts * ts * ts);
+        // The discrete loop is stable when the poles of the sampled triple stay inside the
+        // unit circle; at ωn·Ts ≪ 1 they are e^{−p·Ts}. Refuse gains beyond a tenth of the
+        // sampling rate (the type-2 limit's margin).
+        if !(a1 < T::lit(0.5) && a2 < T::lit(0.1) && a3 < T::lit(0.02)) {
+            return Err(ConfigError::OutOfRange {
+                field: "tracker_load_pole_ratio",
+                expected: "a load pole whose tracker stays well below the sampling rate",
+            });
+        }
+        self.kp = kp;
+        self.kp_ts = ts * kp;
+        self.ki_ts = ki * ts;
+        self.ki_ts_units = ki * ts * T::angle_unit();
+        self.k3_ts_units = k3 * ts * T::angle_unit();
+        Ok(self)
     }
 
     /// The state at a known angle and speed.
@@ -163,6 +224,8 @@ impl<T: Real> TrackerParams<T> {
             predicted: theta,
             theta,
             omega,
+            acceleration: T::zero(),
+            load: T::zero(),
         }
     }
 
@@ -186,13 +249,22 @@ impl<T: Real> TrackerParams<T> {
         // Ki·Ts·e and Ts·ω̂ are in `ki_ts_units` and `ts_units` (`f32`: one rounding fewer
         // than converting e and the increments, and no multiply per conversion).
         let e = T::angle_diff_units(T::angle_from(theta_measured), s.predicted);
-        let omega = s.omega + self.ki_ts_units * e;
+        let (omega, load) = if s.acceleration == T::zero() && self.k3_ts_units == T::zero() {
+            (s.omega + self.ki_ts_units * e, s.load)
+        } else {
+            let load = s.load + self.k3_ts_units * e;
+            (
+                s.omega + self.ki_ts_units * e + self.ts * (s.acceleration + load),
+                load,
+            )
+        };
         let theta = T::angle_add_units(s.predicted, self.kp_ts * e);
         TrackerUpdate {
             predicted: T::angle_add_units(theta, ts_units * omega),
             theta,
             omega,
             innovation: e,
+            load,
         }
     }
 
@@ -200,11 +272,18 @@ impl<T: Real> TrackerParams<T> {
     #[inline(always)]
     pub(crate) fn coasted_state(&self, s: &TrackerState<T>) -> TrackerUpdate<T> {
         let theta = s.predicted;
+        // Coasting, ω̂ follows the commanded acceleration and the last â (the model alone).
+        let omega = if s.acceleration == T::zero() && s.load == T::zero() {
+            s.omega
+        } else {
+            s.omega + self.ts * (s.acceleration + s.load)
+        };
         TrackerUpdate {
             predicted: T::angle_add_units(theta, self.ts_units * s.omega),
             theta,
-            omega: s.omega,
+            omega,
             innovation: T::zero(),
+            load: s.load,
         }
     }
 
@@ -229,6 +308,13 @@ impl<T: Real> TrackerState<T> {
         self.predicted = next.predicted;
         self.theta = next.theta;
         self.omega = next.omega;
+        self.load = next.load;
+    }
+
+    /// Sets the acceleration fed forward from the next sample on, rad/s² (electrical).
+    #[inline(always)]
+    pub(crate) fn set_acceleration(&mut self, acceleration: T) {
+        self.acceleration = acceleration;
     }
 
     /// [`Self::commit`] without θ̂: for a tracker whose angle nobody reads (the estimator's
@@ -238,6 +324,7 @@ impl<T: Real> TrackerState<T> {
     pub(crate) fn commit_speed(&mut self, next: TrackerUpdate<T>) {
         self.predicted = next.predicted;
         self.omega = next.omega;
+        self.load = next.load;
     }
 
     /// θ̂ for the last sample, in [−π, π].
@@ -270,6 +357,23 @@ impl<T: Real> TypeTwoTracker<T> {
             params,
             state: params.state_at(T::zero(), T::zero()),
         })
+    }
+
+    /// A new tracker of the type-3 form with a load pole at `ratio`·ωn (see
+    /// `TrackerParams::with_load_pole` in the module docs), for an acceleration
+    /// feed-forward ([`Self::set_acceleration`]).
+    pub fn with_load_pole(config: TrackerConfig<T>, ratio: T) -> Result<Self, ConfigError> {
+        let params = TrackerParams::new(config)?.with_load_pole(&config, ratio)?;
+        Ok(Self {
+            params,
+            state: params.state_at(T::zero(), T::zero()),
+        })
+    }
+
+    /// The acceleration fed forward into ω̂ from the next sample on, rad/s²: the drive's
+    /// commanded torque through the mechanical model, p·T*/Ĵ.
+    pub fn set_acceleration(&mut self, acceleration: T) {
+        self.state.set_acceleration(acceleration);
     }
 
     /// θ̂ = ω̂ = 0.
@@ -349,6 +453,8 @@ pub(crate) struct TrackerUpdate<T: Real> {
     /// The phase error e = wrap(θm − θ̂⁻) of this sample in angle units (0 when coasting):
     /// × [`Real::angle_unit`] for radians.
     pub innovation: T,
+    /// â after the sample, rad/s².
+    pub load: T,
 }
 
 impl<T: Real> TrackerUpdate<T> {
@@ -549,5 +655,87 @@ mod tests {
             ..TrackerConfig::<f64>::new(60.0, 100e-6)
         };
         assert_eq!(TypeTwoTracker::new(c).unwrap_err().field(), "bandwidth_hz");
+    }
+
+    /// θ of a rotor accelerating at `alpha` from rest, sampled at `ts`.
+    fn accelerating(alpha: f64, n: usize, ts: f64) -> f64 {
+        let t = n as f64 * ts;
+        0.5 * alpha * t * t
+    }
+
+    #[test]
+    fn load_pole_zero_is_the_type_two_tracker() {
+        let c = TrackerConfig::<f64>::new(60.0, 100e-6);
+        let mut a = TypeTwoTracker::new(c).unwrap();
+        let mut b = TypeTwoTracker::with_load_pole(c, 0.0).unwrap();
+        assert_eq!(a.gains(), b.gains());
+        for n in 0..2000 {
+            let th = accelerating(3000.0, n, 1e-4);
+            assert_eq!(a.step(th).unwrap(), b.step(th).unwrap());
+        }
+    }
+
+    #[test]
+    fn type_three_tracker_follows_a_constant_acceleration_without_error() {
+        let (ts, alpha) = (1e-4, 3000.0); // rad/s²: the paper's motor at its current limit
+        let c = TrackerConfig::<f64>::new(60.0, ts);
+        let mut t2 = TypeTwoTracker::new(c).unwrap();
+        let mut t3 = TypeTwoTracker::with_load_pole(c, 0.5).unwrap();
+        let (mut e2, mut e3) = (0.0, 0.0);
+        for n in 1..=10_000 {
+            let th = accelerating(alpha, n, ts);
+            e2 = wrap_angle(th - t2.step(th).unwrap().0);
+            e3 = wrap_angle(th - t3.step(th).unwrap().0);
+        }
+        // Type 2: α/Ki (Ki = 33,551 s⁻²: 0.089 rad); type 3: none after 1 s.
+        let (_, ki) = c.gains();
+        assert!((e2 - alpha / ki).abs() < 0.05 * alpha / ki, "{e2}");
+        assert!(e3.abs() < 1e-6, "{e3}");
+    }
+
+    #[test]
+    fn acceleration_feed_forward_removes_the_transient_lag() {
+        let (ts, alpha) = (1e-4, 3000.0);
+        let c = TrackerConfig::<f64>::new(60.0, ts);
+        let mut plain = TypeTwoTracker::with_load_pole(c, 0.5).unwrap();
+        let mut fed = TypeTwoTracker::with_load_pole(c, 0.5).unwrap();
+        fed.set_acceleration(alpha);
+        let (mut worst_plain, mut worst_fed): (f64, f64) = (0.0, 0.0);
+        for n in 1..=2000 {
+            // The angle integrates the speed over each sample; the tracker's ω̂ advances by
+            // Ts·α per sample as the rotor's does.
+            let th = accelerating(alpha, n, ts);
+            worst_plain = worst_plain.max(wrap_angle(th - plain.step(th).unwrap().0).abs());
+            worst_fed = worst_fed.max(wrap_angle(th - fed.step(th).unwrap().0).abs());
+        }
+        assert!(worst_plain > 0.03, "{worst_plain}");
+        // Only the discretisation of the ramp (half a sample of α·Ts) remains.
+        assert!(worst_fed < 1e-3, "{worst_fed}");
+        // A wrong feed-forward (Ĵ 30 % low, or a load) is a constant acceleration the third
+        // integrator takes up: the error decays to zero.
+        let mut off = TypeTwoTracker::with_load_pole(c, 0.5).unwrap();
+        off.set_acceleration(1.3 * alpha);
+        let mut e = 0.0;
+        for n in 1..=20_000 {
+            let th = accelerating(alpha, n, ts);
+            e = wrap_angle(th - off.step(th).unwrap().0);
+        }
+        assert!(e.abs() < 1e-6, "{e}");
+    }
+
+    #[test]
+    fn type_three_discrete_loop_is_stable_and_refuses_a_fast_pole() {
+        let ts = 1e-4;
+        let c = TrackerConfig::<f64>::new(60.0, ts);
+        let mut t = TypeTwoTracker::with_load_pole(c, 0.5).unwrap();
+        // Impulse response of the angle loop: a 0.1 rad step of the measurement settles.
+        let mut e = 0.0;
+        for _ in 0..5000 {
+            e = 0.1 - t.step(0.1).unwrap().0;
+        }
+        assert!(e.abs() < 1e-9 && t.speed().abs() < 1e-6, "{e}");
+        let fast = TrackerConfig::<f64>::new(800.0, ts);
+        assert!(TypeTwoTracker::with_load_pole(fast, 4.0).is_err());
+        assert!(TypeTwoTracker::with_load_pole(c, -1.0).is_err());
     }
 }

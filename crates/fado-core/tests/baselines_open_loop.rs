@@ -8,7 +8,7 @@ mod common;
 use common::*;
 use fado_core::baselines::{
     EmfObserverConfig, EmfObserverEstimator, LpfIntegratorConfig, LpfIntegratorEstimator,
-    OrtegaConfig, OrtegaEstimator,
+    OrtegaConfig, OrtegaEstimator, OrtegaSettings,
 };
 use fado_core::{Ab, Dq, MachineModel, RotorAngleEstimator, wrap_angle};
 
@@ -151,7 +151,7 @@ fn lpf_turns_a_dc_voltage_error_into_the_predicted_ripple() {
     // A DC integrand error ε leaves ψ_dc = ε/ωc, compensated to ε/ωc·(1 − jωc/ω): an angle
     // ripple asin(|δλ|/λf) at the fundamental, passed to θ̂ with the tracker gain |T(jω)|.
     let cfg = LpfIntegratorConfig::<f64>::for_machine(&MachineModel::paper());
-    let wc = core::f64::consts::TAU * cfg.cutoff_hz;
+    let wc = core::f64::consts::TAU * cfg.settings.cutoff_hz;
     let eps = Ab::new(0.03, -0.04); // 50 mV
     for rpm in [300.0, -300.0] {
         let w = electrical_speed(rpm);
@@ -168,7 +168,7 @@ fn emf_observer_turns_a_dc_voltage_error_into_the_predicted_ripple() {
     // ε passes the rotating filter with gain p/√(p² + ω²) and is divided by ω; the ripple
     // reaches θ̂ through the tracker loop whose damping the filter's ω̂ feedback reduces.
     let cfg = EmfObserverConfig::<f64>::for_machine(&MachineModel::paper());
-    let p = core::f64::consts::TAU * cfg.emf_bandwidth_hz;
+    let p = core::f64::consts::TAU * cfg.settings.emf_bandwidth_hz;
     let eps = Ab::new(0.3, 0.4); // 0.5 V
     for rpm in [300.0, -300.0] {
         let w = electrical_speed(rpm);
@@ -236,17 +236,20 @@ fn ortega_flux_linkage_error_gives_the_predicted_angle_error_and_adaptation_remo
     for ratio in [0.9, 1.1] {
         for rpm in [300.0, -300.0] {
             let w = electrical_speed(rpm);
-            let cfg = OrtegaConfig {
-                flux_linkage_hat: ratio * LF,
-                ..OrtegaConfig::for_machine(&MachineModel::paper())
-            };
+            let cfg = OrtegaConfig::for_machine(&MachineModel {
+                flux_linkage: ratio * LF,
+                ..MachineModel::paper()
+            });
             let mut est = OrtegaEstimator::new(cfg).unwrap();
             let err = settled_error(&mut est, rpm, Dq::new(0.0, 10.0), 1.5, 0.3, Ab::zero());
             let predicted = ortega_steady_angle(w, cfg.scheduled_bandwidth(w), LF, ratio * LF);
             assert_close("ortega λ̂f error", err, predicted, 0.05);
             // With the VESC-style adaptation (κ = 0.2) λ̂ converges to λf and the error goes.
             let mut est = OrtegaEstimator::new(OrtegaConfig {
-                flux_adaptation_ratio: 0.2,
+                settings: OrtegaSettings {
+                    flux_adaptation_ratio: 0.2,
+                    ..cfg.settings
+                },
                 ..cfg
             })
             .unwrap();
@@ -268,8 +271,11 @@ fn ortega_fixed_gain_loses_lock_where_predicted_and_the_schedule_keeps_it() {
     // and the estimate slips poles periodically; the default schedule (ω_obs = 2|ω|) keeps lock
     // at three times it, with the predicted error.
     let fixed = OrtegaConfig::<f64> {
-        observer_speed_ratio: 0.0,
-        observer_bandwidth: 2.0 * core::f64::consts::TAU * 20.0,
+        settings: OrtegaSettings {
+            observer_speed_ratio: 0.0,
+            observer_bandwidth: 2.0 * core::f64::consts::TAU * 20.0,
+            ..OrtegaConfig::for_machine(&MachineModel::paper()).settings
+        },
         ..OrtegaConfig::for_machine(&MachineModel::paper())
     };
     for (rpm, iq) in [(90.0, 14.2), (-90.0, -14.2)] {
@@ -277,7 +283,7 @@ fn ortega_fixed_gain_loses_lock_where_predicted_and_the_schedule_keeps_it() {
         let uq_per_x = -RS * iq;
         let delta_for = |x: f64| 1.0 - ((LF + x * uq_per_x / w) / LF).powi(2);
         // Bisect the first-order limit δ(x) = ω²/ω_obs².
-        let limit = (w / fixed.observer_bandwidth).powi(2);
+        let limit = (w / fixed.settings.observer_bandwidth).powi(2);
         let (mut lo, mut hi) = (0.0, 0.1);
         for _ in 0..60 {
             let mid = 0.5 * (lo + hi);
@@ -292,7 +298,10 @@ fn ortega_fixed_gain_loses_lock_where_predicted_and_the_schedule_keeps_it() {
         let i_dq = Dq::new(0.0, iq);
         let run = |cfg: OrtegaConfig<f64>, x: f64, seconds: f64| {
             let mut est = OrtegaEstimator::new(OrtegaConfig {
-                rs_hat: RS * (1.0 + x),
+                machine: MachineModel {
+                    rs: RS * (1.0 + x),
+                    ..cfg.machine
+                },
                 ..cfg
             })
             .unwrap();
@@ -301,7 +310,7 @@ fn ortega_fixed_gain_loses_lock_where_predicted_and_the_schedule_keeps_it() {
         let a = |x: f64| LF + x * uq_per_x / w;
         // Half the limit: the predicted equilibrium.
         let x = 0.5 * x_limit;
-        let predicted = ortega_steady_angle(w, fixed.observer_bandwidth, a(x), LF);
+        let predicted = ortega_steady_angle(w, fixed.settings.observer_bandwidth, a(x), LF);
         assert_close(
             "ortega fixed gain, ½ limit",
             run(fixed, x, 4.0),
@@ -310,7 +319,10 @@ fn ortega_fixed_gain_loses_lock_where_predicted_and_the_schedule_keeps_it() {
         );
         // Three times the limit: a pole slip (the error passes through ±π) within 6 s.
         let mut est = OrtegaEstimator::new(OrtegaConfig {
-            rs_hat: RS * (1.0 + 3.0 * x_limit),
+            machine: MachineModel {
+                rs: RS * (1.0 + 3.0 * x_limit),
+                ..fixed.machine
+            },
             ..fixed
         })
         .unwrap();

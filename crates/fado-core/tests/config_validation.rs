@@ -405,17 +405,17 @@ fn run_all<T: Real>(failures: &mut Vec<String>, machine: MachineModel<T>) -> usi
         LpfIntegratorConfig::<T>::for_machine(&machine),
         |c| ok(LpfIntegratorEstimator::new(c)),
         &fields!(LpfIntegratorConfig<T>, T;
-            ts: Positive,
-            rs_hat: NonNegative,
-            lq_hat: NonNegative,
-            flux_linkage_hat: Positive,
-            cutoff_hz: NonNegativeBounded,
-            compensation_floor_hz: Positive,
-            t2s1_bandwidth_hz: PositiveBounded,
-            t2s2_bandwidth_hz: PositiveBounded,
-            tracker_damping: Positive,
-            tracker_hold_ratio: NonNegativeBounded,
-            initial_angle: Signed,
+            common.ts: Positive,
+            machine.rs: NonNegative,
+            machine.lq: NonNegative,
+            machine.flux_linkage: Positive,
+            settings.cutoff_hz: NonNegativeBounded,
+            settings.compensation_floor_hz: Positive,
+            common.t2s1_bandwidth_hz: PositiveBounded,
+            common.t2s2_bandwidth_hz: PositiveBounded,
+            common.tracker_damping: Positive,
+            common.tracker_hold_ratio: NonNegativeBounded,
+            common.initial_angle: Signed,
         ),
     );
     n += probe(
@@ -424,19 +424,19 @@ fn run_all<T: Real>(failures: &mut Vec<String>, machine: MachineModel<T>) -> usi
         OrtegaConfig::<T>::for_machine(&machine),
         |c| ok(OrtegaEstimator::new(c)),
         &fields!(OrtegaConfig<T>, T;
-            ts: Positive,
-            rs_hat: NonNegative,
-            lq_hat: NonNegative,
-            flux_linkage_hat: Positive,
-            observer_bandwidth: PositiveBounded,
-            observer_speed_ratio: NonNegative,
-            observer_bandwidth_min: PositiveBounded,
-            flux_adaptation_ratio: NonNegative,
-            t2s1_bandwidth_hz: PositiveBounded,
-            t2s2_bandwidth_hz: PositiveBounded,
-            tracker_damping: Positive,
-            tracker_hold_ratio: NonNegativeBounded,
-            initial_angle: Signed,
+            common.ts: Positive,
+            machine.rs: NonNegative,
+            machine.lq: NonNegative,
+            machine.flux_linkage: Positive,
+            settings.observer_bandwidth: PositiveBounded,
+            settings.observer_speed_ratio: NonNegative,
+            settings.observer_bandwidth_min: PositiveBounded,
+            settings.flux_adaptation_ratio: NonNegative,
+            common.t2s1_bandwidth_hz: PositiveBounded,
+            common.t2s2_bandwidth_hz: PositiveBounded,
+            common.tracker_damping: Positive,
+            common.tracker_hold_ratio: NonNegativeBounded,
+            common.initial_angle: Signed,
         ),
     );
     n += probe(
@@ -445,17 +445,17 @@ fn run_all<T: Real>(failures: &mut Vec<String>, machine: MachineModel<T>) -> usi
         EmfObserverConfig::<T>::for_machine(&machine),
         |c| ok(EmfObserverEstimator::new(c)),
         &fields!(EmfObserverConfig<T>, T;
-            ts: Positive,
-            rs_hat: NonNegative,
-            lq_hat: NonNegative,
-            flux_linkage_hat: Positive,
-            emf_bandwidth_hz: PositiveBounded,
-            speed_floor_hz: Positive,
-            t2s1_bandwidth_hz: PositiveBounded,
-            t2s2_bandwidth_hz: PositiveBounded,
-            tracker_damping: Positive,
-            tracker_hold_ratio: NonNegativeBounded,
-            initial_angle: Signed,
+            common.ts: Positive,
+            machine.rs: NonNegative,
+            machine.lq: NonNegative,
+            machine.flux_linkage: Positive,
+            settings.emf_bandwidth_hz: PositiveBounded,
+            settings.speed_floor_hz: Positive,
+            common.t2s1_bandwidth_hz: PositiveBounded,
+            common.t2s2_bandwidth_hz: PositiveBounded,
+            common.tracker_damping: Positive,
+            common.tracker_hold_ratio: NonNegativeBounded,
+            common.initial_angle: Signed,
         ),
     );
     n
@@ -604,23 +604,17 @@ fn bandwidths_above_what_the_sampling_rate_allows_are_refused() {
     );
     assert_eq!(drive(|c| c.tuning.speed_bandwidth_hz = 150.0), "");
     // Baselines.
-    let lpf = LpfIntegratorConfig::<f64> {
-        cutoff_hz: 1600.0,
-        ..LpfIntegratorConfig::for_machine(&MachineModel::paper())
-    };
+    let mut lpf = LpfIntegratorConfig::<f64>::for_machine(&MachineModel::paper());
+    lpf.settings.cutoff_hz = 1600.0;
     assert_eq!(refused_field(LpfIntegratorEstimator::new(lpf)), "cutoff_hz");
-    let emf = EmfObserverConfig::<f64> {
-        emf_bandwidth_hz: 1600.0,
-        ..EmfObserverConfig::for_machine(&MachineModel::paper())
-    };
+    let mut emf = EmfObserverConfig::<f64>::for_machine(&MachineModel::paper());
+    emf.settings.emf_bandwidth_hz = 1600.0;
     assert_eq!(
         refused_field(EmfObserverEstimator::new(emf)),
         "emf_bandwidth_hz"
     );
-    let ortega = OrtegaConfig::<f64> {
-        observer_bandwidth: 1.0e4,
-        ..OrtegaConfig::for_machine(&MachineModel::paper())
-    };
+    let mut ortega = OrtegaConfig::<f64>::for_machine(&MachineModel::paper());
+    ortega.settings.observer_bandwidth = 1.0e4;
     assert_eq!(
         refused_field(OrtegaEstimator::new(ortega)),
         "observer_bandwidth"

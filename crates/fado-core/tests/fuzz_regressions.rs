@@ -147,20 +147,29 @@ fn baselines_align_with_an_overflowing_current_start_finite() {
     }
     let lq = 28527.0 * 1e31;
     run(OrtegaEstimator::new(OrtegaConfig {
-        lq_hat: lq,
-        observer_bandwidth_min: 285.27,
-        flux_adaptation_ratio: 28527.0 * 1e31,
-        ..OrtegaConfig::for_machine(&MachineModel::paper())
+        settings: fado_core::baselines::OrtegaSettings {
+            observer_bandwidth_min: 285.27,
+            flux_adaptation_ratio: 28527.0 * 1e31,
+            ..Default::default()
+        },
+        ..OrtegaConfig::for_machine(&MachineModel {
+            lq,
+            ..MachineModel::paper()
+        })
     })
     .unwrap());
-    run(LpfIntegratorEstimator::new(LpfIntegratorConfig {
-        lq_hat: lq,
-        ..LpfIntegratorConfig::for_machine(&MachineModel::paper())
-    })
-    .unwrap());
-    run(EmfObserverEstimator::new(EmfObserverConfig {
-        lq_hat: lq,
-        ..EmfObserverConfig::for_machine(&MachineModel::paper())
-    })
-    .unwrap());
+    run(
+        LpfIntegratorEstimator::new(LpfIntegratorConfig::for_machine(&MachineModel {
+            lq,
+            ..MachineModel::paper()
+        }))
+        .unwrap(),
+    );
+    run(
+        EmfObserverEstimator::new(EmfObserverConfig::for_machine(&MachineModel {
+            lq,
+            ..MachineModel::paper()
+        }))
+        .unwrap(),
+    );
 }

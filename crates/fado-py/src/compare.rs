@@ -10,6 +10,13 @@ use pyo3::types::{PyDict, PyList};
 
 use crate::errors::config_error_message;
 
+/// The estimators `compare` runs by default, in its order: the names of the simulator's
+/// registry ([`fado_sim::estimators::ESTIMATORS`]).
+#[pyfunction]
+pub fn estimators() -> Vec<&'static str> {
+    fado_sim::estimators::names()
+}
+
 /// Runs every estimator in every scenario on the same plant, seed and controllers and
 /// returns one dict per (scenario, estimator), scenario-major.
 ///

@@ -157,10 +157,14 @@ impl PyEstimatorConfig {
     /// `config` as given to `fado.estimate`/`fado.Estimator`: `None` (the defaults), an
     /// `EstimatorConfig`, or a `dict` as `fado.simulate` takes it: flat tuning keys
     /// (`{"k_df": 1.0}`), the `[estimator]` table (`{"estimator": {"k_df": 1.0}}`) or dotted
-    /// keys (`{"estimator.k_df": 1.0}`). The other tables of a simulator configuration
-    /// (`simulation`, `controller`, …) do not concern the estimator and are skipped; any other
-    /// key raises `ConfigError` naming it.
-    pub fn from_argument(py: Python<'_>, config: Option<&Bound<'_, PyAny>>) -> PyResult<Self> {
+    /// keys (`{"estimator.k_df": 1.0}`). Any other key raises `ConfigError` naming it; a
+    /// table of the simulator's configuration (`motor`, `simulation`, …) names the functions
+    /// that take it (`function` is the caller's name, `estimate`).
+    pub fn from_argument(
+        py: Python<'_>,
+        config: Option<&Bound<'_, PyAny>>,
+        function: &str,
+    ) -> PyResult<Self> {
         let Some(config) = config.filter(|c| !c.is_none()) else {
             return Ok(Self::default());
         };
@@ -212,8 +216,13 @@ impl PyEstimatorConfig {
             } else if let Some(k) = key.strip_prefix("estimator.") {
                 put(k, &key, value)?;
             } else if value.cast::<PyDict>().is_ok() || key.contains('.') {
-                // Another table of a simulator configuration: not the estimator's.
-                continue;
+                // Another table of a simulator configuration: not this function's.
+                let section = key.split('.').next().unwrap_or(&key);
+                return Err(config_error_message(
+                    py,
+                    &key,
+                    not_used(function, &key, section),
+                ));
             } else {
                 put(&key, &key, value)?;
             }
@@ -229,6 +238,28 @@ impl PyEstimatorConfig {
         let made = Self::default().with_changes(py, Some(&kwargs), &shown);
         made.map_err(|e| renamed(py, e, &shown_as))
     }
+}
+
+/// Why `key` (of the simulator's table `section`) is refused by `function` (`estimate`,
+/// `Estimator`), which takes only the estimator's settings, and which functions take it.
+fn not_used(function: &str, key: &str, section: &str) -> String {
+    let takers = match section {
+        "motor" | "model" => {
+            "the machine is this function's `machine=` argument (a fado.Machine, a preset name or \
+             a dict of Machine fields); a `motor` table is the plant of fado.simulate, \
+             fado.sweep and fado.commission"
+        }
+        "simulation" | "speed_reference" | "inverter" | "current_sensor" | "dc_link_sensor"
+        | "load" | "controller" | "baselines" | "mismatch" | "inverter_model" | "faults" => {
+            "it is a table of the simulator's configuration, which fado.simulate, fado.sweep and \
+             fado.commission take"
+        }
+        _ => "it is no table fado knows",
+    };
+    format!(
+        "`{key}` is not used by fado.{function}, whose config takes the estimator's settings \
+         only (flat, an `estimator` table or `estimator.` keys): {takers}"
+    )
 }
 
 /// A `ConfigError` on a field the user gave as `estimator.<field>` (nested or dotted), named

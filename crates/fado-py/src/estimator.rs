@@ -77,11 +77,17 @@ impl Setup {
         initial_angle: f64,
     ) -> PyResult<Self> {
         let machine = PyMachine::from_argument(py, machine, "machine", function)?;
-        let tuning = PyEstimatorConfig::from_argument(py, config)?;
+        let tuning = PyEstimatorConfig::from_argument(py, config, function)?;
+        let ts = finite(py, "ts", ts)?;
+        // The sampling period against the machine's rated speed (a period in ms given as
+        // s is refused naming `ts`), before any gain derived from it is refused instead.
+        if ts > 0.0 {
+            crate::machine::check_plausible(py, &machine.to_core(), Some(ts))?;
+        }
         Ok(Self {
             machine,
             tuning,
-            ts: finite(py, "ts", ts)?,
+            ts,
             initial_angle,
         })
     }

@@ -47,7 +47,7 @@ pub mod _fado {
     #[pymodule_export]
     use super::commission::{CommissionResult, commission};
     #[pymodule_export]
-    use super::compare::compare;
+    use super::compare::{compare, estimators};
     #[pymodule_export]
     use super::config::PyEstimatorConfig;
     #[pymodule_export]

@@ -24,6 +24,28 @@ pub fn preset_names() -> Vec<&'static str> {
 /// The one field of `MachineModel` outside its serde record (the inverter's in TOML).
 const DC_VOLTAGE: &str = "dc_voltage";
 
+/// The fields a `Machine` derives from its ratings when they are not given, by the rules of
+/// `fado_core::ratings` (the same as `fado-sim`'s `[motor]` table).
+const DERIVED: [&str; 2] = ["inertia", "viscous_friction"];
+
+/// Raises a `UserWarning` per plausibility warning of `m` (`fado_core::machine_checks`),
+/// with `ts` the sampling period when known; the first error as `ConfigError` naming its key.
+pub fn check_plausible(py: Python<'_>, m: &MachineModel<f64>, ts: Option<f64>) -> PyResult<()> {
+    let findings = fado_core::machine_checks::check(m, ts);
+    if let Some(e) = findings.error() {
+        return Err(config_error_message(py, e.key(), e.to_string()));
+    }
+    for w in findings.warnings() {
+        PyErr::warn(
+            py,
+            &py.get_type::<pyo3::exceptions::PyUserWarning>(),
+            &std::ffi::CString::new(w.to_string()).unwrap_or_default(),
+            2,
+        )?;
+    }
+    Ok(())
+}
+
 /// The field names, in `MachineModel` order (`dc_voltage` last).
 pub fn field_names(py: Python<'_>) -> PyResult<Vec<String>> {
     let mut names = record::field_names(py, &MachineModel::<f64>::default())?;
@@ -34,7 +56,10 @@ pub fn field_names(py: Python<'_>) -> PyResult<Vec<String>> {
 /// The motor's parameters and ratings, as the drive models it (SI units, per phase,
 /// amplitude-invariant peak values; the rated speed in r/min).
 ///
-/// Every argument is keyword-only and required except `viscous_friction` (default 0).
+/// Every argument is keyword-only and required except `inertia` and `viscous_friction`,
+/// which default to the values the ratings give (`fado_core::ratings`: the rated torque
+/// reaches the rated speed in 0.15 s; friction 1 % of the rated torque at rated speed), as
+/// in a `fado-sim` motor file.
 /// Its fields (`Machine.fields`) are documented in the type stub and in the Rust documentation
 /// of `MachineModel`. `Machine.paper()` is the paper's motor, `Machine.preset(name)` a motor of the repository's
 /// `motors/` folder (`fado.machine_presets()`). Instances are immutable; `replace(**changes)`
@@ -70,6 +95,41 @@ impl PyMachine {
         Ok(Self::from_core(&m))
     }
 
+    /// `fields` with [`DERIVED`] fields that are absent or `None` set from the ratings given
+    /// (`fado_core::ratings`); left out when the ratings are missing (the constructor then
+    /// names the missing rating).
+    fn with_derived<'py>(
+        py: Python<'py>,
+        fields: Option<&Bound<'py, PyDict>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let out = match fields {
+            Some(f) => f.copy()?,
+            None => PyDict::new(py),
+        };
+        let rating = |k: &str| -> Option<f64> {
+            let v = out.get_item(k).ok()??;
+            let x: f64 = crate::record::plain_number(py, &v).ok()?.extract().ok()?;
+            (x.is_finite() && x > 0.0).then_some(x)
+        };
+        let ratings = rating("rated_torque").zip(rating("rated_speed_rpm"));
+        for key in DERIVED {
+            if out.get_item(key)?.is_some_and(|v| v.is_none()) {
+                out.del_item(key)?;
+            }
+            if out.contains(key)? {
+                continue;
+            }
+            if let Some((torque, speed)) = ratings {
+                let value = match key {
+                    "inertia" => fado_core::ratings::inertia(torque, speed),
+                    _ => fado_core::ratings::viscous_friction(torque, speed),
+                };
+                out.set_item(key, value)?;
+            }
+        }
+        Ok(out)
+    }
+
     /// `base` with `changes` applied, validated. When `constructing`, a field the core refuses
     /// that the caller did not give is a missing required keyword: `TypeError` naming it.
     fn changed(
@@ -92,6 +152,7 @@ impl PyMachine {
             // Outside the serde record: the round trip left it at the empty record's value.
             model.dc_voltage = dc_voltage;
             if let Some(v) = dc_given {
+                let v = crate::record::plain_number(py, &v)?;
                 model.dc_voltage = v.extract().map_err(|_| {
                     pyo3::exceptions::PyTypeError::new_err(format!(
                         "`{DC_VOLTAGE}` must be a number (V), got {}",
@@ -102,6 +163,10 @@ impl PyMachine {
                     ))
                 })?;
             }
+        }
+        // The cross-checks first: their errors name every field involved.
+        if let Some(e) = fado_core::machine_checks::check(&model, None).error() {
+            return Err(config_error_message(py, e.key(), e.to_string()));
         }
         if let Err(e) = model.validate() {
             let given = match changes {
@@ -116,6 +181,7 @@ impl PyMachine {
             }
             return Err(config_error(py, e));
         }
+        check_plausible(py, &model, None)?;
         Ok(Self { model })
     }
 
@@ -192,13 +258,18 @@ impl PyMachine {
         Ok(dict)
     }
 
-    /// The constructor's keywords for [`record::install`]: a field is optional, with the
-    /// empty record's value as its default, when the paper's motor with that value is still
-    /// valid (`viscous_friction = 0`); every other field is required.
+    /// The constructor's keywords for [`record::install`]: the fields derived from the
+    /// ratings ([`DERIVED`]) default to `None` (derived); a field is optional, with the empty
+    /// record's value as its default, when the paper's motor with that value is still valid;
+    /// every other field is required.
     pub fn signature(py: Python<'_>) -> PyResult<Vec<(String, Option<Bound<'_, PyAny>>)>> {
         let empty = Self::from_core(&MachineModel::default()).items(py)?;
         let mut params = Vec::new();
         for name in field_names(py)? {
+            if DERIVED.contains(&name.as_str()) {
+                params.push((name, Some(py.None().into_bound(py))));
+                continue;
+            }
             let value = empty.get_item(&name)?.ok_or_else(|| {
                 pyo3::exceptions::PyRuntimeError::new_err(format!("no field {name}"))
             })?;
@@ -216,7 +287,8 @@ impl PyMachine {
     #[new]
     #[pyo3(signature = (**fields))]
     fn py_new(py: Python<'_>, fields: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
-        Self::changed(py, &MachineModel::default(), fields, true)
+        let fields = Self::with_derived(py, fields)?;
+        Self::changed(py, &MachineModel::default(), Some(&fields), true)
     }
 
     /// A copy with the given fields changed (validated like the constructor).

@@ -45,6 +45,30 @@ pub fn field_names<T: Serialize>(py: Python<'_>, value: &T) -> PyResult<Vec<Stri
         .collect()
 }
 
+/// `value` as a plain Python number when it is a number of another type (a numpy scalar such
+/// as `np.float32(0.3)` or `np.int64(4)`, registered with the `numbers` ABCs): an `int` for
+/// an integral one, a `float` for a real one; any other value unchanged.
+pub fn plain_number<'py>(
+    py: Python<'py>,
+    value: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyAny>> {
+    if value.is_instance_of::<PyFloat>()
+        || value.is_instance_of::<PyInt>()
+        || value.is_instance_of::<PyBool>()
+        || value.is_instance_of::<PyString>()
+    {
+        return Ok(value.clone());
+    }
+    let numbers = py.import("numbers")?;
+    if value.is_instance(&numbers.getattr("Integral")?)? {
+        return value.call_method0("__index__");
+    }
+    if value.is_instance(&numbers.getattr("Real")?)? {
+        return Ok(PyFloat::new(py, value.extract::<f64>()?).into_any());
+    }
+    Ok(value.clone())
+}
+
 /// The JSON-representable Python value of field `field`, or `ConfigError` naming it (a
 /// non-finite number, or anything but a bool, int, float or str).
 fn plain_value<'py>(py: Python<'py>, field: &str, value: &Bound<'py, PyAny>) -> PyResult<()> {
@@ -115,6 +139,7 @@ where
                 "unexpected keyword argument `{name}`: not {kind}; one of {fields:?}"
             )));
         }
+        let value = plain_number(py, &value)?;
         plain_value(py, &name, &value)?;
         // Each field alone first, so that a serde refusal names its field.
         let one = PyDict::new(py);

@@ -108,7 +108,8 @@ struct Finished {
 pub(crate) enum Motor {
     /// A preset of `motors/`: its whole file (`[motor]`, `[inverter]`) over the defaults.
     Preset(&'static fado_sim::presets::Preset),
-    /// A machine: `[motor]` and `[inverter] dc_voltage`.
+    /// A machine: `[motor]` and `[inverter] dc_voltage`, the other `[inverter]` keys its
+    /// ratings give derived (`SimConfig::for_machine`).
     Machine(fado_core::MachineModel<f64>),
 }
 
@@ -148,11 +149,8 @@ impl Motor {
         match self {
             Motor::Preset(p) => p.config(),
             Motor::Machine(m) => {
-                let mut c = SimConfig {
-                    motor: *m,
-                    ..SimConfig::default()
-                };
-                c.inverter.dc_voltage = m.dc_voltage;
+                // The inverter keys the machine's ratings give, derived as for a motor file.
+                let c = SimConfig::for_machine(m);
                 // Errors name the TOML key the machine's field became (`motor.rs`).
                 c.validate()?;
                 Ok(c)

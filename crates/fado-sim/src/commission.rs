@@ -198,8 +198,8 @@ pub fn commission(
     let mut cfg = CommissioningConfig::for_machine(nameplate, ts, plant_params.inverter.dead_time);
     cfg.switching_frequency = plant_params.inverter.switching_frequency;
     adjust(&mut cfg);
-    let mut proc = Commissioning::new(cfg)
-        .map_err(|e| SimConfigError::new(e.field(), e.to_string()).in_section("commissioning"))?;
+    let mut proc = Commissioning::new(cfg).map_err(|e| procedure_error(&e))?;
+    preconditions(plant_params, &cfg)?;
     let pp = plant_params.motor.pole_pairs as f64;
     let rpm = 60.0 / std::f64::consts::TAU;
     let start = Instant::now();
@@ -272,6 +272,68 @@ pub fn commission(
         rotor_motion_inductance: motion,
         cancelled,
     })
+}
+
+/// A refusal of the procedure's configuration, named by the key the user writes: the
+/// nameplate's fields are `[motor]`'s (the DC link `[inverter]`'s), the timing and dead time
+/// `[inverter]`'s; only the procedure's own settings are `commissioning.*`.
+fn procedure_error(e: &fado_core::ConfigError) -> SimConfigError {
+    let field = e.field();
+    let key = match field {
+        "dc_voltage" | "switching_frequency" | "dead_time" => format!("inverter.{field}"),
+        "sample_period" | "ts" => "inverter.switching_frequency".to_owned(),
+        "rs" | "ld" | "lq" | "flux_linkage" | "pole_pairs" | "inertia" | "viscous_friction"
+        | "rated_current" | "rated_speed_rpm" | "rated_torque" => format!("motor.{field}"),
+        other => format!("commissioning.{other}"),
+    };
+    SimConfigError::new(key, e.to_string())
+}
+
+/// Largest ADC step of the current sensor as a fraction of the procedure's current limit:
+/// 1 % (the injection and DC levels are fractions of that limit; the default 12-bit sensor
+/// has 0.22 %).
+pub const MAX_CURRENT_LSB_RATIO: f64 = 0.01;
+
+/// The procedure's preconditions, checked before it runs (it never reports `passed` on a
+/// set-up it cannot measure): the rotor turns at most `fado_core::ratings::MAX_OMEGA_TS` per
+/// sample at rated speed (the estimator's and the identification's discretisation, see
+/// `fado_core::ratings`), and the current sensor resolves 1 % of the procedure's current
+/// limit ([`MAX_CURRENT_LSB_RATIO`]). The ratings themselves are required by the motor file
+/// (`crate::derive`). Errors name the key to change and the value that passes.
+pub fn preconditions(
+    plant: &PlantParams,
+    cfg: &CommissioningConfig<f64>,
+) -> Result<(), SimConfigError> {
+    let m = &cfg.nameplate;
+    let x = m.rated_speed() * cfg.sample_period;
+    if x > fado_core::ratings::MAX_OMEGA_TS * (1.0 + 1e-9) {
+        let f = fado_core::ratings::switching_frequency(m.pole_pairs, m.rated_speed_rpm);
+        return Err(SimConfigError::new(
+            "inverter.switching_frequency",
+            format!(
+                "the rotor turns ω_rated·Ts = {x:.3} rad per sample at rated speed, more than                  the {} the estimator's discretisation is accurate to 0.5 % at (the identified                  parameters would be off by up to {:.1} %): commissioning needs                  switching_frequency ≥ {f} Hz for this motor",
+                fado_core::ratings::MAX_OMEGA_TS,
+                100.0 * (1.0 - (0.5 * x).cos())
+            ),
+        ));
+    }
+    let sensor = &plant.current_sensor;
+    if sensor.enable_quantization {
+        let full_scale = sensor.adc_full_scale_ratio * m.rated_current;
+        let lsb = 2.0 * full_scale / 2f64.powi(sensor.adc_bits.min(62) as i32);
+        let limit = cfg.current_limit_ratio * m.rated_current;
+        if lsb > MAX_CURRENT_LSB_RATIO * limit {
+            return Err(SimConfigError::new(
+                "current_sensor.adc_bits",
+                format!(
+                    "the current sensor's step {lsb:.3e} A ({} bits over ±{full_scale:.3e} A)                      is {:.1} % of the commissioning's current limit {limit:.3e} A; it must                      resolve 1 % (more bits, or a smaller adc_full_scale_ratio)",
+                    sensor.adc_bits,
+                    100.0 * lsb / limit
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// The configuration document `input` with its `[model]` table replaced by the identified

@@ -31,56 +31,10 @@ use serde::Serialize;
 
 use crate::config::EstimatorKind;
 use crate::error::SimConfigError;
+use crate::estimators::{self, ESTIMATORS, Estimator};
 use crate::inverter::InverterModel;
 use crate::scenario::{self, Check, LevelStats, SCENARIOS};
 use crate::sim::Trace;
-
-/// One compared estimator: a kind the drive can run, and for fado whether R̂s is held fixed as
-/// in the paper (`fado-fixed-rs`) instead of adapted (fado's default).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Contender {
-    /// `[estimator] kind`.
-    pub kind: EstimatorKind,
-    /// fado only: `[estimator] rs_adaptation = false`.
-    pub fixed_rs: bool,
-}
-
-impl Contender {
-    /// The estimator with its default settings.
-    pub const fn of(kind: EstimatorKind) -> Self {
-        Self {
-            kind,
-            fixed_rs: false,
-        }
-    }
-
-    /// Its name in tables (`fado`, `fado-fixed-rs`, `lpf-integrator`, ...).
-    pub fn name(self) -> &'static str {
-        match (self.kind, self.fixed_rs) {
-            (EstimatorKind::Fado, true) => "fado-fixed-rs",
-            (kind, _) => estimator_name(kind),
-        }
-    }
-}
-
-impl From<EstimatorKind> for Contender {
-    fn from(kind: EstimatorKind) -> Self {
-        Self::of(kind)
-    }
-}
-
-/// Every estimator compared by default: fado (with its R̂s adaptation), fado as the paper has
-/// it (fixed R̂s), then the baselines.
-pub const ESTIMATORS: [Contender; 5] = [
-    Contender::of(EstimatorKind::Fado),
-    Contender {
-        kind: EstimatorKind::Fado,
-        fixed_rs: true,
-    },
-    Contender::of(EstimatorKind::LpfIntegrator),
-    Contender::of(EstimatorKind::Ortega),
-    Contender::of(EstimatorKind::EmfObserver),
-];
 
 /// Checks that read fado's own internal signals (D̂, FLAG_limit): a baseline has no such
 /// signal and fails them by construction, so `passed_common` leaves them out.
@@ -90,36 +44,19 @@ const FADO_ONLY_CHECKS: [&str; 3] = [
     "FLAG_limit fraction of the hold",
 ];
 
-/// The estimator's name as `RotorAngleEstimator::name` gives it (`lpf-integrator`).
-pub fn estimator_name(kind: EstimatorKind) -> &'static str {
-    match kind {
-        EstimatorKind::Fado => "fado",
-        EstimatorKind::LpfIntegrator => "lpf-integrator",
-        EstimatorKind::Ortega => "ortega",
-        EstimatorKind::EmfObserver => "emf-observer",
-    }
-}
-
 /// Parses an estimator name, with `-` or `_` (`lpf-integrator`, `emf_observer`,
-/// `fado-fixed-rs`).
-pub fn parse_estimator(name: &str) -> Result<Contender, SimConfigError> {
-    let wanted = name.trim().replace('_', "-");
-    ESTIMATORS
-        .into_iter()
-        .find(|c| c.name() == wanted)
-        .ok_or_else(|| {
-            let names: Vec<_> = ESTIMATORS.into_iter().map(Contender::name).collect();
-            SimConfigError::new("estimators", format!("unknown `{name}`; one of {names:?}"))
-        })
+/// `fado-fixed-rs`): a row of [`ESTIMATORS`].
+pub fn parse_estimator(name: &str) -> Result<&'static Estimator, SimConfigError> {
+    estimators::parse("estimators", name)
 }
 
 /// What to compare.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CompareOptions {
-    /// Scenario names. Default: all of [`SCENARIOS`].
+    /// Scenario names. Default: all of [`SCENARIOS`] but the neutral `custom`.
     pub scenarios: Vec<String>,
-    /// Estimators. Default: [`ESTIMATORS`].
-    pub estimators: Vec<Contender>,
+    /// Estimators. Default: all of [`ESTIMATORS`].
+    pub estimators: Vec<&'static Estimator>,
     /// Force the averaged inverter model (fast) instead of the switching-resolved one.
     pub averaged: bool,
     /// TOML applied over every scenario's configuration (its `[estimator] kind` is replaced
@@ -135,8 +72,12 @@ pub struct CompareOptions {
 impl Default for CompareOptions {
     fn default() -> Self {
         Self {
-            scenarios: SCENARIOS.iter().map(|s| s.name.to_owned()).collect(),
-            estimators: ESTIMATORS.to_vec(),
+            scenarios: SCENARIOS
+                .iter()
+                .filter(|s| !s.neutral)
+                .map(|s| s.name.to_owned())
+                .collect(),
+            estimators: ESTIMATORS.iter().collect(),
             averaged: false,
             config_toml: None,
             threads: 2,
@@ -150,7 +91,7 @@ impl Default for CompareOptions {
 pub struct CompareRow {
     /// Scenario name.
     pub scenario: String,
-    /// Estimator name ([`estimator_name`]).
+    /// Estimator name ([`Estimator::name`]).
     pub estimator: String,
     /// All of the scenario's criteria passed.
     pub passed: bool,
@@ -254,10 +195,8 @@ pub fn compare(opts: &CompareOptions) -> Result<Comparison, SimConfigError> {
         let base = scenario::scenario_config(name, opts.config_toml.as_deref(), opts.averaged)?;
         for &contender in &opts.estimators {
             let mut cfg = base.clone();
-            cfg.simulation.estimator = contender.kind;
-            if contender.fixed_rs {
-                cfg.estimator.rs_adaptation = false;
-            }
+            cfg.simulation.estimator = EstimatorKind::of(contender);
+            (contender.prepare)(&mut cfg);
             cfg.validate()?;
             jobs.push((name.clone(), contender, cfg));
         }
@@ -281,7 +220,7 @@ pub fn compare(opts: &CompareOptions) -> Result<Comparison, SimConfigError> {
                         break;
                     };
                     let row = scenario::run_config(name, cfg.clone(), None)
-                        .map(|o| row_of(name, *contender, o, opts.keep_traces));
+                        .map(|o| row_of(name, contender, o, opts.keep_traces));
                     results.lock().expect("a compare worker panicked")[k] = Some(row);
                 }
             });
@@ -308,14 +247,14 @@ pub fn compare(opts: &CompareOptions) -> Result<Comparison, SimConfigError> {
 
 fn row_of(
     scenario: &str,
-    contender: Contender,
+    contender: &Estimator,
     o: scenario::Outcome,
     keep_trace: bool,
 ) -> CompareRow {
     let m = &o.metrics;
     CompareRow {
         scenario: scenario.to_owned(),
-        estimator: contender.name().to_owned(),
+        estimator: contender.name.to_owned(),
         passed: o.passed,
         passed_common: o
             .checks
@@ -341,13 +280,16 @@ fn row_of(
 /// Reads criterion's saved estimate of `<name>_step_f32` (benches/baselines.rs) for every
 /// estimator from `criterion_dir` (`target/criterion`): the median's point estimate and its
 /// confidence interval, in ns. Estimators without saved estimates are left out.
-pub fn read_criterion_step_costs(criterion_dir: &Path, estimators: &[Contender]) -> Vec<StepCost> {
+pub fn read_criterion_step_costs(
+    criterion_dir: &Path,
+    estimators: &[&'static Estimator],
+) -> Vec<StepCost> {
     estimators
         .iter()
-        .filter_map(|&k| {
-            let name = k.name();
+        .filter_map(|k| {
+            let name = k.name;
             let path = criterion_dir
-                .join(format!("{name}_step_f32"))
+                .join(k.bench())
                 .join("new")
                 .join("estimates.json");
             let text = std::fs::read_to_string(&path).ok()?;
@@ -376,11 +318,11 @@ impl Comparison {
         self.summarise(&kinds);
     }
 
-    fn summarise(&mut self, estimators: &[Contender]) {
+    fn summarise(&mut self, estimators: &[&'static Estimator]) {
         self.summary = estimators
             .iter()
-            .map(|&k| {
-                let name = k.name();
+            .map(|k| {
+                let name = k.name;
                 let rows: Vec<_> = self.rows.iter().filter(|r| r.estimator == name).collect();
                 EstimatorSummary {
                     estimator: name.to_owned(),
@@ -590,43 +532,16 @@ mod tests {
     use super::*;
 
     #[test]
-    fn estimator_names_round_trip_and_match_the_core_names() {
-        use fado_core::RotorAngleEstimator;
-        use fado_core::baselines::*;
-        for k in ESTIMATORS {
-            assert_eq!(parse_estimator(k.name()).unwrap(), k);
+    fn estimator_names_parse_with_either_separator() {
+        for e in ESTIMATORS {
+            assert_eq!(parse_estimator(e.name).unwrap(), e);
+            assert_eq!(parse_estimator(&e.key()).unwrap(), e);
         }
         assert_eq!(
-            parse_estimator("emf_observer").unwrap(),
-            EstimatorKind::EmfObserver.into()
+            parse_estimator("fado_fixed_rs").unwrap().name,
+            "fado-fixed-rs"
         );
-        assert!(parse_estimator("fado_fixed_rs").unwrap().fixed_rs);
         assert_eq!(parse_estimator("kalman").unwrap_err().key, "estimators");
-        let m = fado_core::MachineModel::paper();
-        let core = [
-            fado_core::SensorlessEstimator::<f64>::new(fado_core::EstimatorConfig::for_machine(&m))
-                .unwrap()
-                .name(),
-            LpfIntegratorEstimator::<f64>::new(LpfIntegratorConfig::for_machine(&m))
-                .unwrap()
-                .name(),
-            OrtegaEstimator::<f64>::new(OrtegaConfig::for_machine(&m))
-                .unwrap()
-                .name(),
-            EmfObserverEstimator::<f64>::new(EmfObserverConfig::for_machine(&m))
-                .unwrap()
-                .name(),
-        ];
-        let kinds = [
-            EstimatorKind::Fado,
-            EstimatorKind::LpfIntegrator,
-            EstimatorKind::Ortega,
-            EstimatorKind::EmfObserver,
-        ];
-        assert_eq!(
-            core.map(|n| n.to_owned()),
-            kinds.map(estimator_name).map(str::to_owned)
-        );
     }
 
     #[test]
@@ -640,7 +555,8 @@ mod tests {
                 "median":{"confidence_interval":{"confidence_level":0.95,"lower_bound":40.5,"upper_bound":41.5},"point_estimate":41.0,"standard_error":0.2}}"#,
         )
         .unwrap();
-        let costs = read_criterion_step_costs(&dir, &ESTIMATORS);
+        let all: Vec<_> = ESTIMATORS.iter().collect();
+        let costs = read_criterion_step_costs(&dir, &all);
         std::fs::remove_dir_all(&dir).unwrap();
         assert_eq!(costs.len(), 1, "only ortega has estimates");
         assert_eq!(costs[0].estimator, "ortega");

@@ -13,14 +13,22 @@
 //! given directly: they are the plant's times the `[mismatch]` ratios, so "matched" stays
 //! matched when the motor changes.
 
+use std::sync::Arc;
+
 use fado_core::control::{DeadTimeMethod, DriveConfig, DriveTuning};
+use fado_core::magnetics::Saturation;
 use fado_core::{EstimatorConfig, EstimatorTuning, MachineModel};
 use serde::{Deserialize, Serialize};
 
+use crate::criteria::Criteria;
+use crate::dc_link::DcLinkParams;
 use crate::error::{SimConfigError, check};
+pub use crate::estimators::EstimatorKind;
+use crate::estimators::{check_baseline_keys, default_baselines};
 use crate::faults::FaultParams;
 use crate::inverter::InverterParams;
 use crate::load::LoadParams;
+use crate::magnetics::PlantMagnetics;
 use crate::motor::MotorParams;
 use crate::profile::Profile;
 use crate::sensors::{CurrentSensorParams, DcLinkSensorParams};
@@ -52,6 +60,10 @@ pub struct SimulationSettings {
     pub estimator: EstimatorKind,
     /// Windows `[t_off, t_on]` in s during which the k_df feedback is switched off (Fig. 9).
     pub disturbance_feedback_off: Vec<[f64; 2]>,
+    /// A holding brake holds the rotor from the start until the drive reports ready (its
+    /// calibrations over, gates on); the load acts on the brake until then (a hoist, a
+    /// vehicle on a slope). Default false.
+    pub brake: bool,
 }
 
 impl Default for SimulationSettings {
@@ -64,8 +76,9 @@ impl Default for SimulationSettings {
             eval_start: 0.0,
             zero_speed_band_ratio: 0.02,
             precision: Precision::F64,
-            estimator: EstimatorKind::Fado,
+            estimator: EstimatorKind::FADO,
             disturbance_feedback_off: Vec::new(),
+            brake: false,
         }
     }
 }
@@ -107,65 +120,6 @@ pub enum Precision {
     F64,
     /// f32, as on the paper's TMS320F28335 (single-precision FPU).
     F32,
-}
-
-/// Which rotor-angle estimator the drive runs.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum EstimatorKind {
-    /// The paper's estimator (`fado_core::SensorlessEstimator`).
-    #[default]
-    Fado,
-    /// Baseline: compensated low-pass integrator (`fado_core::LpfIntegratorEstimator`).
-    LpfIntegrator,
-    /// Baseline: Ortega–Praly nonlinear flux observer (`fado_core::OrtegaEstimator`).
-    Ortega,
-    /// Baseline: extended-EMF observer (`fado_core::EmfObserverEstimator`).
-    EmfObserver,
-}
-
-/// The tuning of the reference observers (`[simulation] estimator = "lpf_integrator"`,
-/// `"ortega"`, `"emf_observer"`); their model estimates are the drive's `[model]` and their
-/// trackers use `[estimator]`'s settings. Defaults as in `fado_core::baselines`.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct BaselineSettings {
-    /// LPF baseline: cut-off of 1/(s + ωc), Hz. Default as `LpfIntegratorConfig`.
-    pub lpf_cutoff_hz: f64,
-    /// LPF baseline: speed below which its gain/phase compensation is frozen, Hz.
-    pub lpf_compensation_floor_hz: f64,
-    /// Ortega baseline: observer gain, s⁻¹ (when not scheduled on speed).
-    pub ortega_observer_bandwidth: f64,
-    /// Ortega baseline: gain scheduled as this × |ω̂| (0 = fixed gain).
-    pub ortega_observer_speed_ratio: f64,
-    /// Ortega baseline: lower bound of the scheduled gain, s⁻¹.
-    pub ortega_observer_bandwidth_min: f64,
-    /// Ortega baseline: λ̂f adaptation gain ratio (0 = off).
-    pub ortega_flux_adaptation_ratio: f64,
-    /// EMF baseline: observer bandwidth, Hz.
-    pub emf_bandwidth_hz: f64,
-    /// EMF baseline: speed below which the angle is held, Hz.
-    pub emf_speed_floor_hz: f64,
-}
-
-impl Default for BaselineSettings {
-    fn default() -> Self {
-        // The tuning defaults do not depend on the machine: any valid one reads them out.
-        let m = MachineModel::<f64>::paper();
-        let lpf = fado_core::baselines::LpfIntegratorConfig::for_machine(&m);
-        let ortega = fado_core::baselines::OrtegaConfig::for_machine(&m);
-        let emf = fado_core::baselines::EmfObserverConfig::for_machine(&m);
-        Self {
-            lpf_cutoff_hz: lpf.cutoff_hz,
-            lpf_compensation_floor_hz: lpf.compensation_floor_hz,
-            ortega_observer_bandwidth: ortega.observer_bandwidth,
-            ortega_observer_speed_ratio: ortega.observer_speed_ratio,
-            ortega_observer_bandwidth_min: ortega.observer_bandwidth_min,
-            ortega_flux_adaptation_ratio: ortega.flux_adaptation_ratio,
-            emf_bandwidth_hz: emf.emf_bandwidth_hz,
-            emf_speed_floor_hz: emf.speed_floor_hz,
-        }
-    }
 }
 
 /// `[inverter_model]`: what the drive's dead-time compensation is told of the inverter, as
@@ -266,8 +220,11 @@ pub struct SimConfig {
     pub controller: DriveTuning<f64>,
     /// Estimator tuning (`fado_core::EstimatorTuning`).
     pub estimator: EstimatorTuning<f64>,
-    /// Tuning of the reference observers.
-    pub baselines: BaselineSettings,
+    /// Settings of the reference observers, one table per baseline of
+    /// [`crate::estimators::ESTIMATORS`] (`[baselines.ortega]`, ...); their machine model is
+    /// the drive's `[model]` and their shared settings (trackers, sample bounds) are
+    /// `[estimator]`'s.
+    pub baselines: toml::Table,
     /// The drive's model of the plant as ratios to the true values.
     pub mismatch: Mismatch,
     /// The drive's model of the motor, key by key (same keys as `[motor]`); a key not given is
@@ -281,6 +238,22 @@ pub struct SimConfig {
     pub inverter_model: Option<InverterModel>,
     /// Injected faults (`crate::faults`). Default none.
     pub faults: FaultParams,
+    /// The DC link behind the inverter (`crate::dc_link`). Default a stiff source.
+    #[serde(skip_serializing_if = "is_default")]
+    pub dc_link: DcLinkParams,
+    /// The user's pass criteria (`crate::criteria`): all the `custom` scenario judges, and
+    /// judged after their own by the others. Default none.
+    #[serde(skip_serializing_if = "Criteria::is_empty")]
+    pub criteria: Criteria,
+    /// The keys the configuration file left out whose values were derived from the motor's
+    /// ratings (`crate::derive`), with their rules; not a TOML table.
+    #[serde(skip)]
+    pub derived: Vec<crate::derive::Derived>,
+    /// The plant's saturating magnetics, `[motor.saturation]` (the algebraic model of
+    /// [`fado_core::magnetics::Saturation`]); None: the constant inductances of `[motor]`,
+    /// whose `ld`, `lq` and `flux_linkage` then stay the datasheet's (the drive's default model).
+    #[serde(skip)]
+    pub motor_saturation: Option<Saturation<f64>>,
 }
 
 impl Default for SimConfig {
@@ -297,11 +270,15 @@ impl Default for SimConfig {
             load: LoadParams::default(),
             controller: DriveTuning::default(),
             estimator: EstimatorTuning::default(),
-            baselines: BaselineSettings::default(),
+            baselines: default_baselines(),
             mismatch: Mismatch::default(),
             model: None,
             inverter_model: None,
             faults: FaultParams::default(),
+            dc_link: DcLinkParams::default(),
+            criteria: Criteria::default(),
+            derived: Vec::new(),
+            motor_saturation: None,
         }
     }
 }
@@ -322,6 +299,10 @@ impl SimConfig {
             dc_link_sensor: self.dc_link_sensor.clone(),
             load: self.load.clone(),
             faults: self.faults.clone(),
+            dc_link: self.dc_link.clone(),
+            magnetics: self
+                .motor_saturation
+                .map(|s| Arc::new(PlantMagnetics::Saturation(s))),
         }
     }
 
@@ -334,6 +315,20 @@ impl SimConfig {
         self.speed_reference
             .validate()
             .map_err(|e| e.in_section("speed_reference"))?;
+        // The machine's cross-checks, with every key involved named (before the single-key
+        // refusals of the plant's and the model's validation).
+        if let Some((_, key, text)) = self
+            .machine_findings()
+            .into_iter()
+            .find(|(s, ..)| *s == fado_core::machine_checks::Severity::Error)
+        {
+            return Err(SimConfigError::new(key, text));
+        }
+        if let Some(sat) = &self.motor_saturation {
+            sat.validate().map_err(|e| {
+                SimConfigError::new(format!("motor.saturation.{}", e.field()), e.to_string())
+            })?;
+        }
         self.plant().validate()?;
         let rows = self.simulation.duration
             / self.inverter.sample_period()
@@ -347,6 +342,9 @@ impl SimConfig {
         self.mismatch
             .validate()
             .map_err(|e| e.in_section("mismatch"))?;
+        self.criteria
+            .validate()
+            .map_err(|e| e.in_section("criteria"))?;
         if let Some(im) = &self.inverter_model {
             im.validate().map_err(|e| e.in_section("inverter_model"))?;
         }
@@ -366,9 +364,10 @@ impl SimConfig {
             .map_err(|e| self.core_error("estimator", e))?;
         // Every key is checked whichever estimator runs: NaN in an unused key is still an
         // error in the file.
-        self.lpf_estimator()?;
-        self.ortega_estimator()?;
-        self.emf_estimator()?;
+        check_baseline_keys(&self.baselines)?;
+        for e in crate::estimators::ESTIMATORS {
+            (e.check)(self)?;
+        }
         self.drive_config()
             .validate()
             .map_err(|e| self.core_error("controller", e))?;
@@ -525,18 +524,7 @@ impl SimConfig {
             };
             return SimConfigError::new(key, format!("{e}{note}"));
         }
-        let (section, own) = match field {
-            "cutoff_hz" => ("baselines", "lpf_cutoff_hz"),
-            "compensation_floor_hz" => ("baselines", "lpf_compensation_floor_hz"),
-            "observer_bandwidth" => ("baselines", "ortega_observer_bandwidth"),
-            "observer_speed_ratio" => ("baselines", "ortega_observer_speed_ratio"),
-            "observer_bandwidth_min" => ("baselines", "ortega_observer_bandwidth_min"),
-            "flux_adaptation_ratio" => ("baselines", "ortega_flux_adaptation_ratio"),
-            "emf_bandwidth_hz" => ("baselines", "emf_bandwidth_hz"),
-            "speed_floor_hz" => ("baselines", "emf_speed_floor_hz"),
-            other => (section, other),
-        };
-        SimConfigError::new(format!("{section}.{own}"), e.to_string())
+        SimConfigError::new(format!("{section}.{field}"), e.to_string())
     }
 
     /// "Near zero speed" in r/min: `zero_speed_band_ratio` × the motor's rated speed.
@@ -546,30 +534,161 @@ impl SimConfig {
 
     /// This configuration as a TOML document.
     pub fn to_toml(&self) -> String {
-        toml::to_string(self).expect("every field of SimConfig is representable in TOML")
+        let Some(sat) = &self.motor_saturation else {
+            return toml::to_string(self)
+                .expect("every field of SimConfig is representable in TOML");
+        };
+        let mut table = toml::Table::try_from(self).expect("SimConfig is a TOML table");
+        if let Some(toml::Value::Table(motor)) = table.get_mut("motor") {
+            let sat = toml::Table::try_from(sat).expect("Saturation is a TOML table");
+            motor.insert("saturation".into(), toml::Value::Table(sat));
+        }
+        toml::to_string(&table).expect("every field of SimConfig is representable in TOML")
     }
 
-    /// Parses a complete or partial TOML document on top of `base`: tables merge, values and
-    /// arrays replace. The result is validated. Errors name the key.
+    /// Parses a partial TOML document on top of `base`, an explicit configuration (a
+    /// scenario's with the user's motor, a sweep point's): tables merge, values and arrays
+    /// replace, so `[motor]\nrs = 0.5` changes one key of `base`'s motor. The result is
+    /// validated. Errors name the key.
     pub fn from_toml_over(base: &SimConfig, text: &str) -> Result<SimConfig, SimConfigError> {
-        let user: toml::Table = text.parse().map_err(|e| located(text, e))?;
+        Self::parse_over(base, text, false)
+    }
+
+    /// Parses a user's configuration file on top of `base`: as
+    /// [`from_toml_over`](Self::from_toml_over), except that a `[motor]` table describes the
+    /// whole motor — every circuit key and rating required, the others derived from the
+    /// ratings with the `[inverter]` keys they give (`crate::derive`), none taken from
+    /// `base`'s motor.
+    pub fn from_user_toml(base: &SimConfig, text: &str) -> Result<SimConfig, SimConfigError> {
+        Self::parse_over(base, text, true)
+    }
+
+    fn parse_over(
+        base: &SimConfig,
+        text: &str,
+        whole_motor: bool,
+    ) -> Result<SimConfig, SimConfigError> {
+        let mut user: toml::Table = text.parse().map_err(|e| located(text, e))?;
+        let saturation = take_saturation(&mut user).map_err(|e| e.located_in(text))?;
         // Check the user's document on its own first, so that errors (unknown keys, wrong
         // types) name the key the user wrote and point at it.
-        toml::from_str::<SimConfig>(text).map_err(|e| located(text, e))?;
+        if saturation.is_some() {
+            SimConfig::deserialize(toml::Value::Table(user.clone()))
+                .map_err(|e| key_error(e).located_in(text))?;
+        } else {
+            toml::from_str::<SimConfig>(text).map_err(|e| located(text, e))?;
+        }
+        let derived = if whole_motor {
+            crate::derive::complete_motor(&mut user, text)?
+        } else {
+            Vec::new()
+        };
+        let given = user.clone();
         let mut merged = toml::Table::try_from(base)
             .map_err(|e| SimConfigError::new("<base>", e.to_string()))?;
         merge(&mut merged, user);
         let mut cfg = SimConfig::deserialize(toml::Value::Table(merged))
             .map_err(|e| key_error(e).located_in(text))?;
+        // What `base` derived stays derived unless the document gives it now.
+        cfg.derived = base
+            .derived
+            .iter()
+            .filter(|d| {
+                let (section, key) = d.key.split_once('.').unwrap_or(("", ""));
+                !given
+                    .get(section)
+                    .and_then(|t| t.as_table())
+                    .is_some_and(|t| t.contains_key(key))
+            })
+            .filter(|d| !derived.iter().any(|n| n.key == d.key))
+            .cloned()
+            .collect();
+        cfg.derived.extend(derived);
         // `[motor]` has no DC link of its own (it is the inverter's).
         cfg.motor.dc_voltage = cfg.inverter.dc_voltage;
+        cfg.motor_saturation = saturation.or(base.motor_saturation);
         cfg.validate().map_err(|e| e.located_in(text))?;
         Ok(cfg)
     }
 
-    /// Parses a TOML document over the defaults.
+    /// Parses a user's TOML document over the defaults (see
+    /// [`from_user_toml`](Self::from_user_toml)).
     pub fn from_toml(text: &str) -> Result<SimConfig, SimConfigError> {
-        Self::from_toml_over(&SimConfig::default(), text)
+        Self::from_user_toml(&SimConfig::default(), text)
+    }
+
+    /// The defaults with `machine` as the motor and its `dc_voltage` as the DC link; the
+    /// other `[inverter]` keys its ratings give are derived (`crate::derive`) and recorded.
+    pub fn for_machine(machine: &MachineModel<f64>) -> SimConfig {
+        let mut c = SimConfig {
+            motor: *machine,
+            ..SimConfig::default()
+        };
+        let mut given = toml::Table::new();
+        given.insert("dc_voltage".into(), toml::Value::Float(machine.dc_voltage));
+        c.inverter.dc_voltage = machine.dc_voltage;
+        for (key, value) in crate::derive::inverter_values(machine, &given) {
+            match key {
+                "switching_frequency" => c.inverter.switching_frequency = value,
+                "dead_time" => c.inverter.dead_time = value,
+                "threshold_voltage" => c.inverter.threshold_voltage = value,
+                "current_band" => c.inverter.current_band = value,
+                _ => continue,
+            }
+            let full = format!("inverter.{key}");
+            c.derived.push(crate::derive::Derived {
+                rule: fado_core::ratings::rule(&full).unwrap_or(""),
+                key: full,
+                value,
+            });
+        }
+        c
+    }
+
+    /// This configuration as TOML with each derived key's rule beside it (`--dump-config`).
+    pub fn to_toml_annotated(&self) -> String {
+        crate::derive::annotate(&self.to_toml(), &self.derived)
+    }
+
+    /// The plausibility findings of the motor against its ratings, the DC link and the
+    /// sampling period (`fado_core::machine_checks`), each with its message naming the TOML
+    /// keys involved: errors first.
+    pub fn machine_findings(&self) -> Vec<(fado_core::machine_checks::Severity, String, String)> {
+        let m = MachineModel {
+            dc_voltage: self.inverter.dc_voltage,
+            ..self.motor
+        };
+        fado_core::machine_checks::check(&m, Some(self.inverter.sample_period()))
+            .iter()
+            .map(|f| {
+                let mut text = f.to_string();
+                for k in f.keys() {
+                    let full = plant_key(k);
+                    text = text.replace(&format!("`{k}`"), &format!("`{full}`"));
+                }
+                (f.severity(), plant_key(f.key()), text)
+            })
+            .collect()
+    }
+
+    /// The plausibility warnings of [`machine_findings`](Self::machine_findings), as
+    /// `key: message` lines.
+    pub fn warnings(&self) -> Vec<String> {
+        self.machine_findings()
+            .into_iter()
+            .filter(|(s, ..)| *s == fado_core::machine_checks::Severity::Warning)
+            .map(|(_, _, text)| text)
+            .collect()
+    }
+}
+
+/// The TOML key of a machine-check field: `[inverter]`'s for the DC link and the sampling
+/// period, `[motor]`'s otherwise.
+fn plant_key(field: &str) -> String {
+    match field {
+        "dc_voltage" => "inverter.dc_voltage".to_owned(),
+        "ts" => "inverter.switching_frequency".to_owned(),
+        k => format!("motor.{k}"),
     }
 }
 
@@ -602,6 +721,20 @@ fn check_time_constant(
     ))
 }
 
+/// Takes `[motor.saturation]` out of the user's document (`[motor]` itself is
+/// [`MachineModel`], whose keys are the linear machine's), parsed.
+fn take_saturation(user: &mut toml::Table) -> Result<Option<Saturation<f64>>, SimConfigError> {
+    let Some(toml::Value::Table(motor)) = user.get_mut("motor") else {
+        return Ok(None);
+    };
+    let Some(table) = motor.remove("saturation") else {
+        return Ok(None);
+    };
+    Saturation::<f64>::deserialize(table)
+        .map(Some)
+        .map_err(|e| key_error(e).in_section("motor.saturation"))
+}
+
 fn merge(base: &mut toml::Table, over: toml::Table) {
     for (k, v) in over {
         match (base.get_mut(&k), v) {
@@ -631,7 +764,7 @@ fn located(text: &str, e: toml::de::Error) -> SimConfigError {
 }
 
 /// A serde error from a `toml::Value` carries "in `path`"; unknown fields name the field.
-fn key_error(e: toml::de::Error) -> SimConfigError {
+pub(crate) fn key_error(e: toml::de::Error) -> SimConfigError {
     let msg = e.to_string();
     let path = msg
         .split("in `")
@@ -794,12 +927,42 @@ mod located_errors {
         assert_eq!((key.as_str(), line), ("simulation.decimation", 2));
     }
 
+    /// The paper's motor as a whole `[motor]` table whose first key is `first` (which
+    /// replaces the paper's value of that key).
+    pub(crate) fn paper_motor_with(first: &str) -> String {
+        let key = first.split('=').next().unwrap_or("").trim();
+        let m = MachineModel::<f64>::paper();
+        let mut text = format!("[motor]\n{first}\n");
+        for (k, v) in [
+            ("rs", m.rs),
+            ("ld", m.ld),
+            ("lq", m.lq),
+            ("flux_linkage", m.flux_linkage),
+            ("pole_pairs", m.pole_pairs as f64),
+            ("inertia", m.inertia),
+            ("viscous_friction", m.viscous_friction),
+            ("rated_current", m.rated_current),
+            ("rated_speed_rpm", m.rated_speed_rpm),
+            ("rated_torque", m.rated_torque),
+        ] {
+            if k != key {
+                if k == "pole_pairs" {
+                    text.push_str(&format!("{k} = {}\n", v as u32));
+                } else {
+                    text.push_str(&format!("{k} = {v:?}\n"));
+                }
+            }
+        }
+        text.push_str("[inverter]\ndc_voltage = 311.0\nswitching_frequency = 5000.0\n");
+        text
+    }
+
     #[test]
     fn derived_limits_name_the_users_own_key() {
         // Issue 15's probes: before, each was refused as `controller.current_anti_windup_ratio`.
-        let (key, line, col, _) = err("[motor]\nrs = 1e300\n");
+        let (key, line, col, _) = err(&paper_motor_with("rs = 1e300"));
         assert_eq!((key.as_str(), line, col), ("motor.rs", 2, 6));
-        let (key, line, _, _) = err("[motor]\nld = 1e-300\n");
+        let (key, line, _, _) = err(&paper_motor_with("ld = 1e-300"));
         assert_eq!((key.as_str(), line), ("motor.ld", 2));
         let (key, line, _, _) = err("[mismatch]\nrs_ratio = 1e300\n");
         assert_eq!((key.as_str(), line), ("mismatch.rs_ratio", 2));
@@ -835,6 +998,46 @@ mod located_errors {
         );
         let (key, ..) = err("[inverter_model]\ndead_time = 1e-6\n");
         assert_eq!(key, "inverter_model.dead_time");
+    }
+
+    /// A baseline's settings are its table `[baselines.<name>]`; errors name the key there,
+    /// and a setting in the old flat place is refused with its new one.
+    #[test]
+    fn baseline_settings_live_in_their_own_tables() {
+        let cfg = SimConfig::from_toml(
+            "[simulation]\nestimator = \"ortega\"\n[baselines.ortega]\nobserver_speed_ratio = 0.0\n",
+        )
+        .unwrap();
+        assert_eq!(cfg.simulation.estimator.name(), "ortega");
+        assert_eq!(
+            cfg.baselines["ortega"]["observer_speed_ratio"].as_float(),
+            Some(0.0)
+        );
+        // The other settings of the table keep their defaults (tables merge).
+        assert!(cfg.baselines["ortega"].get("observer_bandwidth").is_some());
+        assert_eq!(SimConfig::from_toml(&cfg.to_toml()).unwrap(), cfg);
+        let (key, line, col, _) = err("[baselines.ortega]\nobserver_bandwidth = -1.0\n");
+        assert_eq!(
+            (key.as_str(), line, col),
+            ("baselines.ortega.observer_bandwidth", 2, 22)
+        );
+        let (key, line, _, _) = err("[baselines.lpf_integrator]\ncutoff = 1.0\n");
+        assert_eq!((key.as_str(), line), ("baselines.lpf_integrator.cutoff", 2));
+        let (key, line, _, msg) = err("[baselines]\nlpf_cutoff_hz = 3.0\n");
+        assert_eq!((key.as_str(), line), ("baselines.lpf_cutoff_hz", 2));
+        assert!(
+            msg.contains("`cutoff_hz` in `[baselines.lpf_integrator]`"),
+            "{msg}"
+        );
+        let (key, _, _, msg) = err("[baselines.kalman]\ngain = 1.0\n");
+        assert_eq!(key, "baselines.kalman");
+        assert!(msg.contains("ortega"), "{msg}");
+        let (key, line, _, msg) = err("[simulation]\nestimator = \"kalman\"\n");
+        assert_eq!((key.as_str(), line), ("simulation.estimator", 2));
+        assert!(msg.contains("lpf_integrator"), "{msg}");
+        // A machine-model field a baseline refuses is named by the user's own key.
+        let e = SimConfig::from_toml("[motor]\nflux_linkage = 0.0\n").unwrap_err();
+        assert!(e.key.starts_with("motor."), "{e}");
     }
 
     #[test]
@@ -879,4 +1082,38 @@ mod dead_time_method {
         assert_eq!(method(Plant::Averaged, Sign), Sign);
         assert_eq!(method(Plant::SwitchingResolved, Trapezoidal), Trapezoidal);
     }
+
+    #[test]
+    fn motor_saturation_is_read_checked_and_written_back() {
+        let text =
+            "[motor.saturation]\na_d0 = 380.2\na_q0 = 380.2\npsi_f = 0.088\na_qq = 1e5\nt = 2\n";
+        let cfg = SimConfig::from_toml(text).unwrap();
+        let sat = cfg.motor_saturation.unwrap();
+        assert_eq!((sat.a_qq, sat.t, sat.psi_f), (1e5, 2.0, 0.088));
+        assert!(cfg.plant().magnetics.is_some());
+        // --dump-config round trip keeps it.
+        let back = SimConfig::from_toml(&cfg.to_toml()).unwrap();
+        assert_eq!(back.motor_saturation, cfg.motor_saturation);
+        // Without the table the plant keeps its constant inductances.
+        assert!(SimConfig::default().plant().magnetics.is_none());
+        // Errors name the key and point at it.
+        let e =
+            SimConfig::from_toml("[motor.saturation]\na_d0 = 380.2\na_q0 = -1.0\n").unwrap_err();
+        assert_eq!(e.key, "motor.saturation.a_q0", "{e}");
+        assert_eq!(e.location.as_ref().map(|l| l.line), Some(3), "{e}");
+        let e =
+            SimConfig::from_toml("[motor.saturation]\na_d0 = 380.2\na_qqq = 1.0\n").unwrap_err();
+        assert!(e.key.starts_with("motor.saturation"), "{e}");
+        assert!(e.to_string().contains("a_qqq"), "{e}");
+        let e = SimConfig::from_toml(
+            "[motor]\nrs = -1.0\n[motor.saturation]\na_d0 = 1.0\na_q0 = 1.0\n",
+        )
+        .unwrap_err();
+        assert_eq!(e.key, "motor.rs", "{e}");
+    }
+}
+
+/// Whether `x` is its type's default (sections left out of the written TOML when untouched).
+fn is_default<T: Default + PartialEq>(x: &T) -> bool {
+    *x == T::default()
 }

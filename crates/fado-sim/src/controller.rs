@@ -64,4 +64,28 @@ pub trait Controller {
     fn handle(&mut self, _event: ControlEvent) {}
     /// Short name for tables.
     fn name(&self) -> &str;
+    /// The controller holds the rotor and runs: its start-up (calibrations) is over, its
+    /// gates are on and it has not tripped. A plant brake (`simulation.brake`) releases at the
+    /// first sample this is true. Default: always (controllers without a start-up).
+    fn ready(&self) -> bool {
+        true
+    }
+}
+
+/// A boxed controller (an estimator chosen at run time from
+/// [`crate::estimators::ESTIMATORS`]) is a controller.
+impl<C: Controller + ?Sized> Controller for Box<C> {
+    fn align(&mut self, theta0: f64) {
+        (**self).align(theta0);
+    }
+    #[inline]
+    fn step(&mut self, m: &Measurements) -> Actuation {
+        (**self).step(m)
+    }
+    fn handle(&mut self, event: ControlEvent) {
+        (**self).handle(event);
+    }
+    fn name(&self) -> &str {
+        (**self).name()
+    }
 }

@@ -5,38 +5,17 @@ use fado_core::{Ab, Abc, Diagnostics, Dq, Estimate, RotorAngleEstimator};
 
 use crate::controller::{Actuation, ControlEvent, Controller, Measurements};
 
-/// Estimators whose k_df feedback can be switched at run time (Fig. 9).
-pub trait DisturbanceFeedbackSwitch {
-    /// Enables or disables k_df.
-    fn set_disturbance_feedback(&mut self, enabled: bool);
-}
-
-impl<T: fado_core::Real> DisturbanceFeedbackSwitch for fado_core::SensorlessEstimator<T> {
-    fn set_disturbance_feedback(&mut self, enabled: bool) {
-        self.set_disturbance_feedback_enabled(enabled);
-    }
-}
-
-/// The baselines have no k_df: the Fig. 9 event does nothing to them.
-macro_rules! no_disturbance_feedback {
-    ($($t:ty),*) => {$(
-        impl DisturbanceFeedbackSwitch for $t {
-            fn set_disturbance_feedback(&mut self, _enabled: bool) {}
-        }
-    )*};
-}
-no_disturbance_feedback!(
-    fado_core::LpfIntegratorEstimator<f64>,
-    fado_core::OrtegaEstimator<f64>,
-    fado_core::EmfObserverEstimator<f64>
-);
-
 impl<E> Controller for SensorlessDrive<f64, E>
 where
-    E: RotorAngleEstimator<f64> + DisturbanceFeedbackSwitch,
+    E: RotorAngleEstimator<f64>,
 {
     fn align(&mut self, theta0: f64) {
         SensorlessDrive::align(self, theta0);
+    }
+
+    fn ready(&self) -> bool {
+        let last = self.last();
+        !self.is_calibrating() && !self.is_calibrating_gain() && last.gates_enabled && !last.tripped
     }
 
     #[inline]
@@ -59,7 +38,7 @@ where
     fn handle(&mut self, event: ControlEvent) {
         match event {
             ControlEvent::DisturbanceFeedback(on) => {
-                self.estimator_mut().set_disturbance_feedback(on)
+                RotorAngleEstimator::set_disturbance_feedback(self.estimator_mut(), on)
             }
         }
     }
@@ -86,89 +65,6 @@ impl SimConfig {
         let drive_cfg = self.drive_config();
         SensorlessDrive::with_estimator(drive_cfg, estimator)
             .map_err(|e| self.core_error("controller", e))
-    }
-
-    /// The compensated-LPF baseline of this configuration.
-    pub fn lpf_estimator(&self) -> Result<fado_core::LpfIntegratorEstimator<f64>, SimConfigError> {
-        let e = self.estimator_config();
-        let s = &self.baselines;
-        fado_core::LpfIntegratorEstimator::new(fado_core::baselines::LpfIntegratorConfig {
-            ts: e.ts,
-            rs_hat: e.machine.rs,
-            lq_hat: e.machine.lq,
-            flux_linkage_hat: e.machine.flux_linkage,
-            cutoff_hz: s.lpf_cutoff_hz,
-            compensation_floor_hz: s.lpf_compensation_floor_hz,
-            t2s1_bandwidth_hz: e.tuning.t2s1_bandwidth_hz,
-            t2s2_bandwidth_hz: e.tuning.t2s2_bandwidth_hz,
-            tracker_damping: e.tuning.tracker_damping,
-            bandwidth_definition: e.tuning.bandwidth_definition,
-            tracker_hold_ratio: e.tuning.tracker_hold_ratio,
-            average_current: e.tuning.average_current,
-            rated_current: e.machine.rated_current,
-            dc_voltage: e.machine.dc_voltage,
-            plausible_current_ratio: e.tuning.plausible_current_ratio,
-            plausible_voltage_ratio: e.tuning.plausible_voltage_ratio,
-            plausible_current_step_ratio: e.tuning.plausible_current_step_ratio,
-            initial_angle: e.initial_angle,
-        })
-        .map_err(|e| self.core_error("estimator", e))
-    }
-
-    /// The Ortega–Praly baseline of this configuration.
-    pub fn ortega_estimator(&self) -> Result<fado_core::OrtegaEstimator<f64>, SimConfigError> {
-        let e = self.estimator_config();
-        let s = &self.baselines;
-        fado_core::OrtegaEstimator::new(fado_core::baselines::OrtegaConfig {
-            ts: e.ts,
-            rs_hat: e.machine.rs,
-            lq_hat: e.machine.lq,
-            flux_linkage_hat: e.machine.flux_linkage,
-            observer_bandwidth: s.ortega_observer_bandwidth,
-            observer_speed_ratio: s.ortega_observer_speed_ratio,
-            observer_bandwidth_min: s.ortega_observer_bandwidth_min,
-            flux_adaptation_ratio: s.ortega_flux_adaptation_ratio,
-            t2s1_bandwidth_hz: e.tuning.t2s1_bandwidth_hz,
-            t2s2_bandwidth_hz: e.tuning.t2s2_bandwidth_hz,
-            tracker_damping: e.tuning.tracker_damping,
-            bandwidth_definition: e.tuning.bandwidth_definition,
-            tracker_hold_ratio: e.tuning.tracker_hold_ratio,
-            average_current: e.tuning.average_current,
-            rated_current: e.machine.rated_current,
-            dc_voltage: e.machine.dc_voltage,
-            plausible_current_ratio: e.tuning.plausible_current_ratio,
-            plausible_voltage_ratio: e.tuning.plausible_voltage_ratio,
-            plausible_current_step_ratio: e.tuning.plausible_current_step_ratio,
-            initial_angle: e.initial_angle,
-        })
-        .map_err(|e| self.core_error("estimator", e))
-    }
-
-    /// The extended-EMF baseline of this configuration.
-    pub fn emf_estimator(&self) -> Result<fado_core::EmfObserverEstimator<f64>, SimConfigError> {
-        let e = self.estimator_config();
-        let s = &self.baselines;
-        fado_core::EmfObserverEstimator::new(fado_core::baselines::EmfObserverConfig {
-            ts: e.ts,
-            rs_hat: e.machine.rs,
-            lq_hat: e.machine.lq,
-            flux_linkage_hat: e.machine.flux_linkage,
-            emf_bandwidth_hz: s.emf_bandwidth_hz,
-            speed_floor_hz: s.emf_speed_floor_hz,
-            t2s1_bandwidth_hz: e.tuning.t2s1_bandwidth_hz,
-            t2s2_bandwidth_hz: e.tuning.t2s2_bandwidth_hz,
-            tracker_damping: e.tuning.tracker_damping,
-            bandwidth_definition: e.tuning.bandwidth_definition,
-            tracker_hold_ratio: e.tuning.tracker_hold_ratio,
-            average_current: e.tuning.average_current,
-            rated_current: e.machine.rated_current,
-            dc_voltage: e.machine.dc_voltage,
-            plausible_current_ratio: e.tuning.plausible_current_ratio,
-            plausible_voltage_ratio: e.tuning.plausible_voltage_ratio,
-            plausible_current_step_ratio: e.tuning.plausible_current_step_ratio,
-            initial_angle: e.initial_angle,
-        })
-        .map_err(|e| self.core_error("estimator", e))
     }
 
     /// The sensorless drive of this configuration (aligned by the simulation at start).
@@ -204,6 +100,14 @@ fn dq64(x: Dq<f32>) -> Dq<f64> {
 impl Controller for DriveF32 {
     fn align(&mut self, theta0: f64) {
         self.0.align(theta0 as f32);
+    }
+
+    fn ready(&self) -> bool {
+        let last = self.0.last();
+        !self.0.is_calibrating()
+            && !self.0.is_calibrating_gain()
+            && last.gates_enabled
+            && !last.tripped
     }
 
     #[inline]
@@ -249,7 +153,7 @@ impl Controller for DriveF32 {
     fn handle(&mut self, event: ControlEvent) {
         match event {
             ControlEvent::DisturbanceFeedback(on) => {
-                self.0.estimator_mut().set_disturbance_feedback(on)
+                RotorAngleEstimator::set_disturbance_feedback(self.0.estimator_mut(), on)
             }
         }
     }

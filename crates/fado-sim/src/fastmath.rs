@@ -1,7 +1,9 @@
 //! Short Taylor polynomials for the small arguments of the per-interval propagators
 //! (|x| ≤ 0.1: ωh and μh over at most one 100 µs sample), with libm as the fallback.
-//! Truncation error < 3e-17 relative inside the range: below f64 rounding.
+//! Truncation error < 3e-17 relative inside the range: below f64 rounding. Also the two
+//! frame rotations every propagator shares.
 
+use fado_core::{Ab, Dq};
 use num_complex::Complex64;
 
 /// e^{jx}.
@@ -59,6 +61,21 @@ pub(crate) fn exp(x: f64) -> f64 {
     } else {
         x.exp()
     }
+}
+
+/// The rotor-frame vector `x` in the stationary frame, rotor at `rot` = e^{jθ}.
+#[inline]
+pub(crate) fn rotate(x: Dq<f64>, rot: Complex64) -> Ab<f64> {
+    Ab::new(x.d * rot.re - x.q * rot.im, x.d * rot.im + x.q * rot.re)
+}
+
+/// The stationary-frame vector `x` in the rotor frame, rotor at `rot` = e^{jθ}.
+#[inline]
+pub(crate) fn unrotate(x: Ab<f64>, rot: Complex64) -> Dq<f64> {
+    Dq::new(
+        x.alpha * rot.re + x.beta * rot.im,
+        -x.alpha * rot.im + x.beta * rot.re,
+    )
 }
 
 #[cfg(test)]

@@ -32,7 +32,6 @@
 //! below Vdc, the diodes block and the currents stay zero.
 
 use fado_core::{Ab, Abc, Dq};
-use num_complex::Complex64;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{SimConfigError, check};
@@ -210,20 +209,7 @@ fn clarke(p: [f64; 3]) -> Ab<f64> {
     )
 }
 
-#[inline]
-fn rotate(i: Dq<f64>, rot: Complex64) -> Ab<f64> {
-    Ab::new(i.d * rot.re - i.q * rot.im, i.d * rot.im + i.q * rot.re)
-}
-
-#[inline]
-fn unrotate(i: Ab<f64>, rot: Complex64) -> Dq<f64> {
-    Dq::new(
-        i.alpha * rot.re + i.beta * rot.im,
-        -i.alpha * rot.im + i.beta * rot.re,
-    )
-}
-
-use crate::fastmath::cis;
+use crate::fastmath::{cis, rotate, unrotate};
 
 /// One inverter leg of the switching-resolved model.
 #[derive(Clone, Copy, Debug)]
@@ -270,6 +256,9 @@ pub struct Inverter {
     sample: u64,
     /// DC-link voltage as a fraction of its nominal value (fault injection, a supply dip).
     dc_link_scale: f64,
+    /// The bus voltage of a DC link that is not stiff (`crate::dc_link`), V; `None`: the
+    /// source's.
+    bus_voltage: Option<f64>,
     /// Subtracted from the applied α-β voltage while the gates are enabled (fault injection,
     /// `[faults] voltage_offset`: the drive's voltage is this much above the true one), V.
     voltage_offset: Ab<f64>,
@@ -288,6 +277,7 @@ impl Inverter {
             legs: [Leg::default(); 3],
             sample: 0,
             dc_link_scale: 1.0,
+            bus_voltage: None,
             voltage_offset: Ab::zero(),
         })
     }
@@ -310,7 +300,22 @@ impl Inverter {
     /// DC-link voltage over the present sample (with the dip of
     /// [`set_dc_link_scale`](Self::set_dc_link_scale)).
     pub fn dc_voltage(&self) -> f64 {
+        match self.bus_voltage {
+            Some(v) => v,
+            None => self.source_voltage(),
+        }
+    }
+
+    /// Voltage of the DC source over the present sample (nominal, ripple, the dip of
+    /// [`set_dc_link_scale`](Self::set_dc_link_scale)), V: the bus voltage of a stiff link.
+    pub fn source_voltage(&self) -> f64 {
         self.params.dc_voltage_at(self.time()) * self.dc_link_scale
+    }
+
+    /// Sets the bus voltage the inverter switches from the present sample on (a DC link
+    /// with a capacitor, `crate::dc_link`).
+    pub fn set_bus_voltage(&mut self, v: f64) {
+        self.bus_voltage = Some(v);
     }
 
     /// Scales the DC-link voltage from the present sample on (1 = nominal; a supply dip of
@@ -345,7 +350,7 @@ impl Inverter {
         );
         let vdc = self.dc_voltage();
         let r = motor.params().rs + self.params.on_resistance;
-        let prop = ElectricalPropagator::new(motor.params(), r, motor.omega());
+        let prop = motor.propagator(r);
         let falling = self.sample.is_multiple_of(2);
         let out = if !gates_enabled {
             self.step_diodes(motor, &prop, vdc)
@@ -391,8 +396,8 @@ impl Inverter {
         let rot_h = cis(prop.omega() * self.ts);
         let i1 = prop.advance(i0, v, self.ts, rot0, rot_h);
         let mp = motor.params();
-        let te = 0.5 * (mp.torque(i0) + mp.torque(i1));
-        motor.set_current(i1);
+        let te = 0.5 * (prop.torque_dq(mp, i0) + prop.torque_dq(mp, i1));
+        motor.set_current_from(prop, i1);
         // Keep the leg states coherent for a later switch to the resolved model.
         for (leg, dk) in self.legs.iter_mut().zip(d) {
             leg.gate = dk > 0.0;
@@ -454,7 +459,7 @@ impl Inverter {
         // The current is carried in α-β (phase currents at every edge), d-q only at the end.
         let mut i = rotate(motor.state().i_dq, rot);
         let mut iph = phase_currents(i);
-        let mut te_prev = mp.torque(motor.state().i_dq);
+        let mut te_prev = prop.torque_dq(&mp, motor.state().i_dq);
         let mut t = 0.0;
         let mut next_edge = 0;
         let (mut te_int, mut v_int) = (0.0, Ab::zero());
@@ -462,12 +467,13 @@ impl Inverter {
         // Bound on |di_x/dt|: phase voltage ≤ 2/3·Vdc plus drops, back-EMF ≤ ω·λf. An edge whose
         // current certainly keeps its sign until the edge, and opposes it, waits exactly Td
         // whatever the current's value: no need to stop the integration at the edge itself.
-        let i_bound = i.norm() + 2.0 * vdc * ts / mp.ld.min(mp.lq);
+        let l_min = prop.min_inductance(&mp);
+        let i_bound = i.norm() + 2.0 * vdc * ts / l_min;
         let slew = (2.0 / 3.0 * vdc
             + 2.0 * self.params.threshold_voltage
-            + omega.abs() * (mp.flux_linkage + (mp.ld - mp.lq).abs() * i_bound)
+            + omega.abs() * prop.flux_bound(&mp, i_bound)
             + (mp.rs + self.params.on_resistance) * i_bound)
-            / mp.ld.min(mp.lq);
+            / l_min;
         loop {
             while let Some(&(te, k, g)) = edges.get(next_edge) {
                 let k = k as usize;
@@ -505,7 +511,7 @@ impl Inverter {
                 i = prop.advance_ab(i, v, h, rot, rot_h);
                 rot *= rot_h;
                 iph = phase_currents(i);
-                let te = mp.torque(unrotate(i, rot));
+                let te = prop.torque_ab(&mp, i, rot);
                 te_int += 0.5 * (te_prev + te) * h;
                 te_prev = te;
                 v_int += v * h;
@@ -541,7 +547,7 @@ impl Inverter {
         for leg in &mut self.legs {
             leg.pending -= ts; // ∞ stays ∞
         }
-        motor.set_current(i);
+        motor.set_current_from(prop, i);
         SampleOutcome {
             torque_avg: te_int / ts,
             v_ab_avg: v_int * (1.0 / ts),
@@ -560,7 +566,7 @@ impl Inverter {
         let mp = *motor.params();
         // Below what one sub-step can move, a diode current is taken to have reached zero and
         // blocked (resolving the exact zero crossing is not worth it after a trip).
-        let blocking_current = 1.5 * vdc * h / mp.ld.min(mp.lq);
+        let blocking_current = 1.5 * vdc * h / prop.min_inductance(&mp);
         let omega = prop.omega();
         let rot_h = cis(omega * h);
         let mut rot = motor.rotation();
@@ -569,7 +575,7 @@ impl Inverter {
         let emf_line_peak = 3f64.sqrt() * omega.abs() * mp.flux_linkage;
         for _ in 0..SUBSTEPS {
             let iph = phase_currents(rotate(i, rot));
-            let te0 = mp.torque(i);
+            let te0 = prop.torque_dq(&mp, i);
             let v = if iph.iter().all(|x| x.abs() < blocking_current) && emf_line_peak < vdc {
                 // Diodes blocking: the machine is open-circuited.
                 i = Dq::zero();
@@ -582,14 +588,14 @@ impl Inverter {
                 v
             };
             rot *= rot_h;
-            te_int += 0.5 * (te0 + mp.torque(i)) * h;
+            te_int += 0.5 * (te0 + prop.torque_dq(&mp, i)) * h;
             v_int += v * h;
         }
         for leg in &mut self.legs {
             leg.gate = false;
             leg.pending = f64::INFINITY;
         }
-        motor.set_current(i);
+        motor.set_current_from(prop, i);
         SampleOutcome {
             torque_avg: te_int / self.ts,
             v_ab_avg: v_int * (1.0 / self.ts),

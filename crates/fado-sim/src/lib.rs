@@ -8,10 +8,14 @@
 //!
 //! * [`scenario`]: the paper's Fig. 8–12 as named scenarios with coded pass criteria;
 //!   [`simulate`] is the one-call entry point (CLI `fado-sim run`, Python bindings).
-//! * [`compare`]: every estimator (fado and the `fado_core::baselines`) in every scenario on
-//!   the same plant, seed and controllers (CLI `fado-sim compare`).
+//! * [`estimators`]: the registry of estimators (fado and the `fado_core::baselines`), one
+//!   row each; [`compare`]: every estimator in every scenario on the same plant, seed and
+//!   controllers (CLI `fado-sim compare`).
 //! * [`sweep`]: operating-envelope sweeps over model, sensor, load and profile errors, in
 //!   parallel, resumable, one CSV row per point (CLI `fado-sim sweep`, Python `fado.sweep`).
+//! * [`criteria`]: the pass criteria a user writes (`[criteria]`), all the `custom` scenario
+//!   judges; [`dc_link`]: the DC link behind the inverter (stiff, battery or rectifier, its
+//!   capacitor and brake chopper).
 //! * [`config`]: the whole run as one TOML document ([`SimConfig`]), overriding a scenario key
 //!   by key; unknown keys and impossible values are errors naming the key.
 //! * [`output`]: outputs written whole or not at all (temporary file + rename) under a lock on
@@ -47,16 +51,22 @@ pub mod commission;
 pub mod compare;
 pub mod config;
 pub mod controller;
+pub mod criteria;
+pub mod dc_link;
+pub mod derive;
 pub mod drive;
 pub mod error;
+pub mod estimators;
 mod fastmath;
 pub mod faults;
 pub mod inverter;
 pub mod load;
+pub mod magnetics;
 pub mod motor;
 pub mod output;
 pub mod presets;
 pub mod profile;
+pub mod range;
 pub mod scenario;
 pub mod sensors;
 pub mod sim;

@@ -25,11 +25,20 @@
 //! frame, `L·di/dt = v − R·i − jω·λf·e^{jθ(t)}` (see [`ElectricalPropagator::advance_ab`]):
 //! one real exponential and one complex rotation per interval. Both short exponentials use
 //! degree-10 Taylor polynomials for arguments ≤ 0.1 (error < 3e-17), libm beyond.
+//!
+//! A saturating machine (`[motor.saturation]` or `[motor] flux_map`) has no constant
+//! inductances: its state is the stator flux linkage, integrated by [`crate::magnetics`]
+//! behind the same [`ElectricalPropagator`] interface.
 
+use std::sync::Arc;
+
+use fado_core::magnetics::MagneticModel;
 use fado_core::{Ab, Dq, MachineModel, wrap_angle};
 use num_complex::Complex64;
 
 use crate::error::{SimConfigError, check};
+use crate::fastmath::unrotate;
+use crate::magnetics::{FluxPoint, FluxPropagator, MagneticBounds, PlantMagnetics};
 
 /// The plant's motor: the same record as the drive's model of it, [`MachineModel`] (the
 /// motulator pattern), read from the `[motor]` TOML table. The simulator's default is the
@@ -76,8 +85,11 @@ pub struct MotorState {
 
 /// Exact propagator of the electrical dynamics for one sample at a fixed speed (see the module
 /// docs): built once per sample, then applied to each interval of constant stator voltage.
-#[derive(Clone, Copy, Debug)]
+/// For a saturating machine it is the flux-linkage integrator of [`crate::magnetics`].
+#[derive(Clone, Debug)]
 pub struct ElectricalPropagator {
+    /// The saturating machine's integrator (None: the closed forms below).
+    flux: Option<FluxPropagator>,
     omega: f64,
     mu: f64,
     /// Traceless part N = A − μI.
@@ -108,6 +120,7 @@ impl ElectricalPropagator {
             -omega * p.flux_linkage * a / den,
         );
         let mut prop = Self {
+            flux: None,
             omega,
             mu: -a,
             n: [[0.0, omega], [-omega, 0.0]],
@@ -163,6 +176,9 @@ impl ElectricalPropagator {
         rot0: Complex64,
         rot_h: Complex64,
     ) -> Ab<f64> {
+        if let Some(f) = &self.flux {
+            return f.advance_ab(i_ab, v_ab, h, rot0, rot_h);
+        }
         if self.surface {
             let e = crate::fastmath::exp(-self.a * h);
             let g = (1.0 - e) * self.inv_r;
@@ -190,6 +206,44 @@ impl ElectricalPropagator {
         self.omega
     }
 
+    /// Electromagnetic torque at the stationary-frame current `i_ab`, rotor at `rot` = e^{jθ}:
+    /// `p.torque` of the rotor-frame current for constant inductances, 1.5·p·(ψ × i) of the
+    /// integrated flux for a saturating machine.
+    #[inline]
+    pub fn torque_ab(&self, p: &MotorParams, i_ab: Ab<f64>, rot: Complex64) -> f64 {
+        match &self.flux {
+            Some(f) => f.torque_ab(i_ab, rot),
+            None => p.torque(unrotate(i_ab, rot)),
+        }
+    }
+
+    /// As [`ElectricalPropagator::torque_ab`] for a rotor-frame current.
+    #[inline]
+    pub fn torque_dq(&self, p: &MotorParams, i_dq: Dq<f64>) -> f64 {
+        match &self.flux {
+            Some(f) => f.torque_dq(i_dq),
+            None => p.torque(i_dq),
+        }
+    }
+
+    /// The smallest (incremental) inductance in H: what bounds the current's slew.
+    #[inline]
+    pub fn min_inductance(&self, p: &MotorParams) -> f64 {
+        match &self.flux {
+            Some(f) => f.bounds().l_min,
+            None => p.ld.min(p.lq),
+        }
+    }
+
+    /// A bound on |ψ| for currents up to `i_bound` in Wb (the rotational EMF's bound over ω).
+    #[inline]
+    pub fn flux_bound(&self, p: &MotorParams, i_bound: f64) -> f64 {
+        match &self.flux {
+            Some(f) => f.bounds().psi0.abs() + f.bounds().l_max * i_bound,
+            None => p.flux_linkage + (p.ld - p.lq).abs() * i_bound,
+        }
+    }
+
     /// Advances the rotor-frame current `i` over `h` seconds of constant stator voltage `v_ab`.
     /// `rot0` = e^{jθ} at the interval start, `rot_h` = e^{jωh}; the caller keeps the rotor
     /// angle (e^{jθ} at the end is `rot0·rot_h`).
@@ -202,6 +256,9 @@ impl ElectricalPropagator {
         rot0: Complex64,
         rot_h: Complex64,
     ) -> Dq<f64> {
+        if let Some(f) = &self.flux {
+            return f.advance(i, v_ab, h, rot0, rot_h);
+        }
         if self.surface {
             let rot1 = rot0 * rot_h;
             let i_ab = Ab::new(i.d * rot0.re - i.q * rot0.im, i.d * rot0.im + i.q * rot0.re);
@@ -256,6 +313,10 @@ fn expm_traceless(s: f64, h: f64) -> (f64, f64) {
 #[derive(Clone, Debug)]
 pub struct Motor {
     params: MotorParams,
+    /// A saturating machine's magnetics and their bounds (None: constant inductances).
+    magnetics: Option<(Arc<PlantMagnetics>, MagneticBounds)>,
+    /// Stator flux linkage in the rotor frame (a saturating machine's state).
+    psi_dq: Dq<f64>,
     state: MotorState,
     /// e^{jθ}, computed once per sample.
     rot: Complex64,
@@ -266,9 +327,35 @@ pub struct Motor {
 impl Motor {
     /// A machine at rest at electrical angle `theta0` with zero current.
     pub fn new(params: MotorParams, theta0: f64) -> Result<Self, SimConfigError> {
+        Self::with_magnetics(params, None, theta0)
+    }
+
+    /// A machine at rest with the saturating `magnetics` (None: the constant inductances of
+    /// `params`). `params`' Ld, Lq and λf are then the datasheet's (the drive's default model);
+    /// the physics is the magnetic model's.
+    pub fn with_magnetics(
+        params: MotorParams,
+        magnetics: Option<Arc<PlantMagnetics>>,
+        theta0: f64,
+    ) -> Result<Self, SimConfigError> {
         check_physics(&params)?;
         check::finite("theta0", theta0)?;
+        let magnetics = magnetics.map(|m| {
+            let b = m.bounds(2.0 * params.rated_current.max(1e-3));
+            (m, b)
+        });
+        if let Some((_, b)) = &magnetics
+            && !(b.l_min.is_finite() && b.l_min > 0.0)
+        {
+            return Err(SimConfigError::new(
+                "saturation",
+                "the magnetic model has no positive incremental inductance within twice the \
+                 rated current",
+            ));
+        }
         let mut m = Self {
+            magnetics,
+            psi_dq: Dq::zero(),
             params,
             state: MotorState::default(),
             rot: Complex64::new(1.0, 0.0),
@@ -286,7 +373,46 @@ impl Motor {
             omega_mech,
             theta_mech: theta / self.params.pole_pairs as f64,
         };
+        self.psi_dq = self.flux_of(i_dq);
         self.update_rotation();
+    }
+
+    /// ψ(i) of the machine's magnetics.
+    fn flux_of(&self, i_dq: Dq<f64>) -> Dq<f64> {
+        match &self.magnetics {
+            Some((m, _)) => m.model().flux(i_dq),
+            None => self.params.flux_dq(i_dq),
+        }
+    }
+
+    /// The saturating magnetics, if any (None: constant inductances).
+    pub fn magnetics(&self) -> Option<&PlantMagnetics> {
+        self.magnetics.as_ref().map(|(m, _)| m.as_ref())
+    }
+
+    /// The propagator of one sample at the present speed with circuit resistance `r`: the
+    /// closed form for constant inductances, the flux integrator for a saturating machine.
+    pub fn propagator(&self, r: f64) -> ElectricalPropagator {
+        let mut prop = ElectricalPropagator::new(&self.params, r, self.omega());
+        if let Some((m, b)) = &self.magnetics {
+            prop.flux = Some(FluxPropagator::new(
+                m.clone(),
+                b,
+                r,
+                self.omega(),
+                self.params.pole_pairs,
+                FluxPoint::at(self.state.i_dq, self.psi_dq, self.rot),
+            ));
+        }
+        prop
+    }
+
+    /// Stator flux linkage in the rotor frame, Wb.
+    pub fn flux_dq(&self) -> Dq<f64> {
+        match self.magnetics {
+            Some(_) => self.psi_dq,
+            None => self.params.flux_dq(self.state.i_dq),
+        }
     }
 
     fn update_rotation(&mut self) {
@@ -327,7 +453,7 @@ impl Motor {
     /// Stator flux linkage in the stationary frame (what the estimator's λ2 should equal).
     pub fn flux_ab(&self) -> Ab<f64> {
         let (c, s) = (self.rot.re, self.rot.im);
-        let f = self.params.flux_dq(self.state.i_dq);
+        let f = self.flux_dq();
         Ab::new(f.d * c - f.q * s, f.d * s + f.q * c)
     }
 
@@ -335,6 +461,25 @@ impl Motor {
     #[inline]
     pub fn set_current(&mut self, i_dq: Dq<f64>) {
         self.state.i_dq = i_dq;
+        if self.magnetics.is_some() {
+            self.psi_dq = self.flux_of(i_dq);
+        }
+    }
+
+    /// Sets the current at the end of a sample advanced by `prop` (built by
+    /// [`Motor::propagator`]): a saturating machine takes the flux `prop` integrated (the
+    /// state) when `i_dq` is its last interval's end, else ψ(i_dq).
+    #[inline]
+    pub fn set_current_from(&mut self, prop: &ElectricalPropagator, i_dq: Dq<f64>) {
+        self.state.i_dq = i_dq;
+        if let Some(f) = &prop.flux {
+            let last = f.last();
+            self.psi_dq = if last.i_dq == i_dq {
+                unrotate(last.psi_ab, last.rot)
+            } else {
+                self.flux_of(i_dq)
+            };
+        }
     }
 
     /// Closes a sample of length `ts`: the angle advances at the speed held during the sample,

@@ -35,6 +35,9 @@ pub struct Scenario {
     /// so that the scenario runs for any motor; otherwise it is the paper's in absolute
     /// units (r/min, N·m of its motor).
     pub scaled: bool,
+    /// Judges nothing of its own, not even a trip: only the user's `[criteria]` (the
+    /// `custom` scenario). Left out of `compare`'s default scenario list.
+    pub neutral: bool,
     /// Sets the profile, load, duration and evaluation window on a configuration (a scaled
     /// scenario from its `[motor]` ratings).
     pub setup: fn(&mut SimConfig),
@@ -58,8 +61,10 @@ impl Eq for Scenario {}
 /// comparison ([`crate::compare`]): a medium-speed sanity check under load and a low-speed
 /// staircase; then the paper's experiments scaled by the motor's ratings (its motor: 1500
 /// r/min, 11.5 N·m), which run for any motor: `reversal` (Fig. 11), `stops` (Fig. 12) and
-/// `rated-reversal` (Fig. 11 under the rated torque).
-pub const SCENARIOS: [Scenario; 10] = [
+/// `rated-reversal` (Fig. 11 under the rated torque); `loaded-start`, a start under the
+/// rated torque held by a brake until the drive is ready; `fullrange` and `regen-stop`, the
+/// whole operating range and regenerating stops; and `custom`, the user's own profiles.
+pub const SCENARIOS: [Scenario; 14] = [
     Scenario {
         name: "fig8",
         title: "Flux and disturbance estimation under 2 N·m (Fig. 8)",
@@ -68,6 +73,7 @@ pub const SCENARIOS: [Scenario; 10] = [
                     revolution spent above 30 r/min in HI mode < 2 % of λf; no trip; \
                     speed error < 30 r/min",
         scaled: false,
+        neutral: false,
         setup: setup_fig8,
         observe: observe_nothing,
         checks: checks_fig8,
@@ -80,6 +86,7 @@ pub const SCENARIOS: [Scenario; 10] = [
         criterion: "λ1 drifts while off (|ΔD̂| > 2 mWb) and recovers with τ ≈ 2 s \
                     (residual after 2 s in [0.2, 0.55]); |θ − θ̂| < 0.05 rad",
         scaled: false,
+        neutral: false,
         setup: setup_fig9,
         observe: observe_nothing,
         checks: checks_fig9,
@@ -91,6 +98,7 @@ pub const SCENARIOS: [Scenario; 10] = [
         criterion: "|θ − θ̂| < 0.35 rad (does not diverge); |λ̂r| ≤ 1.15·λ̂f (+1 %); \
                     FLAG_limit high ≥ 95 % of the hold",
         scaled: false,
+        neutral: false,
         setup: setup_fig10,
         observe: observe_fig10,
         checks: checks_fig10,
@@ -102,6 +110,7 @@ pub const SCENARIOS: [Scenario; 10] = [
         criterion: "|θ − θ̂| < 0.25 rad near zero speed (|n| < 30 r/min) [P]; no trip; \
                     speed error < 30 r/min",
         scaled: false,
+        neutral: false,
         setup: setup_fig11,
         observe: observe_nothing,
         checks: checks_reversal,
@@ -113,6 +122,7 @@ pub const SCENARIOS: [Scenario; 10] = [
                   0 → 60, 500 ms at 60)",
         criterion: "no trip or instability [P]; |θ − θ̂| < 0.25 rad [A]; speed error < 30 r/min",
         scaled: false,
+        neutral: false,
         setup: setup_fig12,
         observe: observe_nothing,
         checks: checks_stops,
@@ -123,6 +133,7 @@ pub const SCENARIOS: [Scenario; 10] = [
         profile: "0 → 300 r/min in 1 s, T_L → 7.5 N·m over [1.5 s, 2 s], hold to 4 s",
         criterion: "settled (from 2.5 s) |θ − θ̂| < 0.05 rad; speed error < 10 r/min; no trip",
         scaled: false,
+        neutral: false,
         setup: setup_steady300,
         observe: observe_nothing,
         checks: checks_steady300,
@@ -137,6 +148,7 @@ pub const SCENARIOS: [Scenario; 10] = [
                     the lowest level held together with every level above it; the scenario \
                     passes when every level is held",
         scaled: false,
+        neutral: false,
         setup: setup_lowspeed,
         observe: observe_lowspeed,
         checks: checks_lowspeed,
@@ -149,6 +161,7 @@ pub const SCENARIOS: [Scenario; 10] = [
         criterion: "|θ − θ̂| < 0.25 rad near zero speed (|n| < 2 % of rated) [P]; no trip; \
                     speed error < 2 % of rated speed",
         scaled: true,
+        neutral: false,
         setup: setup_reversal,
         observe: observe_nothing,
         checks: checks_reversal,
@@ -161,6 +174,7 @@ pub const SCENARIOS: [Scenario; 10] = [
         criterion: "no trip or instability [P]; |θ − θ̂| < 0.25 rad [A]; speed error < 2 % \
                     of rated speed",
         scaled: true,
+        neutral: false,
         setup: setup_stops,
         observe: observe_nothing,
         checks: checks_stops,
@@ -171,11 +185,89 @@ pub const SCENARIOS: [Scenario; 10] = [
         profile: "as `reversal` with T_L → 100 % of rated torque",
         criterion: "as `reversal`",
         scaled: true,
+        neutral: false,
         setup: setup_rated_reversal,
         observe: observe_nothing,
         checks: checks_reversal,
     },
+    Scenario {
+        name: "loaded-start",
+        title: "Start under the rated torque, the rotor held by a brake until the drive is ready",
+        profile: "rotor at rest at a seeded random angle, a brake holding it and a constant \
+                  100 % of rated torque (gravity-like) on it; the brake releases at the \
+                  drive's first ready sample (calibrations over); 0 r/min until 1 s, then a \
+                  ramp to +6 % of rated speed (lifting) by 2 s, held to 3 s. The drive starts \
+                  from the rotor's angle (`align`)",
+        criterion: "released; backward travel after the release ≤ 0.5 rad electrical; \
+                    |θ − θ̂| < 0.25 rad from the release on; commanded speed reached \
+                    (|n − n*| < 2 % of rated speed over the last 0.5 s); no trip",
+        scaled: true,
+        neutral: false,
+        setup: setup_loaded_start,
+        observe: observe_loaded_start,
+        checks: checks_loaded_start,
+    },
+    Scenario {
+        name: "fullrange",
+        title: "The whole operating range, scaled by the ratings and the model's limits",
+        profile: "standstill under 50 % of rated torque; to rated speed at the current limit; \
+                  rated load step; field weakening to the top speed the voltage and current \
+                  limits allow (≤ 2× rated; half the rated power still available) holding \
+                  min(rated power, 80 % of the limits' power); brake at the current limit \
+                  through zero; 1 s at zero under 65 % of rated torque; to −rated speed",
+        criterion: "|θ − θ̂| < 0.25 rad over the whole run; in each settled window speed within \
+                    2 % of its target (of the rated speed near zero); no trip; DC voltage within \
+                    the drive's limits",
+        scaled: true,
+        neutral: false,
+        setup: setup_fullrange,
+        observe: observe_fullrange,
+        checks: checks_range,
+    },
+    Scenario {
+        name: "regen-stop",
+        title: "Stops regenerating into a rectifier-fed DC link (with a brake chopper)",
+        profile: "rated speed, stop at the current limit; rated speed again under an overhauling \
+                  rated load, stop and hold it (rectifier, chopper at 1.05 × the bus)",
+        criterion: "as `fullrange`",
+        scaled: true,
+        neutral: false,
+        setup: setup_regen_stop,
+        observe: observe_regen_stop,
+        checks: checks_range,
+    },
+    Scenario {
+        name: "custom",
+        title: "The user's own experiment: `[speed_reference]`, `[load]`, `[criteria]`",
+        profile: "the configuration's `[speed_reference] points` and `[load]`; it runs to 1 s \
+                  after the last breakpoint unless `[simulation] duration` is given",
+        criterion: "only the `[criteria]` written (none: it reports and passes)",
+        scaled: false,
+        neutral: true,
+        setup: setup_custom,
+        observe: observe_nothing,
+        checks: checks_nothing,
+    },
 ];
+
+/// Load of `loaded-start`, fraction of the rated torque: a full load (a hoist at its rated
+/// load, a vehicle on its steepest slope).
+pub const LOADED_START_LOAD_RATIO: f64 = 1.0;
+/// Largest backward travel of the rotor after the brake's release in `loaded-start`,
+/// electrical rad.
+pub const LOADED_START_MAX_BACK: f64 = 0.5;
+/// `loaded-start`: the speed reference is 0 until this time (s), longer than every preset's
+/// start-up (offset and gain calibrations), then ramps to the target in 1 s.
+const LOADED_START_RAMP_AT: f64 = 1.0;
+/// `loaded-start`: duration (s); the speed is judged over its last 0.5 s.
+const LOADED_START_DURATION: f64 = 3.0;
+
+/// The rotor's start angle of `loaded-start` for a seed: electrical rad in [−π, π), spread by
+/// the golden ratio (seeds 1, 2, 3, 4: 0.74, −1.49, 2.57, 0.33 rad).
+pub fn loaded_start_angle(seed: u64) -> f64 {
+    let x = (seed as f64 * 0.618_033_988_749_894_9).fract();
+    std::f64::consts::TAU * x - std::f64::consts::PI
+}
 
 /// Load of the scaled `reversal` and `stops`, as a fraction of the rated torque: the paper's
 /// 7.5 N·m of 11.5 N·m (65.2 %, section V \[P\]).
@@ -242,8 +334,13 @@ impl Scenario {
 
     /// Checks the pass criteria on a finished run.
     pub fn evaluate(&self, cfg: &SimConfig, m: &Metrics, p: &ScenarioProbe) -> Vec<Check> {
-        let mut checks = vec![Check::at_most("tripped", m.tripped as u8 as f64, 0.0)];
+        let mut checks = if self.neutral {
+            Vec::new()
+        } else {
+            vec![Check::at_most("tripped", m.tripped as u8 as f64, 0.0)]
+        };
         (self.checks)(cfg, m, p, &mut checks);
+        checks.extend(cfg.criteria.checks(cfg.motor.rated_speed_rpm, m));
         checks
     }
 }
@@ -257,6 +354,10 @@ fn observe_fig10(cfg: &SimConfig, p: &mut ScenarioProbe) {
 }
 
 /// `lowspeed`: the judged window of each staircase level.
+fn observe_loaded_start(cfg: &SimConfig, p: &mut ScenarioProbe) {
+    p.start = Some(StartStats::new(cfg.simulation.duration - 0.5));
+}
+
 fn observe_lowspeed(cfg: &SimConfig, p: &mut ScenarioProbe) {
     p.levels = lowspeed_levels_rpm(cfg.motor.rated_speed_rpm)
         .iter()
@@ -267,6 +368,102 @@ fn observe_lowspeed(cfg: &SimConfig, p: &mut ScenarioProbe) {
         })
         .collect();
 }
+
+/// `fullrange`: see [`crate::range`].
+fn setup_fullrange(c: &mut SimConfig) {
+    crate::range::setup_fullrange(c);
+}
+
+/// `regen-stop`: see [`crate::range`].
+fn setup_regen_stop(c: &mut SimConfig) {
+    crate::range::setup_regen_stop(c);
+}
+
+fn holds_to_levels(holds: Vec<crate::range::Hold>) -> Vec<LevelStats> {
+    holds
+        .into_iter()
+        .map(|(level, from, to)| LevelStats::new(level, from, to))
+        .collect()
+}
+
+/// `fullrange`: its settled windows.
+fn observe_fullrange(cfg: &SimConfig, p: &mut ScenarioProbe) {
+    p.levels = holds_to_levels(crate::range::fullrange_holds(cfg));
+}
+
+/// `regen-stop`: its settled windows.
+fn observe_regen_stop(cfg: &SimConfig, p: &mut ScenarioProbe) {
+    p.levels = holds_to_levels(crate::range::regen_stop_holds(cfg));
+}
+
+/// `fullrange` and `regen-stop`: the angle over the run, the speed in each settled window
+/// within 2 % of its target (of the rated speed near zero), the DC link within the drive's
+/// limits.
+fn checks_range(cfg: &SimConfig, m: &Metrics, p: &ScenarioProbe, checks: &mut Vec<Check>) {
+    let rated = cfg.motor.rated_speed_rpm;
+    checks.push(Check::at_most("max |θ − θ̂| (rad)", m.max_angle_error, 0.25));
+    for l in &p.levels {
+        let bound = 0.02 * l.level_rpm.abs().max(rated);
+        checks.push(Check::at_most(
+            &format!(
+                "speed error at {:.0} r/min, {:.1}–{:.1} s (r/min)",
+                l.level_rpm, l.from, l.to
+            ),
+            l.max_speed_error_rpm,
+            bound,
+        ));
+    }
+    let v = cfg.inverter.dc_voltage;
+    checks.push(Check::at_most(
+        "max DC-link voltage (V)",
+        m.max_dc_voltage,
+        cfg.controller.dc_link.over_voltage_trip_ratio * v,
+    ));
+    checks.push(Check::at_least(
+        "min DC-link voltage (V)",
+        m.min_dc_voltage,
+        cfg.controller.dc_link_min_ratio * v,
+    ));
+    if p.levels.len() == 5 {
+        let t = crate::range::targets(cfg);
+        checks.push(Check::at_least(
+            &format!(
+                "mean speed at the top (r/min; model: {:.0})",
+                t.top_speed_rpm
+            ),
+            p.levels[2].mean_speed_rpm,
+            0.98 * t.top_speed_rpm,
+        ));
+        checks.push(Check::at_least(
+            &format!(
+                "power held at the top (W; model limit {:.0}, rated {:.0})",
+                t.limit_power_at_top, t.rated_power
+            ),
+            cfg.load.torque.value(7.5) * p.levels[2].mean_speed_rpm * std::f64::consts::TAU / 60.0,
+            0.98 * t.hold_power,
+        ));
+    }
+}
+
+/// `custom`: the user's profiles as they are; the run lasts until 1 s after the last
+/// breakpoint of the speed reference or the load (the user's `[simulation] duration`, applied
+/// after this, wins).
+fn setup_custom(c: &mut SimConfig) {
+    let end = [
+        c.speed_reference.end_time(),
+        c.load.torque.end_time(),
+        c.load.speed_rpm.end_time(),
+    ]
+    .into_iter()
+    .fold(0.0, f64::max);
+    c.simulation.duration = end + CUSTOM_TAIL_SECONDS;
+}
+
+/// What `custom` runs after the last breakpoint of its profiles, s: the settling of a step.
+pub const CUSTOM_TAIL_SECONDS: f64 = 1.0;
+
+/// No criterion of the scenario's own.
+fn checks_nothing(_cfg: &SimConfig, _m: &Metrics, _p: &ScenarioProbe, _checks: &mut Vec<Check>) {}
 
 /// `fig8`: profile, load, duration, evaluation window.
 fn setup_fig8(c: &mut SimConfig) {
@@ -397,6 +594,19 @@ fn setup_reversal(c: &mut SimConfig) {
 /// `rated-reversal`: fig11 scaled, 100 % load.
 fn setup_rated_reversal(c: &mut SimConfig) {
     setup_reversal_under(c, 1.0);
+}
+
+/// `loaded-start`: brake, seeded angle, the rated torque from t = 0 (on the brake until the
+/// release), the lifting ramp.
+fn setup_loaded_start(c: &mut SimConfig) {
+    let n = REVERSAL_SPEED_RATIO * c.motor.rated_speed_rpm;
+    let t0 = LOADED_START_RAMP_AT;
+    c.simulation.brake = true;
+    c.simulation.initial_angle = loaded_start_angle(c.current_sensor.seed);
+    c.speed_reference = Profile::from_points(&[(0.0, 0.0), (t0, 0.0), (t0 + 1.0, n)]);
+    c.load.torque = Profile::constant(LOADED_START_LOAD_RATIO * c.motor.rated_torque);
+    c.simulation.duration = LOADED_START_DURATION;
+    c.simulation.eval_start = 0.0;
 }
 
 /// `stops`: profile, load, duration, evaluation window.
@@ -531,6 +741,89 @@ fn checks_stops(cfg: &SimConfig, m: &Metrics, _p: &ScenarioProbe, checks: &mut V
     ));
 }
 
+/// `loaded-start`: pass criteria.
+fn checks_loaded_start(cfg: &SimConfig, _m: &Metrics, p: &ScenarioProbe, checks: &mut Vec<Check>) {
+    let band = SCALED_SPEED_ERROR_RATIO * cfg.motor.rated_speed_rpm;
+    let st = p.start.clone().unwrap_or_default();
+    let bounds = [
+        (
+            "brake released (time, s; never: ∞)",
+            st.release_time.unwrap_or(f64::INFINITY),
+            cfg.simulation.duration,
+        ),
+        (
+            "backward travel after the release (rad)",
+            st.max_backward,
+            LOADED_START_MAX_BACK,
+        ),
+        (
+            "max |θ − θ̂| from the release on (rad)",
+            st.max_angle_error,
+            0.25,
+        ),
+        ("speed error at the end (r/min)", st.end_speed_error(), band),
+    ];
+    checks.extend(bounds.map(|(name, value, max)| Check::at_most(name, value, max)));
+}
+
+/// What `loaded-start` measures about the start-up and the release.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct StartStats {
+    /// When the brake released (the drive's first ready sample), s.
+    pub release_time: Option<f64>,
+    /// Largest backward travel of the rotor after the release (electrical rad, ≥ 0; backward
+    /// is against the lifting direction, negative angles).
+    pub max_backward: f64,
+    /// Largest |θ − θ̂| from the release on, rad.
+    pub max_angle_error: f64,
+    /// Largest |n − n*| from `end_from` on, r/min (see [`end_speed_error`](Self::end_speed_error)).
+    pub max_end_speed_error_rpm: f64,
+    /// Start of the end window, s.
+    pub end_from: f64,
+    travel: f64,
+    last_theta: Option<f64>,
+    end_samples: u64,
+}
+
+impl StartStats {
+    fn new(end_from: f64) -> Self {
+        Self {
+            end_from,
+            ..Self::default()
+        }
+    }
+
+    fn observe(&mut self, s: &Sample) {
+        if s.brake_engaged {
+            return;
+        }
+        if self.release_time.is_none() {
+            self.release_time = Some(s.time);
+        }
+        if let Some(prev) = self.last_theta {
+            self.travel += fado_core::wrap_angle(s.theta - prev);
+        }
+        self.last_theta = Some(s.theta);
+        self.max_backward = self.max_backward.max(-self.travel);
+        self.max_angle_error = self.max_angle_error.max(s.angle_error.abs());
+        if s.time >= self.end_from {
+            self.end_samples += 1;
+            self.max_end_speed_error_rpm = self
+                .max_end_speed_error_rpm
+                .max((s.speed_rpm - s.speed_ref_rpm).abs());
+        }
+    }
+
+    /// The end window's largest speed error, r/min; ∞ when the run never got there released.
+    pub fn end_speed_error(&self) -> f64 {
+        if self.end_samples == 0 {
+            f64::INFINITY
+        } else {
+            self.max_end_speed_error_rpm
+        }
+    }
+}
+
 /// One pass criterion and how the run did against it.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Check {
@@ -547,7 +840,7 @@ pub struct Check {
 }
 
 impl Check {
-    fn at_most(name: &str, value: f64, max: f64) -> Self {
+    pub(crate) fn at_most(name: &str, value: f64, max: f64) -> Self {
         Self {
             name: name.into(),
             value,
@@ -556,7 +849,7 @@ impl Check {
             passed: value <= max,
         }
     }
-    fn at_least(name: &str, value: f64, min: f64) -> Self {
+    pub(crate) fn at_least(name: &str, value: f64, min: f64) -> Self {
         Self {
             name: name.into(),
             value,
@@ -674,6 +967,8 @@ pub struct ScenarioProbe {
     pub max_lambda_r: f64,
     /// The `lowspeed` staircase levels (empty for the other scenarios).
     pub levels: Vec<LevelStats>,
+    /// The `loaded-start` start-up and release (None for the other scenarios).
+    pub start: Option<StartStats>,
     hold_n: u64,
     hold_flag: u64,
     next_disturbance_sample: f64,
@@ -696,6 +991,7 @@ impl ScenarioProbe {
             hold: None,
             max_lambda_r: 0.0,
             levels: Vec::new(),
+            start: None,
             hold_n: 0,
             hold_flag: 0,
             next_disturbance_sample: 0.0,
@@ -742,6 +1038,9 @@ impl Probe for ScenarioProbe {
         let d = &s.act.estimate.diagnostics;
         for level in &mut self.levels {
             level.observe(s.time, s.angle_error, s.speed_rpm, s.act.tripped);
+        }
+        if let Some(st) = &mut self.start {
+            st.observe(s);
         }
         if s.time >= self.next_disturbance_sample {
             self.disturbance.push((s.time, d.disturbance));
@@ -838,6 +1137,10 @@ pub struct Report {
     pub max_speed_error_rpm: f64,
     /// Tripped.
     pub tripped: bool,
+    /// Highest true DC-link voltage over the run, V.
+    pub max_dc_voltage: f64,
+    /// Lowest true DC-link voltage over the run, V.
+    pub min_dc_voltage: f64,
     /// Simulated seconds.
     pub simulated_seconds: f64,
     /// Wall seconds.
@@ -863,6 +1166,8 @@ impl Outcome {
             zero_speed_band_rpm: m.zero_speed_band_rpm,
             max_speed_error_rpm: m.max_speed_error_rpm,
             tripped: m.tripped,
+            max_dc_voltage: m.max_dc_voltage,
+            min_dc_voltage: m.min_dc_voltage,
             simulated_seconds: self.stats.simulated_seconds,
             wall_seconds: self.stats.wall_seconds,
             checks: self.checks.clone(),
@@ -901,7 +1206,7 @@ pub fn scenario_config(
         // The user's motor first (a scaled scenario needs its ratings), then the scenario,
         // then the user's keys again, so that any of them wins over the scenario's.
         Some(text) => {
-            let user = SimConfig::from_toml_over(&SimConfig::default(), text)?;
+            let user = SimConfig::from_user_toml(&SimConfig::default(), text)?;
             SimConfig::from_toml_over(&sc.apply(user), text)?
         }
         None => sc.config(),
@@ -936,7 +1241,10 @@ impl SimConfig {
         &self,
         controller: C,
     ) -> Result<Simulation<C>, SimConfigError> {
-        let plant = Plant::new(&self.plant(), self.simulation.initial_angle)?;
+        let mut plant = Plant::new(&self.plant(), self.simulation.initial_angle)?;
+        if self.simulation.brake {
+            plant.engage_brake();
+        }
         let mut events = Vec::new();
         for w in &self.simulation.disturbance_feedback_off {
             events.push((w[0], ControlEvent::DisturbanceFeedback(false)));
@@ -1023,34 +1331,13 @@ pub fn run_config_with(
 ) -> Result<Outcome, SimConfigError> {
     let sc = find(scenario)
         .ok_or_else(|| SimConfigError::new("scenario", format!("unknown `{scenario}`")))?;
+    let estimator = cfg.simulation.estimator.estimator();
+    let mut cfg = cfg;
+    (estimator.prepare)(&mut cfg);
     cfg.validate()?;
     let started = Instant::now();
-    match (cfg.simulation.precision, cfg.simulation.estimator) {
-        (Precision::F64, EstimatorKind::Fado) => {
-            let drive = cfg.build_drive()?;
-            run_with(sc, cfg, drive, started, opts)
-        }
-        (Precision::F32, EstimatorKind::Fado) => {
-            let drive = cfg.build_drive_f32()?;
-            run_with(sc, cfg, drive, started, opts)
-        }
-        (Precision::F64, EstimatorKind::LpfIntegrator) => {
-            let drive = cfg.build_baseline_drive(cfg.lpf_estimator()?)?;
-            run_with(sc, cfg, drive, started, opts)
-        }
-        (Precision::F64, EstimatorKind::Ortega) => {
-            let drive = cfg.build_baseline_drive(cfg.ortega_estimator()?)?;
-            run_with(sc, cfg, drive, started, opts)
-        }
-        (Precision::F64, EstimatorKind::EmfObserver) => {
-            let drive = cfg.build_baseline_drive(cfg.emf_estimator()?)?;
-            run_with(sc, cfg, drive, started, opts)
-        }
-        (Precision::F32, _) => Err(SimConfigError::new(
-            "simulation.estimator",
-            "the baselines run with an f64 drive only (simulation.precision = \"f64\")",
-        )),
-    }
+    let drive = (estimator.build)(&cfg)?;
+    run_with(sc, cfg, drive, started, opts)
 }
 
 fn run_with<C: Controller>(

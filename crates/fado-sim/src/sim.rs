@@ -12,6 +12,7 @@ use fado_core::{Abc, Dq, wrap_angle};
 use serde::{Deserialize, Serialize};
 
 use crate::controller::{Actuation, ControlEvent, Controller, Measurements};
+use crate::dc_link::{DcLink, DcLinkParams};
 use crate::error::SimConfigError;
 use crate::faults::{FaultParams, Faults};
 use crate::inverter::{Inverter, InverterParams, SampleOutcome};
@@ -38,6 +39,14 @@ pub struct PlantParams {
     pub load: LoadParams,
     /// Injected faults (none by default).
     pub faults: FaultParams,
+    /// The DC link behind the inverter (stiff by default).
+    #[serde(default)]
+    pub dc_link: DcLinkParams,
+    /// The machine's saturating magnetics (`[motor.saturation]` or `[motor] flux_map`); None:
+    /// the constant inductances of `motor`. Not a TOML table of its own (the configuration
+    /// keeps it under `[motor]`).
+    #[serde(skip)]
+    pub magnetics: Option<std::sync::Arc<crate::magnetics::PlantMagnetics>>,
 }
 
 impl Default for PlantParams {
@@ -51,6 +60,8 @@ impl Default for PlantParams {
             dc_link_sensor: DcLinkSensorParams::default(),
             load: LoadParams::default(),
             faults: FaultParams::default(),
+            dc_link: DcLinkParams::default(),
+            magnetics: None,
         }
     }
 }
@@ -76,6 +87,9 @@ impl PlantParams {
             .map_err(|e| e.in_section("dc_link_sensor"))?;
         self.load.validate().map_err(|e| e.in_section("load"))?;
         self.faults.validate().map_err(|e| e.in_section("faults"))?;
+        self.dc_link
+            .validate()
+            .map_err(|e| e.in_section("dc_link"))?;
         Ok(())
     }
 }
@@ -92,6 +106,10 @@ pub struct Plant {
     load_torque: f64,
     last: SampleOutcome,
     faults: Option<Faults>,
+    dc_link: DcLink,
+    /// A holding brake on the shaft: while engaged the rotor stays where it is and the load
+    /// acts on the brake.
+    brake: bool,
 }
 
 impl Plant {
@@ -99,8 +117,14 @@ impl Plant {
     pub fn new(params: &PlantParams, theta0: f64) -> Result<Self, SimConfigError> {
         params.validate()?;
         let s = |e: SimConfigError, sec: &str| e.in_section(sec);
+        let mo = &params.motor;
+        let rated_power = mo.rated_torque * mo.rated_speed_rpm / RPM_PER_RAD_S;
+        let dc_link = DcLink::new(&params.dc_link, params.inverter.dc_voltage, rated_power)
+            .map_err(|e| s(e, "dc_link"))?;
         let mut plant = Self {
-            motor: Motor::new(params.motor, theta0).map_err(|e| s(e, "motor"))?,
+            dc_link,
+            motor: Motor::with_magnetics(params.motor, params.magnetics.clone(), theta0)
+                .map_err(|e| s(e, "motor"))?,
             inverter: Inverter::new(params.inverter.clone()).map_err(|e| s(e, "inverter"))?,
             current_sensor: CurrentSensor::new(
                 params.current_sensor.clone(),
@@ -108,9 +132,15 @@ impl Plant {
             )
             .map_err(|e| s(e, "current_sensor"))?,
             dc_link_sensor: params.dc_link_sensor.clone(),
-            load: Load::new(params.load.clone(), params.motor.inertia).map_err(|e| s(e, "load"))?,
+            load: Load::new(
+                params.load.clone(),
+                params.motor.inertia,
+                params.motor.rated_speed_rpm,
+            )
+            .map_err(|e| s(e, "load"))?,
             encoder: Encoder::default(),
             load_torque: 0.0,
+            brake: false,
             last: SampleOutcome::default(),
             faults: if params.faults.is_empty() {
                 None
@@ -186,16 +216,44 @@ impl Plant {
         }
     }
 
+    /// Engages the holding brake (the rotor must be at rest: it is held where it is).
+    pub fn engage_brake(&mut self) {
+        self.brake = true;
+    }
+
+    /// Releases the holding brake.
+    pub fn release_brake(&mut self) {
+        self.brake = false;
+    }
+
+    /// Whether the holding brake holds the rotor.
+    pub fn brake_engaged(&self) -> bool {
+        self.brake
+    }
+
     /// Integrates one sample [n, n+1] and loads `duty_next` for [n+1, n+2].
     pub fn step(&mut self, duty_next: Abc<f64>, gates_enabled: bool) -> SampleOutcome {
         let ts = self.sample_period();
         let t = self.time();
         self.load_torque = self.load.torque(t, self.motor.state().omega_mech, ts);
+        let i_before = self.motor.i_ab();
         let out = self
             .inverter
             .step(&mut self.motor, duty_next, gates_enabled);
-        self.motor
-            .advance_mechanical(ts, out.torque_avg, self.load_torque);
+        if !self.dc_link.is_stiff() {
+            // The inverter's power over the sample: 1.5·v·i with the mean current.
+            let i_mean = (i_before + self.motor.i_ab()) * 0.5;
+            let power = 1.5 * (out.v_ab_avg.alpha * i_mean.alpha + out.v_ab_avg.beta * i_mean.beta);
+            let v = self.dc_link.step(self.inverter.source_voltage(), power, ts);
+            self.inverter.set_bus_voltage(v);
+        }
+        if self.brake {
+            // The brake takes both torques: the rotor (at rest) does not move.
+            self.motor.advance_mechanical(ts, 0.0, 0.0);
+        } else {
+            self.motor
+                .advance_mechanical(ts, out.torque_avg, self.load_torque);
+        }
         self.last = out;
         out
     }
@@ -241,6 +299,8 @@ pub struct Sample {
     pub load_torque: f64,
     /// Pole pairs (to convert the controller's electrical speeds).
     pub pole_pairs: f64,
+    /// True DC-link voltage over the previous sample (what the inverter switched), V.
+    pub dc_voltage: f64,
     /// Stator voltage the inverter actually applied over the previous sample [n−1, n]
     /// (time average, α-β), V.
     pub v_ab_applied: fado_core::Ab<f64>,
@@ -248,6 +308,8 @@ pub struct Sample {
     /// a stuck channel reconstructed) when the controller reports it, else the Clarke
     /// transform of the measured phase currents, A.
     pub i_ab_measured: fado_core::Ab<f64>,
+    /// The plant's holding brake holds the rotor over this sample.
+    pub brake_engaged: bool,
     /// The controller's output at this sample.
     pub act: Actuation,
 }
@@ -347,6 +409,9 @@ impl<C: Controller> Simulation<C> {
         };
         let act = self.controller.step(&m);
         self.tripped |= act.tripped;
+        if self.plant.brake_engaged() && self.controller.ready() {
+            self.plant.release_brake();
+        }
         let st = *self.plant.motor().state();
         let sample = Sample {
             time: t,
@@ -362,6 +427,8 @@ impl<C: Controller> Simulation<C> {
             v_ab_applied: self.plant.last_outcome().v_ab_avg,
             i_ab_measured: act.i_ab_used.unwrap_or_else(|| i_abc.to_ab()),
             pole_pairs: self.pole_pairs,
+            dc_voltage: self.plant.inverter().dc_voltage(),
+            brake_engaged: self.plant.brake_engaged(),
             act,
         };
         self.plant.step(act.duty, act.gates_enabled);
@@ -476,6 +543,10 @@ pub struct Metrics {
     pub max_speed_error_rpm: f64,
     /// The controller tripped (at any time, also before the window).
     pub tripped: bool,
+    /// Highest true DC-link voltage over the whole run, V.
+    pub max_dc_voltage: f64,
+    /// Lowest true DC-link voltage over the whole run, V.
+    pub min_dc_voltage: f64,
     /// max |θ − θ̂| over the whole run while the gates are on (start-up included), rad:
     /// the label of the loss-of-lock evaluation (docs/lock.md).
     pub max_angle_error_run: f64,
@@ -522,6 +593,7 @@ impl Metrics {
         Self {
             eval_start,
             zero_speed_band_rpm,
+            min_dc_voltage: f64::INFINITY,
             ..Self::default()
         }
     }
@@ -536,6 +608,8 @@ impl Probe for Metrics {
 
     fn observe(&mut self, s: &Sample) {
         self.tripped |= s.act.tripped;
+        self.max_dc_voltage = self.max_dc_voltage.max(s.dc_voltage);
+        self.min_dc_voltage = self.min_dc_voltage.min(s.dc_voltage);
         if s.act.gates_enabled {
             let e = s.angle_error.abs();
             self.max_angle_error_run = self.max_angle_error_run.max(e);

@@ -70,6 +70,18 @@ fn core_validation_and_syntax_errors_are_located() {
 
 #[test]
 fn a_good_file_is_accepted() {
-    let (code, stderr, _) = run_with("good.toml", "[motor]\nrs = 0.3\n");
+    // A whole motor: its circuit and ratings (the rest is derived from the ratings).
+    let (code, stderr, _) = run_with(
+        "good.toml",
+        "[motor]\nrs = 0.3\nld = 2.63e-3\nlq = 2.63e-3\nflux_linkage = 0.088\npole_pairs = 4\n\
+         rated_current = 21.78\nrated_speed_rpm = 1500.0\nrated_torque = 11.5\n",
+    );
     assert_eq!(code, Some(0), "{stderr}");
+    // Part of a motor is not a motor: the missing keys are named, none taken from the paper's.
+    let (code, stderr, _) = run_with("partial.toml", "[motor]\nrs = 0.3\n");
+    assert_eq!(code, Some(2), "{stderr}");
+    assert!(
+        stderr.contains("`ld`, `lq`, `flux_linkage`, `pole_pairs`, `rated_current`"),
+        "{stderr}"
+    );
 }

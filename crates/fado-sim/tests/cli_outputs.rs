@@ -2,6 +2,9 @@
 //! middle of a write, a full disk. After each, every output is the previous whole file, the
 //! new whole file, or absent with a clear error naming the path (exit code 3).
 
+mod common;
+
+use common::no_temporaries;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
@@ -57,12 +60,6 @@ fn check_whole_run(out: &Path) -> (f64, usize) {
     // Ts = 100 µs, decimation 1.
     assert_eq!(rows, (seconds / 100e-6).round() as usize);
     (seconds, rows)
-}
-
-fn no_temporaries(out: &Path) -> bool {
-    std::fs::read_dir(out)
-        .unwrap()
-        .all(|e| !e.unwrap().file_name().to_string_lossy().contains(".tmp-"))
 }
 
 /// The run went through (exit 0: criteria met, 1: not met; short runs miss fig11's).
@@ -139,19 +136,8 @@ fn a_run_killed_mid_write_leaves_the_previous_run_whole() {
 fn a_full_disk_fails_with_the_path_and_exit_3_and_keeps_the_previous_run() {
     let dir = scratch("full");
     let out = dir.join("small");
-    std::fs::create_dir_all(&out).unwrap();
-    // A 2 MiB tmpfs: needs root (CAP_SYS_ADMIN) and a kernel with tmpfs.
-    let mounted = Command::new("mount")
-        .args(["-t", "tmpfs", "-o", "size=2m", "tmpfs"])
-        .arg(&out)
-        .stderr(Stdio::null())
-        .status()
-        .is_ok_and(|s| s.success());
-    if !mounted {
-        eprintln!("SKIPPED: cannot mount a small tmpfs here (not root, or no CAP_SYS_ADMIN)");
-        return;
-    }
-    let result = std::panic::catch_unwind(|| {
+    // A 2 MiB tmpfs.
+    common::on_small_tmpfs(&out, "2m", || {
         // ~0.3 MB of traces fits.
         let fits = run(&config(&dir, 0.05), &out).output().unwrap();
         assert!(ran(&fits), "{}", stderr(&fits));
@@ -175,12 +161,7 @@ fn a_full_disk_fails_with_the_path_and_exit_3_and_keeps_the_previous_run() {
         assert_eq!(std::fs::read(out.join("traces.csv")).unwrap(), before.1);
         assert!(no_temporaries(&out));
     });
-    let unmounted = Command::new("umount").arg(&out).status().unwrap();
-    assert!(unmounted.success());
     std::fs::remove_dir_all(&dir).unwrap();
-    if let Err(panic) = result {
-        std::panic::resume_unwind(panic);
-    }
 }
 
 #[test]

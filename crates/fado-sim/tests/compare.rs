@@ -1,18 +1,9 @@
 //! `fado_sim::compare`: the comparison runs each estimator exactly as an individual
 //! `simulate` with `[estimator] kind` would, and no baseline in it is broken.
 
-use fado_sim::compare::{CompareOptions, ESTIMATORS, compare, estimator_name};
-use fado_sim::config::EstimatorKind;
+use fado_sim::compare::{CompareOptions, compare};
+use fado_sim::estimators::{ESTIMATORS, find};
 use fado_sim::simulate;
-
-fn kind_toml(kind: EstimatorKind) -> &'static str {
-    match kind {
-        EstimatorKind::Fado => "fado",
-        EstimatorKind::LpfIntegrator => "lpf_integrator",
-        EstimatorKind::Ortega => "ortega",
-        EstimatorKind::EmfObserver => "emf_observer",
-    }
-}
 
 #[test]
 fn compare_gives_the_numbers_of_individual_simulate_runs() {
@@ -20,22 +11,22 @@ fn compare_gives_the_numbers_of_individual_simulate_runs() {
     let short = "[simulation]\nduration = 3.8\n";
     let opts = CompareOptions {
         scenarios: vec!["fig11".into()],
-        estimators: vec![EstimatorKind::Fado.into(), EstimatorKind::Ortega.into()],
+        estimators: vec![find("fado").unwrap(), find("ortega").unwrap()],
         averaged: true,
         config_toml: Some(short.into()),
         ..Default::default()
     };
     let result = compare(&opts).unwrap();
     assert_eq!(result.rows.len(), 2);
-    for kind in [EstimatorKind::Fado, EstimatorKind::Ortega] {
+    for e in &opts.estimators {
         let alone = simulate(
             "fig11",
-            Some(&format!("{short}estimator = \"{}\"\n", kind_toml(kind))),
+            Some(&format!("{short}estimator = \"{}\"\n", e.key())),
             true,
             None,
         )
         .unwrap();
-        let row = result.row("fig11", estimator_name(kind)).unwrap();
+        let row = result.row("fig11", e.name).unwrap();
         let m = &alone.metrics;
         assert!(
             m.zero_speed_samples > 1000,
@@ -83,8 +74,8 @@ fn thread_count_does_not_change_the_numbers() {
     let opts = |threads| CompareOptions {
         scenarios: vec!["steady300".into()],
         estimators: vec![
-            EstimatorKind::LpfIntegrator.into(),
-            EstimatorKind::EmfObserver.into(),
+            find("lpf-integrator").unwrap(),
+            find("emf_observer").unwrap(),
         ],
         averaged: true,
         config_toml: Some("[simulation]\nduration = 2.7\n".into()),

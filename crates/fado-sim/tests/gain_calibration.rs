@@ -175,3 +175,62 @@ fn the_start_up_dc_test_hands_its_resistance_to_the_adaptation_and_not_to_the_fi
         }
     }
 }
+
+/// Runs `cfg` (2 s, speed reference 0 until 0.2 s, then a ramp to 300 r/min at 1 s) and
+/// returns the gain calibration's status, the largest |θ − θ̂| after the drive starts (rad),
+/// the lowest speed (r/min) and the rotor's largest backward travel (electrical rad).
+fn run_loaded(cfg: &mut fado_sim::config::SimConfig) -> (GainCalibrationStatus, f64, f64, f64) {
+    cfg.speed_reference =
+        Profile::from_points(&[(0.0, 0.0), (0.2, 0.0), (1.0, 300.0), (2.0, 300.0)]);
+    let mut sim = cfg.simulation(cfg.build_drive().unwrap()).unwrap();
+    let (mut max_err, mut min_speed, mut back) = (0.0_f64, 0.0_f64, 0.0_f64);
+    let mut status = GainCalibrationStatus::Pending;
+    let (mut travel, mut last) = (0.0, f64::NAN);
+    loop {
+        let s = sim.step();
+        let d = sim.controller();
+        let started = !d.is_calibrating() && !d.is_calibrating_gain();
+        if last.is_finite() {
+            travel += fado_core::wrap_angle(s.theta - last);
+        }
+        last = s.theta;
+        back = back.min(travel);
+        min_speed = min_speed.min(s.speed_rpm);
+        if started {
+            status = d.gain_calibration_status();
+            max_err = max_err.max(s.angle_error.abs());
+        }
+        if s.time >= 2.0 {
+            break;
+        }
+    }
+    (status, max_err, min_speed, -back)
+}
+
+#[test]
+fn a_load_arriving_during_the_calibration_ends_it_and_the_drive_takes_the_load() {
+    // The 2.2 kW IPMSM whose 7 N·m (half its rated torque) arrives at 0.5 s, while the
+    // calibration holds its upper d level (it would end at 0.51 s and then hold zero current
+    // for 50 ms, the rotor free). The motion test ends it within milliseconds and the drive's
+    // speed loop takes the load. Measured: RotorMoved, max |θ − θ̂| 0.149 rad, lowest speed
+    // −31 r/min, 0.34 rad backward (without the test: θ̂ lost, 3.13 rad, −383 r/min).
+    let mut cfg = config(
+        "ipmsm-2k2",
+        0.3,
+        "[load.torque]\npoints = [[0.0, 0.0], [0.4999, 0.0], [0.5, 7.0]]\n",
+    );
+    let (status, err, min_speed, back) = run_loaded(&mut cfg);
+    println!(
+        "{status:?} max |θ − θ̂| {err:.3} rad, lowest {min_speed:.1} r/min, back {back:.3} rad"
+    );
+    assert_eq!(status, GainCalibrationStatus::RotorMoved);
+    assert!(err < 0.25, "{err}");
+    assert!(min_speed > -60.0, "{min_speed}");
+    assert!(back < 0.5, "{back}");
+    // Without a load the same start-up calibrates (the test does not fire at rest; measured
+    // max |θ − θ̂| 0.165 rad, in the first tenths of a second of the ramp).
+    let mut cfg = config("ipmsm-2k2", 0.3, "");
+    let (status, err, _, _) = run_loaded(&mut cfg);
+    assert_eq!(status, GainCalibrationStatus::Calibrated);
+    assert!(err < 0.25, "{err}");
+}

@@ -2,7 +2,7 @@
 //! control, fado's estimator, dead-time compensation, modulation) stepped through
 //! [`crate::drive_step`] around a simulated motor, so that the cost script measures what a
 //! complete sensorless FOC interrupt costs on a Cortex-M4F, not the estimator alone
-//! (docs/firmware.md, "Eleventh session").
+//! (docs/results/firmware-cost.md).
 //!
 //! The motor is the paper's (surface magnets, Ld = Lq, `MachineModel::paper()`), simulated in
 //! `f32` in its stator flux: dλ/dt = v − Rs·i, i = (λ − λf·e^{jθ})/L, with the mechanical

@@ -11,7 +11,7 @@
 //! the program exits with status 0 when every scenario kept lock (QEMU passes the status on).
 //!
 //! # Sharing the estimator with the interrupt (static-init pattern)
-//! The estimator is two records (docs/firmware.md, "Fifth pass"): its parameters, every
+//! The estimator is two records (docs/results/firmware-cost.md): its parameters, every
 //! constant of the step, immutable once built, and its state, what the step changes.
 //!
 //! - The parameters are built (and the configuration checked) once in `main`, outside the
@@ -402,7 +402,7 @@ fn lowest_touched_stack() -> u32 {
 /// One estimator step, out of line: the unit the cost script measures. Firmware uses
 /// `step_lean` (θ̂, ω̂, mode, lock, fault flag) on its state with the borrowed parameters;
 /// `step` also returns the diagnostics of `Estimate` (λ1, D̂, λ̂r, θm, …), about 65 cycles
-/// more (docs/firmware.md), and `EstimatorState::last` recomputes them for the last sample
+/// more (docs/results/firmware-cost.md), and `EstimatorState::last` recomputes them for the last sample
 /// when a debugger or a telemetry task wants them. (`SensorlessEstimator`, the owner of both
 /// records, steps identically: `split_step_is_the_owners_step` in fado-core.)
 #[inline(never)]

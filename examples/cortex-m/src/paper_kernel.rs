@@ -1,5 +1,5 @@
 //! The paper's fixed-R̂s estimator alone, hand-lean, in `f32`: a measured floor for the cost of
-//! fado's step (docs/firmware.md, "Seventh pass").
+//! fado's step (docs/results/firmware-cost.md).
 //!
 //! Exactly the method fado's `EstimatorState::step_lean` runs on its paper's path
 //! (`rs_adaptation`, `observer_lag_compensation`, `observer_on_rotor_flux` and
@@ -9,7 +9,7 @@
 //! fado's trackers fold them since issue 16's sixth session (before, fado multiplied by the
 //! unit at each conversion and the two differed at the `f32` rounding level, within 1e-6 rad).
 //! The image checks, sample by sample, that the kernel's θ̂ stays within 1e-4 rad of fado's
-//! and its mode equal (measured: the same θ̂ and ω̂ to the bit, docs/firmware.md):
+//! and its mode equal (measured: the same θ̂ and ω̂ to the bit, docs/results/firmware-cost.md):
 //!
 //! - the flux integrator with the feedback of the previous sample (eq. (21) / (24)), the
 //!   resistive drop on the interval's average current (SPEC §1 \[A\]);
@@ -280,7 +280,7 @@ pub fn paper_kernel_step(k: &mut PaperKernel, v_ab: Ab<f32>, i_ab: Ab<f32>) -> f
 /// [`paper_kernel_step`] with the observer's gains (16) held over `observer_gain_period`, as
 /// fado holds them by default (0.4 ms: formed once in four samples at 10 kHz, at the end of
 /// the sample, from the new ω̂ of T2S-1): the floor of the method at fado's default gain
-/// period (docs/firmware.md, "Eleventh session").
+/// period (docs/results/firmware-cost.md).
 #[inline(never)]
 // Unmangled in the image, where the cost script finds it by name; the host build
 // (`crates/fado-core/examples/step_driver.rs`, `ESTIMATOR=paper-kernel`) has no such need.

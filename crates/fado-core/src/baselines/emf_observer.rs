@@ -45,25 +45,20 @@
 //!   |(Kp·s + Ki)/(s² + (Kp − Ki/p)·s + Ki)| (1.49 instead of 1.26 at 20 Hz; tested).
 //! - **Parameters.** L̂ errors act through L̂·di/dt (transients) and, as in fado, under load.
 
-use super::{AngleTrackers, GuardedStep, Integrand, TrackerSettings};
+use super::{AngleTrackers, Baseline, BaselineConfig, GuardedStep, Integrand};
 use crate::error::{ConfigError, check};
 use crate::estimator::{Diagnostics, Estimate, RotorAngleEstimator};
-use crate::tracker::BandwidthDefinition;
 use crate::{Ab, Real};
 
-/// Configuration of [`EmfObserverEstimator`]; flat like [`crate::EstimatorConfig`], whose
-/// shared fields have the same names and defaults.
+/// Settings of [`EmfObserverEstimator`] of its own (`[baselines.emf_observer]` in `fado-sim`'s TOML):
+/// plain numbers whose defaults do not depend on the machine.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct EmfObserverConfig<T> {
-    /// Sampling period Ts in s. Default 100 µs (paper, V).
-    pub ts: T,
-    /// Stator resistance estimate R̂s in Ω. From the machine model.
-    pub rs_hat: T,
-    /// Inductance estimate L̂ = L̂d = L̂q in H. From the machine model.
-    pub lq_hat: T,
-    /// Magnet flux linkage estimate λ̂f in Wb: sets the tracker hold level only. Default
-    /// 0.088 Wb (SPEC §6 \[A\]).
-    pub flux_linkage_hat: T,
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(deny_unknown_fields, default)
+)]
+pub struct EmfObserverSettings<T> {
     /// Bandwidth p/2π of the rotating EMF filter in Hz; 2π·p must exceed Ki/Kp of T2S-1.
     /// Default 100 Hz \[A\] (module docs).
     pub emf_bandwidth_hz: T,
@@ -71,60 +66,26 @@ pub struct EmfObserverConfig<T> {
     /// Default 2 Hz \[A\]: there the EMF (1.1 V) is already of the order of the dead-time voltage
     /// error of SPEC §5.
     pub speed_floor_hz: T,
-    /// Bandwidth of T2S-1 in Hz. Default 60 Hz (paper, V), as fado.
-    pub t2s1_bandwidth_hz: T,
-    /// Bandwidth of T2S-2 in Hz. Default 35 Hz (paper, V), as fado.
-    pub t2s2_bandwidth_hz: T,
-    /// Damping ratio of both trackers. Default 1/√2 (SPEC §3 \[A\]).
-    pub tracker_damping: T,
-    /// Meaning of the tracker bandwidths. Default −3 dB (SPEC §3).
-    pub bandwidth_definition: BandwidthDefinition,
-    /// Trackers coast while |λ̂r| is below this fraction of λ̂f. Default 0.2 (SPEC §3 \[A\]).
-    pub tracker_hold_ratio: T,
-    /// Average the current over the interval for the resistive drop. Default true (SPEC §1
-    /// \[A\]).
-    pub average_current: bool,
-    /// Rated (peak) phase current in A, the unit of `plausible_current_ratio`. From the
-    /// machine model.
-    pub rated_current: T,
-    /// DC-link voltage in V, the unit of `plausible_voltage_ratio`. From the machine model.
-    pub dc_voltage: T,
-    /// Samples with |i| above this × `rated_current` are refused (see
-    /// [`crate::plausibility`]). Default 4, as fado's
-    /// ([`crate::EstimatorTuning::plausible_current_ratio`]).
-    pub plausible_current_ratio: T,
-    /// Samples with |v| above this × `dc_voltage` are refused. Default 1.5, as fado's.
-    pub plausible_voltage_ratio: T,
-    /// A current that moved by more than this × (plausible voltage)·ts/L̂q per sample is
-    /// refused; 0 switches the test off. Default 2, as fado's.
-    pub plausible_current_step_ratio: T,
-    /// Rotor angle assumed at reset (rad). Default 0 (SPEC §1 \[A\]).
-    pub initial_angle: T,
 }
 
-impl<T: Real> EmfObserverConfig<T> {
-    /// The default tuning around `machine` (its R̂s, L̂q and λ̂f), sampled at 10 kHz.
-    pub fn for_machine(machine: &crate::MachineModel<T>) -> Self {
+impl<T: Real> Default for EmfObserverSettings<T> {
+    fn default() -> Self {
         Self {
-            ts: T::lit(100e-6),
-            rs_hat: machine.rs,
-            lq_hat: machine.lq,
-            flux_linkage_hat: machine.flux_linkage,
             emf_bandwidth_hz: T::lit(100.0),
             speed_floor_hz: T::lit(2.0),
-            t2s1_bandwidth_hz: T::lit(60.0),
-            t2s2_bandwidth_hz: T::lit(35.0),
-            tracker_damping: T::lit(core::f64::consts::FRAC_1_SQRT_2),
-            bandwidth_definition: BandwidthDefinition::Minus3Db,
-            tracker_hold_ratio: T::lit(0.2),
-            average_current: true,
-            rated_current: machine.rated_current,
-            dc_voltage: machine.dc_voltage,
-            plausible_current_ratio: T::lit(crate::plausibility::CURRENT_RATIO),
-            plausible_voltage_ratio: T::lit(crate::plausibility::VOLTAGE_RATIO),
-            plausible_current_step_ratio: T::lit(crate::plausibility::STEP_RATIO),
-            initial_angle: T::zero(),
         }
+    }
+}
+
+/// Configuration of [`EmfObserverEstimator`]: the machine model, the shared [`CommonTuning`](super::CommonTuning) and
+/// [`EmfObserverSettings`].
+pub type EmfObserverConfig<T> = BaselineConfig<T, EmfObserverSettings<T>>;
+
+impl<T: Real> Baseline<T> for EmfObserverEstimator<T> {
+    type Settings = EmfObserverSettings<T>;
+    const NAME: &'static str = "emf-observer";
+    fn from_config(config: EmfObserverConfig<T>) -> Result<Self, ConfigError> {
+        Self::new(config)
     }
 }
 
@@ -162,28 +123,22 @@ pub struct EmfObserverEstimator<T: Real> {
 impl<T: Real> EmfObserverEstimator<T> {
     /// Builds the estimator; every field of `config` is checked and a bad one is named.
     pub fn new(config: EmfObserverConfig<T>) -> Result<Self, ConfigError> {
-        let ts = check::positive("ts", config.ts)?;
-        check::non_negative("lq_hat", config.lq_hat)?;
-        let integrand = integrand_of!(config, ts)?;
-        let lf = check::positive("flux_linkage_hat", config.flux_linkage_hat)?;
-        let p = T::two_pi() * check::positive("emf_bandwidth_hz", config.emf_bandwidth_hz)?;
+        let ts = check::positive("ts", config.common.ts)?;
+        check::non_negative("lq", config.machine.lq)?;
+        let integrand = integrand_of!(config.machine, config.common, ts)?;
+        let lf = check::positive("flux_linkage", config.machine.flux_linkage)?;
+        let p =
+            T::two_pi() * check::positive("emf_bandwidth_hz", config.settings.emf_bandwidth_hz)?;
         check::below(
             "emf_bandwidth_hz",
             p * ts,
             T::one(),
             "2π·emf_bandwidth_hz·ts below 1",
         )?;
-        let floor = T::two_pi() * check::positive("speed_floor_hz", config.speed_floor_hz)?;
-        check::finite("initial_angle", config.initial_angle)?;
-        let trackers = AngleTrackers::new(TrackerSettings {
-            ts,
-            t2s1_bandwidth_hz: config.t2s1_bandwidth_hz,
-            t2s2_bandwidth_hz: config.t2s2_bandwidth_hz,
-            damping: config.tracker_damping,
-            definition: config.bandwidth_definition,
-            hold_ratio: config.tracker_hold_ratio,
-            flux_linkage_hat: lf,
-        })?;
+        let floor =
+            T::two_pi() * check::positive("speed_floor_hz", config.settings.speed_floor_hz)?;
+        check::finite("initial_angle", config.common.initial_angle)?;
+        let trackers = config.common.trackers(lf)?;
         let (kp, ki) = trackers.t2s1_gains();
         if p * kp <= ki {
             return Err(ConfigError::OutOfRange {
@@ -205,9 +160,9 @@ impl<T: Real> EmfObserverEstimator<T> {
         Ok(est)
     }
 
-    /// Back to the start-up state at `config.initial_angle` with zero current.
+    /// Back to the start-up state at `config.common.initial_angle` with zero current.
     pub fn reset(&mut self) {
-        self.align(self.config.initial_angle, Ab::zero());
+        self.align(self.config.common.initial_angle, Ab::zero());
     }
 
     /// Start-up at a known rotor angle θ0 with the present current: θ̂ = θ0, ω̂ = 0, ê = 0
@@ -218,14 +173,17 @@ impl<T: Real> EmfObserverEstimator<T> {
         } else {
             T::zero()
         };
-        let i_ab =
-            super::usable_align_current(i_ab, self.config.lq_hat, self.config.flux_linkage_hat);
+        let i_ab = super::usable_align_current(
+            i_ab,
+            self.config.machine.lq,
+            self.config.machine.flux_linkage,
+        );
         self.emf = Ab::zero();
         self.integrand.reset_to(i_ab);
         self.trackers.reset_to(theta0);
         self.rejected_samples = 0;
-        let lambda_r = Ab::from_polar(self.config.flux_linkage_hat, theta0);
-        let lambda_s = lambda_r + i_ab * self.config.lq_hat;
+        let lambda_r = Ab::from_polar(self.config.machine.flux_linkage, theta0);
+        let lambda_s = lambda_r + i_ab * self.config.machine.lq;
         self.last = Estimate {
             theta: self.trackers.angle(),
             diagnostics: Diagnostics {
@@ -233,8 +191,8 @@ impl<T: Real> EmfObserverEstimator<T> {
                 lambda2: lambda_s,
                 lambda_r,
                 theta_direct: self.trackers.angle(),
-                rs_hat: self.config.rs_hat,
-                flux_linkage_hat: self.config.flux_linkage_hat,
+                rs_hat: self.config.machine.rs,
+                flux_linkage_hat: self.config.machine.flux_linkage,
                 ..Diagnostics::default()
             },
             ..Estimate::default()
@@ -273,8 +231,8 @@ impl<T: Real> EmfObserverEstimator<T> {
 impl<T: Real> GuardedStep<T> for EmfObserverEstimator<T> {
     #[inline]
     fn step_unchecked(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> Option<Estimate<T>> {
-        let ts = self.config.ts;
-        let lq = self.config.lq_hat;
+        let ts = self.config.common.ts;
+        let lq = self.config.machine.lq;
         let di = i_ab - self.integrand.previous_current().unwrap_or(i_ab);
         let emf_measured = self.integrand.next(v_ab, i_ab) - di * (lq / ts);
         // Half a sample of rotation at ω̂; a = half².
@@ -312,41 +270,23 @@ impl<T: Real> GuardedStep<T> for EmfObserverEstimator<T> {
                 lambda_r,
                 theta_direct: t.theta_direct,
                 tracker_hold: t.hold,
-                rs_hat: self.config.rs_hat,
-                flux_linkage_hat: self.config.flux_linkage_hat,
+                rs_hat: self.config.machine.rs,
+                flux_linkage_hat: self.config.machine.flux_linkage,
                 ..Diagnostics::default()
             },
         })
     }
 
-    fn record(&mut self) -> (&mut Estimate<T>, &mut u32) {
-        (&mut self.last, &mut self.rejected_samples)
-    }
-    fn integrand(&mut self) -> &mut Integrand<T> {
-        &mut self.integrand
-    }
+    guarded_state!();
 }
 
-impl<T: Real> RotorAngleEstimator<T> for EmfObserverEstimator<T> {
-    #[inline]
-    fn step(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> Estimate<T> {
-        EmfObserverEstimator::step(self, v_ab, i_ab)
-    }
-    fn align(&mut self, theta0: T, i_ab: Ab<T>) {
-        EmfObserverEstimator::align(self, theta0, i_ab)
-    }
-    fn reset(&mut self) {
-        EmfObserverEstimator::reset(self)
-    }
-    fn name(&self) -> &'static str {
-        "emf-observer"
-    }
-}
+rotor_angle_estimator!(EmfObserverEstimator);
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::MachineModel;
+    use crate::baselines::CommonTuning;
 
     #[test]
     fn config_errors_name_the_field() {
@@ -354,42 +294,51 @@ mod tests {
         let cases: [(C, &str); 12] = [
             (
                 C {
-                    ts: f64::NAN,
+                    common: CommonTuning {
+                        ts: f64::NAN,
+                        ..Default::default()
+                    },
                     ..C::for_machine(&MachineModel::paper())
                 },
                 "ts",
             ),
             (
-                C {
-                    rs_hat: -0.1,
-                    ..C::for_machine(&MachineModel::paper())
-                },
-                "rs_hat",
+                C::for_machine(&MachineModel {
+                    rs: -0.1,
+                    ..MachineModel::paper()
+                }),
+                "rs",
+            ),
+            (
+                C::for_machine(&MachineModel {
+                    lq: f64::INFINITY,
+                    ..MachineModel::paper()
+                }),
+                "lq",
+            ),
+            (
+                C::for_machine(&MachineModel {
+                    flux_linkage: -0.088,
+                    ..MachineModel::paper()
+                }),
+                "flux_linkage",
             ),
             (
                 C {
-                    lq_hat: f64::INFINITY,
-                    ..C::for_machine(&MachineModel::paper())
-                },
-                "lq_hat",
-            ),
-            (
-                C {
-                    flux_linkage_hat: -0.088,
-                    ..C::for_machine(&MachineModel::paper())
-                },
-                "flux_linkage_hat",
-            ),
-            (
-                C {
-                    emf_bandwidth_hz: 0.0,
+                    settings: EmfObserverSettings {
+                        emf_bandwidth_hz: 0.0,
+                        ..Default::default()
+                    },
                     ..C::for_machine(&MachineModel::paper())
                 },
                 "emf_bandwidth_hz",
             ),
             (
                 C {
-                    emf_bandwidth_hz: 2_000.0,
+                    settings: EmfObserverSettings {
+                        emf_bandwidth_hz: 2_000.0,
+                        ..Default::default()
+                    },
                     ..C::for_machine(&MachineModel::paper())
                 },
                 "emf_bandwidth_hz",
@@ -397,42 +346,60 @@ mod tests {
             // 2π·10 Hz = 63 rad/s < Ki/Kp = 130 rad/s of the 60 Hz T2S-1.
             (
                 C {
-                    emf_bandwidth_hz: 10.0,
+                    settings: EmfObserverSettings {
+                        emf_bandwidth_hz: 10.0,
+                        ..Default::default()
+                    },
                     ..C::for_machine(&MachineModel::paper())
                 },
                 "emf_bandwidth_hz",
             ),
             (
                 C {
-                    speed_floor_hz: 0.0,
+                    settings: EmfObserverSettings {
+                        speed_floor_hz: 0.0,
+                        ..Default::default()
+                    },
                     ..C::for_machine(&MachineModel::paper())
                 },
                 "speed_floor_hz",
             ),
             (
                 C {
-                    t2s1_bandwidth_hz: -60.0,
+                    common: CommonTuning {
+                        t2s1_bandwidth_hz: -60.0,
+                        ..Default::default()
+                    },
                     ..C::for_machine(&MachineModel::paper())
                 },
                 "t2s1_bandwidth_hz",
             ),
             (
                 C {
-                    t2s2_bandwidth_hz: 0.0,
+                    common: CommonTuning {
+                        t2s2_bandwidth_hz: 0.0,
+                        ..Default::default()
+                    },
                     ..C::for_machine(&MachineModel::paper())
                 },
                 "t2s2_bandwidth_hz",
             ),
             (
                 C {
-                    tracker_damping: -1.0,
+                    common: CommonTuning {
+                        tracker_damping: -1.0,
+                        ..Default::default()
+                    },
                     ..C::for_machine(&MachineModel::paper())
                 },
                 "tracker_damping",
             ),
             (
                 C {
-                    initial_angle: f64::NEG_INFINITY,
+                    common: CommonTuning {
+                        initial_angle: f64::NEG_INFINITY,
+                        ..Default::default()
+                    },
                     ..C::for_machine(&MachineModel::paper())
                 },
                 "initial_angle",
@@ -445,7 +412,10 @@ mod tests {
         // Just above the speed-feedback bound is accepted.
         assert!(
             C {
-                emf_bandwidth_hz: 21.0,
+                settings: EmfObserverSettings {
+                    emf_bandwidth_hz: 21.0,
+                    ..Default::default()
+                },
                 ..C::for_machine(&MachineModel::paper())
             }
             .validate()

@@ -50,25 +50,20 @@
 //!   a step decays with 1/ωc (160 ms at the default).
 //! - **Parameters.** Like fado, R̂s errors act at low speed and L̂q errors under load.
 
-use super::{AngleTrackers, GuardedStep, Integrand, TrackerSettings};
+use super::{AngleTrackers, Baseline, BaselineConfig, GuardedStep, Integrand};
 use crate::error::{ConfigError, check};
 use crate::estimator::{Diagnostics, Estimate, RotorAngleEstimator};
-use crate::tracker::BandwidthDefinition;
 use crate::{Ab, Real};
 
-/// Configuration of [`LpfIntegratorEstimator`]; flat like [`crate::EstimatorConfig`], whose
-/// shared fields have the same names and defaults.
+/// Settings of [`LpfIntegratorEstimator`] of its own (`[baselines.lpf_integrator]` in `fado-sim`'s TOML):
+/// plain numbers whose defaults do not depend on the machine.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct LpfIntegratorConfig<T> {
-    /// Sampling period Ts in s. Default 100 µs (paper, V).
-    pub ts: T,
-    /// Stator resistance estimate R̂s in Ω. From the machine model.
-    pub rs_hat: T,
-    /// q-axis inductance estimate L̂q in H (eq. (5)). From the machine model.
-    pub lq_hat: T,
-    /// Magnet flux linkage estimate λ̂f in Wb; sets the start-up flux and the tracker hold
-    /// level only. From the machine model.
-    pub flux_linkage_hat: T,
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(deny_unknown_fields, default)
+)]
+pub struct LpfIntegratorSettings<T> {
     /// Cutoff fc of the low-pass integrator 1/(s + 2π·fc) in Hz; 0 gives the open integrator
     /// of eq. (3). Default 1 Hz \[A\]: one sixth of the 6 Hz electrical speed of the paper's
     /// ±90 r/min tests (compensation 9.5° there), while a DC integrand error ε leaves a bounded
@@ -78,60 +73,26 @@ pub struct LpfIntegratorConfig<T> {
     /// Default 1 Hz \[A\]: equal to the cutoff, so the regularised compensation never exceeds
     /// atan(½) = 27° and at 6 Hz it differs from the exact one by 4.4 mrad.
     pub compensation_floor_hz: T,
-    /// Bandwidth of T2S-1 in Hz. Default 60 Hz (paper, V), as fado.
-    pub t2s1_bandwidth_hz: T,
-    /// Bandwidth of T2S-2 in Hz. Default 35 Hz (paper, V), as fado.
-    pub t2s2_bandwidth_hz: T,
-    /// Damping ratio of both trackers. Default 1/√2 (SPEC §3 \[A\]).
-    pub tracker_damping: T,
-    /// Meaning of the tracker bandwidths. Default −3 dB (SPEC §3).
-    pub bandwidth_definition: BandwidthDefinition,
-    /// Trackers coast while |λ̂r| is below this fraction of λ̂f. Default 0.2 (SPEC §3 \[A\]).
-    pub tracker_hold_ratio: T,
-    /// Average the current over the interval for the resistive drop. Default true (SPEC §1
-    /// \[A\]).
-    pub average_current: bool,
-    /// Rated (peak) phase current in A, the unit of `plausible_current_ratio`. From the
-    /// machine model.
-    pub rated_current: T,
-    /// DC-link voltage in V, the unit of `plausible_voltage_ratio`. From the machine model.
-    pub dc_voltage: T,
-    /// Samples with |i| above this × `rated_current` are refused (see
-    /// [`crate::plausibility`]). Default 4, as fado's
-    /// ([`crate::EstimatorTuning::plausible_current_ratio`]).
-    pub plausible_current_ratio: T,
-    /// Samples with |v| above this × `dc_voltage` are refused. Default 1.5, as fado's.
-    pub plausible_voltage_ratio: T,
-    /// A current that moved by more than this × (plausible voltage)·ts/L̂q per sample is
-    /// refused; 0 switches the test off. Default 2, as fado's.
-    pub plausible_current_step_ratio: T,
-    /// Rotor angle assumed at reset (rad). Default 0 (SPEC §1 \[A\]).
-    pub initial_angle: T,
 }
 
-impl<T: Real> LpfIntegratorConfig<T> {
-    /// The default tuning around `machine` (its R̂s, L̂q and λ̂f), sampled at 10 kHz.
-    pub fn for_machine(machine: &crate::MachineModel<T>) -> Self {
+impl<T: Real> Default for LpfIntegratorSettings<T> {
+    fn default() -> Self {
         Self {
-            ts: T::lit(100e-6),
-            rs_hat: machine.rs,
-            lq_hat: machine.lq,
-            flux_linkage_hat: machine.flux_linkage,
             cutoff_hz: T::lit(1.0),
             compensation_floor_hz: T::lit(1.0),
-            t2s1_bandwidth_hz: T::lit(60.0),
-            t2s2_bandwidth_hz: T::lit(35.0),
-            tracker_damping: T::lit(core::f64::consts::FRAC_1_SQRT_2),
-            bandwidth_definition: BandwidthDefinition::Minus3Db,
-            tracker_hold_ratio: T::lit(0.2),
-            average_current: true,
-            rated_current: machine.rated_current,
-            dc_voltage: machine.dc_voltage,
-            plausible_current_ratio: T::lit(crate::plausibility::CURRENT_RATIO),
-            plausible_voltage_ratio: T::lit(crate::plausibility::VOLTAGE_RATIO),
-            plausible_current_step_ratio: T::lit(crate::plausibility::STEP_RATIO),
-            initial_angle: T::zero(),
         }
+    }
+}
+
+/// Configuration of [`LpfIntegratorEstimator`]: the machine model, the shared [`CommonTuning`](super::CommonTuning) and
+/// [`LpfIntegratorSettings`].
+pub type LpfIntegratorConfig<T> = BaselineConfig<T, LpfIntegratorSettings<T>>;
+
+impl<T: Real> Baseline<T> for LpfIntegratorEstimator<T> {
+    type Settings = LpfIntegratorSettings<T>;
+    const NAME: &'static str = "lpf-integrator";
+    fn from_config(config: LpfIntegratorConfig<T>) -> Result<Self, ConfigError> {
+        Self::new(config)
     }
 }
 
@@ -169,25 +130,20 @@ pub struct LpfIntegratorEstimator<T: Real> {
 impl<T: Real> LpfIntegratorEstimator<T> {
     /// Builds the estimator; every field of `config` is checked and a bad one is named.
     pub fn new(config: LpfIntegratorConfig<T>) -> Result<Self, ConfigError> {
-        let ts = check::positive("ts", config.ts)?;
-        check::non_negative("lq_hat", config.lq_hat)?;
-        let integrand = integrand_of!(config, ts)?;
-        let lf = check::positive("flux_linkage_hat", config.flux_linkage_hat)?;
-        let fc = check::non_negative("cutoff_hz", config.cutoff_hz)?;
+        let ts = check::positive("ts", config.common.ts)?;
+        check::non_negative("lq", config.machine.lq)?;
+        let integrand = integrand_of!(config.machine, config.common, ts)?;
+        let lf = check::positive("flux_linkage", config.machine.flux_linkage)?;
+        let fc = check::non_negative("cutoff_hz", config.settings.cutoff_hz)?;
         let wc = T::two_pi() * fc;
         check::below("cutoff_hz", wc * ts, T::one(), "2π·cutoff_hz·ts below 1")?;
-        let floor =
-            T::two_pi() * check::positive("compensation_floor_hz", config.compensation_floor_hz)?;
-        check::finite("initial_angle", config.initial_angle)?;
-        let trackers = AngleTrackers::new(TrackerSettings {
-            ts,
-            t2s1_bandwidth_hz: config.t2s1_bandwidth_hz,
-            t2s2_bandwidth_hz: config.t2s2_bandwidth_hz,
-            damping: config.tracker_damping,
-            definition: config.bandwidth_definition,
-            hold_ratio: config.tracker_hold_ratio,
-            flux_linkage_hat: lf,
-        })?;
+        let floor = T::two_pi()
+            * check::positive(
+                "compensation_floor_hz",
+                config.settings.compensation_floor_hz,
+            )?;
+        check::finite("initial_angle", config.common.initial_angle)?;
+        let trackers = config.common.trackers(lf)?;
         let mut est = Self {
             config,
             integrand,
@@ -202,9 +158,9 @@ impl<T: Real> LpfIntegratorEstimator<T> {
         Ok(est)
     }
 
-    /// Back to the start-up state at `config.initial_angle` with zero current.
+    /// Back to the start-up state at `config.common.initial_angle` with zero current.
     pub fn reset(&mut self) {
-        self.align(self.config.initial_angle, Ab::zero());
+        self.align(self.config.common.initial_angle, Ab::zero());
     }
 
     /// Start-up at a known rotor angle θ0 with the present current: ψ = λ̂f·e^{jθ0} + L̂q·i
@@ -215,10 +171,13 @@ impl<T: Real> LpfIntegratorEstimator<T> {
         } else {
             T::zero()
         };
-        let i_ab =
-            super::usable_align_current(i_ab, self.config.lq_hat, self.config.flux_linkage_hat);
-        let lambda_r = Ab::from_polar(self.config.flux_linkage_hat, theta0);
-        self.psi = lambda_r + i_ab * self.config.lq_hat;
+        let i_ab = super::usable_align_current(
+            i_ab,
+            self.config.machine.lq,
+            self.config.machine.flux_linkage,
+        );
+        let lambda_r = Ab::from_polar(self.config.machine.flux_linkage, theta0);
+        self.psi = lambda_r + i_ab * self.config.machine.lq;
         self.integrand.reset();
         self.integrand.note_current(i_ab);
         self.trackers.reset_to(theta0);
@@ -230,8 +189,8 @@ impl<T: Real> LpfIntegratorEstimator<T> {
                 lambda2: self.psi,
                 lambda_r,
                 theta_direct: self.trackers.angle(),
-                rs_hat: self.config.rs_hat,
-                flux_linkage_hat: self.config.flux_linkage_hat,
+                rs_hat: self.config.machine.rs,
+                flux_linkage_hat: self.config.machine.flux_linkage,
                 ..Diagnostics::default()
             },
             ..Estimate::default()
@@ -243,7 +202,7 @@ impl<T: Real> LpfIntegratorEstimator<T> {
     /// ω_d/(ω_d² + ω_f²).
     #[inline]
     pub fn compensation(&self, omega: T) -> Ab<T> {
-        let ts = self.config.ts;
+        let ts = self.config.common.ts;
         let (sin_half, cos_half) = (omega * ts * T::lit(0.5)).sin_cos();
         let omega_d = T::lit(2.0) * sin_half / ts;
         let k = self.wc * omega_d / (omega_d * omega_d + self.floor_sq);
@@ -283,9 +242,9 @@ impl<T: Real> GuardedStep<T> for LpfIntegratorEstimator<T> {
     #[inline]
     fn step_unchecked(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> Option<Estimate<T>> {
         let u = self.integrand.next(v_ab, i_ab);
-        let psi = self.psi + (u - self.psi * self.wc) * self.config.ts;
+        let psi = self.psi + (u - self.psi * self.wc) * self.config.common.ts;
         let lambda_s = psi.complex_mul(self.compensation(self.trackers.speed()));
-        let lambda_r = lambda_s - i_ab * self.config.lq_hat;
+        let lambda_r = lambda_s - i_ab * self.config.machine.lq;
         if !(psi.is_finite() && lambda_r.is_finite()) {
             return None;
         }
@@ -304,41 +263,23 @@ impl<T: Real> GuardedStep<T> for LpfIntegratorEstimator<T> {
                 lambda_r,
                 theta_direct: t.theta_direct,
                 tracker_hold: t.hold,
-                rs_hat: self.config.rs_hat,
-                flux_linkage_hat: self.config.flux_linkage_hat,
+                rs_hat: self.config.machine.rs,
+                flux_linkage_hat: self.config.machine.flux_linkage,
                 ..Diagnostics::default()
             },
         })
     }
 
-    fn record(&mut self) -> (&mut Estimate<T>, &mut u32) {
-        (&mut self.last, &mut self.rejected_samples)
-    }
-    fn integrand(&mut self) -> &mut Integrand<T> {
-        &mut self.integrand
-    }
+    guarded_state!();
 }
 
-impl<T: Real> RotorAngleEstimator<T> for LpfIntegratorEstimator<T> {
-    #[inline]
-    fn step(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> Estimate<T> {
-        LpfIntegratorEstimator::step(self, v_ab, i_ab)
-    }
-    fn align(&mut self, theta0: T, i_ab: Ab<T>) {
-        LpfIntegratorEstimator::align(self, theta0, i_ab)
-    }
-    fn reset(&mut self) {
-        LpfIntegratorEstimator::reset(self)
-    }
-    fn name(&self) -> &'static str {
-        "lpf-integrator"
-    }
-}
+rotor_angle_estimator!(LpfIntegratorEstimator);
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::MachineModel;
+    use crate::baselines::CommonTuning;
 
     #[test]
     fn config_errors_name_the_field() {
@@ -346,91 +287,121 @@ mod tests {
         let cases: [(C, &str); 13] = [
             (
                 C {
-                    ts: 0.0,
+                    common: CommonTuning {
+                        ts: 0.0,
+                        ..Default::default()
+                    },
                     ..C::for_machine(&MachineModel::paper())
                 },
                 "ts",
             ),
             (
-                C {
-                    rs_hat: -1.0,
-                    ..C::for_machine(&MachineModel::paper())
-                },
-                "rs_hat",
+                C::for_machine(&MachineModel {
+                    rs: -1.0,
+                    ..MachineModel::paper()
+                }),
+                "rs",
+            ),
+            (
+                C::for_machine(&MachineModel {
+                    lq: f64::NAN,
+                    ..MachineModel::paper()
+                }),
+                "lq",
+            ),
+            (
+                C::for_machine(&MachineModel {
+                    flux_linkage: 0.0,
+                    ..MachineModel::paper()
+                }),
+                "flux_linkage",
             ),
             (
                 C {
-                    lq_hat: f64::NAN,
-                    ..C::for_machine(&MachineModel::paper())
-                },
-                "lq_hat",
-            ),
-            (
-                C {
-                    flux_linkage_hat: 0.0,
-                    ..C::for_machine(&MachineModel::paper())
-                },
-                "flux_linkage_hat",
-            ),
-            (
-                C {
-                    cutoff_hz: -1.0,
-                    ..C::for_machine(&MachineModel::paper())
-                },
-                "cutoff_hz",
-            ),
-            (
-                C {
-                    cutoff_hz: 2_000.0,
+                    settings: LpfIntegratorSettings {
+                        cutoff_hz: -1.0,
+                        ..Default::default()
+                    },
                     ..C::for_machine(&MachineModel::paper())
                 },
                 "cutoff_hz",
             ),
             (
                 C {
-                    compensation_floor_hz: 0.0,
+                    settings: LpfIntegratorSettings {
+                        cutoff_hz: 2_000.0,
+                        ..Default::default()
+                    },
+                    ..C::for_machine(&MachineModel::paper())
+                },
+                "cutoff_hz",
+            ),
+            (
+                C {
+                    settings: LpfIntegratorSettings {
+                        compensation_floor_hz: 0.0,
+                        ..Default::default()
+                    },
                     ..C::for_machine(&MachineModel::paper())
                 },
                 "compensation_floor_hz",
             ),
             (
                 C {
-                    t2s1_bandwidth_hz: 5_000.0,
+                    common: CommonTuning {
+                        t2s1_bandwidth_hz: 5_000.0,
+                        ..Default::default()
+                    },
                     ..C::for_machine(&MachineModel::paper())
                 },
                 "t2s1_bandwidth_hz",
             ),
             (
                 C {
-                    t2s2_bandwidth_hz: f64::NAN,
+                    common: CommonTuning {
+                        t2s2_bandwidth_hz: f64::NAN,
+                        ..Default::default()
+                    },
                     ..C::for_machine(&MachineModel::paper())
                 },
                 "t2s2_bandwidth_hz",
             ),
             (
                 C {
-                    tracker_damping: 0.0,
+                    common: CommonTuning {
+                        tracker_damping: 0.0,
+                        ..Default::default()
+                    },
                     ..C::for_machine(&MachineModel::paper())
                 },
                 "tracker_damping",
             ),
             (
                 C {
-                    tracker_hold_ratio: 1.0,
+                    common: CommonTuning {
+                        tracker_hold_ratio: 1.0,
+                        ..Default::default()
+                    },
                     ..C::for_machine(&MachineModel::paper())
                 },
                 "tracker_hold_ratio",
             ),
             (
                 C {
-                    tracker_hold_ratio: -0.1,
+                    common: CommonTuning {
+                        tracker_hold_ratio: -0.1,
+                        ..Default::default()
+                    },
                     ..C::for_machine(&MachineModel::paper())
                 },
                 "tracker_hold_ratio",
             ),
             (
                 C {
-                    initial_angle: f64::INFINITY,
+                    common: CommonTuning {
+                        initial_angle: f64::INFINITY,
+                        ..Default::default()
+                    },
                     ..C::for_machine(&MachineModel::paper())
                 },
                 "initial_angle",
@@ -443,7 +414,10 @@ mod tests {
         // ωc = 0 is the open integrator of eq. (3).
         assert!(
             C {
-                cutoff_hz: 0.0,
+                settings: LpfIntegratorSettings {
+                    cutoff_hz: 0.0,
+                    ..Default::default()
+                },
                 ..C::for_machine(&MachineModel::paper())
             }
             .validate()
@@ -462,8 +436,10 @@ mod tests {
         // LPF ψ/u = Ts/(1 − (1 − ωcTs)z⁻¹), integrator λ/u = Ts/(1 − z⁻¹): the compensation
         // must equal their ratio (1 − (1 − ωcTs)z⁻¹)/(1 − z⁻¹) at z = e^{jωTs} (floor → 0).
         let est = LpfIntegratorEstimator::new(LpfIntegratorConfig {
-            cutoff_hz: 3.0,
-            compensation_floor_hz: 1e-9,
+            settings: LpfIntegratorSettings {
+                cutoff_hz: 3.0,
+                compensation_floor_hz: 1e-9,
+            },
             ..LpfIntegratorConfig::for_machine(&MachineModel::paper())
         })
         .unwrap();
@@ -501,7 +477,10 @@ mod tests {
     fn dc_integrand_settles_at_eps_over_wc() {
         // The bounded drift that replaces the open integrator's ramp: ψ → ε/ωc.
         let mut est = LpfIntegratorEstimator::new(LpfIntegratorConfig::<f64> {
-            flux_linkage_hat: 1e-3,
+            machine: MachineModel {
+                flux_linkage: 1e-3,
+                ..LpfIntegratorConfig::for_machine(&MachineModel::paper()).machine
+            },
             ..LpfIntegratorConfig::for_machine(&MachineModel::paper())
         })
         .unwrap();

@@ -7,14 +7,16 @@
 //! | [`lpf_integrator`] | 1/(s + ωc) with gain/phase compensation at ω̂ | the low-pass pole ωc |
 //! | [`ortega`] | Lee, Hong, Nam, Ortega, Praly, Astolfi (2010) nonlinear observer | pulling \|λs − L̂·i\| to λ̂f |
 //! | [`emf_observer`] | extended-EMF observer in α-β, angle = ∠ê − sgn(ω̂)·π/2 | none needed: no integrator |
+//! | [`reduced_order`] | Hinkkanen et al. (2018) reduced-order observer in estimated rotor coordinates, with its own angle and speed loop | correcting ψ̂ with the flux read from the current |
 //!
-//! Every baseline implements [`RotorAngleEstimator`](crate::RotorAngleEstimator) and follows
-//! the crate's rules: a flat config with documented defaults, `new(config)` naming a bad
-//! field, `step`/`align`/`reset`, allocation-free, generic over `f32`/`f64`, and a rejected
+//! Every baseline implements [`RotorAngleEstimator`] and
+//! [`Baseline`], and follows the crate's rules: its config is the [`MachineModel`], the
+//! [`CommonTuning`] every estimator shares and a small record of its own settings (plain
+//! numbers with documented defaults), `new(config)` naming a bad field, `step`/`align`/`reset`, allocation-free, generic over `f32`/`f64`, and a rejected
 //! sample leaves the state untouched and sets `diagnostics.input_fault`. A sample is rejected
 //! when it is non-finite, when it lies outside what the machine and inverter can produce (the
 //! bounds of [`crate::plausibility`], with fado's `plausible_*` ratios and defaults, from each
-//! config's `rated_current`, `dc_voltage` and `lq_hat`: until 2026-11-28 a finite 1e6 A sample
+//! machine's `rated_current`, `dc_voltage` and `lq`: until 2026-11-28 a finite 1e6 A sample
 //! went through and left a baseline's angle off), or when the new state it gives overflows
 //! (each step computes its whole new state and commits it only if finite, as fado's does; until
 //! 2026-11-28 each step copied the whole estimator as a backup instead). [`Diagnostics`](crate::Diagnostics) fields a baseline has no
@@ -35,33 +37,190 @@
 //! - the EMF observer has nothing to measure at zero speed (e = jω·λf) and needs the sign of
 //!   ω̂, so a reversal through zero flips its angle reference.
 
-/// The [`Integrand`] of a baseline's config (every baseline config has the fields of the same
-/// names): R̂s, the current averaging and the sample bounds.
+/// The [`Integrand`] of a baseline from its machine model and [`CommonTuning`]: R̂s, the
+/// current averaging and the sample bounds.
 macro_rules! integrand_of {
-    ($config:expr, $ts:expr) => {
+    ($machine:expr, $common:expr, $ts:expr) => {
         super::Integrand::new(
-            $config.rs_hat,
-            $config.average_current,
+            $machine.rs,
+            $common.average_current,
             crate::plausibility::SampleBounds::from_ratios(
-                $config.plausible_current_ratio,
-                $config.plausible_voltage_ratio,
-                $config.plausible_current_step_ratio,
-                $config.rated_current,
-                $config.dc_voltage,
-                $config.lq_hat,
+                $common.plausible_current_ratio,
+                $common.plausible_voltage_ratio,
+                $common.plausible_current_step_ratio,
+                $machine.rated_current,
+                $machine.dc_voltage,
+                $machine.lq,
                 $ts,
             )?,
         )
     };
 }
 
+/// A baseline's [`GuardedStep`] bookkeeping: its `last` estimate, `rejected_samples` counter and
+/// `integrand`.
+macro_rules! guarded_state {
+    () => {
+        fn record(&mut self) -> (&mut Estimate<T>, &mut u32) {
+            (&mut self.last, &mut self.rejected_samples)
+        }
+        fn integrand(&mut self) -> &mut Integrand<T> {
+            &mut self.integrand
+        }
+    };
+}
+
+/// [`RotorAngleEstimator`] of a baseline through its own `step`, `align` and `reset`, named
+/// by [`Baseline::NAME`].
+macro_rules! rotor_angle_estimator {
+    ($ty:ident) => {
+        impl<T: Real> RotorAngleEstimator<T> for $ty<T> {
+            #[inline]
+            fn step(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> Estimate<T> {
+                $ty::step(self, v_ab, i_ab)
+            }
+            fn align(&mut self, theta0: T, i_ab: Ab<T>) {
+                $ty::align(self, theta0, i_ab)
+            }
+            fn reset(&mut self) {
+                $ty::reset(self)
+            }
+            fn name(&self) -> &'static str {
+                <Self as Baseline<T>>::NAME
+            }
+        }
+    };
+}
+
 pub mod emf_observer;
 pub mod lpf_integrator;
 pub mod ortega;
+pub mod reduced_order;
 
-pub use emf_observer::{EmfObserverConfig, EmfObserverEstimator};
-pub use lpf_integrator::{LpfIntegratorConfig, LpfIntegratorEstimator};
-pub use ortega::{OrtegaConfig, OrtegaEstimator};
+pub use emf_observer::{EmfObserverConfig, EmfObserverEstimator, EmfObserverSettings};
+pub use lpf_integrator::{LpfIntegratorConfig, LpfIntegratorEstimator, LpfIntegratorSettings};
+pub use ortega::{OrtegaConfig, OrtegaEstimator, OrtegaSettings};
+pub use reduced_order::{ReducedOrderConfig, ReducedOrderEstimator, ReducedOrderSettings};
+
+/// What every baseline shares with [`crate::EstimatorConfig`] besides the machine model: the
+/// sampling period, the two type-2 trackers, the current averaging of the integrand, the
+/// sample bounds and the start-up angle. One record, so that a comparison gives every
+/// estimator the same values (`fado-sim` fills it from `[estimator]`). Defaults are fado's.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CommonTuning<T> {
+    /// Sampling period Ts in s. Default 100 µs (paper, V).
+    pub ts: T,
+    /// Bandwidth of T2S-1 (angle, and the speed the baseline feeds back to itself) in Hz.
+    /// Default 60 Hz (paper, V), as fado.
+    pub t2s1_bandwidth_hz: T,
+    /// Bandwidth of T2S-2 (speed for control) in Hz. Default 35 Hz (paper, V), as fado.
+    pub t2s2_bandwidth_hz: T,
+    /// Damping ratio of both trackers. Default 1/√2 (SPEC §3 \[A\]).
+    pub tracker_damping: T,
+    /// Meaning of the tracker bandwidths. Default −3 dB (SPEC §3).
+    pub bandwidth_definition: BandwidthDefinition,
+    /// Trackers coast while the estimated rotor flux is below this fraction of λ̂f. Default
+    /// 0.2 (SPEC §3 \[A\]).
+    pub tracker_hold_ratio: T,
+    /// Average the current over the interval for the resistive drop. Default true (SPEC §1
+    /// \[A\]).
+    pub average_current: bool,
+    /// Samples with |i| above this × the machine's `rated_current` are refused (see
+    /// [`crate::plausibility`]). Default 4, as fado's
+    /// ([`crate::EstimatorTuning::plausible_current_ratio`]).
+    pub plausible_current_ratio: T,
+    /// Samples with |v| above this × the machine's `dc_voltage` are refused. Default 1.5, as
+    /// fado's.
+    pub plausible_voltage_ratio: T,
+    /// A current that moved by more than this × (plausible voltage)·ts/L̂q per sample is
+    /// refused; 0 switches the test off. Default 2, as fado's.
+    pub plausible_current_step_ratio: T,
+    /// Rotor angle assumed at reset (rad). Default 0 (SPEC §1 \[A\]).
+    pub initial_angle: T,
+}
+
+impl<T: Real> Default for CommonTuning<T> {
+    fn default() -> Self {
+        Self {
+            ts: T::lit(100e-6),
+            t2s1_bandwidth_hz: T::lit(60.0),
+            t2s2_bandwidth_hz: T::lit(35.0),
+            tracker_damping: T::lit(core::f64::consts::FRAC_1_SQRT_2),
+            bandwidth_definition: BandwidthDefinition::Minus3Db,
+            tracker_hold_ratio: T::lit(0.2),
+            average_current: true,
+            plausible_current_ratio: T::lit(crate::plausibility::CURRENT_RATIO),
+            plausible_voltage_ratio: T::lit(crate::plausibility::VOLTAGE_RATIO),
+            plausible_current_step_ratio: T::lit(crate::plausibility::STEP_RATIO),
+            initial_angle: T::zero(),
+        }
+    }
+}
+
+impl<T: Real> CommonTuning<T> {
+    /// The two trackers of a baseline whose hold level is `tracker_hold_ratio` × λ̂f.
+    fn trackers(&self, flux_linkage_hat: T) -> Result<AngleTrackers<T>, ConfigError> {
+        let ts = check::positive("ts", self.ts)?;
+        AngleTrackers::new(TrackerSettings {
+            ts,
+            t2s1_bandwidth_hz: self.t2s1_bandwidth_hz,
+            t2s2_bandwidth_hz: self.t2s2_bandwidth_hz,
+            damping: self.tracker_damping,
+            definition: self.bandwidth_definition,
+            hold_ratio: self.tracker_hold_ratio,
+            flux_linkage_hat,
+        })
+    }
+}
+
+/// The configuration of a baseline: the drive's [`MachineModel`] (its R̂s, L̂q, λ̂f, rated
+/// current and DC link), the [`CommonTuning`] every estimator shares, and the baseline's own
+/// settings `S` (plain numbers whose defaults do not depend on the machine).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BaselineConfig<T, S> {
+    /// The drive's model of the machine.
+    pub machine: MachineModel<T>,
+    /// Sampling, trackers, integrand and sample bounds, as fado's.
+    pub common: CommonTuning<T>,
+    /// The baseline's own settings.
+    pub settings: S,
+}
+
+impl<T: Real, S: Default> BaselineConfig<T, S> {
+    /// The default tuning around `machine`, sampled at 10 kHz.
+    pub fn for_machine(machine: &MachineModel<T>) -> Self {
+        Self {
+            machine: *machine,
+            common: CommonTuning::default(),
+            settings: S::default(),
+        }
+    }
+}
+
+/// A baseline as a registry builds it: from the machine model, the [`CommonTuning`] and its
+/// own settings.
+pub trait Baseline<T: Real>: RotorAngleEstimator<T> + Sized {
+    /// Its own settings (`[baselines.<name>]` in `fado-sim`'s TOML).
+    type Settings: Copy + Default + PartialEq + core::fmt::Debug;
+    /// Its name in tables, as [`RotorAngleEstimator::name`] gives it (`ortega`).
+    const NAME: &'static str;
+    /// Builds it; a bad value is named by its field (a machine field by the machine's name:
+    /// `rs`, `lq`, `flux_linkage`, ...).
+    fn from_config(config: BaselineConfig<T, Self::Settings>) -> Result<Self, ConfigError>;
+
+    /// Builds it from its parts.
+    fn build(
+        machine: &MachineModel<T>,
+        common: &CommonTuning<T>,
+        settings: &Self::Settings,
+    ) -> Result<Self, ConfigError> {
+        Self::from_config(BaselineConfig {
+            machine: *machine,
+            common: *common,
+            settings: *settings,
+        })
+    }
+}
 
 /// The current an `align` may start from: a non-finite one, or one so large that the start-up
 /// flux λ̂f·e^{jθ0} + L̂q·i would overflow (found by fuzzing, f32 with L̂q = 3e37 H), is
@@ -118,7 +277,7 @@ pub(crate) trait GuardedStep<T: Real> {
 use crate::error::{ConfigError, check};
 use crate::plausibility::SampleBounds;
 use crate::tracker::{BandwidthDefinition, TrackerConfig, TypeTwoTracker};
-use crate::{Ab, Real};
+use crate::{Ab, MachineModel, Real, RotorAngleEstimator};
 
 /// Renames the field of a sub-block's error to the flat config's field name.
 fn renamed(field: &'static str) -> impl Fn(ConfigError) -> ConfigError {
@@ -153,7 +312,7 @@ pub(crate) struct Integrand<T> {
 
 impl<T: Real> Integrand<T> {
     fn new(rs_hat: T, average_current: bool, bounds: SampleBounds<T>) -> Result<Self, ConfigError> {
-        let rs_hat = check::non_negative("rs_hat", rs_hat)?;
+        let rs_hat = check::non_negative("rs", rs_hat)?;
         Ok(Self {
             rs_hat,
             average_current,
@@ -339,7 +498,7 @@ mod tests {
 
     /// Warms `est` up on a rotating machine-like input, then checks that non-finite,
     /// overflowing and implausible samples are refused with the state left exactly as it was.
-    fn rejects_bad_samples<E: RotorAngleEstimator<f32> + Clone>(mut est: E) {
+    pub(super) fn rejects_bad_samples<E: RotorAngleEstimator<f32> + Clone>(mut est: E) {
         let (w, ts) = (125.0_f32, 1e-4_f32);
         let mut last = None;
         for n in 0..200 {
@@ -436,7 +595,10 @@ mod tests {
         }
         check(
             LpfIntegratorEstimator::new(LpfIntegratorConfig {
-                initial_angle: 0.3,
+                common: CommonTuning {
+                    initial_angle: 0.3,
+                    ..Default::default()
+                },
                 ..LpfIntegratorConfig::for_machine(&MachineModel::paper())
             })
             .unwrap(),
@@ -444,7 +606,10 @@ mod tests {
         );
         check(
             OrtegaEstimator::new(OrtegaConfig {
-                initial_angle: 0.3,
+                common: CommonTuning {
+                    initial_angle: 0.3,
+                    ..Default::default()
+                },
                 ..OrtegaConfig::for_machine(&MachineModel::paper())
             })
             .unwrap(),
@@ -452,7 +617,10 @@ mod tests {
         );
         check(
             EmfObserverEstimator::new(EmfObserverConfig {
-                initial_angle: 0.3,
+                common: CommonTuning {
+                    initial_angle: 0.3,
+                    ..Default::default()
+                },
                 ..EmfObserverConfig::for_machine(&MachineModel::paper())
             })
             .unwrap(),

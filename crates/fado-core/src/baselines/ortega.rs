@@ -80,99 +80,59 @@
 //!   the EMF observer only see a magnitude error; L̂ errors act under load as in fado; the
 //!   model assumes Ld = Lq.
 
-use super::{AngleTrackers, GuardedStep, Integrand, TrackerSettings};
+use super::{AngleTrackers, Baseline, BaselineConfig, GuardedStep, Integrand};
 use crate::error::{ConfigError, check};
 use crate::estimator::{Diagnostics, Estimate, RotorAngleEstimator};
-use crate::tracker::BandwidthDefinition;
 use crate::{Ab, Real};
 
 /// Lower and upper bound of the adapted flux linkage relative to λ̂f (VESC's bounds).
 const ADAPTATION_BOUNDS: (f64, f64) = (0.3, 2.5);
 
-/// Configuration of [`OrtegaEstimator`]; flat like [`crate::EstimatorConfig`], whose shared
-/// fields have the same names and defaults.
+/// Settings of [`OrtegaEstimator`] of its own (`[baselines.ortega]` in `fado-sim`'s TOML):
+/// plain numbers whose defaults do not depend on the machine.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct OrtegaConfig<T> {
-    /// Sampling period Ts in s. Default 100 µs (paper, V).
-    pub ts: T,
-    /// Stator resistance estimate R̂s in Ω. From the machine model.
-    pub rs_hat: T,
-    /// Inductance estimate L̂ = L̂d = L̂q in H (the observer assumes a non-salient machine).
-    /// From the machine model.
-    pub lq_hat: T,
-    /// Magnet flux linkage estimate λ̂f in Wb: the radius η̂ is pulled to. Unlike fado, the
-    /// angle depends on it (module docs). From the machine model.
-    pub flux_linkage_hat: T,
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(deny_unknown_fields, default)
+)]
+pub struct OrtegaSettings<T> {
     /// Radial (flux-magnitude) correction rate ω_obs = γ·λ̂f² in rad/s: the fixed value when
-    /// `observer_speed_ratio` is 0, else the upper bound ω_max of the schedule; times `ts` it
-    /// must be below 1. Default 2·2π·100 ≈ 1257 rad/s \[A\]: critically damped at the rated
-    /// 1500 r/min (module docs).
+    /// `observer_speed_ratio` is 0, else the upper bound ω_max of the schedule; times `ts`
+    /// it must be below 1. Default 2·2π·100 ≈ 1257 rad/s \[A\]: critically damped at the
+    /// rated 1500 r/min (module docs).
     pub observer_bandwidth: T,
     /// Speed ratio k of the schedule ω_obs = clamp(k·|ω̂|, ω_min, ω_max); 0 fixes
-    /// ω_obs = `observer_bandwidth`. Default 2 \[A\]: critically damped at every speed (module
-    /// docs).
+    /// ω_obs = `observer_bandwidth`. Default 2 \[A\]: critically damped at every speed
+    /// (module docs).
     pub observer_speed_ratio: T,
     /// Lower bound ω_min of the schedule in rad/s, at most `observer_bandwidth`. Default
     /// 2·2π·1.5 ≈ 18.8 rad/s \[A\]: critical down to fado's 1.5 Hz mode threshold (paper, V).
     pub observer_bandwidth_min: T,
     /// Flux-linkage adaptation ratio κ (module docs); 0 disables it. Default 0 \[A\].
     pub flux_adaptation_ratio: T,
-    /// Bandwidth of T2S-1 in Hz. Default 60 Hz (paper, V), as fado.
-    pub t2s1_bandwidth_hz: T,
-    /// Bandwidth of T2S-2 in Hz. Default 35 Hz (paper, V), as fado.
-    pub t2s2_bandwidth_hz: T,
-    /// Damping ratio of both trackers. Default 1/√2 (SPEC §3 \[A\]).
-    pub tracker_damping: T,
-    /// Meaning of the tracker bandwidths. Default −3 dB (SPEC §3).
-    pub bandwidth_definition: BandwidthDefinition,
-    /// Trackers coast while |η̂| is below this fraction of λ̂f. Default 0.2 (SPEC §3 \[A\]).
-    pub tracker_hold_ratio: T,
-    /// Average the current over the interval for the resistive drop. Default true (SPEC §1
-    /// \[A\]).
-    pub average_current: bool,
-    /// Rated (peak) phase current in A, the unit of `plausible_current_ratio`. From the
-    /// machine model.
-    pub rated_current: T,
-    /// DC-link voltage in V, the unit of `plausible_voltage_ratio`. From the machine model.
-    pub dc_voltage: T,
-    /// Samples with |i| above this × `rated_current` are refused (see
-    /// [`crate::plausibility`]). Default 4, as fado's
-    /// ([`crate::EstimatorTuning::plausible_current_ratio`]).
-    pub plausible_current_ratio: T,
-    /// Samples with |v| above this × `dc_voltage` are refused. Default 1.5, as fado's.
-    pub plausible_voltage_ratio: T,
-    /// A current that moved by more than this × (plausible voltage)·ts/L̂q per sample is
-    /// refused; 0 switches the test off. Default 2, as fado's.
-    pub plausible_current_step_ratio: T,
-    /// Rotor angle assumed at reset (rad). Default 0 (SPEC §1 \[A\]).
-    pub initial_angle: T,
 }
 
-impl<T: Real> OrtegaConfig<T> {
-    /// The default tuning around `machine` (its R̂s, L̂q and λ̂f), sampled at 10 kHz.
-    pub fn for_machine(machine: &crate::MachineModel<T>) -> Self {
+impl<T: Real> Default for OrtegaSettings<T> {
+    fn default() -> Self {
         Self {
-            ts: T::lit(100e-6),
-            rs_hat: machine.rs,
-            lq_hat: machine.lq,
-            flux_linkage_hat: machine.flux_linkage,
             observer_bandwidth: T::lit(2.0 * core::f64::consts::TAU * 100.0),
             observer_speed_ratio: T::lit(2.0),
             observer_bandwidth_min: T::lit(2.0 * core::f64::consts::TAU * 1.5),
             flux_adaptation_ratio: T::zero(),
-            t2s1_bandwidth_hz: T::lit(60.0),
-            t2s2_bandwidth_hz: T::lit(35.0),
-            tracker_damping: T::lit(core::f64::consts::FRAC_1_SQRT_2),
-            bandwidth_definition: BandwidthDefinition::Minus3Db,
-            tracker_hold_ratio: T::lit(0.2),
-            average_current: true,
-            rated_current: machine.rated_current,
-            dc_voltage: machine.dc_voltage,
-            plausible_current_ratio: T::lit(crate::plausibility::CURRENT_RATIO),
-            plausible_voltage_ratio: T::lit(crate::plausibility::VOLTAGE_RATIO),
-            plausible_current_step_ratio: T::lit(crate::plausibility::STEP_RATIO),
-            initial_angle: T::zero(),
         }
+    }
+}
+
+/// Configuration of [`OrtegaEstimator`]: the machine model, the shared [`CommonTuning`](super::CommonTuning) and
+/// [`OrtegaSettings`].
+pub type OrtegaConfig<T> = BaselineConfig<T, OrtegaSettings<T>>;
+
+impl<T: Real> Baseline<T> for OrtegaEstimator<T> {
+    type Settings = OrtegaSettings<T>;
+    const NAME: &'static str = "ortega";
+    fn from_config(config: OrtegaConfig<T>) -> Result<Self, ConfigError> {
+        Self::new(config)
     }
 }
 
@@ -184,18 +144,19 @@ impl<T: Real> OrtegaConfig<T> {
 
     /// γ of the paper's eq. (8), ω_obs/λ̂f², in Wb⁻²·s⁻¹, for the speed ω̂ (rad/s).
     pub fn gamma(&self, omega: T) -> T {
-        self.scheduled_bandwidth(omega) / (self.flux_linkage_hat * self.flux_linkage_hat)
+        self.scheduled_bandwidth(omega) / (self.machine.flux_linkage * self.machine.flux_linkage)
     }
 
     /// ω_obs at the speed ω̂ (rad/s): clamp(k·|ω̂|, ω_min, ω_max), or the fixed value.
     #[inline]
     pub fn scheduled_bandwidth(&self, omega: T) -> T {
-        if self.observer_speed_ratio > T::zero() {
-            (self.observer_speed_ratio * omega.abs())
-                .max(self.observer_bandwidth_min)
-                .min(self.observer_bandwidth)
+        let s = &self.settings;
+        if s.observer_speed_ratio > T::zero() {
+            (s.observer_speed_ratio * omega.abs())
+                .max(s.observer_bandwidth_min)
+                .min(s.observer_bandwidth)
         } else {
-            self.observer_bandwidth
+            s.observer_bandwidth
         }
     }
 }
@@ -227,36 +188,34 @@ pub struct OrtegaEstimator<T: Real> {
 impl<T: Real> OrtegaEstimator<T> {
     /// Builds the estimator; every field of `config` is checked and a bad one is named.
     pub fn new(config: OrtegaConfig<T>) -> Result<Self, ConfigError> {
-        let ts = check::positive("ts", config.ts)?;
-        check::non_negative("lq_hat", config.lq_hat)?;
-        let integrand = integrand_of!(config, ts)?;
-        let lf = check::positive("flux_linkage_hat", config.flux_linkage_hat)?;
-        let w_obs = check::positive("observer_bandwidth", config.observer_bandwidth)?;
+        let ts = check::positive("ts", config.common.ts)?;
+        check::non_negative("lq", config.machine.lq)?;
+        let integrand = integrand_of!(config.machine, config.common, ts)?;
+        let lf = check::positive("flux_linkage", config.machine.flux_linkage)?;
+        let w_obs = check::positive("observer_bandwidth", config.settings.observer_bandwidth)?;
         check::below(
             "observer_bandwidth",
             w_obs * ts,
             T::one(),
             "observer_bandwidth·ts below 1",
         )?;
-        check::non_negative("observer_speed_ratio", config.observer_speed_ratio)?;
-        let w_min = check::positive("observer_bandwidth_min", config.observer_bandwidth_min)?;
+        check::non_negative("observer_speed_ratio", config.settings.observer_speed_ratio)?;
+        let w_min = check::positive(
+            "observer_bandwidth_min",
+            config.settings.observer_bandwidth_min,
+        )?;
         check::below(
             "observer_bandwidth_min",
             w_min,
             w_obs * (T::one() + T::default_epsilon()),
             "at most observer_bandwidth",
         )?;
-        check::non_negative("flux_adaptation_ratio", config.flux_adaptation_ratio)?;
-        check::finite("initial_angle", config.initial_angle)?;
-        let trackers = AngleTrackers::new(TrackerSettings {
-            ts,
-            t2s1_bandwidth_hz: config.t2s1_bandwidth_hz,
-            t2s2_bandwidth_hz: config.t2s2_bandwidth_hz,
-            damping: config.tracker_damping,
-            definition: config.bandwidth_definition,
-            hold_ratio: config.tracker_hold_ratio,
-            flux_linkage_hat: lf,
-        })?;
+        check::non_negative(
+            "flux_adaptation_ratio",
+            config.settings.flux_adaptation_ratio,
+        )?;
+        check::finite("initial_angle", config.common.initial_angle)?;
+        let trackers = config.common.trackers(lf)?;
         let mut est = Self {
             config,
             integrand,
@@ -271,9 +230,9 @@ impl<T: Real> OrtegaEstimator<T> {
         Ok(est)
     }
 
-    /// Back to the start-up state at `config.initial_angle` with zero current.
+    /// Back to the start-up state at `config.common.initial_angle` with zero current.
     pub fn reset(&mut self) {
-        self.align(self.config.initial_angle, Ab::zero());
+        self.align(self.config.common.initial_angle, Ab::zero());
     }
 
     /// Start-up at a known rotor angle θ0 with the present current: x̂ = λ̂f·e^{jθ0} + L̂·i,
@@ -284,11 +243,14 @@ impl<T: Real> OrtegaEstimator<T> {
         } else {
             T::zero()
         };
-        let i_ab =
-            super::usable_align_current(i_ab, self.config.lq_hat, self.config.flux_linkage_hat);
-        self.lambda = self.config.flux_linkage_hat;
+        let i_ab = super::usable_align_current(
+            i_ab,
+            self.config.machine.lq,
+            self.config.machine.flux_linkage,
+        );
+        self.lambda = self.config.machine.flux_linkage;
         let eta = Ab::from_polar(self.lambda, theta0);
-        self.x = eta + i_ab * self.config.lq_hat;
+        self.x = eta + i_ab * self.config.machine.lq;
         self.integrand.reset();
         self.integrand.note_current(i_ab);
         self.trackers.reset_to(theta0);
@@ -300,8 +262,8 @@ impl<T: Real> OrtegaEstimator<T> {
                 lambda2: self.x,
                 lambda_r: eta,
                 theta_direct: self.trackers.angle(),
-                rs_hat: self.config.rs_hat,
-                flux_linkage_hat: self.config.flux_linkage_hat,
+                rs_hat: self.config.machine.rs,
+                flux_linkage_hat: self.config.machine.flux_linkage,
                 ..Diagnostics::default()
             },
             ..Estimate::default()
@@ -340,18 +302,18 @@ impl<T: Real> OrtegaEstimator<T> {
 impl<T: Real> GuardedStep<T> for OrtegaEstimator<T> {
     #[inline]
     fn step_unchecked(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> Option<Estimate<T>> {
-        let li = i_ab * self.config.lq_hat;
+        let li = i_ab * self.config.machine.lq;
         // Predict with the voltage model, then correct radially with the fresh current.
-        let x_pred = self.x + self.integrand.next(v_ab, i_ab) * self.config.ts;
+        let x_pred = self.x + self.integrand.next(v_ab, i_ab) * self.config.common.ts;
         let eta_pred = x_pred - li;
         let radius_error = self.lambda * self.lambda - eta_pred.norm_squared();
         let k_ts = self.ts_half_over_lf2 * self.config.scheduled_bandwidth(self.trackers.speed());
         let k = (k_ts * radius_error).max(T::lit(-0.5));
         let x = x_pred + eta_pred * k;
         let eta = x - li;
-        let kappa = self.config.flux_adaptation_ratio;
+        let kappa = self.config.settings.flux_adaptation_ratio;
         let lambda = if kappa > T::zero() {
-            let lf = self.config.flux_linkage_hat;
+            let lf = self.config.machine.flux_linkage;
             let (lo, hi) = ADAPTATION_BOUNDS;
             (self.lambda - kappa * k_ts * self.lambda * radius_error)
                 .max(T::lit(lo) * lf)
@@ -378,182 +340,209 @@ impl<T: Real> GuardedStep<T> for OrtegaEstimator<T> {
                 lambda_r: eta,
                 theta_direct: t.theta_direct,
                 tracker_hold: t.hold,
-                rs_hat: self.config.rs_hat,
-                flux_linkage_hat: self.config.flux_linkage_hat,
+                rs_hat: self.config.machine.rs,
+                flux_linkage_hat: self.config.machine.flux_linkage,
                 ..Diagnostics::default()
             },
         })
     }
 
-    fn record(&mut self) -> (&mut Estimate<T>, &mut u32) {
-        (&mut self.last, &mut self.rejected_samples)
-    }
-    fn integrand(&mut self) -> &mut Integrand<T> {
-        &mut self.integrand
-    }
+    guarded_state!();
 }
 
-impl<T: Real> RotorAngleEstimator<T> for OrtegaEstimator<T> {
-    #[inline]
-    fn step(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> Estimate<T> {
-        OrtegaEstimator::step(self, v_ab, i_ab)
-    }
-    fn align(&mut self, theta0: T, i_ab: Ab<T>) {
-        OrtegaEstimator::align(self, theta0, i_ab)
-    }
-    fn reset(&mut self) {
-        OrtegaEstimator::reset(self)
-    }
-    fn name(&self) -> &'static str {
-        "ortega"
-    }
-}
+rotor_angle_estimator!(OrtegaEstimator);
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::MachineModel;
+    use crate::baselines::CommonTuning;
 
     #[test]
     fn config_errors_name_the_field() {
         type C = OrtegaConfig<f64>;
         let cases: [(C, &str); 20] = [
             (
-                C {
+                C::for_machine(&MachineModel {
                     rated_current: f64::NAN,
-                    ..C::for_machine(&MachineModel::paper())
-                },
+                    ..MachineModel::paper()
+                }),
                 "rated_current",
             ),
             (
-                C {
+                C::for_machine(&MachineModel {
                     dc_voltage: 0.0,
-                    ..C::for_machine(&MachineModel::paper())
-                },
+                    ..MachineModel::paper()
+                }),
                 "dc_voltage",
             ),
             (
                 C {
-                    plausible_current_ratio: -4.0,
+                    common: CommonTuning {
+                        plausible_current_ratio: -4.0,
+                        ..Default::default()
+                    },
                     ..C::for_machine(&MachineModel::paper())
                 },
                 "plausible_current_ratio",
             ),
             (
                 C {
-                    plausible_voltage_ratio: f64::INFINITY,
+                    common: CommonTuning {
+                        plausible_voltage_ratio: f64::INFINITY,
+                        ..Default::default()
+                    },
                     ..C::for_machine(&MachineModel::paper())
                 },
                 "plausible_voltage_ratio",
             ),
             (
                 C {
-                    plausible_current_step_ratio: f64::NAN,
+                    common: CommonTuning {
+                        plausible_current_step_ratio: f64::NAN,
+                        ..Default::default()
+                    },
                     ..C::for_machine(&MachineModel::paper())
                 },
                 "plausible_current_step_ratio",
             ),
             (
                 C {
-                    ts: -1e-4,
+                    common: CommonTuning {
+                        ts: -1e-4,
+                        ..Default::default()
+                    },
                     ..C::for_machine(&MachineModel::paper())
                 },
                 "ts",
             ),
             (
-                C {
-                    rs_hat: f64::NAN,
-                    ..C::for_machine(&MachineModel::paper())
-                },
-                "rs_hat",
+                C::for_machine(&MachineModel {
+                    rs: f64::NAN,
+                    ..MachineModel::paper()
+                }),
+                "rs",
+            ),
+            (
+                C::for_machine(&MachineModel {
+                    lq: -1e-3,
+                    ..MachineModel::paper()
+                }),
+                "lq",
+            ),
+            (
+                C::for_machine(&MachineModel {
+                    flux_linkage: 0.0,
+                    ..MachineModel::paper()
+                }),
+                "flux_linkage",
             ),
             (
                 C {
-                    lq_hat: -1e-3,
-                    ..C::for_machine(&MachineModel::paper())
-                },
-                "lq_hat",
-            ),
-            (
-                C {
-                    flux_linkage_hat: 0.0,
-                    ..C::for_machine(&MachineModel::paper())
-                },
-                "flux_linkage_hat",
-            ),
-            (
-                C {
-                    observer_bandwidth: 0.0,
-                    ..C::for_machine(&MachineModel::paper())
-                },
-                "observer_bandwidth",
-            ),
-            (
-                C {
-                    observer_bandwidth: 10_000.0,
+                    settings: OrtegaSettings {
+                        observer_bandwidth: 0.0,
+                        ..Default::default()
+                    },
                     ..C::for_machine(&MachineModel::paper())
                 },
                 "observer_bandwidth",
             ),
             (
                 C {
-                    observer_speed_ratio: -1.0,
+                    settings: OrtegaSettings {
+                        observer_bandwidth: 10_000.0,
+                        ..Default::default()
+                    },
+                    ..C::for_machine(&MachineModel::paper())
+                },
+                "observer_bandwidth",
+            ),
+            (
+                C {
+                    settings: OrtegaSettings {
+                        observer_speed_ratio: -1.0,
+                        ..Default::default()
+                    },
                     ..C::for_machine(&MachineModel::paper())
                 },
                 "observer_speed_ratio",
             ),
             (
                 C {
-                    observer_bandwidth_min: 0.0,
+                    settings: OrtegaSettings {
+                        observer_bandwidth_min: 0.0,
+                        ..Default::default()
+                    },
                     ..C::for_machine(&MachineModel::paper())
                 },
                 "observer_bandwidth_min",
             ),
             (
                 C {
-                    observer_bandwidth_min: 2_000.0,
+                    settings: OrtegaSettings {
+                        observer_bandwidth_min: 2_000.0,
+                        ..Default::default()
+                    },
                     ..C::for_machine(&MachineModel::paper())
                 },
                 "observer_bandwidth_min",
             ),
             (
                 C {
-                    flux_adaptation_ratio: -0.2,
+                    settings: OrtegaSettings {
+                        flux_adaptation_ratio: -0.2,
+                        ..Default::default()
+                    },
                     ..C::for_machine(&MachineModel::paper())
                 },
                 "flux_adaptation_ratio",
             ),
             (
                 C {
-                    t2s1_bandwidth_hz: 0.0,
+                    common: CommonTuning {
+                        t2s1_bandwidth_hz: 0.0,
+                        ..Default::default()
+                    },
                     ..C::for_machine(&MachineModel::paper())
                 },
                 "t2s1_bandwidth_hz",
             ),
             (
                 C {
-                    t2s2_bandwidth_hz: 1e9,
+                    common: CommonTuning {
+                        t2s2_bandwidth_hz: 1e9,
+                        ..Default::default()
+                    },
                     ..C::for_machine(&MachineModel::paper())
                 },
                 "t2s2_bandwidth_hz",
             ),
             (
                 C {
-                    tracker_damping: f64::NAN,
+                    common: CommonTuning {
+                        tracker_damping: f64::NAN,
+                        ..Default::default()
+                    },
                     ..C::for_machine(&MachineModel::paper())
                 },
                 "tracker_damping",
             ),
             (
                 C {
-                    tracker_hold_ratio: 2.0,
+                    common: CommonTuning {
+                        tracker_hold_ratio: 2.0,
+                        ..Default::default()
+                    },
                     ..C::for_machine(&MachineModel::paper())
                 },
                 "tracker_hold_ratio",
             ),
             (
                 C {
-                    initial_angle: f64::NAN,
+                    common: CommonTuning {
+                        initial_angle: f64::NAN,
+                        ..Default::default()
+                    },
                     ..C::for_machine(&MachineModel::paper())
                 },
                 "initial_angle",
@@ -576,13 +565,25 @@ mod tests {
             assert!((w_obs * w_obs - 4.0 * w * w).abs() < 1e-9 * w * w, "{f} Hz");
             assert!((c.gamma(w) * 0.088 * 0.088 - w_obs).abs() < 1e-9);
         }
-        assert_eq!(c.scheduled_bandwidth(0.0), c.observer_bandwidth_min);
-        assert_eq!(c.scheduled_bandwidth(-tau * 500.0), c.observer_bandwidth);
+        assert_eq!(
+            c.scheduled_bandwidth(0.0),
+            c.settings.observer_bandwidth_min
+        );
+        assert_eq!(
+            c.scheduled_bandwidth(-tau * 500.0),
+            c.settings.observer_bandwidth
+        );
         let fixed = OrtegaConfig {
-            observer_speed_ratio: 0.0,
+            settings: OrtegaSettings {
+                observer_speed_ratio: 0.0,
+                ..c.settings
+            },
             ..c
         };
-        assert_eq!(fixed.scheduled_bandwidth(tau * 3.0), c.observer_bandwidth);
+        assert_eq!(
+            fixed.scheduled_bandwidth(tau * 3.0),
+            c.settings.observer_bandwidth
+        );
     }
 
     #[test]
@@ -592,7 +593,10 @@ mod tests {
         // the schedule's floor.
         for speed_ratio in [0.0, 2.0] {
             let c = OrtegaConfig::<f64> {
-                observer_speed_ratio: speed_ratio,
+                settings: OrtegaSettings {
+                    observer_speed_ratio: speed_ratio,
+                    ..OrtegaConfig::for_machine(&MachineModel::paper()).settings
+                },
                 ..OrtegaConfig::for_machine(&MachineModel::paper())
             };
             let mut est = OrtegaEstimator::new(c).unwrap();
@@ -605,7 +609,7 @@ mod tests {
                 assert!((eta.angle() - 0.7).abs() < 1e-12);
             }
             let measured = (eta.norm() - 0.088) / (0.088 * 1e-4);
-            let predicted = (1.0 - c.scheduled_bandwidth(0.0) * c.ts).powi(n);
+            let predicted = (1.0 - c.scheduled_bandwidth(0.0) * c.common.ts).powi(n);
             assert!(
                 (measured / predicted - 1.0).abs() < 1e-3,
                 "{measured} {predicted}"
@@ -617,7 +621,10 @@ mod tests {
     fn a_far_out_flux_is_pulled_in_monotonically_without_flipping() {
         // The fixed ω_max gain, where the floor k ≥ −½ acts for |η̂| > 3·λ̂f.
         let mut est = OrtegaEstimator::new(OrtegaConfig::<f64> {
-            observer_speed_ratio: 0.0,
+            settings: OrtegaSettings {
+                observer_speed_ratio: 0.0,
+                ..OrtegaConfig::for_machine(&MachineModel::paper()).settings
+            },
             ..OrtegaConfig::for_machine(&MachineModel::paper())
         })
         .unwrap();
@@ -641,17 +648,21 @@ mod tests {
         // step's radial rate −ln(1 − ω_obs·Ts)/Ts is 1.3 % above ω_obs, hence the tolerance.
         // The fixed gain of the analysis, critical at 300 r/min.
         let c = OrtegaConfig::<f64> {
-            observer_speed_ratio: 0.0,
-            observer_bandwidth: 2.0 * core::f64::consts::TAU * 20.0,
+            settings: OrtegaSettings {
+                observer_speed_ratio: 0.0,
+                observer_bandwidth: 2.0 * core::f64::consts::TAU * 20.0,
+                ..OrtegaConfig::for_machine(&MachineModel::paper()).settings
+            },
             ..OrtegaConfig::for_machine(&MachineModel::paper())
         };
-        let (ts, lf) = (c.ts, c.flux_linkage_hat);
+        let (ts, lf) = (c.common.ts, c.machine.flux_linkage);
         for w in [
             2.0 * core::f64::consts::PI * 3.0,
             -2.0 * core::f64::consts::PI * 3.0,
         ] {
-            let slow =
-                (-c.observer_bandwidth + (c.observer_bandwidth.powi(2) - 4.0 * w * w).sqrt()) / 2.0;
+            let slow = (-c.settings.observer_bandwidth
+                + (c.settings.observer_bandwidth.powi(2) - 4.0 * w * w).sqrt())
+                / 2.0;
             let mut est = OrtegaEstimator::new(c).unwrap();
             est.align(0.002, Ab::zero());
             let err_at = |t_end: f64, est: &mut OrtegaEstimator<f64>, n0: usize| {

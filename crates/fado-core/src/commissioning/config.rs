@@ -45,7 +45,9 @@ pub struct CommissioningConfig<T> {
     pub settle_time: T,
     /// Averaging window of each DC level, each injection and the coast, in s. Default 0.25 s.
     pub measure_time: T,
-    /// Maximum duration of any phase, in s. Default 5 s.
+    /// Maximum duration of any phase, in s. Default 5 s, or twice the nominal length of the
+    /// longest phase (2·`align_time` + `settle_time` + `measure_time`) where that is longer:
+    /// a machine with τ above ≈ 0.2 s (a 10 kV motor) has longer phases, not a bad input.
     pub phase_timeout: T,
     /// Largest current-sensor gain mismatch |k − 1| the DC test accepts as a measurement
     /// (module docs, step 3); a larger one leaves phase a uncorrected. Default the drive's
@@ -58,6 +60,8 @@ impl<T: Real> CommissioningConfig<T> {
     /// The defaults for a nameplate, sampling period and dead time.
     pub fn for_machine(nameplate: MachineModel<T>, sample_period: T, dead_time: T) -> Self {
         let tau = T::lit(0.5) * (nameplate.ld + nameplate.lq) / nameplate.rs;
+        let align_time = T::lit(0.3).max(T::lit(12.0) * tau);
+        let settle_time = T::lit(0.25).max(T::lit(10.0) * tau);
         Self {
             nameplate,
             sample_period,
@@ -69,10 +73,12 @@ impl<T: Real> CommissioningConfig<T> {
             spin_speed_ratio: T::lit(0.2),
             spin_torque_ratio: T::lit(0.1),
             offset_time: T::lit(0.1),
-            align_time: T::lit(0.3).max(T::lit(12.0) * tau),
-            settle_time: T::lit(0.25).max(T::lit(10.0) * tau),
+            align_time,
+            settle_time,
             measure_time: T::lit(0.25),
-            phase_timeout: T::lit(5.0),
+            // 5 s, or twice the longest phase of a slow machine (the phases scale with τ).
+            phase_timeout: T::lit(5.0)
+                .max(T::lit(2.0) * (T::lit(2.0) * align_time + settle_time + T::lit(0.25))),
             max_gain_mismatch: DriveTuning::<T>::default().gain_calibration_max_mismatch,
         }
     }

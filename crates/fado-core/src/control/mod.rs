@@ -6,9 +6,11 @@
 //! `reset`), is allocation-free, generic over [`Real`](crate::Real) and never panics.
 
 pub mod current_controller;
+pub mod dc_link_limit;
 pub mod dead_time_compensation;
 pub mod delay_compensation;
 pub mod drive;
+pub mod field_weakening;
 pub mod gain_calibration;
 pub mod lock_reaction;
 pub mod modulation;
@@ -18,11 +20,13 @@ pub mod speed_controller;
 pub mod standstill_probe;
 
 pub use current_controller::{CurrentController, CurrentControllerConfig};
+pub use dc_link_limit::{DcLinkLimit, DcLinkTuning};
 pub use dead_time_compensation::{
     DeadTimeCompensation, DeadTimeCompensationConfig, DeadTimeMethod,
 };
 pub use delay_compensation::{DelayCompensation, DelayCompensationConfig};
 pub use drive::{DriveConfig, DriveOutput, DriveTuning, SensorlessDrive};
+pub use field_weakening::{FieldWeakening, FieldWeakeningTuning};
 pub use gain_calibration::{GainCalibration, GainCalibrationConfig, GainCalibrationStatus};
 pub use lock_reaction::{LockAction, LockReaction, LockSupervisor};
 pub use modulation::{Modulation, ModulatorConfig, SpaceVectorModulator, VoltageLimit, svpwm_duty};

@@ -203,6 +203,12 @@ pub trait RotorAngleEstimator<T: Real> {
     /// Turns θ̂ by `angle` (rad) now, if the estimator can (the drive's loaded-standstill
     /// probe, see [`crate::control::standstill_probe`]). Default: nothing.
     fn turn_angle(&mut self, _angle: T) {}
+    /// The acceleration the drive commands, rad/s² (electrical), for the estimator's speed
+    /// trackers to feed forward (see [`crate::tracker`]). Default: not used.
+    fn set_acceleration(&mut self, _acceleration: T) {}
+    /// Switches a disturbance feedback (fado's k_df, Fig. 9) on or off, if the estimator has
+    /// one. Default: nothing to switch.
+    fn set_disturbance_feedback(&mut self, _enabled: bool) {}
 }
 
 impl<T: Real> RotorAngleEstimator<T> for SensorlessEstimator<T> {
@@ -219,6 +225,10 @@ impl<T: Real> RotorAngleEstimator<T> for SensorlessEstimator<T> {
     fn name(&self) -> &'static str {
         "fado"
     }
+    fn set_acceleration(&mut self, acceleration: T) {
+        self.state.t2s1.set_acceleration(acceleration);
+        self.state.t2s2.set_acceleration(acceleration);
+    }
     fn rearm_lock_detector(&mut self) {
         self.state.rearm_lock_detector();
     }
@@ -227,6 +237,9 @@ impl<T: Real> RotorAngleEstimator<T> for SensorlessEstimator<T> {
     }
     fn turn_angle(&mut self, angle: T) {
         SensorlessEstimator::turn_angle(self, angle);
+    }
+    fn set_disturbance_feedback(&mut self, enabled: bool) {
+        self.set_disturbance_feedback_enabled(enabled);
     }
     /// With [`EstimatorTuning::rs_adaptation`](crate::EstimatorTuning::rs_adaptation): [`SensorlessEstimator::set_rs_hat`] (a bad
     /// value changes nothing); with the paper's fixed R̂s: nothing.

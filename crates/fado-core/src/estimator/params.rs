@@ -28,6 +28,9 @@ impl<T: Real> EstimatorParams<T> {
     pub fn new(config: EstimatorConfig<T>) -> Result<Self, ConfigError> {
         let ts = check::positive("ts", config.ts)?;
         config.machine.validate()?;
+        // The sampling period against the rated speed (a period in ms given as s), before any
+        // gain derived from it is refused in its stead.
+        crate::machine_checks::validate(&config.machine.cast::<f64>(), Some(ts.to_f64()))?;
         let (ratio, hold) = check_limits(&config, ts)?;
         let blocks = SampleBlocks::new(&config, ts)?;
         let (rs_adaptation, offset) = slow_laws(&config)?;
@@ -222,10 +225,17 @@ impl<T: Real> SampleBlocks<T> {
             ts,
         )?;
         check::positive("tracker_damping", config.tuning.tracker_damping)?;
-        let t2s1 = TrackerParams::new(config.tracker(config.tuning.t2s1_bandwidth_hz))
-            .map_err(rename("t2s1_bandwidth_hz"))?;
-        let t2s2 = TrackerParams::new(config.tracker(config.tuning.t2s2_bandwidth_hz))
-            .map_err(rename("t2s2_bandwidth_hz"))?;
+        let load_pole = config.tuning.tracker_load_pole_ratio;
+        let (c1, c2) = (
+            config.tracker(config.tuning.t2s1_bandwidth_hz),
+            config.tracker(config.tuning.t2s2_bandwidth_hz),
+        );
+        let t2s1 = TrackerParams::new(c1)
+            .map_err(rename("t2s1_bandwidth_hz"))?
+            .with_load_pole(&c1, load_pole)?;
+        let t2s2 = TrackerParams::new(c2)
+            .map_err(rename("t2s2_bandwidth_hz"))?
+            .with_load_pole(&c2, load_pole)?;
         Ok(Self {
             integrator,
             observer,

@@ -75,7 +75,9 @@ fn state_size() {
     // Before the split (issue 16's fourth pass) the one record was 484 B in `f32`, its
     // constants and its state mixed. The state now holds what changes (and R0's 20 B of
     // scaled constants, since `set_rs_hat` replaces R0 at run time).
-    assert!(s32 <= 256, "{s32}");
+    // The trackers' acceleration feed-forward and load integrator (`crate::tracker`) add
+    // 2 × 8 B: 264 B in `f32`.
+    assert!(s32 <= 272, "{s32}");
     assert_eq!(o32, s32 + p32);
 }
 

@@ -3,8 +3,10 @@
 
 use super::{Applied, Blocks, DriveConfig, Resolved};
 use crate::control::current_controller::{CurrentController, CurrentControllerConfig};
+use crate::control::dc_link_limit::DcLinkLimit;
 use crate::control::dead_time_compensation::{DeadTimeCompensation, DeadTimeCompensationConfig};
 use crate::control::delay_compensation::{DelayCompensation, DelayCompensationConfig};
+use crate::control::field_weakening::FieldWeakening;
 use crate::control::lock_reaction::LockSupervisor;
 use crate::control::modulation::{ModulatorConfig, SpaceVectorModulator};
 use crate::control::speed_controller::{SpeedController, SpeedControllerConfig};
@@ -54,13 +56,14 @@ impl<T: Real> Blocks<T> {
         // The speed PI's output is a torque in units of the magnet's q current (see
         // `currents_for_torque`): with MTPA on a salient rotor its limit is the torque of the
         // MTPA point on the current circle |i| = I_max (`SpeedControllerConfig::with_tuning`).
-        let speed = SpeedController::new(SpeedControllerConfig::with_tuning(m, t, ts)).map_err(
-            rename(&[
-                ("bandwidth_hz", "speed_bandwidth_hz"),
-                ("zero_ratio", "speed_zero_ratio"),
-                ("anti_windup_ratio", "speed_anti_windup_ratio"),
-            ]),
-        )?;
+        let speed_config = SpeedControllerConfig::with_tuning(m, t, ts);
+        let dc_link = DcLinkLimit::new(&t.dc_link, m, speed_config.i_max, r.i_max, ts)?;
+        let field_weakening = FieldWeakening::new(&t.field_weakening, m, r.i_max, ts)?;
+        let speed = SpeedController::new(speed_config).map_err(rename(&[
+            ("bandwidth_hz", "speed_bandwidth_hz"),
+            ("zero_ratio", "speed_zero_ratio"),
+            ("anti_windup_ratio", "speed_anti_windup_ratio"),
+        ]))?;
         let injection = CurrentInjection::new(CurrentInjectionConfig::with_tuning(m, t))?;
         let current = CurrentController::new(CurrentControllerConfig::with_tuning(m, t, ts))
             .map_err(rename(&[
@@ -87,6 +90,8 @@ impl<T: Real> Blocks<T> {
             dead_time,
             modulator,
             probe,
+            dc_link,
+            field_weakening,
         })
     }
 
@@ -98,6 +103,8 @@ impl<T: Real> Blocks<T> {
         self.dead_time.reset();
         self.modulator.reset();
         self.probe.reset();
+        self.dc_link.reset();
+        self.field_weakening.reset();
     }
 }
 

@@ -95,6 +95,8 @@ impl<T: Real> DriveConfig<T> {
             min_observability: t.gain_calibration_min_observability,
             max_mismatch: t.gain_calibration_max_mismatch,
             current_limit: self.i_max(),
+            lq_hat: m.lq,
+            motion_voltage: crate::control::gain_calibration::motion_voltage(m),
         };
         GainCalibration::new(config).map_err(rename)?;
         Ok(config)

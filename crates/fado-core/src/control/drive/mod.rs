@@ -43,8 +43,10 @@ pub use output::DriveOutput;
 pub use tuning::DriveTuning;
 
 use crate::control::current_controller::CurrentController;
+use crate::control::dc_link_limit::DcLinkLimit;
 use crate::control::dead_time_compensation::DeadTimeCompensation;
 use crate::control::delay_compensation::DelayCompensation;
+use crate::control::field_weakening::FieldWeakening;
 use crate::control::gain_calibration::GainCalibration;
 use crate::control::lock_reaction::LockSupervisor;
 use crate::control::modulation::SpaceVectorModulator;
@@ -131,6 +133,8 @@ struct Blocks<T> {
     dead_time: DeadTimeCompensation<T>,
     probe: StandstillProbe<T>,
     modulator: SpaceVectorModulator<T>,
+    dc_link: DcLinkLimit<T>,
+    field_weakening: FieldWeakening<T>,
 }
 
 /// What the modulator applies at a sample: the duties, and the voltage that acts (α-β and in

@@ -5,6 +5,11 @@ use super::{DriveConfig, Resolved, StallResolved};
 use crate::Real;
 use crate::error::{ConfigError, check};
 
+/// Largest `current_limit_ratio`: 5 (a drive's short-time overload is 1.5–3 × the rated
+/// current; above 5 the limit is a typo, and the trip level above it would be refused in its
+/// stead).
+const MAX_CURRENT_LIMIT_RATIO: f64 = 5.0;
+
 impl<T: Real> Resolved<T> {
     pub(super) fn new(c: &DriveConfig<T>) -> Result<Self, ConfigError> {
         let ts = check::positive("ts", c.ts)?;
@@ -18,14 +23,23 @@ impl<T: Real> Resolved<T> {
             Ok(n.round().to_f64() as u32)
         };
         Ok(Self {
-            i_max: check::positive("current_limit_ratio", t.current_limit_ratio)? * rated,
+            i_max: check::below(
+                "current_limit_ratio",
+                check::positive("current_limit_ratio", t.current_limit_ratio)?,
+                T::lit(MAX_CURRENT_LIMIT_RATIO),
+                "at most 5 × the rated current (drives' short-time overload is 1.5–3×)",
+            )? * rated,
             i_min: check::non_negative("injection_current_ratio", t.injection_current_ratio)?
                 * rated,
             trip_current: check::positive("trip_current_ratio", t.trip_current_ratio)? * rated,
             current_error_limit: check::positive("current_error_ratio", t.current_error_ratio)?
                 * rated,
-            dc_link_min_voltage: check::non_negative("dc_link_min_ratio", t.dc_link_min_ratio)?
-                * c.machine.dc_voltage,
+            dc_link_min_voltage: check::below(
+                "dc_link_min_ratio",
+                check::non_negative("dc_link_min_ratio", t.dc_link_min_ratio)?,
+                T::one(),
+                "below 1 (a fraction of the nominal DC link: at or above it the warning never clears)",
+            )? * c.machine.dc_voltage,
             offset_calibration_samples: samples(
                 "offset_calibration_time",
                 t.offset_calibration_time,

@@ -122,7 +122,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         let action = self.react_to_lock(&estimate, speed_ref)?;
         // 4. Speed loop, injection (23) and current-vector limit (zero current when coasting).
         let backup = self.blocks;
-        let Some(i_dq_ref) = self.current_reference(&estimate, speed_ref, action) else {
+        let Some(i_dq_ref) = self.current_reference(&estimate, speed_ref, action, vdc) else {
             return Err(self.reject_after_estimate(backup, estimate, i_dq));
         };
         // 5.–8. Current loop, delay and dead-time compensation, modulation, anti-windup.
@@ -131,6 +131,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         let Ok(v_dq) = b.current.step(i_dq_ref, i_dq, omega_ctrl) else {
             return Err(self.reject_after_estimate(backup, estimate, i_dq));
         };
+        b.field_weakening.update(v_dq.norm(), vdc, omega_ctrl);
         // 6. Delay compensation with the advanced angle.
         //    (reusing the Park rotation: one sin/cos per sample instead of two).
         let (v_ab, rot) = b
@@ -203,7 +204,8 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         }
         let o = self.current_offset;
         let i_abc = Abc::new(i_abc.a - o.a, i_abc.b - o.b, i_abc.c - o.c);
-        if i_abc.a.abs() > trip || i_abc.b.abs() > trip || i_abc.c.abs() > trip {
+        let over_voltage = self.blocks.dc_link.over_voltage(vdc);
+        if i_abc.a.abs() > trip || i_abc.b.abs() > trip || i_abc.c.abs() > trip || over_voltage {
             self.tripped = true;
             self.trip_output();
             self.last.input_fault = false;
@@ -248,6 +250,14 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
     #[inline(always)]
     fn estimate(&mut self, i_ab: Ab<T>) -> Result<Estimate<T>, DriveOutput<T>> {
         self.i_ab_used = i_ab;
+        if self.config.tuning.acceleration_feedforward {
+            // p·T*/Ĵ with the model's torque of the last reference, 1.5·p·λ̂a·i_q*.
+            let m = &self.config.machine;
+            let p = T::lit(m.pole_pairs as f64);
+            let i = self.last.i_dq_ref;
+            let torque = T::lit(1.5) * p * m.active_flux(i.d) * i.q;
+            self.estimator.set_acceleration(p * torque / m.inertia);
+        }
         let estimate = self.estimator.step(self.history[1], i_ab);
         if !estimate_is_finite(&estimate) {
             // An estimator that went non-finite cannot steer the drive: hold like a bad input
@@ -276,6 +286,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         estimate: &Estimate<T>,
         speed_ref: T,
         action: LockAction,
+        vdc: T,
     ) -> Option<Dq<T>> {
         // The speed PI's output is a torque demand in units of the magnet's q current i_q,t
         // (its gain assumes Kt = 1.5·p·λ̂f). On a salient rotor the torque per q ampere is
@@ -289,6 +300,13 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             let Ok(iq_torque) = self.blocks.speed.step(speed_ref, estimate.omega_control) else {
                 return None;
             };
+            // The DC link's power limits and over-voltage controller (see `dc_link_limit`).
+            let (iq_torque, brake_id) = self.blocks.dc_link.limit(
+                iq_torque,
+                vdc,
+                estimate.omega_control,
+                self.last.i_dq_ref.norm(),
+            );
             // The loaded-standstill probe (see `standstill_probe`): Δi_d on the d reference,
             // and the turn of θ̂ its reading implies (from the next sample).
             let probe = &mut self.blocks.probe;
@@ -307,8 +325,25 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
                 m.flux_linkage,
                 m.ld - m.lq,
             );
-            let i = self.currents_for_torque(iq_torque, guess, probe_id);
-            limit_current_d_priority(i, self.resolved.i_max)
+            // Field weakening and loss braking add to the d reference (see
+            // `field_weakening`, `dc_link_limit`); zero below the voltage limit.
+            let fw_id = self.blocks.field_weakening.delta_id();
+            let id_added = if brake_id != T::zero() || fw_id != T::zero() {
+                probe_id + brake_id.step_min(fw_id)
+            } else {
+                probe_id
+            };
+            let i = self.currents_for_torque(iq_torque, guess, id_added);
+            let i = limit_current_d_priority(i, self.resolved.i_max);
+            let iq_max = self
+                .blocks
+                .field_weakening
+                .iq_limit(i.d, vdc, estimate.omega_control);
+            if i.q.abs() > iq_max {
+                Dq::new(i.d, iq_max * i.q.signum())
+            } else {
+                i
+            }
         };
         if action == LockAction::Coast {
             self.blocks.probe.reset();

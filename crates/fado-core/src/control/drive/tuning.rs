@@ -3,7 +3,9 @@
 
 use super::STALL_TORQUE_BAND_RATIO;
 use crate::Real;
+use crate::control::dc_link_limit::DcLinkTuning;
 use crate::control::dead_time_compensation::DeadTimeMethod;
+use crate::control::field_weakening::FieldWeakeningTuning;
 use crate::control::lock_reaction::LockReaction;
 use crate::control::modulation::VoltageLimit;
 use crate::machine::PAPER_RATED_CURRENT;
@@ -38,6 +40,11 @@ pub struct DriveTuning<T> {
     /// [`MachineModel::mtpa_id`](crate::MachineModel::mtpa_id)), added to the injection's. No effect on a surface-magnet
     /// rotor. Default true.
     pub mtpa: bool,
+    /// Give the estimator's speed trackers the acceleration the commanded torque causes,
+    /// p·T*/Ĵ (a mechanical-model feed-forward, see [`crate::tracker`]); use with the
+    /// estimator's `tracker_load_pole_ratio` > 0, whose third integrator takes up the load.
+    /// Default false (the paper's trackers) \[A\].
+    pub acceleration_feedforward: bool,
     /// Dead time Td in s (inverter datum). Default 2.5 µs (paper, V).
     #[cfg_attr(feature = "serde", serde(skip))]
     pub dead_time: T,
@@ -151,6 +158,20 @@ pub struct DriveTuning<T> {
     /// A DC-link reading above this multiple of the nominal DC-link voltage is refused like a
     /// non-finite sample. Default [`crate::plausibility::VOLTAGE_RATIO`] (1.5) \[A\].
     pub dc_link_max_ratio: T,
+    /// The DC-link limits: source current limits, over-voltage controller and trip
+    /// (`[controller.dc_link]`, see [`DcLinkTuning`]).
+    #[cfg_attr(
+        feature = "serde",
+        serde(bound(deserialize = "T: Real + serde::Deserialize<'de>"))
+    )]
+    pub dc_link: DcLinkTuning<T>,
+    /// Field weakening and the MTPV limit at the voltage limit (`[controller.field_weakening]`,
+    /// see [`FieldWeakeningTuning`]).
+    #[cfg_attr(
+        feature = "serde",
+        serde(bound(deserialize = "T: Real + serde::Deserialize<'de>"))
+    )]
+    pub field_weakening: FieldWeakeningTuning<T>,
     /// Reaction to the estimator's [`LockStatus::Lost`](crate::LockStatus::Lost) (`DriveFlags::LOCK_LOST`) and, with
     /// `lock_reaction_on_stall`, to the stall symptom (`DriveFlags::STALLED`). Default report
     /// only \[A\] (the paper's behaviour plus the flags).
@@ -373,6 +394,7 @@ impl<T: Real> DriveTuning<T> {
             current_limit_ratio: U::lit(self.current_limit_ratio.to_f64()),
             injection_current_ratio: U::lit(self.injection_current_ratio.to_f64()),
             mtpa: self.mtpa,
+            acceleration_feedforward: self.acceleration_feedforward,
             dead_time: U::lit(self.dead_time.to_f64()),
             switching_frequency: U::lit(self.switching_frequency.to_f64()),
             dead_time_threshold_voltage: U::lit(self.dead_time_threshold_voltage.to_f64()),
@@ -402,6 +424,8 @@ impl<T: Real> DriveTuning<T> {
             input_fault_trip_time: U::lit(self.input_fault_trip_time.to_f64()),
             plausible_current_ratio: U::lit(self.plausible_current_ratio.to_f64()),
             dc_link_max_ratio: U::lit(self.dc_link_max_ratio.to_f64()),
+            dc_link: self.dc_link.cast(),
+            field_weakening: self.field_weakening.cast(),
             lock_reaction: self.lock_reaction,
             lock_reaction_on_stall: self.lock_reaction_on_stall,
             lock_recovery_time: U::lit(self.lock_recovery_time.to_f64()),
@@ -444,6 +468,7 @@ impl<T: Real> Default for DriveTuning<T> {
             current_limit_ratio: per_rated(40.0),
             injection_current_ratio: per_rated(4.0),
             mtpa: true,
+            acceleration_feedforward: false,
             dead_time: T::lit(2.5e-6),
             switching_frequency: T::lit(5e3),
             dead_time_threshold_voltage: T::one(),
@@ -471,6 +496,8 @@ impl<T: Real> Default for DriveTuning<T> {
             input_fault_trip_time: T::lit(10e-3),
             plausible_current_ratio: T::lit(2.0),
             dc_link_max_ratio: T::lit(crate::plausibility::VOLTAGE_RATIO),
+            dc_link: DcLinkTuning::default(),
+            field_weakening: FieldWeakeningTuning::default(),
             lock_reaction: LockReaction::ReportOnly,
             lock_reaction_on_stall: true,
             lock_recovery_time: T::lit(20e-3),

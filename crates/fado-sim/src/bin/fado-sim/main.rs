@@ -6,7 +6,7 @@
 //! fado-sim sweep fig11 --axis rs_error=-0.3:0.3:7 --axis load_torque=0,2.5,5,7.5
 //!                [--random N --seed S] [--config FILE] [--out DIR] [--averaged]
 //!                [--threads N] [--fresh]
-//! fado-sim compare [--scenarios fig8,...] [--estimators fado,fado-fixed-rs,lpf-integrator,ortega,emf-observer]
+//! fado-sim compare [--scenarios fig8,...] [--estimators fado,ortega,...]
 //!                  [--out DIR] [--averaged] [--config FILE] [--criterion target/criterion]
 //! ```
 
@@ -19,6 +19,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use clap::{Parser, Subcommand};
 use fado_sim::SimConfigError;
 use fado_sim::compare;
+use fado_sim::estimators::ESTIMATORS;
 use fado_sim::output::{self, AtomicFile, DirLock, OutputError};
 use fado_sim::scenario::{self, SCENARIOS};
 use fado_sim::scenario::{RunOptions, TraceOutput};
@@ -42,7 +43,7 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// List the scenarios.
+    /// List the scenarios and the estimators.
     List,
     /// List the motor presets of `motors/` (each a valid `--config` file), one line each.
     Motors,
@@ -105,7 +106,9 @@ enum Command {
     /// Identify the motor of FILE's `[motor]` (with `rated_current`, `rated_speed_rpm`,
     /// `rated_torque`) on the simulated plant with `fado_core::commissioning`; print each
     /// parameter against the plant's truth; write DIR/identified.toml (`[model]`),
-    /// DIR/metrics.json and DIR/traces.csv.
+    /// DIR/metrics.json and DIR/traces.csv, as `run` writes: under the directory's lock, each
+    /// whole or not at all. Refused before it runs when the set-up cannot be measured
+    /// (ω_rated·Ts above 0.2, a current sensor coarser than 1 % of its current limit).
     Commission {
         /// TOML file: the plant (`[motor]` with its ratings, `[inverter]`, sensors, …).
         #[arg(long)]
@@ -129,9 +132,8 @@ enum Command {
         /// Comma-separated scenario names. Default: all (see `list`).
         #[arg(long, value_delimiter = ',')]
         scenarios: Option<Vec<String>>,
-        /// Comma-separated estimators. Default: fado,fado-fixed-rs,lpf-integrator,ortega,emf-observer
-        /// (fado-fixed-rs: fado with the paper's fixed R̂s).
-        #[arg(long, value_delimiter = ',')]
+        /// Comma-separated estimators (see `list`). Default: all.
+        #[arg(long, value_delimiter = ',', help = estimators_help())]
         estimators: Option<Vec<String>>,
         /// TOML file applied over every scenario (its `[estimator] kind` is replaced).
         #[arg(long)]
@@ -152,20 +154,79 @@ enum Command {
     },
 }
 
+/// `compare --estimators`' help: the names of the registry.
+fn estimators_help() -> String {
+    format!(
+        "Comma-separated estimators. Default: all of {} (fado-fixed-rs: fado with the paper's \
+         fixed R̂s; see `list`)",
+        fado_sim::estimators::names().join(",")
+    )
+}
+
 /// Exit code of a configuration or usage error (a bad key, value, scenario or axis).
 const EXIT_CONFIG: u8 = 2;
 /// Exit code of an output error: a file that cannot be read or written (the message names
 /// it), or an output directory that another run holds.
 const EXIT_IO: u8 = 3;
 
+/// Set once writing to stdout failed: later writes are skipped.
+static STDOUT_FAILED: AtomicBool = AtomicBool::new(false);
+/// The first stdout error other than a closed pipe (a full disk): reported at exit.
+static STDOUT_ERROR: std::sync::Mutex<Option<std::io::Error>> = std::sync::Mutex::new(None);
+
+/// Writes to stdout without ever panicking: a reader that went away (`fado-sim … | head`)
+/// ends the printing silently, any other error (a full disk) is reported at exit with code 3.
+/// Every command has written its files before it prints.
+fn print_out(args: std::fmt::Arguments<'_>) {
+    use std::io::Write;
+    if STDOUT_FAILED.load(Ordering::Relaxed) {
+        return;
+    }
+    let mut out = std::io::stdout().lock();
+    if let Err(e) = out.write_fmt(args).and_then(|()| out.flush()) {
+        STDOUT_FAILED.store(true, Ordering::Relaxed);
+        if e.kind() != std::io::ErrorKind::BrokenPipe
+            && let Ok(mut slot) = STDOUT_ERROR.lock()
+        {
+            slot.get_or_insert(e);
+        }
+    }
+}
+
+/// `println!` through [`print_out`].
+macro_rules! outln {
+    () => { print_out(format_args!("\n")) };
+    ($($arg:tt)*) => { print_out(format_args!("{}\n", format_args!($($arg)*))) };
+}
+
+/// `print!` through [`print_out`].
+macro_rules! out {
+    ($($arg:tt)*) => { print_out(format_args!($($arg)*)) };
+}
+
 fn main() -> ExitCode {
-    match run(Cli::parse()) {
+    let code = match run(Cli::parse()) {
         Ok(code) => code,
         Err(e) => {
             eprintln!("error: {e}");
             let io = e.downcast_ref::<OutputError>().is_some()
                 || matches!(e.downcast_ref::<SweepError>(), Some(SweepError::Io(_)));
             ExitCode::from(if io { EXIT_IO } else { EXIT_CONFIG })
+        }
+    };
+    if let Some(e) = STDOUT_ERROR.lock().ok().and_then(|mut s| s.take()) {
+        eprintln!("error: cannot write to stdout: {e}");
+        return ExitCode::from(EXIT_IO);
+    }
+    code
+}
+
+/// Prints the plausibility warnings of `cfg`'s motor on stderr, naming the file.
+fn warn_plausibility(cfg: &fado_sim::SimConfig, config: Option<&Path>) {
+    for w in cfg.warnings() {
+        match config {
+            Some(p) => eprintln!("warning: {}: {w}", p.display()),
+            None => eprintln!("warning: {w}"),
         }
     }
 }
@@ -187,8 +248,34 @@ impl TraceSink for FileSink<'_> {
 }
 
 /// The text of an input file; an error names it (exit 3).
-fn read_file(path: &Path) -> Result<String, OutputError> {
-    std::fs::read_to_string(path).map_err(|e| OutputError::new("read", path, e))
+/// Reads a `--config` file, refusing one longer than [`scenario::MAX_CONFIG_BYTES`] before
+/// reading more of it (`--config /dev/zero` stops after 1 MiB, not at the end of memory).
+fn read_file(path: &Path) -> Result<String, Box<dyn std::error::Error>> {
+    use std::io::Read;
+    let file = std::fs::File::open(path).map_err(|e| OutputError::new("read", path, e))?;
+    let limit = scenario::MAX_CONFIG_BYTES as u64;
+    let mut bytes = Vec::new();
+    file.take(limit + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| OutputError::new("read", path, e))?;
+    if bytes.len() as u64 > limit {
+        return Err(SimConfigError::new(
+            "<config>",
+            format!(
+                "{} is longer than the {limit} bytes a configuration may have (not read further)",
+                path.display()
+            ),
+        )
+        .into());
+    }
+    String::from_utf8(bytes).map_err(|e| {
+        OutputError::new(
+            "read",
+            path,
+            std::io::Error::new(std::io::ErrorKind::InvalidData, e),
+        )
+        .into()
+    })
 }
 
 /// A CSV write error as the output error naming `path`.
@@ -204,16 +291,28 @@ fn run(cli: Cli) -> Result<ExitCode, Box<dyn std::error::Error>> {
     match cli.command {
         Command::Motors => {
             for p in fado_sim::presets::PRESETS {
-                println!("{:<22} {}", p.name, p.description());
+                outln!("{:<22} {}", p.name, p.description());
             }
             Ok(ExitCode::SUCCESS)
         }
         Command::List => {
             for s in &SCENARIOS {
-                println!(
+                outln!(
                     "{:<7} {}\n        profile:   {}\n        criterion: {}",
-                    s.name, s.title, s.profile, s.criterion
+                    s.name,
+                    s.title,
+                    s.profile,
+                    s.criterion
                 );
+            }
+            println!("\nEstimators (`[simulation] estimator`, `compare --estimators`):");
+            for e in ESTIMATORS {
+                let settings = if e.own_settings {
+                    format!("[baselines.{}]", e.key())
+                } else {
+                    "[estimator]".to_owned()
+                };
+                println!("{:<15} {} — settings {settings}", e.name, e.summary);
             }
             Ok(ExitCode::SUCCESS)
         }
@@ -231,9 +330,10 @@ fn run(cli: Cli) -> Result<ExitCode, Box<dyn std::error::Error>> {
             let cfg = scenario::scenario_config(&name, text.as_deref(), averaged)
                 .map_err(|e| in_file(e, &config))?;
             if dump_config {
-                print!("{}", cfg.to_toml());
+                out!("{}", cfg.to_toml_annotated());
                 return Ok(ExitCode::SUCCESS);
             }
+            warn_plausibility(&cfg, config.as_deref());
             let bar = ProgressBar::new(1000);
             bar.set_style(
                 ProgressStyle::with_template("{spinner} {msg} [{bar:40}] {percent:>3}% eta {eta}")?
@@ -286,7 +386,7 @@ fn run(cli: Cli) -> Result<ExitCode, Box<dyn std::error::Error>> {
             metrics.rename()?;
             drop(lock);
             print_table(&report);
-            println!("wrote {}/metrics.json and traces.csv", dir.display());
+            outln!("wrote {}/metrics.json and traces.csv", dir.display());
             Ok(if report.passed {
                 ExitCode::SUCCESS
             } else {
@@ -388,8 +488,8 @@ fn run(cli: Cli) -> Result<ExitCode, Box<dyn std::error::Error>> {
                 &dir.join("compare.json"),
                 serde_json::to_string_pretty(&result)?.as_bytes(),
             )?;
-            print!("{md}");
-            println!(
+            out!("{md}");
+            outln!(
                 "\n{} runs in {:.1} s; wrote {}/compare.json and compare.md",
                 result.rows.len(),
                 result.wall_seconds,
@@ -411,10 +511,26 @@ fn run_commission(
     use fado_sim::commission::{self, CommissionOptions};
     let (text, mut cfg) = match (config, motor) {
         (Some(path), None) => {
-            let text = std::fs::read_to_string(path)
-                .map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+            let text = read_file(path)?;
             let cfg = fado_sim::SimConfig::from_toml(&text)
                 .map_err(|e| in_file(e, &Some(path.to_path_buf())))?;
+            // The procedure identifies the file's motor: it never falls back on another's.
+            let has_motor = text
+                .parse::<toml::Table>()
+                .is_ok_and(|t| t.contains_key("motor"));
+            if !has_motor {
+                return Err(SimConfigError::new(
+                    "motor",
+                    format!(
+                        "{} has no [motor] table: commissioning identifies the motor the file \
+                         describes (rs, ld, lq, flux_linkage, pole_pairs as rough values and \
+                         the ratings rated_current, rated_speed_rpm, rated_torque)",
+                        path.display()
+                    ),
+                )
+                .into());
+            }
+            warn_plausibility(&cfg, Some(path));
             (text, cfg)
         }
         (None, Some(name)) => {
@@ -435,6 +551,9 @@ fn run_commission(
         dc_voltage: plant.inverter.dc_voltage,
         ..plant.motor
     };
+    // The directory is held from before the run to the last rename, as `run` holds it.
+    let dir = out.unwrap_or_else(|| PathBuf::from("out").join("commission"));
+    let lock = DirLock::acquire(&dir)?;
     let bar = ProgressBar::new(1000);
     bar.set_style(
         ProgressStyle::with_template("{spinner} {msg:<14} [{bar:40}] {percent:>3}%")?
@@ -450,10 +569,12 @@ fn run_commission(
         CommissionOptions::default(),
         |_| {},
         Some(&mut cb),
-    )?;
+    )
+    .map_err(|e| match config {
+        Some(p) => e.located_in(&text).in_file(p.display().to_string()),
+        None => e,
+    })?;
     bar.finish_and_clear();
-    let dir = out.unwrap_or_else(|| PathBuf::from("out").join("commission"));
-    std::fs::create_dir_all(&dir)?;
     let rows = o
         .identification
         .as_ref()
@@ -471,26 +592,58 @@ fn run_commission(
         "seed": seed,
         "parameters": rows,
     });
-    std::fs::write(
-        dir.join("metrics.json"),
-        serde_json::to_string_pretty(&metrics)?,
-    )?;
-    let mut w = csv::Writer::from_path(dir.join("traces.csv"))?;
+    // Every output is complete and synced under a temporary name before any is renamed into
+    // place (`fado_sim::output`): the previous metrics.json and identified.toml go first,
+    // traces.csv is renamed, then identified.toml, then metrics.json last, so a metrics.json
+    // always sits beside its own traces and identified model; a kill, a full disk or a second
+    // writer leave the previous results whole.
+    let traces_path = dir.join("traces.csv");
+    let mut csv = csv::Writer::from_writer(AtomicFile::create(&traces_path)?);
     for r in &o.trace {
-        w.serialize(r)?;
+        csv.serialize(r).map_err(|e| csv_error(e, &traces_path))?;
     }
-    w.flush()?;
-    println!(
-        "commissioning: {:?} after {:.2} s simulated",
-        o.status, o.simulated_seconds
-    );
-    let Some(id) = &o.identification else {
-        println!("wrote {}/metrics.json and traces.csv", dir.display());
-        return Ok(ExitCode::from(1));
+    let traces = csv
+        .into_inner()
+        .map_err(|e| OutputError::new("write", &traces_path, e.into_error()))?
+        .finish()?;
+    // The input file with its [model] replaced by the identified one: runnable as is
+    // (`fado-sim run reversal --config DIR/identified.toml`).
+    let identified = match &o.identification {
+        Some(id) => {
+            let doc = commission::identified_toml(&text, id)?;
+            let mut f = AtomicFile::create(&dir.join("identified.toml"))?;
+            std::io::Write::write_all(&mut f, doc.as_bytes()).map_err(|e| f.error(e))?;
+            Some(f.finish()?)
+        }
+        None => None,
     };
-    println!(
+    let mut m = AtomicFile::create(&dir.join("metrics.json"))?;
+    serde_json::to_writer_pretty(&mut m, &metrics).map_err(|e| m.error(e.into()))?;
+    let m = m.finish()?;
+    output::remove_if_present(&dir.join("metrics.json"))?;
+    output::remove_if_present(&dir.join("identified.toml"))?;
+    traces.rename()?;
+    if let Some(f) = identified {
+        f.rename()?;
+    }
+    m.rename()?;
+    drop(lock);
+    outln!(
+        "commissioning: {:?} after {:.2} s simulated",
+        o.status,
+        o.simulated_seconds
+    );
+    if o.identification.is_none() {
+        outln!("wrote {}/metrics.json and traces.csv", dir.display());
+        return Ok(ExitCode::from(1));
+    }
+    outln!(
         "{:<18} {:>14} {:>14} {:>10} {:>10}",
-        "parameter", "identified", "truth", "error", "1-sigma"
+        "parameter",
+        "identified",
+        "truth",
+        "error",
+        "1-sigma"
     );
     for r in &rows {
         let relative = !matches!(
@@ -498,7 +651,7 @@ fn run_commission(
             "viscous_friction" | "inverter_voltage" | "threshold_voltage"
         );
         if relative {
-            println!(
+            outln!(
                 "{:<18} {:>14.6e} {:>14.6e} {:>+9.3}% {:>9.3}%",
                 r.parameter,
                 r.identified,
@@ -507,20 +660,17 @@ fn run_commission(
                 100.0 * r.confidence
             );
         } else {
-            println!(
+            outln!(
                 "{:<18} {:>14.6e} {:>14.6e} {:>+10.3e} {:>10.3e}",
-                r.parameter, r.identified, r.truth, r.error, r.confidence
+                r.parameter,
+                r.identified,
+                r.truth,
+                r.error,
+                r.confidence
             );
         }
     }
-    // The input file with its [model] replaced by the identified one: runnable as is
-    // (`fado-sim run reversal --config DIR/identified.toml`). Written whole: to a temporary
-    // file, then renamed.
-    let doc = commission::identified_toml(&text, id)?;
-    let tmp = dir.join("identified.toml.tmp");
-    std::fs::write(&tmp, doc)?;
-    std::fs::rename(&tmp, dir.join("identified.toml"))?;
-    println!(
+    outln!(
         "wrote {}/identified.toml, metrics.json and traces.csv",
         dir.display()
     );
@@ -579,8 +729,8 @@ fn run_sweep(
     });
     bar.finish_and_clear();
     let outcome = outcome?;
-    print!("{}", outcome.summary.to_markdown());
-    println!(
+    out!("{}", outcome.summary.to_markdown());
+    outln!(
         "{} points run, {} resumed, in {:.1} s ({:.1} points/min); wrote {}/sweep.csv, summary.json, summary.md",
         outcome.ran,
         outcome.resumed,
@@ -592,23 +742,25 @@ fn run_sweep(
 }
 
 fn print_table(r: &scenario::Report) {
-    println!(
+    outln!(
         "scenario            {} ({:?} inverter)",
-        r.scenario, r.inverter_model
+        r.scenario,
+        r.inverter_model
     );
-    println!("max |θ−θ̂|           {:.4} rad", r.max_angle_error);
-    println!("rms θ−θ̂             {:.4} rad", r.rms_angle_error);
-    println!(
+    outln!("max |θ−θ̂|           {:.4} rad", r.max_angle_error);
+    outln!("rms θ−θ̂             {:.4} rad", r.rms_angle_error);
+    outln!(
         "max |θ−θ̂| |n|<{:<4}  {:.4} rad",
-        r.zero_speed_band_rpm, r.max_angle_error_zero_speed
+        r.zero_speed_band_rpm,
+        r.max_angle_error_zero_speed
     );
-    println!(
+    outln!(
         "rms θ−θ̂ near zero   {:.4} rad",
         r.rms_angle_error_zero_speed
     );
-    println!("max speed error     {:.2} r/min", r.max_speed_error_rpm);
-    println!("tripped             {}", r.tripped);
-    println!(
+    outln!("max speed error     {:.2} r/min", r.max_speed_error_rpm);
+    outln!("tripped             {}", r.tripped);
+    outln!(
         "simulated / wall    {:.2} s / {:.3} s ({:.0}× real time)",
         r.simulated_seconds,
         r.wall_seconds,
@@ -621,7 +773,7 @@ fn print_table(r: &scenario::Report) {
             (None, Some(b)) => format!("≤ {b}"),
             (None, None) => String::new(),
         };
-        println!(
+        outln!(
             "  [{}] {:<40} {:>10.4}  {}",
             if c.passed { "pass" } else { "FAIL" },
             c.name,
@@ -629,5 +781,5 @@ fn print_table(r: &scenario::Report) {
             lim
         );
     }
-    println!("PASSED              {}", r.passed);
+    outln!("PASSED              {}", r.passed);
 }

@@ -1,0 +1,711 @@
+//! Plausibility of a machine's data: cross-checks of the parameters against the ratings and
+//! the DC link that catch the usual slips (a unit, a pole count for pole pairs, swapped axes)
+//! and name every key involved and the likely slip.
+//!
+//! [`check`] returns [`Finding`]s: an [`Severity::Error`] where the data cannot describe a
+//! motor a drive can run (the rated torque twice what the model gives at rated current, a
+//! reactance of hundreds per unit), a [`Severity::Warning`] where it is unusual but possible
+//! (Ld > Lq on a magnet machine, a 2 s electrical time constant). The per-unit quantities
+//! refer to the rated current I and the back-EMF at rated speed ω·λf:
+//!
+//! | check | quantity | warning | error |
+//! |---|---|---|---|
+//! | range | each field | — | beyond any motor ([`RANGES`]) |
+//! | torque | T_rated / 1.5·p·λf·I (error), / MTPA torque (warning) | outside 0.6–1.6 | outside 0.3–3; 0.4–0.6 with even p: a pole count |
+//! | back-EMF | ω·λf / (Vdc/√3) | — | above 2 |
+//! | DC link | \|v_rated\| / (Vdc/√3) | below 0.2 | below 0.1 (ratings / 10?) |
+//! | reactance | L·I / λf | above 5 | above 50 (mH for H?) |
+//! | resistance | R·I / (ω·λf) | above 0.5 | above 5 (mΩ for Ω?) |
+//! | time constant | min(Ld, Lq)/R | above 2 s | — |
+//! | saliency | Ld / Lq | above 1.1 (swapped?) | — |
+//! | sampling | ω·Ts | above [`crate::ratings::MAX_OMEGA_TS`] | above π (Ts in ms for s?) |
+//!
+//! The bands are those of real machines: the repository's seven presets, from a 30 µH
+//! outrunner to a 240 A automotive IPMSM, sit inside every warning band (a test checks it).
+
+use core::fmt;
+
+use crate::Real;
+use crate::machine::MachineModel;
+use crate::ratings;
+
+/// How serious a finding is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Severity {
+    /// Unusual but possible: reported, the run goes on.
+    Warning,
+    /// The data cannot describe a motor a drive can run: refused.
+    Error,
+}
+
+/// The largest value of each field any motor has (≥ 10 × the largest machines a drive of this
+/// kind runs): a value beyond it is a unit slip or a typo. `(field, max, unit)`.
+pub const RANGES: [(&str, f64, &str); 10] = [
+    ("rs", 1e3, "Ω"),
+    ("ld", 10.0, "H"),
+    ("lq", 10.0, "H"),
+    ("flux_linkage", 100.0, "Wb"),
+    ("pole_pairs", 1000.0, ""),
+    ("inertia", 1e5, "kg·m²"),
+    ("rated_current", 1e5, "A"),
+    ("rated_speed_rpm", 5e5, "r/min"),
+    ("rated_torque", 1e7, "N·m"),
+    ("dc_voltage", 1e5, "V"),
+];
+
+/// One finding of [`check`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Finding {
+    /// A field beyond any motor ([`RANGES`]).
+    Range {
+        /// The field.
+        key: &'static str,
+        /// Its value.
+        value: f64,
+        /// The largest plausible value.
+        max: f64,
+        /// Its unit.
+        unit: &'static str,
+    },
+    /// The rated torque is about half what the model gives at rated current and the pole
+    /// pairs are even: the pole count was given.
+    PoleCount {
+        /// The value given.
+        pole_pairs: u32,
+        /// T_rated / T_model(I_rated).
+        ratio: f64,
+    },
+    /// The rated torque and the model's torque at rated current disagree.
+    Torque {
+        /// T_rated / T_model(I_rated).
+        ratio: f64,
+        /// Warning or error.
+        severity: Severity,
+    },
+    /// The back-EMF at rated speed is far above what the DC link can oppose.
+    BackEmf {
+        /// ω_rated·λf / (Vdc/√3).
+        ratio: f64,
+    },
+    /// The rated point needs a small fraction of the DC link.
+    DcLinkOversized {
+        /// |v_rated| / (Vdc/√3).
+        ratio: f64,
+        /// Warning or error.
+        severity: Severity,
+    },
+    /// An inductance is large for the rated current and flux linkage.
+    Reactance {
+        /// `ld` or `lq`.
+        key: &'static str,
+        /// L·I_rated/λf.
+        per_unit: f64,
+        /// Warning or error.
+        severity: Severity,
+    },
+    /// The resistive drop at rated current is large against the back-EMF.
+    Resistance {
+        /// Rs·I_rated/(ω_rated·λf).
+        per_unit: f64,
+        /// Warning or error.
+        severity: Severity,
+    },
+    /// The electrical time constant is long.
+    TimeConstant {
+        /// min(Ld, Lq)/Rs, s.
+        tau: f64,
+    },
+    /// Ld > Lq on a magnet machine: swapped?
+    Saliency {
+        /// Ld.
+        ld: f64,
+        /// Lq.
+        lq: f64,
+    },
+    /// The rotor turns far per sample at rated speed.
+    Sampling {
+        /// ω_rated·Ts, rad.
+        omega_ts: f64,
+        /// The derived switching frequency that keeps ω_rated·Ts within the bound, Hz.
+        switching_frequency: f64,
+        /// Warning or error.
+        severity: Severity,
+    },
+}
+
+/// The findings of one [`check`], errors first.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Findings {
+    items: [Option<Finding>; 12],
+    len: usize,
+}
+
+impl Findings {
+    fn new() -> Self {
+        Self {
+            items: [None; 12],
+            len: 0,
+        }
+    }
+
+    fn push(&mut self, f: Finding) {
+        if self.len < self.items.len() {
+            self.items[self.len] = Some(f);
+            self.len += 1;
+        }
+    }
+
+    /// Every finding, errors first.
+    pub fn iter(&self) -> impl Iterator<Item = &Finding> {
+        let errors = self.items[..self.len]
+            .iter()
+            .flatten()
+            .filter(|f| f.severity() == Severity::Error);
+        let warnings = self.items[..self.len]
+            .iter()
+            .flatten()
+            .filter(|f| f.severity() == Severity::Warning);
+        errors.chain(warnings)
+    }
+
+    /// The first error, if any.
+    pub fn error(&self) -> Option<&Finding> {
+        self.iter().find(|f| f.severity() == Severity::Error)
+    }
+
+    /// The warnings.
+    pub fn warnings(&self) -> impl Iterator<Item = &Finding> {
+        self.iter().filter(|f| f.severity() == Severity::Warning)
+    }
+
+    /// True when nothing was found.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+}
+
+const TORQUE_KEYS: &[&str] = &[
+    "rated_torque",
+    "rated_current",
+    "flux_linkage",
+    "pole_pairs",
+];
+const TORQUE_KEYS_SALIENT: &[&str] = &[
+    "rated_torque",
+    "rated_current",
+    "flux_linkage",
+    "pole_pairs",
+    "ld",
+    "lq",
+];
+const EMF_KEYS: &[&str] = &[
+    "flux_linkage",
+    "rated_speed_rpm",
+    "pole_pairs",
+    "dc_voltage",
+];
+const DC_LINK_KEYS: &[&str] = &[
+    "rated_speed_rpm",
+    "rated_current",
+    "rated_torque",
+    "dc_voltage",
+];
+const RESISTANCE_KEYS: &[&str] = &["rs", "rated_current", "flux_linkage", "rated_speed_rpm"];
+const TAU_KEYS: &[&str] = &["rs", "ld", "lq"];
+const LD_LQ: &[&str] = &["ld", "lq"];
+const SAMPLING_KEYS: &[&str] = &["ts", "rated_speed_rpm", "pole_pairs"];
+
+impl Finding {
+    /// Warning or error.
+    pub fn severity(&self) -> Severity {
+        match *self {
+            Finding::Range { .. } | Finding::PoleCount { .. } | Finding::BackEmf { .. } => {
+                Severity::Error
+            }
+            Finding::Torque { severity, .. }
+            | Finding::DcLinkOversized { severity, .. }
+            | Finding::Reactance { severity, .. }
+            | Finding::Resistance { severity, .. }
+            | Finding::Sampling { severity, .. } => severity,
+            Finding::TimeConstant { .. } | Finding::Saliency { .. } => Severity::Warning,
+        }
+    }
+
+    /// Every field involved, the likeliest culprit first (`MachineModel` field names; `ts` is
+    /// the sampling period, `dc_voltage` the inverter's DC link).
+    pub fn keys(&self) -> &'static [&'static str] {
+        match *self {
+            Finding::Range { key, .. } => match key {
+                "rs" => &["rs"],
+                "ld" => &["ld"],
+                "lq" => &["lq"],
+                "flux_linkage" => &["flux_linkage"],
+                "pole_pairs" => &["pole_pairs"],
+                "inertia" => &["inertia"],
+                "rated_current" => &["rated_current"],
+                "rated_speed_rpm" => &["rated_speed_rpm"],
+                "rated_torque" => &["rated_torque"],
+                _ => &["dc_voltage"],
+            },
+            Finding::PoleCount { .. } => &["pole_pairs", "rated_torque", "flux_linkage"],
+            Finding::Torque { .. } => TORQUE_KEYS,
+            Finding::BackEmf { .. } => EMF_KEYS,
+            Finding::DcLinkOversized { .. } => DC_LINK_KEYS,
+            Finding::Reactance { key, .. } => {
+                if key == "ld" {
+                    &["ld", "rated_current", "flux_linkage"]
+                } else {
+                    &["lq", "rated_current", "flux_linkage"]
+                }
+            }
+            Finding::Resistance { .. } => RESISTANCE_KEYS,
+            Finding::TimeConstant { .. } => TAU_KEYS,
+            Finding::Saliency { .. } => LD_LQ,
+            Finding::Sampling { .. } => SAMPLING_KEYS,
+        }
+    }
+
+    /// The likeliest culprit (the first of [`keys`](Self::keys)).
+    pub fn key(&self) -> &'static str {
+        self.keys()[0]
+    }
+
+    /// The finding as a fado-core [`crate::ConfigError`] naming [`key`](Self::key) (its
+    /// numbers are in the `Display` text, which front ends show instead).
+    pub fn config_error(&self) -> crate::ConfigError {
+        let expected = match self {
+            Finding::Range { .. } => "within the range of real motors (check the unit)",
+            Finding::PoleCount { .. } => {
+                "pole pairs (the rated torque is half what this many give: a pole count?)"
+            }
+            Finding::Torque { .. } => {
+                "rated_torque within 0.3–3 × the model's torque at rated_current (check units: λf in Wb peak, current in A peak)"
+            }
+            Finding::BackEmf { .. } => {
+                "back-EMF at rated speed (ω·λf) at most 2 × Vdc/√3 (check units and the DC link)"
+            }
+            Finding::DcLinkOversized { .. } => {
+                "ratings that use at least 10 % of the DC link (ratings divided by 10?)"
+            }
+            Finding::Reactance { .. } => {
+                "an inductance below 50 per unit of λf/rated_current (mH given as H?)"
+            }
+            Finding::Resistance { .. } => {
+                "a resistive drop at rated current below 5 × the rated back-EMF (mΩ given as Ω?)"
+            }
+            Finding::TimeConstant { .. } | Finding::Saliency { .. } => "plausible values",
+            Finding::Sampling { .. } => {
+                "a sampling period in s at which the rotor turns less than π per sample at rated speed (ms given as s?)"
+            }
+        };
+        crate::ConfigError::OutOfRange {
+            field: self.key(),
+            expected,
+        }
+    }
+}
+
+/// `keys` as "`a`, `b` and `c`".
+fn write_keys(f: &mut fmt::Formatter<'_>, keys: &[&str]) -> fmt::Result {
+    for (k, key) in keys.iter().enumerate() {
+        if k > 0 {
+            f.write_str(if k + 1 == keys.len() { " and " } else { ", " })?;
+        }
+        write!(f, "`{key}`")?;
+    }
+    Ok(())
+}
+
+impl fmt::Display for Finding {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            Finding::Range {
+                key,
+                value,
+                max,
+                unit,
+            } => write!(
+                f,
+                "`{key}` = {value:e} {unit} is beyond any motor (at most {max:e} {unit}): check its unit"
+            ),
+            Finding::PoleCount { pole_pairs, ratio } => write!(
+                f,
+                "`pole_pairs` = {pole_pairs} looks like a pole count: {}? With it the model \
+                 gives {:.2} × `rated_torque` at `rated_current` (1.5·p·λf·I with `flux_linkage`)",
+                pole_pairs / 2,
+                1.0 / ratio
+            ),
+            Finding::Torque { ratio, severity } => {
+                if severity == Severity::Error {
+                    write!(
+                        f,
+                        "`rated_torque` is {ratio:.3} × the magnet torque 1.5·p·λf·I at \
+                         `rated_current` (from `flux_linkage` and `pole_pairs`)"
+                    )?;
+                } else {
+                    write!(
+                        f,
+                        "`rated_torque` is {ratio:.3} × the torque the model gives at \
+                         `rated_current` on the MTPA point (from "
+                    )?;
+                    write_keys(f, &TORQUE_KEYS_SALIENT[2..])?;
+                    f.write_str(")")?;
+                }
+                if (0.3e-3..3e-3).contains(&ratio) {
+                    f.write_str(": `flux_linkage` in mWb where Wb is meant?")
+                } else if (300.0..3000.0).contains(&ratio) {
+                    f.write_str(
+                        ": `flux_linkage` in Wb where mWb is meant, or `rated_current` in mA?",
+                    )
+                } else if (1.2..1.7).contains(&ratio) || (0.58..0.83).contains(&ratio) {
+                    f.write_str(": rms where peak is meant (√2 = 1.41)? Give the current in A peak and λf in Wb peak")
+                } else {
+                    f.write_str(": check the units (λf in Wb peak per phase, current in A peak)")
+                }
+            }
+            Finding::BackEmf { ratio } => write!(
+                f,
+                "the back-EMF at rated speed ω·λf (`flux_linkage`, `rated_speed_rpm`, \
+                 `pole_pairs`) is {ratio:.2} × the phase voltage the DC link `dc_voltage` can \
+                 make (Vdc/√3): check their units (λf in Wb peak per phase) and the DC link"
+            ),
+            Finding::DcLinkOversized { ratio, .. } => write!(
+                f,
+                "the rated point (`rated_speed_rpm`, `rated_current`, `rated_torque`) needs only \
+                 {:.1} % of the phase voltage the DC link `dc_voltage` makes (Vdc/√3): are the \
+                 ratings divided by 10, or the DC link the wrong one?",
+                100.0 * ratio
+            ),
+            Finding::Reactance { key, per_unit, .. } => {
+                write!(
+                    f,
+                    "`{key}` is {per_unit:.3e} per unit (L·`rated_current`/`flux_linkage`; \
+                     machines have 0.05–5)"
+                )?;
+                if per_unit > 50.0 && per_unit * 1e-3 < 5.0 {
+                    write!(f, ": mH where H is meant? ({key} × 1e-3)")
+                } else {
+                    f.write_str(": check its unit (H)")
+                }
+            }
+            Finding::Resistance { per_unit, .. } => {
+                write!(
+                    f,
+                    "`rs` drops {per_unit:.3} × the rated back-EMF at `rated_current` \
+                     (Rs·I/(ω·λf) from `flux_linkage` and `rated_speed_rpm`; machines have \
+                     0.005–0.3)"
+                )?;
+                if per_unit > 5.0 && per_unit * 1e-3 < 0.5 {
+                    f.write_str(": mΩ where Ω is meant?")
+                } else {
+                    f.write_str(": check its unit (Ω per phase) and the ratings")
+                }
+            }
+            Finding::TimeConstant { tau } => write!(
+                f,
+                "the electrical time constant min(`ld`, `lq`)/`rs` is {tau:.3} s, unusually long \
+                 (motors have 0.1–100 ms): check the units of rs (Ω) and ld, lq (H)"
+            ),
+            Finding::Saliency { ld, lq } => write!(
+                f,
+                "`ld` = {ld:e} H is {:.2} × `lq` = {lq:e} H: a magnet rotor has Ld ≤ Lq (the \
+                 magnet is in the d-axis path); are ld and lq swapped?",
+                ld / lq
+            ),
+            Finding::Sampling {
+                omega_ts,
+                switching_frequency,
+                severity,
+            } => {
+                write!(
+                    f,
+                    "the rotor turns ω_rated·Ts = {omega_ts:.3} rad per sample at rated speed \
+                     (`rated_speed_rpm`, `pole_pairs`, sampling period `ts`)"
+                )?;
+                if severity == Severity::Error {
+                    f.write_str(
+                        ", more than π: the angle cannot be sampled (a sampling period in ms \
+                         where s is meant?)",
+                    )
+                } else {
+                    write!(
+                        f,
+                        "; the estimator's discretisation is accurate to 0.5 % up to {} \
+                         (switching frequency ≥ {switching_frequency} Hz)",
+                        ratings::MAX_OMEGA_TS
+                    )
+                }
+            }
+        }
+    }
+}
+
+/// Cross-checks `m` (its `dc_voltage` included) and, with `ts`, the sampling period against
+/// the rated speed. Fields that are not finite and positive are left to
+/// [`MachineModel::validate`]; a field beyond [`RANGES`] is the only finding then.
+pub fn check(m: &MachineModel<f64>, ts: Option<f64>) -> Findings {
+    let mut out = Findings::new();
+    let values = [
+        m.rs,
+        m.ld,
+        m.lq,
+        m.flux_linkage,
+        m.pole_pairs as f64,
+        m.inertia,
+        m.rated_current,
+        m.rated_speed_rpm,
+        m.rated_torque,
+        m.dc_voltage,
+    ];
+    let mut usable = true;
+    for ((key, max, unit), value) in RANGES.iter().zip(values) {
+        if value > *max {
+            out.push(Finding::Range {
+                key,
+                value,
+                max: *max,
+                unit,
+            });
+        }
+        usable &= value.is_finite() && value > 0.0;
+    }
+    if !out.is_empty() || !usable {
+        return out;
+    }
+    let per_unit_emf = m.rated_speed() * m.flux_linkage;
+    let v_max = m.dc_voltage / 1.732_050_807_568_877_2;
+    // Torque against the model's at rated current: the errors against the magnet torque
+    // 1.5·p·λf·I, which no rotor with Ld ≤ Lq falls short of and which a drive's model with
+    // a mismatched L̂d or L̂q keeps; the warning against the MTPA torque.
+    let magnet = m.rated_torque / (m.torque_constant() * m.rated_current);
+    let ratio = m.rated_torque / ratings::rated_current_torque(m);
+    if m.pole_pairs % 2 == 0 && (0.4..=0.6).contains(&magnet) {
+        out.push(Finding::PoleCount {
+            pole_pairs: m.pole_pairs,
+            ratio: magnet,
+        });
+    } else if !(0.3..=3.0).contains(&magnet) {
+        out.push(Finding::Torque {
+            ratio: magnet,
+            severity: Severity::Error,
+        });
+    } else if !(0.6..=1.6).contains(&ratio) {
+        out.push(Finding::Torque {
+            ratio,
+            severity: Severity::Warning,
+        });
+    }
+    let emf_ratio = per_unit_emf / v_max;
+    if emf_ratio > 2.0 {
+        out.push(Finding::BackEmf { ratio: emf_ratio });
+    }
+    // Reactances, resistance (per unit of the rated current and back-EMF).
+    for (key, l) in [("ld", m.ld), ("lq", m.lq)] {
+        let x = l * m.rated_current / m.flux_linkage;
+        let severity = if x > 50.0 {
+            Some(Severity::Error)
+        } else if x > 5.0 {
+            Some(Severity::Warning)
+        } else {
+            None
+        };
+        if let Some(severity) = severity {
+            out.push(Finding::Reactance {
+                key,
+                per_unit: x,
+                severity,
+            });
+        }
+    }
+    let r = m.rs * m.rated_current / per_unit_emf;
+    if r > 5.0 {
+        out.push(Finding::Resistance {
+            per_unit: r,
+            severity: Severity::Error,
+        });
+    } else if r > 0.5 {
+        out.push(Finding::Resistance {
+            per_unit: r,
+            severity: Severity::Warning,
+        });
+    }
+    // The DC link against the rated point (only when the machine itself is plausible: a
+    // reactance in mH for H makes the rated point's voltage meaningless).
+    if out.error().is_none() {
+        let v = ratings::rated_point_voltage(m) / v_max;
+        if v < 0.1 {
+            out.push(Finding::DcLinkOversized {
+                ratio: v,
+                severity: Severity::Error,
+            });
+        } else if v < 0.2 {
+            out.push(Finding::DcLinkOversized {
+                ratio: v,
+                severity: Severity::Warning,
+            });
+        }
+    }
+    let tau = m.ld.min(m.lq) / m.rs;
+    if tau > 2.0 {
+        out.push(Finding::TimeConstant { tau });
+    }
+    if m.ld > 1.1 * m.lq {
+        out.push(Finding::Saliency { ld: m.ld, lq: m.lq });
+    }
+    if let Some(ts) = ts.filter(|t| t.is_finite() && *t > 0.0) {
+        let x = m.rated_speed() * ts;
+        let severity = if x > core::f64::consts::PI {
+            Some(Severity::Error)
+        } else if x > ratings::MAX_OMEGA_TS * (1.0 + 1e-9) {
+            Some(Severity::Warning)
+        } else {
+            None
+        };
+        if let Some(severity) = severity {
+            out.push(Finding::Sampling {
+                omega_ts: x,
+                switching_frequency: ratings::switching_frequency(m.pole_pairs, m.rated_speed_rpm),
+                severity,
+            });
+        }
+    }
+    out
+}
+
+/// The first error of [`check`] as a [`crate::ConfigError`] (for `validate` methods).
+pub fn validate(m: &MachineModel<f64>, ts: Option<f64>) -> Result<(), crate::ConfigError> {
+    match check(m, ts).error() {
+        Some(e) => Err(e.config_error()),
+        None => Ok(()),
+    }
+}
+
+/// [`validate`] for a model in any precision.
+pub(crate) fn validate_real<T: Real>(m: &MachineModel<T>) -> Result<(), crate::ConfigError> {
+    validate(&m.cast::<f64>(), None)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::string::ToString;
+
+    fn paper() -> MachineModel<f64> {
+        MachineModel::paper()
+    }
+
+    fn first(m: &MachineModel<f64>, ts: Option<f64>) -> Finding {
+        *check(m, ts).iter().next().expect("a finding")
+    }
+
+    #[test]
+    fn the_papers_motor_is_clean() {
+        assert!(check(&paper(), Some(100e-6)).is_empty());
+    }
+
+    #[test]
+    fn absurd_magnitudes_blame_their_own_key() {
+        for (key, set) in [
+            (
+                "flux_linkage",
+                (|m: &mut MachineModel<f64>| m.flux_linkage = 1e300) as fn(&mut _),
+            ),
+            ("pole_pairs", |m| m.pole_pairs = 4_000_000_000),
+            ("rated_speed_rpm", |m| m.rated_speed_rpm = 1e6),
+            ("rs", |m| m.rs = 1e300),
+        ] {
+            let mut m = paper();
+            set(&mut m);
+            let f = first(&m, None);
+            assert_eq!(f.severity(), Severity::Error);
+            assert_eq!(f.key(), key, "{f}");
+            assert_eq!(f.config_error().field(), key);
+        }
+    }
+
+    #[test]
+    fn a_pole_count_for_pole_pairs_is_named() {
+        let mut m = paper();
+        m.pole_pairs = 8;
+        let f = first(&m, None);
+        assert!(matches!(f, Finding::PoleCount { pole_pairs: 8, .. }), "{f}");
+        let text = f.to_string();
+        assert!(
+            text.contains("`pole_pairs` = 8 looks like a pole count: 4?"),
+            "{text}"
+        );
+        assert_eq!(f.severity(), Severity::Error);
+    }
+
+    #[test]
+    fn an_inductance_in_mh_is_named() {
+        let mut m = paper();
+        m.ld = 2.63;
+        m.lq = 2.63;
+        let f = first(&m, None);
+        assert_eq!((f.key(), f.severity()), ("ld", Severity::Error), "{f}");
+        assert!(f.to_string().contains("mH where H is meant"), "{f}");
+    }
+
+    #[test]
+    fn swapped_inductances_are_a_warning_naming_both() {
+        let mut m = MachineModel::<f64> {
+            rs: 3.6,
+            ld: 51e-3,
+            lq: 36e-3,
+            flux_linkage: 0.545,
+            pole_pairs: 3,
+            inertia: 0.015,
+            viscous_friction: 0.0,
+            rated_current: 6.08,
+            rated_speed_rpm: 1500.0,
+            rated_torque: 14.0,
+            dc_voltage: 540.0,
+        };
+        let f = first(&m, None);
+        assert_eq!(f.severity(), Severity::Warning);
+        assert_eq!(f.keys(), &["ld", "lq"]);
+        assert!(f.to_string().contains("swapped"), "{f}");
+        core::mem::swap(&mut m.ld, &mut m.lq);
+        assert!(check(&m, None).is_empty());
+    }
+
+    #[test]
+    fn ratings_divided_by_ten_are_refused_against_the_dc_link() {
+        let mut m = paper();
+        m.rated_current /= 10.0;
+        m.rated_speed_rpm /= 10.0;
+        m.rated_torque /= 10.0;
+        let f = first(&m, None);
+        assert!(matches!(f, Finding::DcLinkOversized { .. }), "{f}");
+        assert_eq!(f.severity(), Severity::Error);
+        assert!(f.to_string().contains("divided by 10"), "{f}");
+    }
+
+    #[test]
+    fn a_sampling_period_in_ms_is_refused_naming_ts() {
+        let f = first(&paper(), Some(0.025));
+        assert_eq!((f.key(), f.severity()), ("ts", Severity::Error), "{f}");
+        let f = first(&paper(), Some(400e-6));
+        assert_eq!(f.severity(), Severity::Warning, "{f}");
+    }
+
+    #[test]
+    fn torque_and_emf_slips_name_every_key_involved() {
+        let mut m = paper();
+        m.flux_linkage = 88.0; // mWb entered as Wb: caught by the torque
+        let f = first(&m, None);
+        assert_eq!(f.keys(), TORQUE_KEYS);
+        let mut m = paper();
+        m.dc_voltage = 24.0;
+        let f = first(&m, None);
+        assert_eq!(f.keys(), EMF_KEYS);
+        let text = f.to_string();
+        for k in EMF_KEYS {
+            assert!(text.contains(k), "{text}");
+        }
+        let mut m = paper();
+        m.rs = 327.0;
+        assert_eq!(first(&m, None).key(), "rs");
+    }
+}

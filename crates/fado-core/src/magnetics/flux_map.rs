@@ -1,0 +1,300 @@
+//! A flux map ψd(i_d, i_q), ψq(i_d, i_q) on a rectangular grid, interpolated bilinearly.
+
+use core::fmt;
+
+use super::{InductanceMatrix, MagneticModel, newton};
+use crate::{Dq, Real};
+
+/// A flux map on the rectangular grid `i_d` × `i_q` (both strictly increasing), borrowed:
+/// `psi_d[k·n_q + m]` and `psi_q[k·n_q + m]` are ψd and ψq at (`i_d[k]`, `i_q[m]`).
+///
+/// Between grid nodes the map is bilinear (continuous, its Jacobian piecewise linear);
+/// beyond the grid it extends the edge cells linearly. Firmware keeps the four slices in
+/// flash (`&'static`, e.g. a `static` [`FluxTable`]); a host program borrows them from its
+/// own storage. A lookup finds the cell by bisection (4 comparisons per axis on 16 nodes).
+///
+/// [`FluxMap::new`] refuses a map that is not monotonic in its own current (ψd strictly
+/// increasing in i_d along every row, ψq in i_q along every column): such a map has no
+/// inverse i(ψ).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FluxMap<'a, T> {
+    i_d: &'a [T],
+    i_q: &'a [T],
+    psi_d: &'a [T],
+    psi_q: &'a [T],
+}
+
+/// Why a flux map was refused: the grid node (k along i_d, m along i_q) where it was seen.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FluxMapError {
+    /// An axis has fewer than two nodes.
+    TooFewNodes {
+        /// "i_d" or "i_q".
+        axis: &'static str,
+    },
+    /// A table's length is not n_d·n_q.
+    Ragged {
+        /// "psi_d" or "psi_q".
+        table: &'static str,
+    },
+    /// An axis is not strictly increasing (or not finite) at this node.
+    Axis {
+        /// "i_d" or "i_q".
+        axis: &'static str,
+        /// Node index along the axis.
+        index: usize,
+    },
+    /// A flux value is not finite.
+    NotFinite {
+        /// "psi_d" or "psi_q".
+        table: &'static str,
+        /// Node along i_d.
+        k: usize,
+        /// Node along i_q.
+        m: usize,
+    },
+    /// ψd does not increase with i_d (or ψq with i_q) from the previous node to this one.
+    NotMonotonic {
+        /// "psi_d" or "psi_q".
+        table: &'static str,
+        /// Node along i_d.
+        k: usize,
+        /// Node along i_q.
+        m: usize,
+    },
+}
+
+impl fmt::Display for FluxMapError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            FluxMapError::TooFewNodes { axis } => {
+                write!(f, "the grid needs at least two values of {axis}")
+            }
+            FluxMapError::Ragged { table } => write!(
+                f,
+                "{table} has not one value per (i_d, i_q) pair of the rectangular grid"
+            ),
+            FluxMapError::Axis { axis, index } => {
+                write!(
+                    f,
+                    "{axis}[{index}] is not finite or not above {axis}[{index}-1]"
+                )
+            }
+            FluxMapError::NotFinite { table, k, m } => {
+                write!(f, "{table} at node ({k}, {m}) is not finite")
+            }
+            FluxMapError::NotMonotonic { table, k, m } => write!(
+                f,
+                "{table} at node ({k}, {m}) does not increase with its own current: the map \
+                 has no inverse (check the sign convention: d on the magnet, ψd = λf at i = 0)"
+            ),
+        }
+    }
+}
+
+impl core::error::Error for FluxMapError {}
+
+fn check_axis<T: Real>(axis: &'static str, x: &[T]) -> Result<(), FluxMapError> {
+    if x.len() < 2 {
+        return Err(FluxMapError::TooFewNodes { axis });
+    }
+    for (index, w) in x.windows(2).enumerate() {
+        if !(w[0].is_finite() && w[1].is_finite() && w[1] > w[0]) {
+            return Err(FluxMapError::Axis {
+                axis,
+                index: index + 1,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The cell of `x` on `axis` (clamped to the edge cells) and the fraction along it (outside
+/// [0, 1] beyond the grid).
+#[inline]
+fn cell<T: Real>(axis: &[T], x: T) -> (usize, T, T) {
+    let n = axis.len();
+    let k = axis.partition_point(|&a| a <= x).clamp(1, n - 1) - 1;
+    let width = axis[k + 1] - axis[k];
+    ((k), (x - axis[k]) / width, width)
+}
+
+impl<'a, T: Real> FluxMap<'a, T> {
+    /// A map from its axes and row-major tables (see the type's docs), checked.
+    pub fn new(
+        i_d: &'a [T],
+        i_q: &'a [T],
+        psi_d: &'a [T],
+        psi_q: &'a [T],
+    ) -> Result<Self, FluxMapError> {
+        check_axis("i_d", i_d)?;
+        check_axis("i_q", i_q)?;
+        let map = Self::from_checked_parts(i_d, i_q, psi_d, psi_q)?;
+        let nq = i_q.len();
+        for (table, t) in [("psi_d", psi_d), ("psi_q", psi_q)] {
+            if let Some(at) = t.iter().position(|v| !v.is_finite()) {
+                return Err(FluxMapError::NotFinite {
+                    table,
+                    k: at / nq,
+                    m: at % nq,
+                });
+            }
+        }
+        // Every value is finite here, so `<=` is the negation of `>`.
+        for k in 0..i_d.len() {
+            for m in 0..nq {
+                let at = k * nq + m;
+                if k > 0 && psi_d[at] <= psi_d[at - nq] {
+                    let table = "psi_d";
+                    return Err(FluxMapError::NotMonotonic { table, k, m });
+                }
+                if m > 0 && psi_q[at] <= psi_q[at - 1] {
+                    let table = "psi_q";
+                    return Err(FluxMapError::NotMonotonic { table, k, m });
+                }
+            }
+        }
+        Ok(map)
+    }
+
+    /// A map from parts whose shapes alone are checked (two nodes or more per axis, one value
+    /// per node): no lookup can index out of bounds, and a map built from the parts of one
+    /// that [`FluxMap::new`] accepted behaves identically. For a host program that keeps the
+    /// checked parts in its own storage and borrows them per use (an O(1) check instead of
+    /// [`FluxMap::new`]'s O(n)); unchecked values give wrong inverses, never a panic.
+    pub fn from_checked_parts(
+        i_d: &'a [T],
+        i_q: &'a [T],
+        psi_d: &'a [T],
+        psi_q: &'a [T],
+    ) -> Result<Self, FluxMapError> {
+        if i_d.len() < 2 {
+            return Err(FluxMapError::TooFewNodes { axis: "i_d" });
+        }
+        if i_q.len() < 2 {
+            return Err(FluxMapError::TooFewNodes { axis: "i_q" });
+        }
+        for (table, t) in [("psi_d", psi_d), ("psi_q", psi_q)] {
+            if t.len() != i_d.len() * i_q.len() {
+                return Err(FluxMapError::Ragged { table });
+            }
+        }
+        Ok(Self {
+            i_d,
+            i_q,
+            psi_d,
+            psi_q,
+        })
+    }
+
+    /// The i_d axis in A.
+    pub fn i_d(&self) -> &'a [T] {
+        self.i_d
+    }
+
+    /// The i_q axis in A.
+    pub fn i_q(&self) -> &'a [T] {
+        self.i_q
+    }
+
+    /// ψd at the grid nodes in Wb, row-major (`[k·n_q + m]`).
+    pub fn psi_d(&self) -> &'a [T] {
+        self.psi_d
+    }
+
+    /// ψq at the grid nodes in Wb, row-major.
+    pub fn psi_q(&self) -> &'a [T] {
+        self.psi_q
+    }
+
+    /// ψ(i) and the incremental inductance ∂ψ/∂i of the bilinear interpolant at `i`.
+    #[inline]
+    pub fn flux_and_jacobian(&self, i: Dq<T>) -> (Dq<T>, InductanceMatrix<T>) {
+        let (k, fx, wx) = cell(self.i_d, i.d);
+        let (m, fy, wy) = cell(self.i_q, i.q);
+        let nq = self.i_q.len();
+        let at = k * nq + m;
+        let corner = |t: &[T]| (t[at], t[at + nq], t[at + 1], t[at + nq + 1]);
+        let bilinear = |(p00, p10, p01, p11): (T, T, T, T)| {
+            let (ex, ey) = (p10 - p00, p01 - p00);
+            let twist = p11 - p10 - p01 + p00;
+            (
+                p00 + fx * ex + fy * (ey + fx * twist),
+                (ex + fy * twist) / wx,
+                (ey + fx * twist) / wy,
+            )
+        };
+        let (d, dd, dq) = bilinear(corner(self.psi_d));
+        let (q, qd, qq) = bilinear(corner(self.psi_q));
+        (Dq::new(d, q), InductanceMatrix { dd, dq, qd, qq })
+    }
+}
+
+impl<T: Real> MagneticModel<T> for FluxMap<'_, T> {
+    #[inline]
+    fn flux(&self, i: Dq<T>) -> Dq<T> {
+        self.flux_and_jacobian(i).0
+    }
+
+    /// Newton from the map's linearisation at zero current.
+    fn current(&self, psi: Dq<T>) -> Dq<T> {
+        let (psi0, l0) = self.flux_and_jacobian(Dq::zero());
+        self.current_from(psi, l0.solve(psi - psi0))
+    }
+
+    fn current_from(&self, psi: Dq<T>, guess: Dq<T>) -> Dq<T> {
+        let scale = self.i_d[self.i_d.len() - 1].abs() * T::lit(1e-6);
+        newton(psi, guess, scale, |i| self.flux_and_jacobian(i))
+    }
+
+    #[inline]
+    fn incremental_inductance(&self, i: Dq<T>) -> InductanceMatrix<T> {
+        self.flux_and_jacobian(i).1
+    }
+}
+
+/// A flux map held by value: `ND` × `NQ` nodes in const-generic arrays (a `static` in
+/// firmware, in flash). [`FluxTable::map`] borrows it as a [`FluxMap`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FluxTable<T, const ND: usize, const NQ: usize> {
+    /// The i_d axis in A, strictly increasing.
+    pub i_d: [T; ND],
+    /// The i_q axis in A, strictly increasing.
+    pub i_q: [T; NQ],
+    /// ψd in Wb: `psi_d[k][m]` at (`i_d[k]`, `i_q[m]`).
+    pub psi_d: [[T; NQ]; ND],
+    /// ψq in Wb, as `psi_d`.
+    pub psi_q: [[T; NQ]; ND],
+}
+
+impl<T: Real, const ND: usize, const NQ: usize> FluxTable<T, ND, NQ> {
+    /// The table borrowed as a checked [`FluxMap`].
+    pub fn map(&self) -> Result<FluxMap<'_, T>, FluxMapError> {
+        FluxMap::new(
+            &self.i_d,
+            &self.i_q,
+            self.psi_d.as_flattened(),
+            self.psi_q.as_flattened(),
+        )
+    }
+
+    /// Tabulates any magnetic model on the grid `i_d` × `i_q` (e.g. an algebraic model
+    /// turned into the table firmware keeps in flash).
+    pub fn from_model(model: &impl MagneticModel<T>, i_d: [T; ND], i_q: [T; NQ]) -> Self {
+        let mut psi_d = [[T::zero(); NQ]; ND];
+        let mut psi_q = [[T::zero(); NQ]; ND];
+        for (k, &id) in i_d.iter().enumerate() {
+            for (m, &iq) in i_q.iter().enumerate() {
+                let psi = model.flux(Dq::new(id, iq));
+                psi_d[k][m] = psi.d;
+                psi_q[k][m] = psi.q;
+            }
+        }
+        Self {
+            i_d,
+            i_q,
+            psi_d,
+            psi_q,
+        }
+    }
+}

@@ -1,0 +1,233 @@
+//! The machine's magnetics: the stator flux linkage ψ as a function of the stator current i in
+//! the rotor frame (d on the magnet), and its inverse — one model for the plant, the estimator,
+//! the drive and commissioning alike (the pattern of motulator's `MagneticModel`).
+//!
+//! Three forms implement [`MagneticModel`]:
+//! - [`ConstantInductance`]: ψ = (Ld·i_d + λf, Lq·i_q), the magnetically linear machine;
+//! - [`Saturation`]: the algebraic self- and cross-saturation model of Hinkkanen et al., "Sensorless
+//!   self-commissioning of synchronous reluctance motors at standstill without rotor locking",
+//!   IEEE TIA 53(3), 2017, <https://doi.org/10.1109/TIA.2016.2644624>, with the magnet and the
+//!   saturating rib ("bridge") of Lelli, Hinkkanen & Giulii Capponi, "A saturation model based on
+//!   a simplified equivalent magnetic circuit for permanent magnet machines", ICEM 2024,
+//!   <https://doi.org/10.1109/ICEM60801.2024.10700403>. It is a current map i(ψ) derived from a
+//!   magnetic energy, so it is reciprocal by construction;
+//! - [`FluxMap`]: a measured or computed map ψd(i_d, i_q), ψq(i_d, i_q) on a rectangular grid,
+//!   interpolated bilinearly, borrowed from a `&'static` table in firmware (flash) or from a
+//!   [`FluxTable`] held by value.
+//!
+//! [`Magnetics`] holds any of the three by value (`Copy`), for records that must name one type.
+//!
+//! # Quantities
+//! - **Incremental inductance** L_inc(i) = ∂ψ/∂i, a 2×2 [`InductanceMatrix`]: what a current
+//!   controller sees for a small step, and what the flux-linkage state equation
+//!   dψ/dt = v − Rs·i − ω·J·ψ turns into di/dt. For an energy-consistent model it is symmetric
+//!   (reciprocity: ∂ψd/∂i_q = ∂ψq/∂i_d).
+//! - **Secant q inductance** L_q,s(i) = ψq/i_q: the one inductance that makes the active flux
+//!   ψ − L_q,s·i lie on the d axis for any map (its q component is ψq − (ψq/i_q)·i_q = 0).
+//!   [`MagneticModel::active_flux`] is its d component, ψd − L_q,s·i_d.
+//! - **Torque** from the co-energy: T = 1.5·p·(ψd·i_q − ψq·i_d) ([`MagneticModel::torque`]).
+//!   For a magnetically linear machine it is 1.5·p·(λf·i_q + (Ld − Lq)·i_d·i_q).
+//!
+//! # Inversion
+//! The form that is not a model's own (ψ(i) of a current map, i(ψ) of a flux map) is solved by
+//! Newton's method on the model's own Jacobian, from the magnetically linear guess or from a
+//! caller's warm start (a plant's last current): at most [`NEWTON_ITERATIONS`] steps, stopping
+//! when the step is below √ε/16 of the solution's size (then the error is of the order of ε). Saturation curves are
+//! monotonic and convex (i(ψ)) or concave (ψ(i)) on each side of the origin, where Newton's
+//! iterates from the linear guess converge monotonically; the tests check inverse ∘ forward = 1.
+//!
+//! Nothing here allocates, panics or uses `unsafe`; a non-finite argument gives a non-finite
+//! result, which callers reject as they reject any non-finite sample.
+
+mod constant;
+mod flux_map;
+mod saturation;
+
+pub use constant::ConstantInductance;
+pub use flux_map::{FluxMap, FluxMapError, FluxTable};
+pub use saturation::Saturation;
+
+use crate::{Dq, Real};
+
+/// The most Newton steps an inversion takes (quadratic convergence needs 3–6 from the linear
+/// guess on the saturation curves of real machines; a bilinear map's cell edges may need more).
+pub const NEWTON_ITERATIONS: usize = 24;
+
+/// A 2×2 matrix acting on d-q vectors: an incremental inductance ∂ψ/∂i (H) or its inverse
+/// ∂i/∂ψ (1/H). `dq` is the entry in row d, column q (∂ψd/∂i_q).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct InductanceMatrix<T> {
+    /// Row d, column d.
+    pub dd: T,
+    /// Row d, column q.
+    pub dq: T,
+    /// Row q, column d.
+    pub qd: T,
+    /// Row q, column q.
+    pub qq: T,
+}
+
+impl<T: Real> InductanceMatrix<T> {
+    /// The diagonal matrix diag(d, q).
+    pub fn diagonal(d: T, q: T) -> Self {
+        Self {
+            dd: d,
+            dq: T::zero(),
+            qd: T::zero(),
+            qq: q,
+        }
+    }
+
+    /// Determinant.
+    #[inline]
+    pub fn det(&self) -> T {
+        self.dd * self.qq - self.dq * self.qd
+    }
+
+    /// The inverse matrix (non-finite entries when the matrix is singular).
+    #[inline]
+    pub fn inverse(&self) -> Self {
+        let k = T::one() / self.det();
+        Self {
+            dd: self.qq * k,
+            dq: -self.dq * k,
+            qd: -self.qd * k,
+            qq: self.dd * k,
+        }
+    }
+
+    /// The product with a d-q vector.
+    #[inline]
+    pub fn apply(&self, x: Dq<T>) -> Dq<T> {
+        Dq::new(self.dd * x.d + self.dq * x.q, self.qd * x.d + self.qq * x.q)
+    }
+
+    /// `A·x = b` solved for x (Cramer's rule).
+    #[inline]
+    pub fn solve(&self, b: Dq<T>) -> Dq<T> {
+        let k = T::one() / self.det();
+        Dq::new(
+            (self.qq * b.d - self.dq * b.q) * k,
+            (self.dd * b.q - self.qd * b.d) * k,
+        )
+    }
+}
+
+/// A magnetic model of a synchronous machine in its rotor frame: ψ(i), i(ψ) and their
+/// Jacobians. Every quantity is SI, peak, per phase (amplitude-invariant transform).
+///
+/// Implementors give the two maps and one Jacobian; the derived quantities (torque, secant q
+/// inductance, active flux, the magnet's flux) are provided.
+pub trait MagneticModel<T: Real> {
+    /// Stator flux linkage ψ(i) in Wb.
+    fn flux(&self, i: Dq<T>) -> Dq<T>;
+
+    /// Stator current i(ψ) in A, the inverse of [`MagneticModel::flux`].
+    fn current(&self, psi: Dq<T>) -> Dq<T>;
+
+    /// i(ψ) starting Newton's method (where the model needs it) from `guess`, a current near
+    /// the answer (a plant's last current): the same result as [`MagneticModel::current`] in
+    /// fewer steps. Models with a closed-form i(ψ) ignore the guess.
+    fn current_from(&self, psi: Dq<T>, guess: Dq<T>) -> Dq<T> {
+        let _ = guess;
+        self.current(psi)
+    }
+
+    /// Incremental inductance ∂ψ/∂i at the current `i`, in H.
+    fn incremental_inductance(&self, i: Dq<T>) -> InductanceMatrix<T>;
+
+    /// Electromagnetic torque 1.5·p·(ψd·i_q − ψq·i_d) in N·m, from the co-energy.
+    fn torque(&self, pole_pairs: u32, i: Dq<T>) -> T {
+        let psi = self.flux(i);
+        T::lit(1.5 * pole_pairs as f64) * (psi.d * i.q - psi.q * i.d)
+    }
+
+    /// Secant q inductance L_q,s = ψq/i_q in H; at |i_q| < 1 µA, the incremental ∂ψq/∂i_q
+    /// (its limit for a map odd in i_q).
+    fn secant_q(&self, i: Dq<T>) -> T {
+        if i.q.abs() < T::lit(1e-6) {
+            self.incremental_inductance(i).qq
+        } else {
+            self.flux(i).q / i.q
+        }
+    }
+
+    /// Magnitude of the active flux ψd − L_q,s·i_d in Wb (Boldea et al., IEEE TPEL 23(5),
+    /// 2008, generalised to any map with the secant q inductance): ψ − L_q,s·i lies on d.
+    fn active_flux(&self, i: Dq<T>) -> T {
+        self.flux(i).d - self.secant_q(i) * i.d
+    }
+
+    /// The magnet's flux linkage ψd(0, 0) in Wb (λf of a linear model).
+    fn magnet_flux(&self) -> T {
+        self.flux(Dq::zero()).d
+    }
+}
+
+/// Newton's method for `f(x) = target` with `f` returning the value and its Jacobian at x.
+/// Stops when the step is below √ε/16 of |x| + `scale` (ε the type's epsilon), or after
+/// [`NEWTON_ITERATIONS`] steps; returns the last iterate (non-finite if `target` is).
+pub(crate) fn newton<T: Real>(
+    target: Dq<T>,
+    mut x: Dq<T>,
+    scale: T,
+    f: impl Fn(Dq<T>) -> (Dq<T>, InductanceMatrix<T>),
+) -> Dq<T> {
+    // Quadratic convergence: after a step of √ε/16 the error is of the order of ε.
+    let tol = T::default_epsilon().sqrt() * T::lit(1.0 / 16.0);
+    for _ in 0..NEWTON_ITERATIONS {
+        let (y, jac) = f(x);
+        let step = jac.solve(y - target);
+        x -= step;
+        if !step.is_finite() || step.norm() <= tol * (x.norm() + scale) {
+            break;
+        }
+    }
+    x
+}
+
+/// Any of the three magnetic models, by value.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Magnetics<'a, T> {
+    /// Constant inductances.
+    Constant(ConstantInductance<T>),
+    /// The algebraic saturation model.
+    Saturation(Saturation<T>),
+    /// A flux map on a rectangular grid.
+    Map(FluxMap<'a, T>),
+}
+
+impl<T: Real> Magnetics<'_, T> {
+    /// True for constant inductances (a plant keeps its closed-form path for them).
+    pub fn is_linear(&self) -> bool {
+        matches!(self, Magnetics::Constant(_))
+    }
+}
+
+macro_rules! dispatch {
+    ($self:ident, $m:ident => $e:expr) => {
+        match $self {
+            Magnetics::Constant($m) => $e,
+            Magnetics::Saturation($m) => $e,
+            Magnetics::Map($m) => $e,
+        }
+    };
+}
+
+impl<T: Real> MagneticModel<T> for Magnetics<'_, T> {
+    fn flux(&self, i: Dq<T>) -> Dq<T> {
+        dispatch!(self, m => m.flux(i))
+    }
+    fn current(&self, psi: Dq<T>) -> Dq<T> {
+        dispatch!(self, m => m.current(psi))
+    }
+    fn current_from(&self, psi: Dq<T>, guess: Dq<T>) -> Dq<T> {
+        dispatch!(self, m => m.current_from(psi, guess))
+    }
+    fn incremental_inductance(&self, i: Dq<T>) -> InductanceMatrix<T> {
+        dispatch!(self, m => m.incremental_inductance(i))
+    }
+}
+
+#[cfg(test)]
+mod tests;

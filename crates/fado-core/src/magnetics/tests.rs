@@ -1,0 +1,422 @@
+use std::string::ToString;
+
+use super::*;
+use crate::MachineModel;
+
+/// The 6.7 kW SyRM of motulator's algebraic-model examples (Hinkkanen et al. 2017's fit).
+fn syrm() -> Saturation<f64> {
+    Saturation {
+        a_d0: 17.4,
+        a_dd: 373.0,
+        s: 5.0,
+        a_q0: 52.1,
+        a_qq: 658.0,
+        t: 1.0,
+        a_dq: 1120.0,
+        u: 1.0,
+        v: 0.0,
+        ..Saturation::default()
+    }
+}
+
+/// The 5.6 kW PM-SyRM (Baldor ECS101M0H7EF4) fit of motulator's example, with the rib.
+fn pmsyrm() -> Saturation<f64> {
+    Saturation {
+        a_d0: 3.96,
+        a_dd: 28.5,
+        s: 4.0,
+        a_q0: 5.89,
+        a_qq: 2.67,
+        t: 6.0,
+        a_dq: 41.5,
+        u: 1.0,
+        v: 1.0,
+        psi_n: 0.804,
+        a_b: 81.75,
+        a_bp: 1.0,
+        w: 2.0,
+        k_q: 0.1,
+        ..Saturation::default()
+    }
+}
+
+/// An interior-magnet machine (Ld 36 mH, Lq 51 mH, λf 0.545 Wb) with q saturation and a
+/// cross term, saturating around the magnet's flux.
+fn ipm() -> Saturation<f64> {
+    Saturation {
+        a_qq: 40.0,
+        t: 2.0,
+        a_dq: 30.0,
+        u: 1.0,
+        v: 1.0,
+        ..Saturation::linear(0.036, 0.051, 0.545)
+    }
+}
+
+/// The same interior-magnet machine with the magnet as an MMF (i_f = λf/Ld) and d
+/// self-saturation: ψd falls with i_q at i_d = 0 (cross-saturation) and positive i_d saturates.
+fn ipm_mmf() -> Saturation<f64> {
+    Saturation {
+        a_d0: 1.0 / 0.036,
+        a_dd: 20.0,
+        s: 2.0,
+        a_q0: 11.0,
+        a_qq: 4000.0,
+        t: 4.0,
+        a_dq: 58.0,
+        i_f: 0.545 / 0.036,
+        ..Saturation::default()
+    }
+}
+
+fn models() -> [(&'static str, Saturation<f64>, f64); 4] {
+    // (name, model, rated-ish current in A)
+    [
+        ("syrm", syrm(), 22.0),
+        ("pmsyrm", pmsyrm(), 12.5),
+        ("ipm", ipm(), 6.0),
+        ("ipm_mmf", ipm_mmf(), 6.0),
+    ]
+}
+
+#[test]
+fn a_magnet_mmf_gives_cross_saturation_and_asymmetric_d_saturation() {
+    let m = ipm_mmf();
+    m.validate().unwrap();
+    let psi0 = m.flux(Dq::zero()).d;
+    // ψd at i_d = 0 falls with i_q.
+    let psi_q6 = m.flux(Dq::new(0.0, 6.0)).d;
+    assert!(psi_q6 < 0.99 * psi0, "{psi0} -> {psi_q6}");
+    // Positive d current meets a lower incremental inductance than negative.
+    let up = m.incremental_inductance(Dq::new(6.0, 0.0)).dd;
+    let down = m.incremental_inductance(Dq::new(-6.0, 0.0)).dd;
+    assert!(up < 0.95 * down, "{up} vs {down}");
+}
+
+fn currents(i_max: f64) -> impl Iterator<Item = Dq<f64>> {
+    (-4..=4).flat_map(move |a| {
+        (-4..=4).map(move |b| {
+            Dq::new(
+                0.4 * i_max * a as f64 / 4.0 + 0.013,
+                0.5 * i_max * b as f64 / 2.0 - 0.007,
+            )
+        })
+    })
+}
+
+#[test]
+fn constant_inductance_is_the_machine_model_bit_for_bit() {
+    let m = MachineModel::<f64> {
+        ld: 2.0e-3,
+        lq: 5.0e-3,
+        ..MachineModel::paper()
+    };
+    let c = ConstantInductance {
+        ld: m.ld,
+        lq: m.lq,
+        flux_linkage: m.flux_linkage,
+    };
+    for i in currents(20.0) {
+        assert_eq!(c.flux(i), m.flux_dq(i));
+        assert!((c.current(c.flux(i)) - i).norm() < 1e-12);
+        let t = c.torque(m.pole_pairs, i);
+        assert!(
+            (t - m.torque(i)).abs() < 1e-12 * (1.0 + t.abs()),
+            "{t} vs {}",
+            m.torque(i)
+        );
+        assert!((c.active_flux(i) - m.active_flux(i.d)).abs() < 1e-15);
+    }
+    // The algebraic form with no saturation is the same machine.
+    let s = Saturation::linear(m.ld, m.lq, m.flux_linkage);
+    for i in currents(20.0) {
+        assert!((s.flux(i) - c.flux(i)).norm() < 1e-14, "{i:?}");
+    }
+}
+
+#[test]
+fn inverse_of_forward_is_the_identity() {
+    for (name, m, i_max) in models() {
+        m.validate().unwrap();
+        for i in currents(2.0 * i_max) {
+            let psi = m.flux(i);
+            assert!(psi.is_finite(), "{name}: {i:?}");
+            let back = m.current(psi);
+            assert!(
+                (back - i).norm() < 1e-9 * (1.0 + i.norm()),
+                "{name}: {i:?} -> {back:?}"
+            );
+        }
+    }
+}
+
+/// Central differences of `f` at `x` with step `h` along d and q: the Jacobian.
+fn fd(f: impl Fn(Dq<f64>) -> Dq<f64>, x: Dq<f64>, h: f64) -> InductanceMatrix<f64> {
+    let dd = (f(x + Dq::new(h, 0.0)) - f(x - Dq::new(h, 0.0))) * (0.5 / h);
+    let dq = (f(x + Dq::new(0.0, h)) - f(x - Dq::new(0.0, h))) * (0.5 / h);
+    InductanceMatrix {
+        dd: dd.d,
+        dq: dq.d,
+        qd: dd.q,
+        qq: dq.q,
+    }
+}
+
+fn close(a: InductanceMatrix<f64>, b: InductanceMatrix<f64>, rel: f64) -> bool {
+    let scale = a.dd.abs().max(a.qq.abs());
+    [a.dd - b.dd, a.dq - b.dq, a.qd - b.qd, a.qq - b.qq]
+        .iter()
+        .all(|e| e.abs() <= rel * scale)
+}
+
+#[test]
+fn incremental_inductance_matches_finite_differences_and_is_reciprocal() {
+    for (name, m, i_max) in models() {
+        for i in currents(1.5 * i_max) {
+            let l = m.incremental_inductance(i);
+            let num = fd(|x| m.flux(x), i, 1e-4 * i_max);
+            assert!(close(l, num, 1e-5), "{name} at {i:?}: {l:?} vs {num:?}");
+            // Reciprocity, from the forward map's values alone.
+            assert!(
+                (num.dq - num.qd).abs() <= 1e-5 * num.dd.abs().max(num.qq.abs()),
+                "{name} at {i:?}: ∂ψd/∂iq {} vs ∂ψq/∂id {}",
+                num.dq,
+                num.qd
+            );
+            // The inverse Jacobian ∂i/∂ψ against the current map's differences.
+            let psi = m.flux(i);
+            let (_, g) = m.current_and_jacobian(psi);
+            let num_g = fd(|p| m.current(p), psi, 1e-6);
+            assert!(
+                close(g, num_g, 1e-5),
+                "{name} at {psi:?}: {g:?} vs {num_g:?}"
+            );
+        }
+    }
+}
+
+/// Magnetic energy 1.5·∫ i·dψ from `psi0` to `psi` along the straight line (Gauss–Legendre,
+/// 5 points on each of 64 pieces).
+fn energy(m: &impl MagneticModel<f64>, psi0: Dq<f64>, psi: Dq<f64>) -> f64 {
+    let (x, w) = (
+        [
+            0.0,
+            -0.538_469_310_105_683_1,
+            0.538_469_310_105_683_1,
+            -0.906_179_845_938_664,
+            0.906_179_845_938_664,
+        ],
+        [
+            0.568_888_888_888_888_9,
+            0.478_628_670_499_366_5,
+            0.478_628_670_499_366_5,
+            0.236_926_885_056_189_1,
+            0.236_926_885_056_189_1,
+        ],
+    );
+    let dpsi = psi - psi0;
+    let n = 64;
+    let mut e = 0.0;
+    for piece in 0..n {
+        for (xk, wk) in x.iter().zip(w) {
+            let s = (piece as f64 + 0.5 + 0.5 * xk) / n as f64;
+            let i = m.current(psi0 + dpsi * s);
+            e += wk * 0.5 / n as f64 * (i.d * dpsi.d + i.q * dpsi.q);
+        }
+    }
+    1.5 * e
+}
+
+#[test]
+fn torque_is_the_co_energy_derivative_and_the_energy_is_path_independent() {
+    for (name, m, i_max) in models() {
+        let p = 2;
+        let psi_ref = m.flux(Dq::zero());
+        for i in currents(1.2 * i_max).step_by(7) {
+            let psi = m.flux(i);
+            // Virtual work at constant stator flux: rotating the rotor by δ (mechanical δ/p)
+            // turns ψ_dq by −δ; T = −∂W/∂θ_mech.
+            let delta = 1e-5;
+            let rot = |a: f64| {
+                Dq::new(
+                    psi.d * a.cos() + psi.q * a.sin(),
+                    -psi.d * a.sin() + psi.q * a.cos(),
+                )
+            };
+            let dw = energy(&m, psi_ref, rot(delta)) - energy(&m, psi_ref, rot(-delta));
+            let t_virtual = -dw / (2.0 * delta / p as f64);
+            let t = m.torque(p, i);
+            assert!(
+                (t - t_virtual).abs() < 1e-6 * (1.0 + t.abs()),
+                "{name} at {i:?}: {t} vs virtual work {t_virtual}"
+            );
+            // Around a closed loop the energy returns (a reciprocal, conservative model).
+            let corner = Dq::new(psi_ref.d, psi.q);
+            let loop_w =
+                energy(&m, psi_ref, corner) + energy(&m, corner, psi) - energy(&m, psi_ref, psi);
+            assert!(
+                loop_w.abs() < 1e-9 * (1.0 + energy(&m, psi_ref, psi).abs()),
+                "{name}: {loop_w}"
+            );
+        }
+    }
+}
+
+#[test]
+fn secant_q_inductance_puts_the_active_flux_on_d() {
+    for (name, m, i_max) in models() {
+        for i in currents(i_max) {
+            let psi = m.flux(i);
+            let lqs = m.secant_q(i);
+            let q = psi.q - lqs * i.q;
+            assert!(q.abs() < 1e-12, "{name}: {q}");
+            assert!((m.active_flux(i) - (psi.d - lqs * i.d)).abs() < 1e-15);
+        }
+        // The q secant inductance falls with q current (self-saturation).
+        let l0 = m.secant_q(Dq::new(0.0, 0.0));
+        let l1 = m.secant_q(Dq::new(0.0, i_max));
+        assert!(l1 < 0.97 * l0, "{name}: {l0} -> {l1}");
+    }
+    // The SyRM's published unsaturated inductances: 1/a_d0, 1/a_q0.
+    let s = syrm();
+    assert!((s.incremental_inductance(Dq::zero()).dd - 1.0 / 17.4).abs() < 1e-12);
+    assert!((s.secant_q(Dq::zero()) - 1.0 / 52.1).abs() < 1e-12);
+}
+
+fn ipm_table<T: Real>() -> FluxTable<T, 16, 16> {
+    let m = ipm().cast::<T>();
+    let axis = |a: f64, b: f64| core::array::from_fn(|k| T::lit(a + (b - a) * k as f64 / 15.0));
+    FluxTable::from_model(&m, axis(-12.0, 6.0), axis(-12.0, 12.0))
+}
+
+#[test]
+fn a_flux_map_interpolates_inverts_and_differentiates() {
+    let table = ipm_table::<f64>();
+    let map = table.map().unwrap();
+    let truth = ipm();
+    for (k, &id) in table.i_d.iter().enumerate() {
+        for (m, &iq) in table.i_q.iter().enumerate() {
+            let psi = map.flux(Dq::new(id, iq));
+            assert_eq!((psi.d, psi.q), (table.psi_d[k][m], table.psi_q[k][m]));
+        }
+    }
+    for i in currents(9.0) {
+        let psi = map.flux(i);
+        // Bilinear between nodes: close to the model it tabulates.
+        assert!((psi - truth.flux(i)).norm() < 2e-3, "{i:?}");
+        let back = map.current(psi);
+        assert!(
+            (back - i).norm() < 1e-9 * (1.0 + i.norm()),
+            "{i:?} -> {back:?}"
+        );
+        let warm = map.current_from(psi, i + Dq::new(0.3, -0.2));
+        assert!((warm - i).norm() < 1e-9 * (1.0 + i.norm()));
+        // Incremental inductance against differences taken inside the cell.
+        let num = fd(|x| map.flux(x), i, 1e-7);
+        assert!(close(map.incremental_inductance(i), num, 1e-6), "{i:?}");
+        assert!(close(
+            map.incremental_inductance(i),
+            truth.incremental_inductance(i),
+            0.05
+        ));
+    }
+    // Beyond the grid, the edge cells extend linearly and still invert.
+    let far = Dq::new(-15.0, 14.0);
+    assert!((map.current(map.flux(far)) - far).norm() < 1e-9);
+    // A linear machine's map is exact everywhere (bilinear reproduces affine maps).
+    let lin = ConstantInductance {
+        ld: 0.036,
+        lq: 0.051,
+        flux_linkage: 0.545,
+    };
+    let ax: [f64; 3] = [-10.0, -1.0, 4.0];
+    let lt = FluxTable::from_model(&lin, ax, [-5.0, 0.0, 5.0]);
+    let lm = lt.map().unwrap();
+    for i in currents(20.0) {
+        assert!((lm.flux(i) - lin.flux(i)).norm() < 1e-14);
+        assert!((lm.torque(3, i) - lin.torque(3, i)).abs() < 1e-12);
+    }
+}
+
+#[test]
+fn a_flux_map_runs_in_f32_from_a_static_table() {
+    static TABLE: FluxTable<f32, 2, 2> = FluxTable {
+        i_d: [-10.0, 10.0],
+        i_q: [-10.0, 10.0],
+        psi_d: [[0.1, 0.1], [0.9, 0.9]],
+        psi_q: [[-0.5, 0.5], [-0.5, 0.5]],
+    };
+    let map: Magnetics<'static, f32> = Magnetics::Map(TABLE.map().unwrap());
+    let psi = map.flux(Dq::new(5.0, 2.0));
+    assert!(
+        (psi.d - 0.7).abs() < 1e-6 && (psi.q - 0.1).abs() < 1e-6,
+        "{psi:?}"
+    );
+    assert!((map.current(psi) - Dq::new(5.0, 2.0)).norm() < 1e-4);
+    let t16 = ipm_table::<f32>();
+    let m16 = t16.map().unwrap();
+    let i = Dq::new(-3.0f32, 4.0);
+    let back = m16.current(m16.flux(i));
+    assert!((back - i).norm() < 1e-4, "{back:?}");
+    assert!(!map.is_linear());
+}
+
+#[test]
+fn bad_maps_are_refused_naming_the_node() {
+    let (id, iq) = ([0.0, 1.0, 2.0], [-1.0, 1.0]);
+    let good_d = [0.5, 0.5, 0.6, 0.6, 0.7, 0.7];
+    let good_q = [-0.1, 0.1, -0.1, 0.1, -0.1, 0.1];
+    assert!(FluxMap::new(&id, &iq, &good_d, &good_q).is_ok());
+    let e = FluxMap::new(&id, &iq, &good_d[..5], &good_q).unwrap_err();
+    assert_eq!(e, FluxMapError::Ragged { table: "psi_d" });
+    let mut d = good_d;
+    d[4] = 0.55; // ψd falls from i_d = 1 to 2 at i_q = −1
+    let e = FluxMap::new(&id, &iq, &d, &good_q).unwrap_err();
+    assert_eq!(
+        e,
+        FluxMapError::NotMonotonic {
+            table: "psi_d",
+            k: 2,
+            m: 0
+        }
+    );
+    let mut q = good_q;
+    q[3] = f64::NAN;
+    let e = FluxMap::new(&id, &iq, &good_d, &q).unwrap_err();
+    assert_eq!(
+        e,
+        FluxMapError::NotFinite {
+            table: "psi_q",
+            k: 1,
+            m: 1
+        }
+    );
+    let e = FluxMap::new(&[0.0, 0.0, 1.0], &iq, &good_d, &good_q).unwrap_err();
+    assert_eq!(
+        e,
+        FluxMapError::Axis {
+            axis: "i_d",
+            index: 1
+        }
+    );
+    let e = FluxMap::<f64>::new(&[0.0], &iq, &[0.0, 0.0], &[0.0, 1.0]).unwrap_err();
+    assert_eq!(e, FluxMapError::TooFewNodes { axis: "i_d" });
+    assert!(e.to_string().contains("i_d"));
+}
+
+#[test]
+fn saturation_parameters_are_checked_naming_the_field() {
+    let mut m = syrm();
+    m.a_dq = -1.0;
+    assert_eq!(m.validate().unwrap_err().field(), "a_dq");
+    let mut m = pmsyrm();
+    m.w = 1.0;
+    assert_eq!(m.validate().unwrap_err().field(), "w");
+    assert_eq!(
+        Saturation::<f64>::default().validate().unwrap_err().field(),
+        "a_d0"
+    );
+    // Non-finite flux gives a non-finite current, never a panic.
+    assert!(!syrm().current(Dq::new(f64::NAN, 0.1)).is_finite());
+    assert!(!ipm().flux(Dq::new(f64::INFINITY, 0.1)).is_finite());
+}

@@ -1,0 +1,275 @@
+//! What a motor's ratings give: the value of every motor and inverter key a user may leave
+//! out, each derived from the ratings by a stated rule — never another motor's number.
+//!
+//! A motor is described by its circuit (Rs, Ld, Lq, λf, pole pairs) and its ratings (rated
+//! current, speed and torque). Everything else a drive or a simulation needs has a rule here,
+//! used by every front end alike (`fado-sim`'s TOML `[motor]`/`[inverter]` tables and Python's
+//! `fado.Machine`), and printed with its rule by `fado-sim run --dump-config`:
+//!
+//! | key | rule |
+//! |---|---|
+//! | `viscous_friction` | [`FRICTION_TORQUE_RATIO`] of the rated torque at rated speed |
+//! | `inertia` | rated torque accelerates it to rated speed in [`MECHANICAL_START_TIME`] |
+//! | `dc_voltage` | the rated point uses [`DC_LINK_MODULATION_RATIO`] of the linear range |
+//! | `switching_frequency` | ω_rated·Ts ≤ [`MAX_OMEGA_TS`], at least [`MIN_SWITCHING_FREQUENCY`] |
+//! | `dead_time` | [`DEAD_TIME_PERIOD_RATIO`] of the carrier period |
+//! | `threshold_voltage` | [`THRESHOLD_VOLTAGE_RATIO`] of the DC link |
+//! | `current_band` | [`CURRENT_BAND_RATIO`] of the rated current |
+//!
+//! # The bound on ω·Ts (why 0.2)
+//! The estimator integrates the voltage the inverter held over each sample and the resistive
+//! drop of the current averaged over the same interval (trapezoid, `average_current`); the
+//! drive applies its voltage 1.5 samples after the angle it was computed at, advanced by the
+//! linearised 1.5·ω̂·Ts. A stator quantity that turns by x = ω·Ts per sample is therefore
+//! represented with the gain cos(x/2) by the trapezoid and sinc(x/2) = sin(x/2)/(x/2) by the
+//! hold, and the drive's voltage of a held sample spans an arc of x. At x = 0.2 the trapezoid's
+//! gain error 1 − cos(x/2) is 0.50 %, the hold's 0.17 %, both below the 1 % tolerance fado's
+//! identification reports its parameters to; at the 0.73 of a 14-pole-pair outrunner on a
+//! 5 kHz inverter they are 6.6 % and 2.2 %, the size of the errors its commissioning then
+//! makes. 0.2 also keeps the observer's gains within their series range (|x| ≤ 0.25 in `f64`,
+//! 0.5 in `f32`, see [`crate::observer`]). The test `omega_ts_bound_keeps_the_discretisation_within_one_percent`
+//! checks these numbers.
+
+use crate::Real;
+use crate::machine::{MachineModel, PAPER_RATED_CURRENT};
+
+/// Viscous friction at rated speed as a fraction of the rated torque: 1 % \[A\]
+/// (B = 0.01·T_rated/ω_rated,mech). Bearings and windage of industrial servo motors take
+/// 0.5–2 % of the rated torque at rated speed; the friction is what the speed controller
+/// feeds forward, and a guess on the high side would hide a load.
+pub const FRICTION_TORQUE_RATIO: f64 = 0.01;
+
+/// Mechanical start time, s: the rated torque accelerates the shaft (motor and load) from
+/// standstill to rated speed in this time, J = T_rated·t/ω_rated,mech. 0.15 s \[A\]: the median
+/// of the repository's motor presets is 0.16 s (from 0.06 s for the automotive IPMSM to 0.74 s
+/// for the hub motor carrying a robot), the paper's motor and dynamometer 0.16 s.
+pub const MECHANICAL_START_TIME: f64 = 0.15;
+
+/// Largest rated electrical speed times sampling period the derived switching frequency allows
+/// (see the module documentation for the derivation): 0.2 rad.
+pub const MAX_OMEGA_TS: f64 = 0.2;
+
+/// Lowest derived switching frequency, Hz: 5 kHz, the paper's and that of most industrial
+/// drives (a slower carrier is audible and its current ripple large).
+pub const MIN_SWITCHING_FREQUENCY: f64 = 5000.0;
+
+/// The derived switching frequency is a whole multiple of this, Hz.
+pub const SWITCHING_FREQUENCY_STEP: f64 = 1000.0;
+
+/// Fraction of the linear modulation range Vdc/√3 that the rated point's phase voltage takes
+/// with the derived DC link: 0.8 \[A\] (20 % voltage headroom for the current controller's
+/// transients).
+pub const DC_LINK_MODULATION_RATIO: f64 = 0.8;
+
+/// Dead time as a fraction of the carrier period: 1.25 % (2.5 µs at the paper's 5 kHz, paper
+/// §V \[P\]).
+pub const DEAD_TIME_PERIOD_RATIO: f64 = 0.0125;
+
+/// Device threshold (knee) voltage as a fraction of the DC link: the paper inverter's 1 V of
+/// 311 V (SPEC §5 \[A\]); a low-voltage MOSFET bridge has almost none.
+pub const THRESHOLD_VOLTAGE_RATIO: f64 = 1.0 / 311.0;
+
+/// Current band of the dead-time and threshold errors as a fraction of the rated current: the
+/// paper inverter's 0.3 A of 21.8 A (SPEC §5 \[A\]; it scales with the devices' output
+/// capacitance, which scales with their current rating).
+pub const CURRENT_BAND_RATIO: f64 = 0.3 / PAPER_RATED_CURRENT;
+
+/// The keys a motor description must give: the circuit and the ratings.
+pub const REQUIRED_MOTOR_KEYS: [&str; 8] = [
+    "rs",
+    "ld",
+    "lq",
+    "flux_linkage",
+    "pole_pairs",
+    "rated_current",
+    "rated_speed_rpm",
+    "rated_torque",
+];
+
+/// The ratings among [`REQUIRED_MOTOR_KEYS`].
+pub const RATING_KEYS: [&str; 3] = ["rated_current", "rated_speed_rpm", "rated_torque"];
+
+/// Each derivable key (`section.key` as in `fado-sim`'s TOML) and its rule, in words.
+pub const RULES: [(&str, &str); 7] = [
+    (
+        "motor.viscous_friction",
+        "1 % of rated_torque at rated_speed_rpm: B = 0.01·T_rated/ω_rated,mech",
+    ),
+    (
+        "motor.inertia",
+        "rated_torque reaches rated_speed_rpm in 0.15 s: J = T_rated·0.15 s/ω_rated,mech",
+    ),
+    (
+        "inverter.dc_voltage",
+        "the rated point's phase voltage (MTPA, rated_current, rated_speed_rpm) at 80 % of Vdc/√3",
+    ),
+    (
+        "inverter.switching_frequency",
+        "ω_rated·Ts ≤ 0.2 (Ts = 1/(2·f_sw)), at least 5 kHz, rounded up to a whole kHz",
+    ),
+    (
+        "inverter.dead_time",
+        "1.25 % of the carrier period 1/switching_frequency",
+    ),
+    ("inverter.threshold_voltage", "1/311 of dc_voltage"),
+    (
+        "inverter.current_band",
+        "1.38 % of rated_current (0.3 A of 21.78 A)",
+    ),
+];
+
+/// The rule of a derivable key (`motor.inertia`), if it has one.
+pub fn rule(key: &str) -> Option<&'static str> {
+    RULES.iter().find(|(k, _)| *k == key).map(|(_, r)| *r)
+}
+
+/// Rated mechanical speed in rad/s from r/min.
+fn rated_speed_mech(rated_speed_rpm: f64) -> f64 {
+    rated_speed_rpm * core::f64::consts::PI / 30.0
+}
+
+/// B = [`FRICTION_TORQUE_RATIO`]·T_rated/ω_rated,mech, N·m·s/rad.
+pub fn viscous_friction(rated_torque: f64, rated_speed_rpm: f64) -> f64 {
+    FRICTION_TORQUE_RATIO * rated_torque / rated_speed_mech(rated_speed_rpm)
+}
+
+/// J = T_rated·[`MECHANICAL_START_TIME`]/ω_rated,mech, kg·m².
+pub fn inertia(rated_torque: f64, rated_speed_rpm: f64) -> f64 {
+    rated_torque * MECHANICAL_START_TIME / rated_speed_mech(rated_speed_rpm)
+}
+
+/// The smallest whole multiple of `step` at or above `x` (x ≥ 0, finite).
+fn ceil_to(x: f64, step: f64) -> f64 {
+    let n = x / step;
+    let whole = n as u64 as f64;
+    step * if whole < n { whole + 1.0 } else { whole }
+}
+
+/// The switching frequency, Hz: the smallest whole kHz at or above
+/// [`MIN_SWITCHING_FREQUENCY`] at which ω_rated·Ts ≤ [`MAX_OMEGA_TS`] with Ts = 1/(2·f_sw).
+pub fn switching_frequency(pole_pairs: u32, rated_speed_rpm: f64) -> f64 {
+    let omega = rated_speed_mech(rated_speed_rpm) * pole_pairs as f64;
+    let needed = omega / (2.0 * MAX_OMEGA_TS);
+    ceil_to(
+        needed.max(MIN_SWITCHING_FREQUENCY),
+        SWITCHING_FREQUENCY_STEP,
+    )
+}
+
+/// The d and q currents of the maximum-torque-per-ampere point of magnitude `i` (A peak):
+/// i_d = (λf − √(λf² + 8·ΔL²·i²))/(4·ΔL) with ΔL = Lq − Ld for a salient rotor with Lq > Ld,
+/// else (0, i).
+pub fn mtpa_current(m: &MachineModel<f64>, i: f64) -> (f64, f64) {
+    let dl = m.lq - m.ld;
+    if !(m.is_salient() && dl > 0.0) {
+        return (0.0, i);
+    }
+    let lf = m.flux_linkage;
+    let id = (lf - (lf * lf + 8.0 * dl * dl * i * i).step_sqrt()) / (4.0 * dl);
+    let iq = (i * i - id * id).max(0.0).step_sqrt();
+    (id, iq)
+}
+
+/// The model's torque at rated current on the MTPA point, N·m.
+pub fn rated_current_torque(m: &MachineModel<f64>) -> f64 {
+    let (id, iq) = mtpa_current(m, m.rated_current);
+    m.torque(crate::Dq::new(id, iq))
+}
+
+/// Magnitude of the steady-state phase voltage (peak) at rated speed and rated current on the
+/// MTPA point: |R·i + jω·(L·i + λf)| in the rotor frame, V.
+pub fn rated_point_voltage(m: &MachineModel<f64>) -> f64 {
+    let (id, iq) = mtpa_current(m, m.rated_current);
+    let w = m.rated_speed();
+    let vd = m.rs * id - w * m.lq * iq;
+    let vq = m.rs * iq + w * (m.ld * id + m.flux_linkage);
+    (vd * vd + vq * vq).step_sqrt()
+}
+
+/// The DC link, V, at which the rated point's phase voltage is [`DC_LINK_MODULATION_RATIO`]
+/// of the linear range Vdc/√3, rounded up to a whole volt.
+pub fn dc_voltage(m: &MachineModel<f64>) -> f64 {
+    let v = rated_point_voltage(m) * 1.732_050_807_568_877_2 / DC_LINK_MODULATION_RATIO;
+    ceil_to(v, 1.0)
+}
+
+/// Td = [`DEAD_TIME_PERIOD_RATIO`] / f_sw, s.
+pub fn dead_time(switching_frequency: f64) -> f64 {
+    DEAD_TIME_PERIOD_RATIO / switching_frequency
+}
+
+/// V_th = [`THRESHOLD_VOLTAGE_RATIO`]·Vdc, V.
+pub fn threshold_voltage(dc_voltage: f64) -> f64 {
+    THRESHOLD_VOLTAGE_RATIO * dc_voltage
+}
+
+/// Ic = [`CURRENT_BAND_RATIO`]·I_rated, A.
+pub fn current_band(rated_current: f64) -> f64 {
+    CURRENT_BAND_RATIO * rated_current
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn omega_ts_bound_keeps_the_discretisation_within_one_percent() {
+        let x = MAX_OMEGA_TS;
+        let (s, c) = (x / 2.0).step_sin_cos();
+        let (trapezoid, hold) = (1.0 - c, 1.0 - s / (x / 2.0));
+        assert!(trapezoid < 0.0051 && trapezoid > 0.0049, "{trapezoid}");
+        assert!(hold < 0.0017, "{hold}");
+        // The outrunner of the issue on a 5 kHz inverter: 6.6 % and 2.2 %.
+        let x: f64 = 0.73;
+        let (s, c) = (x / 2.0).step_sin_cos();
+        assert!((1.0 - c - 0.066).abs() < 1e-3);
+        assert!((1.0 - s / (x / 2.0) - 0.022).abs() < 1e-3);
+    }
+
+    #[test]
+    fn derived_values_follow_their_rules() {
+        let m = MachineModel::<f64>::paper();
+        // 1 % of 11.5 N·m at 157 rad/s.
+        let b = viscous_friction(m.rated_torque, m.rated_speed_rpm);
+        assert!((b * 1500.0 * core::f64::consts::PI / 30.0 - 0.115).abs() < 1e-12);
+        let j = inertia(m.rated_torque, m.rated_speed_rpm);
+        assert!((j * m.rated_speed_mech() / m.rated_torque - 0.15).abs() < 1e-12);
+        // 628 rad/s needs 1.6 kHz: the 5 kHz floor.
+        assert_eq!(switching_frequency(4, 1500.0), 5000.0);
+        // A 14-pole-pair outrunner at 7000 r/min: 10,263 rad/s → 25.7 kHz → 26 kHz.
+        let f = switching_frequency(14, 7000.0);
+        assert_eq!(f, 26_000.0);
+        assert!(14.0 * 7000.0 * core::f64::consts::PI / 30.0 * 0.5 / f <= MAX_OMEGA_TS);
+        assert_eq!(dead_time(5000.0), 2.5e-6);
+        assert_eq!(threshold_voltage(311.0), 1.0);
+        assert!((current_band(PAPER_RATED_CURRENT) - 0.3).abs() < 1e-15);
+        // The paper's rated point: |v| = 72 V, so 156 V at 80 % of Vdc/√3.
+        let v = rated_point_voltage(&m);
+        assert!((v - 72.0).abs() < 1.0, "{v}");
+        let vdc = dc_voltage(&m);
+        assert!(
+            v <= DC_LINK_MODULATION_RATIO * vdc / 3f64.step_sqrt() + 1e-9,
+            "{vdc}"
+        );
+        assert!(vdc - 1.0 < v * 3f64.step_sqrt() / DC_LINK_MODULATION_RATIO);
+        for (k, _) in RULES {
+            assert!(rule(k).is_some());
+        }
+    }
+
+    #[test]
+    fn mtpa_current_maximises_the_torque_on_the_circle() {
+        // The 2.2 kW IPMSM: p 3, Ld 36 mH, Lq 51 mH, λf 0.545 Wb.
+        let m = MachineModel {
+            rs: 3.6,
+            ld: 36e-3,
+            lq: 51e-3,
+            flux_linkage: 0.545,
+            pole_pairs: 3,
+            ..MachineModel::<f64>::paper()
+        };
+        let (id, iq) = mtpa_current(&m, 6.0);
+        assert!((id * id + iq * iq - 36.0).abs() < 1e-9);
+        assert!((m.mtpa_id(iq) - id).abs() < 1e-9);
+    }
+}

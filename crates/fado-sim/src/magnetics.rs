@@ -1,0 +1,706 @@
+//! The plant's saturating magnetics: a [`fado_core::magnetics`] model held by the simulator,
+//! and the integrator of the stator flux linkage that a saturating machine needs.
+//!
+//! **State and equations.** A saturating machine's state is its stator flux linkage ψ, the
+//! current a function of it, i = i(ψ) (the model's inverse map). In the stationary frame
+//!
+//! ```text
+//!   dψ_ab/dt = v_ab − R·i_ab,   i_ab = e^{jθ}·i_dq(e^{−jθ}·ψ_ab),   θ(t) = θ0 + ω·t
+//! ```
+//!
+//! with v_ab constant over each interval of one switch state (the inverter resolves them) and
+//! ω held over the sample, as for the linear machine ([`crate::motor`]). The voltage's share
+//! The right-hand side v − R·i(ψ, θ(t)) is integrated by the classical fourth-order Runge–Kutta
+//! method on sub-steps of at most [`SUBSTEP_TIME_CONSTANTS`] × the shortest time constant
+//! L_inc,min/R (and at most the interval): four evaluations of i(ψ) per sub-step, the first
+//! carried over from the last; an interval shorter than [`SHORT_INTERVAL_SUBSTEPS`] of a
+//! sub-step takes the midpoint rule (two). Second-order rules are not enough here: a hard-switched
+//! saturating machine moves ψ by |v|·h ≈ 15 mWb per interval through the curved part of i(ψ),
+//! and their h³ error terms, through R, accumulate over the electrical time constant (Heun's
+//! method on every interval: 3 mA of 8 A after 2 ms; RK4 with the midpoint rule on the short
+//! ones: 14 µA, measured by `tests`). `tests` bound the error
+//! against a fine reference and check the energy balance v·i = R·i² + dW/dt + T·ω_mech.
+//!
+//! **Why not the closed form.** The linear machine's exact exponential propagator needs
+//! constant inductances; a saturating one has none. Constant-inductance motors keep that exact
+//! path: [`crate::motor::Motor`] builds this integrator only for a saturating model.
+
+use std::cell::Cell;
+use std::path::Path;
+use std::sync::Arc;
+
+use fado_core::magnetics::{FluxMap, FluxMapError, MagneticModel, Magnetics, Saturation};
+use fado_core::{Ab, Dq};
+use num_complex::Complex64;
+
+use crate::error::SimConfigError;
+use crate::fastmath::{cis, rotate, unrotate};
+use crate::source::SourceLocation;
+
+/// The longest sub-step as a fraction of the machine's shortest electrical time constant
+/// L_inc,min/R.
+pub const SUBSTEP_TIME_CONSTANTS: f64 = 0.05;
+
+/// Intervals shorter than this fraction of the longest sub-step (the dead times, the short
+/// pulses of a PWM period) take the midpoint rule (two evaluations of i(ψ)) instead of RK4
+/// (four): its h³ error is then below RK4's on the long intervals.
+pub const SHORT_INTERVAL_SUBSTEPS: f64 = 0.1;
+
+/// A flux map's data held by the simulator (the firmware's `&'static` table, on the heap):
+/// `psi_d[k·n_q + m]` at (`i_d[k]`, `i_q[m]`), checked by [`FluxMap::new`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct FluxMapData {
+    i_d: Vec<f64>,
+    i_q: Vec<f64>,
+    psi_d: Vec<f64>,
+    psi_q: Vec<f64>,
+}
+
+impl FluxMapData {
+    /// The map from its axes and row-major tables, checked.
+    pub fn new(
+        i_d: Vec<f64>,
+        i_q: Vec<f64>,
+        psi_d: Vec<f64>,
+        psi_q: Vec<f64>,
+    ) -> Result<Self, FluxMapError> {
+        FluxMap::new(&i_d, &i_q, &psi_d, &psi_q)?;
+        Ok(Self {
+            i_d,
+            i_q,
+            psi_d,
+            psi_q,
+        })
+    }
+
+    /// The map, borrowed (an O(1) view of the checked data).
+    pub fn map(&self) -> FluxMap<'_, f64> {
+        FluxMap::from_checked_parts(&self.i_d, &self.i_q, &self.psi_d, &self.psi_q)
+            .expect("shapes checked by FluxMapData::new")
+    }
+}
+
+/// Where a flux-map file went wrong: `FILE:LINE:1: `flux_map`: …`.
+fn map_error(file: &str, line: usize, message: impl Into<String>) -> SimConfigError {
+    let mut e = SimConfigError::new("flux_map", message);
+    e.location = Some(SourceLocation {
+        file: Some(file.to_owned()),
+        line,
+        column: 1,
+    });
+    e
+}
+
+/// Reads a flux map from a CSV file (see [`parse_flux_map`]); a file that cannot be read is
+/// refused naming it.
+pub fn read_flux_map(path: &Path) -> Result<FluxMapData, SimConfigError> {
+    let name = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| {
+        SimConfigError::new(
+            "flux_map",
+            format!("cannot read `{name}`: {e} (a path in a TOML file is relative to that file)"),
+        )
+    })?;
+    parse_flux_map(&text, &name)
+}
+
+/// Parses a flux map: CSV with the header `i_d,i_q,psi_d,psi_q` (SI peak values in the rotor
+/// frame, d on the magnet), one row per node of any rectangular grid in any order, lines
+/// starting with `#` ignored. A row that does not parse, a non-finite value, a node given
+/// twice or missing (a ragged grid) and a map not strictly increasing in its own current are
+/// refused as `file:LINE:1: …` (`file` names the source in messages).
+pub fn parse_flux_map(text: &str, file: &str) -> Result<FluxMapData, SimConfigError> {
+    let mut reader = csv::ReaderBuilder::new()
+        .comment(Some(b'#'))
+        .trim(csv::Trim::All)
+        .from_reader(text.as_bytes());
+    // The physical line of the record starting at a byte offset: the reader's own line count
+    // skips comment lines, and a record's offset is where the reader resumed (before any
+    // comment or blank lines preceding it).
+    let lines: Vec<&str> = text.lines().collect();
+    let line_at = |byte: u64| {
+        let start = (byte as usize).min(text.len());
+        let mut line = text.as_bytes()[..start]
+            .iter()
+            .filter(|&&b| b == b'\n')
+            .count();
+        while lines
+            .get(line)
+            .is_some_and(|l| l.trim().is_empty() || l.trim_start().starts_with('#'))
+        {
+            line += 1;
+        }
+        line + 1
+    };
+    let headers = reader
+        .headers()
+        .map_err(|e| map_error(file, 1, e.to_string()))?
+        .clone();
+    let header_line = headers.position().map_or(1, |p| line_at(p.byte()));
+    let want = ["i_d", "i_q", "psi_d", "psi_q"];
+    if headers.iter().collect::<Vec<_>>() != want {
+        return Err(map_error(
+            file,
+            header_line,
+            format!(
+                "the header must be `i_d,i_q,psi_d,psi_q`, got `{}`",
+                headers.iter().collect::<Vec<_>>().join(",")
+            ),
+        ));
+    }
+    // (values, line) per row.
+    let mut rows: Vec<([f64; 4], usize)> = Vec::new();
+    for record in reader.records() {
+        let record = record.map_err(|e| {
+            let line = e.position().map_or(0, |p| line_at(p.byte()));
+            map_error(file, line, e.to_string())
+        })?;
+        let line = record.position().map_or(0, |p| line_at(p.byte()));
+        let mut v = [0.0; 4];
+        for (k, x) in v.iter_mut().enumerate() {
+            let cell = record.get(k).unwrap_or("");
+            *x = cell.parse::<f64>().map_err(|_| {
+                map_error(
+                    file,
+                    line,
+                    format!("`{}` = `{cell}` is not a number", want[k]),
+                )
+            })?;
+            if !x.is_finite() {
+                return Err(map_error(
+                    file,
+                    line,
+                    format!("`{}` = {cell} is not finite", want[k]),
+                ));
+            }
+        }
+        rows.push((v, line));
+    }
+    let axis = |k: usize| {
+        let mut a: Vec<f64> = rows.iter().map(|r| r.0[k]).collect();
+        a.sort_by(f64::total_cmp);
+        a.dedup();
+        a
+    };
+    let (i_d, i_q) = (axis(0), axis(1));
+    let (nd, nq) = (i_d.len(), i_q.len());
+    if nd < 2 || nq < 2 {
+        return Err(map_error(
+            file,
+            header_line,
+            "the grid needs at least two values of i_d and of i_q",
+        ));
+    }
+    let mut psi_d = vec![f64::NAN; nd * nq];
+    let mut psi_q = vec![f64::NAN; nd * nq];
+    let mut line_of = vec![0usize; nd * nq];
+    for (v, line) in &rows {
+        let k = i_d.partition_point(|&x| x < v[0]);
+        let m = i_q.partition_point(|&x| x < v[1]);
+        let at = k * nq + m;
+        if line_of[at] != 0 {
+            return Err(map_error(
+                file,
+                *line,
+                format!(
+                    "the node (i_d, i_q) = ({}, {}) is given twice (line {} too)",
+                    v[0], v[1], line_of[at]
+                ),
+            ));
+        }
+        (psi_d[at], psi_q[at], line_of[at]) = (v[2], v[3], *line);
+    }
+    if let Some(at) = line_of.iter().position(|&l| l == 0) {
+        let last = rows.last().map_or(header_line, |r| r.1);
+        return Err(map_error(
+            file,
+            last,
+            format!(
+                "the grid is ragged: no row for (i_d, i_q) = ({}, {}); a map needs every pair of \
+                 its {nd} i_d and {nq} i_q values",
+                i_d[at / nq],
+                i_q[at % nq]
+            ),
+        ));
+    }
+    FluxMapData::new(i_d, i_q, psi_d, psi_q).map_err(|e| {
+        let line = match e {
+            FluxMapError::NotMonotonic { k, m, .. } | FluxMapError::NotFinite { k, m, .. } => {
+                line_of[k * nq + m]
+            }
+            _ => header_line,
+        };
+        map_error(file, line, e.to_string())
+    })
+}
+
+/// The plant's saturating magnetic model: the algebraic model or a flux map.
+#[derive(Clone, Debug, PartialEq)]
+pub enum PlantMagnetics {
+    /// The algebraic self- and cross-saturation model (`[motor.saturation]`).
+    Saturation(Saturation<f64>),
+    /// A flux map (`[motor] flux_map = "FILE.csv"`).
+    Map(FluxMapData),
+}
+
+impl PlantMagnetics {
+    /// The model as a [`Magnetics`] value (a borrow of the map's data).
+    #[inline]
+    pub fn model(&self) -> Magnetics<'_, f64> {
+        match self {
+            PlantMagnetics::Saturation(s) => Magnetics::Saturation(*s),
+            PlantMagnetics::Map(m) => Magnetics::Map(m.map()),
+        }
+    }
+
+    /// Bounds of the incremental inductances (diagonal entries) over |i_d|, |i_q| ≤ `i_max`
+    /// (a 21 × 21 grid; a map's own grid range if it is wider), and the magnet's flux.
+    pub fn bounds(&self, i_max: f64) -> MagneticBounds {
+        let m = self.model();
+        let (mut l_min, mut l_max) = (f64::INFINITY, 0.0_f64);
+        for a in -10..=10 {
+            for b in -10..=10 {
+                let i = Dq::new(i_max * a as f64 / 10.0, i_max * b as f64 / 10.0);
+                let l = m.incremental_inductance(i);
+                for x in [l.dd, l.qq] {
+                    if x.is_finite() && x > 0.0 {
+                        l_min = l_min.min(x);
+                        l_max = l_max.max(x);
+                    }
+                }
+            }
+        }
+        let psi_zero = m.flux(Dq::zero());
+        MagneticBounds {
+            l_min,
+            l_max,
+            psi0: psi_zero.d,
+            psi_zero,
+        }
+    }
+}
+
+/// What the inverter's edge logic and the sub-step length need of a saturating machine.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MagneticBounds {
+    /// Smallest incremental self-inductance in H.
+    pub l_min: f64,
+    /// Largest incremental self-inductance in H.
+    pub l_max: f64,
+    /// Magnet flux ψd(0, 0) in Wb.
+    pub psi0: f64,
+    /// ψ(0) in Wb (a blocked inverter's current).
+    pub psi_zero: Dq<f64>,
+}
+
+/// The end of the last interval: current and flux in α-β and the rotor's e^{jθ} there.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct FluxPoint {
+    pub i_ab: Ab<f64>,
+    pub psi_ab: Ab<f64>,
+    pub rot: Complex64,
+    /// `i_ab` in the rotor frame at `rot` (what the rotor-frame callers pass back).
+    pub i_dq: Dq<f64>,
+}
+
+impl FluxPoint {
+    /// The machine's state (i_dq, ψ_dq) at rotor position `rot` = e^{jθ}.
+    pub fn at(i_dq: Dq<f64>, psi_dq: Dq<f64>, rot: Complex64) -> Self {
+        Self {
+            i_ab: rotate(i_dq, rot),
+            psi_ab: rotate(psi_dq, rot),
+            rot,
+            i_dq,
+        }
+    }
+}
+
+/// The flux-linkage integrator of one sample (fixed speed and resistance); it remembers the
+/// flux at the end of its last interval, so that the inverter can keep passing currents.
+#[derive(Clone, Debug)]
+pub(crate) struct FluxPropagator {
+    mag: Arc<PlantMagnetics>,
+    bounds: MagneticBounds,
+    r: f64,
+    omega: f64,
+    h_max: f64,
+    pole_pairs: f64,
+    last: Cell<FluxPoint>,
+}
+
+impl FluxPropagator {
+    /// The integrator from the machine's state `start`.
+    pub fn new(
+        mag: Arc<PlantMagnetics>,
+        bounds: &MagneticBounds,
+        r: f64,
+        omega: f64,
+        pole_pairs: u32,
+        start: FluxPoint,
+    ) -> Self {
+        Self {
+            mag,
+            bounds: *bounds,
+            r,
+            omega,
+            h_max: SUBSTEP_TIME_CONSTANTS * bounds.l_min / r,
+            pole_pairs: pole_pairs as f64,
+            last: Cell::new(start),
+        }
+    }
+
+    /// The flux linkage belonging to the current `i_ab` at `rot`: the remembered one when
+    /// `i_ab` is the last interval's end (always, along a sample), else from the model.
+    #[inline]
+    fn flux_of(&self, i_ab: Ab<f64>, rot: Complex64) -> Ab<f64> {
+        let last = self.last.get();
+        if last.i_ab == i_ab {
+            last.psi_ab
+        } else if i_ab == Ab::zero() {
+            rotate(self.bounds.psi_zero, rot)
+        } else {
+            rotate(self.mag.model().flux(unrotate(i_ab, rot)), rot)
+        }
+    }
+
+    /// The magnetics' bounds.
+    pub fn bounds(&self) -> &MagneticBounds {
+        &self.bounds
+    }
+
+    /// The end of the last interval.
+    pub fn last(&self) -> FluxPoint {
+        self.last.get()
+    }
+
+    /// Advances over `h` seconds of constant `v_ab` from the current `i_ab`; `rot0` = e^{jθ} at
+    /// the start, `rot_h` = e^{jωh}. Returns the current at the end.
+    pub fn advance_ab(
+        &self,
+        i_ab: Ab<f64>,
+        v_ab: Ab<f64>,
+        h: f64,
+        rot0: Complex64,
+        rot_h: Complex64,
+    ) -> Ab<f64> {
+        let model = self.mag.model();
+        let mut psi = self.flux_of(i_ab, rot0);
+        let mut i = i_ab;
+        let n = (h / self.h_max).ceil().clamp(1.0, 1e6) as u32;
+        let hs = h / n as f64;
+        let rot_s = if n == 1 { rot_h } else { cis(self.omega * hs) };
+        let mut rot = rot0;
+        let mut guess = unrotate(i, rot);
+        let r = self.r;
+        let rot_half = cis(0.5 * self.omega * hs);
+        let short = hs < SHORT_INTERVAL_SUBSTEPS * self.h_max;
+        for k in 0..n {
+            let rot_mid = rot * rot_half;
+            rot = if k + 1 == n {
+                rot0 * rot_h
+            } else {
+                rot * rot_s
+            };
+            let g = guess;
+            let current_at = |psi: Ab<f64>, rot: Complex64| {
+                rotate(model.current_from(unrotate(psi, rot), g), rot)
+            };
+            let mut current = |psi: Ab<f64>| {
+                let i_dq = model.current_from(unrotate(psi, rot), guess);
+                guess = i_dq;
+                rotate(i_dq, rot)
+            };
+            let k1 = v_ab - i * r;
+            let k2 = v_ab - current_at(psi + k1 * (0.5 * hs), rot_mid) * r;
+            if short {
+                // The midpoint rule: error h³ terms, negligible on a short interval.
+                psi += k2 * hs;
+            } else {
+                let k3 = v_ab - current_at(psi + k2 * (0.5 * hs), rot_mid) * r;
+                let k4 = v_ab - current_at(psi + k3 * hs, rot) * r;
+                psi += (k1 + (k2 + k3) * 2.0 + k4) * (hs / 6.0);
+            }
+            i = current(psi);
+        }
+        self.last.set(FluxPoint {
+            i_ab: i,
+            psi_ab: psi,
+            rot,
+            i_dq: unrotate(i, rot),
+        });
+        i
+    }
+
+    /// As [`FluxPropagator::advance_ab`] in the rotor frame.
+    pub fn advance(
+        &self,
+        i: Dq<f64>,
+        v_ab: Ab<f64>,
+        h: f64,
+        rot0: Complex64,
+        rot_h: Complex64,
+    ) -> Dq<f64> {
+        // The last interval's end, passed back in the rotor frame: its own α-β current (a
+        // round trip through the rotation would change the last bits and lose the flux).
+        let last = self.last.get();
+        let i_ab = if i == last.i_dq && rot0 == last.rot {
+            last.i_ab
+        } else {
+            rotate(i, rot0)
+        };
+        self.advance_ab(i_ab, v_ab, h, rot0, rot_h);
+        self.last.get().i_dq
+    }
+
+    /// Torque 1.5·p·(ψ × i) at the current `i_ab`, rotor at `rot`.
+    #[inline]
+    pub fn torque_ab(&self, i_ab: Ab<f64>, rot: Complex64) -> f64 {
+        let psi = self.flux_of(i_ab, rot);
+        1.5 * self.pole_pairs * (psi.alpha * i_ab.beta - psi.beta * i_ab.alpha)
+    }
+
+    /// Torque at the rotor-frame current `i_dq`, rotor at `rot`.
+    #[inline]
+    pub fn torque_dq(&self, i_dq: Dq<f64>) -> f64 {
+        let last = self.last.get();
+        let psi = if i_dq == last.i_dq {
+            unrotate(last.psi_ab, last.rot)
+        } else if i_dq == Dq::zero() {
+            self.bounds.psi_zero
+        } else {
+            self.mag.model().flux(i_dq)
+        };
+        1.5 * self.pole_pairs * (psi.d * i_dq.q - psi.q * i_dq.d)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::motor::{Motor, MotorParams};
+
+    /// ipmsm-2k2's machine with q self-saturation (secant Lq −30 % at rated current) and
+    /// cross-saturation.
+    pub(crate) fn saturated_ipm() -> Saturation<f64> {
+        Saturation {
+            a_qq: 4000.0,
+            t: 4.0,
+            a_dq: 300.0,
+            u: 1.0,
+            v: 1.0,
+            ..Saturation::linear(0.036, 0.051, 0.545)
+        }
+    }
+
+    fn ipm_params() -> MotorParams {
+        MotorParams {
+            rs: 3.6,
+            ld: 0.036,
+            lq: 0.051,
+            flux_linkage: 0.545,
+            pole_pairs: 3,
+            inertia: 0.015,
+            viscous_friction: 8.9e-4,
+            rated_current: 6.08,
+            rated_speed_rpm: 1500.0,
+            rated_torque: 14.0,
+            dc_voltage: 540.0,
+        }
+    }
+
+    fn motor(theta: f64, i: Dq<f64>, omega: f64) -> Motor {
+        let mag = Arc::new(PlantMagnetics::Saturation(saturated_ipm()));
+        let mut m = Motor::with_magnetics(ipm_params(), Some(mag), theta).unwrap();
+        m.set_state(i, theta, omega / 3.0);
+        m
+    }
+
+    /// RK4 on dψ_ab/dt = v − R·i_ab(ψ_ab, θ(t)) with `n` steps over `h`.
+    fn reference(
+        s: &Saturation<f64>,
+        (r, w): (f64, f64),
+        psi0: Ab<f64>,
+        v: Ab<f64>,
+        th0: f64,
+        h: f64,
+        n: usize,
+    ) -> Ab<f64> {
+        let f = |t: f64, psi: Ab<f64>| {
+            let rot = cis(th0 + w * t);
+            v - rotate(s.current(unrotate(psi, rot)), rot) * r
+        };
+        let dt = h / n as f64;
+        let mut psi = psi0;
+        for k in 0..n {
+            let t = k as f64 * dt;
+            let k1 = f(t, psi);
+            let k2 = f(t + dt / 2.0, psi + k1 * (dt / 2.0));
+            let k3 = f(t + dt / 2.0, psi + k2 * (dt / 2.0));
+            let k4 = f(t + dt, psi + k3 * dt);
+            psi += (k1 + k2 * 2.0 + k3 * 2.0 + k4) * (dt / 6.0);
+        }
+        psi
+    }
+
+    #[test]
+    fn flux_integration_error_against_a_fine_reference_is_bounded() {
+        // A sample's worth of switch states (100 µs in 5 intervals) at several speeds,
+        // repeated over 20 samples, against RK4 at 10 ns steps.
+        let s = saturated_ipm();
+        let r = 3.6;
+        let volts = [
+            Ab::new(360.0, 0.0),
+            Ab::new(180.0, 311.8),
+            Ab::new(0.0, 0.0),
+            Ab::new(-180.0, 311.8),
+            Ab::new(-360.0, 0.0),
+        ];
+        let hs = [7e-6, 23e-6, 40e-6, 18e-6, 12e-6];
+        for w in [0.0, 150.0, -471.0] {
+            let mut m = motor(0.4, Dq::new(-2.0, 5.0), w);
+            let mut psi_ref = m.flux_ab();
+            let mut th = 0.4;
+            let mut worst: f64 = 0.0;
+            for _sample in 0..20 {
+                let prop = m.propagator(r);
+                let mut rot = m.rotation();
+                let mut i = m.i_ab();
+                let mut th_k = th;
+                for (v, h) in volts.iter().zip(hs) {
+                    let rot_h = cis(w * h);
+                    i = prop.advance_ab(i, *v, h, rot, rot_h);
+                    rot *= rot_h;
+                    psi_ref = reference(&s, (r, w), psi_ref, *v, th_k, h, (h / 1e-8) as usize);
+                    th_k += w * h;
+                    let i_ref = rotate(s.current(unrotate(psi_ref, rot)), rot);
+                    worst = worst.max((i - i_ref).norm());
+                }
+                let i_dq = unrotate(i, rot);
+                m.set_current_from(&prop, i_dq);
+                // The angle advances at the held speed (ω_mech = 0 here: advance by hand).
+                th = th_k;
+                let (ip, tp) = (m.state().i_dq, th);
+                m.set_state(ip, tp, w / 3.0);
+                // set_state recomputes ψ from i: keep the integrated flux as the reference's.
+                psi_ref = m.flux_ab();
+            }
+            // Measured: 1e-6 A (RK4 alone) and 1.4e-5 A (with the midpoint rule on the 7 µs
+            // interval) of ~8 A at 471 rad/s over 2 ms of hard switching.
+            assert!(worst < 5e-5, "ω = {w}: worst |i − i_ref| = {worst:e} A");
+            assert!(worst > 0.0);
+        }
+    }
+
+    /// 1.5·∫ i·dψ along the straight line from `a` to `b` (rotor frame; 5-point Gauss–Legendre
+    /// on 32 pieces).
+    fn energy_change(s: &Saturation<f64>, a: Dq<f64>, b: Dq<f64>) -> f64 {
+        let x = [
+            0.0,
+            -0.538_469_310_105_683,
+            0.538_469_310_105_683,
+            -0.906_179_845_938_664,
+            0.906_179_845_938_664,
+        ];
+        let w = [
+            0.568_888_888_888_889,
+            0.478_628_670_499_366,
+            0.478_628_670_499_366,
+            0.236_926_885_056_189,
+            0.236_926_885_056_189,
+        ];
+        let d = b - a;
+        let mut e = 0.0;
+        for piece in 0..32 {
+            for (xk, wk) in x.iter().zip(w) {
+                let t = (piece as f64 + 0.5 + 0.5 * xk) / 32.0;
+                let i = s.current(a + d * t);
+                e += wk * 0.5 / 32.0 * (i.d * d.d + i.q * d.q);
+            }
+        }
+        1.5 * e
+    }
+
+    #[test]
+    fn energy_in_equals_copper_loss_plus_stored_plus_mechanical() {
+        // 2 ms of switch states at 300 rad/s, the integrals taken by the trapezoid over 0.25 µs
+        // pieces of the integrator's own trajectory; W(ψ) by quadrature of i·dψ.
+        let s = saturated_ipm();
+        let r = 3.6;
+        let w = 300.0;
+        let mut m = motor(-0.7, Dq::new(-3.0, 7.0), w);
+        let psi_start = m.flux_dq();
+        let volts = [
+            Ab::new(360.0, 0.0),
+            Ab::new(-180.0, 311.8),
+            Ab::new(0.0, 0.0),
+        ];
+        let (mut e_in, mut e_cu, mut e_mech) = (0.0, 0.0, 0.0);
+        let h = 0.25e-6;
+        for sample in 0..20 {
+            let prop = m.propagator(r);
+            let mut rot = m.rotation();
+            let mut i = m.i_ab();
+            for piece in 0..400 {
+                let v = volts[(piece / 60 + sample) % 3];
+                let rot_h = cis(w * h);
+                let (i0, t0) = (i, prop.torque_ab(m.params(), i, rot));
+                i = prop.advance_ab(i, v, h, rot, rot_h);
+                rot *= rot_h;
+                let t1 = prop.torque_ab(m.params(), i, rot);
+                e_in += 1.5 * h * 0.5 * (v.dot(i0) + v.dot(i));
+                e_cu += 1.5 * r * h * 0.5 * (i0.norm_squared() + i.norm_squared());
+                e_mech += h * 0.5 * (t0 + t1) * w / 3.0;
+            }
+            m.set_current_from(&prop, unrotate(i, rot));
+            let th = m.state().theta + w * 1e-4;
+            let i_dq = m.state().i_dq;
+            let psi = m.flux_dq();
+            m.set_state(i_dq, th, w / 3.0);
+            // set_state re-derives ψ from i (Newton, to rounding): the state is unchanged.
+            assert!((m.flux_dq() - psi).norm() < 1e-12);
+        }
+        let d_w = energy_change(&s, psi_start, m.flux_dq());
+        let residual = e_in - e_cu - d_w - e_mech;
+        assert!(
+            residual.abs() < 1e-6 * e_in.abs(),
+            "in {e_in}, copper {e_cu}, stored {d_w}, mechanical {e_mech}: residual {residual:e}"
+        );
+        assert!(d_w.abs() > 1e-3 * e_in.abs() && e_mech.abs() > 1e-3 * e_in.abs());
+    }
+
+    #[test]
+    fn a_flux_map_file_is_read_in_any_row_order_and_bad_ones_are_refused_at_their_line() {
+        let text = "# a 2 x 3 map\ni_d,i_q,psi_d,psi_q\n0,1,0.60,0.05\n-5,-1,0.40,-0.05\n0,0,0.60,0.0\n# note\n-5,0,0.40,0.0\n-5,1,0.40,0.05\n0,-1,0.60,-0.05\n";
+        let data = parse_flux_map(text, "m.csv").unwrap();
+        let map = data.map();
+        assert_eq!(map.i_d(), &[-5.0, 0.0]);
+        assert_eq!(map.i_q(), &[-1.0, 0.0, 1.0]);
+        let psi = fado_core::MagneticModel::flux(&map, Dq::new(-2.5, 0.5));
+        assert!((psi.d - 0.5).abs() < 1e-12 && (psi.q - 0.025).abs() < 1e-12);
+        let err = |t: &str| parse_flux_map(t, "m.csv").unwrap_err().to_string();
+        // Ragged: the node (0, 1) missing.
+        let ragged = text.replace("0,1,0.60,0.05\n", "");
+        assert!(err(&ragged).contains("ragged"), "{}", err(&ragged));
+        // NaN, at its line.
+        let nan = text.replace("-5,0,0.40,0.0", "-5,0,NaN,0.0");
+        assert!(err(&nan).starts_with("m.csv:7:1:"), "{}", err(&nan));
+        // Not monotonic in its own current: ψd falls from i_d = −5 to 0 at i_q = 1 (line 3).
+        let flat = text.replace("0,1,0.60,0.05", "0,1,0.30,0.05");
+        assert!(
+            err(&flat).starts_with("m.csv:3:1:") && err(&flat).contains("increase"),
+            "{}",
+            err(&flat)
+        );
+        // A node twice, a bad header, a word.
+        let twice = format!("{text}0,1,0.6,0.05\n");
+        assert!(err(&twice).contains("twice"), "{}", err(&twice));
+        assert!(err("id,iq,psi_d,psi_q\n").contains("header"));
+        let word = text.replace("0,0,0.60,0.0", "0,0,big,0.0");
+        assert!(err(&word).starts_with("m.csv:5:1:"), "{}", err(&word));
+        // A file that does not exist names itself.
+        let e = read_flux_map(Path::new("/nonexistent/map.csv"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("/nonexistent/map.csv"), "{e}");
+    }
+}

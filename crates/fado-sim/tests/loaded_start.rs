@@ -1,0 +1,77 @@
+//! The `loaded-start` scenario: a plant brake that holds the rotor until the drive reports
+//! ready, the rated torque on it, and the start-up judged from the release on.
+
+use fado_sim::controller::Controller;
+use fado_sim::scenario::{loaded_start_angle, scenario_config, simulate};
+
+fn preset_toml(name: &str) -> String {
+    fado_sim::presets::find(name).unwrap().toml.to_owned()
+}
+
+#[test]
+fn the_brake_holds_the_rotor_until_the_drive_reports_ready() {
+    // Two motors: the brake takes the rated torque through both calibrations (the rotor does
+    // not move at all), and releases at the drive's first ready sample, not before.
+    for name in ["paper", "ipmsm-2k2"] {
+        let cfg = scenario_config("loaded-start", Some(&preset_toml(name)), false).unwrap();
+        let theta0 = cfg.simulation.initial_angle;
+        let mut sim = cfg.simulation(cfg.build_drive().unwrap()).unwrap();
+        let mut released = None;
+        for _ in 0..20_000 {
+            let s = sim.step();
+            let ready = sim.controller().ready();
+            if s.brake_engaged {
+                assert!(!ready, "{name}: ready but braked at {}", s.time);
+                assert_eq!(
+                    s.theta, theta0,
+                    "{name}: moved under the brake at {}",
+                    s.time
+                );
+                assert_eq!(s.speed_rpm, 0.0);
+                assert!(s.time == 0.0 || s.load_torque > 0.0);
+            } else {
+                released = Some(s.time);
+                assert!(ready);
+                break;
+            }
+        }
+        let t = released.expect("released");
+        println!("{name}: released at {t:.4} s");
+        // After the offset calibration (0.1 s) and the gain calibration.
+        assert!(t > 0.1 && t < 1.0, "{name}: {t}");
+    }
+}
+
+#[test]
+fn the_start_angle_is_seeded_and_spread_over_the_turn() {
+    let angles: Vec<f64> = (1..=4).map(loaded_start_angle).collect();
+    for (k, a) in angles.iter().enumerate() {
+        assert!(
+            (-std::f64::consts::PI..std::f64::consts::PI).contains(a),
+            "{a}"
+        );
+        for b in &angles[..k] {
+            assert!((a - b).abs() > 0.3, "{angles:?}");
+        }
+    }
+    let text = format!("{}\n[current_sensor]\nseed = 3\n", preset_toml("paper"));
+    let cfg = scenario_config("loaded-start", Some(&text), false).unwrap();
+    assert_eq!(cfg.simulation.initial_angle, loaded_start_angle(3));
+    assert!(cfg.simulation.brake);
+}
+
+#[test]
+fn without_a_load_the_scenario_passes_and_its_checks_see_the_release() {
+    // The criteria can be met: with the load set to zero the paper's motor is released,
+    // does not run back, keeps θ̂ and reaches the commanded speed.
+    let text = format!(
+        "{}\n[load.torque]\npoints = [[0.0, 0.0]]\n",
+        preset_toml("paper")
+    );
+    let out = simulate("loaded-start", Some(&text), false, None).unwrap();
+    println!("{:#?}", out.checks);
+    assert!(out.passed, "{:?}", out.checks);
+    let st = out.probe.start.as_ref().unwrap();
+    assert!(st.release_time.is_some());
+    assert!(st.max_backward < 0.05, "{}", st.max_backward);
+}
