@@ -14,7 +14,7 @@ pub struct Isr {
     estimator: SensorlessEstimator<f32>,
     /// Voltage references of the last two samples, newest first. The one computed two samples
     /// ago is the one the PWM applied over the interval that just ended (one sample of
-    /// computation delay, SPEC §1).
+    /// computation delay, docs/method/estimator.md §1).
     v_ref: [Ab<f32>; 2],
     /// Input faults seen (NaN from a broken ADC channel, say).
     pub faults: u32,
@@ -23,7 +23,7 @@ pub struct Isr {
 impl Isr {
     /// Set-up, before the interrupt is enabled: the motor's data (parameters and ratings, here
     /// the paper's motor), the paper's tuning for everything else, and a start at a known
-    /// (aligned) rotor angle with the phase currents flowing then (SPEC §1 step 6:
+    /// (aligned) rotor angle with the phase currents flowing then (docs/method/estimator.md, "Start-up":
     /// λ1 = λ̂f·e^{jθ0} + L̂q·i).
     pub fn new(theta_aligned: f32, i_abc: Abc<f32>) -> Self {
         let motor = MachineModel {

@@ -1,12 +1,12 @@
 //! The f32 estimator, open loop, on a synthetic PMSM signal: standstill, run-up, a speed
-//! reversal through zero and a stop, with the current sensors' offsets and noise of SPEC §6.
+//! reversal through zero and a stop, with the current sensors' offsets and noise of docs/method/estimator.md, "The paper's motor and drive".
 //! Prints the angle and speed errors per phase of the run.
 //!
 //! ```text
 //! cargo run --release -p fado-core --example open_loop
 //! ```
 //!
-//! The machine is ideal (SPEC §6 data) and the voltage is the one that exactly moves its flux
+//! The machine is ideal (docs/method/estimator.md, "The paper's motor and drive" data) and the voltage is the one that exactly moves its flux
 //! from sample to sample, so what is measured is the estimator: the observer, the k_df and
 //! limiter feedbacks, the hand-over between them and the trackers. The closed loop with an
 //! inverter and a load is the simulator's job (fado-sim).
@@ -93,10 +93,10 @@ fn main() {
     })
     .expect("the default configuration is valid");
     let (_, i0) = machine(theta0);
-    // Start-up from a known (aligned) angle, SPEC §1 step 6.
+    // Start-up from a known (aligned) angle, docs/method/estimator.md, "Start-up".
     est.align(theta0 as f32, Ab::new(i0.alpha as f32, i0.beta as f32));
 
-    // Current sensors, SPEC §6: offsets 20 mA and -10 mA, 10 mA rms white noise.
+    // Current sensors, docs/method/estimator.md, "The paper's motor and drive": offsets 20 mA and -10 mA, 10 mA rms white noise.
     let offset = Ab::new(0.02, -0.01);
     let noise_peak = 0.01 * 3f64.sqrt();
     let mut noise = Noise(0x5eed);

@@ -7,8 +7,8 @@
 //! FIXED_RS=1 cargo run ...   # the paper's fixed R̂s (rs_adaptation = false)
 //! PAPER_PATH=1 cargo run ...  # fado on the paper's path (every fado addition that can be off)
 //! LEAN=1 cargo run ...        # `step_lean`, the firmware's call (no diagnostics record)
-//! ESTIMATOR=ortega cargo run ...  # the Ortega baseline, for the host ratio of issue 16
-//! ESTIMATOR=paper-kernel cargo run ...  # the paper's method alone (f32 only; docs/firmware.md)
+//! ESTIMATOR=ortega cargo run ...  # the Ortega baseline, for the host ratio against it
+//! ESTIMATOR=paper-kernel cargo run ...  # the paper's method alone (f32 only; docs/results/firmware-cost.md)
 //! ```
 
 use std::hint::black_box;
@@ -24,7 +24,7 @@ const TABLE: usize = 4096;
 /// Sampling period (s).
 const TS: f64 = 100e-6;
 
-/// An ideal surface-mounted PMSM (SPEC §6) at 19.5 Hz electrical with 10 A on q: the voltage is
+/// An ideal surface-mounted PMSM (docs/method/estimator.md, "The paper's motor and drive") at 19.5 Hz electrical with 10 A on q: the voltage is
 /// the exact interval average that moves the flux from one sample to the next.
 fn signal<T: Real>() -> Vec<(Ab<T>, Ab<T>)> {
     let (rs, l, lf, iq) = (0.327, 2.63e-3, 0.088, 10.0);

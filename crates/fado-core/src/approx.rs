@@ -2,7 +2,7 @@
 //!
 //! On a Cortex-M4F (single-precision FPU) `libm`'s `sinf`/`cosf` reduce their argument and
 //! evaluate their kernels in `f64`, which that FPU does in software (`__aeabi_dmul`, ...), and
-//! `atan2f` is a chain of calls; both cost hundreds of cycles per sample (docs/firmware.md).
+//! `atan2f` is a chain of calls; both cost hundreds of cycles per sample (docs/results/firmware-cost.md).
 //! These versions use only `f32` add, multiply, one division and compare, so host and firmware
 //! builds still compute bit-identical results (IEEE arithmetic, no fused multiply-add in Rust).
 //! `f64` keeps `libm` (see [`crate::Real`]).
@@ -21,7 +21,7 @@
 //!   a deterministic error of 2e-6 rad is below a thousandth of the estimator's angle error
 //!   in every `f32` scenario (rms |θ − θ̂| 1.2e-3 to 1.9e-2 rad in fig8–fig12), and the
 //!   trackers filter it further; the degree-15 version (3.5e-7) cost 8 cycles more per step
-//!   on a Cortex-M4F (docs/firmware.md, sixth pass).
+//!   on a Cortex-M4F (docs/results/firmware-cost.md).
 
 use core::f32::consts::{FRAC_PI_2, PI};
 

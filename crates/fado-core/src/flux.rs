@@ -2,7 +2,7 @@
 //! eq. (21)-(22)) above the speed threshold and the flux limiter k_af (Fig. 6, eq. (24)-(25))
 //! below it.
 //!
-//! Both feedbacks act on the *same* integrator state λ1 (SPEC §1 step 5): a hand-over only
+//! Both feedbacks act on the *same* integrator state λ1 (docs/method/estimator.md §5): a hand-over only
 //! changes the integrand, so λ̂r changes slope but never jumps, and neither does the angle.
 
 use crate::error::{ConfigError, NonFiniteInput, check};
@@ -21,7 +21,7 @@ pub struct FluxIntegratorConfig<T> {
     /// paper V).
     pub rs_hat: T,
     /// Use (i\[n\] + i[n−1])/2 for the resistive drop, which matches the interval the applied
-    /// voltage acted over (SPEC §1, \[A\]). Default `true`
+    /// voltage acted over (docs/method/estimator.md §1, \[A\]). Default `true`
     /// ([`EstimatorTuning::average_current`]).
     pub average_current: bool,
 }
@@ -115,7 +115,7 @@ impl<T: Real> FluxIntegratorState<T> {
         }
     }
 
-    /// Starts from a known flux λ1 (SPEC §1 step 6: λf·e^{jθ0} + L̂q·i), R̂s kept.
+    /// Starts from a known flux λ1 (docs/method/estimator.md, "Start-up": λf·e^{jθ0} + L̂q·i), R̂s kept.
     pub(crate) fn reset_to(&mut self, lambda1: Ab<T>) {
         self.lambda1 = lambda1;
         self.i_prev = Ab::zero();
@@ -191,7 +191,7 @@ impl<T: Real> FluxIntegrator<T> {
         self.reset_to(Ab::zero());
     }
 
-    /// Starts from a known flux λ1 (SPEC §1 step 6: λf·e^{jθ0} + L̂q·i).
+    /// Starts from a known flux λ1 (docs/method/estimator.md, "Start-up": λf·e^{jθ0} + L̂q·i).
     pub fn reset_to(&mut self, lambda1: Ab<T>) {
         self.state.reset_to(lambda1);
     }
@@ -246,7 +246,7 @@ pub struct DisturbanceFeedbackConfig<T> {
     /// [`EstimatorTuning::k_df`]).
     pub k_df: T,
     /// Time to ramp k_df from 0 to its value on activation, s; 0 switches it abruptly as the
-    /// paper does. A ramp softens the re-activation distortion of Fig. 9 (SPEC §1 \[A\]).
+    /// paper does. A ramp softens the re-activation distortion of Fig. 9 (docs/method/estimator.md §1 \[A\]).
     /// Default 0.
     pub ramp_time: T,
 }
@@ -319,7 +319,7 @@ impl<T: Real> DisturbanceFeedbackParams<T> {
 ///
 /// With it the flux loop is λ1 = u / (s + k_df·G(s)), G = D̂/λ1 (eq. (22)): stable for all
 /// ±ω, a DC gain 1/k_df instead of an integrator's infinite one (bounded drift), and an
-/// exact integrator at ω (SPEC §2).
+/// exact integrator at ω (docs/method/estimator.md §2).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DisturbanceFeedback<T> {
     params: DisturbanceFeedbackParams<T>,
@@ -394,7 +394,7 @@ pub struct LimiterOutput<T> {
 
 /// The flux limiter of Fig. 6 (eq. (24)-(25)).
 ///
-/// Π(x) = x·min(1, ρ/|x|) is the radial projection onto the disc of radius ρ (SPEC §1 \[A\]):
+/// Π(x) = x·min(1, ρ/|x|) is the radial projection onto the disc of radius ρ (docs/method/estimator.md §1 \[A\]):
 /// inside the circle the integrator is pure, outside the excess is pulled back radially with
 /// time constant 1/k_af (1.6 ms by default), and the angle is never constrained.
 /// Stateless apart from its configuration; `step` and `reset` exist for uniformity.

@@ -2,7 +2,7 @@
 //!
 //! The Clarke transform is amplitude-invariant (a phase current of peak I gives |i_ab| = I),
 //! the convention of the paper's eq. (1)-(6). An α-β vector doubles as the complex number
-//! `alpha + j·beta` where the observer maths is written in complex form (SPEC §2).
+//! `alpha + j·beta` where the observer maths is written in complex form (docs/method/estimator.md §2).
 
 use core::ops::{Add, AddAssign, Mul, Neg, Sub, SubAssign};
 

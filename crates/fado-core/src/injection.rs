@@ -35,7 +35,7 @@ impl<T: Real> CurrentInjectionConfig<T> {
 }
 
 /// The rule of eq. (23): i_d* = √(I_min² − i_q*²) when |i_q*| < I_min, else 0, so that the
-/// d-q reference vector has magnitude at least I_min (SPEC §4).
+/// d-q reference vector has magnitude at least I_min (docs/method/estimator.md §6).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CurrentInjection<T> {
     i_min: T,

@@ -25,7 +25,7 @@
 //! estimator for persistent zero-stator-frequency operation of sensorless-controlled
 //! induction motors", IEEE TIA 39(4), 2003, estimate the offset vector from the flux
 //! trajectory's centre the same way). At the rotating frequency D̂ does not respond, so the
-//! paper's exact integration at ω (SPEC §2) is kept. In the limiter mode ê is held and still
+//! paper's exact integration at ω (docs/method/estimator.md §2) is kept. In the limiter mode ê is held and still
 //! subtracted: the offset learned at speed no longer walks the angle at standstill. What it
 //! cannot know are DC errors that appear only at standstill (the dead-time residual and R̂s
 //! errors times a current that is constant in α-β there); those are the limiter's, as before.
@@ -54,7 +54,7 @@ pub struct IntegrandOffsetConfig<T> {
     /// mode, so that D̂ tracks the DC of λ1 as the law assumes).
     pub rate: T,
     /// The law starts only after this long in the k_df mode without interruption, s: D̂
-    /// re-converges after each hand-over with the observer's poles at |ω̂| (SPEC §2), and
+    /// re-converges after each hand-over with the observer's poles at |ω̂| (docs/method/estimator.md §2), and
     /// that transient is not an integrand error. Default 5/(2π·f_th), five observer
     /// time constants at the Fig. 3 threshold f_th (ours \[A\]; 0.53 s on the paper's motor,
     /// f_th = 1.5 Hz).

@@ -9,7 +9,7 @@
 //!    An integrand error u (R̂s error × current, a voltage error) integrated by eq. (21)
 //!    moves λ̂r by u/ω: at speed mostly radially for a q-axis current (ΔRs·i_q/ω along d),
 //!    so |λ̂r| leaves λ̂f *before* the angle does — the early warning of the loaded
-//!    zero-speed passage that the paper (section V) and SPEC §7 call the critical case. In
+//!    zero-speed passage that the paper (section V) and docs/guide/first-run.md call the critical case. In
 //!    limiter mode (Fig. 6) the limiter holds |λ̂r| ≤ 1.15·λ̂f, so there a persistent
 //!    shrink below the circle or a persistent push against it is what remains visible.
 //!    The same consistency test is the core of the flux-magnitude checks of voltage-model
@@ -22,14 +22,14 @@
 //!    "phase detector" lock indicator of PLL practice (Gardner, *Phaselock Techniques*, 3rd
 //!    ed., ch. 8, lock detection).
 //! 3. **Mode hand-over chatter** — the rate of the mode selector's hand-overs (Fig. 3). The
-//!    selector's hysteresis (SPEC §1) exists so that noise on ω̂ cannot make it chatter: one
+//!    selector's hysteresis (docs/method/estimator.md §1) exists so that noise on ω̂ cannot make it chatter: one
 //!    hand-over needs ω̂ to cross the whole band (0.004 of the rated speed by default), so a
 //!    run that passes through the band once hands over once or twice. An estimate caught in a
 //!    limit cycle swings ω̂ across the band tens of times a second (ipmsm-gem-50k's start-up
 //!    with L̂q over-estimated by 20–30 %: typically 13–18 hand-overs in 0.25 s, with
 //!    |θ − θ̂| swinging ±0.5 rad before the rotor is lost; runs that keep the rotor below
 //!    0.25 rad: 1–2 on five presets, up to 9 at the start-up of the two salient ones,
-//!    docs/lock.md "Mode hand-over chatter"). The rate is a leaky count: each hand-over adds
+//!    docs/method/lock.md). The rate is a leaky count: each hand-over adds
 //!    1, and the level decays with the time constant `handover_time` (forward Euler at the
 //!    detector's period, pole 1 − ts/`handover_time`); at steady rate r it settles at
 //!    r·`handover_time`. Hysteresis switching that keeps switching is the classic sign of a
@@ -38,20 +38,19 @@
 //!
 //! The upper half of symptom 1 (|λ̂r| above the band) is set wide by default (1.5·λ̂f): on
 //! the fig11 envelope a tight bound's alarms came from the |λ̂r| overshoot after a limiter →
-//! k_df hand-over in runs that kept the rotor (docs/lock.md). The lower half depends on the
+//! k_df hand-over in runs that kept the rotor (docs/method/lock.md). The lower half depends on the
 //! speed estimate: 0.7·λ̂f below the mode hand-over band (where the start-up dip that
 //! precedes a 0.5 rad start-up excursion sits), 0.6·λ̂f from the band's lower edge up, where
 //! runs that keep the rotor dip to 0.67–0.70·λ̂f accelerating out of the reversal at light
 //! load and the losses that only this symptom catches go through 0.42–0.53·λ̂f
-//! (docs/lock.md, 2026-11-24). Near zero speed, where a
+//! (docs/method/lock.md, 2026-11-24). Near zero speed, where a
 //! surface-magnet rotor's angle is not observable from v and i (an integrand error ΔR̂s·i
 //! along q̂ turns λ̂r without changing |λ̂r|), a loss shows first on the mechanical side; the
 //! drive adds that symptom (a speed-loop stall in limiter mode while the loop commands a
 //! torque, `DriveTuning::lock_stall_speed_ratio` and `lock_stall_min_current_ratio`, see
 //! [`crate::control::SensorlessDrive`]). The drive reports the two apart: `LOCK_LOST` for the
 //! estimator's verdict, `STALLED` for the stall symptom, which cannot tell an estimate that has
-//! left the rotor from a rotor that really stalls or lags under its load (docs/lock.md, "The
-//! stall symptom as its own flag"); either starts the drive's reaction
+//! left the rotor from a rotor that really stalls or lags under its load (docs/method/lock.md); either starts the drive's reaction
 //! (`DriveTuning::lock_reaction_on_stall`).
 //!
 //! The verdicts feed an up/down debouncing counter (the counter-based debouncing of AUTOSAR
@@ -367,7 +366,7 @@ impl<T: Real> LockDetectorParams<T> {
         // Below 1e-6 hand-overs the count is 0: the decay alone would take it into the
         // subnormal range and hold it at the smallest subnormal for ever (0.996 times it
         // rounds back to it), and a multiplication by a subnormal is a microcode assist on
-        // x86 (it cost 5 % of the whole step there, docs/lock.md "Mode hand-over chatter").
+        // x86 (it cost 5 % of the whole step there, docs/method/lock.md).
         let decayed = s.handovers * self.handover_keep;
         let decayed = if decayed < T::lit(HANDOVER_FLOOR) {
             T::zero()

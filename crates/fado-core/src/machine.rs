@@ -95,7 +95,7 @@ impl<T: Real> MachineModel<T> {
     }
 
     /// The paper's motor (section V \[P\]: 8-pole SMPMSM, 11.5 N·m, 1500 r/min, Rs = 0.327 Ω,
-    /// Ld = Lq = 2.63 mH; DC link rectified from 3 × 220 V rms: 311 V) with SPEC §6's assumptions
+    /// Ld = Lq = 2.63 mH; DC link rectified from 3 × 220 V rms: 311 V) with docs/method/estimator.md, "The paper's motor and drive"'s assumptions
     /// (λf = 0.088 Wb, J = 0.012 kg·m², B = 1e-3 N·m·s/rad) and the rated current its torque
     /// implies, 11.5 N·m / (1.5·4·0.088 Wb) = 21.78 A peak.
     pub fn paper() -> Self {
@@ -214,7 +214,7 @@ impl<T: Real> MachineModel<T> {
     }
 }
 
-/// The paper motor's rated current in A peak: 11.5 N·m / (1.5·4·0.088 Wb) (SPEC §6).
+/// The paper motor's rated current in A peak: 11.5 N·m / (1.5·4·0.088 Wb) (docs/method/estimator.md, "The paper's motor and drive").
 pub const PAPER_RATED_CURRENT: f64 = 11.5 / (1.5 * 4.0 * 0.088);
 
 #[cfg(test)]

@@ -479,7 +479,7 @@ pub fn check(m: &MachineModel<f64>, ts: Option<f64>) -> Findings {
     // a mismatched L̂d or L̂q keeps; the warning against the MTPA torque.
     let magnet = m.rated_torque / (m.torque_constant() * m.rated_current);
     let ratio = m.rated_torque / ratings::rated_current_torque(m);
-    if m.pole_pairs % 2 == 0 && (0.4..=0.6).contains(&magnet) {
+    if m.pole_pairs.is_multiple_of(2) && (0.4..=0.6).contains(&magnet) {
         out.push(Finding::PoleCount {
             pole_pairs: m.pole_pairs,
             ratio: magnet,

@@ -27,7 +27,7 @@ pub struct ModeSelectorConfig<T> {
     pub threshold_hz: T,
     /// Half-width of the hysteresis band in Hz: enter above threshold + h, leave below
     /// threshold − h. Default 0.002 of the rated electrical frequency
-    /// ([`EstimatorTuning::mode_hysteresis_ratio`]; SPEC §1 \[A\]: 0.2 Hz on the paper's
+    /// ([`EstimatorTuning::mode_hysteresis_ratio`]; docs/method/estimator.md §1 \[A\]: 0.2 Hz on the paper's
     /// motor).
     pub hysteresis_hz: T,
 }
@@ -35,7 +35,7 @@ pub struct ModeSelectorConfig<T> {
 impl<T: Real> ModeSelectorConfig<T> {
     /// The selector for `machine` with the estimator's default tuning
     /// ([`EstimatorTuning::default`]): threshold 0.015 and hysteresis 0.002 of the rated
-    /// electrical frequency (1.5 Hz and 0.2 Hz on the paper's motor: paper V, SPEC §1 \[A\]).
+    /// electrical frequency (1.5 Hz and 0.2 Hz on the paper's motor: paper V, docs/method/estimator.md §1 \[A\]).
     pub fn for_machine(machine: &MachineModel<T>) -> Self {
         Self::with_tuning(machine, &EstimatorTuning::default())
     }

@@ -2,7 +2,7 @@
 //!
 //! # Model and gains
 //! The initially estimated stator flux is a vector rotating at ω_f plus a slowly varying
-//! disturbance, λ1 = λm·e^{jθf} + D (eq. (7)). In complex form (SPEC §2, with z = λ̂1,
+//! disturbance, λ1 = λm·e^{jθf} + D (eq. (7)). In complex form (docs/method/estimator.md §2, with z = λ̂1,
 //! d = D̂, y = λ1, e = y − z) the observer (10) with the gains (16)
 //! (p1 = p4 = 2|ω|, p2 = −p3 = −ω, q1 = q4 = 0, q2 = −q3 = −ω) reads
 //!
@@ -103,7 +103,7 @@ fn single_precision<T: Real>() -> bool {
 const SERIES_LIMIT: f64 = 0.25;
 
 /// Largest |ω·Ts| (rad) served by the `f32` polynomials of [`f32_gains`]: 796 Hz at 10 kHz,
-/// which covers the 700 Hz of docs/firmware.md; beyond it the gains come from
+/// which covers the 700 Hz of docs/results/firmware-cost.md; beyond it the gains come from
 /// [`crate::approx`].
 const SERIES_LIMIT_F32: f64 = 0.5;
 

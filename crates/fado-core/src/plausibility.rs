@@ -13,10 +13,10 @@
 //!
 //! Magnitudes are what the physics bounds (the rated current is a peak magnitude, the
 //! inverter's voltage a hexagon of vertex 2/3·Vdc, the change a magnitude): the disc refuses
-//! nothing the ratios below call plausible. Until 2026-11-24 (docs/firmware.md, eighth pass)
-//! each α-β component was compared instead (the square around the same disc, which also let
-//! through magnitudes up to √2 × the bound along the diagonals); three squared magnitudes cost
-//! five Cortex-M4 cycles fewer than six absolute values. A finite value whose square
+//! nothing the ratios below call plausible. Comparing each α-β component instead (the square
+//! around the same disc) would let through magnitudes up to √2 × the bound along the
+//! diagonals; three squared magnitudes cost five Cortex-M4 cycles fewer than six absolute
+//! values. A finite value whose square
 //! overflows (|x| above ≈ 1.8e19 in `f32`, 1.3e154 in `f64`) is refused like ∞, even by
 //! [`SampleBounds::unbounded`]. The method is the ordinary
 //! range-and-rate check of sensor validation (e.g. IEC 61508-7, A.7.7/A.13 "plausibility

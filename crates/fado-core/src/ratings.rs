@@ -66,11 +66,11 @@ pub const DC_LINK_MODULATION_RATIO: f64 = 0.8;
 pub const DEAD_TIME_PERIOD_RATIO: f64 = 0.0125;
 
 /// Device threshold (knee) voltage as a fraction of the DC link: the paper inverter's 1 V of
-/// 311 V (SPEC §5 \[A\]); a low-voltage MOSFET bridge has almost none.
+/// 311 V (docs/method/estimator.md §7 \[A\]); a low-voltage MOSFET bridge has almost none.
 pub const THRESHOLD_VOLTAGE_RATIO: f64 = 1.0 / 311.0;
 
 /// Current band of the dead-time and threshold errors as a fraction of the rated current: the
-/// paper inverter's 0.3 A of 21.8 A (SPEC §5 \[A\]; it scales with the devices' output
+/// paper inverter's 0.3 A of 21.8 A (docs/method/estimator.md §7 \[A\]; it scales with the devices' output
 /// capacitance, which scales with their current rating).
 pub const CURRENT_BAND_RATIO: f64 = 0.3 / PAPER_RATED_CURRENT;
 

@@ -31,7 +31,7 @@ pub trait Real: RealField + Copy + Default {
     /// The larger of `self` and `y`, as the drive's step computes it: `f64`'s `max` (IEEE
     /// maxNum, a NaN operand ignored); for `f32` a compare and a select (`real::max`: `if self > y`),
     /// which gives `y` when either is NaN. On a Cortex-M4F (no VMAXNM) `f32::max` is a call of
-    /// `libm`'s `fmaxf`, 10–20 cycles; the select is 2–3 (docs/firmware.md, "Eleventh session").
+    /// `libm`'s `fmaxf`, 10–20 cycles; the select is 2–3 (docs/results/firmware-cost.md).
     fn step_max(self, y: Self) -> Self;
     /// The smaller of `self` and `y`: as [`Real::step_max`] (`f32`: `if self < y`).
     fn step_min(self, y: Self) -> Self;
@@ -252,7 +252,7 @@ pub(crate) fn all_finite<T: Real, const N: usize>(values: [T; N]) -> bool {
     zero_if_finite == T::zero()
 }
 
-/// Wraps an angle into [−π, π]: `x − 2π·round(x / 2π)` (SPEC notation).
+/// Wraps an angle into [−π, π]: `x − 2π·round(x / 2π)` (the method pages' notation).
 ///
 /// Every caller in the estimator wraps a sum of angles already in [−π, π] plus a small step,
 /// so the argument lies within ±3π; there one exact subtraction (Sterbenz: |x| ≥ π = 2π/2)

@@ -3,14 +3,14 @@
 //!
 //! Two integrators in the open loop make it type 2: zero steady-state angle error for a
 //! constant speed and a constant error α/Ki for a constant acceleration α. The closed loop is
-//! T(s) = (Kp·s + Ki)/(s² + Kp·s + Ki), Kp = 2ζωn, Ki = ωn² (SPEC §3 \[A\]: the paper's
+//! T(s) = (Kp·s + Ki)/(s² + Kp·s + Ki), Kp = 2ζωn, Ki = ωn² (docs/method/estimator.md §4 \[A\]: the paper's
 //! references 9 and 11 that define it are not recoverable).
 //!
-//! Discretisation (SPEC §3): e = wrap(θm − θ̂⁻); xI ← xI + Ki·Ts·e;
+//! Discretisation (docs/method/estimator.md §4): e = wrap(θm − θ̂⁻); xI ← xI + Ki·Ts·e;
 //! θ̂⁻ ← wrap(θ̂⁻ + Ts·(xI + Kp·e)); ω̂ = xI. Because the angle update uses the *updated* xI,
-//! the poles are the roots of z² − (2 − Kp·Ts − Ki·Ts²)z + (1 − Kp·Ts). SPEC §3 quotes
+//! the poles are the roots of z² − (2 − Kp·Ts − Ki·Ts²)z + (1 − Kp·Ts). docs/method/estimator.md §4 quotes
 //! z² + (Kp·Ts − 2)z + (1 − Kp·Ts + Ki·Ts²), which belongs to the variant using the old xI;
-//! we keep SPEC's recursion and correct the formula (the test `discrete_poles_match_formula`
+//! we keep the reconstructed recursion (docs/method/estimator.md §4) and correct the formula (the test `discrete_poles_match_formula`
 //! probes the actual map). Both approach the continuous poles as ωn·Ts → 0. Wrapping the phase difference keeps the detector
 //! linear over ±π, so the tracker follows the angle through its ±π wrap.
 //!
@@ -36,7 +36,7 @@
 //! as `i32` with 2³² units = 2π (one unit is 1.46e-9 rad), so every wrap of the recursion is
 //! the overflow of an integer add or subtract: e = θm − θ̂⁻ is exact modulo 2π without a
 //! compare, and so are θ̂ and θ̂⁻ (the float recursion needs three [`wrap_angle`] per tracker
-//! and sample, each a compare and a branch on a Cortex-M4F; docs/firmware.md). θm enters
+//! and sample, each a compare and a branch on a Cortex-M4F; docs/results/firmware-cost.md). θm enters
 //! rounded towards zero to a unit, the steps Kp·Ts·e and Ts·ω̂ too, saturating at ±π (a step
 //! beyond π is above the Nyquist frequency, aliased anyway; Kp·Ts·e reaches it only for
 //! Kp·Ts > 1, a bandwidth above a fifth of the sampling rate). One unit is 1/165 of an
@@ -56,7 +56,7 @@ use crate::{Real, wrap_angle};
     serde(rename_all = "snake_case")
 )]
 pub enum BandwidthDefinition {
-    /// The −3 dB frequency of T(s) (SPEC §3 default): ωn = ω_bw / √(1 + 2ζ² + √((1+2ζ²)² + 1)),
+    /// The −3 dB frequency of T(s) (docs/method/estimator.md §4 default): ωn = ω_bw / √(1 + 2ζ² + √((1+2ζ²)² + 1)),
     /// i.e. ωn = ω_bw / 2.058 for ζ = 1/√2.
     #[default]
     Minus3Db,
@@ -75,16 +75,16 @@ pub struct TrackerConfig<T> {
     /// Bandwidth in Hz (paper, V: 60 Hz for T2S-1, 35 Hz for T2S-2; the estimator's
     /// [`EstimatorTuning::t2s1_bandwidth_hz`], [`EstimatorTuning::t2s2_bandwidth_hz`]).
     pub bandwidth_hz: T,
-    /// Damping ratio ζ. Default 1/√2 (SPEC §3 \[A\]; [`EstimatorTuning::tracker_damping`]).
+    /// Damping ratio ζ. Default 1/√2 (docs/method/estimator.md §4 \[A\]; [`EstimatorTuning::tracker_damping`]).
     pub damping: T,
-    /// How `bandwidth_hz` is defined. Default −3 dB (SPEC §3;
+    /// How `bandwidth_hz` is defined. Default −3 dB (docs/method/estimator.md §4;
     /// [`EstimatorTuning::bandwidth_definition`]).
     pub definition: BandwidthDefinition,
 }
 
 impl<T: Real> TrackerConfig<T> {
     /// A tracker of `bandwidth_hz` sampled every `ts`, with the estimator's default damping
-    /// and bandwidth definition ([`EstimatorTuning::default`]: ζ = 1/√2, −3 dB; SPEC §3).
+    /// and bandwidth definition ([`EstimatorTuning::default`]: ζ = 1/√2, −3 dB; docs/method/estimator.md §4).
     pub fn new(bandwidth_hz: T, ts: T) -> Self {
         Self::with_tuning(&EstimatorTuning::default(), bandwidth_hz, ts)
     }
@@ -400,7 +400,7 @@ impl<T: Real> TypeTwoTracker<T> {
     }
 
     /// One sample without a measurement: θ̂ coasts at ω̂ and the integrator holds (used when
-    /// |λ̂r| is too small for eq. (6) to mean anything, SPEC §3 \[A\]).
+    /// |λ̂r| is too small for eq. (6) to mean anything, docs/method/estimator.md §4 \[A\]).
     #[inline]
     pub fn coast(&mut self) -> (T, T) {
         let next = self.params.coasted_state(&self.state);

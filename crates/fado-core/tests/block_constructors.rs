@@ -2,7 +2,7 @@
 //! `for_machine` constructors must give the paper's values on the paper's motor and scale with
 //! any other motor's model and ratings, and they must build what the estimator and the drive
 //! build (both call the same constructors, so the drive's speed and current gains are checked
-//! here against the SPEC §6 formulas on both motors).
+//! here against the docs/method/estimator.md, "The paper's motor and drive" formulas on both motors).
 
 mod common;
 
@@ -27,7 +27,7 @@ fn close(a: f64, b: f64) -> bool {
 #[test]
 fn the_paper_motor_gets_the_paper_values() {
     let m = MachineModel::<f64>::paper();
-    // Paper, V and SPEC §6: I_min 4 A, I_max 40 A, ρ = 1.15·0.088 Wb, 1.5 Hz ± 0.2 Hz.
+    // Paper, V and docs/method/estimator.md, "The paper's motor and drive": I_min 4 A, I_max 40 A, ρ = 1.15·0.088 Wb, 1.5 Hz ± 0.2 Hz.
     assert!(close(CurrentInjectionConfig::for_machine(&m).i_min, 4.0));
     assert!(close(
         SpeedControllerConfig::for_machine(&m, TS).i_max,
@@ -54,7 +54,7 @@ fn the_paper_motor_gets_the_paper_values() {
         (dt.dead_time, dt.switching_frequency, dt.method),
         (2.5e-6, 5e3, DeadTimeMethod::EdgeCurrent)
     );
-    // Speed PI (SPEC §6): Kp = Ĵ·ωsc/K̂t per mechanical rad/s = 0.714 A·s/rad.
+    // Speed PI (docs/method/estimator.md, "The paper's motor and drive"): Kp = Ĵ·ωsc/K̂t per mechanical rad/s = 0.714 A·s/rad.
     let speed = SpeedController::new(SpeedControllerConfig::for_machine(&m, TS)).unwrap();
     assert!((speed.kp() * 4.0 - 0.714).abs() < 1e-3);
 }
@@ -121,7 +121,7 @@ fn every_motor_dependent_value_scales_with_the_motor() {
         TS,
     );
     assert!(close(no_mtpa.i_max, i_max));
-    // Current loop (SPEC §6): Kp,d = L̂d·ωc, Ki = R̂s·ωc from the model.
+    // Current loop (docs/method/estimator.md, "The paper's motor and drive"): Kp,d = L̂d·ωc, Ki = R̂s·ωc from the model.
     let cc = CurrentControllerConfig::for_machine(&ipm, TS);
     assert_eq!((cc.rs_hat, cc.ld_hat, cc.lq_hat), (3.6, 36e-3, 51e-3));
     assert_eq!(cc.flux_linkage_hat, 0.545);

@@ -64,7 +64,7 @@ fn separates<T: Real>(
     Ok(())
 }
 
-/// The gains (16) make the observer the mirror image of itself under ω → −ω (SPEC §2: same
+/// The gains (16) make the observer the mirror image of itself under ω → −ω (docs/method/estimator.md §2: same
 /// poles for both signs): feeding the conjugate input at −ω gives exactly the conjugate
 /// state, bit for bit, for any sequence of inputs and speeds.
 fn mirror_symmetric<T: Real>(steps: &[(Ab<f64>, f64)]) -> Result<(), TestCaseError> {

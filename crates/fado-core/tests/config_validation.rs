@@ -1,4 +1,4 @@
-//! Every public constructor validates every numeric field of its configuration (issue 6,
+//! Every public constructor validates every numeric field of its configuration (
 //! "bad input"): table-driven over the fields of each config type, in f32 and f64.
 //!
 //! For each field, starting from the default configuration:

@@ -2,7 +2,7 @@
 //! timing: a voltage computed at sample n is held in the *stationary* frame over [n+1, n+2]
 //! (one sample of computation, zero-order hold) while the rotor turns. The rotor angle is
 //! known here, so what is checked is the current control itself: its bandwidth, the
-//! decoupling and the delay compensation (SPEC §5, §6).
+//! decoupling and the delay compensation (docs/method/estimator.md §7, §6).
 
 use core::f64::consts::{PI, TAU};
 use fado_core::control::{

@@ -332,7 +332,7 @@ fn drives<T: fado_core::Real>(method: DeadTimeMethod) -> [SensorlessDrive<T>; 2]
     cfg.tuning.dead_time_method = method;
     // The second never trips, so that every input reaches the controllers (a trip level of
     // about T::MAX amps).
-    // It has no plausibility bounds either (issue 14): every finite input is taken.
+    // It has no plausibility bounds either: every finite input is taken.
     let mut no_trip = cfg;
     no_trip.tuning.trip_current_ratio = T::max_value().unwrap() / cfg.machine.rated_current;
     no_trip.tuning.input_fault_trip_time = T::zero();
@@ -401,8 +401,8 @@ proptest! {
 }
 
 // ---------------------------------------------------------------------------------------
-// Closed loop around an ideal SMPMSM (SPEC §6) fed by an averaged inverter whose pole voltages
-// fall short by V̂·sat(i_x/Ic) (SPEC §5 inverter model), with the real timing.
+// Closed loop around an ideal SMPMSM (docs/method/estimator.md, "The paper's motor and drive") fed by an averaged inverter whose pole voltages
+// fall short by V̂·sat(i_x/Ic) (docs/method/estimator.md §7 inverter model), with the real timing.
 
 const RS: f64 = 0.327;
 const L: f64 = 2.63e-3;
@@ -537,7 +537,7 @@ fn voltage_history_is_aligned_with_the_interval_it_acted_over() {
         };
         let config = EstimatorConfig::for_machine(&MachineModel::paper());
         let estimator = SensorlessEstimator::new(config).unwrap();
-        // The model plant is the averaged SPEC §5 inverter (no ripple): the trapezoid is its
+        // The model plant is the averaged docs/method/estimator.md §7 inverter (no ripple): the trapezoid is its
         // exact inverse.
         let mut drive_config = no_calibration();
         drive_config.tuning.dead_time_method = DeadTimeMethod::Trapezoidal;
@@ -743,7 +743,7 @@ fn stall_symptom_flags_a_lost_reference_below_the_current_limit() {
 
 /// The stall symptom is reported as `STALLED`, apart from the estimator's `LOCK_LOST` (a spy
 /// estimator whose own verdict is "locked" throughout: a stall is no evidence against the
-/// angle, docs/lock.md); with `lock_reaction` coast it starts the reaction, `COASTING` with
+/// angle, docs/method/lock.md); with `lock_reaction` coast it starts the reaction, `COASTING` with
 /// `STALLED` as the reason and `LOCK_LOST` down, the reason kept while the drive coasts after
 /// the symptom itself has healed; with `lock_reaction_on_stall` off it is only reported. On
 /// the paper's motor and the 2.2 kW IPMSM.
@@ -798,7 +798,7 @@ fn stall_is_its_own_flag_and_starts_the_reaction_when_asked() {
 }
 
 /// The stall band widens with the model's reluctance torque (`lock_stall_reluctance_band_ratio`,
-/// docs/lock.md "A band for the reluctance torque"): ε_r·|1.5·p·(L̂d − L̂q)·i_d*·i_q*|/(Ĵ·ω_s)
+/// docs/method/lock.md): ε_r·|1.5·p·(L̂d − L̂q)·i_d*·i_q*|/(Ĵ·ω_s)
 /// on top of the band. An estimate stuck 2 bands out while the reference runs 4 bands ahead
 /// (the torque band off): flagged after `lock_stall_time` (50 samples) with ε_r = 0 on every
 /// motor; with ε_r = 200 never on the salient ones (the 2.2 kW IPMSM, L̂q/L̂d 1.42, and the
@@ -882,11 +882,11 @@ fn stall_test_config(machine: &MachineModel<f64>) -> DriveConfig<f64> {
 }
 
 /// The stall symptom also counts in k_df mode below `lock_stall_kdf_speed_ratio` (0.02) of
-/// the rated speed (docs/lock.md: heavy-load losses in k_df mode just above the 0.015 mode
+/// the rated speed (docs/method/lock.md: heavy-load losses in k_df mode just above the 0.015 mode
 /// threshold): ω̂ held at 0.0175·rated in k_df mode, the speed loop catches a reference equal
 /// to it, then loses one 8 rad/s (mechanical) away, below the current limit: `STALLED`
 /// after `lock_stall_time` (50 samples). Not at 0.03·rated (above the band), nor with the
-/// ratio 0 (limiter mode only, the symptom before issue 14b), on the paper's motor and on
+/// ratio 0 (limiter mode only), on the paper's motor and on
 /// the 2.2 kW IPMSM.
 #[test]
 fn stall_symptom_counts_in_kdf_mode_just_above_the_threshold() {
@@ -977,7 +977,7 @@ fn first_stalled(
 }
 
 /// The stall symptom does not count while the estimated rotor answers the torque
-/// (`lock_stall_follow_time`, docs/lock.md fifth session): ω̂ beyond the stall band in the
+/// (`lock_stall_follow_time`, docs/method/lock.md): ω̂ beyond the stall band in the
 /// direction of the speed error and accelerating in it. The speed loop catches a reference
 /// equal to ω̂ (`CATCH` samples, 60 ms: six time constants of the ω̂ low-pass, which starts
 /// from zero at `align`), then the reference runs 3 bands ahead of ω̂ (away from zero) while ω̂ ramps. An
@@ -1044,7 +1044,7 @@ fn stall_symptom_spares_an_estimate_that_answers_the_torque() {
 }
 
 /// The stall band widens with the commanded torque (`lock_stall_torque_band_ratio`,
-/// docs/lock.md sixth session): it is the larger of the fixed band and ε·|T*|/(Ĵ·ω_s), the
+/// docs/method/lock.md): it is the larger of the fixed band and ε·|T*|/(Ĵ·ω_s), the
 /// speed error whose proportional action alone commands T* (kp = Ĵ·ω_s/K_t), so that after a
 /// step of the speed error e it is max(band, ε·e·(1 + the integral's share)). An estimate
 /// stuck 2 bands out while the reference runs 1.5 bands ahead (the speed loop's current below
@@ -1071,7 +1071,7 @@ fn stall_band_widens_with_the_commanded_torque() {
 }
 
 /// A gross speed error against the reference waives the current gate
-/// (`lock_stall_gross_error_ratio`, docs/lock.md "A gross speed error against the reference"):
+/// (`lock_stall_gross_error_ratio`, docs/method/lock.md):
 /// an estimate stuck at +1 band in limiter mode while the reference, caught there, moves to
 /// −3 bands asks, through the speed loop's proportional gain, for a current below the gate
 /// (`lock_stall_min_current_ratio` 0.2 of rated) on every motor here, so the gated symptom

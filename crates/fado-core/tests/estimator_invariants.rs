@@ -174,7 +174,7 @@ fn bounded_near_the_machine<T: Real>(
     // What is left of the angle error once settled, term by term:
     // - Lq·|i_off| shifts λ̂r (eq. (5)): an angle ripple of up to asin(Lq·|i_off|/λf);
     // - the DC part of λ1 still ramps (τ = 1/k_df), and D̂ follows a ramp of slope c with the
-    //   lag c·(2|ω| − jω)/ω², i.e. √5·c/|ω| (from D̂/λ1 = ω(ω + js)/(s + |ω|)², SPEC §2), with
+    //   lag c·(2|ω| − jω)/ω², i.e. √5·c/|ω| (from D̂/λ1 = ω(ω + js)/(s + |ω|)², docs/method/estimator.md §2), with
     //   c ≤ |e| + R̂s·|i_off| — large at 2 Hz, negligible at 300 Hz (taken 4·c/|ω|);
     // - noise above |ω| passes into λ2: at most its integral over one pass of the table;
     // - 0.05 rad for the settling of the coupled tracker and observer at the lowest speeds.
@@ -188,7 +188,7 @@ fn bounded_near_the_machine<T: Real>(
 }
 
 /// Rotor currents of the paper's operating range: i_d from 0 to the injection level I_min =
-/// 4 A (eq. (23)), |i_q| up to the rated 21.8 A (SPEC §6).
+/// 4 A (eq. (23)), |i_q| up to the rated 21.8 A (docs/method/estimator.md, "The paper's motor and drive").
 fn rated_current() -> impl Strategy<Value = Dq<f64>> {
     (0.0..=4.0, -21.8..=21.8).prop_map(|(d, q)| Dq::new(d, q))
 }

@@ -1,7 +1,7 @@
 //! The paper's maths at estimator level, against the ideal machine of `common`: bounded drift
 //! with k_df (Fig. 3, eq. (22)) versus a pure integrator, the limiter at standstill (Fig. 6,
 //! eq. (24)-(25)) and the direction argument of Fig. 10, a jump-free hand-over between the two
-//! (SPEC §1 step 5), the notch under a current-sensor offset (eq. (17)-(20), Fig. 8), and the
+//! (docs/method/estimator.md §5), the notch under a current-sensor offset (eq. (17)-(20), Fig. 8), and the
 //! open-loop accuracy of the `f32` build.
 
 mod common;
@@ -255,7 +255,7 @@ fn positive_d_current_steers_standstill_errors_onto_the_rotor_flux() {
 fn hand_over_between_limiter_and_k_df_does_not_jump() {
     // Speed ramps through ±1.5 Hz at 90 r/min/s (6 Hz/s electrical), up and down and for both
     // signs, with a 10 mV integrand error so that D̂ and the k_df feedback are not zero at the
-    // switch. Both feedbacks act on the same integrator state (SPEC §1 step 5), so a hand-over
+    // switch. Both feedbacks act on the same integrator state (docs/method/estimator.md §5), so a hand-over
     // changes λ̂r's slope, never its value. A jump of θm or θ̂ would show as a spike in the
     // second difference Δ²θ (the change of the per-sample increment), which the smooth parts of
     // the run (ramp, slow recovery from the standstill drift) keep near ω̇·Ts² = 4e-7 rad.
@@ -334,7 +334,7 @@ fn hand_over_between_limiter_and_k_df_does_not_jump() {
     // No spike anywhere. The sample after a hand-over changes the increment by the slope
     // change Ts·k_df·|D̂|/|λ̂r| ≈ 1e-5 rad, as designed; a jump of just 0.01° would be 1.7e-4.
     assert!(worst_d2 < 2e-5, "Δ²θ = {worst_d2}");
-    // The paper's criterion near zero speed (SPEC §7, fig11).
+    // The paper's criterion near zero speed (docs/guide/first-run.md, fig11).
     assert!(worst_error < 0.25, "{worst_error}");
 }
 
@@ -343,8 +343,8 @@ fn notch_keeps_lambda2_centred_under_a_current_sensor_offset() {
     // A DC offset on the measured current makes the integrand error −R̂s·i_off, constant in
     // α-β. λ1 takes its integral effect as a DC shift (bounded by k_df at −R̂s·i_off/k_df); the
     // observer estimates it as D̂, whose response to the rotating flux is notched out at ω
-    // (eq. (17)-(19)), so λ2 = λ1 − D̂ is centred: DC below 2 % of λf (SPEC, fig8 criterion).
-    let i_off = Ab::new(0.2, -0.1); // 10× SPEC's sensor offsets
+    // (eq. (17)-(19)), so λ2 = λ1 − D̂ is centred: DC below 2 % of λf (the fig8 criterion, docs/guide/first-run.md).
+    let i_off = Ab::new(0.2, -0.1); // 10× the default sensor offsets
     let seconds = 8.0;
     for rpm in [300.0, -300.0] {
         // The paper's loop alone (the learned integrand offset, ours, would take −R̂s·i_off
@@ -372,7 +372,7 @@ fn notch_keeps_lambda2_centred_under_a_current_sensor_offset() {
             "{dc_d:?} vs {expected:?}"
         );
         assert!((dc_lambda1 - expected).norm() < 0.05 * expected.norm());
-        // ... and λ2 = λ1 − D̂ is centred (SPEC fig8: DC < 2 % of λf; it is ~0.3 % here, the
+        // ... and λ2 = λ1 − D̂ is centred (fig8's criterion: DC < 2 % of λf; it is ~0.3 % here, the
         // remainder coming from the ω̂ wobble that Lq·i_off causes through eq. (5)).
         assert!(dc_lambda2.norm() < 0.02 * LF, "DC(λ2) = {dc_lambda2:?}");
         // The rotating flux is notched out of D̂: its ripple is a small fraction of λf.

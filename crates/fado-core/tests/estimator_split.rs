@@ -1,5 +1,5 @@
 //! The firmware path of the estimator — [`EstimatorState`] stepped with a borrowed
-//! [`EstimatorParams`] (docs/firmware.md, "Fifth pass") — is the owner's step
+//! [`EstimatorParams`] (docs/guide/firmware.md) — is the owner's step
 //! ([`SensorlessEstimator`]) bit for bit: the same outputs and the same state after every
 //! sample, accepted and rejected ones, with and without the R̂s adaptation, through the
 //! run-time settings (`set_rs_hat`, `enable_rs_adaptation`, `align`, `reset`, the k_df

@@ -1,7 +1,7 @@
 //! The flux-magnitude symptom of the loss-of-lock detector (`fado_core::lock`) on the ideal
 //! machine: its lower bound is `lock_flux_low_ratio` (0.7) below the mode hand-over band
 //! (`mode_threshold_ratio` − `mode_hysteresis_ratio` = 0.013 of the rated speed) and
-//! `lock_flux_low_fast_ratio` (0.6) from there on (docs/lock.md, 2026-11-24). The estimator's
+//! `lock_flux_low_fast_ratio` (0.6) from there on (docs/method/lock.md, 2026-11-24). The estimator's
 //! λ̂f is set to λf / r, so that a locked estimate shows |λ̂r| = r·λ̂f; two motors (the paper's
 //! SPMSM and the 2.2 kW IPMSM).
 

@@ -1,5 +1,4 @@
-//! The observer's gains held over `EstimatorTuning::observer_gain_period` (issue 16, sixth
-//! session): the reason stated for the default (the held gains lag the speed by at most
+//! The observer's gains held over `EstimatorTuning::observer_gain_period`: the reason stated for the default (the held gains lag the speed by at most
 //! α·(N − 1)·Ts, a small fraction of T2S-1's own lag that the lag compensation corrects)
 //! checked on the estimator's output. Two estimators see the same ideal machine signal, one
 //! forming the gains every sample (period 0, the paper's) and one holding them (the default

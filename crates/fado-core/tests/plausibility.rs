@@ -1,4 +1,4 @@
-//! The estimator refuses samples the machine and inverter cannot produce (issue 14): a
+//! The estimator refuses samples the machine and inverter cannot produce: a
 //! 10 kV voltage sample, 1e4/1e5/1e6 A current samples and a current step no inductance
 //! allows are flagged, the state is untouched, and the angle stays within 0.05 rad of the
 //! run without the glitch. Open loop: the paper's SPMSM turning at 5 Hz electrical with a

@@ -338,7 +338,7 @@ fn flux_linkage_law_runs_where_the_revolution_mean_excitation_is_small() {
 #[test]
 fn flux_linkage_law_ignores_errors_inside_its_dead_zone_and_swings_at_the_rotor_frequency() {
     // The no-load |λ̂r| of a real inverter reads a few 0.1 % low (the dead-time
-    // compensation's residual across the current, V⊥/ω: docs/zero-speed-errors.md): inside
+    // compensation's residual across the current, V⊥/ω: docs/method/additions.md): inside
     // the dead zone λ̂f stays. A DC error c left in λ2 makes |λ̂r| swing by ±c at ω̂: the
     // revolution mean ignores it, a per-sample law at the same rate would move λ̂f by
     // ≈ γ_f·c/ω̂ at whatever phase it stops.

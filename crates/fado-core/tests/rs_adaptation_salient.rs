@@ -1,4 +1,4 @@
-//! The R̂s adaptation on a salient rotor with i_d ≠ 0 (issue 11, item 7), open loop against the
+//! The R̂s adaptation on a salient rotor with i_d ≠ 0, open loop against the
 //! ideal interior-magnet machine: with L̂q in eq. (5), |λ̂r| is the active flux
 //! λf + (Ld − Lq)·i_d, so the laws compare it with λ̂f + (L̂d − L̂q)·î_d and scale the turning
 //! law's regressor by 1 + (L̂d − L̂q)·î_d/λ̂a (`fado_core::rs_adaptation`). Without L̂d the
@@ -162,7 +162,7 @@ fn reversal_error(i_d: f64, with_ld: bool) -> f64 {
 
 #[test]
 fn ipmsm_reversal_with_negative_d_current_matches_zero_d_current() {
-    // Issue 11's criterion: −0.15·rated within 0.05 rad of i_d = 0, −0.5·rated within 0.1.
+    // The criterion: −0.15·rated within 0.05 rad of i_d = 0, −0.5·rated within 0.1.
     let base = reversal_error(0.0, true);
     let small = reversal_error(-0.15 * RATED, true);
     let large = reversal_error(-0.5 * RATED, true);

@@ -25,7 +25,7 @@ use crate::scalar::Scalar;
 /// tied to the sampling rate binds for any plausible gain or bandwidth.
 const CHECK_TS: f64 = 1e-9;
 
-/// Tuning of the sensorless estimator (paper, Fig. 5; SPEC §1–§3): everything but the machine
+/// Tuning of the sensorless estimator (paper, Fig. 5; docs/method/estimator.md §1–§3): everything but the machine
 /// and the sampling period (`fado_core::EstimatorTuning`).
 ///
 /// Every argument is keyword-only and optional: an omitted one takes the Rust default

@@ -180,7 +180,7 @@ fn run_slices<T: Scalar>(
     replay_until(e, &va, &vb, &ia, &ib, Some(cancel))
 }
 
-/// The sensorless estimator of Fig. 5 (SPEC §1) around a machine model, stepped one sample
+/// The sensorless estimator of Fig. 5 (docs/method/estimator.md §1) around a machine model, stepped one sample
 /// at a time with `step` or a chunk at a time with `run`; the state carries over between
 /// calls.
 ///
@@ -295,7 +295,7 @@ impl PyEstimator {
     }
 
     /// Start-up at a known rotor angle `theta0` (rad, electrical) with the present current
-    /// (SPEC §1 step 6): λ1 = λ̂f·e^{jθ0} + L̂q·i, D̂ = 0, θ̂ = θ0, ω̂ = 0, limiter mode.
+    /// (docs/method/estimator.md, "Start-up"): λ1 = λ̂f·e^{jθ0} + L̂q·i, D̂ = 0, θ̂ = θ0, ω̂ = 0, limiter mode.
     /// Non-finite arguments raise `InputError` naming them.
     #[pyo3(signature = (theta0, i_alpha = 0.0, i_beta = 0.0))]
     fn align(&mut self, py: Python<'_>, theta0: f64, i_alpha: f64, i_beta: f64) -> PyResult<()> {

@@ -297,7 +297,7 @@ impl PyMachine {
     }
 
     /// The paper's motor (section V: 8-pole SMPMSM, 11.5 N·m, 1500 r/min, Rs 0.327 Ω,
-    /// Ld = Lq = 2.63 mH, 311 V DC link; λf 0.088 Wb and J 0.012 kg·m² from SPEC §6).
+    /// Ld = Lq = 2.63 mH, 311 V DC link; λf 0.088 Wb and J 0.012 kg·m² from docs/method/estimator.md, "The paper's motor and drive").
     #[staticmethod]
     fn paper() -> Self {
         Self::from_core(&MachineModel::paper())

@@ -313,7 +313,7 @@ pub fn scenarios() -> Vec<&'static str> {
 }
 
 /// What a scenario does, as a dict with `name`, `title` (the paper's figure), `profile` and
-/// `criterion` (the pass criterion checked in code, SPEC §7).
+/// `criterion` (the pass criterion checked in code, docs/guide/first-run.md).
 #[pyfunction]
 pub fn describe_scenario<'py>(py: Python<'py>, scenario: &str) -> PyResult<Bound<'py, PyDict>> {
     let Some(s) = scenario::find(scenario) else {

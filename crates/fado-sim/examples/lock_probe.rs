@@ -1,4 +1,4 @@
-//! Diagnostic (issue 14): re-runs points of a `fado-sim sweep fig11` CSV at full rate and
+//! Diagnostic: re-runs points of a `fado-sim sweep fig11` CSV at full rate and
 //! dumps every trace column (f32, little-endian, `TraceRow::COLUMNS` order) in a time window,
 //! one `DIR/point-N.f32` per point, to study loss-of-lock symptoms offline.
 //!

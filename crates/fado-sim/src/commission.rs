@@ -32,7 +32,7 @@ pub struct Truth {
     pub inertia: f64,
     /// B, N·m·s/rad.
     pub viscous_friction: f64,
-    /// Per-phase inverter voltage error Td·f_sw·Vdc + V_th, V (SPEC §5).
+    /// Per-phase inverter voltage error Td·f_sw·Vdc + V_th, V (docs/method/estimator.md §7).
     pub inverter_voltage: f64,
     /// Device threshold V_th, V.
     pub threshold_voltage: f64,

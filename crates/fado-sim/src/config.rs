@@ -143,7 +143,7 @@ impl InverterModel {
 }
 
 /// The drive's model of the plant as ratios to the true values (1 = matched). The robustness
-/// sweep of SPEC §7 varies these.
+/// sweep of docs/guide/first-run.md varies these.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct Mismatch {
@@ -257,7 +257,7 @@ pub struct SimConfig {
 }
 
 impl Default for SimConfig {
-    /// The paper's experiment set-up: its motor ([`MachineModel::paper`]) on SPEC §5–6's
+    /// The paper's experiment set-up: its motor ([`MachineModel::paper`]) on docs/method/estimator.md §7–6's
     /// inverter and sensors, standing still.
     fn default() -> Self {
         Self {
@@ -959,7 +959,7 @@ mod located_errors {
 
     #[test]
     fn derived_limits_name_the_users_own_key() {
-        // Issue 15's probes: before, each was refused as `controller.current_anti_windup_ratio`.
+        // Each of these keys is refused naming itself, not `controller.current_anti_windup_ratio`.
         let (key, line, col, _) = err(&paper_motor_with("rs = 1e300"));
         assert_eq!((key.as_str(), line, col), ("motor.rs", 2, 6));
         let (key, line, _, _) = err(&paper_motor_with("ld = 1e-300"));

@@ -88,4 +88,7 @@ impl<C: Controller + ?Sized> Controller for Box<C> {
     fn name(&self) -> &str {
         (**self).name()
     }
+    fn ready(&self) -> bool {
+        (**self).ready()
+    }
 }

@@ -64,7 +64,12 @@ fn section_location(text: &str, section: &str) -> Option<SourceLocation> {
 /// missing key, located at the `[motor]` header of `text`; a given key that is not a positive
 /// finite number is left to the validation, which names it at its value.
 pub fn complete_motor(user: &mut toml::Table, text: &str) -> Result<Vec<Derived>, SimConfigError> {
-    let Some(toml::Value::Table(motor)) = user.get("motor") else {
+    // No motor table, or one holding only `[motor.saturation]` (taken out before): the
+    // scenario's motor.
+    let Some(toml::Value::Table(motor)) = user.get("motor").filter(|m| {
+        m.as_table()
+            .is_some_and(|t| t.keys().any(|k| k != "saturation"))
+    }) else {
         return Ok(Vec::new());
     };
     let mut motor = motor.clone();

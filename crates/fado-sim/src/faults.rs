@@ -11,7 +11,7 @@
 //! * `voltage_offset = [α, β]`: a constant stationary-frame voltage error in V, added to the
 //!   voltage the drive (and so its estimator) believes it applies — a phase-voltage or DC-link
 //!   measurement offset, an uncompensated inverter asymmetry. The plant receives the
-//!   inverter's voltage minus it while the gates are enabled (issue 13).
+//!   inverter's voltage minus it while the gates are enabled.
 //! * `[faults.dc_link_scale]`: the DC-link voltage as a fraction of its nominal value over
 //!   time, a piecewise-linear [`Profile`] (steps or ramps): a supply dip. It scales the
 //!   voltage the inverter applies and what the DC-link sensor reads alike.

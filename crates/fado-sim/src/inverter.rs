@@ -15,14 +15,14 @@
 //!   If it helps, it slews the pole's parasitic capacitance and the pole moves early; the
 //!   ramp is replaced by the step of equal volt-seconds, at a delay set by [`Commutation`]:
 //!   by default `Td·(1 − |i|/Ic)⁺`, so that every edge loses exactly `Td·Vdc·sat(i/Ic)`
-//!   volt-seconds — the SPEC §5 curve, but applied edge by edge with the instantaneous current;
+//!   volt-seconds — the docs/method/estimator.md §7 curve, but applied edge by edge with the instantaneous current;
 //!   optionally a linear capacitor (`C = Ic·Td/(2·Vdc)`: delay `t_r/2` if the ramp
 //!   `t_r = C·Vdc/|i|` ends within Td, else `Td·(1 − Td/(2·t_r))`), whose error only
 //!   approaches its full value as `1 − Ic/(4|i|)`. At zero current both edges wait Td and the
 //!   error vanishes. Replacing the µs-long ramp by a step changes the current by < 1e-3 A
 //!   (slope Vdc/L times < Td); every other step is exact.
 //! * [`InverterModel::Averaged`]: per sample, the average pole voltages
-//!   `d·Vdc − (Td·f_sw·Vdc + V_th)·sat(i/Ic)` (SPEC §5), with i the phase current at the sample
+//!   `d·Vdc − (Td·f_sw·Vdc + V_th)·sat(i/Ic)` (docs/method/estimator.md §7), with i the phase current at the sample
 //!   start, applied as a constant voltage over the sample (integrated exactly). No ripple.
 //!
 //! Both models add the device threshold drop `−V_th·sat(i/Ic)` to each pole (IGBT and diode
@@ -44,7 +44,7 @@ pub enum InverterModel {
     /// Every switching edge resolved, dead time acting on each edge (reference model).
     #[default]
     SwitchingResolved,
-    /// Per-sample average pole voltages with the SPEC §5 error model (fast).
+    /// Per-sample average pole voltages with the docs/method/estimator.md §7 error model (fast).
     Averaged,
 }
 
@@ -54,13 +54,13 @@ pub enum InverterModel {
 #[serde(rename_all = "snake_case")]
 pub enum Commutation {
     /// Equivalent delay `Td·(1 − |i|/Ic)` for |i| < Ic, 0 above: each edge loses exactly
-    /// `Td·sat(i/Ic)` volt-seconds per volt, the SPEC §5 error curve resolved edge by edge with
+    /// `Td·sat(i/Ic)` volt-seconds per volt, the docs/method/estimator.md §7 error curve resolved edge by edge with
     /// the instantaneous current (ripple included). Default.
     #[default]
     LinearBand,
     /// A linear pole capacitance `C = Ic·Td/(2·Vdc)` slewed by the current: same slope at zero
     /// current, but the error approaches its full value only as `1 − Ic/(4|i|)` (a tail the
-    /// SPEC §5 compensation does not model: ≈ 0.06 V residual at 14 A, 0.2 V at 4 A).
+    /// docs/method/estimator.md §7 compensation does not model: ≈ 0.06 V residual at 14 A, 0.2 V at 4 A).
     Capacitor,
 }
 
@@ -71,7 +71,7 @@ pub struct InverterParams {
     /// Which model to run. Default switching-resolved.
     pub model: InverterModel,
     /// Mean DC-link voltage in V. Default 311 V (rectified 3-phase 220 Vrms, paper §V \[P\];
-    /// SPEC §5 says ≈ 300 V \[A\]).
+    /// docs/method/estimator.md §7 says ≈ 300 V \[A\]).
     pub dc_voltage: f64,
     /// Peak amplitude of the DC-link ripple in V (sinusoidal model). Default 0 \[A\].
     pub dc_ripple_amplitude: f64,
@@ -83,12 +83,12 @@ pub struct InverterParams {
     /// Dead time Td in s. Default 2.5 µs (paper §V \[P\]).
     pub dead_time: f64,
     /// Current band Ic in A over which the dead-time and threshold errors go through zero
-    /// (parasitic capacitance). Default 0.3 A (SPEC §5 \[A\]).
+    /// (parasitic capacitance). Default 0.3 A (docs/method/estimator.md §7 \[A\]).
     pub current_band: f64,
-    /// Commutation model of the helping edge (switching-resolved model). Default the SPEC §5
+    /// Commutation model of the helping edge (switching-resolved model). Default the docs/method/estimator.md §7
     /// linear band.
     pub commutation: Commutation,
-    /// Device threshold (knee) voltage V_th in V, IGBT and diode alike. Default 1 V (SPEC §5 \[A\]).
+    /// Device threshold (knee) voltage V_th in V, IGBT and diode alike. Default 1 V (docs/method/estimator.md §7 \[A\]).
     pub threshold_voltage: f64,
     /// Device on-resistance r_on in Ω. Default 0 \[A\]: a linear drop is indistinguishable from
     /// Rs, so a non-zero value is an R̂s mismatch of the same size.
@@ -176,7 +176,7 @@ impl InverterParams {
         }
     }
 
-    /// Average pole-voltage error of the averaged model for phase current `i` (SPEC §5):
+    /// Average pole-voltage error of the averaged model for phase current `i` (docs/method/estimator.md §7):
     /// −(Td·f_sw·Vdc + V_th)·sat(i/Ic).
     pub fn averaged_error(&self, i: f64, vdc: f64) -> f64 {
         -(self.dead_time * self.switching_frequency * vdc + self.threshold_voltage)
@@ -775,7 +775,7 @@ mod tests {
             assert!((err(ic / 2.0) + full / 2.0).abs() < 1e-9, "{commutation:?}");
             assert!((err(40.0) + full).abs() < 0.01 * full, "{commutation:?}");
             if commutation == Commutation::LinearBand {
-                // Exactly the SPEC §5 curve −Td·f_sw·Vdc·sat(i/Ic).
+                // Exactly the docs/method/estimator.md §7 curve −Td·f_sw·Vdc·sat(i/Ic).
                 for i in [-2.0, -0.2, 0.1, 0.29, 0.31, 3.0] {
                     assert!((err(i) + full * (i / ic).clamp(-1.0, 1.0)).abs() < 1e-12);
                 }
@@ -859,7 +859,7 @@ mod tests {
         // 0.4 rad, ripple ≈ 7× larger: trapezoid 1.12 V, edge current 0.84 V — only a little
         // better: there the peak-valley swing's dependence on the phase's own edge delay has
         // a loop gain Vdc·Td/(6·L̂·Ic) ≈ 1.2 > 1, the two-pass prediction does not converge
-        // (docs/zero-speed-errors.md). Outside the band both are exact.
+        // (docs/method/additions.md). Outside the band both are exact.
         use fado_core::control::DeadTimeMethod;
         let salient = MotorParams {
             rs: 0.018,

@@ -5,7 +5,7 @@
 //! propeller (torque ∝ ω²), a hoist (gravity: a constant torque whatever the direction) and a
 //! constant-power load (a winder, a vehicle above its base speed).
 //!
-//! Sign convention: the load torque T_L is positive when it opposes positive rotation (SPEC §7),
+//! Sign convention: the load torque T_L is positive when it opposes positive rotation (docs/guide/first-run.md),
 //! so `J·dω/dt = Te − T_L − B·ω`. Speeds are the shaft's mechanical ω in rad/s.
 //!
 //! | `mode`            | T_L                                                            |
@@ -120,7 +120,7 @@ pub struct Load {
 
 impl Load {
     /// A load on a shaft of total inertia `inertia` (sets the dynamometer's speed-loop gains:
-    /// Kp = J·ω_bw, Ki = Kp·ω_bw/5, the SPEC §6 rule for the drive's own loop) driven by a
+    /// Kp = J·ω_bw, Ki = Kp·ω_bw/5, the docs/method/estimator.md, "The paper's motor and drive" rule for the drive's own loop) driven by a
     /// motor of rated speed `rated_speed_rpm` (sets the constant-power corner speed).
     pub fn new(
         params: LoadParams,

@@ -1,8 +1,8 @@
 //! The paper's experiments (Fig. 8–12) as named scenarios with their pass criteria checked in
-//! code (SPEC §7). Loads and rates are the paper's \[P\]; the exact profiles around them
+//! code (docs/guide/first-run.md). Loads and rates are the paper's \[P\]; the exact profiles around them
 //! (start-up, load application, settling, hold times) are ours \[A\] and are stated per scenario.
 //!
-//! Every scenario starts at standstill with a known rotor angle (SPEC §1 step 6), brings the
+//! Every scenario starts at standstill with a known rotor angle (docs/method/estimator.md, "Start-up"), brings the
 //! machine to the experiment's initial operating point without load, applies the load with a
 //! 0.5 s ramp, lets it settle, then runs the experiment. Metrics are taken from `eval_start`.
 
@@ -57,7 +57,7 @@ impl PartialEq for Scenario {
 
 impl Eq for Scenario {}
 
-/// The five scenarios of SPEC §7 in the paper's units, two of ours for the estimator
+/// The five scenarios of docs/guide/first-run.md in the paper's units, two of ours for the estimator
 /// comparison ([`crate::compare`]): a medium-speed sanity check under load and a low-speed
 /// staircase; then the paper's experiments scaled by the motor's ratings (its motor: 1500
 /// r/min, 11.5 N·m), which run for any motor: `reversal` (Fig. 11), `stops` (Fig. 12) and
@@ -313,7 +313,7 @@ pub fn find(name: &str) -> Option<&'static Scenario> {
 }
 
 impl Scenario {
-    /// The scenario's default configuration (SPEC §6 plant and drive: the paper's motor, the
+    /// The scenario's default configuration (docs/method/estimator.md, "The paper's motor and drive" plant and drive: the paper's motor, the
     /// profile above).
     pub fn config(&self) -> SimConfig {
         self.apply(SimConfig::default())

@@ -1,5 +1,5 @@
 //! Measurement chain: phase-current sensing with offset, gain error, white noise and ADC
-//! quantisation (SPEC §6 \[A\]), DC-link voltage sensing, and the evaluation encoder.
+//! quantisation (docs/method/estimator.md, "The paper's motor and drive" \[A\]), DC-link voltage sensing, and the evaluation encoder.
 //! Every non-ideality can be switched off on its own; the noise comes from a seeded
 //! xoshiro256++ generator, so a run is reproducible bit for bit for a given seed.
 
@@ -18,22 +18,22 @@ use crate::error::{SimConfigError, check};
 #[serde(deny_unknown_fields, default)]
 pub struct CurrentSensorParams {
     /// Offset of the phase-a sensor as a fraction of the motor's rated current. Default
-    /// 20 mA of the paper's 21.78 A (SPEC §6 \[A\]), 9.2e-4.
+    /// 20 mA of the paper's 21.78 A (docs/method/estimator.md, "The paper's motor and drive" \[A\]), 9.2e-4.
     pub offset_a_ratio: f64,
     /// Offset of the phase-b sensor as a fraction of the rated current. Default −10 mA of
-    /// the paper's 21.78 A (SPEC §6 \[A\]), −4.6e-4.
+    /// the paper's 21.78 A (docs/method/estimator.md, "The paper's motor and drive" \[A\]), −4.6e-4.
     pub offset_b_ratio: f64,
-    /// Relative gain error of the phase-a sensor. Default +0.5 % (SPEC §6 \[A\]).
+    /// Relative gain error of the phase-a sensor. Default +0.5 % (docs/method/estimator.md, "The paper's motor and drive" \[A\]).
     pub gain_error_a: f64,
     /// Relative gain error of the phase-b sensor. Default 0 (the 0.5 % is the mismatch) \[A\].
     pub gain_error_b: f64,
     /// White noise per sensor, rms, as a fraction of the rated current. Default 10 mA of the
-    /// paper's 21.78 A (SPEC §6 \[A\]), 4.6e-4.
+    /// paper's 21.78 A (docs/method/estimator.md, "The paper's motor and drive" \[A\]), 4.6e-4.
     pub noise_rms_ratio: f64,
-    /// ADC resolution in bits. Default 12 (SPEC §6 \[A\]).
+    /// ADC resolution in bits. Default 12 (docs/method/estimator.md, "The paper's motor and drive" \[A\]).
     pub adc_bits: u32,
     /// ADC full scale as a multiple of the rated current: the range is ±this × rated current.
-    /// Default 50 A of the paper's 21.78 A (SPEC §6 \[A\]), 2.296: a sensor sized for the
+    /// Default 50 A of the paper's 21.78 A (docs/method/estimator.md, "The paper's motor and drive" \[A\]), 2.296: a sensor sized for the
     /// motor, not one fixed range (50 A would clip a 240 A motor at a fifth of its rating and
     /// give a 6 A one a 4 % LSB).
     pub adc_full_scale_ratio: f64,

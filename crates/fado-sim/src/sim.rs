@@ -50,7 +50,7 @@ pub struct PlantParams {
 }
 
 impl Default for PlantParams {
-    /// The paper's plant: its motor ([`MotorParams::paper`]), SPEC §5–6's inverter and
+    /// The paper's plant: its motor ([`MotorParams::paper`]), docs/method/estimator.md §7–6's inverter and
     /// sensors, no load, no faults.
     fn default() -> Self {
         Self {
@@ -336,7 +336,7 @@ pub struct Simulation<C> {
 
 impl<C: Controller> Simulation<C> {
     /// A closed loop with the plant at rest at `theta0`; the controller is aligned to
-    /// `theta0 + align_error` (a known or aligned start, SPEC §1 step 6).
+    /// `theta0 + align_error` (a known or aligned start, docs/method/estimator.md, "Start-up").
     pub fn new(
         plant: Plant,
         mut controller: C,
@@ -548,7 +548,7 @@ pub struct Metrics {
     /// Lowest true DC-link voltage over the whole run, V.
     pub min_dc_voltage: f64,
     /// max |θ − θ̂| over the whole run while the gates are on (start-up included), rad:
-    /// the label of the loss-of-lock evaluation (docs/lock.md).
+    /// the label of the loss-of-lock evaluation (docs/method/lock.md).
     pub max_angle_error_run: f64,
     /// First time |θ − θ̂| exceeded 0.5 rad with the gates on, s (None: never).
     pub angle_error_exceeded_time: Option<f64>,
@@ -565,10 +565,10 @@ pub struct Metrics {
     /// The last time |θ − θ̂| was below 0.25 rad before that onset, s (None: never).
     pub loss_settled_time: Option<f64>,
     /// The loss-of-lock labels below judge the drive's loss evidence, `LOCK_LOST` or
-    /// `STALLED` (either up counts as the flag; docs/lock.md).
+    /// `STALLED` (either up counts as the flag; docs/method/lock.md).
     ///
     /// If the flag (a live status) is up 20 ms after the onset: the time it last rose
-    /// minus the onset, s (negative: raised before the error reached 0.5 rad; docs/lock.md
+    /// minus the onset, s (negative: raised before the error reached 0.5 rad; docs/method/lock.md
     /// counts it as a detection if it rose less than 1 s before). None: down then.
     pub lock_detection_delay: Option<f64>,
     /// First rise of the flag at or after the onset, while the error has not settled
@@ -657,7 +657,7 @@ impl Probe for Metrics {
     }
 }
 
-/// Angle-error thresholds and deadline of the loss-of-lock evaluation (issue 14, docs/lock.md):
+/// Angle-error thresholds and deadline of the loss-of-lock evaluation (docs/method/lock.md):
 /// an excursion starts when |θ − θ̂| leaves 0.25 rad (the clean-run level), the loss's onset is
 /// its first crossing of 0.5 rad, it is a loss if it then exceeds 1 rad, and the flag must be
 /// up 20 ms after the onset. An excursion ends when the error has stayed below 0.25 rad for
@@ -672,7 +672,7 @@ const LOSS_DEADLINE: f64 = 0.020;
 /// 0.1 s at a time means a slip slower than 0.5 rad / 0.1 s = 5 rad/s electrical (12 r/min
 /// mechanical on the paper's 4 pole pairs), i.e. the estimate following the rotor. (Without
 /// the dwell, 8 fixed-R̂s losses of the fig11 envelope ended their excursion in a wrap before
-/// the deadline and counted as "not raised" with the flag up throughout; docs/lock.md.)
+/// the deadline and counted as "not raised" with the flag up throughout; docs/method/lock.md.)
 const LOSS_SETTLE_TIME: f64 = 0.1;
 
 /// An excursion of |θ − θ̂| above [`LOSS_SETTLED`] that reached [`LOSS_START`].
@@ -832,7 +832,7 @@ pub struct TraceRow {
     /// Load torque, N·m.
     pub load_torque: f64,
     /// Realised voltage reference α computed at this sample (before dead-time compensation),
-    /// V. The estimator integrates it two samples later (SPEC §1, one-sample delay + [n−1, n]).
+    /// V. The estimator integrates it two samples later (docs/method/estimator.md §1, one-sample delay + [n−1, n]).
     pub v_alpha_ref: f64,
     /// Realised voltage reference β, V.
     pub v_beta_ref: f64,

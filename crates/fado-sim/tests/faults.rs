@@ -1,4 +1,4 @@
-//! The drive under faults (issue 6), in closed loop on the averaged plant (none of these faults
+//! The drive under faults, in closed loop on the averaged plant (none of these faults
 //! needs switching detail): non-finite samples, a current-sensor channel stuck at zero for
 //! 10 ms, a DC-link dip to half voltage, and a sudden load step at zero speed.
 //!
@@ -409,7 +409,7 @@ fn sudden_load_step_at_zero_speed_does_not_lose_control() {
 
 #[test]
 #[ignore = "fails: a sudden rated step at 0 r/min exceeds the paper's 0.25 rad — 0.21 rad at \
-            7.5 N·m but 0.32 rad at 11.5 N·m (main 967edfd; the rotor is thrown to −300 r/min \
+            7.5 N·m but 0.32 rad at 11.5 N·m (the rotor is thrown to −300 r/min \
             through the LO/HI hand-over); control is kept (see the test above)"]
 fn sudden_load_step_at_zero_speed_stays_within_the_papers_0_25_rad() {
     for torque in [7.5, 11.5] {

@@ -61,6 +61,15 @@ fn the_start_angle_is_seeded_and_spread_over_the_turn() {
 }
 
 #[test]
+fn the_scenario_run_releases_the_brake_when_the_drive_is_ready() {
+    // Through the run path (the drive chosen at run time, boxed): released after the
+    // calibrations, not at the first sample.
+    let out = simulate("loaded-start", Some(&preset_toml("paper")), false, None).unwrap();
+    let t = out.probe.start.as_ref().unwrap().release_time.unwrap();
+    assert!(t > 0.1 && t < 1.0, "{t}");
+}
+
+#[test]
 fn without_a_load_the_scenario_passes_and_its_checks_see_the_release() {
     // The criteria can be met: with the load set to zero the paper's motor is released,
     // does not run back, keeps θ̂ and reaches the commanded speed.

@@ -1,10 +1,10 @@
-//! Implausible samples and loss-of-lock detection in closed loop (issue 14), fig11
+//! Implausible samples and loss-of-lock detection in closed loop, fig11
 //! switching-resolved.
 //!
 //! * One finite but absurd phase-current sample (1e4, 1e5, 1e6 A, as `[[faults.stuck_current]]`
 //!   of one sample on channel a) during the loaded zero-speed passage is refused
 //!   (`INPUT_REJECTED` and `INPUT_IMPLAUSIBLE`, no trip) and the estimated angle stays within
-//!   0.05 rad of the same run without it. Before issue 14, 1e6 A left θ̂ π off for the rest of
+//!   0.05 rad of the same run without it. Without the bounds, 1e6 A leaves θ̂ π off for the rest of
 //!   the run.
 //! * The detector flags the paper's fixed R̂s at +10 % error, where fig11 loses the rotor,
 //!   and stays quiet on the matched run.
@@ -85,7 +85,7 @@ fn a_lost_rotor_is_flagged_and_a_matched_run_is_not() {
     assert_eq!(matched.metrics.lock_lost_time, None);
 }
 
-/// Issue 14's "recover" criterion: fig11 with the paper's fixed R̂s at +10 % error, reaction
+/// The "recover" criterion: fig11 with the paper's fixed R̂s at +10 % error, reaction
 /// `recover` (defaults: the recovery switches the R̂s adaptation on), ends at the reference
 /// speed with the reason (`LOCK_LOST`, the estimator's flux verdict, which comes first here;
 /// `COASTING`) in the flags; without switching the adaptation on, the restarted fixed-R̂s
@@ -149,7 +149,7 @@ const IPMSM: &str = include_str!("../../../motors/ipmsm-2k2.toml");
 /// The stall is reported as `STALLED`, not as a lost estimate: in `stops` (fig12 on the paper's
 /// motor, the same ratings-scaled scenario on the 2.2 kW IPMSM) the 5 Hz speed loop does not
 /// hold 4 % of rated speed against the load ramp and the rotor itself slows to a stall with
-/// the estimate right (docs/lock.md, "The stall symptom as its own flag"). Before the split
+/// the estimate right (docs/method/lock.md). Before the split
 /// the drive raised `LOCK_LOST` at 1.071 s in fig12. Checked: `LOCK_LOST` never up, `STALLED`
 /// up, and when it rises the true speed is below half the reference and |θ − θ̂| < 0.25 rad.
 #[test]
@@ -207,18 +207,17 @@ fn reversal_point(
     run_config("reversal", cfg, None).unwrap()
 }
 
-/// The stall band tolerates the lag of a rotor whose estimate is off by less than issue 14's
-/// clean threshold (`lock_stall_torque_band_ratio` = 1 − cos 0.25 rad, docs/lock.md "A band
-/// from the clean threshold"), and still sees a rotor that stalls. Two points of the
+/// The stall band tolerates the lag of a rotor whose estimate is off by less than the paper's
+/// clean threshold (`lock_stall_torque_band_ratio` = 1 − cos 0.25 rad, docs/method/lock.md), and still sees a rotor that stalls. Two points of the
 /// outrunner's reversal envelope (seed 7, R̂s adaptation, `scripts/lock-sweeps-preset.sh`),
 /// a 21-pole-pair motor whose inertia is small for its torque:
 /// * #130 (L̂q −14 %, 0.56 N·m): the rotor and the estimate lag the ramp out of zero speed by
 ///   up to 0.004 of rated speed with the estimate 0.21 rad off, and catch up. It passes, stays
-///   below 0.25 rad and raises neither flag (with the sixth session's ratio 0.015 it raised
+///   below 0.25 rad and raises neither flag (with a ratio of 0.015 it raises
 ///   `STALLED` at 3.593 s);
 /// * #218 (R̂s +4 %, L̂q +9 %, 0.44 N·m): the rotor stalls at the same passage and the angle
 ///   is lost 124 ms later. A flag is up 20 ms after |θ − θ̂| first exceeds 0.5 rad (and rose
-///   less than 1 s before: docs/lock.md's detection).
+///   less than 1 s before: docs/method/lock.md's detection).
 #[test]
 fn the_outrunner_lagging_under_a_clean_estimate_is_not_flagged_and_a_stall_is() {
     let run = |rs, flux, lq, load| reversal_point(OUTRUNNER, "", rs, flux, lq, load);
@@ -233,7 +232,7 @@ fn the_outrunner_lagging_under_a_clean_estimate_is_not_flagged_and_a_stall_is() 
     assert_eq!((m.stall_time, m.lock_lost_time), (None, None), "{m:?}");
     let lost = run(0.040_45, 0.019_55, 0.086_33, 0.436_14);
     let m = &lost.metrics;
-    // docs/lock.md's detection: a flag up 20 ms after the onset that rose less than 1 s
+    // docs/method/lock.md's detection: a flag up 20 ms after the onset that rose less than 1 s
     // before it.
     let delay = m
         .lock_detection_delay
@@ -248,7 +247,7 @@ fn the_outrunner_lagging_under_a_clean_estimate_is_not_flagged_and_a_stall_is() 
 
 const GEM: &str = include_str!("../../../motors/ipmsm-gem-50k.toml");
 
-/// The mode hand-over chatter (`lock` symptom 3, docs/lock.md "Mode hand-over chatter") on
+/// The mode hand-over chatter (`lock` symptom 3, docs/method/lock.md) on
 /// ipmsm-gem-50k's reversal envelope with the paper's fixed R̂s, seed 7:
 /// * #125 (L̂q +25 %): the start-up ends in a limit cycle — ω̂ swinging across the mode
 ///   hand-over band tens of times a second, |θ − θ̂| ±0.5 rad — and the rotor is lost at

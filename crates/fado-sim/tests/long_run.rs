@@ -1,4 +1,4 @@
-//! Long run (issue 6): one simulated hour with the averaged plant and the f32 drive, (a) at a
+//! Long run: one simulated hour with the averaged plant and the f32 drive, (a) at a
 //! constant 300 r/min under 7.5 N·m and (b) at 0 r/min under 7.5 N·m. Per simulated minute it
 //! records the angle-error statistics and the magnitudes of every integrating state — the flux
 //! integrator λ1, the observer's D̂, the trackers' integrators (ω̂ of T2S-1 and T2S-2, as errors
@@ -8,7 +8,7 @@
 //! Ignored by default (≈ 10 min of CPU per case); `scripts/long-run.sh` runs both in release
 //! and prints the tables. `FADO_LONG_RUN_SECONDS` shortens the run (e.g. 120 for a smoke
 //! test; the drift comparison then uses the first and last fifth instead of 10 minutes).
-//! Results of the committed run: docs/long-run.md.
+//! Results of the committed run: docs/method/additions.md.
 
 use std::fmt::Write as _;
 

@@ -1,4 +1,4 @@
-//! Every numeric TOML key of the simulator is validated (issue 6, "bad input"): walking the
+//! Every numeric TOML key of the simulator is validated: walking the
 //! default configuration's keys, `key = nan`, `key = inf` and `key = -inf` are refused naming
 //! exactly that key and pointing at its line and column; −1 and 0 are accepted or refused
 //! naming the key (or, for a cross-key constraint, another key of the same section).

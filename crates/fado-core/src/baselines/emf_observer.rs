@@ -5,7 +5,7 @@
 //! force model for sensorless control of interior permanent-magnet synchronous motors", IEEE
 //! Trans. Ind. Electron. 50(2), 2003 (in the rotor frame: Morimoto et al. 2002, ref. \[4\] of the
 //! paper) is the part of the voltage equation that carries the rotor position,
-//! v = R·i + Ld·di/dt + ω(Ld − Lq)·J·i + e_ex. For the surface-mount machine of SPEC §6
+//! v = R·i + Ld·di/dt + ω(Ld − Lq)·J·i + e_ex. For the surface-mount machine of docs/method/estimator.md, "The paper's motor and drive"
 //! (Ld = Lq = L) it is the back-EMF e = d(λf·e^{jθ})/dt = jω·λf·e^{jθ}, a vector rotating at ω
 //! and leading the rotor flux by sgn(ω)·90°. It is observed here as the disturbance of the
 //! current equation, in reduced-order form with a rotating internal model (ė = jω̂·e, ω̂ from
@@ -30,11 +30,11 @@
 //! (Kp, Ki) the loop becomes s² + (Kp − Ki/p)·s + Ki: stable only for p > Ki/Kp (130 rad/s
 //! for 60 Hz), which `new` enforces. The default p = 2π·100 Hz keeps 80 % of the tracker's
 //! damping term, costs 10 mrad of phase per 1 Hz of speed error (ω̂ lagging an acceleration),
-//! and lets through only p·L̂·σ_i ≈ 17 mV of EMF noise for σ_i = 10 mA (SPEC §6).
+//! and lets through only p·L̂·σ_i ≈ 17 mV of EMF noise for σ_i = 10 mA (docs/method/estimator.md, "The paper's motor and drive").
 //!
 //! # Where it fails
 //! - **Low speed.** The EMF vanishes with ω (0.55 V per Hz for this motor): below a few Hz it
-//!   is of the order of the inverter's voltage error (dead time, device drops: SPEC §5) and the
+//!   is of the order of the inverter's voltage error (dead time, device drops: docs/method/estimator.md §7) and the
 //!   angle error grows like |Δv|/(ω·λf). Below ω_f the estimate is scaled down, and once
 //!   |λ̂r| < 0.2·λ̂f the trackers coast.
 //! - **Reversal.** The flux direction is ∠ê − sgn(ω̂)·90°: if ω̂ has the wrong sign the angle is
@@ -64,7 +64,7 @@ pub struct EmfObserverSettings<T> {
     pub emf_bandwidth_hz: T,
     /// Speed floor f_f in Hz below which the EMF is divided by 2π·f_f instead of ω̂.
     /// Default 2 Hz \[A\]: there the EMF (1.1 V) is already of the order of the dead-time voltage
-    /// error of SPEC §5.
+    /// error of docs/method/estimator.md §7.
     pub speed_floor_hz: T,
 }
 

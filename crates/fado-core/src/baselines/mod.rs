@@ -115,14 +115,14 @@ pub struct CommonTuning<T> {
     pub t2s1_bandwidth_hz: T,
     /// Bandwidth of T2S-2 (speed for control) in Hz. Default 35 Hz (paper, V), as fado.
     pub t2s2_bandwidth_hz: T,
-    /// Damping ratio of both trackers. Default 1/√2 (SPEC §3 \[A\]).
+    /// Damping ratio of both trackers. Default 1/√2 (docs/method/estimator.md §4 \[A\]).
     pub tracker_damping: T,
-    /// Meaning of the tracker bandwidths. Default −3 dB (SPEC §3).
+    /// Meaning of the tracker bandwidths. Default −3 dB (docs/method/estimator.md §4).
     pub bandwidth_definition: BandwidthDefinition,
     /// Trackers coast while the estimated rotor flux is below this fraction of λ̂f. Default
-    /// 0.2 (SPEC §3 \[A\]).
+    /// 0.2 (docs/method/estimator.md §4 \[A\]).
     pub tracker_hold_ratio: T,
-    /// Average the current over the interval for the resistive drop. Default true (SPEC §1
+    /// Average the current over the interval for the resistive drop. Default true (docs/method/estimator.md §1
     /// \[A\]).
     pub average_current: bool,
     /// Samples with |i| above this × the machine's `rated_current` are refused (see
@@ -135,7 +135,7 @@ pub struct CommonTuning<T> {
     /// A current that moved by more than this × (plausible voltage)·ts/L̂q per sample is
     /// refused; 0 switches the test off. Default 2, as fado's.
     pub plausible_current_step_ratio: T,
-    /// Rotor angle assumed at reset (rad). Default 0 (SPEC §1 \[A\]).
+    /// Rotor angle assumed at reset (rad). Default 0 (docs/method/estimator.md §1 \[A\]).
     pub initial_angle: T,
 }
 
@@ -290,7 +290,7 @@ fn renamed(field: &'static str) -> impl Fn(ConfigError) -> ConfigError {
 }
 
 /// The integrand v* − R̂s·i of eq. (3) over one sampling interval, with the same forward
-/// rectangle and optional current averaging as [`crate::flux::FluxIntegrator`] (SPEC §1), so
+/// rectangle and optional current averaging as [`crate::flux::FluxIntegrator`] (docs/method/estimator.md §1), so
 /// that every estimator sees the same voltage-model input.
 ///
 /// It is also where the measured samples enter, so it holds their plausibility bounds
@@ -414,7 +414,7 @@ struct Tracked<T> {
 }
 
 /// T2S-1 (angle, and the speed the baseline feeds back to itself) and T2S-2 (control speed),
-/// fed with ∠λ̂r and coasting while |λ̂r| is below the hold level (SPEC §3), exactly as in
+/// fed with ∠λ̂r and coasting while |λ̂r| is below the hold level (docs/method/estimator.md §4), exactly as in
 /// [`crate::SensorlessEstimator`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct AngleTrackers<T: Real> {

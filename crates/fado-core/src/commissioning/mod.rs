@@ -37,7 +37,7 @@
 //!    rotor's swing (a fast current loop would remove it and the rotor would ring for
 //!    seconds; measured: ±15 r/min still after 1 s on the paper's motor). A feedforward of the
 //!    reference, R̂·i* (nameplate) plus the dead-time part Td·f_sw·Vdc of the inverter error
-//!    (the configured dead time, SPEC §5's trapezoid), carries the bulk of the voltage, so
+//!    (the configured dead time, docs/method/estimator.md §7's trapezoid), carries the bulk of the voltage, so
 //!    the integral only makes up the nameplate's error and the device threshold; being a
 //!    function of i*, not of i, it leaves the swing's damping unchanged. Without it a motor
 //!    whose inverter error dwarfs R·I (the 5 kW PM-SyRM preset: 4.9 V against 1 V) waits
@@ -54,7 +54,7 @@
 //!    of RFOC induction motor drives: one-line estimation of the stator resistance", and
 //!    the dead-time voltage identification of Guerrero et al., "Inverter nonlinearity effects
 //!    in high-frequency signal-injection-based sensorless control methods", IEEE TIA 41(2),
-//!    2005). V̂ = Td·f_sw·Vdc + V_th (SPEC §5) with the known dead time gives V_th.
+//!    2005). V̂ = Td·f_sw·Vdc + V_th (docs/method/estimator.md §7) with the known dead time gives V_th.
 //!    The same two levels give the current sensors' gain ratio k = (1 + g_a)/(1 + g_b) =
 //!    (Δi_a/Δv_a)/(Δi_b/Δv_b), the drive's start-up calibration
 //!    ([`crate::control::gain_calibration`]: its [`ratio_of`](crate::control::gain_calibration::ratio_of), and R̂s as its

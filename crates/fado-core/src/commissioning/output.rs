@@ -32,7 +32,7 @@ pub struct Identification<T> {
     pub model: MachineModel<T>,
     /// Statistical uncertainty of each parameter.
     pub confidence: Confidence<T>,
-    /// Per-phase inverter voltage error V̂ = Td·f_sw·Vdc + V_th in V (SPEC §5): what the
+    /// Per-phase inverter voltage error V̂ = Td·f_sw·Vdc + V_th in V (docs/method/estimator.md §7): what the
     /// dead-time compensation should add.
     pub inverter_voltage: T,
     /// Device threshold voltage V_th = V̂ − Td·f_sw·Vdc in V (for

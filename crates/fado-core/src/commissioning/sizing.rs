@@ -18,7 +18,7 @@ pub(super) fn limit<T: Real>(v: Ab<T>, max: T) -> Ab<T> {
     }
 }
 
-/// The per-phase inverter voltage error model v·sat(i_x/band) of a current (SPEC §5's
+/// The per-phase inverter voltage error model v·sat(i_x/band) of a current (docs/method/estimator.md §7's
 /// trapezoid), in α-β.
 pub(super) fn dead_time_voltage<T: Real>(i_ab: Ab<T>, band: T, v: T) -> Ab<T> {
     let i = i_ab.to_abc();

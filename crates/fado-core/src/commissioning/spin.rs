@@ -30,7 +30,7 @@ impl<T: Real> Commissioning<T> {
     }
 
     /// Dead-time compensation V̂·sat(i*_x/I_band) per phase of the reference current at the
-    /// frame angle `angle` (SPEC §5's trapezoid; I_band = 5 % of the limit).
+    /// frame angle `angle` (docs/method/estimator.md §7's trapezoid; I_band = 5 % of the limit).
     pub(super) fn compensation(&self, i_ref_dq: Dq<T>, angle: T) -> Ab<T> {
         let i = i_ref_dq.to_ab(Rotation::from_angle(angle));
         dead_time_voltage(i, T::lit(0.05) * self.i_limit, self.v_inv)

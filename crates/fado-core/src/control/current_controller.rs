@@ -1,13 +1,13 @@
 //! Synchronous-frame current control of Fig. 5: one PI per axis with decoupling and back-EMF
 //! feed-forward, anti-windup against the voltage the inverter could actually realise.
 //!
-//! Gains (SPEC §6): Kp,d = L̂d·ωc, Kp,q = L̂q·ωc, Ki = R̂s·ωc with ωc = 2π·250 Hz (paper, V).
+//! Gains (docs/method/estimator.md, "The paper's motor and drive"): Kp,d = L̂d·ωc, Kp,q = L̂q·ωc, Ki = R̂s·ωc with ωc = 2π·250 Hz (paper, V).
 //! The PI zero then cancels the stator pole R̂s/L̂ and the loop gain is ωc/s: a first-order
 //! closed loop ωc/(s + ωc), rise time 2.2/ωc, apart from the 1.5-sample delay of computation
 //! and PWM hold (which [`DelayCompensation`](super::delay_compensation) keeps out of the
 //! rotating frame, but not out of the loop).
 //!
-//! Feed-forward (SPEC §6 \[A\]), from the machine model v_d = R·i_d + L_d·di_d/dt − ω·L_q·i_q,
+//! Feed-forward (docs/method/estimator.md, "The paper's motor and drive" \[A\]), from the machine model v_d = R·i_d + L_d·di_d/dt − ω·L_q·i_q,
 //! v_q = R·i_q + L_q·di_q/dt + ω·(L_d·i_d + λ_f), with the measured currents:
 //! v_d,ff = −ω·L̂q·i_q, v_q,ff = ω·(L̂d·i_d + λ̂f). It turns the cross-coupled plant into two
 //! independent R-L branches.
@@ -44,13 +44,13 @@ pub struct CurrentControllerConfig<T> {
     /// q-axis inductance estimate L̂q in H: the machine model's (the paper's motor: 2.63 mH).
     pub lq_hat: T,
     /// Magnet flux linkage estimate λ̂f in Wb (back-EMF feed-forward): the machine model's
-    /// (the paper's motor: 0.088 Wb, SPEC §6 \[A\]).
+    /// (the paper's motor: 0.088 Wb, docs/method/estimator.md, "The paper's motor and drive" \[A\]).
     pub flux_linkage_hat: T,
     /// Closed-loop bandwidth in Hz. Default 250 Hz (paper, V;
     /// [`DriveTuning::current_bandwidth_hz`]). Limited to ωc·Ts ≤ 0.5 so the 1.5-sample loop
     /// delay leaves at least 47° of phase margin.
     pub bandwidth_hz: T,
-    /// Add the decoupling and back-EMF feed-forward. Default true (SPEC §6 \[A\];
+    /// Add the decoupling and back-EMF feed-forward. Default true (docs/method/estimator.md, "The paper's motor and drive" \[A\];
     /// [`DriveTuning::decoupling`]).
     pub decoupling: bool,
     /// Back-calculation gain as a multiple of Ki/Kp = R̂s/L̂ (see [`PiConfig`]). Default 1, the

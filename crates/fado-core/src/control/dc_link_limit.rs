@@ -61,12 +61,14 @@ use crate::machine::MachineModel;
 )]
 pub struct DcLinkTuning<T> {
     /// The source's discharge current limit as a multiple of the rated DC current
-    /// `P_rated / V_dc` (P_rated = rated torque × rated speed). Default ∞ (no limit) \[A\].
-    pub battery_current_limit_ratio: T,
+    /// `P_rated / V_dc` (P_rated = rated torque × rated speed). Default none (no limit) \[A\].
+    #[cfg_attr(feature = "serde", serde(skip_serializing_if = "Option::is_none"))]
+    pub battery_current_limit_ratio: Option<T>,
     /// The source's charge (regeneration) current limit as a multiple of the rated DC current.
-    /// Default ∞ \[A\] (0 for a source that takes nothing back: the over-voltage controller
-    /// alone then stops a drive on a rectifier, more smoothly).
-    pub regeneration_current_limit_ratio: T,
+    /// Default none \[A\] (a rectifier needs none: the over-voltage controller stops a drive
+    /// on it).
+    #[cfg_attr(feature = "serde", serde(skip_serializing_if = "Option::is_none"))]
+    pub regeneration_current_limit_ratio: Option<T>,
     /// The over-voltage controller starts derating the regenerated power at this multiple of
     /// the nominal bus voltage. Default 1.1 \[A\] (mains at +10 % stays below it).
     pub over_voltage_start_ratio: T,
@@ -82,8 +84,8 @@ pub struct DcLinkTuning<T> {
 impl<T: Real> Default for DcLinkTuning<T> {
     fn default() -> Self {
         Self {
-            battery_current_limit_ratio: T::lit(f64::INFINITY),
-            regeneration_current_limit_ratio: T::lit(f64::INFINITY),
+            battery_current_limit_ratio: None,
+            regeneration_current_limit_ratio: None,
             over_voltage_start_ratio: T::lit(1.1),
             over_voltage_stop_ratio: T::lit(1.25),
             over_voltage_trip_ratio: T::lit(1.35),
@@ -95,10 +97,12 @@ impl<T: Real> DcLinkTuning<T> {
     /// The same tuning in another scalar type.
     pub fn cast<U: Real>(&self) -> DcLinkTuning<U> {
         DcLinkTuning {
-            battery_current_limit_ratio: U::lit(self.battery_current_limit_ratio.to_f64()),
-            regeneration_current_limit_ratio: U::lit(
-                self.regeneration_current_limit_ratio.to_f64(),
-            ),
+            battery_current_limit_ratio: self
+                .battery_current_limit_ratio
+                .map(|x| U::lit(x.to_f64())),
+            regeneration_current_limit_ratio: self
+                .regeneration_current_limit_ratio
+                .map(|x| U::lit(x.to_f64())),
             over_voltage_start_ratio: U::lit(self.over_voltage_start_ratio.to_f64()),
             over_voltage_stop_ratio: U::lit(self.over_voltage_stop_ratio.to_f64()),
             over_voltage_trip_ratio: U::lit(self.over_voltage_trip_ratio.to_f64()),
@@ -175,19 +179,16 @@ impl<T: Real> DcLinkLimit<T> {
         let v = machine.dc_voltage;
         let rated_power = machine.rated_torque * machine.rated_speed_mech();
         let i_dc = rated_power / v;
-        // Keys as `[controller]` names them; a current limit may be +∞ (none).
-        let at_least_zero = |field: &'static str, x: T| {
-            if x >= T::zero() {
-                Ok(x)
-            } else {
-                Err(ConfigError::Negative { field })
-            }
+        // Keys as `[controller]` names them; no limit is +∞ here.
+        let limit = |field: &'static str, x: Option<T>| match x {
+            Some(x) => check::non_negative(field, x),
+            None => Ok(T::lit(f64::INFINITY)),
         };
-        let bat = at_least_zero(
+        let bat = limit(
             "dc_link.battery_current_limit_ratio",
             t.battery_current_limit_ratio,
         )?;
-        let reg = at_least_zero(
+        let reg = limit(
             "dc_link.regeneration_current_limit_ratio",
             t.regeneration_current_limit_ratio,
         )?;
@@ -322,8 +323,8 @@ mod tests {
     #[test]
     fn source_current_limits_bound_the_power() {
         let t = DcLinkTuning {
-            battery_current_limit_ratio: 1.0,
-            regeneration_current_limit_ratio: 0.5,
+            battery_current_limit_ratio: Some(1.0),
+            regeneration_current_limit_ratio: Some(0.5),
             ..Default::default()
         };
         let (mut l, m) = limiter(t);

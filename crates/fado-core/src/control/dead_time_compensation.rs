@@ -1,4 +1,4 @@
-//! Compensation of the inverter non-linearity (paper IV-B, after refs. \[14\]-\[15\]; SPEC §5).
+//! Compensation of the inverter non-linearity (paper IV-B, after refs. \[14\]-\[15\]; docs/method/estimator.md §7).
 //!
 //! Dead time and device drops make each pole voltage fall short by about
 //! V̂·sat(i_x/Ic) in the direction of its phase current, V̂ = Td·f_sw·Vdc + V_th (the dead
@@ -10,7 +10,7 @@
 //! φx = 0, +2π/3, −2π/3 for a, b, c (phase b lags a),
 //!
 //! a trapezoid in the angle of the *reference* current vector, advanced like the voltage
-//! (SPEC §5 \[A\]): no chattering on noisy measured currents near their zero crossings.
+//! (docs/method/estimator.md §7 \[A\]): no chattering on noisy measured currents near their zero crossings.
 //! I*·cos(θi − φx) is just phase x of the reference current rotated to the advanced angle,
 //! which is how it is computed (no atan2). The classic sign(i_x) of the measured current is
 //! offered as [`DeadTimeMethod::Sign`]. The Clarke transform of v_comp (its zero sequence
@@ -30,7 +30,7 @@
 //! towards zero. The trapezoid leaves up to 0.64 V on that phase on the paper's motor at
 //! standstill under 7.5 N·m (test `edge_current_compensation_matches_…` in fado-sim's
 //! inverter), a d-axis error that shrank |λ̂r| by 20 % in a 100 ms stop and put `stops` at
-//! 0.25 rad (docs/zero-speed-errors.md). This method predicts, from the voltage reference,
+//! 0.25 rad (docs/method/additions.md). This method predicts, from the voltage reference,
 //! the DC link and the inductance matrix (L̂d, L̂q at θ̂), the gate times of both half carrier
 //! periods (symmetric carrier, min-max zero sequence as [`crate::control::modulation`]), each
 //! pole's edge delayed by the band model, the current of each phase at its own gate edge (the
@@ -61,7 +61,7 @@ use crate::{Ab, Abc, Dq, MachineModel, Real, Rotation};
     serde(rename_all = "snake_case")
 )]
 pub enum DeadTimeMethod {
-    /// V̂·sat(i*_x/Ic) of the advanced reference current (SPEC §5). Default.
+    /// V̂·sat(i*_x/Ic) of the advanced reference current (docs/method/estimator.md §7). Default.
     #[default]
     Trapezoidal,
     /// V̂·sign(i_x) of the measured phase current: the simple textbook variant.
@@ -88,10 +88,10 @@ pub struct DeadTimeCompensationConfig<T> {
     /// Switching frequency f_sw in Hz (inverter datum). Default 5 kHz (paper, V;
     /// [`DriveTuning::switching_frequency`]).
     pub switching_frequency: T,
-    /// Device threshold voltage V_th in V (inverter datum). Default 1 V (SPEC §5 \[A\];
+    /// Device threshold voltage V_th in V (inverter datum). Default 1 V (docs/method/estimator.md §7 \[A\];
     /// [`DriveTuning::dead_time_threshold_voltage`]).
     pub threshold_voltage: T,
-    /// Current band Ic of the trapezoid in A (inverter datum). Default 0.3 A (SPEC §5 \[A\];
+    /// Current band Ic of the trapezoid in A (inverter datum). Default 0.3 A (docs/method/estimator.md §7 \[A\];
     /// [`DriveTuning::dead_time_current_band`]).
     pub current_band: T,
     /// Inductances (L̂d, L̂q) of the ripple prediction of [`DeadTimeMethod::EdgeCurrent`] in H,
@@ -103,7 +103,7 @@ pub struct DeadTimeCompensationConfig<T> {
 impl<T: Real> DeadTimeCompensationConfig<T> {
     /// The compensation for `machine` (ripple inductances L̂d, L̂q of the edge-current method)
     /// on the drive's default inverter data and method ([`DriveTuning::default`]: 2.5 µs,
-    /// 5 kHz (paper, V), 1 V, 0.3 A (SPEC §5 \[A\]), [`DeadTimeMethod::EdgeCurrent`]).
+    /// 5 kHz (paper, V), 1 V, 0.3 A (docs/method/estimator.md §7 \[A\]), [`DeadTimeMethod::EdgeCurrent`]).
     /// Those inverter data are the paper's set-up: give your inverter's through
     /// [`with_tuning`](Self::with_tuning) or the fields.
     pub fn for_machine(machine: &MachineModel<T>) -> Self {

@@ -1,4 +1,4 @@
-//! Compensation of the digital delay (paper IV-B, after ref. \[13\]; SPEC §5):
+//! Compensation of the digital delay (paper IV-B, after ref. \[13\]; docs/method/estimator.md §7):
 //! v*_ab\[n\] = e^{j(θ̂\[n\] + k·ω̂·Ts)}·v*_dq\[n\], k = 1.5 by default.
 //!
 //! The reference computed at sample n is loaded at n+1 and held until n+2 (one sample of
@@ -19,7 +19,7 @@ use crate::{Ab, Dq, Real, Rotation, wrap_angle};
 pub struct DelayCompensationConfig<T> {
     /// Sampling period Ts in s (paper, V: 100 µs). No default: the set-up's.
     pub ts: T,
-    /// Advance in samples k: 1 of computation + ½ of PWM hold. Default 1.5 (SPEC §5 \[A\];
+    /// Advance in samples k: 1 of computation + ½ of PWM hold. Default 1.5 (docs/method/estimator.md §7 \[A\];
     /// [`DriveTuning::delay_compensation_factor`]);
     /// 0 switches the compensation off.
     pub factor: T,
@@ -42,7 +42,7 @@ impl<T: Real> DelayCompensationConfig<T> {
     }
 }
 
-/// The angle advance of SPEC §5 (module docs). Stateless.
+/// The angle advance of docs/method/estimator.md §7 (module docs). Stateless.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DelayCompensation<T> {
     config: DelayCompensationConfig<T>,

@@ -80,7 +80,7 @@
 //! result is refused ([`GainCalibrationStatus::Implausible`]) when the measured currents say
 //! the same, when a conductance comes out non-positive or non-finite, when a current exceeds
 //! `current_limit` in voltage mode, or when |k − 1| exceeds `max_mismatch`. On the simulator's
-//! inverter (dead time with the SPEC §5 linear band, device drops, ripple resolved edge by
+//! inverter (dead time with the docs/method/estimator.md §7 linear band, device drops, ripple resolved edge by
 //! edge) the measured accuracy is in `crates/fado-sim/tests/gain_calibration.rs` (within
 //! 1.2e-3 of 1.005 on four presets at four angles); an inverter whose error keeps growing well
 //! beyond the current band (a capacitive commutation tail, fado-sim's
@@ -681,7 +681,7 @@ mod tests {
 
     /// Runs the calibration on a standstill RL machine (R, L per phase, exact discretisation)
     /// behind an inverter whose pole voltages fall short by `v_err`·sign(i_x) (dead time and
-    /// device drop, SPEC §5, without its band), sensed with gains (1 + ga, 1 + gb) on phases a
+    /// device drop, docs/method/estimator.md §7, without its band), sensed with gains (1 + ga, 1 + gb) on phases a
     /// and b (c = −a − b), under a PI current loop in the calibration's axis frame. Returns the
     /// calibration, the largest true current and the samples taken.
     fn run(angle: f64, ga: f64, gb: f64, v_err: f64) -> (GainCalibration<f64>, f64, u32) {

@@ -26,7 +26,7 @@ pub enum LockReaction {
     ReportOnly,
     /// Raise the flag, switch the estimator's online R̂s adaptation on (if it has one and it
     /// is off) and carry on without coasting: for an active load, which a coasting drive
-    /// lets run the machine away (docs/lock.md).
+    /// lets run the machine away (docs/method/lock.md).
     Adapt,
     /// Raise the flag and hold zero current (speed loop off) until `reset`/`align`.
     Coast,
@@ -34,7 +34,7 @@ pub enum LockReaction {
     /// estimator has run in disturbance-feedback mode (|f̂| above the Fig. 3 threshold) with
     /// no symptom for `lock_recovery_time`. A machine that does not turn by itself within
     /// `lock_recovery_timeout` is re-aligned at the present estimate with the start-up
-    /// procedure (SPEC §1 step 6) and restarted. After `lock_recovery_attempts` losses
+    /// procedure (docs/method/estimator.md, "Start-up") and restarted. After `lock_recovery_attempts` losses
     /// since the last `reset`, coast for good.
     Recover,
 }

@@ -1,6 +1,6 @@
 //! The drive around the estimator (the rest of Fig. 5): speed and current PI control with
 //! anti-windup, the d-axis injection of eq. (23), delay and dead-time compensation (paper
-//! IV-B, SPEC §5), hexagon limiting and SVPWM, composed into [`SensorlessDrive`].
+//! IV-B, docs/method/estimator.md §7), hexagon limiting and SVPWM, composed into [`SensorlessDrive`].
 //!
 //! Every block follows the crate's pattern (`new(config) -> Result<_, ConfigError>`, `step`,
 //! `reset`), is allocation-free, generic over [`Real`](crate::Real) and never panics.

@@ -56,7 +56,7 @@ impl DriveFlags {
     /// heals), or the drive coasts because of it: a reason for [`COASTING`](Self::COASTING).
     /// Either the rotor itself stalls or lags under its load, or the estimate has left the
     /// rotor near zero speed, where a back-EMF estimator cannot tell the two apart from v and
-    /// i (docs/lock.md, "The stall symptom as its own flag"). Reported apart from
+    /// i (docs/method/lock.md). Reported apart from
     /// [`LOCK_LOST`](Self::LOCK_LOST) so that a real stall is not called a lost estimate; it
     /// starts the lock reaction too unless `DriveTuning::lock_reaction_on_stall` is off.
     pub const STALLED: Self = Self(1 << 10);
@@ -219,7 +219,7 @@ fn phase_value<T: Real>(i: Ab<T>, k: usize) -> T {
 }
 
 /// Stuck-channel detector for the usual two-sensor set-up (phases a and b measured, c
-/// reconstructed as −a − b, SPEC §6).
+/// reconstructed as −a − b, docs/method/estimator.md, "The paper's motor and drive").
 ///
 /// Two sensors give no redundancy (a three-sensor sum check is impossible), but the drive knows
 /// what current it is asking for. A channel is judged stuck when, for `samples` samples in a

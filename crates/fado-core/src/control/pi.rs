@@ -30,7 +30,7 @@ use crate::error::{ConfigError, NonFiniteInput, check};
 /// Configuration of a [`Pi`].
 ///
 /// No `Default`: every field is the loop's (the current and speed controllers set theirs from
-/// SPEC §6 and the machine model).
+/// docs/method/estimator.md, "The paper's motor and drive" and the machine model).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PiConfig<T> {
     /// Sampling period Ts in s (paper, V: 100 µs, 10 kHz sampling).

@@ -1,7 +1,7 @@
 //! Speed control of Fig. 5: a PI from the speed error to the q-axis current reference, and
 //! the current-vector limit shared with the d-axis injection of eq. (23).
 //!
-//! Gains (SPEC §6): Kp = Ĵ·ωsc/K̂t, Ki = Kp·ωsc/5 with ωsc = 2π·5 Hz (paper, V) and
+//! Gains (docs/method/estimator.md, "The paper's motor and drive"): Kp = Ĵ·ωsc/K̂t, Ki = Kp·ωsc/5 with ωsc = 2π·5 Hz (paper, V) and
 //! K̂t = 1.5·p·λ̂f. With an ideal current loop the open loop is ωsc·(s + ωsc/5)/s²: crossover
 //! ≈ ωsc and atan(5) = 79° of phase margin. Those gains are per *mechanical* rad/s; the
 //! controller works in electrical rad/s (the estimator's unit), so it divides Kp and Ki by p.
@@ -21,19 +21,19 @@ pub struct SpeedControllerConfig<T> {
     pub ts: T,
     /// Pole pairs p: the machine model's (the paper's motor: 4, 8 poles).
     pub pole_pairs: T,
-    /// Inertia estimate Ĵ in kg·m²: the machine model's (the paper's motor: 0.012, SPEC §6
+    /// Inertia estimate Ĵ in kg·m²: the machine model's (the paper's motor: 0.012, docs/method/estimator.md, "The paper's motor and drive"
     /// \[A\]).
     pub inertia_hat: T,
     /// Magnet flux linkage estimate λ̂f in Wb, for K̂t = 1.5·p·λ̂f: the machine model's (the
-    /// paper's motor: 0.088, SPEC §6 \[A\]).
+    /// paper's motor: 0.088, docs/method/estimator.md, "The paper's motor and drive" \[A\]).
     pub flux_linkage_hat: T,
     /// Speed-loop bandwidth in Hz. Default 5 Hz (paper, V; [`DriveTuning::speed_bandwidth_hz`]).
     pub bandwidth_hz: T,
     /// Ratio ωsc/(Ki/Kp): the PI zero sits this many times below the crossover. Default 5
-    /// (SPEC §6: Ki = Kp·2π·5/5; [`DriveTuning::speed_zero_ratio`]).
+    /// (docs/method/estimator.md, "The paper's motor and drive": Ki = Kp·2π·5/5; [`DriveTuning::speed_zero_ratio`]).
     pub zero_ratio: T,
     /// Output limit in A of q current (in units of the magnet's q current on a salient rotor
-    /// with MTPA). Default [`DriveTuning::current_limit_ratio`] × the rated current (SPEC §6
+    /// with MTPA). Default [`DriveTuning::current_limit_ratio`] × the rated current (docs/method/estimator.md, "The paper's motor and drive"
     /// \[A\]: 40 A on the paper's motor), see [`with_tuning`](Self::with_tuning).
     pub i_max: T,
     /// Back-calculation gain as a multiple of Ki/Kp (see [`PiConfig`]; default
@@ -170,7 +170,7 @@ impl<T: Real> SpeedController<T> {
     }
 }
 
-/// The current-vector limit |i_dq*| ≤ I_max with priority to d (SPEC §4, §6): i_d* (the
+/// The current-vector limit |i_dq*| ≤ I_max with priority to d (docs/method/estimator.md §6, §6): i_d* (the
 /// injection of eq. (23)) is kept within ±I_max and i_q* is cut to √(I_max² − i_d*²).
 /// With I_min ≤ I_max the injection alone never needs the cut (|i_dq*| = I_min while it is
 /// active), but any larger d-axis demand does.
@@ -195,7 +195,10 @@ mod tests {
         .unwrap();
         let kt = 1.5 * 4.0 * 0.088;
         let kp_mech = 0.012 * 2.0 * core::f64::consts::PI * 5.0 / kt;
-        assert!((kp_mech - 0.714).abs() < 1e-3, "SPEC §6 quotes 0.714");
+        assert!(
+            (kp_mech - 0.714).abs() < 1e-3,
+            "the paper's motor (docs/method/estimator.md) quotes 0.714"
+        );
         assert!((c.kp() * 4.0 - kp_mech).abs() < 1e-12);
         assert!((c.ki() / c.kp() - 2.0 * core::f64::consts::PI).abs() < 1e-12);
     }

@@ -6,7 +6,7 @@
 //! integrand is zero and a tangential integrand error ε_q (an R̂s error of 0.01 %, an inverter
 //! residual) makes the *rotor* creep unseen at ω = −ε_q/λf; the speed loop answers with
 //! i_q = i_L/cos δ and the angle either stops at 0.6–0.7 rad or runs to the current limit
-//! (docs/zero-speed-errors.md, fourth pass). The fundamental voltage model cannot observe δ
+//! (docs/method/additions.md). The fundamental voltage model cannot observe δ
 //! there; the torque balance can, under a probe.
 //!
 //! **Torque balance.** With δ = θ − θ̂ (the reported angle error), the currents in the

@@ -21,7 +21,7 @@ pub struct EstimatorConfig<T> {
     /// active-flux magnitude λ̂f + (L̂d − L̂q)·i_d on salient rotors) and the rated speed that
     /// scales the mode threshold.
     pub machine: MachineModel<T>,
-    /// Rotor angle assumed at reset (rad), e.g. from an alignment (SPEC §1 \[A\]).
+    /// Rotor angle assumed at reset (rad), e.g. from an alignment (docs/method/estimator.md §1 \[A\]).
     pub initial_angle: T,
     /// Gains, bandwidths, thresholds and switches.
     pub tuning: EstimatorTuning<T>,

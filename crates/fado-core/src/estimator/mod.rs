@@ -10,7 +10,7 @@
 //!                    │   or k_af·(λ̂r − Π(λ̂r)) (below, Fig. 6)
 //! ```
 //!
-//! Order of operations at sample n (SPEC §1): integrate with the feedback from sample n−1,
+//! Order of operations at sample n (docs/method/estimator.md §1): integrate with the feedback from sample n−1,
 //! run the observer with ω̂ of T2S-1, form λ2, λ̂r and θm, update both trackers, then choose
 //! the mode from |ω̂| of T2S-2 and compute the feedback for sample n+1.
 //!
@@ -31,7 +31,7 @@
 //!   slow laws' state and sums, the counters and flags) and what the user changes at run
 //!   time: R̂s ([`EstimatorState::set_rs_hat`], the adaptation) with what the adaptation
 //!   derives from the R0 it restarts from, λ̂f (its law), the adaptation's and the k_df
-//!   switches. At most 256 B in `f32` (`state_size`, docs/firmware.md).
+//!   switches. At most 256 B in `f32` (`state_size`, docs/results/firmware-cost.md).
 //!
 //! [`EstimatorState::step`] / [`EstimatorState::step_lean`] take the parameters by
 //! reference: the firmware path, with the parameters built once (in a `static`, never copied
@@ -90,8 +90,8 @@ const FLUX_SETTLE_TIME_CONSTANTS: f64 = 2.0;
 /// sampling periods from 50 to 200 µs). The inputs are sampled, not averaged, over the period
 /// (the standstill law's voltage and current excepted: it integrates their means): what they
 /// carry near the decimated Nyquist frequency (625 Hz) is noise that the laws' 0.5–31 s⁻¹
-/// bandwidth rejects either way. N was 4 until issue 16's sixth session; 8 halves the two laws'
-/// share of the mean `f32` step on a Cortex-M4F (docs/firmware.md) with fig8–fig12 and the
+/// bandwidth rejects either way. N = 8 rather than 4 halves the two laws'
+/// share of the mean `f32` step on a Cortex-M4F (docs/results/firmware-cost.md) with fig8–fig12 and the
 /// R̂s-adaptation tests unchanged within their noise.
 const SLOW_PERIOD: u8 = 8;
 /// The loss-of-lock detector runs once every `LOCK_PERIOD` samples (slots [`SLOT_LOCK`] and
@@ -119,7 +119,7 @@ const MAX_OBSERVER_GAIN_PERIOD: f64 = 1.0;
 /// λ̂f, the gains and limits of every block, the slow laws' constants, the sample bounds, the
 /// lock detector's thresholds). Nothing in it changes after construction, so firmware can
 /// build it once and keep it where the interrupt reads it (a `static`, see the module docs
-/// of the `examples/cortex-m` image and docs/firmware.md); the mutable half is
+/// of the `examples/cortex-m` image and docs/results/firmware-cost.md); the mutable half is
 /// [`EstimatorState`].
 ///
 /// The split follows quartiq's `idsp` (`iir::Stateful`/`StatefulRef`, src/iir/process.rs:
@@ -189,7 +189,7 @@ pub struct EstimatorParams<T: Real> {
 /// law), the adaptation's on switch (`enable_rs_adaptation`) and the k_df switch. Stepped
 /// with [`EstimatorState::step`] / [`EstimatorState::step_lean`] and the
 /// [`EstimatorParams`] it was made for; `size_of` is 256 B or less in `f32`
-/// (docs/firmware.md).
+/// (docs/results/firmware-cost.md).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EstimatorState<T: Real> {
     integrator: FluxIntegratorState<T>,

@@ -62,7 +62,7 @@ impl<T: Real> SensorlessEstimator<T> {
         self.state.reset(&self.params);
     }
 
-    /// Start-up at a known rotor angle θ0 with the present current (SPEC §1 step 6):
+    /// Start-up at a known rotor angle θ0 with the present current (docs/method/estimator.md, "Start-up"):
     /// λ1 = λ̂a·e^{jθ0} + L̂q·i with the active flux λ̂a = λ̂f + (L̂d − L̂q)·i_d, D̂ = 0, θ̂ = θ0, ω̂ = 0, limiter mode. An adapted R̂s is kept
     /// (the winding is as warm as it was).
     pub fn align(&mut self, theta0: T, i_ab: Ab<T>) {
@@ -85,7 +85,7 @@ impl<T: Real> SensorlessEstimator<T> {
     /// outputs a control loop uses ([`LeanEstimate`]: θ̂, ω̂, ω̂ for control, the mode, the
     /// lock status and the input-fault flag). The diagnostics of [`Estimate`] (λ1, D̂, λ2,
     /// λ̂r, θm, R̂s, λ̂f, flags) are not formed: on a Cortex-M4F that saves about 65 of the
-    /// step's cycles (docs/firmware.md). [`Self::last`] still gives them for the last sample
+    /// step's cycles (docs/results/firmware-cost.md). [`Self::last`] still gives them for the last sample
     /// (recomputed from the state).
     #[inline]
     pub fn step_lean(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> LeanEstimate<T> {

@@ -28,7 +28,7 @@ impl<T: Real> EstimatorState<T> {
         self.align(p, p.initial_angle, Ab::zero());
     }
 
-    /// Start-up at a known rotor angle θ0 with the present current (SPEC §1 step 6):
+    /// Start-up at a known rotor angle θ0 with the present current (docs/method/estimator.md, "Start-up"):
     /// λ1 = λ̂a·e^{jθ0} + L̂q·i with the active flux λ̂a = λ̂f + (L̂d − L̂q)·i_d, D̂ = 0, θ̂ = θ0,
     /// ω̂ = 0, limiter mode. An adapted R̂s is kept (the winding is as warm as it was).
     pub fn align(&mut self, p: &EstimatorParams<T>, theta0: T, i_ab: Ab<T>) {

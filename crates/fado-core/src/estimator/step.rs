@@ -18,6 +18,8 @@ use crate::{Ab, Real};
 
 /// The new state of one sample, computed before anything is committed.
 struct Candidate<T: Real> {
+    /// L̂d − L̂q, loaded once for every use in the sample.
+    saliency: T,
     /// λ1 integrated with the previous sample's feedback (eq. (21) / (24)).
     lambda1: Ab<T>,
     /// The current the integrator's resistive drop used (the slow laws' current).
@@ -73,9 +75,12 @@ impl<T: Real> EstimatorState<T> {
         if !Self::is_committable(&c) {
             return self.reject(p).into();
         }
-        let rs_hat_used = self.integrator.rs_hat();
-        let flux_linkage_used = self.rs_adaptation.flux_linkage_hat;
         let previous_mode = self.mode;
+        // The estimate is formed before the commit, with the R̂s and λ̂f this sample used;
+        // the loss-of-lock status is filled in after the detector's slot.
+        let rs_hat = self.integrator.rs_hat();
+        let flux_linkage_hat = self.rs_adaptation.flux_linkage_hat;
+        let mut estimate = Self::estimate(&c, rs_hat, flux_linkage_hat, self.lock_status);
         let shift = self.commit(p, &c, i_ab);
         self.judge_lock(p, &c, i_ab);
         self.step_allowance = p.bounds.step();
@@ -88,7 +93,8 @@ impl<T: Real> EstimatorState<T> {
         if self.rs_adaptation_on {
             self.run_slow_laws(p, &c, slot, previous_mode, shift, v_ab, i_ab);
         }
-        Self::estimate(&c, rs_hat_used, flux_linkage_used, self.lock_status).into()
+        estimate.diagnostics.lock = self.lock_status;
+        estimate.into()
     }
 
     /// Phases 1–5 of the sample: integrate, observe, form λ̂r, track, select the mode and
@@ -131,6 +137,7 @@ impl<T: Real> EstimatorState<T> {
         // switched off once on), so the sum needs no test of the flag.
         let feedback = base_feedback + self.slow_feedback;
         Candidate {
+            saliency,
             lambda1,
             i_drop,
             observer_flux,
@@ -279,7 +286,7 @@ impl<T: Real> EstimatorState<T> {
         }
         // λ̂f as this sample used it (the slow laws have not run yet).
         let flux_hat = self.rs_adaptation.flux_linkage_hat;
-        let active_ratio = Self::active_ratio(p, i_ab, c.lambda_r, p.saliency, c.tracker_hold);
+        let active_ratio = Self::active_ratio(p, i_ab, c.lambda_r, c.saliency, c.tracker_hold);
         // A hand-over since the last judged sample (the mode sampled every LOCK_PERIOD
         // samples: two hand-overs within them would need ω̂ to cross the hysteresis band
         // twice in 0.4 ms, and count as none).

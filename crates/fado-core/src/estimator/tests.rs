@@ -50,7 +50,7 @@ fn step_lean_is_step_without_diagnostics() {
     lean_matches_full::<f64>(false);
 }
 
-/// The firmware state budget (docs/firmware.md, issue 16: ≤ 256 B in `f32`): the mutable
+/// The firmware state budget (docs/results/firmware-cost.md: ≤ 256 B in `f32`): the mutable
 /// state alone, the parameters apart (they can live in flash or a `static` the step
 /// borrows). Prints both precisions' sizes.
 #[test]
@@ -72,7 +72,7 @@ fn state_size() {
         "EstimatorState<f32>: {s32} B, <f64>: {s64} B; EstimatorParams<f32>: {p32} B, \
          <f64>: {p64} B; SensorlessEstimator<f32>: {o32} B, <f64>: {o64} B"
     );
-    // Before the split (issue 16's fourth pass) the one record was 484 B in `f32`, its
+    // As one record (parameters and state together) the estimator would be 484 B in `f32`, its
     // constants and its state mixed. The state now holds what changes (and R0's 20 B of
     // scaled constants, since `set_rs_hat` replaces R0 at run time).
     // The trackers' acceleration feed-forward and load integrator (`crate::tracker`) add

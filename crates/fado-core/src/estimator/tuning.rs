@@ -6,7 +6,7 @@ use crate::plausibility;
 use crate::tracker::BandwidthDefinition;
 
 /// The estimator's tuning: every setting that is not the machine or the sampling period.
-/// Defaults are the paper's (section V) or SPEC.md's, as each field says; none depends on the
+/// Defaults are the paper's (section V) or the method pages', as each field says; none depends on the
 /// motor (speeds are ratios of the rated electrical frequency). With the `serde` feature this
 /// is the `[estimator]` table of `fado-sim`'s TOML and the keyword set of Python's
 /// `fado.EstimatorConfig`.
@@ -19,7 +19,7 @@ use crate::tracker::BandwidthDefinition;
 pub struct EstimatorTuning<T> {
     /// Disturbance feedback gain k_df in s⁻¹ (Fig. 3), at most 1/ts. Default 0.5 (paper, V).
     pub k_df: T,
-    /// Ramp time of k_df on activation in s, 0 = abrupt as in the paper. Default 0 (SPEC §1 \[A\]).
+    /// Ramp time of k_df on activation in s, 0 = abrupt as in the paper. Default 0 (docs/method/estimator.md §1 \[A\]).
     pub k_df_ramp_time: T,
     /// Limiter gain k_af in s⁻¹ (Fig. 6), at most 1/ts (a larger step pulls λ̂r through the
     /// circle). Default 2π·100 (paper, V).
@@ -31,18 +31,18 @@ pub struct EstimatorTuning<T> {
     /// (paper, V: 1.5 Hz of its motor's 100 Hz).
     pub mode_threshold_ratio: T,
     /// Hysteresis half-band of the threshold as a fraction of the rated electrical frequency,
-    /// at most the threshold. Default 0.002 (SPEC §1 \[A\]: 0.2 Hz of 100 Hz).
+    /// at most the threshold. Default 0.002 (docs/method/estimator.md §1 \[A\]: 0.2 Hz of 100 Hz).
     pub mode_hysteresis_ratio: T,
     /// Bandwidth of T2S-1 (angle, observer speed) in Hz. Default 60 Hz (paper, V).
     pub t2s1_bandwidth_hz: T,
     /// Bandwidth of T2S-2 (speed for control) in Hz. Default 35 Hz (paper, V).
     pub t2s2_bandwidth_hz: T,
-    /// Damping ratio of both trackers. Default 1/√2 (SPEC §3 \[A\]).
+    /// Damping ratio of both trackers. Default 1/√2 (docs/method/estimator.md §4 \[A\]).
     pub tracker_damping: T,
-    /// Meaning of the tracker bandwidths. Default −3 dB (SPEC §3).
+    /// Meaning of the tracker bandwidths. Default −3 dB (docs/method/estimator.md §4).
     pub bandwidth_definition: BandwidthDefinition,
     /// Trackers coast (no update) while |λ̂r| is below this fraction of λ̂f. Default 0.2
-    /// (SPEC §3 \[A\]).
+    /// (docs/method/estimator.md §4 \[A\]).
     pub tracker_hold_ratio: T,
     /// The trackers' third (load-acceleration) integrator, as the ratio c of its real pole
     /// to ωn (see [`crate::tracker`], "Acceleration feed-forward"). Default 0: the paper's
@@ -50,7 +50,7 @@ pub struct EstimatorTuning<T> {
     /// scenarios: a load pole at half ωn, 8 Hz on T2S-2's 35 Hz, settles a rated load step
     /// within 0.1 rad on the paper's motor, docs/range.md).
     pub tracker_load_pole_ratio: T,
-    /// Average the current over the interval for the resistive drop. Default true (SPEC §1 \[A\]).
+    /// Average the current over the interval for the resistive drop. Default true (docs/method/estimator.md §1 \[A\]).
     pub average_current: bool,
     /// Feed the disturbance observer with λ1 − L̂q·i instead of λ1. Default true (our
     /// improvement \[A\]; `false` is the paper's Fig. 5, where the observer sees λ1).
@@ -60,7 +60,7 @@ pub struct EstimatorTuning<T> {
     /// current is constant in the rotor frame. A rotor-frame current modulation at f_m (a
     /// speed-loop oscillation, a load step, the i_d* swing at the eq. (23) knee) appears in
     /// α-β at f ± f_m; near standstill-to-low speed f − f_m is close to DC, falls into the
-    /// observer's DC pass-band (d/y = ω(ω + js)/(s + |ω|)², SPEC §2) and is taken for a
+    /// observer's DC pass-band (d/y = ω(ω + js)/(s + |ω|)², docs/method/estimator.md §2) and is taken for a
     /// disturbance: D̂ moves, λ2 = λ1 − D̂ loses part of L·Δi, λ̂r turns, and the loop closes
     /// through θ̂ and the current controller. Subtracting the known L̂q·i first leaves the
     /// observer exactly its model (λ̂r is a rotating vector plus the DC disturbance), so D̂ no
@@ -93,7 +93,7 @@ pub struct EstimatorTuning<T> {
     /// 1.67 % to 0.33 % of λf with an averaged inverter without dead time or device drop and
     /// ideal sensors, and from 1.57–2.17 % to 0.29–0.72 % with the default non-idealities on
     /// sensor seeds 1–8 (0.27–0.87 % with a fixed R̂s); the loaded one-hour standstill then
-    /// runs to the current limit on four of five seeds instead of one (docs/zero-speed-errors.md).
+    /// runs to the current limit on four of five seeds instead of one (docs/method/additions.md).
     pub observer_lag_compensation: bool,
     /// The observer's gains (16) are recomputed from its speed once every this many seconds
     /// (rounded to whole samples, at least every sample) and held in between; 0 = every
@@ -102,7 +102,7 @@ pub struct EstimatorTuning<T> {
     /// The gains depend only on the speed the observer runs at, ω̂1 (+ the lag
     /// compensation), which T2S-1's 60 Hz bandwidth keeps from moving much within a
     /// millisecond; forming them (four polynomials, 19 multiplies) is a tenth of the `f32`
-    /// step on a Cortex-M4F (docs/firmware.md). Held over N samples, the internal model
+    /// step on a Cortex-M4F (docs/results/firmware-cost.md). Held over N samples, the internal model
     /// rotates and the notch sits at the speed of the last update: under an acceleration α
     /// they lag the speed by at most α·(N − 1)·Ts, 0.3 ms × α by default, 4 % of the lag
     /// 2ζ/ωn·α = 7.7 ms × α of T2S-1's own ω̂1 that `observer_lag_compensation` corrects
@@ -111,7 +111,7 @@ pub struct EstimatorTuning<T> {
     /// constant 1/(2π·`t2s1_bandwidth_hz`) (2.7 ms at 60 Hz); above 1 s it is refused as a
     /// mistake. Measured (fado-sim fig8–fig12,
     /// sensor seeds 1–8): every run passes, the means of the worst angle error move by at
-    /// most 1.1e-3 rad (fig10 0.0562 → 0.0573 rad; docs/firmware.md, "Sixth session").
+    /// most 1.1e-3 rad (fig10 0.0562 and 0.0573 rad with the gains every sample and held; docs/method/additions.md).
     pub observer_gain_period: T,
     /// Adapt R̂s online (our extension \[A\], see [`crate::rs_adaptation`]): from the d-axis
     /// voltage at standstill under the eq. (23) injection, and from the flux-magnitude error
@@ -143,7 +143,7 @@ pub struct EstimatorTuning<T> {
     /// −10 % / +10 % / −5 % and R̂s +10 % the worst near-zero-speed angle error drops from
     /// 1.02 / 1.21 / 0.98 rad (off) to 0.03 / 0.15 / 0.09 rad; with λ̂f right nothing moves
     /// (fig8, fig10 on seeds 1–8, fig12: the same results, the revolution means stay inside
-    /// the law's 1 % dead zone; docs/zero-speed-errors.md).
+    /// the law's 1 % dead zone; docs/method/additions.md).
     pub flux_linkage_adaptation_rate: T,
     /// With `rs_adaptation`: rate k_e in s⁻¹ at which a constant integrand error (a voltage
     /// offset) is learned while turning and subtracted from the integrand in both modes
@@ -151,7 +151,7 @@ pub struct EstimatorTuning<T> {
     /// [`IntegrandOffsetConfig::rate`](crate::integrand_offset::IntegrandOffsetConfig::rate) (2 s⁻¹).
     ///
     /// Measured (fado-sim fig11, switching-resolved, 0.1 V on the α voltage): the worst
-    /// near-zero-speed angle error drops from 1.21 rad (off) to 0.13 rad (docs/zero-speed-errors.md).
+    /// near-zero-speed angle error drops from 1.21 rad (off) to 0.13 rad (docs/method/additions.md).
     pub offset_adaptation_rate: T,
     /// With `rs_adaptation`: rate k_θ in s⁻¹ at which, at standstill under the eq. (23)
     /// injection (the current along the estimated d axis, light load), λ̂r is turned towards
@@ -161,7 +161,7 @@ pub struct EstimatorTuning<T> {
     /// Measured (fado-sim fig10, switching-resolved, sensor seeds 1–8): the worst angle error
     /// over the run drops from 0.384 rad (off) to 0.308 rad, and during the hold the error
     /// decays instead of walking; what remains is the swing at the stop, before the law acts
-    /// (0.5, 1, 4 and 8 s⁻¹ and a 1 Hz filter on i_q/i_d were worse: docs/zero-speed-errors.md).
+    /// (0.5, 1, 4 and 8 s⁻¹ and a 1 Hz filter on i_q/i_d were worse: docs/method/additions.md).
     pub standstill_angle_rate: T,
     /// In limiter mode, move λ1 and the observer's λ̂1 and D̂ together by −k_df·Ts·D̂ each
     /// sample. Default true (ours \[A\]; `false` is the paper).
@@ -194,7 +194,7 @@ pub struct EstimatorTuning<T> {
     /// |ω̂| is below the mode hand-over band (`mode_threshold_ratio` −
     /// `mode_hysteresis_ratio`, 0.013 of the rated speed; above it,
     /// `lock_flux_low_fast_ratio`). Default 0.7 \[A\] (chosen on the fig11 envelope sweep,
-    /// docs/lock.md). 0.65 no longer flags the start-up of fig11 with R̂s +10 % (|λ̂r| below
+    /// docs/method/lock.md). 0.65 no longer flags the start-up of fig11 with R̂s +10 % (|λ̂r| below
     /// 0.7·λ̂f from 0.298 s at ω̂ −12 r/min, down to 0.67·λ̂f; the error passes 0.5 rad at
     /// 0.40 s), the flag
     /// with which the `recover` reaction switches the R̂s adaptation on in time for the
@@ -204,7 +204,7 @@ pub struct EstimatorTuning<T> {
     pub lock_flux_low_ratio: T,
     /// Loss of lock: |λ̂r| below this multiple of λ̂f is a symptom while |ω̂| is at or above
     /// the lower edge of the mode hand-over band (`mode_threshold_ratio` −
-    /// `mode_hysteresis_ratio`). Default 0.6 \[A\] (docs/lock.md, 2026-11-24): accelerating
+    /// `mode_hysteresis_ratio`). Default 0.6 \[A\] (docs/method/lock.md, 2026-11-24): accelerating
     /// out of the reversal at light load, runs that keep the rotor dip to 0.67–0.70·λ̂f
     /// around the limiter → k_df hand-over (at 17–29 r/min on the paper's motor; 0.7 flagged
     /// them: 3 of 809 passing runs on seeds 7–14), while the losses this half of the symptom
@@ -217,37 +217,37 @@ pub struct EstimatorTuning<T> {
     /// false-alarmed there, 1.3 still 2–3 times per 400 runs, 1.4 once per 400 after the
     /// reversal, |λ̂r| 1.41·λ̂f with a 0.26 rad error), within the 1.4–1.6·λ̂f of a fixed-R̂s
     /// drive that an active load runs away with in k_df mode (those losses the drive's stall
-    /// symptom now sees too: 1.5 detects as many as 1.4, docs/lock.md). The voltage of a
+    /// symptom now sees too: 1.5 detects as many as 1.4, docs/method/lock.md). The voltage of a
     /// machine turning the other way gives 1.3–4.8·λ̂f.
     pub lock_flux_high_ratio: T,
     /// Loss of lock: a T2S-1 innovation |θm − θ̂⁻| above this (rad) is a symptom. Default
-    /// 0.5 rad \[A\] (the angle error the drive must not reach, docs/lock.md).
+    /// 0.5 rad \[A\] (the angle error the drive must not reach, docs/method/lock.md).
     pub lock_innovation_limit: T,
     /// Loss of lock: net symptomatic time (s) before [`LockStatus::Lost`](crate::LockStatus::Lost); 0 disables the
     /// detector. Default 5 ms \[A\] (a quarter of the 20 ms detection target; 5–20 ms made
-    /// no difference on the envelope, docs/lock.md).
+    /// no difference on the envelope, docs/method/lock.md).
     pub lock_detection_time: T,
     /// Loss of lock: net clean time (s) after which [`LockStatus::Lost`](crate::LockStatus::Lost) clears (the status
     /// is live; the drive's reaction latches, [`crate::control::lock_reaction`]). Default
     /// 0.1 s \[A\]: twenty detection times, so that the intermittent symptoms of a lost
     /// estimate keep it up, and short against the seconds between a start-up transient and a
-    /// later loss (docs/lock.md).
+    /// later loss (docs/method/lock.md).
     pub lock_heal_time: T,
     /// Loss of lock: in limiter mode, a sample in which the limiter clamps is a symptom.
     /// Default false \[A\]: a rotor lost in limiter mode clamps continuously (fig11 with
     /// λ̂f +10 %) and a matched drive never clamps, but an adapted R̂s biased by a λ̂f error
-    /// makes the limiter clamp through passages it survives (false alarms, docs/lock.md).
+    /// makes the limiter clamp through passages it survives (false alarms, docs/method/lock.md).
     pub lock_limiter_clamping: bool,
     /// Loss of lock: a rate of mode hand-overs (Fig. 3) of this many per
     /// `lock_handover_time` is a symptom (a leaky count, see [`crate::lock`], symptom 3);
-    /// 0 switches it off. Default 5 \[A\] (docs/lock.md "Mode hand-over chatter"): a
+    /// 0 switches it off. Default 5 \[A\] (docs/method/lock.md): a
     /// sustained 50 hand-overs a second, or a burst of five. On the reversal envelopes of the
     /// seven presets the count of runs that keep the rotor within 0.25 rad stays at 1.0–1.9
     /// on five, and reaches 3.9 on pmsyrm-5k and 4.0 on ipmsm-gem-50k; most start-up limit
     /// cycles that lose ipmsm-gem-50k's rotor reach 5–28.
     pub lock_handover_count: T,
     /// Loss of lock: the time constant of the hand-over count's decay, s. Default 0.1 s
-    /// \[A\] (docs/lock.md "Mode hand-over chatter").
+    /// \[A\] (docs/method/lock.md).
     pub lock_handover_time: T,
 }
 
@@ -259,7 +259,7 @@ impl<T: Real> EstimatorTuning<T> {
     /// [`Self::limiter_recentring`], an abrupt k_df ([`Self::k_df_ramp_time`] 0) and the gains
     /// (16) formed every sample ([`Self::observer_gain_period`] 0). The sample bounds, the
     /// finite test and the loss-of-lock detector stay. What the cost comparisons call "the
-    /// paper's path" (docs/firmware.md; `benches/baselines.rs`).
+    /// paper's path" (docs/results/firmware-cost.md; `benches/baselines.rs`).
     pub fn paper_path(self) -> Self {
         Self {
             rs_adaptation: false,

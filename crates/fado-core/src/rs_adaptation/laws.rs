@@ -164,7 +164,7 @@ impl<T: Real> ResistanceAdaptationParams<T> {
     /// mode has lasted long enough for the λ̂f law (past the hand-over transient). The
     /// returned pull (V) acts until the next run (the estimator holds it over the period).
     /// Always inlined: the estimator's step is its one caller per sample (an out-of-line
-    /// copy costs a call and the spills around it on a Cortex-M4F, docs/firmware.md).
+    /// copy costs a call and the spills around it on a Cortex-M4F, docs/results/firmware-cost.md).
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn next_state(

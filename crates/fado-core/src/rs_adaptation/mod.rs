@@ -87,7 +87,7 @@
 //! settles at δ = atan(i_L/i_d) instead (the torque balance then needs that angle): the law
 //! assumes the eq. (23) regime, and stops where the DC test stops (i_d ≤ 2|i_q|, so at most
 //! atan(½) of bias). Under load (no injection) nothing observes the angle: see
-//! docs/zero-speed-errors.md for the loaded standstill.
+//! docs/method/additions.md for the loaded standstill.
 //!
 //! **Flux linkage** (k_df mode, |ω̂| above 3× the Fig. 3 threshold, past the hand-over
 //! transient, and where the revolution's mean χ is below χ0/2: no load or high speed, where
@@ -96,7 +96,7 @@
 //! under 7.5 N·m on the paper's motor), so λ̂f is learned where its own error dominates
 //! |λ̂r| − λ̂a, each law where its parameter is observable. Two things bias that regressor
 //! there and are not λ̂f's (measured on the paper's motor, fado-sim, no load, λ̂f right;
-//! docs/zero-speed-errors.md):
+//! docs/method/additions.md):
 //!
 //! - the inverter's voltage error *across* the current. With the eq. (23) injection the
 //!   no-load current lies along d, so the dead-time compensation's residual along the
@@ -133,7 +133,7 @@
 //! within ε_off = 0.25 % ([`FLUX_LINKAGE_DEAD_ZONE_OFF`]; a relay with hysteresis on the
 //! dead zone, ours \[A\]). A λ̂f error beyond 2ε is then learned down to the bias, one
 //! between ε and 2ε (as likely a transient of a salient motor's active flux as a λ̂f error)
-//! down to ε. Measured on the fig11 λ̂f × load envelope (docs/zero-speed-errors.md): 62 of 63
+//! down to ε. Measured on the fig11 λ̂f × load envelope (docs/method/additions.md): 62 of 63
 //! points pass, 60 with the plain dead zone, 23 without the law.
 //!
 //! Both laws are frozen while the trackers coast, on a mode change and on rejected samples.
@@ -166,7 +166,7 @@ pub const FLUX_LINKAGE_SPEED_THRESHOLDS: f64 = 3.0;
 /// |λ̂r| − λ̂a within ±ε moves nothing (module docs). 1 % (ours \[A\]): twice the largest
 /// no-load bias measured on the paper's motor with λ̂f right (−0.54 %, the dead-time
 /// compensation's residual across the current, fig8's run-up); fig11 tolerates a λ̂f error
-/// of about ±2 % (docs/zero-speed-errors.md).
+/// of about ±2 % (docs/method/additions.md).
 pub const FLUX_LINKAGE_DEAD_ZONE: f64 = 0.01;
 
 /// Once a revolution mean has left the dead zone, the λ̂f law follows the whole mean until one
@@ -188,7 +188,7 @@ pub struct ResistanceAdaptationConfig<T> {
     /// machine model ([`MachineModel::rs`]; the paper's motor: 0.327 Ω, paper V).
     pub rs_initial: T,
     /// λ̂f in Wb: the start value of the flux-magnitude reference. From the machine model
-    /// ([`MachineModel::flux_linkage`]; the paper's motor: 0.088 Wb, SPEC §6 \[A\]).
+    /// ([`MachineModel::flux_linkage`]; the paper's motor: 0.088 Wb, docs/method/estimator.md, "The paper's motor and drive" \[A\]).
     pub flux_linkage_hat: T,
     /// γ_f in s⁻¹: rate at which the flux-magnitude reference λ̂f follows the revolution
     /// mean of |λ̂r| − λ̂a (beyond its dead zone) while turning without resistance excitation
@@ -199,7 +199,7 @@ pub struct ResistanceAdaptationConfig<T> {
     /// ≈ 0.25 s at no load above the gate speed before fig11's load learns a 10 % error;
     /// measured there with λ̂f −10 % / +10 % / −5 % and R̂s +10 %: 2 s⁻¹ 0.94 / 0.46 / 0.13
     /// rad (two fail), 5 s⁻¹ 0.028 / 0.152 / 0.087, 10 s⁻¹ (deadbeat at 6 Hz) 0.033 / 0.151 /
-    /// 0.094; docs/zero-speed-errors.md).
+    /// 0.094; docs/method/additions.md).
     pub flux_linkage_rate: T,
     /// γ in s⁻¹: decay rate of the relative R̂s error under full excitation while turning.
     /// Default 1 s⁻¹ (ours \[A\]: the winding heats over minutes, so the law can be slow; at
@@ -329,7 +329,7 @@ pub struct ResistanceAdaptationState<T> {
     /// ∂R̂s/∂ê in 1/A: how much of R̂s still comes from standstill DC tests, each of which
     /// read a voltage offset ê along its d axis as ⟨ê, d̂⟩/i_d of resistance. Built by the
     /// standstill law (unit/i_d at its rate), forgotten at the turning law's rate; when the
-    /// integrand-offset estimate ê moves by Δê, R̂s moves by −⟨Δê, ∂R̂s/∂ê⟩ (issue 13).
+    /// integrand-offset estimate ê moves by Δê, R̂s moves by −⟨Δê, ∂R̂s/∂ê⟩.
     pub offset_sensitivity: Ab<T>,
     /// λ̂f law: ∫(|λ̂r| − λ̂a)·|ω̂|dt over the revolution under way, Wb·rad.
     pub flux_error_angle: T,

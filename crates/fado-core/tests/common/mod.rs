@@ -6,7 +6,7 @@
 
 use fado_core::{Ab, Dq, EstimatorConfig, MachineModel, Real, Rotation};
 
-/// Motor of SPEC §6.
+/// Motor of docs/method/estimator.md, "The paper's motor and drive".
 pub const RS: f64 = 0.327;
 /// Inductance (SMPMSM, Ld = Lq).
 pub const L: f64 = 2.63e-3;
@@ -127,7 +127,7 @@ pub struct Machine {
     pub pp: f64,
 }
 
-/// The 2.2 kW interior-magnet motor of issue 11 as a `MachineModel` (p 3, Rs 3.6 Ω, Ld 36 mH,
+/// The 2.2 kW interior-magnet motor of the `ipmsm-2k2` preset as a `MachineModel` (p 3, Rs 3.6 Ω, Ld 36 mH,
 /// Lq 51 mH, λf 0.545 Wb, J 0.02 kg·m², B 2e-3 N·m·s/rad, 6 A peak, 1500 r/min, 14.9 N·m:
 /// magnet plus reluctance torque at the MTPA point of 6 A, 540 V DC link): the one definition
 /// the tests start from, overriding what a test needs.
@@ -175,7 +175,7 @@ impl Machine {
         lf: LF,
         pp: PP,
     };
-    /// The 2.2 kW interior-magnet motor of issue 11 (p 3, Rs 3.6 Ω, Ld 36 mH, Lq 51 mH,
+    /// The 2.2 kW interior-magnet motor of the `ipmsm-2k2` preset (p 3, Rs 3.6 Ω, Ld 36 mH, Lq 51 mH,
     /// λf 0.545 Wb, 6 A peak rated, 1500 r/min).
     pub const IPMSM: Machine = Machine {
         rs: 3.6,

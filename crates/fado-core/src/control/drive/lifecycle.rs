@@ -148,7 +148,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         self.current_offset
     }
 
-    /// Start-up at a known (e.g. aligned) rotor angle θ0 (SPEC §1 step 6): the estimator
+    /// Start-up at a known (e.g. aligned) rotor angle θ0 (docs/method/estimator.md, "Start-up"): the estimator
     /// starts from it with the last measured current; controllers and voltage history are
     /// cleared (the next duty is the first). A trip stays latched.
     pub fn align(&mut self, theta0: T) {

@@ -1,7 +1,7 @@
 //! The whole sensorless drive of Fig. 5: estimator, speed and current control, d-axis
 //! injection, delay and dead-time compensation, SVPWM — one `step` per 10 kHz sample.
 //!
-//! Order of operations at sample n (SPEC §1, §5):
+//! Order of operations at sample n (docs/method/estimator.md §1, §5):
 //!
 //! 1. Reject non-finite inputs (trip after `input_fault_trip_time` of them in a row); remove
 //!    the calibrated offsets; trip (gates off, latched) when a phase current exceeds the trip
@@ -59,7 +59,7 @@ use crate::lock::Debouncer;
 use crate::{Ab, Abc, Dq, Real};
 
 /// Default of [`DriveTuning::lock_stall_torque_band_ratio`]: 1 − cos(0.25 rad), the torque
-/// deficit of an estimate 0.25 rad off (issue 14's largest "clean" angle error).
+/// deficit of an estimate 0.25 rad off (the largest angle error of a clean run).
 const STALL_TORQUE_BAND_RATIO: f64 = 0.031_087_578_289_355_3;
 
 /// The absolute limits and sample counts of a [`DriveConfig`], resolved once from its ratios

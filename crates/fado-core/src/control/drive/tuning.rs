@@ -12,9 +12,9 @@ use crate::machine::PAPER_RATED_CURRENT;
 
 /// The drive's tuning: every setting that is not the machine or the sampling period. Defaults
 /// are ratios of the machine's ratings or durations in seconds, chosen so that the paper's
-/// motor ([`MachineModel::paper`](crate::MachineModel::paper), 21.78 A rated) gets the paper's and SPEC's absolute values
+/// motor ([`MachineModel::paper`](crate::MachineModel::paper), 21.78 A rated) gets the paper's absolute values
 /// (written beside each ratio); the inverter data (dead time, switching frequency, threshold
-/// voltage, current band) are SPEC §5's; they are not serde keys (`fado-sim` derives them from
+/// voltage, current band) are docs/method/estimator.md §7's; they are not serde keys (`fado-sim` derives them from
 /// its `[inverter]` and `[mismatch]`). With the `serde` feature this is the `[controller]`
 /// table of `fado-sim`'s TOML.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -28,10 +28,10 @@ pub struct DriveTuning<T> {
     pub current_bandwidth_hz: T,
     /// Speed-loop bandwidth in Hz. Default 5 Hz (paper, V).
     pub speed_bandwidth_hz: T,
-    /// Speed PI zero as a fraction of its bandwidth, Ki = Kp·ωsc/ratio. Default 5 (SPEC §6).
+    /// Speed PI zero as a fraction of its bandwidth, Ki = Kp·ωsc/ratio. Default 5 (docs/method/estimator.md, "The paper's motor and drive").
     pub speed_zero_ratio: T,
     /// Current limit I_max (|i_dq*|) as a multiple of the rated current. Default 40/21.78
-    /// (SPEC §6 \[A\]: 40 A on the paper's motor).
+    /// (docs/method/estimator.md, "The paper's motor and drive" \[A\]: 40 A on the paper's motor).
     pub current_limit_ratio: T,
     /// Minimum current I_min of the injection (23) as a fraction of the rated current; 0
     /// disables it. Default 4/21.78 (paper, V: 4 A).
@@ -52,26 +52,26 @@ pub struct DriveTuning<T> {
     #[cfg_attr(feature = "serde", serde(skip))]
     pub switching_frequency: T,
     /// Device threshold voltage of the dead-time compensation in V (inverter datum). Default
-    /// 1 V (SPEC §5 \[A\]).
+    /// 1 V (docs/method/estimator.md §7 \[A\]).
     #[cfg_attr(feature = "serde", serde(skip))]
     pub dead_time_threshold_voltage: T,
     /// Current band Ic of the trapezoidal compensation in A (inverter datum). Default 0.3 A
-    /// (SPEC §5 \[A\]).
+    /// (docs/method/estimator.md §7 \[A\]).
     #[cfg_attr(feature = "serde", serde(skip))]
     pub dead_time_current_band: T,
     /// Compensate the dead time at all. Default true (paper IV-B).
     pub dead_time_compensation: bool,
-    /// Shape of the compensation. Default [`DeadTimeMethod::EdgeCurrent`] \[A\]: the SPEC §5
+    /// Shape of the compensation. Default [`DeadTimeMethod::EdgeCurrent`] \[A\]: the docs/method/estimator.md §7
     /// trapezoid evaluated at each switching edge's predicted current (PWM ripple included,
     /// L̂d, L̂q of the machine model); it keeps |λ̂r| from shrinking while a phase
-    /// current sits in the band at standstill under load (docs/zero-speed-errors.md).
+    /// current sits in the band at standstill under load (docs/method/additions.md).
     pub dead_time_method: DeadTimeMethod,
-    /// Angle advance of the voltage in samples. Default 1.5 (SPEC §5 \[A\], ref. \[13\]).
+    /// Angle advance of the voltage in samples. Default 1.5 (docs/method/estimator.md §7 \[A\], ref. \[13\]).
     pub delay_compensation_factor: T,
     /// Over-current trip level on any phase current, as a multiple of the rated current
     /// (latched until `reset`). Default 60/21.78 (1.5·I_max: 60 A on the paper's motor) \[A\].
     pub trip_current_ratio: T,
-    /// Decoupling and back-EMF feed-forward in the current PI. Default true (SPEC §6 \[A\]).
+    /// Decoupling and back-EMF feed-forward in the current PI. Default true (docs/method/estimator.md, "The paper's motor and drive" \[A\]).
     pub decoupling: bool,
     /// Realisable voltage set. Default the hexagon (SVPWM \[16\]).
     pub voltage_limit: VoltageLimit,
@@ -119,12 +119,12 @@ pub struct DriveTuning<T> {
     pub gain_calibration_min_observability: T,
     /// Largest gain mismatch |k − 1| accepted from the calibration; a larger result is refused
     /// (status `Implausible`, k unchanged). Default 0.05 \[A\] (two sensors of ±2.5 % gain
-    /// tolerance; the simulator's default mismatch is 0.5 %, SPEC §6).
+    /// tolerance; the simulator's default mismatch is 0.5 %, docs/method/estimator.md, "The paper's motor and drive").
     pub gain_calibration_max_mismatch: T,
     /// Stuck current-sensor detection: a channel reading within ±this fraction of the rated
     /// current of zero while the reference asks for at least `stuck_sensor_reference_ratio`
     /// in its phase. Default 0.25/21.78 \[A\] (0.25 A: 10 LSB of a 12-bit ±50 A ADC, 25σ of
-    /// 10 mA sensor noise, SPEC §6).
+    /// 10 mA sensor noise, docs/method/estimator.md, "The paper's motor and drive").
     pub stuck_sensor_band_ratio: T,
     /// Stuck current-sensor detection: the reference's phase component, as a fraction of the
     /// rated current, from which a near-zero reading is implausible. Default 2/21.78 \[A\]
@@ -179,7 +179,7 @@ pub struct DriveTuning<T> {
     /// Whether the stall symptom (`DriveFlags::STALLED`, see `lock_stall_speed_ratio`) starts
     /// `lock_reaction` like the estimator's own verdict. Default on \[A\]: near zero speed a
     /// lost estimate shows first, and on the fig11 envelope in 39 % of the fixed-R̂s losses
-    /// only, as a stall (docs/lock.md), and a drive that coasts, re-aligns and restarts
+    /// only, as a stall (docs/method/lock.md), and a drive that coasts, re-aligns and restarts
     /// from a real stall under its load does what a stall asks for too. Off: the stall is
     /// reported and the drive carries on.
     pub lock_reaction_on_stall: bool,
@@ -195,7 +195,7 @@ pub struct DriveTuning<T> {
     pub lock_recovery_attempts: u32,
     /// With `Recover`: switch the estimator's online R̂s adaptation on when a recovery starts
     /// (see [`crate::control::lock_reaction`]). Default on \[A\]: the paper's fixed R̂s is
-    /// what loses the rotor in the loaded zero-speed passage (docs/lock.md), and restarting
+    /// what loses the rotor in the loaded zero-speed passage (docs/method/lock.md), and restarting
     /// with the same R̂s meets the same passage with the same error.
     pub lock_recovery_rs_adaptation: bool,
     /// Stall symptom of the loss-of-lock detection (see [`crate::lock`], "speed-loop stall"):
@@ -206,7 +206,7 @@ pub struct DriveTuning<T> {
     /// \[A\] (4.5 r/min at 1500 r/min rated, a fifth of the default Fig. 3 threshold
     /// `mode_threshold_ratio` 0.015; chosen on the fig11 envelope with the current gate
     /// `lock_stall_min_current_ratio` and the exception `lock_stall_follow_time`,
-    /// docs/lock.md: 0.005 reaches the band 20–60 ms after the error passes 0.5 rad in 10
+    /// docs/method/lock.md: 0.005 reaches the band 20–60 ms after the error passes 0.5 rad in 10
     /// of 208 fixed-R̂s losses; the light-load losses that 0.004 saw late reach
     /// 0.0034–0.0038·rated by 15 ms after the error passes 0.5 rad; below 0.004 the rotor
     /// lagging the ramp under heavy load false-alarmed until the exception); 0 disables.
@@ -224,11 +224,11 @@ pub struct DriveTuning<T> {
     /// false alarms of the symptom (|n̂| 12–25 r/min around the limiter ↔ k_df hand-over)
     /// were swings of ω̂ at light load; the current gate `lock_stall_min_current_ratio`
     /// removes them without this restriction, which missed the losses in which ω̂ sticks
-    /// at 12–20 r/min while the reference passes (docs/lock.md: 0.0075 detects 81.7 % of the
+    /// at 12–20 r/min while the reference passes (docs/method/lock.md: 0.0075 detects 81.7 % of the
     /// fixed-R̂s losses, off 94.2 %, both at the 0.005 band).
     pub lock_stall_max_speed_ratio: T,
     /// The stall symptom counts only while the speed loop asks for a torque: |i_q*| at least
-    /// this multiple of the rated current. Default 0.2 \[A\] (docs/lock.md). A lost
+    /// this multiple of the rated current. Default 0.2 \[A\] (docs/method/lock.md). A lost
     /// estimate shows on the mechanical side through the torque the drive commands and the
     /// rotor does not answer; with next to no torque commanded the rotor's motion is the
     /// load's and the inertia's, and a swing of ω̂ past the band is no evidence against the
@@ -236,7 +236,7 @@ pub struct DriveTuning<T> {
     /// restriction had |i_q*| of 0.05–0.15 of rated (light loads; the lag of ω̂ behind the
     /// ramp at the limiter → k_df hand-over after the reversal, one at start-up), every
     /// loss it caught that the restriction had missed 0.26 or more; 0.15 still false-alarmed
-    /// at 0.151 (docs/lock.md). 0: always.
+    /// at 0.151 (docs/method/lock.md). 0: always.
     pub lock_stall_min_current_ratio: T,
     /// The current gate of `lock_stall_min_current_ratio` does not apply while the speed error
     /// |ω* − ω̂| exceeds this multiple of the stall band *and* ω̂ turns against ω* (ω̂·ω* < 0):
@@ -246,7 +246,7 @@ pub struct DriveTuning<T> {
     /// inertia is small for its torque; there the start-up losses with L̂q over-estimated
     /// (ω̂ oscillating against the reference, |i_q*| 0.12–0.16 of rated) were flagged 25–100 ms
     /// late. 0: the gate always applies. Default 0 \[A\]: with 3, on the reversal envelope
-    /// (docs/lock.md, "A gross speed error against the reference"), ipmsm-gem-50k detects
+    /// (docs/method/lock.md), ipmsm-gem-50k detects
     /// 124/140 and 212/247 losses on seed 7 instead of 96 and 185 (119/141 and 189/224 instead
     /// of 100 and 172 on seed 8) and outrunner-cheetah-24v 268/274 instead of 251 (fixed R̂s),
     /// the paper's motor, ipmsm-2k2, servo-1ft6084 and hub-hoverboard-48v are unchanged on
@@ -257,13 +257,13 @@ pub struct DriveTuning<T> {
     /// The stall symptom also counts in k_df mode while |ω̂| is below this multiple of the
     /// rated speed (the limiter ↔ k_df threshold `mode_threshold_ratio` is 0.015, so the
     /// default is a band of 0.0025·rated, 3.75 r/min at 1500 r/min, above it); 0: limiter
-    /// mode only. Default 0.0175 \[A\] since the sixth session (docs/lock.md, "The stall
-    /// symptom on other motors"); issue 14b's 0.02 (chosen on the fig11 envelope: under heavy
+    /// mode only. Default 0.0175 \[A\] (docs/method/lock.md). A band of 0.02 (chosen on the fig11
+    /// envelope: under heavy
     /// load the estimate is lost in k_df mode just above the threshold, where a limiter-only
     /// symptom does not look) also flagged passing runs on servo-1ft6084 (11 of 259, seed 7),
     /// outrunner-cheetah-24v and hub-hoverboard-48v in which ω̂ swings ±0.003 of rated around
     /// ω* just after the limiter → k_df hand-over at 0.0176–0.0197·rated (0.0175: 4 of 259 on
-    /// servo-1ft6084, seed 7; 1 of 254 on seed 8, 12 before); off (0), one fig11 loss in
+    /// servo-1ft6084, seed 7; 1 of 254 on seed 8, against 12 with 0.02); off (0), one fig11 loss in
     /// 2173 (seeds 7–16) and 1–2 of 220–229 hub-hoverboard-48v losses went late, which
     /// 0.0175 keeps.
     pub lock_stall_kdf_speed_ratio: T,
@@ -275,7 +275,7 @@ pub struct DriveTuning<T> {
     /// acceleration a, ω̂ − ω̂_lp → a·τ; discretised exactly, pole exp(−Ts/τ)), and |i_q*|
     /// is at least `lock_stall_follow_min_current_ratio`. 0 disables. Default 10 ms \[A\]
     /// (half the 20 ms detection deadline). The stall symptom's false alarms on the fig11
-    /// envelope (docs/lock.md, fifth session) were the rotor *itself* lagging the ramp
+    /// envelope (docs/method/lock.md) were the rotor *itself* lagging the ramp
     /// after the reversal under 7.7–11.5 N·m: the 0.18–0.25 rad angle error δ costs
     /// 1 − cos δ ≈ 2–3 % of the torque, more than J·dω*/dt needs at those loads, so the
     /// speed loop falls 6 r/min behind while rotor and estimate accelerate together (ω̂
@@ -314,11 +314,10 @@ pub struct DriveTuning<T> {
     /// (their J is small for their torque). 0: the fixed band alone.
     ///
     /// Default 1 − cos(0.25 rad) = 0.0311 \[A\]: the torque deficit δT/T* = 1 − cos δ of an
-    /// estimate off by δ = 0.25 rad, the largest angle error issue 14 still calls a clean
-    /// run. A rotor that lags its reference because the estimate is off by less than that is
-    /// then inside the band; one off by more, or stalled, leaves it (docs/lock.md, "A band
-    /// from the clean threshold", ninth session). Measured on the seven presets' reversal
-    /// envelopes, seeds 7 and 8, against the sixth session's 0.015:
+    /// estimate off by δ = 0.25 rad, the largest angle error the paper's criterion still calls a
+    /// clean run. A rotor that lags its reference because the estimate is off by less than that is
+    /// then inside the band; one off by more, or stalled, leaves it (docs/method/lock.md). Measured on the seven presets' reversal
+    /// envelopes, seeds 7 and 8, against a ratio of 0.015:
     /// - outrunner-cheetah-24v with the R̂s adaptation: its false alarms go from 13 of 183
     ///   and 12 of 166 passing runs to none. They were rotors lagging the zero-speed exit of
     ///   the ramp by 0.003–0.008 of rated speed under an estimate 0.16–0.25 rad off.
@@ -327,9 +326,9 @@ pub struct DriveTuning<T> {
     ///   late) and outrunner-cheetah-24v with fixed R̂s 3 of 292 (seed 8).
     /// - Nothing else changed on any preset.
     ///
-    /// The sixth session's value, 0.015, was the largest that left the paper's motor as it
-    /// was then (0.02 delayed 92 of its 205 detections on seed 7 and 0.025 missed one; the
-    /// symptom has gained the reluctance band and the gross-error waiver since).
+    /// Without the reluctance band and the gross-error waiver, 0.015 is the largest ratio that
+    /// leaves the paper's motor's detections on time (0.02 delays 92 of its 205 detections on
+    /// seed 7 and 0.025 misses one).
     pub lock_stall_torque_band_ratio: T,
     /// The stall band widens further by this ratio ε_r times the speed error that commands the
     /// model's *reluctance* torque through the speed loop's proportional gain,
@@ -341,8 +340,8 @@ pub struct DriveTuning<T> {
     /// really follows its reference late, is mostly this part: on pmsyrm-5k (L̂q/L̂d 4.25)
     /// and ipmsm-gem-50k (3.24) the stall symptom's false alarms were rotors lagging or
     /// overshooting the reversal ramp by 0.003–0.005 of the rated speed with the estimate
-    /// right (docs/lock.md). Zero on a surface-magnet model (L̂d = L̂q). Default 0.05 \[A\]
-    /// (docs/lock.md, "A band for the reluctance torque": on seed 7 of the seven presets
+    /// right (docs/method/lock.md). Zero on a surface-magnet model (L̂d = L̂q). Default 0.05 \[A\]
+    /// (docs/method/lock.md: on seed 7 of the seven presets
     /// 0.15 loses 10 of 96 detections on ipmsm-gem-50k and 12 of 53 on pmsyrm-5k, 0.05 none;
     /// over seeds 7, 8, 21 and 22 it takes the passing runs flagged from 100 to 10 of 1012 on
     /// pmsyrm-5k and from 213 to 158 of 564 on ipmsm-gem-50k, with no detection lost on any
@@ -351,7 +350,7 @@ pub struct DriveTuning<T> {
     /// The loaded-standstill angle probe (see [`crate::control::standstill_probe`]): at a
     /// loaded standstill a slow square-wave d current, read through the speed loop's torque
     /// balance, turns θ̂ towards the rotor. Default true \[A\] (without it the one-hour loaded
-    /// standstill drifts to the current limit on 4 of 5 sensor seeds, docs/long-run.md).
+    /// standstill drifts to the current limit on 4 of 5 sensor seeds, docs/method/additions.md).
     pub standstill_probe: bool,
     /// Probe amplitude Δi_d as a fraction of the rated current. Default 0.1 \[A\] (2.2 A on
     /// the paper's motor: no torque at δ = 0, 0.5 % more copper loss at rated load; the
@@ -361,7 +360,7 @@ pub struct DriveTuning<T> {
     /// Probe period T_p in s. Default 0.5 s \[A\]: each half holds 0.25 s, 8 time constants
     /// 1/(2π·f_sc) of the 5 Hz speed loop (1.6 of its PI zero's ratio/(2π·f_sc) = 0.16 s), the
     /// correlation reads the second half of each half, after 4 loop time constants. Measured
-    /// on the loaded hour's configuration (docs/zero-speed-errors.md, fifth pass): a longer
+    /// on the loaded hour's configuration (docs/method/additions.md): a longer
     /// period lets the probe's own Δi_d move the angle more within a half (the inverter
     /// residual's tangential part depends on the current vector): worst |θ − θ̂| over five
     /// sensor seeds 0.51 rad at 2 s, 0.095 at 1 s, 0.065 at 0.5 s.

@@ -305,14 +305,14 @@ fn run(cli: Cli) -> Result<ExitCode, Box<dyn std::error::Error>> {
                     s.criterion
                 );
             }
-            println!("\nEstimators (`[simulation] estimator`, `compare --estimators`):");
+            outln!("\nEstimators (`[simulation] estimator`, `compare --estimators`):");
             for e in ESTIMATORS {
                 let settings = if e.own_settings {
                     format!("[baselines.{}]", e.key())
                 } else {
                     "[estimator]".to_owned()
                 };
-                println!("{:<15} {} — settings {settings}", e.name, e.summary);
+                outln!("{:<15} {} — settings {settings}", e.name, e.summary);
             }
             Ok(ExitCode::SUCCESS)
         }
