@@ -704,16 +704,22 @@ mod properties {
     /// 1–8 pole pairs, rated torque 0.4–2.5 × the magnet torque, DC link 0.6–3 × the
     /// line-to-line back-EMF amplitude at rated speed.
     fn valid_machine() -> impl Strategy<Value = MachineModel<f64>> {
+        // Per unit of the rated point (current I, back-EMF ω·λf), inside the bands of
+        // `fado_core::machine_checks` that real machines occupy: reactance L·I/λf 0.02–3
+        // (× saliency ≤ 2), resistance R·I/(ω·λf) 0.001–0.5, magnet torque 0.65–2.5 of
+        // 1.5·p·λf·I (below 0.6 with an even p reads as a pole count), DC link 0.6–3 × the
+        // rated back-EMF's line value.
         (
-            (0.01..5.0f64, 1e-4..0.05f64, 0.8..2.0f64, 0.001..1.0f64),
+            (0.001..0.5f64, 0.02..3.0f64, 0.8..2.0f64, 0.001..1.0f64),
             (1u32..=8, 1e-4..1.0f64, 0.0..0.01f64, 0.5..200.0f64),
-            (100.0..6000.0f64, 0.4..2.5f64, 0.6..3.0f64),
+            (100.0..6000.0f64, 0.65..2.5f64, 0.6..3.0f64),
         )
             .prop_map(
-                |((rs, ld, saliency, lf), (p, j, b, i_rated), (rpm, torque, dc))| {
+                |((r_pu, x_pu, saliency, lf), (p, j, b, i_rated), (rpm, torque, dc))| {
                     let w = rpm * std::f64::consts::PI / 30.0 * p as f64;
+                    let ld = x_pu * lf / i_rated;
                     MachineModel {
-                        rs,
+                        rs: r_pu * w * lf / i_rated,
                         ld,
                         lq: ld * saliency,
                         flux_linkage: lf,
@@ -727,6 +733,11 @@ mod properties {
                     }
                 },
             )
+            // The corners of the box beyond any motor's field ranges (say 5 kΩ for a 0.5 A,
+            // 1 V·s, 40,000 r/min machine) are not motors.
+            .prop_filter("inside the machine checks' field ranges", |m| {
+                fado_core::machine_checks::check(m, None).error().is_none()
+            })
     }
 
     /// Random configurations inside the documented ranges.
