@@ -35,7 +35,7 @@ KNOWN = {
     "crates/fado-sim/src/commission.rs::commission": 87,
     "crates/fado-sim/src/compare.rs::to_markdown": 102,
     "crates/fado-sim/src/config.rs": 1120,
-    "crates/fado-sim/src/derive.rs::complete_motor": 98,
+    "crates/fado-sim/src/derive.rs::complete_motor": 103,
     "crates/fado-sim/src/inverter.rs": 919,
     "crates/fado-sim/src/inverter.rs::step_switching": 143,
     "crates/fado-sim/src/magnetics.rs::parse_flux_map": 124,

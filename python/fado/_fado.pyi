@@ -185,6 +185,7 @@ class EstimatorConfig:
         tracker_damping: float | None = None,
         bandwidth_definition: str | None = None,
         tracker_hold_ratio: float | None = None,
+        tracker_load_pole_ratio: float | None = None,
         average_current: bool | None = None,
         observer_on_rotor_flux: bool | None = None,
         observer_lag_compensation: bool | None = None,
@@ -225,6 +226,7 @@ class EstimatorConfig:
         tracker_damping: float | None = None,
         bandwidth_definition: str | None = None,
         tracker_hold_ratio: float | None = None,
+        tracker_load_pole_ratio: float | None = None,
         average_current: bool | None = None,
         observer_on_rotor_flux: bool | None = None,
         observer_lag_compensation: bool | None = None,
@@ -291,6 +293,9 @@ class EstimatorConfig:
     @property
     def tracker_hold_ratio(self) -> float:
         """Trackers coast while |λ̂r| is below this fraction of λ̂f."""
+    @property
+    def tracker_load_pole_ratio(self) -> float:
+        """The trackers' load-acceleration pole as a ratio of ωn (0: type-2 trackers)."""
     @property
     def average_current(self) -> bool:
         """Average the current over the interval for the resistive drop."""

@@ -29,6 +29,7 @@ PAPER_DEFAULTS = {
     "tracker_damping": 1 / math.sqrt(2),  # SPEC §3 [A]
     "bandwidth_definition": "minus3_db",  # SPEC §3
     "tracker_hold_ratio": 0.2,  # SPEC §3 [A]
+    "tracker_load_pole_ratio": 0.0,  # [A] 0: the paper's type-2 trackers
     "average_current": True,  # SPEC §1 [A]
     "observer_on_rotor_flux": True,  # fado's improvement [A]; False = paper's Fig. 5
     "observer_lag_compensation": True,  # fado's improvement [A] (issue 13); False = the paper

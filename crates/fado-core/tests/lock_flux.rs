@@ -24,6 +24,9 @@ fn lost_at(
 ) -> (bool, f64) {
     let mut config = EstimatorConfig::for_machine(&model);
     config.machine.flux_linkage = model.flux_linkage / ratio;
+    // The model's ratings agree with its λ̂f (a λ̂f 1.5–2× the rating's, with an even pole
+    // count, reads as a pole-count slip to `machine_checks`).
+    config.machine.rated_torque = model.rated_torque / ratio;
     config.tuning.rs_adaptation = false;
     tuning(&mut config.tuning);
     let omega = speed_ratio * model.rated_speed_rpm * m.pp * core::f64::consts::TAU / 60.0;
