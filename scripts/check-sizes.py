@@ -34,7 +34,7 @@ KNOWN = {
     "crates/fado-sim/src/bin/fado-sim/main.rs::run_commission": 175,
     "crates/fado-sim/src/commission.rs::commission": 87,
     "crates/fado-sim/src/compare.rs::to_markdown": 102,
-    "crates/fado-sim/src/config.rs": 1120,
+    "crates/fado-sim/src/config.rs": 1125,
     "crates/fado-sim/src/derive.rs::complete_motor": 103,
     "crates/fado-sim/src/inverter.rs": 919,
     "crates/fado-sim/src/inverter.rs::step_switching": 143,
