@@ -259,7 +259,7 @@ impl PyMachine {
     }
 
     /// The constructor's keywords for [`record::install`]: the fields derived from the
-    /// ratings ([`DERIVED`]) default to `None` (derived); a field is optional, with the empty
+    /// ratings (`DERIVED`) default to `None` (derived); a field is optional, with the empty
     /// record's value as its default, when the paper's motor with that value is still valid;
     /// every other field is required.
     pub fn signature(py: Python<'_>) -> PyResult<Vec<(String, Option<Bound<'_, PyAny>>)>> {
