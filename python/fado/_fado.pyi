@@ -32,6 +32,7 @@ __all__ = [
     "simulate",
     "SimResult",
     "scenarios",
+    "estimators",
     "describe_scenario",
     "default_config",
     "compare",
