@@ -27,7 +27,7 @@ KNOWN = {
     "crates/fado-core/src/baselines/ortega.rs::config_errors_name_the_field": 194,
     "crates/fado-core/src/control/gain_calibration.rs": 920,
     "crates/fado-core/src/machine_checks.rs::fmt": 121,
-    "crates/fado-core/src/machine_checks.rs::check": 128,
+    "crates/fado-core/src/machine_checks.rs::check_into": 126,
     "crates/fado-py/src/commission.rs::commission": 84,
     "crates/fado-py/src/inputs.rs::column": 89,
     "crates/fado-sim/src/bin/fado-sim/main.rs::run": 212,

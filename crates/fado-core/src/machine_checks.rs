@@ -445,6 +445,54 @@ impl fmt::Display for Finding {
 /// [`MachineModel::validate`]; a field beyond [`RANGES`] is the only finding then.
 pub fn check(m: &MachineModel<f64>, ts: Option<f64>) -> Findings {
     let mut out = Findings::new();
+    check_into(m, ts, &mut out);
+    out
+}
+
+/// Where [`check_into`] puts its findings: the whole list ([`Findings`]) or only the first
+/// error ([`FirstError`], which `validate` uses so that the firmware never copies the list).
+trait Sink {
+    fn push(&mut self, f: Finding);
+    fn is_empty(&self) -> bool;
+    fn has_error(&self) -> bool;
+}
+
+impl Sink for Findings {
+    fn push(&mut self, f: Finding) {
+        Findings::push(self, f);
+    }
+    fn is_empty(&self) -> bool {
+        Findings::is_empty(self)
+    }
+    fn has_error(&self) -> bool {
+        self.error().is_some()
+    }
+}
+
+/// The first error of a check and whether anything was found.
+#[derive(Default)]
+struct FirstError {
+    first: Option<Finding>,
+    any: bool,
+}
+
+impl Sink for FirstError {
+    fn push(&mut self, f: Finding) {
+        self.any = true;
+        if self.first.is_none() && f.severity() == Severity::Error {
+            self.first = Some(f);
+        }
+    }
+    fn is_empty(&self) -> bool {
+        !self.any
+    }
+    fn has_error(&self) -> bool {
+        self.first.is_some()
+    }
+}
+
+/// The body of [`check`], writing into `out`.
+fn check_into(m: &MachineModel<f64>, ts: Option<f64>, out: &mut impl Sink) {
     let values = [
         m.rs,
         m.ld,
@@ -470,7 +518,7 @@ pub fn check(m: &MachineModel<f64>, ts: Option<f64>) -> Findings {
         usable &= value.is_finite() && value > 0.0;
     }
     if !out.is_empty() || !usable {
-        return out;
+        return;
     }
     let per_unit_emf = m.rated_speed() * m.flux_linkage;
     let v_max = m.dc_voltage / 1.732_050_807_568_877_2;
@@ -531,7 +579,7 @@ pub fn check(m: &MachineModel<f64>, ts: Option<f64>) -> Findings {
     }
     // The DC link against the rated point (only when the machine itself is plausible: a
     // reactance in mH for H makes the rated point's voltage meaningless).
-    if out.error().is_none() {
+    if !out.has_error() {
         let v = ratings::rated_point_voltage(m) / v_max;
         if v < 0.1 {
             out.push(Finding::DcLinkOversized {
@@ -569,12 +617,13 @@ pub fn check(m: &MachineModel<f64>, ts: Option<f64>) -> Findings {
             });
         }
     }
-    out
 }
 
 /// The first error of [`check`] as a [`crate::ConfigError`] (for `validate` methods).
 pub fn validate(m: &MachineModel<f64>, ts: Option<f64>) -> Result<(), crate::ConfigError> {
-    match check(m, ts).error() {
+    let mut first = FirstError::default();
+    check_into(m, ts, &mut first);
+    match first.first {
         Some(e) => Err(e.config_error()),
         None => Ok(()),
     }

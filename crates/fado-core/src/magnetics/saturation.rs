@@ -109,7 +109,7 @@ fn pow_abs<T: Real>(x: T, e: T) -> T {
     let n = e.to_f64();
     if n == 0.0 {
         T::one()
-    } else if n.fract() == 0.0 && (1.0..=16.0).contains(&n) {
+    } else if (1.0..=16.0).contains(&n) && n == f64::from(n as i32) {
         x.abs().powi(n as i32)
     } else {
         x.abs().powf(e)
