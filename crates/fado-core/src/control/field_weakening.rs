@@ -134,14 +134,19 @@ impl<T: Real> FieldWeakening<T> {
         self.delta_id
     }
 
-    /// One sample of the loop with the current controller's reference `v_ref_norm` = |v*|
-    /// (V), the measured bus `vdc` (V) and the speed `omega` (rad/s, electrical).
+    /// One sample of the loop with the current controller's reference `v_ref_squared` = |v*|²
+    /// (V²), the measured bus `vdc` (V) and the speed `omega` (rad/s, electrical). Below the
+    /// weakening speed the squares are compared, so the idle loop takes no square root.
     #[inline]
-    pub fn update(&mut self, v_ref_norm: T, vdc: T, omega: T) {
-        if !(self.enabled && v_ref_norm.is_finite() && vdc.is_finite() && omega.is_finite()) {
+    pub fn update(&mut self, v_ref_squared: T, vdc: T, omega: T) {
+        if !(self.enabled && v_ref_squared.is_finite() && vdc.is_finite() && omega.is_finite()) {
             return;
         }
-        let error = self.margin * vdc - v_ref_norm;
+        let limit = self.margin * vdc;
+        if self.delta_id == T::zero() && limit >= T::zero() && v_ref_squared <= limit * limit {
+            return; // below the weakening speed: nothing to integrate
+        }
+        let error = limit - v_ref_squared.step_sqrt();
         if error >= T::zero() && self.delta_id == T::zero() {
             return; // below the weakening speed: nothing to integrate
         }
@@ -187,7 +192,7 @@ mod tests {
     fn idle_below_the_voltage_limit() {
         let (mut f, m) = fw();
         for _ in 0..1000 {
-            f.update(100.0, m.dc_voltage, 300.0);
+            f.update(100.0 * 100.0, m.dc_voltage, 300.0);
         }
         assert_eq!(f.delta_id(), 0.0);
         assert_eq!(f.iq_limit(0.0, m.dc_voltage, 300.0), f64::INFINITY);
@@ -204,7 +209,7 @@ mod tests {
         let mut v = 0.0;
         for _ in 0..5000 {
             v = w * (m.flux_linkage + m.ld * f.delta_id()).abs();
-            f.update(v, vdc, w);
+            f.update(v * v, vdc, w);
         }
         assert!((v - target).abs() < 1e-3 * target, "{v} vs {target}");
         let expected = (target / w - m.flux_linkage) / m.ld;
@@ -213,7 +218,7 @@ mod tests {
         let (mut g, _) = fw();
         for _ in 0..212 {
             let v = w * (m.flux_linkage + m.ld * g.delta_id()).abs();
-            g.update(v, vdc, w);
+            g.update(v * v, vdc, w);
         }
         assert!(
             (g.delta_id() - expected).abs() < 0.03 * expected.abs(),
@@ -228,7 +233,7 @@ mod tests {
         let vdc = m.dc_voltage;
         let w = 20.0 * vdc / m.flux_linkage; // far beyond what the voltage allows
         for _ in 0..20_000 {
-            f.update(2.0 * vdc, vdc, w);
+            f.update(4.0 * vdc * vdc, vdc, w);
         }
         // Stops at the characteristic current λf/Ld = 33.5 A (below the 40 A limit).
         let ich = m.flux_linkage / m.ld;

@@ -131,7 +131,8 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         let Ok(v_dq) = b.current.step(i_dq_ref, i_dq, omega_ctrl) else {
             return Err(self.reject_after_estimate(backup, estimate, i_dq));
         };
-        b.field_weakening.update(v_dq.norm(), vdc, omega_ctrl);
+        b.field_weakening
+            .update(v_dq.d * v_dq.d + v_dq.q * v_dq.q, vdc, omega_ctrl);
         // 6. Delay compensation with the advanced angle.
         //    (reusing the Park rotation: one sin/cos per sample instead of two).
         let (v_ab, rot) = b
