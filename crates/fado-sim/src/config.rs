@@ -542,8 +542,13 @@ impl SimConfig {
 
     /// This configuration as a TOML document.
     pub fn to_toml(&self) -> String {
-        let mut table = toml::Table::try_from(self).expect("SimConfig is a TOML table");
         let (sat, map) = (self.motor_saturation.as_ref(), self.motor_flux_map.as_ref());
+        if sat.is_none() && map.is_none() {
+            // Straight from the record: its field order (a TOML table would sort the keys).
+            return toml::to_string(self)
+                .expect("every field of SimConfig is representable in TOML");
+        }
+        let mut table = toml::Table::try_from(self).expect("SimConfig is a TOML table");
         magnetics_file::insert_magnetics(&mut table, sat, map);
         toml::to_string(&table).expect("every field of SimConfig is representable in TOML")
     }

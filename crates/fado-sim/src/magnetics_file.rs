@@ -58,8 +58,9 @@ pub fn resolve(written: &str) -> PathBuf {
 /// A flux map named by a configuration: the file it came from and its data.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FluxMapFile {
-    /// The file, resolved (what `--dump-config` writes back).
-    pub path: PathBuf,
+    /// The file, resolved (what `--dump-config` writes back); None for a map given as data
+    /// (Python's `flux_map=(i_d, i_q, psi_d, psi_q)`), which a dump names but cannot hold.
+    pub path: Option<PathBuf>,
     /// The checked map, shared by every plant built from the configuration.
     pub data: Arc<FluxMapData>,
 }
@@ -70,9 +71,33 @@ impl FluxMapFile {
         let path = resolve(written);
         let data = read_flux_map(&path)?;
         Ok(Self {
-            path,
+            path: Some(path),
             data: Arc::new(data),
         })
+    }
+
+    /// A map given as data, not read from a file.
+    pub fn in_memory(data: FluxMapData) -> Self {
+        Self {
+            path: None,
+            data: Arc::new(data),
+        }
+    }
+
+    /// The `flux_map` value a dump writes: the resolved path, or for a map held in memory a
+    /// description that reading it back refuses as a missing file.
+    pub fn written(&self) -> String {
+        match &self.path {
+            Some(p) => p.display().to_string(),
+            None => {
+                let m = self.data.map();
+                format!(
+                    "({}x{} map given as arrays: write it with fado_sim::magnetics_file::flux_map_csv)",
+                    m.i_d().len(),
+                    m.i_q().len()
+                )
+            }
+        }
     }
 }
 
@@ -144,8 +169,7 @@ pub fn insert_magnetics(
         return;
     };
     if let Some(m) = flux_map {
-        let path = m.path.display().to_string();
-        motor.insert("flux_map".into(), toml::Value::String(path));
+        motor.insert("flux_map".into(), toml::Value::String(m.written()));
     }
     if let Some(s) = saturation {
         let sat = toml::Table::try_from(s).expect("Saturation is a TOML table");
@@ -278,13 +302,16 @@ fn axis(rows: &[Row], k: usize) -> Vec<f64> {
     a
 }
 
+/// ψd and ψq on the grid (row-major) and the line each node came from.
+type Placed = (Vec<f64>, Vec<f64>, Vec<usize>);
+
 /// The rows placed on the grid `i_d` × `i_q`: ψd, ψq and the line of each node (row-major).
 fn place_rows(
     rows: &[Row],
     (i_d, i_q): (&[f64], &[f64]),
     file: &str,
     header_line: usize,
-) -> Result<(Vec<f64>, Vec<f64>, Vec<usize>), SimConfigError> {
+) -> Result<Placed, SimConfigError> {
     let (nd, nq) = (i_d.len(), i_q.len());
     let mut psi_d = vec![f64::NAN; nd * nq];
     let mut psi_q = vec![f64::NAN; nd * nq];
@@ -324,13 +351,29 @@ pub fn parse_flux_map(text: &str, file: &str) -> Result<FluxMapData, SimConfigEr
     let lines = Lines::new(text);
     let header_line = read_header(&mut reader, &lines, file)?;
     let rows = read_rows(&mut reader, &lines, file)?;
-    let (i_d, i_q) = (axis(&rows, 0), axis(&rows, 1));
+    flux_map_from_rows(&rows, file, header_line)
+}
+
+/// A flux map from its nodes, one row (i_d, i_q, ψd, ψq) each in any order, with the line
+/// (or row number) each came from: the refusals of [`parse_flux_map`] after the parsing.
+/// `file` names the source and `header_line` the line of errors about the whole grid.
+pub fn flux_map_from_rows(
+    rows: &[([f64; 4], usize)],
+    file: &str,
+    header_line: usize,
+) -> Result<FluxMapData, SimConfigError> {
+    if let Some((v, line)) = rows.iter().find(|r| r.0.iter().any(|x| !x.is_finite())) {
+        let k = v.iter().position(|x| !x.is_finite()).unwrap_or(0);
+        let msg = format!("`{}` = {} is not finite", HEADER[k], v[k]);
+        return Err(map_error(file, *line, msg));
+    }
+    let (i_d, i_q) = (axis(rows, 0), axis(rows, 1));
     let (nq, shape) = (i_q.len(), i_d.len().min(i_q.len()));
     if shape < 2 {
         let msg = "the grid needs at least two values of i_d and of i_q";
         return Err(map_error(file, header_line, msg));
     }
-    let (psi_d, psi_q, line_of) = place_rows(&rows, (&i_d, &i_q), file, header_line)?;
+    let (psi_d, psi_q, line_of) = place_rows(rows, (&i_d, &i_q), file, header_line)?;
     FluxMapData::new(i_d, i_q, psi_d, psi_q).map_err(|e| {
         let line = match e {
             FluxMapError::NotMonotonic { k, m, .. } | FluxMapError::NotFinite { k, m, .. } => {

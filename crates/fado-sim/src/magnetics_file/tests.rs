@@ -92,7 +92,7 @@ fn a_configuration_names_its_map_relative_to_its_own_directory() {
     set_config_dir(None);
     let cfg = cfg.unwrap();
     let map = cfg.motor_flux_map.as_ref().unwrap();
-    assert_eq!(map.path, dir.join("map.csv"));
+    assert_eq!(map.path, Some(dir.join("map.csv")));
     assert_eq!(*map.data, tabulated());
     assert!(matches!(
         cfg.plant().magnetics.as_deref(),
