@@ -63,6 +63,14 @@ impl<T: Real> Blocks<T> {
             ..SpeedControllerConfig::new(m, t.current_limit_ratio * m.rated_current, t.mtpa, ts)
         };
         let dc_link = DcLinkLimit::new(&t.dc_link, m, speed_config.i_max, r.i_max, ts)?;
+        if t.field_weakening.voltage_margin > T::one()
+            && t.voltage_limit != crate::control::modulation::VoltageLimit::Overmodulation
+        {
+            return Err(ConfigError::OutOfRange {
+                field: "field_weakening.voltage_margin",
+                expected: "at most 1 unless voltage_limit = \"overmodulation\"",
+            });
+        }
         let field_weakening = FieldWeakening::new(&t.field_weakening, m, r.i_max, ts)?;
         let speed = SpeedController::new(speed_config).map_err(rename(&[
             ("bandwidth_hz", "speed_bandwidth_hz"),
