@@ -6,8 +6,8 @@
 //! `static` built by a `const fn` (rustc evaluates it; it lands in `.rodata`, in flash): what a
 //! firmware does with a map measured or computed off line.
 
-use fado_core::magnetics::{FluxMap, FluxTable, MagneticModel};
 use fado_core::Dq;
+use fado_core::magnetics::{FluxMap, FluxTable, MagneticModel};
 
 /// Nodes per axis.
 pub const N: usize = 16;
