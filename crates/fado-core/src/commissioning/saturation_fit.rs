@@ -104,7 +104,7 @@ impl<T: Real> SaturationFit<T> {
         // Scale to a unit diagonal.
         let mut scale = [T::zero(); N];
         for j in 0..N {
-            if !(a[j][j] > T::zero()) {
+            if !a[j][j].is_finite() || a[j][j] <= T::zero() {
                 return None;
             }
             scale[j] = T::one() / a[j][j].sqrt();
@@ -139,16 +139,17 @@ fn solve_in_place<T: Real>(a: &mut [[T; N]; N], b: &mut [T; N]) -> Option<[T; N]
                 pivot = r;
             }
         }
-        if !(a[pivot][col].abs() > tiny) {
+        let p = a[pivot][col].abs();
+        if !p.is_finite() || p <= tiny {
             return None;
         }
         a.swap(col, pivot);
         b.swap(col, pivot);
         for r in col + 1..N {
             let f = a[r][col] / a[col][col];
-            for k in col..N {
-                let v = a[col][k];
-                a[r][k] -= f * v;
+            let (upper, lower) = a.split_at_mut(r);
+            for (x, v) in lower[0][col..].iter_mut().zip(&upper[col][col..]) {
+                *x -= f * *v;
             }
             let v = b[col];
             b[r] -= f * v;
@@ -171,21 +172,11 @@ mod tests {
     use crate::Dq;
     use crate::magnetics::MagneticModel;
 
-    /// motulator's 6.7 kW SyRM fit (Hinkkanen et al. 2017's machine) with a magnet's flux
-    /// added, and the PM-SyRM preset's exponents.
+    /// motulator's 6.7 kW SyRM fit (Hinkkanen et al. 2017's machine) with a magnet's flux.
     fn truth() -> Saturation<f64> {
         Saturation {
-            a_d0: 17.4,
-            a_dd: 373.0,
-            s: 5.0,
-            a_q0: 52.1,
-            a_qq: 658.0,
-            t: 1.0,
-            a_dq: 1120.0,
-            u: 1.0,
-            v: 0.0,
             psi_f: 0.1,
-            ..Saturation::default()
+            ..crate::magnetics::tests::syrm()
         }
     }
 
@@ -197,7 +188,7 @@ mod tests {
                 let psi = model.flux(Dq::new(id, iq));
                 // A deterministic ±noise on the flux (the integration's error).
                 k += 1;
-                let e = noise * if k % 2 == 0 { 1.0 } else { -1.0 };
+                let e = noise * if k.is_multiple_of(2) { 1.0 } else { -1.0 };
                 fit.push(psi.d * (1.0 + e), psi.q * (1.0 - e), id, iq);
             }
         }

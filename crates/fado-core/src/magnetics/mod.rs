@@ -230,4 +230,4 @@ impl<T: Real> MagneticModel<T> for Magnetics<'_, T> {
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;
