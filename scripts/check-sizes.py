@@ -25,7 +25,6 @@ KNOWN = {
     "crates/fado-core/src/baselines/emf_observer.rs::config_errors_name_the_field": 133,
     "crates/fado-core/src/baselines/lpf_integrator.rs::config_errors_name_the_field": 142,
     "crates/fado-core/src/baselines/ortega.rs::config_errors_name_the_field": 194,
-    "crates/fado-core/src/control/gain_calibration.rs": 920,
     "crates/fado-core/src/machine_checks.rs::fmt": 121,
     "crates/fado-core/src/machine_checks.rs::check_into": 126,
     "crates/fado-py/src/commission.rs::commission": 84,

@@ -28,6 +28,7 @@
 mod blocks;
 mod calibration;
 mod config;
+mod hold;
 mod lifecycle;
 mod lock;
 mod output;
@@ -51,6 +52,7 @@ use crate::control::gain_calibration::GainCalibration;
 use crate::control::lock_reaction::LockSupervisor;
 use crate::control::modulation::SpaceVectorModulator;
 use crate::control::monitor::{DriveFlags, FlagCounts, PersistenceMonitor, StuckChannelDetector};
+use crate::control::release_hold::ReleaseHold;
 use crate::control::speed_controller::SpeedController;
 use crate::control::standstill_probe::StandstillProbe;
 use crate::estimator::{Estimate, SensorlessEstimator};
@@ -135,6 +137,8 @@ struct Blocks<T> {
     modulator: SpaceVectorModulator<T>,
     dc_link: DcLinkLimit<T>,
     field_weakening: FieldWeakening<T>,
+    /// The release hold after the start-up.
+    hold: ReleaseHold<T>,
 }
 
 /// What the modulator applies at a sample: the duties, and the voltage that acts (α-β and in

@@ -298,9 +298,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         let i_dq_ref = if action == LockAction::Coast {
             Dq::zero()
         } else {
-            let Ok(iq_torque) = self.blocks.speed.step(speed_ref, estimate.omega_control) else {
-                return None;
-            };
+            let iq_torque = self.speed_or_hold(speed_ref, estimate)?;
             // The DC link's power limits and over-voltage controller (see `dc_link_limit`).
             let (iq_torque, brake_id) = self.blocks.dc_link.limit(
                 iq_torque,
