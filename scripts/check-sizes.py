@@ -38,8 +38,6 @@ KNOWN = {
     "crates/fado-sim/src/inverter.rs": 919,
     "crates/fado-sim/src/inverter.rs::step_switching": 143,
     "crates/fado-sim/src/magnetics.rs::parse_flux_map": 124,
-    "crates/fado-sim/src/scenario.rs": 1494,
-    "crates/fado-sim/src/sim.rs": 1299,
     "crates/fado-sim/src/sweep/point.rs::run_point_until": 87,
     "crates/fado-sim/src/sweep/runner.rs::run": 93,
 }

@@ -121,8 +121,8 @@ use crate::error::{ConfigError, check};
 use crate::{Ab, Real};
 use measure::{PHASE_B_ALPHA, PHASE_B_BETA};
 
-/// Configuration of a [`GainCalibration`], in absolute units (the drive derives it from its
-/// [`DriveTuning`](super::DriveTuning) ratios and its machine model).
+/// Configuration of a [`GainCalibration`], in absolute units (its user derives it from its
+/// own ratios and its machine model; defaults `DEFAULT_*`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GainCalibrationConfig<T> {
     /// Sampling period in s.
@@ -159,6 +159,11 @@ pub struct GainCalibrationConfig<T> {
     /// test.
     pub motion_voltage: T,
 }
+
+/// Default `min_observability` \[A\]: the error grows as 1/share (module docs); 38 % skipped.
+pub const DEFAULT_MIN_OBSERVABILITY: f64 = 0.2;
+/// Default `max_mismatch` \[A\]: two sensors of ±2.5 % gain tolerance.
+pub const DEFAULT_MAX_MISMATCH: f64 = 0.05;
 
 /// Where the calibration stands.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

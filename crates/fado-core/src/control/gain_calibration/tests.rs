@@ -1,3 +1,5 @@
+//! Tests of [`super`]: the calibration on standstill RL machines.
+
 use super::*;
 
 const TS: f64 = 1e-4;
@@ -11,8 +13,8 @@ fn config(current: f64, r: f64, l: f64) -> GainCalibrationConfig<f64> {
         hold_time: 5.0 * l / r,
         max_hold_time: 0.2,
         window_time: 0.05,
-        min_observability: 0.2,
-        max_mismatch: 0.05,
+        min_observability: DEFAULT_MIN_OBSERVABILITY,
+        max_mismatch: DEFAULT_MAX_MISMATCH,
         current_limit: 2.5 * current,
         lq_hat: 1e-3,
         motion_voltage: f64::INFINITY,
