@@ -29,9 +29,13 @@
 //! Armed at every (re)alignment with θ_hold = the aligned angle; it acts only once the angle
 //! estimate has left θ_hold by [`ReleaseHoldTuning::trigger`] while the speed reference is
 //! zero, within [`ReleaseHoldTuning::window`] of the arming. An unloaded start never
-//! triggers it and runs exactly as without it. A non-zero speed reference ends it: the speed
-//! loop's integral is then preset to the hold's torque (the pre-torque) so that the load is
-//! not dropped at the hand-over.
+//! triggers it and runs exactly as without it. It ends after 10/ω_h (the load caught and
+//! settled) or at a non-zero speed reference: the speed loop's integral is then preset to
+//! the hold's integral (the pre-torque: the load it found) so that the load is not dropped at
+//! the hand-over, and the drive's loaded-standstill handling (the speed loop, the
+//! [`standstill_probe`](crate::control::standstill_probe)) holds it from there: the hold's
+//! own reference, the estimated angle, drifts at a loaded standstill like every estimate
+//! there.
 
 use crate::error::{ConfigError, check};
 use crate::{MachineModel, Real};
@@ -91,6 +95,10 @@ impl<T: Real> ReleaseHoldTuning<T> {
 /// Peak of t²·e^(−t)/2 (at t = 2): the largest travel of the triple-pole loop per a/ω_h².
 const PEAK_TRAVEL: f64 = 0.270_670_566_473_225_4;
 
+/// Time the hold acts, in units of 1/ω_h: the triple pole's response to a load step has
+/// decayed to e^(−10)·(1 + 10 + 50) = 0.3 % by then, and its integral holds the load.
+const SETTLE_TIMES: f64 = 10.0;
+
 /// What the hold does at a sample.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum HoldAction<T> {
@@ -109,6 +117,9 @@ pub struct ReleaseHold<T> {
     ts: T,
     trigger: T,
     window_samples: u32,
+    /// Samples the hold acts before it hands over: [`SETTLE_TIMES`]/ω_h.
+    hold_samples: u32,
+    held: u32,
     /// 3·ω_h²/b, 3·ω_h/b, ω_h³·Ts/b.
     kp: T,
     kd: T,
@@ -164,6 +175,8 @@ impl<T: Real> ReleaseHold<T> {
             ts,
             trigger,
             window_samples: n.round().to_f64() as u32,
+            hold_samples: (T::lit(SETTLE_TIMES) / (omega * ts)).round().to_f64() as u32,
+            held: 0,
             kp,
             kd,
             ki_ts,
@@ -186,6 +199,7 @@ impl<T: Real> ReleaseHold<T> {
         self.armed = self.enabled && theta_hold.is_finite();
         self.active = false;
         self.elapsed = 0;
+        self.held = 0;
         self.theta_hold = theta_hold;
         self.integral = T::zero();
         self.output = T::zero();
@@ -233,7 +247,8 @@ impl<T: Real> ReleaseHold<T> {
             self.omega += self.omega_gain * (rate - self.omega);
         }
         let omega = self.omega;
-        if speed_ref != T::zero() || !e.is_finite() || !omega.is_finite() {
+        let settled = self.active && self.held >= self.hold_samples;
+        if speed_ref != T::zero() || settled || !e.is_finite() || !omega.is_finite() {
             let was = self.active;
             self.disarm();
             return if was {
@@ -256,6 +271,7 @@ impl<T: Real> ReleaseHold<T> {
             self.active = true;
             self.engaged = self.engaged.saturating_add(1);
         }
+        self.held = self.held.saturating_add(1);
         let lim = self.i_max;
         self.integral = crate::control::pi::clamp(self.integral + self.ki_ts * e, -lim, lim);
         let out = self.kp * e - self.kd * omega + self.integral;
