@@ -265,7 +265,8 @@ impl<T: Real> ReleaseHold<T> {
             }
             let moved = crate::wrap_angle(self.theta_hold - theta_tracked);
             // NaN compares false: a non-finite tracked angle does not trigger.
-            if !(moved.abs() > self.trigger) {
+            let triggered = moved.abs() > self.trigger;
+            if !triggered {
                 return HoldAction::Idle;
             }
             self.active = true;
