@@ -4,6 +4,7 @@
 use super::*;
 use crate::magnetics::{MagneticModel, Saturation};
 use crate::{Dq, Rotation};
+use std::format;
 
 const TS: f64 = 1e-4;
 
@@ -101,49 +102,42 @@ fn a_linear_salient_rotor_gives_its_axis_and_says_the_polarity_is_unknown() {
     }
 }
 
-#[test]
-fn a_saturating_salient_rotor_gives_its_angle_with_half_and_double_the_saturation() {
-    // κ = 0.01 is an assumption (no published d-axis curve for this machine): the detection
-    // holds from half to double of it; the margins (a₁/m, a₂/m) against (0.01, 0.02) are
-    // printed.
+/// The detection finds `(ld, lq, λf, Rs)` at every test angle within `tol` (rad) at half, the
+/// assumed (κ = 0.01) and double saturation, pulses of `voltage` for `n` samples; prints the
+/// margins (a₁/m, a₂/m) against the thresholds (0.01, 0.02).
+fn found_at_every_saturation(
+    name: &str,
+    (ld, lq, lf, r): (f64, f64, f64, f64),
+    voltage: f64,
+    n: u32,
+    tol: f64,
+) {
     for kappa in [0.005, 0.01, 0.02] {
-        let m = machine(0.036, 0.051, 0.545, kappa);
+        let m = machine(ld, lq, lf, kappa);
         for theta in ANGLES {
-            let (det, _) = detect(&m, 3.6, theta, 260.0, 10, false);
-            assert_eq!(
-                det.status(),
-                InitialAngleStatus::Found,
-                "κ {kappa} θ {theta}"
-            );
+            let (det, _) = detect(&m, r, theta, voltage, n, false);
+            let label = format!("{name} κ {kappa} θ {theta}");
+            assert_eq!(det.status(), InitialAngleStatus::Found, "{label}");
             let e = angle_error(det.angle(), theta);
-            assert!(e < 0.05, "κ {kappa} θ {theta}: {} ({e})", det.angle());
+            assert!(e < tol, "{label}: {} ({e})", det.angle());
             if theta == 0.0 {
-                std::println!("IPMSM κ {kappa}: a1/m, a2/m = {:?}", det.harmonics());
+                std::println!("{name} κ {kappa}: a1/m, a2/m = {:?}", det.harmonics());
             }
         }
     }
 }
 
 #[test]
+fn a_saturating_salient_rotor_gives_its_angle_with_half_and_double_the_saturation() {
+    // κ = 0.01 is an assumption (no published d-axis curve for this machine).
+    found_at_every_saturation("IPMSM", (0.036, 0.051, 0.545, 3.6), 260.0, 10, 0.05);
+}
+
+#[test]
 fn a_surface_magnet_rotor_is_found_through_its_saturation_alone() {
     // The paper's motor (L 2.63 mH, Rs 0.327 Ω, λf 0.088 Wb): no saliency but the
     // saturation's; 115 V for 0.5 ms reaches ≈ 22 A, its rated current.
-    for kappa in [0.005, 0.01, 0.02] {
-        let m = machine(2.63e-3, 2.63e-3, 0.088, kappa);
-        for theta in ANGLES {
-            let (det, _) = detect(&m, 0.327, theta, 115.0, 5, false);
-            assert_eq!(
-                det.status(),
-                InitialAngleStatus::Found,
-                "κ {kappa} θ {theta}"
-            );
-            let e = angle_error(det.angle(), theta);
-            assert!(e < 0.1, "κ {kappa} θ {theta}: {} ({e})", det.angle());
-            if theta == 0.0 {
-                std::println!("SPM κ {kappa}: a1/m, a2/m = {:?}", det.harmonics());
-            }
-        }
-    }
+    found_at_every_saturation("SPM", (2.63e-3, 2.63e-3, 0.088, 0.327), 115.0, 5, 0.1);
 }
 
 #[test]
