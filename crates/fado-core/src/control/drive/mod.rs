@@ -168,7 +168,7 @@ struct Applied<T> {
 /// assert!(out.gates_enabled && (0.0..=1.0).contains(&out.duty.a));
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SensorlessDrive<T, E = SensorlessEstimator<T>> {
+pub struct SensorlessDrive<T: 'static, E = SensorlessEstimator<T>> {
     config: DriveConfig<T>,
     /// The config's limits and sample counts in absolute units.
     resolved: Resolved<T>,
