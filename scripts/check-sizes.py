@@ -35,7 +35,6 @@ KNOWN = {
     "crates/fado-sim/src/compare.rs::to_markdown": 102,
     "crates/fado-sim/src/config.rs": 1125,
     "crates/fado-sim/src/derive.rs::complete_motor": 103,
-    "crates/fado-sim/src/magnetics.rs::parse_flux_map": 124,
     "crates/fado-sim/src/sweep/point.rs::run_point_until": 87,
     "crates/fado-sim/src/sweep/runner.rs::run": 93,
 }
