@@ -9,6 +9,7 @@ use crate::control::delay_compensation::{DelayCompensation, DelayCompensationCon
 use crate::control::field_weakening::FieldWeakening;
 use crate::control::lock_reaction::LockSupervisor;
 use crate::control::modulation::{ModulatorConfig, SpaceVectorModulator};
+use crate::control::ratings_limit::RatingsLimit;
 use crate::control::speed_controller::{SpeedController, SpeedControllerConfig};
 use crate::control::standstill_probe::{StandstillProbe, StandstillProbeConfig};
 use crate::error::{ConfigError, check};
@@ -98,6 +99,7 @@ impl<T: Real> Blocks<T> {
             max_modulation: t.max_modulation,
         })?;
         let probe = StandstillProbe::new(probe_config(c)?)?;
+        let limits = RatingsLimit::new(&t.limits, m)?;
         Ok(Self {
             speed,
             injection,
@@ -108,6 +110,7 @@ impl<T: Real> Blocks<T> {
             probe,
             dc_link,
             field_weakening,
+            limits,
         })
     }
 
