@@ -34,7 +34,7 @@ KNOWN = {
     "crates/fado-sim/src/commission.rs::commission": 87,
     "crates/fado-sim/src/compare.rs::to_markdown": 102,
     "crates/fado-sim/src/config.rs": 1125,
-    "crates/fado-sim/src/derive.rs::complete_motor": 103,
+    "crates/fado-sim/src/derive.rs::complete_motor": 104,
     "crates/fado-sim/src/sweep/point.rs::run_point_until": 87,
     "crates/fado-sim/src/sweep/runner.rs::run": 93,
 }
