@@ -25,7 +25,6 @@ KNOWN = {
     "crates/fado-core/src/baselines/emf_observer.rs::config_errors_name_the_field": 133,
     "crates/fado-core/src/baselines/lpf_integrator.rs::config_errors_name_the_field": 142,
     "crates/fado-core/src/baselines/ortega.rs::config_errors_name_the_field": 194,
-    "crates/fado-core/src/control/gain_calibration.rs": 920,
     "crates/fado-core/src/machine_checks.rs::fmt": 121,
     "crates/fado-core/src/machine_checks.rs::check_into": 126,
     "crates/fado-py/src/commission.rs::commission": 84,
@@ -33,8 +32,7 @@ KNOWN = {
     "crates/fado-sim/src/commission.rs::commission": 87,
     "crates/fado-sim/src/compare.rs::to_markdown": 102,
     "crates/fado-sim/src/config.rs": 1125,
-    "crates/fado-sim/src/derive.rs::complete_motor": 103,
-    "crates/fado-sim/src/magnetics.rs::parse_flux_map": 124,
+    "crates/fado-sim/src/derive.rs::complete_motor": 104,
     "crates/fado-sim/src/sweep/point.rs::run_point_until": 87,
     "crates/fado-sim/src/sweep/runner.rs::run": 93,
 }

@@ -16,6 +16,7 @@ pub mod lock_reaction;
 pub mod modulation;
 pub mod monitor;
 pub mod pi;
+pub mod ratings_limit;
 pub mod speed_controller;
 pub mod standstill_probe;
 
@@ -32,5 +33,6 @@ pub use lock_reaction::{LockAction, LockReaction, LockSupervisor};
 pub use modulation::{Modulation, ModulatorConfig, SpaceVectorModulator, VoltageLimit, svpwm_duty};
 pub use monitor::{DriveFlags, FlagCounts};
 pub use pi::{Pi, PiConfig};
+pub use ratings_limit::{RatingsLimit, RatingsLimitTuning};
 pub use speed_controller::{SpeedController, SpeedControllerConfig, limit_current_d_priority};
 pub use standstill_probe::{StandstillProbe, StandstillProbeConfig};

@@ -22,6 +22,8 @@ pub fn warn_plausibility(cfg: &fado_sim::SimConfig, config: Option<&Path>) {
 /// reading more of it (`--config /dev/zero` stops after 1 MiB, not at the end of memory).
 pub fn read_file(path: &Path) -> Result<String, Box<dyn std::error::Error>> {
     use std::io::Read;
+    // Paths in the file (`[motor] flux_map`) are relative to it.
+    fado_sim::magnetics_file::set_config_dir(path.parent());
     let file = std::fs::File::open(path).map_err(|e| OutputError::new("read", path, e))?;
     let limit = scenario::MAX_CONFIG_BYTES as u64;
     let mut bytes = Vec::new();
