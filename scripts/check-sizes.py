@@ -29,8 +29,6 @@ KNOWN = {
     "crates/fado-core/src/machine_checks.rs::check_into": 126,
     "crates/fado-py/src/commission.rs::commission": 84,
     "crates/fado-py/src/inputs.rs::column": 89,
-    "crates/fado-sim/src/bin/fado-sim/main.rs::run": 212,
-    "crates/fado-sim/src/bin/fado-sim/main.rs::run_commission": 175,
     "crates/fado-sim/src/commission.rs::commission": 87,
     "crates/fado-sim/src/compare.rs::to_markdown": 102,
     "crates/fado-sim/src/config.rs": 1125,
