@@ -52,6 +52,7 @@ use crate::control::gain_calibration::GainCalibration;
 use crate::control::lock_reaction::LockSupervisor;
 use crate::control::modulation::SpaceVectorModulator;
 use crate::control::monitor::{DriveFlags, FlagCounts, PersistenceMonitor, StuckChannelDetector};
+use crate::control::ratings_limit::RatingsLimit;
 use crate::control::release_hold::ReleaseHold;
 use crate::control::speed_controller::SpeedController;
 use crate::control::standstill_probe::StandstillProbe;
@@ -139,6 +140,7 @@ struct Blocks<T> {
     field_weakening: FieldWeakening<T>,
     /// The release hold after the start-up.
     hold: ReleaseHold<T>,
+    limits: RatingsLimit<T>,
 }
 
 /// What the modulator applies at a sample: the duties, and the voltage that acts (α-β and in
@@ -172,7 +174,7 @@ struct Applied<T> {
 /// assert!(out.gates_enabled && (0.0..=1.0).contains(&out.duty.a));
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SensorlessDrive<T, E = SensorlessEstimator<T>> {
+pub struct SensorlessDrive<T: 'static, E = SensorlessEstimator<T>> {
     config: DriveConfig<T>,
     /// The config's limits and sample counts in absolute units.
     resolved: Resolved<T>,
