@@ -25,7 +25,6 @@ KNOWN = {
     "crates/fado-core/src/baselines/emf_observer.rs::config_errors_name_the_field": 133,
     "crates/fado-core/src/baselines/lpf_integrator.rs::config_errors_name_the_field": 142,
     "crates/fado-core/src/baselines/ortega.rs::config_errors_name_the_field": 194,
-    "crates/fado-core/src/control/gain_calibration.rs": 920,
     "crates/fado-core/src/machine_checks.rs::fmt": 121,
     "crates/fado-core/src/machine_checks.rs::check_into": 126,
     "crates/fado-py/src/commission.rs::commission": 84,
@@ -39,8 +38,6 @@ KNOWN = {
     "crates/fado-sim/src/inverter.rs": 919,
     "crates/fado-sim/src/inverter.rs::step_switching": 143,
     "crates/fado-sim/src/magnetics.rs::parse_flux_map": 124,
-    "crates/fado-sim/src/scenario.rs": 1494,
-    "crates/fado-sim/src/sim.rs": 1299,
     "crates/fado-sim/src/sweep/point.rs::run_point_until": 87,
     "crates/fado-sim/src/sweep/runner.rs::run": 93,
 }

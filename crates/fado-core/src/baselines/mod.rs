@@ -127,7 +127,7 @@ pub struct CommonTuning<T> {
     pub average_current: bool,
     /// Samples with |i| above this × the machine's `rated_current` are refused (see
     /// [`crate::plausibility`]). Default 4, as fado's
-    /// ([`crate::EstimatorTuning::plausible_current_ratio`]).
+    /// ([`crate::plausibility::CURRENT_RATIO`]).
     pub plausible_current_ratio: T,
     /// Samples with |v| above this × the machine's `dc_voltage` are refused. Default 1.5, as
     /// fado's.

@@ -5,8 +5,6 @@ use super::{EstimatorParams, EstimatorTuning, LOCK_PERIOD, SLOW_PERIOD};
 use crate::error::ConfigError;
 use crate::lock::LockDetectorConfig;
 use crate::plausibility::SampleBounds;
-use crate::rs_adaptation::ResistanceAdaptationConfig;
-use crate::tracker::TrackerConfig;
 use crate::{MachineModel, Real};
 
 /// Everything the estimator needs: the sampling period, the machine model (R̂s, L̂d, L̂q, λ̂f
@@ -58,10 +56,6 @@ impl<T: Real> EstimatorConfig<T> {
         self.ts * T::lit(SLOW_PERIOD as f64)
     }
 
-    pub(super) fn rs_adaptation_config(&self) -> ResistanceAdaptationConfig<T> {
-        ResistanceAdaptationConfig::with_tuning(&self.machine, &self.tuning, self.slow_ts())
-    }
-
     pub(super) fn lock_detector(&self) -> LockDetectorConfig<T> {
         LockDetectorConfig {
             ts: self.ts * T::lit(LOCK_PERIOD as f64),
@@ -96,9 +90,5 @@ impl<T: Real> EstimatorConfig<T> {
             self.machine.lq,
             self.ts,
         )
-    }
-
-    pub(super) fn tracker(&self, bandwidth_hz: T) -> TrackerConfig<T> {
-        TrackerConfig::with_tuning(&self.tuning, bandwidth_hz, self.ts)
     }
 }

@@ -39,6 +39,7 @@
 //! [`SensorlessEstimator`] owns one of each and steps them with the same code, bit for bit
 //! (`tests/estimator_split.rs`).
 
+mod blocks;
 mod config;
 mod output;
 mod owner;
