@@ -65,14 +65,15 @@ fn models() -> [(&'static str, Magnetics<'static, f64>, f64); 4] {
 /// (eq. (6) needs λa > 0: a strongly salient rotor's positive i_d cancels it).
 fn points(rated: f64, model: Magnetics<'static, f64>) -> impl Iterator<Item = Dq<f64>> {
     let af = ActiveFlux::new(model, rated).unwrap();
-    (0..=8).flat_map(move |k| {
-        let r = rated * (0.05 + 0.95 * k as f64 / 8.0);
-        [-2.6, -1.9, -1.2, -0.3, 0.0, 0.4, 1.2, 1.9].map(|b: f64| {
-            let beta = b + core::f64::consts::FRAC_PI_2;
-            Dq::new(r * beta.cos(), r * beta.sin())
+    (0..=8)
+        .flat_map(move |k| {
+            let r = rated * (0.05 + 0.95 * k as f64 / 8.0);
+            [-2.6, -1.9, -1.2, -0.3, 0.0, 0.4, 1.2, 1.9].map(|b: f64| {
+                let beta = b + core::f64::consts::FRAC_PI_2;
+                Dq::new(r * beta.cos(), r * beta.sin())
+            })
         })
-    })
-    .filter(move |&i| af.point(i).active > 0.25 * af.magnet_flux())
+        .filter(move |&i| af.point(i).active > 0.25 * af.magnet_flux())
 }
 
 #[test]
@@ -170,7 +171,10 @@ fn resistance_regressor_matches_the_flux_error_of_a_resistance_error() {
             );
             checked += 1;
         }
-        assert!(checked > 40, "{name}: only {checked} points outside the freeze");
+        assert!(
+            checked > 40,
+            "{name}: only {checked} points outside the freeze"
+        );
     }
 }
 
