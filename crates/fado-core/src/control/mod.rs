@@ -16,6 +16,7 @@ pub mod lock_reaction;
 pub mod modulation;
 pub mod monitor;
 pub mod pi;
+pub mod saturated_references;
 pub mod speed_controller;
 pub mod standstill_probe;
 
