@@ -814,6 +814,7 @@ fn stall_band_widens_with_the_reluctance_torque() {
         rated_speed_rpm: 2550.0,
         rated_torque: 19.0,
         dc_voltage: 310.0,
+        magnetics: Default::default(),
     };
     for (machine, salient) in [
         (MachineModel::paper(), false),

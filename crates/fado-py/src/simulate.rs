@@ -111,7 +111,7 @@ pub(crate) enum Motor {
     /// A machine: `[motor]` and `[inverter] dc_voltage`, the other `[inverter]` keys its
     /// ratings give derived (`SimConfig::for_machine`), and its flux map if it has one.
     Machine(
-        fado_core::MachineModel<f64>,
+        Box<fado_core::MachineModel<f64>>,
         Option<fado_sim::magnetics_file::FluxMapFile>,
     ),
 }
@@ -119,7 +119,7 @@ pub(crate) enum Motor {
 impl Motor {
     /// The plant of a `fado.Machine`: its record and its flux map.
     pub(crate) fn of_machine(m: &PyMachine) -> Self {
-        Motor::Machine(m.to_core(), m.flux_map().cloned())
+        Motor::Machine(Box::new(m.to_core()), m.flux_map().cloned())
     }
 
     /// `motor` as `simulate` takes it: None, a preset name or a `fado.Machine`.

@@ -348,6 +348,7 @@ pub(crate) mod tests {
             rated_speed_rpm: 1500.0,
             rated_torque: 14.0,
             dc_voltage: 540.0,
+            magnetics: Default::default(),
         }
     }
 

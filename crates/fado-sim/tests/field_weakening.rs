@@ -57,8 +57,10 @@ fn ipmsm_holds_twice_its_rated_speed_at_rated_power() {
 
 #[test]
 fn paper_motor_holds_rated_power_at_four_times_its_rated_speed() {
-    // 1806 W (11.5 N·m at 1500 r/min) at 6000 r/min: ω·Ts = 0.25 rad per sample.
-    let (speed, angle, tripped) = run(&motor("paper.toml"), 6000.0, 1806.0, "");
+    // 1806 W (11.5 N·m at 1500 r/min) at 6000 r/min: ω·Ts = 0.25 rad per sample; the
+    // drive's speed limit raised from its default 2 × rated.
+    let limits = "[controller.limits]\nspeed_ratio = 4.0\n";
+    let (speed, angle, tripped) = run(&motor("paper.toml"), 6000.0, 1806.0, limits);
     assert!(!tripped);
     assert!((speed - 6000.0).abs() < 0.02 * 1500.0, "{speed}");
     assert!(angle < 0.25, "{angle}");
@@ -68,16 +70,28 @@ fn paper_motor_holds_rated_power_at_four_times_its_rated_speed() {
 fn overmodulation_gives_ipmsm_more_power_at_twice_its_rated_speed() {
     // At 3000 r/min the model's limits give ipmsm-2k2 3.9 kW within 0.92 of the inscribed
     // circle (`fado_sim::range::targets`); minimum-distance overmodulation with the loop held
-    // at 1.06 of it gives 4.8 kW. 4.3 kW (13.7 N·m, rising with the speed): out of reach
-    // without overmodulation, held with it.
+    // at 1.08 of it gives 4.9 kW. 4.5 kW (14.2 N·m, rising with the speed; the drive's power
+    // limit raised from its default 2 × the rated 2.2 kW): out of reach without
+    // overmodulation, held with it.
     let m = motor("ipmsm-2k2.toml");
-    let load = "[load.torque]\npoints = [[0.0, 0.0], [0.7, 0.0], [3.7, 13.7], [5.5, 13.7]]\n";
+    let load = "[load.torque]\npoints = [[0.0, 0.0], [0.7, 0.0], [3.7, 14.2], [5.5, 14.2]]\n";
     let over = "voltage_limit = \"overmodulation\"\n\
-                [controller.field_weakening]\nvoltage_margin = 1.06\n";
+                [controller.field_weakening]\nvoltage_margin = 1.08\n\
+                [controller.limits]\npower_ratio = 2.5\n";
     let (speed, angle, tripped) = run_with(&m, 3000.0, load, over);
     assert!(!tripped);
     assert!((speed - 3000.0).abs() < 0.02 * 1500.0, "{speed}");
     assert!(angle < 0.25, "{angle}");
-    let (speed, _, _) = run_with(&m, 3000.0, load, "");
+    let linear = "[controller.limits]\npower_ratio = 2.5\n";
+    let (speed, _, _) = run_with(&m, 3000.0, load, linear);
     assert!(speed < 2940.0, "linear modulation: {speed}");
+}
+
+#[test]
+fn the_speed_limit_holds_the_speed_at_twice_the_rated_one() {
+    // Asked for 6000 r/min, the paper's motor stops at its default limit, 2 × 1500 r/min.
+    let (speed, angle, tripped) = run(&motor("paper.toml"), 6000.0, 900.0, "");
+    assert!(!tripped);
+    assert!((speed - 3000.0).abs() < 0.02 * 1500.0, "{speed}");
+    assert!(angle < 0.25, "{angle}");
 }

@@ -177,7 +177,7 @@ impl<T: Real> CommonTuning<T> {
 /// current and DC link), the [`CommonTuning`] every estimator shares, and the baseline's own
 /// settings `S` (plain numbers whose defaults do not depend on the machine).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct BaselineConfig<T, S> {
+pub struct BaselineConfig<T: 'static, S> {
     /// The drive's model of the machine.
     pub machine: MachineModel<T>,
     /// Sampling, trackers, integrand and sample bounds, as fado's.

@@ -8,7 +8,7 @@ use crate::{MachineModel, Real};
 /// Configuration. Build it with [`CommissioningConfig::for_machine`]; every default is a ratio
 /// of a rating or a duration in seconds (the brief's rule), stated on its field.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct CommissioningConfig<T> {
+pub struct CommissioningConfig<T: 'static> {
     /// The nameplate: ratings trusted, parameters rough (module docs). Required.
     pub nameplate: MachineModel<T>,
     /// Sampling (control) period Ts in s. Required.

@@ -11,7 +11,7 @@ use crate::{MachineModel, Real};
 /// and the ratings the tuning's ratios refer to), the start-up angle and the tuning. Build it
 /// with [`EstimatorConfig::for_machine`]; nothing here assumes the paper's motor.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct EstimatorConfig<T> {
+pub struct EstimatorConfig<T: 'static> {
     /// Sampling period Ts in s (paper, V: 100 µs, 10 kHz).
     pub ts: T,
     /// The drive's model of the motor: R̂s of eq. (3), L̂q of eq. (5), λ̂f (limiter radius,

@@ -119,6 +119,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             .step(tracking_error > self.resolved.current_error_limit);
         // Reaction to a lost rotor (see `lock_reaction`).
         let speed_ref = speed_ref_mech * T::lit(self.config.machine.pole_pairs as f64);
+        let speed_ref = self.blocks.limits.speed(speed_ref);
         let action = self.react_to_lock(&estimate, speed_ref)?;
         // 4. Speed loop, injection (23) and current-vector limit (zero current when coasting).
         let backup = self.blocks;
@@ -144,7 +145,10 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         };
         // 8. Anti-windup with the realised voltage in the same frame; speed loop too.
         b.current.realised(applied.v_dq);
-        let realised_torque = if self.resolved.salient {
+        let realised_torque = if let Some(s) = &self.resolved.saturated {
+            // A saturating model's co-energy torque (`saturated_references`).
+            s.torque_flux(i_dq_ref) / self.config.machine.flux_linkage
+        } else if self.resolved.salient {
             let m = &self.config.machine;
             m.active_flux(i_dq_ref.d) * i_dq_ref.q / m.flux_linkage
         } else {
@@ -256,7 +260,10 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             let m = &self.config.machine;
             let p = T::lit(m.pole_pairs as f64);
             let i = self.last.i_dq_ref;
-            let torque = T::lit(1.5) * p * m.active_flux(i.d) * i.q;
+            let torque = match &self.resolved.saturated {
+                Some(s) => T::lit(1.5) * p * s.torque_flux(i),
+                None => T::lit(1.5) * p * m.active_flux(i.d) * i.q,
+            };
             self.estimator.set_acceleration(p * torque / m.inertia);
         }
         let estimate = self.estimator.step(self.history[1], i_ab);
@@ -298,10 +305,10 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         let i_dq_ref = if action == LockAction::Coast {
             Dq::zero()
         } else {
-            let Ok(iq_torque) = self.blocks.speed.step(speed_ref, estimate.omega_control) else {
-                return None;
-            };
-            // The DC link's power limits and over-voltage controller (see `dc_link_limit`).
+            let iq_torque = self.speed_or_hold(speed_ref, estimate)?;
+            // The ratings' torque and power limits (see `ratings_limit`), the DC link's power
+            // limits and over-voltage controller (see `dc_link_limit`).
+            let iq_torque = self.blocks.limits.torque(iq_torque, estimate.omega_control);
             let (iq_torque, brake_id) = self.blocks.dc_link.limit(
                 iq_torque,
                 vdc,
