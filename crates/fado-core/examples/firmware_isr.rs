@@ -38,6 +38,7 @@ impl Isr {
             rated_speed_rpm: 1500.0,
             rated_torque: 11.5,
             dc_voltage: 311.0,
+            magnetics: Default::default(),
         };
         let config = EstimatorConfig {
             initial_angle: theta_aligned,

@@ -6,8 +6,20 @@
 //! changes the integrand, so λ̂r changes slope but never jumps, and neither does the angle.
 
 use crate::error::{ConfigError, NonFiniteInput, check};
-use crate::estimator::EstimatorTuning;
 use crate::{Ab, MachineModel, Real};
+
+/// Default of [`FluxIntegratorConfig::average_current`]: the resistive drop of the mean
+/// current over the interval (docs/method/estimator.md §1 \[A\]).
+pub const DEFAULT_AVERAGE_CURRENT: bool = true;
+
+/// Default disturbance feedback gain k_df in s⁻¹ (paper, V).
+pub const DEFAULT_K_DF: f64 = 0.5;
+
+/// Default limiter gain k_af in s⁻¹: 2π·100 (paper, V).
+pub const DEFAULT_K_AF: f64 = 2.0 * core::f64::consts::PI * 100.0;
+
+/// Default limiter radius as a multiple of λ̂f (paper, V).
+pub const DEFAULT_LIMITER_RADIUS_RATIO: f64 = 1.15;
 
 /// Configuration of a [`FluxIntegrator`].
 ///
@@ -21,25 +33,19 @@ pub struct FluxIntegratorConfig<T> {
     /// paper V).
     pub rs_hat: T,
     /// Use (i\[n\] + i[n−1])/2 for the resistive drop, which matches the interval the applied
-    /// voltage acted over (docs/method/estimator.md §1, \[A\]). Default `true`
-    /// ([`EstimatorTuning::average_current`]).
+    /// voltage acted over (docs/method/estimator.md §1, \[A\]). Default
+    /// [`DEFAULT_AVERAGE_CURRENT`] (true).
     pub average_current: bool,
 }
 
 impl<T: Real> FluxIntegratorConfig<T> {
     /// The integrator around `machine` (R̂s = [`MachineModel::rs`]) sampled every `ts`, with
-    /// the estimator's default `average_current` ([`EstimatorTuning::default`]).
+    /// the averaged current ([`DEFAULT_AVERAGE_CURRENT`]).
     pub fn for_machine(machine: &MachineModel<T>, ts: T) -> Self {
-        Self::with_tuning(machine, &EstimatorTuning::default(), ts)
-    }
-
-    /// The integrator around `machine` with `tuning`'s `average_current`, sampled every
-    /// `ts`: what the estimator builds.
-    pub fn with_tuning(machine: &MachineModel<T>, tuning: &EstimatorTuning<T>, ts: T) -> Self {
         Self {
             ts,
             rs_hat: machine.rs,
-            average_current: tuning.average_current,
+            average_current: DEFAULT_AVERAGE_CURRENT,
         }
     }
 }
@@ -242,8 +248,8 @@ impl<T: Real> FluxIntegrator<T> {
 pub struct DisturbanceFeedbackConfig<T> {
     /// Sampling period Ts in s (paper, V: 100 µs). No default: the caller's.
     pub ts: T,
-    /// Disturbance feedback gain k_df in s⁻¹ (Fig. 3, eq. (21)). Default 0.5 (paper, V;
-    /// [`EstimatorTuning::k_df`]).
+    /// Disturbance feedback gain k_df in s⁻¹ (Fig. 3, eq. (21)). Default [`DEFAULT_K_DF`]
+    /// (0.5, paper V).
     pub k_df: T,
     /// Time to ramp k_df from 0 to its value on activation, s; 0 switches it abruptly as the
     /// paper does. A ramp softens the re-activation distortion of Fig. 9 (docs/method/estimator.md §1 \[A\]).
@@ -252,19 +258,13 @@ pub struct DisturbanceFeedbackConfig<T> {
 }
 
 impl<T: Real> DisturbanceFeedbackConfig<T> {
-    /// The feedback sampled every `ts` with the estimator's default k_df and ramp
-    /// ([`EstimatorTuning::default`]: 0.5 s⁻¹, paper V; no ramp, as the paper).
+    /// The feedback sampled every `ts` with the default k_df ([`DEFAULT_K_DF`], 0.5 s⁻¹,
+    /// paper V) and no ramp, as the paper.
     pub fn with_ts(ts: T) -> Self {
-        Self::with_tuning(&EstimatorTuning::default(), ts)
-    }
-
-    /// The feedback with `tuning`'s `k_df` and `k_df_ramp_time`, sampled every `ts`: what
-    /// the estimator builds.
-    pub fn with_tuning(tuning: &EstimatorTuning<T>, ts: T) -> Self {
         Self {
             ts,
-            k_df: tuning.k_df,
-            ramp_time: tuning.k_df_ramp_time,
+            k_df: T::lit(DEFAULT_K_DF),
+            ramp_time: T::zero(),
         }
     }
 }
@@ -359,26 +359,31 @@ impl<T: Real> DisturbanceFeedback<T> {
 /// each field's "Default" is what it gives.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FluxLimiterConfig<T> {
-    /// Convergence gain k_af in s⁻¹ (Fig. 6, eq. (24)-(25)). Default 2π·100 (paper, V).
+    /// Convergence gain k_af in s⁻¹ (Fig. 6, eq. (24)-(25)). Default [`DEFAULT_K_AF`] (2π·100,
+    /// paper V).
     pub k_af: T,
     /// Radius ρ of the limiting circle in Wb. Default 1.15·λ̂f (paper, V: 1.15 times the flux
-    /// linkage; [`EstimatorTuning::limiter_radius_ratio`]), 0.1012 Wb on the paper's motor.
+    /// linkage; [`DEFAULT_LIMITER_RADIUS_RATIO`]), 0.1012 Wb on the paper's motor.
     pub radius: T,
 }
 
 impl<T: Real> FluxLimiterConfig<T> {
-    /// The limiter around `machine` with the estimator's default tuning
-    /// ([`EstimatorTuning::default`]): k_af = 2π·100 s⁻¹ and ρ = 1.15·λ̂f (paper, V).
+    /// The limiter around `machine` with the paper's gain and radius: k_af = 2π·100 s⁻¹ and
+    /// ρ = 1.15·λ̂f (paper, V; [`DEFAULT_K_AF`], [`DEFAULT_LIMITER_RADIUS_RATIO`]).
     pub fn for_machine(machine: &MachineModel<T>) -> Self {
-        Self::with_tuning(machine, &EstimatorTuning::default())
+        Self::new(
+            machine,
+            T::lit(DEFAULT_K_AF),
+            T::lit(DEFAULT_LIMITER_RADIUS_RATIO),
+        )
     }
 
-    /// The limiter around `machine` with `tuning`: k_af = `k_af`, ρ = `limiter_radius_ratio`
-    /// × λ̂f ([`MachineModel::flux_linkage`]); what the estimator builds.
-    pub fn with_tuning(machine: &MachineModel<T>, tuning: &EstimatorTuning<T>) -> Self {
+    /// The limiter around `machine` with gain `k_af` (s⁻¹) and radius `radius_ratio` × λ̂f
+    /// ([`MachineModel::flux_linkage`]).
+    pub fn new(machine: &MachineModel<T>, k_af: T, radius_ratio: T) -> Self {
         Self {
-            k_af: tuning.k_af,
-            radius: tuning.limiter_radius_ratio * machine.flux_linkage,
+            k_af,
+            radius: radius_ratio * machine.flux_linkage,
         }
     }
 }

@@ -4,9 +4,13 @@
 //! observable, and steers the integrand errors at standstill towards the positive d-axis where
 //! the rotor flux lies (paper, section V, Fig. 10 discussion).
 
-use crate::control::DriveTuning;
 use crate::error::{ConfigError, check};
+use crate::machine::PAPER_RATED_CURRENT;
 use crate::{MachineModel, Real};
+
+/// Default I_min of the injection as a fraction of the rated current: 4/21.78 (paper,
+/// section V: 4 A on its motor).
+pub const DEFAULT_CURRENT_RATIO: f64 = 4.0 / PAPER_RATED_CURRENT;
 
 /// Configuration of [`CurrentInjection`].
 ///
@@ -15,21 +19,21 @@ use crate::{MachineModel, Real};
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CurrentInjectionConfig<T> {
     /// Minimum current magnitude I_min in A. Default 4/21.78 of the rated current
-    /// ([`DriveTuning::injection_current_ratio`]; paper, section V: 4 A on its motor).
+    /// ([`DEFAULT_CURRENT_RATIO`]; paper, section V: 4 A on its motor).
     pub i_min: T,
 }
 
 impl<T: Real> CurrentInjectionConfig<T> {
-    /// I_min for `machine` with the drive's default ratio ([`DriveTuning::default`]'s
-    /// `injection_current_ratio`, 4/21.78 of the rated current: the paper's 4 A, V).
+    /// I_min for `machine` with the default ratio ([`DEFAULT_CURRENT_RATIO`], 4/21.78 of the
+    /// rated current: the paper's 4 A, V).
     pub fn for_machine(machine: &MachineModel<T>) -> Self {
-        Self::with_tuning(machine, &DriveTuning::default())
+        Self::new(machine, T::lit(DEFAULT_CURRENT_RATIO))
     }
 
-    /// I_min = `injection_current_ratio` × [`MachineModel::rated_current`].
-    pub fn with_tuning(machine: &MachineModel<T>, tuning: &DriveTuning<T>) -> Self {
+    /// I_min = `current_ratio` × [`MachineModel::rated_current`].
+    pub fn new(machine: &MachineModel<T>, current_ratio: T) -> Self {
         Self {
-            i_min: tuning.injection_current_ratio * machine.rated_current,
+            i_min: current_ratio * machine.rated_current,
         }
     }
 }

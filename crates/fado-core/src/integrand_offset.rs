@@ -35,13 +35,16 @@
 //! leaving a large ê behind.
 
 use crate::error::{ConfigError, check};
-use crate::estimator::EstimatorTuning;
+use crate::mode;
 use crate::{Ab, MachineModel, Real};
+
+/// Default k_e in s⁻¹ ([`IntegrandOffsetConfig::rate`]): 2 (ours \[A\], see the field).
+pub const DEFAULT_RATE: f64 = 2.0;
 
 /// Configuration of [`IntegrandOffset`].
 ///
 /// No `Default`: the bound is the motor's. Build it with [`for_machine`](Self::for_machine)
-/// (or [`with_tuning`](Self::with_tuning)); each field's "Default" is what they give.
+/// (or [`new`](Self::new)); each field's "Default" is what they give.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct IntegrandOffsetConfig<T> {
     /// Period of the law in s: the sampling period Ts if it runs every sample, N·Ts in the
@@ -49,7 +52,7 @@ pub struct IntegrandOffsetConfig<T> {
     /// laws). No default: the caller's sampling period.
     pub ts: T,
     /// k_e in s⁻¹: the rate at which ê follows the integrand's DC error while turning, 0 = off.
-    /// Default ([`EstimatorTuning::offset_adaptation_rate`]) 2 s⁻¹ (ours \[A\]: ≈ 5 time constants within the 2.5 s the Fig. 11 profile
+    /// Default ([`DEFAULT_RATE`]) 2 s⁻¹ (ours \[A\]: ≈ 5 time constants within the 2.5 s the Fig. 11 profile
     /// turns before its reversal; well below the observer's |ω̂| ≥ 2π·1.3 rad/s in the k_df
     /// mode, so that D̂ tracks the DC of λ1 as the law assumes).
     pub rate: T,
@@ -65,23 +68,26 @@ pub struct IntegrandOffsetConfig<T> {
 }
 
 impl<T: Real> IntegrandOffsetConfig<T> {
-    /// The law around `machine` with the estimator's default tuning
-    /// ([`EstimatorTuning::default`]), run with period `ts`. Same as
-    /// [`with_tuning`](Self::with_tuning)`(machine, &EstimatorTuning::default(), ts)`.
+    /// The law around `machine` with the default rate ([`DEFAULT_RATE`]) and the default
+    /// Fig. 3 threshold ([`mode::DEFAULT_THRESHOLD_RATIO`]), run with period `ts`.
     pub fn for_machine(machine: &MachineModel<T>, ts: T) -> Self {
-        Self::with_tuning(machine, &EstimatorTuning::default(), ts)
+        Self::new(
+            machine,
+            T::lit(DEFAULT_RATE),
+            T::lit(mode::DEFAULT_THRESHOLD_RATIO),
+            ts,
+        )
     }
 
-    /// The law around `machine` with `tuning`, run with period `ts`: what the estimator
-    /// builds. With the Fig. 3 threshold f_th = `mode_threshold_ratio`·f_rated: `rate` is the
-    /// tuning's `offset_adaptation_rate` (default 2 s⁻¹, see the field), `settle_time`
-    /// 5/(2π·f_th) (five observer time constants at the threshold, ours \[A\]) and `limit`
-    /// λ̂f·2π·f_th (the back-EMF at the threshold, module docs).
-    pub fn with_tuning(machine: &MachineModel<T>, tuning: &EstimatorTuning<T>, ts: T) -> Self {
-        let threshold_hz = tuning.mode_threshold_ratio * machine.rated_frequency_hz();
+    /// The law around `machine` learning at `rate` (s⁻¹), run with period `ts`, for the
+    /// Fig. 3 threshold f_th = `threshold_ratio`·f_rated: `settle_time` 5/(2π·f_th) (five
+    /// observer time constants at the threshold, ours \[A\]) and `limit` λ̂f·2π·f_th (the
+    /// back-EMF at the threshold, module docs).
+    pub fn new(machine: &MachineModel<T>, rate: T, threshold_ratio: T, ts: T) -> Self {
+        let threshold_hz = threshold_ratio * machine.rated_frequency_hz();
         Self {
             ts,
-            rate: tuning.offset_adaptation_rate,
+            rate,
             settle_time: T::lit(5.0) / (T::two_pi() * threshold_hz),
             limit: machine.flux_linkage * T::two_pi() * threshold_hz,
         }

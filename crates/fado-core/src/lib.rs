@@ -6,6 +6,7 @@
 #[cfg(test)]
 extern crate std;
 
+pub mod active_flux;
 pub mod approx;
 pub mod baselines;
 pub mod commissioning;

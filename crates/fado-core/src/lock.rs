@@ -47,11 +47,11 @@
 //! surface-magnet rotor's angle is not observable from v and i (an integrand error ΔR̂s·i
 //! along q̂ turns λ̂r without changing |λ̂r|), a loss shows first on the mechanical side; the
 //! drive adds that symptom (a speed-loop stall in limiter mode while the loop commands a
-//! torque, `DriveTuning::lock_stall_speed_ratio` and `lock_stall_min_current_ratio`, see
+//! torque, with its own speed band and current gate, see
 //! [`crate::control::SensorlessDrive`]). The drive reports the two apart: `LOCK_LOST` for the
 //! estimator's verdict, `STALLED` for the stall symptom, which cannot tell an estimate that has
 //! left the rotor from a rotor that really stalls or lags under its load (docs/method/lock.md); either starts the drive's reaction
-//! (`DriveTuning::lock_reaction_on_stall`).
+//! ([`crate::control::lock_reaction`]).
 //!
 //! The verdicts feed an up/down debouncing counter (the counter-based debouncing of AUTOSAR
 //! DEM, "Specification of Diagnostic Event Manager", §7.7.4.1, with its separate "passed"
@@ -217,8 +217,8 @@ pub(crate) fn samples<T: Real>(field: &'static str, time: T, ts: T) -> Result<u3
 /// A hand-over count below this is 0 (symptom 3; see [`LockDetectorParams::next_state`]).
 const HANDOVER_FLOOR: f64 = 1e-6;
 
-/// Configuration of a [`LockDetector`]; the tuning is in
-/// [`EstimatorConfig`](crate::EstimatorConfig)'s `lock_*` fields.
+/// Configuration of a [`LockDetector`]: plain numbers, which the estimator derives from its
+/// loss-of-lock tuning.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LockDetectorConfig<T> {
     /// Period at which the detector judges a sample, s: the sampling period, or N·Ts when
@@ -290,8 +290,8 @@ impl<T: Real> LockState<T> {
 }
 
 impl<T: Real> LockDetectorParams<T> {
-    /// Checks and precomputes (squared ratios, the sample counts); errors name the
-    /// [`EstimatorConfig`](crate::EstimatorConfig) field.
+    /// Checks and precomputes (squared ratios, the sample counts); errors name the tuning
+    /// field the estimator derives the bad value from (`lock_*`).
     pub(crate) fn new(c: LockDetectorConfig<T>) -> Result<Self, ConfigError> {
         let ts = check::positive("ts", c.ts)?;
         let low = check::non_negative("lock_flux_low_ratio", c.flux_low_ratio)?;
@@ -402,8 +402,8 @@ pub struct LockDetector<T> {
 }
 
 impl<T: Real> LockDetector<T> {
-    /// Checks and precomputes (squared ratios, the sample counts); errors name the
-    /// [`EstimatorConfig`](crate::EstimatorConfig) field.
+    /// Checks and precomputes (squared ratios, the sample counts); errors name the tuning
+    /// field the estimator derives the bad value from (`lock_*`).
     pub fn new(c: LockDetectorConfig<T>) -> Result<Self, ConfigError> {
         Ok(Self {
             params: LockDetectorParams::new(c)?,

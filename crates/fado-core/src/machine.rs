@@ -13,7 +13,7 @@
 //! the datasheet's r/min (a rating, converted once by [`MachineModel::rated_speed`]).
 
 use crate::error::{ConfigError, check};
-use crate::magnetics::ConstantInductance;
+use crate::magnetics::{ConstantInductance, MachineMagnetics, Magnetics};
 use crate::{Dq, Real};
 
 /// The motor's parameters and ratings (a drive's model of it, or a simulated plant).
@@ -28,7 +28,7 @@ use crate::{Dq, Real};
     derive(serde::Serialize, serde::Deserialize),
     serde(deny_unknown_fields, default)
 )]
-pub struct MachineModel<T> {
+pub struct MachineModel<T: 'static> {
     /// Stator resistance Rs in Ω (per phase).
     pub rs: T,
     /// d-axis inductance Ld in H.
@@ -52,6 +52,14 @@ pub struct MachineModel<T> {
     /// Nominal DC-link voltage in V (the inverter's rating; not a TOML key of the motor).
     #[cfg_attr(feature = "serde", serde(skip))]
     pub dc_voltage: T,
+    /// The magnetic model: [`MachineMagnetics::Linear`] (the default) is `ld`, `lq` and
+    /// `flux_linkage`; a saturating model makes the estimator and the drive evaluate the flux
+    /// at the present current (docs/method/saturation.md). `ld`, `lq` and `flux_linkage` then
+    /// stay the model's zero-current values (incremental inductances and ψd at i = 0), the
+    /// constants a block falls back to. Not a TOML key: `fado-sim` reads `[model.saturation]`
+    /// and `[model] flux_map` itself.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    pub magnetics: MachineMagnetics<T>,
 }
 
 /// The empty record: every field 0, which [`MachineModel::validate`] refuses naming the first
@@ -71,13 +79,16 @@ impl<T: Real> Default for MachineModel<T> {
             rated_speed_rpm: T::zero(),
             rated_torque: T::zero(),
             dc_voltage: T::zero(),
+            magnetics: MachineMagnetics::Linear,
         }
     }
 }
 
 impl<T: Real> MachineModel<T> {
     /// The same record in another precision (e.g. an f64 configuration for an f32 drive):
-    /// every real rounded to `U`.
+    /// every real rounded to `U`. A borrowed flux map cannot change precision without
+    /// allocating: it becomes [`MachineMagnetics::Linear`] unless `U` is `T` (build the map in
+    /// the drive's precision and set it with [`MachineModel::with_magnetics`]).
     pub fn cast<U: Real>(&self) -> MachineModel<U> {
         MachineModel {
             rs: U::lit(self.rs.to_f64()),
@@ -91,7 +102,21 @@ impl<T: Real> MachineModel<T> {
             rated_speed_rpm: U::lit(self.rated_speed_rpm.to_f64()),
             rated_torque: U::lit(self.rated_torque.to_f64()),
             dc_voltage: U::lit(self.dc_voltage.to_f64()),
+            magnetics: self.magnetics.cast().unwrap_or_default(),
         }
+    }
+
+    /// This record with the magnetic model `magnetics`.
+    pub fn with_magnetics(mut self, magnetics: MachineMagnetics<T>) -> Self {
+        self.magnetics = magnetics;
+        self
+    }
+
+    /// The magnetic model in effect: the saturating one, or this record's constant
+    /// inductances ([`MachineModel::constant_inductance`]) for [`MachineMagnetics::Linear`].
+    #[inline]
+    pub fn magnetic_model(&self) -> Magnetics<'static, T> {
+        self.magnetics.resolve(self.constant_inductance())
     }
 
     /// The paper's motor (section V \[P\]: 8-pole SMPMSM, 11.5 N·m, 1500 r/min, Rs = 0.327 Ω,
@@ -111,6 +136,7 @@ impl<T: Real> MachineModel<T> {
             rated_speed_rpm: T::lit(1500.0),
             rated_torque: T::lit(11.5),
             dc_voltage: T::lit(311.0),
+            magnetics: MachineMagnetics::Linear,
         }
     }
 
@@ -247,6 +273,7 @@ mod tests {
             rated_speed_rpm: 1500.0,
             rated_torque: 14.7,
             dc_voltage: 540.0,
+            magnetics: Default::default(),
         };
         m.validate().unwrap();
         for i in [1.0, 4.0, 6.0, 12.0] {

@@ -710,6 +710,7 @@ mod tests {
             rated_speed_rpm: 1500.0,
             rated_torque: 14.0,
             dc_voltage: 540.0,
+            magnetics: Default::default(),
         };
         let f = first(&m, None);
         assert_eq!(f.severity(), Severity::Warning);

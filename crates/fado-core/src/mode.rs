@@ -2,7 +2,6 @@
 //! electrical, the limiter k_af below), with hysteresis so that noise on ω̂ cannot chatter.
 
 use crate::error::{ConfigError, check};
-use crate::estimator::EstimatorTuning;
 use crate::{MachineModel, Real};
 
 /// Which feedback closes the flux integrator.
@@ -15,6 +14,14 @@ pub enum Mode {
     DisturbanceFeedback,
 }
 
+/// Default Fig. 3 threshold as a fraction of the rated electrical frequency: 0.015 (paper,
+/// section V: 1.5 Hz of its motor's 100 Hz).
+pub const DEFAULT_THRESHOLD_RATIO: f64 = 0.015;
+
+/// Default hysteresis half-band as a fraction of the rated electrical frequency: 0.002
+/// (docs/method/estimator.md §1 \[A\]: 0.2 Hz of 100 Hz).
+pub const DEFAULT_HYSTERESIS_RATIO: f64 = 0.002;
+
 /// Configuration of a [`ModeSelector`].
 ///
 /// No `Default`: the threshold scales with the motor's rated speed. Build it with
@@ -22,32 +29,35 @@ pub enum Mode {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ModeSelectorConfig<T> {
     /// Threshold on |ω̂|/2π in Hz, electrical. Default 0.015 of the rated electrical
-    /// frequency ([`EstimatorTuning::mode_threshold_ratio`]; paper, section V: 1.5 Hz of its
-    /// motor's 100 Hz).
+    /// frequency ([`DEFAULT_THRESHOLD_RATIO`]; paper, section V: 1.5 Hz of its motor's
+    /// 100 Hz).
     pub threshold_hz: T,
     /// Half-width of the hysteresis band in Hz: enter above threshold + h, leave below
     /// threshold − h. Default 0.002 of the rated electrical frequency
-    /// ([`EstimatorTuning::mode_hysteresis_ratio`]; docs/method/estimator.md §1 \[A\]: 0.2 Hz on the paper's
+    /// ([`DEFAULT_HYSTERESIS_RATIO`]; docs/method/estimator.md §1 \[A\]: 0.2 Hz on the paper's
     /// motor).
     pub hysteresis_hz: T,
 }
 
 impl<T: Real> ModeSelectorConfig<T> {
-    /// The selector for `machine` with the estimator's default tuning
-    /// ([`EstimatorTuning::default`]): threshold 0.015 and hysteresis 0.002 of the rated
-    /// electrical frequency (1.5 Hz and 0.2 Hz on the paper's motor: paper V, docs/method/estimator.md §1 \[A\]).
+    /// The selector for `machine` with the default ratios: threshold 0.015 and hysteresis
+    /// 0.002 of the rated electrical frequency (1.5 Hz and 0.2 Hz on the paper's motor:
+    /// paper V, docs/method/estimator.md §1 \[A\]).
     pub fn for_machine(machine: &MachineModel<T>) -> Self {
-        Self::with_tuning(machine, &EstimatorTuning::default())
+        Self::new(
+            machine,
+            T::lit(DEFAULT_THRESHOLD_RATIO),
+            T::lit(DEFAULT_HYSTERESIS_RATIO),
+        )
     }
 
-    /// The selector for `machine` with `tuning`: `mode_threshold_ratio` and
-    /// `mode_hysteresis_ratio` times [`MachineModel::rated_frequency_hz`]; what the
-    /// estimator builds.
-    pub fn with_tuning(machine: &MachineModel<T>, tuning: &EstimatorTuning<T>) -> Self {
+    /// The selector for `machine` with `threshold_ratio` and `hysteresis_ratio` times
+    /// [`MachineModel::rated_frequency_hz`].
+    pub fn new(machine: &MachineModel<T>, threshold_ratio: T, hysteresis_ratio: T) -> Self {
         let rated_hz = machine.rated_frequency_hz();
         Self {
-            threshold_hz: tuning.mode_threshold_ratio * rated_hz,
-            hysteresis_hz: tuning.mode_hysteresis_ratio * rated_hz,
+            threshold_hz: threshold_ratio * rated_hz,
+            hysteresis_hz: hysteresis_ratio * rated_hz,
         }
     }
 }

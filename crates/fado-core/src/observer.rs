@@ -327,7 +327,7 @@ impl<T: Real> DisturbanceObserverParams<T> {
 
     /// [`Self::next_state`] with gains computed beforehand (by [`Self::gains`], possibly for
     /// an earlier sample's speed: the estimator holds them over
-    /// `EstimatorTuning::observer_gain_period`).
+    /// its observer gain period).
     #[inline(always)]
     pub(crate) fn next_state_with(
         &self,

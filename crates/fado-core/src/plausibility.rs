@@ -78,7 +78,7 @@ impl<T: Real> SampleBounds<T> {
         })
     }
 
-    /// The bounds of the `plausible_*` ratios (the fields of [`crate::EstimatorTuning`] and of
+    /// The bounds of the `plausible_*` ratios (fields of the estimators' tunings and of
     /// the baselines' configurations, which errors name): |i| below `current_ratio` ×
     /// `rated_current`, |v| below `voltage_ratio` × `dc_voltage`, |Δi| per sample below
     /// `step_ratio` × (the plausible voltage)·`ts`/`lq` (0, or a step that overflows, switches

@@ -28,7 +28,7 @@
 //! varying acceleration â, integrated from the phase error (â ← â + K3·Ts·e): a third
 //! integrator, so a constant load leaves no angle error (with the feed-forward alone it would
 //! leave p·T_L/(Ĵ·Ki), 0.11 rad at the paper's rated load). The poles are the type-2 pair
-//! with a real pole added at c·ωn (`EstimatorTuning::tracker_load_pole_ratio`; c = 0 keeps the
+//! with a real pole added at c·ωn (the estimator's `tracker_load_pole_ratio`; c = 0 keeps the
 //! type-2 loop to the bit). The feed-forward removes the lag under the commanded torque; a
 //! load step is a disturbance the third integrator removes at c·ωn.
 //!
@@ -45,7 +45,6 @@
 //! exactly as written above (its results unchanged to the bit).
 
 use crate::error::{ConfigError, NonFiniteInput, check};
-use crate::estimator::EstimatorTuning;
 use crate::{Real, wrap_angle};
 
 /// How the tracker's bandwidth parameter is interpreted.
@@ -64,6 +63,9 @@ pub enum BandwidthDefinition {
     NaturalFrequency,
 }
 
+/// Default damping ratio ζ of a tracker: 1/√2 (docs/method/estimator.md §4 \[A\]).
+pub const DEFAULT_DAMPING: f64 = core::f64::consts::FRAC_1_SQRT_2;
+
 /// Configuration of a [`TypeTwoTracker`].
 ///
 /// No `Default`: the sampling period is the set-up's and the bandwidth the loop's. Build it
@@ -72,31 +74,24 @@ pub enum BandwidthDefinition {
 pub struct TrackerConfig<T> {
     /// Sampling period Ts in s (paper, V: 100 µs).
     pub ts: T,
-    /// Bandwidth in Hz (paper, V: 60 Hz for T2S-1, 35 Hz for T2S-2; the estimator's
-    /// [`EstimatorTuning::t2s1_bandwidth_hz`], [`EstimatorTuning::t2s2_bandwidth_hz`]).
+    /// Bandwidth in Hz (paper, V: 60 Hz for T2S-1, 35 Hz for T2S-2). No default: the loop's.
     pub bandwidth_hz: T,
-    /// Damping ratio ζ. Default 1/√2 (docs/method/estimator.md §4 \[A\]; [`EstimatorTuning::tracker_damping`]).
+    /// Damping ratio ζ. Default [`DEFAULT_DAMPING`] (1/√2, docs/method/estimator.md §4 \[A\]).
     pub damping: T,
     /// How `bandwidth_hz` is defined. Default −3 dB (docs/method/estimator.md §4;
-    /// [`EstimatorTuning::bandwidth_definition`]).
+    /// [`BandwidthDefinition::default`]).
     pub definition: BandwidthDefinition,
 }
 
 impl<T: Real> TrackerConfig<T> {
-    /// A tracker of `bandwidth_hz` sampled every `ts`, with the estimator's default damping
-    /// and bandwidth definition ([`EstimatorTuning::default`]: ζ = 1/√2, −3 dB; docs/method/estimator.md §4).
+    /// A tracker of `bandwidth_hz` sampled every `ts`, with the default damping and
+    /// bandwidth definition (ζ = 1/√2, −3 dB; docs/method/estimator.md §4).
     pub fn new(bandwidth_hz: T, ts: T) -> Self {
-        Self::with_tuning(&EstimatorTuning::default(), bandwidth_hz, ts)
-    }
-
-    /// A tracker of `bandwidth_hz` sampled every `ts` with `tuning`'s `tracker_damping` and
-    /// `bandwidth_definition`: what the estimator builds for T2S-1 and T2S-2.
-    pub fn with_tuning(tuning: &EstimatorTuning<T>, bandwidth_hz: T, ts: T) -> Self {
         Self {
             ts,
             bandwidth_hz,
-            damping: tuning.tracker_damping,
-            definition: tuning.bandwidth_definition,
+            damping: T::lit(DEFAULT_DAMPING),
+            definition: BandwidthDefinition::default(),
         }
     }
 

@@ -112,14 +112,7 @@ fn every_motor_dependent_value_scales_with_the_motor() {
     assert!(close(speed.kp() * 3.0, kp_mech));
     let i_max = drive.current_limit_ratio * 6.0;
     assert!(sc.i_max > i_max, "{} against {i_max}", sc.i_max);
-    let no_mtpa = SpeedControllerConfig::with_tuning(
-        &ipm,
-        &DriveTuning {
-            mtpa: false,
-            ..drive
-        },
-        TS,
-    );
+    let no_mtpa = SpeedControllerConfig::new(&ipm, i_max, false, TS);
     assert!(close(no_mtpa.i_max, i_max));
     // Current loop (docs/method/estimator.md, "The paper's motor and drive"): Kp,d = L̂d·ωc, Ki = R̂s·ωc from the model.
     let cc = CurrentControllerConfig::for_machine(&ipm, TS);

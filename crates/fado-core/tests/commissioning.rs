@@ -158,6 +158,7 @@ fn config<T: Real>(m: MachineModel<f64>) -> CommissioningConfig<T> {
         rated_speed_rpm: T::lit(m.rated_speed_rpm),
         rated_torque: T::lit(m.rated_torque),
         dc_voltage: T::lit(VDC),
+        magnetics: Default::default(),
     };
     CommissioningConfig::for_machine(np, T::lit(TS), T::lit(2.5e-6))
 }

@@ -730,6 +730,7 @@ mod properties {
                         rated_speed_rpm: rpm,
                         rated_torque: torque * 1.5 * p as f64 * lf * i_rated,
                         dc_voltage: dc * 3f64.sqrt() * w * lf,
+                        magnetics: Default::default(),
                     }
                 },
             )

@@ -8,8 +8,7 @@ use core::f64::consts::TAU;
 use std::vec::Vec;
 
 use fado_core::control::{
-    DeadTimeCompensation, DeadTimeCompensationConfig, DeadTimeMethod, DriveConfig, DriveOutput,
-    SensorlessDrive,
+    DeadTimeCompensation, DeadTimeMethod, DriveConfig, DriveOutput, SensorlessDrive,
 };
 use fado_core::estimator::EstimatorTuning;
 use fado_core::{
@@ -171,11 +170,7 @@ fn duties_realise_the_reference_plus_the_dead_time_compensation() {
     };
     let mut drive = SensorlessDrive::with_estimator(cfg, spy).unwrap();
     // The drive's own compensation, built from the same machine model and tuning.
-    let dtc = DeadTimeCompensation::new(DeadTimeCompensationConfig::with_tuning(
-        &cfg.machine,
-        &cfg.tuning,
-    ))
-    .unwrap();
+    let dtc = DeadTimeCompensation::new(cfg.dead_time_compensation_config()).unwrap();
     let mut saturated = 0;
     for n in 0..200 {
         let vdc = if n % 3 == 0 { 20.0 } else { 300.0 };
@@ -819,6 +814,7 @@ fn stall_band_widens_with_the_reluctance_torque() {
         rated_speed_rpm: 2550.0,
         rated_torque: 19.0,
         dc_voltage: 310.0,
+        magnetics: Default::default(),
     };
     for (machine, salient) in [
         (MachineModel::paper(), false),

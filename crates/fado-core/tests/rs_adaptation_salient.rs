@@ -37,6 +37,7 @@ fn model(rs_ratio: f64, with_ld: bool) -> MachineModel<f64> {
         rated_speed_rpm: 1500.0,
         rated_torque: 1.5 * M.pp * M.lf * RATED,
         dc_voltage: 540.0,
+        magnetics: Default::default(),
     }
 }
 

@@ -154,6 +154,7 @@ pub fn complete_motor(user: &mut toml::Table, text: &str) -> Result<Vec<Derived>
         rated_speed_rpm: speed,
         rated_torque: torque,
         dc_voltage: 0.0,
+        magnetics: Default::default(),
     };
     let mut inverter = match user.get("inverter") {
         Some(toml::Value::Table(t)) => t.clone(),

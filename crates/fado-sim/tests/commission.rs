@@ -22,6 +22,7 @@ pub fn ipmsm() -> (PlantParams, MachineModel<f64>) {
         rated_speed_rpm: 1500.0,
         rated_torque: 14.7,
         dc_voltage: 540.0,
+        magnetics: Default::default(),
     };
     p.motor = m;
     (p, m)

@@ -236,6 +236,7 @@ fn a_10_kv_motor_is_not_refused_by_a_key_no_user_can_set() {
         rated_speed_rpm: 1500.0,
         rated_torque: 6350.0,
         dc_voltage: 10_000.0,
+        magnetics: Default::default(),
     };
     let findings = fado_core::machine_checks::check(&m, Some(100e-6));
     assert!(findings.is_empty(), "{findings:?}");

@@ -31,7 +31,6 @@
 
 use fado_core::approx::atan2;
 use fado_core::observer::DiscreteGains;
-use fado_core::tracker::TrackerConfig;
 use fado_core::{Ab, EstimatorConfig, Real};
 
 /// Tracker angle units per radian, 2³²/2π (fado's `f32` `Real::Angle`, the same rounding).
@@ -117,7 +116,7 @@ impl PaperKernel {
         let m = &config.machine;
         let t = &config.tuning;
         let tracker = |bandwidth_hz| {
-            let (kp, ki) = TrackerConfig::with_tuning(t, bandwidth_hz, ts).gains();
+            let (kp, ki) = config.tracker_config(bandwidth_hz).gains();
             (ts * kp, ki * ts * RAD_PER_UNIT)
         };
         let (kp_ts1, ki_ts1) = tracker(t.t2s1_bandwidth_hz);

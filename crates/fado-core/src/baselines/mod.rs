@@ -127,7 +127,7 @@ pub struct CommonTuning<T> {
     pub average_current: bool,
     /// Samples with |i| above this × the machine's `rated_current` are refused (see
     /// [`crate::plausibility`]). Default 4, as fado's
-    /// ([`crate::EstimatorTuning::plausible_current_ratio`]).
+    /// ([`crate::plausibility::CURRENT_RATIO`]).
     pub plausible_current_ratio: T,
     /// Samples with |v| above this × the machine's `dc_voltage` are refused. Default 1.5, as
     /// fado's.
@@ -177,7 +177,7 @@ impl<T: Real> CommonTuning<T> {
 /// current and DC link), the [`CommonTuning`] every estimator shares, and the baseline's own
 /// settings `S` (plain numbers whose defaults do not depend on the machine).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct BaselineConfig<T, S> {
+pub struct BaselineConfig<T: 'static, S> {
     /// The drive's model of the machine.
     pub machine: MachineModel<T>,
     /// Sampling, trackers, integrand and sample bounds, as fado's.

@@ -1,14 +1,14 @@
 //! [`CommissioningConfig`]: the nameplate, the sampling period, the dead time and the
 //! procedure's settings.
 
-use crate::control::DriveTuning;
+use crate::control::gain_calibration::DEFAULT_MAX_MISMATCH;
 use crate::error::{ConfigError, check};
 use crate::{MachineModel, Real};
 
 /// Configuration. Build it with [`CommissioningConfig::for_machine`]; every default is a ratio
 /// of a rating or a duration in seconds (the brief's rule), stated on its field.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct CommissioningConfig<T> {
+pub struct CommissioningConfig<T: 'static> {
     /// The nameplate: ratings trusted, parameters rough (module docs). Required.
     pub nameplate: MachineModel<T>,
     /// Sampling (control) period Ts in s. Required.
@@ -50,9 +50,9 @@ pub struct CommissioningConfig<T> {
     /// a machine with τ above ≈ 0.2 s (a 10 kV motor) has longer phases, not a bad input.
     pub phase_timeout: T,
     /// Largest current-sensor gain mismatch |k − 1| the DC test accepts as a measurement
-    /// (module docs, step 3); a larger one leaves phase a uncorrected. Default the drive's
-    /// [`DriveTuning::gain_calibration_max_mismatch`] (0.05), so that the procedure works in
-    /// the scale the drive will.
+    /// (module docs, step 3); a larger one leaves phase a uncorrected. Default the gain
+    /// calibration's [`DEFAULT_MAX_MISMATCH`] (0.05), the drive's default too, so that the
+    /// procedure works in the scale the drive will.
     pub max_gain_mismatch: T,
 }
 
@@ -79,7 +79,7 @@ impl<T: Real> CommissioningConfig<T> {
             // 5 s, or twice the longest phase of a slow machine (the phases scale with τ).
             phase_timeout: T::lit(5.0)
                 .max(T::lit(2.0) * (T::lit(2.0) * align_time + settle_time + T::lit(0.25))),
-            max_gain_mismatch: DriveTuning::<T>::default().gain_calibration_max_mismatch,
+            max_gain_mismatch: T::lit(DEFAULT_MAX_MISMATCH),
         }
     }
 

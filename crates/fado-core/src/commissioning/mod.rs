@@ -175,7 +175,7 @@ use sizing::{clamp, dc_level, dead_time_voltage, libm_round, limit, spin_sizing}
 
 /// The commissioning state machine (module docs).
 #[derive(Clone, Debug)]
-pub struct Commissioning<T> {
+pub struct Commissioning<T: 'static> {
     cfg: CommissioningConfig<T>,
     ts: T,
     i_limit: T,

@@ -27,7 +27,7 @@ pub struct Confidence<T> {
 
 /// The identified motor and inverter.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Identification<T> {
+pub struct Identification<T: 'static> {
     /// The identified model: parameters measured, ratings copied from the nameplate.
     pub model: MachineModel<T>,
     /// Statistical uncertainty of each parameter.

@@ -2,8 +2,7 @@
 //! sensors' gain ratio) and the inductance injections.
 
 use super::*;
-use crate::control::DriveTuning;
-use crate::control::gain_calibration::{ratio_of, resistance_of};
+use crate::control::gain_calibration::{self, ratio_of, resistance_of};
 use crate::{Ab, Real};
 
 impl<T: Real> Commissioning<T> {
@@ -346,7 +345,7 @@ impl<T: Real> Commissioning<T> {
         if !self.gain_swing_settled {
             return none;
         }
-        let min_share = DriveTuning::<T>::default().gain_calibration_min_observability;
+        let min_share = T::lit(gain_calibration::DEFAULT_MIN_OBSERVABILITY);
         let Some(k) = ratio_of(di, dv, min_share) else {
             return none;
         };

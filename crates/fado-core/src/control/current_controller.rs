@@ -16,7 +16,6 @@
 //! voltage, the caller limits it (to the hexagon, after rotation and compensation) and hands
 //! the realisable d-q voltage back through [`CurrentController::realised`].
 
-use crate::control::DriveTuning;
 use crate::control::pi::{Pi, PiConfig};
 use crate::error::{ConfigError, NonFiniteInput, check};
 use crate::{Dq, MachineModel, Real};
@@ -27,6 +26,16 @@ use crate::{Dq, MachineModel, Real};
 /// (24–565 V). An absolute voltage, not a ratio of the DC link: it only ever acts on estimates
 /// that are wrong, and changing it would change no result of a working drive.
 pub const CURRENT_VOLTAGE_BOUND: f64 = 1000.0;
+
+/// Default closed-loop bandwidth of the current loop in Hz: 250 (paper, V).
+pub const DEFAULT_BANDWIDTH_HZ: f64 = 250.0;
+
+/// Default of [`CurrentControllerConfig::decoupling`]: on (docs/method/estimator.md, "The
+/// paper's motor and drive" \[A\]).
+pub const DEFAULT_DECOUPLING: bool = true;
+
+/// Default back-calculation gain in units of Ki/Kp: 1, the realisable reference \[A\].
+pub const DEFAULT_ANTI_WINDUP_RATIO: f64 = 1.0;
 
 /// Configuration of a [`CurrentController`].
 ///
@@ -46,15 +55,13 @@ pub struct CurrentControllerConfig<T> {
     /// Magnet flux linkage estimate λ̂f in Wb (back-EMF feed-forward): the machine model's
     /// (the paper's motor: 0.088 Wb, docs/method/estimator.md, "The paper's motor and drive" \[A\]).
     pub flux_linkage_hat: T,
-    /// Closed-loop bandwidth in Hz. Default 250 Hz (paper, V;
-    /// [`DriveTuning::current_bandwidth_hz`]). Limited to ωc·Ts ≤ 0.5 so the 1.5-sample loop
+    /// Closed-loop bandwidth in Hz. Default [`DEFAULT_BANDWIDTH_HZ`] (250 Hz, paper V). Limited to ωc·Ts ≤ 0.5 so the 1.5-sample loop
     /// delay leaves at least 47° of phase margin.
     pub bandwidth_hz: T,
-    /// Add the decoupling and back-EMF feed-forward. Default true (docs/method/estimator.md, "The paper's motor and drive" \[A\];
-    /// [`DriveTuning::decoupling`]).
+    /// Add the decoupling and back-EMF feed-forward. Default true (docs/method/estimator.md, "The paper's motor and drive" \[A\]).
     pub decoupling: bool,
     /// Back-calculation gain as a multiple of Ki/Kp = R̂s/L̂ (see [`PiConfig`]). Default 1, the
-    /// realisable reference \[A\] ([`DriveTuning::current_anti_windup_ratio`]).
+    /// realisable reference \[A\].
     pub anti_windup_ratio: T,
     /// Hard bound on each axis' voltage and integral in V, a last guard against absurd
     /// estimates; the real limit is the inverter's (modulation). Default
@@ -63,27 +70,20 @@ pub struct CurrentControllerConfig<T> {
 }
 
 impl<T: Real> CurrentControllerConfig<T> {
-    /// The current loop for `machine` sampled every `ts`, with the drive's default tuning
-    /// ([`DriveTuning::default`]). Same as [`with_tuning`](Self::with_tuning)`(machine,
-    /// &DriveTuning::default(), ts)`.
+    /// The current loop for `machine` sampled every `ts`: R̂s, L̂d, L̂q and λ̂f are the machine
+    /// model's, `bandwidth_hz` [`DEFAULT_BANDWIDTH_HZ`], `decoupling` [`DEFAULT_DECOUPLING`],
+    /// `anti_windup_ratio` [`DEFAULT_ANTI_WINDUP_RATIO`] and `voltage_bound`
+    /// [`CURRENT_VOLTAGE_BOUND`].
     pub fn for_machine(machine: &MachineModel<T>, ts: T) -> Self {
-        Self::with_tuning(machine, &DriveTuning::default(), ts)
-    }
-
-    /// The current loop for `machine` with `tuning`, sampled every `ts`: what the drive
-    /// builds. R̂s, L̂d, L̂q and λ̂f are the machine model's; `bandwidth_hz`, `decoupling` and
-    /// `anti_windup_ratio` the tuning's `current_bandwidth_hz`, `decoupling` and
-    /// `current_anti_windup_ratio`; `voltage_bound` is [`CURRENT_VOLTAGE_BOUND`].
-    pub fn with_tuning(machine: &MachineModel<T>, tuning: &DriveTuning<T>, ts: T) -> Self {
         Self {
             ts,
             rs_hat: machine.rs,
             ld_hat: machine.ld,
             lq_hat: machine.lq,
             flux_linkage_hat: machine.flux_linkage,
-            bandwidth_hz: tuning.current_bandwidth_hz,
-            decoupling: tuning.decoupling,
-            anti_windup_ratio: tuning.current_anti_windup_ratio,
+            bandwidth_hz: T::lit(DEFAULT_BANDWIDTH_HZ),
+            decoupling: DEFAULT_DECOUPLING,
+            anti_windup_ratio: T::lit(DEFAULT_ANTI_WINDUP_RATIO),
             voltage_bound: T::lit(CURRENT_VOLTAGE_BOUND),
         }
     }

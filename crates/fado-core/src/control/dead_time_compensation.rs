@@ -48,7 +48,6 @@
 //! voltage/current distortion in PWM VSI systems operating
 //! with low output voltages", IEEE Trans. Ind. Appl. 31(5), 1995.
 
-use crate::control::DriveTuning;
 use crate::control::pi::clamp;
 use crate::error::{ConfigError, check};
 use crate::{Ab, Abc, Dq, MachineModel, Real, Rotation};
@@ -72,27 +71,41 @@ pub enum DeadTimeMethod {
     EdgeCurrent,
 }
 
+/// Default dead time Td in s: 2.5 µs (paper, V).
+pub const DEFAULT_DEAD_TIME: f64 = 2.5e-6;
+/// Default shape of the compensation: [`DeadTimeMethod::EdgeCurrent`] \[A\] (the
+/// docs/method/estimator.md §7 trapezoid at each switching edge's predicted current; it keeps
+/// |λ̂r| from shrinking while a phase current sits in the band at standstill under load,
+/// docs/method/additions.md).
+pub const DEFAULT_METHOD: DeadTimeMethod = DeadTimeMethod::EdgeCurrent;
+/// Default switching frequency in Hz: 5 kHz (paper, V).
+pub const DEFAULT_SWITCHING_FREQUENCY: f64 = 5e3;
+/// Default device threshold voltage in V: 1 (docs/method/estimator.md §7 \[A\]).
+pub const DEFAULT_THRESHOLD_VOLTAGE: f64 = 1.0;
+/// Default current band Ic of the trapezoid in A: 0.3 (docs/method/estimator.md §7 \[A\]).
+pub const DEFAULT_CURRENT_BAND: f64 = 0.3;
+
 /// Configuration of a [`DeadTimeCompensation`].
 ///
 /// No `Default`: the dead time, switching frequency, threshold and band are the inverter's and
-/// the ripple inductances the motor's. Build it with [`for_machine`](Self::for_machine) or
-/// [`with_tuning`](Self::with_tuning); each field's "Default" is what `for_machine` gives.
+/// the ripple inductances the motor's. Build it with [`for_machine`](Self::for_machine) and
+/// give your inverter's data in the fields; each field's "Default" is what `for_machine` gives.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DeadTimeCompensationConfig<T> {
-    /// Compensate at all. Default true (paper IV-B; [`DriveTuning::dead_time_compensation`]).
+    /// Compensate at all. Default true (paper IV-B).
     pub enabled: bool,
-    /// Shape. Default [`DeadTimeMethod::EdgeCurrent`] ([`DriveTuning::dead_time_method`]).
+    /// Shape. Default [`DEFAULT_METHOD`] (edge current).
     pub method: DeadTimeMethod,
-    /// Dead time Td in s (inverter datum). Default 2.5 µs (paper, V; [`DriveTuning::dead_time`]).
+    /// Dead time Td in s (inverter datum). Default [`DEFAULT_DEAD_TIME`] (2.5 µs, paper V).
     pub dead_time: T,
-    /// Switching frequency f_sw in Hz (inverter datum). Default 5 kHz (paper, V;
-    /// [`DriveTuning::switching_frequency`]).
+    /// Switching frequency f_sw in Hz (inverter datum). Default
+    /// [`DEFAULT_SWITCHING_FREQUENCY`] (5 kHz, paper V).
     pub switching_frequency: T,
-    /// Device threshold voltage V_th in V (inverter datum). Default 1 V (docs/method/estimator.md §7 \[A\];
-    /// [`DriveTuning::dead_time_threshold_voltage`]).
+    /// Device threshold voltage V_th in V (inverter datum). Default
+    /// [`DEFAULT_THRESHOLD_VOLTAGE`] (1 V, docs/method/estimator.md §7 \[A\]).
     pub threshold_voltage: T,
-    /// Current band Ic of the trapezoid in A (inverter datum). Default 0.3 A (docs/method/estimator.md §7 \[A\];
-    /// [`DriveTuning::dead_time_current_band`]).
+    /// Current band Ic of the trapezoid in A (inverter datum). Default
+    /// [`DEFAULT_CURRENT_BAND`] (0.3 A, docs/method/estimator.md §7 \[A\]).
     pub current_band: T,
     /// Inductances (L̂d, L̂q) of the ripple prediction of [`DeadTimeMethod::EdgeCurrent`] in H,
     /// in the rotor frame of the rotation it is given; 0: no ripple (the trapezoid). Default
@@ -102,24 +115,18 @@ pub struct DeadTimeCompensationConfig<T> {
 
 impl<T: Real> DeadTimeCompensationConfig<T> {
     /// The compensation for `machine` (ripple inductances L̂d, L̂q of the edge-current method)
-    /// on the drive's default inverter data and method ([`DriveTuning::default`]: 2.5 µs,
-    /// 5 kHz (paper, V), 1 V, 0.3 A (docs/method/estimator.md §7 \[A\]), [`DeadTimeMethod::EdgeCurrent`]).
-    /// Those inverter data are the paper's set-up: give your inverter's through
-    /// [`with_tuning`](Self::with_tuning) or the fields.
+    /// on the paper's inverter data ([`DEFAULT_DEAD_TIME`] 2.5 µs and
+    /// [`DEFAULT_SWITCHING_FREQUENCY`] 5 kHz, paper V; [`DEFAULT_THRESHOLD_VOLTAGE`] 1 V and
+    /// [`DEFAULT_CURRENT_BAND`] 0.3 A, docs/method/estimator.md §7 \[A\]) with
+    /// [`DeadTimeMethod::EdgeCurrent`]. Give your inverter's data in the fields.
     pub fn for_machine(machine: &MachineModel<T>) -> Self {
-        Self::with_tuning(machine, &DriveTuning::default())
-    }
-
-    /// The compensation for `machine` with `tuning`'s `dead_time*` and `switching_frequency`
-    /// fields: what the drive builds.
-    pub fn with_tuning(machine: &MachineModel<T>, tuning: &DriveTuning<T>) -> Self {
         Self {
-            enabled: tuning.dead_time_compensation,
-            method: tuning.dead_time_method,
-            dead_time: tuning.dead_time,
-            switching_frequency: tuning.switching_frequency,
-            threshold_voltage: tuning.dead_time_threshold_voltage,
-            current_band: tuning.dead_time_current_band,
+            enabled: true,
+            method: DEFAULT_METHOD,
+            dead_time: T::lit(DEFAULT_DEAD_TIME),
+            switching_frequency: T::lit(DEFAULT_SWITCHING_FREQUENCY),
+            threshold_voltage: T::lit(DEFAULT_THRESHOLD_VOLTAGE),
+            current_band: T::lit(DEFAULT_CURRENT_BAND),
             ripple_inductance: Dq::new(machine.ld, machine.lq),
         }
     }

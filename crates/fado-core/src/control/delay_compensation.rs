@@ -8,9 +8,12 @@
 //! 1.5·ω·Ts (0.094 rad at 1500 r/min), which couples the axes and, in the estimator, rotates
 //! the integrand.
 
-use crate::control::DriveTuning;
 use crate::error::{ConfigError, check};
 use crate::{Ab, Dq, Real, Rotation, wrap_angle};
+
+/// Default advance in samples: 1 of computation + ½ of PWM hold (docs/method/estimator.md §7
+/// \[A\], ref. \[13\]).
+pub const DEFAULT_FACTOR: f64 = 1.5;
 
 /// Configuration of a [`DelayCompensation`].
 ///
@@ -19,25 +22,19 @@ use crate::{Ab, Dq, Real, Rotation, wrap_angle};
 pub struct DelayCompensationConfig<T> {
     /// Sampling period Ts in s (paper, V: 100 µs). No default: the set-up's.
     pub ts: T,
-    /// Advance in samples k: 1 of computation + ½ of PWM hold. Default 1.5 (docs/method/estimator.md §7 \[A\];
-    /// [`DriveTuning::delay_compensation_factor`]);
+    /// Advance in samples k: 1 of computation + ½ of PWM hold. Default [`DEFAULT_FACTOR`] (1.5,
+    /// docs/method/estimator.md §7 \[A\]);
     /// 0 switches the compensation off.
     pub factor: T,
 }
 
 impl<T: Real> DelayCompensationConfig<T> {
-    /// The compensation sampled every `ts` with the drive's default advance
-    /// ([`DriveTuning::default`]'s `delay_compensation_factor`, 1.5 samples).
+    /// The compensation sampled every `ts` with the default advance of 1.5 samples
+    /// ([`DEFAULT_FACTOR`]).
     pub fn with_ts(ts: T) -> Self {
-        Self::with_tuning(&DriveTuning::default(), ts)
-    }
-
-    /// The compensation sampled every `ts` with `tuning`'s `delay_compensation_factor`: what
-    /// the drive builds.
-    pub fn with_tuning(tuning: &DriveTuning<T>, ts: T) -> Self {
         Self {
             ts,
-            factor: tuning.delay_compensation_factor,
+            factor: T::lit(DEFAULT_FACTOR),
         }
     }
 }

@@ -52,13 +52,13 @@ impl DriveFlags {
     pub const INPUT_IMPLAUSIBLE: Self = Self(1 << 9);
     /// The speed does not follow the torque: the speed loop asks for a torque below the
     /// current limit and ω̂ has left a reference it had caught without answering that torque
-    /// (the drive's stall symptom, `DriveTuning::lock_stall_speed_ratio`; a live status that
+    /// (the drive's stall symptom, docs/method/lock.md; a live status that
     /// heals), or the drive coasts because of it: a reason for [`COASTING`](Self::COASTING).
     /// Either the rotor itself stalls or lags under its load, or the estimate has left the
     /// rotor near zero speed, where a back-EMF estimator cannot tell the two apart from v and
     /// i (docs/method/lock.md). Reported apart from
     /// [`LOCK_LOST`](Self::LOCK_LOST) so that a real stall is not called a lost estimate; it
-    /// starts the lock reaction too unless `DriveTuning::lock_reaction_on_stall` is off.
+    /// starts the lock reaction too unless the drive is told to report it only.
     pub const STALLED: Self = Self(1 << 10);
 
     /// Every flag with its name, in bit order (for tables and trace decoding).

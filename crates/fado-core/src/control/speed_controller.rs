@@ -6,10 +6,22 @@
 //! ≈ ωsc and atan(5) = 79° of phase margin. Those gains are per *mechanical* rad/s; the
 //! controller works in electrical rad/s (the estimator's unit), so it divides Kp and Ki by p.
 
-use crate::control::DriveTuning;
 use crate::control::pi::{Pi, PiConfig};
 use crate::error::{ConfigError, NonFiniteInput, check};
+use crate::machine::PAPER_RATED_CURRENT;
 use crate::{Dq, MachineModel, Real};
+
+/// Default speed-loop bandwidth in Hz: 5 (paper, V).
+pub const DEFAULT_BANDWIDTH_HZ: f64 = 5.0;
+/// Default ratio of the crossover to the PI zero: 5 (docs/method/estimator.md, "The paper's
+/// motor and drive").
+pub const DEFAULT_ZERO_RATIO: f64 = 5.0;
+/// Default back-calculation gain in units of Ki/Kp: 5, tracking at ωsc \[A\] (see
+/// [`SpeedControllerConfig::anti_windup_ratio`]).
+pub const DEFAULT_ANTI_WINDUP_RATIO: f64 = 5.0;
+/// Default current limit I_max as a multiple of the rated current: 40/21.78
+/// (docs/method/estimator.md, "The paper's motor and drive" \[A\]: 40 A on the paper's motor).
+pub const DEFAULT_CURRENT_LIMIT_RATIO: f64 = 40.0 / PAPER_RATED_CURRENT;
 
 /// Configuration of a [`SpeedController`].
 ///
@@ -27,17 +39,17 @@ pub struct SpeedControllerConfig<T> {
     /// Magnet flux linkage estimate λ̂f in Wb, for K̂t = 1.5·p·λ̂f: the machine model's (the
     /// paper's motor: 0.088, docs/method/estimator.md, "The paper's motor and drive" \[A\]).
     pub flux_linkage_hat: T,
-    /// Speed-loop bandwidth in Hz. Default 5 Hz (paper, V; [`DriveTuning::speed_bandwidth_hz`]).
+    /// Speed-loop bandwidth in Hz. Default [`DEFAULT_BANDWIDTH_HZ`] (5 Hz, paper V).
     pub bandwidth_hz: T,
     /// Ratio ωsc/(Ki/Kp): the PI zero sits this many times below the crossover. Default 5
-    /// (docs/method/estimator.md, "The paper's motor and drive": Ki = Kp·2π·5/5; [`DriveTuning::speed_zero_ratio`]).
+    /// (docs/method/estimator.md, "The paper's motor and drive": Ki = Kp·2π·5/5; [`DEFAULT_ZERO_RATIO`]).
     pub zero_ratio: T,
     /// Output limit in A of q current (in units of the magnet's q current on a salient rotor
-    /// with MTPA). Default [`DriveTuning::current_limit_ratio`] × the rated current (docs/method/estimator.md, "The paper's motor and drive"
-    /// \[A\]: 40 A on the paper's motor), see [`with_tuning`](Self::with_tuning).
+    /// with MTPA). Default [`DEFAULT_CURRENT_LIMIT_RATIO`] × the rated current (docs/method/estimator.md, "The paper's motor and drive"
+    /// \[A\]: 40 A on the paper's motor), see [`torque_limit`](Self::torque_limit).
     pub i_max: T,
     /// Back-calculation gain as a multiple of Ki/Kp (see [`PiConfig`]; default
-    /// [`DriveTuning::speed_anti_windup_ratio`]). Default 5, i.e. a
+    /// [`DEFAULT_ANTI_WINDUP_RATIO`]). Default 5, i.e. a
     /// tracking time constant of 1/ωsc: with the realisable setting (1) the integral relaxes
     /// only with 5/ωsc = 160 ms and a long saturated acceleration leaves it near I_max,
     /// which costs a large speed overshoot \[A\].
@@ -45,25 +57,41 @@ pub struct SpeedControllerConfig<T> {
 }
 
 impl<T: Real> SpeedControllerConfig<T> {
-    /// The speed loop for `machine` sampled every `ts`, with the drive's default tuning
-    /// ([`DriveTuning::default`]). Same as [`with_tuning`](Self::with_tuning)`(machine,
-    /// &DriveTuning::default(), ts)`.
+    /// The speed loop for `machine` sampled every `ts` with the default bandwidth, zero and
+    /// back-calculation ([`DEFAULT_BANDWIDTH_HZ`], [`DEFAULT_ZERO_RATIO`],
+    /// [`DEFAULT_ANTI_WINDUP_RATIO`]) and the default current limit
+    /// [`DEFAULT_CURRENT_LIMIT_RATIO`] × the rated current with MTPA. Same as
+    /// [`new`](Self::new)`(machine, DEFAULT_CURRENT_LIMIT_RATIO × rated current, true, ts)`.
     pub fn for_machine(machine: &MachineModel<T>, ts: T) -> Self {
-        Self::with_tuning(machine, &DriveTuning::default(), ts)
+        let i_max = T::lit(DEFAULT_CURRENT_LIMIT_RATIO) * machine.rated_current;
+        Self::new(machine, i_max, true, ts)
     }
 
-    /// The speed loop for `machine` with `tuning`, sampled every `ts`: what the drive builds.
-    /// p, Ĵ and λ̂f are the machine model's; `bandwidth_hz`, `zero_ratio` and
-    /// `anti_windup_ratio` the tuning's `speed_*` fields; `i_max` is the current limit
-    /// `current_limit_ratio` × the rated current, raised on a salient rotor with `mtpa` to the
-    /// torque of the MTPA point on the circle |i| = I_max, in units of the magnet's q current
-    /// (see the field), so that saturation still reaches I_max.
-    pub fn with_tuning(machine: &MachineModel<T>, tuning: &DriveTuning<T>, ts: T) -> Self {
+    /// The speed loop for `machine` under the current limit `i_max` (A), sampled every `ts`,
+    /// with the default bandwidth, zero and back-calculation. p, Ĵ and λ̂f are the machine
+    /// model's; `i_max` is [`torque_limit`](Self::torque_limit)`(machine, i_max, mtpa)`.
+    pub fn new(machine: &MachineModel<T>, i_max: T, mtpa: bool, ts: T) -> Self {
         let m = machine;
-        let i_max = tuning.current_limit_ratio * m.rated_current;
+        Self {
+            ts,
+            pole_pairs: T::lit(m.pole_pairs as f64),
+            inertia_hat: m.inertia,
+            flux_linkage_hat: m.flux_linkage,
+            bandwidth_hz: T::lit(DEFAULT_BANDWIDTH_HZ),
+            zero_ratio: T::lit(DEFAULT_ZERO_RATIO),
+            i_max: Self::torque_limit(m, i_max, mtpa),
+            anti_windup_ratio: T::lit(DEFAULT_ANTI_WINDUP_RATIO),
+        }
+    }
+
+    /// The output limit for the current limit `i_max` (A): `i_max`, raised on a salient rotor
+    /// with `mtpa` to the torque of the MTPA point on the circle |i| = I_max, in units of the
+    /// magnet's q current (see the field), so that saturation still reaches I_max.
+    pub fn torque_limit(machine: &MachineModel<T>, i_max: T, mtpa: bool) -> T {
+        let m = machine;
         // i_d = (λ̂f − √(λ̂f² + 8·ΔL²·I_max²))/(4·ΔL), ΔL = L̂q − L̂d (Morimoto et al. 1990).
         let dl = m.lq - m.ld;
-        let torque_limit = if tuning.mtpa && m.is_salient() && dl > T::zero() {
+        if mtpa && m.is_salient() && dl > T::zero() {
             let lf = m.flux_linkage;
             let id = (lf - (lf * lf + T::lit(8.0) * dl * dl * i_max * i_max).step_sqrt())
                 / (T::lit(4.0) * dl);
@@ -71,16 +99,6 @@ impl<T: Real> SpeedControllerConfig<T> {
             (m.active_flux(id) * iq / lf).step_max(i_max)
         } else {
             i_max
-        };
-        Self {
-            ts,
-            pole_pairs: T::lit(m.pole_pairs as f64),
-            inertia_hat: m.inertia,
-            flux_linkage_hat: m.flux_linkage,
-            bandwidth_hz: tuning.speed_bandwidth_hz,
-            zero_ratio: tuning.speed_zero_ratio,
-            i_max: torque_limit,
-            anti_windup_ratio: tuning.speed_anti_windup_ratio,
         }
     }
 }
@@ -140,6 +158,12 @@ impl<T: Real> SpeedController<T> {
     #[inline]
     pub fn step(&mut self, omega_ref: T, omega: T) -> Result<T, NonFiniteInput> {
         self.pi.step(omega_ref - omega, T::zero())
+    }
+
+    /// Presets the integral to `iq` (A, clamped to ±I_max): a bumpless start from a known
+    /// torque demand (the release hold's pre-torque).
+    pub fn preset(&mut self, iq: T) {
+        self.pi.reset_to(iq);
     }
 
     /// Anti-windup for a further limit of i_q* downstream (the current-vector limit with

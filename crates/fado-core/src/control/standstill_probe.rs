@@ -51,8 +51,8 @@
 use crate::Real;
 use crate::error::{ConfigError, check};
 
-/// The probe's settings in absolute units (the drive resolves them from
-/// [`crate::control::DriveTuning`]'s ratios, see its `standstill_probe_*` fields).
+/// The probe's settings in absolute units (its user resolves them from its own ratios of the
+/// machine's ratings).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StandstillProbeConfig<T> {
     /// Sampling period, s.

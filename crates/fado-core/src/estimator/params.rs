@@ -5,14 +5,14 @@ use super::{
     EstimatorConfig, EstimatorParams, EstimatorState, FLUX_SETTLE_TIME_CONSTANTS,
     MAX_OBSERVER_GAIN_PERIOD,
 };
+use crate::active_flux::ActiveFlux;
 use crate::error::{ConfigError, check};
 use crate::flux::{
-    DisturbanceFeedbackConfig, DisturbanceFeedbackParams, FluxIntegratorConfig,
-    FluxIntegratorParams, FluxIntegratorState, FluxLimiter, FluxLimiterConfig,
+    DisturbanceFeedbackParams, FluxIntegratorParams, FluxIntegratorState, FluxLimiter,
 };
-use crate::integrand_offset::{IntegrandOffsetConfig, IntegrandOffsetParams, IntegrandOffsetState};
+use crate::integrand_offset::{IntegrandOffsetParams, IntegrandOffsetState};
 use crate::lock::{LockDetectorParams, LockState, LockStatus};
-use crate::mode::{Mode, ModeSelectorConfig, ModeSelectorParams};
+use crate::mode::{Mode, ModeSelectorParams};
 use crate::observer::{
     DisturbanceObserverConfig, DisturbanceObserverParams, ObserverGains, ObserverState,
 };
@@ -82,6 +82,10 @@ impl<T: Real> EstimatorParams<T> {
             ts,
             lq: config.machine.lq,
             saliency: config.machine.ld - config.machine.lq,
+            active_flux: ActiveFlux::new(
+                config.machine.magnetic_model(),
+                config.machine.rated_current,
+            ),
             flux_linkage: lf,
             tracker_hold_ratio: hold,
             limiter_recentring_gain: if config.tuning.limiter_recentring {
@@ -133,6 +137,7 @@ impl<T: Real> EstimatorParams<T> {
         let mut state = EstimatorState {
             integrator: FluxIntegratorState::new(self.rs_initial),
             observer: ObserverState::zero(),
+            lq_secant: self.lq,
             t2s1: self.t2s1.state_at(T::zero(), T::zero()),
             t2s2: self.t2s2.state_at(T::zero(), T::zero()),
             kdf_gain: T::zero(),
@@ -194,31 +199,23 @@ struct SampleBlocks<T: Real> {
 
 impl<T: Real> SampleBlocks<T> {
     fn new(config: &EstimatorConfig<T>, ts: T) -> Result<Self, ConfigError> {
-        let (integrator, _) = FluxIntegratorParams::new(FluxIntegratorConfig::with_tuning(
-            &config.machine,
-            &config.tuning,
-            ts,
-        ))?;
+        let (integrator, _) = FluxIntegratorParams::new(config.flux_integrator_config(ts))?;
         let observer = DisturbanceObserverParams::new(DisturbanceObserverConfig { ts })?;
         let disturbance_feedback = DisturbanceFeedbackParams::new(
-            DisturbanceFeedbackConfig::with_tuning(&config.tuning, ts),
+            config.disturbance_feedback_config(ts),
         )
         .map_err(|e| match e.field() {
             "ramp_time" => rename("k_df_ramp_time")(e),
             _ => e,
         })?;
-        let limiter = FluxLimiter::new(FluxLimiterConfig::with_tuning(
-            &config.machine,
-            &config.tuning,
-        ))?;
-        let selector = ModeSelectorParams::new(ModeSelectorConfig::with_tuning(
-            &config.machine,
-            &config.tuning,
-        ))
-        .map_err(|e| match e.field() {
-            "threshold_hz" => rename("mode_threshold_ratio")(e),
-            _ => rename("mode_hysteresis_ratio")(e),
-        })?;
+        let limiter = FluxLimiter::new(config.limiter_config())?;
+        let selector =
+            ModeSelectorParams::new(config.mode_selector_config()).map_err(|e| {
+                match e.field() {
+                    "threshold_hz" => rename("mode_threshold_ratio")(e),
+                    _ => rename("mode_hysteresis_ratio")(e),
+                }
+            })?;
         below_nyquist(
             "mode_hysteresis_ratio",
             config.mode_threshold_hz() + config.mode_hysteresis_hz(),
@@ -227,8 +224,8 @@ impl<T: Real> SampleBlocks<T> {
         check::positive("tracker_damping", config.tuning.tracker_damping)?;
         let load_pole = config.tuning.tracker_load_pole_ratio;
         let (c1, c2) = (
-            config.tracker(config.tuning.t2s1_bandwidth_hz),
-            config.tracker(config.tuning.t2s2_bandwidth_hz),
+            config.tracker_config(config.tuning.t2s1_bandwidth_hz),
+            config.tracker_config(config.tuning.t2s2_bandwidth_hz),
         );
         let t2s1 = TrackerParams::new(c1)
             .map_err(rename("t2s1_bandwidth_hz"))?
@@ -333,14 +330,16 @@ fn slow_laws<T: Real>(
                 _ => e,
             }
         })?;
-    let offset = IntegrandOffsetParams::new(IntegrandOffsetConfig::with_tuning(
-        &config.machine,
-        &config.tuning,
-        config.slow_ts(),
-    ))
-    .map_err(|e| match e.field() {
-        "rate" => rename("offset_adaptation_rate")(e),
-        _ => rename("mode_threshold_ratio")(e),
-    })?;
-    Ok((rs_adaptation, offset))
+    let offset =
+        IntegrandOffsetParams::new(config.integrand_offset_config()).map_err(|e| {
+            match e.field() {
+                "rate" => rename("offset_adaptation_rate")(e),
+                _ => rename("mode_threshold_ratio")(e),
+            }
+        })?;
+    let active_flux = ActiveFlux::new(
+        config.machine.magnetic_model(),
+        config.machine.rated_current,
+    );
+    Ok((rs_adaptation.with_active_flux(active_flux), offset))
 }

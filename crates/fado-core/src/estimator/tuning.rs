@@ -3,7 +3,8 @@
 use super::OBSERVER_GAIN_PERIOD;
 use crate::Real;
 use crate::plausibility;
-use crate::tracker::BandwidthDefinition;
+use crate::tracker::{self, BandwidthDefinition};
+use crate::{flux, integrand_offset, mode, rs_adaptation};
 
 /// The estimator's tuning: every setting that is not the machine or the sampling period.
 /// Defaults are the paper's (section V) or the method pages', as each field says; none depends on the
@@ -320,30 +321,30 @@ impl<T: Real> EstimatorTuning<T> {
 impl<T: Real> Default for EstimatorTuning<T> {
     fn default() -> Self {
         Self {
-            k_df: T::lit(0.5),
+            k_df: T::lit(flux::DEFAULT_K_DF),
             k_df_ramp_time: T::zero(),
-            k_af: T::lit(2.0 * core::f64::consts::PI * 100.0),
-            limiter_radius_ratio: T::lit(1.15),
-            mode_threshold_ratio: T::lit(0.015),
-            mode_hysteresis_ratio: T::lit(0.002),
+            k_af: T::lit(flux::DEFAULT_K_AF),
+            limiter_radius_ratio: T::lit(flux::DEFAULT_LIMITER_RADIUS_RATIO),
+            mode_threshold_ratio: T::lit(mode::DEFAULT_THRESHOLD_RATIO),
+            mode_hysteresis_ratio: T::lit(mode::DEFAULT_HYSTERESIS_RATIO),
             t2s1_bandwidth_hz: T::lit(60.0),
             t2s2_bandwidth_hz: T::lit(35.0),
-            tracker_damping: T::lit(core::f64::consts::FRAC_1_SQRT_2),
-            bandwidth_definition: BandwidthDefinition::Minus3Db,
+            tracker_damping: T::lit(tracker::DEFAULT_DAMPING),
+            bandwidth_definition: BandwidthDefinition::default(),
             tracker_hold_ratio: T::lit(0.2),
             tracker_load_pole_ratio: T::zero(),
-            average_current: true,
+            average_current: flux::DEFAULT_AVERAGE_CURRENT,
             observer_on_rotor_flux: true,
             observer_lag_compensation: true,
             observer_gain_period: T::lit(OBSERVER_GAIN_PERIOD),
             rs_adaptation: true,
-            rs_adaptation_rate: T::one(),
-            rs_adaptation_excitation_floor: T::lit(0.2),
-            rs_adaptation_min_ratio: T::lit(0.5),
-            rs_adaptation_max_ratio: T::lit(2.0),
-            flux_linkage_adaptation_rate: T::lit(5.0),
-            offset_adaptation_rate: T::lit(2.0),
-            standstill_angle_rate: T::lit(2.0),
+            rs_adaptation_rate: T::lit(rs_adaptation::DEFAULT_RATE),
+            rs_adaptation_excitation_floor: T::lit(rs_adaptation::DEFAULT_EXCITATION_FLOOR),
+            rs_adaptation_min_ratio: T::lit(rs_adaptation::DEFAULT_MIN_RATIO),
+            rs_adaptation_max_ratio: T::lit(rs_adaptation::DEFAULT_MAX_RATIO),
+            flux_linkage_adaptation_rate: T::lit(rs_adaptation::DEFAULT_FLUX_LINKAGE_RATE),
+            offset_adaptation_rate: T::lit(integrand_offset::DEFAULT_RATE),
+            standstill_angle_rate: T::lit(rs_adaptation::DEFAULT_STANDSTILL_ANGLE_RATE),
             limiter_recentring: true,
             plausible_current_ratio: T::lit(plausibility::CURRENT_RATIO),
             plausible_voltage_ratio: T::lit(plausibility::VOLTAGE_RATIO),

@@ -41,10 +41,12 @@
 
 mod constant;
 mod flux_map;
+mod machine;
 mod saturation;
 
 pub use constant::ConstantInductance;
 pub use flux_map::{FluxMap, FluxMapError, FluxTable};
+pub use machine::{MachineMagnetics, zero_current_constants};
 pub use saturation::Saturation;
 
 use crate::{Dq, Real};

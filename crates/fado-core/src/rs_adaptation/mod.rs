@@ -142,7 +142,7 @@
 //! passage needs.
 
 use crate::error::ConfigError;
-use crate::estimator::EstimatorTuning;
+use crate::mode;
 use crate::real::all_finite;
 use crate::{Ab, MachineModel, Real};
 
@@ -173,10 +173,25 @@ pub const FLUX_LINKAGE_DEAD_ZONE: f64 = 0.01;
 /// is within this multiple of the configured λ̂f (module docs). 0.25 % (ours \[A\]).
 pub const FLUX_LINKAGE_DEAD_ZONE_OFF: f64 = 0.0025;
 
+/// Default γ in s⁻¹ ([`ResistanceAdaptationConfig::rate`]): 1 (ours \[A\], see the field).
+pub const DEFAULT_RATE: f64 = 1.0;
+/// Default χ0 ([`ResistanceAdaptationConfig::excitation_floor`]): 0.2 (ours \[A\]).
+pub const DEFAULT_EXCITATION_FLOOR: f64 = 0.2;
+/// Default lower bound of R̂s as a multiple of R0 ([`ResistanceAdaptationConfig::min_ratio`]):
+/// 0.5 (ours \[A\]).
+pub const DEFAULT_MIN_RATIO: f64 = 0.5;
+/// Default upper bound of R̂s as a multiple of R0 ([`ResistanceAdaptationConfig::max_ratio`]):
+/// 2 (ours \[A\]).
+pub const DEFAULT_MAX_RATIO: f64 = 2.0;
+/// Default γ_f in s⁻¹ ([`ResistanceAdaptationConfig::flux_linkage_rate`]): 5 (ours \[A\]).
+pub const DEFAULT_FLUX_LINKAGE_RATE: f64 = 5.0;
+/// Default k_θ in s⁻¹ ([`ResistanceAdaptationConfig::standstill_angle_rate`]): 2 (ours \[A\]).
+pub const DEFAULT_STANDSTILL_ANGLE_RATE: f64 = 2.0;
+
 /// Configuration of [`ResistanceAdaptation`].
 ///
 /// No `Default`: R0, λ̂f, L̂d and L̂q are the motor's. Build it with
-/// [`for_machine`](Self::for_machine) (or [`with_tuning`](Self::with_tuning)); the
+/// [`for_machine`](Self::for_machine) (or [`new`](Self::new)); the
 /// "Default" of each field below is what those constructors give.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ResistanceAdaptationConfig<T> {
@@ -255,47 +270,49 @@ pub struct ResistanceAdaptationConfig<T> {
 }
 
 impl<T: Real> ResistanceAdaptationConfig<T> {
-    /// The laws around `machine` with the estimator's default tuning
-    /// ([`EstimatorTuning::default`]), run with period `ts` (the sampling period if the law
-    /// runs every sample; the estimator runs it every `SLOW_PERIOD` samples). Same as
-    /// [`with_tuning`](Self::with_tuning)`(machine, &EstimatorTuning::default(), ts)`.
+    /// The laws around `machine` with the default rates and bounds (the `DEFAULT_*` constants
+    /// of this module) and the default Fig. 3 threshold ([`mode::DEFAULT_THRESHOLD_RATIO`]),
+    /// run with period `ts` (the sampling period if the law runs every sample; the estimator
+    /// runs it every `SLOW_PERIOD` samples). Same as
+    /// [`new`](Self::new)`(machine, DEFAULT_THRESHOLD_RATIO, ts)`.
     pub fn for_machine(machine: &MachineModel<T>, ts: T) -> Self {
-        Self::with_tuning(machine, &EstimatorTuning::default(), ts)
+        Self::new(machine, T::lit(mode::DEFAULT_THRESHOLD_RATIO), ts)
     }
 
-    /// The laws around `machine` with `tuning`, run with period `ts`: what the estimator
-    /// builds. Where each value comes from:
+    /// The laws around `machine` for the Fig. 3 threshold `threshold_ratio`·f_rated, run with
+    /// period `ts`, with the default rates and bounds. Where each value comes from:
     /// - `rs_initial`, `flux_linkage_hat`, `lq_hat`, `ld_hat`: the machine model (R̂s, λ̂f,
     ///   L̂q, L̂d).
     /// - `rate`, `excitation_floor`, `min_ratio`, `max_ratio`, `flux_linkage_rate`,
-    ///   `standstill_angle_rate`: the tuning's `rs_adaptation_*`, `flux_linkage_adaptation_rate`
-    ///   and `standstill_angle_rate` (defaults and their reasons in the fields' docs here).
+    ///   `standstill_angle_rate`: [`DEFAULT_RATE`], [`DEFAULT_EXCITATION_FLOOR`],
+    ///   [`DEFAULT_MIN_RATIO`], [`DEFAULT_MAX_RATIO`], [`DEFAULT_FLUX_LINKAGE_RATE`] and
+    ///   [`DEFAULT_STANDSTILL_ANGLE_RATE`] (their reasons in the fields' docs here).
     /// - `flux_linkage_min_speed`: three times the Fig. 3 threshold speed,
-    ///   3·2π·`mode_threshold_ratio`·f_rated (ours \[A\], see the field).
+    ///   3·2π·`threshold_ratio`·f_rated (ours \[A\], see the field).
     /// - `standstill_rate` 20 s⁻¹, `standstill_memory_hz` 0.5 Hz, `standstill_speed_hz`
     ///   0.25 Hz, `standstill_flux_rate` 2π·5 s⁻¹: fixed rates and durations of the standstill
     ///   law (ours \[A\], see the fields), the same for every motor.
-    pub fn with_tuning(machine: &MachineModel<T>, tuning: &EstimatorTuning<T>, ts: T) -> Self {
-        let threshold_hz = tuning.mode_threshold_ratio * machine.rated_frequency_hz();
+    pub fn new(machine: &MachineModel<T>, threshold_ratio: T, ts: T) -> Self {
+        let threshold_hz = threshold_ratio * machine.rated_frequency_hz();
         Self {
             ts,
             rs_initial: machine.rs,
             flux_linkage_hat: machine.flux_linkage,
-            flux_linkage_rate: tuning.flux_linkage_adaptation_rate,
-            rate: tuning.rs_adaptation_rate,
-            excitation_floor: tuning.rs_adaptation_excitation_floor,
+            flux_linkage_rate: T::lit(DEFAULT_FLUX_LINKAGE_RATE),
+            rate: T::lit(DEFAULT_RATE),
+            excitation_floor: T::lit(DEFAULT_EXCITATION_FLOOR),
             lq_hat: machine.lq,
             ld_hat: machine.ld,
             standstill_rate: T::lit(20.0),
             standstill_memory_hz: T::lit(0.5),
             standstill_speed_hz: T::lit(0.25),
             standstill_flux_rate: T::lit(2.0 * core::f64::consts::PI * 5.0),
-            standstill_angle_rate: tuning.standstill_angle_rate,
+            standstill_angle_rate: T::lit(DEFAULT_STANDSTILL_ANGLE_RATE),
             flux_linkage_min_speed: T::lit(FLUX_LINKAGE_SPEED_THRESHOLDS)
                 * T::two_pi()
                 * threshold_hz,
-            min_ratio: tuning.rs_adaptation_min_ratio,
-            max_ratio: tuning.rs_adaptation_max_ratio,
+            min_ratio: T::lit(DEFAULT_MIN_RATIO),
+            max_ratio: T::lit(DEFAULT_MAX_RATIO),
         }
     }
 }
@@ -368,7 +385,7 @@ impl<T: Real> ResistanceAdaptationState<T> {
 /// together. `step` advances them; the estimator uses the parameters' `next_state` on its own
 /// state so that a rejected sample changes nothing.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ResistanceAdaptation<T> {
+pub struct ResistanceAdaptation<T: 'static> {
     params: ResistanceAdaptationParams<T>,
     scale: ResistanceScale<T>,
     state: ResistanceAdaptationState<T>,

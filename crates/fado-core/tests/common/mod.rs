@@ -144,6 +144,7 @@ pub fn ipmsm_model() -> MachineModel<f64> {
         rated_speed_rpm: 1500.0,
         rated_torque: 14.9,
         dc_voltage: 540.0,
+        magnetics: Default::default(),
     }
 }
 
@@ -163,6 +164,7 @@ pub fn gem_50k_model(dc_voltage: f64) -> MachineModel<f64> {
         rated_speed_rpm: 3000.0,
         rated_torque: 160.6,
         dc_voltage,
+        magnetics: Default::default(),
     }
 }
 

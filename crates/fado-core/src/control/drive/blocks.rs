@@ -10,6 +10,7 @@ use crate::control::field_weakening::FieldWeakening;
 use crate::control::lock_reaction::LockSupervisor;
 use crate::control::modulation::{ModulatorConfig, SpaceVectorModulator};
 use crate::control::ratings_limit::RatingsLimit;
+use crate::control::release_hold::ReleaseHold;
 use crate::control::speed_controller::{SpeedController, SpeedControllerConfig};
 use crate::control::standstill_probe::{StandstillProbe, StandstillProbeConfig};
 use crate::error::{ConfigError, check};
@@ -56,8 +57,14 @@ impl<T: Real> Blocks<T> {
         let m = &c.machine;
         // The speed PI's output is a torque in units of the magnet's q current (see
         // `currents_for_torque`): with MTPA on a salient rotor its limit is the torque of the
-        // MTPA point on the current circle |i| = I_max (`SpeedControllerConfig::with_tuning`).
-        let speed_config = SpeedControllerConfig::with_tuning(m, t, ts);
+        // MTPA point on the current circle |i| = I_max (`SpeedControllerConfig::torque_limit`).
+        let speed_config = SpeedControllerConfig {
+            bandwidth_hz: t.speed_bandwidth_hz,
+            zero_ratio: t.speed_zero_ratio,
+            anti_windup_ratio: t.speed_anti_windup_ratio,
+            i_max: c.speed_torque_limit(t.mtpa),
+            ..SpeedControllerConfig::new(m, t.current_limit_ratio * m.rated_current, t.mtpa, ts)
+        };
         let dc_link = DcLinkLimit::new(&t.dc_link, m, speed_config.i_max, r.i_max, ts)?;
         if t.field_weakening.voltage_margin > T::one()
             && t.voltage_limit != crate::control::modulation::VoltageLimit::Overmodulation
@@ -73,16 +80,19 @@ impl<T: Real> Blocks<T> {
             ("zero_ratio", "speed_zero_ratio"),
             ("anti_windup_ratio", "speed_anti_windup_ratio"),
         ]))?;
-        let injection = CurrentInjection::new(CurrentInjectionConfig::with_tuning(m, t))?;
-        let current = CurrentController::new(CurrentControllerConfig::with_tuning(m, t, ts))
-            .map_err(rename(&[
-                ("bandwidth_hz", "current_bandwidth_hz"),
-                ("anti_windup_ratio", "current_anti_windup_ratio"),
-            ]))?;
-        let delay = DelayCompensation::new(DelayCompensationConfig::with_tuning(t, ts))
-            .map_err(rename(&[("factor", "delay_compensation_factor")]))?;
-        let dead_time = DeadTimeCompensation::new(DeadTimeCompensationConfig::with_tuning(m, t))
-            .map_err(rename(&[
+        let injection =
+            CurrentInjection::new(CurrentInjectionConfig::new(m, t.injection_current_ratio))?;
+        let current = CurrentController::new(c.current_controller_config()).map_err(rename(&[
+            ("bandwidth_hz", "current_bandwidth_hz"),
+            ("anti_windup_ratio", "current_anti_windup_ratio"),
+        ]))?;
+        let delay = DelayCompensation::new(DelayCompensationConfig {
+            ts,
+            factor: t.delay_compensation_factor,
+        })
+        .map_err(rename(&[("factor", "delay_compensation_factor")]))?;
+        let dead_time =
+            DeadTimeCompensation::new(c.dead_time_compensation_config()).map_err(rename(&[
                 ("threshold_voltage", "dead_time_threshold_voltage"),
                 ("current_band", "dead_time_current_band"),
             ]))?;
@@ -91,8 +101,16 @@ impl<T: Real> Blocks<T> {
             max_modulation: t.max_modulation,
         })?;
         let probe = StandstillProbe::new(probe_config(c)?)?;
+        let hold = ReleaseHold::new(
+            &t.release_hold,
+            m,
+            ts,
+            t.current_bandwidth_hz,
+            speed_config.i_max,
+        )?;
         let limits = RatingsLimit::new(&t.limits, m)?;
         Ok(Self {
+            hold,
             speed,
             injection,
             current,
@@ -116,6 +134,42 @@ impl<T: Real> Blocks<T> {
         self.probe.reset();
         self.dc_link.reset();
         self.field_weakening.reset();
+        self.hold.disarm();
+    }
+}
+
+impl<T: Real> DriveConfig<T> {
+    /// The current loop of the machine model with the tuning's `current_bandwidth_hz`,
+    /// `decoupling` and `current_anti_windup_ratio`: what the drive builds.
+    pub fn current_controller_config(&self) -> CurrentControllerConfig<T> {
+        let t = &self.tuning;
+        // A saturating model: the incremental inductances at the rated MTPA point
+        // (`crate::control::saturated_references`).
+        let (ld_hat, lq_hat) = self.current_loop_inductances();
+        CurrentControllerConfig {
+            ld_hat,
+            lq_hat,
+            bandwidth_hz: t.current_bandwidth_hz,
+            decoupling: t.decoupling,
+            anti_windup_ratio: t.current_anti_windup_ratio,
+            ..CurrentControllerConfig::for_machine(&self.machine, self.ts)
+        }
+    }
+
+    /// The dead-time compensation of the machine model with the tuning's inverter data
+    /// (`dead_time`, `switching_frequency`, `dead_time_threshold_voltage`,
+    /// `dead_time_current_band`) and method: what the drive builds.
+    pub fn dead_time_compensation_config(&self) -> DeadTimeCompensationConfig<T> {
+        let t = &self.tuning;
+        DeadTimeCompensationConfig {
+            enabled: t.dead_time_compensation,
+            method: t.dead_time_method,
+            dead_time: t.dead_time,
+            switching_frequency: t.switching_frequency,
+            threshold_voltage: t.dead_time_threshold_voltage,
+            current_band: t.dead_time_current_band,
+            ..DeadTimeCompensationConfig::for_machine(&self.machine)
+        }
     }
 }
 

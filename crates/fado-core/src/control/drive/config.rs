@@ -11,7 +11,7 @@ use crate::{MachineModel, Real};
 /// tuning. Build it with [`DriveConfig::for_machine`]; the drive hands the same machine model
 /// to its estimator, so the model exists once.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct DriveConfig<T> {
+pub struct DriveConfig<T: 'static> {
     /// Sampling period Ts in s (paper, V: 100 µs, 10 kHz, twice the switching frequency).
     pub ts: T,
     /// The drive's model of the motor.

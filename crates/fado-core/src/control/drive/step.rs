@@ -145,7 +145,10 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         };
         // 8. Anti-windup with the realised voltage in the same frame; speed loop too.
         b.current.realised(applied.v_dq);
-        let realised_torque = if self.resolved.salient {
+        let realised_torque = if let Some(s) = &self.resolved.saturated {
+            // A saturating model's co-energy torque (`saturated_references`).
+            s.torque_flux(i_dq_ref) / self.config.machine.flux_linkage
+        } else if self.resolved.salient {
             let m = &self.config.machine;
             m.active_flux(i_dq_ref.d) * i_dq_ref.q / m.flux_linkage
         } else {
@@ -298,7 +301,10 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             }
         }
         let i = last.i_dq_ref;
-        T::lit(1.5) * p * self.config.machine.active_flux(i.d) * i.q
+        match &self.resolved.saturated {
+            Some(s) => T::lit(1.5) * p * s.torque_flux(i),
+            None => T::lit(1.5) * p * self.config.machine.active_flux(i.d) * i.q,
+        }
     }
 
     /// Step 4: the current reference, the speed PI's torque demand, the injection (23), MTPA and
@@ -321,9 +327,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         let i_dq_ref = if action == LockAction::Coast {
             Dq::zero()
         } else {
-            let Ok(iq_torque) = self.blocks.speed.step(speed_ref, estimate.omega_control) else {
-                return None;
-            };
+            let iq_torque = self.speed_or_hold(speed_ref, estimate)?;
             // The ratings' torque and power limits (see `ratings_limit`), the DC link's power
             // limits and over-voltage controller (see `dc_link_limit`).
             let iq_torque = self.blocks.limits.torque(iq_torque, estimate.omega_control);

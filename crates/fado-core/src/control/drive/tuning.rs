@@ -4,11 +4,14 @@
 use super::STALL_TORQUE_BAND_RATIO;
 use crate::Real;
 use crate::control::dc_link_limit::DcLinkTuning;
-use crate::control::dead_time_compensation::DeadTimeMethod;
+use crate::control::dead_time_compensation::{self, DeadTimeMethod};
 use crate::control::field_weakening::FieldWeakeningTuning;
 use crate::control::lock_reaction::LockReaction;
 use crate::control::modulation::VoltageLimit;
 use crate::control::ratings_limit::RatingsLimitTuning;
+use crate::control::release_hold::ReleaseHoldTuning;
+use crate::control::{current_controller, delay_compensation, gain_calibration, speed_controller};
+use crate::injection;
 use crate::machine::PAPER_RATED_CURRENT;
 
 /// The drive's tuning: every setting that is not the machine or the sampling period. Defaults
@@ -180,6 +183,13 @@ pub struct DriveTuning<T> {
         serde(bound(deserialize = "T: Real + serde::Deserialize<'de>"))
     )]
     pub limits: RatingsLimitTuning<T>,
+    /// The release hold: a position loop that holds a rotor a load turns at zero speed
+    /// after the start-up (`[controller.release_hold]`, see [`ReleaseHoldTuning`]).
+    #[cfg_attr(
+        feature = "serde",
+        serde(bound(deserialize = "T: Real + serde::Deserialize<'de>"))
+    )]
+    pub release_hold: ReleaseHoldTuning<T>,
     /// Reaction to the estimator's [`LockStatus::Lost`](crate::LockStatus::Lost) (`DriveFlags::LOCK_LOST`) and, with
     /// `lock_reaction_on_stall`, to the stall symptom (`DriveFlags::STALLED`). Default report
     /// only \[A\] (the paper's behaviour plus the flags).
@@ -433,6 +443,7 @@ impl<T: Real> DriveTuning<T> {
             dc_link_max_ratio: U::lit(self.dc_link_max_ratio.to_f64()),
             dc_link: self.dc_link.cast(),
             field_weakening: self.field_weakening.cast(),
+            release_hold: self.release_hold.cast(),
             limits: self.limits.cast(),
             lock_reaction: self.lock_reaction,
             lock_reaction_on_stall: self.lock_reaction_on_stall,
@@ -470,31 +481,31 @@ impl<T: Real> Default for DriveTuning<T> {
     fn default() -> Self {
         let per_rated = |amps: f64| T::lit(amps / PAPER_RATED_CURRENT);
         Self {
-            current_bandwidth_hz: T::lit(250.0),
-            speed_bandwidth_hz: T::lit(5.0),
-            speed_zero_ratio: T::lit(5.0),
-            current_limit_ratio: per_rated(40.0),
-            injection_current_ratio: per_rated(4.0),
+            current_bandwidth_hz: T::lit(current_controller::DEFAULT_BANDWIDTH_HZ),
+            speed_bandwidth_hz: T::lit(speed_controller::DEFAULT_BANDWIDTH_HZ),
+            speed_zero_ratio: T::lit(speed_controller::DEFAULT_ZERO_RATIO),
+            current_limit_ratio: T::lit(speed_controller::DEFAULT_CURRENT_LIMIT_RATIO),
+            injection_current_ratio: T::lit(injection::DEFAULT_CURRENT_RATIO),
             mtpa: true,
             acceleration_feedforward: false,
-            dead_time: T::lit(2.5e-6),
-            switching_frequency: T::lit(5e3),
-            dead_time_threshold_voltage: T::one(),
-            dead_time_current_band: T::lit(0.3),
+            dead_time: T::lit(dead_time_compensation::DEFAULT_DEAD_TIME),
+            switching_frequency: T::lit(dead_time_compensation::DEFAULT_SWITCHING_FREQUENCY),
+            dead_time_threshold_voltage: T::lit(dead_time_compensation::DEFAULT_THRESHOLD_VOLTAGE),
+            dead_time_current_band: T::lit(dead_time_compensation::DEFAULT_CURRENT_BAND),
             dead_time_compensation: true,
-            dead_time_method: DeadTimeMethod::EdgeCurrent,
-            delay_compensation_factor: T::lit(1.5),
+            dead_time_method: dead_time_compensation::DEFAULT_METHOD,
+            delay_compensation_factor: T::lit(delay_compensation::DEFAULT_FACTOR),
             trip_current_ratio: per_rated(60.0),
-            decoupling: true,
+            decoupling: current_controller::DEFAULT_DECOUPLING,
             voltage_limit: VoltageLimit::Hexagon,
             max_modulation: T::one(),
-            current_anti_windup_ratio: T::one(),
-            speed_anti_windup_ratio: T::lit(5.0),
+            current_anti_windup_ratio: T::lit(current_controller::DEFAULT_ANTI_WINDUP_RATIO),
+            speed_anti_windup_ratio: T::lit(speed_controller::DEFAULT_ANTI_WINDUP_RATIO),
             offset_calibration_time: T::lit(0.1),
             gain_calibration_time: T::lit(0.05),
             gain_calibration_current_ratio: T::one(),
-            gain_calibration_min_observability: T::lit(0.2),
-            gain_calibration_max_mismatch: T::lit(0.05),
+            gain_calibration_min_observability: T::lit(gain_calibration::DEFAULT_MIN_OBSERVABILITY),
+            gain_calibration_max_mismatch: T::lit(gain_calibration::DEFAULT_MAX_MISMATCH),
             stuck_sensor_band_ratio: per_rated(0.25),
             stuck_sensor_reference_ratio: per_rated(2.0),
             stuck_sensor_time: T::lit(0.5e-3),
@@ -506,6 +517,7 @@ impl<T: Real> Default for DriveTuning<T> {
             dc_link_max_ratio: T::lit(crate::plausibility::VOLTAGE_RATIO),
             dc_link: DcLinkTuning::default(),
             field_weakening: FieldWeakeningTuning::default(),
+            release_hold: ReleaseHoldTuning::default(),
             limits: RatingsLimitTuning::default(),
             lock_reaction: LockReaction::ReportOnly,
             lock_reaction_on_stall: true,

@@ -1,0 +1,178 @@
+//! The rotor flux of eq. (5)–(6) for a saturating machine: the active flux at the estimated
+//! current, and the sensitivities the slow laws need from it.
+//!
+//! **Alignment.** With any magnetic model the stator flux is ψ_ab = e^{jθ}·ψ_dq(i). Removing
+//! the secant q inductance L_q,s(i) = ψq(i)/i_q times the current,
+//!
+//! ```text
+//!   ψ_ab − L_q,s(i)·i_ab = e^{jθ}·(ψd − L_q,s·i_d,  ψq − (ψq/i_q)·i_q) = e^{jθ}·λa(i)
+//!   λa(i) = ψd(i) − L_q,s(i)·i_d      (the active flux)
+//! ```
+//!
+//! leaves a vector on the d axis for any map: eq. (5) with L̂q the secant at the operating
+//! point. For constant inductances L_q,s = Lq and λa = λf + (Ld − Lq)·i_d, eq. (5) itself. The
+//! estimator does not know i_dq, only i_ab and its own angle: it evaluates L_q,s at the current
+//! in the frame of λ2 − L_q,s⁻·i (L_q,s⁻ the last sample's secant), one step of the fixed point
+//! λ̂r = λ2 − L_q,s(î(λ̂r))·i per sample. The secant moves with the load over tens of
+//! milliseconds, so the step's L_q,s⁻ is within a sample's current change of the fixed point.
+//!
+//! **The R̂s regressor** (see `crate::rs_adaptation` for the constant-inductance case). A
+//! resistance error ΔR = R̂s − Rs leaves the synchronous flux error ΔR·(−i_q + j·i_d)/ω in the
+//! rotor frame. Its d part changes |λ̂r| by −ΔR·i_q/ω. Its q part turns λ̂r, so the estimated
+//! frame by ε, which moves î by ε·(i_q, −i_d) and with it the secant L_q,s(î), whose own q
+//! part turns λ̂r further: with L_q,s = ψq/i_q, ∂L_q,s/∂i_d = L_qd/i_q and
+//! ∂L_q,s/∂i_q = (L_qq − L_q,s)/i_q (L_xy the incremental inductances ∂ψx/∂i_y),
+//!
+//! ```text
+//!   ε·κ = ΔR·i_d/ω,   κ = λa + L_qd·i_q − (L_qq − L_q,s)·i_d
+//! ```
+//!
+//! The reference λa(î) moves with î too: by ∇ψd·Δî − ΔL_q,s·i_d − L_q,s·ε·i_q, and the ΔL_q,s
+//! part cancels against |λ̂r|'s own. The flux-magnitude error is e = |λ̂r| − λa(î) = ΔR·φ with
+//!
+//! ```text
+//!   φ = −(1/ω)·[ i_q + i_d·((L_dd − L_q,s)·i_q − L_dq·i_d)/κ ]
+//! ```
+//!
+//! For constant inductances (L_dd = Ld, L_qq = L_q,s = Lq, L_dq = L_qd = 0, κ = λa) this is
+//! the −(i_q/ω)·(1 + (Ld − Lq)·i_d/λa) of the linear law. Where κ falls towards zero, a
+//! resistance error's q flux is amplified by the map's gradient without bound: the law cannot
+//! tell the map's slope from a resistance, and freezes ([`KAPPA_MIN_RATIO`]).
+
+use crate::magnetics::{MagneticModel, Magnetics};
+use crate::{Ab, Dq, Real};
+
+/// The R̂s laws freeze where κ < `KAPPA_MIN_RATIO`·λa: the angle feedback through the
+/// secant's slope then more than doubles the q flux error of a resistance error (the
+/// regressor's i_d term is ill-conditioned), ours \[A\].
+pub const KAPPA_MIN_RATIO: f64 = 0.5;
+
+/// A saturating model as the estimator uses it, with the constants it falls back to.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ActiveFlux<T: 'static> {
+    model: Magnetics<'static, T>,
+    /// The secant is the incremental ∂ψq/∂i_q below this |i_q| (A).
+    small_current: T,
+    /// ψd(0, 0), Wb.
+    magnet_flux: T,
+    /// The incremental L_qq at i = 0 (the secant's limit there), H.
+    lq_zero: T,
+}
+
+/// The active flux at one operating point.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ActiveFluxPoint<T> {
+    /// The current in the estimated rotor frame (d along λ̂r), A.
+    pub i_dq: Dq<T>,
+    /// L_q,s(î), H.
+    pub lq_secant: T,
+    /// λa(î) = ψd − L_q,s·î_d, Wb.
+    pub active: T,
+}
+
+impl<T: Real> ActiveFlux<T> {
+    /// The estimator's view of `model`; None for constant inductances (the blocks keep their
+    /// closed-form arithmetic). `rated_current` scales the small-current threshold (10⁻³ of
+    /// it).
+    pub fn new(model: Magnetics<'static, T>, rated_current: T) -> Option<Self> {
+        if model.is_linear() {
+            return None;
+        }
+        let lq_zero = model.incremental_inductance(Dq::zero()).qq;
+        Some(Self {
+            model,
+            small_current: T::lit(1e-3) * rated_current,
+            magnet_flux: model.magnet_flux(),
+            lq_zero,
+        })
+    }
+
+    /// The model.
+    pub fn model(&self) -> &Magnetics<'static, T> {
+        &self.model
+    }
+
+    /// ψd(0, 0), Wb.
+    pub fn magnet_flux(&self) -> T {
+        self.magnet_flux
+    }
+
+    /// The incremental L_qq at zero current, H (the start-up secant).
+    pub fn lq_zero(&self) -> T {
+        self.lq_zero
+    }
+
+    /// L_q,s and λa at the current `i_dq` of the rotor frame. A secant that is not a
+    /// positive finite number (a map not odd in i_q near i_q = 0) is replaced by L_qq(0).
+    #[inline]
+    pub fn point(&self, i_dq: Dq<T>) -> ActiveFluxPoint<T> {
+        let psi = self.model.flux(i_dq);
+        let secant = if i_dq.q.abs() > self.small_current {
+            psi.q / i_dq.q
+        } else {
+            self.model.incremental_inductance(i_dq).qq
+        };
+        let lq_secant = if secant.is_finite() && secant > T::zero() {
+            secant
+        } else {
+            self.lq_zero
+        };
+        ActiveFluxPoint {
+            i_dq,
+            lq_secant,
+            active: psi.d - lq_secant * i_dq.d,
+        }
+    }
+
+    /// The current `i_ab` in the frame whose d axis is `axis` (any length; zero current for a
+    /// zero or non-finite axis).
+    #[inline]
+    pub fn frame_current(axis: Ab<T>, i_ab: Ab<T>) -> Dq<T> {
+        let n = axis.norm_squared().step_sqrt();
+        if n > T::zero() && n.is_finite() {
+            let k = T::one() / n;
+            Dq::new(axis.dot(i_ab) * k, axis.cross(i_ab) * k)
+        } else {
+            Dq::zero()
+        }
+    }
+
+    /// λ̂r = λ2 − L_q,s(î)·i with î in the frame of λ2 − `lq_prev`·i (module docs), and the
+    /// operating point it used.
+    #[inline]
+    pub fn rotor_flux(
+        &self,
+        lambda2: Ab<T>,
+        i_ab: Ab<T>,
+        lq_prev: T,
+    ) -> (Ab<T>, ActiveFluxPoint<T>) {
+        let i_dq = Self::frame_current(lambda2 - i_ab * lq_prev, i_ab);
+        let point = self.point(i_dq);
+        (lambda2 - i_ab * point.lq_secant, point)
+    }
+
+    /// The bracket of the R̂s regressor φ = −(that)/ω (module docs) at the operating point,
+    /// with the incremental inductances there; None where κ < [`KAPPA_MIN_RATIO`]·λa or λa ≤ 0
+    /// (the law freezes).
+    #[inline]
+    pub fn resistance_regressor(&self, point: &ActiveFluxPoint<T>) -> Option<T> {
+        let i = point.i_dq;
+        let l = self.model.incremental_inductance(i);
+        let lqs = point.lq_secant;
+        let kappa = point.active + l.qd * i.q - (l.qq - lqs) * i.d;
+        let floor = T::lit(KAPPA_MIN_RATIO) * point.active;
+        if !(point.active > T::zero() && kappa >= floor) {
+            return None;
+        }
+        Some(i.q + i.d * ((l.dd - lqs) * i.q - l.dq * i.d) / kappa)
+    }
+
+    /// The incremental L_dd at the operating point (the standstill law's inductive voltage).
+    #[inline]
+    pub fn ld_incremental(&self, i_dq: Dq<T>) -> T {
+        self.model.incremental_inductance(i_dq).dd
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,401 @@
+//! Start-up calibration of the current sensors' gain mismatch: the ratio k = (1 + g_a)/(1 + g_b)
+//! of the phase-a and phase-b channels' gains, measured with two DC current levels along the
+//! aligned rotor's d axis (no torque), as drives calibrate the sensor offsets.
+//!
+//! # Why
+//! Two sensors measure phases a and b; c = −(a + b). With phase a read as (1 + g)·i_a (g the
+//! relative mismatch), the α-β current reads i + g·i_a·(1 + j/√3) =
+//! i + (g/2)(1 + j/√3)·i + (g/2)(1 + j/√3)·conj(i): a small scale and turn of the current, and
+//! a negative-sequence part (g/2)(1 + j/√3)·conj(i). Times R̂s the latter is an integrand
+//! error of eq. (3), DC at standstill; under load nothing observes the angle at standstill and it walks θ̂ at
+//! about R̂s·|Δi|/λ̂f: ≈ 2.5 rad/s on a 2.4 mWb motor with a 0.5 % mismatch (the
+//! `outrunner-cheetah-24v` preset). A common gain of both channels is harmless (it scales the
+//! current like an R̂s scale and is unobservable without a reference); only k is measured.
+//!
+//! # The measurement
+//! At DC steady state the machine is a symmetric resistance, so each phase obeys
+//! v_x = Rs·i_x + u_x, with u_x the inverter's voltage error in phase x (dead time, device
+//! drops; the phase voltages are those of the α-β vector, zero sequence removed). u_x depends
+//! on the sign of i_x (and, within the inverter's current band and the ripple, on its size):
+//! two current levels I₁ = I₂/2 and I₂ along the **same** axis, both with every phase well
+//! outside that band, have the same u_x, and the difference of the two levels is purely
+//! resistive: Δv_x = Rs·Δi_x (the classic two-point DC test, as in
+//! [`crate::commissioning`]). A sensor of gain (1 + g_x) reads Δi_x,meas = (1 + g_x)·Δi_x, so
+//! each phase's apparent conductance is (1 + g_x)/Rs and
+//!
+//! k = (Δi_a,meas / Δv_a) / (Δi_b,meas / Δv_b)
+//!
+//! exactly, whatever Rs (and with no small-mismatch approximation). Equivalently: the true
+//! current difference is parallel to Δv; the measured one is turned from it by
+//! (k − 1)·(2/√3)·cos φ·cos(φ + π/3) rad (φ the axis angle), the form of the cross-product
+//! estimator. The drive applies 1/k to phase a (c following from KCL), after the offsets and
+//! before everything else.
+//!
+//! Δv is the drive's realised voltage reference (the voltage it tells the estimator acted,
+//! after its dead-time compensation); Δi is the measured current; both are averaged over a
+//! window per level. The lower level I₁ is set by the drive's own current loop with the
+//! reference (I₁, 0) in the d-q frame of the aligned angle θ0 at ω = 0 (the inverter error is
+//! unknown, so only a loop finds the voltage for a given current); its voltage, averaged over
+//! the second half of the settling, is then **frozen** (V₁), and the upper level is the voltage
+//! V₁ + R̂s·I₁ along the axis (≈ 2·I₁; a wrong R̂s only moves the level). A d current makes no
+//! torque on a rotor at θ0 (on a salient one too, i_q = 0).
+//!
+//! # Rs, from the same levels
+//! The two levels are also the classic two-point DC test of the resistance:
+//! R = Δv·Δi′/|Δi′|² along the axis, with Δi′ the measured difference corrected by k
+//! ([`resistance_of`], [`GainCalibration::resistance`]). The inverter's constant error cancels
+//! as for k; what remains of the settling is e^(−hold/τ)·τ/window of the step (τ = L/R). The
+//! drive hands it to the estimator's R̂s adaptation as its start value (within 0.5–2× of the
+//! model's R̂s; the paper's fixed R̂s is left as configured): a winding warmer than the model
+//! is then known before the rotor turns, which the scenarios with the plant's Rs 1.3× the
+//! model's need now that the drive starts later.
+//!
+//! # The rotor's swing
+//! The loop regulates the *measured* current onto the axis; the true one is off it by an angle
+//! of order g, so the rotor, held only by the d current's stiffness, swings towards it. Its
+//! back-EMF jω·λf is not resistive and biases Δv: in current mode (no damping) this biased k
+//! by 2.8e-3 on the paper's motor and 2.8e-2 on a 50 kW IPMSM, against a 5e-3 mismatch (fado-sim,
+//! a rotor of huge inertia: 4e-6). In voltage mode the back-EMF drives a current through Rs
+//! that damps the swing (J·s² + c·s + K, c = 1.5·p²·λf²/Rs); each level is averaged only after
+//! a hold of several of its time constants (`hold_time`, from the drive's model), and a machine
+//! whose swing (or settling) needs more than `max_hold_time` is not calibrated
+//! ([`GainCalibrationStatus::TooSlow`]).
+//!
+//! # Observability and error bound
+//! Phase x carries the fraction cos(φ − φ_x) of the axis current (phase axes at φ_a = 0,
+//! φ_b = 2π/3, φ_c = −2π/3 in α-β). With δv_x the part of the voltage error in phase x that does
+//! not cancel between the levels (inverter error that changes with the level, what is left of
+//! the swing's back-EMF) and σ the averaged noise, to first order
+//!
+//! |δk|/k ≤ |δv_a|/|Δv_a| + |δv_b|/|Δv_b| + σ_i/|Δi_a| + σ_i/|Δi_b|,
+//! |Δv_x| = Rs·(I₂ − I₁)·|cos(φ − φ_x)|,
+//!
+//! so the error grows as 1/|cos(φ − φ_x)| where phase a or b carries little current
+//! (φ = ±π/2: phase a; φ = π/6, −5π/6: phase b). Phase c enters through the zero sequence:
+//! where it carries little current (φ = −π/6, 5π/6) its inverter error changes between the
+//! levels (current band, ripple) and spreads δu_c/3 onto a and b (measured with an earlier,
+//! current-mode version: k off by 1.2e-2 to 5.4e-2 at φ = −0.5, share 0.023, on four presets). The calibration is **skipped** (status
+//! [`GainCalibrationStatus::Unobservable`], k unchanged, no current) when the smallest share of
+//! the three phases, [`GainCalibration::observability`], is below `min_observability`, and a
+//! result is refused ([`GainCalibrationStatus::Implausible`]) when the measured currents say
+//! the same, when a conductance comes out non-positive or non-finite, when a current exceeds
+//! `current_limit` in voltage mode, or when |k − 1| exceeds `max_mismatch`. On the simulator's
+//! inverter (dead time with the docs/method/estimator.md §7 linear band, device drops, ripple resolved edge by
+//! edge) the measured accuracy is in `crates/fado-sim/tests/gain_calibration.rs` (within
+//! 1.2e-3 of 1.005 on four presets at four angles); an inverter whose error keeps growing well
+//! beyond the current band (a capacitive commutation tail, fado-sim's
+//! `Commutation::Capacitor`) breaks the cancellation and biases k.
+//!
+//! # Rotor motion
+//! The levels assume a rotor at rest: a load that arrives while the d current holds the rotor
+//! turns it (on the 2.2 kW IPMSM, 7 N·m against its 6 A upper level: towards 0.5 rad, and free
+//! once the current returns to zero). In voltage mode a turning rotor's back-EMF jω·λf lies
+//! across the axis; with the voltage frozen, the current across the axis obeys
+//! R̂s·Δi⊥ + L̂q·dΔi⊥/dt = −ω·λf, Δi⊥ its change since the level's first sample (at rest it
+//! only settles, within the resistive term's small change). The calibration evaluates the
+//! left side every sample (the current low-passed over [`MOTION_FILTER_TIME`] for its
+//! derivative) and ends at once with [`GainCalibrationStatus::RotorMoved`] above
+//! `motion_voltage` ([`MOTION_SPEED_RATIO`] of the rated speed's back-EMF): no release to zero
+//! current, so the drive's speed loop takes the load from the aligned angle. Measured on the
+//! presets at rest (switching-resolved, default sensors): at most 0.27 of the threshold.
+//!
+//! # Sequence
+//! Current loop at I₁ (`settle_time`); voltage V₁: hold (`hold_time`), average
+//! (`window_time`); voltage V₁ + R̂s·I₁: hold, average; current loop at zero (`settle_time`);
+//! then the status is final ([`GainCalibration::running`] false). Every stage ends after a
+//! fixed number of samples: the calibration always terminates, after
+//! [`GainCalibration::duration_samples`]. The current reference is never above I₁ and a
+//! voltage-mode current above `current_limit` ends the sequence (the drive sets it to its
+//! I_max, with I₂ = 2·I₁ ≤ I_max).
+
+mod measure;
+mod motion;
+mod sequence;
+#[cfg(test)]
+mod tests;
+
+pub use measure::{ratio_of, resistance_of};
+pub use motion::{MOTION_FILTER_TIME, MOTION_SPEED_RATIO, motion_voltage};
+
+use crate::error::{ConfigError, check};
+use crate::{Ab, Real};
+use measure::{PHASE_B_ALPHA, PHASE_B_BETA};
+
+/// Configuration of a [`GainCalibration`], in absolute units (its user derives it from its
+/// own ratios and its machine model; defaults `DEFAULT_*`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GainCalibrationConfig<T> {
+    /// Sampling period in s.
+    pub ts: T,
+    /// Lower current level I₁ in A, set by the current loop; the upper one is reached with
+    /// the voltage step R̂s·I₁ (I₂ ≈ 2·I₁).
+    pub current: T,
+    /// R̂s in Ω: sizes the voltage step to the upper level.
+    pub rs_hat: T,
+    /// Settling of the current loop at I₁, of each voltage step and of the return to zero, s.
+    pub settle_time: T,
+    /// Time for the rotor's swing to die out after the voltage is frozen, s (at least
+    /// `settle_time` is used).
+    pub hold_time: T,
+    /// Longest hold accepted, s: a machine needing a longer `hold_time` or `settle_time` is
+    /// not calibrated ([`GainCalibrationStatus::TooSlow`]).
+    pub max_hold_time: T,
+    /// Averaging window of each level, s; 0 disables the calibration.
+    pub window_time: T,
+    /// Smallest share min(|cos φ|, |cos(φ − 2π/3)|) of the axis current in phases a and b,
+    /// and |cos(φ + 2π/3)| in phase c, with which the calibration runs, in [0, 1).
+    pub min_observability: T,
+    /// Largest |k − 1| accepted as a measurement of the sensors (a larger one is refused).
+    pub max_mismatch: T,
+    /// A measured current above this (A) in voltage mode aborts the calibration (R̂s far
+    /// above the machine's resistance).
+    pub current_limit: T,
+    /// L̂q in H: the inductance across the axis, for the rotor-motion test.
+    pub lq_hat: T,
+    /// The rotor-motion test's threshold (V): in voltage mode, a back-EMF across the axis
+    /// |R̂s·Δi⊥ + L̂q·dΔi⊥/dt| (Δi⊥ the change of the current across the axis since the
+    /// level's voltage was frozen, low-passed over [`MOTION_FILTER_TIME`]) above this ends
+    /// the calibration at once with [`GainCalibrationStatus::RotorMoved`]. ∞ disables the
+    /// test.
+    pub motion_voltage: T,
+}
+
+/// Default `min_observability` \[A\]: the error grows as 1/share (module docs); 38 % skipped.
+pub const DEFAULT_MIN_OBSERVABILITY: f64 = 0.2;
+/// Default `max_mismatch` \[A\]: two sensors of ±2.5 % gain tolerance.
+pub const DEFAULT_MAX_MISMATCH: f64 = 0.05;
+
+/// Where the calibration stands.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GainCalibrationStatus {
+    /// Disabled by the configuration (window 0): the ratio stays as it is (1 at first).
+    Off,
+    /// Armed: runs at the next sample the drive gives it.
+    Pending,
+    /// Current levels being applied and averaged.
+    Running,
+    /// Measured: the ratio is the new one.
+    Calibrated,
+    /// Skipped: the axis leaves a phase with less than `min_observability` of the current
+    /// (ratio unchanged, no current applied).
+    Unobservable,
+    /// Skipped: the rotor's swing about the d current dies out too slowly, or the current
+    /// settles too slowly (`hold_time` or `settle_time` above `max_hold_time`; ratio
+    /// unchanged, no current applied).
+    TooSlow,
+    /// Measured but refused: non-finite, a non-positive conductance, too few finite samples,
+    /// a current above `current_limit` in voltage mode, or |k − 1| above `max_mismatch`
+    /// (ratio unchanged).
+    Implausible,
+    /// Ended early: the rotor turned during a voltage-mode level (a load arrived while the
+    /// d current held it; see `motion_voltage`). The drive starts at once from the aligned
+    /// angle, so that its speed loop takes the load (ratio unchanged).
+    RotorMoved,
+}
+
+/// What the drive applies at a sample of the calibration.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GainCalibrationCommand<T> {
+    /// The d-axis current (A) in the frame of the calibration's angle: the current loop's
+    /// reference, or (with `voltage`) the level the dead-time compensation is set for.
+    pub current_d: T,
+    /// Voltage mode: this α-β voltage reference (V), before dead-time compensation, instead
+    /// of the current loop's.
+    pub voltage: Option<Ab<T>>,
+}
+
+/// The sequence's states.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Stage {
+    Idle,
+    /// Current loop at I₁ (its voltage averaged over the second half into V₁).
+    Settle,
+    /// Voltage V₁ (lower level): swing decay, then averaging.
+    HoldLower,
+    AverageLower,
+    /// Voltage V₁ + R̂s·I₁ along the axis (upper level): swing decay, then averaging.
+    HoldUpper,
+    AverageUpper,
+    /// Current loop at 0.
+    Release,
+}
+
+/// The two-level gain-mismatch calibration (module docs). Allocation-free; `step` once per
+/// sample while [`running`](Self::running).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GainCalibration<T> {
+    config: GainCalibrationConfig<T>,
+    settle_samples: u32,
+    hold_samples: u32,
+    /// Settling or hold beyond `max_hold_time`: skipped.
+    too_slow: bool,
+    window_samples: u32,
+    stage: Stage,
+    /// Samples left in the current stage.
+    remaining: u32,
+    /// Unit vector of the axis.
+    axis: Ab<T>,
+    /// The frozen lower-level voltage V₁ (its sum while the current loop settles).
+    v_lower: Ab<T>,
+    v_lower_count: u32,
+    /// Per level (0 lower, 1 upper): sums of the measured current and of the voltage, and
+    /// finite samples.
+    sum_i: [Ab<T>; 2],
+    sum_v: [Ab<T>; 2],
+    count: [u32; 2],
+    /// Voltage mode ended by an over-current.
+    aborted: bool,
+    /// The measured current across the axis as the level's voltage was frozen (A), the
+    /// motion test's reference, and Δi⊥ low-passed (A).
+    cross_ref: T,
+    cross_filtered: T,
+    status: GainCalibrationStatus,
+    ratio: T,
+    /// The last measured ratio, also when refused (NaN before any).
+    measured: T,
+    /// The resistance of the last accepted measurement (NaN before any), Ω.
+    resistance: T,
+}
+
+impl<T: Real> GainCalibration<T> {
+    /// A new calibration (armed unless disabled); every field is checked and a bad one named.
+    pub fn new(config: GainCalibrationConfig<T>) -> Result<Self, ConfigError> {
+        let ts = check::positive("ts", config.ts)?;
+        check::positive("current", config.current)?;
+        check::positive("rs_hat", config.rs_hat)?;
+        let samples = |field: &'static str, time: T| -> Result<u32, ConfigError> {
+            let n = check::non_negative(field, time)? / ts;
+            check::below(field, n, T::lit(4e9), "below 4e9 sampling periods")?;
+            Ok(n.round().to_f64() as u32)
+        };
+        let max_hold = check::non_negative("max_hold_time", config.max_hold_time)?;
+        let max_hold_samples = samples("max_hold_time", max_hold)?;
+        // Settling and hold are derived from the machine model: beyond the budget (or not
+        // finite, for an absurd model) the calibration is skipped, not refused.
+        let too_slow = !(config.settle_time <= max_hold && config.hold_time <= max_hold);
+        let within = |time: T| -> Result<u32, ConfigError> {
+            if time >= T::zero() && time <= max_hold {
+                samples("hold_time", time)
+            } else {
+                Ok(max_hold_samples)
+            }
+        };
+        let settle_samples = within(config.settle_time)?;
+        let hold_samples = within(config.hold_time)?.max(settle_samples);
+        let window_samples = samples("window_time", config.window_time)?;
+        check::below(
+            "min_observability",
+            check::non_negative("min_observability", config.min_observability)?,
+            T::one(),
+            "in [0, 1)",
+        )?;
+        check::positive("max_mismatch", config.max_mismatch)?;
+        check::positive("current_limit", config.current_limit)?;
+        if config.current > config.current_limit {
+            return Err(ConfigError::OutOfRange {
+                field: "current",
+                expected: "at most current_limit",
+            });
+        }
+        let status = if window_samples == 0 {
+            GainCalibrationStatus::Off
+        } else {
+            GainCalibrationStatus::Pending
+        };
+        Ok(Self {
+            config,
+            settle_samples,
+            hold_samples,
+            too_slow,
+            window_samples,
+            stage: Stage::Idle,
+            remaining: 0,
+            axis: Ab::new(T::one(), T::zero()),
+            v_lower: Ab::zero(),
+            v_lower_count: 0,
+            sum_i: [Ab::zero(); 2],
+            sum_v: [Ab::zero(); 2],
+            count: [0; 2],
+            aborted: false,
+            cross_ref: T::zero(),
+            cross_filtered: T::zero(),
+            status,
+            ratio: T::one(),
+            measured: T::zero() / T::zero(),
+            resistance: T::zero() / T::zero(),
+        })
+    }
+
+    /// The configuration in use.
+    pub fn config(&self) -> &GainCalibrationConfig<T> {
+        &self.config
+    }
+
+    /// The whole sequence's duration in samples when it runs: settle at I₁, hold and window
+    /// at each level, release.
+    pub fn duration_samples(&self) -> u32 {
+        self.settle_samples
+            .saturating_mul(2)
+            .saturating_add(self.hold_samples.saturating_mul(2))
+            .saturating_add(self.window_samples.saturating_mul(2))
+    }
+
+    /// Arms the calibration (unless disabled): it starts at the next [`step`](Self::step).
+    /// The ratio measured before is kept until a new one is.
+    pub fn arm(&mut self) {
+        self.stage = Stage::Idle;
+        if self.window_samples > 0 {
+            self.status = GainCalibrationStatus::Pending;
+        }
+    }
+
+    /// Armed and waiting for its first sample.
+    pub fn pending(&self) -> bool {
+        self.status == GainCalibrationStatus::Pending
+    }
+
+    /// Armed or applying current.
+    pub fn running(&self) -> bool {
+        matches!(
+            self.status,
+            GainCalibrationStatus::Pending | GainCalibrationStatus::Running
+        )
+    }
+
+    /// The status.
+    pub fn status(&self) -> GainCalibrationStatus {
+        self.status
+    }
+
+    /// The ratio k = (1 + g_a)/(1 + g_b) in use: the last accepted measurement, 1 before any.
+    /// The drive divides the phase-a reading by it.
+    pub fn ratio(&self) -> T {
+        self.ratio
+    }
+
+    /// The last measured ratio, accepted or not (NaN before any measurement).
+    pub fn measured_ratio(&self) -> T {
+        self.measured
+    }
+
+    /// The stator resistance the last accepted measurement gives, Ω (NaN before any): the
+    /// two-point DC test R = Δv·Δi′/|Δi′|² along the axis, Δi′ the current difference with
+    /// phase a corrected by the measured k ([`resistance_of`]). The inverter's constant
+    /// error cancels between the levels as it does for k; what grows with the current (the
+    /// devices' on-resistance) is in it, as it is in the voltage the estimator integrates.
+    /// The drive starts its R̂s adaptation from it (TI's InstaSPIN re-measures Rs at every
+    /// start the same way, "Rs recalibration", SPRUHJ1, §"Rs Online and Rs Recalibration").
+    pub fn resistance(&self) -> T {
+        self.resistance
+    }
+
+    /// The smallest share of the axis current in any phase, min over x of |cos(φ − φ_x)|,
+    /// for an axis at `angle` (electrical rad): phases a and b for the observability, c for
+    /// the inverter error's cancellation (module docs).
+    pub fn observability(angle: T) -> T {
+        let (s, c) = angle.step_sin_cos_any();
+        let b = c * T::lit(PHASE_B_ALPHA) + s * T::lit(PHASE_B_BETA);
+        let phase_c = -c - b;
+        crate::real::min(crate::real::min(c.abs(), b.abs()), phase_c.abs())
+    }
+}
