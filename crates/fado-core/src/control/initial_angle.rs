@@ -12,7 +12,7 @@
 //! # The measurement
 //! For each direction φ_k = k·π/6 (k = 0 … 11) a voltage pulse +V along φ_k for n samples,
 //! then −V for n samples (the current back to about zero) and n samples that return it to
-//! zero (a proportional current loop, [`RETURN_GAIN`]),
+//! zero (a proportional current loop, `RETURN_GAIN`),
 //! after one such pair along φ₁₁ that is not read (each read pair then starts from its
 //! predecessor's residual current, 30° behind, the first one included). The
 //! rotor at rest, the current at the end of the +V pulse is

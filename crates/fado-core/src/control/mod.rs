@@ -19,6 +19,7 @@ pub mod monitor;
 pub mod pi;
 pub mod ratings_limit;
 pub mod release_hold;
+pub mod saturated_references;
 pub mod speed_controller;
 pub mod standstill_probe;
 

@@ -62,6 +62,7 @@ impl<T: Real> Blocks<T> {
             bandwidth_hz: t.speed_bandwidth_hz,
             zero_ratio: t.speed_zero_ratio,
             anti_windup_ratio: t.speed_anti_windup_ratio,
+            i_max: c.speed_torque_limit(t.mtpa),
             ..SpeedControllerConfig::new(m, t.current_limit_ratio * m.rated_current, t.mtpa, ts)
         };
         let dc_link = DcLinkLimit::new(&t.dc_link, m, speed_config.i_max, r.i_max, ts)?;
@@ -142,7 +143,12 @@ impl<T: Real> DriveConfig<T> {
     /// `decoupling` and `current_anti_windup_ratio`: what the drive builds.
     pub fn current_controller_config(&self) -> CurrentControllerConfig<T> {
         let t = &self.tuning;
+        // A saturating model: the incremental inductances at the rated MTPA point
+        // (`crate::control::saturated_references`).
+        let (ld_hat, lq_hat) = self.current_loop_inductances();
         CurrentControllerConfig {
+            ld_hat,
+            lq_hat,
             bandwidth_hz: t.current_bandwidth_hz,
             decoupling: t.decoupling,
             anti_windup_ratio: t.current_anti_windup_ratio,

@@ -145,7 +145,10 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         };
         // 8. Anti-windup with the realised voltage in the same frame; speed loop too.
         b.current.realised(applied.v_dq);
-        let realised_torque = if self.resolved.salient {
+        let realised_torque = if let Some(s) = &self.resolved.saturated {
+            // A saturating model's co-energy torque (`saturated_references`).
+            s.torque_flux(i_dq_ref) / self.config.machine.flux_linkage
+        } else if self.resolved.salient {
             let m = &self.config.machine;
             m.active_flux(i_dq_ref.d) * i_dq_ref.q / m.flux_linkage
         } else {
@@ -257,7 +260,10 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             let m = &self.config.machine;
             let p = T::lit(m.pole_pairs as f64);
             let i = self.last.i_dq_ref;
-            let torque = T::lit(1.5) * p * m.active_flux(i.d) * i.q;
+            let torque = match &self.resolved.saturated {
+                Some(s) => T::lit(1.5) * p * s.torque_flux(i),
+                None => T::lit(1.5) * p * m.active_flux(i.d) * i.q,
+            };
             self.estimator.set_acceleration(p * torque / m.inertia);
         }
         let estimate = self.estimator.step(self.history[1], i_ab);
