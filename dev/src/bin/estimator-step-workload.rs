@@ -64,7 +64,7 @@ fn isr_step_lean<T: Real>(est: &mut SensorlessEstimator<T>, v: Ab<T>, i: Ab<T>) 
     est.step_lean(v, i)
 }
 
-/// The Cortex-M image's hand-lean paper's estimator (`examples/cortex-m`), the same source.
+// The Cortex-M image's hand-lean paper's estimator (`examples/cortex-m`), the same source.
 #[path = "../../../examples/cortex-m/src/paper_kernel.rs"]
 #[allow(dead_code)]
 mod paper_kernel;
