@@ -33,7 +33,6 @@ KNOWN = {
     "crates/fado-sim/src/bin/fado-sim/main.rs::run_commission": 175,
     "crates/fado-sim/src/commission.rs::commission": 87,
     "crates/fado-sim/src/compare.rs::to_markdown": 102,
-    "crates/fado-sim/src/config.rs": 1125,
     "crates/fado-sim/src/derive.rs::complete_motor": 104,
     "crates/fado-sim/src/sweep/point.rs::run_point_until": 87,
     "crates/fado-sim/src/sweep/runner.rs::run": 93,
