@@ -18,7 +18,7 @@
 //!
 //! # The bound on ω·Ts (why 0.2)
 //! The estimator integrates the voltage the inverter held over each sample and the resistive
-//! drop of the current averaged over the same interval (trapezoid, `average_current`); the
+//! drop of the current averaged over the same interval (trapezoid, `integrator.average_current`); the
 //! drive applies its voltage 1.5 samples after the angle it was computed at, advanced by the
 //! linearised 1.5·ω̂·Ts. A stator quantity that turns by x = ω·Ts per sample is therefore
 //! represented with the gain cos(x/2) by the trapezoid and sinc(x/2) = sin(x/2)/(x/2) by the

@@ -96,7 +96,7 @@ fn run<T: Real>(steps: usize, ortega: bool) -> f64 {
         return run_steps(&table, steps, |v, i| isr_step(&mut est, v, i).theta);
     }
     let mut config = EstimatorConfig::for_machine(&machine);
-    config.tuning.rs_adaptation = std::env::var("FIXED_RS").is_err();
+    config.tuning.rs_adaptation.enabled = std::env::var("FIXED_RS").is_err();
     if std::env::var("PAPER_PATH").is_ok() {
         config.tuning = config.tuning.paper_path();
     }

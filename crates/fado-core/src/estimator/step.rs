@@ -189,9 +189,9 @@ impl<T: Real> EstimatorState<T> {
         } else {
             lambda1
         };
-        // With `observer_lag_compensation` ω̂1 plus T2S-1's low-passed Kp·e (the rate of
+        // With `observer.lag_compensation` ω̂1 plus T2S-1's low-passed Kp·e (the rate of
         // θ̂), not the lagging ω̂1 alone. Its gains were formed for that speed at the end of
-        // a previous sample (the last one, or up to `observer_gain_period` earlier).
+        // a previous sample (the last one, or up to `observer.gain_period` earlier).
         p.observer
             .next_state_with(&self.observer, &self.observer_gains, observer_input)
     }

@@ -406,8 +406,13 @@ mod tests {
         assert_eq!(c.speed_reference.points[4], [6.5, 90.0]);
         assert!(close(c.simulation.duration, base.simulation.duration + 2.0));
         // A TOML key as an axis.
-        let c = point_config(&base, &["estimator.k_df".into()], &[Value::Float(0.25)]).unwrap();
-        assert_eq!(c.estimator.k_df, 0.25);
+        let c = point_config(
+            &base,
+            &["estimator.disturbance_feedback.k_df".into()],
+            &[Value::Float(0.25)],
+        )
+        .unwrap();
+        assert_eq!(c.estimator.disturbance_feedback.k_df, 0.25);
         // Bad values are errors naming the parameter.
         let e = point_config(&base, &["rs_error".into()], &[Value::Float(-1.5)]).unwrap_err();
         assert!(e.to_string().contains("rs_ratio"), "{e}");

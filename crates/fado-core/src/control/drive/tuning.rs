@@ -46,7 +46,7 @@ pub struct DriveTuning<T> {
     pub mtpa: bool,
     /// Give the estimator's speed trackers the acceleration the commanded torque causes,
     /// p·T*/Ĵ (a mechanical-model feed-forward, see [`crate::tracker`]); use with the
-    /// estimator's `tracker_load_pole_ratio` > 0, whose third integrator takes up the load.
+    /// estimator's `tracker.load_pole_ratio` > 0, whose third integrator takes up the load.
     /// Default false (the paper's trackers) \[A\].
     pub acceleration_feedforward: bool,
     /// Dead time Td in s (inverter datum). Default 2.5 µs (paper, V).
@@ -223,7 +223,7 @@ pub struct DriveTuning<T> {
     /// `lock_reaction_on_stall`; widened with the commanded torque on motors of small inertia
     /// for their torque, `lock_stall_torque_band_ratio`). Default 0.003
     /// \[A\] (4.5 r/min at 1500 r/min rated, a fifth of the default Fig. 3 threshold
-    /// `mode_threshold_ratio` 0.015; chosen on the fig11 envelope with the current gate
+    /// `mode.threshold_ratio` 0.015; chosen on the fig11 envelope with the current gate
     /// `lock_stall_min_current_ratio` and the exception `lock_stall_follow_time`,
     /// docs/method/lock.md: 0.005 reaches the band 20–60 ms after the error passes 0.5 rad in 10
     /// of 208 fixed-R̂s losses; the light-load losses that 0.004 saw late reach
@@ -232,11 +232,11 @@ pub struct DriveTuning<T> {
     pub lock_stall_speed_ratio: T,
     /// Net time (s) the stall condition must hold (up/down count, [`crate::lock::Debouncer`]).
     /// Default 5 ms \[A\] (the estimator's
-    /// `lock_detection_time`).
+    /// `lock.detection_time`).
     pub lock_stall_time: T,
     /// Net time (s) without the stall condition after which the stall symptom clears (it is
     /// a live status like the estimator's, see [`crate::lock::Debouncer`]; the reaction
-    /// latches). Default 0.1 s \[A\] (the estimator's `lock_heal_time`).
+    /// latches). Default 0.1 s \[A\] (the estimator's `lock.heal_time`).
     pub lock_stall_heal_time: T,
     /// The stall symptom counts only while |ω̂| is below this multiple of the rated speed, or
     /// while ω̂ turns against ω*; 0: at any speed. Default 0 (off) \[A\]. The first round's
@@ -274,7 +274,7 @@ pub struct DriveTuning<T> {
     /// lose its rotor: a trade to choose per motor, not a default.
     pub lock_stall_gross_error_ratio: T,
     /// The stall symptom also counts in k_df mode while |ω̂| is below this multiple of the
-    /// rated speed (the limiter ↔ k_df threshold `mode_threshold_ratio` is 0.015, so the
+    /// rated speed (the limiter ↔ k_df threshold `mode.threshold_ratio` is 0.015, so the
     /// default is a band of 0.0025·rated, 3.75 r/min at 1500 r/min, above it); 0: limiter
     /// mode only. Default 0.0175 \[A\] (docs/method/lock.md). A band of 0.02 (chosen on the fig11
     /// envelope: under heavy
