@@ -19,6 +19,7 @@ pub mod pi;
 pub mod ratings_limit;
 pub mod speed_controller;
 pub mod standstill_probe;
+pub mod tracker_feedforward;
 
 pub use current_controller::{CurrentController, CurrentControllerConfig};
 pub use dc_link_limit::{DcLinkLimit, DcLinkTuning};
@@ -36,3 +37,4 @@ pub use pi::{Pi, PiConfig};
 pub use ratings_limit::{RatingsLimit, RatingsLimitTuning};
 pub use speed_controller::{SpeedController, SpeedControllerConfig, limit_current_d_priority};
 pub use standstill_probe::{StandstillProbe, StandstillProbeConfig};
+pub use tracker_feedforward::TrackerFeedforwardTuning;

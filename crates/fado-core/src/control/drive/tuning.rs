@@ -9,6 +9,7 @@ use crate::control::field_weakening::FieldWeakeningTuning;
 use crate::control::lock_reaction::LockReaction;
 use crate::control::modulation::VoltageLimit;
 use crate::control::ratings_limit::RatingsLimitTuning;
+use crate::control::tracker_feedforward::TrackerFeedforwardTuning;
 use crate::control::{current_controller, delay_compensation, gain_calibration, speed_controller};
 use crate::injection;
 use crate::machine::PAPER_RATED_CURRENT;
@@ -46,7 +47,8 @@ pub struct DriveTuning<T> {
     /// Give the estimator's speed trackers the acceleration the commanded torque causes,
     /// p·T*/Ĵ (a mechanical-model feed-forward, see [`crate::tracker`]); use with the
     /// estimator's `tracker_load_pole_ratio` > 0, whose third integrator takes up the load.
-    /// Default false (the paper's trackers) \[A\].
+    /// Default false (the paper's trackers) \[A\]; the drive turns it on itself on a rotor its
+    /// trackers would lag (`tracker_feedforward`).
     pub acceleration_feedforward: bool,
     /// Dead time Td in s (inverter datum). Default 2.5 µs (paper, V).
     #[cfg_attr(feature = "serde", serde(skip))]
@@ -183,6 +185,14 @@ pub struct DriveTuning<T> {
         serde(bound(deserialize = "T: Real + serde::Deserialize<'de>"))
     )]
     pub limits: RatingsLimitTuning<T>,
+    /// When the drive turns on the acceleration feed-forward by itself: a rotor its trackers
+    /// would lag by more than `max_lag` at the current limit (`[controller.tracker_feedforward]`,
+    /// see [`crate::control::tracker_feedforward`]).
+    #[cfg_attr(
+        feature = "serde",
+        serde(bound(deserialize = "T: Real + serde::Deserialize<'de>"))
+    )]
+    pub tracker_feedforward: TrackerFeedforwardTuning<T>,
     /// Reaction to the estimator's [`LockStatus::Lost`](crate::LockStatus::Lost) (`DriveFlags::LOCK_LOST`) and, with
     /// `lock_reaction_on_stall`, to the stall symptom (`DriveFlags::STALLED`). Default report
     /// only \[A\] (the paper's behaviour plus the flags).
@@ -437,6 +447,7 @@ impl<T: Real> DriveTuning<T> {
             dc_link: self.dc_link.cast(),
             field_weakening: self.field_weakening.cast(),
             limits: self.limits.cast(),
+            tracker_feedforward: self.tracker_feedforward.cast(),
             lock_reaction: self.lock_reaction,
             lock_reaction_on_stall: self.lock_reaction_on_stall,
             lock_recovery_time: U::lit(self.lock_recovery_time.to_f64()),
@@ -510,6 +521,7 @@ impl<T: Real> Default for DriveTuning<T> {
             dc_link: DcLinkTuning::default(),
             field_weakening: FieldWeakeningTuning::default(),
             limits: RatingsLimitTuning::default(),
+            tracker_feedforward: TrackerFeedforwardTuning::default(),
             lock_reaction: LockReaction::ReportOnly,
             lock_reaction_on_stall: true,
             lock_recovery_time: T::lit(20e-3),
