@@ -9,6 +9,7 @@ use crate::control::field_weakening::FieldWeakeningTuning;
 use crate::control::lock_reaction::LockReaction;
 use crate::control::modulation::VoltageLimit;
 use crate::control::ratings_limit::RatingsLimitTuning;
+use crate::control::release_hold::ReleaseHoldTuning;
 use crate::control::tracker_feedforward::TrackerFeedforwardTuning;
 use crate::control::{current_controller, delay_compensation, gain_calibration, speed_controller};
 use crate::injection;
@@ -193,6 +194,13 @@ pub struct DriveTuning<T> {
         serde(bound(deserialize = "T: Real + serde::Deserialize<'de>"))
     )]
     pub tracker_feedforward: TrackerFeedforwardTuning<T>,
+    /// The release hold: a position loop that holds a rotor a load turns at zero speed
+    /// after the start-up (`[controller.release_hold]`, see [`ReleaseHoldTuning`]).
+    #[cfg_attr(
+        feature = "serde",
+        serde(bound(deserialize = "T: Real + serde::Deserialize<'de>"))
+    )]
+    pub release_hold: ReleaseHoldTuning<T>,
     /// Reaction to the estimator's [`LockStatus::Lost`](crate::LockStatus::Lost) (`DriveFlags::LOCK_LOST`) and, with
     /// `lock_reaction_on_stall`, to the stall symptom (`DriveFlags::STALLED`). Default report
     /// only \[A\] (the paper's behaviour plus the flags).
@@ -446,6 +454,7 @@ impl<T: Real> DriveTuning<T> {
             dc_link_max_ratio: U::lit(self.dc_link_max_ratio.to_f64()),
             dc_link: self.dc_link.cast(),
             field_weakening: self.field_weakening.cast(),
+            release_hold: self.release_hold.cast(),
             limits: self.limits.cast(),
             tracker_feedforward: self.tracker_feedforward.cast(),
             lock_reaction: self.lock_reaction,
@@ -520,6 +529,7 @@ impl<T: Real> Default for DriveTuning<T> {
             dc_link_max_ratio: T::lit(crate::plausibility::VOLTAGE_RATIO),
             dc_link: DcLinkTuning::default(),
             field_weakening: FieldWeakeningTuning::default(),
+            release_hold: ReleaseHoldTuning::default(),
             limits: RatingsLimitTuning::default(),
             tracker_feedforward: TrackerFeedforwardTuning::default(),
             lock_reaction: LockReaction::ReportOnly,
