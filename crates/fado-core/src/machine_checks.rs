@@ -27,7 +27,7 @@ use core::fmt;
 
 use crate::Real;
 use crate::machine::MachineModel;
-use crate::ratings;
+use crate::ratings::{self, MAX_OMEGA_TS, MAX_RUNNING_OMEGA_TS};
 
 /// How serious a finding is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -430,10 +430,9 @@ impl fmt::Display for Finding {
                 } else {
                     write!(
                         f,
-                        "; the drive's angle estimate degrades above {} and commissioning \
-                         needs at most {} (switching frequency ≥ {switching_frequency} Hz)",
-                        ratings::MAX_RUNNING_OMEGA_TS,
-                        ratings::MAX_OMEGA_TS
+                        "; the drive's angle estimate degrades above {MAX_RUNNING_OMEGA_TS} and \
+                         commissioning needs at most {MAX_OMEGA_TS} (switching frequency ≥ \
+                         {switching_frequency} Hz)"
                     )
                 }
             }

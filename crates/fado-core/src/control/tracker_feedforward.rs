@@ -89,26 +89,35 @@ pub fn current_limit_lag<T: Real>(
     p * ratio * machine.rated_torque / (machine.inertia * ki)
 }
 
-/// The drive's and the estimator's tuning with the rule applied (module docs).
-pub fn resolve<T: Real>(
+/// Applies the rule of the module docs to the drive's and the estimator's tuning, in place.
+pub fn apply<T: Real>(
     machine: &MachineModel<T>,
-    mut drive: DriveTuning<T>,
-    mut estimator: EstimatorTuning<T>,
+    drive: &mut DriveTuning<T>,
+    estimator: &mut EstimatorTuning<T>,
     ts: T,
-) -> (DriveTuning<T>, EstimatorTuning<T>) {
+) {
     // NaN compares false: no feed-forward.
-    if current_limit_lag(machine, &drive, &estimator, ts) > drive.tracker_feedforward.max_lag {
+    if current_limit_lag(machine, drive, estimator, ts) > drive.tracker_feedforward.max_lag {
         drive.acceleration_feedforward = true;
         if estimator.tracker_load_pole_ratio == T::zero() {
             estimator.tracker_load_pole_ratio = T::lit(LOAD_POLE_RATIO);
         }
     }
-    (drive, estimator)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn resolve(
+        m: &MachineModel<f64>,
+        mut d: DriveTuning<f64>,
+        mut e: EstimatorTuning<f64>,
+        ts: f64,
+    ) -> (DriveTuning<f64>, EstimatorTuning<f64>) {
+        apply(m, &mut d, &mut e, ts);
+        (d, e)
+    }
 
     #[test]
     fn the_lag_grows_with_the_rated_electrical_speed_and_turns_the_feedforward_on() {

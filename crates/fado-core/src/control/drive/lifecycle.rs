@@ -18,15 +18,15 @@ impl<T: Real> SensorlessDrive<T, SensorlessEstimator<T>> {
     /// acceleration feed-forward ([`crate::control::tracker_feedforward`]).
     pub fn new(
         mut config: DriveConfig<T>,
-        estimator: EstimatorTuning<T>,
+        mut estimator: EstimatorTuning<T>,
     ) -> Result<Self, ConfigError> {
-        let (tuning, estimator) = crate::control::tracker_feedforward::resolve(
-            &config.machine,
-            config.tuning,
-            estimator,
+        let machine = config.machine;
+        crate::control::tracker_feedforward::apply(
+            &machine,
+            &mut config.tuning,
+            &mut estimator,
             config.ts,
         );
-        config.tuning = tuning;
         let estimator = EstimatorConfig {
             ts: check::positive("ts", config.ts)?,
             machine: config.machine,
