@@ -50,7 +50,8 @@ use cortex_m_semihosting::{debug, hprintln};
 use drive_loop::DriveApp;
 use fado_core::{
     Ab, Abc, DriveOutput, Estimate, EstimatorConfig, EstimatorParams, EstimatorState,
-    EstimatorTuning, LeanEstimate, MachineModel, Mode, SensorlessDrive, SensorlessEstimator,
+    EstimatorTuning, LeanEstimate, MachineMagnetics, MachineModel, Mode, SensorlessDrive,
+    SensorlessEstimator,
 };
 use paper_kernel::{PaperKernel, paper_kernel_held_step, paper_kernel_step};
 
@@ -115,6 +116,7 @@ fn ipmsm_2k2() -> MachineModel<f32> {
         rated_speed_rpm: 1500.0,
         rated_torque: 14.0,
         dc_voltage: 540.0,
+        magnetics: MachineMagnetics::Linear,
     }
 }
 
