@@ -10,6 +10,7 @@ use crate::control::lock_reaction::LockReaction;
 use crate::control::modulation::VoltageLimit;
 use crate::control::ratings_limit::RatingsLimitTuning;
 use crate::control::release_hold::ReleaseHoldTuning;
+use crate::control::tracker_feedforward::TrackerFeedforwardTuning;
 use crate::control::{current_controller, delay_compensation, gain_calibration, speed_controller};
 use crate::injection;
 use crate::machine::PAPER_RATED_CURRENT;
@@ -47,7 +48,8 @@ pub struct DriveTuning<T> {
     /// Give the estimator's speed trackers the acceleration the commanded torque causes,
     /// p·T*/Ĵ (a mechanical-model feed-forward, see [`crate::tracker`]); use with the
     /// estimator's `tracker.load_pole_ratio` > 0, whose third integrator takes up the load.
-    /// Default false (the paper's trackers) \[A\].
+    /// Default false (the paper's trackers) \[A\]; the drive turns it on itself on a rotor its
+    /// trackers would lag (`tracker_feedforward`).
     pub acceleration_feedforward: bool,
     /// Dead time Td in s (inverter datum). Default 2.5 µs (paper, V).
     #[cfg_attr(feature = "serde", serde(skip))]
@@ -184,6 +186,14 @@ pub struct DriveTuning<T> {
         serde(bound(deserialize = "T: Real + serde::Deserialize<'de>"))
     )]
     pub limits: RatingsLimitTuning<T>,
+    /// When the drive turns on the acceleration feed-forward by itself: a rotor its trackers
+    /// would lag by more than `max_lag` at the current limit (`[controller.tracker_feedforward]`,
+    /// see [`crate::control::tracker_feedforward`]).
+    #[cfg_attr(
+        feature = "serde",
+        serde(bound(deserialize = "T: Real + serde::Deserialize<'de>"))
+    )]
+    pub tracker_feedforward: TrackerFeedforwardTuning<T>,
     /// The release hold: a position loop that holds a rotor a load turns at zero speed
     /// after the start-up (`[controller.release_hold]`, see [`ReleaseHoldTuning`]).
     #[cfg_attr(
@@ -446,6 +456,7 @@ impl<T: Real> DriveTuning<T> {
             field_weakening: self.field_weakening.cast(),
             release_hold: self.release_hold.cast(),
             limits: self.limits.cast(),
+            tracker_feedforward: self.tracker_feedforward.cast(),
             lock_reaction: self.lock_reaction,
             lock_reaction_on_stall: self.lock_reaction_on_stall,
             lock_recovery_time: U::lit(self.lock_recovery_time.to_f64()),
@@ -520,6 +531,7 @@ impl<T: Real> Default for DriveTuning<T> {
             field_weakening: FieldWeakeningTuning::default(),
             release_hold: ReleaseHoldTuning::default(),
             limits: RatingsLimitTuning::default(),
+            tracker_feedforward: TrackerFeedforwardTuning::default(),
             lock_reaction: LockReaction::ReportOnly,
             lock_reaction_on_stall: true,
             lock_recovery_time: T::lit(20e-3),
