@@ -114,6 +114,7 @@ fn ipmsm_2k2() -> MachineModel<f32> {
         rated_speed_rpm: 1500.0,
         rated_torque: 14.0,
         dc_voltage: 540.0,
+        magnetics: Default::default(),
     }
 }
 
