@@ -401,15 +401,22 @@ impl SimConfig {
     /// `model.<key>` for a key the file gives and the plant key it derives from otherwise.
     fn model_checked(&self) -> Result<MachineModel<f64>, SimConfigError> {
         let derived = self.derived_model();
+        // The magnetic model (`crate::model_magnetics`): `[model.saturation]`, or the plant's.
+        let magnetics = crate::model_magnetics::drive_model(self, self.model.as_ref())?;
         let Some(table) = &self.model else {
-            return Ok(derived);
+            return Ok(derived.with_magnetics(magnetics));
         };
+        let mut table = table.clone();
+        for key in crate::model_magnetics::MODEL_MAGNETICS_KEYS {
+            table.remove(key);
+        }
         let mut merged = toml::Table::try_from(derived)
             .map_err(|e| SimConfigError::new("model", e.to_string()))?;
-        merge(&mut merged, table.clone());
+        merge(&mut merged, table);
         let mut model = MachineModel::<f64>::deserialize(toml::Value::Table(merged))
             .map_err(|e| key_error(e).in_section("model"))?;
         model.dc_voltage = self.inverter.dc_voltage;
+        model.magnetics = magnetics;
         model.validate().map_err(|e| self.core_error("model", e))?;
         Ok(model)
     }

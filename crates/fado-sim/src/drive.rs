@@ -167,9 +167,17 @@ impl SimConfig {
     /// The drive of this configuration in single precision: every parameter rounded to f32.
     pub fn build_drive_f32(&self) -> Result<DriveF32, SimConfigError> {
         let c = self.drive_config();
+        // A flux map is rounded to f32 and interned (`crate::model_magnetics`).
+        let magnetics =
+            crate::model_magnetics::to_f32(&c.machine.magnetics, self).ok_or_else(|| {
+                SimConfigError::new(
+                    "model",
+                    "the flux map does not stay strictly monotonic rounded to f32",
+                )
+            })?;
         let dc = DriveConfig::<f32> {
             ts: c.ts as f32,
-            machine: c.machine.cast(),
+            machine: c.machine.cast().with_magnetics(magnetics),
             tuning: c.tuning.cast(),
         };
         dc.validate()

@@ -63,6 +63,7 @@ pub mod inverter;
 pub mod load;
 pub mod magnetics;
 pub mod magnetics_file;
+pub mod model_magnetics;
 pub mod motor;
 pub mod output;
 pub mod presets;

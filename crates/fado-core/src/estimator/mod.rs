@@ -56,6 +56,7 @@ pub use output::{Diagnostics, Estimate, LeanEstimate};
 pub use owner::{RotorAngleEstimator, SensorlessEstimator};
 pub use tuning::EstimatorTuning;
 
+use crate::active_flux::ActiveFlux;
 use crate::flux::{
     DisturbanceFeedbackParams, FluxIntegratorParams, FluxIntegratorState, FluxLimiter,
 };
@@ -135,6 +136,10 @@ pub struct EstimatorParams<T: Real> {
     lq: T,
     /// L̂d − L̂q, H (0 on a surface-magnet rotor).
     saliency: T,
+    /// A saturating model's active flux (`crate::active_flux`): λ̂r with the secant L̂q at
+    /// the estimated current, the limiter's and the lock detector's bounds from λ̂a(î).
+    /// None for constant inductances (`lq` and `saliency` then hold).
+    active_flux: Option<ActiveFlux<T>>,
     /// The configured λ̂f, Wb.
     flux_linkage: T,
     /// `EstimatorTuning::tracker_hold_ratio`.
@@ -195,6 +200,9 @@ pub struct EstimatorParams<T: Real> {
 pub struct EstimatorState<T: Real> {
     integrator: FluxIntegratorState<T>,
     observer: ObserverState<T>,
+    /// The q inductance of eq. (5) the last sample used: L̂q, or a saturating model's
+    /// secant at the estimated current (`crate::active_flux`).
+    lq_secant: T,
     t2s1: TrackerState<T>,
     t2s2: TrackerState<T>,
     /// The k_df gain in effect (it ramps on activation, `EstimatorTuning::k_df_ramp_time`).

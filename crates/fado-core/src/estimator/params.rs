@@ -5,6 +5,7 @@ use super::{
     EstimatorConfig, EstimatorParams, EstimatorState, FLUX_SETTLE_TIME_CONSTANTS,
     MAX_OBSERVER_GAIN_PERIOD,
 };
+use crate::active_flux::ActiveFlux;
 use crate::error::{ConfigError, check};
 use crate::flux::{
     DisturbanceFeedbackParams, FluxIntegratorParams, FluxIntegratorState, FluxLimiter,
@@ -81,6 +82,10 @@ impl<T: Real> EstimatorParams<T> {
             ts,
             lq: config.machine.lq,
             saliency: config.machine.ld - config.machine.lq,
+            active_flux: ActiveFlux::new(
+                config.machine.magnetic_model(),
+                config.machine.rated_current,
+            ),
             flux_linkage: lf,
             tracker_hold_ratio: hold,
             limiter_recentring_gain: if config.tuning.limiter_recentring {
@@ -132,6 +137,7 @@ impl<T: Real> EstimatorParams<T> {
         let mut state = EstimatorState {
             integrator: FluxIntegratorState::new(self.rs_initial),
             observer: ObserverState::zero(),
+            lq_secant: self.lq,
             t2s1: self.t2s1.state_at(T::zero(), T::zero()),
             t2s2: self.t2s2.state_at(T::zero(), T::zero()),
             kdf_gain: T::zero(),
@@ -331,5 +337,9 @@ fn slow_laws<T: Real>(
                 _ => rename("mode_threshold_ratio")(e),
             }
         })?;
-    Ok((rs_adaptation, offset))
+    let active_flux = ActiveFlux::new(
+        config.machine.magnetic_model(),
+        config.machine.rated_current,
+    );
+    Ok((rs_adaptation.with_active_flux(active_flux), offset))
 }

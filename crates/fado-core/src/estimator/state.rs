@@ -2,6 +2,7 @@
 //! last good sample.
 
 use super::{Diagnostics, Estimate, EstimatorParams, EstimatorState, LeanEstimate};
+use crate::active_flux::{ActiveFlux, ActiveFluxPoint};
 use crate::error::ConfigError;
 use crate::integrand_offset::IntegrandOffsetState;
 use crate::lock::LockState;
@@ -37,18 +38,26 @@ impl<T: Real> EstimatorState<T> {
         } else {
             T::zero()
         };
-        // The active flux λ̂f + (L̂d − L̂q)·i_d (λ̂f exactly for L̂d = L̂q).
+        // The active flux λ̂f + (L̂d − L̂q)·i_d (λ̂f exactly for L̂d = L̂q), or a saturating
+        // model's at the current in the aligned frame, with its secant L̂q.
         let rotor = Ab::from_polar(T::one(), theta0);
-        let active = p.flux_linkage + p.saliency * rotor.dot(i_ab);
-        let active = if active.is_finite() && active > T::zero() {
-            active
-        } else {
-            p.flux_linkage
+        let (active, lq) = match &p.active_flux {
+            None => (p.flux_linkage + p.saliency * rotor.dot(i_ab), p.lq),
+            Some(af) => {
+                let point = af.point(ActiveFlux::frame_current(rotor, i_ab));
+                (point.active, point.lq_secant)
+            }
         };
+        let (active, lq) = if active.is_finite() && active > T::zero() && lq.is_finite() {
+            (active, lq)
+        } else {
+            (p.flux_linkage, p.lq)
+        };
+        self.lq_secant = lq;
         let lambda_r = Ab::from_polar(active, theta0);
         // A current so large that L̂q·i overflows is as unusable as a NaN (found by fuzzing,
         // f32: i = 3e37 A gave λ1 = ∞): start as with zero current.
-        let lambda1 = lambda_r + i_ab * p.lq;
+        let lambda1 = lambda_r + i_ab * lq;
         let (lambda1, i_ab) = if lambda1.is_finite() {
             (lambda1, i_ab)
         } else {
@@ -122,7 +131,16 @@ impl<T: Real> EstimatorState<T> {
         lambda_r: Ab<T>,
         saliency: T,
         tracker_hold: bool,
+        point: Option<ActiveFluxPoint<T>>,
     ) -> T {
+        if let Some(point) = point {
+            // A saturating model: λ̂a(î)/λ̂f at the sample's operating point.
+            return if tracker_hold {
+                T::one()
+            } else {
+                crate::real::max(point.active / p.flux_linkage, p.tracker_hold_ratio)
+            };
+        }
         if saliency != T::zero() && !tracker_hold {
             let i_d = i_ab.dot(lambda_r) / lambda_r.norm_squared().step_sqrt();
             let ratio = T::one() + saliency * i_d / p.flux_linkage;
@@ -146,6 +164,15 @@ impl<T: Real> EstimatorState<T> {
     ) -> Ab<T> {
         let axis = self.observer.flux() - self.observer.disturbance();
         let n2 = axis.norm_squared();
+        if let Some(af) = &p.active_flux {
+            // A saturating model: λ̂a(î) − ψd(0, 0) along the axis, î in its frame.
+            return if n2 > p.hold_level_sq {
+                let point = af.point(ActiveFlux::frame_current(axis, i_ab));
+                axis * ((point.active - af.magnet_flux()) / n2.step_sqrt())
+            } else {
+                Ab::zero()
+            };
+        }
         if n2 > p.hold_level_sq {
             axis * (saliency * i_ab.dot(axis) / n2)
         } else {
@@ -168,7 +195,7 @@ impl<T: Real> EstimatorState<T> {
         let lambda1 = self.integrator.flux();
         let disturbance = self.observer.disturbance();
         let lambda2 = stator_flux(lambda1, disturbance);
-        let lambda_r = rotor_flux(lambda2, self.integrator.last_current(), p.lq);
+        let lambda_r = rotor_flux(lambda2, self.integrator.last_current(), self.lq_secant);
         let mode = self.mode;
         Estimate {
             theta: self.t2s1.angle(),
@@ -228,13 +255,13 @@ impl<T: Real> EstimatorState<T> {
     }
 
     /// As [`SensorlessEstimator::turn_angle`](crate::SensorlessEstimator::turn_angle).
-    pub fn turn_angle(&mut self, p: &EstimatorParams<T>, angle: T) {
+    pub fn turn_angle(&mut self, _p: &EstimatorParams<T>, angle: T) {
         if !angle.is_finite() || self.mode != Mode::Limiter {
             return;
         }
         let lambda1 = self.integrator.flux();
         let lambda2 = stator_flux(lambda1, self.observer.disturbance());
-        let lambda_r = rotor_flux(lambda2, self.integrator.last_current(), p.lq);
+        let lambda_r = rotor_flux(lambda2, self.integrator.last_current(), self.lq_secant);
         let turned = lambda1 + lambda_r.mul_j() * angle;
         if turned.is_finite() {
             self.integrator

@@ -9,6 +9,7 @@ use super::{
     BROKEN_OFFSET, BROKEN_RS, Diagnostics, Estimate, EstimatorParams, EstimatorState, LOCK_PERIOD,
     SLOT_LOCK, SLOT_OFFSET, SLOT_RS, SLOW_PERIOD,
 };
+use crate::active_flux::ActiveFluxPoint;
 use crate::mode::Mode;
 use crate::real::all_finite;
 use crate::rotor_flux::{rotor_angle, stator_flux};
@@ -20,6 +21,8 @@ use crate::{Ab, Real};
 struct Candidate<T: Real> {
     /// L̂d − L̂q, loaded once for every use in the sample.
     saliency: T,
+    /// A saturating model's operating point (`crate::active_flux`), with its secant L̂q.
+    point: Option<ActiveFluxPoint<T>>,
     /// λ1 integrated with the previous sample's feedback (eq. (21) / (24)).
     lambda1: Ab<T>,
     /// The current the integrator's resistive drop used (the slow laws' current).
@@ -109,12 +112,20 @@ impl<T: Real> EstimatorState<T> {
             .next_flux(&self.integrator, v_ab, i_ab, self.feedback);
         // L̂q·i of eq. (5), formed once for both of its uses (λ̂r, and the observer's input
         // on the rotor flux): what `rotor_flux` computes, bit for bit.
-        let lq_i = i_ab * p.lq;
+        // A saturating model's secant L̂q is the last sample's here (`crate::active_flux`).
+        let lq_i = i_ab * self.lq_secant;
         // 2. Disturbance observer.
         let (observer_flux, disturbance) = self.observe(p, lambda1, lq_i, i_ab, saliency);
-        // 3. Rotor flux and direct angle (eq. (20), (5), (6)).
+        // 3. Rotor flux and direct angle (eq. (20), (5), (6)); a saturating model's secant
+        //    L̂q at the current in the frame of λ2 − L̂q⁻·i.
         let lambda2 = stator_flux(lambda1, disturbance);
-        let lambda_r = lambda2 - lq_i;
+        let (lambda_r, point) = match &p.active_flux {
+            None => (lambda2 - lq_i, None),
+            Some(af) => {
+                let (lambda_r, point) = af.rotor_flux(lambda2, i_ab, self.lq_secant);
+                (lambda_r, Some(point))
+            }
+        };
         let tracker_hold = lambda_r.norm_squared() < p.hold_level_sq;
         let theta_direct = rotor_angle(lambda_r);
         // 4. Trackers (Fig. 1, Fig. 5).
@@ -126,7 +137,7 @@ impl<T: Real> EstimatorState<T> {
         let (base_feedback, clamping) = match mode {
             Mode::DisturbanceFeedback => (disturbance * kdf_gain, false),
             Mode::Limiter => {
-                let ratio = Self::active_ratio(p, i_ab, lambda_r, saliency, tracker_hold);
+                let ratio = Self::active_ratio(p, i_ab, lambda_r, saliency, tracker_hold, point);
                 let l = p.limiter.step_scaled(lambda_r, ratio);
                 (l.feedback, l.clamping)
             }
@@ -138,6 +149,7 @@ impl<T: Real> EstimatorState<T> {
         let feedback = base_feedback + self.slow_feedback;
         Candidate {
             saliency,
+            point,
             lambda1,
             i_drop,
             observer_flux,
@@ -266,6 +278,9 @@ impl<T: Real> EstimatorState<T> {
         self.t2s1.commit(c.t2s1);
         // T2S-2's θ̂ is never read (its ω̂ is the control speed): not stored.
         self.t2s2.commit_speed(c.t2s2);
+        if let Some(point) = c.point {
+            self.lq_secant = point.lq_secant;
+        }
         self.mode = c.mode;
         self.kdf_gain = c.kdf_gain;
         self.feedback = c.feedback;
@@ -286,7 +301,8 @@ impl<T: Real> EstimatorState<T> {
         }
         // λ̂f as this sample used it (the slow laws have not run yet).
         let flux_hat = self.rs_adaptation.flux_linkage_hat;
-        let active_ratio = Self::active_ratio(p, i_ab, c.lambda_r, c.saliency, c.tracker_hold);
+        let active_ratio =
+            Self::active_ratio(p, i_ab, c.lambda_r, c.saliency, c.tracker_hold, c.point);
         // A hand-over since the last judged sample (the mode sampled every LOCK_PERIOD
         // samples: two hand-overs within them would need ω̂ to cross the hysteresis band
         // twice in 0.4 ms, and count as none).

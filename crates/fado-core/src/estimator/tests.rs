@@ -76,9 +76,13 @@ fn state_size() {
     // constants and its state mixed. The state now holds what changes (and R0's 20 B of
     // scaled constants, since `set_rs_hat` replaces R0 at run time).
     // The trackers' acceleration feed-forward and load integrator (`crate::tracker`) add
-    // 2 × 8 B: 264 B in `f32`.
+    // 2 × 8 B: 264 B in `f32`; the q inductance of eq. (5) the last sample used (a saturating
+    // model's secant, `crate::active_flux`) 4 B more.
     assert!(s32 <= 272, "{s32}");
-    assert_eq!(o32, s32 + p32);
+    // The owner is both records and nothing else (padded to its alignment: the parameters
+    // may hold a borrowed flux map, pointer-aligned).
+    let align = core::mem::align_of::<SensorlessEstimator<f32>>();
+    assert_eq!(o32, (s32 + p32).next_multiple_of(align));
 }
 
 /// The reason the slow laws may run every [`SLOW_PERIOD`] samples (see its docs): at

@@ -5,6 +5,7 @@ use super::{
     AdaptationRegime, FLUX_LINKAGE_DEAD_ZONE, FLUX_LINKAGE_DEAD_ZONE_OFF, FLUX_LINKAGE_MAX_RATIO,
     FLUX_LINKAGE_MIN_RATIO, ResistanceAdaptationConfig, ResistanceAdaptationState,
 };
+use crate::active_flux::{ActiveFlux, ActiveFluxPoint};
 use crate::error::{ConfigError, check};
 use crate::real::{max, min};
 use crate::{Ab, Real};
@@ -13,7 +14,7 @@ use crate::{Ab, Real};
 /// immutable half of [`ResistanceAdaptation`]). What scales with R0 is in
 /// [`ResistanceScale`]: R0 changes at run time (the estimator's `set_rs_hat`).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct ResistanceAdaptationParams<T> {
+pub(crate) struct ResistanceAdaptationParams<T: 'static> {
     config: ResistanceAdaptationConfig<T>,
     /// γ·Ts.
     rate_ts: T,
@@ -26,6 +27,9 @@ pub(crate) struct ResistanceAdaptationParams<T> {
     /// L̂d − L̂q.
     saliency: T,
     floor_sq: T,
+    /// The saturating model's active flux (`crate::active_flux`); None: the constant
+    /// L̂d, L̂q of the configuration.
+    active_flux: Option<ActiveFlux<T>>,
 }
 
 /// What the laws derive from R0, the resistance they start from and scale with: mutable
@@ -122,7 +126,29 @@ impl<T: Real> ResistanceAdaptationParams<T> {
             },
             saliency: config.ld_hat - config.lq_hat,
             floor_sq: floor * floor,
+            active_flux: None,
         })
+    }
+
+    /// These constants with a saturating model's active flux: the reference λ̂a, the
+    /// regressor φ and the standstill law's inductances evaluated at the estimated current
+    /// (`crate::active_flux`), the laws frozen where φ is ill-conditioned.
+    pub(crate) fn with_active_flux(mut self, active_flux: Option<ActiveFlux<T>>) -> Self {
+        self.active_flux = active_flux;
+        self
+    }
+
+    /// The saturating model's operating point at the current `i` in the frame of `lambda_r`
+    /// (None without one).
+    #[inline(always)]
+    fn operating_point(
+        &self,
+        lambda_r: Ab<T>,
+        i: Ab<T>,
+    ) -> Option<(ActiveFlux<T>, ActiveFluxPoint<T>)> {
+        let af = self.active_flux?;
+        let point = af.point(ActiveFlux::frame_current(lambda_r, i));
+        Some((af, point))
     }
 
     /// The values scaled by R0 = `r0` (checked non-negative by the caller; the products are
@@ -227,6 +253,16 @@ impl<T: Real> ResistanceAdaptationParams<T> {
     ) -> bool {
         let lf = st.flux_linkage_hat;
         let dl = self.saliency;
+        if let Some((af, point)) = self.operating_point(lambda_r, i_drop) {
+            // A saturating model (`crate::active_flux`): λ̂a(î) shifted by the learned λ̂f,
+            // the regressor's bracket at î; frozen where it is ill-conditioned.
+            let Some(bracket) = af.resistance_regressor(&point) else {
+                return false;
+            };
+            let reference = point.active + (lf - self.config.flux_linkage_hat);
+            let a = -(mag * bracket) * scale.chi_per_phi;
+            return self.rotating_step(scale, st, next, reference, a, mag, omega, settled);
+        }
         // The reference is the active flux λ̂a = λ̂f + (L̂d − L̂q)·î_d and φ carries the
         // sensitivity factor 1 + (L̂d − L̂q)·î_d/λ̂a (module docs); for L̂d = L̂q both are
         // exactly λ̂f and 1, and the division for î_d is skipped.
@@ -245,6 +281,25 @@ impl<T: Real> ResistanceAdaptationParams<T> {
         // χ = a/b: then χ/(χ² + χ0²) = a·b/(a² + χ0²·b²) costs one division, and
         // χ² ≥ χ0² is a² ≥ χ0²·b² (false for ω̂ = 0, which also rules out 0/0).
         let a = -lambda_r.cross(i_drop) * scale.chi_per_phi * sensitivity;
+        self.rotating_step(scale, st, next, reference, a, mag, omega, settled)
+    }
+
+    /// The turning law's step (and the λ̂f law's) with the reference λ̂a and the numerator
+    /// `a` of χ = a/(|λ̂r|·ω̂).
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn rotating_step(
+        &self,
+        scale: &ResistanceScale<T>,
+        st: &ResistanceAdaptationState<T>,
+        next: &mut ResistanceAdaptationState<T>,
+        reference: T,
+        a: T,
+        mag: T,
+        omega: T,
+        settled: bool,
+    ) -> bool {
+        let lf = st.flux_linkage_hat;
         let b = mag * omega;
         let (a_sq, floor_b_sq) = (a * a, self.floor_sq * b * b);
         if a_sq >= floor_b_sq && floor_b_sq > T::zero() {
@@ -344,7 +399,21 @@ impl<T: Real> ResistanceAdaptationParams<T> {
         }
         let ts = self.config.ts;
         let inv_i_d = T::one() / i_d;
-        let v_d = unit.dot(v_ab) + omega * self.config.lq_hat * i_q;
+        // L̂q·i_q (the q flux), L̂d (the d inductance a step of i_d meets) and the rotor's
+        // active flux: a saturating model's at the estimated current, else the constants.
+        let (rotation_emf, ld, active) = match self.operating_point(lambda_r, i_mean) {
+            Some((af, point)) => (
+                omega * (point.lq_secant * i_q),
+                af.ld_incremental(point.i_dq),
+                point.active + (lf - self.config.flux_linkage_hat),
+            ),
+            None => (
+                omega * self.config.lq_hat * i_q,
+                self.config.ld_hat,
+                lf + dl * i_d,
+            ),
+        };
+        let v_d = unit.dot(v_ab) + rotation_emf;
         // L̂d·di_d/dt integrates to L̂d·Δi_d between the ends of the period, from the
         // current sampled there (`i_now`); the first period of a test only records it
         // (its inductive voltage would otherwise be read as resistance).
@@ -353,8 +422,7 @@ impl<T: Real> ResistanceAdaptationParams<T> {
         if st.i_d_prev != T::zero() {
             let di_d = i_d_now - st.i_d_prev;
             next.charge_d = st.charge_d * self.forget + i_d * ts;
-            next.volt_seconds_d =
-                st.volt_seconds_d * self.forget + v_d * ts - self.config.ld_hat * di_d;
+            next.volt_seconds_d = st.volt_seconds_d * self.forget + v_d * ts - ld * di_d;
         }
         if next.charge_d * scale.chi_per_phi >= self.config.excitation_floor {
             let r_dc = next.volt_seconds_d / next.charge_d;
@@ -367,7 +435,7 @@ impl<T: Real> ResistanceAdaptationParams<T> {
         // pull a shrunken λ̂r back out (outside, the Fig. 6 limiter already bounds it at
         // its circle; pulling it further in would only speed up the walk of a tangential
         // integrand error along the circle, which goes as e_t/|λ̂r|).
-        let shortfall = min(mag - (lf + dl * i_d), T::zero());
+        let shortfall = min(mag - active, T::zero());
         let mut pull = unit * (self.config.standstill_flux_rate * shortfall);
         // The injection's current response: at standstill with no load the speed loop
         // holds the torque at zero, so the current lies along the rotor's d axis; turn

@@ -385,7 +385,7 @@ impl<T: Real> ResistanceAdaptationState<T> {
 /// together. `step` advances them; the estimator uses the parameters' `next_state` on its own
 /// state so that a rejected sample changes nothing.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ResistanceAdaptation<T> {
+pub struct ResistanceAdaptation<T: 'static> {
     params: ResistanceAdaptationParams<T>,
     scale: ResistanceScale<T>,
     state: ResistanceAdaptationState<T>,

@@ -10,6 +10,7 @@ use crate::control::field_weakening::FieldWeakening;
 use crate::control::lock_reaction::LockSupervisor;
 use crate::control::modulation::{ModulatorConfig, SpaceVectorModulator};
 use crate::control::ratings_limit::RatingsLimit;
+use crate::control::release_hold::ReleaseHold;
 use crate::control::speed_controller::{SpeedController, SpeedControllerConfig};
 use crate::control::standstill_probe::{StandstillProbe, StandstillProbeConfig};
 use crate::error::{ConfigError, check};
@@ -61,6 +62,7 @@ impl<T: Real> Blocks<T> {
             bandwidth_hz: t.speed_bandwidth_hz,
             zero_ratio: t.speed_zero_ratio,
             anti_windup_ratio: t.speed_anti_windup_ratio,
+            i_max: c.speed_torque_limit(t.mtpa),
             ..SpeedControllerConfig::new(m, t.current_limit_ratio * m.rated_current, t.mtpa, ts)
         };
         let dc_link = DcLinkLimit::new(&t.dc_link, m, speed_config.i_max, r.i_max, ts)?;
@@ -99,8 +101,16 @@ impl<T: Real> Blocks<T> {
             max_modulation: t.max_modulation,
         })?;
         let probe = StandstillProbe::new(probe_config(c)?)?;
+        let hold = ReleaseHold::new(
+            &t.release_hold,
+            m,
+            ts,
+            t.current_bandwidth_hz,
+            speed_config.i_max,
+        )?;
         let limits = RatingsLimit::new(&t.limits, m)?;
         Ok(Self {
+            hold,
             speed,
             injection,
             current,
@@ -124,6 +134,7 @@ impl<T: Real> Blocks<T> {
         self.probe.reset();
         self.dc_link.reset();
         self.field_weakening.reset();
+        self.hold.disarm();
     }
 }
 
@@ -132,7 +143,12 @@ impl<T: Real> DriveConfig<T> {
     /// `decoupling` and `current_anti_windup_ratio`: what the drive builds.
     pub fn current_controller_config(&self) -> CurrentControllerConfig<T> {
         let t = &self.tuning;
+        // A saturating model: the incremental inductances at the rated MTPA point
+        // (`crate::control::saturated_references`).
+        let (ld_hat, lq_hat) = self.current_loop_inductances();
         CurrentControllerConfig {
+            ld_hat,
+            lq_hat,
             bandwidth_hz: t.current_bandwidth_hz,
             decoupling: t.decoupling,
             anti_windup_ratio: t.current_anti_windup_ratio,

@@ -28,12 +28,14 @@
 mod blocks;
 mod calibration;
 mod config;
+mod hold;
 mod lifecycle;
 mod lock;
 mod output;
 mod references;
 mod reject;
 mod resolved;
+mod saturation;
 mod step;
 mod tuning;
 
@@ -52,6 +54,8 @@ use crate::control::lock_reaction::LockSupervisor;
 use crate::control::modulation::SpaceVectorModulator;
 use crate::control::monitor::{DriveFlags, FlagCounts, PersistenceMonitor, StuckChannelDetector};
 use crate::control::ratings_limit::RatingsLimit;
+use crate::control::release_hold::ReleaseHold;
+use crate::control::saturated_references::SaturatedReferences;
 use crate::control::speed_controller::SpeedController;
 use crate::control::standstill_probe::StandstillProbe;
 use crate::estimator::{Estimate, SensorlessEstimator};
@@ -66,7 +70,7 @@ const STALL_TORQUE_BAND_RATIO: f64 = 0.031_087_578_289_355_3;
 /// The absolute limits and sample counts of a [`DriveConfig`], resolved once from its ratios
 /// and durations (nothing is recomputed per sample).
 #[derive(Clone, Copy, Debug, PartialEq)]
-struct Resolved<T> {
+struct Resolved<T: 'static> {
     i_max: T,
     i_min: T,
     trip_current: T,
@@ -87,6 +91,9 @@ struct Resolved<T> {
     /// The machine is salient: the speed loop's q current is scaled by λ̂f/λ̂a (see
     /// [`Drive::torque_current`]).
     salient: bool,
+    /// A saturating model's MTPA table and torque (`crate::control::saturated_references`);
+    /// None for constant inductances.
+    saturated: Option<SaturatedReferences<T>>,
 }
 
 /// The stall symptom's thresholds in absolute units (see
@@ -136,6 +143,8 @@ struct Blocks<T> {
     modulator: SpaceVectorModulator<T>,
     dc_link: DcLinkLimit<T>,
     field_weakening: FieldWeakening<T>,
+    /// The release hold after the start-up.
+    hold: ReleaseHold<T>,
     limits: RatingsLimit<T>,
 }
 

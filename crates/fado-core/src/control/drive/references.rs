@@ -15,6 +15,9 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
     /// sample's i_q* instead (no solve) closes an algebraic loop through the injection that
     /// oscillates sample by sample under load (measured on ipmsm-gem-50k `stops`).
     pub(super) fn currents_for_torque(&self, iq_torque: T, guess: T, probe_id: T) -> Dq<T> {
+        if let Some(s) = &self.resolved.saturated {
+            return self.saturated_currents_for_torque(s, iq_torque, guess, probe_id);
+        }
         let m = &self.config.machine;
         let injection = &self.blocks.injection;
         let mtpa = self.resolved.mtpa;
@@ -27,7 +30,22 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         }
         let target = m.flux_linkage * iq_torque;
         let f = |iq: T| m.active_flux(id_of(iq)) * iq - target;
-        let h = T::lit(1e-3) * m.rated_current;
+        let iq = Self::solve_torque(f, iq_torque, guess, m.rated_current, m.flux_linkage);
+        Dq::new(id_of(iq), iq)
+    }
+
+    /// The q current where `f` (the torque flux less its target) vanishes: three Newton steps
+    /// from `guess` (when it has the sign of `iq_torque`, else from `iq_torque`) with a secant
+    /// slope over 0.1 % of `rated_current`; a flat or non-finite slope keeps the last iterate,
+    /// a non-finite result gives `iq_torque`.
+    pub(super) fn solve_torque(
+        f: impl Fn(T) -> T,
+        iq_torque: T,
+        guess: T,
+        rated_current: T,
+        flux_linkage: T,
+    ) -> T {
+        let h = T::lit(1e-3) * rated_current;
         let mut iq = if guess.is_finite() && guess * iq_torque > T::zero() {
             guess
         } else {
@@ -37,7 +55,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             let f0 = f(iq);
             let slope = (f(iq + h) - f0) / h;
             // A flat or non-finite slope (NaN compares false): keep the last iterate.
-            if slope > T::lit(1e-3) * m.flux_linkage {
+            if slope > T::lit(1e-3) * flux_linkage {
                 iq -= f0 / slope;
             } else {
                 break;
@@ -46,7 +64,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         if !iq.is_finite() {
             iq = iq_torque;
         }
-        Dq::new(id_of(iq), iq)
+        iq
     }
 
     /// The current at this sample predicted from the last one used (measured or

@@ -52,6 +52,7 @@ impl<T: Real> Resolved<T> {
             dc_link_max_voltage: t.dc_link_max_ratio * c.machine.dc_voltage,
             mtpa: t.mtpa && c.machine.is_salient(),
             salient: c.machine.is_salient(),
+            saturated: c.saturated_references(),
         })
     }
 }

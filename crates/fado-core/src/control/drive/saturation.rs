@@ -1,0 +1,65 @@
+//! The drive's hooks for a saturating magnetic model (`crate::control::saturated_references`):
+//! the currents for a torque, the speed loop's torque limit and the current loop's
+//! inductances. With constant inductances each returns what the closed forms give.
+
+use super::{DriveConfig, SensorlessDrive};
+use crate::control::saturated_references::SaturatedReferences;
+use crate::control::speed_controller::SpeedControllerConfig;
+use crate::estimator::RotorAngleEstimator;
+use crate::{Dq, Real};
+
+impl<T: Real> DriveConfig<T> {
+    /// The saturating model's references up to the current limit; None for constant
+    /// inductances.
+    pub(super) fn saturated_references(&self) -> Option<SaturatedReferences<T>> {
+        SaturatedReferences::new(&self.machine, self.i_max())
+    }
+
+    /// The speed PI's output limit (a torque in units of the magnet's q current): the
+    /// model's torque at the current limit on the MTPA curve (on the q axis without MTPA), or
+    /// [`SpeedControllerConfig::torque_limit`] for constant inductances.
+    pub(super) fn speed_torque_limit(&self, mtpa: bool) -> T {
+        let m = &self.machine;
+        let i_max = self.tuning.current_limit_ratio * m.rated_current;
+        match self.saturated_references() {
+            Some(s) if mtpa => s.torque_limit(i_max, m.flux_linkage),
+            Some(s) => s.torque_flux(Dq::new(T::zero(), i_max)) / m.flux_linkage,
+            None => SpeedControllerConfig::torque_limit(m, i_max, mtpa),
+        }
+    }
+
+    /// The current loop's (L̂d, L̂q): a saturating model's incremental inductances at the
+    /// rated MTPA point, else the machine model's.
+    pub(super) fn current_loop_inductances(&self) -> (T, T) {
+        match self.saturated_references() {
+            Some(s) => s.rated_incremental(self.machine.rated_current),
+            None => (self.machine.ld, self.machine.lq),
+        }
+    }
+}
+
+impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
+    /// `currents_for_torque` with a saturating model: i_d* = the injection + the model's MTPA
+    /// (with `mtpa` on) + `probe_id`, and i_q* solves ψd·i_q* − ψq·i_d* = λ̂f·i_q,t (the
+    /// co-energy torque, `crate::control::saturated_references`) by the same three Newton
+    /// steps.
+    pub(super) fn saturated_currents_for_torque(
+        &self,
+        s: &SaturatedReferences<T>,
+        iq_torque: T,
+        guess: T,
+        probe_id: T,
+    ) -> Dq<T> {
+        let m = &self.config.machine;
+        let injection = &self.blocks.injection;
+        let mtpa = self.config.tuning.mtpa;
+        let id_of = |iq: T| {
+            let id = injection.step(iq) + probe_id;
+            if mtpa { id + s.mtpa_id(iq) } else { id }
+        };
+        let target = m.flux_linkage * iq_torque;
+        let f = |iq: T| s.torque_flux(Dq::new(id_of(iq), iq)) - target;
+        let iq = Self::solve_torque(f, iq_torque, guess, m.rated_current, m.flux_linkage);
+        Dq::new(id_of(iq), iq)
+    }
+}

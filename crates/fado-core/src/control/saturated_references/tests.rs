@@ -1,0 +1,117 @@
+//! MTPA from the model against a search on the current circle, the torque limit, and the
+//! rated point's incremental inductances.
+
+use super::*;
+use crate::magnetics::{MachineMagnetics, Saturation};
+
+fn machine(a_dq: f64) -> MachineModel<f64> {
+    let sat = Saturation {
+        a_d0: 1.0 / 0.036,
+        a_q0: 11.0,
+        a_qq: 4000.0,
+        t: 4.0,
+        a_dq,
+        i_f: 0.545 / 0.036,
+        ..Saturation::default()
+    };
+    MachineModel {
+        rs: 3.6,
+        ld: 0.036,
+        lq: 0.051,
+        flux_linkage: 0.545,
+        pole_pairs: 3,
+        inertia: 0.015,
+        viscous_friction: 8.9e-4,
+        rated_current: 6.08,
+        rated_speed_rpm: 1500.0,
+        rated_torque: 14.0,
+        dc_voltage: 540.0,
+        magnetics: MachineMagnetics::Saturation(sat),
+    }
+}
+
+fn baldor() -> MachineModel<f64> {
+    let sat = Saturation {
+        a_d0: 3.96,
+        a_dd: 28.5,
+        s: 4.0,
+        a_q0: 5.89,
+        a_qq: 2.67,
+        t: 6.0,
+        a_dq: 41.5,
+        u: 1.0,
+        v: 1.0,
+        psi_n: 0.804,
+        a_b: 81.75,
+        a_bp: 1.0,
+        w: 2.0,
+        k_q: 0.1,
+        ..Saturation::default()
+    };
+    MachineModel {
+        rs: 0.63,
+        ld: 0.0298,
+        lq: 0.1497,
+        flux_linkage: 0.4767,
+        pole_pairs: 2,
+        inertia: 0.05,
+        viscous_friction: 1.6e-3,
+        rated_current: 12.45,
+        rated_speed_rpm: 1800.0,
+        rated_torque: 29.7,
+        dc_voltage: 540.0,
+        magnetics: MachineMagnetics::Saturation(sat),
+    }
+}
+
+#[test]
+fn mtpa_table_maximises_torque_per_ampere() {
+    for (name, m) in [
+        ("ipmsm-2k2-qsat", machine(58.0)),
+        ("strong cross", machine(300.0)),
+        ("baldor", baldor()),
+    ] {
+        let i_max = 2.0 * m.rated_current;
+        let r = SaturatedReferences::new(&m, i_max).unwrap();
+        let model = m.magnetic_model();
+        for frac in [0.1, 0.3, 0.65, 1.0, 1.5] {
+            let current = frac * m.rated_current;
+            // The best torque on the circle by a fine search over the current angle.
+            let best = (0..=4000)
+                .map(|k| {
+                    let beta = k as f64 / 4000.0 * core::f64::consts::FRAC_PI_2;
+                    torque_flux(&model, Dq::new(-current * beta.sin(), current * beta.cos()))
+                })
+                .fold(f64::MIN, f64::max);
+            let at = r.mtpa_on_circle(current);
+            assert!((at.norm() - current).abs() < 1e-6 * current, "{name}");
+            let got = r.torque_flux(at);
+            // Within 0.1 % of the rated torque (the table's interpolation, module docs).
+            let rated = m.rated_torque / (1.5 * m.pole_pairs as f64);
+            assert!(
+                got > best - 1e-3 * rated,
+                "{name} {frac}: MTPA {got}, best {best}"
+            );
+        }
+        // Even in i_q, never positive, zero at zero current.
+        assert_eq!(r.mtpa_id(-3.0), r.mtpa_id(3.0));
+        assert!(r.mtpa_id(5.0) <= 0.0);
+        assert_eq!(r.mtpa_id(0.0), 0.0);
+    }
+}
+
+#[test]
+fn torque_limit_and_rated_inductances_follow_the_model() {
+    let m = baldor();
+    let r = SaturatedReferences::new(&m, 2.0 * m.rated_current).unwrap();
+    // At the rated current the model's MTPA torque is 31.5 N·m (the preset's note).
+    let t_rated = 1.5 * 2.0 * r.torque_flux(r.mtpa_on_circle(m.rated_current));
+    assert!((t_rated - 31.5).abs() < 0.5, "{t_rated}");
+    let limit = r.torque_limit(m.rated_current, m.flux_linkage);
+    assert!((limit * 1.5 * 2.0 * m.flux_linkage - t_rated).abs() < 1e-9);
+    // Saturation: the rated point's incremental L_qq is well below the zero-current one.
+    let (ld, lq) = r.rated_incremental(m.rated_current);
+    assert!(lq < 0.7 * m.lq && lq > 0.0 && ld > 0.0, "{ld} {lq}");
+    // Constant inductances have no saturated references.
+    assert!(SaturatedReferences::new(&MachineModel::<f64>::paper(), 40.0).is_none());
+}
