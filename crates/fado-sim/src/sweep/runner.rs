@@ -173,13 +173,12 @@ pub fn run(
 /// The CSV of a sweep appended to as its points finish.
 type Sink = Mutex<(PathBuf, std::fs::File)>;
 
+/// An output directory taken for a sweep: its lock, the points already finished, the CSV.
+type Opened = (Option<DirLock>, BTreeMap<usize, PointResult>, Option<Sink>);
+
 /// Takes DIR for a sweep: its lock, the points an earlier run of the same definition finished
 /// (none with `fresh`), and DIR/sweep.csv rewritten with them, open for appending.
-fn open_out(
-    spec: &SweepSpec,
-    dir: &Path,
-    fresh: bool,
-) -> Result<(Option<DirLock>, BTreeMap<usize, PointResult>, Option<Sink>), SweepError> {
+fn open_out(spec: &SweepSpec, dir: &Path, fresh: bool) -> Result<Opened, SweepError> {
     let lock = DirLock::acquire(dir)?;
     let done = prepare_resume(spec, dir, fresh)?;
     let csv_path = dir.join("sweep.csv");
