@@ -56,6 +56,11 @@ MODE_DISTURBANCE_FEEDBACK: Final[int]
 _FloatArray = npt.NDArray[np.float64] | npt.NDArray[np.float32]
 _DType = Literal["float64", "float32"]
 _MachineLike = Machine | str | dict[str, Any]
+_FluxMapLike = (
+    str
+    | os.PathLike[str]
+    | tuple[npt.ArrayLike, npt.ArrayLike, npt.ArrayLike, npt.ArrayLike]
+)
 _ConfigLike = EstimatorConfig | dict[str, Any] | None
 
 class FadoError(Exception):
@@ -100,6 +105,7 @@ class Machine:
         dc_voltage: float,
         inertia: float | None = None,
         viscous_friction: float | None = None,
+        flux_map: _FluxMapLike | None = None,
     ) -> Machine: ...
     def replace(
         self,
@@ -115,6 +121,7 @@ class Machine:
         rated_torque: float | None = None,
         dc_voltage: float | None = None,
         viscous_friction: float | None = None,
+        flux_map: _FluxMapLike | None = None,
     ) -> Machine: ...
     @staticmethod
     def paper() -> Machine:
@@ -122,8 +129,22 @@ class Machine:
     @staticmethod
     def preset(name: str) -> Machine:
         """A motor preset of the repository's ``motors/`` folder."""
-    def to_dict(self) -> dict[str, float | int]: ...
-    def __getnewargs_ex__(self) -> tuple[tuple[()], dict[str, float | int]]: ...
+    def to_dict(self) -> dict[str, Any]: ...
+    def __getnewargs_ex__(self) -> tuple[tuple[()], dict[str, Any]]: ...
+    @property
+    def flux_map(
+        self,
+    ) -> (
+        str
+        | tuple[
+            npt.NDArray[np.float64],
+            npt.NDArray[np.float64],
+            npt.NDArray[np.float64],
+            npt.NDArray[np.float64],
+        ]
+        | None
+    ):
+        """The plant's flux map: None, the CSV path, or the node arrays of a map given as arrays."""
     def __eq__(self, value: object, /) -> bool: ...
     def __ne__(self, value: object, /) -> bool: ...
     @property

@@ -405,10 +405,11 @@ def test_machine_fields_and_paper_preset() -> None:
 
 def test_machine_is_keyword_only_with_required_fields() -> None:
     params = inspect.signature(fado.Machine).parameters
-    assert set(params) == set(PAPER_MACHINE)
+    assert set(params) == {*PAPER_MACHINE, "flux_map"}
     assert all(p.kind is inspect.Parameter.KEYWORD_ONLY for p in params.values())
     required = {n for n, p in params.items() if p.default is inspect.Parameter.empty}
     assert required == set(PAPER_MACHINE) - {"viscous_friction", "inertia"}
+    assert params["flux_map"].default is None
     # Left out, friction and inertia come from the ratings (fado_core::ratings), not 0.
     derived = fado.Machine(**{k: v for k, v in IPMSM.items() if k != "inertia"})
     omega_mech = IPMSM["rated_speed_rpm"] * math.pi / 30

@@ -69,7 +69,12 @@ fn plant_config(
             }
         }
     } else {
-        Motor::Machine(PyMachine::from_argument(py, Some(motor), "motor", "commission")?.to_core())
+        Motor::of_machine(&PyMachine::from_argument(
+            py,
+            Some(motor),
+            "motor",
+            "commission",
+        )?)
     };
     let base = motor.base().map_err(|e| sim_error(py, e))?;
     let mut cfg = match config_toml {

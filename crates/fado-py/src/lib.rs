@@ -27,6 +27,7 @@ pub mod compare;
 pub mod config;
 pub mod errors;
 pub mod estimator;
+pub mod flux_map;
 pub mod inputs;
 pub mod interrupt;
 pub mod machine;
@@ -89,10 +90,12 @@ pub mod _fado {
         super::record::install(
             &py.get_type::<super::config::PyEstimatorConfig>(),
             super::config::PyEstimatorConfig::signature(py)?,
+            &[],
         )?;
         super::record::install(
             &py.get_type::<super::machine::PyMachine>(),
             super::machine::PyMachine::signature(py)?,
+            &[super::flux_map::FLUX_MAP],
         )?;
         Ok(())
     }

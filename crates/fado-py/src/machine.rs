@@ -9,12 +9,16 @@
 //! `fado.ConfigError` (a `ValueError`) whose `.field` names the field.
 
 use fado_core::MachineModel;
+use fado_sim::magnetics_file::FluxMapFile;
 use fado_sim::presets::{PRESETS, find};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 
 use crate::errors::{config_error, config_error_message};
 use crate::record;
+
+/// The constructor's keywords without `flux_map`, and the map if the keyword was given.
+type SplitFields<'py> = (Option<Bound<'py, PyDict>>, Option<Option<FluxMapFile>>);
 
 /// The preset names, in `motors/` order.
 pub fn preset_names() -> Vec<&'static str> {
@@ -65,16 +69,44 @@ pub fn field_names(py: Python<'_>) -> PyResult<Vec<String>> {
 /// `motors/` folder (`fado.machine_presets()`). Instances are immutable; `replace(**changes)`
 /// returns a modified copy. Invalid values (including unit slips such as a flux linkage in
 /// mWb) raise `fado.ConfigError` (a `ValueError`) whose `.field` names the field.
+/// `flux_map=` gives the plant a saturating flux map (a CSV path or `(i_d, i_q, psi_d, psi_q)`
+/// arrays, [`crate::flux_map`]) that `simulate` and `commission` run with; it is not a field.
 #[pyclass(name = "Machine", module = "fado", frozen, eq)]
 #[derive(Clone, Debug, PartialEq)]
 pub struct PyMachine {
     model: MachineModel<f64>,
+    /// The plant's flux map (`flux_map=`, [`crate::flux_map`]); None: no map.
+    flux_map: Option<FluxMapFile>,
 }
 
 impl PyMachine {
     /// The Python view of a core machine model (not validated).
     pub fn from_core(m: &MachineModel<f64>) -> Self {
-        Self { model: *m }
+        Self {
+            model: *m,
+            flux_map: None,
+        }
+    }
+
+    /// The flux map given with the machine, if any.
+    pub fn flux_map(&self) -> Option<&FluxMapFile> {
+        self.flux_map.as_ref()
+    }
+
+    /// `fields` without `flux_map`, and the map it gave (`Some(None)`: given as None).
+    fn split_flux_map<'py>(
+        py: Python<'py>,
+        fields: Option<&Bound<'py, PyDict>>,
+    ) -> PyResult<SplitFields<'py>> {
+        let Some(fields) = fields else {
+            return Ok((None, None));
+        };
+        let rest = fields.copy()?;
+        let Some(obj) = rest.get_item(crate::flux_map::FLUX_MAP)? else {
+            return Ok((Some(rest), None));
+        };
+        rest.del_item(crate::flux_map::FLUX_MAP)?;
+        Ok((Some(rest), Some(crate::flux_map::from_argument(py, &obj)?)))
     }
 
     /// The core machine model.
@@ -86,6 +118,7 @@ impl PyMachine {
     pub fn with_rs(&self, rs: f64) -> Self {
         Self {
             model: MachineModel { rs, ..self.model },
+            flux_map: self.flux_map.clone(),
         }
     }
 
@@ -182,7 +215,7 @@ impl PyMachine {
             return Err(config_error(py, e));
         }
         check_plausible(py, &model, None)?;
-        Ok(Self { model })
+        Ok(Self::from_core(&model))
     }
 
     /// The preset called `name`; `ValueError` (`ConfigError` on `machine`) listing the names
@@ -229,7 +262,7 @@ impl PyMachine {
         if let Ok(dict) = machine.cast::<PyDict>() {
             for key in dict.keys() {
                 let key: String = key.extract()?;
-                if !field_names(py)?.contains(&key) {
+                if !field_names(py)?.contains(&key) && key != crate::flux_map::FLUX_MAP {
                     return Err(config_error_message(
                         py,
                         &key,
@@ -255,6 +288,12 @@ impl PyMachine {
     fn items<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let dict = record::to_dict(py, &self.model)?;
         dict.set_item(DC_VOLTAGE, self.model.dc_voltage)?;
+        if let Some(m) = &self.flux_map {
+            dict.set_item(
+                crate::flux_map::FLUX_MAP,
+                crate::flux_map::to_python(py, m)?,
+            )?;
+        }
         Ok(dict)
     }
 
@@ -287,13 +326,29 @@ impl PyMachine {
     #[new]
     #[pyo3(signature = (**fields))]
     fn py_new(py: Python<'_>, fields: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
-        let fields = Self::with_derived(py, fields)?;
-        Self::changed(py, &MachineModel::default(), Some(&fields), true)
+        let (fields, flux_map) = Self::split_flux_map(py, fields)?;
+        let fields = Self::with_derived(py, fields.as_ref())?;
+        let mut m = Self::changed(py, &MachineModel::default(), Some(&fields), true)?;
+        m.flux_map = flux_map.flatten();
+        Ok(m)
     }
 
     /// A copy with the given fields changed (validated like the constructor).
     fn _replace(&self, py: Python<'_>, changes: &Bound<'_, PyDict>) -> PyResult<Self> {
-        Self::changed(py, &self.model, Some(changes), false)
+        let (changes, flux_map) = Self::split_flux_map(py, Some(changes))?;
+        let mut m = Self::changed(py, &self.model, changes.as_ref(), false)?;
+        m.flux_map = flux_map.unwrap_or_else(|| self.flux_map.clone());
+        Ok(m)
+    }
+
+    /// The plant's flux map: None, the CSV file's path, or (i_d, i_q, psi_d, psi_q) node
+    /// arrays for a map given as arrays. `simulate` and `commission` run their plant with it.
+    #[getter(flux_map)]
+    fn py_flux_map<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.flux_map
+            .as_ref()
+            .map(|m| crate::flux_map::to_python(py, m))
+            .transpose()
     }
 
     /// The paper's motor (section V: 8-pole SMPMSM, 11.5 N·m, 1500 r/min, Rs 0.327 Ω,

@@ -161,17 +161,19 @@ where
 const INSTALL: &std::ffi::CStr = cr#"
 import inspect
 
-def install(cls, params):
+def install(cls, params, extra):
     """Attributes, constructor signature and `replace` of a record class whose fields are
     known at run time only: `params` lists (name, default), default `inspect.Parameter.empty`
-    for a required keyword."""
+    for a required keyword; `extra` lists optional keywords that are not fields (their
+    attributes are the class's own)."""
     P = inspect.Parameter
     for name, _ in params:
         def get(self, _name=name):
             return self.to_dict()[_name]
         setattr(cls, name, property(get, doc=f"The field `{name}` (read-only)."))
+    params_all = list(params) + [(name, None) for name in extra]
     cls.__signature__ = inspect.Signature(
-        [P(name, P.KEYWORD_ONLY, default=default) for name, default in params]
+        [P(name, P.KEYWORD_ONLY, default=default) for name, default in params_all]
     )
     changed = cls._replace
 
@@ -179,7 +181,7 @@ def install(cls, params):
         return changed(self, changes)
 
     replace.__signature__ = inspect.Signature(
-        [P("self", P.POSITIONAL_ONLY)] + [P(name, P.KEYWORD_ONLY, default=None) for name, _ in params]
+        [P("self", P.POSITIONAL_ONLY)] + [P(name, P.KEYWORD_ONLY, default=None) for name, _ in params_all]
     )
     replace.__doc__ = changed.__doc__
     replace.__name__ = "replace"
@@ -206,9 +208,11 @@ def install(cls, params):
 /// `replace(**changes)` with that signature calling the class's `_replace(changes)`, the
 /// `fields` tuple, `__repr__` and pickling (through the keyword constructor and `to_dict`).
 /// `params` lists the fields in order with their defaults, `None` for a required keyword.
+/// `extra` names optional keywords (default None) that are not fields.
 pub fn install(
     class: &Bound<'_, pyo3::types::PyType>,
     params: Vec<(String, Option<Bound<'_, PyAny>>)>,
+    extra: &[&str],
 ) -> PyResult<()> {
     let py = class.py();
     let module = PyModule::from_code(py, INSTALL, c"fado/_record.py", c"fado._record")?;
@@ -220,6 +224,8 @@ pub fn install(
         .into_iter()
         .map(|(name, default)| (name, default.unwrap_or_else(|| empty.clone())))
         .collect::<Vec<_>>();
-    module.getattr("install")?.call1((class, params))?;
+    module
+        .getattr("install")?
+        .call1((class, params, extra.to_vec()))?;
     Ok(())
 }

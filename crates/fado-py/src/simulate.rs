@@ -109,11 +109,19 @@ pub(crate) enum Motor {
     /// A preset of `motors/`: its whole file (`[motor]`, `[inverter]`) over the defaults.
     Preset(&'static fado_sim::presets::Preset),
     /// A machine: `[motor]` and `[inverter] dc_voltage`, the other `[inverter]` keys its
-    /// ratings give derived (`SimConfig::for_machine`).
-    Machine(fado_core::MachineModel<f64>),
+    /// ratings give derived (`SimConfig::for_machine`), and its flux map if it has one.
+    Machine(
+        Box<fado_core::MachineModel<f64>>,
+        Option<fado_sim::magnetics_file::FluxMapFile>,
+    ),
 }
 
 impl Motor {
+    /// The plant of a `fado.Machine`: its record and its flux map.
+    pub(crate) fn of_machine(m: &PyMachine) -> Self {
+        Motor::Machine(Box::new(m.to_core()), m.flux_map().cloned())
+    }
+
     /// `motor` as `simulate` takes it: None, a preset name or a `fado.Machine`.
     pub(crate) fn from_argument(
         py: Python<'_>,
@@ -123,7 +131,7 @@ impl Motor {
             return Ok(None);
         };
         if let Ok(m) = motor.cast::<PyMachine>() {
-            return Ok(Some(Motor::Machine(m.get().to_core())));
+            return Ok(Some(Motor::of_machine(m.get())));
         }
         if let Ok(name) = motor.extract::<String>() {
             return match fado_sim::presets::find(&name) {
@@ -148,9 +156,10 @@ impl Motor {
     pub(crate) fn base(&self) -> Result<SimConfig, SimConfigError> {
         match self {
             Motor::Preset(p) => p.config(),
-            Motor::Machine(m) => {
+            Motor::Machine(m, flux_map) => {
                 // The inverter keys the machine's ratings give, derived as for a motor file.
-                let c = SimConfig::for_machine(m);
+                let mut c = SimConfig::for_machine(m);
+                c.motor_flux_map = flux_map.clone();
                 // Errors name the TOML key the machine's field became (`motor.rs`).
                 c.validate()?;
                 Ok(c)

@@ -13,8 +13,6 @@
 //! given directly: they are the plant's times the `[mismatch]` ratios, so "matched" stays
 //! matched when the motor changes.
 
-use std::sync::Arc;
-
 use fado_core::control::{DeadTimeMethod, DriveConfig, DriveTuning};
 use fado_core::magnetics::Saturation;
 use fado_core::{EstimatorConfig, EstimatorTuning, MachineModel};
@@ -28,7 +26,7 @@ use crate::estimators::{check_baseline_keys, default_baselines};
 use crate::faults::FaultParams;
 use crate::inverter::InverterParams;
 use crate::load::LoadParams;
-use crate::magnetics::PlantMagnetics;
+use crate::magnetics_file;
 use crate::motor::MotorParams;
 use crate::profile::Profile;
 use crate::sensors::{CurrentSensorParams, DcLinkSensorParams};
@@ -250,10 +248,14 @@ pub struct SimConfig {
     #[serde(skip)]
     pub derived: Vec<crate::derive::Derived>,
     /// The plant's saturating magnetics, `[motor.saturation]` (the algebraic model of
-    /// [`fado_core::magnetics::Saturation`]); None: the constant inductances of `[motor]`,
-    /// whose `ld`, `lq` and `flux_linkage` then stay the datasheet's (the drive's default model).
+    /// [`fado_core::magnetics::Saturation`]) or `[motor] flux_map` (`crate::magnetics_file`);
+    /// None: the constant inductances of `[motor]`, whose `ld`, `lq` and `flux_linkage` then
+    /// stay the datasheet's (the drive's default model).
     #[serde(skip)]
     pub motor_saturation: Option<Saturation<f64>>,
+    /// The plant's flux map, `[motor] flux_map = "FILE.csv"` (see `motor_saturation`).
+    #[serde(skip)]
+    pub motor_flux_map: Option<crate::magnetics_file::FluxMapFile>,
 }
 
 impl Default for SimConfig {
@@ -279,6 +281,7 @@ impl Default for SimConfig {
             criteria: Criteria::default(),
             derived: Vec::new(),
             motor_saturation: None,
+            motor_flux_map: None,
         }
     }
 }
@@ -300,9 +303,10 @@ impl SimConfig {
             load: self.load.clone(),
             faults: self.faults.clone(),
             dc_link: self.dc_link.clone(),
-            magnetics: self
-                .motor_saturation
-                .map(|s| Arc::new(PlantMagnetics::Saturation(s))),
+            magnetics: magnetics_file::plant_magnetics(
+                self.motor_saturation.as_ref(),
+                self.motor_flux_map.as_ref(),
+            ),
         }
     }
 
@@ -324,6 +328,10 @@ impl SimConfig {
         {
             return Err(SimConfigError::new(key, text));
         }
+        magnetics_file::check_one_model(
+            self.motor_saturation.as_ref(),
+            self.motor_flux_map.as_ref(),
+        )?;
         if let Some(sat) = &self.motor_saturation {
             sat.validate().map_err(|e| {
                 SimConfigError::new(format!("motor.saturation.{}", e.field()), e.to_string())
@@ -541,15 +549,14 @@ impl SimConfig {
 
     /// This configuration as a TOML document.
     pub fn to_toml(&self) -> String {
-        let Some(sat) = &self.motor_saturation else {
+        let (sat, map) = (self.motor_saturation.as_ref(), self.motor_flux_map.as_ref());
+        if sat.is_none() && map.is_none() {
+            // Straight from the record: its field order (a TOML table would sort the keys).
             return toml::to_string(self)
                 .expect("every field of SimConfig is representable in TOML");
-        };
-        let mut table = toml::Table::try_from(self).expect("SimConfig is a TOML table");
-        if let Some(toml::Value::Table(motor)) = table.get_mut("motor") {
-            let sat = toml::Table::try_from(sat).expect("Saturation is a TOML table");
-            motor.insert("saturation".into(), toml::Value::Table(sat));
         }
+        let mut table = toml::Table::try_from(self).expect("SimConfig is a TOML table");
+        magnetics_file::insert_magnetics(&mut table, sat, map);
         toml::to_string(&table).expect("every field of SimConfig is representable in TOML")
     }
 
@@ -576,10 +583,11 @@ impl SimConfig {
         whole_motor: bool,
     ) -> Result<SimConfig, SimConfigError> {
         let mut user: toml::Table = text.parse().map_err(|e| located(text, e))?;
-        let saturation = take_saturation(&mut user).map_err(|e| e.located_in(text))?;
+        let (saturation, flux_map) =
+            magnetics_file::take_magnetics(&mut user).map_err(|e| e.located_in(text))?;
         // Check the user's document on its own first, so that errors (unknown keys, wrong
         // types) name the key the user wrote and point at it.
-        if saturation.is_some() {
+        if saturation.is_some() || flux_map.is_some() {
             SimConfig::deserialize(toml::Value::Table(user.clone()))
                 .map_err(|e| key_error(e).located_in(text))?;
         } else {
@@ -613,7 +621,14 @@ impl SimConfig {
         cfg.derived.extend(derived);
         // `[motor]` has no DC link of its own (it is the inverter's).
         cfg.motor.dc_voltage = cfg.inverter.dc_voltage;
-        cfg.motor_saturation = saturation.or(base.motor_saturation);
+        // A document giving one magnetic model replaces the base's (either).
+        if saturation.is_some() || flux_map.is_some() {
+            (cfg.motor_saturation, cfg.motor_flux_map) = (saturation, flux_map);
+        } else {
+            cfg.motor_saturation = base.motor_saturation;
+            cfg.motor_flux_map = base.motor_flux_map.clone();
+        }
+        crate::model_magnetics::resolve_model_paths(&mut cfg.model);
         cfg.validate().map_err(|e| e.located_in(text))?;
         Ok(cfg)
     }
@@ -726,20 +741,6 @@ fn check_time_constant(
             2.0 * ts
         ),
     ))
-}
-
-/// Takes `[motor.saturation]` out of the user's document (`[motor]` itself is
-/// [`MachineModel`], whose keys are the linear machine's), parsed.
-fn take_saturation(user: &mut toml::Table) -> Result<Option<Saturation<f64>>, SimConfigError> {
-    let Some(toml::Value::Table(motor)) = user.get_mut("motor") else {
-        return Ok(None);
-    };
-    let Some(table) = motor.remove("saturation") else {
-        return Ok(None);
-    };
-    Saturation::<f64>::deserialize(table)
-        .map(Some)
-        .map_err(|e| key_error(e).in_section("motor.saturation"))
 }
 
 fn merge(base: &mut toml::Table, over: toml::Table) {

@@ -35,9 +35,12 @@ impl SimConfigError {
         self
     }
 
-    /// Names the file the located text came from (for `file:line:column:` messages).
+    /// Names the file the located text came from (for `file:line:column:` messages); a
+    /// location in another file (a flux map's CSV) keeps its own.
     pub fn in_file(mut self, file: impl Into<String>) -> Self {
-        if let Some(loc) = &mut self.location {
+        if let Some(loc) = &mut self.location
+            && loc.file.is_none()
+        {
             loc.file = Some(file.into());
         }
         self

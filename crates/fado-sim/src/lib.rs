@@ -62,6 +62,7 @@ pub mod faults;
 pub mod inverter;
 pub mod load;
 pub mod magnetics;
+pub mod magnetics_file;
 pub mod model_magnetics;
 pub mod motor;
 pub mod output;

@@ -26,16 +26,13 @@
 //! path: [`crate::motor::Motor`] builds this integrator only for a saturating model.
 
 use std::cell::Cell;
-use std::path::Path;
 use std::sync::Arc;
 
 use fado_core::magnetics::{FluxMap, FluxMapError, MagneticModel, Magnetics, Saturation};
 use fado_core::{Ab, Dq};
 use num_complex::Complex64;
 
-use crate::error::SimConfigError;
 use crate::fastmath::{cis, rotate, unrotate};
-use crate::source::SourceLocation;
 
 /// The longest sub-step as a fraction of the machine's shortest electrical time constant
 /// L_inc,min/R.
@@ -78,160 +75,6 @@ impl FluxMapData {
         FluxMap::from_checked_parts(&self.i_d, &self.i_q, &self.psi_d, &self.psi_q)
             .expect("shapes checked by FluxMapData::new")
     }
-}
-
-/// Where a flux-map file went wrong: `FILE:LINE:1: `flux_map`: …`.
-fn map_error(file: &str, line: usize, message: impl Into<String>) -> SimConfigError {
-    let mut e = SimConfigError::new("flux_map", message);
-    e.location = Some(SourceLocation {
-        file: Some(file.to_owned()),
-        line,
-        column: 1,
-    });
-    e
-}
-
-/// Reads a flux map from a CSV file (see [`parse_flux_map`]); a file that cannot be read is
-/// refused naming it.
-pub fn read_flux_map(path: &Path) -> Result<FluxMapData, SimConfigError> {
-    let name = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| {
-        SimConfigError::new(
-            "flux_map",
-            format!("cannot read `{name}`: {e} (a path in a TOML file is relative to that file)"),
-        )
-    })?;
-    parse_flux_map(&text, &name)
-}
-
-/// Parses a flux map: CSV with the header `i_d,i_q,psi_d,psi_q` (SI peak values in the rotor
-/// frame, d on the magnet), one row per node of any rectangular grid in any order, lines
-/// starting with `#` ignored. A row that does not parse, a non-finite value, a node given
-/// twice or missing (a ragged grid) and a map not strictly increasing in its own current are
-/// refused as `file:LINE:1: …` (`file` names the source in messages).
-pub fn parse_flux_map(text: &str, file: &str) -> Result<FluxMapData, SimConfigError> {
-    let mut reader = csv::ReaderBuilder::new()
-        .comment(Some(b'#'))
-        .trim(csv::Trim::All)
-        .from_reader(text.as_bytes());
-    // The physical line of the record starting at a byte offset: the reader's own line count
-    // skips comment lines, and a record's offset is where the reader resumed (before any
-    // comment or blank lines preceding it).
-    let lines: Vec<&str> = text.lines().collect();
-    let line_at = |byte: u64| {
-        let start = (byte as usize).min(text.len());
-        let mut line = text.as_bytes()[..start]
-            .iter()
-            .filter(|&&b| b == b'\n')
-            .count();
-        while lines
-            .get(line)
-            .is_some_and(|l| l.trim().is_empty() || l.trim_start().starts_with('#'))
-        {
-            line += 1;
-        }
-        line + 1
-    };
-    let headers = reader
-        .headers()
-        .map_err(|e| map_error(file, 1, e.to_string()))?
-        .clone();
-    let header_line = headers.position().map_or(1, |p| line_at(p.byte()));
-    let want = ["i_d", "i_q", "psi_d", "psi_q"];
-    if headers.iter().collect::<Vec<_>>() != want {
-        return Err(map_error(
-            file,
-            header_line,
-            format!(
-                "the header must be `i_d,i_q,psi_d,psi_q`, got `{}`",
-                headers.iter().collect::<Vec<_>>().join(",")
-            ),
-        ));
-    }
-    // (values, line) per row.
-    let mut rows: Vec<([f64; 4], usize)> = Vec::new();
-    for record in reader.records() {
-        let record = record.map_err(|e| {
-            let line = e.position().map_or(0, |p| line_at(p.byte()));
-            map_error(file, line, e.to_string())
-        })?;
-        let line = record.position().map_or(0, |p| line_at(p.byte()));
-        let mut v = [0.0; 4];
-        for (k, x) in v.iter_mut().enumerate() {
-            let cell = record.get(k).unwrap_or("");
-            *x = cell.parse::<f64>().map_err(|_| {
-                map_error(
-                    file,
-                    line,
-                    format!("`{}` = `{cell}` is not a number", want[k]),
-                )
-            })?;
-            if !x.is_finite() {
-                return Err(map_error(
-                    file,
-                    line,
-                    format!("`{}` = {cell} is not finite", want[k]),
-                ));
-            }
-        }
-        rows.push((v, line));
-    }
-    let axis = |k: usize| {
-        let mut a: Vec<f64> = rows.iter().map(|r| r.0[k]).collect();
-        a.sort_by(f64::total_cmp);
-        a.dedup();
-        a
-    };
-    let (i_d, i_q) = (axis(0), axis(1));
-    let (nd, nq) = (i_d.len(), i_q.len());
-    if nd < 2 || nq < 2 {
-        return Err(map_error(
-            file,
-            header_line,
-            "the grid needs at least two values of i_d and of i_q",
-        ));
-    }
-    let mut psi_d = vec![f64::NAN; nd * nq];
-    let mut psi_q = vec![f64::NAN; nd * nq];
-    let mut line_of = vec![0usize; nd * nq];
-    for (v, line) in &rows {
-        let k = i_d.partition_point(|&x| x < v[0]);
-        let m = i_q.partition_point(|&x| x < v[1]);
-        let at = k * nq + m;
-        if line_of[at] != 0 {
-            return Err(map_error(
-                file,
-                *line,
-                format!(
-                    "the node (i_d, i_q) = ({}, {}) is given twice (line {} too)",
-                    v[0], v[1], line_of[at]
-                ),
-            ));
-        }
-        (psi_d[at], psi_q[at], line_of[at]) = (v[2], v[3], *line);
-    }
-    if let Some(at) = line_of.iter().position(|&l| l == 0) {
-        let last = rows.last().map_or(header_line, |r| r.1);
-        return Err(map_error(
-            file,
-            last,
-            format!(
-                "the grid is ragged: no row for (i_d, i_q) = ({}, {}); a map needs every pair of \
-                 its {nd} i_d and {nq} i_q values",
-                i_d[at / nq],
-                i_q[at % nq]
-            ),
-        ));
-    }
-    FluxMapData::new(i_d, i_q, psi_d, psi_q).map_err(|e| {
-        let line = match e {
-            FluxMapError::NotMonotonic { k, m, .. } | FluxMapError::NotFinite { k, m, .. } => {
-                line_of[k * nq + m]
-            }
-            _ => header_line,
-        };
-        map_error(file, line, e.to_string())
-    })
 }
 
 /// The plant's saturating magnetic model: the algebraic model or a flux map.
@@ -475,7 +318,7 @@ impl FluxPropagator {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::motor::{Motor, MotorParams};
 
@@ -667,41 +510,5 @@ mod tests {
             "in {e_in}, copper {e_cu}, stored {d_w}, mechanical {e_mech}: residual {residual:e}"
         );
         assert!(d_w.abs() > 1e-3 * e_in.abs() && e_mech.abs() > 1e-3 * e_in.abs());
-    }
-
-    #[test]
-    fn a_flux_map_file_is_read_in_any_row_order_and_bad_ones_are_refused_at_their_line() {
-        let text = "# a 2 x 3 map\ni_d,i_q,psi_d,psi_q\n0,1,0.60,0.05\n-5,-1,0.40,-0.05\n0,0,0.60,0.0\n# note\n-5,0,0.40,0.0\n-5,1,0.40,0.05\n0,-1,0.60,-0.05\n";
-        let data = parse_flux_map(text, "m.csv").unwrap();
-        let map = data.map();
-        assert_eq!(map.i_d(), &[-5.0, 0.0]);
-        assert_eq!(map.i_q(), &[-1.0, 0.0, 1.0]);
-        let psi = fado_core::MagneticModel::flux(&map, Dq::new(-2.5, 0.5));
-        assert!((psi.d - 0.5).abs() < 1e-12 && (psi.q - 0.025).abs() < 1e-12);
-        let err = |t: &str| parse_flux_map(t, "m.csv").unwrap_err().to_string();
-        // Ragged: the node (0, 1) missing.
-        let ragged = text.replace("0,1,0.60,0.05\n", "");
-        assert!(err(&ragged).contains("ragged"), "{}", err(&ragged));
-        // NaN, at its line.
-        let nan = text.replace("-5,0,0.40,0.0", "-5,0,NaN,0.0");
-        assert!(err(&nan).starts_with("m.csv:7:1:"), "{}", err(&nan));
-        // Not monotonic in its own current: ψd falls from i_d = −5 to 0 at i_q = 1 (line 3).
-        let flat = text.replace("0,1,0.60,0.05", "0,1,0.30,0.05");
-        assert!(
-            err(&flat).starts_with("m.csv:3:1:") && err(&flat).contains("increase"),
-            "{}",
-            err(&flat)
-        );
-        // A node twice, a bad header, a word.
-        let twice = format!("{text}0,1,0.6,0.05\n");
-        assert!(err(&twice).contains("twice"), "{}", err(&twice));
-        assert!(err("id,iq,psi_d,psi_q\n").contains("header"));
-        let word = text.replace("0,0,0.60,0.0", "0,0,big,0.0");
-        assert!(err(&word).starts_with("m.csv:5:1:"), "{}", err(&word));
-        // A file that does not exist names itself.
-        let e = read_flux_map(Path::new("/nonexistent/map.csv"))
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("/nonexistent/map.csv"), "{e}");
     }
 }

@@ -2,7 +2,9 @@
 //! evaluate, and the `'static` flux maps they borrow.
 //!
 //! The rule, as for every other key of `[model]`: the drive's model is the plant's unless the
-//! file says otherwise. `[model.saturation]` gives an algebraic model of its own. A `[model]`
+//! file says otherwise. `[model.saturation]` gives an algebraic model of its own, `[model]
+//! flux_map = "FILE.csv"` a flux map (the CSV of `crate::magnetics_file`, a relative path
+//! relative to the TOML file). A `[model]`
 //! that sets `ld`, `lq` or `flux_linkage`, or a `[mismatch]` ratio of one of them other than 1,
 //! describes a constant-inductance model (the drive then runs the constant-inductance
 //! arithmetic, as with a linear plant). Otherwise the drive's model is the plant's
@@ -22,10 +24,11 @@ use serde::Deserialize;
 use crate::config::{SimConfig, key_error};
 use crate::error::SimConfigError;
 use crate::magnetics::{FluxMapData, PlantMagnetics};
+use crate::magnetics_file::{FLUX_MAP_KEY, FluxMapFile};
 
 /// The keys of `[model]` that are not `fado_core::MachineModel`'s: taken out of the table
 /// before it is read as one.
-pub const MODEL_MAGNETICS_KEYS: [&str; 1] = ["saturation"];
+pub const MODEL_MAGNETICS_KEYS: [&str; 2] = ["saturation", "flux_map"];
 
 /// The maps leaked so far, in f64 and in f32 (see the module docs).
 type Interned = (
@@ -87,6 +90,21 @@ pub fn drive_model(
         })?;
         return Ok(MachineMagnetics::Saturation(s));
     }
+    if let Some(value) = table.and_then(|t| t.get("flux_map")) {
+        let Some(written) = value.as_str() else {
+            return Err(SimConfigError::new(
+                "model.flux_map",
+                "a file name (a CSV `i_d,i_q,psi_d,psi_q`) is expected",
+            ));
+        };
+        let file = FluxMapFile::read(written).map_err(|mut e| {
+            if e.key == FLUX_MAP_KEY {
+                e.key = "model.flux_map".into();
+            }
+            e
+        })?;
+        return Ok(MachineMagnetics::Map(interned_map(&file.data)));
+    }
     let gives_constants = table.is_some_and(|t| {
         ["ld", "lq", "flux_linkage"]
             .iter()
@@ -107,18 +125,33 @@ pub fn drive_model(
 }
 
 /// A drive model's magnetics in f32: the saturation model rounded, a map rounded and
-/// interned (None if rounding breaks it: the caller refuses the configuration).
-pub fn to_f32(m: &MachineMagnetics<f64>, cfg: &SimConfig) -> Option<MachineMagnetics<f32>> {
+/// interned (None if rounding breaks it, or for a map this module did not intern: the caller
+/// refuses the configuration).
+pub fn to_f32(m: &MachineMagnetics<f64>) -> Option<MachineMagnetics<f32>> {
     match m {
-        MachineMagnetics::Map(_) => {
-            let plant = cfg.plant();
-            match plant.magnetics.as_deref() {
-                Some(PlantMagnetics::Map(data)) => {
-                    interned_map_f32(data).map(MachineMagnetics::Map)
-                }
-                _ => None,
-            }
+        MachineMagnetics::Map(map) => {
+            let data = {
+                let interned = INTERNED.lock().unwrap_or_else(|e| e.into_inner());
+                interned.0.iter().find(|(_, m)| m == map).map(|(d, _)| *d)?
+            };
+            interned_map_f32(data).map(MachineMagnetics::Map)
         }
         other => other.cast(),
+    }
+}
+
+/// Resolves a `[model] flux_map` path where the file is read (relative to the TOML file,
+/// `crate::magnetics_file::resolve`), so that the configuration names the same file on any
+/// thread that later builds the drive from it.
+pub fn resolve_model_paths(model: &mut Option<toml::Table>) {
+    let Some(table) = model else {
+        return;
+    };
+    if let Some(toml::Value::String(written)) = table.get("flux_map") {
+        let resolved = crate::magnetics_file::resolve(written);
+        table.insert(
+            "flux_map".into(),
+            toml::Value::String(resolved.display().to_string()),
+        );
     }
 }

@@ -46,6 +46,9 @@ pub struct FieldWeakeningTuning<T> {
     pub enabled: bool,
     /// Usable fraction of the inscribed circle Vdc/√3 the loop holds |v*| to. Default 0.92
     /// \[A\] (8 % left for the current loop's transients and the dead-time compensation).
+    /// Above 1 (up to six-step's 2√3/π ≈ 1.10,
+    /// [`SIX_STEP_MARGIN`](crate::control::modulation::SIX_STEP_MARGIN)) only with the
+    /// drive's `voltage_limit = "overmodulation"`.
     pub voltage_margin: T,
     /// Bandwidth of the loop, Hz. Default 30 Hz \[A\] (a tenth of the 250 Hz current loop,
     /// well above the speed loop's 5 Hz).
@@ -106,10 +109,10 @@ impl<T: Real> FieldWeakening<T> {
         ts: T,
     ) -> Result<Self, ConfigError> {
         let m = check::positive("field_weakening.voltage_margin", t.voltage_margin)?;
-        if m > T::one() {
+        if m > T::lit(crate::control::modulation::SIX_STEP_MARGIN) {
             return Err(ConfigError::OutOfRange {
                 field: "field_weakening.voltage_margin",
-                expected: "at most 1",
+                expected: "at most 2√3/π ≈ 1.1027 (six-step)",
             });
         }
         let f = check::positive("field_weakening.bandwidth_hz", t.bandwidth_hz)?;

@@ -10,6 +10,19 @@
 //! asked for; scaling keeps the direction the controller wants and is what the anti-windup and
 //! the estimator are told was applied. The inscribed circle Vdc/√3 is offered as an option.
 //!
+//! **Overmodulation up to six-step** (option [`VoltageLimit::Overmodulation`]): a vector
+//! outside the hexagon is realised as the hexagon's point nearest to it (the
+//! minimum-distance overmodulation of Bolognani & Zigliotto, IEEE TIA 1997). On an edge's
+//! normal slab that is the orthogonal projection onto the edge (the tangential component,
+//! i.e. the direction the d/q ratio asks for, is kept as far as the edge allows); beyond an
+//! edge's end it is the vertex. A reference circle of growing radius is thus realised as a
+//! trajectory that spends ever longer on the six vertices and becomes six-step (fundamental
+//! 2·Vdc/π, 10 % above the inscribed circle) as the radius grows without bound. The field
+//! weakening loop may then hold |v*| above the inscribed circle
+//! ([`crate::control::field_weakening`]'s `voltage_margin` up to [`SIX_STEP_MARGIN`]). The
+//! realised vector is what the estimator and the anti-windup are told, so the estimator stays
+//! exact; the current carries the low-order harmonics the vertices add.
+//!
 //! **SVPWM as min-max zero-sequence injection** \[16\]: v_x + v_0 with
 //! v_0 = −(max + min)/2 centres the three references in the carrier, which is equivalent to
 //! the symmetric placement of the two zero vectors in classical SVPWM. Duty d_x = ½ + (v_x +
@@ -33,7 +46,14 @@ pub enum VoltageLimit {
     Hexagon,
     /// The hexagon's inscribed circle, |v| ≤ Vdc/√3: a direction-independent limit.
     InscribedCircle,
+    /// The hexagon, a vector outside realised as its nearest point (minimum-distance
+    /// overmodulation, up to six-step; module docs).
+    Overmodulation,
 }
+
+/// The six-step fundamental 2·Vdc/π in units of the inscribed circle Vdc/√3: 2√3/π ≈ 1.1027,
+/// the largest fundamental a two-level inverter gives.
+pub const SIX_STEP_MARGIN: f64 = 1.102_657_790_843_585_3;
 
 /// Configuration of a [`SpaceVectorModulator`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -97,6 +117,14 @@ impl<T: Real> SpaceVectorModulator<T> {
         }
         let m = self.config.max_modulation;
         let scale = match self.config.limit {
+            VoltageLimit::Overmodulation => {
+                let span = phase_span(v_ab.to_abc());
+                let avail = m * vdc;
+                if span > avail {
+                    return (nearest_on_hexagon(v_ab, avail), true);
+                }
+                T::one()
+            }
             VoltageLimit::Hexagon => {
                 let span = phase_span(v_ab.to_abc());
                 let avail = m * vdc;
@@ -135,6 +163,38 @@ impl<T: Real> SpaceVectorModulator<T> {
     pub fn config(&self) -> &ModulatorConfig<T> {
         &self.config
     }
+}
+
+/// The point of the hexagon of line-voltage span `span` (vertices 2·span/3) nearest to `v`, a
+/// vector outside it: the edge whose outward normal (at 30° + k·60°) is nearest to `v`'s
+/// direction, the orthogonal projection onto its line, clamped to the edge's ends (the
+/// vertices).
+#[inline]
+fn nearest_on_hexagon<T: Real>(v: Ab<T>, span: T) -> Ab<T> {
+    let c30 = T::lit(0.866_025_403_784_438_6);
+    let half = T::lit(0.5);
+    // Projections on the normals at 30°, 90° and 150° (the other three are their negatives).
+    let d = [
+        (c30, half, v.alpha * c30 + v.beta * half),
+        (T::zero(), T::one(), v.beta),
+        (-c30, half, -v.alpha * c30 + v.beta * half),
+    ];
+    let mut best = d[0];
+    for &k in &d[1..] {
+        if k.2.abs() > best.2.abs() {
+            best = k;
+        }
+    }
+    let (nx, ny) = if best.2 < T::zero() {
+        (-best.0, -best.1)
+    } else {
+        (best.0, best.1)
+    };
+    // Inscribed radius span/√3, half an edge span/3; tangent (−ny, nx).
+    let radius = span * T::lit(0.577_350_269_189_625_8);
+    let half_edge = span / T::lit(3.0);
+    let t = clamp(-v.alpha * ny + v.beta * nx, -half_edge, half_edge);
+    Ab::new(radius * nx - t * ny, radius * ny + t * nx)
 }
 
 /// max − min of the three phase values (the line-to-line span a vector needs).
@@ -199,6 +259,45 @@ mod tests {
     }
 
     #[test]
+    fn overmodulation_reaches_six_step() {
+        let m = SpaceVectorModulator::new(ModulatorConfig {
+            limit: VoltageLimit::Overmodulation,
+            max_modulation: 1.0,
+        })
+        .unwrap();
+        let vdc = 300.0_f64;
+        // The fundamental of a circular reference of radius r, realised: from the inscribed
+        // circle (r = Vdc/√3, linear) up to 2·Vdc/π (six-step) as r grows.
+        let fundamental = |r: f64| {
+            let n = 3600;
+            let mut sum = 0.0;
+            for k in 0..n {
+                let a = core::f64::consts::TAU * k as f64 / n as f64;
+                let (v, _) = m.limit(Ab::from_polar(r, a), vdc);
+                sum += v.alpha * a.cos() + v.beta * a.sin();
+            }
+            sum / n as f64
+        };
+        let inscribed = vdc / 3f64.sqrt();
+        assert!((fundamental(inscribed) - inscribed).abs() < 1e-9);
+        let six_step = 2.0 * vdc / core::f64::consts::PI;
+        assert!((SIX_STEP_MARGIN * inscribed - six_step).abs() < 1e-9);
+        let (f1, f2, f3) = (
+            fundamental(1.05 * inscribed),
+            fundamental(1.2 * inscribed),
+            fundamental(1e6 * inscribed),
+        );
+        assert!(inscribed < f1 && f1 < f2 && f2 < f3, "{f1} {f2} {f3}");
+        assert!(
+            (f3 - six_step).abs() < 1e-3 * six_step,
+            "{f3} vs {six_step}"
+        );
+        // Far outside, every angle is realised as a vertex (2/3·Vdc): six-step.
+        let (v, sat) = m.limit(Ab::from_polar(1e6, 0.4), vdc);
+        assert!(sat && (v.norm() - 200.0).abs() < 1e-9, "{v:?}");
+    }
+
+    #[test]
     fn bad_vdc_gives_zero_vector_and_half_duty() {
         let m = SpaceVectorModulator::new(ModulatorConfig::default()).unwrap();
         for vdc in [0.0, -5.0, f64::NAN, f64::INFINITY] {
@@ -239,6 +338,31 @@ mod tests {
             // Min-max injection centres the duties.
             let (hi, lo) = max_min(out.duty);
             prop_assert!((hi + lo - 1.0).abs() < 1e-12);
+        }
+
+        #[test]
+        fn overmodulation_gives_the_nearest_point_of_the_hexagon(
+            mag in 0.0..5000.0_f64, ang in -4.0..4.0_f64, vdc in 1.0..800.0_f64,
+        ) {
+            let m = SpaceVectorModulator::new(ModulatorConfig {
+                limit: VoltageLimit::Overmodulation,
+                max_modulation: 1.0,
+            }).unwrap();
+            let v = Ab::from_polar(mag, ang);
+            let out = m.step(v, vdc);
+            prop_assert!(phase_span(out.v_ab.to_abc()) <= vdc * (1.0 + 1e-9));
+            prop_assert!((pole_ab(out.duty, vdc) - out.v_ab).norm() < 1e-9 * vdc);
+            if !out.saturated {
+                prop_assert_eq!(out.v_ab, v);
+            } else {
+                // No point of the hexagon's boundary is nearer (sampled finely).
+                let d = (v - out.v_ab).norm();
+                for k in 0..720 {
+                    let u = Ab::from_polar(1.0, core::f64::consts::TAU * k as f64 / 720.0);
+                    let p = u * (vdc / phase_span(u.to_abc()));
+                    prop_assert!((v - p).norm() >= d - 1e-9 * vdc);
+                }
+            }
         }
 
         #[test]

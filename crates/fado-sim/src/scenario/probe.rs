@@ -176,7 +176,7 @@ impl LevelStats {
     }
 }
 
-/// Full-rate accumulations the criteria need beyond [`Metrics`].
+/// Full-rate accumulations the criteria need beyond [`Metrics`](crate::sim::Metrics).
 ///
 /// The DC of λ2 (Fig. 8) is the mean of λ2 − λs (estimate minus the true stator flux) over
 /// whole electrical revolutions: every error synchronous with the rotor (dead-time and

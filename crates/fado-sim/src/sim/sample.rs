@@ -48,6 +48,6 @@ pub struct Sample {
 pub trait Probe {
     /// Called once per sample.
     fn observe(&mut self, s: &Sample);
-    /// Called once at the end of [`Simulation::run`] (e.g. to form RMS values).
+    /// Called once at the end of [`Simulation::run`](crate::sim::Simulation::run) (e.g. to form RMS values).
     fn finish(&mut self) {}
 }

@@ -9,6 +9,7 @@ use crate::control::delay_compensation::{DelayCompensation, DelayCompensationCon
 use crate::control::field_weakening::FieldWeakening;
 use crate::control::lock_reaction::LockSupervisor;
 use crate::control::modulation::{ModulatorConfig, SpaceVectorModulator};
+use crate::control::ratings_limit::RatingsLimit;
 use crate::control::speed_controller::{SpeedController, SpeedControllerConfig};
 use crate::control::standstill_probe::{StandstillProbe, StandstillProbeConfig};
 use crate::error::{ConfigError, check};
@@ -64,6 +65,14 @@ impl<T: Real> Blocks<T> {
             ..SpeedControllerConfig::new(m, t.current_limit_ratio * m.rated_current, t.mtpa, ts)
         };
         let dc_link = DcLinkLimit::new(&t.dc_link, m, speed_config.i_max, r.i_max, ts)?;
+        if t.field_weakening.voltage_margin > T::one()
+            && t.voltage_limit != crate::control::modulation::VoltageLimit::Overmodulation
+        {
+            return Err(ConfigError::OutOfRange {
+                field: "field_weakening.voltage_margin",
+                expected: "at most 1 unless voltage_limit = \"overmodulation\"",
+            });
+        }
         let field_weakening = FieldWeakening::new(&t.field_weakening, m, r.i_max, ts)?;
         let speed = SpeedController::new(speed_config).map_err(rename(&[
             ("bandwidth_hz", "speed_bandwidth_hz"),
@@ -91,6 +100,7 @@ impl<T: Real> Blocks<T> {
             max_modulation: t.max_modulation,
         })?;
         let probe = StandstillProbe::new(probe_config(c)?)?;
+        let limits = RatingsLimit::new(&t.limits, m)?;
         Ok(Self {
             speed,
             injection,
@@ -101,6 +111,7 @@ impl<T: Real> Blocks<T> {
             probe,
             dc_link,
             field_weakening,
+            limits,
         })
     }
 

@@ -52,6 +52,7 @@ use crate::control::gain_calibration::GainCalibration;
 use crate::control::lock_reaction::LockSupervisor;
 use crate::control::modulation::SpaceVectorModulator;
 use crate::control::monitor::{DriveFlags, FlagCounts, PersistenceMonitor, StuckChannelDetector};
+use crate::control::ratings_limit::RatingsLimit;
 use crate::control::saturated_references::SaturatedReferences;
 use crate::control::speed_controller::SpeedController;
 use crate::control::standstill_probe::StandstillProbe;
@@ -140,6 +141,7 @@ struct Blocks<T> {
     modulator: SpaceVectorModulator<T>,
     dc_link: DcLinkLimit<T>,
     field_weakening: FieldWeakening<T>,
+    limits: RatingsLimit<T>,
 }
 
 /// What the modulator applies at a sample: the duties, and the voltage that acts (α-β and in

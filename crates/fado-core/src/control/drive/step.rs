@@ -119,6 +119,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             .step(tracking_error > self.resolved.current_error_limit);
         // Reaction to a lost rotor (see `lock_reaction`).
         let speed_ref = speed_ref_mech * T::lit(self.config.machine.pole_pairs as f64);
+        let speed_ref = self.blocks.limits.speed(speed_ref);
         let action = self.react_to_lock(&estimate, speed_ref)?;
         // 4. Speed loop, injection (23) and current-vector limit (zero current when coasting).
         let backup = self.blocks;
@@ -307,7 +308,9 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             let Ok(iq_torque) = self.blocks.speed.step(speed_ref, estimate.omega_control) else {
                 return None;
             };
-            // The DC link's power limits and over-voltage controller (see `dc_link_limit`).
+            // The ratings' torque and power limits (see `ratings_limit`), the DC link's power
+            // limits and over-voltage controller (see `dc_link_limit`).
+            let iq_torque = self.blocks.limits.torque(iq_torque, estimate.omega_control);
             let (iq_torque, brake_id) = self.blocks.dc_link.limit(
                 iq_torque,
                 vdc,

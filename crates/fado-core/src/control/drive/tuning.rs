@@ -8,6 +8,7 @@ use crate::control::dead_time_compensation::{self, DeadTimeMethod};
 use crate::control::field_weakening::FieldWeakeningTuning;
 use crate::control::lock_reaction::LockReaction;
 use crate::control::modulation::VoltageLimit;
+use crate::control::ratings_limit::RatingsLimitTuning;
 use crate::control::{current_controller, delay_compensation, gain_calibration, speed_controller};
 use crate::injection;
 use crate::machine::PAPER_RATED_CURRENT;
@@ -174,6 +175,13 @@ pub struct DriveTuning<T> {
         serde(bound(deserialize = "T: Real + serde::Deserialize<'de>"))
     )]
     pub field_weakening: FieldWeakeningTuning<T>,
+    /// The speed, torque and power limits from the ratings (`[controller.limits]`, see
+    /// [`RatingsLimitTuning`]).
+    #[cfg_attr(
+        feature = "serde",
+        serde(bound(deserialize = "T: Real + serde::Deserialize<'de>"))
+    )]
+    pub limits: RatingsLimitTuning<T>,
     /// Reaction to the estimator's [`LockStatus::Lost`](crate::LockStatus::Lost) (`DriveFlags::LOCK_LOST`) and, with
     /// `lock_reaction_on_stall`, to the stall symptom (`DriveFlags::STALLED`). Default report
     /// only \[A\] (the paper's behaviour plus the flags).
@@ -427,6 +435,7 @@ impl<T: Real> DriveTuning<T> {
             dc_link_max_ratio: U::lit(self.dc_link_max_ratio.to_f64()),
             dc_link: self.dc_link.cast(),
             field_weakening: self.field_weakening.cast(),
+            limits: self.limits.cast(),
             lock_reaction: self.lock_reaction,
             lock_reaction_on_stall: self.lock_reaction_on_stall,
             lock_recovery_time: U::lit(self.lock_recovery_time.to_f64()),
@@ -499,6 +508,7 @@ impl<T: Real> Default for DriveTuning<T> {
             dc_link_max_ratio: T::lit(crate::plausibility::VOLTAGE_RATIO),
             dc_link: DcLinkTuning::default(),
             field_weakening: FieldWeakeningTuning::default(),
+            limits: RatingsLimitTuning::default(),
             lock_reaction: LockReaction::ReportOnly,
             lock_reaction_on_stall: true,
             lock_recovery_time: T::lit(20e-3),

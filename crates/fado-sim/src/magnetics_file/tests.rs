@@ -1,0 +1,154 @@
+//! The flux-map CSV format and the `[motor] flux_map` key: every refusal at its line, paths
+//! relative to the TOML file, the map written and read back bit for bit.
+
+use std::path::Path;
+
+use fado_core::Dq;
+use fado_core::magnetics::MagneticModel;
+
+use super::*;
+use crate::config::SimConfig;
+
+#[test]
+fn a_flux_map_file_is_read_in_any_row_order_and_bad_ones_are_refused_at_their_line() {
+    let text = "# a 2 x 3 map\ni_d,i_q,psi_d,psi_q\n0,1,0.60,0.05\n-5,-1,0.40,-0.05\n0,0,0.60,0.0\n# note\n-5,0,0.40,0.0\n-5,1,0.40,0.05\n0,-1,0.60,-0.05\n";
+    let data = parse_flux_map(text, "m.csv").unwrap();
+    let map = data.map();
+    assert_eq!(map.i_d(), &[-5.0, 0.0]);
+    assert_eq!(map.i_q(), &[-1.0, 0.0, 1.0]);
+    let psi = fado_core::MagneticModel::flux(&map, Dq::new(-2.5, 0.5));
+    assert!((psi.d - 0.5).abs() < 1e-12 && (psi.q - 0.025).abs() < 1e-12);
+    let err = |t: &str| parse_flux_map(t, "m.csv").unwrap_err().to_string();
+    // Ragged: the node (0, 1) missing.
+    let ragged = text.replace("0,1,0.60,0.05\n", "");
+    assert!(err(&ragged).contains("ragged"), "{}", err(&ragged));
+    // NaN, at its line.
+    let nan = text.replace("-5,0,0.40,0.0", "-5,0,NaN,0.0");
+    assert!(err(&nan).starts_with("m.csv:7:1:"), "{}", err(&nan));
+    // Not monotonic in its own current: ψd falls from i_d = −5 to 0 at i_q = 1 (line 3).
+    let flat = text.replace("0,1,0.60,0.05", "0,1,0.30,0.05");
+    assert!(
+        err(&flat).starts_with("m.csv:3:1:") && err(&flat).contains("increase"),
+        "{}",
+        err(&flat)
+    );
+    // A node twice, a bad header, a word.
+    let twice = format!("{text}0,1,0.6,0.05\n");
+    assert!(err(&twice).contains("twice"), "{}", err(&twice));
+    assert!(err("id,iq,psi_d,psi_q\n").contains("header"));
+    let word = text.replace("0,0,0.60,0.0", "0,0,big,0.0");
+    assert!(err(&word).starts_with("m.csv:5:1:"), "{}", err(&word));
+    // A file that does not exist names itself.
+    let e = read_flux_map(Path::new("/nonexistent/map.csv"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("/nonexistent/map.csv"), "{e}");
+}
+
+/// A scratch directory of this test process.
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("fado-magfile-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// ipmsm-2k2's machine with q self- and cross-saturation, tabulated on a 9 × 11 grid.
+fn tabulated() -> FluxMapData {
+    let s = crate::magnetics::tests::saturated_ipm();
+    let i_d: Vec<f64> = (0..9).map(|k| -12.0 + 1.5 * k as f64).collect();
+    let i_q: Vec<f64> = (0..11).map(|m| -10.0 + 2.0 * m as f64).collect();
+    let (mut psi_d, mut psi_q) = (Vec::new(), Vec::new());
+    for &id in &i_d {
+        for &iq in &i_q {
+            let psi = s.flux(Dq::new(id, iq));
+            psi_d.push(psi.d);
+            psi_q.push(psi.q);
+        }
+    }
+    FluxMapData::new(i_d, i_q, psi_d, psi_q).unwrap()
+}
+
+/// ipmsm-2k2's file with `extra` lines at the end of its `[motor]` table.
+fn preset_with(extra: &str) -> String {
+    let text = include_str!("../../../../motors/ipmsm-2k2.toml");
+    let at = text.find("[motor]\n").unwrap() + "[motor]\n".len();
+    format!("{}{extra}{}", &text[..at], &text[at..])
+}
+
+#[test]
+fn a_written_map_reads_back_bit_for_bit() {
+    let data = tabulated();
+    let text = flux_map_csv(&data, "ipmsm-2k2 with saturation\nsecond line");
+    assert!(text.starts_with("# ipmsm-2k2 with saturation\n# second line\ni_d,i_q,psi_d,psi_q\n"));
+    assert_eq!(parse_flux_map(&text, "w.csv").unwrap(), data);
+}
+
+#[test]
+fn a_configuration_names_its_map_relative_to_its_own_directory() {
+    let dir = scratch("relative");
+    std::fs::write(dir.join("map.csv"), flux_map_csv(&tabulated(), "test")).unwrap();
+    set_config_dir(Some(&dir));
+    let cfg = SimConfig::from_toml(&preset_with("flux_map = \"map.csv\"\n"));
+    set_config_dir(None);
+    let cfg = cfg.unwrap();
+    let map = cfg.motor_flux_map.as_ref().unwrap();
+    assert_eq!(map.path, Some(dir.join("map.csv")));
+    assert_eq!(*map.data, tabulated());
+    assert!(matches!(
+        cfg.plant().magnetics.as_deref(),
+        Some(PlantMagnetics::Map(m)) if *m == tabulated()
+    ));
+    // Written back with the resolved path: the dump reads anywhere.
+    let again = SimConfig::from_toml(&cfg.to_toml()).unwrap();
+    assert_eq!(again.motor_flux_map, cfg.motor_flux_map);
+    // A document over it that gives no magnetics keeps the map; one that gives the algebraic
+    // model replaces it.
+    let over = SimConfig::from_toml_over(&cfg, "[motor]\nrs = 3.0\n").unwrap();
+    assert_eq!(over.motor_flux_map, cfg.motor_flux_map);
+    let sat = "[motor.saturation]\na_d0 = 27.8\na_q0 = 19.6\npsi_f = 0.545\n";
+    let over = SimConfig::from_toml_over(&cfg, sat).unwrap();
+    assert!(over.motor_flux_map.is_none() && over.motor_saturation.is_some());
+}
+
+#[test]
+fn a_missing_file_a_bad_value_and_two_models_are_refused_at_the_key() {
+    let text = preset_with("flux_map = \"/nonexistent/map.csv\"\n");
+    let e = SimConfig::from_toml(&text).unwrap_err();
+    assert_eq!(e.key, FLUX_MAP_KEY, "{e}");
+    assert!(e.message.contains("/nonexistent/map.csv"), "{e}");
+    let line = text
+        .lines()
+        .position(|l| l.starts_with("flux_map"))
+        .unwrap()
+        + 1;
+    assert_eq!(e.location.as_ref().map(|l| l.line), Some(line), "{e}");
+    let e = SimConfig::from_toml(&preset_with("flux_map = 3\n")).unwrap_err();
+    assert!(e.key == FLUX_MAP_KEY && e.message.contains("string"), "{e}");
+    let dir = scratch("both");
+    let path = dir.join("m.csv");
+    std::fs::write(&path, flux_map_csv(&tabulated(), "")).unwrap();
+    let both = format!(
+        "{}\n[motor.saturation]\na_d0 = 27.8\na_q0 = 19.6\n",
+        preset_with(&format!("flux_map = \"{}\"\n", path.display()))
+    );
+    let e = SimConfig::from_toml(&both).unwrap_err();
+    assert!(e.key == FLUX_MAP_KEY && e.message.contains("both"), "{e}");
+}
+
+#[test]
+fn an_error_inside_the_map_names_the_csv_file_and_line() {
+    let dir = scratch("inside");
+    let path = dir.join("bad.csv");
+    let good = flux_map_csv(&tabulated(), "");
+    // Line 1 is the header; line 5 the fourth node.
+    let mut lines: Vec<String> = good.lines().map(str::to_owned).collect();
+    let cells: Vec<&str> = lines[4].split(',').collect();
+    lines[4] = format!("{},{},NaN,{}", cells[0], cells[1], cells[3]);
+    std::fs::write(&path, lines.join("\n")).unwrap();
+    let text = preset_with(&format!("flux_map = \"{}\"\n", path.display()));
+    let e = SimConfig::from_toml(&text)
+        .unwrap_err()
+        .in_file("motor.toml");
+    let s = e.to_string();
+    assert!(s.starts_with(&format!("{}:5:1:", path.display())), "{s}");
+}
