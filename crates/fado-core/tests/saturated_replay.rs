@@ -24,7 +24,7 @@ fn ipm(a_dq: f64) -> MachineModel<f64> {
         i_f: 0.545 / 0.036,
         ..Saturation::default()
     };
-    let model = MachineMagnetics::Saturation(sat);
+    let model = MachineMagnetics::Saturation(Box::leak(Box::new(sat)));
     let (ld, lq, lf) = zero_current(model);
     MachineModel {
         rs: 3.6,
@@ -61,7 +61,7 @@ fn baldor() -> MachineModel<f64> {
         k_q: 0.1,
         ..Saturation::default()
     };
-    let model = MachineMagnetics::Saturation(sat);
+    let model = MachineMagnetics::Saturation(Box::leak(Box::new(sat)));
     let (ld, lq, lf) = zero_current(model);
     MachineModel {
         rs: 0.63,
@@ -88,7 +88,9 @@ fn baldor_map() -> MachineModel<f64> {
         axis,
         axis,
     )));
-    m.with_magnetics(MachineMagnetics::Map(table.map().unwrap()))
+    m.with_magnetics(MachineMagnetics::Map(Box::leak(Box::new(
+        table.map().unwrap(),
+    ))))
 }
 
 fn zero_current(m: MachineMagnetics<f64>) -> (f64, f64, f64) {
