@@ -36,6 +36,7 @@
 #![no_main]
 
 mod drive_loop;
+mod flux_lookup;
 mod paper_kernel;
 
 use core::cell::{Cell, OnceCell, RefCell};
@@ -751,6 +752,19 @@ fn main() -> ! {
         deepest_drive_step,
         if drive_ok { "" } else { "  FAILED" }
     );
+    // A 16 x 16 flux map's lookups and inverses (scenario SCENARIOS.len() + 1).
+    scenario_marker(SCENARIOS.len() as u32 + 1);
+    match flux_lookup::run(300) {
+        Some(worst) if worst < 1e-3 => hprintln!(
+            "scenario {}: a 16 x 16 flux map in flash: 300 lookups ψ(i) and inverses i(ψ), worst round trip |i(ψ(i)) − i| {} A",
+            SCENARIOS.len() + 1,
+            worst
+        ),
+        other => {
+            hprintln!("flux map round trip FAILED: {:?}", other);
+            all_locked = false;
+        }
+    }
     scenario_marker(u32::MAX);
     exit(all_locked)
 }

@@ -158,6 +158,7 @@ mod fits;
 mod lifecycle;
 mod output;
 mod phase;
+mod saturation_fit;
 mod sizing;
 mod spin;
 mod standstill;
@@ -168,6 +169,7 @@ mod tests;
 pub use config::CommissioningConfig;
 pub use output::{CommissioningOutput, Confidence, Identification};
 pub use phase::{AbortReason, Parameter, Phase, Status};
+pub use saturation_fit::SaturationFit;
 
 use crate::{Ab, Dq};
 use fits::{BlockStats, EmfWindow, JFit, JWindows, Line, emf_line};

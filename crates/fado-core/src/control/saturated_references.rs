@@ -60,8 +60,8 @@ fn mtpa_condition<T: Real>(model: &impl MagneticModel<T>, i: Dq<T>) -> T {
 /// The MTPA d current at q current `i_q` ≥ 0 by bisection on [−2·`i_max`, 0]; 0 where g ≥ 0
 /// at i_d = 0 (no reluctance torque to gain).
 fn mtpa_id<T: Real>(model: &impl MagneticModel<T>, i_q: T, i_max: T) -> T {
-    let at_zero = mtpa_condition(model, Dq::new(T::zero(), i_q));
-    if at_zero.partial_cmp(&T::zero()) != Some(core::cmp::Ordering::Less) {
+    let g0 = mtpa_condition(model, Dq::new(T::zero(), i_q));
+    if g0.partial_cmp(&T::zero()) != Some(core::cmp::Ordering::Less) {
         return T::zero();
     }
     let (mut lo, mut hi) = (-(i_max + i_max), T::zero());

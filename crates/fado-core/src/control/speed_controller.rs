@@ -160,6 +160,12 @@ impl<T: Real> SpeedController<T> {
         self.pi.step(omega_ref - omega, T::zero())
     }
 
+    /// Presets the integral to `iq` (A, clamped to ±I_max): a bumpless start from a known
+    /// torque demand (the release hold's pre-torque).
+    pub fn preset(&mut self, iq: T) {
+        self.pi.reset_to(iq);
+    }
+
     /// Anti-windup for a further limit of i_q* downstream (the current-vector limit with
     /// the d-axis injection): the q current that was finally used.
     #[inline]

@@ -111,12 +111,15 @@ fn check_axis<T: Real>(axis: &'static str, x: &[T]) -> Result<(), FluxMapError> 
 
 /// The cell of `x` on `axis` (clamped to the edge cells) and the fraction along it (outside
 /// [0, 1] beyond the grid).
+/// Indexing by `get` (a NaN where a shape check failed), so that the firmware's lookup holds
+/// no bounds-check panic.
 #[inline]
 fn cell<T: Real>(axis: &[T], x: T) -> (usize, T, T) {
     let n = axis.len();
-    let k = axis.partition_point(|&a| a <= x).clamp(1, n - 1) - 1;
-    let width = axis[k + 1] - axis[k];
-    ((k), (x - axis[k]) / width, width)
+    let k = axis.partition_point(|&a| a <= x).clamp(1, n.max(2) - 1) - 1;
+    let at = |j: usize| axis.get(j).copied().unwrap_or_else(|| T::lit(f64::NAN));
+    let width = at(k + 1) - at(k);
+    (k, (x - at(k)) / width, width)
 }
 
 impl<'a, T: Real> FluxMap<'a, T> {
@@ -214,7 +217,15 @@ impl<'a, T: Real> FluxMap<'a, T> {
         let (m, fy, wy) = cell(self.i_q, i.q);
         let nq = self.i_q.len();
         let at = k * nq + m;
-        let corner = |t: &[T]| (t[at], t[at + nq], t[at + 1], t[at + nq + 1]);
+        let node = |t: &[T], j: usize| t.get(j).copied().unwrap_or_else(|| T::lit(f64::NAN));
+        let corner = |t: &[T]| {
+            (
+                node(t, at),
+                node(t, at + nq),
+                node(t, at + 1),
+                node(t, at + nq + 1),
+            )
+        };
         let bilinear = |(p00, p10, p01, p11): (T, T, T, T)| {
             let (ex, ey) = (p10 - p00, p01 - p00);
             let twist = p11 - p10 - p01 + p00;
@@ -243,7 +254,7 @@ impl<T: Real> MagneticModel<T> for FluxMap<'_, T> {
     }
 
     fn current_from(&self, psi: Dq<T>, guess: Dq<T>) -> Dq<T> {
-        let scale = self.i_d[self.i_d.len() - 1].abs() * T::lit(1e-6);
+        let scale = self.i_d.last().map_or(T::one(), |x| x.abs()) * T::lit(1e-6);
         newton(psi, guess, scale, |i| self.flux_and_jacobian(i))
     }
 

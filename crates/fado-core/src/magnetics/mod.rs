@@ -232,4 +232,4 @@ impl<T: Real> MagneticModel<T> for Magnetics<'_, T> {
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

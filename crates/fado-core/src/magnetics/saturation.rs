@@ -110,7 +110,13 @@ fn pow_abs<T: Real>(x: T, e: T) -> T {
     if n == 0.0 {
         T::one()
     } else if (1.0..=16.0).contains(&n) && n == f64::from(n as i32) {
-        x.abs().powi(n as i32)
+        // By multiplication: the generic `powi` of a no_std build is libm's `pow`.
+        let a = x.abs();
+        let mut p = a;
+        for _ in 1..n as i32 {
+            p *= a;
+        }
+        p
     } else {
         x.abs().powf(e)
     }

@@ -4,7 +4,7 @@ use super::*;
 use crate::MachineModel;
 
 /// The 6.7 kW SyRM of motulator's algebraic-model examples (Hinkkanen et al. 2017's fit).
-fn syrm() -> Saturation<f64> {
+pub(crate) fn syrm() -> Saturation<f64> {
     Saturation {
         a_d0: 17.4,
         a_dd: 373.0,

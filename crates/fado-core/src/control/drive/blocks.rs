@@ -10,6 +10,7 @@ use crate::control::field_weakening::FieldWeakening;
 use crate::control::lock_reaction::LockSupervisor;
 use crate::control::modulation::{ModulatorConfig, SpaceVectorModulator};
 use crate::control::ratings_limit::RatingsLimit;
+use crate::control::release_hold::ReleaseHold;
 use crate::control::speed_controller::{SpeedController, SpeedControllerConfig};
 use crate::control::standstill_probe::{StandstillProbe, StandstillProbeConfig};
 use crate::error::{ConfigError, check};
@@ -100,8 +101,16 @@ impl<T: Real> Blocks<T> {
             max_modulation: t.max_modulation,
         })?;
         let probe = StandstillProbe::new(probe_config(c)?)?;
+        let hold = ReleaseHold::new(
+            &t.release_hold,
+            m,
+            ts,
+            t.current_bandwidth_hz,
+            speed_config.i_max,
+        )?;
         let limits = RatingsLimit::new(&t.limits, m)?;
         Ok(Self {
+            hold,
             speed,
             injection,
             current,
@@ -125,6 +134,7 @@ impl<T: Real> Blocks<T> {
         self.probe.reset();
         self.dc_link.reset();
         self.field_weakening.reset();
+        self.hold.disarm();
     }
 }
 

@@ -169,6 +169,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             T::zero()
         };
         self.clear_control(theta0);
+        self.blocks.hold.arm(theta0);
         self.lock.restart();
         if self.tripped {
             self.trip_output();

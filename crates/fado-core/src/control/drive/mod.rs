@@ -28,6 +28,7 @@
 mod blocks;
 mod calibration;
 mod config;
+mod hold;
 mod lifecycle;
 mod lock;
 mod output;
@@ -53,6 +54,7 @@ use crate::control::lock_reaction::LockSupervisor;
 use crate::control::modulation::SpaceVectorModulator;
 use crate::control::monitor::{DriveFlags, FlagCounts, PersistenceMonitor, StuckChannelDetector};
 use crate::control::ratings_limit::RatingsLimit;
+use crate::control::release_hold::ReleaseHold;
 use crate::control::saturated_references::SaturatedReferences;
 use crate::control::speed_controller::SpeedController;
 use crate::control::standstill_probe::StandstillProbe;
@@ -141,6 +143,8 @@ struct Blocks<T> {
     modulator: SpaceVectorModulator<T>,
     dc_link: DcLinkLimit<T>,
     field_weakening: FieldWeakening<T>,
+    /// The release hold after the start-up.
+    hold: ReleaseHold<T>,
     limits: RatingsLimit<T>,
 }
 

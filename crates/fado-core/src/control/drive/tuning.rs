@@ -9,6 +9,7 @@ use crate::control::field_weakening::FieldWeakeningTuning;
 use crate::control::lock_reaction::LockReaction;
 use crate::control::modulation::VoltageLimit;
 use crate::control::ratings_limit::RatingsLimitTuning;
+use crate::control::release_hold::ReleaseHoldTuning;
 use crate::control::{current_controller, delay_compensation, gain_calibration, speed_controller};
 use crate::injection;
 use crate::machine::PAPER_RATED_CURRENT;
@@ -100,8 +101,9 @@ pub struct DriveTuning<T> {
     /// window in s; 0 disables the calibration. The current loop settles for
     /// 5·max(L̂d/R̂s, 1/ωc) (five time constants of the stator or of the current loop,
     /// whichever is slower), and each level holds 4 time constants of the rotor's swing
-    /// (`swing_time_constant`) before it is averaged; a machine needing a hold above 0.2 s is
-    /// skipped. Default 0.05 s \[A\] (500 samples at 10 kHz: 10 mA rms of noise averages to
+    /// (`swing_time_constant`) before it is averaged, fewer where that exceeds 0.2 s and the
+    /// swing's bias bound allows (`swing_hold_time_constants`, a low-flux motor); a machine
+    /// needing a hold above 0.2 s is skipped. Default 0.05 s \[A\] (500 samples at 10 kHz: 10 mA rms of noise averages to
     /// 0.45 mA, 0.02 % of the lower level's phase-b current at the observability limit on the
     /// paper's motor). A 0.5 % mismatch walks θ̂ at loaded standstill on a low-flux motor
     /// (README: the outrunner preset lost `reversal` and `stops`, 1.2 rad). Start-up added on
@@ -182,6 +184,13 @@ pub struct DriveTuning<T> {
         serde(bound(deserialize = "T: Real + serde::Deserialize<'de>"))
     )]
     pub limits: RatingsLimitTuning<T>,
+    /// The release hold: a position loop that holds a rotor a load turns at zero speed
+    /// after the start-up (`[controller.release_hold]`, see [`ReleaseHoldTuning`]).
+    #[cfg_attr(
+        feature = "serde",
+        serde(bound(deserialize = "T: Real + serde::Deserialize<'de>"))
+    )]
+    pub release_hold: ReleaseHoldTuning<T>,
     /// Reaction to the estimator's [`LockStatus::Lost`](crate::LockStatus::Lost) (`DriveFlags::LOCK_LOST`) and, with
     /// `lock_reaction_on_stall`, to the stall symptom (`DriveFlags::STALLED`). Default report
     /// only \[A\] (the paper's behaviour plus the flags).
@@ -435,6 +444,7 @@ impl<T: Real> DriveTuning<T> {
             dc_link_max_ratio: U::lit(self.dc_link_max_ratio.to_f64()),
             dc_link: self.dc_link.cast(),
             field_weakening: self.field_weakening.cast(),
+            release_hold: self.release_hold.cast(),
             limits: self.limits.cast(),
             lock_reaction: self.lock_reaction,
             lock_reaction_on_stall: self.lock_reaction_on_stall,
@@ -508,6 +518,7 @@ impl<T: Real> Default for DriveTuning<T> {
             dc_link_max_ratio: T::lit(crate::plausibility::VOLTAGE_RATIO),
             dc_link: DcLinkTuning::default(),
             field_weakening: FieldWeakeningTuning::default(),
+            release_hold: ReleaseHoldTuning::default(),
             limits: RatingsLimitTuning::default(),
             lock_reaction: LockReaction::ReportOnly,
             lock_reaction_on_stall: true,

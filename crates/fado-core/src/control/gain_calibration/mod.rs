@@ -108,13 +108,18 @@
 //! voltage-mode current above `current_limit` ends the sequence (the drive sets it to its
 //! I_max, with I₂ = 2·I₁ ≤ I_max).
 
-use crate::error::{ConfigError, check};
-use crate::{Ab, MachineModel, Real};
+mod measure;
+mod motion;
+mod sequence;
+#[cfg(test)]
+mod tests;
 
-/// The unit vector of phase b in α-β, (cos 2π/3, sin 2π/3) (amplitude-invariant Clarke: the
-/// phase-b value of a vector is its projection on it).
-const PHASE_B_ALPHA: f64 = -0.5;
-const PHASE_B_BETA: f64 = 0.866_025_403_784_438_6;
+pub use measure::{ratio_of, resistance_of};
+pub use motion::{MOTION_FILTER_TIME, MOTION_SPEED_RATIO, motion_voltage};
+
+use crate::error::{ConfigError, check};
+use crate::{Ab, Real};
+use measure::{PHASE_B_ALPHA, PHASE_B_BETA};
 
 /// Configuration of a [`GainCalibration`], in absolute units (its user derives it from its
 /// own ratios and its machine model; defaults `DEFAULT_*`).
@@ -159,28 +164,6 @@ pub struct GainCalibrationConfig<T> {
 pub const DEFAULT_MIN_OBSERVABILITY: f64 = 0.2;
 /// Default `max_mismatch` \[A\]: two sensors of ±2.5 % gain tolerance.
 pub const DEFAULT_MAX_MISMATCH: f64 = 0.05;
-
-/// Speed, as a fraction of the rated speed, at which the rotor-motion test of the gain
-/// calibration fires: its back-EMF ω·λ̂f is the test's threshold
-/// ([`GainCalibrationConfig::motion_voltage`]) \[A\]. 1 % of the rated speed is over ten
-/// times the speed of the rotor's own swing about the calibration's current and the slow
-/// settling of the current across the axis after a level step (both measured on the presets
-/// at below 0.1 % of the rated speed), and a load of half the rated torque reaches it within
-/// milliseconds: on the 2.2 kW IPMSM, 7 N·m turns the rotor 0.01 rad before it is noticed.
-pub const MOTION_SPEED_RATIO: f64 = 0.01;
-
-/// Low-pass time constant (s) of the current across the axis in the rotor-motion test \[A\]:
-/// its derivative times L̂q is the back-EMF's inductive part, whose sample-to-sample noise
-/// (the current sensor's noise and resolution over Ts) the filter averages over ten 10 kHz
-/// samples.
-pub const MOTION_FILTER_TIME: f64 = 1e-3;
-
-/// The rotor-motion threshold (V) of [`GainCalibrationConfig::motion_voltage`] for a
-/// machine: [`MOTION_SPEED_RATIO`] × the rated electrical speed × λ̂f.
-pub fn motion_voltage<T: Real>(m: &MachineModel<T>) -> T {
-    let omega_rated = m.rated_speed_rpm * T::two_pi() / T::lit(60.0) * T::lit(m.pole_pairs as f64);
-    T::lit(MOTION_SPEED_RATIO) * omega_rated * m.flux_linkage
-}
 
 /// Where the calibration stands.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -415,252 +398,4 @@ impl<T: Real> GainCalibration<T> {
         let phase_c = -c - b;
         crate::real::min(crate::real::min(c.abs(), b.abs()), phase_c.abs())
     }
-
-    /// Starts the sequence along the axis at `angle` (the aligned rotor's d axis): skipped
-    /// at once (no current) when unobservable. Returns whether it runs.
-    pub fn start(&mut self, angle: T) -> bool {
-        if self.window_samples == 0 {
-            self.status = GainCalibrationStatus::Off;
-            return false;
-        }
-        if self.too_slow {
-            self.stage = Stage::Idle;
-            self.status = GainCalibrationStatus::TooSlow;
-            return false;
-        }
-        let share = Self::observability(angle);
-        // NaN compares false: a non-finite angle is unobservable too.
-        if !(share >= self.config.min_observability && share > T::zero()) {
-            self.stage = Stage::Idle;
-            self.status = GainCalibrationStatus::Unobservable;
-            return false;
-        }
-        let (s, c) = angle.step_sin_cos_any();
-        self.axis = Ab::new(c, s);
-        self.sum_i = [Ab::zero(); 2];
-        self.sum_v = [Ab::zero(); 2];
-        self.count = [0; 2];
-        self.aborted = false;
-        self.cross_ref = T::zero();
-        self.cross_filtered = T::zero();
-        self.v_lower = Ab::zero();
-        self.v_lower_count = 0;
-        self.stage = Stage::Settle;
-        self.remaining = self.settle_samples;
-        self.status = GainCalibrationStatus::Running;
-        true
-    }
-
-    /// The command of the present stage.
-    pub fn command(&self) -> GainCalibrationCommand<T> {
-        let i1 = self.config.current;
-        match self.stage {
-            Stage::Settle => GainCalibrationCommand {
-                current_d: i1,
-                voltage: None,
-            },
-            Stage::HoldUpper | Stage::AverageUpper => GainCalibrationCommand {
-                current_d: i1 + i1,
-                voltage: Some(self.v_lower + self.axis * (self.config.rs_hat * i1)),
-            },
-            Stage::HoldLower | Stage::AverageLower => GainCalibrationCommand {
-                current_d: i1,
-                voltage: Some(self.v_lower),
-            },
-            Stage::Idle | Stage::Release => GainCalibrationCommand {
-                current_d: T::zero(),
-                voltage: None,
-            },
-        }
-    }
-
-    /// One sample while running: `i_ab` the measured current now (offsets removed, no gain
-    /// correction), `v_ab` the voltage that acted over the last sampling period (the drive's
-    /// realised reference). Returns what to apply at this sample. A non-finite pair is left
-    /// out of the averages; every sample advances the sequence, so it always ends (after
-    /// [`duration_samples`](Self::duration_samples) at most).
-    pub fn step(&mut self, i_ab: Ab<T>, v_ab: Ab<T>) -> GainCalibrationCommand<T> {
-        if self.status != GainCalibrationStatus::Running {
-            return GainCalibrationCommand {
-                current_d: T::zero(),
-                voltage: None,
-            };
-        }
-        let finite = i_ab.is_finite() && v_ab.is_finite();
-        let voltage_mode = !matches!(self.stage, Stage::Settle | Stage::Release | Stage::Idle);
-        // NaN compares false: a non-finite current in voltage mode does not abort by itself.
-        if voltage_mode && i_ab.norm() > self.config.current_limit {
-            self.aborted = true;
-            self.stage = Stage::Release;
-            self.remaining = self.settle_samples;
-        }
-        // Rotor motion: with the voltage frozen, a turning rotor's back-EMF (across the
-        // axis, where the rotor's q axis lies) drives a current across it; at rest that
-        // current stays where it was when the voltage was frozen.
-        if voltage_mode && finite {
-            let cross = self.axis.cross(i_ab);
-            // The reference is the level's first sample (the voltage just frozen or stepped).
-            let level_start = matches!(self.stage, Stage::HoldLower | Stage::HoldUpper)
-                && self.remaining == self.hold_samples;
-            if level_start {
-                self.cross_ref = cross;
-                self.cross_filtered = T::zero();
-            }
-            let delta = cross - self.cross_ref;
-            let tf = T::lit(MOTION_FILTER_TIME);
-            let a = self.config.ts / (tf + self.config.ts);
-            self.cross_filtered += a * (delta - self.cross_filtered);
-            // d/dt of the filtered current is (Δi⊥ − filtered)/τ_f.
-            let emf = self.config.rs_hat * self.cross_filtered
-                + self.config.lq_hat * (delta - self.cross_filtered) / tf;
-
-            if emf.abs() > self.config.motion_voltage {
-                self.stage = Stage::Idle;
-                self.status = GainCalibrationStatus::RotorMoved;
-                self.measured = T::zero() / T::zero();
-                return GainCalibrationCommand {
-                    current_d: T::zero(),
-                    voltage: None,
-                };
-            }
-        }
-        let level = match self.stage {
-            Stage::AverageLower => Some(0),
-            Stage::AverageUpper => Some(1),
-            _ => None,
-        };
-        if let Some(level) = level
-            && finite
-        {
-            self.sum_i[level] += i_ab;
-            self.sum_v[level] += v_ab;
-            self.count[level] += 1;
-        }
-        if self.stage == Stage::Settle && self.remaining <= self.settle_samples / 2 && finite {
-            // The current loop's voltage at I₁, averaged over the second half of its settling
-            // (the loop's response to the current noise averages out), becomes V₁.
-            self.v_lower += v_ab;
-            self.v_lower_count += 1;
-        }
-        if self.stage == Stage::Settle && self.remaining <= 1 {
-            self.v_lower = if self.v_lower_count > 0 {
-                self.v_lower * reciprocal_of_count::<T>(self.v_lower_count)
-            } else {
-                self.axis * (self.config.rs_hat * self.config.current)
-            };
-        }
-        self.remaining = self.remaining.saturating_sub(1);
-        while self.remaining == 0 && self.stage != Stage::Idle {
-            self.advance();
-        }
-        self.command()
-    }
-
-    fn advance(&mut self) {
-        let (next, samples) = match self.stage {
-            Stage::Settle => (Stage::HoldLower, self.hold_samples),
-            Stage::HoldLower => (Stage::AverageLower, self.window_samples),
-            Stage::AverageLower => (Stage::HoldUpper, self.hold_samples),
-            Stage::HoldUpper => (Stage::AverageUpper, self.window_samples),
-            Stage::AverageUpper => (Stage::Release, self.settle_samples),
-            Stage::Release | Stage::Idle => {
-                self.stage = Stage::Idle;
-                self.finish();
-                return;
-            }
-        };
-        self.stage = next;
-        self.remaining = samples;
-    }
-
-    /// The ratio from the two levels' averages, or why not.
-    fn finish(&mut self) {
-        self.measured = T::zero() / T::zero();
-        let min_count = (self.window_samples / 2).max(1);
-        if self.aborted || self.count[0] < min_count || self.count[1] < min_count {
-            self.status = GainCalibrationStatus::Implausible;
-            return;
-        }
-        let inv = [
-            reciprocal_of_count::<T>(self.count[0]),
-            reciprocal_of_count::<T>(self.count[1]),
-        ];
-        let di = self.sum_i[1] * inv[1] - self.sum_i[0] * inv[0];
-        let dv = self.sum_v[1] * inv[1] - self.sum_v[0] * inv[0];
-        match ratio_of(di, dv, self.config.min_observability) {
-            Some(k) => {
-                self.measured = k;
-                if (k - T::one()).abs() <= self.config.max_mismatch {
-                    self.ratio = k;
-                    self.resistance = resistance_of(di, dv, k);
-                    self.status = GainCalibrationStatus::Calibrated;
-                } else {
-                    self.status = GainCalibrationStatus::Implausible;
-                }
-            }
-            None => self.status = GainCalibrationStatus::Implausible,
-        }
-    }
 }
-
-/// R = Δv·Δi′/|Δi′|² (Ω): the resistance along the current difference `di` of two DC levels
-/// and their voltage difference `dv` (α-β), with phase a of `di` divided by the ratio `k`
-/// (phase b as measured; i_β = (i_a + 2·i_b)/√3, amplitude-invariant Clarke). NaN when the
-/// difference is zero or anything is non-finite.
-pub fn resistance_of<T: Real>(di: Ab<T>, dv: Ab<T>, k: T) -> T {
-    let ib = di.to_abc().b;
-    let ia = di.alpha / k;
-    let corrected = crate::Abc::new(ia, ib, -ia - ib).to_ab();
-    let den = corrected.dot(corrected);
-    if den > T::zero() {
-        dv.dot(corrected) / den
-    } else {
-        T::zero() / T::zero()
-    }
-}
-
-/// 1/n for a sample count n, n built as a real by binary decomposition (adds of powers of
-/// two, exact below 2^24 in f32): no integer-to-float conversion, which a Cortex-M4's f32
-/// build would do through software double for `T::lit(n as f64)`.
-fn reciprocal_of_count<T: Real>(n: u32) -> T {
-    let mut x = T::zero();
-    let mut bit = T::one();
-    let mut m = n;
-    while m > 0 {
-        if m & 1 == 1 {
-            x += bit;
-        }
-        bit += bit;
-        m >>= 1;
-    }
-    if x > T::zero() {
-        T::one() / x
-    } else {
-        T::zero()
-    }
-}
-
-/// k = (Δi_a/Δv_a)/(Δi_b/Δv_b) from the α-β differences of the measured current and the
-/// voltage between two levels (module docs), or None when phase a or b carries less than
-/// `min_share` of |Δi|, a conductance is not positive, or anything is non-finite.
-pub fn ratio_of<T: Real>(di: Ab<T>, dv: Ab<T>, min_share: T) -> Option<T> {
-    let pb = |x: Ab<T>| x.alpha * T::lit(PHASE_B_ALPHA) + x.beta * T::lit(PHASE_B_BETA);
-    let (ia, ib) = (di.alpha, pb(di));
-    let (va, vb) = (dv.alpha, pb(dv));
-    let share = crate::real::min(ia.abs(), ib.abs());
-    // Positive conductances (a current difference in the voltage's direction, per phase)
-    // and enough of the current in both measured phases; NaN fails every comparison.
-    let ok = share >= min_share * di.norm()
-        && share > T::zero()
-        && ia * va > T::zero()
-        && ib * vb > T::zero();
-    if !ok {
-        return None;
-    }
-    let k = (ia * vb) / (ib * va);
-    k.is_finite().then_some(k)
-}
-
-#[cfg(test)]
-#[path = "gain_calibration_tests.rs"]
-mod tests;

@@ -1,0 +1,175 @@
+//! The calibration's sequence: start, the levels sample by sample, and the ratio at the end.
+
+use super::measure::{ratio_of, reciprocal_of_count, resistance_of};
+use super::{GainCalibration, GainCalibrationCommand, GainCalibrationStatus, Stage};
+use crate::{Ab, Real};
+
+impl<T: Real> GainCalibration<T> {
+    /// Starts the sequence along the axis at `angle` (the aligned rotor's d axis): skipped
+    /// at once (no current) when unobservable. Returns whether it runs.
+    pub fn start(&mut self, angle: T) -> bool {
+        if self.window_samples == 0 {
+            self.status = GainCalibrationStatus::Off;
+            return false;
+        }
+        if self.too_slow {
+            self.stage = Stage::Idle;
+            self.status = GainCalibrationStatus::TooSlow;
+            return false;
+        }
+        let share = Self::observability(angle);
+        // NaN compares false: a non-finite angle is unobservable too.
+        if !(share >= self.config.min_observability && share > T::zero()) {
+            self.stage = Stage::Idle;
+            self.status = GainCalibrationStatus::Unobservable;
+            return false;
+        }
+        let (s, c) = angle.step_sin_cos_any();
+        self.axis = Ab::new(c, s);
+        self.sum_i = [Ab::zero(); 2];
+        self.sum_v = [Ab::zero(); 2];
+        self.count = [0; 2];
+        self.aborted = false;
+        self.cross_ref = T::zero();
+        self.cross_filtered = T::zero();
+        self.v_lower = Ab::zero();
+        self.v_lower_count = 0;
+        self.stage = Stage::Settle;
+        self.remaining = self.settle_samples;
+        self.status = GainCalibrationStatus::Running;
+        true
+    }
+
+    /// The command of the present stage.
+    pub fn command(&self) -> GainCalibrationCommand<T> {
+        let i1 = self.config.current;
+        match self.stage {
+            Stage::Settle => GainCalibrationCommand {
+                current_d: i1,
+                voltage: None,
+            },
+            Stage::HoldUpper | Stage::AverageUpper => GainCalibrationCommand {
+                current_d: i1 + i1,
+                voltage: Some(self.v_lower + self.axis * (self.config.rs_hat * i1)),
+            },
+            Stage::HoldLower | Stage::AverageLower => GainCalibrationCommand {
+                current_d: i1,
+                voltage: Some(self.v_lower),
+            },
+            Stage::Idle | Stage::Release => GainCalibrationCommand {
+                current_d: T::zero(),
+                voltage: None,
+            },
+        }
+    }
+
+    /// One sample while running: `i_ab` the measured current now (offsets removed, no gain
+    /// correction), `v_ab` the voltage that acted over the last sampling period (the drive's
+    /// realised reference). Returns what to apply at this sample. A non-finite pair is left
+    /// out of the averages; every sample advances the sequence, so it always ends (after
+    /// [`duration_samples`](Self::duration_samples) at most).
+    pub fn step(&mut self, i_ab: Ab<T>, v_ab: Ab<T>) -> GainCalibrationCommand<T> {
+        if self.status != GainCalibrationStatus::Running {
+            return GainCalibrationCommand {
+                current_d: T::zero(),
+                voltage: None,
+            };
+        }
+        let finite = i_ab.is_finite() && v_ab.is_finite();
+        let voltage_mode = !matches!(self.stage, Stage::Settle | Stage::Release | Stage::Idle);
+        // NaN compares false: a non-finite current in voltage mode does not abort by itself.
+        if voltage_mode && i_ab.norm() > self.config.current_limit {
+            self.aborted = true;
+            self.stage = Stage::Release;
+            self.remaining = self.settle_samples;
+        }
+        // Rotor motion: with the voltage frozen, a turning rotor's back-EMF (across the
+        // axis, where the rotor's q axis lies) drives a current across it; at rest that
+        // current stays where it was when the voltage was frozen.
+        if voltage_mode && finite && self.motion_emf(i_ab).abs() > self.config.motion_voltage {
+            self.stage = Stage::Idle;
+            self.status = GainCalibrationStatus::RotorMoved;
+            self.measured = T::zero() / T::zero();
+            return GainCalibrationCommand {
+                current_d: T::zero(),
+                voltage: None,
+            };
+        }
+        let level = match self.stage {
+            Stage::AverageLower => Some(0),
+            Stage::AverageUpper => Some(1),
+            _ => None,
+        };
+        if let Some(level) = level
+            && finite
+        {
+            self.sum_i[level] += i_ab;
+            self.sum_v[level] += v_ab;
+            self.count[level] += 1;
+        }
+        if self.stage == Stage::Settle && self.remaining <= self.settle_samples / 2 && finite {
+            // The current loop's voltage at I₁, averaged over the second half of its settling
+            // (the loop's response to the current noise averages out), becomes V₁.
+            self.v_lower += v_ab;
+            self.v_lower_count += 1;
+        }
+        if self.stage == Stage::Settle && self.remaining <= 1 {
+            self.v_lower = if self.v_lower_count > 0 {
+                self.v_lower * reciprocal_of_count::<T>(self.v_lower_count)
+            } else {
+                self.axis * (self.config.rs_hat * self.config.current)
+            };
+        }
+        self.remaining = self.remaining.saturating_sub(1);
+        while self.remaining == 0 && self.stage != Stage::Idle {
+            self.advance();
+        }
+        self.command()
+    }
+
+    fn advance(&mut self) {
+        let (next, samples) = match self.stage {
+            Stage::Settle => (Stage::HoldLower, self.hold_samples),
+            Stage::HoldLower => (Stage::AverageLower, self.window_samples),
+            Stage::AverageLower => (Stage::HoldUpper, self.hold_samples),
+            Stage::HoldUpper => (Stage::AverageUpper, self.window_samples),
+            Stage::AverageUpper => (Stage::Release, self.settle_samples),
+            Stage::Release | Stage::Idle => {
+                self.stage = Stage::Idle;
+                self.finish();
+                return;
+            }
+        };
+        self.stage = next;
+        self.remaining = samples;
+    }
+
+    /// The ratio from the two levels' averages, or why not.
+    fn finish(&mut self) {
+        self.measured = T::zero() / T::zero();
+        let min_count = (self.window_samples / 2).max(1);
+        if self.aborted || self.count[0] < min_count || self.count[1] < min_count {
+            self.status = GainCalibrationStatus::Implausible;
+            return;
+        }
+        let inv = [
+            reciprocal_of_count::<T>(self.count[0]),
+            reciprocal_of_count::<T>(self.count[1]),
+        ];
+        let di = self.sum_i[1] * inv[1] - self.sum_i[0] * inv[0];
+        let dv = self.sum_v[1] * inv[1] - self.sum_v[0] * inv[0];
+        match ratio_of(di, dv, self.config.min_observability) {
+            Some(k) => {
+                self.measured = k;
+                if (k - T::one()).abs() <= self.config.max_mismatch {
+                    self.ratio = k;
+                    self.resistance = resistance_of(di, dv, k);
+                    self.status = GainCalibrationStatus::Calibrated;
+                } else {
+                    self.status = GainCalibrationStatus::Implausible;
+                }
+            }
+            None => self.status = GainCalibrationStatus::Implausible,
+        }
+    }
+}
