@@ -142,8 +142,9 @@ pub struct EstimatorParams<T: Real> {
     saliency: T,
     /// A saturating model's active flux (`crate::active_flux`): λ̂r with the secant L̂q at
     /// the estimated current, the limiter's and the lock detector's bounds from λ̂a(î).
-    /// None for constant inductances (`lq` and `saliency` then hold).
-    active_flux: Option<ActiveFlux<T>>,
+    /// [`ActiveFlux::saturating`] is None for constant inductances (`lq` and `saliency`
+    /// then hold).
+    active_flux: ActiveFlux<T>,
     /// The configured λ̂f, Wb.
     flux_linkage: T,
     /// `EstimatorTuning::tracker_hold_ratio`.

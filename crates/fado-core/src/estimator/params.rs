@@ -82,10 +82,7 @@ impl<T: Real> EstimatorParams<T> {
             ts,
             lq: config.machine.lq,
             saliency: config.machine.ld - config.machine.lq,
-            active_flux: ActiveFlux::new(
-                config.machine.magnetic_model(),
-                config.machine.rated_current,
-            ),
+            active_flux: ActiveFlux::of(&config.machine),
             flux_linkage: lf,
             tracker_hold_ratio: hold,
             limiter_recentring_gain: if config.tuning.limiter.recentring {
@@ -337,9 +334,6 @@ fn slow_laws<T: Real>(
                 _ => rename("mode_threshold_ratio")(e),
             }
         })?;
-    let active_flux = ActiveFlux::new(
-        config.machine.magnetic_model(),
-        config.machine.rated_current,
-    );
+    let active_flux = ActiveFlux::of(&config.machine);
     Ok((rs_adaptation.with_active_flux(active_flux), offset))
 }

@@ -119,7 +119,7 @@ impl<T: Real> EstimatorState<T> {
         // 3. Rotor flux and direct angle (eq. (20), (5), (6)); a saturating model's secant
         //    L̂q at the current in the frame of λ2 − L̂q⁻·i.
         let lambda2 = stator_flux(lambda1, disturbance);
-        let (lambda_r, point) = match &p.active_flux {
+        let (lambda_r, point) = match p.active_flux.saturating() {
             None => (lambda2 - lq_i, None),
             Some(af) => {
                 let (lambda_r, point) = af.rotor_flux(lambda2, i_ab, self.lq_secant);

@@ -231,7 +231,7 @@ impl SimConfig {
 
     /// The drive's model of the motor derived from the plant: `[motor]` (R̂s: Rs + r_on of
     /// the inverter) scaled by `[mismatch]`, DC link from `[inverter]`.
-    fn derived_model(&self) -> MachineModel<f64> {
+    pub(crate) fn derived_model(&self) -> MachineModel<f64> {
         let (mo, inv, m) = (&self.motor, &self.inverter, &self.mismatch);
         MachineModel {
             rs: (mo.rs + inv.on_resistance) * m.rs_ratio,
@@ -247,25 +247,18 @@ impl SimConfig {
     /// The drive's model: `[model]`'s keys over the derived one, checked; errors name
     /// `model.<key>` for a key the file gives and the plant key it derives from otherwise.
     fn model_checked(&self) -> Result<MachineModel<f64>, SimConfigError> {
-        let derived = self.derived_model();
-        // The magnetic model (`crate::model_magnetics`): `[model.saturation]`, or the plant's.
-        let magnetics = crate::model_magnetics::drive_model(self, self.model.as_ref())?;
-        let Some(table) = &self.model else {
-            return Ok(derived.with_magnetics(magnetics));
+        let (derived, table) = crate::model_magnetics::split(self)?;
+        let Some(table) = table else {
+            return Ok(derived);
         };
-        let mut table = table.clone();
-        for key in crate::model_magnetics::MODEL_MAGNETICS_KEYS {
-            table.remove(key);
-        }
         let mut merged = toml::Table::try_from(derived)
             .map_err(|e| SimConfigError::new("model", e.to_string()))?;
         merge(&mut merged, table);
         let mut model = MachineModel::<f64>::deserialize(toml::Value::Table(merged))
             .map_err(|e| key_error(e).in_section("model"))?;
         model.dc_voltage = self.inverter.dc_voltage;
-        model.magnetics = magnetics;
         model.validate().map_err(|e| self.core_error("model", e))?;
-        Ok(model)
+        Ok(model.with_magnetics(derived.magnetics))
     }
 
     /// The key a user wrote for the model's field `k`: `model.k` when `[model]` gives it,
