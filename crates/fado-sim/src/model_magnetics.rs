@@ -2,7 +2,9 @@
 //! evaluate, and the `'static` flux maps they borrow.
 //!
 //! The rule, as for every other key of `[model]`: the drive's model is the plant's unless the
-//! file says otherwise. `[model.saturation]` gives an algebraic model of its own. A `[model]`
+//! file says otherwise. `[model.saturation]` gives an algebraic model of its own, `[model]
+//! flux_map = "FILE.csv"` a flux map of its own (`crate::magnetics_file`: the format, the
+//! refusals, the path relative to the TOML file). A `[model]`
 //! that sets `ld`, `lq` or `flux_linkage`, or a `[mismatch]` ratio of one of them other than 1,
 //! describes a constant-inductance model (the drive then runs the constant-inductance
 //! arithmetic, as with a linear plant). Otherwise the drive's model is the plant's
@@ -25,7 +27,7 @@ use crate::magnetics::{FluxMapData, PlantMagnetics};
 
 /// The keys of `[model]` that are not `fado_core::MachineModel`'s: taken out of the table
 /// before it is read as one.
-pub const MODEL_MAGNETICS_KEYS: [&str; 1] = ["saturation"];
+pub const MODEL_MAGNETICS_KEYS: [&str; 2] = ["saturation", "flux_map"];
 
 /// The maps leaked so far, in f64 and in f32 (see the module docs).
 type Interned = (
@@ -87,6 +89,9 @@ pub fn drive_model(
         })?;
         return Ok(MachineMagnetics::Saturation(s));
     }
+    if let Some(value) = table.and_then(|t| t.get("flux_map")) {
+        return model_flux_map(value);
+    }
     let gives_constants = table.is_some_and(|t| {
         ["ld", "lq", "flux_linkage"]
             .iter()
@@ -106,18 +111,37 @@ pub fn drive_model(
         .map_or(MachineMagnetics::Linear, plant_model))
 }
 
+/// `[model] flux_map`: the map read, checked and interned; errors name `model.flux_map`.
+fn model_flux_map(value: &toml::Value) -> Result<MachineMagnetics<f64>, SimConfigError> {
+    let rename = |mut e: SimConfigError| {
+        e.key = "model.flux_map".to_owned();
+        e
+    };
+    let Some(written) = value.as_str() else {
+        return Err(SimConfigError::new(
+            "model.flux_map",
+            format!(
+                "must be the path of a CSV file (a string), got a {}",
+                value.type_str()
+            ),
+        ));
+    };
+    let file = crate::magnetics_file::FluxMapFile::read(written).map_err(rename)?;
+    Ok(MachineMagnetics::Map(interned_map(&file.data)))
+}
+
+/// The data of an interned f64 map (`[model] flux_map` or the plant's).
+fn interned_data(map: &FluxMap<'static, f64>) -> Option<&'static FluxMapData> {
+    let interned = INTERNED.lock().unwrap_or_else(|e| e.into_inner());
+    interned.0.iter().find(|(_, m)| m == map).map(|(d, _)| *d)
+}
+
 /// A drive model's magnetics in f32: the saturation model rounded, a map rounded and
 /// interned (None if rounding breaks it: the caller refuses the configuration).
-pub fn to_f32(m: &MachineMagnetics<f64>, cfg: &SimConfig) -> Option<MachineMagnetics<f32>> {
+pub fn to_f32(m: &MachineMagnetics<f64>) -> Option<MachineMagnetics<f32>> {
     match m {
-        MachineMagnetics::Map(_) => {
-            let plant = cfg.plant();
-            match plant.magnetics.as_deref() {
-                Some(PlantMagnetics::Map(data)) => {
-                    interned_map_f32(data).map(MachineMagnetics::Map)
-                }
-                _ => None,
-            }
+        MachineMagnetics::Map(map) => {
+            interned_map_f32(interned_data(map)?).map(MachineMagnetics::Map)
         }
         other => other.cast(),
     }
