@@ -2,12 +2,12 @@
 # Instructions per SensorlessEstimator::step, counted by callgrind (deterministic, unlike
 # wall-clock timings on a shared machine). Each count runs the program for N1 and for N2 steps
 # and divides the difference by N2 - N1, so that start-up and warm-up cancel.
-#  - host build (crates/fado-core/examples/step_driver.rs), f32 and f64: the whole program, and
+#  - host build (dev/src/bin/estimator-step-workload.rs), f32 and f64: the whole program, and
 #    only the instructions inside the out-of-line `isr_step` call (--toggle-collect);
 #  - the freestanding firmware image of tests/embedded (f32, libm maths, LTO), whole program
 #    (its loop adds ~15 instructions of input generation per step);
 #  - f32 inside the step for fado with fixed R̂s, on the paper's path, the paper's method alone
-#    (the Cortex-M image's kernel) and the Ortega baseline (examples/step_driver.rs: FIXED_RS,
+#    (the Cortex-M image's kernel) and the Ortega baseline (dev/src/bin/estimator-step-workload.rs: FIXED_RS,
 #    PAPER_PATH, ESTIMATOR=paper-kernel, ESTIMATOR=ortega).
 # Usage: bash scripts/callgrind.sh   (N1, N2 from the environment; defaults 20000 and 40000)
 set -euo pipefail
@@ -39,8 +39,8 @@ per_step() { # label, then the command (valgrind options, program, args without 
         'BEGIN { printf "%-48s %8.1f instructions/step\n", l, (b - a) / (n2 - n1) }'
 }
 
-cargo build --release --quiet -p fado-core --example step_driver
-driver=target/release/examples/step_driver
+cargo build --release --quiet -p fado-dev --bin estimator-step-workload
+driver=target/release/estimator-step-workload
 image=$(bash scripts/check-no-std.sh --build-only)
 
 echo "callgrind, (Ir(N2) - Ir(N1)) / (N2 - N1) with N1 = $n1, N2 = $n2"

@@ -1,6 +1,6 @@
 //! Replaying a recorded (or simulated) set of signals through the estimator: the loop behind
 //! `fado.estimate` and `Estimator.run`. Plain Rust, no Python: it runs with the GIL released
-//! and is what `examples/replay_speed.rs` times.
+//! and is what `dev/src/bin/replay-speed.rs` times.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 

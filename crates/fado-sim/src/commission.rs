@@ -10,11 +10,14 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
-use fado_core::MachineModel;
-use fado_core::commissioning::{Commissioning, CommissioningConfig, Identification, Phase, Status};
+use fado_core::commissioning::{
+    Commissioning, CommissioningConfig, CommissioningOutput, Identification, Phase, Status,
+};
+use fado_core::{Ab, MachineModel};
 use serde::Serialize;
 
 use crate::error::SimConfigError;
+use crate::motor::MotorState;
 use crate::sim::{Plant, PlantParams};
 
 /// The plant's true values of what commissioning identifies.
@@ -201,12 +204,10 @@ pub fn commission(
     let mut proc = Commissioning::new(cfg).map_err(|e| procedure_error(&e))?;
     preconditions(plant_params, &cfg)?;
     let pp = plant_params.motor.pole_pairs as f64;
-    let rpm = 60.0 / std::f64::consts::TAU;
     let start = Instant::now();
     let n_max = (options.max_seconds / ts) as u64;
     let mut trace = Vec::new();
-    let (mut max_i, mut max_ref, mut motion) = (0.0f64, 0.0f64, 0.0f64);
-    let mut theta_l: Option<f64> = None;
+    let mut watch = Watch::default();
     let mut last_progress = -1.0;
     let mut k = 0u64;
     let mut cancelled = false;
@@ -214,28 +215,9 @@ pub fn commission(
         let (i_abc, vdc, _) = plant.measure();
         let out = proc.step(i_abc, vdc);
         let st = *plant.motor().state();
-        max_i = max_i.max(st.i_dq.norm());
-        max_ref = max_ref.max(out.current_reference.norm());
-        if matches!(out.phase, Phase::InductanceD | Phase::InductanceQ) {
-            let t0 = *theta_l.get_or_insert(st.theta);
-            motion = motion.max(fado_core::wrap_angle(st.theta - t0).abs());
-        }
+        watch.observe(&st, &out);
         if k.is_multiple_of(options.decimation.max(1) as u64) {
-            let i = i_abc.to_ab();
-            trace.push(TraceRow {
-                time: plant.time(),
-                phase: out.phase.index() as u8,
-                i_alpha: i.alpha,
-                i_beta: i.beta,
-                v_alpha: out.v_ab.alpha,
-                v_beta: out.v_ab.beta,
-                v_applied_alpha: plant.last_outcome().v_ab_avg.alpha,
-                v_applied_beta: plant.last_outcome().v_ab_avg.beta,
-                speed_rpm: st.omega_mech * rpm,
-                speed_hat_rpm: out.speed / pp * rpm,
-                theta: st.theta,
-                theta_hat: out.angle,
-            });
+            trace.push(TraceRow::of(&plant, &out, i_abc.to_ab(), &st, pp));
         }
         if let Some(cb) = progress.as_mut()
             && out.progress - last_progress >= 0.005
@@ -266,12 +248,62 @@ pub fn commission(
         trace,
         simulated_seconds: k as f64 * ts,
         wall_seconds: start.elapsed().as_secs_f64(),
-        max_current: max_i,
-        max_current_reference: max_ref,
+        max_current: watch.max_i,
+        max_current_reference: watch.max_ref,
         current_limit: proc.current_limit(),
-        rotor_motion_inductance: motion,
+        rotor_motion_inductance: watch.motion,
         cancelled,
     })
+}
+
+/// What a run watches beyond the procedure's output: the largest current and current
+/// reference, and the rotor's motion during the inductance tests.
+#[derive(Default)]
+struct Watch {
+    max_i: f64,
+    max_ref: f64,
+    motion: f64,
+    /// The rotor's angle at the start of the inductance tests.
+    theta_l: Option<f64>,
+}
+
+impl Watch {
+    fn observe(&mut self, st: &MotorState, out: &CommissioningOutput<f64>) {
+        self.max_i = self.max_i.max(st.i_dq.norm());
+        self.max_ref = self.max_ref.max(out.current_reference.norm());
+        if matches!(out.phase, Phase::InductanceD | Phase::InductanceQ) {
+            let t0 = *self.theta_l.get_or_insert(st.theta);
+            self.motion = self.motion.max(fado_core::wrap_angle(st.theta - t0).abs());
+        }
+    }
+}
+
+impl TraceRow {
+    /// The row of the sample the plant has just measured (`i`: the measured α-β current) and
+    /// the procedure's `out`; `pp` pole pairs.
+    fn of(
+        plant: &Plant,
+        out: &CommissioningOutput<f64>,
+        i: Ab<f64>,
+        st: &MotorState,
+        pp: f64,
+    ) -> Self {
+        let rpm = 60.0 / std::f64::consts::TAU;
+        TraceRow {
+            time: plant.time(),
+            phase: out.phase.index() as u8,
+            i_alpha: i.alpha,
+            i_beta: i.beta,
+            v_alpha: out.v_ab.alpha,
+            v_beta: out.v_ab.beta,
+            v_applied_alpha: plant.last_outcome().v_ab_avg.alpha,
+            v_applied_beta: plant.last_outcome().v_ab_avg.beta,
+            speed_rpm: st.omega_mech * rpm,
+            speed_hat_rpm: out.speed / pp * rpm,
+            theta: st.theta,
+            theta_hat: out.angle,
+        }
+    }
 }
 
 /// A refusal of the procedure's configuration, named by the key the user writes: the

@@ -365,6 +365,15 @@ impl Comparison {
     /// `lowspeed` staircase and, when fado ran, every place where a baseline did better.
     pub fn to_markdown(&self) -> String {
         let mut s = String::new();
+        self.push_runs(&mut s);
+        self.push_summary(&mut s);
+        self.push_staircase(&mut s);
+        self.push_beaten(&mut s);
+        s
+    }
+
+    /// The set-up line and one row per run.
+    fn push_runs(&self, s: &mut String) {
         let yes = |b: bool| if b { "yes" } else { "**no**" };
         let near = |r: &CompareRow, x: f64| {
             if r.zero_speed_samples > 0 {
@@ -398,6 +407,10 @@ impl Comparison {
                 if r.tripped { "**yes**" } else { "no" },
             ));
         }
+    }
+
+    /// One row per estimator: scenarios passed, lowest speed held, step cost.
+    fn push_summary(&self, s: &mut String) {
         s.push_str(
             "\n| estimator | scenarios passed | passed (common checks) | lowest speed held \
              under 7.5 N·m (r/min) | f32 step, criterion median (ns) |\n\
@@ -425,6 +438,10 @@ impl Comparison {
                 )),
             ));
         }
+    }
+
+    /// The `lowspeed` staircase level by level, one column per estimator (when it ran).
+    fn push_staircase(&self, s: &mut String) {
         let staircase: Vec<_> = self
             .rows
             .iter()
@@ -456,6 +473,10 @@ impl Comparison {
                 s.push('\n');
             }
         }
+    }
+
+    /// Where a baseline does better than fado.
+    fn push_beaten(&self, s: &mut String) {
         let beaten = self.where_fado_is_beaten();
         if !beaten.is_empty() {
             s.push_str("\nWhere a baseline does better than fado in this run:\n\n");
@@ -463,7 +484,6 @@ impl Comparison {
                 s.push_str(&format!("- {line}\n"));
             }
         }
-        s
     }
 
     /// Every (scenario, baseline) where the baseline passes a criterion fado fails, has a

@@ -64,15 +64,57 @@ fn section_location(text: &str, section: &str) -> Option<SourceLocation> {
 /// missing key, located at the `[motor]` header of `text`; a given key that is not a positive
 /// finite number is left to the validation, which names it at its value.
 pub fn complete_motor(user: &mut toml::Table, text: &str) -> Result<Vec<Derived>, SimConfigError> {
+    let Some(mut motor) = completable_motor(user) else {
+        return Ok(Vec::new());
+    };
+    check_required(&motor, text)?;
+    let mut derived = Vec::new();
+    let mut put = |table: &mut toml::Table, section: &str, key: &str, value: f64| {
+        table.insert(key.to_owned(), toml::Value::Float(value));
+        let full = format!("{section}.{key}");
+        derived.push(Derived {
+            rule: ratings::rule(&full).unwrap_or(""),
+            key: full,
+            value,
+        });
+    };
+    let num = |t: &toml::Table, k: &str| number(t, k).unwrap_or(0.0);
+    let (torque, speed) = (num(&motor, "rated_torque"), num(&motor, "rated_speed_rpm"));
+    for key in DERIVABLE_MOTOR_KEYS {
+        if !motor.contains_key(key) {
+            let value = match key {
+                "inertia" => ratings::inertia(torque, speed),
+                _ => ratings::viscous_friction(torque, speed),
+            };
+            put(&mut motor, "motor", key, value);
+        }
+    }
+    let machine = machine_of(&motor);
+    let mut inverter = match user.get("inverter") {
+        Some(toml::Value::Table(t)) => t.clone(),
+        _ => toml::Table::new(),
+    };
+    for (key, value) in inverter_values(&machine, &inverter) {
+        put(&mut inverter, "inverter", key, value);
+    }
+    user.insert("motor".into(), toml::Value::Table(motor));
+    user.insert("inverter".into(), toml::Value::Table(inverter));
+    Ok(derived)
+}
+
+/// The user's `[motor]` when it is to be completed: none when there is no motor table (or one
+/// holding only `[motor.saturation]`, taken out before: the scenario's motor), nor when a given
+/// value is not usable (the validation names it at its own value).
+fn completable_motor(user: &toml::Table) -> Option<toml::Table> {
     // No motor table, or one holding only `[motor.saturation]` (taken out before): the
     // scenario's motor.
     let Some(toml::Value::Table(motor)) = user.get("motor").filter(|m| {
         m.as_table()
             .is_some_and(|t| t.keys().any(|k| k != "saturation"))
     }) else {
-        return Ok(Vec::new());
+        return None;
     };
-    let mut motor = motor.clone();
+    let motor = motor.clone();
     // A given value that is not usable is named by the validation at its own value.
     let given_ok = |k: &str| {
         let max = fado_core::machine_checks::RANGES
@@ -83,15 +125,21 @@ pub fn complete_motor(user: &mut toml::Table, text: &str) -> Result<Vec<Derived>
     };
     for key in ratings::REQUIRED_MOTOR_KEYS {
         if motor.contains_key(key) && !given_ok(key) {
-            return Ok(Vec::new());
+            return None;
         }
     }
     let given_bad = |k: &str| {
         motor.contains_key(k) && !number(&motor, k).is_some_and(|x| x.is_finite() && x >= 0.0)
     };
     if DERIVABLE_MOTOR_KEYS.iter().any(|k| given_bad(k)) {
-        return Ok(Vec::new());
+        return None;
     }
+    Some(motor)
+}
+
+/// Every circuit key and rating is given: else an error naming every missing key, located at
+/// the `[motor]` header of `text`.
+fn check_required(motor: &toml::Table, text: &str) -> Result<(), SimConfigError> {
     let missing: Vec<&str> = ratings::REQUIRED_MOTOR_KEYS
         .iter()
         .copied()
@@ -121,51 +169,26 @@ pub fn complete_motor(user: &mut toml::Table, text: &str) -> Result<Vec<Derived>
         e.location = section_location(text, "motor");
         return Err(e);
     }
-    let mut derived = Vec::new();
-    let mut put = |table: &mut toml::Table, section: &str, key: &str, value: f64| {
-        table.insert(key.to_owned(), toml::Value::Float(value));
-        let full = format!("{section}.{key}");
-        derived.push(Derived {
-            rule: ratings::rule(&full).unwrap_or(""),
-            key: full,
-            value,
-        });
-    };
+    Ok(())
+}
+
+/// The machine model of a completed `[motor]` (no DC link).
+fn machine_of(motor: &toml::Table) -> MachineModel<f64> {
     let num = |t: &toml::Table, k: &str| number(t, k).unwrap_or(0.0);
-    let (torque, speed) = (num(&motor, "rated_torque"), num(&motor, "rated_speed_rpm"));
-    for key in DERIVABLE_MOTOR_KEYS {
-        if !motor.contains_key(key) {
-            let value = match key {
-                "inertia" => ratings::inertia(torque, speed),
-                _ => ratings::viscous_friction(torque, speed),
-            };
-            put(&mut motor, "motor", key, value);
-        }
-    }
-    let machine = MachineModel::<f64> {
-        rs: num(&motor, "rs"),
-        ld: num(&motor, "ld"),
-        lq: num(&motor, "lq"),
-        flux_linkage: num(&motor, "flux_linkage"),
-        pole_pairs: num(&motor, "pole_pairs") as u32,
-        inertia: num(&motor, "inertia"),
-        viscous_friction: num(&motor, "viscous_friction"),
-        rated_current: num(&motor, "rated_current"),
-        rated_speed_rpm: speed,
-        rated_torque: torque,
+    MachineModel::<f64> {
+        rs: num(motor, "rs"),
+        ld: num(motor, "ld"),
+        lq: num(motor, "lq"),
+        flux_linkage: num(motor, "flux_linkage"),
+        pole_pairs: num(motor, "pole_pairs") as u32,
+        inertia: num(motor, "inertia"),
+        viscous_friction: num(motor, "viscous_friction"),
+        rated_current: num(motor, "rated_current"),
+        rated_speed_rpm: num(motor, "rated_speed_rpm"),
+        rated_torque: num(motor, "rated_torque"),
         dc_voltage: 0.0,
         magnetics: Default::default(),
-    };
-    let mut inverter = match user.get("inverter") {
-        Some(toml::Value::Table(t)) => t.clone(),
-        _ => toml::Table::new(),
-    };
-    for (key, value) in inverter_values(&machine, &inverter) {
-        put(&mut inverter, "inverter", key, value);
     }
-    user.insert("motor".into(), toml::Value::Table(motor));
-    user.insert("inverter".into(), toml::Value::Table(inverter));
-    Ok(derived)
 }
 
 /// The `[inverter]` keys `given` lacks that `machine`'s ratings give, in dependency order

@@ -31,6 +31,7 @@ presets!(
     "hub-hoverboard-48v",
     "ipmsm-2k2",
     "ipmsm-gem-50k",
+    "multirotor-mn5006-22v",
     "outrunner-cheetah-24v",
     "paper",
     "pmsyrm-5k",

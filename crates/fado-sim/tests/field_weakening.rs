@@ -95,3 +95,15 @@ fn the_speed_limit_holds_the_speed_at_twice_the_rated_one() {
     assert!((speed - 3000.0).abs() < 0.02 * 1500.0, "{speed}");
     assert!(angle < 0.25, "{angle}");
 }
+
+#[test]
+fn servo_holds_rated_power_at_the_largest_omega_ts_of_the_presets() {
+    // servo-1ft6084 at 2 × 4500 r/min: ω·Ts = 4·942.5·1e-4 = 0.377 rad per sample, the
+    // largest any preset reaches in `fullrange` (paper 0.126, outrunner 0.198): the
+    // estimator's discretisation (exact internal model of the observer, held voltage,
+    // trapezoidal resistive drop) keeps the angle there, at the rated 6.6 kW.
+    let (speed, angle, tripped) = run(&motor("servo-1ft6084.toml"), 9000.0, 6597.0, "");
+    assert!(!tripped);
+    assert!((speed - 9000.0).abs() < 0.02 * 4500.0, "{speed}");
+    assert!(angle < 0.1, "{angle}");
+}

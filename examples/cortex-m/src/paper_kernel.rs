@@ -260,7 +260,7 @@ fn kernel_sample(k: &mut PaperKernel, v_ab: Ab<f32>, i_ab: Ab<f32>, g: &Gains) -
 /// `i_ab` the current now; returns θ̂ (rad, in [−π, π]).
 #[inline(never)]
 // Unmangled in the image, where the cost script finds it by name; the host build
-// (`crates/fado-core/examples/step_driver.rs`, `ESTIMATOR=paper-kernel`) has no such need.
+// (`dev/src/bin/estimator-step-workload.rs`, `ESTIMATOR=paper-kernel`) has no such need.
 #[cfg_attr(target_os = "none", unsafe(no_mangle))]
 pub fn paper_kernel_step(k: &mut PaperKernel, v_ab: Ab<f32>, i_ab: Ab<f32>) -> f32 {
     let g = DiscreteGains::new(k.omega1, k.ts);
@@ -282,7 +282,7 @@ pub fn paper_kernel_step(k: &mut PaperKernel, v_ab: Ab<f32>, i_ab: Ab<f32>) -> f
 /// period (docs/results/firmware-cost.md).
 #[inline(never)]
 // Unmangled in the image, where the cost script finds it by name; the host build
-// (`crates/fado-core/examples/step_driver.rs`, `ESTIMATOR=paper-kernel`) has no such need.
+// (`dev/src/bin/estimator-step-workload.rs`, `ESTIMATOR=paper-kernel`) has no such need.
 #[cfg_attr(target_os = "none", unsafe(no_mangle))]
 pub fn paper_kernel_held_step(k: &mut PaperKernel, v_ab: Ab<f32>, i_ab: Ab<f32>) -> f32 {
     let held = Gains {

@@ -174,22 +174,19 @@ fn nearest_on_hexagon<T: Real>(v: Ab<T>, span: T) -> Ab<T> {
     let c30 = T::lit(0.866_025_403_784_438_6);
     let half = T::lit(0.5);
     // Projections on the normals at 30°, 90° and 150° (the other three are their negatives).
-    let d = [
-        (c30, half, v.alpha * c30 + v.beta * half),
-        (T::zero(), T::one(), v.beta),
-        (-c30, half, -v.alpha * c30 + v.beta * half),
-    ];
-    let mut best = d[0];
-    for &k in &d[1..] {
-        if k.2.abs() > best.2.abs() {
-            best = k;
-        }
+    let d1 = v.alpha * c30 + v.beta * half;
+    let d2 = v.beta;
+    let d3 = -v.alpha * c30 + v.beta * half;
+    let (mut nx, mut ny, mut dot) = (c30, half, d1);
+    if d2.abs() > dot.abs() {
+        (nx, ny, dot) = (T::zero(), T::one(), d2);
     }
-    let (nx, ny) = if best.2 < T::zero() {
-        (-best.0, -best.1)
-    } else {
-        (best.0, best.1)
-    };
+    if d3.abs() > dot.abs() {
+        (nx, ny, dot) = (-c30, half, d3);
+    }
+    if dot < T::zero() {
+        (nx, ny) = (-nx, -ny);
+    }
     // Inscribed radius span/√3, half an edge span/3; tangent (−ny, nx).
     let radius = span * T::lit(0.577_350_269_189_625_8);
     let half_edge = span / T::lit(3.0);

@@ -286,7 +286,8 @@ mod tests {
     use super::*;
 
     /// A rigid rotor θ̈ = b·(i − i_L) under the hold with an exact angle estimate: a step
-    /// of the rated load at t = 0. Returns (largest travel, final error, final i).
+    /// of the rated load at t = 0, until the hold hands over. Returns (largest travel, the
+    /// angle error at the hand-over, the torque handed over).
     fn rollback(machine: &MachineModel<f64>, travel: f64) -> (f64, f64, f64) {
         let ts = 1e-4;
         let tuning = ReleaseHoldTuning {
@@ -302,14 +303,16 @@ mod tests {
         h.arm(0.3);
         let mut worst: f64 = 0.0;
         for _ in 0..20_000 {
-            if let HoldAction::Hold(x) = h.step(0.0, theta, theta) {
-                i = x;
+            match h.step(0.0, theta, theta) {
+                HoldAction::Hold(x) => i = x,
+                HoldAction::Handover(x) => return (worst, theta - 0.3, x),
+                HoldAction::Idle => {}
             }
             omega += b * (i - i_load) * ts;
             theta += omega * ts;
             worst = worst.max(0.3 - theta);
         }
-        (worst, theta - 0.3, i)
+        panic!("no hand-over")
     }
 
     #[test]
@@ -319,10 +322,11 @@ mod tests {
         for m in [MachineModel::paper(), light] {
             let (worst, end, i) = rollback(&m, 0.2);
             // The paper's rotor: 0.19 rad for the 0.2 rad design; the light one, where ω_h is
-            // capped at a tenth of the current loop's bandwidth: 0.47 rad.
+            // capped at a tenth of the current loop's bandwidth: 0.47 rad. After 10/ω_h the
+            // rotor is back (the triple pole's 0.3 % residue) and the integral is the load.
             assert!(worst > 0.1 && worst < 0.5, "{worst}");
-            assert!(end.abs() < 1e-3, "{end}");
-            assert!((i - m.rated_current).abs() < 1e-3 * m.rated_current, "{i}");
+            assert!(end.abs() < 0.01 * worst, "{end}");
+            assert!((i - m.rated_current).abs() < 0.01 * m.rated_current, "{i}");
         }
     }
 

@@ -67,8 +67,8 @@ impl<T: Real> DriveConfig<T> {
             i2
         };
         let i1 = T::lit(0.5) * i2;
-        let hold = T::lit(GAIN_CALIBRATION_HOLD_TIME_CONSTANTS)
-            * crate::real::max(swing_time_constant(m, i1), swing_time_constant(m, i2));
+        let swing = crate::real::max(swing_time_constant(m, i1), swing_time_constant(m, i2));
+        let hold = swing_hold_time_constants(m, i1, swing, t) * swing;
         let rename = |e: ConfigError| match e {
             ConfigError::OutOfRange { field, expected } => ConfigError::OutOfRange {
                 field: gain_field(field),
@@ -128,6 +128,53 @@ const GAIN_CALIBRATION_SETTLE_TIME_CONSTANTS: f64 = 5.0;
 /// 2.8e-3 on the paper's motor; a fixed rotor gives 4e-6).
 const GAIN_CALIBRATION_HOLD_TIME_CONSTANTS: f64 = 4.0;
 
+/// Fraction of the sensors' gain mismatch |k − 1| that the rotor's swing may leave in the
+/// measured k on a machine held for fewer than [`GAIN_CALIBRATION_HOLD_TIME_CONSTANTS`]
+/// (see [`swing_hold_time_constants`]): 0.2 \[A\], the accuracy the calibrated presets
+/// measure with the full hold (at least 77 % of a 0.5 % mismatch removed,
+/// `crates/fado-sim/tests/gain_calibration.rs`).
+const SWING_BIAS_FRACTION: f64 = 0.2;
+
+/// The hold of a gain-calibration level in time constants of the rotor's swing `swing` (s):
+/// [`GAIN_CALIBRATION_HOLD_TIME_CONSTANTS`] where that fits [`GAIN_CALIBRATION_MAX_HOLD_TIME`];
+/// beyond, the fewest quarter time constants (at least one) after which the swing's bias on k
+/// is bounded by [`SWING_BIAS_FRACTION`] of the mismatch it measures, if that is fewer.
+///
+/// The bound: over the averaging window W the swing's back-EMF averages to λ̂f·Δθ/W, Δθ the
+/// rotor's travel over the window, at most twice the swing's amplitude left after the hold,
+/// A·e^(−n). A is the shift of the rotor's equilibrium, the angle between the measured current
+/// the loop puts on the axis and the true one, (2/√3)·|k − 1|·|cos φ·cos(φ + π/3)| ≤
+/// 0.87·|k − 1| (module docs of [`crate::control::gain_calibration`]). Against each phase's
+/// voltage step R̂s·I₁·|cos(φ − φ_x)| ≥ R̂s·I₁·s_min (s_min the least phase share the
+/// calibration runs at, `gain_calibration_min_observability`), the two phases' bias is at
+/// most 4·0.87·λ̂f·|k − 1|·e^(−n)/(R̂s·I₁·s_min·W), below ε·|k − 1| for
+/// e^(−n) ≤ ε·R̂s·I₁·s_min·W/(3.46·λ̂f). It is small on a low-flux motor, whose magnet flux is
+/// small against its resistive drop: the 14-pole-pair multirotor preset (λ̂f 0.88 mWb,
+/// R̂s·I₁ 0.5 V) needs 1.25 time constants, the paper's motor more than 4.
+fn swing_hold_time_constants<T: Real>(
+    m: &MachineModel<T>,
+    i1: T,
+    swing: T,
+    t: &DriveTuning<T>,
+) -> T {
+    let full = T::lit(GAIN_CALIBRATION_HOLD_TIME_CONSTANTS);
+    if full * swing <= T::lit(GAIN_CALIBRATION_MAX_HOLD_TIME) {
+        return full;
+    }
+    let bound = T::lit(SWING_BIAS_FRACTION / (4.0 * 0.87))
+        * m.rs
+        * i1
+        * t.gain_calibration_min_observability
+        * t.gain_calibration_time
+        / m.flux_linkage;
+    let mut n = T::one();
+    // e^(−n) = 1 − (1 − e^(−n)); quarter steps up to the full hold.
+    while n < full && T::one() - n.step_one_minus_exp_neg() > bound {
+        n += T::lit(0.25);
+    }
+    n
+}
+
 /// Longest hold of a gain-calibration level, s \[A\]: a start-up budget (with it the whole
 /// calibration takes at most about 0.5 s plus the settling). A rotor whose swing needs longer
 /// is not calibrated (status `TooSlow`): averaged before the swing has died out, the
@@ -165,5 +212,54 @@ fn gain_field(field: &'static str) -> &'static str {
         "settle_time" | "hold_time" | "max_hold_time" => "current_bandwidth_hz",
         "current_limit" => "current_limit_ratio",
         f => f,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The 14-pole-pair multirotor outrunner of `motors/multirotor-mn5006-22v.toml` with the
+    /// inertia `j` (kg·m²).
+    fn multirotor(j: f64) -> MachineModel<f64> {
+        MachineModel {
+            rs: 0.030,
+            ld: 8e-6,
+            lq: 8e-6,
+            flux_linkage: 8.75e-4,
+            pole_pairs: 14,
+            inertia: j,
+            viscous_friction: 7.5e-6,
+            rated_current: 34.0,
+            rated_speed_rpm: 8000.0,
+            rated_torque: 0.625,
+            dc_voltage: 22.2,
+            ..MachineModel::paper()
+        }
+    }
+
+    #[test]
+    fn a_slow_swing_on_a_low_flux_motor_is_held_for_what_its_bias_bound_needs() {
+        let t = DriveTuning::<f64>::default();
+        // The paper's motor: 4 time constants fit the budget (0.17 s), unchanged.
+        let m = MachineModel::<f64>::paper();
+        let i1 = 0.5 * m.rated_current;
+        let swing = swing_time_constant(&m, i1).max(swing_time_constant(&m, 2.0 * i1));
+        assert_eq!(swing_hold_time_constants(&m, i1, swing, &t), 4.0);
+        // The multirotor motor with a 15-inch propeller (3.4e-4 kg·m²): τ = 91 ms, 4τ = 0.36 s
+        // beyond the budget; its bias bound needs 1.25 τ, 0.11 s.
+        let m = multirotor(3.4e-4);
+        let i1 = 0.5 * m.rated_current;
+        let swing = swing_time_constant(&m, i1).max(swing_time_constant(&m, 2.0 * i1));
+        assert!((swing - 0.0906).abs() < 1e-3, "{swing}");
+        let n = swing_hold_time_constants(&m, i1, swing, &t);
+        assert_eq!(n, 1.25);
+        assert!(n * swing <= GAIN_CALIBRATION_MAX_HOLD_TIME);
+        // The bound it meets and the quarter below it does not.
+        let bound = SWING_BIAS_FRACTION / (4.0 * 0.87) * m.rs * i1 * 0.2 * 0.05 / m.flux_linkage;
+        assert!(
+            (-n).exp() <= bound && (-(n - 0.25)).exp() > bound,
+            "{bound}"
+        );
     }
 }

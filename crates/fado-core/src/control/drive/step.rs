@@ -256,14 +256,9 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
     fn estimate(&mut self, i_ab: Ab<T>) -> Result<Estimate<T>, DriveOutput<T>> {
         self.i_ab_used = i_ab;
         if self.config.tuning.acceleration_feedforward {
-            // p·T*/Ĵ with the model's torque of the last reference, 1.5·p·λ̂a·i_q*.
             let m = &self.config.machine;
             let p = T::lit(m.pole_pairs as f64);
-            let i = self.last.i_dq_ref;
-            let torque = match &self.resolved.saturated {
-                Some(s) => T::lit(1.5) * p * s.torque_flux(i),
-                None => T::lit(1.5) * p * m.active_flux(i.d) * i.q,
-            };
+            let torque = self.feedforward_torque(p);
             self.estimator.set_acceleration(p * torque / m.inertia);
         }
         let estimate = self.estimator.step(self.history[1], i_ab);
@@ -283,6 +278,33 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         }
         self.last_i_ab = i_ab;
         Ok(estimate)
+    }
+
+    /// The torque fed forward to the trackers (N·m): the model's torque of the last
+    /// reference, 1.5·p·λ̂a·i_q*; in field weakening (the loop's Δi_d < 0, hence in
+    /// disturbance-feedback mode) the torque of the last sample's estimated stator flux and
+    /// current, 1.5·p·(λ̂2 × i), which holds for any rotor and does not depend on θ̂. The
+    /// reference's torque misses what an angle error δ adds: in the estimated frame the d
+    /// current gives the rotor −1.5·p·λ̂f·i_d·sin δ more, an acceleration that grows with δ
+    /// and, deep in field weakening on a light rotor, outruns the trackers (docs/range.md,
+    /// "Current-limited transients").
+    #[inline(always)]
+    fn feedforward_torque(&self, p: T) -> T {
+        let last = &self.last;
+        let d = &last.estimate.diagnostics;
+        if self.blocks.field_weakening.delta_id() < T::zero() && d.mode == Mode::DisturbanceFeedback
+        {
+            let (l, i) = (d.lambda2, last.i_ab);
+            let torque = T::lit(1.5) * p * (l.alpha * i.beta - l.beta * i.alpha);
+            if torque.is_finite() {
+                return torque;
+            }
+        }
+        let i = last.i_dq_ref;
+        match &self.resolved.saturated {
+            Some(s) => T::lit(1.5) * p * s.torque_flux(i),
+            None => T::lit(1.5) * p * self.config.machine.active_flux(i.d) * i.q,
+        }
     }
 
     /// Step 4: the current reference, the speed PI's torque demand, the injection (23), MTPA and

@@ -101,8 +101,9 @@ pub struct DriveTuning<T> {
     /// window in s; 0 disables the calibration. The current loop settles for
     /// 5·max(L̂d/R̂s, 1/ωc) (five time constants of the stator or of the current loop,
     /// whichever is slower), and each level holds 4 time constants of the rotor's swing
-    /// (`swing_time_constant`) before it is averaged; a machine needing a hold above 0.2 s is
-    /// skipped. Default 0.05 s \[A\] (500 samples at 10 kHz: 10 mA rms of noise averages to
+    /// (`swing_time_constant`) before it is averaged, fewer where that exceeds 0.2 s and the
+    /// swing's bias bound allows (`swing_hold_time_constants`, a low-flux motor); a machine
+    /// needing a hold above 0.2 s is skipped. Default 0.05 s \[A\] (500 samples at 10 kHz: 10 mA rms of noise averages to
     /// 0.45 mA, 0.02 % of the lower level's phase-b current at the observability limit on the
     /// paper's motor). A 0.5 % mismatch walks θ̂ at loaded standstill on a low-flux motor
     /// (README: the outrunner preset lost `reversal` and `stops`, 1.2 rad). Start-up added on

@@ -4,7 +4,7 @@
 //! /proc/thread-self/schedstat on Linux). Each figure is the best of five runs, since the
 //! machine may be shared.
 //!
-//! `cargo run --release -p fado-sim --example sim_speed`
+//! `cargo run --release -p fado-dev --bin simulation-speed`
 
 use std::time::Instant;
 

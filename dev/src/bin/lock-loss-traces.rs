@@ -2,7 +2,7 @@
 //! dumps every trace column (f32, little-endian, `TraceRow::COLUMNS` order) in a time window,
 //! one `DIR/point-N.f32` per point, to study loss-of-lock symptoms offline.
 //!
-//! usage: lock_probe CONFIG.toml SWEEP.csv OUT_DIR T_START T_END [POINT ...]   (no point: all)
+//! usage: lock-loss-traces CONFIG.toml SWEEP.csv OUT_DIR T_START T_END [POINT ...]   (no point: all)
 use fado_sim::sim::{TraceRow, TraceSink};
 use fado_sim::sweep::{Value, point_config};
 use std::io::Write;

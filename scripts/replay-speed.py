@@ -1,9 +1,9 @@
-"""Speed of ``fado.estimate`` on the recording of ``replay_speed.rs`` (the Rust reference).
+"""Speed of ``fado.estimate`` on the recording of ``dev/src/bin/replay-speed.rs`` (the Rust reference).
 
 Run both on the same machine, one after the other::
 
-    cargo run --release -p fado-py --example replay_speed
-    python crates/fado-py/examples/replay_speed.py
+    cargo run --release -p fado-dev --bin replay-speed
+    python scripts/replay-speed.py
 
 Prints the best of several runs in ns per sample for ``estimate`` in float64 and float32,
 and for stepping ``Estimator.step`` from a Python loop (the per-call overhead).
@@ -27,7 +27,7 @@ REPEATS = 5
 
 
 def recording(n: int) -> list[np.ndarray]:
-    """The same spin-up as replay_speed.rs: 0 → 20 Hz electrical in 0.3 s, i_q = 10 A."""
+    """The same spin-up as replay-speed.rs: 0 → 20 Hz electrical in 0.3 s, i_q = 10 A."""
     k = np.arange(n)
     omega = 2 * np.pi * 20.0 * np.minimum(k * TS / 0.3, 1.0)
     theta = 0.3 + TS * np.concatenate(([0.0], np.cumsum(omega)))

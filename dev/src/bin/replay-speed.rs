@@ -1,5 +1,5 @@
 //! The pure-Rust reference for the speed of `fado.estimate`: the same synthetic recording as
-//! `replay_speed.py` (a rotor spinning up to 20 Hz electrical under 10 A, 1 million samples
+//! `scripts/replay-speed.py` (a rotor spinning up to 20 Hz electrical under 10 A, 1 million samples
 //! at 10 kHz), replayed two ways:
 //!
 //! - `step loop`: `SensorlessEstimator::step` per sample, outputs only folded into a checksum
@@ -9,7 +9,7 @@
 //!   cost of writing ~100 bytes per sample into fresh memory (page faults dominate it).
 //!
 //! Prints the best of several runs in ns per sample, for f64 and f32:
-//! `cargo run --release -p fado-py --example replay_speed [-- SAMPLES]`.
+//! `cargo run --release -p fado-dev --bin replay-speed [-- SAMPLES]`.
 
 use std::hint::black_box;
 use std::time::Instant;

@@ -3,7 +3,7 @@
 //! set-up and warm-up cancel).
 //!
 //! ```text
-//! cargo run --release -p fado-core --example step_driver -- f32 100000
+//! cargo run --release -p fado-dev --bin estimator-step-workload -- f32 100000
 //! FIXED_RS=1 cargo run ...   # the paper's fixed R̂s (rs_adaptation = false)
 //! PAPER_PATH=1 cargo run ...  # fado on the paper's path (every fado addition that can be off)
 //! LEAN=1 cargo run ...        # `step_lean`, the firmware's call (no diagnostics record)
@@ -140,7 +140,7 @@ fn main() {
         "f32" => run::<f32>(steps, ortega),
         "f64" => run::<f64>(steps, ortega),
         other => {
-            eprintln!("usage: step_driver <f32|f64> <N>  (got {other:?})");
+            eprintln!("usage: estimator-step-workload <f32|f64> <N>  (got {other:?})");
             std::process::exit(2);
         }
     };
