@@ -128,3 +128,18 @@ def test_bad_shapes_are_refused() -> None:
     assert "four" in str(refusal((i_d, i_q, psi_d)))
     assert "shapes" in str(refusal((i_d, i_q, psi_d.T, psi_q.T)))
     assert "increase" in str(refusal((i_d, i_q, psi_d[::-1], psi_q)))
+
+
+@pytest.mark.parametrize("dtype", ["float64", "float32"])
+def test_estimate_uses_the_machines_map(dtype: str) -> None:
+    # The plant's own signals, replayed through a model with and without the map.
+    every_sample = {"simulation": {"duration": 0.3, "decimation": 1}}
+    run = fado.simulate("reversal", every_sample, motor=fado.Machine(**IPMSM, flux_map=grid()))
+    tr = run.traces
+    signals = (tr["v_alpha_ref"], tr["v_beta_ref"], tr["i_alpha"], tr["i_beta"])
+    ts = float(tr["time"][1] - tr["time"][0])
+    mapped = fado.Machine(**IPMSM, flux_map=grid())
+    with_map = fado.estimate(*signals, machine=mapped, ts=ts, dtype=dtype)
+    linear = fado.estimate(*signals, machine=fado.Machine(**IPMSM), ts=ts, dtype=dtype)
+    assert np.all(np.isfinite(with_map.theta))
+    assert not np.array_equal(with_map.theta, linear.theta)

@@ -92,9 +92,26 @@ impl Setup {
         })
     }
 
-    fn core<T: Scalar>(&self, py: Python<'_>) -> PyResult<fado_core::EstimatorConfig<T>> {
-        self.tuning
-            .estimator_config(py, self.ts, &self.machine.to_core(), self.initial_angle)
+    /// The core configuration; a machine's flux map becomes its model's magnetics.
+    fn core<T: Scalar + 'static>(&self, py: Python<'_>) -> PyResult<fado_core::EstimatorConfig<T>> {
+        let mut c = self.tuning.estimator_config(
+            py,
+            self.ts,
+            &self.machine.to_core(),
+            self.initial_angle,
+        )?;
+        if let Some(m) = self.machine.flux_map() {
+            c.machine.magnetics = crate::flux_map::machine_magnetics(m).ok_or_else(|| {
+                crate::errors::config_error_message(
+                    py,
+                    crate::flux_map::FLUX_MAP,
+                    "`flux_map`: the map does not stay strictly monotonic rounded to float32"
+                        .to_owned(),
+                )
+            })?;
+            c.validate().map_err(|e| config_error(py, e))?;
+        }
+        Ok(c)
     }
 }
 

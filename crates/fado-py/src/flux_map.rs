@@ -6,8 +6,10 @@
 //! `psi_q` of shape (n_d, n_q). Every refusal of the CSV reader applies; a ConfigError on
 //! `flux_map` names the node (its index in the arrays) or the file and line.
 
+use fado_core::magnetics::MachineMagnetics;
 use fado_sim::magnetics::FluxMapData;
 use fado_sim::magnetics_file::{FluxMapFile, flux_map_from_rows};
+use fado_sim::model_magnetics;
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 
@@ -120,4 +122,19 @@ pub fn to_python<'py>(py: Python<'py>, m: &FluxMapFile) -> PyResult<Bound<'py, P
         .map(|c| np.call_method1("asarray", (c,)))
         .collect::<PyResult<Vec<_>>>()?;
     Ok(PyTuple::new(py, arrays)?.into_any())
+}
+
+/// The map as the estimator's model holds it in `T` (f64, or rounded to f32), interned for
+/// the program's life (`fado_sim::model_magnetics`); None when rounding to f32 breaks its
+/// monotonicity.
+pub fn machine_magnetics<T: 'static + Copy>(m: &FluxMapFile) -> Option<MachineMagnetics<T>> {
+    use core::any::Any;
+    let f64_map = MachineMagnetics::Map(model_magnetics::interned_map(&m.data));
+    if let Some(x) = (&f64_map as &dyn Any).downcast_ref::<MachineMagnetics<T>>() {
+        return Some(*x);
+    }
+    let f32_map = MachineMagnetics::Map(model_magnetics::interned_map_f32(&m.data)?);
+    (&f32_map as &dyn Any)
+        .downcast_ref::<MachineMagnetics<T>>()
+        .copied()
 }

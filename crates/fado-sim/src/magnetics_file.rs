@@ -130,6 +130,7 @@ pub fn check_one_model(
 
 /// Takes `[motor.saturation]` and `[motor] flux_map` out of the user's document (`[motor]`
 /// itself is the linear machine's record), parsed; the map's file read and checked.
+/// A `[model] flux_map` path is resolved here too (its file is read with the drive's model).
 pub fn take_magnetics(
     user: &mut toml::Table,
 ) -> Result<(Option<Saturation<f64>>, Option<FluxMapFile>), SimConfigError> {

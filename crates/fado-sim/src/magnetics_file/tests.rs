@@ -152,3 +152,29 @@ fn an_error_inside_the_map_names_the_csv_file_and_line() {
     let s = e.to_string();
     assert!(s.starts_with(&format!("{}:5:1:", path.display())), "{s}");
 }
+
+#[test]
+fn the_drive_model_takes_its_own_map_under_model() {
+    use fado_core::magnetics::MachineMagnetics;
+    let dir = scratch("model");
+    std::fs::write(dir.join("model.csv"), flux_map_csv(&tabulated(), "model")).unwrap();
+    set_config_dir(Some(&dir));
+    let text = format!("{}\n[model]\nflux_map = \"model.csv\"\n", preset_with(""));
+    let cfg = SimConfig::from_toml(&text);
+    set_config_dir(None);
+    let cfg = cfg.unwrap();
+    // The plant stays linear; the drive's model is the map, in f64 and rounded to f32.
+    assert!(cfg.plant().magnetics.is_none());
+    let machine = cfg.drive_config().machine;
+    assert!(
+        matches!(machine.magnetics, MachineMagnetics::Map(m) if m.i_d() == tabulated().map().i_d())
+    );
+    assert!(cfg.build_drive_f32().is_ok());
+    let e = SimConfig::from_toml(&format!(
+        "{}\n[model]\nflux_map = \"/nonexistent.csv\"\n",
+        preset_with("")
+    ))
+    .unwrap_err();
+    assert_eq!(e.key, "model.flux_map", "{e}");
+    assert!(e.message.contains("/nonexistent.csv"), "{e}");
+}
