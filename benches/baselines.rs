@@ -67,7 +67,7 @@ fn estimators(c: &mut Criterion) {
     bench_named(
         c,
         "fado-fixed-rs_step_f32",
-        fado(|c| c.tuning.rs_adaptation = false),
+        fado(|c| c.tuning.rs_adaptation.enabled = false),
         &data,
     );
     // fado on the paper's path (`EstimatorTuning::paper_path`, the Cortex-M image's scenarios

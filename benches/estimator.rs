@@ -56,9 +56,9 @@ fn setup<T: Real>(
     let mut est =
         SensorlessEstimator::<T>::new(common::config_with(|c: &mut EstimatorConfig<T>| {
             c.initial_angle = T::lit(theta0);
-            c.tuning.rs_adaptation = rs_adaptation;
+            c.tuning.rs_adaptation.enabled = rs_adaptation;
             if !lock_detection {
-                c.tuning.lock_detection_time = T::zero();
+                c.tuning.lock.detection_time = T::zero();
             }
         }))
         .expect("default config is valid");
@@ -130,16 +130,16 @@ fn bench_precision<T: Real>(c: &mut Criterion, name: &str) {
         let lf = T::lit(0.088);
         let mut det = LockDetector::new(LockDetectorConfig {
             ts,
-            flux_low_ratio: d.lock_flux_low_ratio,
-            flux_low_fast_ratio: d.lock_flux_low_fast_ratio,
+            flux_low_ratio: d.lock.flux_low_ratio,
+            flux_low_fast_ratio: d.lock.flux_low_fast_ratio,
             fast_speed: T::lit(2.0 * core::f64::consts::PI * 1.3),
-            flux_high_ratio: d.lock_flux_high_ratio,
-            innovation_limit: d.lock_innovation_limit,
-            detection_time: d.lock_detection_time,
-            heal_time: d.lock_heal_time,
+            flux_high_ratio: d.lock.flux_high_ratio,
+            innovation_limit: d.lock.innovation_limit,
+            detection_time: d.lock.detection_time,
+            heal_time: d.lock.heal_time,
             limiter_clamping: true,
             handover_count: T::lit(5.0),
-            handover_time: d.lock_handover_time,
+            handover_time: d.lock.handover_time,
         })
         .unwrap();
         let flux_sq = lf * lf;
@@ -208,7 +208,9 @@ fn bench_precision<T: Real>(c: &mut Criterion, name: &str) {
 
     group.bench_function("tracker", |b| {
         let mut t2s = TypeTwoTracker::new(TrackerConfig::<T>::new(
-            fado_core::EstimatorTuning::<T>::default().t2s1_bandwidth_hz,
+            fado_core::EstimatorTuning::<T>::default()
+                .tracker
+                .t2s1_bandwidth_hz,
             ts,
         ))
         .unwrap();

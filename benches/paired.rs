@@ -117,7 +117,7 @@ fn main() {
         subject("fado", trait_step(fado(|_| {})), data.clone()),
         subject(
             "fado-fixed-rs",
-            trait_step(fado(|c| c.tuning.rs_adaptation = false)),
+            trait_step(fado(|c| c.tuning.rs_adaptation.enabled = false)),
             data.clone(),
         ),
         subject(

@@ -20,7 +20,7 @@ import fado.plot
 
 grid = {"rs_error": [-0.2, -0.1, -0.05, -0.02, 0.0, 0.02, 0.05, 0.1, 0.2],
         "load_torque": [0.0, 2.5, 5.0, 7.5, 10.0]}
-fixed = fado.sweep(grid, "fig11", config={"estimator": {"rs_adaptation": False}}, averaged=True)
+fixed = fado.sweep(grid, "fig11", config={"estimator": {"rs_adaptation": {"enabled": False}}}, averaged=True)
 adaptive = fado.sweep(grid, "fig11", averaged=True)
 print("passed:", int(fixed["passed"].sum()), "of", len(fixed), "with a fixed R̂s;",
       int(adaptive["passed"].sum()), "of", len(adaptive), "with R̂s adaptation")

@@ -30,9 +30,6 @@ KNOWN = {
     "crates/fado-core/src/machine_checks.rs::check_into": 126,
     "crates/fado-py/src/commission.rs::commission": 84,
     "crates/fado-py/src/inputs.rs::column": 89,
-    "crates/fado-sim/src/config.rs": 1132,
-    "crates/fado-sim/src/sweep/point.rs::run_point_until": 87,
-    "crates/fado-sim/src/sweep/runner.rs::run": 93,
 }
 
 FN = re.compile(

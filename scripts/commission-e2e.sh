@@ -8,7 +8,7 @@ bin=${FADO_SIM:-target/release/fado-sim}
 out=${1:-out/commission-e2e}
 seeds=${SEEDS:-1 2 3 4}
 mkdir -p "$out"
-no_adapt=$'\n[estimator]\nrs_adaptation = false\n'
+no_adapt=$'\n[estimator.rs_adaptation]\nenabled = false\n'
 for cfg in motors/*.toml; do
   name=$(basename "$cfg" .toml)
   # The true model: the preset as is ([model] = [motor]).

@@ -2,7 +2,7 @@
 # The λ̂f × load envelope of the fig11 reversal, with and without the λ̂f law (issue 13):
 #   1. `fado-sim sweep fig11` over flux_linkage_error (= λ̂f/λf − 1) −10…+10 % in 2.5 % steps ×
 #      load torque 0…7.5 N·m in 1.25 N·m steps (63 runs), switching-resolved, once with the
-#      defaults and once with `[estimator] flux_linkage_adaptation_rate = 0` (law off);
+#      defaults and once with `[estimator.flux_linkage_adaptation] rate = 0` (law off);
 #   2. docs/envelope-fig11-lf-load-{law-off,default}.csv, and docs/envelope-fig11-lf-load.png
 #      drawn from them (with the issue 13 second pass's per-sample law at 5 s⁻¹,
 #      docs/envelope-fig11-lf-load-after-lf5.csv, as the middle panel);
@@ -18,7 +18,7 @@ sim="$target/release/fado-sim"
 axes=(--axis flux_linkage_error=-0.1:0.1:9 --axis load_torque=0:7.5:7)
 off=$(mktemp /tmp/fado-lf-off.XXXXXX.toml)
 trap 'rm -f "$off"' EXIT
-printf '[estimator]\nflux_linkage_adaptation_rate = 0.0\n' >"$off"
+printf '[estimator.flux_linkage_adaptation]\nrate = 0.0\n' >"$off"
 "$sim" sweep fig11 "${axes[@]}" --fresh --out out/envelope-lf-load-default "$@" >/dev/null
 "$sim" sweep fig11 "${axes[@]}" --config "$off" --fresh --out out/envelope-lf-load-law-off "$@" >/dev/null
 cp out/envelope-lf-load-default/sweep.csv docs/envelope-fig11-lf-load-default.csv

@@ -24,7 +24,7 @@ mkdir -p "$out"
 for variant in $variants; do
     case $variant in fixed-rs*) adapt=false ;; *) adapt=true ;; esac
     case $variant in *clamping) clamp=true ;; *) clamp=false ;; esac
-    { cat "$file"; printf '\n[estimator]\nrs_adaptation = %s\nlock_limiter_clamping = %s\n' "$adapt" "$clamp"
+    { cat "$file"; printf '\n[estimator.rs_adaptation]\nenabled = %s\n[estimator.lock]\nlimiter_clamping = %s\n' "$adapt" "$clamp"
       printf "${EXTRA:-}"; } \
         >"$out/$variant.toml"
     rm -rf "${out:?}/$variant"

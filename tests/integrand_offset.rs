@@ -27,7 +27,7 @@ fn reversal(v_error: Ab<f64>, offset_rate: f64) -> (f64, Ab<f64>) {
     let theta0 = 0.4;
     let mut est = SensorlessEstimator::new(config_with(|c| {
         c.initial_angle = theta0;
-        c.tuning.offset_adaptation_rate = offset_rate;
+        c.tuning.offset_adaptation.rate = offset_rate;
     }))
     .unwrap();
     let i_dq = Dq::new(0.0, IQ_LOAD);
@@ -81,7 +81,7 @@ fn simulated_reversal_with_a_voltage_offset_passes() {
     for offset in ["[0.1, 0.0]", "[0.0, 0.1]"] {
         let with = near_zero(&format!("[faults]\nvoltage_offset = {offset}\n"));
         let without = near_zero(&format!(
-            "[faults]\nvoltage_offset = {offset}\n[estimator]\noffset_adaptation_rate = 0.0\n"
+            "[faults]\nvoltage_offset = {offset}\n[estimator.offset_adaptation]\nrate = 0.0\n"
         ));
         eprintln!("fig11, offset {offset} V: {with:.3} rad (without the law {without:.3})");
         assert!(with < 0.25, "{offset}: {with:.3} rad");

@@ -29,7 +29,7 @@ fn run(name: &str, config: &str) -> Outcome {
 /// starts the paper's motor at 0.62 s (README, known limitations).
 fn plant_resistance(k: f64, adaptation: bool) -> String {
     format!(
-        "[mismatch]\nrs_ratio = {}\n[estimator]\nrs_adaptation = {adaptation}\n\
+        "[mismatch]\nrs_ratio = {}\n[estimator.rs_adaptation]\nenabled = {adaptation}\n\
          [controller]\ngain_calibration_time = 0.0\n",
         1.0 / k
     )
@@ -73,8 +73,8 @@ fn adaptation_never_makes_a_passing_scenario_fail() {
     // fig10 is decided by the sensor-noise seed around its 0.35 rad threshold (0.12–0.68 rad
     // over seeds, either setting): it is judged over eight seeds below.
     for s in SCENARIOS.iter().filter(|s| s.name != "fig10") {
-        let off = run(s.name, "[estimator]\nrs_adaptation = false\n");
-        let on = run(s.name, "[estimator]\nrs_adaptation = true\n");
+        let off = run(s.name, "[estimator.rs_adaptation]\nenabled = false\n");
+        let on = run(s.name, "[estimator.rs_adaptation]\nenabled = true\n");
         if off.passed {
             assert!(on.passed, "{}: {:?}", s.name, on.checks);
         }
@@ -93,8 +93,9 @@ fn fig10_over_eight_noise_seeds_both_paths_stay_within_issue_13s_bound() {
     let mut worst = [0.0f64, 0.0];
     for seed in 1..=8 {
         for (k, on) in [false, true].into_iter().enumerate() {
-            let cfg =
-                format!("[current_sensor]\nseed = {seed}\n[estimator]\nrs_adaptation = {on}\n");
+            let cfg = format!(
+                "[current_sensor]\nseed = {seed}\n[estimator.rs_adaptation]\nenabled = {on}\n"
+            );
             let out = run("fig10", &cfg);
             passed[k] += usize::from(out.passed);
             worst[k] = worst[k].max(out.metrics.max_angle_error);
@@ -121,7 +122,7 @@ fn fig10_over_eight_noise_seeds_both_paths_stay_within_issue_13s_bound() {
 fn flux_linkage_error_needs_the_flux_linkage_law() {
     // A 10 % λ̂f error biases the turning R̂s law by Δλf·ω/i_q (7 % at −90 r/min, 7.5 N·m),
     // which loses the reversal that a fixed, right R̂s survives; learning λ̂f unloaded
-    // (`flux_linkage_adaptation_rate`, on by default) restores it, with λ̂f too low or too
+    // (`flux_linkage_adaptation.rate`, on by default) restores it, with λ̂f too low or too
     // high, and together with an R̂s error (issue 13).
     for case in [
         "flux_linkage_ratio = 0.9",
@@ -131,7 +132,7 @@ fn flux_linkage_error_needs_the_flux_linkage_law() {
         let mismatch = format!("[mismatch]\n{case}\n");
         let biased = run(
             "fig11",
-            &format!("{mismatch}[estimator]\nflux_linkage_adaptation_rate = 0.0\n"),
+            &format!("{mismatch}[estimator.flux_linkage_adaptation]\nrate = 0.0\n"),
         );
         let learned = run("fig11", &mismatch);
         assert!(!biased.passed && learned.passed, "{case}");
@@ -139,7 +140,7 @@ fn flux_linkage_error_needs_the_flux_linkage_law() {
     let lf = "[mismatch]\nflux_linkage_ratio = 0.9\n";
     let fixed = run(
         "fig11",
-        &format!("{lf}[estimator]\nrs_adaptation = false\n"),
+        &format!("{lf}[estimator.rs_adaptation]\nenabled = false\n"),
     );
     assert!(fixed.passed);
 }

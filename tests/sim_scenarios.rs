@@ -89,16 +89,16 @@ fn fig10_sensor_offset_walks_the_estimate_along_the_limiter_circle_at_e_t_over_r
     // the gain calibration (its later start changes the hold this measures). This
     // checks the paper's limiter, so without our R̂s adaptation (whose standstill law pulls
     // |λ̂r| to λ̂f instead of the circle) and with the paper's observer input ω̂1 (our
-    // `observer_lag_compensation` feeds the observer T2S-1's proportional term as well; checked
+    // `observer.lag_compensation` feeds the observer T2S-1's proportional term as well; checked
     // at the end that it does not speed the walk up).
     let paper = "[current_sensor]\nenable_gain_error = false\nenable_noise = false\n\
                enable_quantization = false\n[controller]\noffset_calibration_time = 0.0\n\
-               gain_calibration_time = 0.0\n[estimator]\nrs_adaptation = false\n";
-    let cfg = format!("{paper}observer_lag_compensation = false\n");
+               gain_calibration_time = 0.0\n[estimator.rs_adaptation]\nenabled = false\n";
+    let cfg = format!("{paper}[estimator.observer]\nlag_compensation = false\n");
     let out = run("fig10", Some(&cfg), false);
     let c = &out.config;
     let rs_hat = c.estimator_config().machine.rs;
-    let rho = c.estimator.limiter_radius_ratio * c.estimator_config().machine.flux_linkage;
+    let rho = c.estimator.limiter.radius_ratio * c.estimator_config().machine.flux_linkage;
     let rated = c.motor.rated_current;
     let (oa, ob) = (
         c.current_sensor.offset_a_ratio * rated,
@@ -135,7 +135,7 @@ fn fig10_sensor_offset_walks_the_estimate_along_the_limiter_circle_at_e_t_over_r
     // With the default start-up calibration (100 ms, gates off) the same offsets leave no
     // walk worth the name.
     let cfg = "[current_sensor]\nenable_gain_error = false\nenable_noise = false\n\
-               enable_quantization = false\n[estimator]\nrs_adaptation = false\n";
+               enable_quantization = false\n[estimator.rs_adaptation]\nenabled = false\n";
     let cal = run("fig10", Some(cfg), false);
     let rows: Vec<_> = cal.trace.rows.iter().filter(|r| r.time >= 3.5).collect();
     let (first, last) = (rows[0], rows[rows.len() - 1]);
@@ -203,7 +203,7 @@ fn seed(seed: u64) -> String {
 fn fig8_paper_criterion_on_eight_sensor_seeds() {
     // Issue 13: fig8 < 2 % on seeds 1–8 (the worst revolution's DC of λ2 − λs over λf). It
     // failed on 2–3 of 8 seeds (2.03–2.23 %) until the observer's speed input carried
-    // T2S-1's proportional term (`observer_lag_compensation`): 0.29–0.72 % measured since.
+    // T2S-1's proportional term (`observer.lag_compensation`): 0.29–0.72 % measured since.
     for s in 1..=8 {
         let out = run("fig8", Some(&seed(s)), false);
         assert!(out.passed, "seed {s}: {:?}", out.checks);

@@ -33,7 +33,7 @@ pub fn inputs() -> Vec<(Ab<f32>, Ab<f32>)> {
 }
 
 /// fado on the paper's motor in `f32`, its configuration changed by `tuning`: `|_| {}` for the
-/// default, `|c| c.tuning.rs_adaptation = false` for the paper's fixed R̂s (compare's
+/// default, `|c| c.tuning.rs_adaptation.enabled = false` for the paper's fixed R̂s (compare's
 /// `fado-fixed-rs`), `|c| c.tuning = c.tuning.paper_path()` for the paper's path.
 pub fn fado(tuning: impl FnOnce(&mut EstimatorConfig<f32>)) -> SensorlessEstimator<f32> {
     let mut config = EstimatorConfig::for_machine(&MachineModel::paper());

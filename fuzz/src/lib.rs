@@ -90,14 +90,14 @@ pub struct EstimatorCase {
     /// Run in f32 instead of f64.
     pub single: bool,
     /// ts, machine R̂s, L̂q, λ̂f, then the numeric tuning fields in the order of
-    /// `EstimatorTuning` up to `tracker_hold_ratio`, then `initial_angle` (None = default; the
+    /// `EstimatorTuning` up to `tracker.hold_ratio`, then `initial_angle` (None = default; the
     /// layout of the older flat config, so that the stored regressions decode as before).
     pub fields: [Option<Num>; 15],
-    /// `average_current`, `observer_on_rotor_flux`, natural-frequency bandwidths.
+    /// `integrator.average_current`, `observer.on_rotor_flux`, natural-frequency bandwidths.
     pub flags: [bool; 3],
     /// The R̂s-adaptation fields in the order of `EstimatorTuning` (None = default).
     pub adaptation: [Option<Num>; 5],
-    /// `rs_adaptation`, `limiter_recentring` (None = default).
+    /// `rs_adaptation`, `limiter.recentring` (None = default).
     pub adaptation_flags: [Option<bool>; 2],
     /// What to do.
     pub actions: Vec<EstimatorAction>,
@@ -118,39 +118,40 @@ impl EstimatorCase {
                 ..d.machine
             },
             initial_angle: field(f[14], d.initial_angle),
-            tuning: EstimatorTuning {
-                k_df: field(f[4], t.k_df),
-                k_df_ramp_time: field(f[5], t.k_df_ramp_time),
-                k_af: field(f[6], t.k_af),
-                limiter_radius_ratio: field(f[7], t.limiter_radius_ratio),
-                mode_threshold_ratio: field(f[8], t.mode_threshold_ratio),
-                mode_hysteresis_ratio: field(f[9], t.mode_hysteresis_ratio),
-                t2s1_bandwidth_hz: field(f[10], t.t2s1_bandwidth_hz),
-                t2s2_bandwidth_hz: field(f[11], t.t2s2_bandwidth_hz),
-                tracker_damping: field(f[12], t.tracker_damping),
-                tracker_hold_ratio: field(f[13], t.tracker_hold_ratio),
-                average_current: self.flags[0],
-                observer_on_rotor_flux: self.flags[1],
-                bandwidth_definition: if self.flags[2] {
+            tuning: {
+                let mut tuned = t;
+                tuned.disturbance_feedback.k_df = field(f[4], t.disturbance_feedback.k_df);
+                tuned.disturbance_feedback.ramp_time = field(f[5], t.disturbance_feedback.ramp_time);
+                tuned.limiter.k_af = field(f[6], t.limiter.k_af);
+                tuned.limiter.radius_ratio = field(f[7], t.limiter.radius_ratio);
+                tuned.mode.threshold_ratio = field(f[8], t.mode.threshold_ratio);
+                tuned.mode.hysteresis_ratio = field(f[9], t.mode.hysteresis_ratio);
+                tuned.tracker.t2s1_bandwidth_hz = field(f[10], t.tracker.t2s1_bandwidth_hz);
+                tuned.tracker.t2s2_bandwidth_hz = field(f[11], t.tracker.t2s2_bandwidth_hz);
+                tuned.tracker.damping = field(f[12], t.tracker.damping);
+                tuned.tracker.hold_ratio = field(f[13], t.tracker.hold_ratio);
+                tuned.integrator.average_current = self.flags[0];
+                tuned.observer.on_rotor_flux = self.flags[1];
+                tuned.tracker.bandwidth_definition = if self.flags[2] {
                     BandwidthDefinition::NaturalFrequency
                 } else {
                     BandwidthDefinition::Minus3Db
-                },
-                rs_adaptation: self.adaptation_flags[0].unwrap_or(t.rs_adaptation),
-                rs_adaptation_rate: field(self.adaptation[0], t.rs_adaptation_rate),
-                rs_adaptation_excitation_floor: field(
+                };
+                tuned.rs_adaptation.enabled = self.adaptation_flags[0].unwrap_or(t.rs_adaptation.enabled);
+                tuned.rs_adaptation.rate = field(self.adaptation[0], t.rs_adaptation.rate);
+                tuned.rs_adaptation.excitation_floor = field(
                     self.adaptation[1],
-                    t.rs_adaptation_excitation_floor,
-                ),
-                rs_adaptation_min_ratio: field(self.adaptation[2], t.rs_adaptation_min_ratio),
-                rs_adaptation_max_ratio: field(self.adaptation[3], t.rs_adaptation_max_ratio),
-                flux_linkage_adaptation_rate: field(
+                    t.rs_adaptation.excitation_floor,
+                );
+                tuned.rs_adaptation.min_ratio = field(self.adaptation[2], t.rs_adaptation.min_ratio);
+                tuned.rs_adaptation.max_ratio = field(self.adaptation[3], t.rs_adaptation.max_ratio);
+                tuned.flux_linkage_adaptation.rate = field(
                     self.adaptation[4],
-                    t.flux_linkage_adaptation_rate,
-                ),
-                offset_adaptation_rate: t.offset_adaptation_rate,
-                limiter_recentring: self.adaptation_flags[1].unwrap_or(t.limiter_recentring),
-                ..t
+                    t.flux_linkage_adaptation.rate,
+                );
+                tuned.offset_adaptation.rate = t.offset_adaptation.rate;
+                tuned.limiter.recentring = self.adaptation_flags[1].unwrap_or(t.limiter.recentring);
+                tuned
             },
         }
     }
@@ -452,7 +453,7 @@ pub struct BaselineCase {
     pub shared: [Option<Num>; 9],
     /// The estimator's own fields in declaration order (None = default).
     pub own: [Option<Num>; 4],
-    /// `average_current`.
+    /// `integrator.average_current`.
     pub average_current: bool,
     /// What to do (`SetRs` and `EnableKdf` do not apply and are skipped).
     pub actions: Vec<EstimatorAction>,

@@ -19,7 +19,7 @@ Replay a recording (1-D float64 or float32 arrays, one sample per sampling perio
 
 or step it yourself::
 
-    est = fado.Estimator("paper", fado.EstimatorConfig(k_df=1.0))
+    est = fado.Estimator("paper", fado.EstimatorConfig(disturbance_feedback={"k_df": 1.0}))
     out = est.step(v_alpha, v_beta, i_alpha, i_beta)
 
 Simulate the paper's experiments (Fig. 8–12) on the closed-loop drive model (Rust,

@@ -6,6 +6,7 @@ this file, so it cannot drift from the module.
 
 import inspect
 import os
+from collections.abc import Mapping
 from typing import Any, ClassVar, Final, Literal, final
 
 import numpy as np
@@ -189,210 +190,84 @@ def machine_presets() -> list[str]:
 
 @final
 class EstimatorConfig:
-    """Tuning of the sensorless estimator; omitted fields take the Rust defaults."""
+    """Tuning of the sensorless estimator, one dict per block it tunes (`lock`, `tracker`,
+    ...); omitted fields take the Rust defaults."""
 
     fields: ClassVar[tuple[str, ...]]
     __signature__: ClassVar[inspect.Signature]
     def __new__(
         cls,
         *,
-        k_df: float | None = None,
-        k_df_ramp_time: float | None = None,
-        k_af: float | None = None,
-        limiter_radius_ratio: float | None = None,
-        mode_threshold_ratio: float | None = None,
-        mode_hysteresis_ratio: float | None = None,
-        t2s1_bandwidth_hz: float | None = None,
-        t2s2_bandwidth_hz: float | None = None,
-        tracker_damping: float | None = None,
-        bandwidth_definition: str | None = None,
-        tracker_hold_ratio: float | None = None,
-        tracker_load_pole_ratio: float | None = None,
-        average_current: bool | None = None,
-        observer_on_rotor_flux: bool | None = None,
-        observer_lag_compensation: bool | None = None,
-        observer_gain_period: float | None = None,
-        rs_adaptation: bool | None = None,
-        rs_adaptation_rate: float | None = None,
-        rs_adaptation_excitation_floor: float | None = None,
-        rs_adaptation_min_ratio: float | None = None,
-        rs_adaptation_max_ratio: float | None = None,
-        flux_linkage_adaptation_rate: float | None = None,
-        offset_adaptation_rate: float | None = None,
-        standstill_angle_rate: float | None = None,
-        limiter_recentring: bool | None = None,
-        plausible_current_ratio: float | None = None,
-        plausible_voltage_ratio: float | None = None,
-        plausible_current_step_ratio: float | None = None,
-        lock_flux_low_ratio: float | None = None,
-        lock_flux_low_fast_ratio: float | None = None,
-        lock_flux_high_ratio: float | None = None,
-        lock_innovation_limit: float | None = None,
-        lock_detection_time: float | None = None,
-        lock_heal_time: float | None = None,
-        lock_limiter_clamping: bool | None = None,
-        lock_handover_count: float | None = None,
-        lock_handover_time: float | None = None,
+        integrator: Mapping[str, float | str | bool] | None = None,
+        disturbance_feedback: Mapping[str, float | str | bool] | None = None,
+        limiter: Mapping[str, float | str | bool] | None = None,
+        mode: Mapping[str, float | str | bool] | None = None,
+        tracker: Mapping[str, float | str | bool] | None = None,
+        observer: Mapping[str, float | str | bool] | None = None,
+        rs_adaptation: Mapping[str, float | str | bool] | None = None,
+        flux_linkage_adaptation: Mapping[str, float | str | bool] | None = None,
+        offset_adaptation: Mapping[str, float | str | bool] | None = None,
+        plausibility: Mapping[str, float | str | bool] | None = None,
+        lock: Mapping[str, float | str | bool] | None = None,
     ) -> EstimatorConfig: ...
     def replace(
         self,
+        /,
         *,
-        k_df: float | None = None,
-        k_df_ramp_time: float | None = None,
-        k_af: float | None = None,
-        limiter_radius_ratio: float | None = None,
-        mode_threshold_ratio: float | None = None,
-        mode_hysteresis_ratio: float | None = None,
-        t2s1_bandwidth_hz: float | None = None,
-        t2s2_bandwidth_hz: float | None = None,
-        tracker_damping: float | None = None,
-        bandwidth_definition: str | None = None,
-        tracker_hold_ratio: float | None = None,
-        tracker_load_pole_ratio: float | None = None,
-        average_current: bool | None = None,
-        observer_on_rotor_flux: bool | None = None,
-        observer_lag_compensation: bool | None = None,
-        observer_gain_period: float | None = None,
-        rs_adaptation: bool | None = None,
-        rs_adaptation_rate: float | None = None,
-        rs_adaptation_excitation_floor: float | None = None,
-        rs_adaptation_min_ratio: float | None = None,
-        rs_adaptation_max_ratio: float | None = None,
-        flux_linkage_adaptation_rate: float | None = None,
-        offset_adaptation_rate: float | None = None,
-        standstill_angle_rate: float | None = None,
-        limiter_recentring: bool | None = None,
-        plausible_current_ratio: float | None = None,
-        plausible_voltage_ratio: float | None = None,
-        plausible_current_step_ratio: float | None = None,
-        lock_flux_low_ratio: float | None = None,
-        lock_flux_low_fast_ratio: float | None = None,
-        lock_flux_high_ratio: float | None = None,
-        lock_innovation_limit: float | None = None,
-        lock_detection_time: float | None = None,
-        lock_heal_time: float | None = None,
-        lock_limiter_clamping: bool | None = None,
-        lock_handover_count: float | None = None,
-        lock_handover_time: float | None = None,
+        integrator: Mapping[str, float | str | bool] | None = None,
+        disturbance_feedback: Mapping[str, float | str | bool] | None = None,
+        limiter: Mapping[str, float | str | bool] | None = None,
+        mode: Mapping[str, float | str | bool] | None = None,
+        tracker: Mapping[str, float | str | bool] | None = None,
+        observer: Mapping[str, float | str | bool] | None = None,
+        rs_adaptation: Mapping[str, float | str | bool] | None = None,
+        flux_linkage_adaptation: Mapping[str, float | str | bool] | None = None,
+        offset_adaptation: Mapping[str, float | str | bool] | None = None,
+        plausibility: Mapping[str, float | str | bool] | None = None,
+        lock: Mapping[str, float | str | bool] | None = None,
     ) -> EstimatorConfig: ...
-    def to_dict(self) -> dict[str, float | str | bool]: ...
+    def to_dict(self) -> dict[str, dict[str, float | str | bool]]: ...
     def paper_path(self) -> EstimatorConfig:
         """A copy on the paper's path: every addition of fado's that can be off, off (fixed
         R̂s, observer on λ1 at T2S-1's ω̂, no re-centring, abrupt k_df, gains every sample)."""
-    def __getnewargs_ex__(self) -> tuple[tuple[()], dict[str, float | str | bool]]: ...
+    def __getnewargs_ex__(
+        self,
+    ) -> tuple[tuple[()], dict[str, dict[str, float | str | bool]]]: ...
     def __eq__(self, value: object, /) -> bool: ...
     def __ne__(self, value: object, /) -> bool: ...
     @property
-    def k_df(self) -> float:
-        """Disturbance feedback gain k_df in 1/s (Fig. 3)."""
+    def integrator(self) -> dict[str, float | str | bool]:
+        """Tuning of the flux integrator (eq. (3)) (the fields of `IntegratorTuning`)."""
     @property
-    def k_df_ramp_time(self) -> float:
-        """Ramp time of k_df on activation in s."""
+    def disturbance_feedback(self) -> dict[str, float | str | bool]:
+        """Tuning of the disturbance feedback k_df (Fig. 3) (the fields of `DisturbanceFeedbackTuning`)."""
     @property
-    def k_af(self) -> float:
-        """Limiter gain k_af in 1/s (Fig. 6)."""
+    def limiter(self) -> dict[str, float | str | bool]:
+        """Tuning of the flux limiter (Fig. 6) (the fields of `LimiterTuning`)."""
     @property
-    def limiter_radius_ratio(self) -> float:
-        """Limiter radius as a multiple of λ̂f."""
+    def mode(self) -> dict[str, float | str | bool]:
+        """Tuning of the selection between limiter and k_df (Fig. 3) (the fields of `ModeTuning`)."""
     @property
-    def mode_threshold_ratio(self) -> float:
-        """Speed threshold between limiter and k_df feedback as a fraction of the rated electrical frequency."""
+    def tracker(self) -> dict[str, float | str | bool]:
+        """Tuning of the speed trackers T2S-1 and T2S-2 (the fields of `TrackerTuning`)."""
     @property
-    def mode_hysteresis_ratio(self) -> float:
-        """Hysteresis half-band of the threshold as a fraction of the rated electrical frequency."""
+    def observer(self) -> dict[str, float | str | bool]:
+        """Tuning of the disturbance observer (Fig. 5) (the fields of `ObserverTuning`)."""
     @property
-    def t2s1_bandwidth_hz(self) -> float:
-        """Bandwidth of T2S-1 in Hz."""
+    def rs_adaptation(self) -> dict[str, float | str | bool]:
+        """Tuning of the online R̂s law (the fields of `RsAdaptationTuning`)."""
     @property
-    def t2s2_bandwidth_hz(self) -> float:
-        """Bandwidth of T2S-2 in Hz."""
+    def flux_linkage_adaptation(self) -> dict[str, float | str | bool]:
+        """Tuning of the λ̂f law (the fields of `FluxLinkageAdaptationTuning`)."""
     @property
-    def tracker_damping(self) -> float:
-        """Damping ratio of both trackers."""
+    def offset_adaptation(self) -> dict[str, float | str | bool]:
+        """Tuning of the integrand-offset law (the fields of `OffsetAdaptationTuning`)."""
     @property
-    def bandwidth_definition(self) -> str:
-        """'minus3_db' or 'natural_frequency'."""
+    def plausibility(self) -> dict[str, float | str | bool]:
+        """Tuning of the sample bounds (the fields of `PlausibilityTuning`)."""
     @property
-    def tracker_hold_ratio(self) -> float:
-        """Trackers coast while |λ̂r| is below this fraction of λ̂f."""
-    @property
-    def tracker_load_pole_ratio(self) -> float:
-        """The trackers' load-acceleration pole as a ratio of ωn (0: type-2 trackers)."""
-    @property
-    def average_current(self) -> bool:
-        """Average the current over the interval for the resistive drop."""
-    @property
-    def observer_on_rotor_flux(self) -> bool:
-        """Observer fed with λ1 − L̂q·i (fado's improvement) instead of λ1 (the paper)."""
-    @property
-    def observer_lag_compensation(self) -> bool:
-        """Observer speed ω̂1 plus T2S-1's low-passed Kp·e (fado's improvement); False = the paper's ω̂1."""
-    @property
-    def observer_gain_period(self) -> float:
-        """Period (s) at which the observer's gains are recomputed and held in between; 0 = every sample (the paper)."""
-    @property
-    def rs_adaptation(self) -> bool:
-        """Adapt R̂s online (fado's extension, default True; False = the paper)."""
-    @property
-    def rs_adaptation_rate(self) -> float:
-        """Rate γ of the R̂s adaptation while turning, in 1/s."""
-    @property
-    def rs_adaptation_excitation_floor(self) -> float:
-        """Excitation floor χ0 of the R̂s adaptation."""
-    @property
-    def rs_adaptation_min_ratio(self) -> float:
-        """Lower bound of the adapted R̂s as a multiple of the machine's rs."""
-    @property
-    def rs_adaptation_max_ratio(self) -> float:
-        """Upper bound of the adapted R̂s as a multiple of the machine's rs."""
-    @property
-    def flux_linkage_adaptation_rate(self) -> float:
-        """Rate of the λ̂f learning where R̂s is unobservable, in 1/s (0 = fixed λ̂f)."""
-    @property
-    def offset_adaptation_rate(self) -> float:
-        """With rs_adaptation: rate of the integrand-offset (voltage-offset) estimate while turning, in 1/s (0 = off)."""
-    @property
-    def standstill_angle_rate(self) -> float:
-        """With rs_adaptation: rate at which λ̂r turns towards the current at standstill under the eq. (23) injection, in 1/s (0 = off)."""
-    @property
-    def limiter_recentring(self) -> bool:
-        """In limiter mode, re-centre the common mode of λ1 and D̂ (fado's improvement)."""
-    @property
-    def plausible_current_ratio(self) -> float:
-        """Samples whose α-β current magnitude reaches this × the rated current are refused."""
-    @property
-    def plausible_voltage_ratio(self) -> float:
-        """Samples whose α-β voltage magnitude reaches this × the DC-link voltage are refused."""
-    @property
-    def plausible_current_step_ratio(self) -> float:
-        """Bound on |Δi| in units of (plausible voltage)·ts/L̂q per sample (0 = off)."""
-    @property
-    def lock_flux_low_ratio(self) -> float:
-        """Loss of lock: |λ̂r|/λ̂f below this is a symptom below the mode hand-over band."""
-    @property
-    def lock_flux_low_fast_ratio(self) -> float:
-        """Loss of lock: |λ̂r|/λ̂f below this is a symptom from the mode hand-over band up."""
-    @property
-    def lock_flux_high_ratio(self) -> float:
-        """Loss of lock: |λ̂r|/λ̂f above this is a symptom (0: off)."""
-    @property
-    def lock_innovation_limit(self) -> float:
-        """Loss of lock: T2S-1 innovation above this (rad) is a symptom."""
-    @property
-    def lock_detection_time(self) -> float:
-        """Loss of lock: net symptomatic time (s) before lock = 2 (0 = off)."""
-    @property
-    def lock_heal_time(self) -> float:
-        """Loss of lock: net clean time (s) after which lock = 2 clears (a live status)."""
-    @property
-    def lock_limiter_clamping(self) -> bool:
-        """Loss of lock: limiter clamping in limiter mode is a symptom."""
-    @property
-    def lock_handover_count(self) -> float:
-        """Loss of lock: this many mode hand-overs per lock_handover_time is a symptom (0: off)."""
-    @property
-    def lock_handover_time(self) -> float:
-        """Loss of lock: time constant (s) of the mode hand-over count's decay."""
+    def lock(self) -> dict[str, float | str | bool]:
+        """Tuning of the loss-of-lock detector (the fields of `LockTuning`)."""
 
 @final
 class StepResult:

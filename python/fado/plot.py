@@ -128,7 +128,7 @@ def _lambda2(ax: Axes, r: SimResult) -> None:
 
 def _rotor_flux(ax: Axes, r: SimResult) -> None:
     t = _col(r, "time")
-    ratio = r.estimator_config.limiter_radius_ratio
+    ratio = r.estimator_config.limiter["radius_ratio"]
     radius = ratio * r.machine.flux_linkage
     a, b = _col(r, "lambda_r_alpha"), _col(r, "lambda_r_beta")
     ax.plot(t, a, color="C0", lw=1.0, label="λ̂r α")

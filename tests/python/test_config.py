@@ -16,47 +16,82 @@ import fado
 from fado import EstimatorConfig
 
 # The values the paper (section V) and SPEC.md fix; the Rust `Default` must give exactly these.
-# Speeds are ratios of the rated electrical frequency (the paper's motor: 100 Hz).
+# Speeds are ratios of the rated electrical frequency (the paper's motor: 100 Hz). One dict per
+# block the tuning tunes (the nested tables of the simulator's `[estimator]`).
 PAPER_DEFAULTS = {
-    "k_df": 0.5,  # [P]
-    "k_df_ramp_time": 0.0,  # abrupt, as in the paper
-    "k_af": 2 * math.pi * 100,  # [P]
-    "limiter_radius_ratio": 1.15,  # [P]
-    "mode_threshold_ratio": 0.015,  # [P]: 1.5 Hz of the paper motor's 100 Hz
-    "mode_hysteresis_ratio": 0.002,  # SPEC §1 [A]: 0.2 Hz of 100 Hz
-    "t2s1_bandwidth_hz": 60.0,  # [P]
-    "t2s2_bandwidth_hz": 35.0,  # [P]
-    "tracker_damping": 1 / math.sqrt(2),  # SPEC §3 [A]
-    "bandwidth_definition": "minus3_db",  # SPEC §3
-    "tracker_hold_ratio": 0.2,  # SPEC §3 [A]
-    "tracker_load_pole_ratio": 0.0,  # [A] 0: the paper's type-2 trackers
-    "average_current": True,  # SPEC §1 [A]
-    "observer_on_rotor_flux": True,  # fado's improvement [A]; False = paper's Fig. 5
-    "observer_lag_compensation": True,  # fado's improvement [A] (issue 13); False = the paper
-    "observer_gain_period": 4e-4,  # [A] (issue 16: gains held over 4 samples at 10 kHz); 0 = the paper
-    "rs_adaptation": True,  # fado's extension [A]; False = the paper's fixed R̂s
-    "rs_adaptation_rate": 1.0,  # [A]
-    "rs_adaptation_excitation_floor": 0.2,  # [A]
-    "rs_adaptation_min_ratio": 0.5,  # [A]
-    "rs_adaptation_max_ratio": 2.0,  # [A]
-    "flux_linkage_adaptation_rate": 5.0,  # [A] (issue 13: revolution mean, 1 % dead zone)
-    "offset_adaptation_rate": 2.0,  # [A]
-    "standstill_angle_rate": 2.0,  # [A]
-    "limiter_recentring": True,  # fado's improvement [A]; False = the paper
-    # Issue 14: plausibility bounds (ratios of the ratings) and the loss-of-lock detector.
-    "plausible_current_ratio": 4.0,  # [A]
-    "plausible_voltage_ratio": 1.5,  # [A]
-    "plausible_current_step_ratio": 2.0,  # [A]
-    "lock_flux_low_ratio": 0.7,  # [A]
-    "lock_flux_low_fast_ratio": 0.6,  # [A]
-    "lock_flux_high_ratio": 1.5,  # [A]
-    "lock_innovation_limit": 0.5,  # [A]
-    "lock_detection_time": 5e-3,  # [A]
-    "lock_heal_time": 0.1,  # [A]
-    "lock_limiter_clamping": False,  # [A]
-    "lock_handover_count": 5.0,  # [A] (docs/method/lock.md)
-    "lock_handover_time": 0.1,  # [A]
+    "integrator": {
+        "average_current": True,  # SPEC §1 [A]
+    },
+    "disturbance_feedback": {
+        "k_df": 0.5,  # [P]
+        "ramp_time": 0.0,  # abrupt, as in the paper
+    },
+    "limiter": {
+        "k_af": 2 * math.pi * 100,  # [P]
+        "radius_ratio": 1.15,  # [P]
+        "recentring": True,  # fado's improvement [A]; False = the paper
+    },
+    "mode": {
+        "threshold_ratio": 0.015,  # [P]: 1.5 Hz of the paper motor's 100 Hz
+        "hysteresis_ratio": 0.002,  # SPEC §1 [A]: 0.2 Hz of 100 Hz
+    },
+    "tracker": {
+        "t2s1_bandwidth_hz": 60.0,  # [P]
+        "t2s2_bandwidth_hz": 35.0,  # [P]
+        "damping": 1 / math.sqrt(2),  # SPEC §3 [A]
+        "bandwidth_definition": "minus3_db",  # SPEC §3
+        "hold_ratio": 0.2,  # SPEC §3 [A]
+        "load_pole_ratio": 0.0,  # [A] 0: the paper's type-2 trackers
+    },
+    "observer": {
+        "on_rotor_flux": True,  # fado's improvement [A]; False = paper's Fig. 5
+        "lag_compensation": True,  # fado's improvement [A] (issue 13); False = the paper
+        "gain_period": 4e-4,  # [A] (issue 16: gains held over 4 samples at 10 kHz); 0 = the paper
+    },
+    "rs_adaptation": {
+        "enabled": True,  # fado's extension [A]; False = the paper's fixed R̂s
+        "rate": 1.0,  # [A]
+        "excitation_floor": 0.2,  # [A]
+        "min_ratio": 0.5,  # [A]
+        "max_ratio": 2.0,  # [A]
+        "standstill_angle_rate": 2.0,  # [A]
+    },
+    "flux_linkage_adaptation": {
+        "rate": 5.0,  # [A] (issue 13: revolution mean, 1 % dead zone)
+    },
+    "offset_adaptation": {
+        "rate": 2.0,  # [A]
+    },
+    "plausibility": {
+        "current_ratio": 4.0,  # [A]
+        "voltage_ratio": 1.5,  # [A]
+        "current_step_ratio": 2.0,  # [A]
+    },
+    "lock": {
+        "flux_low_ratio": 0.7,  # [A]
+        "flux_low_fast_ratio": 0.6,  # [A]
+        "flux_high_ratio": 1.5,  # [A]
+        "innovation_limit": 0.5,  # [A]
+        "detection_time": 5e-3,  # [A]
+        "heal_time": 0.1,  # [A]
+        "limiter_clamping": False,  # [A]
+        "handover_count": 5.0,  # [A] (docs/method/lock.md)
+        "handover_time": 0.1,  # [A]
+    },
 }
+
+
+
+def nested(path: str, value: object) -> dict[str, dict[str, object]]:
+    """The keyword of the tuning field at `path` (`lock.heal_time`): its record's dict."""
+    record, field = path.split(".")
+    return {record: {field: value}}
+
+
+def default(path: str) -> object:
+    record, field = path.split(".")
+    return PAPER_DEFAULTS[record][field]
+
 
 # The paper's motor (section V; λf, J, B from SPEC §6; rated current from its rated torque).
 PAPER_MACHINE = {
@@ -100,7 +135,10 @@ def assert_fields(actual: dict[str, object], expected: dict[str, object]) -> Non
 
 
 def test_defaults_are_the_papers() -> None:
-    assert_fields(EstimatorConfig().to_dict(), PAPER_DEFAULTS)
+    got = EstimatorConfig().to_dict()
+    assert list(got) == list(PAPER_DEFAULTS)
+    for record, fields in PAPER_DEFAULTS.items():
+        assert_fields(got[record], fields)
     assert list(EstimatorConfig.fields) == list(PAPER_DEFAULTS)
 
 
@@ -115,35 +153,41 @@ def test_every_field_is_a_keyword_only_argument_and_an_attribute() -> None:
 @pytest.mark.parametrize(
     ("field", "value"),
     [
-        ("k_df_ramp_time", 0.1),
-        ("mode_threshold_ratio", 0.02),
-        ("k_df", 1.0),
-        ("bandwidth_definition", "natural_frequency"),
-        ("average_current", False),
-        ("rs_adaptation", False),
+        ("disturbance_feedback.ramp_time", 0.1),
+        ("mode.threshold_ratio", 0.02),
+        ("disturbance_feedback.k_df", 1.0),
+        ("tracker.bandwidth_definition", "natural_frequency"),
+        ("integrator.average_current", False),
+        ("rs_adaptation.enabled", False),
     ],
 )
 def test_keyword_sets_only_that_field(field: str, value: object) -> None:
-    cfg = EstimatorConfig(**{field: value})
-    expected = dict(PAPER_DEFAULTS, **{field: value})
-    assert_fields(cfg.to_dict(), expected)
+    cfg = EstimatorConfig(**nested(field, value))
+    record, name = field.split(".")
+    for r, fields in PAPER_DEFAULTS.items():
+        expected = dict(fields, **{name: value}) if r == record else fields
+        assert_fields(cfg.to_dict()[r], expected)
 
 
 def test_immutable_and_replace() -> None:
-    cfg = EstimatorConfig(k_af=300.0)
+    cfg = EstimatorConfig(limiter={"k_af": 300.0})
     with pytest.raises(AttributeError):
-        cfg.k_af = 1.0  # type: ignore[misc]
-    changed = cfg.replace(k_df=2.0)
-    assert changed.k_df == 2.0 and changed.k_af == 300.0
-    assert cfg.k_df == PAPER_DEFAULTS["k_df"]
-    assert cfg != changed and cfg == EstimatorConfig(k_af=300.0)
+        cfg.limiter = {"k_af": 1.0}  # type: ignore[misc]
+    changed = cfg.replace(disturbance_feedback={"k_df": 2.0})
+    assert changed.disturbance_feedback["k_df"] == 2.0 and changed.limiter["k_af"] == 300.0
+    assert cfg.disturbance_feedback["k_df"] == default("disturbance_feedback.k_df")
+    assert cfg != changed and cfg == EstimatorConfig(limiter={"k_af": 300.0})
+    # A dict changes only the fields it names.
+    assert changed.limiter["radius_ratio"] == default("limiter.radius_ratio")
     with pytest.raises(fado.ConfigError):
-        cfg.replace(k_df=-1.0)
+        cfg.replace(disturbance_feedback={"k_df": -1.0})
 
 
 def test_round_trips() -> None:
     cfg = EstimatorConfig(
-        k_af=300.0, bandwidth_definition="natural_frequency", average_current=False
+        limiter={"k_af": 300.0},
+        tracker={"bandwidth_definition": "natural_frequency"},
+        integrator={"average_current": False},
     )
     assert EstimatorConfig(**cfg.to_dict()) == cfg
     assert eval(repr(cfg), {"EstimatorConfig": EstimatorConfig}) == cfg
@@ -152,36 +196,39 @@ def test_round_trips() -> None:
 
 
 def test_bandwidth_definition_has_one_spelling_per_value_the_tomls() -> None:
-    assert EstimatorConfig(bandwidth_definition="minus3_db").bandwidth_definition == "minus3_db"
-    natural = EstimatorConfig(bandwidth_definition="natural_frequency")
-    assert natural.bandwidth_definition == "natural_frequency"
-    # The spelling of the simulator's TOML ([estimator] bandwidth_definition), nothing else.
+    minus3 = EstimatorConfig(tracker={"bandwidth_definition": "minus3_db"})
+    assert minus3.tracker["bandwidth_definition"] == "minus3_db"
+    natural = EstimatorConfig(tracker={"bandwidth_definition": "natural_frequency"})
+    assert natural.tracker["bandwidth_definition"] == "natural_frequency"
+    # The spelling of the simulator's TOML ([estimator.tracker] bandwidth_definition), nothing else.
     assert 'bandwidth_definition = "minus3_db"' in fado.default_config("fig11")
     for other in ["-3dB", "natural", "Minus3_dB", "NATURAL_FREQUENCY"]:
         with pytest.raises(fado.ConfigError) as info:
-            EstimatorConfig(bandwidth_definition=other)
-        assert info.value.field == "bandwidth_definition"
+            EstimatorConfig(tracker={"bandwidth_definition": other})
+        assert info.value.field == "tracker.bandwidth_definition"
 
 
 def test_bandwidth_definition_changes_the_trackers() -> None:
     rng = np.random.default_rng(0)
     signals = [rng.normal(size=2000) for _ in range(4)]
-    minus3 = EstimatorConfig(bandwidth_definition="minus3_db")
-    natural = EstimatorConfig(bandwidth_definition="natural_frequency")
+    minus3 = EstimatorConfig(tracker={"bandwidth_definition": "minus3_db"})
+    natural = EstimatorConfig(tracker={"bandwidth_definition": "natural_frequency"})
     a = fado.estimate(*signals, machine="paper", config=minus3)
     b = fado.estimate(*signals, machine="paper", config=natural)
     np.testing.assert_array_equal(a.theta_direct[:1], b.theta_direct[:1])
     assert not np.array_equal(a.theta, b.theta)
 
 
-FLOAT_FIELDS = [f for f, v in PAPER_DEFAULTS.items() if isinstance(v, float)]
+FLOAT_FIELDS = [
+    f"{r}.{f}" for r, fields in PAPER_DEFAULTS.items() for f, v in fields.items() if isinstance(v, float)
+]
 
 
 @pytest.mark.parametrize("field", FLOAT_FIELDS)
 @pytest.mark.parametrize("bad", [math.nan, math.inf, -math.inf])
 def test_non_finite_values_raise_naming_the_field(field: str, bad: float) -> None:
     with pytest.raises(ValueError, match=field) as info:
-        EstimatorConfig(**{field: bad})
+        EstimatorConfig(**nested(field, bad))
     assert isinstance(info.value, fado.ConfigError)
     assert isinstance(info.value, fado.FadoError)
     assert info.value.field == field
@@ -190,28 +237,32 @@ def test_non_finite_values_raise_naming_the_field(field: str, bad: float) -> Non
 @pytest.mark.parametrize(
     ("field", "bad"),
     [
-        ("k_df", -0.5),
-        ("k_df_ramp_time", -1.0),
-        ("k_af", -1.0),
-        ("limiter_radius_ratio", 0.0),
-        ("mode_threshold_ratio", -0.015),
-        ("mode_hysteresis_ratio", 0.02),  # wider than the threshold
-        ("t2s1_bandwidth_hz", 0.0),
-        ("t2s2_bandwidth_hz", -35.0),
-        ("tracker_damping", 0.0),
-        ("tracker_hold_ratio", 1.0),
-        ("bandwidth_definition", "fast"),
+        ("disturbance_feedback.k_df", -0.5),
+        ("disturbance_feedback.ramp_time", -1.0),
+        ("limiter.k_af", -1.0),
+        ("limiter.radius_ratio", 0.0),
+        ("mode.threshold_ratio", -0.015),
+        ("mode.hysteresis_ratio", 0.02),  # wider than the threshold
+        ("tracker.t2s1_bandwidth_hz", 0.0),
+        ("tracker.t2s2_bandwidth_hz", -35.0),
+        ("tracker.damping", 0.0),
+        ("tracker.hold_ratio", 1.0),
+        ("tracker.bandwidth_definition", "fast"),
     ],
 )
 def test_out_of_range_values_raise_naming_the_field(field: str, bad: object) -> None:
     with pytest.raises(fado.ConfigError, match=field) as info:
-        EstimatorConfig(**{field: bad})
+        EstimatorConfig(**nested(field, bad))
     assert info.value.field == field
 
 
 def test_wrong_types_and_unknown_fields_are_type_errors() -> None:
     with pytest.raises(TypeError):
-        EstimatorConfig(k_df="fast")  # type: ignore[arg-type]
+        EstimatorConfig(disturbance_feedback={"k_df": "fast"})
+    with pytest.raises(TypeError):
+        EstimatorConfig(lock={"heal_tme": 0.1})
+    with pytest.raises(TypeError):
+        EstimatorConfig(lock=0.1)  # type: ignore[arg-type]
     with pytest.raises(TypeError):
         EstimatorConfig(rs_hat=0.3)  # type: ignore[call-arg]
     with pytest.raises(TypeError):
@@ -282,15 +333,15 @@ RATED_HZ = 100.0  # the paper motor's rated electrical frequency: 1500 r/min, 4 
     [
         # Above what the sampling rate allows (the discrete loops would be unstable): a
         # tuning alone is fine, the estimator sampled at 10 kHz refuses it.
-        ("t2s1_bandwidth_hz", 4000.0),
-        ("t2s2_bandwidth_hz", 4000.0),
-        ("k_af", 1.01 / TS),
-        ("k_df", 1.01 / TS),
-        ("mode_threshold_ratio", 0.5 / TS / RATED_HZ),
+        ("tracker.t2s1_bandwidth_hz", 4000.0),
+        ("tracker.t2s2_bandwidth_hz", 4000.0),
+        ("limiter.k_af", 1.01 / TS),
+        ("disturbance_feedback.k_df", 1.01 / TS),
+        ("mode.threshold_ratio", 0.5 / TS / RATED_HZ),
     ],
 )
 def test_sampling_rate_limits_name_the_field(field: str, bad: float) -> None:
-    tuning = EstimatorConfig(**{field: bad})
+    tuning = EstimatorConfig(**nested(field, bad))
     fado.Estimator("paper", tuning, ts=TS / 10)  # ten times faster: fine
     for make in (
         lambda: fado.Estimator("paper", tuning, ts=TS),
@@ -305,13 +356,13 @@ def test_sampling_rate_limits_name_the_field(field: str, bad: float) -> None:
 @pytest.mark.parametrize(
     ("field", "bad"),
     [
-        ("limiter_radius_ratio", 0.9),  # the limiter would clamp λ̂f itself
-        ("mode_hysteresis_ratio", 0.016),  # wider than the 0.015 threshold
+        ("limiter.radius_ratio", 0.9),  # the limiter would clamp λ̂f itself
+        ("mode.hysteresis_ratio", 0.016),  # wider than the 0.015 threshold
     ],
 )
 def test_ordering_limits_name_the_field(field: str, bad: float) -> None:
     with pytest.raises(ValueError, match=field) as info:
-        EstimatorConfig(**{field: bad})
+        EstimatorConfig(**nested(field, bad))
     assert isinstance(info.value, fado.ConfigError)
     assert info.value.field == field
 
@@ -321,8 +372,8 @@ def test_ordering_limits_name_the_field(field: str, bad: float) -> None:
     [
         ("[simulation]\nduration = 0.1\n\n[motor]\nrs = -1\n", "motor.rs", 5, 6),
         ("[inverter]\ndead_tme = 1e-6\n", "inverter.dead_tme", 2, 1),
-        ("[estimator]\n  k_df = 'half'\n", "estimator.k_df", 2, 10),
-        ("[estimator]\nt2s1_bandwidth_hz = 4000.0\n", "estimator.t2s1_bandwidth_hz", 2, 21),
+        ("[estimator.disturbance_feedback]\n  k_df = 'half'\n", "estimator.disturbance_feedback.k_df", 2, 10),
+        ("[estimator.tracker]\nt2s1_bandwidth_hz = 4000.0\n", "estimator.tracker.t2s1_bandwidth_hz", 2, 21),
     ],
 )
 def test_simulate_bad_toml_names_key_and_line(
@@ -349,20 +400,22 @@ def test_dict_config_errors_are_located_in_its_toml() -> None:
 
 
 def test_config_as_a_dict_works_as_in_simulate() -> None:
-    """Flat tuning keys, the [estimator] table of a simulator config, or dotted keys: the same
+    """Tuning records, the [estimator] table of a simulator config, or dotted keys: the same
     tuning; the simulator's other tables are not the estimator's and are refused, naming the
     functions that take them."""
     rng = np.random.default_rng(3)
     signals = [rng.normal(size=500) for _ in range(4)]
-    expected = fado.estimate(*signals, machine="paper", config=EstimatorConfig(k_df=1.0))
+    tuned = EstimatorConfig(disturbance_feedback={"k_df": 1.0})
+    expected = fado.estimate(*signals, machine="paper", config=tuned)
     for config in (
-        {"k_df": 1.0},
-        {"estimator": {"k_df": 1.0}},
-        {"estimator.k_df": 1.0},
+        {"disturbance_feedback": {"k_df": 1.0}},
+        {"disturbance_feedback.k_df": 1.0},
+        {"estimator": {"disturbance_feedback": {"k_df": 1.0}}},
+        {"estimator.disturbance_feedback.k_df": 1.0},
     ):
         got = fado.estimate(*signals, machine="paper", config=config)
         np.testing.assert_array_equal(got.theta, expected.theta, strict=True)
-        assert fado.Estimator("paper", config).config == EstimatorConfig(k_df=1.0)
+        assert fado.Estimator("paper", config).config == tuned
     default = fado.estimate(*signals, machine="paper")
     assert not np.array_equal(default.theta, expected.theta)
     for extra, key in (
@@ -370,11 +423,12 @@ def test_config_as_a_dict_works_as_in_simulate() -> None:
         ({"mismatch.rs_ratio": 1.1}, "mismatch.rs_ratio"),
     ):
         with pytest.raises(fado.ConfigError, match="fado.simulate") as info:
-            fado.estimate(*signals, machine="paper", config={"estimator": {"k_df": 1.0}, **extra})
+            fado.estimate(*signals, machine="paper", config={"estimator": {"disturbance_feedback": {"k_df": 1.0}}, **extra})
         assert info.value.field == key
     # The same dict drives the simulator's estimator.
-    sim_config = {"estimator": {"k_df": 1.0}, "simulation": {"duration": 0.05}}
-    assert fado.simulate("fig11", sim_config, averaged=True).estimator_config.k_df == 1.0
+    sim_config = {"estimator": {"disturbance_feedback": {"k_df": 1.0}}, "simulation": {"duration": 0.05}}
+    run = fado.simulate("fig11", sim_config, averaged=True)
+    assert run.estimator_config.disturbance_feedback["k_df"] == 1.0
 
 
 @pytest.mark.parametrize(
@@ -382,9 +436,13 @@ def test_config_as_a_dict_works_as_in_simulate() -> None:
     [
         ({"k_dff": 1.0}, "k_dff"),
         ({"estimator": {"kdf": 1.0}}, "estimator.kdf"),
-        ({"k_df": -1.0}, "k_df"),
-        ({"estimator": {"k_df": -1.0}}, "estimator.k_df"),
-        ({"estimator.k_af": math.nan}, "estimator.k_af"),
+        ({"disturbance_feedback": {"k_df": -1.0}}, "disturbance_feedback.k_df"),
+        ({"estimator": {"disturbance_feedback": {"k_df": -1.0}}}, "estimator.disturbance_feedback.k_df"),
+        # A key of the flat table names its new place.
+        ({"k_df": 1.0}, "k_df"),
+        ({"estimator": {"lock_heal_time": 0.2}}, "estimator.lock_heal_time"),
+        ({"estimator": {"rs_adaptation": False}}, "estimator.rs_adaptation"),
+        ({"estimator.limiter.k_af": math.nan}, "estimator.limiter.k_af"),
     ],
 )
 def test_bad_dict_keys_raise_naming_them_as_written(config: dict[str, object], key: str) -> None:
@@ -520,6 +578,7 @@ def test_fields_are_the_simulator_tables_keys() -> None:
 
     dumped = tomllib.loads(fado.default_config("fig11"))
     assert list(EstimatorConfig.fields) == list(dumped["estimator"])
+    assert EstimatorConfig().to_dict() == dumped["estimator"]
     assert list(fado.Machine.fields) == [*dumped["motor"], "dc_voltage"]
     machine = fado.Machine.paper()
     assert machine.dc_voltage == dumped["inverter"]["dc_voltage"]
@@ -528,10 +587,13 @@ def test_fields_are_the_simulator_tables_keys() -> None:
 @pytest.mark.parametrize(
     ("changes", "error", "field"),
     [
-        ({"k_df": math.nan}, fado.ConfigError, "k_df"),
-        ({"bandwidth_definition": "minus3db"}, fado.ConfigError, "bandwidth_definition"),
-        ({"rs_adaptation": 1.0}, TypeError, "rs_adaptation"),
-        ({"k_af": [1.0]}, TypeError, "k_af"),
+        ({"disturbance_feedback": {"k_df": math.nan}}, fado.ConfigError, "k_df"),
+        ({"tracker": {"bandwidth_definition": "minus3db"}}, fado.ConfigError, "bandwidth_definition"),
+        ({"rs_adaptation": {"enabled": 1.0}}, TypeError, "rs_adaptation.enabled"),
+        ({"limiter": {"k_af": [1.0]}}, TypeError, "limiter.k_af"),
+        # A flat keyword names its new place.
+        ({"k_df": 1.0}, TypeError, "disturbance_feedback"),
+        ({"rs_adaptation": False}, TypeError, "rs_adaptation="),
     ],
 )
 def test_replace_refuses_naming_the_field(
@@ -556,17 +618,27 @@ def test_machine_counts_and_voltages_by_type() -> None:
 
 
 def test_paper_path_switches_off_fados_additions_and_keeps_the_rest() -> None:
-    cfg = EstimatorConfig(k_af=300.0, rs_adaptation_rate=2.0)
+    cfg = EstimatorConfig(limiter={"k_af": 300.0}, rs_adaptation={"rate": 2.0})
     paper = cfg.paper_path()
     off = {
-        "rs_adaptation": False,
-        "observer_lag_compensation": False,
-        "observer_on_rotor_flux": False,
-        "limiter_recentring": False,
-        "k_df_ramp_time": 0.0,
-        "observer_gain_period": 0.0,
+        "rs_adaptation.enabled": False,
+        "observer.lag_compensation": False,
+        "observer.on_rotor_flux": False,
+        "limiter.recentring": False,
+        "disturbance_feedback.ramp_time": 0.0,
+        "observer.gain_period": 0.0,
     }
-    assert_fields(paper.to_dict(), dict(cfg.to_dict(), **off))
+    expected = cfg.to_dict()
+    for path, value in off.items():
+        record, field = path.split(".")
+        expected[record][field] = value
+    for record, fields in expected.items():
+        assert_fields(paper.to_dict()[record], fields)
+
+    def get(c: EstimatorConfig, path: str) -> object:
+        record, field = path.split(".")
+        return c.to_dict()[record][field]
+
     # The defaults have every one of them on (a test that the switch changes something).
-    assert all(cfg.to_dict()[k] != v for k, v in off.items() if k != "k_df_ramp_time")
+    assert all(get(cfg, k) != v for k, v in off.items() if k != "disturbance_feedback.ramp_time")
     assert paper.paper_path() == paper and EstimatorConfig(**paper.to_dict()) == paper

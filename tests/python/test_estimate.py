@@ -83,7 +83,7 @@ def test_estimate_defaults_equal_a_fresh_estimator(spin_up: Recording) -> None:
     n = 3000
     signals = [s[:n] for s in spin_up.signals()]
     machine = fado.Machine.paper().replace(rs=0.3)
-    cfg = fado.EstimatorConfig(k_df=0.7)
+    cfg = fado.EstimatorConfig(disturbance_feedback={"k_df": 0.7})
     by_function = fado.estimate(*signals, machine=machine, config=cfg)
     by_object = fado.Estimator(machine, cfg).run(*signals)
     for name in fado.OUTPUT_NAMES:
@@ -267,7 +267,7 @@ def test_ipmsm_preset_replayed_through_estimate(
     ipm = fado.Machine.preset("ipmsm-2k2")
     assert ipm.salient
     rec = ipmsm_recording(ipm, i_d_ratio)
-    config = fado.EstimatorConfig(rs_adaptation=rs_adaptation)
+    config = fado.EstimatorConfig(rs_adaptation={"enabled": rs_adaptation})
     result = fado.estimate(*rec.signals(), machine="ipmsm-2k2", config=config, theta0=rec.theta0)
     assert settled_error(result, rec) < bound
     np.testing.assert_allclose(result.omega_control[20_000:], rec.omega[20_000:], rtol=0.01)

@@ -13,7 +13,7 @@ from fado import Mode
 
 
 def test_initial_state_is_the_configured_alignment() -> None:
-    cfg = fado.EstimatorConfig(k_df=1.0)
+    cfg = fado.EstimatorConfig(disturbance_feedback={"k_df": 1.0})
     est = fado.Estimator("paper", cfg, theta0=1.0)
     last = est.last
     assert last.theta == pytest.approx(1.0)

@@ -70,6 +70,10 @@ def test_non_finite_scalar_arguments_are_refused_by_name(bad):
             est.align(*args)
     with pytest.raises(ValueError, match="rs_hat"):
         est.set_rs_hat(bad)
-    for field in ["plausible_current_ratio", "lock_detection_time", "lock_flux_high_ratio"]:
-        with pytest.raises(fado.ConfigError, match=field):
-            fado.EstimatorConfig(**{field: bad})
+    for record, field in [
+        ("plausibility", "current_ratio"),
+        ("lock", "detection_time"),
+        ("lock", "flux_high_ratio"),
+    ]:
+        with pytest.raises(fado.ConfigError, match=f"{record}.{field}"):
+            fado.EstimatorConfig(**{record: {field: bad}})

@@ -62,7 +62,7 @@ def test_figure_content(averaged_runs: dict[str, fado.SimResult]) -> None:
     assert levels == [-fado.plot.ANGLE_CRITERION, fado.plot.ANGLE_CRITERION]
     fig10 = fado.plot.plot_fig10(averaged_runs["fig10"])
     run = averaged_runs["fig10"]
-    radius = round(run.estimator_config.limiter_radius_ratio * run.machine.flux_linkage, 9)
+    radius = round(run.estimator_config.limiter["radius_ratio"] * run.machine.flux_linkage, 9)
     flux_axis = fig10.get_axes()[3]
     assert radius in {
         round(float(line.get_ydata()[0]), 9) for line in flux_axis.get_lines()

@@ -51,9 +51,9 @@ def test_grid_is_the_cartesian_product_with_one_row_per_point() -> None:
 
 
 def test_a_list_of_points_is_taken_point_by_point() -> None:
-    points = [{"rs_error": 0.01, "estimator.k_df": 0.25}, {"rs_error": -0.01, "estimator.k_df": 1.0}]
+    points = [{"rs_error": 0.01, "estimator.disturbance_feedback.k_df": 0.25}, {"rs_error": -0.01, "estimator.disturbance_feedback.k_df": 1.0}]
     df = short_sweep(points)
-    assert list(df["estimator.k_df"]) == [0.25, 1.0]
+    assert list(df["estimator.disturbance_feedback.k_df"]) == [0.25, 1.0]
     with pytest.raises(ValueError, match="keys"):
         short_sweep([{"rs_error": 0.0}, {"lq_error": 0.0}])
 

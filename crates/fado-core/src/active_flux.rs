@@ -39,8 +39,8 @@
 //! resistance error's q flux is amplified by the map's gradient without bound: the law cannot
 //! tell the map's slope from a resistance, and freezes ([`KAPPA_MIN_RATIO`]).
 
-use crate::magnetics::{MagneticModel, Magnetics};
-use crate::{Ab, Dq, Real};
+use crate::magnetics::{ConstantInductance, InductanceMatrix, MachineMagnetics, MagneticModel};
+use crate::{Ab, Dq, MachineModel, Real};
 
 /// The R̂s laws freeze where κ < `KAPPA_MIN_RATIO`·λa: the angle feedback through the
 /// secant's slope then more than doubles the q flux error of a resistance error (the
@@ -50,7 +50,11 @@ pub const KAPPA_MIN_RATIO: f64 = 0.5;
 /// A saturating model as the estimator uses it, with the constants it falls back to.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ActiveFlux<T: 'static> {
-    model: Magnetics<'static, T>,
+    /// The model, borrowed (two words: the estimator's parameters stay small enough to be
+    /// built in place in a freestanding image).
+    model: MachineMagnetics<T>,
+    /// What `model` stands for if it is `Linear` (never, as built; see [`ActiveFlux::new`]).
+    linear: ConstantInductance<T>,
     /// The secant is the incremental ∂ψq/∂i_q below this |i_q| (A).
     small_current: T,
     /// ψd(0, 0), Wb.
@@ -71,25 +75,44 @@ pub struct ActiveFluxPoint<T> {
 }
 
 impl<T: Real> ActiveFlux<T> {
-    /// The estimator's view of `model`; None for constant inductances (the blocks keep their
-    /// closed-form arithmetic). `rated_current` scales the small-current threshold (10⁻³ of
-    /// it).
-    pub fn new(model: Magnetics<'static, T>, rated_current: T) -> Option<Self> {
-        if model.is_linear() {
-            return None;
-        }
-        let lq_zero = model.incremental_inductance(Dq::zero()).qq;
-        Some(Self {
-            model,
-            small_current: T::lit(1e-3) * rated_current,
-            magnet_flux: model.magnet_flux(),
-            lq_zero,
-        })
+    /// The estimator's view of `machine`'s magnetic model, if it saturates (see
+    /// [`ActiveFlux::of`]).
+    pub fn new(machine: &MachineModel<T>) -> Option<Self> {
+        Self::of(machine).saturating().copied()
     }
 
-    /// The model.
-    pub fn model(&self) -> &Magnetics<'static, T> {
-        &self.model
+    /// The estimator's view of `machine`'s magnetic model, held whatever the model (the
+    /// parameters keep it without an `Option`, whose niche in a borrowed model made a
+    /// freestanding image copy them with `memcpy`); [`ActiveFlux::saturating`] tells. The
+    /// rated current scales the small-current threshold (10⁻³ of it).
+    pub fn of(machine: &MachineModel<T>) -> Self {
+        let model = machine.magnetic_model();
+        Self {
+            model: machine.magnetics,
+            linear: machine.constant_inductance(),
+            small_current: T::lit(1e-3) * machine.rated_current,
+            magnet_flux: model.magnet_flux(),
+            lq_zero: model.incremental_inductance(Dq::zero()).qq,
+        }
+    }
+
+    /// Itself for a saturating model; None for constant inductances (the blocks keep their
+    /// closed-form arithmetic).
+    #[inline]
+    pub fn saturating(&self) -> Option<&Self> {
+        (!self.model.is_linear()).then_some(self)
+    }
+
+    /// ψ(i) of the model.
+    #[inline]
+    pub fn flux(&self, i: Dq<T>) -> Dq<T> {
+        self.model.resolve(self.linear).flux(i)
+    }
+
+    /// The incremental inductance ∂ψ/∂i of the model at `i`.
+    #[inline]
+    pub fn incremental_inductance(&self, i: Dq<T>) -> InductanceMatrix<T> {
+        self.model.resolve(self.linear).incremental_inductance(i)
     }
 
     /// ψd(0, 0), Wb.
@@ -106,11 +129,11 @@ impl<T: Real> ActiveFlux<T> {
     /// positive finite number (a map not odd in i_q near i_q = 0) is replaced by L_qq(0).
     #[inline]
     pub fn point(&self, i_dq: Dq<T>) -> ActiveFluxPoint<T> {
-        let psi = self.model.flux(i_dq);
+        let psi = self.flux(i_dq);
         let secant = if i_dq.q.abs() > self.small_current {
             psi.q / i_dq.q
         } else {
-            self.model.incremental_inductance(i_dq).qq
+            self.incremental_inductance(i_dq).qq
         };
         let lq_secant = if secant.is_finite() && secant > T::zero() {
             secant
@@ -157,7 +180,7 @@ impl<T: Real> ActiveFlux<T> {
     #[inline]
     pub fn resistance_regressor(&self, point: &ActiveFluxPoint<T>) -> Option<T> {
         let i = point.i_dq;
-        let l = self.model.incremental_inductance(i);
+        let l = self.incremental_inductance(i);
         let lqs = point.lq_secant;
         let kappa = point.active + l.qd * i.q - (l.qq - lqs) * i.d;
         let floor = T::lit(KAPPA_MIN_RATIO) * point.active;
@@ -170,7 +193,7 @@ impl<T: Real> ActiveFlux<T> {
     /// The incremental L_dd at the operating point (the standstill law's inductive voltage).
     #[inline]
     pub fn ld_incremental(&self, i_dq: Dq<T>) -> T {
-        self.model.incremental_inductance(i_dq).dd
+        self.incremental_inductance(i_dq).dd
     }
 }
 

@@ -99,7 +99,7 @@ impl<T: Real> FluxIntegratorParams<T> {
     }
 
     /// The current multiplied by R̂s in the sample ending with `i_ab`: the interval's average
-    /// (with `average_current`) or `i_ab`.
+    /// (with `integrator.average_current`) or `i_ab`.
     #[inline(always)]
     pub(crate) fn drop_current(&self, s: &FluxIntegratorState<T>, i_ab: Ab<T>) -> Ab<T> {
         if self.average_current && s.has_prev {

@@ -40,6 +40,6 @@ pub use estimator::{
 pub use frames::{Ab, Abc, Dq, Rotation};
 pub use lock::LockStatus;
 pub use machine::MachineModel;
-pub use magnetics::{MagneticModel, Magnetics};
+pub use magnetics::{MachineMagnetics, MagneticModel, Magnetics};
 pub use mode::Mode;
 pub use real::{Real, wrap_angle};

@@ -77,7 +77,7 @@ pub enum LockStatus {
     Locked = 0,
     /// Symptoms seen, not yet for long enough to call the rotor lost.
     Suspect = 1,
-    /// The estimate is judged lost (until a net `lock_heal_time` of clean samples, or a
+    /// The estimate is judged lost (until a net `lock.heal_time` of clean samples, or a
     /// reset, e.g. by `align`).
     Lost = 2,
 }

@@ -11,6 +11,13 @@ pub trait Real: RealField + Copy + Default {
     fn lit(x: f64) -> Self;
     /// Converts this scalar to `f64` (for reporting and tests).
     fn to_f64(self) -> f64;
+    /// ⌊self⌋ as an index, clamped to `0..=max` (negative and NaN give 0): one conversion
+    /// instruction on a single-precision FPU, where `to_f64() as usize` is software double
+    /// precision. For table lookups in the per-sample path.
+    fn index_floor(self, max: usize) -> usize;
+    /// The index `k` as this scalar (exact up to 2^24 for `f32`), the inverse of
+    /// [`index_floor`](Self::index_floor) on the nodes of a table.
+    fn from_index(k: usize) -> Self;
     /// (sin x, cos x) for |x| ≤ π/2, as the estimator's step computes them: `libm` for `f64`,
     /// [`crate::approx::sin_cos`] for `f32` (no software double precision on a single-precision
     /// FPU; error below 2e-7).
@@ -107,6 +114,15 @@ impl Real for f32 {
         self as f64
     }
     #[inline(always)]
+    fn index_floor(self, max: usize) -> usize {
+        // Towards zero, saturating, NaN to 0: ⌊x⌋ for x ≥ 0, 0 below.
+        (self as usize).min(max)
+    }
+    #[inline(always)]
+    fn from_index(k: usize) -> Self {
+        k as f32
+    }
+    #[inline(always)]
     fn step_sin_cos(self) -> (Self, Self) {
         crate::approx::sin_cos(self)
     }
@@ -177,6 +193,15 @@ impl Real for f64 {
     #[inline(always)]
     fn to_f64(self) -> f64 {
         self
+    }
+    #[inline(always)]
+    fn index_floor(self, max: usize) -> usize {
+        // Towards zero, saturating, NaN to 0: ⌊x⌋ for x ≥ 0, 0 below.
+        (self as usize).min(max)
+    }
+    #[inline(always)]
+    fn from_index(k: usize) -> Self {
+        k as f64
     }
     #[inline(always)]
     fn step_sin_cos(self) -> (Self, Self) {

@@ -28,7 +28,7 @@
 //! varying acceleration â, integrated from the phase error (â ← â + K3·Ts·e): a third
 //! integrator, so a constant load leaves no angle error (with the feed-forward alone it would
 //! leave p·T_L/(Ĵ·Ki), 0.11 rad at the paper's rated load). The poles are the type-2 pair
-//! with a real pole added at c·ωn (the estimator's `tracker_load_pole_ratio`; c = 0 keeps the
+//! with a real pole added at c·ωn (the estimator's `tracker.load_pole_ratio`; c = 0 keeps the
 //! type-2 loop to the bit). The feed-forward removes the lag under the commanded torque; a
 //! load step is a disturbance the third integrator removes at c·ωn.
 //!

@@ -79,10 +79,10 @@ fn every_motor_dependent_value_scales_with_the_motor() {
         FluxLimiterConfig::for_machine(&ipm).radius,
         1.15 * 0.545
     ));
-    let f_th = est.mode_threshold_ratio * 75.0;
+    let f_th = est.mode.threshold_ratio * 75.0;
     let mode = ModeSelectorConfig::for_machine(&ipm);
     assert!(close(mode.threshold_hz, f_th) && close(mode.threshold_hz, 1.125));
-    assert!(close(mode.hysteresis_hz, est.mode_hysteresis_ratio * 75.0));
+    assert!(close(mode.hysteresis_hz, est.mode.hysteresis_ratio * 75.0));
     let offset = IntegrandOffsetConfig::for_machine(&ipm, TS);
     assert!(close(offset.limit, 0.545 * TAU * f_th));
     assert!(close(offset.settle_time, 5.0 / (TAU * f_th)));
@@ -125,14 +125,18 @@ fn every_motor_dependent_value_scales_with_the_motor() {
 fn motor_independent_blocks_take_the_sampling_period_and_the_tuning() {
     let est = EstimatorTuning::<f64>::default();
     for ts in [50e-6, 100e-6, 125e-6] {
-        let t = TrackerConfig::new(est.t2s1_bandwidth_hz, ts);
+        let t = TrackerConfig::new(est.tracker.t2s1_bandwidth_hz, ts);
         assert_eq!(t.ts, ts);
         assert_eq!(t.damping, FRAC_1_SQRT_2);
         assert_eq!(t.definition, BandwidthDefinition::Minus3Db);
         let fb = DisturbanceFeedbackConfig::with_ts(ts);
         assert_eq!(
             (fb.ts, fb.k_df, fb.ramp_time),
-            (ts, est.k_df, est.k_df_ramp_time)
+            (
+                ts,
+                est.disturbance_feedback.k_df,
+                est.disturbance_feedback.ramp_time
+            )
         );
         let d = DelayCompensationConfig::with_ts(ts);
         assert_eq!((d.ts, d.factor), (ts, 1.5));

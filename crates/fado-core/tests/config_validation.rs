@@ -62,8 +62,15 @@ struct Field<C, T> {
 }
 
 /// The last component of a field path: `tuning.k_df` → `k_df`.
+/// The name errors give the field at `path`: its last segment, or for a field of the
+/// estimator's nested tuning its flat name (`tuning.lock.heal_time` → `lock_heal_time`).
 fn leaf(path: &'static str) -> &'static str {
-    path.rsplit('.').next().unwrap_or(path).trim()
+    let compact = path.replace(' ', "");
+    let flat = fado_core::estimator::tuning::MOVED_KEYS
+        .iter()
+        .find(|(_, new)| compact == *new || compact.ends_with(&format!("tuning.{new}")))
+        .map(|(old, _)| *old);
+    flat.unwrap_or_else(|| path.rsplit('.').next().unwrap_or(path).trim())
 }
 
 macro_rules! fields {
@@ -177,17 +184,17 @@ fn run_all<T: Real>(failures: &mut Vec<String>, machine: MachineModel<T>) -> usi
             machine.rated_speed_rpm: Positive,
             machine.rated_torque: PositiveBounded,
             machine.dc_voltage: Positive,
-            tuning.k_df: NonNegativeBounded,
-            tuning.k_df_ramp_time: NonNegative,
-            tuning.k_af: NonNegativeBounded,
-            tuning.limiter_radius_ratio: Positive,
-            tuning.mode_threshold_ratio: NonNegativeBounded,
-            tuning.mode_hysteresis_ratio: NonNegativeBounded,
-            tuning.t2s1_bandwidth_hz: PositiveBounded,
-            tuning.t2s2_bandwidth_hz: PositiveBounded,
-            tuning.tracker_damping: Positive,
-            tuning.tracker_hold_ratio: NonNegativeBounded,
-            tuning.observer_gain_period: NonNegativeBounded,
+            tuning.disturbance_feedback.k_df: NonNegativeBounded,
+            tuning.disturbance_feedback.ramp_time: NonNegative,
+            tuning.limiter.k_af: NonNegativeBounded,
+            tuning.limiter.radius_ratio: Positive,
+            tuning.mode.threshold_ratio: NonNegativeBounded,
+            tuning.mode.hysteresis_ratio: NonNegativeBounded,
+            tuning.tracker.t2s1_bandwidth_hz: PositiveBounded,
+            tuning.tracker.t2s2_bandwidth_hz: PositiveBounded,
+            tuning.tracker.damping: Positive,
+            tuning.tracker.hold_ratio: NonNegativeBounded,
+            tuning.observer.gain_period: NonNegativeBounded,
             initial_angle: Signed,
         ),
     );
@@ -260,9 +267,9 @@ fn run_all<T: Real>(failures: &mut Vec<String>, machine: MachineModel<T>) -> usi
         EstimatorTuning::<T>::default(),
         |t| ok(SensorlessDrive::new(DriveConfig::for_machine(&machine), t)),
         &fields!(EstimatorTuning<T>, T;
-            k_df: NonNegativeBounded,
-            mode_threshold_ratio: NonNegativeBounded,
-            t2s1_bandwidth_hz: PositiveBounded,
+            disturbance_feedback.k_df: NonNegativeBounded,
+            mode.threshold_ratio: NonNegativeBounded,
+            tracker.t2s1_bandwidth_hz: PositiveBounded,
         ),
     );
     n += probe(
@@ -544,28 +551,34 @@ fn bandwidths_above_what_the_sampling_rate_allows_are_refused() {
         "refused at {limit} Hz although Jury's conditions hold"
     );
     assert_eq!(
-        est(|c| c.tuning.t2s1_bandwidth_hz = limit),
+        est(|c| c.tuning.tracker.t2s1_bandwidth_hz = limit),
         "t2s1_bandwidth_hz"
     );
     assert_eq!(
-        est(|c| c.tuning.t2s2_bandwidth_hz = limit),
+        est(|c| c.tuning.tracker.t2s2_bandwidth_hz = limit),
         "t2s2_bandwidth_hz"
     );
-    assert_eq!(est(|c| c.tuning.t2s1_bandwidth_hz = limit - 1.0), "");
-    // Limiter and disturbance feedback: one step must not remove more than the excess.
-    assert_eq!(est(|c| c.tuning.k_af = 1.0 / ts), "");
-    assert_eq!(est(|c| c.tuning.k_af = 1.01 / ts), "k_af");
-    assert_eq!(est(|c| c.tuning.k_df = 1.0 / ts), "");
-    assert_eq!(est(|c| c.tuning.k_df = 1.01 / ts), "k_df");
-    // The observer's gains are held at most 1 s, whatever ts (a u32 count of samples).
-    assert_eq!(est(|c| c.tuning.observer_gain_period = 1.0), "");
     assert_eq!(
-        est(|c| c.tuning.observer_gain_period = 1.01),
+        est(|c| c.tuning.tracker.t2s1_bandwidth_hz = limit - 1.0),
+        ""
+    );
+    // Limiter and disturbance feedback: one step must not remove more than the excess.
+    assert_eq!(est(|c| c.tuning.limiter.k_af = 1.0 / ts), "");
+    assert_eq!(est(|c| c.tuning.limiter.k_af = 1.01 / ts), "k_af");
+    assert_eq!(est(|c| c.tuning.disturbance_feedback.k_df = 1.0 / ts), "");
+    assert_eq!(
+        est(|c| c.tuning.disturbance_feedback.k_df = 1.01 / ts),
+        "k_df"
+    );
+    // The observer's gains are held at most 1 s, whatever ts (a u32 count of samples).
+    assert_eq!(est(|c| c.tuning.observer.gain_period = 1.0), "");
+    assert_eq!(
+        est(|c| c.tuning.observer.gain_period = 1.01),
         "observer_gain_period"
     );
     assert_eq!(
         est(|c| {
-            c.tuning.observer_gain_period = 1.0;
+            c.tuning.observer.gain_period = 1.0;
             c.ts = 1e-9;
         }),
         ""
@@ -573,21 +586,21 @@ fn bandwidths_above_what_the_sampling_rate_allows_are_refused() {
     // The mode band must lie below Nyquist (5 kHz; the paper motor's rated frequency is
     // 100 Hz, so the ratios are the old thresholds in Hz / 100).
     assert_eq!(
-        est(|c| c.tuning.mode_threshold_ratio = 50.0),
+        est(|c| c.tuning.mode.threshold_ratio = 50.0),
         "mode_threshold_ratio"
     );
-    assert_eq!(est(|c| c.tuning.mode_threshold_ratio = 49.9), "");
+    assert_eq!(est(|c| c.tuning.mode.threshold_ratio = 49.9), "");
     assert_eq!(
         est(|c| {
-            c.tuning.mode_threshold_ratio = 49.0;
-            c.tuning.mode_hysteresis_ratio = 2.0;
+            c.tuning.mode.threshold_ratio = 49.0;
+            c.tuning.mode.hysteresis_ratio = 2.0;
         }),
         "mode_hysteresis_ratio"
     );
     // The same ratio is a lower frequency on a slower motor: 50 × 75 Hz (the 2.2 kW IPMSM,
     // 3 pole pairs at 1500 r/min) is below Nyquist.
     let mut slow = EstimatorConfig::for_machine(&ipmsm::<f64>());
-    slow.tuning.mode_threshold_ratio = 50.0;
+    slow.tuning.mode.threshold_ratio = 50.0;
     assert!((slow.mode_threshold_hz() - 3750.0).abs() < 1e-9);
     assert_eq!(refused_field(SensorlessEstimator::new(slow)), "");
     // Drive: current PI (2π·f·Ts ≤ 0.5) and speed PI (2π·f·Ts < 0.1).
@@ -625,19 +638,19 @@ fn bandwidths_above_what_the_sampling_rate_allows_are_refused() {
 fn thresholds_out_of_order_are_refused() {
     // Hysteresis at most the threshold (1.5 Hz = 0.015 of the paper motor's 100 Hz).
     assert_eq!(
-        est(|c| c.tuning.mode_hysteresis_ratio = 0.016),
+        est(|c| c.tuning.mode.hysteresis_ratio = 0.016),
         "mode_hysteresis_ratio"
     );
-    assert_eq!(est(|c| c.tuning.mode_hysteresis_ratio = 0.015), "");
+    assert_eq!(est(|c| c.tuning.mode.hysteresis_ratio = 0.015), "");
     assert_eq!(
-        est(|c| c.tuning.tracker_hold_ratio = 1.0),
+        est(|c| c.tuning.tracker.hold_ratio = 1.0),
         "tracker_hold_ratio"
     );
     assert_eq!(
-        est(|c| c.tuning.limiter_radius_ratio = 0.9),
+        est(|c| c.tuning.limiter.radius_ratio = 0.9),
         "limiter_radius_ratio"
     );
-    assert_eq!(est(|c| c.tuning.limiter_radius_ratio = 1.0), "");
+    assert_eq!(est(|c| c.tuning.limiter.radius_ratio = 1.0), "");
     // Injection at most the current limit, the trip level above it (as ratios of the same
     // rated current: 41 A, 40 A against the 40 A limit of the paper's motor).
     let limit = DriveConfig::<f64>::for_machine(&MachineModel::paper())
@@ -755,18 +768,19 @@ mod properties {
                         ts,
                         machine,
                         initial_angle: a0,
-                        tuning: EstimatorTuning {
-                            k_df: kdf,
-                            k_df_ramp_time: ramp,
-                            k_af: kaf_ts / ts,
-                            limiter_radius_ratio: ratio,
-                            mode_threshold_ratio: th,
-                            mode_hysteresis_ratio: hy * th,
-                            t2s1_bandwidth_hz: b1,
-                            t2s2_bandwidth_hz: b2,
-                            tracker_damping: z,
-                            tracker_hold_ratio: hold,
-                            ..EstimatorTuning::default()
+                        tuning: {
+                            let mut tuned = EstimatorTuning::default();
+                            tuned.disturbance_feedback.k_df = kdf;
+                            tuned.disturbance_feedback.ramp_time = ramp;
+                            tuned.limiter.k_af = kaf_ts / ts;
+                            tuned.limiter.radius_ratio = ratio;
+                            tuned.mode.threshold_ratio = th;
+                            tuned.mode.hysteresis_ratio = hy * th;
+                            tuned.tracker.t2s1_bandwidth_hz = b1;
+                            tuned.tracker.t2s2_bandwidth_hz = b2;
+                            tuned.tracker.damping = z;
+                            tuned.tracker.hold_ratio = hold;
+                            tuned
                         },
                     }
                 },
@@ -860,11 +874,11 @@ mod properties {
                 machine.flux_linkage: Positive, machine.inertia: Positive,
                 machine.rated_current: Positive, machine.rated_speed_rpm: Positive,
                 machine.rated_torque: Positive, machine.dc_voltage: Positive,
-                tuning.k_df: NonNegative, tuning.k_df_ramp_time: NonNegative,
-                tuning.k_af: NonNegative, tuning.limiter_radius_ratio: Positive,
-                tuning.mode_threshold_ratio: NonNegative, tuning.mode_hysteresis_ratio: NonNegative,
-                tuning.t2s1_bandwidth_hz: Positive, tuning.t2s2_bandwidth_hz: Positive,
-                tuning.tracker_damping: Positive, tuning.tracker_hold_ratio: NonNegative,
+                tuning.disturbance_feedback.k_df: NonNegative, tuning.disturbance_feedback.ramp_time: NonNegative,
+                tuning.limiter.k_af: NonNegative, tuning.limiter.radius_ratio: Positive,
+                tuning.mode.threshold_ratio: NonNegative, tuning.mode.hysteresis_ratio: NonNegative,
+                tuning.tracker.t2s1_bandwidth_hz: Positive, tuning.tracker.t2s2_bandwidth_hz: Positive,
+                tuning.tracker.damping: Positive, tuning.tracker.hold_ratio: NonNegative,
             );
             let f = &fields[which];
             let mut bad = c;

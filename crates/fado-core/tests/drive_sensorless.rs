@@ -333,12 +333,14 @@ fn drives<T: fado_core::Real>(method: DeadTimeMethod) -> [SensorlessDrive<T>; 2]
     no_trip.tuning.input_fault_trip_time = T::zero();
     no_trip.tuning.plausible_current_ratio = T::one() + T::default_epsilon();
     no_trip.tuning.dc_link_max_ratio = T::max_value().unwrap() / cfg.machine.dc_voltage;
-    let unbounded = EstimatorTuning {
-        plausible_current_ratio: T::max_value().unwrap()
-            / (cfg.machine.rated_current * T::lit(2.0)),
-        plausible_voltage_ratio: T::max_value().unwrap() / (cfg.machine.dc_voltage * T::lit(2.0)),
-        plausible_current_step_ratio: T::zero(),
-        ..EstimatorTuning::default()
+    let unbounded = {
+        let mut tuned = EstimatorTuning::default();
+        tuned.plausibility.current_ratio =
+            T::max_value().unwrap() / (cfg.machine.rated_current * T::lit(2.0));
+        tuned.plausibility.voltage_ratio =
+            T::max_value().unwrap() / (cfg.machine.dc_voltage * T::lit(2.0));
+        tuned.plausibility.current_step_ratio = T::zero();
+        tuned
     };
     [(cfg, EstimatorTuning::default()), (no_trip, unbounded)].map(|(c, e)| {
         let mut d = SensorlessDrive::new(c, e).unwrap();

@@ -44,7 +44,7 @@ fn warmed_up<T: Real>(omega: f64, warm_up: usize) -> SensorlessEstimator<T> {
     // The inputs drawn jump by up to 2·I_MAX per sample, more than any inductance allows:
     // this test is about boundedness, so only the magnitude bounds stay on (the step bound
     // is checked in fado-core's tests/plausibility.rs).
-    config.tuning.plausible_current_step_ratio = T::zero();
+    config.tuning.plausibility.current_step_ratio = T::zero();
     let mut est = SensorlessEstimator::<T>::new(config).unwrap();
     est.align(T::lit(theta0), ab(i0));
     for s in profile(theta0, warm_up, |_| omega, |_| i_dq, Ab::zero(), Ab::zero()) {

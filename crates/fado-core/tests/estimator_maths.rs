@@ -7,7 +7,6 @@
 mod common;
 
 use common::*;
-use fado_core::estimator::EstimatorTuning;
 use fado_core::{Ab, Dq, EstimatorConfig, Mode, Real, SensorlessEstimator, wrap_angle};
 
 const TAU: f64 = core::f64::consts::TAU;
@@ -97,15 +96,15 @@ fn k_df_bounds_the_drift_of_a_dc_integrand_error_and_a_pure_integrator_does_not(
     let e = Ab::new(0.04, -0.03); // |e| = 50 mV
     let seconds = 8.0;
     for rpm in [300.0, -300.0] {
-        // The paper's loop alone: the learned integrand offset (`offset_adaptation_rate`,
+        // The paper's loop alone: the learned integrand offset (`offset_adaptation.rate`,
         // ours) would remove e before k_df sees it (tests/integrand_offset.rs).
         let with = run_constant_speed(rpm, seconds, paper_loop(), e, Ab::zero());
         let without = run_constant_speed(
             rpm,
             seconds,
             config_with(|c| {
-                c.tuning.k_df = 0.0;
-                c.tuning.offset_adaptation_rate = 0.0;
+                c.tuning.disturbance_feedback.k_df = 0.0;
+                c.tuning.offset_adaptation.rate = 0.0;
             }),
             e,
             Ab::zero(),
@@ -186,7 +185,7 @@ fn standstill(
 /// The paper's estimator: these checks are of its limiter, so without our R̂s adaptation (which
 /// at standstill under i_d > 0 would correct R̂s and pull |λ̂r| back to λ̂f).
 fn paper() -> EstimatorConfig<f64> {
-    config_with(|c| c.tuning.rs_adaptation = false)
+    config_with(|c| c.tuning.rs_adaptation.enabled = false)
 }
 
 #[test]
@@ -214,9 +213,10 @@ fn limiter_bounds_the_rotor_flux_at_standstill() {
             i_dq,
             seconds,
             EstimatorConfig {
-                tuning: EstimatorTuning {
-                    k_af: 0.0,
-                    ..paper().tuning
+                tuning: {
+                    let mut tuned = paper().tuning;
+                    tuned.limiter.k_af = 0.0;
+                    tuned
                 },
                 ..paper()
             },
@@ -420,7 +420,7 @@ fn f32_estimator_settles_at_plus_minus_300_and_30_rpm() {
 /// The default configuration without the learned integrand offset (ours), for the paper's
 /// eq. (22) DC loop.
 fn paper_loop() -> EstimatorConfig<f64> {
-    config_with(|c| c.tuning.offset_adaptation_rate = 0.0)
+    config_with(|c| c.tuning.offset_adaptation.rate = 0.0)
 }
 
 /// Worst |mean(λ2 − λs)|/λf over the whole electrical revolutions in k_df mode after a
@@ -481,9 +481,10 @@ fn lag_compensation_keeps_lambda2_centred_after_an_accelerated_reversal() {
     ];
     for (m, config, top, i_dq) in cases {
         let off = EstimatorConfig {
-            tuning: EstimatorTuning {
-                observer_lag_compensation: false,
-                ..config.tuning
+            tuning: {
+                let mut tuned = config.tuning;
+                tuned.observer.lag_compensation = false;
+                tuned
             },
             ..config
         };

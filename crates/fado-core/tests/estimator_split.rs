@@ -54,7 +54,7 @@ impl Signal {
 /// laws.
 fn split_matches_owner<T: Real>(model: MachineModel<f64>, rs_adaptation: bool) -> (u32, bool) {
     let mut config = EstimatorConfig::for_machine(&model.cast::<T>());
-    config.tuning.rs_adaptation = rs_adaptation;
+    config.tuning.rs_adaptation.enabled = rs_adaptation;
     let params = EstimatorParams::new(config).unwrap();
     let mut state = EstimatorState::new(&params);
     let mut owner = SensorlessEstimator::new(config).unwrap();

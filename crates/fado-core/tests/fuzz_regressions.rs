@@ -44,7 +44,7 @@ fn huge_initial_angle_is_wrapped() {
     for a0 in [-5.727778756618604e250, 9.112e30, f64::MAX] {
         let mut config = paper();
         config.initial_angle = a0;
-        config.tuning.observer_on_rotor_flux = false;
+        config.tuning.observer.on_rotor_flux = false;
         let mut est = SensorlessEstimator::new(config).unwrap();
         check_estimate(&est.last());
         check_estimate(&est.step(Ab::new(1.0, 0.0), Ab::new(0.5, 0.0)));
@@ -93,8 +93,8 @@ fn align_with_an_overflowing_current_starts_finite() {
     );
     let mut config = paper::<f32>();
     config.initial_angle = -6.41;
-    config.tuning.average_current = false;
-    config.tuning.observer_on_rotor_flux = false;
+    config.tuning.integrator.average_current = false;
+    config.tuning.observer.on_rotor_flux = false;
     let mut est = SensorlessEstimator::new(config).unwrap();
     let huge = f32::MAX * 0.9;
     est.align(huge, Ab::new(huge, huge));

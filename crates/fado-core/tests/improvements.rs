@@ -15,11 +15,11 @@ fn disturbance_excursion(observer_on_rotor_flux: bool) -> f64 {
     let w = 2.0 * std::f64::consts::PI * 6.0;
     let wm = 2.0 * std::f64::consts::PI * 5.0;
     let mut cfg = EstimatorConfig::for_machine(&MachineModel::paper());
-    cfg.tuning.observer_on_rotor_flux = observer_on_rotor_flux;
+    cfg.tuning.observer.on_rotor_flux = observer_on_rotor_flux;
     // The integrand-offset law re-centres D̂ in the k_df mode (a common shift that λ2 and λ̂r
     // do not see), which would show up as a D̂ "excursion" here: off, to compare the observer
     // inputs alone.
-    cfg.tuning.offset_adaptation_rate = 0.0;
+    cfg.tuning.offset_adaptation.rate = 0.0;
     let mut est = SensorlessEstimator::new(cfg).unwrap();
     let current = |t: f64| {
         let i_dq = Dq::new(1.3 + 1.0 * (wm * t).sin(), 3.8 + 0.3 * (wm * t).sin());

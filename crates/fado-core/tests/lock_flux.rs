@@ -1,7 +1,7 @@
 //! The flux-magnitude symptom of the loss-of-lock detector (`fado_core::lock`) on the ideal
-//! machine: its lower bound is `lock_flux_low_ratio` (0.7) below the mode hand-over band
-//! (`mode_threshold_ratio` − `mode_hysteresis_ratio` = 0.013 of the rated speed) and
-//! `lock_flux_low_fast_ratio` (0.6) from there on (docs/method/lock.md, 2026-11-24). The estimator's
+//! machine: its lower bound is `lock.flux_low_ratio` (0.7) below the mode hand-over band
+//! (`mode.threshold_ratio` − `mode.hysteresis_ratio` = 0.013 of the rated speed) and
+//! `lock.flux_low_fast_ratio` (0.6) from there on (docs/method/lock.md, 2026-11-24). The estimator's
 //! λ̂f is set to λf / r, so that a locked estimate shows |λ̂r| = r·λ̂f; two motors (the paper's
 //! SPMSM and the 2.2 kW IPMSM).
 
@@ -27,7 +27,7 @@ fn lost_at(
     // The model's ratings agree with its λ̂f (a λ̂f 1.5–2× the rating's, with an even pole
     // count, reads as a pole-count slip to `machine_checks`).
     config.machine.rated_torque = model.rated_torque / ratio;
-    config.tuning.rs_adaptation = false;
+    config.tuning.rs_adaptation.enabled = false;
     tuning(&mut config.tuning);
     let omega = speed_ratio * model.rated_speed_rpm * m.pp * core::f64::consts::TAU / 60.0;
     let i_dq = Dq::new(0.0, 0.3 * model.rated_current);
@@ -88,7 +88,7 @@ fn the_lower_flux_bound_is_0_7_below_the_hand_over_band_and_0_6_above() {
                 m.lf
             );
             let (lost, _) = lost_at(m, model, speed, 0.65, |t| {
-                t.lock_flux_low_fast_ratio = t.lock_flux_low_ratio
+                t.lock.flux_low_fast_ratio = t.lock.flux_low_ratio
             });
             assert!(lost, "λf {}: one bound, 0.65·λ̂f at {speed}·rated", m.lf);
         }

@@ -33,7 +33,7 @@ fn compare<T: Real>(
     let config = |period: f64| {
         let mut c = EstimatorConfig::<f64>::for_machine(&model);
         c.initial_angle = theta0;
-        c.tuning.observer_gain_period = period;
+        c.tuning.observer.gain_period = period;
         EstimatorConfig::<T> {
             ts: T::lit(c.ts),
             machine: model.cast(),
@@ -43,7 +43,8 @@ fn compare<T: Real>(
     };
     let default_period = EstimatorConfig::<f64>::for_machine(&model)
         .tuning
-        .observer_gain_period;
+        .observer
+        .gain_period;
     assert!(default_period > 3.5 * TS);
     let mut every = SensorlessEstimator::new(config(0.0)).unwrap();
     let mut held = SensorlessEstimator::new(config(default_period)).unwrap();

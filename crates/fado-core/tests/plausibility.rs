@@ -14,7 +14,7 @@ const TS: f64 = 100e-6;
 fn run(glitch: Option<(usize, Ab<f64>, Ab<f64>)>) -> (Vec<f64>, usize) {
     let mut cfg = EstimatorConfig::<f64>::for_machine(&MachineModel::paper());
     cfg.initial_angle = 0.0;
-    cfg.tuning.rs_adaptation = false;
+    cfg.tuning.rs_adaptation.enabled = false;
     let mut est = SensorlessEstimator::new(cfg).unwrap();
     let w = 2.0 * std::f64::consts::PI * 5.0;
     let iq = 10.0;

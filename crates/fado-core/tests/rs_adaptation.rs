@@ -25,7 +25,7 @@ fn estimator(rs_ratio: f64, theta0: f64) -> SensorlessEstimator<f64> {
     SensorlessEstimator::new(config_with(|c| {
         c.machine.rs = RS * rs_ratio;
         c.initial_angle = theta0;
-        c.tuning.rs_adaptation = true;
+        c.tuning.rs_adaptation.enabled = true;
     }))
     .unwrap()
 }
@@ -152,7 +152,7 @@ fn no_excitation_no_drift() {
         let mut est = SensorlessEstimator::new(config_with(|c| {
             c.machine.flux_linkage = LF * 1.05;
             c.initial_angle = 0.4;
-            c.tuning.rs_adaptation = true;
+            c.tuning.rs_adaptation.enabled = true;
         }))
         .unwrap();
         let n = (3.0 / TS) as usize;
@@ -216,8 +216,8 @@ fn standstill_law_freezes_under_q_current() {
 fn standstill_angle_error(angle_rate: f64, error0: f64, seconds: f64) -> f64 {
     let theta0 = 0.4;
     let mut est = SensorlessEstimator::new(config_with(|c| {
-        c.tuning.rs_adaptation = true;
-        c.tuning.standstill_angle_rate = angle_rate;
+        c.tuning.rs_adaptation.enabled = true;
+        c.tuning.rs_adaptation.standstill_angle_rate = angle_rate;
     }))
     .unwrap();
     let i_dq = Dq::new(4.0, 0.0);
@@ -357,7 +357,7 @@ fn flux_linkage_law_ignores_errors_inside_its_dead_zone_and_swings_at_the_rotor_
 fn off_keeps_the_configured_resistance_and_reset_restores_it() {
     let mut off = SensorlessEstimator::new(config_with(|c| {
         c.machine.rs = RS * 1.3;
-        c.tuning.rs_adaptation = false;
+        c.tuning.rs_adaptation.enabled = false;
     }))
     .unwrap();
     let mut on = estimator(1.3, 0.0);
@@ -376,23 +376,23 @@ fn bad_configurations_name_their_field() {
     let cases: [(&str, EstimatorConfig<f64>); 5] = [
         (
             "rs_adaptation_rate",
-            config_with(|c| c.tuning.rs_adaptation_rate = f64::NAN),
+            config_with(|c| c.tuning.rs_adaptation.rate = f64::NAN),
         ),
         (
             "rs_adaptation_rate",
-            config_with(|c| c.tuning.rs_adaptation_rate = 2e4),
+            config_with(|c| c.tuning.rs_adaptation.rate = 2e4),
         ),
         (
             "rs_adaptation_excitation_floor",
-            config_with(|c| c.tuning.rs_adaptation_excitation_floor = 0.0),
+            config_with(|c| c.tuning.rs_adaptation.excitation_floor = 0.0),
         ),
         (
             "rs_adaptation_min_ratio",
-            config_with(|c| c.tuning.rs_adaptation_min_ratio = 1.5),
+            config_with(|c| c.tuning.rs_adaptation.min_ratio = 1.5),
         ),
         (
             "rs_adaptation_max_ratio",
-            config_with(|c| c.tuning.rs_adaptation_max_ratio = 0.9),
+            config_with(|c| c.tuning.rs_adaptation.max_ratio = 0.9),
         ),
     ];
     for (field, config) in cases {
@@ -457,7 +457,7 @@ fn flux_linkage_law_learns_lambda_f_where_resistance_is_unobservable() {
         let mut est = SensorlessEstimator::new(config_with(|c| {
             c.machine.rs = RS * 1.2;
             c.machine.flux_linkage = LF * 1.1;
-            c.tuning.flux_linkage_adaptation_rate = rate;
+            c.tuning.flux_linkage_adaptation.rate = rate;
             c.initial_angle = 0.4;
         }))
         .unwrap();
@@ -512,7 +512,7 @@ fn switched_on_at_run_time_the_fixed_estimator_learns_rs() {
     let mut est = SensorlessEstimator::new(config_with(|c| {
         c.machine.rs = RS * 1.3;
         c.initial_angle = theta0;
-        c.tuning.rs_adaptation = false;
+        c.tuning.rs_adaptation.enabled = false;
     }))
     .unwrap();
     let (_, i0) = flux_and_current(theta0, Dq::new(0.0, IQ_LOAD));

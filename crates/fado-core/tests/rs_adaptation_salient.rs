@@ -46,8 +46,8 @@ fn estimator(rs_ratio: f64, theta0: f64, with_ld: bool) -> SensorlessEstimator<f
     config.initial_angle = theta0;
     // The paper's 1.5 Hz threshold (the default ratio of this motor's 75 Hz would give
     // 1.1 Hz): the reversal's limiter passage is then as long as on the paper's motor.
-    config.tuning.mode_threshold_ratio = 0.02;
-    config.tuning.rs_adaptation = true;
+    config.tuning.mode.threshold_ratio = 0.02;
+    config.tuning.rs_adaptation.enabled = true;
     SensorlessEstimator::new(config).unwrap()
 }
 

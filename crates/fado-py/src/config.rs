@@ -13,6 +13,7 @@
 //! depend on the sampling period and the motor (k_af·ts ≤ 1, bandwidths and the mode
 //! threshold below the Nyquist frequency) are checked when an estimator is built with them.
 
+use fado_core::estimator::tuning::MOVED_KEYS;
 use fado_core::{EstimatorConfig, EstimatorTuning, MachineModel};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -83,6 +84,9 @@ impl PyEstimatorConfig {
         changes: Option<&Bound<'_, PyDict>>,
         shown: &dyn Fn(&str) -> String,
     ) -> PyResult<Self> {
+        if let Some(c) = changes {
+            refuse_moved(c, shown)?;
+        }
         let changed = match changes {
             Some(c) => Self {
                 tuning: record::with_changes(py, &self.tuning, c, "an estimator setting", shown)?,
@@ -145,7 +149,7 @@ impl PyEstimatorConfig {
             initial_angle: T::lit(initial_angle),
             tuning: self.to_core_as(),
         };
-        config.validate().map_err(|e| config_error(py, e))?;
+        config.validate().map_err(|e| core_error(py, e))?;
         Ok(config)
     }
 }
@@ -157,7 +161,7 @@ impl PyEstimatorConfig {
     /// `config` as given to `fado.estimate`/`fado.Estimator`: `None` (the defaults), an
     /// `EstimatorConfig`, or a `dict` as `fado.simulate` takes it: flat tuning keys
     /// (`{"k_df": 1.0}`), the `[estimator]` table (`{"estimator": {"k_df": 1.0}}`) or dotted
-    /// keys (`{"estimator.k_df": 1.0}`). Any other key raises `ConfigError` naming it; a
+    /// keys (`{"estimator.disturbance_feedback.k_df": 1.0}`). Any other key raises `ConfigError` naming it; a
     /// table of the simulator's configuration (`motor`, `simulation`, …) names the functions
     /// that take it (`function` is the caller's name, `estimate`).
     pub fn from_argument(
@@ -177,28 +181,9 @@ impl PyEstimatorConfig {
                 config.get_type().name()?
             )));
         };
-        // The fields given, and the key as the user wrote it for each.
-        let kwargs = PyDict::new(py);
-        let shown_as = PyDict::new(py);
         let fields = Self::field_names(py)?;
-        let put = |key: &str, shown: &str, value: Bound<'_, PyAny>| -> PyResult<()> {
-            if !fields.iter().any(|f| f == key) {
-                return Err(config_error_message(
-                    py,
-                    shown,
-                    format!("`{shown}` is not an estimator setting; one of {fields:?}"),
-                ));
-            }
-            if kwargs.contains(key)? {
-                return Err(config_error_message(
-                    py,
-                    shown,
-                    format!("`{shown}` given twice"),
-                ));
-            }
-            shown_as.set_item(key, shown)?;
-            kwargs.set_item(key, value)
-        };
+        let given = Given::new(py, &fields);
+        let put = |path: &str, shown: &str, value| given.put(path, shown, value);
         for (key, value) in dict.iter() {
             let key: String = key.extract()?;
             if key == SECTION {
@@ -215,6 +200,12 @@ impl PyEstimatorConfig {
                 }
             } else if let Some(k) = key.strip_prefix("estimator.") {
                 put(k, &key, value)?;
+            } else if fields
+                .iter()
+                .any(|f| Some(f.as_str()) == key.split('.').next())
+                || moved(&key).is_some()
+            {
+                put(&key, &key, value)?;
             } else if value.cast::<PyDict>().is_ok() || key.contains('.') {
                 // Another table of a simulator configuration: not this function's.
                 let section = key.split('.').next().unwrap_or(&key);
@@ -227,6 +218,7 @@ impl PyEstimatorConfig {
                 put(&key, &key, value)?;
             }
         }
+        let (kwargs, shown_as) = (&given.kwargs, &given.shown_as);
         let shown = |field: &str| -> String {
             shown_as
                 .get_item(field)
@@ -235,8 +227,149 @@ impl PyEstimatorConfig {
                 .and_then(|s| s.extract::<String>().ok())
                 .unwrap_or_else(|| field.to_owned())
         };
-        let made = Self::default().with_changes(py, Some(&kwargs), &shown);
-        made.map_err(|e| renamed(py, e, &shown_as))
+        let made = Self::default().with_changes(py, Some(kwargs), &shown);
+        made.map_err(|e| renamed(py, e, shown_as))
+    }
+}
+
+/// The fields of a config dict (a nested record as a dict of its fields) and the key as the
+/// user wrote each (`field` or `field.sub` → `estimator.field.sub`, …).
+struct Given<'py, 'a> {
+    kwargs: Bound<'py, PyDict>,
+    shown_as: Bound<'py, PyDict>,
+    fields: &'a [String],
+}
+
+impl<'py, 'a> Given<'py, 'a> {
+    fn new(py: Python<'py>, fields: &'a [String]) -> Self {
+        Self {
+            kwargs: PyDict::new(py),
+            shown_as: PyDict::new(py),
+            fields,
+        }
+    }
+
+    /// Puts `value` at `path` (`field`, or `field.sub` of a nested record; a `dict` for
+    /// `field` gives several of its fields), written by the user as `shown`. A key that is
+    /// no field, that moved, or that is given twice raises `ConfigError` naming `shown`.
+    fn put(&self, path: &str, shown: &str, value: Bound<'py, PyAny>) -> PyResult<()> {
+        let py = self.kwargs.py();
+        let (field, sub) = match path.split_once('.') {
+            Some((f, s)) => (f, Some(s)),
+            None => (path, None),
+        };
+        let moved_error = || moved(path).map(|new| moved_message(shown, path, new));
+        if !self.fields.iter().any(|f| f == field) {
+            let message = moved_error().unwrap_or_else(|| {
+                format!(
+                    "`{shown}` is not an estimator setting; one of {:?}",
+                    self.fields
+                )
+            });
+            return Err(config_error_message(py, shown, message));
+        }
+        let twice = || config_error_message(py, shown, format!("`{shown}` given twice"));
+        let (kwargs, shown_as) = (&self.kwargs, &self.shown_as);
+        match (sub, value.cast::<PyDict>()) {
+            (None, Ok(table)) => {
+                for (k, v) in table.iter() {
+                    let k: String = k.extract()?;
+                    put_sub(kwargs, shown_as, field, &k, &format!("{shown}.{k}"), v)
+                        .map_err(|_| twice())?;
+                }
+            }
+            (Some(k), _) => {
+                put_sub(kwargs, shown_as, field, k, shown, value).map_err(|_| twice())?
+            }
+            (None, Err(_)) => {
+                if let Some(message) = moved_error() {
+                    return Err(config_error_message(py, shown, message));
+                }
+                if kwargs.contains(field)? {
+                    return Err(twice());
+                }
+                shown_as.set_item(field, shown)?;
+                kwargs.set_item(field, value)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Puts `value` as field `sub` of the nested record `field` of `kwargs`, shown as `shown`;
+/// an error when it is there already.
+fn put_sub<'py>(
+    kwargs: &Bound<'py, PyDict>,
+    shown_as: &Bound<'py, PyDict>,
+    field: &str,
+    sub: &str,
+    shown: &str,
+    value: Bound<'py, PyAny>,
+) -> PyResult<()> {
+    let py = kwargs.py();
+    let table = match kwargs.get_item(field)? {
+        Some(t) => t.cast_into::<PyDict>()?,
+        None => {
+            let t = PyDict::new(py);
+            kwargs.set_item(field, &t)?;
+            t
+        }
+    };
+    if table.contains(sub)? {
+        return Err(pyo3::exceptions::PyKeyError::new_err(shown.to_owned()));
+    }
+    shown_as.set_item(format!("{field}.{sub}"), shown)?;
+    table.set_item(sub, value)
+}
+
+/// Where the flat key `key` of earlier configurations lives now (`fado_core`'s table), as a
+/// path below the estimator's tuning (`lock.heal_time`).
+fn moved(key: &str) -> Option<&'static str> {
+    MOVED_KEYS
+        .iter()
+        .find(|(old, _)| *old == key)
+        .map(|(_, new)| *new)
+}
+
+/// The message for the flat key `key` (shown as `shown`) that lives at `path` now.
+fn moved_message(shown: &str, key: &str, path: &str) -> String {
+    let (table, field) = path.split_once('.').unwrap_or((path, ""));
+    let prefix = shown.strip_suffix(key).unwrap_or("");
+    format!(
+        "`{shown}` moved: write it as `{prefix}{table}={{\"{field}\": …}}` (or `{prefix}{path}`)"
+    )
+}
+
+/// Refuses a flat keyword of earlier configurations (`k_df=`) with its new place; a nested
+/// record given as a dict (`rs_adaptation={...}`) is no flat key.
+fn refuse_moved(changes: &Bound<'_, PyDict>, shown: &dyn Fn(&str) -> String) -> PyResult<()> {
+    for (key, value) in changes.iter() {
+        let key: String = key.extract()?;
+        if value.cast::<PyDict>().is_ok() {
+            continue;
+        }
+        if let Some(path) = moved(&key) {
+            let name = shown(&key);
+            return Err(pyo3::exceptions::PyTypeError::new_err(moved_message(
+                &name, &key, path,
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// A refusal of fado-core, whose errors name the flat keys, named by the nested path
+/// (`lock.heal_time`).
+pub(crate) fn core_error(py: Python<'_>, e: fado_core::ConfigError) -> PyErr {
+    let field = e.field();
+    match moved(field) {
+        Some(path) => config_error_message(
+            py,
+            path,
+            e.to_string()
+                .replacen(&format!("`{field}`"), &format!("`{path}`"), 1),
+        ),
+        None => config_error(py, e),
     }
 }
 

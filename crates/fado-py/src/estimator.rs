@@ -121,10 +121,12 @@ impl Engine {
     fn new(py: Python<'_>, setup: &Setup, dtype: Dtype) -> PyResult<Self> {
         let engine = match dtype {
             Dtype::Float64 => Engine::F64(
-                SensorlessEstimator::new(setup.core(py)?).map_err(|e| config_error(py, e))?,
+                SensorlessEstimator::new(setup.core(py)?)
+                    .map_err(|e| crate::config::core_error(py, e))?,
             ),
             Dtype::Float32 => Engine::F32(
-                SensorlessEstimator::new(setup.core(py)?).map_err(|e| config_error(py, e))?,
+                SensorlessEstimator::new(setup.core(py)?)
+                    .map_err(|e| crate::config::core_error(py, e))?,
             ),
         };
         Ok(engine)

@@ -196,7 +196,7 @@ outputs! {
         /// Active flux feedback: 0 = limiter (Fig. 6), 1 = disturbance feedback k_df (Fig. 3).
         mode => diagnostics.mode,
         /// Loss-of-lock status (`fado_core::lock`): 0 locked, 1 suspect, 2 lost (a live
-        /// status: clears after `lock_heal_time` without symptoms, or at `align`/`reset`).
+        /// status: clears after `lock.heal_time` without symptoms, or at `align`/`reset`).
         lock => diagnostics.lock,
     }
     flags {

@@ -118,7 +118,9 @@ fn from_dict<T: DeserializeOwned>(
 /// (a str for a number, a float for a count) raises `TypeError`; a value of the right type
 /// that the field cannot take (a negative count, an unknown spelling, a non-finite number)
 /// raises `ConfigError` (a `ValueError`). Each names the key as the user wrote it,
-/// `shown(key)`; `kind` says what a field is ("an estimator setting").
+/// `shown(key)`; `kind` says what a field is ("an estimator setting"). A field that is a
+/// record of its own (a nested table, `lock`) takes a `dict` of some of its fields, merged
+/// into the current ones; its fields are named `shown("lock.heal_time")`.
 pub fn with_changes<T>(
     py: Python<'_>,
     base: &T,
@@ -133,28 +135,86 @@ where
     for (key, value) in changes.iter() {
         let key: String = key.extract()?;
         let name = shown(&key);
-        if !merged.contains(&key)? {
+        let Some(current) = merged.get_item(&key)? else {
             let fields = field_names(py, base)?;
             return Err(pyo3::exceptions::PyTypeError::new_err(format!(
                 "unexpected keyword argument `{name}`: not {kind}; one of {fields:?}"
             )));
+        };
+        if let Ok(table) = current.cast::<PyDict>() {
+            let table = table.copy()?;
+            merge_record::<T>(py, &key, &table, &value, shown)?;
+            merged.set_item(&key, table)?;
+            continue;
         }
         let value = plain_number(py, &value)?;
         plain_value(py, &name, &value)?;
-        // Each field alone first, so that a serde refusal names its field.
         let one = PyDict::new(py);
         one.set_item(&key, &value)?;
-        if let Err(message) = from_dict::<T>(py, &one)? {
-            let message = format!("`{name}`: {message}");
-            return Err(if message.contains(": invalid type: ") {
-                pyo3::exceptions::PyTypeError::new_err(message)
-            } else {
-                config_error_message(py, &name, message)
-            });
-        }
+        check_one::<T>(py, &one, &name)?;
         merged.set_item(&key, value)?;
     }
     from_dict::<T>(py, &merged)?.map_err(pyo3::exceptions::PyRuntimeError::new_err)
+}
+
+/// Merges `given` (a `dict` of some fields of the nested record `key`) into `table`, its
+/// current fields, each checked on its own as [`with_changes`] checks a field.
+fn merge_record<T: DeserializeOwned>(
+    py: Python<'_>,
+    key: &str,
+    table: &Bound<'_, PyDict>,
+    given: &Bound<'_, PyAny>,
+    shown: &dyn Fn(&str) -> String,
+) -> PyResult<()> {
+    let fields = || -> PyResult<Vec<String>> {
+        table.keys().iter().map(|k| k.extract::<String>()).collect()
+    };
+    let Ok(given) = given.cast::<PyDict>() else {
+        return Err(pyo3::exceptions::PyTypeError::new_err(format!(
+            "`{}` must be a dict of some of its fields {:?}, got {}",
+            shown(key),
+            fields()?,
+            given.get_type().name()?
+        )));
+    };
+    for (sub, value) in given.iter() {
+        let sub: String = sub.extract()?;
+        let name = shown(&format!("{key}.{sub}"));
+        if !table.contains(&sub)? {
+            return Err(pyo3::exceptions::PyTypeError::new_err(format!(
+                "unexpected key `{name}`: not a field of `{}`; one of {:?}",
+                shown(key),
+                fields()?
+            )));
+        }
+        let value = plain_number(py, &value)?;
+        plain_value(py, &name, &value)?;
+        let inner = PyDict::new(py);
+        inner.set_item(&sub, &value)?;
+        let one = PyDict::new(py);
+        one.set_item(key, inner)?;
+        check_one::<T>(py, &one, &name)?;
+        table.set_item(&sub, value)?;
+    }
+    Ok(())
+}
+
+/// Reads the partial record `one` (one field) so that a serde refusal names that field,
+/// `name`: a wrong type as `TypeError`, a value the field cannot take as `ConfigError`.
+fn check_one<T: DeserializeOwned>(
+    py: Python<'_>,
+    one: &Bound<'_, PyDict>,
+    name: &str,
+) -> PyResult<()> {
+    if let Err(message) = from_dict::<T>(py, one)? {
+        let message = format!("`{name}`: {message}");
+        return Err(if message.contains(": invalid type: ") {
+            pyo3::exceptions::PyTypeError::new_err(message)
+        } else {
+            config_error_message(py, name, message)
+        });
+    }
+    Ok(())
 }
 
 /// The Python half of [`install`]: run once per class at module initialisation.

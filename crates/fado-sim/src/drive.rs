@@ -168,13 +168,12 @@ impl SimConfig {
     pub fn build_drive_f32(&self) -> Result<DriveF32, SimConfigError> {
         let c = self.drive_config();
         // A flux map is rounded to f32 and interned (`crate::model_magnetics`).
-        let magnetics =
-            crate::model_magnetics::to_f32(&c.machine.magnetics, self).ok_or_else(|| {
-                SimConfigError::new(
-                    "model",
-                    "the flux map does not stay strictly monotonic rounded to f32",
-                )
-            })?;
+        let magnetics = crate::model_magnetics::to_f32(&c.machine.magnetics).ok_or_else(|| {
+            SimConfigError::new(
+                "model",
+                "the flux map does not stay strictly monotonic rounded to f32",
+            )
+        })?;
         let dc = DriveConfig::<f32> {
             ts: c.ts as f32,
             machine: c.machine.cast().with_magnetics(magnetics),

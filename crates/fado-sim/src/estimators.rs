@@ -41,7 +41,7 @@ pub struct Estimator {
     /// Its settings' defaults, as the TOML table `--dump-config` shows.
     pub defaults: fn() -> toml::Table,
     /// What it changes in the configuration it runs with, before anything is built or
-    /// checked (`fado-fixed-rs`: `[estimator] rs_adaptation = false`).
+    /// checked (`fado-fixed-rs`: `[estimator.rs_adaptation] enabled = false`).
     pub prepare: fn(&mut SimConfig),
     /// Builds the drive around it (f64, or f32 where it supports it); a bad setting is
     /// named by its TOML key.
@@ -80,10 +80,10 @@ pub const ESTIMATORS: &[Estimator] = &[
     },
     Estimator {
         name: "fado-fixed-rs",
-        summary: "fado with the paper's fixed R̂s (`[estimator] rs_adaptation = false`)",
+        summary: "fado with the paper's fixed R̂s (`[estimator.rs_adaptation] enabled = false`)",
         own_settings: false,
         defaults: toml::Table::new,
-        prepare: |cfg| cfg.estimator.rs_adaptation = false,
+        prepare: |cfg| cfg.estimator.rs_adaptation.enabled = false,
         build: build_fado,
         check: no_check,
     },
@@ -175,15 +175,15 @@ pub fn common_tuning(cfg: &SimConfig) -> CommonTuning<f64> {
     let t = &e.tuning;
     CommonTuning {
         ts: e.ts,
-        t2s1_bandwidth_hz: t.t2s1_bandwidth_hz,
-        t2s2_bandwidth_hz: t.t2s2_bandwidth_hz,
-        tracker_damping: t.tracker_damping,
-        bandwidth_definition: t.bandwidth_definition,
-        tracker_hold_ratio: t.tracker_hold_ratio,
-        average_current: t.average_current,
-        plausible_current_ratio: t.plausible_current_ratio,
-        plausible_voltage_ratio: t.plausible_voltage_ratio,
-        plausible_current_step_ratio: t.plausible_current_step_ratio,
+        t2s1_bandwidth_hz: t.tracker.t2s1_bandwidth_hz,
+        t2s2_bandwidth_hz: t.tracker.t2s2_bandwidth_hz,
+        tracker_damping: t.tracker.damping,
+        bandwidth_definition: t.tracker.bandwidth_definition,
+        tracker_hold_ratio: t.tracker.hold_ratio,
+        average_current: t.integrator.average_current,
+        plausible_current_ratio: t.plausibility.current_ratio,
+        plausible_voltage_ratio: t.plausibility.voltage_ratio,
+        plausible_current_step_ratio: t.plausibility.current_step_ratio,
         initial_angle: e.initial_angle,
     }
 }

@@ -133,6 +133,7 @@ pub fn check_one_model(
 pub fn take_magnetics(
     user: &mut toml::Table,
 ) -> Result<(Option<Saturation<f64>>, Option<FluxMapFile>), SimConfigError> {
+    crate::model_magnetics::resolve_model_paths(user);
     let Some(toml::Value::Table(motor)) = user.get_mut("motor") else {
         return Ok((None, None));
     };

@@ -223,8 +223,8 @@ pub const CHOPPER_RATIO: f64 = 1.05;
 /// drive needs through current-limited transients.
 fn enable_feedforward(c: &mut SimConfig) {
     c.controller.acceleration_feedforward = true;
-    if c.estimator.tracker_load_pole_ratio == 0.0 {
-        c.estimator.tracker_load_pole_ratio = 0.5;
+    if c.estimator.tracker.load_pole_ratio == 0.0 {
+        c.estimator.tracker.load_pole_ratio = 0.5;
     }
 }
 

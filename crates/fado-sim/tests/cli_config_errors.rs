@@ -45,19 +45,28 @@ fn unknown_key_and_wrong_type_name_file_line_and_key() {
     assert!(stderr.starts_with(&prefix), "{stderr}");
     assert!(stderr.contains("unknown field"), "{stderr}");
 
-    let (code, stderr, path) = run_with("type.toml", "[estimator]\nk_df = \"half\"\n");
+    let (code, stderr, path) = run_with(
+        "type.toml",
+        "[estimator.disturbance_feedback]\nk_df = \"half\"\n",
+    );
     assert_eq!(code, Some(2), "{stderr}");
-    let prefix = format!("error: {}:2:8: `estimator.k_df`: ", path.display());
+    let prefix = format!(
+        "error: {}:2:8: `estimator.disturbance_feedback.k_df`: ",
+        path.display()
+    );
     assert!(stderr.starts_with(&prefix), "{stderr}");
 }
 
 #[test]
 fn core_validation_and_syntax_errors_are_located() {
     // A tracker bandwidth above what 10 kHz sampling allows (Jury's test in fado-core).
-    let (code, stderr, path) = run_with("bw.toml", "[estimator]\nt2s1_bandwidth_hz = 4000.0\n");
+    let (code, stderr, path) = run_with(
+        "bw.toml",
+        "[estimator.tracker]\nt2s1_bandwidth_hz = 4000.0\n",
+    );
     assert_eq!(code, Some(2), "{stderr}");
     let prefix = format!(
-        "error: {}:2:21: `estimator.t2s1_bandwidth_hz`: ",
+        "error: {}:2:21: `estimator.tracker.t2s1_bandwidth_hz`: ",
         path.display()
     );
     assert!(stderr.starts_with(&prefix), "{stderr}");

@@ -349,7 +349,7 @@ fn the_identified_outrunner_model_passes_stops_with_a_fixed_rs() {
         id.threshold_voltage.max(0.0)
     );
     assert_eq!(cfg.machine_model().rs, id.model.rs);
-    let toml = format!("{text}\n[estimator]\nrs_adaptation = false\n");
+    let toml = format!("{text}\n[estimator.rs_adaptation]\nenabled = false\n");
     let run = fado_sim::scenario::run_config(
         "stops",
         fado_sim::scenario_config("stops", Some(&toml), false).unwrap(),

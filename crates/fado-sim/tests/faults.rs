@@ -368,7 +368,7 @@ fn load_step(torque: f64) -> Run {
         &format!(
             "[simulation]\nduration = 4.5\n\
              [load.torque]\npoints = [[3.0, 0.0], [3.0, {torque}]]\n\
-             [estimator]\nrs_adaptation = false\n"
+             [estimator.rs_adaptation]\nenabled = false\n"
         ),
     )
 }

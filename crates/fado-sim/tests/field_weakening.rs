@@ -27,7 +27,7 @@ fn run_with(motor: &str, speed: f64, load: &str, extra: &str) -> (f64, f64, bool
          {load}\
          [simulation]\neval_start = 0.7\nduration = 5.5\n\
          [controller]\nacceleration_feedforward = true\n{extra}\
-         [estimator]\ntracker_load_pole_ratio = 0.5\n"
+         [estimator.tracker]\nload_pole_ratio = 0.5\n"
     );
     let out = simulate("custom", Some(&text), false, None).unwrap();
     let last = out.trace.rows.last().unwrap();

@@ -153,7 +153,7 @@ fn the_start_up_dc_test_hands_its_resistance_to_the_adaptation_and_not_to_the_fi
     for preset in ["paper", "outrunner-cheetah-24v"] {
         for adaptation in [true, false] {
             let extra = format!(
-                "[mismatch]\nrs_ratio = 0.7692307692307693\n[estimator]\nrs_adaptation = {adaptation}\n"
+                "[mismatch]\nrs_ratio = 0.7692307692307693\n[estimator.rs_adaptation]\nenabled = {adaptation}\n"
             );
             let cfg = config(preset, 0.3, &extra);
             let rs_motor = cfg.motor.rs;

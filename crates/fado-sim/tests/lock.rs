@@ -62,7 +62,7 @@ fn a_lost_rotor_is_flagged_and_a_matched_run_is_not() {
     let cfg = scenario_config(
         "fig11",
         Some(
-            "[estimator]\nrs_adaptation = false\n[mismatch]\nrs_ratio = 1.1\n\
+            "[estimator.rs_adaptation]\nenabled = false\n[mismatch]\nrs_ratio = 1.1\n\
              [controller]\ngain_calibration_time = 0.0\n",
         ),
         false,
@@ -95,7 +95,7 @@ fn a_lost_rotor_is_flagged_and_a_matched_run_is_not() {
 fn recover_ends_at_the_reference_speed_with_the_reason_logged() {
     let run = |extra: &str| {
         let toml = format!(
-            "[estimator]\nrs_adaptation = false\n[mismatch]\nrs_ratio = 1.1\n\
+            "[estimator.rs_adaptation]\nenabled = false\n[mismatch]\nrs_ratio = 1.1\n\
              [controller]\ngain_calibration_time = 0.0\n{extra}"
         );
         let cfg = scenario_config("fig11", Some(&toml), false).unwrap();
@@ -258,7 +258,7 @@ const GEM: &str = include_str!("../../../motors/ipmsm-gem-50k.toml");
 #[test]
 fn a_start_up_limit_cycle_on_a_salient_rotor_is_flagged_by_its_mode_chatter() {
     let run = |rs, flux, lq, load, extra: &str| {
-        let estimator = format!("[estimator]\nrs_adaptation = false\n{extra}\n");
+        let estimator = format!("[estimator.rs_adaptation]\nenabled = false\n{extra}\n");
         reversal_point(GEM, &estimator, rs, flux, lq, load).metrics
     };
     let lost = |extra| run(0.005_789, 0.018_911, 0.251_589, 19.965, extra);
@@ -272,7 +272,7 @@ fn a_start_up_limit_cycle_on_a_salient_rotor_is_flagged_by_its_mode_chatter() {
         .lock_detection_delay
         .expect("no flag up 20 ms after the onset");
     assert!(delay > -1.0, "{m:?}");
-    let m = lost("lock_handover_count = 0.0");
+    let m = lost("[estimator.lock]\nhandover_count = 0.0");
     println!(
         "#125 without the symptom: LOCK_LOST first {:?} s, detection {:?}",
         m.lock_lost_time, m.lock_detection_delay

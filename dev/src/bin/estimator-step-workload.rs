@@ -64,7 +64,7 @@ fn isr_step_lean<T: Real>(est: &mut SensorlessEstimator<T>, v: Ab<T>, i: Ab<T>) 
     est.step_lean(v, i)
 }
 
-/// The Cortex-M image's hand-lean paper's estimator (`examples/cortex-m`), the same source.
+// The Cortex-M image's hand-lean paper's estimator (`examples/cortex-m`), the same source.
 #[path = "../../../examples/cortex-m/src/paper_kernel.rs"]
 #[allow(dead_code)]
 mod paper_kernel;
@@ -96,7 +96,7 @@ fn run<T: Real>(steps: usize, ortega: bool) -> f64 {
         return run_steps(&table, steps, |v, i| isr_step(&mut est, v, i).theta);
     }
     let mut config = EstimatorConfig::for_machine(&machine);
-    config.tuning.rs_adaptation = std::env::var("FIXED_RS").is_err();
+    config.tuning.rs_adaptation.enabled = std::env::var("FIXED_RS").is_err();
     if std::env::var("PAPER_PATH").is_ok() {
         config.tuning = config.tuning.paper_path();
     }

@@ -43,7 +43,9 @@ use core::panic::PanicInfo;
 
 use cortex_m::interrupt::Mutex;
 use cortex_m_rt::entry;
-use fado_core::{Abc, DriveConfig, EstimatorTuning, MachineModel, SensorlessDrive};
+use fado_core::{
+    Abc, DriveConfig, EstimatorTuning, MachineMagnetics, MachineModel, SensorlessDrive,
+};
 use hal::adc::config::{AdcConfig, SampleTime};
 use hal::adc::{Adc, AdcClaim, AdcCommonExt, Configured};
 use hal::gpio::{Analog, gpioa::PA0, gpiob::PB12};
@@ -82,6 +84,7 @@ fn motor() -> MachineModel<f32> {
         rated_speed_rpm: 1800.0,
         rated_torque: 2.34,
         dc_voltage: 24.0,
+        magnetics: MachineMagnetics::Linear,
     }
 }
 

@@ -50,7 +50,8 @@ use cortex_m_semihosting::{debug, hprintln};
 use drive_loop::DriveApp;
 use fado_core::{
     Ab, Abc, DriveOutput, Estimate, EstimatorConfig, EstimatorParams, EstimatorState,
-    EstimatorTuning, LeanEstimate, MachineModel, Mode, SensorlessDrive, SensorlessEstimator,
+    EstimatorTuning, LeanEstimate, MachineMagnetics, MachineModel, Mode, SensorlessDrive,
+    SensorlessEstimator,
 };
 use paper_kernel::{PaperKernel, paper_kernel_held_step, paper_kernel_step};
 
@@ -89,11 +90,11 @@ const ADAPTIVE: usize = 0;
 /// The default configuration with the paper's fixed R̂s (`rs_adaptation = false`).
 const FIXED_RS: usize = 1;
 /// The paper's path: fixed R̂s, and fado's other additions to the method that a switch turns
-/// off (`observer_lag_compensation`, `observer_on_rotor_flux`, `limiter_recentring` false,
-/// `observer_gain_period` 0).
+/// off (`observer.lag_compensation`, `observer.on_rotor_flux`, `limiter.recentring` false,
+/// `observer.gain_period` 0).
 const PAPER_PATH: usize = 2;
 /// The paper's path with the observer's gains held as fado holds them by default
-/// (`observer_gain_period` 0.4 ms): the kernel beside it is [`paper_kernel_held_step`].
+/// (`observer.gain_period` 0.4 ms): the kernel beside it is [`paper_kernel_held_step`].
 const PAPER_PATH_HELD: usize = 3;
 /// The default configuration (R̂s adaptation on) for the salient [`ipmsm_2k2`]: the step with
 /// the active-flux terms of a salient rotor, which the paper's motor (Ld = Lq) never runs.
@@ -115,6 +116,7 @@ fn ipmsm_2k2() -> MachineModel<f32> {
         rated_speed_rpm: 1500.0,
         rated_torque: 14.0,
         dc_voltage: 540.0,
+        magnetics: MachineMagnetics::Linear,
     }
 }
 
@@ -557,7 +559,7 @@ fn main() -> ! {
     // The same with the gains held over fado's default period.
     let paper_held_config = {
         let mut config = paper_config;
-        config.tuning.observer_gain_period = EstimatorTuning::default().observer_gain_period;
+        config.tuning.observer.gain_period = EstimatorTuning::default().observer.gain_period;
         config
     };
     let kernel_configs = [
@@ -571,7 +573,7 @@ fn main() -> ! {
         let model = MachineModel::<f32>::paper();
         let build = |rs_adaptation| {
             let mut config = EstimatorConfig::for_machine(&model);
-            config.tuning.rs_adaptation = rs_adaptation;
+            config.tuning.rs_adaptation.enabled = rs_adaptation;
             EstimatorParams::new(config)
         };
         match (

@@ -2,8 +2,8 @@
 //! fado's step (docs/results/firmware-cost.md).
 //!
 //! Exactly the method fado's `EstimatorState::step_lean` runs on its paper's path
-//! (`rs_adaptation`, `observer_lag_compensation`, `observer_on_rotor_flux` and
-//! `limiter_recentring` all `false`, `k_df_ramp_time` and `observer_gain_period` 0), with the
+//! (`rs_adaptation`, `observer.lag_compensation`, `observer.on_rotor_flux` and
+//! `limiter.recentring` all `false`, `disturbance_feedback.ramp_time` and `observer.gain_period` 0), with the
 //! same discretisation and the same arithmetic in the same order, the trackers' conversions
 //! between radians and fixed-point units folded into their gains (Ki·Ts·2π/2³², Ts·2³²/2π) as
 //! fado's trackers fold them since issue 16's sixth session (before, fado multiplied by the
@@ -89,7 +89,7 @@ pub struct PaperKernel {
     /// k_df mode (true) or limiter mode.
     kdf_mode: bool,
     // Held gains ([`paper_kernel_held_step`] only): a, ℓ1, ℓ2 of eq. (16) and the samples
-    // they are still held for, as fado's `observer_gain_period` holds them.
+    // they are still held for, as fado's `observer.gain_period` holds them.
     /// Samples the gains are held after the one that forms them (period/Ts − 1).
     gain_hold: u32,
     gain_countdown: u32,
@@ -119,20 +119,20 @@ impl PaperKernel {
             let (kp, ki) = config.tracker_config(bandwidth_hz).gains();
             (ts * kp, ki * ts * RAD_PER_UNIT)
         };
-        let (kp_ts1, ki_ts1) = tracker(t.t2s1_bandwidth_hz);
-        let (kp_ts2, ki_ts2) = tracker(t.t2s2_bandwidth_hz);
+        let (kp_ts1, ki_ts1) = tracker(t.tracker.t2s1_bandwidth_hz);
+        let (kp_ts2, ki_ts2) = tracker(t.tracker.t2s2_bandwidth_hz);
         let (th, h) = (config.mode_threshold_hz(), config.mode_hysteresis_hz());
-        let radius = t.limiter_radius_ratio * m.flux_linkage;
-        // As `EstimatorParams::new` rounds `observer_gain_period` to samples.
-        let periods = round(t.observer_gain_period / ts) - 1.0;
+        let radius = t.limiter.radius_ratio * m.flux_linkage;
+        // As `EstimatorParams::new` rounds `observer.gain_period` to samples.
+        let periods = round(t.observer.gain_period / ts) - 1.0;
         let gain_hold = if periods > 0.0 { periods as u32 } else { 0 };
         let g = DiscreteGains::new(0.0, ts);
         Self {
             ts,
             rs: m.rs,
             lq: m.lq,
-            k_df: t.k_df,
-            k_af: t.k_af,
+            k_df: t.disturbance_feedback.k_df,
+            k_af: t.limiter.k_af,
             radius,
             radius_sq: radius * radius,
             enter: two_pi::<f32>() * (th + h),
@@ -276,7 +276,7 @@ pub fn paper_kernel_step(k: &mut PaperKernel, v_ab: Ab<f32>, i_ab: Ab<f32>) -> f
     )
 }
 
-/// [`paper_kernel_step`] with the observer's gains (16) held over `observer_gain_period`, as
+/// [`paper_kernel_step`] with the observer's gains (16) held over `observer.gain_period`, as
 /// fado holds them by default (0.4 ms: formed once in four samples at 10 kHz, at the end of
 /// the sample, from the new ω̂ of T2S-1): the floor of the method at fado's default gain
 /// period (docs/results/firmware-cost.md).

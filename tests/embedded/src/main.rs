@@ -27,6 +27,46 @@ fn panic(_: &PanicInfo) -> ! {
 #[unsafe(no_mangle)]
 pub extern "C" fn rust_eh_personality() {}
 
+/// `memcpy`, which compiled code calls for large moves on every target (on a Cortex-M the
+/// `compiler_builtins` of the target provide it). Without Linux's C library this image brings
+/// its own: `rep movsb`.
+///
+/// # Safety
+/// As C's `memcpy`: `dest` and `src` valid for `n` bytes and not overlapping.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn memcpy(dest: *mut u8, src: *const u8, n: usize) -> *mut u8 {
+    // SAFETY: the caller's contract; `rep movsb` copies rcx bytes from rsi to rdi upwards.
+    unsafe {
+        core::arch::asm!(
+            "rep movsb",
+            inout("rcx") n => _,
+            inout("rdi") dest => _,
+            inout("rsi") src => _,
+            options(nostack, preserves_flags)
+        );
+    }
+    dest
+}
+
+/// `memset`, as [`memcpy`]: `rep stosb`.
+///
+/// # Safety
+/// As C's `memset`: `dest` valid for `n` bytes.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn memset(dest: *mut u8, c: i32, n: usize) -> *mut u8 {
+    // SAFETY: the caller's contract; `rep stosb` stores al into rcx bytes from rdi upwards.
+    unsafe {
+        core::arch::asm!(
+            "rep stosb",
+            inout("rcx") n => _,
+            inout("rdi") dest => _,
+            in("al") c as u8,
+            options(nostack, preserves_flags)
+        );
+    }
+    dest
+}
+
 /// Entry point, the linker's default entry symbol (there is no C runtime to call `main`).
 ///
 /// The kernel enters it with the stack pointer at `argc` and 16-byte aligned, whereas compiled

@@ -22,6 +22,7 @@ pub mod release_hold;
 pub mod saturated_references;
 pub mod speed_controller;
 pub mod standstill_probe;
+pub mod tracker_feedforward;
 
 pub use current_controller::{CurrentController, CurrentControllerConfig};
 pub use dc_link_limit::{DcLinkLimit, DcLinkTuning};
@@ -41,3 +42,4 @@ pub use ratings_limit::{RatingsLimit, RatingsLimitTuning};
 pub use release_hold::{ReleaseHold, ReleaseHoldTuning};
 pub use speed_controller::{SpeedController, SpeedControllerConfig, limit_current_d_priority};
 pub use standstill_probe::{StandstillProbe, StandstillProbeConfig};
+pub use tracker_feedforward::TrackerFeedforwardTuning;

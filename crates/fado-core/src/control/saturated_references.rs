@@ -96,8 +96,8 @@ impl<T: Real> SaturatedReferences<T> {
     pub fn mtpa_id(&self, i_q: T) -> T {
         let x = i_q.abs() / self.step;
         let last = MTPA_NODES - 1;
-        let k = (x.floor().to_f64() as usize).min(last - 1);
-        let f = crate::real::min(x - T::lit(k as f64), T::one());
+        let k = x.index_floor(last - 1);
+        let f = crate::real::min(x - T::from_index(k), T::one());
         if !f.is_finite() {
             return T::zero();
         }

@@ -36,14 +36,14 @@ impl<T: Real> EstimatorConfig<T> {
         }
     }
 
-    /// The mode threshold in Hz electrical: `mode_threshold_ratio` × the rated frequency.
+    /// The mode threshold in Hz electrical: `mode.threshold_ratio` × the rated frequency.
     pub fn mode_threshold_hz(&self) -> T {
-        self.tuning.mode_threshold_ratio * self.machine.rated_frequency_hz()
+        self.tuning.mode.threshold_ratio * self.machine.rated_frequency_hz()
     }
 
-    /// The mode hysteresis in Hz: `mode_hysteresis_ratio` × the rated frequency.
+    /// The mode hysteresis in Hz: `mode.hysteresis_ratio` × the rated frequency.
     pub fn mode_hysteresis_hz(&self) -> T {
-        self.tuning.mode_hysteresis_ratio * self.machine.rated_frequency_hz()
+        self.tuning.mode.hysteresis_ratio * self.machine.rated_frequency_hz()
     }
 
     /// Checks every field; the error names the first bad one.
@@ -59,21 +59,21 @@ impl<T: Real> EstimatorConfig<T> {
     pub(super) fn lock_detector(&self) -> LockDetectorConfig<T> {
         LockDetectorConfig {
             ts: self.ts * T::lit(LOCK_PERIOD as f64),
-            flux_low_ratio: self.tuning.lock_flux_low_ratio,
-            flux_low_fast_ratio: self.tuning.lock_flux_low_fast_ratio,
+            flux_low_ratio: self.tuning.lock.flux_low_ratio,
+            flux_low_fast_ratio: self.tuning.lock.flux_low_fast_ratio,
             // The speed below which the estimator is in limiter mode whatever its history
             // (the mode selector's exit speed).
             fast_speed: crate::real::max(
                 T::two_pi() * (self.mode_threshold_hz() - self.mode_hysteresis_hz()),
                 T::zero(),
             ),
-            flux_high_ratio: self.tuning.lock_flux_high_ratio,
-            innovation_limit: self.tuning.lock_innovation_limit,
-            detection_time: self.tuning.lock_detection_time,
-            heal_time: self.tuning.lock_heal_time,
-            limiter_clamping: self.tuning.lock_limiter_clamping,
-            handover_count: self.tuning.lock_handover_count,
-            handover_time: self.tuning.lock_handover_time,
+            flux_high_ratio: self.tuning.lock.flux_high_ratio,
+            innovation_limit: self.tuning.lock.innovation_limit,
+            detection_time: self.tuning.lock.detection_time,
+            heal_time: self.tuning.lock.heal_time,
+            limiter_clamping: self.tuning.lock.limiter_clamping,
+            handover_count: self.tuning.lock.handover_count,
+            handover_time: self.tuning.lock.handover_time,
         }
     }
 
@@ -82,9 +82,9 @@ impl<T: Real> EstimatorConfig<T> {
     pub fn sample_bounds(&self) -> Result<SampleBounds<T>, ConfigError> {
         let t = &self.tuning;
         SampleBounds::from_ratios(
-            t.plausible_current_ratio,
-            t.plausible_voltage_ratio,
-            t.plausible_current_step_ratio,
+            t.plausibility.current_ratio,
+            t.plausibility.voltage_ratio,
+            t.plausibility.current_step_ratio,
             self.machine.rated_current,
             self.machine.dc_voltage,
             self.machine.lq,

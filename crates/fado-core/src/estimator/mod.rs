@@ -46,7 +46,7 @@ mod owner;
 mod params;
 mod state;
 mod step;
-mod tuning;
+pub mod tuning;
 
 #[cfg(test)]
 mod tests;
@@ -54,7 +54,11 @@ mod tests;
 pub use config::EstimatorConfig;
 pub use output::{Diagnostics, Estimate, LeanEstimate};
 pub use owner::{RotorAngleEstimator, SensorlessEstimator};
-pub use tuning::EstimatorTuning;
+pub use tuning::{
+    DisturbanceFeedbackTuning, EstimatorTuning, FluxLinkageAdaptationTuning, IntegratorTuning,
+    LimiterTuning, LockTuning, ModeTuning, ObserverTuning, OffsetAdaptationTuning,
+    PlausibilityTuning, RsAdaptationTuning, TrackerTuning,
+};
 
 use crate::active_flux::ActiveFlux;
 use crate::flux::{
@@ -138,13 +142,14 @@ pub struct EstimatorParams<T: Real> {
     saliency: T,
     /// A saturating model's active flux (`crate::active_flux`): λ̂r with the secant L̂q at
     /// the estimated current, the limiter's and the lock detector's bounds from λ̂a(î).
-    /// None for constant inductances (`lq` and `saliency` then hold).
-    active_flux: Option<ActiveFlux<T>>,
+    /// [`ActiveFlux::saturating`] is None for constant inductances (`lq` and `saliency`
+    /// then hold).
+    active_flux: ActiveFlux<T>,
     /// The configured λ̂f, Wb.
     flux_linkage: T,
     /// `EstimatorTuning::tracker_hold_ratio`.
     tracker_hold_ratio: T,
-    /// (λ̂f·`tracker_hold_ratio`)²: the trackers coast below this |λ̂r|².
+    /// (λ̂f·`tracker.hold_ratio`)²: the trackers coast below this |λ̂r|².
     hold_level_sq: T,
     /// k_df·Ts with `EstimatorTuning::limiter_recentring`, else 0.
     limiter_recentring_gain: T,

@@ -38,10 +38,11 @@ pub struct SensorlessEstimator<T: Real> {
 impl<T: Real> SensorlessEstimator<T> {
     /// Builds the estimator; every field of `config` is checked and a bad one is named.
     pub fn new(config: EstimatorConfig<T>) -> Result<Self, ConfigError> {
-        let params = EstimatorParams::new(config)?;
-        Ok(Self {
-            params,
+        // Built into the result in place (a freestanding image has no `memcpy` for a copy of
+        // the parameters).
+        EstimatorParams::new(config).map(|params| Self {
             state: params.initial_state(),
+            params,
         })
     }
 

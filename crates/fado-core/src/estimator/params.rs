@@ -82,34 +82,31 @@ impl<T: Real> EstimatorParams<T> {
             ts,
             lq: config.machine.lq,
             saliency: config.machine.ld - config.machine.lq,
-            active_flux: ActiveFlux::new(
-                config.machine.magnetic_model(),
-                config.machine.rated_current,
-            ),
+            active_flux: ActiveFlux::of(&config.machine),
             flux_linkage: lf,
             tracker_hold_ratio: hold,
-            limiter_recentring_gain: if config.tuning.limiter_recentring {
-                config.tuning.k_df * ts
+            limiter_recentring_gain: if config.tuning.limiter.recentring {
+                config.tuning.disturbance_feedback.k_df * ts
             } else {
                 T::zero()
             },
-            offset_recentring_gain: config.tuning.offset_adaptation_rate * ts,
+            offset_recentring_gain: config.tuning.offset_adaptation.rate * ts,
             initial_angle: config.initial_angle,
-            observer_on_rotor_flux: config.tuning.observer_on_rotor_flux,
+            observer_on_rotor_flux: config.tuning.observer.on_rotor_flux,
             gain_hold: blocks.gain_hold,
-            lag_compensation: config.tuning.observer_lag_compensation,
-            lag_keep: if config.tuning.observer_lag_compensation {
+            lag_compensation: config.tuning.observer.lag_compensation,
+            lag_keep: if config.tuning.observer.lag_compensation {
                 T::one() - lag_gain
             } else {
                 T::zero()
             },
             // The innovation it low-passes is in tracker angle units: × rad per unit.
-            lag_input: if config.tuning.observer_lag_compensation {
+            lag_input: if config.tuning.observer.lag_compensation {
                 lag_gain * blocks.t2s1.kp() * T::angle_unit()
             } else {
                 T::zero()
             },
-            rs_adaptation: config.tuning.rs_adaptation,
+            rs_adaptation: config.tuning.rs_adaptation.enabled,
             rs_initial: config.machine.rs,
             hold_level_sq: hold_level * hold_level,
             flux_settle_periods: (T::lit(FLUX_SETTLE_TIME_CONSTANTS)
@@ -221,11 +218,11 @@ impl<T: Real> SampleBlocks<T> {
             config.mode_threshold_hz() + config.mode_hysteresis_hz(),
             ts,
         )?;
-        check::positive("tracker_damping", config.tuning.tracker_damping)?;
-        let load_pole = config.tuning.tracker_load_pole_ratio;
+        check::positive("tracker_damping", config.tuning.tracker.damping)?;
+        let load_pole = config.tuning.tracker.load_pole_ratio;
         let (c1, c2) = (
-            config.tracker_config(config.tuning.t2s1_bandwidth_hz),
-            config.tracker_config(config.tuning.t2s2_bandwidth_hz),
+            config.tracker_config(config.tuning.tracker.t2s1_bandwidth_hz),
+            config.tracker_config(config.tuning.tracker.t2s2_bandwidth_hz),
         );
         let t2s1 = TrackerParams::new(c1)
             .map_err(rename("t2s1_bandwidth_hz"))?
@@ -249,8 +246,8 @@ impl<T: Real> SampleBlocks<T> {
 /// The limiter radius ratio and the tracker hold ratio, checked with the start-up angle, k_af
 /// and the mode threshold.
 fn check_limits<T: Real>(config: &EstimatorConfig<T>, ts: T) -> Result<(T, T), ConfigError> {
-    let ratio = check::positive("limiter_radius_ratio", config.tuning.limiter_radius_ratio)?;
-    let hold = check::non_negative("tracker_hold_ratio", config.tuning.tracker_hold_ratio)?;
+    let ratio = check::positive("limiter_radius_ratio", config.tuning.limiter.radius_ratio)?;
+    let hold = check::non_negative("tracker_hold_ratio", config.tuning.tracker.hold_ratio)?;
     check::below("tracker_hold_ratio", hold, T::one(), "below 1")?;
     check::finite("initial_angle", config.initial_angle)?;
     // A radius below λ̂f would clamp the magnet flux itself, not only drift (Fig. 6).
@@ -262,7 +259,7 @@ fn check_limits<T: Real>(config: &EstimatorConfig<T>, ts: T) -> Result<(T, T), C
     )?;
     // One limiter step pulls the excess radius back by k_af·Ts of itself: above 1 it
     // overshoots through the circle, above 2 it is unstable.
-    let k_af = check::non_negative("k_af", config.tuning.k_af)?;
+    let k_af = check::non_negative("k_af", config.tuning.limiter.k_af)?;
     check::below("k_af", k_af * ts, T::lit(1.0 + 1e-6), "k_af·ts at most 1")?;
     below_nyquist("mode_threshold_ratio", config.mode_threshold_hz(), ts)?;
     Ok((ratio, hold))
@@ -289,12 +286,12 @@ fn rename(field: &'static str) -> impl Fn(ConfigError) -> ConfigError {
     }
 }
 
-/// The observer's gain hold in samples: `observer_gain_period`/Ts rounded, less one.
+/// The observer's gain hold in samples: `observer.gain_period`/Ts rounded, less one.
 fn gain_hold<T: Real>(config: &EstimatorConfig<T>, ts: T) -> Result<u32, ConfigError> {
     // A hold beyond a second is refused as a mistake (the observer would be a fixed
     // filter through any speed change; see the field's docs).
     let gain_period =
-        check::non_negative("observer_gain_period", config.tuning.observer_gain_period)?;
+        check::non_negative("observer_gain_period", config.tuning.observer.gain_period)?;
     check::below(
         "observer_gain_period",
         gain_period,
@@ -337,9 +334,6 @@ fn slow_laws<T: Real>(
                 _ => rename("mode_threshold_ratio")(e),
             }
         })?;
-    let active_flux = ActiveFlux::new(
-        config.machine.magnetic_model(),
-        config.machine.rated_current,
-    );
+    let active_flux = ActiveFlux::of(&config.machine);
     Ok((rs_adaptation.with_active_flux(active_flux), offset))
 }

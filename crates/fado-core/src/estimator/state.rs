@@ -41,7 +41,7 @@ impl<T: Real> EstimatorState<T> {
         // The active flux λ̂f + (L̂d − L̂q)·i_d (λ̂f exactly for L̂d = L̂q), or a saturating
         // model's at the current in the aligned frame, with its secant L̂q.
         let rotor = Ab::from_polar(T::one(), theta0);
-        let (active, lq) = match &p.active_flux {
+        let (active, lq) = match p.active_flux.saturating() {
             None => (p.flux_linkage + p.saliency * rotor.dot(i_ab), p.lq),
             Some(af) => {
                 let point = af.point(ActiveFlux::frame_current(rotor, i_ab));
@@ -164,7 +164,7 @@ impl<T: Real> EstimatorState<T> {
     ) -> Ab<T> {
         let axis = self.observer.flux() - self.observer.disturbance();
         let n2 = axis.norm_squared();
-        if let Some(af) = &p.active_flux {
+        if let Some(af) = p.active_flux.saturating() {
             // A saturating model: λ̂a(î) − ψd(0, 0) along the axis, î in its frame.
             return if n2 > p.hold_level_sq {
                 let point = af.point(ActiveFlux::frame_current(axis, i_ab));

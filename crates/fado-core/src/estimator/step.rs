@@ -119,7 +119,7 @@ impl<T: Real> EstimatorState<T> {
         // 3. Rotor flux and direct angle (eq. (20), (5), (6)); a saturating model's secant
         //    L̂q at the current in the frame of λ2 − L̂q⁻·i.
         let lambda2 = stator_flux(lambda1, disturbance);
-        let (lambda_r, point) = match &p.active_flux {
+        let (lambda_r, point) = match p.active_flux.saturating() {
             None => (lambda2 - lq_i, None),
             Some(af) => {
                 let (lambda_r, point) = af.rotor_flux(lambda2, i_ab, self.lq_secant);
@@ -189,9 +189,9 @@ impl<T: Real> EstimatorState<T> {
         } else {
             lambda1
         };
-        // With `observer_lag_compensation` ω̂1 plus T2S-1's low-passed Kp·e (the rate of
+        // With `observer.lag_compensation` ω̂1 plus T2S-1's low-passed Kp·e (the rate of
         // θ̂), not the lagging ω̂1 alone. Its gains were formed for that speed at the end of
-        // a previous sample (the last one, or up to `observer_gain_period` earlier).
+        // a previous sample (the last one, or up to `observer.gain_period` earlier).
         p.observer
             .next_state_with(&self.observer, &self.observer_gains, observer_input)
     }

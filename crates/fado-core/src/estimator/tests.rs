@@ -21,7 +21,7 @@ fn paper_sample(n: u32) -> (Ab<f64>, Ab<f64>) {
 fn lean_matches_full<T: Real>(rs_adaptation: bool) {
     let model = MachineModel::<T>::paper();
     let mut config = EstimatorConfig::for_machine(&model);
-    config.tuning.rs_adaptation = rs_adaptation;
+    config.tuning.rs_adaptation.enabled = rs_adaptation;
     let mut full = SensorlessEstimator::new(config).unwrap();
     let mut lean = full;
     for n in 0..6000 {
@@ -106,12 +106,12 @@ fn slow_laws_poles_stay_near_one() {
             assert_eq!(config.lock_detector().ts, ts * f64::from(LOCK_PERIOD));
             let t = &config.tuning;
             let rates = [
-                t.rs_adaptation_rate,
+                t.rs_adaptation.rate,
                 rs.standstill_rate,
                 core::f64::consts::TAU * rs.standstill_memory_hz,
                 rs.standstill_flux_rate,
-                t.standstill_angle_rate,
-                t.offset_adaptation_rate,
+                t.rs_adaptation.standstill_angle_rate,
+                t.offset_adaptation.rate,
                 // The λ̂f law at the rate its test uses (off by default).
                 5.0,
             ];
@@ -122,7 +122,7 @@ fn slow_laws_poles_stay_near_one() {
                 assert!((x - exact).abs() <= 0.026 * exact, "rate {rate}, ts {ts}");
             }
             let lock_period = ts * f64::from(LOCK_PERIOD);
-            assert!(t.lock_detection_time / lock_period >= 6.0, "ts {ts}");
+            assert!(t.lock.detection_time / lock_period >= 6.0, "ts {ts}");
             // The estimator is built with these periods.
             let est = SensorlessEstimator::new(config).unwrap();
             assert_eq!(est.params.rs_adaptation_params.config().ts, period);
@@ -171,7 +171,7 @@ fn slow_laws_run_in_their_slots() {
     assert_eq!(est.state.slot, slot);
 }
 
-/// `observer_gain_period` (see its docs): the gains the observer uses are those of the
+/// `observer.gain_period` (see its docs): the gains the observer uses are those of the
 /// speed (ω̂1 + the lag compensation) at the end of the sample that last updated them,
 /// updated once every N = period/Ts accepted samples (N = 4 by default at 10 kHz, in the
 /// slots after the lock detector's), every sample with period 0; a rejected sample
@@ -180,7 +180,7 @@ fn slow_laws_run_in_their_slots() {
 fn observer_gains_are_held_over_their_period() {
     fn check<T: Real>(period: f64, samples_per_update: u32) {
         let mut config = EstimatorConfig::<T>::for_machine(&MachineModel::paper());
-        config.tuning.observer_gain_period = T::lit(period);
+        config.tuning.observer.gain_period = T::lit(period);
         let mut est = SensorlessEstimator::new(config).unwrap();
         let p = est.params;
         assert_eq!(p.gain_hold, samples_per_update - 1);
@@ -225,7 +225,7 @@ fn observer_gains_are_held_over_their_period() {
         check::<f64>(period, n);
     }
     assert_eq!(
-        EstimatorTuning::<f64>::default().observer_gain_period,
+        EstimatorTuning::<f64>::default().observer.gain_period,
         OBSERVER_GAIN_PERIOD
     );
 }

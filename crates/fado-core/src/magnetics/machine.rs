@@ -4,10 +4,11 @@
 //!
 //! [`MachineMagnetics::Linear`] (the default) is the record's own `ld`, `lq` and
 //! `flux_linkage`: every block then runs its constant-inductance arithmetic unchanged, bit for
-//! bit. [`MachineMagnetics::Saturation`] holds the algebraic model by value;
-//! [`MachineMagnetics::Map`] borrows a flux map for the program's life — a `&'static` table in
-//! flash in firmware, a leaked allocation in a simulator or a binding (loaded once per model).
-//! The record stays `Copy` and allocation-free either way.
+//! bit. [`MachineMagnetics::Saturation`] and [`MachineMagnetics::Map`] borrow their model for
+//! the program's life — a `static` in firmware (a map's table in flash), a leaked allocation in
+//! a simulator or a binding (made once per model). The record stays `Copy`, allocation-free and
+//! two words larger than the constant-inductance one (a configuration copied by value stays
+//! small enough for a freestanding image, which has no `memcpy`).
 
 use super::{FluxMap, MagneticModel, Magnetics, Saturation};
 use crate::{Dq, Real};
@@ -18,10 +19,10 @@ pub enum MachineMagnetics<T: 'static> {
     /// Constant inductances: the record's `ld`, `lq` and `flux_linkage`.
     #[default]
     Linear,
-    /// The algebraic self- and cross-saturation model.
-    Saturation(Saturation<T>),
+    /// The algebraic self- and cross-saturation model, borrowed for the program's life.
+    Saturation(&'static Saturation<T>),
     /// A flux map on a rectangular grid, borrowed for the program's life.
-    Map(FluxMap<'static, T>),
+    Map(&'static FluxMap<'static, T>),
 }
 
 impl<T: Real> MachineMagnetics<T> {
@@ -31,16 +32,22 @@ impl<T: Real> MachineMagnetics<T> {
         matches!(self, MachineMagnetics::Linear)
     }
 
-    /// The model in another precision. A saturation model is rounded; a map keeps its table
-    /// when `U` is `T` and is `None` otherwise (a borrowed table cannot be converted without
-    /// allocating: build the map in the drive's precision, see `FluxTable`).
+    /// The model in another precision: itself when `U` is `T`, `None` for a borrowed model
+    /// otherwise (it cannot be converted without allocating: build it in the drive's
+    /// precision, e.g. `Saturation::cast` into a `static`, a map with `FluxTable`).
     pub fn cast<U: Real>(&self) -> Option<MachineMagnetics<U>> {
-        match self {
+        match *self {
             MachineMagnetics::Linear => Some(MachineMagnetics::Linear),
-            MachineMagnetics::Saturation(s) => Some(MachineMagnetics::Saturation(s.cast())),
-            MachineMagnetics::Map(m) => (m as &dyn core::any::Any)
-                .downcast_ref::<FluxMap<'static, U>>()
-                .map(|m| MachineMagnetics::Map(*m)),
+            MachineMagnetics::Saturation(s) => {
+                let s: &'static dyn core::any::Any = s;
+                s.downcast_ref::<Saturation<U>>()
+                    .map(MachineMagnetics::Saturation)
+            }
+            MachineMagnetics::Map(m) => {
+                let m: &'static dyn core::any::Any = m;
+                m.downcast_ref::<FluxMap<'static, U>>()
+                    .map(MachineMagnetics::Map)
+            }
         }
     }
 
@@ -49,8 +56,8 @@ impl<T: Real> MachineMagnetics<T> {
     pub fn resolve(&self, linear: super::ConstantInductance<T>) -> Magnetics<'static, T> {
         match *self {
             MachineMagnetics::Linear => Magnetics::Constant(linear),
-            MachineMagnetics::Saturation(s) => Magnetics::Saturation(s),
-            MachineMagnetics::Map(m) => Magnetics::Map(m),
+            MachineMagnetics::Saturation(s) => Magnetics::Saturation(*s),
+            MachineMagnetics::Map(m) => Magnetics::Map(*m),
         }
     }
 }

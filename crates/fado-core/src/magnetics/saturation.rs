@@ -106,14 +106,14 @@ impl<T: Real> Default for Saturation<T> {
 /// fits use (exact, and several times faster than libm's powf), powf otherwise.
 #[inline]
 fn pow_abs<T: Real>(x: T, e: T) -> T {
-    let n = e.to_f64();
-    if n == 0.0 {
+    let n = e.index_floor(16);
+    if e == T::zero() {
         T::one()
-    } else if (1.0..=16.0).contains(&n) && n == f64::from(n as i32) {
+    } else if n >= 1 && e == T::from_index(n) {
         // By multiplication: the generic `powi` of a no_std build is libm's `pow`.
         let a = x.abs();
         let mut p = a;
-        for _ in 1..n as i32 {
+        for _ in 1..n {
             p *= a;
         }
         p

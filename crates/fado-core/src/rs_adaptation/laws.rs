@@ -29,7 +29,7 @@ pub(crate) struct ResistanceAdaptationParams<T: 'static> {
     floor_sq: T,
     /// The saturating model's active flux (`crate::active_flux`); None: the constant
     /// L̂d, L̂q of the configuration.
-    active_flux: Option<ActiveFlux<T>>,
+    active_flux: ActiveFlux<T>,
 }
 
 /// What the laws derive from R0, the resistance they start from and scale with: mutable
@@ -48,9 +48,9 @@ pub(crate) struct ResistanceScale<T> {
 
 impl<T: Real> ResistanceAdaptationParams<T> {
     /// Checks every field of `config` (the error names it) and precomputes the constants.
+    /// R0 = 0 is allowed: it scales the law and its bounds to nothing (R̂s stays 0).
     pub(crate) fn new(config: ResistanceAdaptationConfig<T>) -> Result<Self, ConfigError> {
         let ts = check::positive("ts", config.ts)?;
-        // R0 = 0 is allowed: it scales the law and its bounds to nothing (R̂s stays 0).
         check::non_negative("rs_initial", config.rs_initial)?;
         check::positive("flux_linkage_hat", config.flux_linkage_hat)?;
         check::non_negative("lq_hat", config.lq_hat)?;
@@ -126,14 +126,14 @@ impl<T: Real> ResistanceAdaptationParams<T> {
             },
             saliency: config.ld_hat - config.lq_hat,
             floor_sq: floor * floor,
-            active_flux: None,
+            active_flux: ActiveFlux::of(&crate::MachineModel::default()),
         })
     }
 
     /// These constants with a saturating model's active flux: the reference λ̂a, the
     /// regressor φ and the standstill law's inductances evaluated at the estimated current
     /// (`crate::active_flux`), the laws frozen where φ is ill-conditioned.
-    pub(crate) fn with_active_flux(mut self, active_flux: Option<ActiveFlux<T>>) -> Self {
+    pub(crate) fn with_active_flux(mut self, active_flux: ActiveFlux<T>) -> Self {
         self.active_flux = active_flux;
         self
     }
@@ -146,7 +146,7 @@ impl<T: Real> ResistanceAdaptationParams<T> {
         lambda_r: Ab<T>,
         i: Ab<T>,
     ) -> Option<(ActiveFlux<T>, ActiveFluxPoint<T>)> {
-        let af = self.active_flux?;
+        let af = *self.active_flux.saturating()?;
         let point = af.point(ActiveFlux::frame_current(lambda_r, i));
         Some((af, point))
     }

@@ -81,7 +81,7 @@
 //! ```
 //!
 //! (times 1 − ω̂²/ω_s², ω_s the standstill speed) near δ = 0 a first-order decay of δ at k_θ
-//! (`standstill_angle_rate`); the factors 1 − 4x² and 1 − ω̂²/ω_s² take the law continuously
+//! (`rs_adaptation.standstill_angle_rate`); the factors 1 − 4x² and 1 − ω̂²/ω_s² take the law continuously
 //! to zero where the DC test's conditions i_d > 2|i_q| and |ω̂| ≤ ω_s end (no jump in dθ̂/dt
 //! when the current or the speed crosses them). Under a light load i_L it
 //! settles at δ = atan(i_L/i_d) instead (the torque balance then needs that angle): the law
@@ -253,7 +253,7 @@ pub struct ResistanceAdaptationConfig<T> {
     /// The λ̂f law runs only above this |ω̂|, rad/s: below it the voltage errors' share of
     /// |λ̂r| − λ̂f (the dead-time residual and the other voltage errors over ω) is not small
     /// against a λ̂f error. Default [`FLUX_LINKAGE_SPEED_THRESHOLDS`] (3) times the Fig. 3
-    /// threshold speed 2π·`mode_threshold_ratio`·f_rated (ours \[A\]; 2π·4.5 Hz on the
+    /// threshold speed 2π·`mode.threshold_ratio`·f_rated (ours \[A\]; 2π·4.5 Hz on the
     /// paper's motor).
     pub flux_linkage_min_speed: T,
     /// k_θ in s⁻¹: while the standstill DC test runs, the estimator also turns λ̂r towards
@@ -284,7 +284,7 @@ impl<T: Real> ResistanceAdaptationConfig<T> {
     /// - `rs_initial`, `flux_linkage_hat`, `lq_hat`, `ld_hat`: the machine model (R̂s, λ̂f,
     ///   L̂q, L̂d).
     /// - `rate`, `excitation_floor`, `min_ratio`, `max_ratio`, `flux_linkage_rate`,
-    ///   `standstill_angle_rate`: [`DEFAULT_RATE`], [`DEFAULT_EXCITATION_FLOOR`],
+    ///   `rs_adaptation.standstill_angle_rate`: [`DEFAULT_RATE`], [`DEFAULT_EXCITATION_FLOOR`],
     ///   [`DEFAULT_MIN_RATIO`], [`DEFAULT_MAX_RATIO`], [`DEFAULT_FLUX_LINKAGE_RATE`] and
     ///   [`DEFAULT_STANDSTILL_ANGLE_RATE`] (their reasons in the fields' docs here).
     /// - `flux_linkage_min_speed`: three times the Fig. 3 threshold speed,

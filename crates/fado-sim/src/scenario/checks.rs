@@ -133,7 +133,7 @@ pub(super) fn checks_fig10(
     checks.push(Check::at_most("max |θ − θ̂| (rad)", m.max_angle_error, 0.35));
     checks.push(Check::at_most(
         "max |λ̂r| / (1.15·λ̂f)",
-        p.max_lambda_r / (cfg.estimator.limiter_radius_ratio * cfg.machine_model().flux_linkage),
+        p.max_lambda_r / (cfg.estimator.limiter.radius_ratio * cfg.machine_model().flux_linkage),
         1.01,
     ));
     checks.push(Check::at_least(

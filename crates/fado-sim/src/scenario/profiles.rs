@@ -52,7 +52,7 @@ pub(super) fn setup_fig9(c: &mut SimConfig) {
     // For the same reason the learned integrand offset is off: it removes that error while
     // turning, so with k_df off λ1 would have nothing to drift from (measured: 0.2 mWb
     // instead of 21 mWb in the 2 s) \[A\].
-    c.estimator.offset_adaptation_rate = 0.0;
+    c.estimator.offset_adaptation.rate = 0.0;
 }
 
 /// `fig10`: profile, load, duration, evaluation window.

@@ -81,7 +81,7 @@ pub struct TraceRow {
     pub i_alpha: f64,
     /// Measured current β, A.
     pub i_beta: f64,
-    /// R̂s the estimator integrated with, Ω (moves with `[estimator] rs_adaptation`).
+    /// R̂s the estimator integrated with, Ω (moves with `[estimator.rs_adaptation] enabled`).
     pub rs_hat: f64,
     /// The estimator's flux-magnitude reference λ̂f, Wb (moves with `rs_adaptation`).
     pub flux_linkage_hat: f64,

@@ -6,7 +6,7 @@
 //! model), a list of parameter names (the axes) and a list of points, one value per axis.
 //! [`SweepSpec::grid`] builds the cartesian product of value lists, [`SweepSpec::random`]
 //! draws uniform samples in ranges from a seed. A parameter is either any TOML key of the
-//! configuration (`section.key`, e.g. `estimator.k_df`, `load.torque.points`) or one of the
+//! configuration (`section.key`, e.g. `estimator.disturbance_feedback.k_df`, `load.torque.points`) or one of the
 //! derived [`PARAMETERS`], whose direction is fixed by their names:
 //!
 //! | parameter | meaning | sets |

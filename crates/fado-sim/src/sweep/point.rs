@@ -333,46 +333,54 @@ pub fn run_point_until(
             ));
         }
     };
-    let m = &outcome.metrics;
-    let mut r = PointResult {
-        index,
-        values: values.to_vec(),
-        status: Status::Ok,
-        passed: outcome.passed,
-        failed_checks: outcome
-            .checks
+    Some(PointResult::of(&outcome, index, values, wall))
+}
+
+impl PointResult {
+    /// The row of a finished run `outcome` of point `index` at `values`, `wall` seconds long;
+    /// a trip or a non-finite overall metric makes it `Diverged`.
+    fn of(outcome: &scenario::Outcome, index: usize, values: &[Value], wall: f64) -> Self {
+        let m = &outcome.metrics;
+        let mut r = PointResult {
+            index,
+            values: values.to_vec(),
+            status: Status::Ok,
+            passed: outcome.passed,
+            failed_checks: outcome
+                .checks
+                .iter()
+                .filter(|c| !c.passed)
+                .map(|c| c.name.as_str())
+                .collect::<Vec<_>>()
+                .join("; "),
+            max_angle_error: m.max_angle_error,
+            rms_angle_error: m.rms_angle_error,
+            max_angle_error_zero_speed: m.max_angle_error_zero_speed,
+            rms_angle_error_zero_speed: m.rms_angle_error_zero_speed,
+            max_speed_error_rpm: m.max_speed_error_rpm,
+            tripped: m.tripped,
+            wall_seconds: wall,
+            max_angle_error_run: m.max_angle_error_run,
+            angle_error_exceeded_time: m.angle_error_exceeded_time.unwrap_or(f64::NAN),
+            lock_lost_time: m.lock_lost_time.unwrap_or(f64::NAN),
+            loss_onset_time: m.loss_onset_time.unwrap_or(f64::NAN),
+            loss_settled_time: m.loss_settled_time.unwrap_or(f64::NAN),
+            lock_detection_delay: m.lock_detection_delay.unwrap_or(f64::NAN),
+            lock_late_delay: m.lock_late_delay.unwrap_or(f64::NAN),
+            stall_time: m.stall_time.unwrap_or(f64::NAN),
+            lock_lost_detection_delay: m.lock_lost_detection_delay.unwrap_or(f64::NAN),
+        };
+        // The zero-speed metrics are NaN-free by construction only when the band was visited;
+        // judge divergence on the overall ones.
+        let finite = [r.max_angle_error, r.rms_angle_error, r.max_speed_error_rpm]
             .iter()
-            .filter(|c| !c.passed)
-            .map(|c| c.name.as_str())
-            .collect::<Vec<_>>()
-            .join("; "),
-        max_angle_error: m.max_angle_error,
-        rms_angle_error: m.rms_angle_error,
-        max_angle_error_zero_speed: m.max_angle_error_zero_speed,
-        rms_angle_error_zero_speed: m.rms_angle_error_zero_speed,
-        max_speed_error_rpm: m.max_speed_error_rpm,
-        tripped: m.tripped,
-        wall_seconds: wall,
-        max_angle_error_run: m.max_angle_error_run,
-        angle_error_exceeded_time: m.angle_error_exceeded_time.unwrap_or(f64::NAN),
-        lock_lost_time: m.lock_lost_time.unwrap_or(f64::NAN),
-        loss_onset_time: m.loss_onset_time.unwrap_or(f64::NAN),
-        loss_settled_time: m.loss_settled_time.unwrap_or(f64::NAN),
-        lock_detection_delay: m.lock_detection_delay.unwrap_or(f64::NAN),
-        lock_late_delay: m.lock_late_delay.unwrap_or(f64::NAN),
-        stall_time: m.stall_time.unwrap_or(f64::NAN),
-        lock_lost_detection_delay: m.lock_lost_detection_delay.unwrap_or(f64::NAN),
-    };
-    // The zero-speed metrics are NaN-free by construction only when the band was visited;
-    // judge divergence on the overall ones.
-    let finite = [r.max_angle_error, r.rms_angle_error, r.max_speed_error_rpm]
-        .iter()
-        .all(|x| x.is_finite());
-    if r.tripped || !finite {
-        r.status = Status::Diverged;
-        r.passed = false;
+            .all(|x| x.is_finite());
+        if r.tripped || !finite {
+            r.status = Status::Diverged;
+            r.passed = false;
+        }
+        r
     }
-    Some(r)
 }
 
 #[cfg(test)]
@@ -406,8 +414,13 @@ mod tests {
         assert_eq!(c.speed_reference.points[4], [6.5, 90.0]);
         assert!(close(c.simulation.duration, base.simulation.duration + 2.0));
         // A TOML key as an axis.
-        let c = point_config(&base, &["estimator.k_df".into()], &[Value::Float(0.25)]).unwrap();
-        assert_eq!(c.estimator.k_df, 0.25);
+        let c = point_config(
+            &base,
+            &["estimator.disturbance_feedback.k_df".into()],
+            &[Value::Float(0.25)],
+        )
+        .unwrap();
+        assert_eq!(c.estimator.disturbance_feedback.k_df, 0.25);
         // Bad values are errors naming the parameter.
         let e = point_config(&base, &["rs_error".into()], &[Value::Float(-1.5)]).unwrap_err();
         assert!(e.to_string().contains("rs_ratio"), "{e}");

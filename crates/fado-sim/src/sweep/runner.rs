@@ -108,20 +108,10 @@ pub fn run(
 ) -> Result<SweepOutcome, SweepError> {
     let started = Instant::now();
     let base = spec.base_config()?;
-    let mut done: BTreeMap<usize, PointResult> = BTreeMap::new();
-    let mut sink = None;
-    let mut lock = None;
-    if let Some(dir) = &opts.out {
-        lock = Some(DirLock::acquire(dir)?);
-        done = prepare_resume(spec, dir, opts.fresh)?;
-        let csv_path = dir.join("sweep.csv");
-        write_csv(&csv_path, spec, done.values())?;
-        let file = OpenOptions::new()
-            .append(true)
-            .open(&csv_path)
-            .map_err(|e| io("open", &csv_path, e))?;
-        sink = Some(Mutex::new((csv_path, file)));
-    }
+    let (lock, mut done, sink) = match &opts.out {
+        Some(dir) => open_out(spec, dir, opts.fresh)?,
+        None => (None, BTreeMap::new(), None),
+    };
     let resumed = done.len();
     let todo: Vec<usize> = (0..spec.points.len())
         .filter(|k| !done.contains_key(k))
@@ -146,13 +136,7 @@ pub fn run(
                     cancel,
                 )?;
                 if let Some(sink) = &sink {
-                    let mut guard = sink.lock().unwrap_or_else(|p| p.into_inner());
-                    let (path, file) = &mut *guard;
-                    let line = csv_line(&r);
-                    if let Err(e) = file.write_all(line.as_bytes()).and_then(|_| file.flush()) {
-                        *write_error.lock().unwrap_or_else(|p| p.into_inner()) =
-                            Some(io("write", path, e));
-                    }
+                    append(sink, &r, &write_error);
                 }
                 let n = finished.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
                 on_point(&r, n);
@@ -180,19 +164,54 @@ pub fn run(
         summary,
     };
     if let Some(dir) = &opts.out {
-        // The final CSV is in index order.
-        write_csv(&dir.join("sweep.csv"), spec, outcome.rows.iter())?;
-        let json_path = dir.join("summary.json");
-        let json = serde_json::to_string_pretty(&outcome.summary)
-            .map_err(|e| io("write", &json_path, e))?;
-        AtomicFile::write(
-            &dir.join("summary.md"),
-            outcome.summary.to_markdown().as_bytes(),
-        )?;
-        AtomicFile::write(&json_path, json.as_bytes())?;
+        write_results(dir, &outcome)?;
     }
     drop(lock);
     Ok(outcome)
+}
+
+/// The CSV of a sweep appended to as its points finish.
+type Sink = Mutex<(PathBuf, std::fs::File)>;
+
+/// An output directory taken for a sweep: its lock, the points already finished, the CSV.
+type Opened = (Option<DirLock>, BTreeMap<usize, PointResult>, Option<Sink>);
+
+/// Takes DIR for a sweep: its lock, the points an earlier run of the same definition finished
+/// (none with `fresh`), and DIR/sweep.csv rewritten with them, open for appending.
+fn open_out(spec: &SweepSpec, dir: &Path, fresh: bool) -> Result<Opened, SweepError> {
+    let lock = DirLock::acquire(dir)?;
+    let done = prepare_resume(spec, dir, fresh)?;
+    let csv_path = dir.join("sweep.csv");
+    write_csv(&csv_path, spec, done.values())?;
+    let file = OpenOptions::new()
+        .append(true)
+        .open(&csv_path)
+        .map_err(|e| io("open", &csv_path, e))?;
+    Ok((Some(lock), done, Some(Mutex::new((csv_path, file)))))
+}
+
+/// Appends the row of `r` to the CSV and flushes it; a failure is kept in `write_error`.
+fn append(sink: &Sink, r: &PointResult, write_error: &Mutex<Option<SweepError>>) {
+    let mut guard = sink.lock().unwrap_or_else(|p| p.into_inner());
+    let (path, file) = &mut *guard;
+    let line = csv_line(r);
+    if let Err(e) = file.write_all(line.as_bytes()).and_then(|_| file.flush()) {
+        *write_error.lock().unwrap_or_else(|p| p.into_inner()) = Some(io("write", path, e));
+    }
+}
+
+/// DIR/sweep.csv in index order, DIR/summary.md and DIR/summary.json.
+fn write_results(dir: &Path, outcome: &SweepOutcome) -> Result<(), SweepError> {
+    write_csv(&dir.join("sweep.csv"), &outcome.spec, outcome.rows.iter())?;
+    let json_path = dir.join("summary.json");
+    let json =
+        serde_json::to_string_pretty(&outcome.summary).map_err(|e| io("write", &json_path, e))?;
+    AtomicFile::write(
+        &dir.join("summary.md"),
+        outcome.summary.to_markdown().as_bytes(),
+    )?;
+    AtomicFile::write(&json_path, json.as_bytes())?;
+    Ok(())
 }
 
 #[derive(Serialize, Deserialize)]

@@ -14,8 +14,19 @@ use crate::{Ab, Abc, Dq, Real};
 impl<T: Real> SensorlessDrive<T, SensorlessEstimator<T>> {
     /// The drive with the paper's estimator, built with the drive's own sampling period and
     /// machine model and the given estimator tuning (start-up angle 0; see
-    /// [`align`](Self::align)).
-    pub fn new(config: DriveConfig<T>, estimator: EstimatorTuning<T>) -> Result<Self, ConfigError> {
+    /// [`align`](Self::align)). A rotor its trackers would lag at the current limit gets the
+    /// acceleration feed-forward ([`crate::control::tracker_feedforward`]).
+    pub fn new(
+        mut config: DriveConfig<T>,
+        mut estimator: EstimatorTuning<T>,
+    ) -> Result<Self, ConfigError> {
+        let machine = config.machine;
+        crate::control::tracker_feedforward::apply(
+            &machine,
+            &mut config.tuning,
+            &mut estimator,
+            config.ts,
+        );
         let estimator = EstimatorConfig {
             ts: check::positive("ts", config.ts)?,
             machine: config.machine,

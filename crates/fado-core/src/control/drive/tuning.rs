@@ -10,6 +10,7 @@ use crate::control::lock_reaction::LockReaction;
 use crate::control::modulation::VoltageLimit;
 use crate::control::ratings_limit::RatingsLimitTuning;
 use crate::control::release_hold::ReleaseHoldTuning;
+use crate::control::tracker_feedforward::TrackerFeedforwardTuning;
 use crate::control::{current_controller, delay_compensation, gain_calibration, speed_controller};
 use crate::injection;
 use crate::machine::PAPER_RATED_CURRENT;
@@ -46,8 +47,9 @@ pub struct DriveTuning<T> {
     pub mtpa: bool,
     /// Give the estimator's speed trackers the acceleration the commanded torque causes,
     /// p·T*/Ĵ (a mechanical-model feed-forward, see [`crate::tracker`]); use with the
-    /// estimator's `tracker_load_pole_ratio` > 0, whose third integrator takes up the load.
-    /// Default false (the paper's trackers) \[A\].
+    /// estimator's `tracker.load_pole_ratio` > 0, whose third integrator takes up the load.
+    /// Default false (the paper's trackers) \[A\]; the drive turns it on itself on a rotor its
+    /// trackers would lag (`tracker_feedforward`).
     pub acceleration_feedforward: bool,
     /// Dead time Td in s (inverter datum). Default 2.5 µs (paper, V).
     #[cfg_attr(feature = "serde", serde(skip))]
@@ -184,6 +186,14 @@ pub struct DriveTuning<T> {
         serde(bound(deserialize = "T: Real + serde::Deserialize<'de>"))
     )]
     pub limits: RatingsLimitTuning<T>,
+    /// When the drive turns on the acceleration feed-forward by itself: a rotor its trackers
+    /// would lag by more than `max_lag` at the current limit (`[controller.tracker_feedforward]`,
+    /// see [`crate::control::tracker_feedforward`]).
+    #[cfg_attr(
+        feature = "serde",
+        serde(bound(deserialize = "T: Real + serde::Deserialize<'de>"))
+    )]
+    pub tracker_feedforward: TrackerFeedforwardTuning<T>,
     /// The release hold: a position loop that holds a rotor a load turns at zero speed
     /// after the start-up (`[controller.release_hold]`, see [`ReleaseHoldTuning`]).
     #[cfg_attr(
@@ -223,7 +233,7 @@ pub struct DriveTuning<T> {
     /// `lock_reaction_on_stall`; widened with the commanded torque on motors of small inertia
     /// for their torque, `lock_stall_torque_band_ratio`). Default 0.003
     /// \[A\] (4.5 r/min at 1500 r/min rated, a fifth of the default Fig. 3 threshold
-    /// `mode_threshold_ratio` 0.015; chosen on the fig11 envelope with the current gate
+    /// `mode.threshold_ratio` 0.015; chosen on the fig11 envelope with the current gate
     /// `lock_stall_min_current_ratio` and the exception `lock_stall_follow_time`,
     /// docs/method/lock.md: 0.005 reaches the band 20–60 ms after the error passes 0.5 rad in 10
     /// of 208 fixed-R̂s losses; the light-load losses that 0.004 saw late reach
@@ -232,11 +242,11 @@ pub struct DriveTuning<T> {
     pub lock_stall_speed_ratio: T,
     /// Net time (s) the stall condition must hold (up/down count, [`crate::lock::Debouncer`]).
     /// Default 5 ms \[A\] (the estimator's
-    /// `lock_detection_time`).
+    /// `lock.detection_time`).
     pub lock_stall_time: T,
     /// Net time (s) without the stall condition after which the stall symptom clears (it is
     /// a live status like the estimator's, see [`crate::lock::Debouncer`]; the reaction
-    /// latches). Default 0.1 s \[A\] (the estimator's `lock_heal_time`).
+    /// latches). Default 0.1 s \[A\] (the estimator's `lock.heal_time`).
     pub lock_stall_heal_time: T,
     /// The stall symptom counts only while |ω̂| is below this multiple of the rated speed, or
     /// while ω̂ turns against ω*; 0: at any speed. Default 0 (off) \[A\]. The first round's
@@ -274,7 +284,7 @@ pub struct DriveTuning<T> {
     /// lose its rotor: a trade to choose per motor, not a default.
     pub lock_stall_gross_error_ratio: T,
     /// The stall symptom also counts in k_df mode while |ω̂| is below this multiple of the
-    /// rated speed (the limiter ↔ k_df threshold `mode_threshold_ratio` is 0.015, so the
+    /// rated speed (the limiter ↔ k_df threshold `mode.threshold_ratio` is 0.015, so the
     /// default is a band of 0.0025·rated, 3.75 r/min at 1500 r/min, above it); 0: limiter
     /// mode only. Default 0.0175 \[A\] (docs/method/lock.md). A band of 0.02 (chosen on the fig11
     /// envelope: under heavy
@@ -446,6 +456,7 @@ impl<T: Real> DriveTuning<T> {
             field_weakening: self.field_weakening.cast(),
             release_hold: self.release_hold.cast(),
             limits: self.limits.cast(),
+            tracker_feedforward: self.tracker_feedforward.cast(),
             lock_reaction: self.lock_reaction,
             lock_reaction_on_stall: self.lock_reaction_on_stall,
             lock_recovery_time: U::lit(self.lock_recovery_time.to_f64()),
@@ -520,6 +531,7 @@ impl<T: Real> Default for DriveTuning<T> {
             field_weakening: FieldWeakeningTuning::default(),
             release_hold: ReleaseHoldTuning::default(),
             limits: RatingsLimitTuning::default(),
+            tracker_feedforward: TrackerFeedforwardTuning::default(),
             lock_reaction: LockReaction::ReportOnly,
             lock_reaction_on_stall: true,
             lock_recovery_time: T::lit(20e-3),

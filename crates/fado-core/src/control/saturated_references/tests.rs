@@ -1,6 +1,8 @@
 //! MTPA from the model against a search on the current circle, the torque limit, and the
 //! rated point's incremental inductances.
 
+use std::boxed::Box;
+
 use super::*;
 use crate::magnetics::{MachineMagnetics, Saturation};
 
@@ -26,7 +28,7 @@ fn machine(a_dq: f64) -> MachineModel<f64> {
         rated_speed_rpm: 1500.0,
         rated_torque: 14.0,
         dc_voltage: 540.0,
-        magnetics: MachineMagnetics::Saturation(sat),
+        magnetics: MachineMagnetics::Saturation(Box::leak(Box::new(sat))),
     }
 }
 
@@ -60,7 +62,7 @@ fn baldor() -> MachineModel<f64> {
         rated_speed_rpm: 1800.0,
         rated_torque: 29.7,
         dc_voltage: 540.0,
-        magnetics: MachineMagnetics::Saturation(sat),
+        magnetics: MachineMagnetics::Saturation(Box::leak(Box::new(sat))),
     }
 }
 

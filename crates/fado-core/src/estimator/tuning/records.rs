@@ -1,58 +1,193 @@
-//! [`EstimatorTuning`]: the estimator's gains, bandwidths, thresholds and switches.
+//! The estimator's tuning records, one per block it tunes (each a table of `[estimator]` in
+//! `fado-sim`'s TOML, a nested dict in Python): their fields, defaults and sources.
 
-use super::OBSERVER_GAIN_PERIOD;
 use crate::Real;
 use crate::plausibility;
 use crate::tracker::{self, BandwidthDefinition};
 use crate::{flux, integrand_offset, mode, rs_adaptation};
 
-/// The estimator's tuning: every setting that is not the machine or the sampling period.
-/// Defaults are the paper's (section V) or the method pages', as each field says; none depends on the
-/// motor (speeds are ratios of the rated electrical frequency). With the `serde` feature this
-/// is the `[estimator]` table of `fado-sim`'s TOML and the keyword set of Python's
-/// `fado.EstimatorConfig`.
+use super::super::OBSERVER_GAIN_PERIOD;
+
+/// `impl cast` for a tuning record: every real field rounded to `U`, the others copied.
+macro_rules! cast_record {
+    ($name:ident { $($real:ident),* ; $($copy:ident),* }) => {
+        impl<T: Real> $name<T> {
+            /// The same record in another precision: every real rounded to `U`.
+            pub fn cast<U: Real>(&self) -> $name<U> {
+                $name {
+                    $($real: U::lit(self.$real.to_f64()),)*
+                    $($copy: self.$copy,)*
+                }
+            }
+        }
+    };
+}
+
+/// Tuning of the flux integrator (eq. (3)) (`[estimator.integrator]`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(
     feature = "serde",
     derive(serde::Serialize, serde::Deserialize),
     serde(deny_unknown_fields, default)
 )]
-pub struct EstimatorTuning<T> {
+pub struct IntegratorTuning {
+    /// Average the current over the interval for the resistive drop. Default true (docs/method/estimator.md §1 \[A\]).
+    pub average_current: bool,
+}
+
+impl Default for IntegratorTuning {
+    fn default() -> Self {
+        Self {
+            average_current: flux::DEFAULT_AVERAGE_CURRENT,
+        }
+    }
+}
+
+/// Tuning of the disturbance feedback k_df (Fig. 3) (`[estimator.disturbance_feedback]`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(deny_unknown_fields, default)
+)]
+pub struct DisturbanceFeedbackTuning<T> {
     /// Disturbance feedback gain k_df in s⁻¹ (Fig. 3), at most 1/ts. Default 0.5 (paper, V).
     pub k_df: T,
     /// Ramp time of k_df on activation in s, 0 = abrupt as in the paper. Default 0 (docs/method/estimator.md §1 \[A\]).
-    pub k_df_ramp_time: T,
+    pub ramp_time: T,
+}
+
+cast_record!(DisturbanceFeedbackTuning { k_df, ramp_time ;  });
+
+impl<T: Real> Default for DisturbanceFeedbackTuning<T> {
+    fn default() -> Self {
+        Self {
+            k_df: T::lit(flux::DEFAULT_K_DF),
+            ramp_time: T::zero(),
+        }
+    }
+}
+
+/// Tuning of the flux limiter (Fig. 6) (`[estimator.limiter]`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(deny_unknown_fields, default)
+)]
+pub struct LimiterTuning<T> {
     /// Limiter gain k_af in s⁻¹ (Fig. 6), at most 1/ts (a larger step pulls λ̂r through the
     /// circle). Default 2π·100 (paper, V).
     pub k_af: T,
     /// Limiter radius as a multiple of λ̂f, at least 1. Default 1.15 (paper, V).
-    pub limiter_radius_ratio: T,
+    pub radius_ratio: T,
+    /// In limiter mode, move λ1 and the observer's λ̂1 and D̂ together by −k_df·Ts·D̂ each
+    /// sample. Default true (ours \[A\]; `false` is the paper).
+    ///
+    /// A shift common to λ1, λ̂1 and D̂ changes nothing the estimator uses: λ2 = λ1 − D̂, λ̂r
+    /// and the observer's innovation and z − d are the same. In HI mode k_df·D̂ (acting on λ1
+    /// alone) pulls that common mode back; in limiter mode nothing does (the limiter sees
+    /// λ̂r only), so the tangential part of a DC integrand error that the observer absorbs
+    /// whenever ω̂ ≠ 0 makes λ1 and D̂ ramp together without bound while the angle stays put.
+    /// Measured (fado-sim long run, 0 r/min under 7.5 N·m, averaged plant, default sensors):
+    /// 0.6 mWb/s, |λ1| ≈ |D̂| ≈ 2.1 Wb after an hour, f32 and f64 alike — in f32 the flux
+    /// increments (≈ 0.5 mWb per sample at standstill) would drown in the rounding of λ1
+    /// after days. The shift keeps D̂ at rate/k_df instead; θ̂ is unchanged while the
+    /// estimator stays in limiter mode (at a hand-over to HI mode D̂ is smaller, so the k_df
+    /// transient that follows differs).
+    pub recentring: bool,
+}
+
+cast_record!(LimiterTuning { k_af, radius_ratio ; recentring });
+
+impl<T: Real> Default for LimiterTuning<T> {
+    fn default() -> Self {
+        Self {
+            k_af: T::lit(flux::DEFAULT_K_AF),
+            radius_ratio: T::lit(flux::DEFAULT_LIMITER_RADIUS_RATIO),
+            recentring: true,
+        }
+    }
+}
+
+/// Tuning of the selection between limiter and k_df (Fig. 3) (`[estimator.mode]`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(deny_unknown_fields, default)
+)]
+pub struct ModeTuning<T> {
     /// Speed threshold between limiter and k_df as a fraction of the rated electrical
     /// frequency; threshold + hysteresis below the Nyquist frequency 1/(2·ts). Default 0.015
     /// (paper, V: 1.5 Hz of its motor's 100 Hz).
-    pub mode_threshold_ratio: T,
+    pub threshold_ratio: T,
     /// Hysteresis half-band of the threshold as a fraction of the rated electrical frequency,
     /// at most the threshold. Default 0.002 (docs/method/estimator.md §1 \[A\]: 0.2 Hz of 100 Hz).
-    pub mode_hysteresis_ratio: T,
+    pub hysteresis_ratio: T,
+}
+
+cast_record!(ModeTuning { threshold_ratio, hysteresis_ratio ;  });
+
+impl<T: Real> Default for ModeTuning<T> {
+    fn default() -> Self {
+        Self {
+            threshold_ratio: T::lit(mode::DEFAULT_THRESHOLD_RATIO),
+            hysteresis_ratio: T::lit(mode::DEFAULT_HYSTERESIS_RATIO),
+        }
+    }
+}
+
+/// Tuning of the speed trackers T2S-1 and T2S-2 (`[estimator.tracker]`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(deny_unknown_fields, default)
+)]
+pub struct TrackerTuning<T> {
     /// Bandwidth of T2S-1 (angle, observer speed) in Hz. Default 60 Hz (paper, V).
     pub t2s1_bandwidth_hz: T,
     /// Bandwidth of T2S-2 (speed for control) in Hz. Default 35 Hz (paper, V).
     pub t2s2_bandwidth_hz: T,
     /// Damping ratio of both trackers. Default 1/√2 (docs/method/estimator.md §4 \[A\]).
-    pub tracker_damping: T,
+    pub damping: T,
     /// Meaning of the tracker bandwidths. Default −3 dB (docs/method/estimator.md §4).
     pub bandwidth_definition: BandwidthDefinition,
     /// Trackers coast (no update) while |λ̂r| is below this fraction of λ̂f. Default 0.2
     /// (docs/method/estimator.md §4 \[A\]).
-    pub tracker_hold_ratio: T,
+    pub hold_ratio: T,
     /// The trackers' third (load-acceleration) integrator, as the ratio c of its real pole
     /// to ωn (see [`crate::tracker`], "Acceleration feed-forward"). Default 0: the paper's
     /// type-2 trackers; 0.5 \[A\] with the drive's `acceleration_feedforward` (the range
     /// scenarios: a load pole at half ωn, 8 Hz on T2S-2's 35 Hz, settles a rated load step
     /// within 0.1 rad on the paper's motor, docs/range.md).
-    pub tracker_load_pole_ratio: T,
-    /// Average the current over the interval for the resistive drop. Default true (docs/method/estimator.md §1 \[A\]).
-    pub average_current: bool,
+    pub load_pole_ratio: T,
+}
+
+cast_record!(TrackerTuning { t2s1_bandwidth_hz, t2s2_bandwidth_hz, damping, hold_ratio, load_pole_ratio ; bandwidth_definition });
+
+impl<T: Real> Default for TrackerTuning<T> {
+    fn default() -> Self {
+        Self {
+            t2s1_bandwidth_hz: T::lit(60.0),
+            t2s2_bandwidth_hz: T::lit(35.0),
+            damping: T::lit(tracker::DEFAULT_DAMPING),
+            bandwidth_definition: BandwidthDefinition::default(),
+            hold_ratio: T::lit(0.2),
+            load_pole_ratio: T::zero(),
+        }
+    }
+}
+
+/// Tuning of the disturbance observer (Fig. 5) (`[estimator.observer]`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(deny_unknown_fields, default)
+)]
+pub struct ObserverTuning<T> {
     /// Feed the disturbance observer with λ1 − L̂q·i instead of λ1. Default true (our
     /// improvement \[A\]; `false` is the paper's Fig. 5, where the observer sees λ1).
     ///
@@ -70,13 +205,13 @@ pub struct EstimatorTuning<T> {
     /// (fado-sim fig8, switching-resolved, with the drive's offset calibration): the ≈ 5 Hz
     /// oscillation after the 2 N·m step disappears and the worst revolution's DC of λ2 − λs
     /// drops from 6.0 % to 2.1 % of λf, the rest being the observer's speed lag through the
-    /// reversal (see `observer_lag_compensation`;
+    /// reversal (see `observer.lag_compensation`;
     /// crates/fado-sim/README.md).
-    pub observer_on_rotor_flux: bool,
+    pub on_rotor_flux: bool,
     /// Drive the observer's gains (16) and its internal model's rotation with ω̂1 + c, c the
     /// T2S-1 proportional term Kp·e through a first-order low-pass at the Fig. 3 threshold
     /// frequency, instead of ω̂1 alone. Default true (ours \[A\]; `false` is the paper's
-    /// Fig. 5, and gives its results bit for bit with `observer_gain_period` = 0).
+    /// Fig. 5, and gives its results bit for bit with `observer.gain_period` = 0).
     ///
     /// The observer's model (eq. (9)) rotates the flux by ω between samples and places its
     /// notch (eq. (18)-(19)) at ω. Under a constant acceleration α the type-2 tracker's
@@ -95,7 +230,7 @@ pub struct EstimatorTuning<T> {
     /// ideal sensors, and from 1.57–2.17 % to 0.29–0.72 % with the default non-idealities on
     /// sensor seeds 1–8 (0.27–0.87 % with a fixed R̂s); the loaded one-hour standstill then
     /// runs to the current limit on four of five seeds instead of one (docs/method/additions.md).
-    pub observer_lag_compensation: bool,
+    pub lag_compensation: bool,
     /// The observer's gains (16) are recomputed from its speed once every this many seconds
     /// (rounded to whole samples, at least every sample) and held in between; 0 = every
     /// sample, as in the paper. Default 0.4 ms (4 samples at the paper's 10 kHz) \[A\].
@@ -106,14 +241,36 @@ pub struct EstimatorTuning<T> {
     /// step on a Cortex-M4F (docs/results/firmware-cost.md). Held over N samples, the internal model
     /// rotates and the notch sits at the speed of the last update: under an acceleration α
     /// they lag the speed by at most α·(N − 1)·Ts, 0.3 ms × α by default, 4 % of the lag
-    /// 2ζ/ωn·α = 7.7 ms × α of T2S-1's own ω̂1 that `observer_lag_compensation` corrects
+    /// 2ζ/ωn·α = 7.7 ms × α of T2S-1's own ω̂1 that `observer.lag_compensation` corrects
     /// (through a 106 ms low-pass). The poles stay at the held speed's r = e^{−|ω|Ts}: the
     /// observer is a fixed stable filter between updates. Keep it well below T2S-1's time
-    /// constant 1/(2π·`t2s1_bandwidth_hz`) (2.7 ms at 60 Hz); above 1 s it is refused as a
+    /// constant 1/(2π·`tracker.t2s1_bandwidth_hz`) (2.7 ms at 60 Hz); above 1 s it is refused as a
     /// mistake. Measured (fado-sim fig8–fig12,
     /// sensor seeds 1–8): every run passes, the means of the worst angle error move by at
     /// most 1.1e-3 rad (fig10 0.0562 and 0.0573 rad with the gains every sample and held; docs/method/additions.md).
-    pub observer_gain_period: T,
+    pub gain_period: T,
+}
+
+cast_record!(ObserverTuning { gain_period ; on_rotor_flux, lag_compensation });
+
+impl<T: Real> Default for ObserverTuning<T> {
+    fn default() -> Self {
+        Self {
+            on_rotor_flux: true,
+            lag_compensation: true,
+            gain_period: T::lit(OBSERVER_GAIN_PERIOD),
+        }
+    }
+}
+
+/// Tuning of the online R̂s law (`[estimator.rs_adaptation]`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(deny_unknown_fields, default)
+)]
+pub struct RsAdaptationTuning<T> {
     /// Adapt R̂s online (our extension \[A\], see [`crate::rs_adaptation`]): from the d-axis
     /// voltage at standstill under the eq. (23) injection, and from the flux-magnitude error
     /// while turning. `false` keeps R̂s fixed as in the paper. Default true.
@@ -125,36 +282,18 @@ pub struct EstimatorTuning<T> {
     /// the Fig. 11 reversal also under the rated 11.5 N·m, and with matched parameters the
     /// worst zero-speed angle error drops from 0.16 to 0.12 rad (Fig. 11) and from 0.18 to
     /// 0.09 rad (Fig. 12).
-    pub rs_adaptation: bool,
+    pub enabled: bool,
     /// γ of the R̂s adaptation in s⁻¹. Default as [`ResistanceAdaptationConfig::rate`](crate::rs_adaptation::ResistanceAdaptationConfig::rate).
-    pub rs_adaptation_rate: T,
+    pub rate: T,
     /// χ0 of the R̂s adaptation. Default as [`ResistanceAdaptationConfig::excitation_floor`](crate::rs_adaptation::ResistanceAdaptationConfig::excitation_floor).
-    pub rs_adaptation_excitation_floor: T,
+    pub excitation_floor: T,
     /// Lower bound of the adapted R̂s as a multiple of `rs_hat`. Default as
     /// [`ResistanceAdaptationConfig::min_ratio`](crate::rs_adaptation::ResistanceAdaptationConfig::min_ratio).
-    pub rs_adaptation_min_ratio: T,
+    pub min_ratio: T,
     /// Upper bound of the adapted R̂s as a multiple of `rs_hat`. Default as
     /// [`ResistanceAdaptationConfig::max_ratio`](crate::rs_adaptation::ResistanceAdaptationConfig::max_ratio).
-    pub rs_adaptation_max_ratio: T,
-    /// With `rs_adaptation`: rate at which the flux-magnitude reference λ̂f is learned where R̂s
-    /// is not observable, s⁻¹ (0 = the configured λ̂f throughout). Default as
-    /// [`ResistanceAdaptationConfig::flux_linkage_rate`](crate::rs_adaptation::ResistanceAdaptationConfig::flux_linkage_rate) (5 s⁻¹).
-    ///
-    /// Measured (fado-sim fig11, switching-resolved, default settings otherwise): with λ̂f
-    /// −10 % / +10 % / −5 % and R̂s +10 % the worst near-zero-speed angle error drops from
-    /// 1.02 / 1.21 / 0.98 rad (off) to 0.03 / 0.15 / 0.09 rad; with λ̂f right nothing moves
-    /// (fig8, fig10 on seeds 1–8, fig12: the same results, the revolution means stay inside
-    /// the law's 1 % dead zone; docs/method/additions.md).
-    pub flux_linkage_adaptation_rate: T,
-    /// With `rs_adaptation`: rate k_e in s⁻¹ at which a constant integrand error (a voltage
-    /// offset) is learned while turning and subtracted from the integrand in both modes
-    /// (ours \[A\], see [`crate::integrand_offset`]); 0 = off. Default as
-    /// [`IntegrandOffsetConfig::rate`](crate::integrand_offset::IntegrandOffsetConfig::rate) (2 s⁻¹).
-    ///
-    /// Measured (fado-sim fig11, switching-resolved, 0.1 V on the α voltage): the worst
-    /// near-zero-speed angle error drops from 1.21 rad (off) to 0.13 rad (docs/method/additions.md).
-    pub offset_adaptation_rate: T,
-    /// With `rs_adaptation`: rate k_θ in s⁻¹ at which, at standstill under the eq. (23)
+    pub max_ratio: T,
+    /// With `rs_adaptation.enabled`: rate k_θ in s⁻¹ at which, at standstill under the eq. (23)
     /// injection (the current along the estimated d axis, light load), λ̂r is turned towards
     /// the stator current (ours \[A\], see [`crate::rs_adaptation`]); 0 = off. Default as
     /// [`ResistanceAdaptationConfig::standstill_angle_rate`](crate::rs_adaptation::ResistanceAdaptationConfig::standstill_angle_rate) (2 s⁻¹).
@@ -164,37 +303,127 @@ pub struct EstimatorTuning<T> {
     /// decays instead of walking; what remains is the swing at the stop, before the law acts
     /// (0.5, 1, 4 and 8 s⁻¹ and a 1 Hz filter on i_q/i_d were worse: docs/method/additions.md).
     pub standstill_angle_rate: T,
-    /// In limiter mode, move λ1 and the observer's λ̂1 and D̂ together by −k_df·Ts·D̂ each
-    /// sample. Default true (ours \[A\]; `false` is the paper).
+}
+
+cast_record!(RsAdaptationTuning { rate, excitation_floor, min_ratio, max_ratio, standstill_angle_rate ; enabled });
+
+impl<T: Real> Default for RsAdaptationTuning<T> {
+    fn default() -> Self {
+        Self {
+            enabled: true,
+            rate: T::lit(rs_adaptation::DEFAULT_RATE),
+            excitation_floor: T::lit(rs_adaptation::DEFAULT_EXCITATION_FLOOR),
+            min_ratio: T::lit(rs_adaptation::DEFAULT_MIN_RATIO),
+            max_ratio: T::lit(rs_adaptation::DEFAULT_MAX_RATIO),
+            standstill_angle_rate: T::lit(rs_adaptation::DEFAULT_STANDSTILL_ANGLE_RATE),
+        }
+    }
+}
+
+/// Tuning of the λ̂f law (`[estimator.flux_linkage_adaptation]`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(deny_unknown_fields, default)
+)]
+pub struct FluxLinkageAdaptationTuning<T> {
+    /// With `rs_adaptation.enabled`: rate at which the flux-magnitude reference λ̂f is learned where R̂s
+    /// is not observable, s⁻¹ (0 = the configured λ̂f throughout). Default as
+    /// [`ResistanceAdaptationConfig::flux_linkage_rate`](crate::rs_adaptation::ResistanceAdaptationConfig::flux_linkage_rate) (5 s⁻¹).
     ///
-    /// A shift common to λ1, λ̂1 and D̂ changes nothing the estimator uses: λ2 = λ1 − D̂, λ̂r
-    /// and the observer's innovation and z − d are the same. In HI mode k_df·D̂ (acting on λ1
-    /// alone) pulls that common mode back; in limiter mode nothing does (the limiter sees
-    /// λ̂r only), so the tangential part of a DC integrand error that the observer absorbs
-    /// whenever ω̂ ≠ 0 makes λ1 and D̂ ramp together without bound while the angle stays put.
-    /// Measured (fado-sim long run, 0 r/min under 7.5 N·m, averaged plant, default sensors):
-    /// 0.6 mWb/s, |λ1| ≈ |D̂| ≈ 2.1 Wb after an hour, f32 and f64 alike — in f32 the flux
-    /// increments (≈ 0.5 mWb per sample at standstill) would drown in the rounding of λ1
-    /// after days. The shift keeps D̂ at rate/k_df instead; θ̂ is unchanged while the
-    /// estimator stays in limiter mode (at a hand-over to HI mode D̂ is smaller, so the k_df
-    /// transient that follows differs).
-    pub limiter_recentring: bool,
+    /// Measured (fado-sim fig11, switching-resolved, default settings otherwise): with λ̂f
+    /// −10 % / +10 % / −5 % and R̂s +10 % the worst near-zero-speed angle error drops from
+    /// 1.02 / 1.21 / 0.98 rad (off) to 0.03 / 0.15 / 0.09 rad; with λ̂f right nothing moves
+    /// (fig8, fig10 on seeds 1–8, fig12: the same results, the revolution means stay inside
+    /// the law's 1 % dead zone; docs/method/additions.md).
+    pub rate: T,
+}
+
+cast_record!(FluxLinkageAdaptationTuning { rate ;  });
+
+impl<T: Real> Default for FluxLinkageAdaptationTuning<T> {
+    fn default() -> Self {
+        Self {
+            rate: T::lit(rs_adaptation::DEFAULT_FLUX_LINKAGE_RATE),
+        }
+    }
+}
+
+/// Tuning of the integrand-offset law (`[estimator.offset_adaptation]`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(deny_unknown_fields, default)
+)]
+pub struct OffsetAdaptationTuning<T> {
+    /// With `rs_adaptation.enabled`: rate k_e in s⁻¹ at which a constant integrand error (a voltage
+    /// offset) is learned while turning and subtracted from the integrand in both modes
+    /// (ours \[A\], see [`crate::integrand_offset`]); 0 = off. Default as
+    /// [`IntegrandOffsetConfig::rate`](crate::integrand_offset::IntegrandOffsetConfig::rate) (2 s⁻¹).
+    ///
+    /// Measured (fado-sim fig11, switching-resolved, 0.1 V on the α voltage): the worst
+    /// near-zero-speed angle error drops from 1.21 rad (off) to 0.13 rad (docs/method/additions.md).
+    pub rate: T,
+}
+
+cast_record!(OffsetAdaptationTuning { rate ;  });
+
+impl<T: Real> Default for OffsetAdaptationTuning<T> {
+    fn default() -> Self {
+        Self {
+            rate: T::lit(integrand_offset::DEFAULT_RATE),
+        }
+    }
+}
+
+/// Tuning of the sample bounds (`[estimator.plausibility]`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(deny_unknown_fields, default)
+)]
+pub struct PlausibilityTuning<T> {
     /// A sample whose α-β current's magnitude reaches this multiple of the rated current is
     /// refused like a non-finite one (see [`crate::plausibility`]). Default
     /// [`plausibility::CURRENT_RATIO`] (4; 87.1 A for the paper's motor) \[A\].
-    pub plausible_current_ratio: T,
+    pub current_ratio: T,
     /// A sample whose α-β voltage's magnitude reaches this multiple of the DC-link voltage
     /// is refused. Default [`plausibility::VOLTAGE_RATIO`] (1.5; 450 V for the
     /// paper's 300 V link) \[A\].
-    pub plausible_voltage_ratio: T,
+    pub voltage_ratio: T,
     /// A current whose α-β vector moved by this × (plausible voltage)·ts/L̂q per sample or
     /// more since the last accepted one is refused; 0 disables the test. Default
     /// [`plausibility::STEP_RATIO`] (2) \[A\].
-    pub plausible_current_step_ratio: T,
+    pub current_step_ratio: T,
+}
+
+cast_record!(PlausibilityTuning { current_ratio, voltage_ratio, current_step_ratio ;  });
+
+impl<T: Real> Default for PlausibilityTuning<T> {
+    fn default() -> Self {
+        Self {
+            current_ratio: T::lit(plausibility::CURRENT_RATIO),
+            voltage_ratio: T::lit(plausibility::VOLTAGE_RATIO),
+            current_step_ratio: T::lit(plausibility::STEP_RATIO),
+        }
+    }
+}
+
+/// Tuning of the loss-of-lock detector (`[estimator.lock]`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(deny_unknown_fields, default)
+)]
+pub struct LockTuning<T> {
     /// Loss of lock (see [`crate::lock`]): |λ̂r| below this multiple of λ̂f is a symptom while
-    /// |ω̂| is below the mode hand-over band (`mode_threshold_ratio` −
-    /// `mode_hysteresis_ratio`, 0.013 of the rated speed; above it,
-    /// `lock_flux_low_fast_ratio`). Default 0.7 \[A\] (chosen on the fig11 envelope sweep,
+    /// |ω̂| is below the mode hand-over band (`mode.threshold_ratio` −
+    /// `mode.hysteresis_ratio`, 0.013 of the rated speed; above it,
+    /// `lock.flux_low_fast_ratio`). Default 0.7 \[A\] (chosen on the fig11 envelope sweep,
     /// docs/method/lock.md). 0.65 no longer flags the start-up of fig11 with R̂s +10 % (|λ̂r| below
     /// 0.7·λ̂f from 0.298 s at ω̂ −12 r/min, down to 0.67·λ̂f; the error passes 0.5 rad at
     /// 0.40 s), the flag
@@ -202,16 +431,16 @@ pub struct EstimatorTuning<T> {
     /// loaded reversal; flagged only at the loss, that run coasts under its active load and
     /// runs away. The same start-up dip precedes the 0.5 rad start-up excursions of the
     /// envelope (57 of 67 flagged within 20 ms on seeds 7–14).
-    pub lock_flux_low_ratio: T,
+    pub flux_low_ratio: T,
     /// Loss of lock: |λ̂r| below this multiple of λ̂f is a symptom while |ω̂| is at or above
-    /// the lower edge of the mode hand-over band (`mode_threshold_ratio` −
-    /// `mode_hysteresis_ratio`). Default 0.6 \[A\] (docs/method/lock.md, 2026-11-24): accelerating
+    /// the lower edge of the mode hand-over band (`mode.threshold_ratio` −
+    /// `mode.hysteresis_ratio`). Default 0.6 \[A\] (docs/method/lock.md, 2026-11-24): accelerating
     /// out of the reversal at light load, runs that keep the rotor dip to 0.67–0.70·λ̂f
     /// around the limiter → k_df hand-over (at 17–29 r/min on the paper's motor; 0.7 flagged
     /// them: 3 of 809 passing runs on seeds 7–14), while the losses this half of the symptom
     /// alone catches go through 0.42–0.53·λ̂f; 0.55–0.65 measured alike, 0 missed 4 losses.
-    /// Equal to `lock_flux_low_ratio`, one bound at every speed (before 2026-11-24).
-    pub lock_flux_low_fast_ratio: T,
+    /// Equal to `lock.flux_low_ratio`, one bound at every speed (before 2026-11-24).
+    pub flux_low_fast_ratio: T,
     /// Loss of lock: |λ̂r| above this multiple of λ̂f is a symptom; 0 switches it off.
     /// Default 1.5 \[A\]: above the limiter circle (1.15) and the 1.20–1.22·λ̂f overshoot
     /// after a limiter → k_df hand-over in runs that keep the rotor (a bound of 1.2
@@ -220,144 +449,52 @@ pub struct EstimatorTuning<T> {
     /// drive that an active load runs away with in k_df mode (those losses the drive's stall
     /// symptom now sees too: 1.5 detects as many as 1.4, docs/method/lock.md). The voltage of a
     /// machine turning the other way gives 1.3–4.8·λ̂f.
-    pub lock_flux_high_ratio: T,
+    pub flux_high_ratio: T,
     /// Loss of lock: a T2S-1 innovation |θm − θ̂⁻| above this (rad) is a symptom. Default
     /// 0.5 rad \[A\] (the angle error the drive must not reach, docs/method/lock.md).
-    pub lock_innovation_limit: T,
+    pub innovation_limit: T,
     /// Loss of lock: net symptomatic time (s) before [`LockStatus::Lost`](crate::LockStatus::Lost); 0 disables the
     /// detector. Default 5 ms \[A\] (a quarter of the 20 ms detection target; 5–20 ms made
     /// no difference on the envelope, docs/method/lock.md).
-    pub lock_detection_time: T,
+    pub detection_time: T,
     /// Loss of lock: net clean time (s) after which [`LockStatus::Lost`](crate::LockStatus::Lost) clears (the status
     /// is live; the drive's reaction latches, [`crate::control::lock_reaction`]). Default
     /// 0.1 s \[A\]: twenty detection times, so that the intermittent symptoms of a lost
     /// estimate keep it up, and short against the seconds between a start-up transient and a
     /// later loss (docs/method/lock.md).
-    pub lock_heal_time: T,
+    pub heal_time: T,
     /// Loss of lock: in limiter mode, a sample in which the limiter clamps is a symptom.
     /// Default false \[A\]: a rotor lost in limiter mode clamps continuously (fig11 with
     /// λ̂f +10 %) and a matched drive never clamps, but an adapted R̂s biased by a λ̂f error
     /// makes the limiter clamp through passages it survives (false alarms, docs/method/lock.md).
-    pub lock_limiter_clamping: bool,
+    pub limiter_clamping: bool,
     /// Loss of lock: a rate of mode hand-overs (Fig. 3) of this many per
-    /// `lock_handover_time` is a symptom (a leaky count, see [`crate::lock`], symptom 3);
+    /// `lock.handover_time` is a symptom (a leaky count, see [`crate::lock`], symptom 3);
     /// 0 switches it off. Default 5 \[A\] (docs/method/lock.md): a
     /// sustained 50 hand-overs a second, or a burst of five. On the reversal envelopes of the
     /// seven presets the count of runs that keep the rotor within 0.25 rad stays at 1.0–1.9
     /// on five, and reaches 3.9 on pmsyrm-5k and 4.0 on ipmsm-gem-50k; most start-up limit
     /// cycles that lose ipmsm-gem-50k's rotor reach 5–28.
-    pub lock_handover_count: T,
+    pub handover_count: T,
     /// Loss of lock: the time constant of the hand-over count's decay, s. Default 0.1 s
     /// \[A\] (docs/method/lock.md).
-    pub lock_handover_time: T,
+    pub handover_time: T,
 }
 
-impl<T: Real> EstimatorTuning<T> {
-    /// This tuning on the paper's path: every addition of fado's to the estimator of Fig. 5
-    /// that can be switched off is off — the fixed R̂s (no [`Self::rs_adaptation`], hence no
-    /// λ̂f or integrand-offset law), the observer on λ1 with ω̂ of T2S-1 alone
-    /// ([`Self::observer_on_rotor_flux`], [`Self::observer_lag_compensation`]), no
-    /// [`Self::limiter_recentring`], an abrupt k_df ([`Self::k_df_ramp_time`] 0) and the gains
-    /// (16) formed every sample ([`Self::observer_gain_period`] 0). The sample bounds, the
-    /// finite test and the loss-of-lock detector stay. What the cost comparisons call "the
-    /// paper's path" (docs/results/firmware-cost.md; `benches/baselines.rs`).
-    pub fn paper_path(self) -> Self {
-        Self {
-            rs_adaptation: false,
-            observer_lag_compensation: false,
-            observer_on_rotor_flux: false,
-            limiter_recentring: false,
-            k_df_ramp_time: T::zero(),
-            observer_gain_period: T::zero(),
-            ..self
-        }
-    }
+cast_record!(LockTuning { flux_low_ratio, flux_low_fast_ratio, flux_high_ratio, innovation_limit, detection_time, heal_time, handover_count, handover_time ; limiter_clamping });
 
-    /// The same record in another precision (e.g. an f64 configuration for an f32 drive):
-    /// every real rounded to `U`.
-    pub fn cast<U: Real>(&self) -> EstimatorTuning<U> {
-        EstimatorTuning {
-            k_df: U::lit(self.k_df.to_f64()),
-            k_df_ramp_time: U::lit(self.k_df_ramp_time.to_f64()),
-            k_af: U::lit(self.k_af.to_f64()),
-            limiter_radius_ratio: U::lit(self.limiter_radius_ratio.to_f64()),
-            mode_threshold_ratio: U::lit(self.mode_threshold_ratio.to_f64()),
-            mode_hysteresis_ratio: U::lit(self.mode_hysteresis_ratio.to_f64()),
-            t2s1_bandwidth_hz: U::lit(self.t2s1_bandwidth_hz.to_f64()),
-            t2s2_bandwidth_hz: U::lit(self.t2s2_bandwidth_hz.to_f64()),
-            tracker_damping: U::lit(self.tracker_damping.to_f64()),
-            bandwidth_definition: self.bandwidth_definition,
-            tracker_hold_ratio: U::lit(self.tracker_hold_ratio.to_f64()),
-            tracker_load_pole_ratio: U::lit(self.tracker_load_pole_ratio.to_f64()),
-            average_current: self.average_current,
-            observer_on_rotor_flux: self.observer_on_rotor_flux,
-            observer_lag_compensation: self.observer_lag_compensation,
-            observer_gain_period: U::lit(self.observer_gain_period.to_f64()),
-            rs_adaptation: self.rs_adaptation,
-            rs_adaptation_rate: U::lit(self.rs_adaptation_rate.to_f64()),
-            rs_adaptation_excitation_floor: U::lit(self.rs_adaptation_excitation_floor.to_f64()),
-            rs_adaptation_min_ratio: U::lit(self.rs_adaptation_min_ratio.to_f64()),
-            rs_adaptation_max_ratio: U::lit(self.rs_adaptation_max_ratio.to_f64()),
-            flux_linkage_adaptation_rate: U::lit(self.flux_linkage_adaptation_rate.to_f64()),
-            offset_adaptation_rate: U::lit(self.offset_adaptation_rate.to_f64()),
-            standstill_angle_rate: U::lit(self.standstill_angle_rate.to_f64()),
-            limiter_recentring: self.limiter_recentring,
-            plausible_current_ratio: U::lit(self.plausible_current_ratio.to_f64()),
-            plausible_voltage_ratio: U::lit(self.plausible_voltage_ratio.to_f64()),
-            plausible_current_step_ratio: U::lit(self.plausible_current_step_ratio.to_f64()),
-            lock_flux_low_ratio: U::lit(self.lock_flux_low_ratio.to_f64()),
-            lock_flux_low_fast_ratio: U::lit(self.lock_flux_low_fast_ratio.to_f64()),
-            lock_flux_high_ratio: U::lit(self.lock_flux_high_ratio.to_f64()),
-            lock_innovation_limit: U::lit(self.lock_innovation_limit.to_f64()),
-            lock_detection_time: U::lit(self.lock_detection_time.to_f64()),
-            lock_heal_time: U::lit(self.lock_heal_time.to_f64()),
-            lock_limiter_clamping: self.lock_limiter_clamping,
-            lock_handover_count: U::lit(self.lock_handover_count.to_f64()),
-            lock_handover_time: U::lit(self.lock_handover_time.to_f64()),
-        }
-    }
-}
-
-impl<T: Real> Default for EstimatorTuning<T> {
+impl<T: Real> Default for LockTuning<T> {
     fn default() -> Self {
         Self {
-            k_df: T::lit(flux::DEFAULT_K_DF),
-            k_df_ramp_time: T::zero(),
-            k_af: T::lit(flux::DEFAULT_K_AF),
-            limiter_radius_ratio: T::lit(flux::DEFAULT_LIMITER_RADIUS_RATIO),
-            mode_threshold_ratio: T::lit(mode::DEFAULT_THRESHOLD_RATIO),
-            mode_hysteresis_ratio: T::lit(mode::DEFAULT_HYSTERESIS_RATIO),
-            t2s1_bandwidth_hz: T::lit(60.0),
-            t2s2_bandwidth_hz: T::lit(35.0),
-            tracker_damping: T::lit(tracker::DEFAULT_DAMPING),
-            bandwidth_definition: BandwidthDefinition::default(),
-            tracker_hold_ratio: T::lit(0.2),
-            tracker_load_pole_ratio: T::zero(),
-            average_current: flux::DEFAULT_AVERAGE_CURRENT,
-            observer_on_rotor_flux: true,
-            observer_lag_compensation: true,
-            observer_gain_period: T::lit(OBSERVER_GAIN_PERIOD),
-            rs_adaptation: true,
-            rs_adaptation_rate: T::lit(rs_adaptation::DEFAULT_RATE),
-            rs_adaptation_excitation_floor: T::lit(rs_adaptation::DEFAULT_EXCITATION_FLOOR),
-            rs_adaptation_min_ratio: T::lit(rs_adaptation::DEFAULT_MIN_RATIO),
-            rs_adaptation_max_ratio: T::lit(rs_adaptation::DEFAULT_MAX_RATIO),
-            flux_linkage_adaptation_rate: T::lit(rs_adaptation::DEFAULT_FLUX_LINKAGE_RATE),
-            offset_adaptation_rate: T::lit(integrand_offset::DEFAULT_RATE),
-            standstill_angle_rate: T::lit(rs_adaptation::DEFAULT_STANDSTILL_ANGLE_RATE),
-            limiter_recentring: true,
-            plausible_current_ratio: T::lit(plausibility::CURRENT_RATIO),
-            plausible_voltage_ratio: T::lit(plausibility::VOLTAGE_RATIO),
-            plausible_current_step_ratio: T::lit(plausibility::STEP_RATIO),
-            lock_flux_low_ratio: T::lit(0.7),
-            lock_flux_low_fast_ratio: T::lit(0.6),
-            lock_flux_high_ratio: T::lit(1.5),
-            lock_innovation_limit: T::lit(0.5),
-            lock_detection_time: T::lit(5e-3),
-            lock_heal_time: T::lit(0.1),
-            lock_limiter_clamping: false,
-            lock_handover_count: T::lit(5.0),
-            lock_handover_time: T::lit(0.1),
+            flux_low_ratio: T::lit(0.7),
+            flux_low_fast_ratio: T::lit(0.6),
+            flux_high_ratio: T::lit(1.5),
+            innovation_limit: T::lit(0.5),
+            detection_time: T::lit(5e-3),
+            heal_time: T::lit(0.1),
+            limiter_clamping: false,
+            handover_count: T::lit(5.0),
+            handover_time: T::lit(0.1),
         }
     }
 }

@@ -1,0 +1,493 @@
+//! The whole simulation as one TOML document: plant sections (`[motor]`, `[inverter]`,
+//! `[current_sensor]`, `[dc_link_sensor]`, `[load]`), the speed reference
+//! (`[speed_reference]`), the drive (`[controller]`, `[estimator]`, `[baselines]`), the
+//! drive's model of the motor (`[model]`, by default `[motor]` scaled by `[mismatch]`),
+//! injected faults (`[faults]`, see [`crate::faults`]), and run settings (`[simulation]`).
+//! `[motor]` and `[model]` are `fado_core::MachineModel`, `[controller]`
+//! `fado_core::control::DriveTuning` and `[estimator]` `fado_core::EstimatorTuning`, read
+//! directly through their serde derives (one schema).
+//!
+//! A file overrides a base configuration (a scenario's) key by key: tables merge, values and
+//! arrays replace. Unknown keys are errors naming the key (`inverter.dead_tme`), and so are
+//! impossible values (`motor.rs: must be > 0`). The estimator's model parameters are never
+//! given directly: they are the plant's times the `[mismatch]` ratios, so "matched" stays
+//! matched when the motor changes.
+
+use fado_core::control::{DeadTimeMethod, DriveConfig, DriveTuning};
+use fado_core::magnetics::Saturation;
+use fado_core::{EstimatorConfig, EstimatorTuning, MachineModel};
+use serde::{Deserialize, Serialize};
+
+use crate::criteria::Criteria;
+use crate::dc_link::DcLinkParams;
+use crate::error::SimConfigError;
+pub use crate::estimators::EstimatorKind;
+use crate::estimators::{check_baseline_keys, default_baselines};
+use crate::faults::FaultParams;
+use crate::inverter::InverterParams;
+use crate::load::LoadParams;
+use crate::magnetics_file;
+use crate::motor::MotorParams;
+use crate::profile::Profile;
+use crate::sensors::{CurrentSensorParams, DcLinkSensorParams};
+use crate::sim::PlantParams;
+
+mod moved;
+mod settings;
+#[cfg(test)]
+mod tests;
+mod toml_io;
+
+pub(crate) use moved::moved;
+pub use settings::{InverterModel, Mismatch, Precision, SimulationSettings};
+pub(crate) use toml_io::key_error;
+use toml_io::merge;
+
+/// The complete, serialisable simulation configuration.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SimConfig {
+    /// Run settings.
+    pub simulation: SimulationSettings,
+    /// Speed reference in r/min (mechanical).
+    pub speed_reference: Profile,
+    /// The PMSM (plant): parameters and ratings.
+    pub motor: MotorParams,
+    /// Inverter and DC link.
+    pub inverter: InverterParams,
+    /// Phase-current sensors.
+    pub current_sensor: CurrentSensorParams,
+    /// DC-link sensor.
+    pub dc_link_sensor: DcLinkSensorParams,
+    /// Load machine.
+    pub load: LoadParams,
+    /// Drive tuning (`fado_core::control::DriveTuning`).
+    pub controller: DriveTuning<f64>,
+    /// Estimator tuning (`fado_core::EstimatorTuning`).
+    pub estimator: EstimatorTuning<f64>,
+    /// Settings of the reference observers, one table per baseline of
+    /// [`crate::estimators::ESTIMATORS`] (`[baselines.ortega]`, ...); their machine model is
+    /// the drive's `[model]` and their shared settings (trackers, sample bounds) are
+    /// `[estimator]`'s.
+    pub baselines: toml::Table,
+    /// The drive's model of the plant as ratios to the true values.
+    pub mismatch: Mismatch,
+    /// The drive's model of the motor, key by key (same keys as `[motor]`); a key not given is
+    /// the plant's (R̂s: Rs + r_on) times its `[mismatch]` ratio.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub model: Option<toml::Table>,
+    /// The drive's data of the inverter for its dead-time compensation, key by key; a key not
+    /// given is `[inverter]`'s times its `[mismatch]` ratio. `fado-sim commission` writes the
+    /// identified threshold voltage here.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub inverter_model: Option<InverterModel>,
+    /// Injected faults (`crate::faults`). Default none.
+    pub faults: FaultParams,
+    /// The DC link behind the inverter (`crate::dc_link`). Default a stiff source.
+    #[serde(skip_serializing_if = "is_default")]
+    pub dc_link: DcLinkParams,
+    /// The user's pass criteria (`crate::criteria`): all the `custom` scenario judges, and
+    /// judged after their own by the others. Default none.
+    #[serde(skip_serializing_if = "Criteria::is_empty")]
+    pub criteria: Criteria,
+    /// The keys the configuration file left out whose values were derived from the motor's
+    /// ratings (`crate::derive`), with their rules; not a TOML table.
+    #[serde(skip)]
+    pub derived: Vec<crate::derive::Derived>,
+    /// The plant's saturating magnetics, `[motor.saturation]` (the algebraic model of
+    /// [`fado_core::magnetics::Saturation`]) or `[motor] flux_map` (`crate::magnetics_file`);
+    /// None: the constant inductances of `[motor]`, whose `ld`, `lq` and `flux_linkage` then
+    /// stay the datasheet's (the drive's default model).
+    #[serde(skip)]
+    pub motor_saturation: Option<Saturation<f64>>,
+    /// The plant's flux map, `[motor] flux_map = "FILE.csv"` (see `motor_saturation`).
+    #[serde(skip)]
+    pub motor_flux_map: Option<crate::magnetics_file::FluxMapFile>,
+}
+
+impl Default for SimConfig {
+    /// The paper's experiment set-up: its motor ([`MachineModel::paper`]) on docs/method/estimator.md §7–6's
+    /// inverter and sensors, standing still.
+    fn default() -> Self {
+        Self {
+            simulation: SimulationSettings::default(),
+            speed_reference: Profile::default(),
+            motor: MotorParams::paper(),
+            inverter: InverterParams::default(),
+            current_sensor: CurrentSensorParams::default(),
+            dc_link_sensor: DcLinkSensorParams::default(),
+            load: LoadParams::default(),
+            controller: DriveTuning::default(),
+            estimator: EstimatorTuning::default(),
+            baselines: default_baselines(),
+            mismatch: Mismatch::default(),
+            model: None,
+            inverter_model: None,
+            faults: FaultParams::default(),
+            dc_link: DcLinkParams::default(),
+            criteria: Criteria::default(),
+            derived: Vec::new(),
+            motor_saturation: None,
+            motor_flux_map: None,
+        }
+    }
+}
+
+impl Default for Profile {
+    fn default() -> Self {
+        Profile::constant(0.0)
+    }
+}
+
+impl SimConfig {
+    /// The plant records.
+    pub fn plant(&self) -> PlantParams {
+        PlantParams {
+            motor: self.motor,
+            inverter: self.inverter.clone(),
+            current_sensor: self.current_sensor.clone(),
+            dc_link_sensor: self.dc_link_sensor.clone(),
+            load: self.load.clone(),
+            faults: self.faults.clone(),
+            dc_link: self.dc_link.clone(),
+            magnetics: magnetics_file::plant_magnetics(
+                self.motor_saturation.as_ref(),
+                self.motor_flux_map.as_ref(),
+            ),
+        }
+    }
+
+    /// Checks every section, and the estimator and drive configurations derived from it; the
+    /// error names the key (`section.field`).
+    pub fn validate(&self) -> Result<(), SimConfigError> {
+        self.simulation
+            .validate()
+            .map_err(|e| e.in_section("simulation"))?;
+        self.speed_reference
+            .validate()
+            .map_err(|e| e.in_section("speed_reference"))?;
+        // The machine's cross-checks, with every key involved named (before the single-key
+        // refusals of the plant's and the model's validation).
+        if let Some((_, key, text)) = self
+            .machine_findings()
+            .into_iter()
+            .find(|(s, ..)| *s == fado_core::machine_checks::Severity::Error)
+        {
+            return Err(SimConfigError::new(key, text));
+        }
+        magnetics_file::check_one_model(
+            self.motor_saturation.as_ref(),
+            self.motor_flux_map.as_ref(),
+        )?;
+        if let Some(sat) = &self.motor_saturation {
+            sat.validate().map_err(|e| {
+                SimConfigError::new(format!("motor.saturation.{}", e.field()), e.to_string())
+            })?;
+        }
+        self.plant().validate()?;
+        let rows = self.simulation.duration
+            / self.inverter.sample_period()
+            / self.simulation.decimation as f64;
+        if rows > 2e7 {
+            return Err(SimConfigError::new(
+                "simulation.decimation",
+                format!("the trace would hold {rows:.3e} rows (limit 2e7): raise it"),
+            ));
+        }
+        self.mismatch
+            .validate()
+            .map_err(|e| e.in_section("mismatch"))?;
+        self.criteria
+            .validate()
+            .map_err(|e| e.in_section("criteria"))?;
+        if let Some(im) = &self.inverter_model {
+            im.validate().map_err(|e| e.in_section("inverter_model"))?;
+        }
+        crate::motor::validate_motor(&self.motor, self.inverter.dc_voltage).map_err(|e| {
+            if e.key == "dc_voltage" {
+                SimConfigError::new("inverter.dc_voltage", e.message)
+            } else {
+                e.in_section("motor")
+            }
+        })?;
+        let ts = self.inverter.sample_period();
+        check_time_constant(&self.motor, ts, |k| format!("motor.{k}"))?;
+        let model = self.model_checked()?;
+        check_time_constant(&model, ts, |k| self.model_key(k))?;
+        self.estimator_config()
+            .validate()
+            .map_err(|e| self.core_error("estimator", e))?;
+        // Every key is checked whichever estimator runs: NaN in an unused key is still an
+        // error in the file.
+        check_baseline_keys(&self.baselines)?;
+        for e in crate::estimators::ESTIMATORS {
+            (e.check)(self)?;
+        }
+        self.drive_config()
+            .validate()
+            .map_err(|e| self.core_error("controller", e))?;
+        Ok(())
+    }
+
+    /// The drive's model of the motor derived from the plant: `[motor]` (R̂s: Rs + r_on of
+    /// the inverter) scaled by `[mismatch]`, DC link from `[inverter]`.
+    pub(crate) fn derived_model(&self) -> MachineModel<f64> {
+        let (mo, inv, m) = (&self.motor, &self.inverter, &self.mismatch);
+        MachineModel {
+            rs: (mo.rs + inv.on_resistance) * m.rs_ratio,
+            ld: mo.ld * m.ld_ratio,
+            lq: mo.lq * m.lq_ratio,
+            flux_linkage: mo.flux_linkage * m.flux_linkage_ratio,
+            inertia: mo.inertia * m.inertia_ratio,
+            dc_voltage: inv.dc_voltage,
+            ..*mo
+        }
+    }
+
+    /// The drive's model: `[model]`'s keys over the derived one, checked; errors name
+    /// `model.<key>` for a key the file gives and the plant key it derives from otherwise.
+    fn model_checked(&self) -> Result<MachineModel<f64>, SimConfigError> {
+        let (derived, table) = crate::model_magnetics::split(self)?;
+        let Some(table) = table else {
+            return Ok(derived);
+        };
+        let mut merged = toml::Table::try_from(derived)
+            .map_err(|e| SimConfigError::new("model", e.to_string()))?;
+        merge(&mut merged, table);
+        let mut model = MachineModel::<f64>::deserialize(toml::Value::Table(merged))
+            .map_err(|e| key_error(e).in_section("model"))?;
+        model.dc_voltage = self.inverter.dc_voltage;
+        model.validate().map_err(|e| self.core_error("model", e))?;
+        Ok(model.with_magnetics(derived.magnetics))
+    }
+
+    /// The key a user wrote for the model's field `k`: `model.k` when `[model]` gives it,
+    /// else `mismatch.k_ratio` when that ratio is not 1, else the plant's `motor.k`.
+    fn model_key(&self, k: &str) -> String {
+        if self.model.as_ref().is_some_and(|t| t.contains_key(k)) {
+            return format!("model.{k}");
+        }
+        let m = &self.mismatch;
+        let ratio = match k {
+            "rs" => m.rs_ratio,
+            "ld" => m.ld_ratio,
+            "lq" => m.lq_ratio,
+            _ => 1.0,
+        };
+        if ratio != 1.0 {
+            format!("mismatch.{k}_ratio")
+        } else {
+            format!("motor.{k}")
+        }
+    }
+
+    /// The drive's model of the motor (`[model]`, or `[motor]` × `[mismatch]`). A `[model]`
+    /// table that [`validate`](Self::validate) refuses is ignored here.
+    pub fn machine_model(&self) -> MachineModel<f64> {
+        self.model_checked()
+            .unwrap_or_else(|_| self.derived_model())
+    }
+
+    /// The estimator configuration: `[estimator]` tuning, the drive's model, sampling period
+    /// from the inverter.
+    pub fn estimator_config(&self) -> EstimatorConfig<f64> {
+        EstimatorConfig {
+            ts: self.inverter.sample_period(),
+            machine: self.machine_model(),
+            initial_angle: self.simulation.initial_angle + self.simulation.align_error,
+            tuning: self.estimator,
+        }
+    }
+
+    /// The drive configuration: `[controller]` tuning, the drive's model, timing and the
+    /// dead-time compensation's inverter data from `[inverter]` (× `[mismatch]`), its
+    /// threshold voltage from `[inverter_model]` when that gives it. With the averaged
+    /// inverter, which has no PWM ripple, `dead_time_method = "edge_current"` becomes the
+    /// trapezoid it then equals (its exact inverse), so that "matched" stays matched.
+    pub fn drive_config(&self) -> DriveConfig<f64> {
+        let (inv, m) = (&self.inverter, &self.mismatch);
+        let threshold = self
+            .inverter_model
+            .as_ref()
+            .and_then(|im| im.threshold_voltage)
+            .unwrap_or(inv.threshold_voltage * m.threshold_voltage_ratio);
+        DriveConfig {
+            ts: inv.sample_period(),
+            machine: self.machine_model(),
+            tuning: DriveTuning {
+                dead_time: inv.dead_time * m.dead_time_ratio,
+                switching_frequency: inv.switching_frequency,
+                dead_time_threshold_voltage: threshold,
+                dead_time_current_band: inv.current_band * m.current_band_ratio,
+                dead_time_method: match (inv.model, self.controller.dead_time_method) {
+                    (crate::inverter::InverterModel::Averaged, DeadTimeMethod::EdgeCurrent) => {
+                        DeadTimeMethod::Trapezoidal
+                    }
+                    (_, method) => method,
+                },
+                ..self.controller
+            },
+        }
+    }
+
+    /// A fado-core refusal of the `[section]` block (`estimator`, `controller`, `model`, or a
+    /// baseline's `lpf_`/`ortega_`/`emf_` keys), named by the TOML key the user writes. The
+    /// machine model's fields are `model.<key>` where `[model]` gives them and otherwise the
+    /// plant key they derive from; the timing and the inverter data are `[inverter]` keys.
+    pub(crate) fn core_error(&self, section: &str, e: fado_core::ConfigError) -> SimConfigError {
+        let field = e.field();
+        let machine_key = |k: &str| -> String {
+            let given = self.model.as_ref().is_some_and(|t| t.contains_key(k));
+            if given {
+                format!("model.{k}")
+            } else {
+                format!("motor.{k}")
+            }
+        };
+        let derived = match field {
+            "ts" | "switching_frequency" => Some("inverter.switching_frequency".to_owned()),
+            "dc_voltage" => Some("inverter.dc_voltage".to_owned()),
+            "rs" | "rs_hat" => Some(machine_key("rs")),
+            "ld" | "ld_hat" => Some(machine_key("ld")),
+            "lq" | "lq_hat" => Some(machine_key("lq")),
+            "flux_linkage" | "flux_linkage_hat" => Some(machine_key("flux_linkage")),
+            "inertia" | "inertia_hat" => Some(machine_key("inertia")),
+            "pole_pairs" | "viscous_friction" | "rated_current" | "rated_speed_rpm"
+            | "rated_torque" => Some(machine_key(field)),
+            "dead_time" => Some("inverter.dead_time".to_owned()),
+            "dead_time_threshold_voltage" => Some(
+                if self
+                    .inverter_model
+                    .as_ref()
+                    .is_some_and(|im| im.threshold_voltage.is_some())
+                {
+                    "inverter_model.threshold_voltage"
+                } else {
+                    "inverter.threshold_voltage"
+                }
+                .to_owned(),
+            ),
+            "dead_time_current_band" => Some("inverter.current_band".to_owned()),
+            "initial_angle" => Some("simulation.initial_angle".to_owned()),
+            _ => None,
+        };
+        if let Some(key) = derived {
+            let note = if key.starts_with("model.") {
+                String::new()
+            } else {
+                format!(" (the drive's value is derived from `{key}` and [mismatch])")
+            };
+            return SimConfigError::new(key, format!("{e}{note}"));
+        }
+        let field = moved(section, field).unwrap_or(field);
+        SimConfigError::new(format!("{section}.{field}"), e.to_string())
+    }
+
+    /// "Near zero speed" in r/min: `zero_speed_band_ratio` × the motor's rated speed.
+    pub fn zero_speed_band_rpm(&self) -> f64 {
+        self.simulation.zero_speed_band_ratio * self.motor.rated_speed_rpm
+    }
+
+    /// The defaults with `machine` as the motor and its `dc_voltage` as the DC link; the
+    /// other `[inverter]` keys its ratings give are derived (`crate::derive`) and recorded.
+    pub fn for_machine(machine: &MachineModel<f64>) -> SimConfig {
+        let mut c = SimConfig {
+            motor: *machine,
+            ..SimConfig::default()
+        };
+        let mut given = toml::Table::new();
+        given.insert("dc_voltage".into(), toml::Value::Float(machine.dc_voltage));
+        c.inverter.dc_voltage = machine.dc_voltage;
+        for (key, value) in crate::derive::inverter_values(machine, &given) {
+            match key {
+                "switching_frequency" => c.inverter.switching_frequency = value,
+                "dead_time" => c.inverter.dead_time = value,
+                "threshold_voltage" => c.inverter.threshold_voltage = value,
+                "current_band" => c.inverter.current_band = value,
+                _ => continue,
+            }
+            let full = format!("inverter.{key}");
+            c.derived.push(crate::derive::Derived {
+                rule: fado_core::ratings::rule(&full).unwrap_or(""),
+                key: full,
+                value,
+            });
+        }
+        c
+    }
+
+    /// The plausibility findings of the motor against its ratings, the DC link and the
+    /// sampling period (`fado_core::machine_checks`), each with its message naming the TOML
+    /// keys involved: errors first.
+    pub fn machine_findings(&self) -> Vec<(fado_core::machine_checks::Severity, String, String)> {
+        let m = MachineModel {
+            dc_voltage: self.inverter.dc_voltage,
+            ..self.motor
+        };
+        fado_core::machine_checks::check(&m, Some(self.inverter.sample_period()))
+            .iter()
+            .map(|f| {
+                let mut text = f.to_string();
+                for k in f.keys() {
+                    let full = plant_key(k);
+                    text = text.replace(&format!("`{k}`"), &format!("`{full}`"));
+                }
+                (f.severity(), plant_key(f.key()), text)
+            })
+            .collect()
+    }
+
+    /// The plausibility warnings of [`machine_findings`](Self::machine_findings), as
+    /// `key: message` lines.
+    pub fn warnings(&self) -> Vec<String> {
+        self.machine_findings()
+            .into_iter()
+            .filter(|(s, ..)| *s == fado_core::machine_checks::Severity::Warning)
+            .map(|(_, _, text)| text)
+            .collect()
+    }
+}
+
+/// The TOML key of a machine-check field: `[inverter]`'s for the DC link and the sampling
+/// period, `[motor]`'s otherwise.
+fn plant_key(field: &str) -> String {
+    match field {
+        "dc_voltage" => "inverter.dc_voltage".to_owned(),
+        "ts" => "inverter.switching_frequency".to_owned(),
+        k => format!("motor.{k}"),
+    }
+}
+
+/// The electrical time constant min(Ld, Lq)/Rs must span at least two sampling periods: a
+/// faster machine cannot be current-controlled at this rate (and the controllers' derived
+/// limits would otherwise refuse a key the user never wrote). The error names the field that
+/// is off: an inductance below 0.1 µH, else the resistance.
+fn check_time_constant(
+    m: &MachineModel<f64>,
+    ts: f64,
+    key: impl Fn(&str) -> String,
+) -> Result<(), SimConfigError> {
+    let l = m.ld.min(m.lq);
+    let tau = l / m.rs;
+    if tau >= 2.0 * ts {
+        return Ok(());
+    }
+    let field = if l < 1e-7 {
+        if m.ld <= m.lq { "ld" } else { "lq" }
+    } else {
+        "rs"
+    };
+    Err(SimConfigError::new(
+        key(field),
+        format!(
+            "the electrical time constant min(Ld, Lq)/Rs = {tau:.3e} s must be at least two \
+             sampling periods ({:.3e} s): check the units of rs, ld and lq",
+            2.0 * ts
+        ),
+    ))
+}
+
+/// Whether `x` is its type's default (sections left out of the written TOML when untouched).
+fn is_default<T: Default + PartialEq>(x: &T) -> bool {
+    *x == T::default()
+}

@@ -1,0 +1,161 @@
+//! The configuration as TOML text: written whole, parsed over a base key by key, and its
+//! errors named by the user's key and located in the user's text.
+
+use serde::Deserialize;
+
+use super::SimConfig;
+use crate::error::SimConfigError;
+use crate::magnetics_file;
+use crate::source::SourceLocation;
+
+impl SimConfig {
+    /// This configuration as a TOML document.
+    pub fn to_toml(&self) -> String {
+        let (sat, map) = (self.motor_saturation.as_ref(), self.motor_flux_map.as_ref());
+        if sat.is_none() && map.is_none() {
+            // Straight from the record: its field order (a TOML table would sort the keys).
+            return toml::to_string(self)
+                .expect("every field of SimConfig is representable in TOML");
+        }
+        let mut table = toml::Table::try_from(self).expect("SimConfig is a TOML table");
+        magnetics_file::insert_magnetics(&mut table, sat, map);
+        toml::to_string(&table).expect("every field of SimConfig is representable in TOML")
+    }
+
+    /// Parses a partial TOML document on top of `base`, an explicit configuration (a
+    /// scenario's with the user's motor, a sweep point's): tables merge, values and arrays
+    /// replace, so `[motor]\nrs = 0.5` changes one key of `base`'s motor. The result is
+    /// validated. Errors name the key.
+    pub fn from_toml_over(base: &SimConfig, text: &str) -> Result<SimConfig, SimConfigError> {
+        Self::parse_over(base, text, false)
+    }
+
+    /// Parses a user's configuration file on top of `base`: as
+    /// [`from_toml_over`](Self::from_toml_over), except that a `[motor]` table describes the
+    /// whole motor — every circuit key and rating required, the others derived from the
+    /// ratings with the `[inverter]` keys they give (`crate::derive`), none taken from
+    /// `base`'s motor.
+    pub fn from_user_toml(base: &SimConfig, text: &str) -> Result<SimConfig, SimConfigError> {
+        Self::parse_over(base, text, true)
+    }
+
+    fn parse_over(
+        base: &SimConfig,
+        text: &str,
+        whole_motor: bool,
+    ) -> Result<SimConfig, SimConfigError> {
+        let mut user: toml::Table = text.parse().map_err(|e| located(text, e))?;
+        super::moved::refuse_moved(&user).map_err(|e| e.located_in(text))?;
+        let (saturation, flux_map) =
+            magnetics_file::take_magnetics(&mut user).map_err(|e| e.located_in(text))?;
+        // Check the user's document on its own first, so that errors (unknown keys, wrong
+        // types) name the key the user wrote and point at it.
+        if saturation.is_some() || flux_map.is_some() {
+            SimConfig::deserialize(toml::Value::Table(user.clone()))
+                .map_err(|e| key_error(e).located_in(text))?;
+        } else {
+            toml::from_str::<SimConfig>(text).map_err(|e| located(text, e))?;
+        }
+        let derived = if whole_motor {
+            crate::derive::complete_motor(&mut user, text)?
+        } else {
+            Vec::new()
+        };
+        let given = user.clone();
+        let mut merged = toml::Table::try_from(base)
+            .map_err(|e| SimConfigError::new("<base>", e.to_string()))?;
+        merge(&mut merged, user);
+        let mut cfg = SimConfig::deserialize(toml::Value::Table(merged))
+            .map_err(|e| key_error(e).located_in(text))?;
+        // What `base` derived stays derived unless the document gives it now.
+        cfg.derived = base
+            .derived
+            .iter()
+            .filter(|d| {
+                let (section, key) = d.key.split_once('.').unwrap_or(("", ""));
+                !given
+                    .get(section)
+                    .and_then(|t| t.as_table())
+                    .is_some_and(|t| t.contains_key(key))
+            })
+            .filter(|d| !derived.iter().any(|n| n.key == d.key))
+            .cloned()
+            .collect();
+        cfg.derived.extend(derived);
+        // `[motor]` has no DC link of its own (it is the inverter's).
+        cfg.motor.dc_voltage = cfg.inverter.dc_voltage;
+        // A document giving one magnetic model replaces the base's (either).
+        if saturation.is_some() || flux_map.is_some() {
+            (cfg.motor_saturation, cfg.motor_flux_map) = (saturation, flux_map);
+        } else {
+            cfg.motor_saturation = base.motor_saturation;
+            cfg.motor_flux_map = base.motor_flux_map.clone();
+        }
+        cfg.validate().map_err(|e| e.located_in(text))?;
+        Ok(cfg)
+    }
+
+    /// Parses a user's TOML document over the defaults (see
+    /// [`from_user_toml`](Self::from_user_toml)).
+    pub fn from_toml(text: &str) -> Result<SimConfig, SimConfigError> {
+        Self::from_user_toml(&SimConfig::default(), text)
+    }
+
+    /// This configuration as TOML with each derived key's rule beside it (`--dump-config`).
+    pub fn to_toml_annotated(&self) -> String {
+        crate::derive::annotate(&self.to_toml(), &self.derived)
+    }
+}
+
+pub(super) fn merge(base: &mut toml::Table, over: toml::Table) {
+    for (k, v) in over {
+        match (base.get_mut(&k), v) {
+            (Some(toml::Value::Table(b)), toml::Value::Table(o)) => merge(b, o),
+            (_, v) => {
+                base.insert(k, v);
+            }
+        }
+    }
+}
+
+/// An error of parsing or deserialising the user's `text`: named by the key at its span (or
+/// as `key_error` does), located at the span.
+fn located(text: &str, e: toml::de::Error) -> SimConfigError {
+    let start = e.span().map(|s| s.start);
+    let key = start.and_then(|at| crate::source::key_at(text, at));
+    let mut err = match key {
+        Some(key) => SimConfigError::new(key, e.message().trim_end().to_owned()),
+        None => {
+            let mut k = key_error(e.clone());
+            k.message = e.message().trim_end().to_owned();
+            k
+        }
+    };
+    err.location = start.map(|at| SourceLocation::at(text, at));
+    err
+}
+
+/// A serde error from a `toml::Value` carries "in `path`"; unknown fields name the field.
+pub(crate) fn key_error(e: toml::de::Error) -> SimConfigError {
+    let msg = e.to_string();
+    let path = msg
+        .split("in `")
+        .nth(1)
+        .and_then(|s| s.split('`').next())
+        .unwrap_or("")
+        .to_owned();
+    let field = msg
+        .split("unknown field `")
+        .nth(1)
+        .and_then(|s| s.split('`').next());
+    let key = match (field, path.is_empty()) {
+        (Some(f), true) => f.to_owned(),
+        (Some(f), false) => format!("{path}.{f}"),
+        (None, _) => path,
+    };
+    let first_line = msg.lines().next().unwrap_or("").to_owned();
+    SimConfigError::new(
+        if key.is_empty() { "<file>".into() } else { key },
+        first_line,
+    )
+}
