@@ -121,6 +121,7 @@ pub(super) fn setup_loaded_start(c: &mut SimConfig) {
     let n = REVERSAL_SPEED_RATIO * c.motor.rated_speed_rpm;
     let t0 = LOADED_START_RAMP_AT;
     c.simulation.brake = true;
+    c.controller.release_hold.enabled = true;
     c.simulation.initial_angle = loaded_start_angle(c.current_sensor.seed);
     c.speed_reference = Profile::from_points(&[(0.0, 0.0), (t0, 0.0), (t0 + 1.0, n)]);
     c.load.torque = Profile::constant(LOADED_START_LOAD_RATIO * c.motor.rated_torque);
