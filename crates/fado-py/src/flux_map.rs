@@ -133,7 +133,7 @@ pub fn machine_magnetics<T: 'static + Copy>(m: &FluxMapFile) -> Option<MachineMa
     if let Some(x) = (&f64_map as &dyn Any).downcast_ref::<MachineMagnetics<T>>() {
         return Some(*x);
     }
-    let f32_map = MachineMagnetics::Map(model_magnetics::interned_map_f32(&m.data)?);
+    let f32_map = model_magnetics::to_f32(&f64_map)?;
     (&f32_map as &dyn Any)
         .downcast_ref::<MachineMagnetics<T>>()
         .copied()

@@ -22,7 +22,7 @@ pub mod release_hold;
 pub mod saturated_references;
 pub mod speed_controller;
 pub mod standstill_probe;
-pub mod tracker_feedforward;
+pub use drive::tracker_feedforward;
 
 pub use current_controller::{CurrentController, CurrentControllerConfig};
 pub use dc_link_limit::{DcLinkLimit, DcLinkTuning};

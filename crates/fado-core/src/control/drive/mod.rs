@@ -37,6 +37,7 @@ mod reject;
 mod resolved;
 mod saturation;
 mod step;
+pub mod tracker_feedforward;
 mod tuning;
 
 pub use config::DriveConfig;

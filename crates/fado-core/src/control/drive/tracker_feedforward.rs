@@ -13,7 +13,7 @@
 //! **Rule.** Where the lag α/Ki at the current limit (T_max = min(`current_limit_ratio`,
 //! `limits.torque_ratio`)·T_rated, Ki of T2S-1) exceeds [`TrackerFeedforwardTuning::max_lag`],
 //! the drive turns on its acceleration feed-forward (`DriveTuning::acceleration_feedforward`)
-//! and gives the trackers their load integrator (`EstimatorTuning::tracker_load_pole_ratio`
+//! and gives the trackers their load integrator (`EstimatorTuning::tracker.load_pole_ratio`
 //! [`LOAD_POLE_RATIO`] where the tuning leaves it at 0): without it the load the model does not
 //! know would leave p·T_L/(Ĵ·Ki) of angle error. A tuning that turns them on itself is kept.
 //!
@@ -129,7 +129,7 @@ mod tests {
         let lag = current_limit_lag(&m, &d, &e, 100e-6);
         assert!((lag - 0.21).abs() < 0.01, "{lag}");
         let (d2, e2) = resolve(&m, d, e, 100e-6);
-        assert!(!d2.acceleration_feedforward && e2.tracker_load_pole_ratio == 0.0);
+        assert!(!d2.acceleration_feedforward && e2.tracker.load_pole_ratio == 0.0);
         assert_eq!((d2, e2), (d, e));
         // A 14-pole-pair multirotor motor with its propeller: 2.4 rad, feed-forward on.
         let fast = MachineModel {
@@ -145,13 +145,11 @@ mod tests {
         assert!((lag - 2.4).abs() < 0.05, "{lag}");
         let (d2, e2) = resolve(&fast, d, e, 25e-6);
         assert!(d2.acceleration_feedforward);
-        assert_eq!(e2.tracker_load_pole_ratio, LOAD_POLE_RATIO);
+        assert_eq!(e2.tracker.load_pole_ratio, LOAD_POLE_RATIO);
         // A tuning's own load pole is kept; an infinite threshold keeps the paper's trackers.
-        let own = EstimatorTuning {
-            tracker_load_pole_ratio: 0.3,
-            ..e
-        };
-        assert_eq!(resolve(&fast, d, own, 25e-6).1.tracker_load_pole_ratio, 0.3);
+        let mut own = e;
+        own.tracker.load_pole_ratio = 0.3;
+        assert_eq!(resolve(&fast, d, own, 25e-6).1.tracker.load_pole_ratio, 0.3);
         let mut off = d;
         off.tracker_feedforward.max_lag = f64::INFINITY;
         assert!(!resolve(&fast, off, e, 25e-6).0.acceleration_feedforward);
