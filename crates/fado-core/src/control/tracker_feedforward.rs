@@ -79,9 +79,9 @@ pub fn current_limit_lag<T: Real>(
     ts: T,
 ) -> T {
     let tracker = TrackerConfig {
-        damping: estimator.tracker_damping,
-        definition: estimator.bandwidth_definition,
-        ..TrackerConfig::new(estimator.t2s1_bandwidth_hz, ts)
+        damping: estimator.tracker.damping,
+        definition: estimator.tracker.bandwidth_definition,
+        ..TrackerConfig::new(estimator.tracker.t2s1_bandwidth_hz, ts)
     };
     let (_, ki) = tracker.gains();
     let ratio = crate::real::min(drive.current_limit_ratio, drive.limits.torque_ratio);
@@ -99,8 +99,8 @@ pub fn apply<T: Real>(
     // NaN compares false: no feed-forward.
     if current_limit_lag(machine, drive, estimator, ts) > drive.tracker_feedforward.max_lag {
         drive.acceleration_feedforward = true;
-        if estimator.tracker_load_pole_ratio == T::zero() {
-            estimator.tracker_load_pole_ratio = T::lit(LOAD_POLE_RATIO);
+        if estimator.tracker.load_pole_ratio == T::zero() {
+            estimator.tracker.load_pole_ratio = T::lit(LOAD_POLE_RATIO);
         }
     }
 }
