@@ -22,7 +22,6 @@ FN_LIMIT = 80
 # A file: "path"; a function: "path::name" (the first function of that name in the file
 # that is over the limit).
 KNOWN = {
-    "crates/fado-core/src/rs_adaptation/laws.rs::new": 81,
     "crates/fado-core/src/baselines/emf_observer.rs::config_errors_name_the_field": 133,
     "crates/fado-core/src/baselines/lpf_integrator.rs::config_errors_name_the_field": 142,
     "crates/fado-core/src/baselines/ortega.rs::config_errors_name_the_field": 194,
