@@ -9,17 +9,6 @@ use crate::lock::LockStatus;
 use crate::mode::Mode;
 use crate::{Ab, Abc, Dq, Real, Rotation};
 
-/// The value of a phase that went on, or the end of the sample with the output of a phase
-/// that ended it (written straight into the caller's output, no copy through a `Result`).
-macro_rules! ended {
-    ($phase:expr) => {
-        match $phase {
-            Ok(value) => value,
-            Err(out) => return out,
-        }
-    };
-}
-
 impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
     /// One 10 kHz sample: phase currents `i_abc` sampled now (A), dc-link voltage `vdc` (V),
     /// speed reference `speed_ref_mech` (mechanical rad/s). The duty returned is to be loaded
@@ -97,22 +86,29 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         vdc: T,
         speed_ref_mech: T,
     ) -> DriveOutput<T> {
-        self.control(i_abc, vdc, speed_ref_mech)
+        match self.control(i_abc, vdc, speed_ref_mech) {
+            Ok(out) | Err(out) => out,
+        }
     }
 
     /// Steps 1–8 of the module docs.
     #[inline(always)]
-    fn control(&mut self, i_abc: Abc<T>, vdc: T, speed_ref_mech: T) -> DriveOutput<T> {
+    fn control(
+        &mut self,
+        i_abc: Abc<T>,
+        vdc: T,
+        speed_ref_mech: T,
+    ) -> Result<DriveOutput<T>, DriveOutput<T>> {
         // 1. Inputs: plausibility, offsets, trip, gain calibration and correction, stuck
         //    channel.
-        ended!(self.screen_inputs(i_abc, vdc, speed_ref_mech));
-        let i_abc = ended!(self.conditioned_currents(i_abc, vdc));
+        self.screen_inputs(i_abc, vdc, speed_ref_mech)?;
+        let i_abc = self.conditioned_currents(i_abc, vdc)?;
         let i_ab = i_abc.to_ab();
         if !i_ab.is_finite() {
-            return self.reject(i_abc);
+            return Err(self.reject(i_abc));
         }
         // 2. Estimator: voltage of [n−1, n] = realised reference computed at n−2.
-        let estimate = ended!(self.estimate(i_ab));
+        let estimate = self.estimate(i_ab)?;
         // 3. Measured current in the estimated rotor frame.
         let rot_theta = Rotation::from_angle(estimate.theta);
         let i_dq = i_ab.to_dq(rot_theta);
@@ -124,17 +120,17 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         // Reaction to a lost rotor (see `lock_reaction`).
         let speed_ref = speed_ref_mech * T::lit(self.config.machine.pole_pairs as f64);
         let speed_ref = self.blocks.limits.speed(speed_ref);
-        let action = ended!(self.react_to_lock(&estimate, speed_ref));
+        let action = self.react_to_lock(&estimate, speed_ref)?;
         // 4. Speed loop, injection (23) and current-vector limit (zero current when coasting).
         let backup = self.blocks;
         let Some(i_dq_ref) = self.current_reference(&estimate, speed_ref, action, vdc) else {
-            return self.reject_after_estimate(backup, estimate, i_dq);
+            return Err(self.reject_after_estimate(backup, estimate, i_dq));
         };
         // 5.–8. Current loop, delay and dead-time compensation, modulation, anti-windup.
         let b = &mut self.blocks;
         // 5. Current loop (unlimited).
         let Ok(v_dq) = b.current.step(i_dq_ref, i_dq, omega_ctrl) else {
-            return self.reject_after_estimate(backup, estimate, i_dq);
+            return Err(self.reject_after_estimate(backup, estimate, i_dq));
         };
         b.field_weakening
             .update(v_dq.d * v_dq.d + v_dq.q * v_dq.q, vdc, omega_ctrl);
@@ -145,7 +141,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             .step_rotated(v_dq, rot_theta, estimate.theta, estimate.omega);
         // 7. Dead-time compensation, hexagon limit, SVPWM.
         let Some(applied) = b.modulate(rot, v_ab, v_dq, i_dq_ref, i_abc, vdc) else {
-            return self.reject_after_estimate(backup, estimate, i_dq);
+            return Err(self.reject_after_estimate(backup, estimate, i_dq));
         };
         // 8. Anti-windup with the realised voltage in the same frame; speed loop too.
         b.current.realised(applied.v_dq);
@@ -159,7 +155,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             i_dq_ref.q
         };
         b.speed.realised(realised_torque);
-        self.record(applied, i_dq, i_dq_ref, estimate, i_ab)
+        Ok(self.record(applied, i_dq, i_dq_ref, estimate, i_ab))
     }
 
     /// Plausibility of the inputs: while tripped the sample is held, and an implausible one
