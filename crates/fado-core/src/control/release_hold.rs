@@ -295,6 +295,7 @@ mod tests {
     fn rollback(machine: &MachineModel<f64>, travel: f64) -> (f64, f64, f64) {
         let ts = 1e-4;
         let tuning = ReleaseHoldTuning {
+            enabled: true,
             travel,
             ..ReleaseHoldTuning::default()
         };
@@ -337,7 +338,10 @@ mod tests {
     #[test]
     fn an_unloaded_rotor_never_triggers_it_and_a_reference_hands_over() {
         let m = MachineModel::<f64>::paper();
-        let t = ReleaseHoldTuning::default();
+        let t = ReleaseHoldTuning {
+            enabled: true,
+            ..ReleaseHoldTuning::default()
+        };
         let mut h = ReleaseHold::new(&t, &m, 1e-4, 250.0, 40.0).unwrap();
         h.arm(1.0);
         for _ in 0..10_000 {

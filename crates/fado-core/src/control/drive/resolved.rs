@@ -15,6 +15,7 @@ impl<T: Real> Resolved<T> {
         let ts = check::positive("ts", c.ts)?;
         c.machine.validate()?;
         let t = &c.tuning;
+        check::positive("tracker_feedforward.max_lag", t.tracker_feedforward.max_lag)?;
         let rated = c.machine.rated_current;
         // A duration as a whole number of samples (at most about 5 days at 10 kHz).
         let samples = &|field: &'static str, time: T| -> Result<u32, ConfigError> {

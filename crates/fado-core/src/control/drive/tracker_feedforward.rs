@@ -50,14 +50,19 @@ pub const LOAD_POLE_RATIO: f64 = 0.5;
 )]
 pub struct TrackerFeedforwardTuning<T> {
     /// Largest angle lag (rad) of the type-2 T2S-1 behind an acceleration at the current limit
-    /// that the drive leaves without feed-forward. Default 1 rad \[A\] (module docs); infinity
-    /// keeps the paper's trackers on every rotor.
+    /// that the drive leaves without feed-forward. Default 2 rad \[A\]: the multirotor preset
+    /// (2.4 rad) and the cheetah outrunner (3.0 rad) need the feed-forward; a 750 W 10-pole
+    /// servo (1.5–2 rad) holds its loaded start without it and loses it with it (5 rad
+    /// backward, `fado-sim/tests/loaded_start.rs`); the strongly salient presets lose their
+    /// `reversal` with it. A large value (1e9) keeps the paper's trackers on every rotor.
     pub max_lag: T,
 }
 
 impl<T: Real> Default for TrackerFeedforwardTuning<T> {
     fn default() -> Self {
-        Self { max_lag: T::one() }
+        Self {
+            max_lag: T::lit(2.0),
+        }
     }
 }
 
@@ -151,7 +156,7 @@ mod tests {
         own.tracker.load_pole_ratio = 0.3;
         assert_eq!(resolve(&fast, d, own, 25e-6).1.tracker.load_pole_ratio, 0.3);
         let mut off = d;
-        off.tracker_feedforward.max_lag = f64::INFINITY;
+        off.tracker_feedforward.max_lag = 1e9;
         assert!(!resolve(&fast, off, e, 25e-6).0.acceleration_feedforward);
     }
 }
