@@ -21,15 +21,7 @@ FN_LIMIT = 80
 # Known exceptions, each with the size it may not exceed: code not yet cut into pieces.
 # A file: "path"; a function: "path::name" (the first function of that name in the file
 # that is over the limit).
-KNOWN = {
-    "crates/fado-core/src/baselines/emf_observer.rs::config_errors_name_the_field": 133,
-    "crates/fado-core/src/baselines/lpf_integrator.rs::config_errors_name_the_field": 142,
-    "crates/fado-core/src/baselines/ortega.rs::config_errors_name_the_field": 194,
-    "crates/fado-core/src/machine_checks.rs::fmt": 121,
-    "crates/fado-core/src/machine_checks.rs::check_into": 126,
-    "crates/fado-py/src/commission.rs::commission": 84,
-    "crates/fado-py/src/inputs.rs::column": 89,
-}
+KNOWN = {}
 
 FN = re.compile(
     r'^(\s*)(?:pub(?:\([^)]*\))?\s+)?(?:const\s+)?(?:async\s+)?(?:unsafe\s+)?'

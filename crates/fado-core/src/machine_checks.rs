@@ -316,6 +316,63 @@ fn write_keys(f: &mut fmt::Formatter<'_>, keys: &[&str]) -> fmt::Result {
     Ok(())
 }
 
+/// The text of [`Finding::Torque`]: the ratio, the torque it compares with, the likely slip.
+fn write_torque(f: &mut fmt::Formatter<'_>, ratio: f64, severity: Severity) -> fmt::Result {
+    if severity == Severity::Error {
+        write!(
+            f,
+            "`rated_torque` is {ratio:.3} × the magnet torque 1.5·p·λf·I at \
+             `rated_current` (from `flux_linkage` and `pole_pairs`)"
+        )?;
+    } else {
+        write!(
+            f,
+            "`rated_torque` is {ratio:.3} × the torque the model gives at \
+             `rated_current` on the MTPA point (from "
+        )?;
+        write_keys(f, &TORQUE_KEYS_SALIENT[2..])?;
+        f.write_str(")")?;
+    }
+    if (0.3e-3..3e-3).contains(&ratio) {
+        f.write_str(": `flux_linkage` in mWb where Wb is meant?")
+    } else if (300.0..3000.0).contains(&ratio) {
+        f.write_str(": `flux_linkage` in Wb where mWb is meant, or `rated_current` in mA?")
+    } else if (1.2..1.7).contains(&ratio) || (0.58..0.83).contains(&ratio) {
+        f.write_str(
+            ": rms where peak is meant (√2 = 1.41)? Give the current in A peak and λf in Wb peak",
+        )
+    } else {
+        f.write_str(": check the units (λf in Wb peak per phase, current in A peak)")
+    }
+}
+
+/// The text of [`Finding::Sampling`]: the angle per sample and what it costs.
+fn write_sampling(
+    f: &mut fmt::Formatter<'_>,
+    omega_ts: f64,
+    switching_frequency: f64,
+    severity: Severity,
+) -> fmt::Result {
+    write!(
+        f,
+        "the rotor turns ω_rated·Ts = {omega_ts:.3} rad per sample at rated speed \
+         (`rated_speed_rpm`, `pole_pairs`, sampling period `ts`)"
+    )?;
+    if severity == Severity::Error {
+        f.write_str(
+            ", more than π: the angle cannot be sampled (a sampling period in ms \
+             where s is meant?)",
+        )
+    } else {
+        write!(
+            f,
+            "; the drive's angle estimate degrades above {MAX_RUNNING_OMEGA_TS} and \
+             commissioning needs at most {MAX_OMEGA_TS} (switching frequency ≥ \
+             {switching_frequency} Hz)"
+        )
+    }
+}
+
 impl fmt::Display for Finding {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match *self {
@@ -335,34 +392,7 @@ impl fmt::Display for Finding {
                 pole_pairs / 2,
                 1.0 / ratio
             ),
-            Finding::Torque { ratio, severity } => {
-                if severity == Severity::Error {
-                    write!(
-                        f,
-                        "`rated_torque` is {ratio:.3} × the magnet torque 1.5·p·λf·I at \
-                         `rated_current` (from `flux_linkage` and `pole_pairs`)"
-                    )?;
-                } else {
-                    write!(
-                        f,
-                        "`rated_torque` is {ratio:.3} × the torque the model gives at \
-                         `rated_current` on the MTPA point (from "
-                    )?;
-                    write_keys(f, &TORQUE_KEYS_SALIENT[2..])?;
-                    f.write_str(")")?;
-                }
-                if (0.3e-3..3e-3).contains(&ratio) {
-                    f.write_str(": `flux_linkage` in mWb where Wb is meant?")
-                } else if (300.0..3000.0).contains(&ratio) {
-                    f.write_str(
-                        ": `flux_linkage` in Wb where mWb is meant, or `rated_current` in mA?",
-                    )
-                } else if (1.2..1.7).contains(&ratio) || (0.58..0.83).contains(&ratio) {
-                    f.write_str(": rms where peak is meant (√2 = 1.41)? Give the current in A peak and λf in Wb peak")
-                } else {
-                    f.write_str(": check the units (λf in Wb peak per phase, current in A peak)")
-                }
-            }
+            Finding::Torque { ratio, severity } => write_torque(f, ratio, severity),
             Finding::BackEmf { ratio } => write!(
                 f,
                 "the back-EMF at rated speed ω·λf (`flux_linkage`, `rated_speed_rpm`, \
@@ -416,26 +446,7 @@ impl fmt::Display for Finding {
                 omega_ts,
                 switching_frequency,
                 severity,
-            } => {
-                write!(
-                    f,
-                    "the rotor turns ω_rated·Ts = {omega_ts:.3} rad per sample at rated speed \
-                     (`rated_speed_rpm`, `pole_pairs`, sampling period `ts`)"
-                )?;
-                if severity == Severity::Error {
-                    f.write_str(
-                        ", more than π: the angle cannot be sampled (a sampling period in ms \
-                         where s is meant?)",
-                    )
-                } else {
-                    write!(
-                        f,
-                        "; the drive's angle estimate degrades above {MAX_RUNNING_OMEGA_TS} and \
-                         commissioning needs at most {MAX_OMEGA_TS} (switching frequency ≥ \
-                         {switching_frequency} Hz)"
-                    )
-                }
-            }
+            } => write_sampling(f, omega_ts, switching_frequency, severity),
         }
     }
 }
@@ -493,56 +504,13 @@ impl Sink for FirstError {
 
 /// The body of [`check`], writing into `out`.
 fn check_into(m: &MachineModel<f64>, ts: Option<f64>, out: &mut impl Sink) {
-    let values = [
-        m.rs,
-        m.ld,
-        m.lq,
-        m.flux_linkage,
-        m.pole_pairs as f64,
-        m.inertia,
-        m.rated_current,
-        m.rated_speed_rpm,
-        m.rated_torque,
-        m.dc_voltage,
-    ];
-    let mut usable = true;
-    for ((key, max, unit), value) in RANGES.iter().zip(values) {
-        if value > *max {
-            out.push(Finding::Range {
-                key,
-                value,
-                max: *max,
-                unit,
-            });
-        }
-        usable &= value.is_finite() && value > 0.0;
-    }
+    let usable = check_ranges(m, out);
     if !out.is_empty() || !usable {
         return;
     }
     let per_unit_emf = m.rated_speed() * m.flux_linkage;
     let v_max = m.dc_voltage / 1.732_050_807_568_877_2;
-    // Torque against the model's at rated current: the errors against the magnet torque
-    // 1.5·p·λf·I, which no rotor with Ld ≤ Lq falls short of and which a drive's model with
-    // a mismatched L̂d or L̂q keeps; the warning against the MTPA torque.
-    let magnet = m.rated_torque / (m.torque_constant() * m.rated_current);
-    let ratio = m.rated_torque / ratings::rated_current_torque(m);
-    if m.pole_pairs.is_multiple_of(2) && (0.4..=0.6).contains(&magnet) {
-        out.push(Finding::PoleCount {
-            pole_pairs: m.pole_pairs,
-            ratio: magnet,
-        });
-    } else if !(0.3..=3.0).contains(&magnet) {
-        out.push(Finding::Torque {
-            ratio: magnet,
-            severity: Severity::Error,
-        });
-    } else if !(0.6..=1.6).contains(&ratio) {
-        out.push(Finding::Torque {
-            ratio,
-            severity: Severity::Warning,
-        });
-    }
+    check_torque(m, out);
     let emf_ratio = per_unit_emf / v_max;
     if emf_ratio > 2.0 {
         out.push(Finding::BackEmf { ratio: emf_ratio });
@@ -601,21 +569,80 @@ fn check_into(m: &MachineModel<f64>, ts: Option<f64>, out: &mut impl Sink) {
         out.push(Finding::Saliency { ld: m.ld, lq: m.lq });
     }
     if let Some(ts) = ts.filter(|t| t.is_finite() && *t > 0.0) {
-        let x = m.rated_speed() * ts;
-        let severity = if x > core::f64::consts::PI {
-            Some(Severity::Error)
-        } else if x > ratings::MAX_RUNNING_OMEGA_TS * (1.0 + 1e-9) {
-            Some(Severity::Warning)
-        } else {
-            None
-        };
-        if let Some(severity) = severity {
-            out.push(Finding::Sampling {
-                omega_ts: x,
-                switching_frequency: ratings::switching_frequency(m.pole_pairs, m.rated_speed_rpm),
-                severity,
+        check_sampling(m, ts, out);
+    }
+}
+
+/// Pushes a [`Finding::Range`] for each field beyond [`RANGES`]; true when every field is
+/// finite and positive (the cross-checks need it).
+fn check_ranges(m: &MachineModel<f64>, out: &mut impl Sink) -> bool {
+    let values = [
+        m.rs,
+        m.ld,
+        m.lq,
+        m.flux_linkage,
+        m.pole_pairs as f64,
+        m.inertia,
+        m.rated_current,
+        m.rated_speed_rpm,
+        m.rated_torque,
+        m.dc_voltage,
+    ];
+    let mut usable = true;
+    for ((key, max, unit), value) in RANGES.iter().zip(values) {
+        if value > *max {
+            out.push(Finding::Range {
+                key,
+                value,
+                max: *max,
+                unit,
             });
         }
+        usable &= value.is_finite() && value > 0.0;
+    }
+    usable
+}
+
+/// Torque against the model's at rated current: the errors against the magnet torque
+/// 1.5·p·λf·I, which no rotor with Ld ≤ Lq falls short of and which a drive's model with a
+/// mismatched L̂d or L̂q keeps; the warning against the MTPA torque.
+fn check_torque(m: &MachineModel<f64>, out: &mut impl Sink) {
+    let magnet = m.rated_torque / (m.torque_constant() * m.rated_current);
+    let ratio = m.rated_torque / ratings::rated_current_torque(m);
+    if m.pole_pairs.is_multiple_of(2) && (0.4..=0.6).contains(&magnet) {
+        out.push(Finding::PoleCount {
+            pole_pairs: m.pole_pairs,
+            ratio: magnet,
+        });
+    } else if !(0.3..=3.0).contains(&magnet) {
+        out.push(Finding::Torque {
+            ratio: magnet,
+            severity: Severity::Error,
+        });
+    } else if !(0.6..=1.6).contains(&ratio) {
+        out.push(Finding::Torque {
+            ratio,
+            severity: Severity::Warning,
+        });
+    }
+}
+
+/// The angle the rotor turns per sample period `ts` at rated speed.
+fn check_sampling(m: &MachineModel<f64>, ts: f64, out: &mut impl Sink) {
+    let x = m.rated_speed() * ts;
+    let severity = if x > core::f64::consts::PI {
+        Some(Severity::Error)
+    } else if x > ratings::MAX_RUNNING_OMEGA_TS * (1.0 + 1e-9) {
+        Some(Severity::Warning)
+    } else {
+        None
+    };
+    if let Some(severity) = severity {
+        out.push(Finding::Sampling {
+            omega_ts: x,
+            switching_frequency: ratings::switching_frequency(m.pole_pairs, m.rated_speed_rpm),
+            severity,
+        });
     }
 }
 

@@ -152,21 +152,7 @@ pub fn commission(
     let config_text = cfg.to_toml();
     let started = std::time::Instant::now();
     let outcome = interrupt::run(py, |cancel| {
-        let mut draw = |f: f64, phase: Phase| {
-            use std::io::Write;
-            let filled = (f.clamp(0.0, 1.0) * 30.0).round() as usize;
-            let mut err = std::io::stderr().lock();
-            let _ = write!(
-                err,
-                "\rcommission {:<13} [{}{}] {:>3.0}% {:>6.1} s",
-                phase.name(),
-                "=".repeat(filled),
-                " ".repeat(30 - filled),
-                f * 100.0,
-                started.elapsed().as_secs_f64()
-            );
-            let _ = err.flush();
-        };
+        let mut draw = |f: f64, phase: Phase| draw_progress(f, phase, started);
         let cb: Option<&mut dyn FnMut(f64, Phase)> = if progress { Some(&mut draw) } else { None };
         let r = sim_commission::commission(
             &plant,
@@ -193,6 +179,24 @@ pub fn commission(
         ));
     }
     CommissionResult::new(py, outcome, config_text)
+}
+
+/// Draws the progress bar of a commissioning run on stderr: `phase`, the fraction `f` done and
+/// the time since `started`.
+fn draw_progress(f: f64, phase: Phase, started: std::time::Instant) {
+    use std::io::Write;
+    let filled = (f.clamp(0.0, 1.0) * 30.0).round() as usize;
+    let mut err = std::io::stderr().lock();
+    let _ = write!(
+        err,
+        "\rcommission {:<13} [{}{}] {:>3.0}% {:>6.1} s",
+        phase.name(),
+        "=".repeat(filled),
+        " ".repeat(30 - filled),
+        f * 100.0,
+        started.elapsed().as_secs_f64()
+    );
+    let _ = err.flush();
 }
 
 /// A finished commissioning run on the simulated plant.

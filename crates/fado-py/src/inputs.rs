@@ -61,6 +61,56 @@ fn type_name(obj: &Bound<'_, PyAny>) -> String {
 
 /// Checks one argument and borrows it read-only.
 pub fn column<'py>(argument: &str, obj: &Bound<'py, PyAny>) -> PyResult<Column<'py>> {
+    let array = one_d_array(argument, obj)?;
+    let py = obj.py();
+    let column = if let Ok(a) = array.cast::<PyArray1<f64>>() {
+        a.try_readonly().map(Column::F64)
+    } else if let Ok(a) = array.cast::<PyArray1<f32>>() {
+        a.try_readonly().map(Column::F32)
+    } else {
+        let dtype = array
+            .dtype()
+            .str()
+            .map(|s| s.to_string())
+            .unwrap_or_else(|_| "?".to_owned());
+        return Err(input_error(
+            py,
+            argument,
+            format!(
+                "expected dtype float64 or float32 (native byte order), got {dtype}; convert \
+                 with x.astype(numpy.float64)"
+            ),
+        ));
+    };
+    let column = column.map_err(|e| {
+        input_error(
+            py,
+            argument,
+            format!("the array cannot be borrowed for reading: {e}"),
+        )
+    })?;
+    check_layout(argument, array)?;
+    // The checks above are exactly what `as_slice` needs; refuse rather than assume.
+    let readable = match &column {
+        Column::F64(a) => a.as_slice().is_ok(),
+        Column::F32(a) => a.as_slice().is_ok(),
+    };
+    if !readable {
+        return Err(input_error(
+            py,
+            argument,
+            "the array's memory cannot be read as one slice; pass numpy.ascontiguousarray(x)"
+                .to_owned(),
+        ));
+    }
+    Ok(column)
+}
+
+/// `obj` as a numpy array of one dimension, or an error naming `argument` and how to convert it.
+fn one_d_array<'a, 'py>(
+    argument: &str,
+    obj: &'a Bound<'py, PyAny>,
+) -> PyResult<&'a Bound<'py, PyUntypedArray>> {
     let py = obj.py();
     let Ok(array) = obj.cast::<PyUntypedArray>() else {
         return Err(input_error(
@@ -90,32 +140,12 @@ pub fn column<'py>(argument: &str, obj: &Bound<'py, PyAny>) -> PyResult<Column<'
             ),
         ));
     }
-    let column = if let Ok(a) = array.cast::<PyArray1<f64>>() {
-        a.try_readonly().map(Column::F64)
-    } else if let Ok(a) = array.cast::<PyArray1<f32>>() {
-        a.try_readonly().map(Column::F32)
-    } else {
-        let dtype = array
-            .dtype()
-            .str()
-            .map(|s| s.to_string())
-            .unwrap_or_else(|_| "?".to_owned());
-        return Err(input_error(
-            py,
-            argument,
-            format!(
-                "expected dtype float64 or float32 (native byte order), got {dtype}; convert \
-                 with x.astype(numpy.float64)"
-            ),
-        ));
-    };
-    let column = column.map_err(|e| {
-        input_error(
-            py,
-            argument,
-            format!("the array cannot be borrowed for reading: {e}"),
-        )
-    })?;
+    Ok(array)
+}
+
+/// Refuses a non-empty array that is not contiguous or not aligned.
+fn check_layout(argument: &str, array: &Bound<'_, PyUntypedArray>) -> PyResult<()> {
+    let py = array.py();
     if !array.is_empty() && !array.is_contiguous() {
         return Err(input_error(
             py,
@@ -134,20 +164,7 @@ pub fn column<'py>(argument: &str, obj: &Bound<'py, PyAny>) -> PyResult<Column<'
             "the array's data are not aligned; pass numpy.require(x, requirements='CA')".to_owned(),
         ));
     }
-    // The checks above are exactly what `as_slice` needs; refuse rather than assume.
-    let readable = match &column {
-        Column::F64(a) => a.as_slice().is_ok(),
-        Column::F32(a) => a.as_slice().is_ok(),
-    };
-    if !readable {
-        return Err(input_error(
-            py,
-            argument,
-            "the array's memory cannot be read as one slice; pass numpy.ascontiguousarray(x)"
-                .to_owned(),
-        ));
-    }
-    Ok(column)
+    Ok(())
 }
 
 /// The four signals of a recording, checked to have equal lengths.

@@ -289,19 +289,9 @@ mod tests {
     use crate::baselines::CommonTuning;
 
     #[test]
-    fn config_errors_name_the_field() {
+    fn config_errors_name_the_machine_field() {
         type C = EmfObserverConfig<f64>;
-        let cases: [(C, &str); 12] = [
-            (
-                C {
-                    common: CommonTuning {
-                        ts: f64::NAN,
-                        ..Default::default()
-                    },
-                    ..C::for_machine(&MachineModel::paper())
-                },
-                "ts",
-            ),
+        let cases: [(C, &str); 3] = [
             (
                 C::for_machine(&MachineModel {
                     rs: -0.1,
@@ -323,6 +313,86 @@ mod tests {
                 }),
                 "flux_linkage",
             ),
+        ];
+        for (config, field) in cases {
+            assert_eq!(config.validate().unwrap_err().field(), field);
+        }
+    }
+
+    #[test]
+    fn config_errors_name_the_sampling_and_filter_field() {
+        type C = EmfObserverConfig<f64>;
+        let cases: [(C, &str); 3] = [
+            (
+                C {
+                    common: CommonTuning {
+                        ts: f64::NAN,
+                        ..Default::default()
+                    },
+                    ..C::for_machine(&MachineModel::paper())
+                },
+                "ts",
+            ),
+            (
+                C {
+                    common: CommonTuning {
+                        t2s1_bandwidth_hz: -60.0,
+                        ..Default::default()
+                    },
+                    ..C::for_machine(&MachineModel::paper())
+                },
+                "t2s1_bandwidth_hz",
+            ),
+            (
+                C {
+                    common: CommonTuning {
+                        t2s2_bandwidth_hz: 0.0,
+                        ..Default::default()
+                    },
+                    ..C::for_machine(&MachineModel::paper())
+                },
+                "t2s2_bandwidth_hz",
+            ),
+        ];
+        for (config, field) in cases {
+            assert_eq!(config.validate().unwrap_err().field(), field);
+        }
+    }
+
+    #[test]
+    fn config_errors_name_the_tracker_field() {
+        type C = EmfObserverConfig<f64>;
+        let cases: [(C, &str); 2] = [
+            (
+                C {
+                    common: CommonTuning {
+                        tracker_damping: -1.0,
+                        ..Default::default()
+                    },
+                    ..C::for_machine(&MachineModel::paper())
+                },
+                "tracker_damping",
+            ),
+            (
+                C {
+                    common: CommonTuning {
+                        initial_angle: f64::NEG_INFINITY,
+                        ..Default::default()
+                    },
+                    ..C::for_machine(&MachineModel::paper())
+                },
+                "initial_angle",
+            ),
+        ];
+        for (config, field) in cases {
+            assert_eq!(config.validate().unwrap_err().field(), field);
+        }
+    }
+
+    #[test]
+    fn config_errors_name_the_settings_field() {
+        type C = EmfObserverConfig<f64>;
+        let cases: [(C, &str); 4] = [
             (
                 C {
                     settings: EmfObserverSettings {
@@ -363,46 +433,6 @@ mod tests {
                     ..C::for_machine(&MachineModel::paper())
                 },
                 "speed_floor_hz",
-            ),
-            (
-                C {
-                    common: CommonTuning {
-                        t2s1_bandwidth_hz: -60.0,
-                        ..Default::default()
-                    },
-                    ..C::for_machine(&MachineModel::paper())
-                },
-                "t2s1_bandwidth_hz",
-            ),
-            (
-                C {
-                    common: CommonTuning {
-                        t2s2_bandwidth_hz: 0.0,
-                        ..Default::default()
-                    },
-                    ..C::for_machine(&MachineModel::paper())
-                },
-                "t2s2_bandwidth_hz",
-            ),
-            (
-                C {
-                    common: CommonTuning {
-                        tracker_damping: -1.0,
-                        ..Default::default()
-                    },
-                    ..C::for_machine(&MachineModel::paper())
-                },
-                "tracker_damping",
-            ),
-            (
-                C {
-                    common: CommonTuning {
-                        initial_angle: f64::NEG_INFINITY,
-                        ..Default::default()
-                    },
-                    ..C::for_machine(&MachineModel::paper())
-                },
-                "initial_angle",
             ),
         ];
         for (config, field) in cases {

@@ -282,19 +282,9 @@ mod tests {
     use crate::baselines::CommonTuning;
 
     #[test]
-    fn config_errors_name_the_field() {
+    fn config_errors_name_the_machine_field() {
         type C = LpfIntegratorConfig<f64>;
-        let cases: [(C, &str); 13] = [
-            (
-                C {
-                    common: CommonTuning {
-                        ts: 0.0,
-                        ..Default::default()
-                    },
-                    ..C::for_machine(&MachineModel::paper())
-                },
-                "ts",
-            ),
+        let cases: [(C, &str); 3] = [
             (
                 C::for_machine(&MachineModel {
                     rs: -1.0,
@@ -316,35 +306,25 @@ mod tests {
                 }),
                 "flux_linkage",
             ),
+        ];
+        for (config, field) in cases {
+            assert_eq!(config.validate().unwrap_err().field(), field);
+        }
+    }
+
+    #[test]
+    fn config_errors_name_the_sampling_and_filter_field() {
+        type C = LpfIntegratorConfig<f64>;
+        let cases: [(C, &str); 3] = [
             (
                 C {
-                    settings: LpfIntegratorSettings {
-                        cutoff_hz: -1.0,
+                    common: CommonTuning {
+                        ts: 0.0,
                         ..Default::default()
                     },
                     ..C::for_machine(&MachineModel::paper())
                 },
-                "cutoff_hz",
-            ),
-            (
-                C {
-                    settings: LpfIntegratorSettings {
-                        cutoff_hz: 2_000.0,
-                        ..Default::default()
-                    },
-                    ..C::for_machine(&MachineModel::paper())
-                },
-                "cutoff_hz",
-            ),
-            (
-                C {
-                    settings: LpfIntegratorSettings {
-                        compensation_floor_hz: 0.0,
-                        ..Default::default()
-                    },
-                    ..C::for_machine(&MachineModel::paper())
-                },
-                "compensation_floor_hz",
+                "ts",
             ),
             (
                 C {
@@ -366,6 +346,16 @@ mod tests {
                 },
                 "t2s2_bandwidth_hz",
             ),
+        ];
+        for (config, field) in cases {
+            assert_eq!(config.validate().unwrap_err().field(), field);
+        }
+    }
+
+    #[test]
+    fn config_errors_name_the_tracker_field() {
+        type C = LpfIntegratorConfig<f64>;
+        let cases: [(C, &str); 4] = [
             (
                 C {
                     common: CommonTuning {
@@ -405,6 +395,46 @@ mod tests {
                     ..C::for_machine(&MachineModel::paper())
                 },
                 "initial_angle",
+            ),
+        ];
+        for (config, field) in cases {
+            assert_eq!(config.validate().unwrap_err().field(), field);
+        }
+    }
+
+    #[test]
+    fn config_errors_name_the_settings_field() {
+        type C = LpfIntegratorConfig<f64>;
+        let cases: [(C, &str); 3] = [
+            (
+                C {
+                    settings: LpfIntegratorSettings {
+                        cutoff_hz: -1.0,
+                        ..Default::default()
+                    },
+                    ..C::for_machine(&MachineModel::paper())
+                },
+                "cutoff_hz",
+            ),
+            (
+                C {
+                    settings: LpfIntegratorSettings {
+                        cutoff_hz: 2_000.0,
+                        ..Default::default()
+                    },
+                    ..C::for_machine(&MachineModel::paper())
+                },
+                "cutoff_hz",
+            ),
+            (
+                C {
+                    settings: LpfIntegratorSettings {
+                        compensation_floor_hz: 0.0,
+                        ..Default::default()
+                    },
+                    ..C::for_machine(&MachineModel::paper())
+                },
+                "compensation_floor_hz",
             ),
         ];
         for (config, field) in cases {

@@ -359,9 +359,9 @@ mod tests {
     use crate::baselines::CommonTuning;
 
     #[test]
-    fn config_errors_name_the_field() {
+    fn config_errors_name_the_machine_field() {
         type C = OrtegaConfig<f64>;
-        let cases: [(C, &str); 20] = [
+        let cases: [(C, &str); 5] = [
             (
                 C::for_machine(&MachineModel {
                     rated_current: f64::NAN,
@@ -376,6 +376,37 @@ mod tests {
                 }),
                 "dc_voltage",
             ),
+            (
+                C::for_machine(&MachineModel {
+                    rs: f64::NAN,
+                    ..MachineModel::paper()
+                }),
+                "rs",
+            ),
+            (
+                C::for_machine(&MachineModel {
+                    lq: -1e-3,
+                    ..MachineModel::paper()
+                }),
+                "lq",
+            ),
+            (
+                C::for_machine(&MachineModel {
+                    flux_linkage: 0.0,
+                    ..MachineModel::paper()
+                }),
+                "flux_linkage",
+            ),
+        ];
+        for (config, field) in cases {
+            assert_eq!(config.validate().unwrap_err().field(), field);
+        }
+    }
+
+    #[test]
+    fn config_errors_name_the_plausibility_field() {
+        type C = OrtegaConfig<f64>;
+        let cases: [(C, &str); 3] = [
             (
                 C {
                     common: CommonTuning {
@@ -406,6 +437,16 @@ mod tests {
                 },
                 "plausible_current_step_ratio",
             ),
+        ];
+        for (config, field) in cases {
+            assert_eq!(config.validate().unwrap_err().field(), field);
+        }
+    }
+
+    #[test]
+    fn config_errors_name_the_sampling_and_filter_field() {
+        type C = OrtegaConfig<f64>;
+        let cases: [(C, &str); 3] = [
             (
                 C {
                     common: CommonTuning {
@@ -417,26 +458,75 @@ mod tests {
                 "ts",
             ),
             (
-                C::for_machine(&MachineModel {
-                    rs: f64::NAN,
-                    ..MachineModel::paper()
-                }),
-                "rs",
+                C {
+                    common: CommonTuning {
+                        t2s1_bandwidth_hz: 0.0,
+                        ..Default::default()
+                    },
+                    ..C::for_machine(&MachineModel::paper())
+                },
+                "t2s1_bandwidth_hz",
             ),
             (
-                C::for_machine(&MachineModel {
-                    lq: -1e-3,
-                    ..MachineModel::paper()
-                }),
-                "lq",
+                C {
+                    common: CommonTuning {
+                        t2s2_bandwidth_hz: 1e9,
+                        ..Default::default()
+                    },
+                    ..C::for_machine(&MachineModel::paper())
+                },
+                "t2s2_bandwidth_hz",
+            ),
+        ];
+        for (config, field) in cases {
+            assert_eq!(config.validate().unwrap_err().field(), field);
+        }
+    }
+
+    #[test]
+    fn config_errors_name_the_tracker_field() {
+        type C = OrtegaConfig<f64>;
+        let cases: [(C, &str); 3] = [
+            (
+                C {
+                    common: CommonTuning {
+                        tracker_damping: f64::NAN,
+                        ..Default::default()
+                    },
+                    ..C::for_machine(&MachineModel::paper())
+                },
+                "tracker_damping",
             ),
             (
-                C::for_machine(&MachineModel {
-                    flux_linkage: 0.0,
-                    ..MachineModel::paper()
-                }),
-                "flux_linkage",
+                C {
+                    common: CommonTuning {
+                        tracker_hold_ratio: 2.0,
+                        ..Default::default()
+                    },
+                    ..C::for_machine(&MachineModel::paper())
+                },
+                "tracker_hold_ratio",
             ),
+            (
+                C {
+                    common: CommonTuning {
+                        initial_angle: f64::NAN,
+                        ..Default::default()
+                    },
+                    ..C::for_machine(&MachineModel::paper())
+                },
+                "initial_angle",
+            ),
+        ];
+        for (config, field) in cases {
+            assert_eq!(config.validate().unwrap_err().field(), field);
+        }
+    }
+
+    #[test]
+    fn config_errors_name_the_settings_field() {
+        type C = OrtegaConfig<f64>;
+        let cases: [(C, &str); 6] = [
             (
                 C {
                     settings: OrtegaSettings {
@@ -496,56 +586,6 @@ mod tests {
                     ..C::for_machine(&MachineModel::paper())
                 },
                 "flux_adaptation_ratio",
-            ),
-            (
-                C {
-                    common: CommonTuning {
-                        t2s1_bandwidth_hz: 0.0,
-                        ..Default::default()
-                    },
-                    ..C::for_machine(&MachineModel::paper())
-                },
-                "t2s1_bandwidth_hz",
-            ),
-            (
-                C {
-                    common: CommonTuning {
-                        t2s2_bandwidth_hz: 1e9,
-                        ..Default::default()
-                    },
-                    ..C::for_machine(&MachineModel::paper())
-                },
-                "t2s2_bandwidth_hz",
-            ),
-            (
-                C {
-                    common: CommonTuning {
-                        tracker_damping: f64::NAN,
-                        ..Default::default()
-                    },
-                    ..C::for_machine(&MachineModel::paper())
-                },
-                "tracker_damping",
-            ),
-            (
-                C {
-                    common: CommonTuning {
-                        tracker_hold_ratio: 2.0,
-                        ..Default::default()
-                    },
-                    ..C::for_machine(&MachineModel::paper())
-                },
-                "tracker_hold_ratio",
-            ),
-            (
-                C {
-                    common: CommonTuning {
-                        initial_angle: f64::NAN,
-                        ..Default::default()
-                    },
-                    ..C::for_machine(&MachineModel::paper())
-                },
-                "initial_angle",
             ),
         ];
         for (config, field) in cases {
