@@ -151,7 +151,7 @@ pub struct EstimatorParams<T: Real> {
     tracker_hold_ratio: T,
     /// (λ̂f·`tracker.hold_ratio`)²: the trackers coast below this |λ̂r|².
     hold_level_sq: T,
-    /// k_df·Ts with `EstimatorTuning::limiter_recentring`, else 0.
+    /// k_df·Ts with `LimiterTuning::recentring`, else 0.
     limiter_recentring_gain: T,
     /// k_e·Ts (k_e = `EstimatorTuning::offset_adaptation_rate`): the k_df mode's re-centring
     /// while the R̂s adaptation runs (the state holds it, or 0, since the adaptation can be

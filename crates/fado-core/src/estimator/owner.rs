@@ -99,7 +99,7 @@ impl<T: Real> SensorlessEstimator<T> {
     ///
     /// θ̂, ω̂, ω̂ for control, the mode and FLAG_limit are those of that sample exactly. The
     /// diagnostics are recomputed: λ1 and D̂ as stored (after the limiter re-centring, see
-    /// [`EstimatorTuning::limiter_recentring`](crate::EstimatorTuning::limiter_recentring)), λ2 = λ1 − D̂, λ̂r = λ2 − L̂q·i with that
+    /// [`LimiterTuning::recentring`](crate::estimator::tuning::LimiterTuning::recentring)), λ2 = λ1 − D̂, λ̂r = λ2 − L̂q·i with that
     /// sample's current, θm = ∠λ̂r, the limiter and hold flags from this λ̂r, R̂s and λ̂f as
     /// they will be used next.
     pub fn last(&self) -> Estimate<T> {

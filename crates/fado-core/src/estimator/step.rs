@@ -248,7 +248,7 @@ impl<T: Real> EstimatorState<T> {
     /// re-centring shift of D̂.
     #[inline(always)]
     fn commit(&mut self, p: &EstimatorParams<T>, c: &Candidate<T>, i_ab: Ab<T>) -> Ab<T> {
-        // Limiter mode: re-centre the common mode (see `EstimatorTuning::limiter_recentring`).
+        // Limiter mode: re-centre the common mode (see `LimiterTuning::recentring`).
         // With the integrand-offset law, the k_df mode re-centres too, at k_e (see
         // `crate::integrand_offset`: D̂ then decays at k_df + k_e instead of k_df, and the
         // ramp k_df·D̂ that the observer has to follow goes with it).
