@@ -48,7 +48,7 @@ fn bench_step<T: Real>(c: &mut Criterion, name: &str, stall_symptom: bool) {
 fn drive_step(c: &mut Criterion) {
     bench_step::<f32>(c, "drive_step_f32", true);
     bench_step::<f64>(c, "drive_step_f64", true);
-    // The loss-of-lock stall symptom's share (issue 14): the same step without it.
+    // The loss-of-lock stall symptom's share: the same step without it.
     bench_step::<f32>(c, "drive_step_f32_no_stall_symptom", false);
 }
 

@@ -1,5 +1,5 @@
 //! Paired (interleaved) timing of fado's `f32` step against the Ortega baseline's: the ratio
-//! issue 16 asks for ("fado's f32 step ≤ 1.2× the Ortega baseline's in the same run"),
+//! fado's bound ("fado's f32 step ≤ 1.2× the Ortega baseline's in the same run"),
 //! measured so that the machine's drift cancels.
 //!
 //! criterion times each estimator in its own few seconds, one after the other; on a shared

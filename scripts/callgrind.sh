@@ -49,7 +49,7 @@ for p in f32 f64; do
     per_step "host $p, inside isr_step only" --toggle-collect='*isr_step*' "$driver" "$p"
 done
 per_step "firmware image f32 (libm, LTO), whole program" "$image"
-# Issue 16's host ratio, f32 inside the step: fado's variants against the Ortega baseline (which
+# The host ratio, f32 inside the step: fado's variants against the Ortega baseline (which
 # shares fado's trackers and atan2, so the ratio is the cost of what each method adds).
 echo "f32 inside isr_step, fado's variants and the Ortega baseline"
 for v in "default (R̂s adaptation)=" "default, step_lean (firmware's call)=LEAN=1" \

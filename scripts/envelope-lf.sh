@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
-# The λ̂f × load envelope of the fig11 reversal, with and without the λ̂f law (issue 13):
+# The λ̂f × load envelope of the fig11 reversal, with and without the λ̂f law:
 #   1. `fado-sim sweep fig11` over flux_linkage_error (= λ̂f/λf − 1) −10…+10 % in 2.5 % steps ×
 #      load torque 0…7.5 N·m in 1.25 N·m steps (63 runs), switching-resolved, once with the
 #      defaults and once with `[estimator.flux_linkage_adaptation] rate = 0` (law off);
 #   2. docs/envelope-fig11-lf-load-{law-off,default}.csv, and docs/envelope-fig11-lf-load.png
-#      drawn from them (with the issue 13 second pass's per-sample law at 5 s⁻¹,
+#      drawn from them (with the per-sample law at 5 s⁻¹,
 #      docs/envelope-fig11-lf-load-after-lf5.csv, as the middle panel);
 #   3. the two markdown tables of the envelope on stdout (docs/results/envelopes.md).
 # Usage: bash scripts/envelope-lf.sh [fado-sim sweep options, e.g. --threads 1]
@@ -46,7 +46,7 @@ def grid(name):
 
 panels = [
     ("law-off", "λ̂f law off (flux_linkage_adaptation_rate = 0)"),
-    ("after-lf5", "issue 13 second pass: per-sample λ̂f law, 5 s⁻¹"),
+    ("after-lf5", "per-sample λ̂f law, 5 s⁻¹"),
     ("default", "defaults: revolution-mean λ̂f law (dead zone 1 %, following beyond 2 %)"),
 ]
 fig = Figure(figsize=(16.5, 5.0), layout="constrained")

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Runs every cargo-fuzz target of fuzz/ for a bounded time and reports (issue 6).
+# Runs every cargo-fuzz target of fuzz/ for a bounded time and reports.
 # Not part of CI: needs the nightly toolchain and cargo-fuzz (`cargo install cargo-fuzz`).
 #
 #   scripts/fuzz.sh [seconds-per-target] [target...]

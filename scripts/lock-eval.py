@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Loss-of-lock detector evaluation (issue 14): reads `fado-sim sweep` CSVs of the fig11
+"""Loss-of-lock detector evaluation: reads `fado-sim sweep` CSVs of the fig11
 envelope and prints the detection/false-alarm table of docs/method/lock.md; with --figure PNG draws
 the detection-delay distribution.
 

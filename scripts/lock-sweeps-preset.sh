@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The fig11-like loss-of-lock envelope of docs/method/lock.md on another motor (issue 14, "Other
+# The fig11-like loss-of-lock envelope of docs/method/lock.md on another motor ("Other
 # motors"): the ratings-scaled `reversal` scenario (fig11 on the paper's motor) of a preset of
 # motors/, with the same design as scripts/lock-sweeps.sh: R̂s error ±10 %, λ̂f error ±10 %,
 # L̂q error ±30 %, final load 0 … the preset's rated torque (fig11's 0 … 11.5 N·m is 0 … rated on

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The four fig11 envelope sweeps of docs/method/lock.md (issue 14): the paper's fixed R̂s and the R̂s
+# The four fig11 envelope sweeps of docs/method/lock.md: the paper's fixed R̂s and the R̂s
 # adaptation, each with and without the limiter-clamping symptom; 400 random points, seed 7.
 # usage: [SEED=N] [VARIANTS="fixed-rs adaptive"] scripts/lock-sweeps.sh OUT_DIR
 #        (then scripts/lock-eval.py, see docs/method/lock.md). SEED (default 7) draws other points of

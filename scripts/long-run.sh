@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Long run of issue 6: one simulated hour with the averaged plant and the f32 drive, (a) at
+# Long run: one simulated hour with the averaged plant and the f32 drive, (a) at
 # 300 r/min under 7.5 N·m and (b) at 0 r/min under 7.5 N·m. Runs the ignored tests of
 # crates/fado-sim/tests/long_run.rs in release and prints their per-minute tables (angle-error
 # statistics, magnitudes of λ1, D̂, the trackers' speed errors, the PI integrals, flag counts)

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Loss-of-lock false alarms on every motor preset (issue 14, docs/method/lock.md): runs
+# Loss-of-lock false alarms on every motor preset (docs/method/lock.md): runs
 # each preset of motors/ through the ratings-scaled scenarios (default: reversal and stops) for
 # sensor-noise seeds 1-4, as scripts/presets.sh does, with full-rate traces, and prints per run
 # the paper's verdict, max |θ − θ̂| over the whole run, whether LOCK_LOST (drive flag 128, the

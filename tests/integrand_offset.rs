@@ -70,7 +70,7 @@ fn a_voltage_offset_is_learned_and_does_not_walk_the_angle() {
 
 #[test]
 fn simulated_reversal_with_a_voltage_offset_passes() {
-    // Issue 13: fig11 (switching-resolved, default non-idealities) with 0.1 V on the α (and on
+    // fig11 (switching-resolved, default non-idealities) with 0.1 V on the α (and on
     // the β) voltage the drive believes it applies. Without the learned offset the angle
     // walks away in the limiter mode (measured 1.21 rad on α).
     use fado::sim::scenario::simulate;

@@ -82,12 +82,12 @@ fn adaptation_never_makes_a_passing_scenario_fail() {
 }
 
 #[test]
-fn fig10_over_eight_noise_seeds_both_paths_stay_within_issue_13s_bound() {
-    // Issue 13: fig10 < 0.25 rad on sensor seeds 1–8. Measured on main 967edfd (observer lag
+fn fig10_over_eight_noise_seeds_both_paths_stay_within_0_25_rad() {
+    // fig10 < 0.25 rad on sensor seeds 1–8. Measured (observer lag
     // compensation): fixed R̂s 8/8, worst 0.0613 rad; adapted 8/8, worst 0.0619 rad (0.0568 /
-    // 0.0570 with the edge-current dead-time compensation, branch issue-restart). Before
-    // the compensation the adapted path was the better one (worst 0.43 against 0.68 rad when
-    // the stop transient decided it); now both sit at the sensor-noise floor, so the adapted
+    // 0.0570 with the edge-current dead-time compensation). Without
+    // the compensation the adapted path is the better one (worst 0.43 against 0.68 rad when
+    // the stop transient decides it); with it both sit at the sensor-noise floor, so the adapted
     // path may not be worse than the fixed one by more than that noise (0.01 rad).
     let mut passed = [0, 0];
     let mut worst = [0.0f64, 0.0];
@@ -123,7 +123,7 @@ fn flux_linkage_error_needs_the_flux_linkage_law() {
     // A 10 % λ̂f error biases the turning R̂s law by Δλf·ω/i_q (7 % at −90 r/min, 7.5 N·m),
     // which loses the reversal that a fixed, right R̂s survives; learning λ̂f unloaded
     // (`flux_linkage_adaptation.rate`, on by default) restores it, with λ̂f too low or too
-    // high, and together with an R̂s error (issue 13).
+    // high, and together with an R̂s error.
     for case in [
         "flux_linkage_ratio = 0.9",
         "flux_linkage_ratio = 1.1",

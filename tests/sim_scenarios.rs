@@ -146,8 +146,8 @@ fn fig10_sensor_offset_walks_the_estimate_along_the_limiter_circle_at_e_t_over_r
     // Uncalibrated again, with the lag compensation (the default). Its walk, as the
     // least-squares slope of θ − θ̂ over the last 1.5 s (after the hold's transients): 0.91×
     // the paper input's with the trapezoidal dead-time compensation, 0.99× with the
-    // edge-current one (branch issue-restart). The end-point difference from 3.5 s read 0.07×
-    // on main e01a9cd only because a stop transient (−0.06 → −0.38 → −0.34 rad) ended there:
+    // edge-current one. The end-point difference from 3.5 s read 0.07×
+    // only because a stop transient (−0.06 → −0.38 → −0.34 rad) ended there:
     // the compensation does not slow this walk; it must not speed it up.
     let comp = run("fig10", Some(paper), false);
     let rows: Vec<_> = comp.trace.rows.iter().filter(|r| r.time >= 4.0).collect();
@@ -201,7 +201,7 @@ fn seed(seed: u64) -> String {
 
 #[test]
 fn fig8_paper_criterion_on_eight_sensor_seeds() {
-    // Issue 13: fig8 < 2 % on seeds 1–8 (the worst revolution's DC of λ2 − λs over λf). It
+    // fig8 < 2 % on seeds 1–8 (the worst revolution's DC of λ2 − λs over λf). It
     // failed on 2–3 of 8 seeds (2.03–2.23 %) until the observer's speed input carried
     // T2S-1's proportional term (`observer.lag_compensation`): 0.29–0.72 % measured since.
     for s in 1..=8 {
@@ -211,8 +211,8 @@ fn fig8_paper_criterion_on_eight_sensor_seeds() {
 }
 
 #[test]
-fn fig10_paper_criterion_on_eight_sensor_seeds_and_issue_13s_bound() {
-    // SPEC's 0.35 rad [A] and issue 13's tighter 0.25 rad, seeds 1–8 (measured 0.059–0.062).
+fn fig10_paper_criterion_on_eight_sensor_seeds_and_the_0_25_rad_bound() {
+    // the method's 0.35 rad [A] and fado's tighter 0.25 rad, seeds 1–8 (measured 0.059–0.062).
     for s in 1..=8 {
         let out = run("fig10", Some(&seed(s)), false);
         assert!(out.passed, "seed {s}: {:?}", out.checks);

@@ -45,8 +45,8 @@ PAPER_DEFAULTS = {
     },
     "observer": {
         "on_rotor_flux": True,  # fado's improvement [A]; False = paper's Fig. 5
-        "lag_compensation": True,  # fado's improvement [A] (issue 13); False = the paper
-        "gain_period": 4e-4,  # [A] (issue 16: gains held over 4 samples at 10 kHz); 0 = the paper
+        "lag_compensation": True,  # fado's improvement [A]; False = the paper
+        "gain_period": 4e-4,  # [A] (gains held over 4 samples at 10 kHz); 0 = the paper
     },
     "rs_adaptation": {
         "enabled": True,  # fado's extension [A]; False = the paper's fixed R̂s
@@ -57,7 +57,7 @@ PAPER_DEFAULTS = {
         "standstill_angle_rate": 2.0,  # [A]
     },
     "flux_linkage_adaptation": {
-        "rate": 5.0,  # [A] (issue 13: revolution mean, 1 % dead zone)
+        "rate": 5.0,  # [A] (revolution mean, 1 % dead zone)
     },
     "offset_adaptation": {
         "rate": 2.0,  # [A]
@@ -108,7 +108,7 @@ PAPER_MACHINE = {
     "dc_voltage": 311.0,
 }
 
-# The 2.2 kW interior-magnet motor of issue 11 (motulator's example), entered by hand.
+# The 2.2 kW interior-magnet motor (motulator's example), entered by hand.
 IPMSM = {
     "rs": 3.6,
     "ld": 36e-3,

@@ -277,7 +277,7 @@ def test_ipmsm_preset_replayed_through_estimate(
 
 @pytest.mark.parametrize("i_d_ratio", [-0.15, -0.5])
 def test_ipmsm_rs_adaptation_is_unbiased_under_negative_i_d(i_d_ratio: float) -> None:
-    """Issue 11 item 7: the R̂s laws compare |λ̂r| with the active flux λ̂f + (L̂d − L̂q)·î_d
+    """The R̂s laws compare |λ̂r| with the active flux λ̂f + (L̂d − L̂q)·î_d
     (before: R̂s 3.93 Ω for 3.6 Ω at i_d = −0.15·rated, 4.73 Ω at −0.5·rated)."""
     ipm = fado.Machine.preset("ipmsm-2k2")
     rec = ipmsm_recording(ipm, i_d_ratio)

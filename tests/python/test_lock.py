@@ -1,4 +1,4 @@
-"""Issue 14: implausible samples, the loss-of-lock output, and non-finite scalar arguments."""
+"""Implausible samples, the loss-of-lock output, and non-finite scalar arguments."""
 
 from __future__ import annotations
 

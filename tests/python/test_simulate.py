@@ -148,12 +148,12 @@ def test_estimator_replay_reproduces_the_in_loop_estimate() -> None:
 def test_replay_with_a_voltage_offset_stays_within_the_papers_bound(
     offset: tuple[float, float],
 ) -> None:
-    """Issue 13: the paper's reversal with a constant 0.1 V offset on one stationary-axis
+    """The paper's reversal with a constant 0.1 V offset on one stationary-axis
     voltage, replayed, stays below 0.25 rad near zero speed. The replay is the one above
     (bit-identical to the drive's estimator without the offset), switching-resolved, with the
     offset added to the voltage the estimator is given (the drive does not react to the
-    estimator's error). Measured on main e198452: 0.066 / 0.044 / 0.031 / 0.113 rad for
-    +α / +β / −α / −β, 0.090 without the offset; on main before issue 13, 0.51 rad."""
+    estimator's error). Measured: 0.066 / 0.044 / 0.031 / 0.113 rad for
+    +α / +β / −α / −β, 0.090 without the offset; 0.51 rad with the paper's fixed-gain path."""
     config = {
         "simulation": {"decimation": 1},
         "controller": {"offset_calibration_time": 0.0, "gain_calibration_time": 0.0},

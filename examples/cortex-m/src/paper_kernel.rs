@@ -6,7 +6,7 @@
 //! `limiter.recentring` all `false`, `disturbance_feedback.ramp_time` and `observer.gain_period` 0), with the
 //! same discretisation and the same arithmetic in the same order, the trackers' conversions
 //! between radians and fixed-point units folded into their gains (Ki·Ts·2π/2³², Ts·2³²/2π) as
-//! fado's trackers fold them since issue 16's sixth session (before, fado multiplied by the
+//! fado's trackers fold them (unfolded, fado would multiply by the
 //! unit at each conversion and the two differed at the `f32` rounding level, within 1e-6 rad).
 //! The image checks, sample by sample, that the kernel's θ̂ stays within 1e-4 rad of fado's
 //! and its mode equal (measured: the same θ̂ and ω̂ to the bit, docs/results/firmware-cost.md):
