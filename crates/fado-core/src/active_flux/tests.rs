@@ -39,23 +39,7 @@ fn ipm_qsat(a_dq: f64) -> Magnetics<'static, f64> {
 
 /// The pmsyrm-baldor-5k6 preset's model (motulator's fit, with the rib).
 fn baldor() -> Magnetics<'static, f64> {
-    Magnetics::Saturation(Saturation {
-        a_d0: 3.96,
-        a_dd: 28.5,
-        s: 4.0,
-        a_q0: 5.89,
-        a_qq: 2.67,
-        t: 6.0,
-        a_dq: 41.5,
-        u: 1.0,
-        v: 1.0,
-        psi_n: 0.804,
-        a_b: 81.75,
-        a_bp: 1.0,
-        w: 2.0,
-        k_q: 0.1,
-        ..Saturation::default()
-    })
+    Magnetics::Saturation(crate::magnetics::tests::pmsyrm())
 }
 
 /// A 17 × 17 flux map of the Baldor model over ±25 A (twice its rated current), leaked as a

@@ -19,8 +19,9 @@ pub(crate) fn syrm() -> Saturation<f64> {
     }
 }
 
-/// The 5.6 kW PM-SyRM (Baldor ECS101M0H7EF4) fit of motulator's example, with the rib.
-fn pmsyrm() -> Saturation<f64> {
+/// The 5.6 kW PM-SyRM (Baldor ECS101M0H7EF4) fit of motulator's example, with the rib (the
+/// pmsyrm-baldor-5k6 preset's model; the other test modules take it from here).
+pub(crate) fn pmsyrm() -> Saturation<f64> {
     Saturation {
         a_d0: 3.96,
         a_dd: 28.5,

@@ -33,23 +33,7 @@ fn machine(a_dq: f64) -> MachineModel<f64> {
 }
 
 fn baldor() -> MachineModel<f64> {
-    let sat = Saturation {
-        a_d0: 3.96,
-        a_dd: 28.5,
-        s: 4.0,
-        a_q0: 5.89,
-        a_qq: 2.67,
-        t: 6.0,
-        a_dq: 41.5,
-        u: 1.0,
-        v: 1.0,
-        psi_n: 0.804,
-        a_b: 81.75,
-        a_bp: 1.0,
-        w: 2.0,
-        k_q: 0.1,
-        ..Saturation::default()
-    };
+    let sat = crate::magnetics::tests::pmsyrm();
     MachineModel {
         rs: 0.63,
         ld: 0.0298,
