@@ -99,7 +99,8 @@ impl<C: Controller> Simulation<C> {
         };
         let act = self.controller.step(&m);
         self.tripped |= act.tripped;
-        if self.plant.brake_engaged() && self.controller.ready() {
+        let ready = self.controller.ready();
+        if self.plant.brake_engaged() && ready {
             self.plant.release_brake();
         }
         let st = *self.plant.motor().state();
@@ -119,6 +120,8 @@ impl<C: Controller> Simulation<C> {
             pole_pairs: self.pole_pairs,
             dc_voltage: self.plant.inverter().dc_voltage(),
             brake_engaged: self.plant.brake_engaged(),
+            ready,
+            startup: self.controller.startup_status(),
             act,
         };
         self.plant.step(act.duty, act.gates_enabled);
