@@ -77,6 +77,8 @@ pub trait Controller {
     fn startup_status(&self) -> StartupStatus {
         StartupStatus::Idle
     }
+    /// The plant's brake has released (a drive re-arms its release hold). Default: nothing.
+    fn brake_released(&mut self) {}
 }
 
 /// A boxed controller (an estimator chosen at run time from
@@ -100,5 +102,8 @@ impl<C: Controller + ?Sized> Controller for Box<C> {
     }
     fn startup_status(&self) -> StartupStatus {
         (**self).startup_status()
+    }
+    fn brake_released(&mut self) {
+        (**self).brake_released();
     }
 }

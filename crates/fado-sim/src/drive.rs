@@ -21,6 +21,10 @@ where
         SensorlessDrive::startup_status(self)
     }
 
+    fn brake_released(&mut self) {
+        self.arm_release_hold();
+    }
+
     #[inline]
     fn step(&mut self, m: &Measurements) -> Actuation {
         let out = SensorlessDrive::step(self, m.i_abc, m.vdc, m.speed_ref_mech);
@@ -111,6 +115,10 @@ impl Controller for DriveF32 {
 
     fn startup_status(&self) -> StartupStatus {
         self.0.startup_status()
+    }
+
+    fn brake_released(&mut self) {
+        self.0.arm_release_hold();
     }
 
     #[inline]

@@ -36,7 +36,8 @@ use crate::control::initial_angle::{
     InitialAngleStatus,
 };
 use crate::error::{ConfigError, check};
-use crate::{Ab, MachineModel, Real};
+use crate::magnetics::MagneticModel;
+use crate::{Ab, Dq, MachineModel, Real};
 
 /// Pulse pairs per direction of the polarity test (the relative difference of the two sums
 /// is averaged over four pairs: its noise halves against one pair).
@@ -136,6 +137,26 @@ impl<T: Real> StartupTuning<T> {
     }
 }
 
+/// Whether the drive's magnetic model meets a larger incremental d inductance along +d (with
+/// the magnet) than along −d over the pulse's path from 0 to `current`: then the faster rise
+/// points against the magnet (a PM-assisted synchronous reluctance rotor whose bridges the
+/// magnet saturates and a negative d current relieves). A constant-inductance model gives no
+/// sign: false, the usual case of a magnet rotor whose d-axis iron saturates further with
+/// the magnet's flux (the polarity tests of drives, `initial_angle`'s module docs).
+pub fn inverted_polarity<T: Real>(machine: &MachineModel<T>, current: T) -> bool {
+    if machine.magnetics.is_linear() || !(current > T::zero()) {
+        return false;
+    }
+    let m = machine.magnetic_model();
+    let (mut plus, mut minus) = (T::zero(), T::zero());
+    for k in 1..=4 {
+        let i = current * T::from_index(k) * T::lit(0.25);
+        plus += m.incremental_inductance(Dq::new(i, T::zero())).dd;
+        minus += m.incremental_inductance(Dq::new(-i, T::zero())).dd;
+    }
+    plus > minus
+}
+
 /// Where the start-up's angle phase stands.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum StartupStatus {
@@ -194,6 +215,9 @@ pub struct AngleSearch<T> {
     l_min: T,
     l_mean: T,
     d_larger: bool,
+    /// The model's d axis meets the larger incremental inductance along +d than along −d
+    /// ([`inverted_polarity`]): the faster rise then points against the magnet.
+    inverted: bool,
     align_samples: u32,
     stage: Stage<T>,
     status: StartupStatus,
@@ -221,6 +245,10 @@ impl<T: Real> AngleSearch<T> {
             l_min: crate::real::min(machine.ld, machine.lq),
             l_mean: T::lit(0.5) * (machine.ld + machine.lq),
             d_larger: machine.ld > machine.lq,
+            inverted: inverted_polarity(
+                machine,
+                tuning.pulse_current_ratio * machine.rated_current,
+            ),
             align_samples,
             stage: Stage::Idle,
             status: StartupStatus::Idle,
@@ -367,7 +395,14 @@ impl<T: Real> AngleSearch<T> {
         }
     }
 
+    /// `angle`: the direction of the faster rise (the magnet's unless the model says
+    /// otherwise).
     fn found(&mut self, angle: T) -> StartupCommand<T> {
+        let angle = if self.inverted {
+            angle + T::pi()
+        } else {
+            angle
+        };
         self.angle = crate::wrap_angle(angle);
         self.status = StartupStatus::Found;
         self.stage = Stage::Done;

@@ -257,6 +257,11 @@ pub(super) fn checks_loaded_start(
         ),
         back,
         motion,
+        (
+            "|θ − θ̂| at the angle found (rad; none: 0)",
+            st.found_angle_error.unwrap_or(0.0),
+            0.25,
+        ),
         ("max |θ − θ̂| from ready on (rad)", st.max_angle_error, 0.25),
         ("speed error at the end (r/min)", st.end_speed_error(), band),
     ];

@@ -69,6 +69,8 @@ pub struct StartStats {
     pub end_from: f64,
     /// The drive's start-up angle phase at the last sample.
     pub startup: fado_core::control::StartupStatus,
+    /// |θ − θ̂| at the sample the start-up found its angle (rad; None: it found none).
+    pub found_angle_error: Option<f64>,
     travel: f64,
     theta0: Option<f64>,
     last_theta: Option<f64>,
@@ -84,6 +86,10 @@ impl StartStats {
     }
 
     fn observe(&mut self, s: &Sample) {
+        let found = fado_core::control::StartupStatus::Found;
+        if s.startup == found && self.startup != found {
+            self.found_angle_error = Some(s.angle_error.abs());
+        }
         self.startup = s.startup;
         if let Some(prev) = self.last_theta {
             self.travel += fado_core::wrap_angle(s.theta - prev);

@@ -13,6 +13,11 @@ pub const LOADED_START_MAX_BACK: f64 = 0.5;
 /// `loaded-start`: the speed reference is 0 until this time (s), longer than every preset's
 /// start-up (offset and gain calibrations), then ramps to the target in 1 s.
 pub(super) const LOADED_START_RAMP_AT: f64 = 1.0;
+/// `loaded-start`: the brake opens this long (s) before the lift, once the drive is ready
+/// (a hoist's brake sequence: open, hold, lift), so that the loaded rotor does not stand on
+/// the drive alone for however long its start-up left. 0.1 s \[A\]: the release hold's
+/// settling (10/ω_h) on every preset.
+pub const LOADED_START_BRAKE_LEAD: f64 = 0.3;
 /// `loaded-start`: duration (s); the speed is judged over its last 0.5 s.
 pub(super) const LOADED_START_DURATION: f64 = 3.0;
 
@@ -121,6 +126,7 @@ pub(super) fn setup_loaded_start(c: &mut SimConfig) {
     let n = REVERSAL_SPEED_RATIO * c.motor.rated_speed_rpm;
     let t0 = LOADED_START_RAMP_AT;
     c.simulation.brake = true;
+    c.simulation.brake_release_at = t0 - LOADED_START_BRAKE_LEAD;
     c.controller.release_hold.enabled = true;
     c.controller.startup.find_angle = true;
     c.simulation.initial_angle = loaded_start_angle(c.current_sensor.seed);
