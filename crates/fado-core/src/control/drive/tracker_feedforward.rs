@@ -133,6 +133,17 @@ pub fn load_step_peak<T: Real>(damping: T, c: T) -> T {
     peak
 }
 
+/// The type-2 gains (Kp, Ki) of the estimator's T2S-1 sampled every `ts`.
+fn t2s1_gains<T: Real>(estimator: &EstimatorTuning<T>, ts: T) -> (T, T) {
+    let t = &estimator.tracker;
+    TrackerConfig {
+        damping: t.damping,
+        definition: t.bandwidth_definition,
+        ..TrackerConfig::new(t.t2s1_bandwidth_hz, ts)
+    }
+    .gains()
+}
+
 /// T2S-1's bandwidth (Hz, in the tuning's own definition) at which a step of the rated load
 /// torque peaks at `load_step_error` in the type-3 tracker (module docs); the tuning's own
 /// bandwidth where that is already enough, at most the one of Kp·Ts = [`MAX_KP_TS`].
@@ -143,12 +154,7 @@ pub fn load_step_bandwidth<T: Real>(
     ts: T,
 ) -> T {
     let t = &estimator.tracker;
-    let tracker = TrackerConfig {
-        damping: t.damping,
-        definition: t.bandwidth_definition,
-        ..TrackerConfig::new(t.t2s1_bandwidth_hz, ts)
-    };
-    let wn = tracker.gains().1.sqrt();
+    let wn = t2s1_gains(estimator, ts).1.sqrt();
     let alpha = T::lit(machine.pole_pairs as f64) * machine.rated_torque / machine.inertia;
     let kappa = load_step_peak(t.damping, t.load_pole_ratio);
     let wn_needed = (kappa * alpha / drive.tracker_feedforward.load_step_error).sqrt();
@@ -170,12 +176,7 @@ pub fn current_limit_lag<T: Real>(
     estimator: &EstimatorTuning<T>,
     ts: T,
 ) -> T {
-    let tracker = TrackerConfig {
-        damping: estimator.tracker.damping,
-        definition: estimator.tracker.bandwidth_definition,
-        ..TrackerConfig::new(estimator.tracker.t2s1_bandwidth_hz, ts)
-    };
-    let (_, ki) = tracker.gains();
+    let (_, ki) = t2s1_gains(estimator, ts);
     let ratio = crate::real::min(drive.current_limit_ratio, drive.limits.torque_ratio);
     let p = T::lit(machine.pole_pairs as f64);
     p * ratio * machine.rated_torque / (machine.inertia * ki)
