@@ -1,7 +1,8 @@
 //! The `loaded-start` scenario: a plant brake that holds the rotor until the drive reports
-//! ready, the rated torque on it, and the start-up judged from the release on.
+//! ready, the rated torque on it, the drive finding the rotor's angle itself, and the
+//! start-up judged from t = 0.
 
-use fado_sim::controller::Controller;
+use fado_core::control::StartupStatus;
 use fado_sim::scenario::{loaded_start_angle, scenario_config, simulate};
 
 fn preset_toml(name: &str) -> String {
@@ -9,19 +10,24 @@ fn preset_toml(name: &str) -> String {
 }
 
 #[test]
-fn the_brake_holds_the_rotor_until_the_drive_reports_ready() {
-    // Two motors: the brake takes the rated torque through both calibrations (the rotor does
-    // not move at all), and releases at the drive's first ready sample, not before.
+fn the_brake_holds_the_rotor_until_the_drive_is_ready_and_the_drive_finds_the_angle() {
+    // Two motors: the brake takes the rated torque through the calibrations and the angle
+    // search (the rotor does not move at all) and releases at the first ready sample from
+    // `brake_release_at` on. The drive is aligned 2 rad off the rotor: with `find_angle` it
+    // ignores that and starts from the angle its pulses find.
     for name in ["paper", "ipmsm-2k2"] {
-        let cfg = scenario_config("loaded-start", Some(&preset_toml(name)), false).unwrap();
+        let mut cfg = scenario_config("loaded-start", Some(&preset_toml(name)), false).unwrap();
+        cfg.simulation.align_error = 2.0;
         let theta0 = cfg.simulation.initial_angle;
         let mut sim = cfg.simulation(cfg.build_drive().unwrap()).unwrap();
-        let mut released = None;
+        let (mut released, mut found) = (None, None);
         for _ in 0..20_000 {
             let s = sim.step();
             let ready = sim.controller().ready();
+            if found.is_none() && s.startup == StartupStatus::Found {
+                found = Some(s.angle_error.abs());
+            }
             if s.brake_engaged {
-                assert!(!ready, "{name}: ready but braked at {}", s.time);
                 assert_eq!(
                     s.theta, theta0,
                     "{name}: moved under the brake at {}",
@@ -36,9 +42,13 @@ fn the_brake_holds_the_rotor_until_the_drive_reports_ready() {
             }
         }
         let t = released.expect("released");
-        println!("{name}: released at {t:.4} s");
-        // After the offset calibration (0.1 s) and the gain calibration.
-        assert!(t > 0.1 && t < 1.0, "{name}: {t}");
+        let e = found.expect("found");
+        println!("{name}: angle found within {e:.4} rad, released at {t:.4} s");
+        assert!(e < 0.05, "{name}: {e}");
+        assert!(
+            t >= cfg.simulation.brake_release_at && t < 1.0,
+            "{name}: {t}"
+        );
     }
 }
 
