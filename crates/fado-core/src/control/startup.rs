@@ -21,7 +21,7 @@
 //! 2. polarity test (status `AxisOnly` only): [`POLARITY_PAIRS`] pulse pairs along +axis and
 //!    as many along −axis with `polarity_current_ratio` × the rated current; the direction
 //!    whose current rises faster is the magnet's (a relative difference of at least
-//!    [`DEFAULT_MIN_POLARITY`](crate::control::initial_angle::DEFAULT_MIN_POLARITY));
+//!    [`DEFAULT_MIN_POLARITY`]);
 //! 3. the result: `Found` → the drive starts from the angle; otherwise the free-rotor
 //!    alignment or [`StartupStatus::NoAngle`].
 
@@ -144,7 +144,7 @@ impl<T: Real> StartupTuning<T> {
 /// sign: false, the usual case of a magnet rotor whose d-axis iron saturates further with
 /// the magnet's flux (the polarity tests of drives, `initial_angle`'s module docs).
 pub fn inverted_polarity<T: Real>(machine: &MachineModel<T>, current: T) -> bool {
-    if machine.magnetics.is_linear() || !(current > T::zero()) {
+    if machine.magnetics.is_linear() || !current.is_finite() || current <= T::zero() {
         return false;
     }
     let m = machine.magnetic_model();

@@ -73,10 +73,13 @@ impl<T: Real> PolarityTest<T> {
             return Ab::zero();
         }
         let n = self.n;
-        let pair = self.sample / (3 * n);
-        let phase = self.sample % (3 * n);
+        // A non-zero divisor: no division that can panic in the per-sample path.
+        let period =
+            core::num::NonZeroU32::new(n.saturating_mul(3)).unwrap_or(core::num::NonZeroU32::MIN);
+        let pair = self.sample / period;
+        let phase = self.sample % period;
         let (s, c) = self.axis.step_sin_cos_any();
-        let u = if pair % 2 == 0 {
+        let u = if pair.is_multiple_of(2) {
             Ab::new(c, s)
         } else {
             Ab::new(-c, -s)
@@ -112,7 +115,7 @@ impl<T: Real> PolarityTest<T> {
         if pair == 0 {
             return;
         }
-        if (pair - 1) % 2 == 0 {
+        if (pair - 1).is_multiple_of(2) {
             self.sums.0 += self.peak;
         } else {
             self.sums.1 += self.peak;
