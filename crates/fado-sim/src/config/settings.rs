@@ -74,6 +74,7 @@ impl SimulationSettings {
         check::finite("initial_angle", self.initial_angle)?;
         check::finite("align_error", self.align_error)?;
         check::non_negative("eval_start", self.eval_start)?;
+        check::non_negative("brake_release_at", self.brake_release_at)?;
         check::positive("zero_speed_band_ratio", self.zero_speed_band_ratio)?;
         for (k, w) in self.disturbance_feedback_off.iter().enumerate() {
             if !(w[0].is_finite() && w[1].is_finite() && w[0] <= w[1]) {
