@@ -197,7 +197,7 @@ impl<T: Real> EstimatorState<T> {
     }
 
     /// Step 4: both trackers on the direct angle θm, or coasting while |λ̂r| is below the hold
-    /// level.
+    /// level; T2S-1 with its running gains in disturbance-feedback mode.
     #[inline(always)]
     fn track(
         &self,
@@ -211,8 +211,15 @@ impl<T: Real> EstimatorState<T> {
                 p.t2s2.coasted_state(&self.t2s2),
             )
         } else {
+            // Above the mode threshold T2S-1 runs at its running bandwidth (the last
+            // sample's mode: the one this sample's angle was integrated in).
+            let t2s1 = if self.mode == Mode::DisturbanceFeedback {
+                &p.t2s1_running
+            } else {
+                &p.t2s1
+            };
             (
-                p.t2s1.next_state(&self.t2s1, theta_direct),
+                t2s1.next_state(&self.t2s1, theta_direct),
                 // Both trackers have the same Ts: T2S-1's Ts in angle units, loaded once.
                 p.t2s2
                     .next_state_with(&self.t2s2, theta_direct, p.t2s1.ts_units()),
