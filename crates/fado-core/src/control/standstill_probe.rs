@@ -264,6 +264,11 @@ impl<T: Real> StandstillProbe<T> {
         self.reading
     }
 
+    /// The gate held at the last sample (a loaded standstill, probing or arming).
+    pub fn gated(&self) -> bool {
+        self.gated != 0
+    }
+
     /// Probing now (the gate has held for a period).
     pub fn active(&self) -> bool {
         self.gated >= self.period_samples
