@@ -30,6 +30,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         probe.step(
             gate,
             iq_torque,
+            estimate.omega_control,
             (last.d, last.q),
             m.flux_linkage,
             m.ld - m.lq,
