@@ -8,19 +8,14 @@
 
 use fado_sim::scenario::simulate;
 
-fn motor(file: &str) -> String {
-    std::fs::read_to_string(
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../motors")
-            .join(file),
-    )
-    .unwrap()
-}
+const GEM_50K: &str = include_str!("../../../motors/ipmsm-gem-50k.toml");
+const PMSYRM_5K: &str = include_str!("../../../motors/pmsyrm-5k.toml");
+const IPMSM_QSAT: &str = include_str!("../../../motors/saturated/ipmsm-2k2-qsat.toml");
 
 /// The largest |θ − θ̂| (rad) from the stop at zero speed reference after the top speed to
 /// 0.5 s after the reference leaves zero again, and whether the run tripped.
-fn standstill(file: &str, extra: &str) -> (f64, bool) {
-    let text = format!("{}\n{extra}", motor(file));
+fn standstill(motor: &str, extra: &str) -> (f64, bool) {
+    let text = format!("{motor}\n{extra}");
     let out = simulate("fullrange", Some(&text), false, None).unwrap();
     let rows = &out.trace.rows;
     let top = rows
@@ -48,9 +43,9 @@ fn standstill(file: &str, extra: &str) -> (f64, bool) {
 
 #[test]
 fn loaded_standstill_and_departure_hold_the_angle_on_interior_magnet_rotors() {
-    for file in ["ipmsm-gem-50k.toml", "pmsyrm-5k.toml"] {
-        let (with, tripped) = standstill(file, "");
-        let (without, _) = standstill(file, "[controller]\nstandstill_probe = false\n");
+    for (file, motor) in [("ipmsm-gem-50k", GEM_50K), ("pmsyrm-5k", PMSYRM_5K)] {
+        let (with, tripped) = standstill(motor, "");
+        let (without, _) = standstill(motor, "[controller]\nstandstill_probe = false\n");
         println!("{file}: {with:.3} rad (without the standstill handling {without:.3})");
         assert!(with < 0.25 && !tripped, "{file}: {with} rad");
         assert!(
@@ -62,7 +57,7 @@ fn loaded_standstill_and_departure_hold_the_angle_on_interior_magnet_rotors() {
 
 #[test]
 fn loaded_standstill_and_departure_hold_the_angle_on_a_saturating_rotor() {
-    let (with, tripped) = standstill("saturated/ipmsm-2k2-qsat.toml", "");
+    let (with, tripped) = standstill(IPMSM_QSAT, "");
     println!("ipmsm-2k2-qsat: {with:.3} rad");
     assert!(with < 0.25 && !tripped, "{with} rad");
 }

@@ -30,23 +30,48 @@
 //! Extremum-Seeking Control*, Wiley 2003, ch. 1–2: a periodic probe, correlation with the
 //! probe over whole periods): Δi_d = +A over the first half of each period, −A over the
 //! second, each level reached by a ramp over the first quarter of its half (a trapezoid: a
-//! step kicks the rotor through the speed loop); τ is correlated with the sign over the
-//! second half of each half-period (the speed loop has settled there; a constant load and a
-//! slow ramp of τ cancel over the period), so that Δτ = mean(τ·s) and δ̂ follows at the end
-//! of each period.
+//! step kicks the rotor through the speed loop); the torque balance is correlated with the
+//! sign over the second half of each half-period (a constant load and a slow ramp of τ cancel
+//! over the period), so that Δτ = mean(τ_b·s) and δ̂ follows at the end of each period.
 //!
-//! **Correction.** The estimator turns θ̂ at the rate g·δ̂ (rad/s, held over the next period),
-//! by g·δ̂·Ts per sample through [`crate::estimator::SensorlessEstimator::turn_angle`], the
-//! mechanism of the no-load standstill angle law of `crate::rs_adaptation`, of which this is
-//! the loaded counterpart: a first-order loop per period with g·T_p = 1/2 (half the deadbeat
-//! gain, with the half-period lag of the measurement), whose steady error under a creep c is
-//! c/g. Bounded at |δ̂| ≤ 0.5 rad (the first-order reading's range).
+//! **Torque balance without a settled speed loop.** The speed loop's τ equals the load and
+//! the probe's torque error only once the rotor has stopped accelerating; before that τ also
+//! carries the rotor's acceleration. The reading removes it: τ_b = τ − c_J·dω̂/dt with
+//! c_J = Ĵ/(1.5·p²·λ̂f), the torque demand per rad/s² of electrical acceleration, summed over
+//! a window as c_J·(ω̂_end − ω̂_before)/Ts. The window then needs only a settled current loop
+//! and speed estimate (the 35 Hz tracker's 4.5 ms time constant), not the 5 Hz speed loop's
+//! 0.16 s zero: the default period is 0.1 s instead of 0.5 s, a window of 25 ms.
+//!
+//! **Correction.** The estimator turns θ̂ at the rate g·δ̂ + ĉ (rad/s, held over the next
+//! period), by that rate·Ts per sample through
+//! [`crate::estimator::SensorlessEstimator::turn_angle`] (the mechanism of the no-load
+//! standstill angle law of `crate::rs_adaptation`, of which this is the loaded counterpart);
+//! ĉ learns the creep, ĉ ← ĉ + h·δ̂ per period. Per period, with the error x_k after period k,
+//! the reading r_k = (x_(k−1) + x_k)/2 (the windows lie across the period) and the turn
+//! g·r_k + ĉ_k held over the next period, the error obeys
+//! 2z³ + (G + H − 4)·z² + (2 + H)·z − G = 0 with G = g·T_p and H = h·T_p. A triple pole p0
+//! needs G = 2·p0³, H = 6·p0² − 2 and (p0 + 1)³ = 4: p0 = 0.587, G = 0.405, H = 0.070
+//! ([`TRIPLE_POLE`], [`TRIPLE_POLE_GAIN`], [`CREEP_GAIN_RATIO`] = H/G). The error of a
+//! step of creep decays by 0.587 per period, and a constant creep c leaves none (a
+//! proportional turn leaves c/g). δ̂ is bounded at ±0.5 rad (the first-order reading's
+//! range) and ĉ at ±0.5·g.
 //!
 //! **Gate.** Only at a loaded standstill: |ω*| below a small fraction of the rated speed,
 //! |τ| above a fraction of the rated current, the estimator in limiter mode, the lock
-//! supervisor running normally; the probe starts after the gate has held for one period (not
-//! in a passage through zero or a short stop), and stops (Δi_d = 0, no turn) the sample the
-//! gate opens.
+//! supervisor running normally; the probe starts after the gate has held for the arming time
+//! (not in a passage through zero or a short stop), and stops (Δi_d = 0, no turn, ĉ
+//! forgotten) the sample the gate opens.
+//!
+//! **Flux-magnitude hold.** While the probe runs, the drive also holds the estimate's rotor
+//! flux on the model's circle, |λ̂r| = λ̂a at the last current reference
+//! ([`crate::estimator::SensorlessEstimator::hold_flux_magnitude`], radially at the limiter's
+//! rate k_af; the angle is untouched). The radial part of the integrand error otherwise
+//! drives |λ̂r| to the limiter's radius 1.15·λ̂f, an offset of λ1 fixed in the stator frame:
+//! when the rotor leaves, that offset is an angle error of up to its size over λ̂f
+//! (0.1–0.15 rad, oscillating at the rotor's frequency until the disturbance observer learns
+//! it). Held throughout rather than set once at the departure: measured on the presets'
+//! `fullrange`, a single reset at the departure loses most of the gain (ipmsm-gem-50k
+//! still loses 0.7–1.1 rad).
 
 use crate::Real;
 use crate::error::{ConfigError, check};
