@@ -11,6 +11,7 @@ use crate::control::modulation::VoltageLimit;
 use crate::control::ratings_limit::RatingsLimitTuning;
 use crate::control::release_hold::ReleaseHoldTuning;
 use crate::control::standstill_probe;
+use crate::control::startup::StartupTuning;
 use crate::control::tracker_feedforward::TrackerFeedforwardTuning;
 use crate::control::{current_controller, delay_compensation, gain_calibration, speed_controller};
 use crate::injection;
@@ -202,6 +203,13 @@ pub struct DriveTuning<T> {
         serde(bound(deserialize = "T: Real + serde::Deserialize<'de>"))
     )]
     pub release_hold: ReleaseHoldTuning<T>,
+    /// How the start-up finds the rotor's angle (`[controller.startup]`, see
+    /// [`StartupTuning`]).
+    #[cfg_attr(
+        feature = "serde",
+        serde(bound(deserialize = "T: Real + serde::Deserialize<'de>"))
+    )]
+    pub startup: StartupTuning<T>,
     /// Reaction to the estimator's [`LockStatus::Lost`](crate::LockStatus::Lost) (`DriveFlags::LOCK_LOST`) and, with
     /// `lock_reaction_on_stall`, to the stall symptom (`DriveFlags::STALLED`). Default report
     /// only \[A\] (the paper's behaviour plus the flags).
@@ -462,6 +470,7 @@ impl<T: Real> DriveTuning<T> {
             dc_link: self.dc_link.cast(),
             field_weakening: self.field_weakening.cast(),
             release_hold: self.release_hold.cast(),
+            startup: self.startup.cast(),
             limits: self.limits.cast(),
             tracker_feedforward: self.tracker_feedforward.cast(),
             lock_reaction: self.lock_reaction,
@@ -538,6 +547,7 @@ impl<T: Real> Default for DriveTuning<T> {
             dc_link: DcLinkTuning::default(),
             field_weakening: FieldWeakeningTuning::default(),
             release_hold: ReleaseHoldTuning::default(),
+            startup: StartupTuning::default(),
             limits: RatingsLimitTuning::default(),
             tracker_feedforward: TrackerFeedforwardTuning::default(),
             lock_reaction: LockReaction::ReportOnly,
