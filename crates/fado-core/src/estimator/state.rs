@@ -280,7 +280,7 @@ impl<T: Real> EstimatorState<T> {
         let lambda2 = stator_flux(lambda1, self.observer.disturbance());
         let lambda_r = rotor_flux(lambda2, self.integrator.last_current(), self.lq_secant);
         let n = lambda_r.norm_squared().step_sqrt();
-        if !(n > T::zero()) {
+        if n <= T::zero() || !n.is_finite() {
             return;
         }
         let pull = p.limiter.config().k_af * p.ts * (magnitude - n) / n;
