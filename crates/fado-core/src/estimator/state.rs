@@ -269,6 +269,27 @@ impl<T: Real> EstimatorState<T> {
         }
     }
 
+    /// Pulls |λ̂r| towards `magnitude` in limiter mode by k_af·Ts of the difference, along λ̂r
+    /// (the angle is untouched): the loaded standstill's flux-magnitude hold (see
+    /// [`crate::control::standstill_probe`]).
+    pub fn hold_flux_magnitude(&mut self, p: &EstimatorParams<T>, magnitude: T) {
+        if !magnitude.is_finite() || magnitude <= T::zero() || self.mode != Mode::Limiter {
+            return;
+        }
+        let lambda1 = self.integrator.flux();
+        let lambda2 = stator_flux(lambda1, self.observer.disturbance());
+        let lambda_r = rotor_flux(lambda2, self.integrator.last_current(), self.lq_secant);
+        let n = lambda_r.norm_squared().step_sqrt();
+        if n <= T::zero() || !n.is_finite() {
+            return;
+        }
+        let pull = p.limiter.config().k_af * p.ts * (magnitude - n) / n;
+        let held = lambda1 + lambda_r * pull.step_max(-T::one()).step_min(T::one());
+        if held.is_finite() {
+            self.integrator.commit(held, self.integrator.last_current());
+        }
+    }
+
     /// Clears a loss-of-lock verdict (as [`RotorAngleEstimator::rearm_lock_detector`](crate::estimator::RotorAngleEstimator::rearm_lock_detector)).
     pub fn rearm_lock_detector(&mut self) {
         self.lock = LockState::default();
