@@ -220,8 +220,8 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             return Err(self.angle_phase_step(i_abc, vdc));
         }
         if self.gain.pending() {
-            let theta0 = self.aligned_angle;
-            self.gain.start(theta0);
+            let axis = self.gain_axis();
+            self.gain.start(axis);
         }
         if self.gain.running() {
             return Err(self.gain_calibration_step(i_abc, vdc));
