@@ -32,6 +32,7 @@ pub fn phase_names() -> Vec<&'static str> {
         Phase::Resistance,
         Phase::InductanceD,
         Phase::InductanceQ,
+        Phase::Magnetics,
         Phase::Spin,
         Phase::Coast,
         Phase::Inertia,

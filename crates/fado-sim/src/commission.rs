@@ -13,10 +13,12 @@ use std::time::Instant;
 use fado_core::commissioning::{
     Commissioning, CommissioningConfig, CommissioningOutput, Identification, Phase, Status,
 };
+use fado_core::magnetics::{ConstantInductance, Magnetics};
 use fado_core::{Ab, MachineModel};
 use serde::Serialize;
 
 use crate::error::SimConfigError;
+use crate::magnetic_accuracy::{self, MagneticAccuracy};
 use crate::motor::MotorState;
 use crate::sim::{Plant, PlantParams};
 
@@ -157,6 +159,14 @@ pub struct CommissionOutcome {
     pub current_limit: f64,
     /// Largest |Δθ| of the rotor during the inductance tests, rad (electrical).
     pub rotor_motion_inductance: f64,
+    /// Largest |Δθ| of the rotor during the flux-linkage pulses from its angle at their
+    /// start, rad (electrical).
+    pub rotor_motion_magnetics: f64,
+    /// Largest |i| (true current) during the flux-linkage pulses, A.
+    pub max_current_magnetics: f64,
+    /// The identified magnetic model (its `[model.saturation]`, or its constant inductances)
+    /// against the plant's over the rated current range (when identified).
+    pub magnetic_accuracy: Option<MagneticAccuracy>,
     /// Stopped early by [`CommissionOptions::cancel`] (`status` is then `Running`).
     pub cancelled: bool,
 }
@@ -241,9 +251,11 @@ pub fn commission(
             break Status::Running;
         }
     };
+    let identification = proc.result().copied();
     Ok(CommissionOutcome {
         status,
-        identification: proc.result().copied(),
+        identification,
+        magnetic_accuracy: identification.map(|id| identified_accuracy(plant_params, &id)),
         truth: Truth::of(plant_params),
         trace,
         simulated_seconds: k as f64 * ts,
@@ -252,8 +264,25 @@ pub fn commission(
         max_current_reference: watch.max_ref,
         current_limit: proc.current_limit(),
         rotor_motion_inductance: watch.motion,
+        rotor_motion_magnetics: watch.motion_pulses,
+        max_current_magnetics: watch.max_i_pulses,
         cancelled,
     })
+}
+
+/// The identified magnetic model against the plant's ([`magnetic_accuracy`]).
+pub fn identified_accuracy(p: &PlantParams, id: &Identification<f64>) -> MagneticAccuracy {
+    let truth = magnetic_accuracy::plant_model(p);
+    let m = &id.model;
+    let identified = match id.saturation {
+        Some(s) => Magnetics::Saturation(s),
+        None => Magnetics::Constant(ConstantInductance {
+            ld: m.ld,
+            lq: m.lq,
+            flux_linkage: m.flux_linkage,
+        }),
+    };
+    magnetic_accuracy::compare(&truth, &identified, p.motor.rated_current)
 }
 
 /// What a run watches beyond the procedure's output: the largest current and current
@@ -265,6 +294,10 @@ struct Watch {
     motion: f64,
     /// The rotor's angle at the start of the inductance tests.
     theta_l: Option<f64>,
+    motion_pulses: f64,
+    max_i_pulses: f64,
+    /// The rotor's angle at the start of the flux-linkage pulses.
+    theta_p: Option<f64>,
 }
 
 impl Watch {
@@ -274,6 +307,12 @@ impl Watch {
         if matches!(out.phase, Phase::InductanceD | Phase::InductanceQ) {
             let t0 = *self.theta_l.get_or_insert(st.theta);
             self.motion = self.motion.max(fado_core::wrap_angle(st.theta - t0).abs());
+        }
+        if out.phase == Phase::Magnetics {
+            let t0 = *self.theta_p.get_or_insert(st.theta);
+            let d = fado_core::wrap_angle(st.theta - t0).abs();
+            self.motion_pulses = self.motion_pulses.max(d);
+            self.max_i_pulses = self.max_i_pulses.max(st.i_dq.norm());
         }
     }
 }
@@ -395,6 +434,11 @@ pub fn identified_toml(input: &str, id: &Identification<f64>) -> Result<String, 
         "pole_pairs".into(),
         toml::Value::Integer(i64::from(m.pole_pairs)),
     );
+    if let Some(s) = &id.saturation {
+        let table = toml::Value::try_from(s)
+            .map_err(|e| SimConfigError::new("model.saturation", e.to_string()))?;
+        model.insert("saturation".into(), table);
+    }
     doc.insert("model".into(), toml::Value::Table(model));
     // The identified threshold to the drive's dead-time compensation (its dead time is the
     // configured one, as the procedure's); a slightly negative result (noise about a zero
@@ -413,7 +457,8 @@ pub fn identified_toml(input: &str, id: &Identification<f64>) -> Result<String, 
          # Inverter voltage error {:.4} V per phase (threshold {:.4} V at {:.1} V DC link), \
          saliency Lq/Ld {:.4}.\n\
          # Current sensors' gain ratio k = {:.5} (1-sigma {:.1e}): phase a was divided by it, \
-         so the model is in phase b's scale, the drive's after its start-up gain calibration.\n",
+         so the model is in phase b's scale, the drive's after its start-up gain calibration.\n\
+         {}",
         id.duration,
         c.rs,
         c.ld,
@@ -426,9 +471,33 @@ pub fn identified_toml(input: &str, id: &Identification<f64>) -> Result<String, 
         id.saliency,
         id.current_gain_ratio,
         c.current_gain_ratio,
+        saturation_comment(id),
     );
     let body = toml::to_string(&doc).map_err(|e| SimConfigError::new("<config>", e.to_string()))?;
     Ok(head + &body)
+}
+
+/// The header's statement on the magnetic model: saturation detected (the written
+/// `[model.saturation]`) or not (constant inductances), with the detection statistic.
+fn saturation_comment(id: &Identification<f64>) -> String {
+    let change = 100.0 * id.saturation_change;
+    let range = id.saturation_current;
+    if !id.saturation_change.is_finite() {
+        return "# Magnetic saturation: not measured (the flux-linkage pulses did not run).\n"
+            .into();
+    }
+    match id.saturation {
+        Some(_) => format!(
+            "# Magnetic saturation detected: the incremental inductances change by {change:.1} % \
+             up to {range:.3} A; [model.saturation] is the algebraic model fitted to the \
+             standstill flux-linkage pulses (RMS current residual {:.3e} A).\n",
+            id.saturation_residual
+        ),
+        None => format!(
+            "# No magnetic saturation detected: the incremental inductances change by \
+             {change:.1} % up to {range:.3} A; the model keeps constant inductances.\n"
+        ),
+    }
 }
 
 /// One row of the identified-vs-truth comparison.

@@ -155,7 +155,9 @@
 
 mod config;
 mod fits;
+mod flux_pulses;
 mod lifecycle;
+mod magnetic_fit;
 mod output;
 mod phase;
 mod saturation_fit;
@@ -166,13 +168,14 @@ mod standstill;
 #[cfg(test)]
 mod tests;
 
-pub use config::CommissioningConfig;
+pub use config::{CommissioningConfig, MagneticsTestConfig};
 pub use output::{CommissioningOutput, Confidence, Identification};
 pub use phase::{AbortReason, Parameter, Phase, Status};
 pub use saturation_fit::SaturationFit;
 
 use crate::{Ab, Dq};
 use fits::{BlockStats, EmfWindow, JFit, JWindows, Line, emf_line};
+use flux_pulses::{FluxPulses, magnetics_time};
 use sizing::{clamp, dc_level, dead_time_voltage, libm_round, limit, spin_sizing};
 
 /// The commissioning state machine (module docs).
@@ -245,6 +248,8 @@ pub struct Commissioning<T: 'static> {
     lq_sigma: T,
     flux: T,
     flux_sigma: T,
+    /// The standstill flux-linkage pulses and their samples.
+    pulses: FluxPulses<T>,
     /// Spin: control frame, synchronous PI, PLL.
     spin_loop: SpinLoop<T>,
     /// The two back-EMF windows: the coast at the spin speed and the one at J_HIGH × it.

@@ -407,10 +407,15 @@ impl<T: Real> Commissioning<T> {
             });
             return;
         }
+        let (saturation, saturation_change, saturation_residual, linear_residual) =
+            self.magnetic_result();
+        let (ld, lq) = saturation
+            .as_ref()
+            .map_or((self.ld, self.lq), Self::zero_current_inductances);
         let model = MachineModel {
             rs: self.rs,
-            ld: self.ld,
-            lq: self.lq,
+            ld,
+            lq,
             flux_linkage: self.flux,
             inertia: j,
             viscous_friction: b.max(T::zero()),
@@ -435,6 +440,11 @@ impl<T: Real> Commissioning<T> {
             saliency: self.lq / self.ld,
             dc_voltage: vdc,
             duration: self.t_total,
+            saturation,
+            saturation_change,
+            saturation_residual,
+            linear_residual,
+            saturation_current: self.pulse_current(),
         });
         self.status = Status::Done;
         self.nominal_done += self.t_phase;

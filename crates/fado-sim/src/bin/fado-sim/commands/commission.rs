@@ -65,6 +65,9 @@ pub fn commission(args: CommissionArgs) -> Outcome {
         return Ok(ExitCode::from(1));
     }
     print_parameters(&rows);
+    if let (Some(id), Some(a)) = (&o.identification, &o.magnetic_accuracy) {
+        print_magnetics(id, a, o.rotor_motion_magnetics);
+    }
     outln!(
         "wrote {}/identified.toml, metrics.json and traces.csv",
         dir.display()
@@ -166,6 +169,20 @@ fn write_outputs(
         "max_current_reference": o.max_current_reference,
         "current_limit": o.current_limit,
         "rotor_motion_inductance": o.rotor_motion_inductance,
+        "rotor_motion_magnetics": o.rotor_motion_magnetics,
+        "max_current_magnetics": o.max_current_magnetics,
+        "magnetics": o.identification.as_ref().map(|id| serde_json::json!({
+            "saturation_detected": id.saturation.is_some(),
+            "inductance_change": id.saturation_change,
+            "residual_rms": id.saturation_residual,
+            "linear_residual_rms": id.linear_residual,
+            "pulse_current": id.saturation_current,
+            "saturation": id.saturation.as_ref().map(|s| serde_json::json!({
+                "a_d0": s.a_d0, "a_dd": s.a_dd, "s": s.s, "a_q0": s.a_q0, "a_qq": s.a_qq,
+                "t": s.t, "a_dq": s.a_dq, "u": s.u, "v": s.v, "psi_f": s.psi_f, "i_f": s.i_f,
+            })),
+            "accuracy": o.magnetic_accuracy,
+        })),
         "seed": seed,
         "parameters": rows,
     });
@@ -205,6 +222,37 @@ fn write_outputs(
     }
     m.rename()?;
     Ok(())
+}
+
+/// The magnetic model: detected or not, and its errors over the rated current range.
+fn print_magnetics(
+    id: &fado_core::commissioning::Identification<f64>,
+    a: &fado_sim::magnetic_accuracy::MagneticAccuracy,
+    motion: f64,
+) {
+    let verdict = if id.saturation.is_some() {
+        "saturation detected: [model.saturation] written"
+    } else {
+        "no saturation detected: constant inductances"
+    };
+    outln!(
+        "magnetics: {verdict} (inductances change {:.1} % up to {:.3} A; rotor turned {:.3} rad)",
+        100.0 * id.saturation_change,
+        id.saturation_current,
+        motion
+    );
+    let pc = |s: &fado_sim::magnetic_accuracy::ErrorStats| {
+        format!("max {:.2} %, rms {:.2} %", 100.0 * s.max, 100.0 * s.rms)
+    };
+    outln!(
+        "  over |i| <= {:.3} A: incremental Ld {}, Lq {}; secant Ld {}, Lq {}; flux {}",
+        a.rated_current,
+        pc(&a.incremental_ld),
+        pc(&a.incremental_lq),
+        pc(&a.secant_ld),
+        pc(&a.secant_lq),
+        pc(&a.flux)
+    );
 }
 
 /// Each identified parameter against the truth: relative errors in %, absolute ones for the
