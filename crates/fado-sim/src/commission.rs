@@ -13,7 +13,7 @@ use std::time::Instant;
 use fado_core::commissioning::{
     Commissioning, CommissioningConfig, CommissioningOutput, Identification, Phase, Status,
 };
-use fado_core::magnetics::{ConstantInductance, Magnetics};
+use fado_core::magnetics::{ConstantInductance, Magnetics, Saturation};
 use fado_core::{Ab, MachineModel};
 use serde::Serialize;
 
@@ -164,9 +164,8 @@ pub struct CommissionOutcome {
     pub rotor_motion_magnetics: f64,
     /// Largest |i| (true current) during the flux-linkage pulses, A.
     pub max_current_magnetics: f64,
-    /// The identified magnetic model (its `[model.saturation]`, or its constant inductances)
-    /// against the plant's over the rated current range (when identified).
-    pub magnetic_accuracy: Option<MagneticAccuracy>,
+    /// The magnetic identification against the plant (when the pulses ran to their end).
+    pub magnetics: Option<MagneticsReport>,
     /// Stopped early by [`CommissionOptions::cancel`] (`status` is then `Running`).
     pub cancelled: bool,
 }
@@ -255,7 +254,7 @@ pub fn commission(
     Ok(CommissionOutcome {
         status,
         identification,
-        magnetic_accuracy: identification.map(|id| identified_accuracy(plant_params, &id)),
+        magnetics: MagneticsReport::of(&proc, plant_params, &nameplate),
         truth: Truth::of(plant_params),
         trace,
         simulated_seconds: k as f64 * ts,
@@ -270,19 +269,67 @@ pub fn commission(
     })
 }
 
-/// The identified magnetic model against the plant's ([`magnetic_accuracy`]).
-pub fn identified_accuracy(p: &PlantParams, id: &Identification<f64>) -> MagneticAccuracy {
-    let truth = magnetic_accuracy::plant_model(p);
-    let m = &id.model;
-    let identified = match id.saturation {
-        Some(s) => Magnetics::Saturation(s),
-        None => Magnetics::Constant(ConstantInductance {
-            ld: m.ld,
-            lq: m.lq,
-            flux_linkage: m.flux_linkage,
-        }),
-    };
-    magnetic_accuracy::compare(&truth, &identified, p.motor.rated_current)
+/// The magnetic identification on the simulated plant: what the pulses gave and its errors
+/// against the plant's model ([`magnetic_accuracy`]).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct MagneticsReport {
+    /// Saturation detected: `[model.saturation]` written.
+    pub saturation_detected: bool,
+    /// The best-fitting algebraic model (written only when saturation is detected).
+    pub fitted: Saturation<f64>,
+    /// The fitted model's largest relative incremental-inductance change over the pulses'
+    /// range.
+    pub inductance_change: f64,
+    /// The fit's RMS current residual, A.
+    pub residual_rms: f64,
+    /// The constant-inductance model's RMS current residual, A.
+    pub linear_residual_rms: f64,
+    /// The pulses' peak current, A.
+    pub pulse_current: f64,
+    /// The magnet's flux the fit used: the identified λ̂f, or the nameplate's when the
+    /// procedure aborted after the pulses (`flux_from_nameplate`), Wb.
+    pub flux_linkage: f64,
+    /// See `flux_linkage`.
+    pub flux_from_nameplate: bool,
+    /// The model the drive gets (the fitted one when saturation is detected, else constant
+    /// inductances: the identified ones, or the nameplate's after an abort) against the
+    /// plant's over the rated current range.
+    pub accuracy: MagneticAccuracy,
+}
+
+impl MagneticsReport {
+    /// The report of a finished (or aborted) procedure; None when the pulses did not end.
+    fn of(
+        proc: &Commissioning<f64>,
+        p: &PlantParams,
+        nameplate: &MachineModel<f64>,
+    ) -> Option<Self> {
+        let id = proc.result();
+        let model = id.map_or(nameplate, |id| &id.model);
+        let fit = proc.magnetic_model(model.flux_linkage)?;
+        let constants = ConstantInductance {
+            ld: model.ld,
+            lq: model.lq,
+            flux_linkage: model.flux_linkage,
+        };
+        let drive = if fit.detected {
+            Magnetics::Saturation(fit.model)
+        } else {
+            Magnetics::Constant(constants)
+        };
+        let truth = magnetic_accuracy::plant_model(p);
+        Some(Self {
+            saturation_detected: fit.detected,
+            fitted: fit.model,
+            inductance_change: fit.change,
+            residual_rms: fit.residual,
+            linear_residual_rms: fit.linear_residual,
+            pulse_current: proc.pulse_current(),
+            flux_linkage: model.flux_linkage,
+            flux_from_nameplate: id.is_none(),
+            accuracy: magnetic_accuracy::compare(&truth, &drive, p.motor.rated_current),
+        })
+    }
 }
 
 /// What a run watches beyond the procedure's output: the largest current and current
@@ -415,6 +462,16 @@ pub fn identified_toml(input: &str, id: &Identification<f64>) -> Result<String, 
     let mut doc: toml::Table = input
         .parse()
         .map_err(|e: toml::de::Error| SimConfigError::new("<config>", e.to_string()))?;
+    // The plant's flux map, named where the file was read: the identified.toml written
+    // elsewhere still finds it.
+    if let Some(toml::Value::Table(motor)) = doc.get_mut("motor")
+        && let Some(toml::Value::String(written)) = motor.get("flux_map")
+    {
+        let resolved = crate::magnetics_file::resolve(written)
+            .display()
+            .to_string();
+        motor.insert("flux_map".into(), toml::Value::String(resolved));
+    }
     let m = id.model;
     let mut model = toml::Table::new();
     for (k, v) in [

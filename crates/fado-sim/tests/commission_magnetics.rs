@@ -59,7 +59,7 @@ fn the_saturated_ipmsm_preset_is_identified_within_two_percent() {
     let o = run(&file("../../motors/saturated/ipmsm-2k2-qsat.toml"));
     let id = o.identification.unwrap();
     assert!(id.saturation.is_some(), "{}", id.saturation_change);
-    assert_within(&o.magnetic_accuracy.unwrap(), 0.02);
+    assert_within(&o.magnetics.unwrap().accuracy, 0.02);
 }
 
 /// A made-up IPMSM with other exponents (d and q saturation of exponent 2, a cross term of
@@ -71,7 +71,7 @@ fn a_made_up_saturated_ipmsm_is_identified_within_two_percent() {
     let o = run(&text);
     let id = o.identification.unwrap();
     assert!(id.saturation.is_some(), "{}", id.saturation_change);
-    assert_within(&o.magnetic_accuracy.unwrap(), 0.02);
+    assert_within(&o.magnetics.unwrap().accuracy, 0.02);
     let doc = identified_toml(&text, &id).unwrap();
     let table: toml::Table = doc.parse().unwrap();
     assert!(table["model"].get("saturation").is_some());

@@ -31,6 +31,23 @@ const REST_SAMPLES: u32 = 8;
 /// otherwise cut short (the gates act at once, a command one sample later).
 const DRAIN_SAMPLES: u32 = 2;
 
+/// The algebraic model fitted to the flux-linkage pulses
+/// ([`Commissioning::magnetic_model`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MagneticFit<T> {
+    /// The best-fitting model.
+    pub model: Saturation<T>,
+    /// The largest relative change of its incremental inductances over the pulses' range.
+    pub change: T,
+    /// Its RMS current residual over the samples, A.
+    pub residual: T,
+    /// The constant-inductance model's RMS residual, A.
+    pub linear_residual: T,
+    /// Saturation detected: `change` above the threshold and `residual` below half of
+    /// `linear_residual`.
+    pub detected: bool,
+}
+
 /// Where the pulses stand.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) enum Stage {
@@ -117,8 +134,9 @@ pub(super) fn magnetics_time<T: Real>(cfg: &CommissioningConfig<T>) -> T {
 }
 
 impl<T: Real> Commissioning<T> {
-    /// The pulses' peak current, A.
-    pub(super) fn pulse_current(&self) -> T {
+    /// The flux-linkage pulses' peak current, A (`magnetics.current_ratio` × the rated
+    /// current).
+    pub fn pulse_current(&self) -> T {
         self.cfg.magnetics.current_ratio * self.cfg.nameplate.rated_current
     }
 
@@ -326,16 +344,38 @@ impl<T: Real> Commissioning<T> {
     /// model and of constant inductances).
     pub(super) fn magnetic_result(&self) -> (Option<Saturation<T>>, T, T, T) {
         let nan = T::zero() / T::zero();
-        if !self.cfg.magnetics.enabled {
-            return (None, nan, nan, nan);
+        match self.magnetic_model(self.flux) {
+            Some(f) => (
+                f.detected.then_some(f.model),
+                f.change,
+                f.residual,
+                f.linear_residual,
+            ),
+            None => (None, nan, nan, nan),
         }
-        let Some((model, rms, rms_linear)) = best_fit(&self.pulses.samples, self.flux) else {
-            return (None, nan, nan, nan);
-        };
+    }
+
+    /// The algebraic model fitted to the flux-linkage pulses (module docs, step 5) with the
+    /// magnet's flux `flux_linkage`, once the pulses are done (None before, with the test off
+    /// or with too few samples). The procedure fits it with its final λ̂f
+    /// ([`Identification::saturation`]); this gives it also when a later phase aborts (with
+    /// the nameplate's λf, say). One call fits 1620 shapes: several milliseconds on a host,
+    /// far longer than a sample on a microcontroller (call it with the gates off).
+    pub fn magnetic_model(&self, flux_linkage: T) -> Option<MagneticFit<T>> {
+        // The stage stays `Hold` from the last pair's end on (through an abort too).
+        if !self.cfg.magnetics.enabled || self.pulses.stage != Stage::Hold {
+            return None;
+        }
+        let (model, residual, linear_residual) = best_fit(&self.pulses.samples, flux_linkage)?;
         let change = inductance_change(&model, self.pulse_current());
-        let detected = change > self.cfg.magnetics.detection_threshold
-            && rms < T::lit(RESIDUAL_RATIO) * rms_linear;
-        (detected.then_some(model), change, rms, rms_linear)
+        Some(MagneticFit {
+            model,
+            change,
+            residual,
+            linear_residual,
+            detected: change > self.cfg.magnetics.detection_threshold
+                && residual < T::lit(RESIDUAL_RATIO) * linear_residual,
+        })
     }
 
     /// The zero-current constants (incremental L̂d, L̂q) of a fitted model.

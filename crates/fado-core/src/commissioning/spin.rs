@@ -359,7 +359,7 @@ impl<T: Real> Commissioning<T> {
         T::lit(0.02) * self.cfg.nameplate.rated_speed() * self.cfg.nameplate.flux_linkage
     }
 
-    /// λ̂f from the two back-EMF windows (module docs, step 5): the line ē_f = λf·ω̄ + e₀
+    /// λ̂f from the two back-EMF windows (module docs, step 6): the line ē_f = λf·ω̄ + e₀
     /// through them. False (and aborted) when implausible.
     pub(super) fn finish_flux(&mut self) -> bool {
         let (flux, sigma, ds) = emf_line(&self.emf_win[0], &self.emf_win[1]);

@@ -60,13 +60,16 @@ pub fn commission(args: CommissionArgs) -> Outcome {
         o.status,
         o.simulated_seconds
     );
+    if let (None, Some(m)) = (&o.identification, &o.magnetics) {
+        print_magnetics(m, o.rotor_motion_magnetics);
+    }
     if o.identification.is_none() {
         outln!("wrote {}/metrics.json and traces.csv", dir.display());
         return Ok(ExitCode::from(1));
     }
     print_parameters(&rows);
-    if let (Some(id), Some(a)) = (&o.identification, &o.magnetic_accuracy) {
-        print_magnetics(id, a, o.rotor_motion_magnetics);
+    if let Some(m) = &o.magnetics {
+        print_magnetics(m, o.rotor_motion_magnetics);
     }
     outln!(
         "wrote {}/identified.toml, metrics.json and traces.csv",
@@ -171,18 +174,7 @@ fn write_outputs(
         "rotor_motion_inductance": o.rotor_motion_inductance,
         "rotor_motion_magnetics": o.rotor_motion_magnetics,
         "max_current_magnetics": o.max_current_magnetics,
-        "magnetics": o.identification.as_ref().map(|id| serde_json::json!({
-            "saturation_detected": id.saturation.is_some(),
-            "inductance_change": id.saturation_change,
-            "residual_rms": id.saturation_residual,
-            "linear_residual_rms": id.linear_residual,
-            "pulse_current": id.saturation_current,
-            "saturation": id.saturation.as_ref().map(|s| serde_json::json!({
-                "a_d0": s.a_d0, "a_dd": s.a_dd, "s": s.s, "a_q0": s.a_q0, "a_qq": s.a_qq,
-                "t": s.t, "a_dq": s.a_dq, "u": s.u, "v": s.v, "psi_f": s.psi_f, "i_f": s.i_f,
-            })),
-            "accuracy": o.magnetic_accuracy,
-        })),
+        "magnetics": o.magnetics,
         "seed": seed,
         "parameters": rows,
     });
@@ -225,20 +217,17 @@ fn write_outputs(
 }
 
 /// The magnetic model: detected or not, and its errors over the rated current range.
-fn print_magnetics(
-    id: &fado_core::commissioning::Identification<f64>,
-    a: &fado_sim::magnetic_accuracy::MagneticAccuracy,
-    motion: f64,
-) {
-    let verdict = if id.saturation.is_some() {
-        "saturation detected: [model.saturation] written"
+fn print_magnetics(m: &fado_sim::commission::MagneticsReport, motion: f64) {
+    let a = &m.accuracy;
+    let verdict = if m.saturation_detected {
+        "saturation detected (the fitted algebraic model)"
     } else {
-        "no saturation detected: constant inductances"
+        "no saturation detected (constant inductances)"
     };
     outln!(
         "magnetics: {verdict} (inductances change {:.1} % up to {:.3} A; rotor turned {:.3} rad)",
-        100.0 * id.saturation_change,
-        id.saturation_current,
+        100.0 * m.inductance_change,
+        m.pulse_current,
         motion
     );
     let pc = |s: &fado_sim::magnetic_accuracy::ErrorStats| {
