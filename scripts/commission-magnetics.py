@@ -30,17 +30,23 @@ ROOT = Path(__file__).resolve().parent.parent
 PAGE = ROOT / "docs" / "results" / "commissioning-magnetics.md"
 SCENARIOS = ["reversal", "stops", "rated-reversal"]
 MADE_UP = ROOT / "crates" / "fado-sim" / "tests" / "data" / "ipmsm-test-saturated.toml"
-LINEAR = ["paper", "ipmsm-2k2", "pmsyrm-5k", "outrunner-cheetah-24v", "servo-1ft6084"]
+LINEAR = ["paper", "pmsyrm-5k", "outrunner-cheetah-24v"]
 
 table = import_module("saturation-table")
 
 
+CACHE = {}
+
+
 def commission(binary: Path, args: list, out: Path) -> dict:
+    if out in CACHE:
+        return CACHE[out]
     cmd = [str(binary), "commission", *args, "--out", str(out)]
     done = subprocess.run(cmd, capture_output=True, text=True)
     if done.returncode not in (0, 1):
         sys.exit(f"{' '.join(cmd)} failed ({done.returncode}): {done.stderr.strip()}")
-    return json.loads((out / "metrics.json").read_text())
+    CACHE[out] = json.loads((out / "metrics.json").read_text())
+    return CACHE[out]
 
 
 def pc(x: float) -> str:
@@ -81,8 +87,8 @@ def closed_loop(binary: Path, preset: Path, seeds: list, work: Path) -> list:
     cells = {}
     for seed in seeds:
         true_cfg = table.with_seed(preset, seed, work)
-        out = work / f"{preset.stem}-commission-{seed}"
-        m = commission(binary, ["--config", str(true_cfg)], out)
+        out = work / f"{preset.stem}-{seed}"
+        m = commission(binary, ["--config", str(true_cfg), "--seed", str(seed)], out)
         ident = out / "identified.toml" if m["passed"] else None
         for scenario in SCENARIOS:
             for label, cfg in (("a", true_cfg), ("b", ident)):
@@ -149,6 +155,24 @@ reversals, over the run for `stops`), "trip" when a seed tripped, and the seeds 
 """
 
 
+LIMITS = """
+## Limits
+
+- The PM-SyRM presets (`pmsyrm-baldor-5k6`, its algebraic model with the saturating rib of
+  Lelli et al., and `pmsyrm-baldor-5k6-measured`, its measured map) abort in the commissioning's
+  inertia test (`Timeout`: the back-EMF PLL's angle wanders on this rotor and the q-current
+  step does not reach its speed), a phase after the pulses and independent of them, so (b)
+  cannot run; their rows above are the pulses' fit with the nameplate's λf, which
+  `Commissioning::magnetic_model` gives after the abort. The searched shapes (the algebraic
+  model without the rib) fit these machines less well than constant inductances fit a linear
+  one (the residual ratio), which the inductance errors show: a rib, or a flux map built from
+  the pulses, is what such a machine needs.
+- A magnetically linear machine's fit moves its inductances by up to a tenth on the strongly
+  salient low-inductance `pmsyrm-5k` (the integration's own errors: inverter error at the
+  current zero crossings) without explaining the data, which the residual criterion rejects.
+"""
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3, 4])
@@ -161,17 +185,17 @@ def main() -> None:
     work = Path(args.out or tempfile.mkdtemp(prefix="fado-commission-magnetics-"))
     work.mkdir(parents=True, exist_ok=True)
     presets = sorted((ROOT / "motors" / "saturated").glob("*.toml"))
-    machines = [(p.stem, ["--config", str(p)]) for p in presets]
-    machines.append((MADE_UP.stem, ["--config", str(MADE_UP)]))
-    machines += [(name, ["--motor", name]) for name in LINEAR]
-    lines = accuracy_rows(binary, machines, args.seeds, work)
     loop = []
     for preset in [*presets, MADE_UP]:
         loop += closed_loop(binary, preset, args.seeds, work)
+    # The closed loop's commissions (same machine, seed and output directory) are reused.
+    machines = [(p.stem, ["--config", str(p)]) for p in [*presets, MADE_UP]]
+    machines += [(name, ["--motor", name]) for name in LINEAR]
+    lines = accuracy_rows(binary, machines, args.seeds, work)
     seeds = "–".join(str(s) for s in (args.seeds[0], args.seeds[-1])) \
         if len(args.seeds) > 1 else str(args.seeds[0])
-    page = HEAD.format(seeds=seeds, minutes=10) + "\n".join(lines) + "\n" + LOOP_HEAD \
-        + "\n".join(loop) + "\n"
+    page = HEAD.format(seeds=seeds, minutes=5) + "\n".join(lines) + "\n" + LOOP_HEAD \
+        + "\n".join(loop) + "\n" + LIMITS
     if args.write:
         PAGE.write_text(page, encoding="utf-8")
     print(page)
