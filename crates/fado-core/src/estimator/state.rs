@@ -156,7 +156,7 @@ impl<T: Real> EstimatorState<T> {
     /// (≈ λ̂f·e^{jθ̂}, no extra state), î_d the current along it. Zero while that vector is
     /// below the tracker's hold level (no usable axis).
     #[inline]
-    pub(super) fn active_flux_swing(
+    pub(super) fn active_flux_swing<const SATURATING: bool>(
         &self,
         p: &EstimatorParams<T>,
         i_ab: Ab<T>,
@@ -164,8 +164,9 @@ impl<T: Real> EstimatorState<T> {
     ) -> Ab<T> {
         let axis = self.observer.flux() - self.observer.disturbance();
         let n2 = axis.norm_squared();
-        if let Some(af) = p.active_flux.saturating() {
+        if SATURATING {
             // A saturating model: λ̂a(î) − ψd(0, 0) along the axis, î in its frame.
+            let af = &p.active_flux;
             return if n2 > p.hold_level_sq {
                 let point = af.point(ActiveFlux::frame_current(axis, i_ab));
                 axis * ((point.active - af.magnet_flux()) / n2.step_sqrt())
