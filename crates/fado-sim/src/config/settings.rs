@@ -73,7 +73,6 @@ impl SimulationSettings {
         }
         check::finite("initial_angle", self.initial_angle)?;
         check::finite("align_error", self.align_error)?;
-        check::finite("brake_release_at", self.brake_release_at)?;
         check::non_negative("eval_start", self.eval_start)?;
         check::non_negative("brake_release_at", self.brake_release_at)?;
         check::positive("zero_speed_band_ratio", self.zero_speed_band_ratio)?;
