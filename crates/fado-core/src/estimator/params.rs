@@ -347,6 +347,5 @@ fn slow_laws<T: Real>(
                 _ => rename("mode_threshold_ratio")(e),
             }
         })?;
-    let active_flux = ActiveFlux::of(&config.machine);
-    Ok((rs_adaptation.with_active_flux(active_flux), offset))
+    Ok((rs_adaptation, offset))
 }

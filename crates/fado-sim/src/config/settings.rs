@@ -73,6 +73,7 @@ impl SimulationSettings {
         }
         check::finite("initial_angle", self.initial_angle)?;
         check::finite("align_error", self.align_error)?;
+        check::finite("brake_release_at", self.brake_release_at)?;
         check::non_negative("eval_start", self.eval_start)?;
         check::positive("zero_speed_band_ratio", self.zero_speed_band_ratio)?;
         for (k, w) in self.disturbance_feedback_off.iter().enumerate() {

@@ -10,6 +10,7 @@ use crate::control::lock_reaction::LockReaction;
 use crate::control::modulation::VoltageLimit;
 use crate::control::ratings_limit::RatingsLimitTuning;
 use crate::control::release_hold::ReleaseHoldTuning;
+use crate::control::standstill_probe;
 use crate::control::startup::StartupTuning;
 use crate::control::tracker_feedforward::TrackerFeedforwardTuning;
 use crate::control::{current_controller, delay_compensation, gain_calibration, speed_controller};
@@ -394,19 +395,25 @@ pub struct DriveTuning<T> {
     /// reading Δi_d·tan δ is 0.2 A at δ = 0.1 rad against a speed-loop ripple the
     /// demodulation averages over a whole period).
     pub standstill_probe_current_ratio: T,
-    /// Probe period T_p in s. Default 0.5 s \[A\]: each half holds 0.25 s, 8 time constants
-    /// 1/(2π·f_sc) of the 5 Hz speed loop (1.6 of its PI zero's ratio/(2π·f_sc) = 0.16 s), the
-    /// correlation reads the second half of each half, after 4 loop time constants. Measured
-    /// on the loaded hour's configuration (docs/method/additions.md): a longer
-    /// period lets the probe's own Δi_d move the angle more within a half (the inverter
-    /// residual's tangential part depends on the current vector): worst |θ − θ̂| over five
-    /// sensor seeds 0.51 rad at 2 s, 0.095 at 1 s, 0.065 at 0.5 s.
+    /// Probe period T_p in s. Default 0.1 s \[A\]: the reading removes the rotor's
+    /// acceleration from the torque balance (`StandstillProbeConfig::inertia`), so it needs
+    /// no settled speed loop, only a settled current loop and speed estimate: each
+    /// correlation window (a quarter period, 25 ms) spans 5.5 time constants of the 35 Hz
+    /// speed tracker the speed loop reads. The correction loop's bandwidth is a fixed
+    /// fraction of 1/T_p, so the period sets how fast a creep is caught: with 0.5 s the
+    /// fullrange hold of the servo and hub presets ended 0.25–0.35 rad off
+    /// (docs/range.md).
     pub standstill_probe_period: T,
-    /// Correction gain g in s⁻¹: θ̂ turns at g·δ̂. Default 1 s⁻¹ \[A\]: g·T_p = 1/2 with
-    /// the default period (a first-order loop per period with the measurement half a period
-    /// late: half the deadbeat gain), a steady error c/g = 0.01–0.02 rad under the measured
-    /// 0.01–0.02 rad/s creep.
+    /// Correction gain g in s⁻¹: θ̂ turns at g·δ̂ plus the learned creep ĉ, which grows by
+    /// 0.173·g·δ̂ per period. Default 0.405/T_p = 4.05 s⁻¹ \[D\]: with the reading half a
+    /// period late the loop per period has a triple pole at 4^(1/3) − 1 = 0.587
+    /// (`fado_core::control::standstill_probe`, "Correction"), and a constant creep leaves no
+    /// angle error.
     pub standstill_probe_gain: T,
+    /// Time (s) the loaded standstill holds before the probe starts. Default 0.5 s \[A\]:
+    /// not in a passage through zero or a short stop (fig12's and the presets' `stops`
+    /// never arm it).
+    pub standstill_probe_arm_time: T,
     /// The probe's gate: the speed reference |ω*| at most this multiple of the rated speed.
     /// Default 0.0005 \[A\] (0.75 r/min at 1500 r/min): a standstill reference. The probe
     /// moves the rotor by ±1–1.5 r/min on the paper's motor, a speed error at a low non-zero
@@ -492,6 +499,7 @@ impl<T: Real> DriveTuning<T> {
             standstill_probe_current_ratio: U::lit(self.standstill_probe_current_ratio.to_f64()),
             standstill_probe_period: U::lit(self.standstill_probe_period.to_f64()),
             standstill_probe_gain: U::lit(self.standstill_probe_gain.to_f64()),
+            standstill_probe_arm_time: U::lit(self.standstill_probe_arm_time.to_f64()),
             standstill_probe_speed_ratio: U::lit(self.standstill_probe_speed_ratio.to_f64()),
             standstill_probe_load_ratio: U::lit(self.standstill_probe_load_ratio.to_f64()),
         }
@@ -562,8 +570,9 @@ impl<T: Real> Default for DriveTuning<T> {
             lock_stall_reluctance_band_ratio: T::lit(0.05),
             standstill_probe: true,
             standstill_probe_current_ratio: T::lit(0.1),
-            standstill_probe_period: T::lit(0.5),
-            standstill_probe_gain: T::one(),
+            standstill_probe_period: T::lit(0.1),
+            standstill_probe_gain: T::lit(standstill_probe::TRIPLE_POLE_GAIN / 0.1),
+            standstill_probe_arm_time: T::lit(0.5),
             standstill_probe_speed_ratio: T::lit(0.0005),
             standstill_probe_load_ratio: T::lit(0.25),
         }
