@@ -10,6 +10,7 @@ use crate::control::lock_reaction::LockReaction;
 use crate::control::modulation::VoltageLimit;
 use crate::control::ratings_limit::RatingsLimitTuning;
 use crate::control::release_hold::ReleaseHoldTuning;
+use crate::control::startup::StartupTuning;
 use crate::control::tracker_feedforward::TrackerFeedforwardTuning;
 use crate::control::{current_controller, delay_compensation, gain_calibration, speed_controller};
 use crate::injection;
@@ -201,6 +202,13 @@ pub struct DriveTuning<T> {
         serde(bound(deserialize = "T: Real + serde::Deserialize<'de>"))
     )]
     pub release_hold: ReleaseHoldTuning<T>,
+    /// How the start-up finds the rotor's angle (`[controller.startup]`, see
+    /// [`StartupTuning`]).
+    #[cfg_attr(
+        feature = "serde",
+        serde(bound(deserialize = "T: Real + serde::Deserialize<'de>"))
+    )]
+    pub startup: StartupTuning<T>,
     /// Reaction to the estimator's [`LockStatus::Lost`](crate::LockStatus::Lost) (`DriveFlags::LOCK_LOST`) and, with
     /// `lock_reaction_on_stall`, to the stall symptom (`DriveFlags::STALLED`). Default report
     /// only \[A\] (the paper's behaviour plus the flags).
@@ -455,6 +463,7 @@ impl<T: Real> DriveTuning<T> {
             dc_link: self.dc_link.cast(),
             field_weakening: self.field_weakening.cast(),
             release_hold: self.release_hold.cast(),
+            startup: self.startup.cast(),
             limits: self.limits.cast(),
             tracker_feedforward: self.tracker_feedforward.cast(),
             lock_reaction: self.lock_reaction,
@@ -530,6 +539,7 @@ impl<T: Real> Default for DriveTuning<T> {
             dc_link: DcLinkTuning::default(),
             field_weakening: FieldWeakeningTuning::default(),
             release_hold: ReleaseHoldTuning::default(),
+            startup: StartupTuning::default(),
             limits: RatingsLimitTuning::default(),
             tracker_feedforward: TrackerFeedforwardTuning::default(),
             lock_reaction: LockReaction::ReportOnly,
