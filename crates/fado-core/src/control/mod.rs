@@ -23,6 +23,7 @@ pub mod saturated_references;
 pub mod speed_controller;
 pub mod standstill_probe;
 pub use drive::tracker_feedforward;
+pub use drive::tuning;
 
 pub use current_controller::{CurrentController, CurrentControllerConfig};
 pub use dc_link_limit::{DcLinkLimit, DcLinkTuning};

@@ -10,9 +10,9 @@
 //! a throttle step loses the rotor (measured on `motors/multirotor-mn5006-22v.toml`, 0 → 6000
 //! r/min at the current limit: 2.1 rad; with the feed-forward 0.09 rad).
 //!
-//! **Rule.** Where the lag α/Ki at the current limit (T_max = min(`current_limit_ratio`,
+//! **Rule.** Where the lag α/Ki at the current limit (T_max = min(`current.limit_ratio`,
 //! `limits.torque_ratio`)·T_rated, Ki of T2S-1) exceeds [`TrackerFeedforwardTuning::max_lag`],
-//! the drive turns on its acceleration feed-forward (`DriveTuning::acceleration_feedforward`)
+//! the drive turns on its acceleration feed-forward (`TrackerFeedforwardTuning::enabled`)
 //! and gives the trackers their load integrator (`EstimatorTuning::tracker.load_pole_ratio`
 //! [`LOAD_POLE_RATIO`] where the tuning leaves it at 0): without it the load the model does not
 //! know would leave p·T_L/(Ĵ·Ki) of angle error. A tuning that turns them on itself is kept.
@@ -49,6 +49,12 @@ pub const LOAD_POLE_RATIO: f64 = 0.5;
     )
 )]
 pub struct TrackerFeedforwardTuning<T> {
+    /// Give the estimator's speed trackers the acceleration the commanded torque causes,
+    /// p·T*/Ĵ (a mechanical-model feed-forward, see [`crate::tracker`]); use with the
+    /// estimator's `tracker.load_pole_ratio` > 0, whose third integrator takes up the load.
+    /// Default false (the paper's trackers) \[A\]; the drive turns it on itself on a rotor its
+    /// trackers would lag by more than `max_lag` (the module docs).
+    pub enabled: bool,
     /// Largest angle lag (rad) of the type-2 T2S-1 behind an acceleration at the current limit
     /// that the drive leaves without feed-forward. Default 2 rad \[A\]: the multirotor preset
     /// (2.4 rad) and the cheetah outrunner (3.0 rad) need the feed-forward; a 750 W 10-pole
@@ -61,6 +67,7 @@ pub struct TrackerFeedforwardTuning<T> {
 impl<T: Real> Default for TrackerFeedforwardTuning<T> {
     fn default() -> Self {
         Self {
+            enabled: false,
             max_lag: T::lit(2.0),
         }
     }
@@ -70,6 +77,7 @@ impl<T: Real> TrackerFeedforwardTuning<T> {
     /// The same tuning in another scalar type.
     pub fn cast<U: Real>(&self) -> TrackerFeedforwardTuning<U> {
         TrackerFeedforwardTuning {
+            enabled: self.enabled,
             max_lag: U::lit(self.max_lag.to_f64()),
         }
     }
@@ -89,7 +97,7 @@ pub fn current_limit_lag<T: Real>(
         ..TrackerConfig::new(estimator.tracker.t2s1_bandwidth_hz, ts)
     };
     let (_, ki) = tracker.gains();
-    let ratio = crate::real::min(drive.current_limit_ratio, drive.limits.torque_ratio);
+    let ratio = crate::real::min(drive.current.limit_ratio, drive.limits.torque_ratio);
     let p = T::lit(machine.pole_pairs as f64);
     p * ratio * machine.rated_torque / (machine.inertia * ki)
 }
@@ -103,7 +111,7 @@ pub fn apply<T: Real>(
 ) {
     // NaN compares false: no feed-forward.
     if current_limit_lag(machine, drive, estimator, ts) > drive.tracker_feedforward.max_lag {
-        drive.acceleration_feedforward = true;
+        drive.tracker_feedforward.enabled = true;
         if estimator.tracker.load_pole_ratio == T::zero() {
             estimator.tracker.load_pole_ratio = T::lit(LOAD_POLE_RATIO);
         }
@@ -134,7 +142,7 @@ mod tests {
         let lag = current_limit_lag(&m, &d, &e, 100e-6);
         assert!((lag - 0.21).abs() < 0.01, "{lag}");
         let (d2, e2) = resolve(&m, d, e, 100e-6);
-        assert!(!d2.acceleration_feedforward && e2.tracker.load_pole_ratio == 0.0);
+        assert!(!d2.tracker_feedforward.enabled && e2.tracker.load_pole_ratio == 0.0);
         assert_eq!((d2, e2), (d, e));
         // A 14-pole-pair multirotor motor with its propeller: 2.4 rad, feed-forward on.
         let fast = MachineModel {
@@ -149,7 +157,7 @@ mod tests {
         let lag = current_limit_lag(&fast, &d, &e, 25e-6);
         assert!((lag - 2.4).abs() < 0.05, "{lag}");
         let (d2, e2) = resolve(&fast, d, e, 25e-6);
-        assert!(d2.acceleration_feedforward);
+        assert!(d2.tracker_feedforward.enabled);
         assert_eq!(e2.tracker.load_pole_ratio, LOAD_POLE_RATIO);
         // A tuning's own load pole is kept; an infinite threshold keeps the paper's trackers.
         let mut own = e;
@@ -157,6 +165,6 @@ mod tests {
         assert_eq!(resolve(&fast, d, own, 25e-6).1.tracker.load_pole_ratio, 0.3);
         let mut off = d;
         off.tracker_feedforward.max_lag = 1e9;
-        assert!(!resolve(&fast, off, e, 25e-6).0.acceleration_feedforward);
+        assert!(!resolve(&fast, off, e, 25e-6).0.tracker_feedforward.enabled);
     }
 }
