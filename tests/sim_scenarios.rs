@@ -1,4 +1,4 @@
-//! The paper's experiments (SPEC §7) in closed loop: the sensorless drive of fado-core on the
+//! The paper's experiments (docs/method/estimator.md, "The experiments") in closed loop: the sensorless drive of fado-core on the
 //! simulated plant with the default non-idealities (dead time, device drops, sensor offsets,
 //! gain error, noise, ADC), matched model parameters. Each run is a few tenths of a second in
 //! release mode, so every scenario runs switching-resolved.

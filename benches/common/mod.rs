@@ -1,5 +1,5 @@
 //! The samples the estimator benchmarks step through (`baselines.rs`, `paired.rs`): one
-//! electrical period of an ideal machine at 300 r/min under load, SPEC §6 motor.
+//! electrical period of an ideal machine at 300 r/min under load, the paper's motor.
 
 use fado_core::{Ab, Dq, EstimatorConfig, MachineModel, Rotation, SensorlessEstimator};
 
@@ -8,7 +8,7 @@ pub const TS: f64 = 100e-6;
 /// 300 r/min, 4 pole pairs: 20 Hz electrical, 500 samples per period.
 pub const PERIOD: usize = 500;
 
-/// One electrical period of (v applied over the interval, i sampled at its end), SPEC §6 motor.
+/// One electrical period of (v applied over the interval, i sampled at its end), the paper's motor.
 pub fn inputs() -> Vec<(Ab<f32>, Ab<f32>)> {
     let (rs, l, lf) = (0.327, 2.63e-3, 0.088);
     let w = core::f64::consts::TAU / (PERIOD as f64 * TS);

@@ -3,7 +3,7 @@
 The recording is generated from the motor equations, not from fado: a rotor turning at a
 prescribed electrical speed with a constant d-q current, flux λ = e^{jθ}·(λf + Ld·i_d + j·Lq·i_q)
 (= λf·e^{jθ} + L·i for surface magnets, Ld = Lq = L) and the voltage that the discrete
-integrator of SPEC §1 would need, v[k] = (λ[k] − λ[k−1])/Ts + R·(i[k] + i[k−1])/2. With a
+integrator of docs/method/estimator.md (section 1) would need, v[k] = (λ[k] − λ[k−1])/Ts + R·(i[k] + i[k−1])/2. With a
 matched machine model the estimator should recover θ; with any data the bindings must
 reproduce the Rust estimator bit for bit. The default motor is the paper's
 (``fado.Machine.paper()``).

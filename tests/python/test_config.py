@@ -20,7 +20,7 @@ from fado import EstimatorConfig
 # block the tuning tunes (the nested tables of the simulator's `[estimator]`).
 PAPER_DEFAULTS = {
     "integrator": {
-        "average_current": True,  # SPEC §1 [A]
+        "average_current": True,  # docs/method/estimator.md, section 1
     },
     "disturbance_feedback": {
         "k_df": 0.5,  # [P]
@@ -33,14 +33,14 @@ PAPER_DEFAULTS = {
     },
     "mode": {
         "threshold_ratio": 0.015,  # [P]: 1.5 Hz of the paper motor's 100 Hz
-        "hysteresis_ratio": 0.002,  # SPEC §1 [A]: 0.2 Hz of 100 Hz
+        "hysteresis_ratio": 0.002,  # 0.2 Hz of 100 Hz (docs/method/estimator.md, section 5)
     },
     "tracker": {
         "t2s1_bandwidth_hz": 60.0,  # [P]
         "t2s2_bandwidth_hz": 35.0,  # [P]
-        "damping": 1 / math.sqrt(2),  # SPEC §3 [A]
-        "bandwidth_definition": "minus3_db",  # SPEC §3
-        "hold_ratio": 0.2,  # SPEC §3 [A]
+        "damping": 1 / math.sqrt(2),  # docs/method/estimator.md, section 4
+        "bandwidth_definition": "minus3_db",  # docs/method/estimator.md, section 4
+        "hold_ratio": 0.2,  # docs/method/estimator.md, section 4
         "load_pole_ratio": 0.0,  # [A] 0: the paper's type-2 trackers
     },
     "observer": {
@@ -93,7 +93,7 @@ def default(path: str) -> object:
     return PAPER_DEFAULTS[record][field]
 
 
-# The paper's motor (section V; λf, J, B from SPEC §6; rated current from its rated torque).
+# The paper's motor (section V; λf, J, B as docs/method/estimator.md states them; rated current from its rated torque).
 PAPER_MACHINE = {
     "rs": 0.327,
     "ld": 2.63e-3,

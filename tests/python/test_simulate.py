@@ -105,7 +105,7 @@ def test_dump_config_is_default_config(fado_sim_cli: Path) -> None:
 def test_estimator_replay_reproduces_the_in_loop_estimate() -> None:
     """The trace's voltage reference and measured current are the estimator's inputs: the
     voltage realised at n−2 is the one applied over [n−1, n] (one sample of computational
-    delay), the current is sampled at n (SPEC §1). Replaying them through `fado.Estimator`
+    delay), the current is sampled at n (docs/method/estimator.md, section 1). Replaying them through `fado.Estimator`
     must give the drive's θ̂ (the whole fig11 run: start-up, both modes, the zero crossing
     under 7.5 N·m)."""
     # Without the start-up offset and gain calibrations, so that the estimator runs from sample 0

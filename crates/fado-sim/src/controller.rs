@@ -3,6 +3,7 @@
 //! The sensorless drive of `fado-core` implements it ([`crate::drive`]); so can sensored
 //! reference controllers in tests.
 
+use fado_core::control::StartupStatus;
 use fado_core::{Ab, Abc, Dq, DriveFlags, Estimate};
 
 /// Everything a controller may read at sample n.
@@ -70,6 +71,14 @@ pub trait Controller {
     fn ready(&self) -> bool {
         true
     }
+    /// Where the controller's start-up angle phase stands (see
+    /// [`fado_core::control::startup`]). Default: [`StartupStatus::Idle`] (controllers that
+    /// start from the angle they are given).
+    fn startup_status(&self) -> StartupStatus {
+        StartupStatus::Idle
+    }
+    /// The plant's brake has released (a drive re-arms its release hold). Default: nothing.
+    fn brake_released(&mut self) {}
 }
 
 /// A boxed controller (an estimator chosen at run time from
@@ -90,5 +99,11 @@ impl<C: Controller + ?Sized> Controller for Box<C> {
     }
     fn ready(&self) -> bool {
         (**self).ready()
+    }
+    fn startup_status(&self) -> StartupStatus {
+        (**self).startup_status()
+    }
+    fn brake_released(&mut self) {
+        (**self).brake_released();
     }
 }

@@ -1,6 +1,6 @@
 //! The sensorless drive of `fado-core` (Fig. 5) as a [`Controller`] of the closed loop.
 
-use fado_core::control::SensorlessDrive;
+use fado_core::control::{SensorlessDrive, StartupStatus};
 use fado_core::{Ab, Abc, Diagnostics, Dq, Estimate, RotorAngleEstimator};
 
 use crate::controller::{Actuation, ControlEvent, Controller, Measurements};
@@ -14,8 +14,15 @@ where
     }
 
     fn ready(&self) -> bool {
-        let last = self.last();
-        !self.is_calibrating() && !self.is_calibrating_gain() && last.gates_enabled && !last.tripped
+        SensorlessDrive::ready(self)
+    }
+
+    fn startup_status(&self) -> StartupStatus {
+        SensorlessDrive::startup_status(self)
+    }
+
+    fn brake_released(&mut self) {
+        self.arm_release_hold();
     }
 
     #[inline]
@@ -103,11 +110,15 @@ impl Controller for DriveF32 {
     }
 
     fn ready(&self) -> bool {
-        let last = self.0.last();
-        !self.0.is_calibrating()
-            && !self.0.is_calibrating_gain()
-            && last.gates_enabled
-            && !last.tripped
+        self.0.ready()
+    }
+
+    fn startup_status(&self) -> StartupStatus {
+        self.0.startup_status()
+    }
+
+    fn brake_released(&mut self) {
+        self.0.arm_release_hold();
     }
 
     #[inline]

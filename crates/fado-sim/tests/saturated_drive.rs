@@ -2,8 +2,9 @@
 //! drive and the estimator given the plant's own magnetic model (`[model]` inherits
 //! `[motor.saturation]`) pass `reversal`, `stops` and `rated-reversal` for the current-sensor
 //! seeds 1–4 on the saturated IPMSM preset, and on a machine that is no preset (the same
-//! IPMSM with five times its cross-saturation). The PM-SyRM preset does not pass with the
-//! default tuning (docs/method/saturation.md, "Limits"); its results are in
+//! IPMSM with five times its cross-saturation); the PM-SyRM's measured flux map runs as the
+//! plant's and the drive's model and passes `stops`. The PM-SyRM's reversals do not pass with
+//! the default tuning (docs/method/saturation.md, "Limits"); its results are in
 //! docs/results/saturation.md (`scripts/saturation-table.py`).
 
 use fado_sim::scenario::{run_config, scenario_config};
@@ -73,4 +74,24 @@ fn the_model_of_the_drive_follows_the_file() {
     let text = format!("{base}\n[model.saturation]\na_d0 = 27.8\na_q0 = -1.0\n");
     let e = scenario_config("reversal", Some(&text), false).unwrap_err();
     assert_eq!(e.key, "model.saturation.a_q0", "{e}");
+}
+
+#[test]
+fn the_measured_flux_map_preset_runs_its_map_and_passes_stops() {
+    use fado_core::magnetics::MachineMagnetics;
+    // The preset's map path is relative to its file: resolve it as the CLI does.
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../motors/saturated");
+    fado_sim::magnetics_file::set_config_dir(Some(std::path::Path::new(dir)));
+    let base = preset("saturated/pmsyrm-baldor-5k6-measured.toml");
+    let cfg = scenario_config("stops", Some(&base), false).unwrap();
+    assert!(matches!(
+        cfg.machine_model().magnetics,
+        MachineMagnetics::Map(_)
+    ));
+    for seed in 1..=4 {
+        let text = format!("{base}\n[current_sensor]\nseed = {seed}\n");
+        let (passed, angle, speed) = run("stops", &text);
+        println!("seed {seed} stops: {angle:.4} rad, {speed:.2} r/min");
+        assert!(passed, "seed {seed} stops: {angle} rad, {speed} r/min");
+    }
 }

@@ -12,7 +12,7 @@
 //! and its mode equal (measured: the same θ̂ and ω̂ to the bit, docs/results/firmware-cost.md):
 //!
 //! - the flux integrator with the feedback of the previous sample (eq. (21) / (24)), the
-//!   resistive drop on the interval's average current (SPEC §1 \[A\]);
+//!   resistive drop on the interval's average current (docs/method/estimator.md, section 1);
 //! - the disturbance observer (eq. (10), gains (16)) at ω̂ of T2S-1 with fado's discrete gains
 //!   (`fado_core::observer::DiscreteGains::new`, the `f32` minimax polynomials);
 //! - λ2 = λ1 − D̂ (eq. (20)), λ̂r = λ2 − L̂q·i (eq. (5)), θm = ∠λ̂r (eq. (6)) with fado's `f32`

@@ -266,4 +266,4 @@ fn direction<T: Real>(k: usize) -> Ab<T> {
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

@@ -22,6 +22,7 @@ pub mod release_hold;
 pub mod saturated_references;
 pub mod speed_controller;
 pub mod standstill_probe;
+pub mod startup;
 pub use drive::tracker_feedforward;
 pub use drive::tuning;
 
@@ -43,4 +44,5 @@ pub use ratings_limit::{RatingsLimit, RatingsLimitTuning};
 pub use release_hold::{ReleaseHold, ReleaseHoldTuning};
 pub use speed_controller::{SpeedController, SpeedControllerConfig, limit_current_d_priority};
 pub use standstill_probe::{StandstillProbe, StandstillProbeConfig};
+pub use startup::{AngleSearch, StartupStatus, StartupTuning};
 pub use tracker_feedforward::TrackerFeedforwardTuning;

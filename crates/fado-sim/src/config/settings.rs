@@ -35,6 +35,10 @@ pub struct SimulationSettings {
     /// calibrations over, gates on); the load acts on the brake until then (a hoist, a
     /// vehicle on a slope). Default false.
     pub brake: bool,
+    /// The brake releases at the first ready sample from this time on (s): a hoist's brake
+    /// opens shortly before the lift, once the drive holds the rotor. Default 0: at the first
+    /// ready sample.
+    pub brake_release_at: f64,
 }
 
 impl Default for SimulationSettings {
@@ -50,6 +54,7 @@ impl Default for SimulationSettings {
             estimator: EstimatorKind::FADO,
             disturbance_feedback_off: Vec::new(),
             brake: false,
+            brake_release_at: 0.0,
         }
     }
 }
@@ -68,6 +73,7 @@ impl SimulationSettings {
         }
         check::finite("initial_angle", self.initial_angle)?;
         check::finite("align_error", self.align_error)?;
+        check::finite("brake_release_at", self.brake_release_at)?;
         check::non_negative("eval_start", self.eval_start)?;
         check::positive("zero_speed_band_ratio", self.zero_speed_band_ratio)?;
         for (k, w) in self.disturbance_feedback_off.iter().enumerate() {

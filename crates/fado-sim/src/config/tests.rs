@@ -317,9 +317,10 @@ mod located_errors {
     }
 }
 
-/// `--dump-config` shows the acceleration feed-forward and the trackers' load pole as the
-/// drive uses them: turned on by `fado_core::control::tracker_feedforward` on the multirotor
-/// preset, whose trackers would lag 2.4 rad at the current limit, and left off on the paper's.
+/// `--dump-config` shows the acceleration feed-forward, the trackers' load pole and T2S-1's
+/// bandwidth as the drive uses them: set by `fado_core::control::tracker_feedforward` on the
+/// multirotor preset, whose trackers would lag 2.4 rad at the current limit, and left off on
+/// the paper's.
 #[test]
 fn the_dump_shows_the_feedforward_the_drive_turns_on() {
     let dump = |name: &str| {
@@ -334,6 +335,10 @@ fn the_dump_shows_the_feedforward_the_drive_turns_on() {
     assert!(fast.contains(on), "{fast}");
     assert!(
         fast.contains("load_pole_ratio = 0.5  # derived: 0.5 with the acceleration"),
+        "{fast}"
+    );
+    assert!(
+        fast.contains("  # derived: raised until a step of the rated torque"),
         "{fast}"
     );
     let paper = dump("paper");

@@ -219,7 +219,9 @@ pub(super) fn checks_stops(
     ));
 }
 
-/// `loaded-start`: pass criteria.
+/// `loaded-start`: pass criteria, from t = 0. A drive that ends its start-up saying it has no
+/// angle (the machine shows none at standstill) is judged on that: it stays off and the
+/// brake holds.
 pub(super) fn checks_loaded_start(
     cfg: &SimConfig,
     _m: &Metrics,
@@ -228,22 +230,39 @@ pub(super) fn checks_loaded_start(
 ) {
     let band = SCALED_SPEED_ERROR_RATIO * cfg.motor.rated_speed_rpm;
     let st = p.start.clone().unwrap_or_default();
+    let back = (
+        "backward travel from t = 0 (rad)",
+        st.max_backward,
+        LOADED_START_MAX_BACK,
+    );
+    let motion = (
+        "rotor motion before ready (rad)",
+        st.startup_motion,
+        LOADED_START_MAX_BACK,
+    );
+    if st.refused() && st.release_time.is_none() {
+        checks.push(Check::at_least(
+            &format!("start-up says it has no angle ({:?})", st.startup),
+            1.0,
+            1.0,
+        ));
+        checks.extend([back, motion].map(|(name, value, max)| Check::at_most(name, value, max)));
+        return;
+    }
     let bounds = [
         (
-            "brake released (time, s; never: ∞)",
+            "drive ready (time, s; never: ∞)",
             st.release_time.unwrap_or(f64::INFINITY),
             cfg.simulation.duration,
         ),
+        back,
+        motion,
         (
-            "backward travel after the release (rad)",
-            st.max_backward,
-            LOADED_START_MAX_BACK,
-        ),
-        (
-            "max |θ − θ̂| from the release on (rad)",
-            st.max_angle_error,
+            "|θ − θ̂| at the angle found (rad; none: 0)",
+            st.found_angle_error.unwrap_or(0.0),
             0.25,
         ),
+        ("max |θ − θ̂| from ready on (rad)", st.max_angle_error, 0.25),
         ("speed error at the end (r/min)", st.end_speed_error(), band),
     ];
     checks.extend(bounds.map(|(name, value, max)| Check::at_most(name, value, max)));

@@ -50,21 +50,29 @@ pub(super) fn observe_regen_stop(cfg: &SimConfig, p: &mut ScenarioProbe) {
     p.levels = holds_to_levels(crate::range::regen_stop_holds(cfg));
 }
 
-/// What `loaded-start` measures about the start-up and the release.
+/// What `loaded-start` measures about the start-up and the release, from t = 0.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct StartStats {
     /// When the brake released (the drive's first ready sample), s.
     pub release_time: Option<f64>,
-    /// Largest backward travel of the rotor after the release (electrical rad, ≥ 0; backward
-    /// is against the lifting direction, negative angles).
+    /// Largest backward travel of the rotor from t = 0 (electrical rad, ≥ 0; backward is
+    /// against the lifting direction, negative angles): the start-up's and the release's.
     pub max_backward: f64,
-    /// Largest |θ − θ̂| from the release on, rad.
+    /// Largest |θ − θ(0)| before the drive was ready (electrical rad): the rotor's motion
+    /// during the start-up (calibrations, angle search).
+    pub startup_motion: f64,
+    /// Largest |θ − θ̂| from the drive's first ready sample on, rad.
     pub max_angle_error: f64,
     /// Largest |n − n*| from `end_from` on, r/min (see [`end_speed_error`](Self::end_speed_error)).
     pub max_end_speed_error_rpm: f64,
     /// Start of the end window, s.
     pub end_from: f64,
+    /// The drive's start-up angle phase at the last sample.
+    pub startup: fado_core::control::StartupStatus,
+    /// |θ − θ̂| at the sample the start-up found its angle (rad; None: it found none).
+    pub found_angle_error: Option<f64>,
     travel: f64,
+    theta0: Option<f64>,
     last_theta: Option<f64>,
     end_samples: u64,
 }
@@ -78,17 +86,26 @@ impl StartStats {
     }
 
     fn observe(&mut self, s: &Sample) {
-        if s.brake_engaged {
+        let found = fado_core::control::StartupStatus::Found;
+        if s.startup == found && self.startup != found {
+            self.found_angle_error = Some(s.angle_error.abs());
+        }
+        self.startup = s.startup;
+        if let Some(prev) = self.last_theta {
+            self.travel += fado_core::wrap_angle(s.theta - prev);
+        }
+        self.last_theta = Some(s.theta);
+        let theta0 = *self.theta0.get_or_insert(s.theta);
+        self.max_backward = self.max_backward.max(-self.travel);
+        if s.brake_engaged || (self.release_time.is_none() && !s.ready) {
+            self.startup_motion = self
+                .startup_motion
+                .max(fado_core::wrap_angle(s.theta - theta0).abs());
             return;
         }
         if self.release_time.is_none() {
             self.release_time = Some(s.time);
         }
-        if let Some(prev) = self.last_theta {
-            self.travel += fado_core::wrap_angle(s.theta - prev);
-        }
-        self.last_theta = Some(s.theta);
-        self.max_backward = self.max_backward.max(-self.travel);
         self.max_angle_error = self.max_angle_error.max(s.angle_error.abs());
         if s.time >= self.end_from {
             self.end_samples += 1;
@@ -105,6 +122,11 @@ impl StartStats {
         } else {
             self.max_end_speed_error_rpm
         }
+    }
+
+    /// The drive ended its start-up saying it has no angle (and stayed off).
+    pub fn refused(&self) -> bool {
+        matches!(self.startup, fado_core::control::StartupStatus::NoAngle(_))
     }
 }
 

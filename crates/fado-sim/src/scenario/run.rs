@@ -93,7 +93,8 @@ impl SimConfig {
             self.speed_reference.clone(),
             self.simulation.align_error,
         )?
-        .with_events(events))
+        .with_events(events)
+        .with_brake_release_at(self.simulation.brake_release_at))
     }
 }
 

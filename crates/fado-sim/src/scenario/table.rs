@@ -144,13 +144,17 @@ pub const SCENARIOS: [Scenario; 14] = [
         name: "loaded-start",
         title: "Start under the rated torque, the rotor held by a brake until the drive is ready",
         profile: "rotor at rest at a seeded random angle, a brake holding it and a constant \
-                  100 % of rated torque (gravity-like) on it; the brake releases at the \
-                  drive's first ready sample (calibrations over); 0 r/min until 1 s, then a \
-                  ramp to +6 % of rated speed (lifting) by 2 s, held to 3 s. The drive starts \
-                  from the rotor's angle (`align`)",
-        criterion: "released; backward travel after the release ≤ 0.5 rad electrical; \
-                    |θ − θ̂| < 0.25 rad from the release on; commanded speed reached \
-                    (|n − n*| < 2 % of rated speed over the last 0.5 s); no trip",
+                  100 % of rated torque (gravity-like) on it; the drive is not told the angle \
+                  and finds it at standstill (`[controller.startup] find_angle`; a plant with \
+                  constant inductances gets the assumed d-axis saturation \
+                  `LOADED_START_D_SATURATION`); the brake opens at the drive's first ready \
+                  sample from 0.7 s on; 0 r/min until 1 s, then a ramp to +6 % of rated speed \
+                  (lifting) by 2 s, held to 3 s",
+        criterion: "from t = 0: the angle found and |θ − θ̂| from ready on < 0.25 rad; backward \
+                    travel ≤ 0.5 rad electrical; commanded speed reached (|n − n*| < 2 % of \
+                    rated speed over the last 0.5 s); no trip. A drive that says it has no \
+                    angle (`StartupStatus::NoAngle`) passes if it stays off and the rotor \
+                    does not move",
         scaled: true,
         neutral: false,
         setup: setup_loaded_start,

@@ -40,6 +40,11 @@ pub struct Sample {
     pub i_ab_measured: fado_core::Ab<f64>,
     /// The plant's holding brake holds the rotor over this sample.
     pub brake_engaged: bool,
+    /// The controller reports ready at this sample (its start-up is over and it holds the
+    /// rotor).
+    pub ready: bool,
+    /// Where the controller's start-up angle phase stands.
+    pub startup: fado_core::control::StartupStatus,
     /// The controller's output at this sample.
     pub act: Actuation,
 }

@@ -22,6 +22,8 @@ pub struct Simulation<C> {
     speed_cursor: usize,
     pole_pairs: f64,
     tripped: bool,
+    /// The brake releases at the first ready sample from this time on (s).
+    brake_release_at: f64,
 }
 
 impl<C: Controller> Simulation<C> {
@@ -47,7 +49,14 @@ impl<C: Controller> Simulation<C> {
             speed_cursor: 0,
             pole_pairs,
             tripped: false,
+            brake_release_at: 0.0,
         })
+    }
+
+    /// The plant's brake releases at the first ready sample from `time` (s) on.
+    pub fn with_brake_release_at(mut self, time: f64) -> Self {
+        self.brake_release_at = time;
+        self
     }
 
     /// Adds timed controller events (e.g. k_df off/on), any order.
@@ -99,8 +108,10 @@ impl<C: Controller> Simulation<C> {
         };
         let act = self.controller.step(&m);
         self.tripped |= act.tripped;
-        if self.plant.brake_engaged() && self.controller.ready() {
+        let ready = self.controller.ready();
+        if self.plant.brake_engaged() && ready && t >= self.brake_release_at {
             self.plant.release_brake();
+            self.controller.brake_released();
         }
         let st = *self.plant.motor().state();
         let sample = Sample {
@@ -119,6 +130,8 @@ impl<C: Controller> Simulation<C> {
             pole_pairs: self.pole_pairs,
             dc_voltage: self.plant.inverter().dc_voltage(),
             brake_engaged: self.plant.brake_engaged(),
+            ready,
+            startup: self.controller.startup_status(),
             act,
         };
         self.plant.step(act.duty, act.gates_enabled);

@@ -3,6 +3,7 @@
 
 use super::{Blocks, DriveTuning, Resolved};
 use crate::control::gain_calibration::{GainCalibration, GainCalibrationConfig};
+use crate::control::startup::AngleSearch;
 use crate::error::{ConfigError, check};
 use crate::{MachineModel, Real};
 
@@ -35,6 +36,7 @@ impl<T: Real> DriveConfig<T> {
         Resolved::new(self)
             .and_then(|r| Blocks::new(self, &r))
             .and_then(|_| GainCalibration::new(self.gain_calibration_config()?))
+            .and_then(|_| AngleSearch::new(self.tuning.startup, &self.machine, self.ts))
             .map(|_| ())
     }
 

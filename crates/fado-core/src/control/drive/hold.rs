@@ -28,6 +28,13 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         })
     }
 
+    /// (Re)arms the release hold at the present θ̂: the application calls it when its brake
+    /// releases later than the start-up's end (a hoist opens its brake just before the lift).
+    pub fn arm_release_hold(&mut self) {
+        let theta = self.last.estimate.theta;
+        self.blocks.hold.arm(theta);
+    }
+
     /// Times the release hold acted since the drive was built (see
     /// [`release_hold`](crate::control::release_hold)).
     pub fn release_holds(&self) -> u32 {

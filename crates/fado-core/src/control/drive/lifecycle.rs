@@ -4,6 +4,7 @@ use super::{Blocks, DriveConfig, DriveOutput, Resolved, SensorlessDrive};
 use crate::control::gain_calibration::{GainCalibration, GainCalibrationStatus};
 use crate::control::lock_reaction::LockSupervisor;
 use crate::control::monitor::{DriveFlags, FlagCounts, PersistenceMonitor, StuckChannelDetector};
+use crate::control::startup::AngleSearch;
 use crate::error::{ConfigError, check};
 use crate::estimator::{
     Estimate, EstimatorConfig, EstimatorTuning, RotorAngleEstimator, SensorlessEstimator,
@@ -59,6 +60,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             aligned_angle: T::zero(),
             gain: GainCalibration::new(config.gain_calibration_config()?)?,
             gain_correction: T::one(),
+            startup: AngleSearch::new(config.tuning.startup, &config.machine, config.ts)?,
             stuck_sensor: StuckChannelDetector::new(
                 config.tuning.stuck_sensor.band_ratio * config.machine.rated_current,
                 config.tuning.stuck_sensor.reference_ratio * config.machine.rated_current,
@@ -100,6 +102,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         self.flag_counts.reset();
         self.lock.reset();
         self.gain.arm();
+        self.startup.arm();
         self.calibrate_offsets();
     }
 

@@ -25,6 +25,7 @@
 //!    current PIs; it enters the two-deep history for the estimator.
 //! 9. The status word [`DriveFlags`] of the sample is formed and counted.
 
+mod angle_phase;
 mod blocks;
 mod calibration;
 mod config;
@@ -59,6 +60,7 @@ use crate::control::release_hold::ReleaseHold;
 use crate::control::saturated_references::SaturatedReferences;
 use crate::control::speed_controller::SpeedController;
 use crate::control::standstill_probe::StandstillProbe;
+use crate::control::startup::AngleSearch;
 use crate::estimator::{Estimate, SensorlessEstimator};
 use crate::injection::CurrentInjection;
 use crate::lock::Debouncer;
@@ -203,6 +205,8 @@ pub struct SensorlessDrive<T: 'static, E = SensorlessEstimator<T>> {
     aligned_angle: T,
     /// The start-up gain-mismatch calibration (after the offsets) and its result.
     gain: GainCalibration<T>,
+    /// The start-up's angle phase (after the offsets, before the gain calibration).
+    startup: AngleSearch<T>,
     /// 1/k: the factor on the phase-a reading (1 until a ratio is measured).
     gain_correction: T,
     /// Stuck phase-current channel detection and reconstruction.

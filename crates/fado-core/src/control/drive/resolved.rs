@@ -16,6 +16,10 @@ impl<T: Real> Resolved<T> {
         c.machine.validate()?;
         let t = &c.tuning;
         check::positive("tracker_feedforward.max_lag", t.tracker_feedforward.max_lag)?;
+        check::positive(
+            "tracker_feedforward.load_step_error",
+            t.tracker_feedforward.load_step_error,
+        )?;
         let rated = c.machine.rated_current;
         // A duration as a whole number of samples (at most about 5 days at 10 kHz).
         let samples = &|field: &'static str, time: T| -> Result<u32, ConfigError> {

@@ -216,6 +216,9 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             self.last.input_fault = false;
             return Err(self.last);
         }
+        if self.startup.active() {
+            return Err(self.angle_phase_step(i_abc, vdc));
+        }
         if self.gain.pending() {
             let theta0 = self.aligned_angle;
             self.gain.start(theta0);

@@ -17,12 +17,28 @@
 //! [`LOAD_POLE_RATIO`] where the tuning leaves it at 0): without it the load the model does not
 //! know would leave p·T_L/(Ĵ·Ki) of angle error. A tuning that turns them on itself is kept.
 //!
-//! **Threshold.** 1 rad \[A\]: on the repository's presets the rule turns the feed-forward on for
-//! the two fast outrunners (lags 2.4 and 3.0 rad; `reversal` and `stops` within 0.07 rad) and
-//! leaves the paper's trackers on the others (lags 0.06 to 0.68 rad). On the two strongly
+//! **Threshold.** 2 rad \[A\] ([`TrackerFeedforwardTuning::max_lag`]): on the repository's
+//! presets the rule turns the feed-forward on for the two fast outrunners (lags 2.4 and 3.0 rad)
+//! and leaves the paper's trackers on the others (lags 0.06 to 0.68 rad). On the two strongly
 //! salient presets (0.50 and 0.68 rad) the type-3 trackers lose `reversal` near zero speed
-//! (measured: ipmsm-gem-50k 3.1 rad, pmsyrm-5k 0.21 rad), so a threshold below their lags would
-//! cost them their zero-speed passage.
+//! (measured: ipmsm-gem-50k 3.1 rad, pmsyrm-5k 0.21 rad), and a 750 W 10-pole servo (1.5–2 rad)
+//! loses its loaded start with them, so a threshold below their lags would cost them.
+//!
+//! **T2S-1's bandwidth on a light rotor.** The feed-forward announces the torque the drive
+//! commands, not the load's: a load step ΔT_L decelerates the rotor at α = p·ΔT_L/Ĵ, which
+//! only the trackers' third integrator learns. The phase error of a type-3 tracker (poles
+//! (s² + 2ζωn·s + ωn²)(s + c·ωn)) under a step α of unannounced acceleration is
+//! e(s) = α/(s³ + Kp·s² + Ki·s + K3), whose peak is κ(ζ, c)·α/ωn² ([`load_step_peak`]: κ = 0.50
+//! at ζ = 1/√2, c = 0.5; 1.04 for the type-2 pair, c = 0). A rated load step on the
+//! 21-pole-pair cheetah outrunner (5.5·10⁴ rad/s² electrical) in the paper's 60 Hz T2S-1
+//! (ωn = 183 s⁻¹) peaks at 0.82 rad; half of it, `fullrange`'s step, measured 0.45 rad. So where
+//! the drive runs the type-3 trackers, the rule raises T2S-1's ωn until a step of the rated
+//! torque peaks at [`TrackerFeedforwardTuning::load_step_error`]: ωn ≥ √(κ·p·T_rated/(Ĵ·e_max)),
+//! never lowering it and never beyond (2ζ + c)·ωn·Ts = [`MAX_KP_TS`]. T2S-2, whose speed closes
+//! the speed loop, keeps its bandwidth. A wider T2S-1 passes more of the directly calculated
+//! angle's noise; the rule widens it only as far as the rotor's own acceleration asks, and on
+//! the presets only for the two outrunners (cheetah 122 Hz, multirotor 108 Hz; the others'
+//! rated steps need less than 60 Hz).
 
 use crate::Real;
 use crate::control::DriveTuning;
@@ -33,6 +49,11 @@ use crate::tracker::TrackerConfig;
 /// Load-integrator pole of the trackers the rule turns on, as a ratio of ωn: 0.5 \[A\] (the
 /// range scenarios' value, docs/range.md).
 pub const LOAD_POLE_RATIO: f64 = 0.5;
+
+/// The largest Kp·Ts the bandwidth rule gives T2S-1: 0.25 \[A\], half the type-3 tracker's
+/// own refusal limit (`crate::tracker`), so that the rule never builds a refused tracker and
+/// the discrete poles stay near their continuous places.
+pub const MAX_KP_TS: f64 = 0.25;
 
 /// `[controller.tracker_feedforward]`: the rule of the module docs.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -62,6 +83,12 @@ pub struct TrackerFeedforwardTuning<T> {
     /// backward, `fado-sim/tests/loaded_start.rs`); the strongly salient presets lose their
     /// `reversal` with it. A large value (1e9) keeps the paper's trackers on every rotor.
     pub max_lag: T,
+    /// Peak angle error (rad) of T2S-1 under a step of the rated load torque that the drive
+    /// allows where it runs the type-3 trackers (acceleration feed-forward on, load pole > 0):
+    /// T2S-1's bandwidth is raised until κ·p·T_rated/(Ĵ·ωn²) is within it (module docs).
+    /// Default 0.2 rad \[A\]: `fullrange`'s step of half the rated torque then peaks near
+    /// 0.1 rad, the range scenarios' aim. A large value (1e9) keeps the tuning's bandwidth.
+    pub load_step_error: T,
 }
 
 impl<T: Real> Default for TrackerFeedforwardTuning<T> {
@@ -69,6 +96,7 @@ impl<T: Real> Default for TrackerFeedforwardTuning<T> {
         Self {
             enabled: false,
             max_lag: T::lit(2.0),
+            load_step_error: T::lit(0.2),
         }
     }
 }
@@ -79,7 +107,72 @@ impl<T: Real> TrackerFeedforwardTuning<T> {
         TrackerFeedforwardTuning {
             enabled: self.enabled,
             max_lag: U::lit(self.max_lag.to_f64()),
+            load_step_error: U::lit(self.load_step_error.to_f64()),
         }
+    }
+}
+
+/// κ(ζ, c): the peak phase error of a tracker with poles (s² + 2ζ·s + 1)(s + c), ωn = 1,
+/// after a unit step of unannounced acceleration, i.e. the peak of the impulse response of
+/// 1/((s² + 2ζ·s + 1)(s + c)) (module docs; the peak error is κ·α/ωn²). Integrated by the
+/// classical Runge–Kutta method over 40/ωn (the peak comes within 2π/ωn; beyond it the
+/// response only decays), step 0.01/ωn.
+pub fn load_step_peak<T: Real>(damping: T, c: T) -> T {
+    let (kp, ki, k3) = (
+        T::lit(2.0) * damping + c,
+        T::one() + T::lit(2.0) * damping * c,
+        c,
+    );
+    // x = (e, ė, ë); e⃛ = −Kp·ë − Ki·ė − K3·e; an impulse sets ë(0+) = 1.
+    let f = |x: [T; 3]| [x[1], x[2], -(kp * x[2] + ki * x[1] + k3 * x[0])];
+    let h = T::lit(0.01);
+    let mut x = [T::zero(), T::zero(), T::one()];
+    let mut peak = T::zero();
+    for _ in 0..4000 {
+        let k1 = f(x);
+        let k2 = f(core::array::from_fn(|i| x[i] + h * T::lit(0.5) * k1[i]));
+        let k3s = f(core::array::from_fn(|i| x[i] + h * T::lit(0.5) * k2[i]));
+        let k4 = f(core::array::from_fn(|i| x[i] + h * k3s[i]));
+        x = core::array::from_fn(|i| {
+            x[i] + h / T::lit(6.0) * (k1[i] + T::lit(2.0) * (k2[i] + k3s[i]) + k4[i])
+        });
+        peak = crate::real::max(peak, x[0].abs());
+    }
+    peak
+}
+
+/// The type-2 gains (Kp, Ki) of the estimator's T2S-1 sampled every `ts`.
+fn t2s1_gains<T: Real>(estimator: &EstimatorTuning<T>, ts: T) -> (T, T) {
+    let t = &estimator.tracker;
+    TrackerConfig {
+        damping: t.damping,
+        definition: t.bandwidth_definition,
+        ..TrackerConfig::new(t.t2s1_bandwidth_hz, ts)
+    }
+    .gains()
+}
+
+/// T2S-1's bandwidth (Hz, in the tuning's own definition) at which a step of the rated load
+/// torque peaks at `load_step_error` in the type-3 tracker (module docs); the tuning's own
+/// bandwidth where that is already enough, at most the one of Kp·Ts = [`MAX_KP_TS`].
+pub fn load_step_bandwidth<T: Real>(
+    machine: &MachineModel<T>,
+    drive: &DriveTuning<T>,
+    estimator: &EstimatorTuning<T>,
+    ts: T,
+) -> T {
+    let t = &estimator.tracker;
+    let wn = t2s1_gains(estimator, ts).1.sqrt();
+    let alpha = T::lit(machine.pole_pairs as f64) * machine.rated_torque / machine.inertia;
+    let kappa = load_step_peak(t.damping, t.load_pole_ratio);
+    let wn_needed = (kappa * alpha / drive.tracker_feedforward.load_step_error).sqrt();
+    let wn_max = T::lit(MAX_KP_TS) / ((T::lit(2.0) * t.damping + t.load_pole_ratio) * ts);
+    let wn_new = crate::real::min(wn_needed, wn_max);
+    // NaN compares false: the tuning's bandwidth.
+    if wn_new > wn {
+        t.t2s1_bandwidth_hz * wn_new / wn
+    } else {
+        t.t2s1_bandwidth_hz
     }
 }
 
@@ -91,18 +184,13 @@ pub fn current_limit_lag<T: Real>(
     estimator: &EstimatorTuning<T>,
     ts: T,
 ) -> T {
-    let tracker = TrackerConfig {
-        damping: estimator.tracker.damping,
-        definition: estimator.tracker.bandwidth_definition,
-        ..TrackerConfig::new(estimator.tracker.t2s1_bandwidth_hz, ts)
-    };
-    let (_, ki) = tracker.gains();
+    let (_, ki) = t2s1_gains(estimator, ts);
     let ratio = crate::real::min(drive.current.limit_ratio, drive.limits.torque_ratio);
     let p = T::lit(machine.pole_pairs as f64);
     p * ratio * machine.rated_torque / (machine.inertia * ki)
 }
 
-/// Applies the rule of the module docs to the drive's and the estimator's tuning, in place.
+/// Applies the rules of the module docs (the feed-forward, then T2S-1's bandwidth) to the drive's and the estimator's tuning, in place.
 pub fn apply<T: Real>(
     machine: &MachineModel<T>,
     drive: &mut DriveTuning<T>,
@@ -115,6 +203,9 @@ pub fn apply<T: Real>(
         if estimator.tracker.load_pole_ratio == T::zero() {
             estimator.tracker.load_pole_ratio = T::lit(LOAD_POLE_RATIO);
         }
+    }
+    if drive.tracker_feedforward.enabled && estimator.tracker.load_pole_ratio > T::zero() {
+        estimator.tracker.t2s1_bandwidth_hz = load_step_bandwidth(machine, drive, estimator, ts);
     }
 }
 
@@ -166,5 +257,100 @@ mod tests {
         let mut off = d;
         off.tracker_feedforward.max_lag = 1e9;
         assert!(!resolve(&fast, off, e, 25e-6).0.tracker_feedforward.enabled);
+    }
+
+    #[test]
+    fn the_load_step_peak_is_the_impulse_response_peak() {
+        let z = crate::tracker::DEFAULT_DAMPING;
+        // c = 0: the type-2 pair's lag α/ωn² with the step response's overshoot
+        // 1 + exp(−πζ/√(1 − ζ²)) = 1.0432.
+        let k0 = load_step_peak(z, 0.0);
+        assert!(
+            (k0 - (1.0 + (-core::f64::consts::PI * z / (1.0 - z * z).sqrt()).exp())).abs() < 1e-3,
+            "{k0}"
+        );
+        // The load pole shortens the lag: 0.50 at c = 0.5, falling with c.
+        let k = load_step_peak(z, 0.5);
+        assert!((k - 0.50).abs() < 0.01, "{k}");
+        assert!(load_step_peak(z, 1.0) < k && load_step_peak(z, 2.0) < load_step_peak(z, 1.0));
+    }
+
+    /// The discrete type-3 T2S-1 at the rule's bandwidth, fed the angle of a rotor that a
+    /// step `alpha` of unannounced acceleration starts to decelerate at speed `omega0`: the
+    /// largest phase error after the step.
+    fn discrete_step_error(bw: f64, ratio: f64, ts: f64, omega0: f64, alpha: f64) -> f64 {
+        let cfg = TrackerConfig::new(bw, ts);
+        let mut t = crate::tracker::TypeTwoTracker::with_load_pole(cfg, ratio).unwrap();
+        // Locked before the step: the prediction for the first sample is the rotor's angle.
+        t.reset_to(omega0 * ts, omega0);
+        let mut peak = 0.0f64;
+        for k in 1..(0.2 / ts) as usize {
+            let time = k as f64 * ts;
+            let theta = omega0 * time - 0.5 * alpha * time * time;
+            t.step(crate::wrap_angle(theta)).unwrap();
+            peak = peak.max(crate::wrap_angle(theta - t.angle()).abs());
+        }
+        peak
+    }
+
+    #[test]
+    fn a_light_rotor_gets_the_t2s1_bandwidth_its_rated_load_step_needs() {
+        // The cheetah outrunner preset: 21 pole pairs, 1.32 N·m, 5e-4 kg·m², Ts = 25 µs.
+        let cheetah = MachineModel {
+            pole_pairs: 21,
+            flux_linkage: 0.0024,
+            rated_current: 17.5,
+            rated_torque: 1.32,
+            rated_speed_rpm: 1800.0,
+            inertia: 5e-4,
+            ..MachineModel::<f64>::paper()
+        };
+        let ts = 25e-6;
+        let (d, e) = resolve(
+            &cheetah,
+            DriveTuning::default(),
+            EstimatorTuning::default(),
+            ts,
+        );
+        assert!(d.tracker_feedforward.enabled);
+        let bw = e.tracker.t2s1_bandwidth_hz;
+        assert!((bw - 122.0).abs() < 2.0, "{bw}");
+        assert_eq!(e.tracker.t2s2_bandwidth_hz, 35.0);
+        // The discrete tracker meets the bound (and not by a wide margin) under the rated
+        // step at rated speed; the paper's 60 Hz does not.
+        let alpha = 21.0 * 1.32 / 5e-4;
+        let omega0 = 1800.0 * 21.0 * core::f64::consts::PI / 30.0;
+        let err = discrete_step_error(bw, LOAD_POLE_RATIO, ts, omega0, alpha);
+        assert!(err < 0.2 && err > 0.18, "{err}");
+        let err60 = discrete_step_error(60.0, LOAD_POLE_RATIO, ts, omega0, alpha);
+        assert!(err60 > 0.8, "{err60}");
+        // The paper's motor with the feed-forward on keeps its 60 Hz to the bit (its rated
+        // step peaks at 0.057 rad), and without the feed-forward nothing changes.
+        let mut on = DriveTuning::default();
+        on.tracker_feedforward.enabled = true;
+        let mut e3 = EstimatorTuning::default();
+        e3.tracker.load_pole_ratio = LOAD_POLE_RATIO;
+        let paper = MachineModel::<f64>::paper();
+        assert_eq!(resolve(&paper, on, e3, 100e-6).1, e3);
+        // A limit of 1e9 keeps the tuning's bandwidth; an absurd rotor is capped at Kp·Ts.
+        let mut keep = DriveTuning::default();
+        keep.tracker_feedforward.load_step_error = 1e9;
+        let e_keep = resolve(&cheetah, keep, EstimatorTuning::default(), ts).1;
+        assert_eq!(e_keep.tracker.t2s1_bandwidth_hz, 60.0);
+        let feather = MachineModel {
+            inertia: 1e-9,
+            ..cheetah
+        };
+        let e_cap = resolve(
+            &feather,
+            DriveTuning::default(),
+            EstimatorTuning::default(),
+            ts,
+        )
+        .1;
+        let cfg = TrackerConfig::new(e_cap.tracker.t2s1_bandwidth_hz, ts);
+        let kp_ts = (2.0 * cfg.damping + LOAD_POLE_RATIO) * cfg.gains().1.sqrt() * ts;
+        assert!((kp_ts - MAX_KP_TS).abs() < 1e-9, "{kp_ts}");
+        assert!(crate::tracker::TypeTwoTracker::with_load_pole(cfg, LOAD_POLE_RATIO).is_ok());
     }
 }

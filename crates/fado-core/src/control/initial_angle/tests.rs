@@ -12,7 +12,7 @@ const TS: f64 = 1e-4;
 /// magnetomotive force, `Saturation::i_f`, S = 4): the incremental d inductance is `ld` at
 /// zero current, and a_dd·λf⁴ = κ/Ld sets how fast it falls with the d flux (d/dψ of the
 /// inverse inductance at λf: 20·κ/(Ld·λf)). κ = 0 is the linear machine.
-fn machine(ld: f64, lq: f64, lf: f64, kappa: f64) -> Saturation<f64> {
+pub(crate) fn machine(ld: f64, lq: f64, lf: f64, kappa: f64) -> Saturation<f64> {
     let a_dd = kappa / ld / lf.powi(4);
     let a_d0 = (1.0 - 5.0 * kappa) / ld;
     Saturation {

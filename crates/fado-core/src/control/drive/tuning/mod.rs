@@ -6,6 +6,7 @@ use crate::control::dc_link_limit::DcLinkTuning;
 use crate::control::field_weakening::FieldWeakeningTuning;
 use crate::control::ratings_limit::RatingsLimitTuning;
 use crate::control::release_hold::ReleaseHoldTuning;
+use crate::control::startup::StartupTuning;
 use crate::control::tracker_feedforward::TrackerFeedforwardTuning;
 
 mod lock;
@@ -139,6 +140,13 @@ pub struct DriveTuning<T> {
         serde(bound(deserialize = "T: Real + serde::Deserialize<'de>"))
     )]
     pub release_hold: ReleaseHoldTuning<T>,
+    /// How the start-up finds the rotor's angle (`[controller.startup]`, see
+    /// [`StartupTuning`]).
+    #[cfg_attr(
+        feature = "serde",
+        serde(bound(deserialize = "T: Real + serde::Deserialize<'de>"))
+    )]
+    pub startup: StartupTuning<T>,
     /// Tuning of the reaction to a lost lock and of the recovery (`[controller.lock]`, see [`LockReactionTuning`]).
     #[cfg_attr(
         feature = "serde",
@@ -262,6 +270,7 @@ impl<T: Real> DriveTuning<T> {
             limits: self.limits.cast(),
             tracker_feedforward: self.tracker_feedforward.cast(),
             release_hold: self.release_hold.cast(),
+            startup: self.startup.cast(),
             lock: self.lock.cast(),
             stall: self.stall.cast(),
         }
@@ -290,6 +299,7 @@ impl<T: Real> Default for DriveTuning<T> {
             limits: RatingsLimitTuning::default(),
             tracker_feedforward: TrackerFeedforwardTuning::default(),
             release_hold: ReleaseHoldTuning::default(),
+            startup: StartupTuning::default(),
             lock: LockReactionTuning::default(),
             stall: StallTuning::default(),
         }

@@ -1,0 +1,427 @@
+//! The start-up's angle phase: where the rotor is before the first current that makes torque.
+//!
+//! # Why
+//! A drive that starts from an assumed angle (or aligns the rotor with a d current) turns a
+//! loaded or braked rotor, or starts with θ̂ wrong by up to π. The phase finds the angle at
+//! standstill without motion ([`initial_angle`](crate::control::initial_angle): pulse pairs in
+//! twelve directions), and where the pulses give the axis but not the magnet's polarity, a
+//! dedicated polarity test along that axis with a larger current (the d-axis saturation: a
+//! current that adds to the magnet's flux meets the smaller incremental inductance). What it
+//! cannot find it says ([`StartupStatus::NoAngle`]): the drive then stays off, or — only when
+//! the application declares the rotor free to turn ([`StartupTuning::free_rotor_align`]) —
+//! aligns it with a d current in two steps (a quarter turn apart, so that neither step can sit
+//! at the unstable equilibrium). The drive never starts from a guessed angle.
+//!
+//! # Sequence
+//! After the offset calibration (gates off) and before the gain calibration (which then holds
+//! its d current along the angle found):
+//! 1. search: [`InitialAngle`] with pulses that reach `pulse_current_ratio` × the rated current
+//!    along the smaller inductance, each at most `pulse_voltage_ratio` × the largest
+//!    sinusoidal voltage V_dc/√3 (longer pulses when the DC link is low);
+//! 2. polarity test (status `AxisOnly` only): [`POLARITY_PAIRS`] pulse pairs along +axis and
+//!    as many along −axis with `polarity_current_ratio` × the rated current; the direction
+//!    whose current rises faster is the magnet's (a relative difference of at least
+//!    [`DEFAULT_MIN_POLARITY`]);
+//! 3. the result: `Found` → the drive starts from the angle; otherwise the free-rotor
+//!    alignment or [`StartupStatus::NoAngle`].
+
+mod polarity;
+#[cfg(test)]
+mod tests;
+
+pub use polarity::PolarityTest;
+
+use crate::control::initial_angle::{
+    DEFAULT_MIN_POLARITY, DEFAULT_MIN_SALIENCY, InitialAngle, InitialAngleConfig,
+    InitialAngleStatus,
+};
+use crate::error::{ConfigError, check};
+use crate::magnetics::MagneticModel;
+use crate::{Ab, Dq, MachineModel, Real};
+
+/// Pulse pairs per direction of the polarity test (the relative difference of the two sums
+/// is averaged over four pairs: its noise halves against one pair).
+pub const POLARITY_PAIRS: u32 = 4;
+
+/// Fewest samples of a pulse: the drive's computation delay puts the current's peak one
+/// sample after the pulse's end; with three samples the rise is mostly inductive.
+const MIN_PULSE_SAMPLES: usize = 3;
+
+/// `[controller.startup]`: how the drive finds the rotor's angle before it starts (module
+/// docs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(
+        deny_unknown_fields,
+        default,
+        bound(
+            serialize = "T: serde::Serialize",
+            deserialize = "T: Real + serde::Deserialize<'de>"
+        )
+    )
+)]
+pub struct StartupTuning<T> {
+    /// Find the rotor's angle at standstill (this module) instead of starting from the angle
+    /// given to [`align`](crate::control::SensorlessDrive::align), which is then ignored.
+    /// Default false: the drive starts from the angle it is given (a known or sensed angle,
+    /// the paper's figures).
+    pub find_angle: bool,
+    /// Peak current of the search's pulses along the smaller inductance, a multiple of the
+    /// rated current. Default 1 \[A\]: a d-axis saturation shows at the currents the machine
+    /// is built for (the paper's motor: 22 A gives a first harmonic of 2–9 % of the mean at
+    /// half to double the assumed saturation, `initial_angle`'s tests).
+    pub pulse_current_ratio: T,
+    /// Largest pulse voltage as a fraction of V_dc/√3. Default 0.5 \[A\]: half the linear
+    /// range, leaving room for the dead-time compensation; a pulse that would need more is
+    /// made longer.
+    pub pulse_voltage_ratio: T,
+    /// Peak current of the polarity test, a multiple of the rated current. Default 1.5 \[A\]:
+    /// deeper into the saturation than the search, below the default current limit (1.84).
+    pub polarity_current_ratio: T,
+    /// With no angle information, align the rotor with a d current: only for a rotor free to
+    /// turn (no load, no brake). Default false: the drive stays off and says so.
+    pub free_rotor_align: bool,
+    /// d current of the free-rotor alignment, a multiple of the rated current. Default 0.5
+    /// \[A\]: half the rated torque's stiffness turns an unloaded rotor.
+    pub align_current_ratio: T,
+    /// Duration of each of the alignment's two steps (s). Default 0.25 s \[A\].
+    pub align_time: T,
+}
+
+impl<T: Real> Default for StartupTuning<T> {
+    fn default() -> Self {
+        Self {
+            find_angle: false,
+            pulse_current_ratio: T::one(),
+            pulse_voltage_ratio: T::lit(0.5),
+            polarity_current_ratio: T::lit(1.5),
+            free_rotor_align: false,
+            align_current_ratio: T::lit(0.5),
+            align_time: T::lit(0.25),
+        }
+    }
+}
+
+impl<T: Real> StartupTuning<T> {
+    /// The same tuning in another scalar type.
+    pub fn cast<U: Real>(&self) -> StartupTuning<U> {
+        StartupTuning {
+            find_angle: self.find_angle,
+            pulse_current_ratio: U::lit(self.pulse_current_ratio.to_f64()),
+            pulse_voltage_ratio: U::lit(self.pulse_voltage_ratio.to_f64()),
+            polarity_current_ratio: U::lit(self.polarity_current_ratio.to_f64()),
+            free_rotor_align: self.free_rotor_align,
+            align_current_ratio: U::lit(self.align_current_ratio.to_f64()),
+            align_time: U::lit(self.align_time.to_f64()),
+        }
+    }
+
+    /// Checks every field; the error names the first bad one.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        check::positive("startup.pulse_current_ratio", self.pulse_current_ratio)?;
+        check::below(
+            "startup.pulse_voltage_ratio",
+            check::positive("startup.pulse_voltage_ratio", self.pulse_voltage_ratio)?,
+            T::lit(1.0 + 1e-9),
+            "in (0, 1]",
+        )?;
+        check::positive(
+            "startup.polarity_current_ratio",
+            self.polarity_current_ratio,
+        )?;
+        check::positive("startup.align_current_ratio", self.align_current_ratio)?;
+        check::non_negative("startup.align_time", self.align_time)?;
+        Ok(())
+    }
+}
+
+/// Whether the drive's magnetic model meets a larger incremental d inductance along +d (with
+/// the magnet) than along −d over the pulse's path from 0 to `current`: then the faster rise
+/// points against the magnet (a PM-assisted synchronous reluctance rotor whose bridges the
+/// magnet saturates and a negative d current relieves). A constant-inductance model gives no
+/// sign: false, the usual case of a magnet rotor whose d-axis iron saturates further with
+/// the magnet's flux (the polarity tests of drives, `initial_angle`'s module docs).
+pub fn inverted_polarity<T: Real>(machine: &MachineModel<T>, current: T) -> bool {
+    if machine.magnetics.is_linear() || !current.is_finite() || current <= T::zero() {
+        return false;
+    }
+    let m = machine.magnetic_model();
+    let (mut plus, mut minus) = (T::zero(), T::zero());
+    for k in 1..=4 {
+        let i = current * T::from_index(k) * T::lit(0.25);
+        plus += m.incremental_inductance(Dq::new(i, T::zero())).dd;
+        minus += m.incremental_inductance(Dq::new(-i, T::zero())).dd;
+    }
+    plus > minus
+}
+
+/// Where the start-up's angle phase stands.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum StartupStatus {
+    /// Not armed: the drive starts from the angle it was given (`find_angle` off), or the
+    /// phase has not begun (offsets still being measured).
+    #[default]
+    Idle,
+    /// The twelve-direction pulses.
+    Searching,
+    /// The polarity test along the axis found.
+    TestingPolarity,
+    /// The free-rotor alignment (d current, two steps).
+    Aligning,
+    /// The angle is known (found, or the free rotor aligned): the drive starts from it.
+    Found,
+    /// No usable angle: the drive stays off (gates off, not ready). The detection's verdict:
+    /// `AxisOnly` (the axis, its polarity not even with the polarity test), `NoInformation`
+    /// or `Implausible`.
+    NoAngle(InitialAngleStatus),
+}
+
+/// What the phase asks of the drive at a sample.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum StartupCommand<T> {
+    /// Apply this α-β voltage (a pulse).
+    Voltage(Ab<T>),
+    /// Hold this d current along this angle with the current loop (the free-rotor
+    /// alignment).
+    Align {
+        /// Electrical rad.
+        angle: T,
+        /// A.
+        current_d: T,
+    },
+    /// The phase is over: start from this angle.
+    Start(T),
+    /// The phase is over without an angle: gates off.
+    Off,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Stage<T> {
+    Idle,
+    Search(InitialAngle<T>),
+    Polarity(PolarityTest<T>),
+    Align { samples: u32, axis: T },
+    Done,
+}
+
+/// The angle phase's state machine (module docs). Allocation-free.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AngleSearch<T> {
+    tuning: StartupTuning<T>,
+    ts: T,
+    rated_current: T,
+    l_min: T,
+    l_mean: T,
+    d_larger: bool,
+    /// The model's d axis meets the larger incremental inductance along +d than along −d
+    /// ([`inverted_polarity`]): the faster rise then points against the magnet.
+    inverted: bool,
+    align_samples: u32,
+    stage: Stage<T>,
+    status: StartupStatus,
+    angle: T,
+    /// The search's detection verdict and (a₁/m, a₂/m); the polarity test's relative
+    /// difference.
+    detection: (InitialAngleStatus, (T, T)),
+    polarity_contrast: T,
+    armed: bool,
+}
+
+impl<T: Real> AngleSearch<T> {
+    /// The phase for `machine` sampled at `ts`, not armed.
+    pub fn new(
+        tuning: StartupTuning<T>,
+        machine: &MachineModel<T>,
+        ts: T,
+    ) -> Result<Self, ConfigError> {
+        tuning.validate()?;
+        let align_samples = crate::lock::samples("startup.align_time", tuning.align_time, ts)?;
+        Ok(Self {
+            tuning,
+            ts,
+            rated_current: machine.rated_current,
+            l_min: crate::real::min(machine.ld, machine.lq),
+            l_mean: T::lit(0.5) * (machine.ld + machine.lq),
+            d_larger: machine.ld > machine.lq,
+            inverted: inverted_polarity(
+                machine,
+                tuning.pulse_current_ratio * machine.rated_current,
+            ),
+            align_samples,
+            stage: Stage::Idle,
+            status: StartupStatus::Idle,
+            angle: T::zero() / T::zero(),
+            detection: (InitialAngleStatus::Running, (T::zero(), T::zero())),
+            polarity_contrast: T::zero(),
+            armed: false,
+        })
+    }
+
+    /// Arms the phase (when `find_angle` is on): it begins at the next [`step`](Self::step).
+    pub fn arm(&mut self) {
+        self.stage = Stage::Idle;
+        self.armed = self.tuning.find_angle;
+        self.status = StartupStatus::Idle;
+        self.angle = T::zero() / T::zero();
+    }
+
+    /// The phase has work to do (armed, or running a stage) or holds the drive off.
+    pub fn active(&self) -> bool {
+        self.armed
+            || !matches!(self.stage, Stage::Idle | Stage::Done)
+            || matches!(self.status, StartupStatus::NoAngle(_))
+    }
+
+    /// Where the phase stands.
+    pub fn status(&self) -> StartupStatus {
+        self.status
+    }
+
+    /// The angle the drive starts from (electrical rad), NaN until one is known.
+    pub fn angle(&self) -> T {
+        self.angle
+    }
+
+    /// The search's verdict and its harmonics (a₁/m, a₂/m): the margins against
+    /// [`DEFAULT_MIN_POLARITY`] and [`DEFAULT_MIN_SALIENCY`].
+    pub fn detection(&self) -> (InitialAngleStatus, (T, T)) {
+        self.detection
+    }
+
+    /// The polarity test's relative difference (+axis − −axis)/mean (0 when it did not run).
+    pub fn polarity_contrast(&self) -> T {
+        self.polarity_contrast
+    }
+
+    /// The tuning.
+    pub fn tuning(&self) -> &StartupTuning<T> {
+        &self.tuning
+    }
+
+    /// Pulse voltage and samples for a peak of `ratio` × the rated current along the smaller
+    /// inductance at DC link `vdc`.
+    fn pulse(&self, ratio: T, vdc: T) -> (T, u32) {
+        let flux = self.l_min * ratio * self.rated_current;
+        let v_max = self.tuning.pulse_voltage_ratio * vdc * T::lit(0.577_350_269_189_625_8);
+        let n = if v_max > T::zero() {
+            (flux / (v_max * self.ts)).index_floor(100_000) + 1
+        } else {
+            MIN_PULSE_SAMPLES
+        };
+        let n = n.max(MIN_PULSE_SAMPLES);
+        (flux / (T::from_index(n) * self.ts), n as u32)
+    }
+
+    /// One sample: `i_ab` the measured current (offsets removed), `vdc` the DC link.
+    pub fn step(&mut self, i_ab: Ab<T>, vdc: T) -> StartupCommand<T> {
+        if self.armed {
+            self.armed = false;
+            self.status = StartupStatus::Searching;
+            let (voltage, pulse_samples) = self.pulse(self.tuning.pulse_current_ratio, vdc);
+            let config = InitialAngleConfig {
+                voltage,
+                pulse_samples,
+                min_saliency: T::lit(DEFAULT_MIN_SALIENCY),
+                min_polarity: T::lit(DEFAULT_MIN_POLARITY),
+                d_larger: self.d_larger,
+                inductance: self.l_mean,
+                ts: self.ts,
+            };
+            match InitialAngle::new(config) {
+                Ok(block) => self.stage = Stage::Search(block),
+                Err(_) => return self.refuse(InitialAngleStatus::Implausible),
+            }
+        }
+        match &mut self.stage {
+            Stage::Search(block) => {
+                let v = block.step(i_ab);
+                if block.running() {
+                    return StartupCommand::Voltage(v);
+                }
+                let (status, angle) = (block.status(), block.angle());
+                self.detection = (status, block.harmonics());
+                self.searched(status, angle, vdc)
+            }
+            Stage::Polarity(test) => {
+                let v = test.step(i_ab);
+                if let Some(result) = test.result() {
+                    self.polarity_contrast = test.contrast();
+                    let axis = test.axis();
+                    return match result {
+                        Some(angle) => self.found(angle),
+                        None => self.unresolved(InitialAngleStatus::AxisOnly, axis),
+                    };
+                }
+                StartupCommand::Voltage(v)
+            }
+            Stage::Align { samples, axis } => {
+                let (n, axis) = (*samples, *axis);
+                *samples += 1;
+                if n >= 2 * self.align_samples {
+                    return self.found(axis + T::lit(core::f64::consts::FRAC_PI_2));
+                }
+                let step = if n < self.align_samples {
+                    T::zero()
+                } else {
+                    T::lit(core::f64::consts::FRAC_PI_2)
+                };
+                StartupCommand::Align {
+                    angle: axis + step,
+                    current_d: self.tuning.align_current_ratio * self.rated_current,
+                }
+            }
+            Stage::Done => match self.status {
+                StartupStatus::Found => StartupCommand::Start(self.angle),
+                _ => StartupCommand::Off,
+            },
+            Stage::Idle => StartupCommand::Off,
+        }
+    }
+
+    /// The search's verdict: start, test the polarity, align or refuse.
+    fn searched(&mut self, status: InitialAngleStatus, angle: T, vdc: T) -> StartupCommand<T> {
+        match status {
+            InitialAngleStatus::Found => self.found(angle),
+            InitialAngleStatus::AxisOnly => {
+                let (voltage, n) = self.pulse(self.tuning.polarity_current_ratio, vdc);
+                let test = PolarityTest::new(angle, voltage, n, self.l_mean, self.ts);
+                self.stage = Stage::Polarity(test);
+                self.status = StartupStatus::TestingPolarity;
+                StartupCommand::Voltage(Ab::zero())
+            }
+            other => self.unresolved(other, T::zero()),
+        }
+    }
+
+    /// `angle`: the direction of the faster rise (the magnet's unless the model says
+    /// otherwise).
+    fn found(&mut self, angle: T) -> StartupCommand<T> {
+        let angle = if self.inverted {
+            angle + T::pi()
+        } else {
+            angle
+        };
+        self.angle = crate::wrap_angle(angle);
+        self.status = StartupStatus::Found;
+        self.stage = Stage::Done;
+        StartupCommand::Start(self.angle)
+    }
+
+    /// No usable angle: the free-rotor alignment from `axis`, or off.
+    fn unresolved(&mut self, status: InitialAngleStatus, axis: T) -> StartupCommand<T> {
+        if self.tuning.free_rotor_align && status != InitialAngleStatus::Implausible {
+            self.stage = Stage::Align { samples: 0, axis };
+            self.status = StartupStatus::Aligning;
+            return StartupCommand::Voltage(Ab::zero());
+        }
+        self.refuse(status)
+    }
+
+    fn refuse(&mut self, status: InitialAngleStatus) -> StartupCommand<T> {
+        self.stage = Stage::Done;
+        self.status = StartupStatus::NoAngle(status);
+        StartupCommand::Off
+    }
+}

@@ -1,0 +1,162 @@
+//! Tests of [`super`]: the phase's status transitions on rotors at rest whose magnetics are
+//! the flux-linkage model of [`crate::magnetics`] (the saturation of `initial_angle`'s tests),
+//! behind a drive's one-sample computation delay.
+
+use super::*;
+use crate::control::initial_angle::tests::machine;
+use crate::magnetics::{MagneticModel, Saturation};
+use crate::{Dq, Rotation};
+
+const TS: f64 = 1e-4;
+
+/// The phase on `model` at rest at `theta` (Rs `r`, DC link `vdc`) until it ends; returns the
+/// phase and the statuses it went through (each once, in order).
+fn run(
+    mut search: AngleSearch<f64>,
+    model: &Saturation<f64>,
+    r: f64,
+    theta: f64,
+    vdc: f64,
+) -> (AngleSearch<f64>, std::vec::Vec<StartupStatus>) {
+    search.arm();
+    let rot = Rotation::from_angle(theta);
+    let mut psi = model.flux(Dq::zero());
+    let mut i = Dq::zero();
+    let mut pending = Ab::zero();
+    let mut seen = std::vec::Vec::new();
+    for _ in 0..200_000 {
+        let v = pending.to_dq(rot);
+        let command = search.step(i.to_ab(rot), vdc);
+        if seen.last() != Some(&search.status()) {
+            seen.push(search.status());
+        }
+        pending = match command {
+            StartupCommand::Voltage(v) => v,
+            StartupCommand::Align { .. } => Ab::zero(),
+            StartupCommand::Start(_) | StartupCommand::Off => break,
+        };
+        psi = Dq::new(psi.d + (v.d - r * i.d) * TS, psi.q + (v.q - r * i.q) * TS);
+        i = model.current_from(psi, i);
+    }
+    (search, seen)
+}
+
+fn phase(ld: f64, lq: f64, rated: f64, tuning: StartupTuning<f64>) -> AngleSearch<f64> {
+    let machine = MachineModel {
+        ld,
+        lq,
+        rated_current: rated,
+        ..MachineModel::paper()
+    };
+    AngleSearch::new(tuning, &machine, TS).unwrap()
+}
+
+fn on() -> StartupTuning<f64> {
+    StartupTuning {
+        find_angle: true,
+        ..StartupTuning::default()
+    }
+}
+
+#[test]
+fn a_saturating_surface_magnet_rotor_is_found_and_the_drive_starts_from_it() {
+    let m = machine(2.63e-3, 2.63e-3, 0.088, 0.01);
+    for theta in [0.74, -1.49, 2.57, 0.33] {
+        let (s, seen) = run(
+            phase(2.63e-3, 2.63e-3, 21.78, on()),
+            &m,
+            0.327,
+            theta,
+            300.0,
+        );
+        assert_eq!(
+            seen,
+            [StartupStatus::Searching, StartupStatus::Found],
+            "{theta}"
+        );
+        let e = crate::wrap_angle(s.angle() - theta).abs();
+        assert!(e < 0.1, "θ {theta}: {} ({e})", s.angle());
+        assert!(!s.active());
+    }
+}
+
+#[test]
+fn an_axis_without_polarity_goes_to_the_polarity_test_which_resolves_it() {
+    // The 2.2 kW IPMSM with a fifth of the assumed saturation: the search's first harmonic
+    // is below its threshold, the polarity test's larger current shows it.
+    let m = machine(0.036, 0.051, 0.545, 0.002);
+    for theta in [0.74, -1.49, 2.57] {
+        let (s, seen) = run(phase(0.036, 0.051, 6.08, on()), &m, 3.6, theta, 540.0);
+        let e = crate::wrap_angle(s.angle() - theta).abs();
+        assert_eq!(
+            seen,
+            [
+                StartupStatus::Searching,
+                StartupStatus::TestingPolarity,
+                StartupStatus::Found
+            ],
+            "θ {theta}: {:?} contrast {}",
+            s.detection(),
+            s.polarity_contrast()
+        );
+        assert!(e < 0.05, "θ {theta}: {} ({e})", s.angle());
+    }
+}
+
+#[test]
+fn a_linear_salient_rotor_ends_axis_only_and_the_drive_stays_off() {
+    let m = machine(0.036, 0.051, 0.545, 0.0);
+    let (s, seen) = run(phase(0.036, 0.051, 6.08, on()), &m, 3.6, 0.74, 540.0);
+    let off = StartupStatus::NoAngle(InitialAngleStatus::AxisOnly);
+    assert_eq!(
+        seen,
+        [
+            StartupStatus::Searching,
+            StartupStatus::TestingPolarity,
+            off
+        ]
+    );
+    assert!(
+        s.polarity_contrast().abs() < 0.01,
+        "{}",
+        s.polarity_contrast()
+    );
+    assert!(s.active(), "the drive stays off");
+    assert!(s.angle().is_nan());
+}
+
+#[test]
+fn a_linear_surface_magnet_rotor_says_so_and_is_aligned_only_when_free() {
+    let m = machine(2.63e-3, 2.63e-3, 0.088, 0.0);
+    let (s, seen) = run(phase(2.63e-3, 2.63e-3, 21.78, on()), &m, 0.327, 0.74, 300.0);
+    let off = StartupStatus::NoAngle(InitialAngleStatus::NoInformation);
+    assert_eq!(seen, [StartupStatus::Searching, off]);
+    assert!(s.active() && s.angle().is_nan());
+    let free = StartupTuning {
+        free_rotor_align: true,
+        ..on()
+    };
+    let (s, seen) = run(phase(2.63e-3, 2.63e-3, 21.78, free), &m, 0.327, 0.74, 300.0);
+    let expected = [
+        StartupStatus::Searching,
+        StartupStatus::Aligning,
+        StartupStatus::Found,
+    ];
+    assert_eq!(seen, expected);
+    assert!((s.angle() - core::f64::consts::FRAC_PI_2).abs() < 1e-12);
+}
+
+#[test]
+fn off_by_default_and_bad_settings_are_named() {
+    let mut s = phase(2.63e-3, 2.63e-3, 21.78, StartupTuning::default());
+    s.arm();
+    assert!(!s.active());
+    assert_eq!(s.status(), StartupStatus::Idle);
+    let bad = StartupTuning {
+        pulse_voltage_ratio: 1.5,
+        ..on()
+    };
+    let machine = MachineModel::paper();
+    let e = AngleSearch::new(bad, &machine, TS).unwrap_err();
+    assert_eq!(e.field(), "startup.pulse_voltage_ratio");
+}
