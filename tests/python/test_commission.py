@@ -86,11 +86,16 @@ def test_traces_are_arrays_over_the_phases_in_order(paper: fado.CommissionResult
     assert np.all(np.diff(phase) >= 0), "phases run in order"
     names = [fado.COMMISSION_PHASES[k] for k in np.unique(phase)]
     assert names == ["offset", "align", "resistance", "inductance_d", "inductance_q",
-                     "spin", "coast", "inertia"]
+                     "magnetics", "spin", "coast", "inertia"]
     # The rotor spins in the spin phases and stands still in the inductance tests.
     spin = paper["speed_rpm"][phase == fado.COMMISSION_PHASES.index("coast")]
     assert spin.min() > 10.0
     assert paper.rotor_motion_inductance < 0.01
+    # The magnetic identification's pulses leave the free rotor nearly where it was, and the
+    # paper's (linear) motor is reported unsaturated.
+    assert paper.rotor_motion_magnetics < 0.15
+    assert paper.saturation_detected is False
+    assert "No magnetic saturation detected" in paper.identified_toml
 
 
 def test_dict_motor_and_a_rough_nameplate() -> None:

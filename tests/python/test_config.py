@@ -42,6 +42,7 @@ PAPER_DEFAULTS = {
         "bandwidth_definition": "minus3_db",  # docs/method/estimator.md, section 4
         "hold_ratio": 0.2,  # docs/method/estimator.md, section 4
         "load_pole_ratio": 0.0,  # [A] 0: the paper's type-2 trackers
+        "t2s1_running_bandwidth_hz": 0.0,  # [A] 0: T2S-1's one bandwidth (the paper)
     },
     "observer": {
         "on_rotor_flux": True,  # fado's improvement [A]; False = paper's Fig. 5

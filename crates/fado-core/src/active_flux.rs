@@ -100,7 +100,13 @@ impl<T: Real> ActiveFlux<T> {
     /// closed-form arithmetic).
     #[inline]
     pub fn saturating(&self) -> Option<&Self> {
-        (!self.model.is_linear()).then_some(self)
+        self.is_saturating().then_some(self)
+    }
+
+    /// Whether the model saturates (false for constant inductances).
+    #[inline]
+    pub fn is_saturating(&self) -> bool {
+        !self.model.is_linear()
     }
 
     /// ψ(i) of the model.

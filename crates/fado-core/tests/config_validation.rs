@@ -199,6 +199,7 @@ fn run_all<T: Real>(failures: &mut Vec<String>, machine: MachineModel<T>) -> usi
             tuning.mode.hysteresis_ratio: NonNegativeBounded,
             tuning.tracker.t2s1_bandwidth_hz: PositiveBounded,
             tuning.tracker.t2s2_bandwidth_hz: PositiveBounded,
+            tuning.tracker.t2s1_running_bandwidth_hz: NonNegativeBounded,
             tuning.tracker.damping: Positive,
             tuning.tracker.hold_ratio: NonNegativeBounded,
             tuning.observer.gain_period: NonNegativeBounded,

@@ -32,6 +32,7 @@ pub fn phase_names() -> Vec<&'static str> {
         Phase::Resistance,
         Phase::InductanceD,
         Phase::InductanceQ,
+        Phase::Magnetics,
         Phase::Spin,
         Phase::Coast,
         Phase::Inertia,
@@ -240,6 +241,14 @@ pub struct CommissionResult {
     /// Largest rotor motion during the inductance tests, rad (electrical).
     #[pyo3(get)]
     rotor_motion_inductance: f64,
+    /// Largest rotor motion during the flux-linkage pulses of the magnetic identification,
+    /// rad (electrical).
+    #[pyo3(get)]
+    rotor_motion_magnetics: f64,
+    /// Whether the magnetic identification found saturation (then `identified_toml` carries
+    /// `[model.saturation]`), or `None` when nothing was identified.
+    #[pyo3(get)]
+    saturation_detected: Option<bool>,
     /// The plant's configuration as TOML.
     #[pyo3(get)]
     config_toml: String,
@@ -321,6 +330,8 @@ impl CommissionResult {
             max_current_reference: o.max_current_reference,
             current_limit: o.current_limit,
             rotor_motion_inductance: o.rotor_motion_inductance,
+            rotor_motion_magnetics: o.rotor_motion_magnetics,
+            saturation_detected: id.map(|id| id.saturation.is_some()),
             config_toml: config_text,
             identified_toml,
             truth: truth.unbind(),

@@ -13,10 +13,12 @@ use std::time::Instant;
 use fado_core::commissioning::{
     Commissioning, CommissioningConfig, CommissioningOutput, Identification, Phase, Status,
 };
+use fado_core::magnetics::{ConstantInductance, Magnetics, Saturation};
 use fado_core::{Ab, MachineModel};
 use serde::Serialize;
 
 use crate::error::SimConfigError;
+use crate::magnetic_accuracy::{self, MagneticAccuracy};
 use crate::motor::MotorState;
 use crate::sim::{Plant, PlantParams};
 
@@ -157,6 +159,13 @@ pub struct CommissionOutcome {
     pub current_limit: f64,
     /// Largest |Δθ| of the rotor during the inductance tests, rad (electrical).
     pub rotor_motion_inductance: f64,
+    /// Largest |Δθ| of the rotor during the flux-linkage pulses from its angle at their
+    /// start, rad (electrical).
+    pub rotor_motion_magnetics: f64,
+    /// Largest |i| (true current) during the flux-linkage pulses, A.
+    pub max_current_magnetics: f64,
+    /// The magnetic identification against the plant (when the pulses ran to their end).
+    pub magnetics: Option<MagneticsReport>,
     /// Stopped early by [`CommissionOptions::cancel`] (`status` is then `Running`).
     pub cancelled: bool,
 }
@@ -241,9 +250,11 @@ pub fn commission(
             break Status::Running;
         }
     };
+    let identification = proc.result().copied();
     Ok(CommissionOutcome {
         status,
-        identification: proc.result().copied(),
+        identification,
+        magnetics: MagneticsReport::of(&proc, plant_params, &nameplate),
         truth: Truth::of(plant_params),
         trace,
         simulated_seconds: k as f64 * ts,
@@ -252,8 +263,73 @@ pub fn commission(
         max_current_reference: watch.max_ref,
         current_limit: proc.current_limit(),
         rotor_motion_inductance: watch.motion,
+        rotor_motion_magnetics: watch.motion_pulses,
+        max_current_magnetics: watch.max_i_pulses,
         cancelled,
     })
+}
+
+/// The magnetic identification on the simulated plant: what the pulses gave and its errors
+/// against the plant's model ([`magnetic_accuracy`]).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct MagneticsReport {
+    /// Saturation detected: `[model.saturation]` written.
+    pub saturation_detected: bool,
+    /// The best-fitting algebraic model (written only when saturation is detected).
+    pub fitted: Saturation<f64>,
+    /// The fitted model's largest relative incremental-inductance change over the pulses'
+    /// range.
+    pub inductance_change: f64,
+    /// The fit's RMS current residual, A.
+    pub residual_rms: f64,
+    /// The constant-inductance model's RMS current residual, A.
+    pub linear_residual_rms: f64,
+    /// The pulses' peak current, A.
+    pub pulse_current: f64,
+    /// The magnet's flux the fit used: the identified λ̂f, or the nameplate's when the
+    /// procedure aborted after the pulses (`flux_from_nameplate`), Wb.
+    pub flux_linkage: f64,
+    /// See `flux_linkage`.
+    pub flux_from_nameplate: bool,
+    /// The model the drive gets (the fitted one when saturation is detected, else constant
+    /// inductances: the identified ones, or the nameplate's after an abort) against the
+    /// plant's over the rated current range.
+    pub accuracy: MagneticAccuracy,
+}
+
+impl MagneticsReport {
+    /// The report of a finished (or aborted) procedure; None when the pulses did not end.
+    fn of(
+        proc: &Commissioning<f64>,
+        p: &PlantParams,
+        nameplate: &MachineModel<f64>,
+    ) -> Option<Self> {
+        let id = proc.result();
+        let model = id.map_or(nameplate, |id| &id.model);
+        let fit = proc.magnetic_model(model.flux_linkage)?;
+        let constants = ConstantInductance {
+            ld: model.ld,
+            lq: model.lq,
+            flux_linkage: model.flux_linkage,
+        };
+        let drive = if fit.detected {
+            Magnetics::Saturation(fit.model)
+        } else {
+            Magnetics::Constant(constants)
+        };
+        let truth = magnetic_accuracy::plant_model(p);
+        Some(Self {
+            saturation_detected: fit.detected,
+            fitted: fit.model,
+            inductance_change: fit.change,
+            residual_rms: fit.residual,
+            linear_residual_rms: fit.linear_residual,
+            pulse_current: proc.pulse_current(),
+            flux_linkage: model.flux_linkage,
+            flux_from_nameplate: id.is_none(),
+            accuracy: magnetic_accuracy::compare(&truth, &drive, p.motor.rated_current),
+        })
+    }
 }
 
 /// What a run watches beyond the procedure's output: the largest current and current
@@ -265,6 +341,10 @@ struct Watch {
     motion: f64,
     /// The rotor's angle at the start of the inductance tests.
     theta_l: Option<f64>,
+    motion_pulses: f64,
+    max_i_pulses: f64,
+    /// The rotor's angle at the start of the flux-linkage pulses.
+    theta_p: Option<f64>,
 }
 
 impl Watch {
@@ -274,6 +354,12 @@ impl Watch {
         if matches!(out.phase, Phase::InductanceD | Phase::InductanceQ) {
             let t0 = *self.theta_l.get_or_insert(st.theta);
             self.motion = self.motion.max(fado_core::wrap_angle(st.theta - t0).abs());
+        }
+        if out.phase == Phase::Magnetics {
+            let t0 = *self.theta_p.get_or_insert(st.theta);
+            let d = fado_core::wrap_angle(st.theta - t0).abs();
+            self.motion_pulses = self.motion_pulses.max(d);
+            self.max_i_pulses = self.max_i_pulses.max(st.i_dq.norm());
         }
     }
 }
@@ -376,6 +462,16 @@ pub fn identified_toml(input: &str, id: &Identification<f64>) -> Result<String, 
     let mut doc: toml::Table = input
         .parse()
         .map_err(|e: toml::de::Error| SimConfigError::new("<config>", e.to_string()))?;
+    // The plant's flux map, named where the file was read: the identified.toml written
+    // elsewhere still finds it.
+    if let Some(toml::Value::Table(motor)) = doc.get_mut("motor")
+        && let Some(toml::Value::String(written)) = motor.get("flux_map")
+    {
+        let resolved = crate::magnetics_file::resolve(written)
+            .display()
+            .to_string();
+        motor.insert("flux_map".into(), toml::Value::String(resolved));
+    }
     let m = id.model;
     let mut model = toml::Table::new();
     for (k, v) in [
@@ -395,6 +491,11 @@ pub fn identified_toml(input: &str, id: &Identification<f64>) -> Result<String, 
         "pole_pairs".into(),
         toml::Value::Integer(i64::from(m.pole_pairs)),
     );
+    if let Some(s) = &id.saturation {
+        let table = toml::Value::try_from(s)
+            .map_err(|e| SimConfigError::new("model.saturation", e.to_string()))?;
+        model.insert("saturation".into(), table);
+    }
     doc.insert("model".into(), toml::Value::Table(model));
     // The identified threshold to the drive's dead-time compensation (its dead time is the
     // configured one, as the procedure's); a slightly negative result (noise about a zero
@@ -413,7 +514,8 @@ pub fn identified_toml(input: &str, id: &Identification<f64>) -> Result<String, 
          # Inverter voltage error {:.4} V per phase (threshold {:.4} V at {:.1} V DC link), \
          saliency Lq/Ld {:.4}.\n\
          # Current sensors' gain ratio k = {:.5} (1-sigma {:.1e}): phase a was divided by it, \
-         so the model is in phase b's scale, the drive's after its start-up gain calibration.\n",
+         so the model is in phase b's scale, the drive's after its start-up gain calibration.\n\
+         {}",
         id.duration,
         c.rs,
         c.ld,
@@ -426,9 +528,33 @@ pub fn identified_toml(input: &str, id: &Identification<f64>) -> Result<String, 
         id.saliency,
         id.current_gain_ratio,
         c.current_gain_ratio,
+        saturation_comment(id),
     );
     let body = toml::to_string(&doc).map_err(|e| SimConfigError::new("<config>", e.to_string()))?;
     Ok(head + &body)
+}
+
+/// The header's statement on the magnetic model: saturation detected (the written
+/// `[model.saturation]`) or not (constant inductances), with the detection statistic.
+fn saturation_comment(id: &Identification<f64>) -> String {
+    let change = 100.0 * id.saturation_change;
+    let range = id.saturation_current;
+    if !id.saturation_change.is_finite() {
+        return "# Magnetic saturation: not measured (the flux-linkage pulses did not run).\n"
+            .into();
+    }
+    match id.saturation {
+        Some(_) => format!(
+            "# Magnetic saturation detected: the incremental inductances change by {change:.1} % \
+             up to {range:.3} A; [model.saturation] is the algebraic model fitted to the \
+             standstill flux-linkage pulses (RMS current residual {:.3e} A).\n",
+            id.saturation_residual
+        ),
+        None => format!(
+            "# No magnetic saturation detected: the incremental inductances change by \
+             {change:.1} % up to {range:.3} A; the model keeps constant inductances.\n"
+        ),
+    }
 }
 
 /// One row of the identified-vs-truth comparison.

@@ -61,6 +61,7 @@ mod fastmath;
 pub mod faults;
 pub mod inverter;
 pub mod load;
+pub mod magnetic_accuracy;
 pub mod magnetics;
 pub mod magnetics_file;
 pub mod model_magnetics;

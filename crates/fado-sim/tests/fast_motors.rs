@@ -86,3 +86,42 @@ fn a_throttle_step_at_the_current_limit_keeps_the_angle() {
         out.metrics.max_angle_error
     );
 }
+
+/// max |θ − θ̂| of a rated load step (0 → T_rated in one sample at 1.5 s) at 80 % of the rated
+/// speed, reached at the current limit from standstill, on `motor` with `extra` appended.
+fn load_step_error(motor: &str, rated_rpm: f64, rated_torque: f64, extra: &str) -> f64 {
+    let n = 0.8 * rated_rpm;
+    let text = format!(
+        "{motor}\n[simulation]\nduration = 1.8\neval_start = 0.7\n\
+         [speed_reference]\npoints = [[0.0, 0.0], [0.6, 0.0], [0.601, {n}]]\n\
+         [load.torque]\npoints = [[1.5, 0.0], [1.5, {rated_torque}]]\n\
+         [criteria]\nno_trip = true\n{extra}"
+    );
+    let out = simulate("custom", Some(&text), false, None).unwrap();
+    assert!(out.passed, "{:?}", out.checks);
+    out.metrics.max_angle_error
+}
+
+#[test]
+fn a_rated_load_step_on_a_light_rotor_keeps_the_angle() {
+    // The drive's acceleration feed-forward cannot announce the load: a step of the rated
+    // torque decelerates the cheetah outrunner at 5.5e4 rad/s² electrical, the 6215 KV170
+    // (inertia from its ratings) at 5.6e4. In the paper's 60 Hz T2S-1 that peaks near
+    // κ·α/ωn² = 0.5·5.5e4/183² = 0.82 rad; the drive's running bandwidth (the tracker
+    // feed-forward rule: a rated step within 0.2 rad) keeps it there. Bound: the range
+    // scenarios' 0.25 rad; the paper's bandwidth is shown to lose more than twice it.
+    let cheetah = fado_sim::presets::find("outrunner-cheetah-24v")
+        .unwrap()
+        .toml;
+    let off = "[controller.tracker_feedforward]\nload_step_error = 1e9\n";
+    for (name, motor, rpm, torque) in [
+        ("cheetah", cheetah, 1800.0, 1.32),
+        ("6215 KV170", OUTRUNNER_6215, 6000.0, 1.95),
+    ] {
+        let on = load_step_error(motor, rpm, torque, "");
+        let paper = load_step_error(motor, rpm, torque, off);
+        println!("{name}: {on:.3} rad (60 Hz T2S-1: {paper:.3} rad)");
+        assert!(on < 0.25, "{name}: {on}");
+        assert!(paper > 0.5, "{name}: {paper}");
+    }
+}

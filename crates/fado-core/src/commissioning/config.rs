@@ -54,6 +54,62 @@ pub struct CommissioningConfig<T: 'static> {
     /// calibration's [`DEFAULT_MAX_MISMATCH`] (0.05), the drive's default too, so that the
     /// procedure works in the scale the drive will.
     pub max_gain_mismatch: T,
+    /// The standstill identification of the magnetic model (module docs, step 5).
+    pub magnetics: MagneticsTestConfig<T>,
+}
+
+/// The standstill flux-linkage pulses that identify the magnetic model (module docs of
+/// [`crate::commissioning`], step 5).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MagneticsTestConfig<T> {
+    /// Run the pulses. Default true.
+    pub enabled: bool,
+    /// Peak current of the pulses as a fraction of the rated current. Default 1 (the
+    /// inductances over the rated current range; each pulse lasts a few ms, so the winding's
+    /// heating is negligible).
+    pub current_ratio: T,
+    /// Pulse voltage limit as a fraction of Vdc/√3. Default 0.9 (the short pulses of a
+    /// machine with a large L·I/V turn the rotor by the square of their length: as fast as the
+    /// modulator allows, with a margin for the inverter's error).
+    pub voltage_ratio: T,
+    /// Saturation is reported (and its model written) when the fitted model's incremental
+    /// inductances change by more than this fraction over the pulses' current range. Default
+    /// 0.05 (a machine whose inductances move less is run as well with constants; the linear
+    /// presets' fits move 1–2 %, docs/results/commissioning-magnetics.md).
+    pub detection_threshold: T,
+}
+
+impl<T: Real> Default for MagneticsTestConfig<T> {
+    fn default() -> Self {
+        Self {
+            enabled: true,
+            current_ratio: T::one(),
+            voltage_ratio: T::lit(0.9),
+            detection_threshold: T::lit(0.05),
+        }
+    }
+}
+
+impl<T: Real> MagneticsTestConfig<T> {
+    /// Checks every field; the error names the first bad one.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        check::positive("magnetics.current_ratio", self.current_ratio)?;
+        if self.current_ratio > T::lit(2.0) {
+            return Err(ConfigError::OutOfRange {
+                field: "magnetics.current_ratio",
+                expected: "at most 2 (twice the rated current)",
+            });
+        }
+        check::positive("magnetics.voltage_ratio", self.voltage_ratio)?;
+        if self.voltage_ratio > T::one() {
+            return Err(ConfigError::OutOfRange {
+                field: "magnetics.voltage_ratio",
+                expected: "at most 1",
+            });
+        }
+        check::positive("magnetics.detection_threshold", self.detection_threshold)?;
+        Ok(())
+    }
 }
 
 impl<T: Real> CommissioningConfig<T> {
@@ -80,6 +136,7 @@ impl<T: Real> CommissioningConfig<T> {
             phase_timeout: T::lit(5.0)
                 .max(T::lit(2.0) * (T::lit(2.0) * align_time + settle_time + T::lit(0.25))),
             max_gain_mismatch: T::lit(DEFAULT_MAX_MISMATCH),
+            magnetics: MagneticsTestConfig::default(),
         }
     }
 
@@ -124,6 +181,7 @@ impl<T: Real> CommissioningConfig<T> {
         check::positive("measure_time", self.measure_time)?;
         check::positive("phase_timeout", self.phase_timeout)?;
         check::positive("max_gain_mismatch", self.max_gain_mismatch)?;
+        self.magnetics.validate()?;
         let min_phase = T::lit(2.0) * self.align_time + self.settle_time + self.measure_time;
         if self.phase_timeout < min_phase || self.phase_timeout < self.offset_time {
             return Err(ConfigError::OutOfRange {

@@ -63,6 +63,7 @@ impl<T: Real> Commissioning<T> {
             lq_sigma: T::zero(),
             flux: T::zero(),
             flux_sigma: T::zero(),
+            pulses: FluxPulses::new(),
             spin_loop: SpinLoop::new(&cfg),
             emf_win: [EmfWindow::new(block); 2],
             jfit: JFit::default(),
@@ -113,6 +114,7 @@ impl<T: Real> Commissioning<T> {
         self.emf_win = [EmfWindow::new(block); 2];
         self.line = Line::default();
         self.jfit = JFit::default();
+        self.pulses = FluxPulses::new();
         self.spin_loop.pll_on = false;
         self.spin_loop.pi_int = Dq::zero();
         self.spin_loop.theta_f = T::zero();
@@ -185,6 +187,17 @@ impl<T: Real> Commissioning<T> {
         }
     }
 
+    /// The measured current that aborts with `OverCurrent`: `trip_ratio` × the current limit,
+    /// × the pulses' peak current in [`Phase::Magnetics`].
+    fn trip_current(&self) -> T {
+        let level = if self.phase == Phase::Magnetics {
+            self.i_limit.max(self.pulse_current())
+        } else {
+            self.i_limit
+        };
+        self.cfg.trip_ratio * level
+    }
+
     pub(super) fn abort(&mut self, reason: AbortReason) {
         self.status = Status::Aborted(reason);
         self.phase = Phase::Aborted;
@@ -244,7 +257,7 @@ impl<T: Real> Commissioning<T> {
         let a = (i_abc.a - self.off_a) * self.gain_correction;
         let b = i_abc.b - self.off_b;
         let i = Abc::new(a, b, -a - b).to_ab();
-        if i.norm() > self.cfg.trip_ratio * self.i_limit {
+        if i.norm() > self.trip_current() {
             // At standstill, an over-current with a back-EMF beyond the rotation threshold is
             // the rotor being turned (the EMF drives the current), reported as such.
             let standstill = matches!(
@@ -259,20 +272,24 @@ impl<T: Real> Commissioning<T> {
             self.abort(reason);
             return self.output(Ab::zero(), vdc, false, T::zero());
         }
-        let (v, applied) = match self.phase {
+        let (v, applied, gates) = match self.phase {
             Phase::Align | Phase::Resistance | Phase::InductanceD | Phase::InductanceQ => {
                 let v = self.standstill(i, vdc);
-                (v, v)
+                (v, v, true)
             }
-            Phase::Spin | Phase::Coast | Phase::Inertia => self.spinning(i, vdc),
-            Phase::Offset | Phase::Done | Phase::Aborted => (Ab::zero(), Ab::zero()),
+            Phase::Magnetics => self.magnetics(i, vdc),
+            Phase::Spin | Phase::Coast | Phase::Inertia => {
+                let (v, applied) = self.spinning(i, vdc);
+                (v, applied, true)
+            }
+            Phase::Offset | Phase::Done | Phase::Aborted => (Ab::zero(), Ab::zero(), true),
         };
         self.c2 = self.c1;
         self.c1 = applied;
         self.i_prev = i;
         self.have_prev = true;
         let speed = self.spin_loop.pll_omega;
-        let running = self.status == Status::Running && self.phase != Phase::Done;
+        let running = gates && self.status == Status::Running && self.phase != Phase::Done;
         self.output(v, vdc, running, speed)
     }
 }
@@ -322,6 +339,7 @@ impl<T: Real> Sizing<T> {
             + T::lit(3.0) * cfg.align_time
             + T::lit(2.0) * dc_level_time
             + T::lit(2.0) * (T::lit(0.02) + cfg.measure_time)
+            + magnetics_time(cfg)
             + (spin_speed / spin_accel + cfg.settle_time)
             + T::lit(2.0) * (T::lit(0.02) + cfg.measure_time)
             + T::lit(1.0);

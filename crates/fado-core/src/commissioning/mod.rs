@@ -1,6 +1,6 @@
-//! Commissioning: identification of the motor (R̂s, L̂d, L̂q, λ̂f, Ĵ, B̂) and of the inverter's
-//! voltage error, at standstill and in a short spin, as one state machine stepped at the
-//! control rate.
+//! Commissioning: identification of the motor (R̂s, L̂d, L̂q, λ̂f, Ĵ, B̂, its magnetic
+//! saturation) and of the inverter's voltage error, at standstill and in a short spin, as one
+//! state machine stepped at the control rate.
 //!
 //! # What the user gives
 //! A rough [`MachineModel`](crate::MachineModel) (the *nameplate*): the **ratings are required and trusted**
@@ -15,9 +15,11 @@
 //! # Safety
 //! Every current reference is within `current_limit_ratio · rated_current` (checked by a
 //! property test); a measured current above `trip_ratio` (2) times that limit aborts with the
-//! gates off. Every phase has a nominal and a maximum duration
-//! ([`CommissioningConfig::phase_timeout`]); every standstill voltage is limited to
-//! `voltage_limit_ratio · Vdc/√3`.
+//! gates off. The magnetic model's flux-linkage pulses (step 5) have no current reference:
+//! they are voltage pulses stopped at `magnetics.current_ratio` × the rated current (a few
+//! ms each), with the trip at `trip_ratio` × that current. Every phase has a nominal and a
+//! maximum duration ([`CommissioningConfig::phase_timeout`]); every standstill voltage is
+//! limited to `voltage_limit_ratio · Vdc/√3` (the pulses' to `magnetics.voltage_ratio`).
 //! Aborts are typed ([`AbortReason`]): rotation where none is expected, current not following
 //! its reference, implausible result, over-current, over-speed, timeout, non-finite samples.
 //!
@@ -85,7 +87,34 @@
 //!    sample-to-sample current change on the voltage applied over that sample gives Ts/L
 //!    regardless of any constant voltage. The q injection's torque alternates at 1.25 kHz
 //!    (at 10 kHz sampling) and moves the rotor by microradians. Saliency: L̂q/L̂d.
-//! 5. **Spin and back-EMF** ([`Phase::Spin`], [`Phase::Coast`]): an I-f start (a current vector
+//! 5. **Magnetic model** ([`Phase::Magnetics`]): the flux linkage ψ(i) of a saturating
+//!    machine at standstill without locking the rotor, after Hinkkanen, Pescetto, Mölsä,
+//!    Saarakkala, Pellegrino and Bojoi, "Sensorless self-commissioning of synchronous
+//!    reluctance motors at standstill without rotor locking", IEEE TIA 53(3), 2017
+//!    (<https://doi.org/10.1109/TIA.2016.2644624>): bipolar excitation, the flux linkage the
+//!    integral of v − R̂s·i, the algebraic saturation model fitted to it. Here the excitation
+//!    is three bipolar pairs of voltage pulses whose currents point along 0°, 60° and 120° of
+//!    the rotor frame (each phase then carries at least half of the current, away from the
+//!    inverter's dead-time band; 60° and 120° cross-saturate), each pulse driven up to
+//!    `magnetics.current_ratio` × the rated current and back by the same number of samples
+//!    at up to 0.9·Vdc/√3 ([`MagneticsTestConfig`]), the opposite pulse at once after it, so
+//!    that the torque's impulse cancels and the rotor, free, moves by hundredths of a radian
+//!    (measured 0.012–0.10 rad electrical on the presets). Between pairs the gates are off:
+//!    the current is zero and ψ = λf·e^{jθ} exactly, where each pair's integral starts.
+//!    ψ̂ = ∫(v − R̂s·i − V̂·sat(i/I_band)), with the DC test's R̂s and inverter error V̂ on the
+//!    trapezoid of each sample's currents. Two angles matter: the rotor's at the start, along
+//!    the current that held it in the inductance tests (the frozen voltage of the DC test
+//!    leaves that current up to 0.1 rad off α; taken as 0, the fit was 10–20 % off), and its
+//!    motion within a pair, read from the pair's end (zero current again: the flux change
+//!    across the magnet is λf·δ) and spread over the pair by the double integral of the
+//!    measured torque's shape ψ × i. At the end, with the final λ̂f, every shape of the
+//!    algebraic model (exponents, and the magnet as a flux or as a current) is fitted by
+//!    least squares and the best kept (`magnetic_fit`). Saturation is reported, and the model
+//!    returned in [`Identification::saturation`], when its incremental inductances change by
+//!    more than `detection_threshold` (5 %) over the pulses' range and it explains the data
+//!    (RMS residual below half the constant-inductance model's); a linear machine keeps its
+//!    constants. Accuracy against the plant's truth: docs/results/commissioning-magnetics.md.
+//! 6. **Spin and back-EMF** ([`Phase::Spin`], [`Phase::Coast`]): an I-f start (a current vector
 //!    turned at a speed ramped to `spin_speed_ratio` of the rated speed), regulated by a
 //!    synchronous-frame PI tuned from the identified R̂s, L̂ (bandwidth 0.2/Ts), with the
 //!    identified inverter error compensated (V̂·sat(i*ₓ/I_band) per phase of the reference,
@@ -110,7 +139,7 @@
 //!    angle by 0.2–0.35 rad with the torque's sign; filtered: 0.075 rad rms). The magnet's
 //!    EMF e_f = E_q − ω̂·(L̂d − L̂q)·i_d is averaged, with ω̂ (the PLL's integral state), over
 //!    a window of `measure_time` in this coast and over a second one at the top of the
-//!    inertia test (step 6), at twice the speed, same currents; λ̂f is the slope of the line
+//!    inertia test (step 7), at twice the speed, same currents; λ̂f is the slope of the line
 //!    ē_f = λf·ω̄ + e₀ through the two. The intercept e₀ takes what of the EMF error does not
 //!    grow with the speed: the residual of the inverter's error after its compensation.
 //!    Measured on the 50 kW IPMSM preset (its 14 V per phase against a magnet EMF of 12 V at
@@ -126,7 +155,7 @@
 //!    (0.4 % of (Lq − Ld) at 60 A is 0.3 % of λf on that preset), R̂s·i and the current
 //!    sensors' gain error (the PLL frame's d current), and the inverter error's part that
 //!    grows with the speed (timing).
-//! 6. **Inertia and friction** ([`Phase::Inertia`]): in closed loop on the PLL's angle (the
+//! 7. **Inertia and friction** ([`Phase::Inertia`]): in closed loop on the PLL's angle (the
 //!    back-EMF observer is the sensorless angle), a q-current step (sized so that each step
 //!    lasts 0.5 s on the nameplate inertia, 10–90 % of the limit) up to 2× the spin speed;
 //!    there, the second back-EMF window (no q current, the coast's d current); then the
@@ -155,7 +184,9 @@
 
 mod config;
 mod fits;
+mod flux_pulses;
 mod lifecycle;
+mod magnetic_fit;
 mod output;
 mod phase;
 mod saturation_fit;
@@ -166,13 +197,15 @@ mod standstill;
 #[cfg(test)]
 mod tests;
 
-pub use config::CommissioningConfig;
+pub use config::{CommissioningConfig, MagneticsTestConfig};
 pub use output::{CommissioningOutput, Confidence, Identification};
 pub use phase::{AbortReason, Parameter, Phase, Status};
 pub use saturation_fit::SaturationFit;
 
 use crate::{Ab, Dq};
 use fits::{BlockStats, EmfWindow, JFit, JWindows, Line, emf_line};
+pub use flux_pulses::MagneticFit;
+use flux_pulses::{FluxPulses, magnetics_time};
 use sizing::{clamp, dc_level, dead_time_voltage, libm_round, limit, spin_sizing};
 
 /// The commissioning state machine (module docs).
@@ -245,6 +278,8 @@ pub struct Commissioning<T: 'static> {
     lq_sigma: T,
     flux: T,
     flux_sigma: T,
+    /// The standstill flux-linkage pulses and their samples.
+    pulses: FluxPulses<T>,
     /// Spin: control frame, synchronous PI, PLL.
     spin_loop: SpinLoop<T>,
     /// The two back-EMF windows: the coast at the spin speed and the one at J_HIGH × it.
@@ -311,7 +346,7 @@ const J_STEP_TIME: f64 = 0.5;
 /// Low-pass time constant of the back-EMF before the PLL's phase detector, s: its pole
 /// (1000 rad/s) four times the PLL's natural frequency (2π·40 Hz), so that it adds little
 /// phase lag at the loop's crossover while averaging ten samples of the L̂q·Δi/Ts noise
-/// (module docs, step 5).
+/// (module docs, step 6).
 const PLL_EMF_FILTER: f64 = 0.001;
 /// Hold of each DC level after its voltage is frozen, before it is averaged, in time
 /// constants of the rotor's swing about the d current in voltage mode

@@ -2,6 +2,7 @@
 //! output.
 
 use super::{Phase, Status};
+use crate::magnetics::Saturation;
 use crate::{Ab, Abc, MachineModel};
 
 /// Relative 1-σ statistical uncertainties of the result (module docs); `inverter_voltage` in V.
@@ -49,6 +50,22 @@ pub struct Identification<T: 'static> {
     pub dc_voltage: T,
     /// Duration of the procedure in s.
     pub duration: T,
+    /// The magnetic model (module docs, step 5): the algebraic saturation model fitted to the
+    /// standstill flux-linkage pulses, when saturation is detected (its incremental
+    /// inductances change by more than [`super::MagneticsTestConfig::detection_threshold`]
+    /// over the pulses' current range; `model.ld` and `model.lq` are then its zero-current
+    /// incremental values). None for a magnetically linear machine, or with the test off.
+    pub saturation: Option<Saturation<T>>,
+    /// The detection statistic: the largest relative change of the best-fitting model's
+    /// incremental inductances over the pulses' current range (NaN with the test off).
+    pub saturation_change: T,
+    /// RMS current residual of the fit over the pulses' samples, A (NaN with the test off).
+    pub saturation_residual: T,
+    /// RMS current residual of the constant-inductance model over the same samples, A (NaN
+    /// with the test off).
+    pub linear_residual: T,
+    /// The pulses' peak current, A: the range over which the model is measured.
+    pub saturation_current: T,
 }
 
 /// What one step returns.
@@ -60,7 +77,8 @@ pub struct CommissioningOutput<T> {
     pub duty: Abc<T>,
     /// Gates on.
     pub gates_enabled: bool,
-    /// The current reference (α-β) the command regulates to, A.
+    /// The current reference (α-β) the command regulates to, A (zero in the flux-linkage
+    /// pulses, which are voltage pulses stopped at their peak current).
     pub current_reference: Ab<T>,
     /// Phase of this sample.
     pub phase: Phase,

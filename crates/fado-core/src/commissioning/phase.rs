@@ -13,6 +13,8 @@ pub enum Phase {
     InductanceD,
     /// Square-wave injection along q.
     InductanceQ,
+    /// Bipolar flux-linkage pulses up to the rated current: the magnetic model.
+    Magnetics,
     /// I-f open-loop acceleration.
     Spin,
     /// No q current (the d current at −½ the limit), rotor coasting: the first back-EMF
@@ -36,6 +38,7 @@ impl Phase {
             Phase::Resistance => "resistance",
             Phase::InductanceD => "inductance_d",
             Phase::InductanceQ => "inductance_q",
+            Phase::Magnetics => "magnetics",
             Phase::Spin => "spin",
             Phase::Coast => "coast",
             Phase::Inertia => "inertia",
@@ -44,7 +47,7 @@ impl Phase {
         }
     }
 
-    /// Index 0–9 in procedure order.
+    /// Index 0–10 in procedure order.
     pub fn index(self) -> usize {
         self as usize
     }

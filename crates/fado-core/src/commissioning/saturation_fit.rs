@@ -38,7 +38,7 @@ pub struct SaturationFit<T> {
 }
 
 /// |x|^e for an exponent e ≥ 0 (|0|^0 = 1).
-fn pow_abs<T: Real>(x: T, e: T) -> T {
+pub(super) fn pow_abs<T: Real>(x: T, e: T) -> T {
     if e == T::zero() {
         T::one()
     } else {
@@ -99,24 +99,8 @@ impl<T: Real> SaturationFit<T> {
     /// coefficient the data cannot see is not guessed). A coefficient fitted negative
     /// (saturation terms only) is refused as well: the model would not be monotonic.
     pub fn solve(&self) -> Option<Saturation<T>> {
-        let mut a = self.ata;
-        let mut b = self.atb;
-        // Scale to a unit diagonal.
-        let mut scale = [T::zero(); N];
-        for j in 0..N {
-            if !a[j][j].is_finite() || a[j][j] <= T::zero() {
-                return None;
-            }
-            scale[j] = T::one() / a[j][j].sqrt();
-        }
-        for j in 0..N {
-            for k in 0..N {
-                a[j][k] *= scale[j] * scale[k];
-            }
-            b[j] *= scale[j];
-        }
-        let x = solve_in_place(&mut a, &mut b)?;
-        let c = |j: usize| x[j] * scale[j];
+        let x = solve_normal(self.ata, self.atb)?;
+        let c = |j: usize| x[j];
         let fitted = Saturation {
             a_d0: c(0),
             a_dd: c(1),
@@ -129,12 +113,39 @@ impl<T: Real> SaturationFit<T> {
     }
 }
 
+/// The normal equations `a·x = b` solved on the problem scaled to a unit diagonal (the
+/// regressors span several decades: |x|^5 against x); None when a diagonal entry is not
+/// positive (a regressor the data never excites) or the matrix is singular.
+pub(super) fn solve_normal<T: Real, const M: usize>(
+    mut a: [[T; M]; M],
+    mut b: [T; M],
+) -> Option<[T; M]> {
+    let mut scale = [T::zero(); M];
+    for j in 0..M {
+        if !a[j][j].is_finite() || a[j][j] <= T::zero() {
+            return None;
+        }
+        scale[j] = T::one() / a[j][j].sqrt();
+    }
+    for j in 0..M {
+        for k in 0..M {
+            a[j][k] *= scale[j] * scale[k];
+        }
+        b[j] *= scale[j];
+    }
+    let x = solve_in_place(&mut a, &mut b)?;
+    Some(core::array::from_fn(|j| x[j] * scale[j]))
+}
+
 /// Gaussian elimination with partial pivoting; None for a (numerically) singular matrix.
-fn solve_in_place<T: Real>(a: &mut [[T; N]; N], b: &mut [T; N]) -> Option<[T; N]> {
+pub(super) fn solve_in_place<T: Real, const M: usize>(
+    a: &mut [[T; M]; M],
+    b: &mut [T; M],
+) -> Option<[T; M]> {
     let tiny = T::lit(1e-12);
-    for col in 0..N {
+    for col in 0..M {
         let mut pivot = col;
-        for r in col + 1..N {
+        for r in col + 1..M {
             if a[r][col].abs() > a[pivot][col].abs() {
                 pivot = r;
             }
@@ -145,7 +156,7 @@ fn solve_in_place<T: Real>(a: &mut [[T; N]; N], b: &mut [T; N]) -> Option<[T; N]
         }
         a.swap(col, pivot);
         b.swap(col, pivot);
-        for r in col + 1..N {
+        for r in col + 1..M {
             let f = a[r][col] / a[col][col];
             let (upper, lower) = a.split_at_mut(r);
             for (x, v) in lower[0][col..].iter_mut().zip(&upper[col][col..]) {
@@ -155,10 +166,10 @@ fn solve_in_place<T: Real>(a: &mut [[T; N]; N], b: &mut [T; N]) -> Option<[T; N]
             b[r] -= f * v;
         }
     }
-    let mut x = [T::zero(); N];
-    for col in (0..N).rev() {
+    let mut x = [T::zero(); M];
+    for col in (0..M).rev() {
         let mut acc = b[col];
-        for k in col + 1..N {
+        for k in col + 1..M {
             acc -= a[col][k] * x[k];
         }
         x[col] = acc / a[col][col];

@@ -58,7 +58,7 @@ pub(super) fn if_level<T: Real>(np: &MachineModel<T>, ld: T, lq: T, i_limit: T) 
 /// The I-f current (`if_level`) and the spin's electrical acceleration: spin_torque_ratio ×
 /// the rated torque on the nameplate J, at most a quarter of the magnet torque 1.5·p·λf·I_if
 /// (the rotor then lags the current vector by about 15°, far from the pull-out even with the
-/// nameplate's λf 1.25× and J 0.8× the truth; module docs, step 5).
+/// nameplate's λf 1.25× and J 0.8× the truth; module docs, step 6).
 pub(super) fn spin_sizing<T: Real>(
     np: &MachineModel<T>,
     ld: T,

@@ -359,7 +359,7 @@ impl<T: Real> Commissioning<T> {
         T::lit(0.02) * self.cfg.nameplate.rated_speed() * self.cfg.nameplate.flux_linkage
     }
 
-    /// λ̂f from the two back-EMF windows (module docs, step 5): the line ē_f = λf·ω̄ + e₀
+    /// λ̂f from the two back-EMF windows (module docs, step 6): the line ē_f = λf·ω̄ + e₀
     /// through them. False (and aborted) when implausible.
     pub(super) fn finish_flux(&mut self) -> bool {
         let (flux, sigma, ds) = emf_line(&self.emf_win[0], &self.emf_win[1]);
@@ -407,10 +407,15 @@ impl<T: Real> Commissioning<T> {
             });
             return;
         }
+        let (saturation, saturation_change, saturation_residual, linear_residual) =
+            self.magnetic_result();
+        let (ld, lq) = saturation
+            .as_ref()
+            .map_or((self.ld, self.lq), Self::zero_current_inductances);
         let model = MachineModel {
             rs: self.rs,
-            ld: self.ld,
-            lq: self.lq,
+            ld,
+            lq,
             flux_linkage: self.flux,
             inertia: j,
             viscous_friction: b.max(T::zero()),
@@ -435,6 +440,11 @@ impl<T: Real> Commissioning<T> {
             saliency: self.lq / self.ld,
             dc_voltage: vdc,
             duration: self.t_total,
+            saturation,
+            saturation_change,
+            saturation_residual,
+            linear_residual,
+            saturation_current: self.pulse_current(),
         });
         self.status = Status::Done;
         self.nominal_done += self.t_phase;

@@ -74,6 +74,11 @@ impl<T: Real> Commissioning<T> {
                 };
                 if t > T::lit(0.02) && self.have_prev {
                     window = true;
+                    if !d_axis {
+                        // The mean current of the q injection: the rotor's d axis lies along
+                        // it (flux_pulses::start_magnetics).
+                        self.pulses.held_current += i;
+                    }
                     let (x, y) = if d_axis {
                         (self.c2.alpha, i.alpha - self.i_prev.alpha)
                     } else {
@@ -123,7 +128,13 @@ impl<T: Real> Commissioning<T> {
     }
 
     /// The regulator's voltage with the injection, limited to the standstill voltage limit.
-    fn standstill_voltage(&mut self, i: Ab<T>, vdc: T, frozen: bool, inj: Ab<T>) -> Ab<T> {
+    pub(super) fn standstill_voltage(
+        &mut self,
+        i: Ab<T>,
+        vdc: T,
+        frozen: bool,
+        inj: Ab<T>,
+    ) -> Ab<T> {
         let cfg = self.cfg;
         let ts = self.ts;
         let e = self.i_ref - i;
@@ -252,7 +263,7 @@ impl<T: Real> Commissioning<T> {
                     Some((l, s)) => {
                         self.lq = l;
                         self.lq_sigma = s;
-                        self.start_spin();
+                        self.start_magnetics();
                     }
                     None => return false,
                 }

@@ -180,13 +180,17 @@ impl<T: Real> InitialAngle<T> {
         // Slot 0 is a pulse pair along the last direction that is not read: every read
         // pulse then starts from the residual current of the one before it, 30° behind
         // (after a pair the current is not quite zero: the resistance's drop).
-        let slot = (self.sample / (3 * n)) as usize;
+        // The pair's length as a non-zero divisor (`new` refuses 0 samples): no division
+        // that can panic in the per-sample path.
+        let period =
+            core::num::NonZeroU32::new(n.saturating_mul(3)).unwrap_or(core::num::NonZeroU32::MIN);
+        let slot = (self.sample / period) as usize;
         if slot > DIRECTIONS {
             self.evaluate();
             return Ab::zero();
         }
         let k = (slot + DIRECTIONS - 1) % DIRECTIONS;
-        let phase = self.sample % (3 * n);
+        let phase = self.sample % period;
         let u = direction::<T>(k);
         // The peak over the pulse pair and the rest that follows (the computation delay).
         let along = u.dot(i_ab);

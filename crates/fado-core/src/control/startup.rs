@@ -31,6 +31,7 @@ mod tests;
 
 pub use polarity::PolarityTest;
 
+use crate::control::gain_calibration::GainCalibration;
 use crate::control::initial_angle::{
     DEFAULT_MIN_POLARITY, DEFAULT_MIN_SALIENCY, InitialAngle, InitialAngleConfig,
     InitialAngleStatus,
@@ -42,6 +43,11 @@ use crate::{Ab, Dq, MachineModel, Real};
 /// Pulse pairs per direction of the polarity test (the relative difference of the two sums
 /// is averaged over four pairs: its noise halves against one pair).
 pub const POLARITY_PAIRS: u32 = 4;
+
+/// Largest share of the gain calibration's current a held rotor's saliency may drive across a
+/// turned axis ([`AngleSearch::gain_axis`]). 0.2 \[A\]: the 2.2 kW IPMSM (share 0.13 at its
+/// seed-2 angle) is calibrated; the Baldor PM-SyRM (0.51) reads it as motion.
+const MAX_CROSS_SHARE: f64 = 0.2;
 
 /// Fewest samples of a pulse: the drive's computation delay puts the current's peak one
 /// sample after the pulse's end; with three samples the rise is mostly inductive.
@@ -83,6 +89,13 @@ pub struct StartupTuning<T> {
     /// With no angle information, align the rotor with a d current: only for a rotor free to
     /// turn (no load, no brake). Default false: the drive stays off and says so.
     pub free_rotor_align: bool,
+    /// A brake holds the rotor through the whole start-up (the application releases it only
+    /// once the drive is ready): the gain calibration may then run along an axis other than
+    /// the rotor's d axis, whose torque the brake takes — the nearest of the six axes k·π/3
+    /// (every phase carrying at least half the current) where the d axis leaves a phase with
+    /// too little (`gain_calibration_min_observability`). Default false: a rotor that no
+    /// brake holds is turned by any current off its d axis.
+    pub rotor_held: bool,
     /// d current of the free-rotor alignment, a multiple of the rated current. Default 0.5
     /// \[A\]: half the rated torque's stiffness turns an unloaded rotor.
     pub align_current_ratio: T,
@@ -98,6 +111,7 @@ impl<T: Real> Default for StartupTuning<T> {
             pulse_voltage_ratio: T::lit(0.5),
             polarity_current_ratio: T::lit(1.5),
             free_rotor_align: false,
+            rotor_held: false,
             align_current_ratio: T::lit(0.5),
             align_time: T::lit(0.25),
         }
@@ -113,6 +127,7 @@ impl<T: Real> StartupTuning<T> {
             pulse_voltage_ratio: U::lit(self.pulse_voltage_ratio.to_f64()),
             polarity_current_ratio: U::lit(self.polarity_current_ratio.to_f64()),
             free_rotor_align: self.free_rotor_align,
+            rotor_held: self.rotor_held,
             align_current_ratio: U::lit(self.align_current_ratio.to_f64()),
             align_time: U::lit(self.align_time.to_f64()),
         }
@@ -213,6 +228,7 @@ pub struct AngleSearch<T> {
     ts: T,
     rated_current: T,
     l_min: T,
+    l_max: T,
     l_mean: T,
     d_larger: bool,
     /// The model's d axis meets the larger incremental inductance along +d than along −d
@@ -243,6 +259,7 @@ impl<T: Real> AngleSearch<T> {
             ts,
             rated_current: machine.rated_current,
             l_min: crate::real::min(machine.ld, machine.lq),
+            l_max: crate::real::max(machine.ld, machine.lq),
             l_mean: T::lit(0.5) * (machine.ld + machine.lq),
             d_larger: machine.ld > machine.lq,
             inverted: inverted_polarity(
@@ -298,6 +315,33 @@ impl<T: Real> AngleSearch<T> {
     /// The tuning.
     pub fn tuning(&self) -> &StartupTuning<T> {
         &self.tuning
+    }
+
+    /// The gain calibration's axis for a rotor at `theta` (see
+    /// [`StartupTuning::rotor_held`]): `theta`, or with `rotor_held` and a share of the
+    /// current in some phase below `min_observability` there, the nearest k·π/3.
+    pub fn gain_axis(&self, theta: T, min_observability: T) -> T {
+        if !self.tuning.rotor_held
+            || !theta.is_finite()
+            || GainCalibration::observability(theta) >= min_observability
+        {
+            return theta;
+        }
+        let sixth = T::pi() / T::lit(3.0);
+        // (−π, π] + π → (0, 2π]: k in 0..=6, k·π/3 − π a multiple of π/3.
+        let k = ((crate::wrap_angle(theta) + T::pi()) / sixth + T::lit(0.5)).index_floor(6);
+        let axis = T::from_index(k) * sixth - T::pi();
+        // Off the d axis a salient rotor drives a current across the calibration's axis
+        // (its share (L̂q − L̂d)/(L̂q + L̂d)·sin 2Δ of the level), which the calibration's
+        // motion test reads as a turning rotor: the axis turns only while that share stays
+        // below MAX_CROSS_SHARE.
+        let (s2, _) = (T::lit(2.0) * (axis - theta)).step_sin_cos_any();
+        let saliency = (self.l_max - self.l_min) / (self.l_max + self.l_min);
+        if saliency * s2.abs() <= T::lit(MAX_CROSS_SHARE) {
+            axis
+        } else {
+            theta
+        }
     }
 
     /// Pulse voltage and samples for a peak of `ratio` × the rated current along the smaller

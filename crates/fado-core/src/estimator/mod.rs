@@ -186,6 +186,9 @@ pub struct EstimatorParams<T: Real> {
     limiter: FluxLimiter<T>,
     selector: ModeSelectorParams<T>,
     t2s1: TrackerParams<T>,
+    /// T2S-1 in disturbance-feedback mode (`tracker.t2s1_running_bandwidth_hz`; a copy of
+    /// `t2s1` where none is set).
+    t2s1_running: TrackerParams<T>,
     t2s2: TrackerParams<T>,
     rs_adaptation_params: ResistanceAdaptationParams<T>,
     offset: IntegrandOffsetParams<T>,

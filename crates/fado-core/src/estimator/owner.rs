@@ -146,6 +146,16 @@ impl<T: Real> SensorlessEstimator<T> {
         self.state.turn_angle(&self.params, angle);
     }
 
+    /// Pulls the rotor-flux magnitude |λ̂r| towards `magnitude` (Wb, the model's active flux
+    /// at the present current) in limiter mode, radially at the limiter's rate k_af: at a
+    /// loaded standstill the drive holds the estimate on the model's flux circle, so that the
+    /// radial part of the integrand error does not sit in λ1 as an offset the departure turns
+    /// into an angle error ([`crate::control::standstill_probe`]). Off the step's path; does
+    /// nothing outside limiter mode or for a non-finite or non-positive magnitude.
+    pub fn hold_flux_magnitude(&mut self, magnitude: T) {
+        self.state.hold_flux_magnitude(&self.params, magnitude);
+    }
+
     /// ê, the learned integrand offset (V, α-β; zero without `rs_adaptation`).
     pub fn integrand_offset(&self) -> Ab<T> {
         self.state.integrand_offset()
@@ -204,6 +214,9 @@ pub trait RotorAngleEstimator<T: Real> {
     /// Turns θ̂ by `angle` (rad) now, if the estimator can (the drive's loaded-standstill
     /// probe, see [`crate::control::standstill_probe`]). Default: nothing.
     fn turn_angle(&mut self, _angle: T) {}
+    /// Pulls |λ̂r| towards `magnitude` (Wb) now, if the estimator can (the drive's loaded
+    /// standstill, see [`crate::control::standstill_probe`]). Default: nothing.
+    fn hold_flux_magnitude(&mut self, _magnitude: T) {}
     /// The acceleration the drive commands, rad/s² (electrical), for the estimator's speed
     /// trackers to feed forward (see [`crate::tracker`]). Default: not used.
     fn set_acceleration(&mut self, _acceleration: T) {}
@@ -238,6 +251,9 @@ impl<T: Real> RotorAngleEstimator<T> for SensorlessEstimator<T> {
     }
     fn turn_angle(&mut self, angle: T) {
         SensorlessEstimator::turn_angle(self, angle);
+    }
+    fn hold_flux_magnitude(&mut self, magnitude: T) {
+        SensorlessEstimator::hold_flux_magnitude(self, magnitude);
     }
     fn set_disturbance_feedback(&mut self, enabled: bool) {
         self.set_disturbance_feedback_enabled(enabled);

@@ -119,6 +119,7 @@ impl<T: Real> EstimatorParams<T> {
             limiter: blocks.limiter,
             selector: blocks.selector,
             t2s1: blocks.t2s1,
+            t2s1_running: blocks.t2s1_running,
             t2s2: blocks.t2s2,
             rs_adaptation_params: rs_adaptation,
             offset,
@@ -188,6 +189,7 @@ struct SampleBlocks<T: Real> {
     limiter: FluxLimiter<T>,
     selector: ModeSelectorParams<T>,
     t2s1: TrackerParams<T>,
+    t2s1_running: TrackerParams<T>,
     t2s2: TrackerParams<T>,
     /// The observer's gains are held over this many samples after the one that computes
     /// them.
@@ -230,6 +232,16 @@ impl<T: Real> SampleBlocks<T> {
         let t2s2 = TrackerParams::new(c2)
             .map_err(rename("t2s2_bandwidth_hz"))?
             .with_load_pole(&c2, load_pole)?;
+        // T2S-1 in disturbance-feedback mode: its own bandwidth where one is set.
+        let running_hz = config.tuning.tracker.t2s1_running_bandwidth_hz;
+        let t2s1_running = if running_hz == T::zero() {
+            t2s1
+        } else {
+            let c = config.tracker_config(running_hz);
+            TrackerParams::new(c)
+                .map_err(rename("t2s1_running_bandwidth_hz"))?
+                .with_load_pole(&c, load_pole)?
+        };
         Ok(Self {
             integrator,
             observer,
@@ -237,6 +249,7 @@ impl<T: Real> SampleBlocks<T> {
             limiter,
             selector,
             t2s1,
+            t2s1_running,
             t2s2,
             gain_hold: gain_hold(config, ts)?,
         })
@@ -334,6 +347,5 @@ fn slow_laws<T: Real>(
                 _ => rename("mode_threshold_ratio")(e),
             }
         })?;
-    let active_flux = ActiveFlux::of(&config.machine);
-    Ok((rs_adaptation.with_active_flux(active_flux), offset))
+    Ok((rs_adaptation, offset))
 }

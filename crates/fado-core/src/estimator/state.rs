@@ -156,7 +156,7 @@ impl<T: Real> EstimatorState<T> {
     /// (≈ λ̂f·e^{jθ̂}, no extra state), î_d the current along it. Zero while that vector is
     /// below the tracker's hold level (no usable axis).
     #[inline]
-    pub(super) fn active_flux_swing(
+    pub(super) fn active_flux_swing<const SATURATING: bool>(
         &self,
         p: &EstimatorParams<T>,
         i_ab: Ab<T>,
@@ -164,8 +164,9 @@ impl<T: Real> EstimatorState<T> {
     ) -> Ab<T> {
         let axis = self.observer.flux() - self.observer.disturbance();
         let n2 = axis.norm_squared();
-        if let Some(af) = p.active_flux.saturating() {
+        if SATURATING {
             // A saturating model: λ̂a(î) − ψd(0, 0) along the axis, î in its frame.
+            let af = &p.active_flux;
             return if n2 > p.hold_level_sq {
                 let point = af.point(ActiveFlux::frame_current(axis, i_ab));
                 axis * ((point.active - af.magnet_flux()) / n2.step_sqrt())
@@ -266,6 +267,27 @@ impl<T: Real> EstimatorState<T> {
         if turned.is_finite() {
             self.integrator
                 .commit(turned, self.integrator.last_current());
+        }
+    }
+
+    /// Pulls |λ̂r| towards `magnitude` in limiter mode by k_af·Ts of the difference, along λ̂r
+    /// (the angle is untouched): the loaded standstill's flux-magnitude hold (see
+    /// [`crate::control::standstill_probe`]).
+    pub fn hold_flux_magnitude(&mut self, p: &EstimatorParams<T>, magnitude: T) {
+        if !magnitude.is_finite() || magnitude <= T::zero() || self.mode != Mode::Limiter {
+            return;
+        }
+        let lambda1 = self.integrator.flux();
+        let lambda2 = stator_flux(lambda1, self.observer.disturbance());
+        let lambda_r = rotor_flux(lambda2, self.integrator.last_current(), self.lq_secant);
+        let n = lambda_r.norm_squared().step_sqrt();
+        if n <= T::zero() || !n.is_finite() {
+            return;
+        }
+        let pull = p.limiter.config().k_af * p.ts * (magnitude - n) / n;
+        let held = lambda1 + lambda_r * pull.step_max(-T::one()).step_min(T::one());
+        if held.is_finite() {
+            self.integrator.commit(held, self.integrator.last_current());
         }
     }
 

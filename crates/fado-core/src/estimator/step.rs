@@ -4,6 +4,14 @@
 //!
 //! Each phase is a function of its own, inlined into [`EstimatorState::advance`]: the
 //! sample is computed first into a [`Candidate`] and committed only if it is finite.
+//!
+//! The step exists in two copies, chosen by the machine's magnetics (fixed when the
+//! parameters are built): constant inductances run the closed-form arithmetic of eq. (5)
+//! with no trace of a magnetic model (`SATURATING = false`, inlined into the caller), a
+//! saturating model the operating-point evaluations of `crate::active_flux` (out of line).
+//! One branch per sample picks the copy; within it every test of the model is resolved at
+//! compile time, so that the constant-inductance path costs what it would without the
+//! saturating one (docs/results/host-cost.md, docs/results/firmware-cost.md).
 
 use super::{
     BROKEN_OFFSET, BROKEN_RS, Diagnostics, Estimate, EstimatorParams, EstimatorState, LOCK_PERIOD,
@@ -21,7 +29,8 @@ use crate::{Ab, Real};
 struct Candidate<T: Real> {
     /// L̂d − L̂q, loaded once for every use in the sample.
     saliency: T,
-    /// A saturating model's operating point (`crate::active_flux`), with its secant L̂q.
+    /// A saturating model's operating point (`crate::active_flux`), with its secant L̂q
+    /// (None on the constant-inductance path).
     point: Option<ActiveFluxPoint<T>>,
     /// λ1 integrated with the previous sample's feedback (eq. (21) / (24)).
     lambda1: Ab<T>,
@@ -59,6 +68,34 @@ impl<T: Real> EstimatorState<T> {
         v_ab: Ab<T>,
         i_ab: Ab<T>,
     ) -> O {
+        if p.active_flux.is_saturating() {
+            self.advance_saturating(p, v_ab, i_ab)
+        } else {
+            self.advance_with::<O, false>(p, v_ab, i_ab)
+        }
+    }
+
+    /// The step of a saturating model: out of line, so that the constant-inductance step it
+    /// stands beside stays as small as without it where it is inlined.
+    #[inline(never)]
+    fn advance_saturating<O: From<Estimate<T>>>(
+        &mut self,
+        p: &EstimatorParams<T>,
+        v_ab: Ab<T>,
+        i_ab: Ab<T>,
+    ) -> O {
+        self.advance_with::<O, true>(p, v_ab, i_ab)
+    }
+
+    /// The step with the magnetics resolved at compile time: `SATURATING` is whether
+    /// `p`'s model saturates (`crate::active_flux`).
+    #[inline(always)]
+    fn advance_with<O: From<Estimate<T>>, const SATURATING: bool>(
+        &mut self,
+        p: &EstimatorParams<T>,
+        v_ab: Ab<T>,
+        i_ab: Ab<T>,
+    ) -> O {
         // Plausibility first (a few compares; false for NaN/∞ too, see `crate::plausibility`).
         if !p.bounds.check(
             v_ab,
@@ -74,7 +111,7 @@ impl<T: Real> EstimatorState<T> {
         // but absurd inputs can still overflow it, and a rejected sample must leave none of it
         // changed. One test at the end covers all of this (cheaper than a test per input and
         // per block, and than copying the estimator as a backup every sample).
-        let c = self.candidate(p, v_ab, i_ab);
+        let c = self.candidate::<SATURATING>(p, v_ab, i_ab);
         if !Self::is_committable(&c) {
             return self.reject(p).into();
         }
@@ -84,8 +121,8 @@ impl<T: Real> EstimatorState<T> {
         let rs_hat = self.integrator.rs_hat();
         let flux_linkage_hat = self.rs_adaptation.flux_linkage_hat;
         let mut estimate = Self::estimate(&c, rs_hat, flux_linkage_hat, self.lock_status);
-        let shift = self.commit(p, &c, i_ab);
-        self.judge_lock(p, &c, i_ab);
+        let shift = self.commit::<SATURATING>(p, &c, i_ab);
+        self.judge_lock::<SATURATING>(p, &c, i_ab);
         self.step_allowance = p.bounds.step();
         let slot = self.slot;
         // SLOW_PERIOD is a power of two: the modulo is a mask.
@@ -94,7 +131,7 @@ impl<T: Real> EstimatorState<T> {
         //    sample (see `rs_adaptation`, `integrand_offset`), after the commit so that the
         //    paper's path is untouched by them. A non-finite result is dropped (R̂s, ê stay).
         if self.rs_adaptation_on {
-            self.run_slow_laws(p, &c, slot, previous_mode, shift, v_ab, i_ab);
+            self.run_slow_laws::<SATURATING>(p, &c, slot, previous_mode, shift, v_ab, i_ab);
         }
         estimate.diagnostics.lock = self.lock_status;
         estimate.into()
@@ -103,7 +140,12 @@ impl<T: Real> EstimatorState<T> {
     /// Phases 1–5 of the sample: integrate, observe, form λ̂r, track, select the mode and
     /// the feedback for the next sample. Nothing is committed.
     #[inline(always)]
-    fn candidate(&self, p: &EstimatorParams<T>, v_ab: Ab<T>, i_ab: Ab<T>) -> Candidate<T> {
+    fn candidate<const SATURATING: bool>(
+        &self,
+        p: &EstimatorParams<T>,
+        v_ab: Ab<T>,
+        i_ab: Ab<T>,
+    ) -> Candidate<T> {
         // L̂d − L̂q: zero on a surface-magnet rotor, where the active-flux terms vanish.
         let saliency = p.saliency;
         // 1. Integrate with the feedback of the previous sample (eq. (21) / (24)).
@@ -111,20 +153,20 @@ impl<T: Real> EstimatorState<T> {
             .integrator
             .next_flux(&self.integrator, v_ab, i_ab, self.feedback);
         // L̂q·i of eq. (5), formed once for both of its uses (λ̂r, and the observer's input
-        // on the rotor flux): what `rotor_flux` computes, bit for bit.
-        // A saturating model's secant L̂q is the last sample's here (`crate::active_flux`).
-        let lq_i = i_ab * self.lq_secant;
+        // on the rotor flux): what `rotor_flux` computes, bit for bit. A saturating model's
+        // secant L̂q is the last sample's here (`crate::active_flux`).
+        let lq_i = i_ab * if SATURATING { self.lq_secant } else { p.lq };
         // 2. Disturbance observer.
-        let (observer_flux, disturbance) = self.observe(p, lambda1, lq_i, i_ab, saliency);
+        let (observer_flux, disturbance) =
+            self.observe::<SATURATING>(p, lambda1, lq_i, i_ab, saliency);
         // 3. Rotor flux and direct angle (eq. (20), (5), (6)); a saturating model's secant
         //    L̂q at the current in the frame of λ2 − L̂q⁻·i.
         let lambda2 = stator_flux(lambda1, disturbance);
-        let (lambda_r, point) = match p.active_flux.saturating() {
-            None => (lambda2 - lq_i, None),
-            Some(af) => {
-                let (lambda_r, point) = af.rotor_flux(lambda2, i_ab, self.lq_secant);
-                (lambda_r, Some(point))
-            }
+        let (lambda_r, point) = if SATURATING {
+            let (lambda_r, point) = p.active_flux.rotor_flux(lambda2, i_ab, self.lq_secant);
+            (lambda_r, Some(point))
+        } else {
+            (lambda2 - lq_i, None)
         };
         let tracker_hold = lambda_r.norm_squared() < p.hold_level_sq;
         let theta_direct = rotor_angle(lambda_r);
@@ -171,7 +213,7 @@ impl<T: Real> EstimatorState<T> {
     /// Step 2: the disturbance observer at ω̂ of T2S-1 (eq. (10), (16)), on λ1 or on λ1 − L̂q·i (see
     /// `EstimatorTuning::observer_on_rotor_flux`): (λ̂1, D̂).
     #[inline(always)]
-    fn observe(
+    fn observe<const SATURATING: bool>(
         &self,
         p: &EstimatorParams<T>,
         lambda1: Ab<T>,
@@ -182,7 +224,7 @@ impl<T: Real> EstimatorState<T> {
         let observer_input = if p.observer_on_rotor_flux {
             let active = lambda1 - lq_i;
             if saliency != T::zero() {
-                active - self.active_flux_swing(p, i_ab, saliency)
+                active - self.active_flux_swing::<SATURATING>(p, i_ab, saliency)
             } else {
                 active
             }
@@ -197,7 +239,7 @@ impl<T: Real> EstimatorState<T> {
     }
 
     /// Step 4: both trackers on the direct angle θm, or coasting while |λ̂r| is below the hold
-    /// level.
+    /// level; T2S-1 with its running gains in disturbance-feedback mode.
     #[inline(always)]
     fn track(
         &self,
@@ -211,8 +253,15 @@ impl<T: Real> EstimatorState<T> {
                 p.t2s2.coasted_state(&self.t2s2),
             )
         } else {
+            // Above the mode threshold T2S-1 runs at its running bandwidth (the last
+            // sample's mode: the one this sample's angle was integrated in).
+            let t2s1 = if self.mode == Mode::DisturbanceFeedback {
+                &p.t2s1_running
+            } else {
+                &p.t2s1
+            };
             (
-                p.t2s1.next_state(&self.t2s1, theta_direct),
+                t2s1.next_state(&self.t2s1, theta_direct),
                 // Both trackers have the same Ts: T2S-1's Ts in angle units, loaded once.
                 p.t2s2
                     .next_state_with(&self.t2s2, theta_direct, p.t2s1.ts_units()),
@@ -247,7 +296,12 @@ impl<T: Real> EstimatorState<T> {
     /// observer's gains when due, the trackers, the mode and the feedback. Returns the
     /// re-centring shift of D̂.
     #[inline(always)]
-    fn commit(&mut self, p: &EstimatorParams<T>, c: &Candidate<T>, i_ab: Ab<T>) -> Ab<T> {
+    fn commit<const SATURATING: bool>(
+        &mut self,
+        p: &EstimatorParams<T>,
+        c: &Candidate<T>,
+        i_ab: Ab<T>,
+    ) -> Ab<T> {
         // Limiter mode: re-centre the common mode (see `LimiterTuning::recentring`).
         // With the integrand-offset law, the k_df mode re-centres too, at k_e (see
         // `crate::integrand_offset`: D̂ then decays at k_df + k_e instead of k_df, and the
@@ -293,7 +347,12 @@ impl<T: Real> EstimatorState<T> {
     /// commits it (a rejected sample never reaches this point). Outside its slot the
     /// detector's state is neither copied nor written back.
     #[inline(always)]
-    fn judge_lock(&mut self, p: &EstimatorParams<T>, c: &Candidate<T>, i_ab: Ab<T>) {
+    fn judge_lock<const SATURATING: bool>(
+        &mut self,
+        p: &EstimatorParams<T>,
+        c: &Candidate<T>,
+        i_ab: Ab<T>,
+    ) {
         // The innovation is T2S-1's phase error of this sample (0 when the trackers coasted).
         // The round-robin's slot, read only now: nothing before the commit needs it.
         if self.slot % LOCK_PERIOD != SLOT_LOCK {
@@ -325,7 +384,7 @@ impl<T: Real> EstimatorState<T> {
     /// slot of the round-robin (see [`SLOW_PERIOD`]).
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
-    fn run_slow_laws(
+    fn run_slow_laws<const SATURATING: bool>(
         &mut self,
         p: &EstimatorParams<T>,
         c: &Candidate<T>,
@@ -343,7 +402,7 @@ impl<T: Real> EstimatorState<T> {
         }
         let broken = self.slow_broken;
         if slot == SLOT_RS {
-            self.adapt_resistance(p, c, broken, v_ab, i_ab);
+            self.adapt_resistance::<SATURATING>(p, c, broken, v_ab, i_ab);
         } else if c.mode == Mode::Limiter {
             // Only the standstill law uses the means, and only after a whole period in the
             // limiter mode (else its regime is `Frozen`).
@@ -357,7 +416,7 @@ impl<T: Real> EstimatorState<T> {
 
     /// The R̂s adaptation's slot: R̂s, λ̂f and the standstill pull for the next period.
     #[inline(always)]
-    fn adapt_resistance(
+    fn adapt_resistance<const SATURATING: bool>(
         &mut self,
         p: &EstimatorParams<T>,
         c: &Candidate<T>,
@@ -380,7 +439,7 @@ impl<T: Real> EstimatorState<T> {
         let i_mean = (self.i_sum + c.i_drop) * per_sample;
         self.v_sum = Ab::zero();
         self.i_sum = Ab::zero();
-        let (state, pull) = p.rs_adaptation_params.next_state(
+        let (state, pull) = p.rs_adaptation_params.next_state::<SATURATING>(
             &self.rs_scale,
             &self.rs_adaptation,
             v_mean - self.offset.offset,
@@ -391,6 +450,7 @@ impl<T: Real> EstimatorState<T> {
             c.t2s1.omega,
             regime,
             self.offset.learning_samples >= p.flux_settle_periods,
+            Some(&p.active_flux),
         );
         // The pull acts until the law runs again (one period), with ê.
         let slow_feedback = self.offset.offset + pull;

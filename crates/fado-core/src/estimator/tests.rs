@@ -229,3 +229,47 @@ fn observer_gains_are_held_over_their_period() {
         OBSERVER_GAIN_PERIOD
     );
 }
+
+/// The loaded standstill's flux-magnitude hold: under a radial integrand error (0.05 V along
+/// the rotor's axis, with 10 A of q current at standstill) the limiter's disc lets |λ̂r| grow
+/// to its radius 1.15·λ̂f, an offset of λ1 that a departure turns into an angle error;
+/// `hold_flux_magnitude` keeps |λ̂r| on the model's λ̂f without turning the angle.
+#[test]
+fn flux_magnitude_hold_keeps_the_flux_on_the_model_circle_and_the_angle() {
+    let model = MachineModel::<f64>::paper();
+    let lf = model.flux_linkage;
+    let run = |hold: bool| {
+        let mut config = EstimatorConfig::for_machine(&model);
+        config.tuning.rs_adaptation.enabled = false;
+        let mut est = SensorlessEstimator::new(config).unwrap();
+        let theta = 0.3f64;
+        let (c, s) = (theta.cos(), theta.sin());
+        let i = Ab::new(-10.0 * s, 10.0 * c);
+        est.align(theta, i);
+        let v = i * model.rs + Ab::new(c, s) * 0.05;
+        let mut last = est.step(v, i);
+        for _ in 0..20_000 {
+            last = est.step(v, i);
+            if hold {
+                est.hold_flux_magnitude(lf);
+            }
+        }
+        let r = last.diagnostics.lambda_r;
+        let angle = (r.beta.atan2(r.alpha) - theta).abs();
+        (
+            r.norm_squared().sqrt() / lf,
+            angle,
+            (last.theta - theta).abs(),
+        )
+    };
+    let (free, free_angle, free_theta) = run(false);
+    let (held, held_angle, held_theta) = run(true);
+    assert!(
+        (free - 1.15).abs() < 0.01,
+        "without the hold |λ̂r|/λ̂f = {free}"
+    );
+    assert!((held - 1.0).abs() < 0.005, "with the hold |λ̂r|/λ̂f = {held}");
+    for a in [free_angle, held_angle, free_theta, held_theta] {
+        assert!(a < 1e-6, "the radial error turned the angle by {a} rad");
+    }
+}

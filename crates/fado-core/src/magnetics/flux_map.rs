@@ -11,7 +11,10 @@ use crate::{Dq, Real};
 /// Between grid nodes the map is bilinear (continuous, its Jacobian piecewise linear);
 /// beyond the grid it extends the edge cells linearly. Firmware keeps the four slices in
 /// flash (`&'static`, e.g. a `static` [`FluxTable`]); a host program borrows them from its
-/// own storage. A lookup finds the cell by bisection (4 comparisons per axis on 16 nodes).
+/// own storage. A lookup finds the cell in O(1) on a uniform axis — the node index from
+/// (x − x₀)/Δ with 1/Δ precomputed, the cell and its spacing confirmed by two comparisons, the
+/// fraction by a multiplication — and by bisection (4 comparisons on 16 nodes) and a division
+/// on any other: a uniform grid costs no division per lookup.
 ///
 /// [`FluxMap::new`] refuses a map that is not monotonic in its own current (ψd strictly
 /// increasing in i_d along every row, ψq in i_q along every column): such a map has no
@@ -22,6 +25,10 @@ pub struct FluxMap<'a, T> {
     i_q: &'a [T],
     psi_d: &'a [T],
     psi_q: &'a [T],
+    /// (n_d − 1)/(i_d[last] − i_d[0]): the inverse node spacing of a uniform i_d axis.
+    inv_step_d: T,
+    /// The same for i_q.
+    inv_step_q: T,
 }
 
 /// Why a flux map was refused: the grid node (k along i_d, m along i_q) where it was seen.
@@ -109,15 +116,45 @@ fn check_axis<T: Real>(axis: &'static str, x: &[T]) -> Result<(), FluxMapError> 
     Ok(())
 }
 
+/// The inverse node spacing (n − 1)/(x[last] − x[0]) of `axis` (two nodes or more): exact
+/// for a uniform axis, a first guess of the cell for any other.
+fn inverse_step<T: Real>(axis: &[T]) -> T {
+    let n = axis.len();
+    let span =
+        axis.last().copied().unwrap_or(T::zero()) - axis.first().copied().unwrap_or(T::zero());
+    T::from_index(n.max(2) - 1) / span
+}
+
+/// Relative mismatch between a cell's width and the uniform spacing 1/`inv_step`, in units of
+/// the type's ε, up to which the fraction is taken as (x − x_k)·`inv_step`: the rounding of a
+/// uniform axis' nodes (a few ulp of the largest node over the spacing: under 10 ε on 16 f32
+/// nodes over ±12 A), so that the fraction is the divided one to rounding, and any
+/// deliberately non-uniform spacing is divided.
+const UNIFORM_TOLERANCE_EPS: f64 = 64.0;
+
 /// The cell of `x` on `axis` (clamped to the edge cells) and the fraction along it (outside
-/// [0, 1] beyond the grid).
+/// [0, 1] beyond the grid). On a uniform axis the node index comes from `inv_step` (module
+/// docs); where that cell does not hold `x` or its width is not the uniform spacing, by
+/// bisection with the width divided.
 /// Indexing by `get` (a NaN where a shape check failed), so that the firmware's lookup holds
 /// no bounds-check panic.
 #[inline]
-fn cell<T: Real>(axis: &[T], x: T) -> (usize, T, T) {
+fn cell<T: Real>(axis: &[T], inv_step: T, x: T) -> (usize, T, T) {
     let n = axis.len();
-    let k = axis.partition_point(|&a| a <= x).clamp(1, n.max(2) - 1) - 1;
+    let last = n.max(2) - 2;
     let at = |j: usize| axis.get(j).copied().unwrap_or_else(|| T::lit(f64::NAN));
+    let x0 = at(0);
+    let guess = ((x - x0) * inv_step).index_floor(last);
+    let (lo, hi) = (at(guess), at(guess + 1));
+    let width = hi - lo;
+    // At and beyond the last node the division (a fraction of exactly 1 on the node).
+    let inside = (x >= lo || guess == 0) && x < hi;
+    let uniform =
+        (width * inv_step - T::one()).abs() <= T::default_epsilon() * T::lit(UNIFORM_TOLERANCE_EPS);
+    if inside && uniform {
+        return (guess, (x - lo) * inv_step, width);
+    }
+    let k = axis.partition_point(|&a| a <= x).clamp(1, n.max(2) - 1) - 1;
     let width = at(k + 1) - at(k);
     (k, (x - at(k)) / width, width)
 }
@@ -187,6 +224,8 @@ impl<'a, T: Real> FluxMap<'a, T> {
             i_q,
             psi_d,
             psi_q,
+            inv_step_d: inverse_step(i_d),
+            inv_step_q: inverse_step(i_q),
         })
     }
 
@@ -210,11 +249,12 @@ impl<'a, T: Real> FluxMap<'a, T> {
         self.psi_q
     }
 
-    /// ψ(i) and the incremental inductance ∂ψ/∂i of the bilinear interpolant at `i`.
+    /// The cell of `i` (fractions fx, fy along it, widths wx, wy) and the four corners of
+    /// ψd and ψq, as (p00, p10, p01, p11) with 1 one node up in i_d, 01 in i_q.
     #[inline]
-    pub fn flux_and_jacobian(&self, i: Dq<T>) -> (Dq<T>, InductanceMatrix<T>) {
-        let (k, fx, wx) = cell(self.i_d, i.d);
-        let (m, fy, wy) = cell(self.i_q, i.q);
+    fn corners(&self, i: Dq<T>) -> (T, T, T, T, Corners<T>, Corners<T>) {
+        let (k, fx, wx) = cell(self.i_d, self.inv_step_d, i.d);
+        let (m, fy, wy) = cell(self.i_q, self.inv_step_q, i.q);
         let nq = self.i_q.len();
         let at = k * nq + m;
         let node = |t: &[T], j: usize| t.get(j).copied().unwrap_or_else(|| T::lit(f64::NAN));
@@ -226,25 +266,48 @@ impl<'a, T: Real> FluxMap<'a, T> {
                 node(t, at + nq + 1),
             )
         };
-        let bilinear = |(p00, p10, p01, p11): (T, T, T, T)| {
+        (fx, fy, wx, wy, corner(self.psi_d), corner(self.psi_q))
+    }
+
+    /// ψ(i) and the incremental inductance ∂ψ/∂i of the bilinear interpolant at `i`.
+    #[inline]
+    pub fn flux_and_jacobian(&self, i: Dq<T>) -> (Dq<T>, InductanceMatrix<T>) {
+        let (fx, fy, wx, wy, cd, cq) = self.corners(i);
+        let bilinear = |(p00, p10, p01, p11): Corners<T>| {
             let (ex, ey) = (p10 - p00, p01 - p00);
             let twist = p11 - p10 - p01 + p00;
             (
-                p00 + fx * ex + fy * (ey + fx * twist),
+                bilinear_value((p00, p10, p01, p11), fx, fy),
                 (ex + fy * twist) / wx,
                 (ey + fx * twist) / wy,
             )
         };
-        let (d, dd, dq) = bilinear(corner(self.psi_d));
-        let (q, qd, qq) = bilinear(corner(self.psi_q));
+        let (d, dd, dq) = bilinear(cd);
+        let (q, qd, qq) = bilinear(cq);
         (Dq::new(d, q), InductanceMatrix { dd, dq, qd, qq })
     }
 }
 
+/// Four corner values of a cell: (p00, p10, p01, p11).
+type Corners<T> = (T, T, T, T);
+
+/// The bilinear interpolant p00 + fx·(p10 − p00) + fy·((p01 − p00) + fx·twist): the one
+/// expression [`FluxMap::flux`] and [`FluxMap::flux_and_jacobian`] share, so that both give
+/// the same ψ bit for bit.
+#[inline(always)]
+fn bilinear_value<T: Real>((p00, p10, p01, p11): Corners<T>, fx: T, fy: T) -> T {
+    let (ex, ey) = (p10 - p00, p01 - p00);
+    let twist = p11 - p10 - p01 + p00;
+    p00 + fx * ex + fy * (ey + fx * twist)
+}
+
 impl<T: Real> MagneticModel<T> for FluxMap<'_, T> {
+    /// The bilinear values alone: no Jacobian, so two divisions (the cell fractions) instead
+    /// of six.
     #[inline]
     fn flux(&self, i: Dq<T>) -> Dq<T> {
-        self.flux_and_jacobian(i).0
+        let (fx, fy, _, _, cd, cq) = self.corners(i);
+        Dq::new(bilinear_value(cd, fx, fy), bilinear_value(cq, fx, fy))
     }
 
     /// Newton from the map's linearisation at zero current.

@@ -27,9 +27,6 @@ pub(crate) struct ResistanceAdaptationParams<T: 'static> {
     /// L̂d − L̂q.
     saliency: T,
     floor_sq: T,
-    /// The saturating model's active flux (`crate::active_flux`); None: the constant
-    /// L̂d, L̂q of the configuration.
-    active_flux: ActiveFlux<T>,
 }
 
 /// What the laws derive from R0, the resistance they start from and scale with: mutable
@@ -126,27 +123,21 @@ impl<T: Real> ResistanceAdaptationParams<T> {
             },
             saliency: config.ld_hat - config.lq_hat,
             floor_sq: floor * floor,
-            active_flux: ActiveFlux::of(&crate::MachineModel::default()),
         })
     }
 
-    /// These constants with a saturating model's active flux: the reference λ̂a, the
-    /// regressor φ and the standstill law's inductances evaluated at the estimated current
-    /// (`crate::active_flux`), the laws frozen where φ is ill-conditioned.
-    pub(crate) fn with_active_flux(mut self, active_flux: ActiveFlux<T>) -> Self {
-        self.active_flux = active_flux;
-        self
-    }
-
-    /// The saturating model's operating point at the current `i` in the frame of `lambda_r`
-    /// (None without one).
+    /// A saturating model's operating point at the current `i` in the frame of `lambda_r`
+    /// (None for constant inductances: `SATURATING` false).
     #[inline(always)]
-    fn operating_point(
-        &self,
+    fn operating_point<const SATURATING: bool>(
+        active_flux: Option<&ActiveFlux<T>>,
         lambda_r: Ab<T>,
         i: Ab<T>,
-    ) -> Option<(ActiveFlux<T>, ActiveFluxPoint<T>)> {
-        let af = *self.active_flux.saturating()?;
+    ) -> Option<(&ActiveFlux<T>, ActiveFluxPoint<T>)> {
+        if !SATURATING {
+            return None;
+        }
+        let af = active_flux?;
         let point = af.point(ActiveFlux::frame_current(lambda_r, i));
         Some((af, point))
     }
@@ -187,13 +178,18 @@ impl<T: Real> ResistanceAdaptationParams<T> {
     /// every N samples, their means over the N samples, so that its integrals stay those of
     /// every sample — a sampled v_d would add the noise of the samples left out, and alias
     /// whatever the current loop puts at multiples of 1/(N·Ts) to DC). `settled`: the k_df
-    /// mode has lasted long enough for the λ̂f law (past the hand-over transient). The
+    /// mode has lasted long enough for the λ̂f law (past the hand-over transient).
+    /// `SATURATING` with `active_flux`: a saturating model (`crate::active_flux`), whose
+    /// active flux at the estimated current gives the reference λ̂a, the regressor φ and the
+    /// standstill law's inductances (the laws frozen where φ is ill-conditioned); else the
+    /// constant L̂d, L̂q of the configuration (the constant-inductance copy of the
+    /// estimator's step passes `SATURATING` false: no test of the model in it). The
     /// returned pull (V) acts until the next run (the estimator holds it over the period).
     /// Always inlined: the estimator's step is its one caller per sample (an out-of-line
     /// copy costs a call and the spills around it on a Cortex-M4F, docs/results/firmware-cost.md).
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
-    pub(crate) fn next_state(
+    pub(crate) fn next_state<const SATURATING: bool>(
         &self,
         scale: &ResistanceScale<T>,
         st: &ResistanceAdaptationState<T>,
@@ -205,6 +201,7 @@ impl<T: Real> ResistanceAdaptationParams<T> {
         omega: T,
         regime: AdaptationRegime,
         settled: bool,
+        active_flux: Option<&ActiveFlux<T>>,
     ) -> (ResistanceAdaptationState<T>, Ab<T>) {
         let mut next = ResistanceAdaptationState {
             rs_hat: st.rs_hat,
@@ -219,13 +216,25 @@ impl<T: Real> ResistanceAdaptationParams<T> {
         }
         let mag = mag_sq.step_sqrt();
         let pull = if regime == AdaptationRegime::Rotating {
-            if !self.rotating(scale, st, &mut next, i_drop, lambda_r, mag, omega, settled) {
+            let point = Self::operating_point::<SATURATING>(active_flux, lambda_r, i_drop);
+            if !self.rotating(
+                scale, st, &mut next, i_drop, lambda_r, mag, omega, settled, point,
+            ) {
                 return (next, Ab::zero());
             }
             Ab::zero()
         } else {
-            let standstill = self.standstill(
-                scale, st, &mut next, v_ab, i_mean, i_now, lambda_r, mag, omega,
+            let standstill = self.standstill::<SATURATING>(
+                scale,
+                st,
+                &mut next,
+                v_ab,
+                i_mean,
+                i_now,
+                lambda_r,
+                mag,
+                omega,
+                active_flux,
             );
             match standstill {
                 Some(pull) => pull,
@@ -250,10 +259,11 @@ impl<T: Real> ResistanceAdaptationParams<T> {
         mag: T,
         omega: T,
         settled: bool,
+        point: Option<(&ActiveFlux<T>, ActiveFluxPoint<T>)>,
     ) -> bool {
         let lf = st.flux_linkage_hat;
         let dl = self.saliency;
-        if let Some((af, point)) = self.operating_point(lambda_r, i_drop) {
+        if let Some((af, point)) = point {
             // A saturating model (`crate::active_flux`): λ̂a(î) shifted by the learned λ̂f,
             // the regressor's bracket at î; frozen where it is ill-conditioned.
             let Some(bracket) = af.resistance_regressor(&point) else {
@@ -374,7 +384,7 @@ impl<T: Real> ResistanceAdaptationParams<T> {
     /// (nothing adapts, no pull).
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
-    fn standstill(
+    fn standstill<const SATURATING: bool>(
         &self,
         scale: &ResistanceScale<T>,
         st: &ResistanceAdaptationState<T>,
@@ -385,6 +395,7 @@ impl<T: Real> ResistanceAdaptationParams<T> {
         lambda_r: Ab<T>,
         mag: T,
         omega: T,
+        active_flux: Option<&ActiveFlux<T>>,
     ) -> Option<Ab<T>> {
         let lf = st.flux_linkage_hat;
         let dl = self.saliency;
@@ -401,18 +412,19 @@ impl<T: Real> ResistanceAdaptationParams<T> {
         let inv_i_d = T::one() / i_d;
         // L̂q·i_q (the q flux), L̂d (the d inductance a step of i_d meets) and the rotor's
         // active flux: a saturating model's at the estimated current, else the constants.
-        let (rotation_emf, ld, active) = match self.operating_point(lambda_r, i_mean) {
-            Some((af, point)) => (
-                omega * (point.lq_secant * i_q),
-                af.ld_incremental(point.i_dq),
-                point.active + (lf - self.config.flux_linkage_hat),
-            ),
-            None => (
-                omega * self.config.lq_hat * i_q,
-                self.config.ld_hat,
-                lf + dl * i_d,
-            ),
-        };
+        let (rotation_emf, ld, active) =
+            match Self::operating_point::<SATURATING>(active_flux, lambda_r, i_mean) {
+                Some((af, point)) => (
+                    omega * (point.lq_secant * i_q),
+                    af.ld_incremental(point.i_dq),
+                    point.active + (lf - self.config.flux_linkage_hat),
+                ),
+                None => (
+                    omega * self.config.lq_hat * i_q,
+                    self.config.ld_hat,
+                    lf + dl * i_d,
+                ),
+            };
         let v_d = unit.dot(v_ab) + rotation_emf;
         // L̂d·di_d/dt integrates to L̂d·Δi_d between the ends of the period, from the
         // current sampled there (`i_now`); the first period of a test only records it

@@ -424,7 +424,7 @@ impl<T: Real> ResistanceAdaptation<T> {
         if !inputs_finite {
             return self.state.rs_hat;
         }
-        let (next, _) = self.params.next_state(
+        let (next, _) = self.params.next_state::<false>(
             &self.scale,
             &self.state,
             v_ab,
@@ -435,6 +435,7 @@ impl<T: Real> ResistanceAdaptation<T> {
             omega,
             regime,
             true,
+            None,
         );
         if next.is_finite() {
             self.state = next;

@@ -13,15 +13,15 @@ const FEEDFORWARD_RULE: &str = "on where the type-2 T2S-1 would lag the accelera
 const LOAD_POLE_RULE: &str = "0.5 with the acceleration feed-forward the drive turns on \
     itself (fado_core::control::tracker_feedforward)";
 
-/// The same rule's bandwidth of T2S-1 on a light rotor.
-const BANDWIDTH_RULE: &str = "raised until a step of the rated torque peaks at \
-    `[controller.tracker_feedforward] load_step_error` in the type-3 T2S-1 \
+/// The same rule's running bandwidth of T2S-1 on a light rotor.
+const BANDWIDTH_RULE: &str = "T2S-1's bandwidth in k_df mode at which a step of the rated \
+    torque peaks at `[controller.tracker_feedforward] load_step_error` \
     (fado_core::control::tracker_feedforward)";
 
 /// `cfg` with the values the drive's build-time rule sets in its tuning (the acceleration
-/// feed-forward, the trackers' load pole and T2S-1's bandwidth of
-/// `fado_core::control::tracker_feedforward`),
-/// each recorded as derived: what the drive runs with, as `--dump-config` shows it.
+/// feed-forward, the trackers' load pole and T2S-1's running bandwidth of
+/// `fado_core::control::tracker_feedforward`), each recorded as derived: what the drive runs
+/// with, as `--dump-config` shows it.
 pub(crate) fn with_drive_rules(cfg: &SimConfig) -> SimConfig {
     let mut c = cfg.clone();
     let drive = c.drive_config();
@@ -53,14 +53,14 @@ pub(crate) fn with_drive_rules(cfg: &SimConfig) -> SimConfig {
         derive("estimator.tracker.load_pole_ratio", pole, LOAD_POLE_RULE);
         c.estimator.tracker.load_pole_ratio = pole;
     }
-    let bandwidth = estimator.tracker.t2s1_bandwidth_hz;
-    if bandwidth != c.estimator.tracker.t2s1_bandwidth_hz {
+    let bandwidth = estimator.tracker.t2s1_running_bandwidth_hz;
+    if bandwidth != c.estimator.tracker.t2s1_running_bandwidth_hz {
         derive(
-            "estimator.tracker.t2s1_bandwidth_hz",
+            "estimator.tracker.t2s1_running_bandwidth_hz",
             bandwidth,
             BANDWIDTH_RULE,
         );
-        c.estimator.tracker.t2s1_bandwidth_hz = bandwidth;
+        c.estimator.tracker.t2s1_running_bandwidth_hz = bandwidth;
     }
     c
 }

@@ -338,7 +338,7 @@ fn the_dump_shows_the_feedforward_the_drive_turns_on() {
         "{fast}"
     );
     assert!(
-        fast.contains("  # derived: raised until a step of the rated torque"),
+        fast.contains("  # derived: T2S-1's bandwidth in k_df mode"),
         "{fast}"
     );
     let paper = dump("paper");

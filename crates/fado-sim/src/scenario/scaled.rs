@@ -129,6 +129,7 @@ pub(super) fn setup_loaded_start(c: &mut SimConfig) {
     c.simulation.brake_release_at = t0 - LOADED_START_BRAKE_LEAD;
     c.controller.release_hold.enabled = true;
     c.controller.startup.find_angle = true;
+    c.controller.startup.rotor_held = true;
     c.simulation.initial_angle = loaded_start_angle(c.current_sensor.seed);
     with_assumed_d_saturation(c);
     c.speed_reference = Profile::from_points(&[(0.0, 0.0), (t0, 0.0), (t0 + 1.0, n)]);

@@ -147,7 +147,8 @@ pub const SCENARIOS: [Scenario; 14] = [
                   100 % of rated torque (gravity-like) on it; the drive is not told the angle \
                   and finds it at standstill (`[controller.startup] find_angle`; a plant with \
                   constant inductances gets the assumed d-axis saturation \
-                  `LOADED_START_D_SATURATION`); the brake opens at the drive's first ready \
+                  `LOADED_START_D_SATURATION`; `rotor_held`: the brake holds it through the \
+                  start-up); the brake opens at the drive's first ready \
                   sample from 0.7 s on; 0 r/min until 1 s, then a ramp to +6 % of rated speed \
                   (lifting) by 2 s, held to 3 s",
         criterion: "from t = 0: the angle found and |θ − θ̂| from ready on < 0.25 rad; backward \

@@ -267,5 +267,10 @@ fn probe_config<T: Real>(c: &DriveConfig<T>) -> Result<StandstillProbeConfig<T>,
             "standstill_probe_load_ratio",
             t.standstill_probe.load_ratio,
         )? * rated,
+        inertia: {
+            let p = T::lit(m.pole_pairs as f64);
+            m.inertia / (T::lit(1.5) * p * p * m.flux_linkage)
+        },
+        arm_time: t.standstill_probe.arm_time,
     })
 }

@@ -33,7 +33,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
     }
 
     /// One sample of the gain calibration (offsets removed, no gain correction): the current
-    /// loop holds the calibration's d current in the frame of the aligned angle at ω = 0, with
+    /// loop holds the calibration's current in the frame of its axis ([`Self::gain_axis`]) at ω = 0, with
     /// the usual dead-time compensation and modulation; the estimator is not stepped (the
     /// drive re-aligns at the end). The calibration gets the realised voltage that acted over
     /// the last period, as the estimator would.
@@ -67,11 +67,8 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             self.realign(theta0);
             return self.last;
         }
-        let theta0 = if self.aligned_angle.is_finite() {
-            self.aligned_angle
-        } else {
-            T::zero()
-        };
+        let axis = self.gain_axis();
+        let theta0 = if axis.is_finite() { axis } else { T::zero() };
         let rot = Rotation::from_angle(theta0);
         let i_dq = i_ab.to_dq(rot);
         let i_dq_ref = Dq::new(command.current_d, T::zero());
@@ -96,6 +93,14 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             b.current.realised(applied.v_dq);
         }
         self.record(applied, i_dq, i_dq_ref, estimate, i_ab)
+    }
+
+    /// The gain calibration's axis: the aligned angle, or with a held rotor
+    /// ([`StartupTuning::rotor_held`](crate::control::StartupTuning::rotor_held)) the
+    /// nearest well-observed axis.
+    pub(super) fn gain_axis(&self) -> T {
+        let min = self.config.tuning.gain_calibration.min_observability;
+        self.startup.gain_axis(self.aligned_angle, min)
     }
 
     /// The phase currents with the measured gain ratio applied to phase a; c keeps the sum of

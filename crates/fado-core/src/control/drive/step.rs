@@ -220,8 +220,8 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             return Err(self.angle_phase_step(i_abc, vdc));
         }
         if self.gain.pending() {
-            let theta0 = self.aligned_angle;
-            self.gain.start(theta0);
+            let axis = self.gain_axis();
+            self.gain.start(axis);
         }
         if self.gain.running() {
             return Err(self.gain_calibration_step(i_abc, vdc));
@@ -341,23 +341,8 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
                 self.last.i_dq_ref.norm(),
             );
             // The loaded-standstill probe (see `standstill_probe`): Δi_d on the d reference,
-            // and the turn of θ̂ its reading implies (from the next sample).
-            let probe = &mut self.blocks.probe;
-            let gate = probe.gate(
-                speed_ref,
-                iq_torque,
-                estimate.diagnostics.mode == Mode::Limiter,
-                action == LockAction::Run,
-            );
-            let m = &self.config.machine;
-            let last = self.last.i_dq_ref;
-            let probe_id = probe.step(
-                gate,
-                iq_torque,
-                (last.d, last.q),
-                m.flux_linkage,
-                m.ld - m.lq,
-            );
+            // and the corrections of the estimate (from the next sample).
+            let probe_id = self.standstill_probe_current(speed_ref, iq_torque, estimate, action);
             // Field weakening and loss braking add to the d reference (see
             // `field_weakening`, `dc_link_limit`); zero below the voltage limit.
             let fw_id = self.blocks.field_weakening.delta_id();
@@ -378,13 +363,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
                 i
             }
         };
-        if action == LockAction::Coast {
-            self.blocks.probe.reset();
-        }
-        let turn = self.blocks.probe.rate();
-        if turn != T::zero() {
-            self.estimator.turn_angle(turn * self.config.ts);
-        }
+        self.standstill_corrections(action);
         Some(i_dq_ref)
     }
 

@@ -3,6 +3,7 @@
 //! behind a drive's one-sample computation delay.
 
 use super::*;
+use crate::control::gain_calibration::GainCalibration;
 use crate::control::initial_angle::tests::machine;
 use crate::magnetics::{MagneticModel, Saturation};
 use crate::{Dq, Rotation};
@@ -159,4 +160,29 @@ fn off_by_default_and_bad_settings_are_named() {
     let machine = MachineModel::paper();
     let e = AngleSearch::new(bad, &machine, TS).unwrap_err();
     assert_eq!(e.field(), "startup.pulse_voltage_ratio");
+}
+
+#[test]
+fn a_held_rotor_gets_the_nearest_well_observed_gain_axis_and_a_free_one_its_d_axis() {
+    let free = phase(2.63e-3, 2.63e-3, 21.78, on());
+    let held = phase(
+        2.63e-3,
+        2.63e-3,
+        21.78,
+        StartupTuning {
+            rotor_held: true,
+            ..on()
+        },
+    );
+    let third = core::f64::consts::FRAC_PI_3;
+    // −1.49 rad leaves phase a 8 % of the current: the held rotor's axis is −π/2 ± π/6's
+    // nearest multiple of π/3, −π/3; 0.74 rad is observed well enough (22 %) and is kept.
+    assert_eq!(free.gain_axis(-1.49, 0.2), -1.49);
+    assert!((held.gain_axis(-1.49, 0.2) + third).abs() < 1e-12);
+    assert_eq!(held.gain_axis(0.74, 0.2), 0.74);
+    for k in -3..=3 {
+        let axis = held.gain_axis(k as f64 * third + 0.5, 0.99);
+        let share = GainCalibration::observability(axis);
+        assert!(share > 0.49, "{k}: {axis} {share}");
+    }
 }

@@ -103,6 +103,10 @@ pub const MOVED_KEYS: &[(&str, &str)] = &[
     ("bandwidth_definition", "tracker.bandwidth_definition"),
     ("tracker_hold_ratio", "tracker.hold_ratio"),
     ("tracker_load_pole_ratio", "tracker.load_pole_ratio"),
+    (
+        "t2s1_running_bandwidth_hz",
+        "tracker.t2s1_running_bandwidth_hz",
+    ),
     ("observer_on_rotor_flux", "observer.on_rotor_flux"),
     ("observer_lag_compensation", "observer.lag_compensation"),
     ("observer_gain_period", "observer.gain_period"),

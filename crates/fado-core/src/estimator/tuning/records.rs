@@ -149,9 +149,16 @@ pub struct TrackerTuning<T> {
     /// scenarios: a load pole at half ωn, 8 Hz on T2S-2's 35 Hz, settles a rated load step
     /// within 0.1 rad on the paper's motor, docs/range.md).
     pub load_pole_ratio: T,
+    /// Bandwidth of T2S-1 in Hz while the estimator runs in disturbance-feedback mode (above
+    /// the mode threshold, where the directly calculated angle comes from the voltage model);
+    /// in limiter mode T2S-1 keeps `t2s1_bandwidth_hz`, whose narrower band holds θ̂ against
+    /// the limiter's angle errors at standstill. Default 0: the same as `t2s1_bandwidth_hz`
+    /// (the paper's one tracker). The drive sets it on a light rotor from its rated-load
+    /// acceleration (`fado_core::control::tracker_feedforward`, docs/range.md).
+    pub t2s1_running_bandwidth_hz: T,
 }
 
-cast_record!(TrackerTuning { t2s1_bandwidth_hz, t2s2_bandwidth_hz, damping, hold_ratio, load_pole_ratio ; bandwidth_definition });
+cast_record!(TrackerTuning { t2s1_bandwidth_hz, t2s2_bandwidth_hz, damping, hold_ratio, load_pole_ratio, t2s1_running_bandwidth_hz ; bandwidth_definition });
 
 impl<T: Real> Default for TrackerTuning<T> {
     fn default() -> Self {
@@ -162,6 +169,7 @@ impl<T: Real> Default for TrackerTuning<T> {
             bandwidth_definition: BandwidthDefinition::default(),
             hold_ratio: T::lit(0.2),
             load_pole_ratio: T::zero(),
+            t2s1_running_bandwidth_hz: T::zero(),
         }
     }
 }

@@ -214,6 +214,7 @@ pub const MOVED_KEYS: &[(&str, &str)] = &[
     ),
     ("standstill_probe_period", "standstill_probe.period"),
     ("standstill_probe_gain", "standstill_probe.gain"),
+    ("standstill_probe_arm_time", "standstill_probe.arm_time"),
     (
         "standstill_probe_speed_ratio",
         "standstill_probe.speed_ratio",

@@ -3,7 +3,7 @@
 //! the loaded-standstill angle probe.
 
 use crate::Real;
-use crate::control::gain_calibration;
+use crate::control::{gain_calibration, standstill_probe};
 use crate::machine::PAPER_RATED_CURRENT;
 use crate::real::cast_record;
 
@@ -218,19 +218,25 @@ pub struct StandstillProbeTuning<T> {
     /// reading Δi_d·tan δ is 0.2 A at δ = 0.1 rad against a speed-loop ripple the
     /// demodulation averages over a whole period).
     pub current_ratio: T,
-    /// Probe period T_p in s. Default 0.5 s \[A\]: each half holds 0.25 s, 8 time constants
-    /// 1/(2π·f_sc) of the 5 Hz speed loop (1.6 of its PI zero's ratio/(2π·f_sc) = 0.16 s), the
-    /// correlation reads the second half of each half, after 4 loop time constants. Measured
-    /// on the loaded hour's configuration (docs/method/additions.md): a longer
-    /// period lets the probe's own Δi_d move the angle more within a half (the inverter
-    /// residual's tangential part depends on the current vector): worst |θ − θ̂| over five
-    /// sensor seeds 0.51 rad at 2 s, 0.095 at 1 s, 0.065 at 0.5 s.
+    /// Probe period T_p in s. Default 0.1 s \[A\]: the reading removes the rotor's
+    /// acceleration from the torque balance (`StandstillProbeConfig::inertia`), so it needs
+    /// no settled speed loop, only a settled current loop and speed estimate: each
+    /// correlation window (a quarter period, 25 ms) spans 5.5 time constants of the 35 Hz
+    /// speed tracker the speed loop reads. The correction loop's bandwidth is a fixed
+    /// fraction of 1/T_p, so the period sets how fast a creep is caught: with 0.5 s the
+    /// fullrange hold of the servo and hub presets ended 0.25–0.35 rad off
+    /// (docs/range.md).
     pub period: T,
-    /// Correction gain g in s⁻¹: θ̂ turns at g·δ̂. Default 1 s⁻¹ \[A\]: g·T_p = 1/2 with
-    /// the default period (a first-order loop per period with the measurement half a period
-    /// late: half the deadbeat gain), a steady error c/g = 0.01–0.02 rad under the measured
-    /// 0.01–0.02 rad/s creep.
+    /// Correction gain g in s⁻¹: θ̂ turns at g·δ̂ plus the learned creep ĉ, which grows by
+    /// 0.173·g·δ̂ per period. Default 0.405/T_p = 4.05 s⁻¹ \[D\]: with the reading half a
+    /// period late the loop per period has a triple pole at 4^(1/3) − 1 = 0.587
+    /// (`fado_core::control::standstill_probe`, "Correction"), and a constant creep leaves no
+    /// angle error.
     pub gain: T,
+    /// Time (s) the loaded standstill holds before the probe starts. Default 0.5 s \[A\]:
+    /// not in a passage through zero or a short stop (fig12's and the presets' `stops`
+    /// never arm it).
+    pub arm_time: T,
     /// The probe's gate: the speed reference |ω*| at most this multiple of the rated speed.
     /// Default 0.0005 \[A\] (0.75 r/min at 1500 r/min): a standstill reference. The probe
     /// moves the rotor by ±1–1.5 r/min on the paper's motor, a speed error at a low non-zero
@@ -243,15 +249,16 @@ pub struct StandstillProbeTuning<T> {
     pub load_ratio: T,
 }
 
-cast_record!(StandstillProbeTuning { current_ratio, period, gain, speed_ratio, load_ratio ; enabled });
+cast_record!(StandstillProbeTuning { current_ratio, period, gain, arm_time, speed_ratio, load_ratio ; enabled });
 
 impl<T: Real> Default for StandstillProbeTuning<T> {
     fn default() -> Self {
         Self {
             enabled: true,
             current_ratio: T::lit(0.1),
-            period: T::lit(0.5),
-            gain: T::one(),
+            period: T::lit(0.1),
+            gain: T::lit(standstill_probe::TRIPLE_POLE_GAIN / 0.1),
+            arm_time: T::lit(0.5),
             speed_ratio: T::lit(0.0005),
             load_ratio: T::lit(0.25),
         }

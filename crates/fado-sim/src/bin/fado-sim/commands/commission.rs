@@ -60,11 +60,17 @@ pub fn commission(args: CommissionArgs) -> Outcome {
         o.status,
         o.simulated_seconds
     );
+    if let (None, Some(m)) = (&o.identification, &o.magnetics) {
+        print_magnetics(m, o.rotor_motion_magnetics);
+    }
     if o.identification.is_none() {
         outln!("wrote {}/metrics.json and traces.csv", dir.display());
         return Ok(ExitCode::from(1));
     }
     print_parameters(&rows);
+    if let Some(m) = &o.magnetics {
+        print_magnetics(m, o.rotor_motion_magnetics);
+    }
     outln!(
         "wrote {}/identified.toml, metrics.json and traces.csv",
         dir.display()
@@ -166,6 +172,9 @@ fn write_outputs(
         "max_current_reference": o.max_current_reference,
         "current_limit": o.current_limit,
         "rotor_motion_inductance": o.rotor_motion_inductance,
+        "rotor_motion_magnetics": o.rotor_motion_magnetics,
+        "max_current_magnetics": o.max_current_magnetics,
+        "magnetics": o.magnetics,
         "seed": seed,
         "parameters": rows,
     });
@@ -205,6 +214,34 @@ fn write_outputs(
     }
     m.rename()?;
     Ok(())
+}
+
+/// The magnetic model: detected or not, and its errors over the rated current range.
+fn print_magnetics(m: &fado_sim::commission::MagneticsReport, motion: f64) {
+    let a = &m.accuracy;
+    let verdict = if m.saturation_detected {
+        "saturation detected (the fitted algebraic model)"
+    } else {
+        "no saturation detected (constant inductances)"
+    };
+    outln!(
+        "magnetics: {verdict} (inductances change {:.1} % up to {:.3} A; rotor turned {:.3} rad)",
+        100.0 * m.inductance_change,
+        m.pulse_current,
+        motion
+    );
+    let pc = |s: &fado_sim::magnetic_accuracy::ErrorStats| {
+        format!("max {:.2} %, rms {:.2} %", 100.0 * s.max, 100.0 * s.rms)
+    };
+    outln!(
+        "  over |i| <= {:.3} A: incremental Ld {}, Lq {}; secant Ld {}, Lq {}; flux {}",
+        a.rated_current,
+        pc(&a.incremental_ld),
+        pc(&a.incremental_lq),
+        pc(&a.secant_ld),
+        pc(&a.secant_lq),
+        pc(&a.flux)
+    );
 }
 
 /// Each identified parameter against the truth: relative errors in %, absolute ones for the

@@ -1,0 +1,386 @@
+//! The standstill flux-linkage pulses ([`Phase::Magnetics`], module docs step 5): bipolar
+//! voltage pulses in six directions of the d-q plane, the flux linkage integrated from zero
+//! current, the samples stored for the fit at the end.
+
+use super::magnetic_fit::{FluxSamples, SAMPLE_CAPACITY, best_fit, inductance_change};
+use super::*;
+use crate::magnetics::{MagneticModel, Saturation};
+use crate::{Ab, Real};
+
+/// Bipolar pairs of pulses (directions k·π/6 of the voltage, each followed at once by its
+/// opposite), in the order that cancels the reluctance torque's impulse of a pair (∝ sin 2φ)
+/// with the next one: 0°, 90°, then 30° with 150°, 60° with 120°.
+const PAIR_ANGLES_DEG: [f64; 3] = [0.0, 60.0, 120.0];
+
+/// Samples per rise of a pulse on the identified inductance, at most (the pulse voltage is
+/// lowered to L̂·I_p/(N·Ts) where the limit would reach I_p sooner): the stopping rule reacts
+/// one sample late, so the overshoot is about 2/N of the peak current.
+const RISE_SAMPLES: f64 = 16.0;
+
+/// Saturation is reported only where the fitted model's RMS current residual is below this
+/// fraction of the constant-inductance model's: the saturation terms must explain the data,
+/// not the integration's own errors (the linear presets' fits reach 0.68–0.96 of it, the
+/// saturated ones 0.03, docs/results/commissioning-magnetics.md).
+const RESIDUAL_RATIO: f64 = 0.5;
+
+/// Gates-off rest between pairs, in samples: the diodes take the current to zero (in
+/// microseconds), so that the next pair starts from ψ = (λf, 0).
+const REST_SAMPLES: u32 = 8;
+
+/// Zero-voltage samples (gates on) after a pair's last command, which the gates-off would
+/// otherwise cut short (the gates act at once, a command one sample later).
+const DRAIN_SAMPLES: u32 = 2;
+
+/// The algebraic model fitted to the flux-linkage pulses
+/// ([`Commissioning::magnetic_model`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MagneticFit<T> {
+    /// The best-fitting model.
+    pub model: Saturation<T>,
+    /// The largest relative change of its incremental inductances over the pulses' range.
+    pub change: T,
+    /// Its RMS current residual over the samples, A.
+    pub residual: T,
+    /// The constant-inductance model's RMS residual, A.
+    pub linear_residual: T,
+    /// Saturation detected: `change` above the threshold and `residual` below half of
+    /// `linear_residual`.
+    pub detected: bool,
+}
+
+/// Where the pulses stand.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Stage {
+    /// Gates off, the current at zero.
+    Rest,
+    /// The first pulse of a pair rising (`forward`), then returning; the second likewise.
+    Rise1,
+    Return1,
+    Rise2,
+    Return2,
+    /// Zero voltage before the rest.
+    Drain,
+    /// The pulses done: the d current brought back to the DC test's I₁ (frozen voltage)
+    /// before the spin, which starts from it.
+    Hold,
+}
+
+/// The pulses' state.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct FluxPulses<T> {
+    pub(super) samples: FluxSamples<T>,
+    pub(super) stage: Stage,
+    pair: usize,
+    count: u32,
+    n_up: u32,
+    n_max: u32,
+    dir: Ab<T>,
+    v_pulse: T,
+    /// The flux-linkage change since the pair's start, V·s (α-β = d-q at standstill).
+    psi: Ab<T>,
+    integrating: bool,
+    decimation: u32,
+    k: u32,
+    /// The rotor's angle at the pair's start, estimated from the pairs before, rad.
+    theta0: T,
+    /// The first sample of the pair in `samples`.
+    pair_start: usize,
+    /// ∫τ and ∫∫τ over the pair, τ = ψ × i the torque's shape (its scale 1.5·p/J unknown).
+    w: T,
+    d: T,
+    /// The sum of the current over the q injection before the pulses.
+    pub(super) held_current: Ab<T>,
+}
+
+impl<T: Real> FluxPulses<T> {
+    pub(super) fn new() -> Self {
+        Self {
+            samples: FluxSamples::new(),
+            stage: Stage::Rest,
+            pair: 0,
+            count: 0,
+            n_up: 0,
+            n_max: 0,
+            dir: Ab::zero(),
+            v_pulse: T::zero(),
+            psi: Ab::zero(),
+            integrating: false,
+            decimation: 1,
+            k: 0,
+            theta0: T::zero(),
+            pair_start: 0,
+            w: T::zero(),
+            d: T::zero(),
+            held_current: Ab::zero(),
+        }
+    }
+}
+
+/// The nominal duration of [`Phase::Magnetics`] (for the progress), s: six pairs of four
+/// edges, each the longer of [`RISE_SAMPLES`] and the nameplate's L̂q·I_p/V at the voltage
+/// limit, the rests, and the hold.
+pub(super) fn magnetics_time<T: Real>(cfg: &CommissioningConfig<T>) -> T {
+    let m = &cfg.magnetics;
+    if !m.enabled {
+        return T::zero();
+    }
+    let np = &cfg.nameplate;
+    let ts = cfg.sample_period;
+    let v_max = m.voltage_ratio * np.dc_voltage * T::lit(SQRT3_INV);
+    let rise = (np.ld.max(np.lq) * m.current_ratio * np.rated_current / v_max)
+        .max(T::lit(RISE_SAMPLES) * ts);
+    let rest = T::from_index((REST_SAMPLES + DRAIN_SAMPLES) as usize) * ts;
+    T::from_index(PAIR_ANGLES_DEG.len()) * (T::lit(4.0) * rise + rest) + cfg.settle_time
+}
+
+impl<T: Real> Commissioning<T> {
+    /// The flux-linkage pulses' peak current, A (`magnetics.current_ratio` × the rated
+    /// current).
+    pub fn pulse_current(&self) -> T {
+        self.cfg.magnetics.current_ratio * self.cfg.nameplate.rated_current
+    }
+
+    /// Starts [`Phase::Magnetics`] (or the spin, with the test off), from the inductance
+    /// tests' I₁ along d.
+    pub(super) fn start_magnetics(&mut self) {
+        if !self.cfg.magnetics.enabled {
+            self.start_spin();
+            return;
+        }
+        // The rotor's angle: along the current it was held by in the inductance tests (the
+        // torque 1.5·p·(λf + (Ld − Lq)·i_d)·i_q vanishes at i_q = 0 in its frame). The frozen
+        // voltage of the DC test leaves that current up to 0.1 rad off the α axis (its β part:
+        // the phases' inverter errors); taken as 0, the pulses' flux and current would be
+        // turned by that angle against the rotor's frame.
+        let held = self.pulses.held_current;
+        let theta = if held.norm() > T::zero() {
+            held.beta.atan2(held.alpha)
+        } else {
+            T::zero()
+        };
+        self.pulses = FluxPulses::new();
+        self.pulses.theta0 = theta;
+        // Store about 3/4 of the capacity: 6 pairs × 4 edges of about RISE_SAMPLES each
+        // (fewer where the voltage limit makes the edges longer: the rest is not stored).
+        let expected = PAIR_ANGLES_DEG.len() as f64 * 4.0 * RISE_SAMPLES;
+        self.pulses.decimation = libm_round(expected / (0.75 * SAMPLE_CAPACITY as f64));
+        self.i_ref = Ab::zero();
+        self.next_phase(Phase::Magnetics);
+    }
+
+    /// One sample of [`Phase::Magnetics`]: (command, applied voltage, gates on).
+    pub(super) fn magnetics(&mut self, i: Ab<T>, vdc: T) -> (Ab<T>, Ab<T>, bool) {
+        self.pulse_integrate(i);
+        self.pulses.count += 1;
+        match self.pulses.stage {
+            Stage::Rest => return self.pulse_rest(i, vdc),
+            Stage::Hold => return self.pulse_hold(i, vdc),
+            _ => {}
+        }
+        let i_p = self.pulse_current();
+        let p = &mut self.pulses;
+        let reached = i.norm() >= i_p || p.count > p.n_max;
+        let v = p.v_pulse;
+        // `count` is the number of commands of the stage issued so far, plus one.
+        let cmd = match p.stage {
+            Stage::Rise1 | Stage::Rise2 if reached => {
+                p.n_up = p.count - 1;
+                p.count = 1;
+                if p.stage == Stage::Rise1 {
+                    p.stage = Stage::Return1;
+                    -v
+                } else {
+                    p.stage = Stage::Return2;
+                    v
+                }
+            }
+            Stage::Rise1 => v,
+            Stage::Rise2 => -v,
+            Stage::Return1 if p.count > p.n_up => {
+                p.stage = Stage::Rise2;
+                p.count = 1;
+                -v
+            }
+            Stage::Return1 => -v,
+            Stage::Return2 if p.count > p.n_up => {
+                p.stage = Stage::Drain;
+                p.count = 1;
+                T::zero()
+            }
+            Stage::Return2 => v,
+            Stage::Drain if p.count > DRAIN_SAMPLES => {
+                self.pulse_pair_end(i);
+                let p = &mut self.pulses;
+                p.stage = Stage::Rest;
+                p.count = 0;
+                p.integrating = false;
+                p.pair += 1;
+                return (Ab::zero(), Ab::zero(), false);
+            }
+            Stage::Drain | Stage::Rest | Stage::Hold => T::zero(),
+        };
+        let out = p.dir * cmd;
+        (out, out, true)
+    }
+
+    /// The flux-linkage integral over the last sample, v − R̂s·i less the identified inverter
+    /// error (the DC test's V̂ on the trapezoid of the phase currents), and the stored sample.
+    fn pulse_integrate(&mut self, i: Ab<T>) {
+        if !(self.pulses.integrating && self.have_prev) {
+            return;
+        }
+        let i_mid = (i + self.i_prev) * T::lit(0.5);
+        let err = dead_time_voltage(i_mid, T::lit(0.05) * self.i_limit, self.v_inv);
+        let (c, s) = (self.pulses.theta0.cos(), self.pulses.theta0.sin());
+        let flux = self.cfg.nameplate.flux_linkage;
+        let p = &mut self.pulses;
+        p.psi += (self.c2 - err - i_mid * self.rs) * self.ts;
+        let psi = Ab::new(flux * c, flux * s) + p.psi;
+        p.w += (psi.alpha * i.beta - psi.beta * i.alpha) * self.ts;
+        p.d += p.w * self.ts;
+        p.k += 1;
+        if p.k >= p.decimation {
+            p.k = 0;
+            p.samples.push(
+                Dq::new(p.psi.alpha, p.psi.beta),
+                Dq::new(i.alpha, i.beta),
+                p.d,
+            );
+        }
+    }
+
+    /// The rotor's motion over the pair from its flux linkage, and the pair's samples turned
+    /// into the rotor frame (module docs, step 5). At the pair's end the current is (nearly)
+    /// zero again, so ψ is the magnet's λf·e^{j(θ0 + δ)}: the flux change's component across
+    /// the magnet, less L̂·i of the residual current, is λf·δ. Within the pair the angle
+    /// follows the double integral of the torque, whose shape ψ × i is measured and whose
+    /// scale (1.5·p/J) the end's δ gives: δ(t) = δ·D(t)/D(end). The magnet's flux enters as
+    /// the nameplate's, to first order without effect: δ ∝ 1/λf and its correction ∝ λf·δ.
+    fn pulse_pair_end(&mut self, i: Ab<T>) {
+        let flux = self.cfg.nameplate.flux_linkage;
+        let lq = self.lq;
+        let p = &mut self.pulses;
+        let theta0 = p.theta0;
+        let to_dq = |x: Ab<T>, a: T| {
+            let (c, s) = (a.cos(), a.sin());
+            Dq::new(c * x.alpha + s * x.beta, c * x.beta - s * x.alpha)
+        };
+        let (psi_end, i_end) = (to_dq(p.psi, theta0), to_dq(i, theta0));
+        let delta = (psi_end.q - lq * i_end.q) / flux;
+        let d_end = p.d;
+        let magnet = Ab::new(flux * theta0.cos(), flux * theta0.sin());
+        let delta = if delta.is_finite() { delta } else { T::zero() };
+        p.samples.map_from(p.pair_start, |dpsi, i, d| {
+            let share = if d_end != T::zero() {
+                d / d_end
+            } else {
+                T::zero()
+            };
+            let angle = theta0 + delta * share.max(T::zero()).min(T::lit(2.0));
+            let psi = to_dq(magnet + Ab::new(dpsi.d, dpsi.q), angle);
+            (
+                Dq::new(psi.d - flux, psi.q),
+                to_dq(Ab::new(i.d, i.q), angle),
+            )
+        });
+        p.theta0 += delta;
+        p.pair_start = p.samples.len();
+        p.w = T::zero();
+        p.d = T::zero();
+    }
+
+    /// Gates off until the current is zero, then the next pair (or the hold after the last).
+    fn pulse_rest(&mut self, i: Ab<T>, vdc: T) -> (Ab<T>, Ab<T>, bool) {
+        let i_p = self.pulse_current();
+        if self.pulses.count < REST_SAMPLES || i.norm() > T::lit(0.02) * i_p {
+            return (Ab::zero(), Ab::zero(), false);
+        }
+        if self.pulses.pair >= PAIR_ANGLES_DEG.len() {
+            self.pulses.stage = Stage::Hold;
+            self.pulses.count = 0;
+            let i1 = T::lit(0.5) * dc_level(&self.cfg.nameplate, self.i_limit);
+            self.i_ref = Ab::new(i1, T::zero());
+            return self.pulse_hold(i, vdc);
+        }
+        // The voltage's direction that drives the current along the pair's angle γ on the
+        // identified inductances: Δψ ∥ (L̂d·cos γ, L̂q·sin γ).
+        let gamma = T::lit(PAIR_ANGLES_DEG[self.pulses.pair].to_radians());
+        let flux_dir = Ab::new(self.ld * gamma.cos(), self.lq * gamma.sin());
+        let l_eff = flux_dir.norm();
+        let (c, s) = (self.pulses.theta0.cos(), self.pulses.theta0.sin());
+        let flux_dir = flux_dir * (T::one() / l_eff);
+        let dir = Ab::new(
+            c * flux_dir.alpha - s * flux_dir.beta,
+            s * flux_dir.alpha + c * flux_dir.beta,
+        );
+        let v_max = self.cfg.magnetics.voltage_ratio * vdc * T::lit(SQRT3_INV);
+        let v = v_max.min(l_eff * i_p / (T::lit(RISE_SAMPLES) * self.ts));
+        // A rise that has not reached I_p after 4× its nominal length stops there.
+        let nominal = l_eff * i_p / (v * self.ts);
+        let p = &mut self.pulses;
+        p.dir = dir;
+        p.v_pulse = v;
+        p.n_max = (T::lit(4.0) * nominal).index_floor(100_000) as u32 + 8;
+        p.psi = Ab::zero();
+        p.integrating = true;
+        p.stage = Stage::Rise1;
+        p.count = 1;
+        let out = dir * v;
+        (out, out, true)
+    }
+
+    /// After the pulses: I₁ along d at the inductance tests' frozen voltage, held for the
+    /// settling time, then the spin (which starts from that voltage).
+    fn pulse_hold(&mut self, i: Ab<T>, vdc: T) -> (Ab<T>, Ab<T>, bool) {
+        let v = self.standstill_voltage(i, vdc, true, Ab::zero());
+        if T::from_index(self.pulses.count as usize) * self.ts >= self.cfg.settle_time {
+            self.start_spin();
+        }
+        (v, v, true)
+    }
+
+    /// The fitted magnetic model with the final λ̂f (module docs, step 5): (the model if
+    /// saturation is detected, the detection statistic, the RMS current residuals of the
+    /// model and of constant inductances).
+    pub(super) fn magnetic_result(&self) -> (Option<Saturation<T>>, T, T, T) {
+        let nan = T::zero() / T::zero();
+        match self.magnetic_model(self.flux) {
+            Some(f) => (
+                f.detected.then_some(f.model),
+                f.change,
+                f.residual,
+                f.linear_residual,
+            ),
+            None => (None, nan, nan, nan),
+        }
+    }
+
+    /// The algebraic model fitted to the flux-linkage pulses (module docs, step 5) with the
+    /// magnet's flux `flux_linkage`, once the pulses are done (None before, with the test off
+    /// or with too few samples). The procedure fits it with its final λ̂f
+    /// ([`Identification::saturation`]); this gives it also when a later phase aborts (with
+    /// the nameplate's λf, say). One call fits 1620 shapes: several milliseconds on a host,
+    /// far longer than a sample on a microcontroller (call it with the gates off).
+    pub fn magnetic_model(&self, flux_linkage: T) -> Option<MagneticFit<T>> {
+        // The stage stays `Hold` from the last pair's end on (through an abort too).
+        if !self.cfg.magnetics.enabled || self.pulses.stage != Stage::Hold {
+            return None;
+        }
+        let (model, residual, linear_residual) = best_fit(&self.pulses.samples, flux_linkage)?;
+        let change = inductance_change(&model, self.pulse_current());
+        Some(MagneticFit {
+            model,
+            change,
+            residual,
+            linear_residual,
+            detected: change > self.cfg.magnetics.detection_threshold
+                && residual < T::lit(RESIDUAL_RATIO) * linear_residual,
+        })
+    }
+
+    /// The zero-current constants (incremental L̂d, L̂q) of a fitted model.
+    pub(super) fn zero_current_inductances(model: &Saturation<T>) -> (T, T) {
+        let l = model.incremental_inductance(Dq::zero());
+        (l.dd, l.qq)
+    }
+}

@@ -1,0 +1,111 @@
+//! The commissioning's magnetic identification (`fado_core::commissioning`, step 5) on the
+//! simulated plant: the algebraic model of saturated machines recovered within stated
+//! bounds over the rated current range, the rotor left nearly where it was, and
+//! magnetically linear machines reported as such.
+
+use fado_core::MachineModel;
+use fado_core::commissioning::Status;
+use fado_sim::commission::{CommissionOptions, CommissionOutcome, commission, identified_toml};
+use fado_sim::magnetic_accuracy::MagneticAccuracy;
+
+/// Largest rotor motion during the flux-linkage pulses, rad (electrical): measured 0.012 to
+/// 0.10 rad on the presets (the 24 V outrunner, the lowest inertia per torque, the most).
+const MAX_MOTION: f64 = 0.15;
+
+fn run(text: &str) -> CommissionOutcome {
+    let cfg = fado_sim::SimConfig::from_toml(text).unwrap();
+    let plant = cfg.plant();
+    let nameplate = MachineModel {
+        dc_voltage: plant.inverter.dc_voltage,
+        ..plant.motor
+    };
+    let o = commission(
+        &plant,
+        nameplate,
+        CommissionOptions::default(),
+        |_| {},
+        None,
+    )
+    .unwrap();
+    assert_eq!(o.status, Status::Done);
+    assert!(
+        o.rotor_motion_magnetics < MAX_MOTION,
+        "rotor turned {} rad",
+        o.rotor_motion_magnetics
+    );
+    o
+}
+
+fn file(path: &str) -> String {
+    std::fs::read_to_string(format!("{}/{path}", env!("CARGO_MANIFEST_DIR"))).unwrap()
+}
+
+/// Every inductance within `bound` (relative) over the rated current range.
+fn assert_within(a: &MagneticAccuracy, bound: f64) {
+    for (name, s) in [
+        ("incremental Ld", a.incremental_ld),
+        ("incremental Lq", a.incremental_lq),
+        ("secant Ld", a.secant_ld),
+        ("secant Lq", a.secant_lq),
+    ] {
+        assert!(s.max < bound, "{name}: {:?}", s);
+    }
+}
+
+/// The 2.2 kW IPMSM with q self-saturation (Lq 51 → 36 mH) and cross-saturation: the fitted
+/// model within 2 % of the plant's (measured: 0.7 % at most).
+#[test]
+fn the_saturated_ipmsm_preset_is_identified_within_two_percent() {
+    let o = run(&file("../../motors/saturated/ipmsm-2k2-qsat.toml"));
+    let id = o.identification.unwrap();
+    assert!(id.saturation.is_some(), "{}", id.saturation_change);
+    assert_within(&o.magnetics.unwrap().accuracy, 0.02);
+}
+
+/// A made-up IPMSM with other exponents (d and q saturation of exponent 2, a cross term of
+/// exponents 1, 1; Ld 5 → 2 mH, Lq 30 mH falling by half at rated current): within 2 %
+/// (measured: 0.5 % at most), and its identified.toml carries the model.
+#[test]
+fn a_made_up_saturated_ipmsm_is_identified_within_two_percent() {
+    let text = file("tests/data/ipmsm-test-saturated.toml");
+    let o = run(&text);
+    let id = o.identification.unwrap();
+    assert!(id.saturation.is_some(), "{}", id.saturation_change);
+    assert_within(&o.magnetics.unwrap().accuracy, 0.02);
+    let doc = identified_toml(&text, &id).unwrap();
+    let table: toml::Table = doc.parse().unwrap();
+    assert!(table["model"].get("saturation").is_some());
+    assert!(doc.contains("# Magnetic saturation detected"));
+    // It runs as it is: the drive takes the identified model.
+    let cfg = fado_sim::SimConfig::from_toml(&doc).unwrap();
+    assert!(
+        !fado_sim::model_magnetics::split(&cfg)
+            .unwrap()
+            .0
+            .magnetics
+            .is_linear()
+    );
+}
+
+/// Magnetically linear machines, the strongly salient low-inductance PM-SyRM among them (the
+/// least accurate integration: its constant-inductance residual is 1.6 % of the rated
+/// current), are reported unsaturated and keep constant inductances.
+#[test]
+fn linear_machines_are_reported_unsaturated() {
+    for name in ["paper", "pmsyrm-5k", "outrunner-cheetah-24v"] {
+        let text = fado_sim::presets::find(name).unwrap().toml;
+        let o = run(text);
+        let id = o.identification.unwrap();
+        assert!(
+            id.saturation.is_none(),
+            "{name}: change {}, residual {} against {}",
+            id.saturation_change,
+            id.saturation_residual,
+            id.linear_residual
+        );
+        let doc = identified_toml(text, &id).unwrap();
+        let table: toml::Table = doc.parse().unwrap();
+        assert!(table["model"].get("saturation").is_none());
+        assert!(doc.contains("# No magnetic saturation detected"), "{name}");
+    }
+}
