@@ -25,7 +25,7 @@ fn currents<T: Real>(samples: usize) -> Vec<Abc<T>> {
 fn bench_step<T: Real>(c: &mut Criterion, name: &str, stall_symptom: bool) {
     let mut config = DriveConfig::for_machine(&MachineModel::paper());
     if !stall_symptom {
-        config.tuning.lock_stall_speed_ratio = T::zero();
+        config.tuning.stall.speed_ratio = T::zero();
     }
     let mut drive = SensorlessDrive::<T>::new(config, EstimatorTuning::default())
         .expect("default configuration is valid");

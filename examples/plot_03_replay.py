@@ -24,7 +24,7 @@ rec = fado.simulate(
     "fig11",
     {
         "simulation": {"decimation": 1},
-        "controller": {"offset_calibration_time": 0.0, "gain_calibration_time": 0.0},
+        "controller": {"offset_calibration": {"time": 0.0}, "gain_calibration": {"time": 0.0}},
     },
     averaged=True,
 )

@@ -12,7 +12,7 @@ columns are computed by `fado_sim::Metrics`):
   drive's stall symptom), either up; the sweep's `lock_detection_delay`/`lock_late_delay` judge
   that, `lock_lost_time` and `stall_time` are each flag's first rise. The false-alarm columns
   and detection are given for either flag and for LOCK_LOST alone (`lock_lost_detection_delay`;
-  older sweeps without that column: run one with `[controller] lock_stall_speed_ratio = 0.0`).
+  older sweeps without that column: run one with `[controller.stall] speed_ratio = 0.0`).
   detected = the flag (a live status) is up at t0 + 20 ms and rose no earlier than
              t0 − X (`lock_detection_delay` = its last rise − t0 ≥ −X), X = 1 s: the time
              fig11's reference takes from its steady −90 r/min to the reversal (2.5 → 3.5 s),

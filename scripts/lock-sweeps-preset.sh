@@ -5,7 +5,7 @@
 # L̂q error ±30 %, final load 0 … the preset's rated torque (fig11's 0 … 11.5 N·m is 0 … rated on
 # the paper's motor); N random points (default 400), seed SEED (default 7).
 # EXTRA: TOML text appended to each variant's configuration (printf escapes, e.g.
-# EXTRA='\n[controller]\nlock_stall_follow_min_current_ratio = 0.3\n'), to try a setting.
+# EXTRA='\n[controller.stall]\nfollow_min_current_ratio = 0.3\n'), to try a setting.
 # usage: [SEED=N] [N=400] [SCENARIO=reversal] [VARIANTS="fixed-rs adaptive"] [EXTRA=...] \
 #        scripts/lock-sweeps-preset.sh PRESET OUT_DIR      (then scripts/lock-eval.py)
 set -euo pipefail

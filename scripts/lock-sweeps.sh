@@ -6,7 +6,7 @@
 #        the same design (seeds 7-14 tuned the detector, 15-16 were seen, 17-20 are the
 #        hold-out of the speed-dependent lower flux bound, docs/method/lock.md); VARIANTS
 #        (default all four) picks the configurations; EXTRA (TOML text, printf escapes,
-#        appended to each variant's configuration, e.g. EXTRA='[controller]\nx = 1\n') tries a
+#        appended to each variant's configuration, e.g. EXTRA='[controller.stall]\nx = 1\n') tries a
 #        setting.
 set -euo pipefail
 out=${1:?usage: scripts/lock-sweeps.sh OUT_DIR}

@@ -30,7 +30,7 @@ fn run(name: &str, config: &str) -> Outcome {
 fn plant_resistance(k: f64, adaptation: bool) -> String {
     format!(
         "[mismatch]\nrs_ratio = {}\n[estimator.rs_adaptation]\nenabled = {adaptation}\n\
-         [controller]\ngain_calibration_time = 0.0\n",
+         [controller.gain_calibration]\ntime = 0.0\n",
         1.0 / k
     )
 }

@@ -92,8 +92,8 @@ fn fig10_sensor_offset_walks_the_estimate_along_the_limiter_circle_at_e_t_over_r
     // `observer.lag_compensation` feeds the observer T2S-1's proportional term as well; checked
     // at the end that it does not speed the walk up).
     let paper = "[current_sensor]\nenable_gain_error = false\nenable_noise = false\n\
-               enable_quantization = false\n[controller]\noffset_calibration_time = 0.0\n\
-               gain_calibration_time = 0.0\n[estimator.rs_adaptation]\nenabled = false\n";
+               enable_quantization = false\n[controller.offset_calibration]\ntime = 0.0\n\
+               [controller.gain_calibration]\ntime = 0.0\n[estimator.rs_adaptation]\nenabled = false\n";
     let cfg = format!("{paper}[estimator.observer]\nlag_compensation = false\n");
     let out = run("fig10", Some(&cfg), false);
     let c = &out.config;

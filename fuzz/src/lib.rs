@@ -332,23 +332,23 @@ impl DriveCase {
         let f = &self.fields;
         let ts = field(f[0], d.ts);
         let mut tuning = t;
-        tuning.current_bandwidth_hz = field(f[7], t.current_bandwidth_hz);
-        tuning.speed_bandwidth_hz = field(f[8], t.speed_bandwidth_hz);
-        tuning.speed_zero_ratio = field(f[9], t.speed_zero_ratio);
-        tuning.current_limit_ratio = field(f[10], t.current_limit_ratio);
-        tuning.injection_current_ratio = field(f[11], t.injection_current_ratio);
-        tuning.dead_time = field(f[12], t.dead_time);
-        tuning.switching_frequency = field(f[13], t.switching_frequency);
-        tuning.dead_time_threshold_voltage = field(f[14], t.dead_time_threshold_voltage);
-        tuning.dead_time_current_band = field(f[15], t.dead_time_current_band);
-        tuning.delay_compensation_factor = field(f[16], t.delay_compensation_factor);
-        tuning.trip_current_ratio = field(f[17], t.trip_current_ratio);
-        tuning.max_modulation = field(f[18], t.max_modulation);
-        tuning.current_anti_windup_ratio = field(f[19], t.current_anti_windup_ratio);
-        tuning.speed_anti_windup_ratio = field(f[20], t.speed_anti_windup_ratio);
-        tuning.dead_time_compensation = self.flags[0];
-        tuning.decoupling = self.flags[1];
-        tuning.offset_calibration_time = ts * T::lit(f64::from(self.calibration));
+        tuning.current.bandwidth_hz = field(f[7], t.current.bandwidth_hz);
+        tuning.speed.bandwidth_hz = field(f[8], t.speed.bandwidth_hz);
+        tuning.speed.zero_ratio = field(f[9], t.speed.zero_ratio);
+        tuning.current.limit_ratio = field(f[10], t.current.limit_ratio);
+        tuning.injection.current_ratio = field(f[11], t.injection.current_ratio);
+        tuning.inverter.dead_time = field(f[12], t.inverter.dead_time);
+        tuning.inverter.switching_frequency = field(f[13], t.inverter.switching_frequency);
+        tuning.inverter.threshold_voltage = field(f[14], t.inverter.threshold_voltage);
+        tuning.inverter.current_band = field(f[15], t.inverter.current_band);
+        tuning.delay_compensation.factor = field(f[16], t.delay_compensation.factor);
+        tuning.protection.trip_current_ratio = field(f[17], t.protection.trip_current_ratio);
+        tuning.modulation.max_modulation = field(f[18], t.modulation.max_modulation);
+        tuning.current.anti_windup_ratio = field(f[19], t.current.anti_windup_ratio);
+        tuning.speed.anti_windup_ratio = field(f[20], t.speed.anti_windup_ratio);
+        tuning.dead_time_compensation.enabled = self.flags[0];
+        tuning.current.decoupling = self.flags[1];
+        tuning.offset_calibration.time = ts * T::lit(f64::from(self.calibration));
         DriveConfig {
             ts,
             machine: MachineModel {

@@ -112,7 +112,7 @@ def test_estimator_replay_reproduces_the_in_loop_estimate() -> None:
     # on the raw measured currents the trace records.
     config = {
         "simulation": {"decimation": 1},
-        "controller": {"offset_calibration_time": 0.0, "gain_calibration_time": 0.0},
+        "controller": {"offset_calibration": {"time": 0.0}, "gain_calibration": {"time": 0.0}},
     }
     result = fado.simulate("fig11", config, averaged=True)
     tr = result.traces
@@ -156,7 +156,7 @@ def test_replay_with_a_voltage_offset_stays_within_the_papers_bound(
     +α / +β / −α / −β, 0.090 without the offset; 0.51 rad with the paper's fixed-gain path."""
     config = {
         "simulation": {"decimation": 1},
-        "controller": {"offset_calibration_time": 0.0, "gain_calibration_time": 0.0},
+        "controller": {"offset_calibration": {"time": 0.0}, "gain_calibration": {"time": 0.0}},
     }
     result = fado.simulate("fig11", config)
     tr = result.traces
@@ -245,6 +245,35 @@ def test_bad_config_names_the_key(config: object, field: str) -> None:
     assert isinstance(info.value, ValueError)
     if field != "<file>":
         assert field in str(info.value)
+
+
+@pytest.mark.parametrize(
+    ("config", "field", "place"),
+    [
+        ({"controller": {"lock_stall_time": 0.01}}, "controller.lock_stall_time", "[controller.stall] time"),
+        ({"controller.mtpa": False}, "controller.mtpa", "[controller.mtpa] enabled"),
+        (
+            {"controller": {"acceleration_feedforward": True}},
+            "controller.acceleration_feedforward",
+            "[controller.tracker_feedforward] enabled",
+        ),
+    ],
+)
+def test_a_flat_controller_key_names_its_new_place(config: dict[str, object], field: str, place: str) -> None:
+    with pytest.raises(fado.ConfigError) as info:
+        fado.simulate("fig11", config, averaged=True)
+    assert info.value.field == field
+    assert f"`{field}` moved: write it as `{place}`" in str(info.value)
+    assert info.value.line is not None
+
+
+def test_nested_controller_tables_reach_the_drive() -> None:
+    text = fado.default_config("fig11")
+    assert "[controller.stall]" in text
+    config = {"simulation": {"duration": 0.05}, "controller": {"stall": {"time": 0.01}, "mtpa": {"enabled": False}}}
+    result = fado.simulate("fig11", config, averaged=True)
+    assert "[controller.stall]\nspeed_ratio = 0.003\ntime = 0.01\n" in result.config_toml
+    assert "[controller.mtpa]\nenabled = false\n" in result.config_toml
 
 
 def test_unwritable_dict_value_is_a_config_error() -> None:

@@ -22,7 +22,7 @@ pd = pytest.importorskip("pandas")
 # have started, and no parameter of the model would move the run).
 SHORT = {
     "simulation": {"duration": 0.3, "eval_start": 0.0},
-    "controller": {"gain_calibration_time": 0.0},
+    "controller": {"gain_calibration": {"time": 0.0}},
 }
 GRID = {"rs_error": [-0.05, 0.0, 0.05], "lq_error": [0.0, 0.3]}
 

@@ -329,6 +329,23 @@ fn wrap_far<T: Real>(x: T) -> T {
     }
 }
 
+/// `impl cast` for a tuning record: every real field rounded to `U`, the others copied.
+macro_rules! cast_record {
+    ($name:ident { $($real:ident),* ; $($copy:ident),* }) => {
+        impl<T: $crate::Real> $name<T> {
+            /// The same record in another precision: every real rounded to `U`.
+            pub fn cast<U: $crate::Real>(&self) -> $name<U> {
+                $name {
+                    $($real: U::lit(self.$real.to_f64()),)*
+                    $($copy: self.$copy,)*
+                }
+            }
+        }
+    };
+}
+
+pub(crate) use cast_record;
+
 #[cfg(test)]
 mod tests {
     use super::*;

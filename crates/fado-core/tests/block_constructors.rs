@@ -73,7 +73,7 @@ fn every_motor_dependent_value_scales_with_the_motor() {
         i_min(&ipm) / ipm.rated_current,
         i_min(&paper) / paper.rated_current
     ));
-    assert!(close(i_min(&ipm), drive.injection_current_ratio * 6.0));
+    assert!(close(i_min(&ipm), drive.injection.current_ratio * 6.0));
     // Limiter circle and integrand-offset bound follow λ̂f and the rated frequency (75 Hz).
     assert!(close(
         FluxLimiterConfig::for_machine(&ipm).radius,
@@ -108,9 +108,9 @@ fn every_motor_dependent_value_scales_with_the_motor() {
     // magnet's q current, above I_max.
     let sc = SpeedControllerConfig::for_machine(&ipm, TS);
     let speed = SpeedController::new(sc).unwrap();
-    let kp_mech = 0.02 * TAU * drive.speed_bandwidth_hz / (1.5 * 3.0 * 0.545);
+    let kp_mech = 0.02 * TAU * drive.speed.bandwidth_hz / (1.5 * 3.0 * 0.545);
     assert!(close(speed.kp() * 3.0, kp_mech));
-    let i_max = drive.current_limit_ratio * 6.0;
+    let i_max = drive.current.limit_ratio * 6.0;
     assert!(sc.i_max > i_max, "{} against {i_max}", sc.i_max);
     let no_mtpa = SpeedControllerConfig::new(&ipm, i_max, false, TS);
     assert!(close(no_mtpa.i_max, i_max));

@@ -63,11 +63,18 @@ struct Field<C, T> {
 
 /// The last component of a field path: `tuning.k_df` → `k_df`.
 /// The name errors give the field at `path`: its last segment, or for a field of the
-/// estimator's nested tuning its flat name (`tuning.lock.heal_time` → `lock_heal_time`).
+/// estimator's or the drive's nested tuning its flat name (`tuning.lock.heal_time` →
+/// `lock_heal_time`, `tuning.inverter.current_band` → `dead_time_current_band`).
 fn leaf(path: &'static str) -> &'static str {
+    const INVERTER: &[(&str, &str)] = &[
+        ("dead_time_threshold_voltage", "inverter.threshold_voltage"),
+        ("dead_time_current_band", "inverter.current_band"),
+    ];
     let compact = path.replace(' ', "");
     let flat = fado_core::estimator::tuning::MOVED_KEYS
         .iter()
+        .chain(fado_core::control::tuning::MOVED_KEYS)
+        .chain(INVERTER)
         .find(|(_, new)| compact == *new || compact.ends_with(&format!("tuning.{new}")))
         .map(|(old, _)| *old);
     flat.unwrap_or_else(|| path.rsplit('.').next().unwrap_or(path).trim())
@@ -216,35 +223,35 @@ fn run_all<T: Real>(failures: &mut Vec<String>, machine: MachineModel<T>) -> usi
             machine.rated_speed_rpm: Positive,
             machine.rated_torque: PositiveBounded,
             machine.dc_voltage: Positive,
-            tuning.current_bandwidth_hz: PositiveBounded,
-            tuning.speed_bandwidth_hz: PositiveBounded,
-            tuning.speed_zero_ratio: Positive,
+            tuning.current.bandwidth_hz: PositiveBounded,
+            tuning.speed.bandwidth_hz: PositiveBounded,
+            tuning.speed.zero_ratio: Positive,
             // A huge limit makes the trip level (a ratio of its own) fall below it.
-            tuning.current_limit_ratio: Positive,
-            tuning.injection_current_ratio: NonNegativeBounded,
-            tuning.dead_time: NonNegativeBounded,
-            tuning.switching_frequency: Positive,
-            tuning.dead_time_threshold_voltage: NonNegative,
-            tuning.dead_time_current_band: Positive,
-            tuning.delay_compensation_factor: NonNegativeBounded,
-            tuning.trip_current_ratio: Positive,
-            tuning.max_modulation: PositiveBounded,
-            tuning.current_anti_windup_ratio: NonNegativeBounded,
-            tuning.speed_anti_windup_ratio: NonNegativeBounded,
-            tuning.offset_calibration_time: NonNegativeBounded,
-            tuning.gain_calibration_time: NonNegativeBounded,
-            // A huge level is capped at current_limit_ratio, a huge mismatch bound accepted.
-            tuning.gain_calibration_current_ratio: Positive,
-            tuning.gain_calibration_min_observability: NonNegativeBounded,
-            tuning.gain_calibration_max_mismatch: Positive,
-            // A huge band is refused naming `stuck_sensor_reference_ratio`, which must exceed it.
-            tuning.stuck_sensor_band_ratio: NonNegative,
-            tuning.stuck_sensor_reference_ratio: Positive,
-            tuning.stuck_sensor_time: NonNegativeBounded,
-            tuning.current_error_ratio: Positive,
-            tuning.current_error_time: NonNegativeBounded,
-            tuning.dc_link_min_ratio: NonNegative,
-            tuning.input_fault_trip_time: NonNegativeBounded,
+            tuning.current.limit_ratio: Positive,
+            tuning.injection.current_ratio: NonNegativeBounded,
+            tuning.inverter.dead_time: NonNegativeBounded,
+            tuning.inverter.switching_frequency: Positive,
+            tuning.inverter.threshold_voltage: NonNegative,
+            tuning.inverter.current_band: Positive,
+            tuning.delay_compensation.factor: NonNegativeBounded,
+            tuning.protection.trip_current_ratio: Positive,
+            tuning.modulation.max_modulation: PositiveBounded,
+            tuning.current.anti_windup_ratio: NonNegativeBounded,
+            tuning.speed.anti_windup_ratio: NonNegativeBounded,
+            tuning.offset_calibration.time: NonNegativeBounded,
+            tuning.gain_calibration.time: NonNegativeBounded,
+            // A huge level is capped at current.limit_ratio, a huge mismatch bound accepted.
+            tuning.gain_calibration.current_ratio: Positive,
+            tuning.gain_calibration.min_observability: NonNegativeBounded,
+            tuning.gain_calibration.max_mismatch: Positive,
+            // A huge band is refused naming `stuck_sensor.reference_ratio`, which must exceed it.
+            tuning.stuck_sensor.band_ratio: NonNegative,
+            tuning.stuck_sensor.reference_ratio: Positive,
+            tuning.stuck_sensor.time: NonNegativeBounded,
+            tuning.protection.current_error_ratio: Positive,
+            tuning.protection.current_error_time: NonNegativeBounded,
+            tuning.protection.dc_link_min_ratio: NonNegative,
+            tuning.protection.input_fault_trip_time: NonNegativeBounded,
         ),
     );
     // The drive with its estimator: the same checks reach `SensorlessDrive::new`, and so do
@@ -258,8 +265,8 @@ fn run_all<T: Real>(failures: &mut Vec<String>, machine: MachineModel<T>) -> usi
             ts: Positive,
             machine.rs: Positive,
             machine.flux_linkage: Positive,
-            tuning.current_limit_ratio: Positive,
-            tuning.current_bandwidth_hz: PositiveBounded,
+            tuning.current.limit_ratio: Positive,
+            tuning.current.bandwidth_hz: PositiveBounded,
         ),
     );
     n += probe(
@@ -606,17 +613,17 @@ fn bandwidths_above_what_the_sampling_rate_allows_are_refused() {
     assert_eq!(refused_field(SensorlessEstimator::new(slow)), "");
     // Drive: current PI (2π·f·Ts ≤ 0.5) and speed PI (2π·f·Ts < 0.1).
     let f_cc = 0.5 / (2.0 * std::f64::consts::PI * ts);
-    assert_eq!(drive(|c| c.tuning.current_bandwidth_hz = 790.0), "");
+    assert_eq!(drive(|c| c.tuning.current.bandwidth_hz = 790.0), "");
     assert!(f_cc < 800.0);
     assert_eq!(
-        drive(|c| c.tuning.current_bandwidth_hz = 800.0),
+        drive(|c| c.tuning.current.bandwidth_hz = 800.0),
         "current_bandwidth_hz"
     );
     assert_eq!(
-        drive(|c| c.tuning.speed_bandwidth_hz = 160.0),
+        drive(|c| c.tuning.speed.bandwidth_hz = 160.0),
         "speed_bandwidth_hz"
     );
-    assert_eq!(drive(|c| c.tuning.speed_bandwidth_hz = 150.0), "");
+    assert_eq!(drive(|c| c.tuning.speed.bandwidth_hz = 150.0), "");
     // Baselines.
     let mut lpf = LpfIntegratorConfig::<f64>::for_machine(&MachineModel::paper());
     lpf.settings.cutoff_hz = 1600.0;
@@ -656,28 +663,35 @@ fn thresholds_out_of_order_are_refused() {
     // rated current: 41 A, 40 A against the 40 A limit of the paper's motor).
     let limit = DriveConfig::<f64>::for_machine(&MachineModel::paper())
         .tuning
-        .current_limit_ratio;
+        .current
+        .limit_ratio;
     assert_eq!(
-        drive(|c| c.tuning.injection_current_ratio = limit * 41.0 / 40.0),
+        drive(|c| c.tuning.injection.current_ratio = limit * 41.0 / 40.0),
         "injection_current_ratio"
     );
-    assert_eq!(drive(|c| c.tuning.injection_current_ratio = limit), "");
+    assert_eq!(drive(|c| c.tuning.injection.current_ratio = limit), "");
     assert_eq!(
-        drive(|c| c.tuning.trip_current_ratio = limit),
+        drive(|c| c.tuning.protection.trip_current_ratio = limit),
         "trip_current_ratio"
     );
     assert_eq!(
-        drive(|c| c.tuning.stuck_sensor_reference_ratio = c.tuning.stuck_sensor_band_ratio),
+        drive(|c| c.tuning.stuck_sensor.reference_ratio = c.tuning.stuck_sensor.band_ratio),
         "stuck_sensor_reference_ratio"
     );
     // Durations: at most 4e9 sampling periods (a u32 count).
     assert_eq!(
-        drive(|c| c.tuning.current_error_time = 4.1e5),
+        drive(|c| c.tuning.protection.current_error_time = 4.1e5),
         "current_error_time"
     );
-    assert_eq!(drive(|c| c.tuning.current_error_time = 3.9e5), "");
-    assert_eq!(drive(|c| c.tuning.max_modulation = 1.01), "max_modulation");
-    assert_eq!(drive(|c| c.tuning.dead_time = 1e-4), "dead_time");
+    assert_eq!(
+        drive(|c| c.tuning.protection.current_error_time = 3.9e5),
+        ""
+    );
+    assert_eq!(
+        drive(|c| c.tuning.modulation.max_modulation = 1.01),
+        "max_modulation"
+    );
+    assert_eq!(drive(|c| c.tuning.inverter.dead_time = 1e-4), "dead_time");
     let pi = PiConfig::<f64> {
         ts: 1e-4,
         kp: 1.0,
@@ -824,28 +838,29 @@ mod properties {
                     DriveConfig {
                         ts,
                         machine,
-                        tuning: DriveTuning {
-                            current_bandwidth_hz: cbw * 0.5 / two_pi_ts,
-                            speed_bandwidth_hz: sbw * 0.1 / two_pi_ts,
-                            speed_zero_ratio: zr,
-                            current_limit_ratio: limit,
-                            injection_current_ratio: imin * limit,
-                            trip_current_ratio: trip * limit,
-                            dead_time: td * ts,
-                            switching_frequency: 0.5 / ts,
-                            delay_compensation_factor: delay,
-                            max_modulation: m,
-                            current_anti_windup_ratio: caw,
-                            speed_anti_windup_ratio: saw,
-                            offset_calibration_time: cal,
-                            stuck_sensor_band_ratio: band,
-                            stuck_sensor_reference_ratio: band + reference,
-                            stuck_sensor_time: stuck,
-                            current_error_ratio: err,
-                            current_error_time: err_time,
-                            dc_link_min_ratio: dc_min,
-                            input_fault_trip_time: fault,
-                            ..DriveTuning::default()
+                        tuning: {
+                            let mut t = DriveTuning::default();
+                            t.current.bandwidth_hz = cbw * 0.5 / two_pi_ts;
+                            t.speed.bandwidth_hz = sbw * 0.1 / two_pi_ts;
+                            t.speed.zero_ratio = zr;
+                            t.current.limit_ratio = limit;
+                            t.injection.current_ratio = imin * limit;
+                            t.protection.trip_current_ratio = trip * limit;
+                            t.inverter.dead_time = td * ts;
+                            t.inverter.switching_frequency = 0.5 / ts;
+                            t.delay_compensation.factor = delay;
+                            t.modulation.max_modulation = m;
+                            t.current.anti_windup_ratio = caw;
+                            t.speed.anti_windup_ratio = saw;
+                            t.offset_calibration.time = cal;
+                            t.stuck_sensor.band_ratio = band;
+                            t.stuck_sensor.reference_ratio = band + reference;
+                            t.stuck_sensor.time = stuck;
+                            t.protection.current_error_ratio = err;
+                            t.protection.current_error_time = err_time;
+                            t.protection.dc_link_min_ratio = dc_min;
+                            t.protection.input_fault_trip_time = fault;
+                            t
                         },
                     }
                 },
@@ -895,10 +910,10 @@ mod properties {
             let fields = fields!(DriveConfig<f64>, f64;
                 ts: Positive, machine.rs: Positive, machine.lq: Positive,
                 machine.rated_current: Positive, machine.dc_voltage: Positive,
-                tuning.current_limit_ratio: Positive, tuning.injection_current_ratio: NonNegative,
-                tuning.trip_current_ratio: Positive, tuning.offset_calibration_time: NonNegative,
-                tuning.stuck_sensor_band_ratio: NonNegative, tuning.current_error_time: NonNegative,
-                tuning.dc_link_min_ratio: NonNegative,
+                tuning.current.limit_ratio: Positive, tuning.injection.current_ratio: NonNegative,
+                tuning.protection.trip_current_ratio: Positive, tuning.offset_calibration.time: NonNegative,
+                tuning.stuck_sensor.band_ratio: NonNegative, tuning.protection.current_error_time: NonNegative,
+                tuning.protection.dc_link_min_ratio: NonNegative,
             );
             let f = &fields[which];
             let mut bad = c;

@@ -66,14 +66,14 @@ fn ratings_derived_limits_scale_with_the_motor() {
     assert!((c.i_max() - 40.0 * scale).abs() < 1e-9, "{}", c.i_max());
     assert!((c.i_min() - 4.0 * scale).abs() < 1e-9, "{}", c.i_min());
     assert!((c.trip_current() - 60.0 * scale).abs() < 1e-9);
-    assert!((c.i_max() - c.tuning.current_limit_ratio * 6.0).abs() < 1e-12);
+    assert!((c.i_max() - c.tuning.current.limit_ratio * 6.0).abs() < 1e-12);
     assert!(c.i_max() < 11.1 && c.trip_current() < 16.6);
 
     let drive = || {
         let mut c = c;
-        c.tuning.offset_calibration_time = 0.0;
-        c.tuning.gain_calibration_time = 0.0;
-        c.tuning.gain_calibration_time = 0.0;
+        c.tuning.offset_calibration.time = 0.0;
+        c.tuning.gain_calibration.time = 0.0;
+        c.tuning.gain_calibration.time = 0.0;
         let mut d = SensorlessDrive::new(c, EstimatorTuning::default()).unwrap();
         d.align(0.0);
         d
@@ -202,10 +202,10 @@ struct Settled {
 fn run(mtpa: bool, rpm: f64, ramp: f64, load: f64, seconds: f64) -> Settled {
     let m = ipmsm();
     let mut c = DriveConfig::for_machine(&m);
-    c.tuning.offset_calibration_time = 0.0;
-    c.tuning.gain_calibration_time = 0.0;
-    c.tuning.dead_time_compensation = false;
-    c.tuning.mtpa = mtpa;
+    c.tuning.offset_calibration.time = 0.0;
+    c.tuning.gain_calibration.time = 0.0;
+    c.tuning.dead_time_compensation.enabled = false;
+    c.tuning.mtpa.enabled = mtpa;
     let i_max = c.i_max();
     let mut drive = SensorlessDrive::new(c, EstimatorTuning::default()).unwrap();
     let theta0 = 0.7;

@@ -59,8 +59,8 @@ impl RotorAngleEstimator<f64> for Spy {
 /// controllers from the first sample (the calibration has its own tests in `improvements.rs`).
 fn no_calibration<T: fado_core::Real>() -> DriveConfig<T> {
     let mut c = DriveConfig::for_machine(&MachineModel::paper());
-    c.tuning.offset_calibration_time = T::zero();
-    c.tuning.gain_calibration_time = T::zero();
+    c.tuning.offset_calibration.time = T::zero();
+    c.tuning.gain_calibration.time = T::zero();
     c
 }
 
@@ -69,7 +69,7 @@ fn no_calibration<T: fado_core::Real>() -> DriveConfig<T> {
 /// amps is (rightly) implausible and would be replaced by the model reconstruction.
 fn synthetic_currents<T: fado_core::Real>() -> DriveConfig<T> {
     let mut c = no_calibration();
-    c.tuning.stuck_sensor_time = T::zero();
+    c.tuning.stuck_sensor.time = T::zero();
     c
 }
 
@@ -163,7 +163,7 @@ fn duties_realise_the_reference_plus_the_dead_time_compensation() {
     // (The trapezoid: it depends on the current only; the edge-current default also on the
     // unlimited reference, checked against the switching-resolved inverter in fado-sim.)
     let mut cfg = synthetic_currents();
-    cfg.tuning.dead_time_method = DeadTimeMethod::Trapezoidal;
+    cfg.tuning.dead_time_compensation.method = DeadTimeMethod::Trapezoidal;
     let spy = Spy {
         omega: TAU * 30.0,
         ..Spy::default()
@@ -246,44 +246,47 @@ fn configuration_errors_name_the_field() {
     // 50 A of injection against the 40 A limit, a 30 A trip level below it (paper motor,
     // 21.78 A rated).
     assert_eq!(
-        bad(|c| c.tuning.injection_current_ratio = 50.0 / c.machine.rated_current),
+        bad(|c| c.tuning.injection.current_ratio = 50.0 / c.machine.rated_current),
         "injection_current_ratio"
     );
     assert_eq!(
-        bad(|c| c.tuning.trip_current_ratio = 30.0 / c.machine.rated_current),
+        bad(|c| c.tuning.protection.trip_current_ratio = 30.0 / c.machine.rated_current),
         "trip_current_ratio"
     );
     assert_eq!(bad(|c| c.machine.pole_pairs = 0), "pole_pairs");
     assert_eq!(bad(|c| c.machine.inertia = f64::NAN), "inertia");
     assert_eq!(
-        bad(|c| c.tuning.current_bandwidth_hz = 5e3),
+        bad(|c| c.tuning.current.bandwidth_hz = 5e3),
         "current_bandwidth_hz"
     );
     assert_eq!(
-        bad(|c| c.tuning.speed_bandwidth_hz = -1.0),
+        bad(|c| c.tuning.speed.bandwidth_hz = -1.0),
         "speed_bandwidth_hz"
     );
     assert_eq!(
-        bad(|c| c.tuning.speed_anti_windup_ratio = 1e9),
+        bad(|c| c.tuning.speed.anti_windup_ratio = 1e9),
         "speed_anti_windup_ratio"
     );
     assert_eq!(
-        bad(|c| c.tuning.current_anti_windup_ratio = -1.0),
+        bad(|c| c.tuning.current.anti_windup_ratio = -1.0),
         "current_anti_windup_ratio"
     );
     assert_eq!(
-        bad(|c| c.tuning.dead_time_current_band = 0.0),
+        bad(|c| c.tuning.inverter.current_band = 0.0),
         "dead_time_current_band"
     );
     assert_eq!(
-        bad(|c| c.tuning.dead_time_threshold_voltage = -1.0),
+        bad(|c| c.tuning.inverter.threshold_voltage = -1.0),
         "dead_time_threshold_voltage"
     );
     assert_eq!(
-        bad(|c| c.tuning.delay_compensation_factor = -1.0),
+        bad(|c| c.tuning.delay_compensation.factor = -1.0),
         "delay_compensation_factor"
     );
-    assert_eq!(bad(|c| c.tuning.max_modulation = 2.0), "max_modulation");
+    assert_eq!(
+        bad(|c| c.tuning.modulation.max_modulation = 2.0),
+        "max_modulation"
+    );
     assert_eq!(bad(|c| c.machine.ld = 0.0), "ld");
     assert_eq!(bad(|c| c.machine.rs = f64::INFINITY), "rs");
     assert!(
@@ -324,15 +327,16 @@ fn check_output<T: fado_core::Real>(o: &DriveOutput<T>) -> Result<(), TestCaseEr
 
 fn drives<T: fado_core::Real>(method: DeadTimeMethod) -> [SensorlessDrive<T>; 2] {
     let mut cfg = no_calibration();
-    cfg.tuning.dead_time_method = method;
+    cfg.tuning.dead_time_compensation.method = method;
     // The second never trips, so that every input reaches the controllers (a trip level of
     // about T::MAX amps).
     // It has no plausibility bounds either: every finite input is taken.
     let mut no_trip = cfg;
-    no_trip.tuning.trip_current_ratio = T::max_value().unwrap() / cfg.machine.rated_current;
-    no_trip.tuning.input_fault_trip_time = T::zero();
-    no_trip.tuning.plausible_current_ratio = T::one() + T::default_epsilon();
-    no_trip.tuning.dc_link_max_ratio = T::max_value().unwrap() / cfg.machine.dc_voltage;
+    no_trip.tuning.protection.trip_current_ratio =
+        T::max_value().unwrap() / cfg.machine.rated_current;
+    no_trip.tuning.protection.input_fault_trip_time = T::zero();
+    no_trip.tuning.plausibility.current_ratio = T::one() + T::default_epsilon();
+    no_trip.tuning.plausibility.dc_link_ratio = T::max_value().unwrap() / cfg.machine.dc_voltage;
     let unbounded = {
         let mut tuned = EstimatorTuning::default();
         tuned.plausibility.current_ratio =
@@ -537,7 +541,7 @@ fn voltage_history_is_aligned_with_the_interval_it_acted_over() {
         // The model plant is the averaged docs/method/estimator.md §7 inverter (no ripple): the trapezoid is its
         // exact inverse.
         let mut drive_config = no_calibration();
-        drive_config.tuning.dead_time_method = DeadTimeMethod::Trapezoidal;
+        drive_config.tuning.dead_time_compensation.method = DeadTimeMethod::Trapezoidal;
         if older {
             let est = OneSampleOlder {
                 inner: estimator,
@@ -626,12 +630,12 @@ fn status_word_reports_dc_link_low_and_persistent_bad_input_trips_and_is_counted
     assert_eq!(d.flag_counts().count(DriveFlags::INPUT_REJECTED), 0);
 }
 
-/// The stall symptom of the loss-of-lock detection (`DriveTuning::lock_stall_speed_ratio`):
+/// The stall symptom of the loss-of-lock detection (`StallTuning::speed_ratio`):
 /// a spy estimator in limiter mode that reports a standing rotor. Not armed until the speed
 /// loop has caught its reference; then a reference beyond the band (4.5 r/min on the
-/// paper's motor) for `lock_stall_time` (50 samples) while the speed loop asks for at least
-/// `lock_stall_min_current_ratio` (0.2) of the rated current raises `STALLED`, a live status
-/// that clears after `lock_stall_heal_time` without the condition (or at `align`); a speed
+/// paper's motor) for `stall.time` (50 samples) while the speed loop asks for at least
+/// `stall.min_current_ratio` (0.2) of the rated current raises `STALLED`, a live status
+/// that clears after `stall.heal_time` without the condition (or at `align`); a speed
 /// error with the current reference at its limit does not; ratio 0 never does.
 #[test]
 fn stall_symptom_flags_a_lost_reference_below_the_current_limit() {
@@ -663,8 +667,8 @@ fn stall_symptom_flags_a_lost_reference_below_the_current_limit() {
     // mechanical rad/s); the current limit is raised so that the speed loop's reference
     // for the errors below stays below it.
     let high_limit = |c: &mut DriveConfig<f64>| {
-        c.tuning.current_limit_ratio = 4.9;
-        c.tuning.trip_current_ratio = 9.8;
+        c.tuning.current.limit_ratio = 4.9;
+        c.tuning.protection.trip_current_ratio = 9.8;
     };
     // Never caught (8 rad/s from the first sample): not armed, no flag.
     assert_eq!(run(&high_limit, &[(500, 8.0)]).0, None);
@@ -682,7 +686,7 @@ fn stall_symptom_flags_a_lost_reference_below_the_current_limit() {
     assert_eq!(first, Some(torque + 50), "{first:?} {torque}");
     let no_gate = |c: &mut DriveConfig<f64>| {
         high_limit(c);
-        c.tuning.lock_stall_min_current_ratio = 0.0;
+        c.tuning.stall.min_current_ratio = 0.0;
     };
     assert_eq!(run(&no_gate, &[(20, 0.0), (200, 4.0)]).0, Some(20 + 49));
     // The gate is a ratio of the machine's rating: on the 2.2 kW IPMSM (6 A rated, so 1.2 A;
@@ -691,9 +695,9 @@ fn stall_symptom_flags_a_lost_reference_below_the_current_limit() {
     let ipmsm = |c: &mut DriveConfig<f64>| {
         let machine = common::ipmsm_model();
         let mut d = DriveConfig::for_machine(&machine);
-        d.tuning.offset_calibration_time = 0.0;
-        d.tuning.gain_calibration_time = 0.0;
-        d.tuning.stuck_sensor_time = 0.0;
+        d.tuning.offset_calibration.time = 0.0;
+        d.tuning.gain_calibration.time = 0.0;
+        d.tuning.stuck_sensor.time = 0.0;
         *c = d;
         high_limit(c);
     };
@@ -702,10 +706,10 @@ fn stall_symptom_flags_a_lost_reference_below_the_current_limit() {
     assert!(torque > 20, "{torque}");
     assert_eq!(first, Some(torque + 50), "{first:?} {torque}");
     // A live status: still up while the condition has been gone for less than
-    // `lock_stall_heal_time` (0.1 s = 1000 samples, net of the 200 − 49 symptomatic samples
+    // `stall.heal_time` (0.1 s = 1000 samples, net of the 200 − 49 symptomatic samples
     // after the rise, capped at the healing count), clear after it; align clears it at once.
     let ts = drive.config().ts;
-    let heal = (drive.config().tuning.lock_stall_heal_time / ts).round() as usize;
+    let heal = (drive.config().tuning.stall.heal_time / ts).round() as usize;
     let mut cleared = None;
     for k in 1..=2 * heal {
         let up = drive
@@ -733,16 +737,16 @@ fn stall_symptom_flags_a_lost_reference_below_the_current_limit() {
     // Off.
     let off = |c: &mut DriveConfig<f64>| {
         high_limit(c);
-        c.tuning.lock_stall_speed_ratio = 0.0;
+        c.tuning.stall.speed_ratio = 0.0;
     };
     assert_eq!(run(&off, &[(20, 0.0), (500, 8.0)]).0, None);
 }
 
 /// The stall symptom is reported as `STALLED`, apart from the estimator's `LOCK_LOST` (a spy
 /// estimator whose own verdict is "locked" throughout: a stall is no evidence against the
-/// angle, docs/method/lock.md); with `lock_reaction` coast it starts the reaction, `COASTING` with
+/// angle, docs/method/lock.md); with `lock.reaction` coast it starts the reaction, `COASTING` with
 /// `STALLED` as the reason and `LOCK_LOST` down, the reason kept while the drive coasts after
-/// the symptom itself has healed; with `lock_reaction_on_stall` off it is only reported. On
+/// the symptom itself has healed; with `lock.reaction_on_stall` off it is only reported. On
 /// the paper's motor and the 2.2 kW IPMSM.
 #[test]
 fn stall_is_its_own_flag_and_starts_the_reaction_when_asked() {
@@ -750,9 +754,9 @@ fn stall_is_its_own_flag_and_starts_the_reaction_when_asked() {
     for machine in [MachineModel::paper(), common::ipmsm_model()] {
         let run = |reaction: LockReaction, on_stall: bool| {
             let mut c = stall_test_config(&machine);
-            c.tuning.lock_reaction = reaction;
-            c.tuning.lock_reaction_on_stall = on_stall;
-            let heal = (c.tuning.lock_stall_heal_time / c.ts).round() as usize;
+            c.tuning.lock.reaction = reaction;
+            c.tuning.lock.reaction_on_stall = on_stall;
+            let heal = (c.tuning.stall.heal_time / c.ts).round() as usize;
             let mut drive = SensorlessDrive::with_estimator(c, Spy::default()).unwrap();
             drive.align(0.0);
             // Caught at 0, then 8 rad/s (mechanical) away for 200 samples, then the
@@ -794,10 +798,10 @@ fn stall_is_its_own_flag_and_starts_the_reaction_when_asked() {
     }
 }
 
-/// The stall band widens with the model's reluctance torque (`lock_stall_reluctance_band_ratio`,
+/// The stall band widens with the model's reluctance torque (`stall.reluctance_band_ratio`,
 /// docs/method/lock.md): ε_r·|1.5·p·(L̂d − L̂q)·i_d*·i_q*|/(Ĵ·ω_s)
 /// on top of the band. An estimate stuck 2 bands out while the reference runs 4 bands ahead
-/// (the torque band off): flagged after `lock_stall_time` (50 samples) with ε_r = 0 on every
+/// (the torque band off): flagged after `stall.time` (50 samples) with ε_r = 0 on every
 /// motor; with ε_r = 200 never on the salient ones (the 2.2 kW IPMSM, L̂q/L̂d 1.42, and the
 /// 5 kW PM-assisted reluctance motor of motors/pmsyrm-5k.toml, 4.25), whose MTPA d current
 /// makes a reluctance torque, but still on the paper's surface-magnet motor, where it is zero
@@ -825,7 +829,8 @@ fn stall_band_widens_with_the_reluctance_torque() {
     ] {
         let band = DriveConfig::<f64>::for_machine(&machine)
             .tuning
-            .lock_stall_speed_ratio
+            .stall
+            .speed_ratio
             * machine.rated_speed();
         let run = |ratio: f64| stuck_estimate_stalls(&machine, 0.0, ratio, 6.0 * band);
         let p = machine.pole_pairs;
@@ -851,10 +856,10 @@ fn stuck_estimate_stalls(
     ahead: f64,
 ) -> Option<u32> {
     let mut c = stall_test_config(machine);
-    let band = c.tuning.lock_stall_speed_ratio * machine.rated_speed();
-    c.tuning.lock_stall_min_current_ratio = 0.0;
-    c.tuning.lock_stall_torque_band_ratio = torque;
-    c.tuning.lock_stall_reluctance_band_ratio = reluctance;
+    let band = c.tuning.stall.speed_ratio * machine.rated_speed();
+    c.tuning.stall.min_current_ratio = 0.0;
+    c.tuning.stall.torque_band_ratio = torque;
+    c.tuning.stall.reluctance_band_ratio = reluctance;
     let spy = SpeedSpy {
         omega0: 2.0 * band,
         accel: 0.0,
@@ -871,22 +876,22 @@ fn stuck_estimate_stalls(
 /// current limits out of the way, for the stall-symptom tests with a spy estimator.
 fn stall_test_config(machine: &MachineModel<f64>) -> DriveConfig<f64> {
     let mut c = DriveConfig::for_machine(machine);
-    c.tuning.offset_calibration_time = 0.0;
-    c.tuning.gain_calibration_time = 0.0;
-    c.tuning.stuck_sensor_time = 0.0;
-    c.tuning.current_limit_ratio = 4.9;
-    c.tuning.trip_current_ratio = 9.8;
+    c.tuning.offset_calibration.time = 0.0;
+    c.tuning.gain_calibration.time = 0.0;
+    c.tuning.stuck_sensor.time = 0.0;
+    c.tuning.current.limit_ratio = 4.9;
+    c.tuning.protection.trip_current_ratio = 9.8;
     // The spy's zero currents wind the current loops up to the voltage limit, where field
     // weakening would reshape the references the stall band is computed from.
     c.tuning.field_weakening.enabled = false;
     c
 }
 
-/// The stall symptom also counts in k_df mode below `lock_stall_kdf_speed_ratio` (0.02) of
+/// The stall symptom also counts in k_df mode below `stall.kdf_speed_ratio` (0.02) of
 /// the rated speed (docs/method/lock.md: heavy-load losses in k_df mode just above the 0.015 mode
 /// threshold): ω̂ held at 0.0175·rated in k_df mode, the speed loop catches a reference equal
 /// to it, then loses one 8 rad/s (mechanical) away, below the current limit: `STALLED`
-/// after `lock_stall_time` (50 samples). Not at 0.03·rated (above the band), nor with the
+/// after `stall.time` (50 samples). Not at 0.03·rated (above the band), nor with the
 /// ratio 0 (limiter mode only), on the paper's motor and on
 /// the 2.2 kW IPMSM.
 #[test]
@@ -895,7 +900,7 @@ fn stall_symptom_counts_in_kdf_mode_just_above_the_threshold() {
     for machine in [MachineModel::paper(), ipmsm] {
         let run = |speed_ratio: f64, kdf_ratio: f64| {
             let mut c = stall_test_config(&machine);
-            c.tuning.lock_stall_kdf_speed_ratio = kdf_ratio;
+            c.tuning.stall.kdf_speed_ratio = kdf_ratio;
             let omega = speed_ratio * machine.rated_speed();
             let spy = SpeedSpy {
                 omega0: omega,
@@ -978,12 +983,12 @@ fn first_stalled(
 }
 
 /// The stall symptom does not count while the estimated rotor answers the torque
-/// (`lock_stall_follow_time`, docs/method/lock.md): ω̂ beyond the stall band in the
+/// (`stall.follow_time`, docs/method/lock.md): ω̂ beyond the stall band in the
 /// direction of the speed error and accelerating in it. The speed loop catches a reference
 /// equal to ω̂ (`CATCH` samples, 60 ms: six time constants of the ω̂ low-pass, which starts
 /// from zero at `align`), then the reference runs 3 bands ahead of ω̂ (away from zero) while ω̂ ramps. An
 /// estimate accelerating towards the reference at 2 bands beyond zero is not flagged; the
-/// same run with the exception off is, after `lock_stall_time` (50 samples); so are an
+/// same run with the exception off is, after `stall.time` (50 samples); so are an
 /// estimate that sticks, one that falls away from the reference, one that accelerates but
 /// within the band of zero, one that accelerates slower than the exception's least
 /// acceleration, and one that accelerates below the exception's current gate.
@@ -994,17 +999,18 @@ fn stall_symptom_spares_an_estimate_that_answers_the_torque() {
     for machine in [MachineModel::paper(), ipmsm] {
         let band = DriveConfig::<f64>::for_machine(&machine)
             .tuning
-            .lock_stall_speed_ratio
+            .stall
+            .speed_ratio
             * machine.rated_speed();
         // 0.3 of the rated speed per second: ω̂ stays far inside the k_df threshold.
         let ramp = 0.3 * machine.rated_speed();
         let run = |omega0: f64, accel: f64, follow_time: f64, gate: f64| {
             let mut c = stall_test_config(&machine);
-            c.tuning.lock_stall_min_current_ratio = 0.0;
-            c.tuning.lock_stall_follow_time = follow_time;
-            c.tuning.lock_stall_follow_min_current_ratio = gate;
+            c.tuning.stall.min_current_ratio = 0.0;
+            c.tuning.stall.follow_time = follow_time;
+            c.tuning.stall.follow_min_current_ratio = gate;
             let ts = c.ts;
-            c.tuning.lock_stall_follow_accel_ratio = 0.005;
+            c.tuning.stall.follow_accel_ratio = 0.005;
             let spy = SpeedSpy {
                 omega0,
                 accel,
@@ -1038,18 +1044,18 @@ fn stall_symptom_spares_an_estimate_that_answers_the_torque() {
         let rated = machine.rated_speed();
         let n = run(0.2 * band, 0.02 * rated, 10e-3, 0.0).unwrap_or(0);
         assert!((CATCH + 49..=CATCH + 50).contains(&n), "{p}: {n}");
-        // Accelerates, but slower than `lock_stall_follow_accel_ratio` (0.005·rated/s).
+        // Accelerates, but slower than `stall.follow_accel_ratio` (0.005·rated/s).
         let n = run(2.0 * band, 0.002 * rated, 10e-3, 0.0).unwrap_or(0);
         assert!((CATCH + 49..=CATCH + 50).contains(&n), "{p}: {n}");
     }
 }
 
-/// The stall band widens with the commanded torque (`lock_stall_torque_band_ratio`,
+/// The stall band widens with the commanded torque (`stall.torque_band_ratio`,
 /// docs/method/lock.md): it is the larger of the fixed band and ε·|T*|/(Ĵ·ω_s), the
 /// speed error whose proportional action alone commands T* (kp = Ĵ·ω_s/K_t), so that after a
 /// step of the speed error e it is max(band, ε·e·(1 + the integral's share)). An estimate
 /// stuck 2 bands out while the reference runs 1.5 bands ahead (the speed loop's current below
-/// the limit): flagged after `lock_stall_time` (50 samples) with ε = 0 and with ε = 0.5
+/// the limit): flagged after `stall.time` (50 samples) with ε = 0 and with ε = 0.5
 /// (the widened band stays below e), never with ε = 1.5 (above e from the sample after the
 /// step on). On the paper's motor and on the 2.2 kW IPMSM (the torque read from the salient
 /// model's currents).
@@ -1059,7 +1065,8 @@ fn stall_band_widens_with_the_commanded_torque() {
     for machine in [MachineModel::paper(), ipmsm] {
         let band = DriveConfig::<f64>::for_machine(&machine)
             .tuning
-            .lock_stall_speed_ratio
+            .stall
+            .speed_ratio
             * machine.rated_speed();
         let run = |ratio: f64| stuck_estimate_stalls(&machine, ratio, 0.0, 3.5 * band);
         let p = machine.pole_pairs;
@@ -1072,12 +1079,12 @@ fn stall_band_widens_with_the_commanded_torque() {
 }
 
 /// A gross speed error against the reference waives the current gate
-/// (`lock_stall_gross_error_ratio`, docs/method/lock.md):
+/// (`stall.gross_error_ratio`, docs/method/lock.md):
 /// an estimate stuck at +1 band in limiter mode while the reference, caught there, moves to
 /// −3 bands asks, through the speed loop's proportional gain, for a current below the gate
-/// (`lock_stall_min_current_ratio` 0.2 of rated) on every motor here, so the gated symptom
+/// (`stall.min_current_ratio` 0.2 of rated) on every motor here, so the gated symptom
 /// never rises; with the speed error (4 bands, ω̂ turning against ω*) beyond the ratio 3 it
-/// rises after `lock_stall_time` (50 samples). Not with the reference at −1.5 bands (2.5 bands
+/// rises after `stall.time` (50 samples). Not with the reference at −1.5 bands (2.5 bands
 /// of error), nor at +5 bands (4 bands of error, but ω̂ turns with ω*). On the paper's motor,
 /// the 2.2 kW IPMSM and the 50 kW automotive IPMSM of motors/ipmsm-gem-50k.toml, whose small
 /// inertia for its torque puts its 0.2·rated current gate at a speed error of 28 bands.
@@ -1087,11 +1094,11 @@ fn a_gross_speed_error_against_the_reference_waives_the_current_gate() {
     for machine in [MachineModel::paper(), common::ipmsm_model(), gem] {
         let run = |gross: f64, reference_bands: f64| {
             let mut c = stall_test_config(&machine);
-            c.tuning.lock_stall_gross_error_ratio = gross;
-            c.tuning.lock_stall_torque_band_ratio = 0.0;
-            c.tuning.lock_stall_reluctance_band_ratio = 0.0;
-            c.tuning.lock_stall_follow_time = 0.0;
-            let band = c.tuning.lock_stall_speed_ratio * machine.rated_speed();
+            c.tuning.stall.gross_error_ratio = gross;
+            c.tuning.stall.torque_band_ratio = 0.0;
+            c.tuning.stall.reluctance_band_ratio = 0.0;
+            c.tuning.stall.follow_time = 0.0;
+            let band = c.tuning.stall.speed_ratio * machine.rated_speed();
             let spy = SpeedSpy {
                 omega0: band,
                 accel: 0.0,

@@ -64,8 +64,8 @@ fn huge_initial_angle_is_wrapped() {
 #[test]
 fn drive_align_to_a_huge_angle_is_wrapped() {
     let mut config = DriveConfig::for_machine(&MachineModel::paper());
-    config.tuning.current_bandwidth_hz = 0.16;
-    config.tuning.offset_calibration_time = 219.0 * config.ts; // 219 samples
+    config.tuning.current.bandwidth_hz = 0.16;
+    config.tuning.offset_calibration.time = 219.0 * config.ts; // 219 samples
     let mut drive = SensorlessDrive::new(config, EstimatorTuning::default()).unwrap();
     let w = 2.0 * core::f64::consts::PI * -21.4;
     for k in 0..16 {

@@ -109,7 +109,7 @@ fn reset_rearms_the_calibration_and_zero_time_disables_it() {
     // The ratio measured is kept until a new one is.
     assert!((drive.current_gain_ratio() - 1.005).abs() < 2e-5);
     let mut config = DriveConfig::for_machine(&MachineModel::paper());
-    config.tuning.gain_calibration_time = 0.0;
+    config.tuning.gain_calibration.time = 0.0;
     let drive = SensorlessDrive::<f64>::new(config, EstimatorTuning::default()).unwrap();
     assert!(!drive.is_calibrating_gain());
     assert_eq!(drive.gain_calibration_status(), GainCalibrationStatus::Off);

@@ -56,7 +56,7 @@ fn observer_on_rotor_flux_ignores_rotor_frame_current_swings() {
 #[test]
 fn offset_calibration_runs_with_gates_off_then_removes_the_offsets() {
     let mut cfg = DriveConfig::<f64>::for_machine(&MachineModel::paper());
-    cfg.tuning.offset_calibration_time = 20e-3; // 200 samples
+    cfg.tuning.offset_calibration.time = 20e-3; // 200 samples
     let mut drive = SensorlessDrive::new(cfg, EstimatorTuning::default()).unwrap();
     drive.align(0.3);
     let offset = Abc::new(0.02, -0.01, -0.01);
@@ -81,7 +81,7 @@ fn offset_calibration_runs_with_gates_off_then_removes_the_offsets() {
 #[test]
 fn offset_calibration_can_be_disabled_and_is_restarted_by_reset() {
     let mut off = DriveConfig::<f64>::for_machine(&MachineModel::paper());
-    off.tuning.offset_calibration_time = 0.0;
+    off.tuning.offset_calibration.time = 0.0;
     let mut drive = SensorlessDrive::new(off, EstimatorTuning::default()).unwrap();
     drive.align(0.0);
     assert!(!drive.is_calibrating());

@@ -235,7 +235,7 @@ pub fn annotate(toml: &str, derived: &[Derived]) -> String {
     }
     let mut out = String::from(
         "# Keys marked `derived` are not in the configuration file: their values follow from\n\
-         # the motor's ratings by the rule given (fado_core::ratings).\n",
+         # the motor's ratings (fado_core::ratings) or the drive's own rules, by the rule given.\n",
     );
     let mut section = String::new();
     for line in toml.lines() {

@@ -2,7 +2,7 @@
 //! `regen-stop`, and the model limits they aim at.
 //!
 //! **Limits from the model.** The steady-state machine (the drive's model: R̂s, L̂d, L̂q,
-//! λ̂f) with |i| ≤ I_max (`[controller] current_limit_ratio`) and |v| ≤ m·V_dc/√3 (the field
+//! λ̂f) with |i| ≤ I_max (`[controller.current] limit_ratio`) and |v| ≤ m·V_dc/√3 (the field
 //! weakening loop's `voltage_margin` of the inscribed circle) gives the largest torque at
 //! each speed, found by a scan of i_d over [−I_max, 0] with the largest i_q both limits allow
 //! ([`max_torque`]). `fullrange`'s top speed is the highest speed up to 2× the rated one at
@@ -81,7 +81,7 @@ pub fn targets(cfg: &SimConfig) -> RangeTargets {
     let w_mech = |rpm: f64| rpm * std::f64::consts::TAU / 60.0;
     let p = m.pole_pairs as f64;
     let rated_power = m.rated_torque * w_mech(rated);
-    let i_max = cfg.controller.current_limit_ratio * m.rated_current;
+    let i_max = cfg.controller.current.limit_ratio * m.rated_current;
     let v_max =
         cfg.controller.field_weakening.voltage_margin * cfg.inverter.dc_voltage / 3f64.sqrt();
     let power = |rpm: f64| max_torque(cfg, p * w_mech(rpm), i_max, v_max) * w_mech(rpm);
@@ -222,7 +222,7 @@ pub const CHOPPER_RATIO: f64 = 1.05;
 /// The acceleration feed-forward and the type-3 trackers (`crate::scenario` docs): what a
 /// drive needs through current-limited transients.
 fn enable_feedforward(c: &mut SimConfig) {
-    c.controller.acceleration_feedforward = true;
+    c.controller.tracker_feedforward.enabled = true;
     if c.estimator.tracker.load_pole_ratio == 0.0 {
         c.estimator.tracker.load_pole_ratio = 0.5;
     }
@@ -243,7 +243,7 @@ mod tests {
         assert_eq!(t.hold_power, t.rated_power);
         // At standstill the limit is the current limit's torque: 1.5·p·λf·I_max.
         let m = c.machine_model();
-        let i_max = c.controller.current_limit_ratio * m.rated_current;
+        let i_max = c.controller.current.limit_ratio * m.rated_current;
         let t0 = max_torque(&c, 0.0, i_max, 1e3);
         assert!((t0 - 1.5 * 4.0 * m.flux_linkage * i_max).abs() < 1e-9 * t0);
         // Above the voltage limit's corner the torque falls.

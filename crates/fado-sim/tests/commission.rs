@@ -345,7 +345,7 @@ fn the_identified_outrunner_model_passes_stops_with_a_fixed_rs() {
     let text = fado_sim::commission::identified_toml(preset.toml, &id).unwrap();
     let cfg = fado_sim::SimConfig::from_toml(&text).unwrap();
     assert_eq!(
-        cfg.drive_config().tuning.dead_time_threshold_voltage,
+        cfg.drive_config().tuning.inverter.threshold_voltage,
         id.threshold_voltage.max(0.0)
     );
     assert_eq!(cfg.machine_model().rs, id.model.rs);

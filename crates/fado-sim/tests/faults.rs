@@ -210,7 +210,7 @@ fn persistent_non_finite_input_trips_safely() {
     let r = run("steady300", &format!("{STEADY}{faults}"));
     let trip = r.first_flag(DriveFlags::TRIPPED, 0.0).expect("tripped");
     println!("persistent NaN from 2.5 s: tripped at {trip:.4} s");
-    // input_fault_trip_time = 10 ms: the 100th rejected sample trips (latched).
+    // protection.input_fault_trip_time = 10 ms: the 100th rejected sample trips (latched).
     assert!((trip - (2.5 + 99.0 * r.ts)).abs() < 0.5 * r.ts, "{trip}");
     assert_eq!(
         r.flagged(DriveFlags::TRIPPED, trip, 10.0),
@@ -229,7 +229,7 @@ fn stuck_current_channel_is_detected_and_ridden_through_at_300_rpm() {
         let off = run(
             "steady300",
             &format!(
-                "{STEADY}{}[controller]\nstuck_sensor_time = 0.0\n",
+                "{STEADY}{}[controller.stuck_sensor]\ntime = 0.0\n",
                 stuck(channel, 2.5)
             ),
         );
@@ -274,7 +274,7 @@ fn stuck_current_channel_is_detected_and_ridden_through_at_standstill_under_load
     // The start-up gain calibration is off: it starts the drive 0.52 s later, which changes
     // the standstill this test was set up on (measured with it: stuck a detected after
     // 0.4 ms, 0.075 rad; stuck b after 5 ms, 0.30 rad against 0.074 without the fault).
-    let standstill = format!("{STANDSTILL}[controller]\ngain_calibration_time = 0.0\n");
+    let standstill = format!("{STANDSTILL}[controller.gain_calibration]\ntime = 0.0\n");
     for channel in ["a", "b"] {
         let r = run("fig10", &format!("{standstill}{}", stuck(channel, 3.0)));
         let detected = r.first_flag(DriveFlags::SENSOR_STUCK, 3.0).map(|t| t - 3.0);

@@ -26,7 +26,7 @@ fn run_with(motor: &str, speed: f64, load: &str, extra: &str) -> (f64, f64, bool
         "{motor}[speed_reference]\npoints = [[0.0, 0.0], [0.7, 0.0], [3.7, {speed}], [5.5, {speed}]]\n\
          {load}\
          [simulation]\neval_start = 0.7\nduration = 5.5\n\
-         [controller]\nacceleration_feedforward = true\n{extra}\
+         [controller.tracker_feedforward]\nenabled = true\n{extra}\
          [estimator.tracker]\nload_pole_ratio = 0.5\n"
     );
     let out = simulate("custom", Some(&text), false, None).unwrap();
@@ -75,7 +75,7 @@ fn overmodulation_gives_ipmsm_more_power_at_twice_its_rated_speed() {
     // overmodulation, held with it.
     let m = motor("ipmsm-2k2.toml");
     let load = "[load.torque]\npoints = [[0.0, 0.0], [0.7, 0.0], [3.7, 14.2], [5.5, 14.2]]\n";
-    let over = "voltage_limit = \"overmodulation\"\n\
+    let over = "[controller.modulation]\nvoltage_limit = \"overmodulation\"\n\
                 [controller.field_weakening]\nvoltage_margin = 1.08\n\
                 [controller.limits]\npower_ratio = 2.5\n";
     let (speed, angle, tripped) = run_with(&m, 3000.0, load, over);

@@ -71,7 +71,9 @@ fn the_mismatch_is_measured_on_every_calibrated_preset_and_skipped_where_it_shou
                 k - k_true
             );
             let machine = p.machine().unwrap();
-            let limit = fado_core::control::DriveTuning::<f64>::default().current_limit_ratio
+            let limit = fado_core::control::DriveTuning::<f64>::default()
+                .current
+                .limit_ratio
                 * machine.rated_current;
             assert!(
                 peak <= limit,
@@ -121,7 +123,7 @@ fn the_calibration_can_be_switched_off() {
     let (k, _, status, peak, t) = start_up(
         "outrunner-cheetah-24v",
         0.3,
-        "[controller]\ngain_calibration_time = 0.0\n",
+        "[controller.gain_calibration]\ntime = 0.0\n",
     );
     assert_eq!((k, status), (1.0, GainCalibrationStatus::Off));
     assert!(peak < 1e-9 && t < 0.101, "{peak} {t}");

@@ -140,17 +140,20 @@ fn absurd_magnitudes_blame_their_own_key() {
     }
 }
 
-/// A current limit of 1e9 × the rated current (blamed `trip_current_ratio`), a DC-link warning
+/// A current limit of 1e9 × the rated current (blamed `protection.trip_current_ratio`), a DC-link warning
 /// level above the DC link (the flag on for the whole run, which still passed).
 #[test]
 fn drive_settings_that_cannot_work_blame_their_own_key() {
-    for key in ["current_limit_ratio = 1e9", "dc_link_min_ratio = 2.0"] {
+    for (table, key) in [
+        ("current", "limit_ratio = 1e9"),
+        ("protection", "dc_link_min_ratio = 2.0"),
+    ] {
         let e = refused(&format!(
-            "{}[controller]\n{key}\n",
+            "{}[controller.{table}]\n{key}\n",
             fado_sim::presets::find("paper").unwrap().toml
         ));
         let name = key.split(' ').next().unwrap();
-        assert_eq!(e.key, format!("controller.{name}"), "{e}");
+        assert_eq!(e.key, format!("controller.{table}.{name}"), "{e}");
     }
 }
 

@@ -63,7 +63,7 @@ fn a_lost_rotor_is_flagged_and_a_matched_run_is_not() {
         "fig11",
         Some(
             "[estimator.rs_adaptation]\nenabled = false\n[mismatch]\nrs_ratio = 1.1\n\
-             [controller]\ngain_calibration_time = 0.0\n",
+             [controller.gain_calibration]\ntime = 0.0\n",
         ),
         false,
     )
@@ -96,7 +96,7 @@ fn recover_ends_at_the_reference_speed_with_the_reason_logged() {
     let run = |extra: &str| {
         let toml = format!(
             "[estimator.rs_adaptation]\nenabled = false\n[mismatch]\nrs_ratio = 1.1\n\
-             [controller]\ngain_calibration_time = 0.0\n{extra}"
+             [controller.gain_calibration]\ntime = 0.0\n{extra}"
         );
         let cfg = scenario_config("fig11", Some(&toml), false).unwrap();
         let out = run_config("fig11", cfg, None).unwrap();
@@ -116,7 +116,7 @@ fn recover_ends_at_the_reference_speed_with_the_reason_logged() {
         });
         (worst, flags, out.metrics)
     };
-    let (worst, flags, m) = run("lock_reaction = \"recover\"\n");
+    let (worst, flags, m) = run("[controller.lock]\nreaction = \"recover\"\n");
     println!(
         "recover: LOCK_LOST at {:?} s, |n − n*| over the last 0.2 s ≤ {worst:.1} r/min",
         m.lock_lost_time
@@ -129,11 +129,11 @@ fn recover_ends_at_the_reference_speed_with_the_reason_logged() {
     );
     assert!(worst < 5.0, "{worst} r/min off the reference at the end");
     let (worst_fixed, _, _) =
-        run("lock_reaction = \"recover\"\nlock_recovery_rs_adaptation = false\n");
+        run("[controller.lock]\nreaction = \"recover\"\nrecovery_rs_adaptation = false\n");
     println!("recover with the fixed R̂s: ≤ {worst_fixed:.1} r/min");
     assert!(worst_fixed > 30.0, "{worst_fixed}");
     // `adapt`: no coasting, the R̂s adaptation switched on at the first verdict.
-    let (worst_adapt, flags, m) = run("lock_reaction = \"adapt\"\n");
+    let (worst_adapt, flags, m) = run("[controller.lock]\nreaction = \"adapt\"\n");
     println!("adapt: |n − n*| over the last 0.2 s ≤ {worst_adapt:.1} r/min");
     assert!(!m.tripped && m.lock_lost_time.is_some());
     assert!(flags.contains(DriveFlags::LOCK_LOST), "{flags:?}");
@@ -208,7 +208,7 @@ fn reversal_point(
 }
 
 /// The stall band tolerates the lag of a rotor whose estimate is off by less than the paper's
-/// clean threshold (`lock_stall_torque_band_ratio` = 1 − cos 0.25 rad, docs/method/lock.md), and still sees a rotor that stalls. Two points of the
+/// clean threshold (`stall.torque_band_ratio` = 1 − cos 0.25 rad, docs/method/lock.md), and still sees a rotor that stalls. Two points of the
 /// outrunner's reversal envelope (seed 7, R̂s adaptation, `scripts/lock-sweeps-preset.sh`),
 /// a 21-pole-pair motor whose inertia is small for its torque:
 /// * #130 (L̂q −14 %, 0.56 N·m): the rotor and the estimate lag the ramp out of zero speed by

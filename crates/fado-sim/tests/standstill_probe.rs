@@ -21,7 +21,7 @@ fn standstill(
     seconds: f64,
 ) -> (f64, f64) {
     let toml = format!(
-        "{}\n[controller]\nstandstill_probe = {probe}\n[estimator.rs_adaptation]\nenabled = false\n\
+        "{}\n[controller.standstill_probe]\nenabled = {probe}\n[estimator.rs_adaptation]\nenabled = false\n\
          [mismatch]\nrs_ratio = {rs_ratio}\n",
         motor.unwrap_or("")
     );

@@ -1,7 +1,7 @@
 //! Estimation through current-limited transients: from standstill to the rated speed at the
 //! current limit, a rated load step at the rated speed, a stop at the current limit, then 1 s
 //! at standstill. With the drive's acceleration feed-forward into the type-3 speed trackers
-//! (`[controller] acceleration_feedforward`, `[estimator.tracker] load_pole_ratio`) the angle
+//! (`[controller.tracker_feedforward] enabled`, `[estimator.tracker] load_pole_ratio`) the angle
 //! stays within 0.25 rad throughout on the paper's motor and on an interior-magnet motor;
 //! with the paper's type-2 trackers it does not (their lag α/Ki under the current-limited
 //! acceleration).
@@ -19,8 +19,7 @@ fn profile(rated_rpm: f64, rated_torque: f64) -> String {
     )
 }
 
-const FEEDFORWARD: &str =
-    "[controller]\nacceleration_feedforward = true\n[estimator.tracker]\nload_pole_ratio = 0.5\n";
+const FEEDFORWARD: &str = "[controller.tracker_feedforward]\nenabled = true\n[estimator.tracker]\nload_pole_ratio = 0.5\n";
 
 fn max_angle_error(config: &str) -> f64 {
     let out = simulate("custom", Some(config), false, None).unwrap();

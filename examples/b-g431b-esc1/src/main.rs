@@ -177,8 +177,8 @@ fn main() -> ! {
     let model = motor();
     let mut config = DriveConfig::for_machine(&model);
     config.ts = 1.0 / PWM_HZ as f32;
-    config.tuning.switching_frequency = PWM_HZ as f32;
-    config.tuning.dead_time = DEAD_TIME_NS as f32 * 1e-9;
+    config.tuning.inverter.switching_frequency = PWM_HZ as f32;
+    config.tuning.inverter.dead_time = DEAD_TIME_NS as f32 * 1e-9;
     let Ok(drive) = SensorlessDrive::new(config, EstimatorTuning::default()) else {
         panic!("the motor data or the tuning were refused");
     };

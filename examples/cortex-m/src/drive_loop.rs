@@ -141,9 +141,9 @@ impl DriveApp {
     pub fn new() -> Option<Self> {
         let model = MachineModel::<f32>::paper();
         let mut config = DriveConfig::for_machine(&model);
-        config.tuning.offset_calibration_time = 0.0;
-        config.tuning.gain_calibration_time = 0.0;
-        config.tuning.stuck_sensor_time = 0.0;
+        config.tuning.offset_calibration.time = 0.0;
+        config.tuning.gain_calibration.time = 0.0;
+        config.tuning.stuck_sensor.time = 0.0;
         let t = config.tuning;
         let ts = config.ts;
         let mut drive = SensorlessDrive::new(config, EstimatorTuning::default()).ok()?;
@@ -160,9 +160,9 @@ impl DriveApp {
             inertia: model.inertia,
             friction: model.viscous_friction,
             vdc: model.dc_voltage,
-            dead_time_error: t.dead_time * t.switching_frequency * model.dc_voltage
-                + t.dead_time_threshold_voltage,
-            band: t.dead_time_current_band,
+            dead_time_error: t.inverter.dead_time * t.inverter.switching_frequency * model.dc_voltage
+                + t.inverter.threshold_voltage,
+            band: t.inverter.current_band,
         };
         Some(Self {
             drive,

@@ -32,9 +32,9 @@ pub enum LockReaction {
     Coast,
     /// Coast at zero current with the detector re-armed; restart the speed loop once the
     /// estimator has run in disturbance-feedback mode (|f̂| above the Fig. 3 threshold) with
-    /// no symptom for `lock_recovery_time`. A machine that does not turn by itself within
-    /// `lock_recovery_timeout` is re-aligned at the present estimate with the start-up
-    /// procedure (docs/method/estimator.md, "Start-up") and restarted. After `lock_recovery_attempts` losses
+    /// no symptom for `lock.recovery_time`. A machine that does not turn by itself within
+    /// `lock.recovery_timeout` is re-aligned at the present estimate with the start-up
+    /// procedure (docs/method/estimator.md, "Start-up") and restarted. After `lock.recovery_attempts` losses
     /// since the last `reset`, coast for good.
     Recover,
 }

@@ -24,6 +24,7 @@ pub mod speed_controller;
 pub mod standstill_probe;
 pub mod startup;
 pub use drive::tracker_feedforward;
+pub use drive::tuning;
 
 pub use current_controller::{CurrentController, CurrentControllerConfig};
 pub use dc_link_limit::{DcLinkLimit, DcLinkTuning};

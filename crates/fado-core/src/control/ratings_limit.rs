@@ -7,7 +7,7 @@
 //! `torque_ratio` × the rated torque and to `power_ratio` × the rated power (the rated torque
 //! at the rated speed) divided by the speed ω̂. Each default is 2 × the rating \[A\]: the
 //! field-weakening range to twice the rated speed that `fullrange` exercises, and an overload
-//! above the current limit's (`current_limit_ratio`, 1.84 × on the paper's motor), so that
+//! above the current limit's (`current.limit_ratio`, 1.84 × on the paper's motor), so that
 //! the current limit, not these, sets the transients of a surface-magnet motor; on an
 //! interior-magnet motor the torque limit caps the reluctance torque MTPA adds at the current
 //! limit. Below the limits the torque demand passes bit for bit.

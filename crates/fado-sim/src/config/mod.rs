@@ -13,6 +13,7 @@
 //! given directly: they are the plant's times the `[mismatch]` ratios, so "matched" stays
 //! matched when the motor changes.
 
+use fado_core::control::tuning::{DeadTimeCompensationTuning, InverterData};
 use fado_core::control::{DeadTimeMethod, DriveConfig, DriveTuning};
 use fado_core::magnetics::Saturation;
 use fado_core::{EstimatorConfig, EstimatorTuning, MachineModel};
@@ -32,6 +33,7 @@ use crate::profile::Profile;
 use crate::sensors::{CurrentSensorParams, DcLinkSensorParams};
 use crate::sim::PlantParams;
 
+mod drive_rules;
 mod moved;
 mod settings;
 #[cfg(test)]
@@ -302,8 +304,9 @@ impl SimConfig {
     /// The drive configuration: `[controller]` tuning, the drive's model, timing and the
     /// dead-time compensation's inverter data from `[inverter]` (× `[mismatch]`), its
     /// threshold voltage from `[inverter_model]` when that gives it. With the averaged
-    /// inverter, which has no PWM ripple, `dead_time_method = "edge_current"` becomes the
-    /// trapezoid it then equals (its exact inverse), so that "matched" stays matched.
+    /// inverter, which has no PWM ripple, `[controller.dead_time_compensation] method =
+    /// "edge_current"` becomes the trapezoid it then equals (its exact inverse), so that
+    /// "matched" stays matched.
     pub fn drive_config(&self) -> DriveConfig<f64> {
         let (inv, m) = (&self.inverter, &self.mismatch);
         let threshold = self
@@ -315,15 +318,20 @@ impl SimConfig {
             ts: inv.sample_period(),
             machine: self.machine_model(),
             tuning: DriveTuning {
-                dead_time: inv.dead_time * m.dead_time_ratio,
-                switching_frequency: inv.switching_frequency,
-                dead_time_threshold_voltage: threshold,
-                dead_time_current_band: inv.current_band * m.current_band_ratio,
-                dead_time_method: match (inv.model, self.controller.dead_time_method) {
-                    (crate::inverter::InverterModel::Averaged, DeadTimeMethod::EdgeCurrent) => {
-                        DeadTimeMethod::Trapezoidal
-                    }
-                    (_, method) => method,
+                inverter: InverterData {
+                    dead_time: inv.dead_time * m.dead_time_ratio,
+                    switching_frequency: inv.switching_frequency,
+                    threshold_voltage: threshold,
+                    current_band: inv.current_band * m.current_band_ratio,
+                },
+                dead_time_compensation: DeadTimeCompensationTuning {
+                    method: match (inv.model, self.controller.dead_time_compensation.method) {
+                        (crate::inverter::InverterModel::Averaged, DeadTimeMethod::EdgeCurrent) => {
+                            DeadTimeMethod::Trapezoidal
+                        }
+                        (_, method) => method,
+                    },
+                    ..self.controller.dead_time_compensation
                 },
                 ..self.controller
             },

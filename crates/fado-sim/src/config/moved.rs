@@ -1,13 +1,16 @@
-//! Keys of the flat `[estimator]` table of earlier configuration files, which live in the
-//! nested tables of their blocks (`[estimator.lock]`, …): refused with their new place, and
-//! the names by which fado-core's configuration errors (flat names) are reported.
+//! Keys of the flat `[estimator]` and `[controller]` tables of earlier configuration files,
+//! which live in the nested tables of their blocks (`[estimator.lock]`, `[controller.stall]`,
+//! …): refused with their new place, and the names by which fado-core's configuration errors
+//! (flat names) are reported.
 
+use fado_core::control::tuning::MOVED_KEYS as CONTROLLER;
 use fado_core::estimator::tuning::MOVED_KEYS as ESTIMATOR;
 
 use crate::error::SimConfigError;
 
 /// Every section whose flat keys moved, with fado-core's table of (flat key, nested path).
-const SECTIONS: &[(&str, &[(&str, &str)])] = &[("estimator", ESTIMATOR)];
+const SECTIONS: &[(&str, &[(&str, &str)])] =
+    &[("estimator", ESTIMATOR), ("controller", CONTROLLER)];
 
 /// The path below `section` where the flat key `key` lives now, if it moved.
 pub(crate) fn moved(section: &str, key: &str) -> Option<&'static str> {
@@ -36,8 +39,8 @@ pub(super) fn refuse_moved(user: &toml::Table) -> Result<(), SimConfigError> {
         let Some(toml::Value::Table(table)) = user.get(*section) else {
             continue;
         };
-        // `rs_adaptation` is a flat key (a bool) and a table: only a value that is not a
-        // table is the flat key.
+        // `rs_adaptation`, `standstill_probe`, … are a flat key (a bool) and a table: only a
+        // value that is not a table is the flat key.
         for (key, value) in table {
             if let (Some(path), false) = (moved(section, key), value.is_table()) {
                 return Err(moved_error(section, key, path));

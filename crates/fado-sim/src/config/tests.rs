@@ -127,6 +127,37 @@ mod located_errors {
         );
         let (key, line, _, _) = err("[estimator.mode]\nhysteresis_ratio = 0.03\n");
         assert_eq!((key.as_str(), line), ("estimator.mode.hysteresis_ratio", 2));
+        // A key of the flat `[controller]` table names its new place; a flat switch that is a
+        // table now (`standstill_probe`) too.
+        let (key, line, col, message) =
+            err("[motor]\nrs = 0.3\n[controller]\nlock_stall_time = 0.01\n");
+        assert_eq!(
+            (key.as_str(), line, col),
+            ("controller.lock_stall_time", 4, 19)
+        );
+        assert!(
+            message.ends_with(
+                "`controller.lock_stall_time` moved: write it as `[controller.stall] time`"
+            ),
+            "{message}"
+        );
+        let (key, line, _, message) = err("[controller]\nmtpa = true\nstandstill_probe = false\n");
+        assert_eq!((key.as_str(), line), ("controller.mtpa", 2));
+        assert!(
+            message.ends_with("write it as `[controller.mtpa] enabled`"),
+            "{message}"
+        );
+        let (key, _, _, message) = err("controller.acceleration_feedforward = true\n");
+        assert_eq!(key, "controller.acceleration_feedforward");
+        assert!(
+            message.ends_with("write it as `[controller.tracker_feedforward] enabled`"),
+            "{message}"
+        );
+        // fado-core's drive checks (flat field names) are named by the nested key.
+        let (key, line, col, _) = err("[controller.stall]\ntime = -1.0\n");
+        assert_eq!((key.as_str(), line, col), ("controller.stall.time", 2, 8));
+        let (key, line, _, _) = err("[controller.current]\nlimit_ratio = 0.0\n");
+        assert_eq!((key.as_str(), line), ("controller.current.limit_ratio", 2));
         // Array elements and dotted keys.
         let (key, line, col, _) =
             err("[simulation]\ndisturbance_feedback_off = [[0.0, 1.0], [2.0, 1.0]]\n");
@@ -186,7 +217,7 @@ mod located_errors {
 
     #[test]
     fn derived_limits_name_the_users_own_key() {
-        // Each of these keys is refused naming itself, not `controller.current_anti_windup_ratio`.
+        // Each of these keys is refused naming itself, not `controller.current.anti_windup_ratio`.
         let (key, line, col, _) = err(&paper_motor_with("rs = 1e300"));
         assert_eq!((key.as_str(), line, col), ("motor.rs", 2, 6));
         let (key, line, _, _) = err(&paper_motor_with("ld = 1e-300"));
@@ -206,12 +237,12 @@ mod located_errors {
             "[inverter]\nthreshold_voltage = 1.0\n[mismatch]\nthreshold_voltage_ratio = 2.0\n",
         )
         .unwrap();
-        assert_eq!(cfg.drive_config().tuning.dead_time_threshold_voltage, 2.0);
+        assert_eq!(cfg.drive_config().tuning.inverter.threshold_voltage, 2.0);
         let cfg = SimConfig::from_toml(
             "[mismatch]\nthreshold_voltage_ratio = 2.0\n[inverter_model]\nthreshold_voltage = 0.93\n",
         )
         .unwrap();
-        assert_eq!(cfg.drive_config().tuning.dead_time_threshold_voltage, 0.93);
+        assert_eq!(cfg.drive_config().tuning.inverter.threshold_voltage, 0.93);
         assert_eq!(cfg.inverter.threshold_voltage, 1.0);
         let (key, line, col, _) = err("[inverter_model]\nthreshold_voltage = -0.1\n");
         assert_eq!(
@@ -286,6 +317,38 @@ mod located_errors {
     }
 }
 
+/// `--dump-config` shows the acceleration feed-forward, the trackers' load pole and T2S-1's
+/// bandwidth as the drive uses them: set by `fado_core::control::tracker_feedforward` on the
+/// multirotor preset, whose trackers would lag 2.4 rad at the current limit, and left off on
+/// the paper's.
+#[test]
+fn the_dump_shows_the_feedforward_the_drive_turns_on() {
+    let dump = |name: &str| {
+        let preset = crate::presets::find(name).unwrap();
+        super::SimConfig::from_toml(preset.toml)
+            .unwrap()
+            .to_toml_annotated()
+    };
+    let fast = dump("multirotor-mn5006-22v");
+    let on =
+        "[controller.tracker_feedforward]\nenabled = true  # derived: on where the type-2 T2S-1";
+    assert!(fast.contains(on), "{fast}");
+    assert!(
+        fast.contains("load_pole_ratio = 0.5  # derived: 0.5 with the acceleration"),
+        "{fast}"
+    );
+    assert!(
+        fast.contains("  # derived: T2S-1's bandwidth in k_df mode"),
+        "{fast}"
+    );
+    let paper = dump("paper");
+    assert!(
+        paper.contains("[controller.tracker_feedforward]\nenabled = false\n"),
+        "{paper}"
+    );
+    assert!(paper.contains("load_pole_ratio = 0.0\n"), "{paper}");
+}
+
 mod dead_time_method {
     use super::super::*;
     use crate::inverter::InverterModel as Plant;
@@ -296,11 +359,15 @@ mod dead_time_method {
         let method = |model: Plant, asked| {
             let mut c = SimConfig::default();
             c.inverter.model = model;
-            c.controller.dead_time_method = asked;
-            c.drive_config().tuning.dead_time_method
+            c.controller.dead_time_compensation.method = asked;
+            c.drive_config().tuning.dead_time_compensation.method
         };
         assert_eq!(
-            SimConfig::default().drive_config().tuning.dead_time_method,
+            SimConfig::default()
+                .drive_config()
+                .tuning
+                .dead_time_compensation
+                .method,
             EdgeCurrent
         );
         assert_eq!(method(Plant::SwitchingResolved, EdgeCurrent), EdgeCurrent);

@@ -101,9 +101,11 @@ impl SimConfig {
         Self::from_user_toml(&SimConfig::default(), text)
     }
 
-    /// This configuration as TOML with each derived key's rule beside it (`--dump-config`).
+    /// This configuration as TOML with each derived key's rule beside it (`--dump-config`),
+    /// with the values the drive's build-time rules set (`drive_rules`).
     pub fn to_toml_annotated(&self) -> String {
-        crate::derive::annotate(&self.to_toml(), &self.derived)
+        let shown = super::drive_rules::with_drive_rules(self);
+        crate::derive::annotate(&shown.to_toml(), &shown.derived)
     }
 }
 

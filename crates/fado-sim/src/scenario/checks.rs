@@ -39,7 +39,7 @@ pub(super) fn checks_range(
     checks.push(Check::at_least(
         "min DC-link voltage (V)",
         m.min_dc_voltage,
-        cfg.controller.dc_link_min_ratio * v,
+        cfg.controller.protection.dc_link_min_ratio * v,
     ));
     if p.levels.len() == 5 {
         let t = crate::range::targets(cfg);

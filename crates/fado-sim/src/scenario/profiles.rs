@@ -48,7 +48,7 @@ pub(super) fn setup_fig9(c: &mut SimConfig) {
     // provide one of visible size \[A\]. (Calibrated, λ1 drifts only 1–3 mWb in
     // the 2 s: too little for the drift check, and the recovery ratio is then
     // dominated by noise.)
-    c.controller.offset_calibration_time = 0.0;
+    c.controller.offset_calibration.time = 0.0;
     // For the same reason the learned integrand offset is off: it removes that error while
     // turning, so with k_df off λ1 would have nothing to drift from (measured: 0.2 mWb
     // instead of 21 mWb in the 2 s) \[A\].

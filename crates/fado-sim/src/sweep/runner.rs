@@ -283,7 +283,7 @@ mod tests {
             ],
         ));
         spec.config_toml = Some(format!(
-            "{}[controller]\ncurrent_bandwidth_hz = 700.0\ntrip_current_ratio = 1.88\n",
+            "{}[controller.current]\nbandwidth_hz = 700.0\n[controller.protection]\ntrip_current_ratio = 1.88\n",
             spec.config_toml.unwrap()
         ));
         let out = run(&spec, &SweepOptions::default(), &|_, _| {}).unwrap();

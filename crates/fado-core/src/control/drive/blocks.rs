@@ -59,15 +59,21 @@ impl<T: Real> Blocks<T> {
         // `currents_for_torque`): with MTPA on a salient rotor its limit is the torque of the
         // MTPA point on the current circle |i| = I_max (`SpeedControllerConfig::torque_limit`).
         let speed_config = SpeedControllerConfig {
-            bandwidth_hz: t.speed_bandwidth_hz,
-            zero_ratio: t.speed_zero_ratio,
-            anti_windup_ratio: t.speed_anti_windup_ratio,
-            i_max: c.speed_torque_limit(t.mtpa),
-            ..SpeedControllerConfig::new(m, t.current_limit_ratio * m.rated_current, t.mtpa, ts)
+            bandwidth_hz: t.speed.bandwidth_hz,
+            zero_ratio: t.speed.zero_ratio,
+            anti_windup_ratio: t.speed.anti_windup_ratio,
+            i_max: c.speed_torque_limit(t.mtpa.enabled),
+            ..SpeedControllerConfig::new(
+                m,
+                t.current.limit_ratio * m.rated_current,
+                t.mtpa.enabled,
+                ts,
+            )
         };
         let dc_link = DcLinkLimit::new(&t.dc_link, m, speed_config.i_max, r.i_max, ts)?;
         if t.field_weakening.voltage_margin > T::one()
-            && t.voltage_limit != crate::control::modulation::VoltageLimit::Overmodulation
+            && t.modulation.voltage_limit
+                != crate::control::modulation::VoltageLimit::Overmodulation
         {
             return Err(ConfigError::OutOfRange {
                 field: "field_weakening.voltage_margin",
@@ -81,14 +87,14 @@ impl<T: Real> Blocks<T> {
             ("anti_windup_ratio", "speed_anti_windup_ratio"),
         ]))?;
         let injection =
-            CurrentInjection::new(CurrentInjectionConfig::new(m, t.injection_current_ratio))?;
+            CurrentInjection::new(CurrentInjectionConfig::new(m, t.injection.current_ratio))?;
         let current = CurrentController::new(c.current_controller_config()).map_err(rename(&[
             ("bandwidth_hz", "current_bandwidth_hz"),
             ("anti_windup_ratio", "current_anti_windup_ratio"),
         ]))?;
         let delay = DelayCompensation::new(DelayCompensationConfig {
             ts,
-            factor: t.delay_compensation_factor,
+            factor: t.delay_compensation.factor,
         })
         .map_err(rename(&[("factor", "delay_compensation_factor")]))?;
         let dead_time =
@@ -97,15 +103,15 @@ impl<T: Real> Blocks<T> {
                 ("current_band", "dead_time_current_band"),
             ]))?;
         let modulator = SpaceVectorModulator::new(ModulatorConfig {
-            limit: t.voltage_limit,
-            max_modulation: t.max_modulation,
+            limit: t.modulation.voltage_limit,
+            max_modulation: t.modulation.max_modulation,
         })?;
         let probe = StandstillProbe::new(probe_config(c)?)?;
         let hold = ReleaseHold::new(
             &t.release_hold,
             m,
             ts,
-            t.current_bandwidth_hz,
+            t.current.bandwidth_hz,
             speed_config.i_max,
         )?;
         let limits = RatingsLimit::new(&t.limits, m)?;
@@ -139,8 +145,8 @@ impl<T: Real> Blocks<T> {
 }
 
 impl<T: Real> DriveConfig<T> {
-    /// The current loop of the machine model with the tuning's `current_bandwidth_hz`,
-    /// `decoupling` and `current_anti_windup_ratio`: what the drive builds.
+    /// The current loop of the machine model with the tuning's `current.bandwidth_hz`,
+    /// `decoupling` and `current.anti_windup_ratio`: what the drive builds.
     pub fn current_controller_config(&self) -> CurrentControllerConfig<T> {
         let t = &self.tuning;
         // A saturating model: the incremental inductances at the rated MTPA point
@@ -149,25 +155,25 @@ impl<T: Real> DriveConfig<T> {
         CurrentControllerConfig {
             ld_hat,
             lq_hat,
-            bandwidth_hz: t.current_bandwidth_hz,
-            decoupling: t.decoupling,
-            anti_windup_ratio: t.current_anti_windup_ratio,
+            bandwidth_hz: t.current.bandwidth_hz,
+            decoupling: t.current.decoupling,
+            anti_windup_ratio: t.current.anti_windup_ratio,
             ..CurrentControllerConfig::for_machine(&self.machine, self.ts)
         }
     }
 
     /// The dead-time compensation of the machine model with the tuning's inverter data
-    /// (`dead_time`, `switching_frequency`, `dead_time_threshold_voltage`,
-    /// `dead_time_current_band`) and method: what the drive builds.
+    /// (`dead_time`, `switching_frequency`, `inverter.threshold_voltage`,
+    /// `inverter.current_band`) and method: what the drive builds.
     pub fn dead_time_compensation_config(&self) -> DeadTimeCompensationConfig<T> {
         let t = &self.tuning;
         DeadTimeCompensationConfig {
-            enabled: t.dead_time_compensation,
-            method: t.dead_time_method,
-            dead_time: t.dead_time,
-            switching_frequency: t.switching_frequency,
-            threshold_voltage: t.dead_time_threshold_voltage,
-            current_band: t.dead_time_current_band,
+            enabled: t.dead_time_compensation.enabled,
+            method: t.dead_time_compensation.method,
+            dead_time: t.inverter.dead_time,
+            switching_frequency: t.inverter.switching_frequency,
+            threshold_voltage: t.inverter.threshold_voltage,
+            current_band: t.inverter.current_band,
             ..DeadTimeCompensationConfig::for_machine(&self.machine)
         }
     }
@@ -190,10 +196,10 @@ fn check_limits<T: Real>(c: &DriveConfig<T>, r: &Resolved<T>) -> Result<(), Conf
             expected: "above current_limit_ratio",
         });
     }
-    let band = check::non_negative("stuck_sensor_band_ratio", t.stuck_sensor_band_ratio)?;
+    let band = check::non_negative("stuck_sensor_band_ratio", t.stuck_sensor.band_ratio)?;
     let min_ref = check::positive(
         "stuck_sensor_reference_ratio",
-        t.stuck_sensor_reference_ratio,
+        t.stuck_sensor.reference_ratio,
     )?;
     if min_ref <= band {
         return Err(ConfigError::OutOfRange {
@@ -204,15 +210,18 @@ fn check_limits<T: Real>(c: &DriveConfig<T>, r: &Resolved<T>) -> Result<(), Conf
     check::below(
         "plausible_current_ratio",
         T::one(),
-        check::finite("plausible_current_ratio", c.tuning.plausible_current_ratio)?,
+        check::finite(
+            "plausible_current_ratio",
+            c.tuning.plausibility.current_ratio,
+        )?,
         "above 1",
     )?;
-    check::positive("dc_link_max_ratio", c.tuning.dc_link_max_ratio)?;
+    check::positive("dc_link_max_ratio", c.tuning.plausibility.dc_link_ratio)?;
     LockSupervisor::new(
-        c.tuning.lock_reaction,
+        c.tuning.lock.reaction,
         c.ts,
-        c.tuning.lock_recovery_time,
-        c.tuning.lock_recovery_timeout,
+        c.tuning.lock.recovery_time,
+        c.tuning.lock.recovery_timeout,
         0,
     )?;
     Ok(())
@@ -240,28 +249,28 @@ fn probe_config<T: Real>(c: &DriveConfig<T>) -> Result<StandstillProbeConfig<T>,
     let rated = m.rated_current;
     Ok(StandstillProbeConfig {
         ts: c.ts,
-        amplitude: if t.standstill_probe {
+        amplitude: if t.standstill_probe.enabled {
             check::non_negative(
                 "standstill_probe_current_ratio",
-                t.standstill_probe_current_ratio,
+                t.standstill_probe.current_ratio,
             )? * rated
         } else {
             T::zero()
         },
-        period: t.standstill_probe_period,
-        gain: t.standstill_probe_gain,
+        period: t.standstill_probe.period,
+        gain: t.standstill_probe.gain,
         max_speed: check::non_negative(
             "standstill_probe_speed_ratio",
-            t.standstill_probe_speed_ratio,
+            t.standstill_probe.speed_ratio,
         )? * m.rated_speed(),
         min_load: check::non_negative(
             "standstill_probe_load_ratio",
-            t.standstill_probe_load_ratio,
+            t.standstill_probe.load_ratio,
         )? * rated,
         inertia: {
             let p = T::lit(m.pole_pairs as f64);
             m.inertia / (T::lit(1.5) * p * p * m.flux_linkage)
         },
-        arm_time: t.standstill_probe_arm_time,
+        arm_time: t.standstill_probe.arm_time,
     })
 }

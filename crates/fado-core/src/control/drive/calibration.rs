@@ -99,7 +99,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
     /// ([`StartupTuning::rotor_held`](crate::control::StartupTuning::rotor_held)) the
     /// nearest well-observed axis.
     pub(super) fn gain_axis(&self) -> T {
-        let min = self.config.tuning.gain_calibration_min_observability;
+        let min = self.config.tuning.gain_calibration.min_observability;
         self.startup.gain_axis(self.aligned_angle, min)
     }
 

@@ -41,19 +41,19 @@ impl<T: Real> DriveConfig<T> {
     }
 
     /// The start-up gain calibration's configuration in absolute units: upper level
-    /// `gain_calibration_current_ratio` × the rated current (at most the current limit),
-    /// settling 5·max(L̂d/R̂s, 1/ωc) per level, window `gain_calibration_time`.
+    /// `gain_calibration.current_ratio` × the rated current (at most the current limit),
+    /// settling 5·max(L̂d/R̂s, 1/ωc) per level, window `gain_calibration.time`.
     pub fn gain_calibration_config(&self) -> Result<GainCalibrationConfig<T>, ConfigError> {
         self.machine.validate()?;
         let t = &self.tuning;
         let m = &self.machine;
         let ratio = check::positive(
             "gain_calibration_current_ratio",
-            t.gain_calibration_current_ratio,
+            t.gain_calibration.current_ratio,
         )?;
-        let ratio = crate::real::min(ratio, t.current_limit_ratio);
+        let ratio = crate::real::min(ratio, t.current.limit_ratio);
         let omega_c =
-            T::two_pi() * check::positive("current_bandwidth_hz", t.current_bandwidth_hz)?;
+            T::two_pi() * check::positive("current_bandwidth_hz", t.current.bandwidth_hz)?;
         let tau_stator = m.ld / m.rs;
         let tau = crate::real::max(tau_stator, T::one() / omega_c);
         let settle = T::lit(GAIN_CALIBRATION_SETTLE_TIME_CONSTANTS) * tau;
@@ -93,9 +93,9 @@ impl<T: Real> DriveConfig<T> {
             settle_time: settle,
             hold_time: hold,
             max_hold_time: T::lit(GAIN_CALIBRATION_MAX_HOLD_TIME),
-            window_time: t.gain_calibration_time,
-            min_observability: t.gain_calibration_min_observability,
-            max_mismatch: t.gain_calibration_max_mismatch,
+            window_time: t.gain_calibration.time,
+            min_observability: t.gain_calibration.min_observability,
+            max_mismatch: t.gain_calibration.max_mismatch,
             current_limit: self.i_max(),
             lq_hat: m.lq,
             motion_voltage: crate::control::gain_calibration::motion_voltage(m),
@@ -106,17 +106,17 @@ impl<T: Real> DriveConfig<T> {
 
     /// The configured current limit I_max in A.
     pub fn i_max(&self) -> T {
-        self.tuning.current_limit_ratio * self.machine.rated_current
+        self.tuning.current.limit_ratio * self.machine.rated_current
     }
 
     /// The configured injection level I_min of eq. (23) in A.
     pub fn i_min(&self) -> T {
-        self.tuning.injection_current_ratio * self.machine.rated_current
+        self.tuning.injection.current_ratio * self.machine.rated_current
     }
 
     /// The configured trip level in A.
     pub fn trip_current(&self) -> T {
-        self.tuning.trip_current_ratio * self.machine.rated_current
+        self.tuning.protection.trip_current_ratio * self.machine.rated_current
     }
 }
 
@@ -148,7 +148,7 @@ const SWING_BIAS_FRACTION: f64 = 0.2;
 /// the loop puts on the axis and the true one, (2/√3)·|k − 1|·|cos φ·cos(φ + π/3)| ≤
 /// 0.87·|k − 1| (module docs of [`crate::control::gain_calibration`]). Against each phase's
 /// voltage step R̂s·I₁·|cos(φ − φ_x)| ≥ R̂s·I₁·s_min (s_min the least phase share the
-/// calibration runs at, `gain_calibration_min_observability`), the two phases' bias is at
+/// calibration runs at, `gain_calibration.min_observability`), the two phases' bias is at
 /// most 4·0.87·λ̂f·|k − 1|·e^(−n)/(R̂s·I₁·s_min·W), below ε·|k − 1| for
 /// e^(−n) ≤ ε·R̂s·I₁·s_min·W/(3.46·λ̂f). It is small on a low-flux motor, whose magnet flux is
 /// small against its resistive drop: the 14-pole-pair multirotor preset (λ̂f 0.88 mWb,
@@ -166,8 +166,8 @@ fn swing_hold_time_constants<T: Real>(
     let bound = T::lit(SWING_BIAS_FRACTION / (4.0 * 0.87))
         * m.rs
         * i1
-        * t.gain_calibration_min_observability
-        * t.gain_calibration_time
+        * t.gain_calibration.min_observability
+        * t.gain_calibration.time
         / m.flux_linkage;
     let mut n = T::one();
     // e^(−n) = 1 − (1 − e^(−n)); quarter steps up to the full hold.

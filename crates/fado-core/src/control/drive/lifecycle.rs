@@ -62,8 +62,8 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             gain_correction: T::one(),
             startup: AngleSearch::new(config.tuning.startup, &config.machine, config.ts)?,
             stuck_sensor: StuckChannelDetector::new(
-                config.tuning.stuck_sensor_band_ratio * config.machine.rated_current,
-                config.tuning.stuck_sensor_reference_ratio * config.machine.rated_current,
+                config.tuning.stuck_sensor.band_ratio * config.machine.rated_current,
+                config.tuning.stuck_sensor.reference_ratio * config.machine.rated_current,
                 resolved.stuck_sensor_samples,
             ),
             current_error: PersistenceMonitor::new(resolved.current_error_samples),
@@ -77,11 +77,11 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             flag_counts: FlagCounts::default(),
             i_ab_used: Ab::zero(),
             lock: LockSupervisor::new(
-                config.tuning.lock_reaction,
+                config.tuning.lock.reaction,
                 config.ts,
-                config.tuning.lock_recovery_time,
-                config.tuning.lock_recovery_timeout,
-                config.tuning.lock_recovery_attempts,
+                config.tuning.lock.recovery_time,
+                config.tuning.lock.recovery_timeout,
+                config.tuning.lock.recovery_attempts,
             )?,
             implausible_now: false,
         };
@@ -111,7 +111,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
     /// after any offset calibration, along the d axis of the last [`align`](Self::align)'s
     /// angle (the rotor must be there and at rest), then the drive re-aligns there and starts.
     /// The ratio in use is kept until a new one is measured. Nothing happens when it is
-    /// disabled (`gain_calibration_time` 0).
+    /// disabled (`gain_calibration.time` 0).
     pub fn calibrate_gain(&mut self) {
         self.gain.arm();
     }
@@ -141,7 +141,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
     }
 
     /// (Re)starts the current-sensor offset calibration: for the next
-    /// `offset_calibration_time` the samples run with the gates off (the machine must be at
+    /// `offset_calibration.time` the samples run with the gates off (the machine must be at
     /// rest, so that the true current is zero) and average the raw phase currents; then the
     /// drive re-aligns at the angle of the last [`align`](Self::align) and starts.
     pub fn calibrate_offsets(&mut self) {
@@ -248,7 +248,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         self.rejected_samples
     }
 
-    /// Recoveries from a lost rotor started since the last reset (`lock_reaction` recover).
+    /// Recoveries from a lost rotor started since the last reset (`lock.reaction` recover).
     pub fn lock_recoveries(&self) -> u32 {
         self.lock.attempts()
     }

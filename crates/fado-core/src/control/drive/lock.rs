@@ -1,4 +1,4 @@
-//! The drive's reaction to a lost rotor (see `lock_reaction`): the stall symptom, the
+//! The drive's reaction to a lost rotor (see `lock.reaction`): the stall symptom, the
 //! supervisor's action and the reason the drive coasts.
 
 use super::{DriveOutput, SensorlessDrive};
@@ -21,10 +21,10 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         let diag = &estimate.diagnostics;
         let stalled = self.stall_symptom(estimate, speed_ref);
         let estimate_lost = diag.lock == LockStatus::Lost;
-        let lost = estimate_lost || (stalled && self.config.tuning.lock_reaction_on_stall);
+        let lost = estimate_lost || (stalled && self.config.tuning.lock.reaction_on_stall);
         let healthy = diag.lock == LockStatus::Locked && diag.mode == Mode::DisturbanceFeedback;
         let action = self.lock.step(lost, healthy);
-        if lost && self.config.tuning.lock_reaction == LockReaction::Adapt {
+        if lost && self.config.tuning.lock.reaction == LockReaction::Adapt {
             self.estimator.enable_rs_adaptation();
         }
         match action {
@@ -36,7 +36,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             LockAction::Rearm => {
                 self.estimator.rearm_lock_detector();
                 self.stall.reset();
-                if self.config.tuning.lock_recovery_rs_adaptation {
+                if self.config.tuning.lock.recovery_rs_adaptation {
                     self.estimator.enable_rs_adaptation();
                 }
             }
@@ -68,16 +68,16 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
     /// The stall symptom, debounced: whether the drive counts as stalled now.
     ///
     /// In limiter mode (or in k_df mode just above its threshold,
-    /// `DriveTuning::lock_stall_kdf_speed_ratio`, off by default) the speed loop loses a
+    /// `StallTuning::kdf_speed_ratio`, off by default) the speed loop loses a
     /// reference it had caught by more than the band (the larger of a fraction of the rated
-    /// speed and the speed error of the commanded torque, `lock_stall_torque_band_ratio`)
+    /// speed and the speed error of the commanded torque, `stall.torque_band_ratio`)
     /// (armed once |ω* − ω̂| was within the band since the last start), although its current
     /// reference is below the limit (at the limit, a speed error is the machine's torque
     /// limit, not evidence against the estimate; within 1 % counts as at the limit) and it
-    /// asks for a torque (see `DriveTuning::lock_stall_min_current_ratio`), while ω̂ is near
-    /// zero or turns against ω* (`DriveTuning::lock_stall_max_speed_ratio`; off by default),
+    /// asks for a torque (see `StallTuning::min_current_ratio`), while ω̂ is near
+    /// zero or turns against ω* (`StallTuning::max_speed_ratio`; off by default),
     /// and unless the estimated rotor answers the torque: it turns in the direction of the
-    /// speed error beyond the band and accelerates in it (`DriveTuning::lock_stall_follow_time`).
+    /// speed error beyond the band and accelerates in it (`StallTuning::follow_time`).
     #[inline(always)]
     fn stall_symptom(&mut self, estimate: &Estimate<T>, speed_ref: T) -> bool {
         let omega_ctrl = estimate.omega_control;

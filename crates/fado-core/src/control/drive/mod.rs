@@ -3,7 +3,7 @@
 //!
 //! Order of operations at sample n (docs/method/estimator.md §1, §5):
 //!
-//! 1. Reject non-finite inputs (trip after `input_fault_trip_time` of them in a row); remove
+//! 1. Reject non-finite inputs (trip after `protection.input_fault_trip_time` of them in a row); remove
 //!    the calibrated offsets; trip (gates off, latched) when a phase current exceeds the trip
 //!    level; divide phase a by the calibrated gain ratio (see
 //!    [`gain_calibration`](crate::control::gain_calibration); while that calibration runs, its
@@ -40,7 +40,7 @@ mod saturation;
 mod standstill;
 mod step;
 pub mod tracker_feedforward;
-mod tuning;
+pub mod tuning;
 
 pub use config::DriveConfig;
 pub(crate) use config::swing_time_constant;
@@ -67,7 +67,7 @@ use crate::injection::CurrentInjection;
 use crate::lock::Debouncer;
 use crate::{Ab, Abc, Dq, Real};
 
-/// Default of [`DriveTuning::lock_stall_torque_band_ratio`]: 1 − cos(0.25 rad), the torque
+/// Default of [`StallTuning::torque_band_ratio`](crate::control::tuning::StallTuning::torque_band_ratio): 1 − cos(0.25 rad), the torque
 /// deficit of an estimate 0.25 rad off (the largest angle error of a clean run).
 const STALL_TORQUE_BAND_RATIO: f64 = 0.031_087_578_289_355_3;
 
@@ -101,7 +101,7 @@ struct Resolved<T: 'static> {
 }
 
 /// The stall symptom's thresholds in absolute units (see
-/// `DriveTuning::lock_stall_speed_ratio`).
+/// `StallTuning::speed_ratio`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct StallResolved<T> {
     /// Speed error (electrical rad/s) in limiter mode, and samples in a row
@@ -118,7 +118,7 @@ struct StallResolved<T> {
     min_current: T,
     /// ... or beyond this multiple of the band (∞: the current gate always applies).
     gross_ratio: T,
-    /// Per-sample gain 1 − exp(−Ts/τ) of the ω̂ low-pass of `lock_stall_follow_time` (0: the
+    /// Per-sample gain 1 − exp(−Ts/τ) of the ω̂ low-pass of `stall.follow_time` (0: the
     /// "answers the torque" exception is off).
     follow_gain: T,
     /// The exception holds from this |i_q*| on (A).
@@ -127,10 +127,10 @@ struct StallResolved<T> {
     /// times τ.
     follow_lead: T,
     /// Band widening per unit of (λ̂f + (L̂d − L̂q)·i_d*)·i_q* (electrical rad/s per Wb·A): the
-    /// torque ratio of `lock_stall_torque_band_ratio` times 1.5·p (torque) times p (electrical
+    /// torque ratio of `stall.torque_band_ratio` times 1.5·p (torque) times p (electrical
     /// speed) over Ĵ·ω_s.
     torque_band: T,
-    /// The same for `lock_stall_reluctance_band_ratio`, per unit of (L̂d − L̂q)·i_d*·i_q*
+    /// The same for `stall.reluctance_band_ratio`, per unit of (L̂d − L̂q)·i_d*·i_q*
     /// (Wb·A).
     reluctance_band: T,
 }
@@ -225,14 +225,14 @@ pub struct SensorlessDrive<T: 'static, E = SensorlessEstimator<T>> {
     i_ab_used: Ab<T>,
     /// Reaction to a lost rotor.
     lock: LockSupervisor,
-    /// The stall symptom (see `DriveTuning::lock_stall_speed_ratio`) as a live status (heals
+    /// The stall symptom (see `StallTuning::speed_ratio`) as a live status (heals
     /// like the estimator's; cleared by `align`, `reset`, a recovery's re-arming).
     stall: Debouncer,
     stall_armed: bool,
     /// Why the drive coasts (`LOCK_LOST`, `STALLED` or both): the symptoms up when the
     /// reaction started, kept while it coasts.
     coast_reason: DriveFlags,
-    /// ω̂ low-passed with `DriveTuning::lock_stall_follow_time` (electrical rad/s).
+    /// ω̂ low-passed with `StallTuning::follow_time` (electrical rad/s).
     omega_slow: T,
     /// This sample was refused as implausible.
     implausible_now: bool,

@@ -5,7 +5,7 @@ use super::{DriveConfig, Resolved, StallResolved};
 use crate::Real;
 use crate::error::{ConfigError, check};
 
-/// Largest `current_limit_ratio`: 5 (a drive's short-time overload is 1.5–3 × the rated
+/// Largest `current.limit_ratio`: 5 (a drive's short-time overload is 1.5–3 × the rated
 /// current; above 5 the limit is a typo, and the trip level above it would be refused in its
 /// stead).
 const MAX_CURRENT_LIMIT_RATIO: f64 = 5.0;
@@ -30,32 +30,40 @@ impl<T: Real> Resolved<T> {
         Ok(Self {
             i_max: check::below(
                 "current_limit_ratio",
-                check::positive("current_limit_ratio", t.current_limit_ratio)?,
+                check::positive("current_limit_ratio", t.current.limit_ratio)?,
                 T::lit(MAX_CURRENT_LIMIT_RATIO),
                 "at most 5 × the rated current (drives' short-time overload is 1.5–3×)",
             )? * rated,
-            i_min: check::non_negative("injection_current_ratio", t.injection_current_ratio)?
+            i_min: check::non_negative("injection_current_ratio", t.injection.current_ratio)?
                 * rated,
-            trip_current: check::positive("trip_current_ratio", t.trip_current_ratio)? * rated,
-            current_error_limit: check::positive("current_error_ratio", t.current_error_ratio)?
+            trip_current: check::positive("trip_current_ratio", t.protection.trip_current_ratio)?
                 * rated,
+            current_error_limit: check::positive(
+                "current_error_ratio",
+                t.protection.current_error_ratio,
+            )? * rated,
             dc_link_min_voltage: check::below(
                 "dc_link_min_ratio",
-                check::non_negative("dc_link_min_ratio", t.dc_link_min_ratio)?,
+                check::non_negative("dc_link_min_ratio", t.protection.dc_link_min_ratio)?,
                 T::one(),
                 "below 1 (a fraction of the nominal DC link: at or above it the warning never clears)",
             )? * c.machine.dc_voltage,
             offset_calibration_samples: samples(
                 "offset_calibration_time",
-                t.offset_calibration_time,
+                t.offset_calibration.time,
             )?,
-            stuck_sensor_samples: samples("stuck_sensor_time", t.stuck_sensor_time)?,
-            current_error_samples: samples("current_error_time", t.current_error_time)?,
-            input_fault_trip_samples: samples("input_fault_trip_time", t.input_fault_trip_time)?,
+            stuck_sensor_samples: samples("stuck_sensor_time", t.stuck_sensor.time)?,
+            current_error_samples: samples("current_error_time", t.protection.current_error_time)?,
+            input_fault_trip_samples: samples(
+                "input_fault_trip_time",
+                t.protection.input_fault_trip_time,
+            )?,
             stall: StallResolved::new(c, samples)?,
-            plausible_current: t.plausible_current_ratio * t.trip_current_ratio * rated,
-            dc_link_max_voltage: t.dc_link_max_ratio * c.machine.dc_voltage,
-            mtpa: t.mtpa && c.machine.is_salient(),
+            plausible_current: t.plausibility.current_ratio
+                * t.protection.trip_current_ratio
+                * rated,
+            dc_link_max_voltage: t.plausibility.dc_link_ratio * c.machine.dc_voltage,
+            mtpa: t.mtpa.enabled && c.machine.is_salient(),
             salient: c.machine.is_salient(),
             saturated: c.saturated_references(),
         })
@@ -76,62 +84,54 @@ impl<T: Real> StallResolved<T> {
         let torque_band = |field: &'static str, ratio: T| -> Result<T, ConfigError> {
             Ok(check::non_negative(field, ratio)?
                 * T::lit(1.5 * (c.machine.pole_pairs as f64) * (c.machine.pole_pairs as f64))
-                / (c.machine.inertia * T::lit(core::f64::consts::TAU) * t.speed_bandwidth_hz))
+                / (c.machine.inertia * T::lit(core::f64::consts::TAU) * t.speed.bandwidth_hz))
         };
         Ok(Self {
-            speed: check::non_negative("lock_stall_speed_ratio", t.lock_stall_speed_ratio)?
+            speed: check::non_negative("lock_stall_speed_ratio", t.stall.speed_ratio)?
                 * c.machine.rated_speed(),
-            samples: if t.lock_stall_speed_ratio > T::zero() {
-                samples("lock_stall_time", t.lock_stall_time)?.max(1)
+            samples: if t.stall.speed_ratio > T::zero() {
+                samples("lock_stall_time", t.stall.time)?.max(1)
             } else {
                 0
             },
-            heal_samples: samples("lock_stall_heal_time", t.lock_stall_heal_time)?,
+            heal_samples: samples("lock_stall_heal_time", t.stall.heal_time)?,
             max_speed: match check::non_negative(
                 "lock_stall_max_speed_ratio",
-                t.lock_stall_max_speed_ratio,
+                t.stall.max_speed_ratio,
             )? {
                 r if r == T::zero() => T::lit(f64::INFINITY),
                 r => r * c.machine.rated_speed(),
             },
-            kdf_band: check::non_negative(
-                "lock_stall_kdf_speed_ratio",
-                t.lock_stall_kdf_speed_ratio,
-            )? * c.machine.rated_speed(),
+            kdf_band: check::non_negative("lock_stall_kdf_speed_ratio", t.stall.kdf_speed_ratio)?
+                * c.machine.rated_speed(),
             min_current: check::non_negative(
                 "lock_stall_min_current_ratio",
-                t.lock_stall_min_current_ratio,
+                t.stall.min_current_ratio,
             )? * rated,
             gross_ratio: match check::non_negative(
                 "lock_stall_gross_error_ratio",
-                t.lock_stall_gross_error_ratio,
+                t.stall.gross_error_ratio,
             )? {
                 k if k == T::zero() => T::lit(f64::INFINITY),
                 k => k,
             },
-            follow_gain: match check::non_negative(
-                "lock_stall_follow_time",
-                t.lock_stall_follow_time,
-            )? {
+            follow_gain: match check::non_negative("lock_stall_follow_time", t.stall.follow_time)? {
                 tau if tau == T::zero() => T::zero(),
                 tau => T::one() - (-c.ts / tau).exp(),
             },
             follow_min_current: check::non_negative(
                 "lock_stall_follow_min_current_ratio",
-                t.lock_stall_follow_min_current_ratio,
+                t.stall.follow_min_current_ratio,
             )? * rated,
             follow_lead: check::non_negative(
                 "lock_stall_follow_accel_ratio",
-                t.lock_stall_follow_accel_ratio,
+                t.stall.follow_accel_ratio,
             )? * c.machine.rated_speed()
-                * check::non_negative("lock_stall_follow_time", t.lock_stall_follow_time)?,
-            torque_band: torque_band(
-                "lock_stall_torque_band_ratio",
-                t.lock_stall_torque_band_ratio,
-            )?,
+                * check::non_negative("lock_stall_follow_time", t.stall.follow_time)?,
+            torque_band: torque_band("lock_stall_torque_band_ratio", t.stall.torque_band_ratio)?,
             reluctance_band: torque_band(
                 "lock_stall_reluctance_band_ratio",
-                t.lock_stall_reluctance_band_ratio,
+                t.stall.reluctance_band_ratio,
             )?,
         })
     }

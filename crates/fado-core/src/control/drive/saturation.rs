@@ -20,7 +20,7 @@ impl<T: Real> DriveConfig<T> {
     /// [`SpeedControllerConfig::torque_limit`] for constant inductances.
     pub(super) fn speed_torque_limit(&self, mtpa: bool) -> T {
         let m = &self.machine;
-        let i_max = self.tuning.current_limit_ratio * m.rated_current;
+        let i_max = self.tuning.current.limit_ratio * m.rated_current;
         match self.saturated_references() {
             Some(s) if mtpa => s.torque_limit(i_max, m.flux_linkage),
             Some(s) => s.torque_flux(Dq::new(T::zero(), i_max)) / m.flux_linkage,
@@ -52,7 +52,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
     ) -> Dq<T> {
         let m = &self.config.machine;
         let injection = &self.blocks.injection;
-        let mtpa = self.config.tuning.mtpa;
+        let mtpa = self.config.tuning.mtpa.enabled;
         let id_of = |iq: T| {
             let id = injection.step(iq) + probe_id;
             if mtpa { id + s.mtpa_id(iq) } else { id }

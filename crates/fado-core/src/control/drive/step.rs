@@ -23,7 +23,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
     /// Every output carries the status word [`DriveOutput::flags`]; the drive also counts the
     /// samples each flag was raised ([`flag_counts`](Self::flag_counts)). A stuck
     /// phase-current channel (see [`StuckChannelDetector`](crate::control::monitor::StuckChannelDetector)) is replaced by its reconstruction
-    /// while it lasts; rejected samples for `input_fault_trip_time` in a row trip the drive.
+    /// while it lasts; rejected samples for `protection.input_fault_trip_time` in a row trip the drive.
     pub fn step(&mut self, i_abc: Abc<T>, vdc: T, speed_ref_mech: T) -> DriveOutput<T> {
         let mut out = self.step_control(i_abc, vdc, speed_ref_mech);
         if out.input_fault && !out.tripped {
@@ -117,7 +117,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         self.current_error_now = self
             .current_error
             .step(tracking_error > self.resolved.current_error_limit);
-        // Reaction to a lost rotor (see `lock_reaction`).
+        // Reaction to a lost rotor (see `lock.reaction`).
         let speed_ref = speed_ref_mech * T::lit(self.config.machine.pole_pairs as f64);
         let speed_ref = self.blocks.limits.speed(speed_ref);
         let action = self.react_to_lock(&estimate, speed_ref)?;
@@ -258,7 +258,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
     #[inline(always)]
     fn estimate(&mut self, i_ab: Ab<T>) -> Result<Estimate<T>, DriveOutput<T>> {
         self.i_ab_used = i_ab;
-        if self.config.tuning.acceleration_feedforward {
+        if self.config.tuning.tracker_feedforward.enabled {
             let m = &self.config.machine;
             let p = T::lit(m.pole_pairs as f64);
             let torque = self.feedforward_torque(p);

@@ -10,9 +10,9 @@
 //! a throttle step loses the rotor (measured on `motors/multirotor-mn5006-22v.toml`, 0 → 6000
 //! r/min at the current limit: 2.1 rad; with the feed-forward 0.09 rad).
 //!
-//! **Rule.** Where the lag α/Ki at the current limit (T_max = min(`current_limit_ratio`,
+//! **Rule.** Where the lag α/Ki at the current limit (T_max = min(`current.limit_ratio`,
 //! `limits.torque_ratio`)·T_rated, Ki of T2S-1) exceeds [`TrackerFeedforwardTuning::max_lag`],
-//! the drive turns on its acceleration feed-forward (`DriveTuning::acceleration_feedforward`)
+//! the drive turns on its acceleration feed-forward (`TrackerFeedforwardTuning::enabled`)
 //! and gives the trackers their load integrator (`EstimatorTuning::tracker.load_pole_ratio`
 //! [`LOAD_POLE_RATIO`] where the tuning leaves it at 0): without it the load the model does not
 //! know would leave p·T_L/(Ĵ·Ki) of angle error. A tuning that turns them on itself is kept.
@@ -74,6 +74,12 @@ pub const MAX_KP_TS: f64 = 0.25;
     )
 )]
 pub struct TrackerFeedforwardTuning<T> {
+    /// Give the estimator's speed trackers the acceleration the commanded torque causes,
+    /// p·T*/Ĵ (a mechanical-model feed-forward, see [`crate::tracker`]); use with the
+    /// estimator's `tracker.load_pole_ratio` > 0, whose third integrator takes up the load.
+    /// Default false (the paper's trackers) \[A\]; the drive turns it on itself on a rotor its
+    /// trackers would lag by more than `max_lag` (the module docs).
+    pub enabled: bool,
     /// Largest angle lag (rad) of the type-2 T2S-1 behind an acceleration at the current limit
     /// that the drive leaves without feed-forward. Default 2 rad \[A\]: the multirotor preset
     /// (2.4 rad) and the cheetah outrunner (3.0 rad) need the feed-forward; a 750 W 10-pole
@@ -95,6 +101,7 @@ pub struct TrackerFeedforwardTuning<T> {
 impl<T: Real> Default for TrackerFeedforwardTuning<T> {
     fn default() -> Self {
         Self {
+            enabled: false,
             max_lag: T::lit(2.0),
             load_step_error: T::lit(0.15),
         }
@@ -105,6 +112,7 @@ impl<T: Real> TrackerFeedforwardTuning<T> {
     /// The same tuning in another scalar type.
     pub fn cast<U: Real>(&self) -> TrackerFeedforwardTuning<U> {
         TrackerFeedforwardTuning {
+            enabled: self.enabled,
             max_lag: U::lit(self.max_lag.to_f64()),
             load_step_error: U::lit(self.load_step_error.to_f64()),
         }
@@ -188,7 +196,7 @@ pub fn current_limit_lag<T: Real>(
     ts: T,
 ) -> T {
     let (_, ki) = tracker_gains(estimator, estimator.tracker.t2s1_bandwidth_hz, ts);
-    let ratio = crate::real::min(drive.current_limit_ratio, drive.limits.torque_ratio);
+    let ratio = crate::real::min(drive.current.limit_ratio, drive.limits.torque_ratio);
     let p = T::lit(machine.pole_pairs as f64);
     p * ratio * machine.rated_torque / (machine.inertia * ki)
 }
@@ -202,12 +210,12 @@ pub fn apply<T: Real>(
 ) {
     // NaN compares false: no feed-forward.
     if current_limit_lag(machine, drive, estimator, ts) > drive.tracker_feedforward.max_lag {
-        drive.acceleration_feedforward = true;
+        drive.tracker_feedforward.enabled = true;
         if estimator.tracker.load_pole_ratio == T::zero() {
             estimator.tracker.load_pole_ratio = T::lit(LOAD_POLE_RATIO);
         }
     }
-    if drive.acceleration_feedforward && estimator.tracker.load_pole_ratio > T::zero() {
+    if drive.tracker_feedforward.enabled && estimator.tracker.load_pole_ratio > T::zero() {
         let running = load_step_bandwidth(machine, drive, estimator, ts);
         if running != estimator.tracker.t2s1_bandwidth_hz {
             estimator.tracker.t2s1_running_bandwidth_hz = running;
@@ -239,7 +247,7 @@ mod tests {
         let lag = current_limit_lag(&m, &d, &e, 100e-6);
         assert!((lag - 0.21).abs() < 0.01, "{lag}");
         let (d2, e2) = resolve(&m, d, e, 100e-6);
-        assert!(!d2.acceleration_feedforward && e2.tracker.load_pole_ratio == 0.0);
+        assert!(!d2.tracker_feedforward.enabled && e2.tracker.load_pole_ratio == 0.0);
         assert_eq!((d2, e2), (d, e));
         // A 14-pole-pair multirotor motor with its propeller: 2.4 rad, feed-forward on.
         let fast = MachineModel {
@@ -254,7 +262,7 @@ mod tests {
         let lag = current_limit_lag(&fast, &d, &e, 25e-6);
         assert!((lag - 2.4).abs() < 0.05, "{lag}");
         let (d2, e2) = resolve(&fast, d, e, 25e-6);
-        assert!(d2.acceleration_feedforward);
+        assert!(d2.tracker_feedforward.enabled);
         assert_eq!(e2.tracker.load_pole_ratio, LOAD_POLE_RATIO);
         // A tuning's own load pole is kept; an infinite threshold keeps the paper's trackers.
         let mut own = e;
@@ -262,7 +270,7 @@ mod tests {
         assert_eq!(resolve(&fast, d, own, 25e-6).1.tracker.load_pole_ratio, 0.3);
         let mut off = d;
         off.tracker_feedforward.max_lag = 1e9;
-        assert!(!resolve(&fast, off, e, 25e-6).0.acceleration_feedforward);
+        assert!(!resolve(&fast, off, e, 25e-6).0.tracker_feedforward.enabled);
     }
 
     #[test]
@@ -318,7 +326,7 @@ mod tests {
             EstimatorTuning::default(),
             ts,
         );
-        assert!(d.acceleration_feedforward);
+        assert!(d.tracker_feedforward.enabled);
         let bw = e.tracker.t2s1_running_bandwidth_hz;
         assert!((bw - 141.0).abs() < 2.0, "{bw}");
         assert_eq!(e.tracker.t2s1_bandwidth_hz, 60.0);
@@ -333,10 +341,8 @@ mod tests {
         assert!(err60 > 0.8, "{err60}");
         // The paper's motor with the feed-forward on keeps its 60 Hz to the bit (its rated
         // step peaks at 0.057 rad), and without the feed-forward nothing changes.
-        let on = DriveTuning {
-            acceleration_feedforward: true,
-            ..DriveTuning::default()
-        };
+        let mut on = DriveTuning::default();
+        on.tracker_feedforward.enabled = true;
         let mut e3 = EstimatorTuning::default();
         e3.tracker.load_pole_ratio = LOAD_POLE_RATIO;
         let paper = MachineModel::<f64>::paper();

@@ -3,25 +3,11 @@
 
 use crate::Real;
 use crate::plausibility;
+use crate::real::cast_record;
 use crate::tracker::{self, BandwidthDefinition};
 use crate::{flux, integrand_offset, mode, rs_adaptation};
 
 use super::super::OBSERVER_GAIN_PERIOD;
-
-/// `impl cast` for a tuning record: every real field rounded to `U`, the others copied.
-macro_rules! cast_record {
-    ($name:ident { $($real:ident),* ; $($copy:ident),* }) => {
-        impl<T: Real> $name<T> {
-            /// The same record in another precision: every real rounded to `U`.
-            pub fn cast<U: Real>(&self) -> $name<U> {
-                $name {
-                    $($real: U::lit(self.$real.to_f64()),)*
-                    $($copy: self.$copy,)*
-                }
-            }
-        }
-    };
-}
 
 /// Tuning of the flux integrator (eq. (3)) (`[estimator.integrator]`).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -159,7 +145,7 @@ pub struct TrackerTuning<T> {
     pub hold_ratio: T,
     /// The trackers' third (load-acceleration) integrator, as the ratio c of its real pole
     /// to ωn (see [`crate::tracker`], "Acceleration feed-forward"). Default 0: the paper's
-    /// type-2 trackers; 0.5 \[A\] with the drive's `acceleration_feedforward` (the range
+    /// type-2 trackers; 0.5 \[A\] with the drive's `tracker_feedforward.enabled` (the range
     /// scenarios: a load pole at half ωn, 8 Hz on T2S-2's 35 Hz, settles a rated load step
     /// within 0.1 rad on the paper's motor, docs/range.md).
     pub load_pole_ratio: T,

@@ -1,0 +1,66 @@
+//! The values the drive's build-time rules set in its tuning, shown by `--dump-config` as
+//! derived keys beside the rule: what the drive runs with, not only what the file says.
+
+use super::SimConfig;
+use crate::derive::Derived;
+
+/// The rule of `fado_core::control::tracker_feedforward` in words, beside the keys it sets.
+const FEEDFORWARD_RULE: &str = "on where the type-2 T2S-1 would lag the acceleration at the \
+    current limit by more than `[controller.tracker_feedforward] max_lag` \
+    (fado_core::control::tracker_feedforward)";
+
+/// The same rule's load integrator of the trackers, where the tuning leaves it at 0.
+const LOAD_POLE_RULE: &str = "0.5 with the acceleration feed-forward the drive turns on \
+    itself (fado_core::control::tracker_feedforward)";
+
+/// The same rule's running bandwidth of T2S-1 on a light rotor.
+const BANDWIDTH_RULE: &str = "T2S-1's bandwidth in k_df mode at which a step of the rated \
+    torque peaks at `[controller.tracker_feedforward] load_step_error` \
+    (fado_core::control::tracker_feedforward)";
+
+/// `cfg` with the values the drive's build-time rule sets in its tuning (the acceleration
+/// feed-forward, the trackers' load pole and T2S-1's running bandwidth of
+/// `fado_core::control::tracker_feedforward`), each recorded as derived: what the drive runs
+/// with, as `--dump-config` shows it.
+pub(crate) fn with_drive_rules(cfg: &SimConfig) -> SimConfig {
+    let mut c = cfg.clone();
+    let drive = c.drive_config();
+    let (mut tuning, mut estimator) = (drive.tuning, c.estimator);
+    fado_core::control::tracker_feedforward::apply(
+        &drive.machine,
+        &mut tuning,
+        &mut estimator,
+        drive.ts,
+    );
+    let mut derive = |key: &str, value: f64, rule: &'static str| {
+        c.derived.retain(|d| d.key != key);
+        c.derived.push(Derived {
+            key: key.to_owned(),
+            value,
+            rule,
+        });
+    };
+    if tuning.tracker_feedforward.enabled != c.controller.tracker_feedforward.enabled {
+        derive(
+            "controller.tracker_feedforward.enabled",
+            1.0,
+            FEEDFORWARD_RULE,
+        );
+        c.controller.tracker_feedforward.enabled = true;
+    }
+    let pole = estimator.tracker.load_pole_ratio;
+    if pole != c.estimator.tracker.load_pole_ratio {
+        derive("estimator.tracker.load_pole_ratio", pole, LOAD_POLE_RULE);
+        c.estimator.tracker.load_pole_ratio = pole;
+    }
+    let bandwidth = estimator.tracker.t2s1_running_bandwidth_hz;
+    if bandwidth != c.estimator.tracker.t2s1_running_bandwidth_hz {
+        derive(
+            "estimator.tracker.t2s1_running_bandwidth_hz",
+            bandwidth,
+            BANDWIDTH_RULE,
+        );
+        c.estimator.tracker.t2s1_running_bandwidth_hz = bandwidth;
+    }
+    c
+}
