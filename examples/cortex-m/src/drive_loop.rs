@@ -160,7 +160,9 @@ impl DriveApp {
             inertia: model.inertia,
             friction: model.viscous_friction,
             vdc: model.dc_voltage,
-            dead_time_error: t.inverter.dead_time * t.inverter.switching_frequency * model.dc_voltage
+            dead_time_error: t.inverter.dead_time
+                * t.inverter.switching_frequency
+                * model.dc_voltage
                 + t.inverter.threshold_voltage,
             band: t.inverter.current_band,
         };
