@@ -45,7 +45,7 @@ fn standstill(motor: &str, extra: &str) -> (f64, bool) {
 fn loaded_standstill_and_departure_hold_the_angle_on_interior_magnet_rotors() {
     for (file, motor) in [("ipmsm-gem-50k", GEM_50K), ("pmsyrm-5k", PMSYRM_5K)] {
         let (with, tripped) = standstill(motor, "");
-        let (without, _) = standstill(motor, "[controller]\nstandstill_probe = false\n");
+        let (without, _) = standstill(motor, "[controller.standstill_probe]\nenabled = false\n");
         println!("{file}: {with:.3} rad (without the standstill handling {without:.3})");
         assert!(with < 0.25 && !tripped, "{file}: {with} rad");
         assert!(
