@@ -26,6 +26,7 @@
 use crate::Real;
 use crate::error::{ConfigError, check};
 use crate::machine::MachineModel;
+use crate::real::cast_record;
 
 /// `[controller.field_weakening]`: the voltage-margin loop.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -68,17 +69,7 @@ impl<T: Real> Default for FieldWeakeningTuning<T> {
     }
 }
 
-impl<T: Real> FieldWeakeningTuning<T> {
-    /// The same tuning in another scalar type.
-    pub fn cast<U: Real>(&self) -> FieldWeakeningTuning<U> {
-        FieldWeakeningTuning {
-            enabled: self.enabled,
-            voltage_margin: U::lit(self.voltage_margin.to_f64()),
-            bandwidth_hz: U::lit(self.bandwidth_hz.to_f64()),
-            mtpv: self.mtpv,
-        }
-    }
-}
+cast_record!(FieldWeakeningTuning { voltage_margin, bandwidth_hz ; enabled, mtpv });
 
 /// The field-weakening loop's state.
 #[derive(Clone, Copy, Debug, PartialEq)]

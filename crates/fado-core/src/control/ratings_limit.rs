@@ -21,6 +21,7 @@
 use crate::Real;
 use crate::error::{ConfigError, check};
 use crate::machine::MachineModel;
+use crate::real::cast_record;
 
 /// `[controller.limits]`: the drive's speed, torque and power limits as multiples of the
 /// motor's ratings.
@@ -57,16 +58,7 @@ impl<T: Real> Default for RatingsLimitTuning<T> {
     }
 }
 
-impl<T: Real> RatingsLimitTuning<T> {
-    /// The same tuning in another scalar type.
-    pub fn cast<U: Real>(&self) -> RatingsLimitTuning<U> {
-        RatingsLimitTuning {
-            speed_ratio: U::lit(self.speed_ratio.to_f64()),
-            torque_ratio: U::lit(self.torque_ratio.to_f64()),
-            power_ratio: U::lit(self.power_ratio.to_f64()),
-        }
-    }
-}
+cast_record!(RatingsLimitTuning { speed_ratio, torque_ratio, power_ratio ;  });
 
 /// The limits resolved in the drive's units (stateless).
 #[derive(Clone, Copy, Debug, PartialEq)]

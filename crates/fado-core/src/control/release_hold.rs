@@ -38,6 +38,7 @@
 //! there.
 
 use crate::error::{ConfigError, check};
+use crate::real::cast_record;
 use crate::{MachineModel, Real};
 
 /// `[controller.release_hold]`: the release hold's settings (module docs).
@@ -84,17 +85,7 @@ impl<T: Real> Default for ReleaseHoldTuning<T> {
     }
 }
 
-impl<T: Real> ReleaseHoldTuning<T> {
-    /// The same tuning in another scalar type.
-    pub fn cast<U: Real>(&self) -> ReleaseHoldTuning<U> {
-        ReleaseHoldTuning {
-            enabled: self.enabled,
-            travel: U::lit(self.travel.to_f64()),
-            trigger: U::lit(self.trigger.to_f64()),
-            window: U::lit(self.window.to_f64()),
-        }
-    }
-}
+cast_record!(ReleaseHoldTuning { travel, trigger, window ; enabled });
 
 /// Peak of t²·e^(−t)/2 (at t = 2): the largest travel of the triple-pole loop per a/ω_h².
 const PEAK_TRAVEL: f64 = 0.270_670_566_473_225_4;

@@ -38,6 +38,7 @@ use crate::control::initial_angle::{
 };
 use crate::error::{ConfigError, check};
 use crate::magnetics::MagneticModel;
+use crate::real::cast_record;
 use crate::{Ab, Dq, MachineModel, Real};
 
 /// Pulse pairs per direction of the polarity test (the relative difference of the two sums
@@ -119,20 +120,6 @@ impl<T: Real> Default for StartupTuning<T> {
 }
 
 impl<T: Real> StartupTuning<T> {
-    /// The same tuning in another scalar type.
-    pub fn cast<U: Real>(&self) -> StartupTuning<U> {
-        StartupTuning {
-            find_angle: self.find_angle,
-            pulse_current_ratio: U::lit(self.pulse_current_ratio.to_f64()),
-            pulse_voltage_ratio: U::lit(self.pulse_voltage_ratio.to_f64()),
-            polarity_current_ratio: U::lit(self.polarity_current_ratio.to_f64()),
-            free_rotor_align: self.free_rotor_align,
-            rotor_held: self.rotor_held,
-            align_current_ratio: U::lit(self.align_current_ratio.to_f64()),
-            align_time: U::lit(self.align_time.to_f64()),
-        }
-    }
-
     /// Checks every field; the error names the first bad one.
     pub fn validate(&self) -> Result<(), ConfigError> {
         check::positive("startup.pulse_current_ratio", self.pulse_current_ratio)?;
@@ -151,6 +138,11 @@ impl<T: Real> StartupTuning<T> {
         Ok(())
     }
 }
+
+cast_record!(StartupTuning {
+    pulse_current_ratio, pulse_voltage_ratio, polarity_current_ratio, align_current_ratio,
+    align_time ; find_angle, free_rotor_align, rotor_held
+});
 
 /// Whether the drive's magnetic model meets a larger incremental d inductance along +d (with
 /// the magnet) than along −d over the pulse's path from 0 to `current`: then the faster rise

@@ -48,6 +48,7 @@ use crate::Real;
 use crate::control::DriveTuning;
 use crate::estimator::EstimatorTuning;
 use crate::machine::MachineModel;
+use crate::real::cast_record;
 use crate::tracker::TrackerConfig;
 
 /// Load-integrator pole of the trackers the rule turns on, as a ratio of ωn: 0.5 \[A\] (the
@@ -108,16 +109,7 @@ impl<T: Real> Default for TrackerFeedforwardTuning<T> {
     }
 }
 
-impl<T: Real> TrackerFeedforwardTuning<T> {
-    /// The same tuning in another scalar type.
-    pub fn cast<U: Real>(&self) -> TrackerFeedforwardTuning<U> {
-        TrackerFeedforwardTuning {
-            enabled: self.enabled,
-            max_lag: U::lit(self.max_lag.to_f64()),
-            load_step_error: U::lit(self.load_step_error.to_f64()),
-        }
-    }
-}
+cast_record!(TrackerFeedforwardTuning { max_lag, load_step_error ; enabled });
 
 /// κ(ζ, c): the peak phase error of a tracker with poles (s² + 2ζ·s + 1)(s + c), ωn = 1,
 /// after a unit step of unannounced acceleration, i.e. the peak of the impulse response of
