@@ -70,6 +70,18 @@ pub fn validate_motor(motor: &MotorParams, dc_voltage: f64) -> Result<(), SimCon
         .map_err(|e| SimConfigError::new(e.field(), e.to_string()))
 }
 
+/// [`validate_motor`] with the error's key in its configuration section: `motor.<key>`, or
+/// `inverter.dc_voltage` for the bus voltage.
+pub fn validate_motor_section(motor: &MotorParams, dc_voltage: f64) -> Result<(), SimConfigError> {
+    validate_motor(motor, dc_voltage).map_err(|e| {
+        if e.key == "dc_voltage" {
+            SimConfigError::new("inverter.dc_voltage", e.message)
+        } else {
+            e.in_section("motor")
+        }
+    })
+}
+
 /// The true machine state (evaluation only: the drive never reads it).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct MotorState {

@@ -205,13 +205,7 @@ impl SimConfig {
         if let Some(im) = &self.inverter_model {
             im.validate().map_err(|e| e.in_section("inverter_model"))?;
         }
-        crate::motor::validate_motor(&self.motor, self.inverter.dc_voltage).map_err(|e| {
-            if e.key == "dc_voltage" {
-                SimConfigError::new("inverter.dc_voltage", e.message)
-            } else {
-                e.in_section("motor")
-            }
-        })?;
+        crate::motor::validate_motor_section(&self.motor, self.inverter.dc_voltage)?;
         let ts = self.inverter.sample_period();
         check_time_constant(&self.motor, ts, |k| format!("motor.{k}"))?;
         let model = self.model_checked()?;

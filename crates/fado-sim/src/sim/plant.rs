@@ -59,13 +59,7 @@ impl Default for PlantParams {
 impl PlantParams {
     /// Checks every record; the error names the key as `section.field`.
     pub fn validate(&self) -> Result<(), SimConfigError> {
-        crate::motor::validate_motor(&self.motor, self.inverter.dc_voltage).map_err(|e| {
-            if e.key == "dc_voltage" {
-                SimConfigError::new("inverter.dc_voltage", e.message)
-            } else {
-                e.in_section("motor")
-            }
-        })?;
+        crate::motor::validate_motor_section(&self.motor, self.inverter.dc_voltage)?;
         self.inverter
             .validate()
             .map_err(|e| e.in_section("inverter"))?;
