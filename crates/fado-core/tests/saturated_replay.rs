@@ -11,7 +11,7 @@
 //! same exact signals (docs/method/saturation.md, "Results and limits").
 
 use fado_core::control::saturated_references::SaturatedReferences;
-use fado_core::magnetics::{FluxTable, MachineMagnetics, MagneticModel, Saturation};
+use fado_core::magnetics::{FluxMap, FluxTable, MachineMagnetics, MagneticModel, Saturation};
 use fado_core::{Ab, Dq, EstimatorConfig, MachineModel, Rotation, SensorlessEstimator, wrap_angle};
 
 /// The ipmsm-2k2-qsat preset (q self-saturation, cross-saturation `a_dq`, the magnet as an
@@ -112,20 +112,88 @@ fn automotive() -> MachineModel<f64> {
         ..Saturation::default()
     };
     let model = MachineMagnetics::Saturation(Box::leak(Box::new(sat)));
-    let (ld, lq, lf) = zero_current(model);
+    rated_machine(model, 0.018, 3, (240.0, 3000.0, 100.0), 520.0)
+}
+
+/// The pmsm-gem-1k1-measured preset: gym-electric-motor's measured 12 × 25 flux map (read
+/// from the preset's CSV, its ratings and resistance as the preset assumes them).
+fn gem_measured() -> MachineModel<f64> {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../motors/saturated/pmsm-gem-1k1-measured.csv"
+    );
+    let text = std::fs::read_to_string(path).unwrap();
+    let rows: Vec<[f64; 4]> = text
+        .lines()
+        .filter(|l| !l.starts_with('#') && !l.starts_with("i_d"))
+        .map(|l| {
+            let v: Vec<f64> = l.split(',').map(|x| x.trim().parse().unwrap()).collect();
+            [v[0], v[1], v[2], v[3]]
+        })
+        .collect();
+    let mut i_d: Vec<f64> = rows.iter().map(|r| r[0]).collect();
+    i_d.dedup();
+    let i_q: Vec<f64> = rows
+        .iter()
+        .take_while(|r| r[0] == rows[0][0])
+        .map(|r| r[1])
+        .collect();
+    let leak = |v: Vec<f64>| -> &'static [f64] { Box::leak(v.into_boxed_slice()) };
+    let (psi_d, psi_q) = (
+        leak(rows.iter().map(|r| r[2]).collect()),
+        leak(rows.iter().map(|r| r[3]).collect()),
+    );
+    let map = FluxMap::new(leak(i_d), leak(i_q), psi_d, psi_q).unwrap();
+    let model = MachineMagnetics::Map(Box::leak(Box::new(map)));
+    rated_machine(model, 0.5, 3, (8.0, 3000.0, 3.3), 400.0)
+}
+
+/// A made-up machine of a class no preset has: a small 20-pole IPMSM at 48 V (1.84 N·m at
+/// 15 A, 2000 r/min), Lq/Ld 3.4 at zero current, d self-saturation (S = 2), q saturation
+/// (secant L_q −46 % at rated current) and cross-saturation of exponents U = V = 1 (ψd −1.9 %
+/// at rated i_q), the magnet as an MMF i_f that holds ψd = 8 mVs at zero current.
+fn small_ipm() -> MachineModel<f64> {
+    let (a_d0, a_dd, lf): (f64, f64, f64) = (4000.0, 9.4e6, 0.008);
+    let sat = Saturation {
+        a_d0,
+        a_dd,
+        s: 2.0,
+        a_q0: 1700.0,
+        a_qq: 5.0e7,
+        t: 2.0,
+        a_dq: 4.0e11,
+        u: 1.0,
+        v: 1.0,
+        i_f: a_d0 * lf + a_dd * lf.powi(3),
+        ..Saturation::default()
+    };
+    let model = MachineMagnetics::Saturation(Box::leak(Box::new(sat)));
+    rated_machine(model, 0.1, 10, (15.0, 2000.0, 1.84), 48.0)
+}
+
+/// A machine of `magnetics` with its zero-current Ld, Lq, λf, the ratings (A peak, r/min,
+/// N·m) and the inertia and friction of `fado_core::ratings`' rules.
+fn rated_machine(
+    magnetics: MachineMagnetics<f64>,
+    rs: f64,
+    pole_pairs: u32,
+    (rated_current, rated_speed_rpm, rated_torque): (f64, f64, f64),
+    dc_voltage: f64,
+) -> MachineModel<f64> {
+    let (ld, lq, flux_linkage) = zero_current(magnetics);
     MachineModel {
-        rs: 0.018,
+        rs,
         ld,
         lq,
-        flux_linkage: lf,
-        pole_pairs: 3,
-        inertia: 0.03883,
-        viscous_friction: 5.1e-3,
-        rated_current: 240.0,
-        rated_speed_rpm: 3000.0,
-        rated_torque: 100.0,
-        dc_voltage: 520.0,
-        magnetics: model,
+        flux_linkage,
+        pole_pairs,
+        inertia: fado_core::ratings::inertia(rated_torque, rated_speed_rpm),
+        viscous_friction: fado_core::ratings::viscous_friction(rated_torque, rated_speed_rpm),
+        rated_current,
+        rated_speed_rpm,
+        rated_torque,
+        dc_voltage,
+        magnetics,
     }
 }
 
@@ -216,8 +284,10 @@ fn replay_with(
     }
 }
 
-/// The machines and the loads each holds. The PM-SyRM and the made-up automotive IPMSM hold 0
-/// and 30 % only: at 65 and 100 % their active flux is about twice the magnet's and the
+/// The machines and the loads each holds: the presets' algebraic models and maps, a measured
+/// map of another machine (pmsm-gem-1k1-measured), a made-up 20-pole IPMSM of a class no
+/// preset has, and a made-up automotive-scale IPMSM. The PM-SyRM and the automotive IPMSM
+/// hold 0 and 30 % only: at 65 and 100 % their active flux is about twice the magnet's and the
 /// estimator's slow mode grows in the generating direction (`the_slow_mode_...` below,
 /// docs/method/saturation.md, "Results and limits").
 #[test]
@@ -228,6 +298,8 @@ fn saturated_machines_replayed_with_their_model_hold_the_angle_through_the_rever
         ("ipmsm-2k2, 5x cross-saturation", ipm(300.0), &all[..]),
         ("pmsyrm-baldor-5k6", baldor(), &all[..2]),
         ("pmsyrm-baldor-5k6 as a 17x17 map", baldor_map(), &all[..2]),
+        ("pmsm-gem-1k1-measured", gem_measured(), &all[..]),
+        ("made-up 20-pole IPMSM", small_ipm(), &all[..]),
         ("automotive IPMSM (made up)", automotive(), &all[..2]),
     ] {
         for &load in loads {
