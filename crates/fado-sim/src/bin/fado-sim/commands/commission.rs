@@ -199,16 +199,16 @@ fn write_outputs(
     let map_path = dir.join(IDENTIFIED_MAP_FILE);
     let (map, identified) = match &o.identification {
         Some(id) => {
+            // A model that does not tabulate as a monotonic map over the drive's range (its
+            // extrapolation far beyond the pulses' current) stays the algebraic one.
             let map = match identified_map_csv(id) {
-                Some(csv) => {
-                    let csv = csv.map_err(|e| {
-                        OutputError::new(
-                            "tabulate",
-                            &map_path,
-                            std::io::Error::other(e.to_string()),
-                        )
-                    })?;
-                    Some(write_whole(&map_path, &csv)?)
+                Some(Ok(csv)) => Some(write_whole(&map_path, &csv)?),
+                Some(Err(e)) => {
+                    eprintln!(
+                        "warning: the identified magnetic model does not tabulate as a flux map \
+                         ({e}); identified.toml keeps it as [model.saturation]"
+                    );
+                    None
                 }
                 None => None,
             };
