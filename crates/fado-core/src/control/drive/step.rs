@@ -207,8 +207,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         {
             return Err(self.calibration_step(i_abc));
         }
-        let o = self.current_offset;
-        let i_abc = Abc::new(i_abc.a - o.a, i_abc.b - o.b, i_abc.c - o.c);
+        let i_abc = self.offsets_removed(i_abc);
         let over_voltage = self.blocks.dc_link.over_voltage(vdc);
         if i_abc.a.abs() > trip || i_abc.b.abs() > trip || i_abc.c.abs() > trip || over_voltage {
             self.tripped = true;
@@ -261,7 +260,10 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         if self.config.tuning.tracker_feedforward.enabled {
             let m = &self.config.machine;
             let p = T::lit(m.pole_pairs as f64);
-            let torque = self.feedforward_torque(p);
+            // Less the load the release hold found (zero unless it acted): the trackers'
+            // load acceleration starts from it (see `tracker_feedforward`).
+            let held = T::lit(1.5) * p * m.flux_linkage * self.blocks.hold.load();
+            let torque = self.feedforward_torque(p) - held;
             self.estimator.set_acceleration(p * torque / m.inertia);
         }
         let estimate = self.estimator.step(self.history[1], i_ab);
