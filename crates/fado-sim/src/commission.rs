@@ -486,39 +486,7 @@ pub fn identified_toml_with_map(
             .to_string();
         motor.insert("flux_map".into(), toml::Value::String(resolved));
     }
-    let m = id.model;
-    let mut model = toml::Table::new();
-    for (k, v) in [
-        ("rs", m.rs),
-        ("ld", m.ld),
-        ("lq", m.lq),
-        ("flux_linkage", m.flux_linkage),
-        ("inertia", m.inertia),
-        ("viscous_friction", m.viscous_friction),
-        ("rated_current", m.rated_current),
-        ("rated_speed_rpm", m.rated_speed_rpm),
-        ("rated_torque", m.rated_torque),
-    ] {
-        model.insert(k.into(), toml::Value::Float(v));
-    }
-    model.insert(
-        "pole_pairs".into(),
-        toml::Value::Integer(i64::from(m.pole_pairs)),
-    );
-    let mut saturation_lines = String::new();
-    if let Some(s) = &id.saturation {
-        let table = toml::Value::try_from(s)
-            .map_err(|e| SimConfigError::new("model.saturation", e.to_string()))?;
-        match map_file {
-            Some(file) => {
-                model.insert("flux_map".into(), toml::Value::String(file.into()));
-                saturation_lines = commented_saturation(table)?;
-            }
-            None => {
-                model.insert("saturation".into(), table);
-            }
-        }
-    }
+    let (model, saturation_lines) = model_table(id, map_file)?;
     doc.insert("model".into(), toml::Value::Table(model));
     // The identified threshold to the drive's dead-time compensation (its dead time is the
     // configured one, as the procedure's); a slightly negative result (noise about a zero
@@ -556,6 +524,49 @@ pub fn identified_toml_with_map(
     );
     let body = toml::to_string(&doc).map_err(|e| SimConfigError::new("<config>", e.to_string()))?;
     Ok(head + &body)
+}
+
+/// The identified `[model]` table (the keys of [`MachineModel`], and the magnetic model as
+/// [`identified_toml_with_map`] says) and the header's comment lines of the algebraic model
+/// when the table names its map instead.
+fn model_table(
+    id: &Identification<f64>,
+    map_file: Option<&str>,
+) -> Result<(toml::Table, String), SimConfigError> {
+    let m = id.model;
+    let mut model = toml::Table::new();
+    for (k, v) in [
+        ("rs", m.rs),
+        ("ld", m.ld),
+        ("lq", m.lq),
+        ("flux_linkage", m.flux_linkage),
+        ("inertia", m.inertia),
+        ("viscous_friction", m.viscous_friction),
+        ("rated_current", m.rated_current),
+        ("rated_speed_rpm", m.rated_speed_rpm),
+        ("rated_torque", m.rated_torque),
+    ] {
+        model.insert(k.into(), toml::Value::Float(v));
+    }
+    model.insert(
+        "pole_pairs".into(),
+        toml::Value::Integer(i64::from(m.pole_pairs)),
+    );
+    let mut saturation_lines = String::new();
+    if let Some(s) = &id.saturation {
+        let table = toml::Value::try_from(s)
+            .map_err(|e| SimConfigError::new("model.saturation", e.to_string()))?;
+        match map_file {
+            Some(file) => {
+                model.insert("flux_map".into(), toml::Value::String(file.into()));
+                saturation_lines = commented_saturation(table)?;
+            }
+            None => {
+                model.insert("saturation".into(), table);
+            }
+        }
+    }
+    Ok((model, saturation_lines))
 }
 
 /// The algebraic model's `[model.saturation]` table as comment lines (for the header of a
