@@ -9,7 +9,9 @@ the flux map of that repository's saturated-PMSM example environment). It holds 
 `Psi_q_map` (Vs) and the differential inductances on a 33 × 18 grid whose axes
 `i_d_grid_k` (−16 … +1 A) and `i_q_grid_k` (−16 … +16 A), both in 1 A steps, are stored beside
 it; rows are i_q and columns i_d. The nodes outside |i| ≤ 16 A are NaN: the measurement covers a
-disc of 16 A. fado's CSV needs a full rectangular grid, so the converter keeps the largest
+disc of 16 A. The file does not say how the map was obtained; the disc, the scatter of the
+differential inductances and the asymmetry in i_q are those of a measurement. fado's CSV
+needs a full rectangular grid, so the converter keeps the largest
 rectangle of measured nodes around the origin, i_d −10 … +1 A and i_q −12 … +12 A (12 × 25
 nodes, corner at 15.6 A), and makes it symmetric about the d axis node by node (ψd even, ψq odd
 in i_q: each node the mean of itself and its mirror in i_q), as a machine symmetric about its
@@ -22,7 +24,8 @@ The drive and the plant extrapolate a map linearly from its edge cells beyond it
 
 The script prints the values a preset takes from the map: ψd, incremental Ld and Lq at zero
 current, the secant Lq at i_d = 0, and the torque 1.5·p·(ψd·i_q − ψq·i_d) on the
-maximum-torque-per-ampere curve at a given current (bilinear in the map, the drive's own interpolation).
+maximum-torque-per-ampere curve at a given current (bilinear in the map, the drive's own
+interpolation).
 
 Usage: python3 scripts/flux-map-gem.py Reforce_PMSM_LUT.mat OUT.csv [--pole-pairs 3]
   [--rated-current 8]   (scipy reads the MATLAB file: pip install scipy)
