@@ -110,11 +110,10 @@ def main() -> None:
     args = ap.parse_args()
     grid = symmetrise(load(args.source))
     d_axis, q_axis, psi_d, psi_q = grid
-    flux_map_csv.write(args.out, [SOURCE, f"Converted by scripts/flux-map-gem.py: the "
-                                  f"{len(d_axis)} × {len(q_axis)} measured nodes with i_d "
-                                  f"{D_RANGE[0]:g}…{D_RANGE[1]:g} A and i_q {Q_RANGE[0]:g}…"
-                                  f"{Q_RANGE[1]:g} A, one row each, symmetrised in i_q, no interpolation."],
-                       d_axis, q_axis, psi_d, psi_q)
+    note = (f"Converted by scripts/flux-map-gem.py: the {len(d_axis)} × {len(q_axis)} measured "
+            f"nodes with i_d {D_RANGE[0]:g}…{D_RANGE[1]:g} A and i_q {Q_RANGE[0]:g}…"
+            f"{Q_RANGE[1]:g} A, one row each, symmetrised in i_q, no interpolation.")
+    flux_map_csv.write(args.out, [SOURCE, note], d_axis, q_axis, psi_d, psi_q)
     lf, ld, lq = flux_map_csv.zero_current(d_axis, q_axis, psi_d, psi_q)
     psi_q0 = bilinear(d_axis, q_axis, psi_q, 0.0, 0.0)
     print(f"wrote {args.out}: {len(d_axis)} × {len(q_axis)} nodes; at zero current "
