@@ -34,11 +34,13 @@
 //! rotor by 0.27·a/(ωc/10)² = 0.48 rad on the multirotor preset (measured 0.52 rad with the
 //! free fall before the trigger, against the 0.5 rad a loaded start may lose). Where the hold
 //! is enabled, the drive raises the current loop's bandwidth to the 10·ω_h its design travel
-//! needs ([`current_bandwidth_for_hold`]), never lowering the tuning's and at most
+//! needs ([`current_bandwidth_for_hold`]) where the cap would let the rated load move the
+//! rotor by more than 1.75 times the design travel, never lowering the tuning's and at most
 //! ωc·Ts = [`MAX_CURRENT_WC_TS`]. The electrical side allows it: such a motor's stator pole
 //! R/L (3.7·10³ s⁻¹ on the multirotor preset) is itself above the paper's 2π·250 Hz, and its
 //! PWM samples at 40 kHz or more. On the presets the rule acts only on the two outrunners
-//! (multirotor 387 Hz, cheetah 436 Hz).
+//! (multirotor 387 Hz, capped travel 2.4 times the design; cheetah 436 Hz, 3.0 times); a
+//! 750 W 10-pole servo (1.6 times, 0.33 rad) keeps its 250 Hz.
 //!
 //! # When
 //! Armed at every (re)alignment with θ_hold = the aligned angle; it acts only once the angle
@@ -107,6 +109,13 @@ cast_record!(ReleaseHoldTuning { travel, trigger, window ; enabled });
 /// (the current loop refuses ωc·Ts above 0.5, 47°).
 pub const MAX_CURRENT_WC_TS: f64 = 0.2;
 
+/// How far beyond its design travel the current loop's cap may let the rated load move the
+/// rotor before the hold's rule raises the loop: 1.75 \[A\] (0.35 rad for the default 0.2 rad
+/// design: the free fall before the trigger adds 0.05–0.1 rad on the presets, which leaves it
+/// within the 0.5 rad a loaded start may lose; a 24-pole multirotor motor at 2.0 lost
+/// 0.48–0.54 rad). A tuning that holds the rotor is left as it is.
+const CAPPED_TRAVEL_RATIO: f64 = 1.75;
+
 /// The hold's stiffness ω_h (rad/s) before the caps: the rated load moves the rotor by
 /// `travel`, ω_h = √(0.27·b·I_rated/travel), b = 1.5·p²·λ̂f/Ĵ (module docs).
 fn design_omega<T: Real>(machine: &MachineModel<T>, travel: T) -> T {
@@ -116,9 +125,11 @@ fn design_omega<T: Real>(machine: &MachineModel<T>, travel: T) -> T {
 }
 
 /// The current loop's bandwidth (Hz) the release hold needs on `machine` sampled every `ts`:
-/// 10·ω_h/2π for its design travel where the hold is enabled and that is above `current_hz`
-/// (the tuning's), at most ωc·Ts = [`MAX_CURRENT_WC_TS`]; `current_hz` otherwise (module
-/// docs, "The current loop it needs"). A non-finite result keeps `current_hz`.
+/// 10·ω_h/2π for its design travel where the hold is enabled and the cap ω_h ≤ ωc/10 of
+/// `current_hz` (the tuning's) would let the rated load move the rotor by more than 1.75
+/// times that travel (ω_h² > 1.75·(ωc/10)²), at most ωc·Ts = [`MAX_CURRENT_WC_TS`]; `current_hz`
+/// otherwise (module docs, "The current loop it needs"). A non-finite result keeps
+/// `current_hz`.
 pub fn current_bandwidth_for_hold<T: Real>(
     tuning: &ReleaseHoldTuning<T>,
     machine: &MachineModel<T>,
@@ -128,7 +139,13 @@ pub fn current_bandwidth_for_hold<T: Real>(
     if !tuning.enabled {
         return current_hz;
     }
-    let wc = T::lit(10.0) * design_omega(machine, tuning.travel);
+    let omega = design_omega(machine, tuning.travel);
+    let capped = T::two_pi() * current_hz / T::lit(10.0);
+    // NaN compares false: the tuning's.
+    if !(omega * omega > T::lit(CAPPED_TRAVEL_RATIO) * capped * capped) {
+        return current_hz;
+    }
+    let wc = T::lit(10.0) * omega;
     let wc = crate::real::min(wc, T::lit(MAX_CURRENT_WC_TS) / ts);
     let hz = wc / T::two_pi();
     // NaN compares false: the tuning's.
@@ -265,13 +282,18 @@ impl<T: Real> ReleaseHold<T> {
         self.engaged
     }
 
-    /// The load the hold found, A of magnet q current: its integral, from the trigger on and
-    /// kept after the hand-over until the next [`arm`](Self::arm); zero if it never acted.
+    /// The torque the hold stands for, A of magnet q current: its command while it acts, then
+    /// its integral (the load it found), kept after the hand-over until the next
+    /// [`arm`](Self::arm); zero if it never acted.
     /// The drive's tracker feed-forward takes it off the commanded torque (see
     /// [`tracker_feedforward`](crate::control::tracker_feedforward), "The release hold's
     /// load").
     pub fn load(&self) -> T {
-        self.integral
+        if self.active {
+            self.output
+        } else {
+            self.integral
+        }
     }
 
     /// The loop's sampling period, s.
@@ -416,6 +438,16 @@ mod tests {
         assert!(wide < 0.25 && paper > 0.4, "{wide} {paper}");
         // The paper's motor keeps the tuning's bandwidth, as does a disabled hold; the
         // sampling caps the rule at ωc·Ts = 0.2.
+        // A 750 W 10-pole servo's capped travel is 1.6 times the design (0.33 rad): kept.
+        let servo = MachineModel {
+            pole_pairs: 5,
+            flux_linkage: 0.05,
+            rated_current: 6.4,
+            rated_torque: 2.4,
+            inertia: 4e-4,
+            ..MachineModel::<f64>::paper()
+        };
+        assert_eq!(current_bandwidth_for_hold(&on, &servo, 1e-4, 250.0), 250.0);
         let paper_motor = MachineModel::<f64>::paper();
         assert_eq!(
             current_bandwidth_for_hold(&on, &paper_motor, 1e-4, 250.0),

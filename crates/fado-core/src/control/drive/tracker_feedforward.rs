@@ -50,10 +50,15 @@
 //! and the trackers' speed runs up until their load integrator learns it (measured on the
 //! multirotor preset: T2S-2 at 290 r/min over a held rotor; at the hand-over the speed loop
 //! then takes the holding torque away and the rotor falls back 2 rad). So the drive feeds
-//! forward p·(T* − T_hold)/Ĵ with T_hold = 1.5·p·λ̂f·i_hold, the hold's integral (the load it
-//! found) from its trigger on and kept after its hand-over until it is armed again: the same
-//! as starting the trackers' load integrator â at −p·T_hold/Ĵ. Zero where the hold never acts,
-//! so nothing else changes.
+//! forward p·(T* − T_hold)/Ĵ with T_hold = 1.5·p·λ̂f·i_hold, i_hold
+//! ([`ReleaseHold::load`](crate::control::release_hold::ReleaseHold::load)) the hold's whole
+//! command while it acts (the rotor it holds does not accelerate on average: the trackers
+//! follow its small travel as a type-3 loop without feed-forward) and its integral, the load
+//! it found, after the hand-over until it is armed again: the same as starting the trackers'
+//! load integrator â at −p·T_hold/Ĵ. Zero where the hold never acts, so nothing else changes.
+//! Measured with a feed-forward less the integral alone (the hold's proportional kick still
+//! fed forward): the trackers swing ±200 r/min and the multirotor's θ̂ ends 0.3 rad off at the
+//! hand-over.
 
 use crate::Real;
 use crate::control::DriveTuning;
