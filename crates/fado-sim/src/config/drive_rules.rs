@@ -18,6 +18,16 @@ const BANDWIDTH_RULE: &str = "T2S-1's bandwidth in k_df mode at which a step of 
     torque peaks at `[controller.tracker_feedforward] load_step_error` \
     (fado_core::control::tracker_feedforward)";
 
+/// The speed loop's bandwidth on a light rotor, and T2S-2's with it.
+const SPEED_RULE: &str = "raised until a step of the rated torque at the rated speed dips \
+    the speed by at most `[controller.speed] load_step_dip_ratio` × the rated speed, T2S-2 in \
+    the tuning's ratio (fado_core::control::speed_bandwidth)";
+
+/// The injection's bound on a salient rotor.
+const INJECTION_RULE: &str = "the injection's I_min bounded to `[controller.injection] \
+    max_active_flux_share` × λ̂f/(L̂q − L̂d), the d current that shrinks the active flux by \
+    that share (DriveConfig::i_min)";
+
 /// `cfg` with the values the drive's build-time rule sets in its tuning (the acceleration
 /// feed-forward, the trackers' load pole and T2S-1's running bandwidth of
 /// `fado_core::control::tracker_feedforward`), each recorded as derived: what the drive runs
@@ -32,35 +42,77 @@ pub(crate) fn with_drive_rules(cfg: &SimConfig) -> SimConfig {
         &mut estimator,
         drive.ts,
     );
-    let mut derive = |key: &str, value: f64, rule: &'static str| {
-        c.derived.retain(|d| d.key != key);
-        c.derived.push(Derived {
-            key: key.to_owned(),
-            value,
-            rule,
-        });
-    };
+    fado_core::control::speed_bandwidth::apply(
+        &drive.machine,
+        &mut tuning,
+        &mut estimator,
+        drive.ts,
+    );
     if tuning.tracker_feedforward.enabled != c.controller.tracker_feedforward.enabled {
-        derive(
+        record(
+            &mut c.derived,
             "controller.tracker_feedforward.enabled",
             1.0,
             FEEDFORWARD_RULE,
         );
         c.controller.tracker_feedforward.enabled = true;
     }
-    let pole = estimator.tracker.load_pole_ratio;
-    if pole != c.estimator.tracker.load_pole_ratio {
-        derive("estimator.tracker.load_pole_ratio", pole, LOAD_POLE_RULE);
-        c.estimator.tracker.load_pole_ratio = pole;
-    }
-    let bandwidth = estimator.tracker.t2s1_running_bandwidth_hz;
-    if bandwidth != c.estimator.tracker.t2s1_running_bandwidth_hz {
-        derive(
+    let (ratio, rated) = (
+        c.controller.injection.current_ratio,
+        drive.machine.rated_current,
+    );
+    let injection = if drive.i_min() < ratio * rated {
+        drive.i_min() / rated
+    } else {
+        ratio
+    };
+    let t = &mut c.estimator.tracker;
+    for (key, field, value, rule) in [
+        (
+            "estimator.tracker.load_pole_ratio",
+            &mut t.load_pole_ratio,
+            estimator.tracker.load_pole_ratio,
+            LOAD_POLE_RULE,
+        ),
+        (
             "estimator.tracker.t2s1_running_bandwidth_hz",
-            bandwidth,
+            &mut t.t2s1_running_bandwidth_hz,
+            estimator.tracker.t2s1_running_bandwidth_hz,
             BANDWIDTH_RULE,
-        );
-        c.estimator.tracker.t2s1_running_bandwidth_hz = bandwidth;
+        ),
+        (
+            "estimator.tracker.t2s2_bandwidth_hz",
+            &mut t.t2s2_bandwidth_hz,
+            estimator.tracker.t2s2_bandwidth_hz,
+            SPEED_RULE,
+        ),
+        (
+            "controller.injection.current_ratio",
+            &mut c.controller.injection.current_ratio,
+            injection,
+            INJECTION_RULE,
+        ),
+        (
+            "controller.speed.bandwidth_hz",
+            &mut c.controller.speed.bandwidth_hz,
+            tuning.speed.bandwidth_hz,
+            SPEED_RULE,
+        ),
+    ] {
+        if value != *field {
+            record(&mut c.derived, key, value, rule);
+            *field = value;
+        }
     }
     c
+}
+
+/// Records `key` as derived by `rule` at `value` (replacing an earlier record of it).
+fn record(derived: &mut Vec<Derived>, key: &str, value: f64, rule: &'static str) {
+    derived.retain(|d| d.key != key);
+    derived.push(Derived {
+        key: key.to_owned(),
+        value,
+        rule,
+    });
 }

@@ -16,13 +16,20 @@ impl<T: Real> SensorlessDrive<T, SensorlessEstimator<T>> {
     /// The drive with the paper's estimator, built with the drive's own sampling period and
     /// machine model and the given estimator tuning (start-up angle 0; see
     /// [`align`](Self::align)). A rotor its trackers would lag at the current limit gets the
-    /// acceleration feed-forward ([`crate::control::tracker_feedforward`]).
+    /// acceleration feed-forward ([`crate::control::tracker_feedforward`]), a light rotor the
+    /// speed-loop bandwidth of its load step ([`crate::control::speed_bandwidth`]).
     pub fn new(
         mut config: DriveConfig<T>,
         mut estimator: EstimatorTuning<T>,
     ) -> Result<Self, ConfigError> {
         let machine = config.machine;
         crate::control::tracker_feedforward::apply(
+            &machine,
+            &mut config.tuning,
+            &mut estimator,
+            config.ts,
+        );
+        crate::control::speed_bandwidth::apply(
             &machine,
             &mut config.tuning,
             &mut estimator,
