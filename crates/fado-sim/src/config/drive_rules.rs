@@ -18,6 +18,11 @@ const BANDWIDTH_RULE: &str = "T2S-1's bandwidth in k_df mode at which a step of 
     torque peaks at `[controller.tracker_feedforward] load_step_error` \
     (fado_core::control::tracker_feedforward)";
 
+/// The release hold's rule for the current loop's bandwidth.
+const HOLD_CURRENT_RULE: &str = "10·ω_h of the release hold's design travel where the hold is \
+    enabled and that is above the tuning's, at most ωc·Ts = 0.2 \
+    (fado_core::control::release_hold)";
+
 /// The speed loop's bandwidth on a light rotor, and T2S-2's with it.
 const SPEED_RULE: &str = "raised until a step of the rated torque at the rated speed dips \
     the speed by at most `[controller.speed] load_step_dip_ratio` × the rated speed, T2S-2 in \
@@ -30,7 +35,10 @@ const INJECTION_RULE: &str = "the injection's I_min bounded to `[controller.inje
 
 /// `cfg` with the values the drive's build-time rule sets in its tuning (the acceleration
 /// feed-forward, the trackers' load pole and T2S-1's running bandwidth of
-/// `fado_core::control::tracker_feedforward`), each recorded as derived: what the drive runs
+/// `fado_core::control::tracker_feedforward`, the current loop's bandwidth of
+/// `fado_core::control::release_hold`, the speed loop's and T2S-2's of
+/// `fado_core::control::speed_bandwidth`, the injection's bound of `DriveConfig::i_min`), each
+/// recorded as derived: what the drive runs
 /// with, as `--dump-config` shows it.
 pub(crate) fn with_drive_rules(cfg: &SimConfig) -> SimConfig {
     let mut c = cfg.clone();
@@ -48,15 +56,22 @@ pub(crate) fn with_drive_rules(cfg: &SimConfig) -> SimConfig {
         &mut estimator,
         drive.ts,
     );
+    let mut derived = std::mem::take(&mut c.derived);
     if tuning.tracker_feedforward.enabled != c.controller.tracker_feedforward.enabled {
         record(
-            &mut c.derived,
+            &mut derived,
             "controller.tracker_feedforward.enabled",
             1.0,
             FEEDFORWARD_RULE,
         );
         c.controller.tracker_feedforward.enabled = true;
     }
+    let current = fado_core::control::release_hold::current_bandwidth_for_hold(
+        &tuning.release_hold,
+        &drive.machine,
+        drive.ts,
+        tuning.current.bandwidth_hz,
+    );
     let (ratio, rated) = (
         c.controller.injection.current_ratio,
         drive.machine.rated_current,
@@ -67,47 +82,54 @@ pub(crate) fn with_drive_rules(cfg: &SimConfig) -> SimConfig {
         ratio
     };
     let t = &mut c.estimator.tracker;
-    for (key, field, value, rule) in [
+    for (key, value, field, rule) in [
         (
             "estimator.tracker.load_pole_ratio",
-            &mut t.load_pole_ratio,
             estimator.tracker.load_pole_ratio,
+            &mut t.load_pole_ratio,
             LOAD_POLE_RULE,
         ),
         (
             "estimator.tracker.t2s1_running_bandwidth_hz",
-            &mut t.t2s1_running_bandwidth_hz,
             estimator.tracker.t2s1_running_bandwidth_hz,
+            &mut t.t2s1_running_bandwidth_hz,
             BANDWIDTH_RULE,
         ),
         (
+            "controller.current.bandwidth_hz",
+            current,
+            &mut c.controller.current.bandwidth_hz,
+            HOLD_CURRENT_RULE,
+        ),
+        (
             "estimator.tracker.t2s2_bandwidth_hz",
-            &mut t.t2s2_bandwidth_hz,
             estimator.tracker.t2s2_bandwidth_hz,
+            &mut t.t2s2_bandwidth_hz,
+            SPEED_RULE,
+        ),
+        (
+            "controller.speed.bandwidth_hz",
+            tuning.speed.bandwidth_hz,
+            &mut c.controller.speed.bandwidth_hz,
             SPEED_RULE,
         ),
         (
             "controller.injection.current_ratio",
-            &mut c.controller.injection.current_ratio,
             injection,
+            &mut c.controller.injection.current_ratio,
             INJECTION_RULE,
-        ),
-        (
-            "controller.speed.bandwidth_hz",
-            &mut c.controller.speed.bandwidth_hz,
-            tuning.speed.bandwidth_hz,
-            SPEED_RULE,
         ),
     ] {
         if value != *field {
-            record(&mut c.derived, key, value, rule);
+            record(&mut derived, key, value, rule);
             *field = value;
         }
     }
+    c.derived = derived;
     c
 }
 
-/// Records `key` as derived by `rule` at `value` (replacing an earlier record of it).
+/// Records `key` as derived with `value` by `rule`, replacing an earlier record of it.
 fn record(derived: &mut Vec<Derived>, key: &str, value: f64, rule: &'static str) {
     derived.retain(|d| d.key != key);
     derived.push(Derived {
