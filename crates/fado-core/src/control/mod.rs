@@ -20,6 +20,7 @@ pub mod pi;
 pub mod ratings_limit;
 pub mod release_hold;
 pub mod saturated_references;
+pub mod speed_bandwidth;
 pub mod speed_controller;
 pub mod standstill_probe;
 pub mod startup;

@@ -86,8 +86,7 @@ impl<T: Real> Blocks<T> {
             ("zero_ratio", "speed_zero_ratio"),
             ("anti_windup_ratio", "speed_anti_windup_ratio"),
         ]))?;
-        let injection =
-            CurrentInjection::new(CurrentInjectionConfig::new(m, t.injection.current_ratio))?;
+        let injection = CurrentInjection::new(CurrentInjectionConfig { i_min: c.i_min() })?;
         let current = CurrentController::new(c.current_controller_config()).map_err(rename(&[
             ("bandwidth_hz", "current_bandwidth_hz"),
             ("anti_windup_ratio", "current_anti_windup_ratio"),
