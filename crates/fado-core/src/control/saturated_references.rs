@@ -50,8 +50,7 @@ fn torque_flux<T: Real>(model: &impl MagneticModel<T>, i: Dq<T>) -> T {
 
 /// The MTPA condition g (module docs) at `i`.
 fn mtpa_condition<T: Real>(model: &impl MagneticModel<T>, i: Dq<T>) -> T {
-    let psi = model.flux(i);
-    let l = model.incremental_inductance(i);
+    let (psi, l) = model.flux_and_inductance(i);
     let d_tau_d = l.dd * i.q - psi.q - l.qd * i.d;
     let d_tau_q = psi.d + l.dq * i.q - l.qq * i.d;
     d_tau_d * i.q - d_tau_q * i.d
@@ -108,6 +107,33 @@ impl<T: Real> SaturatedReferences<T> {
     #[inline]
     pub fn torque_flux(&self, i: Dq<T>) -> T {
         torque_flux(&self.model, i)
+    }
+
+    /// τ at `i` as [`SaturatedReferences::torque_flux`], with ψ(i) solved from `guess` (the
+    /// model's flux at a nearby current), and that ψ: the drive's solves chain their flux from
+    /// one evaluation to the next and from sample to sample, so that each costs one or two
+    /// Newton steps instead of a solve from the linear guess.
+    #[inline]
+    pub fn torque_flux_from(&self, i: Dq<T>, guess: Dq<T>) -> (T, Dq<T>) {
+        let psi = self.model.flux_from(i, guess);
+        (psi.d * i.q - psi.q * i.d, psi)
+    }
+
+    /// τ at `i` with its derivative along a path of slope di_d/di_q = `did_diq`, ψ(i) solved
+    /// from `guess` as in [`SaturatedReferences::torque_flux_from`], and that ψ:
+    /// dτ/di_q = (L·(did_diq, 1))d·i_q + ψd − (L·(did_diq, 1))q·i_d − ψq·did_diq with L the
+    /// incremental inductance.
+    #[inline]
+    pub fn torque_flux_slope(&self, i: Dq<T>, did_diq: T, guess: Dq<T>) -> (T, T, Dq<T>) {
+        let (psi, l) = self.model.flux_and_inductance_from(i, guess);
+        let dpsi = l.apply(Dq::new(did_diq, T::one()));
+        let slope = dpsi.d * i.q + psi.d - dpsi.q * i.d - psi.q * did_diq;
+        (psi.d * i.q - psi.q * i.d, slope, psi)
+    }
+
+    /// The model's flux ψ(i) in Wb.
+    pub fn flux(&self, i: Dq<T>) -> Dq<T> {
+        self.model.flux(i)
     }
 
     /// The MTPA point on the circle |i| = `current` (A), i_q ≥ 0 (|(mtpa_id(i_q), i_q)|
