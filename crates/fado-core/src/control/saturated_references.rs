@@ -48,25 +48,29 @@ fn torque_flux<T: Real>(model: &impl MagneticModel<T>, i: Dq<T>) -> T {
     psi.d * i.q - psi.q * i.d
 }
 
-/// The MTPA condition g (module docs) at `i`.
-fn mtpa_condition<T: Real>(model: &impl MagneticModel<T>, i: Dq<T>) -> T {
-    let (psi, l) = model.flux_and_inductance(i);
+/// The MTPA condition g (module docs) at `i`, the model's flux solved from `guess` (a nearby
+/// current's), and that flux.
+fn mtpa_condition<T: Real>(model: &impl MagneticModel<T>, i: Dq<T>, guess: Dq<T>) -> (T, Dq<T>) {
+    let (psi, l) = model.flux_and_inductance_from(i, guess);
     let d_tau_d = l.dd * i.q - psi.q - l.qd * i.d;
     let d_tau_q = psi.d + l.dq * i.q - l.qq * i.d;
-    d_tau_d * i.q - d_tau_q * i.d
+    (d_tau_d * i.q - d_tau_q * i.d, psi)
 }
 
 /// The MTPA d current at q current `i_q` ≥ 0 by bisection on [−2·`i_max`, 0]; 0 where g ≥ 0
-/// at i_d = 0 (no reluctance torque to gain).
+/// at i_d = 0 (no reluctance torque to gain). Each point's flux starts from the last one's.
 fn mtpa_id<T: Real>(model: &impl MagneticModel<T>, i_q: T, i_max: T) -> T {
-    let g0 = mtpa_condition(model, Dq::new(T::zero(), i_q));
+    let start = Dq::new(T::zero(), i_q);
+    let (g0, mut psi) = mtpa_condition(model, start, model.flux(start));
     if g0.partial_cmp(&T::zero()) != Some(core::cmp::Ordering::Less) {
         return T::zero();
     }
     let (mut lo, mut hi) = (-(i_max + i_max), T::zero());
     for _ in 0..MTPA_BISECTIONS {
         let mid = T::lit(0.5) * (lo + hi);
-        if mtpa_condition(model, Dq::new(mid, i_q)) < T::zero() {
+        let g;
+        (g, psi) = mtpa_condition(model, Dq::new(mid, i_q), psi);
+        if g < T::zero() {
             hi = mid;
         } else {
             lo = mid;

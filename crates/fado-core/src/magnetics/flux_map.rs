@@ -36,10 +36,10 @@ pub struct FluxMap<'a, T> {
 /// An axis' first node, its inverse mean node spacing and whether every cell has that spacing
 /// (to [`UNIFORM_TOLERANCE_EPS`]): a uniform axis finds a cell with no load and no division.
 #[derive(Clone, Copy, Debug, PartialEq)]
-struct AxisScale<T> {
-    first: T,
-    inv_step: T,
-    uniform: bool,
+pub(super) struct AxisScale<T> {
+    pub(super) first: T,
+    pub(super) inv_step: T,
+    pub(super) uniform: bool,
 }
 
 impl<T: Real> AxisScale<T> {
@@ -261,6 +261,14 @@ impl<'a, T: Real> FluxMap<'a, T> {
         })
     }
 
+    /// The axes' first node, inverse mean spacing and uniformity (d, q).
+    pub(super) const fn axis_scales(&self) -> (AxisScale<T>, AxisScale<T>)
+    where
+        T: Copy,
+    {
+        (self.axis_d, self.axis_q)
+    }
+
     /// The i_d axis in A.
     pub fn i_d(&self) -> &'a [T] {
         self.i_d
@@ -402,5 +410,71 @@ impl<T: Real, const ND: usize, const NQ: usize> FluxTable<T, ND, NQ> {
             psi_d,
             psi_q,
         }
+    }
+}
+
+impl<const ND: usize, const NQ: usize> FluxTable<f32, ND, NQ> {
+    /// The table borrowed as a [`FluxMap`] in a constant expression, for a map in flash
+    /// beside its table (`static MAP: FluxMap<'static, f32> = TABLE.const_map();`): the checks
+    /// of [`FluxMap::new`] run by the compiler, so that a table it refuses does not build (the
+    /// panic names the check), and the map it gives is [`FluxTable::map`]'s.
+    pub const fn const_map(&self) -> FluxMap<'_, f32> {
+        assert!(
+            ND >= 2 && NQ >= 2,
+            "a flux map needs two nodes or more per axis"
+        );
+        let axis_d = const_axis(&self.i_d);
+        let axis_q = const_axis(&self.i_q);
+        let mut k = 0;
+        while k < ND {
+            let mut m = 0;
+            while m < NQ {
+                let (d, q) = (self.psi_d[k][m], self.psi_q[k][m]);
+                assert!(d.is_finite() && q.is_finite(), "a flux value is not finite");
+                assert!(
+                    k == 0 || d > self.psi_d[k - 1][m],
+                    "psi_d does not increase with i_d"
+                );
+                assert!(
+                    m == 0 || q > self.psi_q[k][m - 1],
+                    "psi_q does not increase with i_q"
+                );
+                m += 1;
+            }
+            k += 1;
+        }
+        FluxMap {
+            i_d: &self.i_d,
+            i_q: &self.i_q,
+            psi_d: self.psi_d.as_flattened(),
+            psi_q: self.psi_q.as_flattened(),
+            axis_d,
+            axis_q,
+        }
+    }
+}
+
+/// [`AxisScale::of`] in a constant expression (`f32`), the axis checked as [`check_axis`]
+/// checks it (a panic instead of an error).
+const fn const_axis<const N: usize>(axis: &[f32; N]) -> AxisScale<f32> {
+    let mut k = 1;
+    while k < N {
+        let ok = axis[k - 1].is_finite() && axis[k].is_finite() && axis[k] > axis[k - 1];
+        assert!(ok, "an axis is not finite and strictly increasing");
+        k += 1;
+    }
+    let inv_step = (N - 1) as f32 / (axis[N - 1] - axis[0]);
+    let tol = f32::EPSILON * UNIFORM_TOLERANCE_EPS as f32;
+    let mut uniform = true;
+    let mut k = 1;
+    while k < N {
+        let mismatch = (axis[k] - axis[k - 1]) * inv_step - 1.0;
+        uniform &= mismatch <= tol && -mismatch <= tol;
+        k += 1;
+    }
+    AxisScale {
+        first: axis[0],
+        inv_step,
+        uniform,
     }
 }

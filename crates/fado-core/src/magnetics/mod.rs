@@ -43,11 +43,13 @@ mod constant;
 mod flux_map;
 mod machine;
 mod saturation;
+mod uniform_table;
 
 pub use constant::ConstantInductance;
 pub use flux_map::{FluxMap, FluxMapError, FluxTable};
 pub use machine::{MachineMagnetics, zero_current_constants};
 pub use saturation::Saturation;
+pub use uniform_table::UniformFluxTable;
 
 use crate::{Dq, Real};
 

@@ -366,6 +366,53 @@ fn a_flux_map_interpolates_inverts_and_differentiates() {
     }
 }
 
+/// The uniform table is the flux map of the same table: values and Jacobians to rounding
+/// inside and beyond the grid, its inverse; the compiler's build is the run-time one; a
+/// non-uniform axis is refused.
+#[test]
+fn a_uniform_table_is_the_flux_map() {
+    let table = ipm_table::<f64>();
+    let (map, uniform) = (table.map().unwrap(), UniformFluxTable::new(&table).unwrap());
+    for i in currents(9.0).chain([Dq::new(-15.0, 14.0), Dq::new(7.0, -13.0)]) {
+        let (a, la) = map.flux_and_jacobian(i);
+        let (b, lb) = uniform.flux_and_jacobian(i);
+        assert!((a - b).norm() < 1e-14, "{i:?}: {a:?} vs {b:?}");
+        assert!(close(la, lb, 1e-12), "{i:?}");
+        assert_eq!(uniform.flux(i), b);
+        assert!(
+            (uniform.current(b) - i).norm() < 1e-9 * (1.0 + i.norm()),
+            "{i:?}"
+        );
+    }
+    let t32 = ipm_table::<f32>();
+    assert_eq!(
+        UniformFluxTable::from_f32_table(&t32),
+        UniformFluxTable::new(&t32).unwrap()
+    );
+    let mut skewed = table;
+    skewed.i_d[3] += 0.1;
+    assert!(UniformFluxTable::new(&skewed).is_none());
+}
+
+/// A map built by the compiler from a `static` table is the checked map of the same table.
+#[test]
+fn a_const_map_is_the_checked_map() {
+    static TABLE: FluxTable<f32, 16, 16> = FluxTable {
+        i_d: [0.0; 16],
+        i_q: [0.0; 16],
+        psi_d: [[0.0; 16]; 16],
+        psi_q: [[0.0; 16]; 16],
+    };
+    let table = ipm_table::<f32>();
+    assert_eq!(table.const_map(), table.map().unwrap());
+    // Non-uniform axes too.
+    let mut skewed = ipm_table::<f32>();
+    skewed.i_d[3] += 0.1;
+    assert_eq!(skewed.const_map(), skewed.map().unwrap());
+    // An unchecked table does not build (in a `static`, at compile time).
+    assert!(std::panic::catch_unwind(|| TABLE.const_map()).is_err());
+}
+
 #[test]
 fn a_flux_map_runs_in_f32_from_a_static_table() {
     static TABLE: FluxTable<f32, 2, 2> = FluxTable {

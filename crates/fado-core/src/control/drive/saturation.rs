@@ -19,11 +19,16 @@ impl<T: Real> DriveConfig<T> {
 
     /// The speed PI's output limit (a torque in units of the magnet's q current): the
     /// model's torque at the current limit on the MTPA curve (on the q axis without MTPA), or
-    /// [`SpeedControllerConfig::torque_limit`] for constant inductances.
-    pub(super) fn speed_torque_limit(&self, mtpa: bool) -> T {
+    /// [`SpeedControllerConfig::torque_limit`] for constant inductances (`saturated`: the
+    /// model's references, built once per drive).
+    pub(super) fn speed_torque_limit(
+        &self,
+        saturated: Option<&SaturatedReferences<T>>,
+        mtpa: bool,
+    ) -> T {
         let m = &self.machine;
         let i_max = self.tuning.current.limit_ratio * m.rated_current;
-        match self.saturated_references() {
+        match saturated {
             Some(s) if mtpa => s.torque_limit(i_max, m.flux_linkage),
             Some(s) => s.torque_flux(Dq::new(T::zero(), i_max)) / m.flux_linkage,
             None => SpeedControllerConfig::torque_limit(m, i_max, mtpa),
@@ -31,9 +36,12 @@ impl<T: Real> DriveConfig<T> {
     }
 
     /// The current loop's (L̂d, L̂q): a saturating model's incremental inductances at the
-    /// rated MTPA point, else the machine model's.
-    pub(super) fn current_loop_inductances(&self) -> (T, T) {
-        match self.saturated_references() {
+    /// rated MTPA point (from its references `saturated`), else the machine model's.
+    pub(super) fn current_loop_inductances(
+        &self,
+        saturated: Option<&SaturatedReferences<T>>,
+    ) -> (T, T) {
+        match saturated {
             Some(s) => s.rated_incremental(self.machine.rated_current),
             None => (self.machine.ld, self.machine.lq),
         }
