@@ -131,8 +131,9 @@ impl<T: Real> ActiveFlux<T> {
         self.lq_zero
     }
 
-    /// L_q,s and λa at the current `i_dq` of the rotor frame. A secant that is not a
-    /// positive finite number (a map not odd in i_q near i_q = 0) is replaced by L_qq(0).
+    /// L_q,s = (ψq − ψq(i_d, 0))/i_q ([`MagneticModel::secant_q`]) and λa at the
+    /// current `i_dq` of the rotor frame. A secant that is not a positive finite number is
+    /// replaced by L_qq(0).
     #[inline]
     pub fn point(&self, i_dq: Dq<T>) -> ActiveFluxPoint<T> {
         self.point_at(i_dq, self.flux(i_dq))
@@ -149,8 +150,11 @@ impl<T: Real> ActiveFlux<T> {
 
     #[inline]
     fn point_at(&self, i_dq: Dq<T>, psi: Dq<T>) -> ActiveFluxPoint<T> {
+        // ψq(î_d, 0) removed (zero unless a map is not odd in i_q): λ̂r then lies within
+        // atan(ψq(î_d, 0)/λa) of d, where ψq/i_q would grow without bound near i_q = 0.
         let secant = if i_dq.q.abs() > self.small_current {
-            psi.q / i_dq.q
+            let model = self.model.resolve(self.linear);
+            (psi.q - model.q_flux_offset(i_dq.d)) / i_dq.q
         } else {
             self.incremental_inductance(i_dq).qq
         };
