@@ -81,11 +81,14 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         for _ in 0..3 {
             let (f0, slope) = f(iq);
             // A flat, falling or non-finite slope (NaN compares false): Newton's step would
-            // stay on a local extremum of the torque or run away from the root.
+            // stay on a local extremum of the torque or run away from the root; the bracket
+            // unless the iterate is a root already.
             if slope > T::lit(1e-3) * flux_linkage {
                 iq -= f0 / slope;
             } else {
-                if let Some(root) = Self::bisect_torque(|x| f(x).0, iq_torque, rated_current) {
+                if f0 != T::zero()
+                    && let Some(root) = Self::bisect_torque(|x| f(x).0, iq_torque, rated_current)
+                {
                     iq = root;
                 }
                 break;
