@@ -55,6 +55,10 @@ def mtpa_currents(m: dict, i: float) -> tuple[float, float]:
 
 
 INVERTER_OPTIONAL_KEYS = {"dead_time", "threshold_voltage", "current_band"}
+# A saturated machine (motors/saturated/) adds its magnetic model: `[motor.saturation]` or
+# `flux_map`; its ld, lq, flux_linkage are the model's zero-current values, which the rows
+# below evaluate (docs/method/saturation.md).
+MOTOR_MAGNETICS_KEYS = {"saturation", "flux_map"}
 
 
 def torque(m: dict, i_d: float, i_q: float) -> float:
@@ -77,13 +81,15 @@ def check(path: Path) -> tuple[dict, list[str]]:
     inv = doc.get("inverter", {})
     for section, got, want in (("motor", m, MOTOR_KEYS), ("inverter", inv, INVERTER_KEYS)):
         # A MOSFET inverter may state its own dead time and knee voltage (the 24/48 V presets).
-        optional = INVERTER_OPTIONAL_KEYS if section == "inverter" else set()
+        optional = INVERTER_OPTIONAL_KEYS if section == "inverter" else MOTOR_MAGNETICS_KEYS
         if not want <= set(got) <= want | optional:
             missing, extra = sorted(want - set(got)), sorted(set(got) - want - optional)
             errors.append(f"[{section}] missing {missing} extra {extra}")
     if errors:
         return {"name": name}, errors
     for key, value in {**m, **inv}.items():
+        if key in MOTOR_MAGNETICS_KEYS:
+            continue
         if key == "viscous_friction":
             ok = value >= 0
         elif key == "pole_pairs":

@@ -23,6 +23,8 @@ from pathlib import Path
 
 import numpy as np
 
+import flux_map_csv
+
 
 def grid(i_s_dq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The d and q axes of a rectangular grid (i_d along axis 0, i_q along axis 1), or exit."""
@@ -46,32 +48,18 @@ def main() -> None:
     if not (np.isfinite(i_s).all() and np.isfinite(psi).all()):
         sys.exit("a non-finite value in the source")
     d_axis, q_axis = grid(i_s)
-    if np.any(np.diff(d_axis) <= 0) or np.any(np.diff(q_axis) <= 0):
-        sys.exit("the grid's axes are not strictly increasing")
-    if np.any(np.diff(psi.real, axis=0) <= 0) or np.any(np.diff(psi.imag, axis=1) <= 0):
-        sys.exit("ψd is not strictly increasing in i_d or ψq in i_q: the map has no inverse")
-    lines = [f"# {args.provenance}",
-             f"# Converted by scripts/flux-map-motulator.py from {args.source.name}: "
-             f"{len(d_axis)} × {len(q_axis)} nodes, one row each, no interpolation.",
-             "i_d,i_q,psi_d,psi_q"]
-    for k, i_d in enumerate(d_axis):
-        for m, i_q in enumerate(q_axis):
-            p = psi[k, m]
-            lines.append(f"{i_d:.6g},{i_q:.6g},{p.real:.9g},{p.imag:.9g}")
-    tmp = args.out.with_suffix(args.out.suffix + ".tmp")
-    tmp.write_text("\n".join(lines) + "\n", encoding="utf-8")
-    tmp.replace(args.out)
-    # The zero-current values of a preset's [motor] keys (central differences at the origin).
-    k0, m0 = int(np.argmin(abs(d_axis))), int(np.argmin(abs(q_axis)))
-    if d_axis[k0] != 0 or q_axis[m0] != 0 or not (0 < k0 < len(d_axis) - 1) \
-            or not (0 < m0 < len(q_axis) - 1):
+    flux_map_csv.write(args.out, [args.provenance,
+                                  f"Converted by scripts/flux-map-motulator.py from "
+                                  f"{args.source.name}: {len(d_axis)} × {len(q_axis)} nodes, "
+                                  "one row each, no interpolation."],
+                       d_axis, q_axis, psi.real, psi.imag)
+    zero = flux_map_csv.zero_current(d_axis, q_axis, psi.real, psi.imag)
+    if zero is None:
         print(f"wrote {args.out} (the grid has no interior node at zero current)")
         return
-    ld = (psi.real[k0 + 1, m0] - psi.real[k0 - 1, m0]) / (d_axis[k0 + 1] - d_axis[k0 - 1])
-    lq = (psi.imag[k0, m0 + 1] - psi.imag[k0, m0 - 1]) / (q_axis[m0 + 1] - q_axis[m0 - 1])
     print(f"wrote {args.out}: {len(d_axis)} × {len(q_axis)} nodes; at zero current "
-          f"flux_linkage = {psi.real[k0, m0]:.4f} Wb, incremental ld = {ld * 1e3:.2f} mH, "
-          f"lq = {lq * 1e3:.2f} mH")
+          f"flux_linkage = {zero[0]:.4f} Wb, incremental ld = {zero[1] * 1e3:.2f} mH, "
+          f"lq = {zero[2] * 1e3:.2f} mH")
 
 
 if __name__ == "__main__":

@@ -3,7 +3,8 @@
 code.
 
 Runs `fado-sim run fullrange` and `fado-sim run regen-stop` (release build, switching-resolved,
-default non-idealities) for every preset of motors/ and the current-sensor seeds 1-4, and prints
+default non-idealities) for every preset of motors/ and motors/saturated/ and the current-sensor
+seeds 1-4, and prints
 the Markdown table: the top speed and the power held against the model's limits (`fullrange`
 computes them, fado_sim::range), the largest angle error over the seeds, and which runs pass.
 Usage: python3 scripts/range-table.py [--seeds 1 2 3 4] [--out DIR]
@@ -29,15 +30,16 @@ def run(binary: Path, scenario: str, config: Path, out: Path) -> dict:
     return json.loads((out / "metrics.json").read_text())
 
 
-def with_seed(preset: Path, seed: int, directory: Path) -> Path:
-    """The preset with `[current_sensor] seed` set (merged into its own table if it has one)."""
+def with_seed(preset: Path, seed: int) -> Path:
+    """The preset with `[current_sensor] seed` set (merged into its own table if it has one),
+    written beside the preset so that a flux map it names by a relative path resolves."""
     text = preset.read_text(encoding="utf-8")
     if re.search(r"^\[current_sensor\]", text, flags=re.M):
         text = re.sub(r"^\[current_sensor\]\n", f"[current_sensor]\nseed = {seed}\n", text,
                       count=1, flags=re.M)
     else:
         text += f"\n[current_sensor]\nseed = {seed}\n"
-    path = directory / f"{preset.stem}-seed{seed}.toml"
+    path = preset.parent / f".range-table-{preset.stem}-seed{seed}.toml"
     path.write_text(text, encoding="utf-8")
     return path
 
@@ -60,12 +62,17 @@ def main() -> None:
           "| max \\|θ − θ̂\\| fullrange (rad) | fullrange passes | max \\|θ − θ̂\\| regen-stop (rad) "
           "| regen-stop passes | failed criteria |")
     print("|---|---|---|---|---|---|---|---|")
-    for preset in sorted((ROOT / "motors").glob("*.toml")):
+    presets = sorted((ROOT / "motors").glob("*.toml")) + sorted(
+        (ROOT / "motors" / "saturated").glob("*.toml"))
+    for preset in presets:
         row = {s: [] for s in SCENARIOS}
         for seed in args.seeds:
-            cfg = with_seed(preset, seed, work)
-            for s in SCENARIOS:
-                row[s].append(run(binary, s, cfg, work / f"{preset.stem}-{s}-seed{seed}"))
+            cfg = with_seed(preset, seed)
+            try:
+                for s in SCENARIOS:
+                    row[s].append(run(binary, s, cfg, work / f"{preset.stem}-{s}-seed{seed}"))
+            finally:
+                cfg.unlink()
         fr = row["fullrange"]
         top = check(fr[0], "mean speed at the top")
         power = check(fr[0], "power held at the top")
@@ -79,7 +86,8 @@ def main() -> None:
         angle = {s: max(m["max_angle_error"] for m in row[s]) for s in SCENARIOS}
         n = len(args.seeds)
         failed_text = "; ".join(failed).replace("|", "\\|") or "—"
-        print(f"| {preset.stem} | {model_top} → {reached:.0f} | "
+        name = preset.relative_to(ROOT / "motors").with_suffix("").as_posix()
+        print(f"| {name} | {model_top} → {reached:.0f} | "
               f"{limits.group(1) if limits else '?'} / {held:.0f} (rated {limits.group(2) if limits else '?'}) | "
               f"{angle['fullrange']:.3f} | {passes['fullrange']}/{n} | {angle['regen-stop']:.3f} | "
               f"{passes['regen-stop']}/{n} | {failed_text} |")

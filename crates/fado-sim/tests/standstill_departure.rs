@@ -4,13 +4,17 @@
 //! handling (the angle probe and the flux-magnitude hold,
 //! `fado_core::control::standstill_probe`) keeps |θ − θ̂| below 0.25 rad from the stop to
 //! 0.5 s after the departure on two interior-magnet presets whose standstill loses the angle
-//! without it, and on the saturating 2.2 kW IPMSM.
+//! without it, and on the saturating 2.2 kW IPMSM. The probe's arming time counts from the
+//! standstill reference: on a slow torque motor and a hub motor, whose rotors settle into
+//! limiter mode late after the stop at the current limit, both range scenarios hold the angle.
 
 use fado_sim::scenario::simulate;
 
 const GEM_50K: &str = include_str!("../../../motors/ipmsm-gem-50k.toml");
 const PMSYRM_5K: &str = include_str!("../../../motors/pmsyrm-5k.toml");
 const IPMSM_QSAT: &str = include_str!("../../../motors/saturated/ipmsm-2k2-qsat.toml");
+const HUB: &str = include_str!("../../../motors/hub-hoverboard-48v.toml");
+const TORQUE_32P: &str = include_str!("data/torque-ipm-32p.toml");
 
 /// The largest |θ − θ̂| (rad) from the stop at zero speed reference after the top speed to
 /// 0.5 s after the reference leaves zero again, and whether the run tripped.
@@ -60,4 +64,26 @@ fn loaded_standstill_and_departure_hold_the_angle_on_a_saturating_rotor() {
     let (with, tripped) = standstill(IPMSM_QSAT, "");
     println!("ipmsm-2k2-qsat: {with:.3} rad");
     assert!(with < 0.25 && !tripped, "{with} rad");
+}
+
+/// A 150 r/min 32-pole interior-magnet torque motor (made up, L̂q/L̂d = 2) and the hub motor
+/// preset: their rotors enter limiter mode 0.5 s after the stop's reference reaches zero, and
+/// an arming time counted from limiter mode let θ̂ creep to 0.45 and 0.25 rad before the
+/// probe started (seed 2 of the hub).
+#[test]
+fn slow_rotors_hold_the_angle_through_both_range_scenarios() {
+    for (file, motor) in [("torque-ipm-32p", TORQUE_32P), ("hub-hoverboard-48v", HUB)] {
+        for scenario in ["fullrange", "regen-stop"] {
+            let text = format!("{motor}\n[current_sensor]\nseed = 2\n");
+            let m = simulate(scenario, Some(&text), false, None)
+                .unwrap()
+                .metrics;
+            println!("{file} {scenario}: {:.3} rad", m.max_angle_error);
+            assert!(
+                m.max_angle_error < 0.25 && !m.tripped,
+                "{file} {scenario}: {} rad",
+                m.max_angle_error
+            );
+        }
+    }
 }

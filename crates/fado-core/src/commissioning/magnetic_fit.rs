@@ -16,10 +16,19 @@
 //! U, V ∈ {0, 1, 2}) is fitted in each form (1620 least-squares problems of at most six
 //! unknowns over the stored samples, once, at the end of the procedure); the model with the
 //! least squared current residual among those that are monotonic (non-negative saturation
-//! coefficients) is kept. Hinkkanen et al. (IEEE TIA 53(3), 2017) choose the exponents by hand
+//! coefficients) is kept.
+//!
+//! A third form adds the **saturating rib** of Lelli, Hinkkanen & Giulii Capponi (ICEM 2024):
+//! a PM-assisted SyRM's magnet acts through the iron bridges, a Norton source ψn behind the
+//! bridges' saturating inverse inductance a_b·ρ^W/(1 + a_bp·ρ^W), ρ = √((ψd − ψn)² + k_q·ψq²).
+//! For fixed ψn, a_bp, k_q (W = 2) the model is again linear in its coefficients (a_b a
+//! seventh); the three are searched on a grid with the exponents, then refined
+//! (`rib_search`). The rib is kept only when it at least halves the squared residual of the
+//! best model without it (`RIB_GAIN`), so that a machine without bridges keeps the simpler
+//! model. Hinkkanen et al. (IEEE TIA 53(3), 2017) choose the exponents by hand
 //! for their machine; a search lets the data choose them for a machine nobody looked at.
 
-use super::saturation_fit::{pow_abs, solve_normal};
+use super::saturation_fit::solve_normal;
 use crate::magnetics::{MagneticModel, Saturation};
 use crate::{Dq, Real};
 
@@ -27,8 +36,63 @@ use crate::{Dq, Real};
 /// numbers (3.2 kB in f32).
 pub(super) const SAMPLE_CAPACITY: usize = 160;
 
-/// Unknowns of one fit: a_d0, a_dd, a_q0, a_qq, a_dq, i_f.
-const COLS: usize = 6;
+/// Unknowns of one fit: a_d0, a_dd, a_q0, a_qq, a_dq, i_f, a_b.
+const COLS: usize = 7;
+
+/// The rib's Norton flux ψn tried, in units of λ̂f (the magnet's flux at zero current lies
+/// below it; 1.69 on the 5.6 kW PM-SyRM of Lelli et al.).
+const RIB_PSI_N: [f64; 9] = [1.1, 1.2, 1.35, 1.5, 1.6, 1.7, 1.85, 2.1, 2.5];
+
+/// The rib's saturation a_bp tried, in units of 1/λ̂f² (W = 2: a_bp·ρ² is the rib's own
+/// saturation at ρ; 0.23 on that machine).
+const RIB_A_BP: [f64; 4] = [0.0, 0.25, 1.0, 4.0];
+
+/// The rib's share of the q flux k_q tried (0.1 on that machine).
+const RIB_K_Q: [f64; 5] = [0.0, 0.05, 0.1, 0.2, 0.4];
+
+/// Rounds of the alternating search over the rib's grid and the exponents (`rib_search`).
+const RIB_ROUNDS: usize = 2;
+
+/// The rib is kept when it lowers the squared current residual of the best model without it
+/// by at least this factor (its 3 searched parameters and a_b would otherwise fit noise).
+const RIB_GAIN: f64 = 0.5;
+
+/// A rib's nonlinear parameters (W = 2), in the units of the grids above.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Rib {
+    psi_n: f64,
+    a_bp: f64,
+    k_q: f64,
+}
+
+impl Rib {
+    /// Every rib of the grid.
+    fn grid() -> impl Iterator<Item = Rib> {
+        RIB_PSI_N.into_iter().flat_map(|psi_n| {
+            RIB_A_BP
+                .into_iter()
+                .flat_map(move |a_bp| RIB_K_Q.into_iter().map(move |k_q| Rib { psi_n, a_bp, k_q }))
+        })
+    }
+
+    /// ψn, a_bp, k_q in SI for the magnet's flux `flux`.
+    fn si<T: Real>(&self, flux: T) -> (T, T, T) {
+        (
+            T::lit(self.psi_n) * flux,
+            T::lit(self.a_bp) / (flux * flux),
+            T::lit(self.k_q),
+        )
+    }
+
+    /// The rib's regressor (d, q) at the flux linkage (x, y): G_b/a_b·(ψb, k_q·ψq).
+    fn rows<T: Real>(&self, flux: T, x: T, y: T) -> (T, T) {
+        let (psi_n, a_bp, k_q) = self.si(flux);
+        let b = x - psi_n;
+        let rho2 = b * b + k_q * y * y;
+        let g = rho2 / (T::one() + a_bp * rho2);
+        (g * b, k_q * g * y)
+    }
+}
 
 /// Largest self-saturation exponent tried.
 const MAX_SELF_EXPONENT: u8 = 8;
@@ -95,6 +159,8 @@ struct Shape {
     s: Option<u8>,
     t: Option<u8>,
     cross: Option<(u8, u8)>,
+    /// The saturating rib of Lelli et al. (with the magnet as a current).
+    rib: Option<Rib>,
 }
 
 impl Shape {
@@ -105,14 +171,14 @@ impl Shape {
             3 => self.t.is_some(),
             4 => self.cross.is_some(),
             5 => self.form == Form::MagnetCurrent,
+            6 => self.rib.is_some(),
             _ => true,
         }
     }
 
     /// The regressor rows (d, q) of the flux linkage change `dpsi`, λ̂f `flux`.
     fn rows<T: Real>(&self, flux: T, dpsi: Dq<T>) -> ([T; COLS], [T; COLS]) {
-        let two = T::lit(2.0);
-        let e = |n: Option<u8>| T::lit(f64::from(n.unwrap_or(0)));
+        let e = |n: u8| T::lit(f64::from(n));
         let x = match self.form {
             Form::AroundFlux => dpsi.d,
             Form::MagnetCurrent => flux + dpsi.d,
@@ -120,25 +186,23 @@ impl Shape {
         let y = dpsi.q;
         let z = T::zero();
         let (cross_d, cross_q) = match self.cross {
-            Some((u, v)) => {
-                let (u, v) = (e(Some(u)), e(Some(v)));
-                (
-                    pow_abs(x, u) * x * pow_abs(y, v + two) / (v + two),
-                    pow_abs(x, u + two) * pow_abs(y, v) * y / (u + two),
-                )
-            }
+            Some((u, v)) => (
+                powi_abs(x, u) * x * powi_abs(y, v + 2) / e(v + 2),
+                powi_abs(x, u + 2) * powi_abs(y, v) * y / e(u + 2),
+            ),
             None => (z, z),
         };
-        let self_d = self.s.map_or(z, |_| pow_abs(x, e(self.s)) * x);
-        let self_q = self.t.map_or(z, |_| pow_abs(y, e(self.t)) * y);
+        let self_d = self.s.map_or(z, |s| powi_abs(x, s) * x);
+        let self_q = self.t.map_or(z, |t| powi_abs(y, t) * y);
         let magnet = if self.form == Form::MagnetCurrent {
             -T::one()
         } else {
             z
         };
+        let (rib_d, rib_q) = self.rib.map_or((z, z), |r| r.rows(flux, x, y));
         (
-            [x, self_d, z, z, cross_d, magnet],
-            [z, z, y, self_q, cross_q, z],
+            [x, self_d, z, z, cross_d, magnet, rib_d],
+            [z, z, y, self_q, cross_q, z, rib_q],
         )
     }
 
@@ -146,6 +210,9 @@ impl Shape {
     fn model<T: Real>(&self, flux: T, c: &[T; COLS]) -> Saturation<T> {
         let e = |n: Option<u8>| T::lit(f64::from(n.unwrap_or(0)));
         let (u, v) = self.cross.unzip();
+        let (psi_n, a_bp, k_q) = self
+            .rib
+            .map_or((T::zero(), T::zero(), T::zero()), |r| r.si(flux));
         Saturation {
             a_d0: c[0],
             a_dd: c[1],
@@ -162,7 +229,11 @@ impl Shape {
                 T::zero()
             },
             i_f: c[5],
-            ..Saturation::default()
+            psi_n,
+            a_b: c[6],
+            a_bp,
+            w: T::lit(2.0),
+            k_q,
         }
     }
 
@@ -199,6 +270,13 @@ impl Shape {
     }
 }
 
+/// |x|^n for the small integer exponents of the search (products: no `powf` in the
+/// search's inner loop).
+fn powi_abs<T: Real>(x: T, n: u8) -> T {
+    let a = x.abs();
+    (0..n).fold(T::one(), |p, _| p * a)
+}
+
 /// Every candidate shape, in a fixed order (module docs).
 fn shapes() -> impl Iterator<Item = Shape> {
     let selfs = || core::iter::once(None).chain((1..=MAX_SELF_EXPONENT).map(Some));
@@ -209,7 +287,15 @@ fn shapes() -> impl Iterator<Item = Shape> {
         .into_iter()
         .flat_map(move |form| {
             crosses.clone().flat_map(move |cross| {
-                selfs().flat_map(move |s| selfs().map(move |t| Shape { form, s, t, cross }))
+                selfs().flat_map(move |s| {
+                    selfs().map(move |t| Shape {
+                        form,
+                        s,
+                        t,
+                        cross,
+                        rib: None,
+                    })
+                })
             })
         })
 }
@@ -227,17 +313,112 @@ pub(super) fn best_fit<T: Real>(
         s: None,
         t: None,
         cross: None,
+        rib: None,
     };
     let (_, r_linear) = linear.fit(samples, flux)?;
-    let mut best: Option<(Saturation<T>, T)> = None;
-    for shape in shapes() {
+    let (_, m, r) = best_of(shapes(), samples, flux)?;
+    let (m, r) = match rib_search(samples, flux) {
+        Some((m_rib, r_rib)) if r_rib < T::lit(RIB_GAIN) * r => (m_rib, r_rib),
+        _ => (m, r),
+    };
+    Some((m, (r / n).sqrt(), (r_linear / n).sqrt()))
+}
+
+/// The shape of `candidates` with the least squared current residual: it, its model and
+/// the residual.
+fn best_of<T: Real>(
+    candidates: impl Iterator<Item = Shape>,
+    samples: &FluxSamples<T>,
+    flux: T,
+) -> Option<(Shape, Saturation<T>, T)> {
+    let mut best: Option<(Shape, Saturation<T>, T)> = None;
+    for shape in candidates {
         if let Some((m, r)) = shape.fit(samples, flux)
-            && best.as_ref().is_none_or(|(_, b)| r < *b)
+            && best.as_ref().is_none_or(|(_, _, b)| r < *b)
         {
-            best = Some((m, r));
+            best = Some((shape, m, r));
         }
     }
-    best.map(|(m, r)| (m, (r / n).sqrt(), (r_linear / n).sqrt()))
+    best
+}
+
+/// The best model with a rib: the rib's grid times the coarse exponents
+/// ([`coarse_shapes`]: 180 × 100 fits), then [`RIB_ROUNDS`] rounds of every exponent with
+/// the rib fixed and the rib's three parameters refined with the exponents fixed
+/// ([`refine_rib`]). A search alternating from the best shape without a rib stops in a
+/// local optimum (measured on the 5.6 kW PM-SyRM: incremental inductances 25 % off, where
+/// the product reaches 1.4 %).
+fn rib_search<T: Real>(samples: &FluxSamples<T>, flux: T) -> Option<(Saturation<T>, T)> {
+    let coarse = coarse_shapes().flat_map(|shape| {
+        Rib::grid().map(move |rib| Shape {
+            rib: Some(rib),
+            ..shape
+        })
+    });
+    let (mut shape, mut m, mut r) = best_of(coarse, samples, flux)?;
+    for _ in 0..RIB_ROUNDS {
+        let rib = shape.rib;
+        let exponents = shapes()
+            .filter(|s| s.form == Form::MagnetCurrent)
+            .map(|s| Shape { rib, ..s });
+        (shape, m, r) = best_of(exponents, samples, flux)?;
+        (shape, m, r) = refine_rib((shape, m, r), samples, flux);
+    }
+    Some((m, r))
+}
+
+/// The exponents of the rib's first search: S, T ∈ {none, 2, 4, 6, 8} and the cross term
+/// none or U = V ∈ {0, 1, 2}, with the magnet as a current.
+fn coarse_shapes() -> impl Iterator<Item = Shape> {
+    let selfs = || core::iter::once(None).chain((2..=MAX_SELF_EXPONENT).step_by(2).map(Some));
+    let crosses = core::iter::once(None).chain((0..=MAX_CROSS_EXPONENT).map(|u| Some((u, u))));
+    crosses.flat_map(move |cross| {
+        selfs().flat_map(move |s| {
+            selfs().map(move |t| Shape {
+                form: Form::MagnetCurrent,
+                s,
+                t,
+                cross,
+                rib: None,
+            })
+        })
+    })
+}
+
+/// A pattern search of the rib's ψn, a_bp and k_q about `best` (steps of 10 % of each, or of
+/// its grid's first step, halved when no neighbour fits better, down to 0.1 %).
+fn refine_rib<T: Real>(
+    mut best: (Shape, Saturation<T>, T),
+    samples: &FluxSamples<T>,
+    flux: T,
+) -> (Shape, Saturation<T>, T) {
+    let mut h = 0.1;
+    while h > 1e-3 {
+        let Some(rib) = best.0.rib else {
+            return best;
+        };
+        let steps = [
+            (h * rib.psi_n, 0.0, 0.0),
+            (0.0, h * (rib.a_bp + RIB_A_BP[1]), 0.0),
+            (0.0, 0.0, h * (rib.k_q + RIB_K_Q[1])),
+        ];
+        let neighbours = steps.into_iter().flat_map(|(a, b, c)| {
+            [1.0, -1.0].map(|sign| Rib {
+                psi_n: rib.psi_n + sign * a,
+                a_bp: (rib.a_bp + sign * b).max(0.0),
+                k_q: (rib.k_q + sign * c).max(0.0),
+            })
+        });
+        let candidates = neighbours.map(|rib| Shape {
+            rib: Some(rib),
+            ..best.0
+        });
+        match best_of(candidates, samples, flux) {
+            Some(next) if next.2 < best.2 => best = next,
+            _ => h *= 0.5,
+        }
+    }
+    best
 }
 
 /// The detection statistic: the largest relative change of the incremental inductances
@@ -321,6 +502,44 @@ mod tests {
             }
             assert!(inductance_change(&m, i_max) > 0.3);
         }
+    }
+
+    /// The 5.6 kW PM-SyRM of Lelli et al. (the magnet as the rib's Norton source), sampled
+    /// along the pulses' six directions (0°, 60°, …, 300°) up to its rated 12.45 A: the
+    /// search with the rib finds a model whose incremental inductances are within 2 % of the
+    /// truth's over the rated current range (a 9 × 9 grid of |i| ≤ 12.45 A; measured 0.26 %);
+    /// the best model without it is off by more than 10 % (measured 59 %).
+    #[test]
+    fn the_rib_search_recovers_the_pm_syrm() {
+        let truth = crate::magnetics::tests::pmsyrm();
+        let i_max = 12.45;
+        let psi0 = truth.flux(Dq::zero());
+        let mut s = FluxSamples::new();
+        for k in 0..6 {
+            let a = core::f64::consts::TAU * k as f64 / 6.0;
+            for n in 1..=20 {
+                let i = Dq::new(a.cos(), a.sin()) * (i_max * n as f64 / 20.0);
+                s.push(truth.flux(i) - psi0, i, 0.0);
+            }
+        }
+        let worst = |m: &Saturation<f64>| {
+            let mut w = 0.0f64;
+            for j in -4..=4 {
+                for k in -4..=4 {
+                    let i = Dq::new(j as f64, k as f64) * (i_max / 4.0);
+                    if i.norm() <= i_max {
+                        let (a, b) = (m.incremental_inductance(i), truth.incremental_inductance(i));
+                        w = w
+                            .max((a.dd / b.dd - 1.0).abs())
+                            .max((a.qq / b.qq - 1.0).abs());
+                    }
+                }
+            }
+            w
+        };
+        let (m, _, _) = best_fit(&s, psi0.d).unwrap();
+        let (_, m0, _) = best_of(shapes(), &s, psi0.d).unwrap();
+        assert!(m.a_b > 0.0 && worst(&m) < 0.02 && worst(&m0) > 0.1);
     }
 
     /// Constant inductances: no change; too few samples: no model.

@@ -108,8 +108,9 @@
 //!    motion within a pair, read from the pair's end (zero current again: the flux change
 //!    across the magnet is λf·δ) and spread over the pair by the double integral of the
 //!    measured torque's shape ψ × i. At the end, with the final λ̂f, every shape of the
-//!    algebraic model (exponents, and the magnet as a flux or as a current) is fitted by
-//!    least squares and the best kept (`magnetic_fit`). Saturation is reported, and the model
+//!    algebraic model (exponents, the magnet as a flux or as a current, and the saturating
+//!    rib of a PM-assisted SyRM) is fitted by least squares and the best kept
+//!    (`magnetic_fit`). Saturation is reported, and the model
 //!    returned in [`Identification::saturation`], when its incremental inductances change by
 //!    more than `detection_threshold` (5 %) over the pulses' range and it explains the data
 //!    (RMS residual below half the constant-inductance model's); a linear machine keeps its
@@ -157,7 +158,8 @@
 //!    grows with the speed (timing).
 //! 7. **Inertia and friction** ([`Phase::Inertia`]): in closed loop on the PLL's angle (the
 //!    back-EMF observer is the sensorless angle), a q-current step (sized so that each step
-//!    lasts 0.5 s on the nameplate inertia, 10–90 % of the limit) up to 2× the spin speed;
+//!    lasts 0.5 s on the nameplate inertia, 10–90 % of the limit, at most the I-f level of
+//!    λ̂f and L̂: `step_level`, as the spin's and for its reason) up to 2× the spin speed;
 //!    there, the second back-EMF window (no q current, the coast's d current); then the
 //!    opposite step down to 0.5×. Since ω_mech(t) = ω(t₀) + (1/J)·∫T̂e − (B/J)·∫ω_mech with
 //!    T̂e = 1.5·p·(λ̂f·i_q + (L̂d − L̂q)·i_d·i_q), the means over consecutive windows of 40 ms
@@ -206,7 +208,7 @@ use crate::{Ab, Dq};
 use fits::{BlockStats, EmfWindow, JFit, JWindows, Line, emf_line};
 pub use flux_pulses::MagneticFit;
 use flux_pulses::{FluxPulses, magnetics_time};
-use sizing::{clamp, dc_level, dead_time_voltage, libm_round, limit, spin_sizing};
+use sizing::{clamp, dc_level, dead_time_voltage, libm_round, limit, spin_sizing, step_level};
 
 /// The commissioning state machine (module docs).
 #[derive(Clone, Debug)]

@@ -55,6 +55,34 @@ pub(super) fn if_level<T: Real>(np: &MachineModel<T>, ld: T, lq: T, i_limit: T) 
     dc_level(&MachineModel { ld, lq, ..*np }, i_limit)
 }
 
+/// The inertia test's q-current step: `wanted` within 10–90 % of the limit, and at most the
+/// I-f level ([`if_level`]) of the identified λ̂f, L̂d, L̂q. The step's current runs in closed
+/// loop on the back-EMF PLL's angle, and an angle error ε puts I·sin ε of it on the d axis,
+/// where the active flux λf + (Ld − Lq)·i_d that the PLL locks onto falls; at
+/// I = λf/(Lq − Ld) it vanishes for ε = −π/2 and the PLL has nothing to hold it. Measured
+/// on the 5.6 kW PM-SyRM presets (I = 4.0 A ≈ λf/(Lq − Ld), its secant Lq below the
+/// injection's L̂q under load): the PLL drifted to ε ≈ −1.5 rad within 0.1 s of the step,
+/// the current turned onto +d, the rotor stopped accelerating and the test timed out.
+pub(super) fn step_level<T: Real>(
+    np: &MachineModel<T>,
+    flux: T,
+    ld: T,
+    lq: T,
+    i_limit: T,
+    wanted: T,
+) -> T {
+    let cap = if_level(
+        &MachineModel {
+            flux_linkage: flux,
+            ..*np
+        },
+        ld,
+        lq,
+        i_limit,
+    );
+    clamp(wanted, T::lit(0.1) * i_limit, T::lit(0.9) * i_limit).min(cap)
+}
+
 /// The I-f current (`if_level`) and the spin's electrical acceleration: spin_torque_ratio ×
 /// the rated torque on the nameplate J, at most a quarter of the magnet torque 1.5·p·λf·I_if
 /// (the rotor then lags the current vector by about 15°, far from the pull-out even with the

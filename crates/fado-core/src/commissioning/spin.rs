@@ -327,14 +327,18 @@ impl<T: Real> Commissioning<T> {
             return false;
         }
         // q current of the torque steps: each step takes J_STEP_TIME on the nameplate
-        // inertia with the identified λ̂f, within 10–90 % of the limit.
+        // inertia with the identified λ̂f, within 10–90 % of the limit and at most the I-f
+        // level of λ̂f and the identified L̂ (`step_level`).
         let p = T::lit(cfg.nameplate.pole_pairs as f64);
         let d_omega_mech = T::lit(J_HIGH - J_LOW) * self.spin_speed / p;
         let kt = T::lit(1.5) * p * self.flux;
-        self.i_j = clamp(
+        self.i_j = step_level(
+            &cfg.nameplate,
+            self.flux,
+            self.ld,
+            self.lq,
+            self.i_limit,
             cfg.nameplate.inertia * d_omega_mech / (T::lit(J_STEP_TIME) * kt),
-            T::lit(0.1) * self.i_limit,
-            T::lit(0.9) * self.i_limit,
         );
         // Release rate of the coast's d current: |(L̂d − L̂q)·di_d/dt| ≤
         // ID_RELEASE_EMF·ω̂·λ̂f.

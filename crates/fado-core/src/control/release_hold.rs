@@ -25,6 +25,23 @@
 //! rated load moves the paper's rotor 0.19 rad for a 0.2 rad design, and a rotor of a
 //! twelfth of its inertia, where the cap binds, 0.47 rad (the unit tests).
 //!
+//! # The current loop it needs
+//! The hold's torque comes through the current loop, a first-order lag 1/ωc: ω_h is capped at
+//! ωc/10 so that the loop stays the designed triple pole. On a light, many-pole rotor the
+//! rated load's electrical acceleration p·T_rated/Ĵ is 10–40 times the paper's motor's
+//! (4.4·10⁴ rad/s² on the multirotor preset, 5.5·10⁴ on the cheetah outrunner, 3.8·10³ on the
+//! paper's): with the paper's 250 Hz current loop the cap binds and the rated load moves the
+//! rotor by 0.27·a/(ωc/10)² = 0.48 rad on the multirotor preset (measured 0.52 rad with the
+//! free fall before the trigger, against the 0.5 rad a loaded start may lose). Where the hold
+//! is enabled, the drive raises the current loop's bandwidth to the 10·ω_h its design travel
+//! needs ([`current_bandwidth_for_hold`]) where the cap would let the rated load move the
+//! rotor by more than twice the design travel, never lowering the tuning's and at most
+//! ωc·Ts = [`MAX_CURRENT_WC_TS`]. The electrical side allows it: such a motor's stator pole
+//! R/L (3.7·10³ s⁻¹ on the multirotor preset) is itself above the paper's 2π·250 Hz, and its
+//! PWM samples at 40 kHz or more. On the presets the rule acts only on the two outrunners
+//! (multirotor 387 Hz, capped travel 2.4 times the design; cheetah 436 Hz, 3.0 times); a
+//! 750 W 10-pole servo (1.6 times, 0.33 rad) keeps its 250 Hz.
+//!
 //! # When
 //! Armed at every (re)alignment with θ_hold = the aligned angle; it acts only once the angle
 //! estimate has left θ_hold by [`ReleaseHoldTuning::trigger`] while the speed reference is
@@ -86,6 +103,53 @@ impl<T: Real> Default for ReleaseHoldTuning<T> {
 }
 
 cast_record!(ReleaseHoldTuning { travel, trigger, window ; enabled });
+
+/// The largest ωc·Ts the hold's current-loop rule gives ([`current_bandwidth_for_hold`]):
+/// 0.2 \[A\], with the loop's 1.5-sample delay a phase margin of 90° − 0.3 rad = 73°
+/// (the current loop refuses ωc·Ts above 0.5, 47°).
+pub const MAX_CURRENT_WC_TS: f64 = 0.2;
+
+/// How far beyond its design travel the current loop's cap may let the rated load move the
+/// rotor before the hold's rule raises the loop: 2 \[A\] (0.4 rad for the default 0.2 rad
+/// design, 80 % of the 0.5 rad a loaded start may lose, the rest for the free fall before the
+/// trigger). A tuning that holds the rotor is left as it is.
+const CAPPED_TRAVEL_RATIO: f64 = 2.0;
+
+/// The hold's stiffness ω_h (rad/s) before the caps: the rated load moves the rotor by
+/// `travel`, ω_h = √(0.27·b·I_rated/travel), b = 1.5·p²·λ̂f/Ĵ (module docs).
+fn design_omega<T: Real>(machine: &MachineModel<T>, travel: T) -> T {
+    let p = T::lit(machine.pole_pairs as f64);
+    let b = T::lit(1.5) * p * p * machine.flux_linkage / machine.inertia;
+    (T::lit(PEAK_TRAVEL) * b * machine.rated_current / travel).step_sqrt()
+}
+
+/// The current loop's bandwidth (Hz) the release hold needs on `machine` sampled every `ts`:
+/// 10·ω_h/2π for its design travel where the hold is enabled and the cap ω_h ≤ ωc/10 of
+/// `current_hz` (the tuning's) would let the rated load move the rotor by more than twice
+/// that travel (ω_h² > 2·(ωc/10)²), at most ωc·Ts = [`MAX_CURRENT_WC_TS`]; `current_hz`
+/// otherwise (module docs, "The current loop it needs"). A non-finite result keeps
+/// `current_hz`.
+pub fn current_bandwidth_for_hold<T: Real>(
+    tuning: &ReleaseHoldTuning<T>,
+    machine: &MachineModel<T>,
+    ts: T,
+    current_hz: T,
+) -> T {
+    if !tuning.enabled {
+        return current_hz;
+    }
+    let omega = design_omega(machine, tuning.travel);
+    let capped = T::two_pi() * current_hz / T::lit(10.0);
+    // NaN compares false: the tuning's.
+    if !(omega * omega > T::lit(CAPPED_TRAVEL_RATIO) * capped * capped) {
+        return current_hz;
+    }
+    let wc = T::lit(10.0) * omega;
+    let wc = crate::real::min(wc, T::lit(MAX_CURRENT_WC_TS) / ts);
+    let hz = wc / T::two_pi();
+    // NaN compares false: the tuning's.
+    if hz > current_hz { hz } else { current_hz }
+}
 
 /// Peak of t²·e^(−t)/2 (at t = 2): the largest travel of the triple-pole loop per a/ω_h².
 const PEAK_TRAVEL: f64 = 0.270_670_566_473_225_4;
@@ -152,8 +216,7 @@ impl<T: Real> ReleaseHold<T> {
         check::below("release_hold.window", n, T::lit(4e9), "below 4e9 samples")?;
         let p = T::lit(machine.pole_pairs as f64);
         let b = T::lit(1.5) * p * p * machine.flux_linkage / machine.inertia;
-        let omega = (T::lit(PEAK_TRAVEL) * b * machine.rated_current / travel)
-            .step_sqrt()
+        let omega = design_omega(machine, travel)
             .step_min(T::two_pi() * current_bandwidth_hz / T::lit(10.0))
             .step_min(T::lit(0.1) / ts);
         let kp = T::lit(3.0) * omega * omega / b;
@@ -216,6 +279,20 @@ impl<T: Real> ReleaseHold<T> {
     /// Times the hold acted since the drive was built.
     pub fn engaged(&self) -> u32 {
         self.engaged
+    }
+
+    /// The torque the hold stands for, A of magnet q current: its command while it acts, then
+    /// its integral (the load it found), kept after the hand-over until the next
+    /// [`arm`](Self::arm); zero if it never acted.
+    /// The drive's tracker feed-forward takes it off the commanded torque (see
+    /// [`tracker_feedforward`](crate::control::tracker_feedforward), "The release hold's
+    /// load").
+    pub fn load(&self) -> T {
+        if self.active {
+            self.output
+        } else {
+            self.integral
+        }
     }
 
     /// The loop's sampling period, s.
@@ -324,6 +401,66 @@ mod tests {
             assert!(end.abs() < 0.01 * worst, "{end}");
             assert!((i - m.rated_current).abs() < 0.01 * m.rated_current, "{i}");
         }
+    }
+
+    #[test]
+    fn a_light_rotor_gets_the_current_loop_its_hold_needs() {
+        // The multirotor preset (14 pole pairs, 0.875 mWb, 34 A, 2e-4 kg·m², Ts = 25 µs):
+        // b·I = 4.4e4 rad/s², ω_h = √(0.27·4.4e4/0.2) = 243 rad/s, ωc = 10·ω_h: 387 Hz.
+        let fast = crate::control::tracker_feedforward::multirotor_model();
+        let on = ReleaseHoldTuning {
+            enabled: true,
+            ..ReleaseHoldTuning::default()
+        };
+        let hz = current_bandwidth_for_hold(&on, &fast, 25e-6, 250.0);
+        assert!((hz - 387.2).abs() < 0.5, "{hz}");
+        // With it the hold is the designed triple pole (not capped): the rated load moves the
+        // rigid rotor by about the design travel, against 0.48 rad at 250 Hz.
+        let ts = 25e-6;
+        let p = 14.0;
+        let b = 1.5 * p * p * fast.flux_linkage / fast.inertia;
+        let travel = |current_hz: f64| {
+            let mut h = ReleaseHold::new(&on, &fast, ts, current_hz, 68.0).unwrap();
+            let (mut theta, mut omega, mut i, mut worst) = (0.0f64, 0.0, 0.0, 0.0f64);
+            h.arm(0.0);
+            for _ in 0..(0.05 / ts) as usize {
+                if let HoldAction::Hold(x) = h.step(0.0, theta, theta) {
+                    i = x;
+                }
+                omega += b * (i - fast.rated_current) * ts;
+                theta += omega * ts;
+                worst = worst.max(-theta);
+            }
+            worst
+        };
+        let (wide, paper) = (travel(hz), travel(250.0));
+        assert!(wide < 0.25 && paper > 0.4, "{wide} {paper}");
+        // The paper's motor keeps the tuning's bandwidth, as does a disabled hold; the
+        // sampling caps the rule at ωc·Ts = 0.2.
+        // A 750 W 10-pole servo's capped travel is 1.6 times the design (0.33 rad): kept.
+        let servo = MachineModel {
+            pole_pairs: 5,
+            flux_linkage: 0.05,
+            rated_current: 6.4,
+            rated_torque: 2.4,
+            inertia: 4e-4,
+            ..MachineModel::<f64>::paper()
+        };
+        assert_eq!(current_bandwidth_for_hold(&on, &servo, 1e-4, 250.0), 250.0);
+        let paper_motor = MachineModel::<f64>::paper();
+        assert_eq!(
+            current_bandwidth_for_hold(&on, &paper_motor, 1e-4, 250.0),
+            250.0
+        );
+        let off = ReleaseHoldTuning::default();
+        assert_eq!(current_bandwidth_for_hold(&off, &fast, ts, 250.0), 250.0);
+        let feather = MachineModel {
+            inertia: 1e-9,
+            ..fast
+        };
+        let capped = current_bandwidth_for_hold(&on, &feather, ts, 250.0);
+        let wc_ts = core::f64::consts::TAU * capped * ts;
+        assert!((wc_ts - MAX_CURRENT_WC_TS).abs() < 1e-12, "{wc_ts}");
     }
 
     #[test]

@@ -57,10 +57,18 @@
 //! range) and ĉ at ±0.5·g.
 //!
 //! **Gate.** Only at a loaded standstill: |ω*| below a small fraction of the rated speed,
-//! |τ| above a fraction of the rated current, the estimator in limiter mode, the lock
-//! supervisor running normally; the probe starts after the gate has held for the arming time
-//! (not in a passage through zero or a short stop), and stops (Δi_d = 0, no turn, ĉ
-//! forgotten) the sample the gate opens.
+//! |τ| above a fraction of the rated current, the lock supervisor running normally. The
+//! arming time counts from the sample the standstill reference begins, not from limiter
+//! mode: a stop that ends within it (a passage through zero, fig12's 0.3 s stops) never
+//! arms the probe, and in a longer one the probe starts the first sample the estimator is
+//! in limiter mode after it, so the creep of θ̂ that limiter mode lets run (ε_q/λ̂f,
+//! 0.2–0.4 rad/s on the presets and made-up machines, docs/range.md) has no unwatched half
+//! second in which to build while the rotor settles from a stop at the current limit.
+//! Once probing, the gate no longer asks for limiter mode: the probe's own torque swings
+//! the rotor by a few r/min, which on a slow motor (a 150 r/min torque motor's Fig. 3
+//! threshold is 2.25 r/min) takes the estimator out of limiter mode for a few samples, and
+//! a probe that stopped there would forget ĉ each time. The probe stops (Δi_d = 0, no turn,
+//! ĉ forgotten) the sample the standstill ends.
 //!
 //! **Flux-magnitude hold.** While the probe runs, the drive also holds the estimate's rotor
 //! flux on the model's circle, |λ̂r| = λ̂a at the last current reference
@@ -124,8 +132,10 @@ pub struct StandstillProbe<T> {
     period_samples: u32,
     /// Samples the gate holds before the probe starts (≥ 1).
     arm_samples: u32,
-    /// Samples the gate has held since it last opened (saturating).
+    /// Samples the standstill has held since it last ended (saturating at the arming time).
     gated: u32,
+    /// Probing: armed, and the estimator has been in limiter mode since.
+    probing: bool,
     /// Sample index within the running period.
     phase: u32,
     /// Σ s·τ over the settled windows.
@@ -205,6 +215,7 @@ impl<T: Real> StandstillProbe<T> {
             period_samples,
             arm_samples: 1,
             gated: 0,
+            probing: false,
             phase: 0,
             sum: T::zero(),
             sum_id: T::zero(),
@@ -221,27 +232,31 @@ impl<T: Real> StandstillProbe<T> {
     }
 
     /// Whether the drive is at a loaded standstill: |ω*| ≤ the speed bound, |τ| ≥ the load
-    /// bound, `limiter_mode` (which bounds |ω̂| by the Fig. 3 threshold) and `running` (the
-    /// lock supervisor's normal run). Not |ω̂| itself: the probe moves the rotor by
-    /// ±1–1.5 r/min on the paper's motor, which a tight bound on ω̂ would read as motion.
-    pub fn gate(&self, omega_ref: T, tau: T, limiter_mode: bool, running: bool) -> bool {
+    /// bound and `running` (the lock supervisor's normal run). Not |ω̂| itself: the probe
+    /// moves the rotor by ±1–1.5 r/min on the paper's motor, which a tight bound on ω̂ would
+    /// read as motion. The arming time counts while it holds; the probe starts in limiter
+    /// mode ([`Self::step`]).
+    pub fn gate(&self, omega_ref: T, tau: T, running: bool) -> bool {
         let c = &self.config;
         c.amplitude > T::zero()
             && running
-            && limiter_mode
             && omega_ref.abs() <= c.max_speed
             && tau.abs() >= c.min_load
     }
 
-    /// One sample: `gate` from [`Self::gate`], `tau` the speed loop's torque demand of this
+    /// One sample: `gate` from [`Self::gate`], `limiter_mode` the estimator's mode (the
+    /// armed probe starts in limiter mode, which bounds |ω̂| by the Fig. 3 threshold, and then
+    /// holds until the gate opens), `tau` the speed loop's torque demand of this
     /// sample (units of the magnet's q current), `omega` the speed estimate of the speed loop
     /// (electrical rad/s), `i_dq_prev` the last sample's current reference (d, q) in the
     /// estimated frame, `flux_linkage` λ̂f, `saliency` L̂d − L̂q.
     /// Returns Δi_d for this sample's d-current reference (A); [`Self::rate`] is the turn
     /// for the estimator.
+    #[allow(clippy::too_many_arguments)]
     pub fn step(
         &mut self,
         gate: bool,
+        limiter_mode: bool,
         tau: T,
         omega: T,
         i_dq_prev: (T, T),
@@ -259,6 +274,12 @@ impl<T: Real> StandstillProbe<T> {
             // Armed after the gate has held for the arming time: no probe yet.
             self.gated += 1;
             return T::zero();
+        }
+        if !self.probing {
+            if !limiter_mode {
+                return T::zero();
+            }
+            self.probing = true;
         }
         let half = n / 2;
         let (sign, in_half) = if self.phase < half {
@@ -351,9 +372,9 @@ impl<T: Real> StandstillProbe<T> {
         self.gated != 0
     }
 
-    /// Probing now (the gate has held for a period).
+    /// Probing now (armed, and in limiter mode since).
     pub fn active(&self) -> bool {
-        self.gated >= self.arm_samples
+        self.probing
     }
 }
 
@@ -441,7 +462,7 @@ mod tests {
         let mut id = i_d0;
         for _ in 0..400 {
             let iq = b.currents(tau, id).1;
-            let did = p.step(true, tau, 0.0, (id, iq), b.flux, b.saliency);
+            let did = p.step(true, true, tau, 0.0, (id, iq), b.flux, b.saliency);
             id = i_d0 + did;
             tau += (b.tau(id) - tau) / lag;
         }
@@ -475,7 +496,7 @@ mod tests {
         let mut p = probe(2.2);
         let tau = b_tau_zero();
         for _ in 0..400 {
-            p.step(true, tau, 0.0, (0.0, tau), 0.1, 0.0);
+            p.step(true, true, tau, 0.0, (0.0, tau), 0.1, 0.0);
         }
         assert!(p.active() && p.reading() == 0.0 && p.rate() == 0.0);
     }
@@ -537,19 +558,19 @@ mod tests {
         let mut id = 0.0;
         let mut tau = b.tau(0.0);
         for _ in 0..400 {
-            id = p.step(true, tau, 0.0, (id, tau), 0.1, 0.0);
+            id = p.step(true, true, tau, 0.0, (id, tau), 0.1, 0.0);
             tau = b.tau(id);
         }
         let first = 0.25 * (1.0 + CREEP_GAIN_RATIO) * p.reading();
         assert!(p.rate() > 0.0 && (p.rate() - first).abs() < 1e-12);
-        assert!(p.gate(0.5, 5.0, true, true) && p.gate(-0.5, -5.0, true, true));
-        assert!(!p.gate(2.0, 5.0, true, true) && !p.gate(0.0, 0.5, true, true));
-        assert!(!p.gate(0.0, 5.0, false, true) && !p.gate(0.0, 5.0, true, false));
-        assert_eq!(p.step(false, tau, 0.0, (0.0, tau), 0.1, 0.0), 0.0);
+        assert!(p.gate(0.5, 5.0, true) && p.gate(-0.5, -5.0, true));
+        assert!(!p.gate(2.0, 5.0, true) && !p.gate(0.0, 0.5, true));
+        assert!(!p.gate(0.0, 5.0, false));
+        assert_eq!(p.step(false, true, tau, 0.0, (0.0, tau), 0.1, 0.0), 0.0);
         assert_eq!((p.rate(), p.active()), (0.0, false));
-        assert_eq!(p.step(true, f64::NAN, 0.0, (0.0, tau), 0.1, 0.0), 0.0);
+        assert_eq!(p.step(true, true, f64::NAN, 0.0, (0.0, tau), 0.1, 0.0), 0.0);
         // Off (amplitude 0): never gated.
-        assert!(!probe(0.0).gate(0.0, 5.0, true, true));
+        assert!(!probe(0.0).gate(0.0, 5.0, true));
     }
 
     /// A rigid rotor under the speed PI (5 Hz, zero at a fifth of it), period 0.1 s: the
@@ -581,7 +602,7 @@ mod tests {
             let (mut omega, mut integral, mut id) = (0.0, b.tau(0.0), 0.0);
             for _ in 0..3000 {
                 let tau = kp * -omega + integral;
-                id = p.step(true, tau, omega, (id, tau), flux, 0.0);
+                id = p.step(true, true, tau, omega, (id, tau), flux, 0.0);
                 let torque = b.torque(tau, id) / flux;
                 omega += ts * (torque - b.load / flux) / c_j;
                 integral += ts * ki * -omega;
@@ -644,7 +665,7 @@ mod tests {
         let mut worst_late = 0.0f64;
         for n in 0..3000 {
             let tau = b.tau(id);
-            id = p.step(true, tau, 0.0, (id, tau), b.flux, 0.0);
+            id = p.step(true, true, tau, 0.0, (id, tau), b.flux, 0.0);
             // δ = θ − θ̂: the creep turns θ̂ away, the probe's turn brings it back.
             b.delta += ts * (creep - p.rate());
             if n > 1500 {
@@ -652,5 +673,42 @@ mod tests {
             }
         }
         assert!(worst_late < 0.05 * creep / gain, "{worst_late} rad");
+    }
+
+    /// The arming time counts the standstill whatever the estimator's mode; the armed probe
+    /// starts the first sample in limiter mode and then holds when limiter mode drops (its
+    /// own swing of the rotor), until the standstill ends.
+    #[test]
+    fn arming_counts_the_standstill_and_the_probe_holds_out_of_limiter_mode() {
+        let (tau, flux) = (14.0, 0.1);
+        let mut p = probe(2.2); // arming time 0.2 s = 200 samples
+        let mut step = |p: &mut StandstillProbe<f64>, gate: bool, limiter: bool| {
+            p.step(gate, limiter, tau, 0.0, (0.0, tau), flux, 0.0)
+        };
+        for _ in 0..300 {
+            assert_eq!(step(&mut p, true, false), 0.0);
+        }
+        assert!(p.gated() && !p.active(), "armed, not yet in limiter mode");
+        assert_ne!(
+            step(&mut p, true, true),
+            0.0,
+            "starts at once in limiter mode"
+        );
+        assert!(p.active());
+        for _ in 0..50 {
+            step(&mut p, true, false);
+        }
+        assert!(p.active(), "holds out of limiter mode");
+        assert_eq!(step(&mut p, false, true), 0.0);
+        assert!(!p.active() && !p.gated(), "stops with the standstill");
+        // A stop shorter than the arming time never probes, even in limiter mode.
+        for _ in 0..150 {
+            assert_eq!(step(&mut p, true, true), 0.0);
+        }
+        step(&mut p, false, true);
+        for _ in 0..150 {
+            assert_eq!(step(&mut p, true, true), 0.0);
+        }
+        assert!(!p.active());
     }
 }

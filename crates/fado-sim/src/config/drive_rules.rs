@@ -18,9 +18,15 @@ const BANDWIDTH_RULE: &str = "T2S-1's bandwidth in k_df mode at which a step of 
     torque peaks at `[controller.tracker_feedforward] load_step_error` \
     (fado_core::control::tracker_feedforward)";
 
+/// The release hold's rule for the current loop's bandwidth.
+const HOLD_CURRENT_RULE: &str = "10·ω_h of the release hold's design travel where the hold is \
+    enabled and that is above the tuning's, at most ωc·Ts = 0.2 \
+    (fado_core::control::release_hold)";
+
 /// `cfg` with the values the drive's build-time rule sets in its tuning (the acceleration
 /// feed-forward, the trackers' load pole and T2S-1's running bandwidth of
-/// `fado_core::control::tracker_feedforward`), each recorded as derived: what the drive runs
+/// `fado_core::control::tracker_feedforward`, the current loop's bandwidth of
+/// `fado_core::control::release_hold`), each recorded as derived: what the drive runs
 /// with, as `--dump-config` shows it.
 pub(crate) fn with_drive_rules(cfg: &SimConfig) -> SimConfig {
     let mut c = cfg.clone();
@@ -32,35 +38,58 @@ pub(crate) fn with_drive_rules(cfg: &SimConfig) -> SimConfig {
         &mut estimator,
         drive.ts,
     );
-    let mut derive = |key: &str, value: f64, rule: &'static str| {
-        c.derived.retain(|d| d.key != key);
-        c.derived.push(Derived {
-            key: key.to_owned(),
-            value,
-            rule,
-        });
-    };
+    let mut derived = std::mem::take(&mut c.derived);
     if tuning.tracker_feedforward.enabled != c.controller.tracker_feedforward.enabled {
-        derive(
+        record(
+            &mut derived,
             "controller.tracker_feedforward.enabled",
             1.0,
             FEEDFORWARD_RULE,
         );
         c.controller.tracker_feedforward.enabled = true;
     }
-    let pole = estimator.tracker.load_pole_ratio;
-    if pole != c.estimator.tracker.load_pole_ratio {
-        derive("estimator.tracker.load_pole_ratio", pole, LOAD_POLE_RULE);
-        c.estimator.tracker.load_pole_ratio = pole;
-    }
-    let bandwidth = estimator.tracker.t2s1_running_bandwidth_hz;
-    if bandwidth != c.estimator.tracker.t2s1_running_bandwidth_hz {
-        derive(
+    let current = fado_core::control::release_hold::current_bandwidth_for_hold(
+        &tuning.release_hold,
+        &drive.machine,
+        drive.ts,
+        tuning.current.bandwidth_hz,
+    );
+    let t = &mut c.estimator.tracker;
+    for (key, value, field, rule) in [
+        (
+            "estimator.tracker.load_pole_ratio",
+            estimator.tracker.load_pole_ratio,
+            &mut t.load_pole_ratio,
+            LOAD_POLE_RULE,
+        ),
+        (
             "estimator.tracker.t2s1_running_bandwidth_hz",
-            bandwidth,
+            estimator.tracker.t2s1_running_bandwidth_hz,
+            &mut t.t2s1_running_bandwidth_hz,
             BANDWIDTH_RULE,
-        );
-        c.estimator.tracker.t2s1_running_bandwidth_hz = bandwidth;
+        ),
+        (
+            "controller.current.bandwidth_hz",
+            current,
+            &mut c.controller.current.bandwidth_hz,
+            HOLD_CURRENT_RULE,
+        ),
+    ] {
+        if value != *field {
+            record(&mut derived, key, value, rule);
+            *field = value;
+        }
     }
+    c.derived = derived;
     c
+}
+
+/// Records `key` as derived with `value` by `rule`, replacing an earlier record of it.
+fn record(derived: &mut Vec<Derived>, key: &str, value: f64, rule: &'static str) {
+    derived.retain(|d| d.key != key);
+    derived.push(Derived {
+        key: key.to_owned(),
+        value,
+        rule,
+    });
 }

@@ -16,7 +16,9 @@ impl<T: Real> SensorlessDrive<T, SensorlessEstimator<T>> {
     /// The drive with the paper's estimator, built with the drive's own sampling period and
     /// machine model and the given estimator tuning (start-up angle 0; see
     /// [`align`](Self::align)). A rotor its trackers would lag at the current limit gets the
-    /// acceleration feed-forward ([`crate::control::tracker_feedforward`]).
+    /// acceleration feed-forward ([`crate::control::tracker_feedforward`]); an enabled release
+    /// hold the current-loop bandwidth it needs
+    /// ([`current_bandwidth_for_hold`](crate::control::release_hold::current_bandwidth_for_hold)).
     pub fn new(
         mut config: DriveConfig<T>,
         mut estimator: EstimatorTuning<T>,
@@ -27,6 +29,13 @@ impl<T: Real> SensorlessDrive<T, SensorlessEstimator<T>> {
             &mut config.tuning,
             &mut estimator,
             config.ts,
+        );
+        let t = &mut config.tuning;
+        t.current.bandwidth_hz = crate::control::release_hold::current_bandwidth_for_hold(
+            &t.release_hold,
+            &machine,
+            config.ts,
+            t.current.bandwidth_hz,
         );
         let estimator = EstimatorConfig {
             ts: check::positive("ts", config.ts)?,

@@ -19,16 +19,12 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         action: LockAction,
     ) -> T {
         let probe = &mut self.blocks.probe;
-        let gate = probe.gate(
-            speed_ref,
-            iq_torque,
-            estimate.diagnostics.mode == Mode::Limiter,
-            action == LockAction::Run,
-        );
+        let gate = probe.gate(speed_ref, iq_torque, action == LockAction::Run);
         let m = &self.config.machine;
         let last = self.last.i_dq_ref;
         probe.step(
             gate,
+            estimate.diagnostics.mode == Mode::Limiter,
             iq_torque,
             estimate.omega_control,
             (last.d, last.q),

@@ -260,7 +260,10 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         if self.config.tuning.tracker_feedforward.enabled {
             let m = &self.config.machine;
             let p = T::lit(m.pole_pairs as f64);
-            let torque = self.feedforward_torque(p);
+            // Less the load the release hold found (zero unless it acted): the trackers'
+            // load acceleration starts from it (see `tracker_feedforward`).
+            let held = T::lit(1.5) * p * m.flux_linkage * self.blocks.hold.load();
+            let torque = self.feedforward_torque(p) - held;
             self.estimator.set_acceleration(p * torque / m.inertia);
         }
         let estimate = self.estimator.step(self.history[1], i_ab);

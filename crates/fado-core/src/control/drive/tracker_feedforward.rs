@@ -43,6 +43,22 @@
 //! T2S-2, whose speed closes the speed loop, keeps its bandwidth. On the presets the rule
 //! acts only on the two outrunners (cheetah 141 Hz, multirotor 125 Hz; the others' rated
 //! steps need less than 60 Hz).
+//!
+//! **The release hold's load.** When a brake opens under a load, the
+//! [release hold](crate::control::release_hold) commands the torque that holds the rotor; fed
+//! forward whole, that torque reads as an acceleration p·T*/Ĵ of a rotor that does not move,
+//! and the trackers' speed runs up until their load integrator learns it (measured on the
+//! multirotor preset: T2S-2 at 290 r/min over a held rotor; at the hand-over the speed loop
+//! then takes the holding torque away and the rotor falls back 2 rad). So the drive feeds
+//! forward p·(T* − T_hold)/Ĵ with T_hold = 1.5·p·λ̂f·i_hold, i_hold
+//! ([`ReleaseHold::load`](crate::control::release_hold::ReleaseHold::load)) the hold's whole
+//! command while it acts (the rotor it holds does not accelerate on average: the trackers
+//! follow its small travel as a type-3 loop without feed-forward) and its integral, the load
+//! it found, after the hand-over until it is armed again: the same as starting the trackers'
+//! load integrator â at −p·T_hold/Ĵ. Zero where the hold never acts, so nothing else changes.
+//! Measured with a feed-forward less the integral alone (the hold's proportional kick still
+//! fed forward): the trackers swing ±200 r/min and the multirotor's θ̂ ends 0.3 rad off at the
+//! hand-over.
 
 use crate::Real;
 use crate::control::DriveTuning;
@@ -215,6 +231,22 @@ pub fn apply<T: Real>(
     }
 }
 
+/// The machine model of the `multirotor-mn5006-22v` preset's ratings (14 pole pairs,
+/// 0.875 mWb, 34 A, 0.625 N·m, 8000 r/min, 2e-4 kg·m²; the paper's R and L), for the tests of
+/// the fast-motor rules.
+#[cfg(test)]
+pub(crate) fn multirotor_model() -> MachineModel<f64> {
+    MachineModel {
+        pole_pairs: 14,
+        flux_linkage: 8.75e-4,
+        rated_current: 34.0,
+        rated_torque: 0.625,
+        rated_speed_rpm: 8000.0,
+        inertia: 2.0e-4,
+        ..MachineModel::paper()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -242,15 +274,7 @@ mod tests {
         assert!(!d2.tracker_feedforward.enabled && e2.tracker.load_pole_ratio == 0.0);
         assert_eq!((d2, e2), (d, e));
         // A 14-pole-pair multirotor motor with its propeller: 2.4 rad, feed-forward on.
-        let fast = MachineModel {
-            pole_pairs: 14,
-            flux_linkage: 8.75e-4,
-            rated_current: 34.0,
-            rated_torque: 0.625,
-            rated_speed_rpm: 8000.0,
-            inertia: 2.0e-4,
-            ..m
-        };
+        let fast = multirotor_model();
         let lag = current_limit_lag(&fast, &d, &e, 25e-6);
         assert!((lag - 2.4).abs() < 0.05, "{lag}");
         let (d2, e2) = resolve(&fast, d, e, 25e-6);

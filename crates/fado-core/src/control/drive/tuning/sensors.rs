@@ -233,9 +233,13 @@ pub struct StandstillProbeTuning<T> {
     /// (`fado_core::control::standstill_probe`, "Correction"), and a constant creep leaves no
     /// angle error.
     pub gain: T,
-    /// Time (s) the loaded standstill holds before the probe starts. Default 0.5 s \[A\]:
-    /// not in a passage through zero or a short stop (fig12's and the presets' `stops`
-    /// never arm it).
+    /// Time (s) the loaded standstill reference holds before the probe may start; it then
+    /// starts the first sample the estimator is in limiter mode. Default 0.5 s \[A\]: not in
+    /// a passage through zero or a short stop (fig12's and the presets' `stops` hold zero for
+    /// 0.3 s and never arm it). Counted from the reference, not from limiter mode, so that a
+    /// stop at the current limit whose rotor settles into limiter mode late leaves θ̂ no
+    /// unwatched half second to creep in (a 150 r/min 32-pole torque motor reached 0.45 rad
+    /// that way, docs/range.md).
     pub arm_time: T,
     /// The probe's gate: the speed reference |ω*| at most this multiple of the rated speed.
     /// Default 0.0005 \[A\] (0.75 r/min at 1500 r/min): a standstill reference. The probe
