@@ -2,8 +2,9 @@
 //! drive and the estimator given the plant's own magnetic model (`[model]` inherits
 //! `[motor.saturation]`) pass `reversal`, `stops` and `rated-reversal` for the current-sensor
 //! seeds 1–4 on the saturated IPMSM preset and on the measured PMSM flux map
-//! (`pmsm-gem-1k1-measured`), and on a machine that is no preset (the same IPMSM with five
-//! times its cross-saturation); the PM-SyRM's measured flux map runs as the
+//! (`pmsm-gem-1k1-measured`), and on machines that are no preset (the same IPMSM with five
+//! times its cross-saturation; a made-up 20-pole 48 V IPMSM with d, q and cross-saturation,
+//! `tests/data/ipmsm-20p-48v-saturated.toml`); the PM-SyRM's measured flux map runs as the
 //! plant's and the drive's model and passes `stops`. The PM-SyRM's reversals do not pass with
 //! the default tuning (docs/method/saturation.md, "Limits"); its results are in
 //! docs/results/saturation.md (`scripts/saturation-table.py`).
@@ -27,9 +28,8 @@ fn run(scenario: &str, text: &str) -> (bool, f64, f64) {
     (out.passed, angle, m.max_speed_error_rpm)
 }
 
-/// `reversal`, `stops` and `rated-reversal` pass for the sensor seeds 1–4 on the preset.
-fn passes_every_seed(path: &str) {
-    let base = preset(path);
+/// `reversal`, `stops` and `rated-reversal` pass for the sensor seeds 1–4 on the machine.
+fn passes_every_seed(base: &str) {
     for seed in 1..=4 {
         let text = format!("{base}\n[current_sensor]\nseed = {seed}\n");
         for scenario in ["reversal", "stops", "rated-reversal"] {
@@ -42,7 +42,7 @@ fn passes_every_seed(path: &str) {
 
 #[test]
 fn saturated_ipmsm_passes_every_seed() {
-    passes_every_seed("saturated/ipmsm-2k2-qsat.toml");
+    passes_every_seed(&preset("saturated/ipmsm-2k2-qsat.toml"));
 }
 
 #[test]
@@ -50,7 +50,12 @@ fn the_measured_pmsm_map_passes_every_seed() {
     // The preset's map path is relative to its file: resolve it as the CLI does.
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../motors/saturated");
     fado_sim::magnetics_file::set_config_dir(Some(std::path::Path::new(dir)));
-    passes_every_seed("saturated/pmsm-gem-1k1-measured.toml");
+    passes_every_seed(&preset("saturated/pmsm-gem-1k1-measured.toml"));
+}
+
+#[test]
+fn a_made_up_20_pole_ipmsm_passes_every_seed() {
+    passes_every_seed(include_str!("data/ipmsm-20p-48v-saturated.toml"));
 }
 
 #[test]

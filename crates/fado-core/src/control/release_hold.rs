@@ -141,15 +141,16 @@ pub fn current_bandwidth_for_hold<T: Real>(
     }
     let omega = design_omega(machine, tuning.travel);
     let capped = T::two_pi() * current_hz / T::lit(10.0);
-    let binds = omega * omega > T::lit(CAPPED_TRAVEL_RATIO) * capped * capped;
-    let wc = T::lit(10.0) * omega;
-    let hz = crate::real::min(wc, T::lit(MAX_CURRENT_WC_TS) / ts) / T::two_pi();
     // NaN compares false: the tuning's.
-    if binds && hz > current_hz {
-        hz
-    } else {
-        current_hz
+    let needs_wider_loop = omega * omega > T::lit(CAPPED_TRAVEL_RATIO) * capped * capped;
+    if !needs_wider_loop {
+        return current_hz;
     }
+    let wc = T::lit(10.0) * omega;
+    let wc = crate::real::min(wc, T::lit(MAX_CURRENT_WC_TS) / ts);
+    let hz = wc / T::two_pi();
+    // NaN compares false: the tuning's.
+    if hz > current_hz { hz } else { current_hz }
 }
 
 /// Peak of t²·e^(−t)/2 (at t = 2): the largest travel of the triple-pole loop per a/ω_h².

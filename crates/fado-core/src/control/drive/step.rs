@@ -207,8 +207,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         {
             return Err(self.calibration_step(i_abc));
         }
-        let o = self.current_offset;
-        let i_abc = Abc::new(i_abc.a - o.a, i_abc.b - o.b, i_abc.c - o.c);
+        let i_abc = self.offsets_removed(i_abc);
         let over_voltage = self.blocks.dc_link.over_voltage(vdc);
         if i_abc.a.abs() > trip || i_abc.b.abs() > trip || i_abc.c.abs() > trip || over_voltage {
             self.tripped = true;
