@@ -37,6 +37,7 @@ mod references;
 mod reject;
 mod resolved;
 mod saturation;
+pub mod speed_bandwidth;
 mod standstill;
 mod step;
 pub mod tracker_feedforward;
