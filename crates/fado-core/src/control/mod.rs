@@ -20,10 +20,10 @@ pub mod pi;
 pub mod ratings_limit;
 pub mod release_hold;
 pub mod saturated_references;
-pub mod speed_bandwidth;
 pub mod speed_controller;
 pub mod standstill_probe;
 pub mod startup;
+pub use drive::speed_bandwidth;
 pub use drive::tracker_feedforward;
 pub use drive::tuning;
 

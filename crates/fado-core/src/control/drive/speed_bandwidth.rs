@@ -53,7 +53,8 @@ pub fn apply<T: Real>(
     let own = drive.speed.bandwidth_hz;
     // NaN compares false: the tuning's bandwidth; an invalid one (≤ 0) is left for the
     // drive's checks to name.
-    if !(needed > own) || !needed.is_finite() || !(own > T::zero()) {
+    let raise = needed.is_finite() && own > T::zero() && needed > own;
+    if !raise {
         return;
     }
     let t = &mut estimator.tracker;
