@@ -179,6 +179,27 @@ pub fn inverted_polarity<T: Real>(machine: &MachineModel<T>, current: T) -> bool
     plus > minus
 }
 
+/// Whether the pulses of `current` meet a larger incremental inductance along d than along q:
+/// the model's L̂d > L̂q for constant inductances; for a saturating model (a flux map) the
+/// incremental inductances averaged over the pulses' paths from 0 to ±`current` along each
+/// axis, which the search's second harmonic reads (a measured map may turn the order of the
+/// datasheet's small-signal values).
+pub fn d_axis_larger<T: Real>(machine: &MachineModel<T>, current: T) -> bool {
+    if machine.magnetics.is_linear() || !current.is_finite() || current <= T::zero() {
+        return machine.ld > machine.lq;
+    }
+    let m = machine.magnetic_model();
+    let (mut d, mut q) = (T::zero(), T::zero());
+    for k in 1..=4 {
+        let i = current * T::from_index(k) * T::lit(0.25);
+        d += m.incremental_inductance(Dq::new(i, T::zero())).dd;
+        d += m.incremental_inductance(Dq::new(-i, T::zero())).dd;
+        q += m.incremental_inductance(Dq::new(T::zero(), i)).qq;
+        q += m.incremental_inductance(Dq::new(T::zero(), -i)).qq;
+    }
+    d > q
+}
+
 /// Where the start-up's angle phase stands.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum StartupStatus {
@@ -287,7 +308,7 @@ impl<T: Real> AngleSearch<T> {
             l_min: crate::real::min(machine.ld, machine.lq),
             l_max: crate::real::max(machine.ld, machine.lq),
             l_mean,
-            d_larger: machine.ld > machine.lq,
+            d_larger: d_axis_larger(machine, tuning.pulse_current_ratio * machine.rated_current),
             inverted: inverted_polarity(
                 machine,
                 tuning.pulse_current_ratio * machine.rated_current,
