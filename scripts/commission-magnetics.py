@@ -160,15 +160,27 @@ reversals, over the run for `stops`), "trip" when a seed tripped, and the seeds 
 LIMITS = """
 ## Limits
 
-- The PM-SyRM presets (`pmsyrm-baldor-5k6`, its algebraic model with the saturating rib of
-  Lelli et al., and `pmsyrm-baldor-5k6-measured`, its measured map) abort in the commissioning's
-  inertia test (`Timeout`: the back-EMF PLL's angle wanders on this rotor and the q-current
-  step does not reach its speed), a phase after the pulses and independent of them, so (b)
-  cannot run; their rows above are the pulses' fit with the nameplate's λf, which
-  `Commissioning::magnetic_model` gives after the abort. The searched shapes (the algebraic
-  model without the rib) fit these machines less well than constant inductances fit a linear
-  one (the residual ratio), which the inductance errors show: a rib, or a flux map built from
-  the pulses, is what such a machine needs.
+- The PM-SyRM presets (`pmsyrm-baldor-5k6`, `pmsyrm-baldor-5k6-measured`) trip in `reversal`
+  and `rated-reversal` with their true model as well as with the commissioned one: the drive's
+  closed loop on this rotor (the estimator's laws), not the identification, is what fails
+  there; `stops` passes with the true model, and with the commissioned one on the algebraic
+  preset but not on the measured map.
+- On these machines the identified λ̂f is high by 3 % (algebraic model) and 8 % (measured
+  map): the back-EMF windows run at a d current of −½ the test limit and read the active flux
+  through constant L̂d, L̂q. The pulses' fit takes this λ̂f as the magnet's flux, so it
+  carries into every flux value (the "flux max" column) and into the inductances where the
+  rib bends them.
+- The measured map's own asymmetry in i_d and its noise are beyond the algebraic model (with
+  the rib: the residual ratio 0.12–0.13 against 0.003–0.05 on the algebraic machines);
+  its incremental inductances are off by up to a third at the edges of the rated range.
+- A fitted model is used only where its incremental inductances at the inductance tests'
+  operating point agree with those tests within 20 %: the measured 1.1 kW PMSM map
+  (`pmsm-gem-1k1-measured`, its saliency 1.2) is fitted no better than by a shape without
+  physical meaning, and keeps constant inductances.
+- The identified flux map spans ± the drive's default current limit; the pulses measure only
+  up to the rated current, and beyond it the table holds the model's extrapolation. A model
+  that does not tabulate as a monotonic map there is written as `[model.saturation]`
+  instead (with a warning).
 - A magnetically linear machine's fit moves its inductances by up to a tenth on the strongly
   salient low-inductance `pmsyrm-5k` (the integration's own errors: inverter error at the
   current zero crossings) without explaining the data, which the residual criterion rejects.

@@ -23,6 +23,12 @@ const RISE_SAMPLES: f64 = 16.0;
 /// saturated ones 0.03, docs/results/commissioning-magnetics.md).
 const RESIDUAL_RATIO: f64 = 0.5;
 
+/// Largest relative difference between a fitted model's incremental inductances at the
+/// inductance tests' operating point and those tests' L̂d, L̂q for the model to be used
+/// (`agrees_with_injection`): well above the saturated presets' fits (a few %), well below
+/// a meaningless one's.
+const INJECTION_AGREEMENT: f64 = 0.2;
+
 /// Gates-off rest between pairs, in samples: the diodes take the current to zero (in
 /// microseconds), so that the next pair starts from ψ = (λf, 0).
 const REST_SAMPLES: u32 = 8;
@@ -367,7 +373,9 @@ impl<T: Real> Commissioning<T> {
         if !self.cfg.magnetics.enabled || self.pulses.stage != Stage::Hold {
             return None;
         }
-        let (model, residual, linear_residual) = best_fit(&self.pulses.samples, flux_linkage)?;
+        let consistent = |m: &Saturation<T>| self.agrees_with_injection(m);
+        let (model, residual, linear_residual) =
+            best_fit(&self.pulses.samples, flux_linkage, consistent)?;
         let change = inductance_change(&model, self.pulse_current());
         Some(MagneticFit {
             model,
@@ -375,8 +383,21 @@ impl<T: Real> Commissioning<T> {
             residual,
             linear_residual,
             detected: change > self.cfg.magnetics.detection_threshold
-                && residual < T::lit(RESIDUAL_RATIO) * linear_residual,
+                && residual < T::lit(RESIDUAL_RATIO) * linear_residual
+                && consistent(&model),
         })
+    }
+
+    /// Whether the incremental L_dd, L_qq of `model` at the inductance tests' operating point
+    /// (the I₁ bias along d) are within [`INJECTION_AGREEMENT`] of what those tests measured
+    /// there: a fit that explains the pulses with terms of no physical meaning (measured on
+    /// the measured 1.1 kW PMSM map of gym-electric-motor: a rib with L_qq(0) 100 % off)
+    /// is refused.
+    fn agrees_with_injection(&self, model: &Saturation<T>) -> bool {
+        let i1 = T::lit(0.5) * dc_level(&self.cfg.nameplate, self.i_limit);
+        let l = model.incremental_inductance(Dq::new(i1, T::zero()));
+        let tol = T::lit(INJECTION_AGREEMENT);
+        (l.dd / self.ld - T::one()).abs() < tol && (l.qq / self.lq - T::one()).abs() < tol
     }
 
     /// The zero-current constants (incremental L̂d, L̂q) of a fitted model.

@@ -302,10 +302,12 @@ fn shapes() -> impl Iterator<Item = Shape> {
 
 /// The best-fitting algebraic model of the samples with the magnet's flux `flux` (module
 /// docs), its RMS current residual and the constant-inductance model's, in A; None when no
-/// shape fits (too few samples).
+/// shape fits (too few samples). A model with the rib is taken only where `accept` takes it
+/// (the procedure's check against the injection tests' inductances).
 pub(super) fn best_fit<T: Real>(
     samples: &FluxSamples<T>,
     flux: T,
+    accept: impl Fn(&Saturation<T>) -> bool,
 ) -> Option<(Saturation<T>, T, T)> {
     let n = T::lit((2 * samples.len()).max(1) as f64);
     let linear = Shape {
@@ -318,7 +320,7 @@ pub(super) fn best_fit<T: Real>(
     let (_, r_linear) = linear.fit(samples, flux)?;
     let (_, m, r) = best_of(shapes(), samples, flux)?;
     let (m, r) = match rib_search(samples, flux) {
-        Some((m_rib, r_rib)) if r_rib < T::lit(RIB_GAIN) * r => (m_rib, r_rib),
+        Some((m_rib, r_rib)) if r_rib < T::lit(RIB_GAIN) * r && accept(&m_rib) => (m_rib, r_rib),
         _ => (m, r),
     };
     Some((m, (r / n).sqrt(), (r_linear / n).sqrt()))
@@ -490,7 +492,7 @@ mod tests {
         };
         for (truth, i_max) in [(around, 20.0), (current, 10.0)] {
             let flux = truth.flux(Dq::zero()).d;
-            let (m, rms, rms_linear) = best_fit(&samples(&truth, i_max), flux).unwrap();
+            let (m, rms, rms_linear) = best_fit(&samples(&truth, i_max), flux, |_| true).unwrap();
             assert!(
                 rms < 1e-6 * i_max && rms_linear > 1e-2 * i_max,
                 "{rms} {rms_linear}"
@@ -537,7 +539,7 @@ mod tests {
             }
             w
         };
-        let (m, _, _) = best_fit(&s, psi0.d).unwrap();
+        let (m, _, _) = best_fit(&s, psi0.d, |_| true).unwrap();
         let (_, m0, _) = best_of(shapes(), &s, psi0.d).unwrap();
         assert!(m.a_b > 0.0 && worst(&m) < 0.02 && worst(&m0) > 0.1);
     }
@@ -547,6 +549,6 @@ mod tests {
     fn a_linear_model_does_not_change_and_no_samples_give_none() {
         let linear = Saturation::linear(4e-3, 17e-3, 0.134);
         assert!(inductance_change(&linear, 22.0) < 1e-9);
-        assert!(best_fit(&FluxSamples::<f64>::new(), 0.134).is_none());
+        assert!(best_fit(&FluxSamples::<f64>::new(), 0.134, |_| true).is_none());
     }
 }
