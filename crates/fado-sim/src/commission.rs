@@ -429,7 +429,10 @@ pub fn preconditions(
         return Err(SimConfigError::new(
             "inverter.switching_frequency",
             format!(
-                "the rotor turns ω_rated·Ts = {x:.3} rad per sample at rated speed, more than                  the {} the estimator's discretisation is accurate to 0.5 % at (the identified                  parameters would be off by up to {:.1} %): commissioning needs                  switching_frequency ≥ {f} Hz for this motor",
+                "the rotor turns ω_rated·Ts = {x:.3} rad per sample at rated speed, more than \
+                 the {} the estimator's discretisation is accurate to 0.5 % at (the identified \
+                 parameters would be off by up to {:.1} %): commissioning needs \
+                 switching_frequency ≥ {f} Hz for this motor",
                 fado_core::ratings::MAX_OMEGA_TS,
                 100.0 * (1.0 - (0.5 * x).cos())
             ),
@@ -444,7 +447,9 @@ pub fn preconditions(
             return Err(SimConfigError::new(
                 "current_sensor.adc_bits",
                 format!(
-                    "the current sensor's step {lsb:.3e} A ({} bits over ±{full_scale:.3e} A)                      is {:.1} % of the commissioning's current limit {limit:.3e} A; it must                      resolve 1 % (more bits, or a smaller adc_full_scale_ratio)",
+                    "the current sensor's step {lsb:.3e} A ({} bits over ±{full_scale:.3e} A) \
+                     is {:.1} % of the commissioning's current limit {limit:.3e} A; it must \
+                     resolve 1 % (more bits, or a smaller adc_full_scale_ratio)",
                     sensor.adc_bits,
                     100.0 * lsb / limit
                 ),
