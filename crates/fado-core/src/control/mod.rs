@@ -23,6 +23,7 @@ pub mod saturated_references;
 pub mod speed_controller;
 pub mod standstill_probe;
 pub mod startup;
+pub use drive::speed_bandwidth;
 pub use drive::tracker_feedforward;
 pub use drive::tuning;
 

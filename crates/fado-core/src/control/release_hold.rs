@@ -142,7 +142,8 @@ pub fn current_bandwidth_for_hold<T: Real>(
     let omega = design_omega(machine, tuning.travel);
     let capped = T::two_pi() * current_hz / T::lit(10.0);
     // NaN compares false: the tuning's.
-    if !(omega * omega > T::lit(CAPPED_TRAVEL_RATIO) * capped * capped) {
+    let needs_wider_loop = omega * omega > T::lit(CAPPED_TRAVEL_RATIO) * capped * capped;
+    if !needs_wider_loop {
         return current_hz;
     }
     let wc = T::lit(10.0) * omega;

@@ -682,7 +682,7 @@ mod tests {
     fn arming_counts_the_standstill_and_the_probe_holds_out_of_limiter_mode() {
         let (tau, flux) = (14.0, 0.1);
         let mut p = probe(2.2); // arming time 0.2 s = 200 samples
-        let mut step = |p: &mut StandstillProbe<f64>, gate: bool, limiter: bool| {
+        let step = |p: &mut StandstillProbe<f64>, gate: bool, limiter: bool| {
             p.step(gate, limiter, tau, 0.0, (0.0, tau), flux, 0.0)
         };
         for _ in 0..300 {

@@ -23,16 +23,34 @@ const HOLD_CURRENT_RULE: &str = "10·ω_h of the release hold's design travel wh
     enabled and that is above the tuning's, at most ωc·Ts = 0.2 \
     (fado_core::control::release_hold)";
 
+/// The speed loop's bandwidth on a light rotor, and T2S-2's with it.
+const SPEED_RULE: &str = "raised until a step of the rated torque at the rated speed dips \
+    the speed by at most `[controller.speed] load_step_dip_ratio` × the rated speed, T2S-2 in \
+    the tuning's ratio (fado_core::control::speed_bandwidth)";
+
+/// The injection's bound on a salient rotor.
+const INJECTION_RULE: &str = "the injection's I_min bounded to `[controller.injection] \
+    max_active_flux_share` × λ̂f/(L̂q − L̂d), the d current that shrinks the active flux by \
+    that share (DriveConfig::i_min)";
+
 /// `cfg` with the values the drive's build-time rule sets in its tuning (the acceleration
 /// feed-forward, the trackers' load pole and T2S-1's running bandwidth of
 /// `fado_core::control::tracker_feedforward`, the current loop's bandwidth of
-/// `fado_core::control::release_hold`), each recorded as derived: what the drive runs
+/// `fado_core::control::release_hold`, the speed loop's and T2S-2's of
+/// `fado_core::control::speed_bandwidth`, the injection's bound of `DriveConfig::i_min`), each
+/// recorded as derived: what the drive runs
 /// with, as `--dump-config` shows it.
 pub(crate) fn with_drive_rules(cfg: &SimConfig) -> SimConfig {
     let mut c = cfg.clone();
     let drive = c.drive_config();
     let (mut tuning, mut estimator) = (drive.tuning, c.estimator);
     fado_core::control::tracker_feedforward::apply(
+        &drive.machine,
+        &mut tuning,
+        &mut estimator,
+        drive.ts,
+    );
+    fado_core::control::speed_bandwidth::apply(
         &drive.machine,
         &mut tuning,
         &mut estimator,
@@ -54,6 +72,15 @@ pub(crate) fn with_drive_rules(cfg: &SimConfig) -> SimConfig {
         drive.ts,
         tuning.current.bandwidth_hz,
     );
+    let (ratio, rated) = (
+        c.controller.injection.current_ratio,
+        drive.machine.rated_current,
+    );
+    let injection = if drive.i_min() < ratio * rated {
+        drive.i_min() / rated
+    } else {
+        ratio
+    };
     let t = &mut c.estimator.tracker;
     for (key, value, field, rule) in [
         (
@@ -73,6 +100,24 @@ pub(crate) fn with_drive_rules(cfg: &SimConfig) -> SimConfig {
             current,
             &mut c.controller.current.bandwidth_hz,
             HOLD_CURRENT_RULE,
+        ),
+        (
+            "estimator.tracker.t2s2_bandwidth_hz",
+            estimator.tracker.t2s2_bandwidth_hz,
+            &mut t.t2s2_bandwidth_hz,
+            SPEED_RULE,
+        ),
+        (
+            "controller.speed.bandwidth_hz",
+            tuning.speed.bandwidth_hz,
+            &mut c.controller.speed.bandwidth_hz,
+            SPEED_RULE,
+        ),
+        (
+            "controller.injection.current_ratio",
+            injection,
+            &mut c.controller.injection.current_ratio,
+            INJECTION_RULE,
         ),
     ] {
         if value != *field {

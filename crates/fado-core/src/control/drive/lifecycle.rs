@@ -16,8 +16,9 @@ impl<T: Real> SensorlessDrive<T, SensorlessEstimator<T>> {
     /// The drive with the paper's estimator, built with the drive's own sampling period and
     /// machine model and the given estimator tuning (start-up angle 0; see
     /// [`align`](Self::align)). A rotor its trackers would lag at the current limit gets the
-    /// acceleration feed-forward ([`crate::control::tracker_feedforward`]); an enabled release
-    /// hold the current-loop bandwidth it needs
+    /// acceleration feed-forward ([`crate::control::tracker_feedforward`]), a light rotor the
+    /// speed-loop bandwidth of its load step ([`crate::control::speed_bandwidth`]); an enabled
+    /// release hold the current-loop bandwidth it needs
     /// ([`current_bandwidth_for_hold`](crate::control::release_hold::current_bandwidth_for_hold)).
     pub fn new(
         mut config: DriveConfig<T>,
@@ -25,6 +26,12 @@ impl<T: Real> SensorlessDrive<T, SensorlessEstimator<T>> {
     ) -> Result<Self, ConfigError> {
         let machine = config.machine;
         crate::control::tracker_feedforward::apply(
+            &machine,
+            &mut config.tuning,
+            &mut estimator,
+            config.ts,
+        );
+        crate::control::speed_bandwidth::apply(
             &machine,
             &mut config.tuning,
             &mut estimator,
@@ -93,6 +100,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
                 config.tuning.lock.recovery_attempts,
             )?,
             implausible_now: false,
+            saturated_flux: Dq::zero(),
         };
         drive.reset();
         Ok(drive)
@@ -211,6 +219,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         self.sensor_stuck_now = false;
         self.current_error_now = false;
         self.history = [Ab::zero(); 2];
+        self.saturated_flux = self.zero_current_flux();
         self.last = DriveOutput::idle(Estimate {
             theta,
             ..Estimate::default()

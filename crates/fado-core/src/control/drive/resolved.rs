@@ -34,8 +34,14 @@ impl<T: Real> Resolved<T> {
                 T::lit(MAX_CURRENT_LIMIT_RATIO),
                 "at most 5 × the rated current (drives' short-time overload is 1.5–3×)",
             )? * rated,
-            i_min: check::non_negative("injection_current_ratio", t.injection.current_ratio)?
-                * rated,
+            i_min: {
+                check::non_negative("injection_current_ratio", t.injection.current_ratio)?;
+                check::non_negative(
+                    "injection_max_active_flux_share",
+                    t.injection.max_active_flux_share,
+                )?;
+                c.i_min()
+            },
             trip_current: check::positive("trip_current_ratio", t.protection.trip_current_ratio)?
                 * rated,
             current_error_limit: check::positive(

@@ -56,9 +56,16 @@ pub struct SpeedLoopTuning<T> {
     pub zero_ratio: T,
     /// Speed PI back-calculation gain in units of Ki/Kp. Default 5 (tracking at ωsc) \[A\].
     pub anti_windup_ratio: T,
+    /// The drive raises `bandwidth_hz` (and T2S-2's with it) until the first-order speed dip
+    /// of a step of the rated torque at the rated speed, Ω_rated/(ωs·τm) with τm =
+    /// Ĵ·Ω_rated/T_rated, is at most this multiple of the rated speed
+    /// ([`crate::control::speed_bandwidth`]). Default 2 \[D\]: the rotor stays within the
+    /// rated speed turning the other way, where the drive has the voltage for its rated
+    /// torque; no preset needs more than its 5 Hz. A large value (1e9) keeps `bandwidth_hz`.
+    pub load_step_dip_ratio: T,
 }
 
-cast_record!(SpeedLoopTuning { bandwidth_hz, zero_ratio, anti_windup_ratio ;  });
+cast_record!(SpeedLoopTuning { bandwidth_hz, zero_ratio, anti_windup_ratio, load_step_dip_ratio ;  });
 
 impl<T: Real> Default for SpeedLoopTuning<T> {
     fn default() -> Self {
@@ -66,6 +73,7 @@ impl<T: Real> Default for SpeedLoopTuning<T> {
             bandwidth_hz: T::lit(speed_controller::DEFAULT_BANDWIDTH_HZ),
             zero_ratio: T::lit(speed_controller::DEFAULT_ZERO_RATIO),
             anti_windup_ratio: T::lit(speed_controller::DEFAULT_ANTI_WINDUP_RATIO),
+            load_step_dip_ratio: T::lit(2.0),
         }
     }
 }
@@ -81,14 +89,24 @@ pub struct InjectionTuning<T> {
     /// Minimum current I_min of the injection (23) as a fraction of the rated current; 0
     /// disables it. Default 4/21.78 (paper, V: 4 A).
     pub current_ratio: T,
+    /// On a rotor with L̂q > L̂d the positive d current of the injection shrinks the active
+    /// flux λ̂f + (L̂d − L̂q)·i_d the estimator's angle rests on: I_min is bounded so that it
+    /// takes at most this share of λ̂f, I_min ≤ share·λ̂f/(L̂q − L̂d). Default 0.25 \[A\]:
+    /// ipmsm-gem-50k (L̂q/L̂d = 3.2, I_min 44 A takes 55 %) loses 0.30–0.32 rad in
+    /// `regen-stop`'s stop through zero where the injection rises as i_q reverses, 0.25–0.28 rad
+    /// on two of four seeds with 0.4, 0.09–0.11 rad on all four with 0.25 (docs/range.md);
+    /// the paper's motor and the surface-magnet presets take nothing, ipmsm-2k2 3 %. A large
+    /// value (1e9) keeps `current_ratio`.
+    pub max_active_flux_share: T,
 }
 
-cast_record!(InjectionTuning { current_ratio ;  });
+cast_record!(InjectionTuning { current_ratio, max_active_flux_share ;  });
 
 impl<T: Real> Default for InjectionTuning<T> {
     fn default() -> Self {
         Self {
             current_ratio: T::lit(injection::DEFAULT_CURRENT_RATIO),
+            max_active_flux_share: T::lit(0.25),
         }
     }
 }

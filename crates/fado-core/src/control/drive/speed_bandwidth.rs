@@ -1,0 +1,135 @@
+//! The speed loop's bandwidth from the rotor's mechanical time constant: a load step never
+//! drives a light rotor out of the speed range the drive holds.
+//!
+//! **Why.** A speed PI of bandwidth ωs has the proportional gain Ĵ·ωs (torque per mechanical
+//! rad/s). A load step ΔT meets, for the first few milliseconds, only that gain (the
+//! integral comes a zero ωs/`zero_ratio` later): the speed dips by about ΔT/(Ĵ·ωs). With the
+//! mechanical time constant τm = Ĵ·Ω_rated/T_rated (the time the rated torque takes to bring
+//! the rotor to its rated speed), a step of the rated torque at the rated speed dips it by
+//! Ω_rated/(ωs·τm). On the paper's motor (τm = 0.16 s) the paper's 5 Hz loop dips by 0.19
+//! of the rated speed; on a 22-pole-pair gimbal motor (4·10⁻⁵ kg·m², 0.5 N·m, 600 r/min,
+//! τm = 5 ms) by 6.3 × the rated speed: `fullrange`'s step of half the rated torque reverses
+//! it within 10 ms, the load drives it past the speed at which the voltage limit leaves the
+//! drive its torque (−2,000 r/min), and the drive trips (measured dip with ωs raised to 20 Hz:
+//! 0.77 of the rated speed against the estimate's 0.79).
+//!
+//! **Rule.** ωs ≥ 1/(d·τm) with d = `[controller.speed] load_step_dip_ratio` = 2: a step of
+//! the rated torque from the rated speed leaves the rotor within the rated speed turning the
+//! other way, where the drive has the voltage for its rated torque. Where that raises the
+//! bandwidth the speed tracker T2S-2, whose ω̂ closes the loop, keeps the tuning's ratio to
+//! it (the paper's 35 Hz to 5 Hz), up to Kp·Ts = [`MAX_KP_TS`]. Below it (every preset: the
+//! lightest, pmsyrm-5k, has τm = 59 ms and needs 1.35 Hz) the tuning is unchanged to the bit.
+
+use crate::Real;
+use crate::control::DriveTuning;
+use crate::control::tracker_feedforward::MAX_KP_TS;
+use crate::estimator::EstimatorTuning;
+use crate::machine::MachineModel;
+use crate::tracker::TrackerConfig;
+
+/// τm = Ĵ·Ω_rated/T_rated (s): the time the rated torque takes to bring the rotor from
+/// standstill to its rated speed.
+pub fn mechanical_time_constant<T: Real>(machine: &MachineModel<T>) -> T {
+    machine.inertia * machine.rated_speed_mech() / machine.rated_torque
+}
+
+/// The speed loop's bandwidth (Hz) the rule asks: 1/(2π·d·τm), d = `speed.load_step_dip_ratio`
+/// (module docs); NaN or 0 where the model lacks the ratings (no rule).
+pub fn required_bandwidth_hz<T: Real>(machine: &MachineModel<T>, drive: &DriveTuning<T>) -> T {
+    let tau = mechanical_time_constant(machine);
+    T::one() / (T::lit(core::f64::consts::TAU) * drive.speed.load_step_dip_ratio * tau)
+}
+
+/// Applies the rule (module docs) to the drive's and the estimator's tuning, in place: raises
+/// the speed loop's bandwidth to [`required_bandwidth_hz`] where it is below, and T2S-2's with
+/// it in the tuning's ratio (at most the one of Kp·Ts = [`MAX_KP_TS`]).
+pub fn apply<T: Real>(
+    machine: &MachineModel<T>,
+    drive: &mut DriveTuning<T>,
+    estimator: &mut EstimatorTuning<T>,
+    ts: T,
+) {
+    let needed = required_bandwidth_hz(machine, drive);
+    let own = drive.speed.bandwidth_hz;
+    // NaN compares false: the tuning's bandwidth; an invalid one (≤ 0) is left for the
+    // drive's checks to name.
+    let raise = needed.is_finite() && own > T::zero() && needed > own;
+    if !raise {
+        return;
+    }
+    let t = &mut estimator.tracker;
+    let ratio = t.t2s2_bandwidth_hz / own;
+    let candidate = needed * ratio;
+    // Kp = (2ζ + c)·ωn of the tracker (its load pole adds c·ωn), proportional to the
+    // bandwidth in either of its definitions.
+    let (kp2, _) = TrackerConfig {
+        damping: t.damping,
+        definition: t.bandwidth_definition,
+        ..TrackerConfig::new(candidate, ts)
+    }
+    .gains();
+    let kp = kp2 * (T::one() + t.load_pole_ratio / (T::lit(2.0) * t.damping));
+    let tracker = crate::real::min(candidate, candidate * T::lit(MAX_KP_TS) / (kp * ts));
+    drive.speed.bandwidth_hz = needed;
+    if tracker > t.t2s2_bandwidth_hz {
+        t.t2s2_bandwidth_hz = tracker;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn gimbal() -> MachineModel<f64> {
+        MachineModel {
+            pole_pairs: 22,
+            flux_linkage: 0.0042,
+            ld: 120e-6,
+            lq: 120e-6,
+            rs: 0.35,
+            rated_current: 3.6,
+            rated_torque: 0.5,
+            rated_speed_rpm: 600.0,
+            inertia: 4e-5,
+            ..MachineModel::paper()
+        }
+    }
+
+    /// The paper's motor keeps its tuning to the bit; the gimbal motor gets the bandwidth at
+    /// which a rated step dips the speed by d·Ω_rated (first order), and T2S-2 the paper's
+    /// ratio to it.
+    #[test]
+    fn light_rotor_gets_the_bandwidth_of_its_load_step() {
+        let (d0, e0) = (
+            DriveTuning::<f64>::default(),
+            EstimatorTuning::<f64>::default(),
+        );
+        let (mut d, mut e) = (d0, e0);
+        apply(&MachineModel::paper(), &mut d, &mut e, 100e-6);
+        assert_eq!((d, e), (d0, e0));
+        let m = gimbal();
+        let tau = mechanical_time_constant(&m);
+        assert!((tau - 4e-5 * 62.83185307 / 0.5).abs() < 1e-9, "{tau}");
+        apply(&m, &mut d, &mut e, 50e-6);
+        let ws = core::f64::consts::TAU * d.speed.bandwidth_hz;
+        // The first-order dip of a rated step from rated speed: Ω_rated/(ωs·τm) = d.
+        assert!((1.0 / (ws * tau) - d.speed.load_step_dip_ratio).abs() < 1e-9);
+        assert!(
+            (d.speed.bandwidth_hz - 15.83).abs() < 0.01,
+            "{}",
+            d.speed.bandwidth_hz
+        );
+        let ratio = e0.tracker.t2s2_bandwidth_hz / d0.speed.bandwidth_hz;
+        assert!((e.tracker.t2s2_bandwidth_hz - ratio * d.speed.bandwidth_hz).abs() < 1e-9);
+        // The Kp·Ts cap at a slow sampling rate.
+        let (mut d, mut e) = (d0, e0);
+        apply(&m, &mut d, &mut e, 1e-3);
+        let (kp, _) = TrackerConfig {
+            damping: e.tracker.damping,
+            definition: e.tracker.bandwidth_definition,
+            ..TrackerConfig::new(e.tracker.t2s2_bandwidth_hz, 1e-3)
+        }
+        .gains();
+        assert!((kp * 1e-3 - MAX_KP_TS).abs() < 1e-9, "{kp}");
+    }
+}
