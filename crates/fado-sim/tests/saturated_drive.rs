@@ -2,7 +2,8 @@
 //! drive and the estimator given the plant's own magnetic model (`[model]` inherits
 //! `[motor.saturation]`) pass `reversal`, `stops` and `rated-reversal` for the current-sensor
 //! seeds 1–4 on the saturated IPMSM preset and on the measured PMSM flux map
-//! (`pmsm-gem-1k1-measured`), and on machines that are no preset (the same IPMSM with five
+//! (`pmsm-gem-1k1-measured`, and the same map as measured, not odd in i_q,
+//! `tests/data/pmsm-gem-1k1-raw.csv`), and on machines that are no preset (the same IPMSM with five
 //! times its cross-saturation; a made-up 20-pole 48 V IPMSM with d, q and cross-saturation,
 //! `tests/data/ipmsm-20p-48v-saturated.toml`); the PM-SyRM's measured flux map runs as the
 //! plant's and the drive's model and passes `stops`. The PM-SyRM's reversals do not pass with
@@ -51,6 +52,20 @@ fn the_measured_pmsm_map_passes_every_seed() {
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../motors/saturated");
     fado_sim::magnetics_file::set_config_dir(Some(std::path::Path::new(dir)));
     passes_every_seed(&preset("saturated/pmsm-gem-1k1-measured.toml"));
+}
+
+#[test]
+fn a_measured_map_not_odd_in_i_q_passes_every_seed() {
+    // The measured PMSM map as delivered (tests/data/pmsm-gem-1k1-raw.csv: ψq(i_d, 0) of
+    // −2.5 … −6.0 mVs) in the preset's place, given by its absolute path.
+    let csv = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/pmsm-gem-1k1-raw.csv"
+    );
+    let text = preset("saturated/pmsm-gem-1k1-measured.toml")
+        .replace("\"pmsm-gem-1k1-measured.csv\"", &format!("{csv:?}"));
+    assert!(text.contains("pmsm-gem-1k1-raw.csv"));
+    passes_every_seed(&text);
 }
 
 #[test]

@@ -202,3 +202,50 @@ fn constant_inductance_models_are_not_wrapped() {
     };
     assert!(active(Magnetics::Constant(c), 6.08).is_none());
 }
+
+/// The frame coupling against the closed loop it describes: the current held at î in the
+/// estimated frame, the machine's own current e^{jδ}·î, λ̂r = ψ(i) − L_q,s(î)·i. A frame
+/// error δ moves |λ̂r| by s·δ and turns it from the rotor's d axis by (1 − κ/λa)·δ
+/// (numerical derivatives), and the
+/// offset law holds where |s|/κ exceeds the bound: on the Baldor PM-SyRM at its rated MTPA
+/// point, not on the IPMSM's.
+#[test]
+fn frame_coupling_matches_the_closed_loop_flux_change() {
+    for (name, model, rated) in models() {
+        let af = active(model, rated).unwrap();
+        for i in points(rated, model) {
+            let pt = af.point(i);
+            let (s, kappa) = af.frame_coupling(&pt);
+            let seen = |delta: f64| {
+                let (sin, cos) = delta.sin_cos();
+                let turned = Dq::new(i.d * cos - i.q * sin, i.d * sin + i.q * cos);
+                let psi = model.flux(turned);
+                let r = Dq::new(
+                    psi.d - pt.lq_secant * turned.d,
+                    psi.q - pt.lq_secant * turned.q,
+                );
+                (r.d.hypot(r.q), r.q.atan2(r.d))
+            };
+            let h = 1e-5;
+            let ((m1, a1), (m0, a0)) = (seen(h), seen(-h));
+            let (magnitude, angle) = ((m1 - m0) / (2.0 * h), (a1 - a0) / (2.0 * h));
+            // A bilinear map's incremental inductance is one-sided on its grid lines.
+            let tol = if name.contains("map") { 5e-2 } else { 1e-5 };
+            assert!(
+                (magnitude - s).abs() < tol * pt.active,
+                "{name} {i:?}: d|λr|/dδ {magnitude}, s {s}"
+            );
+            assert!(
+                (angle - (1.0 - kappa / pt.active)).abs() < tol,
+                "{name} {i:?}: dangle/dδ {angle}, 1 − κ/λa {}",
+                1.0 - kappa / pt.active
+            );
+        }
+    }
+    // The rated MTPA points (crate::control::saturated_references at 12.45 A and 6.08 A).
+    let baldor = active(baldor(), 12.45).unwrap();
+    assert!(baldor.holds_offset(&baldor.point(Dq::new(-8.26, 8.54))));
+    assert!(!baldor.holds_offset(&baldor.point(Dq::new(2.0, 0.5))));
+    let ipm = active(ipm_qsat(58.0), 6.08).unwrap();
+    assert!(!ipm.holds_offset(&ipm.point(Dq::new(-0.08, 5.99))));
+}

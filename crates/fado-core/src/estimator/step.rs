@@ -487,7 +487,20 @@ impl<T: Real> EstimatorState<T> {
         // `IntegrandOffset::next_state`).
         let n = T::lit(SLOW_PERIOD as f64);
         let decay = c.kdf_gain * (p.ts * n) + self.offset_recentring_gain * (n - T::one());
-        let learning = broken & BROKEN_OFFSET == 0 && c.mode == Mode::DisturbanceFeedback;
+        // A saturating model's frame coupling (`crate::active_flux`): where the flux magnitude
+        // carries the frame error the law holds ê and the k_df mode stops re-centring at k_e
+        // until the next period.
+        let holds = c
+            .point
+            .is_some_and(|point| p.active_flux.holds_offset(&point));
+        if c.point.is_some() && self.rs_adaptation_on {
+            self.offset_recentring_gain = if holds {
+                T::zero()
+            } else {
+                p.offset_recentring_gain
+            };
+        }
+        let learning = broken & BROKEN_OFFSET == 0 && c.mode == Mode::DisturbanceFeedback && !holds;
         let offset = p
             .offset
             .next_state(&self.offset, c.disturbance, decay, shift, learning);

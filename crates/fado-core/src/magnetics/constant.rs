@@ -32,6 +32,11 @@ impl<T: Real> MagneticModel<T> for ConstantInductance<T> {
     }
 
     #[inline]
+    fn q_flux_offset(&self, _i_d: T) -> T {
+        T::zero()
+    }
+
+    #[inline]
     fn secant_q(&self, _i: Dq<T>) -> T {
         self.lq
     }

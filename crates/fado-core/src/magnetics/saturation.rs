@@ -269,6 +269,12 @@ impl<T: Real> MagneticModel<T> for Saturation<T> {
         self.current_and_jacobian(psi).0
     }
 
+    /// Zero: i_q is odd in ψq and i_d even, so ψq(i_d, 0) = 0.
+    #[inline]
+    fn q_flux_offset(&self, _i_d: T) -> T {
+        T::zero()
+    }
+
     fn incremental_inductance(&self, i: Dq<T>) -> InductanceMatrix<T> {
         self.current_and_jacobian(self.flux(i)).1.inverse()
     }

@@ -309,6 +309,57 @@ fn secant_q_inductance_puts_the_active_flux_on_d() {
     assert!((s.secant_q(Dq::zero()) - 1.0 / 52.1).abs() < 1e-12);
 }
 
+/// A map that is not odd in i_q (a measured map's ψq(i_d, 0) ≠ 0, here −4 % of the magnet's
+/// flux, varying with i_d): the secant without the offset stays finite and continuous through
+/// i_q = 0 and ψ − L_q,s·i = (λa, ψq(i_d, 0)), i.e. the rotor flux lies at
+/// atan(ψq(i_d, 0)/λa) from d; the plain ψq/i_q grows without bound there.
+#[test]
+fn the_secant_of_a_map_not_odd_in_i_q_removes_its_q_flux_at_zero_q_current() {
+    let mut table = ipm_table::<f64>();
+    let offset = |id: f64| -0.04 * 0.545 * (1.0 + 0.02 * id);
+    for (k, &id) in table.i_d.iter().enumerate() {
+        for q in table.psi_q[k].iter_mut() {
+            *q += offset(id);
+        }
+    }
+    let map = table.map().unwrap();
+    for i in currents(9.0) {
+        let psi = map.flux(i);
+        let lqs = map.secant_q(i);
+        assert!(
+            (map.q_flux_offset(i.d) - offset(i.d)).abs() < 1e-15,
+            "{i:?}"
+        );
+        assert!(lqs.is_finite() && lqs > 0.0, "{i:?}: {lqs}");
+        let rotor = psi - Dq::new(lqs * i.d, lqs * i.q);
+        assert!((rotor.d - map.active_flux(i)).abs() < 1e-15);
+        assert!((rotor.q - offset(i.d)).abs() < 1e-12, "{i:?}: {rotor:?}");
+        // The angle from d is the stated one, under 0.05 rad here.
+        assert!((rotor.q / rotor.d).atan().abs() < 0.05, "{i:?}");
+    }
+    // Continuous through i_q = 0: the secant there is the incremental L_qq, its limit.
+    for id in [-9.0, -2.0, 0.0, 3.0] {
+        let at = |iq: f64| map.secant_q(Dq::new(id, iq));
+        let l = map.incremental_inductance(Dq::new(id, 0.0)).qq;
+        for iq in [1e-7, 1e-4, -1e-4, 1e-2] {
+            assert!(
+                (at(iq) - l).abs() < 1e-3 * l,
+                "{id} {iq}: {} vs {l}",
+                at(iq)
+            );
+        }
+        // Without the offset the secant would be off by ψq(i_d, 0)/i_q: 22 H at 1 mA.
+        assert!((map.flux(Dq::new(id, 1e-3)).q / 1e-3 - l).abs() > 10.0);
+    }
+    // Odd models have no offset: the constant and algebraic ones, a table of an odd model.
+    let odd = ipm_table::<f64>();
+    let odd_map = odd.map().unwrap();
+    for id in [-9.0, -0.5, 4.0] {
+        assert_eq!(ipm().q_flux_offset(id), 0.0);
+        assert!(odd_map.q_flux_offset(id).abs() < 1e-15);
+    }
+}
+
 fn ipm_table<T: Real>() -> FluxTable<T, 16, 16> {
     let m = ipm().cast::<T>();
     let axis = |a: f64, b: f64| core::array::from_fn(|k| T::lit(a + (b - a) * k as f64 / 15.0));

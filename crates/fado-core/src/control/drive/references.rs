@@ -5,12 +5,21 @@ use super::SensorlessDrive;
 use crate::estimator::RotorAngleEstimator;
 use crate::{Ab, Dq, Real};
 
+/// Halvings of the torque solve's bracket where its path is not monotone (2⁻²⁴ of the bracket,
+/// below 10⁻⁶ of the rated current; the next sample's Newton steps refine it), ours.
+const TORQUE_BISECTIONS: usize = 24;
+
+/// Doublings of the torque solve's bracket before it gives up (2⁴ × the rated current beyond
+/// the demand), ours.
+const TORQUE_BRACKET_DOUBLINGS: usize = 4;
+
 impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
     /// (i_d*, i_q*) for a torque demand `iq_torque` in units of the magnet's q current
     /// (torque / (1.5·p·λ̂f)): i_d* = the eq. (23) injection + MTPA of i_q* + the
     /// standstill probe's `probe_id`, and i_q* solves
     /// (λ̂f + (L̂d − L̂q)·i_d*(i_q*))·i_q* = λ̂f·i_q,t by three Newton steps from `guess` (the
-    /// last sample's i_q*; a secant over 0.1 % of the rated current for the slope). On a
+    /// last sample's i_q*; a secant over 0.1 % of the rated current for the slope), by
+    /// bisection where the slope is flat or falling (L̂d > L̂q: [`Self::solve_torque`]). On a
     /// surface-magnet rotor i_q* = i_q,t, as in the paper. Taking i_d* from the last
     /// sample's i_q* instead (no solve) closes an algebraic loop through the injection that
     /// oscillates sample by sample under load (measured on ipmsm-gem-50k `stops`).
@@ -38,8 +47,9 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
 
     /// The q current where `f` (the torque flux less its target) vanishes: three Newton steps
     /// from `guess` (when it has the sign of `iq_torque`, else from `iq_torque`) with a secant
-    /// slope over 0.1 % of `rated_current`; a flat or non-finite slope keeps the last iterate,
-    /// a non-finite result gives `iq_torque`.
+    /// slope over 0.1 % of `rated_current`; a flat, falling or non-finite slope ends Newton's
+    /// steps and the root is bracketed instead ([`Self::bisect_torque`]), a non-finite result
+    /// gives `iq_torque`.
     pub(super) fn solve_torque(
         f: impl Fn(T) -> T,
         iq_torque: T,
@@ -52,7 +62,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             let f0 = f(iq);
             (f0, (f(iq + h) - f0) / h)
         };
-        Self::solve_torque_with(secant, iq_torque, guess, flux_linkage)
+        Self::solve_torque_with(secant, iq_torque, guess, rated_current, flux_linkage)
     }
 
     /// [`Self::solve_torque`] with `f` returning the value and its slope at i_q.
@@ -60,6 +70,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         f: impl Fn(T) -> (T, T),
         iq_torque: T,
         guess: T,
+        rated_current: T,
         flux_linkage: T,
     ) -> T {
         let mut iq = if guess.is_finite() && guess * iq_torque > T::zero() {
@@ -69,10 +80,17 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         };
         for _ in 0..3 {
             let (f0, slope) = f(iq);
-            // A flat or non-finite slope (NaN compares false): keep the last iterate.
+            // A flat, falling or non-finite slope (NaN compares false): Newton's step would
+            // stay on a local extremum of the torque or run away from the root; the bracket
+            // unless the iterate is a root already.
             if slope > T::lit(1e-3) * flux_linkage {
                 iq -= f0 / slope;
             } else {
+                if f0 != T::zero()
+                    && let Some(root) = Self::bisect_torque(|x| f(x).0, iq_torque, rated_current)
+                {
+                    iq = root;
+                }
                 break;
             }
         }
@@ -80,6 +98,44 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             iq = iq_torque;
         }
         iq
+    }
+
+    /// A root of `f` by bisection, for a torque path that is not monotone: where the eq. (23)
+    /// injection i_d = √(I_min² − i_q²) falls to zero at |i_q| → I_min it turns the torque
+    /// down on a rotor whose d current adds torque (L_d > L_q, or a measured map with
+    /// ψq(i_d, 0) < 0), a local maximum of the torque below I_min that Newton's steps from
+    /// the last i_q* stop on. The bracket runs from −`rated_current` to |`iq_torque`| +
+    /// `rated_current` (each end doubled up to [`TORQUE_BRACKET_DOUBLINGS`] times until the
+    /// torque there is on either side of the demand, in the demand's direction), so that every
+    /// torque up to the path's limit is reached; [`TORQUE_BISECTIONS`] halvings of it leave
+    /// 2⁻²⁴ of its width, and the next sample's Newton steps start from there. None where no
+    /// bracket is found (a non-finite `f`).
+    fn bisect_torque(f: impl Fn(T) -> T, iq_torque: T, rated_current: T) -> Option<T> {
+        let s = if iq_torque < T::zero() {
+            -T::one()
+        } else {
+            T::one()
+        };
+        // g rises with x = s·i_q on the path's monotone branches.
+        let g = |x: T| s * f(s * x);
+        let (mut lo, mut hi) = (-rated_current, iq_torque.abs() + rated_current);
+        let mut doublings = 0;
+        while !(g(hi) > T::zero() && g(lo) < T::zero()) {
+            doublings += 1;
+            if doublings > TORQUE_BRACKET_DOUBLINGS || !(lo.is_finite() && hi.is_finite()) {
+                return None;
+            }
+            (lo, hi) = (lo + lo, hi + hi);
+        }
+        for _ in 0..TORQUE_BISECTIONS {
+            let mid = T::lit(0.5) * (lo + hi);
+            if g(mid) > T::zero() {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        Some(s * T::lit(0.5) * (lo + hi))
     }
 
     /// The current at this sample predicted from the last one used (measured or

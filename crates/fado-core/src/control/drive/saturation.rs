@@ -79,7 +79,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             warm.set(psi);
             (tau - target, slope)
         };
-        let iq = Self::solve_torque_with(f, iq_torque, guess, m.flux_linkage);
+        let iq = Self::solve_torque_with(f, iq_torque, guess, m.rated_current, m.flux_linkage);
         (Dq::new(id_of(iq), iq), warm.get())
     }
 

@@ -66,3 +66,35 @@ fn saturated_torque_solve_is_the_cold_solve() {
         }
     }
 }
+
+/// On a rotor whose d current adds torque (L_d > L_q here; a measured map with ψq(i_d, 0) < 0
+/// alike) the eq. (23) injection makes the torque path non-monotone: a local maximum below
+/// I_min, then a dip to the torque at |i_q| = I_min. The solve, from the last sample's i_q*
+/// as in the drive, reaches every torque of a ramp up to the limit and back, both directions.
+#[test]
+fn the_torque_solve_reaches_every_torque_on_a_non_monotone_path() {
+    use crate::injection::{CurrentInjection, CurrentInjectionConfig};
+    let (ld, lq, flux, i_rated) = (0.010, 0.002, 0.05, 10.0);
+    let i_min = 2.0;
+    let inj = CurrentInjection::new(CurrentInjectionConfig { i_min }).unwrap();
+    let tau = |iq: f64| (flux + (ld - lq) * inj.step(iq)) * iq / flux;
+    // The path is not monotone: its slope falls below zero just under I_min.
+    let h = 1e-4;
+    let min_slope = (0..20_000)
+        .map(|k| (tau(k as f64 * h + h) - tau(k as f64 * h)) / h)
+        .fold(f64::INFINITY, f64::min);
+    assert!(min_slope < -1.0, "{min_slope}");
+    let limit = tau(2.0 * i_rated);
+    for sign in [1.0, -1.0] {
+        let n = 4000;
+        let (mut iq, mut worst) = (0.0, 0.0f64);
+        for k in (0..=n).chain((0..n).rev()) {
+            let target = sign * limit * k as f64 / n as f64;
+            let f = |x: f64| (tau(x) - target) * flux;
+            iq = super::SensorlessDrive::<f64>::solve_torque(f, target, iq, i_rated, flux);
+            worst = worst.max((tau(iq) - target).abs() / limit);
+        }
+        std::println!("min slope {min_slope:.2}, worst residual {worst:.1e} of the limit");
+        assert!(worst < 1e-3, "{sign}: {worst}");
+    }
+}
