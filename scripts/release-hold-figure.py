@@ -89,8 +89,8 @@ def table(binary):
             text = motor.read_text() + f"\n[current_sensor]\nseed = {seed}\n"
             with tempfile.TemporaryDirectory() as tmp:
                 stdout, _ = run(binary, text, tmp)
-            back = check(stdout, "backward travel after the release (rad)")
-            err = check(stdout, "max |θ − θ̂| from the release on (rad)")
+            back = check(stdout, "backward travel from t = 0 (rad)")
+            err = check(stdout, "max |θ − θ̂| from ready on (rad)")
             passed = "PASSED              true" in stdout
             print(f"| {motor.stem} | {seed} | {back:.3f} | {err:.3f} | {passed} |")
 

@@ -179,24 +179,40 @@ pub fn inverted_polarity<T: Real>(machine: &MachineModel<T>, current: T) -> bool
     plus > minus
 }
 
-/// Whether the pulses of `current` meet a larger incremental inductance along d than along q:
-/// the model's L̂d > L̂q for constant inductances; for a saturating model (a flux map) the
-/// incremental inductances averaged over the pulses' paths from 0 to ±`current` along each
-/// axis, which the search's second harmonic reads (a measured map may turn the order of the
-/// datasheet's small-signal values).
+/// Whether the pulses that reach `current` along the smaller small-signal inductance meet a
+/// larger inductance along d than along q: the model's L̂d > L̂q for constant inductances; for
+/// a saturating model (a flux map) the secant inductances along ±d and ±q over the current
+/// each axis reaches with the pulses' flux L̂min·`current`, which the search's second
+/// harmonic reads (a measured map may turn the order of the small-signal values).
 pub fn d_axis_larger<T: Real>(machine: &MachineModel<T>, current: T) -> bool {
     if machine.magnetics.is_linear() || !current.is_finite() || current <= T::zero() {
         return machine.ld > machine.lq;
     }
+    let flux = crate::real::min(machine.ld, machine.lq) * current;
     let m = machine.magnetic_model();
-    let (mut d, mut q) = (T::zero(), T::zero());
-    for k in 1..=4 {
-        let i = current * T::from_index(k) * T::lit(0.25);
-        d += m.incremental_inductance(Dq::new(i, T::zero())).dd;
-        d += m.incremental_inductance(Dq::new(-i, T::zero())).dd;
-        q += m.incremental_inductance(Dq::new(T::zero(), i)).qq;
-        q += m.incremental_inductance(Dq::new(T::zero(), -i)).qq;
-    }
+    let secant = |axis: Dq<T>, l0: T| {
+        let mut l = l0;
+        for _ in 0..3 {
+            let peak = flux / l;
+            let mut sum = T::zero();
+            for k in 0..8 {
+                let i = peak * (T::from_index(k) + T::lit(0.5)) * T::lit(0.125);
+                let inc = m.incremental_inductance(Dq::new(axis.d * i, axis.q * i));
+                sum += inc.dd * axis.d * axis.d + inc.qq * axis.q * axis.q;
+            }
+            let next = sum * T::lit(0.125);
+            if !next.is_finite() || next <= T::zero() {
+                return l0;
+            }
+            l = next;
+        }
+        l
+    };
+    let one = T::one();
+    let d =
+        secant(Dq::new(one, T::zero()), machine.ld) + secant(Dq::new(-one, T::zero()), machine.ld);
+    let q =
+        secant(Dq::new(T::zero(), one), machine.lq) + secant(Dq::new(T::zero(), -one), machine.lq);
     d > q
 }
 
