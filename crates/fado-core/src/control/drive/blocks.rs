@@ -193,8 +193,10 @@ impl<T: Real> DriveConfig<T> {
 /// above it, the stuck-sensor thresholds, the plausibility ratios and the lock supervisor.
 fn check_limits<T: Real>(c: &DriveConfig<T>, r: &Resolved<T>) -> Result<(), ConfigError> {
     let t = &c.tuning;
-    let (i_max, i_min) = (r.i_max, r.i_min);
-    if i_min > i_max {
+    let i_max = r.i_max;
+    // The configured level, not the one the active-flux bound may lower (`DriveConfig::i_min`):
+    // a ratio above the limit is the user's slip whatever the machine.
+    if t.injection.current_ratio > t.current.limit_ratio {
         return Err(ConfigError::OutOfRange {
             field: "injection_current_ratio",
             expected: "at most current_limit_ratio",

@@ -40,6 +40,21 @@ pub fn required_bandwidth_hz<T: Real>(machine: &MachineModel<T>, drive: &DriveTu
     T::one() / (T::lit(core::f64::consts::TAU) * drive.speed.load_step_dip_ratio * tau)
 }
 
+/// The largest bandwidth (Hz) the speed PI accepts at the sample period `ts`: 2π·f·ts below
+/// 0.1 (kept 1 % inside) and its anti-windup gain `anti_windup_ratio`·ki/kp·ts = r·2π·f·ts/
+/// `zero_ratio` at most 1, so that the raised loop is one the drive can build.
+fn speed_loop_limit_hz<T: Real>(drive: &DriveTuning<T>, ts: T) -> T {
+    let w_ts = T::lit(0.099);
+    let s = &drive.speed;
+    let aw = s.anti_windup_ratio / s.zero_ratio;
+    let w_ts = if aw > T::zero() {
+        crate::real::min(w_ts, T::one() / aw)
+    } else {
+        w_ts
+    };
+    w_ts / (T::two_pi() * ts)
+}
+
 /// Applies the rule (module docs) to the drive's and the estimator's tuning, in place: raises
 /// the speed loop's bandwidth to [`required_bandwidth_hz`] where it is below, and T2S-2's with
 /// it in the tuning's ratio (at most the one of Kp·Ts = [`MAX_KP_TS`]).
@@ -49,7 +64,10 @@ pub fn apply<T: Real>(
     estimator: &mut EstimatorTuning<T>,
     ts: T,
 ) {
-    let needed = required_bandwidth_hz(machine, drive);
+    let needed = crate::real::min(
+        required_bandwidth_hz(machine, drive),
+        speed_loop_limit_hz(drive, ts),
+    );
     let own = drive.speed.bandwidth_hz;
     // NaN compares false: the tuning's bandwidth; an invalid one (≤ 0) is left for the
     // drive's checks to name.
