@@ -120,7 +120,9 @@ HEAD = """# Magnetic identification at standstill
 
 `fado-sim commission` on saturated machines: the flux-linkage pulses of
 [`fado_core::commissioning`](../reference/rust.md) (module docs, step 5) fit the algebraic
-saturation model, written under `[model.saturation]` of `identified.toml`. Every machine starts
+saturation model (with the saturating rib of Lelli et al. where it explains the data),
+tabulated as the flux map `identified-flux-map.csv` that `[model] flux_map` of
+`identified.toml` names (the model's own `[model.saturation]` in its header). Every machine starts
 from its datasheet (unsaturated, zero-current) `ld`, `lq`, `flux_linkage`; switching-resolved
 inverter with dead time and threshold, default sensor offset, gain, noise and ADC, sensor seeds
 {seeds}. Errors are identified/true − 1 over the rated current range (a 21 × 21 grid of

@@ -9,7 +9,9 @@ the flux map of that repository's saturated-PMSM example environment). It holds 
 `Psi_q_map` (Vs) and the differential inductances on a 33 × 18 grid whose axes
 `i_d_grid_k` (−16 … +1 A) and `i_q_grid_k` (−16 … +16 A), both in 1 A steps, are stored beside
 it; rows are i_q and columns i_d. The nodes outside |i| ≤ 16 A are NaN: the measurement covers a
-disc of 16 A. fado's CSV needs a full rectangular grid, so the converter keeps the largest
+disc of 16 A. The file does not say how the map was obtained; the disc, the scatter of the
+differential inductances and the asymmetry in i_q are those of a measurement. fado's CSV
+needs a full rectangular grid, so the converter keeps the largest
 rectangle of measured nodes around the origin, i_d −10 … +1 A and i_q −12 … +12 A (12 × 25
 nodes, corner at 15.6 A), and makes it symmetric about the d axis node by node (ψd even, ψq odd
 in i_q: each node the mean of itself and its mirror in i_q), as a machine symmetric about its
@@ -22,7 +24,8 @@ The drive and the plant extrapolate a map linearly from its edge cells beyond it
 
 The script prints the values a preset takes from the map: ψd, incremental Ld and Lq at zero
 current, the secant Lq at i_d = 0, and the torque 1.5·p·(ψd·i_q − ψq·i_d) on the
-maximum-torque-per-ampere curve at a given current (bilinear in the map, the drive's own interpolation).
+maximum-torque-per-ampere curve at a given current (bilinear in the map, the drive's own
+interpolation).
 
 Usage: python3 scripts/flux-map-gem.py Reforce_PMSM_LUT.mat OUT.csv [--pole-pairs 3]
   [--rated-current 8]   (scipy reads the MATLAB file: pip install scipy)
@@ -107,11 +110,10 @@ def main() -> None:
     args = ap.parse_args()
     grid = symmetrise(load(args.source))
     d_axis, q_axis, psi_d, psi_q = grid
-    flux_map_csv.write(args.out, [SOURCE, f"Converted by scripts/flux-map-gem.py: the "
-                                  f"{len(d_axis)} × {len(q_axis)} measured nodes with i_d "
-                                  f"{D_RANGE[0]:g}…{D_RANGE[1]:g} A and i_q {Q_RANGE[0]:g}…"
-                                  f"{Q_RANGE[1]:g} A, one row each, symmetrised in i_q, no interpolation."],
-                       d_axis, q_axis, psi_d, psi_q)
+    note = (f"Converted by scripts/flux-map-gem.py: the {len(d_axis)} × {len(q_axis)} measured "
+            f"nodes with i_d {D_RANGE[0]:g}…{D_RANGE[1]:g} A and i_q {Q_RANGE[0]:g}…"
+            f"{Q_RANGE[1]:g} A, one row each, symmetrised in i_q, no interpolation.")
+    flux_map_csv.write(args.out, [SOURCE, note], d_axis, q_axis, psi_d, psi_q)
     lf, ld, lq = flux_map_csv.zero_current(d_axis, q_axis, psi_d, psi_q)
     psi_q0 = bilinear(d_axis, q_axis, psi_q, 0.0, 0.0)
     print(f"wrote {args.out}: {len(d_axis)} × {len(q_axis)} nodes; at zero current "

@@ -17,7 +17,8 @@ printf '| motor | magnetics | simulated (s) | CPU (s), best of %s | × real time
 for pair in "motors/ipmsm-2k2.toml:constant inductances" \
     "motors/saturated/ipmsm-2k2-qsat.toml:algebraic saturation" \
     "motors/saturated/pmsyrm-baldor-5k6.toml:algebraic saturation with rib" \
-    "motors/saturated/pmsyrm-baldor-5k6-measured.toml:measured 21 × 27 flux map"; do
+    "motors/saturated/pmsyrm-baldor-5k6-measured.toml:measured 21 × 27 flux map" \
+    "motors/saturated/pmsm-gem-1k1-measured.toml:measured 12 × 25 flux map"; do
     file=${pair%%:*}
     kind=${pair#*:}
     best=

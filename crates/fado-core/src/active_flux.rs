@@ -135,7 +135,20 @@ impl<T: Real> ActiveFlux<T> {
     /// positive finite number (a map not odd in i_q near i_q = 0) is replaced by L_qq(0).
     #[inline]
     pub fn point(&self, i_dq: Dq<T>) -> ActiveFluxPoint<T> {
-        let psi = self.flux(i_dq);
+        self.point_at(i_dq, self.flux(i_dq))
+    }
+
+    /// [`ActiveFlux::point`] with the model's ψ(i_dq) solved from `psi_guess`, a flux near it
+    /// in the same frame (the estimated stator flux there): one or two Newton steps where the
+    /// model's ψ(i) is an inversion ([`MagneticModel::flux_from`]).
+    #[inline]
+    pub fn point_from(&self, i_dq: Dq<T>, psi_guess: Dq<T>) -> ActiveFluxPoint<T> {
+        let psi = self.model.resolve(self.linear).flux_from(i_dq, psi_guess);
+        self.point_at(i_dq, psi)
+    }
+
+    #[inline]
+    fn point_at(&self, i_dq: Dq<T>, psi: Dq<T>) -> ActiveFluxPoint<T> {
         let secant = if i_dq.q.abs() > self.small_current {
             psi.q / i_dq.q
         } else {
@@ -153,8 +166,8 @@ impl<T: Real> ActiveFlux<T> {
         }
     }
 
-    /// The current `i_ab` in the frame whose d axis is `axis` (any length; zero current for a
-    /// zero or non-finite axis).
+    /// The current `i_ab` (or any α-β vector) in the frame whose d axis is `axis` (any length;
+    /// zero for a zero or non-finite axis).
     #[inline]
     pub fn frame_current(axis: Ab<T>, i_ab: Ab<T>) -> Dq<T> {
         let n = axis.norm_squared().step_sqrt();
@@ -175,8 +188,10 @@ impl<T: Real> ActiveFlux<T> {
         i_ab: Ab<T>,
         lq_prev: T,
     ) -> (Ab<T>, ActiveFluxPoint<T>) {
-        let i_dq = Self::frame_current(lambda2 - i_ab * lq_prev, i_ab);
-        let point = self.point(i_dq);
+        let axis = lambda2 - i_ab * lq_prev;
+        let i_dq = Self::frame_current(axis, i_ab);
+        // λ2 in the same frame is the estimated ψ(î): the model's flux starts there.
+        let point = self.point_from(i_dq, Self::frame_current(axis, lambda2));
         (lambda2 - i_ab * point.lq_secant, point)
     }
 

@@ -423,3 +423,61 @@ fn the_slow_mode_of_the_estimator_at_the_reversal_speed() {
         "pmsyrm-baldor-5k6 65 % generating: {generating}"
     );
 }
+
+/// The drive's torque path on saturated machines: i_q* ↦ τ(injection + MTPA(i_q*), i_q*)
+/// (the references `fado_core::control::saturated_references` gives the speed loop, with the
+/// eq. (23) injection of the default I_min) rises strictly from zero to the current limit, and
+/// three Newton steps per sample from the last i_q* (the drive's solve) track a ramp of the
+/// torque demand to the speed loop's limit within 1 % of that limit. The speed loop's plant
+/// gain is then the model's 1.5·p·λ̂f per unit of its output at every load: a slow
+/// oscillation under load on these machines is not the torque-to-current map's.
+#[test]
+fn the_drives_torque_path_rises_monotonically_on_saturated_machines() {
+    for (name, m) in [
+        ("pmsyrm-baldor-5k6", baldor()),
+        ("pmsyrm-baldor-5k6 as a 17x17 map", baldor_map()),
+        ("automotive IPMSM (made up)", automotive()),
+        ("pmsm-gem-1k1-measured", gem_measured()),
+        ("ipmsm-2k2-qsat", ipm(58.0)),
+        ("made-up 20-pole IPMSM", small_ipm()),
+    ] {
+        // The drive's defaults: current limit 1.84 and I_min 0.18 of the rated current.
+        let i_max = 1.836521739130435 * m.rated_current;
+        let i_min = 0.1836521739130435 * m.rated_current;
+        let refs = SaturatedReferences::new(&m, i_max).unwrap();
+        let id_of = |iq: f64| (i_min * i_min - iq * iq).max(0.0).sqrt() + refs.mtpa_id(iq);
+        // τ in units of the magnet's q current (τ/λ̂f, A).
+        let tau = |iq: f64| refs.torque_flux(Dq::new(id_of(iq), iq)) / m.flux_linkage;
+        let n = 2000;
+        let h = i_max / n as f64;
+        let min_slope = (0..n)
+            .map(|k| (tau((k + 1) as f64 * h) - tau(k as f64 * h)) / h)
+            .fold(f64::INFINITY, f64::min);
+        let limit = refs.torque_limit(i_max, m.flux_linkage);
+        let solve = |target: f64, guess: f64| {
+            let step = 1e-3 * m.rated_current;
+            let mut iq = if guess > 0.0 { guess } else { target };
+            for _ in 0..3 {
+                let f0 = tau(iq) - target;
+                let slope = (tau(iq + step) - tau(iq)) / step;
+                if slope > 1e-3 {
+                    iq -= f0 / slope;
+                }
+            }
+            iq
+        };
+        // The demand ramps to the limit over 2000 samples (0.2 s at 10 kHz).
+        let (mut iq, mut worst) = (0.0, 0.0f64);
+        for k in 1..=n {
+            let target = limit * k as f64 / n as f64;
+            iq = solve(target, iq);
+            worst = worst.max((tau(iq) - target).abs() / limit);
+        }
+        println!(
+            "{name}: min dτ/di_q* {min_slope:.3} (in λ̂f), limit {limit:.2} A, \
+             worst ramp residual {worst:.1e} of the limit"
+        );
+        assert!(min_slope > 0.05, "{name}: torque path slope {min_slope}");
+        assert!(worst < 0.01, "{name}: solve residual {worst}");
+    }
+}

@@ -459,6 +459,20 @@ pub fn preconditions(
 /// identified threshold voltage (for the drive's dead-time compensation), headed by comments
 /// giving the uncertainties, the inverter's voltage error and the sensors' gain ratio.
 pub fn identified_toml(input: &str, id: &Identification<f64>) -> Result<String, SimConfigError> {
+    identified_toml_with_map(input, id, None)
+}
+
+/// [`identified_toml`] whose magnetic model, when saturation was identified, is the flux map
+/// `map_file` (a path relative to the document: `[model] flux_map`, the table that
+/// [`crate::identified_map`] writes) instead of `[model.saturation]`, whose values the header
+/// keeps as comments (one magnetic model per `[model]`; uncommented in place of `flux_map`
+/// they give the algebraic model itself). Without saturation, or with `map_file` None, it is
+/// [`identified_toml`].
+pub fn identified_toml_with_map(
+    input: &str,
+    id: &Identification<f64>,
+    map_file: Option<&str>,
+) -> Result<String, SimConfigError> {
     let mut doc: toml::Table = input
         .parse()
         .map_err(|e: toml::de::Error| SimConfigError::new("<config>", e.to_string()))?;
@@ -472,30 +486,7 @@ pub fn identified_toml(input: &str, id: &Identification<f64>) -> Result<String, 
             .to_string();
         motor.insert("flux_map".into(), toml::Value::String(resolved));
     }
-    let m = id.model;
-    let mut model = toml::Table::new();
-    for (k, v) in [
-        ("rs", m.rs),
-        ("ld", m.ld),
-        ("lq", m.lq),
-        ("flux_linkage", m.flux_linkage),
-        ("inertia", m.inertia),
-        ("viscous_friction", m.viscous_friction),
-        ("rated_current", m.rated_current),
-        ("rated_speed_rpm", m.rated_speed_rpm),
-        ("rated_torque", m.rated_torque),
-    ] {
-        model.insert(k.into(), toml::Value::Float(v));
-    }
-    model.insert(
-        "pole_pairs".into(),
-        toml::Value::Integer(i64::from(m.pole_pairs)),
-    );
-    if let Some(s) = &id.saturation {
-        let table = toml::Value::try_from(s)
-            .map_err(|e| SimConfigError::new("model.saturation", e.to_string()))?;
-        model.insert("saturation".into(), table);
-    }
+    let (model, saturation_lines) = model_table(id, map_file)?;
     doc.insert("model".into(), toml::Value::Table(model));
     // The identified threshold to the drive's dead-time compensation (its dead time is the
     // configured one, as the procedure's); a slightly negative result (noise about a zero
@@ -515,7 +506,7 @@ pub fn identified_toml(input: &str, id: &Identification<f64>) -> Result<String, 
          saliency Lq/Ld {:.4}.\n\
          # Current sensors' gain ratio k = {:.5} (1-sigma {:.1e}): phase a was divided by it, \
          so the model is in phase b's scale, the drive's after its start-up gain calibration.\n\
-         {}",
+         {}{}",
         id.duration,
         c.rs,
         c.ld,
@@ -529,9 +520,71 @@ pub fn identified_toml(input: &str, id: &Identification<f64>) -> Result<String, 
         id.current_gain_ratio,
         c.current_gain_ratio,
         saturation_comment(id),
+        saturation_lines,
     );
     let body = toml::to_string(&doc).map_err(|e| SimConfigError::new("<config>", e.to_string()))?;
     Ok(head + &body)
+}
+
+/// The identified `[model]` table (the keys of [`MachineModel`], and the magnetic model as
+/// [`identified_toml_with_map`] says) and the header's comment lines of the algebraic model
+/// when the table names its map instead.
+fn model_table(
+    id: &Identification<f64>,
+    map_file: Option<&str>,
+) -> Result<(toml::Table, String), SimConfigError> {
+    let m = id.model;
+    let mut model = toml::Table::new();
+    for (k, v) in [
+        ("rs", m.rs),
+        ("ld", m.ld),
+        ("lq", m.lq),
+        ("flux_linkage", m.flux_linkage),
+        ("inertia", m.inertia),
+        ("viscous_friction", m.viscous_friction),
+        ("rated_current", m.rated_current),
+        ("rated_speed_rpm", m.rated_speed_rpm),
+        ("rated_torque", m.rated_torque),
+    ] {
+        model.insert(k.into(), toml::Value::Float(v));
+    }
+    model.insert(
+        "pole_pairs".into(),
+        toml::Value::Integer(i64::from(m.pole_pairs)),
+    );
+    let mut saturation_lines = String::new();
+    if let Some(s) = &id.saturation {
+        let table = toml::Value::try_from(s)
+            .map_err(|e| SimConfigError::new("model.saturation", e.to_string()))?;
+        match map_file {
+            Some(file) => {
+                model.insert("flux_map".into(), toml::Value::String(file.into()));
+                saturation_lines = commented_saturation(table)?;
+            }
+            None => {
+                model.insert("saturation".into(), table);
+            }
+        }
+    }
+    Ok((model, saturation_lines))
+}
+
+/// The algebraic model's `[model.saturation]` table as comment lines (for the header of a
+/// document whose `[model]` names the model's flux map).
+fn commented_saturation(table: toml::Value) -> Result<String, SimConfigError> {
+    let mut doc = toml::Table::new();
+    let mut model = toml::Table::new();
+    model.insert("saturation".into(), table);
+    doc.insert("model".into(), toml::Value::Table(model));
+    let text = toml::to_string(&doc).map_err(|e| SimConfigError::new("<config>", e.to_string()))?;
+    let mut out = String::from(
+        "# [model] flux_map tabulates this algebraic model (identified; in place of flux_map it \
+         gives the model itself):\n",
+    );
+    for line in text.lines().filter(|l| !l.trim().is_empty()) {
+        out.push_str(&format!("#   {line}\n"));
+    }
+    Ok(out)
 }
 
 /// The header's statement on the magnetic model: saturation detected (the written

@@ -59,6 +59,7 @@ pub mod error;
 pub mod estimators;
 mod fastmath;
 pub mod faults;
+pub mod identified_map;
 pub mod inverter;
 pub mod load;
 pub mod magnetic_accuracy;

@@ -43,14 +43,12 @@ pub const SUBSTEP_TIME_CONSTANTS: f64 = 0.05;
 /// (four): its h³ error is then below RK4's on the long intervals.
 pub const SHORT_INTERVAL_SUBSTEPS: f64 = 0.1;
 
-/// A flux map's data held by the simulator (the firmware's `&'static` table, on the heap):
-/// `psi_d[k·n_q + m]` at (`i_d[k]`, `i_q[m]`), checked by [`FluxMap::new`].
-#[derive(Clone, Debug, PartialEq)]
+/// A flux map's data held by the simulator (the firmware's `&'static` table, leaked once per
+/// map read: a plant borrows the checked map per evaluation of i(ψ), with its axes' spacing
+/// found once): `psi_d[k·n_q + m]` at (`i_d[k]`, `i_q[m]`), checked by [`FluxMap::new`].
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FluxMapData {
-    i_d: Vec<f64>,
-    i_q: Vec<f64>,
-    psi_d: Vec<f64>,
-    psi_q: Vec<f64>,
+    map: FluxMap<'static, f64>,
 }
 
 impl FluxMapData {
@@ -62,18 +60,15 @@ impl FluxMapData {
         psi_q: Vec<f64>,
     ) -> Result<Self, FluxMapError> {
         FluxMap::new(&i_d, &i_q, &psi_d, &psi_q)?;
-        Ok(Self {
-            i_d,
-            i_q,
-            psi_d,
-            psi_q,
-        })
+        let leak = |v: Vec<f64>| -> &'static [f64] { Vec::leak(v) };
+        let map = FluxMap::new(leak(i_d), leak(i_q), leak(psi_d), leak(psi_q))?;
+        Ok(Self { map })
     }
 
-    /// The map, borrowed (an O(1) view of the checked data).
-    pub fn map(&self) -> FluxMap<'_, f64> {
-        FluxMap::from_checked_parts(&self.i_d, &self.i_q, &self.psi_d, &self.psi_q)
-            .expect("shapes checked by FluxMapData::new")
+    /// The map, borrowed.
+    #[inline]
+    pub fn map(&self) -> FluxMap<'static, f64> {
+        self.map
     }
 }
 

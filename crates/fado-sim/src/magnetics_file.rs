@@ -108,7 +108,7 @@ pub fn plant_magnetics(
     flux_map: Option<&FluxMapFile>,
 ) -> Option<Arc<PlantMagnetics>> {
     match (flux_map, saturation) {
-        (Some(m), _) => Some(Arc::new(PlantMagnetics::Map((*m.data).clone()))),
+        (Some(m), _) => Some(Arc::new(PlantMagnetics::Map(*m.data))),
         (None, Some(s)) => Some(Arc::new(PlantMagnetics::Saturation(*s))),
         (None, None) => None,
     }

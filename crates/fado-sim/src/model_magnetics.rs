@@ -84,7 +84,7 @@ pub fn interned_map(map: &FluxMapData) -> &'static FluxMap<'static, f64> {
     if let Some((_, m)) = i.maps.iter().find(|(d, _)| *d == map) {
         return m;
     }
-    let data: &'static FluxMapData = Box::leak(Box::new(map.clone()));
+    let data: &'static FluxMapData = Box::leak(Box::new(*map));
     let m: &'static FluxMap<'static, f64> = Box::leak(Box::new(data.map()));
     i.maps.push((data, m));
     m

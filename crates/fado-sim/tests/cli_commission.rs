@@ -303,3 +303,47 @@ fn commission_io_errors_name_the_path_with_exit_3() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A saturated machine's identified model is also written as a flux map beside
+/// identified.toml, which names it by a relative path: the directory moved elsewhere still
+/// resolves it (`run --dump-config` from another working directory). A machine without
+/// saturation commissioned into the same directory leaves no map behind.
+#[test]
+fn the_identified_flux_map_sits_beside_identified_toml_and_goes_with_it() {
+    use fado_sim::identified_map::IDENTIFIED_MAP_FILE;
+    let dir = scratch("map");
+    let out = dir.join("out");
+    let cfg = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/ipmsm-test-saturated.toml");
+    let o = commission(&cfg, &out, 1).output().unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let csv = std::fs::read_to_string(out.join(IDENTIFIED_MAP_FILE)).unwrap();
+    let header = csv.lines().find(|l| !l.starts_with('#')).unwrap();
+    assert_eq!(header, "i_d,i_q,psi_d,psi_q");
+    let doc = std::fs::read_to_string(out.join("identified.toml")).unwrap();
+    assert!(
+        doc.contains(&format!("flux_map = \"{IDENTIFIED_MAP_FILE}\"")),
+        "{doc}"
+    );
+    assert!(doc.contains("#   [model.saturation]"), "{doc}");
+    assert!(no_temporaries(&out));
+    let moved = dir.join("moved");
+    std::fs::rename(&out, &moved).unwrap();
+    let dump = Command::new(BIN)
+        .args(["run", "reversal", "--dump-config", "--config"])
+        .arg(moved.join("identified.toml"))
+        .current_dir(std::env::temp_dir())
+        .output()
+        .unwrap();
+    assert_eq!(dump.status.code(), Some(0), "{}", stderr(&dump));
+    let text = String::from_utf8_lossy(&dump.stdout);
+    let resolved = moved.join(IDENTIFIED_MAP_FILE).display().to_string();
+    assert!(text.contains(&resolved), "{text}");
+    let linear = dir.join("paper.toml");
+    std::fs::write(&linear, fado_sim::presets::find("paper").unwrap().toml).unwrap();
+    let o = commission(&linear, &moved, 1).output().unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(!moved.join(IDENTIFIED_MAP_FILE).exists());
+    let doc = std::fs::read_to_string(moved.join("identified.toml")).unwrap();
+    assert!(!doc.contains("flux_map"), "{doc}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -7,7 +7,7 @@
 //! firmware does with a map measured or computed off line.
 
 use fado_core::Dq;
-use fado_core::magnetics::{FluxMap, FluxTable, MagneticModel};
+use fado_core::magnetics::{FluxMap, FluxTable, MagneticModel, UniformFluxTable};
 
 /// Nodes per axis.
 pub const N: usize = 16;
@@ -45,11 +45,26 @@ const fn table() -> FluxTable<f32, N, N> {
     t
 }
 
-/// The map in flash.
+/// The table in flash.
 pub static TABLE: FluxTable<f32, N, N> = table();
 
-/// ψ(i): one bilinear lookup (cell search by bisection on both axes, four corners, the
-/// interpolation) — the unit of the ≤ 60-cycle target.
+/// The table as a checked map, in flash too (built and checked by the compiler,
+/// `FluxTable::const_map`): what a saturating machine's `MachineModel` borrows.
+pub static MAP: FluxMap<'static, f32> = TABLE.const_map();
+
+/// The same table for the uniform-grid lookup (`UniformFluxTable`: interleaved nodes, the
+/// shape in the type), in flash, built and checked by the compiler.
+pub static UNIFORM: UniformFluxTable<f32, N, N> = UniformFluxTable::from_f32_table(&TABLE);
+
+/// ψ(i) from [`UNIFORM`]: the lookup a firmware's own code makes in its interrupt.
+#[inline(never)]
+#[unsafe(no_mangle)]
+pub fn uniform_table_lookup(table: &UniformFluxTable<f32, N, N>, i: Dq<f32>) -> Dq<f32> {
+    table.flux(i)
+}
+
+/// ψ(i): one bilinear lookup (the cell from the uniform axes' inverse spacing, four corners
+/// per table, the interpolation) — the unit of the ≤ 60-cycle target.
 #[inline(never)]
 #[unsafe(no_mangle)]
 pub fn flux_map_lookup(map: &FluxMap<'static, f32>, i: Dq<f32>) -> Dq<f32> {
@@ -64,10 +79,11 @@ pub fn flux_map_inverse(map: &FluxMap<'static, f32>, psi: Dq<f32>, guess: Dq<f32
     map.current_from(psi, guess)
 }
 
-/// Runs `n` lookups and inverses along a current trajectory sweeping the map (a rotating
-/// current vector of growing amplitude); returns the worst round-trip error |i(ψ(i)) − i|.
+/// Runs `n` lookups (by the map and by the uniform table) and inverses along a current
+/// trajectory sweeping the map (a rotating current vector of growing amplitude); returns the
+/// worst round-trip error |i(ψ(i)) − i| or difference between the two lookups.
 pub fn run(n: usize) -> Option<f32> {
-    let map = TABLE.map().ok()?;
+    let map = MAP;
     let mut worst: f32 = 0.0;
     let mut guess = Dq::new(0.0, 0.0);
     for k in 0..n {
@@ -77,6 +93,8 @@ pub fn run(n: usize) -> Option<f32> {
         let (s, c) = (crate::sin(phase), crate::cos(phase));
         let i = Dq::new(a * c, a * s);
         let psi = flux_map_lookup(&map, core::hint::black_box(i));
+        let same = uniform_table_lookup(&UNIFORM, core::hint::black_box(i));
+        worst = worst.max((same - psi).norm());
         let back = flux_map_inverse(&map, core::hint::black_box(psi), guess);
         guess = back;
         worst = worst.max((back - i).norm());

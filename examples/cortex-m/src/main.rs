@@ -48,8 +48,9 @@ use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m_rt::{entry, exception};
 use cortex_m_semihosting::{debug, hprintln};
 use drive_loop::DriveApp;
+use fado_core::magnetics::MagneticModel;
 use fado_core::{
-    Ab, Abc, DriveOutput, Estimate, EstimatorConfig, EstimatorParams, EstimatorState,
+    Ab, Abc, Dq, DriveOutput, Estimate, EstimatorConfig, EstimatorParams, EstimatorState,
     EstimatorTuning, LeanEstimate, MachineMagnetics, MachineModel, Mode, SensorlessDrive,
     SensorlessEstimator,
 };
@@ -99,6 +100,9 @@ const PAPER_PATH_HELD: usize = 3;
 /// The default configuration (R̂s adaptation on) for the salient [`ipmsm_2k2`]: the step with
 /// the active-flux terms of a salient rotor, which the paper's motor (Ld = Lq) never runs.
 const SALIENT: usize = 4;
+/// The default configuration for [`ipmsm_2k2_map`]: the step of a saturating model, its
+/// active flux from the 16 × 16 flux map in flash.
+const SATURATING_MAP: usize = 5;
 
 /// The 2.2 kW interior-magnet motor of `motors/ipmsm-2k2.toml` (motulator's example motor,
 /// Lq/Ld 1.42): a salient rotor, whose active-flux terms cost cycles the paper's motor does
@@ -120,9 +124,21 @@ fn ipmsm_2k2() -> MachineModel<f32> {
     }
 }
 
+/// [`ipmsm_2k2`] saturating: its magnetics the 16 × 16 flux map in flash
+/// ([`flux_lookup::MAP`], q self-saturation and cross-saturation), the constant fields the
+/// map's values at zero current.
+fn ipmsm_2k2_map() -> MachineModel<f32> {
+    MachineModel {
+        magnetics: MachineMagnetics::Map(&flux_lookup::MAP),
+        ..ipmsm_2k2()
+    }
+}
+
 /// The generated machine and the estimator's model of scenario `s`.
 fn model_of(s: &Scenario) -> MachineModel<f32> {
-    if s.salient {
+    if s.params == SATURATING_MAP {
+        ipmsm_2k2_map()
+    } else if s.salient {
         ipmsm_2k2()
     } else {
         MachineModel::paper()
@@ -135,7 +151,7 @@ fn model_of(s: &Scenario) -> MachineModel<f32> {
 /// fado's default fixed-R̂s path differ by 2e-2 rad here.
 const KERNEL_TOLERANCE: f32 = 1e-4;
 
-const SCENARIOS: [Scenario; 10] = [
+const SCENARIOS: [Scenario; 12] = [
     Scenario {
         name: "low speed, R^s adaptation",
         speed_hz: 19.5,
@@ -226,6 +242,24 @@ const SCENARIOS: [Scenario; 10] = [
         kernel: false,
         salient: true,
     },
+    Scenario {
+        name: "low speed, R^s adaptation, ipmsm-2k2 saturating, 16 x 16 flux map in flash",
+        speed_hz: 19.5,
+        ramp_s: 0.05,
+        hold_samples: 1000,
+        params: SATURATING_MAP,
+        kernel: false,
+        salient: true,
+    },
+    Scenario {
+        name: "rated speed, R^s adaptation, ipmsm-2k2 saturating, 16 x 16 flux map in flash",
+        speed_hz: 75.0,
+        ramp_s: 0.2,
+        hold_samples: 1000,
+        params: SATURATING_MAP,
+        kernel: false,
+        salient: true,
+    },
 ];
 
 /// The generated machine: angle and speed of an ideal PMSM, its flux and current. Its data are
@@ -236,6 +270,9 @@ struct Machine {
     rs: f32,
     lq: f32,
     flux_linkage: f32,
+    /// A saturating model's ψ(0, i_q) (the current is constant in the rotor frame), used
+    /// instead of (λf, Lq·i_q).
+    flux_dq: Option<Dq<f32>>,
     iq: f32,
     theta: f32,
     omega: f32,
@@ -249,11 +286,16 @@ struct Machine {
 impl Machine {
     fn new(s: &Scenario, model: &MachineModel<f32>) -> Self {
         let omega_final = TAU * s.speed_hz;
+        let iq = IQ_RATIO * model.rated_current;
         let mut m = Self {
             rs: model.rs,
             lq: model.lq,
             flux_linkage: model.flux_linkage,
-            iq: IQ_RATIO * model.rated_current,
+            flux_dq: match model.magnetics {
+                MachineMagnetics::Linear => None,
+                _ => Some(model.magnetic_model().flux(Dq::new(0.0, iq))),
+            },
+            iq,
             theta: 0.0,
             omega: 0.0,
             d_omega: omega_final * TS / s.ramp_s,
@@ -269,7 +311,10 @@ impl Machine {
     fn flux_and_current(&self) -> (Ab<f32>, Ab<f32>) {
         let unit = Ab::new(cos(self.theta), sin(self.theta));
         let i = unit.mul_j() * self.iq;
-        (unit * self.flux_linkage + i * self.lq, i)
+        match self.flux_dq {
+            Some(psi) => (unit * psi.d + unit.mul_j() * psi.q, i),
+            None => (unit * self.flux_linkage + i * self.lq, i),
+        }
     }
 
     /// Advances one sample; returns (the average voltage over the interval, the current now).
@@ -347,9 +392,9 @@ static DRIVE: Mutex<RefCell<Option<DriveApp>>> = Mutex::new(RefCell::new(None));
 
 /// The estimator's parameters, written once by `main` before the interrupt runs (index 0 with
 /// the default R̂s adaptation, 1 with the paper's fixed R̂s, 2 the paper's path and 3 the same
-/// with the gains held, 4 the default on a salient motor: see [`PAPER_PATH`],
-/// [`PAPER_PATH_HELD`], [`SALIENT`]); read-only afterwards.
-static PARAMS: Mutex<OnceCell<[EstimatorParams<f32>; 5]>> = Mutex::new(OnceCell::new());
+/// with the gains held, 4 the default on a salient motor, 5 on a saturating one: see
+/// [`PAPER_PATH`], [`PAPER_PATH_HELD`], [`SALIENT`], [`SATURATING_MAP`]); read-only afterwards.
+static PARAMS: Mutex<OnceCell<[EstimatorParams<f32>; 6]>> = Mutex::new(OnceCell::new());
 
 /// Lowest stack pointer seen just before calling [`estimator_step`] or [`drive_step`] (stack
 /// measurement).
@@ -568,6 +613,7 @@ fn main() -> ! {
         paper_config,
         paper_held_config,
         paper_config,
+        paper_config,
     ];
     let params = {
         let model = MachineModel::<f32>::paper();
@@ -582,9 +628,10 @@ fn main() -> ! {
             EstimatorParams::new(paper_config),
             EstimatorParams::new(paper_held_config),
             EstimatorParams::new(EstimatorConfig::for_machine(&ipmsm_2k2())),
+            EstimatorParams::new(EstimatorConfig::for_machine(&ipmsm_2k2_map())),
         ) {
-            (Ok(adaptive), Ok(fixed), Ok(paper), Ok(held), Ok(salient)) => {
-                [adaptive, fixed, paper, held, salient]
+            (Ok(adaptive), Ok(fixed), Ok(paper), Ok(held), Ok(salient), Ok(saturating)) => {
+                [adaptive, fixed, paper, held, salient, saturating]
             }
             _ => {
                 hprintln!("invalid configuration");

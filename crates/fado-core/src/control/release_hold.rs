@@ -35,7 +35,7 @@
 //! free fall before the trigger, against the 0.5 rad a loaded start may lose). Where the hold
 //! is enabled, the drive raises the current loop's bandwidth to the 10·ω_h its design travel
 //! needs ([`current_bandwidth_for_hold`]) where the cap would let the rated load move the
-//! rotor by more than twice the design travel, never lowering the tuning's and at most
+//! rotor by more than 1.75 times the design travel, never lowering the tuning's and at most
 //! ωc·Ts = [`MAX_CURRENT_WC_TS`]. The electrical side allows it: such a motor's stator pole
 //! R/L (3.7·10³ s⁻¹ on the multirotor preset) is itself above the paper's 2π·250 Hz, and its
 //! PWM samples at 40 kHz or more. On the presets the rule acts only on the two outrunners
@@ -110,10 +110,11 @@ cast_record!(ReleaseHoldTuning { travel, trigger, window ; enabled });
 pub const MAX_CURRENT_WC_TS: f64 = 0.2;
 
 /// How far beyond its design travel the current loop's cap may let the rated load move the
-/// rotor before the hold's rule raises the loop: 2 \[A\] (0.4 rad for the default 0.2 rad
-/// design, 80 % of the 0.5 rad a loaded start may lose, the rest for the free fall before the
-/// trigger). A tuning that holds the rotor is left as it is.
-const CAPPED_TRAVEL_RATIO: f64 = 2.0;
+/// rotor before the hold's rule raises the loop: 1.75 \[A\] (0.35 rad for the default 0.2 rad
+/// design: the free fall before the trigger adds 0.05–0.1 rad on the presets, which leaves it
+/// within the 0.5 rad a loaded start may lose; a 24-pole multirotor motor at 2.0 lost
+/// 0.48–0.54 rad). A tuning that holds the rotor is left as it is.
+const CAPPED_TRAVEL_RATIO: f64 = 1.75;
 
 /// The hold's stiffness ω_h (rad/s) before the caps: the rated load moves the rotor by
 /// `travel`, ω_h = √(0.27·b·I_rated/travel), b = 1.5·p²·λ̂f/Ĵ (module docs).
@@ -125,8 +126,8 @@ fn design_omega<T: Real>(machine: &MachineModel<T>, travel: T) -> T {
 
 /// The current loop's bandwidth (Hz) the release hold needs on `machine` sampled every `ts`:
 /// 10·ω_h/2π for its design travel where the hold is enabled and the cap ω_h ≤ ωc/10 of
-/// `current_hz` (the tuning's) would let the rated load move the rotor by more than twice
-/// that travel (ω_h² > 2·(ωc/10)²), at most ωc·Ts = [`MAX_CURRENT_WC_TS`]; `current_hz`
+/// `current_hz` (the tuning's) would let the rated load move the rotor by more than 1.75
+/// times that travel (ω_h² > 1.75·(ωc/10)²), at most ωc·Ts = [`MAX_CURRENT_WC_TS`]; `current_hz`
 /// otherwise (module docs, "The current loop it needs"). A non-finite result keeps
 /// `current_hz`.
 pub fn current_bandwidth_for_hold<T: Real>(
@@ -141,7 +142,8 @@ pub fn current_bandwidth_for_hold<T: Real>(
     let omega = design_omega(machine, tuning.travel);
     let capped = T::two_pi() * current_hz / T::lit(10.0);
     // NaN compares false: the tuning's.
-    if !(omega * omega > T::lit(CAPPED_TRAVEL_RATIO) * capped * capped) {
+    let needs_wider_loop = omega * omega > T::lit(CAPPED_TRAVEL_RATIO) * capped * capped;
+    if !needs_wider_loop {
         return current_hz;
     }
     let wc = T::lit(10.0) * omega;

@@ -48,26 +48,29 @@ fn torque_flux<T: Real>(model: &impl MagneticModel<T>, i: Dq<T>) -> T {
     psi.d * i.q - psi.q * i.d
 }
 
-/// The MTPA condition g (module docs) at `i`.
-fn mtpa_condition<T: Real>(model: &impl MagneticModel<T>, i: Dq<T>) -> T {
-    let psi = model.flux(i);
-    let l = model.incremental_inductance(i);
+/// The MTPA condition g (module docs) at `i`, the model's flux solved from `guess` (a nearby
+/// current's), and that flux.
+fn mtpa_condition<T: Real>(model: &impl MagneticModel<T>, i: Dq<T>, guess: Dq<T>) -> (T, Dq<T>) {
+    let (psi, l) = model.flux_and_inductance_from(i, guess);
     let d_tau_d = l.dd * i.q - psi.q - l.qd * i.d;
     let d_tau_q = psi.d + l.dq * i.q - l.qq * i.d;
-    d_tau_d * i.q - d_tau_q * i.d
+    (d_tau_d * i.q - d_tau_q * i.d, psi)
 }
 
 /// The MTPA d current at q current `i_q` ≥ 0 by bisection on [−2·`i_max`, 0]; 0 where g ≥ 0
-/// at i_d = 0 (no reluctance torque to gain).
+/// at i_d = 0 (no reluctance torque to gain). Each point's flux starts from the last one's.
 fn mtpa_id<T: Real>(model: &impl MagneticModel<T>, i_q: T, i_max: T) -> T {
-    let g0 = mtpa_condition(model, Dq::new(T::zero(), i_q));
+    let start = Dq::new(T::zero(), i_q);
+    let (g0, mut psi) = mtpa_condition(model, start, model.flux(start));
     if g0.partial_cmp(&T::zero()) != Some(core::cmp::Ordering::Less) {
         return T::zero();
     }
     let (mut lo, mut hi) = (-(i_max + i_max), T::zero());
     for _ in 0..MTPA_BISECTIONS {
         let mid = T::lit(0.5) * (lo + hi);
-        if mtpa_condition(model, Dq::new(mid, i_q)) < T::zero() {
+        let g;
+        (g, psi) = mtpa_condition(model, Dq::new(mid, i_q), psi);
+        if g < T::zero() {
             hi = mid;
         } else {
             lo = mid;
@@ -108,6 +111,33 @@ impl<T: Real> SaturatedReferences<T> {
     #[inline]
     pub fn torque_flux(&self, i: Dq<T>) -> T {
         torque_flux(&self.model, i)
+    }
+
+    /// τ at `i` as [`SaturatedReferences::torque_flux`], with ψ(i) solved from `guess` (the
+    /// model's flux at a nearby current), and that ψ: the drive's solves chain their flux from
+    /// one evaluation to the next and from sample to sample, so that each costs one or two
+    /// Newton steps instead of a solve from the linear guess.
+    #[inline]
+    pub fn torque_flux_from(&self, i: Dq<T>, guess: Dq<T>) -> (T, Dq<T>) {
+        let psi = self.model.flux_from(i, guess);
+        (psi.d * i.q - psi.q * i.d, psi)
+    }
+
+    /// τ at `i` with its derivative along a path of slope di_d/di_q = `did_diq`, ψ(i) solved
+    /// from `guess` as in [`SaturatedReferences::torque_flux_from`], and that ψ:
+    /// dτ/di_q = (L·(did_diq, 1))d·i_q + ψd − (L·(did_diq, 1))q·i_d − ψq·did_diq with L the
+    /// incremental inductance.
+    #[inline]
+    pub fn torque_flux_slope(&self, i: Dq<T>, did_diq: T, guess: Dq<T>) -> (T, T, Dq<T>) {
+        let (psi, l) = self.model.flux_and_inductance_from(i, guess);
+        let dpsi = l.apply(Dq::new(did_diq, T::one()));
+        let slope = dpsi.d * i.q + psi.d - dpsi.q * i.d - psi.q * did_diq;
+        (psi.d * i.q - psi.q * i.d, slope, psi)
+    }
+
+    /// The model's flux ψ(i) in Wb.
+    pub fn flux(&self, i: Dq<T>) -> Dq<T> {
+        self.model.flux(i)
     }
 
     /// The MTPA point on the circle |i| = `current` (A), i_q ≥ 0 (|(mtpa_id(i_q), i_q)|

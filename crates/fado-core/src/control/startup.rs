@@ -25,10 +25,12 @@
 //! 3. the result: `Found` → the drive starts from the angle; otherwise the free-rotor
 //!    alignment or [`StartupStatus::NoAngle`].
 
+mod motion;
 mod polarity;
 #[cfg(test)]
 mod tests;
 
+pub use motion::{MotionMonitor, READ_CURRENT_RATIO};
 pub use polarity::PolarityTest;
 
 use crate::control::gain_calibration::GainCalibration;
@@ -102,6 +104,15 @@ pub struct StartupTuning<T> {
     pub align_current_ratio: T,
     /// Duration of each of the alignment's two steps (s). Default 0.25 s \[A\].
     pub align_time: T,
+    /// Travel of the rotor (electrical rad) that the start-up reads as motion during the
+    /// offset calibration and the angle search ([`MotionMonitor`]); the start-up then defers
+    /// ([`StartupStatus::RotorMoving`]). Default 0.05 rad \[A\]: a tenth of the
+    /// `loaded-start` bound on the backward travel, ten times the monitor's reading on the
+    /// presets at rest.
+    pub motion_travel: T,
+    /// How long the rotor has to stay still, the phases shorted, before a deferred start-up
+    /// begins again (s). Default 0.1 s \[A\]: the default offset calibration's time.
+    pub quiet_time: T,
 }
 
 impl<T: Real> Default for StartupTuning<T> {
@@ -115,6 +126,8 @@ impl<T: Real> Default for StartupTuning<T> {
             rotor_held: false,
             align_current_ratio: T::lit(0.5),
             align_time: T::lit(0.25),
+            motion_travel: T::lit(0.05),
+            quiet_time: T::lit(0.1),
         }
     }
 }
@@ -135,13 +148,15 @@ impl<T: Real> StartupTuning<T> {
         )?;
         check::positive("startup.align_current_ratio", self.align_current_ratio)?;
         check::non_negative("startup.align_time", self.align_time)?;
+        check::positive("startup.motion_travel", self.motion_travel)?;
+        check::positive("startup.quiet_time", self.quiet_time)?;
         Ok(())
     }
 }
 
 cast_record!(StartupTuning {
     pulse_current_ratio, pulse_voltage_ratio, polarity_current_ratio, align_current_ratio,
-    align_time ; find_angle, free_rotor_align, rotor_held
+    align_time, motion_travel, quiet_time ; find_angle, free_rotor_align, rotor_held
 });
 
 /// Whether the drive's magnetic model meets a larger incremental d inductance along +d (with
@@ -164,6 +179,27 @@ pub fn inverted_polarity<T: Real>(machine: &MachineModel<T>, current: T) -> bool
     plus > minus
 }
 
+/// Whether the pulses of `current` meet a larger incremental inductance along d than along q:
+/// the model's L̂d > L̂q for constant inductances; for a saturating model (a flux map) the
+/// incremental inductances averaged over the pulses' paths from 0 to ±`current` along each
+/// axis, which the search's second harmonic reads (a measured map may turn the order of the
+/// datasheet's small-signal values).
+pub fn d_axis_larger<T: Real>(machine: &MachineModel<T>, current: T) -> bool {
+    if machine.magnetics.is_linear() || !current.is_finite() || current <= T::zero() {
+        return machine.ld > machine.lq;
+    }
+    let m = machine.magnetic_model();
+    let (mut d, mut q) = (T::zero(), T::zero());
+    for k in 1..=4 {
+        let i = current * T::from_index(k) * T::lit(0.25);
+        d += m.incremental_inductance(Dq::new(i, T::zero())).dd;
+        d += m.incremental_inductance(Dq::new(-i, T::zero())).dd;
+        q += m.incremental_inductance(Dq::new(T::zero(), i)).qq;
+        q += m.incremental_inductance(Dq::new(T::zero(), -i)).qq;
+    }
+    d > q
+}
+
 /// Where the start-up's angle phase stands.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum StartupStatus {
@@ -179,6 +215,11 @@ pub enum StartupStatus {
     Aligning,
     /// The angle is known (found, or the free rotor aligned): the drive starts from it.
     Found,
+    /// The rotor turned during the offset calibration or the angle search
+    /// ([`MotionMonitor`]): the drive shorts the phases (the zero vector, whose current
+    /// brakes the rotor) and begins the start-up again once the rotor has stood still for
+    /// `quiet_time`. Not ready meanwhile.
+    RotorMoving,
     /// No usable angle: the drive stays off (gates off, not ready). The detection's verdict:
     /// `AxisOnly` (the axis, its polarity not even with the polarity test), `NoInformation`
     /// or `Implausible`.
@@ -202,6 +243,9 @@ pub enum StartupCommand<T> {
     Start(T),
     /// The phase is over without an angle: gates off.
     Off,
+    /// The rotor stood still for `quiet_time` after it moved: the start-up begins again from
+    /// the offset calibration.
+    Restart,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -209,7 +253,14 @@ enum Stage<T> {
     Idle,
     Search(InitialAngle<T>),
     Polarity(PolarityTest<T>),
-    Align { samples: u32, axis: T },
+    Align {
+        samples: u32,
+        axis: T,
+    },
+    /// The zero vector after a motion, `samples` into the present quiet window.
+    Defer {
+        samples: u32,
+    },
     Done,
 }
 
@@ -227,6 +278,8 @@ pub struct AngleSearch<T> {
     /// ([`inverted_polarity`]): the faster rise then points against the magnet.
     inverted: bool,
     align_samples: u32,
+    quiet_samples: u32,
+    monitor: MotionMonitor<T>,
     stage: Stage<T>,
     status: StartupStatus,
     angle: T,
@@ -246,19 +299,29 @@ impl<T: Real> AngleSearch<T> {
     ) -> Result<Self, ConfigError> {
         tuning.validate()?;
         let align_samples = crate::lock::samples("startup.align_time", tuning.align_time, ts)?;
+        let quiet_samples = crate::lock::samples("startup.quiet_time", tuning.quiet_time, ts)?;
+        let l_mean = T::lit(0.5) * (machine.ld + machine.lq);
         Ok(Self {
             tuning,
             ts,
             rated_current: machine.rated_current,
             l_min: crate::real::min(machine.ld, machine.lq),
             l_max: crate::real::max(machine.ld, machine.lq),
-            l_mean: T::lit(0.5) * (machine.ld + machine.lq),
-            d_larger: machine.ld > machine.lq,
+            l_mean,
+            d_larger: d_axis_larger(machine, tuning.pulse_current_ratio * machine.rated_current),
             inverted: inverted_polarity(
                 machine,
                 tuning.pulse_current_ratio * machine.rated_current,
             ),
             align_samples,
+            quiet_samples: quiet_samples.max(1),
+            monitor: MotionMonitor::new(
+                machine.rs,
+                l_mean,
+                machine.flux_linkage,
+                machine.rated_current,
+                ts,
+            ),
             stage: Stage::Idle,
             status: StartupStatus::Idle,
             angle: T::zero() / T::zero(),
@@ -274,6 +337,47 @@ impl<T: Real> AngleSearch<T> {
         self.armed = self.tuning.find_angle;
         self.status = StartupStatus::Idle;
         self.angle = T::zero() / T::zero();
+        self.monitor.stop();
+    }
+
+    /// The offset calibration runs under the zero vector and watched for motion
+    /// ([`MotionMonitor`]): the start-up of a rotor whose angle is unknown (`find_angle`),
+    /// which may carry a load that no brake holds. Otherwise it runs with the gates off.
+    pub fn watches_offsets(&self) -> bool {
+        self.tuning.find_angle
+    }
+
+    /// The motion monitor (its travel since its last restart).
+    pub fn motion(&self) -> &MotionMonitor<T> {
+        &self.monitor
+    }
+
+    /// Starts watching the offset calibration from reference current `reference` (the
+    /// mean raw current of its first samples, A).
+    pub fn watch_offsets(&mut self, reference: Ab<T>) {
+        self.monitor.restart(reference);
+    }
+
+    /// One watched offset-calibration sample (raw current, the zero vector applied): true
+    /// when the rotor has moved, the start-up then deferred.
+    pub fn offset_sample(&mut self, i_ab: Ab<T>) -> bool {
+        if !self.monitor.running() {
+            return false;
+        }
+        if self.monitor.step(Ab::zero(), i_ab) > self.tuning.motion_travel {
+            self.defer();
+            return true;
+        }
+        false
+    }
+
+    /// The rotor moved: the zero vector until it stands still (see
+    /// [`StartupStatus::RotorMoving`]).
+    fn defer(&mut self) {
+        self.armed = false;
+        self.stage = Stage::Defer { samples: 0 };
+        self.status = StartupStatus::RotorMoving;
+        self.monitor.restart(Ab::zero());
     }
 
     /// The phase has work to do (armed, or running a stage) or holds the drive off.
@@ -350,8 +454,10 @@ impl<T: Real> AngleSearch<T> {
         (flux / (T::from_index(n) * self.ts), n as u32)
     }
 
-    /// One sample: `i_ab` the measured current (offsets removed), `vdc` the DC link.
-    pub fn step(&mut self, i_ab: Ab<T>, vdc: T) -> StartupCommand<T> {
+    /// One sample: `i_ab` the measured current (offsets removed), `v_ab` the voltage that
+    /// acted over the last period (the realised reference: the motion monitor's input while
+    /// deferring), `vdc` the DC link.
+    pub fn step(&mut self, i_ab: Ab<T>, v_ab: Ab<T>, vdc: T) -> StartupCommand<T> {
         if self.armed {
             self.armed = false;
             self.status = StartupStatus::Searching;
@@ -365,6 +471,7 @@ impl<T: Real> AngleSearch<T> {
                 inductance: self.l_mean,
                 ts: self.ts,
             };
+            self.monitor.restart(Ab::zero());
             match InitialAngle::new(config) {
                 Ok(block) => self.stage = Stage::Search(block),
                 Err(_) => return self.refuse(InitialAngleStatus::Implausible),
@@ -393,6 +500,7 @@ impl<T: Real> AngleSearch<T> {
                 StartupCommand::Voltage(v)
             }
             Stage::Align { samples, axis } => {
+                self.monitor.stop();
                 let (n, axis) = (*samples, *axis);
                 *samples += 1;
                 if n >= 2 * self.align_samples {
@@ -408,12 +516,34 @@ impl<T: Real> AngleSearch<T> {
                     current_d: self.tuning.align_current_ratio * self.rated_current,
                 }
             }
+            Stage::Defer { .. } => self.deferred(i_ab, v_ab),
             Stage::Done => match self.status {
                 StartupStatus::Found => StartupCommand::Start(self.angle),
                 _ => StartupCommand::Off,
             },
             Stage::Idle => StartupCommand::Off,
         }
+    }
+
+    /// A deferral's sample: the zero vector, and at the end of each `quiet_time` window the
+    /// restart when the rotor stood still through it.
+    fn deferred(&mut self, i_ab: Ab<T>, v_ab: Ab<T>) -> StartupCommand<T> {
+        let Stage::Defer { samples } = &mut self.stage else {
+            return StartupCommand::Off;
+        };
+        *samples += 1;
+        let done = *samples >= self.quiet_samples;
+        self.monitor.step(v_ab, i_ab);
+        if !done {
+            return StartupCommand::Voltage(Ab::zero());
+        }
+        if self.monitor.quiet(self.tuning.motion_travel) {
+            self.arm();
+            return StartupCommand::Restart;
+        }
+        self.stage = Stage::Defer { samples: 0 };
+        self.monitor.restart(Ab::zero());
+        StartupCommand::Voltage(Ab::zero())
     }
 
     /// The search's verdict: start, test the polarity, align or refuse.

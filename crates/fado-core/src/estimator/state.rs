@@ -168,7 +168,11 @@ impl<T: Real> EstimatorState<T> {
             // A saturating model: λ̂a(î) − ψd(0, 0) along the axis, î in its frame.
             let af = &p.active_flux;
             return if n2 > p.hold_level_sq {
-                let point = af.point(ActiveFlux::frame_current(axis, i_ab));
+                // The axis is the estimated active flux: ψ(î) ≈ axis + L̂q,s·î starts the
+                // model's flux.
+                let i_dq = ActiveFlux::frame_current(axis, i_ab);
+                let guess = ActiveFlux::frame_current(axis, axis + i_ab * self.lq_secant);
+                let point = af.point_from(i_dq, guess);
                 axis * ((point.active - af.magnet_flux()) / n2.step_sqrt())
             } else {
                 Ab::zero()

@@ -11,10 +11,11 @@ use crate::{Dq, Real};
 /// Between grid nodes the map is bilinear (continuous, its Jacobian piecewise linear);
 /// beyond the grid it extends the edge cells linearly. Firmware keeps the four slices in
 /// flash (`&'static`, e.g. a `static` [`FluxTable`]); a host program borrows them from its
-/// own storage. A lookup finds the cell in O(1) on a uniform axis — the node index from
-/// (x − x₀)/Δ with 1/Δ precomputed, the cell and its spacing confirmed by two comparisons, the
-/// fraction by a multiplication — and by bisection (4 comparisons on 16 nodes) and a division
-/// on any other: a uniform grid costs no division per lookup.
+/// own storage. A lookup finds the cell in O(1) on a uniform axis (found so at construction)
+/// — the node index ⌊(x − x₀)/Δ⌋ with 1/Δ precomputed, clamped to the edge cells, and the
+/// fraction the remainder: no load, no division — and by bisection (4 comparisons on 16
+/// nodes) and a division on any other; the corners are two loads of adjacent nodes per row
+/// and table, each pair behind one bounds check.
 ///
 /// [`FluxMap::new`] refuses a map that is not monotonic in its own current (ψd strictly
 /// increasing in i_d along every row, ψq in i_q along every column): such a map has no
@@ -25,10 +26,35 @@ pub struct FluxMap<'a, T> {
     i_q: &'a [T],
     psi_d: &'a [T],
     psi_q: &'a [T],
-    /// (n_d − 1)/(i_d[last] − i_d[0]): the inverse node spacing of a uniform i_d axis.
-    inv_step_d: T,
+    /// The i_d axis' first node and (n_d − 1)/(i_d[last] − i_d[0]), its inverse node
+    /// spacing if uniform; whether it is.
+    axis_d: AxisScale<T>,
     /// The same for i_q.
-    inv_step_q: T,
+    axis_q: AxisScale<T>,
+}
+
+/// An axis' first node, its inverse mean node spacing and whether every cell has that spacing
+/// (to [`UNIFORM_TOLERANCE_EPS`]): a uniform axis finds a cell with no load and no division.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct AxisScale<T> {
+    pub(super) first: T,
+    pub(super) inv_step: T,
+    pub(super) uniform: bool,
+}
+
+impl<T: Real> AxisScale<T> {
+    fn of(axis: &[T]) -> Self {
+        let inv_step = inverse_step(axis);
+        let tol = T::default_epsilon() * T::lit(UNIFORM_TOLERANCE_EPS);
+        let uniform = axis
+            .windows(2)
+            .all(|w| ((w[1] - w[0]) * inv_step - T::one()).abs() <= tol);
+        Self {
+            first: axis.first().copied().unwrap_or(T::zero()),
+            inv_step,
+            uniform,
+        }
+    }
 }
 
 /// Why a flux map was refused: the grid node (k along i_d, m along i_q) where it was seen.
@@ -126,37 +152,42 @@ fn inverse_step<T: Real>(axis: &[T]) -> T {
 }
 
 /// Relative mismatch between a cell's width and the uniform spacing 1/`inv_step`, in units of
-/// the type's ε, up to which the fraction is taken as (x − x_k)·`inv_step`: the rounding of a
-/// uniform axis' nodes (a few ulp of the largest node over the spacing: under 10 ε on 16 f32
-/// nodes over ±12 A), so that the fraction is the divided one to rounding, and any
-/// deliberately non-uniform spacing is divided.
+/// the type's ε, up to which an axis is uniform: the rounding of a uniform axis' nodes (a few
+/// ulp of the largest node over the spacing: under 10 ε on 16 f32 nodes over ±12 A), so that
+/// the fraction (x − x₀)·(1/Δ) − k is the divided one to rounding, and any deliberately
+/// non-uniform spacing is divided.
 const UNIFORM_TOLERANCE_EPS: f64 = 64.0;
 
-/// The cell of `x` on `axis` (clamped to the edge cells) and the fraction along it (outside
-/// [0, 1] beyond the grid). On a uniform axis the node index comes from `inv_step` (module
-/// docs); where that cell does not hold `x` or its width is not the uniform spacing, by
-/// bisection with the width divided.
+/// The cell of `x` on `axis` (clamped to the edge cells), the fraction along it (outside
+/// [0, 1] beyond the grid) and the cell's inverse width. On a uniform axis t = (x − x₀)/Δ
+/// with 1/Δ precomputed, the cell ⌊t⌋ clamped (a NaN to the first) and the fraction t − ⌊t⌋:
+/// no load, no branch but the clamp, no division. On any other axis by bisection, with the
+/// width divided.
 /// Indexing by `get` (a NaN where a shape check failed), so that the firmware's lookup holds
 /// no bounds-check panic.
-#[inline]
-fn cell<T: Real>(axis: &[T], inv_step: T, x: T) -> (usize, T, T) {
+#[inline(always)]
+fn cell<T: Real>(axis: &[T], scale: &AxisScale<T>, x: T) -> (usize, T, T) {
     let n = axis.len();
     let last = n.max(2) - 2;
-    let at = |j: usize| axis.get(j).copied().unwrap_or_else(|| T::lit(f64::NAN));
-    let x0 = at(0);
-    let guess = ((x - x0) * inv_step).index_floor(last);
-    let (lo, hi) = (at(guess), at(guess + 1));
-    let width = hi - lo;
-    // At and beyond the last node the division (a fraction of exactly 1 on the node).
-    let inside = (x >= lo || guess == 0) && x < hi;
-    let uniform =
-        (width * inv_step - T::one()).abs() <= T::default_epsilon() * T::lit(UNIFORM_TOLERANCE_EPS);
-    if inside && uniform {
-        return (guess, (x - lo) * inv_step, width);
+    if scale.uniform {
+        let t = (x - scale.first) * scale.inv_step;
+        let k = t.index_floor(last);
+        return (k, t - T::from_index(k), scale.inv_step);
     }
-    let k = axis.partition_point(|&a| a <= x).clamp(1, n.max(2) - 1) - 1;
-    let width = at(k + 1) - at(k);
-    (k, (x - at(k)) / width, width)
+    let at = |j: usize| axis.get(j).copied().unwrap_or_else(|| T::lit(f64::NAN));
+    let k = axis.partition_point(|&a| a <= x).clamp(1, last + 1) - 1;
+    let inv_width = T::one() / (at(k + 1) - at(k));
+    (k, (x - at(k)) * inv_width, inv_width)
+}
+
+/// The pair `t[j]`, `t[j + 1]` (NaNs where a shape check failed): one bounds check for two
+/// loads.
+#[inline(always)]
+fn pair<T: Real>(t: &[T], j: usize) -> (T, T) {
+    match t.get(j..j.wrapping_add(2)) {
+        Some(&[a, b]) => (a, b),
+        _ => (T::lit(f64::NAN), T::lit(f64::NAN)),
+    }
 }
 
 impl<'a, T: Real> FluxMap<'a, T> {
@@ -200,8 +231,9 @@ impl<'a, T: Real> FluxMap<'a, T> {
     /// A map from parts whose shapes alone are checked (two nodes or more per axis, one value
     /// per node): no lookup can index out of bounds, and a map built from the parts of one
     /// that [`FluxMap::new`] accepted behaves identically. For a host program that keeps the
-    /// checked parts in its own storage and borrows them per use (an O(1) check instead of
-    /// [`FluxMap::new`]'s O(n)); unchecked values give wrong inverses, never a panic.
+    /// checked parts in its own storage and borrows them per use (O(n_d + n_q): the axes'
+    /// spacing, instead of [`FluxMap::new`]'s O(n_d·n_q)); unchecked values give wrong
+    /// inverses, never a panic.
     pub fn from_checked_parts(
         i_d: &'a [T],
         i_q: &'a [T],
@@ -224,9 +256,17 @@ impl<'a, T: Real> FluxMap<'a, T> {
             i_q,
             psi_d,
             psi_q,
-            inv_step_d: inverse_step(i_d),
-            inv_step_q: inverse_step(i_q),
+            axis_d: AxisScale::of(i_d),
+            axis_q: AxisScale::of(i_q),
         })
+    }
+
+    /// The axes' first node, inverse mean spacing and uniformity (d, q).
+    pub(super) const fn axis_scales(&self) -> (AxisScale<T>, AxisScale<T>)
+    where
+        T: Copy,
+    {
+        (self.axis_d, self.axis_q)
     }
 
     /// The i_d axis in A.
@@ -249,37 +289,33 @@ impl<'a, T: Real> FluxMap<'a, T> {
         self.psi_q
     }
 
-    /// The cell of `i` (fractions fx, fy along it, widths wx, wy) and the four corners of
-    /// ψd and ψq, as (p00, p10, p01, p11) with 1 one node up in i_d, 01 in i_q.
-    #[inline]
+    /// The cell of `i` (fractions fx, fy along it, inverse widths gx, gy) and the four
+    /// corners of ψd and ψq, as (p00, p10, p01, p11) with 1 one node up in i_d, 01 in i_q.
+    #[inline(always)]
     fn corners(&self, i: Dq<T>) -> (T, T, T, T, Corners<T>, Corners<T>) {
-        let (k, fx, wx) = cell(self.i_d, self.inv_step_d, i.d);
-        let (m, fy, wy) = cell(self.i_q, self.inv_step_q, i.q);
+        let (k, fx, gx) = cell(self.i_d, &self.axis_d, i.d);
+        let (m, fy, gy) = cell(self.i_q, &self.axis_q, i.q);
         let nq = self.i_q.len();
         let at = k * nq + m;
-        let node = |t: &[T], j: usize| t.get(j).copied().unwrap_or_else(|| T::lit(f64::NAN));
         let corner = |t: &[T]| {
-            (
-                node(t, at),
-                node(t, at + nq),
-                node(t, at + 1),
-                node(t, at + nq + 1),
-            )
+            let (p00, p01) = pair(t, at);
+            let (p10, p11) = pair(t, at + nq);
+            (p00, p10, p01, p11)
         };
-        (fx, fy, wx, wy, corner(self.psi_d), corner(self.psi_q))
+        (fx, fy, gx, gy, corner(self.psi_d), corner(self.psi_q))
     }
 
     /// ψ(i) and the incremental inductance ∂ψ/∂i of the bilinear interpolant at `i`.
     #[inline]
     pub fn flux_and_jacobian(&self, i: Dq<T>) -> (Dq<T>, InductanceMatrix<T>) {
-        let (fx, fy, wx, wy, cd, cq) = self.corners(i);
+        let (fx, fy, gx, gy, cd, cq) = self.corners(i);
         let bilinear = |(p00, p10, p01, p11): Corners<T>| {
             let (ex, ey) = (p10 - p00, p01 - p00);
             let twist = p11 - p10 - p01 + p00;
             (
                 bilinear_value((p00, p10, p01, p11), fx, fy),
-                (ex + fy * twist) / wx,
-                (ey + fx * twist) / wy,
+                (ex + fy * twist) * gx,
+                (ey + fx * twist) * gy,
             )
         };
         let (d, dd, dq) = bilinear(cd);
@@ -302,8 +338,7 @@ fn bilinear_value<T: Real>((p00, p10, p01, p11): Corners<T>, fx: T, fy: T) -> T 
 }
 
 impl<T: Real> MagneticModel<T> for FluxMap<'_, T> {
-    /// The bilinear values alone: no Jacobian, so two divisions (the cell fractions) instead
-    /// of six.
+    /// The bilinear values alone (no Jacobian).
     #[inline]
     fn flux(&self, i: Dq<T>) -> Dq<T> {
         let (fx, fy, _, _, cd, cq) = self.corners(i);
@@ -318,12 +353,17 @@ impl<T: Real> MagneticModel<T> for FluxMap<'_, T> {
 
     fn current_from(&self, psi: Dq<T>, guess: Dq<T>) -> Dq<T> {
         let scale = self.i_d.last().map_or(T::one(), |x| x.abs()) * T::lit(1e-6);
-        newton(psi, guess, scale, |i| self.flux_and_jacobian(i))
+        newton(psi, guess, scale, |i| self.flux_and_jacobian(i)).0
     }
 
     #[inline]
     fn incremental_inductance(&self, i: Dq<T>) -> InductanceMatrix<T> {
         self.flux_and_jacobian(i).1
+    }
+
+    #[inline]
+    fn flux_and_inductance(&self, i: Dq<T>) -> (Dq<T>, InductanceMatrix<T>) {
+        self.flux_and_jacobian(i)
     }
 }
 
@@ -370,5 +410,71 @@ impl<T: Real, const ND: usize, const NQ: usize> FluxTable<T, ND, NQ> {
             psi_d,
             psi_q,
         }
+    }
+}
+
+impl<const ND: usize, const NQ: usize> FluxTable<f32, ND, NQ> {
+    /// The table borrowed as a [`FluxMap`] in a constant expression, for a map in flash
+    /// beside its table (`static MAP: FluxMap<'static, f32> = TABLE.const_map();`): the checks
+    /// of [`FluxMap::new`] run by the compiler, so that a table it refuses does not build (the
+    /// panic names the check), and the map it gives is [`FluxTable::map`]'s.
+    pub const fn const_map(&self) -> FluxMap<'_, f32> {
+        assert!(
+            ND >= 2 && NQ >= 2,
+            "a flux map needs two nodes or more per axis"
+        );
+        let axis_d = const_axis(&self.i_d);
+        let axis_q = const_axis(&self.i_q);
+        let mut k = 0;
+        while k < ND {
+            let mut m = 0;
+            while m < NQ {
+                let (d, q) = (self.psi_d[k][m], self.psi_q[k][m]);
+                assert!(d.is_finite() && q.is_finite(), "a flux value is not finite");
+                assert!(
+                    k == 0 || d > self.psi_d[k - 1][m],
+                    "psi_d does not increase with i_d"
+                );
+                assert!(
+                    m == 0 || q > self.psi_q[k][m - 1],
+                    "psi_q does not increase with i_q"
+                );
+                m += 1;
+            }
+            k += 1;
+        }
+        FluxMap {
+            i_d: &self.i_d,
+            i_q: &self.i_q,
+            psi_d: self.psi_d.as_flattened(),
+            psi_q: self.psi_q.as_flattened(),
+            axis_d,
+            axis_q,
+        }
+    }
+}
+
+/// [`AxisScale::of`] in a constant expression (`f32`), the axis checked as [`check_axis`]
+/// checks it (a panic instead of an error).
+const fn const_axis<const N: usize>(axis: &[f32; N]) -> AxisScale<f32> {
+    let mut k = 1;
+    while k < N {
+        let ok = axis[k - 1].is_finite() && axis[k].is_finite() && axis[k] > axis[k - 1];
+        assert!(ok, "an axis is not finite and strictly increasing");
+        k += 1;
+    }
+    let inv_step = (N - 1) as f32 / (axis[N - 1] - axis[0]);
+    let tol = f32::EPSILON * UNIFORM_TOLERANCE_EPS as f32;
+    let mut uniform = true;
+    let mut k = 1;
+    while k < N {
+        let mismatch = (axis[k] - axis[k - 1]) * inv_step - 1.0;
+        uniform &= mismatch <= tol && -mismatch <= tol;
+        k += 1;
+    }
+    AxisScale {
+        first: axis[0],
+        inv_step,
+        uniform,
     }
 }

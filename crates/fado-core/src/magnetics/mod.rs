@@ -43,11 +43,13 @@ mod constant;
 mod flux_map;
 mod machine;
 mod saturation;
+mod uniform_table;
 
 pub use constant::ConstantInductance;
 pub use flux_map::{FluxMap, FluxMapError, FluxTable};
 pub use machine::{MachineMagnetics, zero_current_constants};
 pub use saturation::Saturation;
+pub use uniform_table::UniformFluxTable;
 
 use crate::{Dq, Real};
 
@@ -135,8 +137,33 @@ pub trait MagneticModel<T: Real> {
         self.current(psi)
     }
 
+    /// ψ(i) starting Newton's method (where the model needs it) from `guess`, a flux near the
+    /// answer (the model's flux at a nearby current: the last sample's, the last iterate of a
+    /// solve around ψ(i)): the same result as [`MagneticModel::flux`] to the solver's tolerance
+    /// in fewer steps. Models with a closed-form ψ(i) ignore the guess; a non-finite guess
+    /// starts where [`MagneticModel::flux`] starts.
+    fn flux_from(&self, i: Dq<T>, guess: Dq<T>) -> Dq<T> {
+        let _ = guess;
+        self.flux(i)
+    }
+
     /// Incremental inductance ∂ψ/∂i at the current `i`, in H.
     fn incremental_inductance(&self, i: Dq<T>) -> InductanceMatrix<T>;
+
+    /// ψ(i) and the incremental inductance ∂ψ/∂i at `i` together: the values of
+    /// [`MagneticModel::flux`] and [`MagneticModel::incremental_inductance`], with one
+    /// inversion where the model's ψ(i) is one.
+    fn flux_and_inductance(&self, i: Dq<T>) -> (Dq<T>, InductanceMatrix<T>) {
+        (self.flux(i), self.incremental_inductance(i))
+    }
+
+    /// ψ(i) from `guess` as [`MagneticModel::flux_from`], and the incremental inductance
+    /// ∂ψ/∂i there: a model whose ψ(i) is an inversion gives the inverse of the Jacobian its
+    /// Newton's method last evaluated, within the last (converged) step of ψ(i).
+    fn flux_and_inductance_from(&self, i: Dq<T>, guess: Dq<T>) -> (Dq<T>, InductanceMatrix<T>) {
+        let _ = guess;
+        self.flux_and_inductance(i)
+    }
 
     /// Electromagnetic torque 1.5·p·(ψd·i_q − ψq·i_d) in N·m, from the co-energy.
     fn torque(&self, pole_pairs: u32, i: Dq<T>) -> T {
@@ -168,24 +195,27 @@ pub trait MagneticModel<T: Real> {
 
 /// Newton's method for `f(x) = target` with `f` returning the value and its Jacobian at x.
 /// Stops when the step is below √ε/16 of |x| + `scale` (ε the type's epsilon), or after
-/// [`NEWTON_ITERATIONS`] steps; returns the last iterate (non-finite if `target` is).
+/// [`NEWTON_ITERATIONS`] steps; returns the last iterate (non-finite if `target` is) and the
+/// Jacobian of the one before it (within that last step of the answer).
 pub(crate) fn newton<T: Real>(
     target: Dq<T>,
     mut x: Dq<T>,
     scale: T,
     f: impl Fn(Dq<T>) -> (Dq<T>, InductanceMatrix<T>),
-) -> Dq<T> {
+) -> (Dq<T>, InductanceMatrix<T>) {
     // Quadratic convergence: after a step of √ε/16 the error is of the order of ε.
     let tol = T::default_epsilon().sqrt() * T::lit(1.0 / 16.0);
+    let mut last = InductanceMatrix::default();
     for _ in 0..NEWTON_ITERATIONS {
         let (y, jac) = f(x);
+        last = jac;
         let step = jac.solve(y - target);
         x -= step;
         if !step.is_finite() || step.norm() <= tol * (x.norm() + scale) {
             break;
         }
     }
-    x
+    (x, last)
 }
 
 /// Any of the three magnetic models, by value.
@@ -226,8 +256,17 @@ impl<T: Real> MagneticModel<T> for Magnetics<'_, T> {
     fn current_from(&self, psi: Dq<T>, guess: Dq<T>) -> Dq<T> {
         dispatch!(self, m => m.current_from(psi, guess))
     }
+    fn flux_from(&self, i: Dq<T>, guess: Dq<T>) -> Dq<T> {
+        dispatch!(self, m => m.flux_from(i, guess))
+    }
     fn incremental_inductance(&self, i: Dq<T>) -> InductanceMatrix<T> {
         dispatch!(self, m => m.incremental_inductance(i))
+    }
+    fn flux_and_inductance(&self, i: Dq<T>) -> (Dq<T>, InductanceMatrix<T>) {
+        dispatch!(self, m => m.flux_and_inductance(i))
+    }
+    fn flux_and_inductance_from(&self, i: Dq<T>, guess: Dq<T>) -> (Dq<T>, InductanceMatrix<T>) {
+        dispatch!(self, m => m.flux_and_inductance_from(i, guess))
     }
 }
 

@@ -228,6 +228,14 @@ impl<T: Real> Saturation<T> {
         (i, jac)
     }
 
+    /// ψ(i) by Newton's method on i(ψ) from `start`, and ∂i/∂ψ at the last iterate but one.
+    #[inline]
+    fn flux_newton(&self, i: Dq<T>, start: Dq<T>) -> (Dq<T>, InductanceMatrix<T>) {
+        let scale =
+            self.psi_f.abs() + self.psi_n.abs() + (self.i_f / self.a_d0).abs() + T::lit(1e-6);
+        newton(i, start, scale, |psi| self.current_and_jacobian(psi))
+    }
+
     /// The magnetically linear guess ψ(i) ≈ (ψf + (i_d + i_f)/a_d0, i_q/a_q0).
     fn linear_flux(&self, i: Dq<T>) -> Dq<T> {
         Dq::new(self.psi_f + (i.d + self.i_f) / self.a_d0, i.q / self.a_q0)
@@ -235,12 +243,26 @@ impl<T: Real> Saturation<T> {
 }
 
 impl<T: Real> MagneticModel<T> for Saturation<T> {
+    /// Newton from the magnetically linear guess.
     fn flux(&self, i: Dq<T>) -> Dq<T> {
-        let scale =
-            self.psi_f.abs() + self.psi_n.abs() + (self.i_f / self.a_d0).abs() + T::lit(1e-6);
-        newton(i, self.linear_flux(i), scale, |psi| {
-            self.current_and_jacobian(psi)
-        })
+        self.flux_newton(i, self.linear_flux(i)).0
+    }
+
+    /// Newton from `guess` (from the linear guess if `guess` is not finite).
+    #[inline]
+    fn flux_from(&self, i: Dq<T>, guess: Dq<T>) -> Dq<T> {
+        self.flux_and_inductance_from(i, guess).0
+    }
+
+    #[inline]
+    fn flux_and_inductance_from(&self, i: Dq<T>, guess: Dq<T>) -> (Dq<T>, InductanceMatrix<T>) {
+        let start = if guess.is_finite() {
+            guess
+        } else {
+            self.linear_flux(i)
+        };
+        let (psi, jac) = self.flux_newton(i, start);
+        (psi, jac.inverse())
     }
 
     fn current(&self, psi: Dq<T>) -> Dq<T> {
@@ -249,5 +271,10 @@ impl<T: Real> MagneticModel<T> for Saturation<T> {
 
     fn incremental_inductance(&self, i: Dq<T>) -> InductanceMatrix<T> {
         self.current_and_jacobian(self.flux(i)).1.inverse()
+    }
+
+    fn flux_and_inductance(&self, i: Dq<T>) -> (Dq<T>, InductanceMatrix<T>) {
+        let psi = self.flux(i);
+        (psi, self.current_and_jacobian(psi).1.inverse())
     }
 }

@@ -151,6 +151,31 @@ fn inverse_of_forward_is_the_identity() {
     }
 }
 
+/// A warm-started ψ(i) (from a nearby current's flux, from a far one, from a non-finite guess)
+/// is the cold solve's to the solver's tolerance, and the inductance it returns with it is the
+/// incremental inductance at ψ(i); `flux_and_inductance` is the two separate calls bit for bit.
+#[test]
+fn warm_started_flux_is_the_cold_solve() {
+    for (name, m, i_max) in models() {
+        let far = m.flux(Dq::new(-i_max, 2.0 * i_max));
+        for i in currents(2.0 * i_max) {
+            let cold = m.flux(i);
+            let l = m.incremental_inductance(i);
+            assert_eq!(m.flux_and_inductance(i), (cold, l), "{name}: {i:?}");
+            let near = m.flux(i + Dq::new(0.01 * i_max, -0.01 * i_max));
+            for guess in [near, far, cold, Dq::new(f64::NAN, 0.0)] {
+                let (psi, lw) = m.flux_and_inductance_from(i, guess);
+                assert!(
+                    (psi - cold).norm() < 1e-13 * (1.0 + cold.norm()),
+                    "{name}: {i:?} from {guess:?}: {psi:?} vs {cold:?}"
+                );
+                assert_eq!(m.flux_from(i, guess), psi, "{name}: {i:?}");
+                assert!(close(lw, l, 1e-7), "{name}: {i:?}: {lw:?} vs {l:?}");
+            }
+        }
+    }
+}
+
 /// Central differences of `f` at `x` with step `h` along d and q: the Jacobian.
 fn fd(f: impl Fn(Dq<f64>) -> Dq<f64>, x: Dq<f64>, h: f64) -> InductanceMatrix<f64> {
     let dd = (f(x + Dq::new(h, 0.0)) - f(x - Dq::new(h, 0.0))) * (0.5 / h);
@@ -297,8 +322,10 @@ fn a_flux_map_interpolates_inverts_and_differentiates() {
     let truth = ipm();
     for (k, &id) in table.i_d.iter().enumerate() {
         for (m, &iq) in table.i_q.iter().enumerate() {
+            // The nodes to rounding (the cell fraction of a uniform axis is (x − x₀)/Δ − k).
             let psi = map.flux(Dq::new(id, iq));
-            assert_eq!((psi.d, psi.q), (table.psi_d[k][m], table.psi_q[k][m]));
+            let node = Dq::new(table.psi_d[k][m], table.psi_q[k][m]);
+            assert!((psi - node).norm() < 1e-15, "{psi:?} vs {node:?}");
         }
     }
     for i in currents(9.0) {
@@ -337,6 +364,53 @@ fn a_flux_map_interpolates_inverts_and_differentiates() {
         assert!((lm.flux(i) - lin.flux(i)).norm() < 1e-14);
         assert!((lm.torque(3, i) - lin.torque(3, i)).abs() < 1e-12);
     }
+}
+
+/// The uniform table is the flux map of the same table: values and Jacobians to rounding
+/// inside and beyond the grid, its inverse; the compiler's build is the run-time one; a
+/// non-uniform axis is refused.
+#[test]
+fn a_uniform_table_is_the_flux_map() {
+    let table = ipm_table::<f64>();
+    let (map, uniform) = (table.map().unwrap(), UniformFluxTable::new(&table).unwrap());
+    for i in currents(9.0).chain([Dq::new(-15.0, 14.0), Dq::new(7.0, -13.0)]) {
+        let (a, la) = map.flux_and_jacobian(i);
+        let (b, lb) = uniform.flux_and_jacobian(i);
+        assert!((a - b).norm() < 1e-14, "{i:?}: {a:?} vs {b:?}");
+        assert!(close(la, lb, 1e-12), "{i:?}");
+        assert_eq!(uniform.flux(i), b);
+        assert!(
+            (uniform.current(b) - i).norm() < 1e-9 * (1.0 + i.norm()),
+            "{i:?}"
+        );
+    }
+    let t32 = ipm_table::<f32>();
+    assert_eq!(
+        UniformFluxTable::from_f32_table(&t32),
+        UniformFluxTable::new(&t32).unwrap()
+    );
+    let mut skewed = table;
+    skewed.i_d[3] += 0.1;
+    assert!(UniformFluxTable::new(&skewed).is_none());
+}
+
+/// A map built by the compiler from a `static` table is the checked map of the same table.
+#[test]
+fn a_const_map_is_the_checked_map() {
+    static TABLE: FluxTable<f32, 16, 16> = FluxTable {
+        i_d: [0.0; 16],
+        i_q: [0.0; 16],
+        psi_d: [[0.0; 16]; 16],
+        psi_q: [[0.0; 16]; 16],
+    };
+    let table = ipm_table::<f32>();
+    assert_eq!(table.const_map(), table.map().unwrap());
+    // Non-uniform axes too.
+    let mut skewed = ipm_table::<f32>();
+    skewed.i_d[3] += 0.1;
+    assert_eq!(skewed.const_map(), skewed.map().unwrap());
+    // An unchecked table does not build (in a `static`, at compile time).
+    assert!(std::panic::catch_unwind(|| TABLE.const_map()).is_err());
 }
 
 #[test]

@@ -17,7 +17,11 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         }
         self.i_ab_used = i_ab;
         let estimate = self.last.estimate;
-        let (rot, v_ab, v_dq, i_dq_ref, i_dq) = match self.startup.step(i_ab, vdc) {
+        let command = self.startup.step(i_ab, self.history[1], vdc);
+        if self.startup.status() == StartupStatus::RotorMoving {
+            return self.zero_vector_output();
+        }
+        let (rot, v_ab, v_dq, i_dq_ref, i_dq) = match command {
             StartupCommand::Voltage(v) => {
                 let rot = Rotation::from_angle(T::zero());
                 (rot, v, v.to_dq(rot), Dq::zero(), i_ab.to_dq(rot))
@@ -37,6 +41,12 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
                 self.last_i_ab = i_ab;
                 self.realign(theta);
                 return self.last;
+            }
+            StartupCommand::Restart => {
+                // The rotor stood still: the start-up again, from the offsets.
+                self.gain.arm();
+                self.calibrate_offsets();
+                return self.zero_vector_output();
             }
             StartupCommand::Off => {
                 let mut out = self.last;

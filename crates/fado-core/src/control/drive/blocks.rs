@@ -11,6 +11,7 @@ use crate::control::lock_reaction::LockSupervisor;
 use crate::control::modulation::{ModulatorConfig, SpaceVectorModulator};
 use crate::control::ratings_limit::RatingsLimit;
 use crate::control::release_hold::ReleaseHold;
+use crate::control::saturated_references::SaturatedReferences;
 use crate::control::speed_controller::{SpeedController, SpeedControllerConfig};
 use crate::control::standstill_probe::{StandstillProbe, StandstillProbeConfig};
 use crate::error::{ConfigError, check};
@@ -62,7 +63,7 @@ impl<T: Real> Blocks<T> {
             bandwidth_hz: t.speed.bandwidth_hz,
             zero_ratio: t.speed.zero_ratio,
             anti_windup_ratio: t.speed.anti_windup_ratio,
-            i_max: c.speed_torque_limit(t.mtpa.enabled),
+            i_max: c.speed_torque_limit(r.saturated.as_ref(), t.mtpa.enabled),
             ..SpeedControllerConfig::new(
                 m,
                 t.current.limit_ratio * m.rated_current,
@@ -87,7 +88,8 @@ impl<T: Real> Blocks<T> {
             ("anti_windup_ratio", "speed_anti_windup_ratio"),
         ]))?;
         let injection = CurrentInjection::new(CurrentInjectionConfig { i_min: c.i_min() })?;
-        let current = CurrentController::new(c.current_controller_config()).map_err(rename(&[
+        let current_config = c.current_controller_config_with(r.saturated.as_ref());
+        let current = CurrentController::new(current_config).map_err(rename(&[
             ("bandwidth_hz", "current_bandwidth_hz"),
             ("anti_windup_ratio", "current_anti_windup_ratio"),
         ]))?;
@@ -147,10 +149,19 @@ impl<T: Real> DriveConfig<T> {
     /// The current loop of the machine model with the tuning's `current.bandwidth_hz`,
     /// `decoupling` and `current.anti_windup_ratio`: what the drive builds.
     pub fn current_controller_config(&self) -> CurrentControllerConfig<T> {
+        self.current_controller_config_with(self.saturated_references().as_ref())
+    }
+
+    /// [`DriveConfig::current_controller_config`] with the saturating model's references
+    /// built already.
+    fn current_controller_config_with(
+        &self,
+        saturated: Option<&SaturatedReferences<T>>,
+    ) -> CurrentControllerConfig<T> {
         let t = &self.tuning;
         // A saturating model: the incremental inductances at the rated MTPA point
         // (`crate::control::saturated_references`).
-        let (ld_hat, lq_hat) = self.current_loop_inductances();
+        let (ld_hat, lq_hat) = self.current_loop_inductances(saturated);
         CurrentControllerConfig {
             ld_hat,
             lq_hat,

@@ -6,8 +6,18 @@ use crate::control::gain_calibration::GainCalibrationStatus;
 use crate::estimator::RotorAngleEstimator;
 use crate::{Ab, Abc, Dq, Real, Rotation};
 
+/// Samples of the watched offset calibration averaged as the motion monitor's reference
+/// (1 ms at 10 kHz; at most half the calibration): before a load from t = 0 has turned the
+/// rotor by a thousandth of a radian on the presets.
+const OFFSET_REFERENCE_SAMPLES: u32 = 10;
+
 impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
-    /// One sample of the offset calibration: gates off, duties ½, nothing else stepped.
+    /// One sample of the offset calibration: gates off, duties ½, nothing else stepped; or,
+    /// when the start-up watches it ([`AngleSearch::watches_offsets`]), the zero vector
+    /// (gates on, the phases shorted: at rest no current flows) with the motion monitor
+    /// started after the first [`OFFSET_REFERENCE_SAMPLES`] from their mean.
+    ///
+    /// [`AngleSearch::watches_offsets`]: crate::control::startup::AngleSearch::watches_offsets
     pub(super) fn calibration_step(&mut self, i_abc: Abc<T>) -> DriveOutput<T> {
         self.calibration_sum = Abc::new(
             self.calibration_sum.a + i_abc.a,
@@ -15,6 +25,14 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             self.calibration_sum.c + i_abc.c,
         );
         self.calibration_remaining -= 1;
+        let watched = self.startup.watches_offsets();
+        if watched && self.watch_offsets(i_abc) {
+            // The rotor moves: the offsets of the samples before it did, and the start-up
+            // defers (the zero vector from the next sample, through the angle phase).
+            self.calibration_remaining = 0;
+            self.last_i_ab = Ab::zero();
+            return self.zero_vector_output();
+        }
         if self.calibration_remaining == 0 {
             let k = T::one() / T::lit(self.resolved.offset_calibration_samples as f64);
             let sum = self.calibration_sum;
@@ -26,9 +44,51 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             out.gates_enabled = false;
             return out;
         }
+        if watched {
+            return self.zero_vector_output();
+        }
         let mut out = self.last;
         out.gates_enabled = false;
         out.input_fault = false;
+        out
+    }
+
+    /// The watched offset calibration's sample: the monitor's reference after the first
+    /// samples (then also the offsets in use until the calibration ends), then its reading.
+    /// True when the rotor has moved.
+    fn watch_offsets(&mut self, i_abc: Abc<T>) -> bool {
+        let taken = self.resolved.offset_calibration_samples - self.calibration_remaining;
+        let first = OFFSET_REFERENCE_SAMPLES.min(self.resolved.offset_calibration_samples / 2);
+        if taken == first.max(1) {
+            let k = T::one() / T::lit(taken as f64);
+            let sum = self.calibration_sum;
+            self.current_offset = Abc::new(sum.a * k, sum.b * k, sum.c * k);
+            self.startup.watch_offsets(self.current_offset.to_ab());
+            return false;
+        }
+        self.startup.offset_sample(i_abc.to_ab())
+    }
+
+    /// The phase currents less the offsets in use.
+    pub(super) fn offsets_removed(&self, i_abc: Abc<T>) -> Abc<T> {
+        let o = self.current_offset;
+        Abc::new(i_abc.a - o.a, i_abc.b - o.b, i_abc.c - o.c)
+    }
+
+    /// The zero vector: gates on, duties ½ (the two zero states in turn), no voltage and no
+    /// dead-time compensation (near zero current it would follow the sensors' noise and
+    /// offset error, whose voltage the motion monitor would integrate as travel; the
+    /// uncompensated dead time only adds to the shorted phases' braking).
+    pub(super) fn zero_vector_output(&mut self) -> DriveOutput<T> {
+        let half = T::lit(0.5);
+        let mut out = self.last;
+        out.duty = Abc::new(half, half, half);
+        out.gates_enabled = true;
+        out.input_fault = false;
+        out.v_ref_ab = Ab::zero();
+        out.v_dq_ref = Dq::zero();
+        self.history = [Ab::zero(); 2];
+        self.last = out;
         out
     }
 

@@ -100,6 +100,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
                 config.tuning.lock.recovery_attempts,
             )?,
             implausible_now: false,
+            saturated_flux: Dq::zero(),
         };
         drive.reset();
         Ok(drive)
@@ -218,6 +219,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         self.sensor_stuck_now = false;
         self.current_error_now = false;
         self.history = [Ab::zero(); 2];
+        self.saturated_flux = self.zero_current_flux();
         self.last = DriveOutput::idle(Estimate {
             theta,
             ..Estimate::default()

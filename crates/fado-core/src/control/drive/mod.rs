@@ -237,6 +237,10 @@ pub struct SensorlessDrive<T: 'static, E = SensorlessEstimator<T>> {
     omega_slow: T,
     /// This sample was refused as implausible.
     implausible_now: bool,
+    /// A saturating model's flux ψ at the last current reference (Wb): where the next
+    /// sample's torque solve starts its flux (`saturated_references`); unused for constant
+    /// inductances.
+    saturated_flux: Dq<T>,
 }
 
 fn estimate_is_finite<T: Real>(e: &Estimate<T>) -> bool {

@@ -14,9 +14,11 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
     /// surface-magnet rotor i_q* = i_q,t, as in the paper. Taking i_d* from the last
     /// sample's i_q* instead (no solve) closes an algebraic loop through the injection that
     /// oscillates sample by sample under load (measured on ipmsm-gem-50k `stops`).
-    pub(super) fn currents_for_torque(&self, iq_torque: T, guess: T, probe_id: T) -> Dq<T> {
+    pub(super) fn currents_for_torque(&mut self, iq_torque: T, guess: T, probe_id: T) -> Dq<T> {
         if let Some(s) = &self.resolved.saturated {
-            return self.saturated_currents_for_torque(s, iq_torque, guess, probe_id);
+            let (i, psi) = self.saturated_currents_for_torque(s, iq_torque, guess, probe_id);
+            self.saturated_flux = psi;
+            return i;
         }
         let m = &self.config.machine;
         let injection = &self.blocks.injection;
@@ -46,14 +48,27 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         flux_linkage: T,
     ) -> T {
         let h = T::lit(1e-3) * rated_current;
+        let secant = |iq: T| {
+            let f0 = f(iq);
+            (f0, (f(iq + h) - f0) / h)
+        };
+        Self::solve_torque_with(secant, iq_torque, guess, flux_linkage)
+    }
+
+    /// [`Self::solve_torque`] with `f` returning the value and its slope at i_q.
+    pub(super) fn solve_torque_with(
+        f: impl Fn(T) -> (T, T),
+        iq_torque: T,
+        guess: T,
+        flux_linkage: T,
+    ) -> T {
         let mut iq = if guess.is_finite() && guess * iq_torque > T::zero() {
             guess
         } else {
             iq_torque
         };
         for _ in 0..3 {
-            let f0 = f(iq);
-            let slope = (f(iq + h) - f0) / h;
+            let (f0, slope) = f(iq);
             // A flat or non-finite slope (NaN compares false): keep the last iterate.
             if slope > T::lit(1e-3) * flux_linkage {
                 iq -= f0 / slope;

@@ -2,6 +2,8 @@
 //! the currents for a torque, the speed loop's torque limit and the current loop's
 //! inductances. With constant inductances each returns what the closed forms give.
 
+use core::cell::Cell;
+
 use super::{DriveConfig, SensorlessDrive};
 use crate::control::saturated_references::SaturatedReferences;
 use crate::control::speed_controller::SpeedControllerConfig;
@@ -17,11 +19,16 @@ impl<T: Real> DriveConfig<T> {
 
     /// The speed PI's output limit (a torque in units of the magnet's q current): the
     /// model's torque at the current limit on the MTPA curve (on the q axis without MTPA), or
-    /// [`SpeedControllerConfig::torque_limit`] for constant inductances.
-    pub(super) fn speed_torque_limit(&self, mtpa: bool) -> T {
+    /// [`SpeedControllerConfig::torque_limit`] for constant inductances (`saturated`: the
+    /// model's references, built once per drive).
+    pub(super) fn speed_torque_limit(
+        &self,
+        saturated: Option<&SaturatedReferences<T>>,
+        mtpa: bool,
+    ) -> T {
         let m = &self.machine;
         let i_max = self.tuning.current.limit_ratio * m.rated_current;
-        match self.saturated_references() {
+        match saturated {
             Some(s) if mtpa => s.torque_limit(i_max, m.flux_linkage),
             Some(s) => s.torque_flux(Dq::new(T::zero(), i_max)) / m.flux_linkage,
             None => SpeedControllerConfig::torque_limit(m, i_max, mtpa),
@@ -29,9 +36,12 @@ impl<T: Real> DriveConfig<T> {
     }
 
     /// The current loop's (L̂d, L̂q): a saturating model's incremental inductances at the
-    /// rated MTPA point, else the machine model's.
-    pub(super) fn current_loop_inductances(&self) -> (T, T) {
-        match self.saturated_references() {
+    /// rated MTPA point (from its references `saturated`), else the machine model's.
+    pub(super) fn current_loop_inductances(
+        &self,
+        saturated: Option<&SaturatedReferences<T>>,
+    ) -> (T, T) {
+        match saturated {
             Some(s) => s.rated_incremental(self.machine.rated_current),
             None => (self.machine.ld, self.machine.lq),
         }
@@ -42,14 +52,17 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
     /// `currents_for_torque` with a saturating model: i_d* = the injection + the model's MTPA
     /// (with `mtpa` on) + `probe_id`, and i_q* solves ψd·i_q* − ψq·i_d* = λ̂f·i_q,t (the
     /// co-energy torque, `crate::control::saturated_references`) by the same three Newton
-    /// steps.
+    /// steps, the slope from the model's incremental inductance (one flux solve per step, the
+    /// secant's slope to O(h)). Each evaluation's ψ(i) starts from the last one's, the first
+    /// from the model's flux at the last sample's reference (`saturated_flux`); returns the
+    /// currents and the flux of the last evaluation, the next warm start.
     pub(super) fn saturated_currents_for_torque(
         &self,
         s: &SaturatedReferences<T>,
         iq_torque: T,
         guess: T,
         probe_id: T,
-    ) -> Dq<T> {
+    ) -> (Dq<T>, Dq<T>) {
         let m = &self.config.machine;
         let injection = &self.blocks.injection;
         let mtpa = self.config.tuning.mtpa.enabled;
@@ -58,8 +71,24 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             if mtpa { id + s.mtpa_id(iq) } else { id }
         };
         let target = m.flux_linkage * iq_torque;
-        let f = |iq: T| s.torque_flux(Dq::new(id_of(iq), iq)) - target;
-        let iq = Self::solve_torque(f, iq_torque, guess, m.rated_current, m.flux_linkage);
-        Dq::new(id_of(iq), iq)
+        let h = T::lit(1e-3) * m.rated_current;
+        let warm = Cell::new(self.saturated_flux);
+        let f = |iq: T| {
+            let i = Dq::new(id_of(iq), iq);
+            let (tau, slope, psi) = s.torque_flux_slope(i, (id_of(iq + h) - i.d) / h, warm.get());
+            warm.set(psi);
+            (tau - target, slope)
+        };
+        let iq = Self::solve_torque_with(f, iq_torque, guess, m.flux_linkage);
+        (Dq::new(id_of(iq), iq), warm.get())
+    }
+
+    /// A saturating model's flux at zero current (the torque solve's first warm start); zero
+    /// for constant inductances.
+    pub(super) fn zero_current_flux(&self) -> Dq<T> {
+        match &self.resolved.saturated {
+            Some(s) => s.flux(Dq::zero()),
+            None => Dq::zero(),
+        }
     }
 }

@@ -146,8 +146,11 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         // 8. Anti-windup with the realised voltage in the same frame; speed loop too.
         b.current.realised(applied.v_dq);
         let realised_torque = if let Some(s) = &self.resolved.saturated {
-            // A saturating model's co-energy torque (`saturated_references`).
-            s.torque_flux(i_dq_ref) / self.config.machine.flux_linkage
+            // A saturating model's co-energy torque (`saturated_references`), its flux the
+            // next sample's warm start.
+            let (tau, psi) = s.torque_flux_from(i_dq_ref, self.saturated_flux);
+            self.saturated_flux = psi;
+            tau / self.config.machine.flux_linkage
         } else if self.resolved.salient {
             let m = &self.config.machine;
             m.active_flux(i_dq_ref.d) * i_dq_ref.q / m.flux_linkage
@@ -207,8 +210,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         {
             return Err(self.calibration_step(i_abc));
         }
-        let o = self.current_offset;
-        let i_abc = Abc::new(i_abc.a - o.a, i_abc.b - o.b, i_abc.c - o.c);
+        let i_abc = self.offsets_removed(i_abc);
         let over_voltage = self.blocks.dc_link.over_voltage(vdc);
         if i_abc.a.abs() > trip || i_abc.b.abs() > trip || i_abc.c.abs() > trip || over_voltage {
             self.tripped = true;
@@ -308,7 +310,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         }
         let i = last.i_dq_ref;
         match &self.resolved.saturated {
-            Some(s) => T::lit(1.5) * p * s.torque_flux(i),
+            Some(s) => T::lit(1.5) * p * s.torque_flux_from(i, self.saturated_flux).0,
             None => T::lit(1.5) * p * self.config.machine.active_flux(i.d) * i.q,
         }
     }

@@ -101,3 +101,36 @@ fn torque_limit_and_rated_inductances_follow_the_model() {
     // Constant inductances have no saturated references.
     assert!(SaturatedReferences::new(&MachineModel::<f64>::paper(), 40.0).is_none());
 }
+
+/// The torque solve's slope (the model's incremental inductance along the path
+/// i_d = i_d(i_q)) is the torque's derivative: central differences of the cold τ, on both
+/// presets' models, along the MTPA path and with a d current that moves with i_q.
+#[test]
+fn torque_slope_is_the_derivative_along_the_path() {
+    for (name, m) in [("ipmsm-2k2-qsat", machine(58.0)), ("baldor", baldor())] {
+        let i_max = 2.0 * m.rated_current;
+        let r = SaturatedReferences::new(&m, i_max).unwrap();
+        for k in 1..=8 {
+            // Between the MTPA table's nodes (its path is piecewise linear).
+            let iq = i_max * (k as f64 - 0.37) / 8.0;
+            for (path, id_of) in [
+                ("mtpa", &(|q: f64| r.mtpa_id(q)) as &dyn Fn(f64) -> f64),
+                ("injection", &|q: f64| -0.05 * q * q - 0.4),
+            ] {
+                let h = 1e-5 * m.rated_current;
+                let i = Dq::new(id_of(iq), iq);
+                let did = (id_of(iq + h) - id_of(iq - h)) / (2.0 * h);
+                let guess = r.flux(i + Dq::new(0.3, -0.2));
+                let (tau, slope, psi) = r.torque_flux_slope(i, did, guess);
+                let tau_at = |q: f64| r.torque_flux(Dq::new(id_of(q), q));
+                let fd = (tau_at(iq + h) - tau_at(iq - h)) / (2.0 * h);
+                assert!((tau - r.torque_flux(i)).abs() < 1e-12, "{name} {path}");
+                assert!((psi - r.flux(i)).norm() < 1e-13, "{name} {path}");
+                assert!(
+                    (slope - fd).abs() < 1e-6 * fd.abs(),
+                    "{name} {path} at {iq}: {slope} vs {fd}"
+                );
+            }
+        }
+    }
+}

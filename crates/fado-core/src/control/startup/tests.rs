@@ -27,14 +27,14 @@ fn run(
     let mut seen = std::vec::Vec::new();
     for _ in 0..200_000 {
         let v = pending.to_dq(rot);
-        let command = search.step(i.to_ab(rot), vdc);
+        let command = search.step(i.to_ab(rot), Ab::zero(), vdc);
         if seen.last() != Some(&search.status()) {
             seen.push(search.status());
         }
         pending = match command {
             StartupCommand::Voltage(v) => v,
             StartupCommand::Align { .. } => Ab::zero(),
-            StartupCommand::Start(_) | StartupCommand::Off => break,
+            StartupCommand::Start(_) | StartupCommand::Off | StartupCommand::Restart => break,
         };
         psi = Dq::new(psi.d + (v.d - r * i.d) * TS, psi.q + (v.q - r * i.q) * TS);
         i = model.current_from(psi, i);
@@ -185,4 +185,29 @@ fn a_held_rotor_gets_the_nearest_well_observed_gain_axis_and_a_free_one_its_d_ax
         let share = GainCalibration::observability(axis);
         assert!(share > 0.49, "{k}: {axis} {share}");
     }
+}
+
+#[test]
+fn the_motion_monitor_reads_the_rotors_travel_under_the_zero_vector() {
+    // A non-salient machine (R, L, λf) shorted (v = 0), its rotor turning at 20 rad/s from
+    // θ0 = 1: the current obeys L·di/dt = −R·i − jω·λf·e^(jθ). The monitor's reading is the
+    // travel 2·sin(|Δθ|/2) ≈ |Δθ| whatever θ0, within 1 %.
+    let (r, l, lf, omega) = (3.6, 0.04, 0.5, 20.0);
+    let mut m = MotionMonitor::new(r, l, lf, 6.0, TS);
+    m.restart(Ab::zero());
+    let (mut theta, mut i) = (1.0_f64, Ab::<f64>::zero());
+    for _ in 0..500 {
+        let (s, c) = theta.sin_cos();
+        let e = Ab::new(-omega * lf * s, omega * lf * c);
+        i += (i * (-r) - e) * (TS / l);
+        theta += omega * TS;
+        m.step(Ab::zero(), i);
+    }
+    let travel = 2.0 * ((theta - 1.0) / 2.0).sin();
+    assert!(
+        (m.travel() - travel).abs() < 0.01 * travel,
+        "{} {travel}",
+        m.travel()
+    );
+    assert!(!m.quiet(0.05));
 }

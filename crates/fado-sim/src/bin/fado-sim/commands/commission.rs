@@ -6,6 +6,7 @@ use std::process::ExitCode;
 
 use fado_sim::SimConfigError;
 use fado_sim::commission::{self, CommissionOptions, CommissionOutcome, Comparison};
+use fado_sim::identified_map::{IDENTIFIED_MAP_FILE, identified_map_csv};
 use fado_sim::output::{self, AtomicFile, DirLock, OutputError};
 use indicatif::{ProgressBar, ProgressStyle};
 
@@ -192,28 +193,53 @@ fn write_outputs(
         .into_inner()
         .map_err(|e| OutputError::new("write", &traces_path, e.into_error()))?
         .finish()?;
-    // The input file with its [model] replaced by the identified one: runnable as is
-    // (`fado-sim run reversal --config DIR/identified.toml`).
-    let identified = match &o.identification {
+    // The identified saturation as a flux map beside identified.toml, which names it by its
+    // relative path: the input file with its [model] replaced by the identified one, runnable
+    // as is (`fado-sim run reversal --config DIR/identified.toml`).
+    let map_path = dir.join(IDENTIFIED_MAP_FILE);
+    let (map, identified) = match &o.identification {
         Some(id) => {
-            let doc = commission::identified_toml(text, id)?;
-            let mut f = AtomicFile::create(&dir.join("identified.toml"))?;
-            std::io::Write::write_all(&mut f, doc.as_bytes()).map_err(|e| f.error(e))?;
-            Some(f.finish()?)
+            // A model that does not tabulate as a monotonic map over the drive's range (its
+            // extrapolation far beyond the pulses' current) stays the algebraic one.
+            let map = match identified_map_csv(id) {
+                Some(Ok(csv)) => Some(write_whole(&map_path, &csv)?),
+                Some(Err(e)) => {
+                    eprintln!(
+                        "warning: the identified magnetic model does not tabulate as a flux map \
+                         ({e}); identified.toml keeps it as [model.saturation]"
+                    );
+                    None
+                }
+                None => None,
+            };
+            let file = map.as_ref().map(|_| IDENTIFIED_MAP_FILE);
+            let doc = commission::identified_toml_with_map(text, id, file)?;
+            (map, Some(write_whole(&dir.join("identified.toml"), &doc)?))
         }
-        None => None,
+        None => (None, None),
     };
     let mut m = AtomicFile::create(&dir.join("metrics.json"))?;
     serde_json::to_writer_pretty(&mut m, &metrics).map_err(|e| m.error(e.into()))?;
     let m = m.finish()?;
     output::remove_if_present(&dir.join("metrics.json"))?;
     output::remove_if_present(&dir.join("identified.toml"))?;
+    output::remove_if_present(&map_path)?;
     traces.rename()?;
+    if let Some(f) = map {
+        f.rename()?;
+    }
     if let Some(f) = identified {
         f.rename()?;
     }
     m.rename()?;
     Ok(())
+}
+
+/// `text` complete and synced under a temporary name beside `path`, to be renamed.
+fn write_whole(path: &Path, text: &str) -> Result<output::Finished, OutputError> {
+    let mut f = AtomicFile::create(path)?;
+    std::io::Write::write_all(&mut f, text.as_bytes()).map_err(|e| f.error(e))?;
+    f.finish()
 }
 
 /// The magnetic model: detected or not, and its errors over the rated current range.

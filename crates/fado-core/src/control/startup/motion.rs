@@ -1,0 +1,127 @@
+//! The start-up's motion monitor: how far the rotor has turned since a reference sample, from
+//! the drive's own voltages and currents, while nothing else knows the angle.
+//!
+//! # Why
+//! The offset calibration and the angle search assume a rotor at rest. A load present from
+//! t = 0 without a brake (a vehicle on a slope, a compressor against pressure) turns a rotor
+//! that no current holds; a search on a turning rotor reads its back-EMF as an inductance,
+//! and offsets averaged over a short-circuit current are wrong. The drive has to notice the
+//! motion before the rotor has moved measurably, and without knowing the angle.
+//!
+//! # The measure
+//! The stator flux obeys dψ/dt = v − Rs·i, and ψ = L·i + λr with λr = λf·e^(jθ) the magnet's
+//! flux. From a reference sample on,
+//!
+//! Δλr = Σ (v − R̂s·i)·Ts − L̂·(i − i₀),
+//!
+//! whatever the rotor's angle, and |Δλr| = 2·λf·sin(|Δθ|/2) ≈ λf·|Δθ|: the travel is
+//! |Δλr|/λ̂f electrical rad. The voltage is the realised reference that acted over the
+//! period: the drive reads it under the zero vector (the watched offset calibration, a
+//! deferral), whose phases are shorted, so that a turning rotor drives a current that brakes
+//! it and shows here. L̂ is the mean of L̂d and L̂q (its error, the saliency, multiplies the
+//! small short-circuit current). The inverter's dead time, not compensated under the zero
+//! vector, adds a voltage against the current that the monitor does not count: it reads less
+//! than the true travel, the more so the smaller the machine's resistance against the dead
+//! time's voltage (measured in `crates/fado-sim/tests/startup_motion.rs`: 0.17 rad true for
+//! 0.05 read on the 2.2 kW IPMSM, 1.75 rad on the servo motor). A rotor stands still
+//! ([`MotionMonitor::quiet`]) when the reading stays small and the shorted phases carry no
+//! current above [`READ_CURRENT_RATIO`] of the rated current.
+//!
+//! Measured on the presets at rest (`loaded-start`, the brake holding the rotor; switching-
+//! resolved inverter, default sensors): at most 0.036 rad read over the offsets (same test).
+
+use crate::{Ab, Real};
+
+/// Largest short-circuit current of a rotor that stands still, a fraction of the rated
+/// current \[A\]: ten times the sensors' resolution on the presets, below the current of a
+/// rotor that turns at 1 % of its rated speed with its phases shorted.
+pub const READ_CURRENT_RATIO: f64 = 0.1;
+
+/// The motion monitor (module docs). Allocation-free.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MotionMonitor<T> {
+    rs: T,
+    inductance: T,
+    flux_linkage: T,
+    ts: T,
+    quiet_current: T,
+    /// Σ (v − R̂s·(i − i₀))·Ts since the reference sample (V·s).
+    flux: Ab<T>,
+    /// The reference current i₀ (A).
+    reference: Ab<T>,
+    /// The largest travel read since the reference sample (rad).
+    travel: T,
+    /// A sample's |i − i₀| exceeded the quiet current since the reference sample.
+    loud: bool,
+    running: bool,
+}
+
+impl<T: Real> MotionMonitor<T> {
+    /// The monitor for a machine model of R̂s, mean inductance `inductance`, λ̂f and rated
+    /// current, sampled at `ts`; not running.
+    pub fn new(rs: T, inductance: T, flux_linkage: T, rated_current: T, ts: T) -> Self {
+        Self {
+            rs,
+            inductance,
+            flux_linkage,
+            ts,
+            quiet_current: T::lit(READ_CURRENT_RATIO) * rated_current,
+            flux: Ab::zero(),
+            reference: Ab::zero(),
+            travel: T::zero(),
+            loud: false,
+            running: false,
+        }
+    }
+
+    /// Starts from this sample with reference current `reference` (A).
+    pub fn restart(&mut self, reference: Ab<T>) {
+        self.flux = Ab::zero();
+        self.reference = reference;
+        self.travel = T::zero();
+        self.loud = false;
+        self.running = true;
+    }
+
+    /// Stops reading (the travel is kept).
+    pub fn stop(&mut self) {
+        self.running = false;
+    }
+
+    /// Running since the last [`restart`](Self::restart).
+    pub fn running(&self) -> bool {
+        self.running
+    }
+
+    /// One sample: `v_ab` the voltage that acted over the last period (V), `i_ab` the
+    /// current now (A). Returns the largest travel read so far (electrical rad); a non-finite
+    /// input is skipped.
+    pub fn step(&mut self, v_ab: Ab<T>, i_ab: Ab<T>) -> T {
+        if !self.running || !v_ab.is_finite() || !i_ab.is_finite() {
+            return self.travel;
+        }
+        let di = i_ab - self.reference;
+        self.flux += (v_ab - di * self.rs) * self.ts;
+        let small = di.norm() <= self.quiet_current;
+        self.loud |= !small;
+        if self.flux_linkage > T::zero() {
+            let delta = self.flux - di * self.inductance;
+            let travel = delta.norm() / self.flux_linkage;
+            if travel > self.travel {
+                self.travel = travel;
+            }
+        }
+        self.travel
+    }
+
+    /// The largest travel read since the last restart (electrical rad).
+    pub fn travel(&self) -> T {
+        self.travel
+    }
+
+    /// Since the last restart the rotor has stood still: the travel read is at most `travel`
+    /// and the current stayed small (under the zero vector a turning rotor drives one).
+    pub fn quiet(&self, travel: T) -> bool {
+        !self.loud && self.travel <= travel
+    }
+}
