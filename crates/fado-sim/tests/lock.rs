@@ -257,8 +257,13 @@ const GEM: &str = include_str!("../../../motors/ipmsm-gem-50k.toml");
 ///   0.25 rad is not flagged.
 #[test]
 fn a_start_up_limit_cycle_on_a_salient_rotor_is_flagged_by_its_mode_chatter() {
+    // The eq. (23) injection at its full level (no bound on the active flux it takes,
+    // `[controller.injection] max_active_flux_share`): the envelope's losses this test reads.
     let run = |rs, flux, lq, load, extra: &str| {
-        let estimator = format!("[estimator.rs_adaptation]\nenabled = false\n{extra}\n");
+        let estimator = format!(
+            "[controller.injection]\nmax_active_flux_share = 1e9\n\
+             [estimator.rs_adaptation]\nenabled = false\n{extra}\n"
+        );
         reversal_point(GEM, &estimator, rs, flux, lq, load).metrics
     };
     let lost = |extra| run(0.005_789, 0.018_911, 0.251_589, 19.965, extra);

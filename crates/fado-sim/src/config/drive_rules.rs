@@ -44,18 +44,12 @@ pub(crate) fn with_drive_rules(cfg: &SimConfig) -> SimConfig {
     let mut c = cfg.clone();
     let drive = c.drive_config();
     let (mut tuning, mut estimator) = (drive.tuning, c.estimator);
-    fado_core::control::tracker_feedforward::apply(
-        &drive.machine,
-        &mut tuning,
-        &mut estimator,
-        drive.ts,
-    );
-    fado_core::control::speed_bandwidth::apply(
-        &drive.machine,
-        &mut tuning,
-        &mut estimator,
-        drive.ts,
-    );
+    for apply in [
+        fado_core::control::tracker_feedforward::apply::<f64>,
+        fado_core::control::speed_bandwidth::apply::<f64>,
+    ] {
+        apply(&drive.machine, &mut tuning, &mut estimator, drive.ts);
+    }
     let mut derived = std::mem::take(&mut c.derived);
     if tuning.tracker_feedforward.enabled != c.controller.tracker_feedforward.enabled {
         record(
@@ -72,15 +66,7 @@ pub(crate) fn with_drive_rules(cfg: &SimConfig) -> SimConfig {
         drive.ts,
         tuning.current.bandwidth_hz,
     );
-    let (ratio, rated) = (
-        c.controller.injection.current_ratio,
-        drive.machine.rated_current,
-    );
-    let injection = if drive.i_min() < ratio * rated {
-        drive.i_min() / rated
-    } else {
-        ratio
-    };
+    let injection = injection_ratio(&c, &drive);
     let t = &mut c.estimator.tracker;
     for (key, value, field, rule) in [
         (
@@ -137,4 +123,18 @@ fn record(derived: &mut Vec<Derived>, key: &str, value: f64, rule: &'static str)
         value,
         rule,
     });
+}
+
+/// `[controller.injection] current_ratio` as the drive runs it: the configured ratio, or the
+/// bound of `DriveConfig::i_min` on a salient rotor over the rated current where that is lower.
+fn injection_ratio(c: &SimConfig, drive: &fado_core::control::DriveConfig<f64>) -> f64 {
+    let (ratio, rated) = (
+        c.controller.injection.current_ratio,
+        drive.machine.rated_current,
+    );
+    if drive.i_min() < ratio * rated {
+        drive.i_min() / rated
+    } else {
+        ratio
+    }
 }

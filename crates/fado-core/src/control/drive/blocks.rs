@@ -193,10 +193,9 @@ impl<T: Real> DriveConfig<T> {
 /// above it, the stuck-sensor thresholds, the plausibility ratios and the lock supervisor.
 fn check_limits<T: Real>(c: &DriveConfig<T>, r: &Resolved<T>) -> Result<(), ConfigError> {
     let t = &c.tuning;
-    let i_max = r.i_max;
-    // The configured level, not the one the active-flux bound may lower (`DriveConfig::i_min`):
-    // a ratio above the limit is the user's slip whatever the machine.
-    if t.injection.current_ratio > t.current.limit_ratio {
+    // The configured level, before the bound on a salient rotor (`DriveConfig::i_min`).
+    let (i_max, i_min) = (r.i_max, t.injection.current_ratio * c.machine.rated_current);
+    if i_min > i_max {
         return Err(ConfigError::OutOfRange {
             field: "injection_current_ratio",
             expected: "at most current_limit_ratio",

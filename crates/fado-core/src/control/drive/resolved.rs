@@ -37,9 +37,10 @@ impl<T: Real> Resolved<T> {
             i_min: {
                 check::non_negative("injection_current_ratio", t.injection.current_ratio)?;
                 check::non_negative(
-                    "injection_max_active_flux_share",
+                    "injection.max_active_flux_share",
                     t.injection.max_active_flux_share,
                 )?;
+                check::positive("speed.load_step_dip_ratio", t.speed.load_step_dip_ratio)?;
                 c.i_min()
             },
             trip_current: check::positive("trip_current_ratio", t.protection.trip_current_ratio)?

@@ -17,7 +17,8 @@
 //! the rated torque from the rated speed leaves the rotor within the rated speed turning the
 //! other way, where the drive has the voltage for its rated torque. Where that raises the
 //! bandwidth the speed tracker T2S-2, whose ω̂ closes the loop, keeps the tuning's ratio to
-//! it (the paper's 35 Hz to 5 Hz), up to Kp·Ts = [`MAX_KP_TS`]. Below it (every preset: the
+//! it (the paper's 35 Hz to 5 Hz), up to Kp·Ts = [`MAX_KP_TS`]; the speed loop itself up to
+//! ωs·Ts = [`MAX_SPEED_WS_TS`]. Below it (every preset: the
 //! lightest, pmsyrm-5k, has τm = 59 ms and needs 1.35 Hz) the tuning is unchanged to the bit.
 
 use crate::Real;
@@ -26,6 +27,10 @@ use crate::control::tracker_feedforward::MAX_KP_TS;
 use crate::estimator::EstimatorTuning;
 use crate::machine::MachineModel;
 use crate::tracker::TrackerConfig;
+
+/// The largest ωs·Ts the rule gives the speed loop: 0.05 \[A\], half the speed controller's
+/// own refusal limit (0.1, `crate::control::speed_controller`), as [`MAX_KP_TS`] for T2S-2.
+pub const MAX_SPEED_WS_TS: f64 = 0.05;
 
 /// τm = Ĵ·Ω_rated/T_rated (s): the time the rated torque takes to bring the rotor from
 /// standstill to its rated speed.
@@ -40,21 +45,6 @@ pub fn required_bandwidth_hz<T: Real>(machine: &MachineModel<T>, drive: &DriveTu
     T::one() / (T::lit(core::f64::consts::TAU) * drive.speed.load_step_dip_ratio * tau)
 }
 
-/// The largest bandwidth (Hz) the speed PI accepts at the sample period `ts`: 2π·f·ts below
-/// 0.1 (kept 1 % inside) and its anti-windup gain `anti_windup_ratio`·ki/kp·ts = r·2π·f·ts/
-/// `zero_ratio` at most 1, so that the raised loop is one the drive can build.
-fn speed_loop_limit_hz<T: Real>(drive: &DriveTuning<T>, ts: T) -> T {
-    let w_ts = T::lit(0.099);
-    let s = &drive.speed;
-    let aw = s.anti_windup_ratio / s.zero_ratio;
-    let w_ts = if aw > T::zero() {
-        crate::real::min(w_ts, T::one() / aw)
-    } else {
-        w_ts
-    };
-    w_ts / (T::two_pi() * ts)
-}
-
 /// Applies the rule (module docs) to the drive's and the estimator's tuning, in place: raises
 /// the speed loop's bandwidth to [`required_bandwidth_hz`] where it is below, and T2S-2's with
 /// it in the tuning's ratio (at most the one of Kp·Ts = [`MAX_KP_TS`]).
@@ -64,14 +54,23 @@ pub fn apply<T: Real>(
     estimator: &mut EstimatorTuning<T>,
     ts: T,
 ) {
-    let needed = crate::real::min(
-        required_bandwidth_hz(machine, drive),
-        speed_loop_limit_hz(drive, ts),
-    );
+    let required = required_bandwidth_hz(machine, drive);
     let own = drive.speed.bandwidth_hz;
     // NaN compares false: the tuning's bandwidth; an invalid one (≤ 0) is left for the
     // drive's checks to name.
-    let raise = needed.is_finite() && own > T::zero() && needed > own;
+    let raise = required.is_finite() && own > T::zero() && required > own;
+    if !raise {
+        return;
+    }
+    // ωs·Ts at most MAX_SPEED_WS_TS, and the PI's anti-windup step (anti_windup_ratio·Ki/Kp·Ts
+    // = anti_windup_ratio·ωs·Ts/zero_ratio, refused above 1) at most a half.
+    let s = &drive.speed;
+    let ws_ts = crate::real::min(
+        T::lit(MAX_SPEED_WS_TS),
+        T::lit(0.5) * s.zero_ratio / crate::real::max(s.anti_windup_ratio, T::lit(1e-9)),
+    );
+    let needed = crate::real::min(required, ws_ts / (T::lit(core::f64::consts::TAU) * ts));
+    let raise = needed > own;
     if !raise {
         return;
     }
@@ -137,17 +136,26 @@ mod tests {
             "{}",
             d.speed.bandwidth_hz
         );
+        let d1 = d;
         let ratio = e0.tracker.t2s2_bandwidth_hz / d0.speed.bandwidth_hz;
         assert!((e.tracker.t2s2_bandwidth_hz - ratio * d.speed.bandwidth_hz).abs() < 1e-9);
-        // The Kp·Ts cap at a slow sampling rate.
+        // T2S-2's Kp·Ts cap at a slower sampling rate (the speed loop still below its own),
+        // for a tuning whose T2S-2 is 14 × its speed loop.
         let (mut d, mut e) = (d0, e0);
-        apply(&m, &mut d, &mut e, 1e-3);
+        e.tracker.t2s2_bandwidth_hz = 70.0;
+        apply(&m, &mut d, &mut e, 4e-4);
+        assert_eq!(d.speed.bandwidth_hz, d1.speed.bandwidth_hz);
         let (kp, _) = TrackerConfig {
             damping: e.tracker.damping,
             definition: e.tracker.bandwidth_definition,
-            ..TrackerConfig::new(e.tracker.t2s2_bandwidth_hz, 1e-3)
+            ..TrackerConfig::new(e.tracker.t2s2_bandwidth_hz, 4e-4)
         }
         .gains();
-        assert!((kp * 1e-3 - MAX_KP_TS).abs() < 1e-9, "{kp}");
+        assert!((kp * 4e-4 - MAX_KP_TS).abs() < 1e-9, "{kp}");
+        // And the speed loop's ωs·Ts cap at a slower one still.
+        let (mut d, mut e) = (d0, e0);
+        apply(&m, &mut d, &mut e, 1e-3);
+        let ws_ts = core::f64::consts::TAU * d.speed.bandwidth_hz * 1e-3;
+        assert!((ws_ts - MAX_SPEED_WS_TS).abs() < 1e-12, "{ws_ts}");
     }
 }
