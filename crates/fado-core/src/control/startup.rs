@@ -108,7 +108,8 @@ pub struct StartupTuning<T> {
     /// offset calibration and the angle search ([`MotionMonitor`]); the start-up then defers
     /// ([`StartupStatus::RotorMoving`]). Default 0.05 rad \[A\]: a tenth of the
     /// `loaded-start` bound on the backward travel, ten times the monitor's reading on the
-    /// presets at rest.
+    /// presets at rest. The monitor raises it to what its quiet current alone reads,
+    /// L̂·0.1·I_rated/λ̂f, where that is larger ([`MotionMonitor::threshold`]).
     pub motion_travel: T,
     /// How long the rotor has to stay still, the phases shorted, before a deferred start-up
     /// begins again (s). Default 0.1 s \[A\]: the default offset calibration's time.
@@ -380,7 +381,8 @@ impl<T: Real> AngleSearch<T> {
         if !self.monitor.running() {
             return false;
         }
-        if self.monitor.step(Ab::zero(), i_ab) > self.tuning.motion_travel {
+        let moving = self.monitor.threshold(self.tuning.motion_travel);
+        if self.monitor.step(Ab::zero(), i_ab) > moving {
             self.defer();
             return true;
         }

@@ -114,6 +114,21 @@ impl<T: Real> MotionMonitor<T> {
         self.travel
     }
 
+    /// The travel (electrical rad) above which the rotor counts as moving, given the tuning's
+    /// `travel`: at least what the quiet current alone reads, L̂·I_quiet/λ̂f. A current step
+    /// that the monitor accepts as standing still ([`READ_CURRENT_RATIO`]) must not read as
+    /// motion: on a low-inductance machine of small magnet flux (a 135 µH, 1.5 mWb multirotor
+    /// motor: 0.106 rad) the sensors' noise alone reads past the default 0.05 rad.
+    pub fn threshold(&self, travel: T) -> T {
+        let floor = if self.flux_linkage > T::zero() {
+            self.quiet_current * self.inductance / self.flux_linkage
+        } else {
+            T::zero()
+        };
+        // NaN compares false: the tuning's travel.
+        if floor > travel { floor } else { travel }
+    }
+
     /// The largest travel read since the last restart (electrical rad).
     pub fn travel(&self) -> T {
         self.travel
@@ -122,6 +137,6 @@ impl<T: Real> MotionMonitor<T> {
     /// Since the last restart the rotor has stood still: the travel read is at most `travel`
     /// and the current stayed small (under the zero vector a turning rotor drives one).
     pub fn quiet(&self, travel: T) -> bool {
-        !self.loud && self.travel <= travel
+        !self.loud && self.travel <= self.threshold(travel)
     }
 }
