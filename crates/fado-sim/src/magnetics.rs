@@ -27,6 +27,7 @@
 
 use std::cell::Cell;
 use std::sync::Arc;
+use std::sync::Mutex;
 
 use fado_core::magnetics::{FluxMap, FluxMapError, MagneticModel, Magnetics, Saturation};
 use fado_core::{Ab, Dq};
@@ -44,7 +45,7 @@ pub const SUBSTEP_TIME_CONSTANTS: f64 = 0.05;
 pub const SHORT_INTERVAL_SUBSTEPS: f64 = 0.1;
 
 /// A flux map's data held by the simulator (the firmware's `&'static` table, leaked once per
-/// map read: a plant borrows the checked map per evaluation of i(ψ), with its axes' spacing
+/// distinct map: a plant borrows the checked map per evaluation of i(ψ), with its axes' spacing
 /// found once): `psi_d[k·n_q + m]` at (`i_d[k]`, `i_q[m]`), checked by [`FluxMap::new`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FluxMapData {
@@ -59,9 +60,17 @@ impl FluxMapData {
         psi_d: Vec<f64>,
         psi_q: Vec<f64>,
     ) -> Result<Self, FluxMapError> {
-        FluxMap::new(&i_d, &i_q, &psi_d, &psi_q)?;
+        let checked = FluxMap::new(&i_d, &i_q, &psi_d, &psi_q)?;
+        // Interned: a map read again (each point of a sweep, each run of a table) borrows the
+        // copy leaked the first time, so memory does not grow with the number of runs.
+        static READ: Mutex<Vec<FluxMap<'static, f64>>> = Mutex::new(Vec::new());
+        let mut read = READ.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(map) = read.iter().find(|m| **m == checked) {
+            return Ok(Self { map: *map });
+        }
         let leak = |v: Vec<f64>| -> &'static [f64] { Vec::leak(v) };
         let map = FluxMap::new(leak(i_d), leak(i_q), leak(psi_d), leak(psi_q))?;
+        read.push(map);
         Ok(Self { map })
     }
 

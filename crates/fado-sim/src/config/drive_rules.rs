@@ -43,13 +43,9 @@ const INJECTION_RULE: &str = "the injection's I_min bounded to `[controller.inje
 pub(crate) fn with_drive_rules(cfg: &SimConfig) -> SimConfig {
     let mut c = cfg.clone();
     let drive = c.drive_config();
-    let (mut tuning, mut estimator) = (drive.tuning, c.estimator);
-    for apply in [
-        fado_core::control::tracker_feedforward::apply::<f64>,
-        fado_core::control::speed_bandwidth::apply::<f64>,
-    ] {
-        apply(&drive.machine, &mut tuning, &mut estimator, drive.ts);
-    }
+    let (mut built, mut estimator) = (drive, c.estimator);
+    built.apply_build_rules(&mut estimator);
+    let tuning = built.tuning;
     let mut derived = std::mem::take(&mut c.derived);
     if tuning.tracker_feedforward.enabled != c.controller.tracker_feedforward.enabled {
         record(
@@ -60,12 +56,6 @@ pub(crate) fn with_drive_rules(cfg: &SimConfig) -> SimConfig {
         );
         c.controller.tracker_feedforward.enabled = true;
     }
-    let current = fado_core::control::release_hold::current_bandwidth_for_hold(
-        &tuning.release_hold,
-        &drive.machine,
-        drive.ts,
-        tuning.current.bandwidth_hz,
-    );
     let injection = injection_ratio(&c, &drive);
     let t = &mut c.estimator.tracker;
     for (key, value, field, rule) in [
@@ -83,7 +73,7 @@ pub(crate) fn with_drive_rules(cfg: &SimConfig) -> SimConfig {
         ),
         (
             "controller.current.bandwidth_hz",
-            current,
+            tuning.current.bandwidth_hz,
             &mut c.controller.current.bandwidth_hz,
             HOLD_CURRENT_RULE,
         ),

@@ -124,6 +124,27 @@ impl<T: Real> DriveConfig<T> {
         }
     }
 
+    /// Applies the drive's build-time rules to this configuration and the estimator's tuning,
+    /// in place: the tracker feed-forward
+    /// ([`tracker_feedforward::apply`](crate::control::tracker_feedforward::apply)), the speed
+    /// loop's bandwidth of its load step ([`speed_bandwidth::apply`](crate::control::speed_bandwidth::apply))
+    /// and the current loop an enabled release hold needs
+    /// ([`current_bandwidth_for_hold`](crate::control::release_hold::current_bandwidth_for_hold)).
+    /// The drive runs with the result ([`SensorlessDrive::new`](crate::control::SensorlessDrive::new));
+    /// a tool that shows the derived values calls the same.
+    pub fn apply_build_rules(&mut self, estimator: &mut crate::estimator::EstimatorTuning<T>) {
+        let machine = self.machine;
+        crate::control::tracker_feedforward::apply(&machine, &mut self.tuning, estimator, self.ts);
+        crate::control::speed_bandwidth::apply(&machine, &mut self.tuning, estimator, self.ts);
+        let t = &mut self.tuning;
+        t.current.bandwidth_hz = crate::control::release_hold::current_bandwidth_for_hold(
+            &t.release_hold,
+            &machine,
+            self.ts,
+            t.current.bandwidth_hz,
+        );
+    }
+
     /// The configured trip level in A.
     pub fn trip_current(&self) -> T {
         self.tuning.protection.trip_current_ratio * self.machine.rated_current

@@ -15,35 +15,14 @@ use crate::{Ab, Abc, Dq, Real};
 impl<T: Real> SensorlessDrive<T, SensorlessEstimator<T>> {
     /// The drive with the paper's estimator, built with the drive's own sampling period and
     /// machine model and the given estimator tuning (start-up angle 0; see
-    /// [`align`](Self::align)). A rotor its trackers would lag at the current limit gets the
-    /// acceleration feed-forward ([`crate::control::tracker_feedforward`]), a light rotor the
-    /// speed-loop bandwidth of its load step ([`crate::control::speed_bandwidth`]); an enabled
-    /// release hold the current-loop bandwidth it needs
-    /// ([`current_bandwidth_for_hold`](crate::control::release_hold::current_bandwidth_for_hold)).
+    /// [`align`](Self::align)), after the build-time rules of
+    /// [`DriveConfig::apply_build_rules`] (tracker feed-forward, speed-loop bandwidth of a
+    /// light rotor, the current loop of an enabled release hold).
     pub fn new(
         mut config: DriveConfig<T>,
         mut estimator: EstimatorTuning<T>,
     ) -> Result<Self, ConfigError> {
-        let machine = config.machine;
-        crate::control::tracker_feedforward::apply(
-            &machine,
-            &mut config.tuning,
-            &mut estimator,
-            config.ts,
-        );
-        crate::control::speed_bandwidth::apply(
-            &machine,
-            &mut config.tuning,
-            &mut estimator,
-            config.ts,
-        );
-        let t = &mut config.tuning;
-        t.current.bandwidth_hz = crate::control::release_hold::current_bandwidth_for_hold(
-            &t.release_hold,
-            &machine,
-            config.ts,
-            t.current.bandwidth_hz,
-        );
+        config.apply_build_rules(&mut estimator);
         let estimator = EstimatorConfig {
             ts: check::positive("ts", config.ts)?,
             machine: config.machine,

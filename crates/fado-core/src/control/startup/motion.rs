@@ -45,6 +45,9 @@ pub struct MotionMonitor<T> {
     flux_linkage: T,
     ts: T,
     quiet_current: T,
+    /// What the quiet current alone reads, L̂·I_quiet/λ̂f (rad; 0 without a magnet flux): the
+    /// floor of [`Self::threshold`].
+    travel_floor: T,
     /// Σ (v − R̂s·(i − i₀))·Ts since the reference sample (V·s).
     flux: Ab<T>,
     /// The reference current i₀ (A).
@@ -60,12 +63,19 @@ impl<T: Real> MotionMonitor<T> {
     /// The monitor for a machine model of R̂s, mean inductance `inductance`, λ̂f and rated
     /// current, sampled at `ts`; not running.
     pub fn new(rs: T, inductance: T, flux_linkage: T, rated_current: T, ts: T) -> Self {
+        let quiet_current = T::lit(READ_CURRENT_RATIO) * rated_current;
+        let travel_floor = if flux_linkage > T::zero() {
+            quiet_current * inductance / flux_linkage
+        } else {
+            T::zero()
+        };
         Self {
             rs,
             inductance,
             flux_linkage,
             ts,
-            quiet_current: T::lit(READ_CURRENT_RATIO) * rated_current,
+            quiet_current,
+            travel_floor,
             flux: Ab::zero(),
             reference: Ab::zero(),
             travel: T::zero(),
@@ -120,13 +130,12 @@ impl<T: Real> MotionMonitor<T> {
     /// motion: on a low-inductance machine of small magnet flux (a 135 µH, 1.5 mWb multirotor
     /// motor: 0.106 rad) the sensors' noise alone reads past the default 0.05 rad.
     pub fn threshold(&self, travel: T) -> T {
-        let floor = if self.flux_linkage > T::zero() {
-            self.quiet_current * self.inductance / self.flux_linkage
-        } else {
-            T::zero()
-        };
         // NaN compares false: the tuning's travel.
-        if floor > travel { floor } else { travel }
+        if self.travel_floor > travel {
+            self.travel_floor
+        } else {
+            travel
+        }
     }
 
     /// The largest travel read since the last restart (electrical rad).
