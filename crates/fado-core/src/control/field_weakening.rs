@@ -185,6 +185,23 @@ impl<T: Real> FieldWeakening<T> {
         room.step_sqrt() / self.lq
     }
 
+    /// The largest stator flux the voltage allows at the speed `omega` (rad/s, electrical) on
+    /// the bus `vdc`, Wb: the hexagon's inscribed circle Vdc/√3 (or the loop's own target
+    /// above it, with overmodulation) over |ω̂|; None below the weakening speed (the loop at
+    /// zero), with the loop or its MTPV limit switched off. The drive cuts the q current to
+    /// it ([`crate::control::drive`], the voltage ellipse): the loop moves i_d only, and
+    /// where the q flux alone reaches the voltage (a synchronous-reluctance rotor,
+    /// L_q·I_max > V/ω) no d current brings the voltage back.
+    #[inline]
+    pub fn ellipse_flux(&self, vdc: T, omega: T) -> Option<T> {
+        if !(self.enabled && self.mtpv && self.delta_id < T::zero()) {
+            return None;
+        }
+        let inscribed = T::one() / T::lit(3.0).sqrt();
+        let w = omega.abs().step_max(self.min_speed);
+        Some(self.margin.step_max(inscribed) * vdc / w)
+    }
+
     /// Back to no weakening.
     pub fn reset(&mut self) {
         self.delta_id = T::zero();
@@ -292,5 +309,31 @@ mod tests {
         assert!((iq - psi / m.lq).abs() < 1e-9, "{iq}");
         f.reset();
         assert_eq!(f.delta_id(), 0.0);
+    }
+
+    #[test]
+    fn ellipse_flux_is_the_inscribed_circle_over_the_speed_while_weakening() {
+        let (mut f, m) = fw();
+        let (vdc, w) = (m.dc_voltage, 1000.0);
+        assert_eq!(f.ellipse_flux(vdc, w), None);
+        f.update(4.0 * vdc * vdc, vdc, w);
+        let psi = f.ellipse_flux(vdc, w).unwrap();
+        assert!((psi - vdc / 3f64.sqrt() / w).abs() < 1e-12, "{psi}");
+        // The loop's own target above the inscribed circle (overmodulation) is the bound.
+        let t = FieldWeakeningTuning {
+            voltage_margin: 1.08,
+            ..FieldWeakeningTuning::default()
+        };
+        let mut g = FieldWeakening::new(&t, &m, 40.0, 1e-4).unwrap();
+        g.update(4.0 * vdc * vdc, vdc, w);
+        let psi = g.ellipse_flux(vdc, w).unwrap();
+        assert!((psi - 1.08 * vdc / 3f64.sqrt() / w).abs() < 1e-12, "{psi}");
+        let off = FieldWeakeningTuning {
+            mtpv: false,
+            ..FieldWeakeningTuning::default()
+        };
+        let mut h = FieldWeakening::new(&off, &m, 40.0, 1e-4).unwrap();
+        h.update(4.0 * vdc * vdc, vdc, w);
+        assert_eq!(h.ellipse_flux(vdc, w), None);
     }
 }
