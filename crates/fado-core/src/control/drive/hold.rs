@@ -30,7 +30,11 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
 
     /// (Re)arms the release hold at the present θ̂: the application calls it when its brake
     /// releases later than the start-up's end (a hoist opens its brake just before the lift).
+    /// The loaded-standstill probe then arms after one period instead of its arming time
+    /// ([`StandstillProbe::arm_at_release`](crate::control::StandstillProbe::arm_at_release)).
     pub fn arm_release_hold(&mut self) {
+        // The loaded standstill that follows: the angle probe arms after one period.
+        self.blocks.probe.arm_at_release();
         let theta = self.last.estimate.theta;
         self.blocks.hold.arm(theta);
     }
