@@ -7,7 +7,7 @@
 //! the electrical frequency |ω|. T2S-1 (60 Hz) passes its rate dδ/dt into ω̂1 at any speed
 //! where |ω| is below its bandwidth, and the observer rotates its model at that speed: with
 //! the notch of eq. (17)–(19) off by Δω it leaks λ·Δω/(2jω) of the rotating flux into D̂
-//! (`EstimatorTuning::observer.lag_compensation`), a leak that turns with the same e^{jθ} as
+//! (the observer's lag compensation), a leak that turns with the same e^{jθ} as
 //! the ripple and so has a DC part proportional to ε. With the frame coupling c of
 //! `crate::active_flux` (the observer's radial input e_d + c·e_q) that leak closes a loop
 //! around ε which moves the DC loop's slowest pole to the right while the machine generates,
