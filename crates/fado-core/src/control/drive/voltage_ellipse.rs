@@ -52,9 +52,8 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         let mut iq = i.q;
         for _ in 0..ELLIPSE_STEPS {
             let psi = flux(Dq::new(i.d, iq));
-            // Inside the ellipse, or a NaN flux: nothing to cut.
-            let outside = (psi.d * psi.d + psi.q * psi.q).partial_cmp(&limit_sq)
-                == Some(core::cmp::Ordering::Greater);
+            // Inside the ellipse, or a non-finite flux (NaN compares false): no cut.
+            let outside = psi.d * psi.d + psi.q * psi.q > limit_sq;
             if !outside || psi.q == T::zero() {
                 break;
             }
