@@ -1,5 +1,6 @@
 //! A flux map on a uniform grid held by value, for the lookup a firmware's interrupt makes.
 
+use super::cell_inverse::{self, CellGrid, CellPolynomial};
 use super::{FluxTable, InductanceMatrix, MagneticModel, newton};
 use crate::{Dq, Real};
 
@@ -164,10 +165,14 @@ impl<T: Real, const ND: usize, const NQ: usize> MagneticModel<T> for UniformFlux
         self.current_from(psi, l0.solve(psi - psi0))
     }
 
+    /// In closed form cell by cell as [`super::FluxMap::current_from`]; by Newton's method
+    /// where that finds no root.
     fn current_from(&self, psi: Dq<T>, guess: Dq<T>) -> Dq<T> {
-        let last = self.first.d + T::from_index(ND.saturating_sub(1)) / self.inv_step.d;
-        let scale = last.abs() * T::lit(1e-6);
-        newton(psi, guess, scale, |i| self.flux_and_jacobian(i)).0
+        cell_inverse::invert(self, psi, guess).unwrap_or_else(|| {
+            let last = self.first.d + T::from_index(ND.saturating_sub(1)) / self.inv_step.d;
+            let scale = last.abs() * T::lit(1e-6);
+            newton(psi, guess, scale, |i| self.flux_and_jacobian(i)).0
+        })
     }
 
     #[inline]
@@ -178,5 +183,37 @@ impl<T: Real, const ND: usize, const NQ: usize> MagneticModel<T> for UniformFlux
     #[inline]
     fn flux_and_inductance(&self, i: Dq<T>) -> (Dq<T>, InductanceMatrix<T>) {
         self.flux_and_jacobian(i)
+    }
+}
+
+impl<T: Real, const ND: usize, const NQ: usize> CellGrid<T> for UniformFluxTable<T, ND, NQ> {
+    #[inline]
+    fn last_cell(&self) -> (usize, usize) {
+        (ND.saturating_sub(2), NQ.saturating_sub(2))
+    }
+
+    #[inline]
+    fn cell_of(&self, i: Dq<T>) -> (usize, usize) {
+        let (k, m, _, _) = self.cell(i);
+        (k, m)
+    }
+
+    #[inline]
+    fn polynomial(&self, k: usize, m: usize) -> CellPolynomial<T> {
+        let c = self.coefficients(k, m);
+        CellPolynomial {
+            p00: Dq::new(c[0], c[4]),
+            ex: Dq::new(c[1], c[5]),
+            ey: Dq::new(c[2], c[6]),
+            twist: Dq::new(c[3], c[7]),
+        }
+    }
+
+    #[inline]
+    fn current_at(&self, k: usize, m: usize, u: T, v: T) -> Dq<T> {
+        Dq::new(
+            self.first.d + (T::from_index(k) + u) / self.inv_step.d,
+            self.first.q + (T::from_index(m) + v) / self.inv_step.q,
+        )
     }
 }
