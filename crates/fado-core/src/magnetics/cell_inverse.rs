@@ -26,7 +26,7 @@
 //! that ends in a cell with no root or walks longer than the grid (a map with no inverse
 //! there) returns None: the caller falls back to Newton's method.
 
-use super::InductanceMatrix;
+use super::{InductanceMatrix, newton};
 use crate::{Dq, Real};
 
 /// Tolerance, in units of the type's ε, of a fraction outside [0, 1] that still counts as in
@@ -63,6 +63,17 @@ fn cross<T: Real>(a: Dq<T>, b: Dq<T>) -> T {
 }
 
 impl<T: Real> CellPolynomial<T> {
+    /// From a uniform table's interleaved coefficients [ψd: p00, ex, ey, twist; ψq: the same].
+    #[inline]
+    pub fn from_coefficients(c: &[T; 8]) -> Self {
+        Self {
+            p00: Dq::new(c[0], c[4]),
+            ex: Dq::new(c[1], c[5]),
+            ey: Dq::new(c[2], c[6]),
+            twist: Dq::new(c[3], c[7]),
+        }
+    }
+
     /// ψ at the fractions (u, v) and its Jacobian ∂ψ/∂(u, v).
     #[inline]
     fn eval(&self, u: T, v: T) -> (Dq<T>, InductanceMatrix<T>) {
@@ -184,4 +195,47 @@ pub(super) fn invert<T: Real>(grid: &impl CellGrid<T>, psi: Dq<T>, guess: Dq<T>)
         m = m.wrapping_add_signed(dm);
     }
     None
+}
+
+/// The current at the fractions (u, v) of cell (k, m) of a uniform grid from `first` with
+/// inverse spacings `inv_step`.
+#[inline]
+pub(super) fn uniform_current_at<T: Real>(
+    first: Dq<T>,
+    inv_step: Dq<T>,
+    k: usize,
+    m: usize,
+    u: T,
+    v: T,
+) -> Dq<T> {
+    Dq::new(
+        first.d + (T::from_index(k) + u) / inv_step.d,
+        first.q + (T::from_index(m) + v) / inv_step.q,
+    )
+}
+
+/// i(ψ) on `grid` by [`invert`] from the cell of `guess`, by Newton's method on
+/// `flux_and_jacobian` from `guess` (steps relative to `scale`) where that finds no root: a
+/// bilinear map's [`super::MagneticModel::current_from`].
+#[inline]
+pub(super) fn current_from<T: Real>(
+    grid: &impl CellGrid<T>,
+    psi: Dq<T>,
+    guess: Dq<T>,
+    scale: T,
+    flux_and_jacobian: impl Fn(Dq<T>) -> (Dq<T>, InductanceMatrix<T>),
+) -> Dq<T> {
+    invert(grid, psi, guess).unwrap_or_else(|| newton(psi, guess, scale, flux_and_jacobian).0)
+}
+
+/// i(ψ) on `grid` from the map's linearisation at zero current (`at_zero`, its ψ and ∂ψ/∂i
+/// there) as the guess: a bilinear map's [`super::MagneticModel::current`].
+#[inline]
+pub(super) fn current_from_zero<T: Real>(
+    psi: Dq<T>,
+    at_zero: (Dq<T>, InductanceMatrix<T>),
+    current_from: impl Fn(Dq<T>, Dq<T>) -> Dq<T>,
+) -> Dq<T> {
+    let (psi0, l0) = at_zero;
+    current_from(psi, l0.solve(psi - psi0))
 }

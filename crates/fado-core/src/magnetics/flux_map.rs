@@ -3,7 +3,7 @@
 use core::fmt;
 
 use super::cell_inverse::{self, CellGrid, CellPolynomial};
-use super::{InductanceMatrix, MagneticModel, newton};
+use super::{InductanceMatrix, MagneticModel};
 use crate::{Dq, Real};
 
 /// A flux map on the rectangular grid `i_d` × `i_q` (both strictly increasing), borrowed:
@@ -346,20 +346,18 @@ impl<T: Real> MagneticModel<T> for FluxMap<'_, T> {
         Dq::new(bilinear_value(cd, fx, fy), bilinear_value(cq, fx, fy))
     }
 
-    /// Newton from the map's linearisation at zero current.
+    /// From the map's linearisation at zero current.
     fn current(&self, psi: Dq<T>) -> Dq<T> {
-        let (psi0, l0) = self.flux_and_jacobian(Dq::zero());
-        self.current_from(psi, l0.solve(psi - psi0))
+        let at_zero = self.flux_and_jacobian(Dq::zero());
+        cell_inverse::current_from_zero(psi, at_zero, |p, g| self.current_from(p, g))
     }
 
     /// In closed form, cell by cell from the cell of `guess` (each cell's bilinear map inverts
     /// as a quadratic; see the module docs' Inversion); by Newton's method from `guess` where
     /// that finds no root.
     fn current_from(&self, psi: Dq<T>, guess: Dq<T>) -> Dq<T> {
-        cell_inverse::invert(self, psi, guess).unwrap_or_else(|| {
-            let scale = self.i_d.last().map_or(T::one(), |x| x.abs()) * T::lit(1e-6);
-            newton(psi, guess, scale, |i| self.flux_and_jacobian(i)).0
-        })
+        let scale = self.i_d.last().map_or(T::one(), |x| x.abs()) * T::lit(1e-6);
+        cell_inverse::current_from(self, psi, guess, scale, |i| self.flux_and_jacobian(i))
     }
 
     #[inline]

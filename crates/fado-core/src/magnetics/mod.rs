@@ -49,12 +49,14 @@ mod constant;
 mod flux_map;
 mod machine;
 mod saturation;
+mod uniform_map;
 mod uniform_table;
 
 pub use constant::ConstantInductance;
 pub use flux_map::{FluxMap, FluxMapError, FluxTable};
 pub use machine::{MachineMagnetics, zero_current_constants};
 pub use saturation::Saturation;
+pub use uniform_map::UniformFluxMap;
 pub use uniform_table::UniformFluxTable;
 
 use crate::{Dq, Real};
@@ -254,6 +256,8 @@ pub enum Magnetics<'a, T> {
     Saturation(Saturation<T>),
     /// A flux map on a rectangular grid.
     Map(FluxMap<'a, T>),
+    /// A flux map on a uniform grid, its cells' coefficients precomputed.
+    Uniform(UniformFluxMap<'a, T>),
 }
 
 impl<T: Real> Magnetics<'_, T> {
@@ -269,6 +273,7 @@ macro_rules! dispatch {
             Magnetics::Constant($m) => $e,
             Magnetics::Saturation($m) => $e,
             Magnetics::Map($m) => $e,
+            Magnetics::Uniform($m) => $e,
         }
     };
 }

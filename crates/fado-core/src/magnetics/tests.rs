@@ -479,6 +479,14 @@ fn a_uniform_table_is_the_flux_map() {
             (uniform.current(b) - i).norm() < 1e-9 * (1.0 + i.norm()),
             "{i:?}"
         );
+        // Borrowed with its shape at run time (a machine record's form): the same, bit for bit.
+        let view = uniform.map();
+        assert_eq!(view.flux_and_jacobian(i), (b, lb));
+        assert_eq!(view.flux(i), b);
+        assert_eq!(view.current(b), uniform.current(b));
+        let model = Magnetics::Uniform(view);
+        assert_eq!(model.flux_and_inductance(i), (b, lb));
+        assert_eq!(model.current_from(b, i), uniform.current_from(b, i));
     }
     let t32 = ipm_table::<f32>();
     assert_eq!(
