@@ -160,11 +160,11 @@ reversals, over the run for `stops`), "trip" when a seed tripped, and the seeds 
 LIMITS = """
 ## Limits
 
-- The PM-SyRM presets (`pmsyrm-baldor-5k6`, `pmsyrm-baldor-5k6-measured`) trip in `reversal`
-  and `rated-reversal` with their true model as well as with the commissioned one: the drive's
-  closed loop on this rotor (the estimator's laws), not the identification, is what fails
-  there; `stops` passes with the true model, and with the commissioned one on the algebraic
-  preset but not on the measured map.
+- The PM-SyRM presets (`pmsyrm-baldor-5k6`, `pmsyrm-baldor-5k6-measured`) pass the three
+  scenarios on every seed with their true model, and the algebraic preset with its
+  commissioned model too; the measured map's commissioned model does not: its identified
+  incremental inductances are off by up to a third at the edges of the rated range (below),
+  and the closed loop on it loses the angle near zero speed under load.
 - On these machines the identified λ̂f is high by 3 % (algebraic model) and 8 % (measured
   map): the back-EMF windows run at a d current of −½ the test limit and read the active flux
   through constant L̂d, L̂q. The pulses' fit takes this λ̂f as the magnet's flux, so it

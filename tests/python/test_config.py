@@ -48,6 +48,7 @@ PAPER_DEFAULTS = {
         "on_rotor_flux": True,  # fado's improvement [A]; False = paper's Fig. 5
         "lag_compensation": True,  # fado's improvement [A]; False = the paper
         "gain_period": 4e-4,  # [A] (gains held over 4 samples at 10 kHz); 0 = the paper
+        "frame_ripple_notch": True,  # [A] saturating models only; False = the paper
     },
     "rs_adaptation": {
         "enabled": True,  # fado's extension [A]; False = the paper's fixed R̂s
@@ -625,6 +626,7 @@ def test_paper_path_switches_off_fados_additions_and_keeps_the_rest() -> None:
         "rs_adaptation.enabled": False,
         "observer.lag_compensation": False,
         "observer.on_rotor_flux": False,
+        "observer.frame_ripple_notch": False,
         "limiter.recentring": False,
         "disturbance_feedback.ramp_time": 0.0,
         "observer.gain_period": 0.0,

@@ -28,6 +28,7 @@ pub mod ratings;
 pub mod real;
 pub mod rotor_flux;
 pub mod rs_adaptation;
+pub mod speed_notch;
 pub mod tracker;
 
 pub use baselines::{EmfObserverEstimator, LpfIntegratorEstimator, OrtegaEstimator};

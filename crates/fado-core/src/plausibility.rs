@@ -39,10 +39,15 @@ pub const CURRENT_RATIO: f64 = 4.0;
 /// the order of kV.
 pub const VOLTAGE_RATIO: f64 = 1.5;
 
-/// Default bound on |Δi| per sample, in units of `voltage·Ts/L̂q`: 2 \[A\]. One sample changes the
-/// current by at most (|v| + |e|)·Ts/L; |v| ≤ 2/3·Vdc and the back-EMF at rated speed
-/// |e| ≤ 2·Vdc/√3 ([`MachineModel::validate`]) give (0.67 + 1.15)·Vdc = 1.2·(1.5·Vdc), so 2
-/// covers it with 65 % margin (also L̂d down to 0.6·L̂q, noise and ADC steps).
+/// Default bound on |Δi| per sample, in units of `voltage·Ts/L`, L = min(L̂d, L̂q): 2 \[A\].
+/// One sample changes the current by at most (|v| + |e|)·Ts/L; |v| ≤ 2/3·Vdc and the back-EMF
+/// at rated speed |e| ≤ 2·Vdc/√3 ([`MachineModel::validate`]) give (0.67 + 1.15)·Vdc =
+/// 1.2·(1.5·Vdc), so 2 covers it with 65 % margin (noise and ADC steps). L is the smaller
+/// inductance: in steady state the α-β current turns by ω·|i|·Ts per sample, and on a rotor
+/// with L̂d < L̂q the d current that field weakening adds makes that up to
+/// (|v| + |e|)·Ts/L̂d; with L̂q the bound refuses the steady rotation itself
+/// (pmsyrm-baldor-5k6, L̂d = L̂q/5: 1.07 A per sample at 2,700 r/min under 18.9 A against a
+/// bound of 1.08 A, and the drive tripped on the refused samples).
 pub const STEP_RATIO: f64 = 2.0;
 
 /// The precomputed bounds of [`SampleBounds::check`].
@@ -81,7 +86,8 @@ impl<T: Real> SampleBounds<T> {
     /// The bounds of the `plausible_*` ratios (fields of the estimators' tunings and of
     /// the baselines' configurations, which errors name): |i| below `current_ratio` ×
     /// `rated_current`, |v| below `voltage_ratio` × `dc_voltage`, |Δi| per sample below
-    /// `step_ratio` × (the plausible voltage)·`ts`/`lq` (0, or a step that overflows, switches
+    /// `step_ratio` × (the plausible voltage)·`ts`/`lq`, `lq` the smaller of the machine's
+    /// inductances ([`STEP_RATIO`]) (0, or a step that overflows, switches
     /// the step test off). `rated_current` and `dc_voltage` must be positive (errors name
     /// them).
     pub fn from_ratios(
@@ -127,7 +133,7 @@ impl<T: Real> SampleBounds<T> {
             T::lit(STEP_RATIO),
             machine.rated_current,
             machine.dc_voltage,
-            machine.lq,
+            machine.lq.step_min(machine.ld),
             check::positive("ts", ts)?,
         )
     }
@@ -181,6 +187,35 @@ impl<T: Real> SampleBounds<T> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The steady rotation of the α-β current, ω·|i|·Ts per sample, passes the step bound at
+    /// twice the rated speed and 1.5 × the rated current on rotors with L̂d < L̂q (the bound
+    /// uses the smaller inductance, [`STEP_RATIO`]): a PM-SyRM with L̂d = L̂q/5 and an IPMSM
+    /// with L̂d = 0.6·L̂q, through the estimator's bounds and [`SampleBounds::for_machine`].
+    #[test]
+    fn the_steady_rotation_of_a_salient_rotor_passes_the_step_bound() {
+        let paper = MachineModel::<f64>::paper();
+        let pmsyrm = crate::magnetics::tests::pmsyrm_machine();
+        let ipmsm = MachineModel {
+            ld: 0.6 * paper.lq,
+            ..paper
+        };
+        let ts = 100e-6;
+        for m in [pmsyrm, ipmsm] {
+            let config = crate::estimator::EstimatorConfig::for_machine(&m);
+            for b in [
+                config.sample_bounds().unwrap(),
+                SampleBounds::for_machine(&m, ts).unwrap(),
+            ] {
+                let step = 2.0 * m.rated_speed() * 1.5 * m.rated_current * ts;
+                assert!(b.step() > 1.5 * step, "{} vs {step}", b.step());
+                let i = Ab::new(1.5 * m.rated_current, 0.0);
+                let (s, c) = (2.0 * m.rated_speed() * ts).sin_cos();
+                let turned = Ab::new(i.alpha * c, i.alpha * s);
+                assert!(b.check(Ab::new(100.0, 0.0), turned, i, b.step()));
+            }
+        }
+    }
 
     #[test]
     fn refuses_absurd_and_non_finite_samples() {

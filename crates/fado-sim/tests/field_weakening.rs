@@ -114,3 +114,39 @@ fn rated_power_at_the_largest_omega_ts_of_the_presets() {
         assert!(angle < bound, "{file}: {angle}");
     }
 }
+
+/// `fullrange` on the PM-SyRM (pmsyrm-baldor-5k6, L̂q = 5·L̂d, L_q·I_max = 3.4 Wb against the
+/// 0.41 Wb the voltage allows at its 3,600 r/min top speed): the drive reaches the top speed
+/// and holds its power, brakes from it at the current limit through zero and runs the other
+/// way without a trip, every speed target met. The voltage ellipse
+/// (`[controller.field_weakening] mtpv`, the q current cut to what the voltage allows) is what
+/// does it: without it the stop from the top speed asks for a q flux no d current removes, the
+/// currents run away and the drive trips. (Its angle criterion is the estimator's: the
+/// standstill under load, docs/range.md.)
+#[test]
+fn a_pm_syrm_brakes_from_its_top_speed_inside_the_voltage_ellipse() {
+    use fado_sim::scenario::{run_config, scenario_config};
+    let base = motor("saturated/pmsyrm-baldor-5k6.toml");
+    let run = |extra: &str| {
+        let text = format!("{base}\n{extra}");
+        let cfg = scenario_config("fullrange", Some(&text), false).unwrap();
+        run_config("fullrange", cfg, None).unwrap()
+    };
+    let out = run("");
+    assert!(!out.metrics.tripped);
+    let speed_checks: Vec<_> = out
+        .checks
+        .iter()
+        .filter(|c| {
+            c.name.starts_with("speed error")
+                || c.name.starts_with("mean speed at the top")
+                || c.name.starts_with("power held")
+        })
+        .collect();
+    assert_eq!(speed_checks.len(), 7, "{speed_checks:?}");
+    for c in speed_checks {
+        assert!(c.passed, "{c:?}");
+    }
+    let off = run("[controller.field_weakening]\nmtpv = false\n");
+    assert!(off.metrics.tripped, "without the voltage ellipse");
+}

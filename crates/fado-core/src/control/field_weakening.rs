@@ -22,6 +22,18 @@
 //! added to the d reference before the torque is solved for, so that a salient rotor's
 //! reluctance torque is accounted for. Below the weakening speed the integrator sits at
 //! zero and the drive is unchanged to the bit.
+//!
+//! **No weakening where no steady state needs it.** At a speed ω̂ the steady-state voltage
+//! of any current within I_max is at most R̂s·I_max + |ω̂|·ψ_max, ψ_max = λ̂f +
+//! max(L̂d, L̂q)·I_max (the stator flux's largest magnitude there). Where that stays below
+//! the usable voltage m·v_dc/√3, a reference beyond it is the current loop's own transient
+//! (L·di/dt of a torque step), which a negative d current cannot relieve: it adds an
+//! L̂d·di_d/dt of its own and takes the room of the q current. There the loop only winds
+//! back towards zero. On the 5 kW PM-SyRM a release hold's torque step from rest saturated
+//! the current loop's voltage, the loop's gain at its speed floor (0.1·ω_rated) drove
+//! Δi_d to −33.5 A in four samples, and the limiter (d first) left no q current while the
+//! load turned the rotor back (`fado-sim run loaded-start`, `motors/pmsyrm-5k.toml`,
+//! `[current_sensor] seed = 2`); the bound is 36 % of its rated speed.
 
 use crate::Real;
 use crate::error::{ConfigError, check};
@@ -84,6 +96,10 @@ pub struct FieldWeakening<T> {
     id_min: T,
     /// Speed floor of the gain, rad/s.
     min_speed: T,
+    /// R̂s·I_max (V) and ψ_max = λ̂f + max(L̂d, L̂q)·I_max (Wb): the largest steady-state
+    /// voltage at ω̂ is their R̂s·I_max + |ω̂|·ψ_max (module docs).
+    rs_i_max: T,
+    psi_max: T,
     flux: T,
     ld: T,
     lq: T,
@@ -115,6 +131,8 @@ impl<T: Real> FieldWeakening<T> {
             margin: m / T::lit(3.0).sqrt(),
             id_min: -characteristic.step_min(i_max),
             min_speed: T::lit(0.1) * machine.rated_speed(),
+            rs_i_max: machine.rs * i_max,
+            psi_max: machine.flux_linkage + machine.ld.step_max(machine.lq) * i_max,
             flux: machine.flux_linkage,
             ld: machine.ld,
             lq: machine.lq,
@@ -144,6 +162,9 @@ impl<T: Real> FieldWeakening<T> {
         if error >= T::zero() && self.delta_id == T::zero() {
             return; // below the weakening speed: nothing to integrate
         }
+        if error < T::zero() && self.rs_i_max + omega.abs() * self.psi_max < limit {
+            return; // no steady state needs weakening here: a current-loop transient
+        }
         let w = omega.abs().step_max(self.min_speed);
         let next = self.delta_id + self.gain * error / w;
         self.delta_id = next.step_min(T::zero()).step_max(self.id_min);
@@ -162,6 +183,23 @@ impl<T: Real> FieldWeakening<T> {
         let psi_d = self.flux + self.ld * id;
         let room = (psi * psi - psi_d * psi_d).step_max(T::zero());
         room.step_sqrt() / self.lq
+    }
+
+    /// The largest stator flux the voltage allows at the speed `omega` (rad/s, electrical) on
+    /// the bus `vdc`, Wb: the hexagon's inscribed circle Vdc/√3 (or the loop's own target
+    /// above it, with overmodulation) over |ω̂|; None below the weakening speed (the loop at
+    /// zero), with the loop or its MTPV limit switched off. The drive cuts the q current to
+    /// it ([`crate::control::drive`], the voltage ellipse): the loop moves i_d only, and
+    /// where the q flux alone reaches the voltage (a synchronous-reluctance rotor,
+    /// L_q·I_max > V/ω) no d current brings the voltage back.
+    #[inline]
+    pub fn ellipse_flux(&self, vdc: T, omega: T) -> Option<T> {
+        if !(self.enabled && self.mtpv && self.delta_id < T::zero()) {
+            return None;
+        }
+        let inscribed = T::one() / T::lit(3.0).sqrt();
+        let w = omega.abs().step_max(self.min_speed);
+        Some(self.margin.step_max(inscribed) * vdc / w)
     }
 
     /// Back to no weakening.
@@ -222,6 +260,39 @@ mod tests {
     }
 
     #[test]
+    fn no_weakening_where_no_steady_state_needs_it() {
+        // The 5 kW PM-SyRM's model (R̂s 0.2 Ω, λ̂f 0.134 Wb, L̂q 17 mH, I_max 40.5 A, 310 V):
+        // ψ_max = 0.134 + 0.017·40.5 = 0.82 Wb, the bound ω = (0.92·310/√3 − 0.2·40.5)/ψ_max
+        // = 191 rad/s. At rest a torque step's transient asks twice the voltage: nothing
+        // is integrated (the loop without the bound: −17.5 A in one sample).
+        let mut m = MachineModel::<f64>::paper();
+        (m.rs, m.ld, m.lq, m.flux_linkage) = (0.2, 4e-3, 17e-3, 0.134);
+        (m.rated_speed_rpm, m.dc_voltage) = (2550.0, 310.0);
+        let vdc = m.dc_voltage;
+        let i_max = 40.5;
+        let mut f = FieldWeakening::new(&FieldWeakeningTuning::default(), &m, i_max, 1e-4).unwrap();
+        let v = 2.0 * vdc / 3f64.sqrt();
+        let psi_max = 0.134 + 0.017 * i_max;
+        let bound = (0.92 * vdc / 3f64.sqrt() - 0.2 * i_max) / psi_max;
+        for w in [0.0, 1.0, 0.1 * m.rated_speed(), 0.99 * bound] {
+            for _ in 0..100 {
+                f.update(v * v, vdc, w);
+            }
+            assert_eq!(f.delta_id(), 0.0, "at {w} rad/s");
+        }
+        // Beyond it the loop weakens as before, and below it again the loop winds back
+        // (a positive margin) but never further down.
+        f.update(v * v, vdc, 1.01 * bound);
+        let weakened = f.delta_id();
+        assert!(weakened < 0.0);
+        f.update(v * v, vdc, 0.5 * bound);
+        assert_eq!(f.delta_id(), weakened);
+        let low = 0.5 * vdc / 3f64.sqrt();
+        f.update(low * low, vdc, 0.5 * bound);
+        assert!(f.delta_id() > weakened);
+    }
+
+    #[test]
     fn mtpv_bound_and_voltage_ellipse() {
         let (mut f, m) = fw();
         let vdc = m.dc_voltage;
@@ -238,5 +309,31 @@ mod tests {
         assert!((iq - psi / m.lq).abs() < 1e-9, "{iq}");
         f.reset();
         assert_eq!(f.delta_id(), 0.0);
+    }
+
+    #[test]
+    fn ellipse_flux_is_the_inscribed_circle_over_the_speed_while_weakening() {
+        let (mut f, m) = fw();
+        let (vdc, w) = (m.dc_voltage, 1000.0);
+        assert_eq!(f.ellipse_flux(vdc, w), None);
+        f.update(4.0 * vdc * vdc, vdc, w);
+        let psi = f.ellipse_flux(vdc, w).unwrap();
+        assert!((psi - vdc / 3f64.sqrt() / w).abs() < 1e-12, "{psi}");
+        // The loop's own target above the inscribed circle (overmodulation) is the bound.
+        let t = FieldWeakeningTuning {
+            voltage_margin: 1.08,
+            ..FieldWeakeningTuning::default()
+        };
+        let mut g = FieldWeakening::new(&t, &m, 40.0, 1e-4).unwrap();
+        g.update(4.0 * vdc * vdc, vdc, w);
+        let psi = g.ellipse_flux(vdc, w).unwrap();
+        assert!((psi - 1.08 * vdc / 3f64.sqrt() / w).abs() < 1e-12, "{psi}");
+        let off = FieldWeakeningTuning {
+            mtpv: false,
+            ..FieldWeakeningTuning::default()
+        };
+        let mut h = FieldWeakening::new(&off, &m, 40.0, 1e-4).unwrap();
+        h.update(4.0 * vdc * vdc, vdc, w);
+        assert_eq!(h.ellipse_flux(vdc, w), None);
     }
 }

@@ -140,6 +140,12 @@ impl<T: Real> SaturatedReferences<T> {
         self.model.flux(i)
     }
 
+    /// The model's flux ψ(i) in Wb, solved from `guess` (the flux at a nearby current).
+    #[inline]
+    pub fn flux_from(&self, i: Dq<T>, guess: Dq<T>) -> Dq<T> {
+        self.model.flux_from(i, guess)
+    }
+
     /// The MTPA point on the circle |i| = `current` (A), i_q ≥ 0 (|(mtpa_id(i_q), i_q)|
     /// grows with i_q: bisection).
     pub fn mtpa_on_circle(&self, current: T) -> Dq<T> {

@@ -96,8 +96,10 @@ pub struct StartupTuning<T> {
     /// once the drive is ready): the gain calibration may then run along an axis other than
     /// the rotor's d axis, whose torque the brake takes — the nearest of the six axes k·π/3
     /// (every phase carrying at least half the current) where the d axis leaves a phase with
-    /// too little (`gain_calibration_min_observability`). Default false: a rotor that no
-    /// brake holds is turned by any current off its d axis.
+    /// too little (`gain_calibration_min_observability`). The start-up then leaves the
+    /// release hold unarmed: the application arms it as it opens the brake
+    /// ([`SensorlessDrive::arm_release_hold`](crate::control::SensorlessDrive::arm_release_hold)).
+    /// Default false: a rotor that no brake holds is turned by any current off its d axis.
     pub rotor_held: bool,
     /// d current of the free-rotor alignment, a multiple of the rated current. Default 0.5
     /// \[A\]: half the rated torque's stiffness turns an unloaded rotor.

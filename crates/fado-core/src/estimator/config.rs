@@ -87,7 +87,7 @@ impl<T: Real> EstimatorConfig<T> {
             t.plausibility.current_step_ratio,
             self.machine.rated_current,
             self.machine.dc_voltage,
-            self.machine.lq,
+            self.machine.lq.step_min(self.machine.ld),
             self.ts,
         )
     }

@@ -72,6 +72,7 @@ use crate::plausibility::SampleBounds;
 use crate::rs_adaptation::{
     ResistanceAdaptationParams, ResistanceAdaptationState, ResistanceScale,
 };
+use crate::speed_notch::{SpeedNotch, SpeedNotchState};
 use crate::tracker::{TrackerParams, TrackerState};
 use crate::{Ab, Real};
 
@@ -180,6 +181,11 @@ pub struct EstimatorParams<T: Real> {
     gain_hold: u32,
     /// `EstimatorTuning::rs_adaptation`: whether the start-up state adapts R̂s.
     rs_adaptation: bool,
+    /// A saturating model's notch on the observer's speed at the electrical frequency
+    /// (`crate::speed_notch`), its floor the Fig. 3 threshold.
+    speed_notch: SpeedNotch<T>,
+    /// `EstimatorTuning::observer.frame_ripple_notch`.
+    frame_ripple_notch: bool,
     integrator: FluxIntegratorParams<T>,
     observer: DisturbanceObserverParams<T>,
     disturbance_feedback: DisturbanceFeedbackParams<T>,
@@ -202,7 +208,7 @@ pub struct EstimatorParams<T: Real> {
 /// counters. Run-time settings live here too: R̂s (`set_rs_hat`, the adaptation), λ̂f (its
 /// law), the adaptation's on switch (`enable_rs_adaptation`) and the k_df switch. Stepped
 /// with [`EstimatorState::step`] / [`EstimatorState::step_lean`] and the
-/// [`EstimatorParams`] it was made for; `size_of` is 256 B or less in `f32`
+/// [`EstimatorParams`] it was made for; `size_of` is 284 B or less in `f32`
 /// (docs/results/firmware-cost.md).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EstimatorState<T: Real> {
@@ -217,6 +223,8 @@ pub struct EstimatorState<T: Real> {
     kdf_gain: T,
     /// The low-passed Kp·e of T2S-1 added to ω̂1 for the observer, rad/s.
     lag_compensation: T,
+    /// A saturating model's notch on the observer's speed (`crate::speed_notch`).
+    speed_notch: SpeedNotchState<T>,
     /// The observer's gains, held between their updates
     /// (`EstimatorTuning::observer_gain_period`).
     observer_gains: ObserverGains<T>,
@@ -255,6 +263,13 @@ pub struct EstimatorState<T: Real> {
     gain_countdown: u32,
     /// `BROKEN_*` bits: which slow law's regime was interrupted since it last ran.
     slow_broken: u8,
+    /// A saturating model's frame coupling exceeds `active_flux::OFFSET_COUPLING_MAX` at the
+    /// operating point of the integrand-offset law's last slot: the law holds, and the
+    /// observer runs at the notched speed.
+    frame_coupled: bool,
+    /// The observer runs at the notched speed (`crate::speed_notch`): `frame_coupled` while
+    /// the machine generates, judged in the same slot.
+    notch_on: bool,
     /// The R̂s adaptation runs: `EstimatorTuning::rs_adaptation`, or switched on by
     /// [`EstimatorState::enable_rs_adaptation`].
     rs_adaptation_on: bool,

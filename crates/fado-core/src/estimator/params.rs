@@ -18,6 +18,7 @@ use crate::observer::{
 };
 use crate::plausibility::SampleBounds;
 use crate::rs_adaptation::ResistanceAdaptationParams;
+use crate::speed_notch::SpeedNotch;
 use crate::tracker::TrackerParams;
 use crate::{Ab, Real};
 
@@ -107,6 +108,8 @@ impl<T: Real> EstimatorParams<T> {
                 T::zero()
             },
             rs_adaptation: config.tuning.rs_adaptation.enabled,
+            speed_notch: SpeedNotch::new(ts, T::two_pi() * threshold_hz),
+            frame_ripple_notch: config.tuning.observer.frame_ripple_notch,
             rs_initial: config.machine.rs,
             hold_level_sq: hold_level * hold_level,
             flux_settle_periods: (T::lit(FLUX_SETTLE_TIME_CONSTANTS)
@@ -140,6 +143,9 @@ impl<T: Real> EstimatorParams<T> {
             t2s2: self.t2s2.state_at(T::zero(), T::zero()),
             kdf_gain: T::zero(),
             lag_compensation: T::zero(),
+            speed_notch: SpeedNotch::state_at(T::zero()),
+            frame_coupled: false,
+            notch_on: false,
             observer_gains: ObserverGains::standstill(),
             feedback: Ab::zero(),
             step_allowance: self.bounds.step(),

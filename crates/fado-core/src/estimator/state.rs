@@ -9,6 +9,7 @@ use crate::lock::LockState;
 use crate::mode::Mode;
 use crate::observer::ObserverState;
 use crate::rotor_flux::{rotor_angle, rotor_flux, stator_flux};
+use crate::speed_notch::SpeedNotch;
 use crate::{Ab, Real};
 
 impl<T: Real> EstimatorState<T> {
@@ -82,6 +83,9 @@ impl<T: Real> EstimatorState<T> {
         self.t2s1 = p.t2s1.state_at(theta0, T::zero());
         self.t2s2 = p.t2s2.state_at(theta0, T::zero());
         self.lag_compensation = T::zero();
+        self.speed_notch = SpeedNotch::state_at(T::zero());
+        self.frame_coupled = false;
+        self.notch_on = false;
         // The observer's gains for ω̂ = 0, held as after any update (so that with the
         // default period they are formed in the slots after the lock detector's, which no
         // slow law uses: see `SLOW_PERIOD`).

@@ -321,10 +321,16 @@ impl<T: Real> EstimatorState<T> {
             self.lag_compensation =
                 p.lag_keep * self.lag_compensation + p.lag_input * c.t2s1.innovation;
         }
+        let observer_speed = c.t2s1.omega + self.lag_compensation;
+        let observer_speed = if SATURATING {
+            self.notch_speed(p, c, observer_speed)
+        } else {
+            observer_speed
+        };
         // The observer's gains for the next sample's speed, once every `gain_hold` + 1
         // samples (see `EstimatorTuning::observer_gain_period`).
         if self.gain_countdown == 0 {
-            self.observer_gains = p.observer.gains(c.t2s1.omega + self.lag_compensation);
+            self.observer_gains = p.observer.gains(observer_speed);
             self.gain_countdown = p.gain_hold;
         } else {
             self.gain_countdown -= 1;
@@ -339,6 +345,31 @@ impl<T: Real> EstimatorState<T> {
         self.kdf_gain = c.kdf_gain;
         self.feedback = c.feedback;
         shift
+    }
+
+    /// A saturating model's observer speed: the notch (`crate::speed_notch`) stepped every
+    /// sample, its ripple removed in the k_df mode where the frame coupling is large and the
+    /// machine generates (ω̂·î_q < 0), the quadrant where the DC loop's two couplings add. Both
+    /// are judged at the operating point of the integrand-offset law's slot (the law holds on
+    /// the same coupling test), once every [`SLOW_PERIOD`] samples.
+    #[inline(always)]
+    fn notch_speed(&mut self, p: &EstimatorParams<T>, c: &Candidate<T>, speed: T) -> T {
+        if self.slot == SLOT_OFFSET {
+            self.frame_coupled = c
+                .point
+                .is_some_and(|point| p.active_flux.holds_offset(&point));
+            self.notch_on = p.frame_ripple_notch
+                && self.frame_coupled
+                && c.point
+                    .is_some_and(|point| point.i_dq.q * c.t2s1.omega < T::zero());
+        }
+        let (notch, ripple) = p.speed_notch.step(&self.speed_notch, speed);
+        self.speed_notch = notch;
+        if self.notch_on && c.mode == Mode::DisturbanceFeedback {
+            speed - ripple
+        } else {
+            speed
+        }
     }
 
     /// Loss-of-lock symptoms (see `lock`), in the detector's slot: |λ̂r| against λ̂f (the
@@ -490,9 +521,7 @@ impl<T: Real> EstimatorState<T> {
         // A saturating model's frame coupling (`crate::active_flux`): where the flux magnitude
         // carries the frame error the law holds ê and the k_df mode stops re-centring at k_e
         // until the next period.
-        let holds = c
-            .point
-            .is_some_and(|point| p.active_flux.holds_offset(&point));
+        let holds = self.frame_coupled;
         if c.point.is_some() && self.rs_adaptation_on {
             self.offset_recentring_gain = if holds {
                 T::zero()

@@ -77,8 +77,9 @@ fn state_size() {
     // scaled constants, since `set_rs_hat` replaces R0 at run time).
     // The trackers' acceleration feed-forward and load integrator (`crate::tracker`) add
     // 2 × 8 B: 264 B in `f32`; the q inductance of eq. (5) the last sample used (a saturating
-    // model's secant, `crate::active_flux`) 4 B more.
-    assert!(s32 <= 272, "{s32}");
+    // model's secant, `crate::active_flux`) 4 B more; a saturating model's notch on the
+    // observer's speed (`crate::speed_notch`: three values and its two flags) 12 B more.
+    assert!(s32 <= 284, "{s32}");
     // The owner is both records and nothing else (padded to its alignment: the parameters
     // may hold a borrowed flux map, pointer-aligned).
     let align = core::mem::align_of::<SensorlessEstimator<f32>>();

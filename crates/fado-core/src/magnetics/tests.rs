@@ -19,6 +19,26 @@ pub(crate) fn syrm() -> Saturation<f64> {
     }
 }
 
+/// The pmsyrm-baldor-5k6 preset's machine model with its saturating model [`pmsyrm`] (leaked:
+/// a test's `'static` model).
+pub(crate) fn pmsyrm_machine() -> MachineModel<f64> {
+    let sat = std::boxed::Box::leak(std::boxed::Box::new(pmsyrm()));
+    MachineModel {
+        rs: 0.63,
+        ld: 0.0298,
+        lq: 0.1497,
+        flux_linkage: 0.4767,
+        pole_pairs: 2,
+        inertia: 0.05,
+        viscous_friction: 1.6e-3,
+        rated_current: 12.45,
+        rated_speed_rpm: 1800.0,
+        rated_torque: 29.7,
+        dc_voltage: 540.0,
+        magnetics: MachineMagnetics::Saturation(sat),
+    }
+}
+
 /// The 5.6 kW PM-SyRM (Baldor ECS101M0H7EF4) fit of motulator's example, with the rib (the
 /// pmsyrm-baldor-5k6 preset's model; the other test modules take it from here).
 pub(crate) fn pmsyrm() -> Saturation<f64> {

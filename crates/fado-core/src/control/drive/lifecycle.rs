@@ -179,7 +179,13 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             T::zero()
         };
         self.clear_control(theta0);
-        self.blocks.hold.arm(theta0);
+        // A rotor that a brake holds through the start-up cannot move: θ̂ moving then is the
+        // estimate's own start transient, which the release hold would wind its integral up
+        // on against the brake. The application arms it as it opens the brake
+        // (`arm_release_hold`; docs/method/additions.md, "Release hold after the start-up").
+        if !self.config.tuning.startup.rotor_held {
+            self.blocks.hold.arm(theta0);
+        }
         self.lock.restart();
         if self.tripped {
             self.trip_output();

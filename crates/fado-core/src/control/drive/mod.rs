@@ -42,6 +42,7 @@ mod standstill;
 mod step;
 pub mod tracker_feedforward;
 pub mod tuning;
+mod voltage_ellipse;
 
 pub use config::DriveConfig;
 pub(crate) use config::swing_time_constant;

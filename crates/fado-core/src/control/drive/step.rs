@@ -358,6 +358,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             };
             let i = self.currents_for_torque(iq_torque, guess, id_added);
             let i = limit_current_d_priority(i, self.resolved.i_max);
+            let i = self.voltage_ellipse(i, vdc, estimate.omega_control);
             let iq_max = self
                 .blocks
                 .field_weakening

@@ -12,21 +12,8 @@ fn stall_torque_band_default_is_the_deficit_of_the_clean_threshold() {
 /// steps do.
 #[test]
 fn saturated_torque_solve_is_the_cold_solve() {
-    use crate::magnetics::MachineMagnetics;
-    use crate::{Dq, MachineModel};
-    let sat = std::boxed::Box::leak(std::boxed::Box::new(crate::magnetics::tests::pmsyrm()));
-    let m = MachineModel {
-        rs: 0.63,
-        ld: 0.0298,
-        lq: 0.1497,
-        flux_linkage: 0.4767,
-        pole_pairs: 2,
-        rated_current: 12.45,
-        rated_speed_rpm: 1800.0,
-        rated_torque: 29.7,
-        magnetics: MachineMagnetics::Saturation(sat),
-        ..MachineModel::paper()
-    };
+    use crate::Dq;
+    let m = crate::magnetics::tests::pmsyrm_machine();
     let config = super::DriveConfig::for_machine(&m);
     let tuning = crate::estimator::EstimatorTuning::default();
     let drive = super::SensorlessDrive::new(config, tuning).unwrap();
@@ -96,5 +83,51 @@ fn the_torque_solve_reaches_every_torque_on_a_non_monotone_path() {
         }
         std::println!("min slope {min_slope:.2}, worst residual {worst:.1e} of the limit");
         assert!(worst < 1e-3, "{sign}: {worst}");
+    }
+}
+
+/// The voltage ellipse (`voltage_ellipse`): while the field-weakening loop weakens, a current
+/// reference whose model flux exceeds the voltage's ψ_max = (Vdc/√3)/|ω̂| has its q current
+/// cut to |ψ| = ψ_max within 2 % (the fixed point's three steps, from above), on the saturated PM-SyRM
+/// (its model's flux) and on a constant-inductance IPMSM (λ̂f + L̂d·i_d, L̂q·i_q); a reference
+/// inside the ellipse, and any reference below the weakening speed, is left alone.
+#[test]
+fn voltage_ellipse_cuts_the_q_current_to_the_voltage() {
+    use crate::{Dq, MachineModel};
+    let pmsyrm = crate::magnetics::tests::pmsyrm_machine();
+    let ipmsm = MachineModel {
+        ld: 0.6 * MachineModel::<f64>::paper().lq,
+        ..MachineModel::paper()
+    };
+    for m in [pmsyrm, ipmsm] {
+        let config = super::DriveConfig::for_machine(&m);
+        let tuning = crate::estimator::EstimatorTuning::default();
+        let mut drive = super::SensorlessDrive::new(config, tuning).unwrap();
+        let vdc = m.dc_voltage;
+        let flux = |i: Dq<f64>| match &drive.resolved.saturated {
+            Some(s) => s.flux(i),
+            None => Dq::new(m.flux_linkage + m.ld * i.d, m.lq * i.q),
+        };
+        let i = Dq::new(-0.8 * m.flux_linkage / m.ld, 1.5 * m.rated_current);
+        // The speed at which the voltage allows half of the reference's flux.
+        let omega = vdc / 3f64.sqrt() / (0.5 * flux(i).norm());
+        // Below the weakening speed: unchanged.
+        assert_eq!(drive.voltage_ellipse(i, vdc, omega), i);
+        // Weakening: the loop's Δi_d < 0 after a sample above its margin.
+        drive.blocks.field_weakening.update(vdc * vdc, vdc, omega);
+        let psi_max = vdc / 3f64.sqrt() / omega;
+        let cut = drive.voltage_ellipse(i, vdc, omega);
+        let psi = flux(cut);
+        assert_eq!(cut.d, i.d);
+        assert!(cut.q < i.q && cut.q > 0.0, "{cut:?}");
+        let n = (psi.d * psi.d + psi.q * psi.q).sqrt();
+        assert!((n - psi_max).abs() < 0.02 * psi_max, "{n} vs {psi_max}");
+        let brake = drive.voltage_ellipse(Dq::new(i.d, -i.q), vdc, omega);
+        assert!(
+            (brake.q + cut.q).abs() < 0.05 * cut.q,
+            "{brake:?} vs {cut:?}"
+        );
+        let inside = Dq::new(i.d, 0.5 * cut.q);
+        assert_eq!(drive.voltage_ellipse(inside, vdc, omega), inside);
     }
 }

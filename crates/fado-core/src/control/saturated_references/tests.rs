@@ -33,21 +33,7 @@ fn machine(a_dq: f64) -> MachineModel<f64> {
 }
 
 fn baldor() -> MachineModel<f64> {
-    let sat = crate::magnetics::tests::pmsyrm();
-    MachineModel {
-        rs: 0.63,
-        ld: 0.0298,
-        lq: 0.1497,
-        flux_linkage: 0.4767,
-        pole_pairs: 2,
-        inertia: 0.05,
-        viscous_friction: 1.6e-3,
-        rated_current: 12.45,
-        rated_speed_rpm: 1800.0,
-        rated_torque: 29.7,
-        dc_voltage: 540.0,
-        magnetics: MachineMagnetics::Saturation(Box::leak(Box::new(sat))),
-    }
+    crate::magnetics::tests::pmsyrm_machine()
 }
 
 #[test]

@@ -148,7 +148,8 @@ impl<T: Real> EstimatorTuning<T> {
     /// This tuning on the paper's path: every addition of fado's to the estimator of Fig. 5
     /// that can be switched off is off — the fixed R̂s (no [`RsAdaptationTuning::enabled`],
     /// hence no λ̂f or integrand-offset law), the observer on λ1 with ω̂ of T2S-1 alone
-    /// ([`ObserverTuning::on_rotor_flux`], [`ObserverTuning::lag_compensation`]), no
+    /// ([`ObserverTuning::on_rotor_flux`], [`ObserverTuning::lag_compensation`], no
+    /// [`ObserverTuning::frame_ripple_notch`]), no
     /// [`LimiterTuning::recentring`], an abrupt k_df ([`DisturbanceFeedbackTuning::ramp_time`]
     /// 0) and the gains (16) formed every sample ([`ObserverTuning::gain_period`] 0). The sample
     /// bounds, the finite test and the loss-of-lock detector stay. What the cost comparisons
@@ -158,6 +159,7 @@ impl<T: Real> EstimatorTuning<T> {
         t.rs_adaptation.enabled = false;
         t.observer.lag_compensation = false;
         t.observer.on_rotor_flux = false;
+        t.observer.frame_ripple_notch = false;
         t.limiter.recentring = false;
         t.disturbance_feedback.ramp_time = T::zero();
         t.observer.gain_period = T::zero();

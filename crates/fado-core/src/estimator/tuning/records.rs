@@ -243,9 +243,23 @@ pub struct ObserverTuning<T> {
     /// sensor seeds 1–8): every run passes, the means of the worst angle error move by at
     /// most 1.1e-3 rad (fig10 0.0562 and 0.0573 rad with the gains every sample and held; docs/method/additions.md).
     pub gain_period: T,
+    /// With a saturating magnetic model: run the observer at its speed without the ripple at
+    /// the electrical frequency (a notch at |ω̂|, `crate::speed_notch`) where the frame
+    /// coupling of `crate::active_flux` exceeds `active_flux::OFFSET_COUPLING_MAX` while the
+    /// machine generates. Default true (ours \[A\]; no effect with constant inductances).
+    ///
+    /// A DC error of λ2 turns θ̂ by a ripple at the electrical frequency; at low speed T2S-1
+    /// passes its rate into the observer's speed, which leaks the rotating flux into D̂, and
+    /// with a frame coupling near 1 that loop grows while the machine generates
+    /// (docs/method/saturation.md, "The slow mode"). Measured (`saturated_replay`, exact
+    /// signals at ±6 % of rated speed): with the notch every slow-mode rate is negative at
+    /// 30, 65 and 100 % of rated torque on the PM-SyRM preset, a made-up automotive IPMSM and
+    /// a made-up ferrite PM-SyRM (frame coupling up to 1.12); without it the PM-SyRM's grows
+    /// while generating at rated torque.
+    pub frame_ripple_notch: bool,
 }
 
-cast_record!(ObserverTuning { gain_period ; on_rotor_flux, lag_compensation });
+cast_record!(ObserverTuning { gain_period ; on_rotor_flux, lag_compensation, frame_ripple_notch });
 
 impl<T: Real> Default for ObserverTuning<T> {
     fn default() -> Self {
@@ -253,6 +267,7 @@ impl<T: Real> Default for ObserverTuning<T> {
             on_rotor_flux: true,
             lag_compensation: true,
             gain_period: T::lit(OBSERVER_GAIN_PERIOD),
+            frame_ripple_notch: true,
         }
     }
 }
