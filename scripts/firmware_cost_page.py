@@ -150,7 +150,7 @@ self-saturation and cross-saturation), a `static` `FluxMap` built and checked by
 |---|---:|---:|
 | one lookup ψ(i), uniform-grid table (`UniformFluxTable::flux`) | {cell(cycles, "uniform_table_lookup", 13)} | {fmt(need(text, "uniform_table_lookup"))} B |
 | one lookup ψ(i), any rectangular grid (`FluxMap::flux`, bilinear, no Jacobian) | {cell(cycles, "flux_map_lookup", 13)} | {fmt(need(text, "flux_map_lookup"))} B |
-| its inverse i(ψ) from the last current (`FluxMap::current_from`, closed form per cell) | {cell(cycles, "flux_map_inverse", 13)} | {fmt(need(text, "flux_map_inverse"))} B |
+| its inverse i(ψ) from the trajectory's previous current (`FluxMap::current_from`, closed form per cell) | {cell(cycles, "flux_map_inverse", 13)} | {fmt(need(text, "flux_map_inverse"))} B |
 
 The uniform table's lookup is straight-line code: the cell index from the precomputed inverse
 node spacing (no search, no division), clamped by one compare, its eight bilinear coefficients
@@ -161,8 +161,10 @@ wrapper's call frame, which an inlined lookup does not pay. {"It meets" if unifo
 the 60-cycle target of a lookup ({fmt(uniform[0])} cycles). `FluxMap` keeps any rectangular
 grid in four borrowed slices: a uniform axis (found so at construction) also gives its cell
 with no load or division, and its two corners per row and table sit behind one bounds check.
-Its inverse solves each bilinear cell's quadratic in closed form from the cell of the last
-current, walking to the neighbouring cell where the solution lies beyond the cell's edge.
+Its inverse solves each bilinear cell's quadratic in closed form from the cell of the warm
+start, jumping once to the cell of that solution's extrapolation and walking to the
+neighbouring cell where the solution lies beyond the cell's edge; the scenario's trajectory
+steps several cells between calls (a plant's sub-step stays in its cell or the next).
 
 The estimator's step with the uniform table as its machine's model (`MachineModel::magnetics =
 MachineMagnetics::Uniform(&UNIFORM_MAP)`, a `static` `UniformFluxMap` borrowing the table in

@@ -14,8 +14,9 @@
 //! [`super::FluxMap::new`] accepts has ψd increasing in i_d along every row, so the
 //! denominator ex_d + twist_d·v is positive across the cell.
 //!
-//! The inverse starts in the cell of a warm start (the last current) and walks to the
-//! neighbouring cell the solution points into until the solution lies in the cell it was
+//! The inverse starts in the cell of a warm start (the last current), jumps once to the cell
+//! of that cell's extrapolated solution, and from there walks to the neighbouring cell the
+//! solution points into until the solution lies in the cell it was
 //! solved in (to [`CELL_TOLERANCE_EPS`]), or beyond the grid in an edge cell (the map's linear
 //! extension); the result reproduces ψ to a few ulp (tested). Each cell costs one square root
 //! and three divisions; a plant's sub-step stays in its cell or
@@ -178,7 +179,7 @@ pub(super) fn invert<T: Real>(grid: &impl CellGrid<T>, psi: Dq<T>, guess: Dq<T>)
     let (last_k, last_m) = grid.last_cell();
     let (mut k, mut m) = grid.cell_of(guess);
     let tol = T::default_epsilon() * T::lit(CELL_TOLERANCE_EPS);
-    for _ in 0..last_k + last_m + 2 {
+    for walk in 0..last_k + last_m + 2 {
         let cell = grid.polynomial(k, m);
         let root = cell.solve(psi);
         // No real root: the point lies where this cell's extension folds; its linearisation
@@ -190,6 +191,15 @@ pub(super) fn invert<T: Real>(grid: &impl CellGrid<T>, psi: Dq<T>, guess: Dq<T>)
             let (u, v) = root?;
             let i = grid.current_at(k, m, u, v);
             return i.is_finite().then_some(i);
+        }
+        if walk == 0 && u.is_finite() && v.is_finite() {
+            // From the warm start's cell, straight to the cell of this cell's extrapolated
+            // solution (a Newton step's worth): a far warm start costs two or three cells.
+            let jump = grid.cell_of(grid.current_at(k, m, u, v));
+            if jump != (k, m) {
+                (k, m) = jump;
+                continue;
+            }
         }
         k = k.wrapping_add_signed(dk);
         m = m.wrapping_add_signed(dm);
