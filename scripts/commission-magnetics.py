@@ -160,11 +160,12 @@ reversals, over the run for `stops`), "trip" when a seed tripped, and the seeds 
 LIMITS = """
 ## Limits
 
-- The PM-SyRM presets (`pmsyrm-baldor-5k6`, `pmsyrm-baldor-5k6-measured`) pass the three
-  scenarios on every seed with their true model, and the algebraic preset with its
-  commissioned model too; the measured map's commissioned model does not: its identified
-  incremental inductances are off by up to a third at the edges of the rated range (below),
-  and the closed loop on it loses the angle near zero speed under load.
+- Every preset passes the three scenarios on every seed with its true and with its
+  commissioned model. On the PM-SyRM's measured map the commissioned model's incremental
+  inductances are off by up to a third at the edges of the rated range (below); the estimator
+  holds with it because its turning R̂s law freezes where the frame coupling is large
+  (docs/method/saturation.md, "The offset law's gate"), where it would read that model error
+  as resistance.
 - On these machines the identified λ̂f is high by 3 % (algebraic model) and 8 % (measured
   map): the back-EMF windows run at a d current of −½ the test limit and read the active flux
   through constant L̂d, L̂q. The pulses' fit takes this λ̂f as the magnet's flux, so it

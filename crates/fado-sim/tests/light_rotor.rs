@@ -1,8 +1,8 @@
 //! A light rotor through the range scenarios (`fado_core::control::speed_bandwidth`): a
 //! 22-pole-pair gimbal motor whose mechanical time constant Ĵ·Ω_rated/T_rated is 5 ms. With the
-//! paper's 5 Hz speed loop `fullrange`'s load step reverses it within 10 ms, the load drives it
-//! beyond the speed at which the voltage limit leaves the drive its torque and the drive
-//! trips; with the bandwidth of its load step (15.8 Hz, T2S-2 at 111 Hz) both range scenarios
+//! paper's 5 Hz speed loop `fullrange`'s load step reverses it within 10 ms and the load drives
+//! it beyond the speed at which the voltage limit leaves the drive its torque: the speed
+//! stays thousands of r/min off its reference after the step and the scenario fails; with the bandwidth of its load step (15.8 Hz, T2S-2 at 111 Hz) both range scenarios
 //! hold the angle. Switching-resolved, default non-idealities, current-sensor seed 1.
 
 use fado_sim::SimConfig;
@@ -27,12 +27,14 @@ fn light_rotor_holds_both_range_scenarios_with_the_bandwidth_of_its_load_step() 
         );
     }
     // The rule off: the paper's 5 Hz speed loop and 35 Hz T2S-2.
-    let (angle, tripped, _) = run(
+    let (angle, tripped, passed) = run(
         "fullrange",
         "[controller.speed]\nload_step_dip_ratio = 1e9\n",
     );
-    println!("gimbal fullrange without the rule: {angle:.3} rad, tripped {tripped}");
-    assert!(tripped, "the case does not need the rule");
+    println!(
+        "gimbal fullrange without the rule: {angle:.3} rad, tripped {tripped}, passed {passed}"
+    );
+    assert!(!passed, "the case does not need the rule");
 }
 
 /// `--dump-config` shows the raised bandwidths as derived, with their rule.

@@ -38,7 +38,7 @@ fn datasheet_multirotor_motors_start_under_their_rated_load() {
     // its design travel: the current loop raised to 10·ω_h) and the MAD 5010 start.
     // Measured: MN4004 backward 0.33–0.45 rad, |θ − θ̂| 0.19–0.22 rad (its motion threshold the
     // quiet current's reading, 0.106 rad: `MotionMonitor::threshold`);
-    // MAD 5010 seeds 1, 3, 4 0.31–0.32 / 0.14–0.18 rad.
+    // MAD 5010 seeds 1, 3, 4 0.31–0.32 / 0.14–0.18 rad (seed 2 below).
     for (name, motor, seeds) in [
         ("U8 II", U8, &[1u64, 2, 3, 4][..]),
         ("MN4004", MN4004, &[1, 2, 3, 4][..]),
@@ -52,12 +52,12 @@ fn datasheet_multirotor_motors_start_under_their_rated_load() {
 }
 
 /// Seed 2 puts the rotor at −1.66 rad, where the holding d current leaves phase a's current
-/// near zero: the dead-time compensation's edge-current prediction (PWM ripple 8 A p-p against
-/// a 0.41 A band) leaves a voltage error that hides the rotor's fall from the estimator at the
-/// release (backward 0.72 rad, |θ − θ̂| 0.40 rad; with the dead time at 0 it passes at 0.32 /
-/// 0.15 rad). Not solved: kept as the failing case.
+/// near zero: inside the inverter's dead-time band, whose edge currents the PWM ripple (ΔI
+/// 1.08 A against a 0.41 A band) moves, the compensation's error hid the rotor's fall from the
+/// estimator (backward 0.72 rad, |θ − θ̂| 0.40 rad). The release's d-current floor
+/// (`fado_core::control::release_current`) takes every phase out of the band while the brake
+/// opens: measured 0.31 / 0.16 rad.
 #[test]
-#[ignore = "open: the dead-time compensation at a phase-current zero crossing on a 10 µH rotor"]
 fn mad_5010_seed_2_starts_under_its_rated_load() {
     let out = run("loaded-start", "MAD 5010", MAD5010, 2);
     assert!(out.passed, "{:?}", out.checks);

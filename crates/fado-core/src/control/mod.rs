@@ -18,6 +18,7 @@ pub mod modulation;
 pub mod monitor;
 pub mod pi;
 pub mod ratings_limit;
+pub mod release_current;
 pub mod release_hold;
 pub mod saturated_references;
 pub mod speed_controller;
@@ -42,6 +43,7 @@ pub use modulation::{Modulation, ModulatorConfig, SpaceVectorModulator, VoltageL
 pub use monitor::{DriveFlags, FlagCounts};
 pub use pi::{Pi, PiConfig};
 pub use ratings_limit::{RatingsLimit, RatingsLimitTuning};
+pub use release_current::ReleaseCurrent;
 pub use release_hold::{ReleaseHold, ReleaseHoldTuning};
 pub use speed_controller::{SpeedController, SpeedControllerConfig, limit_current_d_priority};
 pub use standstill_probe::{StandstillProbe, StandstillProbeConfig};

@@ -196,6 +196,8 @@ pub struct ReleaseHold<T> {
     ki_ts: T,
     i_max: T,
     armed: bool,
+    /// Armed by [`arm_at_release`](Self::arm_at_release) (the brake opened).
+    released: bool,
     active: bool,
     elapsed: u32,
     theta_hold: T,
@@ -251,6 +253,7 @@ impl<T: Real> ReleaseHold<T> {
             ki_ts,
             i_max,
             armed: false,
+            released: false,
             active: false,
             elapsed: 0,
             theta_hold: T::zero(),
@@ -266,6 +269,7 @@ impl<T: Real> ReleaseHold<T> {
     /// Arms the hold at the angle `theta_hold` (the alignment's).
     pub fn arm(&mut self, theta_hold: T) {
         self.armed = self.enabled && theta_hold.is_finite();
+        self.released = false;
         self.active = false;
         self.elapsed = 0;
         self.held = 0;
@@ -280,6 +284,18 @@ impl<T: Real> ReleaseHold<T> {
     pub fn disarm(&mut self) {
         self.armed = false;
         self.active = false;
+    }
+
+    /// Armed by [`arm_at_release`](Self::arm_at_release) and not acting: from the
+    /// application's brake opening until the rotor moves or the trigger window closes.
+    pub fn awaiting_fall(&self) -> bool {
+        self.released && self.armed && !self.active
+    }
+
+    /// [`arm`](Self::arm) at the moment the application opens its brake.
+    pub fn arm_at_release(&mut self, theta_hold: T) {
+        self.arm(theta_hold);
+        self.released = self.armed;
     }
 
     /// Holding now.

@@ -70,6 +70,18 @@
 //! a probe that stopped there would forget ĉ each time. The probe stops (Δi_d = 0, no turn,
 //! ĉ forgotten) the sample the standstill ends.
 //!
+//! **At a brake's release** ([`StandstillProbe::arm_at_release`], from
+//! `SensorlessDrive::arm_release_hold`) the arming time is one period (0.1 s) instead: the
+//! standstill that follows is no passage through zero — the load was there, on the brake,
+//! and the reference stays at zero — and the creep of θ̂ runs from the release on (0.45 rad/s
+//! on the hub motor under its rated load, the release hold keeping θ̂, not the rotor, where it
+//! was). One period lets the hold catch the falling rotor first (its largest travel comes at
+//! 2/ω_h, 53 ms on the hub motor, the presets' slowest). Measured on `loaded-start`
+//! (seeds 1–4, every preset): arming 0.02 s after the release the hub motor reads its first
+//! period during the catch (|θ − θ̂| 0.29 rad on seeds 2 and 3); 0.05–0.1 s holds the hub motor
+//! within 0.14–0.22 rad and the measured 1.1 kW map within 0.2–0.22 rad (seed 2: 0.33 and
+//! 0.39 rad without it); 0.15–0.2 s leaves the 1.1 kW map 0.26–0.29 rad.
+//!
 //! **Flux-magnitude hold.** While the probe runs, the drive also holds the estimate's rotor
 //! flux on the model's circle, |λ̂r| = λ̂a at the last current reference
 //! ([`crate::estimator::SensorlessEstimator::hold_flux_magnitude`], radially at the limiter's
@@ -132,6 +144,8 @@ pub struct StandstillProbe<T> {
     period_samples: u32,
     /// Samples the gate holds before the probe starts (≥ 1).
     arm_samples: u32,
+    /// The standstill a brake's release begins: armed after one period (module docs).
+    release: bool,
     /// Samples the standstill has held since it last ended (saturating at the arming time).
     gated: u32,
     /// Probing: armed, and the estimator has been in limiter mode since.
@@ -198,6 +212,23 @@ impl<T: Real> StandstillProbe<T> {
         Ok(probe)
     }
 
+    /// A brake opens now: the standstill that follows arms the probe after one period
+    /// instead of the arming time (module docs, "At a brake's release"), until the probe
+    /// starts or the speed reference `omega_ref` leaves the standstill
+    /// ([`Self::leave_release`]).
+    pub fn arm_at_release(&mut self) {
+        self.release = true;
+    }
+
+    /// Ends the release's short arming once the speed reference `omega_ref` (rad/s
+    /// electrical) leaves the standstill.
+    #[inline]
+    pub fn leave_release(&mut self, omega_ref: T) {
+        if self.release && omega_ref.abs() > self.config.max_speed {
+            self.release = false;
+        }
+    }
+
     /// Back to idle (no probe, no turn).
     pub fn reset(&mut self) {
         *self = Self {
@@ -205,6 +236,7 @@ impl<T: Real> StandstillProbe<T> {
             inv_period: self.inv_period,
             inv_count: self.inv_count,
             arm_samples: self.arm_samples,
+            release: self.release,
             ..Self::new_idle(self.config, self.period_samples)
         };
     }
@@ -214,6 +246,7 @@ impl<T: Real> StandstillProbe<T> {
             config,
             period_samples,
             arm_samples: 1,
+            release: false,
             gated: 0,
             probing: false,
             phase: 0,
@@ -270,7 +303,12 @@ impl<T: Real> StandstillProbe<T> {
             return T::zero();
         }
         let n = self.period_samples;
-        if self.gated < self.arm_samples {
+        let arm = if self.release {
+            self.arm_samples.min(n)
+        } else {
+            self.arm_samples
+        };
+        if !self.probing && self.gated < arm {
             // Armed after the gate has held for the arming time: no probe yet.
             self.gated += 1;
             return T::zero();
@@ -280,6 +318,7 @@ impl<T: Real> StandstillProbe<T> {
                 return T::zero();
             }
             self.probing = true;
+            self.release = false;
         }
         let half = n / 2;
         let (sign, in_half) = if self.phase < half {
@@ -710,5 +749,37 @@ mod tests {
             assert_eq!(step(&mut p, true, true), 0.0);
         }
         assert!(!p.active());
+    }
+
+    /// At a brake's release the probe arms after one period (0.2 s here) instead of the
+    /// arming time (0.5 s), and keeps probing once started; a speed reference that leaves
+    /// the standstill before it starts ends the short arming.
+    #[test]
+    fn a_brake_release_arms_the_probe_after_one_period() {
+        let (tau, flux) = (14.0, 0.1);
+        let config = StandstillProbeConfig {
+            arm_time: 0.5,
+            ..probe(2.2).config
+        };
+        let step =
+            |p: &mut StandstillProbe<f64>| p.step(true, true, tau, 0.0, (0.0, tau), flux, 0.0);
+        let mut p = StandstillProbe::new(config).unwrap();
+        p.arm_at_release();
+        p.leave_release(0.5); // within the standstill's speed bound (1 rad/s)
+        for _ in 0..200 {
+            assert_eq!(step(&mut p), 0.0);
+        }
+        assert_ne!(step(&mut p), 0.0, "armed after one period");
+        assert!(p.active());
+        let probed = (0..1000).filter(|_| step(&mut p) != 0.0).count();
+        assert!(p.active() && probed > 500, "{probed}");
+        // Left before it started: the arming time again.
+        let mut q = StandstillProbe::new(config).unwrap();
+        q.arm_at_release();
+        q.leave_release(2.0);
+        for _ in 0..400 {
+            assert_eq!(step(&mut q), 0.0);
+        }
+        assert!(!q.active());
     }
 }

@@ -455,7 +455,12 @@ impl<T: Real> EstimatorState<T> {
         v_ab: Ab<T>,
         i_ab: Ab<T>,
     ) {
-        let regime = if broken & BROKEN_RS != 0 {
+        // A saturating model's frame coupling above `active_flux::OFFSET_COUPLING_MAX` freezes
+        // the turning law as it holds the offset law: with the current loop holding î, a
+        // frame error moves |λ̂r| by σ·δ, which the law would read as resistance (a model
+        // error's angle, amplified; docs/method/saturation.md, "The offset law's gate").
+        let coupled = SATURATING && self.frame_coupled && c.mode == Mode::DisturbanceFeedback;
+        let regime = if broken & BROKEN_RS != 0 || coupled {
             AdaptationRegime::Frozen
         } else {
             match c.mode {

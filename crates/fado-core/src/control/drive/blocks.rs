@@ -10,6 +10,7 @@ use crate::control::field_weakening::FieldWeakening;
 use crate::control::lock_reaction::LockSupervisor;
 use crate::control::modulation::{ModulatorConfig, SpaceVectorModulator};
 use crate::control::ratings_limit::RatingsLimit;
+use crate::control::release_current::ReleaseCurrent;
 use crate::control::release_hold::ReleaseHold;
 use crate::control::saturated_references::SaturatedReferences;
 use crate::control::speed_controller::{SpeedController, SpeedControllerConfig};
@@ -118,6 +119,7 @@ impl<T: Real> Blocks<T> {
         let limits = RatingsLimit::new(&t.limits, m)?;
         Ok(Self {
             hold,
+            release_current: ReleaseCurrent::for_inverter(m, dead_time.config()),
             speed,
             injection,
             current,

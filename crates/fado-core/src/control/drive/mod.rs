@@ -59,6 +59,7 @@ use crate::control::lock_reaction::LockSupervisor;
 use crate::control::modulation::SpaceVectorModulator;
 use crate::control::monitor::{DriveFlags, FlagCounts, PersistenceMonitor, StuckChannelDetector};
 use crate::control::ratings_limit::RatingsLimit;
+use crate::control::release_current::ReleaseCurrent;
 use crate::control::release_hold::ReleaseHold;
 use crate::control::saturated_references::SaturatedReferences;
 use crate::control::speed_controller::SpeedController;
@@ -151,6 +152,8 @@ struct Blocks<T> {
     field_weakening: FieldWeakening<T>,
     /// The release hold after the start-up.
     hold: ReleaseHold<T>,
+    /// The d-current floor while the hold is armed (no phase in the dead-time band).
+    release_current: ReleaseCurrent<T>,
     limits: RatingsLimit<T>,
 }
 

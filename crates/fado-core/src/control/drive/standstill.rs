@@ -19,6 +19,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         action: LockAction,
     ) -> T {
         let probe = &mut self.blocks.probe;
+        probe.leave_release(speed_ref);
         let gate = probe.gate(speed_ref, iq_torque, action == LockAction::Run);
         let m = &self.config.machine;
         let last = self.last.i_dq_ref;

@@ -357,6 +357,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
                 probe_id
             };
             let i = self.currents_for_torque(iq_torque, guess, id_added);
+            let i = self.release_current_floor(i, estimate.theta, vdc);
             let i = limit_current_d_priority(i, self.resolved.i_max);
             let i = self.voltage_ellipse(i, vdc, estimate.omega_control);
             let iq_max = self

@@ -52,7 +52,9 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         let mut iq = i.q;
         for _ in 0..ELLIPSE_STEPS {
             let psi = flux(Dq::new(i.d, iq));
-            if !(psi.d * psi.d + psi.q * psi.q > limit_sq) || psi.q == T::zero() {
+            // Inside the ellipse, or a non-finite flux (NaN compares false): no cut.
+            let outside = psi.d * psi.d + psi.q * psi.q > limit_sq;
+            if !outside || psi.q == T::zero() {
                 break;
             }
             let room = (limit_sq - psi.d * psi.d).step_max(T::zero());
