@@ -12,16 +12,20 @@
 # in the same run and reported apart (docs/results/firmware-cost.md); scenarios 6 and 7 the
 # same with the observer's gains held as fado's default holds them (paper_kernel_held_step),
 # 8 and 9 the default step on a salient IPMSM, 10 and 11 the same IPMSM saturating, its model a
-# 16 × 16 flux map in flash, scenario 12 the whole drive (drive_step) around a simulated motor
+# 16 × 16 flux map in flash as a uniform-grid table (MachineMagnetics::Uniform), scenario 12 the whole drive (drive_step) around a simulated motor
 # (docs/results/firmware-cost.md); scenario 13 that flux map alone
 # (examples/cortex-m/src/flux_lookup.rs): one lookup ψ(i) (flux_map_lookup) and its inverse
 # i(ψ) by Newton from a warm start (flux_map_inverse), and the same lookup in the uniform-grid
 # table (uniform_table_lookup: UniformFluxTable::flux).
 # Needs qemu-system-arm and binutils-arm-none-eabi (Debian packages of those names).
+# Writes docs/results/firmware-cost.md whole from what it prints (scripts/firmware_cost_page.py).
 # Usage: bash scripts/firmware-cost.sh [STEPS_MEASURED_PER_SCENARIO (default 300)]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 tail_steps="${1:-300}"
+
+# Everything measured, printed (the page below is generated from this output).
+measure() {
 
 for tool in qemu-system-arm arm-none-eabi-objdump; do
     command -v "$tool" >/dev/null || {
@@ -60,7 +64,7 @@ timeout 900 "${qemu[@]}" -singlestep -d exec,nochain -dfilter "$filter" -D "$log
 roots=(estimator_step paper_kernel_step paper_kernel_held_step drive_step flux_map_lookup
     flux_map_inverse uniform_table_lookup)
 titles=(
-    "fado's step (estimator_step: scenarios 0-1 default, 2-3 fixed R̂s, 4-5 the paper's path, 6-7 the paper's path with the gains held over fado's default period, 8-9 a salient IPMSM, 10-11 the same saturating with a 16 × 16 flux map in flash)"
+    "fado's step (estimator_step: scenarios 0-1 default, 2-3 fixed R̂s, 4-5 the paper's path, 6-7 the paper's path with the gains held over fado's default period, 8-9 a salient IPMSM, 10-11 the same saturating with a 16 × 16 uniform flux table in flash)"
     "the paper's estimator alone (paper_kernel_step, beside fado's paper's path: scenarios 4-5)"
     "the same with the gains held (paper_kernel_held_step, beside scenarios 6-7)"
     "the whole drive (drive_step: SensorlessDrive<f32>::step, fado's estimator inside; scenario 12)"
@@ -74,3 +78,9 @@ for k in "${!roots[@]}"; do
     python3 scripts/firmware_cost.py trace "$image" "${roots[$k]}" "$log" "$tail_steps" \
         "${roots[@]:0:$k}" "${roots[@]:$((k + 1))}"
 done
+}
+
+page_log=$(mktemp /tmp/fado-firmware-page.XXXXXX)
+trap 'rm -f "$page_log"' EXIT
+measure | tee "$page_log"
+python3 scripts/firmware_cost_page.py "$page_log" docs/results/firmware-cost.md

@@ -194,6 +194,8 @@ pub fn to_f32(m: &MachineMagnetics<f64>) -> Option<MachineMagnetics<f32>> {
             };
             interned_map_f32(data).map(MachineMagnetics::Map)
         }
+        // Only firmware builds a uniform table (a `static` of its own precision).
+        MachineMagnetics::Uniform(_) => None,
     }
 }
 

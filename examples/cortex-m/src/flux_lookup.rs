@@ -7,7 +7,7 @@
 //! firmware does with a map measured or computed off line.
 
 use fado_core::Dq;
-use fado_core::magnetics::{FluxMap, FluxTable, MagneticModel, UniformFluxTable};
+use fado_core::magnetics::{FluxMap, FluxTable, MagneticModel, UniformFluxMap, UniformFluxTable};
 
 /// Nodes per axis.
 pub const N: usize = 16;
@@ -49,12 +49,16 @@ const fn table() -> FluxTable<f32, N, N> {
 pub static TABLE: FluxTable<f32, N, N> = table();
 
 /// The table as a checked map, in flash too (built and checked by the compiler,
-/// `FluxTable::const_map`): what a saturating machine's `MachineModel` borrows.
+/// `FluxTable::const_map`): any rectangular grid's form.
 pub static MAP: FluxMap<'static, f32> = TABLE.const_map();
 
 /// The same table for the uniform-grid lookup (`UniformFluxTable`: interleaved nodes, the
 /// shape in the type), in flash, built and checked by the compiler.
 pub static UNIFORM: UniformFluxTable<f32, N, N> = UniformFluxTable::from_f32_table(&TABLE);
+
+/// [`UNIFORM`] borrowed with its shape at run time, in flash too: what the saturating
+/// machine's `MachineModel` borrows (`MachineMagnetics::Uniform`).
+pub static UNIFORM_MAP: UniformFluxMap<'static, f32> = UNIFORM.map();
 
 /// ψ(i) from [`UNIFORM`]: the lookup a firmware's own code makes in its interrupt.
 #[inline(never)]

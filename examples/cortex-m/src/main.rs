@@ -101,7 +101,7 @@ const PAPER_PATH_HELD: usize = 3;
 /// the active-flux terms of a salient rotor, which the paper's motor (Ld = Lq) never runs.
 const SALIENT: usize = 4;
 /// The default configuration for [`ipmsm_2k2_map`]: the step of a saturating model, its
-/// active flux from the 16 × 16 flux map in flash.
+/// active flux from the 16 × 16 uniform-grid flux table in flash.
 const SATURATING_MAP: usize = 5;
 
 /// The 2.2 kW interior-magnet motor of `motors/ipmsm-2k2.toml` (motulator's example motor,
@@ -124,12 +124,12 @@ fn ipmsm_2k2() -> MachineModel<f32> {
     }
 }
 
-/// [`ipmsm_2k2`] saturating: its magnetics the 16 × 16 flux map in flash
-/// ([`flux_lookup::MAP`], q self-saturation and cross-saturation), the constant fields the
-/// map's values at zero current.
+/// [`ipmsm_2k2`] saturating: its magnetics the 16 × 16 flux map in flash as a uniform-grid
+/// table ([`flux_lookup::UNIFORM_MAP`], q self-saturation and cross-saturation), the constant
+/// fields the map's values at zero current.
 fn ipmsm_2k2_map() -> MachineModel<f32> {
     MachineModel {
-        magnetics: MachineMagnetics::Map(&flux_lookup::MAP),
+        magnetics: MachineMagnetics::Uniform(&flux_lookup::UNIFORM_MAP),
         ..ipmsm_2k2()
     }
 }
@@ -243,7 +243,7 @@ const SCENARIOS: [Scenario; 12] = [
         salient: true,
     },
     Scenario {
-        name: "low speed, R^s adaptation, ipmsm-2k2 saturating, 16 x 16 flux map in flash",
+        name: "low speed, R^s adaptation, ipmsm-2k2 saturating, 16 x 16 uniform flux table in flash",
         speed_hz: 19.5,
         ramp_s: 0.05,
         hold_samples: 1000,
@@ -252,7 +252,7 @@ const SCENARIOS: [Scenario; 12] = [
         salient: true,
     },
     Scenario {
-        name: "rated speed, R^s adaptation, ipmsm-2k2 saturating, 16 x 16 flux map in flash",
+        name: "rated speed, R^s adaptation, ipmsm-2k2 saturating, 16 x 16 uniform flux table in flash",
         speed_hz: 75.0,
         ramp_s: 0.2,
         hold_samples: 1000,

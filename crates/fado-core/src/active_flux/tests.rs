@@ -14,6 +14,7 @@ fn active(model: Magnetics<'static, f64>, rated: f64) -> Option<ActiveFlux<f64>>
         Magnetics::Constant(_) => MachineMagnetics::Linear,
         Magnetics::Saturation(s) => MachineMagnetics::Saturation(Box::leak(Box::new(s))),
         Magnetics::Map(m) => MachineMagnetics::Map(Box::leak(Box::new(m))),
+        Magnetics::Uniform(m) => MachineMagnetics::Uniform(Box::leak(Box::new(m))),
     };
     let machine = MachineModel {
         rated_current: rated,

@@ -2,7 +2,8 @@
 
 use core::fmt;
 
-use super::{InductanceMatrix, MagneticModel, newton};
+use super::cell_inverse::{self, CellGrid, CellPolynomial};
+use super::{InductanceMatrix, MagneticModel};
 use crate::{Dq, Real};
 
 /// A flux map on the rectangular grid `i_d` × `i_q` (both strictly increasing), borrowed:
@@ -345,15 +346,18 @@ impl<T: Real> MagneticModel<T> for FluxMap<'_, T> {
         Dq::new(bilinear_value(cd, fx, fy), bilinear_value(cq, fx, fy))
     }
 
-    /// Newton from the map's linearisation at zero current.
+    /// From the map's linearisation at zero current.
     fn current(&self, psi: Dq<T>) -> Dq<T> {
-        let (psi0, l0) = self.flux_and_jacobian(Dq::zero());
-        self.current_from(psi, l0.solve(psi - psi0))
+        let at_zero = self.flux_and_jacobian(Dq::zero());
+        cell_inverse::current_from_zero(psi, at_zero, |p, g| self.current_from(p, g))
     }
 
+    /// In closed form, cell by cell from the cell of `guess` (each cell's bilinear map inverts
+    /// as a quadratic; see the module docs' Inversion); by Newton's method from `guess` where
+    /// that finds no root.
     fn current_from(&self, psi: Dq<T>, guess: Dq<T>) -> Dq<T> {
         let scale = self.i_d.last().map_or(T::one(), |x| x.abs()) * T::lit(1e-6);
-        newton(psi, guess, scale, |i| self.flux_and_jacobian(i)).0
+        cell_inverse::current_from(self, psi, guess, scale, |i| self.flux_and_jacobian(i))
     }
 
     #[inline]
@@ -364,6 +368,47 @@ impl<T: Real> MagneticModel<T> for FluxMap<'_, T> {
     #[inline]
     fn flux_and_inductance(&self, i: Dq<T>) -> (Dq<T>, InductanceMatrix<T>) {
         self.flux_and_jacobian(i)
+    }
+}
+
+impl<T: Real> CellGrid<T> for FluxMap<'_, T> {
+    #[inline]
+    fn last_cell(&self) -> (usize, usize) {
+        (self.i_d.len().max(2) - 2, self.i_q.len().max(2) - 2)
+    }
+
+    #[inline]
+    fn cell_of(&self, i: Dq<T>) -> (usize, usize) {
+        let (k, _, _) = cell(self.i_d, &self.axis_d, i.d);
+        let (m, _, _) = cell(self.i_q, &self.axis_q, i.q);
+        (k, m)
+    }
+
+    #[inline]
+    fn polynomial(&self, k: usize, m: usize) -> CellPolynomial<T> {
+        let nq = self.i_q.len();
+        let at = k * nq + m;
+        let corner = |t: &[T]| {
+            let (p00, p01) = pair(t, at);
+            let (p10, p11) = pair(t, at + nq);
+            (p00, p10 - p00, p01 - p00, p11 - p10 - p01 + p00)
+        };
+        let (d, q) = (corner(self.psi_d), corner(self.psi_q));
+        CellPolynomial {
+            p00: Dq::new(d.0, q.0),
+            ex: Dq::new(d.1, q.1),
+            ey: Dq::new(d.2, q.2),
+            twist: Dq::new(d.3, q.3),
+        }
+    }
+
+    #[inline]
+    fn current_at(&self, k: usize, m: usize, u: T, v: T) -> Dq<T> {
+        let along = |axis: &[T], j: usize, f: T| {
+            let (a, b) = pair(axis, j);
+            a + f * (b - a)
+        };
+        Dq::new(along(self.i_d, k, u), along(self.i_q, m, v))
     }
 }
 

@@ -10,7 +10,7 @@
 //! two words larger than the constant-inductance one (a configuration copied by value stays
 //! small enough for a freestanding image, which has no `memcpy`).
 
-use super::{FluxMap, MagneticModel, Magnetics, Saturation};
+use super::{FluxMap, MagneticModel, Magnetics, Saturation, UniformFluxMap};
 use crate::{Dq, Real};
 
 /// The magnetic model of a [`MachineModel`](crate::MachineModel).
@@ -23,6 +23,9 @@ pub enum MachineMagnetics<T: 'static> {
     Saturation(&'static Saturation<T>),
     /// A flux map on a rectangular grid, borrowed for the program's life.
     Map(&'static FluxMap<'static, T>),
+    /// A flux map on a uniform grid ([`super::UniformFluxTable`]'s lookup: no search, each
+    /// cell's coefficients precomputed), borrowed for the program's life.
+    Uniform(&'static UniformFluxMap<'static, T>),
 }
 
 impl<T: Real> MachineMagnetics<T> {
@@ -48,6 +51,11 @@ impl<T: Real> MachineMagnetics<T> {
                 m.downcast_ref::<FluxMap<'static, U>>()
                     .map(MachineMagnetics::Map)
             }
+            MachineMagnetics::Uniform(m) => {
+                let m: &'static dyn core::any::Any = m;
+                m.downcast_ref::<UniformFluxMap<'static, U>>()
+                    .map(MachineMagnetics::Uniform)
+            }
         }
     }
 
@@ -58,6 +66,7 @@ impl<T: Real> MachineMagnetics<T> {
             MachineMagnetics::Linear => Magnetics::Constant(linear),
             MachineMagnetics::Saturation(s) => Magnetics::Saturation(*s),
             MachineMagnetics::Map(m) => Magnetics::Map(*m),
+            MachineMagnetics::Uniform(m) => Magnetics::Uniform(*m),
         }
     }
 }

@@ -29,7 +29,12 @@
 //!   For a magnetically linear machine it is 1.5·p·(λf·i_q + (Ld − Lq)·i_d·i_q).
 //!
 //! # Inversion
-//! The form that is not a model's own (ψ(i) of a current map, i(ψ) of a flux map) is solved by
+//! A flux map's i(ψ) is solved in closed form: inside one cell the bilinear map is inverted by
+//! a quadratic, starting in the cell of a warm start (a plant's last current) and walking to
+//! the neighbouring cell the solution points into, one or two cells per inversion — Newton's
+//! method on the whole map needs three evaluations or more and stalls on the kinks of its
+//! Jacobian at the cell edges (it remains the fallback where a cell's quadratic has no real
+//! root). The algebraic model's ψ(i) (its inverse form) is solved by
 //! Newton's method on the model's own Jacobian, from the magnetically linear guess or from a
 //! caller's warm start (a plant's last current): at most [`NEWTON_ITERATIONS`] steps, stopping
 //! when the step is below √ε/16 of the solution's size (then the error is of the order of ε). Saturation curves are
@@ -39,16 +44,19 @@
 //! Nothing here allocates, panics or uses `unsafe`; a non-finite argument gives a non-finite
 //! result, which callers reject as they reject any non-finite sample.
 
+mod cell_inverse;
 mod constant;
 mod flux_map;
 mod machine;
 mod saturation;
+mod uniform_map;
 mod uniform_table;
 
 pub use constant::ConstantInductance;
 pub use flux_map::{FluxMap, FluxMapError, FluxTable};
 pub use machine::{MachineMagnetics, zero_current_constants};
 pub use saturation::Saturation;
+pub use uniform_map::UniformFluxMap;
 pub use uniform_table::UniformFluxTable;
 
 use crate::{Dq, Real};
@@ -248,6 +256,8 @@ pub enum Magnetics<'a, T> {
     Saturation(Saturation<T>),
     /// A flux map on a rectangular grid.
     Map(FluxMap<'a, T>),
+    /// A flux map on a uniform grid, its cells' coefficients precomputed.
+    Uniform(UniformFluxMap<'a, T>),
 }
 
 impl<T: Real> Magnetics<'_, T> {
@@ -263,6 +273,7 @@ macro_rules! dispatch {
             Magnetics::Constant($m) => $e,
             Magnetics::Saturation($m) => $e,
             Magnetics::Map($m) => $e,
+            Magnetics::Uniform($m) => $e,
         }
     };
 }

@@ -187,6 +187,14 @@ impl<T: Real> Saturation<T> {
 
     /// The current i(ψ) and its Jacobian ∂i/∂ψ (the incremental inverse inductance, symmetric).
     pub fn current_and_jacobian(&self, psi: Dq<T>) -> (Dq<T>, InductanceMatrix<T>) {
+        self.evaluate::<true>(psi)
+    }
+
+    /// i(ψ) and, with `JACOBIAN`, ∂i/∂ψ (else a zero matrix): one body, so that the current
+    /// alone (a plant's four evaluations per sub-step) skips the Jacobian's arithmetic and the
+    /// rib's second power while giving the same current bit for bit.
+    #[inline(always)]
+    fn evaluate<const JACOBIAN: bool>(&self, psi: Dq<T>) -> (Dq<T>, InductanceMatrix<T>) {
         let x = psi.d - self.psi_f;
         let y = psi.q;
         let (two, one) = (T::lit(2.0), T::one());
@@ -195,18 +203,31 @@ impl<T: Real> Saturation<T> {
         let xu = pow_abs(x, self.u);
         let yv = pow_abs(y, self.v);
         let (x2, y2) = (x * x, y * y);
-        let (cu, cv) = (self.a_dq / (self.u + two), self.a_dq / (self.v + two));
+        let cu = self.a_dq / (self.u + two);
+        // One division where U = V (the published fits), the same value.
+        let cv = if self.v == self.u {
+            cu
+        } else {
+            self.a_dq / (self.v + two)
+        };
         // G_d·x and G_q·y; |x|^(U+2) = |x|^U·x², |y|^(V+2) = |y|^V·y².
         let g_d = self.a_d0 + self.a_dd * xs + cv * xu * yv * y2;
         let g_q = self.a_q0 + self.a_qq * yt + cu * xu * x2 * yv;
         let mut i = Dq::new(g_d * x - self.i_f, g_q * y);
-        let cross = self.a_dq * xu * x * yv * y;
-        let mut jac = InductanceMatrix {
-            dd: self.a_d0 + self.a_dd * (self.s + one) * xs + cv * (self.u + one) * xu * yv * y2,
-            dq: cross,
-            qd: cross,
-            qq: self.a_q0 + self.a_qq * (self.t + one) * yt + cu * (self.v + one) * xu * x2 * yv,
-        };
+        let mut jac = InductanceMatrix::default();
+        if JACOBIAN {
+            let cross = self.a_dq * xu * x * yv * y;
+            jac = InductanceMatrix {
+                dd: self.a_d0
+                    + self.a_dd * (self.s + one) * xs
+                    + cv * (self.u + one) * xu * yv * y2,
+                dq: cross,
+                qd: cross,
+                qq: self.a_q0
+                    + self.a_qq * (self.t + one) * yt
+                    + cu * (self.v + one) * xu * x2 * yv,
+            };
+        }
         if self.a_b > T::zero() {
             let b = psi.d - self.psi_n;
             let kq = self.k_q;
@@ -215,15 +236,17 @@ impl<T: Real> Saturation<T> {
             let rw = pow_abs(rho, self.w);
             let den = one + self.a_bp * rw;
             let g_b = self.a_b * rw / den;
-            // (dG_b/dρ)/ρ = a_b·W·ρ^(W−2)/den², finite at ρ = 0 for W ≥ 2.
-            let h = self.a_b * self.w * pow_abs(rho, self.w - two) / (den * den);
             i.d += g_b * b;
             i.q += kq * g_b * y;
-            let c = h * kq * b * y;
-            jac.dd += g_b + h * b * b;
-            jac.dq += c;
-            jac.qd += c;
-            jac.qq += kq * g_b + h * kq * kq * y2;
+            if JACOBIAN {
+                // (dG_b/dρ)/ρ = a_b·W·ρ^(W−2)/den², finite at ρ = 0 for W ≥ 2.
+                let h = self.a_b * self.w * pow_abs(rho, self.w - two) / (den * den);
+                let c = h * kq * b * y;
+                jac.dd += g_b + h * b * b;
+                jac.dq += c;
+                jac.qd += c;
+                jac.qq += kq * g_b + h * kq * kq * y2;
+            }
         }
         (i, jac)
     }
@@ -266,7 +289,7 @@ impl<T: Real> MagneticModel<T> for Saturation<T> {
     }
 
     fn current(&self, psi: Dq<T>) -> Dq<T> {
-        self.current_and_jacobian(psi).0
+        self.evaluate::<false>(psi).0
     }
 
     /// Zero: i_q is odd in ψq and i_d even, so ψq(i_d, 0) = 0.

@@ -437,6 +437,51 @@ fn a_flux_map_interpolates_inverts_and_differentiates() {
     }
 }
 
+/// The closed-form inverse, cell by cell, is the inverse: ψ(i(ψ)) = ψ to rounding inside and
+/// beyond the grid, from a warm start in any cell, on uniform and non-uniform axes of a map
+/// with strong self- and cross-saturation (twisted cells); it agrees with Newton's method.
+#[test]
+fn a_flux_map_inverts_in_closed_form_from_any_cell() {
+    let model = pmsyrm();
+    let uniform: [f64; 13] = core::array::from_fn(|k| -30.0 + 5.0 * k as f64);
+    // Nodes crowded towards zero current: every cell a different width.
+    let skewed: [f64; 13] = core::array::from_fn(|k| {
+        let x = (k as f64 - 6.0) / 6.0;
+        30.0 * x * (0.4 + 0.6 * x.abs())
+    });
+    for (i_d, i_q) in [(uniform, uniform), (skewed, uniform), (skewed, skewed)] {
+        let table = FluxTable::from_model(&model, i_d, i_q);
+        let map = table.map().unwrap();
+        let guesses = [Dq::zero(), Dq::new(-29.0, 29.0), Dq::new(40.0, -40.0)];
+        for i in currents(36.0).chain([Dq::new(-45.0, 3.0), Dq::new(2.0, 44.0)]) {
+            let psi = map.flux(i);
+            for g in guesses.iter().copied().chain([i + Dq::new(0.4, -0.3)]) {
+                let back = cell_inverse::invert(&map, psi, g).expect("a closed-form inverse");
+                let err = (map.flux(back) - psi).norm();
+                assert!(
+                    err < 1e-14 * (1.0 + psi.norm()),
+                    "{i:?} from {g:?}: {err:e}"
+                );
+                assert!(
+                    (back - i).norm() < 1e-9 * (1.0 + i.norm()),
+                    "{i:?}: {back:?}"
+                );
+                assert_eq!(map.current_from(psi, g), back);
+            }
+            // Newton's method from a warm start (it need not converge from a far one).
+            let near = i + Dq::new(0.4, -0.3);
+            let newton = newton(psi, near, 1e-6, |x| map.flux_and_jacobian(x)).0;
+            assert!((newton - i).norm() < 1e-9 * (1.0 + i.norm()), "{i:?}");
+        }
+    }
+    // A non-finite flux has no root: None, and the fallback's answer is not finite either.
+    let map = FluxTable::from_model(&model, uniform, uniform);
+    let map = map.map().unwrap();
+    let nan = Dq::new(f64::NAN, 0.1);
+    assert!(cell_inverse::invert(&map, nan, Dq::zero()).is_none());
+    assert!(!map.current_from(nan, Dq::zero()).is_finite());
+}
+
 /// The uniform table is the flux map of the same table: values and Jacobians to rounding
 /// inside and beyond the grid, its inverse; the compiler's build is the run-time one; a
 /// non-uniform axis is refused.
@@ -454,6 +499,14 @@ fn a_uniform_table_is_the_flux_map() {
             (uniform.current(b) - i).norm() < 1e-9 * (1.0 + i.norm()),
             "{i:?}"
         );
+        // Borrowed with its shape at run time (a machine record's form): the same, bit for bit.
+        let view = uniform.map();
+        assert_eq!(view.flux_and_jacobian(i), (b, lb));
+        assert_eq!(view.flux(i), b);
+        assert_eq!(view.current(b), uniform.current(b));
+        let model = Magnetics::Uniform(view);
+        assert_eq!(model.flux_and_inductance(i), (b, lb));
+        assert_eq!(model.current_from(b, i), uniform.current_from(b, i));
     }
     let t32 = ipm_table::<f32>();
     assert_eq!(

@@ -1,6 +1,6 @@
 //! A flux map on a uniform grid held by value, for the lookup a firmware's interrupt makes.
 
-use super::{FluxTable, InductanceMatrix, MagneticModel, newton};
+use super::{FluxTable, InductanceMatrix, MagneticModel};
 use crate::{Dq, Real};
 
 /// A flux map ψd(i_d, i_q), ψq(i_d, i_q) on a uniform `ND` × `NQ` grid, held by value (a
@@ -22,12 +22,12 @@ use crate::{Dq, Real};
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct UniformFluxTable<T, const ND: usize, const NQ: usize> {
     /// (i_d[0], i_q[0]), A.
-    first: Dq<T>,
+    pub(super) first: Dq<T>,
     /// The inverse node spacings (1/Δ_d, 1/Δ_q), 1/A.
-    inv_step: Dq<T>,
+    pub(super) inv_step: Dq<T>,
     /// Cell (k, m)'s coefficients [ψd: p00, ex, ey, twist; ψq: the same] in `cells[k][m]`,
     /// Wb (see the type's docs).
-    cells: [[[T; 8]; NQ]; ND],
+    pub(super) cells: [[[T; 8]; NQ]; ND],
 }
 
 impl<T: Real, const ND: usize, const NQ: usize> UniformFluxTable<T, ND, NQ> {
@@ -58,11 +58,8 @@ impl<T: Real, const ND: usize, const NQ: usize> UniformFluxTable<T, ND, NQ> {
     /// The cell (k, m) of `i` and the fractions along it (outside [0, 1] beyond the grid).
     #[inline(always)]
     fn cell(&self, i: Dq<T>) -> (usize, usize, T, T) {
-        let tx = (i.d - self.first.d) * self.inv_step.d;
-        let ty = (i.q - self.first.q) * self.inv_step.q;
-        let k = tx.index_floor(ND.saturating_sub(2));
-        let m = ty.index_floor(NQ.saturating_sub(2));
-        (k, m, tx - T::from_index(k), ty - T::from_index(m))
+        let last = (ND.saturating_sub(2), NQ.saturating_sub(2));
+        cell_of(self.first, self.inv_step, last, i)
     }
 
     /// Cell (k, m)'s coefficients (NaNs where the shape is too small for a cell).
@@ -78,20 +75,55 @@ impl<T: Real, const ND: usize, const NQ: usize> UniformFluxTable<T, ND, NQ> {
     #[inline]
     pub fn flux_and_jacobian(&self, i: Dq<T>) -> (Dq<T>, InductanceMatrix<T>) {
         let (k, m, fx, fy) = self.cell(i);
-        let c = self.coefficients(k, m);
-        let (g, h) = (self.inv_step.d, self.inv_step.q);
-        let axis = |j: usize| {
-            let (p00, ex, ey, twist) = (c[j], c[j + 1], c[j + 2], c[j + 3]);
-            (
-                p00 + fx * ex + fy * (ey + fx * twist),
-                (ex + fy * twist) * g,
-                (ey + fx * twist) * h,
-            )
-        };
-        let (d, dd, dq) = axis(0);
-        let (q, qd, qq) = axis(4);
-        (Dq::new(d, q), InductanceMatrix { dd, dq, qd, qq })
+        bilinear_with_jacobian(&self.coefficients(k, m), fx, fy, self.inv_step)
     }
+}
+
+/// The cell (k, m) of `i` on a uniform grid from `first` with inverse spacings `inv_step`,
+/// clamped to the cells up to `last` (a NaN to the first), and the fractions along it: no
+/// search, no division.
+#[inline(always)]
+pub(super) fn cell_of<T: Real>(
+    first: Dq<T>,
+    inv_step: Dq<T>,
+    last: (usize, usize),
+    i: Dq<T>,
+) -> (usize, usize, T, T) {
+    let tx = (i.d - first.d) * inv_step.d;
+    let ty = (i.q - first.q) * inv_step.q;
+    let k = tx.index_floor(last.0);
+    let m = ty.index_floor(last.1);
+    (k, m, tx - T::from_index(k), ty - T::from_index(m))
+}
+
+/// ψ from a cell's interleaved coefficients at the fractions (fx, fy).
+#[inline(always)]
+pub(super) fn bilinear_value<T: Real>(c: &[T; 8], fx: T, fy: T) -> Dq<T> {
+    let value = |j: usize| c[j] + fx * c[j + 1] + fy * (c[j + 2] + fx * c[j + 3]);
+    Dq::new(value(0), value(4))
+}
+
+/// ψ and ∂ψ/∂i from a cell's interleaved coefficients at the fractions (fx, fy), the grid's
+/// inverse spacings `inv_step`.
+#[inline(always)]
+pub(super) fn bilinear_with_jacobian<T: Real>(
+    c: &[T; 8],
+    fx: T,
+    fy: T,
+    inv_step: Dq<T>,
+) -> (Dq<T>, InductanceMatrix<T>) {
+    let (g, h) = (inv_step.d, inv_step.q);
+    let axis = |j: usize| {
+        let (p00, ex, ey, twist) = (c[j], c[j + 1], c[j + 2], c[j + 3]);
+        (
+            p00 + fx * ex + fy * (ey + fx * twist),
+            (ex + fy * twist) * g,
+            (ey + fx * twist) * h,
+        )
+    };
+    let (d, dd, dq) = axis(0);
+    let (q, qd, qq) = axis(4);
+    (Dq::new(d, q), InductanceMatrix { dd, dq, qd, qq })
 }
 
 impl<const ND: usize, const NQ: usize> UniformFluxTable<f32, ND, NQ> {
@@ -153,21 +185,17 @@ impl<T: Real, const ND: usize, const NQ: usize> MagneticModel<T> for UniformFlux
     #[inline]
     fn flux(&self, i: Dq<T>) -> Dq<T> {
         let (k, m, fx, fy) = self.cell(i);
-        let c = self.coefficients(k, m);
-        let value = |j: usize| c[j] + fx * c[j + 1] + fy * (c[j + 2] + fx * c[j + 3]);
-        Dq::new(value(0), value(4))
+        bilinear_value(&self.coefficients(k, m), fx, fy)
     }
 
-    /// Newton from the map's linearisation at zero current.
+    /// As [`super::UniformFluxMap`]'s (the table borrowed, [`UniformFluxTable::map`]).
     fn current(&self, psi: Dq<T>) -> Dq<T> {
-        let (psi0, l0) = self.flux_and_jacobian(Dq::zero());
-        self.current_from(psi, l0.solve(psi - psi0))
+        self.map().current(psi)
     }
 
+    /// As [`super::UniformFluxMap`]'s: in closed form cell by cell.
     fn current_from(&self, psi: Dq<T>, guess: Dq<T>) -> Dq<T> {
-        let last = self.first.d + T::from_index(ND.saturating_sub(1)) / self.inv_step.d;
-        let scale = last.abs() * T::lit(1e-6);
-        newton(psi, guess, scale, |i| self.flux_and_jacobian(i)).0
+        self.map().current_from(psi, guess)
     }
 
     #[inline]
