@@ -92,6 +92,9 @@ pub struct FieldWeakening<T> {
     gain: T,
     /// m/√3.
     margin: T,
+    /// The ellipse's voltage per volt of the bus: the inscribed circle 1/√3, or `margin`
+    /// above it ([`FieldWeakening::ellipse_flux`]).
+    ellipse_ratio: T,
     /// The d current's bound, A (≤ 0): the characteristic current or −I_max.
     id_min: T,
     /// Speed floor of the gain, rad/s.
@@ -129,6 +132,7 @@ impl<T: Real> FieldWeakening<T> {
             mtpv: t.mtpv,
             gain: ts * T::two_pi() * f / machine.ld,
             margin: m / T::lit(3.0).sqrt(),
+            ellipse_ratio: (m / T::lit(3.0).sqrt()).step_max(T::one() / T::lit(3.0).sqrt()),
             id_min: -characteristic.step_min(i_max),
             min_speed: T::lit(0.1) * machine.rated_speed(),
             rs_i_max: machine.rs * i_max,
@@ -197,9 +201,8 @@ impl<T: Real> FieldWeakening<T> {
         if !(self.enabled && self.mtpv && self.delta_id < T::zero()) {
             return None;
         }
-        let inscribed = T::one() / T::lit(3.0).sqrt();
         let w = omega.abs().step_max(self.min_speed);
-        Some(self.margin.step_max(inscribed) * vdc / w)
+        Some(self.ellipse_ratio * vdc / w)
     }
 
     /// Back to no weakening.
