@@ -205,6 +205,8 @@ pub struct SensorlessDrive<T: 'static, E = SensorlessEstimator<T>> {
     calibration_remaining: u32,
     /// Sum of the raw phase currents during the calibration.
     calibration_sum: Abc<T>,
+    /// Sum of |i_ab|² of the raw currents during a watched offset calibration (A²).
+    calibration_square_sum: T,
     /// Phase-current offsets subtracted from every sample (A).
     current_offset: Abc<T>,
     /// The angle of the last `align`, re-applied when the calibration ends.
