@@ -47,6 +47,7 @@
 mod cell_inverse;
 mod constant;
 mod flux_map;
+mod inverse_cache;
 mod machine;
 mod saturation;
 mod uniform_map;
@@ -54,6 +55,7 @@ mod uniform_table;
 
 pub use constant::ConstantInductance;
 pub use flux_map::{FluxMap, FluxMapError, FluxTable};
+pub use inverse_cache::InverseCache;
 pub use machine::{MachineMagnetics, zero_current_constants};
 pub use saturation::Saturation;
 pub use uniform_map::UniformFluxMap;
@@ -264,6 +266,22 @@ impl<T: Real> Magnetics<'_, T> {
     /// True for constant inductances (a plant keeps its closed-form path for them).
     pub fn is_linear(&self) -> bool {
         matches!(self, Magnetics::Constant(_))
+    }
+
+    /// [`MagneticModel::current_from`], a map's with the warm start's cell kept in `cache`
+    /// ([`InverseCache`], one per model): the same result.
+    #[inline]
+    pub fn current_from_cached(
+        &self,
+        psi: Dq<T>,
+        guess: Dq<T>,
+        cache: &mut InverseCache<T>,
+    ) -> Dq<T> {
+        match self {
+            Magnetics::Map(m) => m.current_from_cached(psi, guess, cache),
+            Magnetics::Uniform(m) => m.current_from_cached(psi, guess, cache),
+            _ => self.current_from(psi, guess),
+        }
     }
 }
 
