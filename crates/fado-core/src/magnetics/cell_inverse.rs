@@ -102,20 +102,15 @@ impl<T: Real> CellPolynomial<T> {
         (h.d - self.ey.d * v) / (self.ex.d + self.twist.d * v)
     }
 
-    /// The fractions (u, v) where the polynomial is `psi`: of the (up to) two roots the one
-    /// nearer the cell; None if there is no real root.
-    pub fn solve(&self, psi: Dq<T>) -> Option<(T, T)> {
-        self.solve_with(psi, self.constants())
-    }
-
     /// The quadratic's coefficients that do not depend on ψ: (k2, ex × ey).
     #[inline]
     pub fn constants(&self) -> (T, T) {
         (cross(self.twist, self.ey), cross(self.ex, self.ey))
     }
 
-    /// As [`CellPolynomial::solve`] with the cell's [`CellPolynomial::constants`] given
-    /// (the same arithmetic, so the same result to the bit).
+    /// The fractions (u, v) where the polynomial is `psi`, given the cell's
+    /// [`CellPolynomial::constants`]: of the (up to) two roots the one nearer the cell; None if
+    /// there is no real root.
     pub fn solve_with(&self, psi: Dq<T>, (k2, ex_ey): (T, T)) -> Option<(T, T)> {
         let h = psi - self.p00;
         let k1 = ex_ey + cross(h, self.twist);
@@ -193,31 +188,42 @@ pub(super) fn direction<T: Real>(x: T, k: usize, last: usize, tol: T) -> isize {
 /// i(ψ) on `grid` from the cell of `guess` (module docs); None where the closed form finds no
 /// root or the walk does not settle.
 pub(super) fn invert<T: Real>(grid: &impl CellGrid<T>, psi: Dq<T>, guess: Dq<T>) -> Option<Dq<T>> {
-    invert_from(grid, psi, grid.cell_of(guess), |k, m| {
+    invert_from(grid, grid.cell_of(guess), |k, m| {
         let cell = grid.polynomial(k, m);
-        (cell, cell.constants())
+        cell.root_or_direction(psi, cell.constants())
     })
 }
 
-/// [`invert`] from the cell `start` (the warm start's), each cell's polynomial and its
-/// [`CellPolynomial::constants`] from `cell_at` (a cache's, [`super::InverseCache`]).
+impl<T: Real> CellPolynomial<T> {
+    /// The root (u, v) at `psi` as [`CellPolynomial::solve_with`], and the fractions the walk
+    /// follows: the root, or where there is none (the point lies where this cell's extension
+    /// folds) this cell's linearisation at its centre, which still points towards the
+    /// solution's cell.
+    #[inline]
+    pub fn root_or_direction(&self, psi: Dq<T>, constants: (T, T)) -> (Option<(T, T)>, (T, T)) {
+        let root = self.solve_with(psi, constants);
+        let half = T::lit(0.5);
+        (
+            root,
+            root.unwrap_or_else(|| self.newton_step(psi, (half, half))),
+        )
+    }
+}
+
+/// [`invert`] from the cell `start` (the warm start's), with cell (k, m)'s
+/// [`CellPolynomial::root_or_direction`] at the ψ sought from `solve_at` (a cache's,
+/// [`super::InverseCache`]).
 #[inline]
 pub(super) fn invert_from<T: Real>(
     grid: &impl CellGrid<T>,
-    psi: Dq<T>,
     start: (usize, usize),
-    mut cell_at: impl FnMut(usize, usize) -> (CellPolynomial<T>, (T, T)),
+    mut solve_at: impl FnMut(usize, usize) -> (Option<(T, T)>, (T, T)),
 ) -> Option<Dq<T>> {
     let (last_k, last_m) = grid.last_cell();
     let (mut k, mut m) = start;
     let tol = cell_tolerance::<T>();
     for walk in 0..last_k + last_m + 2 {
-        let (cell, constants) = cell_at(k, m);
-        let root = cell.solve_with(psi, constants);
-        // No real root: the point lies where this cell's extension folds; its linearisation
-        // at the centre still points towards the solution's cell.
-        let half = T::lit(0.5);
-        let (u, v) = root.unwrap_or_else(|| cell.newton_step(psi, (half, half)));
+        let (root, (u, v)) = solve_at(k, m);
         let (dk, dm) = (direction(u, k, last_k, tol), direction(v, m, last_m, tol));
         if dk == 0 && dm == 0 {
             let (u, v) = root?;

@@ -64,17 +64,25 @@ impl<T: Real> InverseCache<T> {
             self.guess = guess;
         }
         let (slots, next) = (&mut self.slots, &mut self.next);
-        invert_from(grid, psi, self.start, |k, m| {
-            for (a, b, cell, constants) in slots.iter().flatten() {
-                if (*a, *b) == (k, m) {
-                    return (*cell, *constants);
+        invert_from(grid, self.start, |k, m| {
+            let at = match slots
+                .iter()
+                .position(|s| matches!(s, Some((a, b, _, _)) if (*a, *b) == (k, m)))
+            {
+                Some(at) => at,
+                None => {
+                    let cell = grid.polynomial(k, m);
+                    let at = *next;
+                    slots[at] = Some((k, m, cell, cell.constants()));
+                    *next = (at + 1) % SLOTS;
+                    at
                 }
+            };
+            match &slots[at] {
+                // The polynomial solved where it lies in the cache (no copy).
+                Some((_, _, cell, constants)) => cell.root_or_direction(psi, *constants),
+                None => (None, (T::lit(f64::NAN), T::lit(f64::NAN))),
             }
-            let cell = grid.polynomial(k, m);
-            let constants = cell.constants();
-            slots[*next] = Some((k, m, cell, constants));
-            *next = (*next + 1) % SLOTS;
-            (cell, constants)
         })
     }
 }
