@@ -34,7 +34,10 @@
 //! the neighbouring cell the solution points into, one or two cells per inversion — Newton's
 //! method on the whole map needs three evaluations or more and stalls on the kinks of its
 //! Jacobian at the cell edges (it remains the fallback where a cell's quadratic has no real
-//! root). The algebraic model's ψ(i) (its inverse form) is solved by
+//! root). A caller that inverts many times from one warm start (a plant's Runge–Kutta stages)
+//! keeps the start's cell and the last cells' polynomials in an [`InverseCache`]: the same walk
+//! and arithmetic, so the same result to the bit, without finding the start cell or loading a
+//! cell's corners again. The algebraic model's ψ(i) (its inverse form) is solved by
 //! Newton's method on the model's own Jacobian, from the magnetically linear guess or from a
 //! caller's warm start (a plant's last current): at most [`NEWTON_ITERATIONS`] steps, stopping
 //! when the step is below √ε/16 of the solution's size (then the error is of the order of ε). Saturation curves are

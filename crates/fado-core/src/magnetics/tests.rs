@@ -496,7 +496,11 @@ fn the_cached_inverse_is_the_inverse_bit_for_bit() {
     let path = |k: usize| {
         // A rotating current of growing amplitude, a far jump halfway, an excursion beyond.
         let t = k as f64 * 0.013;
-        let a = if k == 400 { 44.0 } else { 2.0 + 0.06 * k as f64 };
+        let a = if k == 400 {
+            44.0
+        } else {
+            2.0 + 0.06 * k as f64
+        };
         Dq::new(a * t.cos(), a * t.sin())
     };
     let check = |model: &Magnetics<'_, f64>| {
