@@ -56,7 +56,7 @@ def parse(log):
             cycles[root][("classes", scenario)] = line.split(": ", 1)[1].strip()
             continue
         m = BY_FILE.match(line)
-        if m and root and scenario is not None and not m.group(2).startswith("image:"):
+        if m and root and scenario is not None and m.group(2).split(":")[0] != "image":
             cycles[root][("own", scenario)] += float(m.group(1))
         m = re.match(r"\.text reachable from (\w+): (\d+) B", line)
         if m:
