@@ -70,10 +70,11 @@ pub struct SpeedLoopTuning<T> {
     /// rated torques per second). A large value (1e9) keeps `bandwidth_hz`.
     pub load_ramp_time: T,
     /// The steady speed error ε (a multiple of the rated speed) that a ramp of the rated
-    /// torque over `load_ramp_time` may leave. Default 0.1 \[A\]: the largest ε·t_r that every
-    /// preset's 5 Hz meets is 0.086 s (pmsyrm-5k, τm = 59 ms, asks 4.6 Hz with 0.1 s); a light
-    /// rotor (τm of a few ms) gets the bandwidth of its ramp. A large value (1e9) keeps
-    /// `bandwidth_hz`.
+    /// torque over `load_ramp_time` may leave. Default 0.13 \[A\]: every preset keeps its 5 Hz
+    /// from ε·t_r = 0.086 s on (pmsyrm-5k, τm = 59 ms), a 32-pole torque motor (τm = 39 ms),
+    /// whose loaded passage through zero speed does not take a faster loop, from 0.129 s on
+    /// ([`crate::control::speed_bandwidth`]); a light rotor (τm of a few ms) gets the bandwidth
+    /// of its ramp. A large value (1e9) keeps `bandwidth_hz`.
     pub load_ramp_error_ratio: T,
 }
 
