@@ -25,6 +25,7 @@ pub mod saturated_references;
 pub mod speed_controller;
 pub mod standstill_probe;
 pub mod startup;
+pub use drive::probe_period;
 pub use drive::speed_bandwidth;
 pub use drive::tracker_feedforward;
 pub use drive::tuning;

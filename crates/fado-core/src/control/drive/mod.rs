@@ -33,6 +33,7 @@ mod hold;
 mod lifecycle;
 mod lock;
 mod output;
+pub mod probe_period;
 mod references;
 mod reject;
 mod resolved;
