@@ -30,6 +30,23 @@
 //! cannot know are DC errors that appear only at standstill (the dead-time residual and R̂s
 //! errors times a current that is constant in α-β there); those are the limiter's, as before.
 //!
+//! **Only where an electrical revolution spans many samples.** An error that repeats with the
+//! rotor's angle *and* with the carrier (the inverter's dead-time and ripple pattern, whose
+//! shape depends on where each sample falls in the electrical period) is a constant in α-β
+//! only on average over many revolutions; when the electrical frequency is a whole fraction
+//! of the sampling frequency, f_s/f_e = N samples per revolution (or a ratio of small whole
+//! numbers), the pattern stops sliding and its components of order N alias onto DC: a real
+//! DC integrand error, but one of that speed alone. The law learns it at that speed and
+//! carries it to standstill, where it turns θ̂ at ê/λ̂f, and R̂s drops what the start's
+//! standstill test read of it (`crate::rs_adaptation`). Measured (fado-sim `fullrange`,
+//! switching-resolved): a 10-pole 750 W servo held at 6,000 r/min with 20 kHz sampling
+//! (N = 40) learns 0.15 V and R̂s falls by 15 %; a 4-pole spindle at 48,000 r/min with 40 kHz
+//! sampling (N = 12.5, locked over two revolutions) raises R̂s by 10 %; 1 % off those speeds
+//! nothing moves. An offset of the measurement chain is the same at every speed and is
+//! learned at lower ones, and in the k_df mode the observer removes a DC error whatever ê
+//! is: so the law learns only while |ω̂|·Ts ≤ 2π/[`MIN_REVOLUTION_SAMPLES`] and holds ê
+//! above (`[estimator.offset_adaptation] min_revolution_samples`).
+//!
 //! |ê| is bounded by the back-EMF at the Fig. 3 threshold speed, λ̂f·2π·f_th: a larger offset
 //! would make the limiter mode useless anyway, and the bound keeps a hand-over transient from
 //! leaving a large ê behind.
@@ -40,6 +57,14 @@ use crate::{Ab, MachineModel, Real};
 
 /// Default k_e in s⁻¹ ([`IntegrandOffsetConfig::rate`]): 2 (ours \[A\], see the field).
 pub const DEFAULT_RATE: f64 = 2.0;
+
+/// The fewest samples per electrical revolution at which the estimator's law learns ê (module
+/// docs, "Only where an electrical revolution spans many samples"): 64 (ours \[A\]). Measured
+/// on the locked speeds of `fullrange`: 40 (a 750 W servo at 6,000 r/min, 20 kHz) and 12.5
+/// (a spindle at 48,000 r/min, 40 kHz) learn a DC that is not an offset; 48, 50 and 60 on the
+/// servo learn none. 64 keeps a margin above the largest count seen to alias, and every
+/// speed of the paper's profiles (fig8–fig12: at least 970 samples per revolution) below it.
+pub const MIN_REVOLUTION_SAMPLES: f64 = 64.0;
 
 /// Configuration of [`IntegrandOffset`].
 ///

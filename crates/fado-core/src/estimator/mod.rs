@@ -158,6 +158,10 @@ pub struct EstimatorParams<T: Real> {
     /// while the R̂s adaptation runs (the state holds it, or 0, since the adaptation can be
     /// switched on at run time).
     offset_recentring_gain: T,
+    /// The integrand-offset law learns while |ω̂| is at most this (rad/s): an electrical
+    /// revolution of `offset_adaptation.min_revolution_samples` samples (the law holds ê
+    /// above it, see [`crate::integrand_offset::MIN_REVOLUTION_SAMPLES`]).
+    offset_max_speed: T,
     /// `EstimatorConfig::initial_angle`, rad.
     initial_angle: T,
     /// The configured R̂s (`MachineModel::rs`), Ω: the start-up R̂s.

@@ -35,6 +35,10 @@ impl<T: Real> EstimatorParams<T> {
         let (ratio, hold) = check_limits(&config, ts)?;
         let blocks = SampleBlocks::new(&config, ts)?;
         let (rs_adaptation, offset) = slow_laws(&config)?;
+        check::non_negative(
+            "offset_adaptation_min_revolution_samples",
+            config.tuning.offset_adaptation.min_revolution_samples,
+        )?;
         let lf = config.machine.flux_linkage;
         // Both circles are compared squared: in f32 a huge λ̂f would make them ∞.
         let squared = |field, x: T| {
@@ -92,6 +96,10 @@ impl<T: Real> EstimatorParams<T> {
                 T::zero()
             },
             offset_recentring_gain: config.tuning.offset_adaptation.rate * ts,
+            offset_max_speed: offset_max_speed(
+                config.tuning.offset_adaptation.min_revolution_samples,
+                ts,
+            ),
             initial_angle: config.initial_angle,
             observer_on_rotor_flux: config.tuning.observer.on_rotor_flux,
             gain_hold: blocks.gain_hold,
@@ -354,4 +362,15 @@ fn slow_laws<T: Real>(
             }
         })?;
     Ok((rs_adaptation, offset))
+}
+
+/// The speed (rad/s) below which the integrand-offset law learns: an electrical revolution of
+/// at least `samples` sampling periods, 2π/(samples·Ts); unbounded for 0 samples (see
+/// [`crate::integrand_offset::MIN_REVOLUTION_SAMPLES`]).
+fn offset_max_speed<T: Real>(samples: T, ts: T) -> T {
+    if samples > T::zero() {
+        T::two_pi() / (samples * ts)
+    } else {
+        T::lit(f64::INFINITY)
+    }
 }

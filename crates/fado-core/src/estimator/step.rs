@@ -535,9 +535,15 @@ impl<T: Real> EstimatorState<T> {
             };
         }
         let learning = broken & BROKEN_OFFSET == 0 && c.mode == Mode::DisturbanceFeedback && !holds;
-        let offset = p
+        let mut offset = p
             .offset
             .next_state(&self.offset, c.disturbance, decay, shift, learning);
+        // Above the speed of the shortest revolution the law trusts it holds ê (an error
+        // locked to the rotor and the carrier aliases onto DC there; the count of settled
+        // samples goes on, the λ̂f law waits on it).
+        if c.t2s1.omega.abs() > p.offset_max_speed {
+            offset.offset = self.offset.offset;
+        }
         // R̂s drops what earlier standstill tests read of the offset ê learns now.
         let change = offset.offset - self.offset.offset;
         let rs_hat = self

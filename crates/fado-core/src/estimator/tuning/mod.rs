@@ -127,6 +127,10 @@ pub const MOVED_KEYS: &[(&str, &str)] = &[
         "flux_linkage_adaptation.rate",
     ),
     ("offset_adaptation_rate", "offset_adaptation.rate"),
+    (
+        "offset_adaptation_min_revolution_samples",
+        "offset_adaptation.min_revolution_samples",
+    ),
     ("plausible_current_ratio", "plausibility.current_ratio"),
     ("plausible_voltage_ratio", "plausibility.voltage_ratio"),
     (

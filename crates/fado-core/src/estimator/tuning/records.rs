@@ -375,14 +375,20 @@ pub struct OffsetAdaptationTuning<T> {
     /// Measured (fado-sim fig11, switching-resolved, 0.1 V on the α voltage): the worst
     /// near-zero-speed angle error drops from 1.21 rad (off) to 0.13 rad (docs/method/additions.md).
     pub rate: T,
+    /// The law learns only while an electrical revolution spans at least this many samples,
+    /// |ω̂|·Ts ≤ 2π/N (it holds ê above that speed; the re-centring goes on). Default
+    /// [`MIN_REVOLUTION_SAMPLES`](crate::integrand_offset::MIN_REVOLUTION_SAMPLES) (64; see
+    /// there: an error locked to the rotor and the carrier aliases onto the DC the law reads).
+    pub min_revolution_samples: T,
 }
 
-cast_record!(OffsetAdaptationTuning { rate ;  });
+cast_record!(OffsetAdaptationTuning { rate, min_revolution_samples ;  });
 
 impl<T: Real> Default for OffsetAdaptationTuning<T> {
     fn default() -> Self {
         Self {
             rate: T::lit(integrand_offset::DEFAULT_RATE),
+            min_revolution_samples: T::lit(integrand_offset::MIN_REVOLUTION_SAMPLES),
         }
     }
 }
