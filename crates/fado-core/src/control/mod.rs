@@ -16,6 +16,7 @@ pub mod initial_angle;
 pub mod lock_reaction;
 pub mod modulation;
 pub mod monitor;
+pub mod phase_band;
 pub mod pi;
 pub mod ratings_limit;
 pub mod release_current;

@@ -377,8 +377,10 @@ impl<T: Real> AngleSearch<T> {
     }
 
     /// Starts watching the offset calibration from reference current `reference` (the
-    /// mean raw current of its first samples, A).
-    pub fn watch_offsets(&mut self, reference: Ab<T>) {
+    /// mean raw current of its first samples, A), uncertain by `reference_error` (A:
+    /// [`MotionMonitor::set_reference_error`]).
+    pub fn watch_offsets(&mut self, reference: Ab<T>, reference_error: T) {
+        self.monitor.set_reference_error(reference_error);
         self.monitor.restart(reference);
     }
 

@@ -368,6 +368,11 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             };
             let i = self.currents_for_torque(iq_torque, guess, id_added);
             let i = self.release_current_floor(i, estimate.theta, vdc);
+            let limiter = estimate.diagnostics.mode == crate::mode::Mode::Limiter;
+            let i = self
+                .blocks
+                .phase_band
+                .shift(i, estimate.theta, vdc, limiter);
             let i = limit_current_d_priority(i, self.resolved.i_max);
             let i = self.voltage_ellipse(i, vdc, estimate.omega_control);
             let iq_max = self
