@@ -25,11 +25,13 @@
 //! constant inductances; a saturating one has none. Constant-inductance motors keep that exact
 //! path: [`crate::motor::Motor`] builds this integrator only for a saturating model.
 
-use std::cell::Cell;
+use std::cell::{Cell, RefCell};
 use std::sync::Arc;
 use std::sync::Mutex;
 
-use fado_core::magnetics::{FluxMap, FluxMapError, MagneticModel, Magnetics, Saturation};
+use fado_core::magnetics::{
+    FluxMap, FluxMapError, InverseCache, MagneticModel, Magnetics, Saturation,
+};
 use fado_core::{Ab, Dq};
 use num_complex::Complex64;
 
@@ -190,6 +192,9 @@ pub(crate) struct FluxPropagator {
     h_max: f64,
     pole_pairs: f64,
     last: Cell<FluxPoint>,
+    /// A map's last cell of i(ψ) (`InverseCache`): the sub-steps' inversions from one warm
+    /// start share it.
+    cache: RefCell<InverseCache<f64>>,
 }
 
 impl FluxPropagator {
@@ -210,6 +215,7 @@ impl FluxPropagator {
             h_max: SUBSTEP_TIME_CONSTANTS * bounds.l_min / r,
             pole_pairs: pole_pairs as f64,
             last: Cell::new(start),
+            cache: RefCell::new(InverseCache::new()),
         }
     }
 
@@ -258,6 +264,7 @@ impl FluxPropagator {
         let r = self.r;
         let rot_half = cis(0.5 * self.omega * hs);
         let short = hs < SHORT_INTERVAL_SUBSTEPS * self.h_max;
+        let cache = &mut *self.cache.borrow_mut();
         for k in 0..n {
             let rot_mid = rot * rot_half;
             rot = if k + 1 == n {
@@ -265,14 +272,10 @@ impl FluxPropagator {
             } else {
                 rot * rot_s
             };
+            // Every inversion of a sub-step starts from its first current.
             let g = guess;
-            let current_at = |psi: Ab<f64>, rot: Complex64| {
-                rotate(model.current_from(unrotate(psi, rot), g), rot)
-            };
-            let mut current = |psi: Ab<f64>| {
-                let i_dq = model.current_from(unrotate(psi, rot), guess);
-                guess = i_dq;
-                rotate(i_dq, rot)
+            let mut current_at = |psi: Ab<f64>, rot: Complex64| {
+                rotate(model.current_from_cached(unrotate(psi, rot), g, cache), rot)
             };
             let k1 = v_ab - i * r;
             let k2 = v_ab - current_at(psi + k1 * (0.5 * hs), rot_mid) * r;
@@ -284,7 +287,8 @@ impl FluxPropagator {
                 let k4 = v_ab - current_at(psi + k3 * hs, rot) * r;
                 psi += (k1 + (k2 + k3) * 2.0 + k4) * (hs / 6.0);
             }
-            i = current(psi);
+            guess = model.current_from_cached(unrotate(psi, rot), g, cache);
+            i = rotate(guess, rot);
         }
         self.last.set(FluxPoint {
             i_ab: i,

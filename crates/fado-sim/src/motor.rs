@@ -120,6 +120,25 @@ pub struct ElectricalPropagator {
 }
 
 impl ElectricalPropagator {
+    /// A saturating machine's propagator: `flux` integrates every interval, so the closed
+    /// forms' coefficients are not formed (zeros, never read).
+    fn saturating(flux: FluxPropagator, omega: f64) -> Self {
+        let zero = Complex64::new(0.0, 0.0);
+        Self {
+            flux: Some(flux),
+            omega,
+            mu: 0.0,
+            n: [[0.0; 2]; 2],
+            s: 0.0,
+            surface: false,
+            k: [zero; 2],
+            x_c: [0.0; 2],
+            a: 0.0,
+            inv_r: 0.0,
+            b: zero,
+        }
+    }
+
     /// Propagator at electrical speed `omega` with circuit resistance `r` (Rs plus any
     /// inverter on-resistance).
     pub fn new(p: &MotorParams, r: f64, omega: f64) -> Self {
@@ -405,18 +424,20 @@ impl Motor {
     /// The propagator of one sample at the present speed with circuit resistance `r`: the
     /// closed form for constant inductances, the flux integrator for a saturating machine.
     pub fn propagator(&self, r: f64) -> ElectricalPropagator {
-        let mut prop = ElectricalPropagator::new(&self.params, r, self.omega());
-        if let Some((m, b)) = &self.magnetics {
-            prop.flux = Some(FluxPropagator::new(
-                m.clone(),
-                b,
-                r,
+        match &self.magnetics {
+            Some((m, b)) => ElectricalPropagator::saturating(
+                FluxPropagator::new(
+                    m.clone(),
+                    b,
+                    r,
+                    self.omega(),
+                    self.params.pole_pairs,
+                    FluxPoint::at(self.state.i_dq, self.psi_dq, self.rot),
+                ),
                 self.omega(),
-                self.params.pole_pairs,
-                FluxPoint::at(self.state.i_dq, self.psi_dq, self.rot),
-            ));
+            ),
+            None => ElectricalPropagator::new(&self.params, r, self.omega()),
         }
-        prop
     }
 
     /// Stator flux linkage in the rotor frame, Wb.

@@ -26,10 +26,10 @@ fn light_rotor_holds_both_range_scenarios_with_the_bandwidth_of_its_load_step() 
             "{scenario}: {angle} rad"
         );
     }
-    // The rule off: the paper's 5 Hz speed loop and 35 Hz T2S-2.
+    // The rule off (its step and its ramp): the paper's 5 Hz speed loop and 35 Hz T2S-2.
     let (angle, tripped, passed) = run(
         "fullrange",
-        "[controller.speed]\nload_step_dip_ratio = 1e9\n",
+        "[controller.speed]\nload_step_dip_ratio = 1e9\nload_ramp_error_ratio = 1e9\n",
     );
     println!(
         "gimbal fullrange without the rule: {angle:.3} rad, tripped {tripped}, passed {passed}"

@@ -8,6 +8,8 @@ use fado_sim::scenario::simulate;
 const U8: &str = include_str!("data/multirotor/tmotor-u8ii-kv100-12s.toml");
 const MN4004: &str = include_str!("data/multirotor/tmotor-mn4004-kv300-6s.toml");
 const MAD5010: &str = include_str!("data/multirotor/mad-5010-kv370-6s.toml");
+const MAD5010_200: &str = include_str!("data/multirotor/mad-5010-kv200-6s.toml");
+const FLIPSKY6215: &str = include_str!("data/multirotor/flipsky-6215-kv170-12s.toml");
 
 fn run(scenario: &str, name: &str, motor: &str, seed: u64) -> fado_sim::scenario::Outcome {
     let text = format!("{motor}\n[current_sensor]\nseed = {seed}\n");
@@ -61,4 +63,44 @@ fn datasheet_multirotor_motors_start_under_their_rated_load() {
 fn mad_5010_seed_2_starts_under_its_rated_load() {
     let out = run("loaded-start", "MAD 5010", MAD5010, 2);
     assert!(out.passed, "{:?}", out.checks);
+}
+
+/// The MAD 5010 KV200 (0.152 Ω, 26.5 µH, 1.97 mWb, 20 kHz): its start-up's motion monitor
+/// reads the offsets' reference error (ten samples of the 12-bit sensor, about 7 mA) through
+/// its resistance as 0.05 rad in 0.1 s: without the reference's uncertainty
+/// (`MotionMonitor::set_reference_error`) the braked rotor's start-up would stay deferred at
+/// seeds 2 and 4 (never ready).
+#[test]
+fn mad_5010_kv200_passes_the_reversal_the_stops_and_starts_under_its_rated_load() {
+    for scenario in ["reversal", "stops"] {
+        let out = run(scenario, "MAD 5010 KV200", MAD5010_200, 1);
+        assert!(out.passed, "{scenario}: {:?}", out.checks);
+    }
+    for seed in 1..=4 {
+        let out = run("loaded-start", "MAD 5010 KV200", MAD5010_200, seed);
+        assert!(out.passed, "seed {seed}: {:?}", out.checks);
+    }
+}
+
+/// The Flipsky 6215 KV170 (a salient 15/22 µH outrunner on 12S under a VESC's 15 kHz PWM)
+/// runs the reversal and the stops.
+#[test]
+fn flipsky_6215_passes_the_reversal_and_the_stops() {
+    for scenario in ["reversal", "stops"] {
+        for seed in [1, 2] {
+            let out = run(scenario, "Flipsky 6215", FLIPSKY6215, seed);
+            assert!(out.passed, "{scenario} seed {seed}: {:?}", out.checks);
+        }
+    }
+}
+
+/// Its loaded start passes at seeds 3 and 4; at seeds 1 and 2 the rotor falls back 0.83 and
+/// 0.72 rad after the release (bound 0.5), |θ − θ̂| 0.26 rad at seed 1.
+#[test]
+#[ignore = "open: the salient 15 µH Flipsky 6215 falls back 0.72–0.83 rad after the release at seeds 1 and 2"]
+fn flipsky_6215_starts_under_its_rated_load() {
+    for seed in 1..=4 {
+        let out = run("loaded-start", "Flipsky 6215", FLIPSKY6215, seed);
+        assert!(out.passed, "seed {seed}: {:?}", out.checks);
+    }
 }

@@ -172,6 +172,43 @@ impl<T: Real> CurrentController<T> {
             return Err(NonFiniteInput);
         }
         let ff = self.feedforward(measured, omega);
+        self.step_with_feedforward(reference, measured, ff)
+    }
+
+    /// [`step`](Self::step) with the decoupling and back-EMF feed-forward from a magnetic
+    /// model's flux linkage `flux` (ψd, ψq in Wb, estimated frame): (−ω·ψq, ω·ψd), zero when
+    /// `decoupling` is off. On a saturating machine the flux is not L̂·i + λ̂f for any one pair
+    /// of inductances: the PM-SyRM's secant L_q falls from 150 mH at zero current to 83 mH
+    /// at the rated one, and its incremental one to 51 mH, the current loop's gain
+    /// (`SensorlessDrive` takes the rated point's), which as a decoupling leaves ω·ψq a third
+    /// short at small currents (docs/range.md).
+    #[inline]
+    pub fn step_with_flux(
+        &mut self,
+        reference: Dq<T>,
+        measured: Dq<T>,
+        omega: T,
+        flux: Dq<T>,
+    ) -> Result<Dq<T>, NonFiniteInput> {
+        if !(reference.is_finite() && measured.is_finite() && omega.is_finite() && flux.is_finite())
+        {
+            return Err(NonFiniteInput);
+        }
+        let ff = if self.config.decoupling {
+            Dq::new(-omega * flux.q, omega * flux.d)
+        } else {
+            Dq::zero()
+        };
+        self.step_with_feedforward(reference, measured, ff)
+    }
+
+    #[inline(always)]
+    fn step_with_feedforward(
+        &mut self,
+        reference: Dq<T>,
+        measured: Dq<T>,
+        ff: Dq<T>,
+    ) -> Result<Dq<T>, NonFiniteInput> {
         let e = reference - measured;
         let (d0, q0) = (self.d, self.q);
         let vd = self.d.step(e.d, ff.d)?;
@@ -234,5 +271,59 @@ impl<T: Real> CurrentController<T> {
     /// The configuration in use.
     pub fn config(&self) -> &CurrentControllerConfig<T> {
         &self.config
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The flux form of the feed-forward is the linear one for the linear model's flux
+    /// (λ̂f + L̂d·i_d, L̂q·i_q), and on a saturating machine it is what holds the current: a plant
+    /// whose q flux is 3 × L̂q·i_q (the PM-SyRM's secant against its rated incremental L_q at
+    /// small currents) is within 0.06 A of a 2 A step 10 ms after it with the flux form, 0.56 A
+    /// off with the linear form (ω·(ψq − L̂q·i_q) = 20 V left to the integrator in d).
+    #[test]
+    fn flux_feedforward_matches_the_linear_one_and_decouples_a_saturating_plant() {
+        let mut m = MachineModel::<f64>::paper();
+        m.ld = 0.018;
+        m.lq = 0.051;
+        m.flux_linkage = 0.4767;
+        m.rs = 0.63;
+        let ts = 1e-4;
+        let config = CurrentControllerConfig::for_machine(&m, ts);
+        let (reference, measured, omega) = (Dq::new(0.5, -1.5), Dq::new(0.3, -1.2), 100.0);
+        let linear = Dq::new(m.flux_linkage + m.ld * measured.d, m.lq * measured.q);
+        let mut a = CurrentController::new(config).unwrap();
+        let mut b = a;
+        let va = a.step(reference, measured, omega).unwrap();
+        let vb = b
+            .step_with_flux(reference, measured, omega, linear)
+            .unwrap();
+        assert!((va - vb).norm() < 1e-12, "{va:?} {vb:?}");
+        // A plant whose q flux is 3·L̂q·i_q (and d as the model): v = R·i + dψ/dt + ω·J·ψ,
+        // stepped at a constant speed; the error 10 ms after a q-current reference step.
+        let settle = |flux_form: bool| {
+            let mut c = CurrentController::new(config).unwrap();
+            let mut i = Dq::new(0.0, 0.0);
+            let target = Dq::new(0.0, 2.0);
+            let lq_true = 3.0 * m.lq;
+            for _ in 0..100 {
+                let psi = Dq::new(m.flux_linkage + m.ld * i.d, lq_true * i.q);
+                let v = if flux_form {
+                    let model = Dq::new(m.flux_linkage + m.ld * target.d, lq_true * target.q);
+                    c.step_with_flux(target, i, omega, model).unwrap()
+                } else {
+                    c.step(target, i, omega).unwrap()
+                };
+                // L di/dt = v − R·i − ω·J·ψ (incremental L as the plant's secant here).
+                let emf = Dq::new(-omega * psi.q, omega * psi.d);
+                i.d += ts * (v.d - m.rs * i.d - emf.d) / m.ld;
+                i.q += ts * (v.q - m.rs * i.q - emf.q) / lq_true;
+            }
+            (target - i).norm()
+        };
+        let (with, without) = (settle(true), settle(false));
+        assert!(with < 0.1 && without > 5.0 * with, "{with} {without}");
     }
 }

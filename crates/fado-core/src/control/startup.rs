@@ -292,6 +292,10 @@ pub struct AngleSearch<T> {
     l_min: T,
     l_max: T,
     l_mean: T,
+    /// √(L̂d·L̂q): the pulses' return to zero ([`return_voltage`]).
+    ///
+    /// [`return_voltage`]: crate::control::initial_angle
+    l_return: T,
     d_larger: bool,
     /// The model's d axis meets the larger incremental inductance along +d than along −d
     /// ([`inverted_polarity`]): the faster rise then points against the magnet.
@@ -327,6 +331,7 @@ impl<T: Real> AngleSearch<T> {
             l_min: crate::real::min(machine.ld, machine.lq),
             l_max: crate::real::max(machine.ld, machine.lq),
             l_mean,
+            l_return: (machine.ld * machine.lq).sqrt(),
             d_larger: d_axis_larger(machine, tuning.pulse_current_ratio * machine.rated_current),
             inverted: inverted_polarity(
                 machine,
@@ -372,8 +377,10 @@ impl<T: Real> AngleSearch<T> {
     }
 
     /// Starts watching the offset calibration from reference current `reference` (the
-    /// mean raw current of its first samples, A).
-    pub fn watch_offsets(&mut self, reference: Ab<T>) {
+    /// mean raw current of its first samples, A), uncertain by `reference_error` (A:
+    /// [`MotionMonitor::set_reference_error`]).
+    pub fn watch_offsets(&mut self, reference: Ab<T>, reference_error: T) {
+        self.monitor.set_reference_error(reference_error);
         self.monitor.restart(reference);
     }
 
@@ -488,7 +495,7 @@ impl<T: Real> AngleSearch<T> {
                 min_saliency: T::lit(DEFAULT_MIN_SALIENCY),
                 min_polarity: T::lit(DEFAULT_MIN_POLARITY),
                 d_larger: self.d_larger,
-                inductance: self.l_mean,
+                inductance: self.l_return,
                 ts: self.ts,
             };
             self.monitor.restart(Ab::zero());
@@ -572,7 +579,7 @@ impl<T: Real> AngleSearch<T> {
             InitialAngleStatus::Found => self.found(angle),
             InitialAngleStatus::AxisOnly => {
                 let (voltage, n) = self.pulse(self.tuning.polarity_current_ratio, vdc);
-                let test = PolarityTest::new(angle, voltage, n, self.l_mean, self.ts);
+                let test = PolarityTest::new(angle, voltage, n, self.l_return, self.ts);
                 self.stage = Stage::Polarity(test);
                 self.status = StartupStatus::TestingPolarity;
                 StartupCommand::Voltage(Ab::zero())

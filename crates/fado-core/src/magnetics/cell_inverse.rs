@@ -35,6 +35,12 @@ use crate::{Dq, Real};
 /// without it the walk could alternate between them.
 const CELL_TOLERANCE_EPS: f64 = 64.0;
 
+/// [`CELL_TOLERANCE_EPS`] in the type's units.
+#[inline(always)]
+pub(super) fn cell_tolerance<T: Real>() -> T {
+    T::default_epsilon() * T::lit(CELL_TOLERANCE_EPS)
+}
+
 /// One cell's bilinear polynomial ψ(u, v) = p00 + ex·u + ey·v + twist·u·v, u and v its
 /// fractions along i_d and i_q.
 #[derive(Clone, Copy, Debug)]
@@ -96,12 +102,18 @@ impl<T: Real> CellPolynomial<T> {
         (h.d - self.ey.d * v) / (self.ex.d + self.twist.d * v)
     }
 
-    /// The fractions (u, v) where the polynomial is `psi`: of the (up to) two roots the one
-    /// nearer the cell; None if there is no real root.
-    pub fn solve(&self, psi: Dq<T>) -> Option<(T, T)> {
+    /// The quadratic's coefficients that do not depend on ψ: (k2, ex × ey).
+    #[inline]
+    pub fn constants(&self) -> (T, T) {
+        (cross(self.twist, self.ey), cross(self.ex, self.ey))
+    }
+
+    /// The fractions (u, v) where the polynomial is `psi`, given the cell's
+    /// [`CellPolynomial::constants`]: of the (up to) two roots the one nearer the cell; None if
+    /// there is no real root.
+    pub fn solve_with(&self, psi: Dq<T>, (k2, ex_ey): (T, T)) -> Option<(T, T)> {
         let h = psi - self.p00;
-        let k2 = cross(self.twist, self.ey);
-        let k1 = cross(self.ex, self.ey) + cross(h, self.twist);
+        let k1 = ex_ey + cross(h, self.twist);
         let k0 = cross(h, self.ex);
         let disc = k1 * k1 - T::lit(4.0) * k2 * k0;
         if !disc.is_finite() || disc < T::zero() {
@@ -163,7 +175,7 @@ fn outside<T: Real>((u, v): (T, T)) -> T {
 /// −1, 0 or +1: the neighbouring cell along one axis the fraction `x` of cell `k` points into
 /// (0 inside the cell to the tolerance, or beyond the grid in an edge cell).
 #[inline]
-fn direction<T: Real>(x: T, k: usize, last: usize, tol: T) -> isize {
+pub(super) fn direction<T: Real>(x: T, k: usize, last: usize, tol: T) -> isize {
     if x < -tol && k > 0 {
         -1
     } else if x > T::one() + tol && k < last {
@@ -176,16 +188,42 @@ fn direction<T: Real>(x: T, k: usize, last: usize, tol: T) -> isize {
 /// i(ψ) on `grid` from the cell of `guess` (module docs); None where the closed form finds no
 /// root or the walk does not settle.
 pub(super) fn invert<T: Real>(grid: &impl CellGrid<T>, psi: Dq<T>, guess: Dq<T>) -> Option<Dq<T>> {
-    let (last_k, last_m) = grid.last_cell();
-    let (mut k, mut m) = grid.cell_of(guess);
-    let tol = T::default_epsilon() * T::lit(CELL_TOLERANCE_EPS);
-    for walk in 0..last_k + last_m + 2 {
+    invert_from(grid, grid.cell_of(guess), |k, m| {
         let cell = grid.polynomial(k, m);
-        let root = cell.solve(psi);
-        // No real root: the point lies where this cell's extension folds; its linearisation
-        // at the centre still points towards the solution's cell.
+        cell.root_or_direction(psi, cell.constants())
+    })
+}
+
+impl<T: Real> CellPolynomial<T> {
+    /// The root (u, v) at `psi` as [`CellPolynomial::solve_with`], and the fractions the walk
+    /// follows: the root, or where there is none (the point lies where this cell's extension
+    /// folds) this cell's linearisation at its centre, which still points towards the
+    /// solution's cell.
+    #[inline]
+    pub fn root_or_direction(&self, psi: Dq<T>, constants: (T, T)) -> (Option<(T, T)>, (T, T)) {
+        let root = self.solve_with(psi, constants);
         let half = T::lit(0.5);
-        let (u, v) = root.unwrap_or_else(|| cell.newton_step(psi, (half, half)));
+        (
+            root,
+            root.unwrap_or_else(|| self.newton_step(psi, (half, half))),
+        )
+    }
+}
+
+/// [`invert`] from the cell `start` (the warm start's), with cell (k, m)'s
+/// [`CellPolynomial::root_or_direction`] at the ψ sought from `solve_at` (a cache's,
+/// [`super::InverseCache`]).
+#[inline]
+pub(super) fn invert_from<T: Real>(
+    grid: &impl CellGrid<T>,
+    start: (usize, usize),
+    mut solve_at: impl FnMut(usize, usize) -> (Option<(T, T)>, (T, T)),
+) -> Option<Dq<T>> {
+    let (last_k, last_m) = grid.last_cell();
+    let (mut k, mut m) = start;
+    let tol = cell_tolerance::<T>();
+    for walk in 0..last_k + last_m + 2 {
+        let (root, (u, v)) = solve_at(k, m);
         let (dk, dm) = (direction(u, k, last_k, tol), direction(v, m, last_m, tol));
         if dk == 0 && dm == 0 {
             let (u, v) = root?;

@@ -34,7 +34,10 @@
 //! the neighbouring cell the solution points into, one or two cells per inversion — Newton's
 //! method on the whole map needs three evaluations or more and stalls on the kinks of its
 //! Jacobian at the cell edges (it remains the fallback where a cell's quadratic has no real
-//! root). The algebraic model's ψ(i) (its inverse form) is solved by
+//! root). A caller that inverts many times from one warm start (a plant's Runge–Kutta stages)
+//! keeps the start's cell and the last cells' polynomials in an [`InverseCache`]: the same walk
+//! and arithmetic, so the same result to the bit, without finding the start cell or loading a
+//! cell's corners again. The algebraic model's ψ(i) (its inverse form) is solved by
 //! Newton's method on the model's own Jacobian, from the magnetically linear guess or from a
 //! caller's warm start (a plant's last current): at most [`NEWTON_ITERATIONS`] steps, stopping
 //! when the step is below √ε/16 of the solution's size (then the error is of the order of ε). Saturation curves are
@@ -47,6 +50,7 @@
 mod cell_inverse;
 mod constant;
 mod flux_map;
+mod inverse_cache;
 mod machine;
 mod saturation;
 mod uniform_map;
@@ -54,6 +58,7 @@ mod uniform_table;
 
 pub use constant::ConstantInductance;
 pub use flux_map::{FluxMap, FluxMapError, FluxTable};
+pub use inverse_cache::InverseCache;
 pub use machine::{MachineMagnetics, zero_current_constants};
 pub use saturation::Saturation;
 pub use uniform_map::UniformFluxMap;
@@ -264,6 +269,22 @@ impl<T: Real> Magnetics<'_, T> {
     /// True for constant inductances (a plant keeps its closed-form path for them).
     pub fn is_linear(&self) -> bool {
         matches!(self, Magnetics::Constant(_))
+    }
+
+    /// [`MagneticModel::current_from`], a map's with the warm start's cell kept in `cache`
+    /// ([`InverseCache`], one per model): the same result.
+    #[inline]
+    pub fn current_from_cached(
+        &self,
+        psi: Dq<T>,
+        guess: Dq<T>,
+        cache: &mut InverseCache<T>,
+    ) -> Dq<T> {
+        match self {
+            Magnetics::Map(m) => m.current_from_cached(psi, guess, cache),
+            Magnetics::Uniform(m) => m.current_from_cached(psi, guess, cache),
+            _ => self.current_from(psi, guess),
+        }
     }
 }
 

@@ -25,8 +25,9 @@ const HOLD_CURRENT_RULE: &str = "10·ω_h of the release hold's design travel wh
 
 /// The speed loop's bandwidth on a light rotor, and T2S-2's with it.
 const SPEED_RULE: &str = "raised until a step of the rated torque at the rated speed dips \
-    the speed by at most `[controller.speed] load_step_dip_ratio` × the rated speed, T2S-2 in \
-    the tuning's ratio (fado_core::control::speed_bandwidth)";
+    the speed by at most `[controller.speed] load_step_dip_ratio` × the rated speed and a ramp \
+    of the rated torque over `load_ramp_time` leaves at most `load_ramp_error_ratio` × the \
+    rated speed, T2S-2 in the tuning's ratio (fado_core::control::speed_bandwidth)";
 
 /// The injection's bound on a salient rotor.
 const INJECTION_RULE: &str = "the injection's I_min bounded to `[controller.injection] \

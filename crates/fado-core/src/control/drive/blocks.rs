@@ -9,8 +9,8 @@ use crate::control::delay_compensation::{DelayCompensation, DelayCompensationCon
 use crate::control::field_weakening::FieldWeakening;
 use crate::control::lock_reaction::LockSupervisor;
 use crate::control::modulation::{ModulatorConfig, SpaceVectorModulator};
+use crate::control::phase_band::PhaseBand;
 use crate::control::ratings_limit::RatingsLimit;
-use crate::control::release_current::ReleaseCurrent;
 use crate::control::release_hold::ReleaseHold;
 use crate::control::saturated_references::SaturatedReferences;
 use crate::control::speed_controller::{SpeedController, SpeedControllerConfig};
@@ -122,7 +122,7 @@ impl<T: Real> Blocks<T> {
         let limits = RatingsLimit::new(&t.limits, m)?;
         Ok(Self {
             hold,
-            release_current: ReleaseCurrent::for_inverter(m, dead_time.config()),
+            phase_band: PhaseBand::new(m, dead_time.config()),
             speed,
             injection,
             current,
@@ -147,6 +147,7 @@ impl<T: Real> Blocks<T> {
         self.dc_link.reset();
         self.field_weakening.reset();
         self.hold.disarm();
+        self.phase_band.reset();
     }
 }
 

@@ -11,6 +11,11 @@ use crate::{Ab, Abc, Dq, Real, Rotation};
 /// rotor by a thousandth of a radian on the presets.
 const OFFSET_REFERENCE_SAMPLES: u32 = 10;
 
+/// The reference's uncertainty the motion monitor allows for, in standard errors of its mean
+/// (from the spread of its samples): 3 \[A\], a false reading of motion on one start-up in
+/// several hundred with Gaussian noise.
+const REFERENCE_ERROR_SIGMAS: f64 = 3.0;
+
 impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
     /// One sample of the offset calibration: gates off, duties ½, nothing else stepped; or,
     /// when the start-up watches it ([`AngleSearch::watches_offsets`]), the zero vector
@@ -26,6 +31,9 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         );
         self.calibration_remaining -= 1;
         let watched = self.startup.watches_offsets();
+        if watched {
+            self.calibration_square_sum += i_abc.to_ab().norm_squared();
+        }
         if watched && self.watch_offsets(i_abc) {
             // The rotor moves: the offsets of the samples before it did, and the start-up
             // defers (the zero vector from the next sample, through the angle phase).
@@ -63,7 +71,12 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             let k = T::one() / T::lit(taken as f64);
             let sum = self.calibration_sum;
             self.current_offset = Abc::new(sum.a * k, sum.b * k, sum.c * k);
-            self.startup.watch_offsets(self.current_offset.to_ab());
+            let mean = self.current_offset.to_ab();
+            // The spread of the samples, and three standard errors of their mean.
+            let variance =
+                (self.calibration_square_sum * k - mean.norm_squared()).step_max(T::zero());
+            let error = T::lit(REFERENCE_ERROR_SIGMAS) * (variance * k).sqrt();
+            self.startup.watch_offsets(mean, error);
             return false;
         }
         self.startup.offset_sample(i_abc.to_ab())

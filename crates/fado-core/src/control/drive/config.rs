@@ -127,7 +127,8 @@ impl<T: Real> DriveConfig<T> {
     /// Applies the drive's build-time rules to this configuration and the estimator's tuning,
     /// in place: the tracker feed-forward
     /// ([`tracker_feedforward::apply`](crate::control::tracker_feedforward::apply)), the speed
-    /// loop's bandwidth of its load step ([`speed_bandwidth::apply`](crate::control::speed_bandwidth::apply))
+    /// loop's bandwidth of its load step ([`speed_bandwidth::apply`](crate::control::speed_bandwidth::apply)),
+    /// the standstill probe's period ([`probe_period::apply`](crate::control::probe_period::apply))
     /// and the current loop an enabled release hold needs
     /// ([`current_bandwidth_for_hold`](crate::control::release_hold::current_bandwidth_for_hold)).
     /// The drive runs with the result ([`SensorlessDrive::new`](crate::control::SensorlessDrive::new));
@@ -136,6 +137,7 @@ impl<T: Real> DriveConfig<T> {
         let machine = self.machine;
         crate::control::tracker_feedforward::apply(&machine, &mut self.tuning, estimator, self.ts);
         crate::control::speed_bandwidth::apply(&machine, &mut self.tuning, estimator, self.ts);
+        crate::control::probe_period::apply(&machine, &mut self.tuning, estimator, self.ts);
         let t = &mut self.tuning;
         t.current.bandwidth_hz = crate::control::release_hold::current_bandwidth_for_hold(
             &t.release_hold,

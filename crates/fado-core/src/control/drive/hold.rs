@@ -39,7 +39,12 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         if !self.blocks.hold.awaiting_fall() {
             return i;
         }
-        match self.blocks.release_current.d_current(theta, vdc) {
+        match self
+            .blocks
+            .phase_band
+            .release_current()
+            .d_current(theta, vdc)
+        {
             Some(floor) => Dq::new(i.d.step_max(floor), i.q),
             None => i,
         }

@@ -52,6 +52,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             rejected_samples: 0,
             calibration_remaining: 0,
             calibration_sum: Abc::new(T::zero(), T::zero(), T::zero()),
+            calibration_square_sum: T::zero(),
             current_offset: Abc::new(T::zero(), T::zero(), T::zero()),
             aligned_angle: T::zero(),
             gain: GainCalibration::new(config.gain_calibration_config()?)?,
@@ -144,6 +145,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
     pub fn calibrate_offsets(&mut self) {
         self.calibration_remaining = self.resolved.offset_calibration_samples;
         self.calibration_sum = Abc::new(T::zero(), T::zero(), T::zero());
+        self.calibration_square_sum = T::zero();
         if self.calibration_remaining > 0 {
             self.last.gates_enabled = false;
         }

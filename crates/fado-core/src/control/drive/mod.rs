@@ -33,6 +33,7 @@ mod hold;
 mod lifecycle;
 mod lock;
 mod output;
+pub mod probe_period;
 mod references;
 mod reject;
 mod resolved;
@@ -58,7 +59,9 @@ use crate::control::gain_calibration::GainCalibration;
 use crate::control::lock_reaction::LockSupervisor;
 use crate::control::modulation::SpaceVectorModulator;
 use crate::control::monitor::{DriveFlags, FlagCounts, PersistenceMonitor, StuckChannelDetector};
+use crate::control::phase_band::PhaseBand;
 use crate::control::ratings_limit::RatingsLimit;
+#[cfg(doc)]
 use crate::control::release_current::ReleaseCurrent;
 use crate::control::release_hold::ReleaseHold;
 use crate::control::saturated_references::SaturatedReferences;
@@ -152,8 +155,10 @@ struct Blocks<T> {
     field_weakening: FieldWeakening<T>,
     /// The release hold after the start-up.
     hold: ReleaseHold<T>,
-    /// The d-current floor while the hold is armed (no phase in the dead-time band).
-    release_current: ReleaseCurrent<T>,
+    /// The d-current floor while the hold is armed (its [`ReleaseCurrent`]) and no phase
+    /// current inside
+    /// the dead-time band near zero speed (see [`phase_band`](crate::control::phase_band)).
+    phase_band: PhaseBand<T>,
     limits: RatingsLimit<T>,
 }
 
@@ -208,6 +213,8 @@ pub struct SensorlessDrive<T: 'static, E = SensorlessEstimator<T>> {
     calibration_remaining: u32,
     /// Sum of the raw phase currents during the calibration.
     calibration_sum: Abc<T>,
+    /// Sum of |i_ab|² of the raw currents during a watched offset calibration (A²).
+    calibration_square_sum: T,
     /// Phase-current offsets subtracted from every sample (A).
     current_offset: Abc<T>,
     /// The angle of the last `align`, re-applied when the calibration ends.

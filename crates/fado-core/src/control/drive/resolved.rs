@@ -41,6 +41,8 @@ impl<T: Real> Resolved<T> {
                     t.injection.max_active_flux_share,
                 )?;
                 check::positive("speed.load_step_dip_ratio", t.speed.load_step_dip_ratio)?;
+                check::positive("speed.load_ramp_time", t.speed.load_ramp_time)?;
+                check::positive("speed.load_ramp_error_ratio", t.speed.load_ramp_error_ratio)?;
                 c.i_min()
             },
             trip_current: check::positive("trip_current_ratio", t.protection.trip_current_ratio)?

@@ -127,9 +127,19 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             return Err(self.reject_after_estimate(backup, estimate, i_dq));
         };
         // 5.–8. Current loop, delay and dead-time compensation, modulation, anti-windup.
+        // 5. Current loop (unlimited); a saturating model's decoupling from its flux at the
+        //    reference (the torque solve's last evaluation, no extra solve).
+        let flux = self
+            .resolved
+            .saturated
+            .as_ref()
+            .map(|_| self.saturated_flux);
         let b = &mut self.blocks;
-        // 5. Current loop (unlimited).
-        let Ok(v_dq) = b.current.step(i_dq_ref, i_dq, omega_ctrl) else {
+        let v_dq = match flux {
+            Some(psi) => b.current.step_with_flux(i_dq_ref, i_dq, omega_ctrl, psi),
+            None => b.current.step(i_dq_ref, i_dq, omega_ctrl),
+        };
+        let Ok(v_dq) = v_dq else {
             return Err(self.reject_after_estimate(backup, estimate, i_dq));
         };
         b.field_weakening
@@ -361,6 +371,11 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             };
             let i = self.currents_for_torque(iq_torque, guess, id_added);
             let i = self.release_current_floor(i, estimate.theta, vdc);
+            let limiter = estimate.diagnostics.mode == crate::mode::Mode::Limiter;
+            let i = self
+                .blocks
+                .phase_band
+                .shift(i, estimate.theta, vdc, limiter);
             let i = limit_current_d_priority(i, self.resolved.i_max);
             let i = self.voltage_ellipse(i, vdc, estimate.omega_control);
             let iq_max = self

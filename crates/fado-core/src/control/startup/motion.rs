@@ -23,7 +23,9 @@
 //! vector, adds a voltage against the current that the monitor does not count: it reads less
 //! than the true travel, the more so the smaller the machine's resistance against the dead
 //! time's voltage (measured in `crates/fado-sim/tests/startup_motion.rs`: 0.17 rad true for
-//! 0.05 read on the 2.2 kW IPMSM, 1.75 rad on the servo motor). A rotor stands still
+//! 0.05 read on the 2.2 kW IPMSM, 1.75 rad on the servo motor). The reference current is uncertain (the mean of a few
+//! samples): the threshold grows with what that uncertainty integrates to through R̂s
+//! ([`MotionMonitor::set_reference_error`]). A rotor stands still
 //! ([`MotionMonitor::quiet`]) when the reading stays small and the shorted phases carry no
 //! current above [`READ_CURRENT_RATIO`] of the rated current.
 //!
@@ -48,6 +50,11 @@ pub struct MotionMonitor<T> {
     /// What the quiet current alone reads, L̂·I_quiet/λ̂f (rad; 0 without a magnet flux): the
     /// floor of [`Self::threshold`].
     travel_floor: T,
+    /// R̂s·δ·Ts/λ̂f: the travel a reference current off by its own uncertainty δ (A) reads per
+    /// sample ([`set_reference_error`](Self::set_reference_error)); 0 without a magnet flux.
+    drift_per_sample: T,
+    /// Samples since the reference sample.
+    samples: T,
     /// Σ (v − R̂s·(i − i₀))·Ts since the reference sample (V·s).
     flux: Ab<T>,
     /// The reference current i₀ (A).
@@ -76,6 +83,8 @@ impl<T: Real> MotionMonitor<T> {
             ts,
             quiet_current,
             travel_floor,
+            drift_per_sample: T::zero(),
+            samples: T::zero(),
             flux: Ab::zero(),
             reference: Ab::zero(),
             travel: T::zero(),
@@ -87,10 +96,30 @@ impl<T: Real> MotionMonitor<T> {
     /// Starts from this sample with reference current `reference` (A).
     pub fn restart(&mut self, reference: Ab<T>) {
         self.flux = Ab::zero();
+        self.samples = T::zero();
         self.reference = reference;
         self.travel = T::zero();
         self.loud = false;
         self.running = true;
+    }
+
+    /// The uncertainty δ (A, α-β magnitude) of the current the readings start from (the mean
+    /// of the few samples the reference is taken over: the sensors' noise and resolution). A
+    /// reference off by δ reads as a short-circuit current δ that flows on and integrates
+    /// through R̂s to R̂s·δ·t/λ̂f (the travel a rotor creeping at R̂s·δ/λ̂f reads alike), which
+    /// [`threshold`](Self::threshold) then adds. Kept over restarts (the deferral's windows
+    /// read from the same offsets) until set again; a non-finite or negative δ counts as 0.
+    pub fn set_reference_error(&mut self, delta: T) {
+        let delta = if delta >= T::zero() && delta.is_finite() {
+            delta
+        } else {
+            T::zero()
+        };
+        self.drift_per_sample = if self.flux_linkage > T::zero() {
+            self.rs * delta * self.ts / self.flux_linkage
+        } else {
+            T::zero()
+        };
     }
 
     /// Stops reading (the travel is kept).
@@ -111,6 +140,7 @@ impl<T: Real> MotionMonitor<T> {
             return self.travel;
         }
         let di = i_ab - self.reference;
+        self.samples += T::one();
         self.flux += (v_ab - di * self.rs) * self.ts;
         let small = di.norm() <= self.quiet_current;
         self.loud |= !small;
@@ -129,13 +159,19 @@ impl<T: Real> MotionMonitor<T> {
     /// that the monitor accepts as standing still ([`READ_CURRENT_RATIO`]) must not read as
     /// motion: on a low-inductance machine of small magnet flux (a 135 µH, 1.5 mWb multirotor
     /// motor: 0.106 rad) the sensors' noise alone reads past the default 0.05 rad.
+    ///
+    /// Plus the reference's drift R̂s·δ·t/λ̂f since the restart
+    /// ([`set_reference_error`](Self::set_reference_error)): on a multirotor motor of 0.15 Ω
+    /// and 2 mWb a reference off by 7 mA (ten samples of a 12-bit sensor) reads 0.054 rad in
+    /// 0.1 s, and a rotor that a brake holds would defer its start-up for ever.
     pub fn threshold(&self, travel: T) -> T {
         // NaN compares false: the tuning's travel.
-        if self.travel_floor > travel {
+        let base = if self.travel_floor > travel {
             self.travel_floor
         } else {
             travel
-        }
+        };
+        base + self.drift_per_sample * self.samples
     }
 
     /// The largest travel read since the last restart (electrical rad).

@@ -3,12 +3,8 @@
 //! whose current adds to the magnet's flux and saturates the d-axis iron further.
 
 use super::POLARITY_PAIRS;
-use crate::control::initial_angle::DEFAULT_MIN_POLARITY;
+use crate::control::initial_angle::{DEFAULT_MIN_POLARITY, return_voltage};
 use crate::{Ab, Real};
-
-/// Gain of the return to zero after a pair, as the search's (`initial_angle`'s
-/// `RETURN_GAIN`): a double pole at 0.5 behind the one-sample delay.
-const RETURN_GAIN: f64 = 0.25;
 
 /// The polarity test (module docs). Allocation-free.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -25,6 +21,8 @@ pub struct PolarityTest<T> {
     sums: (T, T),
     contrast: T,
     result: Option<Option<T>>,
+    /// The voltage returned at the last sample (acting over the next period).
+    pending: Ab<T>,
 }
 
 impl<T: Real> PolarityTest<T> {
@@ -43,6 +41,7 @@ impl<T: Real> PolarityTest<T> {
             sums: (T::zero(), T::zero()),
             contrast: T::zero(),
             result: None,
+            pending: Ab::zero(),
         }
     }
 
@@ -100,14 +99,14 @@ impl<T: Real> PolarityTest<T> {
             self.evaluate();
             return Ab::zero();
         }
-        if phase < n {
+        self.pending = if phase < n {
             u * self.voltage
         } else if phase < 2 * n {
             u * (-self.voltage)
         } else {
-            let i = if i_ab.is_finite() { i_ab } else { Ab::zero() };
-            i * (-T::lit(RETURN_GAIN) * self.inductance / self.ts)
-        }
+            return_voltage(i_ab, self.pending, self.inductance, self.ts)
+        };
+        self.pending
     }
 
     /// Adds the finished pair before `pair` to its direction's sum.

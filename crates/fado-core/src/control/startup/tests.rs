@@ -211,3 +211,49 @@ fn the_motion_monitor_reads_the_rotors_travel_under_the_zero_vector() {
     );
     assert!(!m.quiet(0.05));
 }
+
+#[test]
+fn a_reference_off_by_its_own_uncertainty_reads_no_motion() {
+    // The MAD 5010 KV200 datasheet motor (0.152 Ω, 26.5 µH, 1.97 mWb, 20 A, 40 kHz) at rest
+    // under the zero vector: the true current is 0, the reference 7 mA off (ten samples of a
+    // 12-bit sensor). Over a 0.1 s window the offset reads R·δ·t/λf = 0.054 rad, past the
+    // tuning's 0.05; with the reference's uncertainty (3 standard errors, 10 mA) allowed for,
+    // the rotor stands still, and a rotor turning at 20 rad/s still reads as moving.
+    let ts = 25e-6;
+    let (r, l, lf) = (0.1523, 26.49e-6, 1.969e-3);
+    let n = (0.1 / ts) as usize;
+    let read = |delta: f64, omega: f64| {
+        let mut m = MotionMonitor::new(r, l, lf, 20.0, ts);
+        m.set_reference_error(delta);
+        m.restart(Ab::new(0.007, 0.0));
+        let (mut theta, mut i) = (0.3_f64, Ab::<f64>::zero());
+        for _ in 0..n {
+            let (s, c) = theta.sin_cos();
+            let e = Ab::new(-omega * lf * s, omega * lf * c);
+            i += (i * (-r) - e) * (ts / l);
+            theta += omega * ts;
+            m.step(Ab::zero(), i);
+        }
+        m
+    };
+    let blind = read(0.0, 0.0);
+    assert!(
+        blind.travel() > 0.05 && !blind.quiet(0.05),
+        "{}",
+        blind.travel()
+    );
+    let still = read(0.010, 0.0);
+    assert!(
+        still.quiet(0.05),
+        "{} {}",
+        still.travel(),
+        still.threshold(0.05)
+    );
+    let turning = read(0.010, 20.0);
+    assert!(!turning.quiet(0.05), "{}", turning.travel());
+    // A non-finite uncertainty counts as none.
+    let mut m = MotionMonitor::new(r, l, lf, 20.0, ts);
+    m.set_reference_error(f64::NAN);
+    m.restart(Ab::zero());
+    assert_eq!(m.threshold(0.05), 0.05);
+}

@@ -63,9 +63,22 @@ pub struct SpeedLoopTuning<T> {
     /// rated speed turning the other way, where the drive has the voltage for its rated
     /// torque; no preset needs more than its 5 Hz. A large value (1e9) keeps `bandwidth_hz`.
     pub load_step_dip_ratio: T,
+    /// The drive raises `bandwidth_hz` (and T2S-2's with it) until a ramp of the rated torque
+    /// over `load_ramp_time` leaves a steady speed error of at most `load_ramp_error_ratio` ×
+    /// the rated speed: ωs ≥ √(zero_ratio/(ε·t_r·τm)) ([`crate::control::speed_bandwidth`]).
+    /// Default 1 s \[A\]: the scaled scenarios ramp 65 % of the rated torque in 0.5 s (1.3
+    /// rated torques per second). A large value (1e9) keeps `bandwidth_hz`.
+    pub load_ramp_time: T,
+    /// The steady speed error ε (a multiple of the rated speed) that a ramp of the rated
+    /// torque over `load_ramp_time` may leave. Default 0.13 \[A\]: every preset keeps its 5 Hz
+    /// from ε·t_r = 0.086 s on (pmsyrm-5k, τm = 59 ms), a 32-pole torque motor (τm = 39 ms),
+    /// whose loaded passage through zero speed does not take a faster loop, from 0.129 s on
+    /// ([`crate::control::speed_bandwidth`]); a light rotor (τm of a few ms) gets the bandwidth
+    /// of its ramp. A large value (1e9) keeps `bandwidth_hz`.
+    pub load_ramp_error_ratio: T,
 }
 
-cast_record!(SpeedLoopTuning { bandwidth_hz, zero_ratio, anti_windup_ratio, load_step_dip_ratio ;  });
+cast_record!(SpeedLoopTuning { bandwidth_hz, zero_ratio, anti_windup_ratio, load_step_dip_ratio, load_ramp_time, load_ramp_error_ratio ;  });
 
 impl<T: Real> Default for SpeedLoopTuning<T> {
     fn default() -> Self {
@@ -74,6 +87,8 @@ impl<T: Real> Default for SpeedLoopTuning<T> {
             zero_ratio: T::lit(speed_controller::DEFAULT_ZERO_RATIO),
             anti_windup_ratio: T::lit(speed_controller::DEFAULT_ANTI_WINDUP_RATIO),
             load_step_dip_ratio: T::lit(2.0),
+            load_ramp_time: T::lit(1.0),
+            load_ramp_error_ratio: T::lit(0.13),
         }
     }
 }
