@@ -157,13 +157,13 @@ impl<T: Real> SensorlessEstimator<T> {
     }
 
     /// The voltage of this sample's interval was limited by the modulator (the drive's
-    /// hexagon): the R̂s adaptation (and its λ̂f law) does not adapt over the period that
-    /// contains it, as over a mode change. On a limited sample the realised voltage the drive
+    /// hexagon): R̂s's turning law (and its λ̂f law) does not adapt over the period that
+    /// contains it. On a limited sample the realised voltage the drive
     /// reports carries the inverter's least-modelled errors (legs held at a rail without
     /// dead time, pulses near the rails), which the turning law would read as resistance
     /// ([`crate::rs_adaptation`]). Call before [`step`](Self::step).
     pub fn voltage_limited(&mut self) {
-        self.state.slow_broken |= super::BROKEN_RS;
+        self.state.slow_broken |= super::BROKEN_LIMITED;
     }
 
     /// ê, the learned integrand offset (V, α-β; zero without `rs_adaptation`).

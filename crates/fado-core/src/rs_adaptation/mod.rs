@@ -136,9 +136,9 @@
 //! down to ε. Measured on the fig11 λ̂f × load envelope (docs/method/additions.md): 62 of 63
 //! points pass, 60 with the plain dead zone, 23 without the law.
 //!
-//! Both laws are frozen while the trackers coast, on a mode change and on rejected samples,
-//! and over a period that contains a sample whose voltage the drive's modulator limited
-//! ([`crate::SensorlessEstimator::voltage_limited`]): on the hexagon the legs held at a rail
+//! Both laws are frozen while the trackers coast, on a mode change and on rejected samples;
+//! the turning law (and the λ̂f law) also over a period that contains a sample whose voltage
+//! the drive's modulator limited ([`crate::SensorlessEstimator::voltage_limited`]): on the hexagon the legs held at a rail
 //! have no dead time while the drive reports the compensation as lost, and the pulses near
 //! the rails are the inverter's least-modelled; the turning law read that as resistance,
 //! −0.7 % of Rs over `fullrange`'s acceleration at the current limit into field weakening on
