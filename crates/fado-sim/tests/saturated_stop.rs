@@ -3,7 +3,7 @@
 //! with a brake chopper, the range scenarios' acceleration feed-forward, switching-resolved
 //! with the default non-idealities, the current-sensor seeds 1–4. The machine generates at
 //! twice its rated torque down to 300 r/min and the speed loop then leaves the current limit,
-//! where the deceleration falls by 2,000 rad/s² (electrical) at 20–40 Hz: the observer's
+//! where the deceleration falls by 2,000 rad/s² (electrical) at 10–3 Hz electrical: the observer's
 //! notched speed (`fado_core::speed_notch`, "The chirp") removes nothing of that change and
 //! the angle holds within 0.25 rad down to the Fig. 3 threshold (2.75 s), with no trip.
 

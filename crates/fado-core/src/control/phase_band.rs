@@ -191,7 +191,7 @@ mod tests {
         assert!(shifts > 0 && shifts < 36_000 / 10, "{shifts}");
         let paper = MachineModel::<f64>::paper();
         let mut off = PhaseBand::new(&paper, &DeadTimeCompensationConfig::for_machine(&paper));
-        for theta in [0.0, 0.5, 1.0, 1.5707963] {
+        for theta in [0.0, 0.5, 1.0, core::f64::consts::FRAC_PI_2] {
             let i = Dq::new(0.0, 0.1);
             assert_eq!(off.shift(i, theta, 311.0, true), i);
         }

@@ -3,7 +3,7 @@
 use core::fmt;
 
 use super::cell_inverse::{self, CellGrid, CellPolynomial};
-use super::{InductanceMatrix, InverseCache, MagneticModel};
+use super::{InductanceMatrix, MagneticModel};
 use crate::{Dq, Real};
 
 /// A flux map on the rectangular grid `i_d` × `i_q` (both strictly increasing), borrowed:
@@ -322,22 +322,6 @@ impl<'a, T: Real> FluxMap<'a, T> {
         let (d, dd, dq) = bilinear(cd);
         let (q, qd, qq) = bilinear(cq);
         (Dq::new(d, q), InductanceMatrix { dd, dq, qd, qq })
-    }
-
-    /// [`MagneticModel::current_from`] with the warm start's cell kept in `cache` between
-    /// calls ([`InverseCache`]): the same result, one quadratic where the solution stays in
-    /// that cell.
-    #[inline]
-    pub fn current_from_cached(
-        &self,
-        psi: Dq<T>,
-        guess: Dq<T>,
-        cache: &mut InverseCache<T>,
-    ) -> Dq<T> {
-        match cache.invert(self, psi, guess) {
-            Some(i) => i,
-            None => self.current_from(psi, guess),
-        }
     }
 }
 

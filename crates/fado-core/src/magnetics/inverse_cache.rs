@@ -10,6 +10,7 @@
 //! ([`super::MagneticModel::current_from`]) with the same arithmetic, so the result is the
 //! same to the bit (tested).
 
+use super::MagneticModel;
 use super::cell_inverse::{CellGrid, CellPolynomial, invert_from};
 use crate::{Dq, Real};
 
@@ -20,8 +21,8 @@ pub const SLOTS: usize = 4;
 type Slot<T> = (usize, usize, CellPolynomial<T>, (T, T));
 
 /// The cells an inverse of one flux map last visited, for
-/// [`super::FluxMap::current_from_cached`] and [`super::UniformFluxMap::current_from_cached`].
-/// One cache belongs to one map: [`InverseCache::new`] for another.
+/// [`super::Magnetics::current_from_cached`] on a [`super::FluxMap`] or a
+/// [`super::UniformFluxMap`]. One cache belongs to one map: [`InverseCache::new`] for another.
 #[derive(Clone, Copy, Debug)]
 pub struct InverseCache<T> {
     /// The warm start whose cell `start` is (a NaN before the first call: never equal).
@@ -47,6 +48,22 @@ impl<T: Real> InverseCache<T> {
             start: (0, 0),
             slots: [None; SLOTS],
             next: 0,
+        }
+    }
+
+    /// The map's [`MagneticModel::current_from`] with its cells from the cache: the same
+    /// result.
+    #[inline]
+    pub(super) fn current_from<G: CellGrid<T> + MagneticModel<T>>(
+        &mut self,
+        map: &G,
+        psi: Dq<T>,
+        guess: Dq<T>,
+    ) -> Dq<T> {
+        match self.invert(map, psi, guess) {
+            Some(i) => i,
+            // No root on the walk: the map's own inverse, with its Newton fallback.
+            None => map.current_from(psi, guess),
         }
     }
 

@@ -281,8 +281,8 @@ impl<T: Real> Magnetics<'_, T> {
         cache: &mut InverseCache<T>,
     ) -> Dq<T> {
         match self {
-            Magnetics::Map(m) => m.current_from_cached(psi, guess, cache),
-            Magnetics::Uniform(m) => m.current_from_cached(psi, guess, cache),
+            Magnetics::Map(m) => cache.current_from(m, psi, guess),
+            Magnetics::Uniform(m) => cache.current_from(m, psi, guess),
             _ => self.current_from(psi, guess),
         }
     }

@@ -3,7 +3,7 @@
 
 use super::cell_inverse::{self, CellGrid, CellPolynomial};
 use super::uniform_table::{UniformFluxTable, bilinear_value, bilinear_with_jacobian, cell_of};
-use super::{InductanceMatrix, InverseCache, MagneticModel};
+use super::{InductanceMatrix, MagneticModel};
 use crate::{Dq, Real};
 
 /// A [`UniformFluxTable`] borrowed ([`UniformFluxTable::map`]): the same lookup, its cells a
@@ -55,21 +55,6 @@ impl<T: Real> UniformFluxMap<'_, T> {
     pub fn flux_and_jacobian(&self, i: Dq<T>) -> (Dq<T>, InductanceMatrix<T>) {
         let (k, m, fx, fy) = cell_of(self.first, self.inv_step, self.last, i);
         bilinear_with_jacobian(&self.coefficients(k, m), fx, fy, self.inv_step)
-    }
-
-    /// [`MagneticModel::current_from`] with the warm start's cell kept in `cache`, as
-    /// [`super::FluxMap::current_from_cached`].
-    #[inline]
-    pub fn current_from_cached(
-        &self,
-        psi: Dq<T>,
-        guess: Dq<T>,
-        cache: &mut InverseCache<T>,
-    ) -> Dq<T> {
-        match cache.invert(self, psi, guess) {
-            Some(i) => i,
-            None => self.current_from(psi, guess),
-        }
     }
 }
 
