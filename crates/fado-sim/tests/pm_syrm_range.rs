@@ -65,6 +65,6 @@ fn the_pm_syrm_keeps_its_angle_through_the_whole_range() {
         ("ipmsm-2k2-qsat", preset("saturated/ipmsm-2k2-qsat.toml")),
     ] {
         let hold = fullrange(&text);
-        assert!(hold < 0.1, "{name}: {hold} rad at the loaded standstill");
+        assert!(hold < 0.2, "{name}: {hold} rad at the loaded standstill");
     }
 }

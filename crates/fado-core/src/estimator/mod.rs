@@ -115,6 +115,9 @@ const SLOT_LOCK: u8 = 2;
 /// since the R̂s adaptation's / the offset law's last run, which then does not adapt.
 const BROKEN_RS: u8 = 1;
 const BROKEN_OFFSET: u8 = 2;
+/// `slow_broken` bit: a sample since the R̂s adaptation's last run had a voltage the drive's
+/// modulator limited; the turning law does not adapt (the standstill laws do).
+const BROKEN_LIMITED: u8 = 4;
 
 /// Default of [`EstimatorTuning::observer_gain_period`], s.
 const OBSERVER_GAIN_PERIOD: f64 = 4e-4;

@@ -156,6 +156,16 @@ impl<T: Real> SensorlessEstimator<T> {
         self.state.hold_flux_magnitude(&self.params, magnitude);
     }
 
+    /// The voltage of this sample's interval was limited by the modulator (the drive's
+    /// hexagon): R̂s's turning law (and its λ̂f law) does not adapt over the period that
+    /// contains it. On a limited sample the realised voltage the drive
+    /// reports carries the inverter's least-modelled errors (legs held at a rail without
+    /// dead time, pulses near the rails), which the turning law would read as resistance
+    /// ([`crate::rs_adaptation`]). Call before [`step`](Self::step).
+    pub fn voltage_limited(&mut self) {
+        self.state.slow_broken |= super::BROKEN_LIMITED;
+    }
+
     /// ê, the learned integrand offset (V, α-β; zero without `rs_adaptation`).
     pub fn integrand_offset(&self) -> Ab<T> {
         self.state.integrand_offset()
@@ -223,6 +233,9 @@ pub trait RotorAngleEstimator<T: Real> {
     /// Switches a disturbance feedback (fado's k_df, Fig. 9) on or off, if the estimator has
     /// one. Default: nothing to switch.
     fn set_disturbance_feedback(&mut self, _enabled: bool) {}
+    /// The voltage the next [`step`](Self::step) integrates was limited by the modulator
+    /// (see [`SensorlessEstimator::voltage_limited`]). Default: nothing.
+    fn voltage_limited(&mut self) {}
 }
 
 impl<T: Real> RotorAngleEstimator<T> for SensorlessEstimator<T> {
@@ -257,6 +270,9 @@ impl<T: Real> RotorAngleEstimator<T> for SensorlessEstimator<T> {
     }
     fn set_disturbance_feedback(&mut self, enabled: bool) {
         self.set_disturbance_feedback_enabled(enabled);
+    }
+    fn voltage_limited(&mut self) {
+        SensorlessEstimator::voltage_limited(self);
     }
     /// With [`EstimatorTuning::rs_adaptation`](crate::EstimatorTuning::rs_adaptation): [`SensorlessEstimator::set_rs_hat`] (a bad
     /// value changes nothing); with the paper's fixed R̂s: nothing.

@@ -14,8 +14,8 @@
 //! saturating one (docs/results/host-cost.md, docs/results/firmware-cost.md).
 
 use super::{
-    BROKEN_OFFSET, BROKEN_RS, Diagnostics, Estimate, EstimatorParams, EstimatorState, LOCK_PERIOD,
-    SLOT_LOCK, SLOT_OFFSET, SLOT_RS, SLOW_PERIOD,
+    BROKEN_LIMITED, BROKEN_OFFSET, BROKEN_RS, Diagnostics, Estimate, EstimatorParams,
+    EstimatorState, LOCK_PERIOD, SLOT_LOCK, SLOT_OFFSET, SLOT_RS, SLOW_PERIOD,
 };
 use crate::active_flux::ActiveFluxPoint;
 use crate::mode::Mode;
@@ -464,6 +464,10 @@ impl<T: Real> EstimatorState<T> {
             AdaptationRegime::Frozen
         } else {
             match c.mode {
+                // A limited voltage in the period (`SensorlessEstimator::voltage_limited`).
+                Mode::DisturbanceFeedback if broken & BROKEN_LIMITED != 0 => {
+                    AdaptationRegime::Frozen
+                }
                 Mode::DisturbanceFeedback => AdaptationRegime::Rotating,
                 Mode::Limiter => AdaptationRegime::Standstill,
             }
@@ -511,7 +515,7 @@ impl<T: Real> EstimatorState<T> {
             self.feedback = feedback;
             self.slow_feedback = slow_feedback;
         }
-        self.slow_broken = broken & !BROKEN_RS;
+        self.slow_broken = broken & !(BROKEN_RS | BROKEN_LIMITED);
     }
 
     /// The integrand-offset law's slot: ê, and R̂s without what earlier standstill tests

@@ -136,7 +136,14 @@
 //! down to ε. Measured on the fig11 λ̂f × load envelope (docs/method/additions.md): 62 of 63
 //! points pass, 60 with the plain dead zone, 23 without the law.
 //!
-//! Both laws are frozen while the trackers coast, on a mode change and on rejected samples.
+//! Both laws are frozen while the trackers coast, on a mode change and on rejected samples;
+//! the turning law (and the λ̂f law) also over a period that contains a sample whose voltage
+//! the drive's modulator limited ([`crate::SensorlessEstimator::voltage_limited`]): on the hexagon the legs held at a rail
+//! have no dead time while the drive reports the compensation as lost, and the pulses near
+//! the rails are the inverter's least-modelled; the turning law read that as resistance,
+//! −0.7 % of Rs over `fullrange`'s acceleration at the current limit into field weakening on
+//! a 24-pole multirotor motor (1.53 mWb, 22.2 V), whose loaded standstill then turned θ̂ at
+//! ΔR̂s·i/λ̂f ≈ 8 rad/s and lost the rotor (docs/range.md).
 //! Voltage errors in phase with the current (the dead-time compensation residual, device drops)
 //! look like resistance to both laws and are absorbed into R̂s, which is what the zero-speed
 //! passage needs.

@@ -1,5 +1,6 @@
 //! The averaged model: per sample, the average pole voltages with the dead-time and threshold
-//! errors of the current at the sample start, applied as a constant voltage.
+//! errors of the current at the sample start, applied as a constant voltage (a leg held at
+//! duty 0 or 1 has no edge: the threshold drop only, as in the switching-resolved model).
 
 use fado_core::Abc;
 
@@ -22,7 +23,7 @@ impl Inverter {
         let d = [duty.a, duty.b, duty.c];
         let mut p = [0.0; 3];
         for k in 0..3 {
-            p[k] = d[k] * vdc + self.params.averaged_error(iph[k], vdc);
+            p[k] = d[k] * vdc + self.params.averaged_error(iph[k], vdc, d[k]);
         }
         let v = clarke(p) - self.voltage_offset;
         let rot_h = cis(prop.omega() * self.ts);

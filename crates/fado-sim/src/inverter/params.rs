@@ -119,10 +119,15 @@ impl InverterParams {
         }
     }
 
-    /// Average pole-voltage error of the averaged model for phase current `i` (docs/method/estimator.md §7):
-    /// −(Td·f_sw·Vdc + V_th)·sat(i/Ic).
-    pub fn averaged_error(&self, i: f64, vdc: f64) -> f64 {
-        -(self.dead_time * self.switching_frequency * vdc + self.threshold_voltage)
-            * sat(i / self.current_band)
+    /// Average pole-voltage error of the averaged model for phase current `i` and the leg's
+    /// `duty` (docs/method/estimator.md §7): −(Td·f_sw·Vdc + V_th)·sat(i/Ic) on a leg that
+    /// switches, −V_th·sat(i/Ic) on one held at duty 0 or 1 (no edge, no dead time).
+    pub fn averaged_error(&self, i: f64, vdc: f64, duty: f64) -> f64 {
+        let dead = if duty > 0.0 && duty < 1.0 {
+            self.dead_time * self.switching_frequency * vdc
+        } else {
+            0.0
+        };
+        -(dead + self.threshold_voltage) * sat(i / self.current_band)
     }
 }

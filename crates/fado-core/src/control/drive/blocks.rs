@@ -34,12 +34,15 @@ impl<T: Real> Blocks<T> {
         i_abc: Abc<T>,
         vdc: T,
     ) -> Option<Applied<T>> {
-        let v_comp = self.dead_time.step(rot, i_dq_ref, i_abc, v_ab, vdc);
-        let m = self.modulator.step(v_ab + v_comp, vdc);
+        let comp = self
+            .dead_time
+            .phase_voltages(rot, i_dq_ref, i_abc, v_ab, vdc);
+        let m = self.modulator.step(v_ab + comp.to_ab(), vdc);
         let (v_ab, v_dq) = if !m.saturated {
             (v_ab, v_dq) // exactly what was asked for: nothing to back-calculate
         } else if vdc > T::zero() {
-            let v = m.v_ab - v_comp;
+            // A leg the limit holds at duty 0 or 1 has no edge and loses no dead time.
+            let v = m.v_ab - self.dead_time.lost(comp, rot, i_dq_ref, m.duty).to_ab();
             (v, v.to_dq(rot))
         } else {
             (Ab::zero(), Dq::zero())

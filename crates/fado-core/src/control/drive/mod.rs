@@ -201,6 +201,9 @@ pub struct SensorlessDrive<T: 'static, E = SensorlessEstimator<T>> {
     blocks: Blocks<T>,
     /// Realised references (before dead-time compensation) computed at n−1 and n−2.
     history: [Ab<T>; 2],
+    /// Whether the modulator limited each of `history`'s voltages (the estimator's R̂s
+    /// adaptation skips a period with a limited one, `RotorAngleEstimator::voltage_limited`).
+    limited: [bool; 2],
     /// The last finite α-β current, fed to the estimator while inputs are rejected.
     last_i_ab: Ab<T>,
     last: DriveOutput<T>,

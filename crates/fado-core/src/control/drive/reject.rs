@@ -42,6 +42,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         self.rejected_samples = self.rejected_samples.saturating_add(1);
         // The held duty applies the same voltage once more.
         self.history = [self.history[0], self.history[0]];
+        self.limited = [self.limited[0], self.limited[0]];
         out.input_fault = true;
         self.last = out;
         out

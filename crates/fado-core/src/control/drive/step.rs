@@ -279,6 +279,9 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             let torque = self.feedforward_torque(p) - held;
             self.estimator.set_acceleration(p * torque / m.inertia);
         }
+        if self.limited[1] {
+            self.estimator.voltage_limited();
+        }
         let estimate = self.estimator.step(self.history[1], i_ab);
         if !estimate_is_finite(&estimate) {
             // An estimator that went non-finite cannot steer the drive: hold like a bad input
@@ -401,6 +404,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         i_ab: Ab<T>,
     ) -> DriveOutput<T> {
         self.history = [applied.v_ab, self.history[0]];
+        self.limited = [applied.saturated, self.limited[0]];
         self.last = DriveOutput {
             duty: applied.duty,
             gates_enabled: true,
