@@ -63,6 +63,7 @@ PAPER_DEFAULTS = {
     },
     "offset_adaptation": {
         "rate": 2.0,  # [A]
+        "min_revolution_samples": 64.0,  # [A] (offset law held above 2π/(64·Ts))
     },
     "plausibility": {
         "current_ratio": 4.0,  # [A]
