@@ -98,11 +98,11 @@ impl<T: Real> PhaseBand<T> {
         if !self.enabled {
             return i;
         }
-        let need = self.rule.edge_band(vdc);
-        if !active || self.rule.d_current(theta, vdc).is_none() {
+        if !active || !self.rule.ripple_beyond_band(vdc) {
             self.reset();
             return i;
         }
+        let need = self.rule.edge_band(vdc);
         let (s, c) = theta.step_sin_cos_any();
         let k3 = T::lit(0.866_025_403_784_438_6);
         let h = T::lit(0.5);

@@ -85,17 +85,21 @@ impl<T: Real> ReleaseCurrent<T> {
         self.band + self.ripple_per_volt * vdc.step_max(T::zero())
     }
 
+    /// The PWM ripple ΔI at `vdc` exceeds the band Ic (I_b > 2·Ic): where the rule acts
+    /// ([`d_current`](Self::d_current) is `Some` exactly then). NaN compares false: no.
+    pub fn ripple_beyond_band(&self, vdc: T) -> bool {
+        self.edge_band(vdc) > self.band + self.band
+    }
+
     /// The d current (A) that puts every phase at least [`edge_band`](Self::edge_band) away
     /// from zero at the electrical angle `theta`, at most the cap (the cap for a non-finite
     /// angle). None where the ripple ΔI stays within the band Ic: there the compensation's
     /// band model holds at every edge and no floor is needed.
     pub fn d_current(&self, theta: T, vdc: T) -> Option<T> {
-        let need = self.edge_band(vdc);
-        // NaN compares false: no floor.
-        let ripple_beyond_band = need > self.band + self.band;
-        if !ripple_beyond_band {
+        if !self.ripple_beyond_band(vdc) {
             return None;
         }
+        let need = self.edge_band(vdc);
         let (s, c) = theta.step_sin_cos_any();
         let k3 = T::lit(0.866_025_403_784_438_6);
         let h = T::lit(0.5);
