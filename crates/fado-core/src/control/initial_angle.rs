@@ -11,16 +11,20 @@
 //!
 //! # The measurement
 //! For each direction φ_k = k·π/6 (k = 0 … 11) a voltage pulse +V along φ_k for n samples,
-//! then −V for n samples (the current back to about zero) and n samples that return it to
-//! zero (a proportional current loop, `RETURN_GAIN`),
-//! after one such pair along φ₁₁ that is not read (each read pair then starts from its
-//! predecessor's residual current, 30° behind, the first one included). The
+//! then −V for n samples (the current back to about zero) and n samples, at least
+//! [`MIN_REST_SAMPLES`], that return it to zero (a proportional current loop,
+//! `RETURN_GAIN`), after one such pair along φ₁₁ that is not read. The rest is long enough
+//! that each pulse starts from zero current: a pulse that started from its predecessor's
+//! residual would take the residual's decay into its rise, and on a machine whose
+//! resistance's drop is a large part of the pulse voltage (the multirotor preset: the pair
+//! ends 7 A below zero after a 25 A peak) that error outweighs the saturation's first
+//! harmonic and turns the angle with the rotor's position (up to 0.1 rad). The
 //! rotor at rest, the current at the end of the +V pulse is
 //! i_k ≈ V·t·u_kᵀ·L_inc⁻¹·u_k (u_k the unit vector of φ_k, L_inc the incremental inductance
 //! along the path), and the block keeps the largest rise of the measured current's projection
 //! on u_k during the pulse pair from its value before the pulse (the peak, wherever the
-//! drive's computation delay puts it; the rise, because after a pulse pair the resistance's
-//! drop leaves a residual current that decays only with L/R).
+//! drive's computation delay puts it; the rise, so that what the rest leaves of the previous
+//! pair cancels).
 //! With Γ = L_inc⁻¹ in the rotor frame (d at angle θ),
 //!
 //! u_kᵀ·Γ·u_k = (Γd + Γq)/2 + (Γd − Γq)/2·cos 2(φ_k − θ),
@@ -30,6 +34,11 @@
 //! smaller incremental inductance than the one along −d (on a machine whose d axis
 //! saturates): the first harmonic of i_k points at the magnet, which resolves the N/S
 //! ambiguity and, alone, gives the angle of a rotor with no saliency.
+//!
+//! The twelve directions run twice, the second grid turned by 15° ([`GRIDS`]): the harmonics
+//! below come from both pooled, and each grid on its own must agree ([`MAX_GRID_DISAGREEMENT`];
+//! otherwise [`InitialAngleStatus::Inconsistent`]), as must the residual currents the pulses
+//! start from (their decay into a rise below half the polarity threshold).
 //!
 //! # Decision
 //! With m the mean of i_k and a₁, a₂ the amplitudes of the first and second harmonics
@@ -44,8 +53,21 @@
 use crate::error::{ConfigError, check};
 use crate::{Ab, Real};
 
-/// Directions of the pulses: every 30°.
+/// Directions of the pulses in each grid: every 30°.
 pub const DIRECTIONS: usize = 12;
+
+/// Grids of directions: k·30° and k·30° + 15°. Each gives the angle on its own; the two must
+/// agree within [`MAX_GRID_DISAGREEMENT`].
+pub const GRIDS: usize = 2;
+
+/// Largest difference between the two grids' angles (rad; between their axes, modulo π, when
+/// the axis decides) that the detection accepts \[A\]: 0.2 rad, five times the difference
+/// the current sensor's noise and resolution leave on the multirotor preset (0.02–0.03 rad rms
+/// per grid). The inverter's dead time and a residual current act on each grid differently
+/// (a pulse along a phase's zero line keeps that phase in the dead-time band; the 15° grid has
+/// none): where they, and not the rotor, make the harmonics, the grids disagree and the
+/// detection says so ([`InitialAngleStatus::Inconsistent`]) rather than give their angle.
+pub const MAX_GRID_DISAGREEMENT: f64 = 0.2;
 
 /// Default `min_saliency` \[A\]: a second harmonic of 2 % of the mean, ten times the spread of
 /// the peak readings of a sensor of 0.3 % of the pulse's current (noise and resolution),
@@ -70,6 +92,8 @@ pub struct InitialAngleConfig<T> {
     pub d_larger: bool,
     /// L̂ (H): the mean of L̂d and L̂q, for the return of the current to zero after a pair.
     pub inductance: T,
+    /// R̂s (Ω): how much of a residual current at a pulse's start decays into its rise.
+    pub resistance: T,
     /// Sampling period (s).
     pub ts: T,
 }
@@ -79,6 +103,31 @@ pub struct InitialAngleConfig<T> {
 /// i[n+1] = i[n] − g·i[n−1], a double pole at 0.5 for g = 1/4 (no overshoot, the residual
 /// halved every sample).
 const RETURN_GAIN: f64 = 0.25;
+
+/// Fewest samples of the rest after a pulse pair. Behind its one-sample delay the return to
+/// zero (`RETURN_GAIN`) leaves (m + 1)·2⁻ᵐ of the current the pair ends with after m samples:
+/// 0.6 % after 11. The pair ends with up to a quarter of its peak (the resistance's drop
+/// slows the +V pulse's rise and speeds the −V pulse's fall: 7 A of 25 A on the 8 µH,
+/// 30 mΩ multirotor preset), which a next pulse starting from it would read through its
+/// decay as up to 3 % of its rise — twice the first harmonic that gives a surface-magnet
+/// rotor's angle (1.5 % of the mean at the assumed saturation). After 11 samples it is
+/// 0.15 % of the peak.
+pub const MIN_REST_SAMPLES: u32 = 11;
+
+/// Samples of a pulse pair and its rest for pulses of `n` samples: +V for n, −V for n, the
+/// return to zero for n and at least [`MIN_REST_SAMPLES`]; as a non-zero divisor (no
+/// division that can panic in the per-sample path).
+pub(crate) fn pair_samples(n: u32) -> core::num::NonZeroU32 {
+    let period = n.saturating_mul(2).saturating_add(n.max(MIN_REST_SAMPLES));
+    core::num::NonZeroU32::new(period).unwrap_or(core::num::NonZeroU32::MIN)
+}
+
+/// The return of the current to zero between pulse pairs: v = −`RETURN_GAIN`·(L̂/Ts)·i
+/// (a non-finite reading returns nothing).
+pub(crate) fn return_voltage<T: Real>(i_ab: Ab<T>, inductance: T, ts: T) -> Ab<T> {
+    let i = if i_ab.is_finite() { i_ab } else { Ab::zero() };
+    i * (-T::lit(RETURN_GAIN) * inductance / ts)
+}
 
 /// Where the detection stands.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -93,6 +142,9 @@ pub enum InitialAngleStatus {
     NoInformation,
     /// A non-finite or zero reading: nothing decided.
     Implausible,
+    /// The two grids of directions give angles more than [`MAX_GRID_DISAGREEMENT`] apart:
+    /// the harmonics come from the inverter (dead time) or the sensors, not from the rotor.
+    Inconsistent,
 }
 
 /// The pulse sequence and its evaluation (module docs). Allocation-free.
@@ -101,12 +153,14 @@ pub struct InitialAngle<T> {
     config: InitialAngleConfig<T>,
     /// Sample within the whole sequence.
     sample: u32,
-    peaks: [T; DIRECTIONS],
-    start: [T; DIRECTIONS],
+    peaks: [[T; DIRECTIONS]; GRIDS],
+    start: [[T; DIRECTIONS]; GRIDS],
     status: InitialAngleStatus,
     angle: T,
     /// a₁/m and a₂/m of the last evaluation.
     harmonics: (T, T),
+    /// Each grid's angle (NaN where it gives none).
+    grid_angles: [T; GRIDS],
 }
 
 impl<T: Real> InitialAngle<T> {
@@ -114,6 +168,7 @@ impl<T: Real> InitialAngle<T> {
     pub fn new(config: InitialAngleConfig<T>) -> Result<Self, ConfigError> {
         check::positive("voltage", config.voltage)?;
         check::positive("inductance", config.inductance)?;
+        check::non_negative("resistance", config.resistance)?;
         check::positive("ts", config.ts)?;
         if config.pulse_samples == 0 {
             return Err(ConfigError::OutOfRange {
@@ -130,23 +185,24 @@ impl<T: Real> InitialAngle<T> {
         Ok(Self {
             config,
             sample: 0,
-            peaks: [T::zero(); DIRECTIONS],
-            start: [T::zero(); DIRECTIONS],
+            peaks: [[T::zero(); DIRECTIONS]; GRIDS],
+            start: [[T::zero(); DIRECTIONS]; GRIDS],
             status: InitialAngleStatus::Running,
             angle: T::zero() / T::zero(),
             harmonics: (T::zero(), T::zero()),
+            grid_angles: [T::zero() / T::zero(); GRIDS],
         })
     }
 
     /// Samples of the whole sequence.
     pub fn duration_samples(&self) -> u32 {
-        3 * self.config.pulse_samples * (DIRECTIONS as u32 + 1)
+        pair_samples(self.config.pulse_samples).get() * SLOTS
     }
 
     /// Re-arms the detection.
     pub fn arm(&mut self) {
         self.sample = 0;
-        self.peaks = [T::zero(); DIRECTIONS];
+        self.peaks = [[T::zero(); DIRECTIONS]; GRIDS];
         self.status = InitialAngleStatus::Running;
     }
 
@@ -165,6 +221,12 @@ impl<T: Real> InitialAngle<T> {
         self.angle
     }
 
+    /// Each grid's angle (electrical rad; modulo π where the axis decides; NaN where the grid
+    /// gives none): their difference against [`MAX_GRID_DISAGREEMENT`].
+    pub fn grid_angles(&self) -> [T; GRIDS] {
+        self.grid_angles
+    }
+
     /// (a₁/m, a₂/m) of the last evaluation: the margins against the thresholds.
     pub fn harmonics(&self) -> (T, T) {
         self.harmonics
@@ -178,30 +240,29 @@ impl<T: Real> InitialAngle<T> {
         }
         let n = self.config.pulse_samples;
         // Slot 0 is a pulse pair along the last direction that is not read: every read
-        // pulse then starts from the residual current of the one before it, 30° behind
-        // (after a pair the current is not quite zero: the resistance's drop).
-        // The pair's length as a non-zero divisor (`new` refuses 0 samples): no division
-        // that can panic in the per-sample path.
-        let period =
-            core::num::NonZeroU32::new(n.saturating_mul(3)).unwrap_or(core::num::NonZeroU32::MIN);
+        // pulse then starts after a pair and its rest, as the first one does.
+        let period = pair_samples(n);
         let slot = (self.sample / period) as usize;
-        if slot > DIRECTIONS {
+        if slot >= SLOTS as usize {
             self.evaluate();
             return Ab::zero();
         }
-        let k = (slot + DIRECTIONS - 1) % DIRECTIONS;
+        // Each grid: one pair along its last direction that is not read, then its twelve.
+        let (grid, within) = (slot / (DIRECTIONS + 1), slot % (DIRECTIONS + 1));
+        let k = (within + DIRECTIONS - 1) % DIRECTIONS;
         let phase = self.sample % period;
-        let u = direction::<T>(k);
+        let u = direction::<T>(k, grid, 1);
         // The peak over the pulse pair and the rest that follows (the computation delay).
         let along = u.dot(i_ab);
-        if slot > 0 && phase == 0 {
+        let read = within > 0;
+        if read && phase == 0 {
             // The current before the pulse acts (the computation delay): the rise is read
             // from it, so that what is left of the previous pulses cancels.
-            self.start[k] = along;
+            self.start[grid][k] = along;
         }
-        let rise = along - self.start[k];
-        if slot > 0 && (rise > self.peaks[k] || !rise.is_finite()) {
-            self.peaks[k] = rise;
+        let rise = along - self.start[grid][k];
+        if read && (rise > self.peaks[grid][k] || !rise.is_finite()) {
+            self.peaks[grid][k] = rise;
         }
         self.sample += 1;
         let v = self.config.voltage;
@@ -212,60 +273,147 @@ impl<T: Real> InitialAngle<T> {
         } else {
             // The rest: the current back to zero (the resistance's drop leaves a residual
             // that would decay only with L/R).
-            let i = if i_ab.is_finite() { i_ab } else { Ab::zero() };
-            i * (-T::lit(RETURN_GAIN) * self.config.inductance / self.config.ts)
+            return_voltage(i_ab, self.config.inductance, self.config.ts)
         }
     }
 
-    /// The harmonics of the peaks and the decision (module docs).
+    /// The harmonics of the peaks and the decision (module docs): both grids pooled, each
+    /// grid's angle against the other's.
     fn evaluate(&mut self) {
-        let mut mean = T::zero();
-        let (mut h1, mut h2) = (Ab::<T>::zero(), Ab::<T>::zero());
-        for (k, &p) in self.peaks.iter().enumerate() {
-            mean += p;
-            h1 += direction::<T>(k) * p;
-            h2 += direction::<T>(2 * k) * p;
-        }
-        let scale = T::one() / T::lit(DIRECTIONS as f64);
-        mean *= scale;
-        let (a1, a2) = (
-            h1.norm() * scale * T::lit(2.0),
-            h2.norm() * scale * T::lit(2.0),
-        );
-        if !(mean > T::zero() && a1.is_finite() && a2.is_finite()) {
+        let pooled = Harmonics::of(&self.peaks, &[0, 1]);
+        let Some(harmonics) = pooled.amplitudes() else {
             self.status = InitialAngleStatus::Implausible;
             return;
-        }
-        self.harmonics = (a1 / mean, a2 / mean);
-        let polarity = a1 >= self.config.min_polarity * mean;
-        let axis = a2 >= self.config.min_saliency * mean;
-        let theta1 = h1.beta.step_atan2(h1.alpha);
-        let mut theta2 = T::lit(0.5) * h2.beta.step_atan2(h2.alpha);
-        if self.config.d_larger {
-            theta2 += T::lit(core::f64::consts::FRAC_PI_2);
-        }
-        let (status, angle) = match (axis, polarity) {
-            (true, true) => {
-                let (s, c) = theta2.step_sin_cos_any();
-                let theta = if h1.alpha * c + h1.beta * s >= T::zero() {
-                    theta2
-                } else {
-                    theta2 + T::pi()
-                };
-                (InitialAngleStatus::Found, crate::wrap_angle(theta))
-            }
-            (false, true) => (InitialAngleStatus::Found, theta1),
-            (true, false) => (InitialAngleStatus::AxisOnly, crate::wrap_angle(theta2)),
-            (false, false) => (InitialAngleStatus::NoInformation, T::zero() / T::zero()),
         };
+        self.harmonics = harmonics;
+        let (status, angle, period) = self.decide(&pooled, harmonics);
+        // Each grid on its own: the same verdict, and its angle within half the bound of the
+        // pooled one (the two grids then within the bound of each other; an axis modulo π).
+        let mut agree = true;
+        for g in 0..GRIDS {
+            let one = Harmonics::of(&self.peaks, &[g]);
+            let (verdict, a, _) = match one.amplitudes() {
+                Some(h) => self.decide(&one, h),
+                None => (
+                    InitialAngleStatus::Implausible,
+                    T::zero() / T::zero(),
+                    T::one(),
+                ),
+            };
+            self.grid_angles[g] = a;
+            agree &= verdict == status;
+            if angle.is_finite() {
+                let scale = T::lit(2.0) * T::pi() / period;
+                let d = (crate::wrap_angle((a - angle) * scale) / scale).abs();
+                agree &= d <= T::lit(0.5 * MAX_GRID_DISAGREEMENT);
+            }
+        }
+        // A residual current r at a pulse's start decays by up to r·n·Ts·R̂/L̂ into its rise:
+        // where the return could not bring it to zero (the dead-time band holds it), that
+        // may reach half the polarity threshold, and the readings are not the rotor's.
+        let n = T::lit(self.config.pulse_samples as f64);
+        let decay = (n * self.config.ts * self.config.resistance / self.config.inductance)
+            .step_min(T::one());
+        let mut residual = T::zero();
+        for start in self.start.iter().flatten() {
+            residual = residual.step_max(start.abs());
+        }
+        agree &= residual * decay <= T::lit(0.5) * self.config.min_polarity * pooled.mean;
+        if !agree {
+            self.status = InitialAngleStatus::Inconsistent;
+            self.angle = T::zero() / T::zero();
+            return;
+        }
         self.status = status;
         self.angle = angle;
     }
+
+    /// The verdict of `h` with (a₁/m, a₂/m) `(a1, a2)`: the status, the angle (NaN without
+    /// one) and the period it is known to (2π, or π for an axis).
+    fn decide(&self, h: &Harmonics<T>, (a1, a2): (T, T)) -> (InitialAngleStatus, T, T) {
+        let polarity = a1 >= self.config.min_polarity;
+        let axis = a2 >= self.config.min_saliency;
+        let d_larger = self.config.d_larger;
+        let turn = T::lit(2.0) * T::pi();
+        match (axis, polarity) {
+            (true, true) => (InitialAngleStatus::Found, h.angle(d_larger), turn),
+            (false, true) => (InitialAngleStatus::Found, h.polarity_angle(), turn),
+            (true, false) => (InitialAngleStatus::AxisOnly, h.axis(d_larger), T::pi()),
+            (false, false) => (
+                InitialAngleStatus::NoInformation,
+                T::zero() / T::zero(),
+                turn,
+            ),
+        }
+    }
 }
 
-/// The unit vector at k·π/6.
-fn direction<T: Real>(k: usize) -> Ab<T> {
-    let (s, c) = (T::lit(k as f64) * T::pi() / T::lit(6.0)).step_sin_cos_any();
+/// The mean and the first two harmonics of the peaks of some grids (module docs).
+struct Harmonics<T> {
+    mean: T,
+    h1: Ab<T>,
+    h2: Ab<T>,
+}
+
+impl<T: Real> Harmonics<T> {
+    fn of(peaks: &[[T; DIRECTIONS]; GRIDS], grids: &[usize]) -> Self {
+        let (mut mean, mut h1, mut h2) = (T::zero(), Ab::<T>::zero(), Ab::<T>::zero());
+        for &g in grids {
+            for (k, &p) in peaks[g].iter().enumerate() {
+                mean += p;
+                h1 += direction::<T>(k, g, 1) * p;
+                h2 += direction::<T>(k, g, 2) * p;
+            }
+        }
+        let scale = T::one() / T::lit((DIRECTIONS * grids.len()) as f64);
+        Self {
+            mean: mean * scale,
+            h1: h1 * (scale * T::lit(2.0)),
+            h2: h2 * (scale * T::lit(2.0)),
+        }
+    }
+
+    /// (a₁/m, a₂/m), None for a non-finite or non-positive reading.
+    fn amplitudes(&self) -> Option<(T, T)> {
+        let (a1, a2) = (self.h1.norm(), self.h2.norm());
+        (self.mean > T::zero() && a1.is_finite() && a2.is_finite())
+            .then(|| (a1 / self.mean, a2 / self.mean))
+    }
+
+    /// The first harmonic's angle: the magnet's polarity alone.
+    fn polarity_angle(&self) -> T {
+        self.h1.beta.step_atan2(self.h1.alpha)
+    }
+
+    /// The second harmonic's axis (modulo π), turned by π/2 where the model's L̂d > L̂q.
+    fn axis(&self, d_larger: bool) -> T {
+        let mut theta2 = T::lit(0.5) * self.h2.beta.step_atan2(self.h2.alpha);
+        if d_larger {
+            theta2 += T::lit(core::f64::consts::FRAC_PI_2);
+        }
+        crate::wrap_angle(theta2)
+    }
+
+    /// The axis with the polarity the first harmonic points at.
+    fn angle(&self, d_larger: bool) -> T {
+        let theta2 = self.axis(d_larger);
+        let (s, c) = theta2.step_sin_cos_any();
+        let theta = if self.h1.alpha * c + self.h1.beta * s >= T::zero() {
+            theta2
+        } else {
+            theta2 + T::pi()
+        };
+        crate::wrap_angle(theta)
+    }
+}
+
+/// Pulse pairs of the whole sequence: each grid's twelve and its unread first.
+const SLOTS: u32 = (GRIDS * (DIRECTIONS + 1)) as u32;
+
+/// The unit vector at `harmonic` × the direction k·π/6 + grid·π/12.
+fn direction<T: Real>(k: usize, grid: usize, harmonic: usize) -> Ab<T> {
+    let phi = T::lit((2 * k + grid) as f64) * T::pi() / T::lit(12.0);
+    let (s, c) = (phi * T::lit(harmonic as f64)).step_sin_cos_any();
     Ab::new(c, s)
 }
 

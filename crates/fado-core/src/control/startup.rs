@@ -292,6 +292,8 @@ pub struct AngleSearch<T> {
     l_min: T,
     l_max: T,
     l_mean: T,
+    /// R̂s (Ω).
+    rs: T,
     d_larger: bool,
     /// The model's d axis meets the larger incremental inductance along +d than along −d
     /// ([`inverted_polarity`]): the faster rise then points against the magnet.
@@ -327,6 +329,7 @@ impl<T: Real> AngleSearch<T> {
             l_min: crate::real::min(machine.ld, machine.lq),
             l_max: crate::real::max(machine.ld, machine.lq),
             l_mean,
+            rs: machine.rs,
             d_larger: d_axis_larger(machine, tuning.pulse_current_ratio * machine.rated_current),
             inverted: inverted_polarity(
                 machine,
@@ -491,6 +494,7 @@ impl<T: Real> AngleSearch<T> {
                 min_polarity: T::lit(DEFAULT_MIN_POLARITY),
                 d_larger: self.d_larger,
                 inductance: self.l_mean,
+                resistance: self.rs,
                 ts: self.ts,
             };
             self.monitor.restart(Ab::zero());

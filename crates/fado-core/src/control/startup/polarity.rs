@@ -3,12 +3,8 @@
 //! whose current adds to the magnet's flux and saturates the d-axis iron further.
 
 use super::POLARITY_PAIRS;
-use crate::control::initial_angle::DEFAULT_MIN_POLARITY;
+use crate::control::initial_angle::{DEFAULT_MIN_POLARITY, pair_samples, return_voltage};
 use crate::{Ab, Real};
-
-/// Gain of the return to zero after a pair, as the search's (`initial_angle`'s
-/// `RETURN_GAIN`): a double pole at 0.5 behind the one-sample delay.
-const RETURN_GAIN: f64 = 0.25;
 
 /// The polarity test (module docs). Allocation-free.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -64,7 +60,7 @@ impl<T: Real> PolarityTest<T> {
 
     /// Samples of the whole test.
     pub fn duration_samples(&self) -> u32 {
-        3 * self.n * 2 * POLARITY_PAIRS
+        pair_samples(self.n).get() * 2 * POLARITY_PAIRS
     }
 
     /// One sample: `i_ab` the current measured now. Returns the α-β voltage to apply.
@@ -73,9 +69,7 @@ impl<T: Real> PolarityTest<T> {
             return Ab::zero();
         }
         let n = self.n;
-        // A non-zero divisor: no division that can panic in the per-sample path.
-        let period =
-            core::num::NonZeroU32::new(n.saturating_mul(3)).unwrap_or(core::num::NonZeroU32::MIN);
+        let period = pair_samples(n);
         let pair = self.sample / period;
         let phase = self.sample % period;
         let (s, c) = self.axis.step_sin_cos_any();
@@ -105,8 +99,7 @@ impl<T: Real> PolarityTest<T> {
         } else if phase < 2 * n {
             u * (-self.voltage)
         } else {
-            let i = if i_ab.is_finite() { i_ab } else { Ab::zero() };
-            i * (-T::lit(RETURN_GAIN) * self.inductance / self.ts)
+            return_voltage(i_ab, self.inductance, self.ts)
         }
     }
 
