@@ -94,3 +94,18 @@ fn a_good_file_is_accepted() {
         "{stderr}"
     );
 }
+
+#[test]
+fn dump_config_prints_the_plausibility_warnings_on_stderr() {
+    // Swapped inductances on the paper's motor: a warning, shown before the TOML is printed
+    // (the check a user runs before a run).
+    let text = "[motor]\nrs = 0.327\nld = 5e-3\nlq = 2.63e-3\nflux_linkage = 0.088\n\
+                pole_pairs = 4\nrated_current = 21.78\nrated_speed_rpm = 1500.0\n\
+                rated_torque = 11.5\n";
+    let (code, stderr, _) = run_with("swapped.toml", text);
+    assert_eq!(code, Some(0), "{stderr}");
+    assert!(
+        stderr.contains("warning:") && stderr.contains("swapped"),
+        "{stderr}"
+    );
+}
