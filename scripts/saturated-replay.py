@@ -10,8 +10,8 @@ miss. A sensored drive (the true angle and speed) runs the ratings-scaled `rever
 fado-sim (0 → −6 % of rated speed, the load torque to a share of the rated torque over
 [1.2 s, 1.7 s], the reversal to +6 % at 6 % of rated speed per second, 5.5 s): a speed PI with
 inertia feed-forward, the torque reached on the machine's own MTPA curve plus the eq. (23)
-injection of fado's drive (i_d raised to √(I_min² − i_q²), I_min 18.4 % of rated current, so that
-a machine without a magnet keeps a flux at no load), and a dq current PI with the flux's
+injection of fado's drive (|i_d| raised to √(I_min² − i_q²), I_min 18.4 % of rated current, along
+the d direction that raises the active flux: `injection_sign`), and a dq current PI with the flux's
 decoupling. The plant is integrated by RK4 with 4 sub-steps per 100 µs sample (the voltage
 held over the sample, as an ideal inverter's average).
 
@@ -147,7 +147,7 @@ def syrm_6k7(i_f: float = 0.0) -> Machine:
     high-permeance axis on d, fado puts d on the magnet (the low-permeance axis of a PM-assisted
     SyRM), so the axes are swapped (d ↔ q with their exponents). `i_f` adds a magnet MMF."""
     return Machine(
-        name="syrm-6k7" + ("" if i_f == 0 else "-pm"), a_d0=52.1, a_dd=658.0, s=1.0,
+        name="syrm-6k7" + ("" if i_f == 0 else f"-pm{i_f:g}"), a_d0=52.1, a_dd=658.0, s=1.0,
         a_q0=17.4, a_qq=373.0, t=5.0, a_dq=1120.0, u=0.0, v=1.0, i_f=i_f, rs=0.54,
         pole_pairs=2, rated_current=15.5 * math.sqrt(2), rated_speed_rpm=105.8 * 60 / 2,
         rated_torque=20.1, dc_voltage=540.0, inertia=0.015,
@@ -196,6 +196,7 @@ def cases(half_map: bool) -> list[MapCase]:
     out = [
         MapCase("syrm-6k7 (no magnet)", syrm_6k7()),
         MapCase("syrm-6k7 + 0.5 A magnet MMF", syrm_6k7(i_f=0.5)),
+        MapCase("syrm-6k7 + 3 A magnet MMF", syrm_6k7(i_f=3.0)),
         MapCase("ipm-cross20", ipm),
         MapCase("spm-dsat", spm_dsat()),
         MapCase("drone-ipm", drone_ipm()),
@@ -249,6 +250,22 @@ class Mtpa:
         return i_d, i_q
 
 
+def injection_sign(m: Machine) -> float:
+    """The d direction of the no-load injection that raises the active flux
+    λa = ψd − L_q,s·i_d (the rotor flux the estimator follows): +d, fado's drive's eq. (23),
+    where the magnet dominates; −d on a weak-magnet PM-SyRM, whose λa falls through zero at
+    i_d ≈ λf/(L_q − L_d) along +d (0.2 A on syrm-6k7-pm) and would point the rotor flux along
+    −d there."""
+    i = I_MIN_RATIO * m.rated_current
+    h = 1e-3 * i
+    active = []
+    for i_d in (i, -i):
+        pd, _ = m.flux(np.array(i_d), np.array(0.0))
+        _, pq = m.flux(np.array(i_d), np.array(h))
+        active.append(float(pd) - float(pq) / h * i_d)
+    return 1.0 if active[0] >= active[1] else -1.0
+
+
 def profile(points: list[tuple[float, float]], t: float) -> float:
     xs, ys = zip(*points)
     return float(np.interp(t, xs, ys))
@@ -262,7 +279,7 @@ def simulate(m: Machine, load: float, duration: float = 5.5) -> dict[str, np.nda
     speed_ref = [(0.0, 0.0), (0.2, 0.0), (1.2, -n_rev), (2.5, -n_rev), (4.5, n_rev), (9.9, n_rev)]
     load_ref = [(0.0, 0.0), (1.2, 0.0), (1.7, load * m.rated_torque), (9.9, load * m.rated_torque)]
     mtpa = Mtpa(m, 2.0 * m.rated_current)
-    i_min = I_MIN_RATIO * m.rated_current
+    i_min = I_MIN_RATIO * m.rated_current * injection_sign(m)
     # Current PI from the incremental inductances at the rated MTPA point (IMC, 300 Hz).
     ird, irq = mtpa.current(m.rated_torque)
     h = 1e-3 * m.rated_current
@@ -313,7 +330,7 @@ def simulate(m: Machine, load: float, duration: float = 5.5) -> dict[str, np.nda
             int_s += e_s * TS
         tau_ref = max(-tau_max, min(tau_max, tau_ref))
         id_ref, iq_ref = mtpa.current(tau_ref)
-        id_ref += math.sqrt(max(i_min * i_min - iq_ref * iq_ref, 0.0))
+        id_ref += math.copysign(math.sqrt(max(i_min * i_min - iq_ref * iq_ref, 0.0)), i_min)
         # Current loop in the true rotor frame, the flux's back-EMF as the decoupling.
         w_e = p * x[3]
         e_d, e_q = id_ref - i_d, iq_ref - i_q
