@@ -587,8 +587,8 @@ fn check_reactances(m: &MachineModel<f64>, out: &mut impl Sink) {
 }
 
 /// The resistive drop at rated current per unit of the rated back-EMF, Rs·I/(ω·ψ) with ψ the
-/// [`flux_base`]: above
-/// [`RESISTANCE_ERROR`] the copper loss at the rated point is twice its mechanical power.
+/// [`flux_base`]: above [`RESISTANCE_ERROR`] the copper loss at the rated point is twice its
+/// mechanical power.
 fn check_resistance(m: &MachineModel<f64>, out: &mut impl Sink) {
     let r = m.rs * m.rated_current / (m.rated_speed() * flux_base(m));
     let severity = if r > RESISTANCE_ERROR {
