@@ -109,3 +109,22 @@ fn dump_config_prints_the_plausibility_warnings_on_stderr() {
         "{stderr}"
     );
 }
+
+#[test]
+fn a_key_in_the_wrong_table_names_the_table_it_belongs_to() {
+    // `switching_frequency` is the inverter's, not the motor's.
+    let (code, stderr, path) = run_with(
+        "wrong-table.toml",
+        "[motor]\nswitching_frequency = 20000.0\n",
+    );
+    assert_eq!(code, Some(2), "{stderr}");
+    let prefix = format!(
+        "error: {}:2:1: `motor.switching_frequency`: ",
+        path.display()
+    );
+    assert!(stderr.starts_with(&prefix), "{stderr}");
+    assert!(
+        stderr.contains("`switching_frequency` is a key of [inverter]"),
+        "{stderr}"
+    );
+}
