@@ -103,12 +103,12 @@ fn flipsky_6215_passes_the_reversal_and_the_stops() {
     }
 }
 
-/// Its loaded start: the release hold catches the rotor within 0.31–0.32 rad and, on this
-/// light rotor (the standstill probe's torque at a 0.25 rad angle error would swing it by
-/// 0.45 rad), holds it until the lift (`fado_core::control::release_hold`, "Through the loaded
-/// standstill"). Measured: backward travel 0.305 / 0.320 / 0.313 / 0.321 rad, |θ − θ̂| from ready
-/// 0.15–0.17 rad at seeds 1–4; with the hand-over to the speed loop after 10/ω_h seed 2 swung
-/// back 0.67 rad under the probe before the lift.
+/// Its loaded start: the release hold catches the rotor and, on this light rotor (the
+/// standstill probe's torque at a 0.25 rad angle error would swing it by 0.45 rad), holds it
+/// until the lift (`fado_core::control::release_hold`, "Through the loaded standstill").
+/// Measured: backward travel 0.217 / 0.227 / 0.228 / 0.229 rad, |θ − θ̂| from ready 0.08–0.14 rad
+/// at seeds 1–4; with the hand-over to the speed loop after 10/ω_h seed 2 swings back 0.98 rad
+/// under the probe before the lift.
 #[test]
 fn flipsky_6215_starts_under_its_rated_load() {
     for seed in 1..=4 {

@@ -71,10 +71,11 @@
 //! stiffness the probe's torque, and the probe reads its demand as it would read the speed
 //! loop's. The rotor then follows θ̂, within the angle error the probe corrects. Of the
 //! motors tried, the swing is 0.45 rad on the salient Flipsky 6215 (15/22 µH, 14 pole pairs:
-//! without the rule its rotor swung back 0.67 rad at `loaded-start` seed 2, 0.32 rad with
-//! it), 0.34 rad on the multirotor preset and 0.43 rad on the cheetah outrunner; 0.1 rad or
-//! less on every preset that is not a multirotor or outrunner (the 50 kW IPMSM's 0.097 the
-//! largest), which keep the hand-over.
+//! with the hand-over its rotor swings back 0.98 rad at `loaded-start` seed 2, held 0.23 rad),
+//! 0.34 rad on the multirotor preset (seed 2: 0.72 and 0.31 rad) and 0.43 rad on the cheetah
+//! outrunner; 0.1 rad or less on every preset that is not a multirotor or outrunner (the
+//! 50 kW IPMSM's 0.097 the largest), which keep the hand-over (docs/method/startup.md, "The
+//! loaded standstill after the release").
 
 use crate::error::{ConfigError, check};
 use crate::real::cast_record;
