@@ -50,7 +50,9 @@ fn the_outrunner_presets_hold_their_rated_load_at_the_release() {
 /// zero current (`fado_core::control::initial_angle::MIN_REST_SAMPLES`) on two grids: a pulse
 /// that started from its predecessor's residual (7 A after a 25 A peak on this 8 µH, 30 mΩ
 /// motor) read the angle 0.09 rad off here, and |θ − θ̂| from ready reached 0.27 rad.
-/// Measured: found 0.004 rad off, |θ − θ̂| from ready 0.14 rad, backward travel 0.29 rad.
+/// The release hold then holds the rotor through the loaded standstill
+/// (`fado_core::control::release_hold`, "Through the loaded standstill"). Measured: found
+/// 0.004 rad off, |θ − θ̂| from ready 0.09 rad, backward travel 0.20 rad.
 #[test]
 fn the_multirotor_preset_seed_2_holds_its_rated_load_at_the_release() {
     let motor = fado_sim::presets::find("multirotor-mn5006-22v")

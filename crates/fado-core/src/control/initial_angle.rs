@@ -37,8 +37,10 @@
 //!
 //! The twelve directions run twice, the second grid turned by 15° ([`GRIDS`]): the harmonics
 //! below come from both pooled, and each grid on its own must agree ([`MAX_GRID_DISAGREEMENT`];
-//! otherwise [`InitialAngleStatus::Inconsistent`]), as must the residual currents the pulses
-//! start from (their decay into a rise below half the polarity threshold).
+//! otherwise [`InitialAngleStatus::Inconsistent`]); the residual currents the pulses start
+//! from must not move a rise by half the harmonic that decides (their decay, at most
+//! r·n·Ts·R̂/L̂). A polarity the grids' first harmonics do not both point to, or that the
+//! residuals could turn, is left to the polarity test ([`InitialAngleStatus::AxisOnly`]).
 //!
 //! # Decision
 //! With m the mean of i_k and a₁, a₂ the amplitudes of the first and second harmonics
@@ -281,36 +283,62 @@ impl<T: Real> InitialAngle<T> {
     /// grid's angle against the other's.
     fn evaluate(&mut self) {
         let pooled = Harmonics::of(&self.peaks, &[0, 1]);
-        let Some(harmonics) = pooled.amplitudes() else {
+        let Some((a1, a2)) = pooled.amplitudes() else {
             self.status = InitialAngleStatus::Implausible;
             return;
         };
-        self.harmonics = harmonics;
-        let (status, angle, period) = self.decide(&pooled, harmonics);
-        // Each grid on its own: the same verdict, and its angle within half the bound of the
-        // pooled one (the two grids then within the bound of each other; an axis modulo π).
-        let mut agree = true;
-        for g in 0..GRIDS {
-            let one = Harmonics::of(&self.peaks, &[g]);
-            let (verdict, a, _) = match one.amplitudes() {
-                Some(h) => self.decide(&one, h),
-                None => (
-                    InitialAngleStatus::Implausible,
-                    T::zero() / T::zero(),
-                    T::one(),
-                ),
-            };
-            self.grid_angles[g] = a;
-            agree &= verdict == status;
-            if angle.is_finite() {
-                let scale = T::lit(2.0) * T::pi() / period;
-                let d = (crate::wrap_angle((a - angle) * scale) / scale).abs();
-                agree &= d <= T::lit(0.5 * MAX_GRID_DISAGREEMENT);
+        self.harmonics = (a1, a2);
+        let grids = [
+            Harmonics::of(&self.peaks, &[0]),
+            Harmonics::of(&self.peaks, &[1]),
+        ];
+        let effect = self.residual_effect() / pooled.mean;
+        let half = T::lit(0.5);
+        let bound = T::lit(0.5 * MAX_GRID_DISAGREEMENT);
+        let d_larger = self.config.d_larger;
+        let (status, angle) = if a2 >= self.config.min_saliency {
+            // The axis: each grid's within half the bound (modulo π), the residuals' effect
+            // within half the harmonic.
+            let axis = pooled.axis(d_larger);
+            let mut ok = effect <= half * a2;
+            for (g, one) in grids.iter().enumerate() {
+                self.grid_angles[g] = one.axis(d_larger);
+                ok &= angle_apart(self.grid_angles[g], axis, T::pi()) <= bound;
             }
-        }
-        // A residual current r at a pulse's start decays by up to r·n·Ts·R̂/L̂ into its rise:
-        // where the return could not bring it to zero (the dead-time band holds it), that
-        // may reach half the polarity threshold, and the readings are not the rotor's.
+            // Its polarity where every grid's first harmonic points the same way and the
+            // residuals cannot turn it; otherwise the polarity test decides.
+            let theta = pooled.angle(d_larger);
+            let polarity = a1 >= self.config.min_polarity
+                && effect <= half * a1
+                && grids.iter().all(|one| one.points_along(theta));
+            match (ok, polarity) {
+                (false, _) => (InitialAngleStatus::Inconsistent, T::zero() / T::zero()),
+                (true, true) => (InitialAngleStatus::Found, theta),
+                (true, false) => (InitialAngleStatus::AxisOnly, axis),
+            }
+        } else if a1 >= self.config.min_polarity {
+            let theta = pooled.polarity_angle();
+            let mut ok = effect <= half * a1;
+            for (g, one) in grids.iter().enumerate() {
+                self.grid_angles[g] = one.polarity_angle();
+                ok &= angle_apart(self.grid_angles[g], theta, T::lit(2.0) * T::pi()) <= bound;
+            }
+            if ok {
+                (InitialAngleStatus::Found, theta)
+            } else {
+                (InitialAngleStatus::Inconsistent, T::zero() / T::zero())
+            }
+        } else {
+            (InitialAngleStatus::NoInformation, T::zero() / T::zero())
+        };
+        self.status = status;
+        self.angle = angle;
+    }
+
+    /// The largest change a residual current at a pulse's start can make to its rise (A): a
+    /// residual r decays by up to r·n·Ts·R̂/L̂ over the pulse (where the return could not
+    /// bring it to zero: the dead-time band holds it).
+    fn residual_effect(&self) -> T {
         let n = T::lit(self.config.pulse_samples as f64);
         let decay = (n * self.config.ts * self.config.resistance / self.config.inductance)
             .step_min(T::one());
@@ -318,34 +346,15 @@ impl<T: Real> InitialAngle<T> {
         for start in self.start.iter().flatten() {
             residual = residual.step_max(start.abs());
         }
-        agree &= residual * decay <= T::lit(0.5) * self.config.min_polarity * pooled.mean;
-        if !agree {
-            self.status = InitialAngleStatus::Inconsistent;
-            self.angle = T::zero() / T::zero();
-            return;
-        }
-        self.status = status;
-        self.angle = angle;
+        residual * decay
     }
+}
 
-    /// The verdict of `h` with (a₁/m, a₂/m) `(a1, a2)`: the status, the angle (NaN without
-    /// one) and the period it is known to (2π, or π for an axis).
-    fn decide(&self, h: &Harmonics<T>, (a1, a2): (T, T)) -> (InitialAngleStatus, T, T) {
-        let polarity = a1 >= self.config.min_polarity;
-        let axis = a2 >= self.config.min_saliency;
-        let d_larger = self.config.d_larger;
-        let turn = T::lit(2.0) * T::pi();
-        match (axis, polarity) {
-            (true, true) => (InitialAngleStatus::Found, h.angle(d_larger), turn),
-            (false, true) => (InitialAngleStatus::Found, h.polarity_angle(), turn),
-            (true, false) => (InitialAngleStatus::AxisOnly, h.axis(d_larger), T::pi()),
-            (false, false) => (
-                InitialAngleStatus::NoInformation,
-                T::zero() / T::zero(),
-                turn,
-            ),
-        }
-    }
+/// |a − b| for angles known modulo `period` (2π, or π for an axis).
+fn angle_apart<T: Real>(a: T, b: T, period: T) -> T {
+    let scale = T::lit(2.0) * T::pi() / period;
+    let d = (crate::wrap_angle((a - b) * scale) / scale).abs();
+    if d.is_finite() { d } else { T::pi() }
 }
 
 /// The mean and the first two harmonics of the peaks of some grids (module docs).
@@ -394,16 +403,20 @@ impl<T: Real> Harmonics<T> {
         crate::wrap_angle(theta2)
     }
 
+    /// The first harmonic points along `theta` (not against it).
+    fn points_along(&self, theta: T) -> bool {
+        let (s, c) = theta.step_sin_cos_any();
+        self.h1.alpha * c + self.h1.beta * s >= T::zero()
+    }
+
     /// The axis with the polarity the first harmonic points at.
     fn angle(&self, d_larger: bool) -> T {
         let theta2 = self.axis(d_larger);
-        let (s, c) = theta2.step_sin_cos_any();
-        let theta = if self.h1.alpha * c + self.h1.beta * s >= T::zero() {
+        if self.points_along(theta2) {
             theta2
         } else {
-            theta2 + T::pi()
-        };
-        crate::wrap_angle(theta)
+            crate::wrap_angle(theta2 + T::pi())
+        }
     }
 }
 
