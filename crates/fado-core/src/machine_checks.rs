@@ -433,8 +433,9 @@ impl fmt::Display for Finding {
             Finding::Reactance { key, per_unit, .. } => {
                 write!(
                     f,
-                    "`{key}` is {per_unit:.3e} per unit (L·`rated_current`/`flux_linkage`; \
-                     machines have 0.05–5)"
+                    "`{key}` is {per_unit:.3e} per unit (L·`rated_current` over the larger of \
+                     `flux_linkage` and `rated_torque`/(1.5·p·`rated_current`); machines have \
+                     0.05–5)"
                 )?;
                 if per_unit > 50.0 && per_unit * 1e-3 < 5.0 {
                     write!(f, ": mH where H is meant? ({key} × 1e-3)")
@@ -555,10 +556,19 @@ fn check_into(m: &MachineModel<f64>, ts: Option<f64>, out: &mut impl Sink) {
     }
 }
 
-/// Each inductance per unit of the rated current and flux linkage, L·I/λf.
+/// The flux base of the per-unit checks: the larger of λf and the torque's flux per ampere
+/// T/(1.5·p·I). A PM-assisted SyRM with a weak magnet makes its torque from a stator flux many
+/// times its λf.
+fn flux_base(m: &MachineModel<f64>) -> f64 {
+    m.flux_linkage
+        .max(m.rated_torque / (1.5 * m.pole_pairs as f64 * m.rated_current))
+}
+
+/// Each inductance per unit of the rated current and the flux base ([`flux_base`]), L·I/ψ.
 fn check_reactances(m: &MachineModel<f64>, out: &mut impl Sink) {
+    let flux_base = flux_base(m);
     for (key, l) in [("ld", m.ld), ("lq", m.lq)] {
-        let x = l * m.rated_current / m.flux_linkage;
+        let x = l * m.rated_current / flux_base;
         let severity = if x > 50.0 {
             Some(Severity::Error)
         } else if x > 5.0 {
@@ -576,10 +586,11 @@ fn check_reactances(m: &MachineModel<f64>, out: &mut impl Sink) {
     }
 }
 
-/// The resistive drop at rated current per unit of the rated back-EMF, Rs·I/(ω·λf): above
-/// [`RESISTANCE_ERROR`] the copper loss at the rated point is twice its mechanical power.
+/// The resistive drop at rated current per unit of the rated back-EMF, Rs·I/(ω·ψ) with ψ the
+/// [`flux_base`]: above [`RESISTANCE_ERROR`] the copper loss at the rated point is twice its
+/// mechanical power.
 fn check_resistance(m: &MachineModel<f64>, out: &mut impl Sink) {
-    let r = m.rs * m.rated_current / (m.rated_speed() * m.flux_linkage);
+    let r = m.rs * m.rated_current / (m.rated_speed() * flux_base(m));
     let severity = if r > RESISTANCE_ERROR {
         Some(Severity::Error)
     } else if r > 0.5 {
@@ -665,7 +676,11 @@ fn check_ranges(m: &MachineModel<f64>, out: &mut impl Sink) -> bool {
 
 /// Torque against the model's at rated current: the errors against the magnet torque
 /// 1.5·p·λf·I, which no rotor with Ld ≤ Lq falls short of and which a drive's model with a
-/// mismatched L̂d or L̂q keeps; the warning against the MTPA torque.
+/// mismatched L̂d or L̂q keeps; the warning against the MTPA torque. A rated torque above 3 ×
+/// the magnet torque is an error only where the MTPA torque (with the reluctance torque) falls
+/// short of it too: a PM-assisted SyRM with a weak magnet (ferrite, or the 6.7 kW SyRM of
+/// motulator's examples with a 9 mVs magnet, 35 × its magnet torque) makes most of its torque
+/// from the saliency.
 fn check_torque(m: &MachineModel<f64>, out: &mut impl Sink) {
     let magnet = m.rated_torque / (m.torque_constant() * m.rated_current);
     let ratio = m.rated_torque / ratings::rated_current_torque(m);
@@ -676,7 +691,7 @@ fn check_torque(m: &MachineModel<f64>, out: &mut impl Sink) {
             pole_pairs: m.pole_pairs,
             ratio,
         });
-    } else if !(0.3..=3.0).contains(&magnet) {
+    } else if magnet < 0.3 || (magnet > 3.0 && ratio > 3.0) {
         out.push(Finding::Torque {
             ratio: magnet,
             severity: Severity::Error,

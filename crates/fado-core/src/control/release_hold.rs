@@ -94,6 +94,14 @@ pub struct ReleaseHoldTuning<T> {
     /// trigger within 6 ms on the presets (the hub motor's 0.11 kg·m² the slowest); a start-up
     /// that drifts later (an estimate lost under a wrong model) is left to the speed loop.
     pub window: T,
+    /// From the brake's opening until the hold hands over, the estimator's T2S-1 tracks at
+    /// its running bandwidth in limiter mode too (where the drive has derived one,
+    /// [`tracker_feedforward`](crate::control::tracker_feedforward), "T2S-1 at a brake's
+    /// release"): the fall is the unannounced step of the rated load that bandwidth is placed
+    /// against. Default true \[A\]: measured on the made-up 45 µH 48 V motor (`loaded-start`
+    /// seeds 1–4), max |θ − θ̂| from ready 0.22–0.29 rad with the standstill's 60 Hz,
+    /// 0.07–0.08 rad with it (docs/results/startup.md).
+    pub track_fall: bool,
 }
 
 impl<T: Real> Default for ReleaseHoldTuning<T> {
@@ -103,11 +111,12 @@ impl<T: Real> Default for ReleaseHoldTuning<T> {
             travel: T::lit(0.2),
             trigger: T::lit(0.02),
             window: T::lit(0.05),
+            track_fall: true,
         }
     }
 }
 
-cast_record!(ReleaseHoldTuning { travel, trigger, window ; enabled });
+cast_record!(ReleaseHoldTuning { travel, trigger, window ; enabled, track_fall });
 
 /// The largest ωc·Ts the hold's current-loop rule gives ([`current_bandwidth_for_hold`]):
 /// 0.2 \[A\], with the loop's 1.5-sample delay a phase margin of 90° − 0.3 rad = 73°
@@ -184,6 +193,8 @@ pub enum HoldAction<T> {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ReleaseHold<T> {
     enabled: bool,
+    /// [`ReleaseHoldTuning::track_fall`].
+    track_fall: bool,
     ts: T,
     trigger: T,
     window_samples: u32,
@@ -243,6 +254,7 @@ impl<T: Real> ReleaseHold<T> {
         }
         Ok(Self {
             enabled: tuning.enabled,
+            track_fall: tuning.track_fall,
             ts,
             trigger,
             window_samples: n.round().to_f64() as u32,
@@ -296,6 +308,13 @@ impl<T: Real> ReleaseHold<T> {
     pub fn arm_at_release(&mut self, theta_hold: T) {
         self.arm(theta_hold);
         self.released = self.armed;
+    }
+
+    /// The estimator should track the rotor's fall ([`ReleaseHoldTuning::track_fall`]): from
+    /// the application's brake opening until the hold hands over (or its trigger window
+    /// closes without a fall).
+    pub fn tracking_fall(&self) -> bool {
+        self.track_fall && self.released && self.armed
     }
 
     /// Holding now.

@@ -254,8 +254,9 @@ impl<T: Real> EstimatorState<T> {
             )
         } else {
             // Above the mode threshold T2S-1 runs at its running bandwidth (the last
-            // sample's mode: the one this sample's angle was integrated in).
-            let t2s1 = if self.mode == Mode::DisturbanceFeedback {
+            // sample's mode: the one this sample's angle was integrated in), and at a
+            // brake's release (`set_release_tracking`).
+            let t2s1 = if self.mode == Mode::DisturbanceFeedback || self.release_tracking {
                 &p.t2s1_running
             } else {
                 &p.t2s1
