@@ -157,8 +157,8 @@ fn tmotor_mn4006_passes_the_reversal_the_stops_and_starts_under_its_rated_load()
 }
 
 /// The MAD 5010 KV110 (0.62 Ω, 85 µH, 12S, 20 kHz), not tuned to: it starts under its rated
-/// load (seeds 1, 2, 4 backward 0.32 rad, |θ − θ̂| from ready 0.16–0.18 rad; seed 3 ends with
-/// the drive's no-angle status) and passes `stops` at seeds 1, 3, 4 (0.13–0.14 rad) and
+/// load (seeds 2–4 backward 0.31–0.32 rad, |θ − θ̂| from ready 0.16–0.18 rad; seed 1 ends
+/// with the drive's no-angle status) and passes `stops` at seeds 1, 3, 4 (0.13–0.14 rad) and
 /// `reversal` at seeds 2, 3 (0.07–0.15 rad).
 #[test]
 fn mad_5010_kv110_starts_under_its_rated_load_and_passes_the_stops_and_a_reversal() {
