@@ -49,12 +49,12 @@ fn the_outrunner_presets_hold_their_rated_load_at_the_release() {
 /// current inside the inverter's dead-time band, whose edge currents the PWM ripple (ΔI 2.3 A
 /// against a 0.47 A band) moves: the compensation's error hides the first milliseconds of the
 /// fall from the estimator. The release's d-current floor (`fado_core::control::release_current`,
-/// capped at half the rated current: phase a at 0.4 A) brings the backward travel from 0.74 to
-/// 0.34 rad, but the angle found at standstill is 0.12 rad off before the release (0.01–0.02
-/// on the other seeds) and |θ − θ̂| from ready reaches 0.27 rad. Not solved: kept as the
-/// failing case.
+/// capped at half the rated current: phase a at 0.4 A) catches the fall; the estimate stands
+/// 0.1 rad off after it, and on this light rotor the standstill probe's d current at that error
+/// would swing the rotor 0.72 rad back under the speed loop before the lift: the release hold
+/// holds it through the standstill instead (`fado_core::control::release_hold`, "Through the
+/// loaded standstill"). Measured: backward travel 0.31 rad, |θ − θ̂| from ready 0.17 rad.
 #[test]
-#[ignore = "open: the angle found 0.12 rad off at the dead-time band leaves 0.27 rad from ready"]
 fn the_multirotor_preset_seed_2_holds_its_rated_load_at_the_release() {
     let motor = fado_sim::presets::find("multirotor-mn5006-22v")
         .unwrap()
