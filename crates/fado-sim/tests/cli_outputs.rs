@@ -87,7 +87,7 @@ fn a_second_run_into_the_same_directory_is_refused_and_the_first_completes() {
     assert_eq!(second.status.code(), Some(3), "{}", stderr(&second));
     let msg = stderr(&second);
     assert!(msg.contains(&out.display().to_string()), "{msg}");
-    assert!(msg.contains("another fado-sim run"), "{msg}");
+    assert!(msg.contains("another fado-sim command"), "{msg}");
     let first = first.wait_with_output().unwrap();
     assert!(ran(&first), "{}", stderr(&first));
     assert_eq!(check_whole_run(&out).0, 4.0);
