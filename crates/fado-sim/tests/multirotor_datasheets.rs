@@ -12,6 +12,7 @@ const MAD5010_200: &str = include_str!("data/multirotor/mad-5010-kv200-6s.toml")
 const FLIPSKY6215: &str = include_str!("data/multirotor/flipsky-6215-kv170-12s.toml");
 const MN4006: &str = include_str!("data/multirotor/tmotor-mn4006-kv380-6s.toml");
 const M6C12: &str = include_str!("data/multirotor/mad-m6c12-kv150-12s.toml");
+const MAD5010_110: &str = include_str!("data/multirotor/mad-5010-kv110-12s.toml");
 
 fn run(scenario: &str, name: &str, motor: &str, seed: u64) -> fado_sim::scenario::Outcome {
     let text = format!("{motor}\n[current_sensor]\nseed = {seed}\n");
@@ -135,24 +136,45 @@ fn mad_m6c12_passes_the_reversal_the_stops_and_starts_under_its_rated_load() {
 
 /// The T-Motor MN4006 KV380 (24 poles, 0.113 Ω, 57 µH from an ODrive's identification, 6S,
 /// 24 kHz), not tuned to. Measured (seeds 1–4): reversal 0.030–0.054 rad, stops
-/// 0.072–0.133 rad; loaded-start seeds 2–4 backward 0.23–0.27 rad, |θ − θ̂| from ready
-/// 0.09–0.19 rad (held through the loaded standstill; with the hand-over after 10/ω_h seeds 1
-/// and 4 swing back 1.66 and 2.36 rad).
+/// 0.072–0.133 rad; loaded-start backward 0.23–0.30 rad, |θ − θ̂| from ready 0.09–0.19 rad
+/// (held through the loaded standstill, the probe's swing 0.31 rad on this rotor; with the
+/// hand-over after 10/ω_h seeds 1 and 4 swing back 1.66 and 2.36 rad). At seed 1 the estimate
+/// stands 0.16 rad off at the lift, where the probe's d current stops and the torque it gave
+/// through that error (1.6 % of the rated torque) goes: the probe's turn carried past the
+/// standstill (`fado_core::control::standstill_probe`, "After the standstill") keeps the rotor
+/// within 0.30 rad.
 #[test]
 fn tmotor_mn4006_passes_the_reversal_the_stops_and_starts_under_its_rated_load() {
     for (scenario, seed) in [("reversal", 4), ("stops", 4), ("loaded-start", 4)] {
         let out = run(scenario, "MN4006", MN4006, seed);
         assert!(out.passed, "{scenario} seed {seed}: {:?}", out.checks);
     }
+    let out = run("loaded-start", "MN4006", MN4006, 1);
+    assert!(out.passed, "loaded-start seed 1: {:?}", out.checks);
 }
 
-/// Seed 1: held through the standstill (0.12 rad forward), the estimate 0.16 rad off; at the
-/// lift the probe's d current (−2.3 A at that sample) stops with the hold's hand-over, and the
-/// torque it gave through that angle error, 1.5·p·λf·A·sin δ (1.6 % of the rated torque), goes
-/// with it: the rotor falls back 0.55 rad in 80 ms (bound 0.5).
+/// The MAD 5010 KV110 (0.62 Ω, 85 µH, 12S, 20 kHz), not tuned to: it starts under its rated
+/// load (seeds 1, 2, 4 backward 0.32 rad, |θ − θ̂| from ready 0.16–0.18 rad; seed 3 ends with
+/// the drive's no-angle status) and passes `stops` at seeds 1, 3, 4 (0.13–0.14 rad) and
+/// `reversal` at seeds 2, 3 (0.07–0.15 rad).
 #[test]
-#[ignore = "open: the MN4006 at seed 1 falls back 0.55 rad at the lift, when the probe's d current stops"]
-fn tmotor_mn4006_seed_1_starts_under_its_rated_load() {
-    let out = run("loaded-start", "MN4006", MN4006, 1);
-    assert!(out.passed, "{:?}", out.checks);
+fn mad_5010_kv110_starts_under_its_rated_load_and_passes_the_stops_and_a_reversal() {
+    for (scenario, seed) in [("loaded-start", 1), ("stops", 1), ("reversal", 2)] {
+        let out = run(scenario, "MAD 5010 KV110", MAD5010_110, seed);
+        assert!(out.passed, "{scenario} seed {seed}: {:?}", out.checks);
+    }
+}
+
+/// Its slow passages through zero speed under load: `reversal` seeds 1 and 4 lose 0.42 and
+/// 0.31 rad within 40 ms of the crossing (the estimator reports the lock lost there), `stops`
+/// seed 2 0.31 rad at 13 r/min. At 20 r/min its back-EMF (0.1 V) is a fifth of the inverter's
+/// dead-time voltage Td·fs·Vdc = 0.56 V, whose PWM ripple at the switching edges (0.44 A)
+/// exceeds its 0.14 A band.
+#[test]
+#[ignore = "open: the MAD 5010 KV110 loses 0.31-0.42 rad at its slow passages through zero speed"]
+fn mad_5010_kv110_passes_the_reversal_at_every_seed() {
+    for (scenario, seed) in [("reversal", 1), ("reversal", 4), ("stops", 2)] {
+        let out = run(scenario, "MAD 5010 KV110", MAD5010_110, seed);
+        assert!(out.passed, "{scenario} seed {seed}: {:?}", out.checks);
+    }
 }
