@@ -147,9 +147,12 @@ impl core::error::Error for FluxMapError {}
 
 /// `x` beyond `axis` (increasing, two nodes or more) by more than its edge cell's width.
 fn beyond_axis<T: Real>(axis: &[T], x: T) -> bool {
-    let n = axis.len();
-    let (low, high) = (axis[0], axis[n - 1]);
-    x < low - (axis[1] - low) || x > high + (high - axis[n - 2])
+    match (axis.first_chunk::<2>(), axis.last_chunk::<2>()) {
+        (Some(&[low, next]), Some(&[before, high])) => {
+            x < low - (next - low) || x > high + (high - before)
+        }
+        _ => false,
+    }
 }
 
 /// Zero current lies on the grid: i_d's nodes bracket it (an edge node may be 0: maps of
