@@ -13,18 +13,19 @@ datasheet's unsaturated ones):
    (b) with the commissioned identified.toml, per preset the largest angle error over the seeds
    (near zero speed for the reversals, over the run for `stops`) and the seeds passing.
 Prints the Markdown page; `--write` writes it to docs/results/commissioning-magnetics.md.
-Usage: python3 scripts/commission-magnetics.py [--seeds 1 2 3 4] [--out DIR] [--write]
+Usage: python3 scripts/commission-magnetics.py [--seeds 1 2 3 4] [--out DIR | --keep] [--write]
 """
 
 import argparse
 import json
 import subprocess
 import sys
-import tempfile
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from importlib import import_module  # noqa: E402
+
+from run_directory import add_arguments, run_directory  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 PAGE = ROOT / "docs" / "results" / "commissioning-magnetics.md"
@@ -191,29 +192,33 @@ LIMITS = """
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3, 4])
-    ap.add_argument("--out", type=Path, default=None, help="keep the runs here")
+    add_arguments(ap)
     ap.add_argument("--write", action="store_true", help=f"write {PAGE.relative_to(ROOT)}")
     args = ap.parse_args()
     subprocess.run(["cargo", "build", "--release", "--quiet", "-p", "fado-sim", "--bin",
                     "fado-sim"], cwd=ROOT, check=True)
     binary = ROOT / "target" / "release" / "fado-sim"
-    work = Path(args.out or tempfile.mkdtemp(prefix="fado-commission-magnetics-"))
-    work.mkdir(parents=True, exist_ok=True)
-    presets = sorted((ROOT / "motors" / "saturated").glob("*.toml"))
-    loop = []
-    for preset in [*presets, MADE_UP]:
-        loop += closed_loop(binary, preset, args.seeds, work)
-    # The closed loop's commissions (same machine, seed and output directory) are reused.
-    machines = [(p.stem, ["--config", str(p)]) for p in [*presets, MADE_UP]]
-    machines += [(name, ["--motor", name]) for name in LINEAR]
-    lines = accuracy_rows(binary, machines, args.seeds, work)
-    seeds = "–".join(str(s) for s in (args.seeds[0], args.seeds[-1])) \
-        if len(args.seeds) > 1 else str(args.seeds[0])
-    page = HEAD.format(seeds=seeds, minutes=5) + "\n".join(lines) + "\n" + LOOP_HEAD \
-        + "\n".join(loop) + "\n" + LIMITS
+    with run_directory(args.out, args.keep, "fado-commission-magnetics-") as work:
+        page = measured_page(binary, args.seeds, work)
     if args.write:
         PAGE.write_text(page, encoding="utf-8")
     print(page)
+
+
+def measured_page(binary: Path, seeds: list[int], work: Path) -> str:
+    """Runs the closed loop and the accuracy table in `work`; the page."""
+    presets = sorted((ROOT / "motors" / "saturated").glob("*.toml"))
+    loop = []
+    for preset in [*presets, MADE_UP]:
+        loop += closed_loop(binary, preset, seeds, work)
+    # The closed loop's commissions (same machine, seed and output directory) are reused.
+    machines = [(p.stem, ["--config", str(p)]) for p in [*presets, MADE_UP]]
+    machines += [(name, ["--motor", name]) for name in LINEAR]
+    lines = accuracy_rows(binary, machines, seeds, work)
+    seeds_text = "–".join(str(s) for s in (seeds[0], seeds[-1])) \
+        if len(seeds) > 1 else str(seeds[0])
+    return HEAD.format(seeds=seeds_text, minutes=5) + "\n".join(lines) + "\n" + LOOP_HEAD \
+        + "\n".join(loop) + "\n" + LIMITS
 
 
 if __name__ == "__main__":

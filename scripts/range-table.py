@@ -7,7 +7,7 @@ default non-idealities) for every preset of motors/ and motors/saturated/ and th
 seeds 1-4, and prints
 the Markdown table: the top speed and the power held against the model's limits (`fullrange`
 computes them, fado_sim::range), the largest angle error over the seeds, and which runs pass.
-Usage: python3 scripts/range-table.py [--seeds 1 2 3 4] [--out DIR]
+Usage: python3 scripts/range-table.py [--seeds 1 2 3 4] [--out DIR | --keep]
 """
 
 import argparse
@@ -15,8 +15,9 @@ import json
 import re
 import subprocess
 import sys
-import tempfile
 from pathlib import Path
+
+from run_directory import add_arguments, run_directory
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENARIOS = ["fullrange", "regen-stop"]
@@ -51,13 +52,17 @@ def check(m: dict, prefix: str) -> dict | None:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3, 4])
-    ap.add_argument("--out", type=Path, default=None, help="keep the runs here")
+    add_arguments(ap)
     args = ap.parse_args()
     subprocess.run(["cargo", "build", "--release", "--quiet", "-p", "fado-sim", "--bin",
                     "fado-sim"], cwd=ROOT, check=True)
     binary = ROOT / "target" / "release" / "fado-sim"
-    work = Path(args.out or tempfile.mkdtemp(prefix="fado-range-"))
-    work.mkdir(parents=True, exist_ok=True)
+    with run_directory(args.out, args.keep, "fado-range-") as work:
+        table(binary, args.seeds, work)
+
+
+def table(binary: Path, seeds: list[int], work: Path) -> None:
+    """Runs every preset's range scenarios in `work` and prints the table."""
     print("| preset | top speed: model → reached (r/min) | power at the top: limit / held (W) "
           "| max \\|θ − θ̂\\| fullrange (rad) | fullrange passes | max \\|θ − θ̂\\| regen-stop (rad) "
           "| regen-stop passes | failed criteria |")
@@ -66,7 +71,7 @@ def main() -> None:
         (ROOT / "motors" / "saturated").glob("*.toml"))
     for preset in presets:
         row = {s: [] for s in SCENARIOS}
-        for seed in args.seeds:
+        for seed in seeds:
             cfg = with_seed(preset, seed)
             try:
                 for s in SCENARIOS:
@@ -84,7 +89,7 @@ def main() -> None:
                          for c in m["checks"] if not c["passed"]})
         passes = {s: sum(m["passed"] for m in row[s]) for s in SCENARIOS}
         angle = {s: max(m["max_angle_error"] for m in row[s]) for s in SCENARIOS}
-        n = len(args.seeds)
+        n = len(seeds)
         failed_text = "; ".join(failed).replace("|", "\\|") or "—"
         name = preset.relative_to(ROOT / "motors").with_suffix("").as_posix()
         print(f"| {name} | {model_top} → {reached:.0f} | "

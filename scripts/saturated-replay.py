@@ -24,8 +24,8 @@ where |n| < 2 % of rated speed after 2 s (the scenario's criterion), and R̂s/Rs
 The machines (none is a preset or a test machine of fado's): motulator's 6.7 kW SyRM (its
 example's algebraic parameters, no magnet, and with a small one), a strongly cross-saturated
 IPMSM (ψd falls by 20 % at rated i_q), an SPM whose d axis alone saturates, a 14-pole
-drone-class IPM, the IPMSM's map on a coarse non-uniform 8 × 8 grid, and the IPMSM's map given
-i_q-major / in reverse row order. `--half-map` tries a map that covers only i_q ≤ 0 (a user's
+drone-class IPM, the IPMSM's map on a coarse non-uniform 8 × 8 grid, on a grid that ends at
+0.6 × rated current (the rest extrapolated), and given i_q-major / in reverse row order. `--half-map` tries a map that covers only i_q ≤ 0 (a user's
 measured half map): fado must refuse it or hold the angle.
 
 Usage: python3 scripts/saturated-replay.py [--machine NAME ...] [--load 0 0.3 ...] [--out DIR]
@@ -201,6 +201,8 @@ def cases(half_map: bool) -> list[MapCase]:
         MapCase("spm-dsat", spm_dsat()),
         MapCase("drone-ipm", drone_ipm()),
         MapCase("ipm-cross20, coarse 8x8 non-uniform", ipm, coarse, coarse_q),
+        MapCase("ipm-cross20, map to 0.6 x rated current", ipm, np.linspace(-0.6 * r, 0.3 * r, 7),
+                np.linspace(-0.6 * r, 0.6 * r, 9)),
         MapCase("ipm-cross20, i_q-major rows", ipm, layout="q-major"),
         MapCase("ipm-cross20, rows reversed", ipm, layout="reversed"),
     ]

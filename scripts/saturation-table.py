@@ -8,7 +8,7 @@ current-sensor seeds 1-4, the drive given the plant's own magnetic model (`[mode
 `[motor.saturation]`), and prints the Markdown table: per preset and scenario the largest angle
 error over the seeds (near zero speed for the reversals, over the run for `stops`), the largest
 speed error, and how many seeds pass.
-Usage: python3 scripts/saturation-table.py [--seeds 1 2 3 4] [--out DIR]
+Usage: python3 scripts/saturation-table.py [--seeds 1 2 3 4] [--out DIR | --keep]
 """
 
 import argparse
@@ -16,8 +16,9 @@ import json
 import re
 import subprocess
 import sys
-import tempfile
 from pathlib import Path
+
+from run_directory import add_arguments, run_directory
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENARIOS = ["reversal", "stops", "rated-reversal"]
@@ -51,20 +52,24 @@ def with_seed(preset: Path, seed: int, directory: Path) -> Path:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3, 4])
-    ap.add_argument("--out", type=Path, default=None, help="keep the runs here")
+    add_arguments(ap)
     args = ap.parse_args()
     subprocess.run(["cargo", "build", "--release", "--quiet", "-p", "fado-sim", "--bin",
                     "fado-sim"], cwd=ROOT, check=True)
     binary = ROOT / "target" / "release" / "fado-sim"
-    work = Path(args.out or tempfile.mkdtemp(prefix="fado-saturation-"))
-    work.mkdir(parents=True, exist_ok=True)
+    with run_directory(args.out, args.keep, "fado-saturation-") as work:
+        table(binary, args.seeds, work)
+
+
+def table(binary: Path, seeds: list[int], work: Path) -> None:
+    """Runs every saturated preset's scenarios in `work` and prints the table."""
     print("| preset | scenario | max \\|θ − θ̂\\| (rad) | max speed error (r/min) | "
-          f"seeds passing (of {len(args.seeds)}) |")
+          f"seeds passing (of {len(seeds)}) |")
     print("|---|---|---|---|---|")
     for preset in sorted((ROOT / "motors" / "saturated").glob("*.toml")):
         for scenario in SCENARIOS:
             angles, speeds, passed = [], [], 0
-            for seed in args.seeds:
+            for seed in seeds:
                 config = with_seed(preset, seed, work)
                 m = run(binary, scenario, config, work / f"{preset.stem}-{scenario}-{seed}")
                 key = "max_angle_error" if scenario == "stops" else "max_angle_error_zero_speed"

@@ -59,7 +59,9 @@
 //! without the electrical-frequency ripple of a DC error (`crate::speed_notch`), which with
 //! this coupling would make the DC loop grow (docs/method/saturation.md, "The slow mode").
 
-use crate::magnetics::{ConstantInductance, InductanceMatrix, MachineMagnetics, MagneticModel};
+use crate::magnetics::{
+    ConstantInductance, FluxWarmStart, InductanceMatrix, MachineMagnetics, MagneticModel,
+};
 use crate::{Ab, Dq, MachineModel, Real};
 
 /// The R̂s laws freeze where κ < `KAPPA_MIN_RATIO`·λa: the angle feedback through the
@@ -138,6 +140,14 @@ impl<T: Real> ActiveFlux<T> {
         !self.model.is_linear()
     }
 
+    /// Whether the model at the operating point is a map's extension beyond its data (more
+    /// than the edge cell beyond its grid): there the model's slope is a guess, and the laws
+    /// that read a model error as resistance or magnet flux freeze.
+    #[inline]
+    pub fn beyond_data(&self, point: &ActiveFluxPoint<T>) -> bool {
+        self.model.beyond_data(point.i_dq)
+    }
+
     /// ψ(i) of the model.
     #[inline]
     pub fn flux(&self, i: Dq<T>) -> Dq<T> {
@@ -175,6 +185,22 @@ impl<T: Real> ActiveFlux<T> {
     pub fn point_from(&self, i_dq: Dq<T>, psi_guess: Dq<T>) -> ActiveFluxPoint<T> {
         let psi = self.model.resolve(self.linear).flux_from(i_dq, psi_guess);
         self.point_at(i_dq, psi)
+    }
+
+    /// [`ActiveFlux::point_from`] with an iterative ψ(i) started from `warm`, the last
+    /// solution in a frame near this one (`psi_guess` while it is empty), and the warm start
+    /// holding this solution ([`Magnetics::flux_warm`](crate::magnetics::Magnetics::flux_warm)):
+    /// the same point to the solver's tolerance in one or two Newton steps.
+    #[inline]
+    pub fn point_warm(
+        &self,
+        i_dq: Dq<T>,
+        psi_guess: Dq<T>,
+        warm: &FluxWarmStart<T>,
+    ) -> (ActiveFluxPoint<T>, FluxWarmStart<T>) {
+        let model = self.model.resolve(self.linear);
+        let (psi, warm) = model.flux_warm(i_dq, psi_guess, warm);
+        (self.point_at(i_dq, psi), warm)
     }
 
     #[inline]
@@ -221,11 +247,27 @@ impl<T: Real> ActiveFlux<T> {
         i_ab: Ab<T>,
         lq_prev: T,
     ) -> (Ab<T>, ActiveFluxPoint<T>) {
+        let (lambda_r, point, _) =
+            self.rotor_flux_warm(lambda2, i_ab, lq_prev, &FluxWarmStart::empty());
+        (lambda_r, point)
+    }
+
+    /// [`ActiveFlux::rotor_flux`] with the model's ψ(î) started from `warm`
+    /// ([`ActiveFlux::point_warm`]), and the warm start holding this solution.
+    #[inline]
+    pub fn rotor_flux_warm(
+        &self,
+        lambda2: Ab<T>,
+        i_ab: Ab<T>,
+        lq_prev: T,
+        warm: &FluxWarmStart<T>,
+    ) -> (Ab<T>, ActiveFluxPoint<T>, FluxWarmStart<T>) {
         let axis = lambda2 - i_ab * lq_prev;
         let i_dq = Self::frame_current(axis, i_ab);
-        // λ2 in the same frame is the estimated ψ(î): the model's flux starts there.
-        let point = self.point_from(i_dq, Self::frame_current(axis, lambda2));
-        (lambda2 - i_ab * point.lq_secant, point)
+        // λ2 in the same frame is the estimated ψ(î): the model's flux starts there without
+        // a warm start.
+        let (point, warm) = self.point_warm(i_dq, Self::frame_current(axis, lambda2), warm);
+        (lambda2 - i_ab * point.lq_secant, point, warm)
     }
 
     /// The bracket of the R̂s regressor φ = −(that)/ω (module docs) at the operating point,

@@ -359,7 +359,11 @@ fn write_torque(f: &mut fmt::Formatter<'_>, ratio: f64, severity: Severity) -> f
         f.write_str(
             ": rms where peak is meant (√2 = 1.41)? Give the current in A peak and λf in Wb peak",
         )
-    } else if (0.5..0.65).contains(&ratio) {
+    } else if (0.4..0.55).contains(&ratio) {
+        f.write_str(
+            ": `pole_pairs` a pole count (the model's torque twice the rating), or `ld`/`lq` off?",
+        )
+    } else if (0.55..0.65).contains(&ratio) {
         f.write_str(
             ": λf from a line-to-line constant where the phase value is meant (√3 = 1.73)? \
              Give λf in Wb peak per phase",
@@ -685,8 +689,10 @@ fn check_torque(m: &MachineModel<f64>, out: &mut impl Sink) {
     let magnet = m.rated_torque / (m.torque_constant() * m.rated_current);
     let ratio = m.rated_torque / ratings::rated_current_torque(m);
     // Twice the pole pairs doubles the model's torque at every current, the reluctance
-    // torque's too: the ratio against the MTPA torque is then 0.5 on any rotor.
-    if m.pole_pairs.is_multiple_of(2) && (0.4..0.55).contains(&ratio) {
+    // torque's too: the ratio against the MTPA torque is then 0.5 on any rotor. A model whose
+    // Lq alone is too large (a drive's deliberately mismatched L̂q) moves only the MTPA
+    // torque: the magnet torque must fall short too (by at least 20 %).
+    if m.pole_pairs.is_multiple_of(2) && (0.4..0.55).contains(&ratio) && magnet <= 0.8 {
         out.push(Finding::PoleCount {
             pole_pairs: m.pole_pairs,
             ratio,

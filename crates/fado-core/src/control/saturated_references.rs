@@ -22,7 +22,7 @@
 //! and at light load the loop is slower than designed, never faster (a faster one would eat
 //! the delay's phase margin, `CurrentControllerConfig::bandwidth_hz`).
 
-use crate::magnetics::{MagneticModel, Magnetics};
+use crate::magnetics::{FluxWarmStart, MagneticModel, Magnetics};
 use crate::{Dq, MachineModel, Real};
 
 /// Nodes of the MTPA table over [0, I_max].
@@ -113,26 +113,41 @@ impl<T: Real> SaturatedReferences<T> {
         torque_flux(&self.model, i)
     }
 
-    /// τ at `i` as [`SaturatedReferences::torque_flux`], with ψ(i) solved from `guess` (the
-    /// model's flux at a nearby current), and that ψ: the drive's solves chain their flux from
-    /// one evaluation to the next and from sample to sample, so that each costs one or two
-    /// Newton steps instead of a solve from the linear guess.
+    /// τ at `i` as [`SaturatedReferences::torque_flux`] and ψ(i), solved from `warm`'s
+    /// prediction (the tangent plane at a nearby current, `crate::magnetics::FluxWarmStart`),
+    /// `warm` moved to that ψ: the drive's solves chain their flux from one evaluation to the
+    /// next and from sample to sample, so that each costs one or two Newton steps instead of
+    /// a solve from the linear guess.
     #[inline]
-    pub fn torque_flux_from(&self, i: Dq<T>, guess: Dq<T>) -> (T, Dq<T>) {
-        let psi = self.model.flux_from(i, guess);
+    pub fn torque_flux_warm(&self, i: Dq<T>, warm: &mut FluxWarmStart<T>) -> (T, Dq<T>) {
+        let psi = self.model.flux_from(i, warm.prediction(i));
+        *warm = warm.moved(i, psi);
         (psi.d * i.q - psi.q * i.d, psi)
     }
 
     /// τ at `i` with its derivative along a path of slope di_d/di_q = `did_diq`, ψ(i) solved
-    /// from `guess` as in [`SaturatedReferences::torque_flux_from`], and that ψ:
+    /// from `warm` as in [`SaturatedReferences::torque_flux_warm`] (`warm` set to the
+    /// tangent plane there), and that ψ:
     /// dτ/di_q = (L·(did_diq, 1))d·i_q + ψd − (L·(did_diq, 1))q·i_d − ψq·did_diq with L the
     /// incremental inductance.
     #[inline]
-    pub fn torque_flux_slope(&self, i: Dq<T>, did_diq: T, guess: Dq<T>) -> (T, T, Dq<T>) {
-        let (psi, l) = self.model.flux_and_inductance_from(i, guess);
+    pub fn torque_flux_slope(
+        &self,
+        i: Dq<T>,
+        did_diq: T,
+        warm: &mut FluxWarmStart<T>,
+    ) -> (T, T, Dq<T>) {
+        let (psi, l) = self.model.flux_and_inductance_from(i, warm.prediction(i));
+        *warm = FluxWarmStart::at(i, psi, &l);
         let dpsi = l.apply(Dq::new(did_diq, T::one()));
         let slope = dpsi.d * i.q + psi.d - dpsi.q * i.d - psi.q * did_diq;
         (psi.d * i.q - psi.q * i.d, slope, psi)
+    }
+
+    /// The model's flux at the current `i` and the warm start there (its tangent plane).
+    pub fn warm_start(&self, i: Dq<T>) -> (Dq<T>, FluxWarmStart<T>) {
+        let (psi, l) = self.model.flux_and_inductance(i);
+        (psi, FluxWarmStart::at(i, psi, &l))
     }
 
     /// The model's flux ψ(i) in Wb.

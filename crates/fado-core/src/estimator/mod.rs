@@ -66,6 +66,7 @@ use crate::flux::{
 };
 use crate::integrand_offset::{IntegrandOffsetParams, IntegrandOffsetState};
 use crate::lock::{LockDetectorParams, LockState, LockStatus};
+use crate::magnetics::FluxWarmStart;
 use crate::mode::{Mode, ModeSelectorParams};
 use crate::observer::{DisturbanceObserverParams, ObserverGains, ObserverState};
 use crate::plausibility::SampleBounds;
@@ -215,7 +216,7 @@ pub struct EstimatorParams<T: Real> {
 /// counters. Run-time settings live here too: R̂s (`set_rs_hat`, the adaptation), λ̂f (its
 /// law), the adaptation's on switch (`enable_rs_adaptation`) and the k_df switch. Stepped
 /// with [`EstimatorState::step`] / [`EstimatorState::step_lean`] and the
-/// [`EstimatorParams`] it was made for; `size_of` is 284 B or less in `f32`
+/// [`EstimatorParams`] it was made for; `size_of` is 304 B or less in `f32`
 /// (docs/results/firmware-cost.md).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EstimatorState<T: Real> {
@@ -224,6 +225,9 @@ pub struct EstimatorState<T: Real> {
     /// The q inductance of eq. (5) the last sample used: L̂q, or a saturating model's
     /// secant at the estimated current (`crate::active_flux`).
     lq_secant: T,
+    /// A saturating model's last ψ(î), the start of the next sample's solves
+    /// (`crate::magnetics::FluxWarmStart`; empty for a model that needs none).
+    flux_warm: FluxWarmStart<T>,
     t2s1: TrackerState<T>,
     t2s2: TrackerState<T>,
     /// The k_df gain in effect (it ramps on activation, `EstimatorTuning::k_df_ramp_time`).

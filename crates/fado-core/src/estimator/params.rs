@@ -12,6 +12,7 @@ use crate::flux::{
 };
 use crate::integrand_offset::{IntegrandOffsetParams, IntegrandOffsetState};
 use crate::lock::{LockDetectorParams, LockState, LockStatus};
+use crate::magnetics::FluxWarmStart;
 use crate::mode::{Mode, ModeSelectorParams};
 use crate::observer::{
     DisturbanceObserverConfig, DisturbanceObserverParams, ObserverGains, ObserverState,
@@ -147,6 +148,7 @@ impl<T: Real> EstimatorParams<T> {
             integrator: FluxIntegratorState::new(self.rs_initial),
             observer: ObserverState::zero(),
             lq_secant: self.lq,
+            flux_warm: FluxWarmStart::empty(),
             t2s1: self.t2s1.state_at(T::zero(), T::zero()),
             t2s2: self.t2s2.state_at(T::zero(), T::zero()),
             kdf_gain: T::zero(),

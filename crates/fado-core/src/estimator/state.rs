@@ -6,6 +6,7 @@ use crate::active_flux::{ActiveFlux, ActiveFluxPoint};
 use crate::error::ConfigError;
 use crate::integrand_offset::IntegrandOffsetState;
 use crate::lock::LockState;
+use crate::magnetics::FluxWarmStart;
 use crate::mode::Mode;
 use crate::observer::ObserverState;
 use crate::rotor_flux::{rotor_angle, rotor_flux, stator_flux};
@@ -55,6 +56,7 @@ impl<T: Real> EstimatorState<T> {
             (p.flux_linkage, p.lq)
         };
         self.lq_secant = lq;
+        self.flux_warm = FluxWarmStart::empty();
         let lambda_r = Ab::from_polar(active, theta0);
         // A current so large that L̂q·i overflows is as unusable as a NaN (found by fuzzing,
         // f32: i = 3e37 A gave λ1 = ∞): start as with zero current.
@@ -165,28 +167,31 @@ impl<T: Real> EstimatorState<T> {
         p: &EstimatorParams<T>,
         i_ab: Ab<T>,
         saliency: T,
-    ) -> Ab<T> {
+    ) -> (Ab<T>, FluxWarmStart<T>) {
         let axis = self.observer.flux() - self.observer.disturbance();
         let n2 = axis.norm_squared();
         if SATURATING {
             // A saturating model: λ̂a(î) − ψd(0, 0) along the axis, î in its frame.
             let af = &p.active_flux;
             return if n2 > p.hold_level_sq {
-                // The axis is the estimated active flux: ψ(î) ≈ axis + L̂q,s·î starts the
-                // model's flux.
+                // The axis is the estimated active flux: the last sample's solution (in a
+                // frame within a sample's turn of this one) starts the model's flux, else
+                // ψ(î) ≈ axis + L̂q,s·î.
                 let i_dq = ActiveFlux::frame_current(axis, i_ab);
                 let guess = ActiveFlux::frame_current(axis, axis + i_ab * self.lq_secant);
-                let point = af.point_from(i_dq, guess);
-                axis * ((point.active - af.magnet_flux()) / n2.step_sqrt())
+                let (point, warm) = af.point_warm(i_dq, guess, &self.flux_warm);
+                let swing = axis * ((point.active - af.magnet_flux()) / n2.step_sqrt());
+                (swing, warm)
             } else {
-                Ab::zero()
+                (Ab::zero(), self.flux_warm)
             };
         }
-        if n2 > p.hold_level_sq {
+        let swing = if n2 > p.hold_level_sq {
             axis * (saliency * i_ab.dot(axis) / n2)
         } else {
             Ab::zero()
-        }
+        };
+        (swing, self.flux_warm)
     }
 
     #[cold]

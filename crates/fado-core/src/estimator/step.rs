@@ -18,6 +18,7 @@ use super::{
     EstimatorState, LOCK_PERIOD, SLOT_LOCK, SLOT_OFFSET, SLOT_RS, SLOW_PERIOD,
 };
 use crate::active_flux::ActiveFluxPoint;
+use crate::magnetics::FluxWarmStart;
 use crate::mode::Mode;
 use crate::real::all_finite;
 use crate::rotor_flux::{rotor_angle, stator_flux};
@@ -32,6 +33,9 @@ struct Candidate<T: Real> {
     /// A saturating model's operating point (`crate::active_flux`), with its secant L̂q
     /// (None on the constant-inductance path).
     point: Option<ActiveFluxPoint<T>>,
+    /// A saturating model's ψ(î) of this sample, the next sample's warm start
+    /// (`crate::magnetics::FluxWarmStart`; empty for a model that needs none).
+    flux_warm: FluxWarmStart<T>,
     /// λ1 integrated with the previous sample's feedback (eq. (21) / (24)).
     lambda1: Ab<T>,
     /// The current the integrator's resistive drop used (the slow laws' current).
@@ -157,16 +161,18 @@ impl<T: Real> EstimatorState<T> {
         // secant L̂q is the last sample's here (`crate::active_flux`).
         let lq_i = i_ab * if SATURATING { self.lq_secant } else { p.lq };
         // 2. Disturbance observer.
-        let (observer_flux, disturbance) =
+        let (observer_flux, disturbance, flux_warm) =
             self.observe::<SATURATING>(p, lambda1, lq_i, i_ab, saliency);
         // 3. Rotor flux and direct angle (eq. (20), (5), (6)); a saturating model's secant
         //    L̂q at the current in the frame of λ2 − L̂q⁻·i.
         let lambda2 = stator_flux(lambda1, disturbance);
-        let (lambda_r, point) = if SATURATING {
-            let (lambda_r, point) = p.active_flux.rotor_flux(lambda2, i_ab, self.lq_secant);
-            (lambda_r, Some(point))
+        let (lambda_r, point, flux_warm) = if SATURATING {
+            let (lambda_r, point, warm) =
+                p.active_flux
+                    .rotor_flux_warm(lambda2, i_ab, self.lq_secant, &flux_warm);
+            (lambda_r, Some(point), warm)
         } else {
-            (lambda2 - lq_i, None)
+            (lambda2 - lq_i, None, flux_warm)
         };
         let tracker_hold = lambda_r.norm_squared() < p.hold_level_sq;
         let theta_direct = rotor_angle(lambda_r);
@@ -192,6 +198,7 @@ impl<T: Real> EstimatorState<T> {
         Candidate {
             saliency,
             point,
+            flux_warm,
             lambda1,
             i_drop,
             observer_flux,
@@ -211,7 +218,8 @@ impl<T: Real> EstimatorState<T> {
     }
 
     /// Step 2: the disturbance observer at ω̂ of T2S-1 (eq. (10), (16)), on λ1 or on λ1 − L̂q·i (see
-    /// `EstimatorTuning::observer_on_rotor_flux`): (λ̂1, D̂).
+    /// `EstimatorTuning::observer_on_rotor_flux`): (λ̂1, D̂), and the warm start of the model's
+    /// ψ(î) after the active flux's swing (the last sample's where the swing solves none).
     #[inline(always)]
     fn observe<const SATURATING: bool>(
         &self,
@@ -220,22 +228,25 @@ impl<T: Real> EstimatorState<T> {
         lq_i: Ab<T>,
         i_ab: Ab<T>,
         saliency: T,
-    ) -> (Ab<T>, Ab<T>) {
-        let observer_input = if p.observer_on_rotor_flux {
+    ) -> (Ab<T>, Ab<T>, FluxWarmStart<T>) {
+        let (observer_input, warm) = if p.observer_on_rotor_flux {
             let active = lambda1 - lq_i;
             if saliency != T::zero() {
-                active - self.active_flux_swing::<SATURATING>(p, i_ab, saliency)
+                let (swing, warm) = self.active_flux_swing::<SATURATING>(p, i_ab, saliency);
+                (active - swing, warm)
             } else {
-                active
+                (active, self.flux_warm)
             }
         } else {
-            lambda1
+            (lambda1, self.flux_warm)
         };
         // With `observer.lag_compensation` ω̂1 plus T2S-1's low-passed Kp·e (the rate of
         // θ̂), not the lagging ω̂1 alone. Its gains were formed for that speed at the end of
         // a previous sample (the last one, or up to `observer.gain_period` earlier).
-        p.observer
-            .next_state_with(&self.observer, &self.observer_gains, observer_input)
+        let (observer_flux, disturbance) =
+            p.observer
+                .next_state_with(&self.observer, &self.observer_gains, observer_input);
+        (observer_flux, disturbance, warm)
     }
 
     /// Step 4: both trackers on the direct angle θm, or coasting while |λ̂r| is below the hold
@@ -341,6 +352,7 @@ impl<T: Real> EstimatorState<T> {
         self.t2s2.commit_speed(c.t2s2);
         if let Some(point) = c.point {
             self.lq_secant = point.lq_secant;
+            self.flux_warm = c.flux_warm;
         }
         self.mode = c.mode;
         self.kdf_gain = c.kdf_gain;
@@ -461,7 +473,13 @@ impl<T: Real> EstimatorState<T> {
         // frame error moves |λ̂r| by σ·δ, which the law would read as resistance (a model
         // error's angle, amplified; docs/method/saturation.md, "The offset law's gate").
         let coupled = SATURATING && self.frame_coupled && c.mode == Mode::DisturbanceFeedback;
-        let regime = if broken & BROKEN_RS != 0 || coupled {
+        // Beyond a map's data the model's slope is its edge cells' extension: the law would
+        // learn that guess's error as resistance (docs/results/saturated-replay.md: a map that
+        // ends at 0.6 × rated current, 0.32 rad at rated torque with the law, 0.004 frozen).
+        let beyond = SATURATING
+            && c.point
+                .is_some_and(|point| p.active_flux.beyond_data(&point));
+        let regime = if broken & BROKEN_RS != 0 || coupled || beyond {
             AdaptationRegime::Frozen
         } else {
             match c.mode {

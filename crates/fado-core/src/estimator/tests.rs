@@ -78,8 +78,11 @@ fn state_size() {
     // The trackers' acceleration feed-forward and load integrator (`crate::tracker`) add
     // 2 × 8 B: 264 B in `f32`; the q inductance of eq. (5) the last sample used (a saturating
     // model's secant, `crate::active_flux`) 4 B more; a saturating model's notch on the
-    // observer's speed (`crate::speed_notch`: three values and its two flags) 12 B more.
-    assert!(s32 <= 284, "{s32}");
+    // observer's speed (`crate::speed_notch`: three values and its two flags) 12 B more; the
+    // tangent plane of a saturating model's ψ(î) at the last sample's solution, where the
+    // next sample's Newton solves start (`crate::magnetics::FluxWarmStart`: five values)
+    // 20 B more.
+    assert!(s32 <= 304, "{s32}");
     // The owner is both records and nothing else (padded to its alignment: the parameters
     // may hold a borrowed flux map, pointer-aligned).
     let align = core::mem::align_of::<SensorlessEstimator<f32>>();

@@ -153,6 +153,14 @@ fn a_pole_count_on_a_salient_rotor_is_named() {
     let f = first(&m, None);
     assert!(matches!(f, Finding::PoleCount { pole_pairs: 6, .. }), "{f}");
     assert!(f.to_string().contains("looks like a pole count: 3?"), "{f}");
+    // A drive's model with L̂q five times Lq doubles its MTPA torque too, but not the magnet
+    // torque: a warning naming both causes, not a pole count refused.
+    let mut m = paper();
+    m.lq *= 5.0;
+    let f = first(&m, None);
+    assert!(matches!(f, Finding::Torque { .. }), "{f}");
+    assert_eq!(f.severity(), Severity::Warning);
+    assert!(f.to_string().contains("`ld`/`lq` off"), "{f}");
 }
 
 #[test]

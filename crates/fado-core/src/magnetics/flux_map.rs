@@ -145,6 +145,13 @@ impl fmt::Display for FluxMapError {
 
 impl core::error::Error for FluxMapError {}
 
+/// `x` beyond `axis` (increasing, two nodes or more) by more than its edge cell's width.
+fn beyond_axis<T: Real>(axis: &[T], x: T) -> bool {
+    let n = axis.len();
+    let (low, high) = (axis[0], axis[n - 1]);
+    x < low - (axis[1] - low) || x > high + (high - axis[n - 2])
+}
+
 /// Zero current lies on the grid: i_d's nodes bracket it (an edge node may be 0: maps of
 /// interior-magnet machines often end at i_d = 0) and i_q's straddle it. Both axes are
 /// checked increasing and of two nodes or more.
@@ -300,6 +307,15 @@ impl<'a, T: Real> FluxMap<'a, T> {
         T: Copy,
     {
         (self.axis_d, self.axis_q)
+    }
+
+    /// Whether `i` lies beyond the grid by more than its edge cell along either axis: where the
+    /// map's linear extension of its edge cells stands in for data it does not have.
+    pub fn beyond_grid(&self, i: Dq<T>) -> bool
+    where
+        T: Real,
+    {
+        beyond_axis(self.i_d, i.d) || beyond_axis(self.i_q, i.q)
     }
 
     /// The i_d axis in A.

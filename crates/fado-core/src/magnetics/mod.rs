@@ -39,8 +39,11 @@
 //! and arithmetic, so the same result to the bit, without finding the start cell or loading a
 //! cell's corners again. The algebraic model's ψ(i) (its inverse form) is solved by
 //! Newton's method on the model's own Jacobian, from the magnetically linear guess or from a
-//! caller's warm start (a plant's last current): at most [`NEWTON_ITERATIONS`] steps, stopping
-//! when the step is below √ε/16 of the solution's size (then the error is of the order of ε). Saturation curves are
+//! caller's warm start: at most [`NEWTON_ITERATIONS`] steps, stopping when the step is below
+//! √ε/16 of the solution's size (then the error is of the order of ε), and again from the
+//! linear guess where a warm start's solve does not stop within them. A block that solves it
+//! every sample keeps the tangent plane of its last solution ([`FluxWarmStart`]): one step
+//! and the one that confirms it. Saturation curves are
 //! monotonic and convex (i(ψ)) or concave (ψ(i)) on each side of the origin, where Newton's
 //! iterates from the linear guess converge monotonically; the tests check inverse ∘ forward = 1.
 //!
@@ -55,6 +58,7 @@ mod machine;
 mod saturation;
 mod uniform_map;
 mod uniform_table;
+mod warm_start;
 
 pub use constant::ConstantInductance;
 pub use flux_map::{FluxMap, FluxMapError, FluxTable};
@@ -63,6 +67,7 @@ pub use machine::{MachineMagnetics, zero_current_constants};
 pub use saturation::Saturation;
 pub use uniform_map::UniformFluxMap;
 pub use uniform_table::UniformFluxTable;
+pub use warm_start::FluxWarmStart;
 
 use crate::{Dq, Real};
 
@@ -233,10 +238,22 @@ fn secant_q_from<T: Real>(i: Dq<T>, psi_q: T, offset: T, incremental: impl Fn() 
 /// Jacobian of the one before it (within that last step of the answer).
 pub(crate) fn newton<T: Real>(
     target: Dq<T>,
-    mut x: Dq<T>,
+    x: Dq<T>,
     scale: T,
     f: impl Fn(Dq<T>) -> (Dq<T>, InductanceMatrix<T>),
 ) -> (Dq<T>, InductanceMatrix<T>) {
+    let (x, last, _) = newton_checked(target, x, scale, f);
+    (x, last)
+}
+
+/// [`newton`], and whether it stopped on its test (false: after [`NEWTON_ITERATIONS`] steps,
+/// or on a step that is not finite).
+pub(crate) fn newton_checked<T: Real>(
+    target: Dq<T>,
+    mut x: Dq<T>,
+    scale: T,
+    f: impl Fn(Dq<T>) -> (Dq<T>, InductanceMatrix<T>),
+) -> (Dq<T>, InductanceMatrix<T>, bool) {
     // Quadratic convergence: after a step of √ε/16 the error is of the order of ε.
     let tol = T::default_epsilon().sqrt() * T::lit(1.0 / 16.0);
     let mut last = InductanceMatrix::default();
@@ -245,11 +262,14 @@ pub(crate) fn newton<T: Real>(
         last = jac;
         let step = jac.solve(y - target);
         x -= step;
-        if !step.is_finite() || step.norm() <= tol * (x.norm() + scale) {
+        if !step.is_finite() {
             break;
         }
+        if step.norm() <= tol * (x.norm() + scale) {
+            return (x, last, true);
+        }
     }
-    (x, last)
+    (x, last, false)
 }
 
 /// Any of the three magnetic models, by value.

@@ -1,6 +1,6 @@
 //! The algebraic saturation model: a current map i(ψ) from a magnetic energy.
 
-use super::{InductanceMatrix, MagneticModel, newton};
+use super::{InductanceMatrix, MagneticModel, newton, newton_checked};
 use crate::error::{ConfigError, check};
 use crate::{Dq, Real};
 
@@ -102,24 +102,27 @@ impl<T: Real> Default for Saturation<T> {
     }
 }
 
+/// The largest exponent [`pow_abs`] takes by multiplication.
+const POW_BY_MULTIPLICATION: f64 = 8.0;
+
 /// |x|^e with |0|^0 = 1: repeated multiplication for the small integer exponents published
-/// fits use (exact, and several times faster than libm's powf), powf otherwise.
-#[inline]
+/// fits use (exact, and several times faster than libm's powf), powf otherwise. The
+/// exponent is matched by counting in the scalar itself (a compare per factor), not by an
+/// integer conversion: the per-solve setup of a conversion per exponent cost more than the
+/// multiplications on the algebraic model's Newton solves.
+#[inline(always)]
 fn pow_abs<T: Real>(x: T, e: T) -> T {
-    let n = e.index_floor(16);
     if e == T::zero() {
-        T::one()
-    } else if n >= 1 && e == T::from_index(n) {
-        // By multiplication: the generic `powi` of a no_std build is libm's `pow`.
-        let a = x.abs();
-        let mut p = a;
-        for _ in 1..n {
-            p *= a;
-        }
-        p
-    } else {
-        x.abs().powf(e)
+        return T::one();
     }
+    // By multiplication: the generic `powi` of a no_std build is libm's `pow`.
+    let a = x.abs();
+    let (mut p, mut k) = (a, T::one());
+    while k < e && k < T::lit(POW_BY_MULTIPLICATION) {
+        p *= a;
+        k += T::one();
+    }
+    if k == e { p } else { a.powf(e) }
 }
 
 impl<T: Real> Saturation<T> {
@@ -254,13 +257,35 @@ impl<T: Real> Saturation<T> {
     /// ψ(i) by Newton's method on i(ψ) from `start`, and ∂i/∂ψ at the last iterate but one.
     #[inline]
     fn flux_newton(&self, i: Dq<T>, start: Dq<T>) -> (Dq<T>, InductanceMatrix<T>) {
-        let scale =
-            self.psi_f.abs() + self.psi_n.abs() + (self.i_f / self.a_d0).abs() + T::lit(1e-6);
-        newton(i, start, scale, |psi| self.current_and_jacobian(psi))
+        newton(i, start, self.newton_scale(), |psi| {
+            self.current_and_jacobian(psi)
+        })
+    }
+
+    /// [`Saturation::flux_newton`] from a caller's `start`, and from the linear guess again
+    /// where that solve does not converge: on a stiff model (a high power of ψ) Newton's
+    /// steps from far on the steep side shrink the error by a fixed fraction each and may
+    /// not reach the tolerance within [`super::NEWTON_ITERATIONS`].
+    #[inline]
+    fn flux_newton_from(&self, i: Dq<T>, start: Dq<T>) -> (Dq<T>, InductanceMatrix<T>) {
+        let f = |psi| self.current_and_jacobian(psi);
+        let (psi, jac, converged) = newton_checked(i, start, self.newton_scale(), f);
+        if converged {
+            (psi, jac)
+        } else {
+            self.flux_newton(i, self.linear_flux(i))
+        }
+    }
+
+    /// The flux added to |ψ| in Newton's stopping test (the magnet's and the rib's, so that
+    /// the test stays relative near ψ = 0), Wb.
+    #[inline]
+    pub(super) fn newton_scale(&self) -> T {
+        self.psi_f.abs() + self.psi_n.abs() + (self.i_f / self.a_d0).abs() + T::lit(1e-6)
     }
 
     /// The magnetically linear guess ψ(i) ≈ (ψf + (i_d + i_f)/a_d0, i_q/a_q0).
-    fn linear_flux(&self, i: Dq<T>) -> Dq<T> {
+    pub(super) fn linear_flux(&self, i: Dq<T>) -> Dq<T> {
         Dq::new(self.psi_f + (i.d + self.i_f) / self.a_d0, i.q / self.a_q0)
     }
 }
@@ -271,7 +296,8 @@ impl<T: Real> MagneticModel<T> for Saturation<T> {
         self.flux_newton(i, self.linear_flux(i)).0
     }
 
-    /// Newton from `guess` (from the linear guess if `guess` is not finite).
+    /// Newton from `guess` (from the linear guess if `guess` is not finite, or where the solve
+    /// from `guess` does not converge).
     #[inline]
     fn flux_from(&self, i: Dq<T>, guess: Dq<T>) -> Dq<T> {
         self.flux_and_inductance_from(i, guess).0
@@ -284,7 +310,7 @@ impl<T: Real> MagneticModel<T> for Saturation<T> {
         } else {
             self.linear_flux(i)
         };
-        let (psi, jac) = self.flux_newton(i, start);
+        let (psi, jac) = self.flux_newton_from(i, start);
         (psi, jac.inverse())
     }
 

@@ -90,7 +90,7 @@ fn ipm_mmf() -> Saturation<f64> {
     }
 }
 
-fn models() -> [(&'static str, Saturation<f64>, f64); 4] {
+pub(crate) fn models() -> [(&'static str, Saturation<f64>, f64); 4] {
     // (name, model, rated-ish current in A)
     [
         ("syrm", syrm(), 22.0),
@@ -114,7 +114,7 @@ fn a_magnet_mmf_gives_cross_saturation_and_asymmetric_d_saturation() {
     assert!(up < 0.95 * down, "{up} vs {down}");
 }
 
-fn currents(i_max: f64) -> impl Iterator<Item = Dq<f64>> {
+pub(crate) fn currents(i_max: f64) -> impl Iterator<Item = Dq<f64>> {
     (-4..=4).flat_map(move |a| {
         (-4..=4).map(move |b| {
             Dq::new(
@@ -380,7 +380,7 @@ fn the_secant_of_a_map_not_odd_in_i_q_removes_its_q_flux_at_zero_q_current() {
     }
 }
 
-fn ipm_table<T: Real>() -> FluxTable<T, 16, 16> {
+pub(crate) fn ipm_table<T: Real>() -> FluxTable<T, 16, 16> {
     let m = ipm().cast::<T>();
     let axis = |a: f64, b: f64| core::array::from_fn(|k| T::lit(a + (b - a) * k as f64 / 15.0));
     FluxTable::from_model(&m, axis(-12.0, 6.0), axis(-12.0, 12.0))

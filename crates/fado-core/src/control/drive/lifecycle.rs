@@ -10,6 +10,7 @@ use crate::estimator::{
     Estimate, EstimatorConfig, EstimatorTuning, RotorAngleEstimator, SensorlessEstimator,
 };
 use crate::lock::Debouncer;
+use crate::magnetics::FluxWarmStart;
 use crate::{Ab, Abc, Dq, Real};
 
 impl<T: Real> SensorlessDrive<T, SensorlessEstimator<T>> {
@@ -82,6 +83,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             )?,
             implausible_now: false,
             saturated_flux: Dq::zero(),
+            saturated_warm: FluxWarmStart::empty(),
         };
         drive.reset();
         Ok(drive)
@@ -207,7 +209,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         self.sensor_stuck_now = false;
         self.current_error_now = false;
         self.history = [Ab::zero(); 2];
-        self.saturated_flux = self.zero_current_flux();
+        (self.saturated_flux, self.saturated_warm) = self.zero_current_warm_start();
         self.last = DriveOutput::idle(Estimate {
             theta,
             ..Estimate::default()

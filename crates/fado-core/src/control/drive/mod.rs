@@ -71,6 +71,7 @@ use crate::control::startup::AngleSearch;
 use crate::estimator::{Estimate, SensorlessEstimator};
 use crate::injection::CurrentInjection;
 use crate::lock::Debouncer;
+use crate::magnetics::FluxWarmStart;
 use crate::{Ab, Abc, Dq, Real};
 
 /// Default of [`StallTuning::torque_band_ratio`](crate::control::tuning::StallTuning::torque_band_ratio): 1 − cos(0.25 rad), the torque
@@ -251,10 +252,12 @@ pub struct SensorlessDrive<T: 'static, E = SensorlessEstimator<T>> {
     omega_slow: T,
     /// This sample was refused as implausible.
     implausible_now: bool,
-    /// A saturating model's flux ψ at the last current reference (Wb): where the next
-    /// sample's torque solve starts its flux (`saturated_references`); unused for constant
+    /// A saturating model's flux ψ at the last current reference (Wb); unused for constant
     /// inductances.
     saturated_flux: Dq<T>,
+    /// The tangent plane of ψ(i) there: where the next sample's torque solve starts its
+    /// flux (`saturated_references`, `crate::magnetics::FluxWarmStart`).
+    saturated_warm: FluxWarmStart<T>,
 }
 
 fn estimate_is_finite<T: Real>(e: &Estimate<T>) -> bool {

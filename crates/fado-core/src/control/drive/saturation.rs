@@ -8,6 +8,7 @@ use super::{DriveConfig, SensorlessDrive};
 use crate::control::saturated_references::SaturatedReferences;
 use crate::control::speed_controller::SpeedControllerConfig;
 use crate::estimator::RotorAngleEstimator;
+use crate::magnetics::FluxWarmStart;
 use crate::{Dq, Real};
 
 impl<T: Real> DriveConfig<T> {
@@ -53,16 +54,17 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
     /// (with `mtpa` on) + `probe_id`, and i_q* solves ψd·i_q* − ψq·i_d* = λ̂f·i_q,t (the
     /// co-energy torque, `crate::control::saturated_references`) by the same three Newton
     /// steps, the slope from the model's incremental inductance (one flux solve per step, the
-    /// secant's slope to O(h)). Each evaluation's ψ(i) starts from the last one's, the first
-    /// from the model's flux at the last sample's reference (`saturated_flux`); returns the
-    /// currents and the flux of the last evaluation, the next warm start.
+    /// secant's slope to O(h)). Each evaluation's ψ(i) starts from the last one's first-order
+    /// prediction, the first from the model's flux at the last sample's reference
+    /// (`saturated_warm`); returns the currents, the flux of the last evaluation and the warm
+    /// start there, the next sample's.
     pub(super) fn saturated_currents_for_torque(
         &self,
         s: &SaturatedReferences<T>,
         iq_torque: T,
         guess: T,
         probe_id: T,
-    ) -> (Dq<T>, Dq<T>) {
+    ) -> (Dq<T>, Dq<T>, FluxWarmStart<T>) {
         let m = &self.config.machine;
         let injection = &self.blocks.injection;
         let mtpa = self.config.tuning.mtpa.enabled;
@@ -72,23 +74,25 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         };
         let target = m.flux_linkage * iq_torque;
         let h = T::lit(1e-3) * m.rated_current;
-        let warm = Cell::new(self.saturated_flux);
+        let last = Cell::new((self.saturated_flux, self.saturated_warm));
         let f = |iq: T| {
             let i = Dq::new(id_of(iq), iq);
-            let (tau, slope, psi) = s.torque_flux_slope(i, (id_of(iq + h) - i.d) / h, warm.get());
-            warm.set(psi);
+            let (_, mut warm) = last.get();
+            let (tau, slope, psi) = s.torque_flux_slope(i, (id_of(iq + h) - i.d) / h, &mut warm);
+            last.set((psi, warm));
             (tau - target, slope)
         };
         let iq = Self::solve_torque_with(f, iq_torque, guess, m.rated_current, m.flux_linkage);
-        (Dq::new(id_of(iq), iq), warm.get())
+        let (psi, warm) = last.get();
+        (Dq::new(id_of(iq), iq), psi, warm)
     }
 
-    /// A saturating model's flux at zero current (the torque solve's first warm start); zero
-    /// for constant inductances.
-    pub(super) fn zero_current_flux(&self) -> Dq<T> {
+    /// A saturating model's flux at zero current and the warm start there (the torque
+    /// solve's first); zero and empty for constant inductances.
+    pub(super) fn zero_current_warm_start(&self) -> (Dq<T>, FluxWarmStart<T>) {
         match &self.resolved.saturated {
-            Some(s) => s.flux(Dq::zero()),
-            None => Dq::zero(),
+            Some(s) => s.warm_start(Dq::zero()),
+            None => (Dq::zero(), FluxWarmStart::empty()),
         }
     }
 }

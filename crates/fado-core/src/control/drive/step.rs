@@ -158,7 +158,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         let realised_torque = if let Some(s) = &self.resolved.saturated {
             // A saturating model's co-energy torque (`saturated_references`), its flux the
             // next sample's warm start.
-            let (tau, psi) = s.torque_flux_from(i_dq_ref, self.saturated_flux);
+            let (tau, psi) = s.torque_flux_warm(i_dq_ref, &mut self.saturated_warm);
             self.saturated_flux = psi;
             tau / self.config.machine.flux_linkage
         } else if self.resolved.salient {
@@ -327,7 +327,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         }
         let i = last.i_dq_ref;
         match &self.resolved.saturated {
-            Some(s) => T::lit(1.5) * p * s.torque_flux_from(i, self.saturated_flux).0,
+            Some(s) => T::lit(1.5) * p * s.torque_flux_warm(i, &mut { self.saturated_warm }).0,
             None => T::lit(1.5) * p * self.config.machine.active_flux(i.d) * i.q,
         }
     }

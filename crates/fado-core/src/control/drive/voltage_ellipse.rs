@@ -40,11 +40,12 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             return i;
         };
         let m = &self.config.machine;
-        let mut warm = self.saturated_flux;
+        let mut warm = self.saturated_warm;
         let mut flux = |i: Dq<T>| match &self.resolved.saturated {
             Some(s) => {
-                warm = s.flux_from(i, warm);
-                warm
+                let psi = s.flux_from(i, warm.prediction(i));
+                warm = warm.moved(i, psi);
+                psi
             }
             None => Dq::new(m.flux_linkage + m.ld * i.d, m.lq * i.q),
         };
