@@ -103,7 +103,7 @@ class Machine:
         rated_current: float,
         rated_speed_rpm: float,
         rated_torque: float,
-        dc_voltage: float,
+        dc_voltage: float | None = None,
         inertia: float | None = None,
         viscous_friction: float | None = None,
         flux_map: _FluxMapLike | None = None,

@@ -163,6 +163,14 @@ def test_config_file_errors_point_at_the_file(tmp_path: Path) -> None:
     assert c.value.field == "inverter.dead_time"
 
 
+def test_config_tables_commissioning_does_not_read_are_refused() -> None:
+    # A scenario's profile or a [model] would be ignored: refused, naming what takes them.
+    for table in ({"speed_reference": {"points": [[0.0, 0.0]]}}, {"model": {"rs": 1.0}}):
+        with pytest.raises(fado.ConfigError, match="not used by fado.commission") as c:
+            fado.commission("paper", config=table)
+        assert c.value.field == next(iter(table))
+
+
 def test_plot_shows_every_phase(paper: fado.CommissionResult, tmp_path: Path) -> None:
     pytest.importorskip("matplotlib")
     path = tmp_path / "commission.png"

@@ -469,16 +469,25 @@ def test_machine_is_keyword_only_with_required_fields() -> None:
     assert set(params) == {*PAPER_MACHINE, "flux_map"}
     assert all(p.kind is inspect.Parameter.KEYWORD_ONLY for p in params.values())
     required = {n for n, p in params.items() if p.default is inspect.Parameter.empty}
-    assert required == set(PAPER_MACHINE) - {"viscous_friction", "inertia"}
+    assert required == set(PAPER_MACHINE) - {"viscous_friction", "inertia", "dc_voltage"}
     assert params["flux_map"].default is None
-    # Left out, friction and inertia come from the ratings (fado_core::ratings), not 0.
-    derived = fado.Machine(**{k: v for k, v in IPMSM.items() if k != "inertia"})
+    # Left out, friction, inertia and the DC link come from the ratings (fado_core::ratings),
+    # as fado-sim derives them for a motor file without them: not 0, not the paper's.
+    derived = fado.Machine(
+        **{k: v for k, v in IPMSM.items() if k not in ("inertia", "dc_voltage")}
+    )
     omega_mech = IPMSM["rated_speed_rpm"] * math.pi / 30
     assert derived.viscous_friction == pytest.approx(0.01 * IPMSM["rated_torque"] / omega_mech)
     assert derived.inertia == pytest.approx(0.15 * IPMSM["rated_torque"] / omega_mech)
+    # The rated point's phase voltage at 80 % of Vdc/√3: 652 V, the value `fado-sim run
+    # --dump-config` prints for the same [motor] table.
+    assert derived.dc_voltage == 652.0
     for missing in required:
         with pytest.raises(TypeError, match=missing):
             fado.Machine(**{k: v for k, v in IPMSM.items() if k != missing})
+    # Without its ratings a motor is refused naming every one, not the inertia they give.
+    with pytest.raises(TypeError, match="'rated_current', 'rated_speed_rpm', 'rated_torque'"):
+        fado.Machine(**{k: v for k, v in IPMSM.items() if not k.startswith("rated")})
 
 
 def test_machine_immutable_replace_and_round_trips() -> None:

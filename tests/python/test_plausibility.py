@@ -41,6 +41,32 @@ def test_machine_derives_friction_and_inertia_as_the_cli_does() -> None:
     assert fado.Machine(**DRONE, dc_voltage=24.0, viscous_friction=0.0).viscous_friction == 0.0
 
 
+def test_machine_derives_the_dc_link_as_the_cli_does() -> None:
+    # Left out, the DC link comes from the rated point (fado_core::ratings), bit for bit the
+    # simulator's `[inverter] dc_voltage` for the same `[motor]` table.
+    m = fado.Machine(**DRONE)
+    r = fado.simulate("fig11", DRONE_TOML + "[simulation]\nduration = 0.01\n", averaged=True)
+    assert tomllib.loads(r.config_toml)["inverter"]["dc_voltage"] == m.dc_voltage
+    assert fado.Machine(**DRONE, dc_voltage=None) == m
+
+
+def test_machine_without_ratings_names_them_not_what_they_give() -> None:
+    circuit = {k: v for k, v in DRONE.items() if not k.startswith("rated")}
+    with pytest.raises(TypeError, match="'rated_current', 'rated_speed_rpm', 'rated_torque'"):
+        fado.Machine(**circuit)
+
+
+def test_machine_accepts_numpy_0d_arrays_and_whole_float_counts() -> None:
+    # A value read from an array (`np.array(0.05)`, a reduction) or a float column (4.0).
+    fields = {k: np.array(v) for k, v in DRONE.items()}
+    fields["pole_pairs"] = 14.0
+    m = fado.Machine(**fields)
+    assert m == fado.Machine(**DRONE)
+    assert m.replace(rs=np.array(0.06)).rs == 0.06
+    with pytest.raises(TypeError, match="pole_pairs"):
+        fado.Machine(**{**DRONE, "pole_pairs": 14.5})
+
+
 def test_a_simulator_motor_file_without_ratings_is_refused_naming_them() -> None:
     text = "".join(line + "\n" for line in DRONE_TOML.splitlines()[:6])
     with pytest.raises(fado.ConfigError, match="rated_current") as info:

@@ -140,6 +140,14 @@ impl<T: Real> ActiveFlux<T> {
         !self.model.is_linear()
     }
 
+    /// Whether the model at the operating point is a map's extension beyond its data (more
+    /// than the edge cell beyond its grid): there the model's slope is a guess, and the laws
+    /// that read a model error as resistance or magnet flux freeze.
+    #[inline]
+    pub fn beyond_data(&self, point: &ActiveFluxPoint<T>) -> bool {
+        self.model.beyond_data(point.i_dq)
+    }
+
     /// ψ(i) of the model.
     #[inline]
     pub fn flux(&self, i: Dq<T>) -> Dq<T> {

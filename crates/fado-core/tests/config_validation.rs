@@ -925,3 +925,35 @@ mod properties {
         }
     }
 }
+
+/// A PM-assisted SyRM with a weak magnet makes most of its torque from the saliency: the
+/// 6.7 kW SyRM of motulator's examples with a 8.7 mVs magnet (zero-current L_d 15.7 mH,
+/// L_q 57.5 mH, 20.1 N·m at 21.9 A peak) is 35 × its magnet torque and about its MTPA torque,
+/// and its L_q·I is 4 × the torque's flux per ampere (145 × its λf): it passes. The same
+/// machine without its saliency is still refused on the torque.
+#[test]
+fn a_weak_magnet_pm_syrm_passes_the_torque_check_on_its_mtpa_torque() {
+    let syrm = MachineModel {
+        rs: 0.54,
+        ld: 15.75e-3,
+        lq: 57.47e-3,
+        flux_linkage: 8.652e-3,
+        pole_pairs: 2,
+        inertia: 0.015,
+        viscous_friction: 1e-3,
+        rated_current: 21.92,
+        rated_speed_rpm: 3174.0,
+        rated_torque: 20.1,
+        dc_voltage: 540.0,
+        magnetics: Default::default(),
+    };
+    let findings = fado_core::machine_checks::check(&syrm, None);
+    assert!(findings.error().is_none(), "{findings:?}");
+    let round = MachineModel {
+        lq: syrm.ld,
+        ..syrm
+    };
+    let findings = fado_core::machine_checks::check(&round, None);
+    let error = findings.error().expect("refused");
+    assert_eq!(error.key(), "rated_torque", "{findings:?}");
+}

@@ -645,3 +645,116 @@ fn a_stop_at_the_current_limit_while_generating_holds_the_angle() {
         assert!(worst < bound, "{name}: {worst}");
     }
 }
+
+/// motulator's 6.7 kW SyRM (its examples' algebraic model: a_d0 17.4, a_dd 373, S 5, a_q0 52.1,
+/// a_qq 658, T 1, a_dq 1120, U 1, V 0; 2 pole pairs, 0.54 Ω, 21.9 A peak, 20.1 N·m) in fado's
+/// frame (d on the low-permeance axis: the axes and their exponents swapped) with a weak
+/// magnet, an MMF of `i_f` A along d (3 A: ψd(0, 0) = 48 mVs against an active flux of
+/// 0.32–0.58 Vs at 30–100 % of rated torque; frame coupling 1.1–1.5).
+fn weak_magnet_syrm(i_f: f64) -> MachineModel<f64> {
+    let sat = Saturation {
+        a_d0: 52.1,
+        a_dd: 658.0,
+        s: 1.0,
+        a_q0: 17.4,
+        a_qq: 373.0,
+        t: 5.0,
+        a_dq: 1120.0,
+        u: 0.0,
+        v: 1.0,
+        i_f,
+        ..Saturation::default()
+    };
+    let model = MachineMagnetics::Saturation(Box::leak(Box::new(sat)));
+    rated_machine(model, 0.54, 2, (15.5 * 2f64.sqrt(), 3174.0, 20.1), 540.0)
+}
+
+/// The weak-magnet PM-SyRM replayed through the reversal against the 0.25 rad target; it
+/// fails (docs/results/saturated-replay.md, "Not held"): the slow mode grows while generating
+/// (+0.07 to +0.14 s⁻¹ with the notch), the R̂s law drifts R̂s to 1.4 × the truth under load,
+/// and at no load this harness's injection along +d turns the active flux λa = ψd − L_q,s·i_d
+/// negative (it crosses zero at i_d ≈ λf/(L_q − L_d)).
+#[test]
+#[ignore = "the weak-magnet PM-SyRM is not held (docs/results/saturated-replay.md)"]
+fn a_weak_magnet_pm_syrm_replayed_through_the_reversal() {
+    let plant = weak_magnet_syrm(3.0);
+    let mut worst: f64 = 0.0;
+    for load in [0.0, 0.3, 0.65, 1.0] {
+        let r = replay(&plant, &plant, load);
+        let fixed = replay_with(&plant, &plant, load, |c| {
+            c.tuning.rs_adaptation.enabled = false
+        });
+        println!(
+            "weak-magnet PM-SyRM at {:.0} %: {:.3} rad (R̂s/Rs {:.3}–{:.3}), fixed R̂s {:.3} rad",
+            load * 100.0,
+            r.max_error_near_zero,
+            r.rs_ratio_range.0,
+            r.rs_ratio_range.1,
+            fixed.max_error_near_zero
+        );
+        worst = worst.max(r.max_error_near_zero);
+    }
+    for load in [0.3, 0.65, 1.0] {
+        let m = weak_magnet_syrm(3.0);
+        println!(
+            "  slow mode at {:.0} %: {:+.2} / {:+.2} 1/s (generating / motoring)",
+            load * 100.0,
+            slow_mode_rate(&m, load, -0.06, true),
+            slow_mode_rate(&m, load, 0.06, true)
+        );
+    }
+    assert!(worst < 0.25, "weak-magnet PM-SyRM: {worst} rad");
+}
+
+/// `plant`'s model as a 9 × 9 map over ±`span` × its rated current: beyond it the map extends
+/// its edge cells.
+fn short_map(plant: &MachineModel<f64>, span: f64) -> MachineModel<f64> {
+    let axis: [f64; 9] =
+        core::array::from_fn(|k| span * plant.rated_current * (k as f64 / 4.0 - 1.0));
+    let table: &'static FluxTable<f64, 9, 9> = Box::leak(Box::new(FluxTable::from_model(
+        &plant.magnetic_model(),
+        axis,
+        axis,
+    )));
+    plant.with_magnetics(MachineMagnetics::Map(Box::leak(Box::new(
+        table.map().unwrap(),
+    ))))
+}
+
+/// A map that ends short of the operating current: the estimator's model there is the edge
+/// cells' linear extension, and the R̂s law, which reads any model error as resistance,
+/// freezes beyond the grid by more than its edge cell. Replayed at rated torque with a map
+/// that ends at 0.6 × the rated current, the angle holds within 0.25 rad near zero speed and
+/// R̂s stays within 2 % of the truth, as with the R̂s law off.
+#[test]
+fn a_map_that_ends_short_of_the_operating_current_freezes_the_resistance_law() {
+    for (name, plant) in [
+        ("ipmsm-2k2, 5x cross-saturation", ipm(300.0)),
+        ("automotive IPMSM (made up)", automotive()),
+        ("made-up 20-pole IPMSM", small_ipm()),
+    ] {
+        let model = short_map(&plant, 0.6);
+        let r = replay(&plant, &model, 1.0);
+        let fixed = replay_with(&plant, &model, 1.0, |c| {
+            c.tuning.rs_adaptation.enabled = false;
+        });
+        println!(
+            "{name}, map to 0.6 × rated current, rated torque: {:.3} rad (R̂s/Rs {:.3}–{:.3}), \
+             fixed R̂s {:.3} rad",
+            r.max_error_near_zero,
+            r.rs_ratio_range.0,
+            r.rs_ratio_range.1,
+            fixed.max_error_near_zero
+        );
+        assert!(
+            r.max_error_near_zero < 0.25,
+            "{name}: {}",
+            r.max_error_near_zero
+        );
+        assert!(
+            r.rs_ratio_range.0 > 0.98 && r.rs_ratio_range.1 < 1.02,
+            "{name}: R̂s/Rs {:?}",
+            r.rs_ratio_range
+        );
+    }
+}

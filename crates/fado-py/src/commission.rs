@@ -79,7 +79,10 @@ fn plant_config(
     };
     let base = motor.base().map_err(|e| sim_error(py, e))?;
     let mut cfg = match config_toml {
-        Some(text) => SimConfig::from_toml_over(&base, text).map_err(|e| sim_error(py, e))?,
+        Some(text) => {
+            sim_commission::refuse_unused(text, "fado.commission").map_err(|e| sim_error(py, e))?;
+            SimConfig::from_toml_over(&base, text).map_err(|e| sim_error(py, e))?
+        }
         None => base,
     };
     cfg.current_sensor.seed = seed;

@@ -72,13 +72,19 @@ fn from_arrays(py: Python<'_>, parts: &Bound<'_, PyAny>) -> PyResult<FluxMapData
             ),
         ));
     }
-    // Rows numbered from 1 as lines: `line − 1` is the node's index in the arrays.
+    // Rows numbered from 1 as lines: `line − 1` is the node's index in the arrays; line 0
+    // (the "header") is the whole grid.
     let rows: Vec<([f64; 4], usize)> = (0..nd)
         .map(|k| ([a[0].1[k], a[1].1[k], a[2].1[k], a[3].1[k]], k + 1))
         .collect();
-    flux_map_from_rows(&rows, "arrays", 1).map_err(|e| {
-        let at = e.location.as_ref().map_or(0, |l| l.line.saturating_sub(1));
-        refuse(py, format!("node {at} of the arrays: {}", e.message))
+    flux_map_from_rows(&rows, "arrays", 0).map_err(|e| {
+        match e.location.as_ref().map_or(0, |l| l.line) {
+            0 => refuse(py, format!("the arrays' grid: {}", e.message)),
+            line => refuse(
+                py,
+                format!("node {} of the arrays: {}", line - 1, e.message),
+            ),
+        }
     })
 }
 

@@ -4,7 +4,8 @@
 //!
 //! The Python class holds the core record and takes its fields from the record's serde derive
 //! ([`crate::record`]), plus `dc_voltage`, which the record keeps out of its TOML table (there
-//! it is the simulator's `[inverter] dc_voltage`) but a machine given alone needs. Validation
+//! it is the simulator's `[inverter] dc_voltage`) but a machine given alone needs (derived
+//! from the ratings when left out, as the simulator derives it). Validation
 //! is the core's (`MachineModel::validate`: signs, finiteness and unit slips); a refusal raises
 //! `fado.ConfigError` (a `ValueError`) whose `.field` names the field.
 
@@ -29,8 +30,69 @@ pub fn preset_names() -> Vec<&'static str> {
 const DC_VOLTAGE: &str = "dc_voltage";
 
 /// The fields a `Machine` derives from its ratings when they are not given, by the rules of
-/// `fado_core::ratings` (the same as `fado-sim`'s `[motor]` table).
-const DERIVED: [&str; 2] = ["inertia", "viscous_friction"];
+/// `fado_core::ratings` (the same as `fado-sim`'s `[motor]` table and `[inverter]
+/// dc_voltage`).
+const DERIVED: [&str; 3] = ["inertia", "viscous_friction", DC_VOLTAGE];
+
+/// `TypeError` naming every circuit key and rating `fields` lacks (or gives as None), as
+/// `fado-sim` refuses a motor file without them; None when all are given.
+fn missing_required(fields: Option<&Bound<'_, PyDict>>) -> PyResult<Option<PyErr>> {
+    let mut missing = Vec::new();
+    for key in fado_core::ratings::REQUIRED_MOTOR_KEYS {
+        let given = match fields {
+            Some(f) => f.get_item(key)?.is_some_and(|v| !v.is_none()),
+            None => false,
+        };
+        if !given {
+            missing.push(format!("'{key}'"));
+        }
+    }
+    if missing.is_empty() {
+        return Ok(None);
+    }
+    Ok(Some(pyo3::exceptions::PyTypeError::new_err(format!(
+        "Machine() missing required keyword argument{}: {}. The circuit (rs, ld, lq, \
+         flux_linkage, pole_pairs) and the ratings from the datasheet (rated_current in A peak, \
+         rated_speed_rpm, rated_torque) are required; inertia, viscous_friction and dc_voltage \
+         are derived from them when left out (fado_core::ratings); no value is taken from \
+         another motor",
+        if missing.len() > 1 { "s" } else { "" },
+        missing.join(", ")
+    ))))
+}
+
+/// True when `m`'s circuit and ratings are finite and positive: the DC link can be derived
+/// from them (otherwise the validation names the bad field).
+fn derivable(m: &MachineModel<f64>) -> bool {
+    [
+        m.rs,
+        m.ld,
+        m.lq,
+        m.flux_linkage,
+        m.rated_current,
+        m.rated_speed_rpm,
+        m.rated_torque,
+    ]
+    .iter()
+    .all(|x| x.is_finite() && *x > 0.0)
+        && m.pole_pairs > 0
+}
+
+/// The error of a finding on a DC link derived from the ratings (not the user's value): the
+/// rated point it follows from is named instead.
+fn derived_dc_link_error(py: Python<'_>, dc: f64) -> PyErr {
+    config_error_message(
+        py,
+        "rated_speed_rpm",
+        format!(
+            "`dc_voltage` was not given: derived from the rated point ({}), it is {dc:e} V, \
+             beyond any drive; the rated point (`rated_speed_rpm`, `flux_linkage`, \
+             `pole_pairs`, `rated_current`, `ld`, `lq`) is off: check their units (r/min, Wb \
+             peak per phase, A peak, H) or give `dc_voltage`",
+            fado_core::ratings::rule("inverter.dc_voltage").unwrap_or("")
+        ),
+    )
+}
 
 /// Raises a `UserWarning` per plausibility warning of `m` (`fado_core::machine_checks`),
 /// with `ts` the sampling period when known; the first error as `ConfigError` naming its key.
@@ -60,10 +122,11 @@ pub fn field_names(py: Python<'_>) -> PyResult<Vec<String>> {
 /// The motor's parameters and ratings, as the drive models it (SI units, per phase,
 /// amplitude-invariant peak values; the rated speed in r/min).
 ///
-/// Every argument is keyword-only and required except `inertia` and `viscous_friction`,
-/// which default to the values the ratings give (`fado_core::ratings`: the rated torque
-/// reaches the rated speed in 0.15 s; friction 1 % of the rated torque at rated speed), as
-/// in a `fado-sim` motor file.
+/// Every argument is keyword-only and required except `inertia`, `viscous_friction` and
+/// `dc_voltage`, which default to the values the ratings give (`fado_core::ratings`: the
+/// rated torque reaches the rated speed in 0.15 s; friction 1 % of the rated torque at rated
+/// speed; the rated point's phase voltage at 80 % of Vdc/√3), as in a `fado-sim` motor file.
+/// Numbers may be numpy scalars or 0-d arrays; a count (`pole_pairs`) may be a whole float.
 /// Its fields (`Machine.fields`) are documented in the type stub and in the Rust documentation
 /// of `MachineModel`. `Machine.paper()` is the paper's motor, `Machine.preset(name)` a motor of the repository's
 /// `motors/` folder (`fado.machine_presets()`). Instances are immutable; `replace(**changes)`
@@ -149,7 +212,8 @@ impl PyMachine {
             if out.get_item(key)?.is_some_and(|v| v.is_none()) {
                 out.del_item(key)?;
             }
-            if out.contains(key)? {
+            if out.contains(key)? || key == DC_VOLTAGE {
+                // The DC link needs the whole circuit: derived in `changed`.
                 continue;
             }
             if let Some((torque, speed)) = ratings {
@@ -197,8 +261,16 @@ impl PyMachine {
                 })?;
             }
         }
+        let dc_derived =
+            constructing && !changes.is_some_and(|c| c.contains(DC_VOLTAGE).unwrap_or(false));
+        if dc_derived && derivable(&model) {
+            model.dc_voltage = fado_core::ratings::dc_voltage(&model);
+        }
         // The cross-checks first: their errors name every field involved.
         if let Some(e) = fado_core::machine_checks::check(&model, None).error() {
+            if dc_derived && e.key() == DC_VOLTAGE {
+                return Err(derived_dc_link_error(py, model.dc_voltage));
+            }
             return Err(config_error_message(py, e.key(), e.to_string()));
         }
         if let Err(e) = model.validate() {
@@ -327,6 +399,9 @@ impl PyMachine {
     #[pyo3(signature = (**fields))]
     fn py_new(py: Python<'_>, fields: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
         let (fields, flux_map) = Self::split_flux_map(py, fields)?;
+        if let Some(e) = missing_required(fields.as_ref())? {
+            return Err(e);
+        }
         let fields = Self::with_derived(py, fields.as_ref())?;
         let mut m = Self::changed(py, &MachineModel::default(), Some(&fields), true)?;
         m.flux_map = flux_map.flatten();

@@ -59,6 +59,15 @@ pub fn plain_number<'py>(
     {
         return Ok(value.clone());
     }
+    // A numpy 0-d array (`np.array(0.3)`, `x.sum(keepdims=False)` of an array) or a numpy
+    // scalar not registered with the `numbers` ABCs (`np.bool_`): its Python value.
+    if value
+        .getattr("ndim")
+        .is_ok_and(|n| n.extract::<usize>().is_ok_and(|n| n == 0))
+        && value.hasattr("item")?
+    {
+        return plain_number(py, &value.call_method0("item")?);
+    }
     let numbers = py.import("numbers")?;
     if value.is_instance(&numbers.getattr("Integral")?)? {
         return value.call_method0("__index__");
@@ -67,6 +76,24 @@ pub fn plain_number<'py>(
         return Ok(PyFloat::new(py, value.extract::<f64>()?).into_any());
     }
     Ok(value.clone())
+}
+
+/// `value` as an `int` when the field's `current` value is a count (an `int`, not a `bool`)
+/// and `value` a whole float (`4.0`, a pole count read from a float column); otherwise
+/// unchanged, and a fractional float is refused by the field's type.
+fn whole_for_count<'py>(
+    py: Python<'py>,
+    current: &Bound<'py, PyAny>,
+    value: Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let count = current.is_instance_of::<PyInt>() && !current.is_instance_of::<PyBool>();
+    if let (true, Ok(f)) = (count, value.cast::<PyFloat>()) {
+        let x = f.value();
+        if x.is_finite() && x.fract() == 0.0 && x.abs() < 9.0e15 {
+            return Ok(PyInt::new(py, x as i64).into_any());
+        }
+    }
+    Ok(value)
 }
 
 /// The JSON-representable Python value of field `field`, or `ConfigError` naming it (a
@@ -147,7 +174,7 @@ where
             merged.set_item(&key, table)?;
             continue;
         }
-        let value = plain_number(py, &value)?;
+        let value = whole_for_count(py, &current, plain_number(py, &value)?)?;
         plain_value(py, &name, &value)?;
         let one = PyDict::new(py);
         one.set_item(&key, &value)?;

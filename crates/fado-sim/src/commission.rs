@@ -195,6 +195,47 @@ impl Default for CommissionOptions {
     }
 }
 
+/// The tables of a configuration the commissioning reads: the plant's. Every other table is
+/// another command's and is refused by [`refuse_unused`].
+pub const PLANT_TABLES: [&str; 7] = [
+    "motor",
+    "inverter",
+    "current_sensor",
+    "dc_link_sensor",
+    "load",
+    "faults",
+    "dc_link",
+];
+
+/// Refuses a table of the user's configuration `text` that commissioning does not use (a
+/// scenario's `[speed_reference]`, a `[model]` commissioning is to identify, the drive's
+/// `[controller]`), naming what takes it, so that no key is silently ignored; `function` is
+/// the command or function the user called.
+pub fn refuse_unused(text: &str, function: &str) -> Result<(), SimConfigError> {
+    let Ok(table) = text.parse::<toml::Table>() else {
+        return Ok(()); // a syntax error is the parser's to name
+    };
+    let Some(key) = table.keys().find(|k| !PLANT_TABLES.contains(&k.as_str())) else {
+        return Ok(());
+    };
+    let takes = match key.as_str() {
+        "model" => "commissioning identifies the drive's model: it writes the [model] table \
+                    (identified.toml) that `run` and `simulate` then take"
+            .to_owned(),
+        _ => format!(
+            "it is a setting of the simulated drive and its scenarios, which `fado-sim run`, \
+             `sweep` and `compare` (fado.simulate, fado.sweep, fado.compare) take; \
+             commissioning reads only the plant ([{}])",
+            PLANT_TABLES.join("], [")
+        ),
+    };
+    Err(SimConfigError::new(
+        key.clone(),
+        format!("`{key}` is not used by {function}: {takes}"),
+    )
+    .located_in(text))
+}
+
 /// Runs the procedure on a plant. `nameplate` is what the user tells the procedure (ratings
 /// and rough parameters); `config` adjusts the procedure's defaults (its `nameplate`,
 /// `sample_period` and `dead_time` are set from the arguments and the plant's inverter).
@@ -689,7 +730,27 @@ pub fn compare(id: &Identification<f64>, t: &Truth) -> Vec<Comparison> {
 
 #[cfg(test)]
 mod trace_row_tests {
-    use super::TraceRow;
+    use super::{TraceRow, refuse_unused};
+
+    #[test]
+    fn tables_commissioning_does_not_read_are_refused_naming_what_takes_them() {
+        let plant = "[motor]\nrs = 1.0\n[inverter]\ndead_time = 1e-6\n";
+        assert!(refuse_unused(plant, "fado.commission").is_ok());
+        for (table, says) in [
+            (
+                "[speed_reference]\npoints = [[0.0, 0.0]]\n",
+                "fado.simulate",
+            ),
+            ("[model]\nrs = 1.0\n", "identified.toml"),
+            ("[simulation]\nduration = 1.0\n", "fado-sim run"),
+            ("[controller.speed]\nbandwidth_hz = 3.0\n", "fado-sim run"),
+        ] {
+            let e = refuse_unused(&format!("{plant}{table}"), "fado.commission").unwrap_err();
+            assert!(table.contains(&format!("[{}", e.key)), "{e}");
+            assert!(e.message.contains("not used by fado.commission"), "{e}");
+            assert!(e.message.contains(says), "{e}");
+        }
+    }
 
     #[test]
     fn columns_are_the_csv_header_and_values_follow_them() {

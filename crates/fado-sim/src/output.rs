@@ -58,8 +58,9 @@ impl fmt::Display for OutputError {
         if self.is_busy() {
             write!(
                 f,
-                "{}: another fado-sim run or sweep is writing to this directory (it holds {}); \
-                 wait for it or choose another output directory",
+                "{}: another fado-sim command (run, sweep, compare or commission) is writing \
+                 to this directory (it holds {}); wait for it or choose another output \
+                 directory",
                 self.path.display(),
                 LOCK_FILE
             )
@@ -94,7 +95,17 @@ impl DirLock {
     /// Creates `dir` if needed and locks it, or fails at once (no waiting) if another process
     /// holds it. Removes the temporary files that killed writers left there.
     pub fn acquire(dir: &Path) -> Result<Self, OutputError> {
-        std::fs::create_dir_all(dir).map_err(|e| OutputError::new("create directory", dir, e))?;
+        std::fs::create_dir_all(dir).map_err(|e| {
+            if dir.exists() && !dir.is_dir() {
+                // `--out` names a file: say so rather than "File exists".
+                let e = io::Error::new(
+                    e.kind(),
+                    "it is a file, not a directory (--out names the directory to write into)",
+                );
+                return OutputError::new("use as the output directory", dir, e);
+            }
+            OutputError::new("create directory", dir, e)
+        })?;
         let path = dir.join(LOCK_FILE);
         let file = OpenOptions::new()
             .create(true)
@@ -214,8 +225,10 @@ impl Write for AtomicFile {
 
 impl Drop for AtomicFile {
     fn drop(&mut self) {
-        if self.writer.is_some() {
-            // Not committed: the temporary file is garbage (an error was already reported).
+        // Not finished (a write, the last flush or the sync failed: a full disk): the
+        // temporary file is garbage (an error was already reported). `finish` takes `tmp`
+        // when it hands the file on.
+        if !self.tmp.as_os_str().is_empty() {
             let _ = std::fs::remove_file(&self.tmp);
         }
     }
@@ -320,6 +333,22 @@ mod tests {
     }
 
     #[test]
+    fn a_file_whose_last_flush_failed_leaves_no_temporary() {
+        // `finish` takes the writer before its flush and sync; when they fail (a full disk:
+        // `sweep.json` buffered whole, `ENOSPC` at the flush) the file is dropped in that state.
+        let dir = scratch("flush");
+        let _lock = DirLock::acquire(&dir).unwrap();
+        let mut f = AtomicFile::create(&dir.join("sweep.json")).unwrap();
+        f.write_all(b"{}").unwrap();
+        let tmp = f.tmp.clone();
+        assert!(tmp.exists());
+        drop(f.writer.take());
+        drop(f);
+        assert!(!tmp.exists());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
     fn a_killed_writers_temporary_is_removed_by_the_next_lock() {
         let dir = scratch("stale");
         std::fs::create_dir_all(&dir).unwrap();
@@ -329,6 +358,18 @@ mod tests {
         let _lock = DirLock::acquire(&dir).unwrap();
         assert!(!stale.exists());
         assert!(dir.join("keep.csv").exists());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn an_output_directory_that_is_a_file_is_named_as_such() {
+        let dir = scratch("outfile");
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("results");
+        std::fs::write(&file, b"x").unwrap();
+        let e = DirLock::acquire(&file).unwrap_err().to_string();
+        assert!(e.contains("results") && e.contains("it is a file"), "{e}");
+        assert_eq!(std::fs::read(&file).unwrap(), b"x");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

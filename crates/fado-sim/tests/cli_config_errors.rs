@@ -94,3 +94,37 @@ fn a_good_file_is_accepted() {
         "{stderr}"
     );
 }
+
+#[test]
+fn dump_config_prints_the_plausibility_warnings_on_stderr() {
+    // Swapped inductances on the paper's motor: a warning, shown before the TOML is printed
+    // (the check a user runs before a run).
+    let text = "[motor]\nrs = 0.327\nld = 5e-3\nlq = 2.63e-3\nflux_linkage = 0.088\n\
+                pole_pairs = 4\nrated_current = 21.78\nrated_speed_rpm = 1500.0\n\
+                rated_torque = 11.5\n";
+    let (code, stderr, _) = run_with("swapped.toml", text);
+    assert_eq!(code, Some(0), "{stderr}");
+    assert!(
+        stderr.contains("warning:") && stderr.contains("swapped"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn a_key_in_the_wrong_table_names_the_table_it_belongs_to() {
+    // `switching_frequency` is the inverter's, not the motor's.
+    let (code, stderr, path) = run_with(
+        "wrong-table.toml",
+        "[motor]\nswitching_frequency = 20000.0\n",
+    );
+    assert_eq!(code, Some(2), "{stderr}");
+    let prefix = format!(
+        "error: {}:2:1: `motor.switching_frequency`: ",
+        path.display()
+    );
+    assert!(stderr.starts_with(&prefix), "{stderr}");
+    assert!(
+        stderr.contains("`switching_frequency` is a key of [inverter]"),
+        "{stderr}"
+    );
+}

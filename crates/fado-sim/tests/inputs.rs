@@ -257,3 +257,45 @@ fn the_presets_raise_no_finding() {
         assert!(!f.iter().any(|(s, ..)| *s == Severity::Error));
     }
 }
+
+#[test]
+fn an_inductance_in_mh_on_a_minimal_file_blames_the_inductance_not_the_derived_dc_link() {
+    // The drone motor with 2.5 mH entered as 2.5 (H): the DC link left out is derived from the
+    // rated point, which this inductance puts at 1.4 MV. The inductance is named at its own
+    // line, not the DC link nobody wrote.
+    let e = refused(&drone_with("ld", "2.5").replace("lq = 25e-6", "lq = 2.5"));
+    assert_eq!(e.key, "motor.ld", "{e}");
+    assert!(e.message.contains("per unit"), "{e}");
+}
+
+#[test]
+fn a_derived_dc_link_beyond_any_drive_names_the_ratings_it_follows_from() {
+    // A 10 kV-class motor (λf 11.7 Wb, p 4) with its ratings × 10 (15,000 r/min): the rated
+    // point needs 636 kV. The derived `inverter.dc_voltage` is not the user's key.
+    let text = "[motor]\nrs = 0.1\nld = 25e-3\nlq = 25e-3\nflux_linkage = 11.7\npole_pairs = 4\n\
+                rated_current = 1810.0\nrated_speed_rpm = 15000.0\nrated_torque = 127000.0\n";
+    let e = refused(text);
+    assert_eq!(e.key, "motor.rated_speed_rpm", "{e}");
+    assert!(
+        e.message.contains("is not in the file: it is derived"),
+        "{e}"
+    );
+    assert!(e.message.contains("`motor.flux_linkage`"), "{e}");
+}
+
+#[test]
+fn a_threshold_voltage_beyond_the_dc_link_is_refused() {
+    // 1e4 V of device threshold on a derived 17 V link: the drive trips at once.
+    let e = refused(&format!("{DRONE}[inverter]\nthreshold_voltage = 1e4\n"));
+    assert_eq!(e.key, "inverter.threshold_voltage", "{e}");
+}
+
+#[test]
+fn a_current_given_rms_is_a_warning_saying_so() {
+    // 30 A peak entered as 21.2 A rms: the rated torque is 1.41 × the model's.
+    let w = warnings(&drone_with("rated_current", "21.21"));
+    assert!(
+        w.iter().any(|w| w.contains("rms where peak is meant")),
+        "{w:?}"
+    );
+}

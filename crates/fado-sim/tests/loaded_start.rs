@@ -101,6 +101,20 @@ fn made_up(name: &str) -> String {
     std::fs::read_to_string(path).unwrap()
 }
 
+/// Runs `loaded-start` on the motor file `toml` with `seed`, asserts its verdict and returns
+/// the backward travel (rad).
+fn lifts(name: &str, toml: &str, seed: u64) -> f64 {
+    let text = format!("{toml}\n[current_sensor]\nseed = {seed}\n");
+    let out = simulate("loaded-start", Some(&text), false, None).unwrap();
+    let st = out.probe.start.as_ref().unwrap();
+    println!(
+        "{name} seed {seed}: back {:.3} rad, max |θ − θ̂| {:.3} rad",
+        st.max_backward, st.max_angle_error
+    );
+    assert!(out.passed, "{name} seed {seed}: {:?}", out.checks);
+    st.max_backward
+}
+
 #[test]
 fn the_release_hold_catches_the_rated_load_and_the_speed_loop_lifts_it() {
     // The rated torque from the release on: the release hold catches the rotor within the
@@ -113,15 +127,8 @@ fn the_release_hold_catches_the_rated_load_and_the_speed_loop_lifts_it() {
         ("spm-750w", made_up("startup-spm-750w")),
     ] {
         for seed in [1, 3] {
-            let text = format!("{toml}\n[current_sensor]\nseed = {seed}\n");
-            let out = simulate("loaded-start", Some(&text), false, None).unwrap();
-            let st = out.probe.start.as_ref().unwrap();
-            println!(
-                "{name} seed {seed}: back {:.3} rad, max |θ − θ̂| {:.3} rad",
-                st.max_backward, st.max_angle_error
-            );
-            assert!(out.passed, "{name} seed {seed}: {:?}", out.checks);
-            assert!(st.max_backward > 0.05, "{name}: the load acted");
+            let back = lifts(name, &toml, seed);
+            assert!(back > 0.05, "{name}: the load acted");
         }
     }
 }
@@ -153,10 +160,10 @@ fn a_motor_without_standstill_angle_information_ends_with_the_status_and_never_s
 }
 
 #[test]
-fn two_made_up_motors_find_their_angle_and_the_servo_lifts_its_load() {
-    // Motors that are not presets: a 750 W servo (passes seeds 1, 3, 4) and a fast 45 µH,
-    // 48 V motor whose rated torque runs its bare rotor 0.5 rad in 2.7 ms (its angle is found
-    // within 0.03 rad; the rotor is lost after the release: docs/results/startup.md).
+fn two_made_up_motors_find_their_angle_and_lift_their_load() {
+    // Motors that are not presets: a 750 W servo and a fast 45 µH, 48 V motor whose rated
+    // torque runs its bare rotor 0.5 rad in 2.7 ms (its angle is found within 0.03 rad; its
+    // release: `fast_loaded_start.rs`, docs/results/startup.md). Both pass.
     for (file, seeds) in [
         ("startup-spm-750w", [1, 3, 4]),
         ("startup-fast-48v", [1, 2, 3]),
@@ -173,9 +180,7 @@ fn two_made_up_motors_find_their_angle_and_the_servo_lifts_its_load() {
             );
             assert!(found < 0.05, "{file} seed {seed}: {found}");
             assert_eq!(st.startup_motion, 0.0);
-            if file == "startup-spm-750w" {
-                assert!(out.passed, "{file} seed {seed}: {:?}", out.checks);
-            }
+            assert!(out.passed, "{file} seed {seed}: {:?}", out.checks);
         }
     }
 }
@@ -214,5 +219,21 @@ fn saturating_machines_find_their_axis_from_the_models_inductances() {
             println!("{name} seed {seed}: {e:.3} rad");
             assert!(e < 0.15, "{name} seed {seed}: {e}");
         }
+    }
+}
+
+#[test]
+fn the_made_up_20_pole_ipmsm_lifts_its_rated_load_at_every_seed() {
+    // A small flux (8 mWb) makes the loaded standstill's creep of θ̂ fast: at seed 2 the
+    // start-up cannot calibrate the sensors' 0.5 % gain mismatch on this salient rotor (the d
+    // axis leaves phase a nearly without current and the nearest k·π/3 axis would drive 42 %
+    // of the level across it), and θ̂ creeps at about 1 rad/s under the rated current. The
+    // standstill probe holds it at 0.18 rad; its turn carried through the lift's limiter mode
+    // (`fado_core::control::standstill_probe`, "After the standstill") keeps it there:
+    // max |θ − θ̂| 0.235 rad at seed 2 (0.357 when the probe's turn stops with the
+    // standstill), 0.10 rad at seeds 1, 3, 4.
+    let toml = made_up("ipmsm-20p-48v-saturated");
+    for seed in 1..=4 {
+        lifts("ipmsm-20p-48v-saturated", &toml, seed);
     }
 }

@@ -10,6 +10,9 @@ const MN4004: &str = include_str!("data/multirotor/tmotor-mn4004-kv300-6s.toml")
 const MAD5010: &str = include_str!("data/multirotor/mad-5010-kv370-6s.toml");
 const MAD5010_200: &str = include_str!("data/multirotor/mad-5010-kv200-6s.toml");
 const FLIPSKY6215: &str = include_str!("data/multirotor/flipsky-6215-kv170-12s.toml");
+const MN4006: &str = include_str!("data/multirotor/tmotor-mn4006-kv380-6s.toml");
+const M6C12: &str = include_str!("data/multirotor/mad-m6c12-kv150-12s.toml");
+const MAD5010_110: &str = include_str!("data/multirotor/mad-5010-kv110-12s.toml");
 
 fn run(scenario: &str, name: &str, motor: &str, seed: u64) -> fado_sim::scenario::Outcome {
     let text = format!("{motor}\n[current_sensor]\nseed = {seed}\n");
@@ -38,7 +41,7 @@ fn datasheet_multirotor_motors_start_under_their_rated_load() {
     // The U8 II (a round rotor whose model gives no angle at standstill) ends with the drive's
     // status saying so, which the scenario judges; the MN4004 (capped release hold 2.0 times
     // its design travel: the current loop raised to 10·ω_h) and the MAD 5010 start.
-    // Measured: MN4004 backward 0.33–0.45 rad, |θ − θ̂| 0.19–0.22 rad (its motion threshold the
+    // Measured: MN4004 backward 0.33–0.34 rad, |θ − θ̂| 0.17–0.22 rad (its motion threshold the
     // quiet current's reading, 0.106 rad: `MotionMonitor::threshold`);
     // MAD 5010 seeds 1, 3, 4 0.31–0.32 / 0.14–0.18 rad (seed 2 below).
     for (name, motor, seeds) in [
@@ -82,10 +85,10 @@ fn mad_5010_kv200_passes_the_reversal_the_stops_and_starts_under_its_rated_load_
     }
 }
 
-/// Seed 2: ready, then the rotor falls back 0.62 rad after the release (bound 0.5), |θ − θ̂|
-/// 0.32 rad from ready on.
+/// Seed 2: ready, backward travel 0.38 rad after the release (bound 0.5), but |θ − θ̂| 0.32 rad
+/// from ready on (bound 0.25).
 #[test]
-#[ignore = "open: the MAD 5010 KV200 at seed 2 falls back 0.62 rad after the release"]
+#[ignore = "open: the MAD 5010 KV200 at seed 2 keeps |θ − θ̂| 0.32 rad after the release"]
 fn mad_5010_kv200_seed_2_starts_under_its_rated_load() {
     let out = run("loaded-start", "MAD 5010 KV200", MAD5010_200, 2);
     assert!(out.passed, "{:?}", out.checks);
@@ -103,13 +106,75 @@ fn flipsky_6215_passes_the_reversal_and_the_stops() {
     }
 }
 
-/// Its loaded start passes at seeds 3 and 4; at seeds 1 and 2 the rotor falls back 0.83 and
-/// 0.72 rad after the release (bound 0.5), |θ − θ̂| 0.26 rad at seed 1.
+/// Its loaded start: the release hold catches the rotor and, on this light rotor (the
+/// standstill probe's torque at a 0.25 rad angle error would swing it by 0.45 rad), holds it
+/// until the lift (`fado_core::control::release_hold`, "Through the loaded standstill").
+/// Measured: backward travel 0.217 / 0.227 / 0.228 / 0.229 rad, |θ − θ̂| from ready 0.08–0.14 rad
+/// at seeds 1–4; with the hand-over to the speed loop after 10/ω_h seed 2 swings back 0.98 rad
+/// under the probe before the lift.
 #[test]
-#[ignore = "open: the salient 15 µH Flipsky 6215 falls back 0.72–0.83 rad after the release at seeds 1 and 2"]
 fn flipsky_6215_starts_under_its_rated_load() {
     for seed in 1..=4 {
         let out = run("loaded-start", "Flipsky 6215", FLIPSKY6215, seed);
         assert!(out.passed, "seed {seed}: {:?}", out.checks);
+    }
+}
+
+/// The MAD M6C12 KV150 (a 28-pole heavy-lift motor, 0.19 Ω, 32.5 µH, 12S, 20 kHz), entered from
+/// a public firmware's identification and not tuned to: `reversal`, `stops` and
+/// `loaded-start` pass. Measured (seeds 1–4): reversal 0.017–0.035 rad, stops 0.068–0.091 rad,
+/// loaded-start backward 0.22–0.24 rad and |θ − θ̂| from ready 0.11–0.16 rad; held through
+/// its loaded standstill (the probe's swing 0.40 rad on this rotor), without which seeds 2 and 4
+/// swing back 1.0 and 0.97 rad.
+#[test]
+fn mad_m6c12_passes_the_reversal_the_stops_and_starts_under_its_rated_load() {
+    for (scenario, seed) in [("reversal", 3), ("stops", 3), ("loaded-start", 2)] {
+        let out = run(scenario, "MAD M6C12", M6C12, seed);
+        assert!(out.passed, "{scenario} seed {seed}: {:?}", out.checks);
+    }
+}
+
+/// The T-Motor MN4006 KV380 (24 poles, 0.113 Ω, 57 µH from an ODrive's identification, 6S,
+/// 24 kHz), not tuned to. Measured (seeds 1–4): reversal 0.030–0.054 rad, stops
+/// 0.072–0.133 rad; loaded-start backward 0.23–0.30 rad, |θ − θ̂| from ready 0.09–0.19 rad
+/// (held through the loaded standstill, the probe's swing 0.31 rad on this rotor; with the
+/// hand-over after 10/ω_h seeds 1 and 4 swing back 1.66 and 2.36 rad). At seed 1 the estimate
+/// stands 0.16 rad off at the lift, where the probe's d current stops and the torque it gave
+/// through that error (1.6 % of the rated torque) goes: the probe's turn carried past the
+/// standstill (`fado_core::control::standstill_probe`, "After the standstill") keeps the rotor
+/// within 0.30 rad.
+#[test]
+fn tmotor_mn4006_passes_the_reversal_the_stops_and_starts_under_its_rated_load() {
+    for (scenario, seed) in [("reversal", 4), ("stops", 4), ("loaded-start", 4)] {
+        let out = run(scenario, "MN4006", MN4006, seed);
+        assert!(out.passed, "{scenario} seed {seed}: {:?}", out.checks);
+    }
+    let out = run("loaded-start", "MN4006", MN4006, 1);
+    assert!(out.passed, "loaded-start seed 1: {:?}", out.checks);
+}
+
+/// The MAD 5010 KV110 (0.62 Ω, 85 µH, 12S, 20 kHz), not tuned to: it starts under its rated
+/// load (seeds 1, 2, 4 backward 0.32 rad, |θ − θ̂| from ready 0.16–0.18 rad; seed 3 ends with
+/// the drive's no-angle status) and passes `stops` at seeds 1, 3, 4 (0.13–0.14 rad) and
+/// `reversal` at seeds 2, 3 (0.07–0.15 rad).
+#[test]
+fn mad_5010_kv110_starts_under_its_rated_load_and_passes_the_stops_and_a_reversal() {
+    for (scenario, seed) in [("loaded-start", 1), ("stops", 1), ("reversal", 2)] {
+        let out = run(scenario, "MAD 5010 KV110", MAD5010_110, seed);
+        assert!(out.passed, "{scenario} seed {seed}: {:?}", out.checks);
+    }
+}
+
+/// Its slow passages through zero speed under load: `reversal` seeds 1 and 4 lose 0.42 and
+/// 0.31 rad within 40 ms of the crossing (the estimator reports the lock lost there), `stops`
+/// seed 2 0.31 rad at 13 r/min. At 20 r/min its back-EMF (0.1 V) is a fifth of the inverter's
+/// dead-time voltage Td·fs·Vdc = 0.56 V, whose PWM ripple at the switching edges (0.44 A)
+/// exceeds its 0.14 A band.
+#[test]
+#[ignore = "open: the MAD 5010 KV110 loses 0.31-0.42 rad at its slow passages through zero speed"]
+fn mad_5010_kv110_passes_the_reversal_at_every_seed() {
+    for (scenario, seed) in [("reversal", 1), ("reversal", 4), ("stops", 2)] {
+        let out = run(scenario, "MAD 5010 KV110", MAD5010_110, seed);
+        assert!(out.passed, "{scenario} seed {seed}: {:?}", out.checks);
     }
 }

@@ -5,7 +5,8 @@
 //! (`pmsm-gem-1k1-measured`, and the same map as measured, not odd in i_q,
 //! `tests/data/pmsm-gem-1k1-raw.csv`), and on machines that are no preset (the same IPMSM with five
 //! times its cross-saturation; a made-up 20-pole 48 V IPMSM with d, q and cross-saturation,
-//! `tests/data/ipmsm-20p-48v-saturated.toml`), and on the PM-SyRM, whose frame coupling
+//! `tests/data/ipmsm-20p-48v-saturated.toml`; the strongly cross-saturated IPMSM of the
+//! independent replays, `tests/data/ipm-cross20-saturated.toml`), and on the PM-SyRM, whose frame coupling
 //! reaches 0.96 at rated torque (docs/method/saturation.md, "The slow mode"), with its fitted
 //! algebraic model and with its measured flux map as the plant's and the drive's model; the
 //! per-preset table is docs/results/saturation.md (`scripts/saturation-table.py`).
@@ -71,6 +72,13 @@ fn a_measured_map_not_odd_in_i_q_passes_every_seed() {
 #[test]
 fn a_made_up_20_pole_ipmsm_passes_every_seed() {
     passes_every_seed(include_str!("data/ipmsm-20p-48v-saturated.toml"));
+}
+
+/// A machine generated outside fado (the `ipm-cross20` of scripts/saturated-replay.py: the
+/// secant L_q −46 % and ψd −11 % at rated i_q, all of its q saturation from the cross term).
+#[test]
+fn a_cross_saturated_ipmsm_of_the_independent_replays_passes_every_seed() {
+    passes_every_seed(include_str!("data/ipm-cross20-saturated.toml"));
 }
 
 #[test]

@@ -57,7 +57,25 @@
 //! the hand-over, and the drive's loaded-standstill handling (the speed loop, the
 //! [`standstill_probe`](crate::control::standstill_probe)) holds it from there: the hold's
 //! own reference, the estimated angle, drifts at a loaded standstill like every estimate
-//! there.
+//! there. On a light rotor it stays instead (below).
+//!
+//! # Through the loaded standstill
+//! The speed loop that takes over is a PI on the speed estimate, of 5 Hz: it has no integral
+//! of the angle, and on a light many-pole rotor it hardly answers the standstill probe's d
+//! current, a square wave of period T_p = 0.1 s (10 Hz). Where the angle estimate is off by δ
+//! the probe's amplitude A is a torque square wave of b·A·sin δ (electrical rad/s², b =
+//! 1.5·p²·λ̂f/Ĵ), which a free rotor follows with a swing of b·A·sin δ·T_p²/32 about its
+//! mean. Where that swing at δ = 0.25 rad (the |θ − θ̂| a loaded start may keep) exceeds the
+//! hold's design travel, the hold does not hand over after 10/ω_h but acts until the speed
+//! reference leaves zero ([`holds_through_standstill`]): its integral holds the load, its
+//! stiffness the probe's torque, and the probe reads its demand as it would read the speed
+//! loop's. The rotor then follows θ̂, within the angle error the probe corrects. Of the
+//! motors tried, the swing is 0.45 rad on the salient Flipsky 6215 (15/22 µH, 14 pole pairs:
+//! with the hand-over its rotor swings back 0.98 rad at `loaded-start` seed 2, held 0.23 rad),
+//! 0.34 rad on the multirotor preset (seed 2: 0.72 and 0.31 rad) and 0.43 rad on the cheetah
+//! outrunner; 0.1 rad or less on every preset that is not a multirotor or outrunner (the
+//! 50 kW IPMSM's 0.097 the largest), which keep the hand-over (docs/method/startup.md, "The
+//! loaded standstill after the release").
 
 use crate::error::{ConfigError, check};
 use crate::real::cast_record;
@@ -94,6 +112,14 @@ pub struct ReleaseHoldTuning<T> {
     /// trigger within 6 ms on the presets (the hub motor's 0.11 kg·m² the slowest); a start-up
     /// that drifts later (an estimate lost under a wrong model) is left to the speed loop.
     pub window: T,
+    /// From the brake's opening until the hold hands over, the estimator's T2S-1 tracks at
+    /// its running bandwidth in limiter mode too (where the drive has derived one,
+    /// [`tracker_feedforward`](crate::control::tracker_feedforward), "T2S-1 at a brake's
+    /// release"): the fall is the unannounced step of the rated load that bandwidth is placed
+    /// against. Default true \[A\]: measured on the made-up 45 µH 48 V motor (`loaded-start`
+    /// seeds 1–4), max |θ − θ̂| from ready 0.22–0.29 rad with the standstill's 60 Hz,
+    /// 0.07–0.08 rad with it (docs/results/startup.md).
+    pub track_fall: bool,
 }
 
 impl<T: Real> Default for ReleaseHoldTuning<T> {
@@ -103,11 +129,12 @@ impl<T: Real> Default for ReleaseHoldTuning<T> {
             travel: T::lit(0.2),
             trigger: T::lit(0.02),
             window: T::lit(0.05),
+            track_fall: true,
         }
     }
 }
 
-cast_record!(ReleaseHoldTuning { travel, trigger, window ; enabled });
+cast_record!(ReleaseHoldTuning { travel, trigger, window ; enabled, track_fall });
 
 /// The largest ωc·Ts the hold's current-loop rule gives ([`current_bandwidth_for_hold`]):
 /// 0.2 \[A\], with the loop's 1.5-sample delay a phase margin of 90° − 0.3 rad = 73°
@@ -165,6 +192,38 @@ pub fn current_bandwidth_for_hold<T: Real>(
 /// Peak of t²·e^(−t)/2 (at t = 2): the largest travel of the triple-pole loop per a/ω_h².
 const PEAK_TRAVEL: f64 = 0.270_670_566_473_225_4;
 
+/// sin 0.25: the angle error at which the standstill probe's torque is weighed, 0.25 rad \[A\],
+/// the largest |θ − θ̂| a loaded start may keep from ready on (the `loaded-start` criterion).
+const PROBE_ANGLE_SIN: f64 = 0.247_403_959_254_522_93;
+
+/// The hold stays through the loaded standstill, until the speed reference leaves zero, where
+/// the standstill probe would swing a rotor that only the speed loop holds by more than the
+/// hold's design travel (module docs, "Through the loaded standstill"): its d-current square
+/// wave of amplitude `probe_amplitude` (A) and period `probe_period` (s) at an angle error of
+/// 0.25 rad is a torque square wave of b·A·sin 0.25 (electrical rad/s², b = 1.5·p²·λ̂f/Ĵ),
+/// which a free rotor follows with a swing of b·A·sin 0.25·T_p²/32 about its mean (the
+/// probe's period lies near the 5 Hz speed loop's bandwidth, which hardly answers it). False
+/// where the hold is disabled, the probe off, or the inputs not finite.
+pub fn holds_through_standstill<T: Real>(
+    tuning: &ReleaseHoldTuning<T>,
+    machine: &MachineModel<T>,
+    probe_amplitude: T,
+    probe_period: T,
+) -> bool {
+    let p = T::lit(machine.pole_pairs as f64);
+    let b = T::lit(1.5) * p * p * machine.flux_linkage / machine.inertia;
+    let swing = standstill_swing(b, probe_amplitude, probe_period);
+    // NaN compares false: the hand-over after 10/ω_h.
+    tuning.enabled && swing > tuning.travel
+}
+
+/// The free rotor's swing (electrical rad) about its mean under the probe's torque at the
+/// weighed angle error: a square wave of acceleration ±a with half-period T_p/2 drives a
+/// triangular speed of peak a·T_p/4 and a position swing of a·T_p²/32.
+fn standstill_swing<T: Real>(b: T, amplitude: T, period: T) -> T {
+    b * amplitude * T::lit(PROBE_ANGLE_SIN) * period * period / T::lit(32.0)
+}
+
 /// Time the hold acts, in units of 1/ω_h: the triple pole's response to a load step has
 /// decayed to e^(−10)·(1 + 10 + 50) = 0.3 % by then, and its integral holds the load.
 const SETTLE_TIMES: f64 = 10.0;
@@ -184,11 +243,15 @@ pub enum HoldAction<T> {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ReleaseHold<T> {
     enabled: bool,
+    /// [`ReleaseHoldTuning::track_fall`].
+    track_fall: bool,
     ts: T,
     trigger: T,
     window_samples: u32,
     /// Samples the hold acts before it hands over: [`SETTLE_TIMES`]/ω_h.
     hold_samples: u32,
+    /// Acting until the speed reference leaves zero ([`holds_through_standstill`]).
+    through_standstill: bool,
     held: u32,
     /// 3·ω_h²/b, 3·ω_h/b, ω_h³·Ts/b.
     kp: T,
@@ -243,10 +306,12 @@ impl<T: Real> ReleaseHold<T> {
         }
         Ok(Self {
             enabled: tuning.enabled,
+            track_fall: tuning.track_fall,
             ts,
             trigger,
             window_samples: n.round().to_f64() as u32,
             hold_samples: (T::lit(SETTLE_TIMES) / (omega * ts)).round().to_f64() as u32,
+            through_standstill: false,
             held: 0,
             kp,
             kd,
@@ -264,6 +329,12 @@ impl<T: Real> ReleaseHold<T> {
             omega_gain: ts / (T::one() / (T::lit(5.0) * omega) + ts),
             engaged: 0,
         })
+    }
+
+    /// Keeps the hold acting until the speed reference leaves zero instead of handing over
+    /// after 10/ω_h: the rule of [`holds_through_standstill`].
+    pub fn set_through_standstill(&mut self, on: bool) {
+        self.through_standstill = on;
     }
 
     /// Arms the hold at the angle `theta_hold` (the alignment's).
@@ -296,6 +367,13 @@ impl<T: Real> ReleaseHold<T> {
     pub fn arm_at_release(&mut self, theta_hold: T) {
         self.arm(theta_hold);
         self.released = self.armed;
+    }
+
+    /// The estimator should track the rotor's fall ([`ReleaseHoldTuning::track_fall`]): from
+    /// the application's brake opening until the hold hands over (or its trigger window
+    /// closes without a fall).
+    pub fn tracking_fall(&self) -> bool {
+        self.track_fall && self.released && self.armed
     }
 
     /// Holding now.
@@ -346,7 +424,7 @@ impl<T: Real> ReleaseHold<T> {
             self.omega += self.omega_gain * (rate - self.omega);
         }
         let omega = self.omega;
-        let settled = self.active && self.held >= self.hold_samples;
+        let settled = self.active && !self.through_standstill && self.held >= self.hold_samples;
         if speed_ref != T::zero() || settled || !e.is_finite() || !omega.is_finite() {
             let was = self.active;
             self.disarm();
@@ -508,6 +586,65 @@ mod tests {
         let capped = current_bandwidth_for_hold(&on, &feather, ts, 250.0);
         let wc_ts = core::f64::consts::TAU * capped * ts;
         assert!((wc_ts - MAX_CURRENT_WC_TS).abs() < 1e-12, "{wc_ts}");
+    }
+
+    #[test]
+    fn the_probe_swing_is_that_of_a_free_rotor_under_its_square_wave() {
+        // A free rotor under ±a for half a period each, its mean speed zero: the swing about
+        // its mean is a·T²/32.
+        let (a, period, n) = (1000.0, 0.1, 100_000);
+        let ts = period / n as f64;
+        let (mut omega, mut theta) = (-a * period / 4.0, 0.0f64);
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for k in 0..2 * n {
+            let acc = if (k % n) < n / 2 { a } else { -a };
+            omega += acc * ts;
+            theta += omega * ts;
+            lo = lo.min(theta);
+            hi = hi.max(theta);
+        }
+        let swing = (hi - lo) / 2.0;
+        assert!(
+            (swing - a * period * period / 32.0).abs() < 1e-3 * swing,
+            "{swing}"
+        );
+        assert!((standstill_swing(a, 1.0, period) - swing * PROBE_ANGLE_SIN).abs() < 1e-3);
+        assert!((PROBE_ANGLE_SIN - 0.25f64.sin()).abs() < 1e-15);
+    }
+
+    #[test]
+    fn a_light_rotor_is_held_through_its_loaded_standstill() {
+        let on = ReleaseHoldTuning {
+            enabled: true,
+            ..ReleaseHoldTuning::default()
+        };
+        // The multirotor preset (b = 1.5·14²·0.875e-3/2e-4 = 1286 rad/s² per A) under the
+        // probe's 3.4 A at 0.1 s: 0.34 rad, beyond the 0.2 rad design travel.
+        let fast = crate::control::tracker_feedforward::multirotor_model();
+        assert!(holds_through_standstill(&on, &fast, 3.4, 0.1));
+        // The paper's motor (b = 1.5·4²·0.088/0.012 = 176 rad/s² per A, its probe 2.2 A):
+        // 0.03 rad, far within it.
+        let paper = MachineModel::<f64>::paper();
+        let amplitude = 0.1 * paper.rated_current;
+        assert!(!holds_through_standstill(&on, &paper, amplitude, 0.1));
+        // The probe off, the hold disabled, a non-finite inertia: the hand-over after 10/ω_h.
+        assert!(!holds_through_standstill(&on, &fast, 0.0, 0.1));
+        let off = ReleaseHoldTuning::default();
+        assert!(!holds_through_standstill(&off, &fast, 3.4, 0.1));
+        let broken = MachineModel {
+            inertia: f64::NAN,
+            ..fast
+        };
+        assert!(!holds_through_standstill(&on, &broken, 3.4, 0.1));
+        // Held: the hold acts past 10/ω_h and hands its integral over at the reference.
+        let mut h = ReleaseHold::new(&on, &fast, 25e-6, 387.0, 68.0).unwrap();
+        h.set_through_standstill(true);
+        h.arm(0.0);
+        for _ in 0..20_000 {
+            assert!(matches!(h.step(0.0, -0.1, -0.1), HoldAction::Hold(_)));
+        }
+        assert!(h.held > h.hold_samples);
+        assert!(matches!(h.step(1.0, -0.1, -0.1), HoldAction::Handover(x) if x > 0.0));
     }
 
     #[test]

@@ -285,4 +285,7 @@ pub struct EstimatorState<T: Real> {
     /// [`EstimatorState::enable_rs_adaptation`].
     rs_adaptation_on: bool,
     k_df_enabled: bool,
+    /// T2S-1 runs at its running gains in limiter mode too (the drive's brake release, see
+    /// [`EstimatorState::set_release_tracking`]).
+    release_tracking: bool,
 }

@@ -156,6 +156,16 @@ impl<T: Real> SensorlessEstimator<T> {
         self.state.hold_flux_magnitude(&self.params, magnitude);
     }
 
+    /// While `on`, T2S-1 runs at its running bandwidth (`tracker.t2s1_running_bandwidth_hz`)
+    /// in limiter mode too: the drive sets it from a brake's opening until its release hold
+    /// hands over, since the rotor's fall under the load the brake held is the unannounced
+    /// step of the rated torque that bandwidth is designed for
+    /// ([`crate::control::tracker_feedforward`], "T2S-1 at a brake's release"). Without a
+    /// running bandwidth nothing changes. Call before [`step`](Self::step).
+    pub fn set_release_tracking(&mut self, on: bool) {
+        self.state.set_release_tracking(on);
+    }
+
     /// The voltage of this sample's interval was limited by the modulator (the drive's
     /// hexagon): R̂s's turning law (and its λ̂f law) does not adapt over the period that
     /// contains it. On a limited sample the realised voltage the drive
@@ -236,6 +246,9 @@ pub trait RotorAngleEstimator<T: Real> {
     /// The voltage the next [`step`](Self::step) integrates was limited by the modulator
     /// (see [`SensorlessEstimator::voltage_limited`]). Default: nothing.
     fn voltage_limited(&mut self) {}
+    /// A brake has opened and the rotor may fall: track it with the bandwidth its fall needs
+    /// (see [`SensorlessEstimator::set_release_tracking`]). Default: nothing.
+    fn set_release_tracking(&mut self, _on: bool) {}
 }
 
 impl<T: Real> RotorAngleEstimator<T> for SensorlessEstimator<T> {
@@ -273,6 +286,9 @@ impl<T: Real> RotorAngleEstimator<T> for SensorlessEstimator<T> {
     }
     fn voltage_limited(&mut self) {
         SensorlessEstimator::voltage_limited(self);
+    }
+    fn set_release_tracking(&mut self, on: bool) {
+        SensorlessEstimator::set_release_tracking(self, on);
     }
     /// With [`EstimatorTuning::rs_adaptation`](crate::EstimatorTuning::rs_adaptation): [`SensorlessEstimator::set_rs_hat`] (a bad
     /// value changes nothing); with the paper's fixed R̂s: nothing.

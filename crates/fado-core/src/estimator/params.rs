@@ -180,6 +180,7 @@ impl<T: Real> EstimatorParams<T> {
             slow_broken: 0,
             rs_adaptation_on: self.rs_adaptation,
             k_df_enabled: true,
+            release_tracking: false,
         };
         state.reset(self);
         state

@@ -243,6 +243,11 @@ impl<T: Real> EstimatorState<T> {
         self.k_df_enabled = enabled;
     }
 
+    /// As [`SensorlessEstimator::set_release_tracking`](crate::SensorlessEstimator::set_release_tracking).
+    pub fn set_release_tracking(&mut self, on: bool) {
+        self.release_tracking = on;
+    }
+
     /// As [`SensorlessEstimator::set_rs_hat`](crate::SensorlessEstimator::set_rs_hat).
     pub fn set_rs_hat(&mut self, p: &EstimatorParams<T>, rs_hat: T) -> Result<(), ConfigError> {
         self.integrator.set_rs_hat(rs_hat)?;

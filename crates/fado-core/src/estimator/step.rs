@@ -265,8 +265,9 @@ impl<T: Real> EstimatorState<T> {
             )
         } else {
             // Above the mode threshold T2S-1 runs at its running bandwidth (the last
-            // sample's mode: the one this sample's angle was integrated in).
-            let t2s1 = if self.mode == Mode::DisturbanceFeedback {
+            // sample's mode: the one this sample's angle was integrated in), and at a
+            // brake's release (`set_release_tracking`).
+            let t2s1 = if self.mode == Mode::DisturbanceFeedback || self.release_tracking {
                 &p.t2s1_running
             } else {
                 &p.t2s1
@@ -472,7 +473,13 @@ impl<T: Real> EstimatorState<T> {
         // frame error moves |λ̂r| by σ·δ, which the law would read as resistance (a model
         // error's angle, amplified; docs/method/saturation.md, "The offset law's gate").
         let coupled = SATURATING && self.frame_coupled && c.mode == Mode::DisturbanceFeedback;
-        let regime = if broken & BROKEN_RS != 0 || coupled {
+        // Beyond a map's data the model's slope is its edge cells' extension: the law would
+        // learn that guess's error as resistance (docs/results/saturated-replay.md: a map that
+        // ends at 0.6 × rated current, 0.32 rad at rated torque with the law, 0.004 frozen).
+        let beyond = SATURATING
+            && c.point
+                .is_some_and(|point| p.active_flux.beyond_data(&point));
+        let regime = if broken & BROKEN_RS != 0 || coupled || beyond {
             AdaptationRegime::Frozen
         } else {
             match c.mode {

@@ -277,3 +277,56 @@ fn flux_magnitude_hold_keeps_the_flux_on_the_model_circle_and_the_angle() {
         assert!(a < 1e-6, "the radial error turned the angle by {a} rad");
     }
 }
+
+/// `set_release_tracking`: a rotor at rest that falls at a constant acceleration (a brake
+/// opening under a load, no current) is tracked in limiter mode by T2S-1 at its running
+/// bandwidth while the switch is on, at its standstill bandwidth otherwise. The made-up
+/// 45 µH 48 V motor's fall (1.35e5 rad/s² electrical, Ts = 25 µs) over 2.5 ms (0.42 rad):
+/// the 219 Hz type-3 T2S-1 (its rated step's peak κ·a/ωn² = 0.15 rad) lags it by 0.13 rad,
+/// the 60 Hz one by 0.31 rad; without a running bandwidth the switch changes nothing.
+#[test]
+fn release_tracking_runs_t2s1_at_its_running_bandwidth_in_limiter_mode() {
+    let model = MachineModel::<f64> {
+        pole_pairs: 7,
+        flux_linkage: 0.0055,
+        rs: 0.035,
+        ld: 45e-6,
+        lq: 45e-6,
+        rated_current: 40.0,
+        rated_torque: 2.31,
+        rated_speed_rpm: 4000.0,
+        inertia: 1.2e-4,
+        ..MachineModel::paper()
+    };
+    let (ts, accel, theta0) = (25e-6, 1.35e5, 0.4);
+    let lag = |running_hz: f64, on: bool| {
+        let mut config = EstimatorConfig::for_machine(&model);
+        config.ts = ts;
+        config.tuning.rs_adaptation.enabled = false;
+        config.tuning.tracker.load_pole_ratio = 0.5;
+        config.tuning.tracker.t2s1_running_bandwidth_hz = running_hz;
+        let mut est = SensorlessEstimator::new(config).unwrap();
+        est.align(theta0, Ab::zero());
+        let flux = |t: f64| {
+            let th = theta0 - 0.5 * accel * t * t;
+            Ab::new(th.cos(), th.sin()) * model.flux_linkage
+        };
+        let mut worst = 0.0f64;
+        for n in 1..=100 {
+            let (t0, t1) = ((n - 1) as f64 * ts, n as f64 * ts);
+            est.set_release_tracking(on);
+            let e = est.step((flux(t1) - flux(t0)) * (1.0 / ts), Ab::zero());
+            assert!(e.diagnostics.flag_limit, "limiter mode");
+            let theta = theta0 - 0.5 * accel * t1 * t1;
+            worst = worst.max(crate::wrap_angle(e.theta - theta).abs());
+        }
+        worst
+    };
+    let (narrow, wide) = (lag(219.0, false), lag(219.0, true));
+    std::println!("fall lag over 2.5 ms: 60 Hz {narrow:.4} rad, 219 Hz {wide:.4} rad");
+    assert!(
+        narrow > 0.25 && wide < 0.15 && wide < narrow / 2.0,
+        "{narrow} {wide}"
+    );
+    assert_eq!(lag(0.0, true), lag(0.0, false));
+}

@@ -96,6 +96,12 @@ pub enum FluxMapError {
         /// Node along i_q.
         m: usize,
     },
+    /// The grid does not reach zero current: i_d's nodes do not include or bracket 0, or
+    /// i_q's do not reach both signs (a half map).
+    NoZeroCurrent {
+        /// "i_d" or "i_q".
+        axis: &'static str,
+    },
 }
 
 impl fmt::Display for FluxMapError {
@@ -122,11 +128,43 @@ impl fmt::Display for FluxMapError {
                 "{table} at node ({k}, {m}) does not increase with its own current: the map \
                  has no inverse (check the sign convention: d on the magnet, ψd = λf at i = 0)"
             ),
+            FluxMapError::NoZeroCurrent { axis: "i_q" } => f.write_str(
+                "the i_q axis does not reach both signs: beyond its grid a map extends its edge \
+                 cells linearly, which bends ψd (even in i_q) and ψq (odd in i_q) the wrong way \
+                 for the other sign of the torque; complete a half map by the rotor's symmetry \
+                 ψd(i_d, −i_q) = ψd(i_d, i_q), ψq(i_d, −i_q) = −ψq(i_d, i_q)",
+            ),
+            FluxMapError::NoZeroCurrent { axis } => write!(
+                f,
+                "the {axis} axis does not reach zero current (the magnet's flux ψd(0, 0) is read \
+                 there): its first node must be ≤ 0 and its last ≥ 0"
+            ),
         }
     }
 }
 
 impl core::error::Error for FluxMapError {}
+
+/// `x` beyond `axis` (increasing, two nodes or more) by more than its edge cell's width.
+fn beyond_axis<T: Real>(axis: &[T], x: T) -> bool {
+    let n = axis.len();
+    let (low, high) = (axis[0], axis[n - 1]);
+    x < low - (axis[1] - low) || x > high + (high - axis[n - 2])
+}
+
+/// Zero current lies on the grid: i_d's nodes bracket it (an edge node may be 0: maps of
+/// interior-magnet machines often end at i_d = 0) and i_q's straddle it. Both axes are
+/// checked increasing and of two nodes or more.
+fn check_zero_current<T: Real>(i_d: &[T], i_q: &[T]) -> Result<(), FluxMapError> {
+    let zero = T::zero();
+    if !(i_d[0] <= zero && i_d[i_d.len() - 1] >= zero) {
+        return Err(FluxMapError::NoZeroCurrent { axis: "i_d" });
+    }
+    if !(i_q[0] < zero && i_q[i_q.len() - 1] > zero) {
+        return Err(FluxMapError::NoZeroCurrent { axis: "i_q" });
+    }
+    Ok(())
+}
 
 fn check_axis<T: Real>(axis: &'static str, x: &[T]) -> Result<(), FluxMapError> {
     if x.len() < 2 {
@@ -201,6 +239,7 @@ impl<'a, T: Real> FluxMap<'a, T> {
     ) -> Result<Self, FluxMapError> {
         check_axis("i_d", i_d)?;
         check_axis("i_q", i_q)?;
+        check_zero_current(i_d, i_q)?;
         let map = Self::from_checked_parts(i_d, i_q, psi_d, psi_q)?;
         let nq = i_q.len();
         for (table, t) in [("psi_d", psi_d), ("psi_q", psi_q)] {
@@ -268,6 +307,15 @@ impl<'a, T: Real> FluxMap<'a, T> {
         T: Copy,
     {
         (self.axis_d, self.axis_q)
+    }
+
+    /// Whether `i` lies beyond the grid by more than its edge cell along either axis: where the
+    /// map's linear extension of its edge cells stands in for data it does not have.
+    pub fn beyond_grid(&self, i: Dq<T>) -> bool
+    where
+        T: Real,
+    {
+        beyond_axis(self.i_d, i.d) || beyond_axis(self.i_q, i.q)
     }
 
     /// The i_d axis in A.

@@ -35,6 +35,18 @@ impl<T: Real> MachineMagnetics<T> {
         matches!(self, MachineMagnetics::Linear)
     }
 
+    /// Whether the model at `i` is a map's extension beyond its data: `i` beyond the grid
+    /// by more than the edge cell (`FluxMap::beyond_grid`); never for a model defined
+    /// everywhere (constant inductances, the algebraic model).
+    #[inline]
+    pub fn beyond_data(&self, i: Dq<T>) -> bool {
+        match self {
+            MachineMagnetics::Linear | MachineMagnetics::Saturation(_) => false,
+            MachineMagnetics::Map(map) => map.beyond_grid(i),
+            MachineMagnetics::Uniform(map) => map.beyond_grid(i),
+        }
+    }
+
     /// The model in another precision: itself when `U` is `T`, `None` for a borrowed model
     /// otherwise (it cannot be converted without allocating: build it in the drive's
     /// precision, e.g. `Saturation::cast` into a `static`, a map with `FluxTable`).

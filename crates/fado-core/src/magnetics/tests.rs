@@ -633,6 +633,12 @@ fn bad_maps_are_refused_naming_the_node() {
             m: 1
         }
     );
+    // A half map (i_q ≤ 0 only) and a map away from zero d current.
+    let e = FluxMap::new(&id, &[-2.0, 0.0], &good_d, &good_q).unwrap_err();
+    assert_eq!(e, FluxMapError::NoZeroCurrent { axis: "i_q" });
+    assert!(e.to_string().contains("symmetry"), "{e}");
+    let e = FluxMap::new(&[1.0, 2.0, 3.0], &iq, &good_d, &good_q).unwrap_err();
+    assert_eq!(e, FluxMapError::NoZeroCurrent { axis: "i_d" });
     let e = FluxMap::new(&[0.0, 0.0, 1.0], &iq, &good_d, &good_q).unwrap_err();
     assert_eq!(
         e,

@@ -50,6 +50,16 @@ impl<T: Real> UniformFluxMap<'_, T> {
         }
     }
 
+    /// Whether `i` lies beyond the grid by more than its edge cell along either axis (as
+    /// [`super::FluxMap::beyond_grid`]).
+    pub fn beyond_grid(&self, i: Dq<T>) -> bool {
+        let td = (i.d - self.first.d) * self.inv_step.d;
+        let tq = (i.q - self.first.q) * self.inv_step.q;
+        let end = |last: usize| T::from_index(last) + T::lit(2.0);
+        let minus_one = -T::one();
+        td < minus_one || tq < minus_one || td > end(self.last.0) || tq > end(self.last.1)
+    }
+
     /// ψ(i) and the incremental inductance ∂ψ/∂i of the bilinear interpolant at `i`.
     #[inline]
     pub fn flux_and_jacobian(&self, i: Dq<T>) -> (Dq<T>, InductanceMatrix<T>) {

@@ -429,6 +429,13 @@ impl SimConfig {
         fado_core::machine_checks::check(&m, Some(self.inverter.sample_period()))
             .iter()
             .map(|f| {
+                if let Some(d) = self.derived.iter().find(|d| d.key == plant_key(f.key())) {
+                    return (
+                        f.severity(),
+                        DERIVED_DC_LINK_CAUSE.into(),
+                        derived_beyond(d),
+                    );
+                }
                 let mut text = f.to_string();
                 for k in f.keys() {
                     let full = plant_key(k);
@@ -448,6 +455,21 @@ impl SimConfig {
             .map(|(_, _, text)| text)
             .collect()
     }
+}
+
+/// The key blamed when a value derived from the ratings (the DC link) is beyond any drive:
+/// the rated speed, which with `flux_linkage` sets the rated point's voltage.
+const DERIVED_DC_LINK_CAUSE: &str = "motor.rated_speed_rpm";
+
+/// The finding on a derived value `d`: not the user's key, but the keys it is derived from.
+fn derived_beyond(d: &crate::derive::Derived) -> String {
+    format!(
+        "`{}` = {:e} is not in the file: it is derived ({}), and it is beyond any drive; the \
+         rated point it follows from (`motor.rated_speed_rpm`, `motor.flux_linkage`, \
+         `motor.pole_pairs`, `motor.rated_current`, `motor.ld`, `motor.lq`) is off: check their \
+         units (r/min, Wb peak per phase, A peak, H) or give `{}`",
+        d.key, d.value, d.rule, d.key
+    )
 }
 
 /// The TOML key of a machine-check field: `[inverter]`'s for the DC link and the sampling

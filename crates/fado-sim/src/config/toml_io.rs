@@ -133,8 +133,52 @@ fn located(text: &str, e: toml::de::Error) -> SimConfigError {
             k
         }
     };
+    if let Some(hint) = err
+        .message
+        .starts_with("unknown field")
+        .then(|| wrong_table_hint(&err.key))
+        .flatten()
+    {
+        err.message.push_str(&hint);
+    }
     err.location = start.map(|at| SourceLocation::at(text, at));
     err
+}
+
+/// For an unknown `section.key`: the tables of the configuration where `key` is a key (a key
+/// written in the wrong table, `[inverter] rs`), as a sentence to append; None when there is
+/// none.
+fn wrong_table_hint(full: &str) -> Option<String> {
+    let (section, key) = full.rsplit_once('.')?;
+    let defaults: toml::Table = SimConfig::default().to_toml().parse().ok()?;
+    let mut places = Vec::new();
+    tables_with_key(&defaults, "", key, &mut places);
+    places.retain(|p| p != section);
+    if places.is_empty() {
+        return None;
+    }
+    let names: Vec<String> = places.iter().map(|p| format!("[{p}]")).collect();
+    Some(format!(
+        "; `{key}` is a key of {}: written in the wrong table?",
+        names.join(", ")
+    ))
+}
+
+/// Every table path below `prefix` in `table` that holds `key`, depth first.
+fn tables_with_key(table: &toml::Table, prefix: &str, key: &str, out: &mut Vec<String>) {
+    for (k, v) in table {
+        if let toml::Value::Table(t) = v {
+            let path = if prefix.is_empty() {
+                k.clone()
+            } else {
+                format!("{prefix}.{k}")
+            };
+            if t.contains_key(key) {
+                out.push(path.clone());
+            }
+            tables_with_key(t, &path, key, out);
+        }
+    }
 }
 
 /// A serde error from a `toml::Value` carries "in `path`"; unknown fields name the field.

@@ -69,7 +69,13 @@ pub(crate) fn apply(
             .rsplit_once('.')
             .ok_or_else(|| SimConfigError::new(name.to_owned(), "must be section.key"))?;
         let snippet = format!("[{section}]\n{key} = {value}\n");
-        return SimConfig::from_toml_over(&cfg, &snippet);
+        // The snippet is the sweep's, not the user's file: no line and column in it, but the
+        // axis value that caused the refusal.
+        return SimConfig::from_toml_over(&cfg, &snippet).map_err(|mut e| {
+            e.location = None;
+            e.message = format!("{} (the sweep's value {name} = {value})", e.message);
+            e
+        });
     }
     let v = number(name, value)?;
     match name {
@@ -426,6 +432,15 @@ mod tests {
         assert!(e.to_string().contains("rs_ratio"), "{e}");
         let e = point_config(&base, &["reversal_ramp".into()], &[Value::Float(0.0)]).unwrap_err();
         assert_eq!(e.key, "reversal_ramp");
+        // A TOML axis value the configuration refuses names the value, not a line and column
+        // of the sweep's own snippet.
+        let e = point_config(&base, &["motor.rs".into()], &[Value::Float(1200.0)]).unwrap_err();
+        assert_eq!(e.key, "motor.rs", "{e}");
+        assert!(e.location.is_none(), "{e}");
+        assert!(
+            e.to_string().contains("the sweep's value motor.rs = 1200"),
+            "{e}"
+        );
         // A misspelt axis is a definition error, before anything runs.
         for bad in [
             "mismatch.rs_rato",

@@ -11,7 +11,7 @@ use crate::control::lock_reaction::LockSupervisor;
 use crate::control::modulation::{ModulatorConfig, SpaceVectorModulator};
 use crate::control::phase_band::PhaseBand;
 use crate::control::ratings_limit::RatingsLimit;
-use crate::control::release_hold::ReleaseHold;
+use crate::control::release_hold::{ReleaseHold, holds_through_standstill};
 use crate::control::saturated_references::SaturatedReferences;
 use crate::control::speed_controller::{SpeedController, SpeedControllerConfig};
 use crate::control::standstill_probe::{StandstillProbe, StandstillProbeConfig};
@@ -111,14 +111,9 @@ impl<T: Real> Blocks<T> {
             limit: t.modulation.voltage_limit,
             max_modulation: t.modulation.max_modulation,
         })?;
-        let probe = StandstillProbe::new(probe_config(c)?)?;
-        let hold = ReleaseHold::new(
-            &t.release_hold,
-            m,
-            ts,
-            t.current.bandwidth_hz,
-            speed_config.i_max,
-        )?;
+        let probe_config = probe_config(c)?;
+        let probe = StandstillProbe::new(probe_config)?;
+        let hold = release_hold(c, &probe_config, speed_config.i_max)?;
         let limits = RatingsLimit::new(&t.limits, m)?;
         Ok(Self {
             hold,
@@ -258,6 +253,21 @@ fn rename(map: &'static [(&'static str, &'static str)]) -> impl Fn(ConfigError) 
             ConfigError::OutOfRange { expected, .. } => ConfigError::OutOfRange { field, expected },
         }
     }
+}
+
+/// The release hold for the drive's torque limit `i_max` (A), through the loaded standstill
+/// where the probe of `probe` would swing the rotor beyond its design travel
+/// ([`holds_through_standstill`]).
+fn release_hold<T: Real>(
+    c: &DriveConfig<T>,
+    probe: &StandstillProbeConfig<T>,
+    i_max: T,
+) -> Result<ReleaseHold<T>, ConfigError> {
+    let (t, m) = (&c.tuning, &c.machine);
+    let mut hold = ReleaseHold::new(&t.release_hold, m, c.ts, t.current.bandwidth_hz, i_max)?;
+    let through = holds_through_standstill(&t.release_hold, m, probe.amplitude, probe.period);
+    hold.set_through_standstill(through);
+    Ok(hold)
 }
 
 /// The loaded-standstill probe's configuration in absolute units (amplitude 0: off).

@@ -282,6 +282,10 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         if self.limited[1] {
             self.estimator.voltage_limited();
         }
+        // From a brake's opening until the release hold hands over, T2S-1 tracks the fall
+        // (see `tracker_feedforward`, "T2S-1 at a brake's release").
+        self.estimator
+            .set_release_tracking(self.blocks.hold.tracking_fall());
         let estimate = self.estimator.step(self.history[1], i_ab);
         if !estimate_is_finite(&estimate) {
             // An estimator that went non-finite cannot steer the drive: hold like a bad input

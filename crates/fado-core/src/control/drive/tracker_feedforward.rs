@@ -59,6 +59,28 @@
 //! Measured with a feed-forward less the integral alone (the hold's proportional kick still
 //! fed forward): the trackers swing ±200 r/min and the multirotor's θ̂ ends 0.3 rad off at the
 //! hand-over.
+//!
+//! **T2S-1 at a brake's release.** When the brake opens, the rotor falls under a load the
+//! drive does not know: the unannounced step of acceleration a = p·T_L/Ĵ (up to the rated
+//! p·T_rated/Ĵ) that T2S-1's running bandwidth is placed against, at standstill, where T2S-1
+//! keeps its standstill bandwidth. The feed-forward cannot announce it — a braked rotor's
+//! currents say nothing of the load the brake takes (no motion, no back-EMF: the currents are
+//! the drive's own commands), and while the hold acts the trackers are fed nothing of its
+//! command — so the lag is κ·a/ωn² of the standstill ωn: on the made-up 45 µH 48 V motor
+//! (7 pole pairs, 2.31 N·m, 1.2·10⁻⁴ kg·m²: a = 1.35·10⁵ rad/s²) the 60 Hz type-3 T2S-1
+//! (ωn = 183 s⁻¹) would lag 2 rad before the hold catches the rotor, and it lags the hold's
+//! own catch by 0.22–0.29 rad (seeds 1–4); the tracked angle also triggers the hold 0.7 ms
+//! late, in which the rotor falls a further 0.1 rad. So from the brake's opening until the
+//! hold hands over ([`ReleaseHoldTuning::track_fall`](crate::control::release_hold::ReleaseHoldTuning::track_fall)),
+//! T2S-1 runs at its running bandwidth in limiter mode too
+//! ([`SensorlessEstimator::set_release_tracking`](crate::SensorlessEstimator::set_release_tracking)):
+//! 219 Hz on that motor, where the rated step peaks at `load_step_error`; measured 0.07–0.08 rad
+//! and a backward travel of 0.23–0.28 rad instead of 0.37–0.48 (docs/results/startup.md). The
+//! standstill's reason for the narrower tracker — the directly calculated angle carries the
+//! limiter's errors, which a wider tracker passes to θ̂ — holds over seconds of standstill and
+//! departure, not over the hold's 10/ω_h (23 ms on that motor), in which the direct angle
+//! stays within 0.05 rad of the rotor. Where the drive derives no running bandwidth (the
+//! paper's trackers, every preset but the two outrunners) nothing changes.
 
 use crate::Real;
 use crate::control::DriveTuning;

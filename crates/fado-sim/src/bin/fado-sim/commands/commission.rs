@@ -90,6 +90,8 @@ fn load(
             let text = read_file(path)?;
             let cfg = fado_sim::SimConfig::from_toml(&text)
                 .map_err(|e| in_file(e, &Some(path.to_path_buf())))?;
+            commission::refuse_unused(&text, "`fado-sim commission`")
+                .map_err(|e| in_file(e, &Some(path.to_path_buf())))?;
             // The procedure identifies the file's motor: it never falls back on another's.
             let has_motor = text
                 .parse::<toml::Table>()

@@ -41,11 +41,11 @@ pub fn run(args: RunArgs) -> Outcome {
     };
     let cfg = scenario::scenario_config(&args.scenario, text.as_deref(), args.averaged)
         .map_err(|e| in_file(e, &args.config))?;
+    warn_plausibility(&cfg, args.config.as_deref());
     if args.dump_config {
         out!("{}", cfg.to_toml_annotated());
         return Ok(ExitCode::SUCCESS);
     }
-    warn_plausibility(&cfg, args.config.as_deref());
     let dir = args
         .out
         .unwrap_or_else(|| PathBuf::from("out").join(&args.scenario));

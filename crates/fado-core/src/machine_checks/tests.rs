@@ -1,0 +1,219 @@
+use super::*;
+use std::string::ToString;
+
+fn paper() -> MachineModel<f64> {
+    MachineModel::paper()
+}
+
+fn first(m: &MachineModel<f64>, ts: Option<f64>) -> Finding {
+    *check(m, ts).iter().next().expect("a finding")
+}
+
+#[test]
+fn the_papers_motor_is_clean() {
+    assert!(check(&paper(), Some(100e-6)).is_empty());
+}
+
+#[test]
+fn absurd_magnitudes_blame_their_own_key() {
+    for (key, set) in [
+        (
+            "flux_linkage",
+            (|m: &mut MachineModel<f64>| m.flux_linkage = 1e300) as fn(&mut _),
+        ),
+        ("pole_pairs", |m| m.pole_pairs = 4_000_000_000),
+        ("rated_speed_rpm", |m| m.rated_speed_rpm = 1e6),
+        ("rs", |m| m.rs = 1e300),
+    ] {
+        let mut m = paper();
+        set(&mut m);
+        let f = first(&m, None);
+        assert_eq!(f.severity(), Severity::Error);
+        assert_eq!(f.key(), key, "{f}");
+        assert_eq!(f.config_error().field(), key);
+    }
+}
+
+#[test]
+fn a_pole_count_for_pole_pairs_is_named() {
+    let mut m = paper();
+    m.pole_pairs = 8;
+    let f = first(&m, None);
+    assert!(matches!(f, Finding::PoleCount { pole_pairs: 8, .. }), "{f}");
+    let text = f.to_string();
+    assert!(
+        text.contains("`pole_pairs` = 8 looks like a pole count: 4?"),
+        "{text}"
+    );
+    assert_eq!(f.severity(), Severity::Error);
+}
+
+#[test]
+fn an_inductance_in_mh_is_named() {
+    let mut m = paper();
+    m.ld = 2.63;
+    m.lq = 2.63;
+    let f = first(&m, None);
+    assert_eq!((f.key(), f.severity()), ("ld", Severity::Error), "{f}");
+    assert!(f.to_string().contains("mH where H is meant"), "{f}");
+}
+
+#[test]
+fn swapped_inductances_are_a_warning_naming_both() {
+    let mut m = ipmsm();
+    core::mem::swap(&mut m.ld, &mut m.lq);
+    let f = first(&m, None);
+    assert_eq!(f.severity(), Severity::Warning);
+    assert_eq!(f.keys(), &["ld", "lq"]);
+    assert!(f.to_string().contains("swapped"), "{f}");
+    core::mem::swap(&mut m.ld, &mut m.lq);
+    assert!(check(&m, None).is_empty());
+}
+
+#[test]
+fn ratings_divided_by_ten_are_refused_against_the_dc_link() {
+    let mut m = paper();
+    m.rated_current /= 10.0;
+    m.rated_speed_rpm /= 10.0;
+    m.rated_torque /= 10.0;
+    let f = first(&m, None);
+    assert!(matches!(f, Finding::DcLinkOversized { .. }), "{f}");
+    assert_eq!(f.severity(), Severity::Error);
+    assert!(f.to_string().contains("divided by 10"), "{f}");
+}
+
+#[test]
+fn a_sampling_period_in_ms_is_refused_naming_ts() {
+    let f = first(&paper(), Some(0.025));
+    assert_eq!((f.key(), f.severity()), ("ts", Severity::Error), "{f}");
+    // 0.25 rad per sample runs (commissioning refuses it on its own); 0.63 is a warning.
+    assert!(check(&paper(), Some(400e-6)).is_empty());
+    let f = first(&paper(), Some(1e-3));
+    assert_eq!(f.severity(), Severity::Warning, "{f}");
+}
+
+#[test]
+fn torque_and_emf_slips_name_every_key_involved() {
+    let mut m = paper();
+    m.flux_linkage = 88.0; // mWb entered as Wb: caught by the torque
+    let f = first(&m, None);
+    assert_eq!(f.keys(), TORQUE_KEYS);
+    let mut m = paper();
+    m.dc_voltage = 24.0;
+    let f = first(&m, None);
+    assert_eq!(f.keys(), EMF_KEYS);
+    let text = f.to_string();
+    for k in EMF_KEYS {
+        assert!(text.contains(k), "{text}");
+    }
+    let mut m = paper();
+    m.rs = 327.0;
+    assert_eq!(first(&m, None).key(), "rs");
+}
+
+/// The 2.2 kW IPMSM (motulator's): Lq/Ld 1.42.
+fn ipmsm() -> MachineModel<f64> {
+    MachineModel::<f64> {
+        rs: 3.6,
+        ld: 36e-3,
+        lq: 51e-3,
+        flux_linkage: 0.545,
+        pole_pairs: 3,
+        inertia: 0.015,
+        viscous_friction: 0.0,
+        rated_current: 6.08,
+        rated_speed_rpm: 1500.0,
+        rated_torque: 14.0,
+        dc_voltage: 540.0,
+        magnetics: Default::default(),
+    }
+}
+
+#[test]
+fn an_inductance_in_mh_is_blamed_before_the_dc_link_derived_from_it() {
+    // A front end that derives the DC link from the rated point gets 1e5 V and more from an
+    // inductance in mH: the inductance is the cause, not the DC link nobody wrote.
+    let mut m = paper();
+    m.ld = 2.63;
+    m.lq = 2.63;
+    m.dc_voltage = 1.5e5;
+    let f = first(&m, None);
+    assert_eq!((f.key(), f.severity()), ("ld", Severity::Error), "{f}");
+    // A DC link beyond any drive on a plausible machine is still named.
+    let mut m = paper();
+    m.dc_voltage = 1.5e5;
+    assert_eq!(first(&m, None).key(), "dc_voltage");
+}
+
+#[test]
+fn a_pole_count_on_a_salient_rotor_is_named() {
+    let mut m = ipmsm();
+    assert!(check(&m, None).is_empty());
+    m.pole_pairs = 6;
+    let f = first(&m, None);
+    assert!(matches!(f, Finding::PoleCount { pole_pairs: 6, .. }), "{f}");
+    assert!(f.to_string().contains("looks like a pole count: 3?"), "{f}");
+    // A drive's model with L̂q five times Lq doubles its MTPA torque too, but not the magnet
+    // torque: a warning naming both causes, not a pole count refused.
+    let mut m = paper();
+    m.lq *= 5.0;
+    let f = first(&m, None);
+    assert!(matches!(f, Finding::Torque { .. }), "{f}");
+    assert_eq!(f.severity(), Severity::Warning);
+    assert!(f.to_string().contains("`ld`/`lq` off"), "{f}");
+}
+
+#[test]
+fn rms_and_line_to_line_values_are_named_not_taken_for_a_pole_count() {
+    // The current rms where peak is meant: T_rated is 1.41 × the model's.
+    let mut m = paper();
+    m.rated_current /= 2f64.step_sqrt();
+    let f = first(&m, None);
+    assert_eq!(f.severity(), Severity::Warning, "{f}");
+    assert!(f.to_string().contains("rms where peak is meant"), "{f}");
+    // λf from a line-to-line constant on an 8-pole motor: 0.58, not a pole count.
+    let mut m = paper();
+    m.flux_linkage *= 3f64.step_sqrt();
+    let f = first(&m, None);
+    assert!(matches!(f, Finding::Torque { .. }), "{f}");
+    assert!(f.to_string().contains("line-to-line"), "{f}");
+}
+
+#[test]
+fn a_resistance_far_beyond_any_machine_is_refused_naming_both_slips() {
+    // A 10 kV-class machine (λf 11.7 Wb, 181 A, 1500 r/min, p 4) with 0.1 Ω in mΩ: 2.5 × the
+    // rated back-EMF, a machine that cannot run.
+    let m = MachineModel::<f64> {
+        rs: 100.0,
+        ld: 25e-3,
+        lq: 25e-3,
+        flux_linkage: 11.7,
+        pole_pairs: 4,
+        inertia: 12.0,
+        viscous_friction: 0.8,
+        rated_current: 181.0,
+        rated_speed_rpm: 1500.0,
+        rated_torque: 12_700.0,
+        dc_voltage: 14_000.0,
+        magnetics: Default::default(),
+    };
+    let f = first(&m, None);
+    assert_eq!((f.key(), f.severity()), ("rs", Severity::Error), "{f}");
+    let text = f.to_string();
+    assert!(text.contains("mΩ where Ω is meant"), "{text}");
+    assert!(text.contains("`rated_speed_rpm` in r/s"), "{text}");
+}
+
+#[test]
+fn values_that_are_not_finite_are_left_to_the_validation() {
+    let mut m = paper();
+    m.flux_linkage = f64::INFINITY;
+    assert!(check(&m, None).is_empty());
+    assert!(m.validate().is_err());
+}
+
+#[test]
+fn a_switching_frequency_in_khz_is_named() {
+    let f = first(&paper(), Some(0.5 / 20.0));
+    assert!(f.to_string().contains("kHz where Hz is meant"), "{f}");
+}
