@@ -195,8 +195,10 @@ active flux's evaluations (`fado_core::active_flux`) match the borrowed model by
 map's lookup), so that the step carries the lookup's body with no call and no copy of the
 map's record: a lookup costs the step {fmt(in_step)} cycles (the third row: the measured
 unit's own instructions, the match on the model included), {"which meets" if in_step <= 60 else "which misses"}
-the 60-cycle target of a lookup; out of line with its frame it would cost {fmt(need(cycles, "step_map_lookup", 13)[0])}. The out-of-line unit's cycles by instruction class:
-{need(cycles, "uniform_table_lookup", ("classes", 13))} — the grid's origin and spacing and the
+the 60-cycle target of a lookup by {fmt(in_step - 60)} cycles: the table's own 60 plus the
+match on the model and the loads of the borrowed map's record (origin, spacings, cells, shape)
+and its cell's bounds check (out of line with its frame: {fmt(need(cycles, "step_map_lookup", 13)[0])}). The table's
+out-of-line unit's cycles by instruction class: {need(cycles, "uniform_table_lookup", ("classes", 13))} — the grid's origin and spacing and the
 cell's eight coefficients are twelve single-word loads (2 cycles each: the compiler issues
 `VLDR`s, not a `VLDM` of 1 + N, the registers it allocates not being consecutive), each axis's
 cell index a conversion to an integer, a clamp by one compare and the conversion back for the
@@ -218,7 +220,7 @@ flash; the default configuration, scenarios 10–11, the salient `ipmsm-2k2` tur
 
 The saturating step evaluates the map at the estimated current twice per sample (the active
 flux's swing and the rotor flux, `fado_core::active_flux`), each with a second lookup for the
-secant's ψq(î_d, 0), all four inlined into the step; the R̂s law's slots add a lookup with
+secant's ψq(î_d, 0), none with a call of its own; the R̂s law's slots add a lookup with
 the Jacobian where the law needs the incremental inductance (out of line). The map's own
 instructions (the lines of `magnetics/uniform_map.rs` and `uniform_table.rs`) cost the step
 {fmt(map_in_step[0])} and {fmt(map_in_step[1])} cycles per sample on average in the two
