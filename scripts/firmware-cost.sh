@@ -16,7 +16,8 @@
 # (docs/results/firmware-cost.md); scenario 13 that flux map alone
 # (examples/cortex-m/src/flux_lookup.rs): one lookup ψ(i) (flux_map_lookup) and its inverse
 # i(ψ) by Newton from a warm start (flux_map_inverse), and the same lookup in the uniform-grid
-# table (uniform_table_lookup: UniformFluxTable::flux).
+# table (uniform_table_lookup: UniformFluxTable::flux) and as the estimator's step makes it
+# (step_map_lookup: the machine record's MachineMagnetics::flux_warm, inlined into the step).
 # Needs qemu-system-arm and binutils-arm-none-eabi (Debian packages of those names).
 # Writes docs/results/firmware-cost.md whole from what it prints (scripts/firmware_cost_page.py).
 # Usage: bash scripts/firmware-cost.sh [STEPS_MEASURED_PER_SCENARIO (default 300)]
@@ -49,7 +50,7 @@ grep -o 'deepest stack: .*' "$run_log" | sed 's/^/    /' || true
 
 echo "== code reachable from the step and from the interrupt"
 for root in estimator_step paper_kernel_step paper_kernel_held_step SysTick drive_step \
-    flux_map_lookup flux_map_inverse uniform_table_lookup; do
+    flux_map_lookup flux_map_inverse uniform_table_lookup step_map_lookup; do
     { python3 scripts/firmware_cost.py graph "$image" "$root" || true; } |
         grep -E '^(\.text reachable|OK:|FORBIDDEN)' || true
 done
@@ -58,11 +59,11 @@ echo "== instruction trace (QEMU -d exec,nochain -singlestep, filtered to the st
 log=$(mktemp /tmp/fado-firmware-trace.XXXXXX)
 trap 'rm -f "$log" "$run_log"' EXIT
 filter=$(python3 scripts/firmware_cost.py ranges "$image" \
-    estimator_step,paper_kernel_step,paper_kernel_held_step,drive_step,flux_map_lookup,flux_map_inverse,uniform_table_lookup \
+    estimator_step,paper_kernel_step,paper_kernel_held_step,drive_step,flux_map_lookup,flux_map_inverse,uniform_table_lookup,step_map_lookup \
     scenario_marker)
 timeout 900 "${qemu[@]}" -singlestep -d exec,nochain -dfilter "$filter" -D "$log" >/dev/null
 roots=(estimator_step paper_kernel_step paper_kernel_held_step drive_step flux_map_lookup
-    flux_map_inverse uniform_table_lookup)
+    flux_map_inverse uniform_table_lookup step_map_lookup)
 titles=(
     "fado's step (estimator_step: scenarios 0-1 default, 2-3 fixed R̂s, 4-5 the paper's path, 6-7 the paper's path with the gains held over fado's default period, 8-9 a salient IPMSM, 10-11 the same saturating with a 16 × 16 uniform flux table in flash)"
     "the paper's estimator alone (paper_kernel_step, beside fado's paper's path: scenarios 4-5)"
@@ -71,6 +72,7 @@ titles=(
     "one lookup ψ(i) in a 16 × 16 flux map in flash (flux_map_lookup: FluxMap::flux; scenario 13)"
     "its inverse i(ψ) by Newton from the last current (flux_map_inverse: FluxMap::current_from; scenario 13)"
     "the same lookup in the uniform-grid table (uniform_table_lookup: UniformFluxTable::flux; scenario 13)"
+    "the same lookup as the estimator's step makes it (step_map_lookup: MachineMagnetics::flux_warm; scenario 13)"
 )
 # Each root's steps end at the entry of any other root traced in the same run.
 for k in "${!roots[@]}"; do

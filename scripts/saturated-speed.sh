@@ -93,8 +93,10 @@ slow it, so that figures measured under load are lower bounds).
   GEM map's CPU time, the drive and estimator about 25 %, the trace file about 15 % (`perf
   record --call-graph dwarf` on `fado-sim run stops`).
 - **Algebraic model** (`ipmsm-2k2-qsat`, `pmsyrm-baldor-5k6`): the plant's i(ψ) is the model's
-  own closed form; the drive's and the estimator's ψ(i) are Newton solves warm-started from the
-  last sample's flux, about 30 % of the CPU time on the PM-SyRM (the same profile).
+  own closed form; the drive's and the estimator's ψ(i) are Newton solves started from the
+  tangent plane of their last solution (`fado_core::magnetics::FluxWarmStart`: one step and the
+  one that confirms it, 1.4 evaluations per solve on average), about 20 % of the PM-SyRM's
+  instructions, the plant's i(ψ) 10 % (callgrind on `fado-sim run stops`).
 """
 os.makedirs(os.path.dirname(out) or ".", exist_ok=True)
 fd, tmp_path = tempfile.mkstemp(dir=os.path.dirname(out) or ".", suffix=".tmp")

@@ -198,8 +198,7 @@ impl<T: Real> ActiveFlux<T> {
         psi_guess: Dq<T>,
         warm: &FluxWarmStart<T>,
     ) -> (ActiveFluxPoint<T>, FluxWarmStart<T>) {
-        let model = self.model.resolve(self.linear);
-        let (psi, warm) = model.flux_warm(i_dq, psi_guess, warm);
+        let (psi, warm) = self.model.flux_warm(self.linear, i_dq, psi_guess, warm);
         (self.point_at(i_dq, psi), warm)
     }
 
@@ -208,8 +207,7 @@ impl<T: Real> ActiveFlux<T> {
         // ψq(î_d, 0) removed (zero unless a map is not odd in i_q): λ̂r then lies within
         // atan(ψq(î_d, 0)/λa) of d, where ψq/i_q would grow without bound near i_q = 0.
         let secant = if i_dq.q.abs() > self.small_current {
-            let model = self.model.resolve(self.linear);
-            (psi.q - model.q_flux_offset(i_dq.d)) / i_dq.q
+            (psi.q - self.model.q_flux_offset(self.linear, i_dq.d)) / i_dq.q
         } else {
             self.incremental_inductance(i_dq).qq
         };

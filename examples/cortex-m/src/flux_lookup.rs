@@ -7,7 +7,10 @@
 //! firmware does with a map measured or computed off line.
 
 use fado_core::Dq;
-use fado_core::magnetics::{FluxMap, FluxTable, MagneticModel, UniformFluxMap, UniformFluxTable};
+use fado_core::magnetics::{
+    ConstantInductance, FluxMap, FluxTable, FluxWarmStart, MachineMagnetics, MagneticModel,
+    UniformFluxMap, UniformFluxTable,
+};
 
 /// Nodes per axis.
 pub const N: usize = 16;
@@ -67,6 +70,20 @@ pub fn uniform_table_lookup(table: &UniformFluxTable<f32, N, N>, i: Dq<f32>) -> 
     table.flux(i)
 }
 
+/// ψ(i) from a machine record's model as the estimator's step evaluates it
+/// (`MachineMagnetics::flux_warm`: by reference, the match on the model and the lookup inlined
+/// into the caller; the warm start is the algebraic model's and a map leaves it alone).
+#[inline(never)]
+#[unsafe(no_mangle)]
+pub fn step_map_lookup(model: &MachineMagnetics<f32>, i: Dq<f32>) -> Dq<f32> {
+    let linear = ConstantInductance {
+        ld: 0.036,
+        lq: 0.051,
+        flux_linkage: 0.545,
+    };
+    model.flux_warm(linear, i, i, &FluxWarmStart::empty()).0
+}
+
 /// ψ(i): one bilinear lookup (the cell from the uniform axes' inverse spacing, four corners
 /// per table, the interpolation) — the unit of the ≤ 60-cycle target.
 #[inline(never)]
@@ -99,6 +116,9 @@ pub fn run(n: usize) -> Option<f32> {
         let psi = flux_map_lookup(&map, core::hint::black_box(i));
         let same = uniform_table_lookup(&UNIFORM, core::hint::black_box(i));
         worst = worst.max((same - psi).norm());
+        let model = MachineMagnetics::Uniform(&UNIFORM_MAP);
+        let in_step = step_map_lookup(core::hint::black_box(&model), core::hint::black_box(i));
+        worst = worst.max((in_step - psi).norm());
         let back = flux_map_inverse(&map, core::hint::black_box(psi), guess);
         guess = back;
         worst = worst.max((back - i).norm());

@@ -69,11 +69,18 @@ impl<T: Real> UniformFluxMap<'_, T> {
 }
 
 impl<T: Real> MagneticModel<T> for UniformFluxMap<'_, T> {
-    /// The bilinear values alone (no Jacobian).
-    #[inline]
+    /// The bilinear values alone (no Jacobian), inlined into the caller (the lookup a
+    /// firmware's step makes twice per sample).
+    #[inline(always)]
     fn flux(&self, i: Dq<T>) -> Dq<T> {
         let (k, m, fx, fy) = cell_of(self.first, self.inv_step, self.last, i);
         bilinear_value(&self.coefficients(k, m), fx, fy)
+    }
+
+    /// ψq(i_d, 0), one lookup inlined into the caller (as [`MagneticModel::flux`]).
+    #[inline(always)]
+    fn q_flux_offset(&self, i_d: T) -> T {
+        self.flux(Dq::new(i_d, T::zero())).q
     }
 
     /// From the map's linearisation at zero current.

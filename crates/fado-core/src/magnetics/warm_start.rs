@@ -13,7 +13,9 @@
 //! Models whose ψ(i) is not an iteration (constant inductances, flux maps) evaluate it
 //! directly and leave the warm start empty: no prediction and no Jacobian on their path.
 
-use super::{InductanceMatrix, MagneticModel, Magnetics};
+use super::{
+    ConstantInductance, InductanceMatrix, MachineMagnetics, MagneticModel, Magnetics, Saturation,
+};
 use crate::{Dq, Real};
 
 /// The tangent plane of ψ(i) at the last solution, ψ ≈ c + L·i (module docs); empty until
@@ -102,12 +104,60 @@ impl<T: Real> Magnetics<'_, T> {
         warm: &FluxWarmStart<T>,
     ) -> (Dq<T>, FluxWarmStart<T>) {
         match self {
-            Magnetics::Saturation(s) => {
-                let (psi, l) = s.flux_and_inductance_from(i, warm.guess(i, fallback));
-                (psi, FluxWarmStart::at(i, psi, &l))
-            }
+            Magnetics::Saturation(s) => s.flux_warm(i, fallback, warm),
             _ => (self.flux(i), *warm),
         }
+    }
+}
+
+impl<T: Real> MachineMagnetics<T> {
+    /// [`Magnetics::flux_warm`] of the borrowed model, `linear` standing for
+    /// [`MachineMagnetics::Linear`]: evaluated by reference, so that a map's lookup is inlined
+    /// into its caller (no copy of the map's record into a [`Magnetics`], no call of its
+    /// dispatch, no call frame: what a firmware's step pays is the lookup's own instructions).
+    #[inline(always)]
+    pub fn flux_warm(
+        &self,
+        linear: ConstantInductance<T>,
+        i: Dq<T>,
+        fallback: Dq<T>,
+        warm: &FluxWarmStart<T>,
+    ) -> (Dq<T>, FluxWarmStart<T>) {
+        match *self {
+            MachineMagnetics::Linear => (linear.flux(i), *warm),
+            MachineMagnetics::Saturation(s) => s.flux_warm(i, fallback, warm),
+            MachineMagnetics::Map(m) => (m.flux(i), *warm),
+            MachineMagnetics::Uniform(m) => (m.flux(i), *warm),
+        }
+    }
+}
+
+impl<T: Real> MachineMagnetics<T> {
+    /// [`MagneticModel::q_flux_offset`] of the borrowed model by reference, as
+    /// [`MachineMagnetics::flux_warm`] evaluates ψ (a map's lookup inlined into the caller).
+    #[inline(always)]
+    pub fn q_flux_offset(&self, linear: ConstantInductance<T>, i_d: T) -> T {
+        match *self {
+            MachineMagnetics::Linear => linear.q_flux_offset(i_d),
+            MachineMagnetics::Saturation(s) => s.q_flux_offset(i_d),
+            MachineMagnetics::Map(m) => m.q_flux_offset(i_d),
+            MachineMagnetics::Uniform(m) => m.q_flux_offset(i_d),
+        }
+    }
+}
+
+impl<T: Real> Saturation<T> {
+    /// ψ(i) solved from `warm`'s prediction (`fallback` while empty), and the warm start at
+    /// that solution.
+    #[inline]
+    fn flux_warm(
+        &self,
+        i: Dq<T>,
+        fallback: Dq<T>,
+        warm: &FluxWarmStart<T>,
+    ) -> (Dq<T>, FluxWarmStart<T>) {
+        let (psi, l) = self.flux_and_inductance_from(i, warm.guess(i, fallback));
+        (psi, FluxWarmStart::at(i, psi, &l))
     }
 }
 
