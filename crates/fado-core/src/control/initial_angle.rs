@@ -367,14 +367,17 @@ struct Harmonics<T> {
 impl<T: Real> Harmonics<T> {
     fn of(peaks: &[[T; DIRECTIONS]; GRIDS], grids: &[usize]) -> Self {
         let (mut mean, mut h1, mut h2) = (T::zero(), Ab::<T>::zero(), Ab::<T>::zero());
-        for &g in grids {
-            for (k, &p) in peaks[g].iter().enumerate() {
+        let mut readings = 0;
+        // `get` rather than indexing: no bounds-check panic in the firmware's step.
+        for (g, row) in grids.iter().filter_map(|&g| Some((g, peaks.get(g)?))) {
+            for (k, &p) in row.iter().enumerate() {
                 mean += p;
                 h1 += direction::<T>(k, g, 1) * p;
                 h2 += direction::<T>(k, g, 2) * p;
+                readings += 1;
             }
         }
-        let scale = T::one() / T::lit((DIRECTIONS * grids.len()) as f64);
+        let scale = T::one() / T::from_index(readings.max(1));
         Self {
             mean: mean * scale,
             h1: h1 * (scale * T::lit(2.0)),
