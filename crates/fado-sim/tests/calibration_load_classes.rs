@@ -94,15 +94,22 @@ fn run(mut cfg: SimConfig) -> (f64, GainCalibrationStatus, f64, f64, f64) {
 ///
 /// | machine | no load | 20 ms before | 100 ms before |
 /// |---|---|---|---|
-/// | 400 V servo | 0.254 rad | Calibrated (not seen), 1.19 rad, 5.5 rad back | RotorMoved, 0.29 rad, 4.5 rad back |
-/// | 48 V hub | 0.124 rad | RotorMoved, 0.16 rad, 0.75 rad back | RotorMoved, 0.14 rad, 1.5 rad back |
-/// | 12S multirotor | 0.029 rad | RotorMoved, 0.86 rad, 24.6 rad back | RotorMoved, 0.87 rad, 38 rad back |
+/// | 400 V servo | 0.254 rad | Calibrated (not seen), 1.19 rad, 5.5 rad back | RotorMoved, 0.167 rad, 0.081 rad back |
+/// | 48 V hub | 0.124 rad | RotorMoved, 0.104 rad, 0.094 rad back | RotorMoved, 0.102 rad, 0.092 rad back |
+/// | 12S multirotor | 0.029 rad | RotorMoved, 0.203 rad, 0.41 rad back | RotorMoved, 0.202 rad, 0.41 rad back |
 /// | 50 kW traction | TooSlow, 0.075 rad | TooSlow, 1.04 rad, 13.5 rad back | — |
-/// | 10 kV-class | TooSlow, 0.36 rad | TooSlow, 0.62 rad, 8.1 rad back | — |
+/// | 10 kV-class | TooSlow, 0.058 rad | TooSlow, 0.62 rad, 8.1 rad back | — |
 /// | 2-pole spindle | 0.035 rad | Implausible, 3.14 rad, 33 rad back | Implausible, 3.14 rad, 34 rad back |
 ///
-/// None meets the criteria: the start-up (control/startup*, the calibrations) holds the
-/// IPMSM preset's rotor but not these. Ignored until it does; run with `--ignored`.
+/// Where the gain calibration's motion test sees the load (a voltage-mode level), the release
+/// hold catches the rotor (`ReleaseHold::engage`) and the four cases pass. Not met: a load
+/// that arrives during the calibration's last stage (the current loop at zero current, which
+/// the motion test does not watch: the servo at 20 ms) or during the offset calibration (the
+/// gates off: the traction and 10 kV machines, whose gain calibration is skipped as too
+/// slow); the spindle, whose motion the test does not see before the calibration is refused;
+/// and the servo's unloaded start into a speed reference already at 6.4 % of its rated speed
+/// (the estimator lags the departure's acceleration: 0.24 rad after a step of 200 r/min,
+/// 0.075 rad on a ramp of 1000 r/min/s). Ignored until they are met; run with `--ignored`.
 #[test]
 #[ignore = "the start-up loses these machines under a load arriving during its calibrations"]
 fn a_load_arriving_during_the_calibrations_on_machines_of_other_classes() {
@@ -133,4 +140,34 @@ fn a_load_arriving_during_the_calibrations_on_machines_of_other_classes() {
         }
     }
     assert!(failed.is_empty(), "{failed:#?}");
+}
+
+/// The cases of the table above that the gain calibration's motion test sees (a voltage-mode
+/// level): RotorMoved, and the release hold catches the rotor within the benchmark's
+/// criteria (measured: the servo 100 ms before the end, the hub motor and the 12S multirotor
+/// 20 and 100 ms before; 0.08–0.41 rad back, |θ − θ̂| 0.10–0.21 rad).
+#[test]
+fn a_load_the_motion_test_sees_is_caught_on_machines_of_other_classes() {
+    for (index, befores) in [
+        (0, &[0.1][..]),
+        (1, &[0.02, 0.1][..]),
+        (2, &[0.02, 0.1][..]),
+    ] {
+        let (name, motor, inverter) = MACHINES[index];
+        let (end, ..) = run(config(motor, inverter, ""));
+        let machine = config(motor, inverter, "").motor;
+        let (torque, rated) = (0.5 * machine.rated_torque, machine.rated_speed_rpm);
+        for &before in befores {
+            let at = end - before;
+            let extra = format!(
+                "[load.torque]\npoints = [[0.0, 0.0], [{:.6}, 0.0], [{at:.6}, {torque}]]\n",
+                at - 1e-4
+            );
+            let (_, status, err, min_speed, back) = run(config(motor, inverter, &extra));
+            assert_eq!(status, GainCalibrationStatus::RotorMoved, "{name} {before}");
+            assert!(err < 0.25, "{name} {before}: {err}");
+            assert!(back < 0.5, "{name} {before}: {back}");
+            assert!(min_speed > -0.04 * rated, "{name} {before}: {min_speed}");
+        }
+    }
 }
