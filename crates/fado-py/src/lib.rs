@@ -31,6 +31,7 @@ pub mod flux_map;
 pub mod inputs;
 pub mod interrupt;
 pub mod machine;
+pub mod number;
 pub mod outputs;
 pub mod record;
 pub mod replay;
