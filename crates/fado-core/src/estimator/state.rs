@@ -75,8 +75,19 @@ impl<T: Real> EstimatorState<T> {
             } else {
                 Ab::zero()
             });
+        // A saturating model's observer follows a rotating vector of the low-passed active
+        // flux, which starts at the aligned one (`crate::active_flux`).
+        self.swing_reference = if p.active_flux.is_saturating() {
+            active
+        } else {
+            p.flux_linkage
+        };
+        let reference = match p.active_flux.saturating() {
+            Some(af) => af.observer_reference(active),
+            None => p.flux_linkage,
+        };
         self.observer = ObserverState::at(if p.observer_on_rotor_flux {
-            Ab::from_polar(p.flux_linkage, theta0)
+            Ab::from_polar(reference, theta0)
         } else {
             lambda1
         });
@@ -180,7 +191,8 @@ impl<T: Real> EstimatorState<T> {
                 let i_dq = ActiveFlux::frame_current(axis, i_ab);
                 let guess = ActiveFlux::frame_current(axis, axis + i_ab * self.lq_secant);
                 let (point, warm) = af.point_warm(i_dq, guess, &self.flux_warm);
-                let swing = axis * ((point.active - af.magnet_flux()) / n2.step_sqrt());
+                let reference = af.observer_reference(self.swing_reference);
+                let swing = axis * ((point.active - reference) / n2.step_sqrt());
                 (swing, warm)
             } else {
                 (Ab::zero(), self.flux_warm)

@@ -270,7 +270,11 @@ impl<T: Real> ResistanceAdaptationParams<T> {
                 return false;
             };
             let reference = point.active + (lf - self.config.flux_linkage_hat);
-            let a = -(mag * bracket) * scale.chi_per_phi;
+            // χ relative to the active flux where it exceeds λ̂f (a reluctance rotor's |λ̂r|
+            // is many times its magnet's flux: relative to λ̂f a weak magnet's χ would pass
+            // χ0 on the map's slope alone at no load).
+            let a =
+                -(mag * bracket) * scale.chi_per_phi * crate::real::min(T::one(), lf / reference);
             return self.rotating_step(scale, st, next, reference, a, mag, omega, settled);
         }
         // The reference is the active flux λ̂a = λ̂f + (L̂d − L̂q)·î_d and φ carries the
