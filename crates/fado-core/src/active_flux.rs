@@ -298,8 +298,8 @@ impl<T: Real> ActiveFlux<T> {
 
     /// The bracket of the R̂s regressor φ = −(that)/ω (module docs) at the operating point,
     /// with the incremental inductances there; None where κ < [`KAPPA_MIN_RATIO`]·λa, λa ≤ 0
-    /// or the bracket's turned part (its i_d term) exceeds its direct part i_q (the law
-    /// freezes).
+    /// or the bracket's turned part (its i_d term) is not smaller than its direct part i_q
+    /// (the law freezes).
     #[inline]
     pub fn resistance_regressor(&self, point: &ActiveFluxPoint<T>) -> Option<T> {
         let i = point.i_dq;
@@ -310,11 +310,11 @@ impl<T: Real> ActiveFlux<T> {
         if !(point.active > T::zero() && kappa >= floor) {
             return None;
         }
-        // The part the frame's turn carries through the map's slope; where it exceeds the
+        // The part the frame's turn carries through the map's slope; where it reaches the
         // resistance's own d-axis flux i_q (no load, the current along d: cross-saturation
         // alone), any angle error reads as resistance: frozen.
         let turned = i.d * ((l.dd - lqs) * i.q - l.dq * i.d) / kappa;
-        if !(turned.abs() <= i.q.abs()) {
+        if !(turned.abs() < i.q.abs()) {
             return None;
         }
         Some(i.q + turned)

@@ -40,21 +40,7 @@ impl<T: Real> EstimatorState<T> {
         } else {
             T::zero()
         };
-        // The active flux λ̂f + (L̂d − L̂q)·i_d (λ̂f exactly for L̂d = L̂q), or a saturating
-        // model's at the current in the aligned frame, with its secant L̂q.
-        let rotor = Ab::from_polar(T::one(), theta0);
-        let (active, lq) = match p.active_flux.saturating() {
-            None => (p.flux_linkage + p.saliency * rotor.dot(i_ab), p.lq),
-            Some(af) => {
-                let point = af.point(ActiveFlux::frame_current(rotor, i_ab));
-                (point.active, point.lq_secant)
-            }
-        };
-        let (active, lq) = if active.is_finite() && active > T::zero() && lq.is_finite() {
-            (active, lq)
-        } else {
-            (p.flux_linkage, p.lq)
-        };
+        let (active, lq) = Self::aligned_active(p, theta0, i_ab);
         self.lq_secant = lq;
         self.flux_warm = FluxWarmStart::empty();
         let lambda_r = Ab::from_polar(active, theta0);
@@ -115,6 +101,25 @@ impl<T: Real> EstimatorState<T> {
         self.i_sum = Ab::zero();
         self.slow_feedback = self.offset.offset;
         self.step_allowance = p.bounds.step();
+    }
+
+    /// The active flux λ̂f + (L̂d − L̂q)·i_d (λ̂f exactly for L̂d = L̂q), or a saturating
+    /// model's at the current in the frame aligned at `theta0`, with its secant L̂q; λ̂f and
+    /// L̂q where that is not a positive finite flux.
+    fn aligned_active(p: &EstimatorParams<T>, theta0: T, i_ab: Ab<T>) -> (T, T) {
+        let rotor = Ab::from_polar(T::one(), theta0);
+        let (active, lq) = match p.active_flux.saturating() {
+            None => (p.flux_linkage + p.saliency * rotor.dot(i_ab), p.lq),
+            Some(af) => {
+                let point = af.point(ActiveFlux::frame_current(rotor, i_ab));
+                (point.active, point.lq_secant)
+            }
+        };
+        if active.is_finite() && active > T::zero() && lq.is_finite() {
+            (active, lq)
+        } else {
+            (p.flux_linkage, p.lq)
+        }
     }
 
     /// One sample (Fig. 5) with the parameters `p` this state was made for: as

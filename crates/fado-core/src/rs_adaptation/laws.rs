@@ -265,7 +265,12 @@ impl<T: Real> ResistanceAdaptationParams<T> {
         let dl = self.saliency;
         if let Some((af, point)) = point {
             // A saturating model (`crate::active_flux`): λ̂a(î) shifted by the learned λ̂f,
-            // the regressor's bracket at î; frozen where it is ill-conditioned.
+            // the regressor's bracket at î; frozen where it is ill-conditioned, and until the
+            // hand-over's transient has settled (`settled`, as the λ̂f law): there the angle
+            // error turns î, and the regressor judged at î is not the machine's.
+            if !settled {
+                return false;
+            }
             let Some(bracket) = af.resistance_regressor(&point) else {
                 return false;
             };
