@@ -314,10 +314,7 @@ impl<T: Real> ActiveFlux<T> {
         // resistance's own d-axis flux i_q (no load, the current along d: cross-saturation
         // alone), any angle error reads as resistance: frozen.
         let turned = i.d * ((l.dd - lqs) * i.q - l.dq * i.d) / kappa;
-        if !(turned.abs() < i.q.abs()) {
-            return None;
-        }
-        Some(i.q + turned)
+        (turned.abs() < i.q.abs()).then_some(i.q + turned)
     }
 
     /// The frame coupling's (s, κ) at the operating point (module docs): while the current
