@@ -154,3 +154,81 @@ def test_estimate_refuses_plant_tables_naming_the_functions_that_take_them() -> 
         fado.estimate(*signals, machine="paper", config={"motor": {"rs": 0.3}})
     assert info.value.field == "motor"
     assert "machine=" in str(info.value) and "fado.simulate" in str(info.value)
+
+
+IPM = dict(
+    rs=3.6, ld=0.036, lq=0.051, flux_linkage=0.545, pole_pairs=3,
+    rated_current=6.08, rated_speed_rpm=1500.0, rated_torque=14.0,
+)
+
+
+def test_a_bool_where_a_quantity_is_meant_is_refused_naming_the_argument() -> None:
+    # float(True) is 1.0: ts=True would be a one-second sampling period.
+    signals = [np.zeros(10) for _ in range(4)]
+    for kwargs, name in (
+        (dict(ts=True), "ts"),
+        (dict(ts=np.True_), "ts"),
+        (dict(theta0=False), "theta0"),
+    ):
+        with pytest.raises(fado.InputError, match="bool") as info:
+            fado.estimate(*signals, machine="paper", **kwargs)
+        assert info.value.argument == name
+    with pytest.raises(fado.InputError, match="bool"):
+        fado.Estimator("paper", ts=True)
+    with pytest.raises(fado.InputError, match="i_alpha"):
+        fado.Estimator("paper").align(0.0, True)
+    # numpy real scalars are numbers.
+    r = fado.estimate(*signals, machine="paper", ts=np.float32(1e-4), theta0=np.float64(0.5))
+    assert len(r) == 10
+
+
+def test_ratings_scaled_with_a_derived_dc_link_and_ipm_flux_slips_warn() -> None:
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        fado.Machine(**IPM)
+    tenth = dict(IPM, rated_current=0.608, rated_speed_rpm=150.0, rated_torque=1.4)
+    with pytest.warns(UserWarning, match="divided by 10"):
+        fado.Machine(**tenth)
+    with pytest.warns(UserWarning, match="rms where peak"):
+        fado.Machine(**dict(IPM, flux_linkage=0.545 / math.sqrt(2)))
+    with pytest.warns(UserWarning, match="line-to-line"):
+        fado.Machine(**dict(IPM, flux_linkage=0.545 * math.sqrt(3)))
+
+
+def test_a_motor_without_magnet_is_refused_saying_why() -> None:
+    with pytest.raises(fado.ConfigError, match="synchronous reluctance") as info:
+        fado.Machine(**dict(IPM, flux_linkage=0.0))
+    assert info.value.field == "flux_linkage"
+
+
+def _recording(n: int = 2000) -> list[np.ndarray]:
+    """A steady rotation of the paper's motor: 10 A turning at 60 Hz, the voltage it needs."""
+    t = np.arange(n) * 1e-4
+    w = 2 * math.pi * 60
+    i = 10 * np.exp(1j * w * t)
+    v = (0.5 + 1j * w * 2.63e-3) * i + 1j * w * 0.088 * np.exp(1j * (w * t - 0.3))
+    return [np.ascontiguousarray(x) for x in (v.real, v.imag, i.real, i.imag)]
+
+
+@pytest.mark.parametrize(
+    ("change", "match"),
+    [
+        (lambda s: [s[0], s[1], s[2] * 1e3, s[3] * 1e3], "mA where A is meant"),
+        (lambda s: [s[0] / 1e3, s[1] / 1e3, s[2], s[3]], "kV where V is meant"),
+        (lambda s: [s[0], s[1], s[2], np.zeros_like(s[3])], "`i_beta` is 0 in every sample"),
+        (lambda s: [s[0], s[1], np.where(np.arange(len(s[2])) % 10 == 0, np.nan, s[2]), s[3]],
+         "non-finite"),
+    ],
+)
+def test_a_recording_in_the_wrong_units_warns_naming_the_column(change, match) -> None:
+    signals = _recording()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        fado.estimate(*signals, machine="paper", ts=1e-4)
+    with pytest.warns(UserWarning, match=match):
+        fado.estimate(*change(signals), machine="paper", ts=1e-4)
+
+
+def test_a_start_angle_in_degrees_warns() -> None:
+    with pytest.warns(UserWarning, match="degrees where radians"):
+        fado.estimate(*_recording(), machine="paper", ts=1e-4, theta0=30.0)

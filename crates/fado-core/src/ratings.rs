@@ -11,7 +11,7 @@
 //! | `viscous_friction` | [`FRICTION_TORQUE_RATIO`] of the rated torque at rated speed |
 //! | `inertia` | rated torque accelerates it to rated speed in [`MECHANICAL_START_TIME`] |
 //! | `dc_voltage` | the rated point uses [`DC_LINK_MODULATION_RATIO`] of the linear range |
-//! | `switching_frequency` | ω_rated·Ts ≤ [`MAX_OMEGA_TS`], at least [`MIN_SWITCHING_FREQUENCY`] |
+//! | `switching_frequency` | ω_rated·Ts ≤ [`MAX_OMEGA_TS`], at least the DC link's class floor ([`min_switching_frequency`]) |
 //! | `dead_time` | [`DEAD_TIME_PERIOD_RATIO`] of the carrier period |
 //! | `threshold_voltage` | [`THRESHOLD_VOLTAGE_RATIO`] of the DC link |
 //! | `current_band` | [`CURRENT_BAND_RATIO`] of the rated current |
@@ -58,9 +58,35 @@ pub const MAX_OMEGA_TS: f64 = 0.2;
 /// refuses beyond it; the derived switching frequency keeps that bound.
 pub const MAX_RUNNING_OMEGA_TS: f64 = 0.6;
 
-/// Lowest derived switching frequency, Hz: 5 kHz, the paper's and that of most industrial
-/// drives (a slower carrier is audible and its current ripple large).
+/// Lowest derived switching frequency of a low-voltage inverter (DC link up to
+/// [`LOW_VOLTAGE_DC_LINK`]), Hz: 5 kHz, the paper's and that of most industrial drives (a
+/// slower carrier is audible and its current ripple large).
 pub const MIN_SWITCHING_FREQUENCY: f64 = 5000.0;
+
+/// Largest DC link, V, of the low-voltage class: 1.2 kV, the 1,200 V and 1,700 V IGBT and SiC
+/// bridges of 400–690 V mains drives and battery inverters (a 690 V mains drive's DC link is
+/// 975 V). Above it the bridge is a medium-voltage one (3.3–6.5 kV IGBTs, IGCTs, or devices in
+/// series), whose switching losses keep the carrier at 0.5–2 kHz \[A\].
+pub const LOW_VOLTAGE_DC_LINK: f64 = 1200.0;
+
+/// Lowest derived switching frequency of a medium-voltage inverter (DC link above
+/// [`LOW_VOLTAGE_DC_LINK`]), Hz: 2 kHz, the upper end of that class's carriers, and the lowest
+/// whole kHz at which a current loop of 250 Hz (the drive's default bandwidth, the paper's
+/// drive's) keeps ωc·Ts ≤ 0.5 with Ts = 1/(2·f_sw) (1.6 kHz). With [`DEAD_TIME_PERIOD_RATIO`]
+/// its dead time is 6.25 µs, that of 3.3 kV IGBT modules, rather than the 2.5 µs of a
+/// 1,200 V one.
+pub const MIN_SWITCHING_FREQUENCY_MEDIUM_VOLTAGE: f64 = 2000.0;
+
+/// The lowest derived switching frequency for an inverter on `dc_voltage` (V): the class floor
+/// [`MIN_SWITCHING_FREQUENCY`] up to [`LOW_VOLTAGE_DC_LINK`], else
+/// [`MIN_SWITCHING_FREQUENCY_MEDIUM_VOLTAGE`].
+pub fn min_switching_frequency(dc_voltage: f64) -> f64 {
+    if dc_voltage > LOW_VOLTAGE_DC_LINK {
+        MIN_SWITCHING_FREQUENCY_MEDIUM_VOLTAGE
+    } else {
+        MIN_SWITCHING_FREQUENCY
+    }
+}
 
 /// The derived switching frequency is a whole multiple of this, Hz.
 pub const SWITCHING_FREQUENCY_STEP: f64 = 1000.0;
@@ -114,7 +140,7 @@ pub const RULES: [(&str, &str); 7] = [
     ),
     (
         "inverter.switching_frequency",
-        "ω_rated·Ts ≤ 0.2 (Ts = 1/(2·f_sw)), at least 5 kHz, rounded up to a whole kHz",
+        "ω_rated·Ts ≤ 0.2 (Ts = 1/(2·f_sw)), at least 5 kHz (2 kHz on a DC link above 1.2 kV), rounded up to a whole kHz",
     ),
     (
         "inverter.dead_time",
@@ -154,13 +180,14 @@ fn ceil_to(x: f64, step: f64) -> f64 {
     step * if whole < n { whole + 1.0 } else { whole }
 }
 
-/// The switching frequency, Hz: the smallest whole kHz at or above
-/// [`MIN_SWITCHING_FREQUENCY`] at which ω_rated·Ts ≤ [`MAX_OMEGA_TS`] with Ts = 1/(2·f_sw).
-pub fn switching_frequency(pole_pairs: u32, rated_speed_rpm: f64) -> f64 {
+/// The switching frequency, Hz: the smallest whole kHz at or above the floor of the DC link's
+/// class ([`min_switching_frequency`] of `dc_voltage`) at which ω_rated·Ts ≤ [`MAX_OMEGA_TS`]
+/// with Ts = 1/(2·f_sw).
+pub fn switching_frequency(pole_pairs: u32, rated_speed_rpm: f64, dc_voltage: f64) -> f64 {
     let omega = rated_speed_mech(rated_speed_rpm) * pole_pairs as f64;
     let needed = omega / (2.0 * MAX_OMEGA_TS);
     ceil_to(
-        needed.max(MIN_SWITCHING_FREQUENCY),
+        needed.max(min_switching_frequency(dc_voltage)),
         SWITCHING_FREQUENCY_STEP,
     )
 }
@@ -244,9 +271,17 @@ mod tests {
         let j = inertia(m.rated_torque, m.rated_speed_rpm);
         assert!((j * m.rated_speed_mech() / m.rated_torque - 0.15).abs() < 1e-12);
         // 628 rad/s needs 1.6 kHz: the 5 kHz floor.
-        assert_eq!(switching_frequency(4, 1500.0), 5000.0);
+        assert_eq!(switching_frequency(4, 1500.0, 311.0), 5000.0);
+        // A medium-voltage drive (10 kV DC link): the 2 kHz floor, 6.25 µs dead time; the
+        // drive's 250 Hz current loop within ωc·Ts ≤ 0.5.
+        let f = switching_frequency(2, 1500.0, 10e3);
+        assert_eq!(f, 2000.0);
+        assert_eq!(dead_time(f), 6.25e-6);
+        assert!(core::f64::consts::TAU * 250.0 * 0.5 / f <= 0.5);
+        // At 1.2 kV the low-voltage floor still holds.
+        assert_eq!(switching_frequency(2, 1500.0, LOW_VOLTAGE_DC_LINK), 5000.0);
         // A 14-pole-pair outrunner at 7000 r/min: 10,263 rad/s → 25.7 kHz → 26 kHz.
-        let f = switching_frequency(14, 7000.0);
+        let f = switching_frequency(14, 7000.0, 22.2);
         assert_eq!(f, 26_000.0);
         assert!(14.0 * 7000.0 * core::f64::consts::PI / 30.0 * 0.5 / f <= MAX_OMEGA_TS);
         assert_eq!(dead_time(5000.0), 2.5e-6);

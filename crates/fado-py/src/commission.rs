@@ -19,6 +19,7 @@ use pyo3::types::{PyDict, PyList, PyString};
 use crate::errors::input_error;
 use crate::interrupt;
 use crate::machine::PyMachine;
+use crate::number::number;
 use crate::simulate::{Motor, sim_error};
 
 /// The trace columns of a `CommissionResult`, in `traces.csv` order.
@@ -110,7 +111,7 @@ fn plant_config(
 /// a bad argument `InputError` (both `ValueError`s).
 #[pyfunction]
 #[pyo3(
-    signature = (motor, *, nameplate = None, config_toml = None, seed = 1, averaged = false, theta0 = 1.0, decimation = 10, progress = false),
+    signature = (motor, *, nameplate = None, config_toml = None, seed = 1, averaged = false, theta0 = None, decimation = 10, progress = false),
     text_signature = "(motor, *, nameplate=None, config_toml=None, seed=1, averaged=False, theta0=1.0, decimation=10, progress=False)"
 )]
 #[allow(clippy::too_many_arguments)]
@@ -121,10 +122,11 @@ pub fn commission(
     config_toml: Option<&str>,
     seed: u64,
     averaged: bool,
-    theta0: f64,
+    theta0: Option<Bound<'_, PyAny>>,
     decimation: i64,
     progress: bool,
 ) -> PyResult<CommissionResult> {
+    let theta0 = number(py, "theta0", theta0.as_ref(), 1.0)?;
     if !theta0.is_finite() {
         return Err(input_error(
             py,

@@ -12,6 +12,7 @@ use crate::errors::{config_error, input_error};
 use crate::inputs::{ColumnSlice, Signals};
 use crate::interrupt;
 use crate::machine::PyMachine;
+use crate::number::number;
 use crate::outputs::{EstimateResult, StepResult};
 use crate::replay::replay_until;
 use crate::scalar::{Dtype, Scalar};
@@ -223,18 +224,19 @@ pub struct PyEstimator {
 impl PyEstimator {
     #[new]
     #[pyo3(
-        signature = (machine = None, config = None, *, ts = DEFAULT_TS, theta0 = 0.0, dtype = Dtype::Float64),
+        signature = (machine = None, config = None, *, ts = None, theta0 = None, dtype = Dtype::Float64),
         text_signature = "(machine, config=None, *, ts=0.0001, theta0=0.0, dtype='float64')"
     )]
     fn py_new(
         py: Python<'_>,
         machine: Option<Bound<'_, PyAny>>,
         config: Option<Bound<'_, PyAny>>,
-        ts: f64,
-        theta0: f64,
+        ts: Option<Bound<'_, PyAny>>,
+        theta0: Option<Bound<'_, PyAny>>,
         dtype: Dtype,
     ) -> PyResult<Self> {
-        let theta0 = finite(py, "theta0", theta0)?;
+        let ts = number(py, "ts", ts.as_ref(), DEFAULT_TS)?;
+        let theta0 = finite(py, "theta0", number(py, "theta0", theta0.as_ref(), 0.0)?)?;
         let setup = Setup::new(
             py,
             "Estimator",
@@ -316,12 +318,21 @@ impl PyEstimator {
     /// Start-up at a known rotor angle `theta0` (rad, electrical) with the present current
     /// (docs/method/estimator.md, "Start-up"): λ1 = λ̂f·e^{jθ0} + L̂q·i, D̂ = 0, θ̂ = θ0, ω̂ = 0, limiter mode.
     /// Non-finite arguments raise `InputError` naming them.
-    #[pyo3(signature = (theta0, i_alpha = 0.0, i_beta = 0.0))]
-    fn align(&mut self, py: Python<'_>, theta0: f64, i_alpha: f64, i_beta: f64) -> PyResult<()> {
-        let theta0 = finite(py, "theta0", theta0)?;
+    #[pyo3(
+        signature = (theta0, i_alpha = None, i_beta = None),
+        text_signature = "(self, theta0, i_alpha=0.0, i_beta=0.0)"
+    )]
+    fn align(
+        &mut self,
+        py: Python<'_>,
+        theta0: Bound<'_, PyAny>,
+        i_alpha: Option<Bound<'_, PyAny>>,
+        i_beta: Option<Bound<'_, PyAny>>,
+    ) -> PyResult<()> {
+        let theta0 = finite(py, "theta0", number(py, "theta0", Some(&theta0), 0.0)?)?;
         let i = [
-            finite(py, "i_alpha", i_alpha)?,
-            finite(py, "i_beta", i_beta)?,
+            finite(py, "i_alpha", number(py, "i_alpha", i_alpha.as_ref(), 0.0)?)?,
+            finite(py, "i_beta", number(py, "i_beta", i_beta.as_ref(), 0.0)?)?,
         ];
         self.engine.align(theta0, i);
         Ok(())
@@ -334,7 +345,8 @@ impl PyEstimator {
 
     /// Replaces R̂s at run time (e.g. online resistance adaptation); raises `ConfigError` for
     /// a bad value and leaves the estimator unchanged.
-    fn set_rs_hat(&mut self, py: Python<'_>, rs_hat: f64) -> PyResult<()> {
+    fn set_rs_hat(&mut self, py: Python<'_>, rs_hat: Bound<'_, PyAny>) -> PyResult<()> {
+        let rs_hat = number(py, "rs_hat", Some(&rs_hat), 0.0)?;
         match &mut self.engine {
             Engine::F64(e) => e.set_rs_hat(rs_hat),
             Engine::F32(e) => e.set_rs_hat(rs_hat as f32),
@@ -398,7 +410,7 @@ pub const DEFAULT_TS: f64 = 1e-4;
 /// few milliseconds (`KeyboardInterrupt`).
 #[pyfunction]
 #[pyo3(
-    signature = (v_alpha, v_beta, i_alpha, i_beta, *, machine = None, ts = DEFAULT_TS, config = None, theta0 = None, dtype = Dtype::Float64),
+    signature = (v_alpha, v_beta, i_alpha, i_beta, *, machine = None, ts = None, config = None, theta0 = None, dtype = Dtype::Float64),
     text_signature = "(v_alpha, v_beta, i_alpha, i_beta, *, machine, ts=0.0001, config=None, theta0=None, dtype='float64')"
 )]
 #[allow(clippy::too_many_arguments)]
@@ -409,15 +421,23 @@ pub fn estimate(
     i_alpha: &Bound<'_, PyAny>,
     i_beta: &Bound<'_, PyAny>,
     machine: Option<Bound<'_, PyAny>>,
-    ts: f64,
+    ts: Option<Bound<'_, PyAny>>,
     config: Option<Bound<'_, PyAny>>,
-    theta0: Option<f64>,
+    theta0: Option<Bound<'_, PyAny>>,
     dtype: Dtype,
 ) -> PyResult<EstimateResult> {
-    let theta0 = theta0.map(|t| finite(py, "theta0", t)).transpose()?;
+    let ts = number(py, "ts", ts.as_ref(), DEFAULT_TS)?;
+    let theta0 = match theta0 {
+        Some(t) => Some(finite(py, "theta0", number(py, "theta0", Some(&t), 0.0)?)?),
+        None => None,
+    };
     let setup = Setup::new(py, "estimate", machine.as_ref(), config.as_ref(), ts, 0.0)?;
     let signals = Signals::new(v_alpha, v_beta, i_alpha, i_beta)?;
     let mut engine = Engine::new(py, &setup, dtype)?;
+    let core = setup.core::<f64>(py)?;
+    if let Ok(bounds) = core.sample_bounds() {
+        crate::recording_checks::warn_all(py, &signals, &bounds, core.machine.rs, theta0)?;
+    }
     if let Some(theta0) = theta0 {
         let [_, _, ia, ib] = signals.slices();
         let first = |c: ColumnSlice<'_>| match c {

@@ -210,7 +210,7 @@ pub fn inverter_values(
     let f_sw = match number(given, "switching_frequency") {
         Some(f) => f,
         None => {
-            let f = ratings::switching_frequency(machine.pole_pairs, machine.rated_speed_rpm);
+            let f = ratings::switching_frequency(machine.pole_pairs, machine.rated_speed_rpm, dc);
             out.push(("switching_frequency", f));
             f
         }

@@ -417,7 +417,8 @@ impl<T: Real> ReleaseHold<T> {
         let step = self.resume_step;
         let gap = speed_ref - self.resumed;
         // NaN compares false: a non-finite reference ends the ramp (the speed loop refuses it).
-        if !(gap.abs() > step) {
+        let beyond = gap.abs() > step;
+        if !beyond {
             self.resuming = false;
             return speed_ref;
         }

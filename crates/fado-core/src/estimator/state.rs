@@ -6,7 +6,7 @@ use crate::active_flux::{ActiveFlux, ActiveFluxPoint};
 use crate::error::ConfigError;
 use crate::integrand_offset::IntegrandOffsetState;
 use crate::lock::LockState;
-use crate::magnetics::FluxWarmStart;
+use crate::magnetics::{FluxLookup, FluxWarmStart};
 use crate::mode::Mode;
 use crate::observer::ObserverState;
 use crate::rotor_flux::{rotor_angle, rotor_flux, stator_flux};
@@ -40,21 +40,7 @@ impl<T: Real> EstimatorState<T> {
         } else {
             T::zero()
         };
-        // The active flux λ̂f + (L̂d − L̂q)·i_d (λ̂f exactly for L̂d = L̂q), or a saturating
-        // model's at the current in the aligned frame, with its secant L̂q.
-        let rotor = Ab::from_polar(T::one(), theta0);
-        let (active, lq) = match p.active_flux.saturating() {
-            None => (p.flux_linkage + p.saliency * rotor.dot(i_ab), p.lq),
-            Some(af) => {
-                let point = af.point(ActiveFlux::frame_current(rotor, i_ab));
-                (point.active, point.lq_secant)
-            }
-        };
-        let (active, lq) = if active.is_finite() && active > T::zero() && lq.is_finite() {
-            (active, lq)
-        } else {
-            (p.flux_linkage, p.lq)
-        };
+        let (active, lq) = Self::aligned_active(p, theta0, i_ab);
         self.lq_secant = lq;
         self.flux_warm = FluxWarmStart::empty();
         let lambda_r = Ab::from_polar(active, theta0);
@@ -75,8 +61,19 @@ impl<T: Real> EstimatorState<T> {
             } else {
                 Ab::zero()
             });
+        // A saturating model's observer follows a rotating vector of the low-passed active
+        // flux, which starts at the aligned one (`crate::active_flux`).
+        self.swing_reference = if p.active_flux.is_saturating() {
+            active
+        } else {
+            p.flux_linkage
+        };
+        let reference = match p.active_flux.saturating() {
+            Some(af) => af.observer_reference(active),
+            None => p.flux_linkage,
+        };
         self.observer = ObserverState::at(if p.observer_on_rotor_flux {
-            Ab::from_polar(p.flux_linkage, theta0)
+            Ab::from_polar(reference, theta0)
         } else {
             lambda1
         });
@@ -106,6 +103,25 @@ impl<T: Real> EstimatorState<T> {
         self.step_allowance = p.bounds.step();
     }
 
+    /// The active flux λ̂f + (L̂d − L̂q)·i_d (λ̂f exactly for L̂d = L̂q), or a saturating
+    /// model's at the current in the frame aligned at `theta0`, with its secant L̂q; λ̂f and
+    /// L̂q where that is not a positive finite flux.
+    fn aligned_active(p: &EstimatorParams<T>, theta0: T, i_ab: Ab<T>) -> (T, T) {
+        let rotor = Ab::from_polar(T::one(), theta0);
+        let (active, lq) = match p.active_flux.saturating() {
+            None => (p.flux_linkage + p.saliency * rotor.dot(i_ab), p.lq),
+            Some(af) => {
+                let point = af.point(ActiveFlux::frame_current(rotor, i_ab));
+                (point.active, point.lq_secant)
+            }
+        };
+        if active.is_finite() && active > T::zero() && lq.is_finite() {
+            (active, lq)
+        } else {
+            (p.flux_linkage, p.lq)
+        }
+    }
+
     /// One sample (Fig. 5) with the parameters `p` this state was made for: as
     /// [`SensorlessEstimator::step`](crate::SensorlessEstimator::step).
     #[inline]
@@ -123,6 +139,24 @@ impl<T: Real> EstimatorState<T> {
         i_ab: Ab<T>,
     ) -> LeanEstimate<T> {
         self.advance(p, v_ab, i_ab)
+    }
+
+    /// [`Self::step_lean`] with the machine's model named by its type: `model` is the table
+    /// `p`'s machine borrows (`MachineMagnetics::Uniform(&MAP)` with `MAP = TABLE.map()`,
+    /// `model = &TABLE`), so that the saturating step is compiled for that table — its
+    /// lookups inlined with the grid's shape a constant, no match on the model and no index
+    /// checked (docs/results/firmware-cost.md, "Flux map"). The same estimate as
+    /// [`Self::step_lean`]; where `model` is not `p`'s model (or `p`'s machine has constant
+    /// inductances), [`Self::step_lean`] itself.
+    #[inline]
+    pub fn step_lean_in<M: FluxLookup<T>>(
+        &mut self,
+        p: &EstimatorParams<T>,
+        model: M,
+        v_ab: Ab<T>,
+        i_ab: Ab<T>,
+    ) -> LeanEstimate<T> {
+        self.advance_in(p, model, v_ab, i_ab)
     }
 
     /// λ̂a/λ̂f = 1 + (L̂d − L̂q)·î_d/λ̂f, the active flux the limiter circle and the lock
@@ -162,17 +196,18 @@ impl<T: Real> EstimatorState<T> {
     /// (≈ λ̂f·e^{jθ̂}, no extra state), î_d the current along it. Zero while that vector is
     /// below the tracker's hold level (no usable axis).
     #[inline]
-    pub(super) fn active_flux_swing<const SATURATING: bool>(
+    pub(super) fn active_flux_swing<M: FluxLookup<T>, const SATURATING: bool>(
         &self,
         p: &EstimatorParams<T>,
+        af: &ActiveFlux<T, M>,
         i_ab: Ab<T>,
         saliency: T,
     ) -> (Ab<T>, FluxWarmStart<T>) {
         let axis = self.observer.flux() - self.observer.disturbance();
         let n2 = axis.norm_squared();
         if SATURATING {
-            // A saturating model: λ̂a(î) − ψd(0, 0) along the axis, î in its frame.
-            let af = &p.active_flux;
+            // A saturating model: λ̂a(î) less the observer's reference along the axis, î in
+            // its frame (`ActiveFlux::observer_reference`).
             return if n2 > p.hold_level_sq {
                 // The axis is the estimated active flux: the last sample's solution (in a
                 // frame within a sample's turn of this one) starts the model's flux, else
@@ -180,7 +215,8 @@ impl<T: Real> EstimatorState<T> {
                 let i_dq = ActiveFlux::frame_current(axis, i_ab);
                 let guess = ActiveFlux::frame_current(axis, axis + i_ab * self.lq_secant);
                 let (point, warm) = af.point_warm(i_dq, guess, &self.flux_warm);
-                let swing = axis * ((point.active - af.magnet_flux()) / n2.step_sqrt());
+                let reference = af.observer_reference(self.swing_reference);
+                let swing = axis * ((point.active - reference) / n2.step_sqrt());
                 (swing, warm)
             } else {
                 (Ab::zero(), self.flux_warm)

@@ -217,3 +217,141 @@ fn a_switching_frequency_in_khz_is_named() {
     let f = first(&paper(), Some(0.5 / 20.0));
     assert!(f.to_string().contains("kHz where Hz is meant"), "{f}");
 }
+
+/// `m` with its DC link derived from its ratings, as a motor file without `dc_voltage` gets it.
+fn derived_dc_link(mut m: MachineModel<f64>) -> MachineModel<f64> {
+    m.dc_voltage = ratings::dc_voltage(&m);
+    m
+}
+
+/// `m` with its three ratings multiplied by `k`.
+fn ratings_times(m: &MachineModel<f64>, k: f64) -> MachineModel<f64> {
+    MachineModel {
+        rated_current: m.rated_current * k,
+        rated_speed_rpm: m.rated_speed_rpm * k,
+        rated_torque: m.rated_torque * k,
+        ..*m
+    }
+}
+
+#[test]
+fn ratings_scaled_together_are_named_where_the_dc_link_is_derived() {
+    // With the DC link derived from the ratings, / 10 and × 10 keep the torque, the resistance
+    // and the DC link consistent; the armature reaction and ω·L/R name them.
+    for m in [paper(), ipmsm()] {
+        assert!(check(&derived_dc_link(m), Some(100e-6)).is_empty());
+        let low = derived_dc_link(ratings_times(&m, 0.1));
+        let f = check(&low, Some(100e-6));
+        let scale = f
+            .iter()
+            .find(|f| matches!(f, Finding::RatingScale { .. }))
+            .unwrap_or_else(|| panic!("{f:?}"));
+        assert_eq!(scale.severity(), Severity::Warning);
+        assert!(scale.to_string().contains("divided by 10"), "{scale}");
+        for k in RATING_KEYS_OF_SCALE {
+            assert!(scale.keys().contains(&k), "{k}");
+        }
+        let high = derived_dc_link(ratings_times(&m, 10.0));
+        let f = check(&high, Some(10e-6));
+        let scale = f
+            .iter()
+            .find(|f| matches!(f, Finding::RatingScale { .. }))
+            .unwrap_or_else(|| panic!("{f:?}"));
+        assert!(scale.to_string().contains("multiplied by 10"), "{scale}");
+    }
+}
+
+const RATING_KEYS_OF_SCALE: [&str; 3] = ["rated_current", "rated_speed_rpm", "rated_torque"];
+
+#[test]
+fn a_rated_speed_times_ten_on_a_drone_motor_is_named_by_its_electrical_frequency() {
+    // 14 pole pairs at 70,000 r/min (7,000 × 10): 16 kHz electrical.
+    let m = MachineModel::<f64> {
+        rs: 0.05,
+        ld: 25e-6,
+        lq: 25e-6,
+        flux_linkage: 1.1e-3,
+        pole_pairs: 14,
+        inertia: 1e-5,
+        viscous_friction: 0.0,
+        rated_current: 30.0,
+        rated_speed_rpm: 7000.0,
+        rated_torque: 0.69,
+        dc_voltage: 22.2,
+        magnetics: Default::default(),
+    };
+    assert!(
+        !check(&m, None)
+            .iter()
+            .any(|f| matches!(f, Finding::ElectricalFrequency { .. }))
+    );
+    let fast = derived_dc_link(ratings_times(&m, 10.0));
+    let f = check(&fast, None);
+    let e = f
+        .iter()
+        .find(|f| matches!(f, Finding::ElectricalFrequency { .. }))
+        .unwrap_or_else(|| panic!("{f:?}"));
+    assert_eq!(e.keys(), &["rated_speed_rpm", "pole_pairs"]);
+}
+
+#[test]
+fn a_flux_linkage_slip_on_a_salient_rotor_is_named() {
+    // The 2.2 kW IPMSM with λf given rms: 1.29 × the model's torque, inside the wide band;
+    // undoing the slip brings it to 0.93.
+    let mut m = ipmsm();
+    m.flux_linkage /= 2f64.step_sqrt();
+    let f = first(&m, None);
+    assert!(
+        matches!(
+            f,
+            Finding::Torque {
+                slip: TorqueSlip::Rms,
+                ..
+            }
+        ),
+        "{f}"
+    );
+    assert!(f.to_string().contains("rms where peak is meant"), "{f}");
+    // λf from a line-to-line constant on the 6-pole IPMSM: 0.54, and 3 pole pairs are not a
+    // pole count.
+    let mut m = ipmsm();
+    m.flux_linkage *= 3f64.step_sqrt();
+    let f = first(&m, None);
+    assert!(f.to_string().contains("line-to-line"), "{f}");
+    assert!(!f.to_string().contains("pole count"), "{f}");
+    // A strongly salient IPMSM (motors/ipmsm-gem-50k.toml, Lq/Ld 3.2): line-to-line λf moves
+    // the ratio to 0.79 only, which the undone slip brings back to 1.0.
+    let gem = MachineModel::<f64> {
+        rs: 0.018,
+        ld: 0.37e-3,
+        lq: 1.2e-3,
+        flux_linkage: 0.066,
+        pole_pairs: 3,
+        inertia: 0.1,
+        viscous_friction: 0.0,
+        rated_current: 240.0,
+        rated_speed_rpm: 3000.0,
+        rated_torque: 160.6,
+        dc_voltage: 520.0,
+        magnetics: Default::default(),
+    };
+    assert!(check(&gem, None).is_empty());
+    let mut m = gem;
+    m.flux_linkage *= 3f64.step_sqrt();
+    let f = check(&m, None);
+    let t = f
+        .iter()
+        .find(|f| matches!(f, Finding::Torque { .. }))
+        .unwrap_or_else(|| panic!("{f:?}"));
+    assert!(t.to_string().contains("line-to-line"), "{t}");
+}
+
+#[test]
+fn a_motor_without_magnet_is_refused_saying_why() {
+    let mut m = ipmsm();
+    m.flux_linkage = 0.0;
+    let f = first(&m, None);
+    assert_eq!((f.key(), f.severity()), ("flux_linkage", Severity::Error));
+    assert!(f.to_string().contains("synchronous reluctance"), "{f}");
+    assert!(f.to_string().contains("must be positive"), "{f}");
+}

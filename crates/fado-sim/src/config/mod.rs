@@ -219,10 +219,43 @@ impl SimConfig {
         for e in crate::estimators::ESTIMATORS {
             (e.check)(self)?;
         }
+        self.check_current_loop_sampling()?;
         self.drive_config()
             .validate()
             .map_err(|e| self.core_error("controller", e))?;
         Ok(())
+    }
+
+    /// The current loop's bandwidth within what the sampling allows (2π·f_c·Ts ≤ 0.5, the
+    /// core's bound): refused naming the switching frequency when the bandwidth is the
+    /// default (a slow inverter, e.g. a medium-voltage one at 1 kHz), the bandwidth when the
+    /// file sets it; the message gives both values that pass.
+    fn check_current_loop_sampling(&self) -> Result<(), SimConfigError> {
+        let (bw, ts) = (
+            self.controller.current.bandwidth_hz,
+            self.inverter.sample_period(),
+        );
+        let x = std::f64::consts::TAU * bw * ts;
+        if !x.is_finite() || x <= 0.5 {
+            return Ok(());
+        }
+        let f_min = std::f64::consts::TAU * bw / (2.0 * 0.5);
+        let bw_max = 0.5 / (std::f64::consts::TAU * ts);
+        let key = if bw == SimConfig::default().controller.current.bandwidth_hz {
+            "inverter.switching_frequency"
+        } else {
+            "controller.current.bandwidth_hz"
+        };
+        Err(SimConfigError::new(
+            key,
+            format!(
+                "the current loop's bandwidth `controller.current.bandwidth_hz` = {bw} Hz \
+                 needs 2π·f_c·Ts ≤ 0.5, and `inverter.switching_frequency` = {} Hz samples \
+                 at Ts = {ts:.3e} s (2π·f_c·Ts = {x:.3}): raise switching_frequency to at \
+                 least {f_min:.0} Hz or lower bandwidth_hz to at most {bw_max:.1} Hz",
+                self.inverter.switching_frequency
+            ),
+        ))
     }
 
     /// The drive's model of the motor derived from the plant: `[motor]` (R̂s: Rs + r_on of

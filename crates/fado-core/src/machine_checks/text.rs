@@ -1,0 +1,220 @@
+//! The words of each [`Finding`]: what was found, every key involved and the likely slip.
+
+use core::fmt;
+
+use super::{
+    Finding, MAX_ELECTRICAL_FREQUENCY, RESISTANCE_ERROR, SCALE_LOW, Severity, TORQUE_KEYS_SALIENT,
+    TorqueSlip,
+};
+use crate::ratings::{MAX_OMEGA_TS, MAX_RUNNING_OMEGA_TS};
+
+/// `keys` as "`a`, `b` and `c`".
+fn write_keys(f: &mut fmt::Formatter<'_>, keys: &[&str]) -> fmt::Result {
+    for (k, key) in keys.iter().enumerate() {
+        if k > 0 {
+            f.write_str(if k + 1 == keys.len() { " and " } else { ", " })?;
+        }
+        write!(f, "`{key}`")?;
+    }
+    Ok(())
+}
+
+/// The text of [`Finding::Torque`]: the ratio, the torque it compares with, the likely slip.
+fn write_torque(
+    f: &mut fmt::Formatter<'_>,
+    ratio: f64,
+    severity: Severity,
+    slip: TorqueSlip,
+) -> fmt::Result {
+    if severity == Severity::Error {
+        write!(
+            f,
+            "`rated_torque` is {ratio:.3} × the magnet torque 1.5·p·λf·I at \
+             `rated_current` (from `flux_linkage` and `pole_pairs`)"
+        )?;
+    } else {
+        write!(
+            f,
+            "`rated_torque` is {ratio:.3} × the torque the model gives at \
+             `rated_current` on the MTPA point (from "
+        )?;
+        write_keys(f, &TORQUE_KEYS_SALIENT[2..])?;
+        f.write_str(")")?;
+    }
+    if (0.3e-3..3e-3).contains(&ratio) {
+        return f.write_str(": `flux_linkage` in mWb where Wb is meant?");
+    } else if (300.0..3000.0).contains(&ratio) {
+        return f.write_str(": `flux_linkage` in Wb where mWb is meant, or `rated_current` in mA?");
+    }
+    match slip {
+        TorqueSlip::Rms => f.write_str(
+            ": rms where peak is meant (√2 = 1.41)? Give the current in A peak and λf in Wb peak",
+        ),
+        TorqueSlip::PoleCount => f.write_str(
+            ": `pole_pairs` a pole count (the model's torque twice the rating), or `ld`/`lq` off?",
+        ),
+        TorqueSlip::LineToLine => f.write_str(
+            ": λf from a line-to-line constant where the phase value is meant (√3 = 1.73)? \
+             Give λf in Wb peak per phase",
+        ),
+        TorqueSlip::Unknown => {
+            f.write_str(": check the units (λf in Wb peak per phase, current in A peak)")
+        }
+    }
+}
+
+/// The text of [`Finding::Sampling`]: the angle per sample and what it costs.
+fn write_sampling(
+    f: &mut fmt::Formatter<'_>,
+    omega_ts: f64,
+    switching_frequency: f64,
+    severity: Severity,
+) -> fmt::Result {
+    write!(
+        f,
+        "the rotor turns ω_rated·Ts = {omega_ts:.3} rad per sample at rated speed \
+         (`rated_speed_rpm`, `pole_pairs`, sampling period `ts`)"
+    )?;
+    if severity == Severity::Error {
+        f.write_str(
+            ", more than π: the angle cannot be sampled (a sampling period in ms \
+             where s is meant, or a switching frequency in kHz where Hz is meant?)",
+        )
+    } else {
+        write!(
+            f,
+            "; the drive's angle estimate degrades above {MAX_RUNNING_OMEGA_TS} and \
+             commissioning needs at most {MAX_OMEGA_TS} (switching frequency ≥ \
+             {switching_frequency} Hz)"
+        )
+    }
+}
+
+/// The text of [`Finding::RatingScale`]: both per-unit quantities and the direction.
+fn write_scale(f: &mut fmt::Formatter<'_>, reaction: f64, x_over_r: f64) -> fmt::Result {
+    write!(
+        f,
+        "the ratings look scaled: the armature reaction L·`rated_current`/ψ is \
+         {reaction:.3} per unit and the reactance at `rated_speed_rpm` over `rs` ω·L/R is \
+         {x_over_r:.3} (their product {:.3}; machines have 0.2–40)",
+        reaction * x_over_r
+    )?;
+    if reaction * x_over_r < SCALE_LOW {
+        f.write_str(": are `rated_current`, `rated_speed_rpm` and `rated_torque` divided by 10?")
+    } else {
+        f.write_str(
+            ": are `rated_current`, `rated_speed_rpm` and `rated_torque` multiplied by 10, or \
+             `rs` 1000 × too small?",
+        )
+    }
+}
+
+/// The text of [`Finding::Reactance`]: the per-unit value and the likely unit slip.
+fn write_reactance(f: &mut fmt::Formatter<'_>, key: &str, per_unit: f64) -> fmt::Result {
+    write!(
+        f,
+        "`{key}` is {per_unit:.3e} per unit (L·`rated_current` over the larger of \
+         `flux_linkage` and `rated_torque`/(1.5·p·`rated_current`); machines have 0.05–5)"
+    )?;
+    if per_unit > 50.0 && per_unit * 1e-3 < 5.0 {
+        write!(f, ": mH where H is meant? ({key} × 1e-3)")
+    } else {
+        f.write_str(": check its unit (H)")
+    }
+}
+
+/// The text of [`Finding::Resistance`]: the per-unit drop and the likely slip.
+fn write_resistance(f: &mut fmt::Formatter<'_>, per_unit: f64) -> fmt::Result {
+    write!(
+        f,
+        "`rs` drops {per_unit:.3} × the rated back-EMF at `rated_current` (Rs·I/(ω·λf) from \
+         `flux_linkage` and `rated_speed_rpm`; machines have 0.005–0.3)"
+    )?;
+    if per_unit > RESISTANCE_ERROR && per_unit * 1e-3 < 0.5 {
+        f.write_str(
+            ": mΩ where Ω is meant, or `rated_speed_rpm` in r/s or rad/s where r/min is meant?",
+        )
+    } else if per_unit <= RESISTANCE_ERROR {
+        f.write_str(
+            ": check its unit (Ω per phase) and the ratings (`rated_speed_rpm` in rad/s where \
+             r/min is meant makes it 9.55 × too large)",
+        )
+    } else {
+        f.write_str(": check its unit (Ω per phase) and the ratings")
+    }
+}
+
+impl fmt::Display for Finding {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            Finding::NoMagnet => f.write_str(
+                "`flux_linkage` must be positive: λf = 0 is a synchronous reluctance motor \
+                 without magnet, outside this method. The estimator takes the rotor's angle \
+                 from the rotor flux λs − Lq·i, of magnitude λf + (Ld − Lq)·id, and its \
+                 limiter holds that magnitude at λ̂f at standstill: without a magnet it \
+                 vanishes at zero d current, and the angle with it. A PM-assisted SyRM is \
+                 entered with its magnet's λf (motors/pmsyrm-5k.toml: 0.134 Wb)",
+            ),
+            Finding::Range {
+                key,
+                value,
+                max,
+                unit,
+            } => write!(
+                f,
+                "`{key}` = {value:e} {unit} is beyond any motor (at most {max:e} {unit}): check its unit"
+            ),
+            Finding::PoleCount { pole_pairs, ratio } => write!(
+                f,
+                "`pole_pairs` = {pole_pairs} looks like a pole count: {}? With it the model \
+                 gives {:.2} × `rated_torque` at `rated_current` (on the MTPA point, with \
+                 `flux_linkage`)",
+                pole_pairs / 2,
+                1.0 / ratio
+            ),
+            Finding::Torque {
+                ratio,
+                severity,
+                slip,
+            } => write_torque(f, ratio, severity, slip),
+            Finding::RatingScale { reaction, x_over_r } => write_scale(f, reaction, x_over_r),
+            Finding::ElectricalFrequency { frequency } => write!(
+                f,
+                "the rated electrical frequency p·`rated_speed_rpm`/60 with `pole_pairs` is \
+                 {frequency:.0} Hz, above the {MAX_ELECTRICAL_FREQUENCY} Hz of the fastest \
+                 motors: is `rated_speed_rpm` × 10, or `pole_pairs` a pole count?"
+            ),
+            Finding::BackEmf { ratio } => write!(
+                f,
+                "the back-EMF at rated speed ω·λf (`flux_linkage`, `rated_speed_rpm`, \
+                 `pole_pairs`) is {ratio:.2} × the phase voltage the DC link `dc_voltage` can \
+                 make (Vdc/√3): check their units (λf in Wb peak per phase) and the DC link"
+            ),
+            Finding::DcLinkOversized { ratio, .. } => write!(
+                f,
+                "the rated point (`rated_speed_rpm`, `rated_current`, `rated_torque`) needs only \
+                 {:.1} % of the phase voltage the DC link `dc_voltage` makes (Vdc/√3): are the \
+                 ratings divided by 10, or the DC link the wrong one?",
+                100.0 * ratio
+            ),
+            Finding::Reactance { key, per_unit, .. } => write_reactance(f, key, per_unit),
+            Finding::Resistance { per_unit, .. } => write_resistance(f, per_unit),
+            Finding::TimeConstant { tau } => write!(
+                f,
+                "the electrical time constant min(`ld`, `lq`)/`rs` is {tau:.3} s, unusually long \
+                 (motors have 0.1–100 ms): check the units of rs (Ω) and ld, lq (H)"
+            ),
+            Finding::Saliency { ld, lq } => write!(
+                f,
+                "`ld` = {ld:e} H is {:.2} × `lq` = {lq:e} H: a magnet rotor has Ld ≤ Lq (the \
+                 magnet is in the d-axis path); are ld and lq swapped?",
+                ld / lq
+            ),
+            Finding::Sampling {
+                omega_ts,
+                switching_frequency,
+                severity,
+            } => write_sampling(f, omega_ts, switching_frequency, severity),
+        }
+    }
+}
