@@ -157,28 +157,6 @@ impl<T: Real> ActiveFlux<T> {
         }
     }
 
-    /// [`ActiveFlux::point`] with the model's ψ(i_dq) solved from `psi_guess`, a flux near it
-    /// in the same frame (the estimated stator flux there): one or two Newton steps where the
-    /// model's ψ(i) is an inversion ([`MagneticModel::flux_from`]).
-    #[inline]
-    pub fn point_from(&self, i_dq: Dq<T>, psi_guess: Dq<T>) -> ActiveFluxPoint<T> {
-        let psi = self.model.resolve(self.linear).flux_from(i_dq, psi_guess);
-        self.point_at(i_dq, psi)
-    }
-
-    /// The current `i_ab` (or any α-β vector) in the frame whose d axis is `axis` (any length;
-    /// zero for a zero or non-finite axis).
-    #[inline]
-    pub fn frame_current(axis: Ab<T>, i_ab: Ab<T>) -> Dq<T> {
-        let n = axis.norm_squared().step_sqrt();
-        if n > T::zero() && n.is_finite() {
-            let k = T::one() / n;
-            Dq::new(axis.dot(i_ab) * k, axis.cross(i_ab) * k)
-        } else {
-            Dq::zero()
-        }
-    }
-
     /// The machine record's model.
     #[inline]
     pub fn model(&self) -> &MachineMagnetics<T> {
@@ -250,7 +228,20 @@ impl<T: Real, M: FluxLookup<T>> ActiveFlux<T, M> {
     pub fn point(&self, i_dq: Dq<T>) -> ActiveFluxPoint<T> {
         self.point_at(i_dq, self.flux(i_dq))
     }
+}
 
+impl<T: Real> ActiveFlux<T> {
+    /// [`ActiveFlux::point`] with the model's ψ(i_dq) solved from `psi_guess`, a flux near it
+    /// in the same frame (the estimated stator flux there): one or two Newton steps where the
+    /// model's ψ(i) is an inversion ([`MagneticModel::flux_from`]).
+    #[inline]
+    pub fn point_from(&self, i_dq: Dq<T>, psi_guess: Dq<T>) -> ActiveFluxPoint<T> {
+        let psi = self.model.resolve(self.linear).flux_from(i_dq, psi_guess);
+        self.point_at(i_dq, psi)
+    }
+}
+
+impl<T: Real, M: FluxLookup<T>> ActiveFlux<T, M> {
     /// [`ActiveFlux::point_from`] with an iterative ψ(i) started from `warm`, the last
     /// solution in a frame near this one (`psi_guess` while it is empty), and the warm start
     /// holding this solution ([`Magnetics::flux_warm`](crate::magnetics::Magnetics::flux_warm)):
@@ -286,7 +277,24 @@ impl<T: Real, M: FluxLookup<T>> ActiveFlux<T, M> {
             active: psi.d - lq_secant * i_dq.d,
         }
     }
+}
 
+impl<T: Real> ActiveFlux<T> {
+    /// The current `i_ab` (or any α-β vector) in the frame whose d axis is `axis` (any length;
+    /// zero for a zero or non-finite axis).
+    #[inline]
+    pub fn frame_current(axis: Ab<T>, i_ab: Ab<T>) -> Dq<T> {
+        let n = axis.norm_squared().step_sqrt();
+        if n > T::zero() && n.is_finite() {
+            let k = T::one() / n;
+            Dq::new(axis.dot(i_ab) * k, axis.cross(i_ab) * k)
+        } else {
+            Dq::zero()
+        }
+    }
+}
+
+impl<T: Real, M: FluxLookup<T>> ActiveFlux<T, M> {
     /// λ̂r = λ2 − L_q,s(î)·i with î in the frame of λ2 − `lq_prev`·i (module docs), and the
     /// operating point it used.
     #[inline]
