@@ -55,3 +55,18 @@ def test_a_half_map_in_i_q_is_refused_naming_the_symmetry(replay_script) -> None
     case = next(c for c in sr.cases(True) if "half map" in c.name)
     with pytest.raises(ValueError, match="the arrays' grid: the i_q axis does not reach both"):
         sr.fado_machine(fado, case)
+
+
+def test_a_weak_magnet_pm_syrm_holds_the_angle_at_65_percent(replay_script) -> None:
+    """motulator's 6.7 kW SyRM with a 3 A magnet MMF (39 mVs) at 65 % of rated torque: the
+    no-load injection goes along −d (fado's drive's rule), and the replay with the default
+    R̂s adaptation holds the angle (docs/results/saturated-replay.md)."""
+    sr = replay_script
+    case = next(c for c in sr.cases(False) if c.name == "syrm-6k7 + 3 A magnet MMF")
+    assert sr.injection_sign(case.machine) == -1.0
+    ipm = next(c for c in sr.cases(False) if c.name == "ipm-cross20")
+    assert sr.injection_sign(ipm.machine) == 1.0
+    rec = sr.simulate(case.machine, 0.65)
+    err, rs_lo, rs_hi = sr.replay(fado, case, rec)
+    assert err < 0.25, err
+    assert 0.95 < rs_lo and rs_hi < 1.05, (rs_lo, rs_hi)
