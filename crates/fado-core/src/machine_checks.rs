@@ -20,6 +20,8 @@
 //! | time constant | min(Ld, Lq)/R | above 2 s | — |
 //! | saliency | Ld / Lq | above 1.1 (swapped?) | — |
 //! | sampling | ω·Ts | above [`crate::ratings::MAX_RUNNING_OMEGA_TS`] | above π (Ts in ms for s? f_sw in kHz for Hz?) |
+//! | friction | B·ω_rated,mech / T_rated | above 0.2 | above 1 (the rated point cannot be reached; N·m·s per krpm or per r/min?) |
+//! | inertia | start time J·ω_rated,mech / T_rated | above 60 s (kg·cm² or g·m² for kg·m²?) | — |
 //! | rating scale | (L·I/ψ)·(ω·L/R) | below [`SCALE_LOW`] (ratings / 10?), above [`SCALE_HIGH`] (ratings × 10?) | — |
 //! | electrical frequency | ω_rated/2π | above [`MAX_ELECTRICAL_FREQUENCY`] (r/min × 10? a pole count?) | — |
 //!
@@ -141,6 +143,18 @@ pub enum Finding {
         severity: Severity,
         /// The likeliest slip.
         slip: TorqueSlip,
+    },
+    /// The viscous friction takes a large share of the rated torque at rated speed.
+    Friction {
+        /// B·ω_rated,mech / T_rated.
+        ratio: f64,
+        /// Warning or error.
+        severity: Severity,
+    },
+    /// The rated torque takes long to accelerate the inertia to rated speed.
+    Inertia {
+        /// J·ω_rated,mech / T_rated, s.
+        start_time: f64,
     },
     /// The ratings look scaled together (/ 10 or × 10): see [`SCALE_LOW`].
     RatingScale {
@@ -295,6 +309,12 @@ const SCALE_KEYS: &[&str] = &[
     "rs",
 ];
 const FREQUENCY_KEYS: &[&str] = &["rated_speed_rpm", "pole_pairs"];
+const EMF_KEYS_DC_FIRST: &[&str] = &[
+    "dc_voltage",
+    "flux_linkage",
+    "rated_speed_rpm",
+    "pole_pairs",
+];
 
 impl Finding {
     /// Warning or error.
@@ -308,10 +328,12 @@ impl Finding {
             | Finding::DcLinkOversized { severity, .. }
             | Finding::Reactance { severity, .. }
             | Finding::Resistance { severity, .. }
-            | Finding::Sampling { severity, .. } => severity,
+            | Finding::Sampling { severity, .. }
+            | Finding::Friction { severity, .. } => severity,
             Finding::TimeConstant { .. }
             | Finding::Saliency { .. }
             | Finding::RatingScale { .. }
+            | Finding::Inertia { .. }
             | Finding::ElectricalFrequency { .. } => Severity::Warning,
         }
     }
@@ -339,6 +361,7 @@ impl Finding {
                 ..
             } => TORQUE_KEYS,
             Finding::Torque { .. } => TORQUE_KEYS_SALIENT,
+            Finding::BackEmf { ratio } if ratio > 300.0 => EMF_KEYS_DC_FIRST,
             Finding::BackEmf { .. } => EMF_KEYS,
             Finding::DcLinkOversized { .. } => DC_LINK_KEYS,
             Finding::Reactance { key, .. } => {
@@ -353,6 +376,8 @@ impl Finding {
             Finding::Saliency { .. } => LD_LQ,
             Finding::Sampling { .. } => SAMPLING_KEYS,
             Finding::RatingScale { .. } => SCALE_KEYS,
+            Finding::Friction { .. } => &["viscous_friction", "rated_torque", "rated_speed_rpm"],
+            Finding::Inertia { .. } => &["inertia", "rated_torque", "rated_speed_rpm"],
             Finding::ElectricalFrequency { .. } => FREQUENCY_KEYS,
         }
     }
@@ -389,7 +414,11 @@ impl Finding {
             Finding::TimeConstant { .. }
             | Finding::Saliency { .. }
             | Finding::RatingScale { .. }
+            | Finding::Inertia { .. }
             | Finding::ElectricalFrequency { .. } => "plausible values",
+            Finding::Friction { .. } => {
+                "a friction torque at rated speed below the rated torque (N·m·s/rad)"
+            }
             Finding::Sampling { .. } => {
                 "a sampling period in s at which the rotor turns less than π per sample at rated speed (ms given as s?)"
             }
@@ -496,6 +525,7 @@ fn check_into(m: &MachineModel<f64>, ts: Option<f64>, out: &mut impl Sink) {
     check_torque(m, out);
     check_reactances(m, out);
     check_resistance(m, out);
+    check_mechanics(m, out);
     let tau = m.ld.min(m.lq) / m.rs;
     if tau > 2.0 {
         out.push(Finding::TimeConstant { tau });
@@ -674,6 +704,27 @@ fn check_torque(m: &MachineModel<f64>, out: &mut impl Sink) {
                 slip,
             });
         }
+    }
+}
+
+/// The friction torque and the start time at rated speed against the rated torque.
+fn check_mechanics(m: &MachineModel<f64>, out: &mut impl Sink) {
+    let w = m.rated_speed_mech();
+    let friction = m.viscous_friction * w / m.rated_torque;
+    if friction > 1.0 {
+        out.push(Finding::Friction {
+            ratio: friction,
+            severity: Severity::Error,
+        });
+    } else if friction > 0.2 {
+        out.push(Finding::Friction {
+            ratio: friction,
+            severity: Severity::Warning,
+        });
+    }
+    let start_time = m.inertia * w / m.rated_torque;
+    if start_time > 60.0 {
+        out.push(Finding::Inertia { start_time });
     }
 }
 

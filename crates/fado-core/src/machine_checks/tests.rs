@@ -355,3 +355,29 @@ fn a_motor_without_magnet_is_refused_saying_why() {
     assert!(f.to_string().contains("synchronous reluctance"), "{f}");
     assert!(f.to_string().contains("must be positive"), "{f}");
 }
+
+#[test]
+fn friction_inertia_and_a_dc_link_in_kv_are_named() {
+    // 1 N·m·s/rad on the 2.2 kW IPMSM: 157 N·m of friction at rated speed against 14 N·m.
+    let mut m = ipmsm();
+    m.viscous_friction = 1.0;
+    let f = first(&m, None);
+    assert_eq!(
+        (f.key(), f.severity()),
+        ("viscous_friction", Severity::Error),
+        "{f}"
+    );
+    m.viscous_friction = 0.03;
+    assert_eq!(first(&m, None).severity(), Severity::Warning);
+    // 15 kg·m² for 0.015: a start time of 168 s, a warning.
+    let mut m = ipmsm();
+    m.inertia = 15.0;
+    let f = first(&m, None);
+    assert!(matches!(f, Finding::Inertia { .. }), "{f}");
+    // 0.54 (kV) for 540 V: the DC link is named first.
+    let mut m = ipmsm();
+    m.dc_voltage = 0.54;
+    let f = first(&m, None);
+    assert_eq!(f.key(), "dc_voltage", "{f}");
+    assert!(f.to_string().contains("kV where V is meant"), "{f}");
+}
