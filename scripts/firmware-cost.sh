@@ -12,12 +12,17 @@
 # in the same run and reported apart (docs/results/firmware-cost.md); scenarios 6 and 7 the
 # same with the observer's gains held as fado's default holds them (paper_kernel_held_step),
 # 8 and 9 the default step on a salient IPMSM, 10 and 11 the same IPMSM saturating, its model a
-# 16 × 16 flux map in flash as a uniform-grid table (MachineMagnetics::Uniform), scenario 12 the whole drive (drive_step) around a simulated motor
+# 16 × 16 flux map in flash as a uniform-grid table (MachineMagnetics::Uniform), stepped by
+# estimator_step_table (EstimatorState::step_lean_in: the step compiled for the table named
+# by its type) with estimator_step (the machine record's model, matched at run time) beside
+# it on the same samples, scenario 12 the whole drive (drive_step) around a simulated motor
 # (docs/results/firmware-cost.md); scenario 13 that flux map alone
 # (examples/cortex-m/src/flux_lookup.rs): one lookup ψ(i) (flux_map_lookup) and its inverse
 # i(ψ) by Newton from a warm start (flux_map_inverse), and the same lookup in the uniform-grid
-# table (uniform_table_lookup: UniformFluxTable::flux) and as the estimator's step makes it
-# (step_map_lookup: the machine record's MachineMagnetics::flux_warm, inlined into the step).
+# table (uniform_table_lookup: UniformFluxTable::flux) and as the estimator's steps make it
+# (step_map_lookup: the machine record's MachineMagnetics::flux_warm, as step_lean inlines it;
+# step_table_lookup: FluxLookup::flux_warm on the table named by its type, as step_lean_in
+# inlines it).
 # Needs qemu-system-arm and binutils-arm-none-eabi (Debian packages of those names).
 # Writes docs/results/firmware-cost.md whole from what it prints (scripts/firmware_cost_page.py).
 # Usage: bash scripts/firmware-cost.sh [STEPS_MEASURED_PER_SCENARIO (default 300)]
@@ -50,7 +55,8 @@ grep -o 'deepest stack: .*' "$run_log" | sed 's/^/    /' || true
 
 echo "== code reachable from the step and from the interrupt"
 for root in estimator_step paper_kernel_step paper_kernel_held_step SysTick drive_step \
-    flux_map_lookup flux_map_inverse uniform_table_lookup step_map_lookup; do
+    flux_map_lookup flux_map_inverse uniform_table_lookup step_map_lookup estimator_step_table \
+    step_table_lookup; do
     { python3 scripts/firmware_cost.py graph "$image" "$root" || true; } |
         grep -E '^(\.text reachable|OK:|FORBIDDEN)' || true
 done
@@ -59,13 +65,13 @@ echo "== instruction trace (QEMU -d exec,nochain -singlestep, filtered to the st
 log=$(mktemp /tmp/fado-firmware-trace.XXXXXX)
 trap 'rm -f "$log" "$run_log"' EXIT
 filter=$(python3 scripts/firmware_cost.py ranges "$image" \
-    estimator_step,paper_kernel_step,paper_kernel_held_step,drive_step,flux_map_lookup,flux_map_inverse,uniform_table_lookup,step_map_lookup \
+    estimator_step,paper_kernel_step,paper_kernel_held_step,drive_step,flux_map_lookup,flux_map_inverse,uniform_table_lookup,step_map_lookup,estimator_step_table,step_table_lookup \
     scenario_marker)
 timeout 900 "${qemu[@]}" -singlestep -d exec,nochain -dfilter "$filter" -D "$log" >/dev/null
 roots=(estimator_step paper_kernel_step paper_kernel_held_step drive_step flux_map_lookup
-    flux_map_inverse uniform_table_lookup step_map_lookup)
+    flux_map_inverse uniform_table_lookup step_map_lookup estimator_step_table step_table_lookup)
 titles=(
-    "fado's step (estimator_step: scenarios 0-1 default, 2-3 fixed R̂s, 4-5 the paper's path, 6-7 the paper's path with the gains held over fado's default period, 8-9 a salient IPMSM, 10-11 the same saturating with a 16 × 16 uniform flux table in flash)"
+    "fado's step (estimator_step: scenarios 0-1 default, 2-3 fixed R̂s, 4-5 the paper's path, 6-7 the paper's path with the gains held over fado's default period, 8-9 a salient IPMSM, 10-11 the same saturating with a 16 × 16 uniform flux table in flash, the machine record's model matched at run time)"
     "the paper's estimator alone (paper_kernel_step, beside fado's paper's path: scenarios 4-5)"
     "the same with the gains held (paper_kernel_held_step, beside scenarios 6-7)"
     "the whole drive (drive_step: SensorlessDrive<f32>::step, fado's estimator inside; scenario 12)"
@@ -73,6 +79,8 @@ titles=(
     "its inverse i(ψ) by Newton from the last current (flux_map_inverse: FluxMap::current_from; scenario 13)"
     "the same lookup in the uniform-grid table (uniform_table_lookup: UniformFluxTable::flux; scenario 13)"
     "the same lookup as the estimator's step makes it (step_map_lookup: MachineMagnetics::flux_warm; scenario 13)"
+    "the step compiled for the table (estimator_step_table: EstimatorState::step_lean_in with the 16 × 16 table named by its type; scenarios 10-11)"
+    "the same lookup as the step compiled for the table makes it (step_table_lookup: FluxLookup::flux_warm; scenario 13)"
 )
 # Each root's steps end at the entry of any other root traced in the same run.
 for k in "${!roots[@]}"; do

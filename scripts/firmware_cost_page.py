@@ -23,6 +23,8 @@ ROOTS = [
     "flux_map_inverse",
     "uniform_table_lookup",
     "step_map_lookup",
+    "estimator_step_table",
+    "step_table_lookup",
 ]
 STEP = re.compile(
     r"scenario (\d+): \d+ of \d+ steps measured: (\d+) instructions \(max \d+\), "
@@ -107,10 +109,18 @@ def page(cycles, text, sizes):
     uniform = need(cycles, "uniform_table_lookup", 13)
     inlined = round(need(cycles, "uniform_table_lookup", ("own", 13)))
     in_step = round(need(cycles, "step_map_lookup", ("own", 13)))
-    # The map's own instructions inside the saturating step (the lookups inlined there).
-    map_in_step = [round(sum(c for k, c in need(cycles, "estimator_step").items()
-                             if isinstance(k, tuple) and k[0] == "file" and k[1] == s
-                             and k[2].startswith("magnetics/uniform"))) for s in (10, 11)]
+    typed = round(need(cycles, "step_table_lookup", ("own", 13)))
+
+    def map_in_step(root):
+        # The map's own instructions inside a saturating step (the lookups inlined there).
+        return [round(sum(c for k, c in need(cycles, root).items()
+                          if isinstance(k, tuple) and k[0] == "file" and k[1] == s
+                          and k[2].startswith(("magnetics/uniform", "magnetics/lookup"))))
+                for s in (10, 11)]
+
+    map_typed, map_record = map_in_step("estimator_step_table"), map_in_step("estimator_step")
+    step_typed = [need(cycles, "estimator_step_table", s)[0] for s in (10, 11)]
+    step_record = [need(cycles, "estimator_step", s)[0] for s in (10, 11)]
     lo, hi = min(kernel + held), max(kernel + held)
     return f"""# Firmware cost on a Cortex-M4F
 
@@ -137,8 +147,10 @@ Regenerate: `bash scripts/firmware-cost.sh` (writes this page whole; needs the
 - **Stack**: painted before each scenario, the lowest overwritten word afterwards.
 - **Scenarios**: the paper's motor at 19.5 Hz and 700 Hz electrical (i_q = 0.4 × rated), and the
   salient `ipmsm-2k2` at 19.5 Hz and 75 Hz (its rated speed), with constant inductances and
-  saturating (its model the 16 × 16 flux map in flash, "Flux map" below); every scenario must
-  keep lock or the image fails (`bash scripts/firmware-run.sh`, run by CI).
+  saturating (its model the 16 × 16 flux map in flash, "Flux map" below: the step compiled for
+  the table and the machine record's step beside it on the same samples, whose estimates must
+  agree bit for bit); every scenario must keep lock or the image fails (`bash
+  scripts/firmware-run.sh`, run by CI).
 
 ## Results
 
@@ -172,59 +184,73 @@ self-saturation and cross-saturation), a `static` `FluxMap` built and checked by
 
 | unit | cycles | `.text` reachable |
 |---|---:|---:|
-| one lookup ψ(i), uniform-grid table (`UniformFluxTable::flux`), inlined in its caller | {fmt(inlined)} | — |
+| **one lookup ψ(i) as the estimator's step makes it**, the table named by its type (`EstimatorState::step_lean_in`: `FluxLookup::flux_warm` on `&UniformFluxTable<f32, 16, 16>`, inlined into the step) | {fmt(typed)} | — |
+| the same out of line, its call frame included | {cell(cycles, "step_table_lookup", 13)} | {fmt(need(text, "step_table_lookup"))} B |
+| one lookup ψ(i), the table borrowed at run time (`UniformFluxTable::flux` through a reference), inlined in its caller | {fmt(inlined)} | — |
 | the same out of line, its call frame included | {cell(cycles, "uniform_table_lookup", 13)} | {fmt(need(text, "uniform_table_lookup"))} B |
-| **one lookup ψ(i) as the estimator's step makes it** (the machine record's `MachineMagnetics::Uniform`, by reference: the match on the model and the lookup, inlined into the step) | {fmt(in_step)} | — |
+| one lookup ψ(i) as the machine record's step makes it (`step_lean`: `MachineMagnetics::Uniform`, the model matched at run time, inlined into the step) | {fmt(in_step)} | — |
 | the same out of line, its call frame included | {cell(cycles, "step_map_lookup", 13)} | {fmt(need(text, "step_map_lookup"))} B |
 | one lookup ψ(i), any rectangular grid (`FluxMap::flux`, bilinear, no Jacobian) | {cell(cycles, "flux_map_lookup", 13)} | {fmt(need(text, "flux_map_lookup"))} B |
 | its inverse i(ψ) from the trajectory's previous current (`FluxMap::current_from`, closed form per cell) | {cell(cycles, "flux_map_inverse", 13)} | {fmt(need(text, "flux_map_inverse"))} B |
 
-The uniform table's lookup is straight-line code: the cell index from the precomputed inverse
-node spacing (no search, no division), clamped by one compare, its eight bilinear coefficients
-(ψd's and ψq's p00, p10 − p00, p01 − p00 and the twist, precomputed per cell and stored side by
-side) loaded from one run, and six multiplications and additions per table; the array's shape
-is in the type, so no index is bounds-checked. The lookup is `#[inline]`, so that a firmware's
-step carries its body without a call: its own cycles (the first row) are the measured
-wrapper's less the wrapper's call frame — the instructions the line tables attribute to the
-image's source rather than fado-core's. The `thumbv7em-none-eabihf` target keeps a frame
-pointer in every function (rustc's target specification: `frame-pointer` always), so an
-out-of-line call also pays `push {{r7, lr}}`, `mov r7, sp` and `pop {{r7, pc}}`, {fmt(uniform[0] - inlined)} cycles
-(the second row). The estimator's step reaches the map through its machine record: the
-active flux's evaluations (`fado_core::active_flux`) match the borrowed model by reference
-(`MachineMagnetics::flux_warm` and `q_flux_offset`, `#[inline(always)]`, as is the uniform
-map's lookup), so that the step carries the lookup's body with no call and no copy of the
-map's record: a lookup costs the step {fmt(in_step)} cycles (the third row: the measured
-unit's own instructions, the match on the model included), {"which meets" if in_step <= 60 else "which misses"}
-the 60-cycle target of a lookup by {fmt(in_step - 60)} cycles: the table's own 60 plus the
-match on the model and the loads of the borrowed map's record (origin, spacings, cells, shape)
-and its cell's bounds check (out of line with its frame: {fmt(need(cycles, "step_map_lookup", 13)[0])}). The table's
-out-of-line unit's cycles by instruction class: {need(cycles, "uniform_table_lookup", ("classes", 13))} — the grid's origin and spacing and the
-cell's eight coefficients are twelve single-word loads (2 cycles each: the compiler issues
-`VLDR`s, not a `VLDM` of 1 + N, the registers it allocates not being consecutive), each axis's
-cell index a conversion to an integer, a clamp by one compare and the conversion back for the
-fraction, and the two bilinear forms six multiplications and six additions. `FluxMap` keeps any rectangular
-grid in four borrowed slices: a uniform axis (found so at construction) also gives its cell
-with no load or division, and its two corners per row and table sit behind one bounds check.
-Its inverse solves each bilinear cell's quadratic in closed form from the cell of the warm
-start, jumping once to the cell of that solution's extrapolation and walking to the
+A lookup's "inlined" cycles are the measured unit's own instructions, the ones the line tables
+attribute to fado-core rather than to the image's wrapper: the `thumbv7em-none-eabihf` target
+keeps a frame pointer in every function (rustc's target specification: `frame-pointer`
+always), so an out-of-line call also pays `push {{r7, lr}}`, `mov r7, sp` and
+`pop {{r7, pc}}` ({fmt(uniform[0] - inlined)} cycles), which a step that carries the lookup's
+body does not.
+
+The uniform table's lookup is straight-line code: each axis's index from the precomputed
+inverse node spacing, t = (x − x₀)·(1/Δ) (no search, no division), converted to an integer and
+clamped to the nodes (for a 16-node axis one `USAT`), and the fraction t − k; the node's eight
+bilinear coefficients (ψd's and ψq's p00, p10 − p00, p01 − p00 and the twist, precomputed per
+node and stored side by side; the last row and column hold the edge cell's polynomial at their
+node, for the linear extension beyond the grid) loaded from one run; six multiplications and
+additions per table. The array's shape is in the type, so no index is bounds-checked.
+A firmware whose map is known when it is built steps the estimator with
+`EstimatorState::step_lean_in(&params, &TABLE, v, i)`: the parameters' machine borrows the
+same table (`MachineMagnetics::Uniform(&MAP)`, `MAP = TABLE.map()`), and the saturating step
+is compiled for the table's type: the grid's origin and spacing become constants of the code,
+the cells' address a register, and there is no match on the model: a lookup costs the step
+{fmt(typed)} cycles (the first row), {"which meets the 60-cycle target of a lookup with " + fmt(60 - typed) + " cycles to spare" if typed <= 60 else "which misses the 60-cycle target of a lookup by " + fmt(typed - 60) + " cycles"}.
+Where the table passed is not the parameters' model, `step_lean_in` is `step_lean` (one
+compare of the model's tag and cells per sample decides). The machine record's own step
+(`step_lean`) serves any model chosen at run time: each lookup matches on the model, loads the
+borrowed map's record (origin, spacings, cells, shape) and checks the cell's index, {fmt(in_step)}
+cycles (the fifth row). The unit's cycles by instruction class (the table named by its type,
+out of line): {need(cycles, "step_table_lookup", ("classes", 13))} — the cell's eight
+coefficients are eight single-word loads (2 cycles each: the compiler issues `VLDR`s, not a
+`VLDM` of 1 + N, the registers it allocates not being consecutive). `FluxMap` keeps any
+rectangular grid in four borrowed slices: a uniform axis (found so at construction) also gives
+its cell with no load or division, and its two corners per row and table sit behind one bounds
+check. Its inverse solves each bilinear cell's quadratic in closed form from the cell of the
+warm start, jumping once to the cell of that solution's extrapolation and walking to the
 neighbouring cell where the solution lies beyond the cell's edge; the scenario's trajectory
 steps several cells between calls (a plant's sub-step stays in its cell or the next).
 
 The estimator's step with the uniform table as its machine's model (`MachineModel::magnetics =
 MachineMagnetics::Uniform(&UNIFORM_MAP)`, a `static` `UniformFluxMap` borrowing the table in
-flash; the default configuration, scenarios 10–11, the salient `ipmsm-2k2` turned saturating):
+flash; the default configuration, scenarios 10–11, the salient `ipmsm-2k2` turned
+saturating), both steps on the same samples, their estimates the same bit for bit:
 
 | step | 19.5 Hz | 75 Hz |
 |---|---:|---:|
-| `step_lean`, default (R̂s adaptation), ipmsm-2k2 with the 16 × 16 uniform table | {cell(cycles, "estimator_step", 10)} | {cell(cycles, "estimator_step", 11)} |
+| `step_lean_in`, default (R̂s adaptation), the 16 × 16 table named by its type | {cell(cycles, "estimator_step_table", 10)} | {cell(cycles, "estimator_step_table", 11)} |
+| `step_lean`, the same, the machine record's model matched at run time | {cell(cycles, "estimator_step", 10)} | {cell(cycles, "estimator_step", 11)} |
 
 The saturating step evaluates the map at the estimated current twice per sample (the active
-flux's swing and the rotor flux, `fado_core::active_flux`), each with a second lookup for the
-secant's ψq(î_d, 0), none with a call of its own; the R̂s law's slots add a lookup with
-the Jacobian where the law needs the incremental inductance (out of line). The map's own
-instructions (the lines of `magnetics/uniform_map.rs` and `uniform_table.rs`) cost the step
-{fmt(map_in_step[0])} and {fmt(map_in_step[1])} cycles per sample on average in the two
-scenarios; the machine record holds the map by reference.
+flux's swing and the rotor flux, `fado_core::active_flux`), each with the secant's
+ψq(î_d, 0) from the table's line i_q = 0 (a 1-D lookup that shares the 2-D lookup's d index),
+none with a call of its own; the R̂s law's slots add a lookup with the Jacobian where the law
+needs the incremental inductance. The map's own instructions (the lines of `magnetics/`
+`uniform_table.rs`, `uniform_map.rs` and `lookup.rs`; the index conversions of `real.rs`
+apart) cost the step compiled for the table {fmt(map_typed[0])} and {fmt(map_typed[1])} cycles
+per sample on average in the two scenarios, the record's step {fmt(map_record[0])} and
+{fmt(map_record[1])}. The rest of the two steps' difference is memory traffic: by instruction
+class (scenario 10), the step compiled for the table spends
+{need(cycles, "estimator_step_table", ("classes", 10))}; the record's
+{need(cycles, "estimator_step", ("classes", 10))} — the borrowed model's record loaded again
+around each evaluation, and the registers its matches take spilled.
 
 ## What the cycles buy
 

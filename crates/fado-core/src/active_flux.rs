@@ -60,7 +60,8 @@
 //! this coupling would make the DC loop grow (docs/method/saturation.md, "The slow mode").
 
 use crate::magnetics::{
-    ConstantInductance, FluxWarmStart, InductanceMatrix, MachineMagnetics, MagneticModel,
+    ConstantInductance, FluxLookup, FluxWarmStart, InductanceMatrix, MachineMagnetics,
+    MagneticModel,
 };
 use crate::{Ab, Dq, MachineModel, Real};
 
@@ -78,12 +79,14 @@ pub const KAPPA_MIN_RATIO: f64 = 0.5;
 /// ipmsm-2k2-qsat, 0.3 on a small 20-pole IPMSM) never reach it.
 pub const OFFSET_COUPLING_MAX: f64 = 0.5;
 
-/// A saturating model as the estimator uses it, with the constants it falls back to.
+/// A saturating model as the estimator uses it, with the constants it falls back to. `M` is
+/// how the model is named: the machine record's [`MachineMagnetics`] (any model, chosen at
+/// run time), or a table's own type ([`ActiveFlux::with_model`], [`FluxLookup`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ActiveFlux<T: 'static> {
+pub struct ActiveFlux<T: 'static, M = MachineMagnetics<T>> {
     /// The model, borrowed (two words: the estimator's parameters stay small enough to be
     /// built in place in a freestanding image).
-    model: MachineMagnetics<T>,
+    model: M,
     /// What `model` stands for if it is `Linear` (never, as built; see [`ActiveFlux::new`]).
     linear: ConstantInductance<T>,
     /// The secant is the incremental ∂ψq/∂i_q below this |i_q| (A).
@@ -127,6 +130,49 @@ impl<T: Real> ActiveFlux<T> {
         }
     }
 
+    /// [`ActiveFlux::point`] with the model's ψ(i_dq) solved from `psi_guess`, a flux near it
+    /// in the same frame (the estimated stator flux there): one or two Newton steps where the
+    /// model's ψ(i) is an inversion ([`MagneticModel::flux_from`]).
+    #[inline]
+    pub fn point_from(&self, i_dq: Dq<T>, psi_guess: Dq<T>) -> ActiveFluxPoint<T> {
+        let psi = self.model.resolve(self.linear).flux_from(i_dq, psi_guess);
+        self.point_at(i_dq, psi)
+    }
+
+    /// The current `i_ab` (or any α-β vector) in the frame whose d axis is `axis` (any length;
+    /// zero for a zero or non-finite axis).
+    #[inline]
+    pub fn frame_current(axis: Ab<T>, i_ab: Ab<T>) -> Dq<T> {
+        let n = axis.norm_squared().step_sqrt();
+        if n > T::zero() && n.is_finite() {
+            let k = T::one() / n;
+            Dq::new(axis.dot(i_ab) * k, axis.cross(i_ab) * k)
+        } else {
+            Dq::zero()
+        }
+    }
+
+    /// The machine record's model.
+    #[inline]
+    pub fn model(&self) -> &MachineMagnetics<T> {
+        &self.model
+    }
+
+    /// The same view with the model named by `model` (the same model as the record's,
+    /// [`FluxLookup::is_model_of`]; the caller checks).
+    #[inline(always)]
+    pub fn with_model<N: FluxLookup<T>>(&self, model: N) -> ActiveFlux<T, N> {
+        ActiveFlux {
+            model,
+            linear: self.linear,
+            small_current: self.small_current,
+            magnet_flux: self.magnet_flux,
+            lq_zero: self.lq_zero,
+        }
+    }
+}
+
+impl<T: Real, M: FluxLookup<T>> ActiveFlux<T, M> {
     /// Itself for a saturating model; None for constant inductances (the blocks keep their
     /// closed-form arithmetic).
     #[inline]
@@ -151,13 +197,13 @@ impl<T: Real> ActiveFlux<T> {
     /// ψ(i) of the model.
     #[inline]
     pub fn flux(&self, i: Dq<T>) -> Dq<T> {
-        self.model.resolve(self.linear).flux(i)
+        self.model.flux_at(self.linear, i)
     }
 
     /// The incremental inductance ∂ψ/∂i of the model at `i`.
     #[inline]
     pub fn incremental_inductance(&self, i: Dq<T>) -> InductanceMatrix<T> {
-        self.model.resolve(self.linear).incremental_inductance(i)
+        self.model.inductance_at(self.linear, i)
     }
 
     /// ψd(0, 0), Wb.
@@ -176,15 +222,6 @@ impl<T: Real> ActiveFlux<T> {
     #[inline]
     pub fn point(&self, i_dq: Dq<T>) -> ActiveFluxPoint<T> {
         self.point_at(i_dq, self.flux(i_dq))
-    }
-
-    /// [`ActiveFlux::point`] with the model's ψ(i_dq) solved from `psi_guess`, a flux near it
-    /// in the same frame (the estimated stator flux there): one or two Newton steps where the
-    /// model's ψ(i) is an inversion ([`MagneticModel::flux_from`]).
-    #[inline]
-    pub fn point_from(&self, i_dq: Dq<T>, psi_guess: Dq<T>) -> ActiveFluxPoint<T> {
-        let psi = self.model.resolve(self.linear).flux_from(i_dq, psi_guess);
-        self.point_at(i_dq, psi)
     }
 
     /// [`ActiveFlux::point_from`] with an iterative ψ(i) started from `warm`, the last
@@ -223,19 +260,6 @@ impl<T: Real> ActiveFlux<T> {
         }
     }
 
-    /// The current `i_ab` (or any α-β vector) in the frame whose d axis is `axis` (any length;
-    /// zero for a zero or non-finite axis).
-    #[inline]
-    pub fn frame_current(axis: Ab<T>, i_ab: Ab<T>) -> Dq<T> {
-        let n = axis.norm_squared().step_sqrt();
-        if n > T::zero() && n.is_finite() {
-            let k = T::one() / n;
-            Dq::new(axis.dot(i_ab) * k, axis.cross(i_ab) * k)
-        } else {
-            Dq::zero()
-        }
-    }
-
     /// λ̂r = λ2 − L_q,s(î)·i with î in the frame of λ2 − `lq_prev`·i (module docs), and the
     /// operating point it used.
     #[inline]
@@ -261,10 +285,11 @@ impl<T: Real> ActiveFlux<T> {
         warm: &FluxWarmStart<T>,
     ) -> (Ab<T>, ActiveFluxPoint<T>, FluxWarmStart<T>) {
         let axis = lambda2 - i_ab * lq_prev;
-        let i_dq = Self::frame_current(axis, i_ab);
+        let i_dq = ActiveFlux::<T>::frame_current(axis, i_ab);
         // λ2 in the same frame is the estimated ψ(î): the model's flux starts there without
         // a warm start.
-        let (point, warm) = self.point_warm(i_dq, Self::frame_current(axis, lambda2), warm);
+        let (point, warm) =
+            self.point_warm(i_dq, ActiveFlux::<T>::frame_current(axis, lambda2), warm);
         (lambda2 - i_ab * point.lq_secant, point, warm)
     }
 

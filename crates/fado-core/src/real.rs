@@ -15,6 +15,13 @@ pub trait Real: RealField + Copy + Default {
     /// instruction on a single-precision FPU, where `to_f64() as usize` is software double
     /// precision. For table lookups in the per-sample path.
     fn index_floor(self, max: usize) -> usize;
+    /// [`index_floor`](Self::index_floor) (the same index for every `self`) for a `max`
+    /// that is a constant of the caller's code: where it is 2ⁿ − 1, `f32`'s clamp is one
+    /// saturation (`USAT` on a Cortex-M4F) instead of a compare and a select.
+    #[inline(always)]
+    fn index_floor_const(self, max: usize) -> usize {
+        self.index_floor(max)
+    }
     /// The index `k` as this scalar (exact up to 2^24 for `f32`), the inverse of
     /// [`index_floor`](Self::index_floor) on the nodes of a table.
     fn from_index(k: usize) -> Self;
@@ -117,6 +124,16 @@ impl Real for f32 {
     fn index_floor(self, max: usize) -> usize {
         // Towards zero, saturating, NaN to 0: ⌊x⌋ for x ≥ 0, 0 below.
         (self as usize).min(max)
+    }
+    #[inline(always)]
+    fn index_floor_const(self, max: usize) -> usize {
+        if (max as u32).wrapping_add(1).is_power_of_two() && max < i32::MAX as usize {
+            // Towards zero, saturating, NaN to 0 as `index_floor`; clamped to [0, 2ⁿ − 1],
+            // the pattern of one unsigned saturation.
+            (self as i32).max(0).min(max as i32) as usize
+        } else {
+            self.index_floor(max)
+        }
     }
     #[inline(always)]
     fn from_index(k: usize) -> Self {

@@ -216,9 +216,12 @@ fn run_loaded(cfg: &mut fado_sim::config::SimConfig) -> (GainCalibrationStatus, 
 fn a_load_arriving_during_the_calibration_ends_it_and_the_drive_takes_the_load() {
     // The 2.2 kW IPMSM whose 7 N·m (half its rated torque) arrives at 0.5 s, while the
     // calibration holds its upper d level (it would end at 0.51 s and then hold zero current
-    // for 50 ms, the rotor free). The motion test ends it within milliseconds and the drive's
-    // speed loop takes the load. Measured: RotorMoved, max |θ − θ̂| 0.159 rad, lowest speed
-    // −38 r/min, 0.43 rad backward (without the test: θ̂ lost, 3.13 rad, −383 r/min).
+    // for 50 ms, the rotor free). The motion test ends it within milliseconds, the release
+    // hold catches the rotor at the aligned angle and hands the load to the speed loop, whose
+    // reference then resumes from zero (`ReleaseHold::engage`). Measured: RotorMoved, max
+    // |θ − θ̂| 0.117 rad, lowest speed −28.6 r/min, 0.11 rad backward (the speed loop alone
+    // from the aligned angle: 0.159 rad, −38 r/min, 0.43 rad; without the test: θ̂ lost,
+    // 3.13 rad, −383 r/min).
     let mut cfg = config(
         "ipmsm-2k2",
         0.3,

@@ -8,8 +8,8 @@
 
 use fado_core::Dq;
 use fado_core::magnetics::{
-    ConstantInductance, FluxMap, FluxTable, FluxWarmStart, MachineMagnetics, MagneticModel,
-    UniformFluxMap, UniformFluxTable,
+    ConstantInductance, FluxLookup, FluxMap, FluxTable, FluxWarmStart, MachineMagnetics,
+    MagneticModel, UniformFluxMap, UniformFluxTable,
 };
 
 /// Nodes per axis.
@@ -84,6 +84,20 @@ pub fn step_map_lookup(model: &MachineMagnetics<f32>, i: Dq<f32>) -> Dq<f32> {
     model.flux_warm(linear, i, i, &FluxWarmStart::empty()).0
 }
 
+/// ψ(i) from [`UNIFORM`] named by its type, as the estimator's step compiled for the table
+/// evaluates it (`EstimatorState::step_lean_in`, `FluxLookup::flux_warm`): the table's
+/// address and grid constants of the code, no match on the model, no index checked.
+#[inline(never)]
+#[unsafe(no_mangle)]
+pub fn step_table_lookup(i: Dq<f32>) -> Dq<f32> {
+    let linear = ConstantInductance {
+        ld: 0.036,
+        lq: 0.051,
+        flux_linkage: 0.545,
+    };
+    FluxLookup::flux_warm(&&UNIFORM, linear, i, i, &FluxWarmStart::empty()).0
+}
+
 /// ψ(i): one bilinear lookup (the cell from the uniform axes' inverse spacing, four corners
 /// per table, the interpolation) — the unit of the ≤ 60-cycle target.
 #[inline(never)]
@@ -119,6 +133,8 @@ pub fn run(n: usize) -> Option<f32> {
         let model = MachineMagnetics::Uniform(&UNIFORM_MAP);
         let in_step = step_map_lookup(core::hint::black_box(&model), core::hint::black_box(i));
         worst = worst.max((in_step - psi).norm());
+        let typed = step_table_lookup(core::hint::black_box(i));
+        worst = worst.max((typed - psi).norm());
         let back = flux_map_inverse(&map, core::hint::black_box(psi), guess);
         guess = back;
         worst = worst.max((back - i).norm());

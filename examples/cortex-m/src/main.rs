@@ -382,6 +382,11 @@ struct App {
     kernel_mode_diff: u32,
     /// The kernel's worst |θ̂ − θ| over the last `hold_samples / 2` samples.
     kernel_worst: f32,
+    /// The saturating scenarios' state stepped beside [`App::state`] on the same samples by
+    /// [`estimator_step`] (the machine record's model, matched at run time), and the number
+    /// of samples whose estimate differs from [`estimator_step_table`]'s (none: the same step).
+    record: Option<EstimatorState<f32>>,
+    record_diffs: u32,
 }
 
 static APP: Mutex<RefCell<Option<App>>> = Mutex::new(RefCell::new(None));
@@ -464,6 +469,22 @@ pub fn estimator_step(
     state.step_lean(params, v_ab, i_ab)
 }
 
+/// One estimator step of the saturating scenarios, out of line: `step_lean_in` with the
+/// machine's map named by its type (the 16 × 16 table in flash that the parameters' machine
+/// borrows, [`flux_lookup::UNIFORM`]), so that the step is compiled for that table: what a
+/// firmware whose map is known when it is built runs. The same estimate as
+/// [`estimator_step`] on the same parameters (the record's model, matched at run time).
+#[inline(never)]
+#[unsafe(no_mangle)]
+pub fn estimator_step_table(
+    params: &EstimatorParams<f32>,
+    state: &mut EstimatorState<f32>,
+    v_ab: Ab<f32>,
+    i_ab: Ab<f32>,
+) -> LeanEstimate<f32> {
+    state.step_lean_in(params, &flux_lookup::UNIFORM, v_ab, i_ab)
+}
+
 /// One drive step (Clarke/Park, current and speed control, the estimator, modulation),
 /// out of line: the CI gate (`scripts/check-firmware-symbols.sh`) checks the code reachable
 /// from it as it checks the interrupt's. `main` steps a drive through it once; the
@@ -488,7 +509,16 @@ impl App {
         }
         let (v, i) = self.machine.sample();
         note_step_sp();
-        let out = estimator_step(params, &mut self.state, v, i);
+        let out = if self.params == SATURATING_MAP {
+            estimator_step_table(params, &mut self.state, v, i)
+        } else {
+            estimator_step(params, &mut self.state, v, i)
+        };
+        if let Some(record) = self.record.as_mut()
+            && estimator_step(params, record, v, i) != out
+        {
+            self.record_diffs += 1;
+        }
         let kernel = self.kernel.as_mut().map(|k| {
             if self.samples == 0 {
                 k.prime(i);
@@ -668,6 +698,8 @@ fn main() -> ! {
             kernel_omega_diff: 0.0,
             kernel_mode_diff: 0,
             kernel_worst: 0.0,
+            record: (which == SATURATING_MAP).then_some(state),
+            record_diffs: 0,
         };
         // The scenario marker the cost script splits the trace at.
         scenario_marker(index as u32);
@@ -677,7 +709,7 @@ fn main() -> ! {
                 *slot = Some(app);
             }
         });
-        let (worst, rejected, samples, kernel) = loop {
+        let (worst, rejected, samples, kernel, record_diffs) = loop {
             cortex_m::asm::wfi();
             let finished = interrupt::free(|cs| match APP.borrow(cs).try_borrow_mut() {
                 Ok(mut slot) => match slot.as_mut() {
@@ -694,6 +726,7 @@ fn main() -> ! {
                                     app.kernel_worst,
                                 )
                             }),
+                            app.record.map(|_| app.record_diffs),
                         );
                         *slot = None;
                         Some(r)
@@ -710,7 +743,7 @@ fn main() -> ! {
         let step_sp = interrupt::free(|cs| STEP_SP.borrow(cs).get());
         deepest_isr = deepest_isr.max(idle_sp - lowest);
         deepest_step = deepest_step.max(step_sp.saturating_sub(lowest));
-        let locked = worst < 0.1 && rejected == 0;
+        let locked = worst < 0.1 && rejected == 0 && record_diffs.is_none_or(|n| n == 0);
         all_locked &= locked;
         hprintln!(
             "scenario {}: {} at {} Hz electrical: {} samples, worst |θ̂ − θ| over the last {} = {} rad, {} rejected{}",
@@ -723,6 +756,14 @@ fn main() -> ! {
             rejected,
             if locked { "" } else { "  NOT LOCKED" }
         );
+        if let Some(n) = record_diffs {
+            hprintln!(
+                "scenario {}: the machine record's step (estimator_step) beside estimator_step_table: {} of {} samples differ",
+                index,
+                n,
+                samples
+            );
+        }
         if let Some((diff, omega_diff, mode_diff, kernel_worst)) = kernel {
             let same = diff <= KERNEL_TOLERANCE && mode_diff == 0 && kernel_worst < 0.1;
             all_locked &= same;

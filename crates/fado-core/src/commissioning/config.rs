@@ -35,13 +35,15 @@ pub struct CommissioningConfig<T: 'static> {
     /// Offset calibration in s. Default 0.1 s (1000 samples at 10 kHz).
     pub offset_time: T,
     /// Alignment in s (each of its two steps, and the hold after). Default the larger of
-    /// 0.3 s and 12·τ, τ = ½(Ld + Lq)/Rs of the nameplate: the standstill loop's 2 % settling
-    /// time is 8·τ (ζ = 0.7, ωn = R/(√2·L)), plus margin for the rotor's swing.
+    /// 0.3 s and 12·τ, τ = ½(Ld + Lq)/Rs of the nameplate: across the current reference the
+    /// standstill loop is in voltage mode (module docs, step 2), so the current that damps
+    /// the rotor's swing settles with τ, and the swing no faster (8·τ: 2 % of a ζ = 0.7 mode
+    /// at ωn = R/(√2·L)), plus margin.
     pub align_time: T,
-    /// Settling before each measurement in s. Default the larger of 0.25 s (the standstill
-    /// loop settles within 0.6 of it for a nameplate R/L off by 1.6× either way on every
-    /// tested motor with τ ≤ 25 ms) and 10·τ (τ as for `align_time`; the 5 kW PM-SyRM
-    /// preset's τ = 52 ms).
+    /// Settling before each measurement in s. Default the larger of 0.25 s (the current and
+    /// the rotor settle within 0.6 of it for a nameplate R/L off by 1.6× either way on every
+    /// tested motor with τ ≤ 25 ms) and 10·τ (τ as for `align_time`, with which the current
+    /// across the reference settles; the 5 kW PM-SyRM preset's τ = 52 ms).
     pub settle_time: T,
     /// Averaging window of each DC level, each injection and the coast, in s. Default 0.25 s.
     pub measure_time: T,

@@ -36,6 +36,7 @@ impl<T: Real> Commissioning<T> {
             i_prev: Ab::zero(),
             have_prev: false,
             v_int: Ab::zero(),
+            u_ref: Ab::new(T::one(), T::zero()),
             v_ff: Ab::zero(),
             i_ref: Ab::zero(),
             err_par: T::zero(),
@@ -98,6 +99,7 @@ impl<T: Real> Commissioning<T> {
         self.c2 = Ab::zero();
         self.have_prev = false;
         self.v_int = Ab::zero();
+        self.u_ref = Ab::new(T::one(), T::zero());
         self.v_ff = Ab::zero();
         self.i_ref = Ab::zero();
         self.err_par = T::zero();
@@ -198,6 +200,27 @@ impl<T: Real> Commissioning<T> {
         self.cfg.trip_ratio * level
     }
 
+    /// Why a measured current `i` beyond the trip stops the procedure. At standstill, an
+    /// over-current with a back-EMF beyond the rotation threshold is the rotor being turned
+    /// (the EMF drives the current); one mostly across the reference, without that EMF, is a
+    /// current that cannot follow its reference's direction (an open phase: the loop, which
+    /// regulates along the reference, pushes the current the machine can carry until its
+    /// projection matches).
+    fn over_current_reason(&self, i: Ab<T>) -> AbortReason {
+        let phase = self.phase;
+        let standstill = matches!(
+            phase,
+            Phase::Align | Phase::Resistance | Phase::InductanceD | Phase::InductanceQ
+        );
+        if standstill && self.emf_lpf.beta.abs() > self.emf_limit() {
+            AbortReason::RotationDetected { phase }
+        } else if standstill && self.u_ref.cross(i).abs() > self.u_ref.dot(i).abs() {
+            AbortReason::CurrentNotFollowing { phase }
+        } else {
+            AbortReason::OverCurrent { phase }
+        }
+    }
+
     pub(super) fn abort(&mut self, reason: AbortReason) {
         self.status = Status::Aborted(reason);
         self.phase = Phase::Aborted;
@@ -258,17 +281,7 @@ impl<T: Real> Commissioning<T> {
         let b = i_abc.b - self.off_b;
         let i = Abc::new(a, b, -a - b).to_ab();
         if i.norm() > self.trip_current() {
-            // At standstill, an over-current with a back-EMF beyond the rotation threshold is
-            // the rotor being turned (the EMF drives the current), reported as such.
-            let standstill = matches!(
-                self.phase,
-                Phase::Align | Phase::Resistance | Phase::InductanceD | Phase::InductanceQ
-            );
-            let reason = if standstill && self.emf_lpf.beta.abs() > self.emf_limit() {
-                AbortReason::RotationDetected { phase: self.phase }
-            } else {
-                AbortReason::OverCurrent { phase: self.phase }
-            };
+            let reason = self.over_current_reason(i);
             self.abort(reason);
             return self.output(Ab::zero(), vdc, false, T::zero());
         }
@@ -318,12 +331,7 @@ impl<T: Real> Sizing<T> {
         let ts = cfg.sample_period;
         let i_limit = cfg.current_limit_ratio * np.rated_current;
         let l_avg_np = T::lit(0.5) * (np.ld + np.lq);
-        // Integral gain K = R²/(2L) of the standstill loop (module docs), bounded so that the
-        // loop stays well below the sampling rate (K·Ts/L ≤ 0.01 gives ωn·Ts ≤ 0.1). No
-        // proportional path: its impedance would take the damping of the rotor's swing.
-        let k_int =
-            (T::lit(0.5) * np.rs * np.rs / l_avg_np).min(T::lit(0.01) * l_avg_np / (ts * ts));
-        let k_p = T::zero();
+        let (k_p, k_int) = standstill_gains(np.rs, l_avg_np, ts);
         // Injection: a current ripple of 30 % of the I₁ bias (45 % of the limit), peak-peak.
         let i_dc = dc_level(np, i_limit);
         let i1 = T::lit(0.5) * i_dc;

@@ -29,25 +29,38 @@
 //! 2. **Alignment** ([`Phase::Align`]): a current vector at 2π/3, then turned to 0 (α axis),
 //!    drags the rotor's d axis onto phase a. Two steps so that a rotor starting at the
 //!    unstable equilibrium of one is pulled by the other (the usual two-step alignment, e.g.
-//!    ST MCSDK's and TI InstaSPIN's). The standstill regulator is an integral-only loop
-//!    (v̇ = K·(i* − i), K = R̂²/(2L̂): L·s² + R·s + K with ζ ≈ 0.7 on the nameplate), *frozen*
-//!    to a constant voltage in the alignment hold (once the current has settled within 3 %
-//!    of its reference, as in the DC test: frozen at a fixed time, mid-swing, the 50 kW IPMSM
-//!    preset's hold parked a phase current inside the dead-time band, whose dead zone took
-//!    the resistive damping away, and the rotor swung ±50 r/min undamped into the DC test),
-//!    the DC measurement windows and the injections: voltage mode leaves the machine's own resistance as the damping of the
-//!    rotor's swing (a fast current loop would remove it and the rotor would ring for
-//!    seconds; measured: ±15 r/min still after 1 s on the paper's motor). A feedforward of the
+//!    ST MCSDK's and TI InstaSPIN's). The standstill regulator acts **along the current
+//!    reference only**: a PI on the error's component along i*, its voltage along i*; across
+//!    i* the voltage is the feedforward's alone (voltage mode). The rotor's swing about the
+//!    d current turns the magnet's flux, whose back-EMF lies across the d axis, i.e. across
+//!    i*; in voltage mode that EMF drives a current through the machine's own resistance
+//!    whose torque opposes the swing (damping 1.5·p²·λf²/R). An integral across i* would act
+//!    at the swing's frequency ω as a series reactance K/ω that blocks this current: on a
+//!    48 V hub motor (15 pole pairs, 0.4 mH, 0.15 Ω) the swing at 5 Hz met K/ω = 0.86 Ω
+//!    against R = 0.15 Ω, its damping fell by R²/(R² + (K/ω)²) = 1/33 and the DC test never
+//!    settled (`CurrentNotFollowing`, `fado-sim/tests/commission_classes.rs`). Along i* the
+//!    loop is as fast as the sampling allows (`standstill_gains`: ζ = 0.7 at
+//!    ωn = 0.1/Ts, its proportional part making up √2·L̂·ωn − R̂): the current along the
+//!    d axis only sets the swing's stiffness, not its damping, and the voltage the loop has
+//!    to find besides R̂·i* is the inverter's threshold, which does not scale with R·I (60 V
+//!    against R·I = 8 V on a 10 kV-class machine, where an integral-only K = R̂²/(2L̂) took
+//!    5 s to build the alignment's current). The voltage is *frozen* (the integral's state
+//!    held, no proportional part) in the alignment hold (once the current has settled within
+//!    3 % of its reference, as in the DC test: frozen at a fixed time, mid-swing, the 50 kW
+//!    IPMSM preset's hold parked a phase current inside the dead-time band, whose dead zone
+//!    took the resistive damping away, and the rotor swung ±50 r/min undamped into the DC
+//!    test), the DC measurement windows and the injections. A feedforward of the
 //!    reference, R̂·i* (nameplate) plus the dead-time part Td·f_sw·Vdc of the inverter error
-//!    (the configured dead time, docs/method/estimator.md §7's trapezoid), carries the bulk of the voltage, so
-//!    the integral only makes up the nameplate's error and the device threshold; being a
-//!    function of i*, not of i, it leaves the swing's damping unchanged. Without it a motor
-//!    whose inverter error dwarfs R·I (the 5 kW PM-SyRM preset: 4.9 V against 1 V) waits
-//!    for the integral to climb through the dead-time band while a fraction of an ampere
-//!    already swings the rotor (measured: `RotationDetected` in the DC test). The loop's
-//!    speed scales with R/L, so the alignment steps and the settling scale with the
-//!    nameplate's τ = L̄/R (defaults of [`CommissioningConfig::align_time`] and
-//!    [`CommissioningConfig::settle_time`]).
+//!    (the configured dead time, docs/method/estimator.md §7's trapezoid), carries the bulk of
+//!    the voltage, so the loop only makes up the nameplate's error and the device threshold;
+//!    being a function of i*, not of i, it leaves the swing's damping unchanged. Without it
+//!    a motor whose inverter error dwarfs R·I (the 5 kW PM-SyRM preset: 4.9 V against 1 V)
+//!    waits for the loop to climb through the dead-time band while a fraction of an ampere
+//!    already swings the rotor (measured: `RotationDetected` in the DC test). The rotor's
+//!    swing in voltage mode, and the creep of an over-damped one (time constant λf/(R·I):
+//!    1.3 s on the 10 kV-class machine), scale with the machine, so the alignment steps and
+//!    the settling scale with the nameplate's τ = L̄/R (defaults of
+//!    [`CommissioningConfig::align_time`] and [`CommissioningConfig::settle_time`]).
 //! 3. **Resistance** ([`Phase::Resistance`]): DC current along α at two levels I₁ = I₂/2, I₂ =
 //!    90 % of the limit (capped for reluctance rotors, see `dc_level`). With all three phase currents beyond the inverter's current band the
 //!    pole-voltage error is a constant V̂·sign(i_x) per phase, i.e. 4/3·V̂ on the α axis, so
@@ -208,7 +221,10 @@ use crate::{Ab, Dq};
 use fits::{BlockStats, EmfWindow, JFit, JWindows, Line, emf_line};
 pub use flux_pulses::MagneticFit;
 use flux_pulses::{FluxPulses, magnetics_time};
-use sizing::{clamp, dc_level, dead_time_voltage, libm_round, limit, spin_sizing, step_level};
+use sizing::{
+    clamp, dc_level, dead_time_voltage, libm_round, limit, spin_sizing, standstill_gains,
+    step_level,
+};
 
 /// The commissioning state machine (module docs).
 #[derive(Clone, Debug)]
@@ -244,6 +260,9 @@ pub struct Commissioning<T: 'static> {
     have_prev: bool,
     // Standstill regulator.
     v_int: Ab<T>,
+    /// Unit vector along the current reference (the last non-zero one), along which the
+    /// loop regulates.
+    u_ref: Ab<T>,
     v_ff: Ab<T>,
     i_ref: Ab<T>,
     err_par: T,

@@ -82,7 +82,8 @@ pub enum AbortReason {
         phase: Phase,
     },
     /// The current did not reach its reference with the voltage at its limit (an open phase,
-    /// a missing motor, a far too high resistance), or it lost its reference in a spin.
+    /// a missing motor, a far too high resistance), went beyond the trip mostly across its
+    /// reference at standstill (an open phase), or lost its reference in a spin.
     CurrentNotFollowing {
         /// Where.
         phase: Phase,

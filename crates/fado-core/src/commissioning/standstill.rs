@@ -6,8 +6,8 @@ use crate::control::gain_calibration::{self, ratio_of, resistance_of};
 use crate::{Ab, Real};
 
 impl<T: Real> Commissioning<T> {
-    /// The standstill phases: integral-only regulation of the α-β current to `i_ref`, plus
-    /// the square-wave injection; the measurements; the phase transitions.
+    /// The standstill phases: regulation of the current along `i_ref` (voltage mode across
+    /// it), plus the square-wave injection; the measurements; the phase transitions.
     pub(super) fn standstill(&mut self, i: Ab<T>, vdc: T) -> Ab<T> {
         let (inj, window) = self.standstill_reference(i, vdc);
         let frozen = self.standstill_frozen();
@@ -39,7 +39,7 @@ impl<T: Real> Commissioning<T> {
                 };
                 // Current ramped up over the whole first step: the rotor is pulled in
                 // quasi-statically rather than kicked (a kick's swing drives extra current
-                // through the slow loop by its EMF).
+                // by its EMF).
                 let mag = i2 * (t / at).min(T::one());
                 self.i_ref = Ab::from_polar(mag, ang);
                 // Rotation is expected here: checked from the DC test on.
@@ -97,9 +97,9 @@ impl<T: Real> Commissioning<T> {
         let at = self.cfg.align_time;
         let t = self.t_phase;
         let settle = self.cfg.settle_time;
-        // Integral-only regulator with clamping anti-windup; frozen (voltage mode, the
-        // machine's own resistance damping the rotor) in the alignment hold, the DC
-        // measurement windows and the injections.
+        // The regulator (along the reference, clamping anti-windup) is frozen (voltage mode
+        // along the reference too) in the alignment hold, the DC measurement windows and the
+        // injections.
         match self.phase {
             // The hold: frozen only once the current has settled at its reference (the
             // criterion of the DC test below), not at a fixed time.
@@ -139,17 +139,30 @@ impl<T: Real> Commissioning<T> {
         let ts = self.ts;
         let e = self.i_ref - i;
         let v_max = cfg.voltage_limit_ratio * vdc * T::lit(SQRT3_INV);
+        // The loop regulates the current along the reference only (module docs, step 2):
+        // across it the voltage stays the feedforward's, so that the rotor's swing, whose
+        // back-EMF lies across the d current, sees the machine's own resistance.
+        let n = self.i_ref.norm();
+        if n > T::zero() {
+            self.u_ref = self.i_ref * (T::one() / n);
+        }
+        let u = self.u_ref;
+        let e_par = u.dot(e);
         let v_int = if frozen {
             self.v_int
         } else {
-            self.v_int + e * (self.k_int * ts)
+            u * (u.dot(self.v_int) + e_par * (self.k_int * ts))
         };
         // Feedforward of the reference (module docs): the nameplate R·i* and the dead-time part
-        // Td·f_sw·Vdc of the inverter error, so that the slow integral only makes up the
-        // nameplate's error and the device threshold. It follows i*, not i: the rotor's swing
-        // still sees the machine's own resistance as damping.
+        // Td·f_sw·Vdc of the inverter error, so that the loop only makes up the nameplate's
+        // error and the device threshold. It follows i*, not i: the rotor's swing still sees
+        // the machine's own resistance as damping.
         let ff = self.standstill_feedforward();
-        let v_pi = if frozen { v_int } else { v_int + e * self.k_p } + ff;
+        let v_pi = if frozen {
+            v_int
+        } else {
+            v_int + u * (e_par * self.k_p)
+        } + ff;
         self.v_ff = ff;
         let v = limit(v_pi + inj, v_max);
         if v != v_pi + inj {
@@ -166,9 +179,11 @@ impl<T: Real> Commissioning<T> {
         let cfg = self.cfg;
         let ts = self.ts;
         let e = self.i_ref - i;
-        // Following check: 20 ms low-pass of |i* − i| relative to |i*|.
+        // Following check: 20 ms low-pass of the error along the reference, the component the
+        // loop regulates (across it the current is the rotor's swing's and the sensors' gain
+        // mismatch's, which voltage mode leaves), relative to |i*|.
         let k = (ts / T::lit(0.02)).min(T::one());
-        self.err_par += k * (e.norm() - self.err_par);
+        self.err_par += k * (self.u_ref.dot(e).abs() - self.err_par);
         // Rotation check: 20 ms low-pass of the back-EMF across the reference (the α axis
         // after the alignment, where a turning rotor's EMF ω·λf lies), from the model with
         // R̂s once known (the nameplate before) and the nameplate L.

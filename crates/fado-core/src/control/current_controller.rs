@@ -20,12 +20,32 @@ use crate::control::pi::{Pi, PiConfig};
 use crate::error::{ConfigError, NonFiniteInput, check};
 use crate::{Dq, MachineModel, Real};
 
-/// Hard bound of the current PIs' voltage and integral in V, default of
+/// Hard bound of the current PIs' voltage and integral in V, the least value of
 /// [`CurrentControllerConfig::voltage_bound`] \[A\]: a last guard against absurd estimates,
-/// far above what the modulation lets through for the DC links fado has been run with
-/// (24–565 V). An absolute voltage, not a ratio of the DC link: it only ever acts on estimates
-/// that are wrong, and changing it would change no result of a working drive.
+/// far above what the modulation lets through on DC links up to 750 V. It only ever acts on
+/// estimates that are wrong; on a higher DC link the bound is
+/// [`CURRENT_VOLTAGE_BOUND_DC_RATIO`] × V_dc ([`voltage_bound`]).
 pub const CURRENT_VOLTAGE_BOUND: f64 = 1000.0;
+
+/// The current PIs' bound as a multiple of the DC link, where that is above
+/// [`CURRENT_VOLTAGE_BOUND`]: 4/3, twice the longest voltage vector the inverter makes
+/// (a hexagon vertex, 2/3·V_dc) \[A\]. A fixed bound below what the modulation realises caps
+/// the machine's voltage: a 10 kV-class machine on a 14 kV link held at 1000 V stalls at a
+/// sixth of its rated speed (`crates/fado-sim/tests/calibration_load_classes.rs`).
+pub const CURRENT_VOLTAGE_BOUND_DC_RATIO: f64 = 4.0 / 3.0;
+
+/// The current PIs' hard bound (V) on the DC link `dc_voltage`: the larger of
+/// [`CURRENT_VOLTAGE_BOUND`] and [`CURRENT_VOLTAGE_BOUND_DC_RATIO`] × `dc_voltage` (a
+/// non-finite or non-positive link gives the former).
+pub fn voltage_bound<T: Real>(dc_voltage: T) -> T {
+    let scaled = T::lit(CURRENT_VOLTAGE_BOUND_DC_RATIO) * dc_voltage;
+    // NaN compares false: the absolute bound.
+    if scaled > T::lit(CURRENT_VOLTAGE_BOUND) {
+        scaled
+    } else {
+        T::lit(CURRENT_VOLTAGE_BOUND)
+    }
+}
 
 /// Default closed-loop bandwidth of the current loop in Hz: 250 (paper, V).
 pub const DEFAULT_BANDWIDTH_HZ: f64 = 250.0;
@@ -65,7 +85,7 @@ pub struct CurrentControllerConfig<T> {
     pub anti_windup_ratio: T,
     /// Hard bound on each axis' voltage and integral in V, a last guard against absurd
     /// estimates; the real limit is the inverter's (modulation). Default
-    /// [`CURRENT_VOLTAGE_BOUND`].
+    /// [`voltage_bound`] of the machine model's DC link: [`CURRENT_VOLTAGE_BOUND`] up to 750 V.
     pub voltage_bound: T,
 }
 
@@ -73,7 +93,7 @@ impl<T: Real> CurrentControllerConfig<T> {
     /// The current loop for `machine` sampled every `ts`: R̂s, L̂d, L̂q and λ̂f are the machine
     /// model's, `bandwidth_hz` [`DEFAULT_BANDWIDTH_HZ`], `decoupling` [`DEFAULT_DECOUPLING`],
     /// `anti_windup_ratio` [`DEFAULT_ANTI_WINDUP_RATIO`] and `voltage_bound`
-    /// [`CURRENT_VOLTAGE_BOUND`].
+    /// [`voltage_bound`] of `machine.dc_voltage`.
     pub fn for_machine(machine: &MachineModel<T>, ts: T) -> Self {
         Self {
             ts,
@@ -84,7 +104,7 @@ impl<T: Real> CurrentControllerConfig<T> {
             bandwidth_hz: T::lit(DEFAULT_BANDWIDTH_HZ),
             decoupling: DEFAULT_DECOUPLING,
             anti_windup_ratio: T::lit(DEFAULT_ANTI_WINDUP_RATIO),
-            voltage_bound: T::lit(CURRENT_VOLTAGE_BOUND),
+            voltage_bound: voltage_bound(machine.dc_voltage),
         }
     }
 }
@@ -325,5 +345,25 @@ mod tests {
         };
         let (with, without) = (settle(true), settle(false));
         assert!(with < 0.1 && without > 5.0 * with, "{with} {without}");
+    }
+
+    /// The PIs' bound leaves every voltage the inverter makes through: the absolute 1000 V on
+    /// DC links up to 750 V, 4/3·V_dc (twice a hexagon vertex) above; a machine model
+    /// without a DC link keeps the absolute bound. A 10 kV-class machine whose back-EMF at a
+    /// fifth of its rated speed is 1.5 kV on a 14 kV link is not capped at 1 kV.
+    #[test]
+    fn the_voltage_bound_scales_with_a_high_dc_link() {
+        assert_eq!(voltage_bound(24.0), CURRENT_VOLTAGE_BOUND);
+        assert_eq!(voltage_bound(750.0), CURRENT_VOLTAGE_BOUND);
+        assert_eq!(voltage_bound(f64::NAN), CURRENT_VOLTAGE_BOUND);
+        assert_eq!(voltage_bound(0.0), CURRENT_VOLTAGE_BOUND);
+        let high = voltage_bound(14_000.0);
+        assert!(high >= 2.0 / 3.0 * 14_000.0 * 2.0 - 1e-9, "{high}");
+        let mut m = MachineModel::<f64>::paper();
+        m.dc_voltage = 14_000.0;
+        assert_eq!(
+            CurrentControllerConfig::for_machine(&m, 1e-4).voltage_bound,
+            high
+        );
     }
 }

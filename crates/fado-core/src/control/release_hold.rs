@@ -120,6 +120,14 @@ pub struct ReleaseHoldTuning<T> {
     /// seeds 1–4), max |θ − θ̂| from ready 0.22–0.29 rad with the standstill's 60 Hz,
     /// 0.07–0.08 rad with it (docs/results/startup.md).
     pub track_fall: bool,
+    /// After a hold the start-up's motion test engaged ([`ReleaseHold::engage`]), the time (s)
+    /// in which the speed loop's reference rises from zero to the rated speed until it meets
+    /// the application's reference. Default 2 s \[A\]: the rotor leaves the held standstill
+    /// at half its rated speed per second, within what the estimator follows from rest
+    /// (measured on a 1.5 kW servo of 0.15 s mechanical start time, no load: 0.075 rad at
+    /// 1/3 of its rated speed per second, 0.20 rad at 1, 0.25 rad after a step of 6.4 % of
+    /// its rated speed; `crates/fado-sim/tests/calibration_load_classes.rs`).
+    pub resume_time: T,
 }
 
 impl<T: Real> Default for ReleaseHoldTuning<T> {
@@ -130,11 +138,12 @@ impl<T: Real> Default for ReleaseHoldTuning<T> {
             trigger: T::lit(0.02),
             window: T::lit(0.05),
             track_fall: true,
+            resume_time: T::lit(2.0),
         }
     }
 }
 
-cast_record!(ReleaseHoldTuning { travel, trigger, window ; enabled, track_fall });
+cast_record!(ReleaseHoldTuning { travel, trigger, window, resume_time ; enabled, track_fall });
 
 /// The largest ωc·Ts the hold's current-loop rule gives ([`current_bandwidth_for_hold`]):
 /// 0.2 \[A\], with the loop's 1.5-sample delay a phase margin of 90° − 0.3 rad = 73°
@@ -261,6 +270,9 @@ pub struct ReleaseHold<T> {
     armed: bool,
     /// Armed by [`arm_at_release`](Self::arm_at_release) (the brake opened).
     released: bool,
+    /// Engaged by [`engage`](Self::engage) (the start-up saw the rotor move): acts at any
+    /// speed reference until it has settled.
+    engaged_by_motion: bool,
     active: bool,
     elapsed: u32,
     theta_hold: T,
@@ -273,6 +285,13 @@ pub struct ReleaseHold<T> {
     omega_gain: T,
     /// Times the hold acted since the drive was built.
     engaged: u32,
+    /// The resumed reference's step per sample (electrical rad/s): the rated speed over
+    /// `resume_time`.
+    resume_step: T,
+    /// The speed reference resumes from zero after a motion hold's hand-over.
+    resuming: bool,
+    /// The resumed reference (electrical rad/s).
+    resumed: T,
 }
 
 impl<T: Real> ReleaseHold<T> {
@@ -286,11 +305,14 @@ impl<T: Real> ReleaseHold<T> {
         i_max: T,
     ) -> Result<Self, ConfigError> {
         let travel = check::positive("release_hold.travel", tuning.travel)?;
+        let resume_time = check::positive("release_hold.resume_time", tuning.resume_time)?;
+        let p = T::lit(machine.pole_pairs as f64);
+        let omega_rated = machine.rated_speed_rpm * T::two_pi() / T::lit(60.0) * p;
+        let resume_step = omega_rated * ts / resume_time;
         let trigger = check::positive("release_hold.trigger", tuning.trigger)?;
         let window = check::non_negative("release_hold.window", tuning.window)?;
         let n = window / ts;
         check::below("release_hold.window", n, T::lit(4e9), "below 4e9 samples")?;
-        let p = T::lit(machine.pole_pairs as f64);
         let b = T::lit(1.5) * p * p * machine.flux_linkage / machine.inertia;
         let omega = design_omega(machine, travel)
             .step_min(T::two_pi() * current_bandwidth_hz / T::lit(10.0))
@@ -298,7 +320,7 @@ impl<T: Real> ReleaseHold<T> {
         let kp = T::lit(3.0) * omega * omega / b;
         let kd = T::lit(3.0) * omega / b;
         let ki_ts = omega * omega * omega * ts / b;
-        if !(kp.is_finite() && kd.is_finite() && ki_ts.is_finite()) {
+        if !(kp.is_finite() && kd.is_finite() && ki_ts.is_finite() && resume_step.is_finite()) {
             return Err(ConfigError::OutOfRange {
                 field: "release_hold.travel",
                 expected: "finite hold gains for the machine model",
@@ -319,6 +341,7 @@ impl<T: Real> ReleaseHold<T> {
             i_max,
             armed: false,
             released: false,
+            engaged_by_motion: false,
             active: false,
             elapsed: 0,
             theta_hold: T::zero(),
@@ -328,6 +351,9 @@ impl<T: Real> ReleaseHold<T> {
             omega: T::zero(),
             omega_gain: ts / (T::one() / (T::lit(5.0) * omega) + ts),
             engaged: 0,
+            resume_step,
+            resuming: false,
+            resumed: T::zero(),
         })
     }
 
@@ -341,6 +367,8 @@ impl<T: Real> ReleaseHold<T> {
     pub fn arm(&mut self, theta_hold: T) {
         self.armed = self.enabled && theta_hold.is_finite();
         self.released = false;
+        self.engaged_by_motion = false;
+        self.resuming = false;
         self.active = false;
         self.elapsed = 0;
         self.held = 0;
@@ -349,6 +377,49 @@ impl<T: Real> ReleaseHold<T> {
         self.output = T::zero();
         self.theta_last = theta_hold;
         self.omega = T::zero();
+    }
+
+    /// Acts at once, holding `theta_hold`, whether the hold is enabled or not: the start-up
+    /// saw a load turn the rotor during a calibration
+    /// ([`GainCalibrationStatus::RotorMoved`](crate::control::GainCalibrationStatus::RotorMoved)).
+    /// It holds at any speed reference until it has settled (10/ω_h; through the loaded
+    /// standstill where [`holds_through_standstill`] says so, while the reference is zero),
+    /// then hands its integral, the load it found, to the speed loop. The estimator tracks the
+    /// fall as after a brake's release ([`tracking_fall`](Self::tracking_fall)).
+    pub fn engage(&mut self, theta_hold: T) {
+        let enabled = self.enabled;
+        self.enabled = true;
+        self.arm(theta_hold);
+        self.enabled = enabled;
+        if self.armed {
+            self.released = true;
+            self.engaged_by_motion = true;
+            self.active = true;
+            self.engaged = self.engaged.saturating_add(1);
+        }
+    }
+
+    /// The speed loop's reference for the application's `speed_ref` (electrical rad/s): zero
+    /// while a hold the start-up's motion test engaged acts, then rising from zero by the
+    /// rated speed per `resume_time` until it meets `speed_ref`; `speed_ref` itself
+    /// otherwise.
+    pub fn resumed(&mut self, speed_ref: T) -> T {
+        if self.active && self.engaged_by_motion {
+            return T::zero();
+        }
+        if !self.resuming {
+            return speed_ref;
+        }
+        let step = self.resume_step;
+        let gap = speed_ref - self.resumed;
+        // NaN compares false: a non-finite reference ends the ramp (the speed loop refuses it).
+        let beyond = gap.abs() > step;
+        if !beyond {
+            self.resuming = false;
+            return speed_ref;
+        }
+        self.resumed += if gap > T::zero() { step } else { -step };
+        self.resumed
     }
 
     /// Disarmed and not acting (the next [`arm`](Self::arm) re-arms it).
@@ -424,9 +495,18 @@ impl<T: Real> ReleaseHold<T> {
             self.omega += self.omega_gain * (rate - self.omega);
         }
         let omega = self.omega;
-        let settled = self.active && !self.through_standstill && self.held >= self.hold_samples;
-        if speed_ref != T::zero() || settled || !e.is_finite() || !omega.is_finite() {
+        // Engaged by the start-up's motion test, the hold keeps the rotor at any reference
+        // until it has settled; armed at a release, a reference hands over at once.
+        let moving_ref = speed_ref != T::zero();
+        let standstill_hold = self.through_standstill && !(self.engaged_by_motion && moving_ref);
+        let settled = self.active && !standstill_hold && self.held >= self.hold_samples;
+        let leave = moving_ref && !self.engaged_by_motion;
+        if leave || settled || !e.is_finite() || !omega.is_finite() {
             let was = self.active;
+            if was && self.engaged_by_motion {
+                self.resuming = true;
+                self.resumed = T::zero();
+            }
             self.disarm();
             return if was {
                 HoldAction::Handover(self.integral)
@@ -459,210 +539,4 @@ impl<T: Real> ReleaseHold<T> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A rigid rotor θ̈ = b·(i − i_L) under the hold with an exact angle estimate: a step
-    /// of the rated load at t = 0, until the hold hands over. Returns (largest travel, the
-    /// angle error at the hand-over, the torque handed over).
-    fn rollback(machine: &MachineModel<f64>, travel: f64) -> (f64, f64, f64) {
-        let ts = 1e-4;
-        let tuning = ReleaseHoldTuning {
-            enabled: true,
-            travel,
-            ..ReleaseHoldTuning::default()
-        };
-        let p = machine.pole_pairs as f64;
-        let b = 1.5 * p * p * machine.flux_linkage / machine.inertia;
-        // The rated load in A of magnet q current (the hold's unit).
-        let i_load = machine.rated_torque / (1.5 * p * machine.flux_linkage);
-        let i_max = 2.0 * i_load;
-        let mut h = ReleaseHold::new(&tuning, machine, ts, 250.0, i_max).unwrap();
-        let (mut theta, mut omega, mut i) = (0.3, 0.0, 0.0);
-        h.arm(0.3);
-        let mut worst: f64 = 0.0;
-        for _ in 0..20_000 {
-            match h.step(0.0, theta, theta) {
-                HoldAction::Hold(x) => i = x,
-                HoldAction::Handover(x) => return (worst, theta - 0.3, x),
-                HoldAction::Idle => {}
-            }
-            omega += b * (i - i_load) * ts;
-            theta += omega * ts;
-            worst = worst.max(0.3 - theta);
-        }
-        panic!("no hand-over")
-    }
-
-    #[test]
-    fn the_rated_load_moves_the_rotor_by_about_the_design_travel() {
-        let mut light = MachineModel::paper();
-        light.inertia = 0.001;
-        for m in [MachineModel::paper(), light] {
-            let (worst, end, i) = rollback(&m, 0.2);
-            // The paper's rotor: 0.19 rad for the 0.2 rad design; the light one, where ω_h is
-            // capped at a tenth of the current loop's bandwidth: 0.47 rad. After 10/ω_h the
-            // rotor is back (the triple pole's 0.3 % residue) and the integral is the load.
-            assert!(worst > 0.1 && worst < 0.5, "{worst}");
-            assert!(end.abs() < 0.01 * worst, "{end}");
-            assert!((i - m.rated_current).abs() < 0.01 * m.rated_current, "{i}");
-        }
-    }
-
-    #[test]
-    fn a_rotor_whose_reluctance_adds_torque_is_held_against_its_rated_torque() {
-        // A rated torque 2.25 times the magnet's 1.5·p·λ̂f·I_rated (the 50 kW IPMSM's ratio):
-        // the rated load accelerates the rotor 2.25 times as fast. Designed for that
-        // acceleration p·T_rated/Ĵ the hold lets the rigid rotor move by about the 0.2 rad
-        // design travel; designed for the magnet's torque it would let it move 2.25 times as
-        // far (0.45 rad).
-        let paper = MachineModel::<f64>::paper();
-        let salient = MachineModel {
-            rated_torque: 2.25 * paper.rated_torque,
-            ..paper
-        };
-        let (worst, end, i) = rollback(&salient, 0.2);
-        assert!(worst > 0.15 && worst < 0.21, "{worst}");
-        assert!(end.abs() < 0.01 * worst, "{end}");
-        let i_load = salient.rated_torque / (1.5 * 4.0 * salient.flux_linkage);
-        assert!((i - i_load).abs() < 0.01 * i_load, "{i}");
-    }
-
-    #[test]
-    fn a_light_rotor_gets_the_current_loop_its_hold_needs() {
-        // The multirotor preset (14 pole pairs, 0.875 mWb, 34 A, 2e-4 kg·m², Ts = 25 µs):
-        // b·I = 4.4e4 rad/s², ω_h = √(0.27·4.4e4/0.2) = 243 rad/s, ωc = 10·ω_h: 387 Hz.
-        let fast = crate::control::tracker_feedforward::multirotor_model();
-        let on = ReleaseHoldTuning {
-            enabled: true,
-            ..ReleaseHoldTuning::default()
-        };
-        let hz = current_bandwidth_for_hold(&on, &fast, 25e-6, 250.0);
-        assert!((hz - 387.2).abs() < 0.5, "{hz}");
-        // With it the hold is the designed triple pole (not capped): the rated load moves the
-        // rigid rotor by about the design travel, against 0.48 rad at 250 Hz.
-        let ts = 25e-6;
-        let p = 14.0;
-        let b = 1.5 * p * p * fast.flux_linkage / fast.inertia;
-        let travel = |current_hz: f64| {
-            let mut h = ReleaseHold::new(&on, &fast, ts, current_hz, 68.0).unwrap();
-            let (mut theta, mut omega, mut i, mut worst) = (0.0f64, 0.0, 0.0, 0.0f64);
-            h.arm(0.0);
-            for _ in 0..(0.05 / ts) as usize {
-                if let HoldAction::Hold(x) = h.step(0.0, theta, theta) {
-                    i = x;
-                }
-                omega += b * (i - fast.rated_current) * ts;
-                theta += omega * ts;
-                worst = worst.max(-theta);
-            }
-            worst
-        };
-        let (wide, paper) = (travel(hz), travel(250.0));
-        assert!(wide < 0.25 && paper > 0.4, "{wide} {paper}");
-        // The paper's motor keeps the tuning's bandwidth, as does a disabled hold; the
-        // sampling caps the rule at ωc·Ts = 0.2.
-        // A 750 W 10-pole servo's capped travel is 1.6 times the design (0.33 rad): kept.
-        let servo = MachineModel {
-            pole_pairs: 5,
-            flux_linkage: 0.05,
-            rated_current: 6.4,
-            rated_torque: 2.4,
-            inertia: 4e-4,
-            ..MachineModel::<f64>::paper()
-        };
-        assert_eq!(current_bandwidth_for_hold(&on, &servo, 1e-4, 250.0), 250.0);
-        let paper_motor = MachineModel::<f64>::paper();
-        assert_eq!(
-            current_bandwidth_for_hold(&on, &paper_motor, 1e-4, 250.0),
-            250.0
-        );
-        let off = ReleaseHoldTuning::default();
-        assert_eq!(current_bandwidth_for_hold(&off, &fast, ts, 250.0), 250.0);
-        let feather = MachineModel {
-            inertia: 1e-9,
-            ..fast
-        };
-        let capped = current_bandwidth_for_hold(&on, &feather, ts, 250.0);
-        let wc_ts = core::f64::consts::TAU * capped * ts;
-        assert!((wc_ts - MAX_CURRENT_WC_TS).abs() < 1e-12, "{wc_ts}");
-    }
-
-    #[test]
-    fn the_probe_swing_is_that_of_a_free_rotor_under_its_square_wave() {
-        // A free rotor under ±a for half a period each, its mean speed zero: the swing about
-        // its mean is a·T²/32.
-        let (a, period, n) = (1000.0, 0.1, 100_000);
-        let ts = period / n as f64;
-        let (mut omega, mut theta) = (-a * period / 4.0, 0.0f64);
-        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-        for k in 0..2 * n {
-            let acc = if (k % n) < n / 2 { a } else { -a };
-            omega += acc * ts;
-            theta += omega * ts;
-            lo = lo.min(theta);
-            hi = hi.max(theta);
-        }
-        let swing = (hi - lo) / 2.0;
-        assert!(
-            (swing - a * period * period / 32.0).abs() < 1e-3 * swing,
-            "{swing}"
-        );
-        assert!((standstill_swing(a, 1.0, period) - swing * PROBE_ANGLE_SIN).abs() < 1e-3);
-        assert!((PROBE_ANGLE_SIN - 0.25f64.sin()).abs() < 1e-15);
-    }
-
-    #[test]
-    fn a_light_rotor_is_held_through_its_loaded_standstill() {
-        let on = ReleaseHoldTuning {
-            enabled: true,
-            ..ReleaseHoldTuning::default()
-        };
-        // The multirotor preset (b = 1.5·14²·0.875e-3/2e-4 = 1286 rad/s² per A) under the
-        // probe's 3.4 A at 0.1 s: 0.34 rad, beyond the 0.2 rad design travel.
-        let fast = crate::control::tracker_feedforward::multirotor_model();
-        assert!(holds_through_standstill(&on, &fast, 3.4, 0.1));
-        // The paper's motor (b = 1.5·4²·0.088/0.012 = 176 rad/s² per A, its probe 2.2 A):
-        // 0.03 rad, far within it.
-        let paper = MachineModel::<f64>::paper();
-        let amplitude = 0.1 * paper.rated_current;
-        assert!(!holds_through_standstill(&on, &paper, amplitude, 0.1));
-        // The probe off, the hold disabled, a non-finite inertia: the hand-over after 10/ω_h.
-        assert!(!holds_through_standstill(&on, &fast, 0.0, 0.1));
-        let off = ReleaseHoldTuning::default();
-        assert!(!holds_through_standstill(&off, &fast, 3.4, 0.1));
-        let broken = MachineModel {
-            inertia: f64::NAN,
-            ..fast
-        };
-        assert!(!holds_through_standstill(&on, &broken, 3.4, 0.1));
-        // Held: the hold acts past 10/ω_h and hands its integral over at the reference.
-        let mut h = ReleaseHold::new(&on, &fast, 25e-6, 387.0, 68.0).unwrap();
-        h.set_through_standstill(true);
-        h.arm(0.0);
-        for _ in 0..20_000 {
-            assert!(matches!(h.step(0.0, -0.1, -0.1), HoldAction::Hold(_)));
-        }
-        assert!(h.held > h.hold_samples);
-        assert!(matches!(h.step(1.0, -0.1, -0.1), HoldAction::Handover(x) if x > 0.0));
-    }
-
-    #[test]
-    fn an_unloaded_rotor_never_triggers_it_and_a_reference_hands_over() {
-        let m = MachineModel::<f64>::paper();
-        let t = ReleaseHoldTuning {
-            enabled: true,
-            ..ReleaseHoldTuning::default()
-        };
-        let mut h = ReleaseHold::new(&t, &m, 1e-4, 250.0, 40.0).unwrap();
-        h.arm(1.0);
-        for _ in 0..10_000 {
-            assert_eq!(h.step(0.0, 1.0 + 0.01, 1.0 + 0.01), HoldAction::Idle);
-        }
-        assert_eq!(h.engaged(), 0);
-        h.arm(1.0);
-        assert!(matches!(h.step(0.0, 0.9, 0.9), HoldAction::Hold(x) if x > 0.0));
-        assert!(matches!(h.step(5.0, 0.9, 0.9), HoldAction::Handover(x) if x > 0.0));
-        assert_eq!(h.step(0.0, 0.5, 0.5), HoldAction::Idle);
-    }
-}
+mod tests;

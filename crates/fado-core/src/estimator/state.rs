@@ -6,7 +6,7 @@ use crate::active_flux::{ActiveFlux, ActiveFluxPoint};
 use crate::error::ConfigError;
 use crate::integrand_offset::IntegrandOffsetState;
 use crate::lock::LockState;
-use crate::magnetics::FluxWarmStart;
+use crate::magnetics::{FluxLookup, FluxWarmStart};
 use crate::mode::Mode;
 use crate::observer::ObserverState;
 use crate::rotor_flux::{rotor_angle, rotor_flux, stator_flux};
@@ -125,6 +125,24 @@ impl<T: Real> EstimatorState<T> {
         self.advance(p, v_ab, i_ab)
     }
 
+    /// [`Self::step_lean`] with the machine's model named by its type: `model` is the table
+    /// `p`'s machine borrows (`MachineMagnetics::Uniform(&MAP)` with `MAP = TABLE.map()`,
+    /// `model = &TABLE`), so that the saturating step is compiled for that table — its
+    /// lookups inlined with the grid's shape a constant, no match on the model and no index
+    /// checked (docs/results/firmware-cost.md, "Flux map"). The same estimate as
+    /// [`Self::step_lean`]; where `model` is not `p`'s model (or `p`'s machine has constant
+    /// inductances), [`Self::step_lean`] itself.
+    #[inline]
+    pub fn step_lean_in<M: FluxLookup<T>>(
+        &mut self,
+        p: &EstimatorParams<T>,
+        model: M,
+        v_ab: Ab<T>,
+        i_ab: Ab<T>,
+    ) -> LeanEstimate<T> {
+        self.advance_in(p, model, v_ab, i_ab)
+    }
+
     /// λ̂a/λ̂f = 1 + (L̂d − L̂q)·î_d/λ̂f, the active flux the limiter circle and the lock
     /// detector's bounds refer to (1 on a surface-magnet rotor, and while the trackers hold),
     /// î_d the current along λ̂r; at least the tracker's hold ratio. Formed where it is used
@@ -162,9 +180,10 @@ impl<T: Real> EstimatorState<T> {
     /// (≈ λ̂f·e^{jθ̂}, no extra state), î_d the current along it. Zero while that vector is
     /// below the tracker's hold level (no usable axis).
     #[inline]
-    pub(super) fn active_flux_swing<const SATURATING: bool>(
+    pub(super) fn active_flux_swing<M: FluxLookup<T>, const SATURATING: bool>(
         &self,
         p: &EstimatorParams<T>,
+        af: &ActiveFlux<T, M>,
         i_ab: Ab<T>,
         saliency: T,
     ) -> (Ab<T>, FluxWarmStart<T>) {
@@ -172,7 +191,6 @@ impl<T: Real> EstimatorState<T> {
         let n2 = axis.norm_squared();
         if SATURATING {
             // A saturating model: λ̂a(î) − ψd(0, 0) along the axis, î in its frame.
-            let af = &p.active_flux;
             return if n2 > p.hold_level_sq {
                 // The axis is the estimated active flux: the last sample's solution (in a
                 // frame within a sample's turn of this one) starts the model's flux, else

@@ -17,7 +17,8 @@ use super::{
     BROKEN_LIMITED, BROKEN_OFFSET, BROKEN_RS, Diagnostics, Estimate, EstimatorParams,
     EstimatorState, LOCK_PERIOD, SLOT_LOCK, SLOT_OFFSET, SLOT_RS, SLOW_PERIOD,
 };
-use crate::active_flux::ActiveFluxPoint;
+use crate::active_flux::{ActiveFlux, ActiveFluxPoint};
+use crate::magnetics::FluxLookup;
 use crate::magnetics::FluxWarmStart;
 use crate::mode::Mode;
 use crate::real::all_finite;
@@ -75,8 +76,51 @@ impl<T: Real> EstimatorState<T> {
         if p.active_flux.is_saturating() {
             self.advance_saturating(p, v_ab, i_ab)
         } else {
-            self.advance_with::<O, false>(p, v_ab, i_ab)
+            self.advance_with::<O, _, false>(p, &p.active_flux, v_ab, i_ab)
         }
+    }
+
+    /// [`Self::advance`] with the model named by `model` (a table's own type,
+    /// `crate::magnetics::FluxLookup`): where it is the parameters' model, the saturating
+    /// step compiled for it, out of line; else the step of the parameters' model.
+    #[inline(always)]
+    pub(super) fn advance_in<O: From<Estimate<T>>, M: FluxLookup<T>>(
+        &mut self,
+        p: &EstimatorParams<T>,
+        model: M,
+        v_ab: Ab<T>,
+        i_ab: Ab<T>,
+    ) -> O {
+        if p.active_flux.is_saturating() && model.is_model_of(p.active_flux.model()) {
+            self.advance_typed(p, model, v_ab, i_ab)
+        } else {
+            self.advance_record(p, v_ab, i_ab)
+        }
+    }
+
+    /// [`Self::advance`] out of line: [`Self::advance_in`]'s step where `model` is not the
+    /// parameters' (its caller then carries no copy of the constant-inductance step).
+    #[inline(never)]
+    fn advance_record<O: From<Estimate<T>>>(
+        &mut self,
+        p: &EstimatorParams<T>,
+        v_ab: Ab<T>,
+        i_ab: Ab<T>,
+    ) -> O {
+        self.advance(p, v_ab, i_ab)
+    }
+
+    /// The saturating step compiled for the model `M`, out of line.
+    #[inline(never)]
+    fn advance_typed<O: From<Estimate<T>>, M: FluxLookup<T>>(
+        &mut self,
+        p: &EstimatorParams<T>,
+        model: M,
+        v_ab: Ab<T>,
+        i_ab: Ab<T>,
+    ) -> O {
+        let af = p.active_flux.with_model(model);
+        self.advance_with::<O, M, true>(p, &af, v_ab, i_ab)
     }
 
     /// The step of a saturating model: out of line, so that the constant-inductance step it
@@ -88,15 +132,16 @@ impl<T: Real> EstimatorState<T> {
         v_ab: Ab<T>,
         i_ab: Ab<T>,
     ) -> O {
-        self.advance_with::<O, true>(p, v_ab, i_ab)
+        self.advance_with::<O, _, true>(p, &p.active_flux, v_ab, i_ab)
     }
 
     /// The step with the magnetics resolved at compile time: `SATURATING` is whether
-    /// `p`'s model saturates (`crate::active_flux`).
+    /// `p`'s model saturates (`crate::active_flux`), `af` that model as `M` names it.
     #[inline(always)]
-    fn advance_with<O: From<Estimate<T>>, const SATURATING: bool>(
+    fn advance_with<O: From<Estimate<T>>, M: FluxLookup<T>, const SATURATING: bool>(
         &mut self,
         p: &EstimatorParams<T>,
+        af: &ActiveFlux<T, M>,
         v_ab: Ab<T>,
         i_ab: Ab<T>,
     ) -> O {
@@ -115,7 +160,7 @@ impl<T: Real> EstimatorState<T> {
         // but absurd inputs can still overflow it, and a rejected sample must leave none of it
         // changed. One test at the end covers all of this (cheaper than a test per input and
         // per block, and than copying the estimator as a backup every sample).
-        let c = self.candidate::<SATURATING>(p, v_ab, i_ab);
+        let c = self.candidate::<M, SATURATING>(p, af, v_ab, i_ab);
         if !Self::is_committable(&c) {
             return self.reject(p).into();
         }
@@ -125,7 +170,7 @@ impl<T: Real> EstimatorState<T> {
         let rs_hat = self.integrator.rs_hat();
         let flux_linkage_hat = self.rs_adaptation.flux_linkage_hat;
         let mut estimate = Self::estimate(&c, rs_hat, flux_linkage_hat, self.lock_status);
-        let shift = self.commit::<SATURATING>(p, &c, i_ab);
+        let shift = self.commit::<M, SATURATING>(p, af, &c, i_ab);
         self.judge_lock::<SATURATING>(p, &c, i_ab);
         self.step_allowance = p.bounds.step();
         let slot = self.slot;
@@ -135,7 +180,7 @@ impl<T: Real> EstimatorState<T> {
         //    sample (see `rs_adaptation`, `integrand_offset`), after the commit so that the
         //    paper's path is untouched by them. A non-finite result is dropped (R̂s, ê stay).
         if self.rs_adaptation_on {
-            self.run_slow_laws::<SATURATING>(p, &c, slot, previous_mode, shift, v_ab, i_ab);
+            self.run_slow_laws::<M, SATURATING>(p, af, &c, slot, previous_mode, shift, v_ab, i_ab);
         }
         estimate.diagnostics.lock = self.lock_status;
         estimate.into()
@@ -144,9 +189,10 @@ impl<T: Real> EstimatorState<T> {
     /// Phases 1–5 of the sample: integrate, observe, form λ̂r, track, select the mode and
     /// the feedback for the next sample. Nothing is committed.
     #[inline(always)]
-    fn candidate<const SATURATING: bool>(
+    fn candidate<M: FluxLookup<T>, const SATURATING: bool>(
         &self,
         p: &EstimatorParams<T>,
+        af: &ActiveFlux<T, M>,
         v_ab: Ab<T>,
         i_ab: Ab<T>,
     ) -> Candidate<T> {
@@ -162,14 +208,13 @@ impl<T: Real> EstimatorState<T> {
         let lq_i = i_ab * if SATURATING { self.lq_secant } else { p.lq };
         // 2. Disturbance observer.
         let (observer_flux, disturbance, flux_warm) =
-            self.observe::<SATURATING>(p, lambda1, lq_i, i_ab, saliency);
+            self.observe::<M, SATURATING>(p, af, lambda1, lq_i, i_ab, saliency);
         // 3. Rotor flux and direct angle (eq. (20), (5), (6)); a saturating model's secant
         //    L̂q at the current in the frame of λ2 − L̂q⁻·i.
         let lambda2 = stator_flux(lambda1, disturbance);
         let (lambda_r, point, flux_warm) = if SATURATING {
             let (lambda_r, point, warm) =
-                p.active_flux
-                    .rotor_flux_warm(lambda2, i_ab, self.lq_secant, &flux_warm);
+                af.rotor_flux_warm(lambda2, i_ab, self.lq_secant, &flux_warm);
             (lambda_r, Some(point), warm)
         } else {
             (lambda2 - lq_i, None, flux_warm)
@@ -221,9 +266,10 @@ impl<T: Real> EstimatorState<T> {
     /// `EstimatorTuning::observer_on_rotor_flux`): (λ̂1, D̂), and the warm start of the model's
     /// ψ(î) after the active flux's swing (the last sample's where the swing solves none).
     #[inline(always)]
-    fn observe<const SATURATING: bool>(
+    fn observe<M: FluxLookup<T>, const SATURATING: bool>(
         &self,
         p: &EstimatorParams<T>,
+        af: &ActiveFlux<T, M>,
         lambda1: Ab<T>,
         lq_i: Ab<T>,
         i_ab: Ab<T>,
@@ -232,7 +278,7 @@ impl<T: Real> EstimatorState<T> {
         let (observer_input, warm) = if p.observer_on_rotor_flux {
             let active = lambda1 - lq_i;
             if saliency != T::zero() {
-                let (swing, warm) = self.active_flux_swing::<SATURATING>(p, i_ab, saliency);
+                let (swing, warm) = self.active_flux_swing::<M, SATURATING>(p, af, i_ab, saliency);
                 (active - swing, warm)
             } else {
                 (active, self.flux_warm)
@@ -308,9 +354,10 @@ impl<T: Real> EstimatorState<T> {
     /// observer's gains when due, the trackers, the mode and the feedback. Returns the
     /// re-centring shift of D̂.
     #[inline(always)]
-    fn commit<const SATURATING: bool>(
+    fn commit<M: FluxLookup<T>, const SATURATING: bool>(
         &mut self,
         p: &EstimatorParams<T>,
+        af: &ActiveFlux<T, M>,
         c: &Candidate<T>,
         i_ab: Ab<T>,
     ) -> Ab<T> {
@@ -335,7 +382,7 @@ impl<T: Real> EstimatorState<T> {
         }
         let observer_speed = c.t2s1.omega + self.lag_compensation;
         let observer_speed = if SATURATING {
-            self.notch_speed(p, c, observer_speed)
+            self.notch_speed(p, af, c, observer_speed)
         } else {
             observer_speed
         };
@@ -366,11 +413,15 @@ impl<T: Real> EstimatorState<T> {
     /// are judged at the operating point of the integrand-offset law's slot (the law holds on
     /// the same coupling test), once every [`SLOW_PERIOD`] samples.
     #[inline(always)]
-    fn notch_speed(&mut self, p: &EstimatorParams<T>, c: &Candidate<T>, speed: T) -> T {
+    fn notch_speed<M: FluxLookup<T>>(
+        &mut self,
+        p: &EstimatorParams<T>,
+        af: &ActiveFlux<T, M>,
+        c: &Candidate<T>,
+        speed: T,
+    ) -> T {
         if self.slot == SLOT_OFFSET {
-            self.frame_coupled = c
-                .point
-                .is_some_and(|point| p.active_flux.holds_offset(&point));
+            self.frame_coupled = c.point.is_some_and(|point| af.holds_offset(&point));
             self.notch_on = p.frame_ripple_notch
                 && self.frame_coupled
                 && c.point
@@ -428,9 +479,10 @@ impl<T: Real> EstimatorState<T> {
     /// slot of the round-robin (see [`SLOW_PERIOD`]).
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
-    fn run_slow_laws<const SATURATING: bool>(
+    fn run_slow_laws<M: FluxLookup<T>, const SATURATING: bool>(
         &mut self,
         p: &EstimatorParams<T>,
+        af: &ActiveFlux<T, M>,
         c: &Candidate<T>,
         slot: u8,
         previous_mode: Mode,
@@ -446,7 +498,7 @@ impl<T: Real> EstimatorState<T> {
         }
         let broken = self.slow_broken;
         if slot == SLOT_RS {
-            self.adapt_resistance::<SATURATING>(p, c, broken, v_ab, i_ab);
+            self.adapt_resistance::<M, SATURATING>(p, af, c, broken, v_ab, i_ab);
         } else if c.mode == Mode::Limiter {
             // Only the standstill law uses the means, and only after a whole period in the
             // limiter mode (else its regime is `Frozen`).
@@ -460,9 +512,10 @@ impl<T: Real> EstimatorState<T> {
 
     /// The R̂s adaptation's slot: R̂s, λ̂f and the standstill pull for the next period.
     #[inline(always)]
-    fn adapt_resistance<const SATURATING: bool>(
+    fn adapt_resistance<M: FluxLookup<T>, const SATURATING: bool>(
         &mut self,
         p: &EstimatorParams<T>,
+        af: &ActiveFlux<T, M>,
         c: &Candidate<T>,
         broken: u8,
         v_ab: Ab<T>,
@@ -476,9 +529,7 @@ impl<T: Real> EstimatorState<T> {
         // Beyond a map's data the model's slope is its edge cells' extension: the law would
         // learn that guess's error as resistance (docs/results/saturated-replay.md: a map that
         // ends at 0.6 × rated current, 0.32 rad at rated torque with the law, 0.004 frozen).
-        let beyond = SATURATING
-            && c.point
-                .is_some_and(|point| p.active_flux.beyond_data(&point));
+        let beyond = SATURATING && c.point.is_some_and(|point| af.beyond_data(&point));
         let regime = if broken & BROKEN_RS != 0 || coupled || beyond {
             AdaptationRegime::Frozen
         } else {
@@ -498,7 +549,7 @@ impl<T: Real> EstimatorState<T> {
         let i_mean = (self.i_sum + c.i_drop) * per_sample;
         self.v_sum = Ab::zero();
         self.i_sum = Ab::zero();
-        let (state, pull) = p.rs_adaptation_params.next_state::<SATURATING>(
+        let (state, pull) = p.rs_adaptation_params.next_state::<M, SATURATING>(
             &self.rs_scale,
             &self.rs_adaptation,
             v_mean - self.offset.offset,
@@ -509,7 +560,7 @@ impl<T: Real> EstimatorState<T> {
             c.t2s1.omega,
             regime,
             self.offset.learning_samples >= p.flux_settle_periods,
-            Some(&p.active_flux),
+            Some(af),
         );
         // The pull acts until the law runs again (one period), with ê.
         let slow_feedback = self.offset.offset + pull;

@@ -330,3 +330,72 @@ fn release_tracking_runs_t2s1_at_its_running_bandwidth_in_limiter_mode() {
     );
     assert_eq!(lag(0.0, true), lag(0.0, false));
 }
+
+/// `step_lean_in` with the machine's uniform table named by its type is `step_lean` on the
+/// machine record that borrows it, bit for bit (the same lookups, compiled for the table),
+/// accepted and rejected samples alike, in both precisions; with another table (or a machine
+/// of constant inductances) it is `step_lean` itself.
+fn typed_table_step_matches<T: Real>() {
+    use crate::magnetics::{
+        FluxLookup, FluxTable, MachineMagnetics, MagneticModel, UniformFluxTable,
+    };
+    use std::boxed::Box;
+    let t64 = crate::magnetics::tests::ipm_table::<f64>();
+    let table = FluxTable::<T, 16, 16> {
+        i_d: t64.i_d.map(T::lit),
+        i_q: t64.i_q.map(T::lit),
+        psi_d: t64.psi_d.map(|r| r.map(T::lit)),
+        psi_q: t64.psi_q.map(|r| r.map(T::lit)),
+    };
+    let uniform: &'static UniformFluxTable<T, 16, 16> =
+        Box::leak(Box::new(UniformFluxTable::new(&table).unwrap()));
+    let other: &'static UniformFluxTable<T, 16, 16> = Box::leak(Box::new(*uniform));
+    let machine = MachineModel::<T> {
+        rs: T::lit(3.6),
+        ld: T::lit(0.036),
+        lq: T::lit(0.051),
+        flux_linkage: T::lit(0.545),
+        pole_pairs: 3,
+        rated_current: T::lit(6.08),
+        magnetics: MachineMagnetics::Uniform(Box::leak(Box::new(uniform.map()))),
+        ..MachineModel::<T>::paper()
+    };
+    assert!(uniform.is_model_of(&machine.magnetics));
+    assert!(!other.is_model_of(&machine.magnetics));
+    for model in [
+        machine,
+        MachineModel {
+            magnetics: MachineMagnetics::Linear,
+            ..machine
+        },
+    ] {
+        let params = EstimatorParams::new(EstimatorConfig::for_machine(&model)).unwrap();
+        let mut record = EstimatorState::new(&params);
+        let (mut typed, mut untyped) = (record, record);
+        let (w, ts) = (2.0 * core::f64::consts::PI * 20.0, 1e-4);
+        let flux = |n: u32| {
+            let rot = crate::Rotation::from_angle(w * ts * n as f64);
+            let i = crate::Dq::new(-1.5, 4.0);
+            (t64.map().unwrap().flux(i).to_ab(rot), i.to_ab(rot))
+        };
+        for n in 1..3000 {
+            let ((p1, i), (p0, _)) = (flux(n), flux(n - 1));
+            let v = i * 3.6 + (p1 - p0) * (1.0 / ts);
+            let v = if n == 1000 { Ab::new(f64::NAN, 0.0) } else { v };
+            let lit = |x: Ab<f64>| Ab::new(T::lit(x.alpha), T::lit(x.beta));
+            let (v, i) = (lit(v), lit(i));
+            let a = record.step_lean(&params, v, i);
+            assert_eq!(typed.step_lean_in(&params, uniform, v, i), a, "sample {n}");
+            assert_eq!(untyped.step_lean_in(&params, other, v, i), a, "sample {n}");
+            assert_eq!(typed, record, "sample {n}");
+            assert_eq!(untyped, record, "sample {n}");
+        }
+        assert!(record.rejected_samples() >= 1);
+    }
+}
+
+#[test]
+fn a_step_compiled_for_its_table_is_the_records_step() {
+    typed_table_step_matches::<f32>();
+    typed_table_step_matches::<f64>();
+}

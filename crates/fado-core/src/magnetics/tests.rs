@@ -561,6 +561,40 @@ fn a_uniform_table_is_the_flux_map() {
     assert!(UniformFluxTable::new(&skewed).is_none());
 }
 
+/// The uniform table's ψq(i_d, 0) (the secant's offset, one 1-D lookup on the line
+/// i_q = 0) is its own 2-D interpolant's value there, inside and beyond the grid, on a map
+/// whose q flux at zero q current is not zero; the compiler's build is the run-time one.
+#[test]
+fn a_uniform_tables_q_offset_is_its_interpolant_at_zero_q_current() {
+    let mut table = ipm_table::<f64>();
+    for (row, &i_d) in table.psi_q.iter_mut().zip(&table.i_d) {
+        row.iter_mut().for_each(|p| *p += 0.02 + 1e-3 * i_d);
+    }
+    let uniform = UniformFluxTable::new(&table).unwrap();
+    let view = uniform.map();
+    for i_d in (-40..=20).map(|k| 0.37 * k as f64) {
+        let two_d = uniform.flux(Dq::new(i_d, 0.0)).q;
+        let offset = uniform.q_flux_offset(i_d);
+        assert!((offset - two_d).abs() < 1e-15, "{i_d}: {offset} vs {two_d}");
+        assert!(
+            (offset - (0.02 + 1e-3 * i_d)).abs() < 1e-3,
+            "{i_d}: {offset}"
+        );
+        assert_eq!(view.q_flux_offset(i_d), offset);
+    }
+    let f = |x: &f64| *x as f32;
+    let t32 = FluxTable {
+        i_d: table.i_d.map(|x| f(&x)),
+        i_q: table.i_q.map(|x| f(&x)),
+        psi_d: table.psi_d.map(|r| r.map(|x| f(&x))),
+        psi_q: table.psi_q.map(|r| r.map(|x| f(&x))),
+    };
+    assert_eq!(
+        UniformFluxTable::from_f32_table(&t32),
+        UniformFluxTable::new(&t32).unwrap()
+    );
+}
+
 /// A map built by the compiler from a `static` table is the checked map of the same table.
 #[test]
 fn a_const_map_is_the_checked_map() {

@@ -2,7 +2,9 @@
 //! holds (one type for any grid size), with the table's lookup.
 
 use super::cell_inverse::{self, CellGrid, CellPolynomial};
-use super::uniform_table::{UniformFluxTable, bilinear_value, bilinear_with_jacobian, cell_of};
+use super::uniform_table::{
+    UniformFluxTable, axis_cell, bilinear_value, bilinear_with_jacobian, cell_of,
+};
 use super::{InductanceMatrix, MagneticModel};
 use crate::{Dq, Real};
 
@@ -20,10 +22,15 @@ pub struct UniformFluxMap<'a, T> {
     inv_step: Dq<T>,
     /// The table's cells, row-major (`cells[k·n_q + m]`).
     cells: &'a [[T; 8]],
+    /// ψq(i_d, 0) along each d cell (the table's `q_offset`).
+    q_offset: &'a [[T; 2]],
     /// Nodes along i_q (the row length of `cells`).
     nq: usize,
     /// The last cell index along i_d and along i_q (nodes − 2).
     last: (usize, usize),
+    /// The last node index along i_d and along i_q (nodes − 1): a lookup's clamp (the
+    /// table's last nodes hold the edge cells' polynomials).
+    last_node: (usize, usize),
 }
 
 impl<T: Copy, const ND: usize, const NQ: usize> UniformFluxTable<T, ND, NQ> {
@@ -34,8 +41,10 @@ impl<T: Copy, const ND: usize, const NQ: usize> UniformFluxTable<T, ND, NQ> {
             first: self.first,
             inv_step: self.inv_step,
             cells: self.cells.as_flattened(),
+            q_offset: &self.q_offset,
             nq: NQ,
             last: (ND.saturating_sub(2), NQ.saturating_sub(2)),
+            last_node: (ND.saturating_sub(1), NQ.saturating_sub(1)),
         }
     }
 }
@@ -48,6 +57,15 @@ impl<T: Real> UniformFluxMap<'_, T> {
             Some(c) => *c,
             None => [T::lit(f64::NAN); 8],
         }
+    }
+
+    /// Whether this borrows `table`'s cells (is `table.map()`).
+    #[inline]
+    pub fn borrows<const ND: usize, const NQ: usize>(
+        &self,
+        table: &UniformFluxTable<T, ND, NQ>,
+    ) -> bool {
+        core::ptr::eq(self.cells, table.cells.as_flattened())
     }
 
     /// Whether `i` lies beyond the grid by more than its edge cell along either axis (as
@@ -63,7 +81,7 @@ impl<T: Real> UniformFluxMap<'_, T> {
     /// ψ(i) and the incremental inductance ∂ψ/∂i of the bilinear interpolant at `i`.
     #[inline]
     pub fn flux_and_jacobian(&self, i: Dq<T>) -> (Dq<T>, InductanceMatrix<T>) {
-        let (k, m, fx, fy) = cell_of(self.first, self.inv_step, self.last, i);
+        let (k, m, fx, fy) = cell_of(self.first, self.inv_step, self.last_node, i);
         bilinear_with_jacobian(&self.coefficients(k, m), fx, fy, self.inv_step)
     }
 }
@@ -73,14 +91,18 @@ impl<T: Real> MagneticModel<T> for UniformFluxMap<'_, T> {
     /// firmware's step makes twice per sample).
     #[inline(always)]
     fn flux(&self, i: Dq<T>) -> Dq<T> {
-        let (k, m, fx, fy) = cell_of(self.first, self.inv_step, self.last, i);
+        let (k, m, fx, fy) = cell_of(self.first, self.inv_step, self.last_node, i);
         bilinear_value(&self.coefficients(k, m), fx, fy)
     }
 
-    /// ψq(i_d, 0), one lookup inlined into the caller (as [`MagneticModel::flux`]).
+    /// ψq(i_d, 0) from the table's line i_q = 0: one 1-D lookup inlined into the caller.
     #[inline(always)]
     fn q_flux_offset(&self, i_d: T) -> T {
-        self.flux(Dq::new(i_d, T::zero())).q
+        let (k, fx) = axis_cell(self.first.d, self.inv_step.d, self.last_node.0, i_d, false);
+        match self.q_offset.get(k) {
+            Some(c) => c[0] + fx * c[1],
+            None => T::lit(f64::NAN),
+        }
     }
 
     /// From the map's linearisation at zero current.

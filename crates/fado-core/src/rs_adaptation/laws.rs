@@ -7,6 +7,7 @@ use super::{
 };
 use crate::active_flux::{ActiveFlux, ActiveFluxPoint};
 use crate::error::{ConfigError, check};
+use crate::magnetics::FluxLookup;
 use crate::real::{max, min};
 use crate::{Ab, Real};
 
@@ -129,16 +130,16 @@ impl<T: Real> ResistanceAdaptationParams<T> {
     /// A saturating model's operating point at the current `i` in the frame of `lambda_r`
     /// (None for constant inductances: `SATURATING` false).
     #[inline(always)]
-    fn operating_point<const SATURATING: bool>(
-        active_flux: Option<&ActiveFlux<T>>,
+    fn operating_point<M: FluxLookup<T>, const SATURATING: bool>(
+        active_flux: Option<&ActiveFlux<T, M>>,
         lambda_r: Ab<T>,
         i: Ab<T>,
-    ) -> Option<(&ActiveFlux<T>, ActiveFluxPoint<T>)> {
+    ) -> Option<(&ActiveFlux<T, M>, ActiveFluxPoint<T>)> {
         if !SATURATING {
             return None;
         }
         let af = active_flux?;
-        let point = af.point(ActiveFlux::frame_current(lambda_r, i));
+        let point = af.point(ActiveFlux::<T>::frame_current(lambda_r, i));
         Some((af, point))
     }
 
@@ -189,7 +190,7 @@ impl<T: Real> ResistanceAdaptationParams<T> {
     /// copy costs a call and the spills around it on a Cortex-M4F, docs/results/firmware-cost.md).
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
-    pub(crate) fn next_state<const SATURATING: bool>(
+    pub(crate) fn next_state<M: FluxLookup<T>, const SATURATING: bool>(
         &self,
         scale: &ResistanceScale<T>,
         st: &ResistanceAdaptationState<T>,
@@ -201,7 +202,7 @@ impl<T: Real> ResistanceAdaptationParams<T> {
         omega: T,
         regime: AdaptationRegime,
         settled: bool,
-        active_flux: Option<&ActiveFlux<T>>,
+        active_flux: Option<&ActiveFlux<T, M>>,
     ) -> (ResistanceAdaptationState<T>, Ab<T>) {
         let mut next = ResistanceAdaptationState {
             rs_hat: st.rs_hat,
@@ -216,7 +217,7 @@ impl<T: Real> ResistanceAdaptationParams<T> {
         }
         let mag = mag_sq.step_sqrt();
         let pull = if regime == AdaptationRegime::Rotating {
-            let point = Self::operating_point::<SATURATING>(active_flux, lambda_r, i_drop);
+            let point = Self::operating_point::<M, SATURATING>(active_flux, lambda_r, i_drop);
             if !self.rotating(
                 scale, st, &mut next, i_drop, lambda_r, mag, omega, settled, point,
             ) {
@@ -224,7 +225,7 @@ impl<T: Real> ResistanceAdaptationParams<T> {
             }
             Ab::zero()
         } else {
-            let standstill = self.standstill::<SATURATING>(
+            let standstill = self.standstill::<M, SATURATING>(
                 scale,
                 st,
                 &mut next,
@@ -249,7 +250,7 @@ impl<T: Real> ResistanceAdaptationParams<T> {
     /// false when the active flux is no usable reference (nothing adapts).
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
-    fn rotating(
+    fn rotating<M: FluxLookup<T>>(
         &self,
         scale: &ResistanceScale<T>,
         st: &ResistanceAdaptationState<T>,
@@ -259,7 +260,7 @@ impl<T: Real> ResistanceAdaptationParams<T> {
         mag: T,
         omega: T,
         settled: bool,
-        point: Option<(&ActiveFlux<T>, ActiveFluxPoint<T>)>,
+        point: Option<(&ActiveFlux<T, M>, ActiveFluxPoint<T>)>,
     ) -> bool {
         let lf = st.flux_linkage_hat;
         let dl = self.saliency;
@@ -384,7 +385,7 @@ impl<T: Real> ResistanceAdaptationParams<T> {
     /// (nothing adapts, no pull).
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
-    fn standstill<const SATURATING: bool>(
+    fn standstill<M: FluxLookup<T>, const SATURATING: bool>(
         &self,
         scale: &ResistanceScale<T>,
         st: &ResistanceAdaptationState<T>,
@@ -395,7 +396,7 @@ impl<T: Real> ResistanceAdaptationParams<T> {
         lambda_r: Ab<T>,
         mag: T,
         omega: T,
-        active_flux: Option<&ActiveFlux<T>>,
+        active_flux: Option<&ActiveFlux<T, M>>,
     ) -> Option<Ab<T>> {
         let lf = st.flux_linkage_hat;
         let dl = self.saliency;
@@ -413,7 +414,7 @@ impl<T: Real> ResistanceAdaptationParams<T> {
         // L̂q·i_q (the q flux), L̂d (the d inductance a step of i_d meets) and the rotor's
         // active flux: a saturating model's at the estimated current, else the constants.
         let (rotation_emf, ld, active) =
-            match Self::operating_point::<SATURATING>(active_flux, lambda_r, i_mean) {
+            match Self::operating_point::<M, SATURATING>(active_flux, lambda_r, i_mean) {
                 Some((af, point)) => (
                     omega * (point.lq_secant * i_q),
                     af.ld_incremental(point.i_dq),

@@ -431,19 +431,21 @@ impl<T: Real> ResistanceAdaptation<T> {
         if !inputs_finite {
             return self.state.rs_hat;
         }
-        let (next, _) = self.params.next_state::<false>(
-            &self.scale,
-            &self.state,
-            v_ab,
-            i_drop,
-            i_drop,
-            i_drop,
-            lambda_r,
-            omega,
-            regime,
-            true,
-            None,
-        );
+        let (next, _) = self
+            .params
+            .next_state::<crate::magnetics::MachineMagnetics<T>, false>(
+                &self.scale,
+                &self.state,
+                v_ab,
+                i_drop,
+                i_drop,
+                i_drop,
+                lambda_r,
+                omega,
+                regime,
+                true,
+                None,
+            );
         if next.is_finite() {
             self.state = next;
         }

@@ -138,6 +138,11 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             self.last_i_ab = self.gain_corrected(i_abc).to_ab();
             let theta0 = self.aligned_angle;
             self.realign(theta0);
+            if self.gain.status() == GainCalibrationStatus::RotorMoved {
+                // A load turns the rotor: the release hold catches it at the aligned angle
+                // before the speed loop takes over (`ReleaseHold::engage`).
+                self.blocks.hold.engage(theta0);
+            }
             return self.last;
         }
         let axis = self.gain_axis();

@@ -17,6 +17,8 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         if let HoldAction::Handover(iq) = hold {
             self.blocks.speed.preset(iq);
         }
+        // After a hold the start-up's motion test engaged, the reference resumes from zero.
+        let speed_ref = self.blocks.hold.resumed(speed_ref);
         let iq = self
             .blocks
             .speed

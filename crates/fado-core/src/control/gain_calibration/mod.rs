@@ -96,8 +96,10 @@
 //! left side every sample (the current low-passed over [`MOTION_FILTER_TIME`] for its
 //! derivative) and ends at once with [`GainCalibrationStatus::RotorMoved`] above
 //! `motion_voltage` ([`MOTION_SPEED_RATIO`] of the rated speed's back-EMF): no release to zero
-//! current, so the drive's speed loop takes the load from the aligned angle. Measured on the
-//! presets at rest (switching-resolved, default sensors): at most 0.27 of the threshold.
+//! current. The drive starts at once from the aligned angle with its release hold engaged
+//! ([`ReleaseHold::engage`](crate::control::release_hold::ReleaseHold::engage)), which catches
+//! the rotor there and hands the load it found to the speed loop. Measured on the presets at
+//! rest (switching-resolved, default sensors): at most 0.27 of the threshold.
 //!
 //! # Sequence
 //! Current loop at I₁ (`settle_time`); voltage V₁: hold (`hold_time`), average

@@ -1,0 +1,262 @@
+//! The release hold's tests: the rigid rotor under the rated load, the current loop it
+//! needs, the loaded standstill and the motion hold.
+use super::*;
+
+/// A rigid rotor θ̈ = b·(i − i_L) under the hold with an exact angle estimate: a step
+/// of the rated load at t = 0, until the hold hands over. Returns (largest travel, the
+/// angle error at the hand-over, the torque handed over).
+fn rollback(machine: &MachineModel<f64>, travel: f64) -> (f64, f64, f64) {
+    let ts = 1e-4;
+    let tuning = ReleaseHoldTuning {
+        enabled: true,
+        travel,
+        ..ReleaseHoldTuning::default()
+    };
+    let p = machine.pole_pairs as f64;
+    let b = 1.5 * p * p * machine.flux_linkage / machine.inertia;
+    // The rated load in A of magnet q current (the hold's unit).
+    let i_load = machine.rated_torque / (1.5 * p * machine.flux_linkage);
+    let i_max = 2.0 * i_load;
+    let mut h = ReleaseHold::new(&tuning, machine, ts, 250.0, i_max).unwrap();
+    let (mut theta, mut omega, mut i) = (0.3, 0.0, 0.0);
+    h.arm(0.3);
+    let mut worst: f64 = 0.0;
+    for _ in 0..20_000 {
+        match h.step(0.0, theta, theta) {
+            HoldAction::Hold(x) => i = x,
+            HoldAction::Handover(x) => return (worst, theta - 0.3, x),
+            HoldAction::Idle => {}
+        }
+        omega += b * (i - i_load) * ts;
+        theta += omega * ts;
+        worst = worst.max(0.3 - theta);
+    }
+    panic!("no hand-over")
+}
+
+#[test]
+fn the_rated_load_moves_the_rotor_by_about_the_design_travel() {
+    let mut light = MachineModel::paper();
+    light.inertia = 0.001;
+    for m in [MachineModel::paper(), light] {
+        let (worst, end, i) = rollback(&m, 0.2);
+        // The paper's rotor: 0.19 rad for the 0.2 rad design; the light one, where ω_h is
+        // capped at a tenth of the current loop's bandwidth: 0.47 rad. After 10/ω_h the
+        // rotor is back (the triple pole's 0.3 % residue) and the integral is the load.
+        assert!(worst > 0.1 && worst < 0.5, "{worst}");
+        assert!(end.abs() < 0.01 * worst, "{end}");
+        assert!((i - m.rated_current).abs() < 0.01 * m.rated_current, "{i}");
+    }
+}
+
+#[test]
+fn a_rotor_whose_reluctance_adds_torque_is_held_against_its_rated_torque() {
+    // A rated torque 2.25 times the magnet's 1.5·p·λ̂f·I_rated (the 50 kW IPMSM's ratio):
+    // the rated load accelerates the rotor 2.25 times as fast. Designed for that
+    // acceleration p·T_rated/Ĵ the hold lets the rigid rotor move by about the 0.2 rad
+    // design travel; designed for the magnet's torque it would let it move 2.25 times as
+    // far (0.45 rad).
+    let paper = MachineModel::<f64>::paper();
+    let salient = MachineModel {
+        rated_torque: 2.25 * paper.rated_torque,
+        ..paper
+    };
+    let (worst, end, i) = rollback(&salient, 0.2);
+    assert!(worst > 0.15 && worst < 0.21, "{worst}");
+    assert!(end.abs() < 0.01 * worst, "{end}");
+    let i_load = salient.rated_torque / (1.5 * 4.0 * salient.flux_linkage);
+    assert!((i - i_load).abs() < 0.01 * i_load, "{i}");
+}
+
+#[test]
+fn a_light_rotor_gets_the_current_loop_its_hold_needs() {
+    // The multirotor preset (14 pole pairs, 0.875 mWb, 34 A, 2e-4 kg·m², Ts = 25 µs):
+    // b·I = 4.4e4 rad/s², ω_h = √(0.27·4.4e4/0.2) = 243 rad/s, ωc = 10·ω_h: 387 Hz.
+    let fast = crate::control::tracker_feedforward::multirotor_model();
+    let on = ReleaseHoldTuning {
+        enabled: true,
+        ..ReleaseHoldTuning::default()
+    };
+    let hz = current_bandwidth_for_hold(&on, &fast, 25e-6, 250.0);
+    assert!((hz - 387.2).abs() < 0.5, "{hz}");
+    // With it the hold is the designed triple pole (not capped): the rated load moves the
+    // rigid rotor by about the design travel, against 0.48 rad at 250 Hz.
+    let ts = 25e-6;
+    let p = 14.0;
+    let b = 1.5 * p * p * fast.flux_linkage / fast.inertia;
+    let travel = |current_hz: f64| {
+        let mut h = ReleaseHold::new(&on, &fast, ts, current_hz, 68.0).unwrap();
+        let (mut theta, mut omega, mut i, mut worst) = (0.0f64, 0.0, 0.0, 0.0f64);
+        h.arm(0.0);
+        for _ in 0..(0.05 / ts) as usize {
+            if let HoldAction::Hold(x) = h.step(0.0, theta, theta) {
+                i = x;
+            }
+            omega += b * (i - fast.rated_current) * ts;
+            theta += omega * ts;
+            worst = worst.max(-theta);
+        }
+        worst
+    };
+    let (wide, paper) = (travel(hz), travel(250.0));
+    assert!(wide < 0.25 && paper > 0.4, "{wide} {paper}");
+    // The paper's motor keeps the tuning's bandwidth, as does a disabled hold; the
+    // sampling caps the rule at ωc·Ts = 0.2.
+    // A 750 W 10-pole servo's capped travel is 1.6 times the design (0.33 rad): kept.
+    let servo = MachineModel {
+        pole_pairs: 5,
+        flux_linkage: 0.05,
+        rated_current: 6.4,
+        rated_torque: 2.4,
+        inertia: 4e-4,
+        ..MachineModel::<f64>::paper()
+    };
+    assert_eq!(current_bandwidth_for_hold(&on, &servo, 1e-4, 250.0), 250.0);
+    let paper_motor = MachineModel::<f64>::paper();
+    assert_eq!(
+        current_bandwidth_for_hold(&on, &paper_motor, 1e-4, 250.0),
+        250.0
+    );
+    let off = ReleaseHoldTuning::default();
+    assert_eq!(current_bandwidth_for_hold(&off, &fast, ts, 250.0), 250.0);
+    let feather = MachineModel {
+        inertia: 1e-9,
+        ..fast
+    };
+    let capped = current_bandwidth_for_hold(&on, &feather, ts, 250.0);
+    let wc_ts = core::f64::consts::TAU * capped * ts;
+    assert!((wc_ts - MAX_CURRENT_WC_TS).abs() < 1e-12, "{wc_ts}");
+}
+
+#[test]
+fn the_probe_swing_is_that_of_a_free_rotor_under_its_square_wave() {
+    // A free rotor under ±a for half a period each, its mean speed zero: the swing about
+    // its mean is a·T²/32.
+    let (a, period, n) = (1000.0, 0.1, 100_000);
+    let ts = period / n as f64;
+    let (mut omega, mut theta) = (-a * period / 4.0, 0.0f64);
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for k in 0..2 * n {
+        let acc = if (k % n) < n / 2 { a } else { -a };
+        omega += acc * ts;
+        theta += omega * ts;
+        lo = lo.min(theta);
+        hi = hi.max(theta);
+    }
+    let swing = (hi - lo) / 2.0;
+    assert!(
+        (swing - a * period * period / 32.0).abs() < 1e-3 * swing,
+        "{swing}"
+    );
+    assert!((standstill_swing(a, 1.0, period) - swing * PROBE_ANGLE_SIN).abs() < 1e-3);
+    assert!((PROBE_ANGLE_SIN - 0.25f64.sin()).abs() < 1e-15);
+}
+
+#[test]
+fn a_light_rotor_is_held_through_its_loaded_standstill() {
+    let on = ReleaseHoldTuning {
+        enabled: true,
+        ..ReleaseHoldTuning::default()
+    };
+    // The multirotor preset (b = 1.5·14²·0.875e-3/2e-4 = 1286 rad/s² per A) under the
+    // probe's 3.4 A at 0.1 s: 0.34 rad, beyond the 0.2 rad design travel.
+    let fast = crate::control::tracker_feedforward::multirotor_model();
+    assert!(holds_through_standstill(&on, &fast, 3.4, 0.1));
+    // The paper's motor (b = 1.5·4²·0.088/0.012 = 176 rad/s² per A, its probe 2.2 A):
+    // 0.03 rad, far within it.
+    let paper = MachineModel::<f64>::paper();
+    let amplitude = 0.1 * paper.rated_current;
+    assert!(!holds_through_standstill(&on, &paper, amplitude, 0.1));
+    // The probe off, the hold disabled, a non-finite inertia: the hand-over after 10/ω_h.
+    assert!(!holds_through_standstill(&on, &fast, 0.0, 0.1));
+    let off = ReleaseHoldTuning::default();
+    assert!(!holds_through_standstill(&off, &fast, 3.4, 0.1));
+    let broken = MachineModel {
+        inertia: f64::NAN,
+        ..fast
+    };
+    assert!(!holds_through_standstill(&on, &broken, 3.4, 0.1));
+    // Held: the hold acts past 10/ω_h and hands its integral over at the reference.
+    let mut h = ReleaseHold::new(&on, &fast, 25e-6, 387.0, 68.0).unwrap();
+    h.set_through_standstill(true);
+    h.arm(0.0);
+    for _ in 0..20_000 {
+        assert!(matches!(h.step(0.0, -0.1, -0.1), HoldAction::Hold(_)));
+    }
+    assert!(h.held > h.hold_samples);
+    assert!(matches!(h.step(1.0, -0.1, -0.1), HoldAction::Handover(x) if x > 0.0));
+}
+
+#[test]
+fn an_unloaded_rotor_never_triggers_it_and_a_reference_hands_over() {
+    let m = MachineModel::<f64>::paper();
+    let t = ReleaseHoldTuning {
+        enabled: true,
+        ..ReleaseHoldTuning::default()
+    };
+    let mut h = ReleaseHold::new(&t, &m, 1e-4, 250.0, 40.0).unwrap();
+    h.arm(1.0);
+    for _ in 0..10_000 {
+        assert_eq!(h.step(0.0, 1.0 + 0.01, 1.0 + 0.01), HoldAction::Idle);
+    }
+    assert_eq!(h.engaged(), 0);
+    h.arm(1.0);
+    assert!(matches!(h.step(0.0, 0.9, 0.9), HoldAction::Hold(x) if x > 0.0));
+    assert!(matches!(h.step(5.0, 0.9, 0.9), HoldAction::Handover(x) if x > 0.0));
+    assert_eq!(h.step(0.0, 0.5, 0.5), HoldAction::Idle);
+}
+
+#[test]
+fn a_motion_hold_acts_at_any_reference_and_the_reference_resumes_from_zero() {
+    // Disabled by the tuning, engaged by the start-up's motion test: the rated load on the
+    // paper's rigid rotor at a speed reference of 100 rad/s is held about the design
+    // travel, the hold hands over after 10/ω_h, and the speed loop's reference then rises
+    // from zero by the rated speed per `resume_time` until it meets the application's.
+    let m = MachineModel::<f64>::paper();
+    let t = ReleaseHoldTuning::default();
+    assert!(!t.enabled);
+    let ts = 1e-4;
+    let p = m.pole_pairs as f64;
+    let b = 1.5 * p * p * m.flux_linkage / m.inertia;
+    let i_load = m.rated_torque / (1.5 * p * m.flux_linkage);
+    let mut h = ReleaseHold::new(&t, &m, ts, 250.0, 2.0 * i_load).unwrap();
+    h.engage(0.3);
+    assert!(h.active() && h.tracking_fall() && h.engaged() == 1);
+    let (mut theta, mut omega, mut worst) = (0.3f64, 0.0f64, 0.0f64);
+    let mut handed = None;
+    for k in 0..20_000 {
+        assert_eq!(h.resumed(100.0), if h.active() { 0.0 } else { 100.0 });
+        let i = match h.step(100.0, theta, theta) {
+            HoldAction::Hold(x) => x,
+            HoldAction::Handover(x) => {
+                handed = Some((k, x));
+                break;
+            }
+            HoldAction::Idle => panic!("idle at {k}"),
+        };
+        omega += b * (i - i_load) * ts;
+        theta += omega * ts;
+        worst = worst.max(0.3 - theta);
+    }
+    let (k, x) = handed.expect("no hand-over");
+    assert!(worst > 0.1 && worst < 0.25, "{worst}");
+    assert_eq!(k as u32, h.hold_samples);
+    assert!((x - i_load).abs() < 0.01 * i_load, "{x}");
+    let step = m.rated_speed_rpm * core::f64::consts::TAU / 60.0 * p * ts / t.resume_time;
+    assert!((h.resumed(100.0) - step).abs() < 1e-12);
+    assert!((h.resumed(100.0) - 2.0 * step).abs() < 1e-12);
+    let mut n = 2;
+    while h.resumed(100.0) < 100.0 {
+        n += 1;
+    }
+    // The last call meets the reference.
+    assert_eq!(n + 1, (100.0 / step).ceil() as u32);
+    assert_eq!(h.resumed(250.0), 250.0);
+    // Armed as usual (not by motion), a reference hands over at once and nothing resumes.
+    let on = ReleaseHoldTuning { enabled: true, ..t };
+    let mut h = ReleaseHold::new(&on, &m, ts, 250.0, 2.0 * i_load).unwrap();
+    h.arm(0.3);
+    assert!(matches!(h.step(0.0, 0.2, 0.2), HoldAction::Hold(_)));
+    assert!(matches!(h.step(50.0, 0.2, 0.2), HoldAction::Handover(_)));
+    assert_eq!(h.resumed(50.0), 50.0);
+}
