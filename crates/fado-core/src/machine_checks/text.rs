@@ -96,7 +96,7 @@ fn write_scale(f: &mut fmt::Formatter<'_>, reaction: f64, x_over_r: f64) -> fmt:
         f,
         "the ratings look scaled: the armature reaction L·`rated_current`/ψ is \
          {reaction:.3} per unit and the reactance at `rated_speed_rpm` over `rs` ω·L/R is \
-         {x_over_r:.3} (their product {:.3}; machines have 0.2–40)",
+         {x_over_r:.3} (their product {:.3}; machines have 0.05–40)",
         reaction * x_over_r
     )?;
     if reaction * x_over_r < SCALE_LOW {
