@@ -238,21 +238,7 @@ fn ratings_times(m: &MachineModel<f64>, k: f64) -> MachineModel<f64> {
 fn ratings_scaled_together_are_named_where_the_dc_link_is_derived() {
     // With the DC link derived from the ratings, / 10 and × 10 keep the torque, the resistance
     // and the DC link consistent; the armature reaction and ω·L/R name them.
-    let drone = MachineModel::<f64> {
-        rs: 0.05,
-        ld: 25e-6,
-        lq: 25e-6,
-        flux_linkage: 1.1e-3,
-        pole_pairs: 14,
-        inertia: 1e-5,
-        viscous_friction: 0.0,
-        rated_current: 30.0,
-        rated_speed_rpm: 6000.0,
-        rated_torque: 0.69,
-        dc_voltage: 22.2,
-        magnetics: Default::default(),
-    };
-    for m in [ipmsm(), drone] {
+    for m in [ipmsm(), drone(6000.0)] {
         assert!(check(&derived_dc_link(m), Some(10e-6)).is_empty());
         let low = derived_dc_link(ratings_times(&m, 0.1));
         let f = check(&low, Some(10e-6));
@@ -280,20 +266,7 @@ const RATING_KEYS_OF_SCALE: [&str; 3] = ["rated_current", "rated_speed_rpm", "ra
 #[test]
 fn a_rated_speed_times_ten_on_a_drone_motor_is_named_by_its_electrical_frequency() {
     // 14 pole pairs at 70,000 r/min (7,000 × 10): 16 kHz electrical.
-    let m = MachineModel::<f64> {
-        rs: 0.05,
-        ld: 25e-6,
-        lq: 25e-6,
-        flux_linkage: 1.1e-3,
-        pole_pairs: 14,
-        inertia: 1e-5,
-        viscous_friction: 0.0,
-        rated_current: 30.0,
-        rated_speed_rpm: 7000.0,
-        rated_torque: 0.69,
-        dc_voltage: 22.2,
-        magnetics: Default::default(),
-    };
+    let m = drone(7000.0);
     assert!(
         !check(&m, None)
             .iter()
@@ -415,4 +388,22 @@ fn a_gimbal_motor_is_not_taken_for_ratings_divided_by_ten() {
         "{:?}",
         check(&m, Some(25e-6))
     );
+}
+
+/// A 24 V multirotor outrunner: 14 pole pairs, 25 µH, 30 A, 0.69 N·m at `rated_speed_rpm`.
+fn drone(rated_speed_rpm: f64) -> MachineModel<f64> {
+    MachineModel::<f64> {
+        rs: 0.05,
+        ld: 25e-6,
+        lq: 25e-6,
+        flux_linkage: 1.1e-3,
+        pole_pairs: 14,
+        inertia: 1e-5,
+        viscous_friction: 0.0,
+        rated_current: 30.0,
+        rated_speed_rpm,
+        rated_torque: 0.69,
+        dc_voltage: 22.2,
+        magnetics: Default::default(),
+    }
 }
