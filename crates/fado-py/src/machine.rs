@@ -287,10 +287,10 @@ impl PyMachine {
                     dc_voltage: 1.0,
                     ..model
                 };
-                if let Err(cause) = probe.validate() {
-                    if !DERIVED.contains(&cause.field()) {
-                        return Err(config_error(py, cause));
-                    }
+                if let Err(cause) = probe.validate()
+                    && !DERIVED.contains(&cause.field())
+                {
+                    return Err(config_error(py, cause));
                 }
             }
             if constructing && !given {
