@@ -232,3 +232,13 @@ def test_a_recording_in_the_wrong_units_warns_naming_the_column(change, match) -
 def test_a_start_angle_in_degrees_warns() -> None:
     with pytest.warns(UserWarning, match="degrees where radians"):
         fado.estimate(*_recording(), machine="paper", ts=1e-4, theta0=30.0)
+
+
+def test_a_bad_rating_is_named_not_the_value_derived_from_it() -> None:
+    # A negative rated speed leaves no inertia to derive: the speed is the cause.
+    with pytest.raises(fado.ConfigError) as info:
+        fado.Machine(**dict(IPM, rated_speed_rpm=-1500.0))
+    assert info.value.field == "rated_speed_rpm"
+    with pytest.raises(fado.ConfigError) as info:
+        fado.Machine(**dict(IPM, rated_torque=0.0))
+    assert info.value.field == "rated_torque"

@@ -278,6 +278,21 @@ impl PyMachine {
                 Some(c) => c.contains(e.field())?,
                 None => false,
             };
+            if constructing && !given && DERIVED.contains(&e.field()) {
+                // A derived field refused: the rating it is derived from is the cause
+                // (`rated_speed_rpm = -1500` leaves no inertia to derive).
+                let probe = MachineModel {
+                    inertia: 1.0,
+                    viscous_friction: 0.0,
+                    dc_voltage: 1.0,
+                    ..model
+                };
+                if let Err(cause) = probe.validate()
+                    && !DERIVED.contains(&cause.field())
+                {
+                    return Err(config_error(py, cause));
+                }
+            }
             if constructing && !given {
                 return Err(pyo3::exceptions::PyTypeError::new_err(format!(
                     "Machine() missing required keyword argument: '{}'",

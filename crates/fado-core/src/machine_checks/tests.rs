@@ -238,10 +238,10 @@ fn ratings_times(m: &MachineModel<f64>, k: f64) -> MachineModel<f64> {
 fn ratings_scaled_together_are_named_where_the_dc_link_is_derived() {
     // With the DC link derived from the ratings, / 10 and × 10 keep the torque, the resistance
     // and the DC link consistent; the armature reaction and ω·L/R name them.
-    for m in [paper(), ipmsm()] {
-        assert!(check(&derived_dc_link(m), Some(100e-6)).is_empty());
+    for m in [ipmsm(), drone(6000.0)] {
+        assert!(check(&derived_dc_link(m), Some(10e-6)).is_empty());
         let low = derived_dc_link(ratings_times(&m, 0.1));
-        let f = check(&low, Some(100e-6));
+        let f = check(&low, Some(10e-6));
         let scale = f
             .iter()
             .find(|f| matches!(f, Finding::RatingScale { .. }))
@@ -266,20 +266,7 @@ const RATING_KEYS_OF_SCALE: [&str; 3] = ["rated_current", "rated_speed_rpm", "ra
 #[test]
 fn a_rated_speed_times_ten_on_a_drone_motor_is_named_by_its_electrical_frequency() {
     // 14 pole pairs at 70,000 r/min (7,000 × 10): 16 kHz electrical.
-    let m = MachineModel::<f64> {
-        rs: 0.05,
-        ld: 25e-6,
-        lq: 25e-6,
-        flux_linkage: 1.1e-3,
-        pole_pairs: 14,
-        inertia: 1e-5,
-        viscous_friction: 0.0,
-        rated_current: 30.0,
-        rated_speed_rpm: 7000.0,
-        rated_torque: 0.69,
-        dc_voltage: 22.2,
-        magnetics: Default::default(),
-    };
+    let m = drone(7000.0);
     assert!(
         !check(&m, None)
             .iter()
@@ -319,31 +306,27 @@ fn a_flux_linkage_slip_on_a_salient_rotor_is_named() {
     let f = first(&m, None);
     assert!(f.to_string().contains("line-to-line"), "{f}");
     assert!(!f.to_string().contains("pole count"), "{f}");
-    // A strongly salient IPMSM (motors/ipmsm-gem-50k.toml, Lq/Ld 3.2): line-to-line λf moves
-    // the ratio to 0.79 only, which the undone slip brings back to 1.0.
+    // A strongly salient IPMSM (motors/ipmsm-gem-50k.toml, Lq/Ld 3.2) with a line-to-line λf:
+    // 0.79, where saturated machines sit too; not reported (the module documentation).
     let gem = MachineModel::<f64> {
         rs: 0.018,
         ld: 0.37e-3,
         lq: 1.2e-3,
-        flux_linkage: 0.066,
+        flux_linkage: 0.066 * 3f64.step_sqrt(),
         pole_pairs: 3,
         inertia: 0.1,
         viscous_friction: 0.0,
         rated_current: 240.0,
         rated_speed_rpm: 3000.0,
         rated_torque: 160.6,
-        dc_voltage: 520.0,
+        dc_voltage: 900.0,
         magnetics: Default::default(),
     };
-    assert!(check(&gem, None).is_empty());
-    let mut m = gem;
-    m.flux_linkage *= 3f64.step_sqrt();
-    let f = check(&m, None);
-    let t = f
-        .iter()
-        .find(|f| matches!(f, Finding::Torque { .. }))
-        .unwrap_or_else(|| panic!("{f:?}"));
-    assert!(t.to_string().contains("line-to-line"), "{t}");
+    assert!(
+        !check(&gem, None)
+            .iter()
+            .any(|f| matches!(f, Finding::Torque { .. }))
+    );
 }
 
 #[test]
@@ -354,4 +337,73 @@ fn a_motor_without_magnet_is_refused_saying_why() {
     assert_eq!((f.key(), f.severity()), ("flux_linkage", Severity::Error));
     assert!(f.to_string().contains("synchronous reluctance"), "{f}");
     assert!(f.to_string().contains("must be positive"), "{f}");
+}
+
+#[test]
+fn friction_inertia_and_a_dc_link_in_kv_are_named() {
+    // 1 N·m·s/rad on the 2.2 kW IPMSM: 157 N·m of friction at rated speed against 14 N·m.
+    let mut m = ipmsm();
+    m.viscous_friction = 1.0;
+    let f = first(&m, None);
+    assert_eq!(
+        (f.key(), f.severity()),
+        ("viscous_friction", Severity::Error),
+        "{f}"
+    );
+    m.viscous_friction = 0.03;
+    assert_eq!(first(&m, None).severity(), Severity::Warning);
+    // 15 kg·m² for 0.015: a start time of 168 s, a warning.
+    let mut m = ipmsm();
+    m.inertia = 15.0;
+    let f = first(&m, None);
+    assert!(matches!(f, Finding::Inertia { .. }), "{f}");
+    // 0.54 (kV) for 540 V: the DC link is named first.
+    let mut m = ipmsm();
+    m.dc_voltage = 0.54;
+    let f = first(&m, None);
+    assert_eq!(f.key(), "dc_voltage", "{f}");
+    assert!(f.to_string().contains("kV where V is meant"), "{f}");
+}
+
+#[test]
+fn a_gimbal_motor_is_not_taken_for_ratings_divided_by_ten() {
+    // 22 pole pairs, 0.35 Ω, 120 µH, 3.6 A, 600 r/min (crates/fado-sim/tests/data/gimbal-22pp.toml):
+    // ω·L/R 0.47, product 0.049.
+    let m = MachineModel::<f64> {
+        rs: 0.35,
+        ld: 120e-6,
+        lq: 120e-6,
+        flux_linkage: 0.0042,
+        pole_pairs: 22,
+        inertia: 4e-5,
+        viscous_friction: 0.0,
+        rated_current: 3.6,
+        rated_speed_rpm: 600.0,
+        rated_torque: 0.5,
+        dc_voltage: 24.0,
+        magnetics: Default::default(),
+    };
+    assert!(
+        check(&m, Some(25e-6)).is_empty(),
+        "{:?}",
+        check(&m, Some(25e-6))
+    );
+}
+
+/// A 24 V multirotor outrunner: 14 pole pairs, 25 µH, 30 A, 0.69 N·m at `rated_speed_rpm`.
+fn drone(rated_speed_rpm: f64) -> MachineModel<f64> {
+    MachineModel::<f64> {
+        rs: 0.05,
+        ld: 25e-6,
+        lq: 25e-6,
+        flux_linkage: 1.1e-3,
+        pole_pairs: 14,
+        inertia: 1e-5,
+        viscous_friction: 0.0,
+        rated_current: 30.0,
+        rated_speed_rpm,
+        rated_torque: 0.69,
+        dc_voltage: 22.2,
+        magnetics: Default::default(),
+    }
 }

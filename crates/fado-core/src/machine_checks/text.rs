@@ -96,7 +96,7 @@ fn write_scale(f: &mut fmt::Formatter<'_>, reaction: f64, x_over_r: f64) -> fmt:
         f,
         "the ratings look scaled: the armature reaction L·`rated_current`/ψ is \
          {reaction:.3} per unit and the reactance at `rated_speed_rpm` over `rs` ω·L/R is \
-         {x_over_r:.3} (their product {:.3}; machines have 0.2–40)",
+         {x_over_r:.3} (their product {:.3}; machines have 0.05–40)",
         reaction * x_over_r
     )?;
     if reaction * x_over_r < SCALE_LOW {
@@ -144,6 +144,30 @@ fn write_resistance(f: &mut fmt::Formatter<'_>, per_unit: f64) -> fmt::Result {
     }
 }
 
+/// The text of [`Finding::Friction`] and [`Finding::Inertia`].
+fn write_mechanics(f: &mut fmt::Formatter<'_>, finding: &Finding) -> fmt::Result {
+    match *finding {
+        Finding::Friction { ratio, .. } => write!(
+            f,
+            "`viscous_friction` takes {ratio:.3} × `rated_torque` at `rated_speed_rpm` \
+             (B·ω_rated,mech; machines 0.005–0.05){}",
+            if ratio > 1.0 {
+                ": the rated point cannot be reached. B is in N·m·s/rad (N·m per rad/s): a value in \
+                 N·m per 1000 r/min is 105 × it"
+            } else {
+                ": check its unit (N·m·s/rad)"
+            }
+        ),
+        Finding::Inertia { start_time } => write!(
+            f,
+            "`inertia` takes {start_time:.1} s to reach `rated_speed_rpm` at \
+             `rated_torque` (J·ω_rated,mech/T_rated; drives 0.01–30 s): kg·cm² or g·m² \
+             where kg·m² is meant (÷ 10⁴, ÷ 10³)?"
+        ),
+        _ => Ok(()),
+    }
+}
+
 impl fmt::Display for Finding {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match *self {
@@ -184,12 +208,20 @@ impl fmt::Display for Finding {
                  {frequency:.0} Hz, above the {MAX_ELECTRICAL_FREQUENCY} Hz of the fastest \
                  motors: is `rated_speed_rpm` × 10, or `pole_pairs` a pole count?"
             ),
-            Finding::BackEmf { ratio } => write!(
-                f,
-                "the back-EMF at rated speed ω·λf (`flux_linkage`, `rated_speed_rpm`, \
-                 `pole_pairs`) is {ratio:.2} × the phase voltage the DC link `dc_voltage` can \
-                 make (Vdc/√3): check their units (λf in Wb peak per phase) and the DC link"
-            ),
+            Finding::BackEmf { ratio } => {
+                write!(
+                    f,
+                    "the back-EMF at rated speed ω·λf (`flux_linkage`, `rated_speed_rpm`, \
+                     `pole_pairs`) is {ratio:.2} × the phase voltage the DC link `dc_voltage` \
+                     can make (Vdc/√3)"
+                )?;
+                if ratio > 300.0 {
+                    f.write_str(": `dc_voltage` in kV where V is meant?")
+                } else {
+                    f.write_str(": check their units (λf in Wb peak per phase) and the DC link")
+                }
+            }
+            Finding::Friction { .. } | Finding::Inertia { .. } => write_mechanics(f, self),
             Finding::DcLinkOversized { ratio, .. } => write!(
                 f,
                 "the rated point (`rated_speed_rpm`, `rated_current`, `rated_torque`) needs only \
