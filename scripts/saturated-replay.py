@@ -136,6 +136,7 @@ class MapCase:
     d_axis: np.ndarray | None = None
     q_axis: np.ndarray | None = None
     layout: str = "grid"  # grid | q-major | reversed
+    control: str = "mtpa"  # mtpa | id0 (the sensored drive's current references)
     notes: str = ""
     flags: dict = field(default_factory=dict)
 
@@ -193,10 +194,18 @@ def cases(half_map: bool) -> list[MapCase]:
     r = ipm.rated_current
     coarse = np.array([-2.0, -1.3, -0.8, -0.4, -0.1, 0.0, 0.5, 1.2]) * r
     coarse_q = np.array([-2.0, -1.1, -0.5, -0.15, 0.15, 0.6, 1.2, 2.0]) * r
+    coarse_s = np.array([-2.0, -1.4, -0.9, -0.5, -0.2, 0.0, 0.4, 1.0])
     out = [
         MapCase("syrm-6k7 (no magnet)", syrm_6k7()),
         MapCase("syrm-6k7 + 0.5 A magnet MMF", syrm_6k7(i_f=0.5)),
+        MapCase("syrm-6k7 + 1 A magnet MMF", syrm_6k7(i_f=1.0)),
         MapCase("syrm-6k7 + 3 A magnet MMF", syrm_6k7(i_f=3.0)),
+        MapCase("syrm-6k7 + 0.5 A magnet MMF, i_d = 0 control", syrm_6k7(i_f=0.5),
+                control="id0"),
+        MapCase("syrm-6k7 + 3 A magnet MMF, i_d = 0 control", syrm_6k7(i_f=3.0),
+                control="id0"),
+        MapCase("syrm-6k7 + 3 A magnet MMF, coarse 8x8 non-uniform", syrm_6k7(i_f=3.0),
+                coarse_s * syrm_6k7().rated_current, coarse_q / r * syrm_6k7().rated_current),
         MapCase("ipm-cross20", ipm),
         MapCase("spm-dsat", spm_dsat()),
         MapCase("drone-ipm", drone_ipm()),
@@ -253,19 +262,28 @@ class Mtpa:
 
 
 def injection_sign(m: Machine) -> float:
-    """The d direction of the no-load injection that raises the active flux
-    λa = ψd − L_q,s·i_d (the rotor flux the estimator follows): +d, fado's drive's eq. (23),
-    where the magnet dominates; −d on a weak-magnet PM-SyRM, whose λa falls through zero at
-    i_d ≈ λf/(L_q − L_d) along +d (0.2 A on syrm-6k7-pm) and would point the rotor flux along
-    −d there."""
+    """The d direction of the no-load injection, fado's drive's rule
+    (`fado_core::injection::direction`): +d (eq. (23)) unless the active flux
+    λa = ψd − L_q,s·i_d at i_d = +I_min, i_q = 0 is negative, then −d. A weak-magnet PM-SyRM's λa
+    falls through zero along +d at i_d ≈ λf/(L_q − L_d) (0.2 A on syrm-6k7-pm0.5) and would
+    point the rotor flux along −d."""
     i = I_MIN_RATIO * m.rated_current
     h = 1e-3 * i
-    active = []
-    for i_d in (i, -i):
-        pd, _ = m.flux(np.array(i_d), np.array(0.0))
-        _, pq = m.flux(np.array(i_d), np.array(h))
-        active.append(float(pd) - float(pq) / h * i_d)
-    return 1.0 if active[0] >= active[1] else -1.0
+    pd, _ = m.flux(np.array(i), np.array(0.0))
+    _, pq = m.flux(np.array(i), np.array(h))
+    return -1.0 if float(pd) - float(pq) / h * i < 0.0 else 1.0
+
+
+class IdZero:
+    """i_d = 0 control: the torque from i_q alone (1.5·p·ψd(0, i_q)·i_q), no injection."""
+
+    def __init__(self, m: Machine, i_max: float):
+        self.i_q = np.linspace(0.0, i_max, 401)
+        self.tau = np.maximum.accumulate(m.torque(np.zeros_like(self.i_q), self.i_q))
+
+    def current(self, tau: float) -> tuple[float, float]:
+        i_q = float(np.interp(abs(tau), self.tau, self.i_q))
+        return 0.0, i_q if tau >= 0 else -i_q
 
 
 def profile(points: list[tuple[float, float]], t: float) -> float:
@@ -273,8 +291,10 @@ def profile(points: list[tuple[float, float]], t: float) -> float:
     return float(np.interp(t, xs, ys))
 
 
-def simulate(m: Machine, load: float, duration: float = 5.5) -> dict[str, np.ndarray]:
-    """The sensored drive on the exact plant through `reversal` under `load` × rated torque."""
+def simulate(m: Machine, load: float, control: str = "mtpa",
+             duration: float = 5.5) -> dict[str, np.ndarray]:
+    """The sensored drive on the exact plant through `reversal` under `load` × rated torque:
+    `control` "mtpa" (the MTPA curve and the injection) or "id0" (i_d = 0, no injection)."""
     p = m.pole_pairs
     w_rated_m = m.rated_speed_rpm * 2 * math.pi / 60
     n_rev = 0.06 * w_rated_m
@@ -282,6 +302,9 @@ def simulate(m: Machine, load: float, duration: float = 5.5) -> dict[str, np.nda
     load_ref = [(0.0, 0.0), (1.2, 0.0), (1.7, load * m.rated_torque), (9.9, load * m.rated_torque)]
     mtpa = Mtpa(m, 2.0 * m.rated_current)
     i_min = I_MIN_RATIO * m.rated_current * injection_sign(m)
+    refs = mtpa if control == "mtpa" else IdZero(m, 2.0 * m.rated_current)
+    if control != "mtpa":
+        i_min = 0.0
     # Current PI from the incremental inductances at the rated MTPA point (IMC, 300 Hz).
     ird, irq = mtpa.current(m.rated_torque)
     h = 1e-3 * m.rated_current
@@ -331,7 +354,7 @@ def simulate(m: Machine, load: float, duration: float = 5.5) -> dict[str, np.nda
         if abs(tau_ref) < tau_max:
             int_s += e_s * TS
         tau_ref = max(-tau_max, min(tau_max, tau_ref))
-        id_ref, iq_ref = mtpa.current(tau_ref)
+        id_ref, iq_ref = refs.current(tau_ref)
         id_ref += math.copysign(math.sqrt(max(i_min * i_min - iq_ref * iq_ref, 0.0)), i_min)
         # Current loop in the true rotor frame, the flux's back-EMF as the decoupling.
         w_e = p * x[3]
@@ -396,12 +419,16 @@ def main() -> None:
         if args.machine and not any(s in case.name for s in args.machine):
             continue
         for load in args.load:
-            key = (case.machine.name, load)
+            if case.control == "id0" and load > 0.0:
+                # i_d = 0 leaves a reluctance rotor the magnet's torque alone (a few % of rated):
+                # a light-load control only.
+                continue
+            key = (case.machine.name, load, case.control)
             if key not in sims:
-                sims[key] = simulate(case.machine, load)
+                sims[key] = simulate(case.machine, load, case.control)
                 if args.out:
                     args.out.mkdir(parents=True, exist_ok=True)
-                    slug = case.machine.name
+                    slug = case.machine.name + ("" if case.control == "mtpa" else "-id0")
                     np.savez(args.out / f"{slug}-{round(load * 100)}.npz", **sims[key])
             try:
                 err, lo, hi = replay(fado, case, sims[key])

@@ -199,3 +199,36 @@ def test_a_motor_without_magnet_is_refused_saying_why() -> None:
     with pytest.raises(fado.ConfigError, match="synchronous reluctance") as info:
         fado.Machine(**dict(IPM, flux_linkage=0.0))
     assert info.value.field == "flux_linkage"
+
+
+def _recording(n: int = 2000) -> list[np.ndarray]:
+    """A steady rotation of the paper's motor: 10 A turning at 60 Hz, the voltage it needs."""
+    t = np.arange(n) * 1e-4
+    w = 2 * math.pi * 60
+    i = 10 * np.exp(1j * w * t)
+    v = (0.5 + 1j * w * 2.63e-3) * i + 1j * w * 0.088 * np.exp(1j * (w * t - 0.3))
+    return [np.ascontiguousarray(x) for x in (v.real, v.imag, i.real, i.imag)]
+
+
+@pytest.mark.parametrize(
+    ("change", "match"),
+    [
+        (lambda s: [s[0], s[1], s[2] * 1e3, s[3] * 1e3], "mA where A is meant"),
+        (lambda s: [s[0] / 1e3, s[1] / 1e3, s[2], s[3]], "kV where V is meant"),
+        (lambda s: [s[0], s[1], s[2], np.zeros_like(s[3])], "`i_beta` is 0 in every sample"),
+        (lambda s: [s[0], s[1], np.where(np.arange(len(s[2])) % 10 == 0, np.nan, s[2]), s[3]],
+         "non-finite"),
+    ],
+)
+def test_a_recording_in_the_wrong_units_warns_naming_the_column(change, match) -> None:
+    signals = _recording()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        fado.estimate(*signals, machine="paper", ts=1e-4)
+    with pytest.warns(UserWarning, match=match):
+        fado.estimate(*change(signals), machine="paper", ts=1e-4)
+
+
+def test_a_start_angle_in_degrees_warns() -> None:
+    with pytest.warns(UserWarning, match="degrees where radians"):
+        fado.estimate(*_recording(), machine="paper", ts=1e-4, theta0=30.0)

@@ -434,6 +434,10 @@ pub fn estimate(
     let setup = Setup::new(py, "estimate", machine.as_ref(), config.as_ref(), ts, 0.0)?;
     let signals = Signals::new(v_alpha, v_beta, i_alpha, i_beta)?;
     let mut engine = Engine::new(py, &setup, dtype)?;
+    let core = setup.core::<f64>(py)?;
+    if let Ok(bounds) = core.sample_bounds() {
+        crate::recording_checks::warn_all(py, &signals, &bounds, core.machine.rs, theta0)?;
+    }
     if let Some(theta0) = theta0 {
         let [_, _, ia, ib] = signals.slices();
         let first = |c: ColumnSlice<'_>| match c {

@@ -34,6 +34,7 @@ pub mod machine;
 pub mod number;
 pub mod outputs;
 pub mod record;
+pub mod recording_checks;
 pub mod replay;
 pub mod scalar;
 pub mod simulate;

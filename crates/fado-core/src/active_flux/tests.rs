@@ -250,3 +250,53 @@ fn frame_coupling_matches_the_closed_loop_flux_change() {
     let ipm = active(ipm_qsat(58.0), 6.08).unwrap();
     assert!(!ipm.holds_offset(&ipm.point(Dq::new(-0.08, 5.99))));
 }
+
+/// motulator's 6.7 kW SyRM in fado's frame with a magnet MMF of `i_f` A (the weak-magnet
+/// PM-SyRM of `saturated_replay`).
+fn weak_magnet(i_f: f64) -> Magnetics<'static, f64> {
+    Magnetics::Saturation(Saturation {
+        a_d0: 52.1,
+        a_dd: 658.0,
+        s: 1.0,
+        a_q0: 17.4,
+        a_qq: 373.0,
+        t: 5.0,
+        a_dq: 1120.0,
+        u: 0.0,
+        v: 1.0,
+        i_f,
+        ..Saturation::default()
+    })
+}
+
+/// At no load with the injection along −d (the current along d) the weak-magnet PM-SyRM's
+/// regressor is the map's slope turned by the frame (cross-saturation alone at i_q = 0): the
+/// law freezes there. The IPMSM's regressor at a loaded point stays.
+#[test]
+fn the_regressor_freezes_where_the_maps_slope_carries_it() {
+    let af = active(weak_magnet(0.5), 21.9).unwrap();
+    for i_q in [0.0, -0.0] {
+        let pt = af.point(Dq::new(-4.0, i_q));
+        assert!(pt.active > 0.1, "{pt:?}");
+        assert!(af.resistance_regressor(&pt).is_none(), "{i_q}");
+    }
+    let ipm = active(ipm_qsat(58.0), 6.08).unwrap();
+    assert!(
+        ipm.resistance_regressor(&ipm.point(Dq::new(-1.0, 5.0)))
+            .is_some()
+    );
+}
+
+/// The observer's reference: the magnet's ψd(0, 0) until half the low-passed active flux
+/// exceeds it.
+#[test]
+fn the_observer_reference_is_the_magnet_or_half_the_active_flux() {
+    let af = active(weak_magnet(0.5), 21.9).unwrap();
+    let magnet = af.magnet_flux();
+    assert!((magnet - 8.7e-3).abs() < 0.5e-3, "{magnet}");
+    assert_eq!(af.observer_reference(0.01), magnet);
+    assert_eq!(af.observer_reference(0.5), 0.5 * SWING_REFERENCE_SHARE);
+    let baldor = active(baldor(), 12.45).unwrap();
+    let lf = baldor.magnet_flux();
+    assert_eq!(baldor.observer_reference(1.9 * lf), lf);
+}

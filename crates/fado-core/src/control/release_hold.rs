@@ -379,18 +379,22 @@ impl<T: Real> ReleaseHold<T> {
         self.omega = T::zero();
     }
 
-    /// Acts at once, holding `theta_hold`, whether the hold is enabled or not: the start-up
+    /// Acts at once, holding `theta_hold` from the rotor's electrical speed `omega` (rad/s:
+    /// the loop's damping acts from the first sample), whether the hold is enabled or not: the start-up
     /// saw a load turn the rotor during a calibration
     /// ([`GainCalibrationStatus::RotorMoved`](crate::control::GainCalibrationStatus::RotorMoved)).
     /// It holds at any speed reference until it has settled (10/ω_h; through the loaded
     /// standstill where [`holds_through_standstill`] says so, while the reference is zero),
     /// then hands its integral, the load it found, to the speed loop. The estimator tracks the
     /// fall as after a brake's release ([`tracking_fall`](Self::tracking_fall)).
-    pub fn engage(&mut self, theta_hold: T) {
+    pub fn engage(&mut self, theta_hold: T, omega: T) {
         let enabled = self.enabled;
         self.enabled = true;
         self.arm(theta_hold);
         self.enabled = enabled;
+        if omega.is_finite() {
+            self.omega = omega;
+        }
         if self.armed {
             self.released = true;
             self.engaged_by_motion = true;
@@ -413,7 +417,8 @@ impl<T: Real> ReleaseHold<T> {
         let step = self.resume_step;
         let gap = speed_ref - self.resumed;
         // NaN compares false: a non-finite reference ends the ramp (the speed loop refuses it).
-        if !(gap.abs() > step) {
+        let beyond = gap.abs() > step;
+        if !beyond {
             self.resuming = false;
             return speed_ref;
         }

@@ -184,6 +184,8 @@ pub struct EstimatorParams<T: Real> {
     flux_settle_periods: u32,
     /// `EstimatorTuning::observer_on_rotor_flux`.
     observer_on_rotor_flux: bool,
+    /// Ts/τ of a saturating model's observer reference (`crate::active_flux`).
+    swing_reference_gain: T,
     /// The observer's gains are held over this many samples after the one that computes
     /// them: `EstimatorTuning::observer_gain_period`/Ts rounded, less one.
     gain_hold: u32,
@@ -216,7 +218,7 @@ pub struct EstimatorParams<T: Real> {
 /// counters. Run-time settings live here too: R̂s (`set_rs_hat`, the adaptation), λ̂f (its
 /// law), the adaptation's on switch (`enable_rs_adaptation`) and the k_df switch. Stepped
 /// with [`EstimatorState::step`] / [`EstimatorState::step_lean`] and the
-/// [`EstimatorParams`] it was made for; `size_of` is 304 B or less in `f32`
+/// [`EstimatorParams`] it was made for; `size_of` is 308 B or less in `f32`
 /// (docs/results/firmware-cost.md).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EstimatorState<T: Real> {
@@ -225,6 +227,9 @@ pub struct EstimatorState<T: Real> {
     /// The q inductance of eq. (5) the last sample used: L̂q, or a saturating model's
     /// secant at the estimated current (`crate::active_flux`).
     lq_secant: T,
+    /// A saturating model's reference magnitude of the observer's rotating vector: the active
+    /// flux λ̂a(î) low-passed (`crate::active_flux`, "The observer's reference").
+    swing_reference: T,
     /// A saturating model's last ψ(î), the start of the next sample's solves
     /// (`crate::magnetics::FluxWarmStart`; empty for a model that needs none).
     flux_warm: FluxWarmStart<T>,

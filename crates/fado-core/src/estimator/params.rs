@@ -103,6 +103,7 @@ impl<T: Real> EstimatorParams<T> {
             ),
             initial_angle: config.initial_angle,
             observer_on_rotor_flux: config.tuning.observer.on_rotor_flux,
+            swing_reference_gain: ts / T::lit(crate::active_flux::SWING_REFERENCE_TIME),
             gain_hold: blocks.gain_hold,
             lag_compensation: config.tuning.observer.lag_compensation,
             lag_keep: if config.tuning.observer.lag_compensation {
@@ -148,6 +149,7 @@ impl<T: Real> EstimatorParams<T> {
             integrator: FluxIntegratorState::new(self.rs_initial),
             observer: ObserverState::zero(),
             lq_secant: self.lq,
+            swing_reference: self.flux_linkage,
             flux_warm: FluxWarmStart::empty(),
             t2s1: self.t2s1.state_at(T::zero(), T::zero()),
             t2s2: self.t2s2.state_at(T::zero(), T::zero()),

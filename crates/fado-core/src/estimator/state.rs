@@ -40,21 +40,7 @@ impl<T: Real> EstimatorState<T> {
         } else {
             T::zero()
         };
-        // The active flux λ̂f + (L̂d − L̂q)·i_d (λ̂f exactly for L̂d = L̂q), or a saturating
-        // model's at the current in the aligned frame, with its secant L̂q.
-        let rotor = Ab::from_polar(T::one(), theta0);
-        let (active, lq) = match p.active_flux.saturating() {
-            None => (p.flux_linkage + p.saliency * rotor.dot(i_ab), p.lq),
-            Some(af) => {
-                let point = af.point(ActiveFlux::frame_current(rotor, i_ab));
-                (point.active, point.lq_secant)
-            }
-        };
-        let (active, lq) = if active.is_finite() && active > T::zero() && lq.is_finite() {
-            (active, lq)
-        } else {
-            (p.flux_linkage, p.lq)
-        };
+        let (active, lq) = Self::aligned_active(p, theta0, i_ab);
         self.lq_secant = lq;
         self.flux_warm = FluxWarmStart::empty();
         let lambda_r = Ab::from_polar(active, theta0);
@@ -75,8 +61,19 @@ impl<T: Real> EstimatorState<T> {
             } else {
                 Ab::zero()
             });
+        // A saturating model's observer follows a rotating vector of the low-passed active
+        // flux, which starts at the aligned one (`crate::active_flux`).
+        self.swing_reference = if p.active_flux.is_saturating() {
+            active
+        } else {
+            p.flux_linkage
+        };
+        let reference = match p.active_flux.saturating() {
+            Some(af) => af.observer_reference(active),
+            None => p.flux_linkage,
+        };
         self.observer = ObserverState::at(if p.observer_on_rotor_flux {
-            Ab::from_polar(p.flux_linkage, theta0)
+            Ab::from_polar(reference, theta0)
         } else {
             lambda1
         });
@@ -104,6 +101,25 @@ impl<T: Real> EstimatorState<T> {
         self.i_sum = Ab::zero();
         self.slow_feedback = self.offset.offset;
         self.step_allowance = p.bounds.step();
+    }
+
+    /// The active flux λ̂f + (L̂d − L̂q)·i_d (λ̂f exactly for L̂d = L̂q), or a saturating
+    /// model's at the current in the frame aligned at `theta0`, with its secant L̂q; λ̂f and
+    /// L̂q where that is not a positive finite flux.
+    fn aligned_active(p: &EstimatorParams<T>, theta0: T, i_ab: Ab<T>) -> (T, T) {
+        let rotor = Ab::from_polar(T::one(), theta0);
+        let (active, lq) = match p.active_flux.saturating() {
+            None => (p.flux_linkage + p.saliency * rotor.dot(i_ab), p.lq),
+            Some(af) => {
+                let point = af.point(ActiveFlux::frame_current(rotor, i_ab));
+                (point.active, point.lq_secant)
+            }
+        };
+        if active.is_finite() && active > T::zero() && lq.is_finite() {
+            (active, lq)
+        } else {
+            (p.flux_linkage, p.lq)
+        }
     }
 
     /// One sample (Fig. 5) with the parameters `p` this state was made for: as
@@ -190,7 +206,8 @@ impl<T: Real> EstimatorState<T> {
         let axis = self.observer.flux() - self.observer.disturbance();
         let n2 = axis.norm_squared();
         if SATURATING {
-            // A saturating model: λ̂a(î) − ψd(0, 0) along the axis, î in its frame.
+            // A saturating model: λ̂a(î) less the observer's reference along the axis, î in
+            // its frame (`ActiveFlux::observer_reference`).
             return if n2 > p.hold_level_sq {
                 // The axis is the estimated active flux: the last sample's solution (in a
                 // frame within a sample's turn of this one) starts the model's flux, else
@@ -198,7 +215,8 @@ impl<T: Real> EstimatorState<T> {
                 let i_dq = ActiveFlux::frame_current(axis, i_ab);
                 let guess = ActiveFlux::frame_current(axis, axis + i_ab * self.lq_secant);
                 let (point, warm) = af.point_warm(i_dq, guess, &self.flux_warm);
-                let swing = axis * ((point.active - af.magnet_flux()) / n2.step_sqrt());
+                let reference = af.observer_reference(self.swing_reference);
+                let swing = axis * ((point.active - reference) / n2.step_sqrt());
                 (swing, warm)
             } else {
                 (Ab::zero(), self.flux_warm)

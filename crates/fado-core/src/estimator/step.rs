@@ -400,6 +400,8 @@ impl<T: Real> EstimatorState<T> {
         if let Some(point) = c.point {
             self.lq_secant = point.lq_secant;
             self.flux_warm = c.flux_warm;
+            self.swing_reference = self.swing_reference
+                + p.swing_reference_gain * (point.active - self.swing_reference);
         }
         self.mode = c.mode;
         self.kdf_gain = c.kdf_gain;

@@ -52,9 +52,17 @@ impl<T: Real> FluxLookup<T> for MachineMagnetics<T> {
         MachineMagnetics::is_linear(self)
     }
 
+    /// The same variant borrowing the same model (by address, not by value).
     #[inline]
     fn is_model_of(&self, machine: &MachineMagnetics<T>) -> bool {
-        self == machine
+        use core::ptr::eq;
+        match (self, machine) {
+            (MachineMagnetics::Linear, MachineMagnetics::Linear) => true,
+            (MachineMagnetics::Saturation(a), MachineMagnetics::Saturation(b)) => eq(*a, *b),
+            (MachineMagnetics::Map(a), MachineMagnetics::Map(b)) => eq(*a, *b),
+            (MachineMagnetics::Uniform(a), MachineMagnetics::Uniform(b)) => eq(*a, *b),
+            _ => false,
+        }
     }
 
     #[inline]

@@ -266,12 +266,21 @@ impl<T: Real> ResistanceAdaptationParams<T> {
         let dl = self.saliency;
         if let Some((af, point)) = point {
             // A saturating model (`crate::active_flux`): λ̂a(î) shifted by the learned λ̂f,
-            // the regressor's bracket at î; frozen where it is ill-conditioned.
+            // the regressor's bracket at î; frozen where it is ill-conditioned, and until the
+            // hand-over's transient has settled (`settled`, as the λ̂f law): there the angle
+            // error turns î, and the regressor judged at î is not the machine's.
+            if !settled {
+                return false;
+            }
             let Some(bracket) = af.resistance_regressor(&point) else {
                 return false;
             };
             let reference = point.active + (lf - self.config.flux_linkage_hat);
-            let a = -(mag * bracket) * scale.chi_per_phi;
+            // χ relative to the active flux where it exceeds λ̂f (a reluctance rotor's |λ̂r|
+            // is many times its magnet's flux: relative to λ̂f a weak magnet's χ would pass
+            // χ0 on the map's slope alone at no load).
+            let a =
+                -(mag * bracket) * scale.chi_per_phi * crate::real::min(T::one(), lf / reference);
             return self.rotating_step(scale, st, next, reference, a, mag, omega, settled);
         }
         // The reference is the active flux λ̂a = λ̂f + (L̂d − L̂q)·î_d and φ carries the

@@ -91,7 +91,8 @@ impl<T: Real> Blocks<T> {
             ("zero_ratio", "speed_zero_ratio"),
             ("anti_windup_ratio", "speed_anti_windup_ratio"),
         ]))?;
-        let injection = CurrentInjection::new(CurrentInjectionConfig { i_min: c.i_min() })?;
+        let injection = CurrentInjection::new(CurrentInjectionConfig { i_min: c.i_min() })?
+            .along(c.injection_direction());
         let current_config = c.current_controller_config_with(r.saturated.as_ref());
         let current = CurrentController::new(current_config).map_err(rename(&[
             ("bandwidth_hz", "current_bandwidth_hz"),

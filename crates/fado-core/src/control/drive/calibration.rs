@@ -137,12 +137,19 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             }
             self.last_i_ab = self.gain_corrected(i_abc).to_ab();
             let theta0 = self.aligned_angle;
-            self.realign(theta0);
             if self.gain.status() == GainCalibrationStatus::RotorMoved {
-                // A load turns the rotor: the release hold catches it at the aligned angle
-                // before the speed loop takes over (`ReleaseHold::engage`).
-                self.blocks.hold.engage(theta0);
+                // A load turns the rotor: the drive starts from where its back-EMF says the
+                // rotor has turned to, and the release hold catches it there before the speed
+                // loop takes over (`ReleaseHold::engage`).
+                let m = &self.config.machine;
+                let turned = self.gain.motion_travel(m.flux_linkage, m.ld);
+                let theta = crate::wrap_angle(self.gain_axis() + turned);
+                let omega = self.gain.motion_speed(m.flux_linkage, m.ld);
+                self.realign(theta);
+                self.blocks.hold.engage(theta, omega);
+                return self.last;
             }
+            self.realign(theta0);
             return self.last;
         }
         let axis = self.gain_axis();

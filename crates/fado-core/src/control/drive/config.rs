@@ -111,17 +111,31 @@ impl<T: Real> DriveConfig<T> {
 
     /// The injection level I_min of eq. (23) in A: `injection.current_ratio` × the rated
     /// current, on a rotor with L̂q > L̂d at most `injection.max_active_flux_share` ×
-    /// λ̂f/(L̂q − L̂d) (the d current that shrinks the active flux by that share).
+    /// λ̂f/(L̂q − L̂d) (the d current that shrinks the active flux by that share) where it
+    /// goes along +d; along −d ([`Self::injection_direction`]) it raises the active flux and
+    /// keeps the configured level.
     pub fn i_min(&self) -> T {
         let (t, m) = (&self.tuning.injection, &self.machine);
         let own = t.current_ratio * m.rated_current;
         let bound = t.max_active_flux_share * m.flux_linkage / (m.lq - m.ld);
         // NaN compares false (and L̂q ≤ L̂d gives no bound): the configured level.
-        if m.lq > m.ld && bound >= T::zero() && bound < own {
+        if self.injection_direction() > T::zero()
+            && m.lq > m.ld
+            && bound >= T::zero()
+            && bound < own
+        {
             bound
         } else {
             own
         }
+    }
+
+    /// The d direction of the eq. (23) injection, +1 or −1: −d where the configured level
+    /// along +d would turn the model's active flux negative
+    /// ([`injection::direction`](crate::injection::direction)).
+    pub fn injection_direction(&self) -> T {
+        let own = self.tuning.injection.current_ratio * self.machine.rated_current;
+        crate::injection::direction(&self.machine, own)
     }
 
     /// Applies the drive's build-time rules to this configuration and the estimator's tuning,

@@ -99,7 +99,8 @@
 //! current. The drive starts at once from the aligned angle with its release hold engaged
 //! ([`ReleaseHold::engage`](crate::control::release_hold::ReleaseHold::engage)), which catches
 //! the rotor there and hands the load it found to the speed loop. Measured on the presets at
-//! rest (switching-resolved, default sensors): at most 0.27 of the threshold.
+//! rest (switching-resolved, default sensors): at most 0.59 of the threshold
+//! ([`GainCalibration::motion_peak`]).
 //!
 //! # Sequence
 //! Current loop at I₁ (`settle_time`); voltage V₁: hold (`hold_time`), average
@@ -117,7 +118,7 @@ mod sequence;
 mod tests;
 
 pub use measure::{ratio_of, resistance_of};
-pub use motion::{MOTION_FILTER_TIME, MOTION_SPEED_RATIO, motion_voltage};
+pub use motion::{MOTION_FILTER_TIME, MOTION_SPEED_RATIO, MOTION_TRAVEL_SHARE, motion_voltage};
 
 use crate::error::{ConfigError, check};
 use crate::{Ab, Real};
@@ -251,6 +252,16 @@ pub struct GainCalibration<T> {
     /// motion test's reference, and Δi⊥ low-passed (A).
     cross_ref: T,
     cross_filtered: T,
+    /// Σ of the back-EMF across the axis times Ts over the level's samples where it exceeded
+    /// [`MOTION_TRAVEL_SHARE`] of `motion_voltage` (V·s): the turn of a moving rotor times its
+    /// d-axis flux ([`GainCalibration::motion_flux`]).
+    motion_flux: T,
+    /// The d current of the level in which the rotor moved (A; zero before) and the
+    /// back-EMF across the axis that ended it (V).
+    motion_current: T,
+    motion_emf: T,
+    /// The largest |back-EMF across the axis| read since the start, over `motion_voltage`.
+    motion_peak: T,
     status: GainCalibrationStatus,
     ratio: T,
     /// The last measured ratio, also when refused (NaN before any).
@@ -321,6 +332,10 @@ impl<T: Real> GainCalibration<T> {
             aborted: false,
             cross_ref: T::zero(),
             cross_filtered: T::zero(),
+            motion_flux: T::zero(),
+            motion_current: T::zero(),
+            motion_emf: T::zero(),
+            motion_peak: T::zero(),
             status,
             ratio: T::one(),
             measured: T::zero() / T::zero(),

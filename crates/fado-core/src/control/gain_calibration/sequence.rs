@@ -32,6 +32,10 @@ impl<T: Real> GainCalibration<T> {
         self.aborted = false;
         self.cross_ref = T::zero();
         self.cross_filtered = T::zero();
+        self.motion_flux = T::zero();
+        self.motion_current = T::zero();
+        self.motion_emf = T::zero();
+        self.motion_peak = T::zero();
         self.v_lower = Ab::zero();
         self.v_lower_count = 0;
         self.stage = Stage::Settle;
@@ -86,7 +90,14 @@ impl<T: Real> GainCalibration<T> {
         // Rotor motion: with the voltage frozen, a turning rotor's back-EMF (across the
         // axis, where the rotor's q axis lies) drives a current across it; at rest that
         // current stays where it was when the voltage was frozen.
-        if voltage_mode && finite && self.motion_emf(i_ab).abs() > self.config.motion_voltage {
+        let emf = if voltage_mode && finite {
+            self.motion_emf(i_ab)
+        } else {
+            T::zero()
+        };
+        if emf.abs() > self.config.motion_voltage {
+            self.motion_current = self.command().current_d;
+            self.motion_emf = emf;
             self.stage = Stage::Idle;
             self.status = GainCalibrationStatus::RotorMoved;
             self.measured = T::zero() / T::zero();

@@ -212,8 +212,8 @@ fn f32_identifies_the_mismatch_too() {
 /// Feeds the calibration a resistive machine (the current is the last voltage over R)
 /// whose rotor, from `turn_at` s, turns at `omega` (electrical rad/s): its back-EMF
 /// ω·λf across the axis drives a current towards −ω·λf/R there through L = 3 mH
-/// (λf 0.1 Wb). Returns the status.
-fn with_turning_rotor(omega: f64, turn_at: f64) -> GainCalibrationStatus {
+/// (λf 0.1 Wb). Returns the calibration.
+fn turning_rotor(omega: f64, turn_at: f64) -> GainCalibration<f64> {
     let r = 0.3;
     let mut c = config(8.0, r, 3e-3);
     // 1 % of 300 rad/s electrical on a 0.1 Wb magnet.
@@ -236,7 +236,30 @@ fn with_turning_rotor(omega: f64, turn_at: f64) -> GainCalibrationStatus {
         v = cmd.voltage.unwrap_or(axis * (r * cmd.current_d));
         n += 1;
     }
-    cal.status()
+    cal
+}
+
+fn with_turning_rotor(omega: f64, turn_at: f64) -> GainCalibrationStatus {
+    turning_rotor(omega, turn_at).status()
+}
+
+#[test]
+fn a_turning_rotor_s_speed_and_turn_are_read_from_its_back_emf() {
+    // 6 rad/s electrical from mid-hold: the speed that ended the calibration and the turn
+    // since the rotor started (ψd = λf = 0.1 Wb here, no d-axis inductance term).
+    let cal = turning_rotor(6.0, 0.075);
+    assert_eq!(cal.status(), GainCalibrationStatus::RotorMoved);
+    let speed = cal.motion_speed(0.1, 0.0);
+    let turn = cal.motion_travel(0.1, 0.0);
+    assert!(speed > 3.0 && speed <= 6.5, "{speed}");
+    // Noticed within a few milliseconds: the turn is a few of them at 6 rad/s.
+    assert!(turn > 0.0 && turn < 6.0 * 0.005, "{turn}");
+    assert!(cal.motion_peak() >= 1.0);
+    // At rest nothing is read.
+    let rest = turning_rotor(0.0, 0.0);
+    assert_eq!(rest.motion_travel(0.1, 0.0), 0.0);
+    assert_eq!(rest.motion_speed(0.1, 0.0), 0.0);
+    assert!(rest.motion_peak() < 0.5, "{}", rest.motion_peak());
 }
 
 #[test]

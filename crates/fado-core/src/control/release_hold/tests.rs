@@ -220,20 +220,20 @@ fn a_motion_hold_acts_at_any_reference_and_the_reference_resumes_from_zero() {
     let b = 1.5 * p * p * m.flux_linkage / m.inertia;
     let i_load = m.rated_torque / (1.5 * p * m.flux_linkage);
     let mut h = ReleaseHold::new(&t, &m, ts, 250.0, 2.0 * i_load).unwrap();
-    h.engage(0.3);
+    h.engage(0.3, 0.0);
     assert!(h.active() && h.tracking_fall() && h.engaged() == 1);
-    let (mut theta, mut omega, mut i, mut worst) = (0.3f64, 0.0f64, 0.0, 0.0f64);
+    let (mut theta, mut omega, mut worst) = (0.3f64, 0.0f64, 0.0f64);
     let mut handed = None;
     for k in 0..20_000 {
         assert_eq!(h.resumed(100.0), if h.active() { 0.0 } else { 100.0 });
-        match h.step(100.0, theta, theta) {
-            HoldAction::Hold(x) => i = x,
+        let i = match h.step(100.0, theta, theta) {
+            HoldAction::Hold(x) => x,
             HoldAction::Handover(x) => {
                 handed = Some((k, x));
                 break;
             }
             HoldAction::Idle => panic!("idle at {k}"),
-        }
+        };
         omega += b * (i - i_load) * ts;
         theta += omega * ts;
         worst = worst.max(0.3 - theta);

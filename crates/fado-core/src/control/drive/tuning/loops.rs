@@ -111,7 +111,8 @@ pub struct InjectionTuning<T> {
     /// `regen-stop`'s stop through zero where the injection rises as i_q reverses, 0.25–0.28 rad
     /// on two of four seeds with 0.4, 0.09–0.11 rad on all four with 0.25 (docs/range.md);
     /// the paper's motor and the surface-magnet presets take nothing, ipmsm-2k2 3 %. A large
-    /// value (1e9) keeps `current_ratio`.
+    /// value (1e9) keeps `current_ratio`. No bound where the injection goes along −d
+    /// ([`injection::direction`](crate::injection::direction)): there it raises the active flux.
     pub max_active_flux_share: T,
 }
 
