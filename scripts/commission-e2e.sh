@@ -21,7 +21,7 @@ for cfg in motors/*.toml; do
   done
   for seed in $seeds; do
     d="$out/$name-$seed"
-    "$bin" commission --motor "$name" --seed "$seed" --out "$d" > /dev/null || true
+    "$bin" commission --motor "$name" --seed "$seed" --out "$d" > /dev/null 2> "$d.err" || true
     [[ -f "$d/identified.toml" ]] || continue
     cp "$d/identified.toml" "$d/id-on.toml"
     { cat "$d/identified.toml"; printf '%s' "$no_adapt"; } > "$d/id-off.toml"
@@ -54,7 +54,15 @@ for name in motors:
     for seed in seeds:
         d = os.path.join(out, f"{name}-{seed}")
         if not os.path.isfile(os.path.join(d, "identified.toml")):
-            print(f"| {name} | identified, seed {seed} | commissioning failed | | | |")
+            # Refused before it ran (its preconditions: no metrics.json, the key named in the
+            # error) or aborted (metrics.json with its status).
+            try:
+                why = json.load(open(os.path.join(d, "metrics.json")))["status"]
+            except FileNotFoundError:
+                err = open(d + ".err").read().strip().splitlines()
+                key = err[-1].split(": ")[1].strip("`") if err and err[-1].count(": ") > 1 else "?"
+                why = f"refused ({key})"
+            print(f"| {name} | identified, seed {seed} | commissioning {why} | | | |")
             continue
         row = [cell(os.path.join(d, f"{a}-{s}")) for a, s in cols]
         print(f"| {name} | identified, seed {seed} | " + " | ".join(row) + " |")

@@ -54,12 +54,28 @@ pub(super) fn standstill_gains<T: Real>(rs: T, l: T, ts: T) -> (T, T) {
 }
 
 /// Natural frequency of the standstill loop along the reference, × Ts: well below the
-/// sampling rate (a nameplate L 1.6× the machine's leaves ωn·Ts = 0.13, ζ = 0.9, with the
-/// loop's sample of delay 0.02 rad of phase at ωn), and the fastest such loop, because the
+/// sampling rate (a nameplate L 1.6× the machine's leaves ωn·Ts = 0.13 and ζ = 0.9, where
+/// the loop's 1.5 samples of delay cost 0.19 rad of phase), and the fastest such loop: the
 /// voltage it has to find besides R̂·i* is the inverter's unmodelled threshold, which does
 /// not scale with R·I: 60 V against R·I = 8 V on a 10 kV-class machine, where K = R²/(2L)
 /// (0.2 V/(A·s)) took 5 s to build the alignment's current.
 pub(super) const STANDSTILL_LOOP_BANDWIDTH: f64 = 0.1;
+
+/// The spin's synchronous current PI's integral gain, V/(A·s), at crossover `wc` (rad/s) with
+/// the proportional gain wc·L: wc·R (its zero cancels the machine's pole R/L), and at least
+/// what follows the I-f spin's back-EMF within [`SPIN_EMF_FOLLOWING`] of the current limit
+/// `i_limit`. The loop has no feedforward of that EMF, a ramp ω̇·λf (`accel` ω̇ in electrical
+/// rad/s², `flux` λf of the nameplate), whose following error is ω̇·λf/k_i: on a 10 kV-class
+/// machine (λf 11.7 Wb, R/L = 4 s⁻¹) at a 2 kHz carrier, wc·R left 61 A against the 27 A the
+/// spin tolerates (`CurrentNotFollowing` in the spin), and at 5 kHz 24 A, which took λ̂f
+/// 1.6 % low.
+pub(super) fn spin_integral_gain<T: Real>(rs: T, wc: T, accel: T, flux: T, i_limit: T) -> T {
+    (wc * rs).max(accel * flux / (T::lit(SPIN_EMF_FOLLOWING) * i_limit))
+}
+
+/// The I-f spin's largest following error of its back-EMF ramp, as a fraction of the current
+/// limit: 5 % (the spin aborts at 30 %; the nameplate's λf and J may be 1.25× off).
+pub(super) const SPIN_EMF_FOLLOWING: f64 = 0.05;
 
 /// The I-f spin's current amplitude: the DC test's upper level ([`dc_level`]), for the same
 /// reason. The rotor lags the I-f vector by δ, with i_d = I·cos δ, and the torque

@@ -15,7 +15,13 @@ impl<T: Real> Commissioning<T> {
         );
         let wc = T::lit(0.2) / self.ts;
         self.spin_loop.kp = Dq::new(wc * self.ld, wc * self.lq);
-        self.spin_loop.ki = wc * self.rs;
+        self.spin_loop.ki = spin_integral_gain(
+            self.rs,
+            wc,
+            self.spin_accel,
+            self.cfg.nameplate.flux_linkage,
+            self.i_limit,
+        );
         // Bumpless: the standstill voltage (rotor at θ = 0, frame at 0) becomes the integral,
         // without the inverter error the compensation now supplies.
         let i1 = T::lit(0.5) * dc_level(&self.cfg.nameplate, self.i_limit);
