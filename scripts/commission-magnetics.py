@@ -175,10 +175,13 @@ LIMITS = """
 - The measured map's own asymmetry in i_d and its noise are beyond the algebraic model (with
   the rib: the residual ratio 0.12–0.13 against 0.003–0.05 on the algebraic machines);
   its incremental inductances are off by up to a third at the edges of the rated range.
-- A fitted model is used only where its incremental inductances at the inductance tests'
-  operating point agree with those tests within 20 %: the measured 1.1 kW PMSM map
-  (`pmsm-gem-1k1-measured`, its saliency 1.2) is fitted no better than by a shape without
-  physical meaning, and keeps constant inductances.
+- A fitted model is used only where it has a physical meaning: its incremental inductances
+  at the inductance tests' operating point within 20 % of those tests', and its incremental
+  inductance matrix above a tenth of its zero-current one over the pulses' range. On the
+  measured 1.1 kW PMSM map (`pmsm-gem-1k1-measured`, its saliency 1.2) the best fits of
+  seeds 1, 3 and 4 (with the rib) fold back: their law i(ψ) gives a second flux for some
+  currents inside the rated range, where the incremental inductance is about zero; those
+  seeds keep constant inductances ("none" above), seed 2's fit stays invertible and is used.
 - The identified flux map spans ± the drive's default current limit; the pulses measure only
   up to the rated current, and beyond it the table holds the model's extrapolation. A model
   that does not tabulate as a monotonic map there is written as `[model.saturation]`

@@ -127,8 +127,12 @@
 //!    (`magnetic_fit`). Saturation is reported, and the model
 //!    returned in [`Identification::saturation`], when its incremental inductances change by
 //!    more than `detection_threshold` (5 %) over the pulses' range and it explains the data
-//!    (RMS residual below half the constant-inductance model's); a linear machine keeps its
-//!    constants. Accuracy against the plant's truth: docs/results/commissioning-magnetics.md.
+//!    (RMS residual below half the constant-inductance model's) with a physical meaning: its
+//!    incremental inductances at the inductance tests' operating point within 20 % of
+//!    theirs, and its incremental inductance matrix above a tenth of the zero-current one
+//!    over the pulses' range (a fitted law i(ψ) that folds back gives a second flux for some
+//!    currents, where the incremental inductance is about zero); a linear machine, or one
+//!    whose best fit has no physical meaning, keeps its constants. Accuracy against the plant's truth: docs/results/commissioning-magnetics.md.
 //! 6. **Spin and back-EMF** ([`Phase::Spin`], [`Phase::Coast`]): an I-f start (a current vector
 //!    turned at a speed ramped to `spin_speed_ratio` of the rated speed), regulated by a
 //!    synchronous-frame PI tuned from the identified R̂s, L̂ (bandwidth 0.2/Ts; its integral
