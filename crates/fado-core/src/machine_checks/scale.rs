@@ -22,11 +22,11 @@
 //! most 0.46 × the long bound (the gimbal motor and the 48 V hub); those with a product above 3
 //! have τ at least 3.4 × the short bound (the 10 kV machine). A slotless 40 W motor (maxon
 //! EC 22: 85 µs, product 0.006) sits at 0.06 × the long bound: the product alone, which
-//! separated / 10 from real machines above 0.03, takes it for ratings / 10. Every preset and
-//! test machine with its ratings / 10 or × 10 is caught, but for four: ratings × 10 on the
-//! Baldor PM-SyRM and the 32-pole torque IPM (caught by the product) and ratings / 10 on three
-//! multirotor motors (caught by the product and the half bound); a slotless motor × 10
-//! (product 0.6, the size of a real high-speed machine) is not.
+//! separated / 10 from real machines above 0.03, takes it for ratings / 10. Every motor file
+//! of the repository with its ratings / 10 or × 10 is named (by this finding, or by the range
+//! of the rated speed or of the DC link derived from the ratings) but for one: the slotless
+//! motor × 10 (product 0.6, τ 85 µs at 6.9 kW), the size of a real high-speed machine
+//! (`crates/fado-sim/tests/rating_scale_files.rs`).
 
 use super::{Finding, MachineModel, Sink};
 use crate::Real;
