@@ -271,3 +271,15 @@ fn a_map_in_other_units_or_on_other_axes_than_the_motor_is_refused() {
     let e = write("syre.csv", &syre).unwrap_err();
     assert!(e.message.contains("SyR-e"), "{e}");
 }
+
+#[test]
+fn a_path_relative_to_a_relative_configuration_resolves_to_an_absolute_one() {
+    // `fado-sim commission --config dir/motor.toml` writes identified.toml into its output
+    // directory: the plant's map must be named there by a path that does not depend on it.
+    set_config_dir(Some(Path::new("some/dir")));
+    let p = resolve("map.csv");
+    set_config_dir(None);
+    assert!(p.is_absolute(), "{}", p.display());
+    assert!(p.ends_with("some/dir/map.csv"), "{}", p.display());
+    assert!(resolve("m.csv").is_absolute());
+}
