@@ -11,7 +11,7 @@
 //! | `viscous_friction` | [`FRICTION_TORQUE_RATIO`] of the rated torque at rated speed |
 //! | `inertia` | rated torque accelerates it to rated speed in [`MECHANICAL_START_TIME`] |
 //! | `dc_voltage` | the rated point uses [`DC_LINK_MODULATION_RATIO`] of the linear range |
-//! | `switching_frequency` | ω_rated·Ts ≤ [`MAX_OMEGA_TS`], at least the DC link's class floor ([`min_switching_frequency`]) |
+//! | `switching_frequency` | ω_rated·Ts ≤ [`MAX_OMEGA_TS`] and min(Ld, Lq)/Rs ≥ 2·Ts, at least the DC link's class floor ([`min_switching_frequency`]) |
 //! | `dead_time` | [`DEAD_TIME_PERIOD_RATIO`] of the carrier period |
 //! | `threshold_voltage` | [`THRESHOLD_VOLTAGE_RATIO`] of the DC link |
 //! | `current_band` | [`CURRENT_BAND_RATIO`] of the rated current |
@@ -140,7 +140,7 @@ pub const RULES: [(&str, &str); 7] = [
     ),
     (
         "inverter.switching_frequency",
-        "ω_rated·Ts ≤ 0.2 (Ts = 1/(2·f_sw)), at least 5 kHz (2 kHz on a DC link above 1.2 kV), rounded up to a whole kHz",
+        "ω_rated·Ts ≤ 0.2 and the electrical time constant min(ld, lq)/rs ≥ 2·Ts (Ts = 1/(2·f_sw)), at least 5 kHz (2 kHz on a DC link above 1.2 kV), rounded up to a whole kHz",
     ),
     (
         "inverter.dead_time",
@@ -190,6 +190,20 @@ pub fn switching_frequency(pole_pairs: u32, rated_speed_rpm: f64, dc_voltage: f6
         needed.max(min_switching_frequency(dc_voltage)),
         SWITCHING_FREQUENCY_STEP,
     )
+}
+
+/// The switching frequency of machine `m`, Hz: [`switching_frequency`], raised where needed to
+/// the smallest whole kHz at which the electrical time constant min(Ld, Lq)/Rs spans two
+/// sampling periods (a current loop needs at least that; a slotless 40 W motor's 85 µs asks
+/// for 12 kHz).
+pub fn switching_frequency_of(m: &MachineModel<f64>) -> f64 {
+    let f = switching_frequency(m.pole_pairs, m.rated_speed_rpm, m.dc_voltage);
+    let tau = m.ld.min(m.lq) / m.rs;
+    if tau.is_finite() && tau > 0.0 && 1.0 / tau > f {
+        ceil_to(1.0 / tau, SWITCHING_FREQUENCY_STEP)
+    } else {
+        f
+    }
 }
 
 /// The d and q currents of the maximum-torque-per-ampere point of magnitude `i` (A peak):

@@ -5,6 +5,7 @@
 //! Every block follows the crate's pattern (`new(config) -> Result<_, ConfigError>`, `step`,
 //! `reset`), is allocation-free, generic over [`Real`](crate::Real) and never panics.
 
+pub mod calibration_turn;
 pub mod current_controller;
 pub mod dc_link_limit;
 pub mod dead_time_compensation;
@@ -24,6 +25,7 @@ pub mod release_hold;
 pub mod saturated_references;
 pub mod speed_controller;
 pub mod standstill_probe;
+pub mod start_ramp;
 pub mod startup;
 pub use drive::probe_period;
 pub use drive::speed_bandwidth;
@@ -49,5 +51,6 @@ pub use release_current::ReleaseCurrent;
 pub use release_hold::{ReleaseHold, ReleaseHoldTuning};
 pub use speed_controller::{SpeedController, SpeedControllerConfig, limit_current_d_priority};
 pub use standstill_probe::{StandstillProbe, StandstillProbeConfig};
+pub use start_ramp::{StartRamp, StartRampTuning};
 pub use startup::{AngleSearch, StartupStatus, StartupTuning};
 pub use tracker_feedforward::TrackerFeedforwardTuning;

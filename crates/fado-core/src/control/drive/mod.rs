@@ -43,6 +43,7 @@ mod standstill;
 mod step;
 pub mod tracker_feedforward;
 pub mod tuning;
+mod turn;
 mod voltage_ellipse;
 
 pub use config::DriveConfig;
@@ -50,6 +51,7 @@ pub(crate) use config::swing_time_constant;
 pub use output::DriveOutput;
 pub use tuning::DriveTuning;
 
+use crate::control::calibration_turn::CalibrationTurn;
 use crate::control::current_controller::CurrentController;
 use crate::control::dc_link_limit::DcLinkLimit;
 use crate::control::dead_time_compensation::DeadTimeCompensation;
@@ -67,6 +69,7 @@ use crate::control::release_hold::ReleaseHold;
 use crate::control::saturated_references::SaturatedReferences;
 use crate::control::speed_controller::SpeedController;
 use crate::control::standstill_probe::StandstillProbe;
+use crate::control::start_ramp::StartRamp;
 use crate::control::startup::AngleSearch;
 use crate::estimator::{Estimate, SensorlessEstimator};
 use crate::injection::CurrentInjection;
@@ -161,6 +164,8 @@ struct Blocks<T> {
     /// the dead-time band near zero speed (see [`phase_band`](crate::control::phase_band)).
     phase_band: PhaseBand<T>,
     limits: RatingsLimit<T>,
+    /// The speed reference's ramp from the start-up's end.
+    start_ramp: StartRamp<T>,
 }
 
 /// What the modulator applies at a sample: the duties, and the voltage that acts (α-β and in
@@ -218,10 +223,13 @@ pub struct SensorlessDrive<T: 'static, E = SensorlessEstimator<T>> {
     calibration_square_sum: T,
     /// Phase-current offsets subtracted from every sample (A).
     current_offset: Abc<T>,
-    /// The angle of the last `align`, re-applied when the calibration ends.
+    /// The angle of the last `align` (or of the calibration's turn), re-applied when the
+    /// calibration ends.
     aligned_angle: T,
     /// The start-up gain-mismatch calibration (after the offsets) and its result.
     gain: GainCalibration<T>,
+    /// The free rotor's turn onto a well-observed axis before that calibration, while under way.
+    turn: Option<CalibrationTurn<T>>,
     /// The start-up's angle phase (after the offsets, before the gain calibration).
     startup: AngleSearch<T>,
     /// 1/k: the factor on the phase-a reading (1 until a ratio is measured).
