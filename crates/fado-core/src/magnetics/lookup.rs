@@ -65,9 +65,14 @@ impl<T: Real> FluxLookup<T> for MachineMagnetics<T> {
         }
     }
 
+    /// A [`MachineMagnetics::Map`]'s C¹ interpolant (`FluxMap::smooth_flux_and_jacobian`),
+    /// any other model's own ψ(i).
     #[inline]
     fn flux_at(&self, linear: ConstantInductance<T>, i: Dq<T>) -> Dq<T> {
-        self.resolve(linear).flux(i)
+        match *self {
+            MachineMagnetics::Map(m) => m.smooth_flux_and_jacobian(i).0,
+            _ => self.resolve(linear).flux(i),
+        }
     }
 
     #[inline(always)]
@@ -78,17 +83,26 @@ impl<T: Real> FluxLookup<T> for MachineMagnetics<T> {
         fallback: Dq<T>,
         warm: &FluxWarmStart<T>,
     ) -> (Dq<T>, FluxWarmStart<T>) {
-        MachineMagnetics::flux_warm(self, linear, i, fallback, warm)
+        match *self {
+            MachineMagnetics::Map(m) => (m.smooth_flux_and_jacobian(i).0, *warm),
+            _ => MachineMagnetics::flux_warm(self, linear, i, fallback, warm),
+        }
     }
 
     #[inline(always)]
     fn q_flux_offset(&self, linear: ConstantInductance<T>, i_d: T) -> T {
-        MachineMagnetics::q_flux_offset(self, linear, i_d)
+        match *self {
+            MachineMagnetics::Map(m) => m.smooth_flux_and_jacobian(Dq::new(i_d, T::zero())).0.q,
+            _ => MachineMagnetics::q_flux_offset(self, linear, i_d),
+        }
     }
 
     #[inline]
     fn inductance_at(&self, linear: ConstantInductance<T>, i: Dq<T>) -> InductanceMatrix<T> {
-        self.resolve(linear).incremental_inductance(i)
+        match *self {
+            MachineMagnetics::Map(m) => m.smooth_flux_and_jacobian(i).1,
+            _ => self.resolve(linear).incremental_inductance(i),
+        }
     }
 
     #[inline]

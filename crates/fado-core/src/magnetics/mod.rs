@@ -57,6 +57,7 @@ mod inverse_cache;
 mod lookup;
 mod machine;
 mod saturation;
+mod smooth_map;
 mod uniform_map;
 mod uniform_table;
 mod warm_start;
