@@ -35,6 +35,7 @@ pub mod number;
 pub mod outputs;
 pub mod record;
 pub mod recording_checks;
+pub mod recording_model;
 pub mod replay;
 pub mod scalar;
 pub mod simulate;

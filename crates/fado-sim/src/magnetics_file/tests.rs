@@ -45,6 +45,49 @@ fn a_flux_map_file_is_read_in_any_row_order_and_bad_ones_are_refused_at_their_li
     assert!(e.contains("/nonexistent/map.csv"), "{e}");
 }
 
+#[test]
+fn a_crlf_file_with_comments_and_blank_lines_is_refused_at_its_own_line() {
+    // A lab's export: CRLF line ends, comments and a blank line before the header, a blank
+    // line inside; the bad value is on line 8 whatever the line ends.
+    let lf = "# lab map\n# 2 x 2\n\ni_d,i_q,psi_d,psi_q\n-5,-1,0.40,-0.05\n\n-5,1,0.40,0.05\n0,-1,x,-0.05\n0,1,0.60,0.05\n";
+    let crlf = lf.replace('\n', "\r\n");
+    for text in [lf, crlf.as_str()] {
+        let e = parse_flux_map(text, "m.csv").unwrap_err().to_string();
+        assert!(e.starts_with("m.csv:8:1:"), "{e}");
+        let good = text.replace(",x,", ",0.60,");
+        assert_eq!(
+            parse_flux_map(&good, "m.csv").unwrap().map().i_d(),
+            &[-5.0, 0.0]
+        );
+        let header = text
+            .replace("psi_q\r", "psi_qq\r")
+            .replace("psi_q\n", "psi_qq\n");
+        let e = parse_flux_map(&header, "m.csv").unwrap_err().to_string();
+        assert!(e.starts_with("m.csv:4:1:"), "{e}");
+    }
+}
+
+#[test]
+fn a_falling_map_is_told_apart_as_noise_or_swapped_axes() {
+    // ψq along i_q at i_d = 0: one dip among rising steps (a measured map's noise), then the
+    // whole line falling (the axes or signs swapped).
+    let map = |q: [f64; 5]| {
+        let mut t = String::from("i_d,i_q,psi_d,psi_q\n");
+        for (m, iq) in [-2.0, -1.0, 0.0, 1.0, 2.0].iter().enumerate() {
+            t += &format!("-1,{iq},0.5,{}\n0,{iq},0.6,{}\n", 0.02 * iq, q[m]);
+        }
+        parse_flux_map(&t, "m.csv").unwrap_err().to_string()
+    };
+    let noisy = map([-0.04, -0.02, 0.0, -0.001, 0.04]);
+    assert!(
+        noisy.starts_with("m.csv:9:1:") && noisy.contains("noise"),
+        "{noisy}"
+    );
+    assert!(noisy.contains("-0.001000 Wb at i_q = 1 A"), "{noisy}");
+    let swapped = map([0.04, 0.02, 0.0, -0.02, -0.04]);
+    assert!(swapped.contains("axes and signs"), "{swapped}");
+}
+
 /// A scratch directory of this test process.
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("fado-magfile-{}-{name}", std::process::id()));
