@@ -797,10 +797,10 @@ fn script_map(plant: &MachineModel<f64>) -> MachineModel<f64> {
 /// and 100 % of the rated torque. Two things hold it (docs/method/saturation.md, "A map's
 /// interpolation"): the estimator reads a map through its C¹ interpolant (through the
 /// bilinear map's chord slopes the slow mode stops decaying, −0.02 and +0.26 s⁻¹ on the 0.5 A
-/// machine, and the replay loses 0.28 rad at 30 %), and the R̂s law's error is relative to
-/// the active flux where it exceeds λ̂f (relative to the 8.7 mVs magnet the law runs 22 times
-/// its rate, learns the map's residual error as 3–5 % of resistance within milliseconds and
-/// the replay loses 0.21 rad at 30 %).
+/// machine, and the 30 % rows exceed 0.1 rad on all three magnets), and the R̂s law's error
+/// is relative to the active flux where it exceeds λ̂f (relative to the 8.7 mVs magnet the law
+/// runs 22 times its rate and learns the map's residual error as resistance within
+/// milliseconds: R̂s 4–12 % high, and the 0.5 and 1 A machines lose 0.28–0.71 rad under load).
 #[test]
 fn a_weak_magnet_pm_syrm_given_its_map_through_the_load_step() {
     let mut failed = Vec::new();

@@ -35,10 +35,11 @@ use crate::{Dq, Real};
 fn slope_weights<T: Real>(p: [T; 3], h: [T; 2]) -> [T; 3] {
     let zero = T::zero();
     let (hl, hr) = (h[0], h[1]);
-    if !(hl > zero) {
+    // An edge node (a zero width) takes its one cell's chord.
+    if hl <= zero {
         return [zero, -T::one() / hr, T::one() / hr];
     }
-    if !(hr > zero) {
+    if hr <= zero {
         return [-T::one() / hl, T::one() / hl, zero];
     }
     let (dl, dr) = ((p[1] - p[0]) / hl, (p[2] - p[1]) / hr);
@@ -88,10 +89,10 @@ fn hermite_weights<T: Real>(x: [T; 4], p: [T; 4], t: T) -> ([T; 4], [T; 4]) {
     slope[1] = d00;
     slope[2] = d01;
     for n in 0..3 {
-        value[n] = value[n] + h * (h10 * s1[n]);
-        value[n + 1] = value[n + 1] + h * (h11 * s2[n]);
-        slope[n] = slope[n] + d10 * s1[n];
-        slope[n + 1] = slope[n + 1] + d11 * s2[n];
+        value[n] += h * (h10 * s1[n]);
+        value[n + 1] += h * (h11 * s2[n]);
+        slope[n] += d10 * s1[n];
+        slope[n + 1] += d11 * s2[n];
     }
     (value, slope)
 }
