@@ -354,6 +354,18 @@ impl<T: Real, M: FluxLookup<T>> ActiveFlux<T, M> {
         (turned.abs() < i.q.abs()).then_some(i.q + turned)
     }
 
+    /// How far the map's two interpolants of the same nodes disagree on λa at the operating
+    /// point (|λa of the C¹ one − λa of the bilinear one|, Wb): what the nodes leave open
+    /// between them, zero on a node and for any model but a map read through its C¹
+    /// interpolant.
+    #[inline]
+    pub fn interpolation_spread(&self, point: &ActiveFluxPoint<T>) -> T {
+        match self.model.bilinear_flux(point.i_dq) {
+            Some(psi) => (self.point_at(point.i_dq, psi).active - point.active).abs(),
+            None => T::zero(),
+        }
+    }
+
     /// The frame coupling's (s, κ) at the operating point (module docs): while the current
     /// loop holds î, a frame error δ moves |λ̂r| by s·δ and leaves (κ/λa)·δ of it visible.
     #[inline]

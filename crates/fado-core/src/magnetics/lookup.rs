@@ -44,6 +44,11 @@ pub trait FluxLookup<T: Real>: Copy {
 
     /// Whether `i` lies beyond a map's data ([`MachineMagnetics::beyond_data`]).
     fn beyond_data(&self, i: Dq<T>) -> bool;
+
+    /// A map read through its C¹ interpolant (`flux_at`): its bilinear ψ(i), the other
+    /// interpolant of the same nodes (their difference measures what the nodes leave open
+    /// between them); None for any other model.
+    fn bilinear_flux(&self, i: Dq<T>) -> Option<Dq<T>>;
 }
 
 impl<T: Real> FluxLookup<T> for MachineMagnetics<T> {
@@ -109,6 +114,14 @@ impl<T: Real> FluxLookup<T> for MachineMagnetics<T> {
     fn beyond_data(&self, i: Dq<T>) -> bool {
         MachineMagnetics::beyond_data(self, i)
     }
+
+    #[inline]
+    fn bilinear_flux(&self, i: Dq<T>) -> Option<Dq<T>> {
+        match *self {
+            MachineMagnetics::Map(m) => Some(m.flux(i)),
+            _ => None,
+        }
+    }
 }
 
 /// A uniform-grid table in flash, named by its type: the lookup's shape and its cells'
@@ -157,5 +170,11 @@ impl<T: Real, const ND: usize, const NQ: usize> FluxLookup<T> for &UniformFluxTa
     #[inline]
     fn beyond_data(&self, i: Dq<T>) -> bool {
         self.map().beyond_grid(i)
+    }
+
+    /// None: a typed table is read bilinearly.
+    #[inline(always)]
+    fn bilinear_flux(&self, _i: Dq<T>) -> Option<Dq<T>> {
+        None
     }
 }

@@ -30,6 +30,13 @@ pub(crate) struct ResistanceAdaptationParams<T: 'static> {
     floor_sq: T,
 }
 
+/// The resistance error, as a share of R0, whose flux error the turning law must see above a
+/// map's interpolation spread (`ActiveFlux::interpolation_spread`) to run. Ours \[A\]: a
+/// model error read as resistance biases R̂s by at most about this share; 2 % holds the
+/// traction IPMSM's coarse 7 × 8 map of `scripts/saturated-replay.py` (R̂s 0.95–1.05 × the
+/// truth running everywhere).
+pub(crate) const MAP_RESISTANCE_RESOLUTION: f64 = 0.02;
+
 /// What the laws derive from R0, the resistance they start from and scale with: mutable
 /// (R0 is replaced at run time), so kept with the state.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -275,6 +282,14 @@ impl<T: Real> ResistanceAdaptationParams<T> {
             let Some(bracket) = af.resistance_regressor(&point) else {
                 return false;
             };
+            // Frozen where the map's interpolation leaves λa more open than the flux error a
+            // resistance error of `MAP_RESISTANCE_RESOLUTION`·R0 causes, R0·|bracket|/|ω̂|
+            // times it: there the law would learn the interpolation as resistance.
+            if af.interpolation_spread(&point) * omega.abs()
+                >= T::lit(MAP_RESISTANCE_RESOLUTION) * scale.r0 * bracket.abs()
+            {
+                return false;
+            }
             let reference = point.active + (lf - self.config.flux_linkage_hat);
             // χ relative to the active flux where it exceeds λ̂f (a reluctance rotor's |λ̂r|
             // is many times its magnet's flux: relative to λ̂f a weak magnet's χ would pass
