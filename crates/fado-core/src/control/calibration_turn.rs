@@ -34,8 +34,8 @@
 //! and its motion test reads a swing as motion only above 0.5 % of the rated speed's back-EMF
 //! (on the cheetah preset an amplitude of 0.12 rad). A model inertia off by a factor of two
 //! changes r by √2 and keeps the residual below 4.3 % of Δ. A turn longer than
-//! [`MAX_TURN_TIME`] (a heavy rotor on a weak current) is not made: the calibration is then
-//! skipped as before.
+//! [`MAX_TURN_TIME`] (a heavy rotor on a weak current: the paper's motor, the servo, the
+//! IPMSM presets) is not made, and the calibration is skipped as `Unobservable`.
 //!
 //! # Limits
 //! The rotor must be free to turn and unloaded: a load holds it off the turned axis by its
@@ -54,9 +54,13 @@ use crate::{MachineModel, Real};
 /// \[A\]: about three periods leave at most 1.3 % of the turn as a residual swing (module docs).
 pub const TURN_SWING_PERIODS: f64 = 3.0;
 
-/// Longest turn made, s \[A\]: a start-up budget of the order of the calibration itself
-/// (0.33–0.52 s on the presets).
-pub const MAX_TURN_TIME: f64 = 0.5;
+/// Longest turn made, s \[A\]: the budget of one of the calibration's holds
+/// (`GAIN_CALIBRATION_MAX_HOLD_TIME`). The turn delays the start, and a rotor too heavy for
+/// it gains little from it: on the paper's motor (three swing periods 0.43 s) the mismatch
+/// left walks θ̂ at 0.26 rad/s, and `stops` from θ0 = 0.5 passes at 0.111 rad unturned but
+/// at 0.355 rad turned, its start pushed into the scenario's load step. The multirotor and
+/// outrunner motors turn in 0.10–0.15 s.
+pub const MAX_TURN_TIME: f64 = 0.2;
 
 /// The nearest of the six axes k·π/3 to `theta` (electrical rad, any finite value): every
 /// phase carries at least half of a current along it.
@@ -70,7 +74,7 @@ pub fn well_observed_axis<T: Real>(theta: T) -> T {
 /// The natural frequency ω_n (electrical rad/s) of a rotor held by the d current `i_d` (A):
 /// √(1.5·p²·λ̂a·i_d/Ĵ), λ̂a the model's active flux at `i_d` (the damping left out).
 pub fn swing_frequency<T: Real>(machine: &MachineModel<T>, i_d: T) -> T {
-    let p = T::lit(machine.pole_pairs as f64);
+    let p = T::from_index(machine.pole_pairs as usize);
     let stiffness = T::lit(1.5) * p * p * machine.active_flux(i_d) * i_d;
     (stiffness / machine.inertia)
         .step_max(T::zero())
@@ -201,6 +205,12 @@ mod tests {
             }
         }
         assert!(plan(f64::NAN).is_none());
+        // The paper's motor: three swing periods at its I₁ take 0.43 s, beyond the budget.
+        let paper = MachineModel::<f64>::paper();
+        let i1 = 0.5 * paper.rated_current;
+        let periods = TURN_SWING_PERIODS * 2.0 * PI / swing_frequency(&paper, i1);
+        assert!((periods - 0.43).abs() < 0.01, "{periods}");
+        assert!(CalibrationTurn::plan(&paper, 0.5, i1, 0.2, 1e-4).is_none());
     }
 
     #[test]

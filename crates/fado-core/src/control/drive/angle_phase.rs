@@ -38,7 +38,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             StartupCommand::Start(theta) => {
                 // The current is back at about zero: the estimator starts from it.
                 self.last_i_ab = i_ab;
-                self.realign(theta);
+                self.start_at(theta);
                 return self.last;
             }
             StartupCommand::Restart => {

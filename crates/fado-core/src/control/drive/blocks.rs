@@ -15,6 +15,7 @@ use crate::control::release_hold::{ReleaseHold, holds_through_standstill};
 use crate::control::saturated_references::SaturatedReferences;
 use crate::control::speed_controller::{SpeedController, SpeedControllerConfig};
 use crate::control::standstill_probe::{StandstillProbe, StandstillProbeConfig};
+use crate::control::start_ramp::StartRamp;
 use crate::error::{ConfigError, check};
 use crate::injection::{CurrentInjection, CurrentInjectionConfig};
 use crate::{Ab, Abc, Dq, Real, Rotation};
@@ -116,6 +117,7 @@ impl<T: Real> Blocks<T> {
         let probe = StandstillProbe::new(probe_config)?;
         let hold = release_hold(c, &probe_config, speed_config.i_max)?;
         let limits = RatingsLimit::new(&t.limits, m)?;
+        let start_ramp = StartRamp::new(&t.start_ramp, m, ts)?;
         Ok(Self {
             hold,
             phase_band: PhaseBand::new(m, dead_time.config()),
@@ -129,6 +131,7 @@ impl<T: Real> Blocks<T> {
             dc_link,
             field_weakening,
             limits,
+            start_ramp,
         })
     }
 
@@ -144,6 +147,7 @@ impl<T: Real> Blocks<T> {
         self.field_weakening.reset();
         self.hold.disarm();
         self.phase_band.reset();
+        self.start_ramp.disarm();
     }
 }
 

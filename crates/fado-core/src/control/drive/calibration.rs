@@ -46,8 +46,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             let sum = self.calibration_sum;
             self.current_offset = Abc::new(sum.a * k, sum.b * k, sum.c * k);
             self.last_i_ab = Ab::zero();
-            let theta0 = self.aligned_angle;
-            self.realign(theta0);
+            self.start_at(self.aligned_angle);
             let mut out = self.last;
             out.gates_enabled = false;
             return out;
@@ -145,11 +144,11 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
                 let turned = self.gain.motion_travel(m.flux_linkage, m.ld);
                 let theta = crate::wrap_angle(self.gain_axis() + turned);
                 let omega = self.gain.motion_speed(m.flux_linkage, m.ld);
-                self.realign(theta);
+                self.start_at(theta);
                 self.blocks.hold.engage(theta, omega);
                 return self.last;
             }
-            self.realign(theta0);
+            self.start_at(theta0);
             return self.last;
         }
         let axis = self.gain_axis();

@@ -177,6 +177,14 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         self.realign(theta0);
     }
 
+    /// The start-up's end at `theta0` ([`realign`](Self::realign)): the speed reference
+    /// starts from the rotor's speed there, zero, and ramps to the user's
+    /// ([`start_ramp`](crate::control::start_ramp)).
+    pub(super) fn start_at(&mut self, theta0: T) {
+        self.realign(theta0);
+        self.blocks.start_ramp.arm(T::zero());
+    }
+
     /// [`align`](Self::align) without touching the gain calibration (its own end re-aligns).
     pub(super) fn realign(&mut self, theta0: T) {
         self.aligned_angle = theta0;

@@ -69,6 +69,7 @@ use crate::control::release_hold::ReleaseHold;
 use crate::control::saturated_references::SaturatedReferences;
 use crate::control::speed_controller::SpeedController;
 use crate::control::standstill_probe::StandstillProbe;
+use crate::control::start_ramp::StartRamp;
 use crate::control::startup::AngleSearch;
 use crate::estimator::{Estimate, SensorlessEstimator};
 use crate::injection::CurrentInjection;
@@ -163,6 +164,8 @@ struct Blocks<T> {
     /// the dead-time band near zero speed (see [`phase_band`](crate::control::phase_band)).
     phase_band: PhaseBand<T>,
     limits: RatingsLimit<T>,
+    /// The speed reference's ramp from the start-up's end.
+    start_ramp: StartRamp<T>,
 }
 
 /// What the modulator applies at a sample: the duties, and the voltage that acts (α-β and in

@@ -120,6 +120,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         // Reaction to a lost rotor (see `lock.reaction`).
         let speed_ref = speed_ref_mech * T::lit(self.config.machine.pole_pairs as f64);
         let speed_ref = self.blocks.limits.speed(speed_ref);
+        let speed_ref = self.blocks.start_ramp.step(speed_ref);
         let action = self.react_to_lock(&estimate, speed_ref)?;
         // 4. Speed loop, injection (23) and current-vector limit (zero current when coasting).
         let backup = self.blocks;

@@ -7,6 +7,9 @@ use crate::control::calibration_turn::CalibrationTurn;
 use crate::estimator::{Estimate, RotorAngleEstimator};
 use crate::{Ab, Abc, Dq, Real, Rotation};
 
+/// The current loop's voltage, its reference and the measured current, all d-q (V, A, A).
+type CurrentLoopSample<T> = (Dq<T>, Dq<T>, Dq<T>);
+
 impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
     /// While the gain calibration is armed: the turn's sample, or `None` when no turn is under
     /// way (none needed or possible, or this one just ended: the rotor is then at the turned
@@ -79,7 +82,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         current_d: T,
         i_ab: Ab<T>,
         estimate: Estimate<T>,
-    ) -> Result<(Dq<T>, Dq<T>, Dq<T>), DriveOutput<T>> {
+    ) -> Result<CurrentLoopSample<T>, DriveOutput<T>> {
         let i_dq = i_ab.to_dq(rot);
         let i_dq_ref = Dq::new(current_d, T::zero());
         let backup = self.blocks;

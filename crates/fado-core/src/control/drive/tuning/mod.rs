@@ -6,6 +6,7 @@ use crate::control::dc_link_limit::DcLinkTuning;
 use crate::control::field_weakening::FieldWeakeningTuning;
 use crate::control::ratings_limit::RatingsLimitTuning;
 use crate::control::release_hold::ReleaseHoldTuning;
+use crate::control::start_ramp::StartRampTuning;
 use crate::control::startup::StartupTuning;
 use crate::control::tracker_feedforward::TrackerFeedforwardTuning;
 
@@ -147,6 +148,13 @@ pub struct DriveTuning<T> {
         serde(bound(deserialize = "T: Real + serde::Deserialize<'de>"))
     )]
     pub startup: StartupTuning<T>,
+    /// The speed reference's bounded acceleration from the rotor's speed at the start-up's
+    /// end to the user's (`[controller.start_ramp]`, see [`StartRampTuning`]).
+    #[cfg_attr(
+        feature = "serde",
+        serde(bound(deserialize = "T: Real + serde::Deserialize<'de>"))
+    )]
+    pub start_ramp: StartRampTuning<T>,
     /// Tuning of the reaction to a lost lock and of the recovery (`[controller.lock]`, see [`LockReactionTuning`]).
     #[cfg_attr(
         feature = "serde",
@@ -272,6 +280,7 @@ impl<T: Real> DriveTuning<T> {
             tracker_feedforward: self.tracker_feedforward.cast(),
             release_hold: self.release_hold.cast(),
             startup: self.startup.cast(),
+            start_ramp: self.start_ramp.cast(),
             lock: self.lock.cast(),
             stall: self.stall.cast(),
         }
@@ -301,6 +310,7 @@ impl<T: Real> Default for DriveTuning<T> {
             tracker_feedforward: TrackerFeedforwardTuning::default(),
             release_hold: ReleaseHoldTuning::default(),
             startup: StartupTuning::default(),
+            start_ramp: StartRampTuning::default(),
             lock: LockReactionTuning::default(),
             stall: StallTuning::default(),
         }
