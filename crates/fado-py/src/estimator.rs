@@ -83,7 +83,7 @@ impl Setup {
         // The sampling period against the machine's rated speed (a period in ms given as
         // s is refused naming `ts`), before any gain derived from it is refused instead.
         if ts > 0.0 {
-            crate::machine::check_plausible(py, &machine.to_core(), Some(ts))?;
+            crate::machine::check_plausible(py, &machine.to_core_with_map(), Some(ts))?;
         }
         Ok(Self {
             machine,

@@ -12,7 +12,7 @@
 //! **Paths.** A relative `flux_map` path is relative to the directory of the TOML file that
 //! names it: the command-line tool records that directory when it reads a `--config` file
 //! ([`set_config_dir`]); a TOML text given without a file (a Python `config_toml` string)
-//! resolves it against the working directory.
+//! resolves it against the working directory. The resolved path is absolute ([`resolve`]).
 
 use std::cell::RefCell;
 use std::path::{Path, PathBuf};
@@ -43,16 +43,20 @@ pub fn set_config_dir(dir: Option<&Path>) {
     CONFIG_DIR.with(|d| *d.borrow_mut() = dir.map(Path::to_path_buf));
 }
 
-/// `written` resolved as a `flux_map` path (see [`set_config_dir`]).
+/// `written` resolved as a `flux_map` path (see [`set_config_dir`]), made absolute: a
+/// configuration written back elsewhere (a `--dump-config`, the `identified.toml` that
+/// `commission` writes into its output directory) still names the same file, also when the
+/// configuration was read by a relative path.
 pub fn resolve(written: &str) -> PathBuf {
     let p = Path::new(written);
     if p.is_absolute() {
         return p.to_path_buf();
     }
-    CONFIG_DIR.with(|d| match &*d.borrow() {
+    let joined = CONFIG_DIR.with(|d| match &*d.borrow() {
         Some(dir) => dir.join(p),
         None => p.to_path_buf(),
-    })
+    });
+    std::path::absolute(&joined).unwrap_or(joined)
 }
 
 /// A flux map named by a configuration: the file it came from and its data.
