@@ -22,7 +22,7 @@
 //! | sampling | ω·Ts | above [`crate::ratings::MAX_RUNNING_OMEGA_TS`] | above π (Ts in ms for s? f_sw in kHz for Hz?) |
 //! | friction | B·ω_rated,mech / T_rated | above 0.2 | above 1 (the rated point cannot be reached; N·m·s per krpm or per r/min?) |
 //! | inertia | start time J·ω_rated,mech / T_rated | above 60 s (kg·cm² or g·m² for kg·m²?) | — |
-//! | rating scale | (L·I/ψ)·(ω·L/R) | below [`SCALE_LOW`] (ratings / 10?), above [`SCALE_HIGH`] (ratings × 10?) | — |
+//! | rating scale | L_min/R against T_rated·ω_rated and (L·I/ψ)·(ω·L/R) ([`scale`]) | long for the power (ratings / 10?), short (ratings × 10?) | — |
 //! | electrical frequency | ω_rated/2π | above [`MAX_ELECTRICAL_FREQUENCY`] (r/min × 10? a pole count?) | — |
 //!
 //! The torque check names the likeliest slip by undoing each in turn (λf given rms, λf from
@@ -34,17 +34,9 @@
 //! model overstates the torque, sit at 0.7–0.8, where a line-to-line λf on a rotor with
 //! Lq/Ld ≈ 3 lands as well (0.79); only the wide band's 0.6 catches it.
 //!
-//! The rating-scale check catches ratings scaled together (current, speed and torque / 10 or
-//! × 10), which leave the torque, the resistance and a derived DC link consistent: it rests on
-//! the two per-unit quantities a rewinding of the same machine leaves unchanged and a common
-//! scale k of the ratings multiplies by k each, the armature reaction L·I/ψ and the reactance
-//! at rated speed over the resistance ω·L/R. Their product spans 0.05–37 over the
-//! repository's presets and the other classes its tests enter (from a 22-pole-pair gimbal
-//! motor, whose high-resistance winding makes ω·L/R 0.47, to a 50 kW IPMSM; a 12 V pump, an
-//! e-bike hub, a 2-pole blower, a 30 kW industrial IPMSM, a 10 kV machine in between);
-//! ratings / 10 divide it by 100. The check therefore catches ratings / 10 on machines whose
-//! product is below 3 (the small and mid-size ones: the 2.2 kW IPMSM's 2.7 becomes 0.027) and
-//! misses it on larger ones (the paper's motor: 3.3 → 0.033).
+//! The rating-scale check ([`scale`]) catches ratings scaled together (current, speed and
+//! torque / 10 or × 10), which leave the torque, the resistance and a derived DC link
+//! consistent.
 //!
 //! The bands are those of real machines: the repository's presets, from an 8 µH multirotor
 //! outrunner to a 240 A automotive IPMSM, sit inside every warning band (a test checks it).
@@ -90,14 +82,7 @@ pub const RESISTANCE_ERROR: f64 = 2.0;
 /// peak value is meant gives √2 = 1.41.
 pub const TORQUE_WARNING_HIGH: f64 = 1.3;
 
-/// (L·I/ψ)·(ω·L/R) below which the ratings look divided by 10: 0.03 (real machines ≥ 0.049,
-/// a gimbal motor; the presets' and test classes' / 10 are 0.002–0.37; see the module
-/// documentation).
-pub const SCALE_LOW: f64 = 0.03;
-
-/// (L·I/ψ)·(ω·L/R) above which the ratings look multiplied by 10: 200 (real machines ≤ 37
-/// among the presets, ≈ 100 for the largest machines' X/R; the presets × 10 are 23–3,700).
-pub const SCALE_HIGH: f64 = 200.0;
+pub use scale::{SCALE_HIGH, SCALE_LOW};
 
 /// Rated electrical frequency above which the rated speed or the pole pairs look wrong: 5 kHz
 /// (a 2-pole 240,000 r/min turbo compressor runs at 4 kHz; a 14-pole-pair drone motor at
@@ -163,12 +148,18 @@ pub enum Finding {
         /// J·ω_rated,mech / T_rated, s.
         start_time: f64,
     },
-    /// The ratings look scaled together (/ 10 or × 10): see [`SCALE_LOW`].
+    /// The ratings look scaled together (/ 10 or × 10): see [`scale`].
     RatingScale {
         /// L_max·I/ψ (armature reaction per unit).
         reaction: f64,
         /// ω_rated·L_min/R.
         x_over_r: f64,
+        /// L_min/R, s.
+        tau: f64,
+        /// T_rated·ω_rated,mech, W.
+        power: f64,
+        /// True for ratings that look divided by 10, false for multiplied.
+        divided: bool,
     },
     /// The rated electrical frequency is beyond any motor of this kind.
     ElectricalFrequency {
@@ -735,15 +726,10 @@ fn check_mechanics(m: &MachineModel<f64>, out: &mut impl Sink) {
     }
 }
 
-/// The ratings scaled together ([`SCALE_LOW`], [`SCALE_HIGH`]) and the rated electrical
-/// frequency ([`MAX_ELECTRICAL_FREQUENCY`]).
+/// The ratings scaled together ([`scale`]) and the rated electrical frequency
+/// ([`MAX_ELECTRICAL_FREQUENCY`]).
 fn check_scale(m: &MachineModel<f64>, out: &mut impl Sink) {
-    let reaction = m.ld.max(m.lq) * m.rated_current / flux_base(m);
-    let x_over_r = m.rated_speed() * m.ld.min(m.lq) / m.rs;
-    let product = reaction * x_over_r;
-    if !(SCALE_LOW..=SCALE_HIGH).contains(&product) {
-        out.push(Finding::RatingScale { reaction, x_over_r });
-    }
+    scale::check(m, out);
     let frequency = m.rated_speed() / core::f64::consts::TAU;
     if frequency > MAX_ELECTRICAL_FREQUENCY {
         out.push(Finding::ElectricalFrequency { frequency });
@@ -788,6 +774,7 @@ pub(crate) fn validate_real<T: Real>(m: &MachineModel<T>) -> Result<(), crate::C
     validate(&m.cast::<f64>(), None)
 }
 
+pub mod scale;
 mod text;
 
 #[cfg(test)]

@@ -83,7 +83,7 @@ impl Setup {
         // The sampling period against the machine's rated speed (a period in ms given as
         // s is refused naming `ts`), before any gain derived from it is refused instead.
         if ts > 0.0 {
-            crate::machine::check_plausible(py, &machine.to_core(), Some(ts))?;
+            crate::machine::check_plausible(py, &machine.to_core_with_map(), Some(ts))?;
         }
         Ok(Self {
             machine,
@@ -436,7 +436,7 @@ pub fn estimate(
     let mut engine = Engine::new(py, &setup, dtype)?;
     let core = setup.core::<f64>(py)?;
     if let Ok(bounds) = core.sample_bounds() {
-        crate::recording_checks::warn_all(py, &signals, &bounds, core.machine.rs, theta0)?;
+        crate::recording_checks::warn_all(py, &signals, &bounds, &core.machine, setup.ts, theta0)?;
     }
     if let Some(theta0) = theta0 {
         let [_, _, ia, ib] = signals.slices();

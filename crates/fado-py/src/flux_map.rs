@@ -6,7 +6,9 @@
 //! `psi_q` of shape (n_d, n_q). Every refusal of the CSV reader applies; a ConfigError on
 //! `flux_map` names the node (its index in the arrays) or the file and line.
 
+use fado_core::MachineModel;
 use fado_core::magnetics::MachineMagnetics;
+use fado_sim::magnetic_agreement::{Stated, check};
 use fado_sim::magnetics::FluxMapData;
 use fado_sim::magnetics_file::{FluxMapFile, flux_map_from_rows};
 use fado_sim::model_magnetics;
@@ -100,6 +102,18 @@ pub fn from_argument(py: Python<'_>, obj: &Bound<'_, PyAny>) -> PyResult<Option<
             .map_err(|e| refuse(py, e.to_string()));
     }
     from_arrays(py, obj).map(|d| Some(FluxMapFile::in_memory(d)))
+}
+
+/// Refuses a map whose zero-current values disagree with the machine's `ld`, `lq` and
+/// `flux_linkage` (`fado_sim::magnetic_agreement`: other units, other axes, another machine).
+pub fn check_agreement(py: Python<'_>, model: &MachineModel<f64>, m: &FluxMapFile) -> PyResult<()> {
+    let stated = Stated {
+        section: "",
+        ld: model.ld,
+        lq: model.lq,
+        flux_linkage: model.flux_linkage,
+    };
+    check(&m.data.map(), FLUX_MAP, stated).map_err(|e| refuse(py, e.message))
 }
 
 /// The map back to Python: its path (as given, resolved), or the four node arrays

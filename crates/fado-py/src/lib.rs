@@ -25,6 +25,7 @@
 pub mod commission;
 pub mod compare;
 pub mod config;
+pub mod datasheet;
 pub mod errors;
 pub mod estimator;
 pub mod flux_map;
@@ -35,6 +36,7 @@ pub mod number;
 pub mod outputs;
 pub mod record;
 pub mod recording_checks;
+pub mod recording_model;
 pub mod replay;
 pub mod scalar;
 pub mod simulate;

@@ -94,6 +94,14 @@ fn derived_dc_link_error(py: Python<'_>, dc: f64) -> PyErr {
     )
 }
 
+/// `m` with `flux_map` (if any) as its magnetic model.
+fn with_map(m: &MachineModel<f64>, flux_map: Option<&FluxMapFile>) -> MachineModel<f64> {
+    match flux_map.and_then(crate::flux_map::machine_magnetics::<f64>) {
+        Some(magnetics) => m.with_magnetics(magnetics),
+        None => *m,
+    }
+}
+
 /// Raises a `UserWarning` per plausibility warning of `m` (`fado_core::machine_checks`),
 /// with `ts` the sampling period when known; the first error as `ConfigError` naming its key.
 pub fn check_plausible(py: Python<'_>, m: &MachineModel<f64>, ts: Option<f64>) -> PyResult<()> {
@@ -156,6 +164,14 @@ impl PyMachine {
         self.flux_map.as_ref()
     }
 
+    /// The map against the machine's zero-current constants ([`crate::flux_map::check_agreement`]).
+    fn check_flux_map(&self, py: Python<'_>) -> PyResult<()> {
+        match &self.flux_map {
+            Some(map) => crate::flux_map::check_agreement(py, &self.model, map),
+            None => Ok(()),
+        }
+    }
+
     /// `fields` without `flux_map`, and the map it gave (`Some(None)`: given as None).
     fn split_flux_map<'py>(
         py: Python<'py>,
@@ -175,6 +191,12 @@ impl PyMachine {
     /// The core machine model.
     pub fn to_core(&self) -> MachineModel<f64> {
         self.model
+    }
+
+    /// The core record with the plant's flux map as its magnetic model (what the plausibility
+    /// checks weigh: a saturated machine's torque is its map's).
+    pub fn to_core_with_map(&self) -> MachineModel<f64> {
+        with_map(&self.model, self.flux_map.as_ref())
     }
 
     /// The same machine with R̂s replaced (not validated).
@@ -234,6 +256,7 @@ impl PyMachine {
         base: &MachineModel<f64>,
         changes: Option<&Bound<'_, PyDict>>,
         constructing: bool,
+        flux_map: Option<&FluxMapFile>,
     ) -> PyResult<Self> {
         let mut model = *base;
         if let Some(changes) = changes {
@@ -267,7 +290,8 @@ impl PyMachine {
             model.dc_voltage = fado_core::ratings::dc_voltage(&model);
         }
         // The cross-checks first: their errors name every field involved.
-        if let Some(e) = fado_core::machine_checks::check(&model, None).error() {
+        if let Some(e) = fado_core::machine_checks::check(&with_map(&model, flux_map), None).error()
+        {
             if dc_derived && e.key() == DC_VOLTAGE {
                 return Err(derived_dc_link_error(py, model.dc_voltage));
             }
@@ -301,7 +325,7 @@ impl PyMachine {
             }
             return Err(config_error(py, e));
         }
-        check_plausible(py, &model, None)?;
+        check_plausible(py, &with_map(&model, flux_map), None)?;
         Ok(Self::from_core(&model))
     }
 
@@ -401,7 +425,8 @@ impl PyMachine {
             })?;
             let alone = PyDict::new(py);
             alone.set_item(&name, &value)?;
-            let optional = Self::changed(py, &MachineModel::paper(), Some(&alone), false).is_ok();
+            let optional =
+                Self::changed(py, &MachineModel::paper(), Some(&alone), false, None).is_ok();
             params.push((name, optional.then_some(value)));
         }
         Ok(params)
@@ -418,16 +443,33 @@ impl PyMachine {
             return Err(e);
         }
         let fields = Self::with_derived(py, fields.as_ref())?;
-        let mut m = Self::changed(py, &MachineModel::default(), Some(&fields), true)?;
-        m.flux_map = flux_map.flatten();
+        let flux_map = flux_map.flatten();
+        let base = MachineModel::default();
+        let mut m = Self::changed(py, &base, Some(&fields), true, flux_map.as_ref())?;
+        m.flux_map = flux_map;
+        m.check_flux_map(py)?;
         Ok(m)
+    }
+
+    /// A machine from its datasheet's values: any `Machine` field, or instead of `rs`, `ld`,
+    /// `lq`, `flux_linkage` and `rated_current` the datasheet's `rs_line_to_line`,
+    /// `l_line_to_line`, `ke_vll_rms_per_krpm`, `ke_vll_peak_per_krpm`, `kt_nm_per_arms` and
+    /// `rated_current_arms` (converted as `fado-sim`'s `[motor]` table converts them; see
+    /// docs/configuration.md). A field given both ways is refused naming both.
+    #[staticmethod]
+    #[pyo3(signature = (**fields))]
+    fn from_datasheet(py: Python<'_>, fields: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
+        let converted = crate::datasheet::convert(py, fields)?;
+        Self::py_new(py, Some(&converted))
     }
 
     /// A copy with the given fields changed (validated like the constructor).
     fn _replace(&self, py: Python<'_>, changes: &Bound<'_, PyDict>) -> PyResult<Self> {
         let (changes, flux_map) = Self::split_flux_map(py, Some(changes))?;
-        let mut m = Self::changed(py, &self.model, changes.as_ref(), false)?;
-        m.flux_map = flux_map.unwrap_or_else(|| self.flux_map.clone());
+        let flux_map = flux_map.unwrap_or_else(|| self.flux_map.clone());
+        let mut m = Self::changed(py, &self.model, changes.as_ref(), false, flux_map.as_ref())?;
+        m.flux_map = flux_map;
+        m.check_flux_map(py)?;
         Ok(m)
     }
 

@@ -12,7 +12,10 @@
 //! | constant column | every sample of one column equal while its partner varies | a dead channel, a column taken twice |
 //! | non-finite samples | over 1 % of samples NaN or ±∞ | a gap in the logger |
 //! | start angle | \|θ0\| > 2π | degrees for radians |
+//! | voltage equation | the active flux misfits λf, and fits with a slip undone | the currents' sign reversed, the voltage and current columns exchanged ([`crate::recording_model`]) |
+//! | negative sequence | every turning window turns backwards | α and β swapped, if the motor turned forward |
 
+use fado_core::MachineModel;
 use fado_core::plausibility::SampleBounds;
 use pyo3::prelude::*;
 
@@ -39,12 +42,13 @@ fn warn(py: Python<'_>, text: &str) -> PyResult<()> {
     )
 }
 
-/// The findings on `signals` against the estimator's `bounds`, R̂s `rs` and start angle
-/// `theta0`, as texts (empty: nothing unusual).
+/// The findings on `signals` against the estimator's `bounds`, its machine `m` sampled every
+/// `ts` and start angle `theta0`, as texts (empty: nothing unusual).
 pub fn findings(
     signals: &Signals<'_>,
     bounds: &SampleBounds<f64>,
-    rs: f64,
+    m: &MachineModel<f64>,
+    ts: f64,
     theta0: Option<f64>,
 ) -> Vec<String> {
     let mut out = Vec::new();
@@ -72,7 +76,8 @@ pub fn findings(
         }
     }
     constant_columns(&cols, &mut out);
-    magnitudes(&cols, bounds, rs, &mut out);
+    magnitudes(&cols, bounds, m.rs, &mut out);
+    out.extend(crate::recording_model::findings(&cols, m, ts));
     out
 }
 
@@ -146,7 +151,7 @@ fn magnitudes(cols: &[Vec<f64>], b: &SampleBounds<f64>, rs: f64, out: &mut Vec<S
         out.push(format!(
             "the voltages (`v_alpha`, `v_beta`) reach {v_max:.4e} V only, a tenth of the \
              resistive drop R̂s·|i| = {drop:.4e} V of the currents alone: a voltage in kV \
-             where V is meant?"
+             where V is meant, or the voltage and current columns exchanged?"
         ));
     }
 }
@@ -156,10 +161,11 @@ pub fn warn_all(
     py: Python<'_>,
     signals: &Signals<'_>,
     bounds: &SampleBounds<f64>,
-    rs: f64,
+    m: &MachineModel<f64>,
+    ts: f64,
     theta0: Option<f64>,
 ) -> PyResult<()> {
-    for text in findings(signals, bounds, rs, theta0) {
+    for text in findings(signals, bounds, m, ts, theta0) {
         warn(py, &text)?;
     }
     Ok(())

@@ -466,8 +466,7 @@ pub fn preconditions(
     let m = &cfg.nameplate;
     let x = m.rated_speed() * cfg.sample_period;
     if x > fado_core::ratings::MAX_OMEGA_TS * (1.0 + 1e-9) {
-        let f =
-            fado_core::ratings::switching_frequency(m.pole_pairs, m.rated_speed_rpm, m.dc_voltage);
+        let f = fado_core::ratings::switching_frequency_of(m);
         return Err(SimConfigError::new(
             "inverter.switching_frequency",
             format!(

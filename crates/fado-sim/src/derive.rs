@@ -210,7 +210,10 @@ pub fn inverter_values(
     let f_sw = match number(given, "switching_frequency") {
         Some(f) => f,
         None => {
-            let f = ratings::switching_frequency(machine.pole_pairs, machine.rated_speed_rpm, dc);
+            let f = ratings::switching_frequency_of(&MachineModel {
+                dc_voltage: dc,
+                ..*machine
+            });
             out.push(("switching_frequency", f));
             f
         }

@@ -63,6 +63,7 @@ pub mod identified_map;
 pub mod inverter;
 pub mod load;
 pub mod magnetic_accuracy;
+pub mod magnetic_agreement;
 pub mod magnetics;
 pub mod magnetics_file;
 pub mod model_magnetics;

@@ -12,7 +12,7 @@
 //! **Paths.** A relative `flux_map` path is relative to the directory of the TOML file that
 //! names it: the command-line tool records that directory when it reads a `--config` file
 //! ([`set_config_dir`]); a TOML text given without a file (a Python `config_toml` string)
-//! resolves it against the working directory.
+//! resolves it against the working directory. The resolved path is absolute ([`resolve`]).
 
 use std::cell::RefCell;
 use std::path::{Path, PathBuf};
@@ -43,16 +43,20 @@ pub fn set_config_dir(dir: Option<&Path>) {
     CONFIG_DIR.with(|d| *d.borrow_mut() = dir.map(Path::to_path_buf));
 }
 
-/// `written` resolved as a `flux_map` path (see [`set_config_dir`]).
+/// `written` resolved as a `flux_map` path (see [`set_config_dir`]), made absolute: a
+/// configuration written back elsewhere (a `--dump-config`, the `identified.toml` that
+/// `commission` writes into its output directory) still names the same file, also when the
+/// configuration was read by a relative path.
 pub fn resolve(written: &str) -> PathBuf {
     let p = Path::new(written);
     if p.is_absolute() {
         return p.to_path_buf();
     }
-    CONFIG_DIR.with(|d| match &*d.borrow() {
+    let joined = CONFIG_DIR.with(|d| match &*d.borrow() {
         Some(dir) => dir.join(p),
         None => p.to_path_buf(),
-    })
+    });
+    std::path::absolute(&joined).unwrap_or(joined)
 }
 
 /// A flux map named by a configuration: the file it came from and its data.
@@ -221,7 +225,12 @@ impl<'a> Lines<'a> {
 
     /// The line of the first record starting at or after byte `byte`.
     fn at(&self, byte: u64) -> usize {
-        let start = (byte as usize).min(self.text.len());
+        let mut start = (byte as usize).min(self.text.len());
+        // In a CRLF file the reader resumes after the `\r`: the `\n` there still ends the
+        // line before the record.
+        if start > 0 && self.text.as_bytes().get(start - 1..=start) == Some(b"\r\n") {
+            start += 1;
+        }
         let mut line = self.text.as_bytes()[..start]
             .iter()
             .filter(|&&b| b == b'\n')
@@ -376,15 +385,67 @@ pub fn flux_map_from_rows(
         return Err(map_error(file, header_line, msg));
     }
     let (psi_d, psi_q, line_of) = place_rows(rows, (&i_d, &i_q), file, header_line)?;
-    FluxMapData::new(i_d, i_q, psi_d, psi_q).map_err(|e| {
-        let line = match e {
-            FluxMapError::NotMonotonic { k, m, .. } | FluxMapError::NotFinite { k, m, .. } => {
-                line_of[k * nq + m]
-            }
-            _ => header_line,
-        };
-        map_error(file, line, e.to_string())
+    let grid = Grid {
+        i_d: &i_d,
+        i_q: &i_q,
+        psi_d: &psi_d,
+        psi_q: &psi_q,
+    };
+    let falls = |table: &str, k: usize, m: usize| grid.falls(table, k, m);
+    let checked = FluxMapData::new(i_d.clone(), i_q.clone(), psi_d.clone(), psi_q.clone());
+    checked.map_err(|e| match e {
+        FluxMapError::NotMonotonic { table, k, m } => {
+            map_error(file, line_of[k * nq + m], falls(table, k, m))
+        }
+        FluxMapError::NotFinite { k, m, .. } => map_error(file, line_of[k * nq + m], e.to_string()),
+        _ => map_error(file, header_line, e.to_string()),
     })
+}
+
+/// A map's nodes before its checks (row-major ψ), for the messages of its refusals.
+struct Grid<'a> {
+    i_d: &'a [f64],
+    i_q: &'a [f64],
+    psi_d: &'a [f64],
+    psi_q: &'a [f64],
+}
+
+impl Grid<'_> {
+    /// Why `table` (ψd along i_d, ψq along i_q) falls into node (k, m): the values, and the
+    /// likely cause by how much of the node's line falls. A map falling along most of its
+    /// axis has its axes or signs swapped (SyR-e's maps put d on the high-permeance axis); a
+    /// few falling steps among rising ones are noise of a measured map.
+    fn falls(&self, table: &str, k: usize, m: usize) -> String {
+        let nq = self.i_q.len();
+        let d_axis = table == "psi_d";
+        let (axis, name, other, at) = if d_axis {
+            (self.i_d, "i_d", ("i_q", self.i_q[m]), k)
+        } else {
+            (self.i_q, "i_q", ("i_d", self.i_d[k]), m)
+        };
+        let value = |n: usize| match d_axis {
+            true => self.psi_d[n * nq + m],
+            false => self.psi_q[k * nq + n],
+        };
+        let steps = axis.len() - 1;
+        let falling = (1..axis.len())
+            .filter(|&n| value(n) <= value(n - 1))
+            .count();
+        let cause = if 2 * falling > steps {
+            "the map falls along most of this axis: check its axes and signs (d on the magnet,              ψd = λf at i = 0, SI peak values; SyR-e's maps put d on the high-permeance axis)"
+        } else {
+            "a local dip (noise in a measured map?): smooth the map or thin its grid"
+        };
+        format!(
+            "{table} does not increase with its own current: {:.6} Wb at {name} = {} A,              {:.6} Wb at {name} = {} A ({} = {} A); {falling} of the line's {steps} steps fall,              and a map with no inverse i(ψ) cannot be run: {cause}",
+            value(at - 1),
+            axis[at - 1],
+            value(at),
+            axis[at],
+            other.0,
+            other.1,
+        )
+    }
 }
 
 /// The map as CSV text in this module's format (every node, i_d-major; values in Rust's

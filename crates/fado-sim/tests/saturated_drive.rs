@@ -6,7 +6,8 @@
 //! `tests/data/pmsm-gem-1k1-raw.csv`), and on machines that are no preset (the same IPMSM with five
 //! times its cross-saturation; a made-up 20-pole 48 V IPMSM with d, q and cross-saturation,
 //! `tests/data/ipmsm-20p-48v-saturated.toml`; the strongly cross-saturated IPMSM of the
-//! independent replays, `tests/data/ipm-cross20-saturated.toml`), and on the PM-SyRM, whose frame coupling
+//! independent replays, `tests/data/ipm-cross20-saturated.toml`; an IPMSM with a saturating rib,
+//! `tests/data/ipm-rib-saturated.toml`), and on the PM-SyRM, whose frame coupling
 //! reaches 0.96 at rated torque (docs/method/saturation.md, "The slow mode"), with its fitted
 //! algebraic model and with its measured flux map as the plant's and the drive's model; the
 //! per-preset table is docs/results/saturation.md (`scripts/saturation-table.py`).
@@ -79,6 +80,14 @@ fn a_made_up_20_pole_ipmsm_passes_every_seed() {
 #[test]
 fn a_cross_saturated_ipmsm_of_the_independent_replays_passes_every_seed() {
     passes_every_seed(include_str!("data/ipm-cross20-saturated.toml"));
+}
+
+/// A machine generated outside fado in the rib form of Lelli et al. with other parameters than
+/// the PM-SyRM preset's (the `ipm-rib` of scripts/saturated-replay.py: the magnet as the rib's
+/// Norton source, the secant L_q −50 % and ψd −4 % at rated i_q, mostly from the cross term).
+#[test]
+fn an_ipmsm_with_a_saturating_rib_of_the_independent_replays_passes_every_seed() {
+    passes_every_seed(include_str!("data/ipm-rib-saturated.toml"));
 }
 
 #[test]

@@ -5,6 +5,7 @@
 //! Every block follows the crate's pattern (`new(config) -> Result<_, ConfigError>`, `step`,
 //! `reset`), is allocation-free, generic over [`Real`](crate::Real) and never panics.
 
+pub mod calibration_turn;
 pub mod current_controller;
 pub mod dc_link_limit;
 pub mod dead_time_compensation;

@@ -407,3 +407,89 @@ fn drone(rated_speed_rpm: f64) -> MachineModel<f64> {
         magnetics: Default::default(),
     }
 }
+
+/// maxon EC 22, 40 W, 24 V winding (part 386658): 0.641 Ω and 0.0546 mH phase to phase,
+/// 1470 r/min/V (λf = 3.75 mWb peak), 1 pole pair, 20.7 mN·m at 31,800 r/min; slotless, so its
+/// armature reaction (0.024) and ω·L/R (0.28) are those of a geared-down large machine.
+fn slotless() -> MachineModel<f64> {
+    MachineModel::<f64> {
+        rs: 0.3205,
+        ld: 27.3e-6,
+        lq: 27.3e-6,
+        flux_linkage: 3.75e-3,
+        pole_pairs: 1,
+        inertia: 2.39e-7,
+        viscous_friction: 0.0,
+        rated_current: 3.7,
+        rated_speed_rpm: 31_800.0,
+        rated_torque: 20.7e-3,
+        dc_voltage: 24.0,
+        magnetics: Default::default(),
+    }
+}
+
+/// The rating-scale finding of `m` with its DC link derived, and whether it says "divided".
+fn scale_of(m: &MachineModel<f64>) -> Option<bool> {
+    check(&derived_dc_link(*m), None)
+        .iter()
+        .find_map(|f| match f {
+            Finding::RatingScale { divided, .. } => {
+                let text = f.to_string();
+                let word = if *divided {
+                    "divided by 10"
+                } else {
+                    "multiplied by 10"
+                };
+                assert!(text.contains(word), "{text}");
+                Some(*divided)
+            }
+            _ => None,
+        })
+}
+
+#[test]
+fn a_slotless_motor_is_not_taken_for_ratings_divided_by_ten_but_its_slips_are() {
+    // Product 0.006, below the 0.03 that alone separated / 10 from the slotted machines; its
+    // 85 µs time constant is that of a 40 W motor.
+    assert!(
+        check(&slotless(), Some(25e-6)).is_empty(),
+        "{:?}",
+        check(&slotless(), Some(25e-6))
+    );
+    assert_eq!(scale_of(&ratings_times(&slotless(), 0.1)), Some(true));
+}
+
+#[test]
+fn ratings_divided_by_ten_on_large_machines_are_named_by_their_time_constant() {
+    // The paper's motor / 10 is an 18 W motor with an 8 ms time constant (product 0.033, above
+    // the product's bound). The 50 kW IPMSM / 10, a 500 W motor with 21 ms (product 0.38), is
+    // in crates/fado-sim/tests/rating_scale_files.rs with every motor file.
+    for m in [paper(), ipmsm()] {
+        assert_eq!(scale_of(&m), None, "{m:?}");
+        assert_eq!(scale_of(&ratings_times(&m, 0.1)), Some(true), "{m:?}");
+        assert_eq!(scale_of(&ratings_times(&m, 10.0)), Some(false), "{m:?}");
+    }
+}
+
+#[test]
+fn ratings_times_ten_on_small_machines_are_named_by_their_time_constant() {
+    // A 48 V hub motor (crates/fado-sim/tests/data/classes/hub-48v.toml) × 10 is a 50 kW
+    // machine with a 2.7 ms time constant (product 18, inside the product's band).
+    let hub = MachineModel::<f64> {
+        rs: 0.15,
+        ld: 0.4e-3,
+        lq: 0.45e-3,
+        flux_linkage: 0.047,
+        pole_pairs: 15,
+        inertia: 0.05,
+        viscous_friction: 0.0,
+        rated_current: 15.0,
+        rated_speed_rpm: 300.0,
+        rated_torque: 16.0,
+        dc_voltage: 48.0,
+        magnetics: Default::default(),
+    };
+    assert_eq!(scale_of(&hub), None);
+    assert_eq!(scale_of(&ratings_times(&hub, 10.0)), Some(false));
+    assert_eq!(scale_of(&ratings_times(&hub, 0.1)), Some(true));
+}

@@ -3,8 +3,7 @@
 use core::fmt;
 
 use super::{
-    Finding, MAX_ELECTRICAL_FREQUENCY, RESISTANCE_ERROR, SCALE_LOW, Severity, TORQUE_KEYS_SALIENT,
-    TorqueSlip,
+    Finding, MAX_ELECTRICAL_FREQUENCY, RESISTANCE_ERROR, Severity, TORQUE_KEYS_SALIENT, TorqueSlip,
 };
 use crate::ratings::{MAX_OMEGA_TS, MAX_RUNNING_OMEGA_TS};
 
@@ -90,16 +89,36 @@ fn write_sampling(
     }
 }
 
-/// The text of [`Finding::RatingScale`]: both per-unit quantities and the direction.
-fn write_scale(f: &mut fmt::Formatter<'_>, reaction: f64, x_over_r: f64) -> fmt::Result {
+/// The text of [`Finding::RatingScale`]: the size the ratings state against the windings'
+/// and the direction.
+fn write_scale(f: &mut fmt::Formatter<'_>, finding: &Finding) -> fmt::Result {
+    let Finding::RatingScale {
+        reaction,
+        x_over_r,
+        tau,
+        power,
+        divided,
+    } = *finding
+    else {
+        return Ok(());
+    };
+    let (long, short) = super::scale::tau_bounds(power);
+    let (bound, kind) = if divided {
+        (long, "at most")
+    } else {
+        (short, "at least")
+    };
     write!(
         f,
-        "the ratings look scaled: the armature reaction L·`rated_current`/ψ is \
-         {reaction:.3} per unit and the reactance at `rated_speed_rpm` over `rs` ω·L/R is \
-         {x_over_r:.3} (their product {:.3}; machines have 0.05–40)",
+        "the ratings look scaled: `rated_torque` at `rated_speed_rpm` is {power:.4} W while the \
+         windings' time constant min(`ld`, `lq`)/`rs` is {:.4} ms (machines of that power have \
+         {kind} about {:.4} ms), and the armature reaction L·`rated_current`/ψ {reaction:.3} \
+         times ω·L/R {x_over_r:.3} is {:.3e} (machines have 0.005–60)",
+        tau * 1e3,
+        bound * 1e3,
         reaction * x_over_r
     )?;
-    if reaction * x_over_r < SCALE_LOW {
+    if divided {
         f.write_str(": are `rated_current`, `rated_speed_rpm` and `rated_torque` divided by 10?")
     } else {
         f.write_str(
@@ -201,7 +220,7 @@ impl fmt::Display for Finding {
                 severity,
                 slip,
             } => write_torque(f, ratio, severity, slip),
-            Finding::RatingScale { reaction, x_over_r } => write_scale(f, reaction, x_over_r),
+            Finding::RatingScale { .. } => write_scale(f, self),
             Finding::ElectricalFrequency { frequency } => write!(
                 f,
                 "the rated electrical frequency p·`rated_speed_rpm`/60 with `pole_pairs` is \

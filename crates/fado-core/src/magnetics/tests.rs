@@ -175,6 +175,37 @@ fn inverse_of_forward_is_the_identity() {
 /// is the cold solve's to the solver's tolerance, and the inductance it returns with it is the
 /// incremental inductance at ψ(i); `flux_and_inductance` is the two separate calls bit for bit.
 #[test]
+fn a_strong_cross_term_is_solved_from_the_linear_guess_at_every_angle() {
+    // ipm-cross20 of scripts/saturated-replay.py: all of q's saturation from the cross term.
+    // From the linear guess the plain Newton iteration overshoots into the steep region at
+    // some angles of the rated current (near +q); the damped fallback solves them all
+    // (half and full rated current at every angle, twice the rated current where i_d ≤ 0).
+    let s = Saturation {
+        a_dq: 4000.0,
+        u: 0.0,
+        v: 1.0,
+        i_f: 25.0,
+        ..Saturation::linear(12e-3, 30e-3, 0.0)
+    };
+    let mut worst = 0.0f64;
+    for k in 0..=720 {
+        let b = k as f64 * core::f64::consts::PI / 720.0;
+        for magnitude in [6.0, 12.0, 24.0] {
+            // At twice the rated current with i_d > 0 the model itself folds (its energy is
+            // not convex where ψd and |ψq| are both large): no solve can invert it there.
+            if magnitude > 12.0 && k > 360 {
+                continue;
+            }
+            let i = Dq::new(-magnitude * b.cos(), magnitude * b.sin());
+            worst = worst.max((s.current(s.flux(i)) - i).norm());
+            let warm = s.flux_from(i, s.linear_flux(i));
+            worst = worst.max((s.current(warm) - i).norm());
+        }
+    }
+    assert!(worst < 1e-9, "{worst}");
+}
+
+#[test]
 fn warm_started_flux_is_the_cold_solve() {
     for (name, m, i_max) in models() {
         let far = m.flux(Dq::new(-i_max, 2.0 * i_max));

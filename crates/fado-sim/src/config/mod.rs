@@ -33,6 +33,7 @@ use crate::profile::Profile;
 use crate::sensors::{CurrentSensorParams, DcLinkSensorParams};
 use crate::sim::PlantParams;
 
+mod datasheet_keys;
 mod drive_rules;
 mod moved;
 mod settings;
@@ -159,6 +160,26 @@ impl SimConfig {
         }
     }
 
+    /// The plant's saturating model against `[motor]`'s `ld`, `lq` and `flux_linkage`
+    /// ([`crate::magnetic_agreement`]).
+    fn check_magnetic_agreement(&self) -> Result<(), SimConfigError> {
+        let (sat, map) = (self.motor_saturation.as_ref(), self.motor_flux_map.as_ref());
+        let Some(plant) = magnetics_file::plant_magnetics(sat, map) else {
+            return Ok(());
+        };
+        let key = match map {
+            Some(_) => magnetics_file::FLUX_MAP_KEY,
+            None => "motor.saturation",
+        };
+        let stated = crate::magnetic_agreement::Stated {
+            section: "motor",
+            ld: self.motor.ld,
+            lq: self.motor.lq,
+            flux_linkage: self.motor.flux_linkage,
+        };
+        crate::magnetic_agreement::check(&plant.model(), key, stated)
+    }
+
     /// Checks every section, and the estimator and drive configurations derived from it; the
     /// error names the key (`section.field`).
     pub fn validate(&self) -> Result<(), SimConfigError> {
@@ -186,6 +207,7 @@ impl SimConfig {
                 SimConfigError::new(format!("motor.saturation.{}", e.field()), e.to_string())
             })?;
         }
+        self.check_magnetic_agreement()?;
         self.plant().validate()?;
         let rows = self.simulation.duration
             / self.inverter.sample_period()
@@ -455,10 +477,16 @@ impl SimConfig {
     /// sampling period (`fado_core::machine_checks`), each with its message naming the TOML
     /// keys involved: errors first.
     pub fn machine_findings(&self) -> Vec<(fado_core::machine_checks::Severity, String, String)> {
-        let m = MachineModel {
+        let mut m = MachineModel {
             dc_voltage: self.inverter.dc_voltage,
             ..self.motor
         };
+        // A saturating plant's torque is its magnetic model's, not its zero-current
+        // inductances'.
+        let (sat, map) = (self.motor_saturation.as_ref(), self.motor_flux_map.as_ref());
+        if let Some(plant) = magnetics_file::plant_magnetics(sat, map) {
+            m = m.with_magnetics(crate::model_magnetics::plant_model(&plant));
+        }
         fado_core::machine_checks::check(&m, Some(self.inverter.sample_period()))
             .iter()
             .map(|f| {

@@ -45,6 +45,49 @@ fn a_flux_map_file_is_read_in_any_row_order_and_bad_ones_are_refused_at_their_li
     assert!(e.contains("/nonexistent/map.csv"), "{e}");
 }
 
+#[test]
+fn a_crlf_file_with_comments_and_blank_lines_is_refused_at_its_own_line() {
+    // A lab's export: CRLF line ends, comments and a blank line before the header, a blank
+    // line inside; the bad value is on line 8 whatever the line ends.
+    let lf = "# lab map\n# 2 x 2\n\ni_d,i_q,psi_d,psi_q\n-5,-1,0.40,-0.05\n\n-5,1,0.40,0.05\n0,-1,x,-0.05\n0,1,0.60,0.05\n";
+    let crlf = lf.replace('\n', "\r\n");
+    for text in [lf, crlf.as_str()] {
+        let e = parse_flux_map(text, "m.csv").unwrap_err().to_string();
+        assert!(e.starts_with("m.csv:8:1:"), "{e}");
+        let good = text.replace(",x,", ",0.60,");
+        assert_eq!(
+            parse_flux_map(&good, "m.csv").unwrap().map().i_d(),
+            &[-5.0, 0.0]
+        );
+        let header = text
+            .replace("psi_q\r", "psi_qq\r")
+            .replace("psi_q\n", "psi_qq\n");
+        let e = parse_flux_map(&header, "m.csv").unwrap_err().to_string();
+        assert!(e.starts_with("m.csv:4:1:"), "{e}");
+    }
+}
+
+#[test]
+fn a_falling_map_is_told_apart_as_noise_or_swapped_axes() {
+    // ψq along i_q at i_d = 0: one dip among rising steps (a measured map's noise), then the
+    // whole line falling (the axes or signs swapped).
+    let map = |q: [f64; 5]| {
+        let mut t = String::from("i_d,i_q,psi_d,psi_q\n");
+        for (m, iq) in [-2.0, -1.0, 0.0, 1.0, 2.0].iter().enumerate() {
+            t += &format!("-1,{iq},0.5,{}\n0,{iq},0.6,{}\n", 0.02 * iq, q[m]);
+        }
+        parse_flux_map(&t, "m.csv").unwrap_err().to_string()
+    };
+    let noisy = map([-0.04, -0.02, 0.0, -0.001, 0.04]);
+    assert!(
+        noisy.starts_with("m.csv:9:1:") && noisy.contains("noise"),
+        "{noisy}"
+    );
+    assert!(noisy.contains("-0.001000 Wb at i_q = 1 A"), "{noisy}");
+    let swapped = map([0.04, 0.02, 0.0, -0.02, -0.04]);
+    assert!(swapped.contains("axes and signs"), "{swapped}");
+}
+
 /// A scratch directory of this test process.
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("fado-magfile-{}-{name}", std::process::id()));
@@ -54,8 +97,13 @@ fn scratch(name: &str) -> PathBuf {
 
 /// ipmsm-2k2's machine with q self- and cross-saturation, tabulated on a 9 × 11 grid.
 fn tabulated() -> FluxMapData {
+    tabulated_from(-12.0)
+}
+
+/// The same machine on 9 nodes of i_d from `i_d0` A in steps of 1.5 A.
+fn tabulated_from(i_d0: f64) -> FluxMapData {
     let s = crate::magnetics::tests::saturated_ipm();
-    let i_d: Vec<f64> = (0..9).map(|k| -12.0 + 1.5 * k as f64).collect();
+    let i_d: Vec<f64> = (0..9).map(|k| i_d0 + 1.5 * k as f64).collect();
     let i_q: Vec<f64> = (0..11).map(|m| -10.0 + 2.0 * m as f64).collect();
     let (mut psi_d, mut psi_q) = (Vec::new(), Vec::new());
     for &id in &i_d {
@@ -177,4 +225,61 @@ fn the_drive_model_takes_its_own_map_under_model() {
     .unwrap_err();
     assert_eq!(e.key, "model.flux_map", "{e}");
     assert!(e.message.contains("/nonexistent.csv"), "{e}");
+}
+
+#[test]
+fn a_map_in_other_units_or_on_other_axes_than_the_motor_is_refused() {
+    // ipmsm-2k2's saturated map against its own [motor] values: accepted. The same map in
+    // mVs, and in SyR-e's frame (d on the high-permeance axis, the magnet along −q): refused
+    // at `motor.flux_map`, naming the key it disagrees with.
+    let dir = scratch("agreement");
+    let good = tabulated();
+    let m = good.map();
+    let write = |name: &str, data: &FluxMapData| {
+        std::fs::write(dir.join(name), flux_map_csv(data, "test")).unwrap();
+        set_config_dir(Some(&dir));
+        let cfg = SimConfig::from_toml(&preset_with(&format!("flux_map = \"{name}\"\n")));
+        set_config_dir(None);
+        cfg
+    };
+    assert!(write("good.csv", &good).is_ok());
+    let scaled = |x: &[f64]| x.iter().map(|v| v * 1000.0).collect::<Vec<_>>();
+    let mvs = FluxMapData::new(
+        m.i_d().to_vec(),
+        m.i_q().to_vec(),
+        scaled(m.psi_d()),
+        scaled(m.psi_q()),
+    )
+    .unwrap();
+    let e = write("mvs.csv", &mvs).unwrap_err();
+    assert_eq!(e.key, FLUX_MAP_KEY);
+    assert!(e.message.contains("`motor.flux_linkage`"), "{e}");
+    // SyR-e's frame: i_d' = i_q, i_q' = −i_d, ψd' = ψq, ψq' = −ψd (a map reaching both
+    // signs of i_d, so that the rotated one reaches both of i_q).
+    let whole = tabulated_from(-6.0);
+    let m = whole.map();
+    let rows: Vec<([f64; 4], usize)> = (0..m.i_d().len())
+        .flat_map(|k| (0..m.i_q().len()).map(move |j| (k, j)))
+        .enumerate()
+        .map(|(n, (k, j))| {
+            let at = k * m.i_q().len() + j;
+            let v = [m.i_q()[j], -m.i_d()[k], m.psi_q()[at], -m.psi_d()[at]];
+            (v, n + 2)
+        })
+        .collect();
+    let syre = flux_map_from_rows(&rows, "syre.csv", 1).unwrap();
+    let e = write("syre.csv", &syre).unwrap_err();
+    assert!(e.message.contains("SyR-e"), "{e}");
+}
+
+#[test]
+fn a_path_relative_to_a_relative_configuration_resolves_to_an_absolute_one() {
+    // `fado-sim commission --config dir/motor.toml` writes identified.toml into its output
+    // directory: the plant's map must be named there by a path that does not depend on it.
+    set_config_dir(Some(Path::new("some/dir")));
+    let p = resolve("map.csv");
+    set_config_dir(None);
+    assert!(p.is_absolute(), "{}", p.display());
+    assert!(p.ends_with("some/dir/map.csv"), "{}", p.display());
+    assert!(resolve("m.csv").is_absolute());
 }

@@ -28,12 +28,11 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             }
             StartupCommand::Align { angle, current_d } => {
                 let rot = Rotation::from_angle(angle);
-                let i_dq = i_ab.to_dq(rot);
-                let i_dq_ref = Dq::new(current_d, T::zero());
-                let backup = self.blocks;
-                let Ok(v_dq) = self.blocks.current.step(i_dq_ref, i_dq, T::zero()) else {
-                    return self.reject_after_estimate(backup, estimate, i_dq);
-                };
+                let (v_dq, i_dq_ref, i_dq) =
+                    match self.d_current_voltage(rot, current_d, i_ab, estimate) {
+                        Ok(loop_out) => loop_out,
+                        Err(out) => return out,
+                    };
                 (rot, v_dq.to_ab(rot), v_dq, i_dq_ref, i_dq)
             }
             StartupCommand::Start(theta) => {

@@ -57,6 +57,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             current_offset: Abc::new(T::zero(), T::zero(), T::zero()),
             aligned_angle: T::zero(),
             gain: GainCalibration::new(config.gain_calibration_config()?)?,
+            turn: None,
             gain_correction: T::one(),
             startup: AngleSearch::new(config.tuning.startup, &config.machine, config.ts)?,
             stuck_sensor: StuckChannelDetector::new(
@@ -102,6 +103,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         self.flag_counts.reset();
         self.lock.reset();
         self.gain.arm();
+        self.turn = None;
         self.startup.arm();
         self.calibrate_offsets();
     }
@@ -170,6 +172,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         if self.gain.running() {
             // A gain calibration under way restarts along the new axis.
             self.gain.arm();
+            self.turn = None;
         }
         self.realign(theta0);
     }

@@ -43,6 +43,7 @@ mod standstill;
 mod step;
 pub mod tracker_feedforward;
 pub mod tuning;
+mod turn;
 mod voltage_ellipse;
 
 pub use config::DriveConfig;
@@ -50,6 +51,7 @@ pub(crate) use config::swing_time_constant;
 pub use output::DriveOutput;
 pub use tuning::DriveTuning;
 
+use crate::control::calibration_turn::CalibrationTurn;
 use crate::control::current_controller::CurrentController;
 use crate::control::dc_link_limit::DcLinkLimit;
 use crate::control::dead_time_compensation::DeadTimeCompensation;
@@ -221,10 +223,13 @@ pub struct SensorlessDrive<T: 'static, E = SensorlessEstimator<T>> {
     calibration_square_sum: T,
     /// Phase-current offsets subtracted from every sample (A).
     current_offset: Abc<T>,
-    /// The angle of the last `align`, re-applied when the calibration ends.
+    /// The angle of the last `align` (or of the calibration's turn), re-applied when the
+    /// calibration ends.
     aligned_angle: T,
     /// The start-up gain-mismatch calibration (after the offsets) and its result.
     gain: GainCalibration<T>,
+    /// The free rotor's turn onto a well-observed axis before that calibration, while under way.
+    turn: Option<CalibrationTurn<T>>,
     /// The start-up's angle phase (after the offsets, before the gain calibration).
     startup: AngleSearch<T>,
     /// 1/k: the factor on the phase-a reading (1 until a ratio is measured).

@@ -233,6 +233,10 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             return Err(self.angle_phase_step(i_abc, vdc));
         }
         if self.gain.pending() {
+            // A free rotor at an unobservable angle first turns to a well-observed axis.
+            if let Some(out) = self.calibration_turn_step(i_abc, vdc) {
+                return Err(out);
+            }
             let axis = self.gain_axis();
             self.gain.start(axis);
         }

@@ -1,0 +1,101 @@
+//! The rating-scale check (`fado_core::machine_checks::scale`) on every motor file the
+//! repository holds — the presets, the test machines and the datasheet machines entered as
+//! their datasheets state them: none is taken for scaled ratings, and each with its
+//! `rated_current`, `rated_speed_rpm` and `rated_torque` divided or multiplied by 10 (the DC
+//! link left to be derived, as a file without `dc_voltage` has it) is named, but for the
+//! listed exceptions that the module documentation explains.
+
+use std::path::{Path, PathBuf};
+
+use fado_core::MachineModel;
+use fado_core::machine_checks::{Finding, check};
+use fado_sim::SimConfig;
+
+fn files(dir: &Path, out: &mut Vec<PathBuf>) {
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.is_dir() {
+            files(&p, out);
+        } else if p.extension().is_some_and(|x| x == "toml") {
+            out.push(p);
+        }
+    }
+}
+
+/// Every motor file: `motors/**` and `crates/fado-sim/tests/data/**`.
+fn motor_files() -> Vec<PathBuf> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut out = Vec::new();
+    files(&root.join("../../motors"), &mut out);
+    files(&root.join("tests/data"), &mut out);
+    out.sort();
+    out
+}
+
+/// `Some(true)` when `m` (its DC link derived) looks like ratings / 10, `Some(false)` × 10;
+/// an error that names a rating (a rated speed beyond any motor) or the DC link derived from
+/// them counts as the expected one.
+fn scale(m: &MachineModel<f64>, expected: bool) -> Option<bool> {
+    let m = MachineModel {
+        dc_voltage: fado_core::ratings::dc_voltage(m),
+        ..*m
+    };
+    let findings = check(&m, None);
+    if let Some(e) = findings.error() {
+        // The derived DC link's error names the ratings it follows from (`SimConfig`).
+        let rating = fado_core::ratings::RATING_KEYS.contains(&e.key());
+        return (rating || e.key() == "dc_voltage").then_some(expected);
+    }
+    findings.iter().find_map(|f| match f {
+        Finding::RatingScale { divided, .. } => Some(*divided),
+        _ => None,
+    })
+}
+
+fn times(m: &MachineModel<f64>, k: f64) -> MachineModel<f64> {
+    MachineModel {
+        rated_current: m.rated_current * k,
+        rated_speed_rpm: m.rated_speed_rpm * k,
+        rated_torque: m.rated_torque * k,
+        ..*m
+    }
+}
+
+/// (file name, factor) pairs the check misses: a slotless motor × 10 is the size of a real
+/// high-speed machine (see `machine_checks::scale`).
+const MISSED: [(&str, f64); 1] = [("maxon-ec22-40w-24v.toml", 10.0)];
+
+#[test]
+fn no_motor_file_is_taken_for_scaled_ratings_and_each_scaled_one_is_named() {
+    let mut checked = 0;
+    let mut caught = 0;
+    for path in motor_files() {
+        let text = std::fs::read_to_string(&path).unwrap();
+        if !text.contains("[motor]") {
+            continue;
+        }
+        let Ok(cfg) = SimConfig::from_toml(&text) else {
+            continue; // a file of an error test
+        };
+        let name = path.file_name().unwrap().to_str().unwrap();
+        let m = cfg.motor;
+        assert_eq!(scale(&m, false), None, "{name}");
+        checked += 1;
+        for (k, divided) in [(0.1, true), (10.0, false)] {
+            let found = scale(&times(&m, k), divided);
+            if MISSED.contains(&(name, k)) {
+                assert_ne!(
+                    found,
+                    Some(divided),
+                    "{name} × {k} is caught: update MISSED"
+                );
+            } else {
+                assert_eq!(found, Some(divided), "{name} × {k}");
+                caught += 1;
+            }
+        }
+    }
+    // 35 files, 69 of their 70 scaled variants named.
+    assert!(checked >= 35, "{checked} files");
+    assert_eq!(caught, 2 * checked - MISSED.len());
+}
