@@ -54,7 +54,7 @@ fn observer_on_rotor_flux_ignores_rotor_frame_current_swings() {
 }
 
 #[test]
-fn offset_calibration_runs_with_gates_off_then_removes_the_offsets() {
+fn offset_calibration_runs_under_the_zero_vector_then_removes_the_offsets() {
     let mut cfg = DriveConfig::<f64>::for_machine(&MachineModel::paper());
     cfg.tuning.offset_calibration.time = 20e-3; // 200 samples
     let mut drive = SensorlessDrive::new(cfg, EstimatorTuning::default()).unwrap();
@@ -65,8 +65,9 @@ fn offset_calibration_runs_with_gates_off_then_removes_the_offsets() {
         // Alternating ±5 mA noise averages out.
         let n = if k % 2 == 0 { 0.005 } else { -0.005 };
         let out = drive.step(Abc::new(offset.a + n, offset.b - n, offset.c), 300.0, 5.0);
-        assert!(!out.gates_enabled);
-        assert_eq!(out.duty, Abc::new(0.5, 0.5, 0.5));
+        // The phases shorted through the low-side switches (watched for motion).
+        assert!(out.gates_enabled || k == 199, "sample {k}");
+        assert!(k == 199 || out.duty == Abc::new(0.0, 0.0, 0.0), "sample {k}");
     }
     assert!(!drive.is_calibrating());
     let o = drive.current_offset();

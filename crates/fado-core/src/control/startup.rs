@@ -363,10 +363,11 @@ impl<T: Real> AngleSearch<T> {
     }
 
     /// The offset calibration runs under the zero vector and watched for motion
-    /// ([`MotionMonitor`]): the start-up of a rotor whose angle is unknown (`find_angle`),
-    /// which may carry a load that no brake holds. Otherwise it runs with the gates off.
+    /// ([`MotionMonitor`]): always, since any rotor may carry a load that no brake holds; at
+    /// rest no current flows (the offsets are those of gates off), and a turning rotor drives
+    /// a short-circuit current that brakes it and shows its travel.
     pub fn watches_offsets(&self) -> bool {
-        self.tuning.find_angle
+        true
     }
 
     /// The motion monitor (its travel since its last restart).
@@ -382,15 +383,20 @@ impl<T: Real> AngleSearch<T> {
         self.monitor.restart(reference);
     }
 
-    /// One watched offset-calibration sample (raw current, the zero vector applied): true
-    /// when the rotor has moved, the start-up then deferred.
-    pub fn offset_sample(&mut self, i_ab: Ab<T>) -> bool {
+    /// One watched offset-calibration sample (raw current, the zero vector applied; `v_ab`
+    /// the voltage it sets, the devices' drop): true when the rotor has moved, the start-up
+    /// then deferred (`find_angle`).
+    pub fn offset_sample(&mut self, i_ab: Ab<T>, v_ab: Ab<T>) -> bool {
         if !self.monitor.running() {
             return false;
         }
         let moving = self.monitor.threshold(self.tuning.motion_travel);
-        if self.monitor.step(Ab::zero(), i_ab) > moving {
-            self.defer();
+        if self.monitor.step(v_ab, i_ab) > moving {
+            // A rotor of unknown angle: wait until it stands still. With its start angle
+            // known (`find_angle` off) the drive starts from where it has turned to.
+            if self.tuning.find_angle {
+                self.defer();
+            }
             return true;
         }
         false

@@ -189,9 +189,11 @@ struct Applied<T> {
 /// let config = DriveConfig::for_machine(&MachineModel::paper());
 /// let mut drive = SensorlessDrive::<f32>::new(config, EstimatorTuning::default()).unwrap();
 /// drive.align(0.0);
-/// // Power-up: the first samples run with the gates off and measure the sensor offsets.
+/// // Power-up: the first samples short the phases through the low-side switches (duties 0;
+/// // at rest no current flows) and measure the sensor offsets.
 /// while drive.is_calibrating() {
-///     assert!(!drive.step(Abc::new(0.02, -0.01, -0.01), 300.0, 0.0).gates_enabled);
+///     let out = drive.step(Abc::new(0.02, -0.01, -0.01), 300.0, 0.0);
+///     assert!(!out.gates_enabled || out.duty.a == 0.0);
 /// }
 /// assert!((drive.current_offset().a - 0.02).abs() < 1e-6);
 /// // In the 10 kHz ISR: phase currents sampled now, dc-link voltage, speed reference.
@@ -215,7 +217,7 @@ pub struct SensorlessDrive<T: 'static, E = SensorlessEstimator<T>> {
     last: DriveOutput<T>,
     tripped: bool,
     rejected_samples: u32,
-    /// Samples of the offset calibration still to take (gates off while > 0).
+    /// Samples of the offset calibration still to take (the zero vector while > 0).
     calibration_remaining: u32,
     /// Sum of the raw phase currents during the calibration.
     calibration_sum: Abc<T>,

@@ -191,7 +191,8 @@ pub enum GainCalibrationStatus {
     /// (ratio unchanged).
     Implausible,
     /// Ended early: the rotor turned during a voltage-mode level (a load arrived while the
-    /// d current held it; see `motion_voltage`). The drive starts at once from the aligned
+    /// d current held it; see `motion_voltage`), or skipped because it turned during the
+    /// offset calibration ([`GainCalibration::skip_moving`]). The drive starts at once from the aligned
     /// angle, so that its speed loop takes the load (ratio unchanged).
     RotorMoved,
 }
@@ -364,6 +365,16 @@ impl<T: Real> GainCalibration<T> {
         if self.window_samples > 0 {
             self.status = GainCalibrationStatus::Pending;
         }
+    }
+
+    /// Skipped because the rotor turned before it could run (the drive's offset calibration
+    /// saw a load turn it): [`GainCalibrationStatus::RotorMoved`], no current, the ratio kept.
+    pub fn skip_moving(&mut self) {
+        self.stage = Stage::Idle;
+        self.motion_flux = T::zero();
+        self.motion_current = T::zero();
+        self.motion_emf = T::zero();
+        self.status = GainCalibrationStatus::RotorMoved;
     }
 
     /// Armed and waiting for its first sample.

@@ -39,6 +39,10 @@ use crate::{Ab, Real};
 /// rotor that turns at 1 % of its rated speed with its phases shorted.
 pub const READ_CURRENT_RATIO: f64 = 0.1;
 
+/// Low-pass time constant (s) of the derivative of Δλr ([`MotionMonitor::flux_rate`]) \[A\]:
+/// the gain calibration's motion filter's (ten 10 kHz samples).
+pub const RATE_FILTER_TIME: f64 = 1e-3;
+
 /// The motion monitor (module docs). Allocation-free.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MotionMonitor<T> {
@@ -61,6 +65,10 @@ pub struct MotionMonitor<T> {
     reference: Ab<T>,
     /// The largest travel read since the reference sample (rad).
     travel: T,
+    /// Δλr at the last sample (V·s) and its derivative low-passed over
+    /// [`RATE_FILTER_TIME`] (V).
+    delta: Ab<T>,
+    rate: Ab<T>,
     /// A sample's |i − i₀| exceeded the quiet current since the reference sample.
     loud: bool,
     running: bool,
@@ -88,6 +96,8 @@ impl<T: Real> MotionMonitor<T> {
             flux: Ab::zero(),
             reference: Ab::zero(),
             travel: T::zero(),
+            delta: Ab::zero(),
+            rate: Ab::zero(),
             loud: false,
             running: false,
         }
@@ -99,6 +109,8 @@ impl<T: Real> MotionMonitor<T> {
         self.samples = T::zero();
         self.reference = reference;
         self.travel = T::zero();
+        self.delta = Ab::zero();
+        self.rate = Ab::zero();
         self.loud = false;
         self.running = true;
     }
@@ -146,6 +158,9 @@ impl<T: Real> MotionMonitor<T> {
         self.loud |= !small;
         if self.flux_linkage > T::zero() {
             let delta = self.flux - di * self.inductance;
+            let a = self.ts / (T::lit(RATE_FILTER_TIME) + self.ts);
+            self.rate += ((delta - self.delta) * (T::one() / self.ts) - self.rate) * a;
+            self.delta = delta;
             let travel = delta.norm() / self.flux_linkage;
             if travel > self.travel {
                 self.travel = travel;
@@ -172,6 +187,19 @@ impl<T: Real> MotionMonitor<T> {
             travel
         };
         base + self.drift_per_sample * self.samples
+    }
+
+    /// Δλr = Σ (v − R̂s·(i − i₀))·Ts − L̂·(i − i₀) at the last sample (V·s): the change of the
+    /// rotor's flux vector since the reference sample (module docs). A drive that knows the
+    /// angle θ₀ the rotor started from has it at arg(λ̂f·e^(jθ₀) + Δλr).
+    pub fn flux_change(&self) -> Ab<T> {
+        self.delta
+    }
+
+    /// dΔλr/dt low-passed over [`RATE_FILTER_TIME`] (V): with the rotor's flux vector λr,
+    /// its electrical speed is (λr × dλr/dt)/|λr|².
+    pub fn flux_rate(&self) -> Ab<T> {
+        self.rate
     }
 
     /// The largest travel read since the last restart (electrical rad).
