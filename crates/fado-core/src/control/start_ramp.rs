@@ -20,10 +20,12 @@
 //! At the start-up's end ([`StartRamp::arm`]) the ramp starts from the rotor's speed as the
 //! drive knows it there (zero for a rotor at rest; the estimate starts from zero). A user's
 //! reference within 2π·[`StartRampTuning::step_hz`] (electrical rad/s) of it passes at once;
-//! one further away is stepped to by that much and then approached by at most
-//! [`StartRampTuning::accel_ratio`] × the rated acceleration a_rated = p·T_rated/Ĵ
-//! (electrical) per second. Once the ramp meets the reference it ends: from then on the
-//! reference passes bit for bit.
+//! one further away is stepped to by that much and then approached at the reference's own
+//! rate of change plus at most [`StartRampTuning::accel_ratio`] × the rated acceleration
+//! a_rated = p·T_rated/Ĵ (electrical) per second: the gap left after the step closes at that
+//! acceleration whatever the reference does meanwhile, so a user's ramp faster than the
+//! bound is caught up with rather than chased. Once the ramp meets the reference it ends:
+//! from then on the reference passes bit for bit.
 //!
 //! The step is an electrical speed because what it has to stay within is the estimator's
 //! speed tracker (T2S-2, a type-2 loop of natural frequency ωn = 2π·35 Hz/2.058 = 107 rad/s
@@ -90,6 +92,9 @@ pub struct StartRamp<T> {
     limit: T,
     /// The ramp's reference (electrical rad/s).
     value: T,
+    /// The user's reference of the previous sample (electrical rad/s): the ramp closes its
+    /// gap at `step` per sample on top of the reference's own change.
+    last_reference: Option<T>,
     active: bool,
 }
 
@@ -117,6 +122,7 @@ impl<T: Real> StartRamp<T> {
             jump: if jump.is_finite() { jump } else { step },
             limit: step,
             value: T::zero(),
+            last_reference: None,
             active: false,
         })
     }
@@ -126,6 +132,7 @@ impl<T: Real> StartRamp<T> {
         self.active = self.step > T::zero() && speed.is_finite();
         self.value = speed;
         self.limit = self.jump;
+        self.last_reference = None;
     }
 
     /// Ends the ramp (the user's reference passes).
@@ -145,19 +152,23 @@ impl<T: Real> StartRamp<T> {
         if !self.active {
             return reference;
         }
+        // The gap closes at `limit` beyond the reference's own change since the last sample,
+        // so a reference that moves on (a user's ramp) is caught up with, never chased.
+        let moved = self.last_reference.map(|last| (reference - last).abs());
+        self.last_reference = Some(reference);
+        let mut limit = self.limit;
+        if let Some(moved) = moved.filter(|m| m.is_finite()) {
+            limit += moved;
+        }
+        self.limit = self.step;
         let gap = reference - self.value;
         // NaN compares false: the reference passes.
-        let beyond = gap.abs() > self.limit;
+        let beyond = gap.abs() > limit;
         if !beyond {
             self.active = false;
             return reference;
         }
-        self.value += if gap > T::zero() {
-            self.limit
-        } else {
-            -self.limit
-        };
-        self.limit = self.step;
+        self.value += if gap > T::zero() { limit } else { -limit };
         self.value
     }
 }
@@ -178,6 +189,23 @@ mod tests {
             accel_ratio: 0.1,
         };
         StartRamp::new(&tuning, &m, 1e-3).unwrap()
+    }
+
+    #[test]
+    fn a_reference_that_moves_on_is_caught_up_with() {
+        // The user's ramp rises 1 rad/s a sample, faster than the ramp's own 0.4: the ramp
+        // follows the reference's change plus 0.4, so the 9 rad/s gap left after the first
+        // step closes at 0.4 a sample: met at the 24th sample after the step.
+        let mut r = ramp();
+        r.arm(0.0);
+        let mut n = 0;
+        while r.active() && n < 100 {
+            let reference = 10.0 + n as f64;
+            let out = r.step(reference);
+            assert!(out <= reference, "{n}: {out} > {reference}");
+            n += 1;
+        }
+        assert_eq!(n, 24, "caught up after {n} samples");
     }
 
     #[test]
