@@ -125,6 +125,9 @@ class Machine:
         flux_map: _FluxMapLike | None = None,
     ) -> Machine: ...
     @staticmethod
+    def from_datasheet(**fields: Any) -> Machine:
+        """A machine from its datasheet's values: any field, or ``rs_line_to_line``, ``l_line_to_line``, ``ke_vll_rms_per_krpm``, ``ke_vll_peak_per_krpm``, ``kt_nm_per_arms``, ``rated_current_arms`` in their place."""
+    @staticmethod
     def paper() -> Machine:
         """The paper's motor."""
     @staticmethod

@@ -16,6 +16,11 @@
 //! λ̂r = λ2 − L_q,s(î(λ̂r))·i per sample. The secant moves with the load over tens of
 //! milliseconds, so the step's L_q,s⁻ is within a sample's current change of the fixed point.
 //!
+//! **A map** (`MachineMagnetics::Map`) is read through its C¹ interpolant
+//! ([`FluxMap::smooth_flux_and_jacobian`](crate::magnetics::FluxMap::smooth_flux_and_jacobian)),
+//! since the angle reads the model's slope through κ below: a bilinear map's chord slopes jump
+//! at every cell edge and lie below the tangent over part of each cell of a saturating axis.
+//!
 //! **The R̂s regressor** (see `crate::rs_adaptation` for the constant-inductance case). A
 //! resistance error ΔR = R̂s − Rs leaves the synchronous flux error ΔR·(−i_q + j·i_d)/ω in the
 //! rotor frame. Its d part changes |λ̂r| by −ΔR·i_q/ω. Its q part turns λ̂r, so the estimated
@@ -347,6 +352,18 @@ impl<T: Real, M: FluxLookup<T>> ActiveFlux<T, M> {
         // alone), any angle error reads as resistance: frozen.
         let turned = i.d * ((l.dd - lqs) * i.q - l.dq * i.d) / kappa;
         (turned.abs() < i.q.abs()).then_some(i.q + turned)
+    }
+
+    /// How far the map's two interpolants of the same nodes disagree on λa at the operating
+    /// point (|λa of the C¹ one − λa of the bilinear one|, Wb): what the nodes leave open
+    /// between them, zero on a node and for any model but a map read through its C¹
+    /// interpolant.
+    #[inline]
+    pub fn interpolation_spread(&self, point: &ActiveFluxPoint<T>) -> T {
+        match self.model.bilinear_flux(point.i_dq) {
+            Some(psi) => (self.point_at(point.i_dq, psi).active - point.active).abs(),
+            None => T::zero(),
+        }
     }
 
     /// The frame coupling's (s, κ) at the operating point (module docs): while the current

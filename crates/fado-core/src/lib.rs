@@ -11,6 +11,7 @@ pub mod approx;
 pub mod baselines;
 pub mod commissioning;
 pub mod control;
+pub mod datasheet;
 pub mod error;
 pub mod estimator;
 pub mod flux;

@@ -25,6 +25,7 @@
 pub mod commission;
 pub mod compare;
 pub mod config;
+pub mod datasheet;
 pub mod errors;
 pub mod estimator;
 pub mod flux_map;

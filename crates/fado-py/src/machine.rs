@@ -451,6 +451,18 @@ impl PyMachine {
         Ok(m)
     }
 
+    /// A machine from its datasheet's values: any `Machine` field, or instead of `rs`, `ld`,
+    /// `lq`, `flux_linkage` and `rated_current` the datasheet's `rs_line_to_line`,
+    /// `l_line_to_line`, `ke_vll_rms_per_krpm`, `ke_vll_peak_per_krpm`, `kt_nm_per_arms` and
+    /// `rated_current_arms` (converted as `fado-sim`'s `[motor]` table converts them; see
+    /// docs/configuration.md). A field given both ways is refused naming both.
+    #[staticmethod]
+    #[pyo3(signature = (**fields))]
+    fn from_datasheet(py: Python<'_>, fields: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
+        let converted = crate::datasheet::convert(py, fields)?;
+        Self::py_new(py, Some(&converted))
+    }
+
     /// A copy with the given fields changed (validated like the constructor).
     fn _replace(&self, py: Python<'_>, changes: &Bound<'_, PyDict>) -> PyResult<Self> {
         let (changes, flux_map) = Self::split_flux_map(py, Some(changes))?;

@@ -109,17 +109,17 @@ fn the_mismatch_is_measured_on_every_calibrated_preset_and_skipped_where_it_shou
 #[test]
 fn an_axis_without_current_in_a_phase_is_reported_unobservable() {
     // θ0 = π/2: phase a carries no current; −π/6: phase c (inverter error would not cancel).
+    // The paper's motor is too heavy for the free rotor's turn to a well-observed axis
+    // (`fado_core::control::calibration_turn`, 0.43 s against 0.2 s): skipped, no current.
+    // The outrunner turns in 0.11 s and is calibrated there (tests/start_angle.rs).
     for angle in [std::f64::consts::FRAC_PI_2, -std::f64::consts::FRAC_PI_6] {
-        for name in ["outrunner-cheetah-24v", "paper"] {
-            let (k, _, status, peak, _) = start_up(name, angle, "");
-            assert_eq!(
-                status,
-                GainCalibrationStatus::Unobservable,
-                "{name} {angle}"
-            );
-            assert_eq!(k, 1.0);
-            assert!(peak < 1e-9);
-        }
+        let (k, _, status, peak, _) = start_up("paper", angle, "");
+        assert_eq!(status, GainCalibrationStatus::Unobservable, "{angle}");
+        assert_eq!(k, 1.0);
+        assert!(peak < 1e-9);
+        let (k, k_true, status, _, _) = start_up("outrunner-cheetah-24v", angle, "");
+        assert_eq!(status, GainCalibrationStatus::Calibrated, "{angle}");
+        assert!((k - k_true).abs() < 1.5e-3, "{angle}: k {k}");
     }
 }
 

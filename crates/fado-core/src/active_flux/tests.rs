@@ -44,7 +44,8 @@ fn baldor() -> Magnetics<'static, f64> {
 }
 
 /// A 17 × 17 flux map of the Baldor model over ±25 A (twice its rated current), leaked as a
-/// firmware table would live in flash.
+/// firmware table would live in flash. The tests take the machine's flux from the
+/// estimator's own view of its model ([`ActiveFlux::flux`]: a map's C¹ interpolant).
 fn baldor_map() -> Magnetics<'static, f64> {
     let axis: [f64; 17] = core::array::from_fn(|k| -25.0 + 50.0 * k as f64 / 16.0);
     let table: &'static FluxTable<f64, 17, 17> =
@@ -84,7 +85,7 @@ fn secant_flux_is_aligned_with_d_for_any_model() {
         for i in points(rated, model) {
             let theta = 2.1;
             let rot = Rotation::from_angle(theta);
-            let psi = model.flux(i).to_ab(rot);
+            let psi = af.flux(i).to_ab(rot);
             let pt = af.point(i);
             let lr = psi - i.to_ab(rot) * pt.lq_secant;
             let err = crate::wrap_angle(lr.angle() - theta);
@@ -93,12 +94,12 @@ fn secant_flux_is_aligned_with_d_for_any_model() {
             // The secant and the incremental inductance are one map: ψq = L_q,s·i_q, and
             // L_q,s's slope is (L_qq − L_q,s)/i_q (finite differences of the model).
             if i.q.abs() > 0.1 {
-                assert!((pt.lq_secant * i.q - model.flux(i).q).abs() < 1e-12);
+                assert!((pt.lq_secant * i.q - af.flux(i).q).abs() < 1e-12);
                 let h = 1e-5 * rated;
                 let up = af.point(Dq::new(i.d, i.q + h)).lq_secant;
                 let dn = af.point(Dq::new(i.d, i.q - h)).lq_secant;
                 let slope = (up - dn) / (2.0 * h);
-                let l = model.incremental_inductance(i);
+                let l = af.incremental_inductance(i);
                 let expected = (l.qq - pt.lq_secant) / i.q;
                 let tol = if name.contains("map") { 1e-3 } else { 1e-5 };
                 assert!(
@@ -117,7 +118,7 @@ fn per_sample_fixed_point_converges_to_the_rotor_angle() {
         for i in points(rated, model) {
             let theta = -0.7;
             let rot = Rotation::from_angle(theta);
-            let psi = model.flux(i).to_ab(rot);
+            let psi = af.flux(i).to_ab(rot);
             let i_ab = i.to_ab(rot);
             // From the zero-current secant, as after a start-up.
             let mut lq = af.lq_zero();
@@ -152,7 +153,7 @@ fn resistance_regressor_matches_the_flux_error_of_a_resistance_error() {
             };
             let error_at = |dr: f64| {
                 let flux_error = Dq::new(-i.q, i.d) * (dr / omega);
-                let lambda2 = (model.flux(i) + flux_error).to_ab(rot);
+                let lambda2 = (af.flux(i) + flux_error).to_ab(rot);
                 let mut lq = pt.lq_secant;
                 let mut out = (Ab::zero(), pt);
                 for _ in 0..400 {
@@ -220,7 +221,7 @@ fn frame_coupling_matches_the_closed_loop_flux_change() {
             let seen = |delta: f64| {
                 let (sin, cos) = delta.sin_cos();
                 let turned = Dq::new(i.d * cos - i.q * sin, i.d * sin + i.q * cos);
-                let psi = model.flux(turned);
+                let psi = af.flux(turned);
                 let r = Dq::new(
                     psi.d - pt.lq_secant * turned.d,
                     psi.q - pt.lq_secant * turned.q,
@@ -299,4 +300,26 @@ fn the_observer_reference_is_the_magnet_or_half_the_active_flux() {
     let baldor = active(baldor(), 12.45).unwrap();
     let lf = baldor.magnet_flux();
     assert_eq!(baldor.observer_reference(1.9 * lf), lf);
+}
+
+/// The interpolation spread (what the R̂s law compares with a resistance error's flux) is
+/// zero on a map's nodes and on a model that is no map, and grows between the nodes where
+/// the map bends: on the Baldor 17 × 17 map at mid-cell under load it is a few mVs.
+#[test]
+fn the_interpolation_spread_is_zero_on_the_nodes_and_opens_between_them() {
+    let map = active(baldor_map(), 12.45).unwrap();
+    let model = active(baldor(), 12.45).unwrap();
+    let node = Dq::new(-6.25, 9.375);
+    let mid = Dq::new(-7.8125, 10.9375);
+    assert!(map.interpolation_spread(&map.point(node)) < 1e-12);
+    assert_eq!(model.interpolation_spread(&model.point(mid)), 0.0);
+    let spread = map.interpolation_spread(&map.point(mid));
+    std::println!(
+        "Baldor 17x17 map: λa spread at mid-cell {:.2} mVs",
+        spread * 1e3
+    );
+    assert!(
+        spread > 1e-4 && spread < 0.02 * map.point(mid).active,
+        "{spread}"
+    );
 }

@@ -12,9 +12,10 @@
 //! vector turns off the q axis, the rotor stalls where the true q current equals the load, and
 //! the speed loop's integral winds the current up, which raises Δi and the walk with it.
 //! Measured on the `outrunner-cheetah-24v` preset (R̂s·I_rated/λ̂f = 766 rad/s; a 0.5 %
-//! mismatch, `reversal`, sensor seed 1): started at 0.35–0.70 rad the calibration is skipped
-//! and the reversal stalls with |θ − θ̂| = 1.2 rad (0.23–0.25 rad at 0.65–0.70); without the
-//! sensors' gain error every one of these angles passes within 0.004 rad.
+//! mismatch, `reversal`, sensor seed 1): started at 0.35–0.70 rad the calibration is skipped;
+//! the reversal stalls with |θ − θ̂| = 1.2 rad at 0.35–0.60 and reaches 0.23–0.25 rad (its
+//! bound 0.25) at 0.65–0.70; without the sensors' gain error every one of these angles passes
+//! within 0.004 rad.
 //!
 //! # The rule
 //! A rotor that no brake holds ([`StartupTuning::rotor_held`] false) turns with a d current:
@@ -28,9 +29,9 @@
 //! spring of natural frequency ω_n = √(1.5·p²·λ̂a·I₁/Ĵ) (electrical, λ̂a the active flux at
 //! I₁). Driven through a cycloid of duration T the undamped spring keeps a residual swing of at
 //! most |sin(π·r)|/(π·r·(r² − 1)) of Δ, with r = ω_n·T/(2π) swing periods: none for a whole
-//! number r ≥ 2, and with [`TURN_SWING_PERIODS`] = 3 at most 1.3 % of Δ wherever r lands near 3
-//! (0.007 rad for the largest turn, π/6), well within what the calibration's current-mode settling and its
-//! voltage-mode hold take: the hold damps the swing in time constants of the model's swing,
+//! number r ≥ 2, and with [`TURN_SWING_PERIODS`] = 3 at most 1.3 % of Δ wherever r lands
+//! near 3 (0.007 rad for the largest turn, π/6), well within what the calibration's
+//! current-mode settling and its voltage-mode hold take: the hold damps the swing in time constants of the model's swing,
 //! and its motion test reads a swing as motion only above 0.5 % of the rated speed's back-EMF
 //! (on the cheetah preset an amplitude of 0.12 rad). A model inertia off by a factor of two
 //! changes r by √2 and keeps the residual below 4.3 % of Δ. A turn longer than

@@ -147,7 +147,8 @@ impl<T: Real> StartRamp<T> {
         }
         let gap = reference - self.value;
         // NaN compares false: the reference passes.
-        if !(gap.abs() > self.limit) {
+        let beyond = gap.abs() > self.limit;
+        if !beyond {
             self.active = false;
             return reference;
         }

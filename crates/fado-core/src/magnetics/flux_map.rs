@@ -10,7 +10,8 @@ use crate::{Dq, Real};
 /// `psi_d[k·n_q + m]` and `psi_q[k·n_q + m]` are ψd and ψq at (`i_d[k]`, `i_q[m]`).
 ///
 /// Between grid nodes the map is bilinear (continuous, its Jacobian piecewise linear);
-/// beyond the grid it extends the edge cells linearly. Firmware keeps the four slices in
+/// beyond the grid it extends the edge cells linearly. [`FluxMap::smooth_flux_and_jacobian`]
+/// is its C¹ interpolant, the estimator's view of the same nodes. Firmware keeps the four slices in
 /// flash (`&'static`, e.g. a `static` [`FluxTable`]); a host program borrows them from its
 /// own storage. A lookup finds the cell in O(1) on a uniform axis (found so at construction)
 /// — the node index ⌊(x − x₀)/Δ⌋ with 1/Δ precomputed, clamped to the edge cells, and the

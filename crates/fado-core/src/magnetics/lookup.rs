@@ -44,6 +44,11 @@ pub trait FluxLookup<T: Real>: Copy {
 
     /// Whether `i` lies beyond a map's data ([`MachineMagnetics::beyond_data`]).
     fn beyond_data(&self, i: Dq<T>) -> bool;
+
+    /// A map read through its C¹ interpolant (`flux_at`): its bilinear ψ(i), the other
+    /// interpolant of the same nodes (their difference measures what the nodes leave open
+    /// between them); None for any other model.
+    fn bilinear_flux(&self, i: Dq<T>) -> Option<Dq<T>>;
 }
 
 impl<T: Real> FluxLookup<T> for MachineMagnetics<T> {
@@ -65,9 +70,14 @@ impl<T: Real> FluxLookup<T> for MachineMagnetics<T> {
         }
     }
 
+    /// A [`MachineMagnetics::Map`]'s C¹ interpolant (`FluxMap::smooth_flux_and_jacobian`),
+    /// any other model's own ψ(i).
     #[inline]
     fn flux_at(&self, linear: ConstantInductance<T>, i: Dq<T>) -> Dq<T> {
-        self.resolve(linear).flux(i)
+        match *self {
+            MachineMagnetics::Map(m) => m.smooth_flux_and_jacobian(i).0,
+            _ => self.resolve(linear).flux(i),
+        }
     }
 
     #[inline(always)]
@@ -78,22 +88,39 @@ impl<T: Real> FluxLookup<T> for MachineMagnetics<T> {
         fallback: Dq<T>,
         warm: &FluxWarmStart<T>,
     ) -> (Dq<T>, FluxWarmStart<T>) {
-        MachineMagnetics::flux_warm(self, linear, i, fallback, warm)
+        match *self {
+            MachineMagnetics::Map(m) => (m.smooth_flux_and_jacobian(i).0, *warm),
+            _ => MachineMagnetics::flux_warm(self, linear, i, fallback, warm),
+        }
     }
 
     #[inline(always)]
     fn q_flux_offset(&self, linear: ConstantInductance<T>, i_d: T) -> T {
-        MachineMagnetics::q_flux_offset(self, linear, i_d)
+        match *self {
+            MachineMagnetics::Map(m) => m.smooth_flux_and_jacobian(Dq::new(i_d, T::zero())).0.q,
+            _ => MachineMagnetics::q_flux_offset(self, linear, i_d),
+        }
     }
 
     #[inline]
     fn inductance_at(&self, linear: ConstantInductance<T>, i: Dq<T>) -> InductanceMatrix<T> {
-        self.resolve(linear).incremental_inductance(i)
+        match *self {
+            MachineMagnetics::Map(m) => m.smooth_flux_and_jacobian(i).1,
+            _ => self.resolve(linear).incremental_inductance(i),
+        }
     }
 
     #[inline]
     fn beyond_data(&self, i: Dq<T>) -> bool {
         MachineMagnetics::beyond_data(self, i)
+    }
+
+    #[inline]
+    fn bilinear_flux(&self, i: Dq<T>) -> Option<Dq<T>> {
+        match *self {
+            MachineMagnetics::Map(m) => Some(m.flux(i)),
+            _ => None,
+        }
     }
 }
 
@@ -143,5 +170,11 @@ impl<T: Real, const ND: usize, const NQ: usize> FluxLookup<T> for &UniformFluxTa
     #[inline]
     fn beyond_data(&self, i: Dq<T>) -> bool {
         self.map().beyond_grid(i)
+    }
+
+    /// None: a typed table is read bilinearly.
+    #[inline(always)]
+    fn bilinear_flux(&self, _i: Dq<T>) -> Option<Dq<T>> {
+        None
     }
 }

@@ -13,7 +13,9 @@
 //!   magnetic energy, so it is reciprocal by construction;
 //! - [`FluxMap`]: a measured or computed map ψd(i_d, i_q), ψq(i_d, i_q) on a rectangular grid,
 //!   interpolated bilinearly, borrowed from a `&'static` table in firmware (flash) or from a
-//!   [`FluxTable`] held by value.
+//!   [`FluxTable`] held by value. The estimator reads it through its C¹ interpolant of the same
+//!   nodes ([`FluxMap::smooth_flux_and_jacobian`]), whose incremental inductances do not jump at
+//!   the cell edges.
 //!
 //! [`Magnetics`] holds any of the three by value (`Copy`), for records that must name one type.
 //!
@@ -57,6 +59,7 @@ mod inverse_cache;
 mod lookup;
 mod machine;
 mod saturation;
+mod smooth_map;
 mod uniform_map;
 mod uniform_table;
 mod warm_start;

@@ -30,6 +30,13 @@ pub(crate) struct ResistanceAdaptationParams<T: 'static> {
     floor_sq: T,
 }
 
+/// The resistance error, as a share of R0, whose flux error the turning law must see above a
+/// map's interpolation spread (`ActiveFlux::interpolation_spread`) to run. Ours \[A\]: a
+/// model error read as resistance biases R̂s by at most about this share; 2 % holds the
+/// traction IPMSM's coarse 7 × 8 map of `scripts/saturated-replay.py` (R̂s 0.95–1.05 × the
+/// truth running everywhere).
+pub(crate) const MAP_RESISTANCE_RESOLUTION: f64 = 0.02;
+
 /// What the laws derive from R0, the resistance they start from and scale with: mutable
 /// (R0 is replaced at run time), so kept with the state.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -275,13 +282,35 @@ impl<T: Real> ResistanceAdaptationParams<T> {
             let Some(bracket) = af.resistance_regressor(&point) else {
                 return false;
             };
+            // Frozen where the map's interpolation leaves λa more open than the flux error a
+            // resistance error of `MAP_RESISTANCE_RESOLUTION`·R0 causes, R0·|bracket|/|ω̂|
+            // times it: there the law would learn the interpolation as resistance.
+            if af.interpolation_spread(&point) * omega.abs()
+                >= T::lit(MAP_RESISTANCE_RESOLUTION) * scale.r0 * bracket.abs()
+            {
+                return false;
+            }
             let reference = point.active + (lf - self.config.flux_linkage_hat);
             // χ relative to the active flux where it exceeds λ̂f (a reluctance rotor's |λ̂r|
             // is many times its magnet's flux: relative to λ̂f a weak magnet's χ would pass
             // χ0 on the map's slope alone at no load).
-            let a =
-                -(mag * bracket) * scale.chi_per_phi * crate::real::min(T::one(), lf / reference);
-            return self.rotating_step(scale, st, next, reference, a, mag, omega, settled);
+            // ẽ relative to the same flux: ẽ·χ is then (ΔR/R0)·χ², and R̂s decays at
+            // γ·χ²/(χ² + χ0²) as on any other rotor (relative to λ̂f it would decay
+            // reference/λ̂f times faster, 22 times on a PM-SyRM with an 8.7 mVs magnet, and
+            // learn a map's interpolation error or a load step's transient as resistance
+            // within milliseconds).
+            let relative_to = crate::real::max(lf, reference);
+            let a = -(mag * bracket) * scale.chi_per_phi * (lf / relative_to);
+            return self.rotating_step(
+                scale,
+                st,
+                next,
+                (reference, relative_to),
+                a,
+                mag,
+                omega,
+                settled,
+            );
         }
         // The reference is the active flux λ̂a = λ̂f + (L̂d − L̂q)·î_d and φ carries the
         // sensitivity factor 1 + (L̂d − L̂q)·î_d/λ̂a (module docs); for L̂d = L̂q both are
@@ -301,11 +330,12 @@ impl<T: Real> ResistanceAdaptationParams<T> {
         // χ = a/b: then χ/(χ² + χ0²) = a·b/(a² + χ0²·b²) costs one division, and
         // χ² ≥ χ0² is a² ≥ χ0²·b² (false for ω̂ = 0, which also rules out 0/0).
         let a = -lambda_r.cross(i_drop) * scale.chi_per_phi * sensitivity;
-        self.rotating_step(scale, st, next, reference, a, mag, omega, settled)
+        self.rotating_step(scale, st, next, (reference, lf), a, mag, omega, settled)
     }
 
-    /// The turning law's step (and the λ̂f law's) with the reference λ̂a and the numerator
-    /// `a` of χ = a/(|λ̂r|·ω̂).
+    /// The turning law's step (and the λ̂f law's) with the reference λ̂a, the flux the error
+    /// is taken relative to (λ̂f, or a saturating rotor's active flux where that is more) and
+    /// the numerator `a` of χ = a/(|λ̂r|·ω̂).
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     fn rotating_step(
@@ -313,19 +343,19 @@ impl<T: Real> ResistanceAdaptationParams<T> {
         scale: &ResistanceScale<T>,
         st: &ResistanceAdaptationState<T>,
         next: &mut ResistanceAdaptationState<T>,
-        reference: T,
+        (reference, relative_to): (T, T),
         a: T,
         mag: T,
         omega: T,
         settled: bool,
     ) -> bool {
-        let lf = st.flux_linkage_hat;
         let b = mag * omega;
         let (a_sq, floor_b_sq) = (a * a, self.floor_sq * b * b);
         if a_sq >= floor_b_sq && floor_b_sq > T::zero() {
-            // ẽ·χ/(χ² + χ0²) with ẽ = (|λ̂r| − λ̂a)/λ̂f, in one division.
+            // ẽ·χ/(χ² + χ0²) with ẽ = (|λ̂r| − λ̂a)/`relative_to`, in one division.
             let weight = a_sq / (a_sq + floor_b_sq);
-            next.rs_hat -= scale.gain * (mag - reference) * a * b / (lf * (a_sq + floor_b_sq));
+            next.rs_hat -=
+                scale.gain * (mag - reference) * a * b / (relative_to * (a_sq + floor_b_sq));
             // The turning law replaces what the standstill tests contributed.
             next.offset_sensitivity = st.offset_sensitivity * (T::one() - self.rate_ts * weight);
         }

@@ -33,6 +33,7 @@ use crate::profile::Profile;
 use crate::sensors::{CurrentSensorParams, DcLinkSensorParams};
 use crate::sim::PlantParams;
 
+mod datasheet_keys;
 mod drive_rules;
 mod moved;
 mod settings;

@@ -46,11 +46,13 @@ impl SimConfig {
     ) -> Result<SimConfig, SimConfigError> {
         let mut user: toml::Table = text.parse().map_err(|e| located(text, e))?;
         super::moved::refuse_moved(&user).map_err(|e| e.located_in(text))?;
+        let converted =
+            super::datasheet_keys::convert(&mut user).map_err(|e| e.located_in(text))?;
         let (saturation, flux_map) =
             magnetics_file::take_magnetics(&mut user).map_err(|e| e.located_in(text))?;
         // Check the user's document on its own first, so that errors (unknown keys, wrong
         // types) name the key the user wrote and point at it.
-        if saturation.is_some() || flux_map.is_some() {
+        if saturation.is_some() || flux_map.is_some() || !converted.is_empty() {
             SimConfig::deserialize(toml::Value::Table(user.clone()))
                 .map_err(|e| key_error(e).located_in(text))?;
         } else {
@@ -82,6 +84,7 @@ impl SimConfig {
             .cloned()
             .collect();
         cfg.derived.extend(derived);
+        cfg.derived.extend(converted);
         // `[motor]` has no DC link of its own (it is the inverter's).
         cfg.motor.dc_voltage = cfg.inverter.dc_voltage;
         // A document giving one magnetic model replaces the base's (either).
