@@ -207,8 +207,8 @@ impl SimConfig {
                 SimConfigError::new(format!("motor.saturation.{}", e.field()), e.to_string())
             })?;
         }
-        self.check_magnetic_agreement()?;
         self.plant().validate()?;
+        self.check_magnetic_agreement()?;
         let rows = self.simulation.duration
             / self.inverter.sample_period()
             / self.simulation.decimation as f64;
