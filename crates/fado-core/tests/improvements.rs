@@ -67,7 +67,10 @@ fn offset_calibration_runs_under_the_zero_vector_then_removes_the_offsets() {
         let out = drive.step(Abc::new(offset.a + n, offset.b - n, offset.c), 300.0, 5.0);
         // The phases shorted through the low-side switches (watched for motion).
         assert!(out.gates_enabled || k == 199, "sample {k}");
-        assert!(k == 199 || out.duty == Abc::new(0.0, 0.0, 0.0), "sample {k}");
+        assert!(
+            k == 199 || out.duty == Abc::new(0.0, 0.0, 0.0),
+            "sample {k}"
+        );
     }
     assert!(!drive.is_calibrating());
     let o = drive.current_offset();
