@@ -89,9 +89,13 @@ slow it, so that figures measured under load are lower bounds).
   interval of one switch state is one sub-step: four inversions (Runge–Kutta), two on the short
   ones. The plant keeps the warm start's cell and the last four cells' polynomials
   (`fado_core::magnetics::InverseCache`), so that an inversion is one quadratic — a square root
-  and two divisions in sequence, whose latency bounds it: the inversions are about 40 % of the
-  GEM map's CPU time, the drive and estimator about 25 %, the trace file about 15 % (`perf
-  record --call-graph dwarf` on `fado-sim run stops`).
+  and two divisions in sequence, whose latency bounds it: the inversions are about 30 % of the
+  GEM map's CPU time (`perf record` on `fado-sim run stops`). The estimator reads the map
+  through its C¹ interpolant (`FluxMap::smooth_flux_and_jacobian`, docs/method/saturation.md
+  "A map's interpolation"): a 4 × 4 stencil per flux component, evaluated for the operating
+  point's flux, the R̂s law's point and the incremental inductances of the frame coupling and
+  the R̂s regressor, about 23 % of the CPU time; these evaluations share the operating point
+  but not their results, which is where the map rows fall short of 50× real time.
 - **Algebraic model** (`ipmsm-2k2-qsat`, `pmsyrm-baldor-5k6`): the plant's i(ψ) is the model's
   own closed form; the drive's and the estimator's ψ(i) are Newton solves started from the
   tangent plane of their last solution (`fado_core::magnetics::FluxWarmStart`: one step and the

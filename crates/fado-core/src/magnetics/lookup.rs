@@ -97,7 +97,7 @@ impl<T: Real> FluxLookup<T> for MachineMagnetics<T> {
     #[inline(always)]
     fn q_flux_offset(&self, linear: ConstantInductance<T>, i_d: T) -> T {
         match *self {
-            MachineMagnetics::Map(m) => m.smooth_flux_and_jacobian(Dq::new(i_d, T::zero())).0.q,
+            MachineMagnetics::Map(m) => m.smooth_q_flux_offset(i_d),
             _ => MachineMagnetics::q_flux_offset(self, linear, i_d),
         }
     }

@@ -29,72 +29,98 @@ use super::{FluxMap, InductanceMatrix};
 use crate::real::{max, min};
 use crate::{Dq, Real};
 
-/// A node's slope as weights on (its left neighbour, itself, its right neighbour), from
-/// the values `p` and the cell widths `h` (left, right; a zero width where the node is an
-/// edge node).
-fn slope_weights<T: Real>(p: [T; 3], h: [T; 2]) -> [T; 3] {
-    let zero = T::zero();
-    let (hl, hr) = (h[0], h[1]);
-    // An edge node (a zero width) takes its one cell's chord.
-    if hl <= zero {
-        return [zero, -T::one() / hr, T::one() / hr];
-    }
-    if hr <= zero {
-        return [-T::one() / hl, T::one() / hl, zero];
-    }
-    let (dl, dr) = ((p[1] - p[0]) / hl, (p[2] - p[1]) / hr);
-    if dl * dr <= zero {
-        return [zero; 3];
-    }
-    let (sl, sr) = (hr / (hl + hr), hl / (hl + hr));
-    let three = T::lit(3.0);
-    let slope = sl * dl + sr * dr;
-    if slope.abs() > three * min(dl.abs(), dr.abs()) {
-        return if dl.abs() < dr.abs() {
-            [-three / hl, three / hl, zero]
-        } else {
-            [zero, -three / hr, three / hr]
-        };
-    }
-    // sl·(p1 − p0)/hl + sr·(p2 − p1)/hr.
-    [-sl / hl, sl / hl - sr / hr, sr / hr]
+/// One cell of an axis around a point: its four nodes (the neighbours repeated at an edge),
+/// the widths and their inverses, and the Hermite basis at the point's fraction along it —
+/// everything the interpolant needs that does not depend on the node values, computed once
+/// per lookup and shared by the four rows and both flux components.
+struct Cell<T> {
+    /// Widths of the left neighbour's cell, this cell and the right neighbour's cell (zero
+    /// where the neighbour is an edge repeat).
+    h: [T; 3],
+    /// Their inverses (zero for a zero width).
+    inv: [T; 3],
+    /// The basis (h00, h10·h, h01, h11·h) for the value and (d00, d10, d01, d11) for its
+    /// derivative along the axis.
+    value: [T; 4],
+    slope: [T; 4],
 }
 
-/// The cubic Hermite interpolant on the cell [x1, x2] of the four nodes `x` (x0 and x3 the
-/// neighbours, equal to x1 or x2 at an edge) and values `p`, at the fraction `t`: weights
-/// on the four values for the value and for its derivative along x.
-fn hermite_weights<T: Real>(x: [T; 4], p: [T; 4], t: T) -> ([T; 4], [T; 4]) {
-    let h = x[2] - x[1];
-    let s1 = slope_weights([p[0], p[1], p[2]], [x[1] - x[0], h]);
-    let s2 = slope_weights([p[1], p[2], p[3]], [h, x[3] - x[2]]);
-    let one = T::one();
-    let (two, three, six) = (T::lit(2.0), T::lit(3.0), T::lit(6.0));
-    let (t2, t3) = (t * t, t * t * t);
-    let (h00, h10, h01, h11) = (
-        two * t3 - three * t2 + one,
-        t3 - two * t2 + t,
-        three * t2 - two * t3,
-        t3 - t2,
-    );
-    let (d00, d10, d01, d11) = (
-        (six * t2 - six * t) / h,
-        three * t2 - two * t * two + one,
-        (six * t - six * t2) / h,
-        three * t2 - two * t,
-    );
-    let mut value = [T::zero(); 4];
-    let mut slope = [T::zero(); 4];
-    value[1] = h00;
-    value[2] = h01;
-    slope[1] = d00;
-    slope[2] = d01;
-    for n in 0..3 {
-        value[n] += h * (h10 * s1[n]);
-        value[n + 1] += h * (h11 * s2[n]);
-        slope[n] += d10 * s1[n];
-        slope[n + 1] += d11 * s2[n];
+impl<T: Real> Cell<T> {
+    fn new(x: [T; 4], t: T) -> Self {
+        let zero = T::zero();
+        let h = [x[1] - x[0], x[2] - x[1], x[3] - x[2]];
+        let inv = h.map(|w| if w > zero { T::one() / w } else { zero });
+        let one = T::one();
+        let (two, three, six) = (T::lit(2.0), T::lit(3.0), T::lit(6.0));
+        let (t2, t3) = (t * t, t * t * t);
+        let hc = h[1];
+        Self {
+            h,
+            inv,
+            value: [
+                two * t3 - three * t2 + one,
+                (t3 - two * t2 + t) * hc,
+                three * t2 - two * t3,
+                (t3 - t2) * hc,
+            ],
+            slope: [
+                (six * t2 - six * t) * inv[1],
+                three * t2 - two * t * two + one,
+                (six * t - six * t2) * inv[1],
+                three * t2 - two * t,
+            ],
+        }
     }
-    (value, slope)
+
+    /// A node's slope as weights on (its left neighbour, itself, its right neighbour), from
+    /// the values `p` and the cells `left`, `right` of this cell's widths (a zero width where
+    /// the node is an edge node).
+    fn slope_weights(&self, p: [T; 3], left: usize, right: usize) -> [T; 3] {
+        let zero = T::zero();
+        let (hl, hr) = (self.h[left], self.h[right]);
+        let (il, ir) = (self.inv[left], self.inv[right]);
+        // An edge node (a zero width) takes its one cell's chord.
+        if hl <= zero {
+            return [zero, -ir, ir];
+        }
+        if hr <= zero {
+            return [-il, il, zero];
+        }
+        let (dl, dr) = ((p[1] - p[0]) * il, (p[2] - p[1]) * ir);
+        if dl * dr <= zero {
+            return [zero; 3];
+        }
+        let span = T::one() / (hl + hr);
+        let (sl, sr) = (hr * span, hl * span);
+        let three = T::lit(3.0);
+        let slope = sl * dl + sr * dr;
+        if slope.abs() > three * min(dl.abs(), dr.abs()) {
+            return if dl.abs() < dr.abs() {
+                [-three * il, three * il, zero]
+            } else {
+                [zero, -three * ir, three * ir]
+            };
+        }
+        // sl·(p1 − p0)/hl + sr·(p2 − p1)/hr.
+        [-sl * il, sl * il - sr * ir, sr * ir]
+    }
+
+    /// The cubic Hermite interpolant on this cell of the values `p` at the four nodes:
+    /// weights on the four values for the value and for its derivative along the axis.
+    fn weights(&self, p: [T; 4]) -> ([T; 4], [T; 4]) {
+        let s1 = self.slope_weights([p[0], p[1], p[2]], 0, 1);
+        let s2 = self.slope_weights([p[1], p[2], p[3]], 1, 2);
+        let (v, d) = (&self.value, &self.slope);
+        let mut value = [T::zero(), v[0], v[2], T::zero()];
+        let mut slope = [T::zero(), d[0], d[2], T::zero()];
+        for n in 0..3 {
+            value[n] += v[1] * s1[n];
+            value[n + 1] += v[3] * s2[n];
+            slope[n] += d[1] * s1[n];
+            slope[n + 1] += d[3] * s2[n];
+        }
+        (value, slope)
+    }
 }
 
 /// The cell of `x` on `axis` (two nodes or more), the fraction along it clamped to [0, 1],
@@ -122,17 +148,18 @@ impl<T: Real> FluxMap<'_, T> {
         // Inside the grid the clamped point is i itself; beyond it the edge extends linearly.
         let clamped = Dq::new(xd[1] + u * (xd[2] - xd[1]), xq[1] + v * (xq[2] - xq[1]));
         let nq = i_q.len();
+        let (cd, cq) = (Cell::new(xd, u), Cell::new(xq, v));
         let surface = |table: &[T]| {
             // Along i_q in the four rows, then along i_d through their values and slopes.
             let mut rows = [T::zero(); 4];
             let mut rows_q = [T::zero(); 4];
             for (r, &k) in kd.iter().enumerate() {
                 let p = kq.map(|m| node(table, k * nq + m));
-                let (w, wq) = hermite_weights(xq, p, v);
+                let (w, wq) = cq.weights(p);
                 rows[r] = dot(w, p);
                 rows_q[r] = dot(wq, p);
             }
-            let (w, wd) = hermite_weights(xd, rows, u);
+            let (w, wd) = cd.weights(rows);
             (dot(w, rows), dot(wd, rows), dot(w, rows_q))
         };
         let (d, dd, dq) = surface(self.psi_d());
@@ -140,6 +167,29 @@ impl<T: Real> FluxMap<'_, T> {
         let l = InductanceMatrix { dd, dq, qd, qq };
         let beyond = i - clamped;
         (Dq::new(d, q) + l.apply(beyond), l)
+    }
+}
+
+impl<T: Real> FluxMap<'_, T> {
+    /// ψq(i_d, 0) of the map's C¹ interpolant: where the i_q axis has a node at zero the
+    /// interpolant passes through it, so only the interpolation along i_d of that node column
+    /// remains (one Hermite cell instead of five); elsewhere the full surface.
+    pub fn smooth_q_flux_offset(&self, i_d: T) -> T {
+        let i_q = self.i_q();
+        let Some(m0) = i_q.iter().position(|&x| x == T::zero()) else {
+            return self.smooth_flux_and_jacobian(Dq::new(i_d, T::zero())).0.q;
+        };
+        let axis = self.i_d();
+        let (kd, u) = stencil(axis, i_d);
+        let node = |table: &[T], j: usize| table.get(j).copied().unwrap_or(T::zero());
+        let xd = kd.map(|j| node(axis, j));
+        let nq = i_q.len();
+        let column = kd.map(|k| node(self.psi_q(), k * nq + m0));
+        let cell = Cell::new(xd, u);
+        let (w, wd) = cell.weights(column);
+        // Beyond the grid the edge extends linearly along i_d.
+        let beyond = i_d - (xd[1] + u * (xd[2] - xd[1]));
+        dot(w, column) + dot(wd, column) * beyond
     }
 }
 

@@ -173,3 +173,15 @@ fn it_is_monotonic_in_its_own_current() {
         }
     }
 }
+
+#[test]
+fn its_q_flux_offset_is_the_surface_at_zero_q_current() {
+    let table = syrm_table();
+    let map = table.map().unwrap();
+    for k in -40..=40 {
+        let i_d = 0.71 * k as f64;
+        let full = map.smooth_flux_and_jacobian(Dq::new(i_d, 0.0)).0.q;
+        let offset = map.smooth_q_flux_offset(i_d);
+        assert!((full - offset).abs() < 1e-12, "{i_d}: {full} vs {offset}");
+    }
+}
