@@ -7,7 +7,7 @@
 //!
 //! The test is the active flux. In the stationary frame, with the machine's R̂s and L̂q,
 //!
-//! ψa[k] = Ts·Σ (v − R̂s·i) − L̂q·i[k] = c + (λf + (L̂d − L̂q)·i_d[k])·e^{jθ[k]}
+//! ψa\[k\] = Ts·Σ (v − R̂s·i) − L̂q·i\[k\] = c + (λf + (L̂d − L̂q)·i_d\[k\])·e^{jθ\[k\]}
 //!
 //! lies on a circle about an unknown centre c (the integral's start). The recording is cut
 //! into windows of one electrical turn each (the turn of v/(ω_rated·λf) + i/I_rated, which

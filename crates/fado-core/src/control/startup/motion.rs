@@ -196,7 +196,7 @@ impl<T: Real> MotionMonitor<T> {
         self.delta
     }
 
-    /// dΔλr/dt low-passed over [`RATE_FILTER_TIME`] (V): with the rotor's flux vector λr,
+    /// dΔλr/dt low-passed over 1 ms (`RATE_FILTER_TIME`) (V): with the rotor's flux vector λr,
     /// its electrical speed is (λr × dλr/dt)/|λr|².
     pub fn flux_rate(&self) -> Ab<T> {
         self.rate
