@@ -138,10 +138,6 @@ pub struct ActiveFluxPoint<T> {
     pub lq_secant: T,
     /// λa(î) = ψd − L_q,s·î_d, Wb.
     pub active: T,
-    /// The incremental inductance at î where the model's lookup gave it with the flux (a
-    /// map's C¹ interpolant), so that the laws reading it at this point do not look it up
-    /// again; None for any other model (looked up where needed).
-    pub inductance: Option<InductanceMatrix<T>>,
 }
 
 impl<T: Real> ActiveFlux<T> {
@@ -235,8 +231,7 @@ impl<T: Real, M: FluxLookup<T>> ActiveFlux<T, M> {
     /// replaced by L_qq(0).
     #[inline]
     pub fn point(&self, i_dq: Dq<T>) -> ActiveFluxPoint<T> {
-        let (psi, l) = self.model.flux_and_inductance_at(self.linear, i_dq);
-        self.point_at(i_dq, psi, l)
+        self.point_at(i_dq, self.flux(i_dq))
     }
 }
 
@@ -247,7 +242,7 @@ impl<T: Real> ActiveFlux<T> {
     #[inline]
     pub fn point_from(&self, i_dq: Dq<T>, psi_guess: Dq<T>) -> ActiveFluxPoint<T> {
         let psi = self.model.resolve(self.linear).flux_from(i_dq, psi_guess);
-        self.point_at(i_dq, psi, None)
+        self.point_at(i_dq, psi)
     }
 }
 
@@ -263,27 +258,18 @@ impl<T: Real, M: FluxLookup<T>> ActiveFlux<T, M> {
         psi_guess: Dq<T>,
         warm: &FluxWarmStart<T>,
     ) -> (ActiveFluxPoint<T>, FluxWarmStart<T>) {
-        let (psi, l, warm) =
-            self.model
-                .flux_and_inductance_warm(self.linear, i_dq, psi_guess, warm);
-        (self.point_at(i_dq, psi, l), warm)
+        let (psi, warm) = self.model.flux_warm(self.linear, i_dq, psi_guess, warm);
+        (self.point_at(i_dq, psi), warm)
     }
 
     #[inline]
-    fn point_at(
-        &self,
-        i_dq: Dq<T>,
-        psi: Dq<T>,
-        inductance: Option<InductanceMatrix<T>>,
-    ) -> ActiveFluxPoint<T> {
+    fn point_at(&self, i_dq: Dq<T>, psi: Dq<T>) -> ActiveFluxPoint<T> {
         // ψq(î_d, 0) removed (zero unless a map is not odd in i_q): λ̂r then lies within
         // atan(ψq(î_d, 0)/λa) of d, where ψq/i_q would grow without bound near i_q = 0.
         let secant = if i_dq.q.abs() > self.small_current {
             (psi.q - self.model.q_flux_offset(self.linear, i_dq.d)) / i_dq.q
         } else {
-            inductance
-                .unwrap_or_else(|| self.incremental_inductance(i_dq))
-                .qq
+            self.incremental_inductance(i_dq).qq
         };
         let lq_secant = if secant.is_finite() && secant > T::zero() {
             secant
@@ -294,7 +280,6 @@ impl<T: Real, M: FluxLookup<T>> ActiveFlux<T, M> {
             i_dq,
             lq_secant,
             active: psi.d - lq_secant * i_dq.d,
-            inductance,
         }
     }
 }
@@ -355,7 +340,7 @@ impl<T: Real, M: FluxLookup<T>> ActiveFlux<T, M> {
     #[inline]
     pub fn resistance_regressor(&self, point: &ActiveFluxPoint<T>) -> Option<T> {
         let i = point.i_dq;
-        let l = self.inductance_of(point);
+        let l = self.incremental_inductance(i);
         let lqs = point.lq_secant;
         let kappa = point.active + l.qd * i.q - (l.qq - lqs) * i.d;
         let floor = T::lit(KAPPA_MIN_RATIO) * point.active;
@@ -376,7 +361,7 @@ impl<T: Real, M: FluxLookup<T>> ActiveFlux<T, M> {
     #[inline]
     pub fn interpolation_spread(&self, point: &ActiveFluxPoint<T>) -> T {
         match self.model.bilinear_flux(point.i_dq) {
-            Some(psi) => (self.point_at(point.i_dq, psi, None).active - point.active).abs(),
+            Some(psi) => (self.point_at(point.i_dq, psi).active - point.active).abs(),
             None => T::zero(),
         }
     }
@@ -386,7 +371,7 @@ impl<T: Real, M: FluxLookup<T>> ActiveFlux<T, M> {
     #[inline]
     pub fn frame_coupling(&self, point: &ActiveFluxPoint<T>) -> (T, T) {
         let i = point.i_dq;
-        let l = self.inductance_of(point);
+        let l = self.incremental_inductance(i);
         let lqs = point.lq_secant;
         let s = (lqs - l.dd) * i.q + l.dq * i.d;
         let kappa = point.active + l.qd * i.q - (l.qq - lqs) * i.d;
@@ -406,14 +391,6 @@ impl<T: Real, M: FluxLookup<T>> ActiveFlux<T, M> {
     #[inline]
     pub fn observer_reference(&self, active_lp: T) -> T {
         crate::real::max(self.magnet_flux, active_lp * T::lit(SWING_REFERENCE_SHARE))
-    }
-
-    /// The incremental inductance at `point`: the one its lookup gave, or looked up.
-    #[inline]
-    fn inductance_of(&self, point: &ActiveFluxPoint<T>) -> InductanceMatrix<T> {
-        point
-            .inductance
-            .unwrap_or_else(|| self.incremental_inductance(point.i_dq))
     }
 
     /// The incremental L_dd at the operating point (the standstill law's inductive voltage).

@@ -36,31 +36,6 @@ pub trait FluxLookup<T: Real>: Copy {
         warm: &FluxWarmStart<T>,
     ) -> (Dq<T>, FluxWarmStart<T>);
 
-    /// ψ(i) and, where the lookup gives it with the flux at no further cost (a map's C¹
-    /// interpolant), the incremental inductance there.
-    #[inline(always)]
-    fn flux_and_inductance_at(
-        &self,
-        linear: ConstantInductance<T>,
-        i: Dq<T>,
-    ) -> (Dq<T>, Option<InductanceMatrix<T>>) {
-        (self.flux_at(linear, i), None)
-    }
-
-    /// [`FluxLookup::flux_warm`] with the incremental inductance where the lookup gives it
-    /// with the flux ([`FluxLookup::flux_and_inductance_at`]).
-    #[inline(always)]
-    fn flux_and_inductance_warm(
-        &self,
-        linear: ConstantInductance<T>,
-        i: Dq<T>,
-        fallback: Dq<T>,
-        warm: &FluxWarmStart<T>,
-    ) -> (Dq<T>, Option<InductanceMatrix<T>>, FluxWarmStart<T>) {
-        let (psi, warm) = self.flux_warm(linear, i, fallback, warm);
-        (psi, None, warm)
-    }
-
     /// ψq(i_d, 0) ([`MagneticModel::q_flux_offset`]).
     fn q_flux_offset(&self, linear: ConstantInductance<T>, i_d: T) -> T;
 
@@ -116,41 +91,6 @@ impl<T: Real> FluxLookup<T> for MachineMagnetics<T> {
         match *self {
             MachineMagnetics::Map(m) => (m.smooth_flux_and_jacobian(i).0, *warm),
             _ => MachineMagnetics::flux_warm(self, linear, i, fallback, warm),
-        }
-    }
-
-    #[inline]
-    fn flux_and_inductance_at(
-        &self,
-        linear: ConstantInductance<T>,
-        i: Dq<T>,
-    ) -> (Dq<T>, Option<InductanceMatrix<T>>) {
-        match *self {
-            MachineMagnetics::Map(m) => {
-                let (psi, l) = m.smooth_flux_and_jacobian(i);
-                (psi, Some(l))
-            }
-            _ => (self.resolve(linear).flux(i), None),
-        }
-    }
-
-    #[inline(always)]
-    fn flux_and_inductance_warm(
-        &self,
-        linear: ConstantInductance<T>,
-        i: Dq<T>,
-        fallback: Dq<T>,
-        warm: &FluxWarmStart<T>,
-    ) -> (Dq<T>, Option<InductanceMatrix<T>>, FluxWarmStart<T>) {
-        match *self {
-            MachineMagnetics::Map(m) => {
-                let (psi, l) = m.smooth_flux_and_jacobian(i);
-                (psi, Some(l), *warm)
-            }
-            _ => {
-                let (psi, warm) = MachineMagnetics::flux_warm(self, linear, i, fallback, warm);
-                (psi, None, warm)
-            }
         }
     }
 
