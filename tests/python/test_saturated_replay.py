@@ -52,7 +52,7 @@ def test_the_plant_holds_its_flux_balance_and_the_replay_holds_the_angle(replay_
 
 def test_a_half_map_in_i_q_is_refused_naming_the_symmetry(replay_script) -> None:
     sr = replay_script
-    case = next(c for c in sr.cases(True) if "half map" in c.name)
+    case = next(c for c in sr.cases(True) if "i_q <= 0 half map" in c.name)
     with pytest.raises(ValueError, match="the arrays' grid: the i_q axis does not reach both"):
         sr.fado_machine(fado, case)
 
