@@ -88,8 +88,6 @@ pub struct StartRamp<T> {
     step: T,
     /// Largest step from the rotor's speed at the start (electrical rad/s, at least `step`).
     jump: T,
-    /// The largest change at the next sample: `jump` at the start, then `step`.
-    limit: T,
     /// The ramp's reference (electrical rad/s).
     value: T,
     /// The user's reference of the previous sample (electrical rad/s): the ramp closes its
@@ -120,7 +118,6 @@ impl<T: Real> StartRamp<T> {
         Ok(Self {
             step,
             jump: if jump.is_finite() { jump } else { step },
-            limit: step,
             value: T::zero(),
             last_reference: None,
             active: false,
@@ -131,7 +128,6 @@ impl<T: Real> StartRamp<T> {
     pub fn arm(&mut self, speed: T) {
         self.active = self.step > T::zero() && speed.is_finite();
         self.value = speed;
-        self.limit = self.jump;
         self.last_reference = None;
     }
 
@@ -152,15 +148,21 @@ impl<T: Real> StartRamp<T> {
         if !self.active {
             return reference;
         }
-        // The gap closes at `limit` beyond the reference's own change since the last sample,
-        // so a reference that moves on (a user's ramp) is caught up with, never chased.
-        let moved = self.last_reference.map(|last| (reference - last).abs());
+        // The first sample after `arm` may step by `jump`; later ones close the gap at `step`
+        // beyond the reference's own change since the last sample, so a reference that moves
+        // on (a user's ramp) is caught up with, never chased.
+        let limit = match self.last_reference {
+            None => self.jump,
+            Some(last) => {
+                let moved = (reference - last).abs();
+                if moved.is_finite() {
+                    self.step + moved
+                } else {
+                    self.step
+                }
+            }
+        };
         self.last_reference = Some(reference);
-        let mut limit = self.limit;
-        if let Some(moved) = moved.filter(|m| m.is_finite()) {
-            limit += moved;
-        }
-        self.limit = self.step;
         let gap = reference - self.value;
         // NaN compares false: the reference passes.
         let beyond = gap.abs() > limit;

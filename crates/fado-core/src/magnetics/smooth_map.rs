@@ -176,9 +176,11 @@ impl<T: Real> FluxMap<'_, T> {
     /// remains (one Hermite cell instead of five); elsewhere the full surface.
     pub fn smooth_q_flux_offset(&self, i_d: T) -> T {
         let i_q = self.i_q();
-        let Some(m0) = i_q.iter().position(|&x| x == T::zero()) else {
+        // The axis ascends: the first node not below zero, if it is zero.
+        let m0 = i_q.partition_point(|&x| x < T::zero());
+        if i_q.get(m0).is_none_or(|&x| x != T::zero()) {
             return self.smooth_flux_and_jacobian(Dq::new(i_d, T::zero())).0.q;
-        };
+        }
         let axis = self.i_d();
         let (kd, u) = stencil(axis, i_d);
         let node = |table: &[T], j: usize| table.get(j).copied().unwrap_or(T::zero());
