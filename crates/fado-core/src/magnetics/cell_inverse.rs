@@ -96,10 +96,13 @@ impl<T: Real> CellPolynomial<T> {
         (psi, jac)
     }
 
-    /// u for the root v: from the d row, whose coefficient of u is positive in the cell.
+    /// The fractions (u, v) at the root v = `num`/`den`: u from the d row, whose coefficient
+    /// of u is positive in the cell, (h_d − ey_d·v)/(ex_d + twist_d·v) with both terms
+    /// multiplied by `den`, so that u's division does not wait for v's.
     #[inline]
-    fn u_of(&self, h: Dq<T>, v: T) -> T {
-        (h.d - self.ey.d * v) / (self.ex.d + self.twist.d * v)
+    fn root_at(&self, h: Dq<T>, num: T, den: T) -> (T, T) {
+        let u = (h.d * den - self.ey.d * num) / (self.ex.d * den + self.twist.d * num);
+        (u, num / den)
     }
 
     /// The quadratic's coefficients that do not depend on ψ: (k2, ex × ey).
@@ -127,14 +130,16 @@ impl<T: Real> CellPolynomial<T> {
             } else {
                 k1 - root
             };
-        let near = k0 / q;
-        let v1 = if near.is_finite() { near } else { q / k2 };
-        let first = (self.u_of(h, v1), v1);
+        let near = self.root_at(h, k0, q);
+        let first = if near.1.is_finite() {
+            near
+        } else {
+            self.root_at(h, q, k2)
+        };
         if k2 == T::zero() || outside(first) == T::zero() {
             return first.0.is_finite().then_some(first);
         }
-        let v2 = q / k2;
-        let second = (self.u_of(h, v2), v2);
+        let second = self.root_at(h, q, k2);
         let better = if outside(second) < outside(first) {
             second
         } else {
@@ -192,7 +197,11 @@ pub(super) fn invert<T: Real>(grid: &impl CellGrid<T>, psi: Dq<T>, guess: Dq<T>)
         let cell = grid.polynomial(k, m);
         cell.root_or_direction(psi, cell.constants())
     })
+    .map(|(i, _)| i)
 }
+
+/// A solution's cell and its fractions there: (k, m, u, v).
+pub(super) type Solved<T> = (usize, usize, T, T);
 
 impl<T: Real> CellPolynomial<T> {
     /// The root (u, v) at `psi` as [`CellPolynomial::solve_with`], and the fractions the walk
@@ -218,7 +227,7 @@ pub(super) fn invert_from<T: Real>(
     grid: &impl CellGrid<T>,
     start: (usize, usize),
     mut solve_at: impl FnMut(usize, usize) -> (Option<(T, T)>, (T, T)),
-) -> Option<Dq<T>> {
+) -> Option<(Dq<T>, Solved<T>)> {
     let (last_k, last_m) = grid.last_cell();
     let (mut k, mut m) = start;
     let tol = cell_tolerance::<T>();
@@ -228,7 +237,7 @@ pub(super) fn invert_from<T: Real>(
         if dk == 0 && dm == 0 {
             let (u, v) = root?;
             let i = grid.current_at(k, m, u, v);
-            return i.is_finite().then_some(i);
+            return i.is_finite().then_some((i, (k, m, u, v)));
         }
         if walk == 0 && u.is_finite() && v.is_finite() {
             // From the warm start's cell, straight to the cell of this cell's extrapolated

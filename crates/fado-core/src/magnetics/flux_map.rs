@@ -33,6 +33,10 @@ pub struct FluxMap<'a, T> {
     axis_d: AxisScale<T>,
     /// The same for i_q.
     axis_q: AxisScale<T>,
+    /// The C¹ interpolant's node slopes along i_q, ∂ψd/∂i_q then ∂ψq/∂i_q at every node
+    /// (row-major, 2·n_d·n_q values; [`FluxMap::with_node_slopes`]), or empty: each lookup
+    /// then finds the slopes of its stencil's nodes from their neighbours.
+    q_slopes: &'a [T],
 }
 
 /// An axis' first node, its inverse mean node spacing and whether every cell has that spacing
@@ -209,7 +213,7 @@ const UNIFORM_TOLERANCE_EPS: f64 = 64.0;
 /// Indexing by `get` (a NaN where a shape check failed), so that the firmware's lookup holds
 /// no bounds-check panic.
 #[inline(always)]
-fn cell<T: Real>(axis: &[T], scale: &AxisScale<T>, x: T) -> (usize, T, T) {
+pub(super) fn cell<T: Real>(axis: &[T], scale: &AxisScale<T>, x: T) -> (usize, T, T) {
     let n = axis.len();
     let last = n.max(2) - 2;
     if scale.uniform {
@@ -302,6 +306,7 @@ impl<'a, T: Real> FluxMap<'a, T> {
             psi_q,
             axis_d: AxisScale::of(i_d),
             axis_q: AxisScale::of(i_q),
+            q_slopes: &[],
         })
     }
 
@@ -340,6 +345,29 @@ impl<'a, T: Real> FluxMap<'a, T> {
     /// ψq at the grid nodes in Wb, row-major.
     pub fn psi_q(&self) -> &'a [T] {
         self.psi_q
+    }
+
+    /// The node slopes the map carries ([`FluxMap::with_node_slopes`]; empty if none).
+    pub fn node_slopes(&self) -> &'a [T] {
+        self.q_slopes
+    }
+
+    /// This map with `slopes` as its node slopes (checked by the caller,
+    /// `FluxMap::with_node_slopes`).
+    pub(super) fn carrying_slopes(self, slopes: &'a [T]) -> Self {
+        Self {
+            q_slopes: slopes,
+            ..self
+        }
+    }
+
+    /// Whether `other` has the same nodes (axes and tables), whatever node slopes either
+    /// carries.
+    pub fn same_nodes(&self, other: &FluxMap<'_, T>) -> bool {
+        self.i_d == other.i_d
+            && self.i_q == other.i_q
+            && self.psi_d == other.psi_d
+            && self.psi_q == other.psi_q
     }
 
     /// The cell of `i` (fractions fx, fy along it, inverse widths gx, gy) and the four
@@ -547,6 +575,7 @@ impl<const ND: usize, const NQ: usize> FluxTable<f32, ND, NQ> {
             psi_q: self.psi_q.as_flattened(),
             axis_d,
             axis_q,
+            q_slopes: &[],
         }
     }
 }

@@ -70,12 +70,12 @@ impl<T: Real> FluxLookup<T> for MachineMagnetics<T> {
         }
     }
 
-    /// A [`MachineMagnetics::Map`]'s C¹ interpolant (`FluxMap::smooth_flux_and_jacobian`),
-    /// any other model's own ψ(i).
+    /// A [`MachineMagnetics::Map`]'s C¹ interpolant (`FluxMap::smooth_flux`), any other
+    /// model's own ψ(i).
     #[inline]
     fn flux_at(&self, linear: ConstantInductance<T>, i: Dq<T>) -> Dq<T> {
         match *self {
-            MachineMagnetics::Map(m) => m.smooth_flux_and_jacobian(i).0,
+            MachineMagnetics::Map(m) => m.smooth_flux(i),
             _ => self.resolve(linear).flux(i),
         }
     }
@@ -89,7 +89,7 @@ impl<T: Real> FluxLookup<T> for MachineMagnetics<T> {
         warm: &FluxWarmStart<T>,
     ) -> (Dq<T>, FluxWarmStart<T>) {
         match *self {
-            MachineMagnetics::Map(m) => (m.smooth_flux_and_jacobian(i).0, *warm),
+            MachineMagnetics::Map(m) => (m.smooth_flux(i), *warm),
             _ => MachineMagnetics::flux_warm(self, linear, i, fallback, warm),
         }
     }

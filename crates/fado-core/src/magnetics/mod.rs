@@ -66,7 +66,7 @@ mod warm_start;
 
 pub use constant::ConstantInductance;
 pub use flux_map::{FluxMap, FluxMapError, FluxTable};
-pub use inverse_cache::InverseCache;
+pub use inverse_cache::{InverseCache, REFINE_TOLERANCE};
 pub use lookup::FluxLookup;
 pub use machine::{MachineMagnetics, zero_current_constants};
 pub use saturation::Saturation;
@@ -310,6 +310,25 @@ impl<T: Real> Magnetics<'_, T> {
             Magnetics::Uniform(m) => cache.current_from(m, psi, guess),
             _ => self.current_from(psi, guess),
         }
+    }
+
+    /// [`Magnetics::current_from_cached`] at a flux a hair from the cache's last solution: a
+    /// map's by one Newton step in that solution's cell where that is the root to
+    /// [`REFINE_TOLERANCE`] of the cell (`InverseCache::refine`), else as
+    /// `current_from_cached`.
+    #[inline]
+    pub fn current_near_cached(
+        &self,
+        psi: Dq<T>,
+        guess: Dq<T>,
+        cache: &mut InverseCache<T>,
+    ) -> Dq<T> {
+        let near = match self {
+            Magnetics::Map(m) => cache.refine(m, psi),
+            Magnetics::Uniform(m) => cache.refine(m, psi),
+            _ => None,
+        };
+        near.unwrap_or_else(|| self.current_from_cached(psi, guess, cache))
     }
 }
 

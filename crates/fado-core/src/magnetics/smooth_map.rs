@@ -24,8 +24,19 @@
 //! exceeded axis (as the bilinear map extends its edge cells). The Jacobian is the
 //! interpolant's own derivative: the slopes' weights are linear in the node values once the
 //! limiter's branch is chosen, so the same weights give the derivative along the other axis.
+//!
+//! **Cost.** A lookup interpolates four rows along i_q, each through two nodes and their
+//! slopes, then once along i_d through the rows. The rows' node slopes depend on the map
+//! alone: a host program finds them once per map ([`FluxMap::fill_node_slopes`],
+//! [`FluxMap::with_node_slopes`]; `fado-sim` does for every map it reads) and a lookup loads
+//! them, the same numbers a lookup without them finds from the nodes' neighbours (tested bit
+//! for bit). The slopes along i_d are those of the rows' values at the point's i_q, found per
+//! lookup. The cells are found as the bilinear lookup finds them (O(1) on a uniform axis),
+//! and [`FluxMap::smooth_flux`] leaves out the Jacobian where a caller needs the flux alone
+//! (the estimator's operating point).
 
-use super::{FluxMap, InductanceMatrix};
+use super::flux_map::{AxisScale, cell};
+use super::{FluxMap, FluxMapError, InductanceMatrix};
 use crate::real::{max, min};
 use crate::{Dq, Real};
 
@@ -46,10 +57,16 @@ struct Cell<T> {
 }
 
 impl<T: Real> Cell<T> {
-    fn new(x: [T; 4], t: T) -> Self {
+    /// The cell with the nodes `x` (the neighbours repeated at an edge) on an axis of
+    /// `scale`, at the fraction `t`: a uniform axis' widths have the precomputed inverse.
+    fn new(x: [T; 4], t: T, scale: &AxisScale<T>) -> Self {
         let zero = T::zero();
         let h = [x[1] - x[0], x[2] - x[1], x[3] - x[2]];
-        let inv = h.map(|w| if w > zero { T::one() / w } else { zero });
+        let inv = if scale.uniform {
+            h.map(|w| if w > zero { scale.inv_step } else { zero })
+        } else {
+            h.map(|w| if w > zero { T::one() / w } else { zero })
+        };
         let one = T::one();
         let (two, three, six) = (T::lit(2.0), T::lit(3.0), T::lit(6.0));
         let (t2, t3) = (t * t, t * t * t);
@@ -105,68 +122,199 @@ impl<T: Real> Cell<T> {
         [-sl * il, sl * il - sr * ir, sr * ir]
     }
 
-    /// The cubic Hermite interpolant on this cell of the values `p` at the four nodes:
-    /// weights on the four values for the value and for its derivative along the axis.
-    fn weights(&self, p: [T; 4]) -> ([T; 4], [T; 4]) {
+    /// The slopes at this cell's two nodes of the values `p` at the four nodes.
+    #[inline]
+    fn node_slopes(&self, p: [T; 4]) -> [T; 2] {
         let s1 = self.slope_weights([p[0], p[1], p[2]], 0, 1);
         let s2 = self.slope_weights([p[1], p[2], p[3]], 1, 2);
+        [dot3(s1, [p[0], p[1], p[2]]), dot3(s2, [p[1], p[2], p[3]])]
+    }
+
+    /// The cubic Hermite interpolant on this cell through the values `p` at its two nodes
+    /// with the slopes `s` there: (value, derivative along the axis).
+    #[inline(always)]
+    fn hermite(&self, p: [T; 2], s: [T; 2]) -> (T, T) {
         let (v, d) = (&self.value, &self.slope);
-        let mut value = [T::zero(), v[0], v[2], T::zero()];
-        let mut slope = [T::zero(), d[0], d[2], T::zero()];
-        for n in 0..3 {
-            value[n] += v[1] * s1[n];
-            value[n + 1] += v[3] * s2[n];
-            slope[n] += d[1] * s1[n];
-            slope[n + 1] += d[3] * s2[n];
-        }
-        (value, slope)
+        (
+            v[0] * p[0] + v[1] * s[0] + v[2] * p[1] + v[3] * s[1],
+            d[0] * p[0] + d[1] * s[0] + d[2] * p[1] + d[3] * s[1],
+        )
     }
 }
 
-/// The cell of `x` on `axis` (two nodes or more), the fraction along it clamped to [0, 1],
-/// and the four node indices around it (repeated at an edge).
-fn stencil<T: Real>(axis: &[T], x: T) -> ([usize; 4], T) {
+/// The cell of `x` on `axis` (two nodes or more; found as the bilinear lookup finds it, in
+/// O(1) on a uniform axis), the fraction along it clamped to [0, 1], the four node indices
+/// around it (repeated at an edge) and their positions.
+#[inline(always)]
+fn stencil<T: Real>(axis: &[T], scale: &AxisScale<T>, x: T) -> ([usize; 4], [T; 4], T) {
     let n = axis.len();
-    let last = n.max(2) - 2;
-    let k = axis.partition_point(|&a| a <= x).clamp(1, last + 1) - 1;
-    let at = |j: usize| axis.get(j).copied().unwrap_or(T::zero());
-    let t = (x - at(k)) / (at(k + 1) - at(k));
+    let (k, t, _) = cell(axis, scale, x);
     let t = max(min(t, T::one()), T::zero());
-    ([k.saturating_sub(1), k, k + 1, (k + 2).min(n - 1)], t)
+    let kx = [k.saturating_sub(1), k, k + 1, (k + 2).min(n - 1)];
+    (kx, kx.map(|j| axis.get(j).copied().unwrap_or(T::zero())), t)
 }
 
-impl<T: Real> FluxMap<'_, T> {
+/// Whether `x` lies on `axis`'s grid (first node ≤ x ≤ last node; false for a NaN).
+fn on_axis<T: Real>(axis: &[T], x: T) -> bool {
+    match (axis.first(), axis.last()) {
+        (Some(&a), Some(&b)) => a <= x && x <= b,
+        _ => false,
+    }
+}
+
+/// The lookup's stencils: the i_d and i_q cells around a point, their node indices, and the
+/// clamped point (the point itself inside the grid).
+struct Stencil<T> {
+    kd: [usize; 4],
+    kq: [usize; 4],
+    cd: Cell<T>,
+    cq: Cell<T>,
+    clamped: Dq<T>,
+    /// The point lies on the grid (the clamped point is the point).
+    inside: bool,
+}
+
+impl<'a, T: Real> FluxMap<'a, T> {
+    /// This map carrying its C¹ interpolant's node slopes along i_q (`slopes`, filled by
+    /// [`FluxMap::fill_node_slopes`]): a lookup then loads its stencil's slopes instead of
+    /// finding them from their neighbours, the same interpolant with a third of its
+    /// arithmetic. For a host program that keeps a map for many lookups. Refused with
+    /// [`FluxMapError::Ragged`] unless `slopes` are this map's own (2·n_d·n_q values, each
+    /// the slope a lookup would find).
+    pub fn with_node_slopes(self, slopes: &'a [T]) -> Result<Self, FluxMapError> {
+        let n = self.psi_d().len();
+        let own = slopes.len() == 2 * n
+            && (0..2 * n).all(|at| slopes[at] == self.q_node_slope(at / n, at % n));
+        if !own {
+            return Err(FluxMapError::Ragged {
+                table: "node slopes",
+            });
+        }
+        Ok(self.carrying_slopes(slopes))
+    }
+
+    /// Writes the C¹ interpolant's node slopes along i_q into `out` (2·n_d·n_q values:
+    /// ∂ψd/∂i_q then ∂ψq/∂i_q, row-major); false, `out` untouched, if its length differs.
+    pub fn fill_node_slopes(&self, out: &mut [T]) -> bool {
+        let n = self.psi_d().len();
+        if out.len() != 2 * n {
+            return false;
+        }
+        for (at, slot) in out.iter_mut().enumerate() {
+            *slot = self.q_node_slope(at / n, at % n);
+        }
+        true
+    }
+
+    /// The slope along i_q at node `at` (row-major) of ψd (`table` 0) or ψq (1): what a
+    /// lookup's stencil finds there.
+    fn q_node_slope(&self, table: usize, at: usize) -> T {
+        let (axis, nq) = (self.i_q(), self.i_q().len());
+        let values = if table == 0 {
+            self.psi_d()
+        } else {
+            self.psi_q()
+        };
+        let (k, m) = (at / nq, at % nq);
+        let node = |t: &[T], j: usize| t.get(j).copied().unwrap_or(T::zero());
+        // The stencil of the cell starting at this node (the last node: the cell ending there).
+        let (first, col) = if m + 1 < nq { (m, 0) } else { (m - 1, 1) };
+        let kq = [
+            first.saturating_sub(1),
+            first,
+            first + 1,
+            (first + 2).min(nq - 1),
+        ];
+        let (_, scale) = self.axis_scales();
+        let cell = Cell::new(kq.map(|j| node(axis, j)), T::zero(), &scale);
+        let slopes = cell.node_slopes(kq.map(|j| node(values, k * nq + j)));
+        slopes[col]
+    }
+
+    #[inline(always)]
+    fn stencil(&self, i: Dq<T>) -> Stencil<T> {
+        let (i_d, i_q) = (self.i_d(), self.i_q());
+        let (scale_d, scale_q) = self.axis_scales();
+        let (kd, xd, u) = stencil(i_d, &scale_d, i.d);
+        let (kq, xq, v) = stencil(i_q, &scale_q, i.q);
+        // Inside the grid the clamped point is i itself; beyond it the edge extends linearly.
+        let clamped = Dq::new(xd[1] + u * (xd[2] - xd[1]), xq[1] + v * (xq[2] - xq[1]));
+        Stencil {
+            kd,
+            kq,
+            cd: Cell::new(xd, u, &scale_d),
+            cq: Cell::new(xq, v, &scale_q),
+            clamped,
+            inside: on_axis(i_d, i.d) && on_axis(i_q, i.q),
+        }
+    }
+
+    /// One table's surface at the stencil's point: (value, ∂/∂i_d, ∂/∂i_q), the derivatives
+    /// zero unless `JACOBIAN`. `table` 0 is ψd, 1 ψq.
+    #[inline(always)]
+    fn surface<const JACOBIAN: bool>(&self, s: &Stencil<T>, table: usize) -> (T, T, T) {
+        let values = if table == 0 {
+            self.psi_d()
+        } else {
+            self.psi_q()
+        };
+        let nq = self.i_q().len();
+        let n = values.len();
+        let node = |t: &[T], j: usize| t.get(j).copied().unwrap_or(T::zero());
+        // Along i_q in the four rows, then along i_d through their values and slopes.
+        let mut rows = [T::zero(); 4];
+        let mut rows_q = [T::zero(); 4];
+        for (r, &k) in s.kd.iter().enumerate() {
+            let at = [k * nq + s.kq[1], k * nq + s.kq[2]];
+            let p = at.map(|j| node(values, j));
+            let slopes = if self.node_slopes().is_empty() {
+                s.cq.node_slopes(s.kq.map(|m| node(values, k * nq + m)))
+            } else {
+                at.map(|j| node(self.node_slopes(), table * n + j))
+            };
+            let (value, along_q) = s.cq.hermite(p, slopes);
+            rows[r] = value;
+            rows_q[r] = along_q;
+        }
+        let (cd, r) = (&s.cd, rows);
+        let w1 = cd.slope_weights([r[0], r[1], r[2]], 0, 1);
+        let w2 = cd.slope_weights([r[1], r[2], r[3]], 1, 2);
+        let slopes = [dot3(w1, [r[0], r[1], r[2]]), dot3(w2, [r[1], r[2], r[3]])];
+        let (value, along_d) = cd.hermite([r[1], r[2]], slopes);
+        if !JACOBIAN {
+            return (value, T::zero(), T::zero());
+        }
+        // The i_d slopes' weights are linear in the rows once the limiter's branch is
+        // chosen: the same weights on the rows' i_q derivatives.
+        let q = rows_q;
+        let slopes_q = [dot3(w1, [q[0], q[1], q[2]]), dot3(w2, [q[1], q[2], q[3]])];
+        let (along_q, _) = cd.hermite([q[1], q[2]], slopes_q);
+        (value, along_d, along_q)
+    }
+
     /// ψ(i) and ∂ψ/∂i of the map's C¹ interpolant (module docs): the same nodes as
     /// [`FluxMap::flux_and_jacobian`]'s bilinear one, a smooth surface between them.
     pub fn smooth_flux_and_jacobian(&self, i: Dq<T>) -> (Dq<T>, InductanceMatrix<T>) {
-        let (i_d, i_q) = (self.i_d(), self.i_q());
-        let (kd, u) = stencil(i_d, i.d);
-        let (kq, v) = stencil(i_q, i.q);
-        let node = |axis: &[T], j: usize| axis.get(j).copied().unwrap_or(T::zero());
-        let xd = kd.map(|j| node(i_d, j));
-        let xq = kq.map(|j| node(i_q, j));
-        // Inside the grid the clamped point is i itself; beyond it the edge extends linearly.
-        let clamped = Dq::new(xd[1] + u * (xd[2] - xd[1]), xq[1] + v * (xq[2] - xq[1]));
-        let nq = i_q.len();
-        let (cd, cq) = (Cell::new(xd, u), Cell::new(xq, v));
-        let surface = |table: &[T]| {
-            // Along i_q in the four rows, then along i_d through their values and slopes.
-            let mut rows = [T::zero(); 4];
-            let mut rows_q = [T::zero(); 4];
-            for (r, &k) in kd.iter().enumerate() {
-                let p = kq.map(|m| node(table, k * nq + m));
-                let (w, wq) = cq.weights(p);
-                rows[r] = dot(w, p);
-                rows_q[r] = dot(wq, p);
-            }
-            let (w, wd) = cd.weights(rows);
-            (dot(w, rows), dot(wd, rows), dot(w, rows_q))
-        };
-        let (d, dd, dq) = surface(self.psi_d());
-        let (q, qd, qq) = surface(self.psi_q());
+        let s = self.stencil(i);
+        let (d, dd, dq) = self.surface::<true>(&s, 0);
+        let (q, qd, qq) = self.surface::<true>(&s, 1);
         let l = InductanceMatrix { dd, dq, qd, qq };
-        let beyond = i - clamped;
-        (Dq::new(d, q) + l.apply(beyond), l)
+        if s.inside {
+            return (Dq::new(d, q), l);
+        }
+        (Dq::new(d, q) + l.apply(i - s.clamped), l)
+    }
+
+    /// ψ(i) of the map's C¹ interpolant alone: [`FluxMap::smooth_flux_and_jacobian`]'s flux,
+    /// bit for bit, without the Jacobian inside the grid (beyond it the extension needs it).
+    pub fn smooth_flux(&self, i: Dq<T>) -> Dq<T> {
+        let s = self.stencil(i);
+        if !s.inside {
+            return self.smooth_flux_and_jacobian(i).0;
+        }
+        let (d, _, _) = self.surface::<false>(&s, 0);
+        let (q, _, _) = self.surface::<false>(&s, 1);
+        Dq::new(d, q)
     }
 }
 
@@ -179,24 +327,23 @@ impl<T: Real> FluxMap<'_, T> {
         // The axis ascends: the first node not below zero, if it is zero.
         let m0 = i_q.partition_point(|&x| x < T::zero());
         if i_q.get(m0).is_none_or(|&x| x != T::zero()) {
-            return self.smooth_flux_and_jacobian(Dq::new(i_d, T::zero())).0.q;
+            return self.smooth_flux(Dq::new(i_d, T::zero())).q;
         }
-        let axis = self.i_d();
-        let (kd, u) = stencil(axis, i_d);
+        let (scale, _) = self.axis_scales();
+        let (kd, xd, u) = stencil(self.i_d(), &scale, i_d);
         let node = |table: &[T], j: usize| table.get(j).copied().unwrap_or(T::zero());
-        let xd = kd.map(|j| node(axis, j));
         let nq = i_q.len();
         let column = kd.map(|k| node(self.psi_q(), k * nq + m0));
-        let cell = Cell::new(xd, u);
-        let (w, wd) = cell.weights(column);
+        let cell = Cell::new(xd, u, &scale);
+        let (value, slope) = cell.hermite([column[1], column[2]], cell.node_slopes(column));
         // Beyond the grid the edge extends linearly along i_d.
         let beyond = i_d - (xd[1] + u * (xd[2] - xd[1]));
-        dot(w, column) + dot(wd, column) * beyond
+        value + slope * beyond
     }
 }
 
-fn dot<T: Real>(w: [T; 4], p: [T; 4]) -> T {
-    w[0] * p[0] + w[1] * p[1] + w[2] * p[2] + w[3] * p[3]
+fn dot3<T: Real>(w: [T; 3], p: [T; 3]) -> T {
+    w[0] * p[0] + w[1] * p[1] + w[2] * p[2]
 }
 
 #[cfg(test)]

@@ -556,6 +556,33 @@ fn the_cached_inverse_is_the_inverse_bit_for_bit() {
     check(&Magnetics::Uniform(uniform_table.map()));
 }
 
+/// Near the cache's last solution (a Runge–Kutta step's end beside its last stage) the
+/// refined inverse is the inverse to 10⁻⁹ of a cell; far from it, the cached inverse itself.
+#[test]
+fn the_refined_inverse_is_the_inverse_near_the_last_solution() {
+    let uniform: [f64; 13] = core::array::from_fn(|k| -30.0 + 5.0 * k as f64);
+    let table = FluxTable::from_model(&pmsyrm(), uniform, uniform);
+    let model = Magnetics::Map(table.map().unwrap());
+    let mut cache = InverseCache::new();
+    let mut guess = Dq::zero();
+    for k in 0..300 {
+        let t = k as f64 * 0.021;
+        let psi = model.flux(Dq::new(14.0 * t.cos(), 14.0 * t.sin()));
+        let last = model.current_from_cached(psi, guess, &mut cache);
+        let near = psi + Dq::new(1e-7, -1e-7);
+        let refined = model.current_near_cached(near, guess, &mut cache);
+        let exact = model.current_from(near, guess);
+        assert!(
+            (refined - exact).norm() < 1e-8,
+            "step {k}: {refined:?} {exact:?}"
+        );
+        let far = psi + Dq::new(0.02, -0.02);
+        let refused = model.current_near_cached(far, guess, &mut cache);
+        assert_eq!(refused, model.current_from(far, guess), "step {k}");
+        guess = last;
+    }
+}
+
 /// The uniform table is the flux map of the same table: values and Jacobians to rounding
 /// inside and beyond the grid, its inverse; the compiler's build is the run-time one; a
 /// non-uniform axis is refused.

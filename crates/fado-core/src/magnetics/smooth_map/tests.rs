@@ -185,3 +185,29 @@ fn its_q_flux_offset_is_the_surface_at_zero_q_current() {
         assert!((full - offset).abs() < 1e-12, "{i_d}: {full} vs {offset}");
     }
 }
+
+/// The node slopes a map carries are the ones a lookup finds: the same interpolant bit for
+/// bit, inside and beyond the grid; the flux alone is the full lookup's flux bit for bit;
+/// slopes that are not the map's own are refused.
+#[test]
+fn carried_node_slopes_give_the_same_interpolant() {
+    let t = syrm_table();
+    let map = t.map().unwrap();
+    let mut slopes = std::vec![0.0; 2 * map.psi_d().len()];
+    assert!(map.fill_node_slopes(&mut slopes));
+    assert!(!map.fill_node_slopes(&mut slopes[1..]));
+    let carrying = map.with_node_slopes(&slopes).unwrap();
+    for a in 0..=40 {
+        for b in 0..=40 {
+            let i = Dq::new(-50.0 + 1.9 * a as f64, -50.0 + 2.5 * b as f64);
+            let full = map.smooth_flux_and_jacobian(i);
+            assert_eq!(carrying.smooth_flux_and_jacobian(i), full, "{i:?}");
+            assert_eq!(carrying.smooth_flux(i), full.0, "{i:?}");
+            assert_eq!(map.smooth_flux(i), full.0, "{i:?}");
+        }
+    }
+    let mut wrong = slopes.clone();
+    wrong[5] += 1e-3;
+    assert!(map.with_node_slopes(&wrong).is_err());
+    assert!(map.with_node_slopes(&slopes[1..]).is_err());
+}

@@ -108,7 +108,7 @@ fn load(
                 )
                 .into());
             }
-            warn_plausibility(&cfg, Some(path));
+            warn_plausibility(&cfg, Some(path), Some(&text));
             Ok((text, cfg))
         }
         (None, Some(name)) => {
