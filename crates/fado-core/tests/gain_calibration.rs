@@ -1,7 +1,8 @@
 //! The drive's start-up current-sensor gain calibration through `SensorlessDrive::step`, on a
 //! standstill machine (the rotor held: no swing) fed by the drive's own duties: the paper's
-//! SPMSM and the 2.2 kW IPMSM. The inverter is ideal but the drive still adds its dead-time
-//! compensation, a constant voltage per sign pattern that the two-level difference cancels.
+//! SPMSM and the 2.2 kW IPMSM. The inverter is ideal and the drive is told so (no dead time,
+//! no threshold): its rotor-motion test reads the voltage that acted with the inverter's part
+//! from its dead-time model, which must describe the inverter it drives.
 
 mod common;
 
@@ -11,7 +12,9 @@ use fado_core::{Ab, Abc, EstimatorTuning, MachineModel};
 /// Start-up of a drive on `machine` held at `theta0`, phase a read (1 + g) high; returns the
 /// drive after its calibrations, the largest true phase current and the samples taken.
 fn start_up(machine: MachineModel<f64>, theta0: f64, g: f64) -> (SensorlessDrive<f64>, f64, u32) {
-    let config = DriveConfig::for_machine(&machine);
+    let mut config = DriveConfig::for_machine(&machine);
+    config.tuning.inverter.dead_time = 0.0;
+    config.tuning.inverter.threshold_voltage = 0.0;
     let ts = config.ts;
     let vdc = machine.dc_voltage;
     let mut drive = SensorlessDrive::new(config, EstimatorTuning::default()).unwrap();
