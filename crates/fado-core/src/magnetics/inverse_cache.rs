@@ -83,6 +83,9 @@ impl<T: Real> InverseCache<T> {
             self.start = grid.cell_of(guess);
             self.guess = guess;
         }
+        if let Some(found) = self.in_start_cell(grid, psi) {
+            return Some(found);
+        }
         let (slots, next) = (&mut self.slots, &mut self.next);
         let solved = invert_from(grid, self.start, |k, m| {
             let at = match slots
@@ -113,6 +116,30 @@ impl<T: Real> InverseCache<T> {
             Some((at, u, v))
         });
         solved.map(|(i, _)| i)
+    }
+
+    /// The walk's first cell alone, where the start cell is kept and holds the root (the walk
+    /// then ends there, with this arithmetic): no slot search, no walk.
+    #[inline(always)]
+    fn in_start_cell(&mut self, grid: &impl CellGrid<T>, psi: Dq<T>) -> Option<Dq<T>> {
+        let (k, m) = self.start;
+        let at = self.last.map_or(0, |(at, _, _)| at);
+        let (a, b, cell, constants) = self.slots.get(at).copied().flatten()?;
+        if (a, b) != (k, m) {
+            return None;
+        }
+        let (u, v) = cell.solve_with(psi, constants)?;
+        let (last_k, last_m) = grid.last_cell();
+        let tol = cell_tolerance::<T>();
+        if direction(u, k, last_k, tol) != 0 || direction(v, m, last_m, tol) != 0 {
+            return None;
+        }
+        let i = grid.current_at(k, m, u, v);
+        if !i.is_finite() {
+            return None;
+        }
+        self.last = Some((at, u, v));
+        Some(i)
     }
 
     /// i(ψ) by one Newton step on the polynomial of the last solution's cell from that
