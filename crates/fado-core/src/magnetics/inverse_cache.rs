@@ -168,8 +168,8 @@ impl<T: Real> InverseCache<T> {
     }
 }
 
-/// The largest error of [`InverseCache::refine`]'s Newton step as a fraction of its cell
-/// (10⁻⁹ A on a 1 A cell), ours: orders of magnitude below a plant integrator's own error
-/// (10⁻⁵ A, `fado-sim`'s magnetics tests), at a step a Runge–Kutta step's end moves from its
-/// last stage (10⁻⁵ of a cell: 10⁻¹¹ of it).
+/// The largest error of [`super::Magnetics::current_near_cached`]'s Newton step as a fraction
+/// of its cell (10⁻⁹ A on a 1 A cell), ours: orders of magnitude below a plant integrator's
+/// own error (10⁻⁵ A, `fado-sim`'s magnetics tests), at a step a Runge–Kutta step's end moves
+/// from its last stage (10⁻⁵ of a cell: 10⁻¹¹ of it).
 pub const REFINE_TOLERANCE: f64 = 1e-9;
