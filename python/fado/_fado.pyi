@@ -126,7 +126,7 @@ class Machine:
     ) -> Machine: ...
     @staticmethod
     def from_datasheet(**fields: Any) -> Machine:
-        """A machine from its datasheet's values: any field, or ``rs_line_to_line``, ``l_line_to_line``, ``ke_vll_rms_per_krpm``, ``ke_vll_peak_per_krpm``, ``kt_nm_per_arms``, ``rated_current_arms`` in their place."""
+        """A machine from its datasheet's values: any field, or ``rs_line_to_line``, ``l_line_to_line``, ``ke_vll_rms_per_krpm``, ``ke_vll_peak_per_krpm``, ``kt_nm_per_arms``, ``rated_current_arms``, ``kv_rpm_per_volt``, ``inertia_kg_cm2`` in their place."""
     @staticmethod
     def paper() -> Machine:
         """The paper's motor."""

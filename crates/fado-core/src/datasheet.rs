@@ -16,6 +16,13 @@
 //! | `ke_vll_peak_per_krpm` | V peak per 1000 r/min | `flux_linkage` | Ke/√3 / (p·1000·2π/60) |
 //! | `kt_nm_per_arms` | N·m per A rms | `flux_linkage` | Kt/(1.5·√2·p) (the magnet torque per ampere) |
 //! | `rated_current_arms` | A rms | `rated_current` | √2·I |
+//! | `kv_rpm_per_volt` | r/min per V (peak line-to-line) | `flux_linkage` | 60/(2π·√3·p·Kv) = 5.513/(p·Kv) |
+//! | `inertia_kg_cm2` | kg·cm² | `inertia` | J·10⁻⁴ |
+//!
+//! Kv (hobby and robotics motors) is the no-load speed per volt of the supply, which a
+//! sinusoidally driven motor reaches when its peak line-to-line back-EMF equals it: a
+//! 100 r/min/V, 7-pole-pair outrunner has λf = 7.88 mWb (`examples/motors/my-outrunner.toml`).
+//! Servo datasheets give the rotor inertia in kg·cm² (10⁻⁴ kg·m²).
 
 use crate::Real;
 
@@ -35,7 +42,7 @@ pub struct Alternative {
 }
 
 /// Every alternative key.
-pub const ALTERNATIVES: [Alternative; 6] = [
+pub const ALTERNATIVES: [Alternative; 8] = [
     Alternative {
         key: "rs_line_to_line",
         targets: &["rs"],
@@ -78,6 +85,20 @@ pub const ALTERNATIVES: [Alternative; 6] = [
         rule: "from rated_current_arms (A rms): rated_current = √2·I_rms",
         needs_pole_pairs: false,
     },
+    Alternative {
+        key: "kv_rpm_per_volt",
+        targets: &["flux_linkage"],
+        unit: "r/min per V, peak line-to-line back-EMF",
+        rule: "from kv_rpm_per_volt (r/min per V, peak line-to-line): λf = 60/(2π·√3·p·Kv)",
+        needs_pole_pairs: true,
+    },
+    Alternative {
+        key: "inertia_kg_cm2",
+        targets: &["inertia"],
+        unit: "kg·cm²",
+        rule: "from inertia_kg_cm2 (kg·cm²): inertia = J·1e-4",
+        needs_pole_pairs: false,
+    },
 ];
 
 /// The alternative called `key`, if it is one.
@@ -96,6 +117,8 @@ pub fn convert(alt: &Alternative, value: f64, pole_pairs: f64) -> f64 {
         "ke_vll_rms_per_krpm" => per_krpm(value * sqrt2 / sqrt3),
         "ke_vll_peak_per_krpm" => per_krpm(value / sqrt3),
         "kt_nm_per_arms" => value / (1.5 * sqrt2 * pole_pairs),
+        "kv_rpm_per_volt" => 30.0 / (core::f64::consts::PI * sqrt3 * pole_pairs * value),
+        "inertia_kg_cm2" => value * 1e-4,
         _ => value * sqrt2,
     }
 }
@@ -141,6 +164,14 @@ mod tests {
             convert(alternative("rs_line_to_line").unwrap(), 0.641, 1.0),
             0.3205
         );
+        // Kv 100 r/min/V on 7 pole pairs: 5.513/(7·100) = 7.88 mWb, and Kv is Ke peak
+        // line-to-line per 1000 r/min inverted (1000/Kv V per 1000 r/min).
+        let kv = convert(alternative("kv_rpm_per_volt").unwrap(), 100.0, 7.0);
+        assert!((kv - 7.876e-3).abs() < 1e-6, "{kv}");
+        let ke = convert(alternative("ke_vll_peak_per_krpm").unwrap(), 10.0, 7.0);
+        assert!((kv / ke - 1.0).abs() < 1e-12, "{kv} {ke}");
+        let j = convert(alternative("inertia_kg_cm2").unwrap(), 2.5, 1.0);
+        assert!((j - 2.5e-4).abs() < 1e-18, "{j}");
     }
 
     #[test]

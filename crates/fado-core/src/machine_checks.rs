@@ -11,7 +11,7 @@
 //! | check | quantity | warning | error |
 //! |---|---|---|---|
 //! | range | each field | — | beyond any motor ([`RANGES`]) |
-//! | torque | T_rated / 1.5·p·λf·I (error), / MTPA torque (warning) | outside 0.6–1.3 (rms for peak: 1.41; λf line-to-line: 0.58) | outside 0.3–3; 0.4–0.55 of the MTPA torque with even p: a pole count |
+//! | torque | T_rated / 1.5·p·λf·I (error), / MTPA torque (warning) | outside 0.6–1.3 (rms for peak: 1.41; λf line-to-line: 0.58; inside it, a slip whose undoing brings it within 0.9–1.1) | outside 0.3–3; 0.4–0.55 of the MTPA torque with even p: a pole count |
 //! | DC link range | Vdc | — | beyond any drive (checked after the machine's own fields) |
 //! | back-EMF | ω·λf / (Vdc/√3) | — | above 2 |
 //! | DC link | \|v_rated\| / (Vdc/√3) | below 0.2 | below 0.1 (ratings / 10?) |
@@ -30,9 +30,9 @@
 //! the model's torque closest to the rating. On a salient rotor the reluctance torque makes
 //! the ratio move less than the slip's factor (λf given rms on the 2.2 kW IPMSM: 1.29, inside
 //! the wide band), so a ratio of 1.2–1.3 that the undone rms slip brings within 0.9–1.1 is
-//! reported too. Below 1 no such narrowing is possible: saturated machines, whose linear
-//! model overstates the torque, sit at 0.7–0.8, where a line-to-line λf on a rotor with
-//! Lq/Ld ≈ 3 lands as well (0.79); only the wide band's 0.6 catches it.
+//! reported too. Below 1 it names a line-to-line λf on a rotor with Lq/Ld ≈ 3 (0.79, undone 1.00)
+//! on a model with constant inductances ([`LINE_TO_LINE_BELOW`]); a saturated machine entered
+//! without its saturation (0.7–0.85) can land there too, and the warning says so.
 //!
 //! The rating-scale check ([`scale`]) catches ratings scaled together (current, speed and
 //! torque / 10 or × 10), which leave the torque, the resistance and a derived DC link
@@ -81,6 +81,10 @@ pub const RESISTANCE_ERROR: f64 = 2.0;
 /// zero-current model overstates the torque); a current or a flux linkage given rms where the
 /// peak value is meant gives √2 = 1.41.
 pub const TORQUE_WARNING_HIGH: f64 = 1.3;
+
+/// T_rated over the MTPA torque below which a model with constant inductances is searched for
+/// a line-to-line λf (a warning where undoing it brings the ratio within 0.9–1.1): 0.9.
+pub const LINE_TO_LINE_BELOW: f64 = 0.9;
 
 pub use scale::{SCALE_HIGH, SCALE_LOW};
 
@@ -282,6 +286,14 @@ const TORQUE_KEYS_SALIENT: &[&str] = &[
     "ld",
     "lq",
 ];
+const TORQUE_KEYS_FLUX_FIRST: &[&str] = &[
+    "flux_linkage",
+    "rated_torque",
+    "rated_current",
+    "pole_pairs",
+    "ld",
+    "lq",
+];
 const EMF_KEYS: &[&str] = &[
     "flux_linkage",
     "rated_speed_rpm",
@@ -354,6 +366,11 @@ impl Finding {
                 _ => &["dc_voltage"],
             },
             Finding::PoleCount { .. } => &["pole_pairs", "rated_torque", "flux_linkage"],
+            Finding::Torque {
+                severity: Severity::Warning,
+                slip: TorqueSlip::LineToLine,
+                ..
+            } => TORQUE_KEYS_FLUX_FIRST,
             Finding::Torque {
                 severity: Severity::Error,
                 ..
@@ -692,10 +709,12 @@ fn check_torque(m: &MachineModel<f64>, out: &mut impl Sink) {
             severity: Severity::Warning,
             slip: likely_slip(m).0,
         });
-    } else if ratio > 1.2 {
-        // Inside the wide band, but the undone rms slip brings it within 0.9–1.1.
+    } else if ratio > 1.2 || (ratio < LINE_TO_LINE_BELOW && m.magnetics.is_linear()) {
+        // Inside the wide band, but undoing the rms or line-to-line slip brings it to 0.9–1.1.
         let slip = likely_slip(m).0;
-        if slip == TorqueSlip::Rms {
+        if (ratio > 1.2 && slip == TorqueSlip::Rms)
+            || (ratio < 1.0 && slip == TorqueSlip::LineToLine)
+        {
             out.push(Finding::Torque {
                 ratio,
                 severity: Severity::Warning,

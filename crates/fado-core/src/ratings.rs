@@ -11,7 +11,7 @@
 //! | `viscous_friction` | [`FRICTION_TORQUE_RATIO`] of the rated torque at rated speed |
 //! | `inertia` | rated torque accelerates it to rated speed in [`MECHANICAL_START_TIME`] |
 //! | `dc_voltage` | the rated point uses [`DC_LINK_MODULATION_RATIO`] of the linear range |
-//! | `switching_frequency` | ω_rated·Ts ≤ [`MAX_OMEGA_TS`] and min(Ld, Lq)/Rs ≥ 2·Ts, at least the DC link's class floor ([`min_switching_frequency`]) |
+//! | `switching_frequency` | ω_rated·Ts ≤ [`MAX_OMEGA_TS`], min(Ld, Lq)/Rs ≥ 2·Ts and the PWM current ripple ([`ripple_current`]) ≤ [`MAX_RIPPLE_CURRENT_RATIO`] of the rated current, at least the DC link's class floor ([`min_switching_frequency`]) |
 //! | `dead_time` | [`DEAD_TIME_PERIOD_RATIO`] of the carrier period |
 //! | `threshold_voltage` | [`THRESHOLD_VOLTAGE_RATIO`] of the DC link |
 //! | `current_band` | [`CURRENT_BAND_RATIO`] of the rated current |
@@ -29,6 +29,26 @@
 //! makes. 0.2 also keeps the observer's gains within their series range (|x| ≤ 0.25 in `f64`,
 //! 0.5 in `f32`, see [`crate::observer`]). The test `omega_ts_bound_keeps_the_discretisation_within_one_percent`
 //! checks these numbers.
+//!
+//! # The bound on the current ripple (why Vdc/(6·L·f_sw) and 0.6)
+//! The bound on ω_rated·Ts says nothing about the inductance: a slotless motor (maxon EC 22
+//! 40 W, 27.3 µH per phase on 24 V) meets it at 5 kHz, where its PWM current ripple is
+//! eight times its rated current. With the centred (min-max zero sequence) modulation of
+//! [`crate::control::modulation`] the phase voltage deviates from its period average by at
+//! most (2/3)·Vdc while an active vector lasts; the peak-to-peak ripple of a phase current
+//! grows with the modulation and, over the linear range (|v| ≤ Vdc/√3), is largest at its
+//! edge: ΔI_pp = Vdc/(6·L·f_sw) with L = min(Ld, Lq) ([`ripple_current`]; the test
+//! `ripple_bound_is_the_largest_ripple_of_the_centred_modulation` integrates the pattern).
+//! The half-bridge estimate Vdc/(4·L·f_sw) (one leg at duty ½ against the DC link's
+//! mid-point) overstates the three-phase ripple 1.5 times. The derived
+//! frequency keeps ΔI_pp ≤ [`MAX_RIPPLE_CURRENT_RATIO`] = 0.6 of the rated current: maxon's
+//! rule for its controllers' motor chokes (ESCON and EPOS4 hardware references, "Motor
+//! chokes": Vcc/(6·f_PWM·L_terminal) ≤ 0.3·I_N, L_terminal = 2·L, the ripple at half the
+//! linear range), stated at the linear range's edge. Measured closed loop
+//! (`crates/fado-sim/tests/datasheet_carrier.rs`, sensor seed 1): the maxon EC 22 fails
+//! `stops` at 12, 20 and 30 kHz (ΔI_pp 3.3, 2.0 and 1.3 times its rated current; largest
+//! |θ − θ̂| 0.96, 0.72, 0.28 rad) and passes at 40 kHz (1.0 times, 0.05 rad); the rule gives
+//! it 67 kHz.
 
 use crate::Real;
 use crate::machine::{MachineModel, PAPER_RATED_CURRENT};
@@ -88,6 +108,11 @@ pub fn min_switching_frequency(dc_voltage: f64) -> f64 {
     }
 }
 
+/// Largest peak-to-peak PWM current ripple ([`ripple_current`]) the derived switching
+/// frequency allows, as a fraction of the rated current: 0.6 (maxon's motor-choke rule, see
+/// the module documentation).
+pub const MAX_RIPPLE_CURRENT_RATIO: f64 = 0.6;
+
 /// The derived switching frequency is a whole multiple of this, Hz.
 pub const SWITCHING_FREQUENCY_STEP: f64 = 1000.0;
 
@@ -140,7 +165,7 @@ pub const RULES: [(&str, &str); 7] = [
     ),
     (
         "inverter.switching_frequency",
-        "ω_rated·Ts ≤ 0.2 and the electrical time constant min(ld, lq)/rs ≥ 2·Ts (Ts = 1/(2·f_sw)), at least 5 kHz (2 kHz on a DC link above 1.2 kV), rounded up to a whole kHz",
+        "ω_rated·Ts ≤ 0.2, the electrical time constant min(ld, lq)/rs ≥ 2·Ts (Ts = 1/(2·f_sw)) and the PWM current ripple dc_voltage/(6·min(ld, lq)·f_sw) ≤ 0.6·rated_current (maxon's motor-choke rule), at least 5 kHz (2 kHz on a DC link above 1.2 kV), rounded up to a whole kHz",
     ),
     (
         "inverter.dead_time",
@@ -192,18 +217,31 @@ pub fn switching_frequency(pole_pairs: u32, rated_speed_rpm: f64, dc_voltage: f6
     )
 }
 
+/// The largest peak-to-peak PWM ripple of a phase current over the linear modulation range,
+/// A: Vdc/(6·L·f_sw) for a phase inductance `inductance` (module documentation, "The bound
+/// on the current ripple").
+pub fn ripple_current(dc_voltage: f64, inductance: f64, switching_frequency: f64) -> f64 {
+    dc_voltage / (6.0 * inductance * switching_frequency)
+}
+
 /// The switching frequency of machine `m`, Hz: [`switching_frequency`], raised where needed to
 /// the smallest whole kHz at which the electrical time constant min(Ld, Lq)/Rs spans two
-/// sampling periods (a current loop needs at least that; a slotless 40 W motor's 85 µs asks
-/// for 12 kHz).
+/// sampling periods (a current loop needs at least that) and at which the PWM current ripple
+/// [`ripple_current`] on `m.dc_voltage` is at most [`MAX_RIPPLE_CURRENT_RATIO`] of the rated
+/// current (a slotless 40 W motor, 27.3 µH on 24 V, asks for 67 kHz).
 pub fn switching_frequency_of(m: &MachineModel<f64>) -> f64 {
-    let f = switching_frequency(m.pole_pairs, m.rated_speed_rpm, m.dc_voltage);
-    let tau = m.ld.min(m.lq) / m.rs;
+    let mut f = switching_frequency(m.pole_pairs, m.rated_speed_rpm, m.dc_voltage);
+    let l = m.ld.min(m.lq);
+    let tau = l / m.rs;
     if tau.is_finite() && tau > 0.0 && 1.0 / tau > f {
-        ceil_to(1.0 / tau, SWITCHING_FREQUENCY_STEP)
-    } else {
-        f
+        f = ceil_to(1.0 / tau, SWITCHING_FREQUENCY_STEP);
     }
+    let ripple =
+        ripple_current(m.dc_voltage, l, 1.0) / (MAX_RIPPLE_CURRENT_RATIO * m.rated_current);
+    if ripple.is_finite() && ripple > f {
+        f = ceil_to(ripple, SWITCHING_FREQUENCY_STEP);
+    }
+    f
 }
 
 /// The d and q currents of the maximum-torque-per-ampere point of magnitude `i` (A peak):
@@ -337,6 +375,80 @@ mod tests {
         for (k, _) in RULES {
             assert!(rule(k).is_some());
         }
+    }
+
+    /// The centred modulation's phase-current ripple over one carrier period (pure
+    /// inductance L, star point free), integrated on a fine grid for reference vectors over the
+    /// linear range and a sixth of a turn: its largest peak-to-peak value is the bound of
+    /// [`ripple_current`], reached at the linear range's edge.
+    #[test]
+    fn ripple_bound_is_the_largest_ripple_of_the_centred_modulation() {
+        let (vdc, l, f) = (24.0, 27.3e-6, 20e3);
+        let n = 4000usize;
+        let ripple = |m: f64, th: f64| {
+            let v = [0.0, 2.0, -2.0]
+                .map(|k: f64| m / 3f64.sqrt() * (th - k * core::f64::consts::FRAC_PI_3).cos());
+            let (mx, mn) = (v[0].max(v[1]).max(v[2]), v[0].min(v[1]).min(v[2]));
+            let duty = v.map(|x| 0.5 + x - 0.5 * (mx + mn));
+            let mean = (duty[0] + duty[1] + duty[2]) / 3.0;
+            let mut i = [0.0f64; 3];
+            let (mut hi, mut lo) = ([0.0f64; 3], [0.0f64; 3]);
+            for k in 0..n {
+                let carrier = (2.0 * (k as f64 + 0.5) / n as f64 - 1.0).abs();
+                let pole = duty.map(|d| if carrier < d { 1.0 } else { 0.0 });
+                let star = (pole[0] + pole[1] + pole[2]) / 3.0;
+                for x in 0..3 {
+                    // Phase voltage less its period average, per Vdc; current per Vdc/(L·f).
+                    i[x] += (pole[x] - star - (duty[x] - mean)) / n as f64;
+                    hi[x] = hi[x].max(i[x]);
+                    lo[x] = lo[x].min(i[x]);
+                }
+            }
+            (0..3).map(|x| hi[x] - lo[x]).fold(0.0, f64::max) * vdc / (l * f)
+        };
+        let bound = ripple_current(vdc, l, f);
+        let mut largest = 0.0f64;
+        for step in 0..=20 {
+            let m = step as f64 / 20.0;
+            for a in 0..=12 {
+                let r = ripple(m, a as f64 * core::f64::consts::FRAC_PI_3 / 12.0);
+                assert!(r <= bound * (1.0 + 1e-3), "m {m}: {r} > {bound}");
+                largest = largest.max(r);
+            }
+        }
+        assert!(largest > 0.99 * bound, "{largest} vs {bound}");
+        // At half the linear range it is half the bound: maxon's Vcc/(6·f·L_terminal).
+        let half = (0..=12)
+            .map(|a| ripple(0.5, a as f64 * core::f64::consts::FRAC_PI_3 / 12.0))
+            .fold(0.0, f64::max);
+        assert!((half / bound - 0.5).abs() < 0.01, "{half} vs {bound}");
+    }
+
+    #[test]
+    fn derived_switching_frequency_bounds_the_ripple() {
+        // The slotless maxon EC 22 40 W on 24 V (27.3 µH, 3.68 A): ω_rated·Ts and L/R ask for
+        // 12 kHz, the ripple for 67 kHz.
+        let maxon = MachineModel {
+            rs: 0.3205,
+            ld: 27.3e-6,
+            lq: 27.3e-6,
+            flux_linkage: 3.75e-3,
+            pole_pairs: 1,
+            rated_current: 3.68,
+            rated_speed_rpm: 31_800.0,
+            rated_torque: 20.7e-3,
+            dc_voltage: 24.0,
+            ..MachineModel::<f64>::paper()
+        };
+        let f = switching_frequency_of(&maxon);
+        assert_eq!(f, 67_000.0);
+        let r = ripple_current(24.0, 27.3e-6, f);
+        assert!(r <= MAX_RIPPLE_CURRENT_RATIO * 3.68, "{r}");
+        assert!(ripple_current(24.0, 27.3e-6, f - 1000.0) > MAX_RIPPLE_CURRENT_RATIO * 3.68);
+        // The paper's motor: 311/(6·2.63 mH·5 kHz) = 3.9 A, 18 % of its rated current.
+        let paper = MachineModel::<f64>::paper();
+        assert_eq!(switching_frequency_of(&paper), 5000.0);
+        assert!(ripple_current(311.0, paper.ld.min(paper.lq), 5000.0) < 0.6 * 21.8);
     }
 
     /// The 2.2 kW IPMSM: p 3, Ld 36 mH, Lq 51 mH, λf 0.545 Wb.

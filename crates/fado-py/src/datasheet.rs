@@ -36,15 +36,32 @@ pub fn convert<'py>(
     }
     for (k, v) in fields.iter() {
         let key: String = k.extract()?;
-        if datasheet::alternative(&key).is_none() {
-            out.set_item(k, v)?;
+        if datasheet::alternative(&key).is_some() {
+            continue;
         }
+        if !crate::machine::is_field(&key) {
+            return Err(pyo3::exceptions::PyTypeError::new_err(format!(
+                "unexpected keyword argument `{key}`: neither a Machine field ({}) nor a \
+                 datasheet key ({})",
+                fado_core::ratings::REQUIRED_MOTOR_KEYS.join(", ")
+                    + ", inertia, viscous_friction, dc_voltage, flux_map",
+                crate::machine::datasheet_keys()
+            )));
+        }
+        out.set_item(k, v)?;
     }
     for alt in &ALTERNATIVES {
         let Some(value) = fields.get_item(alt.key)? else {
             continue;
         };
         let value = number(py, alt.key, Some(&value), 0.0)?;
+        if !(value.is_finite() && value > 0.0) {
+            return Err(config_error_message(
+                py,
+                alt.key,
+                format!("`{}` must be a positive number in {}", alt.key, alt.unit),
+            ));
+        }
         let pole_pairs = match fields.get_item("pole_pairs")? {
             Some(p) => Some(number(py, "pole_pairs", Some(&p), 0.0)?),
             None => None,

@@ -50,8 +50,26 @@ fn missing_required(fields: Option<&Bound<'_, PyDict>>) -> PyResult<Option<PyErr
     if missing.is_empty() {
         return Ok(None);
     }
+    // A key that is no field (`Kv=100` for `flux_linkage`) is the likelier cause: named first.
+    let mut unknown = Vec::new();
+    if let Some(f) = fields {
+        for k in f.keys() {
+            let k: String = k.extract()?;
+            if !is_field(&k) {
+                unknown.push(k);
+            }
+        }
+    }
+    let unknown = match unknown.first() {
+        Some(k) => format!(
+            "`{k}` is not a Machine field: a datasheet's values (Kv, Kt, Ke, line-to-line R and \
+             L, rms currents, kg·cm²) go to Machine.from_datasheet as {}. ",
+            datasheet_keys()
+        ),
+        None => String::new(),
+    };
     Ok(Some(pyo3::exceptions::PyTypeError::new_err(format!(
-        "Machine() missing required keyword argument{}: {}. The circuit (rs, ld, lq, \
+        "{unknown}Machine() missing required keyword argument{}: {}. The circuit (rs, ld, lq, \
          flux_linkage, pole_pairs) and the ratings from the datasheet (rated_current in A peak, \
          rated_speed_rpm, rated_torque) are required; inertia, viscous_friction and dc_voltage \
          are derived from them when left out (fado_core::ratings); no value is taken from \
@@ -59,6 +77,22 @@ fn missing_required(fields: Option<&Bound<'_, PyDict>>) -> PyResult<Option<PyErr
         if missing.len() > 1 { "s" } else { "" },
         missing.join(", ")
     ))))
+}
+
+/// True when `key` is a `Machine` field (a keyword of its constructor).
+pub(crate) fn is_field(key: &str) -> bool {
+    fado_core::ratings::REQUIRED_MOTOR_KEYS.contains(&key)
+        || DERIVED.contains(&key)
+        || key == "flux_map"
+}
+
+/// The datasheet keys of `Machine.from_datasheet` with their units, as text.
+pub(crate) fn datasheet_keys() -> String {
+    let keys: Vec<String> = fado_core::datasheet::ALTERNATIVES
+        .iter()
+        .map(|a| format!("`{}` ({})", a.key, a.unit))
+        .collect();
+    keys.join(", ")
 }
 
 /// True when `m`'s circuit and ratings are finite and positive: the DC link can be derived
@@ -452,9 +486,9 @@ impl PyMachine {
     }
 
     /// A machine from its datasheet's values: any `Machine` field, or instead of `rs`, `ld`,
-    /// `lq`, `flux_linkage` and `rated_current` the datasheet's `rs_line_to_line`,
-    /// `l_line_to_line`, `ke_vll_rms_per_krpm`, `ke_vll_peak_per_krpm`, `kt_nm_per_arms` and
-    /// `rated_current_arms` (converted as `fado-sim`'s `[motor]` table converts them; see
+    /// `lq`, `flux_linkage`, `rated_current` and `inertia` the datasheet's `rs_line_to_line`,
+    /// `l_line_to_line`, `ke_vll_rms_per_krpm`, `ke_vll_peak_per_krpm`, `kt_nm_per_arms`,
+    /// `kv_rpm_per_volt`, `rated_current_arms` and `inertia_kg_cm2` (converted as `fado-sim`'s `[motor]` table converts them; see
     /// docs/configuration.md). A field given both ways is refused naming both.
     #[staticmethod]
     #[pyo3(signature = (**fields))]

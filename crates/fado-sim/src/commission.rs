@@ -20,6 +20,7 @@ use serde::Serialize;
 use crate::error::SimConfigError;
 use crate::magnetic_accuracy::{self, MagneticAccuracy};
 use crate::motor::MotorState;
+use crate::saturation_verdict::{freeze_resistance_law, saturation_comment, verdict_name};
 use crate::sim::{Plant, PlantParams};
 
 /// The plant's true values of what commissioning identifies.
@@ -332,6 +333,14 @@ pub struct MagneticsReport {
     pub flux_linkage: f64,
     /// See `flux_linkage`.
     pub flux_from_nameplate: bool,
+    /// The rotor's largest turn over one pair of pulses as the procedure estimated it from
+    /// the flux, rad (electrical).
+    pub pulse_motion: f64,
+    /// What the pulses say ([`fado_core::commissioning::SaturationVerdict`]): `detected`,
+    /// `not_detected`, `inconclusive` (a fit of large change that does not explain the data)
+    /// or `rotor_moved` (the rotor turned beyond
+    /// [`fado_core::commissioning::PULSE_MOTION_LIMIT`]).
+    pub verdict: &'static str,
     /// The model the drive gets (the fitted one when saturation is detected, else constant
     /// inductances: the identified ones, or the nameplate's after an abort) against the
     /// plant's over the rated current range.
@@ -368,6 +377,8 @@ impl MagneticsReport {
             pulse_current: proc.pulse_current(),
             flux_linkage: model.flux_linkage,
             flux_from_nameplate: id.is_none(),
+            pulse_motion: fit.motion,
+            verdict: verdict_name(fit.verdict()),
             accuracy: magnetic_accuracy::compare(&truth, &drive, p.motor.rated_current),
         })
     }
@@ -543,6 +554,7 @@ pub fn identified_toml_with_map(
         toml::Value::Float(id.threshold_voltage.max(0.0)),
     );
     doc.insert("inverter_model".into(), toml::Value::Table(inverter_model));
+    let frozen = freeze_resistance_law(&mut doc, id);
     let c = id.confidence;
     let head = format!(
         "# [model] identified by `fado-sim commission` (fado_core::commissioning) in {:.2} s.\n\
@@ -552,7 +564,7 @@ pub fn identified_toml_with_map(
          saliency Lq/Ld {:.4}.\n\
          # Current sensors' gain ratio k = {:.5} (1-sigma {:.1e}): phase a was divided by it, \
          so the model is in phase b's scale, the drive's after its start-up gain calibration.\n\
-         {}{}",
+         {}{}{}",
         id.duration,
         c.rs,
         c.ld,
@@ -567,6 +579,7 @@ pub fn identified_toml_with_map(
         c.current_gain_ratio,
         saturation_comment(id),
         saturation_lines,
+        frozen,
     );
     let body = toml::to_string(&doc).map_err(|e| SimConfigError::new("<config>", e.to_string()))?;
     Ok(head + &body)
@@ -631,29 +644,6 @@ fn commented_saturation(table: toml::Value) -> Result<String, SimConfigError> {
         out.push_str(&format!("#   {line}\n"));
     }
     Ok(out)
-}
-
-/// The header's statement on the magnetic model: saturation detected (the written
-/// `[model.saturation]`) or not (constant inductances), with the detection statistic.
-fn saturation_comment(id: &Identification<f64>) -> String {
-    let change = 100.0 * id.saturation_change;
-    let range = id.saturation_current;
-    if !id.saturation_change.is_finite() {
-        return "# Magnetic saturation: not measured (the flux-linkage pulses did not run).\n"
-            .into();
-    }
-    match id.saturation {
-        Some(_) => format!(
-            "# Magnetic saturation detected: the incremental inductances change by {change:.1} % \
-             up to {range:.3} A; [model.saturation] is the algebraic model fitted to the \
-             standstill flux-linkage pulses (RMS current residual {:.3e} A).\n",
-            id.saturation_residual
-        ),
-        None => format!(
-            "# No magnetic saturation detected: the incremental inductances change by \
-             {change:.1} % up to {range:.3} A; the model keeps constant inductances.\n"
-        ),
-    }
 }
 
 /// One row of the identified-vs-truth comparison.

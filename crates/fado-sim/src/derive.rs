@@ -284,12 +284,15 @@ mod tests {
             ]
         );
         assert!(d.iter().all(|d| !d.rule.is_empty() && d.value > 0.0));
-        // 21 pole pairs at 1800 r/min: 3958 rad/s → 10 kHz.
-        let f = d
-            .iter()
-            .find(|d| d.key.ends_with("switching_frequency"))
-            .unwrap();
-        assert_eq!(f.value, 10_000.0);
+        // 21 pole pairs at 1800 r/min: 3958 rad/s → 10 kHz by ω_rated·Ts; its 30 µH on the
+        // derived DC link ask for 14 kHz by the ripple (≤ 0.6 × 17.5 A).
+        let value = |key: &str| d.iter().find(|d| d.key.ends_with(key)).unwrap().value;
+        let (f, vdc) = (value("switching_frequency"), value("dc_voltage"));
+        assert_eq!(ratings::switching_frequency(21, 1800.0, vdc), 10_000.0);
+        assert_eq!(f, 14_000.0);
+        let bound = ratings::MAX_RIPPLE_CURRENT_RATIO * 17.5;
+        assert!(ratings::ripple_current(vdc, 30e-6, f) <= bound);
+        assert!(ratings::ripple_current(vdc, 30e-6, f - 1000.0) > bound);
     }
 
     #[test]

@@ -72,6 +72,7 @@ pub mod output;
 pub mod presets;
 pub mod profile;
 pub mod range;
+pub mod saturation_verdict;
 pub mod scenario;
 pub mod sensors;
 pub mod sim;

@@ -266,13 +266,19 @@ fn read_header(
     let line = headers.position().map_or(1, |p| lines.at(p.byte()));
     let got: Vec<&str> = headers.iter().collect();
     if got != HEADER {
+        let joined = got.join(",");
+        let hint = if joined.contains(';') || joined.contains('\t') {
+            ": the file is separated by semicolons or tabs (a spreadsheet's export, often with \
+             decimal commas); the map is comma-separated with decimal points"
+        } else if joined.to_ascii_lowercase() == HEADER.join(",") {
+            ": the names are lower case"
+        } else {
+            ""
+        };
         return Err(map_error(
             file,
             line,
-            format!(
-                "the header must be `i_d,i_q,psi_d,psi_q`, got `{}`",
-                got.join(",")
-            ),
+            format!("the header must be `i_d,i_q,psi_d,psi_q`, got `{joined}`{hint}"),
         ));
     }
     Ok(line)
@@ -431,13 +437,24 @@ impl Grid<'_> {
         let falling = (1..axis.len())
             .filter(|&n| value(n) <= value(n - 1))
             .count();
-        let cause = if 2 * falling > steps {
-            "the map falls along most of this axis: check its axes and signs (d on the magnet,              ψd = λf at i = 0, SI peak values; SyR-e's maps put d on the high-permeance axis)"
+        let (psi_d0, psi_q0) = self.at_zero_current();
+        let cause = if psi_q0.abs() > 2.0 * psi_d0.abs() {
+            format!(
+                "the columns psi_d and psi_q look swapped: nearest zero current ψd = \
+                 {psi_d0:.6} Wb and ψq = {psi_q0:.6} Wb, where a magnet machine has ψd = λf \
+                 and ψq = 0 (the header is i_d,i_q,psi_d,psi_q)"
+            )
+        } else if 2 * falling > steps {
+            "the map falls along most of this axis: check its axes and signs (d on the magnet, \
+             ψd = λf at i = 0, SI peak values; SyR-e's maps put d on the high-permeance axis)"
+                .to_owned()
         } else {
-            "a local dip (noise in a measured map?): smooth the map or thin its grid"
+            "a local dip (noise in a measured map?): smooth the map or thin its grid".to_owned()
         };
         format!(
-            "{table} does not increase with its own current: {:.6} Wb at {name} = {} A,              {:.6} Wb at {name} = {} A ({} = {} A); {falling} of the line's {steps} steps fall,              and a map with no inverse i(ψ) cannot be run: {cause}",
+            "{table} does not increase with its own current: {:.6} Wb at {name} = {} A, \
+             {:.6} Wb at {name} = {} A ({} = {} A); {falling} of the line's {steps} steps fall, \
+             and a map with no inverse i(ψ) cannot be run: {cause}",
             value(at - 1),
             axis[at - 1],
             value(at),
@@ -445,6 +462,20 @@ impl Grid<'_> {
             other.0,
             other.1,
         )
+    }
+}
+
+impl Grid<'_> {
+    /// (ψd, ψq) at the node nearest zero current.
+    fn at_zero_current(&self) -> (f64, f64) {
+        let nearest = |axis: &[f64]| {
+            (0..axis.len())
+                .min_by(|&a, &b| axis[a].abs().total_cmp(&axis[b].abs()))
+                .unwrap_or(0)
+        };
+        let (k, m) = (nearest(self.i_d), nearest(self.i_q));
+        let n = k * self.i_q.len() + m;
+        (self.psi_d[n], self.psi_q[n])
     }
 }
 

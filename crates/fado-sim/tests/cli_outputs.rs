@@ -1,5 +1,5 @@
 //! `fado-sim run` under hostile conditions: two writers on one directory, `kill -9` in the
-//! middle of a write, a full disk. After each, every output is the previous whole file, the
+//! middle of a write, a full disk; `compare` on a held directory. After each, every output is the previous whole file, the
 //! new whole file, or absent with a clear error naming the path (exit code 3).
 
 mod common;
@@ -182,6 +182,46 @@ fn an_unwritable_output_directory_is_an_io_error_naming_it() {
     std::fs::write(&bad, "[simulation]\nduraton = 1\n").unwrap();
     let o = run(&bad, &dir.join("o")).output().unwrap();
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn compare_reports_a_held_output_directory_before_it_runs() {
+    // The directory is held by another command; the comparison's own configuration fails
+    // only once the runs start (a negative duration): the lock is the error reported (exit 3,
+    // naming the directory), so nothing ran.
+    let dir = scratch("compare-held");
+    let out = dir.join("out");
+    let lock = fado_sim::output::DirLock::acquire(&out).unwrap();
+    let bad = dir.join("bad.toml");
+    std::fs::write(&bad, "[simulation]\nduration = -1.0\n").unwrap();
+    let compare = || {
+        Command::new(BIN)
+            .args([
+                "compare",
+                "--scenarios",
+                "fig11",
+                "--estimators",
+                "fado",
+                "--averaged",
+            ])
+            .arg("--config")
+            .arg(&bad)
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap()
+    };
+    let o = compare();
+    assert_eq!(o.status.code(), Some(3), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains(&out.display().to_string()),
+        "{}",
+        stderr(&o)
+    );
+    drop(lock);
+    // Free, the same command reaches the configuration's error (exit 2).
+    assert_eq!(compare().status.code(), Some(2));
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

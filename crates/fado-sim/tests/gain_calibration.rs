@@ -224,7 +224,7 @@ fn a_load_arriving_during_the_calibration_ends_it_and_the_drive_takes_the_load()
     // for 50 ms, the rotor free). The motion test ends it within milliseconds, the release
     // hold catches the rotor at the aligned angle and hands the load to the speed loop, whose
     // reference then resumes from zero (`ReleaseHold::engage`). Measured: RotorMoved, max
-    // |θ − θ̂| 0.111 rad, lowest speed −18.3 r/min, 0.092 rad backward (the speed loop alone
+    // |θ − θ̂| 0.112 rad, lowest speed −17.7 r/min, 0.094 rad backward (the speed loop alone
     // from the aligned angle: 0.159 rad, −38 r/min, 0.43 rad; without the test: θ̂ lost,
     // 3.13 rad, −383 r/min).
     let mut cfg = config(

@@ -110,11 +110,23 @@
 //!    is three bipolar pairs of voltage pulses whose currents point along 0°, 60° and 120° of
 //!    the rotor frame (each phase then carries at least half of the current, away from the
 //!    inverter's dead-time band; 60° and 120° cross-saturate), each pulse driven up to
-//!    `magnetics.current_ratio` × the rated current and back by the same number of samples
-//!    at up to 0.9·Vdc/√3 ([`MagneticsTestConfig`]), the opposite pulse at once after it, so
-//!    that the torque's impulse cancels and the rotor, free, moves by hundredths of a radian
-//!    (measured 0.012–0.10 rad electrical on the presets). Between pairs the gates are off:
-//!    the current is zero and ψ = λf·e^{jθ} exactly, where each pair's integral starts.
+//!    `magnetics.current_ratio` × the rated current (stopped on the next sample's predicted
+//!    current) and back to zero, its last sample landing the current on zero at a sample
+//!    boundary (so that no sample's current changes sign inside it, where the inverter
+//!    error's model is wrong by up to 4/3·V̂·Ts), at up to 0.9·Vdc/√3
+//!    ([`MagneticsTestConfig`]) and at least 3·R̂s·I_p (nearer the resistive drop the rise
+//!    stalls short of I_p), the identified inverter error compensated, the opposite pulse at
+//!    once after it, so that the torque's impulse cancels. A pair with rises of N samples
+//!    turns a free rotor by about 2·p·T_p·(N·Ts)²/J; N is 16, and where that would turn the
+//!    nameplate's rotor by more than 0.2 rad it is shortened, down to 4, to keep the turn at
+//!    0.05 rad, each shortened pair repeated
+//!    an even number of times with its order alternating (+−, −+), so that the rotor returns
+//!    (Hinkkanen et al.'s bipolar excitation, sized for a light rotor). The rotor's turn over
+//!    each pair, read from the flux at its end, is the motion monitor: beyond
+//!    [`PULSE_MOTION_LIMIT`] (0.15 rad) the pulses start again with rises half as long, and a
+//!    rotor that turns that far at the shortest rises leaves the saturation unidentified
+//!    ([`SaturationVerdict::RotorMoved`], never "not detected"). Between pairs the gates are
+//!    off: the current is zero and ψ = λf·e^{jθ} exactly, where each pair's integral starts.
 //!    ψ̂ = ∫(v − R̂s·i − V̂·sat(i/I_band)), with the DC test's R̂s and inverter error V̂ on the
 //!    trapezoid of each sample's currents. Two angles matter: the rotor's at the start, along
 //!    the current that held it in the inductance tests (the frozen voltage of the DC test
@@ -132,7 +144,12 @@
 //!    theirs, and its incremental inductance matrix above a tenth of the zero-current one
 //!    over the pulses' range (a fitted law i(ψ) that folds back gives a second flux for some
 //!    currents, where the incremental inductance is about zero); a linear machine, or one
-//!    whose best fit has no physical meaning, keeps its constants. Accuracy against the plant's truth: docs/results/commissioning-magnetics.md.
+//!    whose best fit has no physical meaning, keeps its constants. A fit whose inductances
+//!    change by more than [`INCONCLUSIVE_CHANGE`] (a quarter) without explaining the data is
+//!    no linear machine's: it keeps the constants too, but its verdict is
+//!    [`SaturationVerdict::Inconclusive`], not "not detected"
+//!    ([`Identification::saturation_verdict`]). Accuracy against the plant's truth:
+//!    docs/results/commissioning-magnetics.md.
 //! 6. **Spin and back-EMF** ([`Phase::Spin`], [`Phase::Coast`]): an I-f start (a current vector
 //!    turned at a speed ramped to `spin_speed_ratio` of the rated speed), regulated by a
 //!    synchronous-frame PI tuned from the identified R̂s, L̂ (bandwidth 0.2/Ts; its integral
@@ -225,8 +242,8 @@ pub use saturation_fit::SaturationFit;
 
 use crate::{Ab, Dq};
 use fits::{BlockStats, EmfWindow, JFit, JWindows, Line, emf_line};
-pub use flux_pulses::MagneticFit;
 use flux_pulses::{FluxPulses, magnetics_time};
+pub use flux_pulses::{INCONCLUSIVE_CHANGE, MagneticFit, PULSE_MOTION_LIMIT, SaturationVerdict};
 use sizing::{
     clamp, dc_level, dead_time_voltage, libm_round, limit, spin_integral_gain, spin_sizing,
     standstill_gains, step_level,

@@ -3,7 +3,7 @@
 
 use super::{Phase, Status};
 use crate::magnetics::Saturation;
-use crate::{Ab, Abc, MachineModel};
+use crate::{Ab, Abc, MachineModel, Real};
 
 /// Relative 1-σ statistical uncertainties of the result (module docs); `inverter_voltage` in V.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -66,6 +66,24 @@ pub struct Identification<T: 'static> {
     pub linear_residual: T,
     /// The pulses' peak current, A: the range over which the model is measured.
     pub saturation_current: T,
+    /// The rotor's largest turn over one pair of the pulses, estimated from the flux at the
+    /// pair's end, rad (electrical; NaN with the test off). Above
+    /// [`super::PULSE_MOTION_LIMIT`] the pulses cannot tell saturation from the turning
+    /// magnet's back-EMF: `saturation` is then None whatever the machine
+    /// ([`super::MagneticFit::rotor_moved`]).
+    pub saturation_motion: T,
+}
+
+impl<T: Real> Identification<T> {
+    /// What the standstill flux-linkage pulses say about the machine's saturation (module
+    /// docs, step 5): detected, not detected, inconclusive, the rotor moved, or not measured.
+    pub fn saturation_verdict(&self) -> super::SaturationVerdict {
+        super::flux_pulses::verdict(
+            self.saturation.is_some(),
+            self.saturation_change,
+            self.saturation_motion,
+        )
+    }
 }
 
 /// What one step returns.

@@ -417,7 +417,7 @@ impl<T: Real> Commissioning<T> {
             });
             return;
         }
-        let (saturation, saturation_change, saturation_residual, linear_residual) =
+        let (saturation, saturation_change, saturation_residual, linear_residual, motion) =
             self.magnetic_result();
         let (ld, lq) = saturation
             .as_ref()
@@ -455,6 +455,7 @@ impl<T: Real> Commissioning<T> {
             saturation_residual,
             linear_residual,
             saturation_current: self.pulse_current(),
+            saturation_motion: motion,
         });
         self.status = Status::Done;
         self.nominal_done += self.t_phase;

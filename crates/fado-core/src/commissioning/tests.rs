@@ -115,3 +115,60 @@ fn the_if_current_respects_the_reluctance_limit() {
     let paper = MachineModel::<f64>::paper();
     assert_eq!(if_level(&paper, paper.ld, paper.lq, 10.0), 9.0);
 }
+
+/// The pulses' plan (module docs, step 5): a heavy rotor keeps 16-sample rises and single
+/// pairs; the 750 W servo SPM's light rotor (2e-4 kg·m², 5 pole pairs, 3.1 N·m at 6 A) gets
+/// rises of about 5 samples, each pair repeated an even number of times (its order
+/// alternating, so the rotor returns), about as many samples as one full pair; rises never
+/// below 4 samples, and a nameplate that gives no number keeps the full ones.
+#[test]
+fn light_rotors_get_short_alternating_pulses() {
+    use super::flux_pulses::pulse_plan;
+    let servo = MachineModel {
+        rs: 1.1,
+        ld: 1.5e-3,
+        lq: 3e-3,
+        flux_linkage: 0.07,
+        pole_pairs: 5,
+        inertia: 2e-4,
+        viscous_friction: 0.0,
+        rated_current: 6.0,
+        rated_speed_rpm: 3000.0,
+        rated_torque: 3.1,
+        dc_voltage: 320.0,
+        ..MachineModel::<f64>::paper()
+    };
+    let plan = |inertia: f64| {
+        let np = MachineModel { inertia, ..servo };
+        pulse_plan(&CommissioningConfig::for_machine(np, 1e-4, 2.5e-6), 6.0)
+    };
+    let (n, repeats) = plan(2e-4);
+    // 2·p·T_p·(N·Ts)²/J = 0.05 rad: T_p = 1.5·5·(0.07 + 1.5e-3·6)·6 = 3.56 N·m.
+    let expected = (0.05f64 * 2e-4 / (2.0 * 5.0 * 3.555)).sqrt() / 1e-4;
+    assert!(
+        (n - expected).abs() < 1e-9 && (5.0..6.0).contains(&n),
+        "{n}"
+    );
+    assert_eq!(repeats, 4);
+    assert!(n * repeats as f64 >= 16.0);
+    assert_eq!(plan(2e-2), (16.0, 1));
+    // Full-length rises would turn a 1.3e-3 kg·m² rotor by 0.07 rad (its rise 13.5 samples):
+    // below four times the target, they stay.
+    assert_eq!(plan(1.3e-3), (16.0, 1));
+    assert_eq!(plan(1e-7), (4.0, 4));
+    assert_eq!(plan(f64::NAN), (16.0, 1));
+}
+
+/// The verdict names the cause: a rotor that turned is never "not detected", nor is a fit
+/// whose inductances change by more than a quarter without explaining the data.
+#[test]
+fn the_saturation_verdict_names_the_cause() {
+    use super::flux_pulses::verdict;
+    use SaturationVerdict::*;
+    assert_eq!(verdict(false, 0.53, 0.76), RotorMoved);
+    assert_eq!(verdict(true, 0.53, 0.76), RotorMoved);
+    assert_eq!(verdict(true, 0.53, 0.01), Detected);
+    assert_eq!(verdict(false, 0.53, 0.01), Inconclusive);
+    assert_eq!(verdict(false, 0.11, 0.01), NotDetected);
+    assert_eq!(verdict(false, f64::NAN, f64::NAN), NotMeasured);
+}

@@ -218,7 +218,7 @@ pub struct EstimatorParams<T: Real> {
 /// counters. Run-time settings live here too: R̂s (`set_rs_hat`, the adaptation), λ̂f (its
 /// law), the adaptation's on switch (`enable_rs_adaptation`) and the k_df switch. Stepped
 /// with [`EstimatorState::step`] / [`EstimatorState::step_lean`] and the
-/// [`EstimatorParams`] it was made for; `size_of` is 308 B or less in `f32`
+/// [`EstimatorParams`] it was made for; `size_of` is 312 B or less in `f32`
 /// (docs/results/firmware-cost.md).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EstimatorState<T: Real> {

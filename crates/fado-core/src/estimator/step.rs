@@ -575,6 +575,7 @@ impl<T: Real> EstimatorState<T> {
             state.i_d_prev,
             state.offset_sensitivity.alpha,
             state.offset_sensitivity.beta,
+            state.standstill_share,
             state.flux_error_angle,
             state.flux_excitation,
             state.flux_angle,
@@ -622,9 +623,9 @@ impl<T: Real> EstimatorState<T> {
         }
         // R̂s drops what earlier standstill tests read of the offset ê learns now.
         let change = offset.offset - self.offset.offset;
-        let rs_hat = self
-            .rs_adaptation
-            .rs_after_offset_change(&self.rs_scale, change);
+        let (rs_hat, standstill_share) =
+            self.rs_adaptation
+                .rs_after_offset_change(&self.rs_scale, change, c.point.is_some());
         let slow_feedback = self.slow_feedback + change;
         let feedback = c.base_feedback + slow_feedback;
         if all_finite([
@@ -637,6 +638,7 @@ impl<T: Real> EstimatorState<T> {
         ]) {
             self.offset = offset;
             self.rs_adaptation.rs_hat = rs_hat;
+            self.rs_adaptation.standstill_share = standstill_share;
             self.integrator.set_rs_hat_unchecked(rs_hat);
             self.feedback = feedback;
             self.slow_feedback = slow_feedback;

@@ -52,6 +52,11 @@ fn write_torque(
         TorqueSlip::PoleCount => f.write_str(
             ": `pole_pairs` a pole count (the model's torque twice the rating), or `ld`/`lq` off?",
         ),
+        TorqueSlip::LineToLine if severity == Severity::Warning && ratio > 0.6 => f.write_str(
+            ": λf from a line-to-line constant where the phase value is meant (√3 = 1.73)? \
+             Give λf in Wb peak per phase. (A saturated machine entered with its no-load \
+             `ld`, `lq` lands here too: give its saturation model or flux map.)",
+        ),
         TorqueSlip::LineToLine => f.write_str(
             ": λf from a line-to-line constant where the phase value is meant (√3 = 1.73)? \
              Give λf in Wb peak per phase",

@@ -216,6 +216,7 @@ impl<T: Real> ResistanceAdaptationParams<T> {
             flux_linkage_hat: st.flux_linkage_hat,
             flux_learning: st.flux_learning,
             offset_sensitivity: st.offset_sensitivity,
+            standstill_share: st.standstill_share,
             ..ResistanceAdaptationState::default()
         };
         let mag_sq = lambda_r.norm_squared();
@@ -357,7 +358,9 @@ impl<T: Real> ResistanceAdaptationParams<T> {
             next.rs_hat -=
                 scale.gain * (mag - reference) * a * b / (relative_to * (a_sq + floor_b_sq));
             // The turning law replaces what the standstill tests contributed.
-            next.offset_sensitivity = st.offset_sensitivity * (T::one() - self.rate_ts * weight);
+            let keep = T::one() - self.rate_ts * weight;
+            next.offset_sensitivity = st.offset_sensitivity * keep;
+            next.standstill_share = st.standstill_share * keep;
         }
         if settled && omega.abs() >= self.config.flux_linkage_min_speed {
             self.flux_law(st, next, a, mag - reference, omega);
@@ -478,7 +481,9 @@ impl<T: Real> ResistanceAdaptationParams<T> {
         }
         if next.charge_d * scale.chi_per_phi >= self.config.excitation_floor {
             let r_dc = next.volt_seconds_d / next.charge_d;
-            next.rs_hat += self.standstill_gain * (r_dc - next.rs_hat);
+            let step = self.standstill_gain * (r_dc - next.rs_hat);
+            next.rs_hat += step;
+            next.standstill_share += step;
             let sensitivity = unit * inv_i_d;
             next.offset_sensitivity +=
                 (sensitivity - next.offset_sensitivity) * self.standstill_gain;
@@ -504,21 +509,48 @@ impl<T: Real> ResistanceAdaptationParams<T> {
 }
 
 impl<T: Real> ResistanceAdaptationState<T> {
-    /// R̂s after the integrand-offset estimate ê (`crate::integrand_offset`) moved by
-    /// `offset_change` (V): R̂s drops what standstill tests read of it, −⟨Δê, ∂R̂s/∂ê⟩,
-    /// within its bounds (compare-and-select: a NaN becomes a bound, so R̂s stays finite).
+    /// R̂s and the standstill tests' remaining share of it after the integrand-offset estimate
+    /// ê (`crate::integrand_offset`) moved by `offset_change` (V): R̂s drops what standstill
+    /// tests read of it, −⟨Δê, ∂R̂s/∂ê⟩, and, `bounded` (a saturating model), never more
+    /// than the tests put in (the change clamped between zero and −`standstill_share`, which
+    /// it then reduces), within R̂s's bounds (compare-and-select: a NaN becomes a bound, so
+    /// R̂s stays finite).
+    ///
+    /// Why the bound: ∂R̂s/∂ê is 1/i_d of the test's current, and the R̂s error it leaves
+    /// acts at the load's current, |i|/i_d times the offset's own voltage. A Δê that is not
+    /// the offset the test read (the offset law's transient through a load's arrival, a few
+    /// mV) would otherwise move R̂s past anything the test measured: on the traction IPMSM
+    /// (`crates/fado-sim/tests/data/traction-ipm-saturated.toml`, tests at 22 A, loaded at
+    /// 247 A) 4 mV move R̂s by −0.9 %, which the zero-speed passage integrates into the angle
+    /// at ΔR̂s·|i|/λa (docs/method/saturation.md, "The offset's re-attribution"). Bounded
+    /// on a saturating model only: there the offset law learns through the frame coupling
+    /// (up to `active_flux::OFFSET_COUPLING_MAX`), so a load's arrival leaves a share of its
+    /// frame error in ê; with constant inductances the transfer is the unbounded one, and
+    /// fig8–fig12 and the linear presets' runs stay as they are (bounded, fig8's largest
+    /// error near zero speed is 0.0064 rad instead of 0.0037).
     #[inline(always)]
     pub(crate) fn rs_after_offset_change(
         &self,
         scale: &ResistanceScale<T>,
         offset_change: Ab<T>,
-    ) -> T {
-        min(
-            max(
-                self.rs_hat - offset_change.dot(self.offset_sensitivity),
-                scale.rs_min,
-            ),
-            scale.rs_max,
+        bounded: bool,
+    ) -> (T, T) {
+        let share = self.standstill_share;
+        let wanted = offset_change.dot(self.offset_sensitivity);
+        // The change −wanted lies between 0 and −share: wanted between 0 and share.
+        let taken = min(max(wanted, min(share, T::zero())), max(share, T::zero()));
+        let moved = if !bounded || taken == wanted {
+            self.rs_hat - offset_change.dot(self.offset_sensitivity)
+        } else {
+            self.rs_hat - taken
+        };
+        (
+            min(max(moved, scale.rs_min), scale.rs_max),
+            if bounded {
+                share - taken
+            } else {
+                share - wanted
+            },
         )
     }
 }

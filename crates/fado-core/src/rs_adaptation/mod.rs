@@ -355,6 +355,10 @@ pub struct ResistanceAdaptationState<T> {
     /// standstill law (unit/i_d at its rate), forgotten at the turning law's rate; when the
     /// integrand-offset estimate ê moves by Δê, R̂s moves by −⟨Δê, ∂R̂s/∂ê⟩.
     pub offset_sensitivity: Ab<T>,
+    /// R̂s − (R̂s without the standstill tests), Ω: what the tests still contribute to R̂s.
+    /// Built with R̂s by the standstill law, forgotten with ∂R̂s/∂ê; it bounds what a change
+    /// of ê takes back (`rs_after_offset_change`): no more than the tests put in.
+    pub standstill_share: T,
     /// λ̂f law: ∫(|λ̂r| − λ̂a)·|ω̂|dt over the revolution under way, Wb·rad.
     pub flux_error_angle: T,
     /// λ̂f law: Σ a·sgn(ω̂)·Ts ≈ λ̂f·∫|χ|dθ over the revolution under way (module docs), Wb·rad.
@@ -380,6 +384,7 @@ impl<T: Real> ResistanceAdaptationState<T> {
             self.i_d_prev,
             self.offset_sensitivity.alpha,
             self.offset_sensitivity.beta,
+            self.standstill_share,
             self.flux_error_angle,
             self.flux_excitation,
             self.flux_angle,
@@ -474,3 +479,6 @@ impl<T: Real> ResistanceAdaptation<T> {
         self.params.config()
     }
 }
+
+#[cfg(test)]
+mod tests;

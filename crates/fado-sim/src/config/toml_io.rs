@@ -54,7 +54,7 @@ impl SimConfig {
         // types) name the key the user wrote and point at it.
         if saturation.is_some() || flux_map.is_some() || !converted.is_empty() {
             SimConfig::deserialize(toml::Value::Table(user.clone()))
-                .map_err(|e| key_error(e).located_in(text))?;
+                .map_err(|e| with_unknown_key_hint(key_error(e)).located_in(text))?;
         } else {
             toml::from_str::<SimConfig>(text).map_err(|e| located(text, e))?;
         }
@@ -136,16 +136,78 @@ fn located(text: &str, e: toml::de::Error) -> SimConfigError {
             k
         }
     };
-    if let Some(hint) = err
-        .message
-        .starts_with("unknown field")
-        .then(|| wrong_table_hint(&err.key))
-        .flatten()
-    {
-        err.message.push_str(&hint);
+    err = with_unknown_key_hint(err);
+    if let Some(at) = start {
+        syntax_hint(text, at, &mut err);
     }
     err.location = start.map(|at| SourceLocation::at(text, at));
     err
+}
+
+/// `err` (an unknown key) with the places the key belongs to: another table
+/// ([`wrong_table_hint`]) or, in `[motor]`, the datasheet's keys ([`datasheet_hint`]).
+pub(crate) fn with_unknown_key_hint(mut err: SimConfigError) -> SimConfigError {
+    if !err.message.starts_with("unknown field") {
+        return err;
+    }
+    if let Some(hint) = wrong_table_hint(&err.key).or_else(|| datasheet_hint(&err.key)) {
+        err.message.push_str(&hint);
+    }
+    err
+}
+
+/// For an unknown `motor.key`: the datasheet key it most likely means (a Kv, Kt, Ke or an
+/// inertia in kg·cm²), else the list of the datasheet keys `[motor]` takes.
+fn datasheet_hint(full: &str) -> Option<String> {
+    let key = full.strip_prefix("motor.")?.to_ascii_lowercase();
+    let keys: Vec<String> = fado_core::datasheet::ALTERNATIVES
+        .iter()
+        .map(|a| format!("`{}` ({})", a.key, a.unit))
+        .collect();
+    let meant = if key.starts_with("kv") {
+        Some("kv_rpm_per_volt")
+    } else if key.starts_with("kt") {
+        Some("kt_nm_per_arms")
+    } else if key.starts_with("ke") {
+        Some("ke_vll_rms_per_krpm` or `ke_vll_peak_per_krpm")
+    } else if key.starts_with("inertia") || key == "j" {
+        Some("inertia_kg_cm2` (kg·cm²) or `inertia")
+    } else {
+        None
+    };
+    Some(match meant {
+        Some(k) => format!(
+            "; a datasheet's constant is given as `{k}` (converted to fado's key; \
+             docs/guide/your-motor.md), and [motor] also takes {}",
+            keys.join(", ")
+        ),
+        None => format!(
+            "; [motor] also takes a datasheet's keys: {}",
+            keys.join(", ")
+        ),
+    })
+}
+
+/// A hint for a syntax error at `at` that has a usual cause: a decimal comma (`rs = 0,06`),
+/// a key given twice (named).
+fn syntax_hint(text: &str, at: usize, err: &mut SimConfigError) {
+    let bytes = text.as_bytes();
+    let digit = |i: Option<usize>| i.and_then(|i| bytes.get(i)).is_some_and(u8::is_ascii_digit);
+    if bytes.get(at) == Some(&b',') && digit(at.checked_sub(1)) && digit(Some(at + 1)) {
+        err.message
+            .push_str(": a decimal comma? TOML numbers take a point (0.06, not 0,06)");
+    } else if err.message.starts_with("duplicate key") {
+        let rest = text.get(at..).unwrap_or("");
+        let name: String = rest
+            .chars()
+            .take_while(|c| c.is_ascii_alphanumeric() || *c == '_' || *c == '-')
+            .collect();
+        if !name.is_empty() {
+            err.message.push_str(&format!(
+                ": `{name}` is given twice in its table (keep one)"
+            ));
+        }
+    }
 }
 
 /// For an unknown `section.key`: the tables of the configuration where `key` is a key (a key

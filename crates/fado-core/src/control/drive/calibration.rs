@@ -188,7 +188,10 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             return self.reject(i_abc);
         }
         self.i_ab_used = i_ab;
-        let command = self.gain.step(i_ab, self.history[1]);
+        let (rot, inverter) = self.calibration_inverter_voltage(i_abc, vdc);
+        let command = self
+            .gain
+            .step_with_inverter(i_ab, self.history[1], inverter);
         if !self.gain.running() {
             // Done (zero current after the release): the ratio, then the aligned start.
             let k = self.gain.ratio();
@@ -208,15 +211,17 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
                 }
             }
             self.last_i_ab = self.gain_corrected(i_abc).to_ab();
+            self.calibration_compensation = [Ab::zero(); 2];
             let theta0 = self.aligned_angle;
             if self.gain.status() == GainCalibrationStatus::RotorMoved {
                 // A load turns the rotor: the drive starts from where its back-EMF says the
                 // rotor has turned to, and the release hold catches it there before the speed
                 // loop takes over (`ReleaseHold::engage`).
                 let m = &self.config.machine;
-                let turned = self.gain.motion_travel(m.flux_linkage, m.ld);
+                let saliency = m.ld - m.lq;
+                let turned = self.gain.motion_travel(m.flux_linkage, saliency);
                 let theta = crate::wrap_angle(self.gain_axis() + turned);
-                let omega = self.gain.motion_speed(m.flux_linkage, m.ld);
+                let omega = self.gain.motion_speed(m.flux_linkage, saliency);
                 self.start_at(theta);
                 self.blocks.hold.engage(theta, omega);
                 return self.last;
@@ -224,9 +229,6 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             self.start_at(theta0);
             return self.last;
         }
-        let axis = self.gain_axis();
-        let theta0 = if axis.is_finite() { axis } else { T::zero() };
-        let rot = Rotation::from_angle(theta0);
         let i_dq = i_ab.to_dq(rot);
         let i_dq_ref = Dq::new(command.current_d, T::zero());
         let backup = self.blocks;
@@ -249,7 +251,24 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         if command.voltage.is_none() {
             b.current.realised(applied.v_dq);
         }
+        // The trapezoid at the reference current, for the motion test two samples on, when
+        // this voltage has acted.
+        let reference = b.dead_time.trapezoid(i_dq_ref.to_ab(rot).to_abc(), vdc);
+        self.calibration_compensation = [reference.to_ab(), self.calibration_compensation[0]];
         self.record(applied, i_dq, i_dq_ref, estimate, i_ab)
+    }
+
+    /// The gain calibration's frame (its axis) and what the inverter added to the voltage that
+    /// acted over the last period, as the dead-time trapezoid gives it: its value at the
+    /// reference current the voltage was computed for, less its value at the measured current
+    /// `i_abc` (offsets removed). Within the band a phase is a resistance of V̂/I_c (tens to
+    /// hundreds of ohms): with the current loop at zero, a turning rotor's back-EMF appears
+    /// across the idle devices and drives only a band current, which this term reads.
+    fn calibration_inverter_voltage(&self, i_abc: Abc<T>, vdc: T) -> (Rotation<T>, Ab<T>) {
+        let axis = self.gain_axis();
+        let rot = Rotation::from_angle(if axis.is_finite() { axis } else { T::zero() });
+        let loss = self.blocks.dead_time.trapezoid(i_abc, vdc).to_ab();
+        (rot, self.calibration_compensation[1] - loss)
     }
 
     /// The gain calibration's axis: the aligned angle, or with a held rotor

@@ -46,6 +46,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             estimator,
             blocks,
             history: [Ab::zero(); 2],
+            calibration_compensation: [Ab::zero(); 2],
             limited: [false; 2],
             last_i_ab: Ab::zero(),
             last: DriveOutput::idle(Estimate::default()),

@@ -209,6 +209,10 @@ pub struct SensorlessDrive<T: 'static, E = SensorlessEstimator<T>> {
     blocks: Blocks<T>,
     /// Realised references (before dead-time compensation) computed at n−1 and n−2.
     history: [Ab<T>; 2],
+    /// The dead-time trapezoid (α-β, V) at the reference currents of the gain calibration's
+    /// voltages computed at n−1 and n−2 (its rotor-motion test's inverter voltage; zero
+    /// outside it).
+    calibration_compensation: [Ab<T>; 2],
     /// Whether the modulator limited each of `history`'s voltages (the estimator's R̂s
     /// adaptation skips a period with a limited one, `RotorAngleEstimator::voltage_limited`).
     limited: [bool; 2],

@@ -89,18 +89,35 @@
 //! # Rotor motion
 //! The levels assume a rotor at rest: a load that arrives while the d current holds the rotor
 //! turns it (on the 2.2 kW IPMSM, 7 N·m against its 6 A upper level: towards 0.5 rad, and free
-//! once the current returns to zero). In voltage mode a turning rotor's back-EMF jω·λf lies
-//! across the axis; with the voltage frozen, the current across the axis obeys
-//! R̂s·Δi⊥ + L̂q·dΔi⊥/dt = −ω·λf, Δi⊥ its change since the level's first sample (at rest it
-//! only settles, within the resistive term's small change). The calibration evaluates the
-//! left side every sample (the current low-passed over [`MOTION_FILTER_TIME`] for its
-//! derivative) and ends at once with [`GainCalibrationStatus::RotorMoved`] above
-//! `motion_voltage` ([`MOTION_SPEED_RATIO`] of the rated speed's back-EMF): no release to zero
-//! current. The drive starts at once from the aligned angle with its release hold engaged
+//! once the current returns to zero). A turning rotor's back-EMF ω·ψa (ψa = λ̂f + (L̂d − L̂q)·i_d,
+//! the active flux) lies across the axis, and across it the voltage that acted obeys
+//! Δv⊥ = R̂s·Δi⊥ + L̂q·dΔi⊥/dt + ω·ψa, Δ the change since the stage's first sample. The
+//! calibration evaluates R̂s·Δi⊥ + L̂q·dΔi⊥/dt − Δv⊥ every sample of every stage (the current
+//! low-passed over [`MOTION_FILTER_TIME`] for its derivative, the voltage alike): in voltage
+//! mode the reference is frozen and Δv⊥ is the inverter's own change, under the current loop
+//! (the settling at I₁, the release to zero) it is the loop's voltage too. The inverter's part
+//! comes from the drive's dead-time trapezoid at the measured current against the one at the
+//! reference current (`GainCalibration::step_with_inverter`): a phase whose current a turning
+//! rotor moves into the band, or from one side of it to the other, changes its voltage by up
+//! to 2·V̂, which the rotor's motion does not explain (on the 2-pole spindle of
+//! `crates/fado-sim/tests/calibration_load_classes.rs`, the phase carrying a fifth of the
+//! level reverses, and without the term the test reads 0.69 of its threshold while the rotor
+//! turns at 500 r/min). Above `motion_voltage` ([`MOTION_SPEED_RATIO`] of the rated speed's
+//! back-EMF; [`LOOP_MOTION_FACTOR`] times it under the current loop, whose step through the
+//! band the trapezoid gives only roughly) the calibration ends at once with
+//! [`GainCalibrationStatus::RotorMoved`]: no release to zero current. The drive starts at once
+//! from the aligned angle plus the turn read ([`GainCalibration::motion_travel`]) with its
+//! release hold engaged
 //! ([`ReleaseHold::engage`](crate::control::release_hold::ReleaseHold::engage)), which catches
-//! the rotor there and hands the load it found to the speed loop. Measured on the presets at
-//! rest (switching-resolved, default sensors): at most 0.59 of the threshold
-//! ([`GainCalibration::motion_peak`]).
+//! the rotor there and hands the load it found to the speed loop. Measured on the presets and
+//! the machines of that test at rest (switching-resolved, default sensors, five angles): at
+//! most 0.59 of the threshold in voltage mode ([`GainCalibration::motion_peak`]) and 0.48
+//! under the loop ([`GainCalibration::loop_motion_peak`]).
+//!
+//! With the loop at zero current every phase sits in the inverter's band, a resistance of
+//! V̂/I_c (V̂ the dead-time and device voltage, I_c the band): a back-EMF below V̂ drives a
+//! band current of a few sensor steps, and the release stage reads a turning rotor only once
+//! its back-EMF nears V̂ (the 1.5 kW servo motor there: 8.8 V, 5 % of its rated speed).
 //!
 //! # Sequence
 //! Current loop at I₁ (`settle_time`); voltage V₁: hold (`hold_time`), average
@@ -118,7 +135,9 @@ mod sequence;
 mod tests;
 
 pub use measure::{ratio_of, resistance_of};
-pub use motion::{MOTION_FILTER_TIME, MOTION_SPEED_RATIO, MOTION_TRAVEL_SHARE, motion_voltage};
+pub use motion::{
+    LOOP_MOTION_FACTOR, MOTION_FILTER_TIME, MOTION_SPEED_RATIO, MOTION_TRAVEL_SHARE, motion_voltage,
+};
 
 use crate::error::{ConfigError, check};
 use crate::{Ab, Real};
@@ -253,6 +272,10 @@ pub struct GainCalibration<T> {
     /// motion test's reference, and Δi⊥ low-passed (A).
     cross_ref: T,
     cross_filtered: T,
+    /// The voltage that acted across the axis at the stage's first sample (V), and its
+    /// change since then low-passed as Δi⊥ is (V).
+    cross_v_ref: T,
+    cross_v_filtered: T,
     /// Σ of the back-EMF across the axis times Ts over the level's samples where it exceeded
     /// [`MOTION_TRAVEL_SHARE`] of `motion_voltage` (V·s): the turn of a moving rotor times its
     /// d-axis flux ([`GainCalibration::motion_flux`]).
@@ -263,6 +286,8 @@ pub struct GainCalibration<T> {
     motion_emf: T,
     /// The largest |back-EMF across the axis| read since the start, over `motion_voltage`.
     motion_peak: T,
+    /// The same, of the stages under the current loop.
+    loop_motion_peak: T,
     status: GainCalibrationStatus,
     ratio: T,
     /// The last measured ratio, also when refused (NaN before any).
@@ -333,10 +358,13 @@ impl<T: Real> GainCalibration<T> {
             aborted: false,
             cross_ref: T::zero(),
             cross_filtered: T::zero(),
+            cross_v_ref: T::zero(),
+            cross_v_filtered: T::zero(),
             motion_flux: T::zero(),
             motion_current: T::zero(),
             motion_emf: T::zero(),
             motion_peak: T::zero(),
+            loop_motion_peak: T::zero(),
             status,
             ratio: T::one(),
             measured: T::zero() / T::zero(),

@@ -32,10 +32,13 @@ impl<T: Real> GainCalibration<T> {
         self.aborted = false;
         self.cross_ref = T::zero();
         self.cross_filtered = T::zero();
+        self.cross_v_ref = T::zero();
+        self.cross_v_filtered = T::zero();
         self.motion_flux = T::zero();
         self.motion_current = T::zero();
         self.motion_emf = T::zero();
         self.motion_peak = T::zero();
+        self.loop_motion_peak = T::zero();
         self.v_lower = Ab::zero();
         self.v_lower_count = 0;
         self.stage = Stage::Settle;
@@ -73,6 +76,21 @@ impl<T: Real> GainCalibration<T> {
     /// out of the averages; every sample advances the sequence, so it always ends (after
     /// [`duration_samples`](Self::duration_samples) at most).
     pub fn step(&mut self, i_ab: Ab<T>, v_ab: Ab<T>) -> GainCalibrationCommand<T> {
+        self.step_with_inverter(i_ab, v_ab, Ab::zero())
+    }
+
+    /// [`step`](Self::step) on a real inverter: `inverter` is what the inverter added to the
+    /// realised reference `v_ab` over the last period as the drive models it (its dead-time
+    /// compensation less the loss its model gives at the measured current; zero for an
+    /// ideal inverter). The rotor-motion test reads the back-EMF from the voltage that acted,
+    /// `v_ab + inverter`, in every stage (module docs, "Rotor motion"); the levels' averages
+    /// take `v_ab` alone, whose inverter error cancels between them.
+    pub fn step_with_inverter(
+        &mut self,
+        i_ab: Ab<T>,
+        v_ab: Ab<T>,
+        inverter: Ab<T>,
+    ) -> GainCalibrationCommand<T> {
         if self.status != GainCalibrationStatus::Running {
             return GainCalibrationCommand {
                 current_d: T::zero(),
@@ -87,15 +105,16 @@ impl<T: Real> GainCalibration<T> {
             self.stage = Stage::Release;
             self.remaining = self.settle_samples;
         }
-        // Rotor motion: with the voltage frozen, a turning rotor's back-EMF (across the
-        // axis, where the rotor's q axis lies) drives a current across it; at rest that
-        // current stays where it was when the voltage was frozen.
-        let emf = if voltage_mode && finite {
-            self.motion_emf(i_ab)
+        // Rotor motion: a turning rotor's back-EMF lies across the axis (where the rotor's
+        // q axis lies). With the voltage frozen it drives a current across it; with the
+        // current loop holding the current, the loop's voltage across it follows the
+        // back-EMF. At rest both stay where they were at the stage's first sample.
+        let emf = if finite && inverter.is_finite() {
+            self.motion_emf(i_ab, v_ab, inverter, voltage_mode)
         } else {
             T::zero()
         };
-        if emf.abs() > self.config.motion_voltage {
+        if emf.abs() > self.motion_threshold(voltage_mode) {
             self.motion_current = self.command().current_d;
             self.motion_emf = emf;
             self.stage = Stage::Idle;

@@ -7,12 +7,25 @@ use fado_sim::SimConfigError;
 use fado_sim::output::OutputError;
 use fado_sim::scenario;
 
-/// Prints the plausibility warnings of `cfg`'s motor on stderr, naming the file.
-pub fn warn_plausibility(cfg: &fado_sim::SimConfig, config: Option<&Path>) {
-    for w in cfg.warnings() {
-        match config {
-            Some(p) => eprintln!("warning: {}: {w}", p.display()),
-            None => eprintln!("warning: {w}"),
+/// Prints the plausibility warnings of `cfg`'s motor on stderr, each at the
+/// FILE:LINE:COLUMN of the key it blames first when `text` (the file's) holds it, else naming
+/// the file.
+pub fn warn_plausibility(cfg: &fado_sim::SimConfig, config: Option<&Path>, text: Option<&str>) {
+    use fado_core::machine_checks::Severity;
+    for (_, key, w) in cfg
+        .machine_findings()
+        .into_iter()
+        .filter(|(s, ..)| *s == Severity::Warning)
+    {
+        let at = text
+            .and_then(|t| fado_sim::source::value_span(t, &key).map(|s| (t, s.start)))
+            .map(|(t, start)| fado_sim::source::SourceLocation::at(t, start));
+        match (config, at) {
+            (Some(p), Some(at)) => {
+                eprintln!("{}:{}:{}: warning: {w}", p.display(), at.line, at.column)
+            }
+            (Some(p), None) => eprintln!("warning: {}: {w}", p.display()),
+            (None, _) => eprintln!("warning: {w}"),
         }
     }
 }
@@ -40,14 +53,63 @@ pub fn read_file(path: &Path) -> Result<String, Box<dyn std::error::Error>> {
         )
         .into());
     }
-    String::from_utf8(bytes).map_err(|e| {
-        OutputError::new(
-            "read",
-            path,
-            std::io::Error::new(std::io::ErrorKind::InvalidData, e),
+    let text = String::from_utf8(bytes).map_err(|e| not_utf8(path, &e))?;
+    if is_blank(&text) {
+        return Err(SimConfigError::new(
+            "<config>",
+            format!(
+                "{} holds no key (empty, or only comments): give the motor's [motor] table \
+                 (docs/guide/your-motor.md), or leave out --config to run the scenario's own \
+                 motor",
+                path.display()
+            ),
         )
-        .into()
-    })
+        .into());
+    }
+    Ok(text)
+}
+
+/// The error of a `--config` file that is not UTF-8, at the line and column of its first bad
+/// byte (a file saved as Latin-1 or Windows-1252, often for a `Ω` or `µ` in a comment).
+fn not_utf8(path: &Path, e: &std::string::FromUtf8Error) -> SimConfigError {
+    let at = e.utf8_error().valid_up_to();
+    let good = String::from_utf8_lossy(&e.as_bytes()[..at]).into_owned();
+    let mut err = SimConfigError::new(
+        "<config>",
+        format!(
+            "byte 0x{:02x} is not UTF-8: TOML files are UTF-8 (saved as Latin-1 or \
+             Windows-1252, for a `Ω` or `µ` in a comment?); save it as UTF-8",
+            e.as_bytes()[at]
+        ),
+    );
+    err.location = Some(fado_sim::source::SourceLocation::at(&good, good.len()));
+    err.in_file(path.display().to_string())
+}
+
+/// True when `text` has nothing but whitespace, comments and a byte-order mark.
+fn is_blank(text: &str) -> bool {
+    text.trim_start_matches('\u{feff}')
+        .lines()
+        .map(str::trim)
+        .all(|l| l.is_empty() || l.starts_with('#'))
+}
+
+/// A note on stderr when the `--config` file `text` has no `[motor]` table: the scenario's
+/// own motor runs (the paper's for the paper's figures and the ratings-scaled scenarios).
+pub fn note_scenario_motor(text: Option<&str>, config: Option<&Path>) {
+    let (Some(text), Some(path)) = (text, config) else {
+        return;
+    };
+    let has_motor = text
+        .parse::<toml::Table>()
+        .is_ok_and(|t| t.contains_key("motor"));
+    if !has_motor {
+        eprintln!(
+            "note: {} has no [motor] table: the scenario's own motor runs (the paper's, \
+             motors/paper.toml, unless the scenario names another)",
+            path.display()
+        );
+    }
 }
 
 /// A CSV write error as the output error naming `path`.

@@ -74,7 +74,23 @@ const EXIT_CONFIG: u8 = 2;
 const EXIT_IO: u8 = 3;
 
 fn main() -> ExitCode {
-    let code = match run(Cli::parse()) {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        // `--help` and `--version` print through `out!` (a closed or full stdout never panics
+        // and a full one exits 3, as every command's output).
+        Err(e) if !e.use_stderr() => {
+            out!("{}", e.render());
+            return match stdout::take_error() {
+                Some(err) => {
+                    eprintln!("error: cannot write to stdout: {err}");
+                    ExitCode::from(EXIT_IO)
+                }
+                None => ExitCode::SUCCESS,
+            };
+        }
+        Err(e) => e.exit(),
+    };
+    let code = match run(cli) {
         Ok(code) => code,
         Err(e) => {
             eprintln!("error: {e}");

@@ -108,7 +108,7 @@ fn load(
                 )
                 .into());
             }
-            warn_plausibility(&cfg, Some(path));
+            warn_plausibility(&cfg, Some(path), Some(&text));
             Ok((text, cfg))
         }
         (None, Some(name)) => {
@@ -247,10 +247,20 @@ fn write_whole(path: &Path, text: &str) -> Result<output::Finished, OutputError>
 /// The magnetic model: detected or not, and its errors over the rated current range.
 fn print_magnetics(m: &fado_sim::commission::MagneticsReport, motion: f64) {
     let a = &m.accuracy;
-    let verdict = if m.saturation_detected {
-        "saturation detected (the fitted algebraic model)"
-    } else {
-        "no saturation detected (constant inductances)"
+    let verdict = match m.verdict {
+        "rotor_moved" => format!(
+            "saturation not identified: the rotor turned {:.3} rad during the pulses, beyond \
+             the {} rad within which they tell saturation (constant inductances)",
+            m.pulse_motion,
+            fado_core::commissioning::PULSE_MOTION_LIMIT
+        ),
+        "inconclusive" => format!(
+            "saturation not identified: the best fit does not explain the flux linkage \
+             (residual {:.3} of constant inductances'; constant inductances)",
+            m.residual_rms / m.linear_residual_rms
+        ),
+        "detected" => "saturation detected (the fitted algebraic model)".to_owned(),
+        _ => "no saturation detected (constant inductances)".to_owned(),
     };
     outln!(
         "magnetics: {verdict} (inductances change {:.1} % up to {:.3} A; rotor turned {:.3} rad)",

@@ -49,6 +49,13 @@ fn estimators_help() -> String {
 /// DIR/compare.md and DIR/compare.json and prints the table.
 pub fn compare(args: CompareArgs) -> Outcome {
     let opts = options(&args)?;
+    let dir = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("out").join("compare"));
+    // Taken before the runs: an output directory that cannot be created or that another
+    // command holds is reported at once, not after the comparison.
+    let _lock = DirLock::acquire(&dir)?;
     let mut result = compare::compare(&opts).map_err(|e| in_file(e, &args.config))?;
     if let Some(dir) = &args.criterion {
         let costs = compare::read_criterion_step_costs(dir, &opts.estimators);
@@ -60,10 +67,6 @@ pub fn compare(args: CompareArgs) -> Outcome {
         }
         result.set_step_costs(costs);
     }
-    let dir = args
-        .out
-        .unwrap_or_else(|| PathBuf::from("out").join("compare"));
-    let _lock = DirLock::acquire(&dir)?;
     let md = result.to_markdown();
     AtomicFile::write(&dir.join("compare.md"), md.as_bytes())?;
     AtomicFile::write(

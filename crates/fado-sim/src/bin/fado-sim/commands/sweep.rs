@@ -9,7 +9,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 
 use super::Outcome;
 use crate::axes;
-use crate::files::{in_file, read_file};
+use crate::files::{in_file, read_file, warn_plausibility};
 
 /// The arguments of `sweep`.
 #[derive(clap::Args)]
@@ -51,7 +51,8 @@ pub fn sweep(args: SweepArgs) -> Outcome {
     if let Some(p) = &args.config {
         spec.config_toml = Some(read_file(p)?);
     }
-    spec.base_config().map_err(|e| in_file(e, &args.config))?;
+    let base = spec.base_config().map_err(|e| in_file(e, &args.config))?;
+    warn_plausibility(&base, args.config.as_deref(), spec.config_toml.as_deref());
     let dir = args
         .out
         .unwrap_or_else(|| PathBuf::from("out").join(format!("{}-sweep", args.scenario)));

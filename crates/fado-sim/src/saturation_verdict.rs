@@ -1,0 +1,99 @@
+//! What `fado-sim commission` says of the standstill pulses' verdict on a machine's
+//! saturation ([`SaturationVerdict`]): its name in metrics.json, the header line of
+//! identified.toml, and the online R̂s law fixed where the saturation is unidentified.
+
+use fado_core::commissioning::{Identification, PULSE_MOTION_LIMIT, SaturationVerdict};
+
+/// The name of a [`SaturationVerdict`] in metrics.json.
+pub fn verdict_name(v: SaturationVerdict) -> &'static str {
+    match v {
+        SaturationVerdict::Detected => "detected",
+        SaturationVerdict::NotDetected => "not_detected",
+        SaturationVerdict::Inconclusive => "inconclusive",
+        SaturationVerdict::RotorMoved => "rotor_moved",
+        SaturationVerdict::NotMeasured => "not_measured",
+    }
+}
+
+/// Where the pulses left the saturation unidentified (`inconclusive`, `rotor_moved`: the
+/// model's constant inductances are likely wrong at load), `[estimator.rs_adaptation]
+/// enabled = false` in `doc`, and the header line saying why: the online R̂s law reads the
+/// model's flux error at load as resistance. On the 750 W servo SPM
+/// (`tests/data/spm-dq-sat-saturated.toml`) it drifted by +1.3 % and lost `stops` (0.8–1.1
+/// rad on seeds 1–4); with R̂s fixed at the commissioned value `reversal`, `stops` and
+/// `rated-reversal` pass (0.04–0.14 rad). A key the user set is kept.
+pub(crate) fn freeze_resistance_law(doc: &mut toml::Table, id: &Identification<f64>) -> String {
+    if !matches!(
+        id.saturation_verdict(),
+        SaturationVerdict::Inconclusive | SaturationVerdict::RotorMoved
+    ) {
+        return String::new();
+    }
+    let estimator = doc
+        .entry("estimator")
+        .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+    let Some(estimator) = estimator.as_table_mut() else {
+        return String::new();
+    };
+    let law = estimator
+        .entry("rs_adaptation")
+        .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+    let Some(law) = law.as_table_mut() else {
+        return String::new();
+    };
+    if law.contains_key("enabled") {
+        return String::new();
+    }
+    law.insert("enabled".into(), toml::Value::Boolean(false));
+    "# [estimator.rs_adaptation] enabled = false: with the saturation unidentified, the online \
+     R̂s law would read the constant inductances' flux error at load as resistance; R̂s stays \
+     the commissioned value (re-run the commissioning after a large temperature change).\n"
+        .into()
+}
+
+/// The header's statement on the magnetic model: saturation detected (the written
+/// `[model.saturation]`) or not (constant inductances), with the detection statistic.
+pub(crate) fn saturation_comment(id: &Identification<f64>) -> String {
+    let change = 100.0 * id.saturation_change;
+    let range = id.saturation_current;
+    if !id.saturation_change.is_finite() {
+        return "# Magnetic saturation: not measured (the flux-linkage pulses did not run).\n"
+            .into();
+    }
+    match id.saturation_verdict() {
+        SaturationVerdict::RotorMoved => {
+            return format!(
+                "# Magnetic saturation not identified: the rotor turned {:.3} rad (electrical) \
+                 during the standstill flux-linkage pulses, beyond the {PULSE_MOTION_LIMIT} rad \
+                 within which they tell saturation from the turning magnet's back-EMF (a rotor \
+                 too light for pulses of the rated current, even at the shortest rises); the \
+                 model keeps constant inductances.\n",
+                id.saturation_motion
+            );
+        }
+        SaturationVerdict::Inconclusive => {
+            return format!(
+                "# Magnetic saturation not identified: the best fit's incremental inductances \
+                 change by {change:.1} % up to {range:.3} A but it does not explain the flux \
+                 linkage (RMS current residual {:.3e} A against {:.3e} A with constant \
+                 inductances, not below half of it): the pulses' flux is too inaccurate on this \
+                 machine to show saturation or its absence; the model keeps constant \
+                 inductances.\n",
+                id.saturation_residual, id.linear_residual
+            );
+        }
+        _ => {}
+    }
+    match id.saturation {
+        Some(_) => format!(
+            "# Magnetic saturation detected: the incremental inductances change by {change:.1} % \
+             up to {range:.3} A; [model.saturation] is the algebraic model fitted to the \
+             standstill flux-linkage pulses (RMS current residual {:.3e} A).\n",
+            id.saturation_residual
+        ),
+        None => format!(
+            "# No magnetic saturation detected: the incremental inductances change by \
+             {change:.1} % up to {range:.3} A; the model keeps constant inductances.\n"
+        ),
+    }
+}

@@ -1,0 +1,225 @@
+//! Inputs a user gives by slip, through the CLI: each gets an error or a warning at the
+//! FILE:LINE:COLUMN of the key it blames, naming the likely cause, or runs correctly.
+//! (`docs/guide/your-motor.md` describes the keys; `fado_core::machine_checks` the checks.)
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+
+/// A fresh scratch directory for `name`.
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("fado-slips-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// `fado-sim run reversal --dump-config --config FILE` (no simulation): (exit code, stderr).
+fn dump(path: &Path) -> (Option<i32>, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_fado-sim"))
+        .args(["run", "reversal", "--dump-config", "--config"])
+        .arg(path)
+        .stdout(Stdio::null())
+        .output()
+        .unwrap();
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// Writes `text` as `name` in a scratch directory and dumps it.
+fn dump_text(name: &str, text: &str) -> (Option<i32>, String, PathBuf) {
+    let dir = scratch(name);
+    let path = dir.join(format!("{name}.toml"));
+    std::fs::write(&path, text).unwrap();
+    let (code, err) = dump(&path);
+    (code, err, path)
+}
+
+/// The 14-pole outrunner of `examples/motors/my-outrunner.toml` (Kv 100 r/min/V).
+const OUTRUNNER: &str = "[motor]\nrs = 0.06\nld = 30e-6\nlq = 30e-6\nflux_linkage = 7.88e-3\n\
+                         pole_pairs = 7\ninertia = 5e-4\nviscous_friction = 1.2e-4\n\
+                         rated_current = 28.3\nrated_speed_rpm = 1800.0\nrated_torque = 2.34\n\
+                         \n[inverter]\ndc_voltage = 24.0\nswitching_frequency = 20000.0\n";
+
+#[test]
+fn a_line_to_line_flux_on_a_strongly_salient_ipm_is_a_warning_at_its_line() {
+    // motors/ipmsm-gem-50k.toml with λf × √3 (0.066 → 0.1143 Wb): 0.79 × the MTPA torque.
+    let preset = include_str!("../../../motors/ipmsm-gem-50k.toml");
+    let text = preset.replace("flux_linkage = 0.066 ", "flux_linkage = 0.1143 ");
+    assert_ne!(text, preset);
+    let line = text
+        .lines()
+        .position(|l| l.starts_with("flux_linkage"))
+        .unwrap()
+        + 1;
+    let (code, err, path) = dump_text("gem-ll", &text);
+    assert_eq!(code, Some(0), "{err}");
+    let at = format!("{}:{line}:16: warning: ", path.display());
+    assert!(err.contains(&at), "{at}\n{err}");
+    assert!(err.contains("line-to-line"), "{err}");
+    // The preset itself: no warning.
+    let (code, err, _) = dump_text("gem", preset);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(!err.contains("warning"), "{err}");
+}
+
+#[test]
+fn a_kv_or_kt_key_is_pointed_to_the_datasheet_keys_and_kv_is_converted() {
+    let text = OUTRUNNER.replace("flux_linkage = 7.88e-3", "Kv = 100.0");
+    let (code, err, path) = dump_text("kv", &text);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.starts_with(&format!("error: {}:5:1: `motor.Kv`", path.display())),
+        "{err}"
+    );
+    assert!(err.contains("`kv_rpm_per_volt`"), "{err}");
+    // Given as the datasheet key: λf = 60/(2π·√3·p·Kv) = 7.876 mWb, printed with its rule.
+    let text = OUTRUNNER
+        .replace("flux_linkage = 7.88e-3", "kv_rpm_per_volt = 100.0")
+        .replace("inertia = 5e-4", "inertia_kg_cm2 = 5.0");
+    let dir = scratch("kv-ok");
+    let path = dir.join("kv-ok.toml");
+    std::fs::write(&path, text).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_fado-sim"))
+        .args(["run", "reversal", "--dump-config", "--config"])
+        .arg(&path)
+        .output()
+        .unwrap();
+    let dumped = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{dumped}");
+    let value = |key: &str| -> f64 {
+        let line = dumped
+            .lines()
+            .find(|l| l.starts_with(&format!("{key} = ")))
+            .unwrap_or_else(|| panic!("{key}: {dumped}"));
+        line.split('=')
+            .nth(1)
+            .unwrap()
+            .split('#')
+            .next()
+            .unwrap()
+            .trim()
+            .parse()
+            .unwrap()
+    };
+    assert!((value("flux_linkage") - 7.876e-3).abs() < 1e-6);
+    assert!((value("inertia") - 5e-4).abs() < 1e-12);
+    assert!(dumped.contains("from kv_rpm_per_volt"), "{dumped}");
+    assert!(dumped.contains("from inertia_kg_cm2"), "{dumped}");
+    // No torque warning: Kv converted as the docs state agrees with the rated torque.
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("warning"));
+}
+
+#[test]
+fn a_decimal_comma_and_a_key_given_twice_are_named() {
+    let (code, err, path) = dump_text("comma", &OUTRUNNER.replace("rs = 0.06", "rs = 0,06"));
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains(&format!("{}:2:7:", path.display())), "{err}");
+    assert!(err.contains("decimal comma"), "{err}");
+    let text = OUTRUNNER.replace("pole_pairs = 7\n", "pole_pairs = 7\npole_pairs = 14\n");
+    let (code, err, path) = dump_text("twice", &text);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains(&format!("{}:7:1:", path.display())), "{err}");
+    assert!(err.contains("`pole_pairs` is given twice"), "{err}");
+}
+
+#[test]
+fn an_empty_config_is_refused_and_one_without_a_motor_says_whose_motor_runs() {
+    for (name, text) in [("empty", ""), ("comments", "# my motor\n\n# todo\n")] {
+        let (code, err, path) = dump_text(name, text);
+        assert_eq!(code, Some(2), "{err}");
+        assert!(err.contains(&path.display().to_string()), "{err}");
+        assert!(err.contains("holds no key"), "{err}");
+    }
+    let (code, err, path) = dump_text("no-motor", "[simulation]\nduration = 0.5\n");
+    assert_eq!(code, Some(0), "{err}");
+    assert!(
+        err.contains(&format!("{} has no [motor] table", path.display())),
+        "{err}"
+    );
+    assert!(err.contains("paper"), "{err}");
+}
+
+/// A motor file with the flux map `csv` (the first 3 × 3 nodes of a surface-magnet map).
+fn with_map(name: &str, csv: &str) -> (Option<i32>, String) {
+    let dir = scratch(name);
+    std::fs::write(dir.join("map.csv"), csv).unwrap();
+    let toml = "[motor]\nrs = 0.5\nld = 3e-3\nlq = 3e-3\nflux_linkage = 0.1\npole_pairs = 3\n\
+                rated_current = 8.0\nrated_speed_rpm = 3000.0\nrated_torque = 3.6\n\
+                flux_map = \"map.csv\"\n";
+    let path = dir.join("motor.toml");
+    std::fs::write(&path, toml).unwrap();
+    dump(&path)
+}
+
+/// A linear 3 × 3 map of L = 3 mH and λf = 0.1 Wb, its rows joined by `sep` with the
+/// decimal mark `dot`; `swap` exchanges the ψ columns.
+fn map(sep: &str, dot: &str, swap: bool) -> String {
+    let mut s = ["i_d", "i_q", "psi_d", "psi_q"].join(sep) + "\n";
+    for i_d in [-10.0, 0.0, 10.0] {
+        for i_q in [-10.0, 0.0, 10.0] {
+            let (pd, pq) = (0.1 + 3e-3 * i_d, 3e-3 * i_q);
+            let (pd, pq) = if swap { (pq, pd) } else { (pd, pq) };
+            let row = [i_d, i_q, pd, pq].map(|x: f64| format!("{x:.4}").replace('.', dot));
+            s += &(row.join(sep) + "\n");
+        }
+    }
+    s
+}
+
+#[test]
+fn a_flux_map_from_a_spreadsheet_or_with_swapped_columns_is_named() {
+    let (code, err) = with_map("map-ok", &map(",", ".", false));
+    assert_eq!(code, Some(0), "{err}");
+    let (code, err) = with_map("map-semicolon", &map(";", ",", false));
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("map.csv:1:1:"), "{err}");
+    assert!(err.contains("semicolons or tabs"), "{err}");
+    let (code, err) = with_map("map-swapped", &map(",", ".", true));
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("psi_d and psi_q look swapped"), "{err}");
+    assert!(!err.contains("  "), "{err}");
+    let upper = map(",", ".", false).replacen("i_d,i_q,psi_d,psi_q", "I_d,I_q,Psi_d,Psi_q", 1);
+    let (code, err) = with_map("map-upper", &upper);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("lower case"), "{err}");
+}
+
+#[test]
+fn help_on_a_full_stdout_exits_3_and_on_a_closed_one_does_not_panic() {
+    let Ok(full) = std::fs::OpenOptions::new().write(true).open("/dev/full") else {
+        return;
+    };
+    let out = Command::new(env!("CARGO_BIN_EXE_fado-sim"))
+        .arg("--help")
+        .stdout(full)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(3));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("cannot write to stdout"));
+    let mut child = Command::new(env!("CARGO_BIN_EXE_fado-sim"))
+        .args(["run", "--help"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(out.status.code(), Some(0), "{out:?}");
+}
+
+#[test]
+fn a_config_saved_as_latin_1_is_named_at_its_bad_byte() {
+    // "rs = 0.06   # 0.12 µ…" with µ as Latin-1's 0xb5 on line 2.
+    let mut bytes = b"[motor]\nrs = 0.06   # 0.12 ".to_vec();
+    bytes.push(0xb5);
+    bytes.extend_from_slice(&OUTRUNNER.as_bytes()["[motor]\nrs = 0.06".len()..]);
+    let dir = scratch("latin1");
+    let path = dir.join("latin1.toml");
+    std::fs::write(&path, bytes).unwrap();
+    let (code, err) = dump(&path);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains(&format!("{}:2:20:", path.display())), "{err}");
+    assert!(err.contains("0xb5 is not UTF-8"), "{err}");
+}
