@@ -86,16 +86,18 @@ slow it, so that figures measured under load are lower bounds).
   i(ψ) is solved in closed form per bilinear cell, from the cell of the sub-step's warm start
   (`fado_core::magnetics`, "Inversion"); the sub-step is 0.05 of the shortest incremental
   time constant over the map's own grid (`fado-sim`'s `magnetics` module), so that nearly every
-  interval of one switch state is one sub-step: four inversions (Runge–Kutta), two on the short
-  ones. The plant keeps the warm start's cell and the last four cells' polynomials
-  (`fado_core::magnetics::InverseCache`), so that an inversion is one quadratic — a square root
-  and two divisions in sequence, whose latency bounds it: the inversions are about 30 % of the
-  GEM map's CPU time (`perf record` on `fado-sim run stops`). The estimator reads the map
-  through its C¹ interpolant (`FluxMap::smooth_flux_and_jacobian`, docs/method/saturation.md
-  "A map's interpolation"): a 4 × 4 stencil per flux component, evaluated for the operating
-  point's flux, the R̂s law's point and the incremental inductances of the frame coupling and
-  the R̂s regressor, about 23 % of the CPU time; these evaluations share the operating point
-  but not their results, which is where the map rows fall short of 50× real time.
+  interval of one switch state is one sub-step: three inversions (the Runge–Kutta stages; the
+  end's current, a hair from the last stage's flux, is one Newton step in that stage's cell),
+  two on the short ones. The plant keeps the warm start's cell and the last four cells'
+  polynomials (`fado_core::magnetics::InverseCache`), so that an inversion is one quadratic —
+  a square root and a division in sequence, whose latency bounds it: the inversions are about
+  20 % of the GEM map's CPU time and the Runge–Kutta steps around them 8 % (`perf record` on
+  `fado-sim run stops`). The estimator reads the map through its C¹ interpolant
+  (docs/method/saturation.md "A map's interpolation") twice per sample, at the two operating
+  points it forms (the observer's and the rotor flux's, at different currents): the flux
+  alone (`FluxMap::smooth_flux`), the cells found as the bilinear lookup finds them, the node
+  slopes along i_q loaded (found once per map); the Jacobian only in the slow laws' slots.
+  These reads are about 12 % of the CPU time; the drive's torque solve on the map about 5 %.
 - **Algebraic model** (`ipmsm-2k2-qsat`, `pmsyrm-baldor-5k6`): the plant's i(ψ) is the model's
   own closed form; the drive's and the estimator's ψ(i) are Newton solves started from the
   tangent plane of their last solution (`fado_core::magnetics::FluxWarmStart`: one step and the

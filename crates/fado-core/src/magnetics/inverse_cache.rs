@@ -83,6 +83,9 @@ impl<T: Real> InverseCache<T> {
             self.start = grid.cell_of(guess);
             self.guess = guess;
         }
+        if let Some(found) = self.in_start_cell(grid, psi) {
+            return Some(found);
+        }
         let (slots, next) = (&mut self.slots, &mut self.next);
         let solved = invert_from(grid, self.start, |k, m| {
             let at = match slots
@@ -115,6 +118,30 @@ impl<T: Real> InverseCache<T> {
         solved.map(|(i, _)| i)
     }
 
+    /// The walk's first cell alone, where the start cell is kept and holds the root (the walk
+    /// then ends there, with this arithmetic): no slot search, no walk.
+    #[inline(always)]
+    fn in_start_cell(&mut self, grid: &impl CellGrid<T>, psi: Dq<T>) -> Option<Dq<T>> {
+        let (k, m) = self.start;
+        let at = self.last.map_or(0, |(at, _, _)| at);
+        let (a, b, cell, constants) = self.slots.get(at).copied().flatten()?;
+        if (a, b) != (k, m) {
+            return None;
+        }
+        let (u, v) = cell.solve_with(psi, constants)?;
+        let (last_k, last_m) = grid.last_cell();
+        let tol = cell_tolerance::<T>();
+        if direction(u, k, last_k, tol) != 0 || direction(v, m, last_m, tol) != 0 {
+            return None;
+        }
+        let i = grid.current_at(k, m, u, v);
+        if !i.is_finite() {
+            return None;
+        }
+        self.last = Some((at, u, v));
+        Some(i)
+    }
+
     /// i(ψ) by one Newton step on the polynomial of the last solution's cell from that
     /// solution, where `psi` lies so near it that the step's own error (the cell's twist times
     /// the product of the step's fractions: exact for a bilinear cell) is below
@@ -141,8 +168,8 @@ impl<T: Real> InverseCache<T> {
     }
 }
 
-/// The largest error of [`InverseCache::refine`]'s Newton step as a fraction of its cell
-/// (10⁻⁹ A on a 1 A cell), ours: orders of magnitude below a plant integrator's own error
-/// (10⁻⁵ A, `fado-sim`'s magnetics tests), at a step a Runge–Kutta step's end moves from its
-/// last stage (10⁻⁵ of a cell: 10⁻¹¹ of it).
+/// The largest error of [`super::Magnetics::current_near_cached`]'s Newton step as a fraction
+/// of its cell (10⁻⁹ A on a 1 A cell), ours: orders of magnitude below a plant integrator's
+/// own error (10⁻⁵ A, `fado-sim`'s magnetics tests), at a step a Runge–Kutta step's end moves
+/// from its last stage (10⁻⁵ of a cell: 10⁻¹¹ of it).
 pub const REFINE_TOLERANCE: f64 = 1e-9;

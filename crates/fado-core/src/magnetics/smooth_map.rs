@@ -307,6 +307,9 @@ impl<'a, T: Real> FluxMap<'a, T> {
 
     /// ψ(i) of the map's C¹ interpolant alone: [`FluxMap::smooth_flux_and_jacobian`]'s flux,
     /// bit for bit, without the Jacobian inside the grid (beyond it the extension needs it).
+    /// Out of line, as the full lookup is: a step that matches on the model (the firmware's
+    /// record) keeps its other models' code as small as without it.
+    #[inline(never)]
     pub fn smooth_flux(&self, i: Dq<T>) -> Dq<T> {
         let s = self.stencil(i);
         if !s.inside {
