@@ -143,7 +143,7 @@ more than a quarter without explaining the data, "rotor moved" where the rotor t
 `ipmsm-test-saturated` is a made-up machine of other exponents
 (`crates/fado-sim/tests/data/ipmsm-test-saturated.toml`); `spm-dq-sat-saturated` a made-up
 750 W servo SPM whose d axis saturates on the magnet, with a light rotor (2e-4 kg·m²) and an
-electrical time constant of 14 samples, on which the pulses adapt (docs/commissioning.md,
+electrical time constant of 28 samples at its derived carrier, on which the pulses adapt (docs/commissioning.md,
 "Light rotors and fast machines"); the linear presets check the detection.
 
 Regenerate: `python3 scripts/commission-magnetics.py --write` (about {minutes} minutes on one
@@ -197,17 +197,17 @@ LIMITS = """
 - A magnetically linear machine's fit moves its inductances by up to a tenth on the strongly
   salient low-inductance `pmsyrm-5k` (the integration's own errors: inverter error at the
   current zero crossings) without explaining the data, which the residual criterion rejects.
-- On `spm-dq-sat-saturated` the adapted pulses hold the light rotor, but the flux they
-  integrate is not accurate enough for the fit: the inverter error (4/3·V̂ = 6.7 V on its
-  320 V link) is a third of the pulse voltage, and where a phase current passes through zero
-  inside a sample its error is known only to within that. The verdict is "inconclusive" and
-  the model keeps constant inductances. With them the online R̂s law reads the flux error
-  at load as resistance (+1.3 %) and `stops` fails (0.8–1.1 rad on seeds 1–4; the true
-  model passes at 0.017 rad), so identified.toml fixes R̂s at the commissioned value
-  (`[estimator.rs_adaptation] enabled = false`, as for every inconclusive or rotor-moved
-  verdict): `reversal`, `stops` and `rated-reversal` then pass on seeds 1–4 (0.035–0.039,
-  0.038–0.138 and 0.075–0.082 rad; `crates/fado-sim/tests/commission_magnetics.rs`). Its
-  saturation itself has to come from a flux map or a model measured otherwise.
+- On `spm-dq-sat-saturated`, at the 10 kHz carrier its ripple rule derives, the adapted
+  pulses hold the light rotor to about 0.15 rad and identify its saturation (the table);
+  the commissioned model passes `reversal` and `stops` on seeds 1–4
+  (`crates/fado-sim/tests/commission_magnetics.rs`). On a 5 kHz carrier the inverter error
+  (4/3·V̂ = 6.7 V on its 320 V link) is a third of the pulse voltage, and where a phase
+  current passes through zero inside a sample its error is known only to within that: the
+  verdict is "inconclusive" and the model keeps constant inductances. With them the online
+  R̂s law reads the flux error at load as resistance and `stops` fails, so identified.toml
+  fixes R̂s at the commissioned value (`[estimator.rs_adaptation] enabled = false`, as for
+  every inconclusive or rotor-moved verdict), with which `reversal` and `stops` pass on
+  seeds 1–4 (the same test file).
 """
 
 
