@@ -537,20 +537,15 @@ impl<T: Real> ResistanceAdaptationState<T> {
     ) -> (T, T) {
         let share = self.standstill_share;
         let wanted = offset_change.dot(self.offset_sensitivity);
-        // The change −wanted lies between 0 and −share: wanted between 0 and share.
-        let taken = min(max(wanted, min(share, T::zero())), max(share, T::zero()));
-        let moved = if !bounded || taken == wanted {
-            self.rs_hat - offset_change.dot(self.offset_sensitivity)
+        // Bounded, the change −taken lies between 0 and −share: taken between 0 and share.
+        let taken = if bounded {
+            min(max(wanted, min(share, T::zero())), max(share, T::zero()))
         } else {
-            self.rs_hat - taken
+            wanted
         };
         (
-            min(max(moved, scale.rs_min), scale.rs_max),
-            if bounded {
-                share - taken
-            } else {
-                share - wanted
-            },
+            min(max(self.rs_hat - taken, scale.rs_min), scale.rs_max),
+            share - taken,
         )
     }
 }
