@@ -487,24 +487,48 @@ impl SimConfig {
         if let Some(plant) = magnetics_file::plant_magnetics(sat, map) {
             m = m.with_magnetics(crate::model_magnetics::plant_model(&plant));
         }
-        fado_core::machine_checks::check(&m, Some(self.inverter.sample_period()))
-            .iter()
-            .map(|f| {
-                if let Some(d) = self.derived.iter().find(|d| d.key == plant_key(f.key())) {
-                    return (
-                        f.severity(),
-                        DERIVED_DC_LINK_CAUSE.into(),
-                        derived_beyond(d),
-                    );
-                }
-                let mut text = f.to_string();
-                for k in f.keys() {
-                    let full = plant_key(k);
-                    text = text.replace(&format!("`{k}`"), &format!("`{full}`"));
-                }
-                (f.severity(), plant_key(f.key()), text)
-            })
-            .collect()
+        let mut findings: Vec<_> =
+            fado_core::machine_checks::check(&m, Some(self.inverter.sample_period()))
+                .iter()
+                .map(|f| {
+                    if let Some(d) = self.derived.iter().find(|d| d.key == plant_key(f.key())) {
+                        return (
+                            f.severity(),
+                            DERIVED_DC_LINK_CAUSE.into(),
+                            derived_beyond(d),
+                        );
+                    }
+                    let mut text = f.to_string();
+                    for k in f.keys() {
+                        let full = plant_key(k);
+                        text = text.replace(&format!("`{k}`"), &format!("`{full}`"));
+                    }
+                    (f.severity(), plant_key(f.key()), text)
+                })
+                .collect();
+        findings.extend(self.rms_map_warning());
+        findings
+    }
+
+    /// A warning where `[motor] flux_map` looks like a map whose currents are rms
+    /// ([`crate::magnetic_agreement::rms_currents`]).
+    fn rms_map_warning(&self) -> Option<(fado_core::machine_checks::Severity, String, String)> {
+        let map = self.motor_flux_map.as_ref()?;
+        let plant = magnetics_file::plant_magnetics(None, Some(map))?;
+        let stated = crate::magnetic_agreement::Stated {
+            section: "motor",
+            ld: self.motor.ld,
+            lq: self.motor.lq,
+            flux_linkage: self.motor.flux_linkage,
+        };
+        let key = magnetics_file::FLUX_MAP_KEY;
+        crate::magnetic_agreement::rms_currents(
+            &plant.model(),
+            key,
+            stated,
+            self.motor.rated_current,
+        )
+        .map(|w| (fado_core::machine_checks::Severity::Warning, key.into(), w))
     }
 
     /// The plausibility warnings of [`machine_findings`](Self::machine_findings), as
