@@ -122,8 +122,10 @@ impl<T: Real> InverseCache<T> {
         let tol = cell_tolerance::<T>();
         let (lo, hi) = (T::lit(INSIDE_MARGIN), T::lit(1.0 - INSIDE_MARGIN));
         for neighbour in [false, true] {
-            let (k, m, cell, constants) = self.slots.get(at).copied().flatten()?;
-            let (u, v) = cell.solve_with(psi, constants)?;
+            // The slot where it lies (no copy of its polynomial).
+            let (k, m, cell, constants) = self.slots.get(at)?.as_ref()?;
+            let (k, m) = (*k, *m);
+            let (u, v) = cell.solve_with(psi, *constants)?;
             if u > lo && u < hi && v > lo && v < hi {
                 let i = grid.current_at(k, m, u, v);
                 if !i.is_finite() {
@@ -148,11 +150,11 @@ impl<T: Real> InverseCache<T> {
     fn in_start_cell(&mut self, grid: &impl CellGrid<T>, psi: Dq<T>) -> Option<Dq<T>> {
         let (k, m) = self.start;
         let at = self.last.map_or(0, |(at, _, _)| at);
-        let (a, b, cell, constants) = self.slots.get(at).copied().flatten()?;
-        if (a, b) != (k, m) {
+        let (a, b, cell, constants) = self.slots.get(at)?.as_ref()?;
+        if (*a, *b) != (k, m) {
             return None;
         }
-        let (u, v) = cell.solve_with(psi, constants)?;
+        let (u, v) = cell.solve_with(psi, *constants)?;
         let (last_k, last_m) = grid.last_cell();
         let tol = cell_tolerance::<T>();
         if direction(u, k, last_k, tol) != 0 || direction(v, m, last_m, tol) != 0 {
@@ -176,7 +178,8 @@ impl<T: Real> InverseCache<T> {
     #[inline]
     pub(super) fn refine(&self, grid: &impl CellGrid<T>, psi: Dq<T>) -> Option<Dq<T>> {
         let (at, u, v) = self.last?;
-        let (k, m, cell, _) = self.slots.get(at).copied().flatten()?;
+        let (k, m, cell, _) = self.slots.get(at)?.as_ref()?;
+        let (k, m) = (*k, *m);
         let (u2, v2) = cell.newton_step(psi, (u, v));
         let (du, dv) = (u2 - u, v2 - v);
         let error = (du * dv).abs() * (cell.twist.d.abs() + cell.twist.q.abs());
