@@ -220,6 +220,43 @@ fn classes(release: bool) -> Vec<String> {
     failed
 }
 
+/// Half the rated torque arriving 5 ms and 20 ms after the calibrations end, in the running
+/// drive's first moments, on each machine, with the release hold off (the drive's default)
+/// and on. Measured (this code): with the hold off only the 48 V hub motor meets the
+/// benchmark's criteria (the servo 1.0–2.8 rad back, the multirotor 39–48 rad, the traction
+/// machine 12 rad, the 10 kV-class machine 7 rad, the spindle 30–37 rad: the speed loop alone
+/// meets the load); with it on the traction and 10 kV-class machines pass too (their
+/// reference is still zero, and the hold catches the fall), while on the others the
+/// application's reference already ramps (6 % of the rated speed at the servo's end), at
+/// which the hold hands over at once and the speed loop alone meets the load again. Not met;
+/// run with `--ignored` (`-- --nocapture` prints each case).
+#[test]
+#[ignore = "the running drive's speed loop alone does not catch a load arriving just after the calibrations on a moving reference"]
+fn a_load_arriving_just_after_the_calibrations() {
+    let mut failed = Vec::new();
+    for hold in ["", "[controller.release_hold]\nenabled = true\n"] {
+        for (name, motor, inverter) in MACHINES {
+            let base = config(motor, inverter, hold);
+            let end = run(base.clone()).spans[5].0;
+            for at in [end + 0.005, end + 0.02] {
+                let r = run(loaded(&base, at));
+                let verdict = failure(&base, &r);
+                println!(
+                    "{name:26} hold {} load at {at:.3} s: {verdict:?}",
+                    !hold.is_empty()
+                );
+                if let Some(v) = verdict {
+                    failed.push(format!(
+                        "{name} (hold {}) at {at:.3} s: {v}",
+                        !hold.is_empty()
+                    ));
+                }
+            }
+        }
+    }
+    assert!(failed.is_empty(), "{failed:#?}");
+}
+
 /// The machines of the sweep: the 2.2 kW IPMSM preset and three classes of the table.
 fn sweep_machines() -> [(&'static str, SimConfig); 4] {
     [
