@@ -191,12 +191,24 @@ impl SimConfig {
             .map_err(|e| e.in_section("speed_reference"))?;
         // The machine's cross-checks, with every key involved named (before the single-key
         // refusals of the plant's and the model's validation).
-        if let Some((_, key, text)) = self
-            .machine_findings()
-            .into_iter()
+        // An error that follows from a slip another finding names (ratings multiplied by 10
+        // refused for the carrier they would need) carries that finding as its likely cause.
+        let findings = self.machine_findings();
+        if let Some((_, key, text)) = findings
+            .iter()
             .find(|(s, ..)| *s == fado_core::machine_checks::Severity::Error)
         {
-            return Err(SimConfigError::new(key, text));
+            let causes: Vec<&str> = findings
+                .iter()
+                .filter(|(s, ..)| *s == fado_core::machine_checks::Severity::Warning)
+                .map(|(.., t)| t.as_str())
+                .collect();
+            let text = if causes.is_empty() {
+                text.clone()
+            } else {
+                format!("{text}; likely cause: {}", causes.join("; "))
+            };
+            return Err(SimConfigError::new(key.clone(), text));
         }
         magnetics_file::check_one_model(
             self.motor_saturation.as_ref(),
