@@ -147,6 +147,16 @@ def test_identified_toml_runs_in_the_simulator(paper: fado.CommissionResult) -> 
     assert sim.passed
 
 
+def test_a_line_to_line_resistance_on_the_nameplate_is_a_warning_naming_it() -> None:
+    # The paper's motor told rs = 2 × 0.327 Ω (a terminal-to-terminal value): the standstill
+    # test measures the phase value, which the identified machine holds.
+    nameplate = dict(fado.Machine.preset("paper").to_dict(), rs=2 * 0.327)
+    with pytest.warns(UserWarning, match="line-to-line") as caught:
+        r = fado.commission("paper", nameplate=nameplate)
+    assert any("`nameplate.rs`" in str(w.message) for w in caught)
+    assert r.passed and r.machine is not None
+    assert r.machine.rs == pytest.approx(0.327, rel=0.02)
+
 def test_an_abort_is_reported_not_raised() -> None:
     # A nameplate 10× the real resistance: the DC test finds Rs outside 1/4–4× of it (the
     # nameplate itself is unusual, 1.3 × the rated back-EMF dropped at rated current: a warning;

@@ -4,6 +4,7 @@ map in every form giving the same run bit for bit, and each refusal naming its c
 from __future__ import annotations
 
 import pickle
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -143,3 +144,21 @@ def test_estimate_uses_the_machines_map(dtype: str) -> None:
     linear = fado.estimate(*signals, machine=fado.Machine(**IPMSM), ts=ts, dtype=dtype)
     assert np.all(np.isfinite(with_map.theta))
     assert not np.array_equal(with_map.theta, linear.theta)
+
+
+def test_a_map_in_rms_currents_is_a_warning_naming_it(tmp_path: Path) -> None:
+    # The same machine's map with its currents in A rms (peak / √2): both zero-current
+    # inductances √2 × `ld`, `lq`, the magnet's flux unchanged.
+    i_d, i_q, psi_d, psi_q = grid()
+    rms = (i_d / np.sqrt(2.0), i_q / np.sqrt(2.0), psi_d, psi_q)
+    with pytest.warns(UserWarning, match="A rms") as caught:
+        fado.Machine(**IPMSM, flux_map=rms)
+    assert "`flux_map`" in str(caught[0].message) and "`lq`" in str(caught[0].message)
+    d, q = np.meshgrid(rms[0], rms[1], indexing="ij")
+    path = write_csv(tmp_path / "rms.csv", (d.ravel(), q.ravel(), psi_d.ravel(), psi_q.ravel()))
+    with pytest.warns(UserWarning, match="A rms"):
+        fado.Machine(**IPMSM, flux_map=path)
+    # The map in A peak: no warning.
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        fado.Machine(**IPMSM, flux_map=grid())

@@ -108,7 +108,9 @@ fn plant_config(
 /// bar to stderr.
 ///
 /// A bad key or value raises `ConfigError` (`.field` the TOML path or the `Machine` field),
-/// a bad argument `InputError` (both `ValueError`s).
+/// a bad argument `InputError` (both `ValueError`s). A nameplate `rs` twice or half the
+/// resistance the standstill test measures raises a `UserWarning` naming it
+/// (`fado_sim::nameplate_agreement`: a line-to-line value?).
 #[pyfunction]
 #[pyo3(
     signature = (motor, *, nameplate = None, config_toml = None, seed = 1, averaged = false, theta0 = None, decimation = 10, progress = false),
@@ -146,7 +148,9 @@ pub fn commission(
         })?;
     let cfg = plant_config(py, &motor, config_toml, seed, averaged)?;
     let plant = cfg.plant();
-    let nameplate = match nameplate.filter(|n| !n.is_none()) {
+    let told = nameplate.filter(|n| !n.is_none());
+    let section = if told.is_some() { "nameplate" } else { "motor" };
+    let nameplate = match told {
         Some(n) => PyMachine::from_argument(py, Some(&n), "nameplate", "commission")?.to_core(),
         None => plant.motor,
     };
@@ -184,7 +188,31 @@ pub fn commission(
             "commissioning interrupted",
         ));
     }
+    warn_nameplate(py, section, &nameplate, &outcome)?;
     CommissionResult::new(py, outcome, config_text)
+}
+
+/// A `UserWarning` where the measured resistance contradicts the nameplate's `rs`
+/// (`fado_sim::nameplate_agreement`), naming it in `section` (`nameplate` or `motor`).
+fn warn_nameplate(
+    py: Python<'_>,
+    section: &str,
+    nameplate: &fado_core::MachineModel<f64>,
+    outcome: &CommissionOutcome,
+) -> PyResult<()> {
+    let key = format!("{section}.rs");
+    let Some(id) = &outcome.identification else {
+        return Ok(());
+    };
+    match fado_sim::nameplate_agreement::resistance(&key, nameplate.rs, id.model.rs) {
+        Some(w) => PyErr::warn(
+            py,
+            &py.get_type::<pyo3::exceptions::PyUserWarning>(),
+            &std::ffi::CString::new(w).unwrap_or_default(),
+            1,
+        ),
+        None => Ok(()),
+    }
 }
 
 /// Draws the progress bar of a commissioning run on stderr: `phase`, the fraction `f` done and

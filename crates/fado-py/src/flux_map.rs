@@ -8,7 +8,7 @@
 
 use fado_core::MachineModel;
 use fado_core::magnetics::MachineMagnetics;
-use fado_sim::magnetic_agreement::{Stated, check};
+use fado_sim::magnetic_agreement::{Stated, check, rms_currents};
 use fado_sim::magnetics::FluxMapData;
 use fado_sim::magnetics_file::{FluxMapFile, flux_map_from_rows};
 use fado_sim::model_magnetics;
@@ -105,7 +105,8 @@ pub fn from_argument(py: Python<'_>, obj: &Bound<'_, PyAny>) -> PyResult<Option<
 }
 
 /// Refuses a map whose zero-current values disagree with the machine's `ld`, `lq` and
-/// `flux_linkage` (`fado_sim::magnetic_agreement`: other units, other axes, another machine).
+/// `flux_linkage` (`fado_sim::magnetic_agreement`: other units, other axes, another machine);
+/// warns where its currents look rms (`fado_sim::magnetic_agreement::rms_currents`).
 pub fn check_agreement(py: Python<'_>, model: &MachineModel<f64>, m: &FluxMapFile) -> PyResult<()> {
     let stated = Stated {
         section: "",
@@ -113,7 +114,17 @@ pub fn check_agreement(py: Python<'_>, model: &MachineModel<f64>, m: &FluxMapFil
         lq: model.lq,
         flux_linkage: model.flux_linkage,
     };
-    check(&m.data.map(), FLUX_MAP, stated).map_err(|e| refuse(py, e.message))
+    check(&m.data.map(), FLUX_MAP, stated).map_err(|e| refuse(py, e.message))?;
+    // Currents given rms: a UserWarning naming the slip (the map can still describe a motor).
+    if let Some(w) = rms_currents(&m.data.map(), FLUX_MAP, stated, model.rated_current) {
+        PyErr::warn(
+            py,
+            &py.get_type::<pyo3::exceptions::PyUserWarning>(),
+            &std::ffi::CString::new(w).unwrap_or_default(),
+            2,
+        )?;
+    }
+    Ok(())
 }
 
 /// The map back to Python: its path (as given, resolved), or the four node arrays

@@ -68,6 +68,7 @@ pub mod magnetics;
 pub mod magnetics_file;
 pub mod model_magnetics;
 pub mod motor;
+pub mod nameplate_agreement;
 pub mod output;
 pub mod presets;
 pub mod profile;

@@ -10,6 +10,7 @@
 //! the high-permeance axis and the magnet along −q) or of another machine disagrees by far
 //! more, and is refused naming both keys instead of being run with nonsense.
 
+use fado_core::Dq;
 use fado_core::magnetics::{MagneticModel, zero_current_constants};
 
 use crate::error::SimConfigError;
@@ -26,6 +27,18 @@ pub const FLUX_RATIO: (f64, f64) = (2.0 / 3.0, 1.5);
 /// falls by up to about half (the secant L_q of scripts/saturated-replay.py's traction IPMSM:
 /// −57 %); mH read as H or currents in mA (1000) are outside.
 pub const INDUCTANCE_RATIO: (f64, f64) = (0.25, 4.0);
+
+/// The band around √2 of the ratio of a map's small-current inductances to the stated `ld` and
+/// `lq` that names a map whose currents are rms where peak values are meant (read at 1/√2 of
+/// the current it was measured at, the map gives √2 × each inductance and keeps ψd(0, 0)):
+/// 1.41 ± 12 %, on both axes at once with the flux within [`RMS_FLUX_RATIO`]. A datasheet's
+/// inductances taken at rated current lie below the map's on q (the traction IPMSM's −57 %)
+/// but hardly on d, so a correct map of a saturating machine meets only one of the two.
+pub const RMS_INDUCTANCE_RATIO: (f64, f64) = (1.25, 1.6);
+
+/// The range of ψd(0, 0) / `flux_linkage` that goes with [`RMS_INDUCTANCE_RATIO`]: the flux
+/// agrees (a map in other flux units, or a `flux_linkage` off, is another slip).
+pub const RMS_FLUX_RATIO: (f64, f64) = (0.85, 1.15);
 
 /// The machine's stated zero-current constants, with the section that states them
 /// (`motor` or `model`, for the keys errors name).
@@ -94,9 +107,55 @@ pub fn check(
     Ok(())
 }
 
+/// The current, as a fraction of the rated current, of the secant inductances
+/// [`rms_currents`] compares: 5 %, inside the first cell of a measured map's grid (1–2 A
+/// steps on 8–12 A machines), where the map is as linear as it gets.
+pub const SMALL_CURRENT: f64 = 0.05;
+
+/// The secant inductances of `model` from −h to +h along each axis, H: the zero-current
+/// values a datasheet states, taken symmetrically (a PM-SyRM's d axis saturates one way
+/// first: the Baldor map's slopes at i = 0 are 0.021 and 0.031 H either side, its stated
+/// `ld` their mean).
+fn small_current_inductances(model: &impl MagneticModel<f64>, h: f64) -> (f64, f64) {
+    let at = |d: f64, q: f64| model.flux(Dq::new(d, q));
+    let ld = (at(h, 0.0).d - at(-h, 0.0).d) / (2.0 * h);
+    let lq = (at(0.0, h).q - at(0.0, -h).q) / (2.0 * h);
+    (ld, lq)
+}
+
+/// A warning where `model` (named `model_key`) shows the pattern of currents given rms:
+/// both small-current inductances (at ±[`SMALL_CURRENT`] × `rated_current`) √2 × the stated ones ([`RMS_INDUCTANCE_RATIO`]) with the
+/// magnet's flux agreeing ([`RMS_FLUX_RATIO`]). The torque at rated current cannot tell: on a
+/// surface-magnet rotor 1.5·p·ψd·i_q keeps its value, and on a salient one the reluctance
+/// part moves by less than the datasheet's spread. None where the map fits the stated values.
+pub fn rms_currents(
+    model: &impl MagneticModel<f64>,
+    model_key: &str,
+    stated: Stated<'_>,
+    rated_current: f64,
+) -> Option<String> {
+    let (ld, lq) = small_current_inductances(model, SMALL_CURRENT * rated_current);
+    let flux = model.flux(Dq::zero()).d;
+    let (rd, rq, rf) = (ld / stated.ld, lq / stated.lq, flux / stated.flux_linkage);
+    let in_band = |r: f64| (RMS_INDUCTANCE_RATIO.0..=RMS_INDUCTANCE_RATIO.1).contains(&r);
+    if !(in_band(rd) && in_band(rq) && (RMS_FLUX_RATIO.0..=RMS_FLUX_RATIO.1).contains(&rf)) {
+        return None;
+    }
+    Some(format!(
+        "`{model_key}` gives inductances {rd:.3} × `{}` and {rq:.3} × `{}` at small current \
+         while its ψd(0, 0) is {rf:.3} × `{}`: its currents i_d, i_q in A rms where A \
+         peak is meant (√2 = 1.414 on both axes, the flux unchanged)? Multiply its i_d and i_q \
+         columns by √2; or `{}` and `{}` are values at a current the map does not start from",
+        stated.key("ld"),
+        stated.key("lq"),
+        stated.key("flux_linkage"),
+        stated.key("ld"),
+        stated.key("lq"),
+    ))
+}
+
 #[cfg(test)]
 mod tests {
-    use fado_core::Dq;
     use fado_core::magnetics::{ConstantInductance, InductanceMatrix};
 
     use super::*;
@@ -169,5 +228,21 @@ mod tests {
         let mut line = STATED;
         line.flux_linkage = 0.30 * 3f64.sqrt();
         assert!(check(&model(1.0, 1.0), "motor.flux_map", line).is_err());
+    }
+
+    #[test]
+    fn a_map_in_rms_currents_is_named_and_the_same_machines_map_is_not() {
+        assert!(rms_currents(&model(1.0, 1.0), "motor.flux_map", STATED, 10.0).is_none());
+        // Currents rms: the map reads at i/√2 what the machine has at i.
+        let rms = model(1.0, 1.0 / 2f64.sqrt());
+        assert!(check(&rms, "motor.flux_map", STATED).is_ok());
+        let w = rms_currents(&rms, "motor.flux_map", STATED, 10.0).expect("named");
+        assert!(w.contains("A rms") && w.contains("`motor.ld`"), "{w}");
+        // The same map with `lq` at rated current (−40 %): only one axis at √2, not named.
+        let mut rated = STATED;
+        rated.lq = 0.030 * 0.6;
+        assert!(rms_currents(&model(1.0, 1.0), "motor.flux_map", rated, 10.0).is_none());
+        // Fluxes in other units too: another slip, which `check` names.
+        assert!(rms_currents(&model(1000.0, 1.0), "motor.flux_map", STATED, 10.0).is_none());
     }
 }

@@ -223,3 +223,93 @@ fn a_config_saved_as_latin_1_is_named_at_its_bad_byte() {
     assert!(err.contains(&format!("{}:2:20:", path.display())), "{err}");
     assert!(err.contains("0xb5 is not UTF-8"), "{err}");
 }
+
+/// `text` (a flux-map CSV) with its current columns i_d, i_q divided by √2: the map of the
+/// same machine written in A rms.
+fn rms_currents(text: &str) -> String {
+    let mut out = String::new();
+    for line in text.lines() {
+        let cols: Vec<&str> = line.split(',').collect();
+        match cols.first().map(|c| c.trim().parse::<f64>()) {
+            Some(Ok(_)) => {
+                let i: Vec<f64> = cols[..2]
+                    .iter()
+                    .map(|c| c.trim().parse().unwrap())
+                    .collect();
+                let r = std::f64::consts::FRAC_1_SQRT_2;
+                out += &format!("{},{},{},{}\n", i[0] * r, i[1] * r, cols[2], cols[3]);
+            }
+            _ => out += &format!("{line}\n"),
+        }
+    }
+    out
+}
+
+#[test]
+fn a_flux_map_in_rms_currents_is_a_warning_at_its_key_and_the_measured_maps_are_not() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../motors/saturated");
+    for name in ["pmsm-gem-1k1-measured", "pmsyrm-baldor-5k6-measured"] {
+        let toml = std::fs::read_to_string(root.join(format!("{name}.toml"))).unwrap();
+        let csv = std::fs::read_to_string(root.join(format!("{name}.csv"))).unwrap();
+        let line = toml
+            .lines()
+            .position(|l| l.starts_with("flux_map"))
+            .unwrap()
+            + 1;
+        // The preset as it is: no warning.
+        let dir = scratch(&format!("rms-{name}"));
+        let path = dir.join(format!("{name}.toml"));
+        std::fs::write(&path, &toml).unwrap();
+        std::fs::write(dir.join(format!("{name}.csv")), &csv).unwrap();
+        let (code, err) = dump(&path);
+        assert_eq!(code, Some(0), "{err}");
+        assert!(!err.contains("warning"), "{name}: {err}");
+        // Its map in A rms: named at the flux_map key's value, as a warning.
+        std::fs::write(dir.join(format!("{name}.csv")), rms_currents(&csv)).unwrap();
+        let (code, err) = dump(&path);
+        assert_eq!(code, Some(0), "{err}");
+        let at = format!("{}:{line}:12: warning: `motor.flux_map`", path.display());
+        assert!(err.contains(&at), "{at}\n{err}");
+        assert!(err.contains("A rms") && err.contains("`motor.lq`"), "{err}");
+    }
+}
+
+#[test]
+fn a_line_to_line_resistance_on_the_nameplate_is_named_once_commission_measures_it() {
+    // The paper's motor told a nameplate with rs = 2 × 0.327 Ω (a terminal-to-terminal value).
+    let preset = include_str!("../../../motors/paper.toml");
+    let text = preset.replace("rs = 0.327 ", "rs = 0.654 ");
+    assert_ne!(text, preset);
+    let line = text.lines().position(|l| l.starts_with("rs ")).unwrap() + 1;
+    let dir = scratch("nameplate-ll");
+    let path = dir.join("nameplate.toml");
+    std::fs::write(&path, &text).unwrap();
+    let commission = |nameplate: &Path, out: &str| {
+        let o = Command::new(env!("CARGO_BIN_EXE_fado-sim"))
+            .args(["commission", "--motor", "paper", "--nameplate"])
+            .arg(nameplate)
+            .arg("--out")
+            .arg(dir.join(out))
+            .stdout(Stdio::null())
+            .output()
+            .unwrap();
+        (
+            o.status.code(),
+            String::from_utf8_lossy(&o.stderr).into_owned(),
+        )
+    };
+    let (code, err) = commission(&path, "ll");
+    assert_eq!(code, Some(0), "{err}");
+    let at = format!("{}:{line}:6: warning: `motor.rs`", path.display());
+    assert!(err.contains(&at), "{at}\n{err}");
+    assert!(err.contains("line-to-line"), "{err}");
+    // The measured value is what identified.toml holds.
+    let identified = std::fs::read_to_string(dir.join("ll/identified.toml")).unwrap();
+    assert!(identified.contains("rs = 0.32"), "{identified}");
+    // The preset's own record as the nameplate: nothing to say.
+    let own = dir.join("paper.toml");
+    std::fs::write(&own, preset).unwrap();
+    let (code, err) = commission(&own, "own");
+    assert_eq!(code, Some(0), "{err}");
+    assert!(!err.contains("warning"), "{err}");
+}

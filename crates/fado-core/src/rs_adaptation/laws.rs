@@ -3,7 +3,8 @@
 
 use super::{
     AdaptationRegime, FLUX_LINKAGE_DEAD_ZONE, FLUX_LINKAGE_DEAD_ZONE_OFF, FLUX_LINKAGE_MAX_RATIO,
-    FLUX_LINKAGE_MIN_RATIO, ResistanceAdaptationConfig, ResistanceAdaptationState,
+    FLUX_LINKAGE_MIN_RATIO, RESISTIVE_SPEED_ANGLE, ResistanceAdaptationConfig,
+    ResistanceAdaptationState,
 };
 use crate::active_flux::{ActiveFlux, ActiveFluxPoint};
 use crate::error::{ConfigError, check};
@@ -19,6 +20,8 @@ pub(crate) struct ResistanceAdaptationParams<T: 'static> {
     config: ResistanceAdaptationConfig<T>,
     /// γ·Ts.
     rate_ts: T,
+    /// Ts/[`RESISTIVE_SPEED_ANGLE`]: γ·Ts at a resistive speed of 1 rad/s.
+    speed_rate_ts: T,
     /// γ_s·Ts.
     standstill_gain: T,
     /// e^{−ω_m·Ts}.
@@ -120,6 +123,7 @@ impl<T: Real> ResistanceAdaptationParams<T> {
         Ok(Self {
             config,
             rate_ts: rate * ts,
+            speed_rate_ts: ts / T::lit(RESISTIVE_SPEED_ANGLE),
             standstill_gain: rate_s * ts,
             forget: (-(memory_w * ts)).exp(),
             // |ω̂| ≤ ω_s is ω̂²·(1/ω_s²) ≤ 1; ω_s = 0 allows ω̂ = 0 only (1e30: no ∞·0).
@@ -303,11 +307,10 @@ impl<T: Real> ResistanceAdaptationParams<T> {
             let relative_to = crate::real::max(lf, reference);
             let a = -(mag * bracket) * scale.chi_per_phi * (lf / relative_to);
             return self.rotating_step(
-                scale,
                 st,
                 next,
                 (reference, relative_to),
-                a,
+                (a, scale.gain, self.rate_ts),
                 mag,
                 omega,
                 settled,
@@ -331,21 +334,35 @@ impl<T: Real> ResistanceAdaptationParams<T> {
         // χ = a/b: then χ/(χ² + χ0²) = a·b/(a² + χ0²·b²) costs one division, and
         // χ² ≥ χ0² is a² ≥ χ0²·b² (false for ω̂ = 0, which also rules out 0/0).
         let a = -lambda_r.cross(i_drop) * scale.chi_per_phi * sensitivity;
-        self.rotating_step(scale, st, next, (reference, lf), a, mag, omega, settled)
+        let law = self.linear_rate(scale, a, mag);
+        self.rotating_step(st, next, (reference, lf), law, mag, omega, settled)
+    }
+
+    /// `a` with the linear path's γ·Ts·R0 and γ·Ts this period: γ at least the present resistive
+    /// speed R0·|î_q|/λ̂f (times the sensitivity) per [`RESISTIVE_SPEED_ANGLE`] (module docs,
+    /// "The rate on a fast machine"); |a|/|λ̂r| is that speed. At or below it the configured
+    /// γ, bit for bit; γ = 0 stays 0.
+    #[inline(always)]
+    fn linear_rate(&self, scale: &ResistanceScale<T>, a: T, mag: T) -> (T, T, T) {
+        let rate_ts = a.abs() * self.speed_rate_ts / mag;
+        if rate_ts > self.rate_ts && self.rate_ts > T::zero() {
+            (a, rate_ts * scale.r0, rate_ts)
+        } else {
+            (a, scale.gain, self.rate_ts)
+        }
     }
 
     /// The turning law's step (and the λ̂f law's) with the reference λ̂a, the flux the error
-    /// is taken relative to (λ̂f, or a saturating rotor's active flux where that is more) and
-    /// the numerator `a` of χ = a/(|λ̂r|·ω̂).
+    /// is taken relative to (λ̂f, or a saturating rotor's active flux where that is more), the
+    /// numerator `a` of χ = a/(|λ̂r|·ω̂) and the law's gain γ·Ts·R0 and γ·Ts this period.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     fn rotating_step(
         &self,
-        scale: &ResistanceScale<T>,
         st: &ResistanceAdaptationState<T>,
         next: &mut ResistanceAdaptationState<T>,
         (reference, relative_to): (T, T),
-        a: T,
+        (a, gain, rate_ts): (T, T, T),
         mag: T,
         omega: T,
         settled: bool,
@@ -355,10 +372,9 @@ impl<T: Real> ResistanceAdaptationParams<T> {
         if a_sq >= floor_b_sq && floor_b_sq > T::zero() {
             // ẽ·χ/(χ² + χ0²) with ẽ = (|λ̂r| − λ̂a)/`relative_to`, in one division.
             let weight = a_sq / (a_sq + floor_b_sq);
-            next.rs_hat -=
-                scale.gain * (mag - reference) * a * b / (relative_to * (a_sq + floor_b_sq));
+            next.rs_hat -= gain * (mag - reference) * a * b / (relative_to * (a_sq + floor_b_sq));
             // The turning law replaces what the standstill tests contributed.
-            let keep = T::one() - self.rate_ts * weight;
+            let keep = T::one() - rate_ts * weight;
             next.offset_sensitivity = st.offset_sensitivity * keep;
             next.standstill_share = st.standstill_share * keep;
         }

@@ -475,7 +475,8 @@ impl SimConfig {
 
     /// The plausibility findings of the motor against its ratings, the DC link and the
     /// sampling period (`fado_core::machine_checks`), each with its message naming the TOML
-    /// keys involved: errors first.
+    /// keys involved: errors first, then the carrier's finding
+    /// ([`carrier_findings`](Self::carrier_findings)).
     pub fn machine_findings(&self) -> Vec<(fado_core::machine_checks::Severity, String, String)> {
         let mut m = MachineModel {
             dc_voltage: self.inverter.dc_voltage,
@@ -487,24 +488,88 @@ impl SimConfig {
         if let Some(plant) = magnetics_file::plant_magnetics(sat, map) {
             m = m.with_magnetics(crate::model_magnetics::plant_model(&plant));
         }
-        fado_core::machine_checks::check(&m, Some(self.inverter.sample_period()))
+        let mut findings: Vec<_> =
+            fado_core::machine_checks::check(&m, Some(self.inverter.sample_period()))
+                .iter()
+                .map(|f| {
+                    if let Some(d) = self.derived.iter().find(|d| d.key == plant_key(f.key())) {
+                        return (
+                            f.severity(),
+                            DERIVED_DC_LINK_CAUSE.into(),
+                            derived_beyond(d),
+                        );
+                    }
+                    let mut text = f.to_string();
+                    for k in f.keys() {
+                        let full = plant_key(k);
+                        text = text.replace(&format!("`{k}`"), &format!("`{full}`"));
+                    }
+                    (f.severity(), plant_key(f.key()), text)
+                })
+                .chain(self.carrier_findings())
+                .collect();
+        findings.extend(self.rms_map_warning());
+        findings
+    }
+
+    /// A warning where `[motor] flux_map` looks like a map whose currents are rms
+    /// ([`crate::magnetic_agreement::rms_currents`]).
+    fn rms_map_warning(&self) -> Option<(fado_core::machine_checks::Severity, String, String)> {
+        let map = self.motor_flux_map.as_ref()?;
+        let plant = magnetics_file::plant_magnetics(None, Some(map))?;
+        let stated = crate::magnetic_agreement::Stated {
+            section: "motor",
+            ld: self.motor.ld,
+            lq: self.motor.lq,
+            flux_linkage: self.motor.flux_linkage,
+        };
+        let key = magnetics_file::FLUX_MAP_KEY;
+        crate::magnetic_agreement::rms_currents(
+            &plant.model(),
+            key,
+            stated,
+            self.motor.rated_current,
+        )
+        .map(|w| (fado_core::machine_checks::Severity::Warning, key.into(), w))
+    }
+
+    /// The carrier's finding (`fado_core::ratings::check_carrier`): a derived
+    /// `inverter.switching_frequency` beyond the DC link's class of inverters (an error) or
+    /// in the band of fast inverters (a warning), or a given one whose PWM ripple exceeds the
+    /// rated current (a warning), with the TOML keys named.
+    pub fn carrier_findings(
+        &self,
+    ) -> Option<(fado_core::machine_checks::Severity, String, String)> {
+        use fado_core::machine_checks::Severity;
+        let m = MachineModel {
+            dc_voltage: self.inverter.dc_voltage,
+            ..self.motor
+        };
+        let derived = self
+            .derived
             .iter()
-            .map(|f| {
-                if let Some(d) = self.derived.iter().find(|d| d.key == plant_key(f.key())) {
-                    return (
-                        f.severity(),
-                        DERIVED_DC_LINK_CAUSE.into(),
-                        derived_beyond(d),
-                    );
-                }
-                let mut text = f.to_string();
-                for k in f.keys() {
-                    let full = plant_key(k);
-                    text = text.replace(&format!("`{k}`"), &format!("`{full}`"));
-                }
-                (f.severity(), plant_key(f.key()), text)
-            })
-            .collect()
+            .any(|d| d.key == "inverter.switching_frequency");
+        let given = (!derived).then_some(self.inverter.switching_frequency);
+        let finding = fado_core::ratings::check_carrier(&m, given)?;
+        let mut text = finding.to_string();
+        for k in [
+            "switching_frequency",
+            "dc_voltage",
+            "rs",
+            "ld",
+            "lq",
+            "rated_current",
+            "rated_speed_rpm",
+            "pole_pairs",
+        ] {
+            text = text.replace(&format!("`{k}`"), &format!("`{}`", plant_key(k)));
+        }
+        let severity = if finding.is_error() {
+            Severity::Error
+        } else {
+            Severity::Warning
+        };
+        Some((severity, plant_key(finding.keys()[0]), text))
     }
 
     /// The plausibility warnings of [`machine_findings`](Self::machine_findings), as
@@ -538,7 +603,7 @@ fn derived_beyond(d: &crate::derive::Derived) -> String {
 fn plant_key(field: &str) -> String {
     match field {
         "dc_voltage" => "inverter.dc_voltage".to_owned(),
-        "ts" => "inverter.switching_frequency".to_owned(),
+        "ts" | "switching_frequency" => "inverter.switching_frequency".to_owned(),
         k => format!("motor.{k}"),
     }
 }

@@ -17,16 +17,20 @@ pub fn warn_plausibility(cfg: &fado_sim::SimConfig, config: Option<&Path>, text:
         .into_iter()
         .filter(|(s, ..)| *s == Severity::Warning)
     {
-        let at = text
-            .and_then(|t| fado_sim::source::value_span(t, &key).map(|s| (t, s.start)))
-            .map(|(t, start)| fado_sim::source::SourceLocation::at(t, start));
-        match (config, at) {
-            (Some(p), Some(at)) => {
-                eprintln!("{}:{}:{}: warning: {w}", p.display(), at.line, at.column)
-            }
-            (Some(p), None) => eprintln!("warning: {}: {w}", p.display()),
-            (None, _) => eprintln!("warning: {w}"),
-        }
+        warn_at(config, text, &key, &w);
+    }
+}
+
+/// Prints the warning `w` on stderr at the FILE:LINE:COLUMN of `key`'s value in `text`, the
+/// file `config` (as much of that as is known).
+pub fn warn_at(config: Option<&Path>, text: Option<&str>, key: &str, w: &str) {
+    let at = text
+        .and_then(|t| fado_sim::source::value_span(t, key).map(|s| (t, s.start)))
+        .map(|(t, start)| fado_sim::source::SourceLocation::at(t, start));
+    match (config, at) {
+        (Some(p), Some(at)) => eprintln!("{}:{}:{}: warning: {w}", p.display(), at.line, at.column),
+        (Some(p), None) => eprintln!("warning: {}: {w}", p.display()),
+        (None, _) => eprintln!("warning: {w}"),
     }
 }
 

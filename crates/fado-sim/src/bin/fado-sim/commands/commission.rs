@@ -11,7 +11,7 @@ use fado_sim::output::{self, AtomicFile, DirLock, OutputError};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use super::Outcome;
-use crate::files::{csv_error, in_file, read_file, warn_plausibility};
+use crate::files::{csv_error, in_file, read_file, warn_at, warn_plausibility};
 
 /// The arguments of `commission`.
 #[derive(clap::Args)]
@@ -31,6 +31,11 @@ pub struct CommissionArgs {
     /// Use the averaged inverter model.
     #[arg(long)]
     averaged: bool,
+    /// TOML file whose `[motor]` is what the procedure is told (ratings set the test levels,
+    /// parameters size the tests): a datasheet's values, against the plant's truth. Default
+    /// the plant's own `[motor]`.
+    #[arg(long)]
+    nameplate: Option<PathBuf>,
 }
 
 /// Runs the commissioning of `args`' motor, writes DIR/identified.toml, DIR/metrics.json and
@@ -48,7 +53,11 @@ pub fn commission(args: CommissionArgs) -> Outcome {
         .out
         .unwrap_or_else(|| PathBuf::from("out").join("commission"));
     let lock = DirLock::acquire(&dir)?;
-    let o = identify(&cfg, &text, config)?;
+    let told = match &args.nameplate {
+        Some(path) => Some((path.clone(), nameplate(path)?)),
+        None => None,
+    };
+    let o = identify(&cfg, told.as_ref().map(|t| &t.1.1), &text, config)?;
     let rows = o
         .identification
         .as_ref()
@@ -69,6 +78,18 @@ pub fn commission(args: CommissionArgs) -> Outcome {
         return Ok(ExitCode::from(1));
     }
     print_parameters(&rows);
+    if let Some(id) = &o.identification {
+        // The nameplate's resistance against the measured one.
+        let (file, source, motor) = match &told {
+            Some((path, (text, motor))) => (Some(path.as_path()), Some(text.as_str()), motor),
+            None => (config, Some(text.as_str()), &cfg.motor),
+        };
+        if let Some(w) =
+            fado_sim::nameplate_agreement::resistance("motor.rs", motor.rs, id.model.rs)
+        {
+            warn_at(file, source, "motor.rs", &w);
+        }
+    }
     if let Some(m) = &o.magnetics {
         print_magnetics(m, o.rotor_motion_magnetics);
     }
@@ -120,18 +141,30 @@ fn load(
     }
 }
 
-/// Runs the procedure on the plant of `cfg`, told the nameplate of its `[motor]` record
-/// (parameters only size the tests) with the inverter's DC link, with a progress bar; an error
-/// is located in `text`, the file `config` (if any).
+/// The text and the `[motor]` record of `--nameplate FILE`.
+fn nameplate(
+    path: &Path,
+) -> Result<(String, fado_core::MachineModel<f64>), Box<dyn std::error::Error>> {
+    let text = read_file(path)?;
+    let cfg =
+        fado_sim::SimConfig::from_toml(&text).map_err(|e| in_file(e, &Some(path.to_path_buf())))?;
+    warn_plausibility(&cfg, Some(path), Some(&text));
+    Ok((text, cfg.plant().motor))
+}
+
+/// Runs the procedure on the plant of `cfg`, told `nameplate` (default the plant's `[motor]`
+/// record; parameters only size the tests) with the inverter's DC link, with a progress bar;
+/// an error is located in `text`, the file `config` (if any).
 fn identify(
     cfg: &fado_sim::SimConfig,
+    nameplate: Option<&fado_core::MachineModel<f64>>,
     text: &str,
     config: Option<&Path>,
 ) -> Result<CommissionOutcome, Box<dyn std::error::Error>> {
     let plant = cfg.plant();
     let nameplate = fado_core::MachineModel {
         dc_voltage: plant.inverter.dc_voltage,
-        ..plant.motor
+        ..*nameplate.unwrap_or(&plant.motor)
     };
     let bar = ProgressBar::new(1000);
     bar.set_style(
