@@ -11,6 +11,7 @@ import os
 import signal
 import threading
 import time
+import tomllib
 from pathlib import Path
 
 import numpy as np
@@ -95,7 +96,37 @@ def test_traces_are_arrays_over_the_phases_in_order(paper: fado.CommissionResult
     # paper's (linear) motor is reported unsaturated.
     assert paper.rotor_motion_magnetics < 0.15
     assert paper.saturation_detected is False
+    assert paper.saturation_verdict == "not_detected"
     assert "No magnetic saturation detected" in paper.identified_toml
+
+
+ROOT = Path(__file__).resolve().parents[2]
+# A made-up 750 W servo SPM whose d axis saturates on the magnet (its file documents it).
+LIGHT_SPM = ROOT / "crates" / "fado-sim" / "tests" / "data" / "spm-dq-sat-saturated.toml"
+
+
+def light_spm(inertia: float) -> tuple[dict[str, float], dict[str, dict[str, object]]]:
+    """The servo SPM as a dict of Machine fields with `inertia`, and its saturation and a
+    5 kHz carrier as the config (crates/fado-sim/tests/commission_magnetics.rs's machine)."""
+    doc = tomllib.loads(LIGHT_SPM.read_text())
+    motor = dict(doc["motor"])
+    saturation = motor.pop("saturation")
+    motor.update(inertia=inertia, dc_voltage=doc["inverter"]["dc_voltage"])
+    return motor, {"motor": {"saturation": saturation}, "inverter": {"switching_frequency": 5000.0}}
+
+
+def test_the_saturation_verdict_names_what_the_pulses_saw() -> None:
+    # The saturated IPMSM preset (a heavy rotor, q saturation and cross-saturation): detected.
+    heavy = fado.commission("ipmsm-2k2", config=ROOT / "motors" / "saturated" / "ipmsm-2k2-qsat.toml")
+    assert heavy.saturation_verdict == "detected", heavy.status
+    assert heavy.saturation_detected is True
+    # The servo SPM with a rotor ten times lighter than its file's: the pulses turn it beyond
+    # the limit within which they tell saturation from the magnet's back-EMF.
+    motor, config = light_spm(2e-5)
+    light = fado.commission(motor, config=config)
+    assert light.saturation_verdict == "rotor_moved", (light.status, light.rotor_motion_magnetics)
+    assert light.rotor_motion_magnetics > 0.15
+    assert light.saturation_detected is not True
 
 
 def test_dict_motor_and_a_rough_nameplate() -> None:

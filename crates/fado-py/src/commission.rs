@@ -282,6 +282,14 @@ pub struct CommissionResult {
     /// `[model.saturation]`), or `None` when nothing was identified.
     #[pyo3(get)]
     saturation_detected: Option<bool>,
+    /// The standstill flux-linkage pulses' verdict on the machine's saturation, as
+    /// `fado-sim commission` names it in metrics.json: `detected`, `not_detected`,
+    /// `inconclusive` (a fit of large change that does not explain the flux), `rotor_moved`
+    /// (the rotor turned beyond `PULSE_MOTION_LIMIT` during the pulses) or `not_measured`;
+    /// `None` when the pulses did not run to their end. It stands when the procedure aborts
+    /// later (then `saturation_detected` is `None`).
+    #[pyo3(get)]
+    saturation_verdict: Option<String>,
     /// The plant's configuration as TOML.
     #[pyo3(get)]
     config_toml: String,
@@ -365,6 +373,7 @@ impl CommissionResult {
             rotor_motion_inductance: o.rotor_motion_inductance,
             rotor_motion_magnetics: o.rotor_motion_magnetics,
             saturation_detected: id.map(|id| id.saturation.is_some()),
+            saturation_verdict: o.magnetics.as_ref().map(|m| m.verdict.to_owned()),
             config_toml: config_text,
             identified_toml,
             truth: truth.unbind(),

@@ -7,6 +7,7 @@
 //! 0.5 s ramp, lets it settle, then runs the experiment. Metrics are taken from `eval_start`.
 
 mod checks;
+mod load_settling;
 mod probe;
 mod profiles;
 mod report;

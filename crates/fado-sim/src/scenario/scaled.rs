@@ -36,6 +36,9 @@ pub const SCALED_LOAD_RATIO: f64 = 7.5 / 11.5;
 pub const REVERSAL_SPEED_RATIO: f64 = 90.0 / 1500.0;
 /// Top speed of the scaled `stops`: 60 of 1500 r/min (4 %, Fig. 12 \[A\]).
 pub const STOPS_SPEED_RATIO: f64 = 60.0 / 1500.0;
+/// The scaled `reversal`'s evaluation start, s (fig11's, 0.3 s after the load's ramp), unless
+/// the drive's speed loop settles that ramp later (`load_settling`).
+pub const REVERSAL_EVAL_START: f64 = 2.0;
 /// Speed-error bound of the scaled scenarios, fraction of the rated speed: 30 of 1500 r/min.
 pub const SCALED_SPEED_ERROR_RATIO: f64 = 30.0 / 1500.0;
 
@@ -107,7 +110,15 @@ pub(super) fn setup_reversal_under(c: &mut SimConfig, load: f64) {
     c.speed_reference = pts(&[(0.0, 0.0), (0.2, 0.0), (1.2, -n), (2.5, -n), (4.5, n)]);
     c.load.torque = pts(&[(1.2, 0.0), (1.7, load * t_rated)]);
     c.simulation.duration = 5.5;
-    c.simulation.eval_start = 2.0;
+    // Judged from 2.0 s, or from where the drive's own speed loop has brought the load ramp's
+    // error back within the band, at the latest the reversal's start (`load_settling`).
+    let band = SCALED_SPEED_ERROR_RATIO * n_rated;
+    let settled = super::load_settling::instant(c, 1.2, 1.7, load * t_rated, band);
+    c.simulation.eval_start = if settled.is_nan() {
+        REVERSAL_EVAL_START
+    } else {
+        settled.clamp(REVERSAL_EVAL_START, 2.5)
+    };
 }
 
 /// `reversal`: fig11 scaled, 65.2 % load.
