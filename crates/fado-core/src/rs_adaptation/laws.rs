@@ -19,6 +19,9 @@ pub(crate) struct ResistanceAdaptationParams<T: 'static> {
     config: ResistanceAdaptationConfig<T>,
     /// γ·Ts.
     rate_ts: T,
+    /// The saturating turning law's multiple of γ: [`SATURATING_RATE_RATIO`], or less where
+    /// that would take its γ·Ts to 1.
+    saturating_rate_ratio: T,
     /// γ_s·Ts.
     standstill_gain: T,
     /// e^{−ω_m·Ts}.
@@ -36,6 +39,29 @@ pub(crate) struct ResistanceAdaptationParams<T: 'static> {
 /// traction IPMSM's coarse 7 × 8 map of `scripts/saturated-replay.py` (R̂s 0.95–1.05 × the
 /// truth running everywhere).
 pub(crate) const MAP_RESISTANCE_RESOLUTION: f64 = 0.02;
+
+/// The turning law's rate with a saturating model as a multiple of γ
+/// ([`ResistanceAdaptationConfig::rate`]). γ = 1 s⁻¹ is bounded by the hand-over's
+/// flux-magnitude ripple, which the constant-inductance law reads as it comes (at 5 s⁻¹ it
+/// moved R̂s by ≈ 1.5 % on the paper's motor); the saturating law waits that transient out
+/// (`settled`), so its bound is the flux dynamics it must stay slow against (3 s⁻¹ against
+/// the k_df mode's ≥ 8 rad/s on the paper's motor). Ours \[A\]: 3 takes R̂s from 0.7 and
+/// 1.4 times the truth to within 0.4 % during `rated-reversal`'s two loaded seconds before
+/// its zero-speed passage on a d-saturated SPM whose rated R·I/λf (94 rad/s) makes that
+/// passage need R̂s within about 0.5 % (1 s⁻¹ leaves 1.5–1.7 % and loses the rotor,
+/// 0.36–0.92 rad; `crates/fado-sim/tests/saturated_rs_convergence.rs`).
+pub(crate) const SATURATING_RATE_RATIO: f64 = 3.0;
+
+/// 1/(2π·`hz`)²: |ω̂| ≤ 2π·`hz` is ω̂²·(that) ≤ 1; `hz` = 0 allows ω̂ = 0 only (1e30: no
+/// ∞·0).
+fn inverse_square_speed<T: Real>(hz: T) -> T {
+    if hz > T::zero() {
+        let w = T::two_pi() * hz;
+        T::one() / (w * w)
+    } else {
+        T::lit(1e30)
+    }
+}
 
 /// What the laws derive from R0, the resistance they start from and scale with: mutable
 /// (R0 is replaced at run time), so kept with the state.
@@ -120,15 +146,13 @@ impl<T: Real> ResistanceAdaptationParams<T> {
         Ok(Self {
             config,
             rate_ts: rate * ts,
+            saturating_rate_ratio: crate::real::min(
+                T::lit(SATURATING_RATE_RATIO),
+                T::one() / (rate * ts),
+            ),
             standstill_gain: rate_s * ts,
             forget: (-(memory_w * ts)).exp(),
-            // |ω̂| ≤ ω_s is ω̂²·(1/ω_s²) ≤ 1; ω_s = 0 allows ω̂ = 0 only (1e30: no ∞·0).
-            standstill_inv_omega_sq: if standstill_hz > T::zero() {
-                let w = T::two_pi() * standstill_hz;
-                T::one() / (w * w)
-            } else {
-                T::lit(1e30)
-            },
+            standstill_inv_omega_sq: inverse_square_speed(standstill_hz),
             saliency: config.ld_hat - config.lq_hat,
             floor_sq: floor * floor,
         })
@@ -271,8 +295,7 @@ impl<T: Real> ResistanceAdaptationParams<T> {
         point: Option<(&ActiveFlux<T, M>, ActiveFluxPoint<T>)>,
     ) -> bool {
         let lf = st.flux_linkage_hat;
-        let dl = self.saliency;
-        if let Some((af, point)) = point {
+        let (reference, relative_to, a, gains) = if let Some((af, point)) = point {
             // A saturating model (`crate::active_flux`): λ̂a(î) shifted by the learned λ̂f,
             // the regressor's bracket at î; frozen where it is ill-conditioned, and until the
             // hand-over's transient has settled (`settled`, as the λ̂f law): there the angle
@@ -302,17 +325,43 @@ impl<T: Real> ResistanceAdaptationParams<T> {
             // within milliseconds).
             let relative_to = crate::real::max(lf, reference);
             let a = -(mag * bracket) * scale.chi_per_phi * (lf / relative_to);
-            return self.rotating_step(
-                scale,
-                st,
-                next,
-                (reference, relative_to),
-                a,
-                mag,
-                omega,
-                settled,
-            );
-        }
+            // At `SATURATING_RATE_RATIO`·γ: it waits out the hand-over (above).
+            let ratio = self.saturating_rate_ratio;
+            let gains = (scale.gain * ratio, self.rate_ts * ratio);
+            (reference, relative_to, a, gains)
+        } else {
+            let Some(linear) = self.linear_regressor(scale, st, i_drop, lambda_r, mag) else {
+                return false;
+            };
+            linear
+        };
+        self.rotating_step(
+            st,
+            next,
+            (reference, relative_to),
+            gains,
+            a,
+            mag,
+            omega,
+            settled,
+        )
+    }
+
+    /// The constant-inductance turning law's reference λ̂a, the flux its error is taken
+    /// relative to (λ̂f), the numerator `a` of χ and its gains γ·Ts·R0 and γ·Ts; None where
+    /// the active flux is not positive.
+    #[inline(always)]
+    #[allow(clippy::type_complexity)]
+    fn linear_regressor(
+        &self,
+        scale: &ResistanceScale<T>,
+        st: &ResistanceAdaptationState<T>,
+        i_drop: Ab<T>,
+        lambda_r: Ab<T>,
+        mag: T,
+    ) -> Option<(T, T, T, (T, T))> {
+        let lf = st.flux_linkage_hat;
+        let dl = self.saliency;
         // The reference is the active flux λ̂a = λ̂f + (L̂d − L̂q)·î_d and φ carries the
         // sensitivity factor 1 + (L̂d − L̂q)·î_d/λ̂a (module docs); for L̂d = L̂q both are
         // exactly λ̂f and 1, and the division for î_d is skipped.
@@ -323,7 +372,7 @@ impl<T: Real> ResistanceAdaptationParams<T> {
             let active = lf + dl * i_d;
             // A non-positive (or NaN) reference: nothing to compare with.
             if active.partial_cmp(&T::zero()) != Some(core::cmp::Ordering::Greater) {
-                return false;
+                return None;
             }
             (active, T::one() + dl * i_d / active)
         };
@@ -331,20 +380,21 @@ impl<T: Real> ResistanceAdaptationParams<T> {
         // χ = a/b: then χ/(χ² + χ0²) = a·b/(a² + χ0²·b²) costs one division, and
         // χ² ≥ χ0² is a² ≥ χ0²·b² (false for ω̂ = 0, which also rules out 0/0).
         let a = -lambda_r.cross(i_drop) * scale.chi_per_phi * sensitivity;
-        self.rotating_step(scale, st, next, (reference, lf), a, mag, omega, settled)
+        Some((reference, lf, a, (scale.gain, self.rate_ts)))
     }
 
     /// The turning law's step (and the λ̂f law's) with the reference λ̂a, the flux the error
-    /// is taken relative to (λ̂f, or a saturating rotor's active flux where that is more) and
-    /// the numerator `a` of χ = a/(|λ̂r|·ω̂).
+    /// is taken relative to (λ̂f, or a saturating rotor's active flux where that is more), the
+    /// law's gain γ·Ts·R0 and γ·Ts, and the numerator `a` of χ = a/(|λ̂r|·ω̂); `settled`: the
+    /// λ̂f law may run.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     fn rotating_step(
         &self,
-        scale: &ResistanceScale<T>,
         st: &ResistanceAdaptationState<T>,
         next: &mut ResistanceAdaptationState<T>,
         (reference, relative_to): (T, T),
+        (gain, rate_ts): (T, T),
         a: T,
         mag: T,
         omega: T,
@@ -355,10 +405,9 @@ impl<T: Real> ResistanceAdaptationParams<T> {
         if a_sq >= floor_b_sq && floor_b_sq > T::zero() {
             // ẽ·χ/(χ² + χ0²) with ẽ = (|λ̂r| − λ̂a)/`relative_to`, in one division.
             let weight = a_sq / (a_sq + floor_b_sq);
-            next.rs_hat -=
-                scale.gain * (mag - reference) * a * b / (relative_to * (a_sq + floor_b_sq));
+            next.rs_hat -= gain * (mag - reference) * a * b / (relative_to * (a_sq + floor_b_sq));
             // The turning law replaces what the standstill tests contributed.
-            let keep = T::one() - self.rate_ts * weight;
+            let keep = T::one() - rate_ts * weight;
             next.offset_sensitivity = st.offset_sensitivity * keep;
             next.standstill_share = st.standstill_share * keep;
         }

@@ -227,7 +227,9 @@ pub struct ResistanceAdaptationConfig<T> {
     /// Default 1 s⁻¹ (ours \[A\]: the winding heats over minutes, so the law can be slow; at
     /// 5 s⁻¹ the hand-over's magnitude ripple at the 2–4 Hz electrical frequency moved R̂s by
     /// ≈ 1.5 %, enough to lose the Fig. 12 stops, at 1 s⁻¹ by ≈ 0.3 %). The fast correction
-    /// at start-up is the standstill law's.
+    /// at start-up is the standstill law's. With a saturating model the turning law, which
+    /// waits out the hand-over's transient, runs at three times this rate (at most 1/ts;
+    /// docs/method/saturation.md, "The R̂s law's regressor").
     pub rate: T,
     /// χ0: the excitation (relative flux error per relative resistance error) below which the
     /// turning law is frozen, and the scale of its normalisation χ/(χ² + χ0²); the standstill
