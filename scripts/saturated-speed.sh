@@ -82,27 +82,38 @@ slow it, so that figures measured under load are lower bounds).
 
 ## Where the time goes
 
+Instructions counted by callgrind on `fado-sim run stops` (deterministic, unlike time on a
+shared machine; `valgrind --tool=callgrind target/release/fado-sim run stops --config …`).
+
 - **Flux map** (`pmsyrm-baldor-5k6-measured`, `pmsm-gem-1k1-measured`): the plant's inverse
-  i(ψ) is solved in closed form per bilinear cell, from the cell of the sub-step's warm start
-  (`fado_core::magnetics`, "Inversion"); the sub-step is 0.05 of the shortest incremental
-  time constant over the map's own grid (`fado-sim`'s `magnetics` module), so that nearly every
-  interval of one switch state is one sub-step: three inversions (the Runge–Kutta stages; the
-  end's current, a hair from the last stage's flux, is one Newton step in that stage's cell),
-  two on the short ones. The plant keeps the warm start's cell and the last four cells'
-  polynomials (`fado_core::magnetics::InverseCache`), so that an inversion is one quadratic —
-  a square root and a division in sequence, whose latency bounds it: the inversions are about
-  20 % of the GEM map's CPU time and the Runge–Kutta steps around them 8 % (`perf record` on
-  `fado-sim run stops`). The estimator reads the map through its C¹ interpolant
-  (docs/method/saturation.md "A map's interpolation") twice per sample, at the two operating
-  points it forms (the observer's and the rotor flux's, at different currents): the flux
-  alone (`FluxMap::smooth_flux`), the cells found as the bilinear lookup finds them, the node
-  slopes along i_q loaded (found once per map); the Jacobian only in the slow laws' slots.
-  These reads are about 12 % of the CPU time; the drive's torque solve on the map about 5 %.
+  i(ψ) is solved in closed form per bilinear cell (`fado_core::magnetics`, "Inversion"); the
+  sub-step is 0.05 of the shortest incremental time constant over the map's own grid
+  (`fado-sim`'s `magnetics` module), so that nearly every interval of one switch state is one
+  sub-step: three inversions on a long interval (the Runge–Kutta stages; the end's current, a
+  hair from the last stage's flux, is one Newton step in that stage's cell), two on a short
+  one (the midpoint rule). `stops` on the GEM map has five intervals per sample, three in five
+  short: twelve inversions per sample. The plant keeps the last four cells' polynomials
+  (`fado_core::magnetics::InverseCache`, carried from sample to sample) and solves first in
+  the last solution's cell, then in the neighbour its root points into, taking a root that
+  lies inside by more than 10⁻⁶ of the cell (the walk's own answer, bit for bit): 95 % of the
+  inversions are one or two quadratics, a square root and two divisions each, with no search.
+  The inversions are 21 % of the GEM map's instructions and the Runge–Kutta steps around them
+  12 %. The estimator reads the map through its C¹ interpolant (docs/method/saturation.md
+  "A map's interpolation") twice per sample, at the two operating points it forms (the
+  observer's and the rotor flux's, at different currents): the flux alone
+  (`FluxMap::smooth_flux`), the cells found as the bilinear lookup finds them, the node slopes
+  along i_q loaded (found once per map); the Jacobian only in the slow laws' slots. These
+  reads are about 15 % of the instructions; the drive's torque solve on the map about 6 %.
 - **Algebraic model** (`ipmsm-2k2-qsat`, `pmsyrm-baldor-5k6`): the plant's i(ψ) is the model's
   own closed form; the drive's and the estimator's ψ(i) are Newton solves started from the
   tangent plane of their last solution (`fado_core::magnetics::FluxWarmStart`: one step and the
-  one that confirms it, 1.4 evaluations per solve on average), about 20 % of the PM-SyRM's
-  instructions, the plant's i(ψ) 10 % (callgrind on `fado-sim run stops`).
+  one that confirms it, 1.4 evaluations per solve on average), about 19 % of the PM-SyRM's
+  instructions, the plant's i(ψ) 11 %.
+- **Trace** (every motor): `traces.csv` keeps one sample in ten, 40 columns, each row formatted
+  into one line buffer (`fado_sim::sim::CsvTraceWriter`: floats by `zmij` in `ryu`'s form, the
+  bytes the `csv` crate writes): 5 % of the GEM map's instructions, 10 % of the
+  constant-inductance motor's. A flux map's file is read once (the 21 × 27 Baldor map in 8 M
+  instructions).
 """
 os.makedirs(os.path.dirname(out) or ".", exist_ok=True)
 fd, tmp_path = tempfile.mkstemp(dir=os.path.dirname(out) or ".", suffix=".tmp")

@@ -91,3 +91,38 @@ def test_a_key_given_both_ways_is_refused_naming_both() -> None:
     fields = {k: v for k, v in DATASHEETS["servo-310v"].items() if k != "pole_pairs"}
     with pytest.raises(fado.ConfigError, match="pole_pairs"):
         fado.Machine.from_datasheet(**fields)
+
+
+# The slotless maxon EC 22 40 W on 24 V, and the same with a tenth of its inductance.
+MAXON_FIELDS = {
+    "rs": 0.3205,
+    "ld": 27.3e-6,
+    "lq": 27.3e-6,
+    "flux_linkage": 3.75e-3,
+    "pole_pairs": 1,
+    "rated_current": 3.68,
+    "rated_speed_rpm": 31800.0,
+    "rated_torque": 20.7e-3,
+    "dc_voltage": 24.0,
+}
+
+
+def test_the_carrier_rule_refuses_and_warns_as_the_cli() -> None:
+    """`fado_core::ratings::check_carrier` through `fado.simulate`: a derived carrier above
+    the 100 kHz of realistic inverters is refused naming the bound's keys and the carrier it
+    needs, one above 40 kHz and a given carrier with a ripple above 1.2 times the rated
+    current are warnings (crates/fado-sim/tests/datasheet_carrier.rs reads the same rows
+    from a motor file)."""
+    thin = fado.Machine(**{**MAXON_FIELDS, "ld": 2.73e-6, "lq": 2.73e-6})
+    with pytest.raises(fado.ConfigError) as e:
+        fado.simulate("stops", motor=thin)
+    assert e.value.field == "motor.ld"
+    for part in ("664 kHz", "100 kHz", "`motor.lq`", "`inverter.dc_voltage`", "`motor.rated_current`"):
+        assert part in str(e.value), part
+    short = {"simulation": {"duration": 0.01, "eval_start": 0.0}}
+    maxon = fado.Machine(**MAXON_FIELDS)
+    with pytest.warns(UserWarning, match="67 kHz"):
+        fado.simulate("stops", config=short, averaged=True, motor=maxon)
+    slow = {**short, "inverter": {"switching_frequency": 12000.0}}
+    with pytest.warns(UserWarning, match="`inverter.switching_frequency` = 12000 Hz"):
+        fado.simulate("stops", config=slow, averaged=True, motor=maxon)

@@ -11,7 +11,7 @@
 //! | `viscous_friction` | [`FRICTION_TORQUE_RATIO`] of the rated torque at rated speed |
 //! | `inertia` | rated torque accelerates it to rated speed in [`MECHANICAL_START_TIME`] |
 //! | `dc_voltage` | the rated point uses [`DC_LINK_MODULATION_RATIO`] of the linear range |
-//! | `switching_frequency` | ω_rated·Ts ≤ [`MAX_OMEGA_TS`], min(Ld, Lq)/Rs ≥ 2·Ts and the PWM current ripple ([`ripple_current`]) ≤ [`MAX_RIPPLE_CURRENT_RATIO`] of the rated current, at least the DC link's class floor ([`min_switching_frequency`]) |
+//! | `switching_frequency` | ω_rated·Ts ≤ [`MAX_OMEGA_TS`], min(Ld, Lq)/Rs ≥ 2·Ts and the PWM current ripple ([`ripple_current`]) ≤ [`MAX_RIPPLE_CURRENT_RATIO`] of the rated current, at least the DC link's class floor ([`min_switching_frequency`]); none above the class's ceiling of realistic carriers ([`max_switching_frequency`], [`check_carrier`]) |
 //! | `dead_time` | [`DEAD_TIME_PERIOD_RATIO`] of the carrier period |
 //! | `threshold_voltage` | [`THRESHOLD_VOLTAGE_RATIO`] of the DC link |
 //! | `current_band` | [`CURRENT_BAND_RATIO`] of the rated current |
@@ -52,6 +52,14 @@
 
 use crate::Real;
 use crate::machine::{MachineModel, PAPER_RATED_CURRENT};
+
+mod carrier;
+
+pub use carrier::{
+    CarrierBound, CarrierFinding, CarrierNeed, FAST_CARRIER_RATIO, MAX_GIVEN_RIPPLE_RATIO,
+    MAX_SWITCHING_FREQUENCY, MAX_SWITCHING_FREQUENCY_MEDIUM_VOLTAGE, carrier_need, check_carrier,
+    max_switching_frequency,
+};
 
 /// Viscous friction at rated speed as a fraction of the rated torque: 1 % \[A\]
 /// (B = 0.01·T_rated/ω_rated,mech). Bearings and windage of industrial servo motors take
@@ -101,10 +109,20 @@ pub const MIN_SWITCHING_FREQUENCY_MEDIUM_VOLTAGE: f64 = 2000.0;
 /// [`MIN_SWITCHING_FREQUENCY`] up to [`LOW_VOLTAGE_DC_LINK`], else
 /// [`MIN_SWITCHING_FREQUENCY_MEDIUM_VOLTAGE`].
 pub fn min_switching_frequency(dc_voltage: f64) -> f64 {
+    of_class(
+        dc_voltage,
+        MIN_SWITCHING_FREQUENCY,
+        MIN_SWITCHING_FREQUENCY_MEDIUM_VOLTAGE,
+    )
+}
+
+/// `low_voltage` for an inverter on `dc_voltage` (V) up to [`LOW_VOLTAGE_DC_LINK`], else
+/// `medium_voltage`.
+pub(crate) fn of_class(dc_voltage: f64, low_voltage: f64, medium_voltage: f64) -> f64 {
     if dc_voltage > LOW_VOLTAGE_DC_LINK {
-        MIN_SWITCHING_FREQUENCY_MEDIUM_VOLTAGE
+        medium_voltage
     } else {
-        MIN_SWITCHING_FREQUENCY
+        low_voltage
     }
 }
 
@@ -165,7 +183,7 @@ pub const RULES: [(&str, &str); 7] = [
     ),
     (
         "inverter.switching_frequency",
-        "ω_rated·Ts ≤ 0.2, the electrical time constant min(ld, lq)/rs ≥ 2·Ts (Ts = 1/(2·f_sw)) and the PWM current ripple dc_voltage/(6·min(ld, lq)·f_sw) ≤ 0.6·rated_current (maxon's motor-choke rule), at least 5 kHz (2 kHz on a DC link above 1.2 kV), rounded up to a whole kHz",
+        "ω_rated·Ts ≤ 0.2, the electrical time constant min(ld, lq)/rs ≥ 2·Ts (Ts = 1/(2·f_sw)) and the PWM current ripple dc_voltage/(6·min(ld, lq)·f_sw) ≤ 0.6·rated_current (maxon's motor-choke rule), at least 5 kHz (2 kHz on a DC link above 1.2 kV), rounded up to a whole kHz; refused above 100 kHz (10 kHz above 1.2 kV: no inverter of the class has it; the error names the bound's keys and the carrier it needs), a warning above 40 kHz (4 kHz: a GaN inverter)",
     ),
     (
         "inverter.dead_time",
@@ -184,7 +202,7 @@ pub fn rule(key: &str) -> Option<&'static str> {
 }
 
 /// Rated mechanical speed in rad/s from r/min.
-fn rated_speed_mech(rated_speed_rpm: f64) -> f64 {
+pub(crate) fn rated_speed_mech(rated_speed_rpm: f64) -> f64 {
     rated_speed_rpm * core::f64::consts::PI / 30.0
 }
 
@@ -199,7 +217,7 @@ pub fn inertia(rated_torque: f64, rated_speed_rpm: f64) -> f64 {
 }
 
 /// The smallest whole multiple of `step` at or above `x` (x ≥ 0, finite).
-fn ceil_to(x: f64, step: f64) -> f64 {
+pub(crate) fn ceil_to(x: f64, step: f64) -> f64 {
     let n = x / step;
     let whole = n as u64 as f64;
     step * if whole < n { whole + 1.0 } else { whole }
@@ -228,20 +246,11 @@ pub fn ripple_current(dc_voltage: f64, inductance: f64, switching_frequency: f64
 /// the smallest whole kHz at which the electrical time constant min(Ld, Lq)/Rs spans two
 /// sampling periods (a current loop needs at least that) and at which the PWM current ripple
 /// [`ripple_current`] on `m.dc_voltage` is at most [`MAX_RIPPLE_CURRENT_RATIO`] of the rated
-/// current (a slotless 40 W motor, 27.3 µH on 24 V, asks for 67 kHz).
+/// current (a slotless 40 W motor, 27.3 µH on 24 V, asks for 67 kHz). Above the ceiling of
+/// realistic carriers ([`max_switching_frequency`]) the front ends refuse the value
+/// ([`check_carrier`], module `carrier`'s documentation).
 pub fn switching_frequency_of(m: &MachineModel<f64>) -> f64 {
-    let mut f = switching_frequency(m.pole_pairs, m.rated_speed_rpm, m.dc_voltage);
-    let l = m.ld.min(m.lq);
-    let tau = l / m.rs;
-    if tau.is_finite() && tau > 0.0 && 1.0 / tau > f {
-        f = ceil_to(1.0 / tau, SWITCHING_FREQUENCY_STEP);
-    }
-    let ripple =
-        ripple_current(m.dc_voltage, l, 1.0) / (MAX_RIPPLE_CURRENT_RATIO * m.rated_current);
-    if ripple.is_finite() && ripple > f {
-        f = ceil_to(ripple, SWITCHING_FREQUENCY_STEP);
-    }
-    f
+    carrier_need(m).frequency
 }
 
 /// The d and q currents of the maximum-torque-per-ampere point of magnitude `i` (A peak):

@@ -102,6 +102,8 @@ struct Finished {
     config_toml: String,
     estimator: fado_core::EstimatorConfig<f64>,
     columns: Vec<Vec<f64>>,
+    /// The carrier's warning (`SimConfig::carrier_findings`), issued as a `UserWarning`.
+    warnings: Vec<String>,
 }
 
 /// The motor a simulation runs with, before the scenario and the user's configuration.
@@ -214,6 +216,12 @@ fn run(
     cancel: &AtomicBool,
 ) -> Result<Finished, Failed> {
     let cfg = layered_config(scenario, motor, config_toml, averaged).map_err(Failed::Config)?;
+    let warnings = cfg
+        .carrier_findings()
+        .filter(|(s, ..)| *s == fado_core::machine_checks::Severity::Warning)
+        .map(|(.., text)| text)
+        .into_iter()
+        .collect();
     let rows = scenario::trace_rows(&cfg);
     if rows > MAX_TRACE_ROWS_IN_MEMORY {
         let e = SimConfigError::new(
@@ -261,6 +269,7 @@ fn run(
         config_toml: outcome.config.to_toml(),
         estimator: outcome.config.estimator_config(),
         columns: columns.columns,
+        warnings,
     })
 }
 
@@ -302,7 +311,17 @@ pub fn simulate(
         )
     })?;
     match finished {
-        Ok(f) => SimResult::new(py, scenario, f),
+        Ok(f) => {
+            for w in &f.warnings {
+                PyErr::warn(
+                    py,
+                    &py.get_type::<pyo3::exceptions::PyUserWarning>(),
+                    &std::ffi::CString::new(w.as_str()).unwrap_or_default(),
+                    1,
+                )?;
+            }
+            SimResult::new(py, scenario, f)
+        }
         Err(Failed::Config(e)) => Err(sim_error(py, e)),
         Err(Failed::Json(e)) => Err(pyo3::exceptions::PyRuntimeError::new_err(format!(
             "metrics to JSON: {e}"

@@ -220,6 +220,43 @@ fn classes(release: bool) -> Vec<String> {
     failed
 }
 
+/// Half the rated torque arriving 5 ms and 20 ms after the calibrations end, in the running
+/// drive's first moments, on each machine, with the release hold off (the drive's default)
+/// and on. Measured (this code): with the hold off only the 48 V hub motor meets the
+/// benchmark's criteria (the servo 1.0–2.8 rad back, the multirotor 39–48 rad, the traction
+/// machine 12 rad, the 10 kV-class machine 7 rad, the spindle 30–37 rad: the speed loop alone
+/// meets the load); with it on the traction and 10 kV-class machines pass too (their
+/// reference is still zero, and the hold catches the fall), while on the others the
+/// application's reference already ramps (6 % of the rated speed at the servo's end), at
+/// which the hold hands over at once and the speed loop alone meets the load again. Not met;
+/// run with `--ignored` (`-- --nocapture` prints each case).
+#[test]
+#[ignore = "the running drive's speed loop alone does not catch a load arriving just after the calibrations on a moving reference"]
+fn a_load_arriving_just_after_the_calibrations() {
+    let mut failed = Vec::new();
+    for hold in ["", "[controller.release_hold]\nenabled = true\n"] {
+        for (name, motor, inverter) in MACHINES {
+            let base = config(motor, inverter, hold);
+            let end = run(base.clone()).spans[5].0;
+            for at in [end + 0.005, end + 0.02] {
+                let r = run(loaded(&base, at));
+                let verdict = failure(&base, &r);
+                println!(
+                    "{name:26} hold {} load at {at:.3} s: {verdict:?}",
+                    !hold.is_empty()
+                );
+                if let Some(v) = verdict {
+                    failed.push(format!(
+                        "{name} (hold {}) at {at:.3} s: {v}",
+                        !hold.is_empty()
+                    ));
+                }
+            }
+        }
+    }
+    assert!(failed.is_empty(), "{failed:#?}");
+}
+
 /// The machines of the sweep: the 2.2 kW IPMSM preset and three classes of the table.
 fn sweep_machines() -> [(&'static str, SimConfig); 4] {
     [
@@ -231,12 +268,12 @@ fn sweep_machines() -> [(&'static str, SimConfig); 4] {
 }
 
 /// Whether the sweep's cell (machine, phase, share of the phase) is one the drive meets:
-/// every phase on the IPMSM; on the others the voltage-mode levels and the settling's end,
-/// and the offsets on the servo motor. The cells it does not meet are in
-/// [`the_start_up_phases_that_lose_a_light_or_unheld_rotor`].
+/// every phase on the IPMSM; on the others the offsets, the voltage-mode levels and the
+/// settling's end, and the settling's start on the servo motor. The cells it does not meet
+/// are in [`the_start_up_phases_that_lose_a_light_or_unheld_rotor`].
 fn met(machine: &str, phase: &str, share: f64) -> bool {
     machine == "ipmsm-2k2"
-        || matches!(phase, "lower" | "upper")
+        || matches!(phase, "offsets" | "lower" | "upper")
         || (phase == "settle" && share > 0.5)
         || (machine == "400 V servo" && phase != "release")
 }
@@ -270,14 +307,17 @@ fn sweep(want: bool) -> Vec<String> {
 }
 
 /// The load's arrival swept through every phase of the calibrations on the 2.2 kW IPMSM
-/// preset, and through the voltage-mode levels, the settling's end and the servo motor's
-/// offsets on the 400 V servo, the 12S multirotor and the 2-pole spindle: the offsets (the
-/// shorted phases' motion monitor), the settling at I₁ and the release to zero (the current
-/// loop's voltage across the axis), the two voltage-mode levels. Every cell meets the
-/// benchmark's criteria; `-- --nocapture` prints the table (machine, phase, arrival, status,
-/// max |θ − θ̂|, backward travel, lowest speed). Measured: the IPMSM within 0.14 rad and
-/// 0.21 rad back in every phase (its release too: the loop sees its back-EMF at 0.5 % of its
-/// rated speed above the band), the others within 0.22 rad and 0.43 rad back.
+/// preset, and through the offsets, the voltage-mode levels and the settling's end on the
+/// 400 V servo, the 12S multirotor and the 2-pole spindle: the offsets (the shorted phases'
+/// motion monitor, its travel over the whole calibration and over its recent window), the
+/// settling at I₁ and the release to zero (the current loop's voltage across the axis), the
+/// two voltage-mode levels. Every cell meets the benchmark's criteria; `-- --nocapture`
+/// prints the table (machine, phase, arrival, status, max |θ − θ̂|, backward travel, lowest
+/// speed). Measured: the IPMSM within 0.13 rad and 0.20 rad back in every phase (its release
+/// too: the loop sees its back-EMF at 0.5 % of its rated speed above the band), the others
+/// within 0.22 rad and 0.43 rad back (the multirotor's offsets 0.41 rad, the spindle's
+/// 0.30 rad: the recent window reads the multirotor's turn at 0.09 rad, where the whole
+/// calibration's drift allowance let it reach 0.32 rad).
 #[test]
 fn a_load_arriving_in_a_phase_of_the_start_up_is_caught() {
     let failed = sweep(true);
@@ -287,12 +327,12 @@ fn a_load_arriving_in_a_phase_of_the_start_up_is_caught() {
 /// The sweep's cells the drive does not meet (measured): the release to zero current on the
 /// servo, the multirotor and the spindle (0.92–52 rad back: the band hides the back-EMF, then
 /// the running drive's speed loop meets the load on a reference already ramping, where the
-/// release hold does not act); the offsets on the multirotor (0.68–0.91 rad back) and late in
-/// them on the spindle (0.59 rad), whose light rotors the shorted phases brake too little
-/// before the monitor's 0.05 rad; the settling's first half on the multirotor (0.56–0.82 rad)
-/// and the spindle (0.60 rad, and π off 1 ms in: the loop's current is still rising).
+/// release hold does not act); the settling's first half on the multirotor (0.56–0.82 rad)
+/// and the spindle (1.3 rad, and π off 1 ms in): I₁ is half the rated current, whose d-axis
+/// stiffness holds at most half the rated torque (at a quarter turn), and the loop's motion
+/// test fires only at 3 % of the rated speed (1800 r/min on the spindle).
 #[test]
-#[ignore = "the release to zero current, the offsets and the settling's start lose a light or unheld rotor"]
+#[ignore = "the release to zero current and the settling's start lose a light or unheld rotor"]
 fn the_start_up_phases_that_lose_a_light_or_unheld_rotor() {
     let failed = sweep(false);
     assert!(failed.is_empty(), "{failed:#?}");

@@ -50,3 +50,78 @@ fn the_slotless_maxon_runs_at_its_derived_carrier_and_not_at_the_speed_bound_alo
     let out = run("stops", &slow, 1);
     assert!(!out.passed, "{:?}", out.checks);
 }
+
+/// The carrier rule's rows (`fado_core::ratings::check_carrier`), as the command line reads a
+/// motor file: a derived carrier above the ceiling of realistic carriers is refused, naming the
+/// bound's keys and the carrier it needs; one in the band of fast inverters is a warning; a
+/// given carrier whose ripple is above 1.2 times the rated current is a warning naming it.
+#[test]
+fn the_carrier_rule_refuses_what_no_inverter_has_and_warns_below() {
+    // A tenth of the maxon's inductance: the ripple asks for 664 kHz.
+    let thin = MAXON
+        .replace("ld = 27.3e-6", "ld = 2.73e-6")
+        .replace("lq = 27.3e-6", "lq = 2.73e-6");
+    assert_ne!(thin, MAXON);
+    let e = SimConfig::from_toml(&thin).unwrap_err();
+    assert_eq!(e.key, "motor.ld", "{e}");
+    let text = e.to_string();
+    for part in [
+        "664 kHz",
+        "100 kHz",
+        "`motor.lq`",
+        "`inverter.dc_voltage`",
+        "`motor.rated_current`",
+        "`inverter.switching_frequency`",
+    ] {
+        assert!(text.contains(part), "{part}: {text}");
+    }
+    // Given the inverter's carrier (a GaN bridge beyond the ceiling), the same motor runs:
+    // its ripple (2.7 times the rated current at 150 kHz) is a warning.
+    let given = thin.replace(
+        "[inverter]\n",
+        "[inverter]\nswitching_frequency = 150000.0\n",
+    );
+    let cfg = SimConfig::from_toml(&given).unwrap();
+    assert!(
+        cfg.warnings()
+            .iter()
+            .any(|w| w.starts_with("`inverter.switching_frequency` = 150000 Hz")),
+        "{:?}",
+        cfg.warnings()
+    );
+    // The maxon's own 67 kHz: a warning (a GaN inverter), the run goes on.
+    let cfg = SimConfig::from_toml(MAXON).unwrap();
+    let w = cfg.warnings();
+    assert!(
+        w.iter().any(|w| w.contains("67 kHz") && w.contains("GaN")),
+        "{w:?}"
+    );
+    // A given 12 kHz (ripple 3.3 times the rated current): a warning naming the key and the
+    // carrier the rule gives; 40 kHz (1.0 times): none.
+    let given = |f: &str| {
+        let text = MAXON.replace(
+            "[inverter]\n",
+            &format!("[inverter]\nswitching_frequency = {f}\n"),
+        );
+        SimConfig::from_toml(&text).unwrap().warnings()
+    };
+    let w = given("12000.0");
+    assert!(
+        w.iter()
+            .any(|w| w.contains("`inverter.switching_frequency` = 12000 Hz")
+                && w.contains("67000 Hz")),
+        "{w:?}"
+    );
+    let w = given("40000.0");
+    assert!(
+        !w.iter().any(|w| w.contains("switching_frequency")),
+        "{w:?}"
+    );
+    // `--dump-config` states the ceiling with the rule.
+    let dump = SimConfig::from_toml(MAXON).unwrap().to_toml_annotated();
+    let line = dump
+        .lines()
+        .find(|l| l.starts_with("switching_frequency"))
+        .unwrap();
+    assert!(line.contains("refused above 100 kHz"), "{line}");
+}

@@ -30,7 +30,7 @@ mod polarity;
 #[cfg(test)]
 mod tests;
 
-pub use motion::{MotionMonitor, READ_CURRENT_RATIO};
+pub use motion::{MotionMonitor, READ_CURRENT_RATIO, RECENT_WINDOW_TIME};
 pub use polarity::PolarityTest;
 
 use crate::control::gain_calibration::GainCalibration;
@@ -391,7 +391,8 @@ impl<T: Real> AngleSearch<T> {
             return false;
         }
         let moving = self.monitor.threshold(self.tuning.motion_travel);
-        if self.monitor.step(v_ab, i_ab) > moving {
+        let travel = self.monitor.step(v_ab, i_ab);
+        if travel > moving || self.monitor.moved_recently(self.tuning.motion_travel) {
             // A rotor of unknown angle: wait until it stands still. With its start angle
             // known (`find_angle` off) the drive starts from where it has turned to.
             if self.tuning.find_angle {

@@ -3,7 +3,8 @@
 
 use super::{
     AdaptationRegime, FLUX_LINKAGE_DEAD_ZONE, FLUX_LINKAGE_DEAD_ZONE_OFF, FLUX_LINKAGE_MAX_RATIO,
-    FLUX_LINKAGE_MIN_RATIO, ResistanceAdaptationConfig, ResistanceAdaptationState,
+    FLUX_LINKAGE_MIN_RATIO, RESISTIVE_SPEED_ANGLE, ResistanceAdaptationConfig,
+    ResistanceAdaptationState,
 };
 use crate::active_flux::{ActiveFlux, ActiveFluxPoint};
 use crate::error::{ConfigError, check};
@@ -19,6 +20,8 @@ pub(crate) struct ResistanceAdaptationParams<T: 'static> {
     config: ResistanceAdaptationConfig<T>,
     /// γ·Ts.
     rate_ts: T,
+    /// Ts/[`RESISTIVE_SPEED_ANGLE`]: γ·Ts at a resistive speed of 1 rad/s.
+    speed_rate_ts: T,
     /// The saturating turning law's multiple of γ: [`SATURATING_RATE_RATIO`], or less where
     /// that would take its γ·Ts to 1.
     saturating_rate_ratio: T,
@@ -146,6 +149,7 @@ impl<T: Real> ResistanceAdaptationParams<T> {
         Ok(Self {
             config,
             rate_ts: rate * ts,
+            speed_rate_ts: ts / T::lit(RESISTIVE_SPEED_ANGLE),
             saturating_rate_ratio: crate::real::min(
                 T::lit(SATURATING_RATE_RATIO),
                 T::one() / (rate * ts),
@@ -295,7 +299,8 @@ impl<T: Real> ResistanceAdaptationParams<T> {
         point: Option<(&ActiveFlux<T, M>, ActiveFluxPoint<T>)>,
     ) -> bool {
         let lf = st.flux_linkage_hat;
-        let (reference, relative_to, a, gains) = if let Some((af, point)) = point {
+        let dl = self.saliency;
+        if let Some((af, point)) = point {
             // A saturating model (`crate::active_flux`): λ̂a(î) shifted by the learned λ̂f,
             // the regressor's bracket at î; frozen where it is ill-conditioned, and until the
             // hand-over's transient has settled (`settled`, as the λ̂f law): there the angle
@@ -327,41 +332,16 @@ impl<T: Real> ResistanceAdaptationParams<T> {
             let a = -(mag * bracket) * scale.chi_per_phi * (lf / relative_to);
             // At `SATURATING_RATE_RATIO`·γ: it waits out the hand-over (above).
             let ratio = self.saturating_rate_ratio;
-            let gains = (scale.gain * ratio, self.rate_ts * ratio);
-            (reference, relative_to, a, gains)
-        } else {
-            let Some(linear) = self.linear_regressor(scale, st, i_drop, lambda_r, mag) else {
-                return false;
-            };
-            linear
-        };
-        self.rotating_step(
-            st,
-            next,
-            (reference, relative_to),
-            gains,
-            a,
-            mag,
-            omega,
-            settled,
-        )
-    }
-
-    /// The constant-inductance turning law's reference λ̂a, the flux its error is taken
-    /// relative to (λ̂f), the numerator `a` of χ and its gains γ·Ts·R0 and γ·Ts; None where
-    /// the active flux is not positive.
-    #[inline(always)]
-    #[allow(clippy::type_complexity)]
-    fn linear_regressor(
-        &self,
-        scale: &ResistanceScale<T>,
-        st: &ResistanceAdaptationState<T>,
-        i_drop: Ab<T>,
-        lambda_r: Ab<T>,
-        mag: T,
-    ) -> Option<(T, T, T, (T, T))> {
-        let lf = st.flux_linkage_hat;
-        let dl = self.saliency;
+            return self.rotating_step(
+                st,
+                next,
+                (reference, relative_to),
+                (a, scale.gain * ratio, self.rate_ts * ratio),
+                mag,
+                omega,
+                settled,
+            );
+        }
         // The reference is the active flux λ̂a = λ̂f + (L̂d − L̂q)·î_d and φ carries the
         // sensitivity factor 1 + (L̂d − L̂q)·î_d/λ̂a (module docs); for L̂d = L̂q both are
         // exactly λ̂f and 1, and the division for î_d is skipped.
@@ -372,7 +352,7 @@ impl<T: Real> ResistanceAdaptationParams<T> {
             let active = lf + dl * i_d;
             // A non-positive (or NaN) reference: nothing to compare with.
             if active.partial_cmp(&T::zero()) != Some(core::cmp::Ordering::Greater) {
-                return None;
+                return false;
             }
             (active, T::one() + dl * i_d / active)
         };
@@ -380,13 +360,27 @@ impl<T: Real> ResistanceAdaptationParams<T> {
         // χ = a/b: then χ/(χ² + χ0²) = a·b/(a² + χ0²·b²) costs one division, and
         // χ² ≥ χ0² is a² ≥ χ0²·b² (false for ω̂ = 0, which also rules out 0/0).
         let a = -lambda_r.cross(i_drop) * scale.chi_per_phi * sensitivity;
-        Some((reference, lf, a, (scale.gain, self.rate_ts)))
+        let law = self.linear_rate(scale, a, mag);
+        self.rotating_step(st, next, (reference, lf), law, mag, omega, settled)
+    }
+
+    /// `a` with the linear path's γ·Ts·R0 and γ·Ts this period: γ at least the present resistive
+    /// speed R0·|î_q|/λ̂f (times the sensitivity) per [`RESISTIVE_SPEED_ANGLE`] (module docs,
+    /// "The rate on a fast machine"); |a|/|λ̂r| is that speed. At or below it the configured
+    /// γ, bit for bit; γ = 0 stays 0.
+    #[inline(always)]
+    fn linear_rate(&self, scale: &ResistanceScale<T>, a: T, mag: T) -> (T, T, T) {
+        let rate_ts = a.abs() * self.speed_rate_ts / mag;
+        if rate_ts > self.rate_ts && self.rate_ts > T::zero() {
+            (a, rate_ts * scale.r0, rate_ts)
+        } else {
+            (a, scale.gain, self.rate_ts)
+        }
     }
 
     /// The turning law's step (and the λ̂f law's) with the reference λ̂a, the flux the error
     /// is taken relative to (λ̂f, or a saturating rotor's active flux where that is more), the
-    /// law's gain γ·Ts·R0 and γ·Ts, and the numerator `a` of χ = a/(|λ̂r|·ω̂); `settled`: the
-    /// λ̂f law may run.
+    /// numerator `a` of χ = a/(|λ̂r|·ω̂) and the law's gain γ·Ts·R0 and γ·Ts this period.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     fn rotating_step(
@@ -394,8 +388,7 @@ impl<T: Real> ResistanceAdaptationParams<T> {
         st: &ResistanceAdaptationState<T>,
         next: &mut ResistanceAdaptationState<T>,
         (reference, relative_to): (T, T),
-        (gain, rate_ts): (T, T),
-        a: T,
+        (a, gain, rate_ts): (T, T, T),
         mag: T,
         omega: T,
         settled: bool,

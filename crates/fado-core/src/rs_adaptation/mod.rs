@@ -45,6 +45,20 @@
 //! error from any other cause (the hand-over transient, λ̂f or L̂q errors) would be read as a
 //! large resistance error, e/χ.
 //!
+//! **The rate on a fast machine** (constant inductances). Below the k_df threshold a relative
+//! R̂s error ε integrates into the angle at ε·Ω with the resistive speed Ω = R0·|i_q|/λ̂f of
+//! the present current (the integrand error ε·R0·i lies along the current, across λ̂r): the
+//! paper's motor has Ω = 81 rad/s at its rated current, a 12S multirotor outrunner (0.62 Ω,
+//! 3.58 mWb, 10 A) 1,730 rad/s, where 0.05 % of R̂s turns θ̂ by 0.14 rad in a 300 ms loaded
+//! stop. The turning law makes ε decay at γ, so an error it has not yet removed integrates
+//! into ε·Ω/γ rad; the law runs at γ_Ω = Ω/[`RESISTIVE_SPEED_ANGLE`] where that exceeds the
+//! configured γ, which bounds this angle at 120·ε (0.1 % → 0.12 rad) on every machine. With
+//! the present current rather than the rated one, the law stays at γ without load (where an
+//! R̂s error costs no angle and the hand-over transient is most of |λ̂r| − λ̂a: at 5 s⁻¹ the
+//! outrunner's no-load start learned +0.6 % of Rs and lost the rotor when the load arrived).
+//! The paper's motor and the presets up to the hub motor (117 rad/s at rated current) keep
+//! γ. A saturating model's law keeps the configured γ.
+//!
 //! **Standstill** (limiter mode, current along the flux, i.e. the eq. (23) injection at light
 //! load): the DC test of drive commissioning, done online. At standstill v_d = Rs·i_d +
 //! Ld·di_d/dt − ω·Lq·i_q, and the rotor flux induces nothing along d, so
@@ -182,6 +196,12 @@ pub const FLUX_LINKAGE_DEAD_ZONE_OFF: f64 = 0.0025;
 
 /// Default γ in s⁻¹ ([`ResistanceAdaptationConfig::rate`]): 1 (ours \[A\], see the field).
 pub const DEFAULT_RATE: f64 = 1.0;
+
+/// The turning law on a machine with constant inductances runs at least at the present
+/// resistive speed R0·|î_q|/λ̂f (rad/s) divided by this many radians: 120 (module docs, "The
+/// rate on a fast machine"; ours \[A\]). A relative R̂s error ε then integrates into at most
+/// 120·ε rad of angle while it decays (0.1 % into 0.12 rad).
+pub const RESISTIVE_SPEED_ANGLE: f64 = 120.0;
 /// Default χ0 ([`ResistanceAdaptationConfig::excitation_floor`]): 0.2 (ours \[A\]).
 pub const DEFAULT_EXCITATION_FLOOR: f64 = 0.2;
 /// Default lower bound of R̂s as a multiple of R0 ([`ResistanceAdaptationConfig::min_ratio`]):
@@ -227,9 +247,11 @@ pub struct ResistanceAdaptationConfig<T> {
     /// Default 1 s⁻¹ (ours \[A\]: the winding heats over minutes, so the law can be slow; at
     /// 5 s⁻¹ the hand-over's magnitude ripple at the 2–4 Hz electrical frequency moved R̂s by
     /// ≈ 1.5 %, enough to lose the Fig. 12 stops, at 1 s⁻¹ by ≈ 0.3 %). The fast correction
-    /// at start-up is the standstill law's. With a saturating model the turning law, which
+    /// at start-up is the standstill law's. With constant inductances the law runs at least
+    /// at the present resistive speed R0·|î_q|/λ̂f over [`RESISTIVE_SPEED_ANGLE`] (module
+    /// docs, "The rate on a fast machine"); with a saturating model the turning law, which
     /// waits out the hand-over's transient, runs at three times this rate (at most 1/ts;
-    /// docs/method/saturation.md, "The R̂s law's regressor").
+    /// docs/method/saturation.md, "The R̂s law's regressor"). 0 turns the turning law off.
     pub rate: T,
     /// χ0: the excitation (relative flux error per relative resistance error) below which the
     /// turning law is frozen, and the scale of its normalisation χ/(χ² + χ0²); the standstill

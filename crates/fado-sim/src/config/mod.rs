@@ -475,7 +475,8 @@ impl SimConfig {
 
     /// The plausibility findings of the motor against its ratings, the DC link and the
     /// sampling period (`fado_core::machine_checks`), each with its message naming the TOML
-    /// keys involved: errors first.
+    /// keys involved: errors first, then the carrier's finding
+    /// ([`carrier_findings`](Self::carrier_findings)).
     pub fn machine_findings(&self) -> Vec<(fado_core::machine_checks::Severity, String, String)> {
         let mut m = MachineModel {
             dc_voltage: self.inverter.dc_voltage,
@@ -504,7 +505,47 @@ impl SimConfig {
                 }
                 (f.severity(), plant_key(f.key()), text)
             })
+            .chain(self.carrier_findings())
             .collect()
+    }
+
+    /// The carrier's finding (`fado_core::ratings::check_carrier`): a derived
+    /// `inverter.switching_frequency` beyond the DC link's class of inverters (an error) or
+    /// in the band of fast inverters (a warning), or a given one whose PWM ripple exceeds the
+    /// rated current (a warning), with the TOML keys named.
+    pub fn carrier_findings(
+        &self,
+    ) -> Option<(fado_core::machine_checks::Severity, String, String)> {
+        use fado_core::machine_checks::Severity;
+        let m = MachineModel {
+            dc_voltage: self.inverter.dc_voltage,
+            ..self.motor
+        };
+        let derived = self
+            .derived
+            .iter()
+            .any(|d| d.key == "inverter.switching_frequency");
+        let given = (!derived).then_some(self.inverter.switching_frequency);
+        let finding = fado_core::ratings::check_carrier(&m, given)?;
+        let mut text = finding.to_string();
+        for k in [
+            "switching_frequency",
+            "dc_voltage",
+            "rs",
+            "ld",
+            "lq",
+            "rated_current",
+            "rated_speed_rpm",
+            "pole_pairs",
+        ] {
+            text = text.replace(&format!("`{k}`"), &format!("`{}`", plant_key(k)));
+        }
+        let severity = if finding.is_error() {
+            Severity::Error
+        } else {
+            Severity::Warning
+        };
+        Some((severity, plant_key(finding.keys()[0]), text))
     }
 
     /// The plausibility warnings of [`machine_findings`](Self::machine_findings), as
@@ -538,7 +579,7 @@ fn derived_beyond(d: &crate::derive::Derived) -> String {
 fn plant_key(field: &str) -> String {
     match field {
         "dc_voltage" => "inverter.dc_voltage".to_owned(),
-        "ts" => "inverter.switching_frequency".to_owned(),
+        "ts" | "switching_frequency" => "inverter.switching_frequency".to_owned(),
         k => format!("motor.{k}"),
     }
 }

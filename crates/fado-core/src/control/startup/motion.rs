@@ -43,6 +43,17 @@ pub const READ_CURRENT_RATIO: f64 = 0.1;
 /// the gain calibration's motion filter's (ten 10 kHz samples).
 pub const RATE_FILTER_TIME: f64 = 1e-3;
 
+/// The recent window of [`MotionMonitor::recent_travel`] (s) \[A\]: a rotor that a load
+/// accelerates from rest has turned a·W²/2 in it, and the reference's drift adds only
+/// R̂s·δ·W/λ̂f (on the 12S multirotor of `crates/fado-sim/tests/calibration_load_classes.rs`,
+/// whose shorted phases' device slope makes the drift 5.3 rad/s: 0.02 rad in 4 ms, against
+/// 0.27 rad over the first 50 ms of the offsets).
+pub const RECENT_WINDOW_TIME: f64 = 4e-3;
+
+/// Snapshots of Δλr over [`RECENT_WINDOW_TIME`]: the window read spans between 7/8 and all of
+/// it.
+const RECENT_SLOTS: usize = 8;
+
 /// The motion monitor (module docs). Allocation-free.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MotionMonitor<T> {
@@ -72,6 +83,16 @@ pub struct MotionMonitor<T> {
     /// A sample's |i − i₀| exceeded the quiet current since the reference sample.
     loud: bool,
     running: bool,
+    /// Samples between two snapshots of Δλr (at least 1).
+    slot_samples: u32,
+    /// Δλr every `slot_samples` samples, the oldest at `slot` (V·s), and how many are taken.
+    slots: [Ab<T>; RECENT_SLOTS],
+    slot: usize,
+    taken: u32,
+    /// Samples since the last snapshot.
+    since_slot: u32,
+    /// The largest travel read over the recent window, less its drift allowance (rad).
+    recent_excess: T,
 }
 
 impl<T: Real> MotionMonitor<T> {
@@ -100,6 +121,20 @@ impl<T: Real> MotionMonitor<T> {
             rate: Ab::zero(),
             loud: false,
             running: false,
+            slot_samples: {
+                let n = T::lit(RECENT_WINDOW_TIME / RECENT_SLOTS as f64) / ts;
+                // NaN compares false: one sample.
+                if n >= T::one() && n < T::lit(1e6) {
+                    n.round().to_f64() as u32
+                } else {
+                    1
+                }
+            },
+            slots: [Ab::zero(); RECENT_SLOTS],
+            slot: 0,
+            taken: 0,
+            since_slot: 0,
+            recent_excess: T::lit(-1.0),
         }
     }
 
@@ -113,6 +148,11 @@ impl<T: Real> MotionMonitor<T> {
         self.rate = Ab::zero();
         self.loud = false;
         self.running = true;
+        self.slots = [Ab::zero(); RECENT_SLOTS];
+        self.slot = 0;
+        self.taken = 0;
+        self.since_slot = 0;
+        self.recent_excess = T::lit(-1.0);
     }
 
     /// The uncertainty δ (A, α-β magnitude) of the current the readings start from (the mean
@@ -165,8 +205,60 @@ impl<T: Real> MotionMonitor<T> {
             if travel > self.travel {
                 self.travel = travel;
             }
+            self.step_recent(delta);
         }
         self.travel
+    }
+
+    /// The recent window's sample: the travel since the oldest snapshot less the drift the
+    /// reference's error reads over the samples since it, and a new snapshot every
+    /// `slot_samples`.
+    fn step_recent(&mut self, delta: Ab<T>) {
+        if self.taken > 0 {
+            let span = self.since_slot + (self.taken - 1) * self.slot_samples;
+            let travel = (delta - self.slots[self.slot]).norm() / self.flux_linkage;
+            let excess = travel - self.drift_per_sample * T::lit(span as f64);
+            if excess > self.recent_excess {
+                self.recent_excess = excess;
+            }
+        }
+        self.since_slot += 1;
+        if self.taken == 0 || self.since_slot >= self.slot_samples {
+            if (self.taken as usize) < RECENT_SLOTS {
+                let k = (self.slot + self.taken as usize) % RECENT_SLOTS;
+                self.slots[k] = delta;
+                self.taken += 1;
+            } else {
+                self.slots[self.slot] = delta;
+                self.slot = (self.slot + 1) % RECENT_SLOTS;
+            }
+            self.since_slot = 0;
+        }
+    }
+
+    /// The largest travel (electrical rad) read over a recent window of
+    /// [`RECENT_WINDOW_TIME`] since the last restart, less the drift the reference's error
+    /// reads over that window ([`set_reference_error`](Self::set_reference_error)); negative
+    /// before two samples. [`threshold`](Self::threshold) lets the reference's drift grow with
+    /// the time since the restart: a rotor that a load accelerates late in a long window
+    /// turns far before its travel passes it (the 12S multirotor of
+    /// `crates/fado-sim/tests/calibration_load_classes.rs`, half its rated torque 50 ms into
+    /// the offsets: 0.34 rad), and over the recent window it reads its travel with a drift
+    /// allowance of a few hundredths of a radian.
+    pub fn recent_travel(&self) -> T {
+        self.recent_excess
+    }
+
+    /// The rotor moved within a recent window: its travel over it, less that window's drift
+    /// ([`recent_travel`](Self::recent_travel)), exceeds the threshold without drift (the
+    /// tuning's `travel`, at least what the quiet current reads).
+    pub fn moved_recently(&self, travel: T) -> bool {
+        let base = if self.travel_floor > travel {
+            self.travel_floor
+        } else {
+            travel
+        };
+        self.recent_excess > base
     }
 
     /// The travel (electrical rad) above which the rotor counts as moving, given the tuning's

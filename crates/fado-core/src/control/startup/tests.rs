@@ -257,3 +257,38 @@ fn a_reference_off_by_its_own_uncertainty_reads_no_motion() {
     m.restart(Ab::zero());
     assert_eq!(m.threshold(0.05), 0.05);
 }
+
+#[test]
+fn a_load_arriving_late_is_read_over_the_recent_window() {
+    // The MAD 5010 KV200 datasheet motor of the test above, its reference 7 mA off and
+    // allowed 10 mA: at rest for 0.1 s the recent window reads no motion; a rotor that a load
+    // accelerates at 3·10⁴ rad/s² (electrical) from 80 ms on reads as moving over the recent
+    // window by 0.1 rad of travel, where the whole window's drift allowance (R·δ·t/λf, 0.06
+    // rad by then, plus the tuning's 0.05) has not yet been passed.
+    let ts = 25e-6;
+    let (r, l, lf) = (0.1523, 26.49e-6, 1.969e-3);
+    let run = |accel: f64| {
+        let mut m = MotionMonitor::new(r, l, lf, 20.0, ts);
+        m.set_reference_error(0.010);
+        m.restart(Ab::new(0.007, 0.0));
+        let (mut theta, mut omega, mut i) = (0.3_f64, 0.0, Ab::<f64>::zero());
+        for k in 0..(0.1 / ts) as usize {
+            let (s, c) = theta.sin_cos();
+            let e = Ab::new(-omega * lf * s, omega * lf * c);
+            i += (i * (-r) - e) * (ts / l);
+            if k as f64 * ts >= 0.08 {
+                omega += accel * ts;
+            }
+            theta += omega * ts;
+            m.step(Ab::zero(), i);
+            if m.moved_recently(0.05) {
+                return Some((theta - 0.3, m.travel() > m.threshold(0.05)));
+            }
+        }
+        assert!(m.recent_travel() < 0.05, "{}", m.recent_travel());
+        None
+    };
+    assert_eq!(run(0.0), None);
+    let (travel, whole) = run(3e4).expect("the load's motion is read");
+    assert!(travel < 0.1 && !whole, "{travel} {whole}");
+}
