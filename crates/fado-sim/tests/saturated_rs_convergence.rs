@@ -7,6 +7,24 @@
 //! drive's. Measured (`cargo test --release -p fado-sim --test saturated_rs_convergence --
 //! --nocapture` prints them): 0.35 % at most on both machines, R̂s within 3 % of the plant's
 //! a quarter of the way through the run.
+//!
+//! The d-saturated SPM test machine (`tests/data/spm-dq-sat-saturated.toml`, the magnet as a
+//! d-axis MMF) passes its zero-speed passage under rated load only with R̂s within about
+//! 0.5 % (its rated R·I/λf is 94 rad/s: 1 % of R̂s error turns θ̂ at ≈ 0.9 rad/s there); its
+//! standstill test at start-up leaves R̂s 3.5–7.8 % off, and the turning law, at
+//! `SATURATING_RATE_RATIO` times γ, takes it to within 0.4 % over the two loaded seconds
+//! before the passage (seeds 1 and 2; at γ it keeps 1.5–1.7 % and loses the rotor).
+//!
+//! The PM-SyRM's measured map (`pmsyrm-baldor-5k6-measured`) does not converge, and its test
+//! is ignored: at no load a resistance error moves |λ̂r| by < 0.2 % of the active flux per 1 %
+//! of R (χ < χ0, frozen), its standstill test never reaches its charge (R0/λ̂f is 1.0 there,
+//! so the test needs ∫i_d ≥ 0.2 A·s, and the start-up's 0.12 s at the 0.9 A injection gives
+//! 0.09), and under load the frame coupling σ/κ is 0.96–0.99, where the turning law freezes
+//! (docs/method/saturation.md, "The offset law's gate"): with the machine's own map it would
+//! learn R̂s there (0.7 / 1.4 × → 0.994 / 0.993, seeds 1–4 passing, with that freeze lifted),
+//! but with its commissioned model it then reads the model's flux error as resistance (R̂s
+//! 0.87–0.95 × the truth, `stops` lost on seeds 1 and 2). Started 0.7 or 1.4 times off, the
+//! drive loses the rotor at the loaded zero-speed passage (0.88–3.14 rad).
 
 use fado_sim::scenario::{run_config, scenario_config};
 
@@ -15,12 +33,12 @@ fn preset(path: &str) -> String {
     std::fs::read_to_string(format!("{root}{path}")).unwrap()
 }
 
-/// R̂s/Rs at the end of `rated-reversal` started from `ratio` × the plant's Rs, and whether
-/// the scenario passed.
-fn final_ratio(base: &str, ratio: f64) -> (f64, bool) {
+/// R̂s/Rs at the end of `rated-reversal` started from `ratio` × the plant's Rs (current-sensor
+/// seed `seed`), and whether the scenario passed.
+fn final_ratio(base: &str, ratio: f64, seed: u64) -> (f64, bool) {
     let text = format!(
         "{base}\n[mismatch]\nrs_ratio = {ratio}\n[controller.gain_calibration]\ntime = 0.0\n\
-         [current_sensor]\nseed = 1\n"
+         [current_sensor]\nseed = {seed}\n"
     );
     let cfg = scenario_config("rated-reversal", Some(&text), false).unwrap();
     let rs = cfg.motor.rs + cfg.inverter.on_resistance;
@@ -36,26 +54,67 @@ fn final_ratio(base: &str, ratio: f64) -> (f64, bool) {
     (rows.last().unwrap().rs_hat / rs, out.passed)
 }
 
-fn converges(base: &str, name: &str) {
-    for ratio in [0.7, 1.4] {
-        let (end, passed) = final_ratio(base, ratio);
-        println!("{name}: R̂s from {ratio} × Rs ends at {end:.4} × Rs, passed {passed}");
-        assert!((end - 1.0).abs() < 0.02, "{name}, from {ratio}: {end}");
-        assert!(passed, "{name}, from {ratio}");
+fn converges(base: &str, name: &str, seeds: &[u64]) {
+    for &seed in seeds {
+        for ratio in [0.7, 1.4] {
+            let (end, passed) = final_ratio(base, ratio, seed);
+            println!(
+                "{name}, seed {seed}: R̂s from {ratio} × Rs ends at {end:.4} × Rs, passed {passed}"
+            );
+            assert!(
+                (end - 1.0).abs() < 0.02,
+                "{name}, seed {seed}, from {ratio}: {end}"
+            );
+            assert!(passed, "{name}, seed {seed}, from {ratio}");
+        }
     }
+}
+
+/// Flux maps named relative to the presets' directory.
+fn in_saturated_presets() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../motors/saturated");
+    fado_sim::magnetics_file::set_config_dir(Some(std::path::Path::new(dir)));
 }
 
 #[test]
 fn rs_converges_on_the_saturated_ipmsm_algebraic_model() {
-    converges(&preset("saturated/ipmsm-2k2-qsat.toml"), "ipmsm-2k2-qsat");
+    converges(
+        &preset("saturated/ipmsm-2k2-qsat.toml"),
+        "ipmsm-2k2-qsat",
+        &[1],
+    );
 }
 
 #[test]
 fn rs_converges_on_the_measured_pmsm_flux_map() {
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../motors/saturated");
-    fado_sim::magnetics_file::set_config_dir(Some(std::path::Path::new(dir)));
+    in_saturated_presets();
     converges(
         &preset("saturated/pmsm-gem-1k1-measured.toml"),
         "pmsm-gem-1k1-measured",
+        &[1],
+    );
+}
+
+#[test]
+fn rs_converges_on_the_d_saturated_spm() {
+    let file = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/spm-dq-sat-saturated.toml"
+    );
+    converges(
+        &std::fs::read_to_string(file).unwrap(),
+        "spm-dq-sat-saturated",
+        &[1, 2],
+    );
+}
+
+#[test]
+#[ignore = "the turning law is frozen under load by the frame coupling (module docs)"]
+fn rs_converges_on_the_measured_pm_syrm_flux_map() {
+    in_saturated_presets();
+    converges(
+        &preset("saturated/pmsyrm-baldor-5k6-measured.toml"),
+        "pmsyrm-baldor-5k6-measured",
+        &[1, 2],
     );
 }

@@ -249,7 +249,9 @@ pub struct ResistanceAdaptationConfig<T> {
     /// ≈ 1.5 %, enough to lose the Fig. 12 stops, at 1 s⁻¹ by ≈ 0.3 %). The fast correction
     /// at start-up is the standstill law's. With constant inductances the law runs at least
     /// at the present resistive speed R0·|î_q|/λ̂f over [`RESISTIVE_SPEED_ANGLE`] (module
-    /// docs, "The rate on a fast machine"); 0 turns the turning law off.
+    /// docs, "The rate on a fast machine"); with a saturating model the turning law, which
+    /// waits out the hand-over's transient, runs at three times this rate (at most 1/ts;
+    /// docs/method/saturation.md, "The R̂s law's regressor"). 0 turns the turning law off.
     pub rate: T,
     /// χ0: the excitation (relative flux error per relative resistance error) below which the
     /// turning law is frozen, and the scale of its normalisation χ/(χ² + χ0²); the standstill
