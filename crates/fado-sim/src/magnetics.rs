@@ -200,8 +200,8 @@ pub(crate) struct FluxPropagator {
     h_max: f64,
     pole_pairs: f64,
     last: Cell<FluxPoint>,
-    /// A map's last cell of i(ψ) (`InverseCache`): the sub-steps' inversions from one warm
-    /// start share it.
+    /// A map's last cells of i(ψ) (`InverseCache`): every inversion of the sample shares them,
+    /// and the motor carries them to the next sample's integrator.
     cache: RefCell<InverseCache<f64>>,
 }
 
@@ -214,6 +214,7 @@ impl FluxPropagator {
         omega: f64,
         pole_pairs: u32,
         start: FluxPoint,
+        cache: InverseCache<f64>,
     ) -> Self {
         Self {
             mag,
@@ -223,7 +224,7 @@ impl FluxPropagator {
             h_max: SUBSTEP_TIME_CONSTANTS * bounds.l_min / r,
             pole_pairs: pole_pairs as f64,
             last: Cell::new(start),
-            cache: RefCell::new(InverseCache::new()),
+            cache: RefCell::new(cache),
         }
     }
 
@@ -239,6 +240,12 @@ impl FluxPropagator {
         } else {
             rotate(self.mag.model().flux(unrotate(i_ab, rot)), rot)
         }
+    }
+
+    /// The map's inverse cells as the last interval left them (for the next sample's
+    /// integrator).
+    pub fn inverse_cache(&self) -> InverseCache<f64> {
+        *self.cache.borrow()
     }
 
     /// The magnetics' bounds.

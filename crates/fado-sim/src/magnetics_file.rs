@@ -213,6 +213,8 @@ pub fn read_flux_map(path: &Path) -> Result<FluxMapData, SimConfigError> {
 struct Lines<'a> {
     text: &'a str,
     lines: Vec<&'a str>,
+    /// The byte offsets of the text's `\n`s, ascending.
+    newlines: Vec<usize>,
 }
 
 impl<'a> Lines<'a> {
@@ -220,6 +222,11 @@ impl<'a> Lines<'a> {
         Self {
             text,
             lines: text.lines().collect(),
+            newlines: text
+                .bytes()
+                .enumerate()
+                .filter_map(|(at, b)| (b == b'\n').then_some(at))
+                .collect(),
         }
     }
 
@@ -231,10 +238,8 @@ impl<'a> Lines<'a> {
         if start > 0 && self.text.as_bytes().get(start - 1..=start) == Some(b"\r\n") {
             start += 1;
         }
-        let mut line = self.text.as_bytes()[..start]
-            .iter()
-            .filter(|&&b| b == b'\n')
-            .count();
+        // The `\n`s before `start` (a search: a map's records are read in one pass).
+        let mut line = self.newlines.partition_point(|&at| at < start);
         while self
             .lines
             .get(line)

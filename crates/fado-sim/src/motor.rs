@@ -32,7 +32,7 @@
 
 use std::sync::Arc;
 
-use fado_core::magnetics::MagneticModel;
+use fado_core::magnetics::{InverseCache, MagneticModel};
 use fado_core::{Ab, Dq, MachineModel, wrap_angle};
 use num_complex::Complex64;
 
@@ -353,6 +353,8 @@ pub struct Motor {
     rot: Complex64,
     /// (ts, e^{−B·ts/J}) of the last mechanical step: the sample period never changes.
     decay: (f64, f64),
+    /// A flux map's inverse cells, carried from one sample's integrator to the next.
+    inverse: InverseCache<f64>,
 }
 
 impl Motor {
@@ -391,6 +393,7 @@ impl Motor {
             state: MotorState::default(),
             rot: Complex64::new(1.0, 0.0),
             decay: (0.0, 1.0),
+            inverse: InverseCache::new(),
         };
         m.set_state(Dq::zero(), theta0, 0.0);
         Ok(m)
@@ -433,6 +436,7 @@ impl Motor {
                     self.omega(),
                     self.params.pole_pairs,
                     FluxPoint::at(self.state.i_dq, self.psi_dq, self.rot),
+                    self.inverse,
                 ),
                 self.omega(),
             ),
@@ -506,6 +510,7 @@ impl Motor {
     pub fn set_current_from(&mut self, prop: &ElectricalPropagator, i_dq: Dq<f64>) {
         self.state.i_dq = i_dq;
         if let Some(f) = &prop.flux {
+            self.inverse = f.inverse_cache();
             let last = f.last();
             self.psi_dq = if last.i_dq == i_dq {
                 unrotate(last.psi_ab, last.rot)

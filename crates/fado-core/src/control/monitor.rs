@@ -218,6 +218,12 @@ fn phase_value<T: Real>(i: Ab<T>, k: usize) -> T {
     i.alpha * u.alpha + i.beta * u.beta
 }
 
+/// The reference level, in multiples of a [`StuckChannelDetector`]'s `min_reference`, from
+/// which a near-zero reading is replaced at once, without the model's contradiction: 2 (2 A
+/// on the paper's motor with the default 1 A threshold, half of I_min: a reading inside the
+/// band under it is a current error of at least 1.75 A).
+pub const IMMEDIATE_REFERENCE: f64 = 2.0;
+
 /// Stuck-channel detector for the usual two-sensor set-up (phases a and b measured, c
 /// reconstructed as −a − b, docs/method/estimator.md, "The paper's motor and drive").
 ///
@@ -229,9 +235,21 @@ fn phase_value<T: Real>(i: Ab<T>, k: usize) -> T {
 /// normal operation this does not persist. The channel is released as soon as it reads
 /// outside the band again.
 ///
-/// A channel is replaced by a reconstruction from the first implausible sample on (the
-/// flag waits for the persistence, the substitution does not, so that the current loop never
-/// acts on a zero reading): the caller's model prediction of the current vector (the drive
+/// A channel is replaced by a reconstruction from its first implausible sample on (the flag
+/// waits for the persistence, the substitution does not, so that the current loop acts on a
+/// stuck reading for as few samples as possible). Under a reference of at least
+/// [`IMMEDIATE_REFERENCE`] × `min_reference` in its phase a near-zero reading is implausible
+/// at once; under a reference between `min_reference` and that, only where the model's
+/// one-sample prediction of the phase also lies `band` or more from the reading. After a
+/// reference step a healthy reading lags the reference by the loop's delay and can sit inside
+/// the band for a sample while the reference asks for more; the prediction, driven by the
+/// voltage that acted, follows it to within 0.22 band (fig8–fig12, and `reversal` and `stops`
+/// on motors/ipmsm-2k2, servo-1ft6084 and hub-hoverboard-48v), while a channel stuck under
+/// such a reference reads 5.9–9.5 band from it (steady300, phase a stuck at 2.5 s and
+/// 2.525 s, crates/fado-sim/tests/faults.rs). So `min_reference` sets when a fault is
+/// flagged and replaced, and changes no sample of a healthy run that raises no flag.
+///
+/// The reconstruction is the caller's model prediction of the current vector (the drive
 /// propagates the machine model one sample from the last trusted current), corrected along
 /// the other (good) phase's axis so that it matches that phase's reading exactly; with both
 /// channels implausible, the prediction itself. The current loop and the estimator then run
@@ -285,9 +303,16 @@ impl<T: Real> StuckChannelDetector<T> {
                     self.monitors[k].reset();
                 }
             } else {
-                let asked = phase_value(i_ref_ab, k).abs() >= self.min_reference;
-                self.stuck[k] = self.monitors[k].step(near_zero && asked);
-                suspect[k] = near_zero && asked && self.monitors[k].is_running();
+                let asked = phase_value(i_ref_ab, k).abs();
+                self.stuck[k] = self.monitors[k].step(near_zero && asked >= self.min_reference);
+                // Replaced before the flag only where the reading cannot be a healthy one
+                // (see the type's docs): a reference of twice the threshold, or the model's
+                // one-sample prediction a band away from the reading.
+                let contradicted = asked >= self.min_reference
+                    && (reading[k] - phase_value(i_model_ab, k)).abs() >= self.band;
+                suspect[k] = near_zero
+                    && (asked >= T::lit(IMMEDIATE_REFERENCE) * self.min_reference || contradicted)
+                    && self.monitors[k].is_running();
             }
             suspect[k] |= self.stuck[k];
         }
@@ -377,6 +402,25 @@ mod tests {
                 (0.01, 8.66, false)
             );
         }
+        // Under a reference between the threshold and twice it (3 A in phase a), a near-zero
+        // reading the model agrees with (a healthy current lagging a reference step) is
+        // used as read until the persistence flags it; one the model puts 2.9 A away is
+        // replaced at once.
+        let mut d = StuckChannelDetector::<f64>::new(0.25, 2.0, 5);
+        let small = Ab::new(3.0, 0.0);
+        let agreeing = Ab::new(0.1, 0.0);
+        for n in 1..=4 {
+            assert_eq!(
+                d.step(0.05, -0.05, small, agreeing),
+                (0.05, -0.05, false),
+                "{n}"
+            );
+        }
+        let (a, _, stuck) = d.step(0.05, -0.05, small, agreeing);
+        assert!(stuck && (a - 0.1).abs() < 1e-12, "{a}");
+        let mut d = StuckChannelDetector::<f64>::new(0.25, 2.0, 5);
+        let (a, b, stuck) = d.step(0.0, -1.45, small, Ab::new(2.9, 0.0));
+        assert!(!stuck && (a - 2.9).abs() < 1e-12 && b == -1.45, "{a} {b}");
         // Disabled: never replaced either.
         let mut off = StuckChannelDetector::<f64>::new(0.25, 2.0, 0);
         assert!((0..50).all(|_| off.step(0.0, 0.0, i_ref, i_model) == (0.0, 0.0, false)));

@@ -79,6 +79,9 @@ impl<T: Real> InverseCache<T> {
         psi: Dq<T>,
         guess: Dq<T>,
     ) -> Option<Dq<T>> {
+        if let Some(found) = self.near_last_cell(grid, psi) {
+            return Some(found);
+        }
         if guess != self.guess {
             self.start = grid.cell_of(guess);
             self.guess = guess;
@@ -88,19 +91,7 @@ impl<T: Real> InverseCache<T> {
         }
         let (slots, next) = (&mut self.slots, &mut self.next);
         let solved = invert_from(grid, self.start, |k, m| {
-            let at = match slots
-                .iter()
-                .position(|s| matches!(s, Some((a, b, _, _)) if (*a, *b) == (k, m)))
-            {
-                Some(at) => at,
-                None => {
-                    let cell = grid.polynomial(k, m);
-                    let at = *next;
-                    slots[at] = Some((k, m, cell, cell.constants()));
-                    *next = (at + 1) % SLOTS;
-                    at
-                }
-            };
+            let at = slot_of(slots, next, grid, k, m);
             match &slots[at] {
                 // The polynomial solved where it lies in the cache (no copy).
                 Some((_, _, cell, constants)) => cell.root_or_direction(psi, *constants),
@@ -116,6 +107,39 @@ impl<T: Real> InverseCache<T> {
             Some((at, u, v))
         });
         solved.map(|(i, _)| i)
+    }
+
+    /// The last solution's cell, or the neighbour its root points into, where the root lies
+    /// inside that cell by more than [`INSIDE_MARGIN`] of it: no other cell then holds the
+    /// root within the walk's tolerance, so the walk from any warm start ends in this cell,
+    /// with this arithmetic (the same result, bit for bit). A plant's next inversion lies in
+    /// the last one's cell or its neighbour: one or two roots, no search for the warm start's
+    /// cell. None elsewhere (near an edge, beyond the grid, two cells away: the walk).
+    #[inline(always)]
+    fn near_last_cell(&mut self, grid: &impl CellGrid<T>, psi: Dq<T>) -> Option<Dq<T>> {
+        let (mut at, _, _) = self.last?;
+        let (last_k, last_m) = grid.last_cell();
+        let tol = cell_tolerance::<T>();
+        let (lo, hi) = (T::lit(INSIDE_MARGIN), T::lit(1.0 - INSIDE_MARGIN));
+        for neighbour in [false, true] {
+            let (k, m, cell, constants) = self.slots.get(at).copied().flatten()?;
+            let (u, v) = cell.solve_with(psi, constants)?;
+            if u > lo && u < hi && v > lo && v < hi {
+                let i = grid.current_at(k, m, u, v);
+                if !i.is_finite() {
+                    return None;
+                }
+                self.last = Some((at, u, v));
+                return Some(i);
+            }
+            let (dk, dm) = (direction(u, k, last_k, tol), direction(v, m, last_m, tol));
+            if neighbour || (dk == 0 && dm == 0) {
+                return None;
+            }
+            let (k, m) = (k.wrapping_add_signed(dk), m.wrapping_add_signed(dm));
+            at = slot_of(&mut self.slots, &mut self.next, grid, k, m);
+        }
+        None
     }
 
     /// The walk's first cell alone, where the start cell is kept and holds the root (the walk
@@ -167,6 +191,36 @@ impl<T: Real> InverseCache<T> {
         i.is_finite().then_some(i)
     }
 }
+
+/// The slot of cell (k, m), its polynomial computed into the next slot in turn if no slot
+/// holds it.
+#[inline]
+fn slot_of<T: Real>(
+    slots: &mut [Option<Slot<T>>; SLOTS],
+    next: &mut usize,
+    grid: &impl CellGrid<T>,
+    k: usize,
+    m: usize,
+) -> usize {
+    match slots
+        .iter()
+        .position(|s| matches!(s, Some((a, b, _, _)) if (*a, *b) == (k, m)))
+    {
+        Some(at) => at,
+        None => {
+            let cell = grid.polynomial(k, m);
+            let at = *next;
+            slots[at] = Some((k, m, cell, cell.constants()));
+            *next = (at + 1) % SLOTS;
+            at
+        }
+    }
+}
+
+/// How far inside its cell, as a fraction of the cell, a root must lie for the inverse to
+/// take the last solution's cell or its neighbour without the walk: far above the walk's
+/// tolerance ([`cell_tolerance`], 64 ε), so that no other cell holds that root.
+const INSIDE_MARGIN: f64 = 1e-6;
 
 /// The largest error of [`super::Magnetics::current_near_cached`]'s Newton step as a fraction
 /// of its cell (10⁻⁹ A on a 1 A cell), ours: orders of magnitude below a plant integrator's

@@ -324,7 +324,11 @@ impl<'a, T: Real> FluxMap<'a, T> {
 impl<T: Real> FluxMap<'_, T> {
     /// ψq(i_d, 0) of the map's C¹ interpolant: where the i_q axis has a node at zero the
     /// interpolant passes through it, so only the interpolation along i_d of that node column
-    /// remains (one Hermite cell instead of five); elsewhere the full surface.
+    /// remains (one Hermite cell instead of five); elsewhere the full surface. Out of line,
+    /// as [`FluxMap::smooth_flux`] is: inlined, its Hermite cell takes the registers of a step
+    /// that matches on the model (the firmware's record), whose other models' code then spills
+    /// (docs/results/firmware-cost.md).
+    #[inline(never)]
     pub fn smooth_q_flux_offset(&self, i_d: T) -> T {
         let i_q = self.i_q();
         // The axis ascends: the first node not below zero, if it is zero.

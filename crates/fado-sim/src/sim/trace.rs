@@ -52,17 +52,25 @@ impl TraceSink for TraceColumns {
 
 /// Writes rows as CSV (header first) as they come. A write error is kept, the following rows
 /// are dropped, and [`finish`](Self::finish) reports it.
+///
+/// The bytes are those of the `csv` crate serializing [`TraceRow`] (header line, `,` between
+/// fields, `\n` after each row, no field needing quotes): floats in the shortest form that
+/// reads back to the same value (`zmij`, printed as `ryu` prints them, which `csv` uses),
+/// flags and status words as integers. A row is formatted into one line buffer and written
+/// whole; `tests` compare the bytes with `csv`'s on rows with every kind of value.
 pub struct CsvTraceWriter<W: std::io::Write> {
-    writer: csv::Writer<W>,
+    writer: W,
+    line: Vec<u8>,
     error: Option<csv::Error>,
     rows: u64,
 }
 
 impl<W: std::io::Write> CsvTraceWriter<W> {
-    /// A writer onto `w` (buffer `w` yourself if it is a file; csv adds its own 8 KiB).
+    /// A writer onto `w` (buffer `w` yourself if it is a file: each row is one `write_all`).
     pub fn new(w: W) -> Self {
         Self {
-            writer: csv::Writer::from_writer(w),
+            writer: w,
+            line: Vec::with_capacity(1024),
             error: None,
             rows: 0,
         }
@@ -85,20 +93,36 @@ impl<W: std::io::Write> CsvTraceWriter<W> {
         }
         if self.rows == 0 {
             // The header alone, as `Trace::write_csv` writes for an empty trace.
-            self.writer.write_record(TraceRow::COLUMNS)?;
+            self.write_header()?;
         }
-        self.writer
-            .into_inner()
-            .map_err(|e| csv::Error::from(e.into_error()))
+        self.writer.flush()?;
+        Ok(self.writer)
+    }
+
+    fn write_header(&mut self) -> std::io::Result<()> {
+        self.line.clear();
+        self.line
+            .extend_from_slice(TraceRow::COLUMNS.join(",").as_bytes());
+        self.line.push(b'\n');
+        self.writer.write_all(&self.line)
+    }
+
+    fn write_row(&mut self, row: &TraceRow) -> std::io::Result<()> {
+        if self.rows == 0 {
+            self.write_header()?;
+        }
+        self.line.clear();
+        row.write_csv_line(&mut self.line);
+        self.writer.write_all(&self.line)
     }
 }
 
 impl<W: std::io::Write> TraceSink for CsvTraceWriter<W> {
     fn push(&mut self, row: &TraceRow) {
         if self.error.is_none() {
-            match self.writer.serialize(row) {
+            match self.write_row(row) {
                 Ok(()) => self.rows += 1,
-                Err(e) => self.error = Some(e),
+                Err(e) => self.error = Some(e.into()),
             }
         }
     }

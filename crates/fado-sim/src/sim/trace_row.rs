@@ -140,6 +140,44 @@ impl TraceRow {
         "lock",
     ];
 
+    /// The columns that are integers (flags, the status word, the lock code): `traces.csv`
+    /// prints them without a decimal point.
+    const INTEGER_COLUMNS: [bool; 40] = {
+        let mut integer = [false; 40];
+        let mut k = 24; // flag_limit, limiter_clamping, tracker_hold, tripped
+        while k < 28 {
+            integer[k] = true;
+            k += 1;
+        }
+        integer[38] = true; // fault_flags
+        integer[39] = true; // lock
+        integer
+    };
+
+    /// Appends the row as one line of `traces.csv` (fields in [`COLUMNS`](Self::COLUMNS)
+    /// order, `\n` at the end): the bytes the `csv` crate's serializer writes for it.
+    pub fn write_csv_line(&self, out: &mut Vec<u8>) {
+        let mut float = zmij::Buffer::new();
+        let mut int = itoa::Buffer::new();
+        for (k, (value, integer)) in self
+            .values()
+            .into_iter()
+            .zip(Self::INTEGER_COLUMNS)
+            .enumerate()
+        {
+            if k > 0 {
+                out.push(b',');
+            }
+            if integer {
+                // Every integer column is a u8 or u16, exact in an f64.
+                out.extend_from_slice(int.format(value as u16).as_bytes());
+            } else {
+                push_float(out, value, &mut float);
+            }
+        }
+        out.push(b'\n');
+    }
+
     /// The row's values in [`COLUMNS`](Self::COLUMNS) order (flags as 0.0/1.0).
     pub fn values(&self) -> [f64; 40] {
         [
@@ -184,6 +222,26 @@ impl TraceRow {
             self.fault_flags as f64,
             self.lock as f64,
         ]
+    }
+}
+
+/// Appends `value` as `ryu` prints it (what `csv` writes): `zmij`'s digits and form, which
+/// are `ryu`'s but for a positive exponent's `+` (`1e+16`, `ryu` `1e16`), which only
+/// |value| ≥ 10¹⁶ has.
+#[inline]
+fn push_float(out: &mut Vec<u8>, value: f64, buffer: &mut zmij::Buffer) {
+    let printed = buffer.format(value).as_bytes();
+    let plus = if value.abs() < 1e15 {
+        None
+    } else {
+        printed.iter().position(|&c| c == b'+')
+    };
+    match plus {
+        Some(plus) => {
+            out.extend_from_slice(&printed[..plus]);
+            out.extend_from_slice(&printed[plus + 1..]);
+        }
+        None => out.extend_from_slice(printed),
     }
 }
 

@@ -107,9 +107,16 @@ pub struct StuckSensorTuning<T> {
     /// 10 mA sensor noise, docs/method/estimator.md, "The paper's motor and drive").
     pub band_ratio: T,
     /// Stuck current-sensor detection: the reference's phase component, as a fraction of the
-    /// rated current, from which a near-zero reading is implausible. Default 2/21.78 \[A\]
-    /// (half of I_min: every running state has |i_dq*| ≥ I_min, so some phase always carries
-    /// ≥ 0.866·I_min).
+    /// rated current, from which a near-zero reading is implausible. Default 1/21.78 \[A\]
+    /// (1 A on the paper's motor, a quarter of I_min: every running state has |i_dq*| ≥ I_min,
+    /// so some phase always carries ≥ 0.866·I_min). A channel that sticks while its phase's
+    /// reference is below it reads what a healthy channel reads at its zero crossing until
+    /// the reference leaves the band: at 14 A and 20 Hz up to 0.57 ms (1.1 ms at 2 A, where
+    /// the current loop acting on the stuck reading turns θ̂ by 0.069–0.076 rad; at 1 A at
+    /// most 0.01 rad, crates/fado-sim/tests/faults.rs). Below twice it a reading is replaced
+    /// before the flag only where the model contradicts it too
+    /// ([`crate::control::monitor::StuckChannelDetector`]), so the threshold changes no
+    /// sample of a healthy run.
     pub reference_ratio: T,
     /// Stuck current-sensor detection: how long (s) a channel must look stuck; 0 disables
     /// the detector. Default 0.5 ms (< 1 current-loop time constant) \[A\].
@@ -122,7 +129,7 @@ impl<T: Real> Default for StuckSensorTuning<T> {
     fn default() -> Self {
         Self {
             band_ratio: per_rated(0.25),
-            reference_ratio: per_rated(2.0),
+            reference_ratio: per_rated(1.0),
             time: T::lit(0.5e-3),
         }
     }
