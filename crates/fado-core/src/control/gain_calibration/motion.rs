@@ -42,6 +42,32 @@ pub const MOTION_TRAVEL_SHARE: f64 = 0.7;
 /// electrical on the 1.5 kW servo motor there under half its rated torque.
 pub const LOOP_MOTION_FACTOR: f64 = 6.0;
 
+/// The window (s) over which the motion test also averages the back-EMF under the current
+/// loop \[A\]: the loop's step through the inverter's band, which [`LOOP_MOTION_FACTOR`]
+/// covers in the 1 ms filter's reading, lasts about a millisecond, and averaged over 4 ms it
+/// reads less; a rotor that a load accelerates keeps its back-EMF growing.
+pub const LOOP_WINDOW_TIME: f64 = 4e-3;
+
+/// The threshold of the back-EMF's mean over [`LOOP_WINDOW_TIME`] under the current loop, in
+/// multiples of `motion_voltage` \[A\]: 2, 1 % of the rated speed, which a rotor that half
+/// its rated torque accelerates freely reaches after 0.1 rad on the 2-pole spindle of
+/// `crates/fado-sim/tests/calibration_load_classes.rs` (against 0.85 rad at 3 %).
+pub const LOOP_WINDOW_FACTOR: f64 = 2.0;
+
+/// Snapshots of the loop's flux over [`LOOP_WINDOW_TIME`].
+pub(super) const WINDOW_SLOTS: usize = 8;
+
+/// Samples between two snapshots at the sampling period `ts` (at least 1).
+pub(super) fn window_slot_samples<T: Real>(ts: T) -> u32 {
+    let n = T::lit(LOOP_WINDOW_TIME / WINDOW_SLOTS as f64) / ts;
+    // NaN compares false: one sample.
+    if n >= T::one() && n < T::lit(1e6) {
+        n.round().to_f64() as u32
+    } else {
+        1
+    }
+}
+
 /// The rotor-motion threshold (V) of [`GainCalibrationConfig::motion_voltage`](super::GainCalibrationConfig::motion_voltage) for a
 /// machine: [`MOTION_SPEED_RATIO`] × the rated electrical speed × λ̂f.
 pub fn motion_voltage<T: Real>(m: &MachineModel<T>) -> T {
@@ -106,6 +132,57 @@ impl<T: Real> GainCalibration<T> {
             *peak = share;
         }
         emf
+    }
+
+    /// Under the current loop: the back-EMF `emf` (V) added to the stage's flux, and the mean
+    /// back-EMF over the recent [`LOOP_WINDOW_TIME`] (V; zero until two snapshots). At the
+    /// stage's first sample the window restarts.
+    pub(super) fn window_emf(&mut self, emf: T) -> T {
+        let stage_start = match self.stage {
+            Stage::Settle | Stage::Release => self.remaining == self.settle_samples,
+            _ => false,
+        };
+        if stage_start {
+            self.window_flux = T::zero();
+            self.window_taken = 0;
+            self.window_slot = 0;
+            self.window_since = 0;
+        }
+        self.window_flux += emf * self.config.ts;
+        let mut mean = T::zero();
+        if self.window_taken > 1 {
+            let span = self.window_since + (self.window_taken - 1) * self.window_slot_samples;
+            let flux = self.window_flux - self.window_slots[self.window_slot];
+            mean = flux / (T::lit(span as f64) * self.config.ts);
+            let share = mean.abs() / (self.config.motion_voltage * T::lit(LOOP_WINDOW_FACTOR));
+            if share > self.loop_window_peak {
+                self.loop_window_peak = share;
+            }
+            if share > T::one() && flux.abs() > self.motion_flux.abs() {
+                // The turn of a rotor that started within the window.
+                self.motion_flux = flux;
+            }
+        }
+        self.window_since += 1;
+        if self.window_taken == 0 || self.window_since >= self.window_slot_samples {
+            if (self.window_taken as usize) < WINDOW_SLOTS {
+                let k = (self.window_slot + self.window_taken as usize) % WINDOW_SLOTS;
+                self.window_slots[k] = self.window_flux;
+                self.window_taken += 1;
+            } else {
+                self.window_slots[self.window_slot] = self.window_flux;
+                self.window_slot = (self.window_slot + 1) % WINDOW_SLOTS;
+            }
+            self.window_since = 0;
+        }
+        mean
+    }
+
+    /// The largest mean back-EMF across the axis over [`LOOP_WINDOW_TIME`] under the current
+    /// loop since the calibration started, over its threshold [`LOOP_WINDOW_FACTOR`] ×
+    /// `motion_voltage` (1 or more: the rotor moved).
+    pub fn loop_window_peak(&self) -> T {
+        self.loop_window_peak
     }
 
     /// The motion test's threshold (V): `motion_voltage` in voltage mode,

@@ -39,6 +39,7 @@ impl<T: Real> GainCalibration<T> {
         self.motion_emf = T::zero();
         self.motion_peak = T::zero();
         self.loop_motion_peak = T::zero();
+        self.loop_window_peak = T::zero();
         self.v_lower = Ab::zero();
         self.v_lower_count = 0;
         self.stage = Stage::Settle;
@@ -114,7 +115,14 @@ impl<T: Real> GainCalibration<T> {
         } else {
             T::zero()
         };
-        if emf.abs() > self.motion_threshold(voltage_mode) {
+        let window = if finite && inverter.is_finite() && !voltage_mode {
+            self.window_emf(emf)
+        } else {
+            T::zero()
+        };
+        if emf.abs() > self.motion_threshold(voltage_mode)
+            || window.abs() > self.config.motion_voltage * T::lit(super::LOOP_WINDOW_FACTOR)
+        {
             self.motion_current = self.command().current_d;
             self.motion_emf = emf;
             self.stage = Stage::Idle;

@@ -214,6 +214,11 @@ fn f32_identifies_the_mismatch_too() {
 /// ω·λf across the axis drives a current towards −ω·λf/R there through L = 3 mH
 /// (λf 0.1 Wb). Returns the calibration.
 fn turning_rotor(omega: f64, turn_at: f64) -> GainCalibration<f64> {
+    rotor_with_emf(|t| if t >= turn_at { omega * 0.1 } else { 0.0 })
+}
+
+/// [`turning_rotor`]'s machine with the back-EMF `emf(t)` (V) across the axis.
+fn rotor_with_emf(emf: impl Fn(f64) -> f64) -> GainCalibration<f64> {
     let r = 0.3;
     let mut c = config(8.0, r, 3e-3);
     // 1 % of 300 rad/s electrical on a 0.1 Wb magnet.
@@ -227,8 +232,7 @@ fn turning_rotor(omega: f64, turn_at: f64) -> GainCalibration<f64> {
     let mut n = 0u32;
     cal.start(0.0);
     while cal.running() {
-        let t = n as f64 * TS;
-        let emf = if t >= turn_at { omega * 0.1 } else { 0.0 };
+        let emf = emf(n as f64 * TS);
         i_emf = decay * i_emf + (1.0 - decay) * (-emf / r);
         // A small steady offset across the axis (the sensors' mismatch) at rest.
         let i = v * (1.0 / r) + axis.mul_j() * (0.02 + i_emf);
@@ -280,4 +284,21 @@ fn a_rotor_turning_during_a_level_ends_the_calibration() {
         with_turning_rotor(1.5, mid),
         GainCalibrationStatus::Calibrated
     );
+}
+
+#[test]
+fn a_rotor_turning_under_the_loop_is_read_by_the_window_mean() {
+    // The machine of `turning_rotor`, its rotor accelerating at 5·10³ rad/s² (electrical)
+    // from 10 ms into the settling at I₁: the loop's 4 ms mean passes its threshold (2 × 3 V)
+    // while the 1 ms reading is still below its own (6 × 3 V), and the turn is read; at rest
+    // neither reads it.
+    let run = |accel: f64| rotor_with_emf(|t| accel * (t - 0.01).max(0.0) * 0.1);
+    let cal = run(5e3);
+    assert_eq!(cal.status(), GainCalibrationStatus::RotorMoved);
+    assert!(cal.loop_motion_peak() < 1.0, "{}", cal.loop_motion_peak());
+    assert!(cal.loop_window_peak() >= 1.0, "{}", cal.loop_window_peak());
+    assert!(cal.motion_travel(0.1, 0.0) > 0.0);
+    let rest = run(0.0);
+    assert_eq!(rest.status(), GainCalibrationStatus::Calibrated);
+    assert!(rest.loop_window_peak() < 0.5, "{}", rest.loop_window_peak());
 }
