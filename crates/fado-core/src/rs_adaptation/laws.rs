@@ -22,9 +22,6 @@ pub(crate) struct ResistanceAdaptationParams<T: 'static> {
     rate_ts: T,
     /// Ts/[`RESISTIVE_SPEED_ANGLE`]: γ·Ts at a resistive speed of 1 rad/s.
     speed_rate_ts: T,
-    /// The saturating turning law's multiple of γ: [`SATURATING_RATE_RATIO`], or less where
-    /// that would take its γ·Ts to 1.
-    saturating_rate_ratio: T,
     /// γ_s·Ts.
     standstill_gain: T,
     /// e^{−ω_m·Ts}.
@@ -42,18 +39,6 @@ pub(crate) struct ResistanceAdaptationParams<T: 'static> {
 /// traction IPMSM's coarse 7 × 8 map of `scripts/saturated-replay.py` (R̂s 0.95–1.05 × the
 /// truth running everywhere).
 pub(crate) const MAP_RESISTANCE_RESOLUTION: f64 = 0.02;
-
-/// The turning law's rate with a saturating model as a multiple of γ
-/// ([`ResistanceAdaptationConfig::rate`]). γ = 1 s⁻¹ is bounded by the hand-over's
-/// flux-magnitude ripple, which the constant-inductance law reads as it comes (at 5 s⁻¹ it
-/// moved R̂s by ≈ 1.5 % on the paper's motor); the saturating law waits that transient out
-/// (`settled`), so its bound is the flux dynamics it must stay slow against (3 s⁻¹ against
-/// the k_df mode's ≥ 8 rad/s on the paper's motor). Ours \[A\]: 3 takes R̂s from 0.7 and
-/// 1.4 times the truth to within 0.4 % during `rated-reversal`'s two loaded seconds before
-/// its zero-speed passage on a d-saturated SPM whose rated R·I/λf (94 rad/s) makes that
-/// passage need R̂s within about 0.5 % (1 s⁻¹ leaves 1.5–1.7 % and loses the rotor,
-/// 0.36–0.92 rad; `crates/fado-sim/tests/saturated_rs_convergence.rs`).
-pub(crate) const SATURATING_RATE_RATIO: f64 = 3.0;
 
 /// 1/(2π·`hz`)²: |ω̂| ≤ 2π·`hz` is ω̂²·(that) ≤ 1; `hz` = 0 allows ω̂ = 0 only (1e30: no
 /// ∞·0).
@@ -150,10 +135,6 @@ impl<T: Real> ResistanceAdaptationParams<T> {
             config,
             rate_ts: rate * ts,
             speed_rate_ts: ts / T::lit(RESISTIVE_SPEED_ANGLE),
-            saturating_rate_ratio: crate::real::min(
-                T::lit(SATURATING_RATE_RATIO),
-                T::one() / (rate * ts),
-            ),
             standstill_gain: rate_s * ts,
             forget: (-(memory_w * ts)).exp(),
             standstill_inv_omega_sq: inverse_square_speed(standstill_hz),
@@ -330,13 +311,11 @@ impl<T: Real> ResistanceAdaptationParams<T> {
             // within milliseconds).
             let relative_to = crate::real::max(lf, reference);
             let a = -(mag * bracket) * scale.chi_per_phi * (lf / relative_to);
-            // At `SATURATING_RATE_RATIO`·γ: it waits out the hand-over (above).
-            let ratio = self.saturating_rate_ratio;
             return self.rotating_step(
                 st,
                 next,
                 (reference, relative_to),
-                (a, scale.gain * ratio, self.rate_ts * ratio),
+                (a, scale.gain, self.rate_ts),
                 mag,
                 omega,
                 settled,
