@@ -152,7 +152,9 @@ impl<T: Real> GainCalibration<T> {
         let mut mean = T::zero();
         if self.window_taken > 1 {
             let span = self.window_since + (self.window_taken - 1) * self.window_slot_samples;
-            let flux = self.window_flux - self.window_slots[self.window_slot];
+            // `% WINDOW_SLOTS` (the slot is always below it) proves the index in range: no
+            // panic path in the firmware's step.
+            let flux = self.window_flux - self.window_slots[self.window_slot % WINDOW_SLOTS];
             mean = flux / (T::lit(span as f64) * self.config.ts);
             let share = mean.abs() / (self.config.motion_voltage * T::lit(LOOP_WINDOW_FACTOR));
             if share > self.loop_window_peak {
@@ -170,7 +172,7 @@ impl<T: Real> GainCalibration<T> {
                 self.window_slots[k] = self.window_flux;
                 self.window_taken += 1;
             } else {
-                self.window_slots[self.window_slot] = self.window_flux;
+                self.window_slots[self.window_slot % WINDOW_SLOTS] = self.window_flux;
                 self.window_slot = (self.window_slot + 1) % WINDOW_SLOTS;
             }
             self.window_since = 0;

@@ -216,7 +216,9 @@ impl<T: Real> MotionMonitor<T> {
     fn step_recent(&mut self, delta: Ab<T>) {
         if self.taken > 0 {
             let span = self.since_slot + (self.taken - 1) * self.slot_samples;
-            let travel = (delta - self.slots[self.slot]).norm() / self.flux_linkage;
+            // `% RECENT_SLOTS` (slot is always below it) proves the index in range: no panic
+            // path in the firmware's step.
+            let travel = (delta - self.slots[self.slot % RECENT_SLOTS]).norm() / self.flux_linkage;
             let excess = travel - self.drift_per_sample * T::lit(span as f64);
             if excess > self.recent_excess {
                 self.recent_excess = excess;
@@ -229,7 +231,7 @@ impl<T: Real> MotionMonitor<T> {
                 self.slots[k] = delta;
                 self.taken += 1;
             } else {
-                self.slots[self.slot] = delta;
+                self.slots[self.slot % RECENT_SLOTS] = delta;
                 self.slot = (self.slot + 1) % RECENT_SLOTS;
             }
             self.since_slot = 0;
