@@ -23,6 +23,7 @@ pub mod ratings_limit;
 pub mod release_current;
 pub mod release_hold;
 pub mod saturated_references;
+pub mod snapshot_window;
 pub mod speed_controller;
 pub mod standstill_probe;
 pub mod start_ramp;

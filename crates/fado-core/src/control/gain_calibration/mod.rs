@@ -150,6 +150,7 @@ pub use motion::{
     MOTION_SPEED_RATIO, MOTION_TRAVEL_SHARE, motion_voltage,
 };
 
+use crate::control::snapshot_window::SnapshotWindow;
 use crate::error::{ConfigError, check};
 use crate::{Ab, Real};
 use measure::{PHASE_B_ALPHA, PHASE_B_BETA};
@@ -300,15 +301,10 @@ pub struct GainCalibration<T> {
     /// The same, of the stages under the current loop.
     loop_motion_peak: T,
     /// Under the current loop: Σ back-EMF·Ts since the stage's first sample (V·s), its
-    /// snapshots every `window_slot_samples` (the oldest at `window_slot`, `window_taken` of
-    /// them) and the samples since the last; the largest mean back-EMF over the window read
+    /// snapshots over [`LOOP_WINDOW_TIME`](motion::LOOP_WINDOW_TIME); the largest mean back-EMF over the window read
     /// since the start, over its threshold ([`LOOP_WINDOW_FACTOR`] × `motion_voltage`).
     window_flux: T,
-    window_slots: [T; motion::WINDOW_SLOTS],
-    window_slot: usize,
-    window_taken: u32,
-    window_since: u32,
-    window_slot_samples: u32,
+    window: SnapshotWindow<T, { motion::WINDOW_SLOTS }>,
     loop_window_peak: T,
     status: GainCalibrationStatus,
     ratio: T,
@@ -388,11 +384,7 @@ impl<T: Real> GainCalibration<T> {
             motion_peak: T::zero(),
             loop_motion_peak: T::zero(),
             window_flux: T::zero(),
-            window_slots: [T::zero(); motion::WINDOW_SLOTS],
-            window_slot: 0,
-            window_taken: 0,
-            window_since: 0,
-            window_slot_samples: motion::window_slot_samples(ts),
+            window: SnapshotWindow::new(motion::LOOP_WINDOW_TIME, ts, T::zero()),
             loop_window_peak: T::zero(),
             status,
             ratio: T::one(),

@@ -57,17 +57,6 @@ pub const LOOP_WINDOW_FACTOR: f64 = 2.0;
 /// Snapshots of the loop's flux over [`LOOP_WINDOW_TIME`].
 pub(super) const WINDOW_SLOTS: usize = 8;
 
-/// Samples between two snapshots at the sampling period `ts` (at least 1).
-pub(super) fn window_slot_samples<T: Real>(ts: T) -> u32 {
-    let n = T::lit(LOOP_WINDOW_TIME / WINDOW_SLOTS as f64) / ts;
-    // NaN compares false: one sample.
-    if n >= T::one() && n < T::lit(1e6) {
-        n.round().to_f64() as u32
-    } else {
-        1
-    }
-}
-
 /// The rotor-motion threshold (V) of [`GainCalibrationConfig::motion_voltage`](super::GainCalibrationConfig::motion_voltage) for a
 /// machine: [`MOTION_SPEED_RATIO`] × the rated electrical speed × λ̂f.
 pub fn motion_voltage<T: Real>(m: &MachineModel<T>) -> T {
@@ -144,17 +133,12 @@ impl<T: Real> GainCalibration<T> {
         };
         if stage_start {
             self.window_flux = T::zero();
-            self.window_taken = 0;
-            self.window_slot = 0;
-            self.window_since = 0;
+            self.window.reset();
         }
         self.window_flux += emf * self.config.ts;
         let mut mean = T::zero();
-        if self.window_taken > 1 {
-            let span = self.window_since + (self.window_taken - 1) * self.window_slot_samples;
-            // `% WINDOW_SLOTS` (the slot is always below it) proves the index in range: no
-            // panic path in the firmware's step.
-            let flux = self.window_flux - self.window_slots[self.window_slot % WINDOW_SLOTS];
+        if let Some((oldest, span)) = self.window.oldest().filter(|_| self.window.taken() > 1) {
+            let flux = self.window_flux - oldest;
             mean = flux / (T::lit(span as f64) * self.config.ts);
             let share = mean.abs() / (self.config.motion_voltage * T::lit(LOOP_WINDOW_FACTOR));
             if share > self.loop_window_peak {
@@ -165,18 +149,7 @@ impl<T: Real> GainCalibration<T> {
                 self.motion_flux = flux;
             }
         }
-        self.window_since += 1;
-        if self.window_taken == 0 || self.window_since >= self.window_slot_samples {
-            if (self.window_taken as usize) < WINDOW_SLOTS {
-                let k = (self.window_slot + self.window_taken as usize) % WINDOW_SLOTS;
-                self.window_slots[k] = self.window_flux;
-                self.window_taken += 1;
-            } else {
-                self.window_slots[self.window_slot % WINDOW_SLOTS] = self.window_flux;
-                self.window_slot = (self.window_slot + 1) % WINDOW_SLOTS;
-            }
-            self.window_since = 0;
-        }
+        self.window.push(self.window_flux);
         mean
     }
 

@@ -32,6 +32,7 @@
 //! Measured on the presets at rest (`loaded-start`, the brake holding the rotor; switching-
 //! resolved inverter, default sensors): at most 0.036 rad read over the offsets (same test).
 
+use crate::control::snapshot_window::SnapshotWindow;
 use crate::{Ab, Real};
 
 /// Largest short-circuit current of a rotor that stands still, a fraction of the rated
@@ -83,14 +84,8 @@ pub struct MotionMonitor<T> {
     /// A sample's |i − i₀| exceeded the quiet current since the reference sample.
     loud: bool,
     running: bool,
-    /// Samples between two snapshots of Δλr (at least 1).
-    slot_samples: u32,
-    /// Δλr every `slot_samples` samples, the oldest at `slot` (V·s), and how many are taken.
-    slots: [Ab<T>; RECENT_SLOTS],
-    slot: usize,
-    taken: u32,
-    /// Samples since the last snapshot.
-    since_slot: u32,
+    /// Δλr over the recent window.
+    recent: SnapshotWindow<Ab<T>, RECENT_SLOTS>,
     /// The largest travel read over the recent window, less its drift allowance (rad).
     recent_excess: T,
 }
@@ -121,19 +116,7 @@ impl<T: Real> MotionMonitor<T> {
             rate: Ab::zero(),
             loud: false,
             running: false,
-            slot_samples: {
-                let n = T::lit(RECENT_WINDOW_TIME / RECENT_SLOTS as f64) / ts;
-                // NaN compares false: one sample.
-                if n >= T::one() && n < T::lit(1e6) {
-                    n.round().to_f64() as u32
-                } else {
-                    1
-                }
-            },
-            slots: [Ab::zero(); RECENT_SLOTS],
-            slot: 0,
-            taken: 0,
-            since_slot: 0,
+            recent: SnapshotWindow::new(RECENT_WINDOW_TIME, ts, Ab::zero()),
             recent_excess: T::lit(-1.0),
         }
     }
@@ -148,10 +131,7 @@ impl<T: Real> MotionMonitor<T> {
         self.rate = Ab::zero();
         self.loud = false;
         self.running = true;
-        self.slots = [Ab::zero(); RECENT_SLOTS];
-        self.slot = 0;
-        self.taken = 0;
-        self.since_slot = 0;
+        self.recent.reset();
         self.recent_excess = T::lit(-1.0);
     }
 
@@ -214,28 +194,14 @@ impl<T: Real> MotionMonitor<T> {
     /// reference's error reads over the samples since it, and a new snapshot every
     /// `slot_samples`.
     fn step_recent(&mut self, delta: Ab<T>) {
-        if self.taken > 0 {
-            let span = self.since_slot + (self.taken - 1) * self.slot_samples;
-            // `% RECENT_SLOTS` (slot is always below it) proves the index in range: no panic
-            // path in the firmware's step.
-            let travel = (delta - self.slots[self.slot % RECENT_SLOTS]).norm() / self.flux_linkage;
+        if let Some((oldest, span)) = self.recent.oldest() {
+            let travel = (delta - oldest).norm() / self.flux_linkage;
             let excess = travel - self.drift_per_sample * T::lit(span as f64);
             if excess > self.recent_excess {
                 self.recent_excess = excess;
             }
         }
-        self.since_slot += 1;
-        if self.taken == 0 || self.since_slot >= self.slot_samples {
-            if (self.taken as usize) < RECENT_SLOTS {
-                let k = (self.slot + self.taken as usize) % RECENT_SLOTS;
-                self.slots[k] = delta;
-                self.taken += 1;
-            } else {
-                self.slots[self.slot % RECENT_SLOTS] = delta;
-                self.slot = (self.slot + 1) % RECENT_SLOTS;
-            }
-            self.since_slot = 0;
-        }
+        self.recent.push(delta);
     }
 
     /// The largest travel (electrical rad) read over a recent window of
