@@ -129,6 +129,23 @@ def test_the_saturation_verdict_names_what_the_pulses_saw() -> None:
     assert light.saturation_detected is not True
 
 
+def test_a_carrier_given_over_a_machine_derives_what_the_file_derives() -> None:
+    # The light servo SPM as a Machine with a 5 kHz carrier in the config (its ratings derive
+    # 10 kHz): the dead time follows the carrier given, as `fado-sim commission` derives it
+    # from the file (crates/fado-sim/tests/commission_magnetics.rs, the same plant), and the
+    # pulses hold the rotor as they do there (measured 0.047 rad from both; with the 10 kHz
+    # dead time left at 5 kHz, 0.43 rad).
+    motor, config = light_spm(2e-4)
+    r = fado.commission(motor, config=config)
+    dumped = tomllib.loads(r.config_toml)
+    assert dumped["inverter"]["dead_time"] == pytest.approx(0.0125 / 5000.0)
+    assert r.rotor_motion_magnetics < 0.1, r.rotor_motion_magnetics
+    # The same through `simulate`'s layers (the Machine, the scenario, the config).
+    sim = fado.simulate("reversal", "[inverter]\nswitching_frequency = 5000.0\n",
+                        averaged=True, motor=fado.Machine(**motor))
+    assert tomllib.loads(sim.config_toml)["inverter"]["dead_time"] == pytest.approx(2.5e-6)
+
+
 def test_dict_motor_and_a_rough_nameplate() -> None:
     # The plant is the dict; the procedure is told a nameplate 20 % off on every parameter.
     rough = dict(IPMSM_DICT, rs=3.6 * 1.2, ld=36e-3 * 0.8, lq=51e-3 * 1.2,
