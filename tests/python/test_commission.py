@@ -146,6 +146,22 @@ def test_a_carrier_given_over_a_machine_derives_what_the_file_derives() -> None:
     assert tomllib.loads(sim.config_toml)["inverter"]["dead_time"] == pytest.approx(2.5e-6)
 
 
+def test_a_datasheet_machine_runs_alike_from_its_file_and_as_a_machine() -> None:
+    # The U8 KV150 outrunner of crates/fado-sim/tests/data/unseen/ (no carrier given: 30 kHz
+    # derived) as its file and as a Machine: the same derived values, the same reversal.
+    path = ROOT / "crates" / "fado-sim" / "tests" / "data" / "unseen" / "tmotor-u8-kv150-12s.toml"
+    doc = tomllib.loads(path.read_text())
+    machine = fado.Machine(**doc["motor"], dc_voltage=doc["inverter"]["dc_voltage"])
+    from_file = fado.simulate("reversal", path.read_text())
+    as_machine = fado.simulate("reversal", motor=machine)
+    inverter = [tomllib.loads(r.config_toml)["inverter"] for r in (from_file, as_machine)]
+    for key in ("switching_frequency", "dead_time", "threshold_voltage", "current_band"):
+        assert inverter[0][key] == inverter[1][key], key
+    assert from_file.metrics["max_angle_error_zero_speed"] == as_machine.metrics[
+        "max_angle_error_zero_speed"]
+    assert from_file.passed and as_machine.passed
+
+
 def test_dict_motor_and_a_rough_nameplate() -> None:
     # The plant is the dict; the procedure is told a nameplate 20 % off on every parameter.
     rough = dict(IPMSM_DICT, rs=3.6 * 1.2, ld=36e-3 * 0.8, lq=51e-3 * 1.2,
