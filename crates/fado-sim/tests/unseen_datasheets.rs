@@ -132,13 +132,17 @@ fn a_50_w_flat_motor_seed_1_holds_its_angle_after_release() {
 /// is a 707 V link): the rated point on MTPA needs 421 V phase peak of the 300 V the link
 /// makes, which the drive reaches by field weakening (`reversal` 0.013 rad, `rated-reversal`
 /// 0.006 rad, `fullrange`'s rated-speed windows 2.8 and 10.7 r/min off). At `fullrange`'s top,
-/// 4800 r/min (1.6 × rated, where the model's limits give 8070 W), the drive holds 4678 r/min
-/// under the 6456 W load (80 % of the limits' power, `fado_sim::range::POWER_MARGIN`): 122 r/min
-/// off (criterion 96), mean 4678 (≥ 4704), 6292 W (≥ 6327). The limits are the model's
-/// steady state without the inverter's voltage error (2.5 µs at 5 kHz on 520 V: 6.5 V, 2.2 %
-/// of the 300 V) nor the loop's headroom on a rotor with Lq/Ld 6.7, whose voltage swings with
-/// i_q 6.7 times as much as with i_d; where the shortfall sits (the limits, the margin or the
-/// field-weakening loop) is open. Seed 1, `|θ − θ̂|` 0.057 rad throughout.
+/// 4800 r/min (1.6 × rated, where the model's limits give 8070 W), it holds 4678 r/min under
+/// the 12.84 N·m load (80 % of the limits' power, `fado_sim::range::POWER_MARGIN`): 122 r/min
+/// off (criterion 96), 6292 W (≥ 6327). Measured there (seed 1, 6–8 s): ω̂ within 0.3 r/min
+/// of the rotor's, i_d −54.8 A, i_q 3.3 A (|i| 55 A of the 58.9 A limit), |v*| 278 V at the
+/// field-weakening loop's 0.92·Vdc/√3 = 276 V, the torque the load's: the speed loop's demand
+/// stays at the load with 122 r/min of error, so a bound on it binds (not the ratings' torque
+/// and power limits, 61 N·m there; not the current limit; not the voltage ellipse's cut,
+/// 6.8 A). The model's steady optimum at 4800 r/min is i_d −58.8 A, i_q 3.7 A (16.1 N·m) at
+/// the current limit, and 4678 r/min allows 20.5 N·m: on a rotor with Lq/Ld 6.7 the torque
+/// at the top comes from −i_d through the reluctance term, 3·(λf + (Lq − Ld)·|i_d|)·i_q,
+/// which the drive leaves 4 A short of the limit.
 #[test]
 #[ignore = "fullrange top at a 520 V link: 4678 of 4800 r/min, 6292 of 6327 W"]
 fn a_15_kw_pm_syrm_on_a_520_v_link_holds_the_fullrange_top() {
