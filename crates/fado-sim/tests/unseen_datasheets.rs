@@ -4,7 +4,8 @@
 //! 12S multirotor outrunner with no carrier given (derived 30 kHz) and a 50 W 12 V flat motor
 //! with a 13.5 g·cm² rotor. Each passes `reversal`, `stops`, `rated-reversal`, `loaded-start`,
 //! `fullrange` and `regen-stop` at the sensor seeds 1 and 2 on its own criteria, and its
-//! commissioned `identified.toml` passes `reversal`.
+//! commissioned `identified.toml` passes `reversal`; the PM-SyRM also on the 520 V link its name
+//! suggests (`fullrange`).
 //!
 //! Measured (seeds 1–4, the largest |θ − θ̂| of each run): servo reversal 0.022, stops 0.054,
 //! rated-reversal 0.018–0.020, fullrange 0.063, regen-stop 0.041–0.043 rad (a round rotor: its
@@ -130,21 +131,14 @@ fn a_50_w_flat_motor_seed_1_holds_its_angle_after_release() {
 
 /// The 15 kW PM-SyRM on the 520 V link its name suggests (its sheet's 500 V rms line-to-line
 /// is a 707 V link): the rated point on MTPA needs 421 V phase peak of the 300 V the link
-/// makes, which the drive reaches by field weakening (`reversal` 0.013 rad, `rated-reversal`
-/// 0.006 rad, `fullrange`'s rated-speed windows 2.8 and 10.7 r/min off). At `fullrange`'s top,
-/// 4800 r/min (1.6 × rated, where the model's limits give 8070 W), it holds 4678 r/min under
-/// the 12.84 N·m load (80 % of the limits' power, `fado_sim::range::POWER_MARGIN`): 122 r/min
-/// off (criterion 96), 6292 W (≥ 6327). Measured there (seed 1, 6–8 s): ω̂ within 0.3 r/min
-/// of the rotor's, i_d −54.8 A, i_q 3.3 A (|i| 55 A of the 58.9 A limit), |v*| 278 V at the
-/// field-weakening loop's 0.92·Vdc/√3 = 276 V, the torque the load's: the speed loop's demand
-/// stays at the load with 122 r/min of error, so a bound on it binds (not the ratings' torque
-/// and power limits, 61 N·m there; not the current limit; not the voltage ellipse's cut,
-/// 6.8 A). The model's steady optimum at 4800 r/min is i_d −58.8 A, i_q 3.7 A (16.1 N·m) at
-/// the current limit, and 4678 r/min allows 20.5 N·m: on a rotor with Lq/Ld 6.7 the torque
-/// at the top comes from −i_d through the reluctance term, 3·(λf + (Lq − Ld)·|i_d|)·i_q,
-/// which the drive leaves 4 A short of the limit.
+/// makes, which the drive reaches by field weakening. At `fullrange`'s top, 4800 r/min (1.6 ×
+/// rated, where the model's limits give 8070 W), its d current stops at the current limit
+/// (λ̂f/L̂d = 145 A is beyond I_max = 58.9 A), which is no MTPV point: the q current is bounded
+/// by the current limit and the voltage ellipse, not cut to the loop's own target
+/// (`fado_core::control::field_weakening::FieldWeakening::iq_limit`). Measured: 4800.0 r/min,
+/// 0.19 r/min off, 6456 W held (≥ 6327), |θ − θ̂| 0.057 rad; with the cut 4678 r/min, 122 r/min
+/// off, 6292 W (i_q 3.3 A where the model's optimum has 3.7 A).
 #[test]
-#[ignore = "fullrange top at a 520 V link: 4678 of 4800 r/min, 6292 of 6327 W"]
 fn a_15_kw_pm_syrm_on_a_520_v_link_holds_the_fullrange_top() {
     let text = file("pmsrm-15kw-520v").replace("dc_voltage = 707.0", "dc_voltage = 520.0");
     let out = simulate("fullrange", Some(&text), false, None).unwrap();
