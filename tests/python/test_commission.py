@@ -129,6 +129,39 @@ def test_the_saturation_verdict_names_what_the_pulses_saw() -> None:
     assert light.saturation_detected is not True
 
 
+def test_a_carrier_given_over_a_machine_derives_what_the_file_derives() -> None:
+    # The light servo SPM as a Machine with a 5 kHz carrier in the config (its ratings derive
+    # 10 kHz): the dead time follows the carrier given, as `fado-sim commission` derives it
+    # from the file (crates/fado-sim/tests/commission_magnetics.rs, the same plant), and the
+    # pulses hold the rotor as they do there (measured 0.047 rad from both; with the 10 kHz
+    # dead time left at 5 kHz, 0.43 rad).
+    motor, config = light_spm(2e-4)
+    r = fado.commission(motor, config=config)
+    dumped = tomllib.loads(r.config_toml)
+    assert dumped["inverter"]["dead_time"] == pytest.approx(0.0125 / 5000.0)
+    assert r.rotor_motion_magnetics < 0.1, r.rotor_motion_magnetics
+    # The same through `simulate`'s layers (the Machine, the scenario, the config).
+    sim = fado.simulate("reversal", "[inverter]\nswitching_frequency = 5000.0\n",
+                        averaged=True, motor=fado.Machine(**motor))
+    assert tomllib.loads(sim.config_toml)["inverter"]["dead_time"] == pytest.approx(2.5e-6)
+
+
+def test_a_datasheet_machine_runs_alike_from_its_file_and_as_a_machine() -> None:
+    # The U8 KV150 outrunner of crates/fado-sim/tests/data/unseen/ (no carrier given: 30 kHz
+    # derived) as its file and as a Machine: the same derived values, the same reversal.
+    path = ROOT / "crates" / "fado-sim" / "tests" / "data" / "unseen" / "tmotor-u8-kv150-12s.toml"
+    doc = tomllib.loads(path.read_text())
+    machine = fado.Machine(**doc["motor"], dc_voltage=doc["inverter"]["dc_voltage"])
+    from_file = fado.simulate("reversal", path.read_text())
+    as_machine = fado.simulate("reversal", motor=machine)
+    inverter = [tomllib.loads(r.config_toml)["inverter"] for r in (from_file, as_machine)]
+    for key in ("switching_frequency", "dead_time", "threshold_voltage", "current_band"):
+        assert inverter[0][key] == inverter[1][key], key
+    assert from_file.metrics["max_angle_error_zero_speed"] == as_machine.metrics[
+        "max_angle_error_zero_speed"]
+    assert from_file.passed and as_machine.passed
+
+
 def test_dict_motor_and_a_rough_nameplate() -> None:
     # The plant is the dict; the procedure is told a nameplate 20 % off on every parameter.
     rough = dict(IPMSM_DICT, rs=3.6 * 1.2, ld=36e-3 * 0.8, lq=51e-3 * 1.2,

@@ -230,6 +230,53 @@ pub fn inverter_values(
     out
 }
 
+/// The `[inverter]` keys of `cfg` still derived (in `cfg.derived`) derived again from its
+/// present machine and the inverter keys it gives: a configuration laid over a base that
+/// derived them (a `fado.Machine`'s inverter, a scenario's) and that gives the carrier, the
+/// DC link or the ratings changes what they follow from: a 5 kHz carrier given over the
+/// light servo SPM of `tests/data/spm-dq-sat-saturated.toml` (whose ratings derive 10 kHz)
+/// gives it the 2.5 µs dead time of 5 kHz from Python as from its file, not the 1.25 µs of
+/// 10 kHz. Unchanged inputs give the same values.
+pub fn rederive_inverter(cfg: &mut crate::SimConfig) {
+    let derived = |key: &str| {
+        cfg.derived
+            .iter()
+            .any(|d| d.key == format!("inverter.{key}"))
+    };
+    let inv = &cfg.inverter;
+    let mut given = toml::Table::new();
+    for (key, value) in [
+        ("dc_voltage", inv.dc_voltage),
+        ("switching_frequency", inv.switching_frequency),
+        ("dead_time", inv.dead_time),
+        ("threshold_voltage", inv.threshold_voltage),
+        ("current_band", inv.current_band),
+    ] {
+        if !derived(key) {
+            given.insert(key.into(), toml::Value::Float(value));
+        }
+    }
+    let machine = MachineModel {
+        dc_voltage: cfg.inverter.dc_voltage,
+        ..cfg.motor
+    };
+    for (key, value) in inverter_values(&machine, &given) {
+        let slot = match key {
+            "dc_voltage" => &mut cfg.inverter.dc_voltage,
+            "switching_frequency" => &mut cfg.inverter.switching_frequency,
+            "dead_time" => &mut cfg.inverter.dead_time,
+            "threshold_voltage" => &mut cfg.inverter.threshold_voltage,
+            "current_band" => &mut cfg.inverter.current_band,
+            _ => continue,
+        };
+        *slot = value;
+        let full = format!("inverter.{key}");
+        if let Some(d) = cfg.derived.iter_mut().find(|d| d.key == full) {
+            d.value = value;
+        }
+    }
+}
+
 /// `toml` (a [`crate::SimConfig::to_toml`] document) with each derived key's line followed by
 /// its rule as a comment, and a header saying so.
 pub fn annotate(toml: &str, derived: &[Derived]) -> String {

@@ -323,3 +323,31 @@ fn the_interpolation_spread_is_zero_on_the_nodes_and_opens_between_them() {
         "{spread}"
     );
 }
+
+/// The constant-inductance coupling test agrees with the general one on the same machine
+/// written as an algebraic model (`Saturation::linear`), over the rated circle of a strongly
+/// salient rotor (the ipmsm-gem-50k preset's inductances, Lq/Ld 3.2, where it holds at the
+/// rated MTPA point and not without load) and of the 2.2 kW IPMSM (Lq/Ld 1.4); a surface
+/// rotor never holds; a NaN current holds.
+#[test]
+fn constant_inductances_hold_the_offset_where_the_algebraic_model_does() {
+    let machines = [(0.37e-3, 1.2e-3, 0.066, 240.0), (0.036, 0.051, 0.545, 6.08)];
+    for (ld, lq, lf, rated) in machines {
+        let model = Magnetics::Saturation(Saturation::linear(ld, lq, lf));
+        let af = active(model, rated).unwrap();
+        for i in points(rated, model) {
+            let general = af.holds_offset(&af.point(i));
+            let constant = constant_inductance_holds_offset(lf, ld - lq, i);
+            assert_eq!(general, constant, "Ld {ld} Lq {lq} at {i:?}");
+            assert!(
+                !constant_inductance_holds_offset(lf, 0.0, i),
+                "surface at {i:?}"
+            );
+        }
+    }
+    let gem =
+        |i_d, i_q| constant_inductance_holds_offset(0.066, 0.37e-3 - 1.2e-3, Dq::new(i_d, i_q));
+    assert!(gem(-151.0, 187.0), "rated MTPA point");
+    assert!(!gem(20.0, 0.0), "the injection without load");
+    assert!(gem(f64::NAN, 1.0));
+}

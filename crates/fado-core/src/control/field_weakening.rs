@@ -97,6 +97,9 @@ pub struct FieldWeakening<T> {
     ellipse_ratio: T,
     /// The d current's bound, A (≤ 0): the characteristic current or −I_max.
     id_min: T,
+    /// The bound is the characteristic current −λ̂f/L̂d (MTPV), not the current limit −I_max:
+    /// only there is the q current cut to the loop's ellipse ([`FieldWeakening::iq_limit`]).
+    bound_is_mtpv: bool,
     /// Speed floor of the gain, rad/s.
     min_speed: T,
     /// R̂s·I_max (V) and ψ_max = λ̂f + max(L̂d, L̂q)·I_max (Wb): the largest steady-state
@@ -134,6 +137,7 @@ impl<T: Real> FieldWeakening<T> {
             margin: m / T::lit(3.0).sqrt(),
             ellipse_ratio: (m / T::lit(3.0).sqrt()).step_max(T::one() / T::lit(3.0).sqrt()),
             id_min: -characteristic.step_min(i_max),
+            bound_is_mtpv: characteristic <= i_max,
             min_speed: T::lit(0.1) * machine.rated_speed(),
             rs_i_max: machine.rs * i_max,
             psi_max: machine.flux_linkage + machine.ld.step_max(machine.lq) * i_max,
@@ -175,11 +179,19 @@ impl<T: Real> FieldWeakening<T> {
     }
 
     /// The q current allowed by the voltage ellipse at the d current `id` (A) and speed
-    /// `omega`, for the bus `vdc`; +∞ unless the loop sits at its MTPV bound.
+    /// `omega`, for the bus `vdc`; +∞ unless the loop sits at its MTPV bound. Where the
+    /// current limit bounds the d current first (λ̂f/L̂d > I_max) the loop's bound is no MTPV
+    /// point: more torque lies along the current limit (on a salient rotor through the
+    /// reluctance term), the current-vector limit and the voltage ellipse at the inscribed
+    /// circle ([`FieldWeakening::ellipse_flux`]) bound the q current, and the cut to the loop's
+    /// own target would hold it below what the voltage allows: with that cut the 15 kW PM-SyRM
+    /// of `crates/fado-sim/tests/data/unseen/pmsrm-15kw-520v.toml` on a 520 V link (λ̂f/L̂d
+    /// 145 A, I_max 58.9 A) stays at 4678 of `fullrange`'s 4800 r/min top, its q current at
+    /// 3.3 A where the model's optimum has 3.7 A.
     #[inline]
     pub fn iq_limit(&self, id: T, vdc: T, omega: T) -> T {
         let at_bound = self.delta_id <= self.id_min * T::lit(0.999);
-        if !(self.mtpv && at_bound && self.enabled) {
+        if !(self.mtpv && self.bound_is_mtpv && at_bound && self.enabled) {
             return T::lit(f64::INFINITY);
         }
         let w = omega.abs().step_max(self.min_speed);
@@ -312,6 +324,22 @@ mod tests {
         assert!((iq - psi / m.lq).abs() < 1e-9, "{iq}");
         f.reset();
         assert_eq!(f.delta_id(), 0.0);
+    }
+
+    #[test]
+    fn a_current_limit_bound_is_no_mtpv_point() {
+        let (_, m) = fw();
+        // λf/Ld = 33.5 A above a 20 A limit: the loop stops at −20 A, no q cut there.
+        let mut f = FieldWeakening::new(&FieldWeakeningTuning::default(), &m, 20.0, 1e-4).unwrap();
+        let vdc = m.dc_voltage;
+        let w = 20.0 * vdc / m.flux_linkage;
+        for _ in 0..20_000 {
+            f.update(4.0 * vdc * vdc, vdc, w);
+        }
+        assert!((f.delta_id() + 20.0).abs() < 1e-9, "{}", f.delta_id());
+        assert_eq!(f.iq_limit(-20.0, vdc, w), f64::INFINITY);
+        // The voltage ellipse still bounds it.
+        assert!(f.ellipse_flux(vdc, w).is_some());
     }
 
     #[test]

@@ -381,8 +381,10 @@ impl<T: Real> EstimatorState<T> {
                 p.lag_keep * self.lag_compensation + p.lag_input * c.t2s1.innovation;
         }
         let observer_speed = c.t2s1.omega + self.lag_compensation;
-        let observer_speed = if SATURATING {
-            self.notch_speed(p, af, c, observer_speed)
+        // The notch where the frame coupling can be large: a saturating model, or a salient
+        // rotor with constant inductances (on a surface-magnet rotor the coupling is zero).
+        let observer_speed = if SATURATING || c.saliency != T::zero() {
+            self.notch_speed(p, af, c, i_ab, observer_speed)
         } else {
             observer_speed
         };
@@ -409,25 +411,37 @@ impl<T: Real> EstimatorState<T> {
         shift
     }
 
-    /// A saturating model's observer speed: the notch (`crate::speed_notch`) stepped every
-    /// sample, its ripple removed in the k_df mode where the frame coupling is large and the
-    /// machine generates (ω̂·î_q < 0), the quadrant where the DC loop's two couplings add. Both
-    /// are judged at the operating point of the integrand-offset law's slot (the law holds on
-    /// the same coupling test), once every [`SLOW_PERIOD`] samples.
+    /// The observer speed of a saturating model or a salient rotor: the notch
+    /// (`crate::speed_notch`) stepped every sample, its ripple removed in the k_df mode where
+    /// the frame coupling is large and the machine generates (ω̂·î_q < 0), the quadrant where
+    /// the DC loop's two couplings add. Both are judged at the operating point of the
+    /// integrand-offset law's slot (the law holds on the same coupling test), once every
+    /// [`SLOW_PERIOD`] samples: a saturating model's at its operating point, constant
+    /// inductances' at the current `i_ab` in the frame of λ̂r
+    /// (`crate::active_flux::constant_inductance_holds_offset`).
     #[inline(always)]
     fn notch_speed<M: FluxLookup<T>>(
         &mut self,
         p: &EstimatorParams<T>,
         af: &ActiveFlux<T, M>,
         c: &Candidate<T>,
+        i_ab: Ab<T>,
         speed: T,
     ) -> T {
         if self.slot == SLOT_OFFSET {
-            self.frame_coupled = c.point.is_some_and(|point| af.holds_offset(&point));
-            self.notch_on = p.frame_ripple_notch
-                && self.frame_coupled
-                && c.point
-                    .is_some_and(|point| point.i_dq.q * c.t2s1.omega < T::zero());
+            let (coupled, i_q) = match c.point {
+                Some(point) => (af.holds_offset(&point), point.i_dq.q),
+                None => {
+                    let i_dq = ActiveFlux::<T>::frame_current(c.lambda_r, i_ab);
+                    let lf = self.rs_adaptation.flux_linkage_hat;
+                    let holds =
+                        crate::active_flux::constant_inductance_holds_offset(lf, c.saliency, i_dq);
+                    (holds, i_dq.q)
+                }
+            };
+            self.frame_coupled = coupled;
+            self.notch_on =
+                p.frame_ripple_notch && self.frame_coupled && i_q * c.t2s1.omega < T::zero();
         }
         let (notch, ripple) = p.speed_notch.step(&self.speed_notch, speed);
         self.speed_notch = notch;
@@ -606,7 +620,7 @@ impl<T: Real> EstimatorState<T> {
         // carries the frame error the law holds ê and the k_df mode stops re-centring at k_e
         // until the next period.
         let holds = self.frame_coupled;
-        if c.point.is_some() && self.rs_adaptation_on {
+        if (c.point.is_some() || c.saliency != T::zero()) && self.rs_adaptation_on {
             self.offset_recentring_gain = if holds {
                 T::zero()
             } else {

@@ -1,3 +1,4 @@
+use super::finding::{EMF_KEYS, TORQUE_KEYS};
 use super::*;
 use std::string::ToString;
 

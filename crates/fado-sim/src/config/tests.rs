@@ -411,3 +411,53 @@ mod dead_time_method {
         assert_eq!(e.key, "motor.rs", "{e}");
     }
 }
+
+/// A document laid over a machine's derived inverter (`SimConfig::for_machine`, Python's
+/// `fado.Machine`) that gives the carrier or the DC link gets the dead time, threshold and
+/// current band the same keys derive in a motor file (`fado-sim --config`): the light servo
+/// SPM's ratings derive 10 kHz; given 5 kHz its dead time is 2.5 µs, not 10 kHz's 1.25 µs.
+#[test]
+fn values_derived_over_a_machine_follow_the_document_s_carrier_and_link() {
+    use super::SimConfig;
+    let motor = "[motor]\nrs = 1.1\nld = 1.5e-3\nlq = 3e-3\nflux_linkage = 0.07\n\
+                 pole_pairs = 5\ninertia = 2e-4\nrated_current = 6.0\nrated_speed_rpm = 3000.0\n\
+                 rated_torque = 3.1\n";
+    let file = |inverter: &str| SimConfig::from_toml(&format!("{motor}[inverter]\n{inverter}"));
+    let machine = file("dc_voltage = 320.0\n").unwrap();
+    let base = SimConfig::for_machine(&fado_core::MachineModel {
+        dc_voltage: 320.0,
+        ..machine.motor
+    });
+    assert_eq!(base.inverter.switching_frequency, 10e3);
+    for (given, whole) in [
+        (
+            "switching_frequency = 5000.0\n",
+            "dc_voltage = 320.0\nswitching_frequency = 5000.0\n",
+        ),
+        ("dc_voltage = 250.0\n", "dc_voltage = 250.0\n"),
+    ] {
+        let over = SimConfig::from_toml_over(&base, &format!("[inverter]\n{given}")).unwrap();
+        let alone = file(whole).unwrap();
+        let (a, b) = (&over.inverter, &alone.inverter);
+        assert_eq!(
+            (
+                a.switching_frequency,
+                a.dead_time,
+                a.threshold_voltage,
+                a.current_band
+            ),
+            (
+                b.switching_frequency,
+                b.dead_time,
+                b.threshold_voltage,
+                b.current_band
+            ),
+            "{given}"
+        );
+        let derived = |key: &str| over.derived.iter().find(|d| d.key == key).map(|d| d.value);
+        assert_eq!(derived("inverter.dead_time"), Some(a.dead_time), "{given}");
+    }
+    // A document that gives nothing the inverter follows from leaves its values as they are.
+    let other = SimConfig::from_toml_over(&base, "[current_sensor]\nseed = 3\n").unwrap();
+    assert_eq!(other.inverter.dead_time, base.inverter.dead_time);
+}

@@ -87,6 +87,11 @@ impl SimConfig {
         cfg.derived.extend(converted);
         // `[motor]` has no DC link of its own (it is the inverter's).
         cfg.motor.dc_voltage = cfg.inverter.dc_voltage;
+        // What stays derived follows the inputs the document gives (its carrier, DC link or
+        // ratings), as it does when the document is read on its own.
+        if gives_inverter_inputs(&given) {
+            crate::derive::rederive_inverter(&mut cfg);
+        }
         // A document giving one magnetic model replaces the base's (either).
         if saturation.is_some() || flux_map.is_some() {
             (cfg.motor_saturation, cfg.motor_flux_map) = (saturation, flux_map);
@@ -110,6 +115,18 @@ impl SimConfig {
         let shown = super::drive_rules::with_drive_rules(self);
         crate::derive::annotate(&shown.to_toml(), &shown.derived)
     }
+}
+
+/// Whether the document `given` holds a key the derived `[inverter]` values follow from: an
+/// `[inverter]` key or a `[motor]` one (the ratings and the circuit set the carrier and the
+/// current band).
+fn gives_inverter_inputs(given: &toml::Table) -> bool {
+    ["inverter", "motor"].iter().any(|s| {
+        given
+            .get(*s)
+            .and_then(|t| t.as_table())
+            .is_some_and(|t| t.values().any(|v| !v.is_table()))
+    })
 }
 
 pub(super) fn merge(base: &mut toml::Table, over: toml::Table) {

@@ -159,4 +159,17 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         let n = predicted.norm();
         (n.is_finite() && n <= self.resolved.trip_current).then_some(predicted)
     }
+
+    /// What [`predicted_current`](Self::predicted_current) cannot know over one sample, in
+    /// A: the back-EMF's turn over the sample, which the prediction holds at its start (half
+    /// of ω̂·Ts on average, |ω̂|·|λ̂r|·|ω̂|·Ts/2 of voltage) through L̂q over Ts. The
+    /// stuck-channel detector allows it between a near-zero reading and the prediction
+    /// (`StuckChannelDetector::set_model_uncertainty`).
+    pub(super) fn stuck_model_uncertainty(&self) -> T {
+        let c = &self.config;
+        let e = &self.last.estimate;
+        let w = e.omega.abs();
+        let turn = w * e.diagnostics.lambda_r.norm() * w * c.ts * T::lit(0.5);
+        turn * (c.ts / c.machine.lq)
+    }
 }

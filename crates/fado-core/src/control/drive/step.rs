@@ -259,6 +259,8 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             let prev = self.last.estimate;
             let rot_ref = Rotation::from_angle(prev.theta + prev.omega * self.config.ts);
             let i_model = self.predicted_current().unwrap_or_else(|| i_abc.to_ab());
+            let uncertainty = self.stuck_model_uncertainty();
+            self.stuck_sensor.set_model_uncertainty(uncertainty);
             (self.last.i_dq_ref.to_ab(rot_ref), i_model)
         };
         let (ia, ib, stuck) = self.stuck_sensor.step(i_abc.a, i_abc.b, i_ref_ab, i_model);

@@ -246,7 +246,9 @@ pub struct ObserverTuning<T> {
     /// With a saturating magnetic model: run the observer at its speed without the ripple at
     /// the electrical frequency (a notch at |ω̂|, `crate::speed_notch`) where the frame
     /// coupling of `crate::active_flux` exceeds `active_flux::OFFSET_COUPLING_MAX` while the
-    /// machine generates. Default true (ours \[A\]; no effect with constant inductances).
+    /// machine generates, on a saturating model or a salient rotor with constant inductances
+    /// (coupling (L̂q − L̂d)·î_q/λ̂a). Default true (ours \[A\]; no effect on a surface-magnet
+    /// rotor).
     ///
     /// A DC error of λ2 turns θ̂ by a ripple at the electrical frequency; at low speed T2S-1
     /// passes its rate into the observer's speed, which leaks the rotating flux into D̂, and

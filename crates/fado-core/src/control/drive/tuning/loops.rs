@@ -107,9 +107,9 @@ pub struct InjectionTuning<T> {
     /// On a rotor with L̂q > L̂d the positive d current of the injection shrinks the active
     /// flux λ̂f + (L̂d − L̂q)·i_d the estimator's angle rests on: I_min is bounded so that it
     /// takes at most this share of λ̂f, I_min ≤ share·λ̂f/(L̂q − L̂d). Default 0.25 \[A\]:
-    /// ipmsm-gem-50k (L̂q/L̂d = 3.2, I_min 44 A takes 55 %) loses 0.30–0.32 rad in
-    /// `regen-stop`'s stop through zero where the injection rises as i_q reverses, 0.25–0.28 rad
-    /// on two of four seeds with 0.4, 0.09–0.11 rad on all four with 0.25 (docs/range.md);
+    /// ipmsm-gem-50k (L̂q/L̂d = 3.2, I_min 44 A takes 55 %) loses 0.15–0.35 rad in
+    /// `regen-stop`'s stop through zero where the injection rises as i_q reverses (0.35 at
+    /// seed 3), 0.105–0.118 rad on seeds 1–4 with 0.25 (docs/range.md);
     /// the paper's motor and the surface-magnet presets take nothing, ipmsm-2k2 3 %. A large
     /// value (1e9) keeps `current_ratio`. No bound where the injection goes along −d
     /// ([`injection::direction`](crate::injection::direction)): there it raises the active flux.
