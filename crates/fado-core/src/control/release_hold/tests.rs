@@ -265,8 +265,11 @@ fn a_motion_hold_acts_at_any_reference_and_the_reference_resumes_from_zero() {
 fn at_the_start_ups_end_a_fall_against_a_moving_reference_is_held() {
     // Off by `enabled` (the drive's default), on by `at_start`: armed at the alignment.
     let m = MachineModel::<f64>::paper();
-    let t = ReleaseHoldTuning::<f64>::default();
-    assert!(!t.enabled && t.at_start);
+    let t = ReleaseHoldTuning::<f64> {
+        at_start: true,
+        ..Default::default()
+    };
+    assert!(!t.enabled && !ReleaseHoldTuning::<f64>::default().at_start);
     let mut h = ReleaseHold::new(&t, &m, 1e-4, 250.0, 40.0).unwrap();
     // A rotor that follows a forward reference never triggers it, however far it goes.
     h.arm(1.0);
