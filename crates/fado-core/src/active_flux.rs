@@ -348,11 +348,20 @@ impl<T: Real, M: FluxLookup<T>> ActiveFlux<T, M> {
     }
 
     /// The bracket of the R̂s regressor φ = −(that)/ω (module docs) at the operating point,
-    /// with the incremental inductances there; None where κ < [`KAPPA_MIN_RATIO`]·λa, λa ≤ 0
-    /// or the bracket's turned part (its i_d term) is not smaller than its direct part i_q
-    /// (the law freezes).
+    /// with the incremental inductances there; None where the law freezes
+    /// ([`ActiveFlux::resistance_regressor_coupled`]).
     #[inline]
     pub fn resistance_regressor(&self, point: &ActiveFluxPoint<T>) -> Option<T> {
+        self.resistance_regressor_coupled(point)
+            .map(|(bracket, _)| bracket)
+    }
+
+    /// [`ActiveFlux::resistance_regressor`]'s bracket and the frame coupling |s|/κ there
+    /// ([`ActiveFlux::frame_coupling`], from the same incremental inductances); None where
+    /// κ < [`KAPPA_MIN_RATIO`]·λa, λa ≤ 0 or the bracket's turned part (its i_d term) is not
+    /// smaller than its direct part i_q (the law freezes).
+    #[inline]
+    pub fn resistance_regressor_coupled(&self, point: &ActiveFluxPoint<T>) -> Option<(T, T)> {
         let i = point.i_dq;
         let l = self.incremental_inductance(i);
         let lqs = point.lq_secant;
@@ -365,7 +374,8 @@ impl<T: Real, M: FluxLookup<T>> ActiveFlux<T, M> {
         // resistance's own d-axis flux i_q (no load, the current along d: cross-saturation
         // alone), any angle error reads as resistance: frozen.
         let turned = i.d * ((l.dd - lqs) * i.q - l.dq * i.d) / kappa;
-        (turned.abs() < i.q.abs()).then_some(i.q + turned)
+        let s = (lqs - l.dd) * i.q + l.dq * i.d;
+        (turned.abs() < i.q.abs()).then_some((i.q + turned, s.abs() / kappa))
     }
 
     /// How far the map's two interpolants of the same nodes disagree on λa at the operating

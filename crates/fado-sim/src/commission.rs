@@ -558,6 +558,7 @@ pub fn identified_toml_with_map(
     );
     doc.insert("inverter_model".into(), toml::Value::Table(inverter_model));
     let frozen = freeze_resistance_law(&mut doc, id);
+    let uncertain = crate::saturation_verdict::model_uncertainty(&mut doc, id);
     let c = id.confidence;
     let head = format!(
         "# [model] identified by `fado-sim commission` (fado_core::commissioning) in {:.2} s.\n\
@@ -567,7 +568,7 @@ pub fn identified_toml_with_map(
          saliency Lq/Ld {:.4}.\n\
          # Current sensors' gain ratio k = {:.5} (1-sigma {:.1e}): phase a was divided by it, \
          so the model is in phase b's scale, the drive's after its start-up gain calibration.\n\
-         {}{}{}",
+         {}{}{}{}",
         id.duration,
         c.rs,
         c.ld,
@@ -583,6 +584,7 @@ pub fn identified_toml_with_map(
         saturation_comment(id),
         saturation_lines,
         frozen,
+        uncertain,
     );
     let body = toml::to_string(&doc).map_err(|e| SimConfigError::new("<config>", e.to_string()))?;
     Ok(head + &body)

@@ -1,6 +1,7 @@
 //! What `fado-sim commission` says of the standstill pulses' verdict on a machine's
 //! saturation ([`SaturationVerdict`]): its name in metrics.json, the header line of
-//! identified.toml, and the online R̂s law fixed where the saturation is unidentified.
+//! identified.toml, the online R̂s law fixed where the saturation is unidentified, and the
+//! identified model's flux uncertainty where it is.
 
 use fado_core::commissioning::{Identification, PULSE_MOTION_LIMIT, SaturationVerdict};
 
@@ -12,6 +13,27 @@ pub fn verdict_name(v: SaturationVerdict) -> &'static str {
         SaturationVerdict::Inconclusive => "inconclusive",
         SaturationVerdict::RotorMoved => "rotor_moved",
         SaturationVerdict::NotMeasured => "not_measured",
+    }
+}
+
+/// `key` = `value` in `doc`'s `[estimator.rs_adaptation]` (the tables made where missing);
+/// false, and nothing written, where the user set the key or a table on the way is not one.
+fn set_law_key(doc: &mut toml::Table, key: &str, value: toml::Value) -> bool {
+    let law = doc
+        .entry("estimator")
+        .or_insert_with(|| toml::Value::Table(toml::Table::new()))
+        .as_table_mut()
+        .and_then(|t| {
+            t.entry("rs_adaptation")
+                .or_insert_with(|| toml::Value::Table(toml::Table::new()))
+                .as_table_mut()
+        });
+    match law {
+        Some(law) if !law.contains_key(key) => {
+            law.insert(key.into(), value);
+            true
+        }
+        _ => false,
     }
 }
 
@@ -29,26 +51,34 @@ pub(crate) fn freeze_resistance_law(doc: &mut toml::Table, id: &Identification<f
     ) {
         return String::new();
     }
-    let estimator = doc
-        .entry("estimator")
-        .or_insert_with(|| toml::Value::Table(toml::Table::new()));
-    let Some(estimator) = estimator.as_table_mut() else {
-        return String::new();
-    };
-    let law = estimator
-        .entry("rs_adaptation")
-        .or_insert_with(|| toml::Value::Table(toml::Table::new()));
-    let Some(law) = law.as_table_mut() else {
-        return String::new();
-    };
-    if law.contains_key("enabled") {
+    if !set_law_key(doc, "enabled", toml::Value::Boolean(false)) {
         return String::new();
     }
-    law.insert("enabled".into(), toml::Value::Boolean(false));
     "# [estimator.rs_adaptation] enabled = false: with the saturation unidentified, the online \
      R̂s law would read the constant inductances' flux error at load as resistance; R̂s stays \
      the commissioned value (re-run the commissioning after a large temperature change).\n"
         .into()
+}
+
+/// Where the pulses identified a saturating model, its flux uncertainty
+/// ([`Identification::model_flux_uncertainty`]) as `[estimator.rs_adaptation]
+/// model_flux_uncertainty` in `doc`, and the header line saying why: the online R̂s law on a
+/// saturating model freezes where the model's flux error could read as resistance
+/// (docs/method/saturation.md, "The R̂s law's regressor"). A key the user set is kept.
+pub(crate) fn model_uncertainty(doc: &mut toml::Table, id: &Identification<f64>) -> String {
+    let Some(u) = id.model_flux_uncertainty() else {
+        return String::new();
+    };
+    if !set_law_key(doc, "model_flux_uncertainty", toml::Value::Float(u)) {
+        return String::new();
+    }
+    format!(
+        "# [estimator.rs_adaptation] model_flux_uncertainty = {u:.4}: the identified model's \
+         flux may be this share of its flux_linkage off the machine's (the fit's RMS current \
+         residual {:.4} A times its larger inductance); the online R̂s law freezes where that \
+         could read as resistance.\n",
+        id.saturation_residual
+    )
 }
 
 /// The header's statement on the magnetic model: saturation detected (the written

@@ -222,24 +222,45 @@ fn classes(release: bool) -> Vec<String> {
 }
 
 /// Half the rated torque arriving 5 ms and 20 ms after the calibrations end, in the running
-/// drive's first moments, on each machine, with the release hold off (the drive's default)
-/// and on. Measured (this code): with the hold off only the 48 V hub motor meets the
-/// benchmark's criteria (the servo 1.0–2.8 rad back, the multirotor 39–48 rad, the traction
-/// machine 12 rad, the 10 kV-class machine 7 rad, the spindle 33–34 rad: the speed loop alone
-/// meets the load); with it on the traction and 10 kV-class machines pass too (their
-/// reference is still zero, and the hold catches the fall), while on the others the
-/// application's reference already ramps (6 % of the rated speed at the servo's end), at
-/// which the hold hands over at once and the speed loop alone meets the load again. Not met;
-/// run with `--ignored` (`-- --nocapture` prints each case).
+/// drive's first moments, on each machine, with the release hold as the drive defaults it
+/// (held at the start-up's end, `[controller.release_hold] at_start`) and enabled. Measured
+/// (this code): every case within the benchmark's criteria but the 12S multirotor 5 ms after
+/// ready ([`a_load_arriving_5_ms_after_ready_on_the_12s_multirotor`]); with `at_start = false`
+/// the speed loop alone meets the load and only the 48 V hub motor keeps them (the servo
+/// 1.0–2.8 rad back, the multirotor 39–48 rad, the traction machine 12 rad, the 10 kV-class
+/// machine 7 rad, the spindle 33–34 rad). On the servo, the multirotor and the spindle the
+/// application's reference already ramps at ready (6 % of the rated speed at the servo's
+/// end): the hold acts on the fall against it (`fado_core::control::release_hold`, "On a
+/// moving reference"). `-- --nocapture` prints each case.
 #[test]
-#[ignore = "the running drive's speed loop alone does not catch a load arriving just after the calibrations on a moving reference"]
 fn a_load_arriving_just_after_the_calibrations() {
+    let failed = just_after(false);
+    assert!(failed.is_empty(), "{failed:#?}");
+}
+
+/// The case of the table above the drive does not meet: the 12S multirotor (21 pole pairs,
+/// 7.2·10⁻⁴ kg·m²) whose load arrives 5 ms after ready, 0.63 rad back, |θ − θ̂| 0.40 rad
+/// (enabled: 0.37 rad back, 0.30 rad); 20 ms after ready it passes. Not met; run with
+/// `--ignored`.
+#[test]
+#[ignore = "the 12S multirotor's rotor under a load 5 ms after ready runs back 0.63 rad before the hold catches it"]
+fn a_load_arriving_5_ms_after_ready_on_the_12s_multirotor() {
+    let failed = just_after(true);
+    assert!(failed.is_empty(), "{failed:#?}");
+}
+
+/// The cases of [`a_load_arriving_just_after_the_calibrations`]: the multirotor 5 ms after
+/// ready (`light` true) or the others; the failures.
+fn just_after(light: bool) -> Vec<String> {
     let mut failed = Vec::new();
     for hold in ["", "[controller.release_hold]\nenabled = true\n"] {
         for (name, motor, inverter) in MACHINES {
             let base = config(motor, inverter, hold);
             let end = run(base.clone()).spans[5].0;
             for at in [end + 0.005, end + 0.02] {
+                if (name == "12S multirotor" && at < end + 0.01) != light {
+                    continue;
+                }
                 let r = run(loaded(&base, at));
                 let verdict = failure(&base, &r);
                 println!(
@@ -255,7 +276,7 @@ fn a_load_arriving_just_after_the_calibrations() {
             }
         }
     }
-    assert!(failed.is_empty(), "{failed:#?}");
+    failed
 }
 
 /// The machines of the sweep: the 2.2 kW IPMSM preset and three classes of the table.
@@ -270,13 +291,13 @@ fn sweep_machines() -> [(&'static str, SimConfig); 4] {
 
 /// Whether the sweep's cell (machine, phase, share of the phase) is one the drive meets:
 /// every phase on the IPMSM; on the others the offsets, the voltage-mode levels and the
-/// settling's end, and the settling's start on the servo motor. The cells it does not meet
-/// are in [`the_start_up_phases_that_lose_a_light_or_unheld_rotor`].
+/// settling's end, and the settling's start and the release's later half on the servo motor.
+/// The cells it does not meet are in [`the_start_up_phases_that_lose_a_light_or_unheld_rotor`].
 fn met(machine: &str, phase: &str, share: f64) -> bool {
     machine == "ipmsm-2k2"
         || matches!(phase, "offsets" | "lower" | "upper")
         || (phase == "settle" && share > 0.5)
-        || (machine == "400 V servo" && phase != "release")
+        || (machine == "400 V servo" && (phase != "release" || share > 0.3))
 }
 
 /// The load's arrival swept through the calibrations' phases (early, middle and late in
@@ -318,7 +339,9 @@ fn sweep(want: bool) -> Vec<String> {
 /// too: the loop sees its back-EMF at 0.5 % of its rated speed above the band), the others
 /// within 0.22 rad and 0.43 rad back (the multirotor's offsets 0.41 rad, the spindle's
 /// 0.30 rad: the recent window reads the multirotor's turn at 0.09 rad, where the whole
-/// calibration's drift allowance let it reach 0.32 rad).
+/// calibration's drift allowance let it reach 0.32 rad). The servo's release at 50 % reads
+/// the rotor at 0.25 rad (0.35 rad back); at 90 % the calibration ends unread and the hold
+/// at the start-up's end catches the rotor (0.14 rad back).
 #[test]
 fn a_load_arriving_in_a_phase_of_the_start_up_is_caught() {
     let failed = sweep(true);
@@ -326,13 +349,13 @@ fn a_load_arriving_in_a_phase_of_the_start_up_is_caught() {
 }
 
 /// The sweep's cells the drive does not meet (measured): the release to zero current on the
-/// servo, the multirotor and the spindle (the servo early in it read by the loop's 4 ms mean:
-/// 0.364 rad back, |θ − θ̂| 0.253 rad; later, and on the others, 3.6–52 rad back: the band
-/// hides the back-EMF, then the running drive's speed loop meets the load on a reference
-/// already ramping, where the release hold does not act); the settling's first half on the
-/// multirotor (0.56–0.82 rad) and the spindle (1.3 rad 5 ms in; 1 ms in 0.497 rad, at the
-/// bound): I₁ is half the rated current, whose d-axis stiffness holds at most half the rated
-/// torque (at a quarter turn).
+/// servo early in it (read by the loop's 4 ms mean: 0.364 rad back, |θ − θ̂| 0.253 rad), on
+/// the multirotor (0.73–0.94 rad back, |θ − θ̂| 0.44–0.60 rad) and on the spindle
+/// (0.79–1.03 rad back late in it; 10 % in, π off): the band hides the back-EMF, the
+/// calibration ends unread and the hold at the start-up's end meets a rotor already
+/// falling; the settling's first half on the multirotor (0.56–0.82 rad) and the spindle
+/// (1.3 rad 5 ms in; 1 ms in 0.497 rad, at the bound): I₁ is half the rated current, whose
+/// d-axis stiffness holds at most half the rated torque (at a quarter turn).
 #[test]
 #[ignore = "the release to zero current and the settling's start lose a light or unheld rotor"]
 fn the_start_up_phases_that_lose_a_light_or_unheld_rotor() {

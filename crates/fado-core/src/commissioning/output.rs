@@ -84,6 +84,23 @@ impl<T: Real> Identification<T> {
             self.saturation_motion,
         )
     }
+
+    /// How far the identified magnetic model's flux may be from the machine's, as a share of
+    /// its λ̂f: the fit's RMS current residual over the pulses times the larger of its
+    /// zero-current incremental inductances (the flux a current error of that size means),
+    /// over its ψd(0, 0). What the online R̂s law takes as
+    /// [`crate::rs_adaptation::ResistanceAdaptationConfig::model_flux_uncertainty`]. None
+    /// without an identified saturating model, or where the figure is not a finite
+    /// non-negative number. Measured (`fado-sim commission`, seed 1): 0.0007 on the
+    /// saturated IPMSM preset, 0.016 and 0.026 on the PM-SyRM's algebraic and measured maps
+    /// (their identified models' flux 5–10 % of the magnet's off at load,
+    /// docs/results/commissioning-magnetics.md).
+    pub fn model_flux_uncertainty(&self) -> Option<T> {
+        self.saturation.as_ref()?;
+        let inductance = crate::real::max(self.model.ld, self.model.lq);
+        let u = self.saturation_residual * inductance / self.model.flux_linkage;
+        (u.is_finite() && u >= T::zero()).then_some(u)
+    }
 }
 
 /// What one step returns.

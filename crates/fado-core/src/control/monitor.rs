@@ -283,7 +283,8 @@ impl<T: Real> StuckChannelDetector<T> {
     }
 
     /// Allows `uncertainty` (A, ≥ 0; a bad value counts as 0) more than `band` between a
-    /// near-zero reading and the model's one-sample prediction in the contradiction test:
+    /// near-zero reading and the model's one-sample prediction in the contradiction test,
+    /// and as much more reference for a replacement at once ([`IMMEDIATE_REFERENCE`]):
     /// what the prediction cannot know over the sample (the drive gives the back-EMF's turn
     /// over the sample through the inductance, which the prediction holds at its start).
     /// Measured on motors/multirotor-mn5006-22v (8 µH, 14 pole pairs, ω̂·Ts up to 0.29 rad):
@@ -332,8 +333,11 @@ impl<T: Real> StuckChannelDetector<T> {
                 // one-sample prediction a band away from the reading.
                 let contradicted = asked >= self.min_reference
                     && (reading[k] - phase_value(i_model_ab, k)).abs() >= self.contradiction;
+                let immediate = T::lit(IMMEDIATE_REFERENCE) * self.min_reference
+                    + self.contradiction
+                    - self.band;
                 suspect[k] = near_zero
-                    && (asked >= T::lit(IMMEDIATE_REFERENCE) * self.min_reference || contradicted)
+                    && (asked >= immediate || contradicted)
                     && self.monitors[k].is_running();
             }
             suspect[k] |= self.stuck[k];
@@ -454,6 +458,14 @@ mod tests {
         );
         let (a, _, _) = d.step(0.0, -1.45, small, Ab::new(2.9, 0.0));
         assert!((a - 2.9).abs() < 1e-12, "{a}");
+        // It raises the immediate level too: 4.5 A in phase a, the model agreeing with the
+        // reading, is replaced at once without the allowance and kept with 1 A of it.
+        let large = Ab::new(4.5, 0.0);
+        let (a, _, _) = d.step(0.05, -0.05, large, agreeing);
+        assert_eq!(a, 0.05);
+        let mut d = StuckChannelDetector::<f64>::new(0.25, 2.0, 5);
+        let (a, _, _) = d.step(0.05, -0.05, large, agreeing);
+        assert!((a - 0.1).abs() < 1e-12, "{a}");
         let mut d = StuckChannelDetector::<f64>::new(0.25, 2.0, 5);
         d.set_model_uncertainty(f64::NAN);
         let (a, _, _) = d.step(0.0, -1.45, small, Ab::new(0.9, 0.0));

@@ -59,7 +59,8 @@ impl<T: Real> EstimatorConfig<T> {
     }
 
     /// The R̂s and λ̂f laws at the slow laws' period, with the tuning's `rs_adaptation_*`,
-    /// `flux_linkage_adaptation.rate`, `rs_adaptation.standstill_angle_rate` and `mode.threshold_ratio`.
+    /// `flux_linkage_adaptation.rate`, `rs_adaptation.standstill_angle_rate`,
+    /// `rs_adaptation.model_flux_uncertainty` and `mode.threshold_ratio`.
     pub(super) fn rs_adaptation_config(&self) -> ResistanceAdaptationConfig<T> {
         let t = &self.tuning;
         ResistanceAdaptationConfig {
@@ -69,6 +70,7 @@ impl<T: Real> EstimatorConfig<T> {
             max_ratio: t.rs_adaptation.max_ratio,
             flux_linkage_rate: t.flux_linkage_adaptation.rate,
             standstill_angle_rate: t.rs_adaptation.standstill_angle_rate,
+            model_flux_uncertainty: t.rs_adaptation.model_flux_uncertainty,
             ..ResistanceAdaptationConfig::new(&self.machine, t.mode.threshold_ratio, self.slow_ts())
         }
     }

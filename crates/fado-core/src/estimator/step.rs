@@ -540,7 +540,8 @@ impl<T: Real> EstimatorState<T> {
         // A saturating model's frame coupling above `active_flux::OFFSET_COUPLING_MAX` freezes
         // the turning law as it holds the offset law: with the current loop holding î, a
         // frame error moves |λ̂r| by σ·δ, which the law would read as resistance (a model
-        // error's angle, amplified; docs/method/saturation.md, "The offset law's gate").
+        // error's angle, or a load step's transient, amplified; docs/method/saturation.md,
+        // "The offset law's gate").
         let coupled = SATURATING && self.frame_coupled && c.mode == Mode::DisturbanceFeedback;
         // Beyond a map's data the model's slope is its edge cells' extension: the law would
         // learn that guess's error as resistance (docs/results/saturated-replay.md: a map that
@@ -594,6 +595,7 @@ impl<T: Real> EstimatorState<T> {
             state.flux_excitation,
             state.flux_angle,
             state.flux_time,
+            state.excitation_time,
             feedback.alpha,
             feedback.beta,
         ]) {

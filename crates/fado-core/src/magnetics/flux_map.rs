@@ -46,6 +46,11 @@ pub(super) struct AxisScale<T> {
     pub(super) first: T,
     pub(super) inv_step: T,
     pub(super) uniform: bool,
+    /// The axis has a node at zero and the other flux component is zero at every node there
+    /// (the i_q axis of a map made odd in i_q: its interpolants' ψq(i_d, 0) is zero,
+    /// [`FluxMap::smooth_q_flux_offset`]); kept here, in the scale's padding, so that the map
+    /// every model record carries does not grow.
+    pub(super) zero_values: bool,
 }
 
 impl<T: Real> AxisScale<T> {
@@ -59,6 +64,7 @@ impl<T: Real> AxisScale<T> {
             first: axis.first().copied().unwrap_or(T::zero()),
             inv_step,
             uniform,
+            zero_values: false,
         }
     }
 }
@@ -299,13 +305,21 @@ impl<'a, T: Real> FluxMap<'a, T> {
                 return Err(FluxMapError::Ragged { table });
             }
         }
+        // The column at i_q = 0, if the axis has that node: all zero (O(n_d)).
+        let m0 = i_q.partition_point(|&x| x < T::zero());
+        let nq = i_q.len();
+        let q_offset_zero = i_q.get(m0).is_some_and(|&x| x == T::zero())
+            && (0..i_d.len()).all(|k| psi_q.get(k * nq + m0) == Some(&T::zero()));
         Ok(Self {
             i_d,
             i_q,
             psi_d,
             psi_q,
             axis_d: AxisScale::of(i_d),
-            axis_q: AxisScale::of(i_q),
+            axis_q: AxisScale {
+                zero_values: q_offset_zero,
+                ..AxisScale::of(i_q)
+            },
             q_slopes: &[],
         })
     }
@@ -350,6 +364,11 @@ impl<'a, T: Real> FluxMap<'a, T> {
     /// The node slopes the map carries ([`FluxMap::with_node_slopes`]; empty if none).
     pub fn node_slopes(&self) -> &'a [T] {
         self.q_slopes
+    }
+
+    /// Whether ψq is zero at every node of an i_q = 0 column (a map made odd in i_q).
+    pub(super) fn q_offset_zero(&self) -> bool {
+        self.axis_q.zero_values
     }
 
     /// This map with `slopes` as its node slopes (checked by the caller,
@@ -568,13 +587,27 @@ impl<const ND: usize, const NQ: usize> FluxTable<f32, ND, NQ> {
             }
             k += 1;
         }
+        // The column at i_q = 0, if the axis has that node: all zero ([`FluxMap::new`]'s).
+        let mut m0 = 0;
+        while m0 < NQ && self.i_q[m0] < 0.0 {
+            m0 += 1;
+        }
+        let mut q_offset_zero = m0 < NQ && self.i_q[m0] == 0.0;
+        let mut k = 0;
+        while q_offset_zero && k < ND {
+            q_offset_zero = self.psi_q[k][m0] == 0.0;
+            k += 1;
+        }
         FluxMap {
             i_d: &self.i_d,
             i_q: &self.i_q,
             psi_d: self.psi_d.as_flattened(),
             psi_q: self.psi_q.as_flattened(),
             axis_d,
-            axis_q,
+            axis_q: AxisScale {
+                zero_values: q_offset_zero,
+                ..axis_q
+            },
             q_slopes: &[],
         }
     }
@@ -602,5 +635,6 @@ const fn const_axis<const N: usize>(axis: &[f32; N]) -> AxisScale<f32> {
         first: axis[0],
         inv_step,
         uniform,
+        zero_values: false,
     }
 }

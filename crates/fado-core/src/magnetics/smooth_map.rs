@@ -324,12 +324,19 @@ impl<'a, T: Real> FluxMap<'a, T> {
 impl<T: Real> FluxMap<'_, T> {
     /// ψq(i_d, 0) of the map's C¹ interpolant: where the i_q axis has a node at zero the
     /// interpolant passes through it, so only the interpolation along i_d of that node column
-    /// remains (one Hermite cell instead of five); elsewhere the full surface. Out of line,
+    /// remains (one Hermite cell instead of five), and where that column is zero at every node
+    /// (a map made odd in i_q, found once when the map is built) nothing; elsewhere the full
+    /// surface. Out of line,
     /// as [`FluxMap::smooth_flux`] is: inlined, its Hermite cell takes the registers of a step
     /// that matches on the model (the firmware's record), whose other models' code then spills
     /// (docs/results/firmware-cost.md).
     #[inline(never)]
     pub fn smooth_q_flux_offset(&self, i_d: T) -> T {
+        if self.q_offset_zero() {
+            // A zero node column: the Hermite cell through zeros with zero slopes (NaN for a
+            // NaN i_d, as the cell's extension gives it).
+            return i_d * T::zero();
+        }
         let i_q = self.i_q();
         // The axis ascends: the first node not below zero, if it is zero.
         let m0 = i_q.partition_point(|&x| x < T::zero());

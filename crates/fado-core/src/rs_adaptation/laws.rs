@@ -4,7 +4,7 @@
 use super::{
     AdaptationRegime, FLUX_LINKAGE_DEAD_ZONE, FLUX_LINKAGE_DEAD_ZONE_OFF, FLUX_LINKAGE_MAX_RATIO,
     FLUX_LINKAGE_MIN_RATIO, RESISTIVE_SPEED_ANGLE, ResistanceAdaptationConfig,
-    ResistanceAdaptationState,
+    ResistanceAdaptationState, SATURATED_PRIOR_TIME, SATURATED_RESISTIVE_SPEED_ANGLE,
 };
 use crate::active_flux::{ActiveFlux, ActiveFluxPoint};
 use crate::error::{ConfigError, check};
@@ -22,6 +22,11 @@ pub(crate) struct ResistanceAdaptationParams<T: 'static> {
     rate_ts: T,
     /// Ts/[`RESISTIVE_SPEED_ANGLE`]: γ·Ts at a resistive speed of 1 rad/s.
     speed_rate_ts: T,
+    /// Ts/[`SATURATED_RESISTIVE_SPEED_ANGLE`]: a saturating model's γ·Ts at a resistive
+    /// speed of 1 rad/s.
+    saturated_speed_rate_ts: T,
+    /// The model's flux uncertainty in Wb: `model_flux_uncertainty`·λ̂f (configured).
+    model_flux: T,
     /// γ_s·Ts.
     standstill_gain: T,
     /// e^{−ω_m·Ts}.
@@ -33,11 +38,12 @@ pub(crate) struct ResistanceAdaptationParams<T: 'static> {
     floor_sq: T,
 }
 
-/// The resistance error, as a share of R0, whose flux error the turning law must see above a
-/// map's interpolation spread (`ActiveFlux::interpolation_spread`) to run. Ours \[A\]: a
-/// model error read as resistance biases R̂s by at most about this share; 2 % holds the
-/// traction IPMSM's coarse 7 × 8 map of `scripts/saturated-replay.py` (R̂s 0.95–1.05 × the
-/// truth running everywhere).
+/// The resistance error, as a share of R0, whose flux error the turning law must see above
+/// what the model leaves open (a map's interpolation spread, `ActiveFlux::interpolation_spread`,
+/// plus the configured `model_flux_uncertainty`, both times 1 + the frame coupling) to run.
+/// Ours \[A\]: a model error read as resistance biases R̂s by at most about this share; 2 %
+/// holds the traction IPMSM's coarse 7 × 8 map of `scripts/saturated-replay.py` (R̂s
+/// 0.95–1.05 × the truth running everywhere).
 pub(crate) const MAP_RESISTANCE_RESOLUTION: f64 = 0.02;
 
 /// 1/(2π·`hz`)²: |ω̂| ≤ 2π·`hz` is ω̂²·(that) ≤ 1; `hz` = 0 allows ω̂ = 0 only (1e30: no
@@ -117,6 +123,8 @@ impl<T: Real> ResistanceAdaptationParams<T> {
             "with standstill_angle_rate·ts below 1",
         )?;
         check::non_negative("flux_linkage_min_speed", config.flux_linkage_min_speed)?;
+        let uncertainty =
+            check::non_negative("model_flux_uncertainty", config.model_flux_uncertainty)?;
         let min = check::positive("min_ratio", config.min_ratio)?;
         if min > T::one() {
             return Err(ConfigError::OutOfRange {
@@ -135,6 +143,8 @@ impl<T: Real> ResistanceAdaptationParams<T> {
             config,
             rate_ts: rate * ts,
             speed_rate_ts: ts / T::lit(RESISTIVE_SPEED_ANGLE),
+            saturated_speed_rate_ts: ts / T::lit(SATURATED_RESISTIVE_SPEED_ANGLE),
+            model_flux: uncertainty * config.flux_linkage_hat,
             standstill_gain: rate_s * ts,
             forget: (-(memory_w * ts)).exp(),
             standstill_inv_omega_sq: inverse_square_speed(standstill_hz),
@@ -226,6 +236,7 @@ impl<T: Real> ResistanceAdaptationParams<T> {
             flux_learning: st.flux_learning,
             offset_sensitivity: st.offset_sensitivity,
             standstill_share: st.standstill_share,
+            excitation_time: st.excitation_time,
             ..ResistanceAdaptationState::default()
         };
         let mag_sq = lambda_r.norm_squared();
@@ -289,15 +300,17 @@ impl<T: Real> ResistanceAdaptationParams<T> {
             if !settled {
                 return false;
             }
-            let Some(bracket) = af.resistance_regressor(&point) else {
+            let Some((bracket, coupling)) = af.resistance_regressor_coupled(&point) else {
                 return false;
             };
-            // Frozen where the map's interpolation leaves λa more open than the flux error a
-            // resistance error of `MAP_RESISTANCE_RESOLUTION`·R0 causes, R0·|bracket|/|ω̂|
-            // times it: there the law would learn the interpolation as resistance.
-            if af.interpolation_spread(&point) * omega.abs()
-                >= T::lit(MAP_RESISTANCE_RESOLUTION) * scale.r0 * bracket.abs()
-            {
+            // Frozen where what the model leaves open (the map's interpolation spread and the
+            // configured model flux uncertainty), times 1 + the frame coupling (a model error's
+            // q part turns the frame, which moves |λ̂r| by the coupling times it), exceeds the
+            // flux error a resistance error of `MAP_RESISTANCE_RESOLUTION`·R0 causes,
+            // R0·|bracket|/|ω̂| times it: there the law would learn the model's error as
+            // resistance.
+            let open = af.interpolation_spread(&point) + self.model_flux * (T::one() + coupling);
+            if open * omega.abs() >= T::lit(MAP_RESISTANCE_RESOLUTION) * scale.r0 * bracket.abs() {
                 return false;
             }
             let reference = point.active + (lf - self.config.flux_linkage_hat);
@@ -311,11 +324,12 @@ impl<T: Real> ResistanceAdaptationParams<T> {
             // within milliseconds).
             let relative_to = crate::real::max(lf, reference);
             let a = -(mag * bracket) * scale.chi_per_phi * (lf / relative_to);
+            let (gain, rate_ts) = self.saturated_rate(scale, st, a, mag);
             return self.rotating_step(
                 st,
                 next,
                 (reference, relative_to),
-                (a, scale.gain, self.rate_ts),
+                (a, gain, rate_ts),
                 mag,
                 omega,
                 settled,
@@ -359,6 +373,34 @@ impl<T: Real> ResistanceAdaptationParams<T> {
         }
     }
 
+    /// A saturating model's γ·Ts·R0 and γ·Ts this period: the least-squares gain of the
+    /// excitation the turning law has seen, Ts/(T_E + E) with E its accumulated excitation time
+    /// Σ χ²/(χ² + χ0²)·Ts and T_E = [`SATURATED_PRIOR_TIME`] the weight of the configured R0
+    /// (module docs, "The rate on a saturating model"), and at least the configured γ; at most
+    /// half the error per period. The configured γ with a `model_flux_uncertainty` above 0
+    /// (the data then carry the model's error, which the gain would take at once); γ = 0 stays
+    /// 0.
+    #[inline(always)]
+    fn saturated_rate(
+        &self,
+        scale: &ResistanceScale<T>,
+        st: &ResistanceAdaptationState<T>,
+        a: T,
+        mag: T,
+    ) -> (T, T) {
+        if self.rate_ts <= T::zero() || self.model_flux > T::zero() {
+            return (scale.gain, self.rate_ts);
+        }
+        let ts = self.config.ts;
+        let least_squares = ts / (T::lit(SATURATED_PRIOR_TIME) + st.excitation_time);
+        let resistive = a.abs() * self.saturated_speed_rate_ts / mag;
+        let rate_ts = min(
+            max(max(least_squares, resistive), self.rate_ts),
+            T::lit(0.5),
+        );
+        (rate_ts * scale.r0, rate_ts)
+    }
+
     /// The turning law's step (and the λ̂f law's) with the reference λ̂a, the flux the error
     /// is taken relative to (λ̂f, or a saturating rotor's active flux where that is more), the
     /// numerator `a` of χ = a/(|λ̂r|·ω̂) and the law's gain γ·Ts·R0 and γ·Ts this period.
@@ -382,6 +424,7 @@ impl<T: Real> ResistanceAdaptationParams<T> {
             next.rs_hat -= gain * (mag - reference) * a * b / (relative_to * (a_sq + floor_b_sq));
             // The turning law replaces what the standstill tests contributed.
             let keep = T::one() - rate_ts * weight;
+            next.excitation_time = st.excitation_time + weight * self.config.ts;
             next.offset_sensitivity = st.offset_sensitivity * keep;
             next.standstill_share = st.standstill_share * keep;
         }

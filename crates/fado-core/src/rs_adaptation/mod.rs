@@ -57,7 +57,25 @@
 //! R̂s error costs no angle and the hand-over transient is most of |λ̂r| − λ̂a: at 5 s⁻¹ the
 //! outrunner's no-load start learned +0.6 % of Rs and lost the rotor when the load arrived).
 //! The paper's motor and the presets up to the hub motor (117 rad/s at rated current) keep
-//! γ. A saturating model's law keeps the configured γ.
+//! γ.
+//!
+//! **The rate on a saturating model.** The saturating law waits out the hand-over's
+//! transient (the λ̂f law's settling) and runs at the largest of three rates: γ; the
+//! least-squares gain of the excitation it has seen, 1/(T_E + E) with E = Σ χ²/(χ² + χ0²)·Ts
+//! its accumulated excitation time and T_E = [`SATURATED_PRIOR_TIME`] (0.2 s) the weight of
+//! the configured R0 (the recursive least-squares gain of a prior worth T_E seconds of full
+//! excitation; Åström & Wittenmark, §2.2), so that a start error the standstill test could
+//! not remove is averaged out within the first second of loaded running; and the present
+//! resistive speed R0·|bracket|/λ̂a over [`SATURATED_RESISTIVE_SPEED_ANGLE`] (40 rad), as the
+//! linear path's floor but four times faster, the saturating law being past the hand-over's
+//! transient, so that a machine whose resistance error costs much angle learns it in time.
+//! With a `model_flux_uncertainty` above 0 it keeps γ: the data then carry the model's
+//! error, which the faster gains would take at once. Measured
+//! (`saturated_rs_convergence`, `rated-reversal` started 0.7 and 1.4 times off, gain
+//! calibration off): see docs/method/saturation.md, "The R̂s law's regressor". A blanket 3γ
+//! also took the d-saturated SPM through, but lost a five-times cross-saturated IPMSM's
+//! `rated-reversal` from the correct start (1.03 rad): an oscillation at the electrical
+//! frequency after the passage, which grows slowly at γ, drove R̂s by −6 % there.
 //!
 //! **Standstill** (limiter mode, current along the flux, i.e. the eq. (23) injection at light
 //! load): the DC test of drive commissioning, done online. At standstill v_d = Rs·i_d +
@@ -202,6 +220,22 @@ pub const DEFAULT_RATE: f64 = 1.0;
 /// rate on a fast machine"; ours \[A\]). A relative R̂s error ε then integrates into at most
 /// 120·ε rad of angle while it decays (0.1 % into 0.12 rad).
 pub const RESISTIVE_SPEED_ANGLE: f64 = 120.0;
+/// The weight of the configured R0 in the saturating turning law's least-squares rate, in
+/// seconds of full excitation: 0.2 s (module docs, "The rate on a saturating model"; ours
+/// \[A\]). The law starts at 1/(0.2 s) = 5 s⁻¹ and falls to the default γ after 0.8 s of
+/// full excitation. 0.05 s (20 s⁻¹ at first) doubled the saturated presets' largest `stops`
+/// error from the correct start (ipmsm-2k2-qsat 0.052 → 0.080 rad, pmsm-gem-1k1-measured
+/// 0.047 → 0.097): the first loaded moments' transient then weighs as much as R0.
+pub const SATURATED_PRIOR_TIME: f64 = 0.2;
+
+/// A saturating model's turning law runs at least at the present resistive speed
+/// R0·|bracket|/λ̂a (rad/s; the bracket of `crate::active_flux`'s regressor) divided by this
+/// many radians: 40 (module docs, "The rate on a saturating model"; ours \[A\]), so that a
+/// relative R̂s error ε integrates into at most 40·ε rad of angle while it decays. Machines at
+/// or below 40 rad/s at their current keep γ there (ipmsm-2k2-qsat: 40 rad/s at its rated
+/// 6.08 A); the d-saturated SPM test machine (94 rad/s at its rated 6 A) runs at 2.3 s⁻¹.
+pub const SATURATED_RESISTIVE_SPEED_ANGLE: f64 = 40.0;
+
 /// Default χ0 ([`ResistanceAdaptationConfig::excitation_floor`]): 0.2 (ours \[A\]).
 pub const DEFAULT_EXCITATION_FLOOR: f64 = 0.2;
 /// Default lower bound of R̂s as a multiple of R0 ([`ResistanceAdaptationConfig::min_ratio`]):
@@ -249,9 +283,10 @@ pub struct ResistanceAdaptationConfig<T> {
     /// ≈ 1.5 %, enough to lose the Fig. 12 stops, at 1 s⁻¹ by ≈ 0.3 %). The fast correction
     /// at start-up is the standstill law's. With constant inductances the law runs at least
     /// at the present resistive speed R0·|î_q|/λ̂f over [`RESISTIVE_SPEED_ANGLE`] (module
-    /// docs, "The rate on a fast machine"); with a saturating model the turning law, which
-    /// waits out the hand-over's transient, runs at three times this rate (at most 1/ts;
-    /// docs/method/saturation.md, "The R̂s law's regressor"). 0 turns the turning law off.
+    /// docs, "The rate on a fast machine"); with a saturating model at the least-squares rate
+    /// of the excitation seen so far or at its resistive speed over
+    /// [`SATURATED_RESISTIVE_SPEED_ANGLE`] where either exceeds this rate (module docs, "The
+    /// rate on a saturating model"). 0 turns the turning law off.
     pub rate: T,
     /// χ0: the excitation (relative flux error per relative resistance error) below which the
     /// turning law is frozen, and the scale of its normalisation χ/(χ² + χ0²); the standstill
@@ -293,6 +328,14 @@ pub struct ResistanceAdaptationConfig<T> {
     /// d axis). 0 = off. Default 2 s⁻¹ (ours \[A\]: a 0.5 s time constant, a tenth of the
     /// 5 Hz speed loop's 31 rad/s, so that the loop re-balances the torque as θ̂ turns).
     pub standstill_angle_rate: T,
+    /// How far the magnetic model's flux may be from the machine's, as a share of λ̂f
+    /// (`flux_linkage_hat`): the turning law on a saturating model freezes where this flux,
+    /// with the map's interpolation spread, times 1 + the frame coupling, exceeds the flux error
+    /// of a 2 % resistance error at the operating point (docs/method/saturation.md, "The R̂s
+    /// law's regressor"). 0 for the machine's own model (a measured map, an algebraic model of
+    /// the machine). Default 0; `fado-sim commission` writes its identified model's figure
+    /// (`fado_core::commissioning::Identification::model_flux_uncertainty`).
+    pub model_flux_uncertainty: T,
     /// Lower bound of R̂s as a multiple of R0. Default 0.5 (ours \[A\]).
     pub min_ratio: T,
     /// Upper bound of R̂s as a multiple of R0. Default 2 (ours \[A\]: copper from −40 °C to
@@ -342,6 +385,7 @@ impl<T: Real> ResistanceAdaptationConfig<T> {
             flux_linkage_min_speed: T::lit(FLUX_LINKAGE_SPEED_THRESHOLDS)
                 * T::two_pi()
                 * threshold_hz,
+            model_flux_uncertainty: T::zero(),
             min_ratio: T::lit(DEFAULT_MIN_RATIO),
             max_ratio: T::lit(DEFAULT_MAX_RATIO),
         }
@@ -391,6 +435,10 @@ pub struct ResistanceAdaptationState<T> {
     pub flux_angle: T,
     /// λ̂f law: the time of the revolution under way, s.
     pub flux_time: T,
+    /// The turning law's accumulated excitation time E = Σ χ²/(χ² + χ0²)·Ts, s: a saturating
+    /// model's law runs at the least-squares rate 1/([`SATURATED_PRIOR_TIME`] + E) while
+    /// that exceeds γ.
+    pub excitation_time: T,
     /// λ̂f law: a revolution mean left the dead zone and has not yet come within
     /// [`FLUX_LINKAGE_DEAD_ZONE_OFF`] of λ̂f.
     pub flux_learning: bool,
@@ -413,6 +461,7 @@ impl<T: Real> ResistanceAdaptationState<T> {
             self.flux_excitation,
             self.flux_angle,
             self.flux_time,
+            self.excitation_time,
         ])
     }
 }

@@ -53,7 +53,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
     /// `currents_for_torque` with a saturating model: i_d* = the injection + the model's MTPA
     /// (with `mtpa` on) + `probe_id`, and i_q* solves ψd·i_q* − ψq·i_d* = λ̂f·i_q,t (the
     /// co-energy torque, `crate::control::saturated_references`) by the same three Newton
-    /// steps, the slope from the model's incremental inductance (one flux solve per step, the
+    /// steps, ended early by a step below `TORQUE_SETTLED` of the rated current, the slope from the model's incremental inductance (one flux solve per step, the
     /// secant's slope to O(h)). Each evaluation's ψ(i) starts from the last one's first-order
     /// prediction, the first from the model's flux at the last sample's reference
     /// (`saturated_warm`); returns the currents, the flux of the last evaluation and the warm
@@ -82,7 +82,9 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             last.set((psi, warm));
             (tau - target, slope)
         };
-        let iq = Self::solve_torque_with(f, iq_torque, guess, m.rated_current, m.flux_linkage);
+        let settled = T::lit(super::references::TORQUE_SETTLED) * m.rated_current;
+        let limits = (m.rated_current, m.flux_linkage);
+        let iq = Self::solve_torque_with(f, iq_torque, guess, limits, settled);
         let (psi, warm) = last.get();
         (Dq::new(id_of(iq), iq), psi, warm)
     }

@@ -260,3 +260,46 @@ fn a_motion_hold_acts_at_any_reference_and_the_reference_resumes_from_zero() {
     assert!(matches!(h.step(50.0, 0.2, 0.2), HoldAction::Handover(_)));
     assert_eq!(h.resumed(50.0), 50.0);
 }
+
+#[test]
+fn at_the_start_ups_end_a_fall_against_a_moving_reference_is_held() {
+    // Off by `enabled` (the drive's default), on by `at_start`: armed at the alignment.
+    let m = MachineModel::<f64>::paper();
+    let t = ReleaseHoldTuning::<f64>::default();
+    assert!(!t.enabled && t.at_start);
+    let mut h = ReleaseHold::new(&t, &m, 1e-4, 250.0, 40.0).unwrap();
+    // A rotor that follows a forward reference never triggers it, however far it goes.
+    h.arm(1.0);
+    for k in 0..400 {
+        let theta = 1.0 + 1e-3 * k as f64;
+        assert_eq!(h.step(10.0, theta, theta), HoldAction::Idle, "at {k}");
+    }
+    // Falling back by less than the trigger from the furthest angle: still idle; by more:
+    // held there as a motion hold, whose reference resumes from zero.
+    let top = 1.0 + 1e-3 * 399.0;
+    assert_eq!(h.step(10.0, top - 0.015, top - 0.015), HoldAction::Idle);
+    let fall = top - 0.025;
+    assert!(matches!(h.step(10.0, fall, fall), HoldAction::Hold(x) if x > 0.0));
+    assert!(h.active() && h.engaged() == 1);
+    assert_eq!(h.resumed(10.0), 0.0);
+    // Against a backward reference the sense turns: a forward fall triggers.
+    h.arm(0.0);
+    for k in 0..50 {
+        let theta = -1e-3 * k as f64;
+        assert_eq!(h.step(-10.0, theta, theta), HoldAction::Idle, "at {k}");
+    }
+    let fall = -0.049 + 0.025;
+    assert!(matches!(h.step(-10.0, fall, fall), HoldAction::Hold(x) if x < 0.0));
+    // A brake's release arms it only where `enabled`; `at_start` off leaves the start-up's
+    // end unarmed too.
+    h.arm_at_release(0.0);
+    assert_eq!(h.step(0.0, 0.5, 0.5), HoldAction::Idle);
+    let off = ReleaseHoldTuning {
+        at_start: false,
+        ..t
+    };
+    let mut h = ReleaseHold::new(&off, &m, 1e-4, 250.0, 40.0).unwrap();
+    h.arm(0.0);
+    assert_eq!(h.step(0.0, 0.5, 0.5), HoldAction::Idle);
+    assert_eq!(h.engaged(), 0);
+}

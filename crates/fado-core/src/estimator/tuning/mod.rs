@@ -123,6 +123,10 @@ pub const MOVED_KEYS: &[(&str, &str)] = &[
         "rs_adaptation.standstill_angle_rate",
     ),
     (
+        "rs_adaptation_model_flux_uncertainty",
+        "rs_adaptation.model_flux_uncertainty",
+    ),
+    (
         "flux_linkage_adaptation_rate",
         "flux_linkage_adaptation.rate",
     ),

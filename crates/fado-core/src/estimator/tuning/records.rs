@@ -314,9 +314,17 @@ pub struct RsAdaptationTuning<T> {
     /// decays instead of walking; what remains is the swing at the stop, before the law acts
     /// (0.5, 1, 4 and 8 s⁻¹ and a 1 Hz filter on i_q/i_d were worse: docs/method/additions.md).
     pub standstill_angle_rate: T,
+    /// How far the magnetic model's flux may be from the machine's, as a share of the model's
+    /// λ̂f: on a saturating model the turning law freezes where what the model leaves open
+    /// exceeds the flux error of a 2 % resistance error (ours \[A\], see
+    /// [`ResistanceAdaptationConfig::model_flux_uncertainty`](crate::rs_adaptation::ResistanceAdaptationConfig::model_flux_uncertainty)).
+    /// Default 0: the model is the machine's (a measured map, the machine's own algebraic
+    /// model); the `identified.toml` of `fado-sim commission` sets its identified model's
+    /// figure.
+    pub model_flux_uncertainty: T,
 }
 
-cast_record!(RsAdaptationTuning { rate, excitation_floor, min_ratio, max_ratio, standstill_angle_rate ; enabled });
+cast_record!(RsAdaptationTuning { rate, excitation_floor, min_ratio, max_ratio, standstill_angle_rate, model_flux_uncertainty ; enabled });
 
 impl<T: Real> Default for RsAdaptationTuning<T> {
     fn default() -> Self {
@@ -327,6 +335,7 @@ impl<T: Real> Default for RsAdaptationTuning<T> {
             min_ratio: T::lit(rs_adaptation::DEFAULT_MIN_RATIO),
             max_ratio: T::lit(rs_adaptation::DEFAULT_MAX_RATIO),
             standstill_angle_rate: T::lit(rs_adaptation::DEFAULT_STANDSTILL_ANGLE_RATE),
+            model_flux_uncertainty: T::zero(),
         }
     }
 }

@@ -211,3 +211,29 @@ fn carried_node_slopes_give_the_same_interpolant() {
     assert!(map.with_node_slopes(&wrong).is_err());
     assert!(map.with_node_slopes(&slopes[1..]).is_err());
 }
+
+/// A map made odd in i_q (its i_q = 0 column zero at every node) is found so when built, and
+/// its q flux offset is the full surface's ψq(i_d, 0), zero, inside and beyond the grid; one
+/// node of that column off zero and the offset is the surface's again, not zero.
+#[test]
+fn a_map_odd_in_q_current_has_no_q_flux_offset() {
+    let mut table = syrm_table();
+    let m0 = table.i_q.iter().position(|&x| x == 0.0).unwrap();
+    assert!(table.psi_q.iter().all(|row| row[m0] == 0.0));
+    let map = table.map().unwrap();
+    assert!(map.q_offset_zero());
+    for k in -40..=40 {
+        let i_d = 0.71 * k as f64;
+        let full = map.smooth_flux_and_jacobian(Dq::new(i_d, 0.0)).0.q;
+        assert_eq!(map.smooth_q_flux_offset(i_d), full, "{i_d}");
+        assert_eq!(full, 0.0, "{i_d}");
+    }
+    assert!(map.smooth_q_flux_offset(f64::NAN).is_nan());
+    table.psi_q[6][m0] = 1e-4;
+    let map = table.map().unwrap();
+    assert!(!map.q_offset_zero());
+    let i_d = table.i_d[6];
+    let offset = map.smooth_q_flux_offset(i_d);
+    let full = map.smooth_flux_and_jacobian(Dq::new(i_d, 0.0)).0.q;
+    assert!((offset - 1e-4).abs() < 1e-12 && (full - offset).abs() < 1e-12);
+}
