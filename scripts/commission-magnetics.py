@@ -59,14 +59,15 @@ def pc(x: float) -> str:
 def accuracy_rows(binary: Path, machines: list, seeds: list, work: Path) -> list:
     rows = ["| machine | seed | saturation | change (%) | residual / linear | "
             "incr. L_d max / rms (%) | incr. L_q max / rms (%) | sec. L_d max (%) | "
-            "sec. L_q max (%) | flux max (%) | rotor turned (rad) |",
-            "|---|---|---|---|---|---|---|---|---|---|---|"]
+            "sec. L_q max (%) | flux max (%) | turn per pair, estimated (rad) | "
+            "plant's turn (rad) |",
+            "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for name, args in machines:
         for seed in seeds:
             m = commission(binary, [*args, "--seed", str(seed)], work / f"{name}-{seed}")
             g = m.get("magnetics")
             if g is None:
-                rows.append(f"| {name} | {seed} | {m['status']} | | | | | | | | "
+                rows.append(f"| {name} | {seed} | {m['status']} | | | | | | | | | "
                             f"{m['rotor_motion_magnetics']:.3f} |")
                 continue
             a = g["accuracy"]
@@ -82,7 +83,8 @@ def accuracy_rows(binary: Path, machines: list, seeds: list, work: Path) -> list
                 f"| {pc(a['incremental_ld']['max'])} / {pc(a['incremental_ld']['rms'])} "
                 f"| {pc(a['incremental_lq']['max'])} / {pc(a['incremental_lq']['rms'])} "
                 f"| {pc(a['secant_ld']['max'])} | {pc(a['secant_lq']['max'])} "
-                f"| {pc(a['flux']['max'])} | {m['rotor_motion_magnetics']:.3f} |")
+                f"| {pc(a['flux']['max'])} | {g['pulse_motion']:.3f} "
+                f"| {m['rotor_motion_magnetics']:.3f} |")
     return rows
 
 
@@ -136,10 +138,13 @@ L_q = ψq/i_q where |i_q| ≥ 0.1·I_rated, secant L_d = (ψd(i_d, i_q) − ψd(
 statistic (the fitted model's largest incremental-inductance change over the pulses' range),
 "residual / linear" the fit's RMS current residual against the constant-inductance model's:
 saturation is reported when the change exceeds 5 % and the ratio is below 0.5. The rotor is
-not locked; "rotor turned" is its largest excursion during the pulses (electrical).
-"saturation" is the verdict: "inconclusive" where the best fit changes its inductances by
-more than a quarter without explaining the data, "rotor moved" where the rotor turned beyond
-0.15 rad over a pair (both keep constant inductances).
+not locked; "turn per pair, estimated" is the procedure's own estimate of the rotor's largest
+turn over one pair of pulses (from the flux at the pair's end), the figure the verdict compares
+with its 0.15 rad limit; "plant's turn" the plant's largest excursion from the pulses' start,
+which the procedure does not see (electrical). "saturation" is the verdict: "inconclusive"
+where the best fit changes its inductances by more than a quarter without explaining the
+data, "rotor moved" where the estimated turn over a pair exceeds 0.15 rad (both keep
+constant inductances).
 `ipmsm-test-saturated` is a made-up machine of other exponents
 (`crates/fado-sim/tests/data/ipmsm-test-saturated.toml`); `spm-dq-sat-saturated` a made-up
 750 W servo SPM whose d axis saturates on the magnet, with a light rotor (2e-4 kg·m²) and an

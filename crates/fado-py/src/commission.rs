@@ -274,8 +274,10 @@ pub struct CommissionResult {
     /// Largest rotor motion during the inductance tests, rad (electrical).
     #[pyo3(get)]
     rotor_motion_inductance: f64,
-    /// Largest rotor motion during the flux-linkage pulses of the magnetic identification,
-    /// rad (electrical).
+    /// Largest rotor motion during the flux-linkage pulses of the magnetic identification
+    /// from the rotor's angle at their start, rad (electrical): the plant's truth. The
+    /// `rotor_moved` verdict compares the procedure's own estimate of the turn over one pair
+    /// of pulses with `PULSE_MOTION_LIMIT` (metrics.json's `magnetics.pulse_motion`).
     #[pyo3(get)]
     rotor_motion_magnetics: f64,
     /// Whether the magnetic identification found saturation (then `identified_toml` carries
@@ -285,7 +287,8 @@ pub struct CommissionResult {
     /// The standstill flux-linkage pulses' verdict on the machine's saturation, as
     /// `fado-sim commission` names it in metrics.json: `detected`, `not_detected`,
     /// `inconclusive` (a fit of large change that does not explain the flux), `rotor_moved`
-    /// (the rotor turned beyond `PULSE_MOTION_LIMIT` during the pulses) or `not_measured`;
+    /// (the procedure's estimate of the rotor's turn over one pair of pulses beyond
+    /// `PULSE_MOTION_LIMIT`) or `not_measured`;
     /// `None` when the pulses did not run to their end. It stands when the procedure aborts
     /// later (then `saturation_detected` is `None`).
     #[pyo3(get)]

@@ -161,7 +161,9 @@ pub struct CommissionOutcome {
     /// Largest |Δθ| of the rotor during the inductance tests, rad (electrical).
     pub rotor_motion_inductance: f64,
     /// Largest |Δθ| of the rotor during the flux-linkage pulses from its angle at their
-    /// start, rad (electrical).
+    /// start, rad (electrical): the plant's truth, which the procedure does not see. The
+    /// verdict compares its own estimate of the turn over one pair with
+    /// [`fado_core::commissioning::PULSE_MOTION_LIMIT`] ([`MagneticsReport::pulse_motion`]).
     pub rotor_motion_magnetics: f64,
     /// Largest |i| (true current) during the flux-linkage pulses, A.
     pub max_current_magnetics: f64,
@@ -334,7 +336,8 @@ pub struct MagneticsReport {
     /// See `flux_linkage`.
     pub flux_from_nameplate: bool,
     /// The rotor's largest turn over one pair of pulses as the procedure estimated it from
-    /// the flux, rad (electrical).
+    /// the flux, rad (electrical): the figure the verdict compares with
+    /// [`fado_core::commissioning::PULSE_MOTION_LIMIT`].
     pub pulse_motion: f64,
     /// What the pulses say ([`fado_core::commissioning::SaturationVerdict`]): `detected`,
     /// `not_detected`, `inconclusive` (a fit of large change that does not explain the data)

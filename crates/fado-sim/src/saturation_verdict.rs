@@ -94,8 +94,9 @@ pub(crate) fn saturation_comment(id: &Identification<f64>) -> String {
         SaturationVerdict::RotorMoved => {
             return format!(
                 "# Magnetic saturation not identified: the rotor turned {:.3} rad (electrical) \
-                 during the standstill flux-linkage pulses, beyond the {PULSE_MOTION_LIMIT} rad \
-                 within which they tell saturation from the turning magnet's back-EMF (a rotor \
+                 over one pair of the standstill flux-linkage pulses by the procedure's flux \
+                 estimate, beyond the {PULSE_MOTION_LIMIT} rad per pair within which they tell \
+                 saturation from the turning magnet's back-EMF (a rotor \
                  too light for pulses of the rated current, even at the shortest rises); the \
                  model keeps constant inductances.\n",
                 id.saturation_motion

@@ -38,13 +38,28 @@ const MOTION_TARGET: f64 = 0.05;
 /// (the 5 kW PM-SyRM: 0.068 estimated, 0.043–0.059 rad measured, with full-length pulses).
 const LIGHT_RATIO: f64 = 0.5;
 
-/// The largest rotor turn over one pair, estimated from the flux at its end, that the
-/// pulses accept, rad (electrical). Beyond it the pulses start again with rises half as
-/// long (down to 4 samples), and a rotor that still turns that far leaves the
-/// saturation unidentified ([`MagneticFit::motion`]): the flux read across a turning magnet
-/// mixes its back-EMF with the saturation (the 750 W servo SPM of
-/// `crates/fado-sim/tests/data/spm-dq-sat-saturated.toml` with its rotor of 2e-4 kg·m²
-/// turned 0.76 rad with 16-sample rises, and the fit read no saturation at all).
+/// The largest rotor turn over one pair of pulses that the pulses accept, rad (electrical),
+/// compared with the drive's own estimate of that turn (the flux across the magnet at the
+/// pair's end, `pulse_pair_end`), never with a total over the pulses. Per pair because the
+/// procedure tracks the total: each pair starts in the frame of the angle θ̂0 its
+/// predecessors' turns moved, so a turn accumulated over the pairs leaves the samples in
+/// the rotor frame; what mixes the turning magnet's back-EMF into the fit is the turn within
+/// a pair, which the samples' angle follows only as the shape of the torque's double
+/// integral scaled by the pair's end. Measured on the 7.2 kW 6SM107S servo of
+/// `crates/fado-sim/tests/data/unseen/servo-6sm107s-3000.toml` (constant inductances): its
+/// rotor turns 0.163 rad from the pulses' start by the plant, 0.088 rad over the 60° pair and
+/// 0.074 over the 120° one (both forward: their first pulses' magnet torque has one sign),
+/// and this estimate reads 0.087 rad for the largest pair. The turn does bias the fit: its
+/// inductances change 7.3 %, above the 5 % detection threshold, against 1.6 % on a rotor of
+/// 1 kg·m² that turns 0.002 rad; but the saturation terms do not explain the flux (residual
+/// 0.80 of the constant inductances', 0.93 held, detection needs below 0.5), so the verdict
+/// stays `not_detected`, as on the held rotor. The presets' turns, estimated and the plant's:
+/// docs/results/commissioning-magnetics.md. Beyond the limit
+/// the pulses start again with rises half as long (down to 4 samples), and a rotor that
+/// still turns that far leaves the saturation unidentified ([`MagneticFit::motion`]): the
+/// 750 W servo SPM of `crates/fado-sim/tests/data/spm-dq-sat-saturated.toml` with its rotor
+/// of 2e-4 kg·m² turned 0.76 rad with 16-sample rises, and the fit read no saturation at
+/// all.
 pub const PULSE_MOTION_LIMIT: f64 = 0.15;
 
 /// Saturation is reported only where the fitted model's RMS current residual is below this
@@ -137,7 +152,7 @@ pub struct MagneticFit<T> {
     /// The constant-inductance model's RMS residual, A.
     pub linear_residual: T,
     /// The largest rotor turn over one pair of pulses, estimated from the flux at its end,
-    /// rad (electrical).
+    /// rad (electrical): the figure compared with [`PULSE_MOTION_LIMIT`].
     pub motion: T,
     /// Saturation detected: `change` above the threshold, `residual` below half of
     /// `linear_residual` and `motion` within [`PULSE_MOTION_LIMIT`].

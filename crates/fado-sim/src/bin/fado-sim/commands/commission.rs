@@ -277,16 +277,17 @@ fn write_whole(path: &Path, text: &str) -> Result<output::Finished, OutputError>
     f.finish()
 }
 
-/// The magnetic model: detected or not, and its errors over the rated current range.
-fn print_magnetics(m: &fado_sim::commission::MagneticsReport, motion: f64) {
+/// The magnetic model: detected or not, and its errors over the rated current range. The
+/// rotor's turn printed is the one the verdict compares with `PULSE_MOTION_LIMIT`: the
+/// procedure's own estimate over one pair of pulses; `plant_motion`, the plant's largest turn
+/// from the pulses' start, follows it labelled as the plant's.
+fn print_magnetics(m: &fado_sim::commission::MagneticsReport, plant_motion: f64) {
     let a = &m.accuracy;
+    let limit = fado_core::commissioning::PULSE_MOTION_LIMIT;
     let verdict = match m.verdict {
-        "rotor_moved" => format!(
-            "saturation not identified: the rotor turned {:.3} rad during the pulses, beyond \
-             the {} rad within which they tell saturation (constant inductances)",
-            m.pulse_motion,
-            fado_core::commissioning::PULSE_MOTION_LIMIT
-        ),
+        "rotor_moved" => "saturation not identified: the rotor turned beyond the limit within \
+                          which the pulses tell saturation (constant inductances)"
+            .to_owned(),
         "inconclusive" => format!(
             "saturation not identified: the best fit does not explain the flux linkage \
              (residual {:.3} of constant inductances'; constant inductances)",
@@ -296,10 +297,14 @@ fn print_magnetics(m: &fado_sim::commission::MagneticsReport, motion: f64) {
         _ => "no saturation detected (constant inductances)".to_owned(),
     };
     outln!(
-        "magnetics: {verdict} (inductances change {:.1} % up to {:.3} A; rotor turned {:.3} rad)",
+        "magnetics: {verdict} (inductances change {:.1} % up to {:.3} A)",
         100.0 * m.inductance_change,
-        m.pulse_current,
-        motion
+        m.pulse_current
+    );
+    outln!(
+        "  rotor turn over a pair of pulses (drive's flux estimate): {:.3} rad, limit {limit} rad; \
+         plant's turn from the pulses' start: {plant_motion:.3} rad",
+        m.pulse_motion
     );
     let pc = |s: &fado_sim::magnetic_accuracy::ErrorStats| {
         format!("max {:.2} %, rms {:.2} %", 100.0 * s.max, 100.0 * s.rms)
