@@ -262,9 +262,9 @@ pub const IMMEDIATE_REFERENCE: f64 = 2.0;
 pub struct StuckChannelDetector<T> {
     band: T,
     min_reference: T,
-    /// `band` plus the model's one-sample uncertainty (A): how far the prediction may lie
-    /// from a healthy reading near zero ([`set_model_uncertainty`](Self::set_model_uncertainty)).
-    contradiction: T,
+    /// The model's one-sample uncertainty (A, ≥ 0) the prediction may lie from a healthy
+    /// reading near zero beyond `band` ([`set_model_uncertainty`](Self::set_model_uncertainty)).
+    allowance: T,
     monitors: [PersistenceMonitor; 2],
     stuck: [bool; 2],
 }
@@ -276,7 +276,7 @@ impl<T: Real> StuckChannelDetector<T> {
         Self {
             band,
             min_reference,
-            contradiction: band,
+            allowance: T::zero(),
             monitors: [PersistenceMonitor::new(samples); 2],
             stuck: [false; 2],
         }
@@ -292,10 +292,10 @@ impl<T: Real> StuckChannelDetector<T> {
     /// contradicted and replaced by the prediction, 0.105 rad with this allowance (0.095
     /// with the detector off); on the paper's motor the allowance is below 0.01 A at 300 r/min.
     pub fn set_model_uncertainty(&mut self, uncertainty: T) {
-        self.contradiction = if uncertainty.is_finite() && uncertainty > T::zero() {
-            self.band + uncertainty
+        self.allowance = if uncertainty.is_finite() && uncertainty > T::zero() {
+            uncertainty
         } else {
-            self.band
+            T::zero()
         };
     }
 
@@ -318,6 +318,8 @@ impl<T: Real> StuckChannelDetector<T> {
     pub fn step(&mut self, i_a: T, i_b: T, i_ref_ab: Ab<T>, i_model_ab: Ab<T>) -> (T, T, bool) {
         let reading = [i_a, i_b];
         let mut suspect = [false; 2];
+        let contradiction = self.band + self.allowance;
+        let immediate = T::lit(IMMEDIATE_REFERENCE) * self.min_reference + self.allowance;
         for k in 0..2 {
             let near_zero = reading[k].abs() < self.band;
             if self.stuck[k] {
@@ -332,10 +334,7 @@ impl<T: Real> StuckChannelDetector<T> {
                 // (see the type's docs): a reference of twice the threshold, or the model's
                 // one-sample prediction a band away from the reading.
                 let contradicted = asked >= self.min_reference
-                    && (reading[k] - phase_value(i_model_ab, k)).abs() >= self.contradiction;
-                let immediate = T::lit(IMMEDIATE_REFERENCE) * self.min_reference
-                    + self.contradiction
-                    - self.band;
+                    && (reading[k] - phase_value(i_model_ab, k)).abs() >= contradiction;
                 suspect[k] = near_zero
                     && (asked >= immediate || contradicted)
                     && self.monitors[k].is_running();

@@ -98,6 +98,9 @@ struct Resolved<T: 'static> {
     stall: StallResolved<T>,
     /// Phase currents beyond ± this (A) are refused as implausible.
     plausible_current: T,
+    /// Ts²/(2·L̂q) (s/H): the stuck-channel detector's model allowance per (rad/s)²·Wb
+    /// (`SensorlessDrive::stuck_model_uncertainty`).
+    stuck_turn_gain: T,
     /// DC-link readings above this (V) are refused as implausible.
     dc_link_max_voltage: T,
     /// MTPA d current on (configured and the machine is salient).

@@ -183,10 +183,8 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
     /// stuck-channel detector allows it between a near-zero reading and the prediction
     /// (`StuckChannelDetector::set_model_uncertainty`).
     pub(super) fn stuck_model_uncertainty(&self) -> T {
-        let c = &self.config;
         let e = &self.last.estimate;
         let w = e.omega.abs();
-        let turn = w * e.diagnostics.lambda_r.norm() * w * c.ts * T::lit(0.5);
-        turn * (c.ts / c.machine.lq)
+        w * e.diagnostics.lambda_r.norm() * w * self.resolved.stuck_turn_gain
     }
 }

@@ -72,6 +72,7 @@ impl<T: Real> Resolved<T> {
                 * t.protection.trip_current_ratio
                 * rated,
             dc_link_max_voltage: t.plausibility.dc_link_ratio * c.machine.dc_voltage,
+            stuck_turn_gain: c.ts * T::lit(0.5) * (c.ts / c.machine.lq),
             mtpa: t.mtpa.enabled && c.machine.is_salient(),
             salient: c.machine.is_salient(),
             saturated: c.saturated_references(),
