@@ -283,6 +283,10 @@ pub struct EstimatorState<T: Real> {
     /// operating point of the integrand-offset law's last slot: the law holds, and the
     /// observer runs at the notched speed.
     frame_coupled: bool,
+    /// The share of its rate at which the integrand-offset law learns, judged in the same
+    /// slot (`crate::active_flux::ActiveFlux::offset_rate_share`; 1 for constant
+    /// inductances).
+    offset_share: T,
     /// The observer runs at the notched speed (`crate::speed_notch`): `frame_coupled` while
     /// the machine generates, judged in the same slot.
     notch_on: bool,

@@ -157,6 +157,7 @@ impl<T: Real> EstimatorParams<T> {
             lag_compensation: T::zero(),
             speed_notch: SpeedNotch::state_at(T::zero()),
             frame_coupled: false,
+            offset_share: T::one(),
             notch_on: false,
             observer_gains: ObserverGains::standstill(),
             feedback: Ab::zero(),

@@ -429,17 +429,22 @@ impl<T: Real> EstimatorState<T> {
         speed: T,
     ) -> T {
         if self.slot == SLOT_OFFSET {
-            let (coupled, i_q) = match c.point {
-                Some(point) => (af.holds_offset(&point), point.i_dq.q),
+            let (coupled, i_q, share) = match c.point {
+                Some(point) => (
+                    af.holds_offset(&point),
+                    point.i_dq.q,
+                    af.offset_rate_share(&point),
+                ),
                 None => {
                     let i_dq = ActiveFlux::<T>::frame_current(c.lambda_r, i_ab);
                     let lf = self.rs_adaptation.flux_linkage_hat;
                     let holds =
                         crate::active_flux::constant_inductance_holds_offset(lf, c.saliency, i_dq);
-                    (holds, i_dq.q)
+                    (holds, i_dq.q, T::one())
                 }
             };
             self.frame_coupled = coupled;
+            self.offset_share = share;
             self.notch_on =
                 p.frame_ripple_notch && self.frame_coupled && i_q * c.t2s1.omega < T::zero();
         }
@@ -618,19 +623,25 @@ impl<T: Real> EstimatorState<T> {
         let decay = c.kdf_gain * (p.ts * n) + self.offset_recentring_gain * (n - T::one());
         // A saturating model's frame coupling (`crate::active_flux`): where the flux magnitude
         // carries the frame error the law holds ê and the k_df mode stops re-centring at k_e
-        // until the next period.
+        // until the next period; below that both run at a share of k_e that falls with the
+        // coupling (`ActiveFlux::offset_rate_share`).
         let holds = self.frame_coupled;
         if (c.point.is_some() || c.saliency != T::zero()) && self.rs_adaptation_on {
             self.offset_recentring_gain = if holds {
                 T::zero()
             } else {
-                p.offset_recentring_gain
+                p.offset_recentring_gain * self.offset_share
             };
         }
         let learning = broken & BROKEN_OFFSET == 0 && c.mode == Mode::DisturbanceFeedback && !holds;
-        let mut offset = p
-            .offset
-            .next_state(&self.offset, c.disturbance, decay, shift, learning);
+        let mut offset = p.offset.next_state(
+            &self.offset,
+            c.disturbance,
+            decay,
+            shift,
+            learning,
+            self.offset_share,
+        );
         // Above the speed of the shortest revolution the law trusts it holds ê (an error
         // locked to the rotor and the carrier aliases onto DC there; the count of settled
         // samples goes on, the λ̂f law waits on it).
