@@ -158,6 +158,7 @@ impl<T: Real> EstimatorParams<T> {
             speed_notch: SpeedNotch::state_at(T::zero()),
             frame_coupled: false,
             offset_share: T::one(),
+            coupled_steady: 0,
             notch_on: false,
             observer_gains: ObserverGains::standstill(),
             feedback: Ab::zero(),
