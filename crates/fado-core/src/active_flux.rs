@@ -362,6 +362,18 @@ impl<T: Real, M: FluxLookup<T>> ActiveFlux<T, M> {
     /// smaller than its direct part i_q (the law freezes).
     #[inline]
     pub fn resistance_regressor_coupled(&self, point: &ActiveFluxPoint<T>) -> Option<(T, T)> {
+        let (direct, turned, coupling) = self.resistance_regressor_parts(point)?;
+        // Where the turned part reaches the resistance's own d-axis flux i_q (no load, the
+        // current along d: cross-saturation alone), any angle error reads as resistance:
+        // frozen.
+        (turned.abs() < direct.abs()).then_some((direct + turned, coupling))
+    }
+
+    /// The R̂s regressor's bracket in its two parts, the direct i_q and the part the frame's
+    /// turn carries through the map's slope (module docs), with the frame coupling |s|/κ;
+    /// None where κ < [`KAPPA_MIN_RATIO`]·λa or λa ≤ 0.
+    #[inline]
+    pub fn resistance_regressor_parts(&self, point: &ActiveFluxPoint<T>) -> Option<(T, T, T)> {
         let i = point.i_dq;
         let l = self.incremental_inductance(i);
         let lqs = point.lq_secant;
@@ -370,12 +382,9 @@ impl<T: Real, M: FluxLookup<T>> ActiveFlux<T, M> {
         if !(point.active > T::zero() && kappa >= floor) {
             return None;
         }
-        // The part the frame's turn carries through the map's slope; where it reaches the
-        // resistance's own d-axis flux i_q (no load, the current along d: cross-saturation
-        // alone), any angle error reads as resistance: frozen.
         let turned = i.d * ((l.dd - lqs) * i.q - l.dq * i.d) / kappa;
         let s = (lqs - l.dd) * i.q + l.dq * i.d;
-        (turned.abs() < i.q.abs()).then_some((i.q + turned, s.abs() / kappa))
+        Some((i.q, turned, s.abs() / kappa))
     }
 
     /// How far the map's two interpolants of the same nodes disagree on λa at the operating

@@ -72,7 +72,9 @@ pub const RANGES: [(&str, f64, &str); 10] = [
 /// Resistive drop at rated current per unit of the rated back-EMF, Rs·I/(ω·λf), above which
 /// the data are refused: 2, a copper loss at the rated point twice its mechanical power
 /// (efficiency below 33 %). Real machines have 0.005–0.35 (the repository's test machines: at
-/// most 0.33, a 6S drone motor); a resistance in mΩ for Ω, or a rated speed in r/s or rad/s
+/// most 0.33, a 6S drone motor), motors wound for torque near standstill more (the 42-pole
+/// robot-joint motor of `crates/fado-sim/tests/data/unseen/` 0.71, the GBM5208 gimbal motor
+/// 1.9 at an assumed 100 r/min; warned); a resistance in mΩ for Ω, or a rated speed in r/s or rad/s
 /// for r/min, gives 6–1000.
 pub const RESISTANCE_ERROR: f64 = 2.0;
 

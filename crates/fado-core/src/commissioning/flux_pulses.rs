@@ -10,6 +10,16 @@ use crate::{Ab, Real};
 /// Bipolar pairs of pulses (directions k·π/6 of the voltage, each followed at once by its
 /// opposite), in the order that cancels the reluctance torque's impulse of a pair (∝ sin 2φ)
 /// with the next one: 0°, 90°, then 30° with 150°, 60° with 120°.
+///
+/// Every pair starts with its positive pulse, so the magnet torque turns the rotor forward
+/// over both the 60° and the 120° pair and their turns add up over the pulses. Starting the
+/// 120° pair with its negative pulse instead halves that total (the 6SM107S servo of
+/// `crates/fado-sim/tests/data/unseen/servo-6sm107s-3000.toml`: 0.163 → 0.088 rad by the plant;
+/// the paper's motor 0.047 → 0.025) but does not unbias the fit, which follows the turn
+/// within each pair (`pulse_pair_end`), not the total: its spurious inductance change rises
+/// (servo 7.3 → 10.3 %, the paper's motor 0.7 → 1.9 %, the 5 kW PM-SyRM 11.4 → 18.1 % with
+/// 0.013 → 0.071 rad within a pair, as the reluctance torque's cancellation between pairs is
+/// lost; ipmsm-2k2-qsat's largest L̂q error 0.71 → 1.08 %), so the order stays.
 const PAIR_ANGLES_DEG: [f64; 3] = [0.0, 60.0, 120.0];
 
 /// Samples per rise of a pulse on the identified inductance, at most (the pulse voltage is

@@ -157,6 +157,7 @@ impl<T: Real> EstimatorParams<T> {
             lag_compensation: T::zero(),
             speed_notch: SpeedNotch::state_at(T::zero()),
             frame_coupled: false,
+            coupled_steady: 0,
             notch_on: false,
             observer_gains: ObserverGains::standstill(),
             feedback: Ab::zero(),

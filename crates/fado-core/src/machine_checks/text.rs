@@ -160,8 +160,9 @@ fn write_resistance(f: &mut fmt::Formatter<'_>, per_unit: f64) -> fmt::Result {
         )
     } else if per_unit <= RESISTANCE_ERROR {
         f.write_str(
-            ": check its unit (Ω per phase) and the ratings (`rated_speed_rpm` in rad/s where \
-             r/min is meant makes it 9.55 × too large)",
+            ": usual only on motors wound for torque near standstill (gimbals, robot joints: \
+             0.5–2); otherwise check its unit (Ω per phase) and the ratings \
+             (`rated_speed_rpm` in rad/s where r/min is meant makes it 9.55 × too large)",
         )
     } else {
         f.write_str(": check its unit (Ω per phase) and the ratings")

@@ -134,7 +134,7 @@ fn the_tangent_plane_near_its_current_is_the_solved_flux() {
             let angle = 0.5 + 0.2 * k as f64;
             let at = Dq::new(-angle.sin(), angle.cos()) * (0.15 * m.rated_current * k as f64);
             let (_, plane) = r.warm_start(at);
-            let near = at + Dq::new(0.6, -0.8) * reach;
+            let near = at + Dq::new(0.6, -0.8) * (0.5 * reach);
             let (mut a, mut b) = (plane, plane);
             let (tau, psi) = r.torque_flux_near(near, at, reach, &mut a);
             assert_eq!(psi, plane.prediction(near), "{name} {k}: the plane's own");
