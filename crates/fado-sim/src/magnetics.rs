@@ -311,35 +311,35 @@ impl FluxPropagator {
             } else {
                 rot * rot_s
             };
-            // Every inversion of a sub-step starts from its first current.
+            // Every inversion of a sub-step starts from its first current. A stage's current
+            // enters the step's flux through R·h/2 or less: Newton's steps from the last
+            // solution where their error is below STAGE_TOLERANCE of the cell (module docs).
             let g = guess;
-            let current_at = |psi: Ab<f64>, rot: Complex64, cache: &mut InverseCache<f64>| {
-                rotate(model.current_from_cached(unrotate(psi, rot), g, cache), rot)
+            let stage = |psi: Ab<f64>, rot: Complex64, cache: &mut InverseCache<f64>| {
+                let i = model.current_near_cached_to(unrotate(psi, rot), g, cache, STAGE_TOLERANCE);
+                rotate(i, rot)
             };
             let k1 = v_ab - i * r;
             if trapezoid {
-                // The trapezoid rule, its end's current the corrector's: Euler's end flux
-                // inverted once, the corrected end R·h·(i* − i)/2 from it: one Newton step
-                // in that cell where that is the root (module docs).
-                let i_euler = current_at(psi + k1 * hs, rot, cache);
+                // The trapezoid rule, its end's current the corrector's: Euler's end a stage,
+                // the corrected end R·h·(i* − i)/2 from it: one Newton step in that cell
+                // where that is the root (module docs).
+                let i_euler = stage(psi + k1 * hs, rot, cache);
                 psi += (k1 + v_ab - i_euler * r) * (0.5 * hs);
                 guess = model.current_near_cached(unrotate(psi, rot), g, cache);
                 i = rotate(guess, rot);
                 continue;
             }
-            let k2 = v_ab - current_at(psi + k1 * (0.5 * hs), rot_mid, cache) * r;
+            let k2 = v_ab - stage(psi + k1 * (0.5 * hs), rot_mid, cache) * r;
             guess = if short {
                 // The midpoint rule: error h³ terms, negligible on a short interval.
                 psi += k2 * hs;
                 model.current_from_cached(unrotate(psi, rot), g, cache)
             } else {
                 // The third stage's flux lies R·h/2·(i₂ − i₀) from the second's, at the same
-                // angle: one Newton step from that stage's solution where its error is below
-                // STAGE_TOLERANCE of the cell (module docs).
-                let psi3 = unrotate(psi + k2 * (0.5 * hs), rot_mid);
-                let i3 = model.current_near_cached_to(psi3, g, cache, STAGE_TOLERANCE);
-                let k3 = v_ab - rotate(i3, rot_mid) * r;
-                let k4 = v_ab - current_at(psi + k3 * hs, rot, cache) * r;
+                // angle, the fourth's half a sub-step from the third's.
+                let k3 = v_ab - stage(psi + k2 * (0.5 * hs), rot_mid, cache) * r;
+                let k4 = v_ab - stage(psi + k3 * hs, rot, cache) * r;
                 psi += (k1 + (k2 + k3) * 2.0 + k4) * (hs / 6.0);
                 // The end lies R·h²·(the stages' spread) from the last stage's flux (10⁻⁵ of
                 // a map's cell): one Newton step from that stage's solution.
