@@ -172,9 +172,11 @@ impl<T: Real> InverseCache<T> {
     /// solution, where `psi` lies so near it that the step's own error (the cell's twist times
     /// the product of the step's fractions: exact for a bilinear cell) is below `tolerance`
     /// of the cell ([`REFINE_TOLERANCE`] for a state's current), and the step stays in the
-    /// cell; None elsewhere (the caller inverts). For a flux a hair from the last inversion's
-    /// (a Runge–Kutta step's end beside its last stage): one division instead of a square
-    /// root, two divisions and the walk. A step taken is the last solution from then on (the
+    /// cell; where the first step stays in the cell but misses the tolerance, a second step
+    /// from it (whose error is the first's squared, relatively: a flux farther from the last
+    /// solution, a Runge–Kutta stage's); None elsewhere (the caller inverts). For a flux a
+    /// hair from the last inversion's (a Runge–Kutta step's end beside its last stage): one
+    /// division instead of a square root, two divisions and the walk. A step taken is the last solution from then on (the
     /// next step starts there; its cell is the same, so an inversion's result is not
     /// changed by it).
     #[inline]
@@ -200,8 +202,7 @@ impl<T: Real> InverseCache<T> {
             |u: T, v: T| direction(u, k, last_k, tol) == 0 && direction(v, m, last_m, tol) == 0;
         let (mut u2, mut v2, mut error) = step((u, v));
         if error > bound && inside(u2, v2) {
-            // A second step from the first: its error is the first's squared, relatively
-            // (a flux farther from the last solution: a short interval's Euler end).
+            // A second step from the first (a flux farther from the last solution).
             (u2, v2, error) = step((u2, v2));
         }
         if !(inside(u2, v2) && error <= bound) {
