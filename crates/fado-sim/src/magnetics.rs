@@ -223,8 +223,8 @@ pub(crate) struct FluxPropagator {
     pole_pairs: f64,
     last: Cell<FluxPoint>,
     /// A map's last cells of i(ψ) (`InverseCache`): every inversion of the sample shares them,
-    /// and the motor carries them to the next sample's integrator.
-    cache: RefCell<InverseCache<f64>>,
+    /// and the motor carries them to the next sample's integrator (None once taken back).
+    cache: RefCell<Option<Box<InverseCache<f64>>>>,
 }
 
 impl FluxPropagator {
@@ -236,7 +236,7 @@ impl FluxPropagator {
         omega: f64,
         pole_pairs: u32,
         start: FluxPoint,
-        cache: InverseCache<f64>,
+        cache: Box<InverseCache<f64>>,
     ) -> Self {
         Self {
             mag,
@@ -246,7 +246,7 @@ impl FluxPropagator {
             h_max: SUBSTEP_TIME_CONSTANTS * bounds.l_min / r,
             pole_pairs: pole_pairs as f64,
             last: Cell::new(start),
-            cache: RefCell::new(cache),
+            cache: RefCell::new(Some(cache)),
         }
     }
 
@@ -264,10 +264,10 @@ impl FluxPropagator {
         }
     }
 
-    /// The map's inverse cells as the last interval left them (for the next sample's
-    /// integrator).
-    pub fn inverse_cache(&self) -> InverseCache<f64> {
-        *self.cache.borrow()
+    /// The map's inverse cells as the last interval left them, taken out (for the next
+    /// sample's integrator); None once taken.
+    pub fn take_inverse_cache(&self) -> Option<Box<InverseCache<f64>>> {
+        self.cache.borrow_mut().take()
     }
 
     /// The magnetics' bounds.
@@ -308,7 +308,8 @@ impl FluxPropagator {
         } else {
             cis(0.5 * self.omega * hs)
         };
-        let cache = &mut *self.cache.borrow_mut();
+        let mut kept = self.cache.borrow_mut();
+        let cache: &mut InverseCache<f64> = kept.get_or_insert_with(Box::default);
         for k in 0..n {
             let rot_mid = rot * rot_half;
             rot = if k + 1 == n {
