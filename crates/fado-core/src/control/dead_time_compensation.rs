@@ -330,7 +330,7 @@ impl<T: Real> DeadTimeCompensation<T> {
 
     /// Each edge's delay, from the current at the edge: the sampled currents `i`, then twice
     /// refined with the ripple the gate times `gates` (rising, falling) and those delays
-    /// imply.
+    /// imply (once where the first refinement keeps them).
     #[inline(always)]
     fn edge_delays(
         &self,
@@ -339,14 +339,18 @@ impl<T: Real> DeadTimeCompensation<T> {
         gates: ([T; 3], [T; 3]),
         vdc: T,
     ) -> ([T; 3], [T; 3]) {
-        let mut delays = (
+        let first = (
             i.map(|x| self.edge_delay(true, x)),
             i.map(|x| self.edge_delay(false, x)),
         );
-        for _ in 0..2 {
-            delays = self.refined_delays(rotation, i, gates, delays, vdc);
+        let once = self.refined_delays(rotation, i, gates, first, vdc);
+        // A refinement that keeps every delay is at its fixed point: the second one would
+        // repeat the same arithmetic on the same numbers (every current outside the band with
+        // its ripple, the common case away from the zero crossings).
+        if once == first {
+            return once;
         }
-        delays
+        self.refined_delays(rotation, i, gates, once, vdc)
     }
 
     /// One refinement of the edges' delays (rising, falling): the current at each edge is
