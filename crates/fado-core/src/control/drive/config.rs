@@ -42,7 +42,8 @@ impl<T: Real> DriveConfig<T> {
 
     /// The start-up gain calibration's configuration in absolute units: upper level
     /// `gain_calibration.current_ratio` × the rated current (at most the current limit),
-    /// settling 5·max(L̂d/R̂s, 1/ωc) per level, window `gain_calibration.time`.
+    /// settling 5·max(L̂d/R̂s, 1/ωc) per level, window `gain_calibration.time` (longer where
+    /// a hold beyond the budget is traded for it, [`hold_and_window`]).
     pub fn gain_calibration_config(&self) -> Result<GainCalibrationConfig<T>, ConfigError> {
         self.machine.validate()?;
         let t = &self.tuning;
@@ -70,25 +71,7 @@ impl<T: Real> DriveConfig<T> {
         };
         let i1 = T::lit(0.5) * i2;
         let swing = crate::real::max(swing_time_constant(m, i1), swing_time_constant(m, i2));
-        let hold = swing_hold_time_constants(m, i1, swing, t) * swing;
-        let budget = T::lit(GAIN_CALIBRATION_MAX_HOLD_TIME);
-        // A brake that holds the rotor (`startup.rotor_held`) leaves no swing to wait for:
-        // where the swing's hold would exceed the budget and skip the calibration, the levels
-        // are held for the current's settling alone (measured: the 8-pole traction IPMSM of
-        // `crates/fado-sim/tests/data/traction-ipm-saturated.toml`, swing hold 0.61 s,
-        // `crates/fado-sim/tests/gain_calibration.rs`). Elsewhere a hold beyond the budget
-        // is cut to it where a window of at most the budget meets the swing's bias bound
-        // ([`traded_window`]).
-        let (hold, window) = if t.startup.rotor_held && hold > budget {
-            (T::zero(), t.gain_calibration.time)
-        } else if hold > budget {
-            match traded_window(m, i1, swing, t) {
-                Some(window) => (budget, window),
-                None => (hold, t.gain_calibration.time),
-            }
-        } else {
-            (hold, t.gain_calibration.time)
-        };
+        let (hold, window) = hold_and_window(m, i1, swing, t);
         let rename = |e: ConfigError| match e {
             ConfigError::OutOfRange { field, expected } => ConfigError::OutOfRange {
                 field: gain_field(field),
@@ -250,13 +233,39 @@ fn swing_hold_time_constants<T: Real>(
     n
 }
 
+/// The hold and the averaging window (s) of each gain-calibration level: the swing's hold
+/// ([`swing_hold_time_constants`]) and the configured window where the hold fits
+/// [`GAIN_CALIBRATION_MAX_HOLD_TIME`].
+fn hold_and_window<T: Real>(m: &MachineModel<T>, i1: T, swing: T, t: &DriveTuning<T>) -> (T, T) {
+    let hold = swing_hold_time_constants(m, i1, swing, t) * swing;
+    let budget = T::lit(GAIN_CALIBRATION_MAX_HOLD_TIME);
+    // A brake that holds the rotor (`startup.rotor_held`) leaves no swing to wait for:
+    // where the swing's hold would exceed the budget and skip the calibration, the levels
+    // are held for the current's settling alone (measured: the 8-pole traction IPMSM of
+    // `crates/fado-sim/tests/data/traction-ipm-saturated.toml`, swing hold 0.61 s,
+    // `crates/fado-sim/tests/gain_calibration.rs`). Elsewhere a hold beyond the budget
+    // is cut to it where a window of at most the budget meets the swing's bias bound
+    // ([`traded_window`]).
+    if t.startup.rotor_held && hold > budget {
+        (T::zero(), t.gain_calibration.time)
+    } else if hold > budget {
+        match traded_window(m, i1, swing, t) {
+            Some(window) => (budget, window),
+            None => (hold, t.gain_calibration.time),
+        }
+    } else {
+        (hold, t.gain_calibration.time)
+    }
+}
+
 /// The averaging window (s) that meets the swing's bias bound of
 /// [`swing_hold_time_constants`] with the hold cut to [`GAIN_CALIBRATION_MAX_HOLD_TIME`], if
 /// it is at most that budget too; `None` otherwise (the calibration is then skipped,
 /// `TooSlow`). The bound e^(−n) ≤ ε·R̂s·I₁·s_min·W/(3.46·λ̂f) is linear in the window W: the
 /// budget's n_b = budget/τ time constants need W = W₀·e^(−n_b)/bound(W₀), W₀ the configured
-/// `gain_calibration.time` (never shorter than W₀; none without a configured window). A window grows only on a rotor whose
-/// resistive drop is large against its magnet flux (R̂s·I₁/λ̂f): the 42-pole robot-joint
+/// `gain_calibration.time` (never shorter than W₀; none without a configured window). A
+/// window grows only on a rotor whose resistive drop is large against its magnet flux
+/// (R̂s·I₁/λ̂f): the 42-pole robot-joint
 /// motor of `crates/fado-sim/tests/data/unseen/` (τ = 0.26 s, 0.79 τ in the budget) is
 /// averaged over 0.10 s; the TooSlow presets (hoverboard hub, 50 kW IPMSM, 5 kW PM-SyRM)
 /// would need 0.6–10 s and stay uncalibrated. Uncalibrated, that motor's 0.5 % mismatch walks
