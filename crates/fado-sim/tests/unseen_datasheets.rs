@@ -216,7 +216,9 @@ fn a_42_pole_robot_joint_motor_passes_its_low_speed_scenarios() {
 /// 0.42 / 0.42 rad (seeds 1 / 2), both at the loaded zero-speed hold after a run at speed: R̂s
 /// climbs to 1.172 Ω (+3.7 %) at 1000 r/min and is still 1.137–1.15 Ω there, a drop error of
 /// 0.6–1.8 % of Rs·I, beyond the 0.3 % this winding tolerates near zero speed
-/// (`fado_core::machine_checks::low_speed_limit`).
+/// (`fado_core::machine_checks::low_speed_limit`). The climb grows with ω·Ts (0.22 rad per
+/// sample at 1000 r/min on its 5 kHz carrier): with an ideal inverter and matched sensors
+/// R̂s reaches 1.184 Ω, on a 10 kHz carrier 1.150 Ω (`fullrange` 0.41 rad).
 #[test]
 #[ignore = "robot-joint motor: 0.68-0.71 rad at fullrange's loaded zero-speed hold"]
 fn a_42_pole_robot_joint_motor_holds_zero_speed_after_its_top_speed() {
