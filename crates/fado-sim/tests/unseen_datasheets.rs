@@ -243,6 +243,29 @@ fn a_14_pole_gimbal_motor_passes_its_low_speed_scenarios() {
     at_seed_1("gimbal-gbm5208-200t-4s", &["reversal", "stops"]);
 }
 
+/// The gimbal motor with its current sensors calibrated: told that a brake holds the rotor
+/// through the start-up (`[controller.startup] rotor_held`, each calibration level held for
+/// the current's settling alone), it passes `reversal` (0.014 / 0.092 rad near zero speed) at
+/// seeds 1 / 2 with its rotor free: the method holds its angle through a reversal on a winding
+/// whose drop is 1.9 × its back-EMF once the sensors' gains are matched. Its `stops` reach
+/// 0.166 / 0.264 rad over the run (0.25 allowed; seed 2 misses).
+#[test]
+fn the_gimbal_motor_with_calibrated_sensors_passes_its_reversal() {
+    let name = "gimbal-gbm5208-200t-4s";
+    let mut missed = Vec::new();
+    for seed in [1, 2] {
+        let text = format!(
+            "{}\n[current_sensor]\nseed = {seed}\n[controller.startup]\nrotor_held = true\n",
+            file(name)
+        );
+        let out = simulate("reversal", Some(&text), false, None).unwrap();
+        if !out.passed {
+            missed.push(format!("reversal seed {seed}: {:?}", out.checks));
+        }
+    }
+    assert!(missed.is_empty(), "{name} missed: {missed:?}");
+}
+
 /// The gimbal motor's configuration is run with the warning on `rs` that names its ratio,
 /// the keys and the speed (2.3 % of rated) below which its low-speed angle is beyond the
 /// criterion.
