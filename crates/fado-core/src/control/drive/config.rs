@@ -43,7 +43,7 @@ impl<T: Real> DriveConfig<T> {
     /// The start-up gain calibration's configuration in absolute units: upper level
     /// `gain_calibration.current_ratio` × the rated current (at most the current limit),
     /// settling 5·max(L̂d/R̂s, 1/ωc) per level, window `gain_calibration.time` (longer where
-    /// a hold beyond the budget is traded for it, [`hold_and_window`]).
+    /// a hold beyond the budget is traded for it, `hold_and_window`).
     pub fn gain_calibration_config(&self) -> Result<GainCalibrationConfig<T>, ConfigError> {
         self.machine.validate()?;
         let t = &self.tuning;
