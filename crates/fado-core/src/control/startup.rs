@@ -466,7 +466,14 @@ impl<T: Real> AngleSearch<T> {
         let (s2, _) = (T::lit(2.0) * (axis - theta)).step_sin_cos_any();
         let saliency = (self.l_max - self.l_min) / (self.l_max + self.l_min);
         if saliency * s2.abs() <= T::lit(MAX_CROSS_SHARE) {
-            axis
+            return axis;
+        }
+        // The q axis is the rotor's other principal axis: no current across it whatever the
+        // saliency, and it lies within asin(min_observability) of the phase the d axis
+        // leaves without current, every phase carrying at least half of it there.
+        let q = crate::wrap_angle(theta + T::lit(core::f64::consts::FRAC_PI_2));
+        if GainCalibration::observability(q) >= min_observability {
+            q
         } else {
             theta
         }
