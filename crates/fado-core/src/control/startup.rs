@@ -449,11 +449,17 @@ impl<T: Real> AngleSearch<T> {
     /// [`StartupTuning::rotor_held`]): `theta`, or with `rotor_held` and a share of the
     /// current in some phase below `min_observability` there, the nearest k·π/3.
     pub fn gain_axis(&self, theta: T, min_observability: T) -> T {
+        self.gain_axis_on_q(theta, min_observability).0
+    }
+
+    /// [`gain_axis`](Self::gain_axis), and whether it is the rotor's q axis (its current
+    /// then settles with L̂q, not L̂d).
+    pub fn gain_axis_on_q(&self, theta: T, min_observability: T) -> (T, bool) {
         if !self.tuning.rotor_held
             || !theta.is_finite()
             || GainCalibration::observability(theta) >= min_observability
         {
-            return theta;
+            return (theta, false);
         }
         let sixth = T::pi() / T::lit(3.0);
         // (−π, π] + π → (0, 2π]: k in 0..=6, k·π/3 − π a multiple of π/3.
@@ -466,16 +472,16 @@ impl<T: Real> AngleSearch<T> {
         let (s2, _) = (T::lit(2.0) * (axis - theta)).step_sin_cos_any();
         let saliency = (self.l_max - self.l_min) / (self.l_max + self.l_min);
         if saliency * s2.abs() <= T::lit(MAX_CROSS_SHARE) {
-            return axis;
+            return (axis, false);
         }
         // The q axis is the rotor's other principal axis: no current across it whatever the
         // saliency, and it lies within asin(min_observability) of the phase the d axis
         // leaves without current, every phase carrying at least half of it there.
         let q = crate::wrap_angle(theta + T::lit(core::f64::consts::FRAC_PI_2));
         if GainCalibration::observability(q) >= min_observability {
-            q
+            (q, true)
         } else {
-            theta
+            (theta, false)
         }
     }
 

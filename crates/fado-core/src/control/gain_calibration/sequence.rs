@@ -8,6 +8,26 @@ impl<T: Real> GainCalibration<T> {
     /// Starts the sequence along the axis at `angle` (the aligned rotor's d axis): skipped
     /// at once (no current) when unobservable. Returns whether it runs.
     pub fn start(&mut self, angle: T) -> bool {
+        self.hold_samples = self.hold_default;
+        self.start_held(angle)
+    }
+
+    /// [`start`](Self::start) along an axis whose current settles more slowly than the
+    /// configuration's: each level is held at least `hold_time` (s; a longer one than
+    /// `max_hold_time`, or a non-finite one, skips the calibration as too slow).
+    pub fn start_with_hold(&mut self, angle: T, hold_time: T) -> bool {
+        let n = hold_time / self.config.ts;
+        // NaN compares false: too slow.
+        if !(hold_time >= T::zero() && hold_time <= self.config.max_hold_time) {
+            self.stage = Stage::Idle;
+            self.status = GainCalibrationStatus::TooSlow;
+            return false;
+        }
+        self.hold_samples = self.hold_default.max(n.round().to_f64() as u32);
+        self.start_held(angle)
+    }
+
+    fn start_held(&mut self, angle: T) -> bool {
         if self.window_samples == 0 {
             self.status = GainCalibrationStatus::Off;
             return false;
