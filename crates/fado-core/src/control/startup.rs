@@ -96,7 +96,9 @@ pub struct StartupTuning<T> {
     /// once the drive is ready): the gain calibration may then run along an axis other than
     /// the rotor's d axis, whose torque the brake takes — the nearest of the six axes k·π/3
     /// (every phase carrying at least half the current) where the d axis leaves a phase with
-    /// too little (`gain_calibration_min_observability`). The start-up then leaves the
+    /// too little (`gain_calibration_min_observability`), or the rotor's q axis where a
+    /// salient rotor would drive too much of the level across that axis (each level then
+    /// held for L̂q's settling, 5·L̂q/R̂s). The start-up then leaves the
     /// release hold unarmed: the application arms it as it opens the brake
     /// ([`SensorlessDrive::arm_release_hold`](crate::control::SensorlessDrive::arm_release_hold)).
     /// Default false: a rotor that no brake holds is turned by any current off its d axis.
@@ -447,7 +449,9 @@ impl<T: Real> AngleSearch<T> {
 
     /// The gain calibration's axis for a rotor at `theta` (see
     /// [`StartupTuning::rotor_held`]): `theta`, or with `rotor_held` and a share of the
-    /// current in some phase below `min_observability` there, the nearest k·π/3.
+    /// current in some phase below `min_observability` there, the nearest k·π/3, or on a
+    /// salient rotor that would drive more than 20 % of the level across that axis, the q
+    /// axis θ + π/2.
     pub fn gain_axis(&self, theta: T, min_observability: T) -> T {
         self.gain_axis_on_q(theta, min_observability).0
     }

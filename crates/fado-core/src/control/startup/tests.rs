@@ -188,6 +188,38 @@ fn a_held_rotor_gets_the_nearest_well_observed_gain_axis_and_a_free_one_its_d_ax
 }
 
 #[test]
+fn a_held_salient_rotor_whose_nearest_axis_would_cross_calibrates_along_q() {
+    // Lq/Ld = 2 (saliency 1/3): at −1.66 rad (phase a at 8.7 % of the d current) the nearest
+    // k·π/3, −2π/3, is 0.44 rad off d and would drive 0.33·sin 0.87 = 26 % of the level
+    // across it; the q axis −1.66 + π/2 carries phase a at 99.6 % and b, c at about half.
+    let held = phase(
+        0.12e-3,
+        0.24e-3,
+        105.0,
+        StartupTuning {
+            rotor_held: true,
+            ..on()
+        },
+    );
+    let (axis, on_q) = held.gain_axis_on_q(-1.66, 0.2);
+    assert!(on_q);
+    assert!((axis - (-1.66 + core::f64::consts::FRAC_PI_2)).abs() < 1e-12);
+    assert!(GainCalibration::observability(axis) > 0.4);
+    // Where d is observed well enough (0.74 rad) or the rotor is round, not q.
+    assert_eq!(held.gain_axis_on_q(0.74, 0.2), (0.74, false));
+    let round = phase(
+        2.63e-3,
+        2.63e-3,
+        21.78,
+        StartupTuning {
+            rotor_held: true,
+            ..on()
+        },
+    );
+    assert!(!round.gain_axis_on_q(-1.66, 0.2).1);
+}
+
+#[test]
 fn the_motion_monitor_reads_the_rotors_travel_under_the_zero_vector() {
     // A non-salient machine (R, L, λf) shorted (v = 0), its rotor turning at 20 rad/s from
     // θ0 = 1: the current obeys L·di/dt = −R·i − jω·λf·e^(jθ). The monitor's reading is the
