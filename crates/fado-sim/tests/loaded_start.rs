@@ -282,3 +282,19 @@ fn the_saturated_traction_ipmsm_holds_its_rated_load_at_the_release() {
         assert!(back > 0.05, "seed {seed}: the load acted");
     }
 }
+
+/// The saturated traction IPMSM at `loaded-start` seed 2 (start angle −1.66 rad: the d axis
+/// leaves phase a at 0.087 of the current, inside the inverter's 3.44 A band at the 23 A
+/// standstill current). Its sensors' gain is calibrated along the held rotor's q axis (k only:
+/// 5·L̂q/R̂s = 0.275 s exceeds the 0.2 s hold), the drive is ready at 0.78 s and the brake
+/// opens at once; the release hold runs into the 1.84 × rated current limit, where the
+/// direct angle lags the rotor, and the catch misses by a little. Measured: backward travel
+/// 0.584 rad (≤ 0.5), max |θ − θ̂| from ready 0.259 rad (≤ 0.25), no trip, the lift at its
+/// commanded speed. Left uncalibrated, θ̂ settles 0.13 rad off under the brake and the rotor
+/// is lost (2.18 rad back).
+#[test]
+#[ignore = "traction IPMSM seed 2: 0.584 rad back, 0.259 rad from ready"]
+fn the_saturated_traction_ipmsm_holds_its_load_at_a_start_angle_that_starves_a_phase() {
+    let toml = made_up("traction-ipm-saturated");
+    lifts("traction-ipm-saturated", &toml, 2);
+}

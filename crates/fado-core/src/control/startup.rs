@@ -52,6 +52,18 @@ pub const POLARITY_PAIRS: u32 = 4;
 /// seed-2 angle) is calibrated; the Baldor PM-SyRM (0.51) reads it as motion.
 const MAX_CROSS_SHARE: f64 = 0.2;
 
+/// Largest share of the gain calibration's current across a turned axis at which a held rotor
+/// whose d axis is observed (some phase between `min_observability` and half the current)
+/// still turns to the nearest k·π/3, where every phase carries at least half: 0.05 \[A\].
+/// Every round rotor turns (nothing crosses); a salient one only within a few degrees of the
+/// axis (measured: a 32-pole torque IPMSM at 11 % and the 50 kW IPMSM at 18 % lose their
+/// loaded start at seed 4). The k of a phase at a fifth of the current misses the 5 %
+/// plausibility bound on the 50 W flat motor of `crates/fado-sim/tests/data/unseen/`
+/// (`loaded-start` seed 1, 0.74 rad: phase b at 0.217, `Implausible`), and its uncalibrated
+/// 0.5 % mismatch walks θ̂ 0.34 rad from the rotor after the release; along π/3 it is
+/// calibrated, 0.095 rad.
+const CROSS_FREE_SHARE: f64 = 0.05;
+
 /// Fewest samples of a pulse: the drive's computation delay puts the current's peak one
 /// sample after the pulse's end; with three samples the rise is mostly inductive.
 const MIN_PULSE_SAMPLES: usize = 3;
@@ -96,9 +108,11 @@ pub struct StartupTuning<T> {
     /// once the drive is ready): the gain calibration may then run along an axis other than
     /// the rotor's d axis, whose torque the brake takes — the nearest of the six axes k·π/3
     /// (every phase carrying at least half the current) where the d axis leaves a phase with
-    /// too little (`gain_calibration_min_observability`), or the rotor's q axis where a
+    /// too little (`gain_calibration_min_observability`) or where no more than 5 % of the
+    /// level crosses that axis (a round rotor), or the rotor's q axis where a
     /// salient rotor would drive too much of the level across that axis (each level then
-    /// held for L̂q's settling, 5·L̂q/R̂s). The start-up then leaves the
+    /// held for L̂q's settling, 5·L̂q/R̂s, at most 0.2 s: beyond, k only). The start-up then
+    /// leaves the
     /// release hold unarmed: the application arms it as it opens the brake
     /// ([`SensorlessDrive::arm_release_hold`](crate::control::SensorlessDrive::arm_release_hold)).
     /// Default false: a rotor that no brake holds is turned by any current off its d axis.
@@ -451,7 +465,8 @@ impl<T: Real> AngleSearch<T> {
     /// [`StartupTuning::rotor_held`]): `theta`, or with `rotor_held` and a share of the
     /// current in some phase below `min_observability` there, the nearest k·π/3, or on a
     /// salient rotor that would drive more than 20 % of the level across that axis, the q
-    /// axis θ + π/2.
+    /// axis θ + π/2. A held rotor observed at `theta` also turns to the nearest k·π/3 where
+    /// at most 5 % of the level crosses it ([`CROSS_FREE_SHARE`]: every round rotor).
     pub fn gain_axis(&self, theta: T, min_observability: T) -> T {
         self.gain_axis_on_q(theta, min_observability).0
     }
@@ -459,10 +474,7 @@ impl<T: Real> AngleSearch<T> {
     /// [`gain_axis`](Self::gain_axis), and whether it is the rotor's q axis (its current
     /// then settles with L̂q, not L̂d).
     pub fn gain_axis_on_q(&self, theta: T, min_observability: T) -> (T, bool) {
-        if !self.tuning.rotor_held
-            || !theta.is_finite()
-            || GainCalibration::observability(theta) >= min_observability
-        {
+        if !self.tuning.rotor_held || !theta.is_finite() {
             return (theta, false);
         }
         let sixth = T::pi() / T::lit(3.0);
@@ -475,7 +487,16 @@ impl<T: Real> AngleSearch<T> {
         // below MAX_CROSS_SHARE.
         let (s2, _) = (T::lit(2.0) * (axis - theta)).step_sin_cos_any();
         let saliency = (self.l_max - self.l_min) / (self.l_max + self.l_min);
-        if saliency * s2.abs() <= T::lit(MAX_CROSS_SHARE) {
+        let cross = saliency * s2.abs();
+        if GainCalibration::observability(theta) >= min_observability {
+            // Observed: the axis turns to k·π/3 only where nothing crosses it.
+            return if cross <= T::lit(CROSS_FREE_SHARE) {
+                (axis, false)
+            } else {
+                (theta, false)
+            };
+        }
+        if cross <= T::lit(MAX_CROSS_SHARE) {
             return (axis, false);
         }
         // The q axis is the rotor's other principal axis: no current across it whatever the

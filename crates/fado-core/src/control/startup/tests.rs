@@ -176,10 +176,12 @@ fn a_held_rotor_gets_the_nearest_well_observed_gain_axis_and_a_free_one_its_d_ax
     );
     let third = core::f64::consts::FRAC_PI_3;
     // −1.49 rad leaves phase a 8 % of the current: the held rotor's axis is −π/2 ± π/6's
-    // nearest multiple of π/3, −π/3; 0.74 rad is observed well enough (22 %) and is kept.
+    // nearest multiple of π/3, −π/3; 0.74 rad is observed (22 %), and this round rotor, which
+    // drives nothing across a turned axis, still turns to π/3 (every phase at half or more).
     assert_eq!(free.gain_axis(-1.49, 0.2), -1.49);
+    assert_eq!(free.gain_axis(0.74, 0.2), 0.74);
     assert!((held.gain_axis(-1.49, 0.2) + third).abs() < 1e-12);
-    assert_eq!(held.gain_axis(0.74, 0.2), 0.74);
+    assert!((held.gain_axis(0.74, 0.2) - third).abs() < 1e-12);
     for k in -3..=3 {
         let axis = held.gain_axis(k as f64 * third + 0.5, 0.99);
         let share = GainCalibration::observability(axis);
@@ -205,8 +207,11 @@ fn a_held_salient_rotor_whose_nearest_axis_would_cross_calibrates_along_q() {
     assert!(on_q);
     assert!((axis - (-1.66 + core::f64::consts::FRAC_PI_2)).abs() < 1e-12);
     assert!(GainCalibration::observability(axis) > 0.4);
-    // Where d is observed well enough (0.74 rad) or the rotor is round, not q.
+    // Where d is observed (0.74 rad) it stays: π/3 would carry 19 % of the level across it.
     assert_eq!(held.gain_axis_on_q(0.74, 0.2), (0.74, false));
+    // Within 0.075 rad of π/3 (at most 5 % across) it turns there.
+    let (near, q) = held.gain_axis_on_q(third - 0.07, 0.2);
+    assert!(!q && (near - third).abs() < 1e-12);
     let round = phase(
         2.63e-3,
         2.63e-3,
