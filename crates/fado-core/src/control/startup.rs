@@ -54,15 +54,17 @@ const MAX_CROSS_SHARE: f64 = 0.2;
 
 /// Largest share of the gain calibration's current across a turned axis at which a held rotor
 /// whose d axis is observed (some phase between `min_observability` and half the current)
-/// still turns to the nearest k·π/3, where every phase carries at least half: 0.05 \[A\].
-/// Every round rotor turns (nothing crosses); a salient one only within a few degrees of the
-/// axis (measured: a 32-pole torque IPMSM at 11 % and the 50 kW IPMSM at 18 % lose their
-/// loaded start at seed 4). The k of a phase at a fifth of the current misses the 5 %
+/// still turns to the nearest k·π/3, where every phase carries at least half: 0.002 \[A\].
+/// The current across the axis biases k by about half its share (measured on the 50 kW
+/// IPMSM at 1.0 rad, 5 % across π/3: k off by 2.4e-2 against a 5e-3 mismatch; at 11–18 % a
+/// 32-pole torque IPMSM and the 50 kW IPMSM lose their loaded start at seed 4): every round
+/// rotor turns (nothing crosses), a salient one only within a fraction of a degree of the
+/// axis, where d carries half the current in every phase anyway. The k of a phase at a fifth of the current misses the 5 %
 /// plausibility bound on the 50 W flat motor of `crates/fado-sim/tests/data/unseen/`
 /// (`loaded-start` seed 1, 0.74 rad: phase b at 0.217, `Implausible`), and its uncalibrated
 /// 0.5 % mismatch walks θ̂ 0.34 rad from the rotor after the release; along π/3 it is
 /// calibrated, 0.095 rad.
-const CROSS_FREE_SHARE: f64 = 0.05;
+const CROSS_FREE_SHARE: f64 = 0.002;
 
 /// Fewest samples of a pulse: the drive's computation delay puts the current's peak one
 /// sample after the pulse's end; with three samples the rise is mostly inductive.
@@ -108,7 +110,7 @@ pub struct StartupTuning<T> {
     /// once the drive is ready): the gain calibration may then run along an axis other than
     /// the rotor's d axis, whose torque the brake takes — the nearest of the six axes k·π/3
     /// (every phase carrying at least half the current) where the d axis leaves a phase with
-    /// too little (`gain_calibration_min_observability`) or where no more than 5 % of the
+    /// too little (`gain_calibration_min_observability`) or where no more than 0.2 % of the
     /// level crosses that axis (a round rotor), or the rotor's q axis where a
     /// salient rotor would drive too much of the level across that axis (each level then
     /// held for L̂q's settling, 5·L̂q/R̂s, at most 0.2 s: beyond, k only). The start-up then
@@ -466,7 +468,7 @@ impl<T: Real> AngleSearch<T> {
     /// current in some phase below `min_observability` there, the nearest k·π/3, or on a
     /// salient rotor that would drive more than 20 % of the level across that axis, the q
     /// axis θ + π/2. A held rotor observed at `theta` also turns to the nearest k·π/3 where
-    /// at most 5 % of the level crosses it ([`CROSS_FREE_SHARE`]: every round rotor).
+    /// at most 0.2 % of the level crosses it ([`CROSS_FREE_SHARE`]: every round rotor).
     pub fn gain_axis(&self, theta: T, min_observability: T) -> T {
         self.gain_axis_on_q(theta, min_observability).0
     }

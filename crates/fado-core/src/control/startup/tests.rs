@@ -209,8 +209,9 @@ fn a_held_salient_rotor_whose_nearest_axis_would_cross_calibrates_along_q() {
     assert!(GainCalibration::observability(axis) > 0.4);
     // Where d is observed (0.74 rad) it stays: π/3 would carry 19 % of the level across it.
     assert_eq!(held.gain_axis_on_q(0.74, 0.2), (0.74, false));
-    // Within 0.075 rad of π/3 (at most 5 % across) it turns there.
-    let (near, q) = held.gain_axis_on_q(third - 0.07, 0.2);
+    // 0.047 rad from π/3 (3 % across) it stays; within 0.002 rad (0.2 %) it turns there.
+    assert_eq!(held.gain_axis_on_q(1.0, 0.2), (1.0, false));
+    let (near, q) = held.gain_axis_on_q(third - 0.002, 0.2);
     assert!(!q && (near - third).abs() < 1e-12);
     let round = phase(
         2.63e-3,
