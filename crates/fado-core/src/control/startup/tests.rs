@@ -210,6 +210,7 @@ fn a_held_salient_rotor_whose_nearest_axis_would_cross_calibrates_along_q() {
     // Where d is observed (0.74 rad) it stays: π/3 would carry 19 % of the level across it.
     assert_eq!(held.gain_axis_on_q(0.74, 0.2), (0.74, false));
     // 0.047 rad from π/3 (3 % across) it stays; within 0.002 rad (0.2 %) it turns there.
+    let third = core::f64::consts::FRAC_PI_3;
     assert_eq!(held.gain_axis_on_q(1.0, 0.2), (1.0, false));
     let (near, q) = held.gain_axis_on_q(third - 0.002, 0.2);
     assert!(!q && (near - third).abs() < 1e-12);
