@@ -252,14 +252,14 @@ fn saturating_machines_find_their_axis_from_the_models_inductances() {
 
 #[test]
 fn the_made_up_20_pole_ipmsm_lifts_its_rated_load_at_every_seed() {
-    // A small flux (8 mWb) makes the loaded standstill's creep of θ̂ fast: at seed 2 the
-    // start-up cannot calibrate the sensors' 0.5 % gain mismatch on this salient rotor (the d
+    // A small flux (8 mWb) makes the loaded standstill's creep of θ̂ fast. At seed 2 the d
     // axis leaves phase a nearly without current and the nearest k·π/3 axis would drive 42 %
-    // of the level across it), and θ̂ creeps at about 1 rad/s under the rated current. The
-    // standstill probe holds it at 0.18 rad; its turn carried through the lift's limiter mode
-    // (`fado_core::control::standstill_probe`, "After the standstill") keeps it there:
-    // max |θ − θ̂| 0.235 rad at seed 2 (0.357 when the probe's turn stops with the
-    // standstill), 0.10 rad at seeds 1, 3, 4.
+    // of the level across this salient rotor: the start-up calibrates the sensors' 0.5 % gain
+    // mismatch along the q axis, which the brake holds (`fado_core::control::startup`,
+    // `gain_axis`). Measured: max |θ − θ̂| from ready 0.107 rad at seed 2, 0.108–0.112 rad at
+    // seeds 1, 3, 4. Uncalibrated, θ̂ creeps at about 1 rad/s under the rated current and the
+    // standstill probe holds it at 0.18 rad (0.242 rad from ready), its turn carried through
+    // the lift's limiter mode (`fado_core::control::standstill_probe`, "After the standstill").
     let toml = made_up("ipmsm-20p-48v-saturated");
     for seed in 1..=4 {
         lifts("ipmsm-20p-48v-saturated", &toml, seed);
@@ -281,4 +281,20 @@ fn the_saturated_traction_ipmsm_holds_its_rated_load_at_the_release() {
         let back = lifts("traction-ipm-saturated", &toml, seed);
         assert!(back > 0.05, "seed {seed}: the load acted");
     }
+}
+
+/// The saturated traction IPMSM at `loaded-start` seed 2 (start angle −1.66 rad: the d axis
+/// leaves phase a at 0.087 of the current, inside the inverter's 3.44 A band at the 23 A
+/// standstill current). Its sensors' gain is calibrated along the held rotor's q axis (k only:
+/// 5·L̂q/R̂s = 0.275 s exceeds the 0.2 s hold), the drive is ready at 0.78 s and the brake
+/// opens at once; the release hold runs into the 1.84 × rated current limit, where the
+/// direct angle lags the rotor, and the catch misses by a little. Measured: backward travel
+/// 0.584 rad (≤ 0.5), max |θ − θ̂| from ready 0.259 rad (≤ 0.25), no trip, the lift at its
+/// commanded speed. Left uncalibrated, θ̂ settles 0.13 rad off under the brake and the rotor
+/// is lost (2.18 rad back).
+#[test]
+#[ignore = "traction IPMSM seed 2: 0.584 rad back, 0.259 rad from ready"]
+fn the_saturated_traction_ipmsm_holds_its_load_at_a_start_angle_that_starves_a_phase() {
+    let toml = made_up("traction-ipm-saturated");
+    lifts("traction-ipm-saturated", &toml, 2);
 }

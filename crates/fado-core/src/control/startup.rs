@@ -52,6 +52,20 @@ pub const POLARITY_PAIRS: u32 = 4;
 /// seed-2 angle) is calibrated; the Baldor PM-SyRM (0.51) reads it as motion.
 const MAX_CROSS_SHARE: f64 = 0.2;
 
+/// Largest share of the gain calibration's current across a turned axis at which a held rotor
+/// whose d axis is observed (some phase between `min_observability` and half the current)
+/// still turns to the nearest k·π/3, where every phase carries at least half: 0.002 \[A\].
+/// The current across the axis biases k by about half its share (measured on the 50 kW
+/// IPMSM at 1.0 rad, 5 % across π/3: k off by 2.4e-2 against a 5e-3 mismatch; at 11–18 % a
+/// 32-pole torque IPMSM and the 50 kW IPMSM lose their loaded start at seed 4): every round
+/// rotor turns (nothing crosses), a salient one only within a fraction of a degree of the
+/// axis, where d carries half the current in every phase anyway. The k of a phase at a fifth of the current misses the 5 %
+/// plausibility bound on the 50 W flat motor of `crates/fado-sim/tests/data/unseen/`
+/// (`loaded-start` seed 1, 0.74 rad: phase b at 0.217, `Implausible`), and its uncalibrated
+/// 0.5 % mismatch walks θ̂ 0.34 rad from the rotor after the release; along π/3 it is
+/// calibrated, 0.095 rad.
+const CROSS_FREE_SHARE: f64 = 0.002;
+
 /// Fewest samples of a pulse: the drive's computation delay puts the current's peak one
 /// sample after the pulse's end; with three samples the rise is mostly inductive.
 const MIN_PULSE_SAMPLES: usize = 3;
@@ -96,7 +110,11 @@ pub struct StartupTuning<T> {
     /// once the drive is ready): the gain calibration may then run along an axis other than
     /// the rotor's d axis, whose torque the brake takes — the nearest of the six axes k·π/3
     /// (every phase carrying at least half the current) where the d axis leaves a phase with
-    /// too little (`gain_calibration_min_observability`). The start-up then leaves the
+    /// too little (`gain_calibration_min_observability`) or where no more than 0.2 % of the
+    /// level crosses that axis (a round rotor), or the rotor's q axis where a
+    /// salient rotor would drive too much of the level across that axis (each level then
+    /// held for L̂q's settling, 5·L̂q/R̂s, at most 0.2 s: beyond, k only). The start-up then
+    /// leaves the
     /// release hold unarmed: the application arms it as it opens the brake
     /// ([`SensorlessDrive::arm_release_hold`](crate::control::SensorlessDrive::arm_release_hold)).
     /// Default false: a rotor that no brake holds is turned by any current off its d axis.
@@ -447,13 +465,19 @@ impl<T: Real> AngleSearch<T> {
 
     /// The gain calibration's axis for a rotor at `theta` (see
     /// [`StartupTuning::rotor_held`]): `theta`, or with `rotor_held` and a share of the
-    /// current in some phase below `min_observability` there, the nearest k·π/3.
+    /// current in some phase below `min_observability` there, the nearest k·π/3, or on a
+    /// salient rotor that would drive more than 20 % of the level across that axis, the q
+    /// axis θ + π/2. A held rotor observed at `theta` also turns to the nearest k·π/3 where
+    /// at most 0.2 % of the level crosses it ([`CROSS_FREE_SHARE`]: every round rotor).
     pub fn gain_axis(&self, theta: T, min_observability: T) -> T {
-        if !self.tuning.rotor_held
-            || !theta.is_finite()
-            || GainCalibration::observability(theta) >= min_observability
-        {
-            return theta;
+        self.gain_axis_on_q(theta, min_observability).0
+    }
+
+    /// [`gain_axis`](Self::gain_axis), and whether it is the rotor's q axis (its current
+    /// then settles with L̂q, not L̂d).
+    pub fn gain_axis_on_q(&self, theta: T, min_observability: T) -> (T, bool) {
+        if !self.tuning.rotor_held || !theta.is_finite() {
+            return (theta, false);
         }
         let sixth = T::pi() / T::lit(3.0);
         // (−π, π] + π → (0, 2π]: k in 0..=6, k·π/3 − π a multiple of π/3.
@@ -465,10 +489,26 @@ impl<T: Real> AngleSearch<T> {
         // below MAX_CROSS_SHARE.
         let (s2, _) = (T::lit(2.0) * (axis - theta)).step_sin_cos_any();
         let saliency = (self.l_max - self.l_min) / (self.l_max + self.l_min);
-        if saliency * s2.abs() <= T::lit(MAX_CROSS_SHARE) {
-            axis
+        let cross = saliency * s2.abs();
+        if GainCalibration::observability(theta) >= min_observability {
+            // Observed: the axis turns to k·π/3 only where nothing crosses it.
+            return if cross <= T::lit(CROSS_FREE_SHARE) {
+                (axis, false)
+            } else {
+                (theta, false)
+            };
+        }
+        if cross <= T::lit(MAX_CROSS_SHARE) {
+            return (axis, false);
+        }
+        // The q axis is the rotor's other principal axis: no current across it whatever the
+        // saliency, and it lies within asin(min_observability) of the phase the d axis
+        // leaves without current, every phase carrying at least half of it there.
+        let q = crate::wrap_angle(theta + T::lit(core::f64::consts::FRAC_PI_2));
+        if GainCalibration::observability(q) >= min_observability {
+            (q, true)
         } else {
-            theta
+            (theta, false)
         }
     }
 

@@ -271,6 +271,24 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         (rot, self.calibration_compensation[1] - loss)
     }
 
+    /// Starts the gain calibration along [`gain_axis`](Self::gain_axis); along the rotor's q
+    /// axis each level is held for the settling of L̂q (5·L̂q/R̂s: the upper level is a
+    /// voltage step, which settles with the axis's own time constant), at most the hold
+    /// budget, beyond which only k is measured
+    /// ([`GainCalibration::start_with_hold`](crate::control::GainCalibration::start_with_hold)).
+    pub(super) fn start_gain_calibration(&mut self) {
+        let min = self.config.tuning.gain_calibration.min_observability;
+        let (axis, on_q) = self.startup.gain_axis_on_q(self.aligned_angle, min);
+        if on_q {
+            let hold = self
+                .config
+                .gain_calibration_settle_time(self.config.machine.lq);
+            self.gain.start_with_hold(axis, hold);
+        } else {
+            self.gain.start(axis);
+        }
+    }
+
     /// The gain calibration's axis: the aligned angle, or with a held rotor
     /// ([`StartupTuning::rotor_held`](crate::control::StartupTuning::rotor_held)) the
     /// nearest well-observed axis.

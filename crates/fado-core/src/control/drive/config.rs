@@ -53,11 +53,8 @@ impl<T: Real> DriveConfig<T> {
             t.gain_calibration.current_ratio,
         )?;
         let ratio = crate::real::min(ratio, t.current.limit_ratio);
-        let omega_c =
-            T::two_pi() * check::positive("current_bandwidth_hz", t.current.bandwidth_hz)?;
-        let tau_stator = m.ld / m.rs;
-        let tau = crate::real::max(tau_stator, T::one() / omega_c);
-        let settle = T::lit(GAIN_CALIBRATION_SETTLE_TIME_CONSTANTS) * tau;
+        check::positive("current_bandwidth_hz", t.current.bandwidth_hz)?;
+        let settle = self.gain_calibration_settle_time(m.ld);
         // On a rotor with L̂q > L̂d at most half of λ̂f/(L̂q − L̂d), so that the d-axis hold keeps
         // half the magnet's stiffness (as the commissioning's DC test, see
         // `commissioning::dc_level`): at λ̂f/(L̂q − L̂d) the reluctance torque cancels it and
@@ -111,6 +108,14 @@ impl<T: Real> DriveConfig<T> {
         };
         GainCalibration::new(config).map_err(rename)?;
         Ok(config)
+    }
+
+    /// The settling of a gain-calibration level along an axis of inductance `l` (H):
+    /// 5·max(l/R̂s, 1/ωc).
+    pub fn gain_calibration_settle_time(&self, l: T) -> T {
+        let omega_c = T::two_pi() * self.tuning.current.bandwidth_hz;
+        let tau = crate::real::max(l / self.machine.rs, T::one() / omega_c);
+        T::lit(GAIN_CALIBRATION_SETTLE_TIME_CONSTANTS) * tau
     }
 
     /// The configured current limit I_max in A.

@@ -240,8 +240,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             if let Some(out) = self.calibration_turn_step(i_abc, vdc) {
                 return Err(out);
             }
-            let axis = self.gain_axis();
-            self.gain.start(axis);
+            self.start_gain_calibration();
         }
         if self.gain.running() {
             return Err(self.gain_calibration_step(i_abc, vdc));

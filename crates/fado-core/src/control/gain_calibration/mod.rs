@@ -266,6 +266,12 @@ pub struct GainCalibration<T> {
     config: GainCalibrationConfig<T>,
     settle_samples: u32,
     hold_samples: u32,
+    /// The hold `new` derives from the configuration ([`start_with_hold`](Self::start_with_hold)
+    /// lengthens it for one calibration).
+    hold_default: u32,
+    /// The hold of this calibration is shorter than its axis's settling
+    /// ([`start_with_hold`](Self::start_with_hold)): k only, no resistance.
+    unsettled: bool,
     /// Settling or hold beyond `max_hold_time`: skipped.
     too_slow: bool,
     window_samples: u32,
@@ -367,6 +373,8 @@ impl<T: Real> GainCalibration<T> {
             config,
             settle_samples,
             hold_samples,
+            hold_default: hold_samples,
+            unsettled: false,
             too_slow,
             window_samples,
             stage: Stage::Idle,

@@ -8,6 +8,32 @@ impl<T: Real> GainCalibration<T> {
     /// Starts the sequence along the axis at `angle` (the aligned rotor's d axis): skipped
     /// at once (no current) when unobservable. Returns whether it runs.
     pub fn start(&mut self, angle: T) -> bool {
+        self.hold_samples = self.hold_default;
+        self.unsettled = false;
+        self.start_held(angle)
+    }
+
+    /// [`start`](Self::start) along an axis whose current settles more slowly than the
+    /// configuration's: each level is held at least `hold_time` (s). Beyond `max_hold_time`
+    /// the levels are held that long and only k is measured: the upper level is a voltage
+    /// step whose unsettled residue scales both phases alike (k keeps none of it) but biases
+    /// the resistance, which is then NaN. A non-finite `hold_time` skips the calibration as
+    /// too slow.
+    pub fn start_with_hold(&mut self, angle: T, hold_time: T) -> bool {
+        // NaN compares false: too slow.
+        if !(hold_time >= T::zero() && hold_time.is_finite()) {
+            self.stage = Stage::Idle;
+            self.status = GainCalibrationStatus::TooSlow;
+            return false;
+        }
+        let max_hold = self.config.max_hold_time;
+        self.unsettled = hold_time > max_hold;
+        let n = hold_time.step_min(max_hold) / self.config.ts;
+        self.hold_samples = self.hold_default.max(n.round().to_f64() as u32);
+        self.start_held(angle)
+    }
+
+    fn start_held(&mut self, angle: T) -> bool {
         if self.window_samples == 0 {
             self.status = GainCalibrationStatus::Off;
             return false;
@@ -201,7 +227,11 @@ impl<T: Real> GainCalibration<T> {
                 self.measured = k;
                 if (k - T::one()).abs() <= self.config.max_mismatch {
                     self.ratio = k;
-                    self.resistance = resistance_of(di, dv, k);
+                    self.resistance = if self.unsettled {
+                        T::zero() / T::zero()
+                    } else {
+                        resistance_of(di, dv, k)
+                    };
                     self.status = GainCalibrationStatus::Calibrated;
                 } else {
                     self.status = GainCalibrationStatus::Implausible;

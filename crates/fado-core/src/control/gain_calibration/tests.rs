@@ -175,6 +175,26 @@ fn too_slow_a_swing_or_a_zero_window_skips() {
 }
 
 #[test]
+fn a_longer_hold_lengthens_one_calibration_and_beyond_the_budget_measures_k_only() {
+    // (R, L) = (0.3 Ω, 3 mH): each level held 5·L/R = 50 ms. Along an axis of twice the
+    // inductance the caller asks 100 ms: two holds longer by 50 ms each; 0.3 s (beyond the
+    // 0.2 s budget) holds 0.2 s; a plain start afterwards holds 50 ms again.
+    let mut cal = GainCalibration::new(config(8.0, 0.3, 3e-3)).unwrap();
+    let base = cal.duration_samples();
+    assert!(cal.start_with_hold(0.0, 0.1));
+    assert_eq!(cal.duration_samples(), base + 1000);
+    assert!(cal.start_with_hold(0.0, 0.3));
+    assert_eq!(cal.duration_samples(), base + 3000);
+    assert!(!cal.start_with_hold(0.0, f64::NAN));
+    assert_eq!(cal.status(), GainCalibrationStatus::TooSlow);
+    assert!(cal.start(0.0));
+    assert_eq!(cal.duration_samples(), base);
+    // A shorter hold than the configured one keeps the configured one.
+    assert!(cal.start_with_hold(0.0, 0.01));
+    assert_eq!(cal.duration_samples(), base);
+}
+
+#[test]
 fn f32_identifies_the_mismatch_too() {
     let mut cal = GainCalibration::<f32>::new(GainCalibrationConfig {
         ts: 1e-4,

@@ -176,15 +176,54 @@ fn a_held_rotor_gets_the_nearest_well_observed_gain_axis_and_a_free_one_its_d_ax
     );
     let third = core::f64::consts::FRAC_PI_3;
     // −1.49 rad leaves phase a 8 % of the current: the held rotor's axis is −π/2 ± π/6's
-    // nearest multiple of π/3, −π/3; 0.74 rad is observed well enough (22 %) and is kept.
+    // nearest multiple of π/3, −π/3; 0.74 rad is observed (22 %), and this round rotor, which
+    // drives nothing across a turned axis, still turns to π/3 (every phase at half or more).
     assert_eq!(free.gain_axis(-1.49, 0.2), -1.49);
+    assert_eq!(free.gain_axis(0.74, 0.2), 0.74);
     assert!((held.gain_axis(-1.49, 0.2) + third).abs() < 1e-12);
-    assert_eq!(held.gain_axis(0.74, 0.2), 0.74);
+    assert!((held.gain_axis(0.74, 0.2) - third).abs() < 1e-12);
     for k in -3..=3 {
         let axis = held.gain_axis(k as f64 * third + 0.5, 0.99);
         let share = GainCalibration::observability(axis);
         assert!(share > 0.49, "{k}: {axis} {share}");
     }
+}
+
+#[test]
+fn a_held_salient_rotor_whose_nearest_axis_would_cross_calibrates_along_q() {
+    // Lq/Ld = 2 (saliency 1/3): at −1.66 rad (phase a at 8.7 % of the d current) the nearest
+    // k·π/3, −2π/3, is 0.44 rad off d and would drive 0.33·sin 0.87 = 26 % of the level
+    // across it; the q axis −1.66 + π/2 carries phase a at 99.6 % and b, c at about half.
+    let held = phase(
+        0.12e-3,
+        0.24e-3,
+        105.0,
+        StartupTuning {
+            rotor_held: true,
+            ..on()
+        },
+    );
+    let (axis, on_q) = held.gain_axis_on_q(-1.66, 0.2);
+    assert!(on_q);
+    assert!((axis - (-1.66 + core::f64::consts::FRAC_PI_2)).abs() < 1e-12);
+    assert!(GainCalibration::observability(axis) > 0.4);
+    // Where d is observed (0.74 rad) it stays: π/3 would carry 19 % of the level across it.
+    assert_eq!(held.gain_axis_on_q(0.74, 0.2), (0.74, false));
+    // 0.047 rad from π/3 (3 % across) it stays; within 0.002 rad (0.2 %) it turns there.
+    let third = core::f64::consts::FRAC_PI_3;
+    assert_eq!(held.gain_axis_on_q(1.0, 0.2), (1.0, false));
+    let (near, q) = held.gain_axis_on_q(third - 0.002, 0.2);
+    assert!(!q && (near - third).abs() < 1e-12);
+    let round = phase(
+        2.63e-3,
+        2.63e-3,
+        21.78,
+        StartupTuning {
+            rotor_held: true,
+            ..on()
+        },
+    );
+    assert!(!round.gain_axis_on_q(-1.66, 0.2).1);
 }
 
 #[test]
