@@ -14,7 +14,7 @@
 //! | torque | T_rated / 1.5·p·λf·I (error), / MTPA torque (warning) | outside 0.6–1.3 (rms for peak: 1.41; λf line-to-line: 0.58; inside it, a slip whose undoing brings it within 0.9–1.1) | outside 0.3–3; 0.4–0.55 of the MTPA torque with even p: a pole count |
 //! | DC link range | Vdc | — | beyond any drive (checked after the machine's own fields) |
 //! | back-EMF | ω·λf / (Vdc/√3) | — | above 2 |
-//! | DC link | \|v_rated\| / (Vdc/√3) | below 0.2 | below 0.1 (ratings / 10?) |
+//! | DC link | \|v_rated\| / (Vdc/√3) | below 0.2, above [`DC_LINK_SHORT`] (mains rms for the link? no-load speed?) | below 0.1 (ratings / 10?) |
 //! | reactance | L·I / λf | above 5 | above 50 (mH for H?) |
 //! | resistance | R·I / (ω·λf) | above 0.5 | above 2 (mΩ for Ω? r/s for r/min?) |
 //! | time constant | min(Ld, Lq)/R | above 2 s | — |
@@ -72,9 +72,23 @@ pub const RANGES: [(&str, f64, &str); 10] = [
 /// Resistive drop at rated current per unit of the rated back-EMF, Rs·I/(ω·λf), above which
 /// the data are refused: 2, a copper loss at the rated point twice its mechanical power
 /// (efficiency below 33 %). Real machines have 0.005–0.35 (the repository's test machines: at
-/// most 0.33, a 6S drone motor); a resistance in mΩ for Ω, or a rated speed in r/s or rad/s
+/// most 0.33, a 6S drone motor), motors wound for torque near standstill more (the 42-pole
+/// robot-joint motor of `crates/fado-sim/tests/data/unseen/` 0.71, the GBM5208 gimbal motor
+/// 1.9 at an assumed 100 r/min; warned); a resistance in mΩ for Ω, or a rated speed in r/s or rad/s
 /// for r/min, gives 6–1000.
 pub const RESISTANCE_ERROR: f64 = 2.0;
+
+/// The rated point's phase voltage |v_rated| (MTPA at rated current and speed) per unit of
+/// the DC link's linear range Vdc/√3 above which the ratings are reported as beyond the link:
+/// 1.15, above six-step operation's fundamental (2/π)·Vdc = 1.10 × Vdc/√3, the most any
+/// inverter makes. The drive still reaches rated speed by field weakening, with less than
+/// rated torque there (the 15 kW PM-SyRM of `crates/fado-sim/tests/data/unseen/pmsrm-15kw-520v.toml`
+/// on a 520 V link: 1.40); the usual slips are a DC link given as the mains' rms voltage (√2
+/// short) and a no-load speed given as the rated speed. Multirotor motors rated near their
+/// no-load speed sit at 1.04–1.10. Checked on constant inductances only: a saturating
+/// machine's unsaturated inductances overstate its flux at rated current (the saturated
+/// presets' 1.1–1.8).
+pub const DC_LINK_SHORT: f64 = 1.15;
 
 /// T_rated over the MTPA torque at rated current above which the ratings are reported as
 /// unusual: 1.3. Real machines sit at 0.7–1.2 (the saturated ones below 1, as their
@@ -281,8 +295,14 @@ fn check_dc_link(m: &MachineModel<f64>, out: &mut impl Sink) {
         out.push(Finding::BackEmf { ratio: emf_ratio });
         return;
     }
-    let v = ratings::rated_point_voltage(m) / v_max;
-    if v < 0.1 {
+    let needed = ratings::rated_point_voltage(m);
+    let v = needed / v_max;
+    if v > DC_LINK_SHORT && m.magnetics.is_linear() {
+        out.push(Finding::DcLinkShort {
+            needed,
+            available: v_max,
+        });
+    } else if v < 0.1 {
         out.push(Finding::DcLinkOversized {
             ratio: v,
             severity: Severity::Error,

@@ -238,36 +238,22 @@ pub fn inverter_values(
 /// gives it the 2.5 µs dead time of 5 kHz from Python as from its file, not the 1.25 µs of
 /// 10 kHz. Unchanged inputs give the same values.
 pub fn rederive_inverter(cfg: &mut crate::SimConfig) {
-    let derived = |key: &str| {
-        cfg.derived
-            .iter()
-            .any(|d| d.key == format!("inverter.{key}"))
-    };
-    let inv = &cfg.inverter;
-    let mut given = toml::Table::new();
-    for (key, value) in [
-        ("dc_voltage", inv.dc_voltage),
-        ("switching_frequency", inv.switching_frequency),
-        ("dead_time", inv.dead_time),
-        ("threshold_voltage", inv.threshold_voltage),
-        ("current_band", inv.current_band),
-    ] {
-        if !derived(key) {
-            given.insert(key.into(), toml::Value::Float(value));
-        }
-    }
     let machine = MachineModel {
         dc_voltage: cfg.inverter.dc_voltage,
         ..cfg.motor
     };
+    let mut given = toml::Table::new();
+    for key in INVERTER_DERIVED {
+        let full = format!("inverter.{key}");
+        if let Some(value) = inverter_slot(&mut cfg.inverter, key)
+            && !cfg.derived.iter().any(|d| d.key == full)
+        {
+            given.insert(key.into(), toml::Value::Float(*value));
+        }
+    }
     for (key, value) in inverter_values(&machine, &given) {
-        let slot = match key {
-            "dc_voltage" => &mut cfg.inverter.dc_voltage,
-            "switching_frequency" => &mut cfg.inverter.switching_frequency,
-            "dead_time" => &mut cfg.inverter.dead_time,
-            "threshold_voltage" => &mut cfg.inverter.threshold_voltage,
-            "current_band" => &mut cfg.inverter.current_band,
-            _ => continue,
+        let Some(slot) = inverter_slot(&mut cfg.inverter, key) else {
+            continue;
         };
         *slot = value;
         let full = format!("inverter.{key}");
@@ -275,6 +261,31 @@ pub fn rederive_inverter(cfg: &mut crate::SimConfig) {
             d.value = value;
         }
     }
+}
+
+/// The `[inverter]` keys that [`inverter_values`] derives when a file leaves them out.
+const INVERTER_DERIVED: [&str; 5] = [
+    "dc_voltage",
+    "switching_frequency",
+    "dead_time",
+    "threshold_voltage",
+    "current_band",
+];
+
+/// The field of `inv` that the `[inverter]` key `key` sets, if it is one of
+/// [`INVERTER_DERIVED`].
+fn inverter_slot<'a>(
+    inv: &'a mut crate::inverter::InverterParams,
+    key: &str,
+) -> Option<&'a mut f64> {
+    Some(match key {
+        "dc_voltage" => &mut inv.dc_voltage,
+        "switching_frequency" => &mut inv.switching_frequency,
+        "dead_time" => &mut inv.dead_time,
+        "threshold_voltage" => &mut inv.threshold_voltage,
+        "current_band" => &mut inv.current_band,
+        _ => return None,
+    })
 }
 
 /// `toml` (a [`crate::SimConfig::to_toml`] document) with each derived key's line followed by

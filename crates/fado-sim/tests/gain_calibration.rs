@@ -247,3 +247,75 @@ fn a_load_arriving_during_the_calibration_ends_it_and_the_drive_takes_the_load()
     assert_eq!(status, GainCalibrationStatus::Calibrated);
     assert!(err < 0.25, "{err}");
 }
+
+/// The start-up of the machine file `toml` at `angle` with its rotor on a brake that the
+/// drive is told of (`startup.rotor_held`), speed reference 0: the drive's ratio, the
+/// sensors' true ratio, the status and the time the drive starts (s).
+fn braked_start_up(toml: &str, angle: f64) -> (f64, f64, GainCalibrationStatus, f64) {
+    start_up_of(&format!(
+        "{toml}\n[controller.startup]\nrotor_held = true\n\
+         [simulation]\ninitial_angle = {angle}\nbrake = true\nbrake_release_at = 10.0\n"
+    ))
+}
+
+/// [`braked_start_up`] of the whole configuration `toml`.
+fn start_up_of(toml: &str) -> (f64, f64, GainCalibrationStatus, f64) {
+    let mut cfg = fado_sim::config::SimConfig::from_toml(toml).unwrap();
+    cfg.speed_reference = Profile::constant(0.0);
+    let k_true = (1.0 + cfg.current_sensor.gain_error_a) / (1.0 + cfg.current_sensor.gain_error_b);
+    let (d, _, t) = run_start_up(&cfg);
+    (
+        d.current_gain_ratio(),
+        k_true,
+        d.gain_calibration_status(),
+        t,
+    )
+}
+
+#[test]
+fn a_braked_rotor_too_heavy_for_the_swing_hold_is_calibrated_on_the_settling_alone() {
+    // Free, these rotors' swing about the d current needs more than the 0.2 s hold budget
+    // (4 time constants: traction IPMSM 0.61 s, 50 kW IPMSM 0.67 s, PM-SyRM 1.0 s, hub motor
+    // 0.89 s) and the calibration is skipped (`TooSlow`). On a brake the drive knows of
+    // nothing swings. Measured (this code, default sensors with 0.5 % on phase a,
+    // switching-resolved): |k − k_true| ≤ 1.9e-3 (the saturated traction IPMSM at 0.3 rad),
+    // ≤ 1.6e-3 on the three presets; at least 62 % of the mismatch removed.
+    for (name, toml) in [
+        (
+            "traction-ipm-saturated",
+            include_str!("data/traction-ipm-saturated.toml"),
+        ),
+        (
+            "ipmsm-gem-50k",
+            fado_sim::presets::find("ipmsm-gem-50k").unwrap().toml,
+        ),
+        (
+            "pmsyrm-5k",
+            fado_sim::presets::find("pmsyrm-5k").unwrap().toml,
+        ),
+        (
+            "hub-hoverboard-48v",
+            fado_sim::presets::find("hub-hoverboard-48v").unwrap().toml,
+        ),
+    ] {
+        for angle in [0.3, 0.0, 1.0, 2.0] {
+            let (k, k_true, status, t) = braked_start_up(toml, angle);
+            println!(
+                "{name:24} θ0 {angle:4.1}: k {k:.5} (true {k_true:.5}, error {:+.1e}) {status:?}, \
+                 start-up {t:.3} s",
+                k - k_true
+            );
+            assert_eq!(
+                status,
+                GainCalibrationStatus::Calibrated,
+                "{name} at {angle}"
+            );
+            assert!((k - k_true).abs() < 2.5e-3, "{name} at {angle}: k {k}");
+        }
+        // Free, the same rotor is still skipped: nothing holds it through the levels.
+        let (k, _, status, _) =
+            start_up_of(&format!("{toml}\n[simulation]\ninitial_angle = 0.3\n"));
+        assert_eq!(status, GainCalibrationStatus::TooSlow, "{name}");
+        assert_eq!(k, 1.0);
+    }
+}

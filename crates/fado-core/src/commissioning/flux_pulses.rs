@@ -10,6 +10,16 @@ use crate::{Ab, Real};
 /// Bipolar pairs of pulses (directions k·π/6 of the voltage, each followed at once by its
 /// opposite), in the order that cancels the reluctance torque's impulse of a pair (∝ sin 2φ)
 /// with the next one: 0°, 90°, then 30° with 150°, 60° with 120°.
+///
+/// Every pair starts with its positive pulse, so the magnet torque turns the rotor forward
+/// over both the 60° and the 120° pair and their turns add up over the pulses. Starting the
+/// 120° pair with its negative pulse instead halves that total (the 6SM107S servo of
+/// `crates/fado-sim/tests/data/unseen/servo-6sm107s-3000.toml`: 0.163 → 0.088 rad by the plant;
+/// the paper's motor 0.047 → 0.025) but does not unbias the fit, which follows the turn
+/// within each pair (`pulse_pair_end`), not the total: its spurious inductance change rises
+/// (servo 7.3 → 10.3 %, the paper's motor 0.7 → 1.9 %, the 5 kW PM-SyRM 11.4 → 18.1 % with
+/// 0.013 → 0.071 rad within a pair, as the reluctance torque's cancellation between pairs is
+/// lost; ipmsm-2k2-qsat's largest L̂q error 0.71 → 1.08 %), so the order stays.
 const PAIR_ANGLES_DEG: [f64; 3] = [0.0, 60.0, 120.0];
 
 /// Samples per rise of a pulse on the identified inductance, at most (the pulse voltage is
@@ -31,6 +41,19 @@ const MIN_RISE_SAMPLES: f64 = 4.0;
 /// presets' heavy rotors turn 0.012–0.10 rad with 16-sample rises and are identified within
 /// 1 % (docs/results/commissioning-magnetics.md).
 const MOTION_TARGET: f64 = 0.05;
+
+/// The back-EMF at a pair's peak speed over the pulse voltage that [`pulse_plan`] allows
+/// full-length rises: 0.2. A pair of rises of N samples peaks at the speed
+/// p·T_p·N·Ts/J (electrical), whose back-EMF against the pulse voltage L̂·I_p/(N·Ts) is
+/// turn·λf/(2·L̂·I_p) with the pair's turn 2·p·T_p·(N·Ts)²/J: a rotor with a strong magnet for
+/// its inductance (λf/(L̂·I_p) 7 on the 7.2 kW 6SM107S servo) reaches it long before the turn
+/// reaches [`MOTION_TARGET`] × 4. Above it the next pulses start on a turning rotor whose
+/// back-EMF adds to the pulse voltage: full-length rises (0.41) swing the servo with
+/// J = 3e-3 kg·m² between ±300 r/min and trip at 41 A (OverCurrent in `Magnetics`). The
+/// presets of `motors/` reach at most 0.064 (pmsm-gem-1k1-measured) and keep full-length
+/// rises; where it is above, the rise is the length that keeps it at the limit, repeated as
+/// a light rotor's.
+const EMF_LIMIT: f64 = 0.2;
 
 /// Rises are shortened only where [`pulse_plan`]'s length is below this fraction of
 /// [`RISE_SAMPLES`], i.e. where full-length pulses would turn the rotor by more than 4 ×
@@ -104,9 +127,12 @@ pub(super) fn pulse_plan<T: Real>(cfg: &CommissioningConfig<T>, i_p: T) -> (T, u
     let np = &cfg.nameplate;
     let p = T::lit(np.pole_pairs as f64);
     let torque = T::lit(1.5) * p * (np.flux_linkage + (np.lq - np.ld).abs() * i_p) * i_p;
-    let n = (T::lit(MOTION_TARGET) * np.inertia / (T::lit(2.0) * p * torque)).sqrt()
-        / cfg.sample_period;
-    rise_repeats(n)
+    let rise_for =
+        |turn: T| (turn * np.inertia / (T::lit(2.0) * p * torque)).sqrt() / cfg.sample_period;
+    // The back-EMF at the pair's peak speed over the pulse voltage L̂·I_p/(N·Ts) is
+    // turn·λf/(2·L̂·I_p): the turn that keeps it at EMF_LIMIT.
+    let emf_turn = T::lit(2.0 * EMF_LIMIT) * np.ld.min(np.lq) * i_p / np.flux_linkage;
+    rise_repeats(rise_for(T::lit(MOTION_TARGET)), rise_for(emf_turn))
 }
 
 /// Whether the pulses adapt to the machine (the `adapted` pulses of `FluxPulses`): where a
@@ -120,13 +146,21 @@ pub(super) fn adapted_pulses<T: Real>(rise: T, l_min: T, rs: T, ts: T) -> bool {
         || l_min / (T::lit(RISE_SAMPLES) * ts) < T::lit(RESISTIVE_MARGIN) * rs
 }
 
-/// [`pulse_plan`]'s rise length (clamped) and repeats for `n` samples per rise.
-fn rise_repeats<T: Real>(n: T) -> (T, usize) {
+/// [`pulse_plan`]'s rise length (clamped) and repeats for `n` samples per rise by the turn
+/// and `n_emf` by the back-EMF ([`EMF_LIMIT`]).
+fn rise_repeats<T: Real>(n: T, n_emf: T) -> (T, usize) {
     let full = T::lit(RISE_SAMPLES);
-    if !n.is_finite() || n >= T::lit(LIGHT_RATIO) * full {
+    let turn_ok = !n.is_finite() || n >= T::lit(LIGHT_RATIO) * full;
+    let emf_ok = !n_emf.is_finite() || n_emf >= full;
+    if turn_ok && emf_ok {
         return (full, 1);
     }
-    let n = n.max(T::lit(MIN_RISE_SAMPLES));
+    let n = match (turn_ok, emf_ok) {
+        (true, _) => n_emf,
+        (false, true) => n,
+        (false, false) => n.min(n_emf),
+    };
+    let n = n.min(full).max(T::lit(MIN_RISE_SAMPLES));
     let halves = (full / n * T::lit(0.5) - T::lit(1e-9)).index_floor(8) + 1;
     (n, 2 * halves)
 }
@@ -562,7 +596,10 @@ impl<T: Real> Commissioning<T> {
         // foresee); at the shortest rises the pulses run on and the fit reports the motion.
         let min = T::lit(MIN_RISE_SAMPLES);
         if delta.abs() > T::lit(PULSE_MOTION_LIMIT) && p.rise > min {
-            let (rise, repeats) = rise_repeats((p.rise * T::lit(0.5)).max(min));
+            // Both bounds at the halved length: the turn's alone would take a half of a
+            // full-length rise (8 samples, [`LIGHT_RATIO`]) for full length again.
+            let halved = (p.rise * T::lit(0.5)).max(min);
+            let (rise, repeats) = rise_repeats(halved, halved);
             self.plan_pulses(rise, repeats);
             return true;
         }

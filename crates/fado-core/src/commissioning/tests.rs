@@ -152,9 +152,19 @@ fn light_rotors_get_short_alternating_pulses() {
     assert_eq!(repeats, 4);
     assert!(n * repeats as f64 >= 16.0);
     assert_eq!(plan(2e-2), (16.0, 1));
-    // Full-length rises would turn a 1.3e-3 kg·m² rotor by 0.07 rad (its rise 13.5 samples):
-    // below four times the target, they stay.
-    assert_eq!(plan(1.3e-3), (16.0, 1));
+    // Full-length rises would turn a 1.3e-3 kg·m² rotor by 0.07 rad, below four times the
+    // target, but its back-EMF at the pair's peak speed would be 0.07·λf/(2·L̂d·I_p) = 0.27 of
+    // the pulse voltage: the rise is the one that keeps it at 0.2 (a turn of 0.0514 rad).
+    let emf_turn: f64 = 0.4 * 1.5e-3 * 6.0 / 0.07;
+    let expected = (emf_turn * 1.3e-3 / (2.0 * 5.0 * 3.555)).sqrt() / 1e-4;
+    let (n, repeats) = plan(1.3e-3);
+    assert!(
+        (n - expected).abs() < 1e-9 && (13.0..14.0).contains(&n),
+        "{n}"
+    );
+    assert_eq!(repeats, 2);
+    // A rotor of 2e-3 kg·m² keeps it below 0.2 with full-length rises.
+    assert_eq!(plan(2e-3), (16.0, 1));
     assert_eq!(plan(1e-7), (4.0, 4));
     assert_eq!(plan(f64::NAN), (16.0, 1));
 }

@@ -125,6 +125,30 @@ impl<T: Real> SaturatedReferences<T> {
         (psi.d * i.q - psi.q * i.d, psi)
     }
 
+    /// [`SaturatedReferences::torque_flux_warm`] where ψ(i) is a solve (the algebraic model),
+    /// `i` within `reach` of the current `at` whose tangent plane `warm` is: ψ from the plane
+    /// alone, off the root by the curvature times |i − at|² (10⁻¹² of the flux for a reach of
+    /// 10⁻⁶ of the rated current, below the drive's other roundings), where the solve would
+    /// take an evaluation of i(ψ) and its Jacobian to confirm the same prediction. The drive's
+    /// realised torque at the reference, a settled Newton step from the torque solve's last
+    /// evaluation. A map (a direct lookup) and a farther `i` take `torque_flux_warm`.
+    #[inline]
+    pub fn torque_flux_near(
+        &self,
+        i: Dq<T>,
+        at: Dq<T>,
+        reach: T,
+        warm: &mut FluxWarmStart<T>,
+    ) -> (T, Dq<T>) {
+        let solved = matches!(self.model, Magnetics::Saturation(_));
+        if solved && warm.is_set() && (i - at).norm() <= reach {
+            let psi = warm.prediction(i);
+            *warm = warm.moved(i, psi);
+            return (psi.d * i.q - psi.q * i.d, psi);
+        }
+        self.torque_flux_warm(i, warm)
+    }
+
     /// τ at `i` with its derivative along a path of slope di_d/di_q = `did_diq`, ψ(i) solved
     /// from `warm` as in [`SaturatedReferences::torque_flux_warm`] (`warm` set to the
     /// tangent plane there), and that ψ:

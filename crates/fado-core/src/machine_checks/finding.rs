@@ -92,6 +92,14 @@ pub enum Finding {
         /// Warning or error.
         severity: Severity,
     },
+    /// The rated point needs more voltage than the DC link makes: rated speed at rated
+    /// current only by field weakening.
+    DcLinkShort {
+        /// |v_rated| on MTPA at rated current and speed, V (phase peak).
+        needed: f64,
+        /// Vdc/√3, V.
+        available: f64,
+    },
     /// An inductance is large for the rated current and flux linkage.
     Reactance {
         /// `ld` or `lq`.
@@ -216,6 +224,15 @@ const DC_LINK_KEYS: &[&str] = &[
     "rated_torque",
     "dc_voltage",
 ];
+const DC_LINK_SHORT_KEYS: &[&str] = &[
+    "dc_voltage",
+    "rated_speed_rpm",
+    "rated_current",
+    "flux_linkage",
+    "ld",
+    "lq",
+    "rs",
+];
 const RESISTANCE_KEYS: &[&str] = &["rs", "rated_current", "flux_linkage", "rated_speed_rpm"];
 const TAU_KEYS: &[&str] = &["rs", "ld", "lq"];
 const LD_LQ: &[&str] = &["ld", "lq"];
@@ -254,6 +271,7 @@ impl Finding {
             | Finding::Saliency { .. }
             | Finding::RatingScale { .. }
             | Finding::Inertia { .. }
+            | Finding::DcLinkShort { .. }
             | Finding::ElectricalFrequency { .. } => Severity::Warning,
         }
     }
@@ -289,6 +307,7 @@ impl Finding {
             Finding::BackEmf { ratio } if ratio > 300.0 => EMF_KEYS_DC_FIRST,
             Finding::BackEmf { .. } => EMF_KEYS,
             Finding::DcLinkOversized { .. } => DC_LINK_KEYS,
+            Finding::DcLinkShort { .. } => DC_LINK_SHORT_KEYS,
             Finding::Reactance { key, .. } => {
                 if key == "ld" {
                     &["ld", "rated_current", "flux_linkage"]
@@ -340,6 +359,7 @@ impl Finding {
             | Finding::Saliency { .. }
             | Finding::RatingScale { .. }
             | Finding::Inertia { .. }
+            | Finding::DcLinkShort { .. }
             | Finding::ElectricalFrequency { .. } => "plausible values",
             Finding::Friction { .. } => {
                 "a friction torque at rated speed below the rated torque (N·m·s/rad)"

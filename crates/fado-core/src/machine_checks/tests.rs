@@ -84,6 +84,35 @@ fn ratings_divided_by_ten_are_refused_against_the_dc_link() {
 }
 
 #[test]
+fn a_rated_point_beyond_the_dc_link_is_a_warning_naming_the_link_and_the_ratings() {
+    // The paper's motor on a link 10 % short of what the bound allows its rated point.
+    let mut m = paper();
+    let clean = ratings::rated_point_voltage(&m) / (m.dc_voltage / 3f64.sqrt());
+    m.dc_voltage *= clean / (DC_LINK_SHORT * 1.1);
+    let f = first(&m, None);
+    assert!(matches!(f, Finding::DcLinkShort { .. }), "{f}");
+    assert_eq!(f.severity(), Severity::Warning);
+    assert_eq!(f.key(), "dc_voltage");
+    for key in [
+        "rated_speed_rpm",
+        "rated_current",
+        "flux_linkage",
+        "ld",
+        "lq",
+    ] {
+        assert!(f.keys().contains(&key), "{key}: {:?}", f.keys());
+    }
+    let text = f.to_string();
+    assert!(
+        text.contains("× the 57.0 V the DC link `dc_voltage`") && text.contains("field weakening"),
+        "{text}"
+    );
+    // Just inside the bound: no finding.
+    m.dc_voltage *= 1.1 * 1.01;
+    assert!(check(&m, None).is_empty(), "{}", first(&m, None));
+}
+
+#[test]
 fn a_sampling_period_in_ms_is_refused_naming_ts() {
     let f = first(&paper(), Some(0.025));
     assert_eq!((f.key(), f.severity()), ("ts", Severity::Error), "{f}");

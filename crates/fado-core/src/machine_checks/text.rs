@@ -160,11 +160,36 @@ fn write_resistance(f: &mut fmt::Formatter<'_>, per_unit: f64) -> fmt::Result {
         )
     } else if per_unit <= RESISTANCE_ERROR {
         f.write_str(
-            ": check its unit (Ω per phase) and the ratings (`rated_speed_rpm` in rad/s where \
-             r/min is meant makes it 9.55 × too large)",
+            ": usual only on motors wound for torque near standstill (gimbals, robot joints: \
+             0.5–2); otherwise check its unit (Ω per phase) and the ratings \
+             (`rated_speed_rpm` in rad/s where r/min is meant makes it 9.55 × too large)",
         )
     } else {
         f.write_str(": check its unit (Ω per phase) and the ratings")
+    }
+}
+
+/// The text of [`Finding::DcLinkOversized`] and [`Finding::DcLinkShort`].
+fn write_dc_link(f: &mut fmt::Formatter<'_>, finding: &Finding) -> fmt::Result {
+    match *finding {
+        Finding::DcLinkOversized { ratio, .. } => write!(
+            f,
+            "the rated point (`rated_speed_rpm`, `rated_current`, `rated_torque`) needs only \
+             {:.1} % of the phase voltage the DC link `dc_voltage` makes (Vdc/√3): are the \
+             ratings divided by 10, or the DC link the wrong one?",
+            100.0 * ratio
+        ),
+        Finding::DcLinkShort { needed, available } => write!(
+            f,
+            "the rated point (`rated_speed_rpm` at `rated_current` on MTPA, from \
+             `flux_linkage`, `ld`, `lq`, `rs`) needs {needed:.1} V phase peak, {:.2} × the \
+             {available:.1} V the DC link `dc_voltage` makes (Vdc/√3): the drive reaches \
+             rated speed only by field weakening, with less than rated torque there; is \
+             `dc_voltage` the mains' rms voltage where the DC link (√2 × it) is meant, or \
+             `rated_speed_rpm` the no-load speed?",
+            needed / available
+        ),
+        _ => Ok(()),
     }
 }
 
@@ -246,13 +271,7 @@ impl fmt::Display for Finding {
                 }
             }
             Finding::Friction { .. } | Finding::Inertia { .. } => write_mechanics(f, self),
-            Finding::DcLinkOversized { ratio, .. } => write!(
-                f,
-                "the rated point (`rated_speed_rpm`, `rated_current`, `rated_torque`) needs only \
-                 {:.1} % of the phase voltage the DC link `dc_voltage` makes (Vdc/√3): are the \
-                 ratings divided by 10, or the DC link the wrong one?",
-                100.0 * ratio
-            ),
+            Finding::DcLinkOversized { .. } | Finding::DcLinkShort { .. } => write_dc_link(f, self),
             Finding::Reactance { key, per_unit, .. } => write_reactance(f, key, per_unit),
             Finding::Resistance { per_unit, .. } => write_resistance(f, per_unit),
             Finding::TimeConstant { tau } => write!(

@@ -170,13 +170,18 @@ impl<T: Real> InverseCache<T> {
 
     /// i(ψ) by one Newton step on the polynomial of the last solution's cell from that
     /// solution, where `psi` lies so near it that the step's own error (the cell's twist times
-    /// the product of the step's fractions: exact for a bilinear cell) is below
-    /// [`REFINE_TOLERANCE`] of the cell, and the step stays in the cell; None elsewhere (the
-    /// caller inverts). For a flux a hair from the last inversion's (a Runge–Kutta step's end
-    /// beside its last stage): one division instead of a square root, two divisions and the
-    /// walk.
+    /// the product of the step's fractions: exact for a bilinear cell) is below `tolerance`
+    /// of the cell ([`REFINE_TOLERANCE`] for a state's current), and the step stays in the
+    /// cell; None elsewhere (the caller inverts). For a flux a hair from the last inversion's
+    /// (a Runge–Kutta step's end beside its last stage): one division instead of a square
+    /// root, two divisions and the walk.
     #[inline]
-    pub(super) fn refine(&self, grid: &impl CellGrid<T>, psi: Dq<T>) -> Option<Dq<T>> {
+    pub(super) fn refine(
+        &self,
+        grid: &impl CellGrid<T>,
+        psi: Dq<T>,
+        tolerance: T,
+    ) -> Option<Dq<T>> {
         let (at, u, v) = self.last?;
         let (k, m, cell, _) = self.slots.get(at)?.as_ref()?;
         let (k, m) = (*k, *m);
@@ -187,7 +192,7 @@ impl<T: Real> InverseCache<T> {
         let (last_k, last_m) = grid.last_cell();
         let tol = cell_tolerance::<T>();
         let inside = direction(u2, k, last_k, tol) == 0 && direction(v2, m, last_m, tol) == 0;
-        if !(inside && error <= T::lit(REFINE_TOLERANCE) * span) {
+        if !(inside && error <= tolerance * span) {
             return None;
         }
         let i = grid.current_at(k, m, u2, v2);

@@ -323,9 +323,23 @@ impl<T: Real> Magnetics<'_, T> {
         guess: Dq<T>,
         cache: &mut InverseCache<T>,
     ) -> Dq<T> {
+        self.current_near_cached_to(psi, guess, cache, T::lit(REFINE_TOLERANCE))
+    }
+
+    /// [`Magnetics::current_near_cached`] with the Newton step taken where its error is below
+    /// `tolerance` of the cell instead of [`REFINE_TOLERANCE`]: for a current whose error a
+    /// caller scales down (a Runge–Kutta stage's enters the step's flux through R·h/3).
+    #[inline]
+    pub fn current_near_cached_to(
+        &self,
+        psi: Dq<T>,
+        guess: Dq<T>,
+        cache: &mut InverseCache<T>,
+        tolerance: T,
+    ) -> Dq<T> {
         let near = match self {
-            Magnetics::Map(m) => cache.refine(m, psi),
-            Magnetics::Uniform(m) => cache.refine(m, psi),
+            Magnetics::Map(m) => cache.refine(m, psi, tolerance),
+            Magnetics::Uniform(m) => cache.refine(m, psi, tolerance),
             _ => None,
         };
         near.unwrap_or_else(|| self.current_from_cached(psi, guess, cache))

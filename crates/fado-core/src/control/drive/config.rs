@@ -71,6 +71,16 @@ impl<T: Real> DriveConfig<T> {
         let i1 = T::lit(0.5) * i2;
         let swing = crate::real::max(swing_time_constant(m, i1), swing_time_constant(m, i2));
         let hold = swing_hold_time_constants(m, i1, swing, t) * swing;
+        // A brake that holds the rotor (`startup.rotor_held`) leaves no swing to wait for:
+        // where the swing's hold would exceed the budget and skip the calibration, the levels
+        // are held for the current's settling alone (measured: the 8-pole traction IPMSM of
+        // `crates/fado-sim/tests/data/traction-ipm-saturated.toml`, swing hold 0.61 s,
+        // `crates/fado-sim/tests/gain_calibration.rs`). Elsewhere the hold stays as derived.
+        let hold = if t.startup.rotor_held && hold > T::lit(GAIN_CALIBRATION_MAX_HOLD_TIME) {
+            T::zero()
+        } else {
+            hold
+        };
         let rename = |e: ConfigError| match e {
             ConfigError::OutOfRange { field, expected } => ConfigError::OutOfRange {
                 field: gain_field(field),

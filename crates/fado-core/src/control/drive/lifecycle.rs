@@ -86,6 +86,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             implausible_now: false,
             saturated_flux: Dq::zero(),
             saturated_warm: FluxWarmStart::empty(),
+            saturated_point: Dq::zero(),
         };
         drive.reset();
         Ok(drive)
@@ -222,6 +223,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         self.current_error_now = false;
         self.history = [Ab::zero(); 2];
         (self.saturated_flux, self.saturated_warm) = self.zero_current_warm_start();
+        self.saturated_point = Dq::zero();
         self.last = DriveOutput::idle(Estimate {
             theta,
             ..Estimate::default()

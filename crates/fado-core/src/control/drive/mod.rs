@@ -275,6 +275,9 @@ pub struct SensorlessDrive<T: 'static, E = SensorlessEstimator<T>> {
     /// The tangent plane of ψ(i) there: where the next sample's torque solve starts its
     /// flux (`saturated_references`, `crate::magnetics::FluxWarmStart`).
     saturated_warm: FluxWarmStart<T>,
+    /// The current that tangent plane was evaluated at, A (the realised torque reads the
+    /// plane alone within a settled step of it).
+    saturated_point: Dq<T>,
 }
 
 fn estimate_is_finite<T: Real>(e: &Estimate<T>) -> bool {

@@ -34,8 +34,13 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
     /// oscillates sample by sample under load (measured on ipmsm-gem-50k `stops`).
     pub(super) fn currents_for_torque(&mut self, iq_torque: T, guess: T, probe_id: T) -> Dq<T> {
         if let Some(s) = &self.resolved.saturated {
-            let (i, psi, warm) = self.saturated_currents_for_torque(s, iq_torque, guess, probe_id);
-            (self.saturated_flux, self.saturated_warm) = (psi, warm);
+            let (i, psi, warm, at) =
+                self.saturated_currents_for_torque(s, iq_torque, guess, probe_id);
+            (
+                self.saturated_flux,
+                self.saturated_warm,
+                self.saturated_point,
+            ) = (psi, warm, at);
             return i;
         }
         let m = &self.config.machine;

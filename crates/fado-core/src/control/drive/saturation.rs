@@ -56,15 +56,15 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
     /// steps, ended early by a step below `TORQUE_SETTLED` of the rated current, the slope from the model's incremental inductance (one flux solve per step, the
     /// secant's slope to O(h)). Each evaluation's ψ(i) starts from the last one's first-order
     /// prediction, the first from the model's flux at the last sample's reference
-    /// (`saturated_warm`); returns the currents, the flux of the last evaluation and the warm
-    /// start there, the next sample's.
+    /// (`saturated_warm`); returns the currents, the flux of the last evaluation, the warm
+    /// start there (the next sample's) and the current it was evaluated at.
     pub(super) fn saturated_currents_for_torque(
         &self,
         s: &SaturatedReferences<T>,
         iq_torque: T,
         guess: T,
         probe_id: T,
-    ) -> (Dq<T>, Dq<T>, FluxWarmStart<T>) {
+    ) -> (Dq<T>, Dq<T>, FluxWarmStart<T>, Dq<T>) {
         let m = &self.config.machine;
         let injection = &self.blocks.injection;
         let mtpa = self.config.tuning.mtpa.enabled;
@@ -74,19 +74,23 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         };
         let target = m.flux_linkage * iq_torque;
         let h = T::lit(1e-3) * m.rated_current;
-        let last = Cell::new((self.saturated_flux, self.saturated_warm));
+        let last = Cell::new((
+            self.saturated_flux,
+            self.saturated_warm,
+            self.saturated_point,
+        ));
         let f = |iq: T| {
             let i = Dq::new(id_of(iq), iq);
-            let (_, mut warm) = last.get();
+            let (_, mut warm, _) = last.get();
             let (tau, slope, psi) = s.torque_flux_slope(i, (id_of(iq + h) - i.d) / h, &mut warm);
-            last.set((psi, warm));
+            last.set((psi, warm, i));
             (tau - target, slope)
         };
         let settled = T::lit(super::references::TORQUE_SETTLED) * m.rated_current;
         let limits = (m.rated_current, m.flux_linkage);
         let iq = Self::solve_torque_with(f, iq_torque, guess, limits, settled);
-        let (psi, warm) = last.get();
-        (Dq::new(id_of(iq), iq), psi, warm)
+        let (psi, warm, at) = last.get();
+        (Dq::new(id_of(iq), iq), psi, warm, at)
     }
 
     /// A saturating model's flux at zero current and the warm start there (the torque

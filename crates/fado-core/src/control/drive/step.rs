@@ -1,5 +1,6 @@
 //! One sample of the drive, in the order of the module docs.
 
+use super::references::TORQUE_SETTLED;
 use super::{Applied, DriveOutput, SensorlessDrive, estimate_is_finite};
 use crate::control::lock_reaction::LockAction;
 use crate::control::monitor::DriveFlags;
@@ -159,7 +160,9 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         let realised_torque = if let Some(s) = &self.resolved.saturated {
             // A saturating model's co-energy torque (`saturated_references`), its flux the
             // next sample's warm start.
-            let (tau, psi) = s.torque_flux_warm(i_dq_ref, &mut self.saturated_warm);
+            let reach = T::lit(TORQUE_SETTLED) * self.config.machine.rated_current;
+            let at = self.saturated_point;
+            let (tau, psi) = s.torque_flux_near(i_dq_ref, at, reach, &mut self.saturated_warm);
             self.saturated_flux = psi;
             tau / self.config.machine.flux_linkage
         } else if self.resolved.salient {

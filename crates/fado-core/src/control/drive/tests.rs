@@ -43,7 +43,7 @@ fn saturated_torque_solve_is_the_cold_solve() {
         // itself (up to 3× off on this rotor: three steps do not converge, up to 4e-4 of the
         // rated current, both solves alike).
         for (guess, bound) in [(1.01 * cold_iq, 1e-7), (iq_torque, 1e-3)] {
-            let (i, _, _) = drive.saturated_currents_for_torque(&s, iq_torque, guess, 0.0);
+            let (i, _, _, _) = drive.saturated_currents_for_torque(&s, iq_torque, guess, 0.0);
             let (new, old) = ((i.q - cold_iq).abs(), (once(guess) - cold_iq).abs());
             std::println!("{iq_torque:8.3} from {guess:8.3}: {new:.1e} A (cold {old:.1e} A)");
             assert!(

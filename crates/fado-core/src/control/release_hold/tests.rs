@@ -119,6 +119,12 @@ fn a_light_rotor_gets_the_current_loop_its_hold_needs() {
     );
     let off = ReleaseHoldTuning::default();
     assert_eq!(current_bandwidth_for_hold(&off, &fast, ts, 250.0), 250.0);
+    // Armed at the start-up's end the hold needs the same loop.
+    let at_start = ReleaseHoldTuning {
+        at_start: true,
+        ..off
+    };
+    assert_eq!(current_bandwidth_for_hold(&at_start, &fast, ts, 250.0), hz);
     let feather = MachineModel {
         inertia: 1e-9,
         ..fast
@@ -281,9 +287,12 @@ fn at_the_start_ups_end_a_fall_against_a_moving_reference_is_held() {
     // held there as a motion hold, whose reference resumes from zero.
     let top = 1.0 + 1e-3 * 399.0;
     assert_eq!(h.step(10.0, top - 0.015, top - 0.015), HoldAction::Idle);
+    // The estimator tracks the fall only once it triggers (armed at the start-up's end, no
+    // brake opened).
+    assert!(!h.tracking_fall());
     let fall = top - 0.025;
     assert!(matches!(h.step(10.0, fall, fall), HoldAction::Hold(x) if x > 0.0));
-    assert!(h.active() && h.engaged() == 1);
+    assert!(h.active() && h.engaged() == 1 && h.tracking_fall());
     assert_eq!(h.resumed(10.0), 0.0);
     // Against a backward reference the sense turns: a forward fall triggers.
     h.arm(0.0);

@@ -121,3 +121,39 @@ fn torque_slope_is_the_derivative_along_the_path() {
         }
     }
 }
+
+/// Within a settled step (10⁻⁶ of the rated current) of the tangent plane's own current the
+/// plane alone is the solved flux to 10⁻¹² of it on both algebraic machines; beyond the reach
+/// it is `torque_flux_warm` to the bit.
+#[test]
+fn the_tangent_plane_near_its_current_is_the_solved_flux() {
+    for (name, m) in [("ipmsm-2k2-qsat", machine(58.0)), ("baldor", baldor())] {
+        let r = SaturatedReferences::new(&m, 2.0 * m.rated_current).unwrap();
+        let reach = 1e-6 * m.rated_current;
+        for k in 0..12 {
+            let angle = 0.5 + 0.2 * k as f64;
+            let at = Dq::new(-angle.sin(), angle.cos()) * (0.15 * m.rated_current * k as f64);
+            let (_, plane) = r.warm_start(at);
+            let near = at + Dq::new(0.6, -0.8) * (0.5 * reach);
+            let (mut a, mut b) = (plane, plane);
+            let (tau, psi) = r.torque_flux_near(near, at, reach, &mut a);
+            assert_eq!(psi, plane.prediction(near), "{name} {k}: the plane's own");
+            let (tau_solved, psi_solved) = r.torque_flux_warm(near, &mut b);
+            let size = psi_solved.norm() * (1.0 + near.norm());
+            assert!(
+                (psi - psi_solved).norm() < 1e-12 * psi_solved.norm(),
+                "{name} {k}: {psi:?} vs {psi_solved:?}"
+            );
+            assert!((tau - tau_solved).abs() < 1e-12 * size, "{name} {k}");
+            assert!((a.prediction(at) - b.prediction(at)).norm() < 1e-12 * size);
+            let far = at + Dq::new(0.6, -0.8) * (2.0 * reach);
+            let (mut a, mut b) = (plane, plane);
+            assert_eq!(
+                r.torque_flux_near(far, at, reach, &mut a),
+                r.torque_flux_warm(far, &mut b),
+                "{name} {k}"
+            );
+            assert_eq!(a, b);
+        }
+    }
+}
