@@ -445,7 +445,9 @@ impl SimResult {
 impl SimResult {
     /// The content of `metrics.json`: scenario, inverter_model, precision, estimator, passed,
     /// max/RMS angle error overall and near zero speed (rad), zero_speed_band_rpm,
-    /// max_speed_error_rpm, tripped, simulated_seconds, wall_seconds, checks. A fresh copy.
+    /// max_speed_error_rpm, tripped, simulated_seconds, wall_seconds, startup (the drive's
+    /// start-up: status, ready_time, motion_before_ready, deferrals, gain_calibration,
+    /// angle_phase; docs/method/startup.md), checks. A fresh copy.
     #[getter]
     fn metrics<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         py.import("copy")?

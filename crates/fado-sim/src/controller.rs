@@ -3,7 +3,7 @@
 //! The sensorless drive of `fado-core` implements it ([`crate::drive`]); so can sensored
 //! reference controllers in tests.
 
-use fado_core::control::StartupStatus;
+use fado_core::control::{GainCalibrationStatus, StartupStatus};
 use fado_core::{Ab, Abc, Dq, DriveFlags, Estimate};
 
 /// Everything a controller may read at sample n.
@@ -77,6 +77,11 @@ pub trait Controller {
     fn startup_status(&self) -> StartupStatus {
         StartupStatus::Idle
     }
+    /// Where the controller's gain calibration stands (see
+    /// [`fado_core::control::GainCalibrationStatus`]). Default: None (controllers without one).
+    fn gain_calibration_status(&self) -> Option<GainCalibrationStatus> {
+        None
+    }
     /// The plant's brake has released (a drive re-arms its release hold). Default: nothing.
     fn brake_released(&mut self) {}
 }
@@ -102,6 +107,9 @@ impl<C: Controller + ?Sized> Controller for Box<C> {
     }
     fn startup_status(&self) -> StartupStatus {
         (**self).startup_status()
+    }
+    fn gain_calibration_status(&self) -> Option<GainCalibrationStatus> {
+        (**self).gain_calibration_status()
     }
     fn brake_released(&mut self) {
         (**self).brake_released();

@@ -1,6 +1,6 @@
 //! The sensorless drive of `fado-core` (Fig. 5) as a [`Controller`] of the closed loop.
 
-use fado_core::control::{SensorlessDrive, StartupStatus};
+use fado_core::control::{GainCalibrationStatus, SensorlessDrive, StartupStatus};
 use fado_core::{Ab, Abc, Diagnostics, Dq, Estimate, RotorAngleEstimator};
 
 use crate::controller::{Actuation, ControlEvent, Controller, Measurements};
@@ -19,6 +19,10 @@ where
 
     fn startup_status(&self) -> StartupStatus {
         SensorlessDrive::startup_status(self)
+    }
+
+    fn gain_calibration_status(&self) -> Option<GainCalibrationStatus> {
+        Some(SensorlessDrive::gain_calibration_status(self))
     }
 
     fn brake_released(&mut self) {
@@ -115,6 +119,10 @@ impl Controller for DriveF32 {
 
     fn startup_status(&self) -> StartupStatus {
         self.0.startup_status()
+    }
+
+    fn gain_calibration_status(&self) -> Option<GainCalibrationStatus> {
+        Some(self.0.gain_calibration_status())
     }
 
     fn brake_released(&mut self) {

@@ -77,6 +77,31 @@ fn the_scenario_run_releases_the_brake_when_the_drive_is_ready() {
     let out = simulate("loaded-start", Some(&preset_toml("paper")), false, None).unwrap();
     let t = out.probe.start.as_ref().unwrap().release_time.unwrap();
     assert!(t > 0.1 && t < 1.0, "{t}");
+    // metrics.json's `startup`: ready by the release (which waits for ready and
+    // `brake_release_at`), held under the brake.
+    let json = serde_json::to_value(out.report()).unwrap();
+    let st = &json["startup"];
+    assert_eq!(st["status"], "ready", "{st}");
+    assert!(st["ready_time"].as_f64().unwrap() <= t, "{st}");
+    assert_eq!(st["motion_before_ready"].as_f64(), Some(0.0), "{st}");
+    assert_eq!(st["angle_phase"], "Found", "{st}");
+    assert!(st["gain_calibration"].is_string(), "{st}");
+}
+
+#[test]
+fn every_scenario_reports_the_start_up_in_its_metrics() {
+    // A scenario without a brake judges from its evaluation window, but its metrics.json
+    // says how the start-up went: the 2.2 kW IPMSM's `reversal` is ready after its
+    // calibrations, which it passed with the rotor at rest.
+    let out = simulate("reversal", Some(&preset_toml("ipmsm-2k2")), true, None).unwrap();
+    let json = serde_json::to_value(out.report()).unwrap();
+    let st = &json["startup"];
+    assert_eq!(st["status"], "ready", "{st}");
+    let t = st["ready_time"].as_f64().unwrap();
+    assert!(t > 0.1 && t < 1.0, "{st}");
+    assert!(st["motion_before_ready"].as_f64().unwrap() < 0.05, "{st}");
+    assert_eq!(st["deferrals"], 0, "{st}");
+    assert_eq!(st["gain_calibration"], "Calibrated", "{st}");
 }
 
 #[test]
@@ -152,6 +177,9 @@ fn a_motor_without_standstill_angle_information_ends_with_the_status_and_never_s
     assert_eq!(st.release_time, None);
     assert_eq!(st.max_backward, 0.0);
     assert!(out.passed, "{:?}", out.checks);
+    let json = serde_json::to_value(out.report()).unwrap();
+    assert_eq!(json["startup"]["status"], "no_angle_information");
+    assert!(json["startup"]["ready_time"].is_null());
     assert!(
         out.checks.iter().any(|c| c.name.contains("no angle")),
         "{:?}",

@@ -134,7 +134,10 @@ pub struct ReleaseHoldTuning<T> {
     /// on a strongly salient rotor with a weak magnet it engages on the start's own estimate
     /// transient at zero reference and its position loop loses the rotor: the saturated
     /// PM-SyRM `motors/saturated/pmsyrm-baldor-5k6.toml` (Lq/Ld ≈ 5) then loses `fullrange`
-    /// (3.14 rad at seed 1, 0.148 rad without it). An application that knows its rotor is light
+    /// (3.14 rad at seeds 2–4 and 0.143 rad at seed 1; 0.141–0.148 rad without it: the hold
+    /// triggers 20 ms after ready on the unloaded rotor, and its loop on the direct angle,
+    /// whose rate there runs against the rotor's, swings the rotor with a growing amplitude
+    /// until the estimate is lost). An application that knows its rotor is light
     /// and its model right turns it on.
     pub at_start: bool,
     /// Backward travel (electrical rad) the rated torque causes, which sets the loop's

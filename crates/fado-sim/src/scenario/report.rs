@@ -4,7 +4,7 @@ use serde::Serialize;
 
 use crate::config::{EstimatorKind, Precision, SimConfig};
 use crate::inverter::InverterModel;
-use crate::sim::{Metrics, RunStats, Trace};
+use crate::sim::{Metrics, RunStats, StartupOutcome, Trace};
 
 use super::{Check, ScenarioProbe};
 
@@ -23,6 +23,8 @@ pub struct Outcome {
     pub checks: Vec<Check>,
     /// Angle and speed metrics.
     pub metrics: Metrics,
+    /// The drive's start-up: how it ended, when it was ready, the rotor's motion before.
+    pub startup: StartupOutcome,
     /// Timing.
     pub stats: RunStats,
     /// Decimated trace.
@@ -64,6 +66,11 @@ pub struct Report {
     pub simulated_seconds: f64,
     /// Wall seconds.
     pub wall_seconds: f64,
+    /// The drive's start-up from t = 0, whatever the evaluation window: its status (`ready`,
+    /// `deferred`, `aborted`, `no_angle_information`, `implausible_angle`, `not_ready`), the
+    /// time of ready, the rotor's motion before it, the start-up's restarts, the gain
+    /// calibration's status and the angle phase ([`StartupOutcome`]).
+    pub startup: StartupOutcome,
     /// The criteria.
     pub checks: Vec<Check>,
 }
@@ -89,6 +96,7 @@ impl Outcome {
             min_dc_voltage: m.min_dc_voltage,
             simulated_seconds: self.stats.simulated_seconds,
             wall_seconds: self.stats.wall_seconds,
+            startup: self.startup.clone(),
             checks: self.checks.clone(),
         }
     }

@@ -8,7 +8,7 @@ use crate::config::SimConfig;
 use crate::controller::{ControlEvent, Controller};
 use crate::error::SimConfigError;
 use crate::inverter::InverterModel;
-use crate::sim::{Decimated, Metrics, Plant, Simulation, Trace, TraceSink};
+use crate::sim::{Decimated, Metrics, Plant, Simulation, StartupOutcome, Trace, TraceSink};
 
 use super::{Outcome, SCENARIOS, Scenario, find};
 
@@ -189,17 +189,18 @@ fn run_with<C: Controller>(
     let mut metrics = Metrics::new(cfg.simulation.eval_start, cfg.zero_speed_band_rpm());
     let mut trace = Trace::new(cfg.simulation.decimation);
     let mut probe = sc.probe(&cfg);
+    let mut startup = StartupOutcome::default();
     let duration = cfg.simulation.duration;
     let mut stats = match opts.trace {
         TraceOutput::Keep => sim.run_until(
             duration,
-            &mut [&mut metrics, &mut trace, &mut probe],
+            &mut [&mut metrics, &mut trace, &mut probe, &mut startup],
             opts.progress,
             opts.cancel,
         ),
         TraceOutput::Discard => sim.run_until(
             duration,
-            &mut [&mut metrics, &mut probe],
+            &mut [&mut metrics, &mut probe, &mut startup],
             opts.progress,
             opts.cancel,
         ),
@@ -207,7 +208,7 @@ fn run_with<C: Controller>(
             let mut rows = Decimated::new(cfg.simulation.decimation, sink);
             sim.run_until(
                 duration,
-                &mut [&mut metrics, &mut rows, &mut probe],
+                &mut [&mut metrics, &mut rows, &mut probe, &mut startup],
                 opts.progress,
                 opts.cancel,
             )
@@ -225,6 +226,7 @@ fn run_with<C: Controller>(
         passed: !stats.cancelled && checks.iter().all(|c| c.passed),
         checks,
         metrics,
+        startup,
         stats,
         trace,
         config: cfg,

@@ -10,6 +10,7 @@ mod metrics;
 mod plant;
 mod sample;
 mod simulation;
+mod startup_outcome;
 #[cfg(test)]
 mod tests;
 mod trace;
@@ -19,6 +20,7 @@ pub use metrics::Metrics;
 pub use plant::{Plant, PlantParams};
 pub use sample::{Probe, Sample};
 pub use simulation::{CANCEL_CHECK_SAMPLES, RunStats, Simulation};
+pub use startup_outcome::{StartupOutcome, StartupVerdict};
 pub use trace::{CsvTraceWriter, Decimated, Trace, TraceColumns, TraceSink};
 pub use trace_row::TraceRow;
 

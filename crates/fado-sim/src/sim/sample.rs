@@ -45,6 +45,8 @@ pub struct Sample {
     pub ready: bool,
     /// Where the controller's start-up angle phase stands.
     pub startup: fado_core::control::StartupStatus,
+    /// The controller's gain calibration status (None: a controller without one).
+    pub gain_calibration: Option<fado_core::control::GainCalibrationStatus>,
     /// The controller's output at this sample.
     pub act: Actuation,
 }

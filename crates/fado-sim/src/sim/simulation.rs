@@ -132,6 +132,7 @@ impl<C: Controller> Simulation<C> {
             brake_engaged: self.plant.brake_engaged(),
             ready,
             startup: self.controller.startup_status(),
+            gain_calibration: self.controller.gain_calibration_status(),
             act,
         };
         self.plant.step(act.duty, act.gates_enabled);
