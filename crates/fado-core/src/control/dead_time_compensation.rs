@@ -37,18 +37,44 @@
 //! the current of each phase at its own gate edge (the piecewise-linear ripple: each other
 //! pole already switched adds the current response of its α-β voltage step ±(2/3)·Vdc·u_k,
 //! −Vdc/(3L̂) on a round rotor; the mean slope removed; the peak sample i − Δ/2 and the
-//! valley sample i + Δ/2, Δ the swing the pattern predicts), and solves the two edges'
-//! delays as the root of delay − band model(edge current the delays imply), a piecewise-linear
-//! problem (`edges` submodule: Newton steps with the pattern's own slopes, bounded rounds);
-//! the period-average pole error is then Vdc·f_sw·(t_fall − t_rise) − V_th·sat(i/Ic). Left
-//! in the same test: 0.119 V; on the MAD 5010 KV110 (44.4 V, 85 µH, 20 kHz) 0.043 V under
-//! 5.55 A, where two fixed-point passes on the trapezoid's gate times left 0.32 V. Outside
-//! the band it is the trapezoid exactly. Limit: where an edge's loop gain
+//! valley sample i + Δ/2, Δ the swing the pattern predicts), and the two edges' delays from
+//! the band model at the edge currents the delays imply (next paragraph); the period-average
+//! pole error is then Vdc·f_sw·(t_fall − t_rise) − V_th·sat(i/Ic). Outside the band it is
+//! the trapezoid exactly.
+//!
+//! **Which solve.** The delays move the edge currents they are computed from: on a round
+//! rotor at the loaded standstill (the phase near zero current between a positive and a
+//! negative one) one second of an edge's delay moves its own edge current by Vdc/(3·L̂),
+//! and the band model turns one ampere into Td/Ic seconds, a loop gain
+//! g = Vdc·Td/(3·min(L̂d, L̂q)·Ic) ([`DeadTimeCompensation::loop_gain`], computed once from
+//! the configuration at the rated DC link `dc_voltage`). Two solves:
+//! - g ≤ [`EDGE_SOLVE_LOOP_GAIN`] (0.75): two fixed-point passes on the gate times of the
+//!   reference plus the trapezoid (`passes` submodule). Against the switching-resolved
+//!   inverter at standstill (fado-sim's inverter tests, phase b through the band) they
+//!   leave 0.097 V on the paper's motor (g = 0.33; 0.64 V with the trapezoid alone) and
+//!   0.042 / 0.080 V under 5.55 / 12 A on the MAD 5010 KV110's inverter with 200 µH
+//!   (g = 0.34).
+//! - g above it: the root of delay − band model(edge current the delays imply) with the
+//!   gate times of the reference plus the compensation itself, a piecewise-linear problem
+//!   (`edges` submodule: Newton steps with the pattern's own slopes, bounded rounds). The
+//!   passes oscillate as g nears 1: on the MAD 5010 KV110 (44.4 V, 85 µH, 20 kHz, g = 0.79)
+//!   they leave 0.32 V under 5.55 A, the root solve 0.043 V (0.054 V under 12 A), and its
+//!   `stops` from a zero start angle keeps |θ − θ̂| at 0.12–0.20 rad (0.21–0.35 rad on the
+//!   passes; crates/fado-sim/tests/multirotor_datasheets.rs). Where g is small the passes
+//!   are the better of the two: the root solve leaves 0.119 V on the paper's motor.
+//!
+//! The threshold lies between the Siemens 1FT6084 preset (g = 0.71, the largest of the
+//! machines whose reversal and stops are kept bit-identical on the passes) and the MAD 5010
+//! KV110 (g = 0.79): a margin of 5 % either side. g of the presets: ipmsm-2k2 0.04,
+//! hub-hoverboard-48v 0.12, outrunner-cheetah-24v 0.18, pmsyrm-5k 0.22, paper 0.33,
+//! servo-1ft6084 0.71 (passes); multirotor-mn5006-22v 1.23, ipmsm-gem-50k 3.9 (root solve).
+//! Limit of the root solve: where an edge's loop gain
 //! (Td/Ic)·(β − σ/2) reaches 1 (a low-inductance salient rotor; same test: trapezoid 1.12 V,
 //! this method 0.75 V at 0.37/1.2 mH) the root is not unique and the step is the plain
 //! evaluation; with every phase in the band the per-phase steps leave the star point's
-//! coupling out (`edges` submodule). Cost: ≈ 600 flops and up to 9 divisions more than the
-//! trapezoid (not measured on target). The current
+//! coupling out (`edges` submodule). Cost over the trapezoid: the passes ≈ 200 flops and 6
+//! divisions, the root solve ≈ 600 flops and up to 9 divisions (not measured on target).
+//! The current
 //! at the switching instants, ripple included, as the quantity that sets the dead-time
 //! distortion at low output voltage: Choi & Sul, "A new compensation strategy reducing
 //! voltage/current distortion in PWM VSI systems operating
@@ -70,6 +96,7 @@
 //! into the next periods).
 
 mod edges;
+mod passes;
 
 use crate::control::pi::clamp;
 use crate::error::{ConfigError, check};
@@ -103,6 +130,12 @@ pub const DEFAULT_DEAD_TIME: f64 = 2.5e-6;
 pub const DEFAULT_METHOD: DeadTimeMethod = DeadTimeMethod::EdgeCurrent;
 /// Default switching frequency in Hz: 5 kHz (paper, V).
 pub const DEFAULT_SWITCHING_FREQUENCY: f64 = 5e3;
+/// Loop gain g = Vdc·Td/(3·min(L̂d, L̂q)·Ic) above which [`DeadTimeMethod::EdgeCurrent`]
+/// solves the edges' delays for their root instead of taking two fixed-point passes: 0.75
+/// (module docs, "Which solve": between the Siemens 1FT6084 preset at g = 0.71, kept on the
+/// passes, and the MAD 5010 KV110 at g = 0.79, where the passes leave 0.32 V at standstill
+/// and the root solve 0.043 V).
+pub const EDGE_SOLVE_LOOP_GAIN: f64 = 0.75;
 /// Default device threshold voltage in V: 1 (docs/method/estimator.md §7 \[A\]).
 pub const DEFAULT_THRESHOLD_VOLTAGE: f64 = 1.0;
 /// Default current band Ic of the trapezoid in A: 0.3 (docs/method/estimator.md §7 \[A\]).
@@ -134,6 +167,10 @@ pub struct DeadTimeCompensationConfig<T> {
     /// in the rotor frame of the rotation it is given; 0: no ripple (the trapezoid). Default
     /// the machine model's (L̂d, L̂q).
     pub ripple_inductance: Dq<T>,
+    /// Rated DC-link voltage in V (inverter datum): with the other fields it sets the
+    /// refinement's loop gain g that chooses the edge-current solve (module docs, "Which
+    /// solve"); 0: the two passes. Default the machine model's `dc_voltage`.
+    pub dc_voltage: T,
 }
 
 impl<T: Real> DeadTimeCompensationConfig<T> {
@@ -151,6 +188,7 @@ impl<T: Real> DeadTimeCompensationConfig<T> {
             threshold_voltage: T::lit(DEFAULT_THRESHOLD_VOLTAGE),
             current_band: T::lit(DEFAULT_CURRENT_BAND),
             ripple_inductance: Dq::new(machine.ld, machine.lq),
+            dc_voltage: machine.dc_voltage,
         }
     }
 }
@@ -166,6 +204,11 @@ pub struct DeadTimeCompensation<T> {
     inv_period: T,
     /// 1/L̂d, 1/L̂q of `ripple_inductance` (zero where it is zero: edge current off).
     inv_ripple: Dq<T>,
+    /// The edge-current refinement's loop gain g = Vdc·Td/(3·min(L̂d, L̂q)·Ic) at the rated
+    /// DC link (module docs, "Which solve").
+    loop_gain: T,
+    /// g above [`EDGE_SOLVE_LOOP_GAIN`]: the root solve, else the two passes.
+    solve_edges: bool,
 }
 
 impl<T: Real> DeadTimeCompensation<T> {
@@ -183,6 +226,7 @@ impl<T: Real> DeadTimeCompensation<T> {
         let ic = check::positive("current_band", config.current_band)?;
         check::non_negative("ripple_inductance", config.ripple_inductance.d)?;
         check::non_negative("ripple_inductance", config.ripple_inductance.q)?;
+        let vdc = check::non_negative("dc_voltage", config.dc_voltage)?;
         let half = T::lit(0.5) / fsw;
         let inv = |l: T| {
             if l > T::zero() {
@@ -191,8 +235,19 @@ impl<T: Real> DeadTimeCompensation<T> {
                 T::zero()
             }
         };
+        let l_min = config
+            .ripple_inductance
+            .d
+            .step_min(config.ripple_inductance.q);
+        let loop_gain = if l_min > T::zero() {
+            vdc * td / (T::lit(3.0) * l_min * ic)
+        } else {
+            T::zero()
+        };
         Ok(Self {
             config,
+            loop_gain,
+            solve_edges: loop_gain > T::lit(EDGE_SOLVE_LOOP_GAIN),
             inv_band: T::one() / ic,
             half,
             inv_period: T::one() / (half + half),
@@ -287,14 +342,31 @@ impl<T: Real> DeadTimeCompensation<T> {
         }
         let one = T::one();
         let i = [i_abc.a, i_abc.b, i_abc.c];
-        let v = [v_abc.a, v_abc.b, v_abc.c];
-        let (d_rise, d_fall) = self.edge_delays(rotation, i, v, vdc);
+        let (d_rise, d_fall) = if self.solves_edges() {
+            self.edge_delays(rotation, i, [v_abc.a, v_abc.b, v_abc.c], vdc)
+        } else {
+            self.passes_delays(rotation, i_abc, v_abc, vdc)
+        };
         let band = self.inv_band;
         let vth = c.threshold_voltage;
         let per_second = vdc * c.switching_frequency;
         let f =
             |k: usize| per_second * (d_rise[k] - d_fall[k]) + vth * clamp(i[k] * band, -one, one);
         Abc::new(f(0), f(1), f(2))
+    }
+
+    /// The edge-current refinement's loop gain g = Vdc·Td/(3·min(L̂d, L̂q)·Ic) at the rated DC
+    /// link, computed once from the configuration (module docs, "Which solve").
+    pub fn loop_gain(&self) -> T {
+        self.loop_gain
+    }
+
+    /// Whether [`DeadTimeMethod::EdgeCurrent`] solves the edges' delays for their root (g
+    /// above [`EDGE_SOLVE_LOOP_GAIN`]) rather than taking the two fixed-point passes (module
+    /// docs, "Which solve").
+    #[inline(always)]
+    pub fn solves_edges(&self) -> bool {
+        self.solve_edges
     }
 
     /// Delay of one edge (band model): the opposing current waits Td, the helping one
@@ -527,6 +599,73 @@ mod tests {
         );
     }
 
+    /// The MAD 5010 KV110's inverter (44.4 V, 20 kHz, Td 0.625 µs, Ic 0.138 A) on 85 µH at
+    /// the rated DC link `vdc`.
+    fn kv110(vdc: f64) -> DeadTimeCompensation<f64> {
+        DeadTimeCompensation::new(DeadTimeCompensationConfig {
+            enabled: true,
+            method: DeadTimeMethod::EdgeCurrent,
+            dead_time: 0.625e-6,
+            switching_frequency: 20e3,
+            threshold_voltage: 44.4 / 311.0,
+            current_band: 0.137_739_130_434_782_6,
+            ripple_inductance: Dq::new(85e-6, 85e-6),
+            dc_voltage: vdc,
+        })
+        .unwrap()
+    }
+
+    #[test]
+    fn the_loop_gain_chooses_the_solve_on_either_side_of_the_threshold() {
+        // g = Vdc·Td/(3·min(L̂d, L̂q)·Ic): the paper's motor 311 V, 2.5 µs, 2.63 mH, 0.3 A.
+        let paper = edge(2.63e-3);
+        let g = 311.0 * 2.5e-6 / (3.0 * 2.63e-3 * 0.3);
+        assert!((paper.loop_gain() - g).abs() < 1e-12 && !paper.solves_edges());
+        // The MAD 5010 KV110 at 44.4 V: g = 0.79, the root solve.
+        let kv = kv110(44.4);
+        assert!((kv.loop_gain() - 0.790).abs() < 1e-3 && kv.solves_edges());
+        // Either side of the threshold through the rated DC link alone.
+        let at = |g: f64| kv110(44.4 * g / kv.loop_gain());
+        assert!(!at(EDGE_SOLVE_LOOP_GAIN * 0.999).solves_edges());
+        assert!(at(EDGE_SOLVE_LOOP_GAIN * 1.001).solves_edges());
+        assert!(!kv110(0.0).solves_edges());
+        // The chosen solve is the one used: standstill under 5.55 A, phase b at 0.2 A, where
+        // its edge currents (the ripple ±0.33 A) are in the band.
+        let rs = 0.6193;
+        let ib = 0.2;
+        let i = Abc::new(-5.55 - 0.5 * ib, ib, 5.55 - 0.5 * ib);
+        let v = Abc::new(rs * i.a, rs * i.b, rs * i.c);
+        let rot = Rotation::from_angle(0.0);
+        let out = |c: &DeadTimeCompensation<f64>, (r, f): ([f64; 3], [f64; 3])| {
+            let per_second = 44.4 * 20e3;
+            let vth = c.config().threshold_voltage;
+            let ic = c.config().current_band;
+            let x = [i.a, i.b, i.c];
+            [0, 1, 2].map(|k| per_second * (r[k] - f[k]) + vth * (x[k] / ic).clamp(-1.0, 1.0))
+        };
+        let x = [i.a, i.b, i.c];
+        for (c, solved) in [(at(EDGE_SOLVE_LOOP_GAIN * 0.999), false), (kv, true)] {
+            let d = if solved {
+                c.edge_delays(rot, x, [v.a, v.b, v.c], 44.4)
+            } else {
+                c.passes_delays(rot, i, v, 44.4)
+            };
+            let want = out(&c, d);
+            let got = c.edge_current(rot, i, v, 44.4);
+            for (g, w) in [got.a, got.b, got.c].into_iter().zip(want) {
+                assert!(
+                    (g - w).abs() < 1e-12,
+                    "solved {solved}: {got:?} vs {want:?}"
+                );
+            }
+        }
+        // The two solves differ there (else the test could not tell them apart).
+        let d_solve = kv.edge_delays(rot, x, [v.a, v.b, v.c], 44.4);
+        let d_pass = kv.passes_delays(rot, i, v, 44.4);
+        let gap = (out(&kv, d_solve)[1] - out(&kv, d_pass)[1]).abs();
+        assert!(gap > 0.05, "{gap} V");
+    }
+
     #[test]
     fn bad_config_names_field() {
         let bad = |f: fn(&mut DeadTimeCompensationConfig<f64>)| {
@@ -543,5 +682,6 @@ mod tests {
             bad(|c| c.ripple_inductance = Dq::new(1e-3, -1e-3)),
             "ripple_inductance"
         );
+        assert_eq!(bad(|c| c.dc_voltage = -1.0), "dc_voltage");
     }
 }
