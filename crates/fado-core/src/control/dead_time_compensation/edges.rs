@@ -116,22 +116,11 @@ impl<T: Real> DeadTimeCompensation<T> {
         let c = &self.config;
         let per_second = vdc * c.switching_frequency;
         let vth = c.threshold_voltage;
-        let mut vp = [0, 1, 2].map(|x| {
+        let vp = [0, 1, 2].map(|x| {
             v[x] + per_second * (d_rise[x] - d_fall[x])
                 + vth * clamp(i[x] * self.inv_band, -one, one)
         });
-        let (mx, mn) = (
-            vp[0].step_max(vp[1]).step_max(vp[2]),
-            vp[0].step_min(vp[1]).step_min(vp[2]),
-        );
-        let v0 = -(mx + mn) * T::lit(0.5);
-        for p in &mut vp {
-            *p += v0;
-        }
-        let secs_per_volt = half / vdc;
-        let h = T::lit(0.5) * half;
-        let gate_rise = vp.map(|p| clamp(h - p * secs_per_volt, zero, half));
-        let gate_fall = vp.map(|p| clamp(h + p * secs_per_volt, zero, half));
+        let (gate_rise, gate_fall) = self.gate_times(vp, vdc);
         let pole_rise = [0, 1, 2].map(|k| (gate_rise[k] + d_rise[k]).step_min(half));
         let pole_fall = [0, 1, 2].map(|k| (gate_fall[k] + d_fall[k]).step_min(half));
         // High times: half − pole_rise in the falling-carrier half, pole_fall in the rising.

@@ -20,7 +20,9 @@ impl<T: Real> DeadTimeCompensation<T> {
         vdc: T,
     ) -> ([T; 3], [T; 3]) {
         let i = [i_abc.a, i_abc.b, i_abc.c];
-        let gates = self.gate_times(v_abc, self.trapezoid(i_abc, vdc), vdc);
+        let first = self.trapezoid(i_abc, vdc);
+        let vp = [v_abc.a + first.a, v_abc.b + first.b, v_abc.c + first.c];
+        let gates = self.gate_times(vp, vdc);
         let mut delays = (
             i.map(|x| self.edge_delay(true, x)),
             i.map(|x| self.edge_delay(false, x)),
@@ -31,15 +33,14 @@ impl<T: Real> DeadTimeCompensation<T> {
         delays
     }
 
-    /// The gate times within each half period of the pole voltages the modulator will
-    /// realise (reference `v_abc` + first-guess compensation `first`, min-max zero sequence
-    /// as SVPWM, as offsets from the DC-link mid-point): legs go high at half/2 − v·half/Vdc
-    /// while the carrier falls (rising edges), low at half/2 + v·half/Vdc while it rises.
+    /// The gate times (rise, fall) within each half period of the pole voltages `vp` (V per
+    /// phase) the modulator will realise (min-max zero sequence as SVPWM, as offsets from the
+    /// DC-link mid-point): legs go high at half/2 − v·half/Vdc while the carrier falls
+    /// (rising edges), low at half/2 + v·half/Vdc while it rises.
     #[inline(always)]
-    fn gate_times(&self, v_abc: Abc<T>, first: Abc<T>, vdc: T) -> ([T; 3], [T; 3]) {
+    pub(super) fn gate_times(&self, mut vp: [T; 3], vdc: T) -> ([T; 3], [T; 3]) {
         let zero = T::zero();
         let half = self.half; // half carrier period = sample period
-        let mut vp = [v_abc.a + first.a, v_abc.b + first.b, v_abc.c + first.c];
         let (mx, mn) = (
             vp[0].step_max(vp[1]).step_max(vp[2]),
             vp[0].step_min(vp[1]).step_min(vp[2]),
