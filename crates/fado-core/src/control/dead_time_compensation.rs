@@ -71,7 +71,8 @@
 //! g alone does not rank the two solves on every machine: on the 400 V servo test class
 //! (560 V, 6 mH, 5 kHz, Td 2.5 µs, Ic 0.085 A; g = 0.91) the root solve leaves 1.39 V at
 //! standstill under 1.5 A where the passes leave 0.79 V, 1.00 against 1.17 V under 4.4 A and
-//! 0.06 against 2.70 V under 8.8 A (same inverter test, phase b through ±6 Ic).
+//! 0.06 against 2.70 V under 8.8 A (the standstill harness of fado-sim's inverter tests, phase b
+//! through ±6 Ic).
 //! Limit of the root solve: where an edge's loop gain
 //! (Td/Ic)·(β − σ/2) reaches 1 (a low-inductance salient rotor; same test: trapezoid 1.12 V,
 //! this method 0.75 V at 0.37/1.2 mH) the root is not unique and the step is the plain
