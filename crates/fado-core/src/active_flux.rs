@@ -362,6 +362,18 @@ impl<T: Real, M: FluxLookup<T>> ActiveFlux<T, M> {
     /// smaller than its direct part i_q (the law freezes).
     #[inline]
     pub fn resistance_regressor_coupled(&self, point: &ActiveFluxPoint<T>) -> Option<(T, T)> {
+        let (direct, turned, coupling) = self.resistance_regressor_parts(point)?;
+        // Where the turned part reaches the resistance's own d-axis flux i_q (no load, the
+        // current along d: cross-saturation alone), any angle error reads as resistance:
+        // frozen.
+        (turned.abs() < direct.abs()).then_some((direct + turned, coupling))
+    }
+
+    /// The R̂s regressor's bracket in its two parts, the direct i_q and the part the frame's
+    /// turn carries through the map's slope (module docs), with the frame coupling |s|/κ;
+    /// None where κ < [`KAPPA_MIN_RATIO`]·λa or λa ≤ 0.
+    #[inline]
+    pub fn resistance_regressor_parts(&self, point: &ActiveFluxPoint<T>) -> Option<(T, T, T)> {
         let i = point.i_dq;
         let l = self.incremental_inductance(i);
         let lqs = point.lq_secant;
@@ -370,12 +382,9 @@ impl<T: Real, M: FluxLookup<T>> ActiveFlux<T, M> {
         if !(point.active > T::zero() && kappa >= floor) {
             return None;
         }
-        // The part the frame's turn carries through the map's slope; where it reaches the
-        // resistance's own d-axis flux i_q (no load, the current along d: cross-saturation
-        // alone), any angle error reads as resistance: frozen.
         let turned = i.d * ((l.dd - lqs) * i.q - l.dq * i.d) / kappa;
         let s = (lqs - l.dd) * i.q + l.dq * i.d;
-        (turned.abs() < i.q.abs()).then_some((i.q + turned, s.abs() / kappa))
+        Some((i.q, turned, s.abs() / kappa))
     }
 
     /// How far the map's two interpolants of the same nodes disagree on λa at the operating
@@ -400,6 +409,27 @@ impl<T: Real, M: FluxLookup<T>> ActiveFlux<T, M> {
         let s = (lqs - l.dd) * i.q + l.dq * i.d;
         let kappa = point.active + l.qd * i.q - (l.qq - lqs) * i.d;
         (s, kappa)
+    }
+
+    /// The share of its configured rate at which the integrand-offset law learns at the
+    /// operating point: 1 − (|s|/κ)/[`OFFSET_COUPLING_MAX`], down to 0 where the law holds
+    /// ([`Self::holds_offset`]), so that the loop gain through the law falls continuously with
+    /// the frame coupling into the hold; 0 where κ ≤ 0 or on a NaN. Why: the law integrates
+    /// c = |s|/κ of a frame error back into the flux (module docs, "The frame coupling"); on
+    /// the 2.2 kW IPMSM with five times its cross-saturation (c = 0.35 at rated i_q, below the
+    /// hold) the full rate grows a 5 Hz oscillation under rated load at ±90 r/min
+    /// (`rated-reversal` speed error 26.9 r/min, θ error ±0.17 rad; 8.6 r/min, 0.028 rad with
+    /// the taper; docs/method/saturation.md, "The offset law's gate"). Machines of small
+    /// coupling keep nearly all of it (ipmsm-2k2-qsat, below 0.08: at least 0.84).
+    #[inline]
+    pub fn offset_rate_share(&self, point: &ActiveFluxPoint<T>) -> T {
+        let (s, kappa) = self.frame_coupling(point);
+        let share = T::one() - s.abs() / kappa / T::lit(OFFSET_COUPLING_MAX);
+        if kappa > T::zero() && share > T::zero() {
+            share
+        } else {
+            T::zero()
+        }
     }
 
     /// Whether the integrand-offset law holds at the operating point: |s|/κ above

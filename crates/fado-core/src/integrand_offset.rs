@@ -174,7 +174,9 @@ impl<T: Real> IntegrandOffsetParams<T> {
     /// feedback, k_df·ts, plus the estimator's common-mode shifts between two runs of the
     /// law, see below), `shift` the common-mode shift the estimator applies to λ1, the
     /// observer and D̂ now (D̂ afterwards is `disturbance − shift`), `learning` whether the
-    /// law runs (the k_df mode, turning, throughout the period).
+    /// law runs (the k_df mode, turning, throughout the period), `share` the share of the
+    /// configured rate it learns at (1 but where a saturating model's frame coupling tapers it,
+    /// `crate::active_flux::ActiveFlux::offset_rate_share`).
     ///
     /// Run once per sample (ts = the sampling period), `decay` = k_df·Ts. The estimator runs
     /// it once every N samples (ts = N·Ts, see `SensorlessEstimator`'s slow laws): then
@@ -190,6 +192,7 @@ impl<T: Real> IntegrandOffsetParams<T> {
         decay: T,
         shift: Ab<T>,
         learning: bool,
+        share: T,
     ) -> IntegrandOffsetState<T> {
         let mut next = IntegrandOffsetState {
             offset: st.offset,
@@ -202,7 +205,7 @@ impl<T: Real> IntegrandOffsetParams<T> {
         };
         if learning && st.learning_samples >= self.settle_samples && self.config.rate > T::zero() {
             let innovation = (disturbance - st.disturbance_prev) + disturbance * decay;
-            let offset = st.offset + innovation * self.config.rate;
+            let offset = st.offset + innovation * (self.config.rate * share);
             let n2 = offset.norm_squared();
             next.offset = if n2 > self.limit_sq {
                 offset * (self.limit_sq / n2).step_sqrt()
@@ -246,7 +249,7 @@ impl<T: Real> IntegrandOffset<T> {
         learning: bool,
     ) -> IntegrandOffsetState<T> {
         self.params
-            .next_state(&self.state, disturbance, decay, shift, learning)
+            .next_state(&self.state, disturbance, decay, shift, learning, T::one())
     }
 
     /// Takes a state computed by [`Self::next_state`] (which the caller checked is finite).

@@ -110,6 +110,10 @@ fn a_machine_with_five_times_the_cross_saturation_passes() {
         let (passed, angle, speed) = run(scenario, &text);
         println!("{scenario}: {angle:.4} rad, {speed:.2} r/min");
         assert!(passed, "{scenario}: {angle} rad, {speed} r/min");
+        // Its frame coupling reaches 0.35 under rated load: at the full offset rate a 5 Hz
+        // oscillation grows at ±90 r/min (26.9 r/min), with the coupling's taper of the rate
+        // (`ActiveFlux::offset_rate_share`) 8.6 r/min, the 7.4 r/min of the laws switched off.
+        assert!(speed < 15.0, "{scenario}: {speed} r/min");
     }
 }
 

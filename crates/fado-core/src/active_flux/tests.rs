@@ -351,3 +351,41 @@ fn constant_inductances_hold_the_offset_where_the_algebraic_model_does() {
     assert!(!gem(20.0, 0.0), "the injection without load");
     assert!(gem(f64::NAN, 1.0));
 }
+
+/// The integrand-offset law's share of its rate: 1 − (|s|/κ)/`OFFSET_COUPLING_MAX`, within
+/// 0..1, and 0 wherever the law holds (continuous into the hold), on every model.
+#[test]
+fn the_offset_rate_tapers_into_the_hold() {
+    for (name, model, rated) in models() {
+        let af = active(model, rated).unwrap();
+        for i in points(rated, model) {
+            let pt = af.point(i);
+            let (s, kappa) = af.frame_coupling(&pt);
+            let share = af.offset_rate_share(&pt);
+            assert!((0.0..=1.0).contains(&share), "{name} {i:?}: {share}");
+            let expected = (1.0 - s.abs() / kappa / OFFSET_COUPLING_MAX).max(0.0);
+            assert!((share - expected).abs() < 1e-12, "{name} {i:?}: {share}");
+            if af.holds_offset(&pt) {
+                assert_eq!(share, 0.0, "{name} {i:?}: held, share {share}");
+            }
+        }
+    }
+    // Five times the preset's cross-saturation at the rated q current: s < 0 (L_q,s below
+    // L_dd), coupling 0.35, so the law runs at 0.3 of its rate; the preset itself (coupling
+    // 0.002 there) at nearly all of it; on the PM-SyRM's rated MTPA point not at all.
+    let strong = active(ipm_qsat(300.0), 6.08).unwrap();
+    let pt = strong.point(Dq::new(0.0, 6.3));
+    let (s, kappa) = strong.frame_coupling(&pt);
+    assert!(
+        s < 0.0 && (s.abs() / kappa - 0.35).abs() < 0.02,
+        "{s} {kappa}"
+    );
+    assert!((strong.offset_rate_share(&pt) - 0.3).abs() < 0.04);
+    let preset = active(ipm_qsat(58.0), 6.08).unwrap();
+    assert!(preset.offset_rate_share(&preset.point(Dq::new(0.0, 6.3))) > 0.95);
+    let baldor = active(baldor(), 12.45).unwrap();
+    assert_eq!(
+        baldor.offset_rate_share(&baldor.point(Dq::new(-8.26, 8.54))),
+        0.0
+    );
+}

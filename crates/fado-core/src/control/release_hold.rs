@@ -187,6 +187,22 @@ impl<T: Real> Default for ReleaseHoldTuning<T> {
 
 cast_record!(ReleaseHoldTuning { travel, trigger, window, resume_time ; enabled, at_start, track_fall });
 
+/// The loop's speed filter on a saturating machine model: 1/(4·ω_h) \[A\] instead of
+/// 1/(5·ω_h). The direct angle moves with the currents' transients, and on a saturating
+/// model by more (its active flux removes the secant L̂q·i, the stator flux follows the
+/// incremental one). Above the filter's corner r·ω_h the loop passes that motion to the q
+/// current with a gain of (1 + r)·K_p (K_d·r·ω_h = r·K_p): 6·K_p at 5·ω_h, 5·K_p at 4·ω_h.
+/// Measured on `crates/fado-sim/tests/data/traction-ipm-saturated.toml` `loaded-start`: at
+/// 5·ω_h the hold's q current swings by 200 A at ≈ 750 Hz from the release on and the rotor
+/// is lost at seeds 1 and 3 (|θ − θ̂| 3.1 rad); at 4·ω_h seeds 1, 3 and 4 keep |θ − θ̂| within
+/// 0.10, 0.19 and 0.09 rad (2·ω_h: 0.14, 0.13, 0.09), at 1·ω_h the loop's damping is lost
+/// (0.88 rad at seed 1). A lower ratio costs a rotor that the hold must stop quickly: the
+/// made-up 20-pole 48 V IPMSM (`tests/data/ipmsm-20p-48v-saturated.toml`) seed 2 keeps
+/// 0.236 rad at 5·ω_h, 0.242 at 4·ω_h and loses its 0.25 rad bound (0.289) at 2·ω_h. The
+/// other saturated presets keep their margins (max |θ − θ̂| from ready 0.03–0.17 rad at
+/// seeds 1–4).
+pub const SATURATING_SPEED_FILTER_RATIO: f64 = 4.0;
+
 /// The largest ωc·Ts the hold's current-loop rule gives ([`current_bandwidth_for_hold`]):
 /// 0.2 \[A\], with the loop's 1.5-sample delay a phase margin of 90° − 0.3 rad = 73°
 /// (the current loop refuses ωc·Ts above 0.5, 47°).
@@ -403,6 +419,16 @@ impl<T: Real> ReleaseHold<T> {
         })
     }
 
+    /// Low-passes the loop's speed over 1/(`ratio`·ω_h) instead of 1/(5·ω_h)
+    /// ([`SATURATING_SPEED_FILTER_RATIO`] on a saturating machine model).
+    pub fn set_speed_filter_ratio(&mut self, ratio: T) {
+        let omega = self.kp / self.kd;
+        let gain = self.ts / (T::one() / (ratio * omega) + self.ts);
+        if gain.is_finite() && gain > T::zero() {
+            self.omega_gain = gain;
+        }
+    }
+
     /// Keeps the hold acting until the speed reference leaves zero instead of handing over
     /// after 10/ω_h: the rule of [`holds_through_standstill`].
     pub fn set_through_standstill(&mut self, on: bool) {
@@ -555,7 +581,8 @@ impl<T: Real> ReleaseHold<T> {
     /// One sample: the speed reference `speed_ref`, the estimator's tracked angle θ̂
     /// (`theta_tracked`, which triggers the hold) and its direct rotor-flux angle (`theta`,
     /// which the loop holds), electrical. The loop's speed is the direct angle's own rate,
-    /// low-passed over 1/(5·ω_h): the tracked angle and the speed outputs lag a rotor that
+    /// low-passed over 1/(5·ω_h) (1/(4·ω_h) on a saturating model,
+    /// [`SATURATING_SPEED_FILTER_RATIO`]): the tracked angle and the speed outputs lag a rotor that
     /// starts to turn from rest by milliseconds, which the loop's damping cannot afford; the
     /// direct angle moves with the currents' transients at the first current too (0.02 rad
     /// on the 50 kW IPMSM's 44 A injection step, the rotor at rest), which the tracked angle

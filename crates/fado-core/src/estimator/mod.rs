@@ -80,6 +80,12 @@ use crate::{Ab, Real};
 /// Observer time constants 1/(2π·f_th) the λ̂f law waits after a LO→HI hand-over.
 const FLUX_SETTLE_TIME_CONSTANTS: f64 = 2.0;
 
+/// A frame-coupled operating point is steady while the active flux λ̂a(î) stays within this
+/// share of its low-pass (`crate::active_flux::SWING_REFERENCE_TIME`): a load's arrival moves
+/// λ̂a by more, and leaves a frame error that the coupling reads as flux magnitude. Ours \[A\]
+/// (docs/method/saturation.md, "The offset law's gate").
+const STEADY_ACTIVE_SHARE: f64 = 0.05;
+
 /// The slow laws — the R̂s adaptation (with its λ̂f law) and the integrand-offset law — run
 /// once every `SLOW_PERIOD` samples and the loss-of-lock detector once every [`LOCK_PERIOD`],
 /// each in its own slot of a round-robin of `SLOW_PERIOD` slots ([`SLOT_RS`], [`SLOT_OFFSET`],
@@ -283,6 +289,16 @@ pub struct EstimatorState<T: Real> {
     /// operating point of the integrand-offset law's last slot: the law holds, and the
     /// observer runs at the notched speed.
     frame_coupled: bool,
+    /// The share of its rate at which the integrand-offset law learns, judged in the same
+    /// slot (`crate::active_flux::ActiveFlux::offset_rate_share`; 1 for constant
+    /// inductances).
+    offset_share: T,
+    /// Consecutive slots of the integrand-offset law with `frame_coupled` at a steady
+    /// operating point in the k_df mode (the active flux within [`STEADY_ACTIVE_SHARE`] of
+    /// its low-pass `swing_reference`, the law's regime unbroken): from
+    /// `flux_settle_periods` on the turning R̂s law runs at the coupled point
+    /// (`crate::rs_adaptation`, "The frame coupling").
+    coupled_steady: u16,
     /// The observer runs at the notched speed (`crate::speed_notch`): `frame_coupled` while
     /// the machine generates, judged in the same slot.
     notch_on: bool,

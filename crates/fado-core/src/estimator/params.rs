@@ -157,6 +157,8 @@ impl<T: Real> EstimatorParams<T> {
             lag_compensation: T::zero(),
             speed_notch: SpeedNotch::state_at(T::zero()),
             frame_coupled: false,
+            offset_share: T::one(),
+            coupled_steady: 0,
             notch_on: false,
             observer_gains: ObserverGains::standstill(),
             feedback: Ab::zero(),

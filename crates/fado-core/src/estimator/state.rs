@@ -84,6 +84,8 @@ impl<T: Real> EstimatorState<T> {
         self.lag_compensation = T::zero();
         self.speed_notch = SpeedNotch::state_at(T::zero());
         self.frame_coupled = false;
+        self.offset_share = T::one();
+        self.coupled_steady = 0;
         self.notch_on = false;
         // The observer's gains for ω̂ = 0, held as after any update (so that with the
         // default period they are formed in the slots after the lock detector's, which no

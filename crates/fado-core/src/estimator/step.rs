@@ -15,7 +15,7 @@
 
 use super::{
     BROKEN_LIMITED, BROKEN_OFFSET, BROKEN_RS, Diagnostics, Estimate, EstimatorParams,
-    EstimatorState, LOCK_PERIOD, SLOT_LOCK, SLOT_OFFSET, SLOT_RS, SLOW_PERIOD,
+    EstimatorState, LOCK_PERIOD, SLOT_LOCK, SLOT_OFFSET, SLOT_RS, SLOW_PERIOD, STEADY_ACTIVE_SHARE,
 };
 use crate::active_flux::{ActiveFlux, ActiveFluxPoint};
 use crate::magnetics::FluxLookup;
@@ -429,17 +429,22 @@ impl<T: Real> EstimatorState<T> {
         speed: T,
     ) -> T {
         if self.slot == SLOT_OFFSET {
-            let (coupled, i_q) = match c.point {
-                Some(point) => (af.holds_offset(&point), point.i_dq.q),
+            let (coupled, i_q, share) = match c.point {
+                Some(point) => (
+                    af.holds_offset(&point),
+                    point.i_dq.q,
+                    af.offset_rate_share(&point),
+                ),
                 None => {
                     let i_dq = ActiveFlux::<T>::frame_current(c.lambda_r, i_ab);
                     let lf = self.rs_adaptation.flux_linkage_hat;
                     let holds =
                         crate::active_flux::constant_inductance_holds_offset(lf, c.saliency, i_dq);
-                    (holds, i_dq.q)
+                    (holds, i_dq.q, T::one())
                 }
             };
             self.frame_coupled = coupled;
+            self.offset_share = share;
             self.notch_on =
                 p.frame_ripple_notch && self.frame_coupled && i_q * c.t2s1.omega < T::zero();
         }
@@ -526,23 +531,31 @@ impl<T: Real> EstimatorState<T> {
         }
     }
 
-    /// The R̂s adaptation's slot: R̂s, λ̂f and the standstill pull for the next period.
+    /// Which R̂s law applies in this slot, and whether a frame-coupled operating point has
+    /// been steady long enough for the turning law (then also its `settled`).
     #[inline(always)]
-    fn adapt_resistance<M: FluxLookup<T>, const SATURATING: bool>(
-        &mut self,
+    fn resistance_regime<M: FluxLookup<T>, const SATURATING: bool>(
+        &self,
         p: &EstimatorParams<T>,
         af: &ActiveFlux<T, M>,
         c: &Candidate<T>,
         broken: u8,
-        v_ab: Ab<T>,
-        i_ab: Ab<T>,
-    ) {
+    ) -> (AdaptationRegime, bool) {
         // A saturating model's frame coupling above `active_flux::OFFSET_COUPLING_MAX` freezes
         // the turning law as it holds the offset law: with the current loop holding î, a
         // frame error moves |λ̂r| by σ·δ, which the law would read as resistance (a model
         // error's angle, or a load step's transient, amplified; docs/method/saturation.md,
         // "The offset law's gate").
-        let coupled = SATURATING && self.frame_coupled && c.mode == Mode::DisturbanceFeedback;
+        // Steady there, for as long as the λ̂f law waits after a hand-over, it runs: the
+        // coupling then carries no load transient, and the law models the rest (the model's
+        // flux uncertainty times 1 + the coupling, `crate::rs_adaptation`).
+        let coupled_settled = SATURATING
+            && self.frame_coupled
+            && u32::from(self.coupled_steady) >= p.flux_settle_periods;
+        let coupled = SATURATING
+            && self.frame_coupled
+            && c.mode == Mode::DisturbanceFeedback
+            && !coupled_settled;
         // Beyond a map's data the model's slope is its edge cells' extension: the law would
         // learn that guess's error as resistance (docs/results/saturated-replay.md: a map that
         // ends at 0.6 × rated current, 0.32 rad at rated torque with the law, 0.004 frozen).
@@ -559,6 +572,21 @@ impl<T: Real> EstimatorState<T> {
                 Mode::Limiter => AdaptationRegime::Standstill,
             }
         };
+        (regime, coupled_settled)
+    }
+
+    /// The R̂s adaptation's slot: R̂s, λ̂f and the standstill pull for the next period.
+    #[inline(always)]
+    fn adapt_resistance<M: FluxLookup<T>, const SATURATING: bool>(
+        &mut self,
+        p: &EstimatorParams<T>,
+        af: &ActiveFlux<T, M>,
+        c: &Candidate<T>,
+        broken: u8,
+        v_ab: Ab<T>,
+        i_ab: Ab<T>,
+    ) {
+        let (regime, coupled_settled) = self.resistance_regime::<M, SATURATING>(p, af, c, broken);
         // The standstill law sees the voltage without the learned offset, and the voltage
         // and current averaged over the period.
         let per_sample = T::one() / T::lit(SLOW_PERIOD as f64);
@@ -576,7 +604,7 @@ impl<T: Real> EstimatorState<T> {
             c.lambda_r,
             c.t2s1.omega,
             regime,
-            self.offset.learning_samples >= p.flux_settle_periods,
+            self.offset.learning_samples >= p.flux_settle_periods || coupled_settled,
             Some(af),
         );
         // The pull acts until the law runs again (one period), with ê.
@@ -618,19 +646,38 @@ impl<T: Real> EstimatorState<T> {
         let decay = c.kdf_gain * (p.ts * n) + self.offset_recentring_gain * (n - T::one());
         // A saturating model's frame coupling (`crate::active_flux`): where the flux magnitude
         // carries the frame error the law holds ê and the k_df mode stops re-centring at k_e
-        // until the next period.
+        // until the next period; below that both run at a share of k_e that falls with the
+        // coupling (`ActiveFlux::offset_rate_share`).
         let holds = self.frame_coupled;
         if (c.point.is_some() || c.saliency != T::zero()) && self.rs_adaptation_on {
             self.offset_recentring_gain = if holds {
                 T::zero()
             } else {
-                p.offset_recentring_gain
+                p.offset_recentring_gain * self.offset_share
             };
         }
-        let learning = broken & BROKEN_OFFSET == 0 && c.mode == Mode::DisturbanceFeedback && !holds;
-        let mut offset = p
-            .offset
-            .next_state(&self.offset, c.disturbance, decay, shift, learning);
+        let regime = broken & BROKEN_OFFSET == 0 && c.mode == Mode::DisturbanceFeedback;
+        let learning = regime && !holds;
+        // A coupled point's steadiness (`coupled_steady`): the active flux near its low-pass.
+        let steady = regime
+            && holds
+            && c.point.is_some_and(|point| {
+                (point.active - self.swing_reference).abs()
+                    <= T::lit(STEADY_ACTIVE_SHARE) * self.swing_reference
+            });
+        self.coupled_steady = if steady {
+            self.coupled_steady.saturating_add(1)
+        } else {
+            0
+        };
+        let mut offset = p.offset.next_state(
+            &self.offset,
+            c.disturbance,
+            decay,
+            shift,
+            learning,
+            self.offset_share,
+        );
         // Above the speed of the shortest revolution the law trusts it holds ê (an error
         // locked to the rotor and the carrier aliases onto DC there; the count of settled
         // samples goes on, the λ̂f law waits on it).

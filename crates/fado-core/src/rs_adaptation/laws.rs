@@ -46,6 +46,39 @@ pub(crate) struct ResistanceAdaptationParams<T: 'static> {
 /// 0.95–1.05 × the truth running everywhere).
 pub(crate) const MAP_RESISTANCE_RESOLUTION: f64 = 0.02;
 
+/// The frame coupling |s|/κ (`ActiveFlux::frame_coupling`) at or above which the turning law
+/// stays frozen even at a steady operating point: there a frame error moves |λ̂r| by more than
+/// the turn of λ̂r it leaves visible (σ/κ ≥ 1), so whatever frame error is left (a load's
+/// transient, the model's own mismatch) outweighs the resistance's flux. Ours \[A\]: the
+/// pmsyrm-baldor-5k6 presets' MTPA points (0.60–0.96 from 30 % to rated torque) lie below it
+/// and their R̂s converges there; the weak-magnet PM-SyRMs of `saturated_replay` (1.1–1.5
+/// under load), which learn a load step's transient as resistance where the law runs at
+/// their coupled points, stay frozen (docs/method/saturation.md, "The offset law's gate").
+pub(crate) const COUPLED_RESISTANCE_MAX: f64 = 1.0;
+
+/// The regressor's bracket and the frame coupling at `point` (None: frozen). Below
+/// `OFFSET_COUPLING_MAX` the bracket's turned part must be smaller than its direct part i_q
+/// (`ActiveFlux::resistance_regressor_coupled`); above it (the estimator runs the law there
+/// only at a steady operating point, `crate::estimator`) the coupling must stay below
+/// [`COUPLED_RESISTANCE_MAX`], and a turned part that adds to i_q may reach twice it (the
+/// bracket is then larger than i_q, not ill-conditioned: at the PM-SyRM's rated MTPA point it
+/// reaches i_q).
+#[inline(always)]
+fn coupled_bracket<T: Real, M: FluxLookup<T>>(
+    af: &ActiveFlux<T, M>,
+    point: &ActiveFluxPoint<T>,
+) -> Option<(T, T)> {
+    let (direct, turned, coupling) = af.resistance_regressor_parts(point)?;
+    let conditioned = turned.abs() < direct.abs();
+    let usable = if coupling > T::lit(crate::active_flux::OFFSET_COUPLING_MAX) {
+        let adds = turned * direct >= T::zero() && turned.abs() < (direct + direct).abs();
+        coupling < T::lit(COUPLED_RESISTANCE_MAX) && (conditioned || adds)
+    } else {
+        conditioned
+    };
+    usable.then_some((direct + turned, coupling))
+}
+
 /// 1/(2π·`hz`)²: |ω̂| ≤ 2π·`hz` is ω̂²·(that) ≤ 1; `hz` = 0 allows ω̂ = 0 only (1e30: no
 /// ∞·0).
 fn inverse_square_speed<T: Real>(hz: T) -> T {
@@ -300,7 +333,7 @@ impl<T: Real> ResistanceAdaptationParams<T> {
             if !settled {
                 return false;
             }
-            let Some((bracket, coupling)) = af.resistance_regressor_coupled(&point) else {
+            let Some((bracket, coupling)) = coupled_bracket(af, &point) else {
                 return false;
             };
             // Frozen where what the model leaves open (the map's interpolation spread and the
@@ -324,7 +357,7 @@ impl<T: Real> ResistanceAdaptationParams<T> {
             // within milliseconds).
             let relative_to = crate::real::max(lf, reference);
             let a = -(mag * bracket) * scale.chi_per_phi * (lf / relative_to);
-            let (gain, rate_ts) = self.saturated_rate(scale, st, a, mag);
+            let (gain, rate_ts) = self.saturated_rate(scale, st, a, mag, coupling);
             return self.rotating_step(
                 st,
                 next,
@@ -379,7 +412,12 @@ impl<T: Real> ResistanceAdaptationParams<T> {
     /// (module docs, "The rate on a saturating model"), and at least the configured γ; at most
     /// half the error per period. The configured γ with a `model_flux_uncertainty` above 0
     /// (the data then carry the model's error, which the gain would take at once); γ = 0 stays
-    /// 0.
+    /// 0. At a frame-coupled point (`coupling` above `OFFSET_COUPLING_MAX`, where the estimator
+    /// runs the law only at a steady operating point) the gain is the prior's 1/T_E whatever
+    /// the excitation seen: the least-squares gain's 1/t decay would leave most of a start
+    /// error in place through the one or two loaded seconds before a zero-speed passage (the
+    /// PM-SyRM's measured map started 1.4 × off: R̂s 1.085 × at `rated-reversal`'s passage,
+    /// 0.974 × with the prior's rate, `saturated_rs_convergence`).
     #[inline(always)]
     fn saturated_rate(
         &self,
@@ -387,12 +425,18 @@ impl<T: Real> ResistanceAdaptationParams<T> {
         st: &ResistanceAdaptationState<T>,
         a: T,
         mag: T,
+        coupling: T,
     ) -> (T, T) {
         if self.rate_ts <= T::zero() || self.model_flux > T::zero() {
             return (scale.gain, self.rate_ts);
         }
         let ts = self.config.ts;
-        let least_squares = ts / (T::lit(SATURATED_PRIOR_TIME) + st.excitation_time);
+        let seen = if coupling > T::lit(crate::active_flux::OFFSET_COUPLING_MAX) {
+            T::zero()
+        } else {
+            st.excitation_time
+        };
+        let least_squares = ts / (T::lit(SATURATED_PRIOR_TIME) + seen);
         let resistive = a.abs() * self.saturated_speed_rate_ts / mag;
         let rate_ts = min(
             max(max(least_squares, resistive), self.rate_ts),

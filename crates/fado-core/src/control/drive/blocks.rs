@@ -11,7 +11,9 @@ use crate::control::lock_reaction::LockSupervisor;
 use crate::control::modulation::{ModulatorConfig, SpaceVectorModulator};
 use crate::control::phase_band::PhaseBand;
 use crate::control::ratings_limit::RatingsLimit;
-use crate::control::release_hold::{ReleaseHold, holds_through_standstill};
+use crate::control::release_hold::{
+    ReleaseHold, SATURATING_SPEED_FILTER_RATIO, holds_through_standstill,
+};
 use crate::control::saturated_references::SaturatedReferences;
 use crate::control::speed_controller::{SpeedController, SpeedControllerConfig};
 use crate::control::standstill_probe::{StandstillProbe, StandstillProbeConfig};
@@ -272,6 +274,9 @@ fn release_hold<T: Real>(
     let mut hold = ReleaseHold::new(&t.release_hold, m, c.ts, t.current.bandwidth_hz, i_max)?;
     let through = holds_through_standstill(&t.release_hold, m, probe.amplitude, probe.period);
     hold.set_through_standstill(through);
+    if !m.magnetic_model().is_linear() {
+        hold.set_speed_filter_ratio(T::lit(SATURATING_SPEED_FILTER_RATIO));
+    }
     Ok(hold)
 }
 

@@ -1,0 +1,124 @@
+//! The figure commissioning writes as `[estimator.rs_adaptation] model_flux_uncertainty`
+//! (`Identification::model_flux_uncertainty`) against the identified model's flux error at
+//! the plant's MTPA operating points (0, 30, 65 and 100 % of rated torque), both as a share
+//! of the identified λ̂f: what the online R̂s law takes the model's flux error to be where it
+//! runs (docs/method/saturation.md, "The offset law's gate").
+//!
+//! Measured (`cargo test --release -p fado-sim --test model_flux_uncertainty -- --ignored
+//! --nocapture`, sensor seed 1), error at 0 / 30 / 65 / 100 % of rated torque against the
+//! figure: ipmsm-2k2-qsat 0.0001–0.0007 / 0.0007; pmsm-gem-1k1-measured 0.0034–0.0085 /
+//! 0.0072; pmsyrm-baldor-5k6 0.030–0.046 / 0.016; pmsyrm-baldor-5k6-measured 0.081–0.086 /
+//! 0.027; ipmsm-test-saturated 0.0072 / 0.0050. Most of it is the magnet's flux at zero
+//! current (the identified λ̂f's error, which the λ̂f law absorbs); less that, the loaded
+//! error still reaches 1.1–1.5 times the figure at rated torque on three of the five
+//! (0.0008, 0.0105, 0.0175 against 0.0007, 0.0072, 0.0160): the figure, an RMS residual over
+//! the pulses, does not bound it, and the test is ignored until one that does is derived from
+//! the identification's own residuals.
+
+use fado_core::Dq;
+use fado_core::MachineModel;
+use fado_core::magnetics::{MagneticModel, Magnetics};
+use fado_sim::commission::{CommissionOptions, commission};
+use fado_sim::magnetic_accuracy::plant_model;
+
+/// The plant's MTPA current for `torque` (N·m): the smallest current magnitude whose best
+/// angle (i_d ≤ 0, 0.25° steps) reaches it, by bisection.
+fn mtpa(model: &impl MagneticModel<f64>, pole_pairs: f64, torque: f64, i_max: f64) -> Dq<f64> {
+    let best = |i: f64| {
+        (0..=360)
+            .map(|k| {
+                let beta = core::f64::consts::FRAC_PI_2 * (1.0 + k as f64 / 360.0);
+                let c = Dq::new(i * beta.cos(), i * beta.sin());
+                let psi = model.flux(c);
+                (1.5 * pole_pairs * (psi.d * c.q - psi.q * c.d), c)
+            })
+            .fold(
+                (f64::MIN, Dq::new(0.0, 0.0)),
+                |a, b| if b.0 > a.0 { b } else { a },
+            )
+    };
+    if torque <= 0.0 {
+        return Dq::new(0.0, 0.0);
+    }
+    let (mut lo, mut hi) = (0.0, i_max);
+    for _ in 0..50 {
+        let mid = 0.5 * (lo + hi);
+        if best(mid).0 >= torque {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    best(hi).1
+}
+
+/// The identified model's flux error |ψ̂ − ψ|/λ̂f at the loads, the same less its error at
+/// zero current (the magnet's, which the λ̂f law absorbs), and the written figure.
+fn measure(path: &str) -> ([f64; 4], [f64; 4], f64) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let cfg = fado_sim::SimConfig::from_toml(&text).unwrap();
+    let plant = cfg.plant();
+    let nameplate = MachineModel {
+        dc_voltage: plant.inverter.dc_voltage,
+        ..plant.motor
+    };
+    let o = commission(
+        &plant,
+        nameplate,
+        CommissionOptions::default(),
+        |_| {},
+        None,
+    )
+    .unwrap();
+    let id = o.identification.unwrap();
+    let report = o.magnetics.unwrap();
+    assert!(report.saturation_detected, "{path}: {}", report.verdict);
+    let identified = Magnetics::<f64>::Saturation(report.fitted);
+    let truth = plant_model(&plant);
+    let m = &plant.motor;
+    let zero = Dq::new(0.0, 0.0);
+    let magnet = identified.flux(zero) - truth.flux(zero);
+    let points = [0.0, 0.3, 0.65, 1.0].map(|load| {
+        mtpa(
+            &truth,
+            m.pole_pairs as f64,
+            load * m.rated_torque,
+            2.0 * m.rated_current,
+        )
+    });
+    let error = |i: Dq<f64>| identified.flux(i) - truth.flux(i);
+    let lf = id.model.flux_linkage;
+    (
+        points.map(|i| error(i).norm() / lf),
+        points.map(|i| (error(i) - magnet).norm() / lf),
+        id.model_flux_uncertainty().unwrap(),
+    )
+}
+
+#[test]
+#[ignore = "the written figure underestimates the flux error at load (module docs: 0.027 against 0.081-0.086 on the PM-SyRM's measured map)"]
+fn the_written_figure_bounds_the_models_flux_error_at_every_load() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../motors/saturated");
+    fado_sim::magnetics_file::set_config_dir(Some(std::path::Path::new(dir)));
+    let root = env!("CARGO_MANIFEST_DIR");
+    let mut short = Vec::new();
+    for path in [
+        format!("{root}/../../motors/saturated/ipmsm-2k2-qsat.toml"),
+        format!("{root}/../../motors/saturated/pmsm-gem-1k1-measured.toml"),
+        format!("{root}/../../motors/saturated/pmsyrm-baldor-5k6.toml"),
+        format!("{root}/../../motors/saturated/pmsyrm-baldor-5k6-measured.toml"),
+        format!("{root}/tests/data/ipmsm-test-saturated.toml"),
+    ] {
+        let (errors, loaded, figure) = measure(&path);
+        let name = path.rsplit('/').next().unwrap();
+        println!(
+            "{name}: flux error at 0/30/65/100 %: {:.4} / {:.4} / {:.4} / {:.4} of λ̂f \
+             (less the magnet's: {:.4} / {:.4} / {:.4}), figure {figure:.4}",
+            errors[0], errors[1], errors[2], errors[3], loaded[1], loaded[2], loaded[3]
+        );
+        if errors.iter().any(|&e| e > figure) {
+            short.push(name.to_string());
+        }
+    }
+    assert!(short.is_empty(), "{short:?}");
+}
