@@ -347,7 +347,7 @@ impl<T: Real> DeadTimeCompensation<T> {
         }
         let one = T::one();
         let i = [i_abc.a, i_abc.b, i_abc.c];
-        let (d_rise, d_fall) = if self.solves_edges() {
+        let (d_rise, d_fall) = if self.solves_edges() && self.middle_follows(i_abc, v_abc, vdc) {
             self.edge_delays(rotation, i, [v_abc.a, v_abc.b, v_abc.c], vdc)
         } else {
             self.passes_delays(rotation, i_abc, v_abc, vdc)
@@ -372,6 +372,21 @@ impl<T: Real> DeadTimeCompensation<T> {
     #[inline(always)]
     pub fn solves_edges(&self) -> bool {
         self.solve_edges
+    }
+
+    /// Whether the middle pole's gate edges follow the other poles' pole edges (module docs,
+    /// "Which solve"): the poles of the reference `v_abc` plus the trapezoid of `i_abc` more
+    /// than Td·Vdc/(half period) = 2·Td·f_sw·Vdc apart, the middle from the largest and from
+    /// the smallest (a pole edge waits at most Td after its gate).
+    #[inline(always)]
+    fn middle_follows(&self, i_abc: Abc<T>, v_abc: Abc<T>, vdc: T) -> bool {
+        let t = self.trapezoid(i_abc, vdc);
+        let vp = [v_abc.a + t.a, v_abc.b + t.b, v_abc.c + t.c];
+        let mx = vp[0].step_max(vp[1]).step_max(vp[2]);
+        let mn = vp[0].step_min(vp[1]).step_min(vp[2]);
+        let mid = vp[0] + vp[1] + vp[2] - mx - mn;
+        let apart = self.config.dead_time * vdc / self.half;
+        mx - mid > apart && mid - mn > apart
     }
 
     /// Delay of one edge (band model): the opposing current waits Td, the helping one
