@@ -347,7 +347,9 @@ impl<T: Real> DeadTimeCompensation<T> {
         }
         let one = T::one();
         let i = [i_abc.a, i_abc.b, i_abc.c];
-        let (d_rise, d_fall) = if self.solves_edges() && self.middle_follows(i_abc, v_abc, vdc) {
+        let solve = self.solves_edges()
+            && (self.loop_gain >= one || self.middle_follows(i_abc, v_abc, vdc));
+        let (d_rise, d_fall) = if solve {
             self.edge_delays(rotation, i, [v_abc.a, v_abc.b, v_abc.c], vdc)
         } else {
             self.passes_delays(rotation, i_abc, v_abc, vdc)
@@ -385,7 +387,7 @@ impl<T: Real> DeadTimeCompensation<T> {
         let mx = vp[0].step_max(vp[1]).step_max(vp[2]);
         let mn = vp[0].step_min(vp[1]).step_min(vp[2]);
         let mid = vp[0] + vp[1] + vp[2] - mx - mn;
-        let apart = self.config.dead_time * vdc / self.half;
+        let apart = T::lit(2.0) * self.config.dead_time * vdc / self.half;
         mx - mid > apart && mid - mn > apart
     }
 
