@@ -212,8 +212,10 @@ fn mad_5010_kv110_passes_the_stops_from_other_start_angles() {
 /// edge-current compensation (loop gain g = 0.79, above `EDGE_SOLVE_LOOP_GAIN`) solves each
 /// edge's delay at the edge current the delays imply
 /// (`fado_core::control::dead_time_compensation`), 0.043 V from the inverter at standstill
-/// (the inverter's unit tests). Measured |θ − θ̂| 0.118 / 0.196 / 0.200 / 0.122 rad at seeds
-/// 1–4 (0.35 / 0.21 / 0.33 / 0.31 with two fixed-point passes on the trapezoid's gate times).
+/// (the inverter's unit tests) where the middle pole's edges follow the others', the two
+/// fixed-point passes in the samples where they do not. Measured |θ − θ̂| 0.115 / 0.194 /
+/// 0.199 / 0.126 rad at seeds 1–4 (0.118 / 0.196 / 0.200 / 0.122 with the root solve in every
+/// sample, 0.35 / 0.21 / 0.33 / 0.31 with the passes in every sample).
 #[test]
 fn mad_5010_kv110_passes_the_stops_from_a_zero_start_angle() {
     let motor = format!("{MAD5010_110}\n[simulation]\ninitial_angle = 0.0\n");

@@ -54,7 +54,8 @@
 //!   leave 0.097 V on the paper's motor (g = 0.33; 0.64 V with the trapezoid alone) and
 //!   0.042 / 0.080 V under 5.55 / 12 A on the MAD 5010 KV110's inverter with 200 µH
 //!   (g = 0.34).
-//! - g above it: the root of delay − band model(edge current the delays imply) with the
+//! - g above it (below g = 1 only in the samples where the middle pole's edges follow the
+//!   others', below): the root of delay − band model(edge current the delays imply) with the
 //!   gate times of the reference plus the compensation itself, a piecewise-linear problem
 //!   (`edges` submodule: Newton steps with the pattern's own slopes, bounded rounds). The
 //!   passes oscillate as g nears 1: on the MAD 5010 KV110 (44.4 V, 85 µH, 20 kHz, g = 0.79)
@@ -68,11 +69,27 @@
 //! KV110 (g = 0.79): a margin of 5 % either side. g of the presets: ipmsm-2k2 0.04,
 //! hub-hoverboard-48v 0.12, outrunner-cheetah-24v 0.18, pmsyrm-5k 0.22, paper 0.33,
 //! servo-1ft6084 0.71 (passes); multirotor-mn5006-22v 1.23, ipmsm-gem-50k 3.9 (root solve).
-//! g alone does not rank the two solves on every machine: on the 400 V servo test class
-//! (560 V, 6 mH, 5 kHz, Td 2.5 µs, Ic 0.085 A; g = 0.91) the root solve leaves 1.39 V at
-//! standstill under 1.5 A where the passes leave 0.79 V, 1.00 against 1.17 V under 4.4 A and
-//! 0.06 against 2.70 V under 8.8 A (the standstill harness of fado-sim's inverter tests, phase b
-//! through ±6 Ic).
+//! Per sample, below g = 1, the root solve runs only where the middle pole's gate edges
+//! follow the other two poles' edges by a margin: the references plus the trapezoid more
+//! than 4·Td·f_sw·Vdc (2·Td in time) from the largest and from the smallest; elsewhere the
+//! passes. Where the middle phase's two edges come before any other pole's edge they see
+//! only the phase's own swing, which both of its delays move (sum-mode loop gain g), and
+//! what the model leaves out moves the root by its error/(1 − g): the device drop
+//! V_th·sat(i(t)/Ic) following the instantaneous current (21 Ω inside the band against
+//! 6 mH on the 400 V servo test class: 560 V, 6 mH, 5 kHz, Td 2.5 µs, Ic 0.085 A, V_th 1.8 V,
+//! g = 0.91) and the zero vector's slope. There, at standstill under 1.5 A with phase b at
+//! −0.5 Ic (the a and c edges 1.9 µs, < Td, from b's), the model's root is unique and
+//! reached (Td on both edges, −0.90 V) while the inverter's own is −1.41 V: it puts the
+//! rising edge's current 5 mA (0.06 Ic) above the inverter's. Measured worst error on
+//! phase b (fado-sim's inverter tests, phase b through ±6 Ic) under 1.5 / 4.4 / 8.8 A: the
+//! passes 0.79 / 1.17 / 2.70 V, the root solve in every sample 1.39 / 1.00 / 0.06 V; with
+//! the margin at 2·Td·f_sw·Vdc (Td in time) the 8.8 A case keeps the root solve
+//! (0.06 V) but the servo's start-up with its load arriving in the release reads 0.253 rad
+//! (crates/fado-sim/tests/calibration_load_classes.rs, bound 0.25; 0.248 at 4·Td·f_sw·Vdc,
+//! 0.283 on the root solve in every sample). At g ≥ 1 the passes do not converge (they
+//! iterate a loop of gain g) and the root solve runs in every sample: on the Flipsky 6215
+//! (g = 1.5) the passes at low current lose the rotor at `loaded-start` seed 4 (2.17 rad
+//! back).
 //! Limit of the root solve: where an edge's loop gain
 //! (Td/Ic)·(β − σ/2) reaches 1 (a low-inductance salient rotor; same test: trapezoid 1.12 V,
 //! this method 0.75 V at 0.37/1.2 mH) the root is not unique and the step is the plain
@@ -136,7 +153,8 @@ pub const DEFAULT_METHOD: DeadTimeMethod = DeadTimeMethod::EdgeCurrent;
 /// Default switching frequency in Hz: 5 kHz (paper, V).
 pub const DEFAULT_SWITCHING_FREQUENCY: f64 = 5e3;
 /// Loop gain g = Vdc·Td/(3·min(L̂d, L̂q)·Ic) above which [`DeadTimeMethod::EdgeCurrent`]
-/// solves the edges' delays for their root instead of taking two fixed-point passes: 0.75
+/// solves the edges' delays for their root instead of taking two fixed-point passes (below
+/// g = 1 only in the samples where the middle pole's edges follow the others'): 0.75
 /// (module docs, "Which solve": between the Siemens 1FT6084 preset at g = 0.71, kept on the
 /// passes, and the MAD 5010 KV110 at g = 0.79, where the passes leave 0.32 V at standstill
 /// and the root solve 0.043 V).
@@ -369,17 +387,19 @@ impl<T: Real> DeadTimeCompensation<T> {
     }
 
     /// Whether [`DeadTimeMethod::EdgeCurrent`] solves the edges' delays for their root (g
-    /// above [`EDGE_SOLVE_LOOP_GAIN`]) rather than taking the two fixed-point passes (module
+    /// above [`EDGE_SOLVE_LOOP_GAIN`]; below g = 1 only in the samples where the middle
+    /// pole's edges follow the others') rather than taking the two fixed-point passes (module
     /// docs, "Which solve").
     #[inline(always)]
     pub fn solves_edges(&self) -> bool {
         self.solve_edges
     }
 
-    /// Whether the middle pole's gate edges follow the other poles' pole edges (module docs,
-    /// "Which solve"): the poles of the reference `v_abc` plus the trapezoid of `i_abc` more
-    /// than Td·Vdc/(half period) = 2·Td·f_sw·Vdc apart, the middle from the largest and from
-    /// the smallest (a pole edge waits at most Td after its gate).
+    /// Whether the middle pole's gate edges follow the other poles' edges with a margin
+    /// (module docs, "Which solve"): the poles of the reference `v_abc` plus the trapezoid of
+    /// `i_abc` more than 2·Td·Vdc/(half period) = 4·Td·f_sw·Vdc apart (2·Td in time: a pole
+    /// edge waits at most Td after its gate, and as much again), the middle from the largest
+    /// and from the smallest.
     #[inline(always)]
     fn middle_follows(&self, i_abc: Abc<T>, v_abc: Abc<T>, vdc: T) -> bool {
         let t = self.trapezoid(i_abc, vdc);
@@ -686,6 +706,36 @@ mod tests {
         let d_pass = kv.passes_delays(rot, i, v, 44.4);
         let gap = (out(&kv, d_solve)[1] - out(&kv, d_pass)[1]).abs();
         assert!(gap > 0.05, "{gap} V");
+    }
+
+    #[test]
+    fn below_a_loop_gain_of_one_the_solve_is_chosen_per_sample() {
+        // The MAD 5010 KV110 (g = 0.79) at standstill under 0.5 A, phase b at 0.05 A: the
+        // references plus the trapezoid lie 0.6–1.6 V apart, under 4·Td·f_sw·Vdc = 2.22 V:
+        // the passes. With the rated DC link raised to g = 1.01: the root solve.
+        let kv = kv110(44.4);
+        let at_one = kv110(44.4 * 1.01 / kv.loop_gain());
+        assert!(kv.solves_edges() && at_one.loop_gain() >= 1.0);
+        let ib = 0.05;
+        let i = Abc::new(-0.5 - 0.5 * ib, ib, 0.5 - 0.5 * ib);
+        let v = Abc::new(0.6193 * i.a, 0.6193 * i.b, 0.6193 * i.c);
+        let rot = Rotation::from_angle(0.0);
+        let x = [i.a, i.b, i.c];
+        let out = |c: &DeadTimeCompensation<f64>, (r, f): ([f64; 3], [f64; 3])| {
+            let per_second = 44.4 * 20e3;
+            let vth = c.config().threshold_voltage;
+            let ic = c.config().current_band;
+            [0, 1, 2].map(|k| per_second * (r[k] - f[k]) + vth * (x[k] / ic).clamp(-1.0, 1.0))
+        };
+        let passes = out(&kv, kv.passes_delays(rot, i, v, 44.4));
+        let solve = out(&kv, kv.edge_delays(rot, x, [v.a, v.b, v.c], 44.4));
+        assert!((passes[1] - solve[1]).abs() > 0.01, "{passes:?} {solve:?}");
+        for (c, want) in [(&kv, passes), (&at_one, solve)] {
+            let got = c.edge_current(rot, i, v, 44.4);
+            for (g, w) in [got.a, got.b, got.c].into_iter().zip(want) {
+                assert!((g - w).abs() < 1e-12, "{got:?} vs {want:?}");
+            }
+        }
     }
 
     #[test]
