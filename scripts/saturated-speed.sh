@@ -89,19 +89,20 @@ shared machine; `valgrind --tool=callgrind target/release/fado-sim run stops --c
   i(ψ) is solved in closed form per bilinear cell (`fado_core::magnetics`, "Inversion"); the
   sub-step is 0.05 of the shortest incremental time constant over the map's own grid
   (`fado-sim`'s `magnetics` module), so that nearly every interval of one switch state is one
-  sub-step: two inversions on a long interval (the second and the last Runge–Kutta stages;
-  the third stage's flux, a hair from the second's, is one Newton step from that stage's
-  solution taken where its error is below 10⁻⁵ of the cell, `STAGE_TOLERANCE`, a stage's
-  current entering the flux through R·h/3 only; the end's current, a hair from the last
-  stage's flux, one Newton step in that stage's cell), one on a short one (the trapezoid
-  rule: Euler's end inverted, the corrected end one Newton step from it). `stops` on the GEM
-  map has five intervals per sample, three in five short: seven inversions per sample. The plant keeps the last four cells' polynomials
-  (`fado_core::magnetics::InverseCache`, carried from sample to sample) and solves first in
+  sub-step. Each Runge–Kutta stage, and the trapezoid rule's Euler end on a short interval
+  (a dead time), is Newton's steps from the last solution in its cell (one, or a second where
+  the first misses), taken where their error is below 10⁻⁵ of the cell (`STAGE_TOLERANCE`: a
+  stage's current enters the flux through R·h/3 or less) and they stay in it; the map is
+  inverted where they do not. The end's current, a hair from the last stage's flux, is one
+  Newton step to 10⁻⁹ of the cell. `stops` on the GEM map has five intervals per sample,
+  three in five short: nine stages and five ends per sample, 1.4 inversions. The plant keeps
+  the last four cells' polynomials
+  (`fado_core::magnetics::InverseCache`, moved from sample to sample) and solves first in
   the last solution's cell, then in the neighbour its root points into, taking a root that
-  lies inside by more than 10⁻⁶ of the cell (the walk's own answer, bit for bit): 95 % of the
+  lies inside by more than 10⁻⁶ of the cell (the walk's own answer, bit for bit): 87 % of the
   inversions are one or two quadratics, a square root and two divisions each, with no search.
-  The inversions are 15 % of the GEM map's instructions, the Newton steps 7 % and the
-  Runge–Kutta steps around them 11 %. The estimator reads the map through its C¹ interpolant (docs/method/saturation.md
+  The inversions are 5.5 % of the GEM map's instructions, the Newton steps 17 % and the
+  Runge–Kutta steps around them 10 %. The estimator reads the map through its C¹ interpolant (docs/method/saturation.md
   "A map's interpolation") twice per sample, at the two operating points it forms (the
   observer's and the rotor flux's, at different currents): the flux alone
   (`FluxMap::smooth_flux`), the cells found as the bilinear lookup finds them, the node slopes

@@ -16,7 +16,7 @@
 //! | back-EMF | ω·λf / (Vdc/√3) | — | above 2 |
 //! | DC link | \|v_rated\| / (Vdc/√3) | below 0.2, above [`DC_LINK_SHORT`] (mains rms for the link? no-load speed?) | below 0.1 (ratings / 10?) |
 //! | reactance | L·I / λf | above 5 | above 50 (mH for H?) |
-//! | resistance | R·I / (ω·λf) | above 0.5 | above 2 (mΩ for Ω? r/s for r/min?) |
+//! | resistance | R·I / (ω·λf) | above 0.5 (with the speed below which a 0.3 % voltage error costs 0.25 rad, [`low_speed_limit`]) | above 2 (mΩ for Ω? r/s for r/min?) |
 //! | time constant | min(Ld, Lq)/R | above 2 s | — |
 //! | saliency | Ld / Lq | above 1.1 (swapped?) | — |
 //! | sampling | ω·Ts | above [`crate::ratings::MAX_RUNNING_OMEGA_TS`] | above π (Ts in ms for s? f_sw in kHz for Hz?) |
@@ -109,6 +109,7 @@ pub const MAX_ELECTRICAL_FREQUENCY: f64 = 5000.0;
 
 use finding::TORQUE_KEYS_SALIENT;
 pub use finding::{Finding, Findings, TorqueSlip};
+pub use text::{LOW_SPEED_VOLTAGE_ERROR, low_speed_limit};
 
 /// The slip whose undoing brings T_rated over the model's MTPA torque at rated current
 /// closest to 1, with that ratio; [`TorqueSlip::Unknown`] (and the given ratio) when none

@@ -353,8 +353,9 @@ pub struct Motor {
     rot: Complex64,
     /// (ts, e^{−B·ts/J}) of the last mechanical step: the sample period never changes.
     decay: (f64, f64),
-    /// A flux map's inverse cells, carried from one sample's integrator to the next.
-    inverse: InverseCache<f64>,
+    /// A flux map's inverse cells, carried from one sample's integrator to the next: moved
+    /// into it and back (a box: no copy of its cells per sample).
+    inverse: Option<Box<InverseCache<f64>>>,
 }
 
 impl Motor {
@@ -393,7 +394,7 @@ impl Motor {
             state: MotorState::default(),
             rot: Complex64::new(1.0, 0.0),
             decay: (0.0, 1.0),
-            inverse: InverseCache::new(),
+            inverse: Some(Box::default()),
         };
         m.set_state(Dq::zero(), theta0, 0.0);
         Ok(m)
@@ -426,7 +427,7 @@ impl Motor {
 
     /// The propagator of one sample at the present speed with circuit resistance `r`: the
     /// closed form for constant inductances, the flux integrator for a saturating machine.
-    pub fn propagator(&self, r: f64) -> ElectricalPropagator {
+    pub fn propagator(&mut self, r: f64) -> ElectricalPropagator {
         match &self.magnetics {
             Some((m, b)) => ElectricalPropagator::saturating(
                 FluxPropagator::new(
@@ -436,7 +437,7 @@ impl Motor {
                     self.omega(),
                     self.params.pole_pairs,
                     FluxPoint::at(self.state.i_dq, self.psi_dq, self.rot),
-                    self.inverse,
+                    self.inverse.take().unwrap_or_default(),
                 ),
                 self.omega(),
             ),
@@ -510,7 +511,9 @@ impl Motor {
     pub fn set_current_from(&mut self, prop: &ElectricalPropagator, i_dq: Dq<f64>) {
         self.state.i_dq = i_dq;
         if let Some(f) = &prop.flux {
-            self.inverse = f.inverse_cache();
+            if let Some(cache) = f.take_inverse_cache() {
+                self.inverse = Some(cache);
+            }
             let last = f.last();
             self.psi_dq = if last.i_dq == i_dq {
                 unrotate(last.psi_ab, last.rot)

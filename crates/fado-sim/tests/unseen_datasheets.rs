@@ -20,10 +20,11 @@
 //! 0.012–0.051, loaded-start 0.066–0.081, fullrange 0.073–0.074, regen-stop 0.089 rad; its
 //! identified model's reversal 0.054, stops 0.100 rad) and a 10-pole 20 kW IPMSM on a 560 V
 //! link (reversal 0.025–0.034, stops 0.038–0.054, rated-reversal 0.028–0.029, loaded-start
-//! 0.159 at seed 1; identified reversal 0.031, stops 0.030 rad) pass; the IPMSM's run down
-//! from its 6500 r/min top, a 42-pole 48 V robot-joint motor and a 14-pole gimbal motor (both
-//! with a resistive drop 0.7–1.9 × their rated back-EMF) miss, in the ignored tests below
-//! with their figures. The 7.2 kW servo with a 3e-3 kg·m² rotor commissions (its flux pulses
+//! 0.159 at seed 1; identified reversal 0.031, stops 0.030 rad) pass, and so does a 42-pole
+//! 48 V robot-joint motor (a resistive drop 0.71 × its rated back-EMF) in `reversal`, `stops`
+//! and `loaded-start` at seeds 1 and 2; the IPMSM's run down from its 6500 r/min top, the
+//! robot-joint motor's zero-speed hold after its top speed and a 14-pole gimbal motor (1.9 ×)
+//! miss, in the ignored tests below with their figures. The 7.2 kW servo with a 3e-3 kg·m² rotor commissions (its flux pulses
 //! bounded by their back-EMF, `fado_core::commissioning`).
 
 use fado_core::MachineModel;
@@ -189,24 +190,102 @@ fn a_20_kw_ipmsm_runs_down_from_its_top_speed() {
     at_seed_1("ipmsm-20kw-10p-560v", &["fullrange", "regen-stop"]);
 }
 
-/// A 42-pole robot-joint motor (GL80 KV30, Rs·I/(ω·λf) 0.71) on 48 V: reversal 0.323–0.328,
-/// stops 0.93–0.95 rad with 30–33 r/min speed error, rated-reversal 0.26–0.32, loaded-start
-/// 1.08–1.36 rad and 0.7–2.6 rad backwards, fullrange 0.58–0.62 rad (seeds 1, 2). Its
-/// commissioning is `Done` (L̂d +5.1 %, L̂q +2.4 %).
+/// A 42-pole robot-joint motor (GL80 KV30, Rs·I/(ω·λf) 0.71) on 48 V: `reversal` 0.051 /
+/// 0.018, `stops` 0.092 / 0.067, `loaded-start` 0.072 / 0.073 rad (seeds 1 / 2; rated-reversal
+/// 0.027 / 0.243). Its low-speed angle rests on R̂s·i: the start-up calibration of the current
+/// sensors' gains removes the 0.5 % mismatch whose negative-sequence drop walks θ̂ at
+/// ≈ 1.5 rad/s under 65 % of its rated torque (uncalibrated: `reversal` 0.32–0.33, `stops`
+/// 0.93–0.95 rad); its rotor's swing (2J/c = 0.26 s) is held for the calibration's 0.2 s
+/// budget and averaged over a 0.10 s window (`fado_core::control::drive::DriveConfig::
+/// gain_calibration_config`).
 #[test]
-#[ignore = "robot-joint motor with a resistive drop 0.7 × its back-EMF: 0.32 rad reversal"]
 fn a_42_pole_robot_joint_motor_passes_its_low_speed_scenarios() {
-    at_seed_1("robot-joint-gl80-kv30-48v", &["reversal", "stops"]);
+    let name = "robot-joint-gl80-kv30-48v";
+    let mut missed = Vec::new();
+    for scenario in ["reversal", "stops", "loaded-start"] {
+        for seed in [1, 2] {
+            if !passes(name, scenario, seed) {
+                missed.push(format!("{scenario} seed {seed}"));
+            }
+        }
+    }
+    assert!(missed.is_empty(), "{name} missed: {missed:?}");
+}
+
+/// The robot-joint motor through its whole range: `fullrange` 0.68 / 0.71 rad, `regen-stop`
+/// 0.42 / 0.42 rad (seeds 1 / 2), both at the loaded zero-speed hold after a run at speed: R̂s
+/// climbs to 1.172 Ω (+3.7 %) at 1000 r/min and is still 1.137–1.15 Ω there, a drop error of
+/// 0.6–1.8 % of Rs·I, beyond the 0.3 % this winding tolerates near zero speed
+/// (`fado_core::machine_checks::low_speed_limit`). The climb grows with ω·Ts (0.22 rad per
+/// sample at 1000 r/min on its 5 kHz carrier): with an ideal inverter and matched sensors
+/// R̂s reaches 1.184 Ω, on a 10 kHz carrier 1.150 Ω (`fullrange` 0.41 rad).
+#[test]
+#[ignore = "robot-joint motor: 0.68-0.71 rad at fullrange's loaded zero-speed hold"]
+fn a_42_pole_robot_joint_motor_holds_zero_speed_after_its_top_speed() {
+    at_seed_1("robot-joint-gl80-kv30-48v", &["fullrange", "regen-stop"]);
 }
 
 /// A 14-pole gimbal motor (GBM5208-200T, 8.5 Ω, Rs·I/(ω·λf) 1.9) on 4S: reversal 0.31–1.58,
 /// stops 0.49–0.58, rated-reversal 1.30–1.31 rad, fullrange π off (seeds 1, 2); its loaded
-/// start ends with the no-angle status; commissioning aborts with `RotationDetected` in the
-/// resistance test.
+/// start ends with the no-angle status. The miss is the current sensors' 0.5 % gain mismatch,
+/// which its start-up calibration leaves (`TooSlow`: the rotor's swing, 2J/c = 0.56 s, needs
+/// a 0.9 s window after the 0.2 s hold): with the gains calibrated (`startup.rotor_held`)
+/// `reversal` is 0.014 / 0.092 rad, with matched sensors 0.016 / 0.023 rad. A 0.3 % voltage
+/// error costs 0.25 rad below 2.3 % of its rated speed, beyond the scenarios' 2 % band; the
+/// plausibility warning on `rs` says so (`fado_core::machine_checks::low_speed_limit`). Its
+/// commissioning passes the DC test, the inductances and the magnetics (the alignment holds
+/// until the rotor's swing has died out, 2.1 s) and aborts with `Implausible { FluxLinkage }`
+/// in the inertia test: a 4 ms transient of the PLL's speed (41 r/min at a 13 r/min coast) at
+/// the torque step reads as twice the spin speed, so both back-EMF windows sit at one speed.
 #[test]
 #[ignore = "gimbal motor with a resistive drop 1.9 × its back-EMF: 0.3-1.6 rad reversal"]
 fn a_14_pole_gimbal_motor_passes_its_low_speed_scenarios() {
     at_seed_1("gimbal-gbm5208-200t-4s", &["reversal", "stops"]);
+}
+
+/// The gimbal motor with its current sensors calibrated: told that a brake holds the rotor
+/// through the start-up (`[controller.startup] rotor_held`, each calibration level held for
+/// the current's settling alone), it passes `reversal` (0.014 / 0.092 rad near zero speed) at
+/// seeds 1 / 2 with its rotor free: the method holds its angle through a reversal on a winding
+/// whose drop is 1.9 × its back-EMF once the sensors' gains are matched. Its `stops` reach
+/// 0.166 / 0.264 rad over the run (0.25 allowed; seed 2 misses).
+#[test]
+fn the_gimbal_motor_with_calibrated_sensors_passes_its_reversal() {
+    let name = "gimbal-gbm5208-200t-4s";
+    let mut missed = Vec::new();
+    for seed in [1, 2] {
+        let text = format!(
+            "{}\n[current_sensor]\nseed = {seed}\n[controller.startup]\nrotor_held = true\n",
+            file(name)
+        );
+        let out = simulate("reversal", Some(&text), false, None).unwrap();
+        if !out.passed {
+            missed.push(format!("reversal seed {seed}: {:?}", out.checks));
+        }
+    }
+    assert!(missed.is_empty(), "{name} missed: {missed:?}");
+}
+
+/// The gimbal motor's configuration is run with the warning on `rs` that names its ratio,
+/// the keys and the speed (2.3 % of rated) below which its low-speed angle is beyond the
+/// criterion.
+#[test]
+fn the_gimbal_motor_is_warned_of_its_low_speed_limit() {
+    let text = file("gimbal-gbm5208-200t-4s");
+    let config = fado_sim::SimConfig::from_toml(&text).unwrap();
+    let plant = config.plant();
+    let m = MachineModel {
+        dc_voltage: plant.inverter.dc_voltage,
+        ..plant.motor
+    };
+    let warning = fado_core::machine_checks::check(&m, None)
+        .iter()
+        .find(|f| f.key() == "rs")
+        .map(|f| f.to_string())
+        .expect("a warning on rs");
+    for part in ["1.876", "`rated_current`", "below 2.3 % of the rated speed"] {
+        assert!(warning.contains(part), "{part}: {warning}");
+    }
 }
 
 /// The 15 kW PM-SyRM on the 520 V link its name suggests (its sheet's 500 V rms line-to-line

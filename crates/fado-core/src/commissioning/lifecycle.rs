@@ -42,6 +42,7 @@ impl<T: Real> Commissioning<T> {
             err_par: T::zero(),
             err_perp: T::zero(),
             emf_lpf: Ab::zero(),
+            align_loud_at: T::zero(),
             frozen: false,
             t_frozen: T::zero(),
             dc_hold: z.dc_hold,
@@ -105,6 +106,7 @@ impl<T: Real> Commissioning<T> {
         self.err_par = T::zero();
         self.err_perp = T::zero();
         self.emf_lpf = Ab::zero();
+        self.align_loud_at = T::zero();
         self.frozen = false;
         self.t_frozen = T::zero();
         self.saturated_time = T::zero();

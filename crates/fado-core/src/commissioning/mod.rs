@@ -291,6 +291,9 @@ pub struct Commissioning<T: 'static> {
     err_par: T,
     err_perp: T,
     emf_lpf: Ab<T>,
+    /// Time in the alignment at which the rotation check's back-EMF was last at half its
+    /// limit or above, s (`align_quiet`).
+    align_loud_at: T,
     frozen: bool,
     /// Time in the DC level at which its voltage was frozen, s.
     t_frozen: T,

@@ -228,15 +228,35 @@ impl<T: Real> Commissioning<T> {
         true
     }
 
+    /// Whether the alignment's hold may end: the rotor's swing about the aligned current has
+    /// died out (the rotation check's back-EMF across the reference below half its limit,
+    /// the margin the DC test's settling keeps, over the last half alignment step), or the
+    /// hold has lasted half the phase timeout, after which the DC test's rotation check
+    /// reports a rotor still turning. The swing's damping in voltage mode is the back-EMF's
+    /// current through Rs, 1.5·p²·λf²/R (module docs, step 2): on a high-resistance winding
+    /// its time constant 2J/c outlasts the alignment's electrical sizing (the 14-pole gimbal
+    /// motor of `crates/fado-sim/tests/data/unseen/`, 8.5 Ω: 2J/c = 0.56 s against a 0.3 s
+    /// step; with the hold fixed at one step it entered the DC test swinging at ±8 r/min,
+    /// four times the check's 2 % of its rated speed, and aborted with `RotationDetected`).
+    fn align_quiet(&mut self) -> bool {
+        let t = self.t_phase;
+        let at = self.cfg.align_time;
+        if t >= T::lit(2.0) * at && self.emf_lpf.beta.abs() >= T::lit(0.5) * self.emf_limit() {
+            self.align_loud_at = t;
+        }
+        t - self.align_loud_at >= T::lit(0.5) * at || t >= T::lit(0.5) * self.cfg.phase_timeout
+    }
+
     /// The phase transitions; false after an abort.
     fn standstill_transition(&mut self) -> bool {
         let at = self.cfg.align_time;
         let t = self.t_phase;
         let settle = self.cfg.settle_time;
         let meas = self.cfg.measure_time;
+        let quiet = self.phase == Phase::Align && self.align_quiet();
         // Transitions.
         match self.phase {
-            Phase::Align if t >= T::lit(3.0) * at => {
+            Phase::Align if quiet && t >= T::lit(3.0) * at => {
                 self.frozen = false;
                 self.next_phase(Phase::Resistance);
             }

@@ -236,7 +236,7 @@ pub(super) fn cell<T: Real>(axis: &[T], scale: &AxisScale<T>, x: T) -> (usize, T
 /// The pair `t[j]`, `t[j + 1]` (NaNs where a shape check failed): one bounds check for two
 /// loads.
 #[inline(always)]
-fn pair<T: Real>(t: &[T], j: usize) -> (T, T) {
+pub(super) fn pair<T: Real>(t: &[T], j: usize) -> (T, T) {
     match t.get(j..j.wrapping_add(2)) {
         Some(&[a, b]) => (a, b),
         _ => (T::lit(f64::NAN), T::lit(f64::NAN)),

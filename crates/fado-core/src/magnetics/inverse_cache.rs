@@ -172,12 +172,16 @@ impl<T: Real> InverseCache<T> {
     /// solution, where `psi` lies so near it that the step's own error (the cell's twist times
     /// the product of the step's fractions: exact for a bilinear cell) is below `tolerance`
     /// of the cell ([`REFINE_TOLERANCE`] for a state's current), and the step stays in the
-    /// cell; None elsewhere (the caller inverts). For a flux a hair from the last inversion's
-    /// (a Runge–Kutta step's end beside its last stage): one division instead of a square
-    /// root, two divisions and the walk.
+    /// cell; where the first step stays in the cell but misses the tolerance, a second step
+    /// from it (whose error is the first's squared, relatively: a flux farther from the last
+    /// solution, a Runge–Kutta stage's); None elsewhere (the caller inverts). For a flux a
+    /// hair from the last inversion's (a Runge–Kutta step's end beside its last stage): one
+    /// division instead of a square root, two divisions and the walk. A step taken is the last solution from then on (the
+    /// next step starts there; its cell is the same, so an inversion's result is not
+    /// changed by it).
     #[inline]
     pub(super) fn refine(
-        &self,
+        &mut self,
         grid: &impl CellGrid<T>,
         psi: Dq<T>,
         tolerance: T,
@@ -185,18 +189,31 @@ impl<T: Real> InverseCache<T> {
         let (at, u, v) = self.last?;
         let (k, m, cell, _) = self.slots.get(at)?.as_ref()?;
         let (k, m) = (*k, *m);
-        let (u2, v2) = cell.newton_step(psi, (u, v));
-        let (du, dv) = (u2 - u, v2 - v);
-        let error = (du * dv).abs() * (cell.twist.d.abs() + cell.twist.q.abs());
-        let span = cell.ex.d.abs() + cell.ey.q.abs();
+        let twist = cell.twist.d.abs() + cell.twist.q.abs();
+        let bound = tolerance * (cell.ex.d.abs() + cell.ey.q.abs());
+        // A step's error: the twist times the product of its fractions (exact, bilinear).
+        let step = |(u, v): (T, T)| {
+            let (u2, v2) = cell.newton_step(psi, (u, v));
+            (u2, v2, ((u2 - u) * (v2 - v)).abs() * twist)
+        };
         let (last_k, last_m) = grid.last_cell();
         let tol = cell_tolerance::<T>();
-        let inside = direction(u2, k, last_k, tol) == 0 && direction(v2, m, last_m, tol) == 0;
-        if !(inside && error <= tolerance * span) {
+        let inside =
+            |u: T, v: T| direction(u, k, last_k, tol) == 0 && direction(v, m, last_m, tol) == 0;
+        let (mut u2, mut v2, mut error) = step((u, v));
+        if error > bound && inside(u2, v2) {
+            // A second step from the first (a flux farther from the last solution).
+            (u2, v2, error) = step((u2, v2));
+        }
+        if !(inside(u2, v2) && error <= bound) {
             return None;
         }
         let i = grid.current_at(k, m, u2, v2);
-        i.is_finite().then_some(i)
+        if !i.is_finite() {
+            return None;
+        }
+        self.last = Some((at, u2, v2));
+        Some(i)
     }
 }
 

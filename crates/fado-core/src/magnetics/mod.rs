@@ -313,9 +313,9 @@ impl<T: Real> Magnetics<'_, T> {
     }
 
     /// [`Magnetics::current_from_cached`] at a flux a hair from the cache's last solution: a
-    /// map's by one Newton step in that solution's cell where that is the root to
-    /// [`REFINE_TOLERANCE`] of the cell (`InverseCache::refine`), else as
-    /// `current_from_cached`.
+    /// map's by Newton's steps in that solution's cell (one, or two where the first misses)
+    /// where that is the root to [`REFINE_TOLERANCE`] of the cell (`InverseCache::refine`),
+    /// else as `current_from_cached`.
     #[inline]
     pub fn current_near_cached(
         &self,
@@ -326,7 +326,7 @@ impl<T: Real> Magnetics<'_, T> {
         self.current_near_cached_to(psi, guess, cache, T::lit(REFINE_TOLERANCE))
     }
 
-    /// [`Magnetics::current_near_cached`] with the Newton step taken where its error is below
+    /// [`Magnetics::current_near_cached`] with the Newton steps taken where their error is below
     /// `tolerance` of the cell instead of [`REFINE_TOLERANCE`]: for a current whose error a
     /// caller scales down (a Runge–Kutta stage's enters the step's flux through R·h/3).
     #[inline]

@@ -35,7 +35,7 @@
 //! and [`FluxMap::smooth_flux`] leaves out the Jacobian where a caller needs the flux alone
 //! (the estimator's operating point).
 
-use super::flux_map::{AxisScale, cell};
+use super::flux_map::{AxisScale, cell, pair};
 use super::{FluxMap, FluxMapError, InductanceMatrix};
 use crate::real::{max, min};
 use crate::{Dq, Real};
@@ -265,14 +265,17 @@ impl<'a, T: Real> FluxMap<'a, T> {
         let mut rows = [T::zero(); 4];
         let mut rows_q = [T::zero(); 4];
         for (r, &k) in s.kd.iter().enumerate() {
-            let at = [k * nq + s.kq[1], k * nq + s.kq[2]];
-            let p = at.map(|j| node(values, j));
+            // The stencil's inner nodes along i_q are adjacent (kq[2] = kq[1] + 1): each
+            // pair behind one bounds check.
+            let at = k * nq + s.kq[1];
+            let (p0, p1) = pair(values, at);
             let slopes = if self.node_slopes().is_empty() {
                 s.cq.node_slopes(s.kq.map(|m| node(values, k * nq + m)))
             } else {
-                at.map(|j| node(self.node_slopes(), table * n + j))
+                let (s0, s1) = pair(self.node_slopes(), table * n + at);
+                [s0, s1]
             };
-            let (value, along_q) = s.cq.hermite(p, slopes);
+            let (value, along_q) = s.cq.hermite([p0, p1], slopes);
             rows[r] = value;
             rows_q[r] = along_q;
         }

@@ -557,7 +557,8 @@ fn the_cached_inverse_is_the_inverse_bit_for_bit() {
 }
 
 /// Near the cache's last solution (a Runge–Kutta step's end beside its last stage) the
-/// refined inverse is the inverse to 10⁻⁹ of a cell; far from it, the cached inverse itself.
+/// refined inverse is the inverse to 10⁻⁹ of a cell, farther (two Newton steps) too; far from
+/// it, the cached inverse itself.
 #[test]
 fn the_refined_inverse_is_the_inverse_near_the_last_solution() {
     let uniform: [f64; 13] = core::array::from_fn(|k| -30.0 + 5.0 * k as f64);
@@ -576,11 +577,46 @@ fn the_refined_inverse_is_the_inverse_near_the_last_solution() {
             (refined - exact).norm() < 1e-8,
             "step {k}: {refined:?} {exact:?}"
         );
+        // Farther, a second Newton step may still reach the tolerance; farther still, the
+        // steps leave the cell or miss it.
         let far = psi + Dq::new(0.02, -0.02);
-        let refused = model.current_near_cached(far, guess, &mut cache);
-        assert_eq!(refused, model.current_from(far, guess), "step {k}");
+        let second = model.current_near_cached(far, guess, &mut cache);
+        assert!(
+            (second - model.current_from(far, guess)).norm() < 1e-8,
+            "step {k}"
+        );
+        let farther = psi + Dq::new(0.2, -0.2);
+        let refused = model.current_near_cached(farther, guess, &mut cache);
+        assert_eq!(refused, model.current_from(farther, guess), "step {k}");
         guess = last;
     }
+}
+
+/// At a Runge–Kutta stage's distance from the cache's last solution (a few % of a 5 A cell)
+/// the refined inverse to a stage's tolerance (10⁻⁵ of the cell) is the inverse to that
+/// tolerance, Newton's steps on most of the path.
+#[test]
+fn a_stage_is_newton_steps_to_its_tolerance() {
+    let uniform: [f64; 13] = core::array::from_fn(|k| -30.0 + 5.0 * k as f64);
+    let table = FluxTable::from_model(&pmsyrm(), uniform, uniform);
+    let model = Magnetics::Map(table.map().unwrap());
+    let (mut cache, mut guess, mut taken) = (InverseCache::new(), Dq::zero(), 0);
+    for k in 0..300 {
+        let t = k as f64 * 0.021;
+        let psi = model.flux(Dq::new(14.0 * t.cos(), 14.0 * t.sin()));
+        let last = model.current_from_cached(psi, guess, &mut cache);
+        let stage = psi + Dq::new(2e-3, -2e-3);
+        let refined = model.current_near_cached_to(stage, guess, &mut cache, 1e-5);
+        let exact = model.current_from(stage, guess);
+        assert!(
+            (refined - exact).norm() < 1e-4,
+            "step {k}: {refined:?} {exact:?}"
+        );
+        taken += usize::from(refined != exact);
+        guess = last;
+    }
+    std::println!("Newton's steps taken at 300 stages: {taken}");
+    assert!(taken > 200, "{taken}");
 }
 
 /// The uniform table is the flux map of the same table: values and Jacobians to rounding

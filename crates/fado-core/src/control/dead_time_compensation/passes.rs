@@ -1,7 +1,8 @@
 //! The edge-current method's two fixed-point passes, the solve where the refinement's loop
 //! gain is small (parent module, "Which solve"): the gate times of the reference plus the
 //! trapezoid, each edge's delay from the sampled current, then twice the band model at the
-//! edge currents the ripple of those gate times and delays implies.
+//! edge currents the ripple of those gate times and delays implies (once where the first
+//! keeps every delay: its fixed point).
 
 use super::DeadTimeCompensation;
 use crate::control::pi::clamp;
@@ -23,14 +24,18 @@ impl<T: Real> DeadTimeCompensation<T> {
         let first = self.trapezoid(i_abc, vdc);
         let vp = [v_abc.a + first.a, v_abc.b + first.b, v_abc.c + first.c];
         let gates = self.gate_times(vp, vdc);
-        let mut delays = (
+        let first = (
             i.map(|x| self.edge_delay(true, x)),
             i.map(|x| self.edge_delay(false, x)),
         );
-        for _ in 0..2 {
-            delays = self.refined_delays(rotation, i, gates, delays, vdc);
+        let once = self.refined_delays(rotation, i, gates, first, vdc);
+        // A refinement that keeps every delay is at its fixed point: the second one would
+        // repeat the same arithmetic on the same numbers (every current outside the band with
+        // its ripple, the common case away from the zero crossings).
+        if once == first {
+            return once;
         }
-        delays
+        self.refined_delays(rotation, i, gates, once, vdc)
     }
 
     /// The gate times (rise, fall) within each half period of the pole voltages `vp` (V per

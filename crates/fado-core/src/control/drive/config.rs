@@ -42,7 +42,8 @@ impl<T: Real> DriveConfig<T> {
 
     /// The start-up gain calibration's configuration in absolute units: upper level
     /// `gain_calibration.current_ratio` × the rated current (at most the current limit),
-    /// settling 5·max(L̂d/R̂s, 1/ωc) per level, window `gain_calibration.time`.
+    /// settling 5·max(L̂d/R̂s, 1/ωc) per level, window `gain_calibration.time` (longer where
+    /// a hold beyond the budget is traded for it, `hold_and_window`).
     pub fn gain_calibration_config(&self) -> Result<GainCalibrationConfig<T>, ConfigError> {
         self.machine.validate()?;
         let t = &self.tuning;
@@ -70,17 +71,7 @@ impl<T: Real> DriveConfig<T> {
         };
         let i1 = T::lit(0.5) * i2;
         let swing = crate::real::max(swing_time_constant(m, i1), swing_time_constant(m, i2));
-        let hold = swing_hold_time_constants(m, i1, swing, t) * swing;
-        // A brake that holds the rotor (`startup.rotor_held`) leaves no swing to wait for:
-        // where the swing's hold would exceed the budget and skip the calibration, the levels
-        // are held for the current's settling alone (measured: the 8-pole traction IPMSM of
-        // `crates/fado-sim/tests/data/traction-ipm-saturated.toml`, swing hold 0.61 s,
-        // `crates/fado-sim/tests/gain_calibration.rs`). Elsewhere the hold stays as derived.
-        let hold = if t.startup.rotor_held && hold > T::lit(GAIN_CALIBRATION_MAX_HOLD_TIME) {
-            T::zero()
-        } else {
-            hold
-        };
+        let (hold, window) = hold_and_window(m, i1, swing, t);
         let rename = |e: ConfigError| match e {
             ConfigError::OutOfRange { field, expected } => ConfigError::OutOfRange {
                 field: gain_field(field),
@@ -103,7 +94,7 @@ impl<T: Real> DriveConfig<T> {
             settle_time: settle,
             hold_time: hold,
             max_hold_time: T::lit(GAIN_CALIBRATION_MAX_HOLD_TIME),
-            window_time: t.gain_calibration.time,
+            window_time: window,
             min_observability: t.gain_calibration.min_observability,
             max_mismatch: t.gain_calibration.max_mismatch,
             current_limit: self.i_max(),
@@ -242,6 +233,58 @@ fn swing_hold_time_constants<T: Real>(
     n
 }
 
+/// The hold and the averaging window (s) of each gain-calibration level: the swing's hold
+/// ([`swing_hold_time_constants`]) and the configured window where the hold fits
+/// [`GAIN_CALIBRATION_MAX_HOLD_TIME`].
+fn hold_and_window<T: Real>(m: &MachineModel<T>, i1: T, swing: T, t: &DriveTuning<T>) -> (T, T) {
+    let hold = swing_hold_time_constants(m, i1, swing, t) * swing;
+    let budget = T::lit(GAIN_CALIBRATION_MAX_HOLD_TIME);
+    // A brake that holds the rotor (`startup.rotor_held`) leaves no swing to wait for:
+    // where the swing's hold would exceed the budget and skip the calibration, the levels
+    // are held for the current's settling alone (measured: the 8-pole traction IPMSM of
+    // `crates/fado-sim/tests/data/traction-ipm-saturated.toml`, swing hold 0.61 s,
+    // `crates/fado-sim/tests/gain_calibration.rs`). Elsewhere a hold beyond the budget
+    // is cut to it where a window of at most the budget meets the swing's bias bound
+    // ([`traded_window`]).
+    if t.startup.rotor_held && hold > budget {
+        (T::zero(), t.gain_calibration.time)
+    } else if hold > budget {
+        match traded_window(m, i1, swing, t) {
+            Some(window) => (budget, window),
+            None => (hold, t.gain_calibration.time),
+        }
+    } else {
+        (hold, t.gain_calibration.time)
+    }
+}
+
+/// The averaging window (s) that meets the swing's bias bound of
+/// [`swing_hold_time_constants`] with the hold cut to [`GAIN_CALIBRATION_MAX_HOLD_TIME`], if
+/// it is at most that budget too; `None` otherwise (the calibration is then skipped,
+/// `TooSlow`). The bound e^(−n) ≤ ε·R̂s·I₁·s_min·W/(3.46·λ̂f) is linear in the window W: the
+/// budget's n_b = budget/τ time constants need W = W₀·e^(−n_b)/bound(W₀), W₀ the configured
+/// `gain_calibration.time` (never shorter than W₀; none without a configured window). A
+/// window grows only on a rotor whose resistive drop is large against its magnet flux
+/// (R̂s·I₁/λ̂f): the 42-pole robot-joint
+/// motor of `crates/fado-sim/tests/data/unseen/` (τ = 0.26 s, 0.79 τ in the budget) is
+/// averaged over 0.10 s; the TooSlow presets (hoverboard hub, 50 kW IPMSM, 5 kW PM-SyRM)
+/// would need 0.6–10 s and stay uncalibrated. Uncalibrated, that motor's 0.5 % mismatch walks
+/// θ̂ by R̂s·|Δi|/λ̂f ≈ 1.5 rad/s under 65 % of its rated torque at standstill: `reversal`
+/// 0.33 rad near zero speed (seed 1), 0.15 rad calibrated.
+fn traded_window<T: Real>(m: &MachineModel<T>, i1: T, swing: T, t: &DriveTuning<T>) -> Option<T> {
+    let budget = T::lit(GAIN_CALIBRATION_MAX_HOLD_TIME);
+    let w0 = t.gain_calibration.time;
+    let bound = T::lit(SWING_BIAS_FRACTION / (4.0 * 0.87))
+        * m.rs
+        * i1
+        * t.gain_calibration.min_observability
+        * w0
+        / m.flux_linkage;
+    let left = T::one() - (budget / swing).step_one_minus_exp_neg();
+    let window = crate::real::max(w0 * left / bound, w0);
+    (w0 > T::zero() && window <= budget).then_some(window)
+}
+
 /// Longest hold of a gain-calibration level, s \[A\]: a start-up budget (with it the whole
 /// calibration takes at most about 0.5 s plus the settling). A rotor whose swing needs longer
 /// is not calibrated (status `TooSlow`): averaged before the swing has died out, the
@@ -328,6 +371,56 @@ mod tests {
             (-n).exp() <= bound && (-(n - 0.25)).exp() > bound,
             "{bound}"
         );
+    }
+
+    /// The 42-pole robot-joint motor of `crates/fado-sim/tests/data/unseen/` (its derived
+    /// inertia): its swing's τ = 0.26 s needs 1.75 τ = 0.45 s of hold with the 50 ms window;
+    /// the budget's 0.2 s hold with a 0.10 s window meets the same bias bound. The hoverboard
+    /// hub preset (τ = 0.22 s, 0.6 s of window needed) stays beyond the budget.
+    #[test]
+    fn a_hold_beyond_the_budget_is_traded_for_a_window_within_it() {
+        let robot = MachineModel {
+            rs: 1.13,
+            ld: 0.57e-3,
+            lq: 0.82e-3,
+            flux_linkage: 8.75e-3,
+            pole_pairs: 21,
+            inertia: 4.7269e-3,
+            viscous_friction: 3.15e-4,
+            rated_current: 6.0,
+            rated_speed_rpm: 500.0,
+            rated_torque: 1.65,
+            dc_voltage: 48.0,
+            ..MachineModel::<f64>::paper()
+        };
+        let c = DriveConfig::for_machine(&robot)
+            .gain_calibration_config()
+            .unwrap();
+        assert_eq!(c.hold_time, GAIN_CALIBRATION_MAX_HOLD_TIME);
+        assert!((c.window_time - 0.102).abs() < 2e-3, "{}", c.window_time);
+        let hub = MachineModel {
+            rs: 0.179,
+            ld: 0.336e-3,
+            lq: 0.336e-3,
+            flux_linkage: 0.02297,
+            pole_pairs: 15,
+            inertia: 0.11,
+            viscous_friction: 1.5e-3,
+            rated_current: 15.0,
+            rated_speed_rpm: 500.0,
+            rated_torque: 7.75,
+            dc_voltage: 48.0,
+            ..MachineModel::<f64>::paper()
+        };
+        let c = DriveConfig::for_machine(&hub)
+            .gain_calibration_config()
+            .unwrap();
+        assert!(
+            c.hold_time > GAIN_CALIBRATION_MAX_HOLD_TIME,
+            "{}",
+            c.hold_time
+        );
+        assert_eq!(c.window_time, 0.05);
     }
 
     /// The injection level: the paper's on a surface-magnet rotor; on ipmsm-gem-50k
