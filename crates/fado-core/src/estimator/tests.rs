@@ -440,7 +440,6 @@ fn salient_rs_at(x: f64) -> f64 {
     let mut config = EstimatorConfig::for_machine(&model);
     config.tuning.rs_adaptation.enabled = true;
     let ts = config.ts;
-    let w = x / ts;
     let mut est = SensorlessEstimator::new(config).unwrap();
     let (i_d, i_q) = (-2.0, 6.0);
     let rot = |th: f64, d: f64, q: f64| {
