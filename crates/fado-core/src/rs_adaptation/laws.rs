@@ -230,9 +230,11 @@ impl<T: Real> ResistanceAdaptationParams<T> {
     }
 
     /// The state after one more period of the law (`ts`), computed without changing this
-    /// one. `i_drop` is the current now (the turning law compares it with λ̂r now);
-    /// `i_now` the current sampled now (its d component at the ends of the period gives
-    /// the inductive voltage's integral L̂d·Δi_d); `v_ab` and `i_mean` are the voltage and
+    /// one. `i_drop` is the current the integrator's resistive drop used this sample (the
+    /// turning law's regressor: an R̂s error enters the integrand as −ΔR̂s·`i_drop`);
+    /// `i_now` the current sampled now, with λ̂r (the turning law's active flux î_d and a
+    /// saturating model's operating point; at standstill its d component at the ends of the
+    /// period gives the inductive voltage's integral L̂d·Δi_d); `v_ab` and `i_mean` are the voltage and
     /// current averaged over the period (the
     /// standstill law integrates them: run once per sample, the samples themselves; run once
     /// every N samples, their means over the N samples, so that its integrals stay those of
@@ -278,9 +280,19 @@ impl<T: Real> ResistanceAdaptationParams<T> {
         }
         let mag = mag_sq.step_sqrt();
         let pull = if regime == AdaptationRegime::Rotating {
-            let point = Self::operating_point::<M, SATURATING>(active_flux, lambda_r, i_drop);
+            // The operating point at the current sampled with λ̂r (module docs, "Sampled at
+            // ω̂·Ts").
+            let point = Self::operating_point::<M, SATURATING>(active_flux, lambda_r, i_now);
             if !self.rotating(
-                scale, st, &mut next, i_drop, lambda_r, mag, omega, settled, point,
+                scale,
+                st,
+                &mut next,
+                (i_drop, i_now),
+                lambda_r,
+                mag,
+                omega,
+                settled,
+                point,
             ) {
                 return (next, Ab::zero());
             }
@@ -316,7 +328,7 @@ impl<T: Real> ResistanceAdaptationParams<T> {
         scale: &ResistanceScale<T>,
         st: &ResistanceAdaptationState<T>,
         next: &mut ResistanceAdaptationState<T>,
-        i_drop: Ab<T>,
+        (i_drop, i_now): (Ab<T>, Ab<T>),
         lambda_r: Ab<T>,
         mag: T,
         omega: T,
@@ -370,11 +382,13 @@ impl<T: Real> ResistanceAdaptationParams<T> {
         }
         // The reference is the active flux λ̂a = λ̂f + (L̂d − L̂q)·î_d and φ carries the
         // sensitivity factor 1 + (L̂d − L̂q)·î_d/λ̂a (module docs); for L̂d = L̂q both are
-        // exactly λ̂f and 1, and the division for î_d is skipped.
+        // exactly λ̂f and 1, and the division for î_d is skipped. î_d is the current sampled
+        // with λ̂r, not the interval's drop current, which lags it by ω̂·Ts/2 (module docs,
+        // "Sampled at ω̂·Ts").
         let (reference, sensitivity) = if dl == T::zero() {
             (lf, T::one())
         } else {
-            let i_d = lambda_r.dot(i_drop) / mag;
+            let i_d = lambda_r.dot(i_now) / mag;
             let active = lf + dl * i_d;
             // A non-positive (or NaN) reference: nothing to compare with.
             if active.partial_cmp(&T::zero()) != Some(core::cmp::Ordering::Greater) {
