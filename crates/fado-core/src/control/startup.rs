@@ -468,7 +468,7 @@ impl<T: Real> AngleSearch<T> {
     /// current in some phase below `min_observability` there, the nearest k·π/3, or on a
     /// salient rotor that would drive more than 20 % of the level across that axis, the q
     /// axis θ + π/2. A held rotor observed at `theta` also turns to the nearest k·π/3 where
-    /// at most 0.2 % of the level crosses it ([`CROSS_FREE_SHARE`]: every round rotor).
+    /// at most 0.2 % of the level crosses it (`CROSS_FREE_SHARE`: every round rotor).
     pub fn gain_axis(&self, theta: T, min_observability: T) -> T {
         self.gain_axis_on_q(theta, min_observability).0
     }
