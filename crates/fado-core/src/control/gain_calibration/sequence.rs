@@ -29,7 +29,9 @@ impl<T: Real> GainCalibration<T> {
         let max_hold = self.config.max_hold_time;
         self.unsettled = hold_time > max_hold;
         let n = hold_time.step_min(max_hold) / self.config.ts;
-        self.hold_samples = self.hold_default.max(n.round().to_f64() as u32);
+        // Rounded in `T` (n ≥ 0): no double-precision conversion in the firmware's step.
+        let n = (n + T::lit(0.5)).index_floor(u32::MAX as usize) as u32;
+        self.hold_samples = self.hold_default.max(n);
         self.start_held(angle)
     }
 
