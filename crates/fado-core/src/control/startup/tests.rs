@@ -162,18 +162,23 @@ fn off_by_default_and_bad_settings_are_named() {
     assert_eq!(e.field(), "startup.pulse_voltage_ratio");
 }
 
-#[test]
-fn a_held_rotor_gets_the_nearest_well_observed_gain_axis_and_a_free_one_its_d_axis() {
-    let free = phase(2.63e-3, 2.63e-3, 21.78, on());
-    let held = phase(
-        2.63e-3,
-        2.63e-3,
-        21.78,
+/// The start-up of a rotor a brake holds (`startup.rotor_held`), as [`phase`] otherwise.
+fn held_phase(ld: f64, lq: f64, rated_current: f64) -> AngleSearch<f64> {
+    phase(
+        ld,
+        lq,
+        rated_current,
         StartupTuning {
             rotor_held: true,
             ..on()
         },
-    );
+    )
+}
+
+#[test]
+fn a_held_rotor_gets_the_nearest_well_observed_gain_axis_and_a_free_one_its_d_axis() {
+    let free = phase(2.63e-3, 2.63e-3, 21.78, on());
+    let held = held_phase(2.63e-3, 2.63e-3, 21.78);
     let third = core::f64::consts::FRAC_PI_3;
     // −1.49 rad leaves phase a 8 % of the current: the held rotor's axis is −π/2 ± π/6's
     // nearest multiple of π/3, −π/3; 0.74 rad is observed (22 %), and this round rotor, which
@@ -194,15 +199,7 @@ fn a_held_salient_rotor_whose_nearest_axis_would_cross_calibrates_along_q() {
     // Lq/Ld = 2 (saliency 1/3): at −1.66 rad (phase a at 8.7 % of the d current) the nearest
     // k·π/3, −2π/3, is 0.44 rad off d and would drive 0.33·sin 0.87 = 26 % of the level
     // across it; the q axis −1.66 + π/2 carries phase a at 99.6 % and b, c at about half.
-    let held = phase(
-        0.12e-3,
-        0.24e-3,
-        105.0,
-        StartupTuning {
-            rotor_held: true,
-            ..on()
-        },
-    );
+    let held = held_phase(0.12e-3, 0.24e-3, 105.0);
     let (axis, on_q) = held.gain_axis_on_q(-1.66, 0.2);
     assert!(on_q);
     assert!((axis - (-1.66 + core::f64::consts::FRAC_PI_2)).abs() < 1e-12);
@@ -214,15 +211,7 @@ fn a_held_salient_rotor_whose_nearest_axis_would_cross_calibrates_along_q() {
     assert_eq!(held.gain_axis_on_q(1.0, 0.2), (1.0, false));
     let (near, q) = held.gain_axis_on_q(third - 0.002, 0.2);
     assert!(!q && (near - third).abs() < 1e-12);
-    let round = phase(
-        2.63e-3,
-        2.63e-3,
-        21.78,
-        StartupTuning {
-            rotor_held: true,
-            ..on()
-        },
-    );
+    let round = held_phase(2.63e-3, 2.63e-3, 21.78);
     assert!(!round.gain_axis_on_q(-1.66, 0.2).1);
 }
 
