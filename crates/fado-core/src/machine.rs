@@ -106,6 +106,13 @@ impl<T: Real> MachineModel<T> {
         }
     }
 
+    /// This record on the DC link `dc_voltage` (V): a motor's record from its own table
+    /// with the inverter's `[inverter] dc_voltage`, which is not a motor key.
+    pub fn with_dc_voltage(mut self, dc_voltage: T) -> Self {
+        self.dc_voltage = dc_voltage;
+        self
+    }
+
     /// This record with the magnetic model `magnetics`.
     pub fn with_magnetics(mut self, magnetics: MachineMagnetics<T>) -> Self {
         self.magnetics = magnetics;

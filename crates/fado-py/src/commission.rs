@@ -155,10 +155,7 @@ pub fn commission(
         None => plant.motor,
     };
     // The procedure runs on the plant's DC link, whatever the nameplate says.
-    let nameplate = fado_core::MachineModel {
-        dc_voltage: plant.inverter.dc_voltage,
-        ..nameplate
-    };
+    let nameplate = nameplate.with_dc_voltage(plant.inverter.dc_voltage);
     let config_text = cfg.to_toml();
     let started = std::time::Instant::now();
     let outcome = interrupt::run(py, |cancel| {

@@ -210,10 +210,7 @@ pub fn inverter_values(
     let f_sw = match number(given, "switching_frequency") {
         Some(f) => f,
         None => {
-            let f = ratings::switching_frequency_of(&MachineModel {
-                dc_voltage: dc,
-                ..*machine
-            });
+            let f = ratings::switching_frequency_of(&machine.with_dc_voltage(dc));
             out.push(("switching_frequency", f));
             f
         }
@@ -238,10 +235,7 @@ pub fn inverter_values(
 /// gives it the 2.5 µs dead time of 5 kHz from Python as from its file, not the 1.25 µs of
 /// 10 kHz. Unchanged inputs give the same values.
 pub fn rederive_inverter(cfg: &mut crate::SimConfig) {
-    let machine = MachineModel {
-        dc_voltage: cfg.inverter.dc_voltage,
-        ..cfg.motor
-    };
+    let machine = cfg.motor.with_dc_voltage(cfg.inverter.dc_voltage);
     let mut given = toml::Table::new();
     for key in INVERTER_DERIVED {
         let full = format!("inverter.{key}");

@@ -59,10 +59,7 @@ impl Preset {
     /// The preset's motor as a drive's model, with the DC link of its inverter.
     pub fn machine(&self) -> Result<MachineModel<f64>, SimConfigError> {
         let c = self.config()?;
-        Ok(MachineModel {
-            dc_voltage: c.inverter.dc_voltage,
-            ..c.motor
-        })
+        Ok(c.motor.with_dc_voltage(c.inverter.dc_voltage))
     }
 }
 
@@ -90,13 +87,7 @@ mod tests {
         }
         let paper = find("paper").unwrap().machine().unwrap();
         let core = MachineModel::<f64>::paper();
-        assert_eq!(
-            MachineModel {
-                dc_voltage: core.dc_voltage,
-                ..paper
-            },
-            core
-        );
+        assert_eq!(paper.with_dc_voltage(core.dc_voltage), core);
         assert!(find("ipmsm-2k2").unwrap().machine().unwrap().is_salient());
         // The interior-magnet motor with Lq/Ld ≥ 1.5.
         let gem = find("ipmsm-gem-50k").unwrap().machine().unwrap();

@@ -211,10 +211,7 @@ fn preset(name: &str) -> (PlantParams, MachineModel<f64>) {
 fn preset_plant(preset: &fado_sim::presets::Preset) -> (PlantParams, MachineModel<f64>) {
     let cfg = preset.config().unwrap();
     let p = cfg.plant();
-    let m = MachineModel {
-        dc_voltage: p.inverter.dc_voltage,
-        ..p.motor
-    };
+    let m = p.motor.with_dc_voltage(p.inverter.dc_voltage);
     (p, m)
 }
 

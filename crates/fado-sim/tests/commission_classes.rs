@@ -39,10 +39,7 @@ fn file(name: &str) -> String {
 /// The plant of a minimal file and its record (with the derived values) as the nameplate.
 fn plant(text: &str) -> (PlantParams, MachineModel<f64>) {
     let p = SimConfig::from_toml(text).unwrap().plant();
-    let m = MachineModel {
-        dc_voltage: p.inverter.dc_voltage,
-        ..p.motor
-    };
+    let m = p.motor.with_dc_voltage(p.inverter.dc_voltage);
     (p, m)
 }
 

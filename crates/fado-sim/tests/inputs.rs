@@ -101,10 +101,7 @@ fn commissioning_refuses_a_sampling_too_slow_for_the_motor() {
     );
     // … and a refusal for the commissioning, which would report parameters off by %.
     let plant = cfg.plant();
-    let nameplate = MachineModel {
-        dc_voltage: plant.inverter.dc_voltage,
-        ..plant.motor
-    };
+    let nameplate = plant.motor.with_dc_voltage(plant.inverter.dc_voltage);
     let e = fado_sim::commission::commission(&plant, nameplate, Default::default(), |_| {}, None)
         .map(|_| ())
         .unwrap_err();
@@ -117,10 +114,7 @@ fn commissioning_refuses_a_current_sensor_too_coarse() {
     let mut cfg = SimConfig::from_toml(fado_sim::presets::find("paper").unwrap().toml).unwrap();
     cfg.current_sensor.adc_bits = 6;
     let plant = cfg.plant();
-    let nameplate = MachineModel {
-        dc_voltage: plant.inverter.dc_voltage,
-        ..plant.motor
-    };
+    let nameplate = plant.motor.with_dc_voltage(plant.inverter.dc_voltage);
     let e = fado_sim::commission::commission(&plant, nameplate, Default::default(), |_| {}, None)
         .map(|_| ())
         .unwrap_err();

@@ -490,10 +490,7 @@ impl SimConfig {
     /// keys involved: errors first, then the carrier's finding
     /// ([`carrier_findings`](Self::carrier_findings)).
     pub fn machine_findings(&self) -> Vec<(fado_core::machine_checks::Severity, String, String)> {
-        let mut m = MachineModel {
-            dc_voltage: self.inverter.dc_voltage,
-            ..self.motor
-        };
+        let mut m = self.motor.with_dc_voltage(self.inverter.dc_voltage);
         // A saturating plant's torque is its magnetic model's, not its zero-current
         // inductances'.
         let (sat, map) = (self.motor_saturation.as_ref(), self.motor_flux_map.as_ref());
@@ -553,10 +550,7 @@ impl SimConfig {
         &self,
     ) -> Option<(fado_core::machine_checks::Severity, String, String)> {
         use fado_core::machine_checks::Severity;
-        let m = MachineModel {
-            dc_voltage: self.inverter.dc_voltage,
-            ..self.motor
-        };
+        let m = self.motor.with_dc_voltage(self.inverter.dc_voltage);
         let derived = self
             .derived
             .iter()

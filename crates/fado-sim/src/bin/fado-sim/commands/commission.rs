@@ -162,10 +162,9 @@ fn identify(
     config: Option<&Path>,
 ) -> Result<CommissionOutcome, Box<dyn std::error::Error>> {
     let plant = cfg.plant();
-    let nameplate = fado_core::MachineModel {
-        dc_voltage: plant.inverter.dc_voltage,
-        ..*nameplate.unwrap_or(&plant.motor)
-    };
+    let nameplate = nameplate
+        .unwrap_or(&plant.motor)
+        .with_dc_voltage(plant.inverter.dc_voltage);
     let bar = ProgressBar::new(1000);
     bar.set_style(
         ProgressStyle::with_template("{spinner} {msg:<14} [{bar:40}] {percent:>3}%")?
