@@ -229,7 +229,7 @@ pub const MAX_CURRENT_WC_TS: f64 = 0.2;
 /// flips from the limit to the opposite limit and the rotor is lost (`loaded-start` seed 3,
 /// with the trigger on the direct angle). Limited to the 3.3 rad/s a sample can hold there,
 /// seed 3 keeps 0.056 rad from ready and seed 2 0.10 rad.
-const SPEED_STEP_ACCELERATION_RATIO: f64 = 2.0;
+pub const SPEED_STEP_ACCELERATION_RATIO: f64 = 2.0;
 
 /// How far beyond its design travel the current loop's cap may let the rated load move the
 /// rotor before the hold's rule raises the loop: 1.75 \[A\] (0.35 rad for the default 0.2 rad
