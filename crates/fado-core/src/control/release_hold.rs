@@ -52,7 +52,14 @@
 //! since θ̂ moving under the brake is the estimate's own start transient and the hold's
 //! integral would wind up against the brake. It acts only once the angle
 //! estimate has left θ_hold by [`ReleaseHoldTuning::trigger`] while the speed reference is
-//! zero, within [`ReleaseHoldTuning::window`] of the arming. An unloaded start never
+//! zero, within [`ReleaseHoldTuning::window`] of the arming; armed at a release on a
+//! saturating machine model, once the direct angle has, the one its loop holds: the tracked
+//! angle follows a rotor that starts to fall milliseconds later. On the saturated traction IPMSM
+//! (`crates/fado-sim/tests/data/traction-ipm-saturated.toml`, `loaded-start` seed 2) the
+//! tracked angle had moved 0.015 rad when the rotor had fallen 0.145 rad, the direct angle
+//! 0.05 rad; triggered by the tracked angle the hold acts 2 ms later, the rotor runs back
+//! 0.58 rad and |θ − θ̂| reaches 0.26 rad from ready, by the direct angle 0.31 and 0.10 rad
+//! (with the speed step's bound, [`SPEED_STEP_ACCELERATION_RATIO`]). An unloaded start never
 //! triggers it and runs exactly as without it. It ends after 10/ω_h (the load caught and
 //! settled) or at a non-zero speed reference: the speed loop's integral is then preset to
 //! the hold's integral (the pre-torque: the load it found) so that the load is not dropped at
@@ -196,7 +203,8 @@ cast_record!(ReleaseHoldTuning { travel, trigger, window, resume_time ; enabled,
 /// 5·ω_h the hold's q current swings by 200 A at ≈ 750 Hz from the release on and the rotor
 /// is lost at seeds 1 and 3 (|θ − θ̂| 3.1 rad); at 4·ω_h seeds 1, 3 and 4 keep |θ − θ̂| within
 /// 0.10, 0.19 and 0.09 rad (2·ω_h: 0.14, 0.13, 0.09), at 1·ω_h the loop's damping is lost
-/// (0.88 rad at seed 1). A lower ratio costs a rotor that the hold must stop quickly: the
+/// (0.88 rad at seed 1); with the bound on the speed's step and the trigger on the direct
+/// angle ([`SPEED_STEP_ACCELERATION_RATIO`]) 0.065, 0.056 and 0.083 rad at 4·ω_h. A lower ratio costs a rotor that the hold must stop quickly: the
 /// made-up 20-pole 48 V IPMSM (`tests/data/ipmsm-20p-48v-saturated.toml`) seed 2 keeps
 /// 0.236 rad at 5·ω_h, 0.242 at 4·ω_h and loses its 0.25 rad bound (0.289) at 2·ω_h. The
 /// other saturated presets keep their margins (max |θ − θ̂| from ready 0.03–0.17 rad at
@@ -207,6 +215,21 @@ pub const SATURATING_SPEED_FILTER_RATIO: f64 = 4.0;
 /// 0.2 \[A\], with the loop's 1.5-sample delay a phase margin of 90° − 0.3 rad = 73°
 /// (the current loop refuses ωc·Ts above 0.5, 47°).
 pub const MAX_CURRENT_WC_TS: f64 = 0.2;
+
+/// The loop's speed changes in a sample by at most this many times b·i_max·Ts (b =
+/// 1.5·p²·λ̂f/Ĵ, i_max the torque demand's limit): 2 \[A\], the acceleration of the hold's
+/// whole torque against a load as large. A rotor cannot change its speed faster; the direct
+/// angle the loop differentiates can, since it moves with the currents' transients. On a
+/// saturating rotor it sees only κ/λa of a frame error (`crate::active_flux`, "The frame
+/// coupling"), a share that moves with the current: 0.35 at the 460 A limit of
+/// `crates/fado-sim/tests/data/traction-ipm-saturated.toml`, 0.59 at its rated 250 A, 1 at
+/// zero current. With θ̂ 0.09 rad off the rotor its direct angle jumps by 0.08 rad within
+/// 0.5 ms as the hold's current leaves the limit, a rate of ≈ 800 rad/s that the speed filter
+/// (1/(4·ω_h)) would pass as 35 rad/s in one sample, 340 A through the D path: the output
+/// flips from the limit to the opposite limit and the rotor is lost (`loaded-start` seed 3,
+/// with the trigger on the direct angle). Limited to the 3.3 rad/s a sample can hold there,
+/// seed 3 keeps 0.056 rad from ready and seed 2 0.10 rad.
+pub const SPEED_STEP_ACCELERATION_RATIO: f64 = 2.0;
 
 /// How far beyond its design travel the current loop's cap may let the rated load move the
 /// rotor before the hold's rule raises the loop: 1.75 \[A\] (0.35 rad for the default 0.2 rad
@@ -344,6 +367,15 @@ pub struct ReleaseHold<T> {
     omega: T,
     /// Per-sample gain Ts/(τ + Ts) of that low-pass, τ = 1/(5·ω_h).
     omega_gain: T,
+    /// The most that low-passed speed changes in a sample (electrical rad/s) on a saturating
+    /// model, [`SPEED_STEP_ACCELERATION_RATIO`]·b·i_max·Ts; zero (unbounded) otherwise.
+    omega_step: T,
+    /// [`SPEED_STEP_ACCELERATION_RATIO`]·b·i_max·Ts, which [`set_saturating`](Self::set_saturating)
+    /// makes `omega_step`.
+    saturating_omega_step: T,
+    /// Armed at a brake's release, triggered by the direct angle (a saturating model, see
+    /// [`set_saturating`](Self::set_saturating)) instead of the tracked one.
+    release_on_direct: bool,
     /// Times the hold acted since the drive was built.
     engaged: u32,
     /// The resumed reference's step per sample (electrical rad/s): the rated speed over
@@ -412,6 +444,9 @@ impl<T: Real> ReleaseHold<T> {
             theta_last: T::zero(),
             omega: T::zero(),
             omega_gain: ts / (T::one() / (T::lit(5.0) * omega) + ts),
+            omega_step: T::zero(),
+            saturating_omega_step: T::lit(SPEED_STEP_ACCELERATION_RATIO) * b * i_max * ts,
+            release_on_direct: false,
             engaged: 0,
             resume_step,
             resuming: false,
@@ -427,6 +462,20 @@ impl<T: Real> ReleaseHold<T> {
         if gain.is_finite() && gain > T::zero() {
             self.omega_gain = gain;
         }
+    }
+
+    /// On a saturating machine model (`on`), where the direct angle sees a share κ/λa of a
+    /// frame error that moves with the current (`crate::active_flux`, "The frame coupling"):
+    /// the loop's speed changes in a sample by at most the acceleration a rotor can have
+    /// ([`SPEED_STEP_ACCELERATION_RATIO`]), and a hold armed at a brake's release triggers on
+    /// the direct angle (module docs, "When").
+    pub fn set_saturating(&mut self, on: bool) {
+        self.omega_step = if on {
+            self.saturating_omega_step
+        } else {
+            T::zero()
+        };
+        self.release_on_direct = on;
     }
 
     /// Keeps the hold acting until the speed reference leaves zero instead of handing over
@@ -578,24 +627,40 @@ impl<T: Real> ReleaseHold<T> {
         sense
     }
 
+    /// The loop's speed from the direct angle `theta`: its rate low-passed, the change in a
+    /// sample at most `omega_step` where that is positive ([`set_saturating`](Self::set_saturating);
+    /// zero, or non-finite from an unbounded torque demand, leaves the low-pass as it is).
+    fn track_speed(&mut self, theta: T) {
+        let rate = crate::wrap_angle(theta - self.theta_last) / self.ts;
+        self.theta_last = theta;
+        if !rate.is_finite() {
+            return;
+        }
+        let lim = self.omega_step;
+        let change = self.omega_gain * (rate - self.omega);
+        self.omega += if lim > T::zero() {
+            crate::control::pi::clamp(change, -lim, lim)
+        } else {
+            change
+        };
+    }
+
     /// One sample: the speed reference `speed_ref`, the estimator's tracked angle θ̂
-    /// (`theta_tracked`, which triggers the hold) and its direct rotor-flux angle (`theta`,
-    /// which the loop holds), electrical. The loop's speed is the direct angle's own rate,
+    /// (`theta_tracked`, which triggers the hold unless it was armed at a brake's release)
+    /// and its direct rotor-flux angle (`theta`, which the loop holds and which triggers a
+    /// hold armed at a release), electrical. The loop's speed is the direct angle's own rate,
     /// low-passed over 1/(5·ω_h) (1/(4·ω_h) on a saturating model,
-    /// [`SATURATING_SPEED_FILTER_RATIO`]): the tracked angle and the speed outputs lag a rotor that
-    /// starts to turn from rest by milliseconds, which the loop's damping cannot afford; the
-    /// direct angle moves with the currents' transients at the first current too (0.02 rad
-    /// on the 50 kW IPMSM's 44 A injection step, the rotor at rest), which the tracked angle
-    /// smooths out.
+    /// [`SATURATING_SPEED_FILTER_RATIO`]), its change in a sample bounded by the acceleration
+    /// a rotor can have ([`SPEED_STEP_ACCELERATION_RATIO`]): the tracked angle and the speed
+    /// outputs lag a rotor that starts to turn from rest by milliseconds, which the loop's
+    /// damping cannot afford; the direct angle moves with the currents' transients at the
+    /// first current too (0.02 rad on the 50 kW IPMSM's 44 A injection step, the rotor at
+    /// rest), which the tracked angle smooths out and the bound keeps from the D path.
     pub fn step(&mut self, speed_ref: T, theta_tracked: T, theta: T) -> HoldAction<T> {
         if !self.armed {
             return HoldAction::Idle;
         }
-        let rate = crate::wrap_angle(theta - self.theta_last) / self.ts;
-        self.theta_last = theta;
-        if rate.is_finite() {
-            self.omega += self.omega_gain * (rate - self.omega);
-        }
+        self.track_speed(theta);
         // Engaged by the start-up's motion test, the hold keeps the rotor at any reference
         // until it has settled; armed at a release, a reference hands over at once; armed at
         // the start-up's end, a moving reference leaves it armed for a fall against it
@@ -627,8 +692,16 @@ impl<T: Real> ReleaseHold<T> {
                 self.disarm();
                 return HoldAction::Idle;
             }
-            let moved = crate::wrap_angle(self.theta_hold - theta_tracked);
-            // NaN compares false: a non-finite tracked angle does not trigger.
+            // Armed at a brake's release the hold watches the angle its loop holds, the direct
+            // one: the tracked angle lags a rotor that starts to fall by milliseconds
+            // (module docs, "When").
+            let watched = if self.released && self.release_on_direct {
+                theta
+            } else {
+                theta_tracked
+            };
+            let moved = crate::wrap_angle(self.theta_hold - watched);
+            // NaN compares false: a non-finite angle does not trigger.
             // On a moving reference only a fall against it triggers (the rotor's lag behind
             // the reference's angle is the speed loop's to close).
             let fall = if sense == T::zero() {

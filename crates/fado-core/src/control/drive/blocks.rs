@@ -276,6 +276,7 @@ fn release_hold<T: Real>(
     hold.set_through_standstill(through);
     if !m.magnetic_model().is_linear() {
         hold.set_speed_filter_ratio(T::lit(SATURATING_SPEED_FILTER_RATIO));
+        hold.set_saturating(true);
     }
     Ok(hold)
 }

@@ -315,3 +315,45 @@ fn at_the_start_ups_end_a_fall_against_a_moving_reference_is_held() {
     assert_eq!(h.step(0.0, 0.5, 0.5), HoldAction::Idle);
     assert_eq!(h.engaged(), 0);
 }
+
+#[test]
+fn on_a_saturating_model_a_release_hold_triggers_on_the_direct_angle_and_bounds_its_speed() {
+    // Armed at a brake's release, a direct angle 0.03 rad from θ_hold (the tracked angle still
+    // there) triggers the hold on a saturating model only. A jump of the direct angle by
+    // 0.08 rad in one sample (the currents' transient, not the rotor) reads 800 rad/s: the
+    // low-pass passes a share of it to the D path, on a saturating model at most the speed
+    // step 2·b·i_max·Ts a rotor can take.
+    let m = MachineModel::<f64>::paper();
+    let t = ReleaseHoldTuning {
+        enabled: true,
+        ..ReleaseHoldTuning::default()
+    };
+    let (ts, i_max) = (1e-4, 40.0);
+    let p = m.pole_pairs as f64;
+    let b = 1.5 * p * p * m.flux_linkage / m.inertia;
+    let step = SPEED_STEP_ACCELERATION_RATIO * b * i_max * ts;
+    let mut linear = ReleaseHold::new(&t, &m, ts, 250.0, i_max).unwrap();
+    let mut saturating = linear;
+    saturating.set_saturating(true);
+    for h in [&mut linear, &mut saturating] {
+        h.arm_at_release(1.0);
+    }
+    assert_eq!(linear.step(0.0, 1.0, 0.97), HoldAction::Idle);
+    assert!(matches!(
+        saturating.step(0.0, 1.0, 0.97),
+        HoldAction::Hold(_)
+    ));
+    for h in [&mut linear, &mut saturating] {
+        h.engage(1.0, 0.0);
+        h.step(0.0, 1.0, 1.0);
+        h.step(0.0, 1.0, 1.08);
+    }
+    assert!(
+        (saturating.omega - step).abs() < 1e-9,
+        "{}",
+        saturating.omega
+    );
+    assert!(linear.omega > 10.0 * step, "{} {step}", linear.omega);
+    saturating.set_saturating(false);
+    assert_eq!(saturating.omega_step, 0.0);
+}
