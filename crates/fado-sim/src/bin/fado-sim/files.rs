@@ -117,39 +117,16 @@ pub fn note_scenario_motor(text: Option<&str>, config: Option<&Path>) {
 }
 
 /// A note on stderr when the `--config` file `text` gives its own `[motor]` to one of the
-/// paper's scenarios in absolute units (`fig8`–`fig12`, `steady300`, `lowspeed`): their loads
-/// (N·m) and speeds (r/min) are the paper motor's, not scaled to this motor's ratings. The
-/// largest of each against the ratings, and the scenarios that are scaled.
+/// paper's experiments in its motor's units (`Scenario::units_note`).
 pub fn note_absolute_scenario(name: &str, cfg: &fado_sim::SimConfig, text: Option<&str>) {
-    let Some(s) = scenario::find(name) else {
-        return;
-    };
     let has_motor = text
         .and_then(|t| t.parse::<toml::Table>().ok())
         .is_some_and(|t| t.contains_key("motor"));
-    if s.scaled || s.neutral || !has_motor {
-        return;
+    if let Some(note) = scenario::find(name).and_then(|s| s.units_note(cfg))
+        && has_motor
+    {
+        eprintln!("note: {note}");
     }
-    let largest = |points: &[[f64; 2]]| points.iter().map(|p| p[1].abs()).fold(0.0, f64::max);
-    let load = largest(&cfg.load.torque.points);
-    let speed = largest(&cfg.speed_reference.points);
-    let m = &cfg.motor;
-    let scaled: Vec<&str> = scenario::SCENARIOS
-        .iter()
-        .filter(|s| s.scaled)
-        .map(|s| s.name)
-        .collect();
-    eprintln!(
-        "note: `{name}` is the paper's experiment in its motor's units (loads up to {load} N·m, \
-         speeds up to {speed} r/min), not scaled to this [motor]: {:.2} × its \
-         `motor.rated_torque` ({} N·m) and {:.3} × its `motor.rated_speed_rpm` ({} r/min); \
-         scaled by the ratings: {}",
-        load / m.rated_torque,
-        m.rated_torque,
-        speed / m.rated_speed_rpm,
-        m.rated_speed_rpm,
-        scaled.join(", ")
-    );
 }
 
 /// A CSV write error as the output error naming `path`.
