@@ -23,7 +23,6 @@
 //! the EPS and appliance motors near zero speed under load with the sensors' gain mismatch
 //! uncalibrated (the test beside them shows both pass without the mismatch).
 
-use fado_core::MachineModel;
 use fado_core::commissioning::Status;
 use fado_sim::commission::{CommissionOptions, commission, identified_toml};
 use fado_sim::scenario::simulate;
@@ -81,10 +80,7 @@ fn every_scenario(name: &str, skip: &[(&str, u64)]) {
 fn commissioned_reversal(name: &str) {
     let text = file(name);
     let plant = fado_sim::SimConfig::from_toml(&text).unwrap().plant();
-    let nameplate = MachineModel {
-        dc_voltage: plant.inverter.dc_voltage,
-        ..plant.motor
-    };
+    let nameplate = plant.motor.with_dc_voltage(plant.inverter.dc_voltage);
     let o = commission(
         &plant,
         nameplate,
