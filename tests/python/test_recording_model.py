@@ -82,3 +82,24 @@ def test_alpha_and_beta_swapped_are_a_motor_turning_the_other_way() -> None:
     forward = _quiet(rec.signals(), "paper")
     backward = _quiet(swapped, "paper")
     assert np.mean(forward.omega[-5000:]) > 0.0 > np.mean(backward.omega[-5000:])
+
+
+def test_one_pair_of_columns_swapped_is_named() -> None:
+    """The currents' α and β exchanged with the voltages as given (or the reverse) break the
+    voltage equation, which the swap undone restores."""
+    rec = synthetic_recording(ramp_then_hold(20_000, 20.0, 0.3))
+    _quiet(rec.signals(), "paper")
+    for signals, match in [
+        ((rec.v_alpha, rec.v_beta, rec.i_beta, rec.i_alpha), "`i_alpha` and `i_beta` exchanged"),
+        ((rec.v_beta, rec.v_alpha, rec.i_alpha, rec.i_beta), "`v_alpha` and `v_beta` exchanged"),
+    ]:
+        with pytest.warns(UserWarning, match=match):
+            fado.estimate(*signals, machine="paper", ts=1e-4)
+
+
+def test_another_machines_recording_is_named() -> None:
+    """The IPMSM's recording replayed on the paper's motor misfits every reading: the warning
+    says the recording contradicts the machine it is replayed on."""
+    signals = ipmsm_recording(IPM, 0.0).signals()
+    with pytest.warns(UserWarning, match="nor with its columns' sign or order changed"):
+        fado.estimate(*signals, machine="paper", ts=1e-4)

@@ -12,7 +12,8 @@
 //! | constant column | every sample of one column equal while its partner varies | a dead channel, a column taken twice |
 //! | non-finite samples | over 1 % of samples NaN or ±∞ | a gap in the logger |
 //! | start angle | \|θ0\| > 2π | degrees for radians |
-//! | voltage equation | the active flux misfits λf, and fits with a slip undone | the currents' sign reversed, the voltage and current columns exchanged ([`crate::recording_model`]) |
+//! | voltage equation | the active flux misfits λf, and fits with a slip undone | the currents' sign reversed, the voltage and current columns exchanged, the currents' (or the voltages') α and β exchanged ([`crate::recording_model`]) |
+//! | voltage equation | the active flux misfits λf in every reading | another machine's parameters, a unit slip in `rs`, `ld`, `lq` or `flux_linkage`, a saturating machine without its magnetic model |
 //! | negative sequence | every turning window turns backwards | α and β swapped, if the motor turned forward |
 
 use fado_core::MachineModel;

@@ -1,7 +1,8 @@
 //! What a recording's voltages and currents say about their own wiring, before
 //! `fado.estimate` replays them: whether they obey the machine's voltage equation as given,
-//! or only with the currents' sign flipped (a generator-convention recording) or with the
-//! voltage and current columns exchanged. Each of these slips leaves the magnitudes within
+//! or only with the currents' sign flipped (a generator-convention recording), with the
+//! voltage and current columns exchanged, or with the α and β columns of the currents alone
+//! (or of the voltages alone) exchanged. Each of these slips leaves the magnitudes within
 //! the bounds of `recording_checks` on a low-voltage motor, and the estimator then locks onto
 //! an angle that is off by up to π without a word.
 //!
@@ -15,9 +16,14 @@
 //! drift stays small); in each a least-squares circle fit (`x² + y²` against `x, y, 1`) finds
 //! c, and the residual is the radius's RMS deviation from λf + (L̂d − L̂q)·i_d, with i_d the
 //! current along the fitted rotor direction, per unit of λf. Its median over the windows is
-//! computed as given and with each slip undone (currents negated; columns exchanged), and the
-//! recording is reported when it misfits (above [`MISFIT`]) while an undone slip fits at least
-//! [`BETTER`] times better and within [`FIT`].
+//! computed as given and with each slip undone (currents negated; columns exchanged; the
+//! currents' or the voltages' α and β exchanged), and the recording is reported when it misfits
+//! (above [`MISFIT`]) while an undone slip fits at least [`BETTER`] times better and within
+//! [`FIT`]. A recording that misfits every reading by more than [`GROSS_MISFIT`] on a machine
+//! of constant inductances is reported too: it is not this machine's as described (another motor's file, a resistance,
+//! inductance or flux off by a unit, or a saturating machine without its magnetic model), and
+//! the estimate replays it on a model that the recording contradicts. (A saturating model's
+//! flux is not the fitted circle: its recordings are judged by the slips alone.)
 //!
 //! Measured on the simulated drive's replays (the estimator's inputs of the paper's Fig. 8–12
 //! and of `reversal` on six presets, averaged and switching inverter;
@@ -25,7 +31,8 @@
 //! saturated 50 kW IPMSM and the PM-SyRM, whose linear models misfit their plants most), with
 //! the currents negated 0.32–4.3, with the columns exchanged 0.28–47.
 //!
-//! A recording with the α and β columns exchanged (two phases swapped) is the mirror image of
+//! A recording with the α and β columns of both the voltages and the currents exchanged (two
+//! phases swapped) is the mirror image of
 //! the motor turning the other way: conjugating every signal maps each solution of the
 //! machine's equations onto another one (ψ, i, θ → ψ*, i*, −θ), and a valid recording may turn
 //! backwards throughout (the paper's Fig. 9 runs at −300 r/min). No test on the recording alone
@@ -44,6 +51,13 @@ pub const FIT: f64 = 0.1;
 /// that misfits its recording, λ̂f or L̂q off, misfits every reading alike).
 pub const BETTER: f64 = 3.0;
 
+/// Residual per unit of λf above which a recording that no undone slip explains is reported
+/// as contradicting its machine: 1 (the active flux off by its own size). A resistance error
+/// alone reaches 0.20–0.69 on the paper's Fig. 11 at 90 r/min (R̂s 0.85–2 × and 0.5 ×), which
+/// the R̂s adaptation learns; the 2.2 kW IPMSM's recording replayed on the paper's motor
+/// misfits by 6.7.
+pub const GROSS_MISFIT: f64 = 1.0;
+
 /// Longest window of one electrical turn, s: 0.5 (a turn at 2 Hz electrical); slower
 /// stretches are not judged.
 pub const MAX_WINDOW: f64 = 0.5;
@@ -60,6 +74,10 @@ enum Reading {
     CurrentsNegated,
     /// The voltage columns read as currents and the current columns as voltages.
     ColumnsExchanged,
+    /// The currents' α and β columns exchanged, the voltages as given.
+    CurrentsSwapped,
+    /// The voltages' α and β columns exchanged, the currents as given.
+    VoltagesSwapped,
 }
 
 /// Solves the 3 × 3 system `a·x = b` (Cramer's rule); None when singular.
@@ -161,6 +179,8 @@ fn residual(
         Reading::AsGiven => ((0, 1), (2, 3), 1.0),
         Reading::CurrentsNegated => ((0, 1), (2, 3), -1.0),
         Reading::ColumnsExchanged => ((2, 3), (0, 1), 1.0),
+        Reading::CurrentsSwapped => ((0, 1), (3, 2), 1.0),
+        Reading::VoltagesSwapped => ((1, 0), (2, 3), 1.0),
     };
     let mut fits = Vec::new();
     for w in windows {
@@ -217,6 +237,14 @@ pub fn findings(cols: &[Vec<f64>], m: &MachineModel<f64>, ts: f64) -> Vec<String
             "the voltage and current columns exchanged: pass the voltages as `v_alpha`, \
              `v_beta` and the currents as `i_alpha`, `i_beta`?",
         ),
+        (
+            Reading::CurrentsSwapped,
+            "`i_alpha` and `i_beta` exchanged (the voltages not): swap the currents' columns?",
+        ),
+        (
+            Reading::VoltagesSwapped,
+            "`v_alpha` and `v_beta` exchanged (the currents not): swap the voltages' columns?",
+        ),
     ];
     let best = alternatives
         .iter()
@@ -229,6 +257,18 @@ pub fn findings(cols: &[Vec<f64>], m: &MachineModel<f64>, ts: f64) -> Vec<String
              within {:.1} % with {text}",
             100.0 * given,
             100.0 * e
+        ));
+    } else if given > GROSS_MISFIT && matches!(m.magnetics, fado_core::MachineMagnetics::Linear) {
+        // A saturating model's flux is not the circle of constant inductances this test
+        // fits: its recordings are judged only by the slips above.
+        out.push(format!(
+            "the recording does not follow the machine's voltage equation (the active flux \
+             ψ − L̂q·i misfits λf = {} Wb by {:.0} % over its turns), nor with its columns' \
+             sign or order changed: is it this machine's (`rs`, `ld`, `lq`, `flux_linkage` \
+             of the motor recorded, in Ω, H and Wb; a saturating machine's flux map)? The \
+             estimate replays it on a model it contradicts",
+            m.flux_linkage,
+            100.0 * given
         ));
     }
     out
