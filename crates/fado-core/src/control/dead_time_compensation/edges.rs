@@ -157,11 +157,13 @@ impl<T: Real> DeadTimeCompensation<T> {
             slope_rise: -p.mean[x],
             slope_fall: -p.mean[x],
         };
-        for (k, &sxk) in s[x].iter().enumerate() {
+        // Zipped rather than indexed by k: no bounds check (and no panic path) in the M4F step.
+        let poles = p.pole_rise.iter().zip(&p.pole_fall);
+        for (k, (&sxk, (&rise, &fall))) in s[x].iter().zip(poles).enumerate() {
             if k == x {
                 continue;
             }
-            let (ar, af) = (tr - p.pole_rise[k], tf - p.pole_fall[k]);
+            let (ar, af) = (tr - rise, tf - fall);
             if ar > zero {
                 out.rise += sxk * ar;
                 out.slope_rise += sxk;
