@@ -280,6 +280,26 @@ pub fn current_bandwidth_for_hold<T: Real>(
     if hz > current_hz { hz } else { current_hz }
 }
 
+/// The hold armed at a brake's release acts only on a fall that reaches the trigger within
+/// this many times the time t_r = √(2·trigger/a_rated) the rated load's fall takes to reach it
+/// (a_rated = p·T_rated/Ĵ, electrical): 8 \[A\]. A constant load of a fraction k of the rated
+/// torque reaches it at t_r/√k, 8·t_r for k = 1/64; the rated load triggers the hold at
+/// 1.0–2.1·t_r, a quarter of it at 2.0–4.3·t_r (the estimate's lag included). What moves
+/// the angle estimate slower at the release is no load the hold can take: an unloaded rotor
+/// that the release's d current turns by its own angle error (the multirotor preset: 0.2 rad
+/// in 50 ms, 16·t_r to the trigger), or the estimate's own drift at the start angle that
+/// starves a phase (module docs, "When"); the hold's loop then swings the unloaded rotor.
+pub const RELEASE_WINDOW_RATIO: f64 = 8.0;
+
+/// The time (s) within which a fall after a brake's release triggers the hold on `machine`:
+/// [`RELEASE_WINDOW_RATIO`]·√(2·trigger/a_rated), a_rated = p·T_rated/Ĵ (non-finite where the
+/// model gives no rated torque; the tuning's window then holds).
+fn release_window<T: Real>(machine: &MachineModel<T>, trigger: T) -> T {
+    let p = T::lit(machine.pole_pairs as f64);
+    let accel = p * machine.rated_torque / machine.inertia;
+    T::lit(RELEASE_WINDOW_RATIO) * (T::lit(2.0) * trigger / accel).step_sqrt()
+}
+
 /// Peak of t²·e^(−t)/2 (at t = 2): the largest travel of the triple-pole loop per a/ω_h².
 const PEAK_TRAVEL: f64 = 0.270_670_566_473_225_4;
 
@@ -341,6 +361,10 @@ pub struct ReleaseHold<T> {
     ts: T,
     trigger: T,
     window_samples: u32,
+    /// Samples after a brake's release within which a fall triggers the hold: at most
+    /// `window_samples`, [`RELEASE_WINDOW_RATIO`] times the time the rated load's fall takes to
+    /// reach the trigger.
+    release_window_samples: u32,
     /// Samples the hold acts before it hands over: [`SETTLE_TIMES`]/ω_h.
     hold_samples: u32,
     /// Acting until the speed reference leaves zero ([`holds_through_standstill`]).
@@ -407,6 +431,7 @@ impl<T: Real> ReleaseHold<T> {
         let n = window / ts;
         check::below("release_hold.window", n, T::lit(4e9), "below 4e9 samples")?;
         let b = T::lit(1.5) * p * p * machine.flux_linkage / machine.inertia;
+        let release_n = release_window(machine, trigger) / ts;
         let omega = design_omega(machine, travel)
             .step_min(T::two_pi() * current_bandwidth_hz / T::lit(10.0))
             .step_min(T::lit(0.1) / ts);
@@ -426,6 +451,12 @@ impl<T: Real> ReleaseHold<T> {
             ts,
             trigger,
             window_samples: n.round().to_f64() as u32,
+            // NaN compares false: the tuning's window.
+            release_window_samples: if release_n < n {
+                release_n.round().to_f64() as u32
+            } else {
+                n.round().to_f64() as u32
+            },
             hold_samples: (T::lit(SETTLE_TIMES) / (omega * ts)).round().to_f64() as u32,
             through_standstill: false,
             held: 0,
@@ -688,7 +719,12 @@ impl<T: Real> ReleaseHold<T> {
         }
         if !self.active {
             self.elapsed = self.elapsed.saturating_add(1);
-            if self.elapsed > self.window_samples {
+            let window = if self.released {
+                self.release_window_samples
+            } else {
+                self.window_samples
+            };
+            if self.elapsed > window {
                 self.disarm();
                 return HoldAction::Idle;
             }
