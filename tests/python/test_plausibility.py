@@ -242,3 +242,16 @@ def test_a_bad_rating_is_named_not_the_value_derived_from_it() -> None:
     with pytest.raises(fado.ConfigError) as info:
         fado.Machine(**dict(IPM, rated_torque=0.0))
     assert info.value.field == "rated_torque"
+
+
+def test_a_paper_figure_on_another_motor_warns_that_its_loads_are_the_papers() -> None:
+    # fig11 loads 7.5 N·m, the paper motor's 65 %: 10.87 × this drone motor's 0.69 N·m.
+    short = {"simulation": {"duration": 0.01}}
+    with pytest.warns(UserWarning, match="paper's experiment in its motor's units") as record:
+        fado.simulate("fig11", motor=fado.Machine(**DRONE, dc_voltage=24.0), config=short)
+    assert any("10.87 × its `motor.rated_torque`" in str(w.message) for w in record)
+    # The scaled scenarios and the paper's own motor: no such warning.
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        fado.simulate("reversal", motor=fado.Machine(**DRONE, dc_voltage=24.0), config=short)
+        fado.simulate("fig11", config=short)

@@ -122,15 +122,25 @@ fn likely_slip(m: &MachineModel<f64>) -> (TorqueSlip, f64) {
         flux_linkage: m.flux_linkage * k,
         ..*m
     };
-    let halved = MachineModel {
-        pole_pairs: m.pole_pairs / 2,
-        ..*m
-    };
+    let with_pole_pairs = |pole_pairs: u32| MachineModel { pole_pairs, ..*m };
+    // λf from a back-EMF constant per 1000 r/min (line-to-line), as `datasheet` converts it.
+    let per_krpm = 1.0 / (m.pole_pairs as f64 * 1000.0 * core::f64::consts::PI / 30.0);
+    let (sqrt2, sqrt3) = (2f64.step_sqrt(), 3f64.step_sqrt());
     let mut best = (TorqueSlip::Unknown, given);
     for (slip, undone) in [
-        (TorqueSlip::Rms, with_flux(2f64.step_sqrt())),
-        (TorqueSlip::LineToLine, with_flux(1.0 / 3f64.step_sqrt())),
-        (TorqueSlip::PoleCount, halved),
+        (TorqueSlip::Rms, with_flux(sqrt2)),
+        (TorqueSlip::LineToLine, with_flux(1.0 / sqrt3)),
+        (TorqueSlip::PoleCount, with_pole_pairs(m.pole_pairs / 2)),
+        (
+            TorqueSlip::PolePairsHalved,
+            with_pole_pairs(m.pole_pairs.saturating_mul(2)),
+        ),
+        (TorqueSlip::KeVllRms, with_flux(per_krpm * sqrt2 / sqrt3)),
+        (TorqueSlip::KeVllPeak, with_flux(per_krpm / sqrt3)),
+        (
+            TorqueSlip::VoltsPerHertz,
+            with_flux(1.0 / core::f64::consts::TAU),
+        ),
     ] {
         if slip == TorqueSlip::PoleCount && !m.pole_pairs.is_multiple_of(2) {
             continue;

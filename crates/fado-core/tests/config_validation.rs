@@ -405,6 +405,7 @@ fn run_all<T: Real>(failures: &mut Vec<String>, machine: MachineModel<T>) -> usi
             switching_frequency: Positive,
             threshold_voltage: NonNegative,
             current_band: Positive,
+            dc_voltage: NonNegative,
         ),
     );
     n += probe(

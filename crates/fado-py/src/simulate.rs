@@ -102,7 +102,8 @@ struct Finished {
     config_toml: String,
     estimator: fado_core::EstimatorConfig<f64>,
     columns: Vec<Vec<f64>>,
-    /// The carrier's warning (`SimConfig::carrier_findings`), issued as a `UserWarning`.
+    /// The carrier's warning (`SimConfig::carrier_findings`) and a paper experiment's note on
+    /// the user's motor (`Scenario::units_note`), each issued as a `UserWarning`.
     warnings: Vec<String>,
 }
 
@@ -216,12 +217,14 @@ fn run(
     cancel: &AtomicBool,
 ) -> Result<Finished, Failed> {
     let cfg = layered_config(scenario, motor, config_toml, averaged).map_err(Failed::Config)?;
-    let warnings = cfg
+    let mut warnings: Vec<String> = cfg
         .carrier_findings()
         .filter(|(s, ..)| *s == fado_core::machine_checks::Severity::Warning)
         .map(|(.., text)| text)
         .into_iter()
         .collect();
+    // A paper experiment in its motor's units on a motor of other ratings says so.
+    warnings.extend(scenario::find(scenario).and_then(|s| s.units_note(&cfg)));
     let rows = scenario::trace_rows(&cfg);
     if rows > MAX_TRACE_ROWS_IN_MEMORY {
         let e = SimConfigError::new(

@@ -313,3 +313,33 @@ fn a_line_to_line_resistance_on_the_nameplate_is_named_once_commission_measures_
     assert_eq!(code, Some(0), "{err}");
     assert!(!err.contains("warning"), "{err}");
 }
+
+#[test]
+fn a_paper_figure_on_the_users_motor_says_its_loads_are_the_papers_not_scaled() {
+    let dir = scratch("absolute");
+    let path = dir.join("outrunner.toml");
+    std::fs::write(&path, OUTRUNNER).unwrap();
+    let note = |scenario: &str| {
+        let out = Command::new(env!("CARGO_BIN_EXE_fado-sim"))
+            .args(["run", scenario, "--dump-config", "--config"])
+            .arg(&path)
+            .stdout(Stdio::null())
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(0));
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    // fig11 loads 7.5 N·m, the paper motor's 65 %: 3.21 × this 2.34 N·m outrunner's rating.
+    let err = note("fig11");
+    assert!(err.contains("`fig11` is the paper's experiment"), "{err}");
+    assert!(err.contains("loads up to 7.5 N·m"), "{err}");
+    assert!(err.contains("3.21 × its `motor.rated_torque`"), "{err}");
+    assert!(
+        err.contains("scaled by the ratings: lowspeed, reversal, stops"),
+        "{err}"
+    );
+    // The scaled scenarios take the ratings' loads: no note.
+    for scenario in ["reversal", "lowspeed", "custom"] {
+        assert!(!note(scenario).contains("note:"), "{scenario}");
+    }
+}

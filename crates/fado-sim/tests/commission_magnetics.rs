@@ -3,7 +3,6 @@
 //! bounds over the rated current range, the rotor left nearly where it was, and
 //! magnetically linear machines reported as such.
 
-use fado_core::MachineModel;
 use fado_core::commissioning::{PULSE_MOTION_LIMIT, SaturationVerdict, Status};
 use fado_sim::commission::{CommissionOptions, CommissionOutcome, commission, identified_toml};
 use fado_sim::magnetic_accuracy::MagneticAccuracy;
@@ -17,10 +16,7 @@ const MAX_MOTION: f64 = 0.15;
 fn commissioned(text: &str) -> CommissionOutcome {
     let cfg = fado_sim::SimConfig::from_toml(text).unwrap();
     let plant = cfg.plant();
-    let nameplate = MachineModel {
-        dc_voltage: plant.inverter.dc_voltage,
-        ..plant.motor
-    };
+    let nameplate = plant.motor.with_dc_voltage(plant.inverter.dc_voltage);
     commission(
         &plant,
         nameplate,

@@ -14,12 +14,20 @@
 //! (0.0008, 0.0105, 0.0175 against 0.0007, 0.0072, 0.0160): the figure, an RMS residual over
 //! the pulses, does not bound it, and the test is ignored until one that does is derived from
 //! the identification's own residuals.
+//!
+//! A figure that bounds it costs the law its reach: the fit's largest flux residual over the
+//! pulses (less its zero-current offset) bounds the loaded error on all five (0.0015 /
+//! 0.0191 / 0.0610 / 0.0370 / 0.0042 at seed 1) but freezes the law at most loaded points of
+//! pmsm-gem-1k1-measured, whose commissioned model then cannot learn a winding 1.3 or 0.8
+//! times its commissioned resistance ([`a_commissioned_model_learns_a_changed_winding_resistance`]:
+//! R̂s ends at 0.952 / 1.030 × Rs, `rated-reversal` lost at 0.82 / 1.04 rad; with the figure
+//! set by hand 0.0105 passes, 0.016 fails). The RMS figure keeps that reach.
 
 use fado_core::Dq;
-use fado_core::MachineModel;
 use fado_core::magnetics::{MagneticModel, Magnetics};
 use fado_sim::commission::{CommissionOptions, commission};
 use fado_sim::magnetic_accuracy::plant_model;
+use fado_sim::scenario::{run_config, scenario_config};
 
 /// The plant's MTPA current for `torque` (N·m): the smallest current magnitude whose best
 /// angle (i_d ≤ 0, 0.25° steps) reaches it, by bisection.
@@ -58,10 +66,7 @@ fn measure(path: &str) -> ([f64; 4], [f64; 4], f64) {
     let text = std::fs::read_to_string(path).unwrap();
     let cfg = fado_sim::SimConfig::from_toml(&text).unwrap();
     let plant = cfg.plant();
-    let nameplate = MachineModel {
-        dc_voltage: plant.inverter.dc_voltage,
-        ..plant.motor
-    };
+    let nameplate = plant.motor.with_dc_voltage(plant.inverter.dc_voltage);
     let o = commission(
         &plant,
         nameplate,
@@ -121,4 +126,54 @@ fn the_written_figure_bounds_the_models_flux_error_at_every_load() {
         }
     }
     assert!(short.is_empty(), "{short:?}");
+}
+
+/// The written figure leaves the R̂s law the reach to learn a winding's temperature: the
+/// commissioned model of pmsm-gem-1k1-measured (current-sensor seed 1, `identified.toml` as
+/// written, RMS figure 0.0072) drives the plant with its winding resistance 1.3 and 0.8 times
+/// the commissioned one (gain calibration off, so that only the turning law can learn it)
+/// through `rated-reversal`: R̂s ends within 2 % of the plant's and the scenario passes.
+/// Measured: 0.991 / 0.997 × Rs, 0.07 / 0.19 rad near zero speed. With the bounding figure
+/// of the module docs (0.0191) the law freezes at most loaded points: 0.952 / 1.030 × Rs and
+/// the rotor lost (0.82 / 1.04 rad).
+#[test]
+fn a_commissioned_model_learns_a_changed_winding_resistance() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../motors/saturated");
+    fado_sim::magnetics_file::set_config_dir(Some(std::path::Path::new(dir)));
+    let text = std::fs::read_to_string(format!("{dir}/pmsm-gem-1k1-measured.toml")).unwrap();
+    let plant = fado_sim::SimConfig::from_toml(&text).unwrap().plant();
+    let nameplate = plant.motor.with_dc_voltage(plant.inverter.dc_voltage);
+    let o = commission(
+        &plant,
+        nameplate,
+        CommissionOptions::default(),
+        |_| {},
+        None,
+    )
+    .unwrap();
+    let id = o.identification.unwrap();
+    let doc = fado_sim::commission::identified_toml(&text, &id).unwrap();
+    let mut failed = Vec::new();
+    for warm in [1.3, 0.8] {
+        let mut table: toml::Table = doc.parse().unwrap();
+        let motor = table["motor"].as_table_mut().unwrap();
+        let rs = motor["rs"].as_float().unwrap() * warm;
+        motor.insert("rs".into(), toml::Value::Float(rs));
+        let hot = format!(
+            "{}\n[controller.gain_calibration]\ntime = 0.0\n",
+            toml::to_string(&table).unwrap()
+        );
+        let cfg = scenario_config("rated-reversal", Some(&hot), false).unwrap();
+        let truth = cfg.motor.rs + cfg.inverter.on_resistance;
+        let out = run_config("rated-reversal", cfg, None).unwrap();
+        let end = out.trace.rows.last().unwrap().rs_hat / truth;
+        println!(
+            "winding × {warm}: R̂s ends at {end:.3} × Rs, passed {}, {:.3} rad near zero speed",
+            out.passed, out.metrics.max_angle_error_zero_speed
+        );
+        if !((end - 1.0).abs() < 0.02 && out.passed) {
+            failed.push(warm);
+        }
+    }
+    assert!(failed.is_empty(), "{failed:?}");
 }

@@ -28,7 +28,6 @@
 //! 3e-3 kg·m² rotor commissions (its flux pulses bounded by their back-EMF,
 //! `fado_core::commissioning`).
 
-use fado_core::MachineModel;
 use fado_core::commissioning::Status;
 use fado_sim::commission::{CommissionOptions, commission, identified_toml};
 use fado_sim::scenario::simulate;
@@ -80,10 +79,7 @@ fn every_scenario(name: &str, skip: &[(&str, u64)]) {
 /// `reversal` on the `identified.toml` it writes, which must pass. The identification.
 fn commissioned_text(name: &str, text: &str) -> fado_core::commissioning::Identification<f64> {
     let plant = fado_sim::SimConfig::from_toml(text).unwrap().plant();
-    let nameplate = MachineModel {
-        dc_voltage: plant.inverter.dc_voltage,
-        ..plant.motor
-    };
+    let nameplate = plant.motor.with_dc_voltage(plant.inverter.dc_voltage);
     let o = commission(
         &plant,
         nameplate,
@@ -296,10 +292,7 @@ fn the_gimbal_motor_is_warned_of_its_low_speed_limit() {
     let text = file("gimbal-gbm5208-200t-4s");
     let config = fado_sim::SimConfig::from_toml(&text).unwrap();
     let plant = config.plant();
-    let m = MachineModel {
-        dc_voltage: plant.inverter.dc_voltage,
-        ..plant.motor
-    };
+    let m = plant.motor.with_dc_voltage(plant.inverter.dc_voltage);
     let warning = fado_core::machine_checks::check(&m, None)
         .iter()
         .find(|f| f.key() == "rs")

@@ -32,17 +32,83 @@
 //! inverter), a d-axis error that shrank |λ̂r| by 20 % in a 100 ms stop and put `stops` at
 //! 0.25 rad (docs/method/additions.md). This method predicts, from the voltage reference,
 //! the DC link and the inductance matrix (L̂d, L̂q at θ̂), the gate times of both half carrier
-//! periods (symmetric carrier, min-max zero sequence as [`crate::control::modulation`]), each
-//! pole's edge delayed by the band model, the current of each phase at its own gate edge (the
-//! piecewise-linear ripple: each other pole already switched adds the current response of its
-//! α-β voltage step ±(2/3)·Vdc·u_k, −Vdc/(3L̂) on a round rotor; the mean slope removed; the
-//! peak sample i − Δ/2 and the valley sample i + Δ/2, Δ the swing the pattern predicts), the
-//! two edges' delays and so the period-average pole error Vdc·f_sw·(t_fall − t_rise) −
-//! V_th·sat(i/Ic), in two fixed-point passes; < 0.1 V left in the same test. Outside the band
-//! it is the trapezoid exactly. Limit: on a low-inductance salient rotor the swing's dependence
-//! on the phase's own edge delay has a loop gain ≈ Vdc·Td/(6·L̂·Ic) above 1, the passes do not
-//! converge and the prediction helps little (same test: 1.12 → 0.84 V at 0.37/1.2 mH). Cost:
-//! ≈ 200 flops and 6 divisions more than the trapezoid (not measured on target). The current
+//! periods of the reference plus the compensation itself (symmetric carrier, min-max zero
+//! sequence as [`crate::control::modulation`]), each pole's edge delayed by the band model,
+//! the current of each phase at its own gate edge (the piecewise-linear ripple: each other
+//! pole already switched adds the current response of its α-β voltage step ±(2/3)·Vdc·u_k,
+//! −Vdc/(3L̂) on a round rotor; the mean slope removed; the peak sample i − Δ/2 and the
+//! valley sample i + Δ/2, Δ the swing the pattern predicts), and the two edges' delays from
+//! the band model at the edge currents the delays imply (next paragraph); the period-average
+//! pole error is then Vdc·f_sw·(t_fall − t_rise) − V_th·sat(i/Ic). Outside the band it is
+//! the trapezoid exactly.
+//!
+//! **Which solve.** The delays move the edge currents they are computed from: on a round
+//! rotor at the loaded standstill (the phase near zero current between a positive and a
+//! negative one) one second of an edge's delay moves its own edge current by Vdc/(3·L̂),
+//! and the band model turns one ampere into Td/Ic seconds, a loop gain
+//! g = Vdc·Td/(3·min(L̂d, L̂q)·Ic) ([`DeadTimeCompensation::loop_gain`], computed once from
+//! the configuration at the rated DC link `dc_voltage`). Two solves:
+//! - g ≤ [`EDGE_SOLVE_LOOP_GAIN`] (0.75): two fixed-point passes on the gate times of the
+//!   reference plus the trapezoid (`passes` submodule). Against the switching-resolved
+//!   inverter at standstill (fado-sim's inverter tests, phase b through the band) they
+//!   leave 0.097 V on the paper's motor (g = 0.33; 0.64 V with the trapezoid alone) and
+//!   0.042 / 0.080 V under 5.55 / 12 A on the MAD 5010 KV110's inverter with 200 µH
+//!   (g = 0.34).
+//! - g above it and below 1, in the samples where the middle pole's edges follow the
+//!   others' (below; the passes elsewhere): the root of delay − band model(edge current the delays imply) with the
+//!   gate times of the reference plus the compensation itself, a piecewise-linear problem
+//!   (`edges` submodule: Newton steps with the pattern's own slopes, bounded rounds). The
+//!   passes oscillate as g nears 1: on the MAD 5010 KV110 (44.4 V, 85 µH, 20 kHz, g = 0.79)
+//!   they leave 0.32 V under 5.55 A, the root solve 0.043 V (0.054 V under 12 A), and its
+//!   `stops` from a zero start angle keeps |θ − θ̂| at 0.12–0.20 rad (0.21–0.35 rad on the
+//!   passes; crates/fado-sim/tests/multirotor_datasheets.rs). Where g is small the passes
+//!   are the better of the two: the root solve leaves 0.119 V on the paper's motor.
+//!
+//! The threshold lies between the Siemens 1FT6084 preset (g = 0.71, the largest of the
+//! machines whose reversal and stops are kept bit-identical on the passes) and the MAD 5010
+//! KV110 (g = 0.79): a margin of 5 % either side. g of the presets: ipmsm-2k2 0.04,
+//! hub-hoverboard-48v 0.12, outrunner-cheetah-24v 0.18, pmsyrm-5k 0.22, paper 0.33,
+//! servo-1ft6084 0.71 (passes); multirotor-mn5006-22v 1.23, ipmsm-gem-50k 3.9 (passes, g ≥ 1).
+//! Per sample, the root solve runs only where the middle pole's gate edges
+//! follow the other two poles' edges by a margin: the references plus the trapezoid more
+//! than 4·Td·f_sw·Vdc (2·Td in time) from the largest and from the smallest; elsewhere the
+//! passes. Where the middle phase's two edges come before any other pole's edge they see
+//! only the phase's own swing, which both of its delays move (sum-mode loop gain g), and
+//! what the model leaves out moves the root by its error/(1 − g): the device drop
+//! V_th·sat(i(t)/Ic) following the instantaneous current (21 Ω inside the band against
+//! 6 mH on the 400 V servo test class: 560 V, 6 mH, 5 kHz, Td 2.5 µs, Ic 0.085 A, V_th 1.8 V,
+//! g = 0.91) and the zero vector's slope. There, at standstill under 1.5 A with phase b at
+//! −0.5 Ic (the a and c edges 1.9 µs, < Td, from b's), the model's root is unique and
+//! reached (Td on both edges, −0.90 V) while the inverter's own is −1.41 V: it puts the
+//! rising edge's current 5 mA (0.06 Ic) above the inverter's. Measured worst error on
+//! phase b (fado-sim's inverter tests, phase b through ±6 Ic) under 1.5 / 4.4 / 8.8 A: the
+//! passes 0.79 / 1.17 / 2.70 V, the root solve in every sample 1.39 / 1.00 / 0.06 V; with
+//! the margin at 2·Td·f_sw·Vdc (Td in time) the 8.8 A case keeps the root solve
+//! (0.06 V) but the servo's start-up with its load arriving in the release reads 0.253 rad
+//! (crates/fado-sim/tests/calibration_load_classes.rs, bound 0.25; 0.248 at 4·Td·f_sw·Vdc,
+//! 0.283 on the root solve in every sample).
+//! At g ≥ 1 the two passes run in every sample. There an edge's loop gain exceeds 1 wherever
+//! it is in the band, the model's root need not be unique (`edges` submodule) and the passes
+//! are measured the better of the two: on the T-Motor U8 II KV100 (44.4 V, 12 µH, 24 kHz,
+//! g = 2.1) `stops` from the start angle 1.0 rad keeps |θ − θ̂| at 0.057 rad on the passes
+//! and reaches 0.317 rad with the root solve in every sample. Not at the loaded standstill
+//! itself, where the ripple (Vdc/(3·L̂) = 1.2 A/µs) keeps the edges out of the band and both
+//! leave 0.012 V under the stops' 14.3 A (fado-sim's inverter tests), but (a) at the
+//! start-up's release, where the held d current steps to zero and the current vector passes
+//! through it with every phase in the band (where the per-phase Newton steps leave the star
+//! point's coupling out): i_q reaches −4.5 A against a −2.5 A reference and |θ − θ̂|
+//! 0.17 rad (0.007 rad on the passes), and (b) from the release and the loaded acceleration
+//! on, R̂s settles at −0.42 % of Rs (−0.17 % on the passes), which the loaded standstill's
+//! resistive speed R̂s·I/λ̂f ≈ 400 rad/s turns into the angle (0.27–0.32 rad in each
+//! standstill, 0.02–0.06 on the passes). ipmsm-gem-50k, multirotor-mn5006-22v and the
+//! Flipsky 6215 (g = 1.5) pass their scenarios on the passes.
+//! Limit of the root solve: where an edge's loop gain
+//! (Td/Ic)·(β − σ/2) reaches 1 (a low-inductance salient rotor; same test at 0.37/1.2 mH,
+//! g = 2.3: trapezoid 1.12 V, the root solve 0.75 V, the passes 0.84 V) the root is not unique and the step is the plain
+//! evaluation; with every phase in the band the per-phase steps leave the star point's
+//! coupling out (`edges` submodule). Cost over the trapezoid: the passes ≈ 200 flops and 6
+//! divisions, the root solve ≈ 600 flops and up to 9 divisions (not measured on target).
+//! The current
 //! at the switching instants, ripple included, as the quantity that sets the dead-time
 //! distortion at low output voltage: Choi & Sul, "A new compensation strategy reducing
 //! voltage/current distortion in PWM VSI systems operating
@@ -62,6 +128,9 @@
 //! skipping the limited samples ([`crate::SensorlessEstimator::voltage_limited`]) R̂s stays
 //! within 0.06 % (either alone leaves +0.3 %: the flux error of the limited samples lingers
 //! into the next periods).
+
+mod edges;
+mod passes;
 
 use crate::control::pi::clamp;
 use crate::error::{ConfigError, check};
@@ -95,6 +164,13 @@ pub const DEFAULT_DEAD_TIME: f64 = 2.5e-6;
 pub const DEFAULT_METHOD: DeadTimeMethod = DeadTimeMethod::EdgeCurrent;
 /// Default switching frequency in Hz: 5 kHz (paper, V).
 pub const DEFAULT_SWITCHING_FREQUENCY: f64 = 5e3;
+/// Loop gain g = Vdc·Td/(3·min(L̂d, L̂q)·Ic) above which [`DeadTimeMethod::EdgeCurrent`]
+/// solves the edges' delays for their root instead of taking two fixed-point passes (up to
+/// g = 1, in the samples where the middle pole's edges follow the others'): 0.75
+/// (module docs, "Which solve": between the Siemens 1FT6084 preset at g = 0.71, kept on the
+/// passes, and the MAD 5010 KV110 at g = 0.79, where the passes leave 0.32 V at standstill
+/// and the root solve 0.043 V).
+pub const EDGE_SOLVE_LOOP_GAIN: f64 = 0.75;
 /// Default device threshold voltage in V: 1 (docs/method/estimator.md §7 \[A\]).
 pub const DEFAULT_THRESHOLD_VOLTAGE: f64 = 1.0;
 /// Default current band Ic of the trapezoid in A: 0.3 (docs/method/estimator.md §7 \[A\]).
@@ -126,6 +202,10 @@ pub struct DeadTimeCompensationConfig<T> {
     /// in the rotor frame of the rotation it is given; 0: no ripple (the trapezoid). Default
     /// the machine model's (L̂d, L̂q).
     pub ripple_inductance: Dq<T>,
+    /// Rated DC-link voltage in V (inverter datum): with the other fields it sets the
+    /// refinement's loop gain g that chooses the edge-current solve (module docs, "Which
+    /// solve"); 0: the two passes. Default the machine model's `dc_voltage`.
+    pub dc_voltage: T,
 }
 
 impl<T: Real> DeadTimeCompensationConfig<T> {
@@ -143,6 +223,7 @@ impl<T: Real> DeadTimeCompensationConfig<T> {
             threshold_voltage: T::lit(DEFAULT_THRESHOLD_VOLTAGE),
             current_band: T::lit(DEFAULT_CURRENT_BAND),
             ripple_inductance: Dq::new(machine.ld, machine.lq),
+            dc_voltage: machine.dc_voltage,
         }
     }
 }
@@ -158,6 +239,11 @@ pub struct DeadTimeCompensation<T> {
     inv_period: T,
     /// 1/L̂d, 1/L̂q of `ripple_inductance` (zero where it is zero: edge current off).
     inv_ripple: Dq<T>,
+    /// The edge-current refinement's loop gain g = Vdc·Td/(3·min(L̂d, L̂q)·Ic) at the rated
+    /// DC link (module docs, "Which solve").
+    loop_gain: T,
+    /// g above [`EDGE_SOLVE_LOOP_GAIN`]: the root solve, else the two passes.
+    solve_edges: bool,
 }
 
 impl<T: Real> DeadTimeCompensation<T> {
@@ -175,6 +261,7 @@ impl<T: Real> DeadTimeCompensation<T> {
         let ic = check::positive("current_band", config.current_band)?;
         check::non_negative("ripple_inductance", config.ripple_inductance.d)?;
         check::non_negative("ripple_inductance", config.ripple_inductance.q)?;
+        let vdc = check::non_negative("dc_voltage", config.dc_voltage)?;
         let half = T::lit(0.5) / fsw;
         let inv = |l: T| {
             if l > T::zero() {
@@ -183,8 +270,19 @@ impl<T: Real> DeadTimeCompensation<T> {
                 T::zero()
             }
         };
+        let l_min = config
+            .ripple_inductance
+            .d
+            .step_min(config.ripple_inductance.q);
+        let loop_gain = if l_min > T::zero() {
+            vdc * td / (T::lit(3.0) * l_min * ic)
+        } else {
+            T::zero()
+        };
         Ok(Self {
             config,
+            loop_gain,
+            solve_edges: loop_gain > T::lit(EDGE_SOLVE_LOOP_GAIN) && loop_gain < T::one(),
             inv_band: T::one() / ic,
             half,
             inv_period: T::one() / (half + half),
@@ -272,16 +370,44 @@ impl<T: Real> DeadTimeCompensation<T> {
         v_abc: Abc<T>,
         vdc: T,
     ) -> Abc<T> {
+        let solve = self.solves_edges() && self.middle_follows(i_abc, v_abc, vdc);
+        self.edge_current_by(solve, rotation, i_abc, v_abc, vdc)
+    }
+
+    /// [`edge_current`](Self::edge_current) with the root solve in every sample, whatever the
+    /// loop gain and the sample: what the choice is measured against (module docs).
+    pub fn edge_current_root_solve(
+        &self,
+        rotation: Rotation<T>,
+        i_abc: Abc<T>,
+        v_abc: Abc<T>,
+        vdc: T,
+    ) -> Abc<T> {
+        self.edge_current_by(true, rotation, i_abc, v_abc, vdc)
+    }
+
+    /// [`edge_current`](Self::edge_current) with the root solve (`solve`) or the two passes.
+    #[inline(always)]
+    fn edge_current_by(
+        &self,
+        solve: bool,
+        rotation: Rotation<T>,
+        i_abc: Abc<T>,
+        v_abc: Abc<T>,
+        vdc: T,
+    ) -> Abc<T> {
         let c = &self.config;
         let l = c.ripple_inductance;
-        let first = self.trapezoid(i_abc, vdc);
         if !(vdc > T::zero() && l.d > T::zero() && l.q > T::zero()) {
-            return first;
+            return self.trapezoid(i_abc, vdc);
         }
         let one = T::one();
         let i = [i_abc.a, i_abc.b, i_abc.c];
-        let gates = self.gate_times(v_abc, first, vdc);
-        let (d_rise, d_fall) = self.edge_delays(rotation, i, gates, vdc);
+        let (d_rise, d_fall) = if solve {
+            self.edge_delays(rotation, i, [v_abc.a, v_abc.b, v_abc.c], vdc)
+        } else {
+            self.passes_delays(rotation, i_abc, v_abc, vdc)
+        };
         let band = self.inv_band;
         let vth = c.threshold_voltage;
         let per_second = vdc * c.switching_frequency;
@@ -290,28 +416,35 @@ impl<T: Real> DeadTimeCompensation<T> {
         Abc::new(f(0), f(1), f(2))
     }
 
-    /// The gate times within each half period of the pole voltages the modulator will
-    /// realise (reference `v_abc` + first-guess compensation `first`, min-max zero sequence
-    /// as SVPWM, as offsets from the DC-link mid-point): legs go high at half/2 − v·half/Vdc
-    /// while the carrier falls (rising edges), low at half/2 + v·half/Vdc while it rises.
+    /// The edge-current refinement's loop gain g = Vdc·Td/(3·min(L̂d, L̂q)·Ic) at the rated DC
+    /// link, computed once from the configuration (module docs, "Which solve").
+    pub fn loop_gain(&self) -> T {
+        self.loop_gain
+    }
+
+    /// Whether [`DeadTimeMethod::EdgeCurrent`] solves the edges' delays for their root (g
+    /// above [`EDGE_SOLVE_LOOP_GAIN`] and below 1; only in the samples where the middle
+    /// pole's edges follow the others') rather than taking the two fixed-point passes (module
+    /// docs, "Which solve").
     #[inline(always)]
-    fn gate_times(&self, v_abc: Abc<T>, first: Abc<T>, vdc: T) -> ([T; 3], [T; 3]) {
-        let zero = T::zero();
-        let half = self.half; // half carrier period = sample period
-        let mut vp = [v_abc.a + first.a, v_abc.b + first.b, v_abc.c + first.c];
-        let (mx, mn) = (
-            vp[0].step_max(vp[1]).step_max(vp[2]),
-            vp[0].step_min(vp[1]).step_min(vp[2]),
-        );
-        let v0 = -(mx + mn) * T::lit(0.5);
-        for v in &mut vp {
-            *v += v0;
-        }
-        let secs_per_volt = half / vdc;
-        let h = T::lit(0.5) * half;
-        let tg_rise = vp.map(|v| clamp(h - v * secs_per_volt, zero, half));
-        let tg_fall = vp.map(|v| clamp(h + v * secs_per_volt, zero, half));
-        (tg_rise, tg_fall)
+    pub fn solves_edges(&self) -> bool {
+        self.solve_edges
+    }
+
+    /// Whether the middle pole's gate edges follow the other poles' edges with a margin
+    /// (module docs, "Which solve"): the poles of the reference `v_abc` plus the trapezoid of
+    /// `i_abc` more than 2·Td·Vdc/(half period) = 4·Td·f_sw·Vdc apart (2·Td in time: a pole
+    /// edge waits at most Td after its gate, and as much again), the middle from the largest
+    /// and from the smallest.
+    #[inline(always)]
+    fn middle_follows(&self, i_abc: Abc<T>, v_abc: Abc<T>, vdc: T) -> bool {
+        let t = self.trapezoid(i_abc, vdc);
+        let vp = [v_abc.a + t.a, v_abc.b + t.b, v_abc.c + t.c];
+        let mx = vp[0].step_max(vp[1]).step_max(vp[2]);
+        let mn = vp[0].step_min(vp[1]).step_min(vp[2]);
+        let mid = vp[0] + vp[1] + vp[2] - mx - mn;
+        let apart = T::lit(2.0) * self.config.dead_time * vdc / self.half;
+        mx - mid > apart && mid - mn > apart
     }
 
     /// Delay of one edge (band model): the opposing current waits Td, the helping one
@@ -326,91 +459,6 @@ impl<T: Real> DeadTimeCompensation<T> {
         } else {
             td * (T::one() - ie.abs() * self.inv_band).step_max(zero)
         }
-    }
-
-    /// Each edge's delay, from the current at the edge: the sampled currents `i`, then twice
-    /// refined with the ripple the gate times `gates` (rising, falling) and those delays
-    /// imply (once where the first refinement keeps them).
-    #[inline(always)]
-    fn edge_delays(
-        &self,
-        rotation: Rotation<T>,
-        i: [T; 3],
-        gates: ([T; 3], [T; 3]),
-        vdc: T,
-    ) -> ([T; 3], [T; 3]) {
-        let first = (
-            i.map(|x| self.edge_delay(true, x)),
-            i.map(|x| self.edge_delay(false, x)),
-        );
-        let once = self.refined_delays(rotation, i, gates, first, vdc);
-        // A refinement that keeps every delay is at its fixed point: the second one would
-        // repeat the same arithmetic on the same numbers (every current outside the band with
-        // its ripple, the common case away from the zero crossings).
-        if once == first {
-            return once;
-        }
-        self.refined_delays(rotation, i, gates, once, vdc)
-    }
-
-    /// One refinement of the edges' delays (rising, falling): the current at each edge is
-    /// the sampled one plus the ripple of the volt-seconds applied up to it.
-    #[inline(always)]
-    fn refined_delays(
-        &self,
-        rotation: Rotation<T>,
-        i: [T; 3],
-        (tg_rise, tg_fall): ([T; 3], [T; 3]),
-        (d_rise, d_fall): ([T; 3], [T; 3]),
-        vdc: T,
-    ) -> ([T; 3], [T; 3]) {
-        let (zero, one) = (T::zero(), T::one());
-        let half = self.half;
-        // Phase axes u_x and the current response L⁻¹·w of a volt-second vector w (α-β, the
-        // rotor frame's 1/L̂d, 1/L̂q).
-        let k3 = T::lit(0.866_025_403_784_438_6);
-        let axes = [
-            Ab::new(one, zero),
-            Ab::new(T::lit(-0.5), k3),
-            Ab::new(T::lit(-0.5), -k3),
-        ];
-        let (inv_ld, inv_lq) = (self.inv_ripple.d, self.inv_ripple.q);
-        let respond = |w: Ab<T>| {
-            let w = w.to_dq(rotation);
-            Dq::new(w.d * inv_ld, w.q * inv_lq).to_ab(rotation)
-        };
-        let pole_step = T::lit(2.0 / 3.0) * vdc; // α-β step of one pole moving by Vdc
-        let pr = [0, 1, 2].map(|k| (tg_rise[k] + d_rise[k]).step_min(half));
-        let pf = [0, 1, 2].map(|k| (tg_fall[k] + d_fall[k]).step_min(half));
-        // Volt-seconds over each half: poles low → high at pr while the carrier falls,
-        // high → low at pf while it rises (zero vectors at the samples).
-        let (mut int_r, mut int_f) = (Ab::zero(), Ab::zero());
-        for k in 0..3 {
-            int_r += axes[k] * (pole_step * (half - pr[k]));
-            int_f += axes[k] * (-pole_step * (half - pf[k]));
-        }
-        // Mean voltage over the period (the back-EMF and R·i it balances) and the current's
-        // swing between the carrier's peak and valley samples, whose mean is the reference:
-        // i(peak) = i − Δ/2, i(valley) = i + Δ/2.
-        let vbar = (int_r + int_f) * self.inv_period;
-        let half_swing = respond((int_r - int_f) * T::lit(0.25));
-        let mut nr = d_rise;
-        let mut nf = d_fall;
-        for x in 0..3 {
-            // Volt-seconds (mean removed) up to x's own gate edge, x not yet switched.
-            let (mut wr, mut wf) = (vbar * -tg_rise[x], vbar * -tg_fall[x]);
-            for k in 0..3 {
-                if k != x {
-                    wr += axes[k] * (pole_step * (tg_rise[x] - pr[k]).step_max(zero));
-                    wf += axes[k] * (-pole_step * (tg_fall[x] - pf[k]).step_max(zero));
-                }
-            }
-            let ie_r = i[x] + axes[x].dot(respond(wr) - half_swing);
-            let ie_f = i[x] + axes[x].dot(respond(wf) + half_swing);
-            nr[x] = self.edge_delay(true, ie_r);
-            nf[x] = self.edge_delay(false, ie_f);
-        }
-        (nr, nf)
     }
 
     /// The part of the compensation `comp` (per phase, from
@@ -629,6 +677,107 @@ mod tests {
         );
     }
 
+    /// The MAD 5010 KV110's inverter (44.4 V, 20 kHz, Td 0.625 µs, Ic 0.138 A) on 85 µH at
+    /// the rated DC link `vdc`.
+    fn kv110(vdc: f64) -> DeadTimeCompensation<f64> {
+        DeadTimeCompensation::new(DeadTimeCompensationConfig {
+            enabled: true,
+            method: DeadTimeMethod::EdgeCurrent,
+            dead_time: 0.625e-6,
+            switching_frequency: 20e3,
+            threshold_voltage: 44.4 / 311.0,
+            current_band: 0.137_739_130_434_782_6,
+            ripple_inductance: Dq::new(85e-6, 85e-6),
+            dc_voltage: vdc,
+        })
+        .unwrap()
+    }
+
+    #[test]
+    fn the_loop_gain_chooses_the_solve_on_either_side_of_the_threshold() {
+        // g = Vdc·Td/(3·min(L̂d, L̂q)·Ic): the paper's motor 311 V, 2.5 µs, 2.63 mH, 0.3 A.
+        let paper = edge(2.63e-3);
+        let g = 311.0 * 2.5e-6 / (3.0 * 2.63e-3 * 0.3);
+        assert!((paper.loop_gain() - g).abs() < 1e-12 && !paper.solves_edges());
+        // The MAD 5010 KV110 at 44.4 V: g = 0.79, the root solve.
+        let kv = kv110(44.4);
+        assert!((kv.loop_gain() - 0.790).abs() < 1e-3 && kv.solves_edges());
+        // Either side of the threshold through the rated DC link alone.
+        let at = |g: f64| kv110(44.4 * g / kv.loop_gain());
+        assert!(!at(EDGE_SOLVE_LOOP_GAIN * 0.999).solves_edges());
+        assert!(at(EDGE_SOLVE_LOOP_GAIN * 1.001).solves_edges());
+        assert!(!kv110(0.0).solves_edges());
+        // The chosen solve is the one used: standstill under 5.55 A, phase b at 0.2 A, where
+        // its edge currents (the ripple ±0.33 A) are in the band.
+        let rs = 0.6193;
+        let ib = 0.2;
+        let i = Abc::new(-5.55 - 0.5 * ib, ib, 5.55 - 0.5 * ib);
+        let v = Abc::new(rs * i.a, rs * i.b, rs * i.c);
+        let rot = Rotation::from_angle(0.0);
+        let out = |c: &DeadTimeCompensation<f64>, (r, f): ([f64; 3], [f64; 3])| {
+            let per_second = 44.4 * 20e3;
+            let vth = c.config().threshold_voltage;
+            let ic = c.config().current_band;
+            let x = [i.a, i.b, i.c];
+            [0, 1, 2].map(|k| per_second * (r[k] - f[k]) + vth * (x[k] / ic).clamp(-1.0, 1.0))
+        };
+        let x = [i.a, i.b, i.c];
+        for (c, solved) in [(at(EDGE_SOLVE_LOOP_GAIN * 0.999), false), (kv, true)] {
+            let d = if solved {
+                c.edge_delays(rot, x, [v.a, v.b, v.c], 44.4)
+            } else {
+                c.passes_delays(rot, i, v, 44.4)
+            };
+            let want = out(&c, d);
+            let got = c.edge_current(rot, i, v, 44.4);
+            for (g, w) in [got.a, got.b, got.c].into_iter().zip(want) {
+                assert!(
+                    (g - w).abs() < 1e-12,
+                    "solved {solved}: {got:?} vs {want:?}"
+                );
+            }
+        }
+        // The two solves differ there (else the test could not tell them apart).
+        let d_solve = kv.edge_delays(rot, x, [v.a, v.b, v.c], 44.4);
+        let d_pass = kv.passes_delays(rot, i, v, 44.4);
+        let gap = (out(&kv, d_solve)[1] - out(&kv, d_pass)[1]).abs();
+        assert!(gap > 0.05, "{gap} V");
+    }
+
+    #[test]
+    fn the_root_solve_runs_below_a_loop_gain_of_one_where_the_middle_pole_follows() {
+        // The MAD 5010 KV110 (g = 0.79) at standstill under 0.5 A, phase b at 0.05 A: the
+        // references plus the trapezoid 0.6–1.6 V apart, under 4·Td·f_sw·Vdc = 2.22 V: the
+        // passes; under 5.55 A, b at 0.2 A, ≥ 3 V apart: the root solve. At g = 1.01: passes.
+        let kv = kv110(44.4);
+        let at_one = kv110(44.4 * 1.01 / kv.loop_gain());
+        assert!(kv.solves_edges() && at_one.loop_gain() >= 1.0 && !at_one.solves_edges());
+        assert!(!kv110(44.4 * 1.0001 / kv.loop_gain()).solves_edges());
+        assert!(kv110(44.4 * 0.99 / kv.loop_gain()).solves_edges());
+        let rot = Rotation::from_angle(0.0);
+        for (load, ib, kv_solves) in [(0.5, 0.05, false), (5.55, 0.2, true)] {
+            let i = Abc::new(-load - 0.5 * ib, ib, load - 0.5 * ib);
+            let v = Abc::new(0.6193 * i.a, 0.6193 * i.b, 0.6193 * i.c);
+            let x = [i.a, i.b, i.c];
+            let out = |c: &DeadTimeCompensation<f64>, (r, f): ([f64; 3], [f64; 3])| {
+                let per_second = 44.4 * 20e3;
+                let vth = c.config().threshold_voltage;
+                let ic = c.config().current_band;
+                [0, 1, 2].map(|k| per_second * (r[k] - f[k]) + vth * (x[k] / ic).clamp(-1.0, 1.0))
+            };
+            let passes = out(&kv, kv.passes_delays(rot, i, v, 44.4));
+            let solve = out(&kv, kv.edge_delays(rot, x, [v.a, v.b, v.c], 44.4));
+            assert!((passes[1] - solve[1]).abs() > 0.01, "{passes:?} {solve:?}");
+            let kv_want = if kv_solves { solve } else { passes };
+            for (c, want) in [(&kv, kv_want), (&at_one, passes)] {
+                let got = c.edge_current(rot, i, v, 44.4);
+                for (g, w) in [got.a, got.b, got.c].into_iter().zip(want) {
+                    assert!((g - w).abs() < 1e-12, "{load} A: {got:?} vs {want:?}");
+                }
+            }
+        }
+    }
+
     #[test]
     fn bad_config_names_field() {
         let bad = |f: fn(&mut DeadTimeCompensationConfig<f64>)| {
@@ -645,5 +794,6 @@ mod tests {
             bad(|c| c.ripple_inductance = Dq::new(1e-3, -1e-3)),
             "ripple_inductance"
         );
+        assert_eq!(bad(|c| c.dc_voltage = -1.0), "dc_voltage");
     }
 }

@@ -36,7 +36,7 @@ pub use drive::tuning;
 pub use current_controller::{CurrentController, CurrentControllerConfig};
 pub use dc_link_limit::{DcLinkLimit, DcLinkTuning};
 pub use dead_time_compensation::{
-    DeadTimeCompensation, DeadTimeCompensationConfig, DeadTimeMethod,
+    DeadTimeCompensation, DeadTimeCompensationConfig, DeadTimeMethod, EDGE_SOLVE_LOOP_GAIN,
 };
 pub use delay_compensation::{DelayCompensation, DelayCompensationConfig};
 pub use drive::{DriveConfig, DriveOutput, DriveTuning, SensorlessDrive};

@@ -13,6 +13,18 @@ pub enum TorqueSlip {
     LineToLine,
     /// The pole count given for the pole pairs: twice too many.
     PoleCount,
+    /// Half the pole pairs (a sheet's pole-pair count read as the poles): the model is half
+    /// the rating.
+    PolePairsHalved,
+    /// A back-EMF constant in V rms line-to-line per 1000 r/min entered as λf: p·128 × too
+    /// large.
+    KeVllRms,
+    /// A back-EMF constant in V peak line-to-line per 1000 r/min entered as λf: p·181 × too
+    /// large.
+    KeVllPeak,
+    /// A flux in V/Hz (2π·λf, the unit of TI's InstaSPIN "rated flux") entered as λf: 2π ×
+    /// too large.
+    VoltsPerHertz,
     /// None of these: check the units.
     Unknown,
 }
@@ -204,6 +216,14 @@ pub(super) const TORQUE_KEYS_SALIENT: &[&str] = &[
     "ld",
     "lq",
 ];
+const TORQUE_KEYS_POLES_FIRST: &[&str] = &[
+    "pole_pairs",
+    "rated_torque",
+    "rated_current",
+    "flux_linkage",
+    "ld",
+    "lq",
+];
 const TORQUE_KEYS_FLUX_FIRST: &[&str] = &[
     "flux_linkage",
     "rated_torque",
@@ -295,8 +315,16 @@ impl Finding {
             },
             Finding::PoleCount { .. } => &["pole_pairs", "rated_torque", "flux_linkage"],
             Finding::Torque {
+                slip: TorqueSlip::PolePairsHalved,
+                ..
+            } => TORQUE_KEYS_POLES_FIRST,
+            Finding::Torque {
                 severity: Severity::Warning,
                 slip: TorqueSlip::LineToLine,
+                ..
+            }
+            | Finding::Torque {
+                slip: TorqueSlip::KeVllRms | TorqueSlip::KeVllPeak | TorqueSlip::VoltsPerHertz,
                 ..
             } => TORQUE_KEYS_FLUX_FIRST,
             Finding::Torque {

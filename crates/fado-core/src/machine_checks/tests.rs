@@ -596,3 +596,75 @@ fn ratings_times_ten_on_small_machines_are_named_by_their_time_constant() {
     assert_eq!(scale_of(&ratings_times(&hub, 10.0)), Some(false));
     assert_eq!(scale_of(&ratings_times(&hub, 0.1)), Some(true));
 }
+
+/// The 400 W servo of `tests/data/unseen/servo-estun-emj04-400w-310v.toml` (fado-sim): 8
+/// poles, λf 62.155 mWb, 1.27 N·m at 3.405 A peak.
+fn servo_400w() -> MachineModel<f64> {
+    MachineModel {
+        rs: 2.3679,
+        ld: 8.3655e-3,
+        lq: 8.3655e-3,
+        flux_linkage: 62.155e-3,
+        pole_pairs: 4,
+        inertia: 3.1e-5,
+        viscous_friction: 0.0,
+        rated_current: 3.405,
+        rated_speed_rpm: 3000.0,
+        rated_torque: 1.27,
+        dc_voltage: 310.0,
+        ..MachineModel::paper()
+    }
+}
+
+#[test]
+fn a_back_emf_constant_or_a_flux_in_v_per_hz_entered_as_flux_linkage_blames_flux_linkage() {
+    assert!(check(&servo_400w(), None).is_empty());
+    // The sheet's Ke: 31.9 V rms and 45.1 V peak line-to-line per 1000 r/min; TI's "rated
+    // flux" 0.3905 V/Hz (2π·λf).
+    for (flux, says) in [
+        (31.9, "`ke_vll_rms_per_krpm`"),
+        (45.1, "`ke_vll_peak_per_krpm`"),
+        (0.3905, "in V/Hz (2π·λf"),
+    ] {
+        let m = MachineModel {
+            flux_linkage: flux,
+            ..servo_400w()
+        };
+        let f = first(&m, None);
+        assert_eq!(
+            (f.key(), f.severity()),
+            ("flux_linkage", Severity::Error),
+            "{f}"
+        );
+        assert!(f.to_string().contains(says), "{flux}: {f}");
+    }
+    // λf in mWb where Wb is meant on the paper's 8-pole motor stays that (p·128 = 513, not
+    // the 1000 of a milli).
+    let mut m = paper();
+    m.flux_linkage = 88.0;
+    assert!(
+        first(&m, None)
+            .to_string()
+            .contains("mWb where Wb is meant")
+    );
+}
+
+#[test]
+fn half_the_pole_pairs_is_named_blaming_pole_pairs() {
+    // A 20-pole motor whose sheet says "poles 10" meaning the pole pairs, entered as 5.
+    let m = MachineModel {
+        pole_pairs: 2,
+        ..servo_400w()
+    };
+    let f = first(&m, None);
+    assert_eq!(
+        (f.key(), f.severity()),
+        ("pole_pairs", Severity::Warning),
+        "{f}"
+    );
+    let text = f.to_string();
+    assert!(text.contains("half the pole pairs"), "{text}");
+    for k in f.keys() {
+        assert!(text.contains(k), "{k}: {text}");
+    }
+}

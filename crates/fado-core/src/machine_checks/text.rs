@@ -40,6 +40,31 @@ fn write_torque(
         write_keys(f, &TORQUE_KEYS_SALIENT[2..])?;
         f.write_str(")")?;
     }
+    let ke = |f: &mut fmt::Formatter<'_>, unit: &str| {
+        write!(
+            f,
+            ": `flux_linkage` a back-EMF constant in V {unit} line-to-line per 1000 r/min? \
+             Give it as `ke_vll_{unit}_per_krpm` (λf in Wb peak per phase from it and \
+             `pole_pairs`)"
+        )
+    };
+    match slip {
+        TorqueSlip::KeVllRms => return ke(f, "rms"),
+        TorqueSlip::KeVllPeak => return ke(f, "peak"),
+        TorqueSlip::VoltsPerHertz => {
+            return f.write_str(
+                ": `flux_linkage` in V/Hz (2π·λf, a \"rated flux\" of TI's InstaSPIN) where Wb \
+                 is meant? λf = the V/Hz value / 2π",
+            );
+        }
+        TorqueSlip::PolePairsHalved => {
+            return f.write_str(
+                ": `pole_pairs` half the pole pairs (a sheet's pole-pair count read as the \
+                 poles)? The model's torque is half the rating",
+            );
+        }
+        _ => {}
+    }
     if (0.3e-3..3e-3).contains(&ratio) {
         return f.write_str(": `flux_linkage` in mWb where Wb is meant?");
     } else if (300.0..3000.0).contains(&ratio) {
@@ -61,9 +86,7 @@ fn write_torque(
             ": λf from a line-to-line constant where the phase value is meant (√3 = 1.73)? \
              Give λf in Wb peak per phase",
         ),
-        TorqueSlip::Unknown => {
-            f.write_str(": check the units (λf in Wb peak per phase, current in A peak)")
-        }
+        _ => f.write_str(": check the units (λf in Wb peak per phase, current in A peak)"),
     }
 }
 

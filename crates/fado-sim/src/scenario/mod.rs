@@ -97,6 +97,41 @@ impl Scenario {
         p
     }
 
+    /// For a paper experiment in its motor's units (`fig8`–`fig12`, `steady300`) run on
+    /// `cfg`, which holds another motor: the words saying so, with the largest load (N·m) and
+    /// speed (r/min) of its profile against that motor's ratings and the scenarios scaled by
+    /// them. None for a scaled scenario, for `custom` and on a motor with the paper motor's
+    /// ratings.
+    pub fn units_note(&self, cfg: &SimConfig) -> Option<String> {
+        let paper = crate::motor::MotorParams::paper();
+        let m = &cfg.motor;
+        let papers =
+            m.rated_torque == paper.rated_torque && m.rated_speed_rpm == paper.rated_speed_rpm;
+        if self.scaled || self.neutral || papers {
+            return None;
+        }
+        let largest = |points: &[[f64; 2]]| points.iter().map(|p| p[1].abs()).fold(0.0, f64::max);
+        let load = largest(&cfg.load.torque.points);
+        let speed = largest(&cfg.speed_reference.points);
+        let scaled: Vec<&str> = SCENARIOS
+            .iter()
+            .filter(|s| s.scaled)
+            .map(|s| s.name)
+            .collect();
+        Some(format!(
+            "`{}` is the paper's experiment in its motor's units (loads up to {load} N·m, \
+             speeds up to {speed} r/min), not scaled to this [motor]: {:.2} × its \
+             `motor.rated_torque` ({} N·m) and {:.3} × its `motor.rated_speed_rpm` ({} r/min); \
+             scaled by the ratings: {}",
+            self.name,
+            load / m.rated_torque,
+            m.rated_torque,
+            speed / m.rated_speed_rpm,
+            m.rated_speed_rpm,
+            scaled.join(", ")
+        ))
+    }
+
     /// Checks the pass criteria on a finished run.
     pub fn evaluate(&self, cfg: &SimConfig, m: &Metrics, p: &ScenarioProbe) -> Vec<Check> {
         let mut checks = if self.neutral {

@@ -97,7 +97,7 @@ pub const SCENARIOS: [Scenario; 14] = [
                     |n − n*| < max(0.5·n*, 0.5 r/min) and no trip; the lowest speed held is \
                     the lowest level held together with every level above it; the scenario \
                     passes when every level is held",
-        scaled: false,
+        scaled: true,
         neutral: false,
         setup: setup_lowspeed,
         observe: observe_lowspeed,

@@ -116,6 +116,19 @@ pub fn note_scenario_motor(text: Option<&str>, config: Option<&Path>) {
     }
 }
 
+/// A note on stderr when the `--config` file `text` gives its own `[motor]` to one of the
+/// paper's experiments in its motor's units (`Scenario::units_note`).
+pub fn note_absolute_scenario(name: &str, cfg: &fado_sim::SimConfig, text: Option<&str>) {
+    let has_motor = text
+        .and_then(|t| t.parse::<toml::Table>().ok())
+        .is_some_and(|t| t.contains_key("motor"));
+    if let Some(note) = scenario::find(name).and_then(|s| s.units_note(cfg))
+        && has_motor
+    {
+        eprintln!("note: {note}");
+    }
+}
+
 /// A CSV write error as the output error naming `path`.
 pub fn csv_error(e: csv::Error, path: &Path) -> OutputError {
     let source = match e.into_kind() {

@@ -11,7 +11,9 @@ use fado_sim::sim::{CsvTraceWriter, TraceRow, TraceSink};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use super::Outcome;
-use crate::files::{csv_error, in_file, note_scenario_motor, read_file, warn_plausibility};
+use crate::files::{
+    csv_error, in_file, note_absolute_scenario, note_scenario_motor, read_file, warn_plausibility,
+};
 
 /// The arguments of `run`.
 #[derive(clap::Args)]
@@ -43,6 +45,7 @@ pub fn run(args: RunArgs) -> Outcome {
         .map_err(|e| in_file(e, &args.config))?;
     warn_plausibility(&cfg, args.config.as_deref(), text.as_deref());
     note_scenario_motor(text.as_deref(), args.config.as_deref());
+    note_absolute_scenario(&args.scenario, &cfg, text.as_deref());
     if args.dump_config {
         out!("{}", cfg.to_toml_annotated());
         return Ok(ExitCode::SUCCESS);

@@ -1,0 +1,230 @@
+//! Six machines of classes no preset or other test machine has, entered from public parameter
+//! tables as a user writes them (only the table's keys; `tests/data/unseen/*.toml`, each naming
+//! its source): an 8-pole 400 W industrial servo on a 310 V link (Estun EMJ-04, its bare rotor
+//! 3.1e-5 kg·m², 7.7 ms to rated speed at rated torque), a 6-pole rotary-compressor IPMSM (GMCC,
+//! Lq/Ld 1.43), an 8-pole 12 V electric-power-steering motor (Rs·I/(ω·λf) 0.54 at rated), a
+//! 4-pole 36 V power-tool inrunner at 20 000 r/min, a 20-pole 47 kW axial-flux traction motor
+//! on 560 V (EMRAX 228 HV) and a 16-pole high-inductance appliance motor on 310 V (L·I/λf 2.4).
+//! Switching-resolved inverter, the default sensor model, current-sensor seeds 1 and 2.
+//!
+//! Measured (the largest |θ − θ̂| of each run, seeds 1 / 2, rad): the compressor `reversal`
+//! 0.008 / 0.009, `stops` 0.073 / 0.068, `rated-reversal` 0.009 / 0.009, `loaded-start` 0.148 /
+//! 0.168, `fullrange` 0.109 / 0.106, `regen-stop` 0.052 / 0.052; EMRAX 0.012 / 0.011, 0.031 /
+//! 0.030, 0.013 / 0.013, 0.121 / 0.187, 0.095 / 0.095, 0.072 / 0.066; the servo 0.004 / 0.007,
+//! 0.008 / 0.007, 0.004 / 0.007, `fullrange` 0.144 / 0.127, `regen-stop` seed 2 0.157; the tool
+//! 0.017 / 0.019, 0.051 / 0.062, 0.019 / 0.020, `loaded-start` seed 1 0.137, 0.088 / 0.088,
+//! 0.070 / 0.056; the EPS motor `reversal` 0.181 / 0.188, `rated-reversal` 0.245 / 0.252 (0.200
+//! / 0.209 near zero speed), `loaded-start` 0.042 / 0.043, `regen-stop` 0.154 / 0.154; the
+//! appliance motor `reversal` 0.231 / 0.118, `rated-reversal` 0.169 / 0.191, `loaded-start`
+//! 0.056 / 0.085. Both commissioned models (compressor, EMRAX) pass `reversal`.
+//!
+//! The misses, in the ignored tests below with their figures: the light servo rotor falls back
+//! when the brake opens (`loaded-start`), the tool motor's angle during that fall (seed 2), and
+//! the EPS and appliance motors near zero speed under load with the sensors' gain mismatch
+//! uncalibrated (the test beside them shows both pass without the mismatch).
+
+use fado_core::commissioning::Status;
+use fado_sim::commission::{CommissionOptions, commission, identified_toml};
+use fado_sim::scenario::simulate;
+
+/// The scenarios every machine runs.
+const SCENARIOS: [&str; 6] = [
+    "reversal",
+    "stops",
+    "rated-reversal",
+    "loaded-start",
+    "fullrange",
+    "regen-stop",
+];
+
+/// The text of `tests/data/unseen/<name>.toml`.
+fn file(name: &str) -> String {
+    let path = format!(
+        "{}/tests/data/unseen/{name}.toml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    std::fs::read_to_string(path).unwrap()
+}
+
+/// `scenario` on machine `name` with the current sensors' noise `seed` and the `extra`
+/// `[current_sensor]` keys: (passed, the largest |θ − θ̂| of the run), printed.
+fn run(name: &str, scenario: &str, seed: u64, extra: &str) -> (bool, f64) {
+    let text = format!("{}\n[current_sensor]\nseed = {seed}\n{extra}", file(name));
+    let out = simulate(scenario, Some(&text), false, None).unwrap();
+    let angle = out.metrics.max_angle_error;
+    eprintln!(
+        "{name} {scenario} seed {seed}: {angle:.3} rad, passed {}",
+        out.passed
+    );
+    if !out.passed {
+        eprintln!("  {:?}", out.checks);
+    }
+    (out.passed, angle)
+}
+
+/// Every scenario at seeds 1 and 2 but those `skip`ped; the misses listed together.
+fn every_scenario(name: &str, skip: &[(&str, u64)]) {
+    let mut missed = Vec::new();
+    for scenario in SCENARIOS {
+        for seed in [1, 2] {
+            if !skip.contains(&(scenario, seed)) && !run(name, scenario, seed, "").0 {
+                missed.push(format!("{scenario} seed {seed}"));
+            }
+        }
+    }
+    assert!(missed.is_empty(), "{name} missed: {missed:?}");
+}
+
+/// `commission` on `name`'s plant, told its own record; then `reversal` on the
+/// `identified.toml` it writes, which must pass.
+fn commissioned_reversal(name: &str) {
+    let text = file(name);
+    let plant = fado_sim::SimConfig::from_toml(&text).unwrap().plant();
+    let nameplate = plant.motor.with_dc_voltage(plant.inverter.dc_voltage);
+    let o = commission(
+        &plant,
+        nameplate,
+        CommissionOptions::default(),
+        |_| {},
+        None,
+    )
+    .unwrap();
+    assert_eq!(o.status, Status::Done, "{name}");
+    let identified = identified_toml(&text, &o.identification.unwrap()).unwrap();
+    let r = simulate("reversal", Some(&identified), false, None).unwrap();
+    eprintln!(
+        "{name}: identified reversal {:.3} rad near zero speed",
+        r.metrics.max_angle_error_zero_speed
+    );
+    assert!(r.passed, "{name}: {:?}", r.checks);
+}
+
+#[test]
+fn a_compressor_ipmsm_passes_every_scenario_and_commissions() {
+    every_scenario("compressor-gmcc-ipm-310v", &[]);
+    commissioned_reversal("compressor-gmcc-ipm-310v");
+}
+
+#[test]
+fn a_47_kw_axial_flux_traction_motor_passes_every_scenario_and_commissions() {
+    every_scenario("traction-emrax228hv-560v", &[]);
+    commissioned_reversal("traction-emrax228hv-560v");
+}
+
+#[test]
+fn a_400_w_servo_with_its_bare_rotor_passes_its_running_scenarios() {
+    let skip = [("loaded-start", 1), ("loaded-start", 2), ("regen-stop", 1)];
+    every_scenario("servo-estun-emj04-400w-310v", &skip);
+}
+
+#[test]
+fn a_36_v_power_tool_motor_passes_every_scenario_but_one_loaded_start() {
+    every_scenario("tool-makita-4p-36v", &[("loaded-start", 2)]);
+}
+
+/// The EPS and appliance motors' scenarios away from a loaded standstill.
+#[test]
+fn the_eps_and_appliance_motors_pass_reversals_and_the_loaded_start() {
+    let mut missed = Vec::new();
+    for (name, scenarios) in [
+        (
+            "eps-nedic-12v",
+            &["reversal", "rated-reversal", "loaded-start", "regen-stop"][..],
+        ),
+        (
+            "appliance-chmotor-16p-310v",
+            &["reversal", "rated-reversal", "loaded-start"][..],
+        ),
+    ] {
+        for scenario in scenarios {
+            for seed in [1, 2] {
+                if !run(name, scenario, seed, "").0 {
+                    missed.push(format!("{name} {scenario} seed {seed}"));
+                }
+            }
+        }
+    }
+    assert!(missed.is_empty(), "missed: {missed:?}");
+}
+
+/// The EPS and appliance motors' misses come from the current sensors' 0.5 % gain mismatch,
+/// which their start-up leaves uncalibrated (`gain_calibration` TooSlow on the EPS motor,
+/// RotorMoved on the appliance motor): without it (the rest of the sensor model on, seed 1)
+/// `stops` and `fullrange` pass, at 0.056 / 0.060 rad (EPS) and 0.067 / 0.134 rad (appliance).
+#[test]
+fn the_eps_and_appliance_motors_hold_a_loaded_standstill_with_matched_sensor_gains() {
+    let mut missed = Vec::new();
+    for name in ["eps-nedic-12v", "appliance-chmotor-16p-310v"] {
+        for scenario in ["stops", "fullrange"] {
+            if !run(name, scenario, 1, "enable_gain_error = false\n").0 {
+                missed.push(format!("{name} {scenario}"));
+            }
+        }
+    }
+    assert!(missed.is_empty(), "missed: {missed:?}");
+}
+
+/// With the default 0.5 % gain mismatch the EPS motor loses its angle while held at zero
+/// speed under 65 % of its rated torque: `stops` 1.095 / 1.110 rad (the rotor rolls back at
+/// −6 … −12 r/min, θ − θ̂ from −0.24 to −0.90 rad over 2.6–3.2 s of seed 1), `fullrange`
+/// 0.594 / 0.581 rad. The appliance motor: `stops` 0.529 / 0.255, `fullrange` 0.308 / 0.432,
+/// `regen-stop` 0.394 / 0.458 rad. A `sensor_gain_error` sweep of `stops` at seed 1 (0, 0.001,
+/// 0.0025, 0.005): EPS 0.056, 0.151, 0.240, 1.095 rad; appliance 0.067, 0.155, 0.172, 0.529.
+#[test]
+#[ignore = "gain mismatch uncalibrated: EPS stops 1.095/1.110, fullrange 0.594/0.581 rad; \
+            appliance stops 0.529/0.255, fullrange 0.308/0.432, regen-stop 0.394/0.458 rad"]
+fn the_eps_and_appliance_motors_hold_a_loaded_standstill() {
+    let mut missed = Vec::new();
+    for (name, scenarios) in [
+        ("eps-nedic-12v", &["stops", "fullrange"][..]),
+        (
+            "appliance-chmotor-16p-310v",
+            &["stops", "fullrange", "regen-stop"][..],
+        ),
+    ] {
+        for scenario in scenarios {
+            for seed in [1, 2] {
+                if !run(name, scenario, seed, "").0 {
+                    missed.push(format!("{name} {scenario} seed {seed}"));
+                }
+            }
+        }
+    }
+    assert!(missed.is_empty(), "missed: {missed:?}");
+}
+
+/// The servo's bare rotor (rated torque to rated speed in 7.7 ms) under the rated gravity-like
+/// load: the brake opens at 0.700 s with the drive at zero q current, the load drops the rotor
+/// to −601 r/min within 2 ms before i_q reaches it, a backward travel of 1.28 rad (seed 1; the
+/// criterion's 0.5) with the angle held (0.118 / 0.157 rad). The tool motor falls the same way
+/// (−409 r/min at 0.705 s) and its angle reaches 0.2516 rad at seed 2 (0.25 allowed). The
+/// servo's `regen-stop` at seed 1: held at zero under the overhauling rated load, its speed
+/// rings ±25 … 76 r/min (60 allowed) over 7–8 s.
+#[test]
+#[ignore = "light rotor falls at brake release: servo backward travel 1.28 rad (0.5), tool \
+            0.2516 rad at seed 2; servo regen-stop seed 1 speed error 76.5 r/min (60)"]
+fn the_light_rotors_lift_their_load_from_the_brake() {
+    let mut missed = Vec::new();
+    for (name, scenario, seed) in [
+        ("servo-estun-emj04-400w-310v", "loaded-start", 1),
+        ("servo-estun-emj04-400w-310v", "loaded-start", 2),
+        ("servo-estun-emj04-400w-310v", "regen-stop", 1),
+        ("tool-makita-4p-36v", "loaded-start", 2),
+    ] {
+        if !run(name, scenario, seed, "").0 {
+            missed.push(format!("{name} {scenario} seed {seed}"));
+        }
+    }
+    assert!(missed.is_empty(), "missed: {missed:?}");
+}
+
+/// The servo's bare rotor cannot be commissioned: the inertia test ends
+/// `Aborted(Implausible { parameter: Inertia })` at 4.21 s (seeds 1–3 alike); the same plant
+/// with 1.0e-4 kg·m² (25 ms to rated speed) commissions, Ĵ +0.28 %, and with 6.2e-5 aborts
+/// alike.
+#[test]
+#[ignore = "bare 3.1e-5 kg·m² servo rotor (7.7 ms to rated speed): commissioning aborts, \
+            Implausible { parameter: Inertia } at 4.21 s"]
+fn a_400_w_servo_with_its_bare_rotor_commissions() {
+    commissioned_reversal("servo-estun-emj04-400w-310v");
+}
