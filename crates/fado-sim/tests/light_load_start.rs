@@ -40,8 +40,8 @@ fn start(toml: &str, fraction: f64, seed: u64) -> (bool, f64, f64) {
 
 /// Three saturated machines whose unloaded start the release hold lost on a fall it took
 /// from the release's own transients (`fado_core::control::release_hold`,
-/// `RELEASE_WINDOW_RATIO`). The hold armed at the release acts only on a fall that reaches
-/// its trigger within 8 times the rated load's time to it; measured (backward travel / max
+/// `RELEASE_WINDOW_RATIO`). The hold armed at the release on a saturating model acts only on
+/// a fall that reaches its trigger within 8 times the rated load's time to it; measured (backward travel / max
 /// |θ − θ̂| from ready, rad, seeds 1–4): the 20-pole 48 V IPMSM 0.068/0.022, 0.192/0.032,
 /// 0/0.026, 0.024/0.026 (with the hold acting at any time of its 50 ms window: 5.34/0.54
 /// and 0.10/0.52 at seeds 1–2), the saturated test IPMSM 0.366/0.056, 0.207/0.033,
