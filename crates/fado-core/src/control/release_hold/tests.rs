@@ -357,3 +357,43 @@ fn on_a_saturating_model_a_release_hold_triggers_on_the_direct_angle_and_bounds_
     saturating.set_saturating(false);
     assert_eq!(saturating.omega_step, 0.0);
 }
+
+#[test]
+fn a_release_hold_acts_only_on_a_fall_as_fast_as_a_load_gives() {
+    // The paper's motor: the rated load's fall reaches the 0.02 rad trigger in
+    // t_r = √(2·0.02/a_rated) = 3.2 ms, the release window is 8·t_r = 26 ms. A motion with a
+    // hundredth of the rated load's acceleration reaches it at 10·t_r = 32 ms: armed at a
+    // release on a saturating model it is left alone; on a linear model, or armed at the
+    // start-up's end (a 50 ms window), it is held.
+    let m = MachineModel::<f64>::paper();
+    let t = ReleaseHoldTuning::<f64> {
+        enabled: true,
+        ..ReleaseHoldTuning::default()
+    };
+    let ts = 1e-4;
+    let a_rated = m.pole_pairs as f64 * m.rated_torque / m.inertia;
+    let t_r = (2.0 * t.trigger / a_rated).sqrt();
+    assert!((t_r - 3.2e-3).abs() < 0.1e-3, "{t_r}");
+    let fall = |h: &mut ReleaseHold<f64>, a: f64| {
+        (1..1_000).find_map(|k| {
+            let theta = 1.0 - 0.5 * a * (k as f64 * ts).powi(2);
+            matches!(h.step(0.0, theta, theta), HoldAction::Hold(_)).then_some(k as f64 * ts)
+        })
+    };
+    let slow = a_rated / 100.0;
+    let mut linear = ReleaseHold::new(&t, &m, ts, 250.0, 40.0).unwrap();
+    let mut h = linear;
+    h.set_saturating(true);
+    h.arm_at_release(1.0);
+    let at = fall(&mut h, a_rated).expect("the rated load triggers");
+    assert!(at < 1.1 * t_r, "{at}");
+    h.arm_at_release(1.0);
+    assert_eq!(fall(&mut h, slow), None);
+    assert_eq!(h.engaged(), 1);
+    h.arm(1.0);
+    let at = fall(&mut h, slow).expect("armed at the start-up's end");
+    assert!((at - 10.0 * t_r).abs() < 0.5e-3, "{at}");
+    linear.arm_at_release(1.0);
+    let at = fall(&mut linear, slow).expect("a linear model");
+    assert!((at - 10.0 * t_r).abs() < 0.5e-3, "{at}");
+}

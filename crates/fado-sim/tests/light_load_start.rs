@@ -1,0 +1,94 @@
+//! `loaded-start` with a light or no load: the brake releases at ready on a rotor that no
+//! load turns (a hoist without payload, a vehicle on the flat), judged by the same criteria
+//! as under the rated torque (backward travel ≤ 0.5 rad, |θ − θ̂| ≤ 0.25 rad from ready on,
+//! the commanded speed reached, no trip).
+
+use fado_sim::scenario::{scenario_config, simulate};
+
+/// The motor file `path` (relative to this crate) with its flux map's path made absolute.
+fn motor(path: &str) -> String {
+    let path = format!("{}/{path}", env!("CARGO_MANIFEST_DIR"));
+    let dir = std::path::Path::new(&path)
+        .parent()
+        .unwrap()
+        .to_str()
+        .unwrap()
+        .to_owned();
+    std::fs::read_to_string(&path)
+        .unwrap()
+        .replace("flux_map = \"", &format!("flux_map = \"{dir}/"))
+}
+
+/// `loaded-start` on `toml` at `seed` with a constant load of `fraction` of the motor's rated
+/// torque: its verdict, backward travel and max |θ − θ̂| from ready (rad).
+fn start(toml: &str, fraction: f64, seed: u64) -> (bool, f64, f64) {
+    let rated = scenario_config("loaded-start", Some(toml), false)
+        .unwrap()
+        .motor
+        .rated_torque;
+    let load = fraction * rated;
+    let text = format!(
+        "{toml}\n[current_sensor]\nseed = {seed}\n\n[load.torque]\npoints = [[0.0, {load}]]\n"
+    );
+    let out = simulate("loaded-start", Some(&text), false, None).unwrap();
+    let st = out.probe.start.as_ref().unwrap();
+    if !out.passed {
+        println!("{:?}", out.checks);
+    }
+    (out.passed, st.max_backward, st.max_angle_error)
+}
+
+/// Three saturated machines whose unloaded start the release hold lost on a fall it took
+/// from the release's own transients (`fado_core::control::release_hold`,
+/// `RELEASE_WINDOW_RATIO`). The hold armed at the release on a saturating model acts only on
+/// a fall that reaches its trigger within 8 times the rated load's time to it; measured (backward travel / max
+/// |θ − θ̂| from ready, rad, seeds 1–4): the 20-pole 48 V IPMSM 0.068/0.022, 0.192/0.032,
+/// 0/0.026, 0.024/0.026 (with the hold acting at any time of its 50 ms window: 5.34/0.54
+/// and 0.10/0.52 at seeds 1–2), the saturated test IPMSM 0.366/0.056, 0.207/0.033,
+/// 0/0.080, 0/0.031 (seed 2: 3.77/0.52), the measured 1.1 kW PMSM 0.155/0.034, 0.030/0.053,
+/// 0.046/0.018, 0/0.021 (seed 1: 0.60 rad back).
+#[test]
+fn saturated_machines_start_without_a_load() {
+    let machines = [
+        "tests/data/ipmsm-20p-48v-saturated.toml",
+        "tests/data/ipmsm-test-saturated.toml",
+        "../../motors/saturated/pmsm-gem-1k1-measured.toml",
+    ];
+    for path in machines {
+        let toml = motor(path);
+        for seed in 1..=4 {
+            let (passed, back, err) = start(&toml, 0.0, seed);
+            println!("{path} seed {seed}: back {back:.3} rad, max |θ − θ̂| {err:.3} rad");
+            assert!(passed, "{path} seed {seed}: back {back}, err {err}");
+        }
+    }
+}
+
+/// Unloaded and quarter-load starts that still miss the criteria. Measured (backward
+/// travel / max |θ − θ̂| from ready, rad): without a load the saturated traction IPMSM
+/// seed 2 0.414/0.533 (at the start angle that starves a phase θ̂ and the direct angle
+/// drift together at 2.5 rad/s on the rotor at rest under the release's 23 A d current,
+/// with the hold kept off too: 0.147/0.717), the 5 kW PM-SyRM seeds 1–2 0.281/0.460 and
+/// 0.841/0.428, the 50 kW IPMSM seed 2 0.051/2.75 (hold off: 0/0.262); under a quarter of
+/// the rated torque the traction IPMSM seed 1 0.746/0.677 and seed 3 lost (its hold catches
+/// the rotor at 130 A, the q current leaves the 62 A load, the current-dependent direct
+/// angle flips the output to the opposite limit), the saturated test IPMSM seed 2
+/// 0.704/0.344.
+#[test]
+#[ignore = "unloaded: traction s2 0.533 rad, PM-SyRM s1/s2 0.460/0.428 rad, 50 kW s2 2.75 rad; quarter load: traction s1 0.677 rad, s3 lost, test IPMSM s2 0.704 rad back"]
+fn unloaded_and_quarter_load_starts_that_still_miss() {
+    let cases = [
+        ("tests/data/traction-ipm-saturated.toml", 0.0, 2),
+        ("../../motors/saturated/pmsyrm-baldor-5k6.toml", 0.0, 1),
+        ("../../motors/saturated/pmsyrm-baldor-5k6.toml", 0.0, 2),
+        ("../../motors/ipmsm-gem-50k.toml", 0.0, 2),
+        ("tests/data/traction-ipm-saturated.toml", 0.25, 1),
+        ("tests/data/traction-ipm-saturated.toml", 0.25, 3),
+        ("tests/data/ipmsm-test-saturated.toml", 0.25, 2),
+    ];
+    for (path, fraction, seed) in cases {
+        let (passed, back, err) = start(&motor(path), fraction, seed);
+        println!("{path} load {fraction} seed {seed}: back {back:.3}, err {err:.3}");
+        assert!(passed, "{path} load {fraction} seed {seed}: {back} {err}");
+    }
+}
