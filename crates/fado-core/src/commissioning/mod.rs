@@ -276,6 +276,11 @@ pub struct Commissioning<T: 'static> {
     off_a: T,
     off_b: T,
     off_n: T,
+    /// Σ(a² + b²) of the raw readings at gates off, A².
+    off_sq: T,
+    /// The current readings' rms about their offsets at gates off (noise and quantisation),
+    /// A: the current resolution.
+    i_resolution: T,
     // Delay line: commands of n−1 and n−2 (estimated applied voltage), current of n−1.
     c1: Ab<T>,
     c2: Ab<T>,
@@ -340,6 +345,12 @@ pub struct Commissioning<T: 'static> {
     /// Time since the d current reached its coast level in stage 1, s.
     t_coast2: T,
     i_j: T,
+    /// Duration of the step up, s (sizes the step down: `rescale_step_down`).
+    t_up: T,
+    /// The PLL's speed at the step up's start, then the speed it gained, electrical rad/s.
+    w_up: T,
+    /// Time of the torque steps beyond their [`J_SKIP`], s: the regression's torque data.
+    j_step_data: T,
     /// d-current reference of the inertia test, released from the coast's level to 0 at a
     /// bounded rate ([`ID_RELEASE_EMF`]), A.
     id_j: T,
@@ -415,6 +426,24 @@ const DC_HOLD_SWING_TIME_CONSTANTS: f64 = 10.0;
 const DC_MAX_HOLD: f64 = 3.0;
 /// Window of the inertia regression, s.
 const J_WINDOW: f64 = 0.04;
+/// Time after each change of the inertia test's torque before its windows are collected
+/// and before the speed may end the step, s: the current's step and the PLL's speed
+/// transient. On the gimbal motor (`gbm5208-200t-4s`: 13 r/min at the step, 0.25 A) the
+/// PLL's speed reads 41 r/min for 4 ms after the step, twice the spin speed: taken as the
+/// step's end, both back-EMF windows sat at one speed (`Implausible { FluxLinkage }`).
+const J_SKIP: f64 = 0.03;
+/// Shortest duration the inertia test's torque steps are sized for on the nameplate
+/// inertia, s: [`J_SKIP`] and five windows. Where 10 % of the limit would end a step sooner
+/// (a light rotor) the step's current floor is lowered to what lasts this long, down to
+/// [`J_STEP_RESOLUTION`] current resolutions.
+const J_STEP_MIN_TIME: f64 = 0.25;
+/// The smallest torque step's q current, in current resolutions (the readings' rms about
+/// their offsets at gates off).
+const J_STEP_RESOLUTION: f64 = 8.0;
+/// Windows the torque steps must give beyond [`J_SKIP`] together: two consecutive windows
+/// make one point of the regression's torque data; a rotor whose steps end sooner at the
+/// smallest step is too light for the test ([`AbortReason::RotorTooLight`]).
+const J_MIN_STEP_WINDOWS: f64 = 2.0;
 /// Bound on the active-flux EMF's d component (L̂d − L̂q)·di_d/dt while the coast's d
 /// current is released at the start of the inertia test, relative to the EMF ω̂·λ̂f: the
 /// PLL's phase detector reads that component as an angle error of about this many rad.

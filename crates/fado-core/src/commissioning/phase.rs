@@ -114,6 +114,38 @@ pub enum AbortReason {
         /// Where.
         phase: Phase,
     },
+    /// The inertia test's torque steps, at the smallest step the current resolution allows,
+    /// ended too soon for the regression's windows: the rotor is too light to be measured
+    /// with these current sensors.
+    RotorTooLight {
+        /// The speed the rotor gained in the step up, r/min (mechanical).
+        speed_rpm: u32,
+        /// The time it took, ms.
+        time_ms: u32,
+        /// The time the steps need (their settling and two 40 ms windows), ms.
+        needed_ms: u32,
+    },
+}
+
+impl core::fmt::Display for AbortReason {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match *self {
+            AbortReason::RotorTooLight {
+                speed_rpm,
+                time_ms,
+                needed_ms,
+            } => write!(
+                f,
+                "the rotor reaches {speed_rpm} r/min in {time_ms} ms under the smallest torque \
+                 step: too light for the inertia test, which needs {needed_ms} ms (a finer \
+                 current sensor, or a load coupled to the rotor)"
+            ),
+            AbortReason::Implausible { parameter } => {
+                write!(f, "implausible result: {parameter:?}")
+            }
+            other => write!(f, "{other:?}"),
+        }
+    }
 }
 
 /// Where the procedure stands.

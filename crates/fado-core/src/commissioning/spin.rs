@@ -196,7 +196,7 @@ impl<T: Real> Commissioning<T> {
             Phase::Coast => t > T::lit(0.02),
             Phase::Inertia => {
                 emf_window.is_some()
-                    || (self.j_step != 1 && t > T::lit(0.03) && self.id_j == T::zero())
+                    || (self.j_step != 1 && t > T::lit(J_SKIP) && self.id_j == T::zero())
             }
             _ => false,
         };
@@ -291,8 +291,15 @@ impl<T: Real> Commissioning<T> {
             }
             Phase::Coast if t >= T::lit(0.02) + cfg.measure_time => return self.start_inertia(),
             Phase::Inertia => {
-                if self.j_step == 0 && self.spin_loop.pll_omega >= T::lit(J_HIGH) * self.spin_speed
+                // No speed ends a step within J_SKIP of its start (the PLL's transient).
+                let settled = t > T::lit(J_SKIP);
+                if self.j_step == 0
+                    && settled
+                    && self.spin_loop.pll_omega >= T::lit(J_HIGH) * self.spin_speed
                 {
+                    self.t_up = t;
+                    self.j_step_data = t - T::lit(J_SKIP);
+                    self.w_up = self.spin_loop.pll_omega - self.w_up;
                     self.j_step = 1;
                     self.jwin.reset();
                     self.nominal_done += self.t_phase;
@@ -301,13 +308,20 @@ impl<T: Real> Commissioning<T> {
                     if !self.finish_flux() {
                         return false;
                     }
+                    self.rescale_step_down();
                     self.j_step = 2;
                     self.jwin.reset();
                     self.nominal_done += self.t_phase;
                     self.t_phase = T::zero();
                 } else if self.j_step == 2
+                    && settled
                     && self.spin_loop.pll_omega <= T::lit(J_LOW) * self.spin_speed
                 {
+                    self.j_step_data += t - T::lit(J_SKIP);
+                    if self.j_step_data < T::lit(J_MIN_STEP_WINDOWS * J_WINDOW) {
+                        self.abort_too_light();
+                        return false;
+                    }
                     self.finish_inertia();
                 }
             }
@@ -338,13 +352,19 @@ impl<T: Real> Commissioning<T> {
         let p = T::lit(cfg.nameplate.pole_pairs as f64);
         let d_omega_mech = T::lit(J_HIGH - J_LOW) * self.spin_speed / p;
         let kt = T::lit(1.5) * p * self.flux;
+        // The q current that takes `time` for the step on the nameplate inertia.
+        let lasting = |time: f64| cfg.nameplate.inertia * d_omega_mech / (T::lit(time) * kt);
+        let floor = (T::lit(0.1) * self.i_limit)
+            .min(lasting(J_STEP_MIN_TIME))
+            .max(self.smallest_step());
         self.i_j = step_level(
             &cfg.nameplate,
             self.flux,
             self.ld,
             self.lq,
             self.i_limit,
-            cfg.nameplate.inertia * d_omega_mech / (T::lit(J_STEP_TIME) * kt),
+            lasting(J_STEP_TIME),
+            floor,
         );
         // Release rate of the coast's d current: |(L̂d − L̂q)·di_d/dt| ≤
         // ID_RELEASE_EMF·ω̂·λ̂f.
@@ -357,10 +377,39 @@ impl<T: Real> Commissioning<T> {
             emf / dl
         };
         self.j_step = 0;
+        self.w_up = self.spin_loop.pll_omega;
         self.t_coast2 = T::zero();
         self.jwin.reset();
         self.next_phase(Phase::Inertia);
         true
+    }
+
+    /// The smallest torque step's q current: [`J_STEP_RESOLUTION`] current resolutions, A.
+    fn smallest_step(&self) -> T {
+        T::lit(J_STEP_RESOLUTION) * self.i_resolution
+    }
+
+    /// The step down's q current from the measured step up: where the step up ended sooner
+    /// than [`J_STEP_MIN_TIME`] (a rotor lighter than the nameplate's), its current scaled by
+    /// the time it took over that time (the acceleration goes as the current), at least the
+    /// smallest step.
+    fn rescale_step_down(&mut self) {
+        let t_min = T::lit(J_STEP_MIN_TIME);
+        if self.t_up < t_min {
+            self.i_j = (self.i_j * self.t_up / t_min).max(self.smallest_step());
+        }
+    }
+
+    /// The torque steps ended too soon for the inertia regression: aborted with the speed
+    /// the rotor gained in the step up and the time it took.
+    fn abort_too_light(&mut self) {
+        let p = self.cfg.nameplate.pole_pairs as f64;
+        let rpm = self.w_up.to_f64() / p * 60.0 / core::f64::consts::TAU;
+        self.abort(AbortReason::RotorTooLight {
+            speed_rpm: libm_round(rpm),
+            time_ms: libm_round(self.t_up.to_f64() * 1e3),
+            needed_ms: libm_round((J_SKIP + J_MIN_STEP_WINDOWS * J_WINDOW) * 1e3),
+        });
     }
 
     /// The back-EMF that counts as rotation at standstill: that of 2 % of the rated speed on
