@@ -78,7 +78,7 @@ impl<T: Real> Commissioning<T> {
             t_up: T::zero(),
             w_up: T::zero(),
             j_step_data: T::zero(),
-            j_light: false,
+            j_hold_d: false,
             id_j: T::zero(),
             id_j_rate: T::zero(),
             result: None,

@@ -351,15 +351,20 @@ pub struct Commissioning<T: 'static> {
     w_up: T,
     /// Time of the torque steps beyond their [`J_SKIP`], s: the regression's torque data.
     j_step_data: T,
-    /// A light rotor's inertia test (its torque steps' floor lowered below 10 % of the limit:
-    /// [`J_STEP_MIN_TIME`]) leaves the windows with the coast's d current out of its fit and
-    /// measures the friction in a coast without current instead, at the start of the step down
-    /// (at most [`J_STEP_TIME`], then the braking step). A PLL angle error ε puts
-    /// i_d·sin ε of the coast's d current on the q axis, a torque the PLL frame does not see:
-    /// on the Estun EMJ-04 servo's bare rotor (3.1e-5 kg·m², steps of 0.03 A) the plant's
-    /// q current in the coasts was −6 … −10 mA (ε ≈ 7 … 12 mrad), a third of the step's, and
-    /// with those windows in the fit B̂ came out 1.9× the truth and Ĵ −14.6 %.
-    j_light: bool,
+    /// The inertia test's torque steps hold the coast's d current (and its windows all go
+    /// into the fit) on a light rotor (its steps' floor lowered below 10 % of the limit:
+    /// [`J_STEP_MIN_TIME`]) and where the limit's resistive drop R̂s·I exceeds the back-EMF
+    /// at the spin speed; elsewhere they run without d current. Without it the steps'
+    /// phase currents sit near the inverter's dead-time band and the PLL reads the EMF
+    /// through its error: on the Estun EMJ-04 servo's bare rotor (steps of 0.03 A, EMF
+    /// 16 V against an inverter error of 4.9 V) its speed read ±150 r/min; on the gimbal
+    /// motor (`gbm5208-200t-4s`, 0.45 V of EMF at its 20 r/min spin speed, R̂s·I 2.1 V) its
+    /// angle swung 0.2 rad and the step up ended at 18 r/min read as 40. With the d current
+    /// held the PLL's lag under the steps' acceleration turns part of it onto q
+    /// (`pll_lag_inertia`). Mixing windows with and without it biases the fit: a PLL angle
+    /// error ε puts i_d·sin ε on the q axis, a torque the PLL frame does not see (on the
+    /// servo −6 … −10 mA in the coasts, a third of the step's; B̂ 1.9× the truth, Ĵ −14.6 %).
+    j_hold_d: bool,
     /// d-current reference of the inertia test, released from the coast's level to 0 at a
     /// bounded rate ([`ID_RELEASE_EMF`]), A.
     id_j: T,

@@ -260,8 +260,14 @@ impl<T: Real> Commissioning<T> {
         if self.spin_loop.pll_on {
             self.spin_loop.pll_theta = wrap_angle(self.spin_loop.pll_theta + rate * ts);
             let w = self.spin_loop.pll_omega;
+            // Not within the PLL's transient after a change of the inertia test's torque.
+            let settle = if self.phase == Phase::Inertia {
+                J_SKIP
+            } else {
+                0.02
+            };
             if self.phase != Phase::Spin
-                && t > T::lit(0.02)
+                && t > T::lit(settle)
                 && (w > T::lit(2.0 * J_HIGH) * self.spin_speed
                     || w < T::lit(0.25) * self.spin_speed)
             {
@@ -354,7 +360,11 @@ impl<T: Real> Commissioning<T> {
         let kt = T::lit(1.5) * p * self.flux;
         // The q current that takes `time` for the step on the nameplate inertia.
         let lasting = |time: f64| cfg.nameplate.inertia * d_omega_mech / (T::lit(time) * kt);
-        self.j_light = lasting(J_STEP_MIN_TIME) < T::lit(0.1) * self.i_limit;
+        // The steps hold the coast's d current on a light rotor (its floor below 10 % of
+        // the limit) and where the limit's resistive drop exceeds the back-EMF at the spin
+        // speed (`j_hold_d`).
+        self.j_hold_d = lasting(J_STEP_MIN_TIME) < T::lit(0.1) * self.i_limit
+            || self.rs * self.i_limit > self.spin_speed * self.flux;
         let floor = (T::lit(0.1) * self.i_limit)
             .min(lasting(J_STEP_MIN_TIME))
             .max(self.smallest_step());
@@ -386,24 +396,24 @@ impl<T: Real> Commissioning<T> {
         true
     }
 
-    /// The d current of the torque steps, A: 0, and on a light rotor the coast's (`j_light`).
+    /// The d current of the torque steps, A: 0, or the coast's where they hold it (`j_hold_d`).
     fn step_id(&self) -> T {
-        if self.j_light {
+        if self.j_hold_d {
             -T::lit(COAST_ID) * self.i_limit
         } else {
             T::zero()
         }
     }
 
-    /// The inertia the PLL's lag adds back to a light rotor's fit (`j_light`), kg·m² (0 on
-    /// other rotors, whose steps run without d current). Under an electrical acceleration
+    /// The inertia the PLL's lag adds back to the fit of steps that hold the coast's d
+    /// current (`j_hold_d`), kg·m² (0 where they run without it). Under an electrical acceleration
     /// α the PLL (a PI, integral gain k_i = ωn²) lags by ε = α/k_i, which turns ε·|i_d| of
     /// the d current onto the q axis, a torque 1.5·p·ψa·|i_d|·ε (ψa = λf + (Ld − Lq)·i_d,
     /// the active flux) the PLL frame does not see and that grows with the acceleration:
     /// the fit reads J − 1.5·p²·ψa·|i_d|/k_i. On the servo's bare rotor that is 2.0e-5 of
     /// its 3.1e-5 kg·m² (fitted alone: Ĵ −67 %).
     fn pll_lag_inertia(&self) -> T {
-        if !self.j_light {
+        if !self.j_hold_d {
             return T::zero();
         }
         let p = T::lit(self.cfg.nameplate.pole_pairs as f64);
