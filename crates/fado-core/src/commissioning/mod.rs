@@ -22,7 +22,8 @@
 //! maximum duration ([`CommissioningConfig::phase_timeout`]); every standstill voltage is
 //! limited to `voltage_limit_ratio · Vdc/√3` (the pulses' to `magnetics.voltage_ratio`).
 //! Aborts are typed ([`AbortReason`]): rotation where none is expected, current not following
-//! its reference, implausible result, over-current, over-speed, timeout, non-finite samples.
+//! its reference, implausible result, over-current, over-speed, timeout, non-finite samples,
+//! a rotor too light for the inertia test.
 //!
 //! # Procedure (phases in order) and why
 //! 1. **Offset calibration** ([`Phase::Offset`]), gates off: the mean of the current readings
@@ -194,7 +195,8 @@
 //!    grows with the speed (timing).
 //! 7. **Inertia and friction** ([`Phase::Inertia`]): in closed loop on the PLL's angle (the
 //!    back-EMF observer is the sensorless angle), a q-current step (sized so that each step
-//!    lasts 0.5 s on the nameplate inertia, 10–90 % of the limit, at most the I-f level of
+//!    lasts 0.5 s on the nameplate inertia, 10–90 % of the limit (less on a light rotor, see
+//!    below), at most the I-f level of
 //!    λ̂f and L̂: `step_level`, as the spin's and for its reason) up to 2× the spin speed;
 //!    there, the second back-EMF window (no q current, the coast's d current); then the
 //!    opposite step down to 0.5×. Since ω_mech(t) = ω(t₀) + (1/J)·∫T̂e − (B/J)·∫ω_mech with
@@ -211,8 +213,20 @@
 //!    level at a bounded rate (`ID_RELEASE_EMF`): the active-flux EMF has a d component
 //!    (L̂d − L̂q)·di_d/dt that the PLL reads as an angle error. The noisy speed difference is
 //!    the dependent variable: as a regressor its noise would bias Ĵ low (errors in
-//!    variables; −20 % measured on the IPMSM). The procedure ends with the gates off and the
-//!    rotor coasting at about 10 % of its rated speed.
+//!    variables; −20 % measured on the IPMSM). No step ends, and no speed check acts, within
+//!    `J_SKIP` (30 ms) of a torque change: the PLL's speed transient there (38 then −10 r/min
+//!    at the gimbal motor's 13 r/min coast) is no speed. A light rotor's steps, which at 10 %
+//!    of the limit would last less than `J_STEP_MIN_TIME` (0.25 s) on the nameplate inertia
+//!    (the Estun EMJ-04 servo's bare 3.1e-5 kg·m² rotor: 46 ms, inside the settling and the
+//!    windows), are sized to last that long, down to eight current resolutions (the readings'
+//!    rms at gates off); such steps, and those of a motor whose R̂s·I exceeds the back-EMF
+//!    at the spin speed, hold the coast's d current, so that the PLL reads the EMF outside
+//!    the inverter's dead-time band, and Ĵ adds back what the PLL's lag under the
+//!    acceleration turns of that current onto q (`j_hold_d`, `pll_lag_inertia`). A rotor
+//!    whose steps still end within two windows aborts with
+//!    [`AbortReason::RotorTooLight`], naming the speed it reached and the time. The
+//!    procedure ends with the gates off and the rotor coasting at about 10 % of its rated
+//!    speed.
 //!
 //! # Confidence
 //! Each identified parameter comes with a relative 1-σ statistical uncertainty computed from
