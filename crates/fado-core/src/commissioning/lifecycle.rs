@@ -79,6 +79,7 @@ impl<T: Real> Commissioning<T> {
             w_up: T::zero(),
             j_step_data: T::zero(),
             j_hold_d: false,
+            coast_id: T::zero(),
             id_j: T::zero(),
             id_j_rate: T::zero(),
             result: None,

@@ -379,6 +379,8 @@ pub struct Commissioning<T: 'static> {
     /// error ε puts i_d·sin ε on the q axis, a torque the PLL frame does not see (on the
     /// servo −6 … −10 mA in the coasts, a third of the step's; B̂ 1.9× the truth, Ĵ −14.6 %).
     j_hold_d: bool,
+    /// The coast's d current (its magnitude), A: `coast_level`.
+    coast_id: T,
     /// d-current reference of the inertia test, released from the coast's level to 0 at a
     /// bounded rate ([`ID_RELEASE_EMF`]), A.
     id_j: T,
@@ -423,6 +425,18 @@ const INJ_HALF: u32 = 4;
 const BLOCK_TIME: f64 = 0.01;
 /// d current of the back-EMF measurement, as a fraction of the limit (module docs).
 const COAST_ID: f64 = 0.5;
+/// The PLL's lag under an electrical acceleration α is α/k_i (its integral gain k_i = ωn²),
+/// which turns ε·|i_d| of the coast's d current onto the q axis: a torque against the
+/// acceleration, as if the rotor's inertia were J − 1.5·p²·ψa·|i_d|/k_i
+/// (`pll_lag_inertia`). On the Estun EMJ-04 servo's bare rotor at `COAST_ID` that is
+/// 2.0e-5 of its 3.1e-5 kg·m²; with 1.5e-5 the coast collapsed (500 → 72 r/min in 30 ms,
+/// `Overspeed { Coast }`). The coast's d current is held where the nameplate inertia is at
+/// least this many times the PLL's (every preset: 4.5 … 240 at `COAST_ID`).
+const J_PLL_MARGIN: f64 = 3.0;
+/// The least coast d current, as a fraction of the limit: twice the compensation's band
+/// (5 % of the limit), so that the phase currents stay out of the dead-time band most of
+/// the time.
+const COAST_ID_MIN: f64 = 0.1;
 /// Speeds between which the inertia test's torque steps run, relative to the spin speed.
 const J_HIGH: f64 = 2.0;
 /// See [`J_HIGH`].

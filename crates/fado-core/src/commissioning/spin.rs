@@ -32,7 +32,25 @@ impl<T: Real> Commissioning<T> {
         self.spin_loop.omega_f = T::zero();
         self.spin_loop.pll_on = false;
         self.err_perp = T::zero();
+        self.coast_id = self.coast_level();
         self.next_phase(Phase::Spin);
+    }
+
+    /// The coast's d current, A (its magnitude): `COAST_ID` of the limit, less where the
+    /// nameplate inertia is below [`J_PLL_MARGIN`] times the inertia the PLL's lag takes
+    /// from it (`pll_lag_inertia` at that current), down to [`COAST_ID_MIN`] of the limit.
+    fn coast_level(&self) -> T {
+        let np = &self.cfg.nameplate;
+        let full = T::lit(COAST_ID) * self.i_limit;
+        let p = T::lit(np.pole_pairs as f64);
+        // The PLL's inertia per ampere of d current (nameplate λf, identified L̂).
+        let per_amp = T::lit(1.5) * p * p * np.flux_linkage / self.spin_loop.pll_ki;
+        let allowed = np.inertia / (T::lit(J_PLL_MARGIN) * per_amp);
+        if allowed >= full {
+            full
+        } else {
+            allowed.max(T::lit(COAST_ID_MIN) * self.i_limit)
+        }
     }
 
     /// Dead-time compensation V̂·sat(i*_x/I_band) per phase of the reference current at the
@@ -138,7 +156,7 @@ impl<T: Real> Commissioning<T> {
             Phase::Coast => (
                 self.spin_loop.pll_theta,
                 rate,
-                Dq::new(-T::lit(COAST_ID) * self.i_limit, T::zero()),
+                Dq::new(-self.coast_id, T::zero()),
             ),
             _ => {
                 // Step up, second back-EMF window (no torque, the coast's d current), step
@@ -146,7 +164,7 @@ impl<T: Real> Commissioning<T> {
                 // rate.
                 let (iq, id_target) = match self.j_step {
                     0 => (self.i_j, self.step_id()),
-                    1 => (T::zero(), -T::lit(COAST_ID) * self.i_limit),
+                    1 => (T::zero(), -self.coast_id),
                     _ => (-self.i_j, self.step_id()),
                 };
                 let step = self.id_j_rate * ts;
@@ -380,7 +398,7 @@ impl<T: Real> Commissioning<T> {
         );
         // Release rate of the coast's d current: |(L̂d − L̂q)·di_d/dt| ≤
         // ID_RELEASE_EMF·ω̂·λ̂f.
-        self.id_j = -T::lit(COAST_ID) * self.i_limit;
+        self.id_j = -self.coast_id;
         let dl = (self.ld - self.lq).abs();
         let emf = T::lit(ID_RELEASE_EMF) * self.spin_loop.pll_omega.abs() * self.flux;
         self.id_j_rate = if dl * self.i_limit < emf * ts {
@@ -399,7 +417,7 @@ impl<T: Real> Commissioning<T> {
     /// The d current of the torque steps, A: 0, or the coast's where they hold it (`j_hold_d`).
     fn step_id(&self) -> T {
         if self.j_hold_d {
-            -T::lit(COAST_ID) * self.i_limit
+            -self.coast_id
         } else {
             T::zero()
         }
