@@ -360,12 +360,8 @@ pub struct Commissioning<T: 'static> {
     /// Time since the d current reached its coast level in stage 1, s.
     t_coast2: T,
     i_j: T,
-    /// Duration of the step up, s (sizes the step down: `rescale_step_down`).
-    t_up: T,
-    /// The PLL's speed at the step up's start, then the speed it gained, electrical rad/s.
-    w_up: T,
-    /// Time of the torque steps beyond their [`J_SKIP`], s: the regression's torque data.
-    j_step_data: T,
+    /// The step up's record (the step down's sizing, `RotorTooLight`).
+    step_rec: StepRecord<T>,
     /// The inertia test's torque steps hold the coast's d current (and its windows all go
     /// into the fit) on a light rotor (its steps' floor lowered below 10 % of the limit:
     /// [`J_STEP_MIN_TIME`]) and where the limit's resistive drop R̂s·I exceeds the back-EMF
@@ -406,6 +402,18 @@ struct SpinLoop<T> {
     e_filt: Dq<T>,
     pll_kp: T,
     pll_ki: T,
+}
+
+/// The inertia test's step up, as measured: it sizes the step down and names a rotor too
+/// light for the test.
+#[derive(Clone, Copy, Debug, Default)]
+struct StepRecord<T> {
+    /// Duration of the step up, s (sizes the step down: `rescale_step_down`).
+    t_up: T,
+    /// The PLL's speed at the step up's start, then the speed it gained, electrical rad/s.
+    w_up: T,
+    /// Time of the torque steps beyond their [`J_SKIP`], s: the regression's torque data.
+    j_step_data: T,
 }
 
 /// The DC test's block statistics: the α voltage and current at each level, their β

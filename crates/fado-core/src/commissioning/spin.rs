@@ -321,9 +321,9 @@ impl<T: Real> Commissioning<T> {
                     && settled
                     && self.spin_loop.pll_omega >= T::lit(J_HIGH) * self.spin_speed
                 {
-                    self.t_up = t;
-                    self.j_step_data = t - T::lit(J_SKIP);
-                    self.w_up = self.spin_loop.pll_omega - self.w_up;
+                    self.step_rec.t_up = t;
+                    self.step_rec.j_step_data = t - T::lit(J_SKIP);
+                    self.step_rec.w_up = self.spin_loop.pll_omega - self.step_rec.w_up;
                     self.j_step = 1;
                     self.jwin.reset();
                     self.nominal_done += self.t_phase;
@@ -341,8 +341,8 @@ impl<T: Real> Commissioning<T> {
                     && settled
                     && self.spin_loop.pll_omega <= T::lit(J_LOW) * self.spin_speed
                 {
-                    self.j_step_data += t - T::lit(J_SKIP);
-                    if self.j_step_data < T::lit(J_MIN_STEP_WINDOWS * J_WINDOW) {
+                    self.step_rec.j_step_data += t - T::lit(J_SKIP);
+                    if self.step_rec.j_step_data < T::lit(J_MIN_STEP_WINDOWS * J_WINDOW) {
                         self.abort_too_light();
                         return false;
                     }
@@ -407,7 +407,7 @@ impl<T: Real> Commissioning<T> {
             emf / dl
         };
         self.j_step = 0;
-        self.w_up = self.spin_loop.pll_omega;
+        self.step_rec.w_up = self.spin_loop.pll_omega;
         self.t_coast2 = T::zero();
         self.jwin.reset();
         self.next_phase(Phase::Inertia);
@@ -451,8 +451,8 @@ impl<T: Real> Commissioning<T> {
     /// smallest step.
     fn rescale_step_down(&mut self) {
         let t_min = T::lit(J_STEP_MIN_TIME);
-        if self.t_up < t_min {
-            self.i_j = (self.i_j * self.t_up / t_min).max(self.smallest_step());
+        if self.step_rec.t_up < t_min {
+            self.i_j = (self.i_j * self.step_rec.t_up / t_min).max(self.smallest_step());
         }
     }
 
@@ -460,10 +460,10 @@ impl<T: Real> Commissioning<T> {
     /// the rotor gained in the step up and the time it took.
     fn abort_too_light(&mut self) {
         let p = self.cfg.nameplate.pole_pairs as f64;
-        let rpm = self.w_up.to_f64() / p * 60.0 / core::f64::consts::TAU;
+        let rpm = self.step_rec.w_up.to_f64() / p * 60.0 / core::f64::consts::TAU;
         self.abort(AbortReason::RotorTooLight {
             speed_rpm: libm_round(rpm),
-            time_ms: libm_round(self.t_up.to_f64() * 1e3),
+            time_ms: libm_round(self.step_rec.t_up.to_f64() * 1e3),
             needed_ms: libm_round((J_SKIP + J_MIN_STEP_WINDOWS * J_WINDOW) * 1e3),
         });
     }
