@@ -225,7 +225,9 @@
 //!    the inverter's dead-time band, and Ĵ adds back what the PLL's lag under the
 //!    acceleration turns of that current onto q (`j_hold_d`, `pll_lag_inertia`). A rotor
 //!    whose steps still end within two windows aborts with
-//!    [`AbortReason::RotorTooLight`], naming the speed it reached and the time. The
+//!    [`AbortReason::RotorTooLight`], naming the speed it reached and the time, as does a
+//!    coast that its friction slows below a quarter of the spin speed before its window
+//!    ends (the servo's plant with a 1.5e-5 kg·m² rotor: 471 r/min lost in 229 ms). The
 //!    procedure ends with the gates off and the rotor coasting at about 10 % of its rated
 //!    speed.
 //!

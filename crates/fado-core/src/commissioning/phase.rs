@@ -114,15 +114,21 @@ pub enum AbortReason {
         /// Where.
         phase: Phase,
     },
-    /// The inertia test's torque steps, at the smallest step the current resolution allows,
-    /// ended too soon for the regression's windows: the rotor is too light to be measured
-    /// with these current sensors.
+    /// The rotor's speed moves too fast for a measurement: in the inertia test
+    /// ([`Phase::Inertia`]) the torque steps, at the smallest step the current resolution
+    /// allows, ended too soon for the regression's windows; in the coast ([`Phase::Coast`])
+    /// its friction slowed it below a quarter of the spin speed before the back-EMF window
+    /// ended. The rotor is too light to be measured (with these current sensors, or against
+    /// its friction).
     RotorTooLight {
-        /// The speed the rotor gained in the step up, r/min (mechanical).
+        /// Where.
+        phase: Phase,
+        /// The speed the rotor gained in the step up, or lost in the coast, r/min
+        /// (mechanical).
         speed_rpm: u32,
         /// The time it took, ms.
         time_ms: u32,
-        /// The time the steps need (their settling and two 40 ms windows), ms.
+        /// The time the measurement needs, ms.
         needed_ms: u32,
     },
 }
@@ -131,9 +137,21 @@ impl core::fmt::Display for AbortReason {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         match *self {
             AbortReason::RotorTooLight {
+                phase: Phase::Coast,
                 speed_rpm,
                 time_ms,
                 needed_ms,
+            } => write!(
+                f,
+                "the rotor loses {speed_rpm} r/min in {time_ms} ms coasting: too light against \
+                 its friction for the back-EMF window, which needs {needed_ms} ms (a load \
+                 coupled to the rotor)"
+            ),
+            AbortReason::RotorTooLight {
+                speed_rpm,
+                time_ms,
+                needed_ms,
+                ..
             } => write!(
                 f,
                 "the rotor reaches {speed_rpm} r/min in {time_ms} ms under the smallest torque \

@@ -284,10 +284,14 @@ impl<T: Real> Commissioning<T> {
             } else {
                 0.02
             };
+            let slow = w < T::lit(0.25) * self.spin_speed;
+            if self.phase == Phase::Coast && t > T::lit(settle) && slow {
+                self.abort_coast_too_light(t, w);
+                return false;
+            }
             if self.phase != Phase::Spin
                 && t > T::lit(settle)
-                && (w > T::lit(2.0 * J_HIGH) * self.spin_speed
-                    || w < T::lit(0.25) * self.spin_speed)
+                && (w > T::lit(2.0 * J_HIGH) * self.spin_speed || slow)
             {
                 self.abort(AbortReason::Overspeed { phase: self.phase });
                 return false;
@@ -311,6 +315,7 @@ impl<T: Real> Commissioning<T> {
                     .to_ab(Rotation::from_angle(self.spin_loop.theta_f));
                 self.spin_loop.pi_int =
                     int_ab.to_dq(Rotation::from_angle(self.spin_loop.pll_theta));
+                self.step_rec.w_up = self.spin_loop.pll_omega;
                 self.next_phase(Phase::Coast);
             }
             Phase::Coast if t >= T::lit(0.02) + cfg.measure_time => return self.start_inertia(),
@@ -462,9 +467,23 @@ impl<T: Real> Commissioning<T> {
         let p = self.cfg.nameplate.pole_pairs as f64;
         let rpm = self.step_rec.w_up.to_f64() / p * 60.0 / core::f64::consts::TAU;
         self.abort(AbortReason::RotorTooLight {
+            phase: Phase::Inertia,
             speed_rpm: libm_round(rpm),
             time_ms: libm_round(self.step_rec.t_up.to_f64() * 1e3),
             needed_ms: libm_round((J_SKIP + J_MIN_STEP_WINDOWS * J_WINDOW) * 1e3),
+        });
+    }
+
+    /// The coast slowed below a quarter of the spin speed `t` s after it started, at `w`:
+    /// aborted with the speed it lost and the time.
+    fn abort_coast_too_light(&mut self, t: T, w: T) {
+        let p = self.cfg.nameplate.pole_pairs as f64;
+        let rpm = (self.step_rec.w_up - w).to_f64() / p * 60.0 / core::f64::consts::TAU;
+        self.abort(AbortReason::RotorTooLight {
+            phase: Phase::Coast,
+            speed_rpm: libm_round(rpm),
+            time_ms: libm_round(t.to_f64() * 1e3),
+            needed_ms: libm_round((T::lit(0.02) + self.cfg.measure_time).to_f64() * 1e3),
         });
     }
 
