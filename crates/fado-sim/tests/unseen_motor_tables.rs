@@ -25,7 +25,7 @@
 //! uncalibrated (the test beside them shows both pass without the mismatch).
 
 use fado_core::MachineModel;
-use fado_core::commissioning::{AbortReason, Status};
+use fado_core::commissioning::{AbortReason, Phase, Status};
 use fado_sim::commission::{CommissionOptions, commission, identified_toml};
 use fado_sim::scenario::simulate;
 
@@ -281,4 +281,42 @@ fn a_400_w_servo_behind_a_coarse_current_sensor_aborts_naming_its_light_rotor() 
         "{name}: {reason:?}"
     );
     assert!(message.contains("too light"), "{message}");
+}
+
+/// The servo's plant with a 1.5e-5 kg·m² rotor (half its own): its friction (4.0e-5 N·m·s)
+/// slows the coast from its 600 r/min to 129 r/min (below a quarter) within 229 ms, before the
+/// 270 ms of the back-EMF window end, and the procedure aborts naming it (`RotorTooLight` in
+/// the coast: 471 r/min lost).
+#[test]
+fn a_servo_rotor_too_light_against_its_friction_aborts_naming_its_coast() {
+    let name = "servo-estun-emj04-400w-310v";
+    let text = file(name).replace("inertia = 3.1e-5", "inertia = 1.5e-5");
+    let plant = fado_sim::SimConfig::from_toml(&text).unwrap().plant();
+    assert_eq!(plant.motor.inertia, 1.5e-5);
+    let nameplate = MachineModel {
+        dc_voltage: plant.inverter.dc_voltage,
+        ..plant.motor
+    };
+    let o = commission(
+        &plant,
+        nameplate,
+        CommissionOptions::default(),
+        |_| {},
+        None,
+    )
+    .unwrap();
+    let Status::Aborted(reason) = o.status else {
+        panic!("{name}: {:?}", o.status);
+    };
+    eprintln!("{name} at 1.5e-5 kg·m²: {reason}");
+    assert!(
+        matches!(
+            reason,
+            AbortReason::RotorTooLight {
+                phase: Phase::Coast,
+                ..
+            }
+        ),
+        "{name}: {reason:?}"
+    );
 }
