@@ -31,6 +31,8 @@ impl<T: Real> Commissioning<T> {
             off_a: T::zero(),
             off_b: T::zero(),
             off_n: T::zero(),
+            off_sq: T::zero(),
+            i_resolution: T::zero(),
             c1: Ab::zero(),
             c2: Ab::zero(),
             i_prev: Ab::zero(),
@@ -73,6 +75,9 @@ impl<T: Real> Commissioning<T> {
             j_step: 0,
             t_coast2: T::zero(),
             i_j: T::zero(),
+            step_rec: StepRecord::default(),
+            j_hold_d: false,
+            coast_id: T::zero(),
             id_j: T::zero(),
             id_j_rate: T::zero(),
             result: None,
@@ -96,6 +101,8 @@ impl<T: Real> Commissioning<T> {
         self.off_a = T::zero();
         self.off_b = T::zero();
         self.off_n = T::zero();
+        self.off_sq = T::zero();
+        self.i_resolution = T::zero();
         self.c1 = Ab::zero();
         self.c2 = Ab::zero();
         self.have_prev = false;
@@ -269,9 +276,15 @@ impl<T: Real> Commissioning<T> {
             self.off_a += i_abc.a;
             self.off_b += i_abc.b;
             self.off_n += T::one();
+            self.off_sq += i_abc.a * i_abc.a + i_abc.b * i_abc.b;
             if self.t_phase >= self.cfg.offset_time {
                 self.off_a /= self.off_n;
                 self.off_b /= self.off_n;
+                // The readings' rms about their means (noise and quantisation): the current
+                // resolution that sizes the inertia test's smallest torque step.
+                let mean_sq = self.off_a * self.off_a + self.off_b * self.off_b;
+                let var = (self.off_sq / self.off_n - mean_sq) * T::lit(0.5);
+                self.i_resolution = var.max(T::zero()).sqrt();
                 self.next_phase(Phase::Align);
             }
             return self.output(Ab::zero(), vdc, false, T::zero());

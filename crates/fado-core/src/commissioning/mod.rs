@@ -22,7 +22,8 @@
 //! maximum duration ([`CommissioningConfig::phase_timeout`]); every standstill voltage is
 //! limited to `voltage_limit_ratio · Vdc/√3` (the pulses' to `magnetics.voltage_ratio`).
 //! Aborts are typed ([`AbortReason`]): rotation where none is expected, current not following
-//! its reference, implausible result, over-current, over-speed, timeout, non-finite samples.
+//! its reference, implausible result, over-current, over-speed, timeout, non-finite samples,
+//! a rotor too light for the inertia test.
 //!
 //! # Procedure (phases in order) and why
 //! 1. **Offset calibration** ([`Phase::Offset`]), gates off: the mean of the current readings
@@ -166,7 +167,8 @@
 //!    IPMSM preset, (Lq − Ld)·I = 1.36 λf, hunted ±1 rad between the two stable lags ±0.74
 //!    rad where its active flux vanishes; the PLL slipped by π, the coast started 2 rad off
 //!    and its speed estimate was 6 % high: λ̂f −5.5 … −5.9 %.) Then the q current is regulated
-//!    to zero and the rotor coasts with a d current of −½ the limit (`COAST_ID`: every phase
+//!    to zero and the rotor coasts with a d current of −½ the limit (less on a light rotor:
+//!    [`J_PLL_MARGIN`]; `COAST_ID`: every phase
 //!    current outside the inverter's dead-time band most of the time, so that its error is
 //!    the compensated V̂·sign(i) rather than the dead zone of i ≈ 0). The back-EMF
 //!    E = v − R̂s·i − L̂q·di/dt (the active-flux EMF, Boldea et al. 2008, whose angle is the
@@ -194,7 +196,8 @@
 //!    grows with the speed (timing).
 //! 7. **Inertia and friction** ([`Phase::Inertia`]): in closed loop on the PLL's angle (the
 //!    back-EMF observer is the sensorless angle), a q-current step (sized so that each step
-//!    lasts 0.5 s on the nameplate inertia, 10–90 % of the limit, at most the I-f level of
+//!    lasts 0.5 s on the nameplate inertia, 10–90 % of the limit (less on a light rotor, see
+//!    below), at most the I-f level of
 //!    λ̂f and L̂: `step_level`, as the spin's and for its reason) up to 2× the spin speed;
 //!    there, the second back-EMF window (no q current, the coast's d current); then the
 //!    opposite step down to 0.5×. Since ω_mech(t) = ω(t₀) + (1/J)·∫T̂e − (B/J)·∫ω_mech with
@@ -211,8 +214,22 @@
 //!    level at a bounded rate (`ID_RELEASE_EMF`): the active-flux EMF has a d component
 //!    (L̂d − L̂q)·di_d/dt that the PLL reads as an angle error. The noisy speed difference is
 //!    the dependent variable: as a regressor its noise would bias Ĵ low (errors in
-//!    variables; −20 % measured on the IPMSM). The procedure ends with the gates off and the
-//!    rotor coasting at about 10 % of its rated speed.
+//!    variables; −20 % measured on the IPMSM). No step ends, and no speed check acts, within
+//!    `J_SKIP` (30 ms) of a torque change: the PLL's speed transient there (38 then −10 r/min
+//!    at the gimbal motor's 13 r/min coast) is no speed. A light rotor's steps, which at 10 %
+//!    of the limit would last less than `J_STEP_MIN_TIME` (0.25 s) on the nameplate inertia
+//!    (the Estun EMJ-04 servo's bare 3.1e-5 kg·m² rotor: 46 ms, inside the settling and the
+//!    windows), are sized to last that long, down to eight current resolutions (the readings'
+//!    rms at gates off); such steps, and those of a motor whose R̂s·I exceeds the back-EMF
+//!    at the spin speed, hold the coast's d current, so that the PLL reads the EMF outside
+//!    the inverter's dead-time band, and Ĵ adds back what the PLL's lag under the
+//!    acceleration turns of that current onto q (`j_hold_d`, `pll_lag_inertia`). A rotor
+//!    whose steps still end within two windows aborts with
+//!    [`AbortReason::RotorTooLight`], naming the speed it reached and the time, as does a
+//!    coast that its friction slows below a quarter of the spin speed before its window
+//!    ends (the servo's plant with a 1.5e-5 kg·m² rotor: 471 r/min lost in 229 ms). The
+//!    procedure ends with the gates off and the rotor coasting at about 10 % of its rated
+//!    speed.
 //!
 //! # Confidence
 //! Each identified parameter comes with a relative 1-σ statistical uncertainty computed from
@@ -276,6 +293,11 @@ pub struct Commissioning<T: 'static> {
     off_a: T,
     off_b: T,
     off_n: T,
+    /// Σ(a² + b²) of the raw readings at gates off, A².
+    off_sq: T,
+    /// The current readings' rms about their offsets at gates off (noise and quantisation),
+    /// A: the current resolution.
+    i_resolution: T,
     // Delay line: commands of n−1 and n−2 (estimated applied voltage), current of n−1.
     c1: Ab<T>,
     c2: Ab<T>,
@@ -340,6 +362,24 @@ pub struct Commissioning<T: 'static> {
     /// Time since the d current reached its coast level in stage 1, s.
     t_coast2: T,
     i_j: T,
+    /// The step up's record (the step down's sizing, `RotorTooLight`).
+    step_rec: StepRecord<T>,
+    /// The inertia test's torque steps hold the coast's d current (and its windows all go
+    /// into the fit) on a light rotor (its steps' floor lowered below 10 % of the limit:
+    /// [`J_STEP_MIN_TIME`]) and where the limit's resistive drop R̂s·I exceeds the back-EMF
+    /// at the spin speed; elsewhere they run without d current. Without it the steps'
+    /// phase currents sit near the inverter's dead-time band and the PLL reads the EMF
+    /// through its error: on the Estun EMJ-04 servo's bare rotor (steps of 0.03 A, EMF
+    /// 16 V against an inverter error of 4.9 V) its speed read ±150 r/min; on the gimbal
+    /// motor (`gbm5208-200t-4s`, 0.45 V of EMF at its 20 r/min spin speed, R̂s·I 2.1 V) its
+    /// angle swung 0.2 rad and the step up ended at 18 r/min read as 40. With the d current
+    /// held the PLL's lag under the steps' acceleration turns part of it onto q
+    /// (`pll_lag_inertia`). Mixing windows with and without it biases the fit: a PLL angle
+    /// error ε puts i_d·sin ε on the q axis, a torque the PLL frame does not see (on the
+    /// servo −6 … −10 mA in the coasts, a third of the step's; B̂ 1.9× the truth, Ĵ −14.6 %).
+    j_hold_d: bool,
+    /// The coast's d current (its magnitude), A: `coast_level`.
+    coast_id: T,
     /// d-current reference of the inertia test, released from the coast's level to 0 at a
     /// bounded rate ([`ID_RELEASE_EMF`]), A.
     id_j: T,
@@ -366,6 +406,18 @@ struct SpinLoop<T> {
     pll_ki: T,
 }
 
+/// The inertia test's step up, as measured: it sizes the step down and names a rotor too
+/// light for the test.
+#[derive(Clone, Copy, Debug, Default)]
+struct StepRecord<T> {
+    /// Duration of the step up, s (sizes the step down: `rescale_step_down`).
+    t_up: T,
+    /// The PLL's speed at the step up's start, then the speed it gained, electrical rad/s.
+    w_up: T,
+    /// Time of the torque steps beyond their [`J_SKIP`], s: the regression's torque data.
+    j_step_data: T,
+}
+
 /// The DC test's block statistics: the α voltage and current at each level, their β
 /// components (the sensors' gain ratio) and the DC-link voltage.
 #[derive(Clone, Debug)]
@@ -384,6 +436,18 @@ const INJ_HALF: u32 = 4;
 const BLOCK_TIME: f64 = 0.01;
 /// d current of the back-EMF measurement, as a fraction of the limit (module docs).
 const COAST_ID: f64 = 0.5;
+/// The PLL's lag under an electrical acceleration α is α/k_i (its integral gain k_i = ωn²),
+/// which turns ε·|i_d| of the coast's d current onto the q axis: a torque against the
+/// acceleration, as if the rotor's inertia were J − 1.5·p²·ψa·|i_d|/k_i
+/// (`pll_lag_inertia`). On the Estun EMJ-04 servo's bare rotor at `COAST_ID` that is
+/// 2.0e-5 of its 3.1e-5 kg·m²; with 1.5e-5 the coast collapsed (500 → 72 r/min in 30 ms,
+/// `Overspeed { Coast }`). The coast's d current is held where the nameplate inertia is at
+/// least this many times the PLL's (every preset: 4.5 … 240 at `COAST_ID`).
+const J_PLL_MARGIN: f64 = 3.0;
+/// The least coast d current, as a fraction of the limit: twice the compensation's band
+/// (5 % of the limit), so that the phase currents stay out of the dead-time band most of
+/// the time.
+const COAST_ID_MIN: f64 = 0.1;
 /// Speeds between which the inertia test's torque steps run, relative to the spin speed.
 const J_HIGH: f64 = 2.0;
 /// See [`J_HIGH`].
@@ -415,6 +479,24 @@ const DC_HOLD_SWING_TIME_CONSTANTS: f64 = 10.0;
 const DC_MAX_HOLD: f64 = 3.0;
 /// Window of the inertia regression, s.
 const J_WINDOW: f64 = 0.04;
+/// Time after each change of the inertia test's torque before its windows are collected
+/// and before the speed may end the step, s: the current's step and the PLL's speed
+/// transient. On the gimbal motor (`gbm5208-200t-4s`: 13 r/min at the step, 0.25 A) the
+/// PLL's speed reads 41 r/min for 4 ms after the step, twice the spin speed: taken as the
+/// step's end, both back-EMF windows sat at one speed (`Implausible { FluxLinkage }`).
+const J_SKIP: f64 = 0.03;
+/// Shortest duration the inertia test's torque steps are sized for on the nameplate
+/// inertia, s: [`J_SKIP`] and five windows. Where 10 % of the limit would end a step sooner
+/// (a light rotor) the step's current floor is lowered to what lasts this long, down to
+/// [`J_STEP_RESOLUTION`] current resolutions.
+const J_STEP_MIN_TIME: f64 = 0.25;
+/// The smallest torque step's q current, in current resolutions (the readings' rms about
+/// their offsets at gates off).
+const J_STEP_RESOLUTION: f64 = 8.0;
+/// Windows the torque steps must give beyond [`J_SKIP`] together: two consecutive windows
+/// make one point of the regression's torque data; a rotor whose steps end sooner at the
+/// smallest step is too light for the test ([`AbortReason::RotorTooLight`]).
+const J_MIN_STEP_WINDOWS: f64 = 2.0;
 /// Bound on the active-flux EMF's d component (L̂d − L̂q)·di_d/dt while the coast's d
 /// current is released at the start of the inertia test, relative to the EMF ω̂·λ̂f: the
 /// PLL's phase detector reads that component as an angle error of about this many rad.

@@ -114,6 +114,56 @@ pub enum AbortReason {
         /// Where.
         phase: Phase,
     },
+    /// The rotor's speed moves too fast for a measurement: in the inertia test
+    /// ([`Phase::Inertia`]) the torque steps, at the smallest step the current resolution
+    /// allows, ended too soon for the regression's windows; in the coast ([`Phase::Coast`])
+    /// its friction slowed it below a quarter of the spin speed before the back-EMF window
+    /// ended. The rotor is too light to be measured (with these current sensors, or against
+    /// its friction).
+    RotorTooLight {
+        /// Where.
+        phase: Phase,
+        /// The speed the rotor gained in the step up, or lost in the coast, r/min
+        /// (mechanical).
+        speed_rpm: u32,
+        /// The time it took, ms.
+        time_ms: u32,
+        /// The time the measurement needs, ms.
+        needed_ms: u32,
+    },
+}
+
+impl core::fmt::Display for AbortReason {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match *self {
+            AbortReason::RotorTooLight {
+                phase: Phase::Coast,
+                speed_rpm,
+                time_ms,
+                needed_ms,
+            } => write!(
+                f,
+                "the rotor loses {speed_rpm} r/min in {time_ms} ms coasting: too light against \
+                 its friction for the back-EMF window, which needs {needed_ms} ms (a load \
+                 coupled to the rotor)"
+            ),
+            AbortReason::RotorTooLight {
+                speed_rpm,
+                time_ms,
+                needed_ms,
+                ..
+            } => write!(
+                f,
+                "the rotor reaches {speed_rpm} r/min in {time_ms} ms under the smallest torque \
+                 step: too light for the inertia test, which needs {needed_ms} ms (a finer \
+                 current sensor, or a load coupled to the rotor)"
+            ),
+            AbortReason::Implausible { parameter } => {
+                write!(f, "implausible result: {parameter:?}")
+            }
+            other => write!(f, "{other:?}"),
+        }
+    }
 }
 
 /// Where the procedure stands.

@@ -91,7 +91,8 @@ pub(super) fn if_level<T: Real>(np: &MachineModel<T>, ld: T, lq: T, i_limit: T) 
     dc_level(&MachineModel { ld, lq, ..*np }, i_limit)
 }
 
-/// The inertia test's q-current step: `wanted` within 10–90 % of the limit, and at most the
+/// The inertia test's q-current step: `wanted` within `floor` and 90 % of the limit (the
+/// floor: 10 % of the limit, lower on a light rotor, `Commissioning::step_floor`), and at most the
 /// I-f level ([`if_level`]) of the identified λ̂f, L̂d, L̂q. The step's current runs in closed
 /// loop on the back-EMF PLL's angle, and an angle error ε puts I·sin ε of it on the d axis,
 /// where the active flux λf + (Ld − Lq)·i_d that the PLL locks onto falls; at
@@ -106,6 +107,7 @@ pub(super) fn step_level<T: Real>(
     lq: T,
     i_limit: T,
     wanted: T,
+    floor: T,
 ) -> T {
     let cap = if_level(
         &MachineModel {
@@ -116,7 +118,7 @@ pub(super) fn step_level<T: Real>(
         lq,
         i_limit,
     );
-    clamp(wanted, T::lit(0.1) * i_limit, T::lit(0.9) * i_limit).min(cap)
+    clamp(wanted, floor, T::lit(0.9) * i_limit).min(cap)
 }
 
 /// The I-f current (`if_level`) and the spin's electrical acceleration: spin_torque_ratio ×

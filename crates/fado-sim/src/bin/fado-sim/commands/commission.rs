@@ -70,6 +70,9 @@ pub fn commission(args: CommissionArgs) -> Outcome {
         o.status,
         o.simulated_seconds
     );
+    if let fado_core::commissioning::Status::Aborted(reason) = o.status {
+        outln!("  {reason}");
+    }
     if let (None, Some(m)) = (&o.identification, &o.magnetics) {
         print_magnetics(m, o.rotor_motion_magnetics);
     }
