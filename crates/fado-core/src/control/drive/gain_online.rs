@@ -6,7 +6,7 @@ use super::{DriveConfig, SensorlessDrive};
 use crate::control::gain_calibration::GainCalibrationStatus;
 use crate::control::gain_tracking::{GainTracking, GainTrackingConfig};
 use crate::estimator::RotorAngleEstimator;
-use crate::{Dq, Real, Rotation};
+use crate::{Ab, Dq, Real, Rotation};
 
 /// R̂s·I_rated/λ̂f (1/s) from which the drive tracks the mismatch: there a 0.5 % mismatch
 /// (negative sequence ε·I/√3) walks θ̂ at a loaded standstill at R̂s·ε·I/(√3·λ̂f) ≥ 0.25 rad/s,
@@ -49,13 +49,21 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             )
     }
 
-    /// One sample of the tracker: the measured d-q current `i_dq` in the frame `rot` of θ̂,
-    /// the voltage that acted over the last period (the estimator's) and ω̂.
+    /// Step 3: the measured current `i_ab` in the frame `rot` of θ̂, and with it one sample
+    /// of the tracker (with the voltage that acted over the last period, the estimator's, and
+    /// ω̂).
     #[inline(always)]
-    pub(super) fn track_gain(&mut self, i_dq: Dq<T>, rot: Rotation<T>, omega: T) {
-        if !self.gain_tracking_active() {
-            return;
+    pub(super) fn measured_dq(&mut self, i_ab: Ab<T>, rot: Rotation<T>, omega: T) -> Dq<T> {
+        let i_dq = i_ab.to_dq(rot);
+        if self.gain_tracking_active() {
+            self.track_gain(i_dq, rot, omega);
         }
+        i_dq
+    }
+
+    /// One sample of the tracker: the measured d-q current `i_dq` in the frame `rot` of θ̂.
+    #[inline(always)]
+    fn track_gain(&mut self, i_dq: Dq<T>, rot: Rotation<T>, omega: T) {
         let v = self.history[1].to_dq(rot);
         self.gain_correction =
             self.gain_tracking

@@ -81,9 +81,10 @@ pub struct GainCalibrationTuning<T> {
     pub max_mismatch: T,
     /// The online gain-mismatch tracker (see [`gain_tracking`](crate::control::gain_tracking)):
     /// where the start-up calibration did not calibrate (status `TooSlow`, `RotorMoved`,
-    /// `Implausible` or `Unobservable`; not where `time` is 0 or it calibrated), the
-    /// correction of phase a adapts while the rotor turns under load, from the −2ω̂
-    /// component of the d-q current and voltage. Default true \[A\].
+    /// `Implausible` or `Unobservable`; not where `time` is 0 or it calibrated) on a machine
+    /// whose R̂s·I_rated/λ̂f is at least 86.6/s (a 0.5 % mismatch walks θ̂ by 0.25 rad/s at a
+    /// loaded standstill), the correction of phase a adapts while the rotor turns under load,
+    /// from the −2ω̂ component of the d-q current and voltage. Default true \[A\].
     pub online: bool,
     /// The online tracker's adaptation time constant τ, s: it converges in about τ and adapts
     /// from |ω̂| ≥ 12/τ (electrical). Default 0.1 s \[A\] (from 120 rad/s; EPS motor of
