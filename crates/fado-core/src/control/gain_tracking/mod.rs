@@ -185,7 +185,9 @@ impl<T: Real> GainTracking<T> {
         let a_min = c.ts * T::lit(MIN_FILTER_SPEED_FACTOR / FILTER_PERIODS) / c.time;
         let a = (c.ts * w / T::lit(FILTER_PERIODS)).step_max(a_min);
         let a = a.step_min(T::lit(0.5));
-        if !(a > T::zero()) || !(c.time > T::zero()) {
+        // False for a time or period that is zero, negative or NaN.
+        let usable = a > T::zero() && c.time > T::zero();
+        if !usable {
             return correction;
         }
         let i = Ab::new(i.d, i.q);
@@ -218,7 +220,8 @@ impl<T: Real> GainTracking<T> {
         } else {
             T::zero()
         };
-        if !(self.ready >= settle) {
+        let settled = self.ready >= settle;
+        if !settled {
             return correction;
         }
         self.residual = residual;

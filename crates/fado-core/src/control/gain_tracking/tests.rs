@@ -120,7 +120,14 @@ fn the_state_is_bounded_and_non_finite_inputs_are_ignored() {
         let r = Rotation::from_angle(th);
         let e = Rotation::from_angle(-2.0 * th).unit();
         let i = i0 + x.complex_mul(e);
-        c = t.step(Dq::new(i.alpha, i.beta), Dq::new(0.0, 4.0), r, 500.0, false, c);
+        c = t.step(
+            Dq::new(i.alpha, i.beta),
+            Dq::new(0.0, 4.0),
+            r,
+            500.0,
+            false,
+            c,
+        );
         assert!(c.is_finite() && (c - 1.0).abs() <= 0.05 + 1e-12);
     }
     assert!((t.residual() - eps).abs() < 2e-3, "reads {}", t.residual());
