@@ -249,7 +249,11 @@ fn a_42_pole_robot_joint_motor_holds_zero_speed_after_its_top_speed() {
 /// start ends with the no-angle status. The miss is the current sensors' 0.5 % gain mismatch,
 /// which its start-up calibration leaves (`TooSlow`: the rotor's swing, 2J/c = 0.56 s, needs
 /// a 0.9 s window after the 0.2 s hold): with the gains calibrated (`startup.rotor_held`)
-/// `reversal` is 0.014 / 0.092 rad, with matched sensors 0.016 / 0.023 rad. A 0.3 % voltage
+/// `reversal` is 0.014 / 0.092 rad, with matched sensors 0.016 / 0.023 rad. The drive's
+/// online gain tracker (`fado_core::control::gain_tracking`) runs on it (R̂s·I/λ̂f 138/s) but
+/// learns only from 12/τ = 120 rad/s electrical, above its rated 100 r/min (73 rad/s):
+/// `reversal` 0.81 / 0.74, `stops` 0.60 / 0.49, `rated-reversal` 1.31 / 1.31 rad, the first
+/// two the same with the tracker off. A 0.3 % voltage
 /// error costs 0.25 rad below 2.3 % of its rated speed, beyond the scenarios' 2 % band; the
 /// plausibility warning on `rs` says so (`fado_core::machine_checks::low_speed_limit`). Its
 /// commissioning: the test below.

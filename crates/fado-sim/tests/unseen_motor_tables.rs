@@ -21,8 +21,10 @@
 //!
 //! The misses, in the ignored tests below with their figures: the light servo rotor falls back
 //! when the brake opens (`loaded-start`), the tool motor's angle during that fall (seed 2), and
-//! the EPS and appliance motors near zero speed under load with the sensors' gain mismatch
-//! uncalibrated (the test beside them shows both pass without the mismatch).
+//! the EPS and appliance motors held at zero speed under load after 4 % of their rated speed
+//! only (`stops`), where the sensors' gain mismatch that their start-up cannot calibrate is
+//! not learnt online (the test beside them shows both pass without the mismatch; the online
+//! tracker holds them in `fullrange`).
 
 use fado_core::MachineModel;
 use fado_core::commissioning::{AbortReason, Phase, Status};
@@ -152,8 +154,8 @@ fn the_eps_and_appliance_motors_pass_reversals_and_the_loaded_start() {
     assert!(missed.is_empty(), "missed: {missed:?}");
 }
 
-/// The EPS and appliance motors' misses come from the current sensors' 0.5 % gain mismatch,
-/// which their start-up leaves uncalibrated (`gain_calibration` TooSlow on the EPS motor,
+/// The EPS and appliance motors' `stops` misses come from the current sensors' 0.5 % gain
+/// mismatch, which their start-up leaves uncalibrated (`gain_calibration` TooSlow on the EPS motor,
 /// RotorMoved on the appliance motor): without it (the rest of the sensor model on, seed 1)
 /// `stops` and `fullrange` pass, at 0.056 / 0.060 rad (EPS) and 0.067 / 0.134 rad (appliance).
 #[test]
@@ -169,23 +171,50 @@ fn the_eps_and_appliance_motors_hold_a_loaded_standstill_with_matched_sensor_gai
     assert!(missed.is_empty(), "missed: {missed:?}");
 }
 
-/// With the default 0.5 % gain mismatch the EPS motor loses its angle while held at zero
-/// speed under 65 % of its rated torque: `stops` 1.095 / 1.110 rad (the rotor rolls back at
-/// −6 … −12 r/min, θ − θ̂ from −0.24 to −0.90 rad over 2.6–3.2 s of seed 1), `fullrange`
-/// 0.594 / 0.581 rad. The appliance motor: `stops` 0.529 / 0.255, `fullrange` 0.308 / 0.432,
-/// `regen-stop` 0.394 / 0.458 rad. A `sensor_gain_error` sweep of `stops` at seed 1 (0, 0.001,
-/// 0.0025, 0.005): EPS 0.056, 0.151, 0.240, 1.095 rad; appliance 0.067, 0.155, 0.172, 0.529.
+/// The drive's online gain tracker (`fado_core::control::gain_tracking`) learns the mismatch
+/// the start-up left uncalibrated while the rotor turns under load: `fullrange` (zero-speed
+/// hold at 9–10 s after 1000–2000 r/min) holds the angle within 0.139 / 0.137 rad on the EPS
+/// motor and 0.057 / 0.079 rad on the appliance motor (seeds 1, 2; 0.594 / 0.581 and
+/// 0.308 / 0.432 rad with the mismatch uncalibrated), and the appliance motor's `regen-stop`
+/// at seed 1 0.219 rad (0.394).
 #[test]
-#[ignore = "gain mismatch uncalibrated: EPS stops 1.095/1.110, fullrange 0.594/0.581 rad; \
-            appliance stops 0.529/0.255, fullrange 0.308/0.432, regen-stop 0.394/0.458 rad"]
+fn the_eps_and_appliance_motors_learn_their_sensor_gains_at_speed() {
+    let mut missed = Vec::new();
+    for (name, scenario, seed) in [
+        ("eps-nedic-12v", "fullrange", 1),
+        ("eps-nedic-12v", "fullrange", 2),
+        ("appliance-chmotor-16p-310v", "fullrange", 1),
+        ("appliance-chmotor-16p-310v", "fullrange", 2),
+        ("appliance-chmotor-16p-310v", "regen-stop", 1),
+    ] {
+        if !run(name, scenario, seed, "").0 {
+            missed.push(format!("{name} {scenario} seed {seed}"));
+        }
+    }
+    assert!(missed.is_empty(), "missed: {missed:?}");
+}
+
+/// `stops` holds at zero speed after 4 % of the rated speed only (17 rad/s on the EPS motor,
+/// 2ω̂ at 5 Hz), below the online tracker's 12/τ (120 rad/s): it learns nothing there and the
+/// default 0.5 % gain mismatch walks the angle. EPS motor: `stops` 1.095 / 1.110 rad (the
+/// rotor rolls back at −6 … −12 r/min, θ − θ̂ from −0.24 to −0.90 rad over 2.6–3.2 s of
+/// seed 1). The appliance motor: `stops` 0.529 / 0.255 rad, and `regen-stop` 0.219 /
+/// 0.458 rad, whose seed-2 maximum lies at 0.75 s in the first acceleration after the
+/// start-up's `RotorMoved` (27 r/min), before the tracker can adapt (0.224 rad there with
+/// matched sensors). A `sensor_gain_error` sweep of `stops` at seed 1 (0, 0.001, 0.0025,
+/// 0.005): EPS 0.056, 0.151, 0.240, 1.095 rad; appliance 0.067, 0.155, 0.172, 0.529. With
+/// the tracker at τ 0.25 s and its filters at 2ω̂·τf = 3 (from 12 rad/s): EPS `stops`
+/// unchanged (its first loaded hold at 2.5 s comes before the speed has been steady long
+/// enough), appliance `stops` 0.529 / 0.196; at τ 0.1 s the appliance's seed 2 reads
+/// 1.05 rad (readings of −0.035 at 40 r/min and 2 A).
+#[test]
+#[ignore = "gain mismatch unlearnt at 4 % rated speed: EPS stops 1.095/1.110 rad; appliance \
+            stops 0.529/0.255, regen-stop 0.219/0.458 rad (seed 2 at its start-up)"]
 fn the_eps_and_appliance_motors_hold_a_loaded_standstill() {
     let mut missed = Vec::new();
     for (name, scenarios) in [
-        ("eps-nedic-12v", &["stops", "fullrange"][..]),
-        (
-            "appliance-chmotor-16p-310v",
-            &["stops", "fullrange", "regen-stop"][..],
-        ),
+        ("eps-nedic-12v", &["stops"][..]),
+        ("appliance-chmotor-16p-310v", &["stops", "regen-stop"][..]),
     ] {
         for scenario in scenarios {
             for seed in [1, 2] {

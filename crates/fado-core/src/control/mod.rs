@@ -13,6 +13,7 @@ pub mod delay_compensation;
 pub mod drive;
 pub mod field_weakening;
 pub mod gain_calibration;
+pub mod gain_tracking;
 pub mod initial_angle;
 pub mod lock_reaction;
 pub mod modulation;

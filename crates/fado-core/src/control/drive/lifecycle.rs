@@ -60,6 +60,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             gain: GainCalibration::new(config.gain_calibration_config()?)?,
             turn: None,
             gain_correction: T::one(),
+            gain_tracking: super::gain_online::gain_tracking_of(&config),
             startup: AngleSearch::new(config.tuning.startup, &config.machine, config.ts)?,
             stuck_sensor: StuckChannelDetector::new(
                 config.tuning.stuck_sensor.band_ratio * config.machine.rated_current,
@@ -105,6 +106,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         self.flag_counts.reset();
         self.lock.reset();
         self.gain.arm();
+        self.gain_tracking.reset();
         self.turn = None;
         self.startup.arm();
         self.calibrate_offsets();

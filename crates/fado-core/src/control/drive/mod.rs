@@ -29,6 +29,7 @@ mod angle_phase;
 mod blocks;
 mod calibration;
 mod config;
+mod gain_online;
 mod hold;
 mod lifecycle;
 mod lock;
@@ -58,6 +59,7 @@ use crate::control::dead_time_compensation::DeadTimeCompensation;
 use crate::control::delay_compensation::DelayCompensation;
 use crate::control::field_weakening::FieldWeakening;
 use crate::control::gain_calibration::GainCalibration;
+use crate::control::gain_tracking::GainTracking;
 use crate::control::lock_reaction::LockSupervisor;
 use crate::control::modulation::SpaceVectorModulator;
 use crate::control::monitor::{DriveFlags, FlagCounts, PersistenceMonitor, StuckChannelDetector};
@@ -243,6 +245,8 @@ pub struct SensorlessDrive<T: 'static, E = SensorlessEstimator<T>> {
     startup: AngleSearch<T>,
     /// 1/k: the factor on the phase-a reading (1 until a ratio is measured).
     gain_correction: T,
+    /// The online tracker of that factor, where the start-up calibration did not set it.
+    gain_tracking: GainTracking<T>,
     /// Stuck phase-current channel detection and reconstruction.
     stuck_sensor: StuckChannelDetector<T>,
     /// Persistent current-control error.

@@ -112,7 +112,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         let estimate = self.estimate(i_ab)?;
         // 3. Measured current in the estimated rotor frame.
         let rot_theta = Rotation::from_angle(estimate.theta);
-        let i_dq = i_ab.to_dq(rot_theta);
+        let i_dq = self.measured_dq(i_ab, rot_theta, estimate.omega);
         let omega_ctrl = estimate.omega_control;
         let tracking_error = (self.last.i_dq_ref - i_dq).norm();
         self.current_error_now = self

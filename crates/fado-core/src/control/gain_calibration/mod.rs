@@ -63,7 +63,9 @@
 //! (the drive's `startup.rotor_held`): nothing swings then, and the drive holds each level for
 //! the current's settling alone (on the 50 kW IPMSM, the 5 kW PM-SyRM, the hub motor and an
 //! 8-pole saturated traction IPMSM, whose free swings need 0.61–1.0 s: k within 1.9e-3 of
-//! 1.005, `crates/fado-sim/tests/gain_calibration.rs`).
+//! 1.005, `crates/fado-sim/tests/gain_calibration.rs`). Where it ends without a ratio, the
+//! drive learns it while the rotor turns under load
+//! ([`gain_tracking`](crate::control::gain_tracking)).
 //!
 //! # Observability and error bound
 //! Phase x carries the fraction cos(φ − φ_x) of the axis current (phase axes at φ_a = 0,

@@ -79,9 +79,20 @@ pub struct GainCalibrationTuning<T> {
     /// (status `Implausible`, k unchanged). Default 0.05 \[A\] (two sensors of ±2.5 % gain
     /// tolerance; the simulator's default mismatch is 0.5 %, docs/method/estimator.md, "The paper's motor and drive").
     pub max_mismatch: T,
+    /// The online gain-mismatch tracker (see [`gain_tracking`](crate::control::gain_tracking)):
+    /// where the start-up calibration did not calibrate (status `TooSlow`, `RotorMoved`,
+    /// `Implausible` or `Unobservable`; not where `time` is 0 or it calibrated) on a machine
+    /// whose R̂s·I_rated/λ̂f is at least 86.6/s (a 0.5 % mismatch walks θ̂ by 0.25 rad/s at a
+    /// loaded standstill), the correction of phase a adapts while the rotor turns under load,
+    /// from the −2ω̂ component of the d-q current and voltage. Default true \[A\].
+    pub online: bool,
+    /// The online tracker's adaptation time constant τ, s: it converges in about τ and adapts
+    /// from |ω̂| ≥ 12/τ (electrical). Default 0.1 s \[A\] (from 120 rad/s; EPS motor of
+    /// `crates/fado-sim/tests/unseen_motor_tables.rs`: 4 % of its rated speed is 17 rad/s).
+    pub online_time: T,
 }
 
-cast_record!(GainCalibrationTuning { time, current_ratio, min_observability, max_mismatch ;  });
+cast_record!(GainCalibrationTuning { time, current_ratio, min_observability, max_mismatch, online_time ; online });
 
 impl<T: Real> Default for GainCalibrationTuning<T> {
     fn default() -> Self {
@@ -90,6 +101,8 @@ impl<T: Real> Default for GainCalibrationTuning<T> {
             current_ratio: T::one(),
             min_observability: T::lit(gain_calibration::DEFAULT_MIN_OBSERVABILITY),
             max_mismatch: T::lit(gain_calibration::DEFAULT_MAX_MISMATCH),
+            online: true,
+            online_time: T::lit(0.1),
         }
     }
 }
