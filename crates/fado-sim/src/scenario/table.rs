@@ -90,9 +90,10 @@ pub const SCENARIOS: [Scenario; 14] = [
     },
     Scenario {
         name: "lowspeed",
-        title: "Lowest speed held under 7.5 N·m: a staircase 60, 30, 15, … r/min [A]",
-        profile: "0 → 60 r/min, T_L → 7.5 N·m, then 2 s at each of 60, 30, 15, 7.5, 3.75, \
-                  1.875, 0.9375 r/min (each reached by a 0.2 s ramp)",
+        title: "Lowest speed held under 65 % of rated torque: a staircase from 4 % of rated speed, halved six times [A]",
+        profile: "0 → 4 % of rated speed, T_L → 65.2 % of rated torque, then 2 s at each of 4, 2, 1, \
+                  0.5, 0.25, 0.125, 0.0625 % of rated speed (each reached by a 0.2 s ramp; \
+                  the paper's motor: 7.5 N·m and 60, 30, 15, 7.5, 3.75, 1.875, 0.9375 r/min)",
         criterion: "a level is held when, over its last 1.5 s, |θ − θ̂| < 0.25 rad, \
                     |n − n*| < max(0.5·n*, 0.5 r/min) and no trip; the lowest speed held is \
                     the lowest level held together with every level above it; the scenario \
