@@ -239,6 +239,24 @@ pub fn refuse_unused(text: &str, function: &str) -> Result<(), SimConfigError> {
     .located_in(text))
 }
 
+/// [`commission`] on `plant_params` told its own motor record on its DC link (what a user of
+/// the simulated motor reads off its nameplate), with the default options, the procedure's
+/// configuration as derived and no progress report.
+pub fn commission_on_own_nameplate(
+    plant_params: &PlantParams,
+) -> Result<CommissionOutcome, SimConfigError> {
+    let nameplate = plant_params
+        .motor
+        .with_dc_voltage(plant_params.inverter.dc_voltage);
+    commission(
+        plant_params,
+        nameplate,
+        CommissionOptions::default(),
+        |_| {},
+        None,
+    )
+}
+
 /// Runs the procedure on a plant. `nameplate` is what the user tells the procedure (ratings
 /// and rough parameters); `config` adjusts the procedure's defaults (its `nameplate`,
 /// `sample_period` and `dead_time` are set from the arguments and the plant's inverter).

@@ -4,7 +4,7 @@
 //! magnetically linear machines reported as such.
 
 use fado_core::commissioning::{PULSE_MOTION_LIMIT, SaturationVerdict, Status};
-use fado_sim::commission::{CommissionOptions, CommissionOutcome, commission, identified_toml};
+use fado_sim::commission::{CommissionOutcome, commission_on_own_nameplate, identified_toml};
 use fado_sim::magnetic_accuracy::MagneticAccuracy;
 
 /// Largest rotor motion during the flux-linkage pulses, rad (electrical): measured 0.002 to
@@ -16,15 +16,7 @@ const MAX_MOTION: f64 = 0.15;
 fn commissioned(text: &str) -> CommissionOutcome {
     let cfg = fado_sim::SimConfig::from_toml(text).unwrap();
     let plant = cfg.plant();
-    let nameplate = plant.motor.with_dc_voltage(plant.inverter.dc_voltage);
-    commission(
-        &plant,
-        nameplate,
-        CommissionOptions::default(),
-        |_| {},
-        None,
-    )
-    .unwrap()
+    commission_on_own_nameplate(&plant).unwrap()
 }
 
 fn run(text: &str) -> CommissionOutcome {

@@ -25,7 +25,7 @@
 
 use fado_core::Dq;
 use fado_core::magnetics::{MagneticModel, Magnetics};
-use fado_sim::commission::{CommissionOptions, commission};
+use fado_sim::commission::commission_on_own_nameplate;
 use fado_sim::magnetic_accuracy::plant_model;
 use fado_sim::scenario::{run_config, scenario_config};
 
@@ -66,15 +66,7 @@ fn measure(path: &str) -> ([f64; 4], [f64; 4], f64) {
     let text = std::fs::read_to_string(path).unwrap();
     let cfg = fado_sim::SimConfig::from_toml(&text).unwrap();
     let plant = cfg.plant();
-    let nameplate = plant.motor.with_dc_voltage(plant.inverter.dc_voltage);
-    let o = commission(
-        &plant,
-        nameplate,
-        CommissionOptions::default(),
-        |_| {},
-        None,
-    )
-    .unwrap();
+    let o = commission_on_own_nameplate(&plant).unwrap();
     let id = o.identification.unwrap();
     let report = o.magnetics.unwrap();
     assert!(report.saturation_detected, "{path}: {}", report.verdict);
@@ -142,15 +134,7 @@ fn a_commissioned_model_learns_a_changed_winding_resistance() {
     fado_sim::magnetics_file::set_config_dir(Some(std::path::Path::new(dir)));
     let text = std::fs::read_to_string(format!("{dir}/pmsm-gem-1k1-measured.toml")).unwrap();
     let plant = fado_sim::SimConfig::from_toml(&text).unwrap().plant();
-    let nameplate = plant.motor.with_dc_voltage(plant.inverter.dc_voltage);
-    let o = commission(
-        &plant,
-        nameplate,
-        CommissionOptions::default(),
-        |_| {},
-        None,
-    )
-    .unwrap();
+    let o = commission_on_own_nameplate(&plant).unwrap();
     let id = o.identification.unwrap();
     let doc = fado_sim::commission::identified_toml(&text, &id).unwrap();
     let mut failed = Vec::new();

@@ -30,27 +30,11 @@
 //! `fado_core::commissioning`).
 
 use fado_core::commissioning::Status;
-use fado_sim::commission::{CommissionOptions, commission, identified_toml};
+use fado_sim::commission::{commission_on_own_nameplate, identified_toml};
 use fado_sim::scenario::simulate;
 
-/// The scenarios every machine runs.
-const SCENARIOS: [&str; 6] = [
-    "reversal",
-    "stops",
-    "rated-reversal",
-    "loaded-start",
-    "fullrange",
-    "regen-stop",
-];
-
-/// The text of `tests/data/unseen/<name>.toml`.
-fn file(name: &str) -> String {
-    let path = format!(
-        "{}/tests/data/unseen/{name}.toml",
-        env!("CARGO_MANIFEST_DIR")
-    );
-    std::fs::read_to_string(path).unwrap()
-}
+mod unseen_common;
+use unseen_common::{SCENARIOS, file};
 
 /// `scenario` on machine `name` with the current sensors' noise `seed`: whether it met its
 /// criteria, printed with its checks.
@@ -80,15 +64,7 @@ fn every_scenario(name: &str, skip: &[(&str, u64)]) {
 /// `reversal` on the `identified.toml` it writes, which must pass. The identification.
 fn commissioned_text(name: &str, text: &str) -> fado_core::commissioning::Identification<f64> {
     let plant = fado_sim::SimConfig::from_toml(text).unwrap().plant();
-    let nameplate = plant.motor.with_dc_voltage(plant.inverter.dc_voltage);
-    let o = commission(
-        &plant,
-        nameplate,
-        CommissionOptions::default(),
-        |_| {},
-        None,
-    )
-    .unwrap();
+    let o = commission_on_own_nameplate(&plant).unwrap();
     assert_eq!(o.status, Status::Done, "{name}");
     let id = o.identification.unwrap();
     let identified = identified_toml(text, &id).unwrap();
@@ -275,15 +251,7 @@ fn a_14_pole_gimbal_motor_passes_its_low_speed_scenarios() {
 fn the_gimbal_motor_commissions() {
     let name = "gimbal-gbm5208-200t-4s";
     let plant = fado_sim::SimConfig::from_toml(&file(name)).unwrap().plant();
-    let nameplate = plant.motor.with_dc_voltage(plant.inverter.dc_voltage);
-    let o = commission(
-        &plant,
-        nameplate,
-        CommissionOptions::default(),
-        |_| {},
-        None,
-    )
-    .unwrap();
+    let o = commission_on_own_nameplate(&plant).unwrap();
     assert_eq!(o.status, Status::Done, "{name}");
     let m = o.identification.unwrap().model;
     let j = m.inertia / plant.motor.inertia - 1.0;

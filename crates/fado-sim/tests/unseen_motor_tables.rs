@@ -28,27 +28,11 @@
 
 use fado_core::MachineModel;
 use fado_core::commissioning::{AbortReason, Phase, Status};
-use fado_sim::commission::{CommissionOptions, commission, identified_toml};
+use fado_sim::commission::{commission_on_own_nameplate, identified_toml};
 use fado_sim::scenario::simulate;
 
-/// The scenarios every machine runs.
-const SCENARIOS: [&str; 6] = [
-    "reversal",
-    "stops",
-    "rated-reversal",
-    "loaded-start",
-    "fullrange",
-    "regen-stop",
-];
-
-/// The text of `tests/data/unseen/<name>.toml`.
-fn file(name: &str) -> String {
-    let path = format!(
-        "{}/tests/data/unseen/{name}.toml",
-        env!("CARGO_MANIFEST_DIR")
-    );
-    std::fs::read_to_string(path).unwrap()
-}
+mod unseen_common;
+use unseen_common::{SCENARIOS, file};
 
 /// `scenario` on machine `name` with the current sensors' noise `seed` and the `extra`
 /// `[current_sensor]` keys: (passed, the largest |θ − θ̂| of the run), printed.
@@ -84,15 +68,7 @@ fn every_scenario(name: &str, skip: &[(&str, u64)]) {
 fn commissioned_reversal(name: &str) -> (MachineModel<f64>, MachineModel<f64>) {
     let text = file(name);
     let plant = fado_sim::SimConfig::from_toml(&text).unwrap().plant();
-    let nameplate = plant.motor.with_dc_voltage(plant.inverter.dc_voltage);
-    let o = commission(
-        &plant,
-        nameplate,
-        CommissionOptions::default(),
-        |_| {},
-        None,
-    )
-    .unwrap();
+    let o = commission_on_own_nameplate(&plant).unwrap();
     assert_eq!(o.status, Status::Done, "{name}");
     let id = o.identification.unwrap();
     let identified_model = id.model;
@@ -285,15 +261,7 @@ fn a_400_w_servo_behind_a_coarse_current_sensor_aborts_naming_its_light_rotor() 
         file(name)
     );
     let plant = fado_sim::SimConfig::from_toml(&text).unwrap().plant();
-    let nameplate = plant.motor.with_dc_voltage(plant.inverter.dc_voltage);
-    let o = commission(
-        &plant,
-        nameplate,
-        CommissionOptions::default(),
-        |_| {},
-        None,
-    )
-    .unwrap();
+    let o = commission_on_own_nameplate(&plant).unwrap();
     let Status::Aborted(reason) = o.status else {
         panic!("{name}: {:?}", o.status);
     };
@@ -316,15 +284,7 @@ fn a_servo_rotor_too_light_against_its_friction_aborts_naming_its_coast() {
     let text = file(name).replace("inertia = 3.1e-5", "inertia = 1.5e-5");
     let plant = fado_sim::SimConfig::from_toml(&text).unwrap().plant();
     assert_eq!(plant.motor.inertia, 1.5e-5);
-    let nameplate = plant.motor.with_dc_voltage(plant.inverter.dc_voltage);
-    let o = commission(
-        &plant,
-        nameplate,
-        CommissionOptions::default(),
-        |_| {},
-        None,
-    )
-    .unwrap();
+    let o = commission_on_own_nameplate(&plant).unwrap();
     let Status::Aborted(reason) = o.status else {
         panic!("{name}: {:?}", o.status);
     };
