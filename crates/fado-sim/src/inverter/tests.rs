@@ -441,34 +441,9 @@ fn edge_current_compensation_on_the_400_v_servo_class_is_no_worse_than_the_passe
     // 0.790 / 1.168 / 2.701 V. Under 1.5 A the a and c poles' edges lie 1.9 µs (< Td) from
     // b's: the root of the solve's model (delays Td, Td; −0.90 V) is unique and reached, the
     // inverter's own root is −1.41 V (fado_core's dead_time_compensation, "Which solve").
-    use fado_core::control::DeadTimeMethod;
     let (mp, p) = servo();
-    let ic = p.current_band;
-    let on_b = |e: Ab<f64>| 1.5 * (-0.5 * e.alpha + 0.866_025_403_784_438_6 * e.beta);
     for (load, max, solve_min) in [(1.5, 0.85, 1.3), (4.4, 1.25, 0.9), (8.8, 2.8, 0.0)] {
-        let (mut chosen, mut passes, mut solve) = (0.0_f64, 0.0_f64, 0.0_f64);
-        for k in -24..=24 {
-            let ib = k as f64 * 0.25 * ic;
-            let i_abc = [-load - 0.5 * ib, ib, load - 0.5 * ib];
-            let err = |rated| {
-                let e = standstill_error_rated(
-                    DeadTimeMethod::EdgeCurrent,
-                    mp,
-                    &p,
-                    0.0,
-                    i_abc,
-                    20,
-                    rated,
-                );
-                on_b(e).abs()
-            };
-            chosen = chosen.max(err(p.dc_voltage));
-            passes = passes.max(err(0.0));
-            solve = solve.max(on_b(standstill_root_solve_error(mp, &p, i_abc)).abs());
-        }
-        println!(
-            "under {load} A: worst {chosen:.3} V, the passes {passes:.3} V, the root solve {solve:.3} V"
-        );
+        let (chosen, passes, solve) = phase_b_sweep(mp, &p, load);
         assert!(
             chosen <= passes + 1e-3,
             "under {load} A: {chosen} V against {passes} V"
@@ -481,6 +456,31 @@ fn edge_current_compensation_on_the_400_v_servo_class_is_no_worse_than_the_passe
             "under {load} A: the root solve {solve} V"
         );
     }
+}
+
+/// Phase b swept over ±6 Ic at standstill with phases a and c at ∓`load` A: the worst
+/// |error| on phase b (V) of the drive's choice, of the two passes and of the root solve in
+/// every sample, printed.
+fn phase_b_sweep(mp: MotorParams, p: &InverterParams, load: f64) -> (f64, f64, f64) {
+    use fado_core::control::DeadTimeMethod;
+    let on_b = |e: Ab<f64>| 1.5 * (-0.5 * e.alpha + 0.866_025_403_784_438_6 * e.beta);
+    let (mut chosen, mut passes, mut solve) = (0.0_f64, 0.0_f64, 0.0_f64);
+    for k in -24..=24 {
+        let ib = k as f64 * 0.25 * p.current_band;
+        let i_abc = [-load - 0.5 * ib, ib, load - 0.5 * ib];
+        let err = |rated| {
+            let e =
+                standstill_error_rated(DeadTimeMethod::EdgeCurrent, mp, p, 0.0, i_abc, 20, rated);
+            on_b(e).abs()
+        };
+        chosen = chosen.max(err(p.dc_voltage));
+        passes = passes.max(err(0.0));
+        solve = solve.max(on_b(standstill_root_solve_error(mp, p, i_abc)).abs());
+    }
+    println!(
+        "under {load} A: worst {chosen:.3} V, the passes {passes:.3} V, the root solve {solve:.3} V"
+    );
+    (chosen, passes, solve)
 }
 
 /// [`standstill_error_on`] with the compensation's root solve in every sample
@@ -536,34 +536,9 @@ fn edge_current_compensation_on_the_u8ii_multirotor_is_the_passes() {
     // 14.3 A the ripple (Vdc/(3·L) = 1.2 A/µs) keeps the edges out of the band and the two
     // agree: the standstill under load is not where the root solve loses this motor's angle
     // (fado_core's dead_time_compensation, "Which solve": the release and R̂s).
-    use fado_core::control::DeadTimeMethod;
     let (mp, p) = u8ii();
-    let ic = p.current_band;
-    let on_b = |e: Ab<f64>| 1.5 * (-0.5 * e.alpha + 0.866_025_403_784_438_6 * e.beta);
     for (load, max) in [(0.3, 0.25), (1.0, 0.23), (7.0, 0.1), (14.3, 0.02)] {
-        let (mut chosen, mut passes, mut solve) = (0.0_f64, 0.0_f64, 0.0_f64);
-        for k in -24..=24 {
-            let ib = k as f64 * 0.25 * ic;
-            let i_abc = [-load - 0.5 * ib, ib, load - 0.5 * ib];
-            let err = |rated| {
-                let e = standstill_error_rated(
-                    DeadTimeMethod::EdgeCurrent,
-                    mp,
-                    &p,
-                    0.0,
-                    i_abc,
-                    20,
-                    rated,
-                );
-                on_b(e).abs()
-            };
-            chosen = chosen.max(err(p.dc_voltage));
-            passes = passes.max(err(0.0));
-            solve = solve.max(on_b(standstill_root_solve_error(mp, &p, i_abc)).abs());
-        }
-        println!(
-            "under {load} A: worst {chosen:.3} V, the passes {passes:.3} V, the root solve {solve:.3} V"
-        );
+        let (chosen, passes, _) = phase_b_sweep(mp, &p, load);
         assert!(
             (chosen - passes).abs() < 1e-9,
             "under {load} A: {chosen} V against {passes} V"
