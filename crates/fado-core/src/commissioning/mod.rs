@@ -168,7 +168,7 @@
 //!    rad where its active flux vanishes; the PLL slipped by π, the coast started 2 rad off
 //!    and its speed estimate was 6 % high: λ̂f −5.5 … −5.9 %.) Then the q current is regulated
 //!    to zero and the rotor coasts with a d current of −½ the limit (less on a light rotor:
-//!    [`J_PLL_MARGIN`]; `COAST_ID`: every phase
+//!    `J_PLL_MARGIN` (3); `COAST_ID`: every phase
 //!    current outside the inverter's dead-time band most of the time, so that its error is
 //!    the compensated V̂·sign(i) rather than the dead zone of i ≈ 0). The back-EMF
 //!    E = v − R̂s·i − L̂q·di/dt (the active-flux EMF, Boldea et al. 2008, whose angle is the
