@@ -36,6 +36,12 @@ impl<T: Real> DriveConfig<T> {
         Resolved::new(self)
             .and_then(|r| Blocks::new(self, &r))
             .and_then(|_| GainCalibration::new(self.gain_calibration_config()?))
+            .and_then(|_| {
+                check::non_negative(
+                    "gain_calibration_online_time",
+                    self.tuning.gain_calibration.online_time,
+                )
+            })
             .and_then(|_| AngleSearch::new(self.tuning.startup, &self.machine, self.ts))
             .map(|_| ())
     }

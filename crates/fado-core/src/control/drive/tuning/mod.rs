@@ -202,6 +202,10 @@ pub const MOVED_KEYS: &[(&str, &str)] = &[
         "gain_calibration_max_mismatch",
         "gain_calibration.max_mismatch",
     ),
+    (
+        "gain_calibration_online_time",
+        "gain_calibration.online_time",
+    ),
     ("stuck_sensor_band_ratio", "stuck_sensor.band_ratio"),
     (
         "stuck_sensor_reference_ratio",
