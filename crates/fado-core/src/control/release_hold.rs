@@ -727,7 +727,11 @@ impl<T: Real> ReleaseHold<T> {
         }
         if !self.active {
             self.elapsed = self.elapsed.saturating_add(1);
-            let window = if self.released && self.release_on_direct {
+            // Armed at a brake's release on a saturating model the hold watches the angle its
+            // loop holds, the direct one (the tracked angle lags a rotor that starts to fall by
+            // milliseconds; module docs, "When"), within the release's own window.
+            let on_direct = self.released && self.release_on_direct;
+            let window = if on_direct {
                 self.release_window_samples
             } else {
                 self.window_samples
@@ -736,14 +740,7 @@ impl<T: Real> ReleaseHold<T> {
                 self.disarm();
                 return HoldAction::Idle;
             }
-            // Armed at a brake's release the hold watches the angle its loop holds, the direct
-            // one: the tracked angle lags a rotor that starts to fall by milliseconds
-            // (module docs, "When").
-            let watched = if self.released && self.release_on_direct {
-                theta
-            } else {
-                theta_tracked
-            };
+            let watched = if on_direct { theta } else { theta_tracked };
             let moved = crate::wrap_angle(self.theta_hold - watched);
             // NaN compares false: a non-finite angle does not trigger.
             // On a moving reference only a fall against it triggers (the rotor's lag behind

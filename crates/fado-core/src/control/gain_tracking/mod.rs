@@ -98,7 +98,7 @@ pub struct GainTrackingConfig<T> {
     pub time: T,
     /// R̂s, Ω.
     pub rs: T,
-    /// L̂d and L̂q, H.
+    /// L̂d, H.
     pub ld: T,
     /// L̂q, H.
     pub lq: T,
