@@ -321,7 +321,29 @@ impl SimConfig {
             .map_err(|e| key_error(e).in_section("model"))?;
         model.dc_voltage = self.inverter.dc_voltage;
         model.validate().map_err(|e| self.core_error("model", e))?;
-        Ok(model.with_magnetics(derived.magnetics))
+        let model = model.with_magnetics(derived.magnetics);
+        self.check_model_agreement(&model)?;
+        Ok(model)
+    }
+
+    /// A `[model]` map or `[model.saturation]` against the model's `ld`, `lq` and
+    /// `flux_linkage` ([`crate::magnetic_agreement`]): a map without a magnet (a SyRM's,
+    /// ψd(0, 0) = 0) is refused with any `flux_linkage` > 0 the model states.
+    fn check_model_agreement(&self, model: &MachineModel<f64>) -> Result<(), SimConfigError> {
+        let table = self.model.as_ref();
+        let Some(key) = crate::model_magnetics::MODEL_MAGNETICS_KEYS
+            .iter()
+            .find(|k| table.is_some_and(|t| t.contains_key(**k)))
+        else {
+            return Ok(());
+        };
+        let stated = crate::magnetic_agreement::Stated {
+            section: "model",
+            ld: model.ld,
+            lq: model.lq,
+            flux_linkage: model.flux_linkage,
+        };
+        crate::magnetic_agreement::check(&model.magnetic_model(), &format!("model.{key}"), stated)
     }
 
     /// The key a user wrote for the model's field `k`: `model.k` when `[model]` gives it,
