@@ -76,7 +76,8 @@ pub struct Saturation<T> {
     pub a_b: T,
     /// Rib saturation coefficient a_bp (≥ 0).
     pub a_bp: T,
-    /// Rib exponent W (≥ 2).
+    /// Rib exponent W (≥ 2, or 0: the constant conductance a_b/(1 + a_bp) of a rib that does
+    /// not saturate, the magnet then a linear Norton source).
     pub w: T,
     /// Rib's share of the q flux k_q (≥ 0).
     pub k_q: T,
@@ -147,7 +148,8 @@ impl<T: Real> Saturation<T> {
     /// Checks every coefficient; the error names the first bad one. The unsaturated inverse
     /// inductances must be positive and every other coefficient and exponent non-negative, so
     /// that i(ψ) is monotonic (the energy convex); the rib's exponent must be at least 2 (its
-    /// Jacobian is then finite at ρ = 0).
+    /// Jacobian is then finite at ρ = 0) or 0 (a constant rib conductance, as motulator's
+    /// `SaturationModelPMSyRM` takes it: scripts/motulator-machines.py's SPMSM).
     pub fn validate(&self) -> Result<(), ConfigError> {
         check::positive("a_d0", self.a_d0)?;
         check::non_negative("a_dd", self.a_dd)?;
@@ -162,10 +164,11 @@ impl<T: Real> Saturation<T> {
         check::finite("psi_n", self.psi_n)?;
         check::non_negative("a_b", self.a_b)?;
         check::non_negative("a_bp", self.a_bp)?;
-        if check::finite("w", self.w)? < T::lit(2.0) {
+        let w = check::finite("w", self.w)?;
+        if w < T::lit(2.0) && w != T::zero() {
             return Err(ConfigError::OutOfRange {
                 field: "w",
-                expected: "at least 2",
+                expected: "0 or at least 2",
             });
         }
         check::non_negative("k_q", self.k_q)?;
@@ -250,8 +253,13 @@ impl<T: Real> Saturation<T> {
             i.d += g_b * b;
             i.q += kq * g_b * y;
             if JACOBIAN {
-                // (dG_b/dρ)/ρ = a_b·W·ρ^(W−2)/den², finite at ρ = 0 for W ≥ 2.
-                let h = self.a_b * self.w * pow_abs(rho, self.w - two) / (den * den);
+                // (dG_b/dρ)/ρ = a_b·W·ρ^(W−2)/den², finite at ρ = 0 for W ≥ 2, zero for a
+                // constant G_b (W = 0).
+                let h = if self.w == T::zero() {
+                    T::zero()
+                } else {
+                    self.a_b * self.w * pow_abs(rho, self.w - two) / (den * den)
+                };
                 let c = h * kq * b * y;
                 jac.dd += g_b + h * b * b;
                 jac.dq += c;
