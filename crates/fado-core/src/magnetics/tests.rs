@@ -796,29 +796,3 @@ fn saturation_parameters_are_checked_naming_the_field() {
     assert!(!syrm().current(Dq::new(f64::NAN, 0.1)).is_finite());
     assert!(!ipm().flux(Dq::new(f64::INFINITY, 0.1)).is_finite());
 }
-
-/// W = 0: a rib of constant conductance a_b/(1 + a_bp), the magnet a linear Norton source
-/// (motulator's `SaturationModelPMSyRM` with W = 0, scripts/motulator-machines.py's SPMSM):
-/// accepted, its current and Jacobian finite at ρ = 0 (ψd = ψn, ψq = 0), where W − 2 < 0
-/// would make ρ^(W−2) infinite, and the Jacobian the linear model's a_d0 + a_b/(1 + a_bp).
-#[test]
-fn a_rib_of_constant_conductance_is_a_linear_norton_magnet() {
-    let m = Saturation {
-        a_d0: 200.0,
-        a_q0: 400.0,
-        psi_n: 0.24,
-        a_b: 200.0,
-        a_bp: 0.0,
-        w: 0.0,
-        ..Saturation::default()
-    };
-    m.validate().unwrap();
-    let (i, jac) = m.current_and_jacobian(Dq::new(0.24, 0.0));
-    assert!(i.is_finite() && jac.dd.is_finite(), "{i:?} {jac:?}");
-    assert!(
-        (jac.dd - 400.0).abs() < 1e-9 && (jac.qq - 400.0).abs() < 1e-9,
-        "{jac:?}"
-    );
-    // The magnet's flux at zero current: a_b·ψn/(a_d0 + a_b) = 0.12 Vs.
-    assert!((m.flux(Dq::new(0.0, 0.0)).d - 0.12).abs() < 1e-9);
-}
