@@ -295,6 +295,28 @@ struct Replay {
     rs_ratio_range: (f64, f64),
 }
 
+/// Prints the replay of `name` at `load` × rated torque and asserts the criterion: within
+/// 0.25 rad near zero speed, R̂s within 5 % of the truth.
+fn assert_holds(name: &str, load: f64, r: &Replay) {
+    println!(
+        "{name} at {:.0} %: max |θ − θ̂| near zero speed {:.4} rad, R̂s/Rs {:.3}–{:.3}",
+        load * 100.0,
+        r.max_error_near_zero,
+        r.rs_ratio_range.0,
+        r.rs_ratio_range.1
+    );
+    assert!(
+        r.max_error_near_zero < 0.25,
+        "{name} {load}: {}",
+        r.max_error_near_zero
+    );
+    assert!(
+        r.rs_ratio_range.0 > 0.95 && r.rs_ratio_range.1 < 1.05,
+        "{name} {load}: R̂s/Rs {:?}",
+        r.rs_ratio_range
+    );
+}
+
 /// The reversal replayed: `plant` makes the signals, `model` is the estimator's machine.
 fn replay(plant: &MachineModel<f64>, model: &MachineModel<f64>, load: f64) -> Replay {
     replay_with(plant, model, load, |_| {})
@@ -406,20 +428,7 @@ fn saturated_machines_replayed_with_their_model_hold_the_angle_through_the_rever
         ("ferrite PM-SyRM (made up)", ferrite_pmsyrm()),
     ] {
         for load in all {
-            let r = replay(&plant, &plant, load);
-            println!(
-                "{name} at {:.0} %: max |θ − θ̂| near zero speed {:.4} rad, R̂s/Rs {:.3}–{:.3}",
-                load * 100.0,
-                r.max_error_near_zero,
-                r.rs_ratio_range.0,
-                r.rs_ratio_range.1
-            );
-            assert!(r.max_error_near_zero < 0.25, "{name} {load}");
-            assert!(
-                r.rs_ratio_range.0 > 0.95 && r.rs_ratio_range.1 < 1.05,
-                "{name} {load}: R̂s/Rs {:?}",
-                r.rs_ratio_range
-            );
+            assert_holds(name, load, &replay(&plant, &plant, load));
         }
     }
 }
@@ -945,24 +954,7 @@ fn motulator_machines() -> [(&'static str, MachineModel<f64>); 4] {
 fn motulator_machines_given_their_maps_hold_the_angle_through_the_reversal() {
     for (name, plant) in motulator_machines() {
         for load in [0.0, 0.3, 0.65, 1.0] {
-            let r = replay_load_step(&plant, &plant, load, |_| {});
-            println!(
-                "{name} at {:.0} %: max |θ − θ̂| near zero speed {:.4} rad, R̂s/Rs {:.3}–{:.3}",
-                load * 100.0,
-                r.max_error_near_zero,
-                r.rs_ratio_range.0,
-                r.rs_ratio_range.1
-            );
-            assert!(
-                r.max_error_near_zero < 0.25,
-                "{name} {load}: {}",
-                r.max_error_near_zero
-            );
-            assert!(
-                r.rs_ratio_range.0 > 0.95 && r.rs_ratio_range.1 < 1.05,
-                "{name} {load}: R̂s/Rs {:?}",
-                r.rs_ratio_range
-            );
+            assert_holds(name, load, &replay_load_step(&plant, &plant, load, |_| {}));
         }
     }
 }
