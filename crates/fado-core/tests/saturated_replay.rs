@@ -965,7 +965,7 @@ fn motulator_machines_given_their_maps_hold_the_angle_through_the_reversal() {
 /// would make ρ^(W−2) infinite, and the Jacobian the linear model's a_d0 + a_b/(1 + a_bp).
 #[test]
 fn a_rib_of_constant_conductance_is_a_linear_norton_magnet() {
-    let m = Saturation {
+    let m = Saturation::<f64> {
         a_d0: 200.0,
         a_q0: 400.0,
         psi_n: 0.24,
