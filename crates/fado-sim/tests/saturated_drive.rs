@@ -199,8 +199,11 @@ fn motulator_small_high_saliency_ipmsm_passes_every_seed() {
 /// (`saturated_replay motulator`) and motulator's own plant's within 0.024 rad
 /// (scripts/motulator-machines.py replay); closed loop the drive loses it while the machine
 /// generates near zero speed. Its magnet is weak (λf 0.2 Vs against L_d·I = 0.64 Vs): ψd
-/// crosses zero on the MTPA curve near 4 A of i_d (ψd = −0.14 Vs at rated torque) and the
-/// secant L_q falls 57 % at rated i_q.
+/// crosses zero on the MTPA curve near 5 A of i_d (ψd = −0.12 Vs at rated torque) and the
+/// secant L_q falls 57 % at rated i_q: its frame coupling |s|/κ (`fado_core::active_flux`,
+/// computed from motulator's model on its MTPA curve) is 0.84 / 1.08 / 1.33 at 30 / 65 /
+/// 100 % of rated torque, beyond the 1.12 of the ferrite PM-SyRM that `saturated_replay`
+/// holds open loop.
 #[test]
 #[ignore = "reversal fails on seeds 2 and 3 (max |θ − θ̂| near zero speed 3.05 and 1.77 rad; \
             seeds 1 and 4 0.086 and 0.124 rad): at 65 % load, generating at −4 % of rated \
