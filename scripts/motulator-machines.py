@@ -30,7 +30,11 @@ and the default tuning (R̂s adaptation on). It prints max |θ − θ̂| where |
 speed after 2 s, and R̂s/Rs's range after 1 s; `--out DIR` keeps each run's signals
 (`NAME-LOAD.npz`), `--reuse` replays them again.
 
+`coupling` prints each magnet machine's frame coupling |s|/κ on its MTPA curve
+(`fado_core::active_flux`'s formula from motulator's model).
+
 Usage: python3 scripts/motulator-machines.py maps DIR
+       python3 scripts/motulator-machines.py coupling [--load 0.3 0.65 1.0]
        python3 scripts/motulator-machines.py replay [--machine NAME ...] [--load 0 0.3 ...]
                                             [--out DIR [--reuse]]
 (`replay` needs motulator and the `fado` package in one Python >= 3.12 environment.)
@@ -278,6 +282,28 @@ def write_maps(out: Path) -> None:
         print(f"wrote {csv} and {m.name}.toml")
 
 
+def frame_coupling(m: Machine, load: float) -> tuple[complex, float]:
+    """The MTPA current of `load` × rated torque and the frame coupling |s|/κ there, with the
+    formula of `fado_core::active_flux::ActiveFlux::frame_coupling` (s = (L_q,s − L_dd)·i_q +
+    L_dq·i_d, κ = λa + L_qd·i_q − (L_qq − L_q,s)·i_d, L_q,s = ψq/i_q the secant, λa = ψd −
+    L_q,s·i_d) from motulator's model."""
+    betas = np.radians(np.arange(0.0, 89.0, 0.5))
+    for a in np.linspace(0.05, 1.5, 60) * m.rated_current:
+        tau = m.torque(-a * np.sin(betas), a * np.cos(betas))
+        k = int(np.argmax(tau))
+        if tau[k] >= load * m.rated_torque:
+            break
+    i = complex(-a * np.sin(betas[k]), a * np.cos(betas[k]))
+    h = 1e-4 * m.rated_current
+    psi, psi_d, psi_q = m.flux(i), m.flux(i + h), m.flux(i + 1j * h)
+    l_dd, l_qd = (psi_d.real - psi.real) / h, (psi_d.imag - psi.imag) / h
+    l_dq, l_qq = (psi_q.real - psi.real) / h, (psi_q.imag - psi.imag) / h
+    l_qs = psi.imag / i.imag
+    s = (l_qs - l_dd) * i.imag + l_dq * i.real
+    kappa = psi.real - l_qs * i.real + l_qd * i.imag - (l_qq - l_qs) * i.real
+    return i, abs(s) / kappa
+
+
 def profile(points: list[tuple[float, float]], t: float) -> float:
     xs, ys = zip(*points)
     return float(np.interp(t, xs, ys))
@@ -419,6 +445,8 @@ def main() -> None:
     sub = ap.add_subparsers(dest="cmd", required=True)
     mp = sub.add_parser("maps", help="write each machine's flux-map CSV and fado-sim TOML")
     mp.add_argument("out", type=Path)
+    cp = sub.add_parser("coupling", help="the frame coupling on the MTPA curve")
+    cp.add_argument("--load", nargs="*", type=float, default=[0.3, 0.65, 1.0])
     rp = sub.add_parser("replay", help="simulate in motulator, replay through fado.estimate")
     rp.add_argument("--machine", nargs="*", help="machine names (substring match)")
     rp.add_argument("--load", nargs="*", type=float, default=[0.0, 0.3, 0.65, 1.0])
@@ -433,6 +461,11 @@ def main() -> None:
     args = ap.parse_args()
     if args.cmd == "maps":
         write_maps(args.out)
+        return
+    if args.cmd == "coupling":
+        for m in MACHINES[:4]:
+            cells = [f"{load:.0%} {frame_coupling(m, load)[1]:.2f}" for load in args.load]
+            print(f"{m.name}: |s|/κ " + ", ".join(cells))
         return
     if args.simulate_only and args.out is None:
         sys.exit("--simulate-only writes to --out DIR")
