@@ -200,8 +200,8 @@ fn motulator_small_high_saliency_ipmsm_passes_every_seed() {
 /// (scripts/motulator-machines.py replay); closed loop the drive loses it while the machine
 /// generates near zero speed. Its magnet is weak (λf 0.2 Vs against L_d·I = 0.64 Vs): ψd
 /// crosses zero on the MTPA curve near 5 A of i_d (ψd = −0.12 Vs at rated torque) and the
-/// secant L_q falls 57 % at rated i_q: its frame coupling |s|/κ (`fado_core::active_flux`,
-/// computed from motulator's model on its MTPA curve) is 0.84 / 1.08 / 1.33 at 30 / 65 /
+/// secant L_q falls 57 % at rated i_q: its frame coupling |s|/κ (`fado_core::active_flux`'s
+/// formula on motulator's model, `scripts/motulator-machines.py coupling`) is 0.84 / 1.08 / 1.33 at 30 / 65 /
 /// 100 % of rated torque, beyond the 1.12 of the ferrite PM-SyRM that `saturated_replay`
 /// holds open loop.
 #[test]
