@@ -209,7 +209,11 @@ fn motulator_small_high_saliency_ipmsm_passes_every_seed() {
             seeds 1 and 4 0.086 and 0.124 rad): at 65 % load, generating at −4 % of rated \
             speed, the angle and speed errors oscillate at about 6 Hz and grow (±0.2 rad at \
             2.7 s, lost at 3.08 s); rated-reversal trips on all four seeds (lost at 1.9 s at \
-            −6 % under the rated load, generating); stops passes (0.041 rad)"]
+            −6 % under the rated load, generating); stops passes (0.041 rad). With \
+            [controller.speed] bandwidth_hz = 4 (default 5) reversal passes every seed \
+            (0.056–0.131 rad) but rated-reversal still loses the angle on every seed; with 3 \
+            rated-reversal holds it on seeds 1–2 (0.14, 0.28 rad; 38 r/min) and loses it on \
+            3–4"]
 fn motulator_ferrite_pm_syrm_passes_every_seed() {
     passes_every_seed(&motulator_machine("mot-pmsyrm-4k"));
 }
