@@ -111,6 +111,19 @@ pub enum Finding {
         needed: f64,
         /// Vdc/√3, V.
         available: f64,
+        /// Vdc, V.
+        dc_voltage: f64,
+        /// The per-phase winding when `rs`, `ld` and `lq` look line-to-line: the halved
+        /// values, with which the rated point fits the link.
+        line_to_line: Option<PhaseWinding>,
+    },
+    /// The DC link is a mains' rms voltage ([`MAINS_RMS`](super::MAINS_RMS)) and the rated
+    /// point needs most of its linear range: a link rectified from those mains is √2 × it.
+    DcLinkMains {
+        /// Vdc, V.
+        dc_voltage: f64,
+        /// |v_rated| / (Vdc/√3).
+        ratio: f64,
     },
     /// An inductance is large for the rated current and flux linkage.
     Reactance {
@@ -127,6 +140,9 @@ pub enum Finding {
         per_unit: f64,
         /// Warning or error.
         severity: Severity,
+        /// Rs/2, Ω, when the resistance halved (a line-to-line value for the phase's) is
+        /// within the bound of this severity.
+        line_to_line: Option<f64>,
     },
     /// The electrical time constant is long.
     TimeConstant {
@@ -149,6 +165,18 @@ pub enum Finding {
         /// Warning or error.
         severity: Severity,
     },
+}
+
+/// A winding's per-phase values, Ω and H: those of a winding whose data look line-to-line
+/// (between two terminals of a star connection, 2 × the phase's).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PhaseWinding {
+    /// Rs, Ω.
+    pub rs: f64,
+    /// Ld, H.
+    pub ld: f64,
+    /// Lq, H.
+    pub lq: f64,
 }
 
 /// The findings of one [`check`](super::check), errors first.
@@ -292,6 +320,7 @@ impl Finding {
             | Finding::RatingScale { .. }
             | Finding::Inertia { .. }
             | Finding::DcLinkShort { .. }
+            | Finding::DcLinkMains { .. }
             | Finding::ElectricalFrequency { .. } => Severity::Warning,
         }
     }
@@ -335,7 +364,7 @@ impl Finding {
             Finding::BackEmf { ratio } if ratio > 300.0 => EMF_KEYS_DC_FIRST,
             Finding::BackEmf { .. } => EMF_KEYS,
             Finding::DcLinkOversized { .. } => DC_LINK_KEYS,
-            Finding::DcLinkShort { .. } => DC_LINK_SHORT_KEYS,
+            Finding::DcLinkShort { .. } | Finding::DcLinkMains { .. } => DC_LINK_SHORT_KEYS,
             Finding::Reactance { key, .. } => {
                 if key == "ld" {
                     &["ld", "rated_current", "flux_linkage"]
@@ -388,6 +417,7 @@ impl Finding {
             | Finding::RatingScale { .. }
             | Finding::Inertia { .. }
             | Finding::DcLinkShort { .. }
+            | Finding::DcLinkMains { .. }
             | Finding::ElectricalFrequency { .. } => "plausible values",
             Finding::Friction { .. } => {
                 "a friction torque at rated speed below the rated torque (N·m·s/rad)"
