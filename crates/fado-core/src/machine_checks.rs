@@ -11,7 +11,7 @@
 //! | check | quantity | warning | error |
 //! |---|---|---|---|
 //! | range | each field | — | beyond any motor ([`RANGES`]) |
-//! | torque | T_rated / 1.5·p·λf·I (error), / MTPA torque (warning) | outside 0.6–1.3 (rms for peak: 1.41; λf line-to-line: 0.58; inside it, a slip whose undoing brings it within 0.9–1.1) | outside 0.3–3; 0.4–0.55 of the MTPA torque with even p: a pole count |
+//! | torque | T_rated / 1.5·p·λf·I (error), / MTPA torque (warning) | outside 0.6–1.3 (rms for peak: 1.41; λf line-to-line: 0.58; λf from Kt per A rms taken as peak: 0.71; inside it, a slip whose undoing brings it within 0.9–1.1) | outside 0.3–3; 0.4–0.55 of the MTPA torque with even p: a pole count |
 //! | DC link range | Vdc | — | beyond any drive (checked after the machine's own fields) |
 //! | back-EMF | ω·λf / (Vdc/√3) | — | above 2 |
 //! | DC link | \|v_rated\| / (Vdc/√3) | below 0.2, above [`DC_LINK_SHORT`] (mains rms for the link? no-load speed? `rs`, `ld`, `lq` line-to-line?); above [`MAINS_LINK_RATIO`] on a link of a mains' rms voltage ([`MAINS_RMS`]) | below 0.1 (ratings / 10?) |
@@ -30,7 +30,9 @@
 //! the model's torque closest to the rating. On a salient rotor the reluctance torque makes
 //! the ratio move less than the slip's factor (λf given rms on the 2.2 kW IPMSM: 1.29, inside
 //! the wide band), so a ratio of 1.2–1.3 that the undone rms slip brings within 0.9–1.1 is
-//! reported too. Below 1 it names a line-to-line λf on a rotor with Lq/Ld ≈ 3 (0.79, undone 1.00)
+//! reported too. Below 1 it names a λf √2 too large (a torque constant per A rms converted as
+//! per A peak: 0.71 on a surface-magnet rotor) and a line-to-line λf on a rotor with Lq/Ld ≈ 3
+//! (0.79, undone 1.00)
 //! on a model with constant inductances ([`LINE_TO_LINE_BELOW`]); a saturated machine entered
 //! without its saturation (0.7–0.85) can land there too, and the warning says so.
 //!
@@ -162,6 +164,7 @@ fn likely_slip(m: &MachineModel<f64>) -> (TorqueSlip, f64) {
     for (slip, undone) in [
         (TorqueSlip::Rms, with_flux(sqrt2)),
         (TorqueSlip::LineToLine, with_flux(1.0 / sqrt3)),
+        (TorqueSlip::KtRms, with_flux(1.0 / sqrt2)),
         (TorqueSlip::PoleCount, with_pole_pairs(m.pole_pairs / 2)),
         (
             TorqueSlip::PolePairsHalved,
@@ -447,23 +450,26 @@ fn check_torque(m: &MachineModel<f64>, out: &mut impl Sink) {
             ratio: magnet,
             severity: Severity::Error,
             slip: likely_slip(m).0,
+            flux_linkage: m.flux_linkage,
         });
     } else if !(0.6..=TORQUE_WARNING_HIGH).contains(&ratio) {
         out.push(Finding::Torque {
             ratio,
             severity: Severity::Warning,
             slip: likely_slip(m).0,
+            flux_linkage: m.flux_linkage,
         });
     } else if ratio > 1.2 || (ratio < LINE_TO_LINE_BELOW && m.magnetics.is_linear()) {
         // Inside the wide band, but undoing the rms or line-to-line slip brings it to 0.9–1.1.
         let slip = likely_slip(m).0;
         if (ratio > 1.2 && slip == TorqueSlip::Rms)
-            || (ratio < 1.0 && slip == TorqueSlip::LineToLine)
+            || (ratio < 1.0 && matches!(slip, TorqueSlip::LineToLine | TorqueSlip::KtRms))
         {
             out.push(Finding::Torque {
                 ratio,
                 severity: Severity::Warning,
                 slip,
+                flux_linkage: m.flux_linkage,
             });
         }
     }

@@ -11,6 +11,9 @@ pub enum TorqueSlip {
     Rms,
     /// λf from a line-to-line constant: √3 too large.
     LineToLine,
+    /// λf √2 too large: a torque constant per A rms (a datasheet's Kt) converted as per A
+    /// peak, λf = Kt/(1.5·p) where Kt/(1.5·√2·p) is meant.
+    KtRms,
     /// The pole count given for the pole pairs: twice too many.
     PoleCount,
     /// Half the pole pairs (a sheet's pole-pair count read as the poles): the model is half
@@ -61,6 +64,8 @@ pub enum Finding {
         severity: Severity,
         /// The likeliest slip.
         slip: TorqueSlip,
+        /// λf as given, Wb (the text gives it with the slip undone).
+        flux_linkage: f64,
     },
     /// The viscous friction takes a large share of the rated torque at rated speed.
     Friction {
@@ -353,7 +358,11 @@ impl Finding {
                 ..
             }
             | Finding::Torque {
-                slip: TorqueSlip::KeVllRms | TorqueSlip::KeVllPeak | TorqueSlip::VoltsPerHertz,
+                slip:
+                    TorqueSlip::KeVllRms
+                    | TorqueSlip::KeVllPeak
+                    | TorqueSlip::VoltsPerHertz
+                    | TorqueSlip::KtRms,
                 ..
             } => TORQUE_KEYS_FLUX_FIRST,
             Finding::Torque {

@@ -821,3 +821,59 @@ fn a_dc_link_given_as_the_mains_rms_voltage_is_named_with_the_rectified_link() {
     };
     assert!(check(&odd, None).is_empty(), "{}", first(&odd, None));
 }
+
+/// A torque constant per A rms converted as per A peak (λf = Kt/(1.5·p), √2 too large): the
+/// 1FT6084 servo (Kt 0.7355 N·m/A peak) and the 400 W servo then have a rated torque 0.71 ×
+/// the model's, inside the wide band; the warning names `flux_linkage` with the value
+/// undone. A line-to-line λf (0.58) stays named as such.
+#[test]
+fn a_flux_linkage_from_a_kt_per_ampere_rms_taken_as_peak_is_named_with_its_value() {
+    let servo = MachineModel::<f64> {
+        rs: 0.268,
+        ld: 2.2e-3,
+        lq: 2.2e-3,
+        flux_linkage: 0.12258,
+        pole_pairs: 4,
+        inertia: 0.0146,
+        viscous_friction: 0.0,
+        rated_current: 19.0,
+        rated_speed_rpm: 4500.0,
+        rated_torque: 14.0,
+        dc_voltage: 800.0,
+        magnetics: Default::default(),
+    };
+    for m in [servo, servo_400w()] {
+        let kt = MachineModel {
+            flux_linkage: m.flux_linkage * 2f64.sqrt(),
+            ..m
+        };
+        let f = first(&kt, None);
+        assert!(
+            matches!(
+                f,
+                Finding::Torque {
+                    slip: TorqueSlip::KtRms,
+                    ..
+                }
+            ),
+            "{f}"
+        );
+        assert_eq!((f.key(), f.severity()), ("flux_linkage", Severity::Warning));
+        let text = f.to_string();
+        assert!(
+            text.contains(" × the torque") && text.contains("kt_nm_per_arms"),
+            "{text}"
+        );
+        assert!(
+            text.contains(&std::format!("flux_linkage = {:e} Wb", m.flux_linkage)),
+            "{text}"
+        );
+    }
+    let ll = MachineModel {
+        flux_linkage: servo.flux_linkage * 3f64.sqrt(),
+        ..servo
+    };
+    let f = first(&ll, None);
+    assert!(matches!(f, Finding::Torque { .. }), "{f}");
+    assert!(f.to_string().contains("line-to-line constant"), "{f}");
+}

@@ -24,6 +24,7 @@ fn write_torque(
     ratio: f64,
     severity: Severity,
     slip: TorqueSlip,
+    flux_linkage: f64,
 ) -> fmt::Result {
     if severity == Severity::Error {
         write!(
@@ -55,6 +56,15 @@ fn write_torque(
             return f.write_str(
                 ": `flux_linkage` in V/Hz (2π·λf, a \"rated flux\" of TI's InstaSPIN) where Wb \
                  is meant? λf = the V/Hz value / 2π",
+            );
+        }
+        TorqueSlip::KtRms => {
+            return write!(
+                f,
+                ": `flux_linkage` √2 too large, from a torque constant per A rms converted as \
+                 per A peak (λf = Kt/(1.5·p) where Kt/(1.5·√2·p) is meant)? flux_linkage = \
+                 {:e} Wb (or give Kt as `kt_nm_per_arms`)",
+                flux_linkage / core::f64::consts::SQRT_2
             );
         }
         TorqueSlip::PolePairsHalved => {
@@ -340,7 +350,8 @@ impl fmt::Display for Finding {
                 ratio,
                 severity,
                 slip,
-            } => write_torque(f, ratio, severity, slip),
+                flux_linkage,
+            } => write_torque(f, ratio, severity, slip, flux_linkage),
             Finding::RatingScale { .. } => write_scale(f, self),
             Finding::ElectricalFrequency { frequency } => write!(
                 f,
