@@ -549,4 +549,6 @@ pub mod scale;
 mod text;
 
 #[cfg(test)]
+mod slip_tests;
+#[cfg(test)]
 mod tests;

@@ -200,11 +200,15 @@ pub fn low_speed_limit(per_unit: f64) -> f64 {
 }
 
 /// The text of [`Finding::Resistance`]: the per-unit drop and the likely slip.
-fn write_resistance(
-    f: &mut fmt::Formatter<'_>,
-    per_unit: f64,
-    line_to_line: Option<f64>,
-) -> fmt::Result {
+fn write_resistance(f: &mut fmt::Formatter<'_>, finding: &Finding) -> fmt::Result {
+    let Finding::Resistance {
+        per_unit,
+        line_to_line,
+        ..
+    } = *finding
+    else {
+        return Ok(());
+    };
     write!(
         f,
         "`rs` drops {per_unit:.3} × the rated back-EMF at `rated_current` (Rs·I/(ω·λf) from \
@@ -377,11 +381,7 @@ impl fmt::Display for Finding {
             | Finding::DcLinkShort { .. }
             | Finding::DcLinkMains { .. } => write_dc_link(f, self),
             Finding::Reactance { key, per_unit, .. } => write_reactance(f, key, per_unit),
-            Finding::Resistance {
-                per_unit,
-                line_to_line,
-                ..
-            } => write_resistance(f, per_unit, line_to_line),
+            Finding::Resistance { .. } => write_resistance(f, self),
             Finding::TimeConstant { tau } => write!(
                 f,
                 "the electrical time constant min(`ld`, `lq`)/`rs` is {tau:.3} s, unusually long \
