@@ -10,7 +10,7 @@
 //! | voltage beyond the bound | over 1 % of samples with \|v\| ≥ the plausible voltage | mV for V, the current columns in the voltage slots |
 //! | voltage too small | max \|v\| < 0.1 × R̂s·max \|i\| while current flows | kV for V |
 //! | constant column | every sample of one column equal while its partner varies | a dead channel, a column taken twice |
-//! | non-finite samples | over 1 % of samples NaN or ±∞, or a run of them lasting [`BURST_SECONDS`] or more | a gap in the logger |
+//! | non-finite samples | over 1 % of samples NaN or ±∞, or a run of them lasting 1 ms or more (`BURST_SECONDS`) | a gap in the logger |
 //! | start angle | \|θ0\| > 2π | degrees for radians |
 //! | voltage equation | the active flux misfits λf, and fits with a slip undone | the currents' sign reversed, the voltage and current columns exchanged, the currents' (or the voltages') α and β exchanged ([`crate::recording_model`]) |
 //! | voltage equation | the active flux misfits λf in every reading | another machine's parameters, a unit slip in `rs`, `ld`, `lq` or `flux_linkage`, a saturating machine without its magnetic model |
