@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 import warnings
 
+import numpy as np
 import pytest
 
 import fado
@@ -78,3 +79,56 @@ def test_a_line_to_line_flux_on_a_salient_ipm_is_a_warning_naming_it() -> None:
     with pytest.warns(UserWarning, match="line-to-line") as record:
         fado.Machine(**dict(GEM, flux_linkage=0.066 * math.sqrt(3.0)))
     assert any("`flux_linkage`" in str(w.message) for w in record)
+
+
+def test_a_dc_link_given_as_the_mains_rms_voltage_warns_with_the_rectified_link() -> None:
+    # motors/servo-1ft6084.toml on "400 V" (its drive's mains) where its 565 V link is meant:
+    # the rated point needs 1.08 of 400 V's linear range (0.76 of 565 V's).
+    servo = fado.Machine.preset("servo-1ft6084")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        servo.replace(dc_voltage=420.0)  # no mains' voltage: a link like any other
+    with pytest.warns(UserWarning, match="mains' rms voltage") as record:
+        servo.replace(dc_voltage=400.0)
+    text = " ".join(str(w.message) for w in record)
+    assert "dc_voltage = 566?" in text, text
+
+
+def test_a_winding_given_line_to_line_names_its_phase_values() -> None:
+    # motors/ipmsm-2k2.toml with rs, ld, lq between two terminals (2 × the phase's): its
+    # rated point then needs 1.22 × its 540 V link's linear range.
+    ipm = fado.Machine.preset("ipmsm-2k2")
+    with pytest.warns(UserWarning, match="line-to-line") as record:
+        ipm.replace(rs=2 * ipm.rs, ld=2 * ipm.ld, lq=2 * ipm.lq)
+    text = " ".join(str(w.message) for w in record)
+    assert "rs = 3.6e0 Ω, ld = 3.6e-2 H, lq = 5.1e-2 H" in text, text
+
+
+def test_a_burst_of_nan_in_a_recording_warns_naming_the_column_and_where() -> None:
+    # 50 NaN in a row (5 ms at 10 kHz, 0.9 % of the samples: below the share that warns
+    # alone); a single glitch per column, as an ADC gives, does not warn.
+    rng = np.random.default_rng(3)
+    signals = [rng.normal(size=5500) * 0.1 for _ in range(4)]
+    signals[2][700] = np.nan
+    with warnings.catch_warnings(record=True) as record:
+        warnings.simplefilter("always")
+        fado.estimate(*signals, machine="paper")
+    assert not [w for w in record if "non-finite" in str(w.message)], record
+    signals[1][1000:1050] = np.nan
+    with pytest.warns(UserWarning, match="non-finite") as record:
+        out = fado.estimate(*signals, machine="paper")
+    text = " ".join(str(w.message) for w in record if "non-finite" in str(w.message))
+    assert "`v_beta` has 50 non-finite" in text and "from sample 1000 (5.0000 ms)" in text, text
+    assert "`i_alpha`" not in text, text
+    assert np.count_nonzero(out.input_fault) == 51
+
+
+def test_a_signal_of_another_length_is_the_one_named() -> None:
+    rng = np.random.default_rng(4)
+    signals = [rng.normal(size=64) for _ in range(4)]
+    with pytest.raises(fado.InputError, match="length 63 differs from v_beta's length 64") as e:
+        fado.estimate(signals[0][:-1], *signals[1:], machine="paper")
+    assert e.value.argument == "v_alpha"
+    with pytest.raises(fado.InputError) as e:
+        fado.estimate(*signals[:3], signals[3][:-1], machine="paper")
+    assert e.value.argument == "i_beta"

@@ -167,6 +167,21 @@ fn check_layout(argument: &str, array: &Bound<'_, PyUntypedArray>) -> PyResult<(
     Ok(())
 }
 
+/// The signal whose length differs, and a signal to compare it with: the one whose length
+/// the other three share (v_α's length differing from three equal ones names v_α), else the
+/// first that differs from v_α's. `None` when all four are equal.
+fn odd_length(lengths: &[usize; 4]) -> Option<(usize, usize)> {
+    let shared = |k: usize| lengths.iter().filter(|&&n| n == lengths[k]).count();
+    let differs = (1..4).find(|&k| lengths[k] != lengths[0])?;
+    match (0..4).find(|&k| shared(k) == 1) {
+        Some(odd) if (0..4).any(|k| shared(k) == 3) => {
+            let reference = (0..4).find(|&k| k != odd).unwrap_or(0);
+            Some((odd, reference))
+        }
+        _ => Some((differs, 0)),
+    }
+}
+
 /// The four signals of a recording, checked to have equal lengths.
 pub struct Signals<'py> {
     columns: [Column<'py>; 4],
@@ -190,20 +205,17 @@ impl<'py> Signals<'py> {
             column(SIGNAL_NAMES[2], i_alpha)?,
             column(SIGNAL_NAMES[3], i_beta)?,
         ];
-        let n = columns[0].slice().len();
-        for (name, c) in SIGNAL_NAMES.iter().zip(&columns).skip(1) {
-            let len = c.slice().len();
-            if len != n {
-                return Err(input_error(
-                    py,
-                    name,
-                    format!(
-                        "length {len} differs from {}'s length {n}; all four signals must \
-                         have one sample per sampling period",
-                        SIGNAL_NAMES[0]
-                    ),
-                ));
-            }
+        let lengths = [0, 1, 2, 3].map(|k| columns[k].slice().len());
+        if let Some((odd, reference)) = odd_length(&lengths) {
+            return Err(input_error(
+                py,
+                SIGNAL_NAMES[odd],
+                format!(
+                    "length {} differs from {}'s length {}; all four signals must have one \
+                     sample per sampling period",
+                    lengths[odd], SIGNAL_NAMES[reference], lengths[reference]
+                ),
+            ));
         }
         Ok(Self { columns })
     }

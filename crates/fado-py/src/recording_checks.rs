@@ -10,7 +10,7 @@
 //! | voltage beyond the bound | over 1 % of samples with \|v\| ≥ the plausible voltage | mV for V, the current columns in the voltage slots |
 //! | voltage too small | max \|v\| < 0.1 × R̂s·max \|i\| while current flows | kV for V |
 //! | constant column | every sample of one column equal while its partner varies | a dead channel, a column taken twice |
-//! | non-finite samples | over 1 % of samples NaN or ±∞ | a gap in the logger |
+//! | non-finite samples | over 1 % of samples NaN or ±∞, or a run of them lasting 1 ms or more (`BURST_SECONDS`) | a gap in the logger |
 //! | start angle | \|θ0\| > 2π | degrees for radians |
 //! | voltage equation | the active flux misfits λf, and fits with a slip undone | the currents' sign reversed, the voltage and current columns exchanged, the currents' (or the voltages') α and β exchanged ([`crate::recording_model`]) |
 //! | voltage equation | the active flux misfits λf in every reading | another machine's parameters, a unit slip in `rs`, `ld`, `lq` or `flux_linkage`, a saturating machine without its magnetic model |
@@ -24,6 +24,50 @@ use crate::inputs::{ColumnSlice, SIGNAL_NAMES, Signals};
 
 /// Share of samples above which refused samples are reported: 1 %.
 const REFUSED_SHARE: f64 = 0.01;
+
+/// Duration of a run of consecutive non-finite samples in one column from which it is
+/// reported whatever its share: 1 ms (10 samples at 10 kHz). A glitching ADC gives single
+/// samples; a run is a gap in the logger, over which the estimator coasts on its speed
+/// estimate with no flux measured.
+const BURST_SECONDS: f64 = 1e-3;
+
+/// The longest run of consecutive non-finite samples of `c`: (first sample, length).
+fn longest_burst(c: &[f64]) -> (usize, usize) {
+    let (mut best, mut start, mut len) = ((0, 0), 0, 0);
+    for (k, x) in c.iter().enumerate() {
+        if x.is_finite() {
+            len = 0;
+            continue;
+        }
+        if len == 0 {
+            start = k;
+        }
+        len += 1;
+        if len > best.1 {
+            best = (start, len);
+        }
+    }
+    best
+}
+
+/// The non-finite samples of column `k`: a finding when they are over [`REFUSED_SHARE`] of
+/// the samples or a run of them lasts [`BURST_SECONDS`] or more (`ts` the sampling period).
+fn non_finite(c: &[f64], k: usize, ts: f64, out: &mut Vec<String>) {
+    let n = c.len();
+    let bad = c.iter().filter(|x| !x.is_finite()).count();
+    let (first, run) = longest_burst(c);
+    let burst = run > 1 && run as f64 * ts >= BURST_SECONDS * (1.0 - 1e-9);
+    if bad as f64 > REFUSED_SHARE * n as f64 || burst {
+        out.push(format!(
+            "`{}` has {bad} non-finite samples of {n} ({:.1} %), the longest run {run} \
+             samples from sample {first} ({:.4} ms): each is refused as a measurement fault \
+             and the estimator coasts over them on its speed estimate (a gap in the logger?)",
+            SIGNAL_NAMES[k],
+            100.0 * bad as f64 / n as f64,
+            1e3 * run as f64 * ts
+        ));
+    }
+}
 
 /// The samples of `c` as f64.
 fn values(c: ColumnSlice<'_>) -> Vec<f64> {
@@ -66,15 +110,7 @@ pub fn findings(
     }
     let cols: Vec<Vec<f64>> = signals.slices().into_iter().map(values).collect();
     for (k, c) in cols.iter().enumerate() {
-        let bad = c.iter().filter(|x| !x.is_finite()).count();
-        if bad as f64 > REFUSED_SHARE * n as f64 {
-            out.push(format!(
-                "`{}` has {bad} non-finite samples of {n} ({:.1} %): each is refused as a \
-                 measurement fault and the estimator coasts over them",
-                SIGNAL_NAMES[k],
-                100.0 * bad as f64 / n as f64
-            ));
-        }
+        non_finite(c, k, ts, &mut out);
     }
     constant_columns(&cols, &mut out);
     magnitudes(&cols, bounds, m.rs, &mut out);

@@ -2,8 +2,9 @@
 //! and `[motor] flux_map = "FILE.csv"` (a flux map), and the flux-map CSV format read and
 //! written.
 //!
-//! **The CSV format.** The header `i_d,i_q,psi_d,psi_q`, then one row per node of a
-//! rectangular grid in any order: SI peak values in the rotor frame (d on the magnet, ψd = λf
+//! **The CSV format.** The header `i_d,i_q,psi_d,psi_q` (the four names in any order, each
+//! row's values in the header's order; a trailing comma on every line is read as an empty
+//! last column), then one row per node of a rectangular grid in any order: SI peak values in the rotor frame (d on the magnet, ψd = λf
 //! at zero current). Lines starting with `#` and blank lines are ignored. A row that does not
 //! parse, a non-finite value, a node given twice or missing (a ragged grid) and a map not
 //! strictly increasing in its own current (it has no inverse i(ψ)) are refused as
@@ -258,51 +259,87 @@ impl<'a> Lines<'a> {
 /// One data row: the four values and the line they are on.
 type Row = ([f64; 4], usize);
 
-/// Checks the header; returns its line.
+/// Where each of [`HEADER`]'s four columns is in the file, and whether every record ends
+/// with an empty field (a trailing comma, as some spreadsheets export).
+#[derive(Clone, Copy)]
+struct Columns {
+    at: [usize; 4],
+    trailing_comma: bool,
+}
+
+/// The columns of a header: its names are [`HEADER`]'s in any order (a tool that writes i_q
+/// first), optionally followed by one empty name (a trailing comma).
+fn columns(got: &[&str]) -> Option<Columns> {
+    let trailing_comma = got.len() == HEADER.len() + 1 && got.last() == Some(&"");
+    let names = if trailing_comma {
+        &got[..HEADER.len()]
+    } else {
+        got
+    };
+    if names.len() != HEADER.len() {
+        return None;
+    }
+    let mut at = [0; 4];
+    for (slot, name) in at.iter_mut().zip(HEADER) {
+        *slot = names.iter().position(|&n| n == name)?;
+    }
+    Some(Columns { at, trailing_comma })
+}
+
+/// Checks the header; returns its line and where each column is.
 fn read_header(
     reader: &mut csv::Reader<&[u8]>,
     lines: &Lines,
     file: &str,
-) -> Result<usize, SimConfigError> {
+) -> Result<(usize, Columns), SimConfigError> {
     let headers = reader
         .headers()
         .map_err(|e| map_error(file, 1, e.to_string()))?
         .clone();
     let line = headers.position().map_or(1, |p| lines.at(p.byte()));
     let got: Vec<&str> = headers.iter().collect();
-    if got != HEADER {
-        let joined = got.join(",");
-        let hint = if joined.contains(';') || joined.contains('\t') {
-            ": the file is separated by semicolons or tabs (a spreadsheet's export, often with \
-             decimal commas); the map is comma-separated with decimal points"
-        } else if joined.to_ascii_lowercase() == HEADER.join(",") {
-            ": the names are lower case"
-        } else {
-            ""
-        };
-        return Err(map_error(
-            file,
-            line,
-            format!("the header must be `i_d,i_q,psi_d,psi_q`, got `{joined}`{hint}"),
-        ));
+    if let Some(columns) = columns(&got) {
+        return Ok((line, columns));
     }
-    Ok(line)
+    let joined = got.join(",");
+    let hint = if joined.contains(';') || joined.contains('\t') {
+        ": the file is separated by semicolons or tabs (a spreadsheet's export, often with \
+         decimal commas); the map is comma-separated with decimal points"
+    } else if joined.to_ascii_lowercase() == HEADER.join(",") {
+        ": the names are lower case"
+    } else if joined.contains('[') || joined.contains('(') {
+        ": the names carry no units (A and Wb peak, SI)"
+    } else {
+        ""
+    };
+    Err(map_error(
+        file,
+        line,
+        format!(
+            "the header must name the columns `i_d`, `i_q`, `psi_d` and `psi_q` (in any \
+             order), got `{joined}`{hint}"
+        ),
+    ))
 }
 
-/// The data rows, every value a finite number.
+/// The data rows, every value a finite number, in [`HEADER`]'s order.
 fn read_rows(
     reader: &mut csv::Reader<&[u8]>,
     lines: &Lines,
     file: &str,
+    columns: Columns,
 ) -> Result<Vec<Row>, SimConfigError> {
     let mut rows = Vec::new();
     for record in reader.records() {
         let record = record.map_err(|e| map_error(file, lines.of(e.position()), e.to_string()))?;
         let line = lines.of(record.position());
+        if columns.trailing_comma && record.get(HEADER.len()).is_some_and(|c| !c.is_empty()) {
+            let msg = "a fifth value where the header's trailing comma leaves the column empty";
+            return Err(map_error(file, line, msg.to_string()));
+        }
         let mut v = [0.0; 4];
-        for (k, x) in v.iter_mut().enumerate() {
-            let cell = record.get(k).unwrap_or("");
-            let name = HEADER[k];
+        for ((x, name), at) in v.iter_mut().zip(HEADER).zip(columns.at) {
+            let cell = record.get(at).unwrap_or("");
             *x = cell.parse::<f64>().map_err(|_| {
                 map_error(file, line, format!("`{name}` = `{cell}` is not a number"))
             })?;
@@ -371,8 +408,8 @@ pub fn parse_flux_map(text: &str, file: &str) -> Result<FluxMapData, SimConfigEr
         .trim(csv::Trim::All)
         .from_reader(text.as_bytes());
     let lines = Lines::new(text);
-    let header_line = read_header(&mut reader, &lines, file)?;
-    let rows = read_rows(&mut reader, &lines, file)?;
+    let (header_line, columns) = read_header(&mut reader, &lines, file)?;
+    let rows = read_rows(&mut reader, &lines, file, columns)?;
     flux_map_from_rows(&rows, file, header_line)
 }
 

@@ -11,6 +11,9 @@ pub enum TorqueSlip {
     Rms,
     /// λf from a line-to-line constant: √3 too large.
     LineToLine,
+    /// λf √2 too large: a torque constant per A rms (a datasheet's Kt) converted as per A
+    /// peak, λf = Kt/(1.5·p) where Kt/(1.5·√2·p) is meant.
+    KtRms,
     /// The pole count given for the pole pairs: twice too many.
     PoleCount,
     /// Half the pole pairs (a sheet's pole-pair count read as the poles): the model is half
@@ -61,6 +64,8 @@ pub enum Finding {
         severity: Severity,
         /// The likeliest slip.
         slip: TorqueSlip,
+        /// λf as given, Wb (the text gives it with the slip undone).
+        flux_linkage: f64,
     },
     /// The viscous friction takes a large share of the rated torque at rated speed.
     Friction {
@@ -111,6 +116,19 @@ pub enum Finding {
         needed: f64,
         /// Vdc/√3, V.
         available: f64,
+        /// Vdc, V.
+        dc_voltage: f64,
+        /// The per-phase winding when `rs`, `ld` and `lq` look line-to-line: the halved
+        /// values, with which the rated point fits the link.
+        line_to_line: Option<PhaseWinding>,
+    },
+    /// The DC link is a mains' rms voltage ([`MAINS_RMS`](super::MAINS_RMS)) and the rated
+    /// point needs most of its linear range: a link rectified from those mains is √2 × it.
+    DcLinkMains {
+        /// Vdc, V.
+        dc_voltage: f64,
+        /// |v_rated| / (Vdc/√3).
+        ratio: f64,
     },
     /// An inductance is large for the rated current and flux linkage.
     Reactance {
@@ -127,6 +145,9 @@ pub enum Finding {
         per_unit: f64,
         /// Warning or error.
         severity: Severity,
+        /// Rs/2, Ω, when the resistance halved (a line-to-line value for the phase's) is
+        /// within the bound of this severity.
+        line_to_line: Option<f64>,
     },
     /// The electrical time constant is long.
     TimeConstant {
@@ -149,6 +170,18 @@ pub enum Finding {
         /// Warning or error.
         severity: Severity,
     },
+}
+
+/// A winding's per-phase values, Ω and H: those of a winding whose data look line-to-line
+/// (between two terminals of a star connection, 2 × the phase's).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PhaseWinding {
+    /// Rs, Ω.
+    pub rs: f64,
+    /// Ld, H.
+    pub ld: f64,
+    /// Lq, H.
+    pub lq: f64,
 }
 
 /// The findings of one [`check`](super::check), errors first.
@@ -292,6 +325,7 @@ impl Finding {
             | Finding::RatingScale { .. }
             | Finding::Inertia { .. }
             | Finding::DcLinkShort { .. }
+            | Finding::DcLinkMains { .. }
             | Finding::ElectricalFrequency { .. } => Severity::Warning,
         }
     }
@@ -324,7 +358,11 @@ impl Finding {
                 ..
             }
             | Finding::Torque {
-                slip: TorqueSlip::KeVllRms | TorqueSlip::KeVllPeak | TorqueSlip::VoltsPerHertz,
+                slip:
+                    TorqueSlip::KeVllRms
+                    | TorqueSlip::KeVllPeak
+                    | TorqueSlip::VoltsPerHertz
+                    | TorqueSlip::KtRms,
                 ..
             } => TORQUE_KEYS_FLUX_FIRST,
             Finding::Torque {
@@ -335,7 +373,7 @@ impl Finding {
             Finding::BackEmf { ratio } if ratio > 300.0 => EMF_KEYS_DC_FIRST,
             Finding::BackEmf { .. } => EMF_KEYS,
             Finding::DcLinkOversized { .. } => DC_LINK_KEYS,
-            Finding::DcLinkShort { .. } => DC_LINK_SHORT_KEYS,
+            Finding::DcLinkShort { .. } | Finding::DcLinkMains { .. } => DC_LINK_SHORT_KEYS,
             Finding::Reactance { key, .. } => {
                 if key == "ld" {
                     &["ld", "rated_current", "flux_linkage"]
@@ -388,6 +426,7 @@ impl Finding {
             | Finding::RatingScale { .. }
             | Finding::Inertia { .. }
             | Finding::DcLinkShort { .. }
+            | Finding::DcLinkMains { .. }
             | Finding::ElectricalFrequency { .. } => "plausible values",
             Finding::Friction { .. } => {
                 "a friction torque at rated speed below the rated torque (N·m·s/rad)"

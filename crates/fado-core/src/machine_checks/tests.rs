@@ -2,11 +2,11 @@ use super::finding::{EMF_KEYS, TORQUE_KEYS};
 use super::*;
 use std::string::ToString;
 
-fn paper() -> MachineModel<f64> {
+pub(super) fn paper() -> MachineModel<f64> {
     MachineModel::paper()
 }
 
-fn first(m: &MachineModel<f64>, ts: Option<f64>) -> Finding {
+pub(super) fn first(m: &MachineModel<f64>, ts: Option<f64>) -> Finding {
     *check(m, ts).iter().next().expect("a finding")
 }
 
@@ -142,7 +142,7 @@ fn torque_and_emf_slips_name_every_key_involved() {
 }
 
 /// The 2.2 kW IPMSM (motulator's): Lq/Ld 1.42.
-fn ipmsm() -> MachineModel<f64> {
+pub(super) fn ipmsm() -> MachineModel<f64> {
     MachineModel::<f64> {
         rs: 3.6,
         ld: 36e-3,
@@ -599,7 +599,7 @@ fn ratings_times_ten_on_small_machines_are_named_by_their_time_constant() {
 
 /// The 400 W servo of `tests/data/unseen/servo-estun-emj04-400w-310v.toml` (fado-sim): 8
 /// poles, λf 62.155 mWb, 1.27 N·m at 3.405 A peak.
-fn servo_400w() -> MachineModel<f64> {
+pub(super) fn servo_400w() -> MachineModel<f64> {
     MachineModel {
         rs: 2.3679,
         ld: 8.3655e-3,

@@ -24,6 +24,7 @@ fn write_torque(
     ratio: f64,
     severity: Severity,
     slip: TorqueSlip,
+    flux_linkage: f64,
 ) -> fmt::Result {
     if severity == Severity::Error {
         write!(
@@ -55,6 +56,15 @@ fn write_torque(
             return f.write_str(
                 ": `flux_linkage` in V/Hz (2π·λf, a \"rated flux\" of TI's InstaSPIN) where Wb \
                  is meant? λf = the V/Hz value / 2π",
+            );
+        }
+        TorqueSlip::KtRms => {
+            return write!(
+                f,
+                ": `flux_linkage` √2 too large, from a torque constant per A rms converted as \
+                 per A peak (λf = Kt/(1.5·p) where Kt/(1.5·√2·p) is meant)? flux_linkage = \
+                 {:e} Wb (or give Kt as `kt_nm_per_arms`)",
+                flux_linkage / core::f64::consts::SQRT_2
             );
         }
         TorqueSlip::PolePairsHalved => {
@@ -190,12 +200,27 @@ pub fn low_speed_limit(per_unit: f64) -> f64 {
 }
 
 /// The text of [`Finding::Resistance`]: the per-unit drop and the likely slip.
-fn write_resistance(f: &mut fmt::Formatter<'_>, per_unit: f64) -> fmt::Result {
+fn write_resistance(f: &mut fmt::Formatter<'_>, finding: &Finding) -> fmt::Result {
+    let Finding::Resistance {
+        per_unit,
+        line_to_line,
+        ..
+    } = *finding
+    else {
+        return Ok(());
+    };
     write!(
         f,
         "`rs` drops {per_unit:.3} × the rated back-EMF at `rated_current` (Rs·I/(ω·λf) from \
          `flux_linkage` and `rated_speed_rpm`; machines have 0.005–0.3)"
     )?;
+    if let Some(rs) = line_to_line {
+        write!(
+            f,
+            "; is `rs` the resistance between two terminals (line-to-line, 2 × the phase's)? \
+             rs = {rs:e} Ω per phase (or give it as `rs_line_to_line`)"
+        )?;
+    }
     if per_unit > RESISTANCE_ERROR && per_unit * 1e-3 < 0.5 {
         f.write_str(
             ": mΩ where Ω is meant, or `rated_speed_rpm` in r/s or rad/s where r/min is meant?",
@@ -221,7 +246,8 @@ fn write_resistance(f: &mut fmt::Formatter<'_>, per_unit: f64) -> fmt::Result {
     }
 }
 
-/// The text of [`Finding::DcLinkOversized`] and [`Finding::DcLinkShort`].
+/// The text of [`Finding::DcLinkOversized`], [`Finding::DcLinkShort`] and
+/// [`Finding::DcLinkMains`].
 fn write_dc_link(f: &mut fmt::Formatter<'_>, finding: &Finding) -> fmt::Result {
     match *finding {
         Finding::DcLinkOversized { ratio, .. } => write!(
@@ -231,15 +257,42 @@ fn write_dc_link(f: &mut fmt::Formatter<'_>, finding: &Finding) -> fmt::Result {
              ratings divided by 10, or the DC link the wrong one?",
             100.0 * ratio
         ),
-        Finding::DcLinkShort { needed, available } => write!(
+        Finding::DcLinkShort {
+            needed,
+            available,
+            dc_voltage,
+            line_to_line,
+        } => {
+            write!(
+                f,
+                "the rated point (`rated_speed_rpm` at `rated_current` on MTPA, from \
+                 `flux_linkage`, `ld`, `lq`, `rs`) needs {needed:.1} V phase peak, {:.2} × the \
+                 {available:.1} V the DC link `dc_voltage` makes (Vdc/√3): the drive reaches \
+                 rated speed only by field weakening, with less than rated torque there; is \
+                 `dc_voltage` the mains' rms voltage where the DC link (√2 × it, {:.0} V) is \
+                 meant, or `rated_speed_rpm` the no-load speed?",
+                needed / available,
+                dc_voltage * core::f64::consts::SQRT_2
+            )?;
+            if let Some(w) = line_to_line {
+                write!(
+                    f,
+                    " Or are `rs`, `ld` and `lq` line-to-line values (between two terminals, \
+                     2 × the phase's)? Per phase rs = {:e} Ω, ld = {:e} H, lq = {:e} H fit the \
+                     link (or give `rs_line_to_line` and `l_line_to_line`)",
+                    w.rs, w.ld, w.lq
+                )?;
+            }
+            Ok(())
+        }
+        Finding::DcLinkMains { dc_voltage, ratio } => write!(
             f,
-            "the rated point (`rated_speed_rpm` at `rated_current` on MTPA, from \
-             `flux_linkage`, `ld`, `lq`, `rs`) needs {needed:.1} V phase peak, {:.2} × the \
-             {available:.1} V the DC link `dc_voltage` makes (Vdc/√3): the drive reaches \
-             rated speed only by field weakening, with less than rated torque there; is \
-             `dc_voltage` the mains' rms voltage where the DC link (√2 × it) is meant, or \
-             `rated_speed_rpm` the no-load speed?",
-            needed / available
+            "`dc_voltage` = {dc_voltage} V is a mains' rms voltage, and the rated point \
+             (`rated_speed_rpm` at `rated_current`, from `flux_linkage`, `ld`, `lq`, `rs`) \
+             needs {:.0} % of the phase voltage it makes (Vdc/√3): if the drive is fed from \
+             {dc_voltage} V AC mains, its DC link is √2 × it: dc_voltage = {:.0}?",
+            100.0 * ratio,
+            dc_voltage * core::f64::consts::SQRT_2
         ),
         _ => Ok(()),
     }
@@ -301,7 +354,8 @@ impl fmt::Display for Finding {
                 ratio,
                 severity,
                 slip,
-            } => write_torque(f, ratio, severity, slip),
+                flux_linkage,
+            } => write_torque(f, ratio, severity, slip, flux_linkage),
             Finding::RatingScale { .. } => write_scale(f, self),
             Finding::ElectricalFrequency { frequency } => write!(
                 f,
@@ -323,9 +377,11 @@ impl fmt::Display for Finding {
                 }
             }
             Finding::Friction { .. } | Finding::Inertia { .. } => write_mechanics(f, self),
-            Finding::DcLinkOversized { .. } | Finding::DcLinkShort { .. } => write_dc_link(f, self),
+            Finding::DcLinkOversized { .. }
+            | Finding::DcLinkShort { .. }
+            | Finding::DcLinkMains { .. } => write_dc_link(f, self),
             Finding::Reactance { key, per_unit, .. } => write_reactance(f, key, per_unit),
-            Finding::Resistance { per_unit, .. } => write_resistance(f, per_unit),
+            Finding::Resistance { .. } => write_resistance(f, self),
             Finding::TimeConstant { tau } => write!(
                 f,
                 "the electrical time constant min(`ld`, `lq`)/`rs` is {tau:.3} s, unusually long \

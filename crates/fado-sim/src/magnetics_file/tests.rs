@@ -46,6 +46,39 @@ fn a_flux_map_file_is_read_in_any_row_order_and_bad_ones_are_refused_at_their_li
 }
 
 #[test]
+fn a_header_in_another_order_a_trailing_comma_a_bom_and_exponents_read_the_same_map() {
+    let text =
+        "i_d,i_q,psi_d,psi_q\n-5,-1,0.40,-0.05\n-5,1,0.40,0.05\n0,-1,0.60,-0.05\n0,1,0.60,0.05\n";
+    let want = parse_flux_map(text, "m.csv").unwrap();
+    // The columns by name: i_q first, ψq before ψd (each row in its header's order).
+    let swapped =
+        "i_q,i_d,psi_q,psi_d\n-1,-5,-0.05,0.40\n1,-5,0.05,0.40\n-1,0,-0.05,0.60\n1,0,0.05,0.60\n";
+    // A spreadsheet's trailing comma on every line, a UTF-8 BOM, exponents and spaces.
+    let trailing = text.replace('\n', ",\n");
+    let bom = format!("\u{feff}{text}");
+    let sci = "i_d,i_q,psi_d,psi_q\n-5e0, -1E0, 4.0e-1, -5e-2\n-5,1,0.40,0.05\n0,-1,6E-1,-0.05\n0,1,0.60,0.05\n";
+    for variant in [swapped, trailing.as_str(), bom.as_str(), sci] {
+        let got = parse_flux_map(variant, "m.csv").unwrap_or_else(|e| panic!("{e}\n{variant}"));
+        assert_eq!(got.map().i_d(), want.map().i_d(), "{variant}");
+        assert_eq!(got.map().i_q(), want.map().i_q(), "{variant}");
+        let at = Dq::new(-2.5, 0.5);
+        assert_eq!(
+            MagneticModel::flux(&got.map(), at),
+            MagneticModel::flux(&want.map(), at),
+            "{variant}"
+        );
+    }
+    let err = |t: &str| parse_flux_map(t, "m.csv").unwrap_err().to_string();
+    // A value in the trailing comma's empty column, a name twice, units in the names.
+    let fifth = trailing.replacen("0.05,\n", "0.05,7\n", 1);
+    assert!(err(&fifth).contains("fifth value"), "{}", err(&fifth));
+    let twice = text.replacen("psi_q", "psi_d", 1);
+    assert!(err(&twice).contains("any order"), "{}", err(&twice));
+    let units = text.replacen("psi_d,", "psi_d [Wb],", 1);
+    assert!(err(&units).contains("no units"), "{}", err(&units));
+}
+
+#[test]
 fn a_crlf_file_with_comments_and_blank_lines_is_refused_at_its_own_line() {
     // A lab's export: CRLF line ends, comments and a blank line before the header, a blank
     // line inside; the bad value is on line 8 whatever the line ends.
