@@ -51,7 +51,7 @@ for name in $machines; do
     "$bin" commission --config "$out/$name-plant-$seed.toml" --seed "$seed" --out "$d" \
       > "$d.log" 2>&1 || true
     if [[ ! -f "$d/identified.toml" ]]; then
-      echo "| $name | commissioned | $seed | not identified: $(tail -c 300 "$d.log" | tr '\n' ' ') | | |"
+      echo "| $name | commissioned | $seed | not identified: $(head -1 "$d.log") | | |"
       continue
     fi
     row="| $name | commissioned | $seed"

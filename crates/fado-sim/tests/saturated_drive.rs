@@ -213,7 +213,9 @@ fn motulator_small_high_saliency_ipmsm_passes_every_seed() {
             [controller.speed] bandwidth_hz = 4 (default 5) reversal passes every seed \
             (0.056–0.131 rad) but rated-reversal still loses the angle on every seed; with 3 \
             rated-reversal holds it on seeds 1–2 (0.14, 0.28 rad; 38 r/min) and loses it on \
-            3–4"]
+            3–4. With [estimator.tracker] t2s2_bandwidth_hz = 60 (default 35) reversal \
+            (0.030–0.063 rad, 4.4 r/min) and stops pass on every seed, rated-reversal loses \
+            the angle on every seed"]
 fn motulator_ferrite_pm_syrm_passes_every_seed() {
     passes_every_seed(&motulator_machine("mot-pmsyrm-4k"));
 }
