@@ -153,7 +153,7 @@ mod tests;
 pub use measure::{ratio_of, resistance_of};
 pub use motion::{
     LOOP_MOTION_FACTOR, LOOP_WINDOW_FACTOR, LOOP_WINDOW_TIME, MOTION_FILTER_TIME,
-    MOTION_SPEED_RATIO, MOTION_TRAVEL_SHARE, motion_voltage,
+    MOTION_NOISE_MARGIN, MOTION_SPEED_RATIO, MOTION_TRAVEL_SHARE, motion_voltage,
 };
 
 use crate::control::snapshot_window::SnapshotWindow;
@@ -308,7 +308,10 @@ pub struct GainCalibration<T> {
     /// back-EMF across the axis that ended it (V).
     motion_current: T,
     motion_emf: T,
-    /// The largest |back-EMF across the axis| read since the start, over `motion_voltage`.
+    /// The voltage-mode motion threshold's floor from the sensors' noise (V,
+    /// [`GainCalibration::motion_noise_floor`]).
+    noise_floor: T,
+    /// The largest |back-EMF across the axis| read since the start, over its threshold.
     motion_peak: T,
     /// The same, of the stages under the current loop.
     loop_motion_peak: T,
@@ -395,6 +398,7 @@ impl<T: Real> GainCalibration<T> {
             motion_flux: T::zero(),
             motion_current: T::zero(),
             motion_emf: T::zero(),
+            noise_floor: T::zero(),
             motion_peak: T::zero(),
             loop_motion_peak: T::zero(),
             window_flux: T::zero(),

@@ -65,6 +65,7 @@ impl<T: Real> GainCalibration<T> {
         self.motion_flux = T::zero();
         self.motion_current = T::zero();
         self.motion_emf = T::zero();
+        self.noise_floor = T::zero();
         self.motion_peak = T::zero();
         self.loop_motion_peak = T::zero();
         self.loop_window_peak = T::zero();
