@@ -182,6 +182,16 @@ pub struct GainCalibrationConfig<T> {
     pub max_hold_time: T,
     /// Averaging window of each level, s; 0 disables the calibration.
     pub window_time: T,
+    /// The averaging window (s) the rotor's swing left after the hold needs along an axis
+    /// whose phases a and b both carry the share `min_observability` (the swing's bias bound,
+    /// [`DriveConfig::gain_calibration_config`](crate::control::DriveConfig::gain_calibration_config));
+    /// 0 where `window_time` meets it. The bias on each phase's conductance scales as
+    /// 1/share, so along the calibration's axis, shares s_a and s_b, the swing needs
+    /// s_min·(1/s_a + 1/s_b)/2 of it ([`GainCalibration::swing_window_share`]): each level is
+    /// averaged over the longer of that and `window_time`, and an axis that needs more than
+    /// `max_hold_time` is not calibrated ([`GainCalibrationStatus::TooSlow`]; as is a
+    /// non-finite one).
+    pub swing_window_time: T,
     /// Smallest share min(|cos φ|, |cos(φ − 2π/3)|) of the axis current in phases a and b,
     /// and |cos(φ + 2π/3)| in phase c, with which the calibration runs, in [0, 1).
     pub min_observability: T,
@@ -277,6 +287,9 @@ pub struct GainCalibration<T> {
     /// Settling or hold beyond `max_hold_time`: skipped.
     too_slow: bool,
     window_samples: u32,
+    /// The window of the present (or last) start: `window_samples`, or the longer one the
+    /// swing needs along its axis.
+    window_run: u32,
     stage: Stage,
     /// Samples left in the current stage.
     remaining: u32,
@@ -382,6 +395,7 @@ impl<T: Real> GainCalibration<T> {
             unsettled: false,
             too_slow,
             window_samples,
+            window_run: window_samples,
             stage: Stage::Idle,
             remaining: 0,
             axis: Ab::new(T::one(), T::zero()),
@@ -417,12 +431,12 @@ impl<T: Real> GainCalibration<T> {
     }
 
     /// The whole sequence's duration in samples when it runs: settle at I₁, hold and window
-    /// at each level, release.
+    /// at each level (the window of the last start, the configured one before any), release.
     pub fn duration_samples(&self) -> u32 {
         self.settle_samples
             .saturating_mul(2)
             .saturating_add(self.hold_samples.saturating_mul(2))
-            .saturating_add(self.window_samples.saturating_mul(2))
+            .saturating_add(self.window_run.saturating_mul(2))
     }
 
     /// Arms the calibration (unless disabled): it starts at the next [`step`](Self::step).
@@ -482,6 +496,17 @@ impl<T: Real> GainCalibration<T> {
     /// start the same way, "Rs recalibration", SPRUHJ1, §"Rs Online and Rs Recalibration").
     pub fn resistance(&self) -> T {
         self.resistance
+    }
+
+    /// The share of `swing_window_time` the rotor's swing needs along the axis at `angle`
+    /// (electrical rad): s_min·(1/s_a + 1/s_b)/2 with s_a = |cos φ|, s_b = |cos(φ − 2π/3)| the
+    /// shares of phases a and b and s_min = `min_observability` (1 where both are s_min,
+    /// 0.3 at φ = 0; ∞ where a share is zero).
+    pub fn swing_window_share(&self, angle: T) -> T {
+        let (s, c) = angle.step_sin_cos_any();
+        let b = c * T::lit(PHASE_B_ALPHA) + s * T::lit(PHASE_B_BETA);
+        let half = T::lit(0.5) * self.config.min_observability;
+        half * (T::one() / c.abs() + T::one() / b.abs())
     }
 
     /// The smallest share of the axis current in any phase, min over x of |cos(φ − φ_x)|,
