@@ -185,7 +185,11 @@ fn the_eps_and_appliance_motors_hold_a_loaded_standstill() {
     let mut missed = Vec::new();
     for (name, scenarios, seeds) in [
         ("eps-nedic-12v", &["stops"][..], &[1, 2, 3, 4][..]),
-        ("appliance-chmotor-16p-310v", &["stops", "regen-stop"][..], &[1, 2][..]),
+        (
+            "appliance-chmotor-16p-310v",
+            &["stops", "regen-stop"][..],
+            &[1, 2][..],
+        ),
     ] {
         for scenario in scenarios {
             for &seed in seeds {

@@ -57,8 +57,12 @@
 //! by 2.8e-3 on the paper's motor and 2.8e-2 on a 50 kW IPMSM, against a 5e-3 mismatch (fado-sim,
 //! a rotor of huge inertia: 4e-6). In voltage mode the back-EMF drives a current through Rs
 //! that damps the swing (J·s² + c·s + K, c = 1.5·p²·λf²/Rs); each level is averaged only after
-//! a hold of several of its time constants (`hold_time`, from the drive's model), and a machine
-//! whose swing (or settling) needs more than `max_hold_time` is not calibrated
+//! a hold of several of its time constants (`hold_time`, from the drive's model), or of a
+//! shorter hold and a window long enough to average what is left of the swing, whose bias on
+//! a phase's conductance grows as 1/(its share of the axis current): that window is sized
+//! along the calibration's axis when it starts (`swing_window_time`,
+//! [`GainCalibration::swing_window_share`]). A machine whose swing (or settling) needs more
+//! than `max_hold_time` of hold or window is not calibrated
 //! ([`GainCalibrationStatus::TooSlow`]), unless a brake holds the rotor through the start-up
 //! (the drive's `startup.rotor_held`): nothing swings then, and the drive holds each level for
 //! the current's settling alone (on the 50 kW IPMSM, the 5 kW PM-SyRM, the hub motor and an
@@ -230,8 +234,8 @@ pub enum GainCalibrationStatus {
     /// (ratio unchanged, no current applied).
     Unobservable,
     /// Skipped: the rotor's swing about the d current dies out too slowly, or the current
-    /// settles too slowly (`hold_time` or `settle_time` above `max_hold_time`; ratio
-    /// unchanged, no current applied).
+    /// settles too slowly (`hold_time`, `settle_time` or the swing's window along the axis,
+    /// `swing_window_time`, above `max_hold_time`; ratio unchanged, no current applied).
     TooSlow,
     /// Measured but refused: non-finite, a non-positive conductance, too few finite samples,
     /// a current above `current_limit` in voltage mode, or |k − 1| above `max_mismatch`

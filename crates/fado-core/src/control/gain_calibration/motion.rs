@@ -61,8 +61,10 @@ pub const LOOP_WINDOW_FACTOR: f64 = 2.0;
 /// reading is the current sensors' noise and resolution through L̂q/[`MOTION_FILTER_TIME`]:
 /// on a high-inductance winding it reaches `motion_voltage` (the 16-pole 310 V appliance
 /// motor of `crates/fado-sim/tests/data/unseen/`, L·I/λf 2.4: one 3.4 mA step of its 12-bit
-/// sensor reads 0.64 of it, and the calibration ended `RotorMoved` with the rotor still,
-/// 0.002 rad turned); on the presets it stays below half of it, and the threshold is theirs.
+/// sensor reads 0.64 of it: without the floor its calibration ends `RotorMoved` with the
+/// rotor still, 0.002 rad turned, at seeds 1 and 2). Where the floor stays below
+/// `motion_voltage` the threshold is `motion_voltage`: on every linear preset's `reversal`
+/// and `stops` the runs are bit-identical with and without it.
 pub const MOTION_NOISE_MARGIN: f64 = 2.0;
 
 /// Snapshots of the loop's flux over [`LOOP_WINDOW_TIME`].
