@@ -52,7 +52,8 @@ impl<T: Real> GainCalibration<T> {
         } else {
             self.config.swing_window_time * self.swing_window_share(angle)
         };
-        if !(swing <= self.config.max_hold_time) {
+        let within = swing <= self.config.max_hold_time;
+        if !within {
             self.stage = Stage::Idle;
             self.status = GainCalibrationStatus::TooSlow;
             return false;
