@@ -224,7 +224,10 @@ fn a_42_pole_robot_joint_motor_holds_zero_speed_after_its_top_speed() {
 /// stops 0.49–0.58, rated-reversal 1.30–1.31 rad, fullrange π off (seeds 1, 2); its loaded
 /// start ends with the no-angle status. The miss is the current sensors' 0.5 % gain mismatch,
 /// which its start-up calibration leaves (`TooSlow`: the rotor's swing, 2J/c = 0.56 s, needs
-/// a 0.9 s window after the 0.2 s hold): with the gains calibrated (`startup.rotor_held`)
+/// a 0.9 s window after the 0.2 s hold at the least observable axis, 0.50 s at its 0.3 rad
+/// start, against the 0.2 s budget; with a 1 s budget it ends `RotorMoved`, at 0.78 s at seed
+/// 1 and 0.11 s at seed 2, its motion threshold 0.5 % of 100 r/min, and `reversal` reads
+/// 0.58 / 0.73 rad): with the gains calibrated (`startup.rotor_held`)
 /// `reversal` is 0.014 / 0.092 rad, with matched sensors 0.016 / 0.023 rad. The drive's
 /// online gain tracker (`fado_core::control::gain_tracking`) runs on it (R̂s·I/λ̂f 138/s) but
 /// learns only from 12/τ = 120 rad/s electrical, above its rated 100 r/min (73 rad/s):

@@ -74,7 +74,7 @@ impl<T: Real> DriveConfig<T> {
         };
         let i1 = T::lit(0.5) * i2;
         let swing = crate::real::max(swing_time_constant(m, i1), swing_time_constant(m, i2));
-        let (hold, window) = hold_and_window(m, i1, swing, t);
+        let (hold, window, swing_window) = hold_and_window(m, i1, swing, t);
         let rename = |e: ConfigError| match e {
             ConfigError::OutOfRange { field, expected } => ConfigError::OutOfRange {
                 field: gain_field(field),
@@ -98,6 +98,7 @@ impl<T: Real> DriveConfig<T> {
             hold_time: hold,
             max_hold_time: T::lit(GAIN_CALIBRATION_MAX_HOLD_TIME),
             window_time: window,
+            swing_window_time: swing_window,
             min_observability: t.gain_calibration.min_observability,
             max_mismatch: t.gain_calibration.max_mismatch,
             current_limit: self.i_max(),
@@ -244,44 +245,52 @@ fn swing_hold_time_constants<T: Real>(
     n
 }
 
-/// The hold and the averaging window (s) of each gain-calibration level: the swing's hold
-/// ([`swing_hold_time_constants`]) and the configured window where the hold fits
-/// [`GAIN_CALIBRATION_MAX_HOLD_TIME`].
-fn hold_and_window<T: Real>(m: &MachineModel<T>, i1: T, swing: T, t: &DriveTuning<T>) -> (T, T) {
+/// The hold and the averaging window (s) of each gain-calibration level, and the window the
+/// swing needs at the least observable axis the calibration runs at (0 where the configured
+/// window meets it; `swing_window_time` of
+/// [`GainCalibrationConfig`]): the swing's hold ([`swing_hold_time_constants`]) and the
+/// configured window where the hold fits [`GAIN_CALIBRATION_MAX_HOLD_TIME`].
+fn hold_and_window<T: Real>(m: &MachineModel<T>, i1: T, swing: T, t: &DriveTuning<T>) -> (T, T, T) {
     let hold = swing_hold_time_constants(m, i1, swing, t) * swing;
     let budget = T::lit(GAIN_CALIBRATION_MAX_HOLD_TIME);
+    let w0 = t.gain_calibration.time;
     // A brake that holds the rotor (`startup.rotor_held`) leaves no swing to wait for:
     // where the swing's hold would exceed the budget and skip the calibration, the levels
     // are held for the current's settling alone (measured: the 8-pole traction IPMSM of
     // `crates/fado-sim/tests/data/traction-ipm-saturated.toml`, swing hold 0.61 s,
     // `crates/fado-sim/tests/gain_calibration.rs`). Elsewhere a hold beyond the budget
-    // is cut to it where a window of at most the budget meets the swing's bias bound
-    // ([`traded_window`]).
+    // is cut to it and traded for a longer window ([`traded_window`]): within the budget at
+    // every observable axis it is the window; beyond, the calibration sizes it from its
+    // axis when it starts, and skips an axis that needs more than the budget.
     if t.startup.rotor_held && hold > budget {
-        (T::zero(), t.gain_calibration.time)
+        (T::zero(), w0, T::zero())
     } else if hold > budget {
         match traded_window(m, i1, swing, t) {
-            Some(window) => (budget, window),
-            None => (hold, t.gain_calibration.time),
+            Some(window) if window <= budget => (budget, window, window),
+            Some(window) => (budget, w0, window),
+            None => (hold, w0, T::zero()),
         }
     } else {
-        (hold, t.gain_calibration.time)
+        (hold, w0, T::zero())
     }
 }
 
 /// The averaging window (s) that meets the swing's bias bound of
-/// [`swing_hold_time_constants`] with the hold cut to [`GAIN_CALIBRATION_MAX_HOLD_TIME`], if
-/// it is at most that budget too; `None` otherwise (the calibration is then skipped,
-/// `TooSlow`). The bound e^(−n) ≤ ε·R̂s·I₁·s_min·W/(3.46·λ̂f) is linear in the window W: the
-/// budget's n_b = budget/τ time constants need W = W₀·e^(−n_b)/bound(W₀), W₀ the configured
-/// `gain_calibration.time` (never shorter than W₀; none without a configured window). A
-/// window grows only on a rotor whose resistive drop is large against its magnet flux
-/// (R̂s·I₁/λ̂f): the 42-pole robot-joint
+/// [`swing_hold_time_constants`] with the hold cut to [`GAIN_CALIBRATION_MAX_HOLD_TIME`] at
+/// an axis whose phases a and b carry the least share the calibration runs at
+/// (`gain_calibration.min_observability`); `None` without a configured window. The bound
+/// e^(−n) ≤ ε·R̂s·I₁·s_min·W/(3.46·λ̂f) is linear in the window W: the budget's n_b =
+/// budget/τ time constants need W = W₀·e^(−n_b)/bound(W₀), W₀ the configured
+/// `gain_calibration.time` (never shorter than W₀). A window grows only on a rotor whose
+/// resistive drop is large against its magnet flux (R̂s·I₁/λ̂f): the 42-pole robot-joint
 /// motor of `crates/fado-sim/tests/data/unseen/` (τ = 0.26 s, 0.79 τ in the budget) is
-/// averaged over 0.10 s; the TooSlow presets (hoverboard hub, 50 kW IPMSM, 5 kW PM-SyRM)
-/// would need 0.6–10 s and stay uncalibrated. Uncalibrated, that motor's 0.5 % mismatch walks
-/// θ̂ by R̂s·|Δi|/λ̂f ≈ 1.5 rad/s under 65 % of its rated torque at standstill: `reversal`
-/// 0.33 rad near zero speed (seed 1), 0.15 rad calibrated.
+/// averaged over 0.10 s. Beyond the budget the calibration scales it by its axis's shares
+/// ([`GainCalibration::swing_window_share`](crate::control::GainCalibration::swing_window_share),
+/// 0.3–1): the 8-pole 12 V EPS motor of `crates/fado-sim/tests/unseen_motor_tables.rs`
+/// (0.224 s at s_min = 0.2) needs 0.124 s at the scenarios' start angle 0.3 rad (shares 0.955,
+/// 0.222); the hoverboard hub (0.60 s) 0.34 s there, and it stays uncalibrated, as do the
+/// 50 kW IPMSM and 5 kW PM-SyRM presets (4.8 and 10 s). Uncalibrated, the EPS motor's 0.5 %
+/// mismatch walks θ̂ in `stops` (1.095 rad, seed 1).
 fn traded_window<T: Real>(m: &MachineModel<T>, i1: T, swing: T, t: &DriveTuning<T>) -> Option<T> {
     let budget = T::lit(GAIN_CALIBRATION_MAX_HOLD_TIME);
     let w0 = t.gain_calibration.time;
@@ -293,7 +302,7 @@ fn traded_window<T: Real>(m: &MachineModel<T>, i1: T, swing: T, t: &DriveTuning<
         / m.flux_linkage;
     let left = T::one() - (budget / swing).step_one_minus_exp_neg();
     let window = crate::real::max(w0 * left / bound, w0);
-    (w0 > T::zero() && window <= budget).then_some(window)
+    (w0 > T::zero()).then_some(window)
 }
 
 /// Longest hold of a gain-calibration level, s \[A\]: a start-up budget (with it the whole
@@ -339,6 +348,7 @@ fn gain_field(field: &'static str) -> &'static str {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::control::gain_calibration::GainCalibrationStatus;
 
     /// The 14-pole-pair multirotor outrunner of `motors/multirotor-mn5006-22v.toml` with the
     /// inertia `j` (kg·m²).
@@ -387,7 +397,7 @@ mod tests {
     /// The 42-pole robot-joint motor of `crates/fado-sim/tests/data/unseen/` (its derived
     /// inertia): its swing's τ = 0.26 s needs 1.75 τ = 0.45 s of hold with the 50 ms window;
     /// the budget's 0.2 s hold with a 0.10 s window meets the same bias bound. The hoverboard
-    /// hub preset (τ = 0.22 s, 0.6 s of window needed) stays beyond the budget.
+    /// hub preset (τ = 0.22 s) needs 0.6 s of window at the least observable axis.
     #[test]
     fn a_hold_beyond_the_budget_is_traded_for_a_window_within_it() {
         let robot = MachineModel {
@@ -409,6 +419,7 @@ mod tests {
             .unwrap();
         assert_eq!(c.hold_time, GAIN_CALIBRATION_MAX_HOLD_TIME);
         assert!((c.window_time - 0.102).abs() < 2e-3, "{}", c.window_time);
+        assert_eq!(c.swing_window_time, c.window_time);
         let hub = MachineModel {
             rs: 0.179,
             ld: 0.336e-3,
@@ -426,12 +437,49 @@ mod tests {
         let c = DriveConfig::for_machine(&hub)
             .gain_calibration_config()
             .unwrap();
-        assert!(
-            c.hold_time > GAIN_CALIBRATION_MAX_HOLD_TIME,
-            "{}",
-            c.hold_time
-        );
+        assert_eq!(c.hold_time, GAIN_CALIBRATION_MAX_HOLD_TIME);
         assert_eq!(c.window_time, 0.05);
+        assert!((c.swing_window_time - 0.60).abs() < 0.01, "{c:?}");
+        // At the scenarios' start angle 0.3 rad (phase shares 0.955, 0.222) the swing needs
+        // 0.34 s: beyond the budget, not calibrated; at 0 rad (1, 0.5) 0.18 s, within it.
+        let mut cal = GainCalibration::new(c).unwrap();
+        assert!(!cal.start(0.3));
+        assert_eq!(cal.status(), GainCalibrationStatus::TooSlow);
+        assert!(cal.start(0.0));
+        assert_eq!(cal.status(), GainCalibrationStatus::Running);
+    }
+
+    /// The 8-pole 12 V EPS motor of `crates/fado-sim/tests/data/unseen/` (its derived
+    /// inertia): the swing's τ = 0.16 s needs a 0.224 s window with the 0.2 s hold at the
+    /// least observable axis, 0.124 s at its 0.3 rad start, which the calibration averages.
+    #[test]
+    fn a_window_beyond_the_budget_at_the_worst_axis_is_sized_at_the_calibration_axis() {
+        let eps = MachineModel {
+            rs: 0.04128,
+            ld: 0.12156e-3,
+            lq: 0.12156e-3,
+            flux_linkage: 9.1193e-3,
+            pole_pairs: 4,
+            inertia: 3.919e-3,
+            rated_current: 50.0,
+            rated_speed_rpm: 1000.0,
+            rated_torque: 2.736,
+            dc_voltage: 12.0,
+            ..MachineModel::<f64>::paper()
+        };
+        let c = DriveConfig::for_machine(&eps)
+            .gain_calibration_config()
+            .unwrap();
+        assert_eq!(c.hold_time, GAIN_CALIBRATION_MAX_HOLD_TIME);
+        assert_eq!(c.window_time, 0.05);
+        assert!((c.swing_window_time - 0.224).abs() < 2e-3, "{c:?}");
+        let mut cal = GainCalibration::new(c).unwrap();
+        let share = cal.swing_window_share(0.3);
+        assert!((share - 0.555).abs() < 2e-3, "{share}");
+        assert!(cal.start(0.3));
+        // Settle and release 5·L/R = 15 ms each, two holds of 0.2 s, two windows of 0.124 s.
+        let window = (cal.duration_samples() as f64 * c.ts - 0.4 - 2.0 * 0.0147) / 2.0;
+        assert!((window - 0.124).abs() < 2e-3, "{window}");
     }
 
     /// The injection level: the paper's on a surface-magnet rotor; on ipmsm-gem-50k

@@ -57,8 +57,12 @@
 //! by 2.8e-3 on the paper's motor and 2.8e-2 on a 50 kW IPMSM, against a 5e-3 mismatch (fado-sim,
 //! a rotor of huge inertia: 4e-6). In voltage mode the back-EMF drives a current through Rs
 //! that damps the swing (J·s² + c·s + K, c = 1.5·p²·λf²/Rs); each level is averaged only after
-//! a hold of several of its time constants (`hold_time`, from the drive's model), and a machine
-//! whose swing (or settling) needs more than `max_hold_time` is not calibrated
+//! a hold of several of its time constants (`hold_time`, from the drive's model), or of a
+//! shorter hold and a window long enough to average what is left of the swing, whose bias on
+//! a phase's conductance grows as 1/(its share of the axis current): that window is sized
+//! along the calibration's axis when it starts (`swing_window_time`,
+//! [`GainCalibration::swing_window_share`]). A machine whose swing (or settling) needs more
+//! than `max_hold_time` of hold or window is not calibrated
 //! ([`GainCalibrationStatus::TooSlow`]), unless a brake holds the rotor through the start-up
 //! (the drive's `startup.rotor_held`): nothing swings then, and the drive holds each level for
 //! the current's settling alone (on the 50 kW IPMSM, the 5 kW PM-SyRM, the hub motor and an
@@ -153,7 +157,7 @@ mod tests;
 pub use measure::{ratio_of, resistance_of};
 pub use motion::{
     LOOP_MOTION_FACTOR, LOOP_WINDOW_FACTOR, LOOP_WINDOW_TIME, MOTION_FILTER_TIME,
-    MOTION_SPEED_RATIO, MOTION_TRAVEL_SHARE, motion_voltage,
+    MOTION_NOISE_MARGIN, MOTION_SPEED_RATIO, MOTION_TRAVEL_SHARE, motion_voltage,
 };
 
 use crate::control::snapshot_window::SnapshotWindow;
@@ -182,6 +186,16 @@ pub struct GainCalibrationConfig<T> {
     pub max_hold_time: T,
     /// Averaging window of each level, s; 0 disables the calibration.
     pub window_time: T,
+    /// The averaging window (s) the rotor's swing left after the hold needs along an axis
+    /// whose phases a and b both carry the share `min_observability` (the swing's bias bound,
+    /// [`DriveConfig::gain_calibration_config`](crate::control::DriveConfig::gain_calibration_config));
+    /// 0 where `window_time` meets it. The bias on each phase's conductance scales as
+    /// 1/share, so along the calibration's axis, shares s_a and s_b, the swing needs
+    /// s_min·(1/s_a + 1/s_b)/2 of it ([`GainCalibration::swing_window_share`]): each level is
+    /// averaged over the longer of that and `window_time`, and an axis that needs more than
+    /// `max_hold_time` is not calibrated ([`GainCalibrationStatus::TooSlow`]; as is a
+    /// non-finite one).
+    pub swing_window_time: T,
     /// Smallest share min(|cos φ|, |cos(φ − 2π/3)|) of the axis current in phases a and b,
     /// and |cos(φ + 2π/3)| in phase c, with which the calibration runs, in [0, 1).
     pub min_observability: T,
@@ -220,8 +234,8 @@ pub enum GainCalibrationStatus {
     /// (ratio unchanged, no current applied).
     Unobservable,
     /// Skipped: the rotor's swing about the d current dies out too slowly, or the current
-    /// settles too slowly (`hold_time` or `settle_time` above `max_hold_time`; ratio
-    /// unchanged, no current applied).
+    /// settles too slowly (`hold_time`, `settle_time` or the swing's window along the axis,
+    /// `swing_window_time`, above `max_hold_time`; ratio unchanged, no current applied).
     TooSlow,
     /// Measured but refused: non-finite, a non-positive conductance, too few finite samples,
     /// a current above `current_limit` in voltage mode, or |k − 1| above `max_mismatch`
@@ -277,6 +291,9 @@ pub struct GainCalibration<T> {
     /// Settling or hold beyond `max_hold_time`: skipped.
     too_slow: bool,
     window_samples: u32,
+    /// The window of the present (or last) start: `window_samples`, or the longer one the
+    /// swing needs along its axis.
+    window_run: u32,
     stage: Stage,
     /// Samples left in the current stage.
     remaining: u32,
@@ -308,7 +325,10 @@ pub struct GainCalibration<T> {
     /// back-EMF across the axis that ended it (V).
     motion_current: T,
     motion_emf: T,
-    /// The largest |back-EMF across the axis| read since the start, over `motion_voltage`.
+    /// The voltage-mode motion threshold's floor from the sensors' noise (V,
+    /// [`GainCalibration::motion_noise_floor`]).
+    noise_floor: T,
+    /// The largest |back-EMF across the axis| read since the start, over its threshold.
     motion_peak: T,
     /// The same, of the stages under the current loop.
     loop_motion_peak: T,
@@ -379,6 +399,7 @@ impl<T: Real> GainCalibration<T> {
             unsettled: false,
             too_slow,
             window_samples,
+            window_run: window_samples,
             stage: Stage::Idle,
             remaining: 0,
             axis: Ab::new(T::one(), T::zero()),
@@ -395,6 +416,7 @@ impl<T: Real> GainCalibration<T> {
             motion_flux: T::zero(),
             motion_current: T::zero(),
             motion_emf: T::zero(),
+            noise_floor: T::zero(),
             motion_peak: T::zero(),
             loop_motion_peak: T::zero(),
             window_flux: T::zero(),
@@ -413,12 +435,12 @@ impl<T: Real> GainCalibration<T> {
     }
 
     /// The whole sequence's duration in samples when it runs: settle at I₁, hold and window
-    /// at each level, release.
+    /// at each level (the window of the last start, the configured one before any), release.
     pub fn duration_samples(&self) -> u32 {
         self.settle_samples
             .saturating_mul(2)
             .saturating_add(self.hold_samples.saturating_mul(2))
-            .saturating_add(self.window_samples.saturating_mul(2))
+            .saturating_add(self.window_run.saturating_mul(2))
     }
 
     /// Arms the calibration (unless disabled): it starts at the next [`step`](Self::step).
@@ -478,6 +500,17 @@ impl<T: Real> GainCalibration<T> {
     /// start the same way, "Rs recalibration", SPRUHJ1, §"Rs Online and Rs Recalibration").
     pub fn resistance(&self) -> T {
         self.resistance
+    }
+
+    /// The share of `swing_window_time` the rotor's swing needs along the axis at `angle`
+    /// (electrical rad): s_min·(1/s_a + 1/s_b)/2 with s_a = |cos φ|, s_b = |cos(φ − 2π/3)| the
+    /// shares of phases a and b and s_min = `min_observability` (1 where both are s_min,
+    /// 0.3 at φ = 0; ∞ where a share is zero).
+    pub fn swing_window_share(&self, angle: T) -> T {
+        let (s, c) = angle.step_sin_cos_any();
+        let b = c * T::lit(PHASE_B_ALPHA) + s * T::lit(PHASE_B_BETA);
+        let half = T::lit(0.5) * self.config.min_observability;
+        half * (T::one() / c.abs() + T::one() / b.abs())
     }
 
     /// The smallest share of the axis current in any phase, min over x of |cos(φ − φ_x)|,

@@ -54,6 +54,19 @@ pub const LOOP_WINDOW_TIME: f64 = 4e-3;
 /// `crates/fado-sim/tests/calibration_load_classes.rs` (against 0.85 rad at 3 %).
 pub const LOOP_WINDOW_FACTOR: f64 = 2.0;
 
+/// The voltage-mode threshold's floor, in multiples of the largest inductive reading
+/// L̂q·dΔi⊥/dt of the settled current loop (the second half of the settling at I₁, the rotor
+/// held by I₁) \[A\]: 2, the peak of the same sensor noise over a voltage mode up to 15 times
+/// as long (a Gaussian's peak grows from 2.9σ over 300 samples to 3.7σ over 5000). The
+/// reading is the current sensors' noise and resolution through L̂q/[`MOTION_FILTER_TIME`]:
+/// on a high-inductance winding it reaches `motion_voltage` (the 16-pole 310 V appliance
+/// motor of `crates/fado-sim/tests/data/unseen/`, L·I/λf 2.4: one 3.4 mA step of its 12-bit
+/// sensor reads 0.64 of it: without the floor its calibration ends `RotorMoved` with the
+/// rotor still, 0.002 rad turned, at seeds 1 and 2). Where the floor stays below
+/// `motion_voltage` the threshold is `motion_voltage`: on every linear preset's `reversal`
+/// and `stops` the runs are bit-identical with and without it.
+pub const MOTION_NOISE_MARGIN: f64 = 2.0;
+
 /// Snapshots of the loop's flux over [`LOOP_WINDOW_TIME`].
 pub(super) const WINDOW_SLOTS: usize = 8;
 
@@ -105,9 +118,13 @@ impl<T: Real> GainCalibration<T> {
         self.cross_filtered += a * (delta - self.cross_filtered);
         self.cross_v_filtered += a * (cross_v - self.cross_v_ref - self.cross_v_filtered);
         // d/dt of the filtered current is (Δi⊥ − filtered)/τ_f.
-        let emf = self.config.rs_hat * self.cross_filtered
-            + self.config.lq_hat * (delta - self.cross_filtered) / tf
-            - self.cross_v_filtered;
+        let inductive = self.config.lq_hat * (delta - self.cross_filtered) / tf;
+        if self.stage == Stage::Settle && self.remaining <= self.settle_samples / 2 {
+            self.noise_floor = self
+                .noise_floor
+                .step_max(T::lit(MOTION_NOISE_MARGIN) * inductive.abs());
+        }
+        let emf = self.config.rs_hat * self.cross_filtered + inductive - self.cross_v_filtered;
         let share = emf.abs() / self.motion_threshold(voltage_mode);
         if share > T::lit(MOTION_TRAVEL_SHARE) {
             self.motion_flux += emf * self.config.ts;
@@ -160,14 +177,21 @@ impl<T: Real> GainCalibration<T> {
         self.loop_window_peak
     }
 
-    /// The motion test's threshold (V): `motion_voltage` in voltage mode,
-    /// [`LOOP_MOTION_FACTOR`] times it under the current loop.
+    /// The motion test's threshold (V): in voltage mode `motion_voltage`, or the sensors'
+    /// noise floor ([`motion_noise_floor`](Self::motion_noise_floor)) where that is larger;
+    /// [`LOOP_MOTION_FACTOR`] times `motion_voltage` under the current loop.
     pub(super) fn motion_threshold(&self, voltage_mode: bool) -> T {
         if voltage_mode {
-            self.config.motion_voltage
+            self.config.motion_voltage.step_max(self.noise_floor)
         } else {
             self.config.motion_voltage * T::lit(LOOP_MOTION_FACTOR)
         }
+    }
+
+    /// The voltage-mode threshold's noise floor (V): [`MOTION_NOISE_MARGIN`] times the largest
+    /// |L̂q·dΔi⊥/dt| read over the second half of the settling at I₁ (zero before it).
+    pub fn motion_noise_floor(&self) -> T {
+        self.noise_floor
     }
 
     /// The largest back-EMF across the axis the motion test has read in voltage mode since the

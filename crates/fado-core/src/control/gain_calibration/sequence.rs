@@ -45,6 +45,23 @@ impl<T: Real> GainCalibration<T> {
             self.status = GainCalibrationStatus::TooSlow;
             return false;
         }
+        // The window the swing needs along this axis (∞ where phase a or b carries nothing);
+        // NaN compares false: too slow.
+        let swing = if self.config.swing_window_time <= T::zero() {
+            T::zero()
+        } else {
+            self.config.swing_window_time * self.swing_window_share(angle)
+        };
+        let within = swing <= self.config.max_hold_time;
+        if !within {
+            self.stage = Stage::Idle;
+            self.status = GainCalibrationStatus::TooSlow;
+            return false;
+        }
+        let n = swing / self.config.ts;
+        // Rounded in `T` (n ≥ 0): no double-precision conversion in the firmware's step.
+        let n = (n + T::lit(0.5)).index_floor(u32::MAX as usize) as u32;
+        self.window_run = self.window_samples.max(n);
         let share = Self::observability(angle);
         // NaN compares false: a non-finite angle is unobservable too.
         if !(share >= self.config.min_observability && share > T::zero()) {
@@ -65,6 +82,7 @@ impl<T: Real> GainCalibration<T> {
         self.motion_flux = T::zero();
         self.motion_current = T::zero();
         self.motion_emf = T::zero();
+        self.noise_floor = T::zero();
         self.motion_peak = T::zero();
         self.loop_motion_peak = T::zero();
         self.loop_window_peak = T::zero();
@@ -196,9 +214,9 @@ impl<T: Real> GainCalibration<T> {
     fn advance(&mut self) {
         let (next, samples) = match self.stage {
             Stage::Settle => (Stage::HoldLower, self.hold_samples),
-            Stage::HoldLower => (Stage::AverageLower, self.window_samples),
+            Stage::HoldLower => (Stage::AverageLower, self.window_run),
             Stage::AverageLower => (Stage::HoldUpper, self.hold_samples),
-            Stage::HoldUpper => (Stage::AverageUpper, self.window_samples),
+            Stage::HoldUpper => (Stage::AverageUpper, self.window_run),
             Stage::AverageUpper => (Stage::Release, self.settle_samples),
             Stage::Release | Stage::Idle => {
                 self.stage = Stage::Idle;
@@ -213,7 +231,7 @@ impl<T: Real> GainCalibration<T> {
     /// The ratio from the two levels' averages, or why not.
     fn finish(&mut self) {
         self.measured = T::zero() / T::zero();
-        let min_count = (self.window_samples / 2).max(1);
+        let min_count = (self.window_run / 2).max(1);
         if self.aborted || self.count[0] < min_count || self.count[1] < min_count {
             self.status = GainCalibrationStatus::Implausible;
             return;

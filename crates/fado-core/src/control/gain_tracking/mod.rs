@@ -10,8 +10,8 @@
 //! is, in the d-q frame of θ, N·conj(i_dq)·e^(−j2θ): at a constant current a component at
 //! −2ω of the measured current. Times R̂s it is a 2ω̂ integrand error of eq. (3), which at
 //! speed averages out of the flux, but at a loaded zero-speed hold is a constant that walks
-//! θ̂ (the EPS motor of `crates/fado-sim/tests/unseen_motor_tables.rs`: 1.1 rad in `stops`
-//! with 0.5 %). Every loaded hold follows a spell at speed, where the mismatch is observable.
+//! θ̂ (the EPS motor of `crates/fado-sim/tests/unseen_motor_tables.rs` with its start-up
+//! calibration skipped: 1.1 rad in `stops` with 0.5 %). Every loaded hold follows a spell at speed, where the mismatch is observable.
 //!
 //! # The measurement
 //! The current loop regulates the *measured* current, so the machine's current carries
@@ -69,7 +69,8 @@
 //! correction stays within 1 ± `max_mismatch`. The convergence time is τ/G (G ≈ 1 with a
 //! good model). The start-up calibration, where it ran, is kept: the drive runs the tracker
 //! only where it did not. Below 12/τ it learns nothing: a loaded hold reached from 4 % of the
-//! rated speed only (the `stops` scenario on the EPS motor, 17 rad/s) keeps the mismatch.
+//! rated speed only (the `stops` scenario, 17 rad/s on the EPS motor) keeps the mismatch the
+//! start-up left; on a 14-pole gimbal motor rated at 73 rad/s it never learns.
 //!
 //! The bound of a bias: saliency at a constant current and the symmetric dead time are
 //! outside −2ω̂ (none to first order); an inverter whose phases differ, or a rotor whose

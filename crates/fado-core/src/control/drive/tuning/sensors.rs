@@ -88,7 +88,8 @@ pub struct GainCalibrationTuning<T> {
     pub online: bool,
     /// The online tracker's adaptation time constant τ, s: it converges in about τ and adapts
     /// from |ω̂| ≥ 12/τ (electrical). Default 0.1 s \[A\] (from 120 rad/s; EPS motor of
-    /// `crates/fado-sim/tests/unseen_motor_tables.rs`: 4 % of its rated speed is 17 rad/s).
+    /// `crates/fado-sim/tests/unseen_motor_tables.rs`: 4 % of its rated speed is 17 rad/s,
+    /// and its start-up calibrates the mismatch that a hold there would keep).
     pub online_time: T,
 }
 
