@@ -69,8 +69,8 @@
 //! resistive speed R0·|bracket|/λ̂a over [`SATURATED_RESISTIVE_SPEED_ANGLE`] (40 rad), as the
 //! linear path's floor but four times faster, the saturating law being past the hand-over's
 //! transient, so that a machine whose resistance error costs much angle learns it in time.
-//! With a `model_flux_uncertainty` above 0 it keeps γ: the data then carry the model's
-//! error, which the faster gains would take at once. Measured
+//! With a `model_flux_uncertainty` or a `model_flux_growth` above 0 it keeps γ: the data
+//! then carry the model's error, which the faster gains would take at once. Measured
 //! (`saturated_rs_convergence`, `rated-reversal` started 0.7 and 1.4 times off, gain
 //! calibration off): see docs/method/saturation.md, "The R̂s law's regressor". A blanket 3γ
 //! also took the d-saturated SPM through, but lost a five-times cross-saturated IPMSM's
