@@ -187,7 +187,7 @@ pub struct MagneticFit<T> {
     pub residual: T,
     /// The constant-inductance model's RMS residual, A.
     pub linear_residual: T,
-    /// The model's largest flux residual over the samples in each of [`RESIDUAL_BANDS`]
+    /// The model's RMS flux residual over the samples in each of [`RESIDUAL_BANDS`]
     /// equal bands of the current magnitude up to the pulses' peak current, Wb.
     pub flux_residuals: [T; RESIDUAL_BANDS],
     /// The largest rotor turn over one pair of pulses, estimated from the flux at its end,

@@ -423,11 +423,13 @@ fn refine_rib<T: Real>(
     best
 }
 
-/// Bands of the current magnitude over the pulses' range in which
-/// [`flux_residual_bands`] measures the fit's flux residual.
+/// Equal bands of the current magnitude, from zero to the pulses' peak current, in each of
+/// which the commissioning measures the fitted model's RMS flux residual
+/// ([`super::Identification::saturation_flux_residuals`]): four, so that each holds tens of
+/// the stored samples.
 pub const RESIDUAL_BANDS: usize = 4;
 
-/// The largest flux residual |ψ̂(i) − ψ| (Wb) of `model` over the stored samples in each of
+/// The RMS flux residual |ψ̂(i) − ψ| (Wb) of `model` over the stored samples in each of
 /// [`RESIDUAL_BANDS`] equal bands of |i| from 0 to `i_max` (a sample beyond it counts in the
 /// last), the samples' ψ being (`flux` + Δψd, Δψq); 0 in a band without samples.
 pub(super) fn flux_residual_bands<T: Real>(

@@ -64,7 +64,7 @@ pub struct Identification<T: 'static> {
     /// RMS current residual of the constant-inductance model over the same samples, A (NaN
     /// with the test off).
     pub linear_residual: T,
-    /// The fit's largest flux residual |ψ̂(i) − ψ| over the pulses' samples in each of
+    /// The fit's RMS flux residual |ψ̂(i) − ψ| over the pulses' samples in each of
     /// [`super::RESIDUAL_BANDS`] equal bands of |i| from zero to `saturation_current`, Wb
     /// (NaN with the test off; 0 in a band without samples).
     pub saturation_flux_residuals: [T; super::RESIDUAL_BANDS],
