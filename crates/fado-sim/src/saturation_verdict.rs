@@ -88,7 +88,7 @@ pub(crate) fn model_uncertainty(doc: &mut toml::Table, id: &Identification<f64>)
         out += &format!(
             "# [estimator.rs_adaptation] model_flux_uncertainty_rated = {g:.4}: and this share \
              more at the rated current, with the current's square (the fit's worst RMS flux \
-             residual in a band of the pulses' current, {:.4} A peak).\n",
+             residual in a quarter of the pulses' current range, up to {:.3} A).\n",
             id.saturation_current
         );
     }
