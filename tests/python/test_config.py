@@ -58,6 +58,7 @@ PAPER_DEFAULTS = {
         "max_ratio": 2.0,  # [A]
         "standstill_angle_rate": 2.0,  # [A]
         "model_flux_uncertainty": 0.0,  # [A] 0: the model is the machine's
+        "model_flux_uncertainty_rated": 0.0,  # [A] 0: the model is the machine's
     },
     "flux_linkage_adaptation": {
         "rate": 5.0,  # [A] (revolution mean, 1 % dead zone)

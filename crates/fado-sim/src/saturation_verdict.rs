@@ -60,25 +60,39 @@ pub(crate) fn freeze_resistance_law(doc: &mut toml::Table, id: &Identification<f
         .into()
 }
 
-/// Where the pulses identified a saturating model, its flux uncertainty
-/// ([`Identification::model_flux_uncertainty`]) as `[estimator.rs_adaptation]
-/// model_flux_uncertainty` in `doc`, and the header line saying why: the online R̂s law on a
-/// saturating model freezes where the model's flux error could read as resistance
-/// (docs/method/saturation.md, "The R̂s law's regressor"). A key the user set is kept.
+/// Where the pulses identified a saturating model, its flux uncertainty at zero current
+/// ([`Identification::model_flux_uncertainty`]) and its growth to the rated current
+/// ([`Identification::model_flux_uncertainty_rated`]) as `[estimator.rs_adaptation]
+/// model_flux_uncertainty` and `model_flux_uncertainty_rated` in `doc`, and the header lines
+/// saying why: the online R̂s law on a saturating model freezes where the model's flux error
+/// at the present current could read as resistance (docs/method/saturation.md, "The R̂s
+/// law's regressor"). A key the user set is kept.
 pub(crate) fn model_uncertainty(doc: &mut toml::Table, id: &Identification<f64>) -> String {
-    let Some(u) = id.model_flux_uncertainty() else {
+    let (Some(u), Some(g)) = (
+        id.model_flux_uncertainty(),
+        id.model_flux_uncertainty_rated(),
+    ) else {
         return String::new();
     };
-    if !set_law_key(doc, "model_flux_uncertainty", toml::Value::Float(u)) {
-        return String::new();
+    let mut out = String::new();
+    if set_law_key(doc, "model_flux_uncertainty", toml::Value::Float(u)) {
+        out += &format!(
+            "# [estimator.rs_adaptation] model_flux_uncertainty = {u:.4}: the identified model's \
+             flux may be this share of its flux_linkage off the machine's (the fit's RMS \
+             current residual {:.4} A times its larger inductance); the online R̂s law freezes \
+             where that could read as resistance.\n",
+            id.saturation_residual
+        );
     }
-    format!(
-        "# [estimator.rs_adaptation] model_flux_uncertainty = {u:.4}: the identified model's \
-         flux may be this share of its flux_linkage off the machine's (the fit's RMS current \
-         residual {:.4} A times its larger inductance); the online R̂s law freezes where that \
-         could read as resistance.\n",
-        id.saturation_residual
-    )
+    if set_law_key(doc, "model_flux_uncertainty_rated", toml::Value::Float(g)) {
+        out += &format!(
+            "# [estimator.rs_adaptation] model_flux_uncertainty_rated = {g:.4}: and this share \
+             more at the rated current, with the current's square (the fit's worst RMS flux \
+             residual in a quarter of the pulses' current range, up to {:.3} A).\n",
+            id.saturation_current
+        );
+    }
+    out
 }
 
 /// The header's statement on the magnetic model: saturation detected (the written

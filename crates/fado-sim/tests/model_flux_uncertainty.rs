@@ -1,27 +1,42 @@
-//! The figure commissioning writes as `[estimator.rs_adaptation] model_flux_uncertainty`
-//! (`Identification::model_flux_uncertainty`) against the identified model's flux error at
-//! the plant's MTPA operating points (0, 30, 65 and 100 % of rated torque), both as a share
-//! of the identified λ̂f: what the online R̂s law takes the model's flux error to be where it
-//! runs (docs/method/saturation.md, "The offset law's gate").
+//! The figure commissioning writes for the identified model's flux uncertainty,
+//! `[estimator.rs_adaptation] model_flux_uncertainty` + `model_flux_uncertainty_rated`·|i|²/I_rated²
+//! (`Identification::model_flux_uncertainty`, `Identification::model_flux_uncertainty_rated`),
+//! against the identified model's flux error at the plant's MTPA operating points (0, 30, 65 and
+//! 100 % of rated torque), both as a share of the identified λ̂f: what the online R̂s law takes
+//! the model's flux error to be at the current where it runs (docs/method/saturation.md, "The
+//! offset law's gate").
 //!
-//! Measured (`cargo test --release -p fado-sim --test model_flux_uncertainty -- --ignored
-//! --nocapture`, sensor seed 1), error at 0 / 30 / 65 / 100 % of rated torque against the
-//! figure: ipmsm-2k2-qsat 0.0001–0.0007 / 0.0007; pmsm-gem-1k1-measured 0.0034–0.0085 /
-//! 0.0072; pmsyrm-baldor-5k6 0.030–0.046 / 0.016; pmsyrm-baldor-5k6-measured 0.081–0.086 /
-//! 0.027; ipmsm-test-saturated 0.0072 / 0.0050. Most of it is the magnet's flux at zero
-//! current (the identified λ̂f's error, which the λ̂f law absorbs); less that, the loaded
-//! error still reaches 1.1–1.5 times the figure at rated torque on three of the five
-//! (0.0008, 0.0105, 0.0175 against 0.0007, 0.0072, 0.0160): the figure, an RMS residual over
-//! the pulses, does not bound it, and the test is ignored until one that does is derived from
-//! the identification's own residuals.
+//! Measured (`cargo test --release -p fado-sim --test model_flux_uncertainty -- --include-ignored
+//! --nocapture`, sensor seed 1), the loaded error (less the magnet's) at 30 / 65 / 100 % of rated
+//! torque against the figure there: ipmsm-2k2-qsat 0.0003 / 0.0005 / 0.0008 against 0.0008 /
+//! 0.0010 / 0.0015; pmsm-gem-1k1-measured 0.0035 / 0.0062 / 0.0105 against 0.0078 / 0.0100 /
+//! 0.0139; pmsyrm-baldor-5k6 0.0069 / 0.0129 / 0.0175 against 0.0192 / 0.0264 / 0.0362;
+//! pmsyrm-baldor-5k6-measured 0.0227 / 0.0054 / 0.0039 against 0.0297 / 0.0347 / 0.0417;
+//! ipmsm-test-saturated 0.0005 / 0.0003 / 0.0001 against 0.0051 / 0.0058 / 0.0068; the six
+//! saturated test machines below at most 0.0028, each below its figure (at least 0.0011 there). The constant figure
+//! alone (the first term, the fit's RMS current residual times its larger inductance) falls
+//! short at rated torque on three of the five presets (0.0008, 0.0105, 0.0175 against 0.0007,
+//! 0.0072, 0.0160); the growth, the fit's worst RMS flux residual in a quarter of the pulses'
+//! current range, covers it.
 //!
-//! A figure that bounds it costs the law its reach: the fit's largest flux residual over the
-//! pulses (less its zero-current offset) bounds the loaded error on all five (0.0015 /
-//! 0.0191 / 0.0610 / 0.0370 / 0.0042 at seed 1) but freezes the law at most loaded points of
-//! pmsm-gem-1k1-measured, whose commissioned model then cannot learn a winding 1.3 or 0.8
-//! times its commissioned resistance ([`a_commissioned_model_learns_a_changed_winding_resistance`]:
-//! R̂s ends at 0.952 / 1.030 × Rs, `rated-reversal` lost at 0.82 / 1.04 rad; with the figure
-//! set by hand 0.0105 passes, 0.016 fails). The RMS figure keeps that reach.
+//! The magnet's error, the error at zero current, is outside the figure: it is the identified
+//! λ̂f's (the back-EMF windows read ψd(−c, 0) + L̂d·c at the coast's d current −c, which on a
+//! saturating machine is not ψd(0, 0)), which the λ̂f law learns online. With it the error is
+//! 0.081–0.086 of λ̂f on the PM-SyRM's measured map (figure 0.027–0.042), 0.030–0.046 on its
+//! algebraic model (0.016–0.036), 0.034–0.037 on the traction IPMSM (0.018–0.028), 0.0072 on
+//! the made-up IPMSM (0.0050–0.0068), 0.0088 on the servo SPM (0.0028–0.0051):
+//! [`the_written_figure_bounds_the_magnets_flux_error_too`] is ignored. The model's own
+//! prediction of that error, its d flux at −c less at zero plus L̂d·c, has the right size on
+//! the PM-SyRMs (0.024 and 0.058 against 0.030 and 0.083) but the wrong sign on
+//! pmsm-gem-1k1-measured (+0.013 against −0.003), whose law it would freeze.
+//!
+//! A constant figure that bounds the loaded error costs the law its reach: the fit's largest
+//! flux residual over all the pulses (0.0191 on pmsm-gem-1k1-measured) freezes the law at most
+//! loaded points there, whose commissioned model then cannot learn a winding 1.3 or 0.8 times
+//! its commissioned resistance ([`a_commissioned_model_learns_a_changed_winding_resistance`]:
+//! R̂s ends at 0.952 / 1.030 × Rs, `rated-reversal` lost at 0.82 / 1.04 rad; with a constant
+//! figure set by hand 0.0105 passes, 0.016 fails). The growing figure, 0.0072 at zero current
+//! and 0.0139 at the rated one, keeps that reach.
 
 use fado_core::Dq;
 use fado_core::magnetics::{MagneticModel, Magnetics};
@@ -60,9 +75,20 @@ fn mtpa(model: &impl MagneticModel<f64>, pole_pairs: f64, torque: f64, i_max: f6
     best(hi).1
 }
 
-/// The identified model's flux error |ψ̂ − ψ|/λ̂f at the loads, the same less its error at
-/// zero current (the magnet's, which the λ̂f law absorbs), and the written figure.
-fn measure(path: &str) -> ([f64; 4], [f64; 4], f64) {
+/// What [`measure`] finds on one machine, as shares of the identified λ̂f at 0, 30, 65 and
+/// 100 % of rated torque.
+struct Measured {
+    /// The identified model's flux error |ψ̂ − ψ|.
+    error: [f64; 4],
+    /// The same less its error at zero current (the magnet's, the identified λ̂f's).
+    loaded: [f64; 4],
+    /// The written figure at the operating point's current: `model_flux_uncertainty` +
+    /// `model_flux_uncertainty_rated`·|i|²/I_rated².
+    figure: [f64; 4],
+}
+
+/// The identified model's flux errors and the written figure at the plant's MTPA points.
+fn measure(path: &str) -> Measured {
     let text = std::fs::read_to_string(path).unwrap();
     let cfg = fado_sim::SimConfig::from_toml(&text).unwrap();
     let plant = cfg.plant();
@@ -85,49 +111,97 @@ fn measure(path: &str) -> ([f64; 4], [f64; 4], f64) {
     });
     let error = |i: Dq<f64>| identified.flux(i) - truth.flux(i);
     let lf = id.model.flux_linkage;
-    (
-        points.map(|i| error(i).norm() / lf),
-        points.map(|i| (error(i) - magnet).norm() / lf),
+    let (u0, rated) = (
         id.model_flux_uncertainty().unwrap(),
-    )
+        id.model_flux_uncertainty_rated().unwrap(),
+    );
+    let i_n = id.model.rated_current;
+    Measured {
+        error: points.map(|i| error(i).norm() / lf),
+        loaded: points.map(|i| (error(i) - magnet).norm() / lf),
+        figure: points.map(|i| u0 + rated * (i.d * i.d + i.q * i.q) / (i_n * i_n)),
+    }
 }
 
-#[test]
-#[ignore = "the written figure underestimates the flux error at load (module docs: 0.027 against 0.081-0.086 on the PM-SyRM's measured map)"]
-fn the_written_figure_bounds_the_models_flux_error_at_every_load() {
+/// The saturated presets and the saturated test machines (made-up algebraic models of other
+/// classes: the traction IPMSM, a ribbed IPMSM, twenty times the cross-saturation, a 20-pole
+/// 48 V IPMSM, a 2-pole inrunner, a d-saturated servo SPM with a light rotor).
+fn machines() -> Vec<String> {
+    let root = env!("CARGO_MANIFEST_DIR");
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../motors/saturated");
     fado_sim::magnetics_file::set_config_dir(Some(std::path::Path::new(dir)));
-    let root = env!("CARGO_MANIFEST_DIR");
+    [
+        "ipmsm-2k2-qsat",
+        "pmsm-gem-1k1-measured",
+        "pmsyrm-baldor-5k6",
+        "pmsyrm-baldor-5k6-measured",
+    ]
+    .iter()
+    .map(|name| format!("{dir}/{name}.toml"))
+    .chain(
+        [
+            "ipmsm-test-saturated",
+            "traction-ipm-saturated",
+            "ipm-rib-saturated",
+            "ipm-cross20-saturated",
+            "ipmsm-20p-48v-saturated",
+            "inrunner-2p-saturated",
+            "spm-dq-sat-saturated",
+        ]
+        .iter()
+        .map(|name| format!("{root}/tests/data/{name}.toml")),
+    )
+    .collect()
+}
+
+fn row(a: [f64; 4]) -> String {
+    format!("{:.4} / {:.4} / {:.4} / {:.4}", a[0], a[1], a[2], a[3])
+}
+
+/// The machines on which `error` (of [`Measured`]) exceeds the figure at some load, each
+/// printed with its errors and figure.
+fn short_of(what: &str, error: impl Fn(&Measured) -> [f64; 4]) -> Vec<String> {
     let mut short = Vec::new();
-    for path in [
-        format!("{root}/../../motors/saturated/ipmsm-2k2-qsat.toml"),
-        format!("{root}/../../motors/saturated/pmsm-gem-1k1-measured.toml"),
-        format!("{root}/../../motors/saturated/pmsyrm-baldor-5k6.toml"),
-        format!("{root}/../../motors/saturated/pmsyrm-baldor-5k6-measured.toml"),
-        format!("{root}/tests/data/ipmsm-test-saturated.toml"),
-    ] {
-        let (errors, loaded, figure) = measure(&path);
+    for path in machines() {
+        let r = measure(&path);
         let name = path.rsplit('/').next().unwrap();
-        println!(
-            "{name}: flux error at 0/30/65/100 %: {:.4} / {:.4} / {:.4} / {:.4} of λ̂f \
-             (less the magnet's: {:.4} / {:.4} / {:.4}), figure {figure:.4}",
-            errors[0], errors[1], errors[2], errors[3], loaded[1], loaded[2], loaded[3]
-        );
-        if errors.iter().any(|&e| e > figure) {
-            short.push(name.to_string());
+        let (e, u) = (row(error(&r)), row(r.figure));
+        println!("{name}: {what} {e} of λ̂f against the figure {u}");
+        if error(&r).iter().zip(&r.figure).any(|(e, u)| e > u) {
+            short.push(format!("{name}: {e} against {u}"));
         }
     }
+    short
+}
+
+/// The figure at the operating point's current bounds the loaded flux error (less the
+/// magnet's, which the λ̂f law learns) at 0, 30, 65 and 100 % of rated torque on every
+/// machine (figures in the module docs).
+#[test]
+fn the_written_figure_bounds_the_models_flux_error_at_every_load() {
+    let short = short_of("flux error less the magnet's", |r| r.loaded);
+    assert!(short.is_empty(), "{short:?}");
+}
+
+/// The figure does not bound the magnet's flux error, the identified λ̂f's (module docs): the
+/// back-EMF windows read ψd(−c, 0) + L̂d·c at the coast's d current −c with the injection
+/// tests' L̂d, which on a saturating machine is not ψd(0, 0).
+#[test]
+#[ignore = "the magnet's flux error (the identified λ̂f's) is outside the figure: 0.081-0.086 against 0.027-0.042 of λ̂f on the PM-SyRM's measured map, 0.030-0.046 against 0.016-0.036 on its algebraic model, 0.0072 against 0.0050-0.0068 on the made-up IPMSM (module docs)"]
+fn the_written_figure_bounds_the_magnets_flux_error_too() {
+    let short = short_of("flux error", |r| r.error);
     assert!(short.is_empty(), "{short:?}");
 }
 
 /// The written figure leaves the R̂s law the reach to learn a winding's temperature: the
 /// commissioned model of pmsm-gem-1k1-measured (current-sensor seed 1, `identified.toml` as
-/// written, RMS figure 0.0072) drives the plant with its winding resistance 1.3 and 0.8 times
-/// the commissioned one (gain calibration off, so that only the turning law can learn it)
-/// through `rated-reversal`: R̂s ends within 2 % of the plant's and the scenario passes.
-/// Measured: 0.991 / 0.997 × Rs, 0.07 / 0.19 rad near zero speed. With the bounding figure
-/// of the module docs (0.0191) the law freezes at most loaded points: 0.952 / 1.030 × Rs and
-/// the rotor lost (0.82 / 1.04 rad).
+/// written, figure 0.0072 at zero current growing by 0.0067 to the rated current) drives the
+/// plant with its winding resistance 1.3 and 0.8 times the commissioned one (gain calibration
+/// off, so that only the turning law can learn it) through `rated-reversal`: R̂s ends within
+/// 2 % of the plant's and the scenario passes. Measured: 0.990 / 0.998 × Rs, 0.14 / 0.25 rad
+/// near zero speed (0.991 / 0.997 ×, 0.07 / 0.19 rad with the constant 0.0072 alone). With the
+/// constant bounding figure of the module docs (0.0191) the law freezes at most loaded points:
+/// 0.952 / 1.030 × Rs and the rotor lost (0.82 / 1.04 rad).
 #[test]
 fn a_commissioned_model_learns_a_changed_winding_resistance() {
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../motors/saturated");

@@ -2,7 +2,9 @@
 //! voltage pulses in six directions of the d-q plane, the flux linkage integrated from zero
 //! current, the samples stored for the fit at the end.
 
-use super::magnetic_fit::{FluxSamples, SAMPLE_CAPACITY, best_fit, inductance_change};
+use super::magnetic_fit::{
+    FluxSamples, RESIDUAL_BANDS, SAMPLE_CAPACITY, best_fit, flux_residual_bands, inductance_change,
+};
 use super::*;
 use crate::magnetics::{MagneticModel, Saturation};
 use crate::{Ab, Real};
@@ -185,6 +187,9 @@ pub struct MagneticFit<T> {
     pub residual: T,
     /// The constant-inductance model's RMS residual, A.
     pub linear_residual: T,
+    /// The model's RMS flux residual over the samples in each of [`RESIDUAL_BANDS`]
+    /// equal bands of the current magnitude up to the pulses' peak current, Wb.
+    pub flux_residuals: [T; RESIDUAL_BANDS],
     /// The largest rotor turn over one pair of pulses, estimated from the flux at its end,
     /// rad (electrical): the figure compared with [`PULSE_MOTION_LIMIT`].
     pub motion: T,
@@ -670,7 +675,9 @@ impl<T: Real> Commissioning<T> {
     /// The fitted magnetic model with the final λ̂f (module docs, step 5): (the model if
     /// saturation is detected, the detection statistic, the RMS current residuals of the
     /// model and of constant inductances, the rotor's largest turn over a pair).
-    pub(super) fn magnetic_result(&self) -> (Option<Saturation<T>>, T, T, T, T) {
+    pub(super) fn magnetic_result(
+        &self,
+    ) -> (Option<Saturation<T>>, T, T, T, T, [T; RESIDUAL_BANDS]) {
         let nan = T::zero() / T::zero();
         match self.magnetic_model(self.flux) {
             Some(f) => (
@@ -679,8 +686,9 @@ impl<T: Real> Commissioning<T> {
                 f.residual,
                 f.linear_residual,
                 f.motion,
+                f.flux_residuals,
             ),
-            None => (None, nan, nan, nan, nan),
+            None => (None, nan, nan, nan, nan, [nan; RESIDUAL_BANDS]),
         }
     }
 
@@ -706,6 +714,12 @@ impl<T: Real> Commissioning<T> {
             change,
             residual,
             linear_residual,
+            flux_residuals: flux_residual_bands(
+                &self.pulses.samples,
+                &model,
+                flux_linkage,
+                self.pulse_current(),
+            ),
             motion: self.pulses.motion,
             detected: change > self.cfg.magnetics.detection_threshold
                 && residual < T::lit(RESIDUAL_RATIO) * linear_residual

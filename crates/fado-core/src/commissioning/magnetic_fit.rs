@@ -423,6 +423,40 @@ fn refine_rib<T: Real>(
     best
 }
 
+/// Equal bands of the current magnitude, from zero to the pulses' peak current, in each of
+/// which the commissioning measures the fitted model's RMS flux residual
+/// ([`super::Identification::saturation_flux_residuals`]): four, so that each holds tens of
+/// the stored samples.
+pub const RESIDUAL_BANDS: usize = 4;
+
+/// The RMS flux residual |ψ̂(i) − ψ| (Wb) of `model` over the stored samples in each of
+/// [`RESIDUAL_BANDS`] equal bands of |i| from 0 to `i_max` (a sample beyond it counts in the
+/// last), the samples' ψ being (`flux` + Δψd, Δψq); 0 in a band without samples.
+pub(super) fn flux_residual_bands<T: Real>(
+    samples: &FluxSamples<T>,
+    model: &impl MagneticModel<T>,
+    flux: T,
+    i_max: T,
+) -> [T; RESIDUAL_BANDS] {
+    let mut sums = [(T::zero(), T::zero()); RESIDUAL_BANDS];
+    let width = i_max / T::from_index(RESIDUAL_BANDS);
+    for (dpsi, i) in samples.iter() {
+        let psi = Dq::new(flux + dpsi.d, dpsi.q);
+        let r = (model.flux(i) - psi).norm();
+        let k = (i.norm() / width).index_floor(RESIDUAL_BANDS - 1);
+        if let Some(b) = sums.get_mut(k) {
+            *b = (b.0 + r * r, b.1 + T::one());
+        }
+    }
+    sums.map(|(s, n)| {
+        if n > T::zero() {
+            (s / n).sqrt()
+        } else {
+            T::zero()
+        }
+    })
+}
+
 /// The detection statistic: the largest relative change of the incremental inductances
 /// L_dd, L_qq (and the largest cross term |L_dq| relative to √(L_dd·L_qq)) of `model` at
 /// currents of magnitude ½ and 1 × `current` (twelve directions each) against its values at

@@ -253,6 +253,7 @@ mod standstill;
 mod tests;
 
 pub use config::{CommissioningConfig, MagneticsTestConfig};
+pub use magnetic_fit::RESIDUAL_BANDS;
 pub use output::{CommissioningOutput, Confidence, Identification};
 pub use phase::{AbortReason, Parameter, Phase, Status};
 pub use saturation_fit::SaturationFit;

@@ -64,6 +64,10 @@ pub struct Identification<T: 'static> {
     /// RMS current residual of the constant-inductance model over the same samples, A (NaN
     /// with the test off).
     pub linear_residual: T,
+    /// The fit's RMS flux residual |ψ̂(i) − ψ| over the pulses' samples in each of
+    /// [`super::RESIDUAL_BANDS`] equal bands of |i| from zero to `saturation_current`, Wb
+    /// (NaN with the test off; 0 in a band without samples).
+    pub saturation_flux_residuals: [T; super::RESIDUAL_BANDS],
     /// The pulses' peak current, A: the range over which the model is measured.
     pub saturation_current: T,
     /// The rotor's largest turn over one pair of the pulses, estimated from the flux at the
@@ -99,6 +103,22 @@ impl<T: Real> Identification<T> {
         self.saturation.as_ref()?;
         let inductance = crate::real::max(self.model.ld, self.model.lq);
         let u = self.saturation_residual * inductance / self.model.flux_linkage;
+        (u.is_finite() && u >= T::zero()).then_some(u)
+    }
+
+    /// How much the model's flux uncertainty grows from zero to the rated current, as a share
+    /// of λ̂f: the fit's RMS flux residual in the worst of the pulses' bands of |i|
+    /// (`saturation_flux_residuals`) at the pulses' peak current, scaled to the rated
+    /// current as the square of the current. What the online R̂s law takes as
+    /// [`crate::estimator::RsAdaptationTuning::model_flux_uncertainty_rated`]. None where
+    /// [`model_flux_uncertainty`](Self::model_flux_uncertainty) is, or where the figure is
+    /// not a finite non-negative number.
+    pub fn model_flux_uncertainty_rated(&self) -> Option<T> {
+        self.model_flux_uncertainty()?;
+        let r = &self.saturation_flux_residuals;
+        let worst = r.iter().fold(T::zero(), |m, &x| crate::real::max(m, x));
+        let scale = self.model.rated_current / self.saturation_current;
+        let u = worst * scale * scale / self.model.flux_linkage;
         (u.is_finite() && u >= T::zero()).then_some(u)
     }
 }

@@ -541,8 +541,14 @@ impl<T: Real> Commissioning<T> {
             });
             return;
         }
-        let (saturation, saturation_change, saturation_residual, linear_residual, motion) =
-            self.magnetic_result();
+        let (
+            saturation,
+            saturation_change,
+            saturation_residual,
+            linear_residual,
+            motion,
+            saturation_flux_residuals,
+        ) = self.magnetic_result();
         let (ld, lq) = saturation
             .as_ref()
             .map_or((self.ld, self.lq), Self::zero_current_inductances);
@@ -578,6 +584,7 @@ impl<T: Real> Commissioning<T> {
             saturation_change,
             saturation_residual,
             linear_residual,
+            saturation_flux_residuals,
             saturation_current: self.pulse_current(),
             saturation_motion: motion,
         });

@@ -60,7 +60,8 @@ impl<T: Real> EstimatorConfig<T> {
 
     /// The R̂s and λ̂f laws at the slow laws' period, with the tuning's `rs_adaptation_*`,
     /// `flux_linkage_adaptation.rate`, `rs_adaptation.standstill_angle_rate`,
-    /// `rs_adaptation.model_flux_uncertainty` and `mode.threshold_ratio`.
+    /// `rs_adaptation.model_flux_uncertainty`, `rs_adaptation.model_flux_uncertainty_rated`
+    /// (over the rated current squared: the block's growth per A²) and `mode.threshold_ratio`.
     pub(super) fn rs_adaptation_config(&self) -> ResistanceAdaptationConfig<T> {
         let t = &self.tuning;
         ResistanceAdaptationConfig {
@@ -71,6 +72,8 @@ impl<T: Real> EstimatorConfig<T> {
             flux_linkage_rate: t.flux_linkage_adaptation.rate,
             standstill_angle_rate: t.rs_adaptation.standstill_angle_rate,
             model_flux_uncertainty: t.rs_adaptation.model_flux_uncertainty,
+            model_flux_growth: t.rs_adaptation.model_flux_uncertainty_rated
+                / (self.machine.rated_current * self.machine.rated_current),
             ..ResistanceAdaptationConfig::new(&self.machine, t.mode.threshold_ratio, self.slow_ts())
         }
     }

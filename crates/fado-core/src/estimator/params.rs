@@ -352,6 +352,7 @@ fn slow_laws<T: Real>(
                 "min_ratio" => rename("rs_adaptation_min_ratio")(e),
                 "max_ratio" => rename("rs_adaptation_max_ratio")(e),
                 "model_flux_uncertainty" => rename("rs_adaptation_model_flux_uncertainty")(e),
+                "model_flux_growth" => rename("rs_adaptation_model_flux_uncertainty_rated")(e),
                 "flux_linkage_rate" => rename("flux_linkage_adaptation_rate")(e),
                 // Fixed rates of the block that only a sampling period can make unstable.
                 "standstill_angle_rate" => e,

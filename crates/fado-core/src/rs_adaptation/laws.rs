@@ -25,8 +25,11 @@ pub(crate) struct ResistanceAdaptationParams<T: 'static> {
     /// Ts/[`SATURATED_RESISTIVE_SPEED_ANGLE`]: a saturating model's γ·Ts at a resistive
     /// speed of 1 rad/s.
     saturated_speed_rate_ts: T,
-    /// The model's flux uncertainty in Wb: `model_flux_uncertainty`·λ̂f (configured).
+    /// The model's flux uncertainty at zero current in Wb: `model_flux_uncertainty`·λ̂f
+    /// (configured).
     model_flux: T,
+    /// Its growth with the current in Wb/A²: `model_flux_growth`·λ̂f (configured).
+    model_flux_growth: T,
     /// γ_s·Ts.
     standstill_gain: T,
     /// e^{−ω_m·Ts}.
@@ -158,6 +161,7 @@ impl<T: Real> ResistanceAdaptationParams<T> {
         check::non_negative("flux_linkage_min_speed", config.flux_linkage_min_speed)?;
         let uncertainty =
             check::non_negative("model_flux_uncertainty", config.model_flux_uncertainty)?;
+        let growth = check::non_negative("model_flux_growth", config.model_flux_growth)?;
         let min = check::positive("min_ratio", config.min_ratio)?;
         if min > T::one() {
             return Err(ConfigError::OutOfRange {
@@ -178,6 +182,7 @@ impl<T: Real> ResistanceAdaptationParams<T> {
             speed_rate_ts: ts / T::lit(RESISTIVE_SPEED_ANGLE),
             saturated_speed_rate_ts: ts / T::lit(SATURATED_RESISTIVE_SPEED_ANGLE),
             model_flux: uncertainty * config.flux_linkage_hat,
+            model_flux_growth: growth * config.flux_linkage_hat,
             standstill_gain: rate_s * ts,
             forget: (-(memory_w * ts)).exp(),
             standstill_inv_omega_sq: inverse_square_speed(standstill_hz),
@@ -348,13 +353,13 @@ impl<T: Real> ResistanceAdaptationParams<T> {
             let Some((bracket, coupling)) = coupled_bracket(af, &point) else {
                 return false;
             };
-            // Frozen where what the model leaves open (the map's interpolation spread and the
-            // configured model flux uncertainty), times 1 + the frame coupling (a model error's
-            // q part turns the frame, which moves |λ̂r| by the coupling times it), exceeds the
-            // flux error a resistance error of `MAP_RESISTANCE_RESOLUTION`·R0 causes,
-            // R0·|bracket|/|ω̂| times it: there the law would learn the model's error as
-            // resistance.
-            let open = af.interpolation_spread(&point) + self.model_flux * (T::one() + coupling);
+            // Frozen where what the model leaves open (the map's interpolation spread, the
+            // configured model flux uncertainty at î) times 1 + the frame coupling (a model
+            // error's q part turns the frame, moving |λ̂r| by the coupling times it) exceeds
+            // the flux of a resistance error of `MAP_RESISTANCE_RESOLUTION`·R0,
+            // R0·|bracket|/|ω̂| times it: the law would learn the model's error as resistance.
+            let model_flux = self.model_flux + self.model_flux_growth * i_now.norm_squared();
+            let open = af.interpolation_spread(&point) + model_flux * (T::one() + coupling);
             if open * omega.abs() >= T::lit(MAP_RESISTANCE_RESOLUTION) * scale.r0 * bracket.abs() {
                 return false;
             }
@@ -424,7 +429,7 @@ impl<T: Real> ResistanceAdaptationParams<T> {
     /// excitation the turning law has seen, Ts/(T_E + E) with E its accumulated excitation time
     /// Σ χ²/(χ² + χ0²)·Ts and T_E = [`SATURATED_PRIOR_TIME`] the weight of the configured R0
     /// (module docs, "The rate on a saturating model"), and at least the configured γ; at most
-    /// half the error per period. The configured γ with a `model_flux_uncertainty` above 0
+    /// half the error per period. The configured γ with a model flux uncertainty above 0
     /// (the data then carry the model's error, which the gain would take at once); γ = 0 stays
     /// 0. At a frame-coupled point (`coupling` above `OFFSET_COUPLING_MAX`, where the estimator
     /// runs the law only at a steady operating point) the gain is the prior's 1/T_E whatever
@@ -441,7 +446,7 @@ impl<T: Real> ResistanceAdaptationParams<T> {
         mag: T,
         coupling: T,
     ) -> (T, T) {
-        if self.rate_ts <= T::zero() || self.model_flux > T::zero() {
+        if self.rate_ts <= T::zero() || self.model_flux + self.model_flux_growth > T::zero() {
             return (scale.gain, self.rate_ts);
         }
         let ts = self.config.ts;

@@ -69,8 +69,8 @@
 //! resistive speed R0·|bracket|/λ̂a over [`SATURATED_RESISTIVE_SPEED_ANGLE`] (40 rad), as the
 //! linear path's floor but four times faster, the saturating law being past the hand-over's
 //! transient, so that a machine whose resistance error costs much angle learns it in time.
-//! With a `model_flux_uncertainty` above 0 it keeps γ: the data then carry the model's
-//! error, which the faster gains would take at once. Measured
+//! With a `model_flux_uncertainty` or a `model_flux_growth` above 0 it keeps γ: the data
+//! then carry the model's error, which the faster gains would take at once. Measured
 //! (`saturated_rs_convergence`, `rated-reversal` started 0.7 and 1.4 times off, gain
 //! calibration off): see docs/method/saturation.md, "The R̂s law's regressor". A blanket 3γ
 //! also took the d-saturated SPM through, but lost a five-times cross-saturated IPMSM's
@@ -350,8 +350,17 @@ pub struct ResistanceAdaptationConfig<T> {
     /// of a 2 % resistance error at the operating point (docs/method/saturation.md, "The R̂s
     /// law's regressor"). 0 for the machine's own model (a measured map, an algebraic model of
     /// the machine). Default 0; `fado-sim commission` writes its identified model's figure
-    /// (`fado_core::commissioning::Identification::model_flux_uncertainty`).
+    /// (`fado_core::commissioning::Identification::model_flux_uncertainty`). The figure at
+    /// zero current: the law takes `model_flux_uncertainty` + `model_flux_growth`·|î|² at the
+    /// present current î.
     pub model_flux_uncertainty: T,
+    /// How much the model's flux uncertainty grows with the current, as a share of λ̂f per A²:
+    /// at the current î the law takes the model's flux to be off the machine's by
+    /// (`model_flux_uncertainty` + `model_flux_growth`·|î|²)·λ̂f (a saturating model's error
+    /// grows with the current, docs/method/saturation.md, "The offset law's gate"). Default 0;
+    /// the estimator sets it from `[estimator.rs_adaptation] model_flux_uncertainty_rated`
+    /// over the rated current squared.
+    pub model_flux_growth: T,
     /// Lower bound of R̂s as a multiple of R0. Default 0.5 (ours \[A\]).
     pub min_ratio: T,
     /// Upper bound of R̂s as a multiple of R0. Default 2 (ours \[A\]: copper from −40 °C to
@@ -402,6 +411,7 @@ impl<T: Real> ResistanceAdaptationConfig<T> {
                 * T::two_pi()
                 * threshold_hz,
             model_flux_uncertainty: T::zero(),
+            model_flux_growth: T::zero(),
             min_ratio: T::lit(DEFAULT_MIN_RATIO),
             max_ratio: T::lit(DEFAULT_MAX_RATIO),
         }

@@ -127,6 +127,10 @@ pub const MOVED_KEYS: &[(&str, &str)] = &[
         "rs_adaptation.model_flux_uncertainty",
     ),
     (
+        "rs_adaptation_model_flux_uncertainty_rated",
+        "rs_adaptation.model_flux_uncertainty_rated",
+    ),
+    (
         "flux_linkage_adaptation_rate",
         "flux_linkage_adaptation.rate",
     ),

@@ -320,11 +320,20 @@ pub struct RsAdaptationTuning<T> {
     /// [`ResistanceAdaptationConfig::model_flux_uncertainty`](crate::rs_adaptation::ResistanceAdaptationConfig::model_flux_uncertainty)).
     /// Default 0: the model is the machine's (a measured map, the machine's own algebraic
     /// model); the `identified.toml` of `fado-sim commission` sets its identified model's
-    /// figure.
+    /// figure. The figure at zero current: the law adds `model_flux_uncertainty_rated` times
+    /// the present current's square over the rated current's.
     pub model_flux_uncertainty: T,
+    /// How much the model's flux uncertainty grows up to the rated current, as a share of the
+    /// model's λ̂f: at the current î the turning law takes the model's flux to be off the
+    /// machine's by (`model_flux_uncertainty` + `model_flux_uncertainty_rated`·|î|²/I_rated²)
+    /// of λ̂f (ours \[A\], see
+    /// [`ResistanceAdaptationConfig::model_flux_growth`](crate::rs_adaptation::ResistanceAdaptationConfig::model_flux_growth)).
+    /// Default 0; the `identified.toml` of `fado-sim commission` sets its identified model's
+    /// figure (`fado_core::commissioning::Identification::model_flux_uncertainty_rated`).
+    pub model_flux_uncertainty_rated: T,
 }
 
-cast_record!(RsAdaptationTuning { rate, excitation_floor, min_ratio, max_ratio, standstill_angle_rate, model_flux_uncertainty ; enabled });
+cast_record!(RsAdaptationTuning { rate, excitation_floor, min_ratio, max_ratio, standstill_angle_rate, model_flux_uncertainty, model_flux_uncertainty_rated ; enabled });
 
 impl<T: Real> Default for RsAdaptationTuning<T> {
     fn default() -> Self {
@@ -336,6 +345,7 @@ impl<T: Real> Default for RsAdaptationTuning<T> {
             max_ratio: T::lit(rs_adaptation::DEFAULT_MAX_RATIO),
             standstill_angle_rate: T::lit(rs_adaptation::DEFAULT_STANDSTILL_ANGLE_RATE),
             model_flux_uncertainty: T::zero(),
+            model_flux_uncertainty_rated: T::zero(),
         }
     }
 }
