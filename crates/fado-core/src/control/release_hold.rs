@@ -307,6 +307,22 @@ fn release_window<T: Real>(machine: &MachineModel<T>, trigger: T) -> T {
     T::lit(RELEASE_WINDOW_RATIO) * (T::lit(2.0) * trigger / accel).step_sqrt()
 }
 
+/// The share of a load the hold armed at a brake's release takes from the fall's start
+/// rather than through its loop: 1 − (ω_h/ω_d)², with ω_h the loop's capped stiffness and
+/// ω_d its design's, in [0, 1] (0 where nothing caps it or the inputs are not finite). The
+/// loop's remaining (ω_h/ω_d)² of the load moves the rotor by 0.27·(ω_h/ω_d)²·a/ω_h², the
+/// design travel (module docs, "The load the fall reveals").
+fn fall_share<T: Real>(omega: T, design: T) -> T {
+    let ratio = omega / design;
+    let share = T::one() - ratio * ratio;
+    // NaN compares false: no share.
+    if share > T::zero() && share <= T::one() {
+        share
+    } else {
+        T::zero()
+    }
+}
+
 /// Peak of t²·e^(−t)/2 (at t = 2): the largest travel of the triple-pole loop per a/ω_h².
 const PEAK_TRAVEL: f64 = 0.270_670_566_473_225_4;
 
@@ -414,6 +430,13 @@ pub struct ReleaseHold<T> {
     resume_step: T,
     /// The speed reference resumes from zero after a motion hold's hand-over.
     resuming: bool,
+    /// Time since a brake's release while the hold awaits the fall, s.
+    fall_time: T,
+    /// The share of the load the capped loop lacks over b: (1 − (ω_h/ω_d)²)/b, A per
+    /// electrical rad/s² (zero where the loop has its design stiffness ω_d).
+    fall_gain: T,
+    /// That share of the rated torque's magnet q current, at most `i_max` (A).
+    max_fall_load: T,
     /// The resumed reference (electrical rad/s).
     resumed: T,
 }
@@ -439,9 +462,12 @@ impl<T: Real> ReleaseHold<T> {
         check::below("release_hold.window", n, T::lit(4e9), "below 4e9 samples")?;
         let b = T::lit(1.5) * p * p * machine.flux_linkage / machine.inertia;
         let release_n = release_window(machine, trigger) / ts;
-        let omega = design_omega(machine, travel)
+        let design = design_omega(machine, travel);
+        let omega = design
             .step_min(T::two_pi() * current_bandwidth_hz / T::lit(10.0))
             .step_min(T::lit(0.1) / ts);
+        let a_rated = p * machine.rated_torque / machine.inertia;
+        let share = fall_share(omega, design);
         let kp = T::lit(3.0) * omega * omega / b;
         let kd = T::lit(3.0) * omega / b;
         let ki_ts = omega * omega * omega * ts / b;
@@ -489,6 +515,9 @@ impl<T: Real> ReleaseHold<T> {
             resume_step,
             resuming: false,
             resumed: T::zero(),
+            fall_time: T::zero(),
+            fall_gain: share / b,
+            max_fall_load: (share * a_rated / b).step_min(i_max),
         })
     }
 
@@ -537,6 +566,7 @@ impl<T: Real> ReleaseHold<T> {
         self.output = T::zero();
         self.theta_last = theta_hold;
         self.omega = T::zero();
+        self.fall_time = T::zero();
     }
 
     /// Acts at once, holding `theta_hold` from the rotor's electrical speed `omega` (rad/s:
@@ -684,6 +714,25 @@ impl<T: Real> ReleaseHold<T> {
         };
     }
 
+    /// The share of the load (A of magnet q current) a rotor at rest from the brake's release
+    /// reveals by its fall at the trigger that the hold's integral starts from: the direct
+    /// angle's travel `e` (θ_hold − θ) in `fall_time` under a constant acceleration,
+    /// a = 2·e/t², over b, times the share the capped loop lacks (module docs, "The load the
+    /// fall reveals"), at most that share of the rated load. Zero where the tracked angle's
+    /// travel `tracked` (θ_hold − θ̂) runs the other way: a transient of the direct angle,
+    /// not a fall.
+    fn fall_load(&self, e: T, tracked: T) -> T {
+        let t = self.fall_time;
+        let load = T::lit(2.0) * e * self.fall_gain / (t * t);
+        let lim = self.max_fall_load;
+        // NaN compares false: no preset.
+        if e * tracked >= T::zero() && load.is_finite() {
+            crate::control::pi::clamp(load, -lim, lim)
+        } else {
+            T::zero()
+        }
+    }
+
     /// One sample: the speed reference `speed_ref`, the estimator's tracked angle θ̂
     /// (`theta_tracked`, which triggers the hold unless it was armed at a brake's release)
     /// and its direct rotor-flux angle (`theta`, which the loop holds and which triggers a
@@ -752,9 +801,15 @@ impl<T: Real> ReleaseHold<T> {
             };
             let triggered = fall > self.trigger;
             if !triggered {
+                self.fall_time += self.ts;
                 return HoldAction::Idle;
             }
             self.active = true;
+            if self.released && self.fall_gain > T::zero() {
+                self.fall_time += self.ts;
+                let tracked = crate::wrap_angle(self.theta_hold - theta_tracked);
+                self.integral = self.fall_load(e, tracked);
+            }
             // A fall against a moving reference is held as a motion the start-up saw: until
             // settled, then the reference resumes from zero.
             self.engaged_by_motion = sense != T::zero();
