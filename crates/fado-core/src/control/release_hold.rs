@@ -112,6 +112,11 @@
 //! outrunner; 0.1 rad or less on every preset that is not a multirotor or outrunner (the
 //! 50 kW IPMSM's 0.097 the largest), which keep the hand-over (docs/method/startup.md, "The
 //! loaded standstill after the release").
+//!
+//! # The load the fall reveals
+//! Where the current loop or the sampling caps ω_h, a hold armed at a brake's release starts
+//! its integral from the share of the load its capped stiffness lacks, read from the fall's
+//! kinematics at the trigger (`release_hold/fall.rs`: the 400 W servo's bare rotor).
 
 use crate::error::{ConfigError, check};
 use crate::real::cast_record;
@@ -307,22 +312,6 @@ fn release_window<T: Real>(machine: &MachineModel<T>, trigger: T) -> T {
     T::lit(RELEASE_WINDOW_RATIO) * (T::lit(2.0) * trigger / accel).step_sqrt()
 }
 
-/// The share of a load the hold armed at a brake's release takes from the fall's start
-/// rather than through its loop: 1 − (ω_h/ω_d)², with ω_h the loop's capped stiffness and
-/// ω_d its design's, in [0, 1] (0 where nothing caps it or the inputs are not finite). The
-/// loop's remaining (ω_h/ω_d)² of the load moves the rotor by 0.27·(ω_h/ω_d)²·a/ω_h², the
-/// design travel (module docs, "The load the fall reveals").
-fn fall_share<T: Real>(omega: T, design: T) -> T {
-    let ratio = omega / design;
-    let share = T::one() - ratio * ratio;
-    // NaN compares false: no share.
-    if share > T::zero() && share <= T::one() {
-        share
-    } else {
-        T::zero()
-    }
-}
-
 /// Peak of t²·e^(−t)/2 (at t = 2): the largest travel of the triple-pole loop per a/ω_h².
 const PEAK_TRAVEL: f64 = 0.270_670_566_473_225_4;
 
@@ -432,10 +421,9 @@ pub struct ReleaseHold<T> {
     resuming: bool,
     /// Time since a brake's release while the hold awaits the fall, s.
     fall_time: T,
-    /// The share of the load the capped loop lacks over b: (1 − (ω_h/ω_d)²)/b, A per
-    /// electrical rad/s² (zero where the loop has its design stiffness ω_d).
+    /// The share of the load the capped loop lacks over b, A per electrical rad/s² (`fall`).
     fall_gain: T,
-    /// That share of the rated torque's magnet q current, at most `i_max` (A).
+    /// That share of the rated load, at most `i_max` (A).
     max_fall_load: T,
     /// The resumed reference (electrical rad/s).
     resumed: T,
@@ -467,7 +455,7 @@ impl<T: Real> ReleaseHold<T> {
             .step_min(T::two_pi() * current_bandwidth_hz / T::lit(10.0))
             .step_min(T::lit(0.1) / ts);
         let a_rated = p * machine.rated_torque / machine.inertia;
-        let share = fall_share(omega, design);
+        let share = fall::fall_share(omega, design);
         let kp = T::lit(3.0) * omega * omega / b;
         let kd = T::lit(3.0) * omega / b;
         let ki_ts = omega * omega * omega * ts / b;
@@ -714,25 +702,6 @@ impl<T: Real> ReleaseHold<T> {
         };
     }
 
-    /// The share of the load (A of magnet q current) a rotor at rest from the brake's release
-    /// reveals by its fall at the trigger that the hold's integral starts from: the direct
-    /// angle's travel `e` (θ_hold − θ) in `fall_time` under a constant acceleration,
-    /// a = 2·e/t², over b, times the share the capped loop lacks (module docs, "The load the
-    /// fall reveals"), at most that share of the rated load. Zero where the tracked angle's
-    /// travel `tracked` (θ_hold − θ̂) runs the other way: a transient of the direct angle,
-    /// not a fall.
-    fn fall_load(&self, e: T, tracked: T) -> T {
-        let t = self.fall_time;
-        let load = T::lit(2.0) * e * self.fall_gain / (t * t);
-        let lim = self.max_fall_load;
-        // NaN compares false: no preset.
-        if e * tracked >= T::zero() && load.is_finite() {
-            crate::control::pi::clamp(load, -lim, lim)
-        } else {
-            T::zero()
-        }
-    }
-
     /// One sample: the speed reference `speed_ref`, the estimator's tracked angle θ̂
     /// (`theta_tracked`, which triggers the hold unless it was armed at a brake's release)
     /// and its direct rotor-flux angle (`theta`, which the loop holds and which triggers a
@@ -799,16 +768,16 @@ impl<T: Real> ReleaseHold<T> {
             } else {
                 moved * sense
             };
+            self.fall_time += self.ts;
             let triggered = fall > self.trigger;
             if !triggered {
-                self.fall_time += self.ts;
                 return HoldAction::Idle;
             }
             self.active = true;
             if self.released && self.fall_gain > T::zero() {
-                self.fall_time += self.ts;
                 let tracked = crate::wrap_angle(self.theta_hold - theta_tracked);
-                self.integral = self.fall_load(e, tracked);
+                let (gain, lim) = (self.fall_gain, self.max_fall_load);
+                self.integral = fall::fall_load(e, tracked, self.fall_time, gain, lim);
             }
             // A fall against a moving reference is held as a motion the start-up saw: until
             // settled, then the reference resumes from zero.
@@ -823,6 +792,8 @@ impl<T: Real> ReleaseHold<T> {
         HoldAction::Hold(self.output)
     }
 }
+
+mod fall;
 
 #[cfg(test)]
 mod tests;
