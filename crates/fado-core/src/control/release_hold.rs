@@ -114,9 +114,9 @@
 //! loaded standstill after the release").
 //!
 //! # The load the fall reveals
-//! Where the current loop or the sampling caps ω_h, a hold armed at a brake's release starts
-//! its integral from the share of the load its capped stiffness lacks, read from the fall's
-//! kinematics at the trigger (`release_hold/fall.rs`: the 400 W servo's bare rotor).
+//! Where the current loop or the sampling caps ω_h, a hold armed at a brake's release watches
+//! the direct angle and starts its integral from the share of the load its capped stiffness
+//! lacks, read from the fall at the trigger (`release_hold/fall.rs`: a 400 W servo's rotor).
 
 use crate::error::{ConfigError, check};
 use crate::real::cast_record;
@@ -745,11 +745,11 @@ impl<T: Real> ReleaseHold<T> {
         }
         if !self.active {
             self.elapsed = self.elapsed.saturating_add(1);
-            // Armed at a brake's release on a saturating model the hold watches the angle its
-            // loop holds, the direct one (the tracked angle lags a rotor that starts to fall by
-            // milliseconds; module docs, "When"), within the release's own window.
-            let on_direct = self.released && self.release_on_direct;
-            let window = if on_direct {
+            // Armed at a brake's release on a saturating model or capped (`fall`), the hold
+            // watches the direct angle its loop holds (the tracked one lags a falling rotor by
+            // milliseconds; module docs, "When"); a saturating model within its own window.
+            let on_direct = self.released && (self.release_on_direct || self.fall_gain > T::zero());
+            let window = if self.released && self.release_on_direct {
                 self.release_window_samples
             } else {
                 self.window_samples

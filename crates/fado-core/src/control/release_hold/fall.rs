@@ -15,8 +15,11 @@
 //! # The rule
 //! A drive with a holding brake knows when it opens; from there the rotor, at rest, falls
 //! under the load alone (the drive's q current is zero), at a = b·i_L (b = 1.5·p²·λ̂f/Ĵ):
-//! after t it has travelled a·t²/2. At the trigger the hold reads the load from the direct
-//! angle's travel e and the time since the release, i_L = 2·e/(b·t²), and starts its integral
+//! after t it has travelled a·t²/2. The capped hold watches the direct angle for its trigger,
+//! as on a saturating model (the tracked angle lags the fall by a sample or more: on the
+//! servo it had moved 0.024 rad of a 0.058 rad fall when it triggered). At the trigger it
+//! reads the load from the direct angle's travel e and the time since the release,
+//! i_L = 2·e/(b·t²), and starts its integral
 //! from the share 1 − (ω_h/ω_d)² of it, at most that share of the rated load: the loop takes
 //! the rest, (ω_h/ω_d)² of the load, within its design travel. Where nothing caps ω_h the
 //! share is zero and the hold is the designed loop. The angles lag the rotor (the estimate's
@@ -34,14 +37,16 @@
 //! fall itself is its measurement of the load.
 //!
 //! # Measured
-//! `loaded-start` backward travel (rad, `python3 scripts/startup-table.py`, seeds 1–4): the
-//! Estun servo 0.487 / 0.884 / 0.534 / 0.484 (1.28 at seed 1 without the preset); the
-//! made-up 750 W servo (`crates/fado-sim/tests/data/startup-spm-750w.toml`) 0.33 / 0.42 /
-//! 0.34 / 0.33 (0.38 / 0.46 / 0.39 / 0.38); the MAD 5010 kv200 0.35 / 0.34 / 0.37 / 0.36
-//! (0.41 / 0.39 / 0.48 / 0.41); the 36 V tool motor 0.31 / 0.46 at seeds 1 / 2, its
-//! |θ − θ̂| from ready 0.160 / 0.245 rad (0.137 / 0.2516); the multirotor preset's travel
-//! and angle unchanged (its end speed error moves by 0.02 r/min at most). Every other preset,
-//! made-up and datasheet machine of the table is uncapped and unchanged.
+//! `loaded-start` backward travel (rad, `python3 scripts/startup-table.py`, seeds 1–4; without
+//! the rule in brackets): the Estun servo 0.445 / 0.863 / 0.451 / 0.440 (1.28 at seed 1), its
+//! |θ − θ̂| from ready 0.051 / 0.096 / 0.074 / 0.053; the made-up 750 W servo
+//! (`crates/fado-sim/tests/data/startup-spm-750w.toml`) 0.22 / 0.22 / 0.23 / 0.22 (0.38 / 0.46
+//! / 0.39 / 0.38); the MAD 5010 kv200 0.22 / 0.21 / 0.26 / 0.23 (0.41 / 0.39 / 0.48 / 0.41);
+//! the multirotor preset 0.17 / 0.18 / 0.21 / 0.18 (0.21 / 0.20 / 0.23 / 0.22); the 36 V tool
+//! motor at seeds 1 / 2 0.21 / 0.26, |θ − θ̂| from ready 0.112 / 0.126 rad (0.137 / 0.2516).
+//! Every other preset, made-up and datasheet machine of the table is uncapped and unchanged.
+//! With the preset but the trigger on the tracked angle the servo ran back 0.49 / 0.88 / 0.53
+//! / 0.48 rad.
 
 use crate::Real;
 
