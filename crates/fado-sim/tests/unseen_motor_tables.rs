@@ -12,7 +12,7 @@
 //! 0.168, `fullrange` 0.109 / 0.106, `regen-stop` 0.052 / 0.052; EMRAX 0.012 / 0.011, 0.031 /
 //! 0.030, 0.013 / 0.013, 0.121 / 0.187, 0.095 / 0.095, 0.072 / 0.066; the servo 0.004 / 0.007,
 //! 0.008 / 0.007, 0.004 / 0.007, `fullrange` 0.144 / 0.127, `regen-stop` seed 2 0.157; the tool
-//! 0.017 / 0.019, 0.051 / 0.062, 0.019 / 0.020, `loaded-start` seed 1 0.137, 0.088 / 0.088,
+//! 0.017 / 0.019, 0.051 / 0.062, 0.019 / 0.020, `loaded-start` 0.112 / 0.126, 0.088 / 0.088,
 //! 0.070 / 0.056; the EPS motor 0.027 / 0.020, `stops` 0.095 / 0.119, 0.021 / 0.019,
 //! `loaded-start` 0.042 / 0.043, `fullrange` 0.117 / 0.126, `regen-stop` 0.024 / 0.036; the
 //! appliance motor 0.016 / 0.015, 0.169 / 0.106, 0.038 / 0.018, 0.056 / 0.085, 0.136 / 0.083,
@@ -20,8 +20,8 @@
 //! pass `reversal`.
 //!
 //! The misses, in the ignored tests below with their figures: the light servo rotor falls back
-//! when the brake opens (`loaded-start`), the tool motor's angle during that fall (seed 2), and
-//! the appliance motor at seeds 3 and 4, whose start-up reads its current step through the
+//! when the brake opens at seed 2 (`loaded-start`) and rings at its regenerating stop, and the
+//! appliance motor at seeds 3 and 4, whose start-up reads its current step through the
 //! inverter's band as motion and leaves the sensors' gain mismatch uncalibrated.
 
 use fado_core::MachineModel;
@@ -94,12 +94,14 @@ fn a_47_kw_axial_flux_traction_motor_passes_every_scenario_and_commissions() {
 
 #[test]
 fn a_400_w_servo_with_its_bare_rotor_passes_its_running_scenarios() {
+    // `loaded-start` in the light rotors' tests below.
     let skip = [("loaded-start", 1), ("loaded-start", 2), ("regen-stop", 1)];
     every_scenario("servo-estun-emj04-400w-310v", &skip);
 }
 
 #[test]
-fn a_36_v_power_tool_motor_passes_every_scenario_but_one_loaded_start() {
+fn a_36_v_power_tool_motor_passes_every_scenario() {
+    // `loaded-start` seed 2 in the light rotors' test below.
     every_scenario("tool-makita-4p-36v", &[("loaded-start", 2)]);
 }
 
@@ -227,26 +229,42 @@ fn the_appliance_motor_calibrates_at_every_seed() {
     assert!(missed.is_empty(), "missed: {missed:?}");
 }
 
-/// The servo's bare rotor (rated torque to rated speed in 7.7 ms) under the rated gravity-like
-/// load: the brake opens at 0.700 s with the drive at zero q current, the load drops the rotor
-/// to −601 r/min within 2 ms before i_q reaches it, a backward travel of 1.28 rad (seed 1; the
-/// criterion's 0.5) with the angle held (0.118 / 0.157 rad). The tool motor falls the same way
-/// (−409 r/min at 0.705 s) and its angle reaches 0.2516 rad at seed 2 (0.25 allowed). The
-/// servo's `regen-stop` at seed 1: held at zero under the overhauling rated load, its speed
-/// rings ±25 … 76 r/min (60 allowed) over 7–8 s.
+/// The light rotors under the rated gravity-like load at the brake's release: the servo's
+/// bare rotor (rated torque to rated speed in 7.7 ms) and the tool motor, whose release holds
+/// are capped by the 10 kHz sampling below their design stiffness (servo ω_h 200 of 470
+/// rad/s): they trigger on the direct angle and start their integral from the load the fall
+/// reveals (`fado_core::control::release_hold`, "The load the fall reveals"). Measured
+/// (backward travel, |θ − θ̂| from ready, rad): the servo at seeds 1 / 3 0.445 / 0.451 and
+/// 0.051 / 0.074 (1.28 back at seed 1 without the rule; the criterion's 0.5); the tool motor
+/// at seed 2 0.264 and 0.126 (0.2516 without; 0.25 allowed).
 #[test]
-#[ignore = "light rotor falls at brake release: servo backward travel 1.28 rad (0.5), tool \
-            0.2516 rad at seed 2; servo regen-stop seed 1 speed error 76.5 r/min (60)"]
 fn the_light_rotors_lift_their_load_from_the_brake() {
     let mut missed = Vec::new();
-    for (name, scenario, seed) in [
-        ("servo-estun-emj04-400w-310v", "loaded-start", 1),
-        ("servo-estun-emj04-400w-310v", "loaded-start", 2),
-        ("servo-estun-emj04-400w-310v", "regen-stop", 1),
-        ("tool-makita-4p-36v", "loaded-start", 2),
+    for (name, seed) in [
+        ("servo-estun-emj04-400w-310v", 1),
+        ("servo-estun-emj04-400w-310v", 3),
+        ("tool-makita-4p-36v", 2),
     ] {
-        if !run(name, scenario, seed, "").0 {
-            missed.push(format!("{name} {scenario} seed {seed}"));
+        if !run(name, "loaded-start", seed, "").0 {
+            missed.push(format!("{name} loaded-start seed {seed}"));
+        }
+    }
+    assert!(missed.is_empty(), "missed: {missed:?}");
+}
+
+/// The servo's bare rotor at seed 2: under the release's 1.7 A d current the estimate lags
+/// the fall (θ̂ 0.08 rad behind a 0.106 rad fall 1.2 ms after the release), the load the
+/// fall reveals reads short of the true one and the rotor runs back 0.863 rad (0.5 allowed;
+/// 0.884 with the trigger on the tracked angle). Its `regen-stop` at seed 1: held at zero
+/// under the overhauling rated load, its speed rings ±25 … 76 r/min (60 allowed) over 7–8 s.
+#[test]
+#[ignore = "servo loaded-start seed 2 backward travel 0.863 rad (0.5): the estimate lags the \
+            fall; servo regen-stop seed 1 speed error 76.5 r/min (60)"]
+fn the_servo_rotor_at_seed_2_and_its_regenerating_stop() {
+    let mut missed = Vec::new();
+    for (scenario, seed) in [("loaded-start", 2), ("regen-stop", 1)] {
+        if !run("servo-estun-emj04-400w-310v", scenario, seed, "").0 {
+            missed.push(format!("{scenario} seed {seed}"));
         }
     }
     assert!(missed.is_empty(), "missed: {missed:?}");

@@ -112,6 +112,11 @@
 //! outrunner; 0.1 rad or less on every preset that is not a multirotor or outrunner (the
 //! 50 kW IPMSM's 0.097 the largest), which keep the hand-over (docs/method/startup.md, "The
 //! loaded standstill after the release").
+//!
+//! # The load the fall reveals
+//! Where the current loop or the sampling caps ω_h, a hold armed at a brake's release watches
+//! the direct angle and starts its integral from the share of the load its capped stiffness
+//! lacks, read from the fall at the trigger (`release_hold/fall.rs`: a 400 W servo's rotor).
 
 use crate::error::{ConfigError, check};
 use crate::real::cast_record;
@@ -414,6 +419,12 @@ pub struct ReleaseHold<T> {
     resume_step: T,
     /// The speed reference resumes from zero after a motion hold's hand-over.
     resuming: bool,
+    /// Time since a brake's release while the hold awaits the fall, s.
+    fall_time: T,
+    /// The share of the load the capped loop lacks over b, A per electrical rad/s² (`fall`).
+    fall_gain: T,
+    /// That share of the rated load, at most `i_max` (A).
+    max_fall_load: T,
     /// The resumed reference (electrical rad/s).
     resumed: T,
 }
@@ -439,9 +450,12 @@ impl<T: Real> ReleaseHold<T> {
         check::below("release_hold.window", n, T::lit(4e9), "below 4e9 samples")?;
         let b = T::lit(1.5) * p * p * machine.flux_linkage / machine.inertia;
         let release_n = release_window(machine, trigger) / ts;
-        let omega = design_omega(machine, travel)
+        let design = design_omega(machine, travel);
+        let omega = design
             .step_min(T::two_pi() * current_bandwidth_hz / T::lit(10.0))
             .step_min(T::lit(0.1) / ts);
+        let a_rated = p * machine.rated_torque / machine.inertia;
+        let share = fall::fall_share(omega, design);
         let kp = T::lit(3.0) * omega * omega / b;
         let kd = T::lit(3.0) * omega / b;
         let ki_ts = omega * omega * omega * ts / b;
@@ -489,6 +503,9 @@ impl<T: Real> ReleaseHold<T> {
             resume_step,
             resuming: false,
             resumed: T::zero(),
+            fall_time: T::zero(),
+            fall_gain: share / b,
+            max_fall_load: (share * a_rated / b).step_min(i_max),
         })
     }
 
@@ -537,6 +554,7 @@ impl<T: Real> ReleaseHold<T> {
         self.output = T::zero();
         self.theta_last = theta_hold;
         self.omega = T::zero();
+        self.fall_time = T::zero();
     }
 
     /// Acts at once, holding `theta_hold` from the rotor's electrical speed `omega` (rad/s:
@@ -727,11 +745,11 @@ impl<T: Real> ReleaseHold<T> {
         }
         if !self.active {
             self.elapsed = self.elapsed.saturating_add(1);
-            // Armed at a brake's release on a saturating model the hold watches the angle its
-            // loop holds, the direct one (the tracked angle lags a rotor that starts to fall by
-            // milliseconds; module docs, "When"), within the release's own window.
-            let on_direct = self.released && self.release_on_direct;
-            let window = if on_direct {
+            // Armed at a brake's release on a saturating model or capped (`fall`), the hold
+            // watches the direct angle its loop holds (the tracked one lags a falling rotor by
+            // milliseconds; module docs, "When"); a saturating model within its own window.
+            let on_direct = self.released && (self.release_on_direct || self.fall_gain > T::zero());
+            let window = if self.released && self.release_on_direct {
                 self.release_window_samples
             } else {
                 self.window_samples
@@ -750,11 +768,17 @@ impl<T: Real> ReleaseHold<T> {
             } else {
                 moved * sense
             };
+            self.fall_time += self.ts;
             let triggered = fall > self.trigger;
             if !triggered {
                 return HoldAction::Idle;
             }
             self.active = true;
+            if self.released && self.fall_gain > T::zero() {
+                let tracked = crate::wrap_angle(self.theta_hold - theta_tracked);
+                let (gain, lim) = (self.fall_gain, self.max_fall_load);
+                self.integral = fall::fall_load(e, tracked, self.fall_time, gain, lim);
+            }
             // A fall against a moving reference is held as a motion the start-up saw: until
             // settled, then the reference resumes from zero.
             self.engaged_by_motion = sense != T::zero();
@@ -768,6 +792,8 @@ impl<T: Real> ReleaseHold<T> {
         HoldAction::Hold(self.output)
     }
 }
+
+mod fall;
 
 #[cfg(test)]
 mod tests;

@@ -397,3 +397,66 @@ fn a_release_hold_acts_only_on_a_fall_as_fast_as_a_load_gives() {
     let at = fall(&mut linear, slow).expect("a linear model");
     assert!((at - 10.0 * t_r).abs() < 0.5e-3, "{at}");
 }
+
+/// A rigid rotor at rest under the rated load from t = 0 with an exact angle, the hold armed
+/// at a brake's release (`released`) or at the alignment: (largest travel over 0.1 s, the
+/// hold's first output, the rated load), A of magnet q current.
+fn fall_from_release(machine: &MachineModel<f64>, released: bool) -> (f64, f64, f64) {
+    let ts = 1e-4;
+    let tuning = ReleaseHoldTuning {
+        enabled: true,
+        ..ReleaseHoldTuning::default()
+    };
+    let p = machine.pole_pairs as f64;
+    let b = 1.5 * p * p * machine.flux_linkage / machine.inertia;
+    let i_load = machine.rated_torque / (1.5 * p * machine.flux_linkage);
+    let mut h = ReleaseHold::new(&tuning, machine, ts, 250.0, 2.0 * i_load).unwrap();
+    if released {
+        h.arm_at_release(0.3);
+    } else {
+        h.arm(0.3);
+    }
+    let (mut theta, mut omega, mut i) = (0.3, 0.0, 0.0);
+    let (mut worst, mut first) = (0.0_f64, None);
+    for _ in 0..1_000 {
+        if let HoldAction::Hold(x) = h.step(0.0, theta, theta) {
+            i = x;
+            first.get_or_insert(x);
+        }
+        omega += b * (i - i_load) * ts;
+        theta += omega * ts;
+        worst = worst.max(0.3 - theta);
+    }
+    (worst, first.expect("the fall triggers the hold"), i_load)
+}
+
+#[test]
+fn a_capped_hold_starts_from_the_load_its_fall_reveals() {
+    // The paper's rotor: ω_h at its design, the hold armed at a release is the designed loop
+    // (the same travel as armed at the alignment, a first output of its P and D terms only).
+    let paper = MachineModel::paper();
+    assert_eq!(
+        fall_from_release(&paper, false),
+        fall_from_release(&paper, true)
+    );
+    // A twelfth of its inertia: ω_h capped at ωc/10 (157 rad/s) below its design ω_d; the
+    // integral starts from the share 1 − (ω_h/ω_d)² = 0.60 of the load the fall shows (the
+    // first output 15.3 A of the 21.8 A load), and the travel falls from 0.47 rad armed at
+    // the alignment to 0.22 rad (measured).
+    let mut light = MachineModel::paper();
+    light.inertia = 0.001;
+    let design = design_omega(&light, 0.2);
+    let capped = core::f64::consts::TAU * 250.0 / 10.0;
+    let share = 1.0 - (capped / design).powi(2);
+    let (armed, _, _) = fall_from_release(&light, false);
+    let (released, first, load) = fall_from_release(&light, true);
+    assert!(share > 0.5, "{share}");
+    assert!(
+        first > 0.8 * share * load,
+        "{first} of {load}, share {share}"
+    );
+    assert!(
+        released < 0.6 * armed,
+        "{released} against {armed}, first {first} of {load}, share {share}"
+    );
+}

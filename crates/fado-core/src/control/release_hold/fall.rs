@@ -1,0 +1,79 @@
+//! The load a rotor's fall from a brake's release reveals, and the share of it the hold's
+//! integral starts from where its stiffness is capped.
+//!
+//! # Why
+//! The hold's loop is a triple pole at ω_h designed so that the rated load moves the rotor by
+//! its design travel, ω_d = √(0.27·a_rated/travel). The current loop (ω_h ≤ ωc/10, ωc·Ts at
+//! most 0.2) and the sampling (ω_h ≤ 0.1/Ts) cap it: a rotor whose rated load accelerates it
+//! faster than its sampling can follow then runs back by 0.27·a/ω_h², (ω_d/ω_h)² times the
+//! design. The Estun EMJ-04 400 W servo's bare rotor (3.1e-5 kg·m², 8 poles, rated torque to
+//! rated speed in 7.7 ms) sampled at 10 kHz has ω_d = 470 rad/s and ω_h = 200 rad/s: its
+//! integral builds the rated load's 3.4 A over 2.5 ms while the rotor falls at 1.6·10⁵ rad/s²
+//! (electrical), −637 r/min and 1.28 rad back (`loaded-start` seed 1,
+//! `crates/fado-sim/tests/unseen_motor_tables.rs`).
+//!
+//! # The rule
+//! A drive with a holding brake knows when it opens; from there the rotor, at rest, falls
+//! under the load alone (the drive's q current is zero), at a = b·i_L (b = 1.5·p²·λ̂f/Ĵ):
+//! after t it has travelled a·t²/2. The capped hold watches the direct angle for its trigger,
+//! as on a saturating model (the tracked angle lags the fall by a sample or more: on the
+//! servo it had moved 0.024 rad of a 0.058 rad fall when it triggered). At the trigger it
+//! reads the load from the direct angle's travel e and the time since the release,
+//! i_L = 2·e/(b·t²), and starts its integral
+//! from the share 1 − (ω_h/ω_d)² of it, at most that share of the rated load: the loop takes
+//! the rest, (ω_h/ω_d)² of the load, within its design travel. Where nothing caps ω_h the
+//! share is zero and the hold is the designed loop. The angles lag the rotor (the estimate's
+//! own delay, 0.08 rad behind a 0.1 rad fall at the servo's seed 2 under the release's 1.7 A
+//! d current): the read load is a lower bound of the true one, never a torque the load has
+//! not shown. A direct angle that moves against the tracked one at the trigger is the
+//! currents' transient, not a fall, and gives no preset (the saturated PM-SyRM
+//! `motors/saturated/pmsyrm-baldor-5k6-measured.toml` at `loaded-start` seed 3: a preset
+//! from it sent the full opposite torque and lost the rotor).
+//!
+//! Real drives with a holding brake energise the motor before they open it and hold with a
+//! position loop sampled fast enough for their rotor (a servo's encoder loop at kHz), or
+//! start from a stored or weighed load torque (a hoist's "torque memory", an elevator's
+//! load-weighing pre-torque); a sensorless drive at its first start has neither, and the
+//! fall itself is its measurement of the load.
+//!
+//! # Measured
+//! `loaded-start` backward travel (rad, `python3 scripts/startup-table.py`, seeds 1–4; without
+//! the rule in brackets): the Estun servo 0.445 / 0.863 / 0.451 / 0.440 (1.28 at seed 1), its
+//! |θ − θ̂| from ready 0.051 / 0.096 / 0.074 / 0.053; the made-up 750 W servo
+//! (`crates/fado-sim/tests/data/startup-spm-750w.toml`) 0.22 / 0.22 / 0.23 / 0.22 (0.38 / 0.46
+//! / 0.39 / 0.38); the MAD 5010 kv200 0.22 / 0.21 / 0.26 / 0.23 (0.41 / 0.39 / 0.48 / 0.41);
+//! the multirotor preset 0.17 / 0.18 / 0.21 / 0.18 (0.21 / 0.20 / 0.23 / 0.22); the 36 V tool
+//! motor at seeds 1 / 2 0.21 / 0.26, |θ − θ̂| from ready 0.112 / 0.126 rad (0.137 / 0.2516).
+//! Every other preset, made-up and datasheet machine of the table is uncapped and unchanged.
+//! With the preset but the trigger on the tracked angle the servo ran back 0.49 / 0.88 / 0.53
+//! / 0.48 rad.
+
+use crate::Real;
+
+/// The share of a load the hold armed at a brake's release takes from the fall's start
+/// rather than through its loop: 1 − (ω_h/ω_d)² for the loop's capped stiffness `omega` and
+/// its design's `design`, in [0, 1] (0 where nothing caps it or the inputs are not finite).
+pub(super) fn fall_share<T: Real>(omega: T, design: T) -> T {
+    let ratio = omega / design;
+    let share = T::one() - ratio * ratio;
+    // NaN compares false: no share.
+    if share > T::zero() && share <= T::one() {
+        share
+    } else {
+        T::zero()
+    }
+}
+
+/// The integral's start (A of magnet q current) at the trigger: the direct angle's travel
+/// `e` (θ_hold − θ) in the time `t` since the release as a constant acceleration, 2·e/t²,
+/// times `gain` (the share over b), within ±`lim`. Zero where the tracked angle's travel
+/// `tracked` (θ_hold − θ̂) runs the other way, or the inputs give no finite load.
+pub(super) fn fall_load<T: Real>(e: T, tracked: T, t: T, gain: T, lim: T) -> T {
+    let load = T::lit(2.0) * e * gain / (t * t);
+    // NaN compares false: no preset.
+    if e * tracked >= T::zero() && load.is_finite() {
+        crate::control::pi::clamp(load, -lim, lim)
+    } else {
+        T::zero()
+    }
+}
