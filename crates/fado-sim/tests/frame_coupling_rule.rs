@@ -12,6 +12,9 @@ fn root() -> &'static str {
 /// The model's coupling at the rated torque, T2S-2 before and after the drive's rules, and the
 /// configuration's warning on the coupling.
 fn coupling_and_tracker(path: &str) -> (Option<f64>, f64, f64, Option<String>) {
+    // The map's directory is the process's: one configuration at a time.
+    static DIR: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    let _dir = DIR.lock().unwrap_or_else(|e| e.into_inner());
     let file = format!("{}{path}", root());
     let dir = std::path::Path::new(&file).parent().unwrap().to_path_buf();
     fado_sim::magnetics_file::set_config_dir(Some(&dir));

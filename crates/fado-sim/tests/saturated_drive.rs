@@ -37,9 +37,14 @@ fn run(scenario: &str, text: &str) -> (bool, f64, f64) {
 
 /// `reversal`, `stops` and `rated-reversal` pass for the sensor seeds 1–4 on the machine.
 fn passes_every_seed(base: &str) {
+    passes_on_every_seed(base, &["reversal", "stops", "rated-reversal"]);
+}
+
+/// The `scenarios` pass for the sensor seeds 1–4 on the machine.
+fn passes_on_every_seed(base: &str, scenarios: &[&str]) {
     for seed in 1..=4 {
         let text = format!("{base}\n[current_sensor]\nseed = {seed}\n");
-        for scenario in ["reversal", "stops", "rated-reversal"] {
+        for &scenario in scenarios {
             let (passed, angle, speed) = run(scenario, &text);
             println!("seed {seed} {scenario}: {angle:.4} rad, {speed:.2} r/min");
             assert!(passed, "seed {seed} {scenario}: {angle} rad, {speed} r/min");
@@ -195,18 +200,6 @@ fn motulator_small_high_saliency_ipmsm_passes_every_seed() {
     passes_every_seed(&motulator_machine("mot-ipm-1k1"));
 }
 
-/// `reversal` and `stops` pass for the sensor seeds 1–4 on the machine.
-fn holds_reversal_and_stops(base: &str) {
-    for seed in 1..=4 {
-        let text = format!("{base}\n[current_sensor]\nseed = {seed}\n");
-        for scenario in ["reversal", "stops"] {
-            let (passed, angle, speed) = run(scenario, &text);
-            println!("seed {seed} {scenario}: {angle:.4} rad, {speed:.2} r/min");
-            assert!(passed, "seed {seed} {scenario}: {angle} rad, {speed} r/min");
-        }
-    }
-}
-
 /// Open loop, the same machine's exact signals hold the angle within 0.18 rad at every load
 /// (`saturated_replay motulator`) and motulator's own plant's within 0.024 rad
 /// (scripts/motulator-machines.py replay); closed loop the drive loses it while the machine
@@ -221,7 +214,7 @@ fn holds_reversal_and_stops(base: &str) {
 /// 0.124 at the paper's 35 Hz), 7–10 r/min; stops 0.040–0.041 rad.
 #[test]
 fn motulator_ferrite_pm_syrm_holds_reversal_and_stops_every_seed() {
-    holds_reversal_and_stops(&motulator_machine("mot-pmsyrm-4k"));
+    passes_on_every_seed(&motulator_machine("mot-pmsyrm-4k"), &["reversal", "stops"]);
 }
 
 /// The same machine under its rated torque near zero speed (`rated-reversal`): at that load
