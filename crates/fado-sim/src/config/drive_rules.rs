@@ -29,6 +29,11 @@ const SPEED_RULE: &str = "raised until a step of the rated torque at the rated s
     of the rated torque over `load_ramp_time` leaves at most `load_ramp_error_ratio` × the \
     rated speed, T2S-2 in the tuning's ratio (fado_core::control::speed_bandwidth)";
 
+/// T2S-2's bandwidth on a saturating model of strong frame coupling.
+const COUPLING_RULE: &str = "the tuning's T2S-2 × c/c_max where the model's frame coupling c = \
+    |s|/κ at the rated torque's MTPA point (at most the current limit) exceeds c_max = \
+    DEFAULT_MAX_FRAME_COUPLING = 1, at most Kp·Ts = 0.25 (fado_core::control::speed_bandwidth)";
+
 /// The injection's bound on a salient rotor.
 const INJECTION_RULE: &str = "the injection's I_min bounded to `[controller.injection] \
     max_active_flux_share` × λ̂f/(L̂q − L̂d), the d current that shrinks the active flux by \
@@ -58,6 +63,12 @@ pub(crate) fn with_drive_rules(cfg: &SimConfig) -> SimConfig {
         c.controller.tracker_feedforward.enabled = true;
     }
     let injection = injection_ratio(&c, &drive);
+    // T2S-2 moves with the speed loop (the light rotor's rule) or alone (the frame coupling's).
+    let tracker_rule = if tuning.speed.bandwidth_hz != c.controller.speed.bandwidth_hz {
+        SPEED_RULE
+    } else {
+        COUPLING_RULE
+    };
     let t = &mut c.estimator.tracker;
     for (key, value, field, rule) in [
         (
@@ -82,7 +93,7 @@ pub(crate) fn with_drive_rules(cfg: &SimConfig) -> SimConfig {
             "estimator.tracker.t2s2_bandwidth_hz",
             estimator.tracker.t2s2_bandwidth_hz,
             &mut t.t2s2_bandwidth_hz,
-            SPEED_RULE,
+            tracker_rule,
         ),
         (
             "controller.speed.bandwidth_hz",
@@ -128,4 +139,41 @@ fn injection_ratio(c: &SimConfig, drive: &fado_core::control::DriveConfig<f64>) 
     } else {
         ratio
     }
+}
+
+/// A warning where the drive's magnetic model couples the frame beyond what the tuning's
+/// speed tracker holds (`fado_core::control::speed_bandwidth::rated_frame_coupling` above
+/// `DEFAULT_MAX_FRAME_COUPLING`), naming the model's magnetic key: the drive raises T2S-2,
+/// which holds such a rotor through zero speed at part load, not generating under the rated
+/// torque.
+pub(crate) fn frame_coupling_warning(
+    cfg: &SimConfig,
+) -> Option<(fado_core::machine_checks::Severity, String, String)> {
+    use fado_core::control::speed_bandwidth::{DEFAULT_MAX_FRAME_COUPLING, rated_frame_coupling};
+    let drive = cfg.drive_config();
+    let c = rated_frame_coupling(&drive.machine, &drive.tuning)?;
+    if !(c > DEFAULT_MAX_FRAME_COUPLING && c.is_finite()) {
+        return None;
+    }
+    let model = cfg.model.as_ref();
+    let key = match crate::model_magnetics::MODEL_MAGNETICS_KEYS
+        .iter()
+        .find(|k| model.is_some_and(|t| t.contains_key(**k)))
+    {
+        Some(k) => format!("model.{k}"),
+        None if cfg.motor_flux_map.is_some() => crate::magnetics_file::FLUX_MAP_KEY.to_owned(),
+        None => "motor.saturation".to_owned(),
+    };
+    let (mut built, mut estimator) = (drive, cfg.estimator);
+    built.apply_build_rules(&mut estimator);
+    let text = format!(
+        "`{key}`: the frame coupling |s|/κ at the rated torque's MTPA point (`motor.rated_torque`) \
+         is {c:.2}, above the {DEFAULT_MAX_FRAME_COUPLING} the speed tracker holds at its \
+         tuning's ratio to the speed loop: the drive runs T2S-2 at {:.1} Hz instead of {:.1} Hz \
+         (fado_core::control::speed_bandwidth); generating under the rated torque near zero \
+         speed may lose the angle (a 4 kW ferrite PM-SyRM of coupling 1.23, ψd < 0 on its MTPA \
+         curve, loses it in `rated-reversal`)",
+        estimator.tracker.t2s2_bandwidth_hz, cfg.estimator.tracker.t2s2_bandwidth_hz
+    );
+    Some((fado_core::machine_checks::Severity::Warning, key, text))
 }

@@ -540,6 +540,7 @@ impl SimConfig {
                 .chain(self.carrier_findings())
                 .collect();
         findings.extend(self.rms_map_warning());
+        findings.extend(drive_rules::frame_coupling_warning(self));
         findings
     }
 
