@@ -31,6 +31,17 @@ fn run(angle: f64, ga: f64, gb: f64, v_err: f64) -> (GainCalibration<f64>, f64, 
     run_sensed(angle, ga, gb, v_err, f64::INFINITY, 0.0)
 }
 
+/// The sign of a phase current, zero at zero (the direction a pole's voltage error takes).
+fn current_sign(x: f64) -> f64 {
+    if x > 0.0 {
+        1.0
+    } else if x < 0.0 {
+        -1.0
+    } else {
+        0.0
+    }
+}
+
 /// [`run`] with the rotor-motion test at `motion_voltage` (V) and the phase currents read in
 /// steps of `lsb` (A; 0: exact).
 fn run_sensed(
@@ -91,19 +102,10 @@ fn run_sensed(
             }
         };
         // Inverter: every pole falls short by v_err in the direction of its current.
-        let sign = |x: f64| {
-            if x > 0.0 {
-                1.0
-            } else if x < 0.0 {
-                -1.0
-            } else {
-                0.0
-            }
-        };
         let u = crate::Abc::new(
-            -v_err * sign(abc.a),
-            -v_err * sign(abc.b),
-            -v_err * sign(abc.c),
+            -v_err * current_sign(abc.a),
+            -v_err * current_sign(abc.b),
+            -v_err * current_sign(abc.c),
         )
         .to_ab();
         let applied = v + u;
