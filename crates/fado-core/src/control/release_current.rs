@@ -34,6 +34,15 @@
 //! and 1.1 kW IPMSMs, the multirotor, the servo and the paper's motor have ΔI > Ic; the
 //! hub, cheetah, 2.2 kW IPMSM and PM-SyRM presets do not.
 //!
+//! # Salient rotors
+//! A d current along θ̂ lowers a salient rotor's active flux λf − (L̂q − L̂d)·i_d, the flux
+//! whose direction the estimator reads as the rotor's. The cap is at most the current that
+//! leaves [`ACTIVE_FLUX_FLOOR`] of λf there. Measured on the 50 kW IPMSM (λf 66 mWb,
+//! L̂q − L̂d 0.83 mH, `loaded-start` without a load, seed 2, start angle −1.66 rad): the rated
+//! current's cap of 120 A puts 69 A of d current on the rotor at rest, |λ̂r| falls to 7 mWb,
+//! the hold triggers on the direct angle's noise and |θ − θ̂| reaches 2.75 rad; capped at
+//! 40 A (|λ̂r| 33 mWb) the release passes at rest (|θ − θ̂| 0.007 rad until the rotor turns).
+//!
 //! Measured (`loaded-start`, seeds 1–4, `crates/fado-sim/tests/multirotor_datasheets.rs`): the
 //! start-up results, docs/results/startup.md (`python3 scripts/startup-table.py`).
 
@@ -45,6 +54,9 @@ use crate::{MachineModel, Real};
 /// on a rotor at rest anyway. Above it the model's constant inductances meet the d iron's
 /// saturation (the multirotor preset under the rated current: backward travel 1.9–5.5 rad).
 pub const CAP_RATIO: f64 = 0.5;
+
+/// The share of λf the release's d current leaves in a salient rotor's active flux.
+pub const ACTIVE_FLUX_FLOOR: f64 = 0.5;
 
 /// The release's d-current floor (module docs). Stateless.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -67,10 +79,19 @@ impl<T: Real> ReleaseCurrent<T> {
         } else {
             T::lit(f64::INFINITY)
         };
+        // A d current along θ̂ lowers the active flux λf − (L̂q − L̂d)·i_d of a salient
+        // rotor: at most the current that keeps [`ACTIVE_FLUX_FLOOR`] of λf.
+        let cap = T::lit(CAP_RATIO) * machine.rated_current;
+        let excess = machine.lq - machine.ld;
+        let cap = if excess > T::zero() {
+            cap.step_min(T::lit(1.0 - ACTIVE_FLUX_FLOOR) * machine.flux_linkage / excess)
+        } else {
+            cap
+        };
         Self {
             ripple_per_volt,
             band: current_band,
-            cap: T::lit(CAP_RATIO) * machine.rated_current,
+            cap,
         }
     }
 
@@ -172,5 +193,26 @@ mod tests {
         };
         let q = ReleaseCurrent::<f64>::new(&slow, 2.5e-6, 0.3);
         assert_eq!(q.d_current(1.57, 311.0), None);
+    }
+
+    #[test]
+    fn a_salient_rotor_keeps_half_its_active_flux() {
+        // The 50 kW IPMSM preset (λf 66 mWb, L̂d 0.37 mH, L̂q 1.2 mH, 240 A, 520 V, Td 2.5 µs,
+        // Ic 0.3 A): at −1.66 rad phase a needs I_b/0.089 = 56 A; the rated current's cap
+        // 120 A would leave λf − 0.83 mH · 120 A < 0; the cap is 39.8 A.
+        let m = MachineModel {
+            rs: 0.018,
+            ld: 0.37e-3,
+            lq: 1.2e-3,
+            flux_linkage: 0.066,
+            pole_pairs: 3,
+            rated_current: 240.0,
+            ..MachineModel::paper()
+        };
+        let r = ReleaseCurrent::<f64>::new(&m, 2.5e-6, 0.3);
+        let cap = 0.5 * 0.066 / 0.83e-3;
+        let id = r.d_current(-1.66, 520.0).unwrap();
+        assert!((id - cap).abs() < 1e-9, "{id} A against {cap} A");
+        assert!(0.066 - 0.83e-3 * id >= 0.5 * 0.066 - 1e-12);
     }
 }
