@@ -436,7 +436,14 @@ pub fn estimate(
     let mut engine = Engine::new(py, &setup, dtype)?;
     let core = setup.core::<f64>(py)?;
     if let Ok(bounds) = core.sample_bounds() {
-        crate::recording_checks::warn_all(py, &signals, &bounds, &core.machine, setup.ts, theta0)?;
+        crate::recording_checks::warn_all(
+            py,
+            signals.slices(),
+            &bounds,
+            &core.machine,
+            setup.ts,
+            theta0,
+        )?;
     }
     if let Some(theta0) = theta0 {
         let [_, _, ia, ib] = signals.slices();

@@ -56,3 +56,27 @@ where
         None => Ok(result),
     }
 }
+
+/// A pass over samples that ends early because its call was cancelled (Ctrl-C).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Cancelled;
+
+/// Err([`Cancelled`]) once `cancel` is set; a long pass calls it every
+/// [`fado_sim::sim::CANCEL_CHECK_SAMPLES`] samples (see [`poll_at`]).
+pub fn poll(cancel: Option<&AtomicBool>) -> Result<(), Cancelled> {
+    match cancel {
+        Some(c) if c.load(Ordering::Relaxed) => Err(Cancelled),
+        _ => Ok(()),
+    }
+}
+
+/// [`poll`] at every [`fado_sim::sim::CANCEL_CHECK_SAMPLES`]-th sample `k` of a pass, Ok
+/// at the others (a look at the flag costs an atomic load; one per sample would cost more
+/// than some passes' own work).
+pub fn poll_at(cancel: Option<&AtomicBool>, k: usize) -> Result<(), Cancelled> {
+    if k.is_multiple_of(fado_sim::sim::CANCEL_CHECK_SAMPLES as usize) {
+        poll(cancel)
+    } else {
+        Ok(())
+    }
+}

@@ -16,11 +16,15 @@
 //! | voltage equation | the active flux misfits λf in every reading | another machine's parameters, a unit slip in `rs`, `ld`, `lq` or `flux_linkage`, a saturating machine without its magnetic model |
 //! | negative sequence | every turning window turns backwards | α and β swapped, if the motor turned forward |
 
+use std::borrow::Cow;
+use std::sync::atomic::AtomicBool;
+
 use fado_core::MachineModel;
 use fado_core::plausibility::SampleBounds;
 use pyo3::prelude::*;
 
-use crate::inputs::{ColumnSlice, SIGNAL_NAMES, Signals};
+use crate::inputs::{ColumnSlice, SIGNAL_NAMES};
+use crate::interrupt::{self, Cancelled, poll_at};
 
 /// Share of samples above which refused samples are reported: 1 %.
 const REFUSED_SHARE: f64 = 0.01;
@@ -31,14 +35,20 @@ const REFUSED_SHARE: f64 = 0.01;
 /// estimate with no flux measured.
 const BURST_SECONDS: f64 = 1e-3;
 
-/// The longest run of consecutive non-finite samples of `c`: (first sample, length).
-fn longest_burst(c: &[f64]) -> (usize, usize) {
-    let (mut best, mut start, mut len) = ((0, 0), 0, 0);
+/// The non-finite samples of `c`: (their count, the first sample and the length of their
+/// longest run), in one pass.
+fn count_non_finite(
+    c: &[f64],
+    cancel: Option<&AtomicBool>,
+) -> Result<(usize, (usize, usize)), Cancelled> {
+    let (mut bad, mut best, mut start, mut len) = (0, (0, 0), 0, 0);
     for (k, x) in c.iter().enumerate() {
+        poll_at(cancel, k)?;
         if x.is_finite() {
             len = 0;
             continue;
         }
+        bad += 1;
         if len == 0 {
             start = k;
         }
@@ -47,15 +57,20 @@ fn longest_burst(c: &[f64]) -> (usize, usize) {
             best = (start, len);
         }
     }
-    best
+    Ok((bad, best))
 }
 
 /// The non-finite samples of column `k`: a finding when they are over [`REFUSED_SHARE`] of
 /// the samples or a run of them lasts [`BURST_SECONDS`] or more (`ts` the sampling period).
-fn non_finite(c: &[f64], k: usize, ts: f64, out: &mut Vec<String>) {
+fn non_finite(
+    c: &[f64],
+    k: usize,
+    ts: f64,
+    cancel: Option<&AtomicBool>,
+    out: &mut Vec<String>,
+) -> Result<(), Cancelled> {
     let n = c.len();
-    let bad = c.iter().filter(|x| !x.is_finite()).count();
-    let (first, run) = longest_burst(c);
+    let (bad, (first, run)) = count_non_finite(c, cancel)?;
     let burst = run > 1 && run as f64 * ts >= BURST_SECONDS * (1.0 - 1e-9);
     if bad as f64 > REFUSED_SHARE * n as f64 || burst {
         out.push(format!(
@@ -67,13 +82,24 @@ fn non_finite(c: &[f64], k: usize, ts: f64, out: &mut Vec<String>) {
             1e3 * run as f64 * ts
         ));
     }
+    Ok(())
 }
 
-/// The samples of `c` as f64.
-fn values(c: ColumnSlice<'_>) -> Vec<f64> {
+/// The samples of `c` as f64: float64 columns borrowed, float32 ones converted.
+fn values<'a>(
+    c: ColumnSlice<'a>,
+    cancel: Option<&AtomicBool>,
+) -> Result<Cow<'a, [f64]>, Cancelled> {
     match c {
-        ColumnSlice::F64(x) => x.to_vec(),
-        ColumnSlice::F32(x) => x.iter().map(|&v| f64::from(v)).collect(),
+        ColumnSlice::F64(x) => Ok(Cow::Borrowed(x)),
+        ColumnSlice::F32(x) => {
+            let mut v = Vec::with_capacity(x.len());
+            for (k, &s) in x.iter().enumerate() {
+                poll_at(cancel, k)?;
+                v.push(f64::from(s));
+            }
+            Ok(Cow::Owned(v))
+        }
     }
 }
 
@@ -87,15 +113,18 @@ fn warn(py: Python<'_>, text: &str) -> PyResult<()> {
     )
 }
 
-/// The findings on `signals` against the estimator's `bounds`, its machine `m` sampled every
-/// `ts` and start angle `theta0`, as texts (empty: nothing unusual).
+/// The findings on the columns `signals` (v_α, v_β, i_α, i_β) against the estimator's
+/// `bounds`, its machine `m` sampled every `ts` and start angle `theta0`, as texts (empty:
+/// nothing unusual); Err once `cancel` is set (looked at every
+/// [`fado_sim::sim::CANCEL_CHECK_SAMPLES`] samples of each pass).
 pub fn findings(
-    signals: &Signals<'_>,
+    signals: [ColumnSlice<'_>; 4],
     bounds: &SampleBounds<f64>,
     m: &MachineModel<f64>,
     ts: f64,
     theta0: Option<f64>,
-) -> Vec<String> {
+    cancel: Option<&AtomicBool>,
+) -> Result<Vec<String>, Cancelled> {
     let mut out = Vec::new();
     if let Some(t) = theta0.filter(|t| t.abs() > std::f64::consts::TAU) {
         out.push(format!(
@@ -104,32 +133,54 @@ pub fn findings(
             t.to_radians()
         ));
     }
-    let n = signals.len();
-    if n == 0 {
-        return out;
+    if signals[0].is_empty() {
+        return Ok(out);
     }
-    let cols: Vec<Vec<f64>> = signals.slices().into_iter().map(values).collect();
+    let [va, vb, ia, ib] = signals;
+    let owned = [
+        values(va, cancel)?,
+        values(vb, cancel)?,
+        values(ia, cancel)?,
+        values(ib, cancel)?,
+    ];
+    let cols: [&[f64]; 4] = [&owned[0], &owned[1], &owned[2], &owned[3]];
     for (k, c) in cols.iter().enumerate() {
-        non_finite(c, k, ts, &mut out);
+        non_finite(c, k, ts, cancel, &mut out)?;
     }
-    constant_columns(&cols, &mut out);
-    magnitudes(&cols, bounds, m.rs, &mut out);
-    out.extend(crate::recording_model::findings(&cols, m, ts));
-    out
+    constant_columns(&cols, cancel, &mut out)?;
+    magnitudes(&cols, bounds, m.rs, cancel, &mut out)?;
+    out.extend(crate::recording_model::findings(&cols, m, ts, cancel)?);
+    Ok(out)
+}
+
+/// The lowest finite sample of `c` and the spread of its finite samples.
+fn spread(c: &[f64], cancel: Option<&AtomicBool>) -> Result<(f64, f64), Cancelled> {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for (k, &x) in c.iter().enumerate() {
+        poll_at(cancel, k)?;
+        if x.is_finite() {
+            lo = lo.min(x);
+            hi = hi.max(x);
+        }
+    }
+    Ok((lo, hi - lo))
 }
 
 /// A column whose every finite sample is equal while its partner's vary.
-fn constant_columns(cols: &[Vec<f64>], out: &mut Vec<String>) {
-    let spread = |c: &Vec<f64>| {
-        let f = c.iter().copied().filter(|x| x.is_finite());
-        let (lo, hi) = f.fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), x| {
-            (l.min(x), h.max(x))
-        });
-        (lo, hi - lo)
-    };
+fn constant_columns(
+    cols: &[&[f64]; 4],
+    cancel: Option<&AtomicBool>,
+    out: &mut Vec<String>,
+) -> Result<(), Cancelled> {
+    let spreads = [
+        spread(cols[0], cancel)?,
+        spread(cols[1], cancel)?,
+        spread(cols[2], cancel)?,
+        spread(cols[3], cancel)?,
+    ];
     for (k, partner) in [(0, 1), (1, 0), (2, 3), (3, 2)] {
-        let (value, s) = spread(&cols[k]);
-        let (_, sp) = spread(&cols[partner]);
+        let (value, s) = spreads[k];
+        let (_, sp) = spreads[partner];
         if cols[k].len() >= 100 && s == 0.0 && sp > 0.0 {
             out.push(format!(
                 "`{}` is {value} in every sample while `{}` varies: a dead channel, or a \
@@ -138,23 +189,57 @@ fn constant_columns(cols: &[Vec<f64>], out: &mut Vec<String>) {
             ));
         }
     }
+    Ok(())
+}
+
+/// What [`magnitudes`] reads from one pass over a pair of columns.
+#[derive(Default)]
+struct Magnitude {
+    /// The largest finite |x + jy|.
+    max: f64,
+    /// Samples with |x + jy| at or above the bound.
+    over: usize,
+    /// The largest finite |x + jy| below the bound.
+    max_below: f64,
+}
+
+/// The magnitudes |x + jy| of the pair `x`, `y` against `bound`, in one pass.
+fn magnitude(
+    x: &[f64],
+    y: &[f64],
+    bound: f64,
+    cancel: Option<&AtomicBool>,
+) -> Result<Magnitude, Cancelled> {
+    let mut m = Magnitude::default();
+    for (k, (a, b)) in x.iter().zip(y).enumerate() {
+        poll_at(cancel, k)?;
+        let r = a.hypot(*b);
+        if !r.is_finite() {
+            continue;
+        }
+        m.max = m.max.max(r);
+        if r >= bound {
+            m.over += 1;
+        } else {
+            m.max_below = m.max_below.max(r);
+        }
+    }
+    Ok(m)
 }
 
 /// Current and voltage magnitudes against the bounds and against each other.
-fn magnitudes(cols: &[Vec<f64>], b: &SampleBounds<f64>, rs: f64, out: &mut Vec<String>) {
+fn magnitudes(
+    cols: &[&[f64]; 4],
+    b: &SampleBounds<f64>,
+    rs: f64,
+    cancel: Option<&AtomicBool>,
+    out: &mut Vec<String>,
+) -> Result<(), Cancelled> {
     let n = cols[0].len() as f64;
-    let mag = |a: &Vec<f64>, c: &Vec<f64>| -> Vec<f64> {
-        a.iter()
-            .zip(c)
-            .map(|(x, y)| x.hypot(*y))
-            .filter(|m| m.is_finite())
-            .collect()
-    };
-    let (i, v) = (mag(&cols[2], &cols[3]), mag(&cols[0], &cols[1]));
-    let max = |m: &Vec<f64>| m.iter().copied().fold(0.0_f64, f64::max);
-    let (i_max, v_max) = (max(&i), max(&v));
-    let over_i = i.iter().filter(|&&m| m >= b.current()).count() as f64;
-    if over_i > REFUSED_SHARE * n {
+    let i = magnitude(cols[2], cols[3], b.current(), cancel)?;
+    let v = magnitude(cols[0], cols[1], b.voltage(), cancel)?;
+    let (i_max, v_max) = (i.max, v.max);
+    if i.over as f64 > REFUSED_SHARE * n {
         let hint = if i_max > 100.0 * b.current() {
             "a current in mA where A is meant"
         } else {
@@ -164,26 +249,21 @@ fn magnitudes(cols: &[Vec<f64>], b: &SampleBounds<f64>, rs: f64, out: &mut Vec<S
             "{:.1} % of the samples have |i| (`i_alpha`, `i_beta`) at or above the plausible \
              {:.4} A (4 × `rated_current`; max {i_max:.4e} A) and are refused as measurement \
              faults: {hint}?",
-            100.0 * over_i / n,
+            100.0 * i.over as f64 / n,
             b.current()
         ));
     }
-    let over_v = v.iter().filter(|&&m| m >= b.voltage()).count() as f64;
-    if over_v > REFUSED_SHARE * n {
+    if v.over as f64 > REFUSED_SHARE * n {
         out.push(format!(
             "{:.1} % of the samples have |v| (`v_alpha`, `v_beta`) at or above the plausible \
              {:.4} V (1.5 × `dc_voltage`; max {v_max:.4e} V) and are refused as measurement \
              faults: a voltage in mV where V is meant, or the current columns in the voltage \
              slots?",
-            100.0 * over_v / n,
+            100.0 * v.over as f64 / n,
             b.voltage()
         ));
     }
-    let drop = rs
-        * i.iter()
-            .copied()
-            .filter(|&m| m < b.current())
-            .fold(0.0, f64::max);
+    let drop = rs * i.max_below;
     if drop > 0.0 && v_max < 0.1 * drop {
         out.push(format!(
             "the voltages (`v_alpha`, `v_beta`) reach {v_max:.4e} V only, a tenth of the \
@@ -191,18 +271,27 @@ fn magnitudes(cols: &[Vec<f64>], b: &SampleBounds<f64>, rs: f64, out: &mut Vec<S
              where V is meant, or the voltage and current columns exchanged?"
         ));
     }
+    Ok(())
 }
 
-/// [`findings`] issued as warnings.
+/// [`findings`] issued as warnings; the passes run with the GIL released and stop on Ctrl-C
+/// ([`interrupt::run`], which then raises `KeyboardInterrupt`).
 pub fn warn_all(
     py: Python<'_>,
-    signals: &Signals<'_>,
+    signals: [ColumnSlice<'_>; 4],
     bounds: &SampleBounds<f64>,
     m: &MachineModel<f64>,
     ts: f64,
     theta0: Option<f64>,
 ) -> PyResult<()> {
-    for text in findings(signals, bounds, m, ts, theta0) {
+    let texts = interrupt::run(py, |cancel| {
+        findings(signals, bounds, m, ts, theta0, Some(cancel.as_ref()))
+    })?;
+    // Err only when cancelled, and then `interrupt::run` raised.
+    let texts = texts.map_err(|Cancelled| {
+        pyo3::exceptions::PyKeyboardInterrupt::new_err("estimate interrupted")
+    })?;
+    for text in texts {
         warn(py, &text)?;
     }
     Ok(())

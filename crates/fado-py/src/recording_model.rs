@@ -38,7 +38,11 @@
 //! backwards throughout (the paper's Fig. 9 runs at −300 r/min). No test on the recording alone
 //! tells them apart; the estimate then runs backwards as the recording does.
 
+use std::sync::atomic::AtomicBool;
+
 use fado_core::MachineModel;
+
+use crate::interrupt::{Cancelled, poll_at};
 
 /// Residual per unit of λf above which the recording misfits its machine as given: 0.1.
 /// The simulated drive's replays fit within 0.017 (see the module documentation).
@@ -135,7 +139,12 @@ fn fit_window(p: &[(f64, f64)], i: &[(f64, f64)], m: &MachineModel<f64>) -> Opti
 }
 
 /// The windows of one electrical turn each (sample ranges).
-fn windows(cols: &[Vec<f64>], m: &MachineModel<f64>, ts: f64) -> Vec<std::ops::Range<usize>> {
+fn windows(
+    cols: &[&[f64]; 4],
+    m: &MachineModel<f64>,
+    ts: f64,
+    cancel: Option<&AtomicBool>,
+) -> Result<Vec<std::ops::Range<usize>>, Cancelled> {
     let (v_base, i_base) = (m.rated_speed() * m.flux_linkage, m.rated_current);
     let n = cols[0].len();
     let z = |k: usize| {
@@ -151,6 +160,7 @@ fn windows(cols: &[Vec<f64>], m: &MachineModel<f64>, ts: f64) -> Vec<std::ops::R
         let mut last = z(start);
         let mut k = start + 1;
         while k < n && turned.abs() < std::f64::consts::TAU && k - start < longest {
+            poll_at(cancel, k)?;
             let now = z(k);
             finite &= now.0.is_finite() && now.1.is_finite();
             small |= now.0.hypot(now.1) < 0.02;
@@ -164,17 +174,18 @@ fn windows(cols: &[Vec<f64>], m: &MachineModel<f64>, ts: f64) -> Vec<std::ops::R
         }
         start = k;
     }
-    out
+    Ok(out)
 }
 
 /// The median residual of `reading` over `windows`.
 fn residual(
-    cols: &[Vec<f64>],
+    cols: &[&[f64]; 4],
     m: &MachineModel<f64>,
     ts: f64,
     windows: &[std::ops::Range<usize>],
     reading: Reading,
-) -> Option<f64> {
+    cancel: Option<&AtomicBool>,
+) -> Result<Option<f64>, Cancelled> {
     let (v, i, sign) = match reading {
         Reading::AsGiven => ((0, 1), (2, 3), 1.0),
         Reading::CurrentsNegated => ((0, 1), (2, 3), -1.0),
@@ -189,6 +200,7 @@ fn residual(
         let mut cur = Vec::with_capacity(w.len());
         let mut prev: Option<(f64, f64)> = None;
         for k in w.clone() {
+            poll_at(cancel, k)?;
             let (va, vb) = (cols[v.0][k], cols[v.1][k]);
             let (ia, ib) = (sign * cols[i.0][k], sign * cols[i.1][k]);
             let (pa, pb) = prev.unwrap_or((ia, ib));
@@ -204,27 +216,32 @@ fn residual(
         }
     }
     if fits.is_empty() {
-        return None;
+        return Ok(None);
     }
     fits.sort_by(f64::total_cmp);
-    Some(fits[fits.len() / 2])
+    Ok(Some(fits[fits.len() / 2]))
 }
 
 /// The findings on the recording `cols` (v_α, v_β, i_α, i_β) against the machine `m` sampled
 /// every `ts`, as texts (empty: it fits, or it never turns a whole electrical turn within a
-/// window).
-pub fn findings(cols: &[Vec<f64>], m: &MachineModel<f64>, ts: f64) -> Vec<String> {
+/// window); Err once `cancel` is set.
+pub fn findings(
+    cols: &[&[f64]; 4],
+    m: &MachineModel<f64>,
+    ts: f64,
+    cancel: Option<&AtomicBool>,
+) -> Result<Vec<String>, Cancelled> {
     let mut out = Vec::new();
     let usable = m.flux_linkage > 0.0 && m.rated_speed() > 0.0 && m.rated_current > 0.0;
-    if !usable || ts.is_nan() || ts <= 0.0 || cols.len() != 4 || cols[0].len() < MIN_WINDOW {
-        return out;
+    if !usable || ts.is_nan() || ts <= 0.0 || cols[0].len() < MIN_WINDOW {
+        return Ok(out);
     }
-    let windows = windows(cols, m, ts);
-    let Some(given) = residual(cols, m, ts, &windows, Reading::AsGiven) else {
-        return out;
+    let windows = windows(cols, m, ts, cancel)?;
+    let Some(given) = residual(cols, m, ts, &windows, Reading::AsGiven, cancel)? else {
+        return Ok(out);
     };
     if given <= MISFIT {
-        return out;
+        return Ok(out);
     }
     let alternatives = [
         (
@@ -246,10 +263,14 @@ pub fn findings(cols: &[Vec<f64>], m: &MachineModel<f64>, ts: f64) -> Vec<String
             "`v_alpha` and `v_beta` exchanged (the currents not): swap the voltages' columns?",
         ),
     ];
-    let best = alternatives
-        .iter()
-        .filter_map(|(r, text)| residual(cols, m, ts, &windows, *r).map(|e| (e, *text)))
-        .min_by(|a, b| a.0.total_cmp(&b.0));
+    let mut best: Option<(f64, &str)> = None;
+    for (r, text) in alternatives {
+        if let Some(e) = residual(cols, m, ts, &windows, r, cancel)?
+            && best.is_none_or(|(b, _)| e < b)
+        {
+            best = Some((e, text));
+        }
+    }
     if let Some((e, text)) = best.filter(|(e, _)| *e < FIT && *e * BETTER < given) {
         out.push(format!(
             "the recording does not follow the machine's voltage equation as given (the \
@@ -271,5 +292,5 @@ pub fn findings(cols: &[Vec<f64>], m: &MachineModel<f64>, ts: f64) -> Vec<String
             100.0 * given
         ));
     }
-    out
+    Ok(out)
 }
