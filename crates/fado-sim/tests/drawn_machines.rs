@@ -1,0 +1,98 @@
+//! Machines drawn at random by `scripts/drawn-machines.py` (a battery of datasheets nobody gave
+//! us: pole pairs 1–24, 12–800 V, 20 W–200 kW, surface and interior magnets, optional
+//! saturation), kept in `tests/data/drawn/` where the battery found something.
+
+use fado_core::control::startup::{MIN_AXIS_MARGIN, pulse_current_share};
+use fado_sim::scenario::{scenario_config, simulate};
+
+/// The drawn motor file `name` of `tests/data/drawn/`.
+fn drawn(name: &str) -> String {
+    let path = format!(
+        "{}/tests/data/drawn/{name}.toml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    std::fs::read_to_string(path).unwrap()
+}
+
+/// `loaded-start` on `name` at `seed`: its verdict, |θ − θ̂| at the angle found, max |θ − θ̂|
+/// from ready and the backward travel (rad).
+fn loaded_start(name: &str, seed: u64) -> (bool, f64, f64, f64) {
+    let text = format!("{}\n[current_sensor]\nseed = {seed}\n", drawn(name));
+    let out = simulate("loaded-start", Some(&text), false, None).unwrap();
+    let st = out.probe.start.as_ref().unwrap();
+    if !out.passed {
+        println!("{name} seed {seed}: {:?}", out.checks);
+    }
+    let found = st.found_angle_error.unwrap_or(f64::INFINITY);
+    (out.passed, found, st.max_angle_error, st.max_backward)
+}
+
+#[test]
+fn saturated_rotors_whose_axes_meet_at_the_rated_current_pulse_below_it() {
+    // Three drawn IPMSMs whose q axis saturates down to the d inductance near the rated
+    // current: the model's secant inductances along d and q differ by 2.2 % (127 W, 3 pole
+    // pairs), 2.1 % (1.6 kW, 12) and 4.8 % (137 kW, 15) of their sum there, below
+    // `MIN_AXIS_MARGIN`; at 0.75 of it by 11 %, 11 % and 9 %. Pulsing at the rated current,
+    // the 127 W machine found its angle 1.516 / 1.541 rad off at seeds 1 / 2 (the axis π/2
+    // off) and ran 70 / 77 rad backwards under its load; the 137 kW one 0.071 rad at seed 1.
+    // Measured at 0.75 of the rated current: found within 0.001–0.012 rad, max |θ − θ̂| from
+    // ready 0.044–0.112 rad, backward travel 0.20–0.34 rad.
+    for name in [
+        "ipm-sat-3p-134v-127w",
+        "ipm-sat-12p-170v-1558w",
+        "ipm-sat-15p-800v-137kw",
+    ] {
+        let cfg = scenario_config("loaded-start", Some(&drawn(name)), false).unwrap();
+        let m = cfg.machine_model();
+        let share = pulse_current_share(&m, m.rated_current);
+        assert_eq!(
+            share, 0.75,
+            "{name}: margin below {MIN_AXIS_MARGIN} at I_rated"
+        );
+        for seed in [1, 2] {
+            let (passed, found, max_error, backward) = loaded_start(name, seed);
+            println!(
+                "{name} seed {seed}: found {found:.3}, max {max_error:.3}, back {backward:.3} rad"
+            );
+            assert!(found < 0.05, "{name} seed {seed}: found {found} rad off");
+            assert!(passed, "{name} seed {seed}");
+        }
+    }
+}
+
+#[test]
+fn a_saturated_rotor_with_clear_axes_pulses_at_the_rated_current() {
+    // The drawn 69 W IPMSM (Lq/Ld 2, q secant 44 % down at the rated current): the secant
+    // inductances differ by 22 % of their sum at the rated current, which the search keeps.
+    let cfg = scenario_config("loaded-start", Some(&drawn("ipm-sat-15p-47v-69w")), false).unwrap();
+    let m = cfg.machine_model();
+    assert_eq!(pulse_current_share(&m, m.rated_current), 1.0);
+}
+
+/// The drawn 69 W, 15-pole-pair IPMSM (6 kHz carrier, q secant 44 % down at the rated
+/// current, 47 V link) and the drawn 289 W 2-pole saturating surface-magnet motor (35 kHz):
+/// held at zero speed under the rated load after the brake's release, θ̂ creeps ahead of
+/// the rotor: max |θ − θ̂| from ready 0.450 / 0.539 rad (69 W, seeds 1 / 2), 0.392 rad
+/// (289 W, seed 2). The same machines without `[motor.saturation]` give 0.046 / 0.053 rad;
+/// with ideal current sensors and no dead time the 69 W machine still gives 0.809 rad, with
+/// the averaged inverter 0.05 rad, and at twice its carrier 0.075 rad (seed 1), at three
+/// times 0.072 (seed 2): the creep comes with the PWM current ripple on a current map that
+/// curves (q self-saturation with a d-axis or cross-saturation term; q saturation alone
+/// gives no polarity and no start), which the sampled current does not average: the
+/// resistive drop the flux integration subtracts is short of the true one.
+#[test]
+#[ignore = "saturated standstill under the rated load at a slow carrier: 69 W IPMSM s1/s2 0.450/0.539 rad, 289 W SPM s2 0.392 rad"]
+fn saturated_rotors_hold_the_rated_load_at_standstill() {
+    for (name, seed) in [
+        ("ipm-sat-15p-47v-69w", 1),
+        ("ipm-sat-15p-47v-69w", 2),
+        ("spm-sat-1p-147v-289w", 2),
+    ] {
+        let (passed, _, max_error, _) = loaded_start(name, seed);
+        println!("{name} seed {seed}: max {max_error:.3} rad");
+        assert!(
+            passed && max_error < 0.25,
+            "{name} seed {seed}: {max_error}"
+        );
+    }
+}
