@@ -320,3 +320,16 @@ fn a_load_arriving_late_is_read_over_the_recent_window() {
     let (travel, whole) = run(3e4).expect("the load's motion is read");
     assert!(travel < 0.1 && !whole, "{travel} {whole}");
 }
+
+#[test]
+fn a_constant_inductance_model_pulses_at_its_configured_current() {
+    // `pulse_current_share` moves the search only on a saturating model whose axes meet:
+    // the paper's salient motor, and a round rotor (no axis order at all), keep share 1.
+    let paper = MachineModel::<f64>::paper();
+    assert_eq!(pulse_current_share(&paper, paper.rated_current), 1.0);
+    let round = MachineModel {
+        lq: paper.ld,
+        ..MachineModel::paper()
+    };
+    assert_eq!(pulse_current_share(&round, round.rated_current), 1.0);
+}
