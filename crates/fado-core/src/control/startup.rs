@@ -221,7 +221,7 @@ pub fn d_axis_larger<T: Real>(machine: &MachineModel<T>, current: T) -> bool {
 /// terms) reads the axis π/2 off: a drawn 127 W IPMSM of `crates/fado-sim/tests/data/drawn/`
 /// (q saturating to the d inductance at its rated current: 0.022) found its angle 1.52 rad
 /// off at seeds 1 and 2 and ran 70 rad backwards under its load; at 0.75 of that current
-/// (−0.113) the angle is found within 0.012 rad.
+/// (−0.113) the angle is found within 0.013 rad.
 pub const MIN_AXIS_MARGIN: f64 = 0.05;
 
 /// Fractions of the configured pulse current the search tries, in order, where the model's
