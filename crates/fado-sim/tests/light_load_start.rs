@@ -88,6 +88,36 @@ fn saturated_machines_start_without_a_load() {
 /// load passes, 0.068/0.064). The traction quarter-load misses stay without dead time
 /// (seed 1 0.386/0.284, seed 3 0.120/0.367): the hold's ±330 A limit cycle on the direct
 /// angle, which sits 0.37 rad off the rotor under that current.
+///
+/// What the traction's unloaded seed 2 does at rest (backward travel / max |θ − θ̂| from
+/// ready, rad): the d current steps from 0 to the injection's 23 A at ready, and with the
+/// rotor still θ̂ turns forward at 2.2 rad/s (0.013 rad in 6 ms, where the hold triggers and
+/// its loop swings ±330 A). At this start angle phase a's axis lies 0.09 rad from q̂: the
+/// band's residual acts where a falling rotor's back-EMF does (under the rated load the
+/// rotor falls 0.057 rad in the first 3 ms while θ̂ moves 0.001 rad), so that neither a
+/// freeze of the flux estimate at rest nor leaving that component out of its integrand
+/// keeps the fall the hold is there to catch. The d current at rest (`[controller.injection]
+/// max_active_flux_share`): 0 A 0.029/0.878, 1.8 A 0.006/0.491, 4.6 A 0.001/0.352, 9.2 A
+/// 0.030/0.334, 37 A 4.56/0.546, 46 A 0.432/0.664 (phase a leaves the edge band Ic + ΔI = 6.3 A
+/// only from 73 A, which leaves 21 % of λf in the active flux). The release floor at every ΔI
+/// with 15 % of λf left (73 A here): the step at ready moves θ̂ 0.007 rad in 1 ms and the hold
+/// triggers on it, 0.361/0.665; the PM-SyRM 0.179/0.346 and 0.875/0.382, the 50 kW 0.480/3.13,
+/// the test IPMSM's quarter load 0.068/0.064. The compensation's shape
+/// (`[controller.dead_time_compensation] method`): trapezoidal 0.368/0.570, sign 0.852/1.349,
+/// edge currents 0.414/0.533. The inverter's band: Ic 1 A 0.0001/0.046 (ΔI > Ic, the release
+/// floor acts), 6 A 0.361/0.620, 10 A 0.005/0.105 (phase a deep in the band, where its error is
+/// linear in the current); V_th = 0 0.016/0.342. A constant 0.123 V taken off the estimator's
+/// voltage along q̂ while the reference stays at the 23 A standstill current stops the drift for
+/// 8 ms, then turns θ̂ backwards (0.005 rad at 10 ms) as phase a's current moves from −2.18 to
+/// −1.90 A inside the band, whose model's slope V̂/Ic is 2.3 V/A, and the hold triggers: lost.
+/// With the rotor braked 116 ms past ready (`[simulation] brake_release_at = 0.9`) θ̂ swings
+/// +0.12 then −0.17 rad at the standstill current: the speed loop's −3.5 to +6.8 A of q current
+/// moves phase a's current between −3.3 and +2.8 A, and the residual turns with it (about +0.12
+/// V along q̂ at −2.2 A, −0.38 V at +2.8 A), so that no single value learned at rest holds; the
+/// case then misses at 0.070/0.495. The compensation's own inverter numbers off the plant's
+/// (`[mismatch]`): band ×0.5 / 0.65 / 0.8 / 1.2 0.403/0.517, 0.353/0.648, 0.474/0.376,
+/// 0.594/0.474; V_th ×0 / 0.5 / 0.8 / 1.2 0.326/1.254, 0.251/0.713, 0.505/0.368, 0.997/0.637;
+/// Td ×0.9 / 0.94 / 0.97 / 1.03 0.171/0.534, 0.487/0.803, 0.500/0.322, 0.481/0.503.
 #[test]
 #[ignore = "unloaded: traction s2 0.533 rad, PM-SyRM s1/s2 0.460/0.428 rad, 50 kW s2 0.269 rad; quarter load: traction s1 0.677 rad, s3 lost, test IPMSM s2 0.704 rad back"]
 fn unloaded_and_quarter_load_starts_that_still_miss() {
