@@ -12,9 +12,14 @@ use crate::{Dq, Real};
 /// reached 78 % of its value there). The time to the trigger is
 /// t_r = √(2·trigger/a_rated), a_rated = p·T_rated/Ĵ; a hold whose current loop is raised to
 /// the 10·ω_h its design needs (`release_hold`, "The current loop it needs") has
-/// t_r·ωc = 10·√(2·trigger·0.27/travel) = 2.3 at the default trigger and travel, and keeps
-/// the floor from the opening. Below it are the rotors whose loop the sampling caps: the
-/// 400 W servo's bare rotor 0.99 (t_r 0.49 ms, ωc·Ts = 0.2 at 10 kHz).
+/// t_r·ωc = 10·√(2·trigger·0.27/travel) = 2.3 at the default trigger and travel; below
+/// that are the rotors whose current loop the sampling caps (ωc·Ts = 0.2). Of the presets
+/// and test machines only the 400 W servo's bare rotor is below 1.5: 0.99 (t_r 0.49 ms at
+/// 10 kHz); the capped multirotor, tool and 750 W servo motors (1.77–1.88) keep the floor
+/// from the opening. A bound between the two, measured, not derived: with the floor on at
+/// the brake on every rotor, the Flipsky 6215 multirotor motor (2.3) ran back 2.07 rad
+/// instead of 0.24 at `loaded-start` seed 4, and the MAD 5010 kv110 kept 0.261 rad of
+/// |θ − θ̂| instead of 0.164 at seed 2.
 const FLOOR_AT_BRAKE_RISE: f64 = 1.5;
 
 /// The release's d-current floor is on while a brake holds the rotor after the start-up
@@ -70,8 +75,12 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
     /// 0.05 A, inside the band: the direct angle had moved 0.022 rad of the rotor's 0.045 rad
     /// at the hold's trigger, the load the fall reveals read 1.37 A of 3.4 A, and the rotor
     /// ran back 0.863 rad (`loaded-start` seed 2,
-    /// `crates/fado-sim/tests/unseen_motor_tables.rs`). At the brake a d current along θ̂
-    /// turns nothing; it costs the floor's copper loss from ready to the opening.
+    /// `crates/fado-sim/tests/unseen_motor_tables.rs`); with the floor on at the brake the
+    /// direct angle reaches the trigger 0.6 ms after the opening, having moved 0.022 rad of
+    /// the rotor's 0.024, the load reads 2.62 A and the rotor runs back 0.458 rad (0.5
+    /// allowed). At the brake a d current along θ̂ turns
+    /// nothing; it costs the floor's copper loss from ready to the opening. Only where the
+    /// fall is that fast (`floor_at_brake`).
     #[inline(always)]
     pub(super) fn release_current_floor(&self, i: Dq<T>, theta: T, vdc: T) -> Dq<T> {
         if !(self.brake_holds || self.blocks.hold.awaiting_fall()) {
