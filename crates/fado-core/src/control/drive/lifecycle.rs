@@ -70,6 +70,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             current_error: PersistenceMonitor::new(resolved.current_error_samples),
             stall: Debouncer::new(resolved.stall.samples, resolved.stall.heal_samples),
             stall_armed: false,
+            brake_holds: false,
             coast_reason: DriveFlags::NONE,
             omega_slow: T::zero(),
             sensor_stuck_now: false,
@@ -203,9 +204,12 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         // estimate's own start transient, which the release hold would wind its integral up
         // on against the brake. The application arms it as it opens the brake
         // (`arm_release_hold`; docs/method/additions.md, "Release hold after the start-up").
-        if !self.config.tuning.startup.rotor_held {
+        let rotor_held = self.config.tuning.startup.rotor_held;
+        if !rotor_held {
             self.blocks.hold.arm(theta0);
         }
+        self.brake_holds =
+            rotor_held && self.config.tuning.release_hold.enabled && self.resolved.floor_at_brake;
         self.lock.restart();
         if self.tripped {
             self.trip_output();

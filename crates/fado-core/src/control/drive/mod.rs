@@ -113,6 +113,9 @@ struct Resolved<T: 'static> {
     /// A saturating model's MTPA table and torque (`crate::control::saturated_references`);
     /// None for constant inductances.
     saturated: Option<SaturatedReferences<T>>,
+    /// The release's d-current floor is on while a brake holds the rotor, before it opens
+    /// (`hold::floor_at_brake`).
+    floor_at_brake: bool,
 }
 
 /// The stall symptom's thresholds in absolute units (see
@@ -266,6 +269,10 @@ pub struct SensorlessDrive<T: 'static, E = SensorlessEstimator<T>> {
     /// like the estimator's; cleared by `align`, `reset`, a recovery's re-arming).
     stall: Debouncer,
     stall_armed: bool,
+    /// A brake holds the rotor from the start-up's end until the application opens it
+    /// ([`arm_release_hold`](Self::arm_release_hold)) on a rotor whose floor is on there
+    /// (`Resolved::floor_at_brake`).
+    brake_holds: bool,
     /// Why the drive coasts (`LOCK_LOST`, `STALLED` or both): the symptoms up when the
     /// reaction started, kept while it coasts.
     coast_reason: DriveFlags,

@@ -28,6 +28,7 @@ impl<T: Real> Resolved<T> {
             Ok(n.round().to_f64() as u32)
         };
         Ok(Self {
+            floor_at_brake: super::hold::floor_at_brake(c),
             i_max: check::below(
                 "current_limit_ratio",
                 check::positive("current_limit_ratio", t.current.limit_ratio)?,

@@ -131,3 +131,46 @@ fn voltage_ellipse_cuts_the_q_current_to_the_voltage() {
         assert_eq!(drive.voltage_ellipse(inside, vdc, omega), inside);
     }
 }
+
+/// The release's floor is on at the brake on the 400 W servo's bare rotor (the rated load's
+/// fall reaches the hold's trigger in 0.49 ms, t_r·ωc = 0.99 with the current loop the hold
+/// raises to ωc·Ts = 0.2), not on the paper's motor (t_r 2.3 ms at its 250 Hz loop) nor on
+/// the servo with the hold off.
+#[test]
+fn the_floor_is_on_at_the_brake_only_where_the_fall_outruns_the_current_loop() {
+    let mut servo = crate::MachineModel::paper();
+    servo.rs = 2.3679;
+    servo.ld = 8.3655e-3;
+    servo.lq = 8.3655e-3;
+    servo.flux_linkage = 62.155e-3;
+    servo.pole_pairs = 4;
+    servo.inertia = 3.1e-5;
+    servo.rated_current = 3.405;
+    servo.rated_speed_rpm = 3000.0;
+    servo.rated_torque = 1.27;
+    let built = |m: &crate::MachineModel<f64>, enabled: bool| {
+        let mut c = super::DriveConfig::for_machine(m);
+        c.tuning.release_hold.enabled = enabled;
+        c.apply_build_rules(&mut crate::estimator::EstimatorTuning::default());
+        c
+    };
+    let c = built(&servo, true);
+    assert!((c.tuning.current.bandwidth_hz - 318.31).abs() < 0.01);
+    assert!(super::hold::floor_at_brake(&c));
+    assert!(!super::hold::floor_at_brake(&built(
+        &crate::MachineModel::paper(),
+        true
+    )));
+    // Through the drive: on from the start-up's end with a brake that holds the rotor and
+    // the hold enabled, off once the application opens it; never with the hold off.
+    for enabled in [true, false] {
+        let mut c = built(&servo, enabled);
+        c.tuning.startup.rotor_held = true;
+        let tuning = crate::estimator::EstimatorTuning::default();
+        let mut drive = super::SensorlessDrive::new(c, tuning).unwrap();
+        drive.align(0.3);
+        assert_eq!(drive.brake_holds, enabled);
+        drive.arm_release_hold();
+        assert!(!drive.brake_holds);
+    }
+}

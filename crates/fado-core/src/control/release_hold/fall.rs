@@ -22,10 +22,16 @@
 //! i_L = 2·e/(b·t²), and starts its integral
 //! from the share 1 − (ω_h/ω_d)² of it, at most that share of the rated load: the loop takes
 //! the rest, (ω_h/ω_d)² of the load, within its design travel. Where nothing caps ω_h the
-//! share is zero and the hold is the designed loop. The angles lag the rotor (the estimate's
-//! own delay, 0.08 rad behind a 0.1 rad fall at the servo's seed 2 under the release's 1.7 A
-//! d current): the read load is a lower bound of the true one, never a torque the load has
-//! not shown. A direct angle that moves against the tracked one at the trigger is the
+//! share is zero and the hold is the designed loop. The angles lag the rotor: the read load
+//! is a lower bound of the true one, never a torque the load has not shown. The lag is small
+//! only once the release's d-current floor keeps every phase out of the inverter's dead-time
+//! band: the servo's rotor falls by the trigger's 0.02 rad within 0.6 ms of the release,
+//! before the current loop (1/ωc = 0.5 ms) raises a floor put on at the opening, and at seed
+//! 2 (θ̂ at −1.66 rad, phase a across it at 0.05 A) the direct angle triggered at 0.8 ms,
+//! having moved 0.022 rad of a 0.045 rad fall, and the load read 1.37 A of 3.4 A; the drive
+//! puts the floor on while the brake still holds such a rotor
+//! (`SensorlessDrive::arm_release_hold`), and the load then reads 2.62 A. A direct angle
+//! that moves against the tracked one at the trigger is the
 //! currents' transient, not a fall, and gives no preset (the saturated PM-SyRM
 //! `motors/saturated/pmsyrm-baldor-5k6-measured.toml` at `loaded-start` seed 3: a preset
 //! from it sent the full opposite torque and lost the rotor).
@@ -38,8 +44,8 @@
 //!
 //! # Measured
 //! `loaded-start` backward travel (rad, `python3 scripts/startup-table.py`, seeds 1–4; without
-//! the rule in brackets): the Estun servo 0.445 / 0.863 / 0.451 / 0.440 (1.28 at seed 1), its
-//! |θ − θ̂| from ready 0.051 / 0.096 / 0.074 / 0.053; the made-up 750 W servo
+//! the rule in brackets): the Estun servo 0.447 / 0.458 / 0.451 / 0.440 (1.28 at seed 1), its
+//! |θ − θ̂| from ready 0.051 / 0.063 / 0.074 / 0.053; the made-up 750 W servo
 //! (`crates/fado-sim/tests/data/startup-spm-750w.toml`) 0.22 / 0.22 / 0.23 / 0.22 (0.38 / 0.46
 //! / 0.39 / 0.38); the MAD 5010 kv200 0.22 / 0.21 / 0.26 / 0.23 (0.41 / 0.39 / 0.48 / 0.41);
 //! the multirotor preset 0.17 / 0.18 / 0.21 / 0.18 (0.21 / 0.20 / 0.23 / 0.22); the 36 V tool
