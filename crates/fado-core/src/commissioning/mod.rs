@@ -263,8 +263,8 @@ use fits::{BlockStats, EmfWindow, JFit, JWindows, Line, emf_line};
 use flux_pulses::{FluxPulses, magnetics_time};
 pub use flux_pulses::{INCONCLUSIVE_CHANGE, MagneticFit, PULSE_MOTION_LIMIT, SaturationVerdict};
 use sizing::{
-    clamp, dc_level, dead_time_voltage, libm_round, limit, spin_integral_gain, spin_sizing,
-    standstill_gains, step_level,
+    INVERTER_BAND_RATIO, clamp, dc_level, dead_time_voltage, libm_round, limit, spin_integral_gain,
+    spin_sizing, standstill_gains, step_level,
 };
 
 /// The commissioning state machine (module docs).
