@@ -348,8 +348,9 @@ fn the_weak_magnet_pm_syrm_is_commissioned_with_its_nameplate_resistance() {
 /// `stops`, although its λ̂f is +17.5 % (0.235 Vs, from the spin's back-EMF at the coast's
 /// 2.5 A of d current) and its flux error reaches 23 % over the rated current. Measured on
 /// seeds 1–4: `reversal` 0.170 / 0.121 / 0.121 / 0.034 rad, `stops` 0.061 / 0.061 / 0.037 /
-/// 0.074 rad. The CLI's identified map of the same fit (`scripts/motulator-closed-loop.sh`)
-/// loses `reversal` on seeds 1 and 3 (1.99, 3.14 rad) and holds `stops` (0.04–0.24 rad).
+/// 0.074 rad. The CLI's identified map of the same fit (`scripts/motulator-closed-loop.sh`,
+/// on 81 nodes per axis, `fado_sim::identified_map::TABLE_TOLERANCE`): `reversal` 0.200 /
+/// 0.093 / 0.105 / 0.030 rad, `stops` 0.057 / 0.046 / 0.237 / 0.043 rad.
 #[test]
 fn the_commissioned_weak_magnet_pm_syrm_holds_reversal_and_stops() {
     commissioned_passes("mot-pmsyrm-4k", &["reversal", "stops"]);
