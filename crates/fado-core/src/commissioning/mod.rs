@@ -65,8 +65,8 @@
 //!    [`CommissioningConfig::align_time`] and [`CommissioningConfig::settle_time`]).
 //! 3. **Resistance** ([`Phase::Resistance`]): DC current along α at two levels I₁ = I₂/2, I₂ =
 //!    90 % of the limit (capped for reluctance rotors, see `dc_level`; where the cap leaves
-//!    the lower level's phases b and c, I₂/4, inside the current band the procedure assumes,
-//!    5 % of the limit, R̂s is the nameplate's with a 1-σ of ∞, k is not measured and the
+//!    the lower level's phases b and c, I₂/4, below ¾ of the current band the procedure
+//!    assumes, 5 % of the limit, R̂s is the nameplate's with a 1-σ of ∞, k is not measured and the
 //!    inverter error is read at the upper level: the ferrite PM-SyRM of
 //!    `fado-sim/tests/data/motulator/`, whose levels gave R̂s +50 %). With all three phase currents beyond the inverter's current band the
 //!    pole-voltage error is a constant V̂·sign(i_x) per phase, i.e. 4/3·V̂ on the α axis, so
