@@ -486,7 +486,7 @@ impl<T: Real> Commissioning<T> {
         // 5.5 V against 4/3·V̂ = 6.7 V, its d pulse stalled at 0.2 A).
         let ahead = i + step * T::lit(1.5);
         let out = if p.adapted {
-            p.dir * cmd + dead_time_voltage(ahead, T::lit(0.05) * self.i_limit, self.v_inv)
+            p.dir * cmd + dead_time_voltage(ahead, self.inverter_band(), self.v_inv)
         } else {
             p.dir * cmd
         };
@@ -527,7 +527,7 @@ impl<T: Real> Commissioning<T> {
         let mean = next * T::lit(0.5);
         flux * (-T::one() / self.ts)
             + mean * self.rs
-            + dead_time_voltage(mean, T::lit(0.05) * self.i_limit, self.v_inv)
+            + dead_time_voltage(mean, self.inverter_band(), self.v_inv)
     }
 
     /// The flux-linkage integral over the last sample, v − R̂s·i less the identified inverter
@@ -537,7 +537,7 @@ impl<T: Real> Commissioning<T> {
             return;
         }
         let i_mid = (i + self.i_prev) * T::lit(0.5);
-        let err = dead_time_voltage(i_mid, T::lit(0.05) * self.i_limit, self.v_inv);
+        let err = dead_time_voltage(i_mid, self.inverter_band(), self.v_inv);
         let (c, s) = (self.pulses.theta0.cos(), self.pulses.theta0.sin());
         let flux = self.cfg.nameplate.flux_linkage;
         let p = &mut self.pulses;

@@ -268,7 +268,7 @@ impl<T: Real> Commissioning<T> {
             return self.output(v, vdc, self.phase != Phase::Offset, T::zero());
         }
         self.bad_samples = 0;
-        if self.phase != Phase::Offset && self.t_phase > self.cfg.phase_timeout {
+        if self.phase != Phase::Offset && self.t_phase > self.phase_limit() {
             self.abort(AbortReason::Timeout { phase: self.phase });
             return self.output(Ab::zero(), vdc, false, T::zero());
         }

@@ -64,7 +64,11 @@
 //!    the settling scale with the nameplate's τ = L̄/R (defaults of
 //!    [`CommissioningConfig::align_time`] and [`CommissioningConfig::settle_time`]).
 //! 3. **Resistance** ([`Phase::Resistance`]): DC current along α at two levels I₁ = I₂/2, I₂ =
-//!    90 % of the limit (capped for reluctance rotors, see `dc_level`). With all three phase currents beyond the inverter's current band the
+//!    90 % of the limit (capped for reluctance rotors, see `dc_level`; where the cap leaves
+//!    the lower level's phases b and c, I₂/4, below ¾ of the current band the procedure
+//!    assumes, 5 % of the limit, R̂s is the nameplate's with a 1-σ of ∞, k is not measured and the
+//!    inverter error is read at the upper level: the ferrite PM-SyRM of
+//!    `fado-sim/tests/data/motulator/`, whose levels gave R̂s +50 %). With all three phase currents beyond the inverter's current band the
 //!    pole-voltage error is a constant V̂·sign(i_x) per phase, i.e. 4/3·V̂ on the α axis, so
 //!    v_α = Rs·i_α + 4/3·V̂: the slope of the two points is Rs, the intercept the inverter
 //!    error (the classic two-point DC test, e.g. Bertoluzzo, Buja & Menis, "Self-commissioning
@@ -263,8 +267,8 @@ use fits::{BlockStats, EmfWindow, JFit, JWindows, Line, emf_line};
 use flux_pulses::{FluxPulses, magnetics_time};
 pub use flux_pulses::{INCONCLUSIVE_CHANGE, MagneticFit, PULSE_MOTION_LIMIT, SaturationVerdict};
 use sizing::{
-    clamp, dc_level, dead_time_voltage, libm_round, limit, spin_integral_gain, spin_sizing,
-    standstill_gains, step_level,
+    INVERTER_BAND_RATIO, clamp, dc_level, dead_time_voltage, libm_round, limit, spin_integral_gain,
+    spin_sizing, standstill_gains, step_level,
 };
 
 /// The commissioning state machine (module docs).

@@ -143,3 +143,8 @@ pub(super) fn libm_round(x: f64) -> u32 {
     let r = x + 0.5;
     if r < 1.0 { 1 } else { r as u32 }
 }
+
+/// The inverter's current band the standstill phases assume, as a fraction of the current
+/// limit: 5 % (docs/method/estimator.md §7's trapezoid, whose band is the pole's parasitic
+/// capacitance's; the simulator's default 0.3 A is 5 % of the paper drive's 6 A limit).
+pub(super) const INVERTER_BAND_RATIO: f64 = 0.05;

@@ -36,6 +36,26 @@ impl<T: Real> Commissioning<T> {
         self.next_phase(Phase::Spin);
     }
 
+    /// The longest the current phase may take: `phase_timeout`, and for the I-f spin its
+    /// ramp to the spin speed on top (spin speed / acceleration, finite). Why: the spin's
+    /// torque is at most a quarter of the magnet's at the I-f current, which a reluctance
+    /// rotor caps at ½·λf/(Lq − Ld) (`spin_sizing`): on a weak-magnet PM-SyRM with a heavy
+    /// rotor the ramp alone outlasts the timeout (scripts/motulator-machines.py's
+    /// mot-pmsyrm-4k: 0.6 A, 0.09 N·m, 6 rad/s² electrical, a 10.5 s ramp in an 11.6 s
+    /// timeout, the spin speed reached 0.9 s before it, too late to settle).
+    pub(super) fn phase_limit(&self) -> T {
+        let timeout = self.cfg.phase_timeout;
+        if self.phase != Phase::Spin {
+            return timeout;
+        }
+        let ramp = self.spin_speed / self.spin_accel;
+        if ramp.is_finite() && ramp > T::zero() {
+            timeout + ramp
+        } else {
+            timeout
+        }
+    }
+
     /// The coast's d current, A (its magnitude): `COAST_ID` of the limit, less where the
     /// nameplate inertia is below [`J_PLL_MARGIN`] times the inertia the PLL's lag takes
     /// from it (`pll_lag_inertia` at that current), down to [`COAST_ID_MIN`] of the limit.
@@ -57,7 +77,7 @@ impl<T: Real> Commissioning<T> {
     /// frame angle `angle` (docs/method/estimator.md §7's trapezoid; I_band = 5 % of the limit).
     pub(super) fn compensation(&self, i_ref_dq: Dq<T>, angle: T) -> Ab<T> {
         let i = i_ref_dq.to_ab(Rotation::from_angle(angle));
-        dead_time_voltage(i, T::lit(0.05) * self.i_limit, self.v_inv)
+        dead_time_voltage(i, self.inverter_band(), self.v_inv)
     }
 
     /// Back-EMF over the last sample interval: E = v − R̂·i − L̂q·Δi/Ts (module docs).
