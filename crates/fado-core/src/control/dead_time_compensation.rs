@@ -306,12 +306,6 @@ impl<T: Real> DeadTimeCompensation<T> {
         c.dead_time * c.switching_frequency * vdc + c.threshold_voltage
     }
 
-    /// The trapezoid's slope inside the band, V̂/Ic in Ω at the DC link `vdc` (0 when
-    /// disabled): the voltage the model's loss moves by per ampere of a phase current there.
-    pub fn band_resistance(&self, vdc: T) -> T {
-        self.amplitude(vdc) * self.inv_band
-    }
-
     /// The trapezoid v_comp,x = V̂·sat(i_x/Ic) for phase currents `i_abc` (A).
     #[inline]
     pub fn trapezoid(&self, i_abc: Abc<T>, vdc: T) -> Abc<T> {

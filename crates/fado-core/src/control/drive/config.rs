@@ -2,7 +2,6 @@
 //! start-up gain calibration's configuration derived from them.
 
 use super::{Blocks, DriveTuning, Resolved};
-use crate::control::dead_time_compensation::DeadTimeCompensation;
 use crate::control::gain_calibration::{GainCalibration, GainCalibrationConfig};
 use crate::control::startup::AngleSearch;
 use crate::error::{ConfigError, check};
@@ -113,9 +112,6 @@ impl<T: Real> DriveConfig<T> {
             } else {
                 crate::control::gain_calibration::motion_voltage(m)
             },
-            // A bad inverter datum is the drive's blocks' error, named there.
-            band_resistance: DeadTimeCompensation::new(self.dead_time_compensation_config())
-                .map_or(T::zero(), |d| d.band_resistance(m.dc_voltage)),
         };
         GainCalibration::new(config).map_err(rename)?;
         Ok(config)

@@ -223,13 +223,6 @@ pub struct GainCalibrationConfig<T> {
     /// the calibration at once with [`GainCalibrationStatus::RotorMoved`]. ∞ disables the
     /// test.
     pub motion_voltage: T,
-    /// The slope V̂/Ic (Ω) of the inverter's band in the drive's dead-time model (its voltage
-    /// V̂ at the rated DC link over its current band Ic; 0 for an ideal inverter or without
-    /// compensation): in the release to zero current every phase sits in the band, where
-    /// the model's loss turns the sensors' noise into voltage at this slope, and the motion
-    /// test's thresholds there rise to what that noise reads
-    /// ([`GainCalibration::release_floor`]).
-    pub band_resistance: T,
 }
 
 /// Default `min_observability` \[A\]: the error grows as 1/share (module docs); 38 % skipped.
@@ -397,7 +390,6 @@ impl<T: Real> GainCalibration<T> {
             "in [0, 1)",
         )?;
         check::positive("max_mismatch", config.max_mismatch)?;
-        check::non_negative("band_resistance", config.band_resistance)?;
         check::positive("current_limit", config.current_limit)?;
         if config.current > config.current_limit {
             return Err(ConfigError::OutOfRange {

@@ -109,10 +109,10 @@ impl<T: Real> GainCalibration<T> {
             self.cross_ref = cross;
             self.cross_filtered = T::zero();
             // The voltage that acted without the inverter's modelled part: the stage just
-            // left was settled at its reference current (or held at zero by the drive's
-            // zero vector), where the model's compensation and loss cancel, and the loss at
-            // this one sample's measured current is the sensors' noise through the band's
-            // slope V̂/Ic (module docs, "Rotor motion").
+            // left is settled at its reference current (at zero current before the first),
+            // where the model's compensation and loss cancel, and the loss at this one
+            // sample's measured current is the sensors' noise through the band's slope V̂/Ic
+            // (module docs, "Rotor motion").
             self.cross_v_ref = if voltage_mode {
                 T::zero()
             } else {
@@ -166,7 +166,7 @@ impl<T: Real> GainCalibration<T> {
         if let Some((oldest, span)) = self.window.oldest().filter(|_| self.window.taken() > 1) {
             let flux = self.window_flux - oldest;
             mean = flux / (T::lit(span as f64) * self.config.ts);
-            let share = mean.abs() / self.window_threshold();
+            let share = mean.abs() / (self.config.motion_voltage * T::lit(LOOP_WINDOW_FACTOR));
             if share > self.loop_window_peak {
                 self.loop_window_peak = share;
             }
@@ -188,44 +188,12 @@ impl<T: Real> GainCalibration<T> {
 
     /// The motion test's threshold (V): in voltage mode `motion_voltage`, or the sensors'
     /// noise floor ([`motion_noise_floor`](Self::motion_noise_floor)) where that is larger;
-    /// [`LOOP_MOTION_FACTOR`] times `motion_voltage` under the current loop, or in the
-    /// release the band's noise ([`release_floor`](Self::release_floor)) where that is
-    /// larger.
+    /// [`LOOP_MOTION_FACTOR`] times `motion_voltage` under the current loop.
     pub(super) fn motion_threshold(&self, voltage_mode: bool) -> T {
         if voltage_mode {
             self.config.motion_voltage.step_max(self.noise_floor)
         } else {
-            (self.config.motion_voltage * T::lit(LOOP_MOTION_FACTOR)).step_max(self.release_floor())
-        }
-    }
-
-    /// The threshold (V) of the loop's mean back-EMF over [`LOOP_WINDOW_TIME`]:
-    /// [`LOOP_WINDOW_FACTOR`] times `motion_voltage`, or in the release the band's noise
-    /// scaled as the two thresholds are (× [`LOOP_WINDOW_FACTOR`]/[`LOOP_MOTION_FACTOR`])
-    /// where that is larger.
-    pub(super) fn window_threshold(&self) -> T {
-        let floor = self.release_floor() * T::lit(LOOP_WINDOW_FACTOR / LOOP_MOTION_FACTOR);
-        (self.config.motion_voltage * T::lit(LOOP_WINDOW_FACTOR)).step_max(floor)
-    }
-
-    /// What the sensors' noise reads through the inverter's band in the release to zero
-    /// current (V; zero in the other stages): the settled loop's noise floor
-    /// ([`motion_noise_floor`](Self::motion_noise_floor), the current's sample-to-sample
-    /// noise δi through L̂q/[`MOTION_FILTER_TIME`], times [`MOTION_NOISE_MARGIN`]) with δi
-    /// read through the band's slope `band_resistance` instead: noise floor ×
-    /// `band_resistance` × [`MOTION_FILTER_TIME`]/L̂q. At zero current every phase sits in
-    /// the band, where the model's loss at the measured current moves by V̂/Ic per ampere
-    /// of the sensors' noise: on the 560 V torque motor of
-    /// `crates/fado-sim/tests/data/torque-ipm-32p.toml` (V̂/Ic 25.7 Ω, one 0.067 A step
-    /// of its sensors 1.7 V per phase) the release reads 1.0–1.15 V through the 1 ms filter
-    /// and 0.2–0.33 V over the 4 ms window with the rotor still, above the loop's
-    /// thresholds 0.98 and 0.33 V, at sensor seeds 1–4.
-    pub fn release_floor(&self) -> T {
-        if self.stage == Stage::Release && self.config.lq_hat > T::zero() {
-            self.noise_floor * self.config.band_resistance * T::lit(MOTION_FILTER_TIME)
-                / self.config.lq_hat
-        } else {
-            T::zero()
+            self.config.motion_voltage * T::lit(LOOP_MOTION_FACTOR)
         }
     }
 

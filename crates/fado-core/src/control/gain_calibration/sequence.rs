@@ -166,7 +166,8 @@ impl<T: Real> GainCalibration<T> {
         } else {
             T::zero()
         };
-        if emf.abs() > self.motion_threshold(voltage_mode) || window.abs() > self.window_threshold()
+        if emf.abs() > self.motion_threshold(voltage_mode)
+            || window.abs() > self.config.motion_voltage * T::lit(super::LOOP_WINDOW_FACTOR)
         {
             self.motion_current = self.command().current_d;
             self.motion_emf = emf;

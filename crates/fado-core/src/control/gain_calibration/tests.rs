@@ -19,7 +19,6 @@ fn config(current: f64, r: f64, l: f64) -> GainCalibrationConfig<f64> {
         current_limit: 2.5 * current,
         lq_hat: 1e-3,
         motion_voltage: f64::INFINITY,
-        band_resistance: 0.0,
     }
 }
 
@@ -276,7 +275,6 @@ fn f32_identifies_the_mismatch_too() {
         current_limit: 20.0,
         lq_hat: 1e-3,
         motion_voltage: f32::INFINITY,
-        band_resistance: 0.0,
     })
     .unwrap();
     // A resistive machine with no dynamics behind an ideal current loop: the current is
