@@ -67,8 +67,8 @@ fn a_slow_torque_motor_holds_its_loaded_reversal() {
 /// The torque motor's start-up gain calibration runs along its start axis (its swing's
 /// window sized at that axis fits the hold budget) through the settling and both levels with
 /// the rotor held, and in its release to zero current the scenario's load, present from the
-/// start, turns the rotor 0.35 rad electrical: the release reads it (`RotorMoved` 27–64 ms
-/// in at seeds 1–4), but in the band every phase's 0.067 A sensor step moves the drive's
+/// start, turns the rotor (0.35 rad electrical by the release's end where nothing reads it):
+/// the release reads it (`RotorMoved` 27–64 ms in at seeds 1–4), but in the band every phase's 0.067 A sensor step moves the drive's
 /// modelled loss by 1.7 V (V̂/Ic = 25.7 Ω), the turn read is off, and the drive starts from
 /// it: `stops` 3.14 rad / 119 r/min (seed 1). The calibration skipped (`TooSlow`, the window
 /// sized for the worst axis): `stops` 0.155 rad / 1.47 r/min, `rated-reversal` 0.112 /
