@@ -112,7 +112,18 @@
 //! to 2·V̂, which the rotor's motion does not explain (on the 2-pole spindle of
 //! `crates/fado-sim/tests/calibration_load_classes.rs`, the phase carrying a fifth of the
 //! level reverses, and without the term the test reads 0.69 of its threshold while the rotor
-//! turns at 500 r/min). Above `motion_voltage` ([`MOTION_SPEED_RATIO`] of the rated speed's
+//! turns at 500 r/min). The stage's reference, the voltage that acted at its first sample,
+//! leaves that modelled part out: the stage just left is settled at its reference current
+//! (at zero current before the first), where the model's compensation and loss cancel,
+//! while the loss at one sample's measured current inside the band is the sensors' noise
+//! times the band's slope V̂/Ic (25.7 Ω on the 560 V, 8 kHz inverter of the 32-pole torque
+//! motor in `crates/fado-sim/tests/data/torque-ipm-32p.toml`: 1.7 V per phase for one
+//! 0.067 A step of its sensors). Taken into the reference, that one sample would offset the
+//! settling's whole reading by 0.35–0.40 V across the axis, above the loop's mean threshold
+//! ([`LOOP_WINDOW_FACTOR`] × `motion_voltage`, 0.33 V there): the test would read that still
+//! rotor as moving at sensor seeds 1–4, and the 310 V appliance motor of
+//! `crates/fado-sim/tests/data/unseen/` at seeds 3 and 4.
+//! Above `motion_voltage` ([`MOTION_SPEED_RATIO`] of the rated speed's
 //! back-EMF; [`LOOP_MOTION_FACTOR`] times it under the current loop, whose step through the
 //! band the trapezoid gives only roughly) the calibration ends at once with
 //! [`GainCalibrationStatus::RotorMoved`]: no release to zero current. The drive starts at once

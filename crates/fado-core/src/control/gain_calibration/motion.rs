@@ -108,7 +108,16 @@ impl<T: Real> GainCalibration<T> {
         if stage_start {
             self.cross_ref = cross;
             self.cross_filtered = T::zero();
-            self.cross_v_ref = cross_v;
+            // The voltage that acted without the inverter's modelled part: the stage just
+            // left is settled at its reference current (at zero current before the first),
+            // where the model's compensation and loss cancel, and the loss at this one
+            // sample's measured current is the sensors' noise through the band's slope V̂/Ic
+            // (module docs, "Rotor motion").
+            self.cross_v_ref = if voltage_mode {
+                T::zero()
+            } else {
+                self.axis.cross(v_ab)
+            };
             self.cross_v_filtered = T::zero();
             self.motion_flux = T::zero();
         }
