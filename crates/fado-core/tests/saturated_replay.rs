@@ -305,16 +305,24 @@ fn assert_holds(name: &str, load: f64, r: &Replay) {
         r.rs_ratio_range.0,
         r.rs_ratio_range.1
     );
-    assert!(
-        r.max_error_near_zero < 0.25,
-        "{name} {load}: {}",
-        r.max_error_near_zero
-    );
-    assert!(
-        r.rs_ratio_range.0 > 0.95 && r.rs_ratio_range.1 < 1.05,
-        "{name} {load}: R̂s/Rs {:?}",
-        r.rs_ratio_range
-    );
+    r.assert_within(&format!("{name} {load}"), 0.05);
+}
+
+impl Replay {
+    /// Asserts the criterion: within 0.25 rad near zero speed, R̂s/Rs within 1 ± `rs_tolerance`.
+    fn assert_within(&self, label: &str, rs_tolerance: f64) {
+        assert!(
+            self.max_error_near_zero < 0.25,
+            "{label}: {}",
+            self.max_error_near_zero
+        );
+        assert!(
+            self.rs_ratio_range.0 > 1.0 - rs_tolerance
+                && self.rs_ratio_range.1 < 1.0 + rs_tolerance,
+            "{label}: R̂s/Rs {:?}",
+            self.rs_ratio_range
+        );
+    }
 }
 
 /// The reversal replayed: `plant` makes the signals, `model` is the estimator's machine.
@@ -902,16 +910,7 @@ fn a_map_that_ends_short_of_the_operating_current_freezes_the_resistance_law() {
             r.rs_ratio_range.1,
             fixed.max_error_near_zero
         );
-        assert!(
-            r.max_error_near_zero < 0.25,
-            "{name}: {}",
-            r.max_error_near_zero
-        );
-        assert!(
-            r.rs_ratio_range.0 > 0.98 && r.rs_ratio_range.1 < 1.02,
-            "{name}: R̂s/Rs {:?}",
-            r.rs_ratio_range
-        );
+        r.assert_within(name, 0.02);
     }
 }
 

@@ -33,13 +33,7 @@ fn run(angle: f64, ga: f64, gb: f64, v_err: f64) -> (GainCalibration<f64>, f64, 
 
 /// The sign of a phase current, zero at zero (the direction a pole's voltage error takes).
 fn current_sign(x: f64) -> f64 {
-    if x > 0.0 {
-        1.0
-    } else if x < 0.0 {
-        -1.0
-    } else {
-        0.0
-    }
+    if x == 0.0 { 0.0 } else { x.signum() }
 }
 
 /// [`run`] with the rotor-motion test at `motion_voltage` (V) and the phase currents read in
