@@ -263,7 +263,8 @@ def test_a_flat_controller_key_names_its_new_place(config: dict[str, object], fi
     with pytest.raises(fado.ConfigError) as info:
         fado.simulate("fig11", config, averaged=True)
     assert info.value.field == field
-    assert f"`{field}` moved: write it as `{place}`" in str(info.value)
+    table = place.split("]")[0] + "]"
+    assert f"`{field}` belongs in `{table}`: write it as `{place}`" in str(info.value)
     assert info.value.line is not None
 
 

@@ -336,7 +336,7 @@ fn moved_message(shown: &str, key: &str, path: &str) -> String {
     let (table, field) = path.split_once('.').unwrap_or((path, ""));
     let prefix = shown.strip_suffix(key).unwrap_or("");
     format!(
-        "`{shown}` moved: write it as `{prefix}{table}={{\"{field}\": …}}` (or `{prefix}{path}`)"
+        "`{shown}` belongs in `{prefix}{table}`: write it as `{prefix}{table}={{\"{field}\": …}}` (or `{prefix}{path}`)"
     )
 }
 

@@ -335,13 +335,13 @@ pub(crate) fn default_baselines() -> toml::Table {
 }
 
 /// Every key of `[baselines]` names a baseline of the registry; a setting written there
-/// directly is refused with the place it lives now.
+/// directly is refused with the table it belongs in.
 pub(crate) fn check_baseline_keys(baselines: &toml::Table) -> Result<(), SimConfigError> {
     for key in baselines.keys() {
         if let Some((_, table, field)) = MOVED_BASELINE_KEYS.iter().find(|m| m.0 == key) {
             return Err(SimConfigError::new(
                 format!("baselines.{key}"),
-                format!("moved: write it as `{field}` in `[baselines.{table}]`"),
+                format!("a setting of `[baselines.{table}]`: write it as `{field}` there"),
             ));
         }
         let known = ESTIMATORS.iter().any(|e| e.own_settings && e.key() == *key);

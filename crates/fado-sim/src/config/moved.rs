@@ -29,7 +29,9 @@ pub(crate) fn moved_error(section: &str, key: &str, path: &str) -> SimConfigErro
     let (table, field) = path.rsplit_once('.').unwrap_or(("", path));
     SimConfigError::new(
         format!("{section}.{key}"),
-        format!("`{section}.{key}` moved: write it as `[{section}.{table}] {field}`"),
+        format!(
+            "`{section}.{key}` belongs in `[{section}.{table}]`: write it as `[{section}.{table}] {field}`"
+        ),
     )
 }
 

@@ -121,7 +121,7 @@ mod located_errors {
         );
         assert!(
             message.ends_with(
-                "`estimator.lock_heal_time` moved: write it as `[estimator.lock] heal_time`"
+                "`estimator.lock_heal_time` belongs in `[estimator.lock]`: write it as `[estimator.lock] heal_time`"
             ),
             "{message}"
         );
@@ -137,7 +137,7 @@ mod located_errors {
         );
         assert!(
             message.ends_with(
-                "`controller.lock_stall_time` moved: write it as `[controller.stall] time`"
+                "`controller.lock_stall_time` belongs in `[controller.stall]`: write it as `[controller.stall] time`"
             ),
             "{message}"
         );
@@ -284,7 +284,9 @@ mod located_errors {
         let (key, line, _, msg) = err("[baselines]\nlpf_cutoff_hz = 3.0\n");
         assert_eq!((key.as_str(), line), ("baselines.lpf_cutoff_hz", 2));
         assert!(
-            msg.contains("`cutoff_hz` in `[baselines.lpf_integrator]`"),
+            msg.contains(
+                "a setting of `[baselines.lpf_integrator]`: write it as `cutoff_hz` there"
+            ),
             "{msg}"
         );
         let (key, _, _, msg) = err("[baselines.kalman]\ngain = 1.0\n");
