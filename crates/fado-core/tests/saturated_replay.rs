@@ -1021,16 +1021,14 @@ const RIPPLE_HZ: f64 = 4.5;
 /// of rated, with a ripple of `ripple` times it at [`RIPPLE_HZ`] from 1 s. `model` is the
 /// estimator's machine. Returns max |θ − θ̂| over 1–6 s.
 fn frame_closed_error(
-    plant: &MachineModel<f64>,
-    model: &MachineModel<f64>,
+    (plant, model): (&MachineModel<f64>, &MachineModel<f64>),
     load: f64,
-    speed_ratio: f64,
-    ripple: f64,
+    (speed_ratio, ripple): (f64, f64),
 ) -> f64 {
-    let ts = 1e-4;
+    let mut est = SensorlessEstimator::new(EstimatorConfig::for_machine(model)).unwrap();
     let magnetics = plant.magnetic_model();
     let i_dq = operating_current(plant, load);
-    let mut est = SensorlessEstimator::new(EstimatorConfig::for_machine(model)).unwrap();
+    let ts = 1e-4;
     let at = |t: f64, theta: f64, theta_hat: f64| {
         let i = (i_dq * (t / 0.5).min(1.0)).to_ab(Rotation::from_angle(theta_hat));
         let rot = Rotation::from_angle(theta);
@@ -1077,7 +1075,7 @@ fn coupled_machines_hold_a_speed_ripple_with_their_frame_closed() {
         ("automotive IPMSM (made up)", automotive()),
         ("ferrite PM-SyRM (made up)", ferrite_pmsyrm()),
     ] {
-        let e = frame_closed_error(&m, &m, 1.0, -0.06, 0.1);
+        let e = frame_closed_error((&m, &m), 1.0, (-0.06, 0.1));
         println!("{name}, generating at rated torque, ±10 % speed ripple: {e:.3} rad");
         assert!(e < 0.25, "{name}: {e} rad");
     }
@@ -1087,7 +1085,7 @@ fn coupled_machines_hold_a_speed_ripple_with_their_frame_closed() {
         ("generating at −10 %, steady", -0.1, 0.0),
         ("motoring, ±10 % ripple", 0.06, 0.1),
     ] {
-        let e = frame_closed_error(&plant, &map, 1.0, speed, ripple);
+        let e = frame_closed_error((&plant, &map), 1.0, (speed, ripple));
         println!("mot-pmsyrm-4k at rated torque, {label}: {e:.3} rad");
         assert!(e < 0.1, "mot-pmsyrm-4k {label}: {e} rad");
     }
@@ -1112,7 +1110,7 @@ fn the_weak_magnet_pm_syrm_holds_a_speed_ripple_while_generating() {
     let (plant, map) = (motulator_pm_syrm(), motulator_machines()[1].1);
     for (label, model) in [("map", map), ("algebraic model", plant)] {
         for load in [0.65, 1.0] {
-            let e = frame_closed_error(&plant, &model, load, -0.06, 0.1);
+            let e = frame_closed_error((&plant, &model), load, (-0.06, 0.1));
             println!(
                 "mot-pmsyrm-4k ({label}) at {:.0} %: {e:.3} rad",
                 load * 100.0
