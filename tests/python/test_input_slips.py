@@ -50,6 +50,33 @@ def test_a_kv_keyword_is_named_and_pointed_to_from_datasheet() -> None:
     assert "kv_rpm_per_volt" in text and "from_datasheet" in text, text
 
 
+@pytest.mark.parametrize(
+    ("call", "slip", "meant"),
+    [
+        (lambda: fado.Machine(**without(OUTRUNNER, "rs"), rss=0.06), "rss", "rs"),
+        (lambda: fado.Machine(**OUTRUNNER, viscous_fricton=0.0), "viscous_fricton", "viscous_friction"),
+        (lambda: fado.EstimatorConfig(limter={"k_af": 1.0}), "limter", "limiter"),
+        (
+            lambda: fado.Machine.from_datasheet(**without(OUTRUNNER, "flux_linkage"), kv_rpm_per_vol=100.0),
+            "kv_rpm_per_vol",
+            "kv_rpm_per_volt",
+        ),
+    ],
+)
+def test_a_misspelt_keyword_names_the_one_it_looks_like(call, slip: str, meant: str) -> None:
+    with pytest.raises(TypeError) as e:
+        call()
+    text = str(e.value)
+    assert f"`{slip}`" in text and f"did you mean `{meant}`?" in text, text
+
+
+def test_a_misspelt_config_key_names_the_one_it_looks_like() -> None:
+    with pytest.raises(fado.ConfigError) as e:
+        fado.simulate("fig11", {"inverter": {"swiching_frequency": 5000.0}}, averaged=True)
+    assert e.value.field == "inverter.swiching_frequency", e.value
+    assert "did you mean `switching_frequency`?" in str(e.value)
+
+
 def test_kv_and_kg_cm2_are_converted_as_the_cli_converts_them() -> None:
     m = fado.Machine.from_datasheet(
         **without(OUTRUNNER, "flux_linkage"), kv_rpm_per_volt=100.0, inertia_kg_cm2=5.0
@@ -132,3 +159,14 @@ def test_a_signal_of_another_length_is_the_one_named() -> None:
     with pytest.raises(fado.InputError) as e:
         fado.estimate(*signals[:3], signals[3][:-1], machine="paper")
     assert e.value.argument == "i_beta"
+
+
+def test_a_reference_beyond_the_motors_limits_is_a_warning_naming_it() -> None:
+    # The outrunner's rated 1,800 r/min given as electrical r/min (× 7 pole pairs).
+    config = {
+        "simulation": {"duration": 0.02},
+        "speed_reference": {"points": [[0.0, 0.0], [1.0, 12600.0]]},
+    }
+    with pytest.warns(UserWarning, match="speed_reference.points") as record:
+        fado.simulate("reversal", config, averaged=True, motor=fado.Machine(**OUTRUNNER))
+    assert any("electrical r/min" in str(w.message) for w in record)

@@ -40,8 +40,11 @@ pub fn convert<'py>(
             continue;
         }
         if !crate::machine::is_field(&key) {
+            let keys = crate::machine::field_list()
+                .chain(fado_core::datasheet::ALTERNATIVES.iter().map(|a| a.key));
+            let meant = fado_sim::suggest::did_you_mean(&key, keys);
             return Err(pyo3::exceptions::PyTypeError::new_err(format!(
-                "unexpected keyword argument `{key}`: neither a Machine field ({}) nor a \
+                "unexpected keyword argument `{key}`{meant}: neither a Machine field ({}) nor a \
                  datasheet key ({})",
                 fado_core::ratings::REQUIRED_MOTOR_KEYS.join(", ")
                     + ", inertia, viscous_friction, dc_voltage, flux_map",

@@ -62,8 +62,9 @@ fn missing_required(fields: Option<&Bound<'_, PyDict>>) -> PyResult<Option<PyErr
     }
     let unknown = match unknown.first() {
         Some(k) => format!(
-            "`{k}` is not a Machine field: a datasheet's values (Kv, Kt, Ke, line-to-line R and \
-             L, rms currents, kg·cm²) go to Machine.from_datasheet as {}. ",
+            "`{k}` is not a Machine field{}: a datasheet's values (Kv, Kt, Ke, line-to-line R \
+             and L, rms currents, kg·cm²) go to Machine.from_datasheet as {}. ",
+            fado_sim::suggest::did_you_mean(k, field_list()),
             datasheet_keys()
         ),
         None => String::new(),
@@ -81,9 +82,16 @@ fn missing_required(fields: Option<&Bound<'_, PyDict>>) -> PyResult<Option<PyErr
 
 /// True when `key` is a `Machine` field (a keyword of its constructor).
 pub(crate) fn is_field(key: &str) -> bool {
-    fado_core::ratings::REQUIRED_MOTOR_KEYS.contains(&key)
-        || DERIVED.contains(&key)
-        || key == "flux_map"
+    field_list().any(|k| k == key)
+}
+
+/// Every keyword of `Machine()`: the required keys, the derived ones and `flux_map`.
+pub(crate) fn field_list() -> impl Iterator<Item = &'static str> {
+    fado_core::ratings::REQUIRED_MOTOR_KEYS
+        .iter()
+        .chain(DERIVED.iter())
+        .copied()
+        .chain(["flux_map"])
 }
 
 /// The datasheet keys of `Machine.from_datasheet` with their units, as text.
@@ -412,7 +420,8 @@ impl PyMachine {
                         py,
                         &key,
                         format!(
-                            "`{key}` is not a Machine field; one of {:?}",
+                            "`{key}` is not a Machine field{}; one of {:?}",
+                            fado_sim::suggest::did_you_mean(&key, field_list()),
                             field_names(py)?
                         ),
                     ));

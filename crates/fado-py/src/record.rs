@@ -164,8 +164,9 @@ where
         let name = shown(&key);
         let Some(current) = merged.get_item(&key)? else {
             let fields = field_names(py, base)?;
+            let meant = fado_sim::suggest::did_you_mean(&key, fields.iter().map(String::as_str));
             return Err(pyo3::exceptions::PyTypeError::new_err(format!(
-                "unexpected keyword argument `{name}`: not {kind}; one of {fields:?}"
+                "unexpected keyword argument `{name}`: not {kind}{meant}; one of {fields:?}"
             )));
         };
         if let Ok(table) = current.cast::<PyDict>() {

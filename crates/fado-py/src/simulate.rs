@@ -225,6 +225,8 @@ fn run(
         .collect();
     // A paper experiment in its motor's units on a motor of other ratings says so.
     warnings.extend(scenario::find(scenario).and_then(|s| s.units_note(&cfg)));
+    // A speed reference or a load beyond the model's limits.
+    warnings.extend(fado_sim::reach::findings(&cfg).into_iter().map(|(_, w)| w));
     let rows = scenario::trace_rows(&cfg);
     if rows > MAX_TRACE_ROWS_IN_MEMORY {
         let e = SimConfigError::new(

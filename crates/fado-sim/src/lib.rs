@@ -73,11 +73,13 @@ pub mod output;
 pub mod presets;
 pub mod profile;
 pub mod range;
+pub mod reach;
 pub mod saturation_verdict;
 pub mod scenario;
 pub mod sensors;
 pub mod sim;
 pub mod source;
+pub mod suggest;
 pub mod sweep;
 pub mod threads;
 

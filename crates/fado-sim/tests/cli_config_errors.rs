@@ -44,6 +44,16 @@ fn unknown_key_and_wrong_type_name_file_line_and_key() {
     let prefix = format!("error: {}:3:3: `inverter.dead_tme`: ", path.display());
     assert!(stderr.starts_with(&prefix), "{stderr}");
     assert!(stderr.contains("unknown field"), "{stderr}");
+    assert!(stderr.contains("did you mean `dead_time`?"), "{stderr}");
+    // A name unlike every key of its table gets the list alone.
+    let (code, stderr, _) = run_with(
+        "unlike.toml",
+        "[inverter]
+gear_ratio = 3
+",
+    );
+    assert_eq!(code, Some(2), "{stderr}");
+    assert!(!stderr.contains("did you mean"), "{stderr}");
 
     let (code, stderr, path) = run_with(
         "type.toml",

@@ -343,3 +343,39 @@ fn a_paper_figure_on_the_users_motor_says_its_loads_are_the_papers_not_scaled() 
         assert!(!note(scenario).contains("note:"), "{scenario}");
     }
 }
+
+#[test]
+fn a_speed_in_electrical_rpm_and_a_load_in_n_cm_are_warnings_at_their_lines() {
+    // The outrunner's rated 1,800 r/min given as electrical r/min (× 7 pole pairs), its rated
+    // 2.34 N·m as 234 N·cm: both beyond what its 24 V link and current limit give.
+    let text = format!(
+        "{OUTRUNNER}\n[speed_reference]\npoints = [[0.0, 0.0], [1.0, 12600.0]]\n\
+         \n[load.torque]\npoints = [[0.0, 0.0], [1.0, 234.0]]\n"
+    );
+    let (code, err, path) = dump_text("reach", &text);
+    assert_eq!(code, Some(0), "{err}");
+    let line = |key: &str| {
+        let after = text.find(key).unwrap();
+        text[after..]
+            .find("points")
+            .map(|p| text[..after + p].lines().count() + 1)
+            .unwrap()
+    };
+    let speed = format!(
+        "{}:{}:10: warning: ",
+        path.display(),
+        line("[speed_reference]")
+    );
+    let load = format!("{}:{}:10: warning: ", path.display(), line("[load.torque]"));
+    assert!(
+        err.contains(&speed) && err.contains("electrical r/min"),
+        "{speed}\n{err}"
+    );
+    assert!(err.contains(&load) && err.contains("N·cm"), "{load}\n{err}");
+    // The same motor with its own ratings-scaled reference and load: no such warning.
+    let (_, err, _) = dump_text("reach-ok", OUTRUNNER);
+    assert!(
+        !err.contains("speed_reference") && !err.contains("load.torque"),
+        "{err}"
+    );
+}

@@ -162,15 +162,29 @@ fn located(text: &str, e: toml::de::Error) -> SimConfigError {
 }
 
 /// `err` (an unknown key) with the places the key belongs to: another table
-/// ([`wrong_table_hint`]) or, in `[motor]`, the datasheet's keys ([`datasheet_hint`]).
+/// ([`wrong_table_hint`]), the key of its table it looks like a slip of ([`meant_key_hint`]) or,
+/// in `[motor]`, the datasheet's keys ([`datasheet_hint`]).
 pub(crate) fn with_unknown_key_hint(mut err: SimConfigError) -> SimConfigError {
     if !err.message.starts_with("unknown field") {
         return err;
     }
-    if let Some(hint) = wrong_table_hint(&err.key).or_else(|| datasheet_hint(&err.key)) {
+    let hint = wrong_table_hint(&err.key)
+        .or_else(|| meant_key_hint(&err.key, &err.message))
+        .or_else(|| datasheet_hint(&err.key));
+    if let Some(hint) = hint {
         err.message.push_str(&hint);
     }
     err
+}
+
+/// For an unknown key: the key of its table it most likely means
+/// ([`crate::suggest::closest`] among the keys serde's message lists as expected).
+fn meant_key_hint(full: &str, message: &str) -> Option<String> {
+    let key = full.rsplit('.').next().unwrap_or(full);
+    let expected = message.split_once("expected one of ")?.1;
+    let keys = expected.split(", ").map(|k| k.trim().trim_matches('`'));
+    let hint = crate::suggest::did_you_mean(key, keys);
+    (!hint.is_empty()).then_some(hint)
 }
 
 /// For an unknown `motor.key`: the datasheet key it most likely means (a Kv, Kt, Ke or an

@@ -7,7 +7,8 @@ use fado_sim::SimConfigError;
 use fado_sim::output::OutputError;
 use fado_sim::scenario;
 
-/// Prints the plausibility warnings of `cfg`'s motor on stderr, each at the
+/// Prints the plausibility warnings of `cfg`'s motor and of its profiles
+/// ([`fado_sim::reach`]) on stderr, each at the
 /// FILE:LINE:COLUMN of the key it blames first when `text` (the file's) holds it, else naming
 /// the file.
 pub fn warn_plausibility(cfg: &fado_sim::SimConfig, config: Option<&Path>, text: Option<&str>) {
@@ -17,6 +18,9 @@ pub fn warn_plausibility(cfg: &fado_sim::SimConfig, config: Option<&Path>, text:
         .into_iter()
         .filter(|(s, ..)| *s == Severity::Warning)
     {
+        warn_at(config, text, &key, &w);
+    }
+    for (key, w) in fado_sim::reach::findings(cfg) {
         warn_at(config, text, &key, &w);
     }
 }
