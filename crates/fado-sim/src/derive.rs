@@ -165,11 +165,35 @@ fn check_required(motor: &toml::Table, text: &str) -> Result<(), SimConfigError>
                  loads and the commissioning's test levels are ratios of them",
             );
         }
+        message.push_str(&torque_hint(motor, &missing));
         let mut e = SimConfigError::new(format!("motor.{}", missing[0]), message);
         e.location = section_location(text, "motor");
         return Err(e);
     }
     Ok(())
+}
+
+/// For a motor whose datasheet gives no rated torque (a multirotor motor's gives a Kv and a
+/// current): the magnet torque 1.5·p·λf·I at its `rated_current`, the value to write when that
+/// current is the continuous one; empty when the torque is given or cannot be computed.
+fn torque_hint(motor: &toml::Table, missing: &[&str]) -> String {
+    let positive = |k: &str| number(motor, k).filter(|x| x.is_finite() && *x > 0.0);
+    let (Some(flux), Some(pairs), Some(current)) = (
+        positive("flux_linkage"),
+        positive("pole_pairs"),
+        positive("rated_current"),
+    ) else {
+        return String::new();
+    };
+    if !missing.contains(&"rated_torque") {
+        return String::new();
+    }
+    let torque = 1.5 * pairs * flux * current;
+    format!(
+        ". Without a rated torque on the datasheet: the magnet torque 1.5·p·λf·I at \
+         `rated_current` is {torque:.4} N·m (`rated_torque = {torque:.4}` where that current is \
+         the continuous one)"
+    )
 }
 
 /// The machine model of a completed `[motor]` (no DC link).

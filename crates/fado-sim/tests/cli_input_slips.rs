@@ -379,3 +379,14 @@ fn a_speed_in_electrical_rpm_and_a_load_in_n_cm_are_warnings_at_their_lines() {
         "{err}"
     );
 }
+
+#[test]
+fn a_motor_without_a_rated_torque_is_refused_with_the_magnet_torque_to_write() {
+    // A multirotor datasheet gives a Kv and a current, no torque: 1.5·7·7.88 mWb·28.3 A.
+    let text = OUTRUNNER.replace("rated_torque = 2.34\n", "");
+    assert_ne!(text, OUTRUNNER);
+    let (code, err, _) = dump_text("no-torque", &text);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("lacks `rated_torque`"), "{err}");
+    assert!(err.contains("`rated_torque = 2.3415`"), "{err}");
+}
