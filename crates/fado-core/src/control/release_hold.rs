@@ -726,6 +726,11 @@ impl<T: Real> ReleaseHold<T> {
         let sense = self.follow(speed_ref, theta_tracked);
         let e = crate::wrap_angle(self.theta_hold - theta);
         let omega = self.omega;
+        // A hold the reference leaves before it has settled holds on as a motion hold: its
+        // integral has not yet taken the load (module docs, "When").
+        if moving_ref && self.active && self.held < self.hold_samples {
+            self.engaged_by_motion = true;
+        }
         let standstill_hold = self.through_standstill && !(self.engaged_by_motion && moving_ref);
         let settled = self.active && !standstill_hold && self.held >= self.hold_samples;
         // A hold triggered at zero reference hands over as the reference leaves zero.
