@@ -2,6 +2,14 @@
 //! needs, the loaded standstill and the motion hold.
 use super::*;
 
+/// b = 1.5·p²·λ̂f/Ĵ (electrical rad/s² per A) and the rated load in A of magnet q current
+/// (the hold's unit) of `machine`.
+fn rigid_rotor(machine: &MachineModel<f64>) -> (f64, f64) {
+    let p = machine.pole_pairs as f64;
+    let b = 1.5 * p * p * machine.flux_linkage / machine.inertia;
+    (b, machine.rated_torque / (1.5 * p * machine.flux_linkage))
+}
+
 /// A rigid rotor θ̈ = b·(i − i_L) under the hold with an exact angle estimate: a step
 /// of the rated load at t = 0, until the hold hands over. Returns (largest travel, the
 /// angle error at the hand-over, the torque handed over).
@@ -223,14 +231,11 @@ fn a_reference_that_leaves_zero_before_the_hold_settles_takes_the_whole_load() {
     // `loaded-start` seed 2: 14.5 rad back). Without the speed loop set it hands over at the
     // reference, as before.
     let m = MachineModel::<f64>::paper();
-    let on = ReleaseHoldTuning {
+    let (ts, (b, i_load)) = (1e-4, rigid_rotor(&m));
+    let on = ReleaseHoldTuning::<f64> {
         enabled: true,
-        ..ReleaseHoldTuning::default()
+        ..Default::default()
     };
-    let ts = 1e-4;
-    let p = m.pole_pairs as f64;
-    let b = 1.5 * p * p * m.flux_linkage / m.inertia;
-    let i_load = m.rated_torque / (1.5 * p * m.flux_linkage);
     let mut h = ReleaseHold::new(&on, &m, ts, 250.0, 2.0 * i_load).unwrap();
     h.set_speed_loop(5.0, 5.0);
     h.arm(0.3);
@@ -285,8 +290,7 @@ fn a_motion_hold_acts_at_any_reference_and_the_reference_resumes_from_zero() {
     assert!(!t.enabled);
     let ts = 1e-4;
     let p = m.pole_pairs as f64;
-    let b = 1.5 * p * p * m.flux_linkage / m.inertia;
-    let i_load = m.rated_torque / (1.5 * p * m.flux_linkage);
+    let (b, i_load) = rigid_rotor(&m);
     let mut h = ReleaseHold::new(&t, &m, ts, 250.0, 2.0 * i_load).unwrap();
     h.engage(0.3, 0.0);
     assert!(h.active() && h.tracking_fall() && h.engaged() == 1);
