@@ -69,6 +69,35 @@ fn a_saturated_rotor_with_clear_axes_pulses_at_the_rated_current() {
     assert_eq!(pulse_current_share(&m, m.rated_current), 1.0);
 }
 
+#[test]
+fn a_release_shortly_before_the_speed_ramp_hands_a_settled_hold_over() {
+    // Three drawn IPMSMs (draw seed 4), one linear and two saturating, whose start-up reports
+    // ready at sensor seed 2 only 25, 74 and 109 ms before `loaded-start`'s ramp leaves zero
+    // at 1.0 s (and a fourth, draw seed 5, 26.5 kW, 18 pole pairs, 58 ms at sensor seed 1;
+    // its seed 2, ready at 1.025 s on the moving reference, runs back 0.388 rad either way):
+    // the brake opens at ready, the release hold catches the rated load, and the reference
+    // leaves zero before the hold has acted 10/ω_h. Handing over its integral
+    // then (13 of the 24 A the 9.7 kW machine's load needs), the rotors ran back 14.5 rad
+    // (9.7 kW, 5 pole pairs; |θ − θ̂| 0.79 rad from ready, R̂s learned +2.9 % in the slow
+    // backward run), 1.49 rad (6.8 kW, 2) and 0.56 rad (138 kW, 17). Held on until the speed
+    // loop can take the rest (`release_hold::HANDOVER_TRAVEL_RATIO`): 0.249, 0.237 and
+    // 0.196 rad back, |θ − θ̂| from ready 0.084, 0.061 and 0.047 rad; the 26.5 kW machine
+    // 0.556 → 0.194 rad. Seed 1 of the first three (ready 0.17–0.30 s before the ramp)
+    // passes either way: 0.24, 0.16, 0.20 rad.
+    for name in [
+        "ipm-5p-760v-9724w",
+        "ipm-sat-2p-800v-6787w",
+        "ipm-sat-17p-800v-138kw",
+        "ipm-18p-800v-26543w",
+    ] {
+        for seed in [1, 2] {
+            let (passed, _, max_error, backward) = loaded_start(name, seed);
+            println!("{name} seed {seed}: max {max_error:.3}, back {backward:.3} rad");
+            assert!(passed, "{name} seed {seed}: {backward} rad back");
+        }
+    }
+}
+
 /// The drawn 69 W, 15-pole-pair IPMSM (6 kHz carrier, q secant 44 % down at the rated
 /// current, 47 V link) and the drawn 289 W 2-pole saturating surface-magnet motor (35 kHz):
 /// held at zero speed under the rated load after the brake's release, θ̂ creeps ahead of

@@ -72,7 +72,15 @@
 //! without). It ends after 10/ω_h (the load caught and
 //! settled) or at a non-zero speed reference: the speed loop's integral is then preset to
 //! the hold's integral (the pre-torque: the load it found) so that the load is not dropped at
-//! the hand-over, and the drive's loaded-standstill handling (the speed loop, the
+//! the hand-over. A reference that leaves zero before the hold has acted 10/ω_h may find an
+//! integral that holds only part of the load (the rest is still in the loop's transient
+//! terms): the hold then acts on as a motion hold ([`ReleaseHold::engage`]), the speed
+//! loop's reference at zero, until the speed loop can take the rest
+//! ([`HANDOVER_TRAVEL_RATIO`]), and the reference resumes from zero. A
+//! brake released at ready 25 ms before the reference's ramp (a drawn 9.7 kW, 5-pole-pair
+//! IPMSM of 0.14 kg·m², ω_h = 84 rad/s, `crates/fado-sim/tests/data/drawn/`, `loaded-start`
+//! seed 2) handed over 13 A of the 24 A load and ran back 14.5 rad under the speed loop;
+//! held on, 0.25 rad. The drive's loaded-standstill handling (the speed loop, the
 //! [`standstill_probe`](crate::control::standstill_probe)) holds it from there: the hold's
 //! own reference, the estimated angle, drifts at a loaded standstill like every estimate
 //! there. On a light rotor it stays instead (below).
@@ -119,94 +127,9 @@
 //! lacks, read from the fall at the trigger (`release_hold/fall.rs`: a 400 W servo's rotor).
 
 use crate::error::{ConfigError, check};
-use crate::real::cast_record;
 use crate::{MachineModel, Real};
 
-/// `[controller.release_hold]`: the release hold's settings (module docs).
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(
-    feature = "serde",
-    derive(serde::Serialize, serde::Deserialize),
-    serde(
-        deny_unknown_fields,
-        default,
-        bound(
-            serialize = "T: serde::Serialize",
-            deserialize = "T: Real + serde::Deserialize<'de>"
-        )
-    )
-)]
-pub struct ReleaseHoldTuning<T> {
-    /// Hold a rotor that a load turns after an application's brake opens
-    /// ([`SensorlessDrive::arm_release_hold`](crate::control::SensorlessDrive::arm_release_hold)),
-    /// raise the current loop where the hold needs it and hold through a light rotor's loaded
-    /// standstill. Default false: under a wrong machine model (L̂q +25 % on the 50 kW IPMSM)
-    /// it triggers on the estimate's own start-up drift and loses the rotor earlier;
-    /// `fado-sim`'s `loaded-start` turns it on. The start-up's own end is `at_start`'s.
-    pub enabled: bool,
-    /// Hold a rotor that a load turns within `window` of the start-up's end (a free rotor,
-    /// not `StartupTuning::rotor_held`), whether `enabled` or not: at zero speed reference
-    /// once θ̂ leaves the aligned angle by `trigger`, on a moving reference once it falls
-    /// back against it by `trigger` from the furthest angle it reached (module docs, "On a
-    /// moving reference"). Default false: the speed loop alone lets half the rated torque
-    /// arriving 5–20 ms after ready turn the light rotors of
-    /// `crates/fado-sim/tests/calibration_load_classes.rs` back 1.0–48 rad, which this hold
-    /// keeps within the benchmark's criteria (module docs, "On a moving reference"), yet
-    /// on a strongly salient rotor with a weak magnet it engages on the start's own estimate
-    /// transient at zero reference and its position loop loses the rotor: the saturated
-    /// PM-SyRM `motors/saturated/pmsyrm-baldor-5k6.toml` (Lq/Ld ≈ 5) then loses `fullrange`
-    /// (3.14 rad at seeds 2–4 and 0.143 rad at seed 1; 0.141–0.148 rad without it: the hold
-    /// triggers 20 ms after ready on the unloaded rotor, and its loop on the direct angle,
-    /// whose rate there runs against the rotor's, swings the rotor with a growing amplitude
-    /// until the estimate is lost). An application that knows its rotor is light
-    /// and its model right turns it on.
-    pub at_start: bool,
-    /// Backward travel (electrical rad) the rated torque causes, which sets the loop's
-    /// stiffness. Default 0.2 rad \[A\]: 40 % of the 0.5 rad a loaded start may lose.
-    pub travel: T,
-    /// Angle (electrical rad) θ̂ leaves the aligned angle by before the hold acts. Default
-    /// 0.02 rad \[A\]: well above θ̂'s own movement at an unloaded standstill, a tenth of
-    /// `travel`.
-    pub trigger: T,
-    /// Time after the alignment (s) within which a turning rotor triggers the hold. Default
-    /// 0.05 s \[A\]: a brake releasing at ready lets a rated load move the rotor by the
-    /// trigger within 6 ms on the presets (the hub motor's 0.11 kg·m² the slowest); a start-up
-    /// that drifts later (an estimate lost under a wrong model) is left to the speed loop.
-    pub window: T,
-    /// From the brake's opening (or, armed at the start-up's end, from the trigger) until the
-    /// hold hands over, the estimator's T2S-1 tracks at
-    /// its running bandwidth in limiter mode too (where the drive has derived one,
-    /// [`tracker_feedforward`](crate::control::tracker_feedforward), "T2S-1 at a brake's
-    /// release"): the fall is the unannounced step of the rated load that bandwidth is placed
-    /// against. Default true \[A\]: measured on the made-up 45 µH 48 V motor (`loaded-start`
-    /// seeds 1–4), max |θ − θ̂| from ready 0.22–0.29 rad with the standstill's 60 Hz,
-    /// 0.07–0.08 rad with it (docs/results/startup.md).
-    pub track_fall: bool,
-    /// After a hold the start-up's motion test engaged ([`ReleaseHold::engage`]), the time (s)
-    /// in which the speed loop's reference rises from zero to the rated speed until it meets
-    /// the application's reference. Default 2 s \[A\]: the rotor leaves the held standstill
-    /// at half its rated speed per second, within what the estimator follows from rest
-    /// (measured on a 1.5 kW servo of 0.15 s mechanical start time, no load: 0.075 rad at
-    /// 1/3 of its rated speed per second, 0.20 rad at 1, 0.25 rad after a step of 6.4 % of
-    /// its rated speed; `crates/fado-sim/tests/calibration_load_classes.rs`).
-    pub resume_time: T,
-}
-
-impl<T: Real> Default for ReleaseHoldTuning<T> {
-    fn default() -> Self {
-        Self {
-            enabled: false,
-            at_start: false,
-            travel: T::lit(0.2),
-            trigger: T::lit(0.02),
-            window: T::lit(0.05),
-            track_fall: true,
-            resume_time: T::lit(2.0),
-        }
-    }
-}
-
-cast_record!(ReleaseHoldTuning { travel, trigger, window, resume_time ; enabled, at_start, track_fall });
+pub use tuning::ReleaseHoldTuning;
 
 /// The loop's speed filter on a saturating machine model: 1/(4·ω_h) \[A\] instead of
 /// 1/(5·ω_h). The direct angle moves with the currents' transients, and on a saturating
@@ -351,6 +274,22 @@ fn standstill_swing<T: Real>(b: T, amplitude: T, period: T) -> T {
 /// decayed to e^(−10)·(1 + 10 + 50) = 0.3 % by then, and its integral holds the load.
 const SETTLE_TIMES: f64 = 10.0;
 
+/// The travel (a share of the design travel, [`ReleaseHoldTuning::travel`]) the speed loop
+/// may let the rotor run back after a hand-over at a reference that leaves zero: 0.25 \[A\]
+/// (0.05 rad of the default 0.2 rad design). The speed loop starts from the hold's integral
+/// (the pre-torque); the torque still in the hold's transient terms, Δi = output − integral,
+/// is a load step for the speed PI (Kp = Ĵ·ωs, Ki = Ĵ·ωs²/z), which lets the rotor run back
+/// by b·Δi·z/ωs² (electrical rad, b = 1.5·p²·λ̂f/Ĵ; the final value of the PI's position
+/// error under a step, ΔT/Ki). A hold the reference leaves within a fraction of 10/ω_h acts
+/// on until that is within this share: on a drawn 9.7 kW IPMSM (ω_h = 84 rad/s, 5 Hz speed
+/// loop) the integral held 13 A of the 24 A load 22 ms after the trigger, b·Δi·z/ωs² = 8 rad
+/// (measured 14.5 rad back), and even a 5 % rest costs 1.4 rad; a heavy rotor's speed loop
+/// takes the rest at once (a drawn 137 kW IPMSM of 2,650 kg·m², ω_h = 6 rad/s: 10/ω_h =
+/// 1.7 s, b·Δi·z/ωs² of its 5 % rest 0.01 rad), where waiting for 10/ω_h would leave the
+/// rotor at rest while the reference ramps (`loaded-start`: 14 r/min behind at the end
+/// against the 5.3 allowed).
+pub const HANDOVER_TRAVEL_RATIO: f64 = 0.25;
+
 /// What the hold does at a sample.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum HoldAction<T> {
@@ -393,6 +332,16 @@ pub struct ReleaseHold<T> {
     /// Engaged by [`engage`](Self::engage) (the start-up saw the rotor move): acts at any
     /// speed reference until it has settled.
     engaged_by_motion: bool,
+    /// Left by the reference while the speed loop could not take the rest of its torque:
+    /// hands over once it can.
+    carrying: bool,
+    /// b = 1.5·p²·λ̂f/Ĵ (electrical rad/s² per A).
+    b: T,
+    /// The rotor's run-back per A of torque the speed loop takes over, z/ωs²·b (electrical
+    /// rad per A; zero until [`set_speed_loop`](Self::set_speed_loop): hands over at once).
+    handover_gain: T,
+    /// [`HANDOVER_TRAVEL_RATIO`] × the design travel (electrical rad).
+    handover_travel: T,
     active: bool,
     elapsed: u32,
     theta_hold: T,
@@ -488,6 +437,10 @@ impl<T: Real> ReleaseHold<T> {
             armed: false,
             released: false,
             engaged_by_motion: false,
+            carrying: false,
+            b,
+            handover_gain: T::zero(),
+            handover_travel: travel * T::lit(HANDOVER_TRAVEL_RATIO),
             active: false,
             elapsed: 0,
             theta_hold: T::zero(),
@@ -534,6 +487,18 @@ impl<T: Real> ReleaseHold<T> {
         self.release_on_direct = on;
     }
 
+    /// The speed loop that takes over at the hand-over, of bandwidth `bandwidth_hz` (Hz) and
+    /// zero ratio `zero_ratio`: a reference that leaves zero hands the hold over once that
+    /// loop lets the torque still in the hold's transient terms run the rotor back by at most
+    /// [`HANDOVER_TRAVEL_RATIO`] of the design travel. Not set (or not finite): at once.
+    pub fn set_speed_loop(&mut self, bandwidth_hz: T, zero_ratio: T) {
+        let ws = T::two_pi() * bandwidth_hz;
+        let gain = self.b * zero_ratio / (ws * ws);
+        if gain.is_finite() && gain > T::zero() {
+            self.handover_gain = gain;
+        }
+    }
+
     /// Keeps the hold acting until the speed reference leaves zero instead of handing over
     /// after 10/ω_h: the rule of [`holds_through_standstill`].
     pub fn set_through_standstill(&mut self, on: bool) {
@@ -545,6 +510,7 @@ impl<T: Real> ReleaseHold<T> {
         self.armed = (self.enabled || self.at_start) && theta_hold.is_finite();
         self.released = false;
         self.engaged_by_motion = false;
+        self.carrying = false;
         self.resuming = false;
         self.active = false;
         self.elapsed = 0;
@@ -702,6 +668,25 @@ impl<T: Real> ReleaseHold<T> {
         };
     }
 
+    /// Whether an acting hold ends at this sample: after 10/ω_h (while the reference is zero,
+    /// not where it holds through the loaded standstill), or, where the reference left zero
+    /// before that while the speed loop could not take the rest of its torque
+    /// ([`set_speed_loop`](Self::set_speed_loop); then a motion hold, the speed loop's
+    /// reference at zero), once it can (module docs, "When").
+    fn settles(&mut self, moving_ref: bool) -> bool {
+        let run_back = self.handover_gain * (self.output - self.integral).abs();
+        // NaN compares false: not carried.
+        let carried = run_back <= self.handover_travel;
+        let young = self.active && !self.engaged_by_motion && self.held < self.hold_samples;
+        if moving_ref && young && !carried {
+            self.engaged_by_motion = true;
+            self.carrying = true;
+        }
+        let standstill_hold = self.through_standstill && !(self.engaged_by_motion && moving_ref);
+        let done = self.held >= self.hold_samples || (self.carrying && carried);
+        self.active && !standstill_hold && done
+    }
+
     /// One sample: the speed reference `speed_ref`, the estimator's tracked angle θ̂
     /// (`theta_tracked`, which triggers the hold unless it was armed at a brake's release)
     /// and its direct rotor-flux angle (`theta`, which the loop holds and which triggers a
@@ -719,16 +704,15 @@ impl<T: Real> ReleaseHold<T> {
         }
         self.track_speed(theta);
         // Engaged by the start-up's motion test, the hold keeps the rotor at any reference
-        // until it has settled; armed at a release, a reference hands over at once; armed at
-        // the start-up's end, a moving reference leaves it armed for a fall against it
-        // (module docs, "On a moving reference").
+        // until it has settled; armed at a release, a reference hands over a settled hold at
+        // once; armed at the start-up's end, a moving reference leaves it armed for a fall
+        // against it (module docs, "On a moving reference").
         let moving_ref = speed_ref != T::zero();
         let sense = self.follow(speed_ref, theta_tracked);
         let e = crate::wrap_angle(self.theta_hold - theta);
         let omega = self.omega;
-        let standstill_hold = self.through_standstill && !(self.engaged_by_motion && moving_ref);
-        let settled = self.active && !standstill_hold && self.held >= self.hold_samples;
-        // A hold triggered at zero reference hands over as the reference leaves zero.
+        let settled = self.settles(moving_ref);
+        // A settled hold triggered at zero reference hands over as the reference leaves zero.
         let leave = moving_ref && !self.engaged_by_motion && (self.released || self.active);
         if leave || settled || !e.is_finite() || !omega.is_finite() {
             let was = self.active;
@@ -794,6 +778,7 @@ impl<T: Real> ReleaseHold<T> {
 }
 
 mod fall;
+mod tuning;
 
 #[cfg(test)]
 mod tests;

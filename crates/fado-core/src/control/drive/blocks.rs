@@ -274,6 +274,7 @@ fn release_hold<T: Real>(
     let mut hold = ReleaseHold::new(&t.release_hold, m, c.ts, t.current.bandwidth_hz, i_max)?;
     let through = holds_through_standstill(&t.release_hold, m, probe.amplitude, probe.period);
     hold.set_through_standstill(through);
+    hold.set_speed_loop(t.speed.bandwidth_hz, t.speed.zero_ratio);
     if !m.magnetic_model().is_linear() {
         hold.set_speed_filter_ratio(T::lit(SATURATING_SPEED_FILTER_RATIO));
         hold.set_saturating(true);
