@@ -42,6 +42,12 @@
 //! and speed estimate (the 35 Hz tracker's 4.5 ms time constant), not the 5 Hz speed loop's
 //! 0.16 s zero: the default period is 0.1 s instead of 0.5 s, a window of 25 ms.
 //!
+//! **Amplitude** ([`amplitude`]). The probe's torque through the angle error, A·sin δ, turns a
+//! light rotor: each period's amplitude is the one that would have held the last period's
+//! largest |ω̂| at half the limiter band's edge, up to the configured A and grown by at most
+//! 1/[`TRIPLE_POLE`] per period; the first period uses the configured A. A rotor whose speed
+//! does not answer the probe beyond that bound keeps the configured A throughout.
+//!
 //! **Correction.** The estimator turns θ̂ at the rate g·δ̂ + ĉ (rad/s, held over the next
 //! period), by that rate·Ts per sample through
 //! [`crate::estimator::SensorlessEstimator::turn_angle`] (the mechanism of the no-load
@@ -418,12 +424,7 @@ impl<T: Real> StandstillProbe<T> {
         }
         self.sum_id += i_dq_prev.0;
         self.sum_iq += i_dq_prev.1;
-        let speed = omega.abs();
-        self.speed_max = if self.phase == 0 {
-            speed
-        } else {
-            self.speed_max.step_max(speed)
-        };
+        self.track_speed(omega);
         let amplitude = self.amplitude;
         self.phase += 1;
         if self.phase == n {
@@ -444,18 +445,22 @@ impl<T: Real> StandstillProbe<T> {
         sign * self.level * amplitude
     }
 
+    /// The largest |ω̂| over the running period, for the next period's amplitude.
+    #[inline(always)]
+    fn track_speed(&mut self, omega: T) {
+        let speed = omega.abs();
+        self.speed_max = if self.phase == 0 {
+            speed
+        } else {
+            self.speed_max.step_max(speed)
+        };
+    }
+
     /// δ̂ from the period's correlation and the new turn rate.
     fn finish_period(&mut self, flux_linkage: T, saliency: T) {
         let delta_tau = self.sum * self.inv_count;
         let (i_d, i_q) = (self.sum_id * self.inv_period, self.sum_iq * self.inv_period);
-        let reading = angle_reading(
-            delta_tau,
-            self.amplitude,
-            i_d,
-            i_q,
-            flux_linkage,
-            saliency,
-        );
+        let reading = angle_reading(delta_tau, self.amplitude, i_d, i_q, flux_linkage, saliency);
         let bound = T::lit(MAX_READING);
         let reading = if reading.is_finite() {
             reading.step_max(-bound).step_min(bound)

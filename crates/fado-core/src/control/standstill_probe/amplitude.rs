@@ -41,11 +41,16 @@
 
 use crate::Real;
 
+/// Default bound S_b as a fraction of the rated speed: half the lower edge of the estimator's
+/// limiter band, (0.015 − 0.002)/2 = 0.0065 (module docs, "Bound") \[A\].
+pub const DEFAULT_SWING_RATIO: f64 =
+    0.5 * (crate::mode::DEFAULT_THRESHOLD_RATIO - crate::mode::DEFAULT_HYSTERESIS_RATIO);
+
 /// The amplitude (A) for the next period from the running `amplitude` A_k, the largest |ω̂|
 /// `swing` S_k over the last period and the `bound` S_b (rad/s): min(A_max, A_k·S_b/S_k,
 /// A_k/p0) with A_max = `largest` (module docs). `bound` 0, or S_k not finite: A_max.
 pub fn next_amplitude<T: Real>(largest: T, amplitude: T, bound: T, swing: T) -> T {
-    if !(bound > T::zero()) || !swing.is_finite() {
+    if bound <= T::zero() || !swing.is_finite() {
         return largest;
     }
     let grown = amplitude * T::lit(1.0 / super::TRIPLE_POLE);
@@ -67,7 +72,10 @@ mod tests {
     #[test]
     fn the_amplitude_holds_the_speed_swing_to_the_band_edge() {
         let (largest, bound) = (0.34, 16.3);
-        assert_eq!(next_amplitude(largest, largest, bound, 2.0 * bound), 0.5 * largest);
+        assert_eq!(
+            next_amplitude(largest, largest, bound, 2.0 * bound),
+            0.5 * largest
+        );
         let a: f64 = next_amplitude(largest, 0.1, bound, 3.0 * bound);
         assert!((a - 0.1 / 3.0).abs() < 1e-15, "{a}");
         // Within the bound: grows, by at most 1/p0 per period, up to the largest.

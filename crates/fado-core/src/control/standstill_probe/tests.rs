@@ -379,7 +379,11 @@ fn the_amplitude_shrinks_where_the_rotor_follows_the_probe() {
         for i in 0..200 + 30 * 200 {
             let did = p.step(true, true, tau, omega, (0.0, tau), flux, 0.0);
             omega += 1e-3 * (k * did - 2.0 * core::f64::consts::PI * 10.0 * omega);
-            peak = if i % 200 == 0 { 0.0 } else { peak.max(omega.abs()) };
+            peak = if i % 200 == 0 {
+                0.0
+            } else {
+                peak.max(omega.abs())
+            };
         }
         assert!(p.active());
         (p.amplitude, peak)
@@ -388,7 +392,10 @@ fn the_amplitude_shrinks_where_the_rotor_follows_the_probe() {
     assert_eq!(free_a, 2.2);
     assert!(free_peak > 4.0 * bound, "{free_peak}");
     let (a, peak) = run(250.0, bound);
-    assert!(a < 0.3 * 2.2 && a > 0.15 * 2.2, "a {a} peak {peak} free {free_peak}");
+    assert!(
+        a < 0.3 * 2.2 && a > 0.15 * 2.2,
+        "a {a} peak {peak} free {free_peak}"
+    );
     assert!((peak - bound).abs() < 0.05 * bound, "{peak}");
     let (heavy_a, heavy_peak) = run(25.0, bound);
     assert_eq!(heavy_a, 2.2, "{heavy_peak}");

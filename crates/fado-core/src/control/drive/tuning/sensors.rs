@@ -297,10 +297,7 @@ impl<T: Real> Default for StandstillProbeTuning<T> {
             arm_time: T::lit(0.5),
             speed_ratio: T::lit(0.0005),
             load_ratio: T::lit(0.25),
-            swing_ratio: T::lit(
-                0.5 * (crate::mode::DEFAULT_THRESHOLD_RATIO
-                    - crate::mode::DEFAULT_HYSTERESIS_RATIO),
-            ),
+            swing_ratio: T::lit(standstill_probe::amplitude::DEFAULT_SWING_RATIO),
         }
     }
 }
