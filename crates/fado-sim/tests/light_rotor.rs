@@ -37,6 +37,40 @@ fn light_rotor_holds_both_range_scenarios_with_the_bandwidth_of_its_load_step() 
     assert!(!passed, "the case does not need the rule");
 }
 
+/// The standstill probe's amplitude follows the rotor's answer on the gimbal too
+/// (`fado_core::control::standstill_probe::amplitude`): its held stop under the overhauling
+/// load swings less, and the first period's full amplitude still finds the angle error the
+/// stop leaves (0.13 rad). Measured, `regen-stop` speed error over 7–8 s at seeds 1 / 2:
+/// 4.5 / 3.9 r/min (12 allowed), 8.3 / 7.1 with the amplitude fixed (`swing_ratio = 0`);
+/// the largest |θ − θ̂| 0.157 / 0.170 rad either way (before the probe starts).
+#[test]
+fn the_gimbal_holds_its_regenerating_stop_with_the_probe_it_answers() {
+    for seed in [1, 2] {
+        let error = |extra: &str| {
+            let text = format!("{GIMBAL}\n[current_sensor]\nseed = {seed}\n{extra}");
+            let out = simulate("regen-stop", Some(&text), false, None).unwrap();
+            let c = out
+                .checks
+                .iter()
+                .find(|c| c.name.starts_with("speed error at 0 r/min, 7.0"));
+            (c.unwrap().value, out.passed, out.metrics.max_angle_error)
+        };
+        let (held, passed, angle) = error("");
+        let (fixed, ..) = error("[controller.standstill_probe]\nswing_ratio = 0\n");
+        println!(
+            "gimbal regen-stop seed {seed}: {held:.1} r/min ({fixed:.1} fixed), {angle:.3} rad"
+        );
+        assert!(
+            passed && angle < 0.2 && held < 6.0,
+            "seed {seed}: {held} r/min, {angle} rad"
+        );
+        assert!(
+            fixed > held + 2.0,
+            "seed {seed}: {fixed} r/min with the amplitude fixed"
+        );
+    }
+}
+
 /// `--dump-config` shows the raised bandwidths as derived, with their rule.
 #[test]
 fn the_raised_bandwidths_are_shown_as_derived() {

@@ -42,6 +42,12 @@
 //! and speed estimate (the 35 Hz tracker's 4.5 ms time constant), not the 5 Hz speed loop's
 //! 0.16 s zero: the default period is 0.1 s instead of 0.5 s, a window of 25 ms.
 //!
+//! **Amplitude** ([`amplitude`]). The probe's torque through the angle error, A·sin δ, turns a
+//! light rotor: each period's amplitude is the one that would have held the last period's
+//! largest |ω̂| at half the limiter band's edge, up to the configured A and grown by at most
+//! 1/[`TRIPLE_POLE`] per period; the first period uses the configured A. A rotor whose speed
+//! does not answer the probe beyond that bound keeps the configured A throughout.
+//!
 //! **Correction.** The estimator turns θ̂ at the rate g·δ̂ + ĉ (rad/s, held over the next
 //! period), by that rate·Ts per sample through
 //! [`crate::estimator::SensorlessEstimator::turn_angle`] (the mechanism of the no-load
@@ -114,14 +120,20 @@
 use crate::Real;
 use crate::error::{ConfigError, check};
 
+pub mod amplitude;
+
 /// The probe's settings in absolute units (its user resolves them from its own ratios of the
 /// machine's ratings).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StandstillProbeConfig<T> {
     /// Sampling period, s.
     pub ts: T,
-    /// Probe amplitude A (A, d current).
+    /// Probe amplitude A (A, d current): the largest; each period's follows the speed
+    /// estimate's swing over the last ([`amplitude`]).
     pub amplitude: T,
+    /// The largest |ω̂| over a period (electrical rad/s) that the probe's amplitude allows
+    /// ([`amplitude`]); 0: the amplitude is fixed.
+    pub swing: T,
     /// Probe period T_p (s).
     pub period: T,
     /// Correction gain g (s⁻¹): θ̂ turns at g·δ̂.
@@ -180,6 +192,10 @@ pub struct StandstillProbe<T> {
     rate: T,
     /// The learned creep ĉ (rad/s): the integral part of the turn rate.
     creep: T,
+    /// The running period's amplitude (A, [`amplitude`]).
+    amplitude: T,
+    /// The largest |ω̂| over the running period (rad/s).
+    speed_max: T,
     /// The trapezoid's level in units of A, and its step per sample on the ramp.
     level: T,
     ramp_step: T,
@@ -211,6 +227,7 @@ impl<T: Real> StandstillProbe<T> {
     pub fn new(config: StandstillProbeConfig<T>) -> Result<Self, ConfigError> {
         let ts = check::positive("ts", config.ts)?;
         check::non_negative("standstill_probe_current_ratio", config.amplitude)?;
+        check::non_negative("standstill_probe_swing_ratio", config.swing)?;
         check::non_negative("standstill_probe_gain", config.gain)?;
         check::non_negative("standstill_probe_speed_ratio", config.max_speed)?;
         check::non_negative("standstill_probe_load_ratio", config.min_load)?;
@@ -316,6 +333,8 @@ impl<T: Real> StandstillProbe<T> {
             reading: T::zero(),
             rate: T::zero(),
             creep: T::zero(),
+            amplitude: config.amplitude,
+            speed_max: T::zero(),
             level: T::zero(),
             ramp_step: T::zero(),
             inv_period: T::zero(),
@@ -405,6 +424,8 @@ impl<T: Real> StandstillProbe<T> {
         }
         self.sum_id += i_dq_prev.0;
         self.sum_iq += i_dq_prev.1;
+        self.track_speed(omega);
+        let amplitude = self.amplitude;
         self.phase += 1;
         if self.phase == n {
             self.finish_period(flux_linkage, saliency);
@@ -421,21 +442,25 @@ impl<T: Real> StandstillProbe<T> {
         } else {
             T::one()
         };
-        sign * self.level * self.config.amplitude
+        sign * self.level * amplitude
+    }
+
+    /// The largest |ω̂| over the running period, for the next period's amplitude.
+    #[inline(always)]
+    fn track_speed(&mut self, omega: T) {
+        let speed = omega.abs();
+        self.speed_max = if self.phase == 0 {
+            speed
+        } else {
+            self.speed_max.step_max(speed)
+        };
     }
 
     /// δ̂ from the period's correlation and the new turn rate.
     fn finish_period(&mut self, flux_linkage: T, saliency: T) {
         let delta_tau = self.sum * self.inv_count;
         let (i_d, i_q) = (self.sum_id * self.inv_period, self.sum_iq * self.inv_period);
-        let reading = angle_reading(
-            delta_tau,
-            self.config.amplitude,
-            i_d,
-            i_q,
-            flux_linkage,
-            saliency,
-        );
+        let reading = angle_reading(delta_tau, self.amplitude, i_d, i_q, flux_linkage, saliency);
         let bound = T::lit(MAX_READING);
         let reading = if reading.is_finite() {
             reading.step_max(-bound).step_min(bound)
@@ -443,6 +468,12 @@ impl<T: Real> StandstillProbe<T> {
             T::zero()
         };
         self.reading = reading;
+        self.amplitude = amplitude::next_amplitude(
+            self.config.amplitude,
+            self.amplitude,
+            self.config.swing,
+            self.speed_max,
+        );
         // A proportional-integral turn (module docs, "Correction"): the integral learns the
         // creep, so that a constant creep leaves no angle error.
         let g = self.config.gain;

@@ -310,6 +310,10 @@ fn probe_config<T: Real>(c: &DriveConfig<T>) -> Result<StandstillProbeConfig<T>,
             let p = T::lit(m.pole_pairs as f64);
             m.inertia / (T::lit(1.5) * p * p * m.flux_linkage)
         },
+        swing: check::non_negative(
+            "standstill_probe_swing_ratio",
+            t.standstill_probe.swing_ratio,
+        )? * m.rated_speed(),
         arm_time: t.standstill_probe.arm_time,
     })
 }

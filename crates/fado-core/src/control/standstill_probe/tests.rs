@@ -47,6 +47,7 @@ fn probe(amplitude: f64) -> StandstillProbe<f64> {
         max_speed: 1.0,
         min_load: 1.0,
         inertia: 0.0,
+        swing: 0.0,
         arm_time: 0.2,
     })
     .unwrap()
@@ -207,6 +208,7 @@ fn inertia_term_reads_an_unsettled_speed_loop() {
             max_speed: 1.0,
             min_load: 1.0,
             inertia,
+            swing: 0.0,
             arm_time: 0.1,
         })
         .unwrap();
@@ -265,6 +267,7 @@ fn creep_is_learned_and_leaves_no_angle_error() {
         max_speed: 1.0,
         min_load: 1.0,
         inertia: 0.0,
+        swing: 0.0,
         arm_time: period,
     })
     .unwrap();
@@ -354,4 +357,46 @@ fn a_brake_release_arms_the_probe_after_one_period() {
         assert_eq!(step(&mut q), 0.0);
     }
     assert!(!q.active());
+}
+
+/// The amplitude follows the rotor's answer ([`amplitude`]): a light rotor, whose speed
+/// answers the probe's torque through the angle error (a first-order speed loop of 10 Hz
+/// around ω̇ = k·Δi_d), swings to 4.3 times the bound at the configured amplitude; with the
+/// bound the amplitude settles where the swing's peak is the bound (measured: 0.23 of the
+/// configured amplitude). A rotor ten times heavier, whose swing stays within the bound
+/// (0.43 of it), keeps the configured amplitude, as does the light one without a bound.
+#[test]
+fn the_amplitude_shrinks_where_the_rotor_follows_the_probe() {
+    let (tau, flux, bound) = (14.0, 0.1, 2.0);
+    // (final amplitude, the last period's largest |ω|)
+    let run = |k: f64, swing: f64| {
+        let mut p = StandstillProbe::new(StandstillProbeConfig {
+            swing,
+            ..probe(2.2).config
+        })
+        .unwrap();
+        let (mut omega, mut peak) = (0.0f64, 0.0f64);
+        for i in 0..200 + 30 * 200 {
+            let did = p.step(true, true, tau, omega, (0.0, tau), flux, 0.0);
+            omega += 1e-3 * (k * did - 2.0 * core::f64::consts::PI * 10.0 * omega);
+            peak = if i % 200 == 0 {
+                0.0
+            } else {
+                peak.max(omega.abs())
+            };
+        }
+        assert!(p.active());
+        (p.amplitude, peak)
+    };
+    let (free_a, free_peak) = run(250.0, 0.0);
+    assert_eq!(free_a, 2.2);
+    assert!(free_peak > 4.0 * bound, "{free_peak}");
+    let (a, peak) = run(250.0, bound);
+    assert!(
+        a < 0.3 * 2.2 && a > 0.15 * 2.2,
+        "a {a} peak {peak} free {free_peak}"
+    );
+    assert!((peak - bound).abs() < 0.05 * bound, "{peak}");
+    let (heavy_a, heavy_peak) = run(25.0, bound);
+    assert_eq!(heavy_a, 2.2, "{heavy_peak}");
 }

@@ -232,6 +232,10 @@ pub const MOVED_KEYS: &[(&str, &str)] = &[
         "standstill_probe.speed_ratio",
     ),
     ("standstill_probe_load_ratio", "standstill_probe.load_ratio"),
+    (
+        "standstill_probe_swing_ratio",
+        "standstill_probe.swing_ratio",
+    ),
     ("lock_reaction", "lock.reaction"),
     ("lock_reaction_on_stall", "lock.reaction_on_stall"),
     ("lock_recovery_time", "lock.recovery_time"),
