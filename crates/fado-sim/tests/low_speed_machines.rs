@@ -75,10 +75,14 @@ fn a_slow_torque_motor_holds_its_loaded_reversal() {
 ///
 /// - the `RotorMoved` start engages the release hold, whose loop on the direct angle rings at
 ///   ≈ 94 Hz from its first sample (i_q demand ±30 A, the rotor ±3 r/min; θ̂ moves 0.02 rad
-///   against the rotor within 4 ms: L̂q·I_rated/λ̂f = 2.8 on this motor, so the currents'
-///   transients move the angle estimate), and the estimate is lost by 1.1 s (0.8 rad). On
+///   against the rotor within 4 ms; L̂q·I_rated/λ̂f = 2.8 on this motor, where the currents'
+///   transients can move the angle estimate), and the estimate is lost by 1.1 s (0.8 rad). On
 ///   the tracked angle the loop swings ±63 A instead (stops 0.17/0.12/0.16 rad at seeds 1–3,
-///   seed 4 3.14);
+///   seed 4 3.14). The hold's design ω_h is 93 rad/s here (0.2 rad under the rated load);
+///   at a third of it (31 rad/s, `[controller.release_hold] travel = 1.8`) the hold keeps
+///   the rotor through the load's ramp, hands over at 1.2 s and `stops` passes at seeds 1–4
+///   (0.130/0.147/0.112/0.112 rad, 0.98–1.44 r/min), at ω_h/2.5 seeds 1, 3, 4 (seed 2
+///   0.367 rad), at ω_h/2 none;
 /// - started aligned without the hold (2.82 / 92.5 at seed 1, seeds 1–4 2.0–3.14 rad), the
 ///   load's ramp pushes the rotor back to −17 r/min as with the calibration off, and the run
 ///   stalls at its zero-speed crossing (1.55–1.75 s) while R̂s rises from 0.1499 to 0.1512:
@@ -93,12 +97,13 @@ fn a_slow_torque_motor_holds_its_loaded_reversal() {
 ///   and the PM-SyRM's presets.
 ///
 /// A release threshold above the band's noise (`Calibrated`) runs the release to 0.963 s,
-/// into the load: 2.55–3.14 rad.
+/// into the load: 2.55–3.14 rad. Its `rated-reversal` reads 2.99/3.01/3.08/3.14 r/min at
+/// seeds 1–4 (3.0 allowed; 0.074–0.180 rad), with ω_h/3 3.20/3.22/2.62/3.17 r/min.
 #[test]
 #[ignore = "stops seed 1 3.14 rad / 119 r/min: the release's RotorMoved (sensor noise) engages \
-            the release hold, which rings at 94 Hz on this motor; started without it the \
-            loaded zero-speed crossing stalls on R̂s +0.8 % (0.155 rad with the calibration \
-            off, R̂s 0.1492 from the standstill DC test)"]
+            the release hold, which rings at 94 Hz on this motor at its design ω_h (93 rad/s; \
+            0.11-0.15 rad at seeds 1-4 with ω_h/3); started without it the loaded zero-speed \
+            crossing stalls on R̂s +0.8 % (0.155 rad with the calibration off)"]
 fn a_slow_torque_motor_holds_its_loaded_stops_and_rated_reversal() {
     let (angle, speed, passed) = run(TORQUE_32P, "stops", "");
     assert!(
