@@ -76,9 +76,10 @@ fn a_slow_torque_motor_holds_its_loaded_reversal() {
 /// - the `RotorMoved` start engages the release hold, whose loop on the direct angle rings at
 ///   ≈ 94 Hz from its first sample (i_q demand ±30 A, the rotor ±3 r/min; θ̂ moves 0.02 rad
 ///   against the rotor within 4 ms; L̂q·I_rated/λ̂f = 2.8 on this motor, where the currents'
-///   transients can move the angle estimate), and the estimate is lost by 1.1 s (0.8 rad). On
-///   the tracked angle the loop swings ±63 A instead (stops 0.17/0.12/0.16 rad at seeds 1–3,
-///   seed 4 3.14). The hold's design ω_h is 93 rad/s here (0.2 rad under the rated load);
+///   transients can move the angle estimate), and the estimate is lost by 1.1 s (0.8 rad),
+///   after its hand-over at 1.0 s; held three times as long the oscillation grows (±63 A,
+///   the rotor at 242 r/min by 1.3 s). On the tracked angle the loop swings ±63 A instead
+///   (stops 0.17/0.12/0.16 rad at seeds 1–3, seed 4 3.14). The hold's design ω_h is 93 rad/s here (0.2 rad under the rated load);
 ///   at a third of it (31 rad/s, `[controller.release_hold] travel = 1.8`) the hold keeps
 ///   the rotor through the load's ramp, hands over at 1.2 s and `stops` passes at seeds 1–4
 ///   (0.130/0.147/0.112/0.112 rad, 0.98–1.44 r/min), at ω_h/2.5 seeds 1, 3, 4 (seed 2
