@@ -1,6 +1,6 @@
 //! When the scaled `reversal` and `rated-reversal` judge the speed after their load ramp: from
 //! the instant a drive of fado's default tuning, its speed loop as the drive's rules build it
-//! for the machine, brings the ramp's speed error back within the scenario's band.
+//! for the machine, brings the ramp's speed error back within half the scenario's band.
 //!
 //! **Why.** Under a load ramping at r (N·m/s) the speed PI (Kp = J·ωs, Ki = J·ωs²/z,
 //! `[controller.speed]`) lags by e = z·r/(J·ωs²) (mechanical rad/s) once the ramp is under
@@ -27,12 +27,25 @@
 //! period, with its build rules (`DriveConfig::apply_build_rules`: the speed loop's bandwidth
 //! raised for a light rotor), on a rigid rotor of the plant's inertia, the load's ramp alone
 //! (the loop is linear; the speed reference's own ramp is judged as it is), integrated at
-//! 0.1 ms to 5 s after the ramp; the instant is the last sample whose error exceeds the band.
+//! 0.1 ms to 5 s after the ramp; the instant is the last sample whose error exceeds
+//! [`SETTLED_BAND_SHARE`] of the band.
+//!
+//! **Why half the band.** At the last sample where the model's error is the whole band, the
+//! drive's measured error is the band too, give or take what the model leaves out (the speed
+//! estimate's filter T2S-2, the current loop, the estimator): on drawn many-pole SPMs that tail
+//! is 0.3–0.6 r/min, and the measured error sat at 0.99–1.02 of the band on every run whose
+//! instant fell after 2.0 s — a verdict decided by the model's residue, not by the drive. From
+//! the model's crossing of half the band (ln 2/σ later, 80 ms at the default 5 Hz loop) the
+//! drive's own lags have the other half; the band itself stays 2 % of the rated speed.
 
 use fado_core::EstimatorTuning;
 use fado_core::control::DriveConfig;
 
 use crate::config::SimConfig;
+
+/// Share of the scenario's speed band within which the model's error must stay from the
+/// instant on: 0.5 (module docs, "Why half the band").
+pub const SETTLED_BAND_SHARE: f64 = 0.5;
 
 /// Integration step of the loop's linear model, s.
 const STEP: f64 = 1e-4;

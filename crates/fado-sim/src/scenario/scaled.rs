@@ -113,7 +113,13 @@ pub(super) fn setup_reversal_under(c: &mut SimConfig, load: f64) {
     // Judged from 2.0 s, or from where the drive's own speed loop has brought the load ramp's
     // error back within the band, at the latest the reversal's start (`load_settling`).
     let band = SCALED_SPEED_ERROR_RATIO * n_rated;
-    let settled = super::load_settling::instant(c, 1.2, 1.7, load * t_rated, band);
+    let settled = super::load_settling::instant(
+        c,
+        1.2,
+        1.7,
+        load * t_rated,
+        super::load_settling::SETTLED_BAND_SHARE * band,
+    );
     c.simulation.eval_start = if settled.is_nan() {
         REVERSAL_EVAL_START
     } else {

@@ -111,7 +111,7 @@ pub const SCENARIOS: [Scenario; 14] = [
                   +6 % at 6 % of rated speed per second (the paper's motor: fig11)",
         criterion: "|θ − θ̂| < 0.25 rad near zero speed (|n| < 2 % of rated) [P]; no trip; \
                     speed error < 2 % of rated speed from 2.0 s, or from where the default \
-                    drive's speed loop brings the load ramp's lag within it on a rotor too \
+                    drive's speed loop brings the load ramp's lag within half of it on a rotor too \
                     light for 2.0 s (at the latest 2.5 s)",
         scaled: true,
         neutral: false,

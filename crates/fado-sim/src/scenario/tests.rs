@@ -122,3 +122,25 @@ fn the_load_settling_instant_follows_the_speed_loops_slower_mode() {
         assert_eq!(t > 2.0, late, "{t}");
     }
 }
+
+/// `reversal` judges the speed from the model's crossing of half the band, not of the band
+/// itself (`load_settling`, "Why half the band"): on the 32-pole torque motor, whose loop
+/// settles after 2.0 s, that is ln 2/σ later than the band's crossing.
+#[test]
+fn the_reversal_is_judged_from_the_models_crossing_of_half_the_band() {
+    let text = include_str!("../../tests/data/torque-ipm-32p.toml");
+    let c = scenario_config("reversal", Some(text), true).unwrap();
+    let m = c.machine_model();
+    let band = SCALED_SPEED_ERROR_RATIO * m.rated_speed_rpm;
+    let torque = SCALED_LOAD_RATIO * m.rated_torque;
+    let whole = load_settling::instant(&c, 1.2, 1.7, torque, band);
+    let half = load_settling::instant(&c, 1.2, 1.7, torque, 0.5 * band);
+    assert_eq!(c.simulation.eval_start, half.clamp(2.0, 2.5));
+    let s = c.controller.speed;
+    let ws = std::f64::consts::TAU * s.bandwidth_hz;
+    let slow = ws * (1.0 - (1.0 - 4.0 / s.zero_ratio).sqrt()) / 2.0;
+    assert!(
+        ((half - whole) - 2f64.ln() / slow).abs() < 2e-3,
+        "{whole} {half}"
+    );
+}
