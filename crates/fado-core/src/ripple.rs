@@ -29,6 +29,7 @@
 //! algebraic model's explicit i(ψ) and one at ψ. A constant inductance has H = 0, and the
 //! estimator does not compute any of this for it.
 
+use crate::control::modulation::svpwm_duty;
 use crate::magnetics::{MagneticModel, Saturation};
 use crate::{Ab, Abc, Dq, Real};
 
@@ -117,6 +118,12 @@ pub fn flux_ripple_moment<T: Real>(duty: Abc<T>, vdc: T, ts: T) -> RippleMoment<
         xy: xy * s2,
         yy: yy * s2,
     }
+}
+
+/// [`flux_ripple_moment`] for the α-β voltage `v_ab` realised by min-max SVPWM
+/// ([`svpwm_duty`], the drive's modulator) on the dc link `vdc`.
+pub fn svpwm_ripple_moment<T: Real>(v_ab: Ab<T>, vdc: T, ts: T) -> RippleMoment<T> {
+    flux_ripple_moment(svpwm_duty(v_ab, vdc), vdc, ts)
 }
 
 /// The period's mean current minus the current at the sample, δi = E\[i(ψ + Δψ)\] − i(ψ), for
