@@ -204,14 +204,8 @@ impl<T: Real> EstimatorState<T> {
         let (lambda1, i_drop) = p
             .integrator
             .next_flux(&self.integrator, v_ab, i_ab, self.feedback);
-        // A saturating model's drop uses the interval's mean current: the sample plus the PWM
-        // ripple's bias (`crate::ripple`; zero for a flux map).
         let (lambda1, i_drop) = if SATURATING {
-            let d = self.ripple_offset;
-            (
-                lambda1 - d * (self.integrator.rs_hat() * p.ts()),
-                i_drop + d,
-            )
+            self.with_ripple_drop(p, lambda1, i_drop)
         } else {
             (lambda1, i_drop)
         };
@@ -423,6 +417,22 @@ impl<T: Real> EstimatorState<T> {
         self.kdf_gain = c.kdf_gain;
         self.feedback = c.feedback;
         shift
+    }
+
+    /// A saturating model's drop with the interval's mean current: the sample plus the PWM
+    /// ripple's bias (`crate::ripple`; zero for a flux map), λ1 and the drop current moved by it.
+    #[inline(always)]
+    fn with_ripple_drop(
+        &self,
+        p: &EstimatorParams<T>,
+        lambda1: Ab<T>,
+        i_drop: Ab<T>,
+    ) -> (Ab<T>, Ab<T>) {
+        let d = self.ripple_offset;
+        (
+            lambda1 - d * (self.integrator.rs_hat() * p.ts()),
+            i_drop + d,
+        )
     }
 
     /// The PWM ripple's current bias (`crate::ripple`) at this sample's operating point, in

@@ -34,7 +34,7 @@ fn ripple_path(duty: Abc<f64>, vdc: f64, ts: f64, falling: bool, n: usize) -> Ve
         // The slice's middle value of Δψ (the voltage is constant within a slice).
         let mid = psi + (v - mean) * (0.5 * h);
         path.push(mid);
-        psi = psi + (v - mean) * h;
+        psi += (v - mean) * h;
     }
     path
 }
@@ -134,7 +134,7 @@ fn sigma_point_offset_matches_the_period_mean_of_the_saturating_current() {
             for p in ripple_path(duty, vdc, ts, falling, 20_000) {
                 let dq = Dq::new(c * p.alpha + s * p.beta, -s * p.alpha + c * p.beta);
                 let ii = model.current(psi + dq) - model.current(psi);
-                acc = acc + Ab::new(c * ii.d - s * ii.q, s * ii.d + c * ii.q);
+                acc += Ab::new(c * ii.d - s * ii.q, s * ii.d + c * ii.q);
                 n += 1.0;
             }
         }
