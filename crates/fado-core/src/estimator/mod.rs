@@ -70,6 +70,7 @@ use crate::magnetics::FluxWarmStart;
 use crate::mode::{Mode, ModeSelectorParams};
 use crate::observer::{DisturbanceObserverParams, ObserverGains, ObserverState};
 use crate::plausibility::SampleBounds;
+use crate::ripple::RippleMoment;
 use crate::rs_adaptation::{
     ResistanceAdaptationParams, ResistanceAdaptationState, ResistanceScale,
 };
@@ -309,4 +310,11 @@ pub struct EstimatorState<T: Real> {
     /// T2S-1 runs at its running gains in limiter mode too (the drive's brake release, see
     /// [`EstimatorState::set_release_tracking`]).
     release_tracking: bool,
+    /// The α-β second moment of the PWM flux ripple over the sampling interval
+    /// (`crate::ripple`), from [`EstimatorState::set_pwm_ripple`]: zero unless the model is
+    /// the algebraic saturating one.
+    ripple_moment: RippleMoment<T>,
+    /// The interval's mean current minus its sampled current (`crate::ripple`), judged at the
+    /// last committed sample and added to the next sample's resistive drop.
+    ripple_offset: Ab<T>,
 }
