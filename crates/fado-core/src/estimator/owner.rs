@@ -167,12 +167,13 @@ impl<T: Real> SensorlessEstimator<T> {
     }
 
     /// The voltage `v_ab` realised over this sample's interval by min-max SVPWM on the dc link
-    /// `vdc` (V): on the algebraic saturating model, the PWM ripple's flux moment over the
-    /// interval, from which the estimator adds the interval's mean current minus the sampled
-    /// one to its resistive drop ([`crate::ripple`]). Nothing for another model. Call before
-    /// [`step`](Self::step).
-    pub fn set_pwm_ripple(&mut self, v_ab: Ab<T>, vdc: T) {
-        self.state.set_pwm_ripple(&self.params, v_ab, vdc);
+    /// `vdc` (V) through an inverter with the dead time `dead_time` (s): on the algebraic
+    /// saturating model, the PWM ripple's terms over the interval, from which the estimator
+    /// adds the interval's mean current minus the sampled one to its resistive drop
+    /// ([`crate::ripple`]; refreshed every [`RIPPLE_EVERY`](crate::ripple::RIPPLE_EVERY)
+    /// samples). Nothing for another model. Call before [`step`](Self::step).
+    pub fn set_pwm_ripple(&mut self, v_ab: Ab<T>, vdc: T, dead_time: T) {
+        self.state.set_pwm_ripple(&self.params, v_ab, vdc, dead_time);
     }
 
     /// The voltage of this sample's interval was limited by the modulator (the drive's
@@ -258,9 +259,9 @@ pub trait RotorAngleEstimator<T: Real> {
     /// A brake has opened and the rotor may fall: track it with the bandwidth its fall needs
     /// (see [`SensorlessEstimator::set_release_tracking`]). Default: nothing.
     fn set_release_tracking(&mut self, _on: bool) {}
-    /// The interval's voltage and dc link for the PWM ripple's current bias (see
-    /// [`SensorlessEstimator::set_pwm_ripple`]). Default: nothing.
-    fn set_pwm_ripple(&mut self, _v_ab: Ab<T>, _vdc: T) {}
+    /// The interval's voltage, dc link and the inverter's dead time for the PWM ripple's
+    /// current bias (see [`SensorlessEstimator::set_pwm_ripple`]). Default: nothing.
+    fn set_pwm_ripple(&mut self, _v_ab: Ab<T>, _vdc: T, _dead_time: T) {}
 }
 
 impl<T: Real> RotorAngleEstimator<T> for SensorlessEstimator<T> {
@@ -302,8 +303,8 @@ impl<T: Real> RotorAngleEstimator<T> for SensorlessEstimator<T> {
     fn set_release_tracking(&mut self, on: bool) {
         SensorlessEstimator::set_release_tracking(self, on);
     }
-    fn set_pwm_ripple(&mut self, v_ab: Ab<T>, vdc: T) {
-        SensorlessEstimator::set_pwm_ripple(self, v_ab, vdc);
+    fn set_pwm_ripple(&mut self, v_ab: Ab<T>, vdc: T, dead_time: T) {
+        SensorlessEstimator::set_pwm_ripple(self, v_ab, vdc, dead_time);
     }
     /// With [`EstimatorTuning::rs_adaptation`](crate::EstimatorTuning::rs_adaptation): [`SensorlessEstimator::set_rs_hat`] (a bad
     /// value changes nothing); with the paper's fixed R̂s: nothing.

@@ -10,7 +10,7 @@ use crate::magnetics::MachineMagnetics;
 use crate::magnetics::{FluxLookup, FluxWarmStart};
 use crate::mode::Mode;
 use crate::observer::ObserverState;
-use crate::ripple::svpwm_ripple_moment;
+use crate::ripple::{PwmRipple, RIPPLE_EVERY};
 use crate::rotor_flux::{rotor_angle, rotor_flux, stator_flux};
 use crate::speed_notch::SpeedNotch;
 use crate::{Ab, Real};
@@ -290,9 +290,12 @@ impl<T: Real> EstimatorState<T> {
     }
 
     /// As [`SensorlessEstimator::set_pwm_ripple`](crate::SensorlessEstimator::set_pwm_ripple).
-    pub fn set_pwm_ripple(&mut self, p: &EstimatorParams<T>, v_ab: Ab<T>, vdc: T) {
+    pub fn set_pwm_ripple(&mut self, p: &EstimatorParams<T>, v_ab: Ab<T>, vdc: T, dead_time: T) {
         if let MachineMagnetics::Saturation(_) = p.active_flux.model() {
-            self.ripple_moment = svpwm_ripple_moment(v_ab, vdc, p.ts());
+            self.ripple_phase = (self.ripple_phase + 1) % RIPPLE_EVERY;
+            if self.ripple_phase == 0 {
+                self.ripple = PwmRipple::from_voltage(v_ab, vdc, p.ts(), dead_time);
+            }
         }
     }
 

@@ -23,7 +23,7 @@ use crate::magnetics::FluxWarmStart;
 use crate::magnetics::MachineMagnetics;
 use crate::mode::Mode;
 use crate::real::all_finite;
-use crate::ripple::{RippleMoment, mean_current_offset_ab};
+use crate::ripple::{PwmRipple, mean_current_offset_ab};
 use crate::rotor_flux::{rotor_angle, stator_flux};
 use crate::rs_adaptation::AdaptationRegime;
 use crate::tracker::TrackerUpdate;
@@ -409,7 +409,9 @@ impl<T: Real> EstimatorState<T> {
         if let Some(point) = c.point {
             self.lq_secant = point.lq_secant;
             self.flux_warm = c.flux_warm;
-            self.ripple_offset = self.ripple_offset_at(p, c, point.i_dq);
+            if self.ripple_phase == 2 {
+                self.ripple_offset = self.ripple_offset_at(p, c, point.i_dq);
+            }
             self.swing_reference = self.swing_reference
                 + p.swing_reference_gain * (point.active - self.swing_reference);
         }
@@ -436,21 +438,24 @@ impl<T: Real> EstimatorState<T> {
     }
 
     /// The PWM ripple's current bias (`crate::ripple`) at this sample's operating point, in
-    /// α-β for the next sample's drop: the algebraic model's sigma points about ψ(î) in the
-    /// frame of λ̂r; zero for another model, without a ripple moment, or where λ̂r is too
-    /// small to give a frame (the trackers coast there).
+    /// α-β for the next samples' drop: the algebraic model's sigma points about ψ(î), the
+    /// ripple's own resistive drop and the dead time's lead through the warm start's
+    /// incremental inductance, in the frame of λ̂r; zero for another model, without a ripple,
+    /// or where λ̂r is too small to give a frame (the trackers coast there).
     #[inline(always)]
     fn ripple_offset_at(&self, p: &EstimatorParams<T>, c: &Candidate<T>, i_dq: Dq<T>) -> Ab<T> {
         let MachineMagnetics::Saturation(model) = p.active_flux.model() else {
             return Ab::zero();
         };
-        if c.tracker_hold || self.ripple_moment == RippleMoment::zero() {
+        if c.tracker_hold || self.ripple == PwmRipple::zero() {
             return Ab::zero();
         }
         let inv = T::one() / c.lambda_r.norm_squared().step_sqrt();
         let (cos, sin) = (c.lambda_r.alpha * inv, c.lambda_r.beta * inv);
         let psi = c.flux_warm.prediction(i_dq);
-        let d = mean_current_offset_ab(model, psi, &self.ripple_moment, cos, sin);
+        let l = c.flux_warm.inductance();
+        let rs_ts = self.integrator.rs_hat() * p.ts();
+        let d = mean_current_offset_ab(model, psi, &l, &self.ripple, rs_ts, cos, sin);
         if d.is_finite() { d } else { Ab::zero() }
     }
 
