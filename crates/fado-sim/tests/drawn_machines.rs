@@ -72,7 +72,7 @@ fn a_saturated_rotor_with_clear_axes_pulses_at_the_rated_current() {
 /// The drawn 69 W, 15-pole-pair IPMSM (6 kHz carrier, q secant 44 % down at the rated
 /// current, 47 V link) and the drawn 289 W 2-pole saturating surface-magnet motor (35 kHz),
 /// held at zero speed under the rated load after the brake's release: max |θ − θ̂| from ready
-/// 0.093 / 0.133 rad (69 W, seeds 1 / 2), 0.106 rad (289 W, seed 2). The same machines
+/// 0.068 / 0.079 rad (69 W, seeds 1 / 2), 0.107 rad (289 W, seed 2). The same machines
 /// without `[motor.saturation]` give 0.046 / 0.053 rad.
 ///
 /// What this holds is the estimator's ripple correction (`fado_core::ripple`). The PWM
@@ -80,11 +80,14 @@ fn a_saturated_rotor_with_clear_axes_pulses_at_the_rated_current() {
 /// term) makes the sampling interval's mean current exceed the sample taken at the carrier's
 /// peak and valley by δi ≈ ½·∂²i/∂ψ²·cov(ψ ripple), a second-order term of one sign (a
 /// constant inductance gives only a first-order one that alternates between the half periods
-/// and cancels). The machine drops R·i_mean; a flux integration that subtracts R·i_sample
-/// integrates R·δi at zero speed. Measured on the 69 W machine, seed 1, with the half periods'
-/// mean current integrated in the plant (Simpson's rule on 16 slices of every switch
-/// interval): (2.0, 7.7) mA at the hold (i_dq ≈ (−2.2, 3.5) A), R·δi_q = 6.8 mV, the back-EMF
-/// of 1.3 rad/s; without the correction the estimate stays at zero speed while the rotor turns
+/// and cancels), plus two first-order terms that do not cancel: the ripple's own resistive
+/// drop (as large as the curvature's term on these machines) and the dead time's lead (the
+/// pulses lag their gates by Td/2; the opposite sign, −10 to −11.5 mA on the 69 W machine).
+/// The machine drops R·i_mean; a flux integration that subtracts R·i_sample integrates R·δi at
+/// zero speed. Measured on the 69 W machine, seed 1, with the half periods' mean current
+/// integrated in the plant (Simpson's rule on 16 slices of every switch interval): 6.7–8.7 mA
+/// along q at the hold (16.6–20.2 mA with no dead time), R·δi_q ≈ 6.8 mV, the back-EMF of
+/// 1.3 rad/s; without the correction the estimate stays at zero speed while the rotor turns
 /// backwards at 2.47 rad/s and the test gives 0.450 / 0.539 rad (69 W) and 0.392 rad (289 W).
 /// Sensors reading the mean current instead of the sample give 0.107 / 0.113 rad on the 69 W
 /// machine: the correction from the duties and the model does as well as measuring the mean.
