@@ -176,7 +176,8 @@ fn ripple_moments<T: Real>(duty: Abc<T>, vdc: T, ts: T) -> (RippleMoment<T>, Ab<
     // ∫₀¹(τ − ½)·g_k dτ = A_k − d_k/3 + d_k·(1 − d_k)/4.
     let first = |a: T, d: T| a - d * T::lit(1.0 / 3.0) + d * (T::one() - d) * T::lit(0.25);
     let scale = vdc * ts;
-    let damping = Abc::new(first(a_a, duty.a), first(a_b, duty.b), first(a_c, duty.c)).to_ab() * scale;
+    let damping =
+        Abc::new(first(a_a, duty.a), first(a_b, duty.b), first(a_c, duty.c)).to_ab() * scale;
     let g_aa = moment_g(duty.a, duty.a, a_a, a_a);
     let g_bb = moment_g(duty.b, duty.b, a_b, a_b);
     let g_cc = moment_g(duty.c, duty.c, a_c, a_c);

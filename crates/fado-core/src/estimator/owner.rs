@@ -173,7 +173,8 @@ impl<T: Real> SensorlessEstimator<T> {
     /// ([`crate::ripple`]; refreshed every [`RIPPLE_EVERY`](crate::ripple::RIPPLE_EVERY)
     /// samples). Nothing for another model. Call before [`step`](Self::step).
     pub fn set_pwm_ripple(&mut self, v_ab: Ab<T>, vdc: T, dead_time: T) {
-        self.state.set_pwm_ripple(&self.params, v_ab, vdc, dead_time);
+        self.state
+            .set_pwm_ripple(&self.params, v_ab, vdc, dead_time);
     }
 
     /// The voltage of this sample's interval was limited by the modulator (the drive's

@@ -65,12 +65,7 @@ impl<T: Real> FluxWarmStart<T> {
     /// The incremental inductance L₀ of the last solution (zero while empty).
     pub fn inductance(&self) -> InductanceMatrix<T> {
         let (dd, dq, qq) = self.l;
-        InductanceMatrix {
-            dd,
-            dq,
-            qd: dq,
-            qq,
-        }
+        InductanceMatrix { dd, dq, qd: dq, qq }
     }
 
     /// Whether it holds a solution.

@@ -245,8 +245,22 @@ fn brute_periodic(
 fn offset_matches_the_periodic_solution_with_resistance_and_dead_time() {
     let (m127, r127) = drawn_127w();
     let cases = [
-        (m127, r127, (133.5, 0.5 / 39000.0), Dq::new(0.0, 1.796), 0.5, 0.320_512_8e-6),
-        (drawn_69w(), 0.885223, (47.3, 0.5 / 6000.0), Dq::new(-0.65, 3.61), 0.7, 2.083_333e-6),
+        (
+            m127,
+            r127,
+            (133.5, 0.5 / 39000.0),
+            Dq::new(0.0, 1.796),
+            0.5,
+            0.320_512_8e-6,
+        ),
+        (
+            drawn_69w(),
+            0.885223,
+            (47.3, 0.5 / 6000.0),
+            Dq::new(-0.65, 3.61),
+            0.7,
+            2.083_333e-6,
+        ),
     ];
     for (model, r, (vdc, ts), i, th, td) in cases {
         let th: f64 = th;
@@ -254,7 +268,8 @@ fn offset_matches_the_periodic_solution_with_resistance_and_dead_time() {
         let v_ab = Ab::new(c * i.d - s * i.q, s * i.d + c * i.q) * r;
         let duty = svpwm_duty(v_ab, vdc);
         for dead_time in [0.0, td] {
-            let (brute, sample) = brute_periodic(&model, r, duty, (vdc, ts, th, 0.5 * dead_time), i);
+            let (brute, sample) =
+                brute_periodic(&model, r, duty, (vdc, ts, th, 0.5 * dead_time), i);
             let ripple = PwmRipple::from_voltage(v_ab, vdc, ts, dead_time);
             let (psi, l) = (model.flux(sample), model.incremental_inductance(sample));
             let ab = mean_current_offset_ab(&model, psi, &l, &ripple, r * ts, c, s);

@@ -296,7 +296,8 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         self.estimator
             .set_release_tracking(self.blocks.hold.tracking_fall());
         let dead_time = self.config.tuning.inverter.dead_time;
-        self.estimator.set_pwm_ripple(self.history[1], vdc, dead_time);
+        self.estimator
+            .set_pwm_ripple(self.history[1], vdc, dead_time);
         let estimate = self.estimator.step(self.history[1], i_ab);
         if !estimate_is_finite(&estimate) {
             // An estimator that went non-finite cannot steer the drive: hold like a bad input
