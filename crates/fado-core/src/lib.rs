@@ -27,6 +27,7 @@ pub mod observer;
 pub mod plausibility;
 pub mod ratings;
 pub mod real;
+pub mod ripple;
 pub mod rotor_flux;
 pub mod rs_adaptation;
 pub mod speed_notch;

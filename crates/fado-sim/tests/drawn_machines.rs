@@ -99,38 +99,28 @@ fn a_release_shortly_before_the_speed_ramp_hands_a_settled_hold_over() {
 }
 
 /// The drawn 69 W, 15-pole-pair IPMSM (6 kHz carrier, q secant 44 % down at the rated
-/// current, 47 V link) and the drawn 289 W 2-pole saturating surface-magnet motor (35 kHz):
-/// held at zero speed under the rated load after the brake's release, θ̂ creeps ahead of
-/// the rotor: max |θ − θ̂| from ready 0.450 / 0.539 rad (69 W, seeds 1 / 2), 0.392 rad
-/// (289 W, seed 2). The same machines without `[motor.saturation]` give 0.046 / 0.053 rad;
-/// with ideal current sensors and no dead time the 69 W machine still gives 0.809 rad, with
-/// the averaged inverter 0.05 rad, and at twice its carrier 0.075 rad (seed 1), at three
-/// times 0.072 (seed 2).
+/// current, 47 V link) and the drawn 289 W 2-pole saturating surface-magnet motor (35 kHz),
+/// held at zero speed under the rated load after the brake's release: max |θ − θ̂| from ready
+/// 0.068 / 0.079 rad (69 W, seeds 1 / 2), 0.107 rad (289 W, seed 2). The same machines
+/// without `[motor.saturation]` give 0.046 / 0.053 rad.
 ///
-/// The cause is the PWM ripple on a current map that curves (q self-saturation with a d-axis
-/// or cross-saturation term; q saturation alone gives no polarity and no start). The flux ψ
-/// ripples piecewise linearly about its value at the carrier's peak and valley, where the
-/// current is sampled, so the period's mean current exceeds the sample by
-/// δi ≈ ½·∂²i/∂ψ²·cov(ψ ripple): a second-order term of one sign, where a constant
-/// inductance gives a first-order one that alternates between the half periods and cancels.
-/// The flux integration subtracts R·i_sample where the machine drops R·i_mean, a voltage
-/// error R·δi integrated at zero speed. Measured on the 69 W machine, seed 1: the half
-/// periods' mean current (Simpson's rule on 16 slices of every switch interval) minus the
-/// sampled one, averaged over 2000 samples in the rotor's d-q frame, is (2.0, 7.7) mA at the
-/// hold (t = 0.83–1.0 s, i_dq ≈ (−2.2, 3.5) A) and (21, 14) mA in the 88 r/min run that
-/// follows (i_dq = (−0.34, 3.65) A); an ideal-switching evaluation of the model at
-/// i_dq = (0, 3.685) A gives 10 mA along q. At the hold R·δi_q = 6.8 mV, the back-EMF of
-/// 1.3 rad/s (electrical, λ ≈ 5.2 mWb); the estimate stays at zero speed while the rotor
-/// turns backwards at 2.47 rad/s (−1.57 r/min, t = 0.74–0.90 s after the release at 0.72 s),
-/// |θ − θ̂| growing at 2.41 rad/s to 0.45 rad (averaged inverter: 0.19 rad/s): the same order,
-/// a factor two not accounted for. Sensors reading that mean current instead of the sample
-/// hold the 69 W machine within 0.107 / 0.113 rad (seeds 1 / 2). The plant's integration is
-/// not the cause: sub-steps four times shorter (`SUBSTEP_TIME_CONSTANTS` 0.0125) give
-/// 0.450 / 0.537 rad. A constant 8.8 mV `[faults] voltage_offset` (acting from t = 0, through
-/// the angle search) in any of twelve directions on the averaged inverter fails this start at
-/// 0.55–3.14 rad: errors of this size are beyond what the zero-speed flux integration holds.
+/// What this holds is the estimator's ripple correction (`fado_core::ripple`). The PWM
+/// ripple on a current map that curves (q self-saturation with a d-axis or cross-saturation
+/// term) makes the sampling interval's mean current exceed the sample taken at the carrier's
+/// peak and valley by δi ≈ ½·∂²i/∂ψ²·cov(ψ ripple), a second-order term of one sign (a
+/// constant inductance gives only a first-order one that alternates between the half periods
+/// and cancels), plus two first-order terms that do not cancel: the ripple's own resistive
+/// drop (as large as the curvature's term on these machines) and the dead time's lead (the
+/// pulses lag their gates by Td/2; the opposite sign, −10 to −11.5 mA on the 69 W machine).
+/// The machine drops R·i_mean; a flux integration that subtracts R·i_sample integrates R·δi at
+/// zero speed. Measured on the 69 W machine, seed 1, with the half periods' mean current
+/// integrated in the plant (Simpson's rule on 16 slices of every switch interval): 6.7–8.7 mA
+/// along q at the hold (16.6–20.2 mA with no dead time), R·δi_q ≈ 6.8 mV, the back-EMF of
+/// 1.3 rad/s; without the correction the estimate stays at zero speed while the rotor turns
+/// backwards at 2.47 rad/s and the test gives 0.450 / 0.539 rad (69 W) and 0.392 rad (289 W).
+/// Sensors reading the mean current instead of the sample give 0.107 / 0.113 rad on the 69 W
+/// machine: the correction from the duties and the model does as well as measuring the mean.
 #[test]
-#[ignore = "saturated standstill under the rated load at a slow carrier: 69 W IPMSM s1/s2 0.450/0.539 rad, 289 W SPM s2 0.392 rad"]
 fn saturated_rotors_hold_the_rated_load_at_standstill() {
     for (name, seed) in [
         ("ipm-sat-15p-47v-69w", 1),

@@ -70,6 +70,7 @@ use crate::magnetics::FluxWarmStart;
 use crate::mode::{Mode, ModeSelectorParams};
 use crate::observer::{DisturbanceObserverParams, ObserverGains, ObserverState};
 use crate::plausibility::SampleBounds;
+use crate::ripple::PwmRipple;
 use crate::rs_adaptation::{
     ResistanceAdaptationParams, ResistanceAdaptationState, ResistanceScale,
 };
@@ -309,4 +310,14 @@ pub struct EstimatorState<T: Real> {
     /// T2S-1 runs at its running gains in limiter mode too (the drive's brake release, see
     /// [`EstimatorState::set_release_tracking`]).
     release_tracking: bool,
+    /// The PWM ripple's terms over the sampling interval (`crate::ripple`), from
+    /// [`EstimatorState::set_pwm_ripple`]: zero unless the model is the algebraic saturating
+    /// one.
+    ripple: PwmRipple<T>,
+    /// Which sample of [`RIPPLE_EVERY`](crate::ripple::RIPPLE_EVERY) this is: the ripple's
+    /// terms are refreshed on phase 0, the offset on phase 2.
+    ripple_phase: u8,
+    /// The interval's mean current minus its sampled current (`crate::ripple`), judged at the
+    /// last committed sample and added to the next sample's resistive drop.
+    ripple_offset: Ab<T>,
 }

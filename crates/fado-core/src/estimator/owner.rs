@@ -166,6 +166,17 @@ impl<T: Real> SensorlessEstimator<T> {
         self.state.set_release_tracking(on);
     }
 
+    /// The voltage `v_ab` realised over this sample's interval by min-max SVPWM on the dc link
+    /// `vdc` (V) through an inverter with the dead time `dead_time` (s): on the algebraic
+    /// saturating model, the PWM ripple's terms over the interval, from which the estimator
+    /// adds the interval's mean current minus the sampled one to its resistive drop
+    /// ([`crate::ripple`]; refreshed every [`RIPPLE_EVERY`](crate::ripple::RIPPLE_EVERY)
+    /// samples). Nothing for another model. Call before [`step`](Self::step).
+    pub fn set_pwm_ripple(&mut self, v_ab: Ab<T>, vdc: T, dead_time: T) {
+        self.state
+            .set_pwm_ripple(&self.params, v_ab, vdc, dead_time);
+    }
+
     /// The voltage of this sample's interval was limited by the modulator (the drive's
     /// hexagon): R̂s's turning law (and its λ̂f law) does not adapt over the period that
     /// contains it. On a limited sample the realised voltage the drive
@@ -249,6 +260,9 @@ pub trait RotorAngleEstimator<T: Real> {
     /// A brake has opened and the rotor may fall: track it with the bandwidth its fall needs
     /// (see [`SensorlessEstimator::set_release_tracking`]). Default: nothing.
     fn set_release_tracking(&mut self, _on: bool) {}
+    /// The interval's voltage, dc link and the inverter's dead time for the PWM ripple's
+    /// current bias (see [`SensorlessEstimator::set_pwm_ripple`]). Default: nothing.
+    fn set_pwm_ripple(&mut self, _v_ab: Ab<T>, _vdc: T, _dead_time: T) {}
 }
 
 impl<T: Real> RotorAngleEstimator<T> for SensorlessEstimator<T> {
@@ -289,6 +303,9 @@ impl<T: Real> RotorAngleEstimator<T> for SensorlessEstimator<T> {
     }
     fn set_release_tracking(&mut self, on: bool) {
         SensorlessEstimator::set_release_tracking(self, on);
+    }
+    fn set_pwm_ripple(&mut self, v_ab: Ab<T>, vdc: T, dead_time: T) {
+        SensorlessEstimator::set_pwm_ripple(self, v_ab, vdc, dead_time);
     }
     /// With [`EstimatorTuning::rs_adaptation`](crate::EstimatorTuning::rs_adaptation): [`SensorlessEstimator::set_rs_hat`] (a bad
     /// value changes nothing); with the paper's fixed R̂s: nothing.

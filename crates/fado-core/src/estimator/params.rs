@@ -18,6 +18,7 @@ use crate::observer::{
     DisturbanceObserverConfig, DisturbanceObserverParams, ObserverGains, ObserverState,
 };
 use crate::plausibility::SampleBounds;
+use crate::ripple::PwmRipple;
 use crate::rs_adaptation::ResistanceAdaptationParams;
 use crate::speed_notch::SpeedNotch;
 use crate::tracker::TrackerParams;
@@ -185,6 +186,9 @@ impl<T: Real> EstimatorParams<T> {
             rs_adaptation_on: self.rs_adaptation,
             k_df_enabled: true,
             release_tracking: false,
+            ripple: PwmRipple::zero(),
+            ripple_phase: 0,
+            ripple_offset: Ab::zero(),
         };
         state.reset(self);
         state

@@ -6,9 +6,11 @@ use crate::active_flux::{ActiveFlux, ActiveFluxPoint};
 use crate::error::ConfigError;
 use crate::integrand_offset::IntegrandOffsetState;
 use crate::lock::LockState;
+use crate::magnetics::MachineMagnetics;
 use crate::magnetics::{FluxLookup, FluxWarmStart};
 use crate::mode::Mode;
 use crate::observer::ObserverState;
+use crate::ripple::{PwmRipple, RIPPLE_EVERY};
 use crate::rotor_flux::{rotor_angle, rotor_flux, stator_flux};
 use crate::speed_notch::SpeedNotch;
 use crate::{Ab, Real};
@@ -43,6 +45,7 @@ impl<T: Real> EstimatorState<T> {
         let (active, lq) = Self::aligned_active(p, theta0, i_ab);
         self.lq_secant = lq;
         self.flux_warm = FluxWarmStart::empty();
+        self.ripple_offset = Ab::zero();
         let lambda_r = Ab::from_polar(active, theta0);
         // A current so large that L̂q·i overflows is as unusable as a NaN (found by fuzzing,
         // f32: i = 3e37 A gave λ1 = ∞): start as with zero current.
@@ -284,6 +287,16 @@ impl<T: Real> EstimatorState<T> {
     /// As [`SensorlessEstimator::set_release_tracking`](crate::SensorlessEstimator::set_release_tracking).
     pub fn set_release_tracking(&mut self, on: bool) {
         self.release_tracking = on;
+    }
+
+    /// As [`SensorlessEstimator::set_pwm_ripple`](crate::SensorlessEstimator::set_pwm_ripple).
+    pub fn set_pwm_ripple(&mut self, p: &EstimatorParams<T>, v_ab: Ab<T>, vdc: T, dead_time: T) {
+        if let MachineMagnetics::Saturation(_) = p.active_flux.model() {
+            self.ripple_phase = (self.ripple_phase + 1) % RIPPLE_EVERY;
+            if self.ripple_phase == 0 {
+                self.ripple = PwmRipple::from_voltage(v_ab, vdc, p.ts(), dead_time);
+            }
+        }
     }
 
     /// As [`SensorlessEstimator::set_rs_hat`](crate::SensorlessEstimator::set_rs_hat).

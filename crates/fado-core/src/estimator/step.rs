@@ -20,12 +20,14 @@ use super::{
 use crate::active_flux::{ActiveFlux, ActiveFluxPoint};
 use crate::magnetics::FluxLookup;
 use crate::magnetics::FluxWarmStart;
+use crate::magnetics::MachineMagnetics;
 use crate::mode::Mode;
 use crate::real::all_finite;
+use crate::ripple::{PwmRipple, mean_current_offset_ab};
 use crate::rotor_flux::{rotor_angle, stator_flux};
 use crate::rs_adaptation::AdaptationRegime;
 use crate::tracker::TrackerUpdate;
-use crate::{Ab, Real};
+use crate::{Ab, Dq, Real};
 
 /// The new state of one sample, computed before anything is committed.
 struct Candidate<T: Real> {
@@ -202,6 +204,11 @@ impl<T: Real> EstimatorState<T> {
         let (lambda1, i_drop) = p
             .integrator
             .next_flux(&self.integrator, v_ab, i_ab, self.feedback);
+        let (lambda1, i_drop) = if SATURATING {
+            self.with_ripple_drop(p, lambda1, i_drop)
+        } else {
+            (lambda1, i_drop)
+        };
         // L̂q·i of eq. (5), formed once for both of its uses (λ̂r, and the observer's input
         // on the rotor flux): what `rotor_flux` computes, bit for bit. A saturating model's
         // secant L̂q is the last sample's here (`crate::active_flux`).
@@ -402,6 +409,9 @@ impl<T: Real> EstimatorState<T> {
         if let Some(point) = c.point {
             self.lq_secant = point.lq_secant;
             self.flux_warm = c.flux_warm;
+            if self.ripple_phase == 2 {
+                self.ripple_offset = self.ripple_offset_at(p, c, point.i_dq);
+            }
             self.swing_reference = self.swing_reference
                 + p.swing_reference_gain * (point.active - self.swing_reference);
         }
@@ -409,6 +419,44 @@ impl<T: Real> EstimatorState<T> {
         self.kdf_gain = c.kdf_gain;
         self.feedback = c.feedback;
         shift
+    }
+
+    /// A saturating model's drop with the interval's mean current: the sample plus the PWM
+    /// ripple's bias (`crate::ripple`; zero for a flux map), λ1 and the drop current moved by it.
+    #[inline(always)]
+    fn with_ripple_drop(
+        &self,
+        p: &EstimatorParams<T>,
+        lambda1: Ab<T>,
+        i_drop: Ab<T>,
+    ) -> (Ab<T>, Ab<T>) {
+        let d = self.ripple_offset;
+        (
+            lambda1 - d * (self.integrator.rs_hat() * p.ts()),
+            i_drop + d,
+        )
+    }
+
+    /// The PWM ripple's current bias (`crate::ripple`) at this sample's operating point, in
+    /// α-β for the next samples' drop: the algebraic model's sigma points about ψ(î), the
+    /// ripple's own resistive drop and the dead time's lead through the warm start's
+    /// incremental inductance, in the frame of λ̂r; zero for another model, without a ripple,
+    /// or where λ̂r is too small to give a frame (the trackers coast there).
+    #[inline(always)]
+    fn ripple_offset_at(&self, p: &EstimatorParams<T>, c: &Candidate<T>, i_dq: Dq<T>) -> Ab<T> {
+        let MachineMagnetics::Saturation(model) = p.active_flux.model() else {
+            return Ab::zero();
+        };
+        if c.tracker_hold || self.ripple == PwmRipple::zero() {
+            return Ab::zero();
+        }
+        let inv = T::one() / c.lambda_r.norm_squared().step_sqrt();
+        let (cos, sin) = (c.lambda_r.alpha * inv, c.lambda_r.beta * inv);
+        let psi = c.flux_warm.prediction(i_dq);
+        let l = c.flux_warm.inductance();
+        let rs_ts = self.integrator.rs_hat() * p.ts();
+        let d = mean_current_offset_ab(model, psi, &l, &self.ripple, rs_ts, cos, sin);
+        if d.is_finite() { d } else { Ab::zero() }
     }
 
     /// The observer speed of a saturating model or a salient rotor: the notch

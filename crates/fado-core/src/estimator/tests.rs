@@ -88,8 +88,11 @@ fn state_size() {
     // (`crate::rs_adaptation`), 4 B more; the share of its rate at which the integrand-offset
     // law learns on a frame-coupled saturating model and the count of steady coupled slots
     // after which the turning R̂s law runs there (`offset_share`, `coupled_steady`), 4 B more
-    // (the count fills the padding beside the flags).
-    assert!(s32 <= 320, "{s32}");
+    // (the count fills the padding beside the flags); a saturating algebraic model's PWM
+    // ripple terms (`crate::ripple::PwmRipple`: the moment's three values, the resistive
+    // drop's and the dead time's α-β vectors), the mean-current offset they give (α-β) and
+    // the refresh phase (`crate::ripple::RIPPLE_EVERY`), 40 B more with the padding.
+    assert!(s32 <= 360, "{s32}");
     // The owner is both records and nothing else (padded to its alignment: the parameters
     // may hold a borrowed flux map, pointer-aligned).
     let align = core::mem::align_of::<SensorlessEstimator<f32>>();

@@ -62,6 +62,12 @@ impl<T: Real> FluxWarmStart<T> {
         Self { c, l }
     }
 
+    /// The incremental inductance L₀ of the last solution (zero while empty).
+    pub fn inductance(&self) -> InductanceMatrix<T> {
+        let (dd, dq, qq) = self.l;
+        InductanceMatrix { dd, dq, qd: dq, qq }
+    }
+
     /// Whether it holds a solution.
     pub fn is_set(&self) -> bool {
         self.l.0 > T::zero()

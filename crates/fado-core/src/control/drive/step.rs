@@ -109,7 +109,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             return Err(self.reject(i_abc));
         }
         // 2. Estimator: voltage of [n−1, n] = realised reference computed at n−2.
-        let estimate = self.estimate(i_ab)?;
+        let estimate = self.estimate(i_ab, vdc)?;
         // 3. Measured current in the estimated rotor frame.
         let rot_theta = Rotation::from_angle(estimate.theta);
         let i_dq = self.measured_dq(i_ab, rot_theta, estimate.omega);
@@ -277,7 +277,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
     /// Step 2: the estimator's sample with the voltage of [n−1, n], the realised reference
     /// computed at n−2; a non-finite or refused estimate holds the sample.
     #[inline(always)]
-    fn estimate(&mut self, i_ab: Ab<T>) -> Result<Estimate<T>, DriveOutput<T>> {
+    fn estimate(&mut self, i_ab: Ab<T>, vdc: T) -> Result<Estimate<T>, DriveOutput<T>> {
         self.i_ab_used = i_ab;
         if self.config.tuning.tracker_feedforward.enabled {
             let m = &self.config.machine;
@@ -295,6 +295,9 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         // (see `tracker_feedforward`, "T2S-1 at a brake's release").
         self.estimator
             .set_release_tracking(self.blocks.hold.tracking_fall());
+        let dead_time = self.config.tuning.inverter.dead_time;
+        self.estimator
+            .set_pwm_ripple(self.history[1], vdc, dead_time);
         let estimate = self.estimator.step(self.history[1], i_ab);
         if !estimate_is_finite(&estimate) {
             // An estimator that went non-finite cannot steer the drive: hold like a bad input
