@@ -75,9 +75,18 @@ fn a_slow_torque_motor_holds_its_loaded_reversal() {
 ///
 /// - the `RotorMoved` start engages the release hold, whose loop on the direct angle rings at
 ///   ≈ 94 Hz from its first sample (i_q demand ±30 A, the rotor ±3 r/min; θ̂ moves 0.02 rad
-///   against the rotor within 4 ms; L̂q·I_rated/λ̂f = 2.8 on this motor, where the currents'
-///   transients can move the angle estimate), and the estimate is lost by 1.1 s (0.8 rad),
-///   after its hand-over at 1.0 s; held three times as long the oscillation grows (±63 A,
+///   against the rotor within 4 ms). The direct angle (the angle of λ̂r) steps by ∓δ,
+///   δ = 0.017–0.018 rad, at each sign change of i_q and keeps that offset while the sign
+///   holds (a relay fitted on 0.896–0.99 s, not proportional to i_q); the hold's P and
+///   filtered D paths turn the step into a q-current kick of (1 + 5)·K_p·2δ (≈ 49 A at
+///   K_p = 260 A/rad; 38 A jumps in the trace) towards the current's new sign, and the loop
+///   sustains a limit cycle. The offset is the inverter's: with `[inverter] dead_time = 0`
+///   and `threshold_voltage = 0` it is below 0.001 rad and the hold's current stays
+///   one-signed (seed 2: 0–15 A, no ringing); it scales with the dead time (3 µs:
+///   0.037 rad). At a third of ω_h the current swings −4.8…5.5 A, the rotor −1.5…0.4 r/min.
+///   The ringing collapses the limiter mode's |λ̂r| to 0.053–0.058 Wb (λ̂f 0.13) at the
+///   hand-over at 1.0 s (lock 2 from 1.004 s), and the estimate is lost by 1.1 s (0.8 rad);
+///   held three times as long the oscillation grows (±63 A,
 ///   the rotor at 242 r/min by 1.3 s). On the tracked angle the loop swings ±63 A instead
 ///   (stops 0.17/0.12/0.16 rad at seeds 1–3, seed 4 3.14). The hold's design ω_h is 93 rad/s here (0.2 rad under the rated load);
 ///   at a third of it (31 rad/s, `[controller.release_hold] travel = 1.8`) the hold keeps
