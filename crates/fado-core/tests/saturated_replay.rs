@@ -983,3 +983,139 @@ fn a_rib_of_constant_conductance_is_a_linear_norton_magnet() {
     // The magnet's flux at zero current: a_b·ψn/(a_d0 + a_b) = 0.12 Vs.
     assert!((m.flux(Dq::new(0.0, 0.0)).d - 0.12).abs() < 1e-9);
 }
+
+/// motulator's 4 kW ferrite PM-SyRM (fado-sim's `tests/data/motulator/mot-pmsyrm-4k.toml`) as
+/// its algebraic model, the plant of fado-sim's closed loop: λf 0.2 Vs, ψd < 0 on its MTPA
+/// curve under load.
+fn motulator_pm_syrm() -> MachineModel<f64> {
+    let sat = Saturation {
+        a_d0: 6.0,
+        a_dd: 40.0,
+        s: 5.0,
+        a_q0: 3.5,
+        a_qq: 5.0,
+        t: 5.0,
+        a_dq: 40.0,
+        u: 1.0,
+        v: 0.0,
+        psi_n: 0.5323338858228551,
+        a_b: 40.0,
+        a_bp: 2.0,
+        w: 2.0,
+        k_q: 0.2,
+        ..Saturation::default()
+    };
+    let model = MachineMagnetics::Saturation(Box::leak(Box::new(sat)));
+    rated_machine(model, 0.9, 2, (10.0, 1500.0, 16.0), 540.0)
+}
+
+/// The frequency of the speed ripple of [`frame_closed_error`]: the 4–5 Hz oscillation that
+/// fado-sim's speed loop (5 Hz) grows on motulator's PM-SyRM during `rated-reversal`'s load
+/// ramp at −6 % of rated speed.
+const RIPPLE_HZ: f64 = 4.5;
+
+/// The estimator with its frame closed, as a current loop closes it: the machine `plant`
+/// carries the current î of its MTPA point at `load` × rated torque (ramped in over 0.5 s)
+/// held in the frame of θ̂, so that a frame error turns the machine's own current and flux
+/// (the frame coupling |s|/κ of `fado_core::active_flux`); the speed is imposed, `speed_ratio`
+/// of rated, with a ripple of `ripple` times it at [`RIPPLE_HZ`] from 1 s. `model` is the
+/// estimator's machine. Returns max |θ − θ̂| over 1–6 s.
+fn frame_closed_error(
+    (plant, model): (&MachineModel<f64>, &MachineModel<f64>),
+    load: f64,
+    (speed_ratio, ripple): (f64, f64),
+) -> f64 {
+    let mut est = SensorlessEstimator::new(EstimatorConfig::for_machine(model)).unwrap();
+    let magnetics = plant.magnetic_model();
+    let i_dq = operating_current(plant, load);
+    let ts = 1e-4;
+    let at = |t: f64, theta: f64, theta_hat: f64| {
+        let i = (i_dq * (t / 0.5).min(1.0)).to_ab(Rotation::from_angle(theta_hat));
+        let rot = Rotation::from_angle(theta);
+        (i, magnetics.flux(i.to_dq(rot)).to_ab(rot))
+    };
+    let w = plant.rated_speed() * speed_ratio;
+    let mut theta = 0.4_f64;
+    let mut theta_hat = theta;
+    let (mut i_prev, mut psi_prev) = at(0.0, theta, theta_hat);
+    est.align(theta, i_prev);
+    let mut worst: f64 = 0.0;
+    for k in 1..=(6.0 / ts) as usize {
+        let t = k as f64 * ts;
+        let swing = if t > 1.0 {
+            ripple * (std::f64::consts::TAU * RIPPLE_HZ * t).sin()
+        } else {
+            0.0
+        };
+        theta = wrap_angle(theta + w * (1.0 + swing) * ts);
+        let (i, psi) = at(t, theta, theta_hat);
+        let v: Ab<f64> = (psi - psi_prev) * (1.0 / ts) + (i + i_prev) * (0.5 * plant.rs);
+        theta_hat = est.step(v, i).theta;
+        (i_prev, psi_prev) = (i, psi);
+        if t > 1.0 {
+            worst = worst.max(wrap_angle(theta - theta_hat).abs());
+        }
+    }
+    worst
+}
+
+/// The estimator with its frame closed at rated torque and ±6 % of rated speed, exact
+/// signals: the coupled machines (frame coupling 0.96–1.12 at rated torque) hold a ±10 %
+/// speed ripple at 4.5 Hz while generating, and motulator's PM-SyRM holds the steady speed
+/// while generating and the ripple while motoring. Measured: pmsyrm-baldor-5k6 0.100 rad, the
+/// made-up automotive IPMSM 0.055, the made-up ferrite PM-SyRM 0.106 (without the observer's
+/// notched speed 3.14, 2.58 and 1.53: the notch is what holds them); motulator's PM-SyRM with
+/// the drive's 13 × 17 map as the estimator's model 0.035 rad steady at −6 % (0.067 at −10 %),
+/// 0.019 with the ripple at +6 %. The same PM-SyRM generating with the ripple loses the angle
+/// (`the_weak_magnet_pm_syrm_holds_a_speed_ripple_while_generating`).
+#[test]
+fn coupled_machines_hold_a_speed_ripple_with_their_frame_closed() {
+    for (name, m) in [
+        ("pmsyrm-baldor-5k6", baldor()),
+        ("automotive IPMSM (made up)", automotive()),
+        ("ferrite PM-SyRM (made up)", ferrite_pmsyrm()),
+    ] {
+        let e = frame_closed_error((&m, &m), 1.0, (-0.06, 0.1));
+        println!("{name}, generating at rated torque, ±10 % speed ripple: {e:.3} rad");
+        assert!(e < 0.25, "{name}: {e} rad");
+    }
+    let (plant, map) = (motulator_pm_syrm(), motulator_machines()[1].1);
+    for (label, speed, ripple) in [
+        ("generating, steady", -0.06, 0.0),
+        ("generating at −10 %, steady", -0.1, 0.0),
+        ("motoring, ±10 % ripple", 0.06, 0.1),
+    ] {
+        let e = frame_closed_error((&plant, &map), 1.0, (speed, ripple));
+        println!("mot-pmsyrm-4k at rated torque, {label}: {e:.3} rad");
+        assert!(e < 0.1, "mot-pmsyrm-4k {label}: {e} rad");
+    }
+}
+
+/// motulator's PM-SyRM generating at −6 % of rated speed with its frame closed and the speed
+/// rippling ±10 % at 4.5 Hz (the oscillation fado-sim's speed loop grows in `rated-reversal`):
+/// the angle is lost, with the drive's map as the estimator's model and with the machine's own
+/// algebraic model alike, so the map's interpolation is not the cause. The observer's speed
+/// (T2S-1's ω̂ with its lag compensation, notched at |ω̂|) carries the frame's own motion, and
+/// with this machine's coupling (|s|/κ 1.29–1.31, κ 0.44·λa at rated torque; 0.96–1.05 and
+/// 0.59–0.64·λa at 65 %) the disturbance observer's DC loop through that speed grows; run
+/// at the true speed (a substitution made for the measurement, not a setting) every case of
+/// this test and of `coupled_machines_hold_a_speed_ripple_with_their_frame_closed` holds
+/// within 0.014 rad.
+#[test]
+#[ignore = "mot-pmsyrm-4k generating at -6 % with a ±10 % speed ripple at 4.5 Hz, frame \
+            closed: 3.14 rad at rated torque with the map as the estimator's model (0.114 at \
+            65 %), 3.14 at 65 % and 100 % with the algebraic model; motoring 0.010-0.021; \
+            the observer's speed carries the frame's motion"]
+fn the_weak_magnet_pm_syrm_holds_a_speed_ripple_while_generating() {
+    let (plant, map) = (motulator_pm_syrm(), motulator_machines()[1].1);
+    for (label, model) in [("map", map), ("algebraic model", plant)] {
+        for load in [0.65, 1.0] {
+            let e = frame_closed_error((&plant, &model), load, (-0.06, 0.1));
+            println!(
+                "mot-pmsyrm-4k ({label}) at {:.0} %: {e:.3} rad",
+                load * 100.0
+            );
+            assert!(e < 0.25, "{label} {load}: {e} rad");
+        }
+    }
+}
