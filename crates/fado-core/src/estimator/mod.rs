@@ -126,14 +126,6 @@ const BROKEN_OFFSET: u8 = 2;
 /// modulator limited; the turning law does not adapt (the standstill laws do).
 const BROKEN_LIMITED: u8 = 4;
 
-/// Default of `observer.frame_rate_gain` ([`ObserverTuning::frame_rate_gain`]), rad.
-pub const OBSERVER_FRAME_RATE_GAIN: f64 = 6.0;
-/// Largest `observer.frame_rate_gain` accepted, rad (25 loses `rated-reversal` on the
-/// ferrite PM-SyRM it is measured on).
-pub const MAX_OBSERVER_FRAME_RATE_GAIN: f64 = 50.0;
-/// Corner of the low-pass on the rate of |λ̂r|/λa(î) (`observer.frame_rate_gain`), Hz: well
-/// above the 3–5 Hz mode it damps, below the PWM-rate noise of a difference per sample.
-pub const FRAME_RATE_CORNER_HZ: f64 = 100.0;
 /// Default of [`EstimatorTuning::observer_gain_period`], s.
 const OBSERVER_GAIN_PERIOD: f64 = 4e-4;
 /// Largest [`EstimatorTuning::observer_gain_period`] accepted, s.
@@ -210,10 +202,6 @@ pub struct EstimatorParams<T: Real> {
     speed_notch: SpeedNotch<T>,
     /// `EstimatorTuning::observer.frame_ripple_notch`.
     frame_ripple_notch: bool,
-    /// `observer.frame_rate_gain`/Ts and the low-pass's gain per sample
-    /// ([`FRAME_RATE_CORNER_HZ`]).
-    frame_rate_gain: T,
-    frame_rate_input: T,
     integrator: FluxIntegratorParams<T>,
     observer: DisturbanceObserverParams<T>,
     disturbance_feedback: DisturbanceFeedbackParams<T>,
@@ -257,10 +245,6 @@ pub struct EstimatorState<T: Real> {
     kdf_gain: T,
     /// The low-passed Kp·e of T2S-1 added to ω̂1 for the observer, rad/s.
     lag_compensation: T,
-    /// |λ̂r|/λa(î) of the last sample with an operating point (0 before the first) and its
-    /// low-passed rate, 1/sample (`observer.frame_rate_gain`).
-    frame_ratio: T,
-    frame_rate: T,
     /// A saturating model's notch on the observer's speed (`crate::speed_notch`).
     speed_notch: SpeedNotchState<T>,
     /// The observer's gains, held between their updates

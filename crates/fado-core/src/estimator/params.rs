@@ -36,7 +36,6 @@ impl<T: Real> EstimatorParams<T> {
         let (ratio, hold) = check_limits(&config, ts)?;
         let blocks = SampleBlocks::new(&config, ts)?;
         let (rs_adaptation, offset) = slow_laws(&config)?;
-        frame_rate_gain(&config)?;
         check::non_negative(
             "offset_adaptation_min_revolution_samples",
             config.tuning.offset_adaptation.min_revolution_samples,
@@ -121,11 +120,6 @@ impl<T: Real> EstimatorParams<T> {
             rs_adaptation: config.tuning.rs_adaptation.enabled,
             speed_notch: SpeedNotch::new(ts, T::two_pi() * threshold_hz),
             frame_ripple_notch: config.tuning.observer.frame_ripple_notch,
-            frame_rate_gain: config.tuning.observer.frame_rate_gain / ts,
-            frame_rate_input: crate::real::min(
-                T::two_pi() * T::lit(super::FRAME_RATE_CORNER_HZ) * ts,
-                T::one(),
-            ),
             rs_initial: config.machine.rs,
             hold_level_sq: hold_level * hold_level,
             flux_settle_periods: (T::lit(FLUX_SETTLE_TIME_CONSTANTS)
@@ -161,8 +155,6 @@ impl<T: Real> EstimatorParams<T> {
             t2s2: self.t2s2.state_at(T::zero(), T::zero()),
             kdf_gain: T::zero(),
             lag_compensation: T::zero(),
-            frame_ratio: T::zero(),
-            frame_rate: T::zero(),
             speed_notch: SpeedNotch::state_at(T::zero()),
             frame_coupled: false,
             offset_share: T::one(),
@@ -326,20 +318,6 @@ fn rename(field: &'static str) -> impl Fn(ConfigError) -> ConfigError {
         ConfigError::NotPositive { .. } => ConfigError::NotPositive { field },
         ConfigError::Negative { .. } => ConfigError::Negative { field },
     }
-}
-
-/// `observer.frame_rate_gain`, checked (finite, 0 to [`super::MAX_OBSERVER_FRAME_RATE_GAIN`]).
-fn frame_rate_gain<T: Real>(config: &EstimatorConfig<T>) -> Result<T, ConfigError> {
-    let gain = check::non_negative(
-        "observer_frame_rate_gain",
-        config.tuning.observer.frame_rate_gain,
-    )?;
-    check::below(
-        "observer_frame_rate_gain",
-        gain,
-        T::lit(super::MAX_OBSERVER_FRAME_RATE_GAIN * (1.0 + 1e-9)),
-        "at most 50",
-    )
 }
 
 /// The observer's gain hold in samples: `observer.gain_period`/Ts rounded, less one.

@@ -82,8 +82,6 @@ impl<T: Real> EstimatorState<T> {
         self.t2s1 = p.t2s1.state_at(theta0, T::zero());
         self.t2s2 = p.t2s2.state_at(theta0, T::zero());
         self.lag_compensation = T::zero();
-        self.frame_ratio = T::zero();
-        self.frame_rate = T::zero();
         self.speed_notch = SpeedNotch::state_at(T::zero());
         self.frame_coupled = false;
         self.offset_share = T::one();

@@ -450,30 +450,11 @@ impl<T: Real> EstimatorState<T> {
         }
         let (notch, ripple) = p.speed_notch.step(&self.speed_notch, speed);
         self.speed_notch = notch;
-        let frame_rate = self.frame_rate_step(p, c);
         if self.notch_on && c.mode == Mode::DisturbanceFeedback {
-            speed - ripple - p.frame_rate_gain * frame_rate
+            speed - ripple
         } else {
             speed
         }
-    }
-
-    /// The low-passed rate of |λ̂r|/λa(î) per sample (see `observer.frame_rate_gain`),
-    /// stepped every sample so that it is warm where the notch acts; 0 without an operating
-    /// point (constant inductances) and on the first sample with one.
-    #[inline(always)]
-    fn frame_rate_step(&mut self, p: &EstimatorParams<T>, c: &Candidate<T>) -> T {
-        if let Some(point) = c.point
-            && point.active > T::zero()
-        {
-            let ratio = c.lambda_r.norm_squared().sqrt() / point.active;
-            if self.frame_ratio != T::zero() {
-                self.frame_rate = self.frame_rate
-                    + p.frame_rate_input * (ratio - self.frame_ratio - self.frame_rate);
-            }
-            self.frame_ratio = ratio;
-        }
-        self.frame_rate
     }
 
     /// Loss-of-lock symptoms (see `lock`), in the detector's slot: |λ̂r| against λ̂f (the

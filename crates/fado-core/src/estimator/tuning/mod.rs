@@ -110,7 +110,6 @@ pub const MOVED_KEYS: &[(&str, &str)] = &[
     ("observer_on_rotor_flux", "observer.on_rotor_flux"),
     ("observer_lag_compensation", "observer.lag_compensation"),
     ("observer_gain_period", "observer.gain_period"),
-    ("observer_frame_rate_gain", "observer.frame_rate_gain"),
     ("rs_adaptation", "rs_adaptation.enabled"),
     ("rs_adaptation_rate", "rs_adaptation.rate"),
     (

@@ -259,23 +259,9 @@ pub struct ObserverTuning<T> {
     /// a made-up ferrite PM-SyRM (frame coupling up to 1.12); without it the PM-SyRM's grows
     /// while generating at rated torque.
     pub frame_ripple_notch: bool,
-    /// Where the notch of `observer.frame_ripple_notch` acts (a large frame coupling while
-    /// generating, a saturating model): the observer's speed less this gain times the rate of
-    /// |λ̂r|/λa(î), the rotor flux's magnitude against the model's, low-passed at
-    /// `crate::estimator::FRAME_RATE_CORNER_HZ`; rad (a rate of a ratio to a speed). 0 = off.
-    /// Default 6 \[A\]; finite, 0 to 50.
-    ///
-    /// A frame error δ moves |λ̂r| by σ·δ while the angle sees only κ·δ of it (the frame
-    /// coupling, docs/method/saturation.md): with a weak κ the observer's speed carries the
-    /// frame's own motion, and the magnitude's rate is that motion. Measured (fado-sim
-    /// `rated-reversal`, the ferrite PM-SyRM of tests/data/motulator/mot-pmsyrm-4k, seeds
-    /// 1–4): lost on every seed at 0, passing at 1.5–12 (0.009–0.015 rad near zero speed at 6,
-    /// 0.039–0.073 on its commissioned model), lost at 25; the paper's figures and the
-    /// linear presets do not move (the notch does not act on them).
-    pub frame_rate_gain: T,
 }
 
-cast_record!(ObserverTuning { gain_period, frame_rate_gain ; on_rotor_flux, lag_compensation, frame_ripple_notch });
+cast_record!(ObserverTuning { gain_period ; on_rotor_flux, lag_compensation, frame_ripple_notch });
 
 impl<T: Real> Default for ObserverTuning<T> {
     fn default() -> Self {
@@ -284,7 +270,6 @@ impl<T: Real> Default for ObserverTuning<T> {
             lag_compensation: true,
             gain_period: T::lit(OBSERVER_GAIN_PERIOD),
             frame_ripple_notch: true,
-            frame_rate_gain: T::lit(crate::estimator::OBSERVER_FRAME_RATE_GAIN),
         }
     }
 }
