@@ -59,7 +59,7 @@
 
 use crate::control::modulation::svpwm_duty;
 use crate::magnetics::{InductanceMatrix, MagneticModel, Saturation};
-use crate::{Ab, Abc, Dq, Real};
+use crate::{Ab, Abc, Dq, Real, Rotation};
 
 /// A symmetric 2×2 second moment of the flux ripple (Wb²), in whichever frame its caller
 /// names (α-β from [`flux_ripple_moment`], d-q after [`RippleMoment::rotated`]).
@@ -83,9 +83,10 @@ impl<T: Real> RippleMoment<T> {
         }
     }
 
-    /// The moment of α-β ripple in the frame at angle θ, given as (cos θ, sin θ):
+    /// The moment of α-β ripple in the frame rotated by `rot` (angle θ):
     /// Δψ_dq = R(−θ)·Δψ_αβ, so C_dq = R(−θ)·C·R(θ).
-    pub fn rotated(&self, cos: T, sin: T) -> Self {
+    pub fn rotated(&self, rot: Rotation<T>) -> Self {
+        let (cos, sin) = (rot.cos, rot.sin);
         let (c2, s2, cs) = (cos * cos, sin * sin, cos * sin);
         let two_cs_xy = T::lit(2.0) * cs * self.xy;
         Self {
@@ -217,25 +218,21 @@ pub fn mean_current_offset<T: Real>(
 }
 
 /// The period's mean current minus its sampled current in α-β for a sample whose rotor
-/// frame is at (cos θ, sin θ), on the algebraic model at the flux `psi` with the incremental
+/// frame is rotated by `rot`, on the algebraic model at the flux `psi` with the incremental
 /// inductance `l` there (module docs): the curvature's [`mean_current_offset`] plus
 /// Γ·(`rs_ts`·Γ·F − lead), Γ = `l`⁻¹, `rs_ts` = R·Ts (Ω·s).
-#[allow(clippy::too_many_arguments)]
 pub fn mean_current_offset_ab<T: Real>(
     model: &Saturation<T>,
     psi: Dq<T>,
     l: &InductanceMatrix<T>,
     ripple: &PwmRipple<T>,
     rs_ts: T,
-    cos: T,
-    sin: T,
+    rot: Rotation<T>,
 ) -> Ab<T> {
-    let to_dq = |x: Ab<T>| Dq::new(cos * x.alpha + sin * x.beta, cos * x.beta - sin * x.alpha);
-    let curvature = mean_current_offset(model, psi, &ripple.moment.rotated(cos, sin));
+    let curvature = mean_current_offset(model, psi, &ripple.moment.rotated(rot));
     let gamma = l.inverse();
-    let flux = gamma.apply(to_dq(ripple.damping)) * rs_ts - to_dq(ripple.lead);
-    let di = curvature + gamma.apply(flux);
-    Ab::new(cos * di.d - sin * di.q, sin * di.d + cos * di.q)
+    let flux = gamma.apply(ripple.damping.to_dq(rot)) * rs_ts - ripple.lead.to_dq(rot);
+    (curvature + gamma.apply(flux)).to_ab(rot)
 }
 
 #[cfg(test)]

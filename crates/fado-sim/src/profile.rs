@@ -66,6 +66,11 @@ impl Profile {
         Ok(())
     }
 
+    /// The largest |value| of the breakpoints (0 for none).
+    pub fn largest_magnitude(&self) -> f64 {
+        self.points.iter().map(|p| p[1].abs()).fold(0.0, f64::max)
+    }
+
     /// Time of the last breakpoint.
     pub fn end_time(&self) -> f64 {
         self.points.last().map_or(0.0, |p| p[0])

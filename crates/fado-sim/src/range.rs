@@ -74,6 +74,15 @@ pub fn max_torque(cfg: &SimConfig, omega: f64, i_max: f64, v_max: f64) -> f64 {
     best
 }
 
+/// The model's limits for `cfg`'s drive: (the current limit |i| ≤ I_max, A; the voltage
+/// limit |v| ≤ the field-weakening loop's `voltage_margin` × V_dc/√3, V).
+pub fn limits(cfg: &SimConfig) -> (f64, f64) {
+    let i_max = cfg.controller.current.limit_ratio * cfg.machine_model().rated_current;
+    let v_max =
+        cfg.controller.field_weakening.voltage_margin * cfg.inverter.dc_voltage / 3f64.sqrt();
+    (i_max, v_max)
+}
+
 /// The targets of `fullrange` for `cfg`'s motor and drive.
 pub fn targets(cfg: &SimConfig) -> RangeTargets {
     let m = cfg.machine_model();
@@ -81,9 +90,7 @@ pub fn targets(cfg: &SimConfig) -> RangeTargets {
     let w_mech = |rpm: f64| rpm * std::f64::consts::TAU / 60.0;
     let p = m.pole_pairs as f64;
     let rated_power = m.rated_torque * w_mech(rated);
-    let i_max = cfg.controller.current.limit_ratio * m.rated_current;
-    let v_max =
-        cfg.controller.field_weakening.voltage_margin * cfg.inverter.dc_voltage / 3f64.sqrt();
+    let (i_max, v_max) = limits(cfg);
     let power = |rpm: f64| max_torque(cfg, p * w_mech(rpm), i_max, v_max) * w_mech(rpm);
     // Highest speed (1 % steps of the rated speed) up to the cap with half the rated power.
     let mut top = rated;

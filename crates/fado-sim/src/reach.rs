@@ -11,7 +11,7 @@
 
 use crate::config::SimConfig;
 use crate::load::LoadMode;
-use crate::range::max_torque;
+use crate::range::{limits, max_torque};
 
 /// Share by which a profile may exceed the model's limits before it is named: 5 % (the
 /// limits are the steady-state model's, without the plant's saturation and losses; a scenario
@@ -22,20 +22,6 @@ pub const REACH_MARGIN: f64 = 0.05;
 /// limits would allow more: 10 (field-weakening ranges of traction motors and spindles reach
 /// 3–5 × their base speed; a reference beyond 10 × is another unit or another motor).
 pub const MECHANICAL_CAP: f64 = 10.0;
-
-/// The largest |value| of a profile's breakpoints.
-fn largest(points: &[[f64; 2]]) -> f64 {
-    points.iter().map(|p| p[1].abs()).fold(0.0, f64::max)
-}
-
-/// The model's limits for `cfg`: (current limit A, voltage limit V).
-fn limits(cfg: &SimConfig) -> (f64, f64) {
-    let m = cfg.machine_model();
-    let i_max = cfg.controller.current.limit_ratio * m.rated_current;
-    let v_max =
-        cfg.controller.field_weakening.voltage_margin * cfg.inverter.dc_voltage / 3f64.sqrt();
-    (i_max, v_max)
-}
 
 /// The speed (r/min, mechanical) above which the model's limits leave no torque: the whole
 /// current limit on the negative d axis, λ̂f − L̂d·I_max, turns the voltage limit into
@@ -56,7 +42,7 @@ pub fn no_load_top_speed(cfg: &SimConfig) -> f64 {
 pub fn findings(cfg: &SimConfig) -> Vec<(String, String)> {
     let m = cfg.machine_model();
     let mut out = Vec::new();
-    let speed = largest(&cfg.speed_reference.points);
+    let speed = cfg.speed_reference.largest_magnitude();
     let top = no_load_top_speed(cfg);
     let cap = MECHANICAL_CAP * m.rated_speed_rpm;
     if speed > (1.0 + REACH_MARGIN) * top.min(cap) {
@@ -81,7 +67,7 @@ pub fn findings(cfg: &SimConfig) -> Vec<(String, String)> {
         ));
     }
     if cfg.load.mode != LoadMode::Speed {
-        let load = largest(&cfg.load.torque.points);
+        let load = cfg.load.torque.largest_magnitude();
         let (i_max, v_max) = limits(cfg);
         let standstill = max_torque(cfg, 0.0, i_max, v_max);
         if load > (1.0 + REACH_MARGIN) * standstill {

@@ -27,7 +27,7 @@ use crate::ripple::{PwmRipple, mean_current_offset_ab};
 use crate::rotor_flux::{rotor_angle, stator_flux};
 use crate::rs_adaptation::AdaptationRegime;
 use crate::tracker::TrackerUpdate;
-use crate::{Ab, Dq, Real};
+use crate::{Ab, Dq, Real, Rotation};
 
 /// The new state of one sample, computed before anything is committed.
 struct Candidate<T: Real> {
@@ -451,11 +451,14 @@ impl<T: Real> EstimatorState<T> {
             return Ab::zero();
         }
         let inv = T::one() / c.lambda_r.norm_squared().step_sqrt();
-        let (cos, sin) = (c.lambda_r.alpha * inv, c.lambda_r.beta * inv);
+        let rot = Rotation {
+            cos: c.lambda_r.alpha * inv,
+            sin: c.lambda_r.beta * inv,
+        };
         let psi = c.flux_warm.prediction(i_dq);
         let l = c.flux_warm.inductance();
         let rs_ts = self.integrator.rs_hat() * p.ts();
-        let d = mean_current_offset_ab(model, psi, &l, &self.ripple, rs_ts, cos, sin);
+        let d = mean_current_offset_ab(model, psi, &l, &self.ripple, rs_ts, rot);
         if d.is_finite() { d } else { Ab::zero() }
     }
 

@@ -91,7 +91,8 @@ fn rotated_moment_is_the_moment_of_the_rotated_ripple() {
     let duty = Abc::new(0.62, 0.41, 0.47);
     let th: f64 = 0.7;
     let (c, s) = (th.cos(), th.sin());
-    let m: RippleMoment<f64> = flux_ripple_moment(duty, vdc, ts).rotated(c, s);
+    let m: RippleMoment<f64> =
+        flux_ripple_moment(duty, vdc, ts).rotated(Rotation { cos: c, sin: s });
     let path = ripple_path(duty, vdc, ts, true, 200_000);
     let n = path.len() as f64;
     let mut b: RippleMoment<f64> = RippleMoment::zero();
@@ -133,7 +134,8 @@ fn sigma_point_offset_matches_the_period_mean_of_the_saturating_current() {
         };
         let l = model.incremental_inductance(i);
         // Without the resistive and dead-time terms (R·Ts = 0, no lead): the curvature alone.
-        let fast = mean_current_offset_ab(&model, psi, &l, &ripple, 0.0, c, s);
+        let fast =
+            mean_current_offset_ab(&model, psi, &l, &ripple, 0.0, Rotation { cos: c, sin: s });
         let mut acc = Ab::new(0.0, 0.0);
         let mut n = 0.0;
         for falling in [true, false] {
@@ -167,7 +169,14 @@ fn constant_inductance_has_no_offset() {
     };
     let i = Dq::new(-1.0, 3.0);
     let (psi, l) = (model.flux(i), model.incremental_inductance(i));
-    let di = mean_current_offset_ab(&model, psi, &l, &ripple, 0.0, 0.8, 0.6);
+    let di = mean_current_offset_ab(
+        &model,
+        psi,
+        &l,
+        &ripple,
+        0.0,
+        Rotation { cos: 0.8, sin: 0.6 },
+    );
     assert!(di.alpha.abs() < 1e-9 && di.beta.abs() < 1e-9, "{di:?}");
 }
 
@@ -272,8 +281,8 @@ fn offset_matches_the_periodic_solution_with_resistance_and_dead_time() {
                 brute_periodic(&model, r, duty, (vdc, ts, th, 0.5 * dead_time), i);
             let ripple = PwmRipple::from_voltage(v_ab, vdc, ts, dead_time);
             let (psi, l) = (model.flux(sample), model.incremental_inductance(sample));
-            let ab = mean_current_offset_ab(&model, psi, &l, &ripple, r * ts, c, s);
-            let fast = Dq::new(c * ab.alpha + s * ab.beta, -s * ab.alpha + c * ab.beta);
+            let rot = Rotation { cos: c, sin: s };
+            let fast = mean_current_offset_ab(&model, psi, &l, &ripple, r * ts, rot).to_dq(rot);
             std::println!("Td {dead_time:e}: model {fast:?}, brute force {brute:?} A");
             let err = (fast - brute).norm();
             assert!(

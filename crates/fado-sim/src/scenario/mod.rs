@@ -110,9 +110,8 @@ impl Scenario {
         if self.scaled || self.neutral || papers {
             return None;
         }
-        let largest = |points: &[[f64; 2]]| points.iter().map(|p| p[1].abs()).fold(0.0, f64::max);
-        let load = largest(&cfg.load.torque.points);
-        let speed = largest(&cfg.speed_reference.points);
+        let load = cfg.load.torque.largest_magnitude();
+        let speed = cfg.speed_reference.largest_magnitude();
         let scaled: Vec<&str> = SCENARIOS
             .iter()
             .filter(|s| s.scaled)
