@@ -205,16 +205,15 @@ fn motulator_small_high_saliency_ipmsm_passes_every_seed() {
 
 /// Open loop, the same machine's exact signals hold the angle within 0.18 rad at every load
 /// (`saturated_replay motulator`) and motulator's own plant's within 0.024 rad
-/// (scripts/motulator-machines.py replay); closed loop the drive loses it while the machine
-/// generates near zero speed where its speed tracker is not fast enough for its frame
-/// coupling. Its magnet is weak (λf 0.2 Vs against L_d·I = 0.64 Vs): ψd crosses zero on the
+/// (scripts/motulator-machines.py replay). Its magnet is weak (λf 0.2 Vs against L_d·I = 0.64 Vs): ψd crosses zero on the
 /// MTPA curve near 5 A of i_d (ψd = −0.12 Vs at rated torque) and the secant L_q falls 57 % at
 /// rated i_q: its frame coupling |s|/κ is 1.23 at the rated torque on the drive's map
 /// (`speed_bandwidth::rated_frame_coupling`; 0.84 / 1.08 / 1.33 at 30 / 65 / 100 % on
 /// motulator's model, `scripts/motulator-machines.py coupling`), above the rule's 1, so the
-/// drive runs T2S-2 at 43 Hz (`fado_core::control::speed_bandwidth`, "Frame coupling").
-/// Measured: reversal 0.139 / 0.088 / 0.120 / 0.147 rad (seeds 1–4; 0.086 / 3.05 / 1.77 /
-/// 0.124 at the paper's 35 Hz), 7–10 r/min; stops 0.040–0.041 rad.
+/// drive runs T2S-2 at 43 Hz (`fado_core::control::speed_bandwidth`, "Frame coupling"), and
+/// while it generates the observer's notched speed carries the estimator's frame-rate
+/// correction (`fado_core::estimator`'s notch, "The frame-rate correction"). Measured:
+/// reversal REV_FIG; stops STOPS_FIG.
 #[test]
 fn motulator_ferrite_pm_syrm_holds_reversal_and_stops_every_seed() {
     passes_on_every_seed(&motulator_machine("mot-pmsyrm-4k"), &["reversal", "stops"]);
@@ -223,27 +222,14 @@ fn motulator_ferrite_pm_syrm_holds_reversal_and_stops_every_seed() {
 /// The same machine under its rated torque near zero speed (`rated-reversal`): at that load
 /// the MTPA current (about (−8.3, 6.0) A) leaves ψd = −0.14 Vs, the rotor flux's angle carried
 /// by the q axis's saturation rather than the magnet, and the frame coupling at 1.23–1.33.
-/// What loses the angle is the disturbance observer's speed: while the machine generates
-/// under load at −6 % of rated speed, a 4–5 Hz oscillation of θ̂ and of the speed grows
-/// until the angle slips (seed 3: ±0.13 rad for 0.3 s, then lost within 30 ms at t = 1.87 s);
-/// R̂s and λ̂f stay frozen (0.900 Ω, 0.200 Vs) and the current on the MTPA curve. Open loop
-/// with the current held in θ̂'s frame and exact signals, the estimator holds the steady −6 %
-/// at rated torque (0.035 rad) and loses it under a ±10 % speed ripple at 4.5 Hz, with the
-/// map or the machine's algebraic model as its model (`saturated_replay`,
-/// `the_weak_magnet_pm_syrm_holds_a_speed_ripple_while_generating`); the same drive with the
-/// machine's algebraic model instead of the map loses `rated-reversal` on every seed too. Run
-/// with the true speed as the observer's speed where the notch acts (a substitution made for
-/// the measurement, not a setting), `rated-reversal` passes on seeds 1–4 at 0.022–0.023 rad
-/// near zero speed and 5–6 r/min.
+/// While the machine generates under load at −6 % of rated speed the observer's notched
+/// speed carries the frame's own motion, and without the frame-rate correction a 4–5 Hz
+/// oscillation of θ̂ and of the speed grows until the angle slips (seed 3: ±0.13 rad for
+/// 0.3 s, then lost within 30 ms; seeds 1–2 trip at 15,000 r/min of speed error). With it
+/// (G = 2 rad) measured on seeds 1–4: RATED_FIG; the
+/// same loop with the true speed as the observer's speed where the notch acts (a substitution
+/// made for the measurement) 0.022–0.023 rad.
 #[test]
-#[ignore = "rated-reversal loses the angle on every seed with the rule's 43 Hz T2S-2 (seeds \
-            1–2 trip at 15,000 r/min speed error, seeds 3–4 1,150–1,260 r/min, angle 3.14 \
-            rad over the run), as at 35, 60 and 100 Hz, without the notch and with the \
-            algebraic model as the drive's; the speed loop at 3.5 Hz passes seed 3 alone \
-            (0.192 rad, 23 r/min), at 2.5 Hz the angle holds on seeds 1, 2, 4 (0.09–0.17 \
-            rad) at 72 r/min (> 30): generating under the rated torque with \
-            ψd < 0 on the MTPA curve, the observer's notched speed carries the frame's own \
-            motion (with the true speed there: 0.022–0.023 rad, 5–6 r/min)"]
 fn motulator_ferrite_pm_syrm_passes_every_seed() {
     passes_every_seed(&motulator_machine("mot-pmsyrm-4k"));
 }
@@ -369,13 +355,11 @@ fn the_commissioned_weak_magnet_pm_syrm_holds_reversal_and_stops() {
     commissioned_passes("mot-pmsyrm-4k", &["reversal", "stops"]);
 }
 
-/// The same machine's identified model under its rated torque near zero speed.
+/// The same machine's identified model under its rated torque near zero speed, with the
+/// estimator's frame-rate correction as on the true map
+/// (`motulator_ferrite_pm_syrm_passes_every_seed`); without it seed 1 loses the angle (1515
+/// r/min of speed error). Measured on seeds 1–4: COMM_FIG.
 #[test]
-#[ignore = "rated-reversal loses the angle (seed 1: 1515 r/min of speed error, the \
-            angle near zero speed never reached), as with the true map \
-            (saturated_drive motulator_ferrite_pm_syrm_passes_every_seed: frame coupling \
-            1.23-1.33, psi_d < 0 on the MTPA curve, the observer's notched speed carries the \
-            frame's own motion while generating)"]
 fn the_commissioned_weak_magnet_pm_syrm_passes_rated_reversal() {
     commissioned_passes("mot-pmsyrm-4k", &["rated-reversal"]);
 }

@@ -303,6 +303,11 @@ pub struct EstimatorState<T: Real> {
     /// The observer runs at the notched speed (`crate::speed_notch`): `frame_coupled` while
     /// the machine generates, judged in the same slot.
     notch_on: bool,
+    /// G/c of the frame-rate correction (`step::notch`), judged in the same slot: zero
+    /// where the notch's coupling test fails and on the constant-inductance path.
+    frame_rate_gain: T,
+    /// |λ̂r|/λa(î) low-passed, the frame-rate correction's rate source (`step::notch`).
+    active_ratio: T,
     /// The R̂s adaptation runs: `EstimatorTuning::rs_adaptation`, or switched on by
     /// [`EstimatorState::enable_rs_adaptation`].
     rs_adaptation_on: bool,

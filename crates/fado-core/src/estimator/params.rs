@@ -161,6 +161,8 @@ impl<T: Real> EstimatorParams<T> {
             offset_share: T::one(),
             coupled_steady: 0,
             notch_on: false,
+            frame_rate_gain: T::zero(),
+            active_ratio: T::one(),
             observer_gains: ObserverGains::standstill(),
             feedback: Ab::zero(),
             step_allowance: self.bounds.step(),

@@ -90,6 +90,8 @@ impl<T: Real> EstimatorState<T> {
         self.offset_share = T::one();
         self.coupled_steady = 0;
         self.notch_on = false;
+        self.frame_rate_gain = T::zero();
+        self.active_ratio = T::one();
         // The observer's gains for ω̂ = 0, held as after any update (so that with the
         // default period they are formed in the slots after the lock detector's, which no
         // slow law uses: see `SLOW_PERIOD`).

@@ -29,6 +29,8 @@ use crate::rs_adaptation::AdaptationRegime;
 use crate::tracker::TrackerUpdate;
 use crate::{Ab, Dq, Real, Rotation};
 
+mod notch;
+
 /// The new state of one sample, computed before anything is committed.
 struct Candidate<T: Real> {
     /// L̂d − L̂q, loaded once for every use in the sample.
@@ -460,52 +462,6 @@ impl<T: Real> EstimatorState<T> {
         let rs_ts = self.integrator.rs_hat() * p.ts();
         let d = mean_current_offset_ab(model, psi, &l, &self.ripple, rs_ts, rot);
         if d.is_finite() { d } else { Ab::zero() }
-    }
-
-    /// The observer speed of a saturating model or a salient rotor: the notch
-    /// (`crate::speed_notch`) stepped every sample, its ripple removed in the k_df mode where
-    /// the frame coupling is large and the machine generates (ω̂·î_q < 0), the quadrant where
-    /// the DC loop's two couplings add. Both are judged at the operating point of the
-    /// integrand-offset law's slot (the law holds on the same coupling test), once every
-    /// [`SLOW_PERIOD`] samples: a saturating model's at its operating point, constant
-    /// inductances' at the current `i_ab` in the frame of λ̂r
-    /// (`crate::active_flux::constant_inductance_holds_offset`).
-    #[inline(always)]
-    fn notch_speed<M: FluxLookup<T>>(
-        &mut self,
-        p: &EstimatorParams<T>,
-        af: &ActiveFlux<T, M>,
-        c: &Candidate<T>,
-        i_ab: Ab<T>,
-        speed: T,
-    ) -> T {
-        if self.slot == SLOT_OFFSET {
-            let (coupled, i_q, share) = match c.point {
-                Some(point) => (
-                    af.holds_offset(&point),
-                    point.i_dq.q,
-                    af.offset_rate_share(&point),
-                ),
-                None => {
-                    let i_dq = ActiveFlux::<T>::frame_current(c.lambda_r, i_ab);
-                    let lf = self.rs_adaptation.flux_linkage_hat;
-                    let holds =
-                        crate::active_flux::constant_inductance_holds_offset(lf, c.saliency, i_dq);
-                    (holds, i_dq.q, T::one())
-                }
-            };
-            self.frame_coupled = coupled;
-            self.offset_share = share;
-            self.notch_on =
-                p.frame_ripple_notch && self.frame_coupled && i_q * c.t2s1.omega < T::zero();
-        }
-        let (notch, ripple) = p.speed_notch.step(&self.speed_notch, speed);
-        self.speed_notch = notch;
-        if self.notch_on && c.mode == Mode::DisturbanceFeedback {
-            speed - ripple
-        } else {
-            speed
-        }
     }
 
     /// Loss-of-lock symptoms (see `lock`), in the detector's slot: |λ̂r| against λ̂f (the
