@@ -213,7 +213,8 @@ fn motulator_small_high_saliency_ipmsm_passes_every_seed() {
 /// drive runs T2S-2 at 43 Hz (`fado_core::control::speed_bandwidth`, "Frame coupling"), and
 /// while it generates the observer's notched speed carries the estimator's frame-rate
 /// correction (`fado_core::estimator`'s notch, "The frame-rate correction"). Measured:
-/// reversal REV_FIG; stops STOPS_FIG.
+/// reversal 0.030 / 0.027 / 0.026 / 0.034 rad (seeds 1–4),
+/// 9–9.5 r/min; stops 0.040–0.041 rad.
 #[test]
 fn motulator_ferrite_pm_syrm_holds_reversal_and_stops_every_seed() {
     passes_on_every_seed(&motulator_machine("mot-pmsyrm-4k"), &["reversal", "stops"]);
@@ -226,7 +227,8 @@ fn motulator_ferrite_pm_syrm_holds_reversal_and_stops_every_seed() {
 /// speed carries the frame's own motion, and without the frame-rate correction a 4–5 Hz
 /// oscillation of θ̂ and of the speed grows until the angle slips (seed 3: ±0.13 rad for
 /// 0.3 s, then lost within 30 ms; seeds 1–2 trip at 15,000 r/min of speed error). With it
-/// (G = 2 rad) measured on seeds 1–4: RATED_FIG; the
+/// (G = 2 rad) measured on seeds 1–4: 0.047 / 0.088 / 0.086 / 0.044 rad near zero speed,
+/// 5.0–6.0 r/min; the
 /// same loop with the true speed as the observer's speed where the notch acts (a substitution
 /// made for the measurement) 0.022–0.023 rad.
 #[test]
@@ -346,10 +348,11 @@ fn the_weak_magnet_pm_syrm_is_commissioned_with_its_nameplate_resistance() {
 /// The same machine's identified model (the fitted algebraic model) in `reversal` and
 /// `stops`, although its λ̂f is +17.5 % (0.235 Vs, from the spin's back-EMF at the coast's
 /// 2.5 A of d current) and its flux error reaches 23 % over the rated current. Measured on
-/// seeds 1–4: `reversal` 0.170 / 0.121 / 0.121 / 0.034 rad, `stops` 0.061 / 0.061 / 0.037 /
+/// seeds 1–4: `reversal` 0.036 / 0.038 / 0.056 / 0.044 rad, `stops` 0.061 / 0.061 / 0.037 /
 /// 0.074 rad. The CLI's identified map of the same fit (`scripts/motulator-closed-loop.sh`,
-/// on 81 nodes per axis, `fado_sim::identified_map::TABLE_TOLERANCE`): `reversal` 0.200 /
-/// 0.093 / 0.105 / 0.030 rad, `stops` 0.057 / 0.046 / 0.237 / 0.043 rad.
+/// on 81 nodes per axis, `fado_sim::identified_map::TABLE_TOLERANCE`): `reversal` 0.034 /
+/// 0.045 / 0.056 / 0.035 rad, `stops` 0.057 / 0.046 / 0.237 / 0.043 rad, `rated-reversal`
+/// 0.164 / 0.092 / 0.083 / 0.057 rad.
 #[test]
 fn the_commissioned_weak_magnet_pm_syrm_holds_reversal_and_stops() {
     commissioned_passes("mot-pmsyrm-4k", &["reversal", "stops"]);
@@ -358,7 +361,8 @@ fn the_commissioned_weak_magnet_pm_syrm_holds_reversal_and_stops() {
 /// The same machine's identified model under its rated torque near zero speed, with the
 /// estimator's frame-rate correction as on the true map
 /// (`motulator_ferrite_pm_syrm_passes_every_seed`); without it seed 1 loses the angle (1515
-/// r/min of speed error). Measured on seeds 1–4: COMM_FIG.
+/// r/min of speed error). Measured on seeds 1–4: 0.141 / 0.082 / 0.091 / 0.050 rad near zero
+/// speed, 6.5–8.8 r/min.
 #[test]
 fn the_commissioned_weak_magnet_pm_syrm_passes_rated_reversal() {
     commissioned_passes("mot-pmsyrm-4k", &["rated-reversal"]);
