@@ -91,8 +91,10 @@ fn state_size() {
     // (the count fills the padding beside the flags); a saturating algebraic model's PWM
     // ripple terms (`crate::ripple::PwmRipple`: the moment's three values, the resistive
     // drop's and the dead time's α-β vectors), the mean-current offset they give (α-β) and
-    // the refresh phase (`crate::ripple::RIPPLE_EVERY`), 40 B more with the padding.
-    assert!(s32 <= 360, "{s32}");
+    // the refresh phase (`crate::ripple::RIPPLE_EVERY`), 40 B more with the padding; a
+    // saturating model's frame-rate correction of the observer's speed (`step::notch`: its
+    // gain G/c and the low-passed |λ̂r|/λa(î)), 8 B more.
+    assert!(s32 <= 368, "{s32}");
     // The owner is both records and nothing else (padded to its alignment: the parameters
     // may hold a borrowed flux map, pointer-aligned).
     let align = core::mem::align_of::<SensorlessEstimator<f32>>();
