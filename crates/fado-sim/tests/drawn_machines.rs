@@ -153,3 +153,27 @@ fn saturated_rotors_hold_the_rated_load_at_standstill() {
         );
     }
 }
+
+/// A drawn 192 kW, 9-pole-pair IPMSM (draw seed 33: q secant saturating, 6 kHz carrier,
+/// 1275 kg·m² with its coupled load, τm = Ĵ·Ω_rated/T_rated = 3.8 s) at `stops` (4 % of its
+/// 204 r/min under 65 % of its rated torque). The speed loop at its 5 Hz limit-cycles between
+/// the current limits (i_q ±910 A from the first ramp, before any load) and the angle is lost:
+/// max |θ − θ̂| 1.80 / 2.17 rad at seeds 1 / 2 (reversal seed 1 1.81 rad, loaded-start seed 2
+/// 1.39 rad). Measured on seed 1: the same machine without `[motor.saturation]` passes at 5 Hz
+/// (0.048 rad); with its saturation the speed loop at 3 Hz passes (0.057 rad; seed 2 0.046),
+/// at 4 Hz 0.134 rad with the speed 4.6 r/min off (beyond the scenario's 4.1), at 1 Hz
+/// 0.050 rad; T2S-2 raised to 70 / 140 Hz loses it (1.50 / 3.14 rad).
+#[test]
+#[ignore = "stops max |θ − θ̂| 1.80 / 2.17 rad at seeds 1 / 2 (speed loop limit cycle at 5 Hz on the saturating model; 0.057 rad at 3 Hz)"]
+fn a_heavy_saturated_rotor_holds_its_angle_through_stops() {
+    for seed in [1, 2] {
+        let text = format!(
+            "{}\n[current_sensor]\nseed = {seed}\n",
+            drawn("ipm-sat-9p-800v-192kw")
+        );
+        let out = simulate("stops", Some(&text), false, None).unwrap();
+        let max_error = out.metrics.max_angle_error;
+        println!("seed {seed}: max {max_error:.3} rad, {:?}", out.checks);
+        assert!(out.passed && max_error < 0.25, "seed {seed}: {max_error}");
+    }
+}
