@@ -102,6 +102,10 @@
 //! stiffness needs ("The current loop it needs"; at 250 Hz the multirotor runs 0.63 rad back,
 //! |θ − θ̂| 0.40 rad) and T2S-1 tracking the fall from the trigger on
 //! ([`ReleaseHoldTuning::track_fall`]; with the standstill's bandwidth |θ − θ̂| 0.30 rad).
+//! A hold armed at a brake's release that opens on a moving reference does the same, on the
+//! angle it watches: a drawn 24 kW, 6-pole-pair IPMSM of 1.01 kg·m² ready 41 / 78 ms into
+//! `loaded-start`'s ramp (`crates/fado-sim/tests/data/drawn/`) runs 0.23 / 0.20 rad back under
+//! the rated load; left to the speed loop, 8.5 / 8.2 rad.
 //!
 //! # Through the loaded standstill
 //! The speed loop that takes over is a PI on the speed estimate, of 5 Hz: it has no integral
@@ -626,12 +630,12 @@ impl<T: Real> ReleaseHold<T> {
         self.ts
     }
 
-    /// Armed at the start-up's end on a moving reference `speed_ref` and not acting: the held
-    /// angle follows θ̂ (`theta_tracked`) wherever it goes further along the reference (module
-    /// docs, "On a moving reference"). The reference's direction, ±1; 0 at a zero or
-    /// non-finite reference, after a release or a motion the start-up saw.
-    fn follow(&mut self, speed_ref: T, theta_tracked: T) -> T {
-        let follows = speed_ref != T::zero() && !self.released && !self.engaged_by_motion;
+    /// Armed (at the start-up's end or at a brake's release) on a moving reference `speed_ref`
+    /// and not acting: the held angle follows the watched angle (`watched`) wherever it goes
+    /// further along the reference (module docs, "On a moving reference"). The reference's
+    /// direction, ±1; 0 at a zero or non-finite reference or after a motion the start-up saw.
+    fn follow(&mut self, speed_ref: T, watched: T) -> T {
+        let follows = speed_ref != T::zero() && !self.engaged_by_motion;
         // NaN compares false: a non-finite reference has no direction.
         let sense = if !follows || !speed_ref.is_finite() {
             T::zero()
@@ -641,10 +645,10 @@ impl<T: Real> ReleaseHold<T> {
             -T::one()
         };
         if sense != T::zero() && !self.active {
-            let ahead = crate::wrap_angle(theta_tracked - self.theta_hold) * sense;
-            // NaN compares false: a non-finite tracked angle leaves it.
+            let ahead = crate::wrap_angle(watched - self.theta_hold) * sense;
+            // NaN compares false: a non-finite watched angle leaves it.
             if ahead > T::zero() {
-                self.theta_hold = crate::wrap_angle(theta_tracked);
+                self.theta_hold = crate::wrap_angle(watched);
             }
         }
         sense
@@ -708,12 +712,18 @@ impl<T: Real> ReleaseHold<T> {
         // once; armed at the start-up's end, a moving reference leaves it armed for a fall
         // against it (module docs, "On a moving reference").
         let moving_ref = speed_ref != T::zero();
-        let sense = self.follow(speed_ref, theta_tracked);
+        // Armed at a brake's release on a saturating model or capped (`fall`), the hold
+        // watches the direct angle its loop holds (the tracked one lags a falling rotor by
+        // milliseconds; module docs, "When").
+        let on_direct = self.released && (self.release_on_direct || self.fall_gain > T::zero());
+        let watched = if on_direct { theta } else { theta_tracked };
+        let sense = self.follow(speed_ref, watched);
         let e = crate::wrap_angle(self.theta_hold - theta);
         let omega = self.omega;
         let settled = self.settles(moving_ref);
-        // A settled hold triggered at zero reference hands over as the reference leaves zero.
-        let leave = moving_ref && !self.engaged_by_motion && (self.released || self.active);
+        // A settled hold triggered at zero reference hands over as the reference leaves zero;
+        // one armed and not acting stays armed for a fall against the reference.
+        let leave = moving_ref && !self.engaged_by_motion && self.active;
         if leave || settled || !e.is_finite() || !omega.is_finite() {
             let was = self.active;
             if was && self.engaged_by_motion {
@@ -729,10 +739,7 @@ impl<T: Real> ReleaseHold<T> {
         }
         if !self.active {
             self.elapsed = self.elapsed.saturating_add(1);
-            // Armed at a brake's release on a saturating model or capped (`fall`), the hold
-            // watches the direct angle its loop holds (the tracked one lags a falling rotor by
-            // milliseconds; module docs, "When"); a saturating model within its own window.
-            let on_direct = self.released && (self.release_on_direct || self.fall_gain > T::zero());
+            // A saturating model watches within its own window.
             let window = if self.released && self.release_on_direct {
                 self.release_window_samples
             } else {
@@ -742,7 +749,6 @@ impl<T: Real> ReleaseHold<T> {
                 self.disarm();
                 return HoldAction::Idle;
             }
-            let watched = if on_direct { theta } else { theta_tracked };
             let moved = crate::wrap_angle(self.theta_hold - watched);
             // NaN compares false: a non-finite angle does not trigger.
             // On a moving reference only a fall against it triggers (the rotor's lag behind

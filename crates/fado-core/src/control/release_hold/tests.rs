@@ -383,6 +383,41 @@ fn at_the_start_ups_end_a_fall_against_a_moving_reference_is_held() {
 }
 
 #[test]
+fn a_brake_released_on_a_moving_reference_is_held_against_a_fall() {
+    // The application opens its brake after its reference has left zero: the hold stays
+    // armed, follows a rotor that goes along the reference and holds a fall against it as a
+    // motion, the reference resuming from zero.
+    let m = MachineModel::<f64>::paper();
+    let t = ReleaseHoldTuning::<f64> {
+        enabled: true,
+        ..Default::default()
+    };
+    let mut h = ReleaseHold::new(&t, &m, 1e-4, 250.0, 40.0).unwrap();
+    h.arm_at_release(1.0);
+    for k in 0..100 {
+        let theta = 1.0 + 1e-3 * k as f64;
+        assert_eq!(h.step(10.0, theta, theta), HoldAction::Idle, "at {k}");
+        assert!(h.awaiting_fall() && h.tracking_fall(), "at {k}");
+    }
+    let top = 1.0 + 1e-3 * 99.0;
+    assert_eq!(h.step(10.0, top - 0.015, top - 0.015), HoldAction::Idle);
+    let fall = top - 0.025;
+    assert!(matches!(h.step(10.0, fall, fall), HoldAction::Hold(x) if x > 0.0));
+    assert!(h.active() && h.engaged() == 1);
+    assert_eq!(h.resumed(10.0), 0.0);
+    // Against a backward reference a forward fall triggers; no fall within the window
+    // disarms it.
+    h.arm_at_release(0.0);
+    let fall = 0.025;
+    assert!(matches!(h.step(-10.0, fall, fall), HoldAction::Hold(x) if x < 0.0));
+    h.arm_at_release(0.0);
+    for _ in 0..=h.window_samples {
+        assert_eq!(h.step(10.0, 0.0, 0.0), HoldAction::Idle);
+    }
+    assert!(!h.awaiting_fall());
+}
+
+#[test]
 fn on_a_saturating_model_a_release_hold_triggers_on_the_direct_angle_and_bounds_its_speed() {
     // Armed at a brake's release, a direct angle 0.03 rad from θ_hold (the tracked angle still
     // there) triggers the hold on a saturating model only. A jump of the direct angle by
