@@ -380,6 +380,8 @@ pub struct ReleaseHold<T> {
     max_fall_load: T,
     /// The resumed reference (electrical rad/s).
     resumed: T,
+    /// The stiffness for the load the fall reveals (`fall`, [`Softening`](fall::Softening)).
+    soft: fall::Softening<T>,
 }
 
 impl<T: Real> ReleaseHold<T> {
@@ -395,8 +397,8 @@ impl<T: Real> ReleaseHold<T> {
         let travel = check::positive("release_hold.travel", tuning.travel)?;
         let resume_time = check::positive("release_hold.resume_time", tuning.resume_time)?;
         let p = T::lit(machine.pole_pairs as f64);
-        let omega_rated = machine.rated_speed_rpm * T::two_pi() / T::lit(60.0) * p;
-        let resume_step = omega_rated * ts / resume_time;
+        let resume_step =
+            machine.rated_speed_rpm * T::two_pi() / T::lit(60.0) * p * ts / resume_time;
         let trigger = check::positive("release_hold.trigger", tuning.trigger)?;
         let window = check::non_negative("release_hold.window", tuning.window)?;
         let n = window / ts;
@@ -409,8 +411,7 @@ impl<T: Real> ReleaseHold<T> {
             .step_min(T::lit(0.1) / ts);
         let a_rated = p * machine.rated_torque / machine.inertia;
         let share = fall::fall_share(omega, design);
-        let kp = T::lit(3.0) * omega * omega / b;
-        let kd = T::lit(3.0) * omega / b;
+        let (kp, kd) = (T::lit(3.0) * omega * omega / b, T::lit(3.0) * omega / b);
         let ki_ts = omega * omega * omega * ts / b;
         if !(kp.is_finite() && kd.is_finite() && ki_ts.is_finite() && resume_step.is_finite()) {
             return Err(ConfigError::OutOfRange {
@@ -463,6 +464,7 @@ impl<T: Real> ReleaseHold<T> {
             fall_time: T::zero(),
             fall_gain: share / b,
             max_fall_load: (share * a_rated / b).step_min(i_max),
+            soft: fall::Softening::new(a_rated, design, omega * ts),
         })
     }
 
@@ -525,6 +527,7 @@ impl<T: Real> ReleaseHold<T> {
         self.theta_last = theta_hold;
         self.omega = T::zero();
         self.fall_time = T::zero();
+        self.hold_samples = self.soft.reset();
     }
 
     /// Acts at once, holding `theta_hold` from the rotor's electrical speed `omega` (rad/s:
@@ -691,6 +694,15 @@ impl<T: Real> ReleaseHold<T> {
         self.active && !standstill_hold && done
     }
 
+    /// Armed at a brake's release on a saturating model, the stiffness for the load the
+    /// fall of `fall` (rad, direct angle) since the release reveals ([`fall::Softening`]).
+    fn soften(&mut self, fall: T) {
+        if self.released && self.release_on_direct {
+            let omega_h = self.kp / self.kd;
+            self.hold_samples = self.soft.soften(fall, self.fall_time, omega_h);
+        }
+    }
+
     /// One sample: the speed reference `speed_ref`, the estimator's tracked angle θ̂
     /// (`theta_tracked`, which triggers the hold unless it was armed at a brake's release)
     /// and its direct rotor-flux angle (`theta`, which the loop holds and which triggers a
@@ -764,6 +776,7 @@ impl<T: Real> ReleaseHold<T> {
                 return HoldAction::Idle;
             }
             self.active = true;
+            self.soften(fall);
             if self.released && self.fall_gain > T::zero() {
                 let tracked = crate::wrap_angle(self.theta_hold - theta_tracked);
                 let (gain, lim) = (self.fall_gain, self.max_fall_load);
@@ -776,8 +789,9 @@ impl<T: Real> ReleaseHold<T> {
         }
         self.held = self.held.saturating_add(1);
         let lim = self.i_max;
-        self.integral = crate::control::pi::clamp(self.integral + self.ki_ts * e, -lim, lim);
-        let out = self.kp * e - self.kd * omega + self.integral;
+        let (kp, kd, ki_ts) = self.soft.gains(self.kp, self.kd, self.ki_ts);
+        self.integral = crate::control::pi::clamp(self.integral + ki_ts * e, -lim, lim);
+        let out = kp * e - kd * omega + self.integral;
         self.output = crate::control::pi::clamp(out, -lim, lim);
         HoldAction::Hold(self.output)
     }

@@ -83,3 +83,74 @@ pub(super) fn fall_load<T: Real>(e: T, tracked: T, t: T, gain: T, lim: T) -> T {
         T::zero()
     }
 }
+
+/// The hold's stiffness for the load the fall reveals, armed at a brake's release on a
+/// saturating machine model. The rotor, at rest at the release, falls by e in t: an
+/// acceleration a = 2·e/t². A loop of ω_h·√(a/a_rated) moves it by the design travel under
+/// that load (0.27·a/ω², module docs of the hold), at most the capped ω_h and at least
+/// 1/[`RELEASE_WINDOW_RATIO`](super::RELEASE_WINDOW_RATIO) of the design's (the slowest fall
+/// the release's window takes); it settles in 10 of its own time constants.
+///
+/// # Why
+/// The loop holds the direct angle, which on a saturating model moves with the current as
+/// well as with the rotor (`crate::active_flux`, "The frame coupling"). At the rated load's
+/// stiffness a light load's hold swings the q current through zero, and from there the
+/// direct angle's motion with the current feeds the loop: on the saturated traction IPMSM
+/// (`crates/fado-sim/tests/data/traction-ipm-saturated.toml`) at a quarter of its rated
+/// torque the hold caught the fall at +128 A, the rotor rebounded at 15 r/min, the q
+/// current ran to the −337 A limit within 4 ms while θ̂ moved 0.11 rad with the rotor still,
+/// and the loop cycled between the limits (`loaded-start` seed 1: 0.72 rad back, |θ − θ̂|
+/// 1.0 rad from ready; seeds 3 and 4 lost). The gains scale as k², k and k³ (k the
+/// stiffness's share), so a quarter load's hold has a quarter of the rated one's
+/// proportional gain. Measured (`loaded-start`, a constant load from t = 0, backward travel /
+/// max |θ − θ̂| from ready, rad) in crates/fado-sim/tests/light_load_start.rs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Softening<T> {
+    /// The rated load's electrical acceleration p·T_rated/Ĵ (rad/s²).
+    a_rated: T,
+    /// ω_h before the caps, for the design travel (rad/s).
+    design: T,
+    /// 10/ω_h in samples at the full stiffness.
+    samples: u32,
+    /// The stiffness's share of ω_h (1: the design's).
+    k: T,
+}
+
+impl<T: Real> Softening<T> {
+    /// For the rated load's acceleration `a_rated` (electrical rad/s²), the design's ω_h
+    /// `design` and the loop's ω_h·Ts `omega_ts`.
+    pub(super) fn new(a_rated: T, design: T, omega_ts: T) -> Self {
+        Self {
+            a_rated,
+            design,
+            samples: (T::lit(super::SETTLE_TIMES) / omega_ts).round().to_f64() as u32,
+            k: T::one(),
+        }
+    }
+
+    /// Back to the full stiffness; its settling time in samples.
+    pub(super) fn reset(&mut self) -> u32 {
+        self.k = T::one();
+        self.samples
+    }
+
+    /// The stiffness for a fall of `fall` (rad) in `t` (s) from rest, the loop's ω_h
+    /// `omega_h` (rad/s); the settling time in samples.
+    pub(super) fn soften(&mut self, fall: T, t: T, omega_h: T) -> u32 {
+        let accel = T::lit(2.0) * fall / (t * t);
+        let k = self.design * (accel / self.a_rated).step_sqrt() / omega_h;
+        let floor = T::one() / T::lit(super::RELEASE_WINDOW_RATIO);
+        // NaN compares false: the full stiffness.
+        if !(k.is_finite() && k < T::one()) {
+            return self.samples;
+        }
+        self.k = if k > floor { k } else { floor };
+        (T::lit(self.samples as f64) / self.k).round().to_f64() as u32
+    }
+
+    /// The loop's gains K_p, K_d and K_i·Ts at the stiffness.
+    pub(super) fn gains(&self, kp: T, kd: T, ki_ts: T) -> (T, T, T) {
+        let k = self.k;
+        (kp * k * k, kd * k, ki_ts * k * k * k)
+    }
+}
