@@ -318,7 +318,7 @@ pub struct ReleaseHold<T> {
     window_samples: u32,
     /// Samples after a brake's release within which a fall triggers the hold on a saturating
     /// model: at most `window_samples`, [`RELEASE_WINDOW_RATIO`] times the time the rated
-    /// load's fall takes to reach the trigger.
+    /// load's fall takes to reach the trigger (a NaN time compares false: `window_samples`).
     release_window_samples: u32,
     /// Samples the hold acts before it hands over: [`SETTLE_TIMES`]/ω_h.
     hold_samples: u32,
@@ -361,6 +361,8 @@ pub struct ReleaseHold<T> {
     omega_step: T,
     /// [`SPEED_STEP_ACCELERATION_RATIO`]·b·i_max·Ts, which [`set_saturating`](Self::set_saturating)
     /// makes `omega_step`.
+    /// Samples after the arming within which a fall triggers it (`arm_after_release`).
+    arm_window: u32,
     saturating_omega_step: T,
     /// Armed at a brake's release, triggered by the direct angle (a saturating model, see
     /// [`set_saturating`](Self::set_saturating)) instead of the tracked one.
@@ -426,7 +428,6 @@ impl<T: Real> ReleaseHold<T> {
             ts,
             trigger,
             window_samples: n.round().to_f64() as u32,
-            // NaN compares false: the tuning's window.
             release_window_samples: if release_n < n {
                 release_n.round().to_f64() as u32
             } else {
@@ -456,6 +457,7 @@ impl<T: Real> ReleaseHold<T> {
             omega_gain: ts / (T::one() / (T::lit(5.0) * omega) + ts),
             omega_step: T::zero(),
             saturating_omega_step: T::lit(SPEED_STEP_ACCELERATION_RATIO) * b * i_max * ts,
+            arm_window: n.round().to_f64() as u32,
             release_on_direct: false,
             engaged: 0,
             resume_step,
@@ -514,6 +516,7 @@ impl<T: Real> ReleaseHold<T> {
     /// Arms the hold at the angle `theta_hold` (the alignment's).
     pub fn arm(&mut self, theta_hold: T) {
         self.armed = (self.enabled || self.at_start) && theta_hold.is_finite();
+        self.arm_window = self.window_samples;
         self.released = false;
         self.engaged_by_motion = false;
         self.carrying = false;
@@ -552,6 +555,18 @@ impl<T: Real> ReleaseHold<T> {
             self.active = true;
             self.engaged = self.engaged.saturating_add(1);
         }
+    }
+
+    /// Arms the hold at `theta_hold`, enabled or not, for at least 10/ω_h: the motion test fired
+    /// in the gain calibration's release (`GainCalibration::moved_in_release`). Engaged at once
+    /// on the unloaded 32-pole torque motor (`tests/data/torque-ipm-32p.toml`) its current flips
+    /// sign and rings at 94 Hz; armed, it acts on the load's fall, one-signed.
+    pub fn arm_after_release(&mut self, theta_hold: T) {
+        let enabled = self.enabled;
+        self.enabled = true;
+        self.arm(theta_hold);
+        self.enabled = enabled;
+        self.arm_window = self.window_samples.max(self.hold_samples);
     }
 
     /// The speed loop's reference for the application's `speed_ref` (electrical rad/s): zero
@@ -755,7 +770,7 @@ impl<T: Real> ReleaseHold<T> {
             let window = if self.released && self.release_on_direct {
                 self.release_window_samples
             } else {
-                self.window_samples
+                self.arm_window
             };
             if self.elapsed > window {
                 self.disarm();

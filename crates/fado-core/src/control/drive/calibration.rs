@@ -203,7 +203,9 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             // The same two levels are the classic DC test of Rs: the estimator's R̂s
             // adaptation starts from it if it lies within 0.5–2× of the model's R̂s (a value
             // outside says something else is wrong, and the model's R̂s is kept).
-            if self.gain.status() == GainCalibrationStatus::Calibrated {
+            if self.gain.status() == GainCalibrationStatus::Calibrated
+                || self.gain.moved_in_release()
+            {
                 let r = self.gain.resistance();
                 let r0 = self.config.machine.rs;
                 if r >= r0 * T::lit(0.5) && r <= r0 + r0 {
@@ -214,17 +216,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             self.calibration_compensation = [Ab::zero(); 2];
             let theta0 = self.aligned_angle;
             if self.gain.status() == GainCalibrationStatus::RotorMoved {
-                // A load turns the rotor: the drive starts from where its back-EMF says the
-                // rotor has turned to, and the release hold catches it there before the speed
-                // loop takes over (`ReleaseHold::engage`).
-                let m = &self.config.machine;
-                let saliency = m.ld - m.lq;
-                let turned = self.gain.motion_travel(m.flux_linkage, saliency);
-                let theta = crate::wrap_angle(self.gain_axis() + turned);
-                let omega = self.gain.motion_speed(m.flux_linkage, saliency);
-                self.start_at(theta);
-                self.blocks.hold.engage(theta, omega);
-                return self.last;
+                return self.start_moved();
             }
             self.start_at(theta0);
             return self.last;
@@ -256,6 +248,26 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
         let reference = b.dead_time.trapezoid(i_dq_ref.to_ab(rot).to_abc(), vdc);
         self.calibration_compensation = [reference.to_ab(), self.calibration_compensation[0]];
         self.record(applied, i_dq, i_dq_ref, estimate, i_ab)
+    }
+
+    /// The start after the gain calibration's `RotorMoved`: a load turns the rotor, and the
+    /// drive starts from where its back-EMF says the rotor has turned to, the release hold
+    /// catching it there before the speed loop takes over (`ReleaseHold::engage`). Read in
+    /// the release, the motion is where a load starts to act (or the band's noise): the hold
+    /// is armed there and acts on the fall that follows (`ReleaseHold::arm_after_release`).
+    fn start_moved(&mut self) -> DriveOutput<T> {
+        let m = &self.config.machine;
+        let saliency = m.ld - m.lq;
+        let turned = self.gain.motion_travel(m.flux_linkage, saliency);
+        let theta = crate::wrap_angle(self.gain_axis() + turned);
+        let omega = self.gain.motion_speed(m.flux_linkage, saliency);
+        self.start_at(theta);
+        if self.gain.moved_in_release() {
+            self.blocks.hold.arm_after_release(theta);
+        } else {
+            self.blocks.hold.engage(theta, omega);
+        }
+        self.last
     }
 
     /// The gain calibration's frame (its axis) and what the inverter added to the voltage that

@@ -130,7 +130,11 @@
 //! from the aligned angle plus the turn read ([`GainCalibration::motion_travel`]) with its
 //! release hold engaged
 //! ([`ReleaseHold::engage`](crate::control::release_hold::ReleaseHold::engage)), which catches
-//! the rotor there and hands the load it found to the speed loop. Measured on the presets and
+//! the rotor there and hands the load it found to the speed loop. In the release to zero
+//! current both levels are averaged, with the rotor at rest: a motion read there leaves their
+//! ratio and resistance standing ([`GainCalibration::moved_in_release`]), and the drive arms
+//! the hold there instead, to act on the fall that follows
+//! ([`ReleaseHold::arm_after_release`](crate::control::release_hold::ReleaseHold::arm_after_release)). Measured on the presets and
 //! the machines of that test at rest (switching-resolved, default sensors, five angles): at
 //! most 0.59 of the threshold in voltage mode ([`GainCalibration::motion_peak`]) and 0.48
 //! under the loop ([`GainCalibration::loop_motion_peak`]).
@@ -336,6 +340,9 @@ pub struct GainCalibration<T> {
     /// back-EMF across the axis that ended it (V).
     motion_current: T,
     motion_emf: T,
+    /// The motion test fired in the release to zero current, after both levels were
+    /// averaged with the rotor at rest ([`GainCalibration::moved_in_release`]).
+    moved_in_release: bool,
     /// The voltage-mode motion threshold's floor from the sensors' noise (V,
     /// [`GainCalibration::motion_noise_floor`]).
     noise_floor: T,
@@ -370,8 +377,7 @@ impl<T: Real> GainCalibration<T> {
         };
         let max_hold = check::non_negative("max_hold_time", config.max_hold_time)?;
         let max_hold_samples = samples("max_hold_time", max_hold)?;
-        // Settling and hold are derived from the machine model: beyond the budget (or not
-        // finite, for an absurd model) the calibration is skipped, not refused.
+        // Settling and hold from the model: beyond the budget (or NaN) skipped, not refused.
         let too_slow = !(config.settle_time <= max_hold && config.hold_time <= max_hold);
         let within = |time: T| -> Result<u32, ConfigError> {
             if time >= T::zero() && time <= max_hold {
@@ -427,6 +433,7 @@ impl<T: Real> GainCalibration<T> {
             motion_flux: T::zero(),
             motion_current: T::zero(),
             motion_emf: T::zero(),
+            moved_in_release: false,
             noise_floor: T::zero(),
             motion_peak: T::zero(),
             loop_motion_peak: T::zero(),
@@ -511,6 +518,16 @@ impl<T: Real> GainCalibration<T> {
     /// start the same way, "Rs recalibration", SPRUHJ1, §"Rs Online and Rs Recalibration").
     pub fn resistance(&self) -> T {
         self.resistance
+    }
+
+    /// Whether the run ended [`GainCalibrationStatus::RotorMoved`] in its release to zero
+    /// current, after both levels were averaged with the rotor at rest: their ratio and
+    /// resistance stand ([`ratio`](Self::ratio), [`resistance`](Self::resistance); NaN
+    /// where the levels gave none), and the turn the release read
+    /// ([`motion_travel`](Self::motion_travel)) is where a load starts to act, not one it
+    /// has finished (module docs, "Rotor motion").
+    pub fn moved_in_release(&self) -> bool {
+        self.moved_in_release
     }
 
     /// The share of `swing_window_time` the rotor's swing needs along the axis at `angle`

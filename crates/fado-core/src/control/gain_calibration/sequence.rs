@@ -75,6 +75,7 @@ impl<T: Real> GainCalibration<T> {
         self.sum_v = [Ab::zero(); 2];
         self.count = [0; 2];
         self.aborted = false;
+        self.moved_in_release = false;
         self.cross_ref = T::zero();
         self.cross_filtered = T::zero();
         self.cross_v_ref = T::zero();
@@ -169,11 +170,7 @@ impl<T: Real> GainCalibration<T> {
         if emf.abs() > self.motion_threshold(voltage_mode)
             || window.abs() > self.config.motion_voltage * T::lit(super::LOOP_WINDOW_FACTOR)
         {
-            self.motion_current = self.command().current_d;
-            self.motion_emf = emf;
-            self.stage = Stage::Idle;
-            self.status = GainCalibrationStatus::RotorMoved;
-            self.measured = T::zero() / T::zero();
+            self.end_moving(emf);
             return GainCalibrationCommand {
                 current_d: T::zero(),
                 voltage: None,
@@ -226,6 +223,25 @@ impl<T: Real> GainCalibration<T> {
         };
         self.stage = next;
         self.remaining = samples;
+    }
+
+    /// Ends the run [`GainCalibrationStatus::RotorMoved`] on the back-EMF `emf` (V). In the
+    /// release both levels are averaged, with the rotor at rest (the test watched them):
+    /// their result stands ([`GainCalibration::moved_in_release`]).
+    fn end_moving(&mut self, emf: T) {
+        self.motion_current = self.command().current_d;
+        self.motion_emf = emf;
+        self.moved_in_release = self.stage == Stage::Release && !self.aborted;
+        if self.moved_in_release {
+            self.finish();
+            if self.status != GainCalibrationStatus::Calibrated {
+                self.resistance = T::zero() / T::zero();
+            }
+        } else {
+            self.measured = T::zero() / T::zero();
+        }
+        self.stage = Stage::Idle;
+        self.status = GainCalibrationStatus::RotorMoved;
     }
 
     /// The ratio from the two levels' averages, or why not.
