@@ -58,24 +58,8 @@ fn write_torque(
                  is meant? λf = the V/Hz value / 2π",
             );
         }
-        TorqueSlip::KtRms => {
-            return write!(
-                f,
-                ": `flux_linkage` √2 too large, from a torque constant per A rms converted as \
-                 per A peak (λf = Kt/(1.5·p) where Kt/(1.5·√2·p) is meant)? flux_linkage = \
-                 {:e} Wb (or give Kt as `kt_nm_per_arms`)",
-                flux_linkage / core::f64::consts::SQRT_2
-            );
-        }
-        TorqueSlip::LineRmsAsPhasePeak => {
-            return write!(
-                f,
-                ": `flux_linkage` √(3/2) = 1.22 too large, from a line-to-line rms back-EMF \
-                 taken as the phase peak (λf = E_LL,rms/ω where √2·E_LL,rms/(√3·ω) is \
-                 meant)? flux_linkage = {:e} Wb (or give the constant as \
-                 `ke_vll_rms_per_krpm`)",
-                flux_linkage * 0.816_496_580_927_726_1
-            );
+        TorqueSlip::KtRms | TorqueSlip::LineRmsAsPhasePeak => {
+            return write_flux_undone(f, slip, flux_linkage);
         }
         TorqueSlip::PolePairsHalved => {
             return f.write_str(
@@ -107,6 +91,37 @@ fn write_torque(
              Give λf in Wb peak per phase",
         ),
         _ => f.write_str(": check the units (λf in Wb peak per phase, current in A peak)"),
+    }
+}
+
+/// The slips of λf a factor too large whose text gives the value undone: a Kt per A rms taken
+/// as per A peak (√2), a line-to-line rms constant taken as the phase peak (√(3/2)).
+fn write_flux_undone(
+    f: &mut fmt::Formatter<'_>,
+    slip: TorqueSlip,
+    flux_linkage: f64,
+) -> fmt::Result {
+    match slip {
+        TorqueSlip::KtRms => {
+            write!(
+                f,
+                ": `flux_linkage` √2 too large, from a torque constant per A rms converted as \
+                 per A peak (λf = Kt/(1.5·p) where Kt/(1.5·√2·p) is meant)? flux_linkage = \
+                 {:e} Wb (or give Kt as `kt_nm_per_arms`)",
+                flux_linkage / core::f64::consts::SQRT_2
+            )
+        }
+        TorqueSlip::LineRmsAsPhasePeak => {
+            write!(
+                f,
+                ": `flux_linkage` √(3/2) = 1.22 too large, from a line-to-line rms back-EMF \
+                 taken as the phase peak (λf = E_LL,rms/ω where √2·E_LL,rms/(√3·ω) is \
+                 meant)? flux_linkage = {:e} Wb (or give the constant as \
+                 `ke_vll_rms_per_krpm`)",
+                flux_linkage * 0.816_496_580_927_726_1
+            )
+        }
+        _ => Ok(()),
     }
 }
 
