@@ -165,6 +165,7 @@ fn likely_slip(m: &MachineModel<f64>) -> (TorqueSlip, f64) {
         (TorqueSlip::Rms, with_flux(sqrt2)),
         (TorqueSlip::LineToLine, with_flux(1.0 / sqrt3)),
         (TorqueSlip::KtRms, with_flux(1.0 / sqrt2)),
+        (TorqueSlip::LineRmsAsPhasePeak, with_flux(sqrt2 / sqrt3)),
         (TorqueSlip::PoleCount, with_pole_pairs(m.pole_pairs / 2)),
         (
             TorqueSlip::PolePairsHalved,
@@ -316,12 +317,36 @@ fn check_resistance(m: &MachineModel<f64>, out: &mut impl Sink) {
             Severity::Error => RESISTANCE_ERROR,
             Severity::Warning => 0.5,
         };
+        let speed_rpm = speed_in_rad_per_s(m);
         out.push(Finding::Resistance {
             per_unit: r,
             severity,
-            line_to_line: (0.5 * r <= bound).then_some(0.5 * m.rs),
+            line_to_line: (0.5 * r <= bound && speed_rpm.is_none()).then_some(0.5 * m.rs),
+            speed_rpm,
         });
     }
+}
+
+/// `rated_speed_rpm` × 30/π when the rated speed reads as given in rad/s where r/min is
+/// meant: the rated point then needs under 35 % of the DC link's linear range and, with the
+/// speed undone, 30 % to [`DC_LINK_SHORT`] of it (where the repository's machines sit) and at
+/// least twice what it needs as given (a line-to-line `rs` moves it by its resistive drop
+/// only), with a resistive drop within its warning bound 0.5. None without a DC link.
+fn speed_in_rad_per_s(m: &MachineModel<f64>) -> Option<f64> {
+    if !(m.dc_voltage.is_finite() && m.dc_voltage > 0.0) {
+        return None;
+    }
+    let v_max = m.dc_voltage / 1.732_050_807_568_877_2;
+    let rpm = m.rated_speed_rpm * 30.0 / core::f64::consts::PI;
+    let undone = MachineModel {
+        rated_speed_rpm: rpm,
+        ..*m
+    };
+    let given = ratings::rated_point_voltage(m) / v_max;
+    let fits = ratings::rated_point_voltage(&undone) / v_max;
+    let r = m.rs * m.rated_current / (undone.rated_speed() * flux_base(m));
+    let plausible = (0.3..=DC_LINK_SHORT).contains(&fits) && fits >= 2.0 * given;
+    (given < 0.35 && plausible && r <= 0.5).then_some(rpm)
 }
 
 /// The per-phase winding of `m` if `rs`, `ld` and `lq` are line-to-line values: the halved
@@ -379,15 +404,15 @@ fn check_dc_link(m: &MachineModel<f64>, out: &mut impl Sink) {
             dc_voltage: m.dc_voltage,
             ratio: v,
         });
-    } else if v < 0.1 {
-        out.push(Finding::DcLinkOversized {
-            ratio: v,
-            severity: Severity::Error,
-        });
     } else if v < 0.2 {
         out.push(Finding::DcLinkOversized {
             ratio: v,
-            severity: Severity::Warning,
+            severity: if v < 0.1 {
+                Severity::Error
+            } else {
+                Severity::Warning
+            },
+            speed_rpm: speed_in_rad_per_s(m),
         });
     }
 }
@@ -463,7 +488,11 @@ fn check_torque(m: &MachineModel<f64>, out: &mut impl Sink) {
         // Inside the wide band, but undoing the rms or line-to-line slip brings it to 0.9–1.1.
         let slip = likely_slip(m).0;
         if (ratio > 1.2 && slip == TorqueSlip::Rms)
-            || (ratio < 1.0 && matches!(slip, TorqueSlip::LineToLine | TorqueSlip::KtRms))
+            || (ratio < 1.0
+                && matches!(
+                    slip,
+                    TorqueSlip::LineToLine | TorqueSlip::KtRms | TorqueSlip::LineRmsAsPhasePeak
+                ))
         {
             out.push(Finding::Torque {
                 ratio,

@@ -390,3 +390,245 @@ fn a_motor_without_a_rated_torque_is_refused_with_the_magnet_torque_to_write() {
     assert!(err.contains("lacks `rated_torque`"), "{err}");
     assert!(err.contains("`rated_torque = 2.3415`"), "{err}");
 }
+
+/// Three motors entered from their datasheets (`tests/data/datasheets/`): a 400 W 220 V
+/// servo, a 100 W 24 V flat robot-joint motor and a 24 V robot-joint outrunner.
+const DATASHEETS: [(&str, &str); 3] = [
+    (
+        "delta",
+        include_str!("data/datasheets/delta-ecma-c20604-400w-220v.toml"),
+    ),
+    (
+        "ec60",
+        include_str!("data/datasheets/maxon-ec60flat-100w-24v.toml"),
+    ),
+    (
+        "d6374",
+        include_str!("data/datasheets/odrive-d6374-150kv-24v.toml"),
+    ),
+];
+
+/// `text` with `key`'s value multiplied by `k` (or replaced by `value` when given).
+fn with_key(text: &str, key: &str, f: impl Fn(f64) -> String) -> String {
+    let prefix = format!("{key} = ");
+    let out: Vec<String> = text
+        .lines()
+        .map(|l| match l.strip_prefix(&prefix) {
+            Some(v) => format!("{prefix}{}", f(v.trim().parse().unwrap())),
+            None => l.to_owned(),
+        })
+        .collect();
+    let out = out.join("\n") + "\n";
+    assert_ne!(out, text, "{key}");
+    out
+}
+
+/// The 1-based line of `key = ` in `text`.
+fn line_of(text: &str, key: &str) -> usize {
+    let prefix = format!("{key} = ");
+    text.lines().position(|l| l.starts_with(&prefix)).unwrap() + 1
+}
+
+/// One slip: its name, the text with it, the key it must be named at, whether it is an
+/// error (`None`: an error on one motor, a warning on another, as the slip's size there
+/// makes it), and a piece of the cause the message must give.
+type Slip = (
+    &'static str,
+    String,
+    &'static str,
+    Option<bool>,
+    &'static str,
+);
+
+/// The slips of a user entering `text` by hand, one per row.
+fn slips(text: &str) -> Vec<Slip> {
+    let x = |k: f64| move |v: f64| format!("{:e}", v * k);
+    let sqrt = f64::sqrt;
+    let pi = std::f64::consts::PI;
+    let lq = |t: &str| -> f64 {
+        let l = t.lines().find(|l| l.starts_with("lq = ")).unwrap();
+        l[5..].trim().parse().unwrap()
+    };
+    let ld_swapped = format!("{:e}", 1.5 * lq(text));
+    vec![
+        (
+            "mH",
+            with_key(&with_key(text, "ld", x(1e3)), "lq", x(1e3)),
+            "ld",
+            Some(true),
+            "mH where H is meant",
+        ),
+        (
+            "pole count",
+            with_key(text, "pole_pairs", |p| format!("{}", 2.0 * p)),
+            "pole_pairs",
+            Some(true),
+            "looks like a pole count",
+        ),
+        (
+            "Ke rms as peak",
+            with_key(text, "flux_linkage", x(sqrt(1.5))),
+            "flux_linkage",
+            Some(false),
+            "line-to-line rms back-EMF taken as the phase peak",
+        ),
+        (
+            "Ke line-to-line",
+            with_key(text, "flux_linkage", x(sqrt(3.0))),
+            "flux_linkage",
+            Some(false),
+            "line-to-line constant",
+        ),
+        (
+            "current rms",
+            with_key(text, "rated_current", x(1.0 / sqrt(2.0))),
+            "rated_torque",
+            Some(false),
+            "rms where peak is meant",
+        ),
+        (
+            "rad/s",
+            with_key(text, "rated_speed_rpm", x(pi / 30.0)),
+            "rated_speed_rpm",
+            None,
+            "in rad/s where r/min is meant",
+        ),
+        (
+            "kHz",
+            with_key(text, "switching_frequency", x(1e-3)),
+            "switching_frequency",
+            Some(true),
+            "kHz where Hz is meant",
+        ),
+        (
+            "swapped",
+            with_key(text, "ld", |_| ld_swapped.clone()),
+            "ld",
+            Some(false),
+            "swapped",
+        ),
+        (
+            "kg·cm²",
+            with_key(text, "inertia", x(1e4)),
+            "inertia",
+            Some(false),
+            "kg·cm²",
+        ),
+        (
+            "typo",
+            text.replace("rated_current =", "rated_curent ="),
+            "rated_curent",
+            Some(true),
+            "did you mean `rated_current`",
+        ),
+        (
+            "table",
+            text.replace("switching_frequency", "#")
+                .replace("[motor]\n", "[motor]\nswitching_frequency = 2e4\n"),
+            "switching_frequency",
+            Some(true),
+            "is a key of [inverter]",
+        ),
+        (
+            "quoted",
+            with_key(text, "rs", |v| format!("\"{v}\"")),
+            "rs",
+            Some(true),
+            "a number in quotes",
+        ),
+        (
+            "unit",
+            with_key(text, "rs", |v| format!("\"{v} ohm\"")),
+            "rs",
+            Some(true),
+            "a unit written into the value",
+        ),
+        (
+            "fraction",
+            with_key(text, "pole_pairs", |p| format!("{p:.1}")),
+            "pole_pairs",
+            Some(true),
+            "a whole number is meant",
+        ),
+    ]
+}
+
+/// Each datasheet motor entered correctly is accepted without a word (its closed-loop runs:
+/// `datasheet_motors.rs`); each slip a user makes entering it is named at its key's line with
+/// its cause, as an error where the run would be wrong by far, a warning where the value is
+/// possible.
+#[test]
+fn datasheet_motors_are_accepted_and_each_slip_is_named_at_its_line_with_its_cause() {
+    for (name, text) in DATASHEETS {
+        let (code, err, _) = dump_text(name, text);
+        assert_eq!(code, Some(0), "{name}: {err}");
+        assert!(!err.contains("warning"), "{name}: {err}");
+        for (slip, slipped, key, error, cause) in slips(text) {
+            let (code, err, path) = dump_text(
+                &format!("{name}-{}", slip.replace(['/', '·', '²'], "")),
+                &slipped,
+            );
+            let expected = match error {
+                Some(true) => code == Some(2),
+                Some(false) => code == Some(0),
+                None => matches!(code, Some(0 | 2)),
+            };
+            assert!(expected, "{name} {slip}: {code:?} {err}");
+            let error = code == Some(2);
+            let what = if error { "error: " } else { "warning: " };
+            let line = line_of(&slipped, key);
+            let at = format!("{}:{line}:", path.display());
+            let named = err.lines().any(|l| {
+                let l = l.strip_prefix("error: ").unwrap_or(l);
+                l.starts_with(&at) && (error || l.contains(what)) && l.contains(cause)
+            });
+            assert!(named, "{name} {slip}: {at} {what}{cause}\n{err}");
+        }
+    }
+}
+
+/// A datasheet motor without `switching_frequency` or `viscous_friction` runs with both
+/// derived, `--dump-config` printing each with its rule; without its ratings it is refused
+/// naming them.
+#[test]
+fn datasheet_motors_without_carrier_friction_or_ratings_are_derived_or_refused() {
+    for (name, text) in DATASHEETS {
+        let bare: String = text
+            .lines()
+            .filter(|l| !l.starts_with("switching_frequency") && !l.starts_with("inertia"))
+            .map(|l| format!("{l}\n"))
+            .collect();
+        let dir = scratch(&format!("{name}-bare"));
+        let path = dir.join("m.toml");
+        std::fs::write(&path, &bare).unwrap();
+        let out = Command::new(env!("CARGO_BIN_EXE_fado-sim"))
+            .args(["run", "reversal", "--dump-config", "--config"])
+            .arg(&path)
+            .output()
+            .unwrap();
+        let dumped = String::from_utf8_lossy(&out.stdout);
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{name}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        for key in ["switching_frequency", "viscous_friction", "inertia"] {
+            let line = dumped
+                .lines()
+                .find(|l| l.starts_with(&format!("{key} = ")))
+                .unwrap_or_else(|| panic!("{name}: {key}\n{dumped}"));
+            assert!(line.contains("# derived: "), "{name}: {line}");
+        }
+        let unrated: String = text
+            .lines()
+            .filter(|l| !l.starts_with("rated_"))
+            .map(|l| format!("{l}\n"))
+            .collect();
+        let (code, err, _) = dump_text(&format!("{name}-unrated"), &unrated);
+        assert_eq!(code, Some(2), "{name}: {err}");
+        for key in ["`rated_current`", "`rated_speed_rpm`", "`rated_torque`"] {
+            assert!(err.contains(key), "{name}: {key}\n{err}");
+        }
+    }
+}

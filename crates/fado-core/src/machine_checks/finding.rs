@@ -14,6 +14,9 @@ pub enum TorqueSlip {
     /// λf √2 too large: a torque constant per A rms (a datasheet's Kt) converted as per A
     /// peak, λf = Kt/(1.5·p) where Kt/(1.5·√2·p) is meant.
     KtRms,
+    /// λf √(3/2) = 1.22 too large: a back-EMF constant in V rms line-to-line taken as the
+    /// phase peak (λf = E_LL,rms/ω where E_LL,rms·√2/(√3·ω) is meant).
+    LineRmsAsPhasePeak,
     /// The pole count given for the pole pairs: twice too many.
     PoleCount,
     /// Half the pole pairs (a sheet's pole-pair count read as the poles): the model is half
@@ -108,6 +111,9 @@ pub enum Finding {
         ratio: f64,
         /// Warning or error.
         severity: Severity,
+        /// `rated_speed_rpm` × 30/π when the rated speed reads as given in rad/s: with it the
+        /// rated point fits the link and the resistance its warning bound.
+        speed_rpm: Option<f64>,
     },
     /// The rated point needs more voltage than the DC link makes: rated speed at rated
     /// current only by field weakening.
@@ -148,6 +154,9 @@ pub enum Finding {
         /// Rs/2, Ω, when the resistance halved (a line-to-line value for the phase's) is
         /// within the bound of this severity.
         line_to_line: Option<f64>,
+        /// `rated_speed_rpm` × 30/π when the rated speed reads as given in rad/s (as for
+        /// [`Finding::DcLinkOversized`]); the likelier slip then, named first.
+        speed_rpm: Option<f64>,
     },
     /// The electrical time constant is long.
     TimeConstant {
@@ -287,6 +296,8 @@ const DC_LINK_SHORT_KEYS: &[&str] = &[
     "rs",
 ];
 const RESISTANCE_KEYS: &[&str] = &["rs", "rated_current", "flux_linkage", "rated_speed_rpm"];
+const RESISTANCE_KEYS_SPEED_FIRST: &[&str] =
+    &["rated_speed_rpm", "rs", "rated_current", "flux_linkage"];
 const TAU_KEYS: &[&str] = &["rs", "ld", "lq"];
 const LD_LQ: &[&str] = &["ld", "lq"];
 const SAMPLING_KEYS: &[&str] = &["ts", "rated_speed_rpm", "pole_pairs"];
@@ -362,7 +373,8 @@ impl Finding {
                     TorqueSlip::KeVllRms
                     | TorqueSlip::KeVllPeak
                     | TorqueSlip::VoltsPerHertz
-                    | TorqueSlip::KtRms,
+                    | TorqueSlip::KtRms
+                    | TorqueSlip::LineRmsAsPhasePeak,
                 ..
             } => TORQUE_KEYS_FLUX_FIRST,
             Finding::Torque {
@@ -381,6 +393,9 @@ impl Finding {
                     &["lq", "rated_current", "flux_linkage"]
                 }
             }
+            Finding::Resistance {
+                speed_rpm: Some(_), ..
+            } => RESISTANCE_KEYS_SPEED_FIRST,
             Finding::Resistance { .. } => RESISTANCE_KEYS,
             Finding::TimeConstant { .. } => TAU_KEYS,
             Finding::Saliency { .. } => LD_LQ,

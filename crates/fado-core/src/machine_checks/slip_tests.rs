@@ -200,3 +200,94 @@ fn a_flux_linkage_from_a_kt_per_ampere_rms_taken_as_peak_is_named_with_its_value
     assert!(matches!(f, Finding::Torque { .. }), "{f}");
     assert!(f.to_string().contains("line-to-line constant"), "{f}");
 }
+
+/// A line-to-line rms back-EMF constant taken as the phase peak (λf = E_LL,rms/ω where
+/// √2·E_LL,rms/(√3·ω) is meant: √(3/2) = 1.22 too large) puts the rated torque at 0.80–0.82 ×
+/// the model's, inside the wide band: on the 1FT6084 and the 400 W servo the warning names
+/// `flux_linkage` with the value undone; the other λf slips keep their own names.
+#[test]
+fn a_flux_linkage_from_a_line_to_line_rms_constant_taken_as_peak_is_named_with_its_value() {
+    for m in [servo_1ft6084(), servo_400w()] {
+        assert!(check(&m, None).is_empty(), "{}", first(&m, None));
+        let slip = MachineModel {
+            flux_linkage: m.flux_linkage * 1.5f64.sqrt(),
+            ..m
+        };
+        let f = first(&slip, None);
+        assert!(
+            matches!(
+                f,
+                Finding::Torque {
+                    slip: TorqueSlip::LineRmsAsPhasePeak,
+                    ..
+                }
+            ),
+            "{f}"
+        );
+        assert_eq!((f.key(), f.severity()), ("flux_linkage", Severity::Warning));
+        let text = f.to_string();
+        assert!(
+            text.contains("line-to-line rms back-EMF taken as the phase peak"),
+            "{text}"
+        );
+        let given: f64 = text
+            .split("flux_linkage = ")
+            .nth(1)
+            .and_then(|s| s.split(' ').next())
+            .and_then(|v| v.parse().ok())
+            .expect("the value undone");
+        assert!((given / m.flux_linkage - 1.0).abs() < 1e-12, "{text}");
+    }
+    let kt = MachineModel {
+        flux_linkage: servo_400w().flux_linkage * 2f64.sqrt(),
+        ..servo_400w()
+    };
+    let f = first(&kt, None);
+    assert!(
+        matches!(
+            f,
+            Finding::Torque {
+                slip: TorqueSlip::KtRms,
+                ..
+            }
+        ),
+        "{f}"
+    );
+}
+
+/// A rated speed in rad/s where r/min is meant (× π/30): the 400 W servo's rated point then
+/// needs 8 % of its 310 V link (an error), the 1FT6084's 11 %; the finding blames
+/// `rated_speed_rpm` and gives the speed undone, not a line-to-line `rs`. Ratings divided by
+/// 10 (which the speed undone can fit too) stay named.
+#[test]
+fn a_rated_speed_in_rad_per_s_is_named_with_the_speed_it_means() {
+    for m in [servo_400w(), servo_1ft6084()] {
+        let slip = MachineModel {
+            rated_speed_rpm: m.rated_speed_rpm * core::f64::consts::PI / 30.0,
+            ..m
+        };
+        let findings = check(&slip, None);
+        let dc = findings
+            .iter()
+            .find(|f| matches!(f, Finding::DcLinkOversized { .. }))
+            .expect("the DC link's finding");
+        assert_eq!(dc.key(), "rated_speed_rpm");
+        let text = dc.to_string();
+        assert!(
+            text.contains(&std::format!("rated_speed_rpm = {:.0}", m.rated_speed_rpm)),
+            "{text}"
+        );
+        for f in findings.iter() {
+            if let Finding::Resistance { line_to_line, .. } = f {
+                assert_eq!(*line_to_line, None, "{f}");
+                assert_eq!(f.key(), "rated_speed_rpm", "{f}");
+            }
+        }
+    }
+    let mut tenth = servo_400w();
+    tenth.rated_current /= 10.0;
+    tenth.rated_speed_rpm /= 10.0;
+    tenth.rated_torque /= 10.0;
+    let f = first(&tenth, None);
+    assert!(f.to_string().contains("divided by 10"), "{f}");
+}

@@ -58,14 +58,8 @@ fn write_torque(
                  is meant? λf = the V/Hz value / 2π",
             );
         }
-        TorqueSlip::KtRms => {
-            return write!(
-                f,
-                ": `flux_linkage` √2 too large, from a torque constant per A rms converted as \
-                 per A peak (λf = Kt/(1.5·p) where Kt/(1.5·√2·p) is meant)? flux_linkage = \
-                 {:e} Wb (or give Kt as `kt_nm_per_arms`)",
-                flux_linkage / core::f64::consts::SQRT_2
-            );
+        TorqueSlip::KtRms | TorqueSlip::LineRmsAsPhasePeak => {
+            return write_flux_undone(f, slip, flux_linkage);
         }
         TorqueSlip::PolePairsHalved => {
             return f.write_str(
@@ -97,6 +91,37 @@ fn write_torque(
              Give λf in Wb peak per phase",
         ),
         _ => f.write_str(": check the units (λf in Wb peak per phase, current in A peak)"),
+    }
+}
+
+/// The slips of λf a factor too large whose text gives the value undone: a Kt per A rms taken
+/// as per A peak (√2), a line-to-line rms constant taken as the phase peak (√(3/2)).
+fn write_flux_undone(
+    f: &mut fmt::Formatter<'_>,
+    slip: TorqueSlip,
+    flux_linkage: f64,
+) -> fmt::Result {
+    match slip {
+        TorqueSlip::KtRms => {
+            write!(
+                f,
+                ": `flux_linkage` √2 too large, from a torque constant per A rms converted as \
+                 per A peak (λf = Kt/(1.5·p) where Kt/(1.5·√2·p) is meant)? flux_linkage = \
+                 {:e} Wb (or give Kt as `kt_nm_per_arms`)",
+                flux_linkage / core::f64::consts::SQRT_2
+            )
+        }
+        TorqueSlip::LineRmsAsPhasePeak => {
+            write!(
+                f,
+                ": `flux_linkage` √(3/2) = 1.22 too large, from a line-to-line rms back-EMF \
+                 taken as the phase peak (λf = E_LL,rms/ω where √2·E_LL,rms/(√3·ω) is \
+                 meant)? flux_linkage = {:e} Wb (or give the constant as \
+                 `ke_vll_rms_per_krpm`)",
+                flux_linkage * 0.816_496_580_927_726_1
+            )
+        }
+        _ => Ok(()),
     }
 }
 
@@ -204,6 +229,7 @@ fn write_resistance(f: &mut fmt::Formatter<'_>, finding: &Finding) -> fmt::Resul
     let Finding::Resistance {
         per_unit,
         line_to_line,
+        speed_rpm,
         ..
     } = *finding
     else {
@@ -214,6 +240,9 @@ fn write_resistance(f: &mut fmt::Formatter<'_>, finding: &Finding) -> fmt::Resul
         "`rs` drops {per_unit:.3} × the rated back-EMF at `rated_current` (Rs·I/(ω·λf) from \
          `flux_linkage` and `rated_speed_rpm`; machines have 0.005–0.3)"
     )?;
+    if let Some(rpm) = speed_rpm {
+        write!(f, "; {}", SpeedInRadPerS(rpm))?;
+    }
     if let Some(rs) = line_to_line {
         write!(
             f,
@@ -246,17 +275,42 @@ fn write_resistance(f: &mut fmt::Formatter<'_>, finding: &Finding) -> fmt::Resul
     }
 }
 
+/// The rad/s-for-r/min slip of the rated speed, with the speed it meant.
+struct SpeedInRadPerS(f64);
+
+impl fmt::Display for SpeedInRadPerS {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "`rated_speed_rpm` in rad/s where r/min is meant? rated_speed_rpm = {:.0} (× 30/π) \
+             fits the DC link and the winding",
+            self.0
+        )
+    }
+}
+
 /// The text of [`Finding::DcLinkOversized`], [`Finding::DcLinkShort`] and
 /// [`Finding::DcLinkMains`].
 fn write_dc_link(f: &mut fmt::Formatter<'_>, finding: &Finding) -> fmt::Result {
     match *finding {
-        Finding::DcLinkOversized { ratio, .. } => write!(
-            f,
-            "the rated point (`rated_speed_rpm`, `rated_current`, `rated_torque`) needs only \
-             {:.1} % of the phase voltage the DC link `dc_voltage` makes (Vdc/√3): are the \
-             ratings divided by 10, or the DC link the wrong one?",
-            100.0 * ratio
-        ),
+        Finding::DcLinkOversized {
+            ratio, speed_rpm, ..
+        } => {
+            write!(
+                f,
+                "the rated point (`rated_speed_rpm`, `rated_current`, `rated_torque`) needs \
+                 only {:.1} % of the phase voltage the DC link `dc_voltage` makes (Vdc/√3): ",
+                100.0 * ratio
+            )?;
+            match speed_rpm {
+                Some(rpm) => write!(
+                    f,
+                    "{}; or are the ratings divided by 10?",
+                    SpeedInRadPerS(rpm)
+                ),
+                None => f.write_str("are the ratings divided by 10, or the DC link the wrong one?"),
+            }
+        }
         Finding::DcLinkShort {
             needed,
             available,

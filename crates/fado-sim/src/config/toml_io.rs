@@ -53,8 +53,9 @@ impl SimConfig {
         // Check the user's document on its own first, so that errors (unknown keys, wrong
         // types) name the key the user wrote and point at it.
         if saturation.is_some() || flux_map.is_some() || !converted.is_empty() {
-            SimConfig::deserialize(toml::Value::Table(user.clone()))
-                .map_err(|e| with_unknown_key_hint(key_error(e)).located_in(text))?;
+            SimConfig::deserialize(toml::Value::Table(user.clone())).map_err(|e| {
+                with_type_hint(with_unknown_key_hint(key_error(e))).located_in(text)
+            })?;
         } else {
             toml::from_str::<SimConfig>(text).map_err(|e| located(text, e))?;
         }
@@ -153,7 +154,7 @@ fn located(text: &str, e: toml::de::Error) -> SimConfigError {
             k
         }
     };
-    err = with_unknown_key_hint(err);
+    err = with_type_hint(with_unknown_key_hint(err));
     if let Some(at) = start {
         syntax_hint(text, at, &mut err);
     }
@@ -171,6 +172,56 @@ pub(crate) fn with_unknown_key_hint(mut err: SimConfigError) -> SimConfigError {
     let hint = wrong_table_hint(&err.key)
         .or_else(|| meant_key_hint(&err.key, &err.message))
         .or_else(|| datasheet_hint(&err.key));
+    if let Some(hint) = hint {
+        err.message.push_str(&hint);
+    }
+    err
+}
+
+/// `err` (a value of the wrong type) with its usual cause: a number in quotes (`rs = "0.5"`),
+/// a unit written into the value (`rs = "0.5 ohm"`), a whole number written with a fraction
+/// (`pole_pairs = 7.0`).
+pub(crate) fn with_type_hint(mut err: SimConfigError) -> SimConfigError {
+    let Some(rest) = err.message.strip_prefix("invalid type: ") else {
+        return err;
+    };
+    let whole = rest.ends_with("expected u32") || rest.ends_with("expected u64");
+    let hint = if let Some(value) = rest
+        .strip_prefix("string \"")
+        .and_then(|s| s.split_once("\", expected"))
+        .map(|(v, _)| v.trim().to_owned())
+    {
+        let number: String = value
+            .chars()
+            .take_while(|c| c.is_ascii_digit() || matches!(c, '.' | '-' | '+' | 'e' | 'E'))
+            .collect();
+        if value.parse::<f64>().is_ok() {
+            Some(format!(
+                ": a number in quotes? Write it without them ({value})"
+            ))
+        } else if !number.is_empty() && number.parse::<f64>().is_ok() {
+            Some(format!(
+                ": a unit written into the value? Write the number alone ({number}), in the \
+                 key's SI unit (docs/guide/your-motor.md)"
+            ))
+        } else {
+            None
+        }
+    } else if let Some(value) = rest
+        .strip_prefix("floating point `")
+        .and_then(|s| s.split_once('`'))
+        .map(|(v, _)| v)
+        .filter(|_| whole)
+    {
+        match value.parse::<f64>() {
+            Ok(v) if v.fract() == 0.0 && v > 0.0 => Some(format!(
+                ": a whole number is meant: write {v:.0} (without the decimal point)"
+            )),
+            _ => Some(": a whole number is meant (for `pole_pairs`: half the pole count)".into()),
+        }
+    } else {
+        None
+    };
     if let Some(hint) = hint {
         err.message.push_str(&hint);
     }
