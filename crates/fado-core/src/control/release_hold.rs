@@ -764,43 +764,8 @@ impl<T: Real> ReleaseHold<T> {
                 HoldAction::Idle
             };
         }
-        if !self.active {
-            self.elapsed = self.elapsed.saturating_add(1);
-            // A saturating model watches within its own window.
-            let window = if self.released && self.release_on_direct {
-                self.release_window_samples
-            } else {
-                self.arm_window
-            };
-            if self.elapsed > window {
-                self.disarm();
-                return HoldAction::Idle;
-            }
-            let moved = crate::wrap_angle(self.theta_hold - watched);
-            // NaN compares false: a non-finite angle does not trigger.
-            // On a moving reference only a fall against it triggers (the rotor's lag behind
-            // the reference's angle is the speed loop's to close).
-            let fall = if sense == T::zero() {
-                moved.abs()
-            } else {
-                moved * sense
-            };
-            self.fall_time += self.ts;
-            let triggered = fall > self.trigger;
-            if !triggered {
-                return HoldAction::Idle;
-            }
-            self.active = true;
-            self.soften(fall);
-            if self.released && self.fall_gain > T::zero() {
-                let tracked = crate::wrap_angle(self.theta_hold - theta_tracked);
-                let (gain, lim) = (self.fall_gain, self.max_fall_load);
-                self.integral = fall::fall_load(e, tracked, self.fall_time, gain, lim);
-            }
-            // A fall against a moving reference is held as a motion the start-up saw: until
-            // settled, then the reference resumes from zero.
-            self.engaged_by_motion = sense != T::zero();
-            self.engaged = self.engaged.saturating_add(1);
+        if !self.active && !self.watch(sense, watched, theta_tracked, e) {
+            return HoldAction::Idle;
         }
         self.held = self.held.saturating_add(1);
         let lim = self.i_max;
@@ -814,6 +779,7 @@ impl<T: Real> ReleaseHold<T> {
 
 mod fall;
 mod tuning;
+mod watch;
 
 #[cfg(test)]
 mod tests;
