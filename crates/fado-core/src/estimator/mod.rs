@@ -31,7 +31,7 @@
 //!   slow laws' state and sums, the counters and flags) and what the user changes at run
 //!   time: R̂s ([`EstimatorState::set_rs_hat`], the adaptation) with what the adaptation
 //!   derives from the R0 it restarts from, λ̂f (its law), the adaptation's and the k_df
-//!   switches. At most 256 B in `f32` (`state_size`, docs/results/firmware-cost.md).
+//!   switches. At most 368 B in `f32` (`state_size`, docs/results/firmware-cost.md).
 //!
 //! [`EstimatorState::step`] / [`EstimatorState::step_lean`] take the parameters by
 //! reference: the firmware path, with the parameters built once (in a `static`, never copied
@@ -225,7 +225,7 @@ pub struct EstimatorParams<T: Real> {
 /// counters. Run-time settings live here too: R̂s (`set_rs_hat`, the adaptation), λ̂f (its
 /// law), the adaptation's on switch (`enable_rs_adaptation`) and the k_df switch. Stepped
 /// with [`EstimatorState::step`] / [`EstimatorState::step_lean`] and the
-/// [`EstimatorParams`] it was made for; `size_of` is 312 B or less in `f32`
+/// [`EstimatorParams`] it was made for; `size_of` is 368 B or less in `f32`
 /// (docs/results/firmware-cost.md).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EstimatorState<T: Real> {
