@@ -298,9 +298,8 @@ fn the_saturated_traction_ipmsm_holds_its_rated_load_at_the_release() {
 /// θ̂ settles 0.13 rad off under the brake and the rotor is lost (2.18 rad back).
 #[test]
 #[ignore = "seed 2 runs 0.539 rad back (limit 0.5; max |θ − θ̂| from ready 0.196 rad, angle \
-            found 0.0004 rad off) with the release hold's stiffness taken from the fall, \
-            which reads the rated load's early fall as a lighter one; 0.309 rad with the \
-            capped hold"]
+            found 0.0004 rad off) with the release hold's stiffness taken from the fall \
+            (0.309 rad with the capped hold)"]
 fn the_saturated_traction_ipmsm_holds_its_load_at_a_start_angle_that_starves_a_phase() {
     let toml = made_up("traction-ipm-saturated");
     lifts("traction-ipm-saturated", &toml, 2);
