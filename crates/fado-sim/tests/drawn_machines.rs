@@ -27,15 +27,18 @@ fn loaded_start(name: &str, seed: u64) -> (bool, f64, f64, f64) {
     (out.passed, found, st.max_angle_error, st.max_backward)
 }
 
+/// The drawn IPMSMs whose axes meet at the rated current (the tests below).
+const AXES_MEET_AT_RATED: [&str; 3] = [
+    "ipm-sat-3p-134v-127w",
+    "ipm-sat-12p-170v-1558w",
+    "ipm-sat-15p-800v-137kw",
+];
+
 #[test]
 fn saturated_rotors_whose_axes_meet_at_the_rated_current_find_their_angle_below_it() {
     // The three machines of the test below: the pulse below the rated current finds the angle
     // within 0.05 rad on seeds 1 and 2 (the start's other criteria are the test below's).
-    for name in [
-        "ipm-sat-3p-134v-127w",
-        "ipm-sat-12p-170v-1558w",
-        "ipm-sat-15p-800v-137kw",
-    ] {
+    for name in AXES_MEET_AT_RATED {
         let cfg = scenario_config("loaded-start", Some(&drawn(name)), false).unwrap();
         let m = cfg.machine_model();
         assert_eq!(pulse_current_share(&m, m.rated_current), 0.75, "{name}");
@@ -59,11 +62,7 @@ fn saturated_rotors_whose_axes_meet_at_the_rated_current_pulse_below_it() {
     // off) and ran 70 / 77 rad backwards under its load; the 137 kW one 0.071 rad at seed 1.
     // Measured at 0.75 of the rated current: found within 0.001–0.012 rad, max |θ − θ̂| from
     // ready 0.044–0.112 rad, backward travel 0.20–0.34 rad.
-    for name in [
-        "ipm-sat-3p-134v-127w",
-        "ipm-sat-12p-170v-1558w",
-        "ipm-sat-15p-800v-137kw",
-    ] {
+    for name in AXES_MEET_AT_RATED {
         let cfg = scenario_config("loaded-start", Some(&drawn(name)), false).unwrap();
         let m = cfg.machine_model();
         let share = pulse_current_share(&m, m.rated_current);
