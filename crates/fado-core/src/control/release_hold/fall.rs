@@ -145,7 +145,9 @@ impl<T: Real> Softening<T> {
             return self.samples;
         }
         self.k = if k > floor { k } else { floor };
-        (T::lit(self.samples as f64) / self.k).round().to_f64() as u32
+        // k ∈ [floor, 1]: a finite count; one conversion instruction in the per-sample path.
+        let n = (T::from_index(self.samples as usize) / self.k).round();
+        n.index_floor(u32::MAX as usize) as u32
     }
 
     /// The loop's gains K_p, K_d and K_i·Ts at the stiffness.
