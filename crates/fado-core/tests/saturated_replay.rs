@@ -713,7 +713,7 @@ fn stop_replay_error(plant: &MachineModel<f64>) -> f64 {
 /// separates a ripple at the electrical frequency from the speed only while that frequency
 /// moves slowly against the notch's own bandwidth (`fado_core::speed_notch`, "The chirp"): through the stop's change of
 /// deceleration at a low electrical frequency it removes nothing. Measured: 0.012 (IPMSM),
-/// 0.037 (PM-SyRM), 0.052 (its map), 0.052 (automotive), 0.167 rad (ferrite); without the
+/// 0.048 (PM-SyRM), 0.059 (its map), 0.053 (automotive), 0.185 rad (ferrite); without the
 /// estimator's frame-rate correction 0.012, 0.074, 0.088, 0.053 and 0.187.
 #[test]
 fn a_stop_at_the_current_limit_while_generating_holds_the_angle() {
@@ -1101,7 +1101,7 @@ fn coupled_machines_hold_a_speed_ripple_with_their_frame_closed() {
 /// coupling (|s|/κ 1.29–1.31, κ 0.44·λa at rated torque; 0.96–1.05 and 0.59–0.64·λa at 65 %)
 /// the disturbance observer's DC loop through that speed grows; the frame-rate correction
 /// (the rate of |λ̂r|/λa(î), `fado_core::estimator`'s notch) takes that motion out. Measured:
-/// map 0.028 / 0.049 rad at 65 / 100 % of rated torque, algebraic model 0.025 / 0.039 (without
+/// map 0.035 / 0.049 rad at 65 / 100 % of rated torque, algebraic model 0.031 / 0.040 (without
 /// the correction 0.114 / 3.14 and 3.14 / 3.14; at the true speed within 0.014 rad).
 #[test]
 fn the_weak_magnet_pm_syrm_holds_a_speed_ripple_while_generating() {

@@ -203,6 +203,11 @@ pub struct EstimatorParams<T: Real> {
     speed_notch: SpeedNotch<T>,
     /// `EstimatorTuning::observer.frame_ripple_notch`.
     frame_ripple_notch: bool,
+    /// The frame-rate correction's speed bound, rad/s electrical (`step::notch`).
+    frame_rate_speed: T,
+    /// The frame-rate correction's current share (`step::notch`): the current where it
+    /// starts, A, and the share per ampere above it.
+    frame_rate_current: (T, T),
     integrator: FluxIntegratorParams<T>,
     observer: DisturbanceObserverParams<T>,
     disturbance_feedback: DisturbanceFeedbackParams<T>,

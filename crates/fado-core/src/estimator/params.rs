@@ -121,6 +121,10 @@ impl<T: Real> EstimatorParams<T> {
             rs_adaptation: config.tuning.rs_adaptation.enabled,
             speed_notch: SpeedNotch::new(ts, T::two_pi() * threshold_hz),
             frame_ripple_notch: config.tuning.observer.frame_ripple_notch,
+            frame_rate_speed: T::two_pi()
+                * config.machine.rated_frequency_hz()
+                * T::lit(super::step::notch::FRAME_RATE_SPEED_SHARE),
+            frame_rate_current: frame_rate_current(config.machine.rated_current),
             rs_initial: config.machine.rs,
             hold_level_sq: hold_level * hold_level,
             flux_settle_periods: (T::lit(FLUX_SETTLE_TIME_CONSTANTS)
@@ -388,4 +392,13 @@ fn offset_max_speed<T: Real>(samples: T, ts: T) -> T {
     } else {
         T::lit(f64::INFINITY)
     }
+}
+
+/// The frame-rate correction's current share (`step::notch`) for a machine of `rated`
+/// current: the current where it starts, A, and the share per ampere above it.
+fn frame_rate_current<T: Real>(rated: T) -> (T, T) {
+    use super::step::notch::{FRAME_RATE_CURRENT_FULL, FRAME_RATE_CURRENT_LOW};
+    let low = T::lit(FRAME_RATE_CURRENT_LOW) * rated;
+    let span = T::lit(FRAME_RATE_CURRENT_FULL - FRAME_RATE_CURRENT_LOW) * rated;
+    (low, T::one() / span)
 }

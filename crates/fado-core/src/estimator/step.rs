@@ -29,7 +29,7 @@ use crate::rs_adaptation::AdaptationRegime;
 use crate::tracker::TrackerUpdate;
 use crate::{Ab, Dq, Real, Rotation};
 
-mod notch;
+pub(super) mod notch;
 
 /// The new state of one sample, computed before anything is committed.
 struct Candidate<T: Real> {

@@ -17,8 +17,13 @@
 //! integrand-offset law's slot (|c| above `OFFSET_COUPLING_MAX` there, so 1/c stays below 2).
 //! Dividing by the signed c gives the correction the sign of the frame motion in both
 //! generating quadrants (s follows i_q): replayed with exact signals, the pmsyrm-baldor-5k6
-//! PM-SyRM's stop at the current limit while generating (i_q < 0 at ω > 0) holds 0.037 rad
+//! PM-SyRM's stop at the current limit while generating (i_q < 0 at ω > 0) holds 0.048 rad
 //! with it and 0.074 without (the magnitude's rate with a fixed sign, g = 6 rad: 0.58 rad).
+//! The correction acts below [`FRAME_RATE_SPEED_SHARE`] of the rated speed and with a share
+//! of G/c that rises from 0 at [`FRAME_RATE_CURRENT_LOW`] of the rated current to 1 at
+//! [`FRAME_RATE_CURRENT_FULL`]: where the current is small the ratio's rate reads noise and
+//! dead time rather than the frame, and the generating test reads the speed loop's own
+//! oscillation at a standstill.
 //! Constant inductances have no operating point and no correction: their step is unchanged.
 
 use super::{Candidate, SLOT_OFFSET};
@@ -26,7 +31,7 @@ use crate::active_flux::ActiveFlux;
 use crate::estimator::{EstimatorParams, EstimatorState};
 use crate::magnetics::FluxLookup;
 use crate::mode::Mode;
-use crate::{Ab, Real};
+use crate::{Ab, Dq, Real};
 
 /// G of the frame-rate correction (module docs), rad. Ours \[A\]: on motulator's ferrite
 /// PM-SyRM (fado-sim's `tests/data/motulator/mot-pmsyrm-4k.toml`, coupling 1.23–1.33 at the
@@ -34,6 +39,31 @@ use crate::{Ab, Real};
 /// 1–4 for G from 1 to 4 and loses `reversal` on seeds 2 and 4 at 6; 2 sits in the middle
 /// (`rated-reversal` 0.044–0.088 rad near zero speed, 0.10–0.14 at G = 1, 0.03–0.04 at 4).
 pub const FRAME_RATE_GAIN: f64 = 2.0;
+
+/// The speed below which the frame-rate correction acts, a share of the rated electrical
+/// speed. Ours \[A\]: above it the correction's loop grows an oscillation where the load
+/// turns the machine from motoring to generating (mot-pmsyrm-4k's `regen-stop` at 400–450
+/// r/min, i_q through zero: the angle lost on seed 2 with the current share alone, 0.30 rad
+/// on seed 3 without either; 0.13–0.20 rad on seeds 1–4 with both). The quadrants it serves lie
+/// below it: `rated-reversal` applies it only below 40 rad/s (0.13 of the rated speed), the
+/// ripple replays at 6 % of the rated speed.
+pub const FRAME_RATE_SPEED_SHARE: f64 = 0.15;
+
+/// The current below which the frame-rate correction vanishes, a share of the rated
+/// current, and [`FRAME_RATE_CURRENT_FULL`] where it acts whole. Ours \[A\]: the frame's rate
+/// moves |λ̂r| by s·δ with s growing with the current, while the ratio's noise and the dead
+/// time's distortion do not shrink with it; below 0.4 of the rated current the rate
+/// reads them, and the generating test (ω̂·î_q < 0) reads the speed loop's own oscillation
+/// at a standstill. The pmsyrm-baldor-5k6-measured map's unloaded standstill in
+/// `regen-stop` (|i| under 3.3 A, a quarter of the rated 12.45 A; c just above 0.5) drifts
+/// to 0.26 rad on seed 3 with the whole correction in 5–10 ms bursts where ω̂ crosses the
+/// mode threshold, 0.13–0.16 rad on seeds 1–4 with the share and the speed bound.
+pub const FRAME_RATE_CURRENT_LOW: f64 = 0.4;
+
+/// The current above which the frame-rate correction acts whole, a share of the rated
+/// current ([`FRAME_RATE_CURRENT_LOW`]). `rated-reversal` on mot-pmsyrm-4k corrects 84 % of
+/// its corrected samples above 0.9 of the rated current.
+pub const FRAME_RATE_CURRENT_FULL: f64 = 0.8;
 
 /// The low-pass of the frame-rate correction's rate, Hz: above the 4–5 Hz oscillation it
 /// damps, below the PWM and the current loop. Ours \[A\].
@@ -62,9 +92,11 @@ impl<T: Real> EstimatorState<T> {
                 Some(point) => {
                     let (s, kappa) = af.frame_coupling(&point);
                     let coupled = af.holds_offset(&point);
-                    // G/c where the notch's coupling test holds (|c| > 0.5, κ > 0).
-                    self.frame_rate_gain = if coupled && kappa > T::zero() {
-                        T::lit(FRAME_RATE_GAIN) * kappa / s
+                    // G/c where the notch's coupling test holds (|c| > 0.5, κ > 0) below
+                    // the correction's speed, times the current's share.
+                    let slow = c.t2s1.omega.abs() < p.frame_rate_speed;
+                    self.frame_rate_gain = if coupled && kappa > T::zero() && slow {
+                        T::lit(FRAME_RATE_GAIN) * kappa / s * Self::frame_rate_share(p, point.i_dq)
                     } else {
                         T::zero()
                     };
@@ -90,6 +122,22 @@ impl<T: Real> EstimatorState<T> {
             speed - ripple - self.frame_rate_gain * rate
         } else {
             speed
+        }
+    }
+
+    /// The share of G/c the current leaves to the frame-rate correction: 0 below
+    /// [`FRAME_RATE_CURRENT_LOW`] of the rated current, 1 above [`FRAME_RATE_CURRENT_FULL`],
+    /// linear between (module docs).
+    #[inline(always)]
+    fn frame_rate_share(p: &EstimatorParams<T>, i_dq: Dq<T>) -> T {
+        let (low, per_amp) = p.frame_rate_current;
+        let share = (i_dq.norm() - low) * per_amp;
+        if share <= T::zero() {
+            T::zero()
+        } else if share >= T::one() {
+            T::one()
+        } else {
+            share
         }
     }
 
