@@ -188,6 +188,9 @@ class Machine:
     def dc_voltage(self) -> float:
         """Nominal DC-link voltage in V."""
 
+def _unexpected_keyword(function: str, key: str, accepted: list[str]) -> str:
+    """The message of the TypeError for a keyword that `function` does not take."""
+
 def machine_presets() -> list[str]:
     """The names of the motor presets."""
 

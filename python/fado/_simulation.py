@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import Any, Union
 
 from fado import _fado, _toml
+from fado._keywords import checked
 
 ConfigLike = Union[str, "os.PathLike[str]", Mapping[str, Any], None]
 
@@ -38,6 +39,7 @@ def config_text(config: ConfigLike) -> str | None:
     )
 
 
+@checked
 def simulate(
     scenario: str = "fig11",
     config: ConfigLike = None,

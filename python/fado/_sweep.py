@@ -15,6 +15,7 @@ from collections.abc import Mapping, Sequence
 from typing import Any, Protocol, Union
 
 from fado import _fado
+from fado._keywords import checked
 from fado._simulation import ConfigLike, config_text
 
 #: The derived parameters (besides any TOML key ``section.key``) and what they mean.
@@ -72,6 +73,7 @@ def run_point(
     )
 
 
+@checked
 def sweep(
     grid: Grid,
     scenario: str = "fig11",

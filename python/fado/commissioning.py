@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING, Any, Union
 import numpy as np
 
 from fado import _fado
+from fado._keywords import checked
 from fado._simulation import ConfigLike, _config_path, config_text
 
 if TYPE_CHECKING:
@@ -35,6 +36,7 @@ __all__ = ["PHASES", "commission", "plot"]
 PHASES: list[str] = list(_fado.COMMISSION_PHASES)
 
 
+@checked
 def commission(
     motor: MotorLike,
     *,

@@ -262,7 +262,13 @@ impl<'py, 'a> Given<'py, 'a> {
         if !self.fields.iter().any(|f| f == field) {
             let message = moved_error().unwrap_or_else(|| {
                 format!(
-                    "`{shown}` is not an estimator setting; one of {:?}",
+                    "`{shown}` is not an estimator setting{}; one of {:?}",
+                    crate::elsewhere::hint(
+                        py,
+                        field,
+                        "EstimatorConfig",
+                        self.fields.iter().map(String::as_str)
+                    ),
                     self.fields
                 )
             });

@@ -6,6 +6,7 @@ use std::sync::atomic::AtomicBool;
 use fado_core::{Ab, SensorlessEstimator};
 use numpy::{PyArrayDescr, PyArrayDescrMethods, dtype};
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 
 use crate::config::PyEstimatorConfig;
 use crate::errors::{config_error, input_error};
@@ -224,7 +225,7 @@ pub struct PyEstimator {
 impl PyEstimator {
     #[new]
     #[pyo3(
-        signature = (machine = None, config = None, *, ts = None, theta0 = None, dtype = Dtype::Float64),
+        signature = (machine = None, config = None, *, ts = None, theta0 = None, dtype = Dtype::Float64, **unknown),
         text_signature = "(machine, config=None, *, ts=0.0001, theta0=0.0, dtype='float64')"
     )]
     fn py_new(
@@ -234,7 +235,10 @@ impl PyEstimator {
         ts: Option<Bound<'_, PyAny>>,
         theta0: Option<Bound<'_, PyAny>>,
         dtype: Dtype,
+        unknown: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
+        let accepted = ["machine", "config", "ts", "theta0", "dtype"];
+        crate::elsewhere::refuse_unknown(py, "Estimator", unknown, &accepted)?;
         let ts = number(py, "ts", ts.as_ref(), DEFAULT_TS)?;
         let theta0 = finite(py, "theta0", number(py, "theta0", theta0.as_ref(), 0.0)?)?;
         let setup = Setup::new(
@@ -410,7 +414,7 @@ pub const DEFAULT_TS: f64 = 1e-4;
 /// few milliseconds (`KeyboardInterrupt`).
 #[pyfunction]
 #[pyo3(
-    signature = (v_alpha, v_beta, i_alpha, i_beta, *, machine = None, ts = None, config = None, theta0 = None, dtype = Dtype::Float64),
+    signature = (v_alpha, v_beta, i_alpha, i_beta, *, machine = None, ts = None, config = None, theta0 = None, dtype = Dtype::Float64, **unknown),
     text_signature = "(v_alpha, v_beta, i_alpha, i_beta, *, machine, ts=0.0001, config=None, theta0=None, dtype='float64')"
 )]
 #[allow(clippy::too_many_arguments)]
@@ -425,7 +429,13 @@ pub fn estimate(
     config: Option<Bound<'_, PyAny>>,
     theta0: Option<Bound<'_, PyAny>>,
     dtype: Dtype,
+    unknown: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<EstimateResult> {
+    let accepted = [
+        "v_alpha", "v_beta", "i_alpha", "i_beta", "machine", "ts", "config",
+    ];
+    let accepted = [&accepted[..], &["theta0", "dtype"]].concat();
+    crate::elsewhere::refuse_unknown(py, "estimate", unknown, &accepted)?;
     let ts = number(py, "ts", ts.as_ref(), DEFAULT_TS)?;
     let theta0 = match theta0 {
         Some(t) => Some(finite(py, "theta0", number(py, "theta0", Some(&t), 0.0)?)?),

@@ -207,12 +207,21 @@ impl<'py> Signals<'py> {
         ];
         let lengths = [0, 1, 2, 3].map(|k| columns[k].slice().len());
         if let Some((odd, reference)) = odd_length(&lengths) {
+            let single = if lengths[odd] == 1 {
+                format!(
+                    "; a single value where a series is meant? A constant signal is \
+                     numpy.full({}, x)",
+                    lengths[reference]
+                )
+            } else {
+                String::new()
+            };
             return Err(input_error(
                 py,
                 SIGNAL_NAMES[odd],
                 format!(
                     "length {} differs from {}'s length {}; all four signals must have one \
-                     sample per sampling period",
+                     sample per sampling period{single}",
                     lengths[odd], SIGNAL_NAMES[reference], lengths[reference]
                 ),
             ));

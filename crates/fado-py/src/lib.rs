@@ -26,6 +26,7 @@ pub mod commission;
 pub mod compare;
 pub mod config;
 pub mod datasheet;
+pub mod elsewhere;
 pub mod errors;
 pub mod estimator;
 pub mod flux_map;
@@ -76,6 +77,11 @@ pub mod _fado {
     #[pymodule_init]
     fn init(m: &Bound<'_, PyModule>) -> PyResult<()> {
         super::errors::Exceptions::register(m)?;
+        // Private (not in `__all__`): the Python wrappers' keyword check (`fado._keywords`).
+        m.setattr(
+            "_unexpected_keyword",
+            wrap_pyfunction!(super::elsewhere::unexpected_keyword, m)?,
+        )?;
         m.add("__version__", env!("CARGO_PKG_VERSION"))?;
         m.add("OUTPUT_NAMES", super::outputs::OUTPUT_NAMES.to_vec())?;
         m.add("TRACE_COLUMNS", super::simulate::trace_columns())?;

@@ -60,14 +60,14 @@ fn missing_required(fields: Option<&Bound<'_, PyDict>>) -> PyResult<Option<PyErr
             }
         }
     }
-    let unknown = match unknown.first() {
-        Some(k) => format!(
+    let unknown = match (unknown.first(), fields) {
+        (Some(k), Some(f)) => format!(
             "`{k}` is not a Machine field{}: a datasheet's values (Kv, Kt, Ke, line-to-line R \
              and L, rms currents, kg·cm²) go to Machine.from_datasheet as {}. ",
-            fado_sim::suggest::did_you_mean(k, field_list()),
+            crate::elsewhere::hint(f.py(), k, "Machine", field_list()),
             datasheet_keys()
         ),
-        None => String::new(),
+        _ => String::new(),
     };
     Ok(Some(pyo3::exceptions::PyTypeError::new_err(format!(
         "{unknown}Machine() missing required keyword argument{}: {}. The circuit (rs, ld, lq, \
@@ -421,7 +421,7 @@ impl PyMachine {
                         &key,
                         format!(
                             "`{key}` is not a Machine field{}; one of {:?}",
-                            fado_sim::suggest::did_you_mean(&key, field_list()),
+                            crate::elsewhere::hint(py, &key, "Machine", field_list()),
                             field_names(py)?
                         ),
                     ));

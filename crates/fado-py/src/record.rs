@@ -116,6 +116,14 @@ fn plain_value<'py>(py: Python<'py>, field: &str, value: &Bound<'py, PyAny>) -> 
     {
         return Ok(());
     }
+    if let Ok(shape) = value.getattr("shape") {
+        // An array (`np.array([0.3])`, a column of a table): one number is meant.
+        return Err(pyo3::exceptions::PyTypeError::new_err(format!(
+            "`{field}` must be one number, got an array of shape {}: pass one value (x.item() \
+             for a one-element array)",
+            shape.str()?
+        )));
+    }
     Err(pyo3::exceptions::PyTypeError::new_err(format!(
         "`{field}` must be a number, a bool or a str, got {}",
         value.get_type().name()?
@@ -164,7 +172,13 @@ where
         let name = shown(&key);
         let Some(current) = merged.get_item(&key)? else {
             let fields = field_names(py, base)?;
-            let meant = fado_sim::suggest::did_you_mean(&key, fields.iter().map(String::as_str));
+            let function = if kind.contains("Machine") {
+                "Machine"
+            } else {
+                "EstimatorConfig"
+            };
+            let meant =
+                crate::elsewhere::hint(py, &key, function, fields.iter().map(String::as_str));
             return Err(pyo3::exceptions::PyTypeError::new_err(format!(
                 "unexpected keyword argument `{name}`: not {kind}{meant}; one of {fields:?}"
             )));
@@ -235,8 +249,18 @@ fn check_one<T: DeserializeOwned>(
     name: &str,
 ) -> PyResult<()> {
     if let Err(message) = from_dict::<T>(py, one)? {
-        let message = format!("`{name}`: {message}");
-        return Err(if message.contains(": invalid type: ") {
+        let wrong_type =
+            message.starts_with("invalid type: ") || message.contains(": invalid type: ");
+        let message = match message.strip_prefix("invalid type: floating point `") {
+            Some(rest)
+                if message.ends_with("expected u32") || message.ends_with("expected u64") =>
+            {
+                let value = rest.split('`').next().unwrap_or(rest);
+                format!("`{name}` is a count: it must be a whole number, got {value}")
+            }
+            _ => format!("`{name}`: {message}"),
+        };
+        return Err(if wrong_type {
             pyo3::exceptions::PyTypeError::new_err(message)
         } else {
             config_error_message(py, name, message)

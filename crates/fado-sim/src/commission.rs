@@ -221,6 +221,11 @@ pub fn refuse_unused(text: &str, function: &str) -> Result<(), SimConfigError> {
     let Some(key) = table.keys().find(|k| !PLANT_TABLES.contains(&k.as_str())) else {
         return Ok(());
     };
+    let outside = (!table[key].is_table()).then(|| crate::suggest::top_level_hint(key));
+    if let Some(hint) = outside.flatten() {
+        let message = format!("`{key}` is outside its table{hint}");
+        return Err(SimConfigError::new(key.clone(), message).located_in(text));
+    }
     let takes = match key.as_str() {
         "model" => "commissioning identifies the drive's model: it writes the [model] table \
                     (identified.toml) that `run` and `simulate` then take"

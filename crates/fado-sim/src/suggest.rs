@@ -30,6 +30,50 @@ pub fn did_you_mean<'a>(given: &str, candidates: impl IntoIterator<Item = &'a st
         .unwrap_or_default()
 }
 
+/// The tables of the simulator's configuration that hold `key` (`inverter` for
+/// `switching_frequency`, `motor` and `model` for `rs`), depth first, as dotted paths.
+pub fn tables_holding(key: &str) -> Vec<String> {
+    let mut places = Vec::new();
+    if let Ok(defaults) = crate::config::SimConfig::default()
+        .to_toml()
+        .parse::<toml::Table>()
+    {
+        tables_with_key(&defaults, "", key, &mut places);
+    }
+    places
+}
+
+/// Every table path below `prefix` in `table` that holds `key`, depth first.
+fn tables_with_key(table: &toml::Table, prefix: &str, key: &str, out: &mut Vec<String>) {
+    for (k, v) in table {
+        if let toml::Value::Table(t) = v {
+            let path = if prefix.is_empty() {
+                k.clone()
+            } else {
+                format!("{prefix}.{k}")
+            };
+            if t.contains_key(key) {
+                out.push(path.clone());
+            }
+            tables_with_key(t, &path, key, out);
+        }
+    }
+}
+
+/// For a key given outside any table (`switching_frequency = 20e3` at the top of a file, or
+/// `{"switching_frequency": 20e3}` as a Python config): the tables that hold it and how to
+/// write it there, as a sentence to append; None when no table holds it.
+pub fn top_level_hint(key: &str) -> Option<String> {
+    let places = tables_holding(key);
+    let first = places.first()?;
+    let names: Vec<String> = places.iter().map(|p| format!("[{p}]")).collect();
+    Some(format!(
+        "; `{key}` is a key of {}: write it in its table (`[{first}]` then `{key} = …` in \
+         TOML, `{{\"{first}\": {{\"{key}\": …}}}}` as a Python dict)",
+        names.join(", ")
+    ))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -72,5 +116,17 @@ mod tests {
             did_you_mean("limter", ["integrator", "limiter", "mode"]),
             "; did you mean `limiter`?"
         );
+    }
+
+    #[test]
+    fn a_key_outside_its_table_is_sent_to_the_table_that_holds_it() {
+        assert_eq!(tables_holding("switching_frequency"), ["inverter"]);
+        let hint = top_level_hint("switching_frequency").unwrap_or_default();
+        assert!(hint.contains("[inverter]"), "{hint}");
+        assert!(
+            hint.contains("{\"inverter\": {\"switching_frequency\": …}}"),
+            "{hint}"
+        );
+        assert_eq!(top_level_hint("gear_ratio"), None);
     }
 }

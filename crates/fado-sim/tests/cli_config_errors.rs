@@ -138,3 +138,20 @@ fn a_key_in_the_wrong_table_names_the_table_it_belongs_to() {
         "{stderr}"
     );
 }
+
+#[test]
+fn a_key_outside_its_table_names_the_table_that_holds_it() {
+    // `switching_frequency = 20e3` above every table header: a key of [inverter].
+    let (code, stderr, path) = run_with("top.toml", "switching_frequency = 20e3\n");
+    assert_eq!(code, Some(2), "{stderr}");
+    let prefix = format!("error: {}:1:1: `switching_frequency`: ", path.display());
+    assert!(stderr.starts_with(&prefix), "{stderr}");
+    assert!(
+        stderr.contains("`switching_frequency` is a key of [inverter]: write it in its table"),
+        "{stderr}"
+    );
+    // A key no table holds gets the list of tables alone.
+    let (code, stderr, _) = run_with("top-unknown.toml", "gear_ratio = 3\n");
+    assert_eq!(code, Some(2), "{stderr}");
+    assert!(!stderr.contains("is a key of"), "{stderr}");
+}

@@ -293,13 +293,14 @@ fn syntax_hint(text: &str, at: usize, err: &mut SimConfigError) {
 }
 
 /// For an unknown `section.key`: the tables of the configuration where `key` is a key (a key
-/// written in the wrong table, `[inverter] rs`), as a sentence to append; None when there is
-/// none.
+/// written in the wrong table, `[inverter] rs`), as a sentence to append; for a key outside
+/// any table (`switching_frequency` at the top), the table that holds it
+/// ([`crate::suggest::top_level_hint`]); None when there is none.
 fn wrong_table_hint(full: &str) -> Option<String> {
-    let (section, key) = full.rsplit_once('.')?;
-    let defaults: toml::Table = SimConfig::default().to_toml().parse().ok()?;
-    let mut places = Vec::new();
-    tables_with_key(&defaults, "", key, &mut places);
+    let Some((section, key)) = full.rsplit_once('.') else {
+        return crate::suggest::top_level_hint(full);
+    };
+    let mut places = crate::suggest::tables_holding(key);
     places.retain(|p| p != section);
     if places.is_empty() {
         return None;
@@ -309,23 +310,6 @@ fn wrong_table_hint(full: &str) -> Option<String> {
         "; `{key}` is a key of {}: written in the wrong table?",
         names.join(", ")
     ))
-}
-
-/// Every table path below `prefix` in `table` that holds `key`, depth first.
-fn tables_with_key(table: &toml::Table, prefix: &str, key: &str, out: &mut Vec<String>) {
-    for (k, v) in table {
-        if let toml::Value::Table(t) = v {
-            let path = if prefix.is_empty() {
-                k.clone()
-            } else {
-                format!("{prefix}.{k}")
-            };
-            if t.contains_key(key) {
-                out.push(path.clone());
-            }
-            tables_with_key(t, &path, key, out);
-        }
-    }
 }
 
 /// A serde error from a `toml::Value` carries "in `path`"; unknown fields name the field.
