@@ -162,6 +162,16 @@
 //! [`GainCalibration::duration_samples`]. The current reference is never above I₁ and a
 //! voltage-mode current above `current_limit` ends the sequence (the drive sets it to its
 //! I_max, with I₂ = 2·I₁ ≤ I_max).
+//!
+//! # Duration
+//! What each stage waits for: under the current loop (the settling at I₁, the release) the
+//! loop's response, 5·max(L̂d/R̂s, 1/ωc) from the drive; in voltage mode the current's own
+//! settling through the axis's L/R (the hold is at least the settling) and the rotor's swing,
+//! and the averaging window. The whole sequence along the calibration's axis
+//! ([`GainCalibration::duration_samples`]) is bounded by `max_time`: a longer one is not run
+//! ([`GainCalibrationStatus::TooSlow`]), so that a calibration never holds a free rotor into
+//! the time its application loads it (the drive's bound and the measurements:
+//! `gain_calibration_max_time` in `control/drive/config.rs`).
 
 mod measure;
 mod motion;
@@ -221,6 +231,10 @@ pub struct GainCalibrationConfig<T> {
     pub current_limit: T,
     /// L̂q in H: the inductance across the axis, for the rotor-motion test.
     pub lq_hat: T,
+    /// Longest whole sequence accepted, s (∞: no bound): a sequence (settle, both levels'
+    /// holds and windows along the calibration's axis, release) beyond it is not run
+    /// ([`GainCalibrationStatus::TooSlow`]; module docs, "Duration").
+    pub max_time: T,
     /// The rotor-motion test's threshold (V): in voltage mode, a back-EMF across the axis
     /// |R̂s·Δi⊥ + L̂q·dΔi⊥/dt| (Δi⊥ the change of the current across the axis since the
     /// level's voltage was frozen, low-passed over [`MOTION_FILTER_TIME`]) above this ends
@@ -250,7 +264,8 @@ pub enum GainCalibrationStatus {
     Unobservable,
     /// Skipped: the rotor's swing about the d current dies out too slowly, or the current
     /// settles too slowly (`hold_time`, `settle_time` or the swing's window along the axis,
-    /// `swing_window_time`, above `max_hold_time`; ratio unchanged, no current applied).
+    /// `swing_window_time`, above `max_hold_time`), or the whole sequence along the axis
+    /// would exceed `max_time` (ratio unchanged, no current applied).
     TooSlow,
     /// Measured but refused: non-finite, a non-positive conductance, too few finite samples,
     /// a current above `current_limit` in voltage mode, or |k − 1| above `max_mismatch`
@@ -303,6 +318,8 @@ pub struct GainCalibration<T> {
     /// The hold of this calibration is shorter than its axis's settling
     /// ([`start_with_hold`](Self::start_with_hold)): k only, no resistance.
     unsettled: bool,
+    /// `max_time` in samples (`u32::MAX` without a bound).
+    max_samples: u32,
     /// Settling or hold beyond `max_hold_time`: skipped.
     too_slow: bool,
     window_samples: u32,
@@ -364,17 +381,30 @@ pub struct GainCalibration<T> {
     resistance: T,
 }
 
+/// `time` (s) in sampling periods `ts`, rounded; `field` names a negative, non-finite or too
+/// long one.
+fn samples_of<T: Real>(field: &'static str, time: T, ts: T) -> Result<u32, ConfigError> {
+    let n = check::non_negative(field, time)? / ts;
+    check::below(field, n, T::lit(4e9), "below 4e9 sampling periods")?;
+    Ok(n.round().to_f64() as u32)
+}
+
+/// `max_time` (s) in sampling periods `ts`: `u32::MAX` for +∞ (no bound); NaN and −∞ refused.
+fn bound_samples<T: Real>(time: T, ts: T) -> Result<u32, ConfigError> {
+    if time > T::zero() && !time.is_finite() {
+        Ok(u32::MAX)
+    } else {
+        samples_of("max_time", time, ts)
+    }
+}
+
 impl<T: Real> GainCalibration<T> {
     /// A new calibration (armed unless disabled); every field is checked and a bad one named.
     pub fn new(config: GainCalibrationConfig<T>) -> Result<Self, ConfigError> {
         let ts = check::positive("ts", config.ts)?;
         check::positive("current", config.current)?;
         check::positive("rs_hat", config.rs_hat)?;
-        let samples = |field: &'static str, time: T| -> Result<u32, ConfigError> {
-            let n = check::non_negative(field, time)? / ts;
-            check::below(field, n, T::lit(4e9), "below 4e9 sampling periods")?;
-            Ok(n.round().to_f64() as u32)
-        };
+        let samples = |field: &'static str, time: T| samples_of(field, time, ts);
         let max_hold = check::non_negative("max_hold_time", config.max_hold_time)?;
         let max_hold_samples = samples("max_hold_time", max_hold)?;
         // Settling and hold from the model: beyond the budget (or NaN) skipped, not refused.
@@ -389,6 +419,7 @@ impl<T: Real> GainCalibration<T> {
         let settle_samples = within(config.settle_time)?;
         let hold_samples = within(config.hold_time)?.max(settle_samples);
         let window_samples = samples("window_time", config.window_time)?;
+        let max_samples = bound_samples(config.max_time, ts)?;
         check::below(
             "min_observability",
             check::non_negative("min_observability", config.min_observability)?,
@@ -411,6 +442,7 @@ impl<T: Real> GainCalibration<T> {
         Ok(Self {
             config,
             settle_samples,
+            max_samples,
             hold_samples,
             hold_default: hold_samples,
             unsettled: false,

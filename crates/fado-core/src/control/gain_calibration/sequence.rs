@@ -62,6 +62,12 @@ impl<T: Real> GainCalibration<T> {
         // Rounded in `T` (n ≥ 0): no double-precision conversion in the firmware's step.
         let n = (n + T::lit(0.5)).index_floor(u32::MAX as usize) as u32;
         self.window_run = self.window_samples.max(n);
+        // The whole sequence along this axis within `max_time`, else not run.
+        if self.duration_samples() > self.max_samples {
+            self.stage = Stage::Idle;
+            self.status = GainCalibrationStatus::TooSlow;
+            return false;
+        }
         let share = Self::observability(angle);
         // NaN compares false: a non-finite angle is unobservable too.
         if !(share >= self.config.min_observability && share > T::zero()) {

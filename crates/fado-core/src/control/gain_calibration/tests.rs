@@ -18,6 +18,7 @@ fn config(current: f64, r: f64, l: f64) -> GainCalibrationConfig<f64> {
         max_mismatch: DEFAULT_MAX_MISMATCH,
         current_limit: 2.5 * current,
         lq_hat: 1e-3,
+        max_time: f64::INFINITY,
         motion_voltage: f64::INFINITY,
     }
 }
@@ -234,6 +235,33 @@ fn too_slow_a_swing_or_a_zero_window_skips() {
 }
 
 #[test]
+fn a_sequence_beyond_its_time_budget_skips() {
+    // (R, L) = (0.3 Ω, 3 mH): settle, hold and window of 50 ms each, 0.3 s in all.
+    let mut c = config(8.0, 0.3, 3e-3);
+    c.max_time = 0.3;
+    let mut cal = GainCalibration::new(c).unwrap();
+    assert_eq!(cal.duration_samples(), 3000);
+    assert!(cal.start(0.3));
+    // A swing's window of 0.15 s along the axis at φ = 0.3 rad (shares 0.955, 0.222) makes it
+    // 0.2 s longer, and a hold of 0.1 s along the axis 0.1 s: beyond it, not run.
+    c.swing_window_time = 0.15 / cal.swing_window_share(0.3);
+    let mut cal = GainCalibration::new(c).unwrap();
+    assert!(!cal.start(0.3));
+    assert_eq!(cal.status(), GainCalibrationStatus::TooSlow);
+    let unbounded = GainCalibrationConfig {
+        max_time: f64::INFINITY,
+        ..c
+    };
+    assert!(GainCalibration::new(unbounded).unwrap().start(0.3));
+    c.swing_window_time = 0.0;
+    let mut cal = GainCalibration::new(c).unwrap();
+    assert!(!cal.start_with_hold(0.3, 0.1));
+    assert_eq!(cal.status(), GainCalibrationStatus::TooSlow);
+    c.max_time = f64::NAN;
+    assert!(GainCalibration::new(c).is_err());
+}
+
+#[test]
 fn a_longer_hold_lengthens_one_calibration_and_beyond_the_budget_measures_k_only() {
     // (R, L) = (0.3 Ω, 3 mH): each level held 5·L/R = 50 ms. Along an axis of twice the
     // inductance the caller asks 100 ms: two holds longer by 50 ms each; 0.3 s (beyond the
@@ -268,6 +296,7 @@ fn f32_identifies_the_mismatch_too() {
         max_mismatch: 0.05,
         current_limit: 20.0,
         lq_hat: 1e-3,
+        max_time: f32::INFINITY,
         motion_voltage: f32::INFINITY,
     })
     .unwrap();
