@@ -102,10 +102,11 @@ fn the_mismatch_is_measured_on_every_calibrated_preset_and_skipped_where_it_shou
     }
     // The outrunner (whose failure motivated the calibration), the multirotor outrunner (its
     // swing held for its bias bound, 1.25 time constants), the paper's motor, the servo and
-    // the 2.2 kW IPMSM are calibrated at every angle; the hub motor at θ0 = 0, where phases a
-    // and b carry 1 and 0.5 of the current and its swing needs a 0.18 s window (0.34 s at
-    // 0.3 rad, 0.60 s at the least observable axis): k within 1.4e-4 of the truth.
-    assert_eq!(calibrated, 21);
+    // the 2.2 kW IPMSM are calibrated at every angle. The hub motor is not: at θ0 = 0, where
+    // phases a and b carry 1 and 0.5 of the current, its swing needs a 0.18 s window (0.34 s
+    // at 0.3 rad, 0.60 s at the least observable axis) and the whole sequence 0.78 s, beyond
+    // the free rotor's 0.7 s budget (`control::drive` config, `gain_calibration_max_time`).
+    assert_eq!(calibrated, 20);
 }
 
 #[test]
