@@ -468,7 +468,7 @@ def simulate(
     averaged: bool = False,
     *,
     progress: bool = False,
-    motor: str | Machine | None = None,
+    motor: _MachineLike | None = None,
 ) -> SimResult:
     """Run a scenario (the paper's Fig. 8–12, or one scaled by the motor's ratings) on the simulated drive (GIL released)."""
 
@@ -479,7 +479,7 @@ def describe_scenario(scenario: str) -> dict[str, str]:
     """Name, title, profile and pass criterion of a scenario."""
 
 def default_config(
-    scenario: str = "fig11", averaged: bool = False, *, motor: str | Machine | None = None
+    scenario: str = "fig11", averaged: bool = False, *, motor: _MachineLike | None = None
 ) -> str:
     """The scenario's configuration as TOML (``fado-sim run --dump-config``)."""
 

@@ -46,7 +46,7 @@ def simulate(
     averaged: bool = False,
     *,
     progress: bool = False,
-    motor: str | _fado.Machine | None = None,
+    motor: str | _fado.Machine | dict[str, Any] | None = None,
 ) -> _fado.SimResult:
     """Runs one of the paper's experiments on the simulated drive (Rust, GIL released).
 
@@ -55,8 +55,8 @@ def simulate(
     ``fullrange``, ``regen-stop`` scaled by the motor's ratings; ``custom``: the
     configuration's own profiles, judged only by its ``[criteria]``).
     `motor` replaces the paper's motor first: a preset name of :func:`fado.machine_presets`
-    (its whole ``motors/`` file: ``[motor]`` and its ``[inverter]``) or a :class:`fado.Machine`
-    (as ``[motor]`` and ``[inverter] dc_voltage``). `config` then overrides
+    (its whole ``motors/`` file: ``[motor]`` and its ``[inverter]``), a :class:`fado.Machine`
+    or a ``dict`` of its fields (as ``[motor]`` and ``[inverter] dc_voltage``). `config` then overrides
     the scenario's configuration key by key, given as TOML text, a path (``str`` or
     :class:`pathlib.Path`) to a TOML file, or a ``dict`` of tables such as
     ``{"simulation": {"duration": 1.0}, "mismatch.rs_ratio": 1.01}``; see

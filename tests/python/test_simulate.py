@@ -401,6 +401,21 @@ def test_motor_machine_sets_motor_and_dc_link() -> None:
     assert "rated_current = 6.08" in fado.default_config("stops", motor="ipmsm-2k2")
 
 
+def test_motor_as_a_dict_of_machine_fields_is_the_machine() -> None:
+    # As `fado.commission` and `fado.estimate` take it.
+    ipm = fado.Machine.preset("ipmsm-2k2")
+    fields = {"rs": ipm.rs, "ld": ipm.ld, "lq": ipm.lq, "flux_linkage": ipm.flux_linkage,
+              "pole_pairs": ipm.pole_pairs, "inertia": ipm.inertia,
+              "viscous_friction": ipm.viscous_friction, "rated_current": ipm.rated_current,
+              "rated_speed_rpm": ipm.rated_speed_rpm, "rated_torque": ipm.rated_torque,
+              "dc_voltage": ipm.dc_voltage}
+    by_dict = fado.default_config("reversal", motor=fields)
+    assert by_dict == fado.default_config("reversal", motor=fado.Machine(**fields))
+    assert "rated_current = 6.08" in by_dict
+    with pytest.raises(ValueError, match="rss"):
+        fado.simulate("reversal", motor=dict(fields, rss=1.0))
+
+
 def test_bad_motor_raises_naming_it() -> None:
     with pytest.raises(ValueError, match="ipmsm-2k2") as info:
         fado.simulate("reversal", motor="no-such-motor")

@@ -125,7 +125,8 @@ impl Motor {
         Motor::Machine(Box::new(m.to_core()), m.flux_map().cloned())
     }
 
-    /// `motor` as `simulate` takes it: None, a preset name or a `fado.Machine`.
+    /// `motor` as `simulate` takes it: None, a preset name, a `fado.Machine` or a dict of its
+    /// fields.
     pub(crate) fn from_argument(
         py: Python<'_>,
         motor: Option<&Bound<'_, PyAny>>,
@@ -149,8 +150,13 @@ impl Motor {
                 )),
             };
         }
+        if motor.cast::<PyDict>().is_ok() {
+            // A dict of `Machine` fields, as `fado.commission` and `fado.estimate` take it.
+            let m = PyMachine::from_argument(py, Some(motor), "motor", "simulate")?;
+            return Ok(Some(Motor::of_machine(&m)));
+        }
         Err(pyo3::exceptions::PyTypeError::new_err(format!(
-            "motor must be a preset name, a fado.Machine or None, got {}",
+            "motor must be a preset name, a fado.Machine, a dict of Machine fields or None, got {}",
             motor.get_type().name()?
         )))
     }
