@@ -121,8 +121,7 @@ impl<T: Real> EstimatorParams<T> {
             rs_adaptation: config.tuning.rs_adaptation.enabled,
             speed_notch: SpeedNotch::new(ts, T::two_pi() * threshold_hz),
             frame_ripple_notch: config.tuning.observer.frame_ripple_notch,
-            frame_rate_speed: T::two_pi()
-                * config.machine.rated_frequency_hz()
+            frame_rate_speed: config.machine.rated_speed()
                 * T::lit(super::step::notch::FRAME_RATE_SPEED_SHARE),
             frame_rate_current: frame_rate_current(config.machine.rated_current),
             rs_initial: config.machine.rs,

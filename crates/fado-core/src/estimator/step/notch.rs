@@ -131,14 +131,9 @@ impl<T: Real> EstimatorState<T> {
     #[inline(always)]
     fn frame_rate_share(p: &EstimatorParams<T>, i_dq: Dq<T>) -> T {
         let (low, per_amp) = p.frame_rate_current;
-        let share = (i_dq.norm() - low) * per_amp;
-        if share <= T::zero() {
-            T::zero()
-        } else if share >= T::one() {
-            T::one()
-        } else {
-            share
-        }
+        // A NaN share gives 0 (`real::max`).
+        let share = crate::real::max((i_dq.norm() - low) * per_amp, T::zero());
+        crate::real::min(share, T::one())
     }
 
     /// A saturating model's d(|λ̂r|/λa(î))/dt low-passed at [`FRAME_RATE_HZ`] (module docs):
