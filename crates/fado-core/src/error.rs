@@ -109,4 +109,12 @@ pub(crate) mod check {
             Err(ConfigError::OutOfRange { field, expected })
         }
     }
+
+    /// A duration `time` (s) as a whole number of sampling periods `ts`, rounded; `field`
+    /// names a negative, non-finite or too long one (4e9 periods: about 5 days at 10 kHz).
+    pub fn samples<T: Real>(field: &'static str, time: T, ts: T) -> Result<u32, ConfigError> {
+        let n = non_negative(field, time)? / ts;
+        below(field, n, T::lit(4e9), "below 4e9 sampling periods")?;
+        Ok(n.round().to_f64() as u32)
+    }
 }

@@ -22,11 +22,7 @@ impl<T: Real> Resolved<T> {
         )?;
         let rated = c.machine.rated_current;
         // A duration as a whole number of samples (at most about 5 days at 10 kHz).
-        let samples = &|field: &'static str, time: T| -> Result<u32, ConfigError> {
-            let n = check::non_negative(field, time)? / ts;
-            check::below(field, n, T::lit(4e9), "below 4e9 sampling periods")?;
-            Ok(n.round().to_f64() as u32)
-        };
+        let samples = &|field: &'static str, time: T| check::samples(field, time, ts);
         Ok(Self {
             floor_at_brake: super::hold::floor_at_brake(c),
             i_max: check::below(

@@ -381,20 +381,12 @@ pub struct GainCalibration<T> {
     resistance: T,
 }
 
-/// `time` (s) in sampling periods `ts`, rounded; `field` names a negative, non-finite or too
-/// long one.
-fn samples_of<T: Real>(field: &'static str, time: T, ts: T) -> Result<u32, ConfigError> {
-    let n = check::non_negative(field, time)? / ts;
-    check::below(field, n, T::lit(4e9), "below 4e9 sampling periods")?;
-    Ok(n.round().to_f64() as u32)
-}
-
 /// `max_time` (s) in sampling periods `ts`: `u32::MAX` for +∞ (no bound); NaN and −∞ refused.
 fn bound_samples<T: Real>(time: T, ts: T) -> Result<u32, ConfigError> {
     if time > T::zero() && !time.is_finite() {
         Ok(u32::MAX)
     } else {
-        samples_of("max_time", time, ts)
+        check::samples("max_time", time, ts)
     }
 }
 
@@ -404,7 +396,7 @@ impl<T: Real> GainCalibration<T> {
         let ts = check::positive("ts", config.ts)?;
         check::positive("current", config.current)?;
         check::positive("rs_hat", config.rs_hat)?;
-        let samples = |field: &'static str, time: T| samples_of(field, time, ts);
+        let samples = |field: &'static str, time: T| check::samples(field, time, ts);
         let max_hold = check::non_negative("max_hold_time", config.max_hold_time)?;
         let max_hold_samples = samples("max_hold_time", max_hold)?;
         // Settling and hold from the model: beyond the budget (or NaN) skipped, not refused.
