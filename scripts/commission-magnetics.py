@@ -13,7 +13,10 @@ datasheet's unsaturated ones):
    (b) with the commissioned identified.toml, per preset the largest angle error over the seeds
    (near zero speed for the reversals, over the run for `stops`) and the seeds passing.
 Prints the Markdown page; `--write` writes it to docs/results/commissioning-magnetics.md.
+`--machine FILE ...` prints only the two tables (closed loop, identification) for those motor
+files: the closed-loop tables of docs/results/saturated-replay.md.
 Usage: python3 scripts/commission-magnetics.py [--seeds 1 2 3 4] [--out DIR | --keep] [--write]
+       python3 scripts/commission-magnetics.py --machine FILE ... [--seeds ...]
 """
 
 import argparse
@@ -221,15 +224,31 @@ def main() -> None:
     ap.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3, 4])
     add_arguments(ap)
     ap.add_argument("--write", action="store_true", help=f"write {PAGE.relative_to(ROOT)}")
+    ap.add_argument("--machine", type=Path, nargs="+",
+                    help="only the closed-loop and identification rows of these motor files")
     args = ap.parse_args()
+    if args.machine and args.write:
+        ap.error("--machine prints rows for another page; it does not --write")
     subprocess.run(["cargo", "build", "--release", "--quiet", "-p", "fado-sim", "--bin",
                     "fado-sim"], cwd=ROOT, check=True)
     binary = ROOT / "target" / "release" / "fado-sim"
     with run_directory(args.out, args.keep, "fado-commission-magnetics-") as work:
-        page = measured_page(binary, args.seeds, work)
+        if args.machine:
+            page = machine_rows(binary, [p.resolve() for p in args.machine], args.seeds, work)
+        else:
+            page = measured_page(binary, args.seeds, work)
     if args.write:
         PAGE.write_text(page, encoding="utf-8")
     print(page)
+
+
+def machine_rows(binary: Path, files: list, seeds: list, work: Path) -> str:
+    """The closed-loop rows, then the identification rows, of the motor `files`."""
+    loop = []
+    for f in files:
+        loop += closed_loop(binary, f, seeds, work)
+    ident = accuracy_rows(binary, [(f.stem, ["--config", str(f)]) for f in files], seeds, work)
+    return "\n".join(loop) + "\n\n" + "\n".join(ident) + "\n"
 
 
 def measured_page(binary: Path, seeds: list[int], work: Path) -> str:
