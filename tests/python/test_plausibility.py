@@ -255,3 +255,21 @@ def test_a_paper_figure_on_another_motor_warns_that_its_loads_are_the_papers() -
         warnings.simplefilter("error")
         fado.simulate("reversal", motor=fado.Machine(**DRONE, dc_voltage=24.0), config=short)
         fado.simulate("fig11", config=short)
+
+
+def test_a_start_ups_gates_off_window_is_not_taken_for_a_voltage_in_kv() -> None:
+    # The first 0.1 s of a start-up: gates off, so the voltages are 0 while the currents read
+    # the sensors' offsets and noise (0.06 % of the rated current here); nothing flows.
+    r = fado.simulate("loaded-start", {"simulation": {"decimation": 1}}, motor="ipmsm-2k2",
+                      averaged=True)
+    k = int(0.1 / r.ts)
+    cols = [np.ascontiguousarray(r.traces[c][:k])
+            for c in ("v_alpha_ref", "v_beta_ref", "i_alpha", "i_beta")]
+    assert np.max(np.abs(cols[0])) == 0.0 and np.max(np.abs(cols[2])) > 0.0
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        fado.estimate(*cols, machine=r.machine, ts=r.ts)
+    # The same window with a current flowing at 10 % of rated and no voltage still warns.
+    cols[2] = cols[2] + 0.1 * r.machine.rated_current
+    with pytest.warns(UserWarning, match="kV where V is meant"):
+        fado.estimate(*cols, machine=r.machine, ts=r.ts)

@@ -8,7 +8,7 @@
 //! |---|---|---|
 //! | current beyond the bound | over 1 % of samples with \|i\| ≥ the plausible current | mA for A (max × 1000), the voltage columns in the current slots |
 //! | voltage beyond the bound | over 1 % of samples with \|v\| ≥ the plausible voltage | mV for V, the current columns in the voltage slots |
-//! | voltage too small | max \|v\| < 0.1 × R̂s·max \|i\| while current flows | kV for V |
+//! | voltage too small | max \|v\| < 0.1 × R̂s·max \|i\| while current flows (max \|i\| ≥ [`FLOW_SHARE`] × `rated_current`) | kV for V |
 //! | constant column | every sample of one column equal while its partner varies | a dead channel, a column taken twice |
 //! | non-finite samples | over 1 % of samples NaN or ±∞, or a run of them lasting 1 ms or more (`BURST_SECONDS`) | a gap in the logger |
 //! | start angle | \|θ0\| > 2π | degrees for radians |
@@ -28,6 +28,13 @@ use crate::interrupt::{self, Cancelled, poll_at};
 
 /// Share of samples above which refused samples are reported: 1 %.
 const REFUSED_SHARE: f64 = 0.01;
+
+/// Share of `rated_current` from which the largest current counts as flowing for the
+/// voltage-too-small finding: 5 %. Below it the currents are the sensors' offsets and noise
+/// (a gates-off offset calibration reads 0.1–0.5 % of the rated current on the presets, and a
+/// drive's ADC offset is rarely above 2 %), with no voltage to go with them: a recording of a
+/// start-up's first 0.1 s is not a voltage in kV.
+const FLOW_SHARE: f64 = 0.05;
 
 /// Duration of a run of consecutive non-finite samples in one column from which it is
 /// reported whatever its share: 1 ms (10 samples at 10 kHz). A glitching ADC gives single
@@ -148,7 +155,7 @@ pub fn findings(
         non_finite(c, k, ts, cancel, &mut out)?;
     }
     constant_columns(&cols, cancel, &mut out)?;
-    magnitudes(&cols, bounds, m.rs, cancel, &mut out)?;
+    magnitudes(&cols, bounds, m, cancel, &mut out)?;
     out.extend(crate::recording_model::findings(&cols, m, ts, cancel)?);
     Ok(out)
 }
@@ -231,7 +238,7 @@ fn magnitude(
 fn magnitudes(
     cols: &[&[f64]; 4],
     b: &SampleBounds<f64>,
-    rs: f64,
+    m: &MachineModel<f64>,
     cancel: Option<&AtomicBool>,
     out: &mut Vec<String>,
 ) -> Result<(), Cancelled> {
@@ -263,8 +270,8 @@ fn magnitudes(
             b.voltage()
         ));
     }
-    let drop = rs * i.max_below;
-    if drop > 0.0 && v_max < 0.1 * drop {
+    let drop = m.rs * i.max_below;
+    if i.max_below >= FLOW_SHARE * m.rated_current && v_max < 0.1 * drop {
         out.push(format!(
             "the voltages (`v_alpha`, `v_beta`) reach {v_max:.4e} V only, a tenth of the \
              resistive drop R̂s·|i| = {drop:.4e} V of the currents alone: a voltage in kV \
