@@ -28,7 +28,9 @@ for file in ${MOTORS:-motors/*.toml}; do
         pass=0 total=0
         for s in $seeds; do
             cfg="$tmp/$name-$sc-$s.toml"
-            { cat "$file"; printf '\n[current_sensor]\nseed = %s\n' "$s"; printf '%b' "${EXTRA:-}"; } >"$cfg"
+            # A flux map named relative to the motor file is given by its absolute path.
+            dir=$(cd "$(dirname "$file")" && pwd)
+            { sed "s|^flux_map = \"\([^/\"][^\"]*\)\"|flux_map = \"$dir/\1\"|" "$file"; printf '\n[current_sensor]\nseed = %s\n' "$s"; printf '%b' "${EXTRA:-}"; } >"$cfg"
             out="$tmp/out-$name-$sc-$s"
             if "$bin" run "$sc" --config "$cfg" --out "$out" >/dev/null 2>&1; then ok=1; else ok=0; fi
             if [[ -f "$out/metrics.json" ]]; then
