@@ -202,7 +202,11 @@ fn heavy_saturated_rotor(scenario: &str, seed: u64, speed_hz: Option<f64>) -> (b
 /// swings between the current-vector limits (±910 A at i_d* = −395 A) at about 16 Hz while
 /// the rotor's speed moves by less than 1.5 r/min and ω̂ by ±5–9 r/min. The angle estimate
 /// follows i_q within 5–8 ms (θ − θ̂ +0.08 to +0.12 rad at +910 A, −0.02 to −0.04 rad at
-/// −910 A), T2S-2 turns that motion of θ̂ into a speed error, and the speed PI, whose
+/// −910 A). That motion is the estimator's slow mode (docs/method/saturation.md): after the
+/// step to +910 A the estimated flux keeps the rotor's direction within 0.005 rad but settles
+/// at the model's |ψ| of the current in the estimated frame (1.200 Wb, the rotor's 1.245 Wb),
+/// a frame error of 0.087 rad the observer does not see. T2S-2 turns that motion of θ̂ into a
+/// speed error, and the speed PI, whose
 /// Kp = Ĵ·ωs/(K̂t·p) is 342 A per electrical rad/s on this rotor, answers it with current of the
 /// sign that moves θ̂ further: a loop that bypasses the rotor, whose gain grows with Ĵ (the
 /// speed loop through the rotor does not depend on Ĵ). The same machine without
@@ -215,7 +219,12 @@ fn heavy_saturated_rotor(scenario: &str, seed: u64, speed_hz: Option<f64>) -> (b
 /// r/min) and `reversal` seed 3. A bound on ωs from Ĵ, τm, the current limit and T2S-2 alone
 /// does not single this machine out: the drawn 137 kW IPMSM (τm = 15.6 s) limit-cycles at
 /// 5 Hz too (|i_q*| at its 513 A limit 38 % of `stops`) yet holds its angle (0.128 rad), and at
-/// 1.5 Hz runs 0.57 rad back in `loaded-start` (limit 0.5).
+/// 1.5 Hz runs 0.57 rad back in `loaded-start` (limit 0.5). Nor does that path's loop gain
+/// estimated from the model, G = c·Kp·ωt·L̂q,s/λa at the rated torque's MTPA point (c the frame
+/// coupling of `fado_core::control::speed_bandwidth`, ωt T2S-2's bandwidth): 67 here at 5 Hz
+/// and 40 at 3 Hz (`loaded-start` seed 2 lost), 27 at 2 Hz, against 38 on motulator's 4 kW
+/// PM-SyRM (T2S-2 at 43 Hz; its `rated-reversal` fails at 3 Hz), 11 on the Baldor PM-SyRM
+/// preset and 8.6 on the drawn 138 kW IPMSM, which hold at 5 Hz.
 #[test]
 #[ignore = "stops max |θ − θ̂| 0.690 / 3.142 rad at seeds 1 / 2: the speed PI limit-cycles \
             between ±910 A through the angle estimate's motion with i_q (0.047 / 0.045 rad with \
