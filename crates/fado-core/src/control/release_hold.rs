@@ -709,10 +709,11 @@ impl<T: Real> ReleaseHold<T> {
         self.active && !standstill_hold && done
     }
 
-    /// Armed at a brake's release on a saturating model, the stiffness for the load the
-    /// fall of `fall` (rad, direct angle) since the release reveals ([`fall::Softening`]).
+    /// Armed at a brake's release on a saturating model or where the current loop or the
+    /// sampling caps the loop (it then watches the direct angle), the stiffness for the load
+    /// the fall of `fall` (rad, direct angle) since the release reveals ([`fall::Softening`]).
     fn soften(&mut self, fall: T) {
-        if self.released && self.release_on_direct {
+        if self.released && (self.release_on_direct || self.fall_gain > T::zero()) {
             let omega_h = self.kp / self.kd;
             self.hold_samples = self.soft.soften(fall, self.fall_time, omega_h);
         }

@@ -48,8 +48,8 @@
 //! |θ − θ̂| from ready 0.051 / 0.063 / 0.074 / 0.053; the made-up 750 W servo
 //! (`crates/fado-sim/tests/data/startup-spm-750w.toml`) 0.22 / 0.22 / 0.23 / 0.22 (0.38 / 0.46
 //! / 0.39 / 0.38); the MAD 5010 kv200 0.22 / 0.21 / 0.26 / 0.23 (0.41 / 0.39 / 0.48 / 0.41);
-//! the multirotor preset 0.17 / 0.18 / 0.21 / 0.18 (0.21 / 0.20 / 0.23 / 0.22); the 36 V tool
-//! motor at seeds 1 / 2 0.21 / 0.26, |θ − θ̂| from ready 0.112 / 0.126 rad (0.137 / 0.2516).
+//! the multirotor preset 0.18 / 0.20 / 0.22 / 0.18 (0.21 / 0.20 / 0.23 / 0.22); the 36 V tool
+//! motor at seeds 1 / 2 0.21 / 0.28, |θ − θ̂| from ready 0.112 / 0.128 rad (0.137 / 0.2516).
 //! Every other preset, made-up and datasheet machine of the table is uncapped and unchanged.
 //! With the preset but the trigger on the tracked angle the servo ran back 0.49 / 0.88 / 0.53
 //! / 0.48 rad.
@@ -85,7 +85,8 @@ pub(super) fn fall_load<T: Real>(e: T, tracked: T, t: T, gain: T, lim: T) -> T {
 }
 
 /// The hold's stiffness for the load the fall reveals, armed at a brake's release on a
-/// saturating machine model. The rotor, at rest at the release, falls by e in t: an
+/// saturating machine model or where the current loop or the sampling caps the loop (both
+/// watch the direct angle, from which the fall is read). The rotor, at rest at the release, falls by e in t: an
 /// acceleration a = 2·e/t². A loop of ω_h·√(a/a_rated) moves it by the design travel under
 /// that load (0.27·a/ω², module docs of the hold), at most the capped ω_h and at least
 /// 1/[`RELEASE_WINDOW_RATIO`](super::RELEASE_WINDOW_RATIO) of the design's (the slowest fall
@@ -102,8 +103,21 @@ pub(super) fn fall_load<T: Real>(e: T, tracked: T, t: T, gain: T, lim: T) -> T {
 /// and the loop cycled between the limits (`loaded-start` seed 1: 0.72 rad back, |θ − θ̂|
 /// 1.0 rad from ready; seeds 3 and 4 lost). The gains scale as k², k and k³ (k the
 /// stiffness's share), so a quarter load's hold has a quarter of the rated one's
-/// proportional gain. Measured (`loaded-start`, a constant load from t = 0, backward travel /
-/// max |θ − θ̂| from ready, rad) in crates/fado-sim/tests/light_load_start.rs.
+/// proportional gain.
+///
+/// A capped loop on a linear model meets the same cycle through the inverter instead: the
+/// light rotor's hold at the rated stiffness swings its q current through zero, and at every
+/// phase current's zero crossing the dead-time compensation's residual moves θ̂. On the
+/// multirotor preset (`motors/multirotor-mn5006-22v.toml`, 8 µH, 40 kHz sampling) under a
+/// quarter of its rated torque the hold cycled between its ±62 A limits at ≈ 25 Hz and
+/// |θ − θ̂| from ready reached 0.44–0.95 rad at seeds 1–4; softened to the fall, 0.065–0.138.
+/// On the capped machines of crates/fado-sim/tests (the multirotor preset, the Estun 400 W
+/// servo, the made-up 750 W servo, the MAD 5010 kv200, the 36 V tool motor) at the rated
+/// load, a quarter of it and none, seeds 1–4, 57 of the 60 starts pass softened and 50 at the
+/// rated stiffness; the one it costs is the tool motor's unloaded seed 2, whose stiff hold
+/// kept θ̂ from drifting at rest after the release (0.046 rad; softened 0.502).
+/// Measured (`loaded-start`, a constant load from t = 0, backward travel / max |θ − θ̂| from
+/// ready, rad) in crates/fado-sim/tests/light_load_start.rs.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) struct Softening<T> {
     /// The rated load's electrical acceleration p·T_rated/Ĵ (rad/s²).
