@@ -648,6 +648,11 @@ impl<T: Real> ReleaseHold<T> {
         self.ts
     }
 
+    /// The loop's stiffness ω_h (rad/s) after the caps: its three poles at −ω_h.
+    pub fn stiffness(&self) -> T {
+        self.kp / self.kd
+    }
+
     /// Armed (at the start-up's end or at a brake's release) on a moving reference `speed_ref`
     /// and not acting: the held angle follows the watched angle (`watched`) wherever it goes
     /// further along the reference (module docs, "On a moving reference"). The reference's

@@ -87,6 +87,14 @@
 //! period during the catch (|θ − θ̂| 0.29 rad on seeds 2 and 3); 0.05–0.1 s holds the hub motor
 //! within 0.14–0.22 rad and the measured 1.1 kW map within 0.2–0.22 rad (seed 2: 0.33 and
 //! 0.39 rad without it); 0.15–0.2 s leaves the 1.1 kW map 0.26–0.29 rad.
+//! A heavy rotor's hold is slower than the period: the arming then lasts the hold's catch,
+//! [`CATCH_TIMES`]/ω_h ([`StandstillProbe::set_release_catch`]; 0.09 s on the hub motor, so
+//! every preset keeps one period). Measured on a drawn 116 kW IPMSM of 25 kg·m²
+//! (`fado-sim/tests/data/drawn/ipm-2p-800v-115696w.toml`, ω_h = 8.5 rad/s, catch 0.40 s):
+//! armed after one period the first reading falls in the catch, turns θ̂ at −0.87 rad/s and
+//! leaves |θ − θ̂| 0.24–0.36 rad at seeds 1–6 (five of six over the 0.25 rad bound); armed
+//! after the catch the probe does not start before `loaded-start`'s lift and the start keeps
+//! 0.025–0.11 rad.
 //!
 //! **After the standstill.** When the standstill ends (the speed reference leaves it: a
 //! hoist's lift after its brake's release) the probe stops, but the creep's cause does not:
@@ -151,6 +159,14 @@ pub struct StandstillProbeConfig<T> {
     pub arm_time: T,
 }
 
+/// The release hold's catch in units of 1/ω_h, 2 + √2 \[D\]: a load step's response of the
+/// hold's triple pole, x = a·t²·e^(−ω_h·t)/2, accelerates the rotor as
+/// a·(2 − 4u + u²)·e^(−u)/2 (u = ω_h·t), whose last change of sign is at u = 2 + √2; from there
+/// on the acceleration stays within 2.4 % of the load's, where before it swings from +1 to
+/// −0.21 times it. The probe's reading removes the acceleration through ω̂, whose lag
+/// and limiter-mode error leave a share of that swing in the torque balance.
+pub const CATCH_TIMES: f64 = 3.414_213_562_373_095;
+
 /// Largest angle reading (rad) the correction acts on (the small-signal reading's range).
 const MAX_READING: f64 = 0.5;
 
@@ -176,6 +192,9 @@ pub struct StandstillProbe<T> {
     arm_samples: u32,
     /// The standstill a brake's release begins: armed after one period (module docs).
     release: bool,
+    /// The release hold's catch in samples ([`Self::set_release_catch`]): the release's
+    /// arming lasts at least this long (0: one period).
+    release_samples: u32,
     /// Samples the standstill has held since it last ended (saturating at the arming time).
     gated: u32,
     /// Probing: armed, and the estimator has been in limiter mode since.
@@ -267,12 +286,28 @@ impl<T: Real> StandstillProbe<T> {
         Ok(probe)
     }
 
-    /// A brake opens now: the standstill that follows arms the probe after one period
-    /// instead of the arming time (module docs, "At a brake's release"), until the probe
-    /// starts or the speed reference `omega_ref` leaves the standstill
-    /// ([`Self::leave_release`]).
+    /// A brake opens now: the standstill that follows arms the probe after one period (or
+    /// the release hold's catch, [`Self::set_release_catch`]) instead of the arming time
+    /// (module docs, "At a brake's release"), until the probe starts or the speed reference
+    /// `omega_ref` leaves the standstill ([`Self::leave_release`]).
     pub fn arm_at_release(&mut self) {
         self.release = true;
+    }
+
+    /// The release hold of stiffness `omega_h` (rad/s, its three poles at −ω_h) catches the
+    /// rotor at a brake's release: the release's arming lasts at least [`CATCH_TIMES`]/ω_h
+    /// (module docs, "At a brake's release"). A non-finite or non-positive ω_h keeps one
+    /// period.
+    pub fn set_release_catch(&mut self, omega_h: T) {
+        let n = T::lit(CATCH_TIMES) / (omega_h * self.config.ts);
+        // NaN compares false: one period.
+        self.release_samples = if omega_h > T::zero() && n < T::lit(4e9) {
+            n.round().to_f64() as u32
+        } else if omega_h > T::zero() {
+            u32::MAX
+        } else {
+            0
+        };
     }
 
     /// Ends the release's short arming once the speed reference `omega_ref` (rad/s
@@ -292,6 +327,7 @@ impl<T: Real> StandstillProbe<T> {
             inv_count: self.inv_count,
             arm_samples: self.arm_samples,
             release: self.release,
+            release_samples: self.release_samples,
             spend_samples: self.spend_samples,
             ..Self::new_idle(self.config, self.period_samples)
         };
@@ -324,6 +360,7 @@ impl<T: Real> StandstillProbe<T> {
             period_samples,
             arm_samples: 1,
             release: false,
+            release_samples: 0,
             gated: 0,
             probing: false,
             phase: 0,
@@ -384,7 +421,7 @@ impl<T: Real> StandstillProbe<T> {
         self.carry = Carry::default();
         let n = self.period_samples;
         let arm = if self.release {
-            self.arm_samples.min(n)
+            self.arm_samples.min(n).max(self.release_samples)
         } else {
             self.arm_samples
         };

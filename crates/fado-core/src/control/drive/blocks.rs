@@ -116,8 +116,9 @@ impl<T: Real> Blocks<T> {
             max_modulation: t.modulation.max_modulation,
         })?;
         let probe_config = probe_config(c)?;
-        let probe = StandstillProbe::new(probe_config)?;
+        let mut probe = StandstillProbe::new(probe_config)?;
         let hold = release_hold(c, &probe_config, speed_config.i_max)?;
+        probe.set_release_catch(hold.stiffness());
         let limits = RatingsLimit::new(&t.limits, m)?;
         let start_ramp = StartRamp::new(&t.start_ramp, m, ts)?;
         Ok(Self {

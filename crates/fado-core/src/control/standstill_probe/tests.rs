@@ -359,6 +359,31 @@ fn a_brake_release_arms_the_probe_after_one_period() {
     assert!(!q.active());
 }
 
+/// A release hold slower than the period (ω_h = 8.5 rad/s, the drawn 116 kW IPMSM of
+/// 25 kg·m²: its catch (2 + √2)/ω_h = 0.40 s) holds the release's arming for the catch
+/// instead of one period (0.2 s here); a hold faster than the period (ω_h = 37.7 rad/s, the
+/// hub motor's: 0.09 s) keeps one period, and a non-finite ω_h one period too.
+#[test]
+fn a_slow_release_hold_arms_the_probe_after_its_catch() {
+    let (tau, flux) = (14.0, 0.1);
+    let config = StandstillProbeConfig {
+        arm_time: 0.5,
+        ..probe(2.2).config
+    };
+    let step = |p: &mut StandstillProbe<f64>| p.step(true, true, tau, 0.0, (0.0, tau), flux, 0.0);
+    // Samples of silence after a release before the probe's first Δi_d.
+    let silent = |omega_h: f64| {
+        let mut p = StandstillProbe::new(config).unwrap();
+        p.set_release_catch(omega_h);
+        p.arm_at_release();
+        (0..2000).take_while(|_| step(&mut p) == 0.0).count()
+    };
+    assert_eq!(silent(8.5), 402, "(2 + √2)/8.5 s at 1 ms");
+    assert_eq!(silent(37.7), 200, "one period");
+    assert_eq!(silent(f64::NAN), 200, "one period");
+    assert_eq!(silent(0.0), 200, "one period");
+}
+
 /// The amplitude follows the rotor's answer ([`amplitude`]): a light rotor, whose speed
 /// answers the probe's torque through the angle error (a first-order speed loop of 10 Hz
 /// around ω̇ = k·Δi_d), swings to 4.3 times the bound at the configured amplitude; with the
