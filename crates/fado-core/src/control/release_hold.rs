@@ -466,7 +466,7 @@ impl<T: Real> ReleaseHold<T> {
             fall_time: T::zero(),
             fall_gain: share / b,
             max_fall_load: (share * a_rated / b).step_min(i_max),
-            soft: fall::Softening::new(a_rated, design, omega * ts),
+            soft: fall::Softening::new(a_rated, design, omega * ts, travel),
         })
     }
 
@@ -769,6 +769,7 @@ impl<T: Real> ReleaseHold<T> {
         }
         self.held = self.held.saturating_add(1);
         let lim = self.i_max;
+        self.soft.track(e);
         let (kp, kd, ki_ts) = self.soft.gains(self.kp, self.kd, self.ki_ts);
         self.integral = crate::control::pi::clamp(self.integral + ki_ts * e, -lim, lim);
         let out = kp * e - kd * omega + self.integral;

@@ -561,3 +561,36 @@ fn a_capped_hold_starts_from_the_load_its_fall_reveals() {
         "{released} against {armed}, first {first} of {load}, share {share}"
     );
 }
+
+#[test]
+fn a_softened_hold_stiffens_its_damping_once_its_error_passes_the_onset() {
+    // A fall read as a quarter of the rated load softens the loop to k = 0.5 (K_p·k², K_d·k,
+    // K_i·k³); a held angle's error beyond half the 0.2 rad design travel raises K_d by its
+    // largest ratio to that onset, up to the capped loop's, and leaves K_p and K_i.
+    let (a_rated, design, ts, travel) = (1e4, 116.0, 1e-4, 0.2);
+    let mut soft = fall::Softening::new(a_rated, design, design * ts, travel);
+    let t = 2e-3;
+    soft.soften(0.25 * a_rated * t * t / 2.0, t, design);
+    let close = |(kp, kd, ki): (f64, f64, f64), want: (f64, f64, f64)| {
+        assert!(
+            (kp - want.0).abs() < 1e-9 && (kd - want.1).abs() < 1e-9 && (ki - want.2).abs() < 1e-9,
+            "{:?} against {want:?}",
+            (kp, kd, ki)
+        );
+    };
+    close(soft.gains(1.0, 1.0, 1.0), (0.25, 0.5, 0.125));
+    soft.track(0.08);
+    close(soft.gains(1.0, 1.0, 1.0), (0.25, 0.5, 0.125));
+    soft.track(-0.15);
+    close(soft.gains(1.0, 1.0, 1.0), (0.25, 0.75, 0.125));
+    soft.track(0.05);
+    close(soft.gains(1.0, 1.0, 1.0), (0.25, 0.75, 0.125));
+    soft.track(0.5);
+    close(soft.gains(1.0, 1.0, 1.0), (0.25, 1.0, 0.125));
+    soft.track(f64::NAN);
+    close(soft.gains(1.0, 1.0, 1.0), (0.25, 1.0, 0.125));
+    // Unsoftened (reset at the arming), the gains are the capped loop's at any error.
+    soft.reset();
+    soft.track(0.5);
+    close(soft.gains(1.0, 1.0, 1.0), (1.0, 1.0, 1.0));
+}
