@@ -80,6 +80,25 @@ fn saturated_rotors_whose_axes_meet_at_the_rated_current_pulse_below_it() {
     }
 }
 
+/// The drawn 137 kW IPMSM (2,650 kg·m²) under its rated torque at `loaded-start` seeds 3 and
+/// 4: its fall reaches the release hold's trigger late (29 ms after the release at seed 4),
+/// when the speed loop already carries 307 A of the load's ≈ 280 A, and the hold starts its
+/// integral from the speed loop's (`fado_core::control::release_hold`, `watch.rs`). Measured
+/// (backward travel / max |θ − θ̂| from ready, rad): 0.282 / 0.082 and 0.342 / 0.050; the hold
+/// started from zero dropped the torque to 14 A in a sample, 0.355 / 0.068 and 0.708 / 0.147.
+#[test]
+fn a_heavy_saturated_rotor_keeps_the_torque_its_speed_loop_carries_at_the_trigger() {
+    let name = "ipm-sat-15p-800v-137kw";
+    for seed in [3, 4] {
+        let (passed, _, max_error, backward) = loaded_start(name, seed);
+        println!("{name} seed {seed}: max {max_error:.3}, back {backward:.3} rad");
+        assert!(
+            passed,
+            "{name} seed {seed}: back {backward}, max {max_error}"
+        );
+    }
+}
+
 #[test]
 fn a_saturated_rotor_with_clear_axes_pulses_at_the_rated_current() {
     // The drawn 69 W IPMSM (Lq/Ld 2, q secant 44 % down at the rated current): the secant

@@ -70,8 +70,8 @@ fn saturated_machines_start_without_a_load() {
 /// travel, "The fall that reads low"). Measured (the scenario's checks: backward travel / max
 /// |θ − θ̂| from ready, rad; the rated load's stiffness in brackets): the saturated test IPMSM
 /// seeds 1–4 0.174/0.071, 0.231/0.052, 0.163/0.043, 0.180/0.084 (0.226/0.210, 0.103/0.260,
-/// 1.443/0.159, 0.182/0.159); the saturated traction IPMSM seeds 1, 3, 4 0.161/0.083,
-/// 0.118/0.033, 0.181/0.073 (0.715/1.006, 0.443/3.141, 0.991/3.142); its seed 2 misses
+/// 1.443/0.159, 0.182/0.159); the saturated traction IPMSM seeds 1, 3, 4 0.161/0.084,
+/// 0.118/0.033, 0.172/0.066 (0.715/1.006, 0.443/3.141, 0.991/3.142); its seed 2 misses
 /// (below).
 #[test]
 fn saturated_machines_start_at_a_quarter_load() {
@@ -108,9 +108,9 @@ fn the_traction_ipmsm_starts_at_half_load_where_a_phase_starves() {
 /// Two drawn saturated IPMSMs (`scripts/drawn-machines.py`, not used to design the hold's
 /// stiffness rule) under a quarter of their rated torque. Measured (the scenario's checks:
 /// backward travel / max |θ − θ̂| from ready, rad; the rated load's stiffness in brackets):
-/// the 3-pole-pair 127 W seeds 1–4 0.164/0.053, 0.315/0.049, 0.166/0.057, 0.148/0.033
+/// the 3-pole-pair 127 W seeds 1–4 0.164/0.055, 0.315/0.049, 0.166/0.059, 0.148/0.033
 /// (0.116/0.591, 0.128/0.916, 0.090/1.287, 0.096/0.474); the 2-pole-pair 6.8 kW seeds 1–4
-/// 0.133/0.054, 0.274/0.047, 0.173/0.052, 0.152/0.047 (0.237/0.391, 0.454/0.222,
+/// 0.134/0.054, 0.273/0.047, 0.168/0.021, 0.146/0.114 (0.237/0.391, 0.454/0.222,
 /// 0.062/0.461, 0.157/0.225).
 #[test]
 fn drawn_saturated_machines_start_at_a_quarter_load() {
@@ -146,7 +146,7 @@ fn pmsyrm_starts_without_a_load() {
 
 /// Unloaded and light-load starts that still miss the criteria. Measured (the scenario's
 /// checks: backward travel / max |θ − θ̂| from ready, rad; with the hold at the rated load's
-/// stiffness in brackets): without a load the saturated traction IPMSM seed 2 2.329/3.140
+/// stiffness in brackets): without a load the saturated traction IPMSM seed 2 53.6/3.139
 /// (0.696/0.537: at its start angle θ̂ and the direct angle drift together at 2.5 rad/s on
 /// the rotor at rest under the release's 23 A d current, and the softer hold that drift
 /// triggers holds a θ̂ that keeps drifting), the 50 kW IPMSM seed 2 0.002/0.269 (a linear
@@ -201,7 +201,7 @@ fn pmsyrm_starts_without_a_load() {
 /// 0.594/0.474; V_th ×0 / 0.5 / 0.8 / 1.2 0.326/1.254, 0.251/0.713, 0.505/0.368, 0.997/0.637;
 /// Td ×0.9 / 0.94 / 0.97 / 1.03 0.171/0.534, 0.487/0.803, 0.500/0.322, 0.481/0.503.
 #[test]
-#[ignore = "unloaded: traction s2 lost (2.329 rad back, |θ − θ̂| 3.140), 50 kW s2 |θ − θ̂| 0.269 rad; traction s2 at quarter load 0.689 rad back; 50 kW quarter load s2/s3 lost, s4 0.661 rad back"]
+#[ignore = "unloaded: traction s2 lost (53.6 rad back, |θ − θ̂| 3.139), 50 kW s2 |θ − θ̂| 0.269 rad; traction s2 at quarter load 0.689 rad back; 50 kW quarter load s2/s3 lost, s4 0.661 rad back"]
 fn unloaded_and_light_load_starts_that_still_miss() {
     let cases = [
         ("tests/data/traction-ipm-saturated.toml", 0.0, 2),
