@@ -230,13 +230,11 @@ pub fn current_bandwidth_for_hold<T: Real>(
 /// (module docs, "When").
 pub const RELEASE_WINDOW_RATIO: f64 = 8.0;
 
-/// The time (s) within which a fall after a brake's release triggers the hold on `machine`:
-/// [`RELEASE_WINDOW_RATIO`]·√(2·trigger/a_rated), a_rated = p·T_rated/Ĵ (non-finite where the
-/// model gives no rated torque; the tuning's window then holds).
-fn release_window<T: Real>(machine: &MachineModel<T>, trigger: T) -> T {
-    let p = T::lit(machine.pole_pairs as f64);
-    let accel = p * machine.rated_torque / machine.inertia;
-    T::lit(RELEASE_WINDOW_RATIO) * (T::lit(2.0) * trigger / accel).step_sqrt()
+/// The triple pole's gains at ω_h `omega` for b (electrical rad/s² per A) sampled every `ts`:
+/// K_p = 3·ω_h²/b, K_d = 3·ω_h/b and K_i·Ts = ω_h³·Ts/b (module docs, "The loop").
+fn loop_gains<T: Real>(omega: T, b: T, ts: T) -> (T, T, T) {
+    let (kp, kd) = (T::lit(3.0) * omega * omega / b, T::lit(3.0) * omega / b);
+    (kp, kd, omega * omega * omega * ts / b)
 }
 
 /// Peak of t²·e^(−t)/2 (at t = 2): the largest travel of the triple-pole loop per a/ω_h².
@@ -384,6 +382,9 @@ pub struct ReleaseHold<T> {
     resumed: T,
     /// The stiffness for the load the fall reveals (`fall`, [`Softening`](fall::Softening)).
     soft: fall::Softening<T>,
+    /// The speed loop's integral of the last sample (A), the torque the hold replaces at its
+    /// trigger ([`set_carried`](Self::set_carried)).
+    carried: T,
 }
 
 impl<T: Real> ReleaseHold<T> {
@@ -406,15 +407,14 @@ impl<T: Real> ReleaseHold<T> {
         let n = window / ts;
         check::below("release_hold.window", n, T::lit(4e9), "below 4e9 samples")?;
         let b = T::lit(1.5) * p * p * machine.flux_linkage / machine.inertia;
-        let release_n = release_window(machine, trigger) / ts;
+        let release_n = watch::release_window(machine, trigger) / ts;
         let design = design_omega(machine, travel);
         let omega = design
             .step_min(T::two_pi() * current_bandwidth_hz / T::lit(10.0))
             .step_min(T::lit(0.1) / ts);
         let a_rated = p * machine.rated_torque / machine.inertia;
         let share = fall::fall_share(omega, design);
-        let (kp, kd) = (T::lit(3.0) * omega * omega / b, T::lit(3.0) * omega / b);
-        let ki_ts = omega * omega * omega * ts / b;
+        let (kp, kd, ki_ts) = loop_gains(omega, b, ts);
         if !(kp.is_finite() && kd.is_finite() && ki_ts.is_finite() && resume_step.is_finite()) {
             return Err(ConfigError::OutOfRange {
                 field: "release_hold.travel",
@@ -466,7 +466,8 @@ impl<T: Real> ReleaseHold<T> {
             fall_time: T::zero(),
             fall_gain: share / b,
             max_fall_load: (share * a_rated / b).step_min(i_max),
-            soft: fall::Softening::new(a_rated, design, omega * ts),
+            soft: fall::Softening::new(a_rated, design, omega * ts, travel),
+            carried: T::zero(),
         })
     }
 
@@ -511,6 +512,13 @@ impl<T: Real> ReleaseHold<T> {
     /// after 10/ω_h: the rule of [`holds_through_standstill`].
     pub fn set_through_standstill(&mut self, on: bool) {
         self.through_standstill = on;
+    }
+
+    /// The speed loop's integral `iq` (A of magnet q current) of this sample: the torque it
+    /// carries, which a hold armed at a brake's release on a saturating model starts its
+    /// integral from when it triggers (`watch.rs`).
+    pub fn set_carried(&mut self, iq: T) {
+        self.carried = iq;
     }
 
     /// Arms the hold at the angle `theta_hold` (the alignment's).
@@ -775,6 +783,7 @@ impl<T: Real> ReleaseHold<T> {
         }
         self.held = self.held.saturating_add(1);
         let lim = self.i_max;
+        self.soft.track(e);
         let (kp, kd, ki_ts) = self.soft.gains(self.kp, self.kd, self.ki_ts);
         self.integral = crate::control::pi::clamp(self.integral + ki_ts * e, -lim, lim);
         let out = kp * e - kd * omega + self.integral;

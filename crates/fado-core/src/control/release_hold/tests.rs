@@ -561,3 +561,70 @@ fn a_capped_hold_starts_from_the_load_its_fall_reveals() {
         "{released} against {armed}, first {first} of {load}, share {share}"
     );
 }
+
+#[test]
+fn a_softened_hold_stiffens_its_damping_once_its_error_passes_the_onset() {
+    // A fall read as a quarter of the rated load softens the loop to k = 0.5 (K_p·k², K_d·k,
+    // K_i·k³); a held angle's error beyond half the 0.2 rad design travel raises K_d by its
+    // largest ratio to that onset, up to the capped loop's, and leaves K_p and K_i.
+    let (a_rated, design, ts, travel) = (1e4, 116.0, 1e-4, 0.2);
+    let mut soft = fall::Softening::new(a_rated, design, design * ts, travel);
+    let t = 2e-3;
+    soft.soften(0.25 * a_rated * t * t / 2.0, t, design);
+    let close = |(kp, kd, ki): (f64, f64, f64), want: (f64, f64, f64)| {
+        assert!(
+            (kp - want.0).abs() < 1e-9 && (kd - want.1).abs() < 1e-9 && (ki - want.2).abs() < 1e-9,
+            "{:?} against {want:?}",
+            (kp, kd, ki)
+        );
+    };
+    close(soft.gains(1.0, 1.0, 1.0), (0.25, 0.5, 0.125));
+    soft.track(0.08);
+    close(soft.gains(1.0, 1.0, 1.0), (0.25, 0.5, 0.125));
+    soft.track(-0.15);
+    close(soft.gains(1.0, 1.0, 1.0), (0.25, 0.75, 0.125));
+    soft.track(0.05);
+    close(soft.gains(1.0, 1.0, 1.0), (0.25, 0.75, 0.125));
+    soft.track(0.5);
+    close(soft.gains(1.0, 1.0, 1.0), (0.25, 1.0, 0.125));
+    soft.track(f64::NAN);
+    close(soft.gains(1.0, 1.0, 1.0), (0.25, 1.0, 0.125));
+    // Unsoftened (reset at the arming), the gains are the capped loop's at any error.
+    soft.reset();
+    soft.track(0.5);
+    close(soft.gains(1.0, 1.0, 1.0), (1.0, 1.0, 1.0));
+}
+
+#[test]
+fn a_release_hold_on_a_saturating_model_takes_over_the_speed_loops_torque() {
+    // Armed at a brake's release on a saturating model, the hold triggered by a fall of the
+    // direct angle starts its integral from the speed loop's where that acts against the fall
+    // (θ_hold − θ > 0: a positive torque), from zero where it pushes with the fall, and a
+    // linear model's hold from zero.
+    let m = MachineModel::<f64>::paper();
+    let t = ReleaseHoldTuning {
+        enabled: true,
+        ..ReleaseHoldTuning::default()
+    };
+    let (ts, i_max) = (1e-4, 40.0);
+    let integral_at_trigger = |saturating: bool, carried: f64| {
+        let mut h = ReleaseHold::new(&t, &m, ts, 250.0, i_max).unwrap();
+        h.set_saturating(saturating);
+        h.arm_at_release(1.0);
+        h.set_carried(carried);
+        // The linear model's hold watches the tracked angle: both fall.
+        assert!(matches!(h.step(0.0, 0.97, 0.97), HoldAction::Hold(_)));
+        h.integral
+    };
+    let first = integral_at_trigger(true, 0.0);
+    assert!(first.abs() < 1.0, "{first}");
+    let taken = integral_at_trigger(true, 12.0);
+    // The first sample's integral term K_i·Ts·e adds to either start.
+    assert!((taken - first - 12.0).abs() < 1e-9, "{taken} {first}");
+    let against = integral_at_trigger(true, -12.0);
+    assert!((against - first).abs() < 1e-9, "{against} {first}");
+    let limited = integral_at_trigger(true, 100.0);
+    assert!((limited - i_max).abs() < 1e-9, "{limited}");
+    let linear = integral_at_trigger(false, 12.0);
+    assert!((linear - first).abs() < 1e-9, "{linear} {first}");
+}
