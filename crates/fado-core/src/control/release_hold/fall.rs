@@ -118,12 +118,12 @@ pub(super) fn fall_load<T: Real>(e: T, tracked: T, t: T, gain: T, lim: T) -> T {
 /// phase current's zero crossing the dead-time compensation's residual moves θ̂. On the
 /// multirotor preset (`motors/multirotor-mn5006-22v.toml`, 8 µH, 40 kHz sampling) under a
 /// quarter of its rated torque the hold cycled between its ±62 A limits at ≈ 25 Hz and
-/// |θ − θ̂| from ready reached 0.44–0.95 rad at seeds 1–4; softened to the fall, 0.065–0.138.
+/// |θ − θ̂| from ready reached 0.44–0.95 rad at seeds 1–4; softened to the fall, 0.065–0.121.
 /// On the capped machines of crates/fado-sim/tests (the multirotor preset, the Estun 400 W
 /// servo, the made-up 750 W servo, the MAD 5010 kv200, the 36 V tool motor) at the rated
 /// load, a quarter of it and none, seeds 1–4, 57 of the 60 starts pass softened and 50 at the
 /// rated stiffness; the one it costs is the tool motor's unloaded seed 2, whose stiff hold
-/// kept θ̂ from drifting at rest after the release (0.046 rad; softened 0.502).
+/// kept θ̂ from drifting at rest after the release (0.046 rad; softened 0.637).
 /// Measured (`loaded-start`, a constant load from t = 0, backward travel / max |θ − θ̂| from
 /// ready, rad) in crates/fado-sim/tests/light_load_start.rs.
 ///
