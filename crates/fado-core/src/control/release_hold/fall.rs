@@ -114,6 +114,9 @@ pub(super) struct Softening<T> {
     samples: u32,
     /// The stiffness's share of ω_h (1: the design's).
     k: T,
+    /// Armed at a brake's release on a linear salient model, the hold softens too
+    /// ([`ReleaseHold::set_dead_time_voltage`](super::ReleaseHold::set_dead_time_voltage)).
+    pub(super) linear: bool,
 }
 
 impl<T: Real> Softening<T> {
@@ -125,6 +128,7 @@ impl<T: Real> Softening<T> {
             design,
             samples: (T::lit(super::SETTLE_TIMES) / omega_ts).round().to_f64() as u32,
             k: T::one(),
+            linear: false,
         }
     }
 

@@ -39,7 +39,10 @@ impl<T: Real> ReleaseHold<T> {
             return false;
         }
         self.active = true;
-        self.soften(fall);
+        // A linear salient model's hold reads its stiffness from the direct angle's travel
+        // (the tracked angle that triggers lags the fall).
+        let soft_fall = if self.soft.linear { e.abs() } else { fall };
+        self.soften(soft_fall);
         if self.released && self.fall_gain > T::zero() {
             let tracked = crate::wrap_angle(self.theta_hold - theta_tracked);
             let (gain, lim) = (self.fall_gain, self.max_fall_load);
