@@ -153,6 +153,21 @@ fn ipmsm_50k_starts_under_light_loads() {
     }
 }
 
+/// The Flipsky 6215 12S datasheet multirotor motor (salient, 15/22 µH) under a quarter of its
+/// rated torque, whose hold softens as the 50 kW IPMSM's (`fado_core::control::release_hold`,
+/// "The light load on a salient rotor"). Measured (backward travel / max |θ − θ̂| from ready,
+/// rad, seeds 1–4): 0.181/0.065, 0.200/0.065, 0.223/0.136, 0.196/0.068 (at the rated load's
+/// stiffness 0.902/1.224, lost, 0.070/2.264, 0.262/0.632).
+#[test]
+fn salient_multirotor_starts_at_a_quarter_load() {
+    let toml = motor("tests/data/multirotor/flipsky-6215-kv170-12s.toml");
+    for seed in 1..=4 {
+        let (passed, back, err) = start(&toml, 0.25, seed);
+        println!("Flipsky 6215 seed {seed}: back {back:.3} rad, max |θ − θ̂| {err:.3} rad");
+        assert!(passed, "seed {seed}: back {back}, err {err}");
+    }
+}
+
 /// Unloaded and light-load starts that still miss the criteria. Measured (the scenario's
 /// checks: backward travel / max |θ − θ̂| from ready, rad; with the hold at the rated load's
 /// stiffness in brackets): without a load the saturated traction IPMSM seed 2 1.184/3.141
@@ -164,7 +179,10 @@ fn ipmsm_50k_starts_under_light_loads() {
 /// IPMSM seed 2 under a quarter and half of the rated torque 0.918/0.094 (0.489/0.370) and
 /// 0.291/0.262 (0.565/0.409); the 5 kW PM-SyRM preset under a tenth of its rated torque
 /// seed 1 0.450/0.414 (softened to the load its fall reveals, as the 50 kW IPMSM's hold:
-/// 0.239/0.138, but then its quarter load's seed 2 runs back 0.536 rad instead of 0.126).
+/// 0.239/0.138, but then its quarter load's seed 2 runs back 0.536 rad instead of 0.126); the
+/// Flipsky 6215 12S multirotor motor under a tenth of its rated torque seed 3 0.281/0.315
+/// and without a load seed 2 1.975/0.867 (at the rated load's stiffness 184.7/1.145 and
+/// lost).
 ///
 /// The unloaded misses and the test IPMSM's are the inverter's dead time: with
 /// `[inverter] dead_time = 0` the traction seed 2 gives 0.0003/0.035, the PM-SyRM
@@ -209,7 +227,7 @@ fn ipmsm_50k_starts_under_light_loads() {
 /// 0.594/0.474; V_th ×0 / 0.5 / 0.8 / 1.2 0.326/1.254, 0.251/0.713, 0.505/0.368, 0.997/0.637;
 /// Td ×0.9 / 0.94 / 0.97 / 1.03 0.171/0.534, 0.487/0.803, 0.500/0.322, 0.481/0.503.
 #[test]
-#[ignore = "unloaded: traction s2 3.141 rad, 50 kW s2 0.269 rad; traction s2 at quarter/half load 0.918/0.291 rad back; 5 kW PM-SyRM tenth load s1 0.414 rad"]
+#[ignore = "unloaded: traction s2 3.141 rad, 50 kW s2 0.269 rad; traction s2 at quarter/half load 0.918/0.291 rad back; 5 kW PM-SyRM tenth load s1 0.414 rad; Flipsky 6215 tenth load s3 0.315 rad, unloaded s2 1.975 rad back"]
 fn unloaded_and_light_load_starts_that_still_miss() {
     let cases = [
         ("tests/data/traction-ipm-saturated.toml", 0.0, 2),
@@ -217,6 +235,8 @@ fn unloaded_and_light_load_starts_that_still_miss() {
         ("tests/data/traction-ipm-saturated.toml", 0.25, 2),
         ("tests/data/traction-ipm-saturated.toml", 0.5, 2),
         ("../../motors/pmsyrm-5k.toml", 0.1, 1),
+        ("tests/data/multirotor/flipsky-6215-kv170-12s.toml", 0.1, 3),
+        ("tests/data/multirotor/flipsky-6215-kv170-12s.toml", 0.0, 2),
     ];
     for (path, fraction, seed) in cases {
         let (passed, back, err) = start(&motor(path), fraction, seed);

@@ -26,7 +26,15 @@
 //! stiffness lets a light load (the 2.2 kW IPMSM at a quarter load 0.20–0.24 rad instead of
 //! 0.07, the 5 kW PM-SyRM's quarter load at seed 2 0.536 rad instead of 0.126), so only a rotor
 //! whose dead-time voltage turns the direct angle faster than ω_h softens
-//! ([`DEAD_TIME_RATE_RATIO`]): of the presets the 50 kW IPMSM.
+//! ([`DEAD_TIME_RATE_RATIO`]): of the presets the 50 kW IPMSM. Of the datasheet test machines
+//! the salient Flipsky 6215 12S multirotor motor softens too
+//! (`crates/fado-sim/tests/data/multirotor/flipsky-6215-kv170-12s.toml`, seeds 1–4, backward
+//! travel / max |θ − θ̂| from ready, rad; the rated stiffness in brackets): a quarter of its
+//! rated torque 0.181/0.065, 0.200/0.065, 0.223/0.136, 0.196/0.068 (0.902/1.224, lost,
+//! 0.070/2.264, 0.262/0.632), a tenth 0.212/0.082, 0.215/0.026, 0.281/0.315, 0.221/0.222 (every
+//! seed lost or beyond 1.1 rad), no load 0.007/0.015, 1.975/0.867, 0/0.041, 0/0.035 (every
+//! seed beyond 1.1 rad), the rated torque 0.224–0.242 rad back, |θ − θ̂| 0.07–0.14
+//! (0.221–0.240, 0.07–0.22).
 
 use super::ReleaseHold;
 use crate::Real;
