@@ -125,6 +125,12 @@
 //! 50 kW IPMSM's 0.097 the largest), which keep the hand-over (docs/method/startup.md, "The
 //! loaded standstill after the release").
 //!
+//! # The light load on a salient rotor
+//! Where the inverter's dead-time voltage turns a linear salient model's direct angle faster
+//! than ω_h (the 50 kW IPMSM), a hold armed at a brake's release takes the stiffness for the
+//! load its fall reveals: at the rated stiffness a light load's hold rings through the
+//! dead-time band and loses the estimate (`release_hold/dead_time.rs`).
+//!
 //! # The load the fall reveals
 //! Where the current loop or the sampling caps ω_h, a hold armed at a brake's release watches
 //! the direct angle and starts its integral from the share of the load its capped stiffness
@@ -133,6 +139,7 @@
 use crate::error::{ConfigError, check};
 use crate::{MachineModel, Real};
 
+pub use dead_time::DEAD_TIME_RATE_RATIO;
 pub use tuning::ReleaseHoldTuning;
 
 /// The loop's speed filter on a saturating machine model: 1/(4·ω_h) \[A\] instead of
@@ -722,16 +729,6 @@ impl<T: Real> ReleaseHold<T> {
         self.active && !standstill_hold && done
     }
 
-    /// Armed at a brake's release on a saturating model or where the current loop or the
-    /// sampling caps the loop (it then watches the direct angle), the stiffness for the load
-    /// the fall of `fall` (rad, direct angle) since the release reveals ([`fall::Softening`]).
-    fn soften(&mut self, fall: T) {
-        if self.released && (self.release_on_direct || self.fall_gain > T::zero()) {
-            let omega_h = self.kp / self.kd;
-            self.hold_samples = self.soft.soften(fall, self.fall_time, omega_h);
-        }
-    }
-
     /// One sample: the speed reference `speed_ref`, the estimator's tracked angle θ̂
     /// (`theta_tracked`, which triggers the hold unless it was armed at a brake's release)
     /// and its direct rotor-flux angle (`theta`, which the loop holds and which triggers a
@@ -792,6 +789,7 @@ impl<T: Real> ReleaseHold<T> {
     }
 }
 
+mod dead_time;
 mod fall;
 mod tuning;
 mod watch;

@@ -61,7 +61,11 @@ use crate::Real;
 /// takes the share k·|e|_max/(0.5·travel) of the capped loop's, at most all of it. Measured
 /// (`loaded-start` rated load, backward travel / max |θ − θ̂| from ready, rad): from 0.75·travel
 /// the drawn 127 W IPMSM's seed 2 runs 0.500 rad back, from 0.5·travel 0.498; the traction
-/// IPMSM's seed 2 0.462 / 0.202 and 0.473 / 0.152.
+/// IPMSM's seed 2 0.462 / 0.202 and 0.473 / 0.152. A linear salient model's softened hold
+/// (`release_hold/dead_time.rs`) keeps the fall's damping: stiffened, its D path turns the
+/// direct angle's jumps at the phase currents' zero crossings back into the ringing, and the
+/// 50 kW IPMSM under a tenth of its rated torque loses seeds 3 and 4 (|θ − θ̂| from ready
+/// 2.82 / 2.75 rad; 0.073 / 0.078 with the fall's damping).
 const STIFFEN_ONSET_RATIO: f64 = 0.5;
 
 /// The share of a load the hold armed at a brake's release takes from the fall's start
@@ -167,6 +171,9 @@ pub(super) struct Softening<T> {
     onset: T,
     /// The largest |error| of the held angle since the trigger (rad).
     peak: T,
+    /// Armed at a brake's release on a linear salient model, the hold softens too
+    /// ([`ReleaseHold::set_dead_time_voltage`](super::ReleaseHold::set_dead_time_voltage)).
+    pub(super) linear: bool,
 }
 
 impl<T: Real> Softening<T> {
@@ -178,6 +185,7 @@ impl<T: Real> Softening<T> {
             design,
             samples: (T::lit(super::SETTLE_TIMES) / omega_ts).round().to_f64() as u32,
             k: T::one(),
+            linear: false,
             onset: T::lit(STIFFEN_ONSET_RATIO) * travel,
             peak: T::zero(),
         }
@@ -228,8 +236,10 @@ impl<T: Real> Softening<T> {
     fn damping(&self) -> T {
         let k = self.k;
         let r = self.peak / self.onset;
-        // NaN compares false: the fall's.
-        if !(k < T::one() && r > T::one()) {
+        // NaN compares false: the fall's. A linear salient model's hold keeps it: its D path
+        // is what turns the direct angle's jumps at the currents' zero crossings into the
+        // ringing its softening is there to avoid.
+        if self.linear || !(k < T::one() && r > T::one()) {
             return k;
         }
         (k * r).step_min(T::one())

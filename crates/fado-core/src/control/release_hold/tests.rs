@@ -593,6 +593,11 @@ fn a_softened_hold_stiffens_its_damping_once_its_error_passes_the_onset() {
     soft.reset();
     soft.track(0.5);
     close(soft.gains(1.0, 1.0, 1.0), (1.0, 1.0, 1.0));
+    // A linear salient model's softened hold keeps the fall's damping at any error.
+    soft.linear = true;
+    soft.soften(0.25 * a_rated * t * t / 2.0, t, design);
+    soft.track(0.5);
+    close(soft.gains(1.0, 1.0, 1.0), (0.25, 0.5, 0.125));
 }
 
 #[test]
@@ -627,4 +632,50 @@ fn a_release_hold_on_a_saturating_model_takes_over_the_speed_loops_torque() {
     assert!((limited - i_max).abs() < 1e-9, "{limited}");
     let linear = integral_at_trigger(false, 12.0);
     assert!((linear - first).abs() < 1e-9, "{linear} {first}");
+}
+
+/// A rigid rotor θ̈ = b·(i − i_L) released at rest under `fraction` of the rated load, the
+/// hold armed at the release with the dead-time voltage `v_dt` (V): the largest travel.
+fn release_travel(fraction: f64, v_dt: f64) -> f64 {
+    let m = MachineModel::paper();
+    let ts = 1e-4;
+    let tuning = ReleaseHoldTuning {
+        enabled: true,
+        ..ReleaseHoldTuning::default()
+    };
+    let (b, i_rated) = rigid_rotor(&m);
+    let i_load = fraction * i_rated;
+    let mut h = ReleaseHold::new(&tuning, &m, ts, 250.0, 2.0 * i_rated).unwrap();
+    h.set_dead_time_voltage(v_dt, m.flux_linkage);
+    let (mut theta, mut omega, mut i) = (0.3, 0.0, 0.0);
+    h.arm_at_release(0.3);
+    let mut worst: f64 = 0.0;
+    for _ in 0..20_000 {
+        match h.step(0.0, theta, theta) {
+            HoldAction::Hold(x) => i = x,
+            HoldAction::Handover(_) => return worst,
+            HoldAction::Idle => {}
+        }
+        omega += b * (i - i_load) * ts;
+        theta += omega * ts;
+        worst = worst.max(0.3 - theta);
+    }
+    panic!("no hand-over")
+}
+
+#[test]
+fn a_dead_time_voltage_that_turns_the_direct_angle_faster_than_the_hold_softens_it() {
+    // The paper's rotor, ω_h = 72 rad/s: λ̂f·ω_h = 6.3 V. Below it the quarter load keeps the
+    // rated stiffness and moves the rotor by a quarter of the design's 0.2 rad; above it the
+    // hold softens to the load the fall reveals and moves it by about the design travel
+    // (measured 0.053 and 0.197 rad; the rated load 0.189 and 0.194 rad).
+    let stiff = release_travel(0.25, 1.0);
+    let soft = release_travel(0.25, 100.0);
+    assert!(stiff > 0.04 && stiff < 0.07, "{stiff}");
+    assert!(soft > 0.15 && soft < 0.25, "{soft}");
+    // A non-finite voltage keeps the rated stiffness.
+    assert_eq!(release_travel(0.25, f64::NAN), stiff);
+    // The rated load is held at the rated stiffness either way.
+    let rated = release_travel(1.0, 100.0);
+    assert!((rated - release_travel(1.0, 1.0)).abs() < 0.02, "{rated}");
 }

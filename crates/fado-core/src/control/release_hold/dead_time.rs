@@ -1,0 +1,63 @@
+//! The light load on a salient rotor: where the inverter's dead-time voltage turns the direct
+//! angle faster than the hold's ω_h, a hold armed at a brake's release takes the stiffness
+//! for the load its fall reveals.
+//!
+//! # Why
+//! A light load's hold at the rated load's stiffness swings its q current through zero; on a
+//! salient rotor the active flux, and with it |λ̂r|, is smallest there (the 50 kW IPMSM's
+//! release d current of +40 A leaves 0.033 Wb of its 0.066 Wb magnet), and the swing carries
+//! every phase current through the inverter's dead-time band, where the compensation's
+//! residual is a voltage error of up to the dead time's 13 V. The direct angle then moves by
+//! that error over |λ̂r| (0.027 rad in one 50 µs sample at 0.069 Wb, the rotor 0.0007 rad),
+//! and the loop's D path turns it into the opposite limit: on the 50 kW IPMSM at a quarter of
+//! its rated torque (`loaded-start` seed 2) the hold rings between −100 and +220 A of q
+//! current at ≈ 90 Hz from the trigger, and the estimate is lost after the hand-over (with
+//! `[inverter] dead_time = 0` the same loop settles within 20 ms). Armed at a brake's release
+//! on a linear salient model the hold therefore takes the stiffness for the load its fall
+//! reveals ([`ReleaseHold::set_dead_time_voltage`], `fall.rs`), read from the direct
+//! angle's travel at the trigger (the tracked angle lags the fall: from
+//! its travel the rated load's stiffness comes out at ≈ 0.45 and the rated load runs the 50 kW
+//! rotor back 0.76–1.15 rad). Measured (`loaded-start`, a constant load from t = 0, backward
+//! travel rad, seeds 1–4; the rated stiffness in brackets): the 50 kW IPMSM at 0.1 of its
+//! rated torque 0.353, 0.257, 0.180, 0.215 (0.214, 3.42, 0.056 with |θ − θ̂| 1.08, 0.245 with
+//! 0.291), at 0.25 0.300, 0.264, 0.156, 0.278 (0.355, lost, lost, 0.661), at 0.5 0.19–0.32
+//! (0.15–0.21), at the rated torque 0.340, 0.316, 0.241, 0.271 (0.332, 0.305, 0.241, 0.271).
+//! A softened hold lets every load run back by about its design travel, more than the rated
+//! stiffness lets a light load (the 2.2 kW IPMSM at a quarter load 0.20–0.24 rad instead of
+//! 0.07, the 5 kW PM-SyRM's quarter load at seed 2 0.536 rad instead of 0.126), so only a rotor
+//! whose dead-time voltage turns the direct angle faster than ω_h softens
+//! ([`DEAD_TIME_RATE_RATIO`]): of the presets the 50 kW IPMSM. Of the datasheet test machines
+//! the salient Flipsky 6215 12S multirotor motor softens too
+//! (`crates/fado-sim/tests/data/multirotor/flipsky-6215-kv170-12s.toml`, seeds 1–4, backward
+//! travel / max |θ − θ̂| from ready, rad; the rated stiffness in brackets): a quarter of its
+//! rated torque 0.181/0.065, 0.200/0.065, 0.223/0.136, 0.196/0.068 (0.902/1.224, lost,
+//! 0.070/2.264, 0.262/0.632), a tenth 0.212/0.082, 0.215/0.026, 0.281/0.315, 0.221/0.222 (every
+//! seed lost or beyond 1.1 rad), no load 0.007/0.015, 1.975/0.867, 0/0.041, 0/0.035 (every
+//! seed beyond 1.1 rad), the rated torque 0.224–0.242 rad back, |θ − θ̂| 0.07–0.14
+//! (0.221–0.240, 0.07–0.22).
+
+use super::ReleaseHold;
+use crate::Real;
+
+/// A linear salient model's hold softens to the load its fall reveals where the inverter's
+/// dead-time voltage over the magnet's flux, V̂/λ̂f, a false speed of the direct angle, exceeds
+/// this many times ω_h: 1 \[A\], measured, not derived (module docs). The presets: the
+/// 50 kW IPMSM 14 V / 0.066 Wb = 212 rad/s against ω_h = 130 rad/s (1.6: it softens), the
+/// 5 kW PM-SyRM 36 against 110 rad/s (0.33) and the 2.2 kW IPMSM 14 against 62 rad/s (0.23),
+/// which keep the rated stiffness.
+pub const DEAD_TIME_RATE_RATIO: f64 = 1.0;
+
+impl<T: Real> ReleaseHold<T> {
+    /// On a linear salient model whose inverter's dead-time voltage `dead_time_voltage`
+    /// (V̂ = Td·f_sw·Vdc + V_th, V) over the magnet's flux `flux` (Wb) is a false speed of the
+    /// direct angle above the loop's ω_h ([`DEAD_TIME_RATE_RATIO`]), the hold armed at a brake's
+    /// release takes the stiffness for the load the direct angle's travel at the trigger
+    /// reveals, as on a saturating model (module docs); the tracked angle still triggers it.
+    /// Non-finite inputs leave the rated stiffness.
+    pub fn set_dead_time_voltage(&mut self, dead_time_voltage: T, flux: T) {
+        let omega_h = self.kp / self.kd;
+        let rate = dead_time_voltage / flux;
+        // NaN compares false: the rated stiffness.
+        self.soft.linear = rate > T::lit(DEAD_TIME_RATE_RATIO) * omega_h;
+    }
+}
