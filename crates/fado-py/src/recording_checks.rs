@@ -8,7 +8,7 @@
 //! |---|---|---|
 //! | current beyond the bound | over 1 % of samples with \|i\| ≥ the plausible current | mA for A (max × 1000), the voltage columns in the current slots |
 //! | voltage beyond the bound | over 1 % of samples with \|v\| ≥ the plausible voltage | mV for V, the current columns in the voltage slots |
-//! | voltage too small | max \|v\| < 0.1 × R̂s·max \|i\| while current flows (max \|i\| ≥ [`FLOW_SHARE`] × `rated_current`) | kV for V |
+//! | voltage too small | max \|v\| < 0.1 × R̂s·max \|i\| while current flows (max \|i\| ≥ 5 % of `rated_current`, `FLOW_SHARE`) | kV for V |
 //! | constant column | every sample of one column equal while its partner varies | a dead channel, a column taken twice |
 //! | non-finite samples | over 1 % of samples NaN or ±∞, or a run of them lasting 1 ms or more (`BURST_SECONDS`) | a gap in the logger |
 //! | start angle | \|θ0\| > 2π | degrees for radians |
