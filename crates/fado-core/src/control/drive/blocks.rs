@@ -279,10 +279,10 @@ fn release_hold<T: Real>(
     if !m.magnetic_model().is_linear() {
         hold.set_speed_filter_ratio(T::lit(SATURATING_SPEED_FILTER_RATIO));
         hold.set_saturating(true);
-    } else if m.is_salient() {
+    } else {
         let d = c.dead_time_compensation_config();
         let v = d.dead_time * d.switching_frequency * d.dc_voltage + d.threshold_voltage;
-        hold.set_dead_time_voltage(v, m.flux_linkage);
+        hold.set_dead_time_voltage(v, m.flux_linkage, m.is_salient());
     }
     Ok(hold)
 }

@@ -174,6 +174,9 @@ pub(super) struct Softening<T> {
     /// Armed at a brake's release on a linear salient model, the hold softens too
     /// ([`ReleaseHold::set_dead_time_voltage`](super::ReleaseHold::set_dead_time_voltage)).
     pub(super) linear: bool,
+    /// A salient rotor's [`linear`](Self::linear) hold keeps the fall's damping at any error
+    /// ([`STIFFEN_ONSET_RATIO`]).
+    pub(super) keep_damping: bool,
 }
 
 impl<T: Real> Softening<T> {
@@ -186,6 +189,7 @@ impl<T: Real> Softening<T> {
             samples: (T::lit(super::SETTLE_TIMES) / omega_ts).round().to_f64() as u32,
             k: T::one(),
             linear: false,
+            keep_damping: false,
             onset: T::lit(STIFFEN_ONSET_RATIO) * travel,
             peak: T::zero(),
         }
@@ -239,7 +243,7 @@ impl<T: Real> Softening<T> {
         // NaN compares false: the fall's. A linear salient model's hold keeps it: its D path
         // is what turns the direct angle's jumps at the currents' zero crossings into the
         // ringing its softening is there to avoid.
-        if self.linear || !(k < T::one() && r > T::one()) {
+        if self.keep_damping || !(k < T::one() && r > T::one()) {
             return k;
         }
         (k * r).step_min(T::one())

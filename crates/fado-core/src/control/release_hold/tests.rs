@@ -595,6 +595,7 @@ fn a_softened_hold_stiffens_its_damping_once_its_error_passes_the_onset() {
     close(soft.gains(1.0, 1.0, 1.0), (1.0, 1.0, 1.0));
     // A linear salient model's softened hold keeps the fall's damping at any error.
     soft.linear = true;
+    soft.keep_damping = true;
     soft.soften(0.25 * a_rated * t * t / 2.0, t, design);
     soft.track(0.5);
     close(soft.gains(1.0, 1.0, 1.0), (0.25, 0.5, 0.125));
@@ -646,7 +647,7 @@ fn release_travel(fraction: f64, v_dt: f64) -> f64 {
     let (b, i_rated) = rigid_rotor(&m);
     let i_load = fraction * i_rated;
     let mut h = ReleaseHold::new(&tuning, &m, ts, 250.0, 2.0 * i_rated).unwrap();
-    h.set_dead_time_voltage(v_dt, m.flux_linkage);
+    h.set_dead_time_voltage(v_dt, m.flux_linkage, true);
     let (mut theta, mut omega, mut i) = (0.3, 0.0, 0.0);
     h.arm_at_release(0.3);
     let mut worst: f64 = 0.0;
