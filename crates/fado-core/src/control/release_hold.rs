@@ -481,7 +481,7 @@ impl<T: Real> ReleaseHold<T> {
     /// Low-passes the loop's speed over 1/(`ratio`·ω_h) instead of 1/(5·ω_h)
     /// ([`SATURATING_SPEED_FILTER_RATIO`] on a saturating machine model).
     pub fn set_speed_filter_ratio(&mut self, ratio: T) {
-        let omega = self.kp / self.kd;
+        let omega = self.stiffness();
         let gain = self.ts / (T::one() / (ratio * omega) + self.ts);
         if gain.is_finite() && gain > T::zero() {
             self.omega_gain = gain;

@@ -281,8 +281,11 @@ fn release_hold<T: Real>(
         hold.set_saturating(true);
     } else {
         let d = c.dead_time_compensation_config();
-        let v = d.dead_time * d.switching_frequency * d.dc_voltage + d.threshold_voltage;
-        hold.set_dead_time_voltage(v, m.flux_linkage, m.is_salient());
+        hold.set_dead_time_voltage(
+            d.error_voltage(d.dc_voltage),
+            m.flux_linkage,
+            m.is_salient(),
+        );
     }
     Ok(hold)
 }

@@ -70,10 +70,9 @@ impl<T: Real> ReleaseHold<T> {
     /// On a `salient` rotor it keeps the fall's damping at any error (module docs, "Surface
     /// magnets"). Non-finite inputs leave the rated stiffness.
     pub fn set_dead_time_voltage(&mut self, dead_time_voltage: T, flux: T, salient: bool) {
-        let omega_h = self.kp / self.kd;
         let rate = dead_time_voltage / flux;
         // NaN compares false: the rated stiffness.
-        self.soft.linear = rate > T::lit(DEAD_TIME_RATE_RATIO) * omega_h;
+        self.soft.linear = rate > T::lit(DEAD_TIME_RATE_RATIO) * self.stiffness();
         self.soft.keep_damping = self.soft.linear && salient;
     }
 }

@@ -171,7 +171,8 @@ pub(super) struct Softening<T> {
     onset: T,
     /// The largest |error| of the held angle since the trigger (rad).
     peak: T,
-    /// Armed at a brake's release on a linear salient model, the hold softens too
+    /// Armed at a brake's release on a linear model whose inverter error outruns it, the hold
+    /// softens too
     /// ([`ReleaseHold::set_dead_time_voltage`](super::ReleaseHold::set_dead_time_voltage)).
     pub(super) linear: bool,
     /// A salient rotor's [`linear`](Self::linear) hold keeps the fall's damping at any error

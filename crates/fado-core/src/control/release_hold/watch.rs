@@ -66,8 +66,9 @@ impl<T: Real> ReleaseHold<T> {
             return false;
         }
         self.active = true;
-        // A linear salient model's hold reads its stiffness from the direct angle's travel
-        // (the tracked angle that triggers lags the fall).
+        // A linear model's hold softened for the inverter's error (`dead_time.rs`) reads its
+        // stiffness from the direct angle's travel (the tracked angle that triggers lags the
+        // fall).
         let soft_fall = if self.soft.linear { e.abs() } else { fall };
         self.soften(soft_fall);
         if self.released && self.fall_gain > T::zero() {
@@ -87,16 +88,15 @@ impl<T: Real> ReleaseHold<T> {
     }
 
     /// Armed at a brake's release on a saturating model, where the current loop or the
-    /// sampling caps the loop (it then watches the direct angle), or on a linear salient model
-    /// whose inverter error turns the direct angle faster than the hold
+    /// sampling caps the loop (it then watches the direct angle), or on a linear model whose
+    /// inverter error turns the direct angle faster than the hold
     /// ([`set_dead_time_voltage`](Self::set_dead_time_voltage)), the stiffness for the load the
     /// fall of `fall` (rad, direct angle) since the release reveals ([`fall::Softening`]).
     fn soften(&mut self, fall: T) {
         if self.released
             && (self.release_on_direct || self.fall_gain > T::zero() || self.soft.linear)
         {
-            let omega_h = self.kp / self.kd;
-            self.hold_samples = self.soft.soften(fall, self.fall_time, omega_h);
+            self.hold_samples = self.soft.soften(fall, self.fall_time, self.stiffness());
         }
     }
 }
