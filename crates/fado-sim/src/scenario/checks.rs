@@ -56,7 +56,12 @@ pub(super) fn checks_range(
                 "power held at the top (W; model limit {:.0}, rated {:.0})",
                 t.limit_power_at_top, t.rated_power
             ),
-            cfg.load.torque.value(7.5) * p.levels[2].mean_speed_rpm * std::f64::consts::TAU / 60.0,
+            cfg.load
+                .torque
+                .value(0.5 * (p.levels[2].from + p.levels[2].to))
+                * p.levels[2].mean_speed_rpm
+                * std::f64::consts::TAU
+                / 60.0,
             0.98 * t.hold_power,
         ));
     }

@@ -172,7 +172,8 @@ pub const SCENARIOS: [Scenario; 14] = [
                   rated load step; field weakening to the top speed the voltage and current \
                   limits allow (≤ 2× rated; half the rated power still available) holding \
                   min(rated power, 80 % of the limits' power); brake at the current limit \
-                  through zero; 1 s at zero under 65 % of rated torque; to −rated speed",
+                  through zero; 1 s at zero under 65 % of rated torque; to −rated speed; each \
+                  judged window later where the rotor needs longer to reach its speed",
         criterion: "|θ − θ̂| < 0.25 rad over the whole run; in each settled window speed within \
                     2 % of its target (of the rated speed near zero); no trip; DC voltage within \
                     the drive's limits",
@@ -186,7 +187,8 @@ pub const SCENARIOS: [Scenario; 14] = [
         name: "regen-stop",
         title: "Stops regenerating into a rectifier-fed DC link (with a brake chopper)",
         profile: "rated speed, stop at the current limit; rated speed again under an overhauling \
-                  rated load, stop and hold it (rectifier, chopper at 1.05 × the bus)",
+                  rated load, stop and hold it (rectifier, chopper at 1.05 × the bus); each \
+                  judged window later where the rotor needs longer to reach its speed",
         criterion: "as `fullrange`",
         scaled: true,
         neutral: false,

@@ -10,8 +10,11 @@
 //! [`POWER_MARGIN`] × the limits' power) there (the margin is the loop's headroom: the
 //! current loop needs voltage to move the current).
 
+pub mod timing;
+
 use crate::config::SimConfig;
 use crate::profile::Profile;
+use timing::{Phase, Timeline};
 
 /// Share of the model's power at the top speed that `fullrange` holds: 0.8 \[A\].
 pub const POWER_MARGIN: f64 = 0.8;
@@ -117,109 +120,167 @@ pub fn targets(cfg: &SimConfig) -> RangeTargets {
 /// A settled window of a scenario: the reference holds `level_rpm` over `[from, to]`.
 pub type Hold = (f64, f64, f64);
 
-/// `fullrange`'s profile on `c` (scaled by its ratings and its model's limits); returns the
-/// settled windows judged.
-pub fn setup_fullrange(c: &mut SimConfig) -> Vec<Hold> {
+/// `fullrange`'s phases in the base timeline: to the rated speed under half the rated torque,
+/// the rated load step, field weakening to the top speed, braking through zero to a
+/// standstill under 65 % of the rated torque, the rated speed reversed.
+fn fullrange_phases(c: &SimConfig) -> [Phase; 5] {
+    let n = c.motor.rated_speed_rpm;
+    let top = targets(c).top_speed_rpm;
+    let phase = Phase::new;
+    [
+        phase(1.2, 2.0, 2.5, n),
+        phase(2.5, 3.0, 3.5, n),
+        phase(3.5, 7.0, 8.0, top),
+        phase(8.0, 9.0, 10.0, 0.0),
+        phase(10.0, 11.0, 12.0, -n),
+    ]
+}
+
+/// `fullrange`'s (speed, load) profiles on the timeline `line`.
+fn fullrange_profiles(c: &SimConfig, line: &Timeline) -> (Profile, Profile) {
     let t = targets(c);
     let n = t.rated_speed_rpm;
     let top = t.top_speed_rpm;
     let rated_torque = c.motor.rated_torque;
     let top_torque = t.hold_power / (top * std::f64::consts::TAU / 60.0);
+    let (s, w) = (&line.start, &line.window);
     // Ramps of 0.1 s ask for more than the current limit gives: the drive accelerates and
     // brakes at its limit.
     let speed = [
         (0.0, 0.0),
-        (1.2, 0.0),
-        (1.3, n), // at the current limit to the rated speed, under 50 %
-        (3.5, n),
-        (5.5, top), // field weakening (at the limit if it cannot follow)
-        (8.0, top),
-        (8.1, 0.0), // brake through zero at the current limit
-        (10.0, 0.0),
-        (10.1, -n), // and the other way
-        (12.0, -n),
+        (1.2 + s[0], 0.0),
+        (1.3 + s[0], n), // at the current limit to the rated speed, under 50 %
+        (3.5 + s[2], n),
+        (5.5 + s[2], top), // field weakening (at the limit if it cannot follow)
+        (8.0 + s[3], top),
+        (8.1 + s[3], 0.0), // brake through zero at the current limit
+        (10.0 + s[4], 0.0),
+        (10.1 + s[4], -n), // and the other way
+        (12.0 + w[4], -n),
     ];
     let load = [
         (0.0, 0.0),
         (0.7, 0.0),
         (1.0, 0.5 * rated_torque),
-        (2.5, 0.5 * rated_torque),
-        (2.5, rated_torque), // rated load step at rated speed
-        (3.5, rated_torque),
-        (5.5, top_torque),
-        (8.0, top_torque),
-        (8.1, 0.65 * rated_torque),
-        (12.0, 0.65 * rated_torque),
+        (2.5 + s[1], 0.5 * rated_torque),
+        (2.5 + s[1], rated_torque), // rated load step at rated speed
+        (3.5 + s[2], rated_torque),
+        (5.5 + s[2], top_torque),
+        (8.0 + s[3], top_torque),
+        (8.1 + s[3], 0.65 * rated_torque),
+        (12.0 + w[4], 0.65 * rated_torque),
     ];
-    c.speed_reference = Profile::from_points(&speed);
-    c.load.torque = Profile::from_points(&load);
-    c.simulation.duration = 12.0;
+    (Profile::from_points(&speed), Profile::from_points(&load))
+}
+
+/// `fullrange`'s timeline on `c`: the base one, or longer where the rotor needs it
+/// ([`timing`]).
+pub fn fullrange_timeline(c: &SimConfig) -> Timeline {
+    let phases = fullrange_phases(c);
+    let top = targets(c).top_speed_rpm.max(c.motor.rated_speed_rpm);
+    timing::plan(c, &phases, top, |line| fullrange_profiles(c, line))
+}
+
+/// `fullrange`'s profile on `c` (scaled by its ratings, its model's limits and its rotor's
+/// time to reach each speed); returns the settled windows judged.
+pub fn setup_fullrange(c: &mut SimConfig) -> Vec<Hold> {
+    let line = fullrange_timeline(c);
+    let profiles = fullrange_profiles(c, &line);
+    apply(c, profiles, 12.0 + line.window[4]);
+    fullrange_holds(c)
+}
+
+/// Sets a range scenario's (speed, load) profiles and its duration (s) on `c`, judged from
+/// 0.7 s, with the feed-forward the scenario's transients need.
+fn apply(c: &mut SimConfig, (speed, load): (Profile, Profile), duration: f64) {
+    c.speed_reference = speed;
+    c.load.torque = load;
+    c.simulation.duration = duration;
     c.simulation.eval_start = 0.7;
     enable_feedforward(c);
-    fullrange_holds(c)
+}
+
+/// The settled windows of `phases` on `line`.
+fn holds(phases: &[Phase], line: &Timeline) -> Vec<Hold> {
+    phases
+        .iter()
+        .zip(&line.window)
+        .map(|(p, w)| (p.level_rpm, p.from + w, p.to + w))
+        .collect()
 }
 
 /// `fullrange`'s settled windows (the second half of each hold of the reference, after the
 /// load has settled): rated speed before and after the load step, the top speed, standstill
 /// under 65 % of the rated torque, the rated speed reversed.
 pub fn fullrange_holds(c: &SimConfig) -> Vec<Hold> {
+    holds(&fullrange_phases(c), &fullrange_timeline(c))
+}
+
+/// `regen-stop`'s phases in the base timeline: to the rated speed, a stop at the current
+/// limit, the rated speed under the overhauling load, a stop against it.
+fn regen_stop_phases(c: &SimConfig) -> [Phase; 4] {
     let n = c.motor.rated_speed_rpm;
-    let top = targets(c).top_speed_rpm;
-    vec![
-        (n, 2.0, 2.5),
-        (n, 3.0, 3.5),
-        (top, 7.0, 8.0),
-        (0.0, 9.0, 10.0),
-        (-n, 11.0, 12.0),
+    let phase = Phase::new;
+    [
+        phase(0.7, 2.0, 2.5, n),
+        phase(2.5, 3.5, 4.0, 0.0),
+        phase(4.0, 5.5, 6.0, n),
+        phase(6.0, 7.0, 8.0, 0.0),
     ]
+}
+
+/// `regen-stop`'s (speed, load) profiles on the timeline `line`.
+fn regen_stop_profiles(c: &SimConfig, line: &Timeline) -> (Profile, Profile) {
+    let n = c.motor.rated_speed_rpm;
+    let rated_torque = c.motor.rated_torque;
+    let (s, w) = (&line.start, &line.window);
+    let speed = [
+        (0.0, 0.0),
+        (0.7, 0.0),
+        (1.7, n),
+        (2.5 + s[1], n),
+        (2.6 + s[1], 0.0), // stop at the current limit
+        (4.0 + s[2], 0.0),
+        (5.0 + s[2], n),
+        (6.0 + s[3], n),
+        (6.1 + s[3], 0.0), // stop against the overhauling load, then hold it
+        (8.0 + w[3], 0.0),
+    ];
+    let load = [
+        (0.0, 0.0),
+        (4.0 + s[2], 0.0),
+        (4.5 + s[2], -rated_torque),
+        (8.0 + w[3], -rated_torque),
+    ];
+    (Profile::from_points(&speed), Profile::from_points(&load))
+}
+
+/// `regen-stop`'s timeline on `c` ([`timing`]).
+pub fn regen_stop_timeline(c: &SimConfig) -> Timeline {
+    let phases = regen_stop_phases(c);
+    timing::plan(c, &phases, c.motor.rated_speed_rpm, |line| {
+        regen_stop_profiles(c, line)
+    })
 }
 
 /// `regen-stop`'s profile on `c`: a rectifier with a brake chopper; a stop from the rated
 /// speed at the current limit, then a stop from the rated speed against an overhauling rated
 /// load (it pulls towards positive rotation); returns the settled windows judged.
 pub fn setup_regen_stop(c: &mut SimConfig) -> Vec<Hold> {
-    let n = c.motor.rated_speed_rpm;
-    let rated_torque = c.motor.rated_torque;
     c.dc_link.source = crate::dc_link::DcSource::Rectifier;
     if c.dc_link.chopper_voltage.is_none() {
         c.dc_link.chopper_voltage = Some(CHOPPER_RATIO * c.inverter.dc_voltage);
     }
-    let speed = [
-        (0.0, 0.0),
-        (0.7, 0.0),
-        (1.7, n),
-        (2.5, n),
-        (2.6, 0.0), // stop at the current limit
-        (4.0, 0.0),
-        (5.0, n),
-        (6.0, n),
-        (6.1, 0.0), // stop against the overhauling load, then hold it
-        (8.0, 0.0),
-    ];
-    let load = [
-        (0.0, 0.0),
-        (4.0, 0.0),
-        (4.5, -rated_torque),
-        (8.0, -rated_torque),
-    ];
-    c.speed_reference = Profile::from_points(&speed);
-    c.load.torque = Profile::from_points(&load);
-    c.simulation.duration = 8.0;
-    c.simulation.eval_start = 0.7;
-    enable_feedforward(c);
+    let line = regen_stop_timeline(c);
+    let profiles = regen_stop_profiles(c, &line);
+    apply(c, profiles, 8.0 + line.window[3]);
     regen_stop_holds(c)
 }
 
 /// `regen-stop`'s settled windows: rated speed, standstill after the first stop, rated speed
 /// under the overhauling load, standstill holding it.
 pub fn regen_stop_holds(c: &SimConfig) -> Vec<Hold> {
-    let n = c.motor.rated_speed_rpm;
-    vec![
-        (n, 2.0, 2.5),
-        (0.0, 3.5, 4.0),
-        (n, 5.5, 6.0),
-        (0.0, 7.0, 8.0),
-    ]
+    holds(&regen_stop_phases(c), &regen_stop_timeline(c))
 }
 
 /// `regen-stop`'s chopper switches on at this multiple of the nominal bus: 1.05 \[A\] (below
