@@ -330,6 +330,9 @@ fn a_heavy_surface_magnet_rotor_holds_its_angle_through_stops() {
         let (passed, max_error) = heavy_surface_magnet_stops(seed, "");
         assert!(passed && max_error < 0.1, "seed {seed}: {max_error}");
         let (passed, max_error) = heavy_surface_magnet_stops(seed, paper);
-        assert!(!passed && max_error > 0.25, "paper's trackers, seed {seed}: {max_error}");
+        assert!(
+            !passed && max_error > 0.25,
+            "paper's trackers, seed {seed}: {max_error}"
+        );
     }
 }
