@@ -6,7 +6,8 @@ use crate::derive::Derived;
 
 /// The rule of `fado_core::control::tracker_feedforward` in words, beside the keys it sets.
 const FEEDFORWARD_RULE: &str = "on where the type-2 T2S-1 would lag the acceleration at the \
-    current limit by more than `[controller.tracker_feedforward] max_lag` \
+    current limit by more than `[controller.tracker_feedforward] max_lag`, or where the \
+    mechanical time constant Ĵ·Ω_rated/T_rated exceeds `heavy_rotor_time` \
     (fado_core::control::tracker_feedforward)";
 
 /// The same rule's load integrator of the trackers, where the tuning leaves it at 0.

@@ -20,6 +20,10 @@ impl<T: Real> Resolved<T> {
             "tracker_feedforward.load_step_error",
             t.tracker_feedforward.load_step_error,
         )?;
+        check::positive(
+            "tracker_feedforward.heavy_rotor_time",
+            t.tracker_feedforward.heavy_rotor_time,
+        )?;
         let rated = c.machine.rated_current;
         // A duration as a whole number of samples (at most about 5 days at 10 kHz).
         let samples = &|field: &'static str, time: T| check::samples(field, time, ts);
