@@ -155,6 +155,22 @@ fn a_brake_released_on_a_moving_reference_is_held_against_the_fall() {
     }
 }
 
+/// A drawn 497 W IPMSM (draw seed 202: 3 pole pairs, 6.2·10⁻⁶ kg·m², saturating), whose
+/// release hold acts through the loaded standstill (`fado_core::control::release_hold`,
+/// `standstill.rs`). At sensor seed 1 θ − θ̂ creeps to 0.10 rad over the standstill, and the
+/// standstill probe's d current, on when `loaded-start`'s reference leaves zero, takes 1 % of
+/// the rated torque with it as it goes: handed over at the reference, the rotor ran back
+/// 0.956 rad under the 5.2 Hz speed loop. Held through the probe's exit: 0.177 rad back (the
+/// release's catch), |θ − θ̂| from ready 0.112 rad; seed 2 0.214 / 0.076 rad either way.
+#[test]
+fn a_light_rotor_is_held_through_the_probes_exit() {
+    for seed in [1, 2] {
+        let (passed, _, max_error, backward) = loaded_start("ipm-sat-3p-201v-497w", seed);
+        println!("seed {seed}: max {max_error:.3}, back {backward:.3} rad");
+        assert!(passed, "seed {seed}: {backward} rad back, max {max_error}");
+    }
+}
+
 /// The drawn 69 W, 15-pole-pair IPMSM (6 kHz carrier, q secant 44 % down at the rated
 /// current, 47 V link) and the drawn 289 W 2-pole saturating surface-magnet motor (35 kHz),
 /// held at zero speed under the rated load after the brake's release: max |θ − θ̂| from ready

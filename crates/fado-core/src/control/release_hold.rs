@@ -108,22 +108,9 @@
 //! the rated load; left to the speed loop, 8.5 / 8.2 rad.
 //!
 //! # Through the loaded standstill
-//! The speed loop that takes over is a PI on the speed estimate, of 5 Hz: it has no integral
-//! of the angle, and on a light many-pole rotor it hardly answers the standstill probe's d
-//! current, a square wave of period T_p = 0.1 s (10 Hz). Where the angle estimate is off by δ
-//! the probe's amplitude A is a torque square wave of b·A·sin δ (electrical rad/s², b =
-//! 1.5·p²·λ̂f/Ĵ), which a free rotor follows with a swing of b·A·sin δ·T_p²/32 about its
-//! mean. Where that swing at δ = 0.25 rad (the |θ − θ̂| a loaded start may keep) exceeds the
-//! hold's design travel, the hold does not hand over after 10/ω_h but acts until the speed
-//! reference leaves zero ([`holds_through_standstill`]): its integral holds the load, its
-//! stiffness the probe's torque, and the probe reads its demand as it would read the speed
-//! loop's. The rotor then follows θ̂, within the angle error the probe corrects. Of the
-//! motors tried, the swing is 0.45 rad on the salient Flipsky 6215 (15/22 µH, 14 pole pairs:
-//! with the hand-over its rotor swings back 0.98 rad at `loaded-start` seed 2, held 0.23 rad),
-//! 0.34 rad on the multirotor preset (seed 2: 0.72 and 0.31 rad) and 0.43 rad on the cheetah
-//! outrunner; 0.1 rad or less on every preset that is not a multirotor or outrunner (the
-//! 50 kW IPMSM's 0.097 the largest), which keep the hand-over (docs/method/startup.md, "The
-//! loaded standstill after the release").
+//! Where the standstill probe would swing a rotor that only the speed loop holds beyond the
+//! design travel, the hold acts until the speed reference leaves zero, and through the
+//! probe's exit (`release_hold/standstill.rs`).
 //!
 //! # The light load on a salient rotor
 //! Where the inverter's dead-time voltage turns a linear salient model's direct angle faster
@@ -140,6 +127,9 @@ use crate::error::{ConfigError, check};
 use crate::{MachineModel, Real};
 
 pub use dead_time::DEAD_TIME_RATE_RATIO;
+pub use standstill::holds_through_standstill;
+#[cfg(test)]
+use standstill::{PROBE_ANGLE_SIN, standstill_swing};
 pub use tuning::ReleaseHoldTuning;
 
 /// The loop's speed filter on a saturating machine model: 1/(4·ω_h) \[A\] instead of
@@ -246,38 +236,6 @@ fn loop_gains<T: Real>(omega: T, b: T, ts: T) -> (T, T, T) {
 
 /// Peak of t²·e^(−t)/2 (at t = 2): the largest travel of the triple-pole loop per a/ω_h².
 const PEAK_TRAVEL: f64 = 0.270_670_566_473_225_4;
-
-/// sin 0.25: the angle error at which the standstill probe's torque is weighed, 0.25 rad \[A\],
-/// the largest |θ − θ̂| a loaded start may keep from ready on (the `loaded-start` criterion).
-const PROBE_ANGLE_SIN: f64 = 0.247_403_959_254_522_93;
-
-/// The hold stays through the loaded standstill, until the speed reference leaves zero, where
-/// the standstill probe would swing a rotor that only the speed loop holds by more than the
-/// hold's design travel (module docs, "Through the loaded standstill"): its d-current square
-/// wave of amplitude `probe_amplitude` (A) and period `probe_period` (s) at an angle error of
-/// 0.25 rad is a torque square wave of b·A·sin 0.25 (electrical rad/s², b = 1.5·p²·λ̂f/Ĵ),
-/// which a free rotor follows with a swing of b·A·sin 0.25·T_p²/32 about its mean (the
-/// probe's period lies near the 5 Hz speed loop's bandwidth, which hardly answers it). False
-/// where the hold is disabled, the probe off, or the inputs not finite.
-pub fn holds_through_standstill<T: Real>(
-    tuning: &ReleaseHoldTuning<T>,
-    machine: &MachineModel<T>,
-    probe_amplitude: T,
-    probe_period: T,
-) -> bool {
-    let p = T::lit(machine.pole_pairs as f64);
-    let b = T::lit(1.5) * p * p * machine.flux_linkage / machine.inertia;
-    let swing = standstill_swing(b, probe_amplitude, probe_period);
-    // NaN compares false: the hand-over after 10/ω_h.
-    tuning.enabled && swing > tuning.travel
-}
-
-/// The free rotor's swing (electrical rad) about its mean under the probe's torque at the
-/// weighed angle error: a square wave of acceleration ±a with half-period T_p/2 drives a
-/// triangular speed of peak a·T_p/4 and a position swing of a·T_p²/32.
-fn standstill_swing<T: Real>(b: T, amplitude: T, period: T) -> T {
-    b * amplitude * T::lit(PROBE_ANGLE_SIN) * period * period / T::lit(32.0)
-}
 
 /// Time the hold acts, in units of 1/ω_h: the triple pole's response to a load step has
 /// decayed to e^(−10)·(1 + 10 + 50) = 0.3 % by then, and its integral holds the load.
@@ -392,6 +350,9 @@ pub struct ReleaseHold<T> {
     /// The speed loop's integral of the last sample (A), the torque the hold replaces at its
     /// trigger ([`set_carried`](Self::set_carried)).
     carried: T,
+    /// The standstill probe's d current was on at the last sample
+    /// ([`set_probing`](Self::set_probing)).
+    probing: bool,
 }
 
 impl<T: Real> ReleaseHold<T> {
@@ -410,8 +371,7 @@ impl<T: Real> ReleaseHold<T> {
         let resume_step =
             machine.rated_speed_rpm * T::two_pi() / T::lit(60.0) * p * ts / resume_time;
         let trigger = check::positive("release_hold.trigger", tuning.trigger)?;
-        let window = check::non_negative("release_hold.window", tuning.window)?;
-        let n = window / ts;
+        let n = check::non_negative("release_hold.window", tuning.window)? / ts;
         check::below("release_hold.window", n, T::lit(4e9), "below 4e9 samples")?;
         let b = T::lit(1.5) * p * p * machine.flux_linkage / machine.inertia;
         let release_n = watch::release_window(machine, trigger) / ts;
@@ -475,6 +435,7 @@ impl<T: Real> ReleaseHold<T> {
             max_fall_load: (share * a_rated / b).step_min(i_max),
             soft: fall::Softening::new(a_rated, design, omega * ts, travel),
             carried: T::zero(),
+            probing: false,
         })
     }
 
@@ -513,12 +474,6 @@ impl<T: Real> ReleaseHold<T> {
         if gain.is_finite() && gain > T::zero() {
             self.handover_gain = gain;
         }
-    }
-
-    /// Keeps the hold acting until the speed reference leaves zero instead of handing over
-    /// after 10/ω_h: the rule of [`holds_through_standstill`].
-    pub fn set_through_standstill(&mut self, on: bool) {
-        self.through_standstill = on;
     }
 
     /// The speed loop's integral `iq` (A of magnet q current) of this sample: the torque it
@@ -714,7 +669,8 @@ impl<T: Real> ReleaseHold<T> {
     /// not where it holds through the loaded standstill), or, where the reference left zero
     /// before that while the speed loop could not take the rest of its torque
     /// ([`set_speed_loop`](Self::set_speed_loop); then a motion hold, the speed loop's
-    /// reference at zero), once it can (module docs, "When").
+    /// reference at zero), once it can (module docs, "When"); held through the loaded
+    /// standstill, 10/ω_h after the probe's d current has gone (`standstill.rs`).
     fn settles(&mut self, moving_ref: bool) -> bool {
         let run_back = self.handover_gain * (self.output - self.integral).abs();
         // NaN compares false: not carried.
@@ -724,6 +680,7 @@ impl<T: Real> ReleaseHold<T> {
             self.engaged_by_motion = true;
             self.carrying = true;
         }
+        self.through_probe_exit(moving_ref);
         let standstill_hold = self.through_standstill && !(self.engaged_by_motion && moving_ref);
         let done = self.held >= self.hold_samples || (self.carrying && carried);
         self.active && !standstill_hold && done
@@ -791,6 +748,7 @@ impl<T: Real> ReleaseHold<T> {
 
 mod dead_time;
 mod fall;
+mod standstill;
 mod tuning;
 mod watch;
 

@@ -44,6 +44,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
     pub(super) fn speed_or_hold(&mut self, speed_ref: T, estimate: &Estimate<T>) -> Option<T> {
         let direct = estimate.diagnostics.theta_direct;
         self.blocks.hold.set_carried(self.blocks.speed.integral());
+        self.blocks.hold.set_probing(self.blocks.probe.active());
         let hold = self.blocks.hold.step(speed_ref, estimate.theta, direct);
         if let HoldAction::Handover(iq) = hold {
             self.blocks.speed.preset(iq);

@@ -202,6 +202,53 @@ fn a_light_rotor_is_held_through_its_loaded_standstill() {
 }
 
 #[test]
+fn a_hold_through_the_standstill_takes_the_probes_exit_before_it_hands_over() {
+    // The multirotor preset's rotor on a saturating model, held through its loaded standstill
+    // (the test above): a reference that leaves zero while the probe's d current is on keeps
+    // the hold as a motion hold, the speed loop's reference at zero, until 10/ω_h after the
+    // probe's last sample.
+    let on = ReleaseHoldTuning {
+        enabled: true,
+        ..ReleaseHoldTuning::default()
+    };
+    let fast = crate::control::tracker_feedforward::multirotor_model();
+    let mut h = ReleaseHold::new(&on, &fast, 25e-6, 387.0, 68.0).unwrap();
+    h.set_through_standstill(true);
+    h.set_saturating(true);
+    h.arm(0.0);
+    for _ in 0..20_000 {
+        assert!(matches!(h.step(0.0, -0.1, -0.1), HoldAction::Hold(_)));
+    }
+    h.set_probing(true);
+    for _ in 0..100 {
+        assert!(matches!(h.step(1.0, -0.1, -0.1), HoldAction::Hold(_)));
+        assert_eq!(h.resumed(1.0), 0.0);
+    }
+    h.set_probing(false);
+    let n = h.hold_samples;
+    for _ in 1..n {
+        assert!(matches!(h.step(1.0, -0.1, -0.1), HoldAction::Hold(_)));
+    }
+    assert!(matches!(h.step(1.0, -0.1, -0.1), HoldAction::Handover(x) if x > 0.0));
+    // The reference then resumes from zero.
+    let first = h.resumed(1.0);
+    assert!(first > 0.0 && first < 1.0, "{first}");
+    // Not held through the standstill, or on a linear model (its speed's step unbounded), a
+    // reference hands over at once, probe or not.
+    for (through, saturating) in [(false, true), (true, false)] {
+        let mut h = ReleaseHold::new(&on, &fast, 25e-6, 387.0, 68.0).unwrap();
+        h.set_through_standstill(through);
+        h.set_saturating(saturating);
+        h.arm(0.0);
+        for _ in 0..100 {
+            assert!(matches!(h.step(0.0, -0.1, -0.1), HoldAction::Hold(_)));
+        }
+        h.set_probing(true);
+        assert!(matches!(h.step(1.0, -0.1, -0.1), HoldAction::Handover(_)));
+    }
+}
+
+#[test]
 fn an_unloaded_rotor_never_triggers_it_and_a_reference_hands_over() {
     let m = MachineModel::<f64>::paper();
     let t = ReleaseHoldTuning {
