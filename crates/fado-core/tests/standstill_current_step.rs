@@ -87,12 +87,12 @@ fn locked_rotor(eps: Ab<f64>) -> (f64, f64) {
             } else {
                 1.0
             };
-        psi_dq = psi_dq + step;
+        psi_dq += step;
         i_dq = magnetics.current_from(psi_dq, i_dq);
         let i_ab = i_dq.to_ab(rot);
         let mut v = step.to_ab(rot) * (1.0 / ts) + (i_ab + i_prev) * (0.5 * m.rs);
         if k == (0.1 / ts) as usize {
-            v = v + eps * (1.0 / ts);
+            v += eps * (1.0 / ts);
         }
         theta_hat = est.step(v, i_ab).theta;
         i_prev = i_ab;

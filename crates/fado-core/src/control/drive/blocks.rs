@@ -33,8 +33,7 @@ impl<T: Real> Blocks<T> {
         rot: Rotation<T>,
         v_ab: Ab<T>,
         v_dq: Dq<T>,
-        i_dq_ref: Dq<T>,
-        i_dq: Dq<T>,
+        (i_dq_ref, i_dq): (Dq<T>, Dq<T>),
         i_abc: Abc<T>,
         vdc: T,
     ) -> Option<Applied<T>> {
