@@ -37,6 +37,11 @@ impl<T: Real> Blocks<T> {
         i_abc: Abc<T>,
         vdc: T,
     ) -> Option<Applied<T>> {
+        // While the release hold catches a fall, the compensation stays at the reference:
+        // the hold's stiffness is set for the inverter error the compensation at the
+        // reference leaves inside the band (`ReleaseHold`'s dead-time softening).
+        let holding = self.hold.tracking_fall() || self.hold.active();
+        let i_dq = if holding { i_dq_ref } else { i_dq };
         let comp = self
             .dead_time
             .phase_voltages_followed(rot, i_dq_ref, i_dq, i_abc, v_ab, vdc);
