@@ -158,7 +158,8 @@ fn a_non_finite_estimate_holds_the_duty_and_steps_the_estimator_once() {
 #[test]
 fn duties_realise_the_reference_plus_the_dead_time_compensation() {
     // duty·Vdc (Clarke) = realised reference + Clarke of the per-phase compensation, which is
-    // the trapezoid of the reference current at θ̂ + 1.5·ω̂·Ts; at a low Vdc the sum is
+    // the trapezoid of the reference current (or of the measured one where the reference
+    // has run ahead of it across the band) at θ̂ + 1.5·ω̂·Ts; at a low Vdc the sum is
     // limited to the hexagon and the reported reference is what remains after what the
     // inverter loses of the compensation (all of it on a switching leg, the device drop on a
     // held one).
@@ -171,15 +172,19 @@ fn duties_realise_the_reference_plus_the_dead_time_compensation() {
         ..Spy::default()
     };
     let mut drive = SensorlessDrive::with_estimator(cfg, spy).unwrap();
-    // The drive's own compensation, built from the same machine model and tuning.
-    let dtc = DeadTimeCompensation::new(cfg.dead_time_compensation_config()).unwrap();
+    // The drive's own compensation, built from the same machine model and tuning, following
+    // the reference through the current loop as the drive's does (the synthetic currents
+    // do not follow the reference: where a phase of the reference runs ahead of them across
+    // the band, the compensation takes the measured current `o.i_dq`).
+    let mut dtc = DeadTimeCompensation::new(cfg.dead_time_compensation_config()).unwrap();
+    dtc.set_current_loop(cfg.tuning.current.bandwidth_hz, cfg.ts);
     let mut saturated = 0;
     for n in 0..200 {
         let vdc = if n % 3 == 0 { 20.0 } else { 300.0 };
         let i = currents(n);
         let o = drive.step(i, vdc, 80.0);
         let adv = Rotation::from_angle(o.estimate.theta + 1.5 * o.estimate.omega * 100e-6);
-        let comp = dtc.phase_voltages(adv, o.i_dq_ref, i, o.v_ref_ab, vdc);
+        let comp = dtc.phase_voltages_followed(adv, o.i_dq_ref, o.i_dq, i, o.v_ref_ab, vdc);
         // Limited: a leg held at a rail loses only the device drop (`DeadTimeCompensation::lost`).
         let lost = if o.voltage_saturated {
             dtc.lost(comp, adv, o.i_dq_ref, o.duty).to_ab()

@@ -232,44 +232,29 @@ fn heavy_saturated_rotor(scenario: &str, seed: u64, speed_hz: Option<f64>) -> (b
 }
 
 /// The 192 kW IPMSM at `stops` (4 % of its 204 r/min under 65 % of its rated torque) with the
-/// speed loop at its 5 Hz: from the start-up's hand-over (0.16 s, before any load) i_q*
-/// swings between the current-vector limits (±910 A at i_d* = −395 A) at about 16 Hz while
-/// the rotor's speed moves by less than 1.5 r/min and ω̂ by ±5–9 r/min. The angle estimate
-/// follows i_q within 5–8 ms (θ − θ̂ +0.08 to +0.12 rad at +910 A, −0.02 to −0.04 rad at
-/// −910 A). That motion is the estimator's slow mode (docs/method/saturation.md): after the
-/// step to +910 A the estimated flux keeps the rotor's direction within 0.005 rad but settles
-/// at the model's |ψ| of the current in the estimated frame (1.200 Wb, the rotor's 1.245 Wb),
-/// a frame error of 0.087 rad the observer does not see. T2S-2 turns that motion of θ̂ into a
-/// speed error, and the speed PI, whose
-/// Kp = Ĵ·ωs/(K̂t·p) is 342 A per electrical rad/s on this rotor, answers it with current of the
-/// sign that moves θ̂ further: a loop that bypasses the rotor, whose gain grows with Ĵ (the
-/// speed loop through the rotor does not depend on Ĵ). The same machine without
-/// `[motor.saturation]` keeps its i_q* within 451 A and passes (0.048 rad); the averaged
-/// inverter model limit-cycles as the switching one does (0.96 / 3.14 rad at seeds 1 / 2).
-/// Measured (seeds 1–4): max |θ − θ̂| 0.690 / 3.142 / 3.141 / 3.141 rad (speed 16–144 r/min
-/// off); `loaded-start` seed 2 1.70 rad; `reversal` passes (0.063–0.087 rad). The speed loop at
-/// 2 Hz ends the limit cycle (the test below); at 3 Hz `loaded-start` seed 2 loses the angle
-/// (3.14 rad); T2S-2 at 20 Hz with the speed loop at 5 Hz loses `stops` seed 4 (0.232 rad, 6.6
-/// r/min) and `reversal` seed 3. A bound on ωs from Ĵ, τm, the current limit and T2S-2 alone
-/// does not single this machine out: the drawn 137 kW IPMSM (τm = 15.6 s) limit-cycles at
-/// 5 Hz too (|i_q*| at its 513 A limit 38 % of `stops`) yet holds its angle (0.128 rad), and at
-/// 1.5 Hz runs 0.57 rad back in `loaded-start` (limit 0.5). Nor does that path's loop gain
-/// estimated from the model, G = c·Kp·ωt·L̂q,s/λa at the rated torque's MTPA point (c the frame
-/// coupling of `fado_core::control::speed_bandwidth`, ωt T2S-2's bandwidth): 67 here at 5 Hz
-/// and 40 at 3 Hz (`loaded-start` seed 2 lost), 27 at 2 Hz, against 38 on motulator's 4 kW
-/// PM-SyRM (T2S-2 at 43 Hz; its `rated-reversal` fails at 3 Hz), 11 on the Baldor PM-SyRM
-/// preset and 8.6 on the drawn 138 kW IPMSM, which hold at 5 Hz.
-/// The figures above are the paper's type-2 trackers'. τm = 3.8 s is above
-/// `[controller.tracker_feedforward] heavy_rotor_time` (3 s), so the drive runs the
-/// acceleration feed-forward (`fado_core::control::tracker_feedforward`, "A heavy rotor"):
-/// `stops` 0.113 / 0.721 / 0.044 / 0.042 rad at seeds 1–4 (seed 2 still limit-cycling,
-/// 13.7 r/min off), `rated-reversal` passes at seeds 1 / 2 (0.063 / 0.051 rad; 0.169 / 0.164
-/// and 4.7 r/min off, beyond its 4.1, with the type-2 trackers), `loaded-start` seed 2
-/// 1.91 rad.
+/// speed loop at its 5 Hz. Its speed PI, Kp = Ĵ·ωs/(K̂t·p) = 342 A per electrical rad/s on
+/// this rotor, answers any motion of θ̂ with current: a loop that bypasses the rotor, whose
+/// gain grows with Ĵ. Fed exact signals (a locked rotor, a voltage-limited current loop),
+/// the estimator does not move θ̂ with i_q: a step to ±910 A moves it by 0.007 rad for a few
+/// milliseconds (the secant L̂q one sample late), on the model and with the current held in
+/// the estimated frame alike. What moves it is a flux error: 0.036 Wb across the d axis
+/// turns θ̂ by 0.021 rad at i_q = 0 and 0.060 rad at ±910 A (κ falls with the current).
+///
+/// Such an error comes from the dead-time compensation. Evaluated at the reference current,
+/// it crosses a phase's zero about one time constant of the current loop before the current
+/// does when i_q* reverses, and the estimator integrates 2·V̂ for that time. With the
+/// compensation at the reference alone (`DeadTimeCompensation::phase_voltages`), i_q*
+/// swings between the current-vector limits (±910 A at i_d* = −395 A) at about 16 Hz from
+/// the start-up's hand-over, each reversal adds 0.02–0.05 Wb to λ1 − ψ (0.23 Wb by 0.6 s),
+/// θ̂ follows, and the rotor is lost: max
+/// |θ − θ̂| 0.690 / 3.142 / 3.141 / 3.141 rad (seeds 1–4), i_q* at 95 % of its limit in 32 /
+/// 17 % of the run (seeds 1 / 2); `loaded-start` seed 2 1.70 rad. The same plant without dead
+/// time passes (0.046 rad, |i_q*| within 505 A, seed 2). The compensation takes the measured
+/// current where the reference has run ahead of the current across a phase's band
+/// (`DeadTimeCompensation::phase_voltages_followed`): 0.112 / 0.126 / 0.109 / 0.111 rad
+/// (seeds 1–4), i_q* at its limit in 0.5 / 0.4 % of the run (the load's acceleration at
+/// 6.9 s); `loaded-start` 0.082 / 0.192 / 0.063 / 0.068 rad, `reversal` 0.035–0.047 rad.
 #[test]
-#[ignore = "stops max |θ − θ̂| 0.113 / 0.721 rad at seeds 1 / 2: the speed PI limit-cycles \
-            between ±910 A through the angle estimate's motion with i_q (0.108 / 0.106 rad with \
-            the speed loop at 2 Hz)"]
 fn a_heavy_saturated_rotor_holds_its_angle_through_stops() {
     for seed in [1, 2] {
         let (passed, max_error, _) = heavy_saturated_rotor("stops", seed, None);
@@ -277,11 +262,11 @@ fn a_heavy_saturated_rotor_holds_its_angle_through_stops() {
     }
 }
 
-/// The 192 kW IPMSM of the test above with its speed loop at 2 Hz (and the heavy rotor's
-/// tracker feed-forward): Kp at 0.4 of the tuning's, i_q* stays within 527 A in `stops` (the
-/// current-vector limit 910 A) and the angle within 0.108 / 0.106 rad at seeds 1 / 2;
-/// `loaded-start` seed 2 (1.91 rad at 5 Hz) 0.062 rad. Seeds 3 and 4 measured alike: `stops`
-/// 0.110 / 0.106 rad, `loaded-start` 0.023 / 0.070 rad, `reversal` (seeds 1–4) 0.036–0.044 rad.
+/// The 192 kW IPMSM of the test above with its speed loop at 2 Hz: Kp at 0.4 of the tuning's,
+/// i_q* stays within 508 A in `stops` (the current-vector limit 910 A) and the angle within
+/// 0.047 / 0.045 rad at seeds 1 / 2; `loaded-start` seed 2 0.094 rad (0.192 at 5 Hz). Seeds 3
+/// and 4 measured alike: `stops` 0.046 / 0.046 rad, `loaded-start` 0.041 / 0.059 rad,
+/// `reversal` (seeds 1–4) 0.082–0.085 rad.
 #[test]
 fn a_heavy_saturated_rotor_holds_its_angle_with_its_speed_loop_at_2_hz() {
     for seed in [1, 2] {
@@ -337,7 +322,7 @@ fn heavy_surface_magnet_stops(seed: u64, extra: &str) -> (bool, f64) {
 /// speed PI) steps at each ramp's start; the speed PI rings through the injection's corner at
 /// 8–10 Hz and `stops` ends 0.309 / 0.314 rad off at seeds 1 / 2 with the paper's type-2
 /// trackers. With the acceleration feed-forward the drive turns on for τm above
-/// `[controller.tracker_feedforward] heavy_rotor_time` (3 s;
+/// `[controller.tracker_feedforward] heavy_rotor_time` (4 s;
 /// `fado_core::control::tracker_feedforward`, "A heavy rotor") it keeps 0.048 / 0.049 rad.
 #[test]
 fn a_heavy_surface_magnet_rotor_holds_its_angle_through_stops() {

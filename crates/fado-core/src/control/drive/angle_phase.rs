@@ -60,7 +60,10 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             }
         };
         let backup = self.blocks;
-        let Some(applied) = self.blocks.modulate(rot, v_ab, v_dq, i_dq_ref, i_abc, vdc) else {
+        let Some(applied) = self
+            .blocks
+            .modulate(rot, v_ab, v_dq, (i_dq_ref, i_dq), i_abc, vdc)
+        else {
             return self.reject_after_estimate(backup, estimate, i_dq);
         };
         if matches!(self.startup.status(), StartupStatus::Aligning) {

@@ -24,7 +24,7 @@ use crate::{Ab, Abc, Dq, Real, Rotation};
 
 impl<T: Real> Blocks<T> {
     /// Dead-time compensation, hexagon limit and SVPWM of the reference `v_ab` (`v_dq` in the
-    /// frame of `rot`), and the voltage that then acts, back-calculated without the
+    /// frame of `rot`; `i_dq_ref` and the measured `i_dq` in the frame of θ̂), and the voltage that then acts, back-calculated without the
     /// compensation where the modulator limited it (zero without a DC link). None when
     /// anything is non-finite.
     #[inline(always)]
@@ -33,13 +33,18 @@ impl<T: Real> Blocks<T> {
         rot: Rotation<T>,
         v_ab: Ab<T>,
         v_dq: Dq<T>,
-        i_dq_ref: Dq<T>,
+        (i_dq_ref, i_dq): (Dq<T>, Dq<T>),
         i_abc: Abc<T>,
         vdc: T,
     ) -> Option<Applied<T>> {
+        // While the release hold catches a fall, the compensation stays at the reference:
+        // the hold's stiffness is set for the inverter error the compensation at the
+        // reference leaves inside the band (`ReleaseHold`'s dead-time softening).
+        let holding = self.hold.tracking_fall() || self.hold.active();
+        let i_dq = if holding { i_dq_ref } else { i_dq };
         let comp = self
             .dead_time
-            .phase_voltages(rot, i_dq_ref, i_abc, v_ab, vdc);
+            .phase_voltages_followed(rot, i_dq_ref, i_dq, i_abc, v_ab, vdc);
         let m = self.modulator.step(v_ab + comp.to_ab(), vdc);
         let (v_ab, v_dq) = if !m.saturated {
             (v_ab, v_dq) // exactly what was asked for: nothing to back-calculate
@@ -106,11 +111,12 @@ impl<T: Real> Blocks<T> {
             factor: t.delay_compensation.factor,
         })
         .map_err(rename(&[("factor", "delay_compensation_factor")]))?;
-        let dead_time =
+        let mut dead_time =
             DeadTimeCompensation::new(c.dead_time_compensation_config()).map_err(rename(&[
                 ("threshold_voltage", "dead_time_threshold_voltage"),
                 ("current_band", "dead_time_current_band"),
             ]))?;
+        dead_time.set_current_loop(t.current.bandwidth_hz, ts);
         let modulator = SpaceVectorModulator::new(ModulatorConfig {
             limit: t.modulation.voltage_limit,
             max_modulation: t.modulation.max_modulation,

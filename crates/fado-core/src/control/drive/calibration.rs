@@ -237,7 +237,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
                 (v_dq.to_ab(rot), v_dq)
             }
         };
-        let Some(applied) = b.modulate(rot, v_ab, v_dq, i_dq_ref, i_abc, vdc) else {
+        let Some(applied) = b.modulate(rot, v_ab, v_dq, (i_dq_ref, i_dq), i_abc, vdc) else {
             return self.reject_after_estimate(backup, estimate, i_dq);
         };
         if command.voltage.is_none() {

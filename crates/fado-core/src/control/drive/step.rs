@@ -152,7 +152,7 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             .delay
             .step_rotated(v_dq, rot_theta, estimate.theta, estimate.omega);
         // 7. Dead-time compensation, hexagon limit, SVPWM.
-        let Some(applied) = b.modulate(rot, v_ab, v_dq, i_dq_ref, i_abc, vdc) else {
+        let Some(applied) = b.modulate(rot, v_ab, v_dq, (i_dq_ref, i_dq), i_abc, vdc) else {
             return Err(self.reject_after_estimate(backup, estimate, i_dq));
         };
         // 8. Anti-windup with the realised voltage in the same frame; speed loop too.

@@ -67,7 +67,10 @@ impl<T: Real, E: RotorAngleEstimator<T>> SensorlessDrive<T, E> {
             Err(out) => return out,
         };
         let v_ab = v_dq.to_ab(rot);
-        let Some(applied) = self.blocks.modulate(rot, v_ab, v_dq, i_dq_ref, i_abc, vdc) else {
+        let Some(applied) = self
+            .blocks
+            .modulate(rot, v_ab, v_dq, (i_dq_ref, i_dq), i_abc, vdc)
+        else {
             return self.reject_after_estimate(backup, estimate, i_dq);
         };
         self.blocks.current.realised(applied.v_dq);
