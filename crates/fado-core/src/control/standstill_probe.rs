@@ -40,7 +40,11 @@
 //! c_J = Ĵ/(1.5·p²·λ̂f), the torque demand per rad/s² of electrical acceleration, summed over
 //! a window as c_J·(ω̂_end − ω̂_before)/Ts. The window then needs only a settled current loop
 //! and speed estimate (the 35 Hz tracker's 4.5 ms time constant), not the 5 Hz speed loop's
-//! 0.16 s zero: the default period is 0.1 s instead of 0.5 s, a window of 25 ms.
+//! 0.16 s zero: the default period is 0.1 s instead of 0.5 s, a window of 25 ms. On a
+//! heavy salient rotor the speed estimate's own answer to the probe's d step outweighs the
+//! rotor's acceleration in that term, and the drive lengthens the period
+//! ([`crate::control::probe_period`]: 0.131 s on a drawn 140 kW IPMSM of 23.3 kg·m², whose
+//! reading at 0.1 s is −3 × δ and loses the rotor, 0.64 rad in `fullrange`).
 //!
 //! **Amplitude** ([`amplitude`]). The probe's torque through the angle error, A·sin δ, turns a
 //! light rotor: each period's amplitude is the one that would have held the last period's
