@@ -24,9 +24,9 @@ use crate::{Ab, Abc, Dq, Real, Rotation};
 
 impl<T: Real> Blocks<T> {
     /// Dead-time compensation, hexagon limit and SVPWM of the reference `v_ab` (`v_dq` in the
-    /// frame of `rot`; `i_dq_ref` and the measured `i_dq` in the frame of θ̂), and the voltage that then acts, back-calculated without the
-    /// compensation where the modulator limited it (zero without a DC link). None when
-    /// anything is non-finite.
+    /// frame of `rot`; `i_dq_ref` and the measured `i_dq` in the frame of θ̂), and the voltage
+    /// that then acts, back-calculated without the compensation where the modulator limited
+    /// it (zero without a DC link). None when anything is non-finite.
     #[inline(always)]
     pub(super) fn modulate(
         &mut self,
