@@ -123,9 +123,9 @@ pub type Hold = (f64, f64, f64);
 /// `fullrange`'s phases in the base timeline: to the rated speed under half the rated torque,
 /// the rated load step, field weakening to the top speed, braking through zero to a
 /// standstill under 65 % of the rated torque, the rated speed reversed.
-fn fullrange_phases(c: &SimConfig) -> [Phase; 5] {
+fn fullrange_phases(c: &SimConfig, t: &RangeTargets) -> [Phase; 5] {
     let n = c.motor.rated_speed_rpm;
-    let top = targets(c).top_speed_rpm;
+    let top = t.top_speed_rpm;
     let phase = Phase::new;
     [
         phase(1.2, 2.0, 2.5, n),
@@ -136,9 +136,8 @@ fn fullrange_phases(c: &SimConfig) -> [Phase; 5] {
     ]
 }
 
-/// `fullrange`'s (speed, load) profiles on the timeline `line`.
-fn fullrange_profiles(c: &SimConfig, line: &Timeline) -> (Profile, Profile) {
-    let t = targets(c);
+/// `fullrange`'s (speed, load) profiles for the targets `t` on the timeline `line`.
+fn fullrange_profiles(c: &SimConfig, t: &RangeTargets, line: &Timeline) -> (Profile, Profile) {
     let n = t.rated_speed_rpm;
     let top = t.top_speed_rpm;
     let rated_torque = c.motor.rated_torque;
@@ -176,18 +175,25 @@ fn fullrange_profiles(c: &SimConfig, line: &Timeline) -> (Profile, Profile) {
 /// `fullrange`'s timeline on `c`: the base one, or longer where the rotor needs it
 /// ([`timing`]).
 pub fn fullrange_timeline(c: &SimConfig) -> Timeline {
-    let phases = fullrange_phases(c);
-    let top = targets(c).top_speed_rpm.max(c.motor.rated_speed_rpm);
-    timing::plan(c, &phases, top, |line| fullrange_profiles(c, line))
+    fullrange_plan(c).2
+}
+
+/// `fullrange`'s targets, phases and timeline on `c`, each found once.
+fn fullrange_plan(c: &SimConfig) -> (RangeTargets, [Phase; 5], Timeline) {
+    let t = targets(c);
+    let phases = fullrange_phases(c, &t);
+    let top = t.top_speed_rpm.max(c.motor.rated_speed_rpm);
+    let line = timing::plan(c, &phases, top, |line| fullrange_profiles(c, &t, line));
+    (t, phases, line)
 }
 
 /// `fullrange`'s profile on `c` (scaled by its ratings, its model's limits and its rotor's
 /// time to reach each speed); returns the settled windows judged.
 pub fn setup_fullrange(c: &mut SimConfig) -> Vec<Hold> {
-    let line = fullrange_timeline(c);
-    let profiles = fullrange_profiles(c, &line);
+    let (t, phases, line) = fullrange_plan(c);
+    let profiles = fullrange_profiles(c, &t, &line);
     apply(c, profiles, 12.0 + line.window[4]);
-    fullrange_holds(c)
+    holds(&phases, &line)
 }
 
 /// Sets a range scenario's (speed, load) profiles and its duration (s) on `c`, judged from
@@ -213,7 +219,8 @@ fn holds(phases: &[Phase], line: &Timeline) -> Vec<Hold> {
 /// load has settled): rated speed before and after the load step, the top speed, standstill
 /// under 65 % of the rated torque, the rated speed reversed.
 pub fn fullrange_holds(c: &SimConfig) -> Vec<Hold> {
-    holds(&fullrange_phases(c), &fullrange_timeline(c))
+    let (_, phases, line) = fullrange_plan(c);
+    holds(&phases, &line)
 }
 
 /// `regen-stop`'s phases in the base timeline: to the rated speed, a stop at the current
@@ -274,7 +281,7 @@ pub fn setup_regen_stop(c: &mut SimConfig) -> Vec<Hold> {
     let line = regen_stop_timeline(c);
     let profiles = regen_stop_profiles(c, &line);
     apply(c, profiles, 8.0 + line.window[3]);
-    regen_stop_holds(c)
+    holds(&regen_stop_phases(c), &line)
 }
 
 /// `regen-stop`'s settled windows: rated speed, standstill after the first stop, rated speed
