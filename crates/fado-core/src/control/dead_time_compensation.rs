@@ -378,34 +378,15 @@ impl<T: Real> DeadTimeCompensation<T> {
         v_ab: Ab<T>,
         vdc: T,
     ) -> Abc<T> {
-        if !self.config.enabled {
-            return Abc::default();
-        }
-        self.compensate(
-            rotation,
-            i_dq_ref.to_ab(rotation).to_abc(),
-            i_abc,
-            v_ab,
-            vdc,
-        )
-    }
-
-    /// [`phase_voltages`](Self::phase_voltages) of an enabled compensation with the current
-    /// the trapezoid and the edge currents take already in phases, `i_ref_abc` (A).
-    #[inline(always)]
-    fn compensate(
-        &self,
-        rotation: Rotation<T>,
-        i_ref_abc: Abc<T>,
-        i_abc: Abc<T>,
-        v_ab: Ab<T>,
-        vdc: T,
-    ) -> Abc<T> {
         let out = match self.config.method {
-            DeadTimeMethod::Trapezoidal => self.trapezoid(i_ref_abc, vdc),
-            DeadTimeMethod::EdgeCurrent => {
-                self.edge_current(rotation, i_ref_abc, v_ab.to_abc(), vdc)
-            }
+            _ if !self.config.enabled => return Abc::default(),
+            DeadTimeMethod::Trapezoidal => self.trapezoid(i_dq_ref.to_ab(rotation).to_abc(), vdc),
+            DeadTimeMethod::EdgeCurrent => self.edge_current(
+                rotation,
+                i_dq_ref.to_ab(rotation).to_abc(),
+                v_ab.to_abc(),
+                vdc,
+            ),
             DeadTimeMethod::Sign => self.sign(i_abc, vdc),
         };
         if out.is_finite() { out } else { Abc::default() }
@@ -444,20 +425,20 @@ impl<T: Real> DeadTimeCompensation<T> {
         } else {
             i_dq_ref
         };
-        if self.follow_gain == T::zero() || !self.config.enabled {
+        if self.follow_gain == T::zero() {
             return self.phase_voltages(rotation, i_dq_ref, i_abc, v_ab, vdc);
         }
         let reference = i_dq_ref.to_ab(rotation).to_abc();
-        let band = self.config.current_band;
+        let band = T::one() / self.inv_band;
         let followed = self.followed.to_ab(rotation).to_abc();
-        let measured = || i_dq.to_ab(rotation).to_abc();
+        let measured = i_dq.to_ab(rotation).to_abc();
         // Set by the filtered reference (noise-free: never in a steady state), held until
         // the measured current has crossed too (the loop's response to a large step is
         // limited by the voltage, slower than its small-signal bandwidth).
         self.ahead = opposed(band, reference, followed)
-            || (self.ahead && opposed(band, reference, measured()));
-        let at = if self.ahead { measured() } else { reference };
-        self.compensate(rotation, at, i_abc, v_ab, vdc)
+            || (self.ahead && opposed(band, reference, measured));
+        let at = if self.ahead { i_dq } else { i_dq_ref };
+        self.phase_voltages(rotation, at, i_abc, v_ab, vdc)
     }
 
     /// [`DeadTimeMethod::EdgeCurrent`] for phase currents `i_abc` (A) and the phase voltage
