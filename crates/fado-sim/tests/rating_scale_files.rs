@@ -71,8 +71,11 @@ fn times(m: &MachineModel<f64>, k: f64) -> MachineModel<f64> {
 /// two heavy drawn surface-magnet machines of `tests/data/drawn/` / 10 are direct-drive
 /// torque motors (the 17-pole-pair 30 kW one 11.9 N·m at 237 r/min, 295 W; the 4-pole-pair
 /// 168 kW one 155 N·m at 103 r/min, 1.7 kW), whose magnet flux and inductance suit a slow,
-/// high-torque winding as well.
-const MISSED: [(&str, f64); 7] = [
+/// high-torque winding as well; the drawn 88 kW 1-pole-pair IPMSM / 10 (9.5 N·m at
+/// 886 r/min, 880 W, τ 8.1 ms against the 9.1 ms bound at 880 W, product 0.055) is a slow
+/// 2-pole machine the bands allow.
+const MISSED: [(&str, f64); 8] = [
+    ("ipm-1p-800v-88kw.toml", 0.1),
     ("ipmsm-20kw-10p-560v.toml", 0.1),
     ("spm-17p-800v-30kw-heavy.toml", 0.1),
     ("spm-4p-800v-168kw.toml", 0.1),
