@@ -16,9 +16,10 @@
 //! the rate low-passed at [`FRAME_RATE_HZ`], c judged with the notch's coupling test in the
 //! integrand-offset law's slot (|c| above `OFFSET_COUPLING_MAX` there, so 1/c stays below 2).
 //! Dividing by the signed c gives the correction the sign of the frame motion in both
-//! quadrants where the notch acts (s·ω̂ < 0; the generating ones where s follows i_q): replayed with exact signals, the pmsyrm-baldor-5k6
-//! PM-SyRM's stop at the current limit while generating (i_q < 0 at ω > 0) holds 0.048 rad
-//! with it and 0.074 without (the magnitude's rate with a fixed sign, g = 6 rad: 0.58 rad).
+//! quadrants where the notch acts (s·ω̂ < 0; the generating ones where s follows i_q):
+//! replayed with exact signals, the pmsyrm-baldor-5k6 PM-SyRM's stop at the current limit
+//! while generating (i_q < 0 at ω > 0) holds 0.048 rad with it and 0.074 without (the
+//! magnitude's rate with a fixed sign, g = 6 rad: 0.58 rad).
 //! The correction acts below [`FRAME_RATE_SPEED_SHARE`] of the rated speed and with a share
 //! of G/c that rises from 0 at [`FRAME_RATE_CURRENT_LOW`] of the rated current to 1 at
 //! [`FRAME_RATE_CURRENT_FULL`]: where the current is small the ratio's rate reads noise and
