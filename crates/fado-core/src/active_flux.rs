@@ -71,9 +71,10 @@
 //! and s/κ reduce to the same number; the saturated PM-SyRM of the pmsyrm-baldor-5k6 preset
 //! reaches 0.81 at 65 % and 0.96 at its rated torque under MTPA (the IPMSM of the
 //! ipmsm-2k2-qsat preset stays below 0.08). Above [`OFFSET_COUPLING_MAX`] the
-//! integrand-offset law holds, and while the machine generates the observer runs at its speed
-//! without the electrical-frequency ripple of a DC error (`crate::speed_notch`), which with
-//! this coupling would make the DC loop grow (docs/method/saturation.md, "The slow mode").
+//! integrand-offset law holds, and where s and ω have opposite signs (while the machine
+//! generates where L_q,s exceeds L_dd) the observer runs at its speed without the
+//! electrical-frequency ripple of a DC error (`crate::speed_notch`), which with this coupling
+//! would make the DC loop grow (docs/method/saturation.md, "The slow mode").
 
 use crate::magnetics::{
     ConstantInductance, FluxLookup, FluxWarmStart, InductanceMatrix, MachineMagnetics,
@@ -88,8 +89,8 @@ pub const KAPPA_MIN_RATIO: f64 = 0.5;
 
 /// The integrand-offset law holds ê, and stops re-centring, where the frame coupling
 /// [`ActiveFlux::frame_coupling`] exceeds this: there the law integrates the frame error
-/// that the flux magnitude carries; the observer's speed is notched there while the machine
-/// generates (`crate::speed_notch`). Ours \[A\]: on the pmsyrm-baldor-5k6 presets
+/// that the flux magnitude carries; the observer's speed is notched there where s and ω̂ have
+/// opposite signs (`crate::speed_notch`). Ours \[A\]: on the pmsyrm-baldor-5k6 presets
 /// (coupling 0.6–0.96 under load) the closed loop then holds `reversal` where the law at
 /// its default rate trips it; the machines whose coupling stays below it (0.08 on
 /// ipmsm-2k2-qsat, 0.3 on a small 20-pole IPMSM) never reach it.

@@ -10,7 +10,8 @@
 //! (the observer's lag compensation), a leak that turns with the same e^{jθ} as
 //! the ripple and so has a DC part proportional to ε. With the frame coupling c of
 //! `crate::active_flux` (the observer's radial input e_d + c·e_q) that leak closes a loop
-//! around ε which moves the DC loop's slowest pole to the right while the machine generates,
+//! around ε which moves the DC loop's slowest pole to the right where c and ω have opposite
+//! signs (while the machine generates where L_q,s exceeds L_dd, c then following i_q),
 //! past zero where c approaches 1. Running the observer at the true speed removes the loop:
 //! every slow-mode rate is then the k_df decay (−0.5 s⁻¹) on the PM-SyRM and the automotive
 //! IPMSM at every load (`saturated_replay`). The notch removes from the observer's speed

@@ -305,8 +305,9 @@ pub struct EstimatorState<T: Real> {
     /// `flux_settle_periods` on the turning R̂s law runs at the coupled point
     /// (`crate::rs_adaptation`, "The frame coupling").
     coupled_steady: u16,
-    /// The observer runs at the notched speed (`crate::speed_notch`): `frame_coupled` while
-    /// the machine generates, judged in the same slot.
+    /// The observer runs at the notched speed (`crate::speed_notch`): `frame_coupled` where
+    /// the frame coupling's s and ω̂ have opposite signs (on a rotor with L_q,s above L_dd,
+    /// while the machine generates), judged in the same slot.
     notch_on: bool,
     /// G/c of the frame-rate correction (`step::notch`), judged in the same slot: zero
     /// where the notch's coupling test fails and on the constant-inductance path.

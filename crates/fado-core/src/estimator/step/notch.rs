@@ -16,9 +16,10 @@
 //! the rate low-passed at [`FRAME_RATE_HZ`], c judged with the notch's coupling test in the
 //! integrand-offset law's slot (|c| above `OFFSET_COUPLING_MAX` there, so 1/c stays below 2).
 //! Dividing by the signed c gives the correction the sign of the frame motion in both
-//! generating quadrants (s follows i_q): replayed with exact signals, the pmsyrm-baldor-5k6
-//! PM-SyRM's stop at the current limit while generating (i_q < 0 at ω > 0) holds 0.048 rad
-//! with it and 0.074 without (the magnitude's rate with a fixed sign, g = 6 rad: 0.58 rad).
+//! quadrants where the notch acts (s·ω̂ < 0; the generating ones where s follows i_q):
+//! replayed with exact signals, the pmsyrm-baldor-5k6 PM-SyRM's stop at the current limit
+//! while generating (i_q < 0 at ω > 0) holds 0.048 rad with it and 0.074 without (the
+//! magnitude's rate with a fixed sign, g = 6 rad: 0.58 rad).
 //! The correction acts below [`FRAME_RATE_SPEED_SHARE`] of the rated speed and with a share
 //! of G/c that rises from 0 at [`FRAME_RATE_CURRENT_LOW`] of the rated current to 1 at
 //! [`FRAME_RATE_CURRENT_FULL`]: where the current is small the ratio's rate reads noise and
@@ -53,7 +54,7 @@ pub const FRAME_RATE_SPEED_SHARE: f64 = 0.15;
 /// current, and [`FRAME_RATE_CURRENT_FULL`] where it acts whole. Ours \[A\]: the frame's rate
 /// moves |λ̂r| by s·δ with s growing with the current, while the ratio's noise and the dead
 /// time's distortion do not shrink with it; below 0.4 of the rated current the rate
-/// reads them, and the generating test (ω̂·î_q < 0) reads the speed loop's own oscillation
+/// reads them, and the quadrant test (ω̂·s < 0) reads the speed loop's own oscillation
 /// at a standstill. The pmsyrm-baldor-5k6-measured map's unloaded standstill in
 /// `regen-stop` (|i| under 3.3 A, a quarter of the rated 12.45 A; c just above 0.5) drifts
 /// to 0.26 rad on seed 3 with the whole correction in 5–10 ms bursts where ω̂ crosses the
@@ -72,12 +73,20 @@ pub const FRAME_RATE_HZ: f64 = 100.0;
 impl<T: Real> EstimatorState<T> {
     /// The observer speed of a saturating model or a salient rotor: the notch
     /// (`crate::speed_notch`) stepped every sample, its ripple removed in the k_df mode where
-    /// the frame coupling is large and the machine generates (ω̂·î_q < 0), the quadrant where
-    /// the DC loop's two couplings add. Both are judged at the operating point of the
+    /// the frame coupling is large and of the opposite sign to the speed (ω̂·s < 0), the
+    /// quadrant where the DC loop's two couplings add: the radial share's copy of a DC error
+    /// has the sign of s, the observer's leak the sign of ω (`crate::speed_notch`). Where
+    /// L_q,s exceeds L_dd, s follows î_q and the quadrant is the generating one (ω̂·î_q < 0);
+    /// where the q axis saturates below L_dd it is the motoring one. Measured on a drawn
+    /// 91 kW IPMSM (`tests/data/drawn/ipm-sat-10p-800v-91kw.toml`) whose L_q,s falls to half
+    /// L_dd at its current limit (c = s/κ = −0.54 at i_q = +1.84 of the rated current):
+    /// gated on ω̂·î_q, its stop at the current limit loses the rotor at 0.9 rad once the
+    /// frame-rate correction starts (`regen-stop`), and its through-zero reversal reaches
+    /// 0.53 rad (`fullrange`). Both are judged at the operating point of the
     /// integrand-offset law's slot (the law holds on the same coupling test), once every
     /// [`SLOW_PERIOD`] samples: a saturating model's at its operating point, constant
     /// inductances' at the current `i_ab` in the frame of λ̂r
-    /// (`crate::active_flux::constant_inductance_holds_offset`).
+    /// (`crate::active_flux::constant_inductance_holds_offset`, s = (L̂q − L̂d)·î_q).
     #[inline(always)]
     pub(super) fn notch_speed<M: FluxLookup<T>>(
         &mut self,
@@ -88,7 +97,7 @@ impl<T: Real> EstimatorState<T> {
         speed: T,
     ) -> T {
         if self.slot == SLOT_OFFSET {
-            let (coupled, i_q, share) = match c.point {
+            let (coupled, s_sign, share) = match c.point {
                 Some(point) => {
                     let (s, kappa) = af.frame_coupling(&point);
                     let coupled = af.holds_offset(&point);
@@ -100,20 +109,21 @@ impl<T: Real> EstimatorState<T> {
                     } else {
                         T::zero()
                     };
-                    (coupled, point.i_dq.q, af.offset_rate_share(&point))
+                    (coupled, s, af.offset_rate_share(&point))
                 }
                 None => {
                     let i_dq = ActiveFlux::<T>::frame_current(c.lambda_r, i_ab);
                     let lf = self.rs_adaptation.flux_linkage_hat;
                     let holds =
                         crate::active_flux::constant_inductance_holds_offset(lf, c.saliency, i_dq);
-                    (holds, i_dq.q, T::one())
+                    // s = (L̂q − L̂d)·î_q, saliency = L̂d − L̂q.
+                    (holds, -c.saliency * i_dq.q, T::one())
                 }
             };
             self.frame_coupled = coupled;
             self.offset_share = share;
             self.notch_on =
-                p.frame_ripple_notch && self.frame_coupled && i_q * c.t2s1.omega < T::zero();
+                p.frame_ripple_notch && self.frame_coupled && s_sign * c.t2s1.omega < T::zero();
         }
         let rate = self.frame_rate(p, c);
         let (notch, ripple) = p.speed_notch.step(&self.speed_notch, speed);

@@ -245,9 +245,10 @@ pub struct ObserverTuning<T> {
     pub gain_period: T,
     /// With a saturating magnetic model: run the observer at its speed without the ripple at
     /// the electrical frequency (a notch at |ω̂|, `crate::speed_notch`) where the frame
-    /// coupling of `crate::active_flux` exceeds `active_flux::OFFSET_COUPLING_MAX` while the
-    /// machine generates, on a saturating model or a salient rotor with constant inductances
-    /// (coupling (L̂q − L̂d)·î_q/λ̂a). Default true (ours \[A\]; no effect on a surface-magnet
+    /// coupling of `crate::active_flux` exceeds `active_flux::OFFSET_COUPLING_MAX` with the
+    /// sign opposite to ω̂ (while the machine generates where L_q,s exceeds L_dd), on a
+    /// saturating model or a salient rotor with constant inductances (coupling
+    /// (L̂q − L̂d)·î_q/λ̂a). Default true (ours \[A\]; no effect on a surface-magnet
     /// rotor).
     ///
     /// A DC error of λ2 turns θ̂ by a ripple at the electrical frequency; at low speed T2S-1
