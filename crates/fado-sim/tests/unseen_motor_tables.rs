@@ -244,7 +244,10 @@ fn calibrated_miss(name: &str, scenario: &str, seed: u64) -> Option<String> {
 /// loop (318 Hz, 1/ωc = 0.5 ms) has raised the release's d-current floor: the drive puts the
 /// floor on while the brake still holds such a rotor (the rated load's time to the trigger
 /// under 1.5/ωc, `fado_core::control::SensorlessDrive::arm_release_hold`). Measured (backward travel, |θ − θ̂| from ready, rad): the servo at
-/// seeds 1 / 2 / 3 / 4 0.447 / 0.458 / 0.451 / 0.440 and 0.051 / 0.063 / 0.074 / 0.053 (seed 2
+/// seeds 1 / 2 / 3 / 4 0.255 / 0.312 / 0.261 / 0.259 and 0.064 / 0.067 / 0.069 / 0.064 with
+/// its current loop at the hold's cap ωc·Ts = 0.35 (557 Hz; the floor raised at the opening
+/// is then in time); with the loop at ωc·Ts = 0.2 (318 Hz) and the floor at the brake
+/// 0.447 / 0.458 / 0.451 / 0.440 and 0.051 / 0.063 / 0.074 / 0.053 (seed 2
 /// 0.863 with the floor raised at the opening: the phase across θ̂ inside the dead-time band,
 /// the direct angle 0.022 rad behind a 0.045 rad fall at the trigger, the load read 1.37 A of
 /// 3.4 A; 1.28 back at seed 1 without the fall's preset; the criterion's 0.5); the tool motor
