@@ -362,7 +362,10 @@ fn rotors_whose_rated_load_outruns_their_sampling_fall_within_the_capped_travel(
             let out = simulate("loaded-start", Some(&text), false, None).unwrap();
             let back = out.probe.start.as_ref().unwrap().max_backward;
             println!("{name} seed {seed}: back {back:.3} rad");
-            assert!(out.passed && back < 0.35, "{name} seed {seed}: {back} rad back");
+            assert!(
+                out.passed && back < 0.35,
+                "{name} seed {seed}: {back} rad back"
+            );
         }
     }
 }
