@@ -337,3 +337,35 @@ fn a_heavy_surface_magnet_rotor_holds_its_angle_through_stops() {
         );
     }
 }
+
+/// Rotors whose rated load outruns their sampling: the release hold's design
+/// (`fado_core::control::release_hold`) needs a current loop of 10·ω_h beyond the cap
+/// `MAX_CURRENT_WC_TS`·(1/Ts), and the rated load then moves the rotor by 0.27·a/ω_h² with ω_h
+/// a tenth of the capped loop's. The drawn 69 W, 15-pole-pair IPMSM (12 kHz sampling, ω_d =
+/// 448 rad/s) and the Estun 400 W servo's bare rotor (`tests/data/unseen/`, 10 kHz, ω_d =
+/// 470 rad/s) stay within 1.75 times the 0.2 rad design travel, the share the hold's current
+/// rule allows a capped loop: 0.20–0.23 and 0.26–0.31 rad at seeds 1–4 with the loop capped at
+/// ωc·Ts = 0.35; at 0.2 they ran 0.34–0.38 and 0.44–0.46 rad back.
+#[test]
+fn rotors_whose_rated_load_outruns_their_sampling_fall_within_the_capped_travel() {
+    for (dir, name) in [
+        ("drawn", "ipm-sat-15p-47v-69w"),
+        ("unseen", "servo-estun-emj04-400w-310v"),
+    ] {
+        let path = format!(
+            "{}/tests/data/{dir}/{name}.toml",
+            env!("CARGO_MANIFEST_DIR")
+        );
+        let motor = std::fs::read_to_string(path).unwrap();
+        for seed in 1..=4 {
+            let text = format!("{motor}\n[current_sensor]\nseed = {seed}\n");
+            let out = simulate("loaded-start", Some(&text), false, None).unwrap();
+            let back = out.probe.start.as_ref().unwrap().max_backward;
+            println!("{name} seed {seed}: back {back:.3} rad");
+            assert!(
+                out.passed && back < 0.35,
+                "{name} seed {seed}: {back} rad back"
+            );
+        }
+    }
+}

@@ -237,14 +237,17 @@ fn calibrated_miss(name: &str, scenario: &str, seed: u64) -> Option<String> {
 
 /// The light rotors under the rated gravity-like load at the brake's release: the servo's
 /// bare rotor (rated torque to rated speed in 7.7 ms) and the tool motor, whose release holds
-/// are capped by the 10 kHz sampling below their design stiffness (servo ω_h 200 of 470
+/// are capped by the 10 kHz sampling below their design stiffness (servo ω_h 350 of 470
 /// rad/s): they trigger on the direct angle and start their integral from the load the fall
 /// reveals (`fado_core::control::release_hold`, "The load the fall reveals"). The servo's
-/// rotor falls by the trigger's 0.02 rad within 0.6 ms of the release, before the current
-/// loop (318 Hz, 1/ωc = 0.5 ms) has raised the release's d-current floor: the drive puts the
-/// floor on while the brake still holds such a rotor (the rated load's time to the trigger
-/// under 1.5/ωc, `fado_core::control::SensorlessDrive::arm_release_hold`). Measured (backward travel, |θ − θ̂| from ready, rad): the servo at
-/// seeds 1 / 2 / 3 / 4 0.447 / 0.458 / 0.451 / 0.440 and 0.051 / 0.063 / 0.074 / 0.053 (seed 2
+/// rotor falls by the trigger's 0.02 rad within 0.49 ms of the release, 1.72 time constants
+/// of its current loop (557 Hz, 1/ωc = 0.29 ms), by which the release's d-current floor
+/// raised at the opening is in time; a rotor whose fall is faster than 1.5/ωc gets the floor
+/// while the brake still holds it (`fado_core::control::SensorlessDrive::arm_release_hold`). Measured (backward travel, |θ − θ̂| from ready, rad): the servo at
+/// seeds 1 / 2 / 3 / 4 0.255 / 0.312 / 0.261 / 0.259 and 0.064 / 0.067 / 0.069 / 0.064 with
+/// its current loop at the hold's cap ωc·Ts = 0.35 (557 Hz; the floor raised at the opening
+/// is then in time); with the loop at ωc·Ts = 0.2 (318 Hz) and the floor at the brake
+/// 0.447 / 0.458 / 0.451 / 0.440 and 0.051 / 0.063 / 0.074 / 0.053 (seed 2
 /// 0.863 with the floor raised at the opening: the phase across θ̂ inside the dead-time band,
 /// the direct angle 0.022 rad behind a 0.045 rad fall at the trigger, the load read 1.37 A of
 /// 3.4 A; 1.28 back at seed 1 without the fall's preset; the criterion's 0.5); the tool motor

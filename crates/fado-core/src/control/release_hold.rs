@@ -150,9 +150,22 @@ pub use tuning::ReleaseHoldTuning;
 pub const SATURATING_SPEED_FILTER_RATIO: f64 = 4.0;
 
 /// The largest ωc·Ts the hold's current-loop rule gives ([`current_bandwidth_for_hold`]):
-/// 0.2 \[A\], with the loop's 1.5-sample delay a phase margin of 90° − 0.3 rad = 73°
-/// (the current loop refuses ωc·Ts above 0.5, 47°).
-pub const MAX_CURRENT_WC_TS: f64 = 0.2;
+/// 0.35 \[A\], with the loop's 1.5-sample delay a phase margin of 90° − 0.525 rad = 60°
+/// (the current loop refuses ωc·Ts above 0.5, 47°). The cap binds on a rotor whose rated load
+/// accelerates it faster than its sampling follows: the rated load's travel grows as
+/// 1/ωc², so the cap sets how far it falls. Measured (`loaded-start` backward travel, seeds
+/// 1–4, rad; at ωc·Ts = 0.2 in brackets): the Estun EMJ-04 400 W servo's bare rotor
+/// (`crates/fado-sim/tests/data/unseen/`, 10 kHz sampling) 0.255 / 0.312 / 0.261 / 0.259
+/// (0.447 / 0.457 / 0.451 / 0.440); the drawn 69 W IPMSM (`tests/data/drawn/`, 12 kHz)
+/// 0.203 / 0.204 / 0.220 / 0.226 (0.359 / 0.343 / 0.377 / 0.370), max |θ − θ̂| from ready
+/// within 0.064–0.102 rad either way; a drawn 31 W, 3-pole-pair SPM (`python3
+/// scripts/drawn-machines.py draw DIR --seed 606`, its seventh: 6.3·10⁻⁸ kg·m², its rated
+/// load 9.2·10⁵ rad/s² electrical at 24 kHz sampling) falls 0.26–0.33 rad within 20 ms of the
+/// release at seeds 1–4 (0.49–0.72; seed 2 0.724 rad back, past the 0.5 allowed). Leaving
+/// its loaded standstill is another matter: where the reference ramps from zero under the
+/// rated load it loses seeds 1, 3 and 4 at 0.35 (|θ − θ̂| 0.322 rad from ready; 18 and 16 rad
+/// back) and seeds 3 and 4 at 0.2 (0.82 and 4.8 rad back).
+pub const MAX_CURRENT_WC_TS: f64 = 0.35;
 
 /// The loop's speed changes in a sample by at most this many times b·i_max·Ts (b =
 /// 1.5·p²·λ̂f/Ĵ, i_max the torque demand's limit): 2 \[A\], the acceleration of the hold's

@@ -21,7 +21,7 @@ const BANDWIDTH_RULE: &str = "T2S-1's bandwidth in k_df mode at which a step of 
 
 /// The release hold's rule for the current loop's bandwidth.
 const HOLD_CURRENT_RULE: &str = "10·ω_h of the release hold's design travel where the hold is \
-    enabled or armed at the start-up's end (`at_start`) and that is above the tuning's, at most ωc·Ts = 0.2 \
+    enabled or armed at the start-up's end (`at_start`) and that is above the tuning's, at most ωc·Ts = 0.35 \
     (fado_core::control::release_hold)";
 
 /// The speed loop's bandwidth on a light rotor, and T2S-2's with it.

@@ -13,9 +13,12 @@ use crate::{Dq, Real};
 /// t_r = √(2·trigger/a_rated), a_rated = p·T_rated/Ĵ; a hold whose current loop is raised to
 /// the 10·ω_h its design needs (`release_hold`, "The current loop it needs") has
 /// t_r·ωc = 10·√(2·trigger·0.27/travel) = 2.3 at the default trigger and travel; below
-/// that are the rotors whose current loop the sampling caps (ωc·Ts = 0.2). Of the presets
-/// and test machines only the 400 W servo's bare rotor is below 1.5: 0.99 (t_r 0.49 ms at
-/// 10 kHz); the capped multirotor, tool and 750 W servo motors (1.77–1.88) keep the floor
+/// that are the rotors whose current loop the sampling caps (ωc·Ts at most
+/// `release_hold::MAX_CURRENT_WC_TS`, 0.35). At that cap none of the presets and test machines
+/// is below 1.5: the 400 W servo's bare rotor has 1.72 (t_r 0.49 ms at 10 kHz, ωc = 3.5·10³
+/// s⁻¹), and its floor raised at the opening is in time (`loaded-start` 0.255–0.312 rad back at
+/// seeds 1–4); with its loop at ωc·Ts = 0.2 it has 0.99 and, the floor raised at the opening,
+/// ran 0.863 rad back at seed 2 (0.458 with the floor at the brake). The capped multirotor, tool and 750 W servo motors (1.77–1.88) keep the floor
 /// from the opening. A bound between the two, measured, not derived: with the floor on at
 /// the brake on every rotor, the Flipsky 6215 multirotor motor (2.3) ran back 2.07 rad
 /// instead of 0.24 at `loaded-start` seed 4, and the MAD 5010 kv110 kept 0.261 rad of

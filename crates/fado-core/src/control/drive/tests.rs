@@ -132,10 +132,10 @@ fn voltage_ellipse_cuts_the_q_current_to_the_voltage() {
     }
 }
 
-/// The release's floor is on at the brake on the 400 W servo's bare rotor (the rated load's
-/// fall reaches the hold's trigger in 0.49 ms, t_r·ωc = 0.99 with the current loop the hold
-/// raises to ωc·Ts = 0.2), not on the paper's motor (t_r 2.3 ms at its 250 Hz loop) nor on
-/// the servo with the hold off.
+/// The release's floor is on at the brake on the 400 W servo's rotor of half its inertia (the
+/// rated load's fall reaches the hold's trigger in 0.34 ms, t_r·ωc = 1.2 with the current loop
+/// the hold raises to ωc·Ts = 0.35), not on its bare rotor (0.49 ms, 1.72), the paper's motor
+/// (t_r 2.3 ms at its 250 Hz loop) nor on the light rotor with the hold off.
 #[test]
 fn the_floor_is_on_at_the_brake_only_where_the_fall_outruns_the_current_loop() {
     let mut servo = crate::MachineModel::paper();
@@ -155,7 +155,11 @@ fn the_floor_is_on_at_the_brake_only_where_the_fall_outruns_the_current_loop() {
         c
     };
     let c = built(&servo, true);
-    assert!((c.tuning.current.bandwidth_hz - 318.31).abs() < 0.01);
+    assert!((c.tuning.current.bandwidth_hz - 557.04).abs() < 0.01);
+    assert!(!super::hold::floor_at_brake(&c));
+    servo.inertia = 1.5e-5;
+    let c = built(&servo, true);
+    assert!((c.tuning.current.bandwidth_hz - 557.04).abs() < 0.01);
     assert!(super::hold::floor_at_brake(&c));
     assert!(!super::hold::floor_at_brake(&built(
         &crate::MachineModel::paper(),

@@ -7,7 +7,8 @@
 //! most 0.2) and the sampling (ω_h ≤ 0.1/Ts) cap it: a rotor whose rated load accelerates it
 //! faster than its sampling can follow then runs back by 0.27·a/ω_h², (ω_d/ω_h)² times the
 //! design. The Estun EMJ-04 400 W servo's bare rotor (3.1e-5 kg·m², 8 poles, rated torque to
-//! rated speed in 7.7 ms) sampled at 10 kHz has ω_d = 470 rad/s and ω_h = 200 rad/s: its
+//! rated speed in 7.7 ms) sampled at 10 kHz has ω_d = 470 rad/s and, with its current loop at
+//! ωc·Ts = 0.2, ω_h = 200 rad/s (350 at the cap [`MAX_CURRENT_WC_TS`](super::MAX_CURRENT_WC_TS)): its
 //! integral builds the rated load's 3.4 A over 2.5 ms while the rotor falls at 1.6·10⁵ rad/s²
 //! (electrical), −637 r/min and 1.28 rad back (`loaded-start` seed 1,
 //! `crates/fado-sim/tests/unseen_motor_tables.rs`).
@@ -44,8 +45,9 @@
 //!
 //! # Measured
 //! `loaded-start` backward travel (rad, `python3 scripts/startup-table.py`, seeds 1–4; without
-//! the rule in brackets): the Estun servo 0.447 / 0.458 / 0.451 / 0.440 (1.28 at seed 1), its
-//! |θ − θ̂| from ready 0.051 / 0.063 / 0.074 / 0.053; the made-up 750 W servo
+//! the rule in brackets): the Estun servo with its current loop at ωc·Ts = 0.2 0.447 / 0.458 /
+//! 0.451 / 0.440 (1.28 at seed 1), its |θ − θ̂| from ready 0.051 / 0.063 / 0.074 / 0.053, at
+//! the cap of 0.35 0.255 / 0.312 / 0.261 / 0.259 and 0.064 / 0.067 / 0.069 / 0.064; the made-up 750 W servo
 //! (`crates/fado-sim/tests/data/startup-spm-750w.toml`) 0.22 / 0.22 / 0.23 / 0.22 (0.38 / 0.46
 //! / 0.39 / 0.38); the MAD 5010 kv200 0.22 / 0.21 / 0.26 / 0.23 (0.41 / 0.39 / 0.48 / 0.41);
 //! the multirotor preset 0.18 / 0.20 / 0.22 / 0.18 (0.21 / 0.20 / 0.23 / 0.22); the 36 V tool

@@ -109,7 +109,7 @@ fn a_light_rotor_gets_the_current_loop_its_hold_needs() {
     let (wide, paper) = (travel(hz), travel(250.0));
     assert!(wide < 0.25 && paper > 0.4, "{wide} {paper}");
     // The paper's motor keeps the tuning's bandwidth, as does a disabled hold; the
-    // sampling caps the rule at ωc·Ts = 0.2.
+    // sampling caps the rule at ωc·Ts = 0.35.
     // A 750 W 10-pole servo's capped travel is 1.6 times the design (0.33 rad): kept.
     let servo = MachineModel {
         pole_pairs: 5,
