@@ -281,6 +281,23 @@ fn a_heavy_saturated_rotor_holds_its_angle_with_its_speed_loop_at_2_hz() {
     );
 }
 
+/// The 192 kW IPMSM through `rated-reversal` (∓6 % of its 204 r/min in 2 s under its rated
+/// torque; the current limit leaves 1.6 × the rated torque, the ramp asks 1.23 ×). Its frame
+/// coupling exceeds 0.5 under load, where the R̂s law runs at the prior's rate and reads a
+/// frame error as resistance: running down to zero speed it learned R̂s 1.030 × Rs while the
+/// rotor decelerated from −10.7 to −7.4 r/min, the passage integrated ΔR·i into the angle,
+/// and i_q* swung between 0 and the limit at 15 Hz: 0.251 / 0.271 rad near zero speed and
+/// 7.3 / 7.5 r/min at seeds 1 / 2 (the law off: 0.038 / 0.040 rad). Frozen below the λ̂f
+/// law's speed floor at coupled points (`fado_core::rs_adaptation`, "A frame-coupled point
+/// near zero speed"): R̂s 1.007 × at the passage, 0.062 / 0.062 rad and 1.2 / 0.9 r/min.
+#[test]
+fn a_heavy_saturated_rotor_reverses_under_its_rated_torque() {
+    for seed in [1, 2] {
+        let (passed, max_error, _) = heavy_saturated_rotor("rated-reversal", seed, None);
+        assert!(passed && max_error < 0.15, "seed {seed}: {max_error}");
+    }
+}
+
 /// A drawn 116 kW IPMSM (draw seed 202: 2 pole pairs, Lq/Ld 1.30, 25.2 kg·m², 668 N·m rated)
 /// whose release hold is slow, ω_h = 8.5 rad/s: the rated load's catch lasts
 /// (2 + √2)/ω_h = 0.40 s, the rotor swinging between −8.6 and +7 r/min. The standstill probe

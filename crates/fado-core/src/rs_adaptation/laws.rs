@@ -353,6 +353,15 @@ impl<T: Real> ResistanceAdaptationParams<T> {
             let Some((bracket, coupling)) = coupled_bracket(af, &point) else {
                 return false;
             };
+            // At a frame-coupled point the law learns at the prior's rate (`saturated_rate`)
+            // and reads a frame error's s·δ as resistance: frozen there below the λ̂f law's
+            // speed floor, where the angle error moves with the speed (module docs, "A
+            // frame-coupled point near zero speed").
+            if coupling > T::lit(crate::active_flux::OFFSET_COUPLING_MAX)
+                && omega.abs() < self.config.flux_linkage_min_speed
+            {
+                return false;
+            }
             // Frozen where what the model leaves open (the map's interpolation spread, the
             // configured model flux uncertainty at î) times 1 + the frame coupling (a model
             // error's q part turns the frame, moving |λ̂r| by the coupling times it) exceeds
