@@ -343,13 +343,14 @@ impl<T: Real> ResistanceAdaptationParams<T> {
         let lf = st.flux_linkage_hat;
         let dl = self.saliency;
         if let Some((af, point)) = point {
-            // A saturating model (`crate::active_flux`): λ̂a(î) shifted by the learned λ̂f, the
-            // regressor's bracket at î; frozen where it is ill-conditioned, until the hand-over's
-            // transient has settled (`settled`, as the λ̂f law: the angle error turns î, and the
-            // regressor judged at î is not the machine's), and `coupled_below_floor`.
-            let Some((bracket, coupling)) = coupled_bracket(af, &point)
-                .filter(|&(_, c)| settled && !self.coupled_below_floor(c, omega))
-            else {
+            // A saturating model (`crate::active_flux`): λ̂a(î) shifted by the learned λ̂f,
+            // the regressor's bracket at î; frozen where it is ill-conditioned, and until the
+            // hand-over's transient has settled (`settled`, as the λ̂f law): there the angle
+            // error turns î, and the regressor judged at î is not the machine's.
+            if !settled {
+                return false;
+            }
+            let Some((bracket, coupling)) = coupled_bracket(af, &point) else {
                 return false;
             };
             // Frozen where what the model leaves open (the map's interpolation spread, the
@@ -406,16 +407,6 @@ impl<T: Real> ResistanceAdaptationParams<T> {
         let a = -lambda_r.cross(i_drop) * scale.chi_per_phi * sensitivity;
         let law = self.linear_rate(scale, a, mag);
         self.rotating_step(st, next, (reference, lf), law, mag, omega, settled)
-    }
-
-    /// At a frame-coupled point (`coupling` above `active_flux::OFFSET_COUPLING_MAX`) the law
-    /// learns at the prior's rate ([`Self::saturated_rate`]) and reads a frame error's s·δ as
-    /// resistance: frozen there below the λ̂f law's speed floor, where the angle error moves
-    /// with the speed (module docs, "A frame-coupled point near zero speed").
-    #[inline(always)]
-    fn coupled_below_floor(&self, coupling: T, omega: T) -> bool {
-        coupling > T::lit(crate::active_flux::OFFSET_COUPLING_MAX)
-            && omega.abs() < self.config.flux_linkage_min_speed
     }
 
     /// `a` with the linear path's γ·Ts·R0 and γ·Ts this period: γ at least the present resistive

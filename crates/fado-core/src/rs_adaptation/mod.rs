@@ -77,25 +77,6 @@
 //! `rated-reversal` from the correct start (1.03 rad): an oscillation at the electrical
 //! frequency after the passage, which grows slowly at γ, drove R̂s by −6 % there.
 //!
-//! **A frame-coupled point near zero speed.** Where the frame coupling exceeds
-//! `active_flux::OFFSET_COUPLING_MAX` the law runs only at a steady operating point, at the
-//! prior's rate 1/T_E (5 s⁻¹) whatever the excitation seen, and a frame error δ moves |λ̂r| by
-//! s·δ, which it reads as resistance. Approaching zero speed the angle error moves with the
-//! speed, not with the operating point the steadiness test watches: on a drawn 192 kW IPMSM
-//! (`fado-sim/tests/data/drawn/ipm-sat-9p-800v-192kw.toml`, τm = 3.8 s) decelerating from
-//! −10.7 to −7.4 r/min at the start of `rated-reversal`'s ramp under the rated load, |θ − θ̂|
-//! grows from 0.004 to 0.071 rad and R̂s from 0.988 to 1.030 × Rs in 0.25 s; through zero
-//! speed ΔR·i then integrates 0.15 Wb across d in 0.7 s, θ̂ moves with i_q (0.14 rad at
-//! i_q ≈ 0, 0.24 rad at the current limit), the speed PI answers at 15 Hz between 0 and the
-//! limit, and the passage ends 0.251 / 0.271 rad and 7.3 / 7.5 r/min off (seeds 1 / 2; with
-//! the law off 0.038 / 0.040 rad). The coupled law is therefore frozen below the λ̂f law's
-//! speed floor ([`ResistanceAdaptationConfig::flux_linkage_min_speed`], 3 × the Fig. 3
-//! threshold): R̂s 1.007 × at the passage, 0.062 / 0.062 rad near zero speed and 1.2 / 0.9
-//! r/min. On the PM-SyRM presets (coupling 0.6–1.1 under load), max |θ − θ̂| at seeds 1 / 2:
-//! `stops` 0.058 / 0.055 rad (0.099 / 0.094 with the law running there), `reversal` 0.059 / 0.062 (0.035 / 0.033), the measured map's `reversal` 0.143 /
-//! 0.140 (0.095 / 0.087), and the start errors of `saturated_rs_convergence` still end within
-//! 1 % (0.990–0.991 ×). The uncoupled path and constant inductances have no such floor.
-//!
 //! **Sampled at ω̂·Ts.** λ̂r is formed at the sampling instant (λ2 − L̂q·i_n, eq. (5)); the
 //! integrator's resistive drop uses the interval's current (i_n + i_{n−1})/2, which at a
 //! steady ω is i_n·cos(x/2)·e^{−jx/2} with x = ω·Ts, half a sample behind i_n. It lies along
