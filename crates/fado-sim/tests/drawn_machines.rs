@@ -281,6 +281,30 @@ fn a_heavy_saturated_rotor_holds_its_angle_with_its_speed_loop_at_2_hz() {
     );
 }
 
+/// The 192 kW IPMSM through `rated-reversal` (∓6 % of its 204 r/min in 2 s under its rated torque).
+/// Not the torque: the ramp asks 8,890 N·m, the current limit gives 11,900 N·m, and the speed
+/// follows the ramp within 1 r/min until 3.6 s, past zero speed. Its frame coupling exceeds 0.5
+/// under load, where the saturating R̂s law runs at the prior's rate 1/T_E (5 s⁻¹,
+/// `fado_core::rs_adaptation`, "The rate on a saturating model") and reads a frame error as
+/// resistance: while the rotor decelerates from −10.7 to −7.4 r/min at the ramp's start (2.62–2.87
+/// s) |θ − θ̂| grows from 0.004 to 0.071 rad and R̂s from 0.988 to 1.030 × Rs. Through zero speed
+/// ΔR·i then integrates 0.15 Wb across d in 0.7 s, θ̂ moves with i_q (0.14 rad at i_q ≈ 0, 0.24 rad
+/// at the current limit), i_q* swings between 0 and the limit at 15 Hz, and the passage ends 0.251
+/// / 0.271 rad and 7.3 / 7.5 r/min off at seeds 1 / 2. With the R̂s law off 0.038 / 0.040 rad; with
+/// the coupled law frozen below 3 × the Fig. 3 threshold 0.062 / 0.062 rad, but then `stops` on the
+/// motulator 60 kW IPMSM (whose 4 % plateau lies below that floor) ends 0.36 rad off on seeds 1–4
+/// (0.135 with the law running); at the configured γ instead of the prior's rate the measured
+/// PM-SyRM map does not converge from 1.4 × Rs (`saturated_rs_convergence`). A 3 s ramp passes
+/// (0.096 / 0.10 rad) but leaves the law's miss in place.
+#[test]
+#[ignore = "open: the coupled-point R̂s law learns +3 % of Rs while the rotor decelerates towards zero speed (0.251 / 0.271 rad)"]
+fn a_heavy_saturated_rotor_reverses_under_its_rated_torque() {
+    for seed in [1, 2] {
+        let (passed, max_error, _) = heavy_saturated_rotor("rated-reversal", seed, None);
+        assert!(passed && max_error < 0.15, "seed {seed}: {max_error}");
+    }
+}
+
 /// A drawn 116 kW IPMSM (draw seed 202: 2 pole pairs, Lq/Ld 1.30, 25.2 kg·m², 668 N·m rated)
 /// whose release hold is slow, ω_h = 8.5 rad/s: the rated load's catch lasts
 /// (2 + √2)/ω_h = 0.40 s, the rotor swinging between −8.6 and +7 r/min. The standstill probe
