@@ -362,6 +362,7 @@ fn a_heavy_surface_magnet_rotor_holds_its_angle_through_stops() {
     }
 }
 
+<<<<<<< HEAD
 /// Rotors whose rated load outruns their sampling: the release hold's design
 /// (`fado_core::control::release_hold`) needs a current loop of 10·ω_h beyond the cap
 /// `MAX_CURRENT_WC_TS`·(1/Ts), and the rated load then moves the rotor by 0.27·a/ω_h² with ω_h
@@ -391,5 +392,57 @@ fn rotors_whose_rated_load_outruns_their_sampling_fall_within_the_capped_travel(
                 "{name} seed {seed}: {back} rad back"
             );
         }
+=======
+/// `fullrange` on the drawn 12 kW, 1-pole-pair saturated IPMSM (draw seed 505, 3.2 g·m²) at
+/// sensor `seed`: its verdict, max |θ − θ̂| (rad), the rotor's motion before ready (rad) and
+/// the gain calibration's status.
+fn one_pole_pair_fullrange(seed: u64) -> (bool, f64, f64, Option<String>) {
+    let text = format!(
+        "{}\n[current_sensor]\nseed = {seed}\n",
+        drawn("ipm-sat-1p-800v-12423w")
+    );
+    let out = simulate("fullrange", Some(&text), false, None).unwrap();
+    let st = &out.startup;
+    println!(
+        "seed {seed}: {} max |θ − θ̂| {:.3} rad, moved {:.3} rad before ready at {:?} s, {:?}",
+        out.passed,
+        out.metrics.max_angle_error,
+        st.motion_before_ready,
+        st.ready_time,
+        st.gain_calibration
+    );
+    (
+        out.passed,
+        out.metrics.max_angle_error,
+        st.motion_before_ready,
+        st.gain_calibration.clone(),
+    )
+}
+
+/// `fullrange`'s half rated torque rises over 0.7–1.0 s while the gain calibration's upper
+/// level (34 A of d current, the rated current) holds the rotor. The load turns it against the
+/// d current's stiffness at 20–30 r/min, a back-EMF of 0.3–0.4 V against the motion test's
+/// 1.17 V (0.5 % of the rated speed): measured at seeds 1–4, the rotor sags 0.164–0.165 rad
+/// before the release to zero current reads it (`RotorMoved` at 0.78 s), the drive starts
+/// from the aligned angle plus the 0.02 rad the release read, and |θ − θ̂| reaches
+/// 0.263–0.267 rad. Reading the sag from the level's own back-EMF, summed since its current
+/// settled, ends the calibration at 0.745–0.749 s with the rotor 0.053–0.066 rad turned, but
+/// the release hold engaged there under the 0.8 N·m the load has reached (of the 9.6 N·m its
+/// stiffness is designed for) rings at about 65 Hz, its q current swinging ±25–30 A through
+/// zero for 0.15 s, and the rotor creeps forward 0.2–0.3 rad while θ̂ stays: |θ − θ̂|
+/// 0.187–0.356 rad, and on the drawn 17 kW 1-pole-pair IPMSM of draw seed 606 0.33–0.39 rad
+/// where the later reading passes with 0.246 rad. The same ringing follows the release's
+/// `RotorMoved`. With the sum and the hold's design travel at 0.1 or 0.4 rad instead of its
+/// 0.2 (`[controller.release_hold] travel`) both machines stay within 0.07–0.16 rad at these
+/// seeds. Not met; run with `--ignored`.
+#[test]
+#[ignore = "a slowly rising load sags the 1-pole-pair rotor on the d current; the hold then rings"]
+fn a_slowly_rising_load_on_the_d_current_hold_of_a_one_pole_pair_rotor() {
+    for seed in 1..=4 {
+        let (passed, max_error, moved, status) = one_pole_pair_fullrange(seed);
+        assert_eq!(status.as_deref(), Some("RotorMoved"), "seed {seed}");
+        assert!(moved < 0.1, "seed {seed}: moved {moved} rad before ready");
+        assert!(passed && max_error < 0.25, "seed {seed}: {max_error}");
+>>>>>>> calload
     }
 }
