@@ -362,7 +362,6 @@ fn a_heavy_surface_magnet_rotor_holds_its_angle_through_stops() {
     }
 }
 
-<<<<<<< HEAD
 /// Rotors whose rated load outruns their sampling: the release hold's design
 /// (`fado_core::control::release_hold`) needs a current loop of 10·ω_h beyond the cap
 /// `MAX_CURRENT_WC_TS`·(1/Ts), and the rated load then moves the rotor by 0.27·a/ω_h² with ω_h
@@ -392,7 +391,9 @@ fn rotors_whose_rated_load_outruns_their_sampling_fall_within_the_capped_travel(
                 "{name} seed {seed}: {back} rad back"
             );
         }
-=======
+    }
+}
+
 /// `fullrange` on the drawn 12 kW, 1-pole-pair saturated IPMSM (draw seed 505, 3.2 g·m²) at
 /// sensor `seed`: its verdict, max |θ − θ̂| (rad), the rotor's motion before ready (rad) and
 /// the gain calibration's status.
@@ -443,6 +444,5 @@ fn a_slowly_rising_load_on_the_d_current_hold_of_a_one_pole_pair_rotor() {
         assert_eq!(status.as_deref(), Some("RotorMoved"), "seed {seed}");
         assert!(moved < 0.1, "seed {seed}: moved {moved} rad before ready");
         assert!(passed && max_error < 0.25, "seed {seed}: {max_error}");
->>>>>>> calload
     }
 }
