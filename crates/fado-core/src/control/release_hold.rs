@@ -234,6 +234,11 @@ fn loop_gains<T: Real>(omega: T, b: T, ts: T) -> (T, T, T) {
     (kp, kd, omega * omega * omega * ts / b)
 }
 
+/// ω_h at or above this share of the current loop's cap ωc/10 counts as at the cap
+/// (`dead_time.rs`, "At the current loop's cap"): 0.999 \[A\], a rounding margin (the rule
+/// that raises the current loop for the hold puts ω_h at the cap exactly).
+const AT_CAP_SHARE: f64 = 0.999;
+
 /// Peak of t²·e^(−t)/2 (at t = 2): the largest travel of the triple-pole loop per a/ω_h².
 const PEAK_TRAVEL: f64 = 0.270_670_566_473_225_4;
 
@@ -347,6 +352,8 @@ pub struct ReleaseHold<T> {
     resumed: T,
     /// The stiffness for the load the fall reveals (`fall`, [`Softening`](fall::Softening)).
     soft: fall::Softening<T>,
+    /// ω_h is the current loop's cap ωc/10 (`dead_time.rs`, "At the current loop's cap").
+    at_current_cap: bool,
     /// The speed loop's integral of the last sample (A), the torque the hold replaces at its
     /// trigger ([`set_carried`](Self::set_carried)).
     carried: T,
@@ -376,9 +383,8 @@ impl<T: Real> ReleaseHold<T> {
         let b = T::lit(1.5) * p * p * machine.flux_linkage / machine.inertia;
         let release_n = watch::release_window(machine, trigger) / ts;
         let design = design_omega(machine, travel);
-        let omega = design
-            .step_min(T::two_pi() * current_bandwidth_hz / T::lit(10.0))
-            .step_min(T::lit(0.1) / ts);
+        let current_cap = T::two_pi() * current_bandwidth_hz / T::lit(10.0);
+        let omega = design.step_min(current_cap).step_min(T::lit(0.1) / ts);
         let a_rated = p * machine.rated_torque / machine.inertia;
         let share = fall::fall_share(omega, design);
         let (kp, kd, ki_ts) = loop_gains(omega, b, ts);
@@ -434,6 +440,7 @@ impl<T: Real> ReleaseHold<T> {
             fall_gain: share / b,
             max_fall_load: (share * a_rated / b).step_min(i_max),
             soft: fall::Softening::new(a_rated, design, omega * ts, travel),
+            at_current_cap: omega >= current_cap * T::lit(AT_CAP_SHARE),
             carried: T::zero(),
             probing: false,
         })

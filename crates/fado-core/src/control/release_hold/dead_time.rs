@@ -72,7 +72,9 @@ impl<T: Real> ReleaseHold<T> {
     pub fn set_dead_time_voltage(&mut self, dead_time_voltage: T, flux: T, salient: bool) {
         let rate = dead_time_voltage / flux;
         // NaN compares false: the rated stiffness.
-        self.soft.linear = rate > T::lit(DEAD_TIME_RATE_RATIO) * self.stiffness();
+        let outruns = rate > T::lit(DEAD_TIME_RATE_RATIO) * self.stiffness();
+        let capped = self.at_current_cap && rate > T::zero();
+        self.soft.linear = outruns || capped;
         self.soft.keep_damping = self.soft.linear && salient;
     }
 }
