@@ -201,6 +201,28 @@ fn surface_magnet_multirotor_motors_start_under_light_loads() {
     }
 }
 
+/// The cheetah outrunner (30 µH, 21 pole pairs) without a load and under a tenth of its rated
+/// torque: its hold's ω_h is the current loop's cap, and it softens to the load its fall
+/// reveals (`fado_core::control::release_hold`, `dead_time.rs`, "At the current loop's cap").
+/// Measured (backward travel / max |θ − θ̂| from ready, rad, seeds 1–4; at the rated
+/// stiffness in brackets): no load 0.084/0.034, 0.044/0.096, 0.032/0.018, 0.027/0.005
+/// (0.219/0.054, 0.071/0.172, 1.100/0.278, 0.186/0.184), a tenth 0.186/0.046, 0.203/0.016,
+/// 0.178/0.029, 0.180/0.207 (0.267/0.235, 0.201/0.286, 0.047/0.254, 0.315/0.313).
+#[test]
+fn the_cheetah_outrunner_starts_without_a_load_and_under_a_tenth() {
+    let toml = motor("../../motors/outrunner-cheetah-24v.toml");
+    for fraction in [0.0, 0.1] {
+        for seed in 1..=4 {
+            let (passed, back, err) = start(&toml, fraction, seed);
+            println!("cheetah load {fraction} seed {seed}: back {back:.3}, max |θ − θ̂| {err:.3}");
+            assert!(
+                passed,
+                "load {fraction} seed {seed}: back {back}, err {err}"
+            );
+        }
+    }
+}
+
 /// The 5 kW PM-SyRM without a load: the release's transients move its direct angle, the
 /// hold triggers on a slow fall and, at that fall's stiffness, holds the rotor where the
 /// rated load's stiffness swung it. Measured (the scenario's checks: backward travel / max

@@ -116,7 +116,9 @@
 //! Where the inverter's dead-time voltage turns a linear salient model's direct angle faster
 //! than ω_h (the 50 kW IPMSM), a hold armed at a brake's release takes the stiffness for the
 //! load its fall reveals: at the rated stiffness a light load's hold rings through the
-//! dead-time band and loses the estimate (`release_hold/dead_time.rs`).
+//! dead-time band and loses the estimate (`release_hold/dead_time.rs`). So does a linear
+//! model's hold whose ω_h is the current loop's cap (the cheetah outrunner's, ringing at the
+//! current loop's bandwidth).
 //!
 //! # The load the fall reveals
 //! Where the current loop or the sampling caps ω_h, a hold armed at a brake's release watches
