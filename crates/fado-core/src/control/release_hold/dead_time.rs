@@ -48,8 +48,8 @@
 //! brackets): the MAD 5010 kv370 12 of 12 (3), the MAD M6C12 kv150 11 of 12 (2), the T-motor
 //! MN4004 kv300 10 of 12 (1), the MN4006 kv380 10 of 12 (1), the U8 kv150 11 of 12 (3); at
 //! the rated torque every seed passes either way, its figures within 0.01 rad. The machines
-//! that the current loop caps soften through the cap (`fall.rs`) and are unchanged, as is
-//! every preset.
+//! that the current loop caps soften through the cap (`fall.rs`) and are unchanged by that
+//! damping, as is every preset.
 //!
 //! # At the current loop's cap
 //! Where ω_h is the current loop's cap ωc/10 (the rule that raises the current loop for the
