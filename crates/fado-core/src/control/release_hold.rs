@@ -354,8 +354,6 @@ pub struct ReleaseHold<T> {
     resumed: T,
     /// The stiffness for the load the fall reveals (`fall`, [`Softening`](fall::Softening)).
     soft: fall::Softening<T>,
-    /// ω_h is the current loop's cap ωc/10 (`dead_time.rs`, "At the current loop's cap").
-    at_current_cap: bool,
     /// The speed loop's integral of the last sample (A), the torque the hold replaces at its
     /// trigger ([`set_carried`](Self::set_carried)).
     carried: T,
@@ -441,8 +439,13 @@ impl<T: Real> ReleaseHold<T> {
             fall_time: T::zero(),
             fall_gain: share / b,
             max_fall_load: (share * a_rated / b).step_min(i_max),
-            soft: fall::Softening::new(a_rated, design, omega * ts, travel),
-            at_current_cap: omega >= current_cap * T::lit(AT_CAP_SHARE),
+            soft: fall::Softening::new(
+                a_rated,
+                design,
+                omega * ts,
+                travel,
+                omega >= current_cap * T::lit(AT_CAP_SHARE),
+            ),
             carried: T::zero(),
             probing: false,
         })

@@ -101,7 +101,7 @@ impl<T: Real> ReleaseHold<T> {
         let rate = dead_time_voltage / flux;
         // NaN compares false: the rated stiffness.
         let outruns = rate > T::lit(DEAD_TIME_RATE_RATIO) * self.stiffness();
-        let capped = self.at_current_cap && rate > T::zero();
+        let capped = self.soft.at_current_cap && rate > T::zero();
         self.soft.linear = outruns || capped;
         self.soft.keep_damping = self.soft.linear && salient;
     }

@@ -615,7 +615,7 @@ fn a_softened_hold_stiffens_its_damping_once_its_error_passes_the_onset() {
     // K_i·k³); a held angle's error beyond half the 0.2 rad design travel raises K_d by its
     // largest ratio to that onset, up to the capped loop's, and leaves K_p and K_i.
     let (a_rated, design, ts, travel) = (1e4, 116.0, 1e-4, 0.2);
-    let mut soft = fall::Softening::new(a_rated, design, design * ts, travel);
+    let mut soft = fall::Softening::new(a_rated, design, design * ts, travel, false);
     let t = 2e-3;
     soft.soften(0.25 * a_rated * t * t / 2.0, t, design);
     let close = |(kp, kd, ki): (f64, f64, f64), want: (f64, f64, f64)| {
