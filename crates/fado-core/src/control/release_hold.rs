@@ -385,6 +385,7 @@ impl<T: Real> ReleaseHold<T> {
         let design = design_omega(machine, travel);
         let current_cap = T::two_pi() * current_bandwidth_hz / T::lit(10.0);
         let omega = design.step_min(current_cap).step_min(T::lit(0.1) / ts);
+        let at_cap = omega >= current_cap * T::lit(AT_CAP_SHARE);
         let a_rated = p * machine.rated_torque / machine.inertia;
         let share = fall::fall_share(omega, design);
         let (kp, kd, ki_ts) = loop_gains(omega, b, ts);
@@ -439,13 +440,7 @@ impl<T: Real> ReleaseHold<T> {
             fall_time: T::zero(),
             fall_gain: share / b,
             max_fall_load: (share * a_rated / b).step_min(i_max),
-            soft: fall::Softening::new(
-                a_rated,
-                design,
-                omega * ts,
-                travel,
-                omega >= current_cap * T::lit(AT_CAP_SHARE),
-            ),
+            soft: fall::Softening::new(a_rated, design, omega * ts, travel, at_cap),
             carried: T::zero(),
             probing: false,
         })
