@@ -116,7 +116,9 @@
 //! Where the inverter's dead-time voltage turns a linear salient model's direct angle faster
 //! than ω_h (the 50 kW IPMSM), a hold armed at a brake's release takes the stiffness for the
 //! load its fall reveals: at the rated stiffness a light load's hold rings through the
-//! dead-time band and loses the estimate (`release_hold/dead_time.rs`).
+//! dead-time band and loses the estimate (`release_hold/dead_time.rs`). So does a linear
+//! model's hold whose ω_h is the current loop's cap (the cheetah outrunner's, ringing at the
+//! current loop's bandwidth).
 //!
 //! # The load the fall reveals
 //! Where the current loop or the sampling caps ω_h, a hold armed at a brake's release watches
@@ -246,6 +248,11 @@ fn loop_gains<T: Real>(omega: T, b: T, ts: T) -> (T, T, T) {
     let (kp, kd) = (T::lit(3.0) * omega * omega / b, T::lit(3.0) * omega / b);
     (kp, kd, omega * omega * omega * ts / b)
 }
+
+/// ω_h at or above this share of the current loop's cap ωc/10 counts as at the cap
+/// (`dead_time.rs`, "At the current loop's cap"): 0.999 \[A\], a rounding margin (the rule
+/// that raises the current loop for the hold puts ω_h at the cap exactly).
+const AT_CAP_SHARE: f64 = 0.999;
 
 /// Peak of t²·e^(−t)/2 (at t = 2): the largest travel of the triple-pole loop per a/ω_h².
 const PEAK_TRAVEL: f64 = 0.270_670_566_473_225_4;
@@ -389,9 +396,9 @@ impl<T: Real> ReleaseHold<T> {
         let b = T::lit(1.5) * p * p * machine.flux_linkage / machine.inertia;
         let release_n = watch::release_window(machine, trigger) / ts;
         let design = design_omega(machine, travel);
-        let omega = design
-            .step_min(T::two_pi() * current_bandwidth_hz / T::lit(10.0))
-            .step_min(T::lit(0.1) / ts);
+        let current_cap = T::two_pi() * current_bandwidth_hz / T::lit(10.0);
+        let omega = design.step_min(current_cap).step_min(T::lit(0.1) / ts);
+        let at_cap = omega >= current_cap * T::lit(AT_CAP_SHARE);
         let a_rated = p * machine.rated_torque / machine.inertia;
         let share = fall::fall_share(omega, design);
         let (kp, kd, ki_ts) = loop_gains(omega, b, ts);
@@ -446,7 +453,7 @@ impl<T: Real> ReleaseHold<T> {
             fall_time: T::zero(),
             fall_gain: share / b,
             max_fall_load: (share * a_rated / b).step_min(i_max),
-            soft: fall::Softening::new(a_rated, design, omega * ts, travel),
+            soft: fall::Softening::new(a_rated, design, omega * ts, travel, at_cap),
             carried: T::zero(),
             probing: false,
         })

@@ -180,12 +180,15 @@ pub(super) struct Softening<T> {
     /// A salient rotor's [`linear`](Self::linear) hold keeps the fall's damping at any error
     /// ([`STIFFEN_ONSET_RATIO`]).
     pub(super) keep_damping: bool,
+    /// ω_h is the current loop's cap ωc/10 (`dead_time.rs`, "At the current loop's cap").
+    pub(super) at_current_cap: bool,
 }
 
 impl<T: Real> Softening<T> {
     /// For the rated load's acceleration `a_rated` (electrical rad/s²), the design's ω_h
-    /// `design`, the loop's ω_h·Ts `omega_ts` and the design travel `travel` (rad).
-    pub(super) fn new(a_rated: T, design: T, omega_ts: T, travel: T) -> Self {
+    /// `design`, the loop's ω_h·Ts `omega_ts`, the design travel `travel` (rad) and whether
+    /// ω_h is the current loop's cap (`at_current_cap`).
+    pub(super) fn new(a_rated: T, design: T, omega_ts: T, travel: T, at_current_cap: bool) -> Self {
         Self {
             a_rated,
             design,
@@ -193,6 +196,7 @@ impl<T: Real> Softening<T> {
             k: T::one(),
             linear: false,
             keep_damping: false,
+            at_current_cap,
             onset: T::lit(STIFFEN_ONSET_RATIO) * travel,
             peak: T::zero(),
         }

@@ -615,7 +615,7 @@ fn a_softened_hold_stiffens_its_damping_once_its_error_passes_the_onset() {
     // K_i·k³); a held angle's error beyond half the 0.2 rad design travel raises K_d by its
     // largest ratio to that onset, up to the capped loop's, and leaves K_p and K_i.
     let (a_rated, design, ts, travel) = (1e4, 116.0, 1e-4, 0.2);
-    let mut soft = fall::Softening::new(a_rated, design, design * ts, travel);
+    let mut soft = fall::Softening::new(a_rated, design, design * ts, travel, false);
     let t = 2e-3;
     soft.soften(0.25 * a_rated * t * t / 2.0, t, design);
     let close = |(kp, kd, ki): (f64, f64, f64), want: (f64, f64, f64)| {
@@ -685,6 +685,11 @@ fn a_release_hold_on_a_saturating_model_takes_over_the_speed_loops_torque() {
 /// A rigid rotor θ̈ = b·(i − i_L) released at rest under `fraction` of the rated load, the
 /// hold armed at the release with the dead-time voltage `v_dt` (V): the largest travel.
 fn release_travel(fraction: f64, v_dt: f64) -> f64 {
+    release_travel_at(fraction, v_dt, 250.0)
+}
+
+/// [`release_travel`] with the current loop's bandwidth `current_hz` (Hz).
+fn release_travel_at(fraction: f64, v_dt: f64, current_hz: f64) -> f64 {
     let m = MachineModel::paper();
     let ts = 1e-4;
     let tuning = ReleaseHoldTuning {
@@ -693,7 +698,7 @@ fn release_travel(fraction: f64, v_dt: f64) -> f64 {
     };
     let (b, i_rated) = rigid_rotor(&m);
     let i_load = fraction * i_rated;
-    let mut h = ReleaseHold::new(&tuning, &m, ts, 250.0, 2.0 * i_rated).unwrap();
+    let mut h = ReleaseHold::new(&tuning, &m, ts, current_hz, 2.0 * i_rated).unwrap();
     h.set_dead_time_voltage(v_dt, m.flux_linkage, true);
     let (mut theta, mut omega, mut i) = (0.3, 0.0, 0.0);
     h.arm_at_release(0.3);
@@ -726,4 +731,22 @@ fn a_dead_time_voltage_that_turns_the_direct_angle_faster_than_the_hold_softens_
     // The rated load is held at the rated stiffness either way.
     let rated = release_travel(1.0, 100.0);
     assert!((rated - release_travel(1.0, 1.0)).abs() < 0.02, "{rated}");
+}
+
+#[test]
+fn a_hold_at_the_current_loops_cap_softens_for_any_dead_time_voltage() {
+    // The paper's rotor, ω_h = 72 rad/s of its design: a current loop of 10·ω_h puts the
+    // loop at its cap, where a dead-time voltage far below λ̂f·ω_h softens it too (module
+    // docs of `dead_time.rs`, "At the current loop's cap"); 5 % above it, or without a
+    // dead-time voltage, the quarter load keeps the rated stiffness.
+    let m: MachineModel<f64> = MachineModel::paper();
+    let tuning: ReleaseHoldTuning<f64> = ReleaseHoldTuning::default();
+    let at_cap = 10.0 * super::design_omega(&m, tuning.travel) / core::f64::consts::TAU;
+    let stiff = release_travel(0.25, 1.0);
+    let capped = release_travel_at(0.25, 1.0, at_cap);
+    assert!(capped > 0.15 && capped < 0.25, "{capped} {stiff}");
+    let above = release_travel_at(0.25, 1.0, 1.05 * at_cap);
+    assert!((above - stiff).abs() < 0.01, "{above} {stiff}");
+    let none = release_travel_at(0.25, 0.0, at_cap);
+    assert!((none - stiff).abs() < 0.01, "{none} {stiff}");
 }
