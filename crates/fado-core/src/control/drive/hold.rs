@@ -18,11 +18,11 @@ use crate::{Dq, Real};
 /// is below 1.5: the 400 W servo's bare rotor has 1.72 (t_r 0.49 ms at 10 kHz, ωc = 3.5·10³
 /// s⁻¹), and its floor raised at the opening is in time (`loaded-start` 0.255–0.312 rad back at
 /// seeds 1–4); with its loop at ωc·Ts = 0.2 it has 0.99 and, the floor raised at the opening,
-/// ran 0.863 rad back at seed 2 (0.458 with the floor at the brake). The capped multirotor, tool and 750 W servo motors (1.77–1.88) keep the floor
-/// from the opening. A bound between the two, measured, not derived: with the floor on at
-/// the brake on every rotor, the Flipsky 6215 multirotor motor (2.3) ran back 2.07 rad
-/// instead of 0.24 at `loaded-start` seed 4, and the MAD 5010 kv110 kept 0.261 rad of
-/// |θ − θ̂| instead of 0.164 at seed 2.
+/// runs 0.863 rad back at seed 2 (0.458 with the floor at the brake). The capped multirotor,
+/// tool and 750 W servo motors (1.77–1.88) keep the floor from the opening. A bound between
+/// the two, measured, not derived: with the floor on at the brake on every rotor, the Flipsky
+/// 6215 multirotor motor (2.3) runs back 2.07 rad instead of 0.24 at `loaded-start` seed 4,
+/// and the MAD 5010 kv110 keeps 0.261 rad of |θ − θ̂| instead of 0.164 at seed 2.
 const FLOOR_AT_BRAKE_RISE: f64 = 1.5;
 
 /// The release's d-current floor is on while a brake holds the rotor after the start-up
