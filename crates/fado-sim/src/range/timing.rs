@@ -30,6 +30,7 @@
 use super::{limits, max_torque};
 use crate::config::SimConfig;
 use crate::profile::Profile;
+use fado_core::control::RatingsLimit;
 
 /// Margin on the ideal drive's lag behind the reference: 1.25 \[A\] (the plant's saturation, losses and the
 /// dead time take torque the steady-state model gives).
@@ -93,20 +94,17 @@ impl IdealRotor {
         let points = 200;
         let table_step = top / points as f64;
         let share = saturated_share(cfg, i_max);
-        // The drive's own bounds from the ratings (`[controller.limits]`): the torque and the
-        // power its speed loop may ask for, whichever is lower than the model's.
-        let ratings = &cfg.controller.limits;
-        let rated_power = m.rated_torque * m.rated_speed_rpm * std::f64::consts::TAU / 60.0;
+        // The drive's own bounds from the ratings (`[controller.limits]`, the drive's
+        // `RatingsLimit` in amperes of τ, T = 1.5·p·λ̂f·τ): the torque and the power its speed
+        // loop may ask for, whichever is lower than the model's.
+        let ratings = RatingsLimit::new(&cfg.controller.limits, &m).ok();
+        let kt = 1.5 * pole_pairs * m.flux_linkage;
         let table = (0..=points)
             .map(|k| {
-                let w = k as f64 * table_step;
-                let model = share * max_torque(cfg, pole_pairs * w, i_max, v_max);
-                let power = if w > 0.0 {
-                    ratings.power_ratio * rated_power / w
-                } else {
-                    f64::INFINITY
-                };
-                model.min(ratings.torque_ratio * m.rated_torque).min(power)
+                let w_e = pole_pairs * k as f64 * table_step;
+                let model = share * max_torque(cfg, w_e, i_max, v_max);
+                let drive = ratings.map_or(f64::INFINITY, |r| kt * r.torque(f64::INFINITY, w_e));
+                model.min(drive)
             })
             .collect();
         Self {
