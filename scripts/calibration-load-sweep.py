@@ -90,7 +90,7 @@ def phase_at(rows, t, ready):
         return "ready"
     seen_current = False
     for r in rows:
-        if abs(float(r["i_d_ref"])) + abs(float(r["i_q_ref"])) > 1e-6 or abs(float(r["i_d"])) > 0.05 * 1:
+        if abs(float(r["i_d_ref"])) + abs(float(r["i_q_ref"])) > 1e-6 or abs(float(r["i_d"])) > 0.05:
             seen_current = True
         if float(r["time"]) >= t:
             break

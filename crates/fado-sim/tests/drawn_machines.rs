@@ -369,7 +369,7 @@ fn a_heavy_surface_magnet_rotor_holds_its_angle_through_stops() {
 /// 448 rad/s) and the Estun 400 W servo's bare rotor (`tests/data/unseen/`, 10 kHz, ω_d =
 /// 470 rad/s) stay within 1.75 times the 0.2 rad design travel, the share the hold's current
 /// rule allows a capped loop: 0.20–0.23 and 0.26–0.31 rad at seeds 1–4 with the loop capped at
-/// ωc·Ts = 0.35; at 0.2 they ran 0.34–0.38 and 0.44–0.46 rad back.
+/// ωc·Ts = 0.35; at 0.2 they run 0.34–0.38 and 0.44–0.46 rad back.
 #[test]
 fn rotors_whose_rated_load_outruns_their_sampling_fall_within_the_capped_travel() {
     for (dir, name) in [
